@@ -1,0 +1,19 @@
+"""hamilton-orbits: celestial mechanics on Hamilton's quaternion core.
+
+The curated public API.  Everything not listed in ``__all__`` is private.
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from hamilton_orbits.quaternion import Quaternion, slerp
+
+try:
+    __version__ = version("hamilton-orbits")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0.0.0+unknown"
+
+__all__ = [
+    "Quaternion",
+    "__version__",
+    "slerp",
+]

@@ -1,0 +1,1 @@
+"""Numba-compiled kernels on plain floats.  Nothing here imports astropy."""

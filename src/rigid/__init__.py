@@ -1,0 +1,6 @@
+"""rigid: rigid-body attitude dynamics on the hamilton_orbits quaternion core.
+
+Cayley (1843) and Sylvester (1866) made executable.  The curated public API.
+"""
+
+__all__: list[str] = []
