@@ -1,0 +1,119 @@
+"""Input validation shared by every public entry point.
+
+Every check raises :class:`ValueError` naming the argument, the (first) offending
+index and the value, as the project's conventions require.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class ConvergenceError(ValueError):
+    """An iterative solver did not reach its tolerance (never a silent NaN)."""
+
+
+def _first_index(mask: np.ndarray) -> tuple[int, ...]:
+    idx = np.argwhere(mask)[0]
+    return tuple(int(i) for i in idx)
+
+
+def _fmt_index(index: tuple[int, ...]) -> str:
+    if len(index) == 0:
+        return ""
+    return " at index " + (str(index[0]) if len(index) == 1 else str(index))
+
+
+def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
+    """Convert ``value`` to a float64 array and reject NaN / inf.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, used in the error message.
+    value : array_like
+        Anything :func:`numpy.asarray` takes (plain numbers; Quantities must be
+        converted to floats at the unit boundary before this call).
+    finite : bool, optional
+        If True (default), NaN and inf raise.
+
+    Raises
+    ------
+    ValueError
+        If a value is NaN or infinite, naming the argument, index and value.
+
+    Examples
+    --------
+    >>> as_float_array("x", [1.0, 2.0])
+    array([1., 2.])
+    >>> as_float_array("x", [1.0, float("nan")])
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `x` to be finite, got nan at index 1
+    """
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"Expected `{name}` to be numeric, got {value!r}") from exc
+    if finite:
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            index = _first_index(bad) if arr.ndim else ()
+            raise ValueError(
+                f"Expected `{name}` to be finite, got {arr[index]!r}{_fmt_index(index)}"
+            )
+    return arr
+
+
+def check_trailing(name: str, arr: np.ndarray, size: int) -> np.ndarray:
+    """Require ``arr.shape == (..., size)``.
+
+    Examples
+    --------
+    >>> check_trailing("v", np.zeros(2), 3)
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `v` to have shape (..., 3), got (2,)
+    """
+    if arr.ndim == 0 or arr.shape[-1] != size:
+        raise ValueError(f"Expected `{name}` to have shape (..., {size}), got {arr.shape}")
+    return arr
+
+
+def check_positive(name: str, arr: np.ndarray, *, strict: bool = True) -> np.ndarray:
+    """Require ``arr > 0`` (or ``>= 0`` with ``strict=False``) elementwise.
+
+    Examples
+    --------
+    >>> check_positive("mu", np.array([1.0, -2.0]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `mu` > 0, got -2.0 at index 1
+    """
+    bad = ~(arr > 0) if strict else ~(arr >= 0)
+    if np.any(bad):
+        index = _first_index(np.atleast_1d(bad)) if arr.ndim else ()
+        value = arr[index] if arr.ndim else arr
+        op = ">" if strict else ">="
+        raise ValueError(f"Expected `{name}` {op} 0, got {float(value)!r}{_fmt_index(index)}")
+    return arr
+
+
+def broadcast(names: tuple[str, ...], *arrays: np.ndarray) -> list[np.ndarray]:
+    """Broadcast arrays together, naming them if their shapes are incompatible.
+
+    Examples
+    --------
+    >>> broadcast(("a", "b"), np.zeros(2), np.zeros(3))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `a`, `b` to broadcast together, got shapes (2,), (3,)
+    """
+    try:
+        return list(np.broadcast_arrays(*arrays))
+    except ValueError as exc:
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        names_s = ", ".join(f"`{n}`" for n in names)
+        raise ValueError(
+            f"Expected {names_s} to broadcast together, got shapes {shapes}"
+        ) from exc
