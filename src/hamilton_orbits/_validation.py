@@ -60,7 +60,7 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
         if bad.any():
             index = _first_index(bad) if arr.ndim else ()
             raise ValueError(
-                f"Expected `{name}` to be finite, got {arr[index]!r}{_fmt_index(index)}"
+                f"Expected `{name}` to be finite, got {float(arr[index])!r}{_fmt_index(index)}"
             )
     return arr
 

@@ -1,0 +1,153 @@
+"""Compiled quaternion kernels: Hamilton's product and rotation on plain floats.
+
+Scalar-first components ``(w, x, y, z)``.  The scalar building blocks
+:func:`qmul` and :func:`qrot` are inlined into every kernel that needs them,
+here and in other modules; the generalised ufuncs broadcast over leading
+dimensions without copies.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import guvectorize, njit
+
+
+@njit(inline="always", cache=True)
+def qmul(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
+    """Hamilton product ``a b`` of two quaternions given by components.
+
+    With a = (s, alpha), b = (t, beta): ab = (st - alpha.beta, s beta + t alpha
+    + alpha x beta), i.e. for pure vectors alpha beta = -alpha.beta + alpha x beta
+    (Hamilton 1845; REFERENCES.md).
+    """
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
+@njit(inline="always", cache=True)
+def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
+    """``q v q^-1`` for any nonzero ``q`` (the scale of ``q`` cancels).
+
+    Uses v' = v + (2/|q|^2) (w (u x v) + u x (u x v)) with u the vector part,
+    which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
+    """
+    n2 = w * w + x * x + y * y + z * z
+    cx = y * vz - z * vy
+    cy = z * vx - x * vz
+    cz = x * vy - y * vx
+    ccx = y * cz - z * cy
+    ccy = z * cx - x * cz
+    ccz = x * cy - y * cx
+    s = 2.0 / n2
+    return (
+        vx + s * (w * cx + ccx),
+        vy + s * (w * cy + ccy),
+        vz + s * (w * cz + ccz),
+    )
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
+)
+def qmul_gufunc(a, b, out):  # pragma: no cover - compiled
+    """Generalised ufunc: Hamilton product over leading dimensions."""
+    w, x, y, z = qmul(a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3])
+    out[0] = w
+    out[1] = x
+    out[2] = y
+    out[3] = z
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:])"], "(n),(m)->(m)", cache=True, nopython=True
+)
+def qrot_gufunc(q, v, out):  # pragma: no cover - compiled
+    """Generalised ufunc: ``q v q^-1`` over leading dimensions."""
+    x, y, z = qrot(q[0], q[1], q[2], q[3], v[0], v[1], v[2])
+    out[0] = x
+    out[1] = y
+    out[2] = z
+
+
+@njit(cache=True)
+def to_matrix_flat(q, out):  # pragma: no cover - compiled
+    """Rotation matrices of ``q`` (N, 4) into ``out`` (N, 3, 3); any nonzero scale."""
+    for i in range(q.shape[0]):
+        w = q[i, 0]
+        x = q[i, 1]
+        y = q[i, 2]
+        z = q[i, 3]
+        s = 2.0 / (w * w + x * x + y * y + z * z)
+        xx = s * x * x
+        yy = s * y * y
+        zz = s * z * z
+        xy = s * x * y
+        xz = s * x * z
+        yz = s * y * z
+        wx = s * w * x
+        wy = s * w * y
+        wz = s * w * z
+        out[i, 0, 0] = 1.0 - (yy + zz)
+        out[i, 0, 1] = xy - wz
+        out[i, 0, 2] = xz + wy
+        out[i, 1, 0] = xy + wz
+        out[i, 1, 1] = 1.0 - (xx + zz)
+        out[i, 1, 2] = yz - wx
+        out[i, 2, 0] = xz - wy
+        out[i, 2, 1] = yz + wx
+        out[i, 2, 2] = 1.0 - (xx + yy)
+
+
+@njit(cache=True)
+def from_matrix_flat(m, out):  # pragma: no cover - compiled
+    """Unit quaternions (canonical sign, w >= 0) of rotation matrices ``m`` (N, 3, 3).
+
+    Shepperd's method: take the largest of 1 + trace and 1 + 2 R_ii - trace to
+    avoid dividing by a small number (Shepperd 1978, J. Guid. Control 1, 223).
+    """
+    for i in range(m.shape[0]):
+        r00 = m[i, 0, 0]
+        r11 = m[i, 1, 1]
+        r22 = m[i, 2, 2]
+        tr = r00 + r11 + r22
+        k = 0
+        big = tr
+        if r00 > big:
+            big = r00
+            k = 1
+        if r11 > big:
+            big = r11
+            k = 2
+        if r22 > big:
+            k = 3
+        if k == 0:
+            w = 1.0 + tr
+            x = m[i, 2, 1] - m[i, 1, 2]
+            y = m[i, 0, 2] - m[i, 2, 0]
+            z = m[i, 1, 0] - m[i, 0, 1]
+        elif k == 1:
+            w = m[i, 2, 1] - m[i, 1, 2]
+            x = 1.0 + 2.0 * r00 - tr
+            y = m[i, 0, 1] + m[i, 1, 0]
+            z = m[i, 0, 2] + m[i, 2, 0]
+        elif k == 2:
+            w = m[i, 0, 2] - m[i, 2, 0]
+            x = m[i, 0, 1] + m[i, 1, 0]
+            y = 1.0 + 2.0 * r11 - tr
+            z = m[i, 1, 2] + m[i, 2, 1]
+        else:
+            w = m[i, 1, 0] - m[i, 0, 1]
+            x = m[i, 0, 2] + m[i, 2, 0]
+            y = m[i, 1, 2] + m[i, 2, 1]
+            z = 1.0 + 2.0 * r22 - tr
+        n = np.sqrt(w * w + x * x + y * y + z * z)
+        if w < 0.0:
+            n = -n
+        out[i, 0] = w / n
+        out[i, 1] = x / n
+        out[i, 2] = y / n
+        out[i, 3] = z / n
