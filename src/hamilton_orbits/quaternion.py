@@ -481,10 +481,10 @@ class Quaternion:
         vn = _norm_last(v)
         # atan2(|v|, w)/|v|: for |v| << w use the series of atan(x)/x, x = |v|/w.
         small = (vn <= _SERIES * w) & (w > 0)
-        safe_w = np.where(w > 0, w, 1.0)
-        x2 = (vn / safe_w) ** 2
+        w_s = np.where(small, w, 1.0)
+        x2 = (np.where(small, vn, 0.0) / w_s) ** 2
         safe_vn = np.where(vn > 0, vn, 1.0)
-        factor = np.where(small, (1.0 - x2 / 3.0) / safe_w, np.arctan2(vn, w) / safe_vn)
+        factor = np.where(small, (1.0 - x2 / 3.0) / w_s, np.arctan2(vn, w) / safe_vn)
         a = np.empty(self._a.shape)
         a[..., 0] = np.log(n)
         a[..., 1:] = factor[..., None] * v
@@ -513,10 +513,9 @@ class Quaternion:
                [-1.,  0.,  0.]])
         """
         v = check_trailing("vectors", as_float_array("vectors", vectors), 3)
-        out = qrot_gufunc(self._a, v)
-        if not np.all(np.isfinite(out)):
+        if not np.all(np.any(self._a != 0, axis=-1)):
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
-        return out
+        return qrot_gufunc(self._a, v)
 
     def canonical(self) -> Quaternion:
         """The same rotation with the sign chosen so that w > 0 (or, if w == 0,

@@ -1,0 +1,374 @@
+"""Tests of Hamilton's quaternion core (issue 2).
+
+References
+----------
+Hamilton, W. R. (1845), "On the application of the method of quaternions to some
+dynamical questions" (seed; equation numbers below are his).
+Cayley, A. (1843), "On the motion of rotation of a solid body" (seed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy.spatial.transform import Rotation
+
+from hamilton_orbits import Quaternion, slerp
+
+EPS = np.finfo(float).eps
+rng = np.random.default_rng(20261122)
+
+finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
+quat_arrays = arrays(np.float64, (4,), elements=finite).filter(
+    lambda a: np.linalg.norm(a) > 1e-3
+)
+vec_arrays = arrays(np.float64, (3,), elements=finite)
+
+
+def random_unit(n: int) -> Quaternion:
+    return Quaternion.from_array(rng.normal(size=(n, 4))).unit()
+
+
+# ---------------------------------------------------------------- Hamilton's algebra
+def test_hamilton_units_square_to_minus_one():
+    """i^2 = j^2 = k^2 = ijk = -1 (Hamilton's defining relations)."""
+    one = np.array([1.0, 0, 0, 0])
+    i, j, k = Quaternion.from_array(np.eye(4)[1:])
+    for u in (i, j, k):
+        np.testing.assert_array_equal((u * u).as_array(), -one)
+    np.testing.assert_array_equal((i * j * k).as_array(), -one)
+    np.testing.assert_array_equal((i * j).as_array(), k.as_array())
+    np.testing.assert_array_equal((j * i).as_array(), -k.as_array())
+
+
+@settings(deadline=None, max_examples=200)
+@given(vec_arrays, vec_arrays)
+def test_product_of_vectors(a, b):
+    """For pure quaternions alpha beta = -alpha.beta + alpha x beta; alpha^2 = -|alpha|^2."""
+    qa, qb = Quaternion.from_vector(a), Quaternion.from_vector(b)
+    prod = (qa * qb).as_array()
+    scale = np.linalg.norm(a) * np.linalg.norm(b) + 1e-300
+    assert abs(prod[0] + np.dot(a, b)) <= 4 * EPS * scale
+    np.testing.assert_allclose(prod[1:], np.cross(a, b), rtol=0, atol=4 * EPS * scale)
+    sq = (qa * qa).as_array()
+    assert abs(sq[0] + np.dot(a, a)) <= 2 * EPS * np.dot(a, a)
+    np.testing.assert_array_equal(sq[1:], 0.0)
+
+
+@settings(deadline=None, max_examples=200)
+@given(vec_arrays, vec_arrays)
+def test_identity_39(d, e):
+    """Hamilton's (39): ((de + ed)/2)^2 = ((de - ed)/2)^2 + d^2 e^2, via quaternion products."""
+    qd, qe = Quaternion.from_vector(d), Quaternion.from_vector(e)
+    sym = (qd * qe + qe * qd) * 0.5
+    anti = (qd * qe - qe * qd) * 0.5
+    lhs = (sym * sym).as_array()
+    rhs = (anti * anti + (qd * qd) * (qe * qe)).as_array()
+    scale = (np.dot(d, d) * np.dot(e, e)) + 1e-300
+    # each side is a handful of rounded products of magnitude <= |d|^2|e|^2
+    np.testing.assert_allclose(lhs, rhs, rtol=0, atol=16 * EPS * scale)
+
+
+@settings(deadline=None, max_examples=200)
+@given(quat_arrays, quat_arrays, quat_arrays)
+def test_associative_and_multiplicative_norm(a, b, c):
+    """(pq)r = p(qr) and |pq| = |p||q| (the law of the moduli)."""
+    p, q, r = Quaternion(a), Quaternion(b), Quaternion(c)
+    scale = np.linalg.norm(a) * np.linalg.norm(b) * np.linalg.norm(c)
+    np.testing.assert_allclose(
+        ((p * q) * r).as_array(), (p * (q * r)).as_array(), rtol=0, atol=16 * EPS * scale
+    )
+    assert abs((p * q).norm() - p.norm() * q.norm()) <= 8 * EPS * p.norm() * q.norm()
+
+
+def test_product_broadcasts():
+    p = random_unit(5)
+    q = Quaternion.from_array(rng.normal(size=(3, 1, 4)))
+    pq = q * p
+    assert pq.shape == (3, 5)
+    np.testing.assert_array_equal(pq[2, 4].as_array(), (q[2, 0] * p[4]).as_array())
+
+
+# ---------------------------------------------------------------- Cayley 1843
+def cayley_direction_cosines(lam, mu, nu):
+    """Cayley's rational direction cosines: columns (alpha, alpha', alpha'') etc."""
+    kappa = 1 + lam**2 + mu**2 + nu**2
+    alpha = np.array([1 + lam**2 - mu**2 - nu**2, 2 * (lam * mu + nu), 2 * (nu * lam - mu)])
+    beta = np.array([2 * (lam * mu - nu), 1 + mu**2 - nu**2 - lam**2, 2 * (mu * nu + lam)])
+    gamma = np.array([2 * (nu * lam + mu), 2 * (mu * nu - lam), 1 + nu**2 - lam**2 - mu**2])
+    # alpha = cos(x1, x), alpha' = cos(x1, y), alpha'' = cos(x1, z): the new x1 axis
+    # in the old frame, so (alpha, alpha', alpha'') is the first column.
+    return np.stack([alpha, beta, gamma], axis=1) / kappa
+
+
+@settings(deadline=None, max_examples=200)
+@given(arrays(np.float64, (3,), elements=st.floats(-50, 50)))
+def test_cayley_direction_cosines(g):
+    """kappa alpha = 1 + lambda^2 - mu^2 - nu^2 and the rest, against as_rotation_matrix."""
+    R = Quaternion.from_gibbs(g).as_rotation_matrix()
+    np.testing.assert_allclose(R, cayley_direction_cosines(*g), rtol=0, atol=8 * EPS)
+
+
+def cayley_compose(a, b):
+    """Cayley's (Pi) formulas for the Rodrigues parameters of the combined displacement.
+
+    Pi = 1 - l l1 - m m1 - n n1, Pi lambda = l + l1 + n1 m - n m1, and cyclically.
+    The seed's transcription prints the last terms of the mu and nu lines as
+    ``l m1`` and ``m n1``; the cyclic substitution l -> m -> n that Cayley states
+    for these formulas gives ``l n1`` and ``m l1``, which is what is used here.
+    """
+    l, m, n = a
+    l1, m1, n1 = b
+    pi = 1 - l * l1 - m * m1 - n * n1
+    return np.array(
+        [l + l1 + n1 * m - n * m1, m + m1 + l1 * n - l * n1, n + n1 + m1 * l - m * l1]
+    ) / pi
+
+
+@settings(deadline=None, max_examples=200)
+@given(
+    arrays(np.float64, (3,), elements=st.floats(-3, 3)),
+    arrays(np.float64, (3,), elements=st.floats(-3, 3)),
+)
+def test_cayley_composition_is_the_hamilton_product(a, b):
+    """Cayley's composition equals q(a) q(b): the displacement b first, then a (active).
+
+    In this package's active convention (v -> q v q^-1) the composite rotation
+    R(a) R(b) applies b first; Cayley's formulas give the Gibbs vector of the
+    Hamilton product q(a) q(b).
+    """
+    pi = 1 - np.dot(a, b)
+    if abs(pi) < 1e-3:  # the composite is near a half-turn: Gibbs vector ill conditioned
+        return
+    q = Quaternion.from_gibbs(a) * Quaternion.from_gibbs(b)
+    expected = cayley_compose(a, b)
+    cond = (1 + np.dot(expected, expected)) * (1 + np.dot(a, a)) * (1 + np.dot(b, b))
+    np.testing.assert_allclose(q.as_gibbs(), expected, rtol=0, atol=32 * EPS * cond)
+    Ra = Quaternion.from_gibbs(a).as_rotation_matrix()
+    Rb = Quaternion.from_gibbs(b).as_rotation_matrix()
+    np.testing.assert_allclose(q.as_rotation_matrix(), Ra @ Rb, rtol=0, atol=16 * EPS)
+
+
+def test_cayley_composition_known_values():
+    """Two quarter-turns about x and y: hand-derived Gibbs vector of the composite.
+
+    a = (1, 0, 0) (90 deg about x), b = (0, 1, 0) (90 deg about y):
+    Pi = 1, (lambda, mu, nu) = (1, 1, 0) + a x b = (1, 1, 1): a 120 deg turn about (1,1,1).
+    """
+    q = Quaternion.from_gibbs([1.0, 0, 0]) * Quaternion.from_gibbs([0, 1.0, 0])
+    np.testing.assert_allclose(q.as_gibbs(), [1.0, 1.0, 1.0], rtol=4 * EPS)
+    axis, angle = q.as_axis_angle()
+    assert abs(angle - 2 * np.pi / 3) <= 4 * EPS
+    np.testing.assert_allclose(axis, np.ones(3) / np.sqrt(3), rtol=4 * EPS)
+
+
+# ---------------------------------------------------------------- representations
+def assert_same_rotation_components(back: Quaternion, q: Quaternion, tol: float) -> None:
+    """Componentwise at ``tol``, up to the overall sign (q and -q are one rotation)."""
+    a, b = back.as_array(), q.as_array()
+    err = min(np.max(np.abs(a - b)), np.max(np.abs(a + b)))
+    assert err <= tol, (a, b, err)
+
+
+@settings(deadline=None, max_examples=300)
+@given(quat_arrays)
+def test_round_trips(a):
+    """Every representation round-trips to the same rotation at a few ulp."""
+    q = Quaternion(a).unit().canonical()
+    tol = 8 * EPS
+    assert_same_rotation_components(Quaternion.from_rotation_matrix(q.as_rotation_matrix()), q, tol)
+    axis, angle = q.as_axis_angle()
+    assert_same_rotation_components(Quaternion.from_axis_angle(axis, angle), q, tol)
+    assert_same_rotation_components(Quaternion.from_mrp(q.as_mrp()), q, tol)
+    assert np.linalg.norm(q.as_mrp()) <= 1 + 2 * EPS
+    if q.w > 1e-3:  # away from a half-turn the Gibbs vector is well conditioned
+        assert_same_rotation_components(Quaternion.from_gibbs(q.as_gibbs()), q, tol)
+    assert_same_rotation_components(q.log().exp(), q, tol)
+
+
+def test_round_trips_batched_all_axis_permutations():
+    """Rotations about each axis and its negative, at angles 0 ... 2 pi."""
+    angles = np.linspace(0, 2 * np.pi, 65)
+    for axis in np.vstack([np.eye(3), -np.eye(3)]):
+        q = Quaternion.from_axis_angle(axis, angles)
+        back = Quaternion.from_rotation_matrix(q.as_rotation_matrix())
+        assert np.max(q.rotation_distance(back)) <= 4 * EPS
+
+
+def test_agreement_with_scipy_rotation():
+    """Matrices and rotated vectors agree with scipy.spatial.transform.Rotation."""
+    q = random_unit(1000)
+    v = rng.normal(size=(1000, 3))
+    r = Rotation.from_quat(q.as_array(), scalar_first=True)
+    np.testing.assert_allclose(q.as_rotation_matrix(), r.as_matrix(), rtol=0, atol=4 * EPS)
+    np.testing.assert_allclose(
+        q.rotate(v), r.apply(v), rtol=0, atol=8 * EPS * np.linalg.norm(v, axis=1).max()
+    )
+    np.testing.assert_allclose(q.as_mrp(), r.as_mrp(), rtol=0, atol=4 * EPS)
+    q2 = Quaternion.from_rotation_matrix(r.as_matrix())
+    assert np.max(q.rotation_distance(q2)) <= 4 * EPS
+    axis, angle = q.as_axis_angle()
+    np.testing.assert_allclose(axis * angle[:, None], r.as_rotvec(), rtol=0, atol=16 * EPS)
+
+
+def test_rotate_is_q_v_qinv():
+    """rotate(v) is literally the Hamilton product q v q^-1 (vector part)."""
+    q = Quaternion.from_array(rng.normal(size=(100, 4)))
+    v = rng.normal(size=(100, 3))
+    full = (q * Quaternion.from_vector(v) * q.inverse()).as_array()
+    np.testing.assert_allclose(full[:, 0], 0.0, atol=16 * EPS * np.abs(v).max())
+    np.testing.assert_allclose(q.rotate(v), full[:, 1:], rtol=0, atol=16 * EPS * 10)
+
+
+def test_non_unit_policy():
+    """Non-unit quaternions act as their versor in every rotation method."""
+    q = random_unit(50)
+    s = rng.uniform(1e-5, 1e5, size=50)
+    big = q * s
+    v = rng.normal(size=(50, 3))
+    np.testing.assert_allclose(big.rotate(v), q.rotate(v), rtol=0, atol=16 * EPS * 4)
+    np.testing.assert_allclose(
+        big.as_rotation_matrix(), q.as_rotation_matrix(), rtol=0, atol=8 * EPS
+    )
+    np.testing.assert_allclose(big.as_mrp(), q.as_mrp(), rtol=0, atol=8 * EPS)
+    np.testing.assert_allclose(big.as_gibbs(), q.as_gibbs(), rtol=16 * EPS)
+    assert np.max(big.rotation_distance(q)) <= 4 * EPS
+
+
+# ---------------------------------------------------------------- exp, log, powers, slerp
+@pytest.mark.parametrize("theta", [1e-300, 1e-200, 1e-20, 1e-9, 1e-8, 1e-7, 1e-3, 1.0, 3.0])
+def test_exp_log_small_angles(theta):
+    """exp and log keep full relative accuracy down to angles of 1e-300."""
+    axis = np.array([2.0, -3.0, 6.0]) / 7.0  # exactly representable up to rounding
+    v = axis * theta
+    q = Quaternion.from_vector(v).exp()
+    # exp(v) = (cos|v|, sin|v| v/|v|)
+    np.testing.assert_allclose(q.vector, np.sin(theta) * axis, rtol=4 * EPS)
+    assert abs(q.w - np.cos(theta)) <= 2 * EPS
+    back = q.log()
+    np.testing.assert_allclose(back.vector, v, rtol=8 * EPS)
+    assert abs(back.w) <= 2 * EPS
+
+
+@pytest.mark.parametrize("delta", [1e-15, 1e-12, 1e-8, 1e-4])
+def test_exp_log_near_pi(delta):
+    """log stays accurate near a half-turn: the recovered angle has relative error ~ulp."""
+    theta = np.pi - delta  # the angle of the rotation is 2 theta; |log| = theta
+    axis = np.array([0.0, 0.6, 0.8])
+    q = Quaternion.from_vector(axis * theta).exp()
+    back = q.log()
+    np.testing.assert_allclose(np.linalg.norm(back.vector), theta, rtol=4 * EPS)
+    np.testing.assert_allclose(back.vector / theta, axis, rtol=0, atol=8 * EPS / delta * EPS + 4 * EPS)
+
+
+def test_log_of_negative_real_and_power():
+    """log(-1) = pi i by the documented convention; q^t via exp/log."""
+    lg = Quaternion.from_array([-1.0, 0, 0, 0]).log()
+    np.testing.assert_array_equal(lg.as_array(), [0.0, np.pi, 0.0, 0.0])
+    q = Quaternion.from_axis_angle([0, 0, 1], 0.9)
+    half = q**0.5
+    np.testing.assert_allclose((half * half).as_array(), q.as_array(), rtol=0, atol=4 * EPS)
+    thirds = q ** np.array([0.0, 1 / 3, 1.0])
+    assert thirds.shape == (3,)
+    np.testing.assert_allclose(thirds.as_axis_angle()[1], [0.0, 0.3, 0.9], rtol=4 * EPS)
+
+
+def test_slerp_constant_speed_and_shortest_arc():
+    q0 = Quaternion.from_axis_angle([1, 0, 0], 0.2)
+    q1 = -Quaternion.from_axis_angle([0, 1, 0], 1.1)  # sign must not matter
+    t = np.linspace(0, 1, 11)
+    path = slerp(q0, q1, t)
+    total = q0.rotation_distance(q1)
+    np.testing.assert_allclose(q0.rotation_distance(path), t * total, rtol=0, atol=8 * EPS)
+    assert path[-1].rotation_distance(q1) <= 4 * EPS
+    assert total < np.pi  # shortest arc
+
+
+def test_slerp_tiny_angle():
+    """slerp between rotations 1e-200 rad apart keeps the interpolated angle exact."""
+    q0 = Quaternion.from_array([1.0, 0, 0, 0])
+    q1 = Quaternion.from_axis_angle([0, 0, 1], 1e-200)
+    mid = slerp(q0, q1, 0.5)
+    np.testing.assert_allclose(mid.as_axis_angle()[1], 0.5e-200, rtol=4 * EPS)
+
+
+# ---------------------------------------------------------------- container protocol
+def test_indexing_len_shape_equality():
+    q = Quaternion.from_array(np.arange(24.0).reshape(2, 3, 4))
+    assert q.shape == (2, 3) and q.ndim == 2 and len(q) == 2
+    assert q[1].shape == (3,)
+    assert q[1, 2].shape == ()
+    np.testing.assert_array_equal(q[..., 0].as_array(), q.as_array()[:, 0])
+    np.testing.assert_array_equal(q[1, 2].as_array(), [20.0, 21.0, 22.0, 23.0])
+    with pytest.raises(IndexError, match="too many indices"):
+        q[0, 0, 0]
+    with pytest.raises(TypeError):
+        len(q[0, 0])
+    assert bool(np.all(q == Quaternion(q.as_array().copy())))
+    assert not q.allclose(-q)
+    p = random_unit(4)
+    assert p.rotation_allclose(-p)
+    assert [x.shape for x in p] == [()] * 4
+
+
+# ---------------------------------------------------------------- bad input and hard cases
+def test_zero_quaternion_raises():
+    z = Quaternion.from_array([[1.0, 0, 0, 0], [0.0, 0, 0, 0]])
+    with pytest.raises(ValueError, match="nonzero quaternion at index 1"):
+        z.inverse()
+    with pytest.raises(ValueError, match="nonzero"):
+        z.unit()
+    with pytest.raises(ValueError, match="nonzero"):
+        z.rotate([1.0, 0, 0])
+    with pytest.raises(ValueError, match="nonzero"):
+        z.as_rotation_matrix()
+    with pytest.raises(ValueError, match="nonzero"):
+        z.log()
+
+
+def test_nan_and_inf_raise_with_index():
+    a = np.ones((3, 4))
+    a[2, 1] = np.nan
+    with pytest.raises(ValueError, match=r"`array` to be finite, got nan at index \(2, 1\)"):
+        Quaternion(a)
+    with pytest.raises(ValueError, match="`vector` to be finite, got inf at index 0"):
+        Quaternion.from_vector([np.inf, 0, 0])
+    with pytest.raises(ValueError, match="`angle` to be finite"):
+        Quaternion.from_axis_angle([1, 0, 0], np.nan)
+
+
+def test_wrong_shape_raises():
+    with pytest.raises(ValueError, match=r"Expected `array` to have shape \(\.\.\., 4\), got \(3,\)"):
+        Quaternion([1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"`vectors` to have shape \(\.\.\., 3\), got \(2, 4\)"):
+        Quaternion.from_array([1.0, 0, 0, 0]).rotate(np.zeros((2, 4)))
+    with pytest.raises(ValueError, match=r"`matrix` to have shape \(\.\.\., 3, 3\)"):
+        Quaternion.from_rotation_matrix(np.eye(4))
+    with pytest.raises(ValueError, match="rotation matrix"):
+        Quaternion.from_rotation_matrix(np.diag([1.0, 1.0, -1.0]))
+    with pytest.raises(ValueError, match="nonzero length"):
+        Quaternion.from_axis_angle([0, 0, 0], 1.0)
+
+
+def test_gibbs_near_half_turn_policy():
+    """Finite Gibbs vectors are returned (full relative accuracy); a half-turn raises."""
+    delta = 1e-12
+    # a rotation by pi - delta about z, built from exact components (cos(angle/2)
+    # computed from the angle would itself carry a relative error eps / delta)
+    q = Quaternion.from_array([np.sin(delta / 2), 0, 0, np.cos(delta / 2)])
+    g = q.as_gibbs()
+    # tan((pi - delta)/2) = cot(delta/2)
+    np.testing.assert_allclose(g[2], np.cos(delta / 2) / np.sin(delta / 2), rtol=EPS)
+    half = Quaternion.from_array([[1.0, 0, 0, 0], [0.0, 0.0, 0.0, 1.0]])
+    with pytest.raises(ValueError, match=r"infinite at index 1.*as_mrp"):
+        half.as_gibbs()
+    np.testing.assert_array_equal(half[1].as_mrp(), [0.0, 0.0, 1.0])
+
+
+def test_axis_angle_identity_convention():
+    axis, angle = Quaternion.from_array([1.0, 0, 0, 0]).as_axis_angle()
+    np.testing.assert_array_equal(axis, [1.0, 0.0, 0.0])
+    assert angle == 0.0
