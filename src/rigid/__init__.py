@@ -3,4 +3,7 @@
 Cayley (1843) and Sylvester (1866) made executable.  The curated public API.
 """
 
-__all__: list[str] = []
+
+from rigid.body import RigidBody
+
+__all__: list[str] = ["RigidBody"]
