@@ -1,0 +1,468 @@
+"""Compiled kernels for Euler's equations, the kinematics and the rigid-body integrators.
+
+Plain floats in one consistent unit system (SI when the caller used Quantities);
+no astropy.  Conventions of the ``rigid`` package: the attitude q carries body
+vectors to space (v_s = q v_b q^-1), omega = (p, q, r) is the body-frame angular
+velocity, dq/dt = q (0, omega) / 2 and A p' + (C - B) q r = N_x, cyclically
+(Cayley 1843).
+
+Torques are encoded as ``(kind, params)`` so that the whole time loop stays
+inside one compiled function:
+
+* ``TORQUE_NONE``: no torque.
+* ``TORQUE_BODY``: constant body-frame torque ``params[0:3]``.
+* ``TORQUE_SPACE``: constant space-frame torque ``params[0:3]`` (turned into the
+  body frame by q^-1 N q).
+* ``TORQUE_GRAVITY_GRADIENT``: the gravity-gradient torque of a point mass on a
+  circular orbit, N = 3 (GM/R^3) c x (I c), c the unit vector from the body
+  towards the primary in the body frame.  ``params = [GM/R^3, n, phase, e1 (3),
+  e2 (3)]``: in space c_s(t) = cos(n t + phase) e1 + sin(n t + phase) e2.
+
+All of these depend on (t, q) only, never on omega, so the "kick"
+omega <- omega + I^-1 N(t, q) h with q frozen is the *exact* flow of the torque
+part of the vector field; this is what makes the kick-drift-kick splittings
+symplectic and of the stated order.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import guvectorize, njit
+
+from hamilton_orbits._kernels.quaternion import qmul, qrot
+
+TORQUE_NONE = 0
+TORQUE_BODY = 1
+TORQUE_SPACE = 2
+TORQUE_GRAVITY_GRADIENT = 3
+
+METHOD_SPLITTING2 = 0
+METHOD_SPLITTING4 = 1
+
+# Yoshida (1990, Phys. Lett. A 150, 262, eq. 5.4) triple jump: a symmetric
+# second-order map S2 composed as S2(w1 h) S2(w0 h) S2(w1 h) is of order four.
+_CBRT2 = 2.0 ** (1.0 / 3.0)
+YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
+YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
+
+
+# --------------------------------------------------------------------------
+# Scalar building blocks (inlined)
+# --------------------------------------------------------------------------
+
+
+@njit(inline="always", cache=True)
+def euler_scalar(a, b, c, p, q, r, nx, ny, nz):  # pragma: no cover - compiled
+    """Euler's equations: (p', q', r') from A p' + (C - B) q r = N_x, cyclically."""
+    return (
+        (nx - (c - b) * q * r) / a,
+        (ny - (a - c) * r * p) / b,
+        (nz - (b - a) * p * q) / c,
+    )
+
+
+@njit(inline="always", cache=True)
+def qdot_scalar(w, x, y, z, p, q, r):  # pragma: no cover - compiled
+    """Quaternion kinematics dq/dt = q (0, omega) / 2 (omega in the body frame)."""
+    dw, dx, dy, dz = qmul(w, x, y, z, 0.0, p, q, r)
+    return 0.5 * dw, 0.5 * dx, 0.5 * dy, 0.5 * dz
+
+
+@njit(inline="always", cache=True)
+def gibbs_dot_scalar(lam, mu, nu, p, q, r):  # pragma: no cover - compiled
+    """Cayley's kinematic equations in Rodrigues' parameters (Cayley 1843, p. 228).
+
+    2 lambda' = (1 + lambda^2) p + (lambda mu - nu) q + (nu lambda + mu) r,
+    2 mu'     = (lambda mu + nu) p + (1 + mu^2) q + (mu nu - lambda) r,
+    2 nu'     = (nu lambda - mu) p + (mu nu + lambda) q + (1 + nu^2) r.
+    """
+    return (
+        0.5 * ((1.0 + lam * lam) * p + (lam * mu - nu) * q + (nu * lam + mu) * r),
+        0.5 * ((lam * mu + nu) * p + (1.0 + mu * mu) * q + (mu * nu - lam) * r),
+        0.5 * ((nu * lam - mu) * p + (mu * nu + lam) * q + (1.0 + nu * nu) * r),
+    )
+
+
+@njit(inline="always", cache=True)
+def _circular_direction(params, t):  # pragma: no cover - compiled
+    ang = params[1] * t + params[2]
+    ca = math.cos(ang)
+    sa = math.sin(ang)
+    return (
+        ca * params[3] + sa * params[6],
+        ca * params[4] + sa * params[7],
+        ca * params[5] + sa * params[8],
+    )
+
+
+@njit(inline="always", cache=True)
+def torque_scalar(kind, params, a, b, c, t, w, x, y, z):  # pragma: no cover - compiled
+    """Body-frame torque (N_x, N_y, N_z) of the encoded torque at time t, attitude q."""
+    if kind == TORQUE_BODY:
+        return params[0], params[1], params[2]
+    if kind == TORQUE_SPACE:
+        # body = q^-1 N q: rotate by the conjugate.
+        return qrot(w, -x, -y, -z, params[0], params[1], params[2])
+    if kind == TORQUE_GRAVITY_GRADIENT:
+        sx, sy, sz = _circular_direction(params, t)
+        cx, cy, cz = qrot(w, -x, -y, -z, sx, sy, sz)
+        k = 3.0 * params[0]
+        icx = a * cx
+        icy = b * cy
+        icz = c * cz
+        return (
+            k * (cy * icz - cz * icy),
+            k * (cz * icx - cx * icz),
+            k * (cx * icy - cy * icx),
+        )
+    return 0.0, 0.0, 0.0
+
+
+# --------------------------------------------------------------------------
+# Vectorised right-hand sides (generalised ufuncs)
+# --------------------------------------------------------------------------
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:], float64[:])"],
+    "(n),(n),(n)->(n)",
+    cache=True,
+    nopython=True,
+)
+def euler_gufunc(moments, omega, torque, out):  # pragma: no cover - compiled
+    """d omega / dt from Euler's equations, over leading dimensions."""
+    dp, dq, dr = euler_scalar(
+        moments[0], moments[1], moments[2], omega[0], omega[1], omega[2],
+        torque[0], torque[1], torque[2],
+    )
+    out[0] = dp
+    out[1] = dq
+    out[2] = dr
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:])"], "(n),(m)->(n)", cache=True, nopython=True
+)
+def qdot_gufunc(quat, omega, out):  # pragma: no cover - compiled
+    """dq/dt = q (0, omega) / 2 over leading dimensions."""
+    dw, dx, dy, dz = qdot_scalar(quat[0], quat[1], quat[2], quat[3], omega[0], omega[1], omega[2])
+    out[0] = dw
+    out[1] = dx
+    out[2] = dy
+    out[3] = dz
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
+)
+def gibbs_dot_gufunc(gibbs, omega, out):  # pragma: no cover - compiled
+    """Cayley's d(lambda, mu, nu)/dt over leading dimensions."""
+    a, b, c = gibbs_dot_scalar(gibbs[0], gibbs[1], gibbs[2], omega[0], omega[1], omega[2])
+    out[0] = a
+    out[1] = b
+    out[2] = c
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
+)
+def gibbs_omega_gufunc(gibbs, gdot, out):  # pragma: no cover - compiled
+    """Cayley's kappa p = 2 (lambda' + nu mu' - nu' mu), cyclically: omega from g, g'."""
+    lam = gibbs[0]
+    mu = gibbs[1]
+    nu = gibbs[2]
+    kap = 1.0 + lam * lam + mu * mu + nu * nu
+    out[0] = 2.0 * (gdot[0] + nu * gdot[1] - gdot[2] * mu) / kap
+    out[1] = 2.0 * (-nu * gdot[0] + gdot[1] + lam * gdot[2]) / kap
+    out[2] = 2.0 * (mu * gdot[0] - lam * gdot[1] + gdot[2]) / kap
+
+
+@guvectorize(
+    ["void(float64[:], float64[:], float64, int64, float64[:], float64[:])"],
+    "(n),(m),(),(),(k)->(n)",
+    cache=True,
+    nopython=True,
+)
+def torque_gufunc(moments, quat, t, kind, params, out):  # pragma: no cover - compiled
+    """Body-frame torque of an encoded torque at time ``t`` and attitude ``quat`` (4,)."""
+    nx, ny, nz = torque_scalar(
+        kind, params, moments[0], moments[1], moments[2], t,
+        quat[0], quat[1], quat[2], quat[3],
+    )
+    out[0] = nx
+    out[1] = ny
+    out[2] = nz
+
+
+# --------------------------------------------------------------------------
+# Lie-Poisson splitting of the free body, with torque kicks
+# --------------------------------------------------------------------------
+
+
+@njit(inline="always", cache=True)
+def _axis_flow(axis, tau, moments, ell, quat):  # pragma: no cover - compiled
+    """Exact flow for time ``tau`` of T_axis = L_axis^2 / (2 I_axis), in place.
+
+    omega = (L_axis / I_axis) e_axis is constant along this flow, so the body
+    angular momentum turns by -theta about e_axis (dL/dt = L x omega) and the
+    attitude by q <- q (cos theta/2, sin theta/2 e_axis), theta = L_axis tau / I_axis.
+    Both are exact rotations: |L| and the space-frame L = q L q^-1 are unchanged
+    up to rounding.
+    """
+    half = 0.5 * ell[axis] * tau / moments[axis]
+    ch = math.cos(half)
+    sh = math.sin(half)
+    c = ch * ch - sh * sh
+    s = 2.0 * ch * sh
+    i = (axis + 1) % 3
+    j = (axis + 2) % 3
+    li = ell[i]
+    lj = ell[j]
+    ell[i] = c * li + s * lj
+    ell[j] = -s * li + c * lj
+    bx = sh if axis == 0 else 0.0
+    by = sh if axis == 1 else 0.0
+    bz = sh if axis == 2 else 0.0
+    w, x, y, z = qmul(quat[0], quat[1], quat[2], quat[3], ch, bx, by, bz)
+    quat[0] = w
+    quat[1] = x
+    quat[2] = y
+    quat[3] = z
+
+
+@njit(inline="always", cache=True)
+def _strang_free(h, moments, ell, quat):  # pragma: no cover - compiled
+    """Symmetric splitting T = T1 + T2 + T3: R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2)."""
+    _axis_flow(0, 0.5 * h, moments, ell, quat)
+    _axis_flow(1, 0.5 * h, moments, ell, quat)
+    _axis_flow(2, h, moments, ell, quat)
+    _axis_flow(1, 0.5 * h, moments, ell, quat)
+    _axis_flow(0, 0.5 * h, moments, ell, quat)
+
+
+@njit(inline="always", cache=True)
+def _kick(kind, params, h, t, moments, ell, quat):  # pragma: no cover - compiled
+    """Exact flow of the torque part: L <- L + N(t, q) h with q frozen."""
+    nx, ny, nz = torque_scalar(
+        kind, params, moments[0], moments[1], moments[2], t, quat[0], quat[1], quat[2], quat[3]
+    )
+    ell[0] += h * nx
+    ell[1] += h * ny
+    ell[2] += h * nz
+
+
+@njit(inline="always", cache=True)
+def _s2_step(kind, params, h, t, moments, ell, quat):  # pragma: no cover - compiled
+    """Second-order symmetric step: kick(h/2) free-splitting(h) kick(h/2)."""
+    if kind != TORQUE_NONE:
+        _kick(kind, params, 0.5 * h, t, moments, ell, quat)
+    _strang_free(h, moments, ell, quat)
+    if kind != TORQUE_NONE:
+        _kick(kind, params, 0.5 * h, t + h, moments, ell, quat)
+
+
+@njit(inline="always", cache=True)
+def _normalise(quat):  # pragma: no cover - compiled
+    n = math.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3])
+    quat[0] /= n
+    quat[1] /= n
+    quat[2] /= n
+    quat[3] /= n
+
+
+@njit(cache=True)
+def run_splitting(
+    method, moments, quat, ell, t0, h, n_steps, out_steps, kind, params, q_out, l_out
+):  # pragma: no cover - compiled
+    """Run ``n_steps`` steps of a splitting method; the whole time loop is compiled.
+
+    ``quat`` (4,) and ``ell`` (3,) (body angular momentum) are advanced in place.
+    The state after step ``out_steps[k]`` (sorted, 0 = initial state) is written
+    to ``q_out[k]``, ``l_out[k]``.  ``method`` is METHOD_SPLITTING2 or
+    METHOD_SPLITTING4 (Yoshida triple jump of the second-order step).  The
+    attitude is renormalised after every step: the sub-flows preserve |q|
+    exactly, so this only removes the random walk of rounding errors.
+    """
+    k = 0
+    nout = out_steps.shape[0]
+    while k < nout and out_steps[k] == 0:
+        q_out[k, :] = quat
+        l_out[k, :] = ell
+        k += 1
+    for n in range(1, n_steps + 1):
+        t = t0 + (n - 1) * h
+        if method == METHOD_SPLITTING2:
+            _s2_step(kind, params, h, t, moments, ell, quat)
+        else:
+            h1 = YOSHIDA_W1 * h
+            h0 = YOSHIDA_W0 * h
+            _s2_step(kind, params, h1, t, moments, ell, quat)
+            _s2_step(kind, params, h0, t + h1, moments, ell, quat)
+            _s2_step(kind, params, h1, t + h1 + h0, moments, ell, quat)
+        _normalise(quat)
+        while k < nout and out_steps[k] == n:
+            q_out[k, :] = quat
+            l_out[k, :] = ell
+            k += 1
+
+
+# --------------------------------------------------------------------------
+# Classical Runge-Kutta on Euler + kinematics (quaternion or Cayley form)
+# --------------------------------------------------------------------------
+
+
+@njit(inline="always", cache=True)
+def _rhs_quat(kind, params, moments, t, y, dy):  # pragma: no cover - compiled
+    """y = (w, x, y, z, p, q, r): Euler's equations plus dq/dt = q omega / 2."""
+    a = moments[0]
+    b = moments[1]
+    c = moments[2]
+    nx, ny, nz = torque_scalar(kind, params, a, b, c, t, y[0], y[1], y[2], y[3])
+    dp, dq, dr = euler_scalar(a, b, c, y[4], y[5], y[6], nx, ny, nz)
+    dw, dx, dyy, dz = qdot_scalar(y[0], y[1], y[2], y[3], y[4], y[5], y[6])
+    dy[0] = dw
+    dy[1] = dx
+    dy[2] = dyy
+    dy[3] = dz
+    dy[4] = dp
+    dy[5] = dq
+    dy[6] = dr
+
+
+@njit(cache=True)
+def rhs_quaternion(t, y, moments, kind, params):  # pragma: no cover - compiled
+    """Right-hand side for scipy's solve_ivp: y (7,) = (quaternion, omega)."""
+    dy = np.empty(7)
+    _rhs_quat(kind, params, moments, t, y, dy)
+    return dy
+
+
+@njit(inline="always", cache=True)
+def _rhs_cayley(kind, params, moments, t, off, y, dy):  # pragma: no cover - compiled
+    """y = (lambda0, mu0, nu0, p, q, r); the attitude is off (1, g0) / sqrt(kappa0).
+
+    Left multiplication by the constant ``off`` commutes with the right-invariant
+    kinematics, so g0 obeys Cayley's equations with the same body omega (his P_0
+    system: the general solution is the composition of a particular one with
+    arbitrary constants l, m, n).
+    """
+    kap = math.sqrt(1.0 + y[0] * y[0] + y[1] * y[1] + y[2] * y[2])
+    w, x, yy, z = qmul(off[0], off[1], off[2], off[3], 1.0 / kap, y[0] / kap, y[1] / kap,
+                       y[2] / kap)
+    a = moments[0]
+    b = moments[1]
+    c = moments[2]
+    nx, ny, nz = torque_scalar(kind, params, a, b, c, t, w, x, yy, z)
+    dp, dq, dr = euler_scalar(a, b, c, y[3], y[4], y[5], nx, ny, nz)
+    gl, gm, gn = gibbs_dot_scalar(y[0], y[1], y[2], y[3], y[4], y[5])
+    dy[0] = gl
+    dy[1] = gm
+    dy[2] = gn
+    dy[3] = dp
+    dy[4] = dq
+    dy[5] = dr
+
+
+@njit(cache=True)
+def run_rk4_quaternion(
+    moments, y0, t0, h, n_steps, out_steps, kind, params, y_out
+):  # pragma: no cover - compiled
+    """Classical RK4 on y = (q, omega), q not normalised inside (only on output)."""
+    y = y0.copy()
+    k1 = np.empty(7)
+    k2 = np.empty(7)
+    k3 = np.empty(7)
+    k4 = np.empty(7)
+    tmp = np.empty(7)
+    k = 0
+    nout = out_steps.shape[0]
+    while k < nout and out_steps[k] == 0:
+        y_out[k, :] = y
+        k += 1
+    for n in range(1, n_steps + 1):
+        t = t0 + (n - 1) * h
+        _rhs_quat(kind, params, moments, t, y, k1)
+        for i in range(7):
+            tmp[i] = y[i] + 0.5 * h * k1[i]
+        _rhs_quat(kind, params, moments, t + 0.5 * h, tmp, k2)
+        for i in range(7):
+            tmp[i] = y[i] + 0.5 * h * k2[i]
+        _rhs_quat(kind, params, moments, t + 0.5 * h, tmp, k3)
+        for i in range(7):
+            tmp[i] = y[i] + h * k3[i]
+        _rhs_quat(kind, params, moments, t + h, tmp, k4)
+        for i in range(7):
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        while k < nout and out_steps[k] == n:
+            y_out[k, :] = y
+            k += 1
+
+
+@njit(cache=True)
+def run_rk4_cayley(
+    moments, off0, omega0, t0, h, n_steps, out_steps, kind, params, recentre, y_out
+):  # pragma: no cover - compiled
+    """Classical RK4 on Cayley's (lambda0, mu0, nu0) and Euler's equations.
+
+    The attitude is off (1, g0) / sqrt(kappa0) with a constant offset ``off``
+    (unit quaternion, initially ``off0``) and g0 = 0 at the start.  After a step
+    that takes |g0| above ``recentre`` the offset absorbs it, off <- off (1, g0)
+    (Cayley's composition formula in homogeneous form: (P_0, P_0 lambda,
+    P_0 mu, P_0 nu)), and g0 restarts at 0.  Rows of ``y_out`` hold the attitude
+    quaternion (4) and omega (3).  Returns the number of re-centrings.
+    """
+    off = off0.copy()
+    y = np.zeros(6)
+    y[3] = omega0[0]
+    y[4] = omega0[1]
+    y[5] = omega0[2]
+    k1 = np.empty(6)
+    k2 = np.empty(6)
+    k3 = np.empty(6)
+    k4 = np.empty(6)
+    tmp = np.empty(6)
+    r2 = recentre * recentre
+    n_recentre = 0
+    k = 0
+    nout = out_steps.shape[0]
+    for n in range(0, n_steps + 1):
+        if n > 0:
+            t = t0 + (n - 1) * h
+            _rhs_cayley(kind, params, moments, t, off, y, k1)
+            for i in range(6):
+                tmp[i] = y[i] + 0.5 * h * k1[i]
+            _rhs_cayley(kind, params, moments, t + 0.5 * h, off, tmp, k2)
+            for i in range(6):
+                tmp[i] = y[i] + 0.5 * h * k2[i]
+            _rhs_cayley(kind, params, moments, t + 0.5 * h, off, tmp, k3)
+            for i in range(6):
+                tmp[i] = y[i] + h * k3[i]
+            _rhs_cayley(kind, params, moments, t + h, off, tmp, k4)
+            for i in range(6):
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            if y[0] * y[0] + y[1] * y[1] + y[2] * y[2] > r2:
+                w, x, yy, z = qmul(off[0], off[1], off[2], off[3], 1.0, y[0], y[1], y[2])
+                off[0] = w
+                off[1] = x
+                off[2] = yy
+                off[3] = z
+                _normalise(off)
+                y[0] = 0.0
+                y[1] = 0.0
+                y[2] = 0.0
+                n_recentre += 1
+        while k < nout and out_steps[k] == n:
+            kap = math.sqrt(1.0 + y[0] * y[0] + y[1] * y[1] + y[2] * y[2])
+            w, x, yy, z = qmul(off[0], off[1], off[2], off[3], 1.0 / kap, y[0] / kap,
+                               y[1] / kap, y[2] / kap)
+            y_out[k, 0] = w
+            y_out[k, 1] = x
+            y_out[k, 2] = yy
+            y_out[k, 3] = z
+            y_out[k, 4] = y[3]
+            y_out[k, 5] = y[4]
+            y_out[k, 6] = y[5]
+            k += 1
+    return n_recentre

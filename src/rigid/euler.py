@@ -1,0 +1,332 @@
+"""Euler's equations with torques, and the quaternion kinematics.
+
+Conventions of the ``rigid`` package: the body frame is the principal-axis frame;
+the attitude ``q`` carries body vectors to space, v_s = q v_b q^-1;
+omega = (p, q, r) is the angular velocity in the body frame (Cayley's letters).
+
+* Euler's equations (Cayley 1843, the equations after "eliminating"):
+  A dp/dt + (C - B) q r = N_x, B dq/dt + (A - C) r p = N_y,
+  C dr/dt + (B - A) p q = N_z, with N the body-frame torque.
+* Kinematics: dq/dt = q (0, omega) / 2 (Hamilton product, omega pure).
+
+Torques are small immutable objects (:class:`BodyTorque`, :class:`SpaceTorque`,
+:class:`GravityGradientTorque`) that encode themselves for the compiled time
+loops of :mod:`rigid.integrators`; :func:`torque_on` evaluates any of them on
+arrays of attitudes.  All of them depend on (t, attitude) only, not on omega.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits._validation import as_float_array, check_positive, check_trailing
+from hamilton_orbits.quaternion import Quaternion
+from hamilton_orbits.units import is_quantity, strip, wrap
+from rigid import _euler_kernels as _k
+
+__all__ = [
+    "BodyTorque",
+    "GravityGradientTorque",
+    "SpaceTorque",
+    "euler_equations",
+    "quaternion_rate",
+    "torque_on",
+]
+
+_TORQUE = u.N * u.m
+_INERTIA = u.kg * u.m**2
+_RATE = u.rad / u.s
+
+
+def _moments(moments: Any) -> np.ndarray:
+    m = check_trailing("moments", strip("moments", moments, _INERTIA), 3)
+    return check_positive("moments", m)
+
+
+def _quat_array(name: str, attitude: Any) -> np.ndarray:
+    if isinstance(attitude, Quaternion):
+        a = attitude.as_array()
+    else:
+        a = check_trailing(name, as_float_array(name, attitude), 4)
+    n = np.sqrt(np.sum(a * a, axis=-1))
+    check_positive(f"|{name}|", n)
+    return a
+
+
+class _Torque:
+    """Base class: ``kind`` and ``params`` encode the torque for the kernels."""
+
+    kind: int = _k.TORQUE_NONE
+
+    def encode(self) -> tuple[int, np.ndarray]:
+        """(kind, params) for the compiled kernels (plain SI floats)."""
+        raise NotImplementedError  # pragma: no cover
+
+
+@dataclass(frozen=True)
+class BodyTorque(_Torque):
+    """A torque constant in the body frame.
+
+    Parameters
+    ----------
+    torque : array_like or Quantity, shape (3,)
+        Body-frame torque (N m when a Quantity).
+
+    Examples
+    --------
+    >>> BodyTorque([0.0, 0.0, 1.0]).encode()
+    (1, array([0., 0., 1.]))
+    """
+
+    torque: Any
+    _params: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        t = strip("torque", self.torque, _TORQUE)
+        if t.shape != (3,):
+            raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
+        object.__setattr__(self, "_params", t.copy())
+
+    def encode(self) -> tuple[int, np.ndarray]:
+        return _k.TORQUE_BODY, self._params.copy()
+
+
+@dataclass(frozen=True)
+class SpaceTorque(_Torque):
+    """A torque constant in the space frame (acting on the body as q^-1 N q).
+
+    Parameters
+    ----------
+    torque : array_like or Quantity, shape (3,)
+        Space-frame torque (N m when a Quantity).
+
+    Examples
+    --------
+    >>> q = Quaternion.from_axis_angle([0, 0, 1], np.pi / 2)
+    >>> np.round(torque_on(SpaceTorque([1.0, 0.0, 0.0]), [1.0, 1.0, 1.0], q), 12) + 0.0
+    array([ 0., -1.,  0.])
+    """
+
+    torque: Any
+    _params: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        t = strip("torque", self.torque, _TORQUE)
+        if t.shape != (3,):
+            raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
+        object.__setattr__(self, "_params", t.copy())
+
+    def encode(self) -> tuple[int, np.ndarray]:
+        return _k.TORQUE_SPACE, self._params.copy()
+
+
+@dataclass(frozen=True)
+class GravityGradientTorque(_Torque):
+    """Gravity-gradient torque of a point mass seen on a circular orbit.
+
+    N = 3 (GM / R^3) c x (I c), with c the unit vector from the body to the
+    primary expressed in the body frame and I = diag(A, B, C) (e.g. Hughes 1986,
+    *Spacecraft Attitude Dynamics*, ch. 8; Schaub & Junkins, *Analytical
+    Mechanics of Space Systems*, sec. 4.7).  In space the direction turns
+    uniformly in the plane of ``e1``, ``e2``:
+    c_s(t) = cos(n t + phase) e1 + sin(n t + phase) e2.
+
+    Parameters
+    ----------
+    gm_over_r3 : float or Quantity
+        GM / R^3 (1/s^2), the square of the orbital mean motion on a Kepler
+        orbit; set independently to study a fixed direction (``mean_motion=0``).
+    mean_motion : float or Quantity, optional
+        Rate n at which the direction turns (rad/s).  Default 0.
+    phase : float or Quantity, optional
+        Angle of the direction at t = 0 (rad).  Default 0.
+    e1, e2 : array_like, shape (3,), optional
+        Orthonormal space-frame vectors spanning the orbit plane; default the
+        x and y axes.
+
+    Raises
+    ------
+    ValueError
+        If ``gm_over_r3`` is negative or ``e1``, ``e2`` are not orthonormal.
+
+    Examples
+    --------
+    Long axis (smallest moment) off the local vertical: the torque pulls it back.
+
+    >>> gg = GravityGradientTorque(1.0)
+    >>> q = Quaternion.from_axis_angle([0, 0, 1], 0.1)
+    >>> np.round(torque_on(gg, [1.0, 2.0, 2.5], q), 6) + 0.0
+    array([ 0.      ,  0.      , -0.298004])
+    """
+
+    gm_over_r3: Any
+    mean_motion: Any = 0.0
+    phase: Any = 0.0
+    e1: Any = (1.0, 0.0, 0.0)
+    e2: Any = (0.0, 1.0, 0.0)
+    _params: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        k = strip("gm_over_r3", self.gm_over_r3, u.s**-2)
+        check_positive("gm_over_r3", k, strict=False)
+        n = strip("mean_motion", self.mean_motion, _RATE)
+        ph = strip("phase", self.phase, u.rad)
+        e1 = as_float_array("e1", self.e1)
+        e2 = as_float_array("e2", self.e2)
+        for name, e in (("e1", e1), ("e2", e2)):
+            if e.shape != (3,):
+                raise ValueError(f"Expected `{name}` to have shape (3,), got {e.shape}")
+            if abs(float(e @ e) - 1.0) > 1e-12:
+                raise ValueError(f"Expected `{name}` to be a unit vector, got |{name}|^2 = "
+                                 f"{float(e @ e)!r}")
+        if abs(float(e1 @ e2)) > 1e-12:
+            raise ValueError(f"Expected `e1`, `e2` orthogonal, got e1.e2 = {float(e1 @ e2)!r}")
+        for name, v in (("gm_over_r3", k), ("mean_motion", n), ("phase", ph)):
+            if v.shape != ():
+                raise ValueError(f"Expected `{name}` to be a scalar, got shape {v.shape}")
+        params = np.concatenate([[float(k), float(n), float(ph)], e1, e2])
+        object.__setattr__(self, "_params", params)
+
+    def encode(self) -> tuple[int, np.ndarray]:
+        return _k.TORQUE_GRAVITY_GRADIENT, self._params.copy()
+
+
+def _encode(torque: Any) -> tuple[int, np.ndarray]:
+    """(kind, params) of ``torque`` (None, a torque object)."""
+    if torque is None:
+        return _k.TORQUE_NONE, np.zeros(1)
+    if isinstance(torque, _Torque):
+        return torque.encode()
+    raise ValueError(
+        "Expected `torque` to be None, BodyTorque, SpaceTorque or GravityGradientTorque, "
+        f"got {type(torque).__name__}"
+    )
+
+
+def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = 0.0) -> np.ndarray:
+    """Body-frame torque of a torque object for arrays of attitudes.
+
+    Parameters
+    ----------
+    torque : BodyTorque, SpaceTorque, GravityGradientTorque or None
+        The torque model.
+    moments : array_like or Quantity, shape (..., 3)
+        Principal moments (A, B, C) (kg m^2 when a Quantity).
+    attitude : Quaternion or array_like, shape (..., 4)
+        Body-to-space attitude (any nonzero scale).
+    t : float or Quantity, shape (...), optional
+        Time (s when a Quantity).  Default 0.
+
+    Returns
+    -------
+    ndarray or Quantity, shape (..., 3)
+        The torque in the body frame (N m if ``moments`` was a Quantity).
+
+    Raises
+    ------
+    ValueError
+        For NaN, wrong shapes, a zero attitude or a non-positive moment.
+
+    Examples
+    --------
+    >>> torque_on(BodyTorque([1.0, 2.0, 3.0]), [1.0, 1.0, 1.0], Quaternion([1, 0, 0, 0]))
+    array([1., 2., 3.])
+    """
+    m = _moments(moments)
+    q = _quat_array("attitude", attitude)
+    tt = strip("t", t, u.s)
+    kind, params = _encode(torque)
+    out = _k.torque_gufunc(m, q, tt, kind, params)
+    return wrap(out, _TORQUE, is_quantity(moments))
+
+
+def euler_equations(moments: Any, omega: Any, torque: Any = 0.0) -> np.ndarray:
+    """Angular acceleration from Euler's equations.
+
+    A dp/dt + (C - B) q r = N_x, B dq/dt + (A - C) r p = N_y,
+    C dr/dt + (B - A) p q = N_z (Cayley 1843, p. 230, the three equations
+    "after eliminating", with the right-hand sides from the force function V
+    written as the body-frame torque N).
+
+    Parameters
+    ----------
+    moments : array_like or Quantity, shape (..., 3)
+        Principal moments (A, B, C) (kg m^2).
+    omega : array_like or Quantity, shape (..., 3)
+        Body-frame angular velocity (p, q, r) (rad/s).
+    torque : array_like or Quantity, shape (..., 3), optional
+        Body-frame torque (N m).  Default 0.
+
+    Returns
+    -------
+    ndarray or Quantity, shape (..., 3)
+        d omega / dt (rad/s^2 when any input was a Quantity).
+
+    Raises
+    ------
+    ValueError
+        For NaN / inf, wrong shapes, non-positive moments or shapes that do not
+        broadcast (naming the argument and index).
+
+    Examples
+    --------
+    >>> np.round(euler_equations([1.0, 2.0, 3.0], [1.0, 1.0, 1.0]), 6)
+    array([-1.      ,  1.      , -0.333333])
+    """
+    quantity = is_quantity(moments) or is_quantity(omega) or is_quantity(torque)
+    m = _moments(moments)
+    w = check_trailing("omega", strip("omega", omega, _RATE), 3)
+    n = strip("torque", torque, _TORQUE)
+    if n.ndim == 0:
+        n = np.broadcast_to(n, (3,))
+    check_trailing("torque", n, 3)
+    try:
+        out = _k.euler_gufunc(m, w, n)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected `moments`, `omega`, `torque` to broadcast together, got shapes "
+            f"{m.shape}, {w.shape}, {n.shape}"
+        ) from exc
+    return wrap(out, _RATE / u.s, quantity)
+
+
+def quaternion_rate(attitude: Any, omega: Any) -> Quaternion:
+    """Quaternion kinematics dq/dt = q (0, omega) / 2.
+
+    Parameters
+    ----------
+    attitude : Quaternion or array_like, shape (..., 4)
+        Body-to-space attitude q.
+    omega : array_like or Quantity, shape (..., 3)
+        Body-frame angular velocity (rad/s when a Quantity; the rate is then
+        per second).
+
+    Returns
+    -------
+    Quaternion, shape (...)
+        dq/dt.  For a unit q it is orthogonal to q (|q| is conserved).
+
+    Raises
+    ------
+    ValueError
+        For NaN, wrong shapes, a zero attitude, or shapes that do not broadcast.
+
+    Examples
+    --------
+    >>> quaternion_rate(Quaternion([1.0, 0.0, 0.0, 0.0]), [0.0, 0.0, 2.0]).as_array()
+    array([0., 0., 0., 1.])
+    """
+    q = _quat_array("attitude", attitude)
+    w = check_trailing("omega", strip("omega", omega, _RATE), 3)
+    try:
+        out = _k.qdot_gufunc(q, w)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected `attitude`, `omega` to broadcast together, got shapes "
+            f"{q.shape}, {w.shape}"
+        ) from exc
+    return Quaternion(out)
