@@ -1,0 +1,517 @@
+"""Compiled kernels for the exact torque-free motion (plain floats, no astropy).
+
+Contents
+--------
+* Carlson's symmetric integrals ``R_F``, ``R_C`` and ``R_J`` by the duplication
+  algorithm (Carlson 1995, Numer. Algorithms 10, 13-26; DLMF 19.36.i).
+* Jacobi ``sn, cn, dn`` with the complementary parameter ``m1 = 1 - m`` passed
+  separately, by the arithmetic-geometric mean / descending Landen
+  transformation (Abramowitz & Stegun 16.4.3; DLMF 22.20.ii), on the reduced
+  argument ``|r| <= K`` and with the quarter-period reflection
+  ``sn(K - v) = cd v``, ``cn(K - v) = sqrt(m1) sd v``, ``dn(K - v) = sqrt(m1) nd v``
+  (DLMF 22.4.iii) for ``|r| > K/2``, so every value keeps its *relative*
+  accuracy up to ``m = 1 - 1e-300``.
+* The closed-form free motion: :func:`free_setup` reduces a state to a small
+  parameter vector, :func:`free_eval` evaluates it at many times,
+  :func:`free_flow` does both.  The derivation, the signs and the branches are
+  in ``docs/free_rigid_body.md``.
+
+Parameter vector layout (``free_setup``), in the working frame W (a proper
+signed permutation of the body axes, ``v_body = P v_W``; moments J1, J2, J3 with
+J3 the axis the polhode encircles, omega_W3 >= 0):
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from hamilton_orbits._kernels.quaternion import qmul
+
+# Parameter-vector slots.
+_KIND = 0  # 0 steady (sphere, rest, rotation about a principal axis), 1 periodic, 2 separatrix
+_P = 1  # 9 entries, row-major, v_body = P v_W
+_C0 = 10  # 4 entries: q0 * qP * qa(0)
+_QPI = 14  # 4 entries: qP^-1
+_A = 18
+_B = 19
+_C = 20
+_LAM = 21
+_M = 22
+_M1 = 23
+_K = 24
+_PIC = 25  # complete Pi(n | m)
+_N = 26  # characteristic n = -J3 (J2 - J1) / (J1 (J3 - J2))
+_U0 = 27
+_L = 28
+_J1 = 29
+_J2 = 30
+_J3 = 31
+_COEF = 32  # L (J3 - J1) / (J1 J3 lam)
+_PI0 = 33  # Pi(n; am u0 | m) (with its periodic part)
+_ALPHA0 = 34
+_RHO = 35  # signed ratio in the continuous azimuth of l in the W frame
+_SB = 36  # sign of b (= sign(J3 - J1))
+_W0 = 37  # 3 entries: omega in the body frame (steady case)
+_Q0 = 40  # 4 entries: q0 (steady case)
+NPARAM = 44
+
+_R = 2.0**-53
+_QF = (3.0 * _R) ** (-1.0 / 6.0)
+_QJ = (0.25 * _R) ** (-1.0 / 6.0)
+
+
+# ---------------------------------------------------------------------------
+# Carlson's symmetric integrals
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def carlson_rf(x, y, z):  # pragma: no cover - compiled
+    """``R_F(x, y, z)`` for ``x, y, z >= 0``, at most one zero (Carlson 1995, alg. 1)."""
+    a0 = (x + y + z) / 3.0
+    q = _QF * max(abs(a0 - x), abs(a0 - y), abs(a0 - z))
+    a = a0
+    xm, ym, zm = x, y, z
+    f = 1.0
+    for _ in range(100):
+        if f * q < abs(a):
+            break
+        sx = math.sqrt(xm)
+        sy = math.sqrt(ym)
+        sz = math.sqrt(zm)
+        lam = sx * sy + sx * sz + sy * sz
+        xm = 0.25 * (xm + lam)
+        ym = 0.25 * (ym + lam)
+        zm = 0.25 * (zm + lam)
+        a = 0.25 * (a + lam)
+        f *= 0.25
+    xx = (a0 - x) * f / a
+    yy = (a0 - y) * f / a
+    zz = -xx - yy
+    e2 = xx * yy - zz * zz
+    e3 = xx * yy * zz
+    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+
+
+@njit(cache=True)
+def carlson_rc1(e):  # pragma: no cover - compiled
+    """``R_C(1, 1 + e)`` for ``e > -1`` (DLMF 19.2.18-19.2.19), series near 0."""
+    if abs(e) < 1e-4:
+        # 1 - e/3 + e^2/5 - e^3/7 + e^4/9: the next term is below 1e-20.
+        return 1.0 + e * (-1.0 / 3.0 + e * (0.2 + e * (-1.0 / 7.0 + e / 9.0)))
+    if e > 0.0:
+        s = math.sqrt(e)
+        return math.atan(s) / s
+    s = math.sqrt(-e)
+    return math.atanh(s) / s
+
+
+@njit(cache=True)
+def carlson_rj(x, y, z, p):  # pragma: no cover - compiled
+    """``R_J(x, y, z, p)`` for ``x, y, z >= 0`` (at most one zero), ``p > 0``.
+
+    Carlson (1995), algorithm 3 (the real case).
+    """
+    a0 = (x + y + z + 2.0 * p) / 5.0
+    delta = (p - x) * (p - y) * (p - z)
+    q = _QJ * max(abs(a0 - x), abs(a0 - y), abs(a0 - z), abs(a0 - p))
+    a = a0
+    xm, ym, zm, pm = x, y, z, p
+    f = 1.0
+    f3 = 1.0
+    total = 0.0
+    for _ in range(100):
+        if f * q < abs(a):
+            break
+        sx = math.sqrt(xm)
+        sy = math.sqrt(ym)
+        sz = math.sqrt(zm)
+        sp = math.sqrt(pm)
+        lam = sx * sy + sx * sz + sy * sz
+        d = (sp + sx) * (sp + sy) * (sp + sz)
+        e = f3 * delta / (d * d)
+        total += f * carlson_rc1(e) / d
+        xm = 0.25 * (xm + lam)
+        ym = 0.25 * (ym + lam)
+        zm = 0.25 * (zm + lam)
+        pm = 0.25 * (pm + lam)
+        a = 0.25 * (a + lam)
+        f *= 0.25
+        f3 *= 1.0 / 64.0
+    xx = (a0 - x) * f / a
+    yy = (a0 - y) * f / a
+    zz = (a0 - z) * f / a
+    pp = -0.5 * (xx + yy + zz)
+    e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp
+    e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp
+    e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp
+    e5 = xx * yy * zz * pp * pp
+    series = (
+        1.0
+        - 3.0 * e2 / 14.0
+        + e3 / 6.0
+        + 9.0 * e2 * e2 / 88.0
+        - 3.0 * e4 / 22.0
+        - 9.0 * e2 * e3 / 52.0
+        + 3.0 * e5 / 26.0
+    )
+    return f * series / (a * math.sqrt(a)) + 6.0 * total
+
+
+# ---------------------------------------------------------------------------
+# Jacobi elliptic functions
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _agm_sncn(u, m, m1):  # pragma: no cover - compiled
+    """``(sn, cn)`` by the AGM (A&S 16.4.3); accurate for ``|u| <= K/2``."""
+    if m == 0.0:
+        return math.sin(u), math.cos(u)
+    ratios = np.empty(64)
+    a = 1.0
+    b = math.sqrt(m1)
+    c = math.sqrt(m)
+    n = 0
+    while abs(c) > 1e-17 * a and n < 63:
+        an = 0.5 * (a + b)
+        cn = 0.25 * c * c / an  # c_n = (a_{n-1} - b_{n-1}) / 2 without cancellation
+        b = math.sqrt(a * b)
+        a = an
+        c = cn
+        n += 1
+        ratios[n] = c / a
+    phi = (2.0**n) * a * u
+    for j in range(n, 0, -1):
+        phi = 0.5 * (phi + math.asin(ratios[j] * math.sin(phi)))
+    return math.sin(phi), math.cos(phi)
+
+
+@njit(cache=True)
+def jacobi_reduced(r, m, m1, kk):  # pragma: no cover - compiled
+    """``sn, cn, dn`` of ``r`` with ``|r| <= K`` (``kk`` = K(m)), ``m + m1 = 1``.
+
+    For ``|r| > K/2`` the reflection about the quarter period keeps the relative
+    accuracy of ``cn`` and ``dn`` when they are small (DLMF 22.4.iii).
+    """
+    v = abs(r)
+    if v <= 0.5 * kk:
+        s, c = _agm_sncn(v, m, m1)
+        d = math.sqrt(m1 + m * c * c)
+    else:
+        s1, c1 = _agm_sncn(kk - v, m, m1)
+        d1 = math.sqrt(m1 + m * c1 * c1)
+        k1 = math.sqrt(m1)
+        s = c1 / d1
+        c = k1 * s1 / d1
+        d = k1 / d1
+    if r < 0.0:
+        s = -s
+    return s, c, d
+
+
+@njit(cache=True)
+def ellipk_m1(m1):  # pragma: no cover - compiled
+    """``K(m)`` from the complementary parameter ``m1 = 1 - m`` (DLMF 19.25.1)."""
+    return carlson_rf(0.0, m1, 1.0)
+
+
+@njit(cache=True)
+def _pi_reduced(n, s, c, d):  # pragma: no cover - compiled
+    """``Pi(n; phi | m)`` for ``|phi| <= pi/2`` from ``sin, cos phi`` and ``d = dn``.
+
+    DLMF 19.25.14: Pi = s R_F(c^2, d^2, 1) + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2).
+    """
+    s2 = s * s
+    val = s * carlson_rf(c * c, d * d, 1.0)
+    if n != 0.0 and s != 0.0:
+        val += n / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - n * s2)
+    return val
+
+
+# ---------------------------------------------------------------------------
+# The free motion
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _sign(x):  # pragma: no cover - compiled
+    return 1.0 if x >= 0.0 else -1.0
+
+
+@njit(cache=True)
+def _quat_from_signed_permutation(p):  # pragma: no cover - compiled
+    """Unit quaternion of a proper rotation matrix (Shepperd 1978), ``p`` (3, 3)."""
+    tr = p[0, 0] + p[1, 1] + p[2, 2]
+    k = 0
+    big = tr
+    for i in range(3):
+        if p[i, i] > big:
+            big = p[i, i]
+            k = i + 1
+    if k == 0:
+        w, x, y, z = 1.0 + tr, p[2, 1] - p[1, 2], p[0, 2] - p[2, 0], p[1, 0] - p[0, 1]
+    elif k == 1:
+        w, x, y, z = p[2, 1] - p[1, 2], 1.0 + 2.0 * p[0, 0] - tr, p[0, 1] + p[1, 0], p[0, 2] + p[2, 0]
+    elif k == 2:
+        w, x, y, z = p[0, 2] - p[2, 0], p[0, 1] + p[1, 0], 1.0 + 2.0 * p[1, 1] - tr, p[1, 2] + p[2, 1]
+    else:
+        w, x, y, z = p[1, 0] - p[0, 1], p[0, 2] + p[2, 0], p[1, 2] + p[2, 1], 1.0 + 2.0 * p[2, 2] - tr
+    nrm = math.sqrt(w * w + x * x + y * y + z * z)
+    return w / nrm, x / nrm, y / nrm, z / nrm
+
+
+@njit(cache=True)
+def _periodic_at(prm, u):  # pragma: no cover - compiled
+    """Working-frame omega, Pi(n; am u | m) and the continuous azimuth at ``u``."""
+    kk = prm[_K]
+    k = math.floor((u + kk) / (2.0 * kk))
+    r = u - 2.0 * kk * k
+    if r > kk:  # rounding at the upper edge
+        r = kk
+    s, c, d = jacobi_reduced(r, prm[_M], prm[_M1], kk)
+    sg = 1.0 if (int(k) & 1) == 0 else -1.0
+    w1 = prm[_A] * sg * c
+    w2 = prm[_B] * sg * s
+    w3 = prm[_C] * d
+    pi_u = 2.0 * k * prm[_PIC] + _pi_reduced(prm[_N], s, c, d)
+    alpha = prm[_SB] * k * math.pi + math.atan2(prm[_RHO] * s, c)
+    return w1, w2, w3, pi_u, alpha
+
+
+@njit(cache=True)
+def _separatrix_at(prm, u):  # pragma: no cover - compiled
+    """Working-frame omega, Pi(n; am u | 1) and the azimuth on the separatrix."""
+    e = math.exp(-abs(u))
+    sech = 2.0 * e / (1.0 + e * e)
+    th = math.tanh(u)
+    a = prm[_A]
+    w1 = a * sech
+    w2 = prm[_B] * th
+    w3 = prm[_C] * sech
+    nu = -prm[_N]
+    snu = math.sqrt(nu)
+    pi_u = (u + snu * math.atan(snu * th)) / (1.0 + nu)
+    alpha = math.atan2(prm[_RHO] * th, sech)
+    return w1, w2, w3, pi_u, alpha
+
+
+@njit(cache=True)
+def free_setup(moments, q0, w0):  # pragma: no cover - compiled
+    """Reduce ``(moments (3,), q0 (4,) unit, omega0 (3,))`` to the parameter vector."""
+    prm = np.zeros(NPARAM)
+    for i in range(3):
+        prm[_W0 + i] = w0[i]
+    for i in range(4):
+        prm[_Q0 + i] = q0[i]
+    i0, i1, i2 = moments[0], moments[1], moments[2]
+    # Steady rotation when I omega is parallel to omega (sphere, rest, principal axis).
+    cx = (i1 - i2) * w0[1] * w0[2]
+    cy = (i2 - i0) * w0[2] * w0[0]
+    cz = (i0 - i1) * w0[0] * w0[1]
+    if cx == 0.0 and cy == 0.0 and cz == 0.0:
+        prm[_KIND] = 0.0
+        return prm
+    # Sort the axes: imin, imid, imax (stable for ties).
+    idx = np.array([0, 1, 2])
+    for a in range(3):
+        for b in range(2 - a):
+            if moments[idx[b]] > moments[idx[b + 1]]:
+                idx[b], idx[b + 1] = idx[b + 1], idx[b]
+    imin, imid, imax = idx[0], idx[1], idx[2]
+    jmin, jmid, jmax = moments[imin], moments[imid], moments[imax]
+    # L^2 - 2 T B, without cancellation beyond its own conditioning.
+    d2 = jmin * w0[imin] ** 2 * (jmin - jmid) + jmax * w0[imax] ** 2 * (jmax - jmid)
+    kind = 1.0
+    if d2 > 0.0 or (d2 == 0.0 and jmid == jmin):
+        order = (imin, imid, imax)
+    elif d2 < 0.0 or (d2 == 0.0 and jmid == jmax):
+        order = (imax, imid, imin)
+    else:
+        order = (imin, imid, imax)
+        kind = 2.0
+    # Proper signed permutation: columns e_o1, e_o2, s e_o3.
+    pm = np.zeros((3, 3))
+    o1, o2, o3 = order
+    s3 = 1.0 if (o2 - o1) % 3 == 1 else -1.0  # cyclic order of the axes is even
+    pm[o1, 0] = 1.0
+    pm[o2, 1] = 1.0
+    pm[o3, 2] = s3
+    j1, j2, j3 = moments[o1], moments[o2], moments[o3]
+    v1, v2, v3 = w0[o1], w0[o2], s3 * w0[o3]
+    if v3 < 0.0:  # half-turn about the first W axis so that omega_W3 > 0
+        pm[o2, 1] = -1.0
+        pm[o3, 2] = -s3
+        v2 = -v2
+        v3 = -v3
+    for i in range(3):
+        for j in range(3):
+            prm[_P + 3 * i + j] = pm[i, j]
+    lsq = (j1 * v1) ** 2 + (j2 * v2) ** 2 + (j3 * v3) ** 2
+    ell = math.sqrt(lsq)
+    p3 = j1 * v1 * v1 * (j3 - j1) + j2 * v2 * v2 * (j3 - j2)  # 2 T J3 - L^2
+    p1 = j2 * v2 * v2 * (j2 - j1) + j3 * v3 * v3 * (j3 - j1)  # L^2 - 2 T J1
+    dm = j1 * v1 * v1 * (j1 - j2) + j3 * v3 * v3 * (j3 - j2)  # L^2 - 2 T J2
+    a = math.sqrt(p3 / (j1 * (j3 - j1)))
+    b = math.sqrt(p3 / (j2 * (j3 - j2)))
+    c = math.sqrt(p1 / (j3 * (j3 - j1)))
+    lam = math.sqrt((j3 - j2) * p1 / (j1 * j2 * j3))
+    nchar = -j3 * (j2 - j1) / (j1 * (j3 - j2))
+    sb = _sign(j3 - j1)
+    prm[_KIND] = kind
+    prm[_C] = c
+    prm[_LAM] = lam
+    prm[_N] = nchar
+    prm[_L] = ell
+    prm[_J1] = j1
+    prm[_J2] = j2
+    prm[_J3] = j3
+    prm[_COEF] = ell * (j3 - j1) / (j1 * j3 * lam)
+    # Continuous azimuth of l_W = atan2(J2 w2, J1 w1) written as atan2(rho sn, cn).
+    rho = sb * (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
+    if kind == 1.0:
+        m = (j2 - j1) * p3 / ((j3 - j2) * p1)
+        m1 = (j3 - j1) * dm / ((j3 - j2) * p1)
+        m = min(max(m, 0.0), 1.0)
+        m1 = min(max(m1, 0.0), 1.0)
+        kk = ellipk_m1(m1)
+        pic = kk
+        if nchar != 0.0:
+            pic += nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+        prm[_A] = a
+        prm[_B] = sb * b
+        prm[_M] = m
+        prm[_M1] = m1
+        prm[_K] = kk
+        prm[_PIC] = pic
+        prm[_RHO] = rho
+        prm[_SB] = sb
+        # Initial phase u0 = F(phi0 | m), sn = omega2 / b, cn = omega1 / a.
+        s0 = v2 / (sb * b)
+        c0 = v1 / a
+        h = math.hypot(s0, c0)
+        s0 /= h
+        c0 /= h
+        dd = m1 + m * c0 * c0
+        f = s0 * carlson_rf(c0 * c0, dd, 1.0)
+        if c0 >= 0.0:
+            u0 = f
+        else:
+            u0 = _sign(s0) * 2.0 * kk - f
+        prm[_U0] = u0
+        _, _, _, pi0, alpha0 = _periodic_at(prm, u0)
+        w1, w2, w3, _, _ = _periodic_at(prm, u0)
+    else:
+        sa = _sign(v1)
+        prm[_A] = sa * a
+        prm[_B] = sa * b
+        prm[_M] = 1.0
+        prm[_M1] = 0.0
+        prm[_RHO] = (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
+        prm[_SB] = 1.0
+        # sinh u0 = tanh / sech = (omega2 / b) / (omega1 / a)
+        u0 = math.asinh((v2 / (sa * b)) / (v1 / (sa * a)))
+        prm[_U0] = u0
+        w1, w2, w3, pi0, alpha0 = _separatrix_at(prm, u0)
+    prm[_PI0] = pi0
+    prm[_ALPHA0] = alpha0
+    # qa(0): the shortest arc from e3 to l_W(0); C0 = q0 qP qa(0).
+    l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
+    nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
+    qaw, qax, qay = (1.0 + l3) / nq, -l2 / nq, l1 / nq
+    pw, px, py, pz = _quat_from_signed_permutation(pm)
+    tw, tx, ty, tz = qmul(q0[0], q0[1], q0[2], q0[3], pw, px, py, pz)
+    cw, cx_, cy_, cz_ = qmul(tw, tx, ty, tz, qaw, qax, qay, 0.0)
+    prm[_C0] = cw
+    prm[_C0 + 1] = cx_
+    prm[_C0 + 2] = cy_
+    prm[_C0 + 3] = cz_
+    prm[_QPI] = pw
+    prm[_QPI + 1] = -px
+    prm[_QPI + 2] = -py
+    prm[_QPI + 3] = -pz
+    return prm
+
+
+@njit(cache=True)
+def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
+    """Evaluate the motion of ``prm`` at times ``t`` (n,) into ``out_q`` (n, 4), ``out_w`` (n, 3)."""
+    kind = prm[_KIND]
+    if kind == 0.0:
+        w1, w2, w3 = prm[_W0], prm[_W0 + 1], prm[_W0 + 2]
+        wn = math.sqrt(w1 * w1 + w2 * w2 + w3 * w3)
+        for i in range(t.shape[0]):
+            out_w[i, 0] = w1
+            out_w[i, 1] = w2
+            out_w[i, 2] = w3
+            if wn == 0.0:
+                ew, ex, ey, ez = 1.0, 0.0, 0.0, 0.0
+            else:
+                half = 0.5 * wn * t[i]
+                sh = math.sin(half) / wn
+                ew, ex, ey, ez = math.cos(half), sh * w1, sh * w2, sh * w3
+            qw, qx, qy, qz = qmul(
+                prm[_Q0], prm[_Q0 + 1], prm[_Q0 + 2], prm[_Q0 + 3], ew, ex, ey, ez
+            )
+            out_q[i, 0] = qw
+            out_q[i, 1] = qx
+            out_q[i, 2] = qy
+            out_q[i, 3] = qz
+        return
+    ell = prm[_L]
+    j1, j2, j3 = prm[_J1], prm[_J2], prm[_J3]
+    lam = prm[_LAM]
+    u0 = prm[_U0]
+    for i in range(t.shape[0]):
+        ti = t[i]
+        u = u0 + lam * ti
+        if kind == 1.0:
+            w1, w2, w3, pi_u, alpha = _periodic_at(prm, u)
+        else:
+            w1, w2, w3, pi_u, alpha = _separatrix_at(prm, u)
+        # Precession angle about the invariable line, in the shortest-arc gauge:
+        # Psi = (L/J3) t + L (J3 - J1)/(J1 J3 lam) [Pi(u) - Pi(u0)] - (alpha - alpha0).
+        psi = ell / j3 * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
+        l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
+        nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
+        # qa^-1 qP^-1
+        bw, bx, by, bz = qmul(
+            (1.0 + l3) / nq, l2 / nq, -l1 / nq, 0.0,
+            prm[_QPI], prm[_QPI + 1], prm[_QPI + 2], prm[_QPI + 3],
+        )
+        zw, zz = math.cos(0.5 * psi), math.sin(0.5 * psi)
+        aw, ax, ay, az = qmul(prm[_C0], prm[_C0 + 1], prm[_C0 + 2], prm[_C0 + 3], zw, 0.0, 0.0, zz)
+        qw, qx, qy, qz = qmul(aw, ax, ay, az, bw, bx, by, bz)
+        out_q[i, 0] = qw
+        out_q[i, 1] = qx
+        out_q[i, 2] = qy
+        out_q[i, 3] = qz
+        for r in range(3):
+            out_w[i, r] = prm[_P + 3 * r] * w1 + prm[_P + 3 * r + 1] * w2 + prm[_P + 3 * r + 2] * w3
+
+
+@njit(cache=True)
+def free_flow(moments, q0, w0, t, out_q, out_w):  # pragma: no cover - compiled
+    """Exact torque-free motion from ``(q0, w0)`` at times ``t``; see module docs."""
+    prm = free_setup(moments, q0, w0)
+    free_eval(prm, t, out_q, out_w)
+
+
+@njit(cache=True)
+def free_step(moments, q, w, h):  # pragma: no cover - compiled
+    """Advance ``q`` (4,) and ``w`` (3,) in place by the exact free flow over ``h``.
+
+    For use inside other kernels (the exact-flow-plus-kicks splitting).
+    """
+    tt = np.empty(1)
+    tt[0] = h
+    oq = np.empty((1, 4))
+    ow = np.empty((1, 3))
+    free_flow(moments, q, w, tt, oq, ow)
+    for i in range(4):
+        q[i] = oq[0, i]
+    for i in range(3):
+        w[i] = ow[0, i]
