@@ -34,6 +34,7 @@ from hamilton_orbits._kernels.quaternion import (
     from_matrix_flat,
     qmul_gufunc,
     qrot_gufunc,
+    rotate_flat,
     to_matrix_flat,
 )
 from hamilton_orbits._validation import _first_index, as_float_array, check_trailing
@@ -275,10 +276,10 @@ class Quaternion:
                [ 0.,  0., -1.],
                [ 0.,  1.,  0.]])
         """
-        _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
         flat = np.ascontiguousarray(self._a.reshape(-1, 4))
         out = np.empty((flat.shape[0], 3, 3))
-        to_matrix_flat(flat, out)
+        if to_matrix_flat(flat, out) >= 0:
+            _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
         return out.reshape(self.shape + (3, 3))
 
     def as_axis_angle(self) -> tuple[np.ndarray, np.ndarray]:
@@ -512,6 +513,14 @@ class Quaternion:
         array([[ 0.,  1.,  0.],
                [-1.,  0.,  0.]])
         """
+        v = np.asarray(vectors, dtype=np.float64)
+        if v.shape[:-1] == self.shape and v.ndim >= 1 and v.shape[-1] == 3:
+            # the common case: one vector per quaternion; validate in the same pass
+            flat_q = np.ascontiguousarray(self._a.reshape(-1, 4))
+            flat_v = np.ascontiguousarray(v.reshape(-1, 3))
+            out = np.empty(flat_v.shape)
+            if rotate_flat(flat_q, flat_v, out) < 0:
+                return out.reshape(v.shape)
         v = check_trailing("vectors", as_float_array("vectors", vectors), 3)
         if not np.all(np.any(self._a != 0, axis=-1)):
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")

@@ -226,7 +226,7 @@ def test_rotate_is_q_v_qinv():
 def test_non_unit_policy():
     """Non-unit quaternions act as their versor in every rotation method."""
     q = random_unit(50)
-    s = rng.uniform(1e-5, 1e5, size=50)
+    s = 10.0 ** rng.uniform(-200, 200, size=50)  # rescaling inside the kernels
     big = q * s
     v = rng.normal(size=(50, 3))
     np.testing.assert_allclose(big.rotate(v), q.rotate(v), rtol=0, atol=16 * EPS * 4)
@@ -323,6 +323,10 @@ def test_zero_quaternion_raises():
         z.unit()
     with pytest.raises(ValueError, match="nonzero"):
         z.rotate([1.0, 0, 0])
+    with pytest.raises(ValueError, match="nonzero quaternion at index 1"):
+        z.rotate(np.ones((2, 3)))  # the one-vector-per-quaternion fast path
+    with pytest.raises(ValueError, match=r"`vectors` to be finite, got nan at index \(1, 2\)"):
+        Quaternion.from_array(np.ones((2, 4))).rotate([[0, 0, 0], [0, 0, np.nan]])
     with pytest.raises(ValueError, match="nonzero"):
         z.as_rotation_matrix()
     with pytest.raises(ValueError, match="nonzero"):

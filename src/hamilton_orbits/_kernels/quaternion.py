@@ -36,6 +36,13 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
     """
     n2 = w * w + x * x + y * y + z * z
+    if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions (scale cancels)
+        m = max(abs(w), abs(x), abs(y), abs(z))
+        w = w / m
+        x = x / m
+        y = y / m
+        z = z / m
+        n2 = w * w + x * x + y * y + z * z
     cx = y * vz - z * vy
     cy = z * vx - x * vz
     cz = x * vy - y * vx
@@ -74,14 +81,53 @@ def qrot_gufunc(q, v, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def to_matrix_flat(q, out):  # pragma: no cover - compiled
-    """Rotation matrices of ``q`` (N, 4) into ``out`` (N, 3, 3); any nonzero scale."""
+def rotate_flat(q, v, out):  # pragma: no cover - compiled
+    """``q v q^-1`` for rows of ``q`` (N, 4) and ``v`` (N, 3) into ``out`` (N, 3).
+
+    One pass that also validates: returns the first row index whose quaternion
+    is zero or whose vector is not finite (``out`` is then incomplete), else -1.
+    """
     for i in range(q.shape[0]):
         w = q[i, 0]
         x = q[i, 1]
         y = q[i, 2]
         z = q[i, 3]
-        s = 2.0 / (w * w + x * x + y * y + z * z)
+        vx = v[i, 0]
+        vy = v[i, 1]
+        vz = v[i, 2]
+        if w == 0.0 and x == 0.0 and y == 0.0 and z == 0.0:
+            return i
+        if not (np.isfinite(vx) and np.isfinite(vy) and np.isfinite(vz)):
+            return i
+        rx, ry, rz = qrot(w, x, y, z, vx, vy, vz)
+        out[i, 0] = rx
+        out[i, 1] = ry
+        out[i, 2] = rz
+    return -1
+
+
+@njit(cache=True)
+def to_matrix_flat(q, out):  # pragma: no cover - compiled
+    """Rotation matrices of ``q`` (N, 4) into ``out`` (N, 3, 3); any nonzero scale.
+
+    Returns the index of the first zero quaternion (no rotation), else -1.
+    """
+    for i in range(q.shape[0]):
+        w = q[i, 0]
+        x = q[i, 1]
+        y = q[i, 2]
+        z = q[i, 3]
+        if w == 0.0 and x == 0.0 and y == 0.0 and z == 0.0:
+            return i
+        n2 = w * w + x * x + y * y + z * z
+        if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions
+            m = max(abs(w), abs(x), abs(y), abs(z))
+            w = w / m
+            x = x / m
+            y = y / m
+            z = z / m
+            n2 = w * w + x * x + y * y + z * z
+        s = 2.0 / n2
         xx = s * x * x
         yy = s * y * y
         zz = s * z * z
@@ -100,6 +146,7 @@ def to_matrix_flat(q, out):  # pragma: no cover - compiled
         out[i, 2, 0] = xz - wy
         out[i, 2, 1] = yz + wx
         out[i, 2, 2] = 1.0 - (xx + yy)
+    return -1
 
 
 @njit(cache=True)
