@@ -5,5 +5,19 @@ Cayley (1843) and Sylvester (1866) made executable.  The curated public API.
 
 
 from rigid.body import RigidBody
+from rigid.integrators import (
+    BodyTorque,
+    GravityGradientTorque,
+    RigidTrajectory,
+    SpaceTorque,
+    integrate,
+)
 
-__all__: list[str] = ["RigidBody"]
+__all__: list[str] = [
+    "BodyTorque",
+    "GravityGradientTorque",
+    "RigidBody",
+    "RigidTrajectory",
+    "SpaceTorque",
+    "integrate",
+]

@@ -47,9 +47,17 @@ from hamilton_orbits._validation import as_float_array, check_positive
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import is_quantity, strip, wrap
 from rigid import _euler_kernels as _k
-from rigid.euler import _encode
+from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, _encode
 
-__all__ = ["METHODS", "RigidTrajectory", "integrate", "integrate_arrays"]
+__all__ = [
+    "METHODS",
+    "BodyTorque",
+    "GravityGradientTorque",
+    "RigidTrajectory",
+    "SpaceTorque",
+    "integrate",
+    "integrate_arrays",
+]
 
 METHODS = ("splitting2", "splitting4", "exact_kick", "dop853", "rk4", "cayley_rk4")
 _FIXED = ("splitting2", "splitting4", "exact_kick", "rk4", "cayley_rk4")
@@ -157,10 +165,26 @@ def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progr
     return q_out, l_out / m
 
 
-def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params):
-    from rigid import _free_kernels as _fk  # the free-motion helper's kernels
-
-    return _fk.run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params)
+def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
+    quat = q0.copy()
+    omega = w0.copy()
+    nout = out_steps.shape[0]
+    q_out = np.empty((nout, 4))
+    w_out = np.empty((nout, 3))
+    bounds, bar = _progress_chunks(n_steps, progress)
+    for a, b in itertools.pairwise(bounds):
+        idx = np.nonzero((out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b))[0]
+        qo = np.empty((idx.size, 4))
+        wo = np.empty((idx.size, 3))
+        _k.run_exact_kick(m, quat, omega, a * h, h, b - a, out_steps[idx] - a, kind, params,
+                          qo, wo)
+        q_out[idx] = qo
+        w_out[idx] = wo
+        if bar is not None:
+            bar.update(b - a)
+    if bar is not None:
+        bar.close()
+    return q_out, w_out
 
 
 def integrate_arrays(
@@ -217,7 +241,7 @@ def integrate_arrays(
     if method in ("splitting2", "splitting4"):
         q, w = _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress)
     elif method == "exact_kick":
-        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params)
+        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress)
     elif method == "rk4":
         y = np.empty((out_steps.size, 7))
         _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
@@ -273,8 +297,8 @@ def integrate(
     recentre : float, optional
         Re-centring threshold on |g_0| for ``"cayley_rk4"``.
     progress : bool, optional
-        Show a tqdm progress bar (splitting methods; needs the ``progress``
-        extra).
+        Show a tqdm progress bar (splitting and exact_kick methods; needs the
+        ``progress`` extra).
 
     Returns
     -------
