@@ -1,0 +1,385 @@
+"""Compiled kernels: state vectors <-> orbital elements for every conic.
+
+Plain floats only (nothing here imports astropy).  The conventions (documented
+in ``docs/elements.md``) in brief:
+
+* ``p = h^2/mu`` (Hamilton's ``p = -beta^2/M``, seed eq. 16), ``inv_a = 2/r - v^2/mu``
+  (vis viva, the reciprocal semi-major axis, 0 for the parabola), and
+  ``1 - e^2 = p inv_a``.
+* ``e`` is the length of the modern eccentricity vector when that is below 1/2
+  (no cancellation for near-circular orbits) and ``sqrt(1 - p inv_a)`` above
+  (no cancellation for near-radial orbits); ``e`` below ``4 eps`` is set to 0.
+  The orbit is parabolic when ``|inv_a| max(r, p) <= 8 eps`` (then ``inv_a = 0``
+  and ``e = 1``), and radial when ``|r x v| <= 8 eps |r| |v|`` (then ``e = 1``,
+  ``p = 0``).
+* The true anomaly comes from ``e sin nu = (r.v) h / (mu r)`` and
+  ``e cos nu = (h^2 - mu r)/(mu r)`` (an atan2, full relative precision near
+  periapsis); the argument of latitude ``u`` is an atan2 of ``r`` in the node
+  basis; ``argp = u - nu``.  So ``u`` is accurate to rounding even when ``e``
+  or ``argp`` is not defined.
+* Undefined angles are 0: ``lan`` for ``inc`` in {0, pi}, ``argp`` for ``e = 0``.
+* Anomalies, mean anomaly and true anomaly lie in (-pi, pi]; ``lan``, ``argp``,
+  ``u`` in [0, 2 pi).
+* Radial orbits (``h = 0``): the line is put in the plane through it that is
+  least inclined to the reference plane (``inc`` = |latitude of periapsis
+  direction|), ``nu = pi``, the anomaly is E with ``r = a (1 - cos E)`` or F with
+  ``r = |a| (cosh F - 1)``; the radial parabola has no finite mean motion and
+  its anomaly and M are 0.
+
+Output columns of :func:`state_to_elements` are listed in ``COLUMNS``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from hamilton_orbits._kernels.kepler import (
+    anomaly_from_nu,
+    mean_from_anomaly,
+    nu_from_anomaly,
+    sinh_minus_x,
+    solve,
+    x_minus_sin,
+)
+
+EPS = 2.220446049250313e-16
+PI = math.pi
+TWO_PI = 2.0 * math.pi
+
+# conic kinds
+ELLIPSE = 0.0
+PARABOLA = 1.0
+HYPERBOLA = 2.0
+RADIAL_ELLIPSE = 3.0
+RADIAL_PARABOLA = 4.0
+RADIAL_HYPERBOLA = 5.0
+
+COLUMNS = (
+    "p",
+    "e",
+    "inv_a",
+    "inc",
+    "lan",
+    "argp",
+    "nu",
+    "anomaly",
+    "M",
+    "u",
+    "kind",
+    "tau",
+)
+NCOL = len(COLUMNS)
+
+_CIRC_TOL = 4.0 * EPS
+_PARAB_TOL = 8.0 * EPS
+_RADIAL_TOL = 8.0 * EPS
+
+
+@njit(cache=True)
+def wrap_2pi(x):  # pragma: no cover - compiled
+    """``x`` reduced to [0, 2 pi)."""
+    y = x % TWO_PI
+    if y >= TWO_PI:
+        y = 0.0
+    if y < 0.0:
+        y += TWO_PI
+        if y >= TWO_PI:
+            y = 0.0
+    return y
+
+
+@njit(cache=True)
+def wrap_pi(x):  # pragma: no cover - compiled
+    """``x`` reduced to (-pi, pi]."""
+    if -PI < x <= PI:
+        return x
+    y = wrap_2pi(x)
+    if y > PI:
+        y -= TWO_PI
+    return y
+
+
+@njit(cache=True)
+def _node_basis(hx, hy, hz):  # pragma: no cover - compiled
+    """From a unit normal: ``inc, lan`` and the node basis ``n`` (to the
+    ascending node) and ``m = h x n``; ``lan = 0`` and ``n = x`` when the plane
+    is the reference plane (the ascending node is undefined)."""
+    rho = math.hypot(hx, hy)
+    inc = math.atan2(rho, hz)
+    if rho > 0.0:
+        nx = -hy / rho
+        ny = hx / rho
+        lan = wrap_2pi(math.atan2(ny, nx))
+    else:
+        nx = 1.0
+        ny = 0.0
+        lan = 0.0
+    mx = -hz * ny
+    my = hz * nx
+    mz = hx * ny - hy * nx
+    return inc, lan, nx, ny, mx, my, mz
+
+
+@njit(cache=True)
+def _radial_normal(dx, dy, dz):  # pragma: no cover - compiled
+    """Conventional unit normal for a radial orbit along unit ``d``: the plane
+    through ``d`` least inclined to the reference plane (normal closest to +z);
+    for ``d = +-z`` the normal is ``-y`` (node on +x)."""
+    rho = math.hypot(dx, dy)
+    if rho == 0.0:
+        return 0.0, -1.0, 0.0
+    return -dz * dx / rho, -dz * dy / rho, rho
+
+
+@njit(cache=True)
+def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """Elements of one state; returns the tuple of ``COLUMNS``."""
+    r2 = rx * rx + ry * ry + rz * rz
+    r = math.sqrt(r2)
+    v2 = vx * vx + vy * vy + vz * vz
+    rv = rx * vx + ry * vy + rz * vz
+    hx = ry * vz - rz * vy
+    hy = rz * vx - rx * vz
+    hz = rx * vy - ry * vx
+    h = math.sqrt(hx * hx + hy * hy + hz * hz)
+    inv_a = 2.0 / r - v2 / mu
+    smu = math.sqrt(mu)
+
+    if h <= _RADIAL_TOL * r * math.sqrt(v2):
+        # ---- radial (rectilinear) orbit: e = 1, p = 0, body at nu = pi ----
+        dx = -rx / r
+        dy = -ry / r
+        dz = -rz / r
+        nx_, ny_, nz_ = _radial_normal(dx, dy, dz)
+        inc, lan, nx, ny, mx, my, mz = _node_basis(nx_, ny_, nz_)
+        u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
+        argp = wrap_2pi(u - PI)
+        if abs(inv_a) * r <= _PARAB_TOL:
+            # radial parabola: time since collision t = sqrt(2/mu) r^1.5 / 3
+            tau = math.sqrt(2.0 / mu) * r * math.sqrt(r) / 3.0
+            if rv < 0.0:
+                tau = -tau
+            return 0.0, 1.0, 0.0, inc, lan, argp, PI, 0.0, 0.0, u, RADIAL_PARABOLA, tau
+        c = r * v2 / mu - 1.0  # cos E (cosh F): 1 - r/a
+        if inv_a > 0.0:
+            s = rv * math.sqrt(inv_a) / smu  # sin E = r.v / sqrt(mu a)
+            anom = math.atan2(s, c)
+            m = x_minus_sin(anom)
+            n = smu * inv_a * math.sqrt(inv_a)
+            kind = RADIAL_ELLIPSE
+        else:
+            s = rv * math.sqrt(-inv_a) / smu  # sinh F
+            anom = math.asinh(s)
+            m = sinh_minus_x(anom)
+            n = smu * (-inv_a) * math.sqrt(-inv_a)
+            kind = RADIAL_HYPERBOLA
+        return 0.0, 1.0, inv_a, inc, lan, argp, PI, anom, m, u, kind, m / n
+
+    # ---- non-radial ----
+    p = h * h / mu
+    w = p * inv_a  # 1 - e^2
+    f = v2 - mu / r
+    ex = (f * rx - rv * vx) / mu
+    ey = (f * ry - rv * vy) / mu
+    ez = (f * rz - rv * vz) / mu
+    ev = math.sqrt(ex * ex + ey * ey + ez * ez)
+    if ev < 0.5:
+        e = ev
+    else:
+        # e = 1 - (1 - e^2)/(1 + e): the nearest float to e, with 1 - e as
+        # accurate as 1 - e^2 = p inv_a is (sqrt(1 - w) can be an ulp off)
+        e = 1.0 - w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))
+    if e <= _CIRC_TOL:
+        e = 0.0
+    if abs(inv_a) * max(r, p) <= _PARAB_TOL:
+        inv_a = 0.0
+        e = 1.0
+    elif e == 1.0:
+        # 1 - e^2 is below the resolution of e: keep the energy (a quasi-
+        # rectilinear orbit) unless treating it as a parabola costs less
+        if abs(inv_a) * r <= h / (r * math.sqrt(v2)):
+            inv_a = 0.0
+    inc, lan, nx, ny, mx, my, mz = _node_basis(hx / h, hy / h, hz / h)
+    u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
+    if e == 0.0:
+        nu = wrap_pi(u)
+        argp = 0.0
+    else:
+        nu = math.atan2(rv * h, h * h - mu * r)
+        argp = wrap_2pi(u - nu)
+    if e == 1.0 and inv_a != 0.0:
+        # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
+        c = r * v2 / mu - 1.0
+        if inv_a > 0.0:
+            anom = math.atan2(rv * math.sqrt(inv_a) / smu, c)
+            m = x_minus_sin(anom)
+            kind = RADIAL_ELLIPSE
+        else:
+            anom = math.asinh(rv * math.sqrt(-inv_a) / smu)
+            m = sinh_minus_x(anom)
+            kind = RADIAL_HYPERBOLA
+        n = smu * abs(inv_a) * math.sqrt(abs(inv_a))
+        return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
+    anom = anomaly_from_nu(nu, e)
+    if e >= 0.5 and inv_a != 0.0:
+        # Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
+        # form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
+        # form e sin E = r.v/sqrt(mu a), e cos E = r v^2/mu - 1 is better, as
+        # inv_a has no cancellation (2/r and v^2/mu differ by r inv_a / 2).
+        # Estimated position errors (units of eps): |a sin E|/b for the first,
+        # (|a sin E|/r)^2 for the second.
+        aa = 1.0 / abs(inv_a)
+        sq = math.sqrt(abs(inv_a))
+        s_ = rv * sq / smu  # e sin E or e sinh F
+        t_ = abs(s_) * aa / e
+        err_nu = t_ / math.sqrt(aa * p)
+        err_sc = (t_ / r) * (t_ / r)
+        if err_sc < err_nu:
+            if inv_a > 0.0:
+                anom = math.atan2(s_, r * v2 / mu - 1.0)
+            else:
+                anom = math.asinh(s_ / e)
+    m = mean_from_anomaly(anom, e)
+    if e < 1.0:
+        kind = ELLIPSE
+        n = smu * inv_a * math.sqrt(inv_a)
+    elif e == 1.0:
+        kind = PARABOLA
+        q = 0.5 * p
+        n = smu / (math.sqrt(2.0 * q) * q)
+    else:
+        kind = HYPERBOLA
+        n = smu * (-inv_a) * math.sqrt(-inv_a)
+    return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
+
+
+@njit(cache=True, parallel=True)
+def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
+    """Rows of ``r`` (N, 3), ``v`` (N, 3), ``mu`` (N,) into ``out`` (N, NCOL)."""
+    for i in prange(r.shape[0]):
+        res = state_to_elements_one(r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i])
+        for j in range(NCOL):
+            out[i, j] = res[j]
+
+
+@njit(cache=True)
+def elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: no cover
+    """State from ``p, e`` and the anomaly (E, D or F by ``e``).
+
+    The perifocal coordinates are taken from the anomaly, not from the true
+    anomaly, because ``r = a ((1 - e) + 2 e sin^2(E/2))`` (and its hyperbolic
+    and parabolic analogues) is a sum of terms of one sign, whereas
+    ``p / (1 + e cos nu)`` cancels near the apoapsis of an eccentric orbit.
+    ``e == 1`` with ``inv_a != 0`` is a rectilinear (or quasi-rectilinear,
+    ``0 <= p`` below the resolution of ``e``) orbit with ``a = 1/inv_a``.
+    Returns ``(rx, ry, rz, vx, vy, vz)``; NaN where no state exists (the
+    radial parabola, ``p < 0``).
+    """
+    nan = math.nan
+    smu = math.sqrt(mu)
+    if e == 1.0 and inv_a == 0.0:
+        # parabola: r = q (1 + D^2), x = q (1 - D^2), y = 2 q D
+        if not (p > 0.0):
+            return nan, nan, nan, nan, nan, nan
+        q = 0.5 * p
+        d = anom
+        d2 = d * d
+        x = q * (1.0 - d2)
+        y = 2.0 * q * d
+        k = math.sqrt(mu / p) / (1.0 + d2)  # sqrt(mu/p) (-sin nu, 1 + cos nu)
+        vx_ = -2.0 * d * k
+        vy_ = 2.0 * k
+    elif e < 1.0 or (e == 1.0 and inv_a > 0.0):
+        if e < 1.0:
+            a = p / ((1.0 - e) * (1.0 + e))
+        else:
+            a = 1.0 / inv_a
+        if not (a > 0.0) or not (p >= 0.0):
+            return nan, nan, nan, nan, nan, nan
+        sh = math.sin(0.5 * anom)
+        s2 = 2.0 * sh * sh  # 1 - cos E
+        se = math.sin(anom)
+        r = a * ((1.0 - e) + e * s2)
+        if not (r > 0.0):
+            return nan, nan, nan, nan, nan, nan
+        x = a * ((1.0 - e) - s2)  # a (cos E - e)
+        y = math.sqrt(a * p) * se  # b sin E
+        k = math.sqrt(mu * a) / r
+        vx_ = -k * se
+        vy_ = k * math.sqrt(p / a) * (1.0 - s2)
+    else:
+        if e > 1.0:
+            a = p / ((e - 1.0) * (e + 1.0))  # |a|
+        else:
+            a = -1.0 / inv_a
+        if not (a > 0.0) or not (p >= 0.0):
+            return nan, nan, nan, nan, nan, nan
+        sh = math.sinh(0.5 * anom)
+        s2 = 2.0 * sh * sh  # cosh F - 1
+        se = math.sinh(anom)
+        r = a * ((e - 1.0) + e * s2)
+        if not (r > 0.0) or not math.isfinite(r):
+            return nan, nan, nan, nan, nan, nan
+        x = a * ((e - 1.0) - s2)  # |a| (e - cosh F)
+        y = math.sqrt(a * p) * se
+        k = smu * math.sqrt(a) / r
+        vx_ = -k * se
+        vy_ = k * math.sqrt(p / a) * (1.0 + s2)
+    cl = math.cos(lan)
+    sl = math.sin(lan)
+    if inc == PI:
+        ci = -1.0
+        si = 0.0
+    else:
+        ci = math.cos(inc)
+        si = math.sin(inc)
+    cw = math.cos(argp)
+    sw = math.sin(argp)
+    # node basis n = (cl, sl, 0), m = h x n = (-ci sl, ci cl, si);
+    # periapsis P = cw n + sw m, Q = h x P = -sw n + cw m
+    px = cw * cl - sw * ci * sl
+    py = cw * sl + sw * ci * cl
+    pz = sw * si
+    qx = -sw * cl - cw * ci * sl
+    qy = -sw * sl + cw * ci * cl
+    qz = cw * si
+    return (
+        x * px + y * qx,
+        x * py + y * qy,
+        x * pz + y * qz,
+        vx_ * px + vy_ * qx,
+        vx_ * py + vy_ * qy,
+        vx_ * pz + vy_ * qz,
+    )
+
+
+@njit(cache=True, parallel=True)
+def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
+    """Rows of ``el`` (N, 7: p, e, inv_a, inc, lan, argp, anomaly) and ``mu``
+    into ``r_out``, ``v_out`` (N, 3)."""
+    for i in prange(el.shape[0]):
+        x, y, z, a, b, c = elements_to_state_one(
+            el[i, 0], el[i, 1], el[i, 2], el[i, 3], el[i, 4], el[i, 5], el[i, 6], mu[i]
+        )
+        r_out[i, 0] = x
+        r_out[i, 1] = y
+        r_out[i, 2] = z
+        v_out[i, 0] = a
+        v_out[i, 1] = b
+        v_out[i, 2] = c
+
+
+@njit(cache=True)
+def nu_anomaly_from_mean(m, e):  # pragma: no cover - compiled
+    """``(nu, anomaly)`` for the mean anomaly ``m`` of a conic with ``e``
+    (Kepler's equation by :func:`hamilton_orbits._kernels.kepler.solve`)."""
+    anom = solve(m, e)
+    return nu_from_anomaly(anom, e), anom
+
+
+def empty_elements(n: int) -> np.ndarray:
+    """An uninitialised (n, NCOL) output array."""
+    return np.empty((n, NCOL))
