@@ -252,14 +252,18 @@ def _quat_from_signed_permutation(p):  # pragma: no cover - compiled
         if p[i, i] > big:
             big = p[i, i]
             k = i + 1
+    d0 = 1.0 + tr
+    d1 = 1.0 + 2.0 * p[0, 0] - tr
+    d2 = 1.0 + 2.0 * p[1, 1] - tr
+    d3 = 1.0 + 2.0 * p[2, 2] - tr
     if k == 0:
-        w, x, y, z = 1.0 + tr, p[2, 1] - p[1, 2], p[0, 2] - p[2, 0], p[1, 0] - p[0, 1]
+        w, x, y, z = d0, p[2, 1] - p[1, 2], p[0, 2] - p[2, 0], p[1, 0] - p[0, 1]
     elif k == 1:
-        w, x, y, z = p[2, 1] - p[1, 2], 1.0 + 2.0 * p[0, 0] - tr, p[0, 1] + p[1, 0], p[0, 2] + p[2, 0]
+        w, x, y, z = p[2, 1] - p[1, 2], d1, p[0, 1] + p[1, 0], p[0, 2] + p[2, 0]
     elif k == 2:
-        w, x, y, z = p[0, 2] - p[2, 0], p[0, 1] + p[1, 0], 1.0 + 2.0 * p[1, 1] - tr, p[1, 2] + p[2, 1]
+        w, x, y, z = p[0, 2] - p[2, 0], p[0, 1] + p[1, 0], d2, p[1, 2] + p[2, 1]
     else:
-        w, x, y, z = p[1, 0] - p[0, 1], p[0, 2] + p[2, 0], p[1, 2] + p[2, 1], 1.0 + 2.0 * p[2, 2] - tr
+        w, x, y, z = p[1, 0] - p[0, 1], p[0, 2] + p[2, 0], p[1, 2] + p[2, 1], d3
     nrm = math.sqrt(w * w + x * x + y * y + z * z)
     return w / nrm, x / nrm, y / nrm, z / nrm
 
@@ -438,7 +442,7 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
-    """Evaluate the motion of ``prm`` at times ``t`` (n,) into ``out_q`` (n, 4), ``out_w`` (n, 3)."""
+    """Evaluate ``prm`` at times ``t`` (n,) into ``out_q`` (n, 4) and ``out_w`` (n, 3)."""
     kind = prm[_KIND]
     if kind == 0.0:
         w1, w2, w3 = prm[_W0], prm[_W0 + 1], prm[_W0 + 2]
