@@ -1,0 +1,647 @@
+"""Compiled kernels: Kepler's equation, anomalies, universal-variable propagation.
+
+Plain floats only (nothing here imports astropy).  Conventions, by eccentricity:
+
+* ``e < 1``  anomaly = eccentric anomaly E,   M = E - e sin E;
+* ``e == 1`` anomaly = parabolic anomaly D = tan(nu/2),  M = D + D^3/3 (Barker);
+* ``e > 1``  anomaly = hyperbolic anomaly F,  M = e sinh F - F.
+
+With periapsis distance q and gravitational parameter mu the time since
+periapsis is ``t = M / n`` with ``n = sqrt(mu / |a|^3)`` for ``e != 1`` and
+``n = sqrt(mu / (2 q^3))`` for the parabola (Barker's equation
+``sqrt(mu/p^3) t = (D + D^3/3)/2`` with ``p = 2q``).
+
+Every M(anomaly) is evaluated without cancellation by the splittings
+``E - e sin E = (1-e) E + e (E - sin E)`` and
+``e sinh F - F = (e-1) sinh F + (sinh F - F)``, both a sum of two terms of the
+same sign, with ``E - sin E`` and ``sinh F - F`` summed as series near zero.
+
+Scalar kernels signal failure (no convergence, argument outside the domain) by
+returning NaN; the public layer turns that into an exception naming the index.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit, vectorize
+
+EPS = 2.220446049250313e-16
+PI = math.pi
+# 2 pi = TWO_PI_HI + TWO_PI_LO to about 1e-32 (Cody-Waite reduction).
+TWO_PI_HI = 6.283185307179586
+TWO_PI_LO = 2.4492935982947064e-16
+MAXIT = 100
+
+# 1/(2k+3)!, k = 0..9: coefficients of x - sin x and sinh x - x = sum x^(2k+3)/(2k+3)!
+_S3 = 1.0 / 6.0
+_S5 = 1.0 / 120.0
+_S7 = 1.0 / 5040.0
+_S9 = 1.0 / 362880.0
+_S11 = 1.0 / 39916800.0
+_S13 = 1.0 / 6227020800.0
+_S15 = 1.0 / 1307674368000.0
+_S17 = 1.0 / 355687428096000.0
+_S19 = 1.0 / 121645100408832000.0
+_S21 = 1.0 / 51090942171709440000.0
+# 1/(2k+2)!, k = 0..9: coefficients of c2 = sum (-psi)^k/(2k+2)!
+_C2 = 1.0 / 2.0
+_C4 = 1.0 / 24.0
+_C6 = 1.0 / 720.0
+_C8 = 1.0 / 40320.0
+_C10 = 1.0 / 3628800.0
+_C12 = 1.0 / 479001600.0
+_C14 = 1.0 / 87178291200.0
+_C16 = 1.0 / 20922789888000.0
+_C18 = 1.0 / 6402373705728000.0
+_C20 = 1.0 / 2432902008176640000.0
+
+
+# ---------------------------------------------------------------------------
+# cancellation-free pieces
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def x_minus_sin(x):  # pragma: no cover - compiled
+    """``x - sin x`` to full relative precision (series for |x| < 1)."""
+    if abs(x) >= 1.0:
+        return x - math.sin(x)
+    z = x * x
+    # alternating series; last term x^21/21! < 2e-20 relative to x^3/6
+    s = _S19 - z * _S21
+    s = _S17 - z * s
+    s = _S15 - z * s
+    s = _S13 - z * s
+    s = _S11 - z * s
+    s = _S9 - z * s
+    s = _S7 - z * s
+    s = _S5 - z * s
+    s = _S3 - z * s
+    return x * z * s
+
+
+@njit(cache=True)
+def sinh_minus_x(x):  # pragma: no cover - compiled
+    """``sinh x - x`` to full relative precision (series for |x| < 1)."""
+    if abs(x) >= 1.0:
+        return math.sinh(x) - x
+    z = x * x
+    s = _S19 + z * _S21
+    s = _S17 + z * s
+    s = _S15 + z * s
+    s = _S13 + z * s
+    s = _S11 + z * s
+    s = _S9 + z * s
+    s = _S7 + z * s
+    s = _S5 + z * s
+    s = _S3 + z * s
+    return x * z * s
+
+
+@njit(cache=True)
+def _reduce_2pi(x):  # pragma: no cover - compiled
+    """Return ``(k, r)`` with ``x = 2 pi k + r`` and ``|r| <= pi`` (Cody-Waite)."""
+    k = math.floor(x / TWO_PI_HI + 0.5)
+    r = (x - k * TWO_PI_HI) - k * TWO_PI_LO
+    return k, r
+
+
+@njit(cache=True)
+def _two_prod(a, b):  # pragma: no cover - compiled
+    """Dekker's exact product: ``a * b = p + err`` exactly (no overflow assumed)."""
+    p = a * b
+    c = 134217729.0 * a
+    ah = c - (c - a)
+    al = a - ah
+    c = 134217729.0 * b
+    bh = c - (c - b)
+    bl = b - bh
+    err = ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, err
+
+
+# ---------------------------------------------------------------------------
+# Kepler's equation and the anomalies
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def mean_from_anomaly(anom, e):  # pragma: no cover - compiled
+    """Mean anomaly M from the eccentric / parabolic / hyperbolic anomaly.
+
+    Elliptic ``M = (1-e) E + e (E - sin E)``; parabolic (``e == 1``)
+    ``M = D + D^3/3``; hyperbolic ``M = (e-1) sinh F + (sinh F - F)``.
+    """
+    if e < 1.0:
+        k, r = _reduce_2pi(anom)
+        m = (1.0 - e) * r + e * x_minus_sin(r)
+        if k == 0.0:
+            return m
+        return k * TWO_PI_HI + (m + k * TWO_PI_LO)
+    if e == 1.0:
+        return anom * (1.0 + anom * anom / 3.0)
+    return (e - 1.0) * math.sinh(anom) + sinh_minus_x(anom)
+
+
+@njit(cache=True)
+def anomaly_from_nu(nu, e):  # pragma: no cover - compiled
+    """Eccentric / parabolic / hyperbolic anomaly from the true anomaly ``nu``.
+
+    Half-angle forms: ``tan(E/2) = sqrt((1-e)/(1+e)) tan(nu/2)`` evaluated as an
+    atan2 (the revolution count of ``nu`` is kept); ``D = tan(nu/2)``;
+    ``tanh(F/2) = sqrt((e-1)/(e+1)) tan(nu/2)``.  For ``e >= 1`` a ``nu`` beyond
+    the asymptote (``1 + e cos nu <= 0``) gives NaN.
+    """
+    k, r = _reduce_2pi(nu)
+    h = 0.5 * r
+    if e < 1.0:
+        a = 2.0 * math.atan2(math.sqrt(1.0 - e) * math.sin(h), math.sqrt(1.0 + e) * math.cos(h))
+        if k == 0.0:
+            return a
+        return k * TWO_PI_HI + (a + k * TWO_PI_LO)
+    # open orbits: nu must lie strictly inside (-nu_inf, nu_inf)
+    s = math.sin(h)
+    c = math.cos(h)
+    if e == 1.0:
+        if c <= 0.0 or abs(r) >= PI:
+            return math.nan
+        return s / c
+    # tanh(F/2) = sqrt(e-1) sin(h) / (sqrt(e+1) cos(h)); must be < 1 in magnitude
+    num = math.sqrt(e - 1.0) * s
+    den = math.sqrt(e + 1.0) * c
+    if not (abs(num) < den):
+        return math.nan
+    return 2.0 * math.atanh(num / den)
+
+
+@njit(cache=True)
+def nu_from_anomaly(anom, e):  # pragma: no cover - compiled
+    """True anomaly from the eccentric / parabolic / hyperbolic anomaly.
+
+    ``nu = 2 atan2(sqrt(1+e) sin(E/2), sqrt(1-e) cos(E/2))`` (revolution count
+    kept); ``nu = 2 atan(D)``; ``nu = 2 atan2(sqrt(e+1) tanh(F/2), sqrt(e-1))``
+    (no overflow for any finite F).
+    """
+    if e < 1.0:
+        k, r = _reduce_2pi(anom)
+        h = 0.5 * r
+        a = 2.0 * math.atan2(math.sqrt(1.0 + e) * math.sin(h), math.sqrt(1.0 - e) * math.cos(h))
+        if k == 0.0:
+            return a
+        return k * TWO_PI_HI + (a + k * TWO_PI_LO)
+    if e == 1.0:
+        return 2.0 * math.atan(anom)
+    return 2.0 * math.atan2(math.sqrt(e + 1.0) * math.tanh(0.5 * anom), math.sqrt(e - 1.0))
+
+
+@njit(cache=True)
+def _cubic_root(p, q):  # pragma: no cover - compiled
+    """The real root of ``x^3 + 3 p x - 2 q = 0`` for ``p > 0``, ``q >= 0``.
+
+    ``x = 2 sqrt(p) sinh(asinh(q / p^(3/2)) / 3)``: no cancellation for any q.
+    """
+    sp = math.sqrt(p)
+    return 2.0 * sp * math.sinh(math.asinh(q / (p * sp)) / 3.0)
+
+
+@njit(cache=True)
+def _solve_elliptic(m, e):  # pragma: no cover - compiled
+    """E in [0, pi] with E - e sin E = m, for 0 <= m <= pi, 0 < e < 1.
+
+    Safeguarded Halley iteration on the convex function
+    f(E) = (1-e) E + e (E - sin E) - m inside the bracket [lo, hi]: lo is the
+    larger of m and the root of the cubic (1-e) E + e E^3/6 = m (both lower
+    bounds, as E - sin E <= E^3/6 and E = m + e sin E >= m); hi = min(m + e, pi).
+    """
+    if m == 0.0:
+        return 0.0
+    om = 1.0 - e
+    lo = max(m, _cubic_root(2.0 * om / e, 3.0 * m / e))
+    hi = m + e
+    if m <= PI and hi > PI:
+        hi = PI
+    if lo > hi:
+        lo = hi
+    a = lo
+    b = hi
+    x = lo
+    for _ in range(MAXIT):
+        sx = math.sin(x)
+        sh = math.sin(0.5 * x)
+        f = om * x + e * x_minus_sin(x) - m
+        if f == 0.0:
+            return x
+        fp = om + 2.0 * e * sh * sh
+        fpp = e * sx
+        if f < 0.0:
+            a = x
+        else:
+            b = x
+        den = fp * fp - 0.5 * f * fpp
+        if den > 0.0:
+            xn = x - f * fp / den
+        else:
+            xn = x - f / fp
+        if not (a <= xn <= b):
+            xn = 0.5 * (a + b)
+        if abs(xn - x) <= 2.0 * EPS * abs(xn) or b - a <= 2.0 * EPS * abs(b):
+            return xn
+        x = xn
+    return math.nan
+
+
+@njit(cache=True)
+def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
+    """F >= 0 with e sinh F - F = m, for m >= 0, e > 1.
+
+    Safeguarded Halley iteration on the convex f(F) = (e-1) sinh F +
+    (sinh F - F) - m.  Bracket: lo = asinh((m + asinh(m/e))/e) (two steps of
+    the fixed point F = asinh((m + F)/e) from below, good for large m); hi is
+    the smaller of asinh(m/(e-1)) and the root of (e-1) F + e F^3/6 = m (upper
+    bounds since sinh F >= F + F^3/6), good near F = 0 and e near 1.
+    """
+    if m == 0.0:
+        return 0.0
+    em = e - 1.0
+    f1 = math.asinh(m / e)
+    lo = math.asinh((m + f1) / e)
+    hi = min(math.asinh(m / em), _cubic_root(2.0 * em / e, 3.0 * m / e))
+    if hi < lo:
+        hi = lo
+    flo = f1 - lo  # f(lo) up to rounding, <= 0
+    fhi = em * math.sinh(hi) + sinh_minus_x(hi) - m
+    a = lo
+    b = hi
+    x = lo if abs(flo) <= abs(fhi) else hi
+    for _ in range(MAXIT):
+        sx = math.sinh(x)
+        sh = math.sinh(0.5 * x)
+        f = em * sx + sinh_minus_x(x) - m
+        if f == 0.0:
+            return x
+        fp = em + 2.0 * e * sh * sh
+        fpp = e * sx
+        if f < 0.0:
+            a = x
+        else:
+            b = x
+        den = fp * fp - 0.5 * f * fpp
+        if den > 0.0:
+            xn = x - f * fp / den
+        else:
+            xn = x - f / fp
+        if not (a <= xn <= b):
+            xn = 0.5 * (a + b)
+        if abs(xn - x) <= 2.0 * EPS * abs(xn) or b - a <= 2.0 * EPS * abs(b):
+            return xn
+        x = xn
+    return math.nan
+
+
+@njit(cache=True)
+def solve_parabolic(m):  # pragma: no cover - compiled
+    """Barker: the real root D of D + D^3/3 = m, in closed form.
+
+    ``D = 2 sinh(asinh(3 m / 2) / 3)`` (Cardano's root written without the
+    cancellation of ``w - 1/w``), then one Newton polish.
+    """
+    d = 2.0 * math.sinh(math.asinh(1.5 * m) / 3.0)
+    if abs(d) < 1e100:
+        d -= (d * (1.0 + d * d / 3.0) - m) / (1.0 + d * d)
+    return d
+
+
+@njit(cache=True)
+def solve(m, e):  # pragma: no cover - compiled
+    """The anomaly (E, D or F by ``e``) solving Kepler's equation for mean anomaly m.
+
+    Elliptic M is reduced to [-pi, pi] (Cody-Waite) and the revolution count is
+    added back, so E is monotone in M.  NaN for e < 0 or no convergence.
+    """
+    if not (e >= 0.0) or not math.isfinite(m) or not math.isfinite(e):
+        return math.nan
+    if e < 1.0:
+        if e == 0.0:
+            return m
+        k, r = _reduce_2pi(m)
+        if r < 0.0:
+            x = -_solve_elliptic(-r, e)
+        else:
+            x = _solve_elliptic(r, e)
+        if k == 0.0:
+            return x
+        return k * TWO_PI_HI + (x + k * TWO_PI_LO)
+    if e == 1.0:
+        return solve_parabolic(m)
+    if m < 0.0:
+        return -_solve_hyperbolic(-m, e)
+    return _solve_hyperbolic(m, e)
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def solve_ufunc(m, e):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`solve`."""
+    return solve(m, e)
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def mean_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`mean_from_anomaly`."""
+    return mean_from_anomaly(anom, e)
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def anomaly_from_nu_ufunc(nu, e):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`anomaly_from_nu`."""
+    return anomaly_from_nu(nu, e)
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def nu_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`nu_from_anomaly`."""
+    return nu_from_anomaly(anom, e)
+
+
+# ---------------------------------------------------------------------------
+# universal variables
+# ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def stumpff_c2c3(psi):  # pragma: no cover - compiled
+    """Stumpff functions ``c2(psi) = (1 - cos sqrt psi)/psi`` and
+    ``c3(psi) = (sqrt psi - sin sqrt psi)/sqrt(psi)^3`` (continued to psi <= 0).
+
+    Power series for |psi| < 1; otherwise the forms ``2 sin^2(s/2)/psi`` and
+    ``(s - sin s)/s^3`` (and their hyperbolic counterparts), which have no
+    cancellation where they are used.
+    """
+    if abs(psi) < 1.0:
+        z = -psi
+        c2 = _C18 + z * _C20
+        c2 = _C16 + z * c2
+        c2 = _C14 + z * c2
+        c2 = _C12 + z * c2
+        c2 = _C10 + z * c2
+        c2 = _C8 + z * c2
+        c2 = _C6 + z * c2
+        c2 = _C4 + z * c2
+        c2 = _C2 + z * c2
+        c3 = _S19 + z * _S21
+        c3 = _S17 + z * c3
+        c3 = _S15 + z * c3
+        c3 = _S13 + z * c3
+        c3 = _S11 + z * c3
+        c3 = _S9 + z * c3
+        c3 = _S7 + z * c3
+        c3 = _S5 + z * c3
+        c3 = _S3 + z * c3
+        return c2, c3
+    if psi > 0.0:
+        s = math.sqrt(psi)
+        sh = math.sin(0.5 * s)
+        return 2.0 * sh * sh / psi, (s - math.sin(s)) / (psi * s)
+    s = math.sqrt(-psi)
+    sh = math.sinh(0.5 * s)
+    return 2.0 * sh * sh / (-psi), (math.sinh(s) - s) / (-psi * s)
+
+
+@njit(cache=True)
+def _uv_eval(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """Universal functions at ``chi``: (T(chi), r(chi), r'(chi), U0, U1, U2, U3).
+
+    ``U0 = 1 - psi c2``, ``U1 = chi (1 - psi c3)``, ``U2 = chi^2 c2``,
+    ``U3 = chi^3 c3``; ``T = r0 U1 + sigma0 U2 + U3`` (= sqrt(mu) t),
+    ``r = r0 U0 + sigma0 U1 + U2`` (= dT/dchi) and
+    ``r' = sigma0 U0 + (1 - alpha r0) U1``.
+    """
+    chi2 = chi * chi
+    psi = alpha * chi2
+    c2, c3 = stumpff_c2c3(psi)
+    u0 = 1.0 - psi * c2
+    u1 = chi * (1.0 - psi * c3)
+    u2 = chi2 * c2
+    u3 = chi2 * chi * c3
+    t = r0 * u1 + sigma0 * u2 + u3
+    r = r0 * u0 + sigma0 * u1 + u2
+    rp = sigma0 * u0 + (1.0 - alpha * r0) * u1
+    return t, r, rp, u0, u1, u2, u3
+
+
+@njit(cache=True)
+def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``).
+
+    T is increasing (dT/dchi = r >= 0).  Laguerre's method (n = 5, Conway 1986)
+    inside a bracket that starts as (0, chi_max) with chi_max = 2 pi/sqrt(alpha)
+    for a bound orbit whose |tau| is at most half a period, else (0, inf) and is
+    grown by doubling; a step that leaves the bracket is replaced by bisection.
+    Returns NaN on failure.
+    """
+    if tau == 0.0:
+        return 0.0
+    sgn = 1.0 if tau > 0.0 else -1.0
+    # bracket on the signed side of chi
+    if alpha > 0.0:
+        big = 2.0 * PI / math.sqrt(alpha)
+    else:
+        big = math.inf
+    # first guess: second-order Taylor series for short steps, otherwise the
+    # mean-motion guess (elliptic) or a logarithmic one (hyperbolic)
+    if r0 > 0.0:
+        x = tau / r0 - sigma0 * tau * tau / (2.0 * r0 * r0 * r0)
+        x1 = tau / r0
+    else:  # radial orbit anchored at the collision: T ~ chi^3/6
+        x1 = sgn * (6.0 * abs(tau)) ** (1.0 / 3.0)
+        x = x1
+    if alpha > 0.0:
+        if abs(x1) * math.sqrt(alpha) > 0.5 or x * sgn <= 0.0:
+            x = tau * alpha
+    elif alpha < 0.0:
+        sa = math.sqrt(-alpha)
+        if abs(x1) * sa > 0.5 or x * sgn <= 0.0:
+            xm = sgn * math.asinh(abs(tau) * sa * sa * sa) / sa
+            x = xm if abs(xm) < abs(x1) else x1
+    else:
+        if x * sgn <= 0.0:
+            x = x1
+    if x * sgn <= 0.0 or not math.isfinite(x):
+        x = x1
+    if sgn > 0.0:
+        a = 0.0
+        b = big
+    else:
+        a = -big
+        b = 0.0
+    if not (a < x < b):
+        x = 0.5 * (a + b) if math.isfinite(b - a) else x1
+    for _ in range(MAXIT + 100):
+        t, r, rp, _u0, _u1, _u2, _u3 = _uv_eval(x, r0, sigma0, alpha)
+        f = t - tau
+        if f == 0.0:
+            return x
+        if f < 0.0:
+            a = x
+        else:
+            b = x
+        # Laguerre, n = 5: dx = n f / (f' + sign(f') sqrt|(n-1)^2 f'^2 - n(n-1) f f''|)
+        disc = math.sqrt(abs(16.0 * r * r - 20.0 * f * rp))
+        den = r + disc if r >= 0.0 else r - disc
+        if den != 0.0 and math.isfinite(den):
+            xn = x - 5.0 * f / den
+        else:
+            xn = math.nan
+        if not (a < xn < b):
+            if math.isinf(b):
+                xn = 2.0 * max(abs(x), abs(x1))
+            elif math.isinf(a):
+                xn = -2.0 * max(abs(x), abs(x1))
+            else:
+                xn = 0.5 * (a + b)
+        if abs(xn - x) <= 2.0 * EPS * abs(xn):
+            return xn
+        if math.isfinite(b - a) and (b - a) <= 4.0 * EPS * max(abs(a), abs(b)):
+            return xn
+        x = xn
+    return math.nan
+
+
+@njit(cache=True)
+def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
+    """Two-body state after time ``dt`` by universal variables (f and g series).
+
+    Returns ``(rx, ry, rz, vx, vy, vz)``, all NaN on failure.
+
+    * A bound orbit's ``dt`` is first reduced modulo the period
+      ``P = 2 pi / (sqrt(mu) alpha^1.5)`` with an exact (Dekker) product, so
+      |dt| may be many periods.
+    * Moving away from periapsis (``sigma0 dt >= 0``, or a nearly circular
+      orbit) the universal Kepler equation ``T(chi) = sqrt(mu) dt`` is a sum
+      of terms of one sign and is solved directly; g is then computed from chi
+      alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g = 1
+      holds identically and the state stays on the initial orbit whatever the
+      solver's last-bit error.
+    * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4), the terms of
+      T(chi) cancel (for an open orbit that starts far out the loss is about
+      r0/q in relative accuracy).  The equation is then anchored at
+      periapsis, where all terms have one sign: chi0 of the initial state is
+      found from sigma0 = e U1(chi0) (atan2 / asinh forms), and
+      ``q U1(chi1) + U3(chi1) = q U1(chi0) + U3(chi0) + sqrt(mu) dt`` is solved
+      for chi1; f and g use dchi = chi1 - chi0 with ``g = dt - U3/sqrt(mu)``
+      and ``r = q U0(chi1) + U2(chi1)``.
+    """
+    nan = math.nan
+    if dt == 0.0:
+        return rx, ry, rz, vx, vy, vz
+    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
+    v2 = vx * vx + vy * vy + vz * vz
+    smu = math.sqrt(mu)
+    sigma0 = (rx * vx + ry * vy + rz * vz) / smu
+    alpha = 2.0 / r0 - v2 / mu
+    t = dt
+    if alpha > 0.0:
+        sa = math.sqrt(alpha)
+        period = TWO_PI_HI / (smu * alpha * sa)
+        if abs(t) > 0.5 * period:
+            k = math.floor(t / period + 0.5)
+            p, err = _two_prod(k, period)
+            t = (t - p) - err
+    tau = smu * t
+    hx = ry * vz - rz * vy
+    hy = rz * vx - rx * vz
+    hz = rx * vy - ry * vx
+    pp = (hx * hx + hy * hy + hz * hz) / mu
+    e2 = 1.0 - alpha * pp
+    if sigma0 * tau < 0.0 and e2 >= 0.25:
+        ecc = math.sqrt(e2)
+        q = pp / (1.0 + ecc)
+        if alpha > 0.0:
+            sa = math.sqrt(alpha)
+            chi0 = math.atan2(sigma0 * sa, 1.0 - r0 * alpha) / sa
+        elif alpha < 0.0:
+            sa = math.sqrt(-alpha)
+            chi0 = math.asinh(sigma0 * sa / ecc) / sa
+        else:
+            chi0 = sigma0 / ecc
+        tp0 = _uv_eval(chi0, q, 0.0, alpha)[0]
+        chi1 = solve_universal(tp0 + tau, q, 0.0, alpha)
+        if not math.isfinite(chi1):
+            return nan, nan, nan, nan, nan, nan
+        r = _uv_eval(chi1, q, 0.0, alpha)[1]
+        dchi = chi1 - chi0
+        _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
+        g = (tau - u3) / smu
+    else:
+        chi = solve_universal(tau, r0, sigma0, alpha)
+        if not math.isfinite(chi):
+            return nan, nan, nan, nan, nan, nan
+        _t, r, _rp, _u0, u1, u2, _u3 = _uv_eval(chi, r0, sigma0, alpha)
+        g = (r0 * u1 + sigma0 * u2) / smu
+    if not (r > 0.0) or not math.isfinite(r):
+        return nan, nan, nan, nan, nan, nan
+    f = 1.0 - u2 / r0
+    fd = -smu * u1 / (r * r0)
+    gd = 1.0 - u2 / r
+    x = f * rx + g * vx
+    y = f * ry + g * vy
+    z = f * rz + g * vz
+    wx = fd * rx + gd * vx
+    wy = fd * ry + gd * vy
+    wz = fd * rz + gd * vz
+    # Velocity = radial part of the f-g velocity + the exact transverse part
+    # h x r / |r|^2 (h = r0 x v0 is constant).  fdot r0 + gdot v0 cancels
+    # heavily in its transverse part when r >> r0; this form keeps r x v = h
+    # to rounding (and gives exactly zero transverse velocity on radial orbits).
+    rr = x * x + y * y + z * z
+    vr = (x * wx + y * wy + z * wz) / rr
+    return (
+        x,
+        y,
+        z,
+        vr * x + (hy * z - hz * y) / rr,
+        vr * y + (hz * x - hx * z) / rr,
+        vr * z + (hx * y - hy * x) / rr,
+    )
+
+
+@njit(cache=True)
+def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
+    """Loop :func:`propagate_uv` over rows; returns the first failing row or -1."""
+    bad = -1
+    for i in range(r.shape[0]):
+        x, y, z, a, b, c = propagate_uv(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], dt[i]
+        )
+        r_out[i, 0] = x
+        r_out[i, 1] = y
+        r_out[i, 2] = z
+        v_out[i, 0] = a
+        v_out[i, 1] = b
+        v_out[i, 2] = c
+        if bad < 0 and not (
+            math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+            and math.isfinite(a) and math.isfinite(b) and math.isfinite(c)
+        ):
+            bad = i
+    return bad
+
+
+__all__ = [
+    "EPS",
+    "anomaly_from_nu",
+    "anomaly_from_nu_ufunc",
+    "mean_from_anomaly",
+    "mean_from_anomaly_ufunc",
+    "nu_from_anomaly",
+    "nu_from_anomaly_ufunc",
+    "propagate_batch",
+    "propagate_uv",
+    "sinh_minus_x",
+    "solve",
+    "solve_parabolic",
+    "solve_ufunc",
+    "solve_universal",
+    "stumpff_c2c3",
+    "x_minus_sin",
+]
