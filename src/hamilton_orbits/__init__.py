@@ -5,6 +5,7 @@ The curated public API.  Everything not listed in ``__all__`` is private.
 
 from importlib.metadata import PackageNotFoundError, version
 
+from hamilton_orbits.kepler import ConvergenceError, solve_kepler
 from hamilton_orbits.quaternion import Quaternion, slerp
 
 try:
@@ -13,7 +14,9 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0.0.0+unknown"
 
 __all__ = [
+    "ConvergenceError",
     "Quaternion",
     "__version__",
     "slerp",
+    "solve_kepler",
 ]
