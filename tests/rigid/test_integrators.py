@@ -1,0 +1,170 @@
+"""Tests for rigid.integrators: orders, invariants, exact flow + kicks, DOP853."""
+
+from __future__ import annotations
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+from hamilton_orbits import Quaternion
+from rigid import (
+    BodyTorque,
+    GravityGradientTorque,
+    RigidBody,
+    SpaceTorque,
+    integrate,
+)
+from rigid.free import free_motion_arrays
+
+EPS = np.finfo(float).eps
+MOMENTS = np.array([1.0, 2.0, 3.0])
+Q0 = Quaternion.from_axis_angle([0.2, -0.5, 0.8], 1.3)
+W0 = np.array([0.4, 1.1, -0.3])
+BODY = RigidBody(MOMENTS, attitude=Q0, omega=W0)
+T_END = 10.0
+
+
+def _exact(t):
+    q, w = free_motion_arrays(MOMENTS, Q0.as_array(), W0, np.asarray(t))
+    return Quaternion(q), w
+
+
+def _error(tr):
+    q, w = _exact(tr.t)
+    return float(np.max(tr.attitude.rotation_distance(q))), float(np.max(np.abs(tr.omega - w)))
+
+
+def _rel_dev(x):
+    return float(np.max(np.abs(x / x[0] - 1.0)))
+
+
+@pytest.mark.parametrize(
+    ("method", "order", "dt"),
+    [("splitting2", 2, 0.02), ("splitting4", 4, 0.04), ("rk4", 4, 0.04)],
+)
+def test_measured_order_free_body(method, order, dt):
+    # Halving dt divides the error by 2^order (4 or 16); asymptotic regime
+    # checked at 20 % (the dt are small enough that the next term is < 10 %).
+    e1 = _error(integrate(BODY, T_END, dt=dt, method=method, n_out=11))
+    e2 = _error(integrate(BODY, T_END, dt=dt / 2, method=method, n_out=11))
+    for a, b in zip(e1, e2, strict=True):
+        assert 0.8 * 2**order < a / b < 1.2 * 2**order
+
+
+@pytest.mark.parametrize(("method", "order"), [("splitting2", 2), ("splitting4", 4)])
+def test_splittings_conserve_momentum_to_rounding_and_energy_to_order(method, order):
+    dt = 0.05
+    a = integrate(BODY, T_END, dt=dt, method=method, n_out=201)
+    b = integrate(BODY, T_END, dt=dt / 2, method=method, n_out=201)
+    # Every sub-flow is an exact rotation: |L| and the space-frame L change only
+    # by the random walk of rounding over ~1e3 sub-rotations (~sqrt(n) eps).
+    for tr in (a, b):
+        assert _rel_dev(np.linalg.norm(tr.angular_momentum_body, axis=-1)) < 1e-13
+        ls = tr.angular_momentum_space
+        assert np.max(np.abs(ls - ls[0])) < 1e-13 * np.linalg.norm(ls[0])
+    # Energy: O(dt^order), ratio 2^order when dt is halved.
+    ea = _rel_dev(a.kinetic_energy)
+    eb = _rel_dev(b.kinetic_energy)
+    assert 0.7 * 2**order < ea / eb < 1.3 * 2**order
+
+
+def test_splitting_energy_error_bounded_no_drift():
+    # Symplectic (Poisson) integrator: the energy error oscillates without
+    # secular growth.  Over 2000 s (~40000 steps) its maximum over the last tenth
+    # is no larger than over the first tenth (up to the oscillation's envelope).
+    tr = integrate(BODY, 2000.0, dt=0.05, method="splitting2", n_out=4001)
+    de = np.abs(tr.kinetic_energy / tr.kinetic_energy[0] - 1.0)
+    first, last = de[:400].max(), de[-400:].max()
+    assert first > 1e-6  # the error is visible, so the comparison means something
+    assert last < 1.5 * first
+
+
+def test_exact_kick_is_exact_for_the_free_body():
+    # The drift is the closed-form free motion: any step size is exact up to the
+    # rounding of the exact solution accumulated over 20 steps.
+    tr = integrate(BODY, T_END, dt=0.5, method="exact_kick", n_out=21)
+    eq, ew = _error(tr)
+    assert eq < 1e-12
+    assert ew < 1e-12
+
+
+def test_dop853_against_exact_and_norm_policy():
+    # rtol 1e-13 over 10 s (about four precession periods of this body): the
+    # attitude and omega agree with the exact solution to 1e-11.
+    tr = integrate(BODY, T_END, method="dop853", rtol=1e-13, atol=1e-15, n_out=51)
+    eq, ew = _error(tr)
+    assert eq < 1e-11
+    assert ew < 1e-11
+    # q is integrated unconstrained and normalised on output: its norm drift is
+    # of the order of the integration error, and the output is unit.
+    assert tr.norm_drift < 1e-12
+    np.testing.assert_allclose(tr.attitude.norm(), 1.0, rtol=0, atol=4 * EPS)
+    assert tr.nfev > 0
+
+
+@pytest.mark.parametrize(
+    "torque",
+    [SpaceTorque([0.05, -0.02, 0.03]), BodyTorque([0.0, 0.0, 0.0])],
+)
+@pytest.mark.parametrize("method", ["splitting2", "splitting4", "exact_kick"])
+def test_constant_space_torque_momentum_law(method, torque):
+    # dL_space/dt = N: a kick adds N h to L_space exactly and every drift keeps
+    # L_space fixed, so L_space(t) = L_space(0) + N t at any step size, to rounding.
+    tr = integrate(BODY, T_END, dt=0.1, method=method, torque=torque, n_out=11)
+    _, params = torque.encode()
+    n_space = params if isinstance(torque, SpaceTorque) else np.zeros(3)
+    ls = tr.angular_momentum_space
+    ref = ls[0] + np.asarray(tr.t)[:, None] * n_space
+    np.testing.assert_allclose(ls, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+
+
+def test_exact_kick_and_splittings_against_dop853_torqued():
+    # Gravity-gradient torque on a turning direction: no closed form, so DOP853
+    # at rtol 1e-13 is the reference.  exact_kick and splitting2 converge at
+    # order 2, splitting4 at order 4 and reaches 1e-9.
+    body = RigidBody(MOMENTS, attitude=Q0, omega=W0)
+    tq = GravityGradientTorque(0.25, mean_motion=0.5)
+    ref = integrate(body, T_END, method="dop853", rtol=1e-13, atol=1e-15, n_out=11, torque=tq)
+
+    def err(method, dt):
+        tr = integrate(body, T_END, dt=dt, method=method, n_out=11, torque=tq)
+        np.testing.assert_allclose(np.asarray(tr.t), np.asarray(ref.t), rtol=0, atol=1e-12)
+        return float(np.max(tr.attitude.rotation_distance(ref.attitude)))
+
+    for method, order, dt in (("exact_kick", 2, 0.02), ("splitting2", 2, 0.02),
+                              ("splitting4", 4, 0.04)):
+        r = err(method, dt) / err(method, dt / 2)
+        assert 0.8 * 2**order < r < 1.2 * 2**order, (method, r)
+    assert err("splitting4", 0.005) < 1e-9
+    assert err("exact_kick", 0.001) < 1e-5
+
+
+def test_progress_and_quantities():
+    a = integrate(BODY, T_END * u.s, dt=0.1 * u.s, method="splitting4", n_out=5)
+    b = integrate(BODY, T_END, dt=0.1, method="splitting4", n_out=5, progress=True)
+    assert a.t.unit == u.s
+    assert a.omega.unit == u.rad / u.s
+    np.testing.assert_array_equal(a.attitude.as_array(), b.attitude.as_array())
+    np.testing.assert_array_equal(a.omega.to_value(u.rad / u.s), b.omega)
+    np.testing.assert_array_equal(b.t, np.linspace(0.0, T_END, 5))
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="`method` to be one of"):
+        integrate(BODY, 1.0, dt=0.1, method="euler")
+    with pytest.raises(ValueError, match="Expected `dt` for method 'splitting2'"):
+        integrate(BODY, 1.0, method="splitting2")
+    with pytest.raises(ValueError, match="`t_end` to be finite, got nan"):
+        integrate(BODY, np.nan, dt=0.1)
+    with pytest.raises(ValueError, match=r"`t_end` > 0, got -1.0"):
+        integrate(BODY, -1.0, dt=0.1)
+    with pytest.raises(ValueError, match=r"`dt` > 0, got 0.0"):
+        integrate(BODY, 1.0, dt=0.0)
+    with pytest.raises(ValueError, match=r"`t_end` to be a scalar, got shape \(2,\)"):
+        integrate(BODY, [1.0, 2.0], dt=0.1)
+    with pytest.raises(ValueError, match="`n_out` to be an integer >= 2"):
+        integrate(BODY, 1.0, dt=0.1, n_out=1)
+    with pytest.raises(ValueError, match="Expected `torque` to be None"):
+        integrate(BODY, 1.0, dt=0.1, torque=[1.0, 0.0, 0.0])
+    with pytest.raises(u.UnitConversionError, match="`dt`"):
+        integrate(BODY, 1.0 * u.s, dt=0.1 * u.m)
