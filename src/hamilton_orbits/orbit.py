@@ -1,0 +1,672 @@
+"""Two-body orbits: state vectors <-> orbital elements for every conic.
+
+:class:`KeplerOrbit` stores the state ``(r, v, mu)`` as plain floats and derives
+all elements in one compiled pass (``hamilton_orbits._kernels.elements``), the
+first time one is asked for.  Hamilton's integrals are also available exactly
+as the seed writes them, as quaternion products: :func:`hamilton_beta`
+(eq. 3), :func:`hamilton_epsilon_from_products` (eq. 13) and
+:func:`hamilton_p` (eq. 16).
+
+Conventions (``docs/elements.md``): angles in radians; ``lan``, ``argp``,
+``argument_of_latitude`` and the longitudes in [0, 2 pi); ``nu``, ``anomaly``
+and (for bound orbits) ``M`` in (-pi, pi]; undefined angles are 0; for orbits
+with ``inc > pi/2`` the longitudes are measured backwards along the orbit
+(``varpi = lan - argp``), so that they stay defined for ``inc -> pi``.
+``eccentricity_vector`` is the modern one (towards periapsis);
+``hamilton_epsilon`` is Hamilton's epsilon, its negative (towards apoapsis).
+
+References
+----------
+W. R. Hamilton, "On the application of the method of quaternions to some
+dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits import kepler as _kepler
+from hamilton_orbits._kernels import elements as _el
+from hamilton_orbits._kernels import kepler as _kk
+from hamilton_orbits._validation import (
+    ConvergenceError,
+    _first_index,
+    _fmt_index,
+    as_float_array,
+    broadcast,
+    check_positive,
+    check_trailing,
+)
+from hamilton_orbits.quaternion import Quaternion
+from hamilton_orbits.units import is_quantity, strip, wrap
+
+__all__ = [
+    "KeplerOrbit",
+    "hamilton_beta",
+    "hamilton_epsilon_from_products",
+    "hamilton_p",
+]
+
+# internal units when Quantities come in
+_L = u.km
+_T = u.s
+_V = u.km / u.s
+_MU = u.km**3 / u.s**2
+_RAD = u.rad
+
+_COL = {name: i for i, name in enumerate(_el.COLUMNS)}
+
+
+def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
+    """Raise ValueError naming ``name``, the first index where ``mask`` and its value."""
+    if np.any(mask):
+        mask = np.atleast_1d(mask)
+        values = np.broadcast_to(np.atleast_1d(values), mask.shape)
+        index = _first_index(mask)
+        shown = index if np.ndim(mask) and mask.size > 1 else ()
+        raise ValueError(
+            f"Expected `{name}` {what}, got {float(values[index])!r}{_fmt_index(shown)}"
+        )
+
+
+def _scalar(a: np.ndarray):
+    return a[()] if isinstance(a, np.ndarray) and a.ndim == 0 else a
+
+
+def _check_state(r_in: Any, v_in: Any, mu_in: Any):
+    """Validate (r, v, mu); return float arrays broadcast to a common shape."""
+    q = [is_quantity(x) for x in (r_in, v_in, mu_in)]
+    if any(q) and not all(q):
+        raise ValueError(
+            "Expected `r`, `v`, `mu` to be all Quantities or all plain floats, got a mix"
+        )
+    quantity = all(q)
+    r = check_trailing("r", strip("r", r_in, _L), 3)
+    v = check_trailing("v", strip("v", v_in, _V), 3)
+    mu = strip("mu", mu_in, _MU)
+    check_positive("mu", mu)
+    lead = broadcast(("r", "v", "mu"), r[..., 0], v[..., 0], mu)[0].shape
+    r = np.broadcast_to(r, (*lead, 3))
+    v = np.broadcast_to(v, (*lead, 3))
+    mu = np.broadcast_to(mu, lead)
+    rn = np.sqrt(np.einsum("...i,...i->...", r, r))
+    bad = ~(rn > 0)
+    if np.any(bad):
+        index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+        raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{_fmt_index(index)}")
+    return r, v, mu, quantity
+
+
+class KeplerOrbit:
+    """Two-body (Kepler) orbits, vectorised over leading dimensions.
+
+    Build with :meth:`from_state` or :meth:`from_elements`.  The object keeps
+    the state; elements are computed once, in one compiled pass, on first use.
+
+    Attributes (shape = the leading dims; Quantities if built from Quantities)
+    ----------
+    a : semi-major axis (``inf`` for the parabola, negative for the hyperbola).
+    e, p, q : eccentricity, semi-latus rectum (Hamilton's p, eq. 16), periapsis
+        distance.
+    inc, lan, argp, nu, M, anomaly : inclination, longitude of the ascending
+        node, argument of periapsis, true anomaly, mean anomaly and the
+        eccentric (e < 1), parabolic ``D = tan(nu/2)`` (e = 1) or hyperbolic
+        (e > 1) anomaly.
+    n, period, energy : mean motion (parabola: ``sqrt(mu / (2 q^3))``, so that
+        ``M = n (t - t_peri)`` with Barker's ``M = D + D^3/3``), period (``inf``
+        if unbound), specific orbital energy.
+    varpi, argument_of_latitude, true_longitude, mean_longitude : the
+        combinations that stay defined when ``e = 0`` or ``inc`` in {0, pi}.
+    time_since_periapsis : ``M / n`` (for the radial parabola the time since
+        the collision).
+    areal_vector : Hamilton's beta = r x v (twice the areal velocity, eq. 3).
+    eccentricity_vector : the modern eccentricity vector, towards periapsis.
+    hamilton_epsilon : Hamilton's epsilon = -eccentricity_vector, towards
+        apoapsis (eq. 13).
+
+    Examples
+    --------
+    >>> o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.2, 0.0], 1.0)
+    >>> round(float(o.e), 12), round(float(o.a), 12), round(float(o.p), 12)
+    (0.44, 1.785714285714, 1.44)
+    >>> [round(float(x), 12) for x in o.hamilton_epsilon]
+    [-0.44, 0.0, 0.0]
+    """
+
+
+    def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
+        # np.array, not ascontiguousarray (which turns 0-d into 1-d)
+        self._r = np.array(r, dtype=np.float64, order="C")
+        self._v = np.array(v, dtype=np.float64, order="C")
+        self._mu = np.array(mu, dtype=np.float64, order="C")
+        self._quantity = quantity
+
+    # ------------------------------------------------------------------ build
+    @classmethod
+    def from_state(cls, r: Any, v: Any, mu: Any) -> KeplerOrbit:
+        """Orbit through the state ``(r, v)`` about a centre of parameter ``mu``.
+
+        Parameters
+        ----------
+        r : array_like or Quantity (length), shape (..., 3)
+            Position relative to the attracting centre (nonzero).
+        v : array_like or Quantity (length/time), shape (..., 3)
+            Velocity.
+        mu : array_like or Quantity (length^3/time^2), shape (...)
+            ``G (m1 + m2) > 0`` (Hamilton's M).
+
+        Returns
+        -------
+        KeplerOrbit
+            Leading shape = broadcast of ``r[..., 0]``, ``v[..., 0]``, ``mu``.
+
+        Raises
+        ------
+        ValueError
+            NaN / inf, trailing dimension not 3, ``mu <= 0``, ``r = 0``,
+            incompatible shapes, or a mix of Quantities and plain floats.
+        astropy.units.UnitConversionError
+            For a Quantity of the wrong kind.
+
+        Examples
+        --------
+        >>> o = KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.0, 0], 1.0)
+        >>> o.shape, [round(float(x), 12) for x in o.e]
+        ((2,), [0.0, 0.5])
+        """
+        r_, v_, mu_, quantity = _check_state(r, v, mu)
+        return cls(r_, v_, mu_, quantity)
+
+    @classmethod
+    def from_elements(
+        cls,
+        *,
+        e: Any,
+        inc: Any,
+        lan: Any,
+        argp: Any,
+        mu: Any,
+        a: Any = None,
+        p: Any = None,
+        q: Any = None,
+        nu: Any = None,
+        M: Any = None,
+    ) -> KeplerOrbit:
+        """Orbit from classical elements.
+
+        Parameters
+        ----------
+        a, p, q : array_like or Quantity (length), shape (...); exactly one
+            Semi-major axis (``a > 0`` with ``e < 1``, ``a < 0`` with
+            ``e > 1``; with ``e == 1`` a finite ``a`` gives the radial orbit of
+            that energy), semi-latus rectum ``p > 0`` or periapsis distance
+            ``q > 0``.
+        e : array_like, shape (...)
+            Eccentricity, ``e >= 0``; ``e == 1`` exactly is the parabola.
+        inc : array_like or Quantity (angle), shape (...)
+            Inclination in [0, pi] (``inc == pi`` is exactly retrograde).
+        lan, argp : array_like or Quantity (angle), shape (...)
+            Longitude of the ascending node, argument of periapsis.
+        nu, M : array_like or Quantity (angle), shape (...); exactly one
+            True anomaly (inside the asymptotes for ``e >= 1``) or mean
+            anomaly (Kepler's equation by :func:`hamilton_orbits.solve_kepler`).
+            A radial orbit takes ``M``.
+        mu : array_like or Quantity (length^3/time^2), shape (...)
+            Gravitational parameter, ``> 0``.
+
+        Returns
+        -------
+        KeplerOrbit
+
+        Raises
+        ------
+        ValueError
+            Naming the argument, index and value: ``e < 0``, ``a`` and ``e``
+            inconsistent, ``p <= 0``, ``q <= 0``, ``mu <= 0``, ``inc`` outside
+            [0, pi], ``nu`` beyond the asymptote, NaN / inf, incompatible
+            shapes, not exactly one of a/p/q or nu/M.
+        ConvergenceError
+            If Kepler's equation cannot be solved.
+
+        Notes
+        -----
+        The state is ``r = x P + y Q`` with perifocal ``x = a (cos E - e)``,
+        ``y = sqrt(a p) sin E`` (and the hyperbolic / parabolic analogues), i.e.
+        Hamilton's conic ``r = p / (1 + e cos v)`` (eq. 20) with ``p = a (1 - e^2)``
+        (eq. 29).
+
+        Examples
+        --------
+        >>> o = KeplerOrbit.from_elements(a=1.0, e=0.5, inc=0.0, lan=0.0, argp=0.0,
+        ...                               nu=0.0, mu=1.0)
+        >>> r, v = o.state()
+        >>> [round(float(x), 12) + 0.0 for x in r], [round(float(x), 12) + 0.0 for x in v]
+        ([0.5, 0.0, 0.0], [0.0, 1.732050807569, 0.0])
+        """
+        sizes = [x is not None for x in (a, p, q)]
+        if sum(sizes) != 1:
+            raise ValueError("Expected exactly one of `a`, `p`, `q`")
+        if (nu is None) == (M is None):
+            raise ValueError("Expected exactly one of `nu`, `M`")
+        given = {"a": a, "p": p, "q": q}
+        lname = next(k for k, x in given.items() if x is not None)
+        lval = given[lname]
+        aname = "nu" if nu is not None else "M"
+        aval = nu if nu is not None else M
+        inputs = {"e": e, "inc": inc, "lan": lan, "argp": argp, "mu": mu, lname: lval, aname: aval}
+        qs = {k: is_quantity(x) for k, x in inputs.items()}
+        quantity = qs[lname] or qs["mu"]
+        if quantity and not (qs[lname] and qs["mu"]):
+            raise ValueError(
+                f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
+            )
+        e_ = strip("e", e, None)
+        inc_ = strip("inc", inc, _RAD)
+        lan_ = strip("lan", lan, _RAD)
+        argp_ = strip("argp", argp, _RAD)
+        mu_ = strip("mu", mu, _MU)
+        len_ = strip(lname, lval, _L)
+        ang_ = strip(aname, aval, _RAD)
+        e_, inc_, lan_, argp_, mu_, len_, ang_ = broadcast(
+            ("e", "inc", "lan", "argp", "mu", lname, aname),
+            e_, inc_, lan_, argp_, mu_, len_, ang_,
+        )
+        shape = e_.shape
+        _raise_at("e", ~(e_ >= 0), e_, ">= 0")
+        check_positive("mu", mu_)
+        _raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi]")
+        radial = np.zeros(shape, dtype=bool)
+        inv_a = np.zeros(shape)
+        if lname == "a":
+            _raise_at("a", len_ == 0, len_, "nonzero")
+            _raise_at("a", (len_ > 0) & (e_ > 1), len_, "< 0 for e > 1 (a and e inconsistent)")
+            _raise_at("a", (len_ < 0) & (e_ < 1), len_, "> 0 for e < 1 (a and e inconsistent)")
+            radial = e_ == 1.0
+            p_ = len_ * (1.0 - e_) * (1.0 + e_)
+            inv_a = np.where(radial, 1.0 / len_, (1.0 - e_) * (1.0 + e_) / np.where(radial, 1, p_))
+        else:
+            _raise_at(lname, ~(len_ > 0), len_, "> 0")
+            p_ = len_ if lname == "p" else len_ * (1.0 + e_)
+            inv_a = (1.0 - e_) * (1.0 + e_) / p_
+        if aname == "nu":
+            _raise_at("nu", radial, ang_, "to be replaced by `M` for a radial orbit (e == 1, a given)")
+            anom = np.asarray(_kk.anomaly_from_nu_ufunc(ang_, e_))
+            _raise_at("nu", ~np.isfinite(anom), ang_, "inside the asymptotes (1 + e cos nu > 0)")
+        else:
+            with np.errstate(invalid="ignore"):
+                anom = np.asarray(_kk.solve_ufunc(ang_, np.where(radial, 0.0, e_)))
+            bad = ~np.isfinite(anom) & ~radial
+            if np.any(bad):
+                index = _first_index(np.atleast_1d(bad))
+                raise ConvergenceError(
+                    f"Kepler's equation not solved for `M` = "
+                    f"{float(np.atleast_1d(ang_)[index])!r}{_fmt_index(index if bad.ndim else ())}"
+                )
+        el = np.stack(
+            [p_ * 1.0, e_ * 1.0, inv_a * 1.0, inc_, lan_, argp_, np.where(radial, 0.0, anom)],
+            axis=-1,
+        ).reshape(-1, 7)
+        flat_mu = np.ascontiguousarray(mu_.reshape(-1), dtype=np.float64)
+        r_out = np.empty((el.shape[0], 3))
+        v_out = np.empty((el.shape[0], 3))
+        el[:, 0] = np.where(radial.reshape(-1), 0.0, el[:, 0])
+        _el.elements_to_state(np.ascontiguousarray(el), flat_mu, r_out, v_out)
+        if np.any(radial):
+            _radial_from_mean(el, flat_mu, ang_.reshape(-1), radial.reshape(-1), r_out, v_out)
+        r_out = r_out.reshape((*shape, 3))
+        v_out = v_out.reshape((*shape, 3))
+        bad = ~np.all(np.isfinite(r_out) & np.isfinite(v_out), axis=-1)
+        _raise_at(lname, bad, len_, "to give a finite state (check the elements)")
+        return cls(r_out, v_out, mu_, quantity)
+
+    # --------------------------------------------------------------- elements
+    @cached_property
+    def _elements(self) -> np.ndarray:
+        flat_r = self._r.reshape(-1, 3)
+        flat_v = self._v.reshape(-1, 3)
+        flat_mu = self._mu.reshape(-1)
+        out = np.empty((flat_r.shape[0], _el.NCOL))
+        _el.state_to_elements(flat_r, flat_v, flat_mu, out)
+        return out.reshape((*self._mu.shape, _el.NCOL))
+
+    def _col(self, name: str) -> np.ndarray:
+        return self._elements[..., _COL[name]]
+
+    def _out(self, value: np.ndarray, unit: u.UnitBase | None):
+        return wrap(_scalar(np.asarray(value)), unit, self._quantity)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Leading shape (number of orbits in each dimension)."""
+        return self._mu.shape
+
+    def __len__(self) -> int:
+        if not self.shape:
+            raise TypeError("len() of a single KeplerOrbit")
+        return self.shape[0]
+
+    def __getitem__(self, key: Any) -> KeplerOrbit:
+        if not self.shape:
+            raise IndexError("a single KeplerOrbit cannot be indexed")
+        return KeplerOrbit(self._r[key], self._v[key], self._mu[key], self._quantity)
+
+    def __repr__(self) -> str:
+        return f"KeplerOrbit(shape={self.shape})"
+
+    @property
+    def mu(self):
+        """Gravitational parameter (length^3/time^2)."""
+        return self._out(self._mu, _MU)
+
+    @property
+    def e(self):
+        """Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."""
+        return self._out(self._col("e"), None)
+
+    @property
+    def p(self):
+        """Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16)."""
+        return self._out(self._col("p"), _L)
+
+    @property
+    def _inv_a(self) -> np.ndarray:
+        return self._col("inv_a")
+
+    @property
+    def a(self):
+        """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
+        inv = self._inv_a
+        safe = np.where(inv == 0, 1.0, inv)
+        return self._out(np.where(inv == 0, np.inf, 1.0 / safe), _L)
+
+    @property
+    def q(self):
+        """Periapsis distance ``p / (1 + e)`` (0 for radial orbits)."""
+        return self._out(self._col("p") / (1.0 + self._col("e")), _L)
+
+    @property
+    def inc(self):
+        """Inclination in [0, pi] (rad)."""
+        return self._out(self._col("inc"), _RAD)
+
+    @property
+    def lan(self):
+        """Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."""
+        return self._out(self._col("lan"), _RAD)
+
+    @property
+    def argp(self):
+        """Argument of periapsis in [0, 2 pi); 0 when ``e = 0``."""
+        return self._out(self._col("argp"), _RAD)
+
+    @property
+    def nu(self):
+        """True anomaly in (-pi, pi] (Hamilton's v, eq. 18)."""
+        return self._out(self._col("nu"), _RAD)
+
+    @property
+    def anomaly(self):
+        """Eccentric (e < 1), parabolic D = tan(nu/2) (e = 1) or hyperbolic (e > 1) anomaly.
+
+        Radial orbits: E with ``r = a (1 - cos E)`` or F with ``r = |a| (cosh F - 1)``;
+        0 for the radial parabola.
+        """
+        return self._out(self._col("anomaly"), _RAD)
+
+    @property
+    def M(self):
+        """Mean anomaly: ``E - e sin E``, ``D + D^3/3`` (Barker) or ``e sinh F - F``."""
+        return self._out(self._col("M"), _RAD)
+
+    @property
+    def _n(self) -> np.ndarray:
+        kind = self._col("kind")
+        inv = np.abs(self._inv_a)
+        p = self._col("p")
+        e = self._col("e")
+        q = np.where(p > 0, p / (1.0 + e), 1.0)
+        n = np.where(
+            kind == _el.PARABOLA,
+            np.sqrt(self._mu / (2.0 * q**3)),
+            np.sqrt(self._mu) * inv * np.sqrt(inv),
+        )
+        return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
+
+    @property
+    def n(self):
+        """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
+        return self._out(self._n, _RAD / _T)
+
+    @property
+    def period(self):
+        """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
+        kind = self._col("kind")
+        bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
+        n = np.where(bound, self._n, 1.0)
+        return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
+
+    @property
+    def energy(self):
+        """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
+        return self._out(-0.5 * self._mu * self._inv_a, _V**2)
+
+    @property
+    def time_since_periapsis(self):
+        """``M / n``; for a radial orbit the time since the collision."""
+        return self._out(self._col("tau"), _T)
+
+    @property
+    def _sign(self) -> np.ndarray:
+        return np.where(self._col("inc") <= 0.5 * np.pi, 1.0, -1.0)
+
+    @property
+    def varpi(self):
+        """Longitude of periapsis ``lan + argp`` (``lan - argp`` for inc > pi/2), [0, 2 pi)."""
+        return self._out(_wrap2pi(self._col("lan") + self._sign * self._col("argp")), _RAD)
+
+    @property
+    def argument_of_latitude(self):
+        """``argp + nu`` in [0, 2 pi), from the position directly (defined when e = 0)."""
+        return self._out(self._col("u"), _RAD)
+
+    @property
+    def true_longitude(self):
+        """``lan + argp + nu`` (``lan - argp - nu`` for inc > pi/2), [0, 2 pi)."""
+        return self._out(_wrap2pi(self._col("lan") + self._sign * self._col("u")), _RAD)
+
+    @property
+    def mean_longitude(self):
+        """``varpi + M`` (``varpi - M`` for inc > pi/2); in [0, 2 pi) for bound orbits."""
+        varpi = self._col("lan") + self._sign * self._col("argp")
+        ml = varpi + self._sign * self._col("M")
+        kind = self._col("kind")
+        bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
+        return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
+
+    @property
+    def areal_vector(self):
+        """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
+        return self._out(np.cross(self._r, self._v), _L * _V)
+
+    @property
+    def eccentricity_vector(self):
+        """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
+        return self._out(_ecc_vector(self._r, self._v, self._mu), None)
+
+    @property
+    def hamilton_epsilon(self):
+        """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
+        return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
+
+    # ----------------------------------------------------------------- methods
+    def state(self) -> tuple[Any, Any]:
+        """The state ``(r, v)``, shapes (..., 3) (Quantities in km, km/s if built from them).
+
+        Examples
+        --------
+        >>> o = KeplerOrbit.from_state([1.0, 0, 0], [0, 1.0, 0], 1.0)
+        >>> [x.tolist() for x in o.state()]
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        """
+        return self._out(self._r.copy(), _L), self._out(self._v.copy(), _V)
+
+    def propagate(self, dt: Any) -> KeplerOrbit:
+        """The orbit after time ``dt`` (any sign; broadcast over the leading dims).
+
+        By universal variables (:func:`hamilton_orbits.kepler.propagate`).
+
+        Parameters
+        ----------
+        dt : array_like or Quantity (time), shape (...)
+
+        Returns
+        -------
+        KeplerOrbit
+
+        Examples
+        --------
+        >>> o = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.1, lan=0.2, argp=0.3,
+        ...                               M=0.5, mu=1.0)
+        >>> round(float(o.propagate(2.0).M), 12)
+        2.5
+        """
+        if is_quantity(dt) != self._quantity:
+            raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
+        dt_ = strip("dt", dt, _T)
+        r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
+        mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
+        return KeplerOrbit(r, v, mu, self._quantity)
+
+    @property
+    def conic(self):
+        """Hamilton's geometry of the orbit, a :class:`hamilton_orbits.conic.Conic`."""
+        from hamilton_orbits.conic import Conic
+
+        return Conic._from_orbit(self)
+
+
+def _wrap2pi(x: np.ndarray) -> np.ndarray:
+    y = np.mod(x, 2.0 * np.pi)
+    return np.where(y >= 2.0 * np.pi, 0.0, y)
+
+
+def _ecc_vector(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    rn = np.sqrt(np.einsum("...i,...i->...", r, r))[..., None]
+    v2 = np.einsum("...i,...i->...", v, v)[..., None]
+    rv = np.einsum("...i,...i->...", r, v)[..., None]
+    m = mu[..., None]
+    return ((v2 - m / rn) * r - rv * v) / m
+
+
+def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
+    """States of radial orbits from their mean anomaly (in place).
+
+    Kepler's equation for a rectilinear orbit (e = 1, a finite) is solved by
+    universal-variable propagation from a reference point: the apoapsis
+    (``M = pi``, at rest at ``r = 2a``) of the bound orbit, the point ``F = 1``
+    of the unbound one.
+    """
+    idx = np.flatnonzero(radial)
+    inv_a = el[idx, 2]
+    ref = el[idx].copy()
+    ref[:, 0] = 0.0
+    bound = inv_a > 0
+    ref[:, 6] = np.where(bound, np.pi, 1.0)
+    r0 = np.empty((idx.size, 3))
+    v0 = np.empty((idx.size, 3))
+    _el.elements_to_state(np.ascontiguousarray(ref), np.ascontiguousarray(mu[idx]), r0, v0)
+    m0 = np.where(bound, np.pi, np.sinh(1.0) - 1.0)
+    ia = np.abs(inv_a)
+    n = np.sqrt(mu[idx]) * ia * np.sqrt(ia)
+    mm = m[idx]
+    _raise_at("M", bound & ~((mm > -np.pi) & (mm <= np.pi)), mm, "in (-pi, pi] for a radial orbit")
+    dt = (mm - m0) / n
+    r1, v1 = _kepler.propagate(r0, v0, mu[idx], dt)
+    r_out[idx] = r1
+    v_out[idx] = v1
+
+
+# ---------------------------------------------------------------------------
+# Hamilton's integrals as quaternion products
+# ---------------------------------------------------------------------------
+
+
+def _vec(name: str, x: Any) -> np.ndarray:
+    return check_trailing(name, as_float_array(name, x), 3)
+
+
+def hamilton_beta(r: Any, v: Any) -> np.ndarray:
+    """Hamilton's areal vector ``beta = (alpha alpha' - alpha' alpha) / 2`` (seed eq. 3).
+
+    Computed from two Hamilton products of the pure quaternions ``alpha = r``
+    and ``alpha' = v``; equals ``r x v``.
+
+    Parameters
+    ----------
+    r, v : array_like, shape (..., 3)
+        Position and velocity (plain floats, any consistent units).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        The vector part of the (pure) quaternion beta.
+
+    Examples
+    --------
+    >>> hamilton_beta([1.0, 0, 0], [0, 2.0, 0]).tolist()
+    [0.0, 0.0, 2.0]
+    """
+    alpha = Quaternion.from_vector(_vec("r", r))
+    dalpha = Quaternion.from_vector(_vec("v", v))
+    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+
+
+def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any) -> np.ndarray:
+    """Hamilton's ``epsilon = iota - alpha' beta / M`` (seed eq. 13), by quaternion products.
+
+    ``iota = alpha / r`` is the unit vector of the position; in Hamilton's
+    algebra ``alpha' beta = -alpha'.beta + alpha' x beta = v x beta`` (as v is
+    perpendicular to beta), so ``epsilon = r/|r| - v x (r x v)/mu``, the
+    negative of the modern eccentricity vector: it points to the apoapsis.
+
+    Parameters
+    ----------
+    r, v : array_like, shape (..., 3)
+    mu : array_like, shape (...)
+        Hamilton's M, ``> 0``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    Examples
+    --------
+    >>> hamilton_epsilon_from_products([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12).tolist()
+    [-0.44, 0.0, 0.0]
+    """
+    r_ = _vec("r", r)
+    v_ = _vec("v", v)
+    mu_ = check_positive("mu", as_float_array("mu", mu))
+    rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
+    iota = Quaternion.from_vector(r_ / rn[..., None])
+    dalpha = Quaternion.from_vector(v_)
+    beta = Quaternion.from_vector(hamilton_beta(r_, v_))
+    eps = iota - (dalpha * beta) * (1.0 / mu_)
+    return eps.vector
+
+
+def hamilton_p(r: Any, v: Any, mu: Any) -> np.ndarray:
+    """Hamilton's semi-parameter ``p = -beta^2 / M`` (seed eq. 16), ``beta^2`` a quaternion square.
+
+    Examples
+    --------
+    >>> float(hamilton_p([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12))
+    1.44
+    """
+    beta = Quaternion.from_vector(hamilton_beta(r, v))
+    mu_ = check_positive("mu", as_float_array("mu", mu))
+    return -(beta * beta).scalar / mu_
