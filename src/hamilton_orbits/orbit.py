@@ -133,7 +133,7 @@ class KeplerOrbit:
     >>> o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.2, 0.0], 1.0)
     >>> round(float(o.e), 12), round(float(o.a), 12), round(float(o.p), 12)
     (0.44, 1.785714285714, 1.44)
-    >>> [round(float(x), 12) for x in o.hamilton_epsilon]
+    >>> [round(float(x), 12) + 0.0 for x in o.hamilton_epsilon]
     [-0.44, 0.0, 0.0]
     """
 
@@ -293,7 +293,9 @@ class KeplerOrbit:
             p_ = len_ if lname == "p" else len_ * (1.0 + e_)
             inv_a = (1.0 - e_) * (1.0 + e_) / p_
         if aname == "nu":
-            _raise_at("nu", radial, ang_, "to be replaced by `M` for a radial orbit (e == 1, a given)")
+            _raise_at(
+                "nu", radial, ang_, "to be replaced by `M` for a radial orbit (e == 1, a given)"
+            )
             anom = np.asarray(_kk.anomaly_from_nu_ufunc(ang_, e_))
             _raise_at("nu", ~np.isfinite(anom), ang_, "inside the asymptotes (1 + e cos nu > 0)")
         else:
