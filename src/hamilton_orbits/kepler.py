@@ -70,8 +70,9 @@ def _angle_pair(
 
 
 def _out(value: np.ndarray, quantity: bool):
-    value = value[()] if value.ndim == 0 else value
-    return wrap(value, u.rad, quantity)
+    if quantity:
+        return wrap(value, u.rad, True)
+    return value[()] if value.ndim == 0 else value
 
 
 def solve_kepler(M: Any, e: Any):

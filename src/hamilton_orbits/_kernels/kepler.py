@@ -33,28 +33,14 @@ TWO_PI_HI = 6.283185307179586
 TWO_PI_LO = 2.4492935982947064e-16
 MAXIT = 100
 
-# 1/(2k+3)!, k = 0..9: coefficients of x - sin x and sinh x - x = sum x^(2k+3)/(2k+3)!
-_S3 = 1.0 / 6.0
-_S5 = 1.0 / 120.0
-_S7 = 1.0 / 5040.0
-_S9 = 1.0 / 362880.0
-_S11 = 1.0 / 39916800.0
-_S13 = 1.0 / 6227020800.0
-_S15 = 1.0 / 1307674368000.0
-_S17 = 1.0 / 355687428096000.0
-_S19 = 1.0 / 121645100408832000.0
-_S21 = 1.0 / 51090942171709440000.0
-# 1/(2k+2)!, k = 0..9: coefficients of c2 = sum (-psi)^k/(2k+2)!
-_C2 = 1.0 / 2.0
-_C4 = 1.0 / 24.0
-_C6 = 1.0 / 720.0
-_C8 = 1.0 / 40320.0
-_C10 = 1.0 / 3628800.0
-_C12 = 1.0 / 479001600.0
-_C14 = 1.0 / 87178291200.0
-_C16 = 1.0 / 20922789888000.0
-_C18 = 1.0 / 6402373705728000.0
-_C20 = 1.0 / 2432902008176640000.0
+# 1/(2k+3)!, k = 0..14: coefficients of x - sin x and sinh x - x = sum x^(2k+3)/(2k+3)!
+_S = tuple(1.0 / math.factorial(2 * k + 3) for k in range(15))
+# 1/(2k+2)!, k = 0..9: coefficients of c2(psi) = sum (-psi)^k/(2k+2)!  (|psi| < 1)
+_C = tuple(1.0 / math.factorial(2 * k + 2) for k in range(10))
+# below this |x|, x - sin x and sinh x - x are summed as series: at |x| = 3 the
+# 15th term is 3^31/31! ~ 8e-20 of the sum, and above it the direct forms lose
+# at most a factor (x + |sin x|)/(x - sin x) < 1.4 (sinh: < 1.9)
+_SERIES_MAX = 3.0
 
 
 # ---------------------------------------------------------------------------
@@ -63,40 +49,30 @@ _C20 = 1.0 / 2432902008176640000.0
 
 
 @njit(cache=True)
+def _series_s(z, sign):  # pragma: no cover - compiled
+    """sum_k (sign z)^k / (2k+3)!  (Horner, 15 terms)."""
+    acc = _S[14]
+    for k in range(13, -1, -1):
+        acc = _S[k] + sign * z * acc
+    return acc
+
+
+@njit(cache=True)
 def x_minus_sin(x):  # pragma: no cover - compiled
-    """``x - sin x`` to full relative precision (series for |x| < 1)."""
-    if abs(x) >= 1.0:
+    """``x - sin x`` to full relative precision (series for |x| < 3)."""
+    if abs(x) >= _SERIES_MAX:
         return x - math.sin(x)
     z = x * x
-    # alternating series; last term x^21/21! < 2e-20 relative to x^3/6
-    s = _S19 - z * _S21
-    s = _S17 - z * s
-    s = _S15 - z * s
-    s = _S13 - z * s
-    s = _S11 - z * s
-    s = _S9 - z * s
-    s = _S7 - z * s
-    s = _S5 - z * s
-    s = _S3 - z * s
-    return x * z * s
+    return x * z * _series_s(z, -1.0)
 
 
 @njit(cache=True)
 def sinh_minus_x(x):  # pragma: no cover - compiled
-    """``sinh x - x`` to full relative precision (series for |x| < 1)."""
-    if abs(x) >= 1.0:
+    """``sinh x - x`` to full relative precision (series for |x| < 3)."""
+    if abs(x) >= _SERIES_MAX:
         return math.sinh(x) - x
     z = x * x
-    s = _S19 + z * _S21
-    s = _S17 + z * s
-    s = _S15 + z * s
-    s = _S13 + z * s
-    s = _S11 + z * s
-    s = _S9 + z * s
-    s = _S7 + z * s
-    s = _S5 + z * s
-    s = _S3 + z * s
-    return x * z * s
+    return x * z * _series_s(z, 1.0)
 
 
 @njit(cache=True)
@@ -217,7 +193,9 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
     if m == 0.0:
         return 0.0
     om = 1.0 - e
-    lo = max(m, _cubic_root(2.0 * om / e, 3.0 * m / e))
+    lo = m
+    if e > 0.1:  # the cubic matters near e = 1; for tiny e its p overflows
+        lo = max(m, _cubic_root(2.0 * om / e, 3.0 * m / e))
     hi = m + e
     if m <= PI and hi > PI:
         hi = PI
@@ -373,38 +351,23 @@ def stumpff_c2c3(psi):  # pragma: no cover - compiled
     """Stumpff functions ``c2(psi) = (1 - cos sqrt psi)/psi`` and
     ``c3(psi) = (sqrt psi - sin sqrt psi)/sqrt(psi)^3`` (continued to psi <= 0).
 
-    Power series for |psi| < 1; otherwise the forms ``2 sin^2(s/2)/psi`` and
-    ``(s - sin s)/s^3`` (and their hyperbolic counterparts), which have no
-    cancellation where they are used.
+    Power series for |psi| < 1; otherwise ``2 sin^2(s/2)/psi`` and
+    ``(s - sin s)/s^3`` (and their hyperbolic counterparts) with ``s - sin s``
+    from :func:`x_minus_sin`, so there is no cancellation anywhere.
     """
     if abs(psi) < 1.0:
         z = -psi
-        c2 = _C18 + z * _C20
-        c2 = _C16 + z * c2
-        c2 = _C14 + z * c2
-        c2 = _C12 + z * c2
-        c2 = _C10 + z * c2
-        c2 = _C8 + z * c2
-        c2 = _C6 + z * c2
-        c2 = _C4 + z * c2
-        c2 = _C2 + z * c2
-        c3 = _S19 + z * _S21
-        c3 = _S17 + z * c3
-        c3 = _S15 + z * c3
-        c3 = _S13 + z * c3
-        c3 = _S11 + z * c3
-        c3 = _S9 + z * c3
-        c3 = _S7 + z * c3
-        c3 = _S5 + z * c3
-        c3 = _S3 + z * c3
-        return c2, c3
+        c2 = _C[9]
+        for k in range(8, -1, -1):
+            c2 = _C[k] + z * c2
+        return c2, _series_s(psi, -1.0)
     if psi > 0.0:
         s = math.sqrt(psi)
         sh = math.sin(0.5 * s)
-        return 2.0 * sh * sh / psi, (s - math.sin(s)) / (psi * s)
+        return 2.0 * sh * sh / psi, x_minus_sin(s) / (psi * s)
     s = math.sqrt(-psi)
     sh = math.sinh(0.5 * s)
-    return 2.0 * sh * sh / (-psi), (math.sinh(s) - s) / (-psi * s)
+    return 2.0 * sh * sh / (-psi), sinh_minus_x(s) / (-psi * s)
 
 
 @njit(cache=True)
