@@ -557,6 +557,8 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     # heavily in its transverse part when r >> r0; this form keeps r x v = h
     # to rounding (and gives exactly zero transverse velocity on radial orbits).
     rr = x * x + y * y + z * z
+    if not (0.0 < rr < math.inf):  # |r|^2 overflows: report, never garbage
+        return nan, nan, nan, nan, nan, nan
     vr = (x * wx + y * wy + z * wz) / rr
     return (
         x,
