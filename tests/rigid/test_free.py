@@ -1,0 +1,326 @@
+"""Tests for the exact torque-free motion (rigid.free, rigid._free_kernels)."""
+
+from __future__ import annotations
+
+import itertools
+
+import astropy.units as u
+import mpmath
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+from scipy.special import ellipj, ellipk, elliprf, elliprj
+
+from hamilton_orbits import Quaternion
+from rigid import RigidBody, free_motion, free_motion_arrays, free_parameters
+from rigid import _free_kernels as fk
+
+EPS = np.finfo(float).eps
+
+
+def euler_rhs(t, y, moments):
+    """Euler's equations A p' = (B - C) q r ... and dq/dt = q (0, omega) / 2 (Cayley 1843)."""
+    a, b, c = moments
+    p, q, r = y[:3]
+    w, x, yy, z = y[3:]
+    return np.array([
+        (b - c) * q * r / a,
+        (c - a) * r * p / b,
+        (a - b) * p * q / c,
+        0.5 * (-x * p - yy * q - z * r),
+        0.5 * (w * p + yy * r - z * q),
+        0.5 * (w * q + z * p - x * r),
+        0.5 * (w * r + x * q - yy * p),
+    ])
+
+
+def dop853(moments, q0, w0, t, rtol=1e-13):
+    sol = solve_ivp(euler_rhs, (0.0, t[-1]), np.concatenate([w0, q0]), method="DOP853",
+                    rtol=rtol, atol=1e-16, t_eval=t, args=(np.asarray(moments),))
+    assert sol.success
+    return sol.y[3:].T, sol.y[:3].T
+
+
+def qdist(q1, q2):
+    """Componentwise distance up to the sign of the quaternion (q and -q are one rotation)."""
+    return np.minimum(np.abs(q1 - q2).max(-1), np.abs(q1 + q2).max(-1))
+
+
+# --- the special-function kernels against independent implementations -------------------
+
+
+def test_carlson_against_scipy():
+    rng = np.random.default_rng(0)
+    x, y, z = rng.uniform(0, 3, (3, 200))
+    p = rng.uniform(0.1, 3, 200)
+    ours_f = np.array([fk.carlson_rf(*a) for a in zip(x, y, z, strict=True)])
+    ours_j = np.array([fk.carlson_rj(*a) for a in zip(x, y, z, p, strict=True)])
+    np.testing.assert_allclose(ours_f, elliprf(x, y, z), rtol=8 * EPS)
+    # R_J adds the R_C series terms; a handful of ulp.
+    np.testing.assert_allclose(ours_j, elliprj(x, y, z, p), rtol=16 * EPS)
+    assert abs(fk.ellipk_m1(0.3) - ellipk(0.7)) <= 4 * EPS * ellipk(0.7)
+
+
+def test_jacobi_against_scipy_moderate_m():
+    for m in (0.0, 0.3, 0.9):
+        kk = ellipk(m)
+        for r in np.linspace(-kk, kk, 41):
+            s, c, d = fk.jacobi_reduced(r, m, 1.0 - m, kk)
+            sr, cr, dr, _ = ellipj(r, m)
+            assert abs(s - sr) < 4 * EPS and abs(c - cr) < 4 * EPS and abs(d - dr) < 4 * EPS
+
+
+def test_jacobi_near_separatrix_against_mpmath():
+    # m = 1 - 1e-12 with m1 passed directly: scipy's ellipj is wrong by orders of
+    # magnitude here (scipy issue 8480); ours keeps ~1e-14 absolute accuracy.  The
+    # relative accuracy of cn, dn ~ 1e-3 is ~1e-11 (cos of an amplitude near pi/2).
+    m1 = 1e-12
+    mpmath.mp.dps = 30
+    mm = mpmath.mpf(1) - mpmath.mpf(m1)
+    kk = fk.ellipk_m1(m1)
+    assert abs(kk - float(mpmath.ellipk(mm))) < 4 * EPS * kk
+    for r in np.linspace(-kk, kk, 61)[1:-1]:
+        ours = fk.jacobi_reduced(r, 1.0 - m1, m1, kk)
+        ref = [float(mpmath.ellipfun(k, mpmath.mpf(r), m=mm)) for k in ("sn", "cn", "dn")]
+        for o, e in zip(ours, ref, strict=True):
+            # The amplitude am(r) comes out of the AGM's backward recursion from
+            # phi_N = 2^N a_N r with a few eps |r| absolute error, which cos/sin
+            # carry into sn, cn, dn.
+            assert abs(o - e) <= 16 * EPS * (1.0 + abs(r))
+            assert abs(o - e) <= 5e-11 * abs(e) or abs(o - e) <= EPS
+
+
+# --- the motion against numerical integration ----------------------------------------
+
+
+CASES = [
+    # moments in every order, both polhode families, both signs of the polar spin
+    (np.array(perm), sgn * np.array(w))
+    for perm in itertools.permutations((1.0, 2.0, 3.0))
+    for w in ((1.0, 0.3, 0.8), (0.9, 0.8, 0.1))
+    for sgn in (1.0, -1.0)
+]
+
+
+@pytest.mark.parametrize(("moments", "w0"), CASES)
+def test_against_dop853_all_branches(moments, w0):
+    w0 = w0[np.argsort(np.argsort(moments))]  # put each component on its moment
+    q0 = np.array([0.3, -0.5, 0.7, 0.2])
+    q0 /= np.linalg.norm(q0)
+    t = np.linspace(0.0, 20.0, 41)
+    q, w = free_motion_arrays(moments, q0, w0, t)
+    qr, wr = dop853(moments, q0, w0, t)
+    # DOP853 at rtol 1e-13 over ~2 periods is good to ~1e-12.
+    assert np.abs(w - wr).max() < 5e-12
+    assert qdist(q, qr).max() < 5e-12
+    # No sign jumps: the returned quaternion is continuous in time.
+    assert np.abs(np.diff(q, axis=0)).max() < 0.5
+
+
+def test_against_dop853_100_periods():
+    moments = np.array([1.0, 2.0, 3.0])
+    w0 = np.array([1.0, 0.3, 0.8])
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    period = free_parameters(RigidBody(moments, q0, w0)).period
+    t = np.linspace(0.0, 100 * period, 501)
+    q, w = free_motion_arrays(moments, q0, w0, t)
+    qr, wr = dop853(moments, q0, w0, t)
+    err = max(np.abs(w - wr).max(), qdist(q, qr).max())
+    # Measured 1.3e-10 after 100 periods (924 s).  This is DOP853's own error
+    # growth: at rtol 2.3e-14 the difference drops to 2.8e-11 (see the slow test
+    # below), and after 10 periods it is 9e-13.
+    assert err < 3e-10
+    assert max(np.abs(w - wr)[:51].max(), qdist(q, qr)[:51].max()) < 2e-12
+
+
+@pytest.mark.slow
+def test_difference_to_dop853_shrinks_with_its_tolerance():
+    moments = np.array([1.0, 2.0, 3.0])
+    w0 = np.array([1.0, 0.3, 0.8])
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    t = np.linspace(0.0, 100 * free_parameters(RigidBody(moments, q0, w0)).period, 201)
+    q, w = free_motion_arrays(moments, q0, w0, t)
+    errs = []
+    for rtol in (1e-13, 2.3e-14):
+        qr, wr = dop853(moments, q0, w0, t, rtol=rtol)
+        errs.append(max(np.abs(w - wr).max(), qdist(q, qr).max()))
+    assert errs[1] < errs[0] / 3 and errs[1] < 5e-11
+
+
+def _mp_reference(moments, q0, w0, times, dps=25):
+    """High-precision Taylor integration (mpmath.odefun) of Euler + quaternion kinematics."""
+    mpmath.mp.dps = dps
+    a, b, c = (mpmath.mpf(float(x)) for x in moments)
+
+    def f(_t, y):
+        p, q, r, w, x, yy, z = y
+        return [(b - c) * q * r / a, (c - a) * r * p / b, (a - b) * p * q / c,
+                (-x * p - yy * q - z * r) / 2, (w * p + yy * r - z * q) / 2,
+                (w * q + z * p - x * r) / 2, (w * r + x * q - yy * p) / 2]
+
+    sol = mpmath.odefun(f, 0, [mpmath.mpf(float(v)) for v in (*w0, *q0)])
+    out = np.array([[float(v) for v in sol(mpmath.mpf(float(t)))] for t in times])
+    return out[:, 3:], out[:, :3]
+
+
+def test_near_separatrix_against_high_precision():
+    # Moments (2, 5, 6), omega = (1, 0, 1 + 2^-40): L^2 - 2TB = 6 (2^-39 + 2^-80)
+    # rounds exactly, so 1 - m = 2^-39 (1 - 2^-39) ~ 1.8e-12 is known to the last bit.
+    # DOP853 cannot serve as reference here: its effective m drifts and the time of
+    # passage near the saddle is wrong by ~6e-5 s; mpmath's Taylor method is exact
+    # to the digits we ask for.
+    moments = np.array([2.0, 5.0, 6.0])
+    w0 = np.array([1.0, 0.0, 1.0 + 2.0**-40])
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    par = free_parameters(RigidBody(moments, q0, w0))
+    assert par.kind == "periodic" and abs(par.m1 / 2.0**-39 - 1.0) < 1e-11
+    times = np.array([0.5, 0.75]) * par.flip_interval  # the saddle passage and beyond
+    q, w = free_motion_arrays(moments, q0, w0, times)
+    qr, wr = _mp_reference(moments, q0, w0, times, dps=20)
+    # 1e-12 absolute: the saddle passage amplifies the eps-level rounding of the
+    # phase by ~1/sqrt(m1) ~ 1e6 in the attitude.
+    assert np.abs(w - wr).max() < 1e-12
+    assert qdist(q, qr).max() < 1e-9
+
+
+def test_exact_separatrix():
+    # Moments (2, 5, 6), omega = (1, w2, 1): L^2 - 2TB = 2(2 - 5) + 6(6 - 5) = 0 exactly.
+    moments = np.array([2.0, 5.0, 6.0])
+    w0 = np.array([1.0, 0.5, 1.0])
+    q0 = np.array([0.5, 0.5, 0.5, 0.5])
+    body = RigidBody(moments, q0, w0)
+    assert free_parameters(body).kind == "separatrix"
+    t = np.linspace(0.0, 10.0, 21)
+    q, w = free_motion_arrays(moments, q0, w0, t)
+    qr, wr = dop853(moments, q0, w0, t)
+    # The homoclinic orbit amplifies DOP853's error like exp(lambda t), lambda = 0.68.
+    assert np.abs(w - wr).max() < 1e-11 and qdist(q, qr).max() < 1e-11
+    # Asymptotically the body spins about the middle axis: omega -> (0, b, 0),
+    # b^2 = (2TC - L^2) / (B (C - B)) = (2 * 7.25 * 6 - 42.25) / 5.
+    _, w_late = free_motion_arrays(moments, q0, w0, [200.0])
+    b = np.sqrt((2 * 0.5 * (2 + 5 * 0.25 + 6) * 6 - (4 + 6.25 + 36)) / 5.0)
+    np.testing.assert_allclose(w_late[0], [0.0, b, 0.0], atol=1e-12)
+    # The other heteroclinic branch (omega_1 < 0) too.
+    w0b = np.array([-1.0, 0.5, 1.0])
+    q, w = free_motion_arrays(moments, q0, w0b, t)
+    qr, wr = dop853(moments, q0, w0b, t)
+    assert np.abs(w - wr).max() < 1e-11 and qdist(q, qr).max() < 1e-11
+
+
+def test_axisymmetric_closed_form():
+    # A = B: omega_3 constant, (p + i q) turns at Omega = (C - A) r / A, and
+    # q(t) = exp(L_space t / (2A)) q0 exp(-Omega t e3 / 2)  (Euler's free symmetric top;
+    # differentiating gives omega = (L/A) R(Omega t) l0 - Omega e3, which is Euler's solution).
+    a, c = 1.5, 2.5
+    moments = np.array([a, a, c])
+    w0 = np.array([0.4, -0.3, 1.2])
+    q0 = Quaternion([0.9, 0.1, -0.3, 0.2]).unit()
+    t = np.linspace(0.0, 50.0, 101)
+    att, w = free_motion(RigidBody(moments, q0, w0), t)
+    omega_b = (c - a) * w0[2] / a
+    ang = omega_b * t
+    wr = np.stack([w0[0] * np.cos(ang) - w0[1] * np.sin(ang),
+                   w0[0] * np.sin(ang) + w0[1] * np.cos(ang), np.full_like(t, w0[2])], -1)
+    l_space = q0.rotate(moments * w0)
+    prec = Quaternion.from_axis_angle(l_space / np.linalg.norm(l_space),
+                                      np.linalg.norm(l_space) / a * t)
+    spin = Quaternion.from_axis_angle([0.0, 0.0, 1.0], -omega_b * t)
+    qr = (prec * q0 * spin).as_array()
+    np.testing.assert_allclose(w, wr, atol=1e-14)
+    assert qdist(att.as_array(), qr).max() < 1e-13
+    # The prolate case B = C (the polhode circles the A axis).
+    moments = np.array([c, a, a])[[0, 1, 2]]
+    moments = np.array([1.0, 1.8, 1.8])
+    w0 = np.array([1.1, 0.2, -0.6])
+    t = np.linspace(0.0, 20.0, 41)
+    q, w = free_motion_arrays(moments, q0.as_array(), w0, t)
+    qr2, wr2 = dop853(moments, q0.as_array(), w0, t)
+    assert np.abs(w - wr2).max() < 1e-12 and qdist(q, qr2).max() < 1e-12
+
+
+def test_sphere_and_steady_rotations():
+    q0 = Quaternion([0.9, 0.1, -0.3, 0.2]).unit()
+    t = np.linspace(0.0, 30.0, 7)
+    for moments, w0 in [([2.0, 2.0, 2.0], [0.3, -0.4, 1.2]),  # sphere
+                        ([1.0, 2.0, 3.0], [0.0, 0.7, 0.0]),  # middle axis (unstable)
+                        ([1.0, 2.0, 3.0], [0.0, 0.0, -0.7]),
+                        ([1.0, 1.0, 1.5], [0.6, 0.8, 0.0]),  # transverse, A = B
+                        ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0])]:  # at rest
+        att, w = free_motion(RigidBody(moments, q0, w0), t)
+        np.testing.assert_array_equal(w, np.broadcast_to(w0, (t.size, 3)))
+        wn = np.linalg.norm(w0)
+        spin = (Quaternion.from_axis_angle(np.asarray(w0) / wn, wn * t) if wn > 0
+                else Quaternion(np.tile([1.0, 0, 0, 0], (t.size, 1))))
+        assert qdist(att.as_array(), (q0 * spin).as_array()).max() < 4 * EPS * (1 + wn * 30)
+
+
+@settings(deadline=None, max_examples=30)
+@given(
+    st.lists(st.floats(0.5, 2.0), min_size=3, max_size=3),
+    st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3),
+    st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4),
+)
+def test_invariants_to_a_few_ulp(moments, w0, q0):
+    moments = np.array(moments)
+    if moments.max() > moments.sum() - moments.max() or np.linalg.norm(q0) < 0.1:
+        return
+    w0 = np.array(w0)
+    t = np.linspace(0.0, 200.0, 50)
+    body = RigidBody(moments, q0, w0)
+    att, w = free_motion(body, t)
+    qa = att.as_array()
+    np.testing.assert_allclose(np.linalg.norm(qa, axis=-1), 1.0, atol=4 * EPS)
+    energy = 0.5 * np.sum(moments * w * w, axis=-1)
+    assert np.all(np.abs(energy - body.kinetic_energy) <= 16 * EPS * body.kinetic_energy)
+    l_space = att.rotate(moments * w)
+    lnorm = body.angular_momentum_norm
+    assert np.all(np.abs(l_space - body.angular_momentum_space) <= 32 * EPS * lnorm)
+    # The initial state is reproduced.
+    np.testing.assert_allclose(w[0], w0, rtol=0, atol=8 * EPS * np.abs(w0).max())
+    assert qdist(qa[0], body.attitude.as_array()) <= 8 * EPS
+
+
+def test_group_property_many_periods():
+    # Evolving t1 then t2 equals evolving t1 + t2 (tests the Pi accumulation 2k Pi(n|m)).
+    moments = np.array([3.0, 1.0, 2.5])
+    w0 = np.array([0.2, 1.0, -0.4])
+    q0 = np.array([0.1, 0.7, -0.1, 0.7])
+    t1, t2 = 1234.5, 987.6
+    qa, wa = free_motion_arrays(moments, q0, w0, t1)
+    qb, wb = free_motion_arrays(moments, qa, wa, t2)
+    qc, wc = free_motion_arrays(moments, q0, w0, t1 + t2)
+    # ~300 periods: the phase carries ~1e-13 relative error of t.
+    assert np.abs(wb - wc).max() < 1e-11 and qdist(qb, qc) < 1e-11
+
+
+def test_shapes_units_and_errors():
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[1.0, 0.3, 0.8] * u.rad / u.s)
+    att, w = free_motion(body, np.zeros((2, 3)) * u.min)
+    assert att.shape == (2, 3) and w.shape == (2, 3, 3) and w.unit == u.rad / u.s
+    att, w = free_motion(body, 1.0)
+    assert att.shape == () and w.shape == (3,) and not isinstance(w, u.Quantity)
+    _, w60 = free_motion(body, 1.0 * u.min)
+    _, w60s = free_motion(body, 60.0)
+    np.testing.assert_array_equal(w60.value, w60s)
+    with pytest.raises(ValueError, match="`t` to be finite, got nan at index 1"):
+        free_motion(body, [0.0, np.nan])
+    with pytest.raises(ValueError, match="RigidBody"):
+        free_motion([1.0, 2.0, 3.0], [0.0])
+    with pytest.raises(ValueError, match=r"`q0` to have shape \(4,\)"):
+        free_motion_arrays([1.0, 2.0, 3.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0])
+    with pytest.raises(ValueError, match=r"`moments` to have shape \(3,\)"):
+        free_motion_arrays([1.0, 2.0], [1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0])
+    with pytest.raises(u.UnitConversionError):
+        free_motion(body, 1.0 * u.m)
+
+
+def test_free_step_kernel_matches_arrays():
+    moments = np.array([1.0, 2.0, 3.0])
+    q = np.array([1.0, 0.0, 0.0, 0.0])
+    w = np.array([1.0, 0.3, 0.8])
+    qr, wr = free_motion_arrays(moments, q, w, 0.7)
+    fk.free_step(moments, q, w, 0.7)
+    np.testing.assert_array_equal(q, qr)
+    np.testing.assert_array_equal(w, wr)
