@@ -339,7 +339,10 @@ class KeplerOrbit:
         return self._elements[..., _COL[name]]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
-        return wrap(_scalar(np.asarray(value)), unit, self._quantity)
+        if self._quantity and unit is not None:
+            # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
+            return wrap(np.array(value, dtype=np.float64), unit, True)
+        return _scalar(np.asarray(value))
 
     @property
     def shape(self) -> tuple[int, ...]:
