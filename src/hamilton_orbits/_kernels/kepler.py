@@ -204,6 +204,7 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
     a = lo
     b = hi
     x = lo
+    xp = math.nan
     for _ in range(MAXIT):
         sx = math.sin(x)
         sh = math.sin(0.5 * x)
@@ -223,8 +224,11 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
             xn = x - f / fp
         if not (a <= xn <= b):
             xn = 0.5 * (a + b)
-        if abs(xn - x) <= 2.0 * EPS * abs(xn) or b - a <= 2.0 * EPS * abs(b):
+        # converged: a step of a few ulp, a bracket of a few ulp, or a 2-cycle
+        # between neighbouring floats (the residual is at its rounding floor)
+        if abs(xn - x) <= 4.0 * EPS * abs(xn) or b - a <= 8.0 * EPS * abs(b) or xn == xp:
             return xn
+        xp = x
         x = xn
     return math.nan
 
@@ -252,6 +256,7 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
     a = lo
     b = hi
     x = lo if abs(flo) <= abs(fhi) else hi
+    xp = math.nan
     for _ in range(MAXIT):
         sx = math.sinh(x)
         sh = math.sinh(0.5 * x)
@@ -271,8 +276,11 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
             xn = x - f / fp
         if not (a <= xn <= b):
             xn = 0.5 * (a + b)
-        if abs(xn - x) <= 2.0 * EPS * abs(xn) or b - a <= 2.0 * EPS * abs(b):
+        # converged: a step of a few ulp, a bracket of a few ulp, or a 2-cycle
+        # between neighbouring floats (the residual is at its rounding floor)
+        if abs(xn - x) <= 4.0 * EPS * abs(xn) or b - a <= 8.0 * EPS * abs(b) or xn == xp:
             return xn
+        xp = x
         x = xn
     return math.nan
 
@@ -439,6 +447,7 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
         b = 0.0
     if not (a < x < b):
         x = 0.5 * (a + b) if math.isfinite(b - a) else x1
+    xp = math.nan
     for _ in range(MAXIT + 100):
         t, r, rp, _u0, _u1, _u2, _u3 = _uv_eval(x, r0, sigma0, alpha)
         f = t - tau
@@ -462,10 +471,11 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
                 xn = -2.0 * max(abs(x), abs(x1))
             else:
                 xn = 0.5 * (a + b)
-        if abs(xn - x) <= 2.0 * EPS * abs(xn):
+        if abs(xn - x) <= 4.0 * EPS * abs(xn) or xn == xp:
             return xn
-        if math.isfinite(b - a) and (b - a) <= 4.0 * EPS * max(abs(a), abs(b)):
+        if math.isfinite(b - a) and (b - a) <= 8.0 * EPS * max(abs(a), abs(b)):
             return xn
+        xp = x
         x = xn
     return math.nan
 
@@ -485,7 +495,8 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g = 1
       holds identically and the state stays on the initial orbit whatever the
       solver's last-bit error.
-    * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4), the terms of
+    * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4, and a step
+      long enough, ``|sigma0 tau| > r0^2 / 10``, to matter), the terms of
       T(chi) cancel (for an open orbit that starts far out the loss is about
       r0/q in relative accuracy).  The equation is then anchored at
       periapsis, where all terms have one sign: chi0 of the initial state is
@@ -516,7 +527,9 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     hz = rx * vy - ry * vx
     pp = (hx * hx + hy * hy + hz * hz) / mu
     e2 = 1.0 - alpha * pp
-    if sigma0 * tau < 0.0 and e2 >= 0.25:
+    # anchor only when it matters: heading for periapsis with a step long
+    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20
+    if sigma0 * tau < 0.0 and e2 >= 0.25 and abs(sigma0 * tau) > 0.1 * r0 * r0:
         ecc = math.sqrt(e2)
         q = pp / (1.0 + ecc)
         if alpha > 0.0:
