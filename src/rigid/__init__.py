@@ -13,6 +13,7 @@ from rigid.integrators import (
     SpaceTorque,
     integrate,
 )
+from rigid.sylvester import confocal, confocal_rotation, contrafocal, disk_equivalent, time_between
 
 __all__: list[str] = [
     "BodyTorque",
@@ -21,8 +22,13 @@ __all__: list[str] = [
     "RigidBody",
     "RigidTrajectory",
     "SpaceTorque",
+    "confocal",
+    "confocal_rotation",
+    "contrafocal",
+    "disk_equivalent",
     "free_motion",
     "free_motion_arrays",
     "free_parameters",
     "integrate",
+    "time_between",
 ]

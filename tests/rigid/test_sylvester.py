@@ -1,0 +1,130 @@
+"""Tests for Sylvester's theorems (rigid.sylvester) against the exact motion."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hamilton_orbits import Quaternion
+from rigid import RigidBody, free_motion, free_parameters
+from rigid.sylvester import (
+    confocal,
+    confocal_rotation,
+    contrafocal,
+    disk_equivalent,
+    time_between,
+)
+
+EPS = np.finfo(float).eps
+BODY = RigidBody([1.0, 2.0, 2.5], Quaternion([0.8, 0.2, -0.4, 0.4]).unit(), [1.0, 0.5, 0.2])
+T = np.linspace(0.0, 60.0, 121)
+
+
+def _axes_cosines(att: Quaternion, lhat: np.ndarray) -> np.ndarray:
+    """cos of the angles between the principal axes (in space) and the invariable line."""
+    return att.as_rotation_matrix().transpose(0, 2, 1) @ lhat  # rows of R^T = axes
+
+
+def _qdist(q1, q2):
+    return np.minimum(np.abs(q1 - q2).max(-1), np.abs(q1 + q2).max(-1))
+
+
+@pytest.mark.parametrize("lam", [-0.1, 0.1, 0.7])
+def test_confocal_theorem(lam):
+    # Sylvester (1866): the principal axes stay equally inclined to the invariable line,
+    # and the bodies differ only by a uniform rotation L lam t about it.
+    other = confocal(BODY, lam)
+    np.testing.assert_allclose(1 / other.moments - 1 / BODY.moments, lam, atol=8 * EPS)
+    np.testing.assert_allclose(other.angular_momentum_space, BODY.angular_momentum_space,
+                               atol=8 * EPS)
+    att, _ = free_motion(BODY, T)
+    att2, _ = free_motion(other, T)
+    lhat = BODY.invariable_plane
+    np.testing.assert_allclose(_axes_cosines(att2, lhat), _axes_cosines(att, lhat), atol=1e-13)
+    rot = confocal_rotation(BODY, lam, T)
+    assert _qdist((rot * att).as_array(), att2.as_array()).max() < 1e-12
+    # The sign matters: the opposite rotation is wrong as soon as lam L t is not small.
+    wrong = confocal_rotation(BODY, -lam, T)
+    assert _qdist((wrong * att).as_array(), att2.as_array()).max() > 0.1
+
+
+@pytest.mark.parametrize("lam", [1.8, 2.0, 2.4])
+def test_contrafocal_theorem(lam):
+    other = contrafocal(BODY, lam)
+    np.testing.assert_allclose(1 / other.moments + 1 / BODY.moments, lam, atol=8 * EPS)
+    np.testing.assert_allclose(other.angular_momentum_space, -BODY.angular_momentum_space,
+                               atol=8 * EPS)
+    att, _ = free_motion(BODY, T)
+    att2, _ = free_motion(other, T)
+    lhat = BODY.invariable_plane
+    # Equal but contrary inclinations: each body's axes against its own invariable
+    # line (the couples are contrary) make supplementary angles.
+    np.testing.assert_allclose(other.invariable_plane, -lhat, atol=8 * EPS)
+    np.testing.assert_allclose(_axes_cosines(att2, other.invariable_plane),
+                               -_axes_cosines(att, lhat), atol=1e-13)
+    rot = confocal_rotation(BODY, -lam, T)
+    assert _qdist((rot * att).as_array(), att2.as_array()).max() < 1e-12
+
+
+def test_related_body_errors():
+    with pytest.raises(ValueError, match="reciprocal moment positive"):
+        confocal(BODY, -1.5)
+    with pytest.raises(ValueError, match="A \\+ B >= C"):
+        contrafocal(BODY, 1.5)
+    with pytest.raises(ValueError, match="RigidBody"):
+        confocal([1.0, 2.0, 3.0], 0.1)
+
+
+@pytest.mark.parametrize(
+    "omega", [[1.0, 0.5, 0.2], [0.2, 0.5, 1.0], [0.6, 0.1, 0.5], [-0.1, 0.9, 0.3]]
+)
+def test_disk_theorem(omega):
+    body = BODY.with_state(omega=omega)
+    disk, rel, _lam, delta = disk_equivalent(body)
+    m = np.sort(disk.moments)
+    assert abs(m[2] - m[0] - m[1]) <= 16 * EPS * m[2]  # a flat disk: C' = A' + B'
+    # Sylvester's choice: direct if L^2 / 2T > B, supplemental otherwise.
+    d = np.sum(body.angular_momentum_body**2) / (2 * body.kinetic_energy)
+    assert rel == ("confocal" if d > 2.0 else "contrafocal")
+    _, w = free_motion(body, T)
+    _, v = free_motion(disk, T)
+    diff = np.sum(v * v, -1) - np.sum(w * w, -1)
+    # The difference of squared angular velocities is constant and equals delta.
+    np.testing.assert_allclose(diff, delta, rtol=0, atol=64 * EPS * np.sum(v * v, -1).max())
+    # On the disk, the angular velocity in its own plane has constant magnitude
+    # (Sylvester 1866, "the angular velocity with which the disk turns about a line
+    # in its own plane is constant").
+    k = int(np.argmax(disk.moments))
+    inplane = np.sum(np.delete(v, k, axis=-1) ** 2, -1)
+    np.testing.assert_allclose(inplane, inplane[0], rtol=64 * EPS)
+    # And the disk keeps the original's inclinations to its own invariable line
+    # (equal for the direct reduction, supplementary for the supplemental one).
+    att, _ = free_motion(body, T)
+    att_d, _ = free_motion(disk, T)
+    sgn = 1.0 if rel == "confocal" else -1.0
+    np.testing.assert_allclose(_axes_cosines(att_d, disk.invariable_plane),
+                               sgn * _axes_cosines(att, body.invariable_plane), atol=1e-13)
+
+
+def test_time_between_positions():
+    body = BODY
+    period = free_parameters(body).period
+    for t in (0.3, 2.5, 0.49 * period, 0.9 * period, 3.2 * period):
+        _, w = free_motion(body, t)
+        got = time_between(body, body.omega, w)
+        assert abs(got - np.mod(t, period)) < 1e-12 * period
+    # Between two later positions.
+    _, w = free_motion(body, [1.0, 4.0])
+    assert abs(time_between(body, w[0], w[1]) - 3.0) < 1e-12 * period
+    with pytest.raises(ValueError, match="same T and"):
+        time_between(body, body.omega, 1.1 * body.omega)
+    with pytest.raises(ValueError, match=r"`omega2` to have shape \(3,\)"):
+        time_between(body, body.omega, [1.0, 2.0])
+
+
+def test_time_between_on_separatrix():
+    body = RigidBody([2.0, 5.0, 6.0], omega=[1.0, 0.5, 1.0])  # L^2 = 2TB exactly
+    _, w = free_motion(body, 3.0)
+    assert abs(time_between(body, body.omega, w) - 3.0) < 1e-12
+    with pytest.raises(ValueError, match="after `omega1`"):
+        time_between(body, w, body.omega)
