@@ -1,0 +1,206 @@
+"""Hamilton's geometry of the conic (seed eqs. 15-65) and the hodograph.
+
+A :class:`Conic` is fixed by the semi-parameter ``p``, the eccentricity ``e``,
+the reciprocal semi-major axis ``1/a`` (0 for the parabola; using ``1/a``
+keeps every formula finite in the parabolic limit), the unit vector towards
+periapsis and the unit normal of the plane.  Hamilton's epsilon is
+``-e * periapsis_direction`` (it points to the apoapsis, eq. 13); the second
+focus is ``2 a epsilon`` and the centre ``a epsilon`` (eqs. 28-36): for the
+ellipse (a > 0) on the apoapsis side, for the hyperbola (a < 0) beyond the
+periapsis, on the far side of the vertex.
+
+At a point at distance ``r`` from the focus the second focal distance is
+``r' = 2a - r`` (eq. 53; negative for the hyperbola, infinite for the
+parabola), and the normal N, focal half-chord of curvature C and radius of
+curvature R are (eqs. 61-65), in forms finite for every conic,
+
+    C = r r'/a = r (2 - r/a),   N = sqrt(p C),   R = C^2 / N = C sqrt(C / p),
+
+so that sqrt(R N) = C and R/C = C/N = N/p.
+
+References
+----------
+W. R. Hamilton, "On the application of the method of quaternions to some
+dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits._validation import as_float_array, check_trailing
+
+__all__ = ["Conic"]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+class Conic:
+    """Hamilton's conic section, vectorised over leading dimensions.
+
+    Build from an orbit (``KeplerOrbit.conic``) or with :meth:`from_state`.
+    Plain floats in the orbit's internal units (km, km/s for Quantity orbits).
+
+    Attributes
+    ----------
+    p, e, inv_a : ndarray, shape (...)
+        Semi-parameter (eq. 16), eccentricity (eq. 17), 1/a (0: parabola).
+    periapsis_direction, normal : ndarray, shape (..., 3)
+        Unit vectors: towards periapsis; along Hamilton's beta (eq. 3).
+    mu : ndarray, shape (...)
+        Gravitational parameter (for the hodograph).
+
+    Examples
+    --------
+    >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    >>> round(float(c.a), 12), round(float(c.b), 12)
+    (1.785714285714, 1.603567451475)
+    >>> [round(float(x), 12) + 0.0 for x in c.second_focus]
+    [-1.571428571429, 0.0, 0.0]
+    """
+
+    def __init__(self, p, e, inv_a, periapsis_direction, normal, mu) -> None:
+        self.p = np.asarray(p, float)
+        self.e = np.asarray(e, float)
+        self.inv_a = np.asarray(inv_a, float)
+        self.periapsis_direction = np.asarray(periapsis_direction, float)
+        self.normal = np.asarray(normal, float)
+        self.mu = np.asarray(mu, float)
+
+    @classmethod
+    def _from_orbit(cls, orbit) -> Conic:
+        el = orbit._elements
+        from hamilton_orbits._kernels.elements import COLUMNS
+
+        col = {k: i for i, k in enumerate(COLUMNS)}
+        inc = el[..., col["inc"]]
+        lan = el[..., col["lan"]]
+        argp = el[..., col["argp"]]
+        cl, sl = np.cos(lan), np.sin(lan)
+        ci = np.where(inc == np.pi, -1.0, np.cos(inc))
+        si = np.where(inc == np.pi, 0.0, np.sin(inc))
+        cw, sw = np.cos(argp), np.sin(argp)
+        P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
+        h = np.stack([si * sl, -si * cl, ci], axis=-1)
+        return cls(el[..., col["p"]], el[..., col["e"]], el[..., col["inv_a"]], P, h, orbit._mu)
+
+    @classmethod
+    def from_state(cls, r: Any, v: Any, mu: Any) -> Conic:
+        """The conic through the state ``(r, v)`` (via :class:`KeplerOrbit`).
+
+        Examples
+        --------
+        >>> round(float(Conic.from_state([1.0, 0, 0], [0, 1.0, 0], 1.0).e), 12)
+        0.0
+        """
+        from hamilton_orbits.orbit import KeplerOrbit
+
+        return KeplerOrbit.from_state(r, v, mu).conic
+
+    # ---------------------------------------------------------------- shape
+    @property
+    def a(self) -> np.ndarray:
+        """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola."""
+        safe = np.where(self.inv_a == 0, 1.0, self.inv_a)
+        return np.where(self.inv_a == 0, np.inf, 1.0 / safe)
+
+    @property
+    def b(self) -> np.ndarray:
+        """Semi-minor axis ``a sqrt(1 - e^2) = sqrt(a p)`` (eq. 43) for the ellipse;
+        for the hyperbola the length ``|a| sqrt(e^2 - 1)`` of the imaginary
+        (conjugate) semi-axis, Hamilton's "vector with a positive square" (eq. 42);
+        inf for the parabola."""
+        ia = np.abs(np.where(self.inv_a == 0, 1.0, self.inv_a))
+        return np.where(self.inv_a == 0, np.inf, np.sqrt(self.p / ia))
+
+    @property
+    def hamilton_epsilon(self) -> np.ndarray:
+        """Hamilton's epsilon = -e * periapsis direction (eq. 13), towards apoapsis."""
+        return -self.e[..., None] * self.periapsis_direction
+
+    def _finite_a(self, what: str) -> np.ndarray:
+        if np.any(self.inv_a == 0):
+            raise ValueError(f"Expected a conic with a centre for `{what}`, got a parabola "
+                             "(e = 1: the centre and second focus are at infinity)")
+        return 1.0 / self.inv_a
+
+    @property
+    def centre(self) -> np.ndarray:
+        """Vector of the centre from the focus, ``a epsilon`` (eq. 36)."""
+        return self._finite_a("centre")[..., None] * self.hamilton_epsilon
+
+    @property
+    def second_focus(self) -> np.ndarray:
+        """Vector of the second focus, ``2 a epsilon`` (eq. 31)."""
+        return 2.0 * self._finite_a("second_focus")[..., None] * self.hamilton_epsilon
+
+    @property
+    def directrix_distance(self) -> np.ndarray:
+        """Distance ``p / e`` from the focus to the directrix (on the periapsis
+        side); inf for the circle."""
+        safe = np.where(self.e == 0, 1.0, self.e)
+        return np.where(self.e == 0, np.inf, self.p / safe)
+
+    # ------------------------------------------------------ at a point
+    def radius(self, nu: Any) -> np.ndarray:
+        """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20)."""
+        nu = as_float_array("nu", nu)
+        return self.p / (1.0 + self.e * np.cos(nu))
+
+    def focal_half_chord(self, r: Any) -> np.ndarray:
+        """C = r r'/a = r (2 - r/a) (eq. 63), at focal distance ``r``."""
+        r = as_float_array("r", r)
+        return r * (2.0 - r * self.inv_a)
+
+    def second_focal_distance(self, r: Any) -> np.ndarray:
+        """``r' = 2a - r`` (eq. 53): negative for the hyperbola, inf for the parabola."""
+        r = as_float_array("r", r)
+        safe = np.where(self.inv_a == 0, 1.0, self.inv_a)
+        return np.where(self.inv_a == 0, np.inf, 2.0 / safe - r)
+
+    def normal_length(self, r: Any) -> np.ndarray:
+        """N = sqrt(p r r'/a) (eq. 65), the normal between the curve and the axis."""
+        return np.sqrt(self.p * self.focal_half_chord(r))
+
+    def radius_of_curvature(self, r: Any) -> np.ndarray:
+        """R = C^2 / N = C sqrt(C / p) (eqs. 63-64)."""
+        c = self.focal_half_chord(r)
+        return c * np.sqrt(c / self.p)
+
+    def radial_speed_squared(self, r: Any) -> np.ndarray:
+        """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66)."""
+        r = as_float_array("r", r)
+        return self.mu * (2.0 / r - self.inv_a - self.p / (r * r))
+
+    def hodograph(self, r: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Hamilton's decomposition of the velocity at position ``r`` (after eq. 65).
+
+        Returns ``(rotating, fixed)``: ``rotating = (mu/h) normal x r/|r|``, of
+        constant magnitude ``mu/h``, perpendicular to the radius vector;
+        ``fixed = (mu/h) normal x (e periapsis_direction)``, constant, of
+        magnitude ``e mu/h`` and parallel to the velocity at perihelion.  Their
+        sum is the velocity (it is eq. 12, ``dalpha/dt = iota M/beta + const``).
+
+        Parameters
+        ----------
+        r : array_like, shape (..., 3)
+            A position on the orbit.
+
+        Examples
+        --------
+        >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+        >>> rot, fix = c.hodograph([1.0, 0, 0])
+        >>> (rot + fix + 0.0).round(12).tolist()
+        [0.0, 1.2, 0.0]
+        """
+        r = check_trailing("r", as_float_array("r", r), 3)
+        h = np.sqrt(self.mu * self.p)
+        k = (self.mu / h)[..., None]
+        rhat = r / np.sqrt(_dot(r, r))[..., None]
+        rot = k * np.cross(self.normal, rhat)
+        fix = k * np.cross(self.normal, self.e[..., None] * self.periapsis_direction)
+        return rot, fix

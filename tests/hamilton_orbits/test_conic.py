@@ -1,0 +1,122 @@
+"""Hamilton's conic geometry (seed eqs. 15-66) against independent computations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hard_cases import perifocal_state
+
+from hamilton_orbits.conic import Conic
+from hamilton_orbits.orbit import KeplerOrbit
+
+EPS = np.finfo(float).eps
+ECCS = (0.0, 0.3, 0.9, 1.0, 1.5, 10.0)
+
+
+def _states(e, n=7):
+    """States at several true anomalies (inside the asymptotes for e >= 1)."""
+    lim = math.pi if e < 1 else 0.9 * math.acos(-1.0 / e)
+    out = []
+    for nu in np.linspace(-lim, lim, n + 2)[1:-1]:
+        out.append(perifocal_state(1.3, e, 0.6, 0.4, 1.9, float(nu), 0.7))
+    return np.array([s[0] for s in out]), np.array([s[1] for s in out])
+
+
+@pytest.mark.parametrize("e", ECCS)
+def test_curvature_normal_chord_relations(e):
+    """sqrt(R N) = C = 2 r r'/(r + r'), R/C = C/N = N/p (eqs. 63-64); N from eq. 65;
+    R from the dynamics: curvature |v x acc| / |v|^3 = mu h / (r^3 v^3)."""
+    r, v = _states(e)
+    c = Conic.from_state(r, v, 0.7)
+    rn = np.linalg.norm(r, axis=-1)
+    C = c.focal_half_chord(rn)
+    N = c.normal_length(rn)
+    R = c.radius_of_curvature(rn)
+    p = c.p
+    tol = 16 * EPS
+    assert np.all(np.abs(np.sqrt(R * N) / C - 1) <= tol)
+    assert np.all(np.abs((R / C) / (C / N) - 1) <= tol)
+    assert np.all(np.abs((C / N) / (N / p) - 1) <= tol)
+    if e != 1.0:
+        r2 = c.second_focal_distance(rn)
+        assert np.all(np.abs(2 * rn * r2 / (rn + r2) / C - 1) <= 1e3 * EPS)  # r + r' = 2a cancels
+    # eq. 65, first form: N = |r eps - alpha| with Hamilton's epsilon
+    N65 = np.linalg.norm(rn[:, None] * c.hamilton_epsilon - r, axis=-1)
+    assert np.all(np.abs(N65 / N - 1) <= 64 * EPS)
+    # independent: radius of curvature of the trajectory from velocity and acceleration
+    h = np.linalg.norm(np.cross(r, v), axis=-1)
+    vn = np.linalg.norm(v, axis=-1)
+    R_dyn = rn**3 * vn**3 / (0.7 * h)
+    assert np.all(np.abs(R_dyn / R - 1) <= 64 * EPS)
+
+
+@pytest.mark.parametrize("e", ECCS)
+def test_hodograph_and_radial_law(e):
+    r, v = _states(e)
+    c = Conic.from_state(r, v, 0.7)
+    rot, fix = c.hodograph(r)
+    scale = np.linalg.norm(v, axis=-1)[:, None]
+    assert np.all(np.abs(rot + fix - v) <= 16 * EPS * scale)
+    h = math.sqrt(0.7 * float(c.p[0]))
+    assert np.all(np.abs(np.linalg.norm(rot, axis=-1) - 0.7 / h) <= 8 * EPS * 0.7 / h)
+    fixn = np.linalg.norm(fix, axis=-1)
+    assert np.all(np.abs(fixn - e * 0.7 / h) <= 8 * EPS * max(1, e) * 0.7 / h)
+    assert np.all(np.abs(np.einsum("ij,ij->i", rot, r)) <= 8 * EPS * scale[:, 0] * 2)
+    # fixed part parallel to the velocity at perihelion
+    _rp, vp = perifocal_state(1.3, e, 0.6, 0.4, 1.9, 0.0, 0.7)
+    if e > 0:
+        cosang = fix @ vp / (np.linalg.norm(fix, axis=-1) * np.linalg.norm(vp))
+        assert np.all(cosang >= 1 - 8 * EPS)
+    # (66): (dr/dt)^2 = mu (2/r - 1/a - p/r^2)
+    rn = np.linalg.norm(r, axis=-1)
+    rdot = np.einsum("ij,ij->i", r, v) / rn
+    lhs = c.radial_speed_squared(rn)
+    assert np.all(np.abs(lhs - rdot**2) <= 64 * EPS * 0.7 * (2 / rn + c.p / rn**2))
+
+
+@pytest.mark.parametrize("e", (0.0, 0.3, 0.9, 1.5, 10.0))
+def test_foci_centre_axes(e):
+    """Sum (ellipse) or difference (hyperbola) of focal distances = 2a (eq. 31);
+    b = a sqrt(1 - e^2) (eq. 43); centre halfway; second focus on the apoapsis side."""
+    r, v = _states(e)
+    c = Conic.from_state(r, v, 0.7)
+    a = float(c.a[0])
+    d1 = np.linalg.norm(r, axis=-1)
+    d2 = np.linalg.norm(r - c.second_focus, axis=-1)
+    if e < 1:
+        # d2 = |r - 2 a eps| rounds each component at the scale |r| + 2 a e <= 4 a
+        assert np.all(np.abs(d1 + d2 - 2 * a) <= 64 * EPS * a)
+        assert abs(float(c.b[0]) - a * math.sqrt(1 - e * e)) <= 8 * EPS * a
+    else:
+        assert np.all(np.abs(np.abs(d1 - d2) - 2 * abs(a)) <= 64 * EPS * (d1 + d2))
+        assert abs(float(c.b[0]) - abs(a) * math.sqrt(e * e - 1)) <= 8 * EPS * abs(a)
+    assert np.allclose(c.centre, 0.5 * c.second_focus, rtol=0, atol=4 * EPS * abs(a))
+    if e > 0:
+        # ellipse: second focus towards apoapsis; hyperbola: beyond the periapsis
+        s = np.sign(c.second_focus[0] @ c.periapsis_direction[0])
+        assert s == (-1 if e < 1 else 1)
+    # directrix: r = e * (distance to the directrix), eq. 15/20
+    if e > 0:
+        x = r @ c.periapsis_direction[0]
+        assert np.all(np.abs(d1 - e * (c.directrix_distance[0] - x)) <= 64 * EPS * d1 * max(1, e))
+
+
+def test_parabola_limits():
+    r, v = _states(1.0)
+    c = Conic.from_state(r, v, 0.7)
+    assert np.all(c.a == np.inf) and np.all(c.b == np.inf)
+    assert np.all(c.second_focal_distance(1.0) == np.inf)
+    with pytest.raises(ValueError, match="parabola"):
+        _ = c.second_focus
+    # C = 2 r (harmonic mean of r and r' = inf), finite N and R
+    rn = np.linalg.norm(r, axis=-1)
+    assert np.all(c.focal_half_chord(rn) == 2 * rn)
+
+
+def test_orbit_conic_matches_state():
+    o = KeplerOrbit.from_elements(a=2.0, e=0.4, inc=math.pi, lan=0.0, argp=1.0, nu=0.5, mu=1.0)
+    c = o.conic
+    assert np.allclose(c.periapsis_direction, o.eccentricity_vector / 0.4, atol=8 * EPS)
+    assert np.allclose(c.normal, o.areal_vector / np.linalg.norm(o.areal_vector), atol=4 * EPS)
