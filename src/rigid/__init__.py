@@ -13,12 +13,14 @@ from rigid.integrators import (
     SpaceTorque,
     integrate,
 )
+from rigid.poinsot import PoinsotPaths, plot_poinsot, poinsot
 from rigid.sylvester import confocal, confocal_rotation, contrafocal, disk_equivalent, time_between
 
 __all__: list[str] = [
     "BodyTorque",
     "FreeParameters",
     "GravityGradientTorque",
+    "PoinsotPaths",
     "RigidBody",
     "RigidTrajectory",
     "SpaceTorque",
@@ -30,5 +32,7 @@ __all__: list[str] = [
     "free_motion_arrays",
     "free_parameters",
     "integrate",
+    "plot_poinsot",
+    "poinsot",
     "time_between",
 ]
