@@ -25,6 +25,7 @@ The compiled kernels live in :mod:`hamilton_orbits._kernels.kepler`.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import astropy.units as u
@@ -353,24 +354,25 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
     check_trailing("r", ra, 3)
     check_trailing("v", va, 3)
     check_positive("mu", mua)
-    rnorm = np.sqrt(np.sum(ra * ra, axis=-1))
-    zero = rnorm == 0.0
-    if np.any(zero):
-        i = int(np.flatnonzero(zero.ravel())[0])
-        raise ValueError(
-            f"Expected `r` nonzero, got {ra.reshape(-1, 3)[i].tolist()!r}"
-            f"{_index(zero.shape, i)}"
-        )
-    lead = broadcast(("r", "v", "mu", "dt"), rnorm, va[..., 0], mua, dta)[0].shape
-    n = int(np.prod(lead))
-    rb = np.ascontiguousarray(np.broadcast_to(ra, (*lead, 3)).reshape(n, 3))
-    vb = np.ascontiguousarray(np.broadcast_to(va, (*lead, 3)).reshape(n, 3))
-    mub = np.ascontiguousarray(np.broadcast_to(mua, lead).reshape(n))
-    dtb = np.ascontiguousarray(np.broadcast_to(dta, lead).reshape(n))
+    try:
+        lead = np.broadcast_shapes(ra.shape[:-1], va.shape[:-1], mua.shape, dta.shape)
+    except ValueError:
+        broadcast(("r", "v", "mu", "dt"), ra[..., 0], va[..., 0], mua, dta)  # raises, naming
+        raise
+    n = math.prod(lead)
+    # views where possible: the kernel takes strided (even stride-0) inputs
+    rb = np.broadcast_to(ra, (*lead, 3)).reshape(n, 3)
+    vb = np.broadcast_to(va, (*lead, 3)).reshape(n, 3)
+    mub = np.broadcast_to(mua, lead).reshape(n)
+    dtb = np.broadcast_to(dta, lead).reshape(n)
     r_out = np.empty((n, 3))
     v_out = np.empty((n, 3))
     bad = _k.propagate_batch(rb, vb, mub, dtb, r_out, v_out)
     if bad >= 0:
+        if not np.any(rb[bad]):
+            raise ValueError(
+                f"Expected `r` nonzero, got {rb[bad].tolist()!r}{_index(lead, bad)}"
+            )
         raise ConvergenceError(
             f"propagate failed for r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, "
             f"mu={mub[bad]!r}, dt={dtb[bad]!r}{_index(lead, bad)}"

@@ -506,9 +506,11 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       and ``r = q U0(chi1) + U2(chi1)``.
     """
     nan = math.nan
+    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
+    if not (r0 > 0.0):
+        return nan, nan, nan, nan, nan, nan
     if dt == 0.0:
         return rx, ry, rz, vx, vy, vz
-    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
     v2 = vx * vx + vy * vy + vz * vz
     smu = math.sqrt(mu)
     sigma0 = (rx * vx + ry * vy + rz * vz) / smu
