@@ -5,7 +5,9 @@ The curated public API.  Everything not listed in ``__all__`` is private.
 
 from importlib.metadata import PackageNotFoundError, version
 
+from hamilton_orbits.conic import Conic
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
+from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
 
 try:
@@ -14,7 +16,9 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0.0.0+unknown"
 
 __all__ = [
+    "Conic",
     "ConvergenceError",
+    "KeplerOrbit",
     "Quaternion",
     "__version__",
     "slerp",
