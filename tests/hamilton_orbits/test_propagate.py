@@ -135,14 +135,15 @@ def test_long_open_arcs_round_trip_physics_limited():
     """Going out for 1e7 time units and back: the return to periapsis is as
     accurate as the far state allows.  Its rounding (eps |r|, eps |v|) shifts
     the time of periapsis passage by ~ eps dt, i.e. ~ eps dt v_p in position;
-    we allow 100 times that (measured at most ~45x, for e = 10)."""
+    we allow 200 times that (measured at most ~80x, for e = 10, where the
+    return leg is anchored at periapsis and sums tp0 + tau ~ 1e7 to ~0)."""
     dt = 1e7
     for e in [0.99999, 1.0, 1.00001, 2.0, 10.0, 1e6]:
         r0, v0 = _periapsis_state(e)
         r1, v1 = propagate(r0, v0, 1.0, dt)
         rb, _ = propagate(r1, v1, 1.0, -dt)
         vp = np.linalg.norm(v0)
-        assert _rel(rb, r0) < 100 * EPS * dt * vp, e
+        assert _rel(rb, r0) < 200 * EPS * dt * vp, e
 
 
 def test_many_periods():

@@ -50,9 +50,11 @@ _SERIES_MAX = 3.0
 
 @njit(cache=True)
 def _series_s(z, sign):  # pragma: no cover - compiled
-    """sum_k (sign z)^k / (2k+3)!  (Horner, 15 terms)."""
-    acc = _S[14]
-    for k in range(13, -1, -1):
+    """sum_k (sign z)^k / (2k+3)!  (Horner; 15 terms, 7 when |z| < 0.1 where
+    the 8th is below 0.1^7/17! ~ 3e-22 of the sum)."""
+    top = 6 if abs(z) < 0.1 else 14
+    acc = _S[top]
+    for k in range(top - 1, -1, -1):
         acc = _S[k] + sign * z * acc
     return acc
 
@@ -365,8 +367,9 @@ def stumpff_c2c3(psi):  # pragma: no cover - compiled
     """
     if abs(psi) < 1.0:
         z = -psi
-        c2 = _C[9]
-        for k in range(8, -1, -1):
+        top = 6 if abs(z) < 0.1 else 9  # 0.1^7/16! ~ 5e-21 of c2
+        c2 = _C[top]
+        for k in range(top - 1, -1, -1):
             c2 = _C[k] + z * c2
         return c2, _series_s(psi, -1.0)
     if psi > 0.0:
@@ -401,17 +404,24 @@ def _uv_eval(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
-    """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``).
+def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``),
+    returned with the universal functions evaluated there:
+    ``(chi, T, r, U0, U1, U2, U3)``.
 
     T is increasing (dT/dchi = r >= 0).  Laguerre's method (n = 5, Conway 1986)
     inside a bracket that starts as (0, chi_max) with chi_max = 2 pi/sqrt(alpha)
     for a bound orbit whose |tau| is at most half a period, else (0, inf) and is
     grown by doubling; a step that leaves the bracket is replaced by bisection.
-    Returns NaN on failure.
+    On convergence (a step of at most 4 ulp, a 2-cycle between neighbouring
+    floats, or a bracket of 8 ulp) the last evaluated point is returned if its
+    residual T - tau is already at rounding level (2 ulp of tau), which saves
+    one evaluation; otherwise the refined point is evaluated.  chi = NaN on
+    failure.
     """
+    nan = math.nan
     if tau == 0.0:
-        return 0.0
+        return 0.0, 0.0, r0, 1.0, 0.0, 0.0, 0.0
     sgn = 1.0 if tau > 0.0 else -1.0
     # bracket on the signed side of chi
     if alpha > 0.0:
@@ -449,10 +459,10 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
         x = 0.5 * (a + b) if math.isfinite(b - a) else x1
     xp = math.nan
     for _ in range(MAXIT + 100):
-        t, r, rp, _u0, _u1, _u2, _u3 = _uv_eval(x, r0, sigma0, alpha)
+        t, r, rp, u0, u1, u2, u3 = _uv_eval(x, r0, sigma0, alpha)
         f = t - tau
         if f == 0.0:
-            return x
+            return x, t, r, u0, u1, u2, u3
         if f < 0.0:
             a = x
         else:
@@ -472,12 +482,24 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             else:
                 xn = 0.5 * (a + b)
         if abs(xn - x) <= 4.0 * EPS * abs(xn) or xn == xp:
-            return xn
+            if abs(f) <= 2.0 * EPS * abs(tau) or xn == xp:
+                return x, t, r, u0, u1, u2, u3
+            # x is a few ulp from the root but that is a time error above
+            # rounding (large chi r): use the refined point
+            t, r, rp, u0, u1, u2, u3 = _uv_eval(xn, r0, sigma0, alpha)
+            return xn, t, r, u0, u1, u2, u3
         if math.isfinite(b - a) and (b - a) <= 8.0 * EPS * max(abs(a), abs(b)):
-            return xn
+            return x, t, r, u0, u1, u2, u3
         xp = x
         x = xn
-    return math.nan
+    return nan, nan, nan, nan, nan, nan, nan
+
+
+@njit(cache=True)
+def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The universal anomaly chi with ``T(chi) = tau``; NaN on failure (see
+    :func:`_solve_uv`)."""
+    return _solve_uv(tau, r0, sigma0, alpha)[0]
 
 
 @njit(cache=True)
@@ -543,18 +565,18 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
         else:
             chi0 = sigma0 / ecc
         tp0 = _uv_eval(chi0, q, 0.0, alpha)[0]
-        chi1 = solve_universal(tp0 + tau, q, 0.0, alpha)
+        sol = _solve_uv(tp0 + tau, q, 0.0, alpha)
+        chi1 = sol[0]
         if not math.isfinite(chi1):
             return nan, nan, nan, nan, nan, nan
-        r = _uv_eval(chi1, q, 0.0, alpha)[1]
+        r = sol[2]
         dchi = chi1 - chi0
         _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
         g = (tau - u3) / smu
     else:
-        chi = solve_universal(tau, r0, sigma0, alpha)
+        chi, _t, r, _u0, u1, u2, _u3 = _solve_uv(tau, r0, sigma0, alpha)
         if not math.isfinite(chi):
             return nan, nan, nan, nan, nan, nan
-        _t, r, _rp, _u0, u1, u2, _u3 = _uv_eval(chi, r0, sigma0, alpha)
         g = (r0 * u1 + sigma0 * u2) / smu
     if not (r > 0.0) or not math.isfinite(r):
         return nan, nan, nan, nan, nan, nan
