@@ -76,5 +76,5 @@ def wrap(value: np.ndarray, unit: u.UnitBase | None, quantity: bool):
     3.0
     """
     if quantity and unit is not None:
-        return u.Quantity(value, unit, copy=False)
+        return u.Quantity(value, unit)
     return value
