@@ -66,8 +66,8 @@ def bench_solve(n: int, rng: np.random.Generator) -> None:
             lambda E: E - e * np.sin(E) - M,
             M + 0.85 * e * np.sign(np.sin(M)),
             fprime=lambda E: 1 - e * np.cos(E),
-            tol=1e-15,
-            maxiter=100,
+            tol=1e-13,  # 1e-15 makes some elements oscillate to maxiter (unfair to scipy)
+            maxiter=50,
         )
 
     t_scipy = _best(scipy_solve) / n
