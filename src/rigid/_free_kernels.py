@@ -313,10 +313,19 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
         prm[_Q0 + i] = q0[i]
     i0, i1, i2 = moments[0], moments[1], moments[2]
     # Steady rotation when I omega is parallel to omega (sphere, rest, principal axis).
-    cx = (i1 - i2) * w0[1] * w0[2]
-    cy = (i2 - i0) * w0[2] * w0[0]
-    cz = (i0 - i1) * w0[0] * w0[1]
-    if cx == 0.0 and cy == 0.0 and cz == 0.0:
+    # Tested on omega / max|omega| so that nothing underflows, and with a relative
+    # threshold of 1e-150: below it the polhode's squared amplitudes (p1, p3 below)
+    # underflow, while the departure from the steady spin, of relative size
+    # 1e-150 * |omega| t, is invisible for any representable time.
+    wn = max(abs(w0[0]), abs(w0[1]), abs(w0[2]))
+    if wn == 0.0:
+        prm[_KIND] = 0.0
+        return prm
+    s0_, s1_, s2_ = w0[0] / wn, w0[1] / wn, w0[2] / wn
+    cx = (i1 - i2) * s1_ * s2_
+    cy = (i2 - i0) * s2_ * s0_
+    cz = (i0 - i1) * s0_ * s1_
+    if max(abs(cx), abs(cy), abs(cz)) <= 1e-150 * max(i0, i1, i2):
         prm[_KIND] = 0.0
         return prm
     # Sort the axes: imin, imid, imax (stable for ties).

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 import pytest
+import rebound
 
 from hamilton_orbits.orbit import KeplerOrbit
 
-rebound = pytest.importorskip("rebound")
 EPS = np.finfo(float).eps
 
 

@@ -324,3 +324,18 @@ def test_free_step_kernel_matches_arrays():
     fk.free_step(moments, q, w, 0.7)
     np.testing.assert_array_equal(q, qr)
     np.testing.assert_array_equal(w, wr)
+
+
+def test_nearly_steady_spin_does_not_underflow():
+    """Regression (found by hypothesis): omega = (0, 1, 7.4e-300) on A = B.
+
+    The polhode amplitudes underflow; the motion is the steady spin about
+    omega to within a relative 1e-300 * |omega| t, and no division by zero occurs.
+    """
+    q0 = np.array([0.0, 0.0, 0.0, 1.0])
+    w0 = np.array([0.0, 1.0, 7.4e-300])
+    t = np.array([0.0, 1.0, 1e3])
+    q, w = free_motion_arrays([1.0, 1.0, 0.5], q0, w0, t)
+    np.testing.assert_array_equal(w, np.broadcast_to(w0, (3, 3)))
+    spin = Quaternion(q0) * Quaternion.from_axis_angle(w0, np.linalg.norm(w0) * t)
+    assert qdist(q, spin.as_array()).max() < 4 * EPS * 1e3
