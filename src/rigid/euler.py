@@ -68,7 +68,24 @@ class _Torque:
 
 
 @dataclass(frozen=True)
-class BodyTorque(_Torque):
+class _ConstantTorque(_Torque):
+    """A constant 3-vector torque (N m); subclasses fix the frame by ``kind``."""
+
+    torque: Any
+    _params: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        t = strip("torque", self.torque, _TORQUE)
+        if t.shape != (3,):
+            raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
+        object.__setattr__(self, "_params", t.copy())
+
+    def encode(self) -> tuple[int, np.ndarray]:
+        return self.kind, self._params.copy()
+
+
+@dataclass(frozen=True)
+class BodyTorque(_ConstantTorque):
     """A torque constant in the body frame.
 
     Parameters
@@ -82,21 +99,11 @@ class BodyTorque(_Torque):
     (1, array([0., 0., 1.]))
     """
 
-    torque: Any
-    _params: np.ndarray = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        t = strip("torque", self.torque, _TORQUE)
-        if t.shape != (3,):
-            raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
-        object.__setattr__(self, "_params", t.copy())
-
-    def encode(self) -> tuple[int, np.ndarray]:
-        return _k.TORQUE_BODY, self._params.copy()
+    kind = _k.TORQUE_BODY
 
 
 @dataclass(frozen=True)
-class SpaceTorque(_Torque):
+class SpaceTorque(_ConstantTorque):
     """A torque constant in the space frame (acting on the body as q^-1 N q).
 
     Parameters
@@ -111,17 +118,7 @@ class SpaceTorque(_Torque):
     array([ 0., -1.,  0.])
     """
 
-    torque: Any
-    _params: np.ndarray = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        t = strip("torque", self.torque, _TORQUE)
-        if t.shape != (3,):
-            raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
-        object.__setattr__(self, "_params", t.copy())
-
-    def encode(self) -> tuple[int, np.ndarray]:
-        return _k.TORQUE_SPACE, self._params.copy()
+    kind = _k.TORQUE_SPACE
 
 
 @dataclass(frozen=True)
