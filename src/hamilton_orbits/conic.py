@@ -57,6 +57,8 @@ class Conic:
     Examples
     --------
     >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    >>> c
+    Conic(p=1.44, e=0.44, inv_a=0.56)
     >>> round(float(c.a), 12), round(float(c.b), 12)
     (1.785714285714, 1.603567451475)
     >>> [round(float(x), 12) + 0.0 for x in c.second_focus]
@@ -70,6 +72,12 @@ class Conic:
         self.periapsis_direction = np.asarray(periapsis_direction, float)
         self.normal = np.asarray(normal, float)
         self.mu = np.asarray(mu, float)
+
+    def __repr__(self) -> str:
+        def fmt(x: np.ndarray) -> str:
+            return np.array2string(np.asarray(x), precision=6, threshold=6)
+
+        return f"Conic(p={fmt(self.p)}, e={fmt(self.e)}, inv_a={fmt(self.inv_a)})"
 
     @classmethod
     def _from_orbit(cls, orbit) -> Conic:
