@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+import numpy as np
+
 import hamilton_orbits
 from hamilton_orbits.cli import main
 
@@ -19,6 +21,13 @@ def test_default_demo_runs(capsys):
     # the round-trip error the demo reports is a measured number, at rounding level
     err = float(out.rsplit("largest geodesic error", 1)[1].split()[0])
     assert err < 1e-14
+    # seven propagation steps of P/7 return to the start: |r| ~ 1.1e10 mm, so
+    # 1e-3 mm is 1e-13 relative (the round-off of seven universal-variable steps)
+    back = float(out.split("is back within", 1)[1].split()[0])
+    assert back < 1e-3
+    # the exact free motion flips the middle-axis spin every flip interval
+    flips = out.split("flip intervals:", 1)[1].split("]")[0].strip(" [")
+    np.testing.assert_allclose([float(x) for x in flips.split()], [2.0, -2.0, 2.0, -2.0])
 
 
 def test_console_script_help():
