@@ -48,6 +48,7 @@ from hamilton_orbits._kernels.kepler import (
 EPS = 2.220446049250313e-16
 PI = math.pi
 TWO_PI = 2.0 * math.pi
+FOUR_PI = 4.0 * math.pi
 
 # conic kinds
 ELLIPSE = 0.0
@@ -81,6 +82,15 @@ _RADIAL_TOL = 8.0 * EPS
 @njit(cache=True)
 def wrap_2pi(x):  # pragma: no cover - compiled
     """``x`` reduced to [0, 2 pi)."""
+    # fast paths, bit for bit what the floored ``%`` below gives for |x| < 2 pi
+    # (there fmod is exact and returns x); NaN fails both tests
+    if 0.0 < x < TWO_PI:
+        return x
+    if -TWO_PI < x < 0.0:
+        y = x + TWO_PI
+        return 0.0 if y >= TWO_PI else y
+    if TWO_PI < x < FOUR_PI:
+        return x - TWO_PI  # exact (Sterbenz), as fmod is
     y = x % TWO_PI
     if y >= TWO_PI:
         y = 0.0
@@ -132,6 +142,31 @@ def _radial_normal(dx, dy, dz):  # pragma: no cover - compiled
     if rho == 0.0:
         return 0.0, -1.0, 0.0
     return -dz * dx / rho, -dz * dy / rho, rho
+
+
+@njit(cache=True)
+def _ecc_anomaly_half_angle(sn, cn, e):  # pragma: no cover - compiled
+    """Eccentric anomaly (0 < e < 1) from ``(sn, cn) = k (sin nu, cos nu)``, k > 0.
+
+    ``tan(E/2) = sqrt((1-e)/(1+e)) tan(nu/2)`` with ``tan(nu/2)`` taken
+    straight from the pair, as ``sn/(k + cn)`` for ``cn >= 0`` and
+    ``(k - cn)/sn`` for ``cn < 0`` (``k = |(sn, cn)|``; no cancellation in
+    either), instead of from sin and cos of a rounded ``nu/2``: the same angle
+    as ``nu = atan2(sn, cn)``, without nu's rounding near apoapsis, and no
+    sin/cos calls.  E is in [-pi, pi].
+    """
+    a = abs(sn)
+    b = abs(cn)
+    big = max(a, b)
+    if 1e-150 < big < 1e150:
+        k = math.sqrt(sn * sn + cn * cn)
+    else:
+        k = math.hypot(sn, cn)
+    se = math.sqrt(1.0 - e)
+    ce = math.sqrt(1.0 + e)
+    if cn >= 0.0:
+        return 2.0 * math.atan2(se * sn, ce * (k + cn))
+    return 2.0 * math.atan2(math.copysign(se * (k - cn), sn), ce * a)
 
 
 @njit(cache=True)
@@ -208,7 +243,7 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
         nu = wrap_pi(u)
         argp = 0.0
     else:
-        nu = math.atan2(rv * h, h * h - mu * r)
+        nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
         argp = wrap_2pi(u - nu)
     if e == 1.0 and inv_a != 0.0:
         # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
@@ -223,7 +258,7 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
             kind = RADIAL_HYPERBOLA
         n = smu * abs(inv_a) * math.sqrt(abs(inv_a))
         return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
-    anom = anomaly_from_nu(nu, e)
+    use_sc = False
     if e >= 0.5 and inv_a != 0.0:
         # Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
         # form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
@@ -237,12 +272,21 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
         t_ = abs(s_) * aa / e
         err_nu = t_ / math.sqrt(aa * p)
         err_sc = (t_ / r) * (t_ / r)
-        if err_sc < err_nu:
-            if inv_a > 0.0:
-                anom = math.atan2(s_, r * v2 / mu - 1.0)
-            else:
-                anom = math.asinh(s_ / e)
-    m = mean_from_anomaly(anom, e)
+        use_sc = err_sc < err_nu
+    if use_sc:
+        if inv_a > 0.0:
+            anom = math.atan2(s_, r * v2 / mu - 1.0)
+        else:
+            anom = math.asinh(s_ / e)
+    elif 0.0 < e < 1.0:
+        anom = _ecc_anomaly_half_angle(rv * h, h * h - mu * r, e)
+    else:
+        anom = anomaly_from_nu(nu, e)
+    if e < 1.0 and -3.0 < anom < 3.0:
+        # mean_from_anomaly without its 2 pi reduction (k = 0 here), bit for bit
+        m = (1.0 - e) * anom + e * x_minus_sin(anom)
+    else:
+        m = mean_from_anomaly(anom, e)
     if e < 1.0:
         kind = ELLIPSE
         n = smu * inv_a * math.sqrt(inv_a)
