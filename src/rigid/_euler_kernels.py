@@ -39,14 +39,6 @@ TORQUE_BODY = 1
 TORQUE_SPACE = 2
 TORQUE_GRAVITY_GRADIENT = 3
 
-METHOD_SPLITTING2 = 0
-METHOD_SPLITTING4 = 1
-
-# Yoshida (1990, Phys. Lett. A 150, 262, eq. 5.4) triple jump: a symmetric
-# second-order map S2 composed as S2(w1 h) S2(w0 h) S2(w1 h) is of order four.
-_CBRT2 = 2.0 ** (1.0 / 3.0)
-YOSHIDA_W1 = 1.0 / (2.0 - _CBRT2)
-YOSHIDA_W0 = -_CBRT2 / (2.0 - _CBRT2)
 
 
 # --------------------------------------------------------------------------
@@ -200,68 +192,198 @@ def torque_gufunc(moments, quat, t, kind, params, out):  # pragma: no cover - co
 # --------------------------------------------------------------------------
 # Lie-Poisson splitting of the free body, with torque kicks
 # --------------------------------------------------------------------------
+#
+# A splitting method is a sequence of "ops" per step, built in Python
+# (rigid.integrators._split_ops): op type 0, 1, 2 is the exact flow of
+# g L_axis^2 / 2 (a rotation about that principal axis; g = 1 / I_axis in the
+# plain splitting), type 3 the exact flow of the torque (a kick), type 4 that of
+# the Casimir part g |L|^2 / 2 (a rotation of the attitude about L).  Rounding
+# is kept at the level of one ulp per *run* rather than per op:
+#
+# * each rotation is applied as an increment, L <- L + ((cos t - 1) L_i +
+#   sin t L_j, ...), with cos t - 1 = -2 sin^2(t/2) and 1 - cos(t/2) computed
+#   directly (no cancellation), so the rotation matrix is orthogonal to
+#   O(eps t^2) instead of O(eps): the plain c = cos t, s = sin t of libm give
+#   c^2 + s^2 - 1 = O(eps) with a sign that stays put while t does, which made
+#   |L| (hence the energy, hence the phase) drift linearly, ~1e-16 per op;
+# * the state is carried as an unevaluated sum hi + lo (Kahan / Moller
+#   compensated summation, with Knuth's branch-free TwoSum), so the rounding of
+#   each increment's addition is fed back into the next one;
+# * the state lives in registers inside the loop (arrays would make every
+#   rotation wait for a store and a reload: ~3x slower).
+
+
+SIN_C = (-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0, -1.0 / 39916800.0)
+VERS_C = (-1.0 / 12.0, 1.0 / 360.0, -1.0 / 20160.0, 1.0 / 1814400.0, -1.0 / 239500800.0)
 
 
 @njit(inline="always", cache=True)
-def _axis_flow(axis, tau, moments, ell, quat):  # pragma: no cover - compiled
-    """Exact flow for time ``tau`` of T_axis = L_axis^2 / (2 I_axis), in place.
+def _two_sum(a, b):  # pragma: no cover - compiled
+    """s = fl(a + b) and the exact rounding error e, a + b = s + e (Knuth)."""
+    s = a + b
+    bp = s - a
+    ap = s - bp
+    return s, (a - ap) + (b - bp)
 
-    omega = (L_axis / I_axis) e_axis is constant along this flow, so the body
-    angular momentum turns by -theta about e_axis (dL/dt = L x omega) and the
-    attitude by q <- q (cos theta/2, sin theta/2 e_axis), theta = L_axis tau / I_axis.
-    Both are exact rotations: |L| and the space-frame L = q L q^-1 are unchanged
-    up to rounding.
+
+@njit(inline="always", cache=True)
+def sin_versin(x):  # pragma: no cover - compiled
+    """(sin x, 1 - cos x), both to about an ulp *relative* (no cancellation).
+
+    Taylor polynomials for |x| < 1/4 (truncation < 1e-17 relative, cheaper than
+    two libm calls), else sin x and 2 sin^2(x/2).
     """
-    half = 0.5 * ell[axis] * tau / moments[axis]
-    ch = math.cos(half)
-    sh = math.sin(half)
-    c = ch * ch - sh * sh
-    s = 2.0 * ch * sh
-    i = (axis + 1) % 3
-    j = (axis + 2) % 3
-    li = ell[i]
-    lj = ell[j]
-    ell[i] = c * li + s * lj
-    ell[j] = -s * li + c * lj
-    bx = sh if axis == 0 else 0.0
-    by = sh if axis == 1 else 0.0
-    bz = sh if axis == 2 else 0.0
-    w, x, y, z = qmul(quat[0], quat[1], quat[2], quat[3], ch, bx, by, bz)
-    quat[0] = w
-    quat[1] = x
-    quat[2] = y
-    quat[3] = z
+    if abs(x) < 0.25:
+        # Estrin's scheme: shorter dependency chain than Horner (the loop is
+        # latency bound: every rotation angle depends on the previous rotation)
+        x2 = x * x
+        x4 = x2 * x2
+        x8 = x4 * x4
+        ps = (SIN_C[0] + x2 * SIN_C[1]) + x4 * (SIN_C[2] + x2 * SIN_C[3]) + x8 * SIN_C[4]
+        pv = (VERS_C[0] + x2 * VERS_C[1]) + x4 * (VERS_C[2] + x2 * VERS_C[3]) + x8 * VERS_C[4]
+        return x + (x * x2) * ps, 0.5 * x2 + (0.5 * x4) * pv
+    s2 = math.sin(0.5 * x)
+    return math.sin(x), 2.0 * s2 * s2
 
 
 @njit(inline="always", cache=True)
-def _strang_free(h, moments, ell, quat):  # pragma: no cover - compiled
-    """Symmetric splitting T = T1 + T2 + T3: R1(h/2) R2(h/2) R3(h) R2(h/2) R1(h/2)."""
-    _axis_flow(0, 0.5 * h, moments, ell, quat)
-    _axis_flow(1, 0.5 * h, moments, ell, quat)
-    _axis_flow(2, h, moments, ell, quat)
-    _axis_flow(1, 0.5 * h, moments, ell, quat)
-    _axis_flow(0, 0.5 * h, moments, ell, quat)
+def _turn_pair(sh, vh, li, lj, ei, ej):  # pragma: no cover - compiled
+    """(L_i, L_j) turned by -theta (sin theta/2 = sh, 1 - cos theta/2 = vh), compensated.
+
+    Returns the new (L_i, L_j, e_i, e_j), e the compensation terms.  The
+    increments (cos theta - 1) L_i + sin theta L_j = 2 sh (L_j - sh L_i - vh L_j)
+    carry no O(eps) orthogonality error.
+    """
+    s2 = 2.0 * sh
+    ni, ei = _two_sum(li, s2 * (lj - (sh * li + vh * lj)) + ei)
+    nj, ej = _two_sum(lj, -s2 * (li + (sh * lj - vh * li)) + ej)
+    return ni, nj, ei, ej
 
 
 @njit(inline="always", cache=True)
-def _kick(kind, params, h, t, moments, ell, quat):  # pragma: no cover - compiled
-    """Exact flow of the torque part: L <- L + N(t, q) h with q frozen."""
-    nx, ny, nz = torque_scalar(
-        kind, params, moments[0], moments[1], moments[2], t, quat[0], quat[1], quat[2], quat[3]
-    )
-    ell[0] += h * nx
-    ell[1] += h * ny
-    ell[2] += h * nz
+def _qturn(sh, vh, w, x, y, z, pw, px, py, pz, ew, ex, ey, ez):  # pragma: no cover
+    """q (cos, sin u) = q - vh q + sh q u for q = (w, x, y, z), q u = (pw, ...), compensated."""
+    w1, ew = _two_sum(w, (sh * pw - vh * w) + ew)
+    x1, ex = _two_sum(x, (sh * px - vh * x) + ex)
+    y1, ey = _two_sum(y, (sh * py - vh * y) + ey)
+    z1, ez = _two_sum(z, (sh * pz - vh * z) + ez)
+    return w1, x1, y1, z1, ew, ex, ey, ez
 
 
-@njit(inline="always", cache=True)
-def _s2_step(kind, params, h, t, moments, ell, quat):  # pragma: no cover - compiled
-    """Second-order symmetric step: kick(h/2) free-splitting(h) kick(h/2)."""
-    if kind != TORQUE_NONE:
-        _kick(kind, params, 0.5 * h, t, moments, ell, quat)
-    _strang_free(h, moments, ell, quat)
-    if kind != TORQUE_NONE:
-        _kick(kind, params, 0.5 * h, t + h, moments, ell, quat)
+@njit(cache=True, fastmath={"contract"})
+def run_splitting(
+    types, fracs, toffs, inv, moments, qh, ql, lh, ll, t0, h, n_steps, out_steps, kind, params,
+    q_out, l_out, pending, more,
+):  # pragma: no cover - compiled
+    """Run ``n_steps`` steps of a splitting method given as ops; the time loop is compiled.
+
+    Op ``j`` of a step is the flow of type ``types[j]`` for time tau = ``fracs[j] h``,
+    at time t_step + ``toffs[j]`` h:
+
+    * 0-2: the flow of inv[axis] L_axis^2 / 2 (``inv`` (5,) holds the parts'
+      inverse moments, 1 / I_axis for the plain splitting).  omega = inv[axis]
+      L_axis e_axis is constant along it, so the body L turns by -theta about
+      e_axis (dL/dt = L x omega) and the attitude by q <- q (cos theta/2,
+      sin theta/2 e_axis), theta = inv[axis] L_axis tau: exact rotations, |L| and
+      the space-frame L = q L q^-1 are unchanged up to rounding.
+    * 3: a kick, the exact flow of the torque part: L <- L + N(t, q) tau, q frozen.
+    * 4: the flow of the Casimir part inv[4] |L|^2 / 2: the body L is fixed and
+      q <- q (cos phi, sin phi L / |L|), phi = inv[4] |L| tau / 2.  It commutes
+      with every other part of the free body.
+
+    When the last op of a step and the first of the next have the same type
+    (e.g. R1(h/2) R1(h/2)), they are fused into one (their flows commute) unless
+    an output falls between them.  ``pending``: the first op of the first step
+    was already applied (fused) by the previous call; ``more``: another call
+    continues this run, so the last step may fuse into it.  (Chunked runs, e.g.
+    with a progress bar, are then bitwise identical to one call.)
+
+    The state is the compensated pair (``qh + ql``, ``lh + ll``), advanced in
+    place (held in registers inside the loop).  The state after step
+    ``out_steps[k]`` (sorted, 0 = initial state) is written to ``q_out[k]``
+    (normalised: the flows preserve |q| to O(eps theta^2), the state itself is
+    not projected) and ``l_out[k]`` (body angular momentum).  Returns
+    (max | |q| - 1 | over the outputs, ``pending`` for the next call).
+    """
+    nops = types.shape[0]
+    f = np.empty(nops)
+    for j in range(nops):
+        f[j] = fracs[j] * h if types[j] == 3 else 0.5 * fracs[j] * h * inv[types[j]]
+    last = nops - 1
+    fuse = nops > 1 and types[0] == types[last]
+    f_fused = f[0] + f[last]
+    a = moments[0]
+    b = moments[1]
+    c = moments[2]
+    l0, l1, l2, e0, e1, e2 = lh[0], lh[1], lh[2], ll[0], ll[1], ll[2]
+    w, x, y, z = qh[0], qh[1], qh[2], qh[3]
+    ew, ex, ey, ez = ql[0], ql[1], ql[2], ql[3]
+    drift = 0.0
+    k = 0
+    nout = out_steps.shape[0]
+    for n in range(0, n_steps + 1):
+        if n > 0:
+            ts = t0 + (n - 1) * h
+            out_here = k < nout and out_steps[k] == n
+            for j in range(1 if pending else 0, nops):
+                typ = types[j]
+                fj = f[j]
+                if j == last:
+                    if fuse and (n < n_steps or more) and not out_here:
+                        fj = f_fused
+                        pending = True
+                    else:
+                        pending = False
+                if typ == 0:
+                    sh, vh = sin_versin(fj * l0)
+                    l1, l2, e1, e2 = _turn_pair(sh, vh, l1, l2, e1, e2)
+                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -x, w, z, -y,
+                                                        ew, ex, ey, ez)
+                elif typ == 1:
+                    sh, vh = sin_versin(fj * l1)
+                    l2, l0, e2, e0 = _turn_pair(sh, vh, l2, l0, e2, e0)
+                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -y, -z, w, x,
+                                                        ew, ex, ey, ez)
+                elif typ == 2:
+                    sh, vh = sin_versin(fj * l2)
+                    l0, l1, e0, e1 = _turn_pair(sh, vh, l0, l1, e0, e1)
+                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -z, y, -x, w,
+                                                        ew, ex, ey, ez)
+                elif typ == 3:
+                    nx, ny, nz = torque_scalar(kind, params, a, b, c, ts + toffs[j] * h,
+                                               w, x, y, z)
+                    l0, e0 = _two_sum(l0, fj * nx + e0)
+                    l1, e1 = _two_sum(l1, fj * ny + e1)
+                    l2, e2 = _two_sum(l2, fj * nz + e2)
+                else:
+                    lx = l0 + e0
+                    ly = l1 + e1
+                    lz = l2 + e2
+                    nl = math.sqrt(lx * lx + ly * ly + lz * lz)
+                    if nl > 0.0:
+                        sh, vh = sin_versin(fj * nl)
+                        pw, px, py, pz = qmul(w, x, y, z, 0.0, lx / nl, ly / nl, lz / nl)
+                        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, pw, px, py,
+                                                            pz, ew, ex, ey, ez)
+        while k < nout and out_steps[k] == n:
+            qw = w + ew
+            qx = x + ex
+            qy = y + ey
+            qz = z + ez
+            nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+            drift = max(drift, abs(nq - 1.0))
+            q_out[k, 0] = qw / nq
+            q_out[k, 1] = qx / nq
+            q_out[k, 2] = qy / nq
+            q_out[k, 3] = qz / nq
+            l_out[k, 0] = l0 + e0
+            l_out[k, 1] = l1 + e1
+            l_out[k, 2] = l2 + e2
+            k += 1
+    lh[0], lh[1], lh[2], ll[0], ll[1], ll[2] = l0, l1, l2, e0, e1, e2
+    qh[0], qh[1], qh[2], qh[3] = w, x, y, z
+    ql[0], ql[1], ql[2], ql[3] = ew, ex, ey, ez
+    return drift, pending
 
 
 @njit(inline="always", cache=True)
@@ -271,42 +393,6 @@ def _normalise(quat):  # pragma: no cover - compiled
     quat[1] /= n
     quat[2] /= n
     quat[3] /= n
-
-
-@njit(cache=True)
-def run_splitting(
-    method, moments, quat, ell, t0, h, n_steps, out_steps, kind, params, q_out, l_out
-):  # pragma: no cover - compiled
-    """Run ``n_steps`` steps of a splitting method; the whole time loop is compiled.
-
-    ``quat`` (4,) and ``ell`` (3,) (body angular momentum) are advanced in place.
-    The state after step ``out_steps[k]`` (sorted, 0 = initial state) is written
-    to ``q_out[k]``, ``l_out[k]``.  ``method`` is METHOD_SPLITTING2 or
-    METHOD_SPLITTING4 (Yoshida triple jump of the second-order step).  The
-    attitude is renormalised after every step: the sub-flows preserve |q|
-    exactly, so this only removes the random walk of rounding errors.
-    """
-    k = 0
-    nout = out_steps.shape[0]
-    while k < nout and out_steps[k] == 0:
-        q_out[k, :] = quat
-        l_out[k, :] = ell
-        k += 1
-    for n in range(1, n_steps + 1):
-        t = t0 + (n - 1) * h
-        if method == METHOD_SPLITTING2:
-            _s2_step(kind, params, h, t, moments, ell, quat)
-        else:
-            h1 = YOSHIDA_W1 * h
-            h0 = YOSHIDA_W0 * h
-            _s2_step(kind, params, h1, t, moments, ell, quat)
-            _s2_step(kind, params, h0, t + h1, moments, ell, quat)
-            _s2_step(kind, params, h1, t + h1 + h0, moments, ell, quat)
-        _normalise(quat)
-        while k < nout and out_steps[k] == n:
-            q_out[k, :] = quat
-            l_out[k, :] = ell
-            k += 1
 
 
 # --------------------------------------------------------------------------
