@@ -233,7 +233,15 @@ def sin_versin(x):  # pragma: no cover - compiled
     Taylor polynomials for |x| < 1/4 (truncation < 1e-17 relative, cheaper than
     two libm calls), else sin x and 2 sin^2(x/2).
     """
-    if abs(x) < 0.25:
+    ax = abs(x)
+    if ax < 0.015625:
+        # |x| < 1/64: the x^9 (sin) and x^8 (1 - cos) terms are below 1e-19 relative
+        x2 = x * x
+        x4 = x2 * x2
+        ps = (SIN_C[0] + x2 * SIN_C[1]) + x4 * SIN_C[2]
+        pv = (VERS_C[0] + x2 * VERS_C[1]) + x4 * VERS_C[2]
+        return x + (x * x2) * ps, 0.5 * x2 + (0.5 * x4) * pv
+    if ax < 0.25:
         # Estrin's scheme: shorter dependency chain than Horner (the loop is
         # latency bound: every rotation angle depends on the previous rotation)
         x2 = x * x
