@@ -82,15 +82,12 @@ _RADIAL_TOL = 8.0 * EPS
 @njit(cache=True)
 def wrap_2pi(x):  # pragma: no cover - compiled
     """``x`` reduced to [0, 2 pi)."""
-    # fast paths, bit for bit what the floored ``%`` below gives for |x| < 2 pi
-    # (there fmod is exact and returns x); NaN fails both tests
-    if 0.0 < x < TWO_PI:
-        return x
-    if -TWO_PI < x < 0.0:
-        y = x + TWO_PI
+    # fast path for -2 pi < x < 4 pi, bit for bit what the floored ``%`` below
+    # gives (there fmod is exact: x, or x - 2 pi by Sterbenz's lemma); written
+    # as selects, as the sign of x is a coin toss; NaN fails the test
+    if -TWO_PI < x < FOUR_PI:
+        y = x + (TWO_PI if x < 0.0 else (-TWO_PI if x >= TWO_PI else 0.0))
         return 0.0 if y >= TWO_PI else y
-    if TWO_PI < x < FOUR_PI:
-        return x - TWO_PI  # exact (Sterbenz), as fmod is
     y = x % TWO_PI
     if y >= TWO_PI:
         y = 0.0
@@ -145,31 +142,6 @@ def _radial_normal(dx, dy, dz):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _ecc_anomaly_half_angle(sn, cn, e):  # pragma: no cover - compiled
-    """Eccentric anomaly (0 < e < 1) from ``(sn, cn) = k (sin nu, cos nu)``, k > 0.
-
-    ``tan(E/2) = sqrt((1-e)/(1+e)) tan(nu/2)`` with ``tan(nu/2)`` taken
-    straight from the pair, as ``sn/(k + cn)`` for ``cn >= 0`` and
-    ``(k - cn)/sn`` for ``cn < 0`` (``k = |(sn, cn)|``; no cancellation in
-    either), instead of from sin and cos of a rounded ``nu/2``: the same angle
-    as ``nu = atan2(sn, cn)``, without nu's rounding near apoapsis, and no
-    sin/cos calls.  E is in [-pi, pi].
-    """
-    a = abs(sn)
-    b = abs(cn)
-    big = max(a, b)
-    if 1e-150 < big < 1e150:
-        k = math.sqrt(sn * sn + cn * cn)
-    else:
-        k = math.hypot(sn, cn)
-    se = math.sqrt(1.0 - e)
-    ce = math.sqrt(1.0 + e)
-    if cn >= 0.0:
-        return 2.0 * math.atan2(se * sn, ce * (k + cn))
-    return 2.0 * math.atan2(math.copysign(se * (k - cn), sn), ce * a)
-
-
-@njit(cache=True)
 def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
     """Elements of one state; returns the tuple of ``COLUMNS``."""
     r2 = rx * rx + ry * ry + rz * rz
@@ -221,12 +193,11 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
     ey = (f * ry - rv * vy) / mu
     ez = (f * rz - rv * vz) / mu
     ev = math.sqrt(ex * ex + ey * ey + ez * ez)
-    if ev < 0.5:
-        e = ev
-    else:
-        # e = 1 - (1 - e^2)/(1 + e): the nearest float to e, with 1 - e as
-        # accurate as 1 - e^2 = p inv_a is (sqrt(1 - w) can be an ulp off)
-        e = 1.0 - w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))
+    # e = ev below 1/2, else e = 1 - (1 - e^2)/(1 + e): the nearest float to e,
+    # with 1 - e as accurate as 1 - e^2 = p inv_a is (sqrt(1 - w) can be an ulp
+    # off); both are cheap, so both are computed and one selected (no branch)
+    ew = 1.0 - w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))
+    e = ev if ev < 0.5 else ew
     if e <= _CIRC_TOL:
         e = 0.0
     if abs(inv_a) * max(r, p) <= _PARAB_TOL:
@@ -237,8 +208,21 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
         # rectilinear orbit) unless treating it as a parabola costs less
         if abs(inv_a) * r <= h / (r * math.sqrt(v2)):
             inv_a = 0.0
-    inc, lan, nx, ny, mx, my, mz = _node_basis(hx / h, hy / h, hz / h)
-    u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
+    # inc, lan and u are angles, so the areal vector need not be normalised
+    # (fewer roundings and divisions than through the unit normal):
+    # n = (-hy, hx)/rho towards the ascending node, h x n = h m with
+    # m = (-hz ny, hz nx, rho)/h, u = atan2(r.m, r.n)
+    rho = math.hypot(hx, hy)
+    inc = math.atan2(rho, hz)
+    if rho > 0.0:
+        nx = -hy / rho
+        ny = hx / rho
+        lan = wrap_2pi(math.atan2(hx, -hy))
+    else:
+        nx = 1.0
+        ny = 0.0
+        lan = 0.0
+    u = wrap_2pi(math.atan2(hz * (ry * nx - rx * ny) + rz * rho, h * (rx * nx + ry * ny)))
     if e == 0.0:
         nu = wrap_pi(u)
         argp = 0.0
@@ -258,28 +242,49 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
             kind = RADIAL_HYPERBOLA
         n = smu * abs(inv_a) * math.sqrt(abs(inv_a))
         return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
-    use_sc = False
-    if e >= 0.5 and inv_a != 0.0:
-        # Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
-        # form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
-        # form e sin E = r.v/sqrt(mu a), e cos E = r v^2/mu - 1 is better, as
-        # inv_a has no cancellation (2/r and v^2/mu differ by r inv_a / 2).
-        # Estimated position errors (units of eps): |a sin E|/b for the first,
-        # (|a sin E|/r)^2 for the second.
-        aa = 1.0 / abs(inv_a)
-        sq = math.sqrt(abs(inv_a))
-        s_ = rv * sq / smu  # e sin E or e sinh F
-        t_ = abs(s_) * aa / e
-        err_nu = t_ / math.sqrt(aa * p)
-        err_sc = (t_ / r) * (t_ / r)
-        use_sc = err_sc < err_nu
-    if use_sc:
-        if inv_a > 0.0:
-            anom = math.atan2(s_, r * v2 / mu - 1.0)
+    # Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
+    # form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
+    # form e sin E = r.v/sqrt(mu a), e cos E = r v^2/mu - 1 is better, as
+    # inv_a has no cancellation (2/r and v^2/mu differ by r inv_a / 2).
+    # Estimated position errors (units of eps): |a sin E|/b for the first,
+    # (|a sin E|/r)^2 for the second; the vis-viva form only for e >= 1/2.
+    # Computed without branches (safe denominators where unused): whether
+    # e >= 1/2 is a coin toss in a batch.
+    ai = abs(inv_a)
+    ok_sc = (e >= 0.5) & (ai != 0.0)
+    ai_ = ai if ok_sc else 1.0
+    e_ = e if ok_sc else 1.0
+    aa = 1.0 / ai_
+    s_ = rv * math.sqrt(ai_) / smu  # e sin E or e sinh F
+    t_ = abs(s_) * aa / e_
+    err_nu = t_ / math.sqrt(aa * p)
+    err_sc = (t_ / r) * (t_ / r)
+    use_sc = ok_sc & (err_sc < err_nu)
+    if 0.0 < e < 1.0:
+        # E = atan2(s_, r v^2/mu - 1) (vis viva), or by half angles
+        # E = 2 atan2(sqrt(1-e) sin(nu/2), sqrt(1+e) cos(nu/2)) with the half
+        # angles of nu straight from (sn, cn) = k (sin nu, cos nu), k > 0, as
+        # tan(nu/2) = sn/(k + cn) for cn >= 0 and (k - cn)/sn for cn < 0 (no
+        # cancellation in either, none of nu's rounding near apoapsis, and no
+        # sin/cos calls); one atan2 call on selected arguments
+        sn = rv * h
+        cn = h * h - mu * r
+        asn = abs(sn)
+        big = max(asn, abs(cn))
+        if 1e-150 < big < 1e150:
+            k = math.sqrt(sn * sn + cn * cn)
         else:
-            anom = math.asinh(s_ / e)
-    elif 0.0 < e < 1.0:
-        anom = _ecc_anomaly_half_angle(rv * h, h * h - mu * r, e)
+            k = math.hypot(sn, cn)
+        se = math.sqrt(1.0 - e)
+        ce = math.sqrt(1.0 + e)
+        pos = cn >= 0.0
+        y_half = se * sn if pos else math.copysign(se * (k - cn), sn)
+        x_half = ce * (k + cn if pos else asn)
+        y_ = s_ if use_sc else y_half
+        x_ = r * v2 / mu - 1.0 if use_sc else x_half
+        anom = (1.0 if use_sc else 2.0) * math.atan2(y_, x_)
+    elif use_sc and inv_a < 0.0:
+        anom = math.asinh(s_ / e)
     else:
         anom = anomaly_from_nu(nu, e)
     if e < 1.0 and -3.0 < anom < 3.0:
