@@ -101,6 +101,46 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
     return r, v, mu, quantity
 
 
+def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
+    """The common case of :func:`_check_state` plus the copies ``KeplerOrbit``
+    keeps, in one compiled pass: ``r`` and ``v`` float64 arrays of one shape
+    ``(..., 3)`` and ``mu`` a number or a float64 array of the leading shape.
+    Returns ``(r, v, mu)`` (fresh C-contiguous arrays, as ``__init__`` makes),
+    or None when the input is of another kind or invalid; the caller then takes
+    the general path, which names the first bad argument and index."""
+    if type(r_in) is not np.ndarray or type(v_in) is not np.ndarray:
+        return None
+    if r_in.dtype != np.float64 or v_in.dtype != np.float64:
+        return None
+    shape = r_in.shape
+    if v_in.shape != shape or len(shape) == 0 or shape[-1] != 3:
+        return None
+    lead = shape[:-1]
+    if isinstance(mu_in, (float, int)) and not isinstance(mu_in, bool):
+        try:
+            mu_flat = np.full(1, float(mu_in))
+        except OverflowError:
+            return None
+    elif (
+        type(mu_in) is np.ndarray and mu_in.dtype == np.float64
+        and (mu_in.shape == lead or mu_in.shape == ())
+    ):
+        mu_flat = mu_in.reshape(-1)
+    else:
+        return None
+    n = r_in.size // 3
+    r_out = np.empty(shape)
+    v_out = np.empty(shape)
+    mu_out = np.empty(lead)
+    if n == 0:
+        return r_out, v_out, mu_out
+    bad = _el.check_copy_state(
+        r_in.reshape(-1, 3), v_in.reshape(-1, 3), mu_flat,
+        r_out.reshape(-1, 3), v_out.reshape(-1, 3), mu_out.reshape(-1),
+    )
+    return None if bad else (r_out, v_out, mu_out)
+
+
 class KeplerOrbit:
     """Two-body (Kepler) orbits, vectorised over leading dimensions.
 
@@ -178,6 +218,12 @@ class KeplerOrbit:
         >>> o.shape, [round(float(x), 12) for x in o.e]
         ((2,), [0.0, 0.5])
         """
+        fast = _check_copy_state_fast(r, v, mu)
+        if fast is not None:
+            obj = cls.__new__(cls)
+            obj._r, obj._v, obj._mu = fast
+            obj._quantity = False
+            return obj
         r_, v_, mu_, quantity = _check_state(r, v, mu)
         return cls(r_, v_, mu_, quantity)
 

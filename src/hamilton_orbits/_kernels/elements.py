@@ -314,6 +314,41 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
+@njit(cache=True, parallel=True)
+def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - compiled
+    """Copy rows of ``r``, ``v`` (N, 3) and ``mu`` (N,) or (1,) (broadcast) into
+    ``r_out``, ``v_out``, ``mu_out`` (N,) in one pass; return the number of rows
+    with a non-finite value, ``mu <= 0`` or ``r = 0`` (the caller then finds
+    and names the first one)."""
+    n = r.shape[0]
+    one = mu.shape[0] == 1
+    bad = 0
+    for i in prange(n):
+        rx = r[i, 0]
+        ry = r[i, 1]
+        rz = r[i, 2]
+        vx = v[i, 0]
+        vy = v[i, 1]
+        vz = v[i, 2]
+        m = mu[0] if one else mu[i]
+        r_out[i, 0] = rx
+        r_out[i, 1] = ry
+        r_out[i, 2] = rz
+        v_out[i, 0] = vx
+        v_out[i, 1] = vy
+        v_out[i, 2] = vz
+        mu_out[i] = m
+        ok = (
+            math.isfinite(rx) and math.isfinite(ry) and math.isfinite(rz)
+            and math.isfinite(vx) and math.isfinite(vy) and math.isfinite(vz)
+            and math.isfinite(m) and m > 0.0
+            and (rx * rx > 0.0 or ry * ry > 0.0 or rz * rz > 0.0)
+        )
+        if not ok:
+            bad += 1
+    return bad
+
+
 @njit(cache=True)
 def elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: no cover
     """State from ``p, e`` and the anomaly (E, D or F by ``e``).
