@@ -204,8 +204,10 @@ def torque_gufunc(moments, quat, t, kind, params, out):  # pragma: no cover - co
 #   sin t L_j, ...), with cos t - 1 = -2 sin^2(t/2) and 1 - cos(t/2) computed
 #   directly (no cancellation), so the rotation matrix is orthogonal to
 #   O(eps t^2) instead of O(eps): the plain c = cos t, s = sin t of libm give
-#   c^2 + s^2 - 1 = O(eps) with a sign that stays put while t does, which made
-#   |L| (hence the energy, hence the phase) drift linearly, ~1e-16 per op;
+#   c^2 + s^2 - 1 = O(eps) with a sign that persists while t changes slowly
+#   (cos t is 1 - t^2/2 rounded the same way step after step), which made |L|
+#   (hence the energy, hence the phase) drift systematically: 4e-12 after 2e7
+#   steps of 7e-6 s, a 1e-9 error floor;
 # * the state is carried as an unevaluated sum hi + lo (Kahan / Moller
 #   compensated summation, with Knuth's branch-free TwoSum), so the rounding of
 #   each increment's addition is fed back into the next one;
