@@ -505,10 +505,28 @@ class KeplerOrbit:
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
         return self._out(-0.5 * self._mu * self._inv_a, _V**2)
 
+    @cached_property
+    def _tau(self) -> np.ndarray:
+        flat_r = self._r.reshape(-1, 3)
+        flat_v = self._v.reshape(-1, 3)
+        flat_mu = self._mu.reshape(-1)
+        out = np.empty(flat_r.shape[0])
+        _el.state_to_time_since_periapsis(flat_r, flat_v, flat_mu, out)
+        return out.reshape(self._mu.shape)
+
     @property
     def time_since_periapsis(self):
-        """``M / n``; for a radial orbit the time since the collision."""
-        return self._out(self._col("tau"), _T)
+        """Time since periapsis (negative before it); for a radial orbit the time
+        since the collision.
+
+        It is ``M / n`` with the *true* mean anomaly of the state: computed with
+        1 - e to the accuracy of 1 - e^2 = p/a, so it stays exact to the state's
+        rounding for near-parabolic orbits and is continuous across e = 1.  The
+        attribute ``M`` instead belongs to the element set as floats (computed
+        with the float ``e``, so that ``(p, e, M)`` reproduce the state); the two
+        differ by ~eps/|1 - e| relative, visible only near e = 1.
+        """
+        return self._out(self._tau, _T)
 
     @property
     def _sign(self) -> np.ndarray:

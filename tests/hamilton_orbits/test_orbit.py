@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import astropy.units as u
+import mpmath
 import numpy as np
 import pytest
 from hard_cases import CASES, perifocal_state
@@ -119,6 +120,58 @@ def test_mean_anomaly_near_periapsis_generic_orientation():
     k = math.sqrt(0.5 / 1.5)
     # absolute error of a few eps in nu (the direction of r is only known to eps)
     assert abs(o.M - 0.5 * k * 1e-12) <= 8 * EPS
+
+
+def _time_since_periapsis_mp(r, v, mu, dps=50):
+    """Time since periapsis of a float state, in 50-digit arithmetic (no cancellation
+    issues at this precision): nu from atan2((r.v) h, h^2 - mu r), then the
+    half-angle anomaly and Kepler's equation for the ellipse or the hyperbola."""
+    with mpmath.workdps(dps):
+        rr = [mpmath.mpf(float(x)) for x in r]
+        vv = [mpmath.mpf(float(x)) for x in v]
+        m = mpmath.mpf(float(mu))
+        hvec = [rr[1] * vv[2] - rr[2] * vv[1], rr[2] * vv[0] - rr[0] * vv[2],
+                rr[0] * vv[1] - rr[1] * vv[0]]
+        h = mpmath.sqrt(sum(x * x for x in hvec))
+        rn = mpmath.sqrt(sum(x * x for x in rr))
+        rv = sum(a * b for a, b in zip(rr, vv, strict=True))
+        v2 = sum(x * x for x in vv)
+        inv_a = 2 / rn - v2 / m
+        e = mpmath.sqrt(1 - h * h / m * inv_a)
+        nu = mpmath.atan2(rv * h, h * h - m * rn)
+        if e < 1:
+            big_e = 2 * mpmath.atan(mpmath.sqrt((1 - e) / (1 + e)) * mpmath.tan(nu / 2))
+            mean = big_e - e * mpmath.sin(big_e)
+            n = mpmath.sqrt(m * inv_a**3)
+        else:
+            big_f = 2 * mpmath.atanh(mpmath.sqrt((e - 1) / (e + 1)) * mpmath.tan(nu / 2))
+            mean = e * mpmath.sinh(big_f) - big_f
+            n = mpmath.sqrt(m * (-inv_a) ** 3)
+        return float(mean / n)
+
+
+@pytest.mark.parametrize("delta", [-1e-6, -1e-10, -1e-13, 1e-13, 1e-10, 1e-6])
+def test_time_since_periapsis_near_parabolic(delta):
+    """Near e = 1 the float e holds 1 - e only to eps absolute; the time since
+    periapsis still comes out exact to the state's rounding (reference: the same
+    float state evaluated in 50-digit arithmetic)."""
+    r, v = perifocal_state(1.3, 1.0 + delta, 0.4, 1.1, 2.3, 1.1, 0.8)
+    o = KeplerOrbit.from_state(r, v, 0.8)
+    ref = _time_since_periapsis_mp(r, v, 0.8)
+    # a handful of roundings in nu and the anomaly, each amplified at most ~2x
+    assert abs(o.time_since_periapsis - ref) <= 16 * EPS * abs(ref)
+
+
+def test_parabola_state_classified_as_parabola():
+    """Regression (hypothesis): a state built on the parabola q = 1, M = 1/4 had
+    |1/a| max(r, p) just above 8 eps and came back as a hyperbola with e - 1 ~ 1e-15.
+    1/a is now zero when it is below the rounding bound of vis viva."""
+    o = KeplerOrbit.from_elements(q=1.0, e=1.0, inc=0.0, lan=0.0, argp=1.0, M=0.25, mu=1.0)
+    back = KeplerOrbit.from_state(*o.state(), 1.0)
+    assert back.e == 1.0 and back.a == np.inf
+    assert abs(back.M - 0.25) <= 4 * EPS
+    # Barker: t = M / n with n = sqrt(mu / (2 q^3)) = 1/sqrt(2)
+    assert abs(back.time_since_periapsis - 0.25 * math.sqrt(2.0)) <= 4 * EPS
 
 
 # --------------------------------------------------------- hypothesis round trips

@@ -75,7 +75,10 @@ COLUMNS = (
 NCOL = len(COLUMNS)
 
 _CIRC_TOL = 4.0 * EPS
-_PARAB_TOL = 8.0 * EPS
+# |1/a| below this many eps of (2/r + v^2/mu), the rounding bound of vis viva
+# (each term carries ~1.5 eps from the state's own rounding and the arithmetic),
+# is indistinguishable from the parabola's 0
+_PARAB_TOL = 4.0 * EPS
 _RADIAL_TOL = 8.0 * EPS
 
 
@@ -142,8 +145,36 @@ def _radial_normal(dx, dy, dz):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
-    """Elements of one state; returns the tuple of ``COLUMNS``."""
+def _hyperbolic_anomaly(sn, cn, e, em1):  # pragma: no cover - compiled
+    """F from tanh(F/2) = sqrt((e-1)/(e+1)) tan(nu/2), with (sn, cn) = k (sin nu, cos nu).
+
+    ``em1`` = e - 1 computed accurately by the caller; tan(nu/2) is taken as
+    sn/(k + cn) (cn >= 0) or (k - cn)/sn (cn < 0), without cancellation.  A state
+    whose rounding puts it on or beyond the asymptote gets the largest finite F
+    of the same sign rather than NaN.
+    """
+    k = math.hypot(sn, cn)
+    if cn >= 0.0:
+        th = math.sqrt(em1 / (e + 1.0)) * (sn / (k + cn))
+    else:
+        th = math.sqrt(em1 / (e + 1.0)) * ((k - cn) / sn)
+    if abs(th) >= 1.0:
+        th = math.copysign(1.0 - EPS / 2.0, th)
+    return 2.0 * math.atanh(th)
+
+
+@njit(cache=True)
+def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
+    """Elements of one state; returns the tuple of ``COLUMNS``.
+
+    With ``accurate=False`` the anomaly and M are those of the element set as
+    floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
+    state.  With ``accurate=True`` they use 1 - e to the accuracy of
+    1 - e^2 = p/a instead, i.e. the true mean anomaly of the state; the two
+    differ by ~eps/|1 - e| relative, which matters only near e = 1 (where a
+    float e cannot hold 1 - e).  The time since periapsis (last column) is
+    meaningful with ``accurate=True``.
+    """
     r2 = rx * rx + ry * ry + rz * rz
     r = math.sqrt(r2)
     v2 = vx * vx + vy * vy + vz * vz
@@ -164,7 +195,7 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
         inc, lan, nx, ny, mx, my, mz = _node_basis(nx_, ny_, nz_)
         u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
         argp = wrap_2pi(u - PI)
-        if abs(inv_a) * r <= _PARAB_TOL:
+        if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
             # radial parabola: time since collision t = sqrt(2/mu) r^1.5 / 3
             tau = math.sqrt(2.0 / mu) * r * math.sqrt(r) / 3.0
             if rv < 0.0:
@@ -196,11 +227,16 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
     # e = ev below 1/2, else e = 1 - (1 - e^2)/(1 + e): the nearest float to e,
     # with 1 - e as accurate as 1 - e^2 = p inv_a is (sqrt(1 - w) can be an ulp
     # off); both are cheap, so both are computed and one selected (no branch)
-    ew = 1.0 - w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))
+    ome_w = w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))  # 1 - e, from 1 - e^2 = p/a
+    ew = 1.0 - ome_w
     e = ev if ev < 0.5 else ew
+    # 1 - e to the accuracy of p/a: near e = 1 the float e holds 1 - e only to
+    # eps absolute, which would spoil the anomalies and M of near-parabolic orbits
+    ome = 1.0 - ev if ev < 0.5 else ome_w
     if e <= _CIRC_TOL:
         e = 0.0
-    if abs(inv_a) * max(r, p) <= _PARAB_TOL:
+    if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
+        # 1/a = 2/r - v^2/mu is zero to within the rounding of its two terms
         inv_a = 0.0
         e = 1.0
     elif e == 1.0:
@@ -275,8 +311,8 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
             k = math.sqrt(sn * sn + cn * cn)
         else:
             k = math.hypot(sn, cn)
-        se = math.sqrt(1.0 - e)
-        ce = math.sqrt(1.0 + e)
+        se = math.sqrt(ome) if accurate else math.sqrt(1.0 - e)
+        ce = math.sqrt(2.0 - ome) if accurate else math.sqrt(1.0 + e)
         pos = cn >= 0.0
         y_half = se * sn if pos else math.copysign(se * (k - cn), sn)
         x_half = ce * (k + cn if pos else asn)
@@ -285,11 +321,17 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - com
         anom = (1.0 if use_sc else 2.0) * math.atan2(y_, x_)
     elif use_sc and inv_a < 0.0:
         anom = math.asinh(s_ / e)
+    elif accurate and e > 1.0:
+        anom = _hyperbolic_anomaly(rv * h, h * h - mu * r, e, -ome)
     else:
         anom = anomaly_from_nu(nu, e)
     if e < 1.0 and -3.0 < anom < 3.0:
         # mean_from_anomaly without its 2 pi reduction (k = 0 here), bit for bit
-        m = (1.0 - e) * anom + e * x_minus_sin(anom)
+        m = (ome if accurate else 1.0 - e) * anom + e * x_minus_sin(anom)
+    elif accurate and e > 1.0:
+        m = -ome * math.sinh(anom) + sinh_minus_x(anom)  # (e - 1) sinh F + (sinh F - F)
+    elif accurate and 0.0 < e < 1.0:
+        m = ome * anom + e * x_minus_sin(anom)  # |anom| <= pi here: no reduction
     else:
         m = mean_from_anomaly(anom, e)
     if e < 1.0:
@@ -312,6 +354,20 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
         res = state_to_elements_one(r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i])
         for j in range(NCOL):
             out[i, j] = res[j]
+
+
+@njit(cache=True, parallel=True)
+def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
+    """Time since periapsis of rows of ``r``, ``v`` (N, 3), ``mu`` (N,) into ``out`` (N,).
+
+    Uses the true mean anomaly (``accurate=True``): exact to the state's rounding
+    also for near-parabolic orbits, continuous across e = 1.
+    """
+    for i in prange(r.shape[0]):
+        res = state_to_elements_one(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], True
+        )
+        out[i] = res[NCOL - 1]
 
 
 @njit(cache=True, parallel=True)
