@@ -183,6 +183,30 @@ def _cubic_root(p, q):  # pragma: no cover - compiled
     return 2.0 * sp * math.sinh(math.asinh(q / (p * sp)) / 3.0)
 
 
+@njit(inline="always", cache=True)
+def _halley_step(x, xp, f, fp, fpp, a, b):  # pragma: no cover - compiled
+    """One safeguarded Halley step for an increasing convex/concave f in [a, b].
+
+    Shrinks the bracket with the sign of f, takes the Halley step (Newton if its
+    denominator is not positive), bisects if the step leaves the bracket, and
+    reports convergence: a step of a few ulp, a bracket of a few ulp, or a
+    2-cycle between neighbouring floats (the residual is at its rounding floor).
+    """
+    if f < 0.0:
+        a = x
+    else:
+        b = x
+    den = fp * fp - 0.5 * f * fpp
+    if den > 0.0:
+        xn = x - f * fp / den
+    else:
+        xn = x - f / fp
+    if not (a <= xn <= b):
+        xn = 0.5 * (a + b)
+    done = abs(xn - x) <= 4.0 * EPS * abs(xn) or b - a <= 8.0 * EPS * abs(b) or xn == xp
+    return xn, a, b, done
+
+
 @njit(cache=True)
 def _solve_elliptic(m, e):  # pragma: no cover - compiled
     """E in [0, pi] with E - e sin E = m, for 0 <= m <= pi, 0 < e < 1.
@@ -215,20 +239,8 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
             return x
         fp = om + 2.0 * e * sh * sh
         fpp = e * sx
-        if f < 0.0:
-            a = x
-        else:
-            b = x
-        den = fp * fp - 0.5 * f * fpp
-        if den > 0.0:
-            xn = x - f * fp / den
-        else:
-            xn = x - f / fp
-        if not (a <= xn <= b):
-            xn = 0.5 * (a + b)
-        # converged: a step of a few ulp, a bracket of a few ulp, or a 2-cycle
-        # between neighbouring floats (the residual is at its rounding floor)
-        if abs(xn - x) <= 4.0 * EPS * abs(xn) or b - a <= 8.0 * EPS * abs(b) or xn == xp:
+        xn, a, b, done = _halley_step(x, xp, f, fp, fpp, a, b)
+        if done:
             return xn
         xp = x
         x = xn
@@ -267,20 +279,8 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
             return x
         fp = em + 2.0 * e * sh * sh
         fpp = e * sx
-        if f < 0.0:
-            a = x
-        else:
-            b = x
-        den = fp * fp - 0.5 * f * fpp
-        if den > 0.0:
-            xn = x - f * fp / den
-        else:
-            xn = x - f / fp
-        if not (a <= xn <= b):
-            xn = 0.5 * (a + b)
-        # converged: a step of a few ulp, a bracket of a few ulp, or a 2-cycle
-        # between neighbouring floats (the residual is at its rounding floor)
-        if abs(xn - x) <= 4.0 * EPS * abs(xn) or b - a <= 8.0 * EPS * abs(b) or xn == xp:
+        xn, a, b, done = _halley_step(x, xp, f, fp, fpp, a, b)
+        if done:
             return xn
         xp = x
         x = xn
