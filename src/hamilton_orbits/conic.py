@@ -28,11 +28,18 @@ from __future__ import annotations
 
 from typing import Any
 
+import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array, check_trailing
+from hamilton_orbits._validation import check_trailing
+from hamilton_orbits.units import is_quantity, strip, wrap
 
 __all__ = ["Conic"]
+
+
+# internal units of a conic built from a Quantity orbit (those of KeplerOrbit)
+_L = u.km
+_V = u.km / u.s
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -65,19 +72,52 @@ class Conic:
     [-1.571428571429, 0.0, 0.0]
     """
 
-    def __init__(self, p, e, inv_a, periapsis_direction, normal, mu) -> None:
-        self.p = np.asarray(p, float)
+    def __init__(
+        self, p, e, inv_a, periapsis_direction, normal, mu, quantity: bool = False
+    ) -> None:
+        self._p = np.asarray(p, float)
         self.e = np.asarray(e, float)
-        self.inv_a = np.asarray(inv_a, float)
+        self._inv_a = np.asarray(inv_a, float)
         self.periapsis_direction = np.asarray(periapsis_direction, float)
         self.normal = np.asarray(normal, float)
-        self.mu = np.asarray(mu, float)
+        self._mu = np.asarray(mu, float)
+        self._quantity = quantity
 
     def __repr__(self) -> str:
         def fmt(x: np.ndarray) -> str:
             return np.array2string(np.asarray(x), precision=6, threshold=6)
 
-        return f"Conic(p={fmt(self.p)}, e={fmt(self.e)}, inv_a={fmt(self.inv_a)})"
+        unit = f" ({_L})" if self._quantity else ""
+        return f"Conic(p={fmt(self._p)}, e={fmt(self.e)}, inv_a={fmt(self._inv_a)}){unit}"
+
+    # ---------------------------------------------------------------- units
+    def _in(self, name: str, value: Any, unit: u.UnitBase) -> np.ndarray:
+        """A length (or vector of lengths) in the conic's units; no unit mixing."""
+        if is_quantity(value) != self._quantity:
+            kind = "a Quantity" if self._quantity else "plain floats"
+            raise ValueError(
+                f"Expected `{name}` as {kind} like the orbit this conic came from, "
+                f"got {type(value).__name__}"
+            )
+        return strip(name, value, unit)
+
+    def _out(self, value: np.ndarray, unit: u.UnitBase):
+        return wrap(value, unit, self._quantity)
+
+    @property
+    def p(self):
+        """Semi-parameter (semi-latus rectum) ``p = -beta^2 / M`` (eq. 16)."""
+        return self._out(self._p, _L)
+
+    @property
+    def inv_a(self):
+        """``1/a`` (0 for the parabola)."""
+        return self._out(self._inv_a, 1 / _L)
+
+    @property
+    def mu(self):
+        """Gravitational parameter (Hamilton's M)."""
+        return self._out(self._mu, _L**3 / u.s**2)
 
     @classmethod
     def _from_orbit(cls, orbit) -> Conic:
@@ -94,7 +134,10 @@ class Conic:
         cw, sw = np.cos(argp), np.sin(argp)
         P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
         h = np.stack([si * sl, -si * cl, ci], axis=-1)
-        return cls(el[..., col["p"]], el[..., col["e"]], el[..., col["inv_a"]], P, h, orbit._mu)
+        return cls(
+            el[..., col["p"]], el[..., col["e"]], el[..., col["inv_a"]], P, h, orbit._mu,
+            quantity=orbit._quantity,
+        )
 
     @classmethod
     def from_state(cls, r: Any, v: Any, mu: Any) -> Conic:
@@ -113,8 +156,8 @@ class Conic:
     @property
     def a(self) -> np.ndarray:
         """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola."""
-        safe = np.where(self.inv_a == 0, 1.0, self.inv_a)
-        return np.where(self.inv_a == 0, np.inf, 1.0 / safe)
+        safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
+        return self._out(np.where(self._inv_a == 0, np.inf, 1.0 / safe), _L)
 
     @property
     def b(self) -> np.ndarray:
@@ -122,8 +165,8 @@ class Conic:
         for the hyperbola the length ``|a| sqrt(e^2 - 1)`` of the imaginary
         (conjugate) semi-axis, Hamilton's "vector with a positive square" (eq. 42);
         inf for the parabola."""
-        ia = np.abs(np.where(self.inv_a == 0, 1.0, self.inv_a))
-        return np.where(self.inv_a == 0, np.inf, np.sqrt(self.p / ia))
+        ia = np.abs(np.where(self._inv_a == 0, 1.0, self._inv_a))
+        return self._out(np.where(self._inv_a == 0, np.inf, np.sqrt(self._p / ia)), _L)
 
     @property
     def hamilton_epsilon(self) -> np.ndarray:
@@ -131,58 +174,61 @@ class Conic:
         return -self.e[..., None] * self.periapsis_direction
 
     def _finite_a(self, what: str) -> np.ndarray:
-        if np.any(self.inv_a == 0):
+        if np.any(self._inv_a == 0):
             raise ValueError(f"Expected a conic with a centre for `{what}`, got a parabola "
                              "(e = 1: the centre and second focus are at infinity)")
-        return 1.0 / self.inv_a
+        return 1.0 / self._inv_a
 
     @property
     def centre(self) -> np.ndarray:
         """Vector of the centre from the focus, ``a epsilon`` (eq. 36)."""
-        return self._finite_a("centre")[..., None] * self.hamilton_epsilon
+        return self._out(self._finite_a("centre")[..., None] * self.hamilton_epsilon, _L)
 
     @property
     def second_focus(self) -> np.ndarray:
         """Vector of the second focus, ``2 a epsilon`` (eq. 31)."""
-        return 2.0 * self._finite_a("second_focus")[..., None] * self.hamilton_epsilon
+        focus = 2.0 * self._finite_a("second_focus")[..., None] * self.hamilton_epsilon
+        return self._out(focus, _L)
 
     @property
     def directrix_distance(self) -> np.ndarray:
         """Distance ``p / e`` from the focus to the directrix (on the periapsis
         side); inf for the circle."""
         safe = np.where(self.e == 0, 1.0, self.e)
-        return np.where(self.e == 0, np.inf, self.p / safe)
+        return self._out(np.where(self.e == 0, np.inf, self._p / safe), _L)
 
     # ------------------------------------------------------ at a point
     def radius(self, nu: Any) -> np.ndarray:
         """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20)."""
-        nu = as_float_array("nu", nu)
-        return self.p / (1.0 + self.e * np.cos(nu))
+        nu = strip("nu", nu, u.rad)
+        return self._out(self._p / (1.0 + self.e * np.cos(nu)), _L)
+
+    def _chord(self, r: np.ndarray) -> np.ndarray:
+        return r * (2.0 - r * self._inv_a)
 
     def focal_half_chord(self, r: Any) -> np.ndarray:
         """C = r r'/a = r (2 - r/a) (eq. 63), at focal distance ``r``."""
-        r = as_float_array("r", r)
-        return r * (2.0 - r * self.inv_a)
+        return self._out(self._chord(self._in("r", r, _L)), _L)
 
     def second_focal_distance(self, r: Any) -> np.ndarray:
         """``r' = 2a - r`` (eq. 53): negative for the hyperbola, inf for the parabola."""
-        r = as_float_array("r", r)
-        safe = np.where(self.inv_a == 0, 1.0, self.inv_a)
-        return np.where(self.inv_a == 0, np.inf, 2.0 / safe - r)
+        r = self._in("r", r, _L)
+        safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
+        return self._out(np.where(self._inv_a == 0, np.inf, 2.0 / safe - r), _L)
 
     def normal_length(self, r: Any) -> np.ndarray:
         """N = sqrt(p r r'/a) (eq. 65), the normal between the curve and the axis."""
-        return np.sqrt(self.p * self.focal_half_chord(r))
+        return self._out(np.sqrt(self._p * self._chord(self._in("r", r, _L))), _L)
 
     def radius_of_curvature(self, r: Any) -> np.ndarray:
         """R = C^2 / N = C sqrt(C / p) (eqs. 63-64)."""
-        c = self.focal_half_chord(r)
-        return c * np.sqrt(c / self.p)
+        c = self._chord(self._in("r", r, _L))
+        return self._out(c * np.sqrt(c / self._p), _L)
 
     def radial_speed_squared(self, r: Any) -> np.ndarray:
         """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66)."""
-        r = as_float_array("r", r)
-        return self.mu * (2.0 / r - self.inv_a - self.p / (r * r))
+        r = self._in("r", r, _L)
+        return self._out(self._mu * (2.0 / r - self._inv_a - self._p / (r * r)), _V**2)
 
     def hodograph(self, r: Any) -> tuple[np.ndarray, np.ndarray]:
         """Hamilton's decomposition of the velocity at position ``r`` (after eq. 65).
@@ -205,10 +251,10 @@ class Conic:
         >>> (rot + fix + 0.0).round(12).tolist()
         [0.0, 1.2, 0.0]
         """
-        r = check_trailing("r", as_float_array("r", r), 3)
-        h = np.sqrt(self.mu * self.p)
-        k = (self.mu / h)[..., None]
+        r = check_trailing("r", self._in("r", r, _L), 3)
+        h = np.sqrt(self._mu * self._p)
+        k = (self._mu / h)[..., None]
         rhat = r / np.sqrt(_dot(r, r))[..., None]
         rot = k * np.cross(self.normal, rhat)
         fix = k * np.cross(self.normal, self.e[..., None] * self.periapsis_direction)
-        return rot, fix
+        return self._out(rot, _V), self._out(fix, _V)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import astropy.units as u
 import numpy as np
 import pytest
 from hard_cases import perifocal_state
@@ -120,3 +121,23 @@ def test_orbit_conic_matches_state():
     c = o.conic
     assert np.allclose(c.periapsis_direction, o.eccentricity_vector / 0.4, atol=8 * EPS)
     assert np.allclose(c.normal, o.areal_vector / np.linalg.norm(o.areal_vector), atol=4 * EPS)
+
+
+def test_quantities_in_quantities_out():
+    """A conic from a Quantity orbit speaks km and km/s; plain floats are not mixed in."""
+    r = [6524.834, 6862.875, 6448.296] * u.km  # Vallado, 4th ed., Example 2-5
+    v = [4.901327, 5.533756, -1.976341] * u.km / u.s
+    orbit = KeplerOrbit.from_state(r, v, 398600.4418 * u.km**3 / u.s**2)
+    c = orbit.conic
+    assert c.a.unit == u.km and abs(c.a - orbit.a) <= 4 * EPS * orbit.a
+    assert c.second_focus.unit == u.km and c.hodograph(r)[0].unit == u.km / u.s
+    rn = np.linalg.norm(r)
+    assert abs(c.radius(orbit.nu) - rn) <= 8 * EPS * rn
+    rot, fix = c.hodograph(r)
+    np.testing.assert_allclose((rot + fix).to_value(u.km / u.s), v.value, rtol=16 * EPS)
+    vr2 = (np.dot(r, v) / rn) ** 2
+    # eq. (66) subtracts terms of the size of v^2: allow a few dozen eps of v^2
+    assert abs(c.radial_speed_squared(rn) - vr2) <= 64 * EPS * np.dot(v, v)
+    assert c.focal_half_chord(rn.to(u.m)).unit == u.km
+    with pytest.raises(ValueError, match="`r` as a Quantity"):
+        c.focal_half_chord(7000.0)
