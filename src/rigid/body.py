@@ -30,6 +30,7 @@ from hamilton_orbits.units import strip
 __all__ = ["RigidBody"]
 
 _EPS = np.finfo(np.float64).eps
+_L_UNIT = u.kg * u.m**2 / u.s  # angular momentum
 # Slack for the symmetry and the triangle-inequality checks: a tensor built by
 # rotating a diagonal one in floating point is symmetric / flat only to a few
 # ulp of its largest entry, and a flat disk (C = A + B, Sylvester's limit case)
@@ -116,7 +117,10 @@ class RigidBody:
     Attributes
     ----------
     moments : ndarray, shape (3,)
-        Principal moments (SI floats, or the caller's consistent units).
+        Principal moments (SI floats, or the caller's consistent units).  The
+        state (``moments``, ``omega``) is kept as floats; the derived quantities
+        (angular momenta, kinetic energy) come back as Quantities when the body
+        was built from Quantities.
     attitude : Quaternion
         Unit attitude quaternion, body (principal) frame to space.
     omega : ndarray, shape (3,)
@@ -141,16 +145,18 @@ class RigidBody:
     >>> import astropy.units as u
     >>> body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.1, 0.0, 1.0] * u.rad / u.s)
     >>> print(round(body.kinetic_energy, 4))
-    1.505
+    1.505 J
     >>> print(body.angular_momentum_space.round(3))
-    [0.1 0.  3. ]
+    [0.1 0.  3. ] m2 kg / s
+    >>> print(RigidBody([1.0, 2.0, 3.0], omega=[0.1, 0.0, 1.0]).kinetic_energy)  # floats
+    1.505
     >>> RigidBody([1.0, 1.0, 3.0])
     Traceback (most recent call last):
     ...
     ValueError: Expected `inertia` to satisfy A + B >= C, got 3.0 at index 2 > 2.0
     """
 
-    __slots__ = ("attitude", "moments", "omega")
+    __slots__ = ("_quantity", "attitude", "moments", "omega")
 
     def __init__(self, inertia: Any, attitude: Any = None, omega: Any = None) -> None:
         inertia_arr = strip("inertia", inertia, u.kg * u.m**2)
@@ -171,6 +177,8 @@ class RigidBody:
         self.moments: np.ndarray = np.asarray(moments, dtype=np.float64)
         self.omega: np.ndarray = np.asarray(omega_arr, dtype=np.float64).copy()
         self.attitude: Quaternion = Quaternion(q)
+        # derived quantities come back as Quantities when the body was built from them
+        self._quantity = isinstance(inertia, u.Quantity) or isinstance(omega, u.Quantity)
 
     def __repr__(self) -> str:
         return (
@@ -187,16 +195,35 @@ class RigidBody:
         >>> print(b.omega)
         [0. 0. 2.]
         """
-        return RigidBody(
+        body = RigidBody(
             self.moments,
             self.attitude if attitude is None else attitude,
             self.omega if omega is None else omega,
         )
+        body._quantity = self._quantity or isinstance(omega, u.Quantity)
+        return body
+
+    # ------------------------------------------------------------ derived (floats)
+    def _l_body(self) -> np.ndarray:
+        return self.moments * self.omega
+
+    def _l_space(self) -> np.ndarray:
+        return np.asarray(self.attitude.rotate(self._l_body()), dtype=np.float64)
+
+    def _energy(self) -> float:
+        return float(0.5 * np.sum(self.moments * self.omega * self.omega))
+
+    def _l_norm(self) -> float:
+        return float(np.sqrt(np.sum(self._l_body() ** 2)))
+
+    def _out(self, value, unit: u.UnitBase):
+        return u.Quantity(value, unit) if self._quantity else value
 
     @property
     def angular_momentum_body(self) -> np.ndarray:
-        """Angular momentum ``(A p, B q, C r)`` in the body frame, shape (3,)."""
-        return self.moments * self.omega
+        """Angular momentum ``(A p, B q, C r)`` in the body frame, shape (3,)
+        (kg m^2/s as a Quantity if the body was built from Quantities)."""
+        return self._out(self._l_body(), _L_UNIT)
 
     @property
     def angular_momentum_space(self) -> np.ndarray:
@@ -204,7 +231,7 @@ class RigidBody:
 
         Constant in torque-free motion; equal to Cayley's ``(g, g', g'')``.
         """
-        return np.asarray(self.attitude.rotate(self.angular_momentum_body), dtype=np.float64)
+        return self._out(self._l_space(), _L_UNIT)
 
     @property
     def cayley_g(self) -> np.ndarray:
@@ -226,13 +253,15 @@ class RigidBody:
 
     @property
     def kinetic_energy(self) -> float:
-        """Kinetic energy ``T = (A p^2 + B q^2 + C r^2) / 2`` (J for SI input)."""
-        return float(0.5 * np.sum(self.moments * self.omega * self.omega))
+        """Kinetic energy ``T = (A p^2 + B q^2 + C r^2) / 2`` (J as a Quantity if the
+        body was built from Quantities)."""
+        return self._out(self._energy(), u.J)
 
     @property
     def angular_momentum_norm(self) -> float:
-        """``|L|``, the magnitude of the angular momentum."""
-        return float(np.sqrt(np.sum(self.angular_momentum_body**2)))
+        """``|L|``, the magnitude of the angular momentum (kg m^2/s as a Quantity if
+        the body was built from Quantities)."""
+        return self._out(self._l_norm(), _L_UNIT)
 
     @property
     def invariable_plane(self) -> np.ndarray:
@@ -248,7 +277,7 @@ class RigidBody:
         >>> print(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 5.0]).invariable_plane)
         [0. 0. 1.]
         """
-        lvec = self.angular_momentum_space
+        lvec = self._l_space()
         norm = float(np.sqrt(np.sum(lvec * lvec)))
         if norm == 0.0:
             raise ValueError(

@@ -85,7 +85,7 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     att, w = free_motion(body, t)
     w = np.asarray(getattr(w, "value", w))
     t_arr = np.asarray(getattr(t, "value", t), dtype=float)
-    scale = 1.0 / np.sqrt(2.0 * body.kinetic_energy)
+    scale = 1.0 / np.sqrt(2.0 * body._energy())
     rho = w * scale
     contact = np.asarray(att.rotate(rho))
     helper = np.eye(3)[int(np.argmin(np.abs(normal)))]
@@ -93,7 +93,7 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(normal, e1)
     herp = np.stack([contact @ e1, contact @ e2], axis=-1)
-    dist = np.sqrt(2.0 * body.kinetic_energy) / body.angular_momentum_norm
+    dist = np.sqrt(2.0 * body._energy()) / body._l_norm()
     return PoinsotPaths(t_arr, rho, contact, herp, normal, np.stack([e1, e2]), float(dist))
 
 

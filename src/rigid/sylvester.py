@@ -79,7 +79,7 @@ def confocal(body: RigidBody, lam: float) -> RigidBody:
     """
     body = _check_body(body)
     lam = float(as_float_array("lam", lam))
-    return _related(body, 1.0 / body.moments + lam, body.angular_momentum_body, "A'")
+    return _related(body, 1.0 / body.moments + lam, body._l_body(), "A'")
 
 
 def contrafocal(body: RigidBody, lam: float) -> RigidBody:
@@ -107,7 +107,7 @@ def contrafocal(body: RigidBody, lam: float) -> RigidBody:
     """
     body = _check_body(body)
     lam = float(as_float_array("lam", lam))
-    return _related(body, lam - 1.0 / body.moments, -body.angular_momentum_body, "A'")
+    return _related(body, lam - 1.0 / body.moments, -body._l_body(), "A'")
 
 
 def confocal_rotation(body: RigidBody, lam: float, t: Any) -> Quaternion:
@@ -124,7 +124,7 @@ def confocal_rotation(body: RigidBody, lam: float, t: Any) -> Quaternion:
     """
     body = _check_body(body)
     t = as_float_array("t", t)
-    ell = body.angular_momentum_space
+    ell = body._l_space()
     norm = float(np.linalg.norm(ell))
     return Quaternion.from_axis_angle(ell / norm, float(lam) * norm * t)
 
@@ -181,8 +181,8 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, float, float]:
     """
     body = _check_body(body)
     moments = body.moments
-    ell2 = float(np.sum(body.angular_momentum_body**2))
-    t2 = 2.0 * body.kinetic_energy
+    ell2 = float(np.sum(body._l_body()**2))
+    t2 = 2.0 * body._energy()
     mid = float(np.sort(moments)[1])
     prefer = "confocal" if ell2 > t2 * mid else "contrafocal"
     valid = []

@@ -136,3 +136,22 @@ def test_bad_state():
         RigidBody([1.0, 1.0, 1.0] * u.m)
     with pytest.raises(ValueError, match="at rest has no invariable plane"):
         _ = RigidBody([1.0, 1.0, 1.0]).invariable_plane
+
+
+def test_derived_quantities_carry_units():
+    """Quantities in, Quantities out: the same numbers as the float body, with units."""
+    q = Quaternion.from_axis_angle([1.0, 2.0, 2.0], 0.7)
+    plain = RigidBody([1.0, 2.0, 3.0], q, [0.3, -0.2, 1.1])
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, q, [0.3, -0.2, 1.1] * u.rad / u.s)
+    assert body.kinetic_energy.unit == u.J
+    assert body.kinetic_energy.value == plain.kinetic_energy
+    for name in ("angular_momentum_body", "angular_momentum_space", "cayley_g"):
+        value = getattr(body, name)
+        assert value.unit == u.kg * u.m**2 / u.s
+        np.testing.assert_array_equal(value.value, getattr(plain, name))
+    assert body.angular_momentum_norm.to_value(u.g * u.cm**2 / u.s) == pytest.approx(
+        1e7 * plain.angular_momentum_norm, rel=1e-15
+    )
+    assert not isinstance(plain.kinetic_energy, u.Quantity)
+    assert body.with_state(omega=[0.0, 0.0, 1.0]).kinetic_energy.unit == u.J
+    np.testing.assert_array_equal(body.invariable_plane, plain.invariable_plane)
