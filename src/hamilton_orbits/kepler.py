@@ -76,6 +76,12 @@ def _out(value: np.ndarray, quantity: bool):
     return value[()] if value.ndim == 0 else value
 
 
+def _first_nan(out: np.ndarray) -> int | None:
+    """Flat index of the first NaN a kernel returned (its failure flag), else None."""
+    bad = np.isnan(out.ravel())
+    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+
+
 def solve_kepler(M: Any, e: Any):
     """Solve Kepler's equation for the anomaly, for every eccentricity ``e >= 0``.
 
@@ -129,9 +135,8 @@ def solve_kepler(M: Any, e: Any):
     """
     Ma, ea, quantity = _angle_pair("M", M, e)
     out = np.asarray(_k.solve_ufunc(Ma, ea), dtype=np.float64)
-    bad = np.isnan(out)
-    if bad.any():
-        i = int(np.flatnonzero(bad.ravel())[0])
+    i = _first_nan(out)
+    if i is not None:
         raise ConvergenceError(
             f"solve_kepler did not converge for M={Ma.ravel()[i]!r}, "
             f"e={ea.ravel()[i]!r}{_index(out.shape, i)}"
@@ -224,9 +229,8 @@ def anomaly_from_true(nu: Any, e: Any):
     """
     xa, ea, quantity = _angle_pair("nu", nu, e)
     out = np.asarray(_k.anomaly_from_nu_ufunc(xa, ea), dtype=np.float64)
-    bad = np.isnan(out)
-    if bad.any():
-        i = int(np.flatnonzero(bad.ravel())[0])
+    i = _first_nan(out)
+    if i is not None:
         raise ValueError(
             f"Expected `nu` inside the asymptotes (1 + e cos nu > 0), got "
             f"{xa.ravel()[i]!r} with e={ea.ravel()[i]!r}{_index(out.shape, i)}"
