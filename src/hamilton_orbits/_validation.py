@@ -51,6 +51,8 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     ...
     ValueError: Expected `x` to be finite, got nan at index 1
     """
+    if np.iscomplexobj(value):
+        raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:

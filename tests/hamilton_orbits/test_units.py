@@ -24,7 +24,8 @@ def test_strip_converts_quantities_and_passes_floats():
 
 
 def test_strip_names_the_argument_on_unit_errors():
-    with pytest.raises(u.UnitConversionError, match="`mu` in units convertible to km3 / s2"):
+    msg = r"`mu` to be a quantity \(convertible to km3 / s2\), got km"
+    with pytest.raises(u.UnitConversionError, match=msg):
         strip("mu", 1.0 * u.km, u.km**3 / u.s**2)
 
 
@@ -48,3 +49,33 @@ def test_validation_messages_name_argument_index_and_value():
     with pytest.raises(ValueError, match="numeric"):
         as_float_array("x", ["a"])
     assert issubclass(ConvergenceError, ValueError)
+
+
+def test_kinds_read_angles_in_any_unit_and_refuse_them_where_dimensionless():
+    from hamilton_orbits.units import ANGLE, ANGULAR_SPEED, DIMENSIONLESS, LENGTH, TIME
+
+    # 90 degrees is a quarter turn: pi/2 to the last bit (astropy's deg is pi/180 rad)
+    assert float(ANGLE("angle", 90 * u.deg)) == np.pi / 2
+    assert float(ANGLE("angle", 1.0 * u.arcsec)) == np.pi / 648000
+    with pytest.raises(u.UnitConversionError, match=r"`e` to be dimensionless, got 5\.7 deg"):
+        DIMENSIONLESS("e", 5.7 * u.deg)
+    with pytest.raises(u.UnitConversionError, match=r"`angle` to be an angle \(convertible to rad"):
+        ANGLE("angle", 1.0 * u.m)
+    with pytest.raises(u.UnitConversionError, match="`dt` to be a time"):
+        TIME("dt", 1.0 * u.m)
+    assert float(ANGULAR_SPEED("omega", 2.0 / u.s)) == 2.0
+    assert float(LENGTH("a", 1.0 * u.km)) == 1000.0
+
+
+def test_mixing_quantities_and_plain_numbers_is_refused():
+    from hamilton_orbits.units import require_consistent
+
+    assert require_consistent(("t", "dt"), (1.0, 0.1)) is False
+    assert require_consistent(("t", "dt"), (1.0 * u.s, None)) is True
+    with pytest.raises(ValueError, match="`dt` to be a Quantity like `t`"):
+        require_consistent(("t", "dt"), (1.0 * u.s, 0.1))
+
+
+def test_complex_input_is_refused_not_truncated():
+    with pytest.raises(ValueError, match="`x` to be real, got complex"):
+        as_float_array("x", [1.0 + 2.0j])
