@@ -9,6 +9,7 @@ from hamilton_orbits.conic import Conic
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
+from hamilton_orbits.scene import Result, Scene
 
 try:
     __version__ = version("hamilton-orbits")
@@ -20,6 +21,8 @@ __all__ = [
     "ConvergenceError",
     "KeplerOrbit",
     "Quaternion",
+    "Result",
+    "Scene",
     "__version__",
     "slerp",
     "solve_kepler",
