@@ -9,6 +9,7 @@ measures what the scene's ``[[analysis]]`` entries ask for.
 
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Any
 
@@ -253,7 +254,7 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     start = time.perf_counter()
     current = system
     try:
-        for a, b in zip(edges[:-1], edges[1:], strict=True):
+        for a, b in itertools.pairwise(edges):
             if stop():
                 complete = False
                 break

@@ -32,7 +32,6 @@ from __future__ import annotations
 import copy
 import json
 import math
-import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
@@ -41,6 +40,7 @@ from typing import Any
 
 import astropy.units as u
 import numpy as np
+import tomllib
 
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
@@ -422,7 +422,8 @@ class Result:
         lines.append(f"simulated: {_fmt(span.to(u.yr))} in {self.wall_time:.2f} s")
         if self.metrics:
             lines.append("")
-            lines.append(format_table([{"quantity": k, "value": v} for k, v in self.metrics.items()]))
+            rows = [{"quantity": k, "value": v} for k, v in self.metrics.items()]
+            lines.append(format_table(rows))
         for title, rows in self.tables.items():
             lines.append("")
             lines.append(title)
