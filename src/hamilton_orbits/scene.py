@@ -300,6 +300,7 @@ class Scene:
             fields={
                 "kind": S.String(required=True),
                 "description": S.String(default=""),
+                "runtime": S.String(default=""),
                 "effects": S.Array(item=_effect_entry(kind.effect_kind), default=[]),
                 **kind.schema,
             }
