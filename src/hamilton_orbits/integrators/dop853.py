@@ -2,7 +2,8 @@
 
 For anything generic: it accepts every effect, velocity-dependent ones included,
 and controls its local error with ``rtol = tol`` and ``atol = tol * scale`` where
-``scale`` is the largest position or velocity of the initial state.  ``dt``, if
+``scale`` is the largest position or velocity of the initial state; ``tol`` is
+raised to scipy's floor of 100 eps.  ``dt``, if
 given, caps the step (``max_step``).  Not symplectic: its energy error drifts
 linearly with time.
 """
@@ -44,7 +45,8 @@ def run(
     """
     from scipy.integrate import solve_ivp
 
-    tol = DEFAULT_TOL if tol is None else float(tol)
+    # scipy refuses rtol below 100 eps (with a warning); that is DOP853's floor here
+    tol = max(DEFAULT_TOL if tol is None else float(tol), 100 * np.finfo(float).eps)
     n = r0.shape[0]
     accel = rhs.accel
     acc = np.empty((n, 3))
