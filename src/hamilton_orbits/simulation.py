@@ -17,7 +17,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.effects import compile_rhs, get, normalize_effects
-from hamilton_orbits.nbody import DAY, System, _energy_gm, energy_gm_many
+from hamilton_orbits.nbody import DAY, System, energy_gm_many
 from hamilton_orbits.units import TIME, is_quantity
 
 __all__ = ["INTEGRATORS", "Trajectory", "integrate", "integrator_module"]
@@ -130,8 +130,8 @@ def _times(t: Any, quantity: bool) -> np.ndarray:
 
 def _diagnostics(system: System, r: np.ndarray, v: np.ndarray, t: np.ndarray):
     gm = system._gm
-    e0 = _energy_gm(r[0], v[0], gm)
     e = energy_gm_many(r, v, gm)
+    e0 = e[0]
     energy_error = (e - e0) / abs(e0) if e0 != 0 else e - e0
     h = np.einsum("j,tjk->tk", gm, np.cross(r, v))
     h0 = np.linalg.norm(h[0])
