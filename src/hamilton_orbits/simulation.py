@@ -1,4 +1,4 @@
-"""Integrate a :class:`~hamilton_orbits.nbody.System`: :func:`integrate` and its :class:`Trajectory`.
+"""Integrate a :class:`~hamilton_orbits.nbody.System`: :func:`integrate`, :class:`Trajectory`.
 
 Every trajectory carries Hamilton's integrals as diagnostics (Hamilton 1845,
 equations (C), (D), (E)): the drift of the centre of mass, the relative error of

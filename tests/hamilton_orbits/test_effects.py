@@ -57,7 +57,8 @@ def test_bad_effects(effects, match):
 
 def test_velocity_dependent_effect_refused_by_symplectic_map():
     s = System.solar_system("J2000", bodies=["sun", "mercury"])
-    with pytest.raises(ValueError, match=r"'gr' depends on velocities.*'leapfrog'.*accept it:.*dop853"):
+    msg = r"'gr' depends on velocities.*'leapfrog'.*accept it:.*dop853"
+    with pytest.raises(ValueError, match=msg):
         integrate(s, 1 * u.day, method="leapfrog", dt=0.1 * u.day, effects=["gr"])
     # the potential form is accepted
     traj = integrate(s, 1 * u.day, method="leapfrog", dt=0.1 * u.day, effects=["gr_potential"])
@@ -135,7 +136,7 @@ def test_j2_nodal_regression_first_order():
 
 def test_j2_against_reboundx_gravitational_harmonics():
     pytest.importorskip("reboundx")
-    s, gm, radius, j2, a, e, inc = leo()
+    s, gm, _radius, _j2, a, _e, _inc = leo()
     t_end = 10 * 2 * np.pi * np.sqrt(a**3 / gm)
     newton, _ = run_rebound(s, t_end)
     rebx, _ = run_rebound(s, t_end, effects=[{"name": "j2", "body": "earth"}])
