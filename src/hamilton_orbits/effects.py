@@ -27,13 +27,25 @@ An :class:`RHS` carries compiled functions with the signature
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+from numba import njit
+
 from hamilton_orbits._kernels import nbody as _nbody
 
-__all__ = ["RHS", "EffectSpec", "get", "known", "newtonian_rhs", "register"]
+__all__ = [
+    "RHS",
+    "EffectSpec",
+    "compile_rhs",
+    "get",
+    "known",
+    "newtonian_rhs",
+    "normalize_effects",
+    "register",
+]
 
 
 @dataclass(frozen=True)
@@ -54,7 +66,9 @@ class EffectSpec:
         Parameter name -> description, for validation and documentation.
     build : callable or None
         Kind-specific builder; for ``"nbody"``: ``build(system, params)`` returns
-        a compiled ``f(r, v, gm, acc)`` adding the effect's acceleration.
+        a compiled ``f(r, v, gm, acc)`` adding the effect's acceleration, where
+        ``system`` is a :class:`~hamilton_orbits.nbody.System` and ``params`` the
+        effect's mapping without its ``"name"``.
     reference : str
         The source of the model (paper, equation).
     """
@@ -175,5 +189,280 @@ register(
         "nbody",
         "Newtonian mutual gravitation, Hamilton's equation (B); always present",
         reference="Hamilton (1845), equation (B)",
+    )
+)
+
+
+# ----------------------------------------------------------------------------------
+# Composition: exactly the listed effects, nothing else.
+
+
+def normalize_effects(
+    effects: Sequence[str | Mapping[str, Any]] | None, kind: str = "nbody"
+) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
+    """Effects as ``((name, ((key, value), ...)), ...)``, checked against the registry.
+
+    ``"newtonian"`` may be listed and is dropped (it is always present).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (listing the known ones), an entry that is neither a
+        name nor a mapping with a ``"name"``, a parameter the effect does not take,
+        or an effect listed twice; naming the index and the value.
+
+    Examples
+    --------
+    >>> normalize_effects(["gr", {"name": "j2", "body": "earth"}])
+    (('gr', ()), ('j2', (('body', 'earth'),)))
+    >>> normalize_effects([{"name": "j2", "bdy": "earth"}])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'j2' at index 0 takes no parameter 'bdy'; it takes: body, ...
+    """
+    if effects is None:
+        return ()
+    if isinstance(effects, (str, Mapping)):
+        effects = [effects]
+    out = []
+    seen: set[str] = set()
+    for k, item in enumerate(effects):
+        if isinstance(item, str):
+            name, params = item, {}
+        elif isinstance(item, Mapping) and isinstance(item.get("name"), str):
+            name = item["name"]
+            params = {key: val for key, val in item.items() if key != "name"}
+        else:
+            raise ValueError(
+                f"Expected `effects` to hold names or mappings with a 'name', got {item!r} "
+                f"at index {k}"
+            )
+        spec = get(kind, name)
+        for key in params:
+            if key not in spec.parameters:
+                takes = ", ".join(spec.parameters) or "none"
+                raise ValueError(
+                    f"Effect {name!r} at index {k} takes no parameter {key!r}; it takes: {takes}"
+                )
+        if name == "newtonian":
+            continue
+        if name in seen:
+            raise ValueError(f"Effect {name!r} is listed twice (again at index {k})")
+        seen.add(name)
+        out.append((name, tuple(sorted(params.items()))))
+    return tuple(out)
+
+
+def _chain(first: Any, second: Any) -> Any:
+    """A compiled ``f(r, v, gm, acc)`` calling ``first`` then ``second``."""
+
+    @njit
+    def chained(r, v, gm, acc):  # pragma: no cover - compiled
+        first(r, v, gm, acc)
+        second(r, v, gm, acc)
+
+    return chained
+
+
+def bind(kernel: Any, p: np.ndarray) -> Any:
+    """A compiled ``f(r, v, gm, acc)`` calling ``kernel(r, v, gm, acc, p)``.
+
+    ``p`` is frozen into the compiled function as a constant.
+    """
+    p = np.ascontiguousarray(p, dtype=np.float64)
+
+    @njit
+    def bound(r, v, gm, acc):  # pragma: no cover - compiled
+        kernel(r, v, gm, acc, p)
+
+    return bound
+
+
+def _key(system: Any) -> tuple:
+    """What a compiled right-hand side depends on besides the state: bodies' shapes."""
+    return (
+        system.names,
+        tuple(system._gm.tolist()),
+        tuple((b._radius, b.j2, b.pole) for b in system.bodies),
+        system.quantity,
+    )
+
+
+def compile_rhs(system: Any, effects: Sequence[str | Mapping[str, Any]] | None = ()) -> RHS:
+    """The right-hand side of ``system`` with exactly the listed ``effects``.
+
+    With no effects this is the cached Newtonian kernel itself; otherwise each
+    listed effect's compiled adder is chained after it, so that an effect that is
+    not listed is not in the compiled function at all.
+
+    Parameters
+    ----------
+    system : hamilton_orbits.nbody.System
+    effects : sequence of str or mapping
+        Names (``"gr"``) or mappings with parameters (``{"name": "j2", "body":
+        "earth"}``).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> compile_rhs(s).effects
+    ('newtonian',)
+    >>> compile_rhs(s, ["gr"]).velocity_dependent  # doctest: +SKIP
+    True
+    """
+    normal = normalize_effects(effects, "nbody")
+    if not normal:
+        return newtonian_rhs()
+    return _compile_cached(_key(system), normal, system)
+
+
+_COMPILED: dict[tuple, RHS] = {}
+
+
+def _compile_cached(key: tuple, normal: tuple, system: Any) -> RHS:
+    cache_key = (key, normal)
+    if cache_key in _COMPILED:
+        return _COMPILED[cache_key]
+    adders = []
+    velocity_dependent = False
+    for name, params in normal:
+        spec = get("nbody", name)
+        if spec.build is None:
+            raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
+        adders.append(spec.build(system, dict(params)))
+        velocity_dependent = velocity_dependent or spec.velocity_dependent
+    extra = adders[0]
+    for adder in adders[1:]:
+        extra = _chain(extra, adder)
+    accel = _chain(_nbody.newtonian, extra)
+    rhs = RHS(accel, extra, velocity_dependent, ("newtonian",) + tuple(n for n, _ in normal))
+    if len(_COMPILED) > 64:
+        _COMPILED.clear()
+    _COMPILED[cache_key] = rhs
+    return rhs
+
+
+# ----------------------------------------------------------------------------------
+# Built-in n-body effects.
+
+_C_AU_PER_DAY = 299792458.0 * 86400.0 / 149597870700.0  # IAU 2012 au, SI c and day
+
+
+def _source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) -> int:
+    name = params.get(key)
+    if name is None:
+        return int(np.argmax(system._gm))
+    if name not in system.names:
+        raise ValueError(
+            f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
+            f"bodies: {', '.join(system.names)}"
+        )
+    idx = system.names.index(name)
+    if not system._gm[idx] > 0:
+        raise ValueError(f"Effect {effect!r}: body {name!r} is massless (gm = 0)")
+    return idx
+
+
+def _speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float:
+    from hamilton_orbits.units import SPEED, is_quantity
+
+    c = params.get("c")
+    if c is None:
+        if system.quantity:
+            return _C_AU_PER_DAY
+        raise ValueError(
+            f"Effect {effect!r}: a system of plain floats needs the speed of light `c` in "
+            "its own units, e.g. {'name': 'gr', 'c': 10065.32}"
+        )
+    if system.quantity and not is_quantity(c):
+        raise ValueError(
+            f"Effect {effect!r}: expected `c` as a Quantity for a Quantity system, got {c!r}"
+        )
+    import astropy.units as u
+
+    value = float(SPEED("c", c, u.au / u.day if system.quantity else None))
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"Effect {effect!r}: expected `c` > 0 and finite, got {value!r}")
+    return value
+
+
+def _build_gr(system: Any, params: Mapping[str, Any]) -> Any:
+    s = _source_index(system, params, "source", "gr")
+    c = _speed_of_light(system, params, "gr")
+    return bind(_nbody.gr_anderson, np.array([s, c]))
+
+
+def _build_gr_potential(system: Any, params: Mapping[str, Any]) -> Any:
+    s = _source_index(system, params, "source", "gr_potential")
+    c = _speed_of_light(system, params, "gr_potential")
+    return bind(_nbody.gr_potential, np.array([s, c]))
+
+
+def _build_j2(system: Any, params: Mapping[str, Any]) -> Any:
+    if "body" not in params:
+        raise ValueError("Effect 'j2' needs the `body` whose oblateness acts, e.g. "
+                         "{'name': 'j2', 'body': 'earth'}")
+    b = _source_index(system, params, "body", "j2")
+    body = system.bodies[b]
+    j2 = params.get("j2", body.j2)
+    radius = params.get("radius", body._radius)
+    if j2 is None or radius is None:
+        raise ValueError(
+            f"Effect 'j2': body {body.name!r} needs `j2` and `radius` (give them to the "
+            "Body or in the effect's mapping)"
+        )
+    if "radius" in params:
+        import astropy.units as u
+
+        from hamilton_orbits.units import LENGTH
+
+        radius = float(LENGTH("radius", radius, u.au if system.quantity else None))
+    j2 = float(j2)
+    if not (np.isfinite(j2) and np.isfinite(radius) and radius > 0):
+        raise ValueError(f"Effect 'j2': expected finite j2 and radius > 0, got {j2!r}, {radius!r}")
+    pole = body.pole if body.pole is not None else (0.0, 0.0, 1.0)
+    return bind(_nbody.j2_field, np.array([b, j2, radius, *pole]))
+
+
+register(
+    EffectSpec(
+        "gr",
+        "nbody",
+        "first post-Newtonian correction from one dominant body (as reboundx 'gr')",
+        velocity_dependent=True,
+        parameters={
+            "source": "the dominant body (default: the most massive)",
+            "c": "speed of light (default: c in au/day for Quantity systems)",
+        },
+        build=_build_gr,
+        reference="Anderson et al. (1975), ApJ 200, 221; reboundx 'gr' (Tamayo et al. 2020)",
+    )
+)
+register(
+    EffectSpec(
+        "gr_potential",
+        "nbody",
+        "relativistic perihelion advance from a potential -3 (GM / c r)^2 (symplectic-safe)",
+        parameters={
+            "source": "the dominant body (default: the most massive)",
+            "c": "speed of light (default: c in au/day for Quantity systems)",
+        },
+        build=_build_gr_potential,
+        reference="Nobili & Roxburgh (1986), IAU Symp. 114, 105",
+    )
+)
+register(
+    EffectSpec(
+        "j2",
+        "nbody",
+        "oblateness J2 of a named body about its pole",
+        parameters={
+            "body": "the oblate body (required)",
+            "j2": "J2 (default: the Body's j2)",
+            "radius": "equatorial radius (default: the Body's radius)",
+        },
+        build=_build_j2,
+        reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )

@@ -83,3 +83,131 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
         acc[k, 0] = ax
         acc[k, 1] = ay
         acc[k, 2] = az
+
+
+# ---------------------------------------------------------------------------
+# Effect kernels: ``f(r, v, gm, acc, p)`` ADD their acceleration into ``acc``.
+# ``p`` is a float64 parameter vector whose layout each builder in
+# :mod:`hamilton_orbits.effects` documents.
+
+
+@njit(cache=True)
+def nothing(r, v, gm, acc):  # pragma: no cover - compiled
+    """The empty sum of effects (a start for chains that add effects only)."""
+    return
+
+
+@njit(cache=True)
+def gr_anderson(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """First post-Newtonian correction from one dominant body (one-body metric).
+
+    ``p = [source, c]``.  For every other body, with ``d``, ``w`` its position and
+    velocity relative to the source and ``mu = gm[source]``,
+
+        a = mu / (c^2 |d|^3) [ (4 mu / |d| - w^2) d + 4 (d . w) w ],
+
+    the test-particle limit of the Einstein-Infeld-Hoffmann equations in harmonic
+    coordinates that Anderson et al. (1975) use for planetary ephemerides; the
+    source receives ``-(gm_i / mu) a`` so that the momentum stays conserved.
+    """
+    s = int(p[0])
+    c2 = p[1] * p[1]
+    mu = gm[s]
+    n = r.shape[0]
+    for i in range(n):
+        if i == s:
+            continue
+        dx = r[i, 0] - r[s, 0]
+        dy = r[i, 1] - r[s, 1]
+        dz = r[i, 2] - r[s, 2]
+        wx = v[i, 0] - v[s, 0]
+        wy = v[i, 1] - v[s, 1]
+        wz = v[i, 2] - v[s, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        d = np.sqrt(d2)
+        w2 = wx * wx + wy * wy + wz * wz
+        dw = dx * wx + dy * wy + dz * wz
+        f = mu / (c2 * d2 * d)
+        fr = f * (4.0 * mu / d - w2)
+        fv = f * 4.0 * dw
+        ax = fr * dx + fv * wx
+        ay = fr * dy + fv * wy
+        az = fr * dz + fv * wz
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        back = gm[i] / mu
+        acc[s, 0] -= back * ax
+        acc[s, 1] -= back * ay
+        acc[s, 2] -= back * az
+
+
+@njit(cache=True)
+def gr_potential(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """Nobili & Roxburgh (1986) potential ``Phi = -3 (mu / (c |d|))^2`` of one body.
+
+    ``p = [source, c]``.  The force ``-grad Phi = -6 mu^2 d / (c^2 |d|^4)`` reproduces
+    the relativistic perihelion advance and depends on positions only.
+    """
+    s = int(p[0])
+    c2 = p[1] * p[1]
+    mu = gm[s]
+    n = r.shape[0]
+    for i in range(n):
+        if i == s:
+            continue
+        dx = r[i, 0] - r[s, 0]
+        dy = r[i, 1] - r[s, 1]
+        dz = r[i, 2] - r[s, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        f = -6.0 * mu * mu / (c2 * d2 * d2)
+        acc[i, 0] += f * dx
+        acc[i, 1] += f * dy
+        acc[i, 2] += f * dz
+        back = gm[i] / mu
+        acc[s, 0] -= back * f * dx
+        acc[s, 1] -= back * f * dy
+        acc[s, 2] -= back * f * dz
+
+
+@njit(cache=True)
+def j2_field(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """The J2 (oblateness) field of one body about its pole, on every other body.
+
+    ``p = [body, j2, radius, kx, ky, kz]`` with ``k`` the unit pole.  With ``d`` the
+    position relative to the body, ``z = d . k`` and ``mu = gm[body]``,
+
+        a = -(3/2) J2 mu R^2 / |d|^5 [ (1 - 5 z^2 / |d|^2) d + 2 z k ],
+
+    the gradient of the degree-2 zonal potential (Vallado 2013, eq. 8-22 in the
+    body's own frame); the body receives ``-(gm_i / mu) a``.
+    """
+    b = int(p[0])
+    j2 = p[1]
+    rad2 = p[2] * p[2]
+    kx = p[3]
+    ky = p[4]
+    kz = p[5]
+    mu = gm[b]
+    n = r.shape[0]
+    for i in range(n):
+        if i == b:
+            continue
+        dx = r[i, 0] - r[b, 0]
+        dy = r[i, 1] - r[b, 1]
+        dz = r[i, 2] - r[b, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        d = np.sqrt(d2)
+        z = dx * kx + dy * ky + dz * kz
+        f = -1.5 * j2 * mu * rad2 / (d2 * d2 * d)
+        g = 1.0 - 5.0 * z * z / d2
+        ax = f * (g * dx + 2.0 * z * kx)
+        ay = f * (g * dy + 2.0 * z * ky)
+        az = f * (g * dz + 2.0 * z * kz)
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        back = gm[i] / mu
+        acc[b, 0] -= back * ax
+        acc[b, 1] -= back * ay
+        acc[b, 2] -= back * az

@@ -1,0 +1,718 @@
+"""Systems of bodies under Hamilton's n-body equation (B) and its integrals (C), (D), (E).
+
+Hamilton (1845) writes the motion of n attracting bodies as
+
+    d^2 alpha / dt^2 = Sigma m' / ((alpha - alpha') sqrt(-(alpha - alpha')^2))     (B)
+
+with alpha the vector of one body, alpha' and m' those of another, in his algebra where
+the square of a vector is minus its squared length.  His "masses" m carry the
+gravitational constant: here they are ``gm`` (G times the mass).  From (B) he deduces
+the laws of the centre of gravity (C), of areas (D) and of vis viva (E), which are
+:meth:`System.barycentre`, :meth:`System.angular_momentum` and :meth:`System.energy`.
+
+Units
+-----
+A :class:`Body` or :class:`System` built from astropy Quantities is held internally in
+**au, day and au^3/day^2** (GM); every answer comes back as a Quantity (energies in J,
+angular momenta in kg m^2/s, through the gravitational constant of
+:mod:`astropy.constants`).  Built from plain floats, the caller's own consistent units
+are used throughout and ``G`` (default 1) is the constant that turns ``gm`` into a
+mass for the energy and the angular momentum.
+
+Massless bodies (``gm == 0``) are test particles: they feel every massive body and pull
+on none, at a cost O(n_massive) each.
+
+References
+----------
+W. R. Hamilton, "On the application of the method of quaternions to some dynamical
+questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l: equations (A)-(E).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import astropy.constants as const
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.units import (
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    SPEED,
+    any_quantity,
+    require_consistent,
+)
+
+__all__ = ["Body", "System", "accelerations_quaternion"]
+
+# internal units of Quantity systems
+AU = u.au
+DAY = u.day
+L_UNIT = u.au
+V_UNIT = u.au / u.day
+GM_UNIT = u.au**3 / u.day**2
+A_UNIT = u.au / u.day**2
+_G_SI = const.G.to_value(u.m**3 / (u.kg * u.s**2))
+# energy of a Quantity system: (sum of gm v^2 terms in au^5/day^4) / G -> J
+_E_SI = (u.au**5 / u.day**4).to(u.m**5 / u.s**4) / _G_SI
+_L_SI = (u.au**5 / u.day**3).to(u.m**5 / u.s**3) / _G_SI
+
+
+def _as_vector(kind, name: str, value: Any, unit) -> np.ndarray:
+    arr = kind(name, value, unit)
+    if arr.shape != (3,):
+        raise ValueError(f"Expected `{name}` to have shape (3,), got {arr.shape}")
+    return arr
+
+
+@dataclass(frozen=True, init=False)
+class Body:
+    """One body: a name, its GM, its position and velocity; optionally its shape.
+
+    Parameters
+    ----------
+    name : str
+        A unique name within its :class:`System` (``"earth"``).
+    gm : Quantity or float
+        G times the mass (Hamilton's m), >= 0; 0 makes a massless test particle.
+    r, v : Quantity or array_like, shape (3,)
+        Position and velocity (barycentric for :meth:`System.solar_system`).
+    radius : Quantity or float, optional
+        Equatorial radius (needed by the ``j2`` effect).
+    j2 : float, optional
+        Dimensionless oblateness coefficient J2 (the ``j2`` effect).
+    pole : array_like, shape (3,), optional
+        Direction of the symmetry axis (normalised here); the frame's z axis when a
+        ``j2`` is given without a pole.
+
+    Raises
+    ------
+    ValueError
+        For a negative GM, a NaN or infinite value, a wrong shape, a zero pole,
+        naming the body and the value; or a mix of Quantities and plain floats.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> earth = Body("earth", gm=3.986004418e14 * u.m**3 / u.s**2,
+    ...              r=[1.0, 0.0, 0.0] * u.au, v=[0.0, 29.78, 0.0] * u.km / u.s)
+    >>> earth.r
+    <Quantity [1., 0., 0.] AU>
+    >>> Body("p", gm=-1.0, r=[1, 0, 0], v=[0, 1, 0])
+    Traceback (most recent call last):
+    ...
+    ValueError: Body 'p': expected `gm` >= 0, got -1.0
+    """
+
+    name: str
+    _gm: float
+    _r: np.ndarray
+    _v: np.ndarray
+    _radius: float | None
+    j2: float | None
+    pole: tuple[float, float, float] | None
+    quantity: bool
+
+    def __init__(
+        self,
+        name: str,
+        gm: Any,
+        r: Any,
+        v: Any,
+        radius: Any = None,
+        j2: Any = None,
+        pole: Any = None,
+    ) -> None:
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"Expected `name` to be a non-empty string, got {name!r}")
+        try:
+            quantity = require_consistent(("gm", "r", "v", "radius"), (gm, r, v, radius))
+            g = GM("gm", gm, GM_UNIT if quantity else None)
+            if g.shape != ():
+                raise ValueError(f"Expected `gm` to be a scalar, got shape {g.shape}")
+            if not g >= 0:
+                raise ValueError(f"expected `gm` >= 0, got {float(g)!r}")
+            rr = _as_vector(LENGTH, "r", r, L_UNIT if quantity else None)
+            vv = _as_vector(SPEED, "v", v, V_UNIT if quantity else None)
+            rad = None
+            if radius is not None:
+                rad = float(LENGTH("radius", radius, L_UNIT if quantity else None))
+                if not rad > 0:
+                    raise ValueError(f"expected `radius` > 0, got {rad!r}")
+            jj = None
+            if j2 is not None:
+                jj = float(DIMENSIONLESS("j2", j2))
+            pl = None
+            if pole is not None or jj is not None:
+                p = np.array([0.0, 0.0, 1.0]) if pole is None else _as_vector(
+                    DIMENSIONLESS, "pole", pole, None
+                )
+                norm = float(np.sqrt(p @ p))
+                if not norm > 0:
+                    raise ValueError(f"expected `pole` to be nonzero, got {p.tolist()}")
+                pl = tuple(float(x) for x in p / norm)
+        except (ValueError, u.UnitConversionError) as exc:
+            msg = str(exc)
+            if msg.startswith("Expected"):
+                msg = "e" + msg[1:]
+            raise type(exc)(f"Body {name!r}: {msg}") from None
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "_gm", float(g))
+        rr.setflags(write=False)
+        vv.setflags(write=False)
+        object.__setattr__(self, "_r", rr)
+        object.__setattr__(self, "_v", vv)
+        object.__setattr__(self, "_radius", rad)
+        object.__setattr__(self, "j2", jj)
+        object.__setattr__(self, "pole", pl)
+        object.__setattr__(self, "quantity", quantity)
+
+    @classmethod
+    def _from_floats(cls, name, gm, r, v, radius, j2, pole, quantity) -> Body:
+        """Build from validated internal floats (no unit conversion, exact values)."""
+        obj = object.__new__(cls)
+        r = np.array(r, dtype=float)
+        v = np.array(v, dtype=float)
+        r.setflags(write=False)
+        v.setflags(write=False)
+        for key, val in (
+            ("name", name), ("_gm", float(gm)), ("_r", r), ("_v", v), ("_radius", radius),
+            ("j2", j2), ("pole", pole), ("quantity", quantity),
+        ):
+            object.__setattr__(obj, key, val)
+        return obj
+
+    @property
+    def gm(self):
+        """G times the mass (au^3/day^2 Quantity, or the caller's float)."""
+        return self._gm * GM_UNIT if self.quantity else self._gm
+
+    @property
+    def r(self):
+        """Position, shape (3,) (au Quantity, or the caller's floats)."""
+        return self._r * L_UNIT if self.quantity else self._r.copy()
+
+    @property
+    def v(self):
+        """Velocity, shape (3,) (au/day Quantity, or the caller's floats)."""
+        return self._v * V_UNIT if self.quantity else self._v.copy()
+
+    @property
+    def radius(self):
+        """Equatorial radius or None (au Quantity, or the caller's float)."""
+        if self._radius is None or not self.quantity:
+            return self._radius
+        return self._radius * L_UNIT
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Body):
+            return NotImplemented
+        return (
+            self.name == other.name and self._gm == other._gm
+            and np.array_equal(self._r, other._r) and np.array_equal(self._v, other._v)
+            and self._radius == other._radius and self.j2 == other.j2
+            and self.pole == other.pole and self.quantity == other.quantity
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        unit = " (au, day)" if self.quantity else ""
+        return f"Body({self.name!r}, gm={self._gm!r}{unit})"
+
+
+class System:
+    """A system of bodies moving under Hamilton's equation (B).
+
+    Parameters
+    ----------
+    bodies : sequence of Body
+        All built from Quantities or all from plain floats; unique names; at least one
+        with ``gm > 0``.
+    G : float, optional
+        The gravitational constant in the caller's units, for plain-float systems
+        (default 1): ``gm / G`` is the mass used by :meth:`energy` and
+        :meth:`angular_momentum`.  Quantity systems use astropy's G (do not pass it).
+
+    Attributes
+    ----------
+    names : tuple of str, shape (n,)
+    gm : ndarray or Quantity, shape (n,)
+    r, v : ndarray or Quantity, shape (n, 3)
+
+    Raises
+    ------
+    ValueError
+        For duplicate names, two bodies at one position (one of them massive: both
+        are named), a mix of Quantity and float bodies, no massive body, or a G <= 0.
+
+    Examples
+    --------
+    >>> sun = Body("sun", gm=1.0, r=[0.0, 0.0, 0.0], v=[0.0, 0.0, 0.0])
+    >>> planet = Body("planet", gm=1e-3, r=[1.0, 0.0, 0.0], v=[0.0, 1.0, 0.0])
+    >>> system = System([sun, planet])
+    >>> system.names
+    ('sun', 'planet')
+    >>> system["planet"].r
+    array([1., 0., 0.])
+    >>> System([sun, Body("twin", gm=1.0, r=[0, 0, 0], v=[0, 1, 0])])
+    Traceback (most recent call last):
+    ...
+    ValueError: Bodies 'sun' and 'twin' are at one position [0.0, 0.0, 0.0]
+    """
+
+    def __init__(self, bodies: Iterable[Body], G: float | None = None) -> None:
+        bodies = list(bodies)
+        if not bodies:
+            raise ValueError("Expected `bodies` to hold at least one Body, got none")
+        for k, b in enumerate(bodies):
+            if not isinstance(b, Body):
+                raise ValueError(f"Expected `bodies` to hold Body objects, got {b!r} at index {k}")
+        quantity = bodies[0].quantity
+        for b in bodies:
+            if b.quantity != quantity:
+                raise ValueError(
+                    f"Expected all bodies to be built from Quantities or all from plain floats; "
+                    f"{bodies[0].name!r} and {b.name!r} differ"
+                )
+        seen: dict[str, int] = {}
+        for k, b in enumerate(bodies):
+            if b.name in seen:
+                raise ValueError(
+                    f"Duplicate body name {b.name!r} at indices {seen[b.name]} and {k}"
+                )
+            seen[b.name] = k
+        if quantity:
+            if G is not None:
+                raise ValueError(
+                    "Expected no `G` for a system of Quantities (astropy's G is used), "
+                    f"got {G!r}"
+                )
+            g = _G_SI
+        else:
+            g = 1.0 if G is None else float(np.asarray(G, dtype=float))
+            if not (np.isfinite(g) and g > 0):
+                raise ValueError(f"Expected `G` > 0 and finite, got {G!r}")
+        self._bodies = tuple(bodies)
+        self._index = seen
+        self._quantity = quantity
+        self._G = g
+        self._gm = np.array([b._gm for b in bodies])
+        self._r = np.array([b._r for b in bodies]).reshape(-1, 3)
+        self._v = np.array([b._v for b in bodies]).reshape(-1, 3)
+        for arr in (self._gm, self._r, self._v):
+            arr.setflags(write=False)
+        if not np.any(self._gm > 0):
+            raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
+        self._check_positions()
+
+    # ------------------------------------------------------------------ checks
+    def _check_positions(self) -> None:
+        """Refuse two bodies at one position when one of them is massive."""
+        r = self._r
+        order = np.lexsort((r[:, 2], r[:, 1], r[:, 0]))
+        rs = r[order]
+        same = np.all(rs[1:] == rs[:-1], axis=1)
+        if not np.any(same):
+            return
+        massive = self._gm[order] > 0
+        # groups of equal rows: a group is bad if it holds a massive body
+        k = 0
+        n = len(order)
+        while k < n - 1:
+            if not same[k]:
+                k += 1
+                continue
+            start = k
+            while k < n - 1 and same[k]:
+                k += 1
+            group = order[start : k + 1]
+            if np.any(massive[start : k + 1]):
+                i, j = sorted(group[:2])
+                raise ValueError(
+                    f"Bodies {self.names[i]!r} and {self.names[j]!r} are at one position "
+                    f"{r[i].tolist()}"
+                )
+            k += 1
+
+    # --------------------------------------------------------------- accessors
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The bodies' names, in order."""
+        return tuple(b.name for b in self._bodies)
+
+    @property
+    def bodies(self) -> tuple[Body, ...]:
+        """The bodies, in order."""
+        return self._bodies
+
+    @property
+    def quantity(self) -> bool:
+        """True for a system built from Quantities (internal units au, day)."""
+        return self._quantity
+
+    @property
+    def G(self) -> float:
+        """The gravitational constant (SI for Quantity systems, else the caller's)."""
+        return self._G
+
+    @property
+    def gm(self):
+        """G times the masses, shape (n,)."""
+        return self._gm * GM_UNIT if self._quantity else self._gm.copy()
+
+    @property
+    def r(self):
+        """Positions, shape (n, 3)."""
+        return self._r * L_UNIT if self._quantity else self._r.copy()
+
+    @property
+    def v(self):
+        """Velocities, shape (n, 3)."""
+        return self._v * V_UNIT if self._quantity else self._v.copy()
+
+    def __len__(self) -> int:
+        return len(self._bodies)
+
+    def __iter__(self):
+        return iter(self._bodies)
+
+    def __getitem__(self, name: str) -> Body:
+        try:
+            return self._bodies[self._index[name]]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"No body named {name!r} in the system; bodies: {', '.join(self.names)}"
+            ) from None
+
+    def index(self, name: str) -> int:
+        """The position of body ``name`` in the arrays (ValueError naming the bodies).
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0],
+        ...            [0, 1, 0])])
+        >>> s.index("b")
+        1
+        """
+        self[name]
+        return self._index[name]
+
+    def __repr__(self) -> str:
+        return f"System({list(self.names)!r}{', au/day' if self._quantity else ''})"
+
+    def with_state(self, r: np.ndarray, v: np.ndarray) -> System:
+        """The same bodies at internal-unit positions ``r`` and velocities ``v`` (n, 3).
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
+        >>> s.with_state(np.ones((1, 3)), np.zeros((1, 3))).r
+        array([[1., 1., 1.]])
+        """
+        r = np.asarray(r, dtype=float)
+        v = np.asarray(v, dtype=float)
+        bodies = [
+            Body._from_floats(b.name, b._gm, r[k], v[k], b._radius, b.j2, b.pole, b.quantity)
+            for k, b in enumerate(self._bodies)
+        ]
+        return System(bodies, G=None if self._quantity else self._G)
+
+    # ------------------------------------------------------------- physics
+    def accelerations(self, effects: Sequence[str | Mapping[str, Any]] = ()):
+        """Accelerations of every body by equation (B), plus the listed effects.
+
+        Parameters
+        ----------
+        effects : sequence of str or mapping, optional
+            Effects as for :func:`hamilton_orbits.integrate` (``"gr"``, ...).
+
+        Returns
+        -------
+        ndarray or Quantity, shape (n, 3)
+            au/day^2 for Quantity systems.
+
+        Examples
+        --------
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("dust", 0.0, [2.0, 0, 0], [0, 0.7, 0])])
+        >>> s.accelerations()
+        array([[ 0.  ,  0.  ,  0.  ],
+               [-0.25,  0.  ,  0.  ]])
+        """
+        from hamilton_orbits.effects import compile_rhs
+
+        rhs = compile_rhs(self, effects)
+        acc = np.empty_like(self._r)
+        rhs.accel(np.ascontiguousarray(self._r), np.ascontiguousarray(self._v), self._gm, acc)
+        return acc * A_UNIT if self._quantity else acc
+
+    def _energy_hamilton(self) -> float:
+        """Hamilton's vis viva form (E): Sigma gm v^2 / 2 - Sigma gm gm' / r (G E)."""
+        return float(_energy_gm(self._r, self._v, self._gm))
+
+    def energy(self):
+        """Total energy, Hamilton's law of vis viva (E).
+
+        ``(1/G) [Sigma gm v^2 / 2 - Sigma_{pairs} gm gm' / |r - r'|]``; massless bodies
+        contribute nothing.  In J for Quantity systems.
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("b", 1.0, [1.0, 0, 0], [0, 0, 0])])
+        >>> s.energy()
+        -1.0
+        """
+        e = self._energy_hamilton()
+        return e * _E_SI * u.J if self._quantity else e / self._G
+
+    def _angular_momentum_hamilton(self) -> np.ndarray:
+        return np.einsum("i,ij->j", self._gm, np.cross(self._r, self._v))
+
+    def angular_momentum(self):
+        """Total angular momentum, Hamilton's law of areas (D): ``(1/G) Sigma gm r x v``.
+
+        Returns a (3,) array (kg m^2/s Quantity for Quantity systems).
+
+        Examples
+        --------
+        >>> s = System([Body("a", 2.0, [1.0, 0, 0], [0, 1.0, 0])], G=2.0)
+        >>> s.angular_momentum()
+        array([0., 0., 1.])
+        """
+        h = self._angular_momentum_hamilton()
+        return h * _L_SI * (u.kg * u.m**2 / u.s) if self._quantity else h / self._G
+
+    def _barycentre_internal(self) -> tuple[np.ndarray, np.ndarray]:
+        total = float(np.sum(self._gm))
+        return self._gm @ self._r / total, self._gm @ self._v / total
+
+    def barycentre(self):
+        """Centre of mass and its velocity, Hamilton's law (C): ``Sigma gm r / Sigma gm``.
+
+        Returns
+        -------
+        (position, velocity) : tuple of (3,) arrays or Quantities
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("b", 3.0, [4.0, 0, 0], [0, 1.0, 0])])
+        >>> s.barycentre()
+        (array([3., 0., 0.]), array([0.  , 0.75, 0.  ]))
+        """
+        rc, vc = self._barycentre_internal()
+        if self._quantity:
+            return rc * L_UNIT, vc * V_UNIT
+        return rc, vc
+
+    # ------------------------------------------------------------- rebound
+    def to_rebound(self):
+        """A ``rebound.Simulation`` of this system (see :mod:`hamilton_orbits.rebound_bridge`).
+
+        Examples
+        --------
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+        >>> s.to_rebound().particles["sun"].m
+        1.0
+        """
+        from hamilton_orbits.rebound_bridge import to_rebound
+
+        return to_rebound(self)
+
+    @classmethod
+    def from_rebound(cls, sim, *, quantity: bool = False) -> System:
+        """A System from a ``rebound.Simulation`` (exact: positions bit for bit).
+
+        See :func:`hamilton_orbits.rebound_bridge.from_rebound`.
+
+        Examples
+        --------
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+        >>> System.from_rebound(s.to_rebound()).names
+        ('sun',)
+        """
+        from hamilton_orbits.rebound_bridge import from_rebound
+
+        return from_rebound(sim, quantity=quantity)
+
+    # -------------------------------------------------------- solar system
+    @classmethod
+    def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None) -> System:
+        """The Sun and planets at ``epoch`` from astropy's built-in ephemeris (offline).
+
+        Positions and velocities are barycentric, ICRS axes (equatorial), from
+        ``astropy.coordinates.get_body_barycentric_posvel(..., ephemeris="builtin")``
+        (the ERFA routines ``epv00`` and ``plan94``: no download, accuracy of order
+        1e-7 au for the inner planets and worse for the outer ones, which is
+        ample for the dynamics but not an ephemeris).
+
+        GM values: the Sun's is the IAU 2015 nominal solar mass parameter (IAU 2015
+        Resolution B3); the planets' are the system GMs (planet plus satellites) of
+        JPL DE440 (Park et al. 2021); the Moon's is DE440's as well.
+
+        Parameters
+        ----------
+        epoch : astropy.time.Time or str, optional
+            The epoch (TDB); a string is read by ``Time(epoch, scale="tdb")``,
+            ``"J2000"`` (default) is 2000-01-01 12:00 TDB.
+        bodies : sequence of str, optional
+            Which bodies, from ``sun, mercury, venus, earth-moon-barycenter, earth, moon,
+            mars, jupiter, saturn, uranus, neptune``; default the Sun, the planets with
+            the Earth-Moon barycentre as one body.  Asking for ``"moon"`` (with
+            ``"earth"``) gives the Earth and the Moon separately.
+
+        Returns
+        -------
+        System
+            A Quantity system (au, day); the bodies' names are as asked.
+
+        References
+        ----------
+        E. Mamajek et al., IAU 2015 Resolution B3 (nominal solar and planetary
+        conversion constants). R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs,
+        "The JPL Planetary and Lunar Ephemerides DE440 and DE441", AJ 161, 105 (2021).
+
+        Examples
+        --------
+        >>> s = System.solar_system("J2000")
+        >>> s.names[:4]
+        ('sun', 'mercury', 'venus', 'earth-moon-barycenter')
+        >>> s = System.solar_system("J2000", bodies=["sun", "earth", "moon"])
+        >>> 356000 < float(np.linalg.norm(s.r[2] - s.r[1]).to_value(u.km)) < 407000
+        True
+        """
+        from astropy.coordinates import get_body_barycentric_posvel
+        from astropy.time import Time
+
+        if bodies is None:
+            bodies = DEFAULT_BODIES
+        bodies = [str(b).lower() for b in bodies]
+        for b in bodies:
+            if b not in SOLAR_SYSTEM_GM:
+                raise ValueError(
+                    f"Unknown solar-system body {b!r}; known: {', '.join(SOLAR_SYSTEM_GM)}"
+                )
+        if "earth-moon-barycenter" in bodies and ("earth" in bodies or "moon" in bodies):
+            raise ValueError(
+                "Expected either 'earth-moon-barycenter' or 'earth' and 'moon', got both"
+            )
+        if isinstance(epoch, Time):
+            t = epoch.tdb
+        elif isinstance(epoch, str) and epoch.upper() == "J2000":
+            t = Time("2000-01-01T12:00:00", scale="tdb")
+        else:
+            try:
+                t = Time(epoch, scale="tdb")
+            except ValueError as exc:
+                raise ValueError(f"Expected `epoch` to be a Time, got {epoch!r}") from exc
+        if not t.isscalar:
+            raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
+        out = []
+        for name in bodies:
+            pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
+            gm = SOLAR_SYSTEM_GM[name] * u.m**3 / u.s**2
+            out.append(Body(name, gm=gm, r=pos.xyz.to(u.au), v=vel.xyz.to(u.au / u.day)))
+        return cls(out)
+
+
+# GM in m^3/s^2.  Sun: IAU 2015 Resolution B3 nominal (G M_sun)^N.  Planets: system GMs
+# (planet + satellites) of JPL DE440, Park et al. (2021), AJ 161, 105, table 8 as given
+# in REFERENCES.md; Earth and Moon separately from the same ephemeris (DE440: GM_earth
+# 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2; their sum is the Earth-Moon
+# system GM 403503.235625... within 1e-9 of the listed 4.03503235502e14).
+SOLAR_SYSTEM_GM: dict[str, float] = {
+    "sun": 1.32712440041e20,
+    "mercury": 2.2031868551e13,
+    "venus": 3.24858592e14,
+    "earth-moon-barycenter": 4.03503235502e14,
+    "earth": 3.98600435507e14,
+    "moon": 4.902800118e12,
+    "mars": 4.2828375816e13,
+    "jupiter": 1.26712764100e17,
+    "saturn": 3.7940584841e16,
+    "uranus": 5.794556400e15,
+    "neptune": 6.836527100e15,
+}
+
+DEFAULT_BODIES = (
+    "sun", "mercury", "venus", "earth-moon-barycenter", "mars",
+    "jupiter", "saturn", "uranus", "neptune",
+)
+
+
+def _energy_gm(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> float:
+    """Hamilton's (E) in gm units; pairs with at least one massless body add nothing."""
+    kinetic = 0.5 * float(gm @ np.einsum("ij,ij->i", v, v))
+    idx = np.flatnonzero(gm > 0)
+    rm = r[idx]
+    gmm = gm[idx]
+    if len(idx) < 2:
+        return kinetic
+    i, j = np.triu_indices(len(idx), 1)
+    d = np.sqrt(np.einsum("ij,ij->i", rm[i] - rm[j], rm[i] - rm[j]))
+    return kinetic - float(np.sum(gmm[i] * gmm[j] / d))
+
+
+def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
+    """Hamilton's (E) in gm units for states ``r``, ``v`` of shape (n_t, n, 3)."""
+    kinetic = 0.5 * np.einsum("j,tjk,tjk->t", gm, v, v)
+    idx = np.flatnonzero(gm > 0)
+    if len(idx) < 2:
+        return kinetic
+    i, j = np.triu_indices(len(idx), 1)
+    rm = r[:, idx]
+    d = rm[:, i] - rm[:, j]
+    dist = np.sqrt(np.einsum("tpk,tpk->tp", d, d))
+    return kinetic - (gm[idx][i] * gm[idx][j] / dist).sum(axis=1)
+
+
+def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
+    """Equation (B) evaluated with :class:`~hamilton_orbits.quaternion.Quaternion` products.
+
+    Exactly as Hamilton writes it: for each body alpha and each other body alpha' of
+    mass m', the term ``m' / ((alpha - alpha') sqrt(-(alpha - alpha')^2))``, where
+    ``alpha - alpha'`` is a pure quaternion (a vector), its square
+    ``(alpha - alpha')^2 = -|alpha - alpha'|^2`` is a negative real number, and the
+    quotient is a quaternion product with the inverse.  A reference for the compiled
+    kernel (O(n^2) memory; for tests).
+
+    Parameters
+    ----------
+    r : array_like, shape (n, 3)
+    gm : array_like, shape (n,)
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+
+    Examples
+    --------
+    >>> accelerations_quaternion([[0.0, 0, 0], [2.0, 0, 0]], [1.0, 0.0])
+    array([[ 0.  ,  0.  ,  0.  ],
+           [-0.25,  0.  ,  0.  ]])
+    """
+    from hamilton_orbits.quaternion import Quaternion
+
+    r = np.asarray(r, dtype=float)
+    gm = np.asarray(gm, dtype=float)
+    n = len(gm)
+    i, j = np.nonzero(~np.eye(n, dtype=bool) & (gm[None, :] != 0))
+    alpha = Quaternion.from_vector(r[i] - r[j])  # alpha - alpha'
+    square = (alpha * alpha).scalar  # (alpha - alpha')^2 = -T^2, a real number
+    denominator = alpha * np.sqrt(-square)  # (alpha - alpha') sqrt(-(alpha - alpha')^2)
+    term = denominator.inverse() * gm[j]  # m' / (...)
+    acc = np.zeros((n, 4))
+    np.add.at(acc, i, term.as_array())
+    return acc[:, 1:]
+
+
+__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "energy_gm_many"]
+_ = _nbody  # the kernels of equation (B) live in hamilton_orbits._kernels.nbody
+_ = any_quantity

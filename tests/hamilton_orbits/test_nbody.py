@@ -1,0 +1,143 @@
+"""Body and System: construction, checks, Hamilton's equation (B) and its integrals."""
+
+from __future__ import annotations
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, System
+from hamilton_orbits.nbody import SOLAR_SYSTEM_GM, accelerations_quaternion
+from hamilton_orbits.rebound_bridge import from_rebound, rebound_accelerations, to_rebound
+
+EPS = np.finfo(float).eps
+
+
+def random_system(n: int, seed: int, n_massless: int = 0) -> System:
+    rng = np.random.default_rng(seed)
+    bodies = [
+        Body(f"b{k}", gm=float(rng.uniform(1e-3, 1.0)) if k < n else 0.0,
+             r=rng.normal(size=3) * 3, v=rng.normal(size=3))
+        for k in range(n + n_massless)
+    ]
+    return System(bodies)
+
+
+def direct_accelerations(r: np.ndarray, gm: np.ndarray) -> np.ndarray:
+    """Equation (B) summed directly with numpy (no pair symmetry, no kernel)."""
+    d = r[None, :, :] - r[:, None, :]  # d[i, j] = r_j - r_i
+    dist = np.linalg.norm(d, axis=2)
+    np.fill_diagonal(dist, np.inf)
+    return np.einsum("j,ijk->ik", gm, d / dist[:, :, None] ** 3)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_kernel_against_direct_and_quaternion_form(seed):
+    s = random_system(7, seed, n_massless=3)
+    acc = s.accelerations()
+    ref = direct_accelerations(s._r, s._gm)
+    quat = accelerations_quaternion(s._r, s._gm)
+    scale = np.einsum("j,ij->i", s._gm, 1.0 / np.where(
+        np.eye(len(s)) > 0, np.inf, np.linalg.norm(s._r[None] - s._r[:, None], axis=2)) ** 2)
+    # a sum of n terms, each a few roundings: a few ulp of the sum of magnitudes
+    tol = 8 * len(s) * EPS * scale[:, None]
+    assert np.all(np.abs(acc - ref) <= tol)
+    assert np.all(np.abs(acc - quat) <= tol)
+
+
+def test_quaternion_form_squares_vectors_to_minus_their_length():
+    # Hamilton: (alpha - alpha')^2 = -T^2; a single pair at distance 2 on x
+    acc = accelerations_quaternion([[0.0, 0, 0], [2.0, 0, 0]], [3.0, 5.0])
+    np.testing.assert_array_equal(acc, [[5.0 / 4, 0, 0], [-3.0 / 4, 0, 0]])
+
+
+def test_against_rebound_accelerations():
+    s = System.solar_system("J2000")
+    ours = s.accelerations().to_value(u.au / u.day**2)
+    theirs = rebound_accelerations(s)
+    scale = np.abs(theirs).max(axis=1, keepdims=True)
+    assert np.all(np.abs(ours - theirs) <= 16 * EPS * scale)
+
+
+def test_massless_particles_cost_nothing_to_the_massive():
+    s = random_system(4, 1)
+    t = random_system(4, 1, n_massless=50)
+    np.testing.assert_array_equal(s.accelerations(), t.accelerations()[:4])
+
+
+def test_rebound_round_trip_bit_for_bit():
+    s = System.solar_system("J2000", bodies=["sun", "earth", "moon", "jupiter"])
+    back = System.from_rebound(s.to_rebound(), quantity=True)
+    assert back.names == s.names
+    np.testing.assert_array_equal(back._r, s._r)
+    np.testing.assert_array_equal(back._v, s._v)
+    np.testing.assert_array_equal(back._gm, s._gm)
+    f = random_system(3, 2, n_massless=2)
+    back = from_rebound(to_rebound(f))
+    np.testing.assert_array_equal(back._r, f._r)
+    np.testing.assert_array_equal(back._v, f._v)
+    np.testing.assert_array_equal(back._gm, f._gm)
+
+
+def test_solar_system_offline_and_cited_gm():
+    s = System.solar_system("J2000")
+    assert s.names == ("sun", "mercury", "venus", "earth-moon-barycenter", "mars",
+                       "jupiter", "saturn", "uranus", "neptune")
+    # IAU 2015 B3 nominal solar GM
+    assert s["sun"].gm.to_value(u.m**3 / u.s**2) == pytest.approx(1.32712440041e20, rel=1e-15)
+    # Earth-Moon distance at J2000 from the built-in ephemeris: the Moon is 402,000 km away
+    em = System.solar_system("J2000", bodies=["sun", "earth", "moon"])
+    d = np.linalg.norm((em.r[2] - em.r[1]).to_value(u.km))
+    assert 356_000 < d < 407_000
+    # Earth + Moon GM equals the Earth-Moon system GM of DE440 (Park et al. 2021)
+    total = SOLAR_SYSTEM_GM["earth"] + SOLAR_SYSTEM_GM["moon"]
+    assert total == pytest.approx(SOLAR_SYSTEM_GM["earth-moon-barycenter"], rel=1e-9)
+    # Earth's barycentric speed ~ 29.8 km/s
+    speed = np.linalg.norm(s["earth-moon-barycenter"].v.to_value(u.km / u.s))
+    assert 29.0 < speed < 30.5
+
+
+def test_hamilton_integrals_of_a_known_pair():
+    # two unit masses at distance 1, at rest: E = -G m m / r = -1, L = 0, centre at 0.5
+    s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1.0, [1.0, 0, 0], [0, 0, 0])])
+    assert s.energy() == -1.0
+    np.testing.assert_array_equal(s.angular_momentum(), [0, 0, 0])
+    np.testing.assert_array_equal(s.barycentre()[0], [0.5, 0, 0])
+
+
+def test_quantity_system_units():
+    s = System.solar_system("J2000")
+    assert s.r.unit == u.au and s.v.unit == u.au / u.day
+    assert s.energy().unit == u.J
+    assert s.angular_momentum().unit == u.kg * u.m**2 / u.s
+    # The solar system's energy is about -2e35 J (dominated by Jupiter: -G M m / 2a)
+    assert -1e36 < s.energy().to_value(u.J) < -1e35
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (lambda: Body("p", gm=-1.0, r=[1, 0, 0], v=[0, 1, 0]), r"Body 'p'.*gm.*-1.0"),
+        (lambda: Body("p", gm=1.0, r=[np.nan, 0, 0], v=[0, 1, 0]), r"Body 'p'.*`r`.*nan"),
+        (lambda: Body("p", gm=1.0, r=[1, 0], v=[0, 1, 0]), r"Body 'p'.*`r`.*shape"),
+        (lambda: Body("p", gm=1.0 * u.m, r=[1, 0, 0] * u.au, v=[0, 1, 0] * u.km / u.s),
+         r"gm"),
+        (lambda: System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                         Body("a", 1.0, [1, 0, 0], [0, 0, 0])]), r"Duplicate body name 'a'"),
+        (lambda: System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                         Body("b", 0.0, [0, 0, 0], [0, 1, 0])]), r"'a' and 'b'.*one position"),
+        (lambda: System([]), r"bodies"),
+        (lambda: System([Body("a", 0.0, [0, 0, 0], [0, 0, 0])]), r"gm"),
+        (lambda: System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])["b"], r"No body named 'b'"),
+        (lambda: System.solar_system("J2000", bodies=["sun", "pluto"]), r"'pluto'"),
+    ],
+)
+def test_bad_input_names_the_body_and_value(make, match):
+    with pytest.raises((ValueError, u.UnitConversionError), match=match):
+        make()
+
+
+def test_two_massless_particles_may_share_a_position():
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 0.0, [1, 0, 0], [0, 1, 0]), Body("q", 0.0, [1, 0, 0], [0, 1.1, 0])])
+    assert np.all(np.isfinite(s.accelerations()))
