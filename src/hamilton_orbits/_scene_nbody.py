@@ -295,7 +295,16 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     for an in spec["analysis"]:
         _ANALYSIS_FUNCS[an["name"]](result, system, an)
     if spec["crosscheck"]:
-        _crosscheck_into(result, system, times, kw)
+        from hamilton_orbits.simulation import Trajectory
+        from hamilton_orbits.simulation import _diagnostics as integrals
+
+        t_int = times.to_value(u.d)
+        r_int = r * r_unit.to(u.au) if system.quantity else r
+        v_int = v * v_unit.to(u.au / u.d) if system.quantity else v
+        ee, ae, bd = integrals(system, r_int, v_int, t_int)
+        traj = Trajectory(times, r * r_unit, v * v_unit, system.names, current, ee, ae, bd, steps, wall,
+                          integ["method"], tuple(n for n in spec["effects"]))
+        _crosscheck_into(result, system, traj, kw)
     result.plotters.append(_plot_orbits)
     result.plotters.append(_plot_energy)
     return result
@@ -384,13 +393,20 @@ _ANALYSIS_FUNCS = {
 }
 
 
-def _crosscheck_into(result: Result, system, times: u.Quantity, kw: dict) -> None:
-    """Integrate the same initial state with rebound (IAS15) and table the differences."""
+def _crosscheck_into(result: Result, system, traj, kw: dict) -> None:
+    """Integrate the same initial state with rebound (IAS15) at the same output times."""
     from hamilton_orbits import crosscheck
 
-    table = crosscheck(system, times[-1], method=kw["method"], effects=kw["effects"])
-    rows = getattr(table, "rows", table)
-    result.tables["cross-check against rebound"] = list(rows)
+    if not result.complete:
+        return
+    table = crosscheck(system, None, method=kw["method"], effects=kw["effects"],
+                       trajectory=traj)
+    result.tables["cross-check against rebound: final position difference"] = table.rows
+    result.tables["cross-check against rebound: codes"] = table.code_rows
+    result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
+    result.metrics["rebound wall time (s)"] = table.wall_time["rebound"]
+    result.metrics["max relative position difference"] = float(
+        table.relative_position_difference.max())
 
 
 def _plot_orbits(result: Result):
