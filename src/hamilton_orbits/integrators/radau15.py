@@ -48,6 +48,10 @@ __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RADAU_SPACINGS"
 NAME = "radau15"
 ACCEPTS_VELOCITY_DEPENDENT = True
 DEFAULT_TOL = 1e-9  # IAS15's epsilon (Rein & Spiegel 2015, section 3.2)
+#: Step-size criteria: ``"global"`` (Rein & Spiegel 2015, section 3.2) and
+#: ``"prs23"`` (Pham, Rein & Spiegel 2024, IAS15's default since rebound 4).
+CRITERIA = ("global", "prs23")
+DEFAULT_CRITERION = "prs23"
 
 #: Gauss-Radau spacings on [0, 1] (Everhart 1985, table; Rein & Spiegel 2015,
 #: section 2.1): ``h_0 = 0`` and the 7 roots of ``P_7(2h - 1) + P_8(2h - 1)``
@@ -89,6 +93,11 @@ def _coefficients(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 _C, _D = _coefficients(RADAU_SPACINGS)
 _H = RADAU_SPACINGS
+# reciprocal differences 1 / (h_n - h_i), i < n, of the divided differences
+_RINV = np.zeros((8, 8))
+for _n in range(1, 8):
+    for _i in range(_n):
+        _RINV[_n, _i] = 1.0 / (_H[_n] - _H[_i])
 
 _F1 = types.float64[::1]
 _F2 = types.float64[:, ::1]
@@ -184,8 +193,9 @@ def _advance(
 ):  # pragma: no cover - compiled
     """Step from ``st[0]`` to ``t_end`` in place; returns ``(steps, status)``.
 
-    ``st`` holds ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters]``
-    (``epsilon = 0``: fixed steps of ``dt``).  ``b, e, br, er, g`` are (7, 3n);
+    ``st`` holds ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters,
+    prs23]`` (``epsilon = 0``: fixed steps of ``dt``; ``prs23 != 0``: the step
+    criterion of Pham, Rein & Spiegel 2024, else the global one of IAS15).  ``b, e, br, er, g`` are (7, 3n);
     ``csx, csv`` the Kahan compensations (3n,).  ``r, v`` (n, 3) are updated.
     """
     n = r.shape[0]
@@ -193,6 +203,7 @@ def _advance(
     h = _H
     c = _C
     d = _D
+    rinv = _RINV
     safety = 0.25
     xf = r.reshape(m)
     vf = v.reshape(m)
@@ -216,6 +227,7 @@ def _advance(
     eps = st[4]
     have_last = st[5] != 0.0
     adaptive = eps > 0.0
+    prs23 = st[7] != 0.0
     steps = 0
     status = 0
     s = np.empty(9)
@@ -342,8 +354,8 @@ def _advance(
                 for k in range(m):
                     gk = atf[k] - a0[k]
                     for i in range(j):
-                        gk = gk / (hn - h[i]) - g[i, k]
-                    gk = gk / (hn - h[j])
+                        gk = gk * rinv[ns, i] - g[i, k]
+                    gk = gk * rinv[ns, j]
                     delta = gk - g[j, k]
                     g[j, k] = gk
                     for i in range(j):
@@ -370,7 +382,50 @@ def _advance(
             status = STATUS_NONFINITE
             break
         dt_done = dt_try
-        if adaptive:
+        if adaptive and prs23:
+            # Pham, Rein & Spiegel (2024): the shortest timescale
+            # tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|) over bodies, with a, a', a''
+            # from the polynomial at the end of the step (derivatives per unit h)
+            min_tau2 = math.inf
+            for i in range(n):
+                y2 = 0.0
+                y3 = 0.0
+                y4 = 0.0
+                for k in range(3 * i, 3 * i + 3):
+                    tmp = (
+                        a0[k] + b[0, k] + b[1, k] + b[2, k] + b[3, k] + b[4, k] + b[5, k] + b[6, k]
+                    )
+                    y2 += tmp * tmp
+                    tmp = (
+                        b[0, k]
+                        + 2.0 * b[1, k]
+                        + 3.0 * b[2, k]
+                        + 4.0 * b[3, k]
+                        + 5.0 * b[4, k]
+                        + 6.0 * b[5, k]
+                        + 7.0 * b[6, k]
+                    )
+                    y3 += tmp * tmp
+                    tmp = (
+                        2.0 * b[1, k]
+                        + 6.0 * b[2, k]
+                        + 12.0 * b[3, k]
+                        + 20.0 * b[4, k]
+                        + 30.0 * b[5, k]
+                        + 42.0 * b[6, k]
+                    )
+                    y4 += tmp * tmp
+                if not (y2 > 0.0 and y2 < math.inf):
+                    continue
+                tau2 = 2.0 * y2 / (y3 + math.sqrt(y4 * y2))
+                if tau2 > 0.0 and tau2 < min_tau2:
+                    min_tau2 = tau2
+            if min_tau2 < math.inf:
+                dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
+            else:
+                dt_new = dt_done / safety
+        if adaptive and not prs23:
+            # Rein & Spiegel (2015), section 3.2: global max |b6| / max |a|
             maxak = 0.0
             maxb6 = 0.0
             for k in range(m):
@@ -385,6 +440,7 @@ def _advance(
                 dt_new = dt_done * (eps / err) ** (1.0 / 7.0)
             else:
                 dt_new = dt_done / safety
+        if adaptive:
             if dt_new < safety * dt_done:
                 # reject: restore the start of the step and try again
                 for k in range(m):
@@ -454,6 +510,7 @@ def run(
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
     max_steps: int = 100_000_000,
+    criterion: str = DEFAULT_CRITERION,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the adaptive 15th-order Gauss-Radau scheme (IAS15-like).
 
@@ -479,6 +536,15 @@ def run(
         ``on_output(i, steps)`` after output ``i`` is reached.
     max_steps : int, optional
         Give up (``ConvergenceError``) after this many steps in one output interval.
+    criterion : {"global", "prs23"}, optional
+        The step-size control: ``"global"`` estimates the error from the last
+        term, ``dt_new = dt (epsilon / (max |b6| / max |a|))^(1/7)`` (Rein &
+        Spiegel 2015, eq. 11 with the global estimate of section 3.2);
+        ``"prs23"`` sets ``dt_new = (7! epsilon)^(1/7) min tau`` with the
+        timescale ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` of each body at the
+        end of the step (Pham, Rein & Spiegel 2024, the criterion rebound's
+        IAS15 uses by default), which takes about half the steps on eccentric
+        orbits at the same energy error.
 
     Returns
     -------
@@ -510,6 +576,11 @@ def run(
     True
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
+    if criterion not in CRITERIA:
+        raise ValueError(
+            f"Expected `criterion` to be one of {', '.join(map(repr, CRITERIA))}, got {criterion!r}"
+        )
+    crit = criterion
     dt_f, tol_f = _setup.check_dt_tol(dt, tol)
     if dt_f is None and tol_f is None:
         tol_f = DEFAULT_TOL
@@ -532,7 +603,7 @@ def run(
     g = np.zeros((7, m))
     csx = np.zeros(m)
     csv = np.zeros(m)
-    st = np.array([t_out[0], 0.0, dt_f, 0.0, tol_f or 0.0, 0.0, 0.0])
+    st = np.array([t_out[0], 0.0, dt_f, 0.0, tol_f or 0.0, 0.0, 0.0, float(crit == "prs23")])
     x = np.ascontiguousarray(r0.copy())
     w = np.ascontiguousarray(v0.copy())
     need_v = bool(rhs.velocity_dependent)
