@@ -195,7 +195,8 @@ def _advance(
 
     ``st`` holds ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters,
     prs23]`` (``epsilon = 0``: fixed steps of ``dt``; ``prs23 != 0``: the step
-    criterion of Pham, Rein & Spiegel 2024, else the global one of IAS15).  ``b, e, br, er, g`` are (7, 3n);
+    criterion of Pham, Rein & Spiegel 2024, else the global one of IAS15).
+    ``b, e, br, er, g`` are (7, 3n);
     ``csx, csv`` the Kahan compensations (3n,).  ``r, v`` (n, 3) are updated.
     """
     n = r.shape[0]
