@@ -56,48 +56,58 @@ DEFAULT_CRITERION = "prs23"
 #: Gauss-Radau spacings on [0, 1] (Everhart 1985, table; Rein & Spiegel 2015,
 #: section 2.1): ``h_0 = 0`` and the 7 roots of ``P_7(2h - 1) + P_8(2h - 1)``
 #: other than ``h = 0`` (``P_n`` Legendre polynomials).
-RADAU_SPACINGS = np.array(
-    [
-        0.0,
-        0.0562625605369221464656521910318,
-        0.180240691736892364987579942780,
-        0.352624717113169637373907769648,
-        0.547153626330555383001448554766,
-        0.734210177215410531523210605558,
-        0.885320946839095768090359771030,
-        0.977520613561287501891174488626,
-    ]
+_H_DECIMAL = (
+    "0",
+    "0.0562625605369221464656521910318",
+    "0.180240691736892364987579942780",
+    "0.352624717113169637373907769648",
+    "0.547153626330555383001448554766",
+    "0.734210177215410531523210605558",
+    "0.885320946839095768090359771030",
+    "0.977520613561287501891174488626",
 )
+RADAU_SPACINGS = np.array([float(x) for x in _H_DECIMAL])
 
 
-def _coefficients(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The matrices ``C`` (b = C g) and ``D = C^-1`` (g = D b).
+def _coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Differences ``h_n - h_i``, and the matrices ``C`` (b = C g) and ``D = C^-1``
+    (g = D b), computed exactly in rationals from the 30-digit spacings and
+    rounded once: a constant's rounding error is repeated in every step, so
+    it must be the smallest possible (a biased constant is a systematic error,
+    which breaks Brouwer's law).
 
     ``C[k, j]`` is the coefficient of ``h^(k+1)`` in ``prod_{m=0..j} (h - h_m)``
     (Rein & Spiegel 2015, eq. 5 expanded into eq. 4).
     """
-    c = np.zeros((7, 7))
+    from fractions import Fraction
+
+    h = [Fraction(x) for x in _H_DECIMAL]
+    rr = np.zeros((8, 8))
+    for n in range(1, 8):
+        for i in range(n):
+            rr[n, i] = float(h[n] - h[i])
+    c = [[Fraction(0)] * 7 for _ in range(7)]
     for j in range(7):
-        poly = np.array([1.0])  # coefficients, lowest order first
+        poly = [Fraction(1)]  # coefficients, lowest order first
         for m in range(j + 1):
-            poly = np.convolve(poly, np.array([-h[m], 1.0]))
-        c[: j + 1, j] = poly[1 : j + 2]
-    d = np.zeros((7, 7))
-    # back substitution of the unit upper-triangular C
+            new = [Fraction(0)] * (len(poly) + 1)
+            for p, coef in enumerate(poly):
+                new[p] -= h[m] * coef
+                new[p + 1] += coef
+            poly = new
+        for k in range(j + 1):
+            c[k][j] = poly[k + 1]
+    d = [[Fraction(0)] * 7 for _ in range(7)]
     for j in range(7):
-        d[j, j] = 1.0
+        d[j][j] = Fraction(1)
         for k in range(j - 1, -1, -1):
-            d[k, j] = -sum(c[k, m] * d[m, j] for m in range(k + 1, j + 1))
-    return c, d
+            d[k][j] = -sum((c[k][m] * d[m][j] for m in range(k + 1, j + 1)), Fraction(0))
+    to_array = np.vectorize(float)
+    return rr, to_array(np.array(c, dtype=object)), to_array(np.array(d, dtype=object))
 
 
-_C, _D = _coefficients(RADAU_SPACINGS)
+_RR, _C, _D = _coefficients()
 _H = RADAU_SPACINGS
-# reciprocal differences 1 / (h_n - h_i), i < n, of the divided differences
-_RINV = np.zeros((8, 8))
-for _n in range(1, 8):
-    for _i in range(_n):
-        _RINV[_n, _i] = 1.0 / (_H[_n] - _H[_i])
 
 _F1 = types.float64[::1]
 _F2 = types.float64[:, ::1]
@@ -115,6 +125,15 @@ def _kahan(p, cs, k, inp):  # pragma: no cover - compiled
     t = p[k] + y
     cs[k] = (t - p[k]) - y
     p[k] = t
+
+
+@njit(cache=True)
+def _kahan2(p, cs, i, k, inp):  # pragma: no cover - compiled
+    """Compensated ``p[i, k] += inp``."""
+    y = inp - cs[i, k]
+    t = p[i, k] + y
+    cs[i, k] = (t - p[i, k]) - y
+    p[i, k] = t
 
 
 @njit(cache=True)
@@ -204,7 +223,7 @@ def _advance(
     h = _H
     c = _C
     d = _D
-    rinv = _RINV
+    rr = _RR
     safety = 0.25
     xf = r.reshape(m)
     vf = v.reshape(m)
@@ -232,6 +251,7 @@ def _advance(
     steps = 0
     status = 0
     s = np.empty(9)
+    csb = np.zeros((7, m))
     while t < t_end:
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
@@ -272,6 +292,9 @@ def _advance(
                 for k in range(m):
                     b[i, k] = 0.0
                     e[i, k] = 0.0
+        for i in range(7):
+            for k in range(m):
+                csb[i, k] = 0.0
         for k in range(m):
             for j in range(7):
                 acc = b[j, k]
@@ -355,13 +378,15 @@ def _advance(
                 for k in range(m):
                     gk = atf[k] - a0[k]
                     for i in range(j):
-                        gk = gk * rinv[ns, i] - g[i, k]
-                    gk = gk * rinv[ns, j]
+                        gk = gk / rr[ns, i] - g[i, k]
+                    gk = gk / rr[ns, j]
                     delta = gk - g[j, k]
                     g[j, k] = gk
+                    # compensated updates of b (a biased rounding here would
+                    # be repeated every step)
                     for i in range(j):
-                        b[i, k] += c[i, j] * delta
-                    b[j, k] += delta
+                        _kahan2(b, csb, i, k, c[i, j] * delta)
+                    _kahan2(b, csb, j, k, delta)
                     if ns == 7:
                         ak = abs(atf[k])
                         if ak > maxak and ak < math.inf:
@@ -456,17 +481,17 @@ def _advance(
                 dt_new = base / safety
         else:
             dt_new = dt
-        # accept: compensated update of positions and velocities
-        dt2 = dt_done * dt_done
+        # accept: compensated update of positions and velocities (dt^2 is
+        # not precomputed: with a fixed step its rounding would be a bias)
         for k in range(m):
-            _kahan(xf, csx, k, b[6, k] / 72.0 * dt2)
-            _kahan(xf, csx, k, b[5, k] / 56.0 * dt2)
-            _kahan(xf, csx, k, b[4, k] / 42.0 * dt2)
-            _kahan(xf, csx, k, b[3, k] / 30.0 * dt2)
-            _kahan(xf, csx, k, b[2, k] / 20.0 * dt2)
-            _kahan(xf, csx, k, b[1, k] / 12.0 * dt2)
-            _kahan(xf, csx, k, b[0, k] / 6.0 * dt2)
-            _kahan(xf, csx, k, a0[k] / 2.0 * dt2)
+            _kahan(xf, csx, k, b[6, k] / 72.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[5, k] / 56.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[4, k] / 42.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[3, k] / 30.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[2, k] / 20.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[1, k] / 12.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, b[0, k] / 6.0 * dt_done * dt_done)
+            _kahan(xf, csx, k, a0[k] / 2.0 * dt_done * dt_done)
             _kahan(xf, csx, k, v0[k] * dt_done)
             _kahan(vf, csv, k, b[6, k] / 8.0 * dt_done)
             _kahan(vf, csv, k, b[5, k] / 7.0 * dt_done)
