@@ -70,7 +70,7 @@ RADAU_SPACINGS = np.array([float(x) for x in _H_DECIMAL])
 
 
 def _coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Differences ``h_n - h_i``, and the matrices ``C`` (b = C g) and ``D = C^-1``
+    """Reciprocal differences ``1 / (h_n - h_i)``, and the matrices ``C`` (b = C g) and ``D = C^-1``
     (g = D b), computed exactly in rationals from the 30-digit spacings and
     rounded once: a constant's rounding error is repeated in every step, so
     it must be the smallest possible (a biased constant is a systematic error,
@@ -85,7 +85,7 @@ def _coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rr = np.zeros((8, 8))
     for n in range(1, 8):
         for i in range(n):
-            rr[n, i] = float(h[n] - h[i])
+            rr[n, i] = float(1 / (h[n] - h[i]))
     c = [[Fraction(0)] * 7 for _ in range(7)]
     for j in range(7):
         poly = [Fraction(1)]  # coefficients, lowest order first
@@ -106,7 +106,7 @@ def _coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rr, to_array(np.array(c, dtype=object)), to_array(np.array(d, dtype=object))
 
 
-_RR, _C, _D = _coefficients()
+_RINV, _C, _D = _coefficients()
 _H = RADAU_SPACINGS
 
 _F1 = types.float64[::1]
@@ -223,7 +223,7 @@ def _advance(
     h = _H
     c = _C
     d = _D
-    rr = _RR
+    rinv = _RINV
     safety = 0.25
     xf = r.reshape(m)
     vf = v.reshape(m)
@@ -378,8 +378,8 @@ def _advance(
                 for k in range(m):
                     gk = atf[k] - a0[k]
                     for i in range(j):
-                        gk = gk / rr[ns, i] - g[i, k]
-                    gk = gk / rr[ns, j]
+                        gk = gk * rinv[ns, i] - g[i, k]
+                    gk = gk * rinv[ns, j]
                     delta = gk - g[j, k]
                     g[j, k] = gk
                     # compensated updates of b (a biased rounding here would
