@@ -6,7 +6,7 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import types
+from numba import njit, types
 
 from hamilton_orbits._validation import as_float_array, check_positive
 
@@ -99,15 +99,29 @@ def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
     ...              np.array([1.0, 0.0]))
     0.01
     """
-    massive = np.nonzero(gm > 0.0)[0]
-    best = math.inf
-    for i in massive:
-        d = np.sqrt(np.sum((r0 - r0[i]) ** 2, axis=1))
-        mu = gm + gm[i]
-        d[i] = math.inf
-        ok = d > 0.0
-        if np.any(ok):
-            best = min(best, float(np.min(np.sqrt(d[ok] ** 3 / mu[ok]))))
+    best = _min_pair_time(np.ascontiguousarray(r0), np.ascontiguousarray(gm))
     if not math.isfinite(best):
         return 1.0
     return 0.01 * best
+
+
+@njit(cache=True)
+def _min_pair_time(r, gm):  # pragma: no cover - compiled
+    """min over pairs (i massive, j != i) of sqrt(d^3 / (gm_i + gm_j)); O(n n_massive)."""
+    n = r.shape[0]
+    best = math.inf
+    for i in range(n):
+        if gm[i] == 0.0:
+            continue
+        for j in range(n):
+            if j == i or (gm[j] != 0.0 and j < i):
+                continue
+            dx = r[j, 0] - r[i, 0]
+            dy = r[j, 1] - r[i, 1]
+            dz = r[j, 2] - r[i, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 > 0.0:
+                t2 = d2 * math.sqrt(d2) / (gm[i] + gm[j])
+                if t2 < best:
+                    best = t2
+    return math.sqrt(best)
