@@ -1,0 +1,127 @@
+"""Input checks and the starting step shared by the ``radau15`` and ``wh`` modules."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit, types
+
+from hamilton_orbits._validation import as_float_array, check_positive
+
+#: The numba type of an acceleration function ``accel(r, v, gm, acc)`` as the
+#: stepping kernels take it: a first-class function type, so that a kernel
+#: compiled for it is cached once for every ``accel`` (a kernel specialised on
+#: a dispatcher argument is keyed by that dispatcher object and recompiled in
+#: every new process).
+ACCEL_TYPE = types.FunctionType(
+    types.void(
+        types.float64[:, ::1], types.float64[:, ::1], types.float64[::1], types.float64[:, ::1]
+    )
+)
+
+
+def check_inputs(
+    r0: Any, v0: Any, gm: Any, t_out: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Float64 copies of the state and output times, checked.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, index and value: non-finite values, shapes other
+        than (n, 3), (n, 3), (n,), (n_t,), negative ``gm`` or ``t_out`` not
+        strictly increasing.
+
+    Examples
+    --------
+    >>> check_inputs([[0.0, 0, 0]], [[0.0, 0, 0]], [-1.0], [0.0, 1.0])
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `gm` >= 0, got -1.0 at index 0
+    """
+    r0 = np.ascontiguousarray(as_float_array("r0", r0), dtype=np.float64)
+    v0 = np.ascontiguousarray(as_float_array("v0", v0), dtype=np.float64)
+    gm = np.ascontiguousarray(as_float_array("gm", gm), dtype=np.float64)
+    t_out = np.ascontiguousarray(as_float_array("t_out", t_out), dtype=np.float64)
+    if r0.ndim != 2 or r0.shape[1] != 3:
+        raise ValueError(f"Expected `r0` to have shape (n, 3), got {r0.shape}")
+    if v0.shape != r0.shape:
+        raise ValueError(f"Expected `v0` to have shape {r0.shape}, got {v0.shape}")
+    if gm.shape != (r0.shape[0],):
+        raise ValueError(f"Expected `gm` to have shape ({r0.shape[0]},), got {gm.shape}")
+    check_positive("gm", gm, strict=False)
+    if t_out.ndim != 1 or t_out.shape[0] < 1:
+        raise ValueError(f"Expected `t_out` to be a non-empty 1-d array, got shape {t_out.shape}")
+    bad = np.nonzero(np.diff(t_out) <= 0.0)[0]
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise ValueError(
+            f"Expected `t_out` to be strictly increasing, got {float(t_out[i])!r} at index {i} "
+            f"after {float(t_out[i - 1])!r}"
+        )
+    return r0, v0, gm, t_out
+
+
+def check_dt_tol(dt: Any, tol: Any) -> tuple[float | None, float | None]:
+    """``dt`` and ``tol`` as positive finite floats (or None).
+
+    Examples
+    --------
+    >>> check_dt_tol(0.5, None)
+    (0.5, None)
+    >>> check_dt_tol(0.0, None)
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `dt` > 0, got 0.0
+    """
+    out: list[float | None] = []
+    for name, value in (("dt", dt), ("tol", tol)):
+        if value is None:
+            out.append(None)
+            continue
+        arr = as_float_array(name, value)
+        if arr.ndim != 0:
+            raise ValueError(f"Expected `{name}` to be a scalar, got shape {arr.shape}")
+        check_positive(name, arr)
+        out.append(float(arr))
+    return out[0], out[1]
+
+
+def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
+    """A first trial step: 1/100 of the shortest pair free-fall time
+    ``sqrt(d^3 / (G m_i + G m_j))`` over pairs with a massive member.
+
+    Examples
+    --------
+    >>> initial_step(np.array([[0.0, 0, 0], [1.0, 0, 0]]), np.zeros((2, 3)),
+    ...              np.array([1.0, 0.0]))
+    0.01
+    """
+    best = _min_pair_time(np.ascontiguousarray(r0), np.ascontiguousarray(gm))
+    if not math.isfinite(best):
+        return 1.0
+    return 0.01 * best
+
+
+@njit(cache=True)
+def _min_pair_time(r, gm):  # pragma: no cover - compiled
+    """min over pairs (i massive, j != i) of sqrt(d^3 / (gm_i + gm_j)); O(n n_massive)."""
+    n = r.shape[0]
+    best = math.inf
+    for i in range(n):
+        if gm[i] == 0.0:
+            continue
+        for j in range(n):
+            if j == i or (gm[j] != 0.0 and j < i):
+                continue
+            dx = r[j, 0] - r[i, 0]
+            dy = r[j, 1] - r[i, 1]
+            dz = r[j, 2] - r[i, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 > 0.0:
+                t2 = d2 * math.sqrt(d2) / (gm[i] + gm[j])
+                if t2 < best:
+                    best = t2
+    return math.sqrt(best)

@@ -1,0 +1,331 @@
+"""Wisdom-Holman map in democratic-heliocentric coordinates.
+
+Wisdom & Holman (1991), AJ 102, 1528, in the democratic-heliocentric form of
+Duncan, Levison & Lee (1998), AJ 116, 2067, section 3: with heliocentric
+positions ``Q_i = r_i - r_0`` and barycentric velocities ``u_i`` of the bodies
+``i >= 1`` (the central body is the one of largest GM), the Hamiltonian splits
+into
+
+- the Kepler part, each body on a Kepler orbit about ``G M_0`` (advanced
+  exactly by the universal-variable kernel
+  :func:`hamilton_orbits._kernels.kepler.propagate_uv`, shared, not copied);
+- the interaction part, the mutual attraction of the bodies ``i >= 1``
+  (Hamilton's equation (B) without the central body), a kick of the ``u_i``;
+- the "jump" ``|sum_i m_i u_i|^2 / (2 m_0)``, a drift of every ``Q_i`` by
+  ``dt sum_i G m_i u_i / (G m_0)``;
+
+and the barycentre moves uniformly.  One step is the second-order symmetric
+composition that rebound's WHFast uses for these coordinates (Rein & Tamayo
+2015, MNRAS 452, 376): Kepler dt/2, jump dt/2, interaction dt, jump dt/2,
+Kepler dt/2; the Kepler halves of consecutive steps are merged, so each step
+costs one Kepler solve per body and one force evaluation.  Effects listed in
+the right-hand side (``rhs.extra``, velocity-independent only) are added to
+the interaction kick, evaluated at the inertial positions; their net
+acceleration of the barycentre moves the barycentre.
+
+Velocity-dependent effects are refused (the kick would not be symplectic).
+No symplectic corrector is applied (correctors are defined for Jacobi
+coordinates; WHFast does not offer them in these coordinates either).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numba import njit, types
+
+from hamilton_orbits._kernels import kepler as _kepler
+from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits._validation import ConvergenceError
+from hamilton_orbits.integrators import _setup
+
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "default_step", "run"]
+
+NAME = "wh"
+ACCEPTS_VELOCITY_DEPENDENT = False
+
+_F1 = types.float64[::1]
+_F2 = types.float64[:, ::1]
+
+
+@njit(cache=True)
+def _no_extra(r, v, gm, acc):  # pragma: no cover - compiled
+    """Placeholder for ``rhs.extra`` when no effect is listed (never called)."""
+    return
+
+
+@njit(cache=True)
+def _kepler_all(q, u, gm0, tau):  # pragma: no cover - compiled
+    """Advance every body ``i >= 1`` on its Kepler orbit about ``gm0`` by ``tau``.
+
+    Returns the index of the first failure (NaN from the kernel), else -1."""
+    for i in range(1, q.shape[0]):
+        x, y, z, vx, vy, vz = _kepler.propagate_uv(
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], gm0, tau
+        )
+        if not math.isfinite(x + y + z + vx + vy + vz):
+            return i
+        q[i, 0] = x
+        q[i, 1] = y
+        q[i, 2] = z
+        u[i, 0] = vx
+        u[i, 1] = vy
+        u[i, 2] = vz
+    return -1
+
+
+@njit(cache=True)
+def _jump(q, u, gm, tau):  # pragma: no cover - compiled
+    """The drift of the ``Q_i`` under ``|sum m_i u_i|^2 / (2 m_0)`` for a time ``tau``."""
+    n = q.shape[0]
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for i in range(1, n):
+        px += gm[i] * u[i, 0]
+        py += gm[i] * u[i, 1]
+        pz += gm[i] * u[i, 2]
+    f = tau / gm[0]
+    for i in range(1, n):
+        q[i, 0] += f * px
+        q[i, 1] += f * py
+        q[i, 2] += f * pz
+
+
+@njit(
+    types.Tuple((types.int64, types.int64))(
+        _setup.ACCEL_TYPE,
+        types.boolean,
+        _F2,
+        _F2,
+        _F1,
+        _F1,
+        _F1,
+        types.float64,
+        types.int64,
+        types.float64,
+    ),
+    cache=True,
+)
+def _advance(
+    extra, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last
+):  # pragma: no cover - compiled
+    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
+    coordinates, in place.  ``q``, ``u``: heliocentric positions and
+    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
+    ``com``: barycentre position and velocity (6,).  Returns ``(steps, bad)``
+    with ``bad`` the index of a body whose Kepler step failed, else -1."""
+    n = q.shape[0]
+    gm0 = gm[0]
+    acc = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    m_tot = 0.0
+    for i in range(n):
+        m_tot += gm[i]
+    h = dt if n_steps > 1 else dt_last
+    bad = _kepler_all(q, u, gm0, 0.5 * h)
+    if bad >= 0:
+        return 0, bad
+    for k in range(3):
+        com[k] += 0.5 * h * com[3 + k]
+    for s in range(n_steps):
+        h = dt if s < n_steps - 1 else dt_last
+        _jump(q, u, gm, 0.5 * h)
+        _nbody.newtonian(q, u, gm_p, acc)
+        for i in range(1, n):
+            for k in range(3):
+                u[i, k] += h * acc[i, k]
+        if has_extra:
+            # inertial state for the effects: r_0 = R - sum m_i Q_i / M
+            for k in range(3):
+                s_q = 0.0
+                s_u = 0.0
+                for i in range(1, n):
+                    s_q += gm[i] * q[i, k]
+                    s_u += gm[i] * u[i, k]
+                r_in[0, k] = com[k] - s_q / m_tot
+                v_in[0, k] = com[3 + k] - s_u / gm0
+                for i in range(1, n):
+                    r_in[i, k] = q[i, k] + r_in[0, k]
+                    v_in[i, k] = u[i, k] + com[3 + k]
+                for i in range(n):
+                    acc_x[i, k] = 0.0
+            extra(r_in, v_in, gm, acc_x)
+            for k in range(3):
+                a_cm = 0.0
+                for i in range(n):
+                    a_cm += gm[i] * acc_x[i, k]
+                a_cm /= m_tot
+                com[3 + k] += h * a_cm
+                for i in range(1, n):
+                    u[i, k] += h * (acc_x[i, k] - a_cm)
+        _jump(q, u, gm, 0.5 * h)
+        if s < n_steps - 1:
+            h_next = dt if s + 1 < n_steps - 1 else dt_last
+            tau = 0.5 * (h + h_next)
+        else:
+            tau = 0.5 * h
+        bad = _kepler_all(q, u, gm0, tau)
+        if bad >= 0:
+            return s, bad
+        for k in range(3):
+            com[k] += tau * com[3 + k]
+    return n_steps, -1
+
+
+def default_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | None = None) -> float:
+    """The step ``run`` takes when ``dt`` is not given.
+
+    ``P_min / 20`` with ``P_min`` the shortest Kepler period of a bound body
+    about the central one; with ``tol``, ``P_min min(1/20, sqrt(tol / eps))``
+    where ``eps`` is the largest mass ratio to the central body, from the
+    Wisdom-Holman energy error ``~ eps (dt / P)^2`` (Wisdom & Holman 1991).
+
+    Examples
+    --------
+    >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    >>> v0 = np.array([[0.0, 0, 0], [0.0, 1, 0]])
+    >>> round(default_step(r0, v0, np.array([1.0, 0.0])) * 20 / (2 * np.pi), 12)
+    1.0
+    """
+    c = int(np.argmax(gm))
+    mu = gm[c]
+    rel_r = np.delete(r0 - r0[c], c, axis=0)
+    rel_v = np.delete(v0 - v0[c], c, axis=0)
+    others = np.delete(gm, c)
+    d = np.linalg.norm(rel_r, axis=1)
+    inv_a = 2.0 / d - np.sum(rel_v**2, axis=1) / (mu + others)
+    bound = inv_a > 0.0
+    if not np.any(bound):
+        raise ValueError("wh needs `dt`: no body is bound to the central body")
+    period = float(np.min(2.0 * np.pi / np.sqrt((mu + others[bound]) * inv_a[bound] ** 3)))
+    frac = 1.0 / 20.0
+    if tol is not None:
+        eps = float(np.max(others / mu)) if others.size else 0.0
+        if eps > 0.0:
+            frac = min(frac, math.sqrt(tol / eps))
+    return period * frac
+
+
+def run(
+    rhs: Any,
+    r0: np.ndarray,
+    v0: np.ndarray,
+    gm: np.ndarray,
+    t_out: np.ndarray,
+    *,
+    dt: float | None = None,
+    tol: float | None = None,
+    on_output: Callable[[int, int], None] | None = None,
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Integrate with the Wisdom-Holman map (democratic-heliocentric coordinates).
+
+    Parameters
+    ----------
+    rhs : RHS
+        The compiled right-hand side; its Newtonian part is split as above and
+        ``rhs.extra`` (the listed effects) joins the kick.  Velocity-dependent
+        effects raise ``ValueError``.
+    r0, v0 : ndarray, shape (n, 3)
+        Initial inertial positions and velocities (internal units).
+    gm : ndarray, shape (n,)
+        ``G m >= 0``; the body of largest GM is the central one.
+    t_out : ndarray, shape (n_t,)
+        Increasing output times; ``t_out[0]`` is the initial time.
+    dt : float, optional
+        The step; the last step before an output time is shortened to land on
+        it.  Default: :func:`default_step`.
+    tol : float, optional
+        Used only without ``dt``, to choose it (see :func:`default_step`).
+    on_output : callable, optional
+        ``on_output(i, steps)`` after output ``i`` is reached.
+
+    Returns
+    -------
+    r, v : ndarray, shape (n_t, n, 3)
+        Inertial states at ``t_out`` (row 0 the initial state).
+    steps : int
+        Steps taken.
+
+    Raises
+    ------
+    ValueError
+        Bad input (naming the argument), a velocity-dependent effect, or no
+        massive central body.
+    ConvergenceError
+        If a Kepler step fails (a body on a collision orbit with the centre).
+
+    Examples
+    --------
+    Two planets on circular orbits; after 100 steps the energy is kept to
+    about (dt / P)^2 times the planet-to-star mass ratio:
+
+    >>> import numpy as np
+    >>> from hamilton_orbits.effects import newtonian_rhs
+    >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0], [0.0, 2.0, 0]])
+    >>> v0 = np.array([[0.0, 0, 0], [0.0, 1.0, 0], [-0.5**0.5, 0, 0]])
+    >>> r, v, steps = run(newtonian_rhs(), r0, v0, np.array([1.0, 1e-3, 1e-3]),
+    ...                   np.array([0.0, 10.0]), dt=0.1)
+    >>> steps
+    100
+    """
+    if rhs.velocity_dependent:
+        raise ValueError(
+            f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
+            f"{', '.join(rhs.effects)}.  Use method='radau15' (or 'dop853') for them"
+        )
+    r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
+    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
+    n = r0.shape[0]
+    c = int(np.argmax(gm))
+    if not gm[c] > 0.0:
+        raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
+    if dt_f is None:
+        dt_f = default_step(r0, v0, gm, tol_f)
+    # the central body first
+    order = np.concatenate([[c], np.delete(np.arange(n), c)])
+    g = np.ascontiguousarray(gm[order])
+    r = r0[order]
+    v = v0[order]
+    m_tot = g.sum()
+    com = np.concatenate([(g @ r) / m_tot, (g @ v) / m_tot])
+    q = np.ascontiguousarray(r - r[0])
+    u = np.ascontiguousarray(v - com[3:])
+    g_p = g.copy()
+    g_p[0] = 0.0
+    extra = rhs.extra if rhs.extra is not None else _no_extra
+    nt = t_out.shape[0]
+    r_out = np.empty((nt, n, 3))
+    v_out = np.empty((nt, n, 3))
+    r_out[0] = r0
+    v_out[0] = v0
+    total = 0
+    inv = np.argsort(order)
+    for i in range(1, nt):
+        span = t_out[i] - t_out[i - 1]
+        n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
+        last = span - (n_steps - 1) * dt_f
+        steps, bad = _advance(extra, rhs.extra is not None, q, u, g, g_p, com, dt_f, n_steps, last)
+        total += steps
+        if bad >= 0:
+            raise ConvergenceError(
+                f"wh: the Kepler step of body {int(order[bad])} failed between "
+                f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = {float(t_out[i])!r}"
+            )
+        # back to inertial coordinates
+        r0_in = com[:3] - (g[1:] @ q[1:]) / m_tot
+        v0_in = com[3:] - (g[1:] @ u[1:]) / g[0]
+        rr = q + r0_in
+        rr[0] = r0_in
+        vv = u + com[3:]
+        vv[0] = v0_in
+        r_out[i] = rr[inv]
+        v_out[i] = vv[inv]
+        if on_output is not None:
+            on_output(i, total)
+    return r_out, v_out, total
