@@ -431,10 +431,13 @@ def _plot_energy(result: Result):
     fig, ax = plt.subplots(figsize=(7, 4))
     t = result.times.to_value(u.yr)
     err = np.abs(result.diagnostics["energy_error"])
-    ax.semilogy(t[1:], np.maximum(err[1:], 1e-18), lw=0.8, label="hamilton-orbits")
+    floor = 1e-18  # an exact zero is drawn at the floor
+    ax.semilogy(t[1:], np.maximum(err[1:], floor), ".", ms=2, label="hamilton-orbits")
     peer = result.diagnostics.get("rebound_energy_error")
     if peer is not None:
-        ax.semilogy(t[1:], np.maximum(np.abs(peer[1:]), 1e-18), lw=0.8, label="rebound")
+        ax.semilogy(t[1:], np.maximum(np.abs(peer[1:]), floor), ".", ms=2, alpha=0.6,
+                    label="rebound IAS15")
+    ax.axhline(np.finfo(float).eps, color="0.6", lw=0.6, ls=":")
     ax.set_xlabel("time [yr]")
     ax.set_ylabel("|relative energy error|")
     ax.set_title(f"{result.scene.name}: energy error")
