@@ -11,6 +11,7 @@ from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
 from hamilton_orbits.rebound_bridge import crosscheck
+from hamilton_orbits.scene import Result, Scene
 from hamilton_orbits.simulation import Trajectory, integrate
 
 try:
@@ -24,6 +25,8 @@ __all__ = [
     "ConvergenceError",
     "KeplerOrbit",
     "Quaternion",
+    "Result",
+    "Scene",
     "System",
     "Trajectory",
     "__version__",

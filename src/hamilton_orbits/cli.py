@@ -1,11 +1,23 @@
 """The ``hamilton-orbits`` command.
 
-``hamilton-orbits`` with no argument runs the default demo: Hamilton's quaternion
-algebra and a rotation round trip, Hamilton's two-body integrals on a textbook
-orbit, then the demo sections that other packages register under the entry-point
-group ``hamilton_orbits.demos`` (``rigid`` adds the flip of a free rigid body), so
-that ``hamilton_orbits`` never imports ``rigid`` itself (DESIGN.md).
-``--version`` and ``--help`` answer at once.
+::
+
+    hamilton-orbits                      # runs the default bundled scene (solar-system)
+    hamilton-orbits run [SCENE|FILE] [--out DIR] [--set KEY=VALUE ...] [--no-progress]
+    hamilton-orbits crosscheck [SCENE|FILE]
+    hamilton-orbits scenes               # the bundled scenes, their effects, run time
+    hamilton-orbits demo                 # the quaternion tour
+
+``run`` prints the scene's summary table and writes its folder (``summary.md``,
+``summary.json``, PNG figures, ``states.nc``), named in the output.  Exit codes:
+0 on success, 2 for a bad scene (every problem is listed, nothing is simulated),
+1 for a failure during the run, 130 after Ctrl-C (what was done is kept and saved).
+
+``demo`` shows Hamilton's quaternion algebra and a rotation round trip, Hamilton's
+two-body integrals on a textbook orbit, then the demo sections that other packages
+register under the entry-point group ``hamilton_orbits.demos`` (``rigid`` adds the
+flip of a free rigid body), so that ``hamilton_orbits`` never imports ``rigid``
+itself (DESIGN.md).
 """
 
 from __future__ import annotations
@@ -70,6 +82,114 @@ def _demo() -> int:
     return 0
 
 
+DEFAULT_SCENE = "solar-system"
+EXIT_OK, EXIT_FAILED, EXIT_BAD_SCENE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+def _load_scene(ref: str, sets: Sequence[str]):
+    """A scene from a bundled name or a file path, with ``--set`` overrides applied."""
+    from pathlib import Path
+
+    from hamilton_orbits.scene import Scene, SceneError
+
+    if ref.endswith(".toml") or Path(ref).exists():
+        scene = Scene.from_toml(ref)
+    else:
+        scene = Scene.bundled(ref)
+    values = {}
+    for item in sets:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise SceneError([f"{scene.source}: --set {item!r}: expected KEY=VALUE"])
+        values[key.strip()] = value.strip()
+    return scene.with_values(values) if values else scene
+
+
+def _list_scenes() -> int:
+    from hamilton_orbits.scene import Scene, format_table
+
+    rows = []
+    for name, description in Scene.list_bundled():
+        scene = Scene.bundled(name)
+        rows.append(
+            {
+                "scene": name + (" (default)" if name == DEFAULT_SCENE else ""),
+                "kind": scene.kind,
+                "effects": ", ".join(e["name"] for e in scene.effects) or "none",
+                "run time": scene.spec.get("runtime") or "?",
+                "description": description[:70],
+            }
+        )
+    print(format_table(rows))
+    return EXIT_OK
+
+
+def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
+    from pathlib import Path
+
+    from hamilton_orbits.scene import SceneError
+
+    try:
+        scene = _load_scene(ref, sets)
+    except SceneError as exc:
+        print(f"hamilton-orbits: {exc}", file=sys.stderr)
+        return EXIT_BAD_SCENE
+    interrupted: list[int] = []
+
+    def stop() -> bool:
+        return bool(interrupted)
+
+    def on_sigint(signum, frame):  # first Ctrl-C: finish the current chunk, keep the rest
+        if interrupted:
+            raise KeyboardInterrupt
+        interrupted.append(signum)
+        print("\nhamilton-orbits: stopping after the current chunk (Ctrl-C again to abort)",
+              file=sys.stderr)
+
+    import signal
+
+    previous = signal.getsignal(signal.SIGINT)
+    try:
+        signal.signal(signal.SIGINT, on_sigint)
+    except ValueError:  # not the main thread: leave Ctrl-C alone
+        previous = None
+    try:
+        result = scene.run(progress=progress and sys.stderr.isatty(), stop=stop)
+    except KeyboardInterrupt:  # pragma: no cover - the kinds turn Ctrl-C into a short result
+        print("hamilton-orbits: interrupted before any output was produced", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except SceneError as exc:
+        print(f"hamilton-orbits: {exc}", file=sys.stderr)
+        return EXIT_BAD_SCENE
+    except Exception as exc:
+        print(f"hamilton-orbits: the run of {scene.name} failed: {exc!r}", file=sys.stderr)
+        return EXIT_FAILED
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    print(result.summary())
+    folder = Path(out) if out else Path("hamilton-orbits-output") / scene.name
+    paths = result.save(folder)
+    print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+    return EXIT_OK if result.complete else EXIT_INTERRUPTED
+
+
+def _crosscheck(ref: str, sets: Sequence[str]) -> int:
+    from hamilton_orbits.scene import SceneError
+
+    try:
+        scene = _load_scene(ref, sets)
+    except SceneError as exc:
+        print(f"hamilton-orbits: {exc}", file=sys.stderr)
+        return EXIT_BAD_SCENE
+    try:
+        print(scene.crosscheck())
+    except Exception as exc:
+        print(f"hamilton-orbits: the cross-check of {scene.name} failed: {exc!r}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hamilton-orbits`` console script.
 
@@ -83,16 +203,37 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(
         prog="hamilton-orbits",
-        description="Celestial mechanics and rigid-body rotation on Hamilton's quaternions.",
+        description=(
+            "Celestial mechanics and rigid-body rotation on Hamilton's quaternions. "
+            f"With no command, runs the default scene ({DEFAULT_SCENE})."
+        ),
     )
     parser.add_argument("--version", action="store_true", help="print the version and exit")
     sub = parser.add_subparsers(dest="command")
-    sub.add_parser("demo", help="the quaternion / rotation demo (the default)")
+    run = sub.add_parser("run", help="run a scene and write its folder")
+    run.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
+    run.add_argument("--out", help="output folder (default hamilton-orbits-output/SCENE)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help='override one key, e.g. --set duration="100 yr" (repeatable)')
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    cc = sub.add_parser("crosscheck", help="run a scene here and in rebound/reboundx; differences")
+    cc.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
+    cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    sub.add_parser("scenes", help="list the bundled scenes")
+    sub.add_parser("demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
     if args.version:
         print(f"hamilton-orbits {__version__}")
-        return 0
-    return _demo()
+        return EXIT_OK
+    if args.command == "demo":
+        return _demo()
+    if args.command == "scenes":
+        return _list_scenes()
+    if args.command == "crosscheck":
+        return _crosscheck(args.scene, args.set)
+    if args.command == "run":
+        return _run(args.scene, args.out, args.set, progress=not args.no_progress)
+    return _run(DEFAULT_SCENE, None, [], progress=True)
 
 
 if __name__ == "__main__":  # pragma: no cover

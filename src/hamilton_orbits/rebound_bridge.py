@@ -11,15 +11,22 @@ from __future__ import annotations
 import ctypes
 import time as _time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from hamilton_orbits.effects import normalize_effects
-from hamilton_orbits.nbody import Body, System, _energy_gm
+from hamilton_orbits.nbody import Body, System
 
-__all__ = ["CrossCheck", "crosscheck", "from_rebound", "rebound_accelerations", "to_rebound"]
+__all__ = [
+    "CrossCheck",
+    "crosscheck",
+    "from_rebound",
+    "rebound_accelerations",
+    "rebound_trajectory",
+    "to_rebound",
+]
 
 
 def to_rebound(system: System) -> Any:
@@ -150,6 +157,8 @@ class CrossCheck:
         The same divided by the body's distance from the centre of mass.
     energy_error : dict
         Final relative energy error, ``{"ours": ..., "rebound": ...}``.
+    rebound_energy_error, rebound_angular_momentum_error : ndarray
+        rebound's errors at each output time of the trajectory.
     angular_momentum_error : dict
     wall_time : dict
         Seconds of each code.
@@ -165,7 +174,28 @@ class CrossCheck:
     steps: dict[str, int]
     method: str
     peer: str
-    rows: list[dict[str, Any]] = field(default_factory=list)
+    rebound_energy_error: np.ndarray | None = None
+    rebound_angular_momentum_error: np.ndarray | None = None
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        """One row per body: final position difference (au for Quantity systems)."""
+        return [
+            {"body": name, "|dr|": float(self.position_difference[k]),
+             "|dr|/r": float(self.relative_position_difference[k])}
+            for k, name in enumerate(self.names)
+        ]
+
+    @property
+    def code_rows(self) -> list[dict[str, Any]]:
+        """One row per code: final energy and angular-momentum errors, steps, wall time."""
+        return [
+            {"code": label, "dE/E": self.energy_error[code],
+             "dL/L": self.angular_momentum_error[code], "steps": self.steps[code],
+             "wall time (s)": round(self.wall_time[code], 3)}
+            for code, label in (("ours", f"hamilton-orbits {self.method}"),
+                                ("rebound", self.peer))
+        ]
 
     def __str__(self) -> str:
         lines = [f"{'body':<24}{'|dr| (au)' :>14}{'|dr|/r':>12}"]
@@ -199,6 +229,38 @@ def run_rebound(system: System, t_end: float, effects: Sequence[Any] = (),
     wall = _time.perf_counter() - start
     _ = rebx  # keep the Extras alive while the simulation runs
     return sim, wall
+
+
+def rebound_trajectory(system: System, t_out: np.ndarray, effects: Sequence[Any] = (),
+                       integrator: str = "ias15") -> tuple[np.ndarray, np.ndarray, float, int]:
+    """rebound's states at the internal times ``t_out`` (``t_out[0]`` the start).
+
+    Returns ``(r, v, wall_time, steps)`` with ``r``, ``v`` of shape (n_t, n, 3).
+    """
+    normal = normalize_effects(effects, "nbody")
+    sim = to_rebound(system)
+    sim.integrator = integrator
+    sim.t = float(t_out[0])
+    rebx = _add_reboundx_effects(sim, system, normal)
+    n = len(system)
+    r = np.empty((len(t_out), n, 3))
+    v = np.empty_like(r)
+    buf = np.empty((n, 3))
+    sim.serialize_particle_data(xyz=buf)
+    r[0] = buf
+    sim.serialize_particle_data(vxvyvz=buf)
+    v[0] = buf
+    wall = 0.0
+    for k in range(1, len(t_out)):
+        start = _time.perf_counter()
+        sim.integrate(float(t_out[k]), exact_finish_time=1)
+        wall += _time.perf_counter() - start
+        sim.serialize_particle_data(xyz=buf)
+        r[k] = buf
+        sim.serialize_particle_data(vxvyvz=buf)
+        v[k] = buf
+    _ = rebx
+    return r, v, wall, int(sim.steps_done)
 
 
 def crosscheck(
@@ -236,36 +298,34 @@ def crosscheck(
     >>> bool(table.relative_position_difference.max() < 1e-9)
     True
     """
-    from hamilton_orbits.simulation import integrate
+    from hamilton_orbits.simulation import _diagnostics, integrate
 
     if trajectory is None:
         trajectory = integrate(system, t, method=method, dt=dt, tol=tol, effects=effects,
                                progress=progress)
     times = trajectory.t.to_value("day") if system.quantity else np.asarray(trajectory.t)
-    t_end = float(times[-1])
-    sim, wall = run_rebound(system, t_end, effects)
+    effects = normalize_effects(effects)
+    r_all, v_all, wall, steps = rebound_trajectory(
+        system, times, [dict(name=n, **dict(p)) for n, p in effects]
+    )
+    energy, ang, _ = _diagnostics(system, r_all, v_all, times)
     final = trajectory.final
-    r_reb = np.array([[p.x, p.y, p.z] for p in sim.particles])
-    v_reb = np.array([[p.vx, p.vy, p.vz] for p in sim.particles])
+    r_reb = r_all[-1]
     dr = np.linalg.norm(final._r - r_reb, axis=1)
     rc = system._gm @ r_reb / system._gm.sum()
     dist = np.linalg.norm(r_reb - rc, axis=1)
     rel = dr / np.where(dist > 0, dist, 1.0)
-    gm = system._gm
-    e0 = _energy_gm(system._r, system._v, gm)
-    e_reb = (_energy_gm(r_reb, v_reb, gm) - e0) / abs(e0)
-    h0 = gm @ np.cross(system._r, system._v)
-    h_reb = gm @ np.cross(r_reb, v_reb)
-    l_reb = float(np.linalg.norm(h_reb - h0) / np.linalg.norm(h0))
-    peer = "rebound ias15" + (" + reboundx" if normalize_effects(effects) else "")
+    peer = "rebound ias15" + (" + reboundx" if effects else "")
     return CrossCheck(
         system.names,
         dr,
         rel,
-        {"ours": float(trajectory.energy_error[-1]), "rebound": float(e_reb)},
-        {"ours": float(trajectory.angular_momentum_error[-1]), "rebound": l_reb},
+        {"ours": float(trajectory.energy_error[-1]), "rebound": float(energy[-1])},
+        {"ours": float(trajectory.angular_momentum_error[-1]), "rebound": float(ang[-1])},
         {"ours": float(trajectory.wall_time), "rebound": wall},
-        {"ours": int(trajectory.steps), "rebound": int(sim.steps_done)},
+        {"ours": int(trajectory.steps), "rebound": steps},
         trajectory.method,
         peer,
+        rebound_energy_error=energy,
+        rebound_angular_momentum_error=ang,
     )

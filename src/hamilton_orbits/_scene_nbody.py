@@ -1,0 +1,471 @@
+"""The ``nbody`` scene kind: bodies, an integrator, effects, analyses.
+
+Registered in :data:`hamilton_orbits.scene.KINDS` on import.  The keys are
+documented in ``docs/scenes.md``; this module turns a validated scene into a
+:class:`~hamilton_orbits.nbody.System`, runs :func:`hamilton_orbits.integrate`
+in chunks (a progress bar over the whole run; Ctrl-C keeps what is done), and
+measures what the scene's ``[[analysis]]`` entries ask for.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits import _schema as S
+from hamilton_orbits import effects as _effects
+from hamilton_orbits.scene import Result, Scene, SceneKind, format_table, register_kind
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
+
+METHODS = ("radau15", "wh", "leapfrog", "dop853")
+SOLAR_SYSTEM = (
+    "sun", "mercury", "venus", "earth", "mars", "jupiter", "saturn", "uranus", "neptune", "moon",
+)
+ANALYSES = {
+    "perihelion_advance": "secular rate of the longitude of perihelion of `body` about `primary`",
+    "nodal_regression": "secular rate of the node of `body` about `primary`, beside the J2 formula",
+    "close_approach": "the smallest distance between `body` and `other`, and when",
+}
+
+
+def _accepts_velocity_dependent(method: str) -> bool:
+    from importlib import import_module
+
+    return bool(import_module(f"hamilton_orbits.integrators.{method}").ACCEPTS_VELOCITY_DEPENDENT)
+
+
+_ANGLE_KEYS = ("inc", "lan", "argp", "M", "nu")
+BODY = S.Table(
+    fields={
+        "name": S.String(required=True),
+        "gm": S.Quantity(kind=GM),
+        "r": S.Vector(kind=LENGTH),
+        "v": S.Vector(kind=SPEED),
+        "primary": S.String(),
+        "a": S.Quantity(kind=LENGTH),
+        "p": S.Quantity(kind=LENGTH, positive=True),
+        "q": S.Quantity(kind=LENGTH, positive=True),
+        "e": S.Quantity(kind=DIMENSIONLESS),
+        **{k: S.Quantity(kind=ANGLE) for k in _ANGLE_KEYS},
+        "radius": S.Quantity(kind=LENGTH, positive=True),
+        "j2": S.Quantity(kind=DIMENSIONLESS),
+        "pole": S.Vector(kind=DIMENSIONLESS),
+    }
+)
+
+SCHEMA: dict[str, S.Field] = {
+    "duration": S.Quantity(kind=TIME, required=True, positive=True),
+    "cadence": S.Quantity(kind=TIME, positive=True),
+    "crosscheck": S.Bool(default=False),
+    "integrator": S.Table(
+        default={},
+        fields={
+            "method": S.Choice(choices=METHODS, default="radau15"),
+            "tol": S.Number(positive=True),
+            "dt": S.Quantity(kind=TIME, positive=True),
+        },
+    ),
+    "initial": S.Table(
+        default={},
+        fields={
+            "solar_system": S.Table(
+                fields={
+                    "epoch": S.String(default="J2000"),
+                    "bodies": S.Array(item=S.Choice(choices=SOLAR_SYSTEM)),
+                }
+            ),
+            "rebound": S.String(),
+        },
+    ),
+    "bodies": S.Array(item=BODY, default=[]),
+    "analysis": S.Array(
+        default=[],
+        item=S.Table(
+            fields={
+                "name": S.Choice(choices=tuple(ANALYSES), required=True),
+                "body": S.String(required=True),
+                "primary": S.String(),
+                "other": S.String(),
+            }
+        ),
+    ),
+}
+
+_DEFAULT_SOLAR = ("sun", "mercury", "venus", "earth", "mars", "jupiter", "saturn", "uranus",
+                  "neptune")
+
+
+def _initial_names(spec: dict) -> list[str]:
+    names: list[str] = []
+    ss = spec["initial"].get("solar_system")
+    if ss is not None:
+        names += list(ss.get("bodies") or _DEFAULT_SOLAR)
+    return names
+
+
+def _check(spec: dict, problems: S.Problems) -> None:
+    init = spec["initial"]
+    if init.get("rebound") is not None and init.get("solar_system") is not None:
+        problems.add("initial", "give either `solar_system` or `rebound`, not both")
+    names = _initial_names(spec)
+    for i, b in enumerate(spec["bodies"]):
+        path = f"bodies[{i}]"
+        if b["name"] in names:
+            problems.add(f"{path}.name", f"a body named {b['name']!r} is already in the scene")
+        if b["gm"] is None:
+            problems.add(f"{path}.gm", 'missing: GM is required ("0 m3/s2" for a test particle)')
+        has_state = b["r"] is not None or b["v"] is not None
+        elements = [k for k in ("a", "p", "q", "e", *_ANGLE_KEYS) if b[k] is not None]
+        if has_state and elements:
+            problems.add(path, f"give either `r` and `v` or orbital elements, not both "
+                               f"({', '.join(elements)})")
+        elif has_state:
+            for k in ("r", "v"):
+                if b[k] is None:
+                    problems.add(f"{path}.{k}", "missing: `r` and `v` go together")
+        elif elements:
+            sizes = [k for k in ("a", "p", "q") if b[k] is not None]
+            if len(sizes) != 1:
+                problems.add(path, "give exactly one of `a`, `p`, `q` with the elements")
+            anomalies = [k for k in ("M", "nu") if b[k] is not None]
+            if len(anomalies) > 1:
+                problems.add(path, "give at most one of `M`, `nu`")
+            if b["primary"] is None:
+                problems.add(f"{path}.primary", "missing: elements need the body they orbit")
+            elif b["primary"] not in names:
+                problems.add(f"{path}.primary",
+                             f"no body named {b['primary']!r}{S.closest(b['primary'], names)}")
+        else:
+            problems.add(path, "missing: a state (`r`, `v`) or orbital elements (`a`, `e`, ...)")
+        names.append(b["name"])
+    if not names and init.get("rebound") is None:
+        problems.add("bodies", "the scene has no bodies")
+    for i, eff in enumerate(spec["effects"]):
+        for key in ("body", "primary"):
+            if key in eff and eff[key] not in names:
+                problems.add(f"effects[{i}].{key}",
+                             f"no body named {eff[key]!r}{S.closest(str(eff[key]), names)}")
+        ek = _effects.get("nbody", eff["name"])
+        method = spec["integrator"]["method"]
+        if ek.velocity_dependent and not _accepts_velocity_dependent(method):
+            ok = [m for m in METHODS if _accepts_velocity_dependent(m)]
+            problems.add(
+                f"effects[{i}]",
+                f"effect {eff['name']!r} depends on velocities and integrator {method!r} "
+                f"cannot take it; use one of {', '.join(ok)}",
+            )
+    for i, an in enumerate(spec["analysis"]):
+        for key in ("body", "primary", "other"):
+            if an.get(key) is not None and an[key] not in names:
+                problems.add(f"analysis[{i}].{key}",
+                             f"no body named {an[key]!r}{S.closest(str(an[key]), names)}")
+    if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
+        problems.add("cadence", f"the cadence {spec['cadence']} exceeds the duration "
+                                f"{spec['duration']}")
+
+
+def build_system(spec: dict):
+    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from."""
+    from astropy.time import Time
+
+    from hamilton_orbits import Body, KeplerOrbit, System
+
+    init = spec["initial"]
+    bodies: list = []
+    if init.get("rebound") is not None:
+        import rebound
+
+        sim = rebound.Simulation(init["rebound"])
+        base = System.from_rebound(sim)
+        bodies = [base[n] for n in base.names]
+    ss = init.get("solar_system")
+    if ss is not None:
+        epoch = Time(ss["epoch"], scale="tdb")
+        base = System.solar_system(epoch, bodies=list(ss.get("bodies") or _DEFAULT_SOLAR))
+        bodies += [base[n] for n in base.names]
+    by_name = {b.name: b for b in bodies}
+    for b in spec["bodies"]:
+        extra = {k: b[k] for k in ("radius", "j2", "pole") if b[k] is not None}
+        if b["r"] is not None:
+            body = Body(b["name"], gm=b["gm"], r=b["r"], v=b["v"], **extra)
+        else:
+            prim = by_name[b["primary"]]
+            mu = (prim.gm + b["gm"]).to(u.km**3 / u.s**2)
+            kw = {k: b[k] for k in ("a", "p", "q", "M", "nu") if b[k] is not None}
+            orbit = KeplerOrbit.from_elements(
+                e=b["e"] if b["e"] is not None else 0.0,
+                inc=b["inc"] if b["inc"] is not None else 0 * u.rad,
+                lan=b["lan"] if b["lan"] is not None else 0 * u.rad,
+                argp=b["argp"] if b["argp"] is not None else 0 * u.rad,
+                mu=mu,
+                **({"M": 0 * u.rad} if "M" not in kw and "nu" not in kw else {}),
+                **kw,
+            )
+            r, v = orbit.state()
+            body = Body(b["name"], gm=b["gm"], r=prim.r + r, v=prim.v + v, **extra)
+        bodies.append(body)
+        by_name[body.name] = body
+    return System(bodies)
+
+
+def _times(spec: dict) -> u.Quantity:
+    duration = spec["duration"].to(u.d)
+    cadence = spec["cadence"].to(u.d) if spec["cadence"] is not None else duration / 1000
+    n = max(1, int(np.ceil((duration / cadence).to_value(u.one) - 1e-9)))
+    t = np.minimum(np.arange(n + 1) * cadence.value, duration.value)
+    return t * u.d
+
+
+def _progress_bar(total: int, enabled: bool):
+    import sys
+
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is in the [progress] extra
+        return None
+    return tqdm(total=total, unit="chunk", disable=not sys.stderr.isatty(), leave=False)
+
+
+def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
+    from hamilton_orbits import integrate
+
+    spec = scene.spec
+    system = build_system(spec)
+    t_all = _times(spec)
+    integ = spec["integrator"]
+    kw: dict[str, Any] = {"method": integ["method"], "effects": list(spec["effects"])}
+    if integ["tol"] is not None:
+        kw["tol"] = integ["tol"]
+    if integ["dt"] is not None:
+        kw["dt"] = integ["dt"]
+    # chunks: a progress bar over the whole run, and Ctrl-C keeps finished chunks
+    n_chunks = min(len(t_all) - 1, 50)
+    edges = np.unique(np.linspace(0, len(t_all) - 1, n_chunks + 1).round().astype(int))
+    bar = _progress_bar(len(edges) - 1, progress)
+    rs, vs, ts = [], [], []
+    steps = 0
+    complete = True
+    start = time.perf_counter()
+    current = system
+    try:
+        for a, b in itertools.pairwise(edges):
+            if stop():
+                complete = False
+                break
+            traj = integrate(current, t_all[a : b + 1] - t_all[a], **kw)
+            first = 0 if not ts else 1
+            ts.append((t_all[a : b + 1])[first:])
+            rs.append(traj.r[first:])
+            vs.append(traj.v[first:])
+            steps += int(traj.steps)
+            current = traj.final
+            if bar is not None:
+                bar.update(1)
+    except KeyboardInterrupt:
+        complete = False
+    finally:
+        if bar is not None:
+            bar.close()
+    wall = time.perf_counter() - start
+    if not ts:
+        raise KeyboardInterrupt
+    times = u.Quantity(np.concatenate([t.to_value(u.d) for t in ts]), u.d)
+    r = np.concatenate([np.asarray(getattr(x, "value", x)) for x in rs])
+    v = np.concatenate([np.asarray(getattr(x, "value", x)) for x in vs])
+    r_unit = getattr(rs[0], "unit", u.au)
+    v_unit = getattr(vs[0], "unit", u.au / u.d)
+    diag = _diagnostics(system, r, v, r_unit, v_unit)
+    result = Result(
+        scene=scene,
+        times=times,
+        diagnostics=diag,
+        states={"names": list(system.names), "r": r * r_unit, "v": v * v_unit},
+        wall_time=wall,
+        complete=complete,
+    )
+    result.metrics["integrator"] = integ["method"]
+    result.metrics["steps"] = steps
+    result.metrics["max |relative energy error|"] = float(np.max(np.abs(diag["energy_error"])))
+    for an in spec["analysis"]:
+        _ANALYSIS_FUNCS[an["name"]](result, system, an)
+    if spec["crosscheck"]:
+        from hamilton_orbits.simulation import Trajectory
+        from hamilton_orbits.simulation import _diagnostics as integrals
+
+        t_int = times.to_value(u.d)
+        r_int = r * r_unit.to(u.au) if system.quantity else r
+        v_int = v * v_unit.to(u.au / u.d) if system.quantity else v
+        ee, ae, bd = integrals(system, r_int, v_int, t_int)
+        traj = Trajectory(times, r * r_unit, v * v_unit, system.names, current, ee, ae, bd, steps, wall,
+                          integ["method"], tuple(n for n in spec["effects"]))
+        _crosscheck_into(result, system, traj, kw)
+    result.plotters.append(_plot_orbits)
+    result.plotters.append(_plot_energy)
+    return result
+
+
+def _diagnostics(system, r, v, r_unit, v_unit) -> dict[str, Any]:
+    """Energy, angular momentum and barycentre of every output state (numpy, no loop)."""
+    gm = system.gm
+    gm = np.asarray(gm.to_value(r_unit**3 / (r_unit / v_unit) ** 2) if hasattr(gm, "unit")
+                    else gm)
+    kin = 0.5 * np.einsum("j,tjk,tjk->t", gm, v, v)
+    pot = np.zeros(r.shape[0])
+    n = r.shape[1]
+    for i in range(n):  # a loop over bodies once for the whole series, not per step
+        d = np.linalg.norm(r[:, i + 1 :] - r[:, i : i + 1], axis=-1)
+        pot -= np.sum(gm[i] * gm[i + 1 :] / d, axis=-1)
+    energy = kin + pot  # in units of G M^2 / L: consistent, relative error is what counts
+    ang = np.einsum("j,tjk->tk", gm, np.cross(r, v))
+    bary = np.einsum("j,tjk->tk", gm, r) / gm.sum()
+    return {
+        "energy_error": (energy - energy[0]) / abs(energy[0]),
+        "angular_momentum_error": np.linalg.norm(ang - ang[0], axis=-1)
+        / np.linalg.norm(ang[0]),
+        "barycentre_drift": np.linalg.norm(bary - bary[0], axis=-1) * r_unit,
+    }
+
+
+def _relative_orbits(result: Result, system, body: str, primary: str):
+    from hamilton_orbits import KeplerOrbit
+
+    names = list(system.names)
+    i, j = names.index(body), names.index(primary)
+    r = result.states["r"][:, i] - result.states["r"][:, j]
+    v = result.states["v"][:, i] - result.states["v"][:, j]
+    gm = system.gm
+    mu = gm[i] + gm[j]
+    return KeplerOrbit.from_state(r.to(u.km), v.to(u.km / u.s), mu.to(u.km**3 / u.s**2))
+
+
+def _rate(times: u.Quantity, angle: u.Quantity) -> u.Quantity:
+    """Least-squares slope of an unwrapped angle against time."""
+    y = np.unwrap(angle.to_value(u.rad))
+    t = times.to_value(u.d)
+    slope = np.polyfit(t - t.mean(), y, 1)[0]
+    return slope * u.rad / u.d
+
+
+def _perihelion_advance(result: Result, system, an: dict) -> None:
+    primary = an.get("primary") or system.names[int(np.argmax(np.asarray(
+        getattr(system.gm, "value", system.gm))))]
+    orbits = _relative_orbits(result, system, an["body"], primary)
+    rate = _rate(result.times, orbits.varpi).to(u.arcsec / (100 * u.yr))
+    result.metrics[f"perihelion advance of {an['body']}"] = rate
+
+
+def _nodal_regression(result: Result, system, an: dict) -> None:
+    primary = an.get("primary") or system.names[0]
+    orbits = _relative_orbits(result, system, an["body"], primary)
+    rate = _rate(result.times, orbits.lan).to(u.deg / u.d)
+    result.metrics[f"nodal regression of {an['body']}"] = rate
+    prim = system[primary]
+    j2 = getattr(prim, "j2", None)
+    if j2 is not None and getattr(prim, "radius", None) is not None:
+        # first-order secular rate: dOmega/dt = -3/2 n J2 (R/p)^2 cos i (Vallado 4th ed. 9-41)
+        o = orbits[0]
+        j2v = float(getattr(j2, "value", j2))
+        formula = (-1.5 * o.n * j2v * (prim.radius / o.p).to(u.one) ** 2 * np.cos(o.inc))
+        formula = formula.to(u.deg / u.d)
+        result.metrics["J2 first-order formula"] = formula
+        result.metrics["ratio simulated / formula"] = float(rate / formula)
+
+
+def _close_approach(result: Result, system, an: dict) -> None:
+    names = list(system.names)
+    i, j = names.index(an["body"]), names.index(an["other"])
+    d = np.linalg.norm(result.states["r"][:, i] - result.states["r"][:, j], axis=-1)
+    k = int(np.argmin(d))
+    result.metrics[f"closest approach {an['body']}-{an['other']}"] = d[k].to(u.au)
+    result.metrics["at time"] = result.times[k].to(u.yr)
+
+
+_ANALYSIS_FUNCS = {
+    "perihelion_advance": _perihelion_advance,
+    "nodal_regression": _nodal_regression,
+    "close_approach": _close_approach,
+}
+
+
+def _crosscheck_into(result: Result, system, traj, kw: dict) -> None:
+    """Integrate the same initial state with rebound (IAS15) at the same output times."""
+    from hamilton_orbits import crosscheck
+
+    if not result.complete:
+        return
+    table = crosscheck(system, None, method=kw["method"], effects=kw["effects"],
+                       trajectory=traj)
+    result.tables["cross-check against rebound: final position difference"] = table.rows
+    result.tables["cross-check against rebound: codes"] = table.code_rows
+    result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
+    result.metrics["rebound wall time (s)"] = table.wall_time["rebound"]
+    result.metrics["max relative position difference"] = float(
+        table.relative_position_difference.max())
+
+
+def _plot_orbits(result: Result):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 6))
+    r = result.states["r"].to_value(u.au)
+    for k, name in enumerate(result.states["names"]):
+        ax.plot(r[:, k, 0], r[:, k, 1], lw=0.6, label=name)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [au]")
+    ax.set_ylabel("y [au]")
+    ax.set_title(f"{result.scene.name}: orbits")
+    ax.legend(fontsize=7, loc="upper right")
+    fig._hamilton_name = "orbits"
+    return fig
+
+
+def _plot_energy(result: Result):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    t = result.times.to_value(u.yr)
+    err = np.abs(result.diagnostics["energy_error"])
+    floor = 1e-18  # an exact zero is drawn at the floor
+    ax.semilogy(t[1:], np.maximum(err[1:], floor), ".", ms=2, label="hamilton-orbits")
+    peer = result.diagnostics.get("rebound_energy_error")
+    if peer is not None:
+        ax.semilogy(t[1:], np.maximum(np.abs(peer[1:]), floor), ".", ms=2, alpha=0.6,
+                    label="rebound IAS15")
+    ax.axhline(np.finfo(float).eps, color="0.6", lw=0.6, ls=":")
+    ax.set_xlabel("time [yr]")
+    ax.set_ylabel("|relative energy error|")
+    ax.set_title(f"{result.scene.name}: energy error")
+    ax.legend()
+    fig._hamilton_name = "energy_error"
+    return fig
+
+
+def _crosscheck(scene: Scene) -> str:
+    from hamilton_orbits import crosscheck
+
+    spec = scene.spec
+    system = build_system(spec)
+    integ = spec["integrator"]
+    table = crosscheck(system, spec["duration"], method=integ["method"],
+                       effects=list(spec["effects"]))
+    rows = getattr(table, "rows", None)
+    return format_table(rows) if rows is not None else str(table)
+
+
+register_kind(
+    SceneKind(
+        name="nbody",
+        summary="bodies under Hamilton's equation (B) and the listed effects",
+        schema=SCHEMA,
+        effect_kind="nbody",
+        check=_check,
+        run=_run,
+        crosscheck=_crosscheck,
+    )
+)

@@ -1,0 +1,243 @@
+"""The ``rotation`` scene kind: a rigid body (or the Earth) and its free motion.
+
+``rigid`` registers this kind with :mod:`hamilton_orbits.scene` through the
+entry point ``hamilton_orbits.scene_kinds: rotation``, so ``hamilton_orbits``
+never imports ``rigid``.  Keys (``docs/scenes.md``)::
+
+    kind = "rotation"
+    duration = "60 s"
+    cadence = "0.01 s"
+
+    [body]
+    moments = ["1 kg m2", "2 kg m2", "3 kg m2"]
+    omega = ["0.001 rad/s", "2 rad/s", "0.001 rad/s"]
+
+    [integrator]
+    method = "splitting4"
+    dt = "1 ms"
+
+    [[analysis]]
+    name = "flip_time"
+
+Every run is checked against the exact torque-free motion
+(:func:`rigid.free_motion`), so the summary states the integrator's error.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits import _schema as S
+from hamilton_orbits.scene import Result, Scene, SceneKind, register_kind
+from hamilton_orbits.units import ANGLE, ANGULAR_SPEED, DIMENSIONLESS, INERTIA, TIME
+
+ANALYSES = {
+    "flip_time": "interval between reversals of the middle-axis spin, beside 2 K(m) / lambda",
+    "wobble_period": "period of the rotation axis about the figure axis, beside Euler's period",
+}
+PRESETS = ("earth",)
+
+
+def _methods() -> tuple[str, ...]:
+    from rigid.integrators import METHODS
+
+    return tuple(METHODS)
+
+
+SCHEMA: dict[str, S.Field] = {
+    "duration": S.Quantity(kind=TIME, required=True, positive=True),
+    "cadence": S.Quantity(kind=TIME, positive=True),
+    "body": S.Table(
+        required=True,
+        fields={
+            "preset": S.Choice(choices=PRESETS),
+            "wobble": S.Quantity(kind=ANGLE),
+            "moments": S.Vector(kind=INERTIA),
+            "omega": S.Vector(kind=ANGULAR_SPEED),
+            "attitude": S.Vector(kind=DIMENSIONLESS, size=4),
+        },
+    ),
+    "integrator": S.Table(
+        default={},
+        fields={
+            "method": S.Choice(choices=_methods, default="splitting4"),
+            "dt": S.Quantity(kind=TIME, positive=True),
+        },
+    ),
+    "analysis": S.Array(
+        default=[],
+        item=S.Table(fields={"name": S.Choice(choices=tuple(ANALYSES), required=True)}),
+    ),
+}
+
+
+def _check(spec: dict, problems: S.Problems) -> None:
+    body = spec["body"]
+    if body["preset"] is None:
+        for key in ("moments", "omega"):
+            if body[key] is None:
+                problems.add(f"body.{key}", "missing: required unless `preset` is given")
+        if body["wobble"] is not None:
+            problems.add("body.wobble", 'only the preset "earth" takes a wobble')
+    else:
+        for key in ("moments", "omega", "attitude"):
+            if body[key] is not None:
+                problems.add(f"body.{key}", f"the preset {body['preset']!r} sets it; remove it")
+    method = spec["integrator"]["method"]
+    if method != "dop853" and spec["integrator"]["dt"] is None:
+        problems.add("integrator.dt", f"missing: the method {method!r} takes a fixed step")
+    for i, eff in enumerate(spec["effects"]):
+        problems.add(f"effects[{i}]", f"the free rigid body takes no effects (got {eff['name']!r})")
+
+
+def build_body(spec: dict):
+    """The :class:`~rigid.RigidBody` a validated rotation scene starts from."""
+    from rigid import RigidBody
+
+    body = spec["body"]
+    if body["preset"] == "earth":
+        from rigid import earth
+
+        wobble = body["wobble"] if body["wobble"] is not None else 0.2 * u.arcsec
+        return earth.rigid_body(wobble=wobble)
+    kw: dict[str, Any] = {"omega": body["omega"]}
+    if body["attitude"] is not None:
+        kw["attitude"] = body["attitude"].to_value(u.one)
+    return RigidBody(body["moments"], **kw)
+
+
+def _si(x: Any, unit: u.UnitBase) -> np.ndarray:
+    return np.asarray(x.to_value(unit) if isinstance(x, u.Quantity) else x, dtype=float)
+
+
+def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
+    from rigid import free_motion, free_parameters, integrate
+
+    spec = scene.spec
+    body = build_body(spec)
+    duration = spec["duration"].to(u.s)
+    cadence = spec["cadence"].to(u.s) if spec["cadence"] is not None else duration / 1000
+    n_out = int(np.ceil((duration / cadence).to_value(u.one) - 1e-9)) + 1
+    integ = spec["integrator"]
+    kw: dict[str, Any] = {"method": integ["method"], "n_out": n_out, "progress": progress}
+    if integ["dt"] is not None:
+        kw["dt"] = integ["dt"].to(u.s)
+    start = time.perf_counter()
+    traj = integrate(body, duration, **kw)
+    wall = time.perf_counter() - start
+    t = traj.t.to(u.s) if isinstance(traj.t, u.Quantity) else traj.t * u.s
+    attitude, omega_exact = free_motion(body, t)
+    omega = _si(traj.omega, u.rad / u.s)
+    omega_ex = _si(omega_exact, u.rad / u.s)
+    scale = np.max(np.linalg.norm(omega_ex, axis=-1))
+    moments = _si(body.moments, u.kg * u.m**2)
+    energy = 0.5 * np.sum(moments * omega**2, axis=-1)
+    ang = np.linalg.norm(moments * omega, axis=-1)
+    diag = {
+        "attitude_error": attitude.rotation_distance(traj.attitude) * u.rad,
+        "omega_error": np.linalg.norm(omega - omega_ex, axis=-1) / scale,
+        "energy_error": (energy - energy[0]) / energy[0],
+        "angular_momentum_error": (ang - ang[0]) / ang[0],
+    }
+    result = Result(
+        scene=scene,
+        times=t,
+        diagnostics=diag,
+        states={"omega": omega * u.rad / u.s,
+                "attitude": traj.attitude.as_array()},
+        wall_time=wall,
+    )
+    result.metrics["integrator"] = integ["method"]
+    result.metrics["max attitude error vs exact"] = np.max(diag["attitude_error"]).to(u.rad)
+    result.metrics["max |omega error| / |omega|"] = float(np.max(diag["omega_error"]))
+    result.metrics["max |relative energy error|"] = float(np.max(np.abs(diag["energy_error"])))
+    par = free_parameters(body)
+    for an in spec["analysis"]:
+        if an["name"] == "flip_time":
+            _flip_time(result, omega, t, par)
+        elif an["name"] == "wobble_period":
+            _wobble_period(result, omega, t, par, spec)
+    result.plotters.append(_plot_omega)
+    return result
+
+
+def _flip_time(result: Result, omega: np.ndarray, t: u.Quantity, par) -> None:
+    """Mean interval between sign changes of the middle-axis spin (linear interpolation)."""
+    w2 = omega[:, 1]
+    ts = t.to_value(u.s)
+    k = np.flatnonzero(np.sign(w2[1:]) != np.sign(w2[:-1]))
+    crossings = ts[k] - w2[k] * (ts[k + 1] - ts[k]) / (w2[k + 1] - w2[k])
+    result.metrics["exact flip interval 2K(m)/lambda"] = par.flip_interval * u.s
+    if crossings.size >= 2:
+        measured = np.mean(np.diff(crossings))
+        result.metrics["simulated flip interval"] = measured * u.s
+        result.metrics["relative difference"] = float(measured / par.flip_interval - 1.0)
+    else:
+        result.metrics["simulated flip interval"] = "fewer than two flips in the run"
+
+
+def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) -> None:
+    """Period of the spin axis about the figure axis in the body frame."""
+    phase = np.unwrap(np.arctan2(omega[:, 1], omega[:, 0]))
+    ts = t.to_value(u.d)
+    rate = np.polyfit(ts - ts.mean(), phase, 1)[0]
+    measured = 2 * np.pi / abs(rate) * u.d
+    result.metrics["simulated wobble period"] = measured
+    result.metrics["exact free-motion period"] = (par.period * u.s).to(u.d)
+    if spec["body"]["preset"] == "earth":
+        from rigid import earth
+
+        result.metrics["Euler period (triaxial)"] = earth.euler_period(triaxial=True).to(u.d)
+
+
+def _plot_omega(result: Result):
+    import matplotlib.pyplot as plt
+
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    t = result.times.to_value(u.s)
+    w = result.states["omega"].to_value(u.rad / u.s)
+    for k in range(3):
+        ax.plot(t, w[:, k], lw=0.8, label=f"omega_{k + 1}")
+    ax.set_ylabel("body angular velocity [rad/s]")
+    ax.legend(fontsize=8)
+    err = result.diagnostics["attitude_error"].to_value(u.rad)
+    ax2.semilogy(t[1:], np.maximum(err[1:], 1e-18), lw=0.8)
+    ax2.set_ylabel("attitude error vs exact [rad]")
+    ax2.set_xlabel("time [s]")
+    ax.set_title(f"{result.scene.name}")
+    fig._hamilton_name = "spin"
+    return fig
+
+
+def _crosscheck(scene: Scene) -> str:
+    from hamilton_orbits.scene import format_table
+
+    result = _run(scene, progress=False)
+    rows = [
+        {"diagnostic": k, "max": result.metrics[k]}
+        for k in ("max attitude error vs exact", "max |omega error| / |omega|",
+                  "max |relative energy error|")
+    ]
+    return f"{scene.name}: against the exact free motion (rigid.free_motion)\n" + format_table(
+        rows
+    )
+
+
+KIND = SceneKind(
+    name="rotation",
+    summary="a rigid body (or the Earth) turning freely, checked against the exact motion",
+    schema=SCHEMA,
+    effect_kind="rotation",
+    check=_check,
+    run=_run,
+    crosscheck=_crosscheck,
+)
+
+
+def register() -> None:
+    """Register the ``rotation`` scene kind (entry point ``hamilton_orbits.scene_kinds``)."""
+    register_kind(KIND)

@@ -1,0 +1,148 @@
+"""Scene files: validation that speaks the user's language, and what a scene runs.
+
+The catalogue below holds one bad scene per kind of message (issue 10): each
+error must name the file and the key path, and for an unknown name the closest
+valid names.  Nothing is simulated until the whole scene is valid.
+"""
+
+import re
+
+import astropy.units as u
+import pytest
+
+from hamilton_orbits import Scene
+from hamilton_orbits.scene import SceneError
+
+GOOD = """\
+kind = "nbody"
+description = "a test scene"
+duration = "1 yr"
+effects = []
+
+[integrator]
+method = "radau15"
+
+[[bodies]]
+name = "sun"
+gm = "1.32712440041e20 m3 / s2"
+r = ["0 au", "0 au", "0 au"]
+v = ["0 km/s", "0 km/s", "0 km/s"]
+
+[[bodies]]
+name = "earth"
+gm = "398600.4418 km3 / s2"
+primary = "sun"
+a = "1 au"
+e = 0.0167
+inc = "0 deg"
+radius = "6378.1366 km"
+j2 = 1.0826359e-3
+pole = [0, 0, 1]
+"""
+
+# (name, edit applied to GOOD, regex the message must contain after "<file>: ")
+CATALOGUE = [
+    ("unknown top-level key", ("duration =", "duraton ="),
+     r"duraton: unknown key \(did you mean 'duration'"),
+    ("unknown effect", ("effects = []", 'effects = ["gr2"]'),
+     r"effects\[0\]\.name: unknown effect 'gr2' \(did you mean 'gr'"),
+    ("effect names a missing body", ("effects = []", 'effects = [{name = "j2", body = "eart"}]'),
+     r"effects\[0\]\.body: no body named 'eart' \(did you mean 'earth'\?\)"),
+    ("unknown effect parameter",
+     ("effects = []", 'effects = [{name = "j2", body = "earth", bdy = 1}]'),
+     r"effects\[0\]\.bdy: unknown parameter of effect 'j2' \(did you mean 'body'"),
+    ("wrong dimension", ('duration = "1 yr"', 'duration = "1 km"'),
+     r"duration: expected a time \(a unit convertible to s\), got .1 km."),
+    ("wrong dimension in a body", ('gm = "398600.4418 km3 / s2"', 'gm = "5.97e24 kg"'),
+     r"bodies\[1\]\.gm: expected a gravitational parameter GM"),
+    ("unreadable unit", ('a = "1 au"', 'a = "1 astro"'),
+     r"bodies\[1\]\.a: cannot read '1 astro' as a number with a unit"),
+    ("bare number where a unit is needed", ('a = "1 au"', "a = 1.0"),
+     r'bodies\[1\]\.a: expected a length \(m\) with its unit, e\.g\. "1\.0 m"'),
+    ("an angle where a number is expected", ("e = 0.0167", 'e = "1 deg"'),
+     r"bodies\[1\]\.e: expected dimensionless"),
+    ("unknown integrator", ('method = "radau15"', 'method = "radau"'),
+     r"integrator\.method: unknown value 'radau' \(did you mean 'radau15'"),
+    ("effect the integrator cannot take",
+     (('method = "radau15"', 'method = "wh"'), ("effects = []", 'effects = ["gr"]')),
+     r"effects\[0\]: effect 'gr' depends on velocities and integrator 'wh' cannot take it"),
+    ("elements orbit a missing body", ('primary = "sun"', 'primary = "sol"'),
+     r"bodies\[1\]\.primary: no body named 'sol' \(valid: 'sun'\)"),
+    ("unknown key in a body", ("e = 0.0167", "ecc = 0.0167"),
+     r"bodies\[1\]\.ecc: unknown key \(did you mean 'e'"),
+    ("missing required key", ('duration = "1 yr"\n', ""),
+     r"duration: missing: a time \(s\) is required"),
+    ("unknown kind", ('kind = "nbody"', 'kind = "n-body"'),
+     r"kind: unknown kind 'n-body' \(did you mean 'nbody'"),
+    ("TOML syntax error", ('description = "a test scene"', 'description = "a test scene'),
+     r"TOML syntax error: .*line 2"),
+]
+
+
+def _edit(text, edits):
+    if isinstance(edits[0], str):
+        edits = (edits,)
+    for old, new in edits:
+        assert old in text
+        text = text.replace(old, new, 1)
+    return text
+
+
+def test_the_good_scene_is_valid(tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    scene = Scene.from_toml(path)
+    assert scene.kind == "nbody"
+    assert scene.spec["duration"] == 1 * u.yr
+    assert scene.effects == ()
+
+
+@pytest.mark.parametrize(("case", "edits", "pattern"), CATALOGUE, ids=[c[0] for c in CATALOGUE])
+def test_bad_scene_messages_name_the_file_and_the_key(tmp_path, case, edits, pattern):
+    path = tmp_path / "bad.toml"
+    path.write_text(_edit(GOOD, edits))
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    assert any(p.startswith(f"{path}: ") for p in info.value.problems), info.value.problems
+    assert re.search(pattern, str(info.value)), str(info.value)
+
+
+def test_every_problem_is_reported_at_once(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(_edit(GOOD, (("duration =", "duraton ="), ('a = "1 au"', 'a = "1 s"'))))
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    assert len(info.value.problems) == 3  # the stray key, the missing duration, the bad unit
+
+
+def test_missing_file_and_unknown_bundled_scene():
+    with pytest.raises(SceneError, match=r"no-such\.toml: cannot read the scene file"):
+        Scene.from_toml("no-such.toml")
+    with pytest.raises(SceneError, match=r"merkury-gr: .*did you mean 'mercury-gr'"):
+        Scene.bundled("merkury-gr")
+
+
+def test_overrides_address_keys_by_path_and_by_name(tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    scene = Scene.from_toml(path)
+    changed = scene.with_values({"duration": "100 yr", "bodies.earth.e": "0.5",
+                                 "integrator.tol": "1e-10", "bodies[0].name": "sol"})
+    assert changed.spec["duration"] == 100 * u.yr
+    assert changed.spec["bodies"][1]["e"] == 0.5 * u.one
+    assert changed.spec["integrator"]["tol"] == 1e-10
+    assert changed.spec["bodies"][0]["name"] == "sol"
+    assert scene.spec["duration"] == 1 * u.yr  # the original is untouched
+    with pytest.raises(SceneError, match=r"bodies\.pluto\.e: no entry named 'pluto'"):
+        scene.with_values({"bodies.pluto.e": 0.1})
+    with pytest.raises(SceneError, match=r"duration: expected a time"):
+        scene.with_values({"duration": "3 m"})
+
+
+def test_bundled_scenes_are_valid_and_listed():
+    listed = dict(Scene.list_bundled())
+    for name in ("solar-system", "mercury-gr", "leo-j2"):
+        assert listed.get(name)
+        assert Scene.bundled(name).kind == "nbody"
+    assert [e["name"] for e in Scene.bundled("leo-j2").effects] == ["j2"]
+    assert Scene.bundled("solar-system").effects == ()
