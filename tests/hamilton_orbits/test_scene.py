@@ -127,7 +127,8 @@ def test_overrides_address_keys_by_path_and_by_name(tmp_path):
     path.write_text(GOOD)
     scene = Scene.from_toml(path)
     changed = scene.with_values({"duration": "100 yr", "bodies.earth.e": "0.5",
-                                 "integrator.tol": "1e-10", "bodies[0].name": "sol"})
+                                 "integrator.tol": "1e-10", "bodies[0].name": "sol",
+                                 "bodies.earth.primary": "sol"})
     assert changed.spec["duration"] == 100 * u.yr
     assert changed.spec["bodies"][1]["e"] == 0.5 * u.one
     assert changed.spec["integrator"]["tol"] == 1e-10
