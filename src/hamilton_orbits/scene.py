@@ -420,7 +420,12 @@ class Result:
         if not self.complete:
             lines.append("STOPPED EARLY: the results cover the part that was run")
         span = self.times[-1] - self.times[0] if len(self.times) else 0 * u.d
-        lines.append(f"simulated: {_fmt(span.to(u.yr))} in {self.wall_time:.2f} s")
+        asked = s.spec.get("duration")
+        if isinstance(asked, u.Quantity) and asked.unit.physical_type == "time":
+            span = span.to(asked.unit)
+        elif span > 1 * u.yr:
+            span = span.to(u.yr)
+        lines.append(f"simulated: {_fmt(span)} in {self.wall_time:.2f} s")
         if self.metrics:
             lines.append("")
             rows = [{"quantity": k, "value": v} for k, v in self.metrics.items()]
