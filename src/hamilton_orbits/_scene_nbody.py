@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import time
+from pathlib import Path
 from typing import Any
 
 import astropy.units as u
@@ -101,8 +102,22 @@ _DEFAULT_SOLAR = ("sun", "mercury", "venus", "earth-moon-barycenter", "mars", "j
                   "saturn", "uranus", "neptune")
 
 
+def _rebound_names(path: str) -> list[str]:
+    """Names of the particles in a rebound binary (``body<k>`` for unnamed ones)."""
+    import rebound
+
+    sim = rebound.Simulation(str(path))
+    return [sim.particles[k].name or f"body{k}" for k in range(sim.N)]
+
+
 def _initial_names(spec: dict) -> list[str]:
     names: list[str] = []
+    rb = spec["initial"].get("rebound")
+    if rb is not None:
+        try:
+            names += _rebound_names(rb)
+        except Exception:  # checked with a message in _check
+            pass
     ss = spec["initial"].get("solar_system")
     if ss is not None:
         names += list(ss.get("bodies") or _DEFAULT_SOLAR)
@@ -113,6 +128,15 @@ def _check(spec: dict, problems: S.Problems) -> None:
     init = spec["initial"]
     if init.get("rebound") is not None and init.get("solar_system") is not None:
         problems.add("initial", "give either `solar_system` or `rebound`, not both")
+    rb = init.get("rebound")
+    if rb is not None:
+        if not Path(rb).is_file():
+            problems.add("initial.rebound", f"no such file {rb!r} (relative to {Path.cwd()})")
+        else:
+            try:
+                _rebound_names(rb)
+            except Exception as exc:
+                problems.add("initial.rebound", f"not a rebound binary: {exc}")
     names = _initial_names(spec)
     for i, b in enumerate(spec["bodies"]):
         path = f"bodies[{i}]"
@@ -181,8 +205,9 @@ def build_system(spec: dict):
     if init.get("rebound") is not None:
         import rebound
 
-        sim = rebound.Simulation(init["rebound"])
-        base = System.from_rebound(sim)
+        # lengths in au, times in days, G m in au^3/day^2 (what final.bin holds)
+        sim = rebound.Simulation(str(init["rebound"]))
+        base = System.from_rebound(sim, quantity=True)
         bodies = [base[n] for n in base.names]
     ss = init.get("solar_system")
     if ss is not None:
@@ -309,6 +334,16 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         _crosscheck_into(result, system, traj, kw)
     result.plotters.append(_plot_orbits)
     result.plotters.append(_plot_energy)
+    final = current
+
+    def write_rebound(_result: Result, out: Path) -> list[Path]:
+        path = out / "final.bin"
+        if path.exists():
+            path.unlink()  # rebound appends to an existing archive
+        final.to_rebound().save_to_file(str(path))
+        return [path]
+
+    result.writers.append(write_rebound)
     return result
 
 
@@ -392,9 +427,10 @@ def _close_approach(result: Result, system, an: dict) -> None:
     w = v[:, i] - v[:, j]
     dist = np.linalg.norm(d, axis=-1)
     k = int(np.argmin(dist))
-    half = 0.5 * (t[min(k + 1, len(t) - 1)] - t[max(k - 1, 0)]) if len(t) > 1 else 0.0
+    lo = 0.5 * (t[max(k - 1, 0)] - t[k])  # half-way to the neighbouring outputs,
+    hi = 0.5 * (t[min(k + 1, len(t) - 1)] - t[k])  # never beyond the run's ends
     ww = float(w[k] @ w[k])
-    tau = float(np.clip(-(d[k] @ w[k]) / ww, -half, half)) if ww > 0 else 0.0
+    tau = float(np.clip(-(d[k] @ w[k]) / ww, lo, hi)) if ww > 0 else 0.0
     closest = float(np.linalg.norm(d[k] + w[k] * tau))
     result.metrics[f"closest approach {an['body']}-{an['other']}"] = closest * u.au
     result.metrics["at time"] = ((t[k] + tau) * u.d).to(u.yr)

@@ -410,6 +410,8 @@ class Result:
     wall_time: float = 0.0
     complete: bool = True
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
+    writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
+                                                                repr=False)
 
     def summary(self) -> str:
         """The summary table as text (what the command prints)."""
@@ -475,7 +477,8 @@ class Result:
     def save(self, directory: str | Path) -> list[Path]:
         """Write the summary (Markdown, JSON), the figures (PNG) and the states (netCDF).
 
-        Returns the paths written.  The states file is netCDF-3 (scipy's writer),
+        A scene kind may add files (n-body scenes: the final state as a rebound
+        binary, ``final.bin``).  Returns the paths written.  The states file is netCDF-3 (scipy's writer),
         which xarray, netCDF4 and ``ncdump`` read.
         """
         out = Path(directory)
@@ -497,6 +500,8 @@ class Result:
                 plt.close(fig)
                 written.append(path)
         written.extend(self._save_states(out))
+        for writer in self.writers:
+            written.extend(writer(self, out))
         return written
 
     def _save_states(self, out: Path) -> list[Path]:
