@@ -478,8 +478,8 @@ class Result:
         """Write the summary (Markdown, JSON), the figures (PNG) and the states (netCDF).
 
         A scene kind may add files (n-body scenes: the final state as a rebound
-        binary, ``final.bin``).  Returns the paths written.  The states file is netCDF-3 (scipy's writer),
-        which xarray, netCDF4 and ``ncdump`` read.
+        binary, ``final.bin``).  Returns the paths written.  The states file is
+        netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.
         """
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
