@@ -511,8 +511,10 @@ def _crosscheck(scene: Scene) -> str:
     integ = spec["integrator"]
     table = crosscheck(system, spec["duration"], method=integ["method"],
                        effects=list(spec["effects"]))
-    rows = getattr(table, "rows", None)
-    return format_table(rows) if rows is not None else str(table)
+    return (
+        f"{scene.name}: hamilton-orbits {integ['method']} against {table.peer}, "
+        f"{spec['duration']}\n\n{format_table(table.rows)}\n\n{format_table(table.code_rows)}"
+    )
 
 
 register_kind(
