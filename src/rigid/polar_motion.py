@@ -12,16 +12,31 @@ is solved exactly by :class:`LiouvillePole`.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import astropy.units as u
 import numpy as np
+from astropy.table import QTable
+from astropy.time import Time
 from scipy.optimize import least_squares
 
+from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, TIME
 from rigid._kernels import liouville as _lk
 
-__all__ = ["EFFECTS", "LiouvillePole", "free_period", "register_effects"]
+__all__ = [
+    "EFFECTS",
+    "LiouvillePole",
+    "PolarMotionRecord",
+    "WobbleFit",
+    "fit_wobble",
+    "free_period",
+    "iers2010_mean_pole",
+    "load_c04",
+    "periodogram",
+    "register_effects",
+]
 
 
 def _harmonic_design(t: np.ndarray, freqs: np.ndarray, n_trend: int) -> np.ndarray:
@@ -467,3 +482,487 @@ def _builder(name: str):
 
 
 register_effects()
+
+
+# --------------------------------------------------------------------------
+# The observed record: IERS 20 C04 from astropy-iers-data, offline
+# --------------------------------------------------------------------------
+
+_C04_NAME = "eopc04.1962-now"
+
+
+@dataclass(frozen=True)
+class PolarMotionRecord:
+    """Observed polar motion (see :func:`load_c04`).
+
+    Attributes
+    ----------
+    time : astropy.time.Time, shape (n,)
+        Epochs (UTC, 0h of each day).
+    x, y : Quantity, shape (n,), arcsec
+        The pole coordinates x_p, y_p (IERS).
+    source : str
+        Where the record was read from.
+    """
+
+    time: Time
+    x: u.Quantity
+    y: u.Quantity
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.time, Time):
+            raise ValueError(f"Expected `time` to be an astropy Time, got {type(self.time)}")
+        n = len(self.time)
+        for name in ("x", "y"):
+            value = getattr(self, name)
+            if not isinstance(value, u.Quantity):
+                raise u.UnitConversionError(
+                    f"Expected `{name}` to be an angle Quantity (e.g. arcsec), got {value!r}"
+                )
+            arr = ANGLE(name, value, u.arcsec)
+            if arr.shape != (n,):
+                raise ValueError(f"Expected `{name}` of shape ({n},) like `time`, got {arr.shape}")
+            object.__setattr__(self, name, arr * u.arcsec)
+
+    @property
+    def m(self) -> u.Quantity:
+        """``m = m1 + i m2 = x_p - i y_p`` (IERS convention), complex Quantity (arcsec)."""
+        return (self.x.to_value(u.arcsec) - 1j * self.y.to_value(u.arcsec)) * u.arcsec
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def select(self, start: Any = None, end: Any = None) -> PolarMotionRecord:
+        """The part of the record with ``start <= time < end`` (Time, or decimal years)."""
+        yr = _decimal_year(self.time)
+        keep = np.ones(yr.shape, dtype=bool)
+        if start is not None:
+            keep &= yr >= _year("start", start)
+        if end is not None:
+            keep &= yr < _year("end", end)
+        if keep.sum() < 2:
+            raise ValueError(
+                f"Expected `start`, `end` to select at least 2 epochs of the record "
+                f"({yr[0]:.2f}-{yr[-1]:.2f}), got start={start!r}, end={end!r}"
+            )
+        return PolarMotionRecord(self.time[keep], self.x[keep], self.y[keep], self.source)
+
+
+def _days(time: Time) -> np.ndarray:
+    """UTC MJD: whole days between the 0h UTC epochs of the record (no scale change)."""
+    return np.asarray(time.utc.mjd if time.scale != "utc" else time.mjd, dtype=np.float64)
+
+
+def _decimal_year(time: Time) -> np.ndarray:
+    """Julian years from MJD (J2000 = MJD 51544.5); +-1 d from the calendar is harmless
+    for windows and decades."""
+    return 2000.0 + (_days(time) - 51544.5) / 365.25
+
+
+def _year(name: str, value: Any) -> float:
+    if isinstance(value, Time):
+        return float(_decimal_year(value))
+    if isinstance(value, u.Quantity):
+        return float(TIME(name, value, u.yr))
+    v = as_float_array(name, value)
+    if v.shape != ():
+        raise ValueError(f"Expected `{name}` to be a scalar, got shape {v.shape}")
+    return float(v)
+
+
+def load_c04(path: Any = None) -> PolarMotionRecord:
+    """Read the IERS 20 C04 polar motion that ships with ``astropy-iers-data``.
+
+    The file ``eopc04.1962-now`` (daily since 1962-01-01, columns x_p, y_p in
+    arcsec; Bizouard et al. 2019, J. Geodesy 93, 621) is found with
+    :mod:`importlib.resources` and parsed here; nothing is downloaded.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Another file in the same format (default: the bundled one).
+
+    Returns
+    -------
+    PolarMotionRecord
+
+    Examples
+    --------
+    >>> rec = load_c04()
+    >>> print(rec.time[0].iso[:10], rec.x.unit, len(rec) > 23000)
+    1962-01-01 arcsec True
+    """
+    if path is None:
+        from importlib.resources import files
+
+        path = files("astropy_iers_data") / "data" / _C04_NAME
+    with open(str(path)) as fh:
+        data = np.loadtxt(fh, comments="#", usecols=(4, 5, 6))
+    if data.ndim != 2 or data.shape[0] < 2:
+        raise ValueError(f"Expected `path` to hold a C04 table, got {data.shape} values")
+    time = Time(data[:, 0], format="mjd", scale="utc")
+    return PolarMotionRecord(time, data[:, 1] * u.arcsec, data[:, 2] * u.arcsec, str(path))
+
+
+# IERS Conventions (2010), sec. 7.1.4, eq. (7.25) and Table 7.7: the conventional mean
+# pole in mas, cubic before 2010.0 and linear after, tau = t - 2000.0 in years.
+_MEAN_POLE_2010 = {
+    "x_before": (55.974, 1.8243, 0.18413, 0.007024),
+    "y_before": (346.346, 1.7896, -0.10729, -0.000908),
+    "x_after": (23.513, 7.6141, 0.0, 0.0),
+    "y_after": (358.891, -0.6287, 0.0, 0.0),
+}
+
+
+def iers2010_mean_pole(time: Any) -> tuple[u.Quantity, u.Quantity]:
+    """The IERS 2010 conventional mean pole ``(x_bar, y_bar)`` in mas.
+
+    IERS Conventions (2010), eq. (7.25) with Table 7.7 (cubic until 2010.0,
+    linear after).
+
+    Examples
+    --------
+    >>> x, y = iers2010_mean_pole(Time("2000-01-01T12:00:00", scale="tt"))
+    >>> print(np.round(x, 3), np.round(y, 3))
+    55.974 mas 346.346 mas
+    """
+    if not isinstance(time, Time):
+        raise ValueError(f"Expected `time` to be an astropy Time, got {type(time).__name__}")
+    # tau in Julian years from J2000.0 (TT); the UTC-TT offset (~1 min) is irrelevant here
+    yr = _decimal_year(time)
+    tau = yr - 2000.0
+    before = yr < 2010.0
+    out = []
+    for c in ("x", "y"):
+        b = np.polynomial.polynomial.polyval(tau, _MEAN_POLE_2010[f"{c}_before"])
+        a = np.polynomial.polynomial.polyval(tau, _MEAN_POLE_2010[f"{c}_after"])
+        out.append(np.where(before, b, a) * u.mas)
+    return out[0], out[1]
+
+
+@dataclass(frozen=True)
+class WobbleFit:
+    """The least-squares wobble fit of :func:`fit_wobble`.
+
+    Periods and their errors are in days, amplitudes in mas, phases in degrees
+    (the argument of the complex amplitude at ``epoch``; prograde terms are
+    ``A exp(i (w (t - epoch) + phase))``, the retrograde annual term
+    ``A exp(-i (w (t - epoch)) + i phase)``).
+
+    ``rms_residual`` is per component (x or y) of the residual.  The errors are the
+    formal ones scaled by the residual scatter and by an
+    AR(1) effective sample size ``n (1 - rho) / (1 + rho)`` (``rho`` the lag-one
+    autocorrelation of the residuals, close to 1 for daily data).  The residuals
+    remain correlated over months (unmodelled excitation), so even these
+    errors are indicative, not rigorous.
+    """
+
+    chandler_period: u.Quantity
+    chandler_period_error: u.Quantity
+    chandler_period_error_formal: u.Quantity
+    annual_period: u.Quantity
+    annual_period_error: u.Quantity
+    chandler_amplitude: u.Quantity
+    chandler_phase: u.Quantity
+    annual_amplitude: u.Quantity
+    annual_phase: u.Quantity
+    annual_retrograde_amplitude: u.Quantity
+    annual_retrograde_phase: u.Quantity
+    mean_pole: u.Quantity
+    drift: u.Quantity
+    rms_residual: u.Quantity
+    residual_autocorrelation: float
+    epoch: Time
+    start: Time
+    end: Time
+    n: int
+    trend: str
+    amplitude_by_decade: QTable
+    q_estimate: float
+    q_caveat: str
+
+    def model(self, time: Time) -> u.Quantity:
+        """The fitted ``m(t)`` (complex, mas) at ``time``, trend included."""
+        t = _days(time) - float(self.epoch.mjd)
+        mean = self.mean_pole.to_value(u.mas) + self.drift.to_value(u.mas / u.yr) * t / 365.25
+        if self.trend == "iers2010":
+            xb, yb = iers2010_mean_pole(time)
+            mean = mean + xb.to_value(u.mas) - 1j * yb.to_value(u.mas)
+        wc = 2 * np.pi / self.chandler_period.to_value(u.day)
+        wa = 2 * np.pi / self.annual_period.to_value(u.day)
+
+        def c(a, p):
+            return a.to_value(u.mas) * np.exp(1j * p.to_value(u.rad))
+
+        return (mean + c(self.chandler_amplitude, self.chandler_phase) * np.exp(1j * wc * t)
+                + c(self.annual_amplitude, self.annual_phase) * np.exp(1j * wa * t)
+                + c(self.annual_retrograde_amplitude, self.annual_retrograde_phase)
+                * np.exp(-1j * wa * t)) * u.mas
+
+
+def _wobble_resid(x, t, m, n_trend):
+    """Residuals and Jacobian of the model for real parameters
+    x = [w_c, w_a, Re/Im of (trend..., chandler, annual+, annual-)]."""
+    wc, wa = x[0], x[1]
+    coef = x[2::2] + 1j * x[3::2]
+    design = _harmonic_design(t, np.array([wc, wa, -wa]), n_trend)
+    r = m - design @ coef
+    n_c = n_trend
+    jac_c = np.empty((t.size, x.size), dtype=np.complex128)
+    jac_c[:, 0] = -coef[n_c] * 1j * t * design[:, n_c]
+    jac_c[:, 1] = -(coef[n_c + 1] * 1j * t * design[:, n_c + 1]
+                    - coef[n_c + 2] * 1j * t * design[:, n_c + 2])
+    jac_c[:, 2::2] = -design
+    jac_c[:, 3::2] = -1j * design
+    return r, jac_c
+
+
+def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: float):
+    """Nonlinear least squares; returns (x, covariance (scaled), residual, rho, rms)."""
+    # start: the highest prograde line within +-10% of the guess, once the trend and the
+    # annual terms are removed (one matrix product instead of a nonlinear search)
+    _, detrended = _project(t, m, 2 * np.pi / np.array([t_a0, -t_a0]), n_trend)
+    grid = np.linspace(0.9 * t_c0, 1.1 * t_c0, 161)
+    amp = np.abs(np.exp(-2j * np.pi * np.outer(1.0 / grid, t)) @ detrended)
+    tc = float(grid[int(np.argmax(amp))])
+    freqs = 2 * np.pi / np.array([tc, t_a0, -t_a0])
+    coef, _ = _project(t, m, freqs, n_trend)
+    x0 = np.concatenate([[freqs[0], freqs[1]], np.column_stack([coef.real, coef.imag]).ravel()])
+
+    def fun(x):
+        r, _ = _wobble_resid(x, t, m, n_trend)
+        return np.concatenate([r.real, r.imag])
+
+    def jac(x):
+        _, j = _wobble_resid(x, t, m, n_trend)
+        return np.concatenate([j.real, j.imag])
+
+    scale = np.concatenate([[1e-4 * freqs[0], 1e-4 * freqs[1]],
+                            np.full(x0.size - 2, max(np.std(np.abs(m)), 1e-300))])
+    sol = least_squares(fun, x0, jac=jac, x_scale=scale, xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                        method="lm")
+    r, jc = _wobble_resid(sol.x, t, m, n_trend)
+    jr = np.concatenate([jc.real, jc.imag])
+    dof = 2 * t.size - sol.x.size
+    s2 = float(np.sum(np.abs(r) ** 2)) / dof
+    cov = np.linalg.inv(jr.T @ jr) * s2
+    rc = r - r.mean()
+    rho = float(np.real(np.vdot(rc[:-1], rc[1:])) / np.real(np.vdot(rc, rc)))
+    return sol.x, cov, r, rho, np.sqrt(s2)
+
+
+def _amp_phase(c: complex) -> tuple[u.Quantity, u.Quantity]:
+    return abs(c) * u.mas, (np.degrees(np.angle(c)) * u.deg)
+
+
+def fit_wobble(
+    record: PolarMotionRecord,
+    start: Any = None,
+    end: Any = None,
+    *,
+    trend: str = "linear",
+    chandler_guess: Any = 433 * u.day,
+) -> WobbleFit:
+    """Fit the Chandler and annual wobbles to an observed pole path.
+
+    Model (complex, ``m = x_p - i y_p``, mas, ``t`` in days from the window's
+    mid epoch)::
+
+        m(t) = mean + drift t + c_C exp(i w_C t) + c_A exp(i w_A t) + c_R exp(-i w_A t)
+
+    with ``mean + drift t`` a linear trend (``trend="linear"``), or the IERS 2010
+    mean pole (``trend="iers2010"``, IERS Conventions 2010 eq. 7.25) plus a
+    constant offset.  ``w_C`` and ``w_A`` are fitted nonlinearly (Levenberg-
+    Marquardt, scipy ``least_squares``, from a grid search of ``w_C`` with the
+    linear parameters projected out).
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+        From :func:`load_c04`.
+    start, end : Time, decimal year or None
+        The window (default: the whole record).
+    trend : {"linear", "iers2010"}
+    chandler_guess : Quantity
+        Centre of the grid search (+-10%).
+
+    Returns
+    -------
+    WobbleFit
+        Also ``amplitude_by_decade`` (the Chandler and annual amplitudes fitted per
+        calendar decade with the periods of the whole window held fixed) and a Q
+        estimate with its caveat.
+
+    Examples
+    --------
+    >>> fit = fit_wobble(load_c04(), 1970, 2010)
+    >>> print(round(fit.chandler_period.to_value(u.day)), round(fit.annual_period.to_value(u.day)))
+    433 365
+    """
+    if not isinstance(record, PolarMotionRecord):
+        raise ValueError(f"Expected `record` from load_c04(), got {type(record).__name__}")
+    if trend not in ("linear", "iers2010"):
+        raise ValueError(f"Expected `trend` 'linear' or 'iers2010', got {trend!r}")
+    rec = record.select(start, end)
+    t_c0 = float(_positive_scalar("chandler_guess", TIME("chandler_guess", chandler_guess,
+                                                         u.day)))
+    days = _days(rec.time)
+    mid = 0.5 * (days[0] + days[-1])
+    epoch = Time(mid, format="mjd", scale="utc")
+    t = days - mid
+    span = float(t[-1] - t[0])
+    if span < 3 * t_c0:
+        raise ValueError(
+            f"Expected a window of at least 3 Chandler periods ({3 * t_c0:.0f} d) to separate "
+            f"the Chandler and annual terms, got {span:.0f} d"
+        )
+    m = rec.m.to_value(u.mas)
+    n_trend = 2
+    if trend == "iers2010":
+        xb, yb = iers2010_mean_pole(rec.time)
+        m = m - (xb.to_value(u.mas) - 1j * yb.to_value(u.mas))
+        n_trend = 1
+    x, cov, _r, rho, rms = _fit_core(t, m, n_trend, t_c0, 365.25)
+    wc, wa = x[0], x[1]
+    coef = x[2::2] + 1j * x[3::2]
+    inflate = np.sqrt((1 + rho) / (1 - rho)) if rho < 1 else np.inf
+    err_wc = np.sqrt(cov[0, 0])
+    err_wa = np.sqrt(cov[1, 1])
+    t_c = 2 * np.pi / wc
+    t_a = 2 * np.pi / wa
+    ca, cp = _amp_phase(coef[n_trend])
+    aa, ap = _amp_phase(coef[n_trend + 1])
+    ra, rp = _amp_phase(coef[n_trend + 2])
+    drift = (coef[1] * 365.25 if n_trend == 2 else 0j) * u.mas / u.yr
+    decades = _amplitude_by_decade(rec, wc, wa)
+    q, caveat = _q_estimate(rec, t_c)
+    return WobbleFit(
+        chandler_period=t_c * u.day,
+        chandler_period_error=t_c * err_wc / wc * inflate * u.day,
+        chandler_period_error_formal=t_c * err_wc / wc * u.day,
+        annual_period=t_a * u.day,
+        annual_period_error=t_a * err_wa / wa * inflate * u.day,
+        chandler_amplitude=ca, chandler_phase=cp,
+        annual_amplitude=aa, annual_phase=ap,
+        annual_retrograde_amplitude=ra, annual_retrograde_phase=rp,
+        mean_pole=coef[0] * u.mas, drift=drift,
+        rms_residual=rms * u.mas,
+        residual_autocorrelation=rho,
+        epoch=epoch, start=rec.time[0], end=rec.time[-1], n=len(rec), trend=trend,
+        amplitude_by_decade=decades, q_estimate=q, q_caveat=caveat,
+    )
+
+
+def _amplitude_by_decade(rec: PolarMotionRecord, wc: float, wa: float) -> QTable:
+    """Chandler and annual amplitudes per calendar decade, periods held fixed."""
+    yr = _decimal_year(rec.time)
+    rows = []
+    first = int(np.floor(yr[0] / 10.0) * 10)
+    for dec in range(first, int(yr[-1]) + 1, 10):
+        sel = (yr >= dec) & (yr < dec + 10)
+        if sel.sum() < 2 * 365:  # under two years: the terms cannot be separated
+            continue
+        sub = PolarMotionRecord(rec.time[sel], rec.x[sel], rec.y[sel])
+        days = _days(sub.time)
+        t = days - 0.5 * (days[0] + days[-1])
+        coef, _ = _project(t, sub.m.to_value(u.mas), np.array([wc, wa, -wa]), 2)
+        rows.append((dec, float(yr[sel][0]), float(yr[sel][-1]), abs(coef[2]), abs(coef[3]),
+                     abs(coef[4])))
+    cols = list(zip(*rows, strict=True)) if rows else [[]] * 6
+    return QTable(
+        [np.array(cols[0], dtype=int), np.array(cols[1]) * u.yr, np.array(cols[2]) * u.yr,
+         np.array(cols[3]) * u.mas, np.array(cols[4]) * u.mas, np.array(cols[5]) * u.mas],
+        names=("decade", "from", "to", "chandler_amplitude", "annual_amplitude",
+               "annual_retrograde_amplitude"),
+    )
+
+
+def _q_estimate(rec: PolarMotionRecord, t_c: float) -> tuple[float, str]:
+    """Q from the half-power width of the Chandler line (resolution limited)."""
+    days = _days(rec.time)
+    years = (days[-1] - days[0]) / 365.25
+    f_c = 365.25 / t_c
+    freqs = np.linspace(f_c - 0.04, f_c + 0.04, 161)
+    pg = periodogram(rec, freqs / u.yr)
+    power = pg["amplitude"].to_value(u.mas) ** 2
+    k = int(np.argmax(power))
+    half = power[k] / 2
+    lo = k
+    while lo > 0 and power[lo] > half:
+        lo -= 1
+    hi = k
+    while hi < power.size - 1 and power[hi] > half:
+        hi += 1
+    fwhm = float(freqs[hi] - freqs[lo])
+    q = f_c / fwhm
+    caveat = (
+        f"Q = f_C / FWHM of the Chandler line = {q:.0f}.  The window's own resolution "
+        f"({1 / years:.3f} cycles/yr over {years:.1f} yr) limits the width, so this is of "
+        "the order of the largest Q the record can resolve, not a measurement of the "
+        "damping: the wobble is re-excited continuously (atmosphere, ocean, hydrology), so a "
+        "line width mixes damping and excitation.  Published estimates range from ~50 to "
+        "~200 (e.g. Wilson & Vicente 1990, GJI 102, 29: Q ~ 179; Furuya & Chao 1996, GJI "
+        "127, 693: Q ~ 49-250)."
+    )
+    return q, caveat
+
+
+def periodogram(
+    record: PolarMotionRecord, frequency: Any = None, *, trend: str = "linear"
+) -> QTable:
+    """The complex (two-sided) amplitude spectrum of the pole path.
+
+    ``A(f) = |(1/n) sum_k (m_k - trend_k) exp(-2 pi i f t_k)|`` (mas), ``f`` in
+    cycles per year: positive ``f`` is prograde, negative retrograde.  For a pure
+    term ``a exp(2 pi i f0 t)``, ``A(f0) = |a|``.
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+    frequency : Quantity, optional
+        Frequencies (1/yr, 1/day ...); default -1.5 .. 1.5 cycles/yr, 1201 points.
+    trend : {"linear", "iers2010"}
+        What is removed first (a least-squares line, or the IERS 2010 mean pole).
+
+    Returns
+    -------
+    astropy.table.QTable
+        Columns ``frequency`` (1/yr), ``period`` (d, signed) and ``amplitude`` (mas).
+
+    Examples
+    --------
+    >>> pg = periodogram(load_c04(), np.linspace(0.8, 0.9, 101) / u.yr)
+    >>> print(f'{pg["period"][np.argmax(pg["amplitude"])]:.0f}')  # the Chandler line
+    432 d
+    """
+    if not isinstance(record, PolarMotionRecord):
+        raise ValueError(f"Expected `record` from load_c04(), got {type(record).__name__}")
+    if frequency is None:
+        f = np.linspace(-1.5, 1.5, 1201)
+    else:
+        if not isinstance(frequency, u.Quantity):
+            raise u.UnitConversionError(
+                f"Expected `frequency` to be a Quantity of 1/time, got {frequency!r}"
+            )
+        f = as_float_array("frequency", frequency.to_value(1 / u.yr))
+    days = _days(record.time)
+    t = (days - days[0]) / 365.25
+    m = record.m.to_value(u.mas)
+    if trend == "iers2010":
+        xb, yb = iers2010_mean_pole(record.time)
+        m = m - (xb.to_value(u.mas) - 1j * yb.to_value(u.mas))
+        m = m - m.mean()
+    elif trend == "linear":
+        _coef, m = _project(t, m, np.zeros(0), 2)
+    else:
+        raise ValueError(f"Expected `trend` 'linear' or 'iers2010', got {trend!r}")
+    amp = np.empty(f.size)
+    chunk = max(1, 2_000_000 // max(t.size, 1))
+    for i in range(0, f.size, chunk):  # chunks of frequencies, vectorised over time
+        fs = f[i:i + chunk]
+        amp[i:i + chunk] = np.abs(np.exp(-2j * np.pi * np.outer(fs, t)) @ m) / t.size
+    with np.errstate(divide="ignore"):
+        period = np.where(f != 0, 365.25 / np.where(f != 0, f, 1.0), np.inf)
+    return QTable([f / u.yr, period * u.day, amp * u.mas],
+                 names=("frequency", "period", "amplitude"))
