@@ -63,7 +63,7 @@ def main(argv: list[str] | None = None) -> str:
         ("C / (M R^2)", f"{float((c / (earth.mass() * earth.R_EQ**2)).decompose()):.5f}", ""),
         ("(B - A) / C", f"{float((b - a) / c):.3e}", ""),
         ("Euler period, linear (triaxial)", f"{t_e.to_value(u.day):.6f}", "d"),
-        ("Euler period, linear (triaxial)", f"{float(t_e / sidereal):.6f}", "sidereal d"),
+        ("Euler period in sidereal days", f"{float(t_e / sidereal):.6f}", "sidereal d"),
         ("Euler period, axisymmetric", f"{earth.euler_period().to_value(u.day):.6f}", "d"),
         ("period fitted, splitting4", f"{p_split.to_value(u.day):.6f}", "d"),
         ("period fitted, exact free motion", f"{p_exact.to_value(u.day):.6f}", "d"),
