@@ -723,20 +723,28 @@ def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: flo
     # start: the highest prograde line within +-10% of the guess, once the trend and the
     # annual terms are removed (one matrix product instead of a nonlinear search)
     _, detrended = _project(t, m, 2 * np.pi / np.array([t_a0, -t_a0]), n_trend)
-    grid = np.linspace(0.9 * t_c0, 1.1 * t_c0, 161)
+    grid = np.linspace(0.9 * t_c0, 1.1 * t_c0, 61)  # 0.33% steps; the line is ~2% wide
     amp = np.abs(np.exp(-2j * np.pi * np.outer(1.0 / grid, t)) @ detrended)
     tc = float(grid[int(np.argmax(amp))])
     freqs = 2 * np.pi / np.array([tc, t_a0, -t_a0])
     coef, _ = _project(t, m, freqs, n_trend)
     x0 = np.concatenate([[freqs[0], freqs[1]], np.column_stack([coef.real, coef.imag]).ravel()])
 
+    cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    def evaluate(x):  # fun and jac at the same x share one evaluation
+        key = x.tobytes()
+        if key not in cache:
+            cache.clear()
+            r, j = _wobble_resid(x, t, m, n_trend)
+            cache[key] = (np.concatenate([r.real, r.imag]), np.concatenate([j.real, j.imag]))
+        return cache[key]
+
     def fun(x):
-        r, _ = _wobble_resid(x, t, m, n_trend)
-        return np.concatenate([r.real, r.imag])
+        return evaluate(x)[0]
 
     def jac(x):
-        _, j = _wobble_resid(x, t, m, n_trend)
-        return np.concatenate([j.real, j.imag])
+        return evaluate(x)[1]
 
     scale = np.concatenate([[1e-4 * freqs[0], 1e-4 * freqs[1]],
                             np.full(x0.size - 2, max(np.std(np.abs(m)), 1e-300))])
@@ -883,7 +891,7 @@ def _q_estimate(rec: PolarMotionRecord, t_c: float) -> tuple[float, str]:
     days = _days(rec.time)
     years = (days[-1] - days[0]) / 365.25
     f_c = 365.25 / t_c
-    freqs = np.linspace(f_c - 0.04, f_c + 0.04, 161)
+    freqs = np.linspace(f_c - 0.04, f_c + 0.04, 81)
     pg = periodogram(rec, freqs / u.yr)
     power = pg["amplitude"].to_value(u.mas) ** 2
     k = int(np.argmax(power))
