@@ -176,9 +176,13 @@ def _cexpm1(w: np.ndarray) -> np.ndarray:
 
 def _phi1(w: np.ndarray) -> np.ndarray:
     """``(exp(w) - 1) / w`` (1 at w = 0)."""
-    out = np.ones_like(w)
-    nz = w != 0
-    out[nz] = _cexpm1(w[nz]) / w[nz]
+    w = np.asarray(w, dtype=np.complex128)
+    small = np.abs(w) < 1e-5  # series: the next term w^3/24 is below one ulp
+    ws = w[small]
+    out = np.empty_like(w)
+    out[small] = 1.0 + ws * (0.5 + ws / 6.0)
+    wl = w[~small]
+    out[~small] = _cexpm1(wl) / wl
     return out
 
 
@@ -391,17 +395,26 @@ class LiouvillePole:
             start = float(t0a)
         sig = self.sigma
         tau = tt - start
-        decay = np.exp(1j * sig * tau)
-        m = decay * complex(m0c)
-        for c, w, ep in self._sinusoids:
-            if c == 0:
-                continue
-            # -i sig c int_t0^t exp(i sig (t - s)) exp(i w (s - ep)) ds
-            #   = -i sig c exp(i w (t - ep)) tau phi1(i (sig - w) tau)
-            z = 1j * (sig - w) * tau
-            m = m - 1j * sig * c * np.exp(1j * w * (tt - ep)) * tau * _phi1(np.asarray(z))
-        if self._series is not None:
-            m = m + self._series_response(tt, start)
+        with np.errstate(over="ignore", invalid="ignore"):
+            decay = np.exp(1j * sig * tau)
+            m = decay * complex(m0c)
+            for c, w, ep in self._sinusoids:
+                if c == 0:
+                    continue
+                # -i sig c int_t0^t exp(i sig (t - s)) exp(i w (s - ep)) ds
+                #   = -i sig c exp(i w (t - ep)) tau phi1(i (sig - w) tau)
+                z = 1j * (sig - w) * tau
+                m = m - 1j * sig * c * np.exp(1j * w * (tt - ep)) * tau * _phi1(z)
+            if self._series is not None:
+                m = m + self._series_response(tt, start)
+        bad = ~np.isfinite(m)
+        if np.any(bad):
+            k = np.argwhere(np.atleast_1d(bad))[0][0]
+            raise ValueError(
+                f"Expected `t` within reach of t0 = {start!r} d (a damped wobble run "
+                f"backwards grows as exp(|t - t0| / tau)), got {float(np.atleast_1d(tt)[k])!r}"
+                f"{f' at index {k}' if tt.ndim else ''}: the pole overflows"
+            )
         if quantity:
             return u.Quantity(m, u.rad).to(m0.unit)
         return m

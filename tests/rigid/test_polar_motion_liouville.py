@@ -5,6 +5,8 @@ import itertools
 import astropy.units as u
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from hamilton_orbits import effects
@@ -147,3 +149,35 @@ def test_effects_are_registered_as_rotation_effects():
         assert spec.kind == "rotation" and spec.reference
     model = effects.get("rotation", "damping").build(Q=50)
     assert model.effects == ("free", "damping") and model.q_inv == 1 / 50
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    q=st.floats(20.0, 1e4),
+    t1=st.floats(0.0, 3000.0),
+    t2=st.floats(0.0, 3000.0),
+    phase=st.floats(-np.pi, np.pi),
+)
+def test_propagator_composes_and_superposes(q, t1, t2, phase):
+    """m(t0 -> t2) = m(t1 -> t2) o m(t0 -> t1) (the exact flow is a semigroup), and the
+    forced solution is the free one plus the response to chi from m0 = 0 (linearity)."""
+    t1, t2 = sorted((t1, t2))
+    chi_p = 30 * MAS * np.exp(1j * phase)
+    kw = {"chandler_period": 433.0, "Q": q, "annual_prograde": chi_p,
+          "annual_retrograde": 0.1 * chi_p}
+    model = LiouvillePole(("elastic", "damping", "annual_excitation"), **kw)
+    m0 = 100 * MAS * np.exp(-1j * phase)
+    direct = model.solve(np.array([t2]), m0, t0=0.0)[0]
+    mid = model.solve(np.array([t1]), m0, t0=0.0)[0]
+    composed = model.solve(np.array([t2]), mid, t0=t1)[0]
+    scale = abs(m0) + 10 * abs(chi_p)
+    assert abs(direct - composed) < 1e-13 * scale
+    free = LiouvillePole(("elastic", "damping"), chandler_period=433.0, Q=q)
+    forced0 = model.solve(np.array([t2]), 0.0, t0=0.0)[0]
+    assert abs(direct - (free.solve(np.array([t2]), m0, t0=0.0)[0] + forced0)) < 1e-13 * scale
+
+
+def test_overflow_backwards_raises_instead_of_inf():
+    model = LiouvillePole(("damping",), Q=1.0)
+    with pytest.raises(ValueError, match="overflows"):
+        model.solve([1e6, -1e6], 1e-6)
