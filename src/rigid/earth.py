@@ -302,7 +302,14 @@ class PolePath:
         return (-self.m.imag * u.rad).to(u.arcsec)
 
     def period(self) -> u.Quantity:
-        """The wobble period fitted to the path (see :func:`rigid.polar_motion.free_period`)."""
+        """The wobble period fitted to the path (see :func:`rigid.polar_motion.free_period`).
+
+        Examples
+        --------
+        >>> path = simulate_wobble(2 * u.yr, method="exact", triaxial=False)
+        >>> bool(abs(path.period() / euler_period() - 1) < 1e-10)
+        True
+        """
         from rigid.polar_motion import free_period
 
         return free_period(self.t, self.m)

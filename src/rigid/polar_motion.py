@@ -347,7 +347,13 @@ class LiouvillePole:
                 f"Q={'inf' if self.q_inv == 0 else 1 / self.q_inv!r})")
 
     def excitation(self, t: Any) -> np.ndarray:
-        """The model's ``chi(t)`` in radians (zero without forcing effects)."""
+        """The model's ``chi(t)`` in radians (zero without forcing effects).
+
+        Examples
+        --------
+        >>> LiouvillePole(("annual_excitation",), annual_prograde=1e-7).excitation([0.0])
+        array([1.e-07+0.j])
+        """
         tt = TIME("t", t, u.day)
         chi = np.zeros(tt.shape, dtype=np.complex128)
         for c, w, ep in self._sinusoids:
@@ -358,7 +364,14 @@ class LiouvillePole:
         return chi
 
     def rhs(self, t: float, m: complex) -> complex:
-        """``dm/dt = i sigma_c (m - chi(t))`` (rad/day; for checks with an ODE solver)."""
+        """``dm/dt = i sigma_c (m - chi(t))`` (rad/day; for checks with an ODE solver).
+
+        Examples
+        --------
+        >>> model = LiouvillePole(("elastic",), chandler_period=433.0)
+        >>> bool(abs(model.rhs(0.0, 1e-6) - 2j * np.pi / 433.0 * 1e-6) < 1e-22)
+        True
+        """
         return 1j * self.sigma * (m - complex(self.excitation(t)))
 
     def solve(self, t: Any, m0: Any, t0: Any = None) -> Any:
@@ -379,6 +392,19 @@ class LiouvillePole:
         -------
         ndarray (complex) or complex Quantity, shape t.shape
             In the unit of ``m0`` if it was a Quantity, else radians.
+
+        Raises
+        ------
+        ValueError
+            For a non-scalar ``m0`` or ``t0``, times outside an excitation series,
+            or a backward run of a damped model so long that the pole overflows.
+
+        Examples
+        --------
+        >>> model = LiouvillePole(("elastic",), chandler_period=400 * u.day)
+        >>> m = model.solve([0, 100, 200] * u.day, 0.1 * u.arcsec)  # quarter turns
+        >>> print(np.round(m.real, 12) + 0.0, np.round(m.imag, 12) + 0.0)
+        [ 0.1  0.  -0.1] arcsec [0.  0.1 0. ] arcsec
         """
         tt = TIME("t", t, u.day)
         m0c, quantity = _complex_angle("m0", m0)
@@ -547,7 +573,13 @@ class PolarMotionRecord:
         return len(self.x)
 
     def select(self, start: Any = None, end: Any = None) -> PolarMotionRecord:
-        """The part of the record with ``start <= time < end`` (Time, or decimal years)."""
+        """The part of the record with ``start <= time < end`` (Time, or decimal years).
+
+        Examples
+        --------
+        >>> print(load_c04().select(2000, 2001).time[0].iso[:10])
+        2000-01-01
+        """
         yr = _decimal_year(self.time)
         keep = np.ones(yr.shape, dtype=bool)
         if start is not None:
@@ -568,9 +600,10 @@ def _days(time: Time) -> np.ndarray:
 
 
 def _decimal_year(time: Time) -> np.ndarray:
-    """Julian years from MJD (J2000 = MJD 51544.5); +-1 d from the calendar is harmless
-    for windows and decades."""
-    return 2000.0 + (_days(time) - 51544.5) / 365.25
+    """Years of 365.25 d counted from 2000-01-01 0h UTC (MJD 51544): 0h on 1 January
+    falls on or just after the integer year from 1901 to 2099, so ``start=1970`` keeps
+    1970-01-01 and ``end=2010`` drops 2010-01-01."""
+    return 2000.0 + (_days(time) - 51544.0) / 365.25
 
 
 def _year(name: str, value: Any) -> float:
@@ -642,10 +675,10 @@ def iers2010_mean_pole(time: Any) -> tuple[u.Quantity, u.Quantity]:
     """
     if not isinstance(time, Time):
         raise ValueError(f"Expected `time` to be an astropy Time, got {type(time).__name__}")
-    # tau in Julian years from J2000.0 (TT); the UTC-TT offset (~1 min) is irrelevant here
-    yr = _decimal_year(time)
-    tau = yr - 2000.0
-    before = yr < 2010.0
+    # tau in Julian years from J2000.0 (MJD 51544.5); the UTC-TT offset (~1 min) is
+    # irrelevant at the mas level
+    tau = (_days(time) - 51544.5) / 365.25
+    before = tau < 10.0
     out = []
     for c in ("x", "y"):
         b = np.polynomial.polynomial.polyval(tau, _MEAN_POLE_2010[f"{c}_before"])
@@ -696,7 +729,16 @@ class WobbleFit:
     q_caveat: str
 
     def model(self, time: Time) -> u.Quantity:
-        """The fitted ``m(t)`` (complex, mas) at ``time``, trend included."""
+        """The fitted ``m(t)`` (complex, mas) at ``time``, trend included.
+
+        Examples
+        --------
+        >>> rec = load_c04().select(1980, 2000)
+        >>> fit = fit_wobble(rec)
+        >>> res = rec.m - fit.model(rec.time)
+        >>> bool(np.sqrt(np.mean(np.abs(res) ** 2) / 2) < 1.01 * fit.rms_residual)
+        True
+        """
         t = _days(time) - float(self.epoch.mjd)
         mean = self.mean_pole.to_value(u.mas) + self.drift.to_value(u.mas / u.yr) * t / 365.25
         if self.trend == "iers2010":
