@@ -181,3 +181,17 @@ def test_overflow_backwards_raises_instead_of_inf():
     model = LiouvillePole(("damping",), Q=1.0)
     with pytest.raises(ValueError, match="overflows"):
         model.solve([1e6, -1e6], 1e-6)
+
+
+def test_entry_point_declared_for_the_registry():
+    """hamilton_orbits finds the rotation effects through its entry-point group, not an
+    import of rigid (DESIGN.md): the declared target exists and registers them."""
+    import importlib
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "pyproject.toml").read_text()
+    section = text.split('[project.entry-points."hamilton_orbits.effects"]')[1].split("\n[")[0]
+    module, func = re.search(r'^rigid = "([\w.]+):(\w+)"', section, flags=re.M).groups()
+    getattr(importlib.import_module(module), func)()
+    assert set(EFFECTS) <= set(effects.known("rotation"))
