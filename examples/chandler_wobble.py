@@ -15,7 +15,7 @@ amplitude per decade).
 
 Writes <out>/chandler_wobble.png and <out>/chandler_wobble.txt.
 Run: python examples/chandler_wobble.py [out_dir] [--quick]
-(--quick uses 1970-2010 and a coarser periodogram).
+(--quick uses 1980-2010 and a coarser periodogram).
 """
 
 from __future__ import annotations
@@ -40,13 +40,13 @@ def main(argv: list[str] | None = None) -> str:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", nargs="?", default=str(Path(__file__).parent / "out"),
                         help="output directory (default examples/out)")
-    parser.add_argument("--quick", action="store_true", help="1970-2010, coarser spectrum")
+    parser.add_argument("--quick", action="store_true", help="1980-2010, coarser spectrum")
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
 
     record = load_c04()
-    start, end = (1970, 2010) if args.quick else (None, None)
+    start, end = (1980, 2010) if args.quick else (None, None)
     fit = fit_wobble(record, start, end)
     rec = record.select(start, end)
 
@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> str:
     m_obs = rec.m.to(u.mas) - trend
     m_model = model.solve(t * u.day, m_obs[0])
 
-    n_f = 601 if args.quick else 1501
+    n_f = 301 if args.quick else 1501
     pg = periodogram(rec, np.linspace(-1.5, 1.5, n_f) / u.yr)
 
     table = fit.amplitude_by_decade
