@@ -47,3 +47,26 @@ def test_elements_crosscheck_quick():
     # the hard cases where rebound returns NaN (radial orbits among them) are listed
     nan_rows = [x for x in lines if "radial bound" in x and " nan " in f" {x} "]
     assert nan_rows
+
+
+def test_pole_wander_rigid_earth_quick(tmp_path):
+    """The integrated rigid-Earth wobble has the linear Euler period (~304.5 sidereal d)."""
+    out = run("pole_wander_rigid_earth.py", str(tmp_path), "--quick")
+    value = {m[0].strip(): float(m[1]) for m in re.findall(r"^(.+?)\s{2,}([-\d.e+]+)\s", out,
+                                                           flags=re.M)}
+    t_e = value["Euler period, linear (triaxial)"]
+    assert abs(value["period fitted, splitting4"] / t_e - 1) < 1e-9
+    assert abs(value["period fitted, exact free motion"] / t_e - 1) < 1e-9
+    assert 304.4 < float(re.search(r"([\d.]+)\s+sidereal d", out).group(1)) < 304.5
+    assert (tmp_path / "pole_wander_rigid_earth.png").stat().st_size > 10_000
+
+
+def test_chandler_wobble_quick(tmp_path):
+    """The fitted Chandler period is within the published 430-436 d (Wilson & Vicente 1990)."""
+    out = run("chandler_wobble.py", str(tmp_path), "--quick")
+    t_c = float(re.search(r"^Chandler period\s+([\d.]+) \+- ([\d.]+)\s+d", out,
+                          flags=re.M).group(1))
+    assert 430 < t_c < 436
+    assert "Q caveat" in out
+    assert (tmp_path / "chandler_wobble.png").stat().st_size > 10_000
+    assert (tmp_path / "chandler_wobble.txt").read_text().startswith("window")

@@ -4,6 +4,7 @@ Cayley (1843) and Sylvester (1866) made executable.  The curated public API.
 """
 
 
+from rigid import earth, polar_motion  # noqa: F401  (submodules: rigid.earth, ...)
 from rigid.body import RigidBody
 from rigid.free import FreeParameters, free_motion, free_motion_arrays, free_parameters
 from rigid.integrators import (
