@@ -239,5 +239,8 @@ KIND = SceneKind(
 
 
 def register() -> None:
-    """Register the ``rotation`` scene kind (entry point ``hamilton_orbits.scene_kinds``)."""
+    """Register the ``rotation`` and ``polar_motion`` scene kinds (entry point)."""
+    from rigid import scene_polar
+
     register_kind(KIND)
+    scene_polar.register()
