@@ -181,11 +181,20 @@ def _flip_time(result: Result, omega: np.ndarray, t: u.Quantity, par) -> None:
 
 
 def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) -> None:
-    """Period of the spin axis about the figure axis in the body frame."""
-    phase = np.unwrap(np.arctan2(omega[:, 1], omega[:, 0]))
+    """Period of the spin axis about the figure axis in the body frame.
+
+    From the upward zero crossings of ``omega_1`` (linear interpolation between
+    outputs): the path is an ellipse for a triaxial body, so its polar angle does
+    not advance uniformly, but it crosses each axis once per period.
+    """
     ts = t.to_value(u.d)
-    rate = np.polyfit(ts - ts.mean(), phase, 1)[0]
-    measured = 2 * np.pi / abs(rate) * u.d
+    w1 = omega[:, 0]
+    k = np.flatnonzero((w1[:-1] < 0) & (w1[1:] >= 0))
+    if k.size < 2:
+        result.metrics["simulated wobble period"] = "less than one full turn in the run"
+        return
+    crossings = ts[k] - w1[k] * (ts[k + 1] - ts[k]) / (w1[k + 1] - w1[k])
+    measured = (crossings[-1] - crossings[0]) / (crossings.size - 1) * u.d
     result.metrics["simulated wobble period"] = measured
     result.metrics["exact free-motion period"] = (par.period * u.s).to(u.d)
     if spec["body"]["preset"] == "earth":
