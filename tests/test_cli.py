@@ -67,3 +67,32 @@ def test_bad_scene_and_setting(capsys):
     assert "no-such-scene" in capsys.readouterr().err
     assert main(["run", "solar-system", "--set", "duration=2 m", "--no-progress"]) == 2
     assert "duration" in capsys.readouterr().err
+
+
+def _cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "hamilton_orbits.cli", *args],
+                          capture_output=True, text=True, cwd=cwd, timeout=600)
+
+
+def test_cli_end_to_end_in_a_subprocess(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('kind = "nbody"\nduraton = "1 yr"\n')
+    res = _cli("run", str(bad), "--no-progress")
+    assert res.returncode == 2
+    assert "bad.toml: duraton: unknown key" in res.stderr
+    res = _cli("run", "leo-j2", "--set", "duration=0.5 d", "--out", str(tmp_path / "leo"),
+               "--no-progress")
+    assert res.returncode == 0, res.stderr
+    assert "simulated: 0.5 d" in res.stdout
+    written = sorted(p.name for p in (tmp_path / "leo").iterdir())
+    assert written == ["energy_error.png", "final.bin", "orbits.png", "states.nc",
+                       "summary.json", "summary.md"]
+    res = _cli("crosscheck", "dzhanibekov")
+    assert res.returncode == 0, res.stderr
+    assert "against the exact free motion" in res.stdout
+
+
+def test_crosscheck_command_on_an_nbody_scene(capsys):
+    assert main(["crosscheck", "leo-j2", "--set", "duration=0.2 d"]) == 0
+    out = capsys.readouterr().out
+    assert "rebound ias15 + reboundx" in out and "satellite" in out
