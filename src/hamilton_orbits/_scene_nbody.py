@@ -81,6 +81,7 @@ SCHEMA: dict[str, S.Field] = {
                 }
             ),
             "rebound": S.String(),
+            "names": S.Array(item=S.String()),
         },
     ),
     "bodies": S.Array(item=BODY, default=[]),
@@ -106,18 +107,23 @@ def _rebound_names(path: str) -> list[str]:
     """Names of the particles in a rebound binary (``body<k>`` for unnamed ones)."""
     import rebound
 
+    from hamilton_orbits.rebound_bridge import particle_name
+
     sim = rebound.Simulation(str(path))
-    return [sim.particles[k].name or f"body{k}" for k in range(sim.N)]
+    return [particle_name(sim.particles[k]) or f"body{k}" for k in range(sim.N)]
 
 
 def _initial_names(spec: dict) -> list[str]:
     names: list[str] = []
     rb = spec["initial"].get("rebound")
     if rb is not None:
-        try:
-            names += _rebound_names(rb)
-        except Exception:  # checked with a message in _check
-            pass
+        if spec["initial"].get("names"):
+            names += list(spec["initial"]["names"])
+        else:
+            try:
+                names += _rebound_names(rb)
+            except Exception:  # checked with a message in _check
+                pass
     ss = spec["initial"].get("solar_system")
     if ss is not None:
         names += list(ss.get("bodies") or _DEFAULT_SOLAR)
@@ -134,9 +140,17 @@ def _check(spec: dict, problems: S.Problems) -> None:
             problems.add("initial.rebound", f"no such file {rb!r} (relative to {Path.cwd()})")
         else:
             try:
-                _rebound_names(rb)
+                found = _rebound_names(rb)
             except Exception as exc:
                 problems.add("initial.rebound", f"not a rebound binary: {exc}")
+            else:
+                given = init.get("names")
+                if given and len(given) != len(found):
+                    problems.add("initial.names", f"expected {len(found)} names (the file "
+                                 f"holds {len(found)} particles), got {len(given)}")
+                elif not given and len(set(found)) != len(found):
+                    problems.add("initial.names", "missing: the particle names read from "
+                                 f"the file are not unique ({found}); give `names`")
     names = _initial_names(spec)
     for i, b in enumerate(spec["bodies"]):
         path = f"bodies[{i}]"
@@ -207,7 +221,7 @@ def build_system(spec: dict):
 
         # lengths in au, times in days, G m in au^3/day^2 (what final.bin holds)
         sim = rebound.Simulation(str(init["rebound"]))
-        base = System.from_rebound(sim, quantity=True)
+        base = System.from_rebound(sim, quantity=True, names=init.get("names"))
         bodies = [base[n] for n in base.names]
     ss = init.get("solar_system")
     if ss is not None:

@@ -527,7 +527,8 @@ class System:
         return to_rebound(self)
 
     @classmethod
-    def from_rebound(cls, sim, *, quantity: bool = False) -> System:
+    def from_rebound(cls, sim, *, quantity: bool = False,
+                     names: Sequence[str] | None = None) -> System:
         """A System from a ``rebound.Simulation`` (exact: positions bit for bit).
 
         See :func:`hamilton_orbits.rebound_bridge.from_rebound`.
@@ -540,7 +541,7 @@ class System:
         """
         from hamilton_orbits.rebound_bridge import from_rebound
 
-        return from_rebound(sim, quantity=quantity)
+        return from_rebound(sim, quantity=quantity, names=names)
 
     # -------------------------------------------------------- solar system
     @classmethod

@@ -47,8 +47,25 @@ def to_rebound(system: System) -> Any:
     for k, name in enumerate(system.names):
         x, y, z = (float(c) for c in system._r[k])
         vx, vy, vz = (float(c) for c in system._v[k])
-        sim.add(m=float(system._gm[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz, name=name)
+        sim.add(m=float(system._gm[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz)
+        # set through the particle in the simulation: rebound copies the name into
+        # memory the simulation owns (``add(name=...)`` keeps a pointer to a
+        # temporary Python buffer, which may be reused before the file is written)
+        sim.particles[k].name = name
     return sim
+
+
+def particle_name(particle: Any) -> str | None:
+    """The name of a rebound particle, read from the C string it points to.
+
+    rebound's ``Particle.name`` getter can return a stale Python buffer for a
+    particle of a simulation loaded from a binary file (ctypes caches the
+    objects assigned to ``c_char_p`` fields); reading the pointer itself is exact.
+    """
+    import rebound
+
+    ptr = ctypes.c_void_p.from_buffer(particle, rebound.Particle._name.offset).value
+    return ctypes.string_at(ptr).decode("utf-8") if ptr else None
 
 
 def from_rebound(sim: Any, *, quantity: bool = False, names: Sequence[str] | None = None
@@ -79,7 +96,7 @@ def from_rebound(sim: Any, *, quantity: bool = False, names: Sequence[str] | Non
     bodies = []
     for k in range(n):
         p = sim.particles[k]
-        name = names[k] if names is not None else (p.name or f"body{k}")
+        name = names[k] if names is not None else (particle_name(p) or f"body{k}")
         gm = sim.G * p.m
         r = [p.x, p.y, p.z]
         v = [p.vx, p.vy, p.vz]

@@ -8,6 +8,7 @@ valid names.  Nothing is simulated until the whole scene is valid.
 import re
 
 import astropy.units as u
+import numpy as np
 import pytest
 
 from hamilton_orbits import Scene
@@ -147,3 +148,39 @@ def test_bundled_scenes_are_valid_and_listed():
         assert Scene.bundled(name).kind == "nbody"
     assert [e["name"] for e in Scene.bundled("leo-j2").effects] == ["j2"]
     assert Scene.bundled("solar-system").effects == ()
+
+
+def test_stop_keeps_what_is_done_and_saves_it(tmp_path):
+    """What Ctrl-C does in the command: the run ends after the current chunk."""
+    calls = []
+
+    def stop():
+        calls.append(1)
+        return len(calls) > 3  # three chunks, then the user asks to stop
+
+    scene = Scene.bundled("comet-encounter").with_values({"crosscheck": False})
+    result = scene.run(progress=False, stop=stop)
+    assert not result.complete
+    assert 0 < result.times[-1] < 1.5 * u.yr
+    assert "STOPPED EARLY" in result.summary()
+    paths = result.save(tmp_path)
+    assert (tmp_path / "states.nc") in paths
+
+
+def test_rebound_binary_in_and_out(tmp_path):
+    first = Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)
+    first.save(tmp_path / "a")
+    path = tmp_path / "a" / "final.bin"
+    scene = Scene.from_dict({
+        "kind": "nbody", "description": "from a rebound binary", "duration": "0.1 yr",
+        "initial": {"rebound": str(path), "names": ["sun", "jupiter", "saturn", "comet"]},
+    })
+    result = scene.run(progress=False)
+    assert result.states["names"] == ["sun", "jupiter", "saturn", "comet"]
+    # the continued run starts exactly where the first ended (bit for bit)
+    np.testing.assert_array_equal(result.states["r"][0].to_value(u.au),
+                                  first.states["r"][-1].to_value(u.au))
+    bad = Scene.from_dict
+    with pytest.raises(SceneError, match=r"initial.rebound: no such file"):
+        bad({"kind": "nbody", "duration": "1 d", "initial": {"rebound": "nope.bin"}})
