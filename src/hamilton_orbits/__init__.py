@@ -6,6 +6,7 @@ The curated public API.  Everything not listed in ``__all__`` is private.
 from importlib.metadata import PackageNotFoundError, version
 
 from hamilton_orbits.conic import Conic
+from hamilton_orbits.ensemble import Ensemble
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
 from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.orbit import KeplerOrbit
@@ -23,6 +24,7 @@ __all__ = [
     "Body",
     "Conic",
     "ConvergenceError",
+    "Ensemble",
     "KeplerOrbit",
     "Quaternion",
     "Result",

@@ -190,6 +190,72 @@ def _crosscheck(ref: str, sets: Sequence[str]) -> int:
     return EXIT_OK
 
 
+def _split_values(text: str) -> list[str]:
+    """``"1e-8,1e-10"`` -> two values; commas inside ``[...]`` or quotes do not split."""
+    out, depth, quote, cur = [], 0, "", []
+    for ch in text:
+        if quote:
+            quote = "" if ch == quote else quote
+        elif ch in "\"'":
+            quote = ch
+        elif ch == "[":
+            depth += 1
+        elif ch == "]":
+            depth -= 1
+        elif ch == "," and depth == 0:
+            out.append("".join(cur).strip())
+            cur = []
+            continue
+        cur.append(ch)
+    out.append("".join(cur).strip())
+    return [v for v in out if v]
+
+
+def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None,
+              progress: bool) -> int:
+    from pathlib import Path
+
+    from hamilton_orbits.ensemble import Ensemble
+    from hamilton_orbits.scene import SceneError, format_table
+
+    vary: dict[str, list[str]] = {}
+    try:
+        scene = _load_scene(ref, [])
+        for item in varies:
+            key, sep, values = item.partition("=")
+            if not sep or not key.strip() or not _split_values(values):
+                raise SceneError([f"{scene.source}: --vary {item!r}: expected KEY=V1,V2,..."])
+            vary[key.strip()] = _split_values(values)
+        ens = Ensemble(scene, vary=vary)
+    except (SceneError, ValueError) as exc:
+        print(f"hamilton-orbits: {exc}", file=sys.stderr)
+        return EXIT_BAD_SCENE
+    client = None
+    if dask:
+        try:
+            from dask.distributed import Client, LocalCluster
+        except ImportError:
+            print("hamilton-orbits: --dask needs Dask: pip install 'hamilton-orbits[dask]'",
+                  file=sys.stderr)
+            return EXIT_FAILED
+        client = Client(LocalCluster()) if dask == "local" else Client(dask)
+    try:
+        df = ens.run(client=client, progress=progress and sys.stderr.isatty())
+    finally:
+        if client is not None:
+            client.close()
+    rows = df.to_dict("records")
+    print(f"ensemble of {scene.name}: {len(df)} members, {df.attrs['failures']} failed")
+    print(format_table(rows))
+    folder = Path(out) if out else Path("hamilton-orbits-output") / f"{scene.name}-ensemble"
+    folder.mkdir(parents=True, exist_ok=True)
+    df.to_csv(folder / "ensemble.csv", index=False)
+    (folder / "ensemble.md").write_text(
+        f"# Ensemble of {scene.name}\n\n```\n{format_table(rows)}\n```\n", encoding="utf-8")
+    print(f"\nwrote ensemble.csv, ensemble.md to {folder}/")
+    return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hamilton-orbits`` console script.
 
@@ -219,6 +285,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     cc = sub.add_parser("crosscheck", help="run a scene here and in rebound/reboundx; differences")
     cc.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
     cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    en = sub.add_parser("ensemble", help="run a grid of variations of a scene in parallel")
+    en.add_argument("scene", help="bundled name or TOML file")
+    en.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
+                    help="values of one key (repeatable: the grid of all combinations)")
+    en.add_argument("--dask", metavar="ADDRESS|local", help="run on a Dask cluster")
+    en.add_argument("--out", help="output folder (default hamilton-orbits-output/SCENE-ensemble)")
+    en.add_argument("--no-progress", action="store_true", help="no progress bar")
     sub.add_parser("scenes", help="list the bundled scenes")
     sub.add_parser("demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
@@ -229,6 +302,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _demo()
     if args.command == "scenes":
         return _list_scenes()
+    if args.command == "ensemble":
+        return _ensemble(args.scene, args.vary, args.dask, args.out,
+                         progress=not args.no_progress)
     if args.command == "crosscheck":
         return _crosscheck(args.scene, args.set)
     if args.command == "run":

@@ -1,0 +1,214 @@
+"""Ensembles: a grid (or a list) of variations of one scene, run in parallel.
+
+Each member is the scene with some keys replaced (:meth:`Scene.with_values`), run
+in a worker process; its row holds the varied values, the member's headline
+metrics (numbers; Quantities as plain numbers in the unit named in the column),
+its wall time, and the error if it failed.  A member that fails does not lose
+the others.
+
+Locally (the default) members run in a pool of processes on all cores.  With a
+``dask.distributed.Client`` (``client=``) they run on that cluster; Dask is the
+optional extra ``[dask]``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits.scene import Scene
+
+__all__ = ["Ensemble", "run_member"]
+
+
+def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) -> dict:
+    """Run one member (in a worker): the scene ``data`` with ``values``; its row.
+
+    Never raises: a failure is recorded in the row's ``error``.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Scene
+    >>> s = Scene.bundled("dzhanibekov")
+    >>> row = run_member(s.data, s.source, {"duration": "20 s"})
+    >>> row["error"] is None, row["simulated flip interval [s]"] > 0
+    (True, True)
+    """
+    row: dict[str, Any] = {key: _plain(v) for key, v in values.items()}
+    start = time.perf_counter()
+    try:
+        scene = Scene(data, source).with_values(dict(values))
+        result = scene.run(progress=False)
+    except Exception as exc:  # a member's failure is data, not the end of the run
+        row["wall time [s]"] = time.perf_counter() - start
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        return row
+    for name, value in result.metrics.items():
+        if isinstance(value, u.Quantity) and value.isscalar:
+            row[f"{name} [{value.unit.to_string()}]"] = float(value.value)
+        elif isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+            value, bool
+        ):
+            row[name] = float(value)
+    row["wall time [s]"] = result.wall_time
+    row["complete"] = bool(result.complete)
+    row["error"] = None
+    return row
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, u.Quantity):
+        return str(value)
+    if isinstance(value, (list, tuple)):
+        return str(list(value))
+    return value
+
+
+class Ensemble:
+    """Variations of one scene, run in parallel; rows in a pandas DataFrame.
+
+    Parameters
+    ----------
+    scene : Scene
+        The base scene.
+    vary : mapping of key -> sequence of values, optional
+        The grid: every combination of the values (keys as for ``--set``:
+        ``"integrator.tol"``, ``"bodies.mercury.e"``, ``"body.omega"``).
+    members : sequence of mappings, optional
+        Instead of (or after) the grid: an explicit list of variations.
+
+    Raises
+    ------
+    ValueError
+        For an empty variation, or a member that does not make a valid scene
+        (checked before anything runs, naming the member's index).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Ensemble, Scene
+    >>> ens = Ensemble(Scene.bundled("dzhanibekov"),
+    ...                vary={"duration": ["20 s", "40 s"], "integrator.dt": ["1 ms", "2 ms"]})
+    >>> len(ens)
+    4
+    >>> ens.members[1]
+    {'duration': '20 s', 'integrator.dt': '2 ms'}
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        vary: Mapping[str, Sequence[Any]] | None = None,
+        members: Sequence[Mapping[str, Any]] | None = None,
+    ) -> None:
+        if not isinstance(scene, Scene):
+            raise ValueError(f"Expected `scene` to be a Scene, got {scene!r}")
+        grid: list[dict[str, Any]] = []
+        if vary:
+            keys = list(vary)
+            for key in keys:
+                values = vary[key]
+                if isinstance(values, (str, bytes)) or not isinstance(values, Sequence):
+                    raise ValueError(
+                        f"Expected `vary[{key!r}]` to be a sequence of values, got {values!r}"
+                    )
+                if len(values) == 0:
+                    raise ValueError(f"Expected `vary[{key!r}]` to hold values, got none")
+            grid = [dict(zip(keys, combo, strict=True))
+                    for combo in itertools.product(*(vary[k] for k in keys))]
+        grid += [dict(m) for m in (members or [])]
+        if not grid:
+            raise ValueError("Expected `vary` or `members` to give at least one member")
+        for k, member in enumerate(grid):
+            try:
+                scene.with_values(member)
+            except Exception as exc:
+                raise ValueError(f"Member {k} ({member}) is not a valid scene: {exc}") from exc
+        self.scene = scene
+        self.members: list[dict[str, Any]] = grid
+
+    def __len__(self) -> int:
+        return len(self.members)
+
+    def __repr__(self) -> str:
+        return f"Ensemble({self.scene.name!r}, {len(self)} members)"
+
+    def run(self, client: Any = None, progress: bool = True, workers: int | None = None):
+        """Run every member; a DataFrame with one row per member, in member order.
+
+        Parameters
+        ----------
+        client : dask.distributed.Client, optional
+            Run on this cluster; default: a local pool of processes.
+        progress : bool
+            A progress bar over the whole grid (tqdm, quiet when not a terminal).
+        workers : int, optional
+            Local processes (default: all cores, at most one per member).
+
+        Returns
+        -------
+        pandas.DataFrame
+            The varied keys, each member's metrics, ``wall time [s]``, ``complete``
+            and ``error`` (None for members that ran).  ``df.attrs["failures"]``
+            counts the members that failed.
+        """
+        try:
+            import pandas as pd
+        except ImportError as exc:  # pragma: no cover - pandas comes with the extra
+            raise ImportError(
+                "Ensemble tables need pandas: pip install 'hamilton-orbits[dask]'"
+            ) from exc
+        args = [(self.scene.data, self.scene.source, m) for m in self.members]
+        bar = _bar(len(args), progress)
+        rows: list[dict | None] = [None] * len(args)
+        try:
+            if client is not None:
+                futures = client.map(run_member, *zip(*args, strict=True), pure=False)
+                index = {f.key: i for i, f in enumerate(futures)}
+                from dask.distributed import as_completed
+
+                for fut in as_completed(futures):
+                    rows[index[fut.key]] = fut.result()
+                    if bar is not None:
+                        bar.update(1)
+            else:
+                import multiprocessing as mp
+                from concurrent.futures import ProcessPoolExecutor, as_completed
+
+                n = workers or min(len(args), os.cpu_count() or 1)
+                if n <= 1:
+                    for i, a in enumerate(args):
+                        rows[i] = run_member(*a)
+                        if bar is not None:
+                            bar.update(1)
+                else:
+                    ctx = mp.get_context("spawn")  # safe beside numba's threads
+                    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+                        futs = {pool.submit(run_member, *a): i for i, a in enumerate(args)}
+                        for fut in as_completed(futs):
+                            rows[futs[fut]] = fut.result()
+                            if bar is not None:
+                                bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+        df = pd.DataFrame(rows)
+        df.attrs["failures"] = int(df["error"].notna().sum())
+        return df
+
+
+def _bar(total: int, enabled: bool):
+    if not enabled:
+        return None
+    import sys
+
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is in the [progress] extra
+        return None
+    return tqdm(total=total, unit="member", disable=not sys.stderr.isatty(), leave=False)

@@ -1,0 +1,86 @@
+"""Ensembles: a grid of scene variations, locally and on Dask, with failures kept."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from hamilton_orbits import Ensemble, Scene
+from hamilton_orbits.cli import _split_values, main
+
+pd = pytest.importorskip("pandas")
+
+
+def comet() -> Scene:
+    return Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.05 yr", "cadence": "1 d", "crosscheck": False})
+
+
+def numeric(df):
+    return df.drop(columns=["wall time [s]"]).to_dict("records")
+
+
+def same_rows(a, b):
+    assert len(a) == len(b)
+    for ra, rb in zip(a, b, strict=True):
+        assert ra.keys() == rb.keys()
+        for k in ra:
+            x, y = ra[k], rb[k]
+            if isinstance(x, float) and math.isnan(x):
+                assert isinstance(y, float) and math.isnan(y)
+            else:
+                assert x == y, (k, x, y)  # bit for bit
+
+
+def test_grid_local_and_on_an_in_process_dask_cluster_agree_bit_for_bit():
+    distributed = pytest.importorskip("dask.distributed")
+    ens = Ensemble(comet(), vary={"integrator.tol": [1e-9, 1e-6]})
+    local = ens.run(progress=False)
+    assert list(local["integrator.tol"]) == [1e-9, 1e-6]
+    assert local.attrs["failures"] == 0
+    assert (local["steps"] > 0).all()
+    # a looser tolerance takes fewer steps
+    assert local["steps"][1] < local["steps"][0]
+    with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = ens.run(client=client, progress=False)
+    same_rows(numeric(local), numeric(remote))
+
+
+def test_a_failing_member_leaves_the_others():
+    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9},
+                                     {"initial.solar_system.epoch": "not a date"},
+                                     {"integrator.tol": 1e-8}])
+    df = ens.run(progress=False, workers=1)
+    assert df.attrs["failures"] == 1
+    assert df["error"].isna().tolist() == [True, False, True]
+    assert "not a date" in df["error"][1]
+    assert df["steps"][0] > 0 and df["steps"][2] > 0
+
+
+def test_invalid_members_are_refused_before_anything_runs():
+    with pytest.raises(ValueError, match=r"Member 1 .*integrator.dt"):
+        Ensemble(Scene.bundled("dzhanibekov"), vary={"integrator.dt": ["1 ms", "bogus"]})
+    with pytest.raises(ValueError, match=r"vary\['duration'\]"):
+        Ensemble(Scene.bundled("dzhanibekov"), vary={"duration": []})
+    with pytest.raises(ValueError, match=r"`scene`"):
+        Ensemble("dzhanibekov", vary={"duration": ["1 s"]})
+
+
+def test_vary_values_split_outside_brackets():
+    assert _split_values('1e-8, 1e-10') == ["1e-8", "1e-10"]
+    assert _split_values('["1 rad/s", "2 rad/s"],["3 rad/s", "4 rad/s"]') == [
+        '["1 rad/s", "2 rad/s"]', '["3 rad/s", "4 rad/s"]']
+
+
+def test_ensemble_command(tmp_path, capsys):
+    code = main(["ensemble", "dzhanibekov", "--vary", "duration=40 s,60 s", "--out",
+                 str(tmp_path), "--no-progress"])
+    assert code == 0
+    df = pd.read_csv(tmp_path / "ensemble.csv")
+    assert list(df["duration"]) == ["40 s", "60 s"]
+    exact = df["exact flip interval 2K(m)/lambda [s]"]
+    assert (abs(df["simulated flip interval [s]"] / exact - 1) < 1e-8).all()
+    assert main(["ensemble", "dzhanibekov", "--vary", "duration"]) == 2
