@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -70,3 +72,15 @@ def test_chandler_wobble_quick(tmp_path):
     assert "Q caveat" in out
     assert (tmp_path / "chandler_wobble.png").stat().st_size > 10_000
     assert (tmp_path / "chandler_wobble.txt").read_text().startswith("window")
+
+
+@pytest.mark.slow  # four clones in worker processes: ~40 s on a loaded 2-core machine
+def test_ensemble_comet_clones_quick(tmp_path):
+    """Every clone runs; the encounter scatters the semi-major axis (some clones escape)."""
+    out = run("ensemble_comet_clones.py", str(tmp_path), "--quick")
+    assert "4 clones, 0 failed" in out
+    rows = re.findall(r"^\s+(0\.9999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s", out, flags=re.M)
+    assert len(rows) == 4
+    assert all(0.02 < float(c) < 0.04 for _, c, _ in rows)
+    assert len({round(float(a)) for _, _, a in rows}) == 4
+    assert (tmp_path / "comet_clones.png").stat().st_size > 10_000
