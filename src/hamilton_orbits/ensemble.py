@@ -187,19 +187,35 @@ class Ensemble:
                         if bar is not None:
                             bar.update(1)
                 else:
-                    ctx = mp.get_context("spawn")  # safe beside numba's threads
-                    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
-                        futs = {pool.submit(run_member, *a): i for i, a in enumerate(args)}
-                        for fut in as_completed(futs):
-                            rows[futs[fut]] = fut.result()
-                            if bar is not None:
-                                bar.update(1)
+                    pool = _pool(n, ProcessPoolExecutor, mp)
+                    futs = {pool.submit(run_member, *a): i for i, a in enumerate(args)}
+                    for fut in as_completed(futs):
+                        rows[futs[fut]] = fut.result()
+                        if bar is not None:
+                            bar.update(1)
         finally:
             if bar is not None:
                 bar.close()
         df = pd.DataFrame(rows)
         df.attrs["failures"] = int(df["error"].notna().sum())
         return df
+
+
+_POOLS: dict[int, Any] = {}
+
+
+def _pool(n: int, executor: Any, mp: Any) -> Any:
+    """A pool of ``n`` worker processes kept for the session (started once: the
+    workers' imports and compiled kernels are paid on the first ensemble only)."""
+    pool = _POOLS.get(n)
+    if pool is None:
+        import atexit
+
+        ctx = mp.get_context("spawn")  # safe beside numba's threads
+        pool = executor(max_workers=n, mp_context=ctx)
+        _POOLS[n] = pool
+        atexit.register(pool.shutdown, wait=False, cancel_futures=True)
+    return pool
 
 
 def _bar(total: int, enabled: bool):
