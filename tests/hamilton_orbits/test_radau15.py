@@ -337,3 +337,39 @@ def test_brouwer_law_energy_error_grows_like_sqrt_t():
     slope = np.polyfit(np.log(t_out[1:]), np.log(rms), 1)[0]
     assert 0.3 < slope < 0.7, (slope, rms)
     assert rms[-1] < 1e-13, rms
+
+
+def test_stepping_kernels_are_loaded_from_the_numba_cache():
+    # The kernels take `accel` as a first-class function type so that they are
+    # compiled once and then loaded from numba's on-disk cache in every new
+    # process (a kernel specialised on a dispatcher argument is recompiled in
+    # each process: ~8 s).  Both kernels have explicit signatures, so importing
+    # them here has already compiled and saved them if the cache was empty; a
+    # fresh process must then load both and compile (save) nothing of them.
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import numpy as np\n"
+        "from hamilton_orbits.effects import newtonian_rhs\n"
+        "from hamilton_orbits.integrators import radau15, wh\n"
+        "r = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[0.0, 0, 0], [0, 1.0, 0]])\n"
+        "gm = np.array([1.0, 0.0]); t = np.array([0.0, 1.0])\n"
+        "radau15.run(newtonian_rhs(), r, v, gm, t); wh.run(newtonian_rhs(), r, v, gm, t, dt=0.1)\n"
+    )
+    src = str(Path(radau15.__file__).resolve().parents[2])
+    env = {**os.environ, "NUMBA_DEBUG_CACHE": "1"}
+    env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    from hamilton_orbits.integrators import wh  # noqa: F401 - compiles / caches wh._advance
+
+    res = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+    )
+    out = res.stdout + res.stderr
+    for name in ("radau15._advance", "wh._advance"):
+        loaded = [line for line in out.splitlines() if "data loaded" in line and name in line]
+        assert loaded, out[-2000:]
+        saved = [line for line in out.splitlines() if "saved" in line and name in line]
+        assert saved == [], saved
