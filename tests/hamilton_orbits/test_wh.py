@@ -161,3 +161,48 @@ def test_bad_input():
         )
     with pytest.raises(ValueError, match=r"no body is bound"):
         wh.run(newtonian_rhs(), r0, 10 * v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+
+
+def test_jacobi_symplectic_corrector_matches_whfast(solar):
+    # Third-order corrector (Wisdom, Holman & Touma 1996) on the Jacobi map,
+    # against WHFast with corrector = 3 at the same dt = 4 days for 100 years.
+    # Measured: positions agree to 3e-11 (Mercury); the energy error falls from
+    # 4.9e-11 without corrector to 7e-15 (WHFast: 2e-14).  Bounds: 1e-9 for
+    # the positions, 1e-13 for |dE/E| (the corrector removes the eps dt^2
+    # term; what is left is eps^2 dt^2 and rounding).
+    _, r0, v0, gm = solar
+    dt = 4.0
+    t_end = 9131 * dt
+    r, v, _ = wh.run(
+        newtonian_rhs(),
+        r0,
+        v0,
+        gm,
+        np.array([0.0, t_end]),
+        dt=dt,
+        coordinates="jacobi",
+        corrector=3,
+    )
+    sim = nbody_states.to_rebound(r0, v0, gm, "whfast")
+    sim.dt = dt
+    sim.integrator.coordinates = "jacobi"
+    sim.integrator.corrector = 3
+    sim.integrate(t_end, exact_finish_time=0)
+    sim.synchronize()
+    r_w, _ = nbody_states.rebound_state(sim)
+    scale = np.linalg.norm(r_w - r_w[0], axis=1)
+    scale[0] = np.linalg.norm(r_w[0])
+    diff = np.linalg.norm(r[-1] - r_w, axis=1) / scale
+    assert diff.max() < 1e-9, diff
+    de = _energy(r[-1], v[-1], gm) / _energy(r0, v0, gm) - 1.0
+    assert abs(de) < 1e-13, de
+
+
+def test_corrector_needs_jacobi():
+    r0 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    v0 = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    args = (newtonian_rhs(), r0, v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    with pytest.raises(ValueError, match=r"coordinates='jacobi' with `corrector` = 3"):
+        wh.run(*args, dt=0.1, corrector=3)
+    with pytest.raises(ValueError, match=r"`corrector` to be 0 or 3, got 5"):
+        wh.run(*args, dt=0.1, coordinates="jacobi", corrector=5)

@@ -30,7 +30,8 @@ Jacobi form plus ``G eta_i r'_i / |r'_i|^3`` (the part the Kepler step already
 took), and there is no jump.
 
 Velocity-dependent effects are refused (the kick would not be symplectic).
-No symplectic corrector is applied yet.
+With Jacobi coordinates the third-order symplectic corrector of Wisdom,
+Holman & Touma (1996) is available (``corrector=3``).
 """
 
 from __future__ import annotations
@@ -230,6 +231,71 @@ def _kepler_jacobi(qj, uj, eta, tau):  # pragma: no cover - compiled
     return -1
 
 
+@njit(cache=True)
+def _kick_jacobi(
+    extra, has_extra, qj, uj, gm, eta, h, move_com, acc, accj, acc_x, r_in, v_in
+):  # pragma: no cover - compiled
+    """The interaction kick of length ``h`` in Jacobi coordinates."""
+    n = qj.shape[0]
+    _jacobi_to_inertial_pos(qj, gm, eta, r_in)
+    _nbody.newtonian(r_in, v_in, gm, acc)
+    if has_extra:
+        for i in range(n):
+            for k in range(3):
+                acc_x[i, k] = 0.0
+        extra(r_in, v_in, gm, acc_x)
+        m_tot = eta[n - 1]
+        for k in range(3):
+            a_cm = 0.0
+            for i in range(n):
+                a_cm += gm[i] * acc_x[i, k]
+                acc[i, k] += acc_x[i, k]
+            if move_com:
+                # the effects' net force moves the barycentre
+                uj[0, k] += h * a_cm / m_tot
+    _inertial_to_jacobi_acc(acc, gm, eta, accj)
+    for i in range(1, n):
+        d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
+        f = eta[i] / (d2 * math.sqrt(d2))
+        for k in range(3):
+            uj[i, k] += h * (accj[i, k] + f * qj[i, k])
+
+
+# Third-order symplectic corrector (Wisdom, Holman & Touma 1996, table 1 as
+# used by WHFast, Rein & Tamayo 2015): a = sqrt(7/40), b = -sqrt(10/7) / 48.
+_CORR_A = math.sqrt(7.0 / 40.0)
+_CORR_B = -math.sqrt(10.0 / 7.0) / 48.0
+
+
+@njit(
+    types.int64(_setup.ACCEL_TYPE, types.boolean, _F2, _F2, _F1, _F1, types.float64, types.float64),
+    cache=True,
+)
+def _corrector_jacobi(extra, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: no cover
+    """Apply the third-order corrector (``sign = 1``) or its inverse (``-1``):
+    ``Z(a dt, -sign b dt) Z(-a dt, sign b dt)`` with ``Z(a, b)`` = Kepler a,
+    kick -b, Kepler -2a, kick b, Kepler a.  Returns a failing index or -1."""
+    n = qj.shape[0]
+    acc = np.empty((n, 3))
+    accj = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.zeros((n, 3))
+    for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
+        bad = _kepler_jacobi(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, -b, False, acc, accj, acc_x, r_in, v_in)
+        bad = _kepler_jacobi(qj, uj, eta, -2.0 * a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, b, False, acc, accj, acc_x, r_in, v_in)
+        bad = _kepler_jacobi(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+    return -1
+
+
 @njit(
     types.Tuple((types.int64, types.int64))(
         _setup.ACCEL_TYPE,
@@ -266,27 +332,7 @@ def _advance_jacobi(
         qj[0, k] += 0.5 * h * uj[0, k]
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _jacobi_to_inertial_pos(qj, gm, eta, r_in)
-        _nbody.newtonian(r_in, v_in, gm, acc)
-        if has_extra:
-            for i in range(n):
-                for k in range(3):
-                    acc_x[i, k] = 0.0
-            extra(r_in, v_in, gm, acc_x)
-            m_tot = eta[n - 1]
-            for k in range(3):
-                a_cm = 0.0
-                for i in range(n):
-                    a_cm += gm[i] * acc_x[i, k]
-                    acc[i, k] += acc_x[i, k]
-                # the effects' net force moves the barycentre
-                uj[0, k] += h * a_cm / m_tot
-        _inertial_to_jacobi_acc(acc, gm, eta, accj)
-        for i in range(1, n):
-            d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
-            f = eta[i] / (d2 * math.sqrt(d2))
-            for k in range(3):
-                uj[i, k] += h * (accj[i, k] + f * qj[i, k])
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, h, True, acc, accj, acc_x, r_in, v_in)
         if s < n_steps - 1:
             h_next = dt if s + 1 < n_steps - 1 else dt_last
             tau = 0.5 * (h + h_next)
@@ -345,6 +391,7 @@ def run(
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
     coordinates: str = "democratic_heliocentric",
+    corrector: int = 0,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -372,6 +419,11 @@ def run(
         1998) or Jacobi (Wisdom & Holman 1991; the central body first, then the
         others in the order given, each on a Kepler orbit about the total mass
         inside it).  Both are WHFast's maps of the same names.
+    corrector : {0, 3}, optional
+        With Jacobi coordinates, 3 applies the third-order symplectic corrector
+        of Wisdom, Holman & Touma (1996) before the steps of each output
+        interval and its inverse after them (so outputs are in true
+        coordinates); it removes the leading O(eps dt^2) error term.
 
     Returns
     -------
@@ -413,6 +465,13 @@ def run(
         raise ValueError(
             f"Expected `coordinates` to be one of {', '.join(map(repr, COORDINATES))}, "
             f"got {coordinates!r}"
+        )
+    if corrector not in (0, 3):
+        raise ValueError(f"Expected `corrector` to be 0 or 3, got {corrector!r}")
+    if corrector and coordinates != "jacobi":
+        raise ValueError(
+            f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
+            "(the corrector is defined for the Jacobi splitting)"
         )
     n = r0.shape[0]
     c = int(np.argmax(gm))
@@ -456,9 +515,15 @@ def run(
         n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
         last = span - (n_steps - 1) * dt_f
         if jacobi:
-            steps, bad = _advance_jacobi(
-                extra, rhs.extra is not None, q, u, g, eta, dt_f, n_steps, last
-            )
+            has_extra = rhs.extra is not None
+            bad = -1
+            if corrector:
+                bad = _corrector_jacobi(extra, has_extra, q, u, g, eta, dt_f, 1.0)
+            steps = 0
+            if bad < 0:
+                steps, bad = _advance_jacobi(extra, has_extra, q, u, g, eta, dt_f, n_steps, last)
+            if bad < 0 and corrector:
+                bad = _corrector_jacobi(extra, has_extra, q, u, g, eta, dt_f, -1.0)
         else:
             steps, bad = _advance(
                 extra, rhs.extra is not None, q, u, g, g_p, com, dt_f, n_steps, last
