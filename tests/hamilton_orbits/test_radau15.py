@@ -368,7 +368,7 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
     )
     out = res.stdout + res.stderr
-    for name in ("radau15._advance", "wh._advance"):
+    for name in ("radau15._advance", "wh._advance", "wh._advance_jacobi", "wh._corrector_jacobi"):
         loaded = [line for line in out.splitlines() if "data loaded" in line and name in line]
         assert loaded, out[-2000:]
         saved = [line for line in out.splitlines() if "saved" in line and name in line]
