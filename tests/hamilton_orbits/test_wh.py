@@ -74,8 +74,9 @@ def test_solar_system_100_years_matches_whfast(solar, coordinates, peer, rel_ene
 def test_energy_error_is_second_order_and_bounded(solar):
     # Wisdom-Holman: the energy error oscillates with an amplitude ~ eps dt^2
     # (no drift).  Halving dt divides the largest error over 20 years by 4
-    # (measured 3.98; bounds 3.5 .. 4.5), and the error at the end is no larger
-    # than the largest one seen before (bounded, not growing).
+    # (measured 3.72; bounds 3.5 .. 4.5), and the largest error of the second
+    # decade is that of the first (measured ratio 1.03 and 1.04; bound 1.2: a
+    # drift would grow it).
     _, r0, v0, gm = solar
     t_out = np.linspace(0.0, 20 * 365.25, 41)
     e0 = _energy(r0, v0, gm)
@@ -84,7 +85,7 @@ def test_energy_error_is_second_order_and_bounded(solar):
         r, v, _ = wh.run(newtonian_rhs(), r0, v0, gm, t_out, dt=dt)
         de = np.abs(_energy(r, v, gm) / e0 - 1.0)
         amp.append(de.max())
-        assert de[-1] <= de.max()
+        assert de[21:].max() < 1.2 * de[1:21].max(), de
     assert 3.5 < amp[0] / amp[1] < 4.5, amp
 
 
