@@ -74,23 +74,14 @@ def _build() -> list[HardCase]:
     for label, speed in (("bound", 0.6), ("parabolic", math.sqrt(2.0)), ("unbound", 2.5)):
         for sign in (1.0, -1.0):
             cases.append(
-                HardCase(
-                    f"radial {label} {'out' if sign > 0 else 'in'}",
-                    1.0 * d,
-                    sign * speed * d,
-                    1.0,
-                    "radial",
-                )
+                HardCase(f"radial {label} {'out' if sign > 0 else 'in'}",
+                         1.0 * d, sign * speed * d, 1.0, "radial")
             )
     cases.append(HardCase("radial at rest", 2.0 * d, 0.0 * d, 1.0, "radial"))
-    cases.append(
-        HardCase("radial along z", np.array([0, 0, 1.5]), np.array([0, 0, 0.3]), 1.0, "radial")
-    )
-    cases.append(
-        HardCase(
-            "radial in plane", np.array([1.5, -0.5, 0]), np.array([-0.3, 0.1, 0]), 1.0, "radial"
-        )
-    )
+    cases.append(HardCase("radial along z", np.array([0, 0, 1.5]), np.array([0, 0, 0.3]), 1.0,
+                          "radial"))
+    cases.append(HardCase("radial in plane", np.array([1.5, -0.5, 0]), np.array([-0.3, 0.1, 0]),
+                          1.0, "radial"))
     # extreme scales: length 1e-10 .. 1e10, mu 1e-20 .. 1e20
     for length in (1e-10, 1e10):
         for mu in (1e-20, 1e20):

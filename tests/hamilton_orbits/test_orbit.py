@@ -130,11 +130,8 @@ def _time_since_periapsis_mp(r, v, mu, dps=50):
         rr = [mpmath.mpf(float(x)) for x in r]
         vv = [mpmath.mpf(float(x)) for x in v]
         m = mpmath.mpf(float(mu))
-        hvec = [
-            rr[1] * vv[2] - rr[2] * vv[1],
-            rr[2] * vv[0] - rr[0] * vv[2],
-            rr[0] * vv[1] - rr[1] * vv[0],
-        ]
+        hvec = [rr[1] * vv[2] - rr[2] * vv[1], rr[2] * vv[0] - rr[0] * vv[2],
+                rr[0] * vv[1] - rr[1] * vv[0]]
         h = mpmath.sqrt(sum(x * x for x in hvec))
         rn = mpmath.sqrt(sum(x * x for x in rr))
         rv = sum(a * b for a, b in zip(rr, vv, strict=True))
@@ -237,27 +234,22 @@ def test_vallado_example_2_6_coe2rv():
     RAAN = 227.89 deg, argp = 53.38 deg, nu = 92.335 deg -> r = [6525.344, 6861.535,
     6449.125] km, v = [4.902276, 5.533124, -1.975709] km/s (printed precision)."""
     o = KeplerOrbit.from_elements(
-        p=11067.790 * u.km,
-        e=0.83285,
-        inc=87.87 * u.deg,
-        lan=227.89 * u.deg,
-        argp=53.38 * u.deg,
-        nu=92.335 * u.deg,
-        mu=398600.4418 * u.km**3 / u.s**2,
+        p=11067.790 * u.km, e=0.83285, inc=87.87 * u.deg, lan=227.89 * u.deg,
+        argp=53.38 * u.deg, nu=92.335 * u.deg, mu=398600.4418 * u.km**3 / u.s**2,
     )
     r, v = o.state()
     # The printed inputs are rounded (angles to 0.01 deg = 1.7e-4 rad, i.e. up to
     # ~1.6 km at r ~ 9500 km); the printed output was computed from unrounded
     # elements, so agreement is limited by the input rounding, not by printed digits.
     assert np.allclose(r.to_value(u.km), [6525.344, 6861.535, 6449.125], atol=0.05, rtol=0)
-    assert np.allclose(v.to_value(u.km / u.s), [4.902276, 5.533124, -1.975709], atol=5e-5, rtol=0)
+    assert np.allclose(v.to_value(u.km / u.s), [4.902276, 5.533124, -1.975709], atol=5e-5,
+                       rtol=0)
     # and the exact inverse of Example 2-5 holds to rounding
     r5 = [6524.834, 6862.875, 6448.296] * u.km
     v5 = [4.901327, 5.533756, -1.976341] * u.km / u.s
     o5 = KeplerOrbit.from_state(r5, v5, 398600.4418 * u.km**3 / u.s**2)
-    back = KeplerOrbit.from_elements(
-        p=o5.p, e=o5.e, inc=o5.inc, lan=o5.lan, argp=o5.argp, nu=o5.nu, mu=o5.mu
-    )
+    back = KeplerOrbit.from_elements(p=o5.p, e=o5.e, inc=o5.inc, lan=o5.lan, argp=o5.argp,
+                                     nu=o5.nu, mu=o5.mu)
     assert _rel(back.state()[0].to_value(u.km), r5.to_value(u.km)) <= 1e-14
 
 
@@ -316,9 +308,8 @@ def test_hamilton_epsilon_points_to_apoapsis():
 
 # ------------------------------------------------------------------- API odds
 def test_quantities_in_quantities_out():
-    o = KeplerOrbit.from_state(
-        [7000.0, 0, 0] * u.km, [0, 7.5, 1.0] * u.km / u.s, 3.986004418e14 * u.m**3 / u.s**2
-    )
+    o = KeplerOrbit.from_state([7000.0, 0, 0] * u.km, [0, 7.5, 1.0] * u.km / u.s,
+                               3.986004418e14 * u.m**3 / u.s**2)
     assert o.a.unit == u.km and o.inc.unit == u.rad and o.period.unit == u.s
     o2 = KeplerOrbit.from_state([7000.0, 0, 0], [0, 7.5, 1.0], 398600.4418)
     assert abs(o.a.to_value(u.km) - o2.a) <= 1e-12 * o2.a
@@ -392,4 +383,5 @@ def test_from_state_bad_input():
     with pytest.raises(ValueError, match="mix"):
         KeplerOrbit.from_state([1.0, 0, 0] * u.km, [0, 1.0, 0], 1.0)
     with pytest.raises(u.UnitConversionError):
-        KeplerOrbit.from_state([1.0, 0, 0] * u.s, [0, 1.0, 0] * u.km / u.s, 1.0 * u.km**3 / u.s**2)
+        KeplerOrbit.from_state([1.0, 0, 0] * u.s, [0, 1.0, 0] * u.km / u.s,
+                               1.0 * u.km**3 / u.s**2)

@@ -74,13 +74,8 @@ def test_against_dop853(e):
     r0, v0 = propagate(r0, v0, 1.0, -span / 3)
     ts = np.linspace(0.0, span, 9)[1:]
     sol = solve_ivp(
-        _kepler_rhs(1.0),
-        (0.0, span),
-        np.concatenate([r0, v0]),
-        method="DOP853",
-        rtol=1e-13,
-        atol=1e-16,
-        t_eval=ts,
+        _kepler_rhs(1.0), (0.0, span), np.concatenate([r0, v0]),
+        method="DOP853", rtol=1e-13, atol=1e-16, t_eval=ts,
     )
     r, v = propagate(r0, v0, 1.0, ts)
     assert np.max(_rel(r, sol.y[:3].T)) < 3e-12
@@ -89,7 +84,6 @@ def test_against_dop853(e):
 
 def test_against_rebound_ias15():
     import rebound
-
     for e in [0.0, 0.7, 0.99, 1.5]:
         r0, v0 = _periapsis_state(e)
         r0, v0 = propagate(r0, v0, 1.0, -2.0)
@@ -175,15 +169,8 @@ def test_radial_orbits():
         r0, v0 = rhat, v_out * rhat
         span = 0.8
         ts = np.linspace(-0.4, span, 7)
-        sol_f = solve_ivp(
-            _kepler_rhs(1.0),
-            (0, span),
-            np.concatenate([r0, v0]),
-            method="DOP853",
-            rtol=1e-13,
-            atol=1e-16,
-            t_eval=ts[ts > 0],
-        )
+        sol_f = solve_ivp(_kepler_rhs(1.0), (0, span), np.concatenate([r0, v0]),
+                          method="DOP853", rtol=1e-13, atol=1e-16, t_eval=ts[ts > 0])
         r, v = propagate(r0, v0, 1.0, ts[ts > 0])
         assert np.max(_rel(r, sol_f.y[:3].T)) < 3e-12
         assert np.max(_rel(v, sol_f.y[3:].T)) < 3e-12

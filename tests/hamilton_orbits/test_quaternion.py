@@ -22,7 +22,9 @@ EPS = np.finfo(float).eps
 rng = np.random.default_rng(20261122)
 
 finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
-quat_arrays = arrays(np.float64, (4,), elements=finite).filter(lambda a: np.linalg.norm(a) > 1e-3)
+quat_arrays = arrays(np.float64, (4,), elements=finite).filter(
+    lambda a: np.linalg.norm(a) > 1e-3
+)
 vec_arrays = arrays(np.float64, (3,), elements=finite)
 
 
@@ -121,10 +123,9 @@ def cayley_compose(a, b):
     l, m, n = a
     l1, m1, n1 = b
     pi = 1 - l * l1 - m * m1 - n * n1
-    return (
-        np.array([l + l1 + n1 * m - n * m1, m + m1 + l1 * n - l * n1, n + n1 + m1 * l - m * l1])
-        / pi
-    )
+    return np.array(
+        [l + l1 + n1 * m - n * m1, m + m1 + l1 * n - l * n1, n + n1 + m1 * l - m * l1]
+    ) / pi
 
 
 @settings(deadline=None, max_examples=200)

@@ -163,12 +163,15 @@ def _elements(r, v, mu):
 
 def test_comet_e_09999_through_perihelion():
     # e = 0.9999, a = 1 (q = 1e-4, Q ~ 2), from aphelion through perihelion and
-    # back over one period.  Reference: the exact Kepler orbit.  At aphelion the
-    # position matches to 1e-12 relative (measured 1e-12, rebound IAS15 3e-13);
-    # the orbit's integrals (energy, areal vector, eccentricity vector) match to
-    # 1e-12 (measured ~1e-13: the perihelion passage at 141 times the aphelion
-    # speed is where the error is made).  The same number of fixed steps
-    # misses by far: the adaptive step must shrink at perihelion.
+    # back over one period.  Reference: the exact Kepler orbit.  The perihelion
+    # passage (141 times the aphelion speed) is where the error is made: over
+    # 10 orientations of this orbit the relative energy error after one period
+    # has a median of 2.2e-13 and a maximum of 8e-13 (rebound IAS15: 6.7e-13
+    # and 1.1e-12), hence 3e-12 for the energy and 1e-11 for the position at
+    # aphelion (a phase error of the same relative size).  The areal vector
+    # (1.3e-15) and the eccentricity vector (1e-16) are kept to rounding:
+    # 1e-13.  The same number of equal steps misses by far: the adaptive step
+    # must shrink at perihelion.
     e, q = 0.9999, 1e-4
     big_q = q * (1 + e) / (1 - e)
     vq = math.sqrt((1 - e) / big_q)  # aphelion speed, mu = 1, a = 1
@@ -183,9 +186,9 @@ def test_comet_e_09999_through_perihelion():
     assert np.linalg.norm(r[-1, 1] - r_ref) / np.linalg.norm(r_ref) < 1e-11
     en, h, ecc = _elements(r[-1, 1], v[-1, 1], 1.0)
     en0, h0, ecc0 = _elements(r0[1], v0[1], 1.0)
-    assert abs(en / en0 - 1.0) < 1e-12
-    assert np.linalg.norm(h - h0) / np.linalg.norm(h0) < 1e-12
-    assert np.linalg.norm(ecc - ecc0) < 1e-12
+    assert abs(en / en0 - 1.0) < 3e-12
+    assert np.linalg.norm(h - h0) / np.linalg.norm(h0) < 1e-13
+    assert np.linalg.norm(ecc - ecc0) < 1e-13
     # the same number of equal steps fails by many orders of magnitude
     r_fixed, _, _ = radau15.run(newtonian_rhs(), r0, v0, gm, t_out, dt=period / steps)
     assert np.linalg.norm(r_fixed[-1, 1] - r_ref) / np.linalg.norm(r_ref) > 1e-3
@@ -223,8 +226,8 @@ def test_close_encounter_three_body_matches_rebound():
     # particle that passes 1e-4 from the planet at t = 3 (built by integrating
     # the encounter state backwards with rebound's IAS15, i.e. forwards with
     # reversed velocities).  Ours and rebound's IAS15 agree after the encounter
-    # to 1e-8 relative: the flyby amplifies differences of rounding by ~1e4
-    # (measured agreement 1e-10).
+    # to 2.5e-12 relative (measured; the flyby amplifies differences of
+    # rounding by ~1e4), bound 1e-10.
     import nbody_states
 
     rp = np.array([1.0, 0.0, 0.0])
@@ -247,7 +250,7 @@ def test_close_encounter_three_body_matches_rebound():
     diff = np.linalg.norm(r[-1] - r_reb, axis=1) / np.linalg.norm(r_reb - r_reb[0], axis=1).clip(
         1.0
     )
-    assert diff.max() < 1e-8, diff
+    assert diff.max() < 1e-10, diff
 
 
 def test_velocity_dependent_force_linear_drag():
@@ -295,8 +298,8 @@ def _solar_vs_rebound(years: float):
 
 
 def test_solar_system_100_years_matches_rebound_ias15():
-    # Measured at most 5e-12 (Mercury); 1e-10 allows for the random walk of the
-    # rounding in either code.
+    # Measured at most 1.8e-11 (Mercury; the others below 3e-13); 1e-10
+    # allows for the random walk of the rounding in either code.
     diff = _solar_vs_rebound(100.0)
     assert diff.max() < 1e-10, diff
 
@@ -334,3 +337,39 @@ def test_brouwer_law_energy_error_grows_like_sqrt_t():
     slope = np.polyfit(np.log(t_out[1:]), np.log(rms), 1)[0]
     assert 0.3 < slope < 0.7, (slope, rms)
     assert rms[-1] < 1e-13, rms
+
+
+def test_stepping_kernels_are_loaded_from_the_numba_cache():
+    # The kernels take `accel` as a first-class function type so that they are
+    # compiled once and then loaded from numba's on-disk cache in every new
+    # process (a kernel specialised on a dispatcher argument is recompiled in
+    # each process: ~8 s).  Both kernels have explicit signatures, so importing
+    # them here has already compiled and saved them if the cache was empty; a
+    # fresh process must then load both and compile (save) nothing of them.
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import numpy as np\n"
+        "from hamilton_orbits.effects import newtonian_rhs\n"
+        "from hamilton_orbits.integrators import radau15, wh\n"
+        "r = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[0.0, 0, 0], [0, 1.0, 0]])\n"
+        "gm = np.array([1.0, 0.0]); t = np.array([0.0, 1.0])\n"
+        "radau15.run(newtonian_rhs(), r, v, gm, t); wh.run(newtonian_rhs(), r, v, gm, t, dt=0.1)\n"
+    )
+    src = str(Path(radau15.__file__).resolve().parents[2])
+    env = {**os.environ, "NUMBA_DEBUG_CACHE": "1"}
+    env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    from hamilton_orbits.integrators import wh  # noqa: F401 - compiles / caches wh._advance
+
+    res = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+    )
+    out = res.stdout + res.stderr
+    for name in ("radau15._advance", "wh._advance", "wh._advance_jacobi", "wh._corrector_jacobi"):
+        loaded = [line for line in out.splitlines() if "data loaded" in line and name in line]
+        assert loaded, out[-2000:]
+        saved = [line for line in out.splitlines() if "saved" in line and name in line]
+        assert saved == [], saved

@@ -31,28 +31,36 @@ def solar():
     return nbody_states.solar_system()
 
 
-def _whfast(r0, v0, gm, dt, t_end):
+def _whfast(r0, v0, gm, dt, t_end, coordinates="democraticheliocentric"):
     sim = nbody_states.to_rebound(r0, v0, gm, "whfast")
     sim.dt = dt
-    sim.integrator.coordinates = "democraticheliocentric"
+    sim.integrator.coordinates = coordinates
     sim.integrate(t_end, exact_finish_time=0)
     sim.synchronize()
     assert sim.t == pytest.approx(t_end, rel=1e-12)
     return nbody_states.rebound_state(sim)
 
 
-def test_solar_system_100_years_matches_whfast(solar):
-    # The same map as WHFast in democratic-heliocentric coordinates (same
-    # splitting, same dt = 4 days, 9131 steps): the two differ only by the
-    # rounding of their Kepler solvers.  Measured after 100 years: relative
-    # positions 1.4e-11 (Mercury) and below, energy errors equal to 1e-5 of
-    # their size (-4.5e-10).  Bounds: 1e-9 and 1e-3.
+@pytest.mark.parametrize(
+    ("coordinates", "peer", "rel_energy"),
+    [("democratic_heliocentric", "democraticheliocentric", 1e-3), ("jacobi", "jacobi", 1e-2)],
+)
+def test_solar_system_100_years_matches_whfast(solar, coordinates, peer, rel_energy):
+    # The same map as WHFast in the same coordinates (same splitting, same
+    # dt = 4 days, 9131 steps): the two differ only by rounding (their Kepler
+    # solvers; in Jacobi coordinates also the Sun-Mercury term, which WHFast
+    # leaves out of both the kick and its correction and we cancel).
+    # Measured after 100 years: relative positions at most 1.4e-11 (DH) and
+    # 9e-11 (Jacobi, Mercury); energy errors equal to 1e-5 (DH, -4.5e-10) and
+    # 1e-3 (Jacobi, 4.9e-11) of their size.  Bounds: 1e-9, and 1e-3 / 1e-2.
     _, r0, v0, gm = solar
     dt = 4.0
     t_end = 9131 * dt
-    r, v, steps = wh.run(newtonian_rhs(), r0, v0, gm, np.array([0.0, t_end]), dt=dt)
+    r, v, steps = wh.run(
+        newtonian_rhs(), r0, v0, gm, np.array([0.0, t_end]), dt=dt, coordinates=coordinates
+    )
     assert steps == 9131
-    r_w, v_w = _whfast(r0, v0, gm, dt, t_end)
+    r_w, v_w = _whfast(r0, v0, gm, dt, t_end, peer)
     scale = np.linalg.norm(r_w - r_w[0], axis=1)
     scale[0] = np.linalg.norm(r_w[0])
     diff = np.linalg.norm(r[-1] - r_w, axis=1) / scale
@@ -60,14 +68,15 @@ def test_solar_system_100_years_matches_whfast(solar):
     e0 = _energy(r0, v0, gm)
     de_ours = _energy(r[-1], v[-1], gm) / e0 - 1.0
     de_whfast = _energy(r_w, v_w, gm) / e0 - 1.0
-    assert abs(de_ours - de_whfast) < 1e-3 * abs(de_whfast), (de_ours, de_whfast)
+    assert abs(de_ours - de_whfast) < rel_energy * abs(de_whfast), (de_ours, de_whfast)
 
 
 def test_energy_error_is_second_order_and_bounded(solar):
     # Wisdom-Holman: the energy error oscillates with an amplitude ~ eps dt^2
     # (no drift).  Halving dt divides the largest error over 20 years by 4
-    # (measured 3.98; bounds 3.5 .. 4.5), and the error at the end is no larger
-    # than the largest one seen before (bounded, not growing).
+    # (measured 3.72; bounds 3.5 .. 4.5), and the largest error of the second
+    # decade is that of the first (measured ratio 1.03 and 1.04; bound 1.2: a
+    # drift would grow it).
     _, r0, v0, gm = solar
     t_out = np.linspace(0.0, 20 * 365.25, 41)
     e0 = _energy(r0, v0, gm)
@@ -76,11 +85,12 @@ def test_energy_error_is_second_order_and_bounded(solar):
         r, v, _ = wh.run(newtonian_rhs(), r0, v0, gm, t_out, dt=dt)
         de = np.abs(_energy(r, v, gm) / e0 - 1.0)
         amp.append(de.max())
-        assert de[-1] <= de.max()
+        assert de[21:].max() < 1.2 * de[1:21].max(), de
     assert 3.5 < amp[0] / amp[1] < 4.5, amp
 
 
-def test_test_particle_drift_is_the_exact_kepler_orbit():
+@pytest.mark.parametrize("coordinates", wh.COORDINATES)
+def test_test_particle_drift_is_the_exact_kepler_orbit(coordinates):
     # A massless body about a single star: the kick and the jump vanish, and
     # the map is the exact Kepler propagation (the shared universal-variable
     # kernel) however large dt.  Reference: KeplerOrbit.  Energy: measured
@@ -93,7 +103,13 @@ def test_test_particle_drift_is_the_exact_kepler_orbit():
     orbit = KeplerOrbit.from_state(r0[1], v0[1], 1.0)
     t_end = 50 * float(orbit.period)
     r, v, steps = wh.run(
-        newtonian_rhs(), r0, v0, np.array([1.0, 0.0]), np.array([0.0, t_end]), dt=t_end / 350
+        newtonian_rhs(),
+        r0,
+        v0,
+        np.array([1.0, 0.0]),
+        np.array([0.0, t_end]),
+        dt=t_end / 350,
+        coordinates=coordinates,
     )
     assert steps == 350
     r_ref, _ = orbit.propagate(t_end).state()
@@ -103,7 +119,8 @@ def test_test_particle_drift_is_the_exact_kepler_orbit():
     assert abs(energy / energy0 - 1.0) < 64 * EPS
 
 
-def test_listed_effect_joins_the_kick_and_moves_the_barycentre(solar):
+@pytest.mark.parametrize("coordinates", wh.COORDINATES)
+def test_listed_effect_joins_the_kick_and_moves_the_barycentre(solar, coordinates):
     # A uniform field g on every body: the relative motion is unchanged and the
     # barycentre falls as g t^2 / 2, exactly (its net acceleration is applied
     # to the barycentre, none to the heliocentric coordinates).
@@ -118,8 +135,8 @@ def test_listed_effect_joins_the_kick_and_moves_the_barycentre(solar):
 
     rhs = RHS(newtonian_rhs().accel, field, False, ("newtonian", "field"))
     t = np.array([0.0, 400.0])
-    r_f, v_f, _ = wh.run(rhs, r0, v0, gm, t, dt=4.0)
-    r_n, v_n, _ = wh.run(newtonian_rhs(), r0, v0, gm, t, dt=4.0)
+    r_f, v_f, _ = wh.run(rhs, r0, v0, gm, t, dt=4.0, coordinates=coordinates)
+    r_n, v_n, _ = wh.run(newtonian_rhs(), r0, v0, gm, t, dt=4.0, coordinates=coordinates)
     # 1e-12 absolute: 100 kicks of the barycentre velocity and 100 drifts
     np.testing.assert_allclose(r_f[-1] - r_n[-1], np.tile(0.5 * g * 400.0**2, (9, 1)), atol=1e-12)
     np.testing.assert_allclose(v_f[-1] - v_n[-1], np.tile(g * 400.0, (9, 1)), atol=1e-14)
@@ -139,5 +156,54 @@ def test_bad_input():
         wh.run(newtonian_rhs(), r0, v0, np.zeros(2), np.array([0.0, 1.0]), dt=0.1)
     with pytest.raises(ValueError, match=r"`dt` > 0, got -0.1"):
         wh.run(newtonian_rhs(), r0, v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]), dt=-0.1)
+    with pytest.raises(ValueError, match=r"`coordinates` to be one of .*got 'helio'"):
+        wh.run(
+            newtonian_rhs(), r0, v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]), coordinates="helio"
+        )
     with pytest.raises(ValueError, match=r"no body is bound"):
         wh.run(newtonian_rhs(), r0, 10 * v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+
+
+def test_jacobi_symplectic_corrector_matches_whfast(solar):
+    # Third-order corrector (Wisdom, Holman & Touma 1996) on the Jacobi map,
+    # against WHFast with corrector = 3 at the same dt = 4 days for 100 years.
+    # Measured: positions agree to 3e-11 (Mercury); the energy error falls from
+    # 4.9e-11 without corrector to 7e-15 (WHFast: 2e-14).  Bounds: 1e-9 for
+    # the positions, 1e-13 for |dE/E| (the corrector removes the eps dt^2
+    # term; what is left is eps^2 dt^2 and rounding).
+    _, r0, v0, gm = solar
+    dt = 4.0
+    t_end = 9131 * dt
+    r, v, _ = wh.run(
+        newtonian_rhs(),
+        r0,
+        v0,
+        gm,
+        np.array([0.0, t_end]),
+        dt=dt,
+        coordinates="jacobi",
+        corrector=3,
+    )
+    sim = nbody_states.to_rebound(r0, v0, gm, "whfast")
+    sim.dt = dt
+    sim.integrator.coordinates = "jacobi"
+    sim.integrator.corrector = 3
+    sim.integrate(t_end, exact_finish_time=0)
+    sim.synchronize()
+    r_w, _ = nbody_states.rebound_state(sim)
+    scale = np.linalg.norm(r_w - r_w[0], axis=1)
+    scale[0] = np.linalg.norm(r_w[0])
+    diff = np.linalg.norm(r[-1] - r_w, axis=1) / scale
+    assert diff.max() < 1e-9, diff
+    de = _energy(r[-1], v[-1], gm) / _energy(r0, v0, gm) - 1.0
+    assert abs(de) < 1e-13, de
+
+
+def test_corrector_needs_jacobi():
+    r0 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    v0 = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    args = (newtonian_rhs(), r0, v0, np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    with pytest.raises(ValueError, match=r"coordinates='jacobi' with `corrector` = 3"):
+        wh.run(*args, dt=0.1, corrector=3)
+    with pytest.raises(ValueError, match=r"`corrector` to be 0 or 3, got 5"):
+        wh.run(*args, dt=0.1, coordinates="jacobi", corrector=5)

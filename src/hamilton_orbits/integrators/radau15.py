@@ -250,7 +250,6 @@ def _advance(
     prs23 = st[7] != 0.0
     steps = 0
     status = 0
-    s = np.empty(9)
     csb = np.zeros((7, m))
     while t < t_end:
         if steps >= max_steps:
@@ -316,32 +315,41 @@ def _advance(
             iters += 1
             for ns in range(1, 8):
                 hn = h[ns]
-                s[0] = dt_try * hn
-                s[1] = s[0] * s[0] / 2.0
-                s[2] = s[1] * hn / 3.0
-                s[3] = s[2] * hn / 2.0
-                s[4] = 3.0 * s[3] * hn / 5.0
-                s[5] = 2.0 * s[4] * hn / 3.0
-                s[6] = 5.0 * s[5] * hn / 7.0
-                s[7] = 3.0 * s[6] * hn / 4.0
-                s[8] = 7.0 * s[7] * hn / 9.0
+                # positions at h_n, eq. (6) of Rein & Spiegel (2015) in Horner
+                # form (one rounding per coefficient, no large powers)
+                k8 = 7.0 * hn / 9.0
+                k7 = 3.0 * hn / 4.0
+                k6 = 5.0 * hn / 7.0
+                k5 = 2.0 * hn / 3.0
+                k4 = 3.0 * hn / 5.0
+                k3 = hn / 2.0
+                k2 = hn / 3.0
+                dth = dt_try * hn
+                dth2 = dth / 2.0
                 for k in range(m):
-                    xsf[k] = (
+                    poly = (
                         (
-                            s[8] * b[6, k]
-                            + s[7] * b[5, k]
-                            + s[6] * b[4, k]
-                            + s[5] * b[3, k]
-                            + s[4] * b[2, k]
-                            + s[3] * b[1, k]
-                            + s[2] * b[0, k]
-                            + s[1] * a0[k]
-                            + s[0] * v0[k]
+                            (
+                                (
+                                    (
+                                        (((b[6, k] * k8 + b[5, k]) * k7 + b[4, k]) * k6 + b[3, k])
+                                        * k5
+                                        + b[2, k]
+                                    )
+                                    * k4
+                                    + b[1, k]
+                                )
+                                * k3
+                                + b[0, k]
+                            )
+                            * k2
+                            + a0[k]
                         )
-                        - csx0[k]
-                    ) + x0[k]
+                        * dth2
+                        + v0[k]
+                    ) * dth
+                    xsf[k] = (poly - csx0[k]) + x0[k]
                 if need_v:
-                    dth = dt_try * hn
                     for k in range(m):
                         vsf[k] = (
                             dth

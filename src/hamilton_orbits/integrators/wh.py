@@ -1,4 +1,4 @@
-"""Wisdom-Holman map in democratic-heliocentric coordinates.
+"""Wisdom-Holman map in democratic-heliocentric (default) or Jacobi coordinates.
 
 Wisdom & Holman (1991), AJ 102, 1528, in the democratic-heliocentric form of
 Duncan, Levison & Lee (1998), AJ 116, 2067, section 3: with heliocentric
@@ -23,9 +23,15 @@ the right-hand side (``rhs.extra``, velocity-independent only) are added to
 the interaction kick, evaluated at the inertial positions; their net
 acceleration of the barycentre moves the barycentre.
 
+With ``coordinates="jacobi"`` (Wisdom & Holman 1991) body ``i`` moves on a
+Kepler orbit about the total mass ``eta_i`` of the bodies up to it, about the
+barycentre of the bodies before it; the kick is the inertial acceleration in
+Jacobi form plus ``G eta_i r'_i / |r'_i|^3`` (the part the Kepler step already
+took), and there is no jump.
+
 Velocity-dependent effects are refused (the kick would not be symplectic).
-No symplectic corrector is applied (correctors are defined for Jacobi
-coordinates; WHFast does not offer them in these coordinates either).
+With Jacobi coordinates the third-order symplectic corrector of Wisdom,
+Holman & Touma (1996) is available (``corrector=3``).
 """
 
 from __future__ import annotations
@@ -42,10 +48,11 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.integrators import _setup
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "default_step", "run"]
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
 
 NAME = "wh"
 ACCEPTS_VELOCITY_DEPENDENT = False
+COORDINATES = ("democratic_heliocentric", "jacobi")
 
 _F1 = types.float64[::1]
 _F2 = types.float64[:, ::1]
@@ -178,6 +185,167 @@ def _advance(
     return n_steps, -1
 
 
+@njit(cache=True)
+def _jacobi_to_inertial_pos(qj, gm, eta, r):  # pragma: no cover - compiled
+    """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre).
+
+    With ``S_i = sum_{j<=i} m_j r_j``: ``S_{n-1} = eta_{n-1} qj_0`` and, going
+    down, ``S_{i-1} = (S_i - m_i qj_i) eta_{i-1} / eta_i``,
+    ``r_i = qj_i + S_{i-1} / eta_{i-1}``, ``r_0 = S_0 / m_0``."""
+    n = qj.shape[0]
+    for k in range(3):
+        s = eta[n - 1] * qj[0, k]
+        for i in range(n - 1, 0, -1):
+            s = (s - gm[i] * qj[i, k]) * (eta[i - 1] / eta[i])
+            r[i, k] = qj[i, k] + s / eta[i - 1]
+        r[0, k] = s / gm[0]
+
+
+@njit(cache=True)
+def _inertial_to_jacobi_acc(a, gm, eta, aj):  # pragma: no cover - compiled
+    """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1."""
+    n = a.shape[0]
+    for k in range(3):
+        s = gm[0] * a[0, k]
+        for i in range(1, n):
+            aj[i, k] = a[i, k] - s / eta[i - 1]
+            s += gm[i] * a[i, k]
+
+
+@njit(cache=True)
+def _kepler_jacobi(qj, uj, eta, tau):  # pragma: no cover - compiled
+    """Each Jacobi body ``i >= 1`` on its Kepler orbit about ``G eta_i`` by ``tau``;
+    returns the first failing index or -1."""
+    for i in range(1, qj.shape[0]):
+        x, y, z, vx, vy, vz = _kepler.propagate_uv(
+            qj[i, 0], qj[i, 1], qj[i, 2], uj[i, 0], uj[i, 1], uj[i, 2], eta[i], tau
+        )
+        if not math.isfinite(x + y + z + vx + vy + vz):
+            return i
+        qj[i, 0] = x
+        qj[i, 1] = y
+        qj[i, 2] = z
+        uj[i, 0] = vx
+        uj[i, 1] = vy
+        uj[i, 2] = vz
+    return -1
+
+
+@njit(cache=True)
+def _kick_jacobi(
+    extra, has_extra, qj, uj, gm, eta, h, move_com, acc, accj, acc_x, r_in, v_in
+):  # pragma: no cover - compiled
+    """The interaction kick of length ``h`` in Jacobi coordinates."""
+    n = qj.shape[0]
+    _jacobi_to_inertial_pos(qj, gm, eta, r_in)
+    _nbody.newtonian(r_in, v_in, gm, acc)
+    if has_extra:
+        for i in range(n):
+            for k in range(3):
+                acc_x[i, k] = 0.0
+        extra(r_in, v_in, gm, acc_x)
+        m_tot = eta[n - 1]
+        for k in range(3):
+            a_cm = 0.0
+            for i in range(n):
+                a_cm += gm[i] * acc_x[i, k]
+                acc[i, k] += acc_x[i, k]
+            if move_com:
+                # the effects' net force moves the barycentre
+                uj[0, k] += h * a_cm / m_tot
+    _inertial_to_jacobi_acc(acc, gm, eta, accj)
+    for i in range(1, n):
+        d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
+        f = eta[i] / (d2 * math.sqrt(d2))
+        for k in range(3):
+            uj[i, k] += h * (accj[i, k] + f * qj[i, k])
+
+
+# Third-order symplectic corrector (Wisdom, Holman & Touma 1996, table 1 as
+# used by WHFast, Rein & Tamayo 2015): a = sqrt(7/40), b = -sqrt(10/7) / 48.
+_CORR_A = math.sqrt(7.0 / 40.0)
+_CORR_B = -math.sqrt(10.0 / 7.0) / 48.0
+
+
+@njit(
+    types.int64(_setup.ACCEL_TYPE, types.boolean, _F2, _F2, _F1, _F1, types.float64, types.float64),
+    cache=True,
+)
+def _corrector_jacobi(extra, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: no cover
+    """Apply the third-order corrector (``sign = 1``) or its inverse (``-1``):
+    ``Z(a dt, -sign b dt) Z(-a dt, sign b dt)`` with ``Z(a, b)`` = Kepler a,
+    kick -b, Kepler -2a, kick b, Kepler a.  Returns a failing index or -1."""
+    n = qj.shape[0]
+    acc = np.empty((n, 3))
+    accj = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.zeros((n, 3))
+    for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
+        bad = _kepler_jacobi(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, -b, False, acc, accj, acc_x, r_in, v_in)
+        bad = _kepler_jacobi(qj, uj, eta, -2.0 * a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, b, False, acc, accj, acc_x, r_in, v_in)
+        bad = _kepler_jacobi(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+    return -1
+
+
+@njit(
+    types.Tuple((types.int64, types.int64))(
+        _setup.ACCEL_TYPE,
+        types.boolean,
+        _F2,
+        _F2,
+        _F1,
+        _F1,
+        types.float64,
+        types.int64,
+        types.float64,
+    ),
+    cache=True,
+)
+def _advance_jacobi(
+    extra, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last
+):  # pragma: no cover - compiled
+    """As :func:`_advance` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
+    ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
+    sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
+    listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
+    removes the part the Kepler step already accounts for."""
+    n = qj.shape[0]
+    acc = np.empty((n, 3))
+    accj = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.zeros((n, 3))
+    h = dt if n_steps > 1 else dt_last
+    bad = _kepler_jacobi(qj, uj, eta, 0.5 * h)
+    if bad >= 0:
+        return 0, bad
+    for k in range(3):
+        qj[0, k] += 0.5 * h * uj[0, k]
+    for s in range(n_steps):
+        h = dt if s < n_steps - 1 else dt_last
+        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, h, True, acc, accj, acc_x, r_in, v_in)
+        if s < n_steps - 1:
+            h_next = dt if s + 1 < n_steps - 1 else dt_last
+            tau = 0.5 * (h + h_next)
+        else:
+            tau = 0.5 * h
+        bad = _kepler_jacobi(qj, uj, eta, tau)
+        if bad >= 0:
+            return s, bad
+        for k in range(3):
+            qj[0, k] += tau * uj[0, k]
+    return n_steps, -1
+
+
 def default_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | None = None) -> float:
     """The step ``run`` takes when ``dt`` is not given.
 
@@ -222,8 +390,10 @@ def run(
     dt: float | None = None,
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
+    coordinates: str = "democratic_heliocentric",
+    corrector: int = 0,
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Integrate with the Wisdom-Holman map (democratic-heliocentric coordinates).
+    """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
     Parameters
     ----------
@@ -244,6 +414,16 @@ def run(
         Used only without ``dt``, to choose it (see :func:`default_step`).
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` is reached.
+    coordinates : {"democratic_heliocentric", "jacobi"}, optional
+        The splitting: democratic-heliocentric (default; Duncan, Levison & Lee
+        1998) or Jacobi (Wisdom & Holman 1991; the central body first, then the
+        others in the order given, each on a Kepler orbit about the total mass
+        inside it).  Both are WHFast's maps of the same names.
+    corrector : {0, 3}, optional
+        With Jacobi coordinates, 3 applies the third-order symplectic corrector
+        of Wisdom, Holman & Touma (1996) before the steps of each output
+        interval and its inverse after them (so outputs are in true
+        coordinates); it removes the leading O(eps dt^2) error term.
 
     Returns
     -------
@@ -281,6 +461,18 @@ def run(
         )
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
     dt_f, tol_f = _setup.check_dt_tol(dt, tol)
+    if coordinates not in COORDINATES:
+        raise ValueError(
+            f"Expected `coordinates` to be one of {', '.join(map(repr, COORDINATES))}, "
+            f"got {coordinates!r}"
+        )
+    if corrector not in (0, 3):
+        raise ValueError(f"Expected `corrector` to be 0 or 3, got {corrector!r}")
+    if corrector and coordinates != "jacobi":
+        raise ValueError(
+            f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
+            "(the corrector is defined for the Jacobi splitting)"
+        )
     n = r0.shape[0]
     c = int(np.argmax(gm))
     if not gm[c] > 0.0:
@@ -293,11 +485,23 @@ def run(
     r = r0[order]
     v = v0[order]
     m_tot = g.sum()
-    com = np.concatenate([(g @ r) / m_tot, (g @ v) / m_tot])
-    q = np.ascontiguousarray(r - r[0])
-    u = np.ascontiguousarray(v - com[3:])
-    g_p = g.copy()
-    g_p[0] = 0.0
+    jacobi = coordinates == "jacobi"
+    if jacobi:
+        eta = np.cumsum(g)
+        s_r = np.cumsum(g[:, None] * r, axis=0)
+        s_v = np.cumsum(g[:, None] * v, axis=0)
+        q = np.empty_like(r)
+        u = np.empty_like(v)
+        q[0] = s_r[-1] / eta[-1]
+        u[0] = s_v[-1] / eta[-1]
+        q[1:] = r[1:] - s_r[:-1] / eta[:-1, None]
+        u[1:] = v[1:] - s_v[:-1] / eta[:-1, None]
+    else:
+        com = np.concatenate([(g @ r) / m_tot, (g @ v) / m_tot])
+        q = np.ascontiguousarray(r - r[0])
+        u = np.ascontiguousarray(v - com[3:])
+        g_p = g.copy()
+        g_p[0] = 0.0
     extra = rhs.extra if rhs.extra is not None else _no_extra
     nt = t_out.shape[0]
     r_out = np.empty((nt, n, 3))
@@ -310,7 +514,20 @@ def run(
         span = t_out[i] - t_out[i - 1]
         n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
         last = span - (n_steps - 1) * dt_f
-        steps, bad = _advance(extra, rhs.extra is not None, q, u, g, g_p, com, dt_f, n_steps, last)
+        if jacobi:
+            has_extra = rhs.extra is not None
+            bad = -1
+            if corrector:
+                bad = _corrector_jacobi(extra, has_extra, q, u, g, eta, dt_f, 1.0)
+            steps = 0
+            if bad < 0:
+                steps, bad = _advance_jacobi(extra, has_extra, q, u, g, eta, dt_f, n_steps, last)
+            if bad < 0 and corrector:
+                bad = _corrector_jacobi(extra, has_extra, q, u, g, eta, dt_f, -1.0)
+        else:
+            steps, bad = _advance(
+                extra, rhs.extra is not None, q, u, g, g_p, com, dt_f, n_steps, last
+            )
         total += steps
         if bad >= 0:
             raise ConvergenceError(
@@ -318,12 +535,18 @@ def run(
                 f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = {float(t_out[i])!r}"
             )
         # back to inertial coordinates
-        r0_in = com[:3] - (g[1:] @ q[1:]) / m_tot
-        v0_in = com[3:] - (g[1:] @ u[1:]) / g[0]
-        rr = q + r0_in
-        rr[0] = r0_in
-        vv = u + com[3:]
-        vv[0] = v0_in
+        if jacobi:
+            rr = np.empty_like(q)
+            vv = np.empty_like(u)
+            _jacobi_to_inertial_pos(q, g, eta, rr)
+            _jacobi_to_inertial_pos(u, g, eta, vv)
+        else:
+            r0_in = com[:3] - (g[1:] @ q[1:]) / m_tot
+            v0_in = com[3:] - (g[1:] @ u[1:]) / g[0]
+            rr = q + r0_in
+            rr[0] = r0_in
+            vv = u + com[3:]
+            vv[0] = v0_in
         r_out[i] = rr[inv]
         v_out[i] = vv[inv]
         if on_output is not None:
