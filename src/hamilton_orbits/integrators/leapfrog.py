@@ -12,13 +12,21 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+
+from hamilton_orbits.integrators._setup import ACCEL_TYPE
 
 NAME = "leapfrog"
 ACCEPTS_VELOCITY_DEPENDENT = False
 
 
-@njit(cache=True)
+_F2 = types.float64[:, ::1]
+
+
+# explicit signature with ``accel`` as a first-class function type: compiled once
+# and loaded from the cache in later processes, whatever the right-hand side
+@njit(types.int64(ACCEL_TYPE, _F2, _F2, types.float64[::1], types.float64, types.float64,
+                  types.float64), cache=True)
 def _advance(accel, r, v, gm, t0, t1, dt):  # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the last one shortened)."""
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
@@ -83,8 +91,9 @@ def run(
         if tol is None:
             raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
         dt = choose_dt(r0, v0, gm, tol)
-    r = np.array(r0, dtype=np.float64)
-    v = np.array(v0, dtype=np.float64)
+    r = np.ascontiguousarray(r0, dtype=np.float64).copy()
+    v = np.ascontiguousarray(v0, dtype=np.float64).copy()
+    gm = np.ascontiguousarray(gm, dtype=np.float64)
     out_r = np.empty((len(t_out),) + r.shape)
     out_v = np.empty_like(out_r)
     out_r[0] = r
