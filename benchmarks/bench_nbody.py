@@ -458,6 +458,87 @@ def bench_work_precision(years: float) -> None:
     print(f"    table: {md}\n    figure: {png}")
 
 
+def bench_leapfrog(years: float, repeat: int) -> None:
+    from hamilton_orbits.integrators import leapfrog
+
+    r0, v0, gm = solar_system()
+    dt = 0.5
+    n = round(years * 365.25 / dt)
+    t_end = n * dt
+    print(f"[5] leapfrog vs rebound leapfrog, solar system, dt = {dt} d, {n} steps")
+
+    def ours():
+        return leapfrog.run(rhs(), r0, v0, gm, np.array([0.0, t_end]), dt=dt)
+
+    def peer():
+        sim = to_rebound(r0, v0, gm, "leapfrog")
+        sim.dt = dt
+        sim.integrate(t_end, exact_finish_time=0)
+        return sim
+
+    t_o, t_p, ratio, (r, _, steps), sim = median_ratio(ours, peer, repeat)
+    x, _ = reb_state(sim)
+    dpos = np.max(np.linalg.norm(r[-1] - x, axis=1)[1:] / np.linalg.norm(x[1:] - x[0], axis=1))
+    print(f"    ours {t_o / steps * 1e6:6.2f} us/step   rebound {t_p / sim.steps_done * 1e6:6.2f}"
+          f" us/step   ratio {ratio:5.2f}   max rel. position difference {dpos:.1e}")
+
+
+def bench_effects_cost(years: float, repeat: int) -> None:
+    """effects=() against a Newtonian kernel written here, and the price of listed effects."""
+    from numba import njit
+
+    from hamilton_orbits.effects import RHS, compile_rhs
+    from hamilton_orbits.integrators import radau15
+    from hamilton_orbits.nbody import Body, System
+
+    @njit
+    def plain_newton(r, v, gm, acc):  # gravity alone, written for this benchmark
+        n = r.shape[0]
+        for i in range(n):
+            acc[i, 0] = 0.0
+            acc[i, 1] = 0.0
+            acc[i, 2] = 0.0
+        for i in range(n):
+            for j in range(i + 1, n):
+                dx = r[j, 0] - r[i, 0]
+                dy = r[j, 1] - r[i, 1]
+                dz = r[j, 2] - r[i, 2]
+                d2 = dx * dx + dy * dy + dz * dz
+                f = 1.0 / (d2 * np.sqrt(d2))
+                acc[i, 0] += gm[j] * f * dx
+                acc[i, 1] += gm[j] * f * dy
+                acc[i, 2] += gm[j] * f * dz
+                acc[j, 0] -= gm[i] * f * dx
+                acc[j, 1] -= gm[i] * f * dy
+                acc[j, 2] -= gm[i] * f * dz
+
+    r0, v0, gm = solar_system()
+    system = System([Body(f"b{k}", gm[k], r0[k], v0[k]) for k in range(len(gm))])
+    t = np.array([0.0, years * 365.25])
+    plain = RHS(plain_newton, None, False, ("newtonian",))
+    variants = {
+        "effects=()": compile_rhs(system, ()),
+        "hand-written Newtonian kernel": plain,
+        "effects=['gr_potential']": compile_rhs(system, [{"name": "gr_potential",
+                                                           "c": 173.1446}]),
+        "effects=['gr']": compile_rhs(system, [{"name": "gr", "c": 173.1446}]),
+    }
+    for rhs_ in variants.values():  # compile every variant before timing
+        radau15.run(rhs_, r0, v0, gm, np.array([0.0, 1.0]), dt=0.5)
+    print(f"[6] what an effect costs: radau15 at a fixed 1-day step, {years:g} years "
+          "(time per step, median of repeats)")
+    base = None
+    for name, rhs_ in variants.items():
+        times = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            _, _, steps = radau15.run(rhs_, r0, v0, gm, t, dt=1.0)
+            times.append((time.perf_counter() - t0) / steps)
+        med = float(np.median(times))
+        base = base or med
+        print(f"    {name:<32}{med * 1e6:8.2f} us/step   x{med / base:5.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter spans, fewer sizes")
@@ -469,6 +550,8 @@ def main() -> None:
     bench_wh(100.0 if quick else 1000.0, repeat)
     bench_scaling(quick, repeat)
     bench_work_precision(20.0 if quick else 100.0)
+    bench_leapfrog(10.0 if quick else 100.0, repeat)
+    bench_effects_cost(10.0 if quick else 100.0, repeat)
 
 
 if __name__ == "__main__":
