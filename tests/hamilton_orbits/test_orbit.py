@@ -197,16 +197,21 @@ def test_elements_state_elements(e, inc, lan, argp, m, q):
     # time since periapsis is continuous across e = 1 (M is not: a state built on
     # the parabola may come back as an ellipse or hyperbola with |1 - e| ~ eps)
     n = math.sqrt(1.0 / (2 * q**3)) if e == 1 else math.sqrt(abs(1 - e) ** 3 / q**3)
+    # the periapsis direction of a near-circle is ill-conditioned: the eccentricity
+    # vector computed from a state carries an absolute error of a few eps, which
+    # turns it by ~ eps / e; so do argp, varpi and M (hypothesis found e = 2.4e-6,
+    # where that is 1e-10 rad)
+    turn = 16 * np.finfo(float).eps / max(e, 1e-300)
     if e > 1e-6:
         # M is undefined for e = 0 (argp = 0 and M carries argp + M)
-        assert abs(back.time_since_periapsis - m / n) <= 1e-12 * max(1.0, abs(m)) / n
+        assert abs(back.time_since_periapsis - m / n) <= (1e-12 * max(1.0, abs(m)) + turn) / n
     s = 1.0 if inc <= math.pi / 2 else -1.0
     varpi = lan + s * argp
     assert _angle_diff(back.mean_longitude, varpi + s * m) <= 1e-12
     if 1e-6 < inc < math.pi - 1e-6:
         assert _angle_diff(back.lan, lan) <= 1e-12
     if e > 1e-6:
-        assert _angle_diff(back.varpi, varpi) <= 1e-12
+        assert _angle_diff(back.varpi, varpi) <= 1e-12 + turn
 
 
 # ------------------------------------------------------ textbook worked examples
