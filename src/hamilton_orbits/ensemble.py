@@ -36,7 +36,7 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     --------
     >>> from hamilton_orbits import Scene
     >>> s = Scene.bundled("dzhanibekov")
-    >>> row = run_member(s.data, s.source, {"duration": "20 s"})
+    >>> row = run_member(s.data, s.source, {"duration": "40 s"})
     >>> row["error"] is None, row["simulated flip interval [s]"] > 0
     (True, True)
     """

@@ -206,7 +206,7 @@ class Scene:
     Traceback (most recent call last):
     ...
     hamilton_orbits.scene.SceneError: invalid scene (...):
-      <dict>: duraton: unknown key (did you mean 'duration'?)
+      <dict>: duraton: unknown key (did you mean 'duration'...?)
       ...
     """
 
@@ -362,7 +362,7 @@ def format_table(rows: Sequence[Mapping[str, Any]]) -> str:
     --------
     >>> print(format_table([{"body": "sun", "dr": 1e-12}, {"body": "earth", "dr": 2.5e-10}]))
     body   dr
-    -----  --------
+    -----  -------
     sun    1e-12
     earth  2.5e-10
     """
