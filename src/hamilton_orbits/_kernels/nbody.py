@@ -97,6 +97,17 @@ def nothing(r, v, gm, acc):  # pragma: no cover - compiled
     return
 
 
+@njit(inline="always", cache=True)
+def _push_pair(acc, i, s, ax, ay, az, back):  # pragma: no cover - compiled
+    """Add ``a`` to body ``i`` and the reaction ``-back * a`` to the source ``s``."""
+    acc[i, 0] += ax
+    acc[i, 1] += ay
+    acc[i, 2] += az
+    acc[s, 0] -= back * ax
+    acc[s, 1] -= back * ay
+    acc[s, 2] -= back * az
+
+
 @njit(cache=True)
 def gr_anderson(r, v, gm, acc, p):  # pragma: no cover - compiled
     """First post-Newtonian correction from one dominant body (one-body metric).
@@ -130,16 +141,8 @@ def gr_anderson(r, v, gm, acc, p):  # pragma: no cover - compiled
         f = mu / (c2 * d2 * d)
         fr = f * (4.0 * mu / d - w2)
         fv = f * 4.0 * dw
-        ax = fr * dx + fv * wx
-        ay = fr * dy + fv * wy
-        az = fr * dz + fv * wz
-        acc[i, 0] += ax
-        acc[i, 1] += ay
-        acc[i, 2] += az
-        back = gm[i] / mu
-        acc[s, 0] -= back * ax
-        acc[s, 1] -= back * ay
-        acc[s, 2] -= back * az
+        _push_pair(acc, i, s, fr * dx + fv * wx, fr * dy + fv * wy, fr * dz + fv * wz,
+                   gm[i] / mu)
 
 
 @njit(cache=True)
@@ -161,13 +164,7 @@ def gr_potential(r, v, gm, acc, p):  # pragma: no cover - compiled
         dz = r[i, 2] - r[s, 2]
         d2 = dx * dx + dy * dy + dz * dz
         f = -6.0 * mu * mu / (c2 * d2 * d2)
-        acc[i, 0] += f * dx
-        acc[i, 1] += f * dy
-        acc[i, 2] += f * dz
-        back = gm[i] / mu
-        acc[s, 0] -= back * f * dx
-        acc[s, 1] -= back * f * dy
-        acc[s, 2] -= back * f * dz
+        _push_pair(acc, i, s, f * dx, f * dy, f * dz, gm[i] / mu)
 
 
 @njit(cache=True)
@@ -201,13 +198,5 @@ def j2_field(r, v, gm, acc, p):  # pragma: no cover - compiled
         z = dx * kx + dy * ky + dz * kz
         f = -1.5 * j2 * mu * rad2 / (d2 * d2 * d)
         g = 1.0 - 5.0 * z * z / d2
-        ax = f * (g * dx + 2.0 * z * kx)
-        ay = f * (g * dy + 2.0 * z * ky)
-        az = f * (g * dz + 2.0 * z * kz)
-        acc[i, 0] += ax
-        acc[i, 1] += ay
-        acc[i, 2] += az
-        back = gm[i] / mu
-        acc[b, 0] -= back * ax
-        acc[b, 1] -= back * ay
-        acc[b, 2] -= back * az
+        _push_pair(acc, i, b, f * (g * dx + 2.0 * z * kx), f * (g * dy + 2.0 * z * ky),
+                   f * (g * dz + 2.0 * z * kz), gm[i] / mu)
