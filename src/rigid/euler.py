@@ -26,7 +26,7 @@ import numpy as np
 from hamilton_orbits._validation import as_float_array, check_positive, check_trailing
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from rigid._kernels import euler as _k
 
 __all__ = [
     "BodyTorque",

@@ -32,7 +32,7 @@ import numpy as np
 from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _free_kernels as _fk
+from rigid._kernels import free as _fk
 from rigid.body import RigidBody
 
 __all__ = ["FreeParameters", "free_motion", "free_motion_arrays", "free_parameters"]

@@ -31,7 +31,7 @@ depends on (t, attitude) only, the fixed-step methods keep their order):
 All splittings fuse the neighbouring flows of one part (also across steps) and
 keep their rounding error at a few ulp per *run*: each rotation is applied as a
 compensated (TwoSum) increment with cos - 1 and sin from the half angle, so it
-is orthogonal to O(eps h^2) (see :mod:`rigid._euler_kernels`).  The attitude is
+is orthogonal to O(eps h^2) (see :mod:`rigid._kernels.euler`).  The attitude is
 normalised on output only (it is not projected inside the run);
 ``norm_drift`` reports max | |q| - 1 | before that.
 ``"exact_kick"``
@@ -66,7 +66,7 @@ import numpy as np
 from hamilton_orbits._validation import as_float_array, check_positive
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from rigid._kernels import euler as _k
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, _encode
 
 __all__ = [
@@ -217,7 +217,7 @@ def _split_ops(
     """(types, fractions of h, time offsets in h, inverse moments) of one step.
 
     Types 0-2 are principal-axis rotations, 3 a torque kick, 4 the Casimir flow
-    (see :func:`rigid._euler_kernels.run_splitting`).
+    (see :func:`rigid._kernels.euler.run_splitting`).
     """
     inv = np.concatenate([1.0 / moments, [0.0, 0.0]])  # axes 0-2, (kick), Casimir
     # Time (for time-dependent torques) is carried by one part: the one with the

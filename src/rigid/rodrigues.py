@@ -48,7 +48,7 @@ import numpy as np
 
 from hamilton_orbits._validation import _first_index, as_float_array, check_trailing
 from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from rigid._kernels import euler as _k
 
 __all__ = [
     "cayley_propagate",

@@ -16,7 +16,7 @@ import numpy as np
 
 from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
-from rigid import _free_kernels as _fk
+from rigid._kernels import free as _fk
 from rigid.body import RigidBody
 
 __all__ = ["confocal", "confocal_rotation", "contrafocal", "disk_equivalent", "time_between"]

@@ -1,4 +1,4 @@
-"""Tests for the exact torque-free motion (rigid.free, rigid._free_kernels)."""
+"""Tests for the exact torque-free motion (rigid.free, rigid._kernels.free)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from scipy.special import ellipj, ellipk, elliprf, elliprj
 
 from hamilton_orbits import Quaternion
 from rigid import RigidBody, free_motion, free_motion_arrays, free_parameters
-from rigid import _free_kernels as fk
+from rigid._kernels import free as fk
 
 EPS = np.finfo(float).eps
 

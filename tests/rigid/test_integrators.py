@@ -14,7 +14,7 @@ from rigid import (
     SpaceTorque,
     integrate,
 )
-from rigid._euler_kernels import sin_versin
+from rigid._kernels.euler import sin_versin
 from rigid.free import free_motion_arrays
 
 EPS = np.finfo(float).eps

@@ -1,0 +1,1 @@
+"""Numba-compiled rigid-body kernels on plain floats.  Nothing here imports astropy."""
