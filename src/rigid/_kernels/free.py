@@ -42,7 +42,7 @@ _LAM = 21
 _M = 22
 _M1 = 23
 _K = 24
-_PIC = 25  # complete Pi(n | m)
+_PIC = 25  # complete Pi(n | m) - K(m) = (n/3) R_J(0, m1, 1, 1 - n)
 _N = 26  # characteristic n = -J3 (J2 - J1) / (J1 (J3 - J2))
 _U0 = 27
 _L = 28
@@ -50,7 +50,7 @@ _J1 = 29
 _J2 = 30
 _J3 = 31
 _COEF = 32  # L (J3 - J1) / (J1 J3 lam)
-_PI0 = 33  # Pi(n; am u0 | m) (with its periodic part)
+_PI0 = 33  # D(u0) = Pi(n; am u0 | m) - u0 (with its secular part)
 _ALPHA0 = 34
 _RHO = 35  # signed ratio in the continuous azimuth of l in the W frame
 _SB = 36  # sign of b (= sign(J3 - J1))
@@ -220,16 +220,18 @@ def ellipk_m1(m1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _pi_reduced(n, s, c, d):  # pragma: no cover - compiled
-    """``Pi(n; phi | m)`` for ``|phi| <= pi/2`` from ``sin, cos phi`` and ``d = dn``.
+def _pi_minus_f(n, s, c, d):  # pragma: no cover - compiled
+    """``Pi(n; phi | m) - F(phi | m)`` for ``|phi| <= pi/2`` from ``sin, cos phi``, ``dn``.
 
-    DLMF 19.25.14: Pi = s R_F(c^2, d^2, 1) + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2).
+    DLMF 19.25.14: Pi = s R_F(c^2, d^2, 1) + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2),
+    and s R_F(c^2, d^2, 1) = F(phi | m) (DLMF 19.25.5).  Only the difference is
+    computed: with ``phi = am r`` the ``F`` part is ``r`` itself, which the caller
+    adds *exactly* in the secular term (no cancellation for thin bodies).
     """
+    if n == 0.0 or s == 0.0:
+        return 0.0
     s2 = s * s
-    val = s * carlson_rf(c * c, d * d, 1.0)
-    if n != 0.0 and s != 0.0:
-        val += n / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - n * s2)
-    return val
+    return n / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - n * s2)
 
 
 # ---------------------------------------------------------------------------
@@ -270,7 +272,7 @@ def _quat_from_signed_permutation(p):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _periodic_at(prm, u):  # pragma: no cover - compiled
-    """Working-frame omega, Pi(n; am u | m) and the continuous azimuth at ``u``."""
+    """Working-frame omega, D(u) = Pi(n; am u | m) - u and the continuous azimuth at ``u``."""
     kk = prm[_K]
     k = math.floor((u + kk) / (2.0 * kk))
     r = u - 2.0 * kk * k
@@ -281,14 +283,14 @@ def _periodic_at(prm, u):  # pragma: no cover - compiled
     w1 = prm[_A] * sg * c
     w2 = prm[_B] * sg * s
     w3 = prm[_C] * d
-    pi_u = 2.0 * k * prm[_PIC] + _pi_reduced(prm[_N], s, c, d)
+    pi_u = 2.0 * k * prm[_PIC] + _pi_minus_f(prm[_N], s, c, d)
     alpha = prm[_SB] * k * math.pi + math.atan2(prm[_RHO] * s, c)
     return w1, w2, w3, pi_u, alpha
 
 
 @njit(cache=True)
 def _separatrix_at(prm, u):  # pragma: no cover - compiled
-    """Working-frame omega, Pi(n; am u | 1) and the azimuth on the separatrix."""
+    """Working-frame omega, D(u) = Pi(n; am u | 1) - u and the azimuth on the separatrix."""
     e = math.exp(-abs(u))
     sech = 2.0 * e / (1.0 + e * e)
     th = math.tanh(u)
@@ -298,7 +300,8 @@ def _separatrix_at(prm, u):  # pragma: no cover - compiled
     w3 = prm[_C] * sech
     nu = -prm[_N]
     snu = math.sqrt(nu)
-    pi_u = (u + snu * math.atan(snu * th)) / (1.0 + nu)
+    # Pi(n; am u | 1) = (u + sqrt(nu) atan(sqrt(nu) tanh u)) / (1 + nu), nu = -n.
+    pi_u = (snu * math.atan(snu * th) - nu * u) / (1.0 + nu)
     alpha = math.atan2(prm[_RHO] * th, sech)
     return w1, w2, w3, pi_u, alpha
 
@@ -391,9 +394,9 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
         m = min(max(m, 0.0), 1.0)
         m1 = min(max(m1, 0.0), 1.0)
         kk = ellipk_m1(m1)
-        pic = kk
+        pic = 0.0  # Pi(n | m) - K(m)
         if nchar != 0.0:
-            pic += nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+            pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
         prm[_A] = a
         prm[_B] = sb * b
         prm[_M] = m
@@ -487,7 +490,10 @@ def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
             w1, w2, w3, pi_u, alpha = _separatrix_at(prm, u)
         # Precession angle about the invariable line, in the shortest-arc gauge:
         # Psi = (L/J3) t + L (J3 - J1)/(J1 J3 lam) [Pi(u) - Pi(u0)] - (alpha - alpha0).
-        psi = ell / j3 * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
+        # With Pi(u) = u + D(u) and u - u0 = lam t the two secular terms add up to
+        # (L/J1) t exactly; summing them in floating point would cancel ~L/J3 t
+        # against itself and lose a factor J1/J3 for a thin body (J3 << J1).
+        psi = ell / j1 * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
         l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
         nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
         # qa^-1 qP^-1
