@@ -298,13 +298,20 @@ def test_shapes_units_and_errors():
     body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[1.0, 0.3, 0.8] * u.rad / u.s)
     att, w = free_motion(body, np.zeros((2, 3)) * u.min)
     assert att.shape == (2, 3) and w.shape == (2, 3, 3) and w.unit == u.rad / u.s
-    att, w = free_motion(body, 1.0)
+    plain = RigidBody([1.0, 2.0, 3.0], omega=[1.0, 0.3, 0.8])  # plain floats are SI
+    att, w = free_motion(plain, 1.0)
     assert att.shape == () and w.shape == (3,) and not isinstance(w, u.Quantity)
     _, w60 = free_motion(body, 1.0 * u.min)
-    _, w60s = free_motion(body, 60.0)
+    _, w60s = free_motion(plain, 60.0)
     np.testing.assert_array_equal(w60.value, w60s)
+    _, w60p = free_motion(plain, 1.0 * u.min)  # a float body with Quantity times
+    assert w60p.unit == u.rad / u.s
+    np.testing.assert_array_equal(w60p.value, w60s)
+    # a body with units needs times with units: a plain 60 could be s, min or days
+    with pytest.raises(ValueError, match="Expected `t` to be a Quantity like `body`"):
+        free_motion(body, 60.0)
     with pytest.raises(ValueError, match="`t` to be finite, got nan at index 1"):
-        free_motion(body, [0.0, np.nan])
+        free_motion(body, [0.0, np.nan] * u.s)
     with pytest.raises(ValueError, match="RigidBody"):
         free_motion([1.0, 2.0, 3.0], [0.0])
     with pytest.raises(ValueError, match=r"`q0` to have shape \(4,\)"):
