@@ -36,6 +36,8 @@ from rigid.body import RigidBody, _pow2, call_units, check_body, check_moments, 
 
 __all__ = ["FreeParameters", "free_motion", "free_motion_arrays", "free_parameters"]
 
+_RATE = 1 / u.s
+
 
 def _check_state(
     moments: Any, q0: Any, omega0: Any, names: tuple[str, str, str] = ("moments", "q0", "omega0")
@@ -224,13 +226,14 @@ class FreeParameters:
         Parameter and complementary parameter ``m1 = 1 - m`` (computed directly).
     K : float
         Complete elliptic integral ``K(m)`` (inf on the separatrix).
-    lam : float
-        Rate ``lambda`` of the argument ``u = u0 + lambda t`` (1 / time).
-    period : float
-        Period of omega in the body, ``4 K / lambda`` (inf on the separatrix).
-    flip_interval : float
+    lam : float or Quantity
+        Rate ``lambda`` of the argument ``u = u0 + lambda t`` (1/s; a Quantity
+        for a body built from Quantities, as are the two times below).
+    period : float or Quantity
+        Period of omega in the body, ``4 K / lambda`` (inf on the separatrix), s.
+    flip_interval : float or Quantity
         Half the period, ``2 K / lambda``: the time between two successive
-        reversals of the middle-axis component (the Dzhanibekov flip).
+        reversals of the middle-axis component (the Dzhanibekov flip), s.
     n : float
         Characteristic of the third-kind integral, ``-J3 (J2 - J1) / (J1 (J3 - J2))``.
     """
@@ -240,9 +243,9 @@ class FreeParameters:
     m: float
     m1: float
     K: float
-    lam: float
-    period: float
-    flip_interval: float
+    lam: Any
+    period: Any
+    flip_interval: Any
     n: float
 
 
@@ -256,7 +259,8 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     Returns
     -------
     FreeParameters
-        Times in seconds for SI bodies (plain floats).
+        ``lam`` in 1/s, ``period`` and ``flip_interval`` in s: Quantities for a
+        body built from Quantities, else plain SI floats.
 
     Examples
     --------
@@ -265,21 +269,25 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     >>> print(p.kind, p.polar_axis, round(p.m, 6), round(p.period, 6))
     periodic 2 0.542289 9.244135
     """
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"Expected `body` to be a RigidBody, got {type(body).__name__}")
-    prm = _fk.free_setup(body.moments, body.attitude.as_array(), body.omega)
+    body = check_body(body)
+    # homogeneous: the kernel sees moments / sm and omega / sw; rates scale back by sw
+    sm, sw = _pow2(body._moments), _pow2(body._omega)
+    prm = _fk.free_setup(body._moments / sm, body.attitude.as_array(), body._omega / sw)
     kind = int(prm[_fk._KIND])
+    q = body._quantity
+    inf = float("inf")
     if kind == 0:
-        inf = float("inf")
-        return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, 0.0, inf, inf, 0.0)
+        return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, wrap(0.0, _RATE, q),
+                              wrap(inf, u.s, q), wrap(inf, u.s, q), 0.0)
     pmat = prm[_fk._P : _fk._P + 9].reshape(3, 3)
     polar = int(np.argmax(np.abs(pmat[:, 2])))
-    lam = float(prm[_fk._LAM])
+    lam = float(prm[_fk._LAM]) * sw
     if kind == 1:
         kk = float(prm[_fk._K])
         return FreeParameters(
-            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk, lam,
-            4.0 * kk / lam, 2.0 * kk / lam, float(prm[_fk._N]),
+            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk,
+            wrap(lam, _RATE, q), wrap(4.0 * kk / lam, u.s, q), wrap(2.0 * kk / lam, u.s, q),
+            float(prm[_fk._N]),
         )
-    inf = float("inf")
-    return FreeParameters("separatrix", polar, 1.0, 0.0, inf, lam, inf, inf, float(prm[_fk._N]))
+    return FreeParameters("separatrix", polar, 1.0, 0.0, inf, wrap(lam, _RATE, q),
+                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk._N]))
