@@ -47,7 +47,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._validation import _first_index, as_float_array, check_trailing
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
 from rigid._kernels import euler as _k
 
 __all__ = [
@@ -61,7 +61,7 @@ __all__ = [
 
 
 def _vec(name: str, value: Any) -> np.ndarray:
-    return check_trailing(name, as_float_array(name, value), 3)
+    return check_trailing(name, DIMENSIONLESS(name, value), 3)
 
 
 def _pair(names: tuple[str, str], a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +106,7 @@ def gibbs_rate(gibbs: Any, omega: Any) -> np.ndarray:
     array([0.1, 0.2, 0.3])
     """
     g = _vec("gibbs", gibbs)
-    w = check_trailing("omega", strip("omega", omega, u.rad / u.s), 3)
+    w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
     g, w = _pair(("gibbs", "omega"), g, w)
     return wrap(_k.gibbs_dot_gufunc(g, w), 1 / u.s, is_quantity(omega))
 
