@@ -48,6 +48,10 @@ _L_UNIT = u.kg * u.m**2 / u.s  # angular momentum
 # ulp of its largest entry, and a flat disk (C = A + B, Sylvester's limit case)
 # must pass.  64 ulp of the largest moment is far below any physical tolerance.
 _SLACK = 64.0 * _EPS
+# Smallest ratio of two moments: the free-motion kernel squares the ratios of the
+# moments and of the rates, so below ~1e-150 they would underflow.  (A body with
+# A / C < 1e-150 is a line, not a rigid body one can build.)
+_MIN_RATIO = 1e-150
 
 
 def check_moments(name: str, moments: np.ndarray) -> np.ndarray:
@@ -76,16 +80,28 @@ def check_moments(name: str, moments: np.ndarray) -> np.ndarray:
         k = int(np.argwhere(bad)[0][0])
         raise ValueError(f"Expected `{name}` > 0, got {float(moments[k])!r} at index {k}")
     # compare on moments / max so that the sum cannot overflow
-    scaled = moments / float(np.max(moments))
+    big = float(np.max(moments))
+    scaled = moments / big
     total = float(np.sum(scaled))
     for k in range(3):
         others = total - scaled[k]
         if scaled[k] > others + _SLACK * total:
             raise ValueError(
                 f"Expected `{name}` to satisfy A + B >= C, got {float(moments[k])!r} "
-                f"at index {k} > {float(np.sum(moments) - moments[k])!r}"
+                f"at index {k} > {_sum_others(moments, k)!r}"
             )
+    k = int(np.argmin(moments))
+    if scaled[k] < _MIN_RATIO:
+        raise ValueError(
+            f"Expected `{name}` within a ratio of {1 / _MIN_RATIO:.0e} of each other, got "
+            f"{float(moments[k])!r} at index {k} beside {big!r}"
+        )
     return moments
+
+
+def _sum_others(moments: np.ndarray, k: int) -> float:
+    with np.errstate(over="ignore"):
+        return float(moments[(k + 1) % 3]) + float(moments[(k + 2) % 3])
 
 
 def _principal(name: str, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -182,15 +198,21 @@ def call_units(body: RigidBody, names: tuple[str, ...], values: tuple[Any, ...])
 
 
 def _pow2(x: np.ndarray) -> float:
-    """The power of two just above ``max|x|`` (1 for zeros): an exact scale factor."""
+    """The power of two at or just below ``max|x|`` (1 for zeros): an exact scale.
+
+    ``x / _pow2(x)`` has its largest entry in [1, 2); the scale itself is always
+    finite and nonzero (down to the subnormals).
+    """
     big = float(np.max(np.abs(x)))
-    return 1.0 if big == 0.0 else math.ldexp(1.0, math.frexp(big)[1])
+    return 1.0 if big == 0.0 else math.ldexp(1.0, math.frexp(big)[1] - 1)
 
 
-def _finite_result(what: str, scaled: Any, scale: float, body: Any) -> Any:
-    """``scaled * scale``, or a ValueError if the product leaves float64."""
+def _finite_result(what: str, scaled: Any, scale: tuple[float, ...], body: Any) -> Any:
+    """``scaled`` times each factor of ``scale``, or a ValueError beyond float64."""
+    out = np.asarray(scaled)
     with np.errstate(over="ignore"):
-        out = np.asarray(scaled) * scale
+        for factor in scale:
+            out = out * factor
     if not np.all(np.isfinite(out)):
         raise ValueError(
             f"Expected `omega` and `inertia` with a representable {what}, got moments "
@@ -375,21 +397,25 @@ class RigidBody:
     def _l_body(self) -> np.ndarray:
         sm, sw = self._scales()
         return _finite_result("angular momentum", (self._moments / sm) * (self._omega / sw),
-                              sm * sw, self)
+                              (sm, sw), self)
 
     def _l_space(self) -> np.ndarray:
-        return np.asarray(self.attitude.rotate(self._l_body()), dtype=np.float64)
+        sm, sw = self._scales()
+        lb = (self._moments / sm) * (self._omega / sw)
+        big = _pow2(lb)
+        ls = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
+        return _finite_result("angular momentum", ls, (big, sm, sw), self)
 
     def _energy(self) -> float:
         sm, sw = self._scales()
         w = self._omega / sw
         half = 0.5 * np.sum((self._moments / sm) * w * w)
-        return float(_finite_result("kinetic energy", half, sm * sw * sw, self))
+        return float(_finite_result("kinetic energy", half, (sm, sw, sw), self))
 
     def _l_norm(self) -> float:
         sm, sw = self._scales()
         lb = (self._moments / sm) * (self._omega / sw)
-        return float(_finite_result("angular momentum", np.sqrt(np.sum(lb * lb)), sm * sw, self))
+        return float(_finite_result("angular momentum", np.sqrt(np.sum(lb * lb)), (sm, sw), self))
 
     def _out(self, value, unit: u.UnitBase):
         return u.Quantity(value, unit) if self._quantity else value
@@ -452,7 +478,10 @@ class RigidBody:
         >>> print(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 5.0]).invariable_plane)
         [0. 0. 1.]
         """
-        lvec = self._l_space()
+        sm, sw = self._scales()
+        lb = (self._moments / sm) * (self._omega / sw)
+        big = _pow2(lb)
+        lvec = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
         norm = float(np.sqrt(np.sum(lvec * lvec)))
         if norm == 0.0:
             raise ValueError(

@@ -63,7 +63,8 @@ def _free_flow_scaled(
     """
     sm = _pow2(moments)
     sw = _pow2(omega0)
-    ts = flat_t * sw
+    with np.errstate(over="ignore"):
+        ts = flat_t * sw
     bad = ~np.isfinite(ts)
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])

@@ -493,6 +493,8 @@ def integrate(
     True
     """
     body = check_body(body)
+    body._energy()  # a body whose I omega^2 or I omega leaves float64 is refused here
+    body._l_norm()
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
     quantity = call_units(body, ("t_end", "dt"), (t_end, dt))

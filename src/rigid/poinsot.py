@@ -98,9 +98,10 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     body = check_body(body)
     quantity = call_units(body, ("t",), (t,))
     normal = body.invariable_plane
+    t_s = TIME("t", t)  # validated, in seconds for the computation
     t_unit = t.unit if isinstance(t, u.Quantity) else u.s
-    t_given = TIME("t", t, t_unit)  # the times as given (validated)
-    flat = np.ascontiguousarray(t_given.reshape(-1) * t_unit.to(u.s))
+    t_given = np.array(t.value, dtype=np.float64) if isinstance(t, u.Quantity) else t_s
+    flat = np.ascontiguousarray(t_s.reshape(-1))
     q, w = _free_flow_scaled(body._moments, body.attitude.as_array(), body._omega, flat, "t")
     # rho = omega / sqrt(2T) on moments / sm and omega / sw (no under- or overflow):
     # rho = (omega / sw) / sqrt(2T / (sm sw^2)) / sqrt(sm)

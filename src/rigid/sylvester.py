@@ -47,7 +47,13 @@ def _related(body: RigidBody, recip: np.ndarray, ell: np.ndarray, quantity: bool
             f"Expected `lam` to leave every reciprocal moment positive, got 1/A'[{k}] = "
             f"{float(recip[k])!r} at index {k}"
         )
-    moments = 1.0 / recip
+    with np.errstate(over="ignore", divide="ignore"):
+        moments = 1.0 / recip
+    if not np.all(np.isfinite(moments)):
+        k = int(np.argwhere(~np.isfinite(moments))[0][0])
+        raise ValueError(
+            f"Expected `lam` to give finite moments, got 1/A'[{k}] = {float(recip[k])!r}"
+        )
     try:
         check_moments("moments", moments)
     except ValueError as exc:
@@ -226,9 +232,13 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
     contrafocal True
     """
     body = check_body(body)
-    moments = body._moments
-    ell2 = float(body._l_norm() ** 2)
-    t2 = 2.0 * body._energy()
+    # On moments / sm and omega / sw (powers of two): lam = lam_s / sm and
+    # delta = sw^2 delta_s, so nothing under- or overflows on the way.
+    sm, sw = _pow2(body._moments), _pow2(body._omega)
+    moments = body._moments / sm
+    lb = moments * (body._omega / sw)
+    ell2 = float(np.sum(lb * lb))
+    t2 = float(np.sum(lb * (body._omega / sw)))
     mid = float(np.sort(moments)[1])
     prefer = "confocal" if ell2 > t2 * mid else "contrafocal"
     valid = []
@@ -239,14 +249,21 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
     if not valid:  # pragma: no cover - a real root always exists (Sylvester 1866)
         raise ValueError(f"Expected `body` to admit a disk reduction, got moments {moments}")
     valid.sort()
-    _, rel, lam = valid[0]
+    _, rel, lam_s = valid[0]
     q = body._quantity
-    if rel == "confocal":
-        disk = _related(body, 1.0 / moments + lam, body._l_body(), q)
-        delta = lam * (2.0 * t2 + lam * ell2)
-    else:
-        disk = _related(body, lam - 1.0 / moments, -body._l_body(), q)
-        delta = lam * (lam * ell2 - 2.0 * t2)
+    sign = 1.0 if rel == "confocal" else -1.0
+    recip = sign / moments + lam_s if rel == "confocal" else lam_s - 1.0 / moments
+    with np.errstate(over="ignore"):
+        disk_moments = (1.0 / recip) * sm
+        lam = lam_s / sm
+        delta = lam_s * (sign * 2.0 * t2 + lam_s * ell2) * sw * sw
+    if not (np.all(np.isfinite(disk_moments)) and np.isfinite(lam) and np.isfinite(delta)
+            and lam != 0.0):
+        raise ValueError(
+            f"Expected `body` to have a disk equivalent within float64, got moments "
+            f"{body._moments.tolist()} and omega {body._omega.tolist()}"
+        )
+    disk = RigidBody._from_si(disk_moments, body.attitude, sign * body._l_body() / disk_moments, q)
     return disk, rel, wrap(lam, _RECIP_UNIT, q), wrap(delta, _W_UNIT**2, q)
 
 
