@@ -445,3 +445,34 @@ def test_near_symmetric_body_is_continuous(c):
         slopes[-1] = 2 * np.linalg.norm(slopes[-1].as_array()[1:]) / d
     assert slopes[0] > 0.0
     assert abs(slopes[0] / slopes[1] - 1.0) < 5e-4
+
+
+@pytest.mark.parametrize(("moments", "w0"), [
+    ([1.0, 1.0 + 5e-7, 1e-6], [1.0, 0.5, 0.3]),  # thin axis off the polar axis: n ~ -2e12
+    ([1e-6, 1.0, 1.0 + 5e-7], [1.0, 0.5, 0.3]),  # the same, polar axis the thin one
+    ([2.0, 1.0 + 1e-9, 1.0], [0.3, 0.5, 1.0]),  # J2 - J3 tiny: n ~ -1e9
+])
+def test_thin_triaxial_body_against_high_precision(moments, w0):
+    # A thin triaxial body is near-symmetric (B <= A + C), and then the characteristic n
+    # of the third-kind integral is huge and negative: Pi = F + (n/3) s^3 R_J cancelled
+    # to 1e-10 before (issue 7, item 3, the triaxial side).  Pi is now taken from DLMF
+    # 19.7.9 there and the secular rate from the form whose terms share a sign.  The
+    # reference is a 25-digit Taylor integration; measured error <= 1.5 eps.
+    q0 = np.array([0.9, 0.1, -0.3, 0.2]) / np.linalg.norm([0.9, 0.1, -0.3, 0.2])
+    qr, wr = _mp_reference(moments, q0, w0, [0.25])
+    q, w = free_motion_arrays(moments, q0, w0, [0.25])
+    assert qdist(q, qr).max() <= 8 * EPS
+    assert np.abs(w - wr).max() <= 8 * EPS * np.abs(w0).max()
+
+
+def test_third_kind_integral_for_large_negative_characteristic():
+    # the kernel's Pi(n; phi | m) for n < -1 (DLMF 19.7.9 form) against mpmath's ellippi
+    for n in (-1.5, -40.0, -2e12):
+        for phi in (-1.2, 0.3, np.pi / 2):
+            m = 0.3
+            s, c = np.sin(phi), np.cos(phi)
+            d = np.sqrt(1.0 - m * s * s)
+            ours = fk._pi_reduced(n, m, s, max(c, 0.0), d)
+            with mpmath.workdps(30):
+                ref = float(mpmath.ellippi(n, phi, m))
+            assert ours == pytest.approx(ref, rel=8 * EPS)
