@@ -332,7 +332,10 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
         )
     same_frame = np.array_equal(p1[_fk._P : _fk._P + 9], p2[_fk._P : _fk._P + 9])
     if p2[_fk._KIND] != kind or not same_frame:
-        raise ValueError("Expected `omega2` on the same branch of the polhode as `omega1`")
+        raise ValueError(
+            f"Expected `omega2` on the same branch of the polhode as `omega1`, got "
+            f"omega1 = {omega1!r}, omega2 = {omega2!r}"
+        )
     du = p2[_fk._U0] - p1[_fk._U0]
     if kind == 1.0:
         dt = float(np.mod(du, 4.0 * p1[_fk._K]) / p1[_fk._LAM])
