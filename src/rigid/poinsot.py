@@ -133,9 +133,10 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
     -------
     matplotlib.figure.Figure
     """
+    paths = poinsot(body, t)  # validates first: bad input fails before matplotlib loads
+
     import matplotlib.pyplot as plt  # lazy: optional dependency
 
-    paths = poinsot(body, t)
     if fig is None:
         fig = plt.figure(figsize=(10, 4.5))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
