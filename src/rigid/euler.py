@@ -62,9 +62,26 @@ def _quat_array(name: str, attitude: Any) -> np.ndarray:
         a = attitude.as_array()
     else:
         a = check_trailing(name, DIMENSIONLESS(name, attitude), 4)
-    n = np.sqrt(np.sum(a * a, axis=-1))
-    check_positive(f"|{name}|", n)
+    zero = ~(np.max(np.abs(a), axis=-1) > 0.0)  # (the max avoids overflow in |q|^2)
+    if np.any(zero):
+        index = tuple(int(i) for i in np.argwhere(np.atleast_1d(zero))[0]) if a.ndim > 1 else ()
+        raise ValueError(
+            f"Expected `{name}` to be a nonzero quaternion, got {a[index].tolist()}"
+            + (f" at index {index}" if index else "")
+        )
     return a
+
+
+def _finite(what: str, out: np.ndarray, names: tuple[str, ...]) -> None:
+    """A result beyond float64 (finite input) is refused, naming the arguments."""
+    bad = ~np.isfinite(out)
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        args = ", ".join(f"`{n}`" for n in names)
+        raise ValueError(
+            f"Expected {args} with a representable {what}, got {float(out[index])!r} at "
+            f"index {index} (beyond float64)"
+        )
 
 
 class _Torque:
@@ -249,12 +266,14 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     tt = np.zeros(()) if t is None else TIME("t", t)
     kind, params = _encode(torque)
     try:
-        out = _k.torque_gufunc(m, q, tt, kind, params)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.torque_gufunc(m, q, tt, kind, params)
     except ValueError as exc:
         raise ValueError(
             f"Expected `moments`, `attitude`, `t` to broadcast together, got shapes "
             f"{m.shape}, {q.shape}, {tt.shape}"
         ) from exc
+    _finite("torque", out, ("moments", "attitude", "torque"))
     return wrap(out, _TORQUE, quantity)
 
 
@@ -300,12 +319,14 @@ def euler_equations(moments: Any, omega: Any, torque: Any = None) -> np.ndarray:
         n = np.broadcast_to(n, (3,))
     check_trailing("torque", n, 3)
     try:
-        out = _k.euler_gufunc(m, w, n)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.euler_gufunc(m, w, n)
     except ValueError as exc:
         raise ValueError(
             f"Expected `moments`, `omega`, `torque` to broadcast together, got shapes "
             f"{m.shape}, {w.shape}, {n.shape}"
         ) from exc
+    _finite("angular acceleration", out, ("moments", "omega", "torque"))
     return wrap(out, _RATE / u.s, quantity)
 
 
@@ -338,10 +359,12 @@ def quaternion_rate(attitude: Any, omega: Any) -> Quaternion:
     q = _quat_array("attitude", attitude)
     w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
     try:
-        out = _k.qdot_gufunc(q, w)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.qdot_gufunc(q, w)
     except ValueError as exc:
         raise ValueError(
             f"Expected `attitude`, `omega` to broadcast together, got shapes "
             f"{q.shape}, {w.shape}"
         ) from exc
+    _finite("quaternion rate", out, ("attitude", "omega"))
     return Quaternion(out)

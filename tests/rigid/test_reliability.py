@@ -364,7 +364,7 @@ def test_any_unit_of_the_right_dimension_works():
 # --- the contract, as a property -------------------------------------------------------------
 
 NAMES = ("inertia", "omega", "attitude", "body", "t", "moments", "q0", "omega0", "lam",
-         "t_end", "dt", "omega1", "omega2")
+         "t_end", "dt", "omega1", "omega2", "torque", "gm_over_r3")
 
 finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
 magnitudes = st.sampled_from([0.0, 1e-300, 1e-200, 1e-12, 1.0, 3.0, 1e12, 1e200, 1e300])
@@ -394,10 +394,14 @@ def _check(call):
 
 
 @settings(deadline=None, max_examples=150)
-@given(moments=vec3, attitude=vec4, omega=vec3, t=value, lam=value)
-def test_public_api_contract(moments, attitude, omega, t, lam):
+@given(moments=vec3, attitude=vec4, omega=vec3, t=value, lam=value,
+       method=st.sampled_from(["splitting2", "splitting4", "exact_kick", "rk4", "cayley_rk4"]))
+def test_public_api_contract(moments, attitude, omega, t, lam, method):
     body = _check(lambda: RigidBody(moments, attitude, omega))
     _check(lambda: free_motion_arrays(moments, attitude, omega, [0.0, t]))
+    _check(lambda: euler_equations(moments, omega, omega))
+    _check(lambda: quaternion_rate(attitude, omega))
+    _check(lambda: torque_on(GravityGradientTorque(abs(lam)), moments, attitude, t))
     if body is None:
         return
     for prop in ("kinetic_energy", "angular_momentum_space", "angular_momentum_norm"):
@@ -410,5 +414,5 @@ def test_public_api_contract(moments, attitude, omega, t, lam):
     _check(lambda: confocal_rotation(body, lam, t))
     _check(lambda: disk_equivalent(body))
     _check(lambda: time_between(body, omega, omega))
-    _check(lambda: integrate(body, abs(t), dt=abs(t) / 4.0 if t else 1.0,
-                             method="splitting2", n_out=3))
+    _check(lambda: integrate(body, abs(t), dt=abs(t) / 4.0 if t else 1.0, method=method,
+                             n_out=3))
