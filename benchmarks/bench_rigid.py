@@ -90,7 +90,7 @@ def main() -> None:
     t_exact, _ = timed(lambda: free_motion_arrays(MOMENTS, Q0.as_array(), W0, tt))
     from scipy.integrate import solve_ivp
 
-    from rigid import _euler_kernels as _k
+    from rigid._kernels import euler as _k
 
     prm = np.zeros(1)
 

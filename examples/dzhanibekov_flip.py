@@ -48,7 +48,7 @@ def body_for(eps: float) -> RigidBody:
 
 def flips_by_dop853(body: RigidBody, n_flips: int) -> np.ndarray:
     """Times of the sign changes of omega_2 from DOP853 (rtol 1e-12)."""
-    a, b, c = body.moments
+    a, b, c = body.moments.to_value(u.kg * u.m**2)
 
     def rhs(_t, w):
         return [(b - c) * w[1] * w[2] / a, (c - a) * w[2] * w[0] / b, (a - b) * w[0] * w[1] / c]
@@ -56,8 +56,9 @@ def flips_by_dop853(body: RigidBody, n_flips: int) -> np.ndarray:
     def crossing(_t, w):
         return w[1]
 
-    period = free_parameters(body).period
-    sol = solve_ivp(rhs, (0.0, 0.6 * period * n_flips), body.omega, method="DOP853",
+    period = free_parameters(body).period.to_value(u.s)
+    sol = solve_ivp(rhs, (0.0, 0.6 * period * n_flips), body.omega.to_value(u.rad / u.s),
+                    method="DOP853",
                     rtol=1e-12, atol=1e-14, events=crossing)
     return sol.t_events[0]
 
@@ -75,12 +76,13 @@ def main() -> None:
         par = free_parameters(body)
         times = flips_by_dop853(body, 4)
         measured = float(np.mean(np.diff(times)))  # successive reversals of omega_2
-        rows.append((eps, par.m1, par.flip_interval, measured))
-        lines.append(f"{eps:8.1e} {par.m1:11.3e} {par.flip_interval:14.6f} {measured:15.6f} "
-                     f"{abs(measured / par.flip_interval - 1):9.1e}")
+        half = par.flip_interval.to_value(u.s)
+        rows.append((eps, par.m1, half, measured))
+        lines.append(f"{eps:8.1e} {par.m1:11.3e} {half:14.6f} {measured:15.6f} "
+                     f"{abs(measured / half - 1):9.1e}")
     rows = np.array(rows)
     # Logarithmic growth: T/2 ~ (ln 16 - ln(1 - m)) / lambda as m -> 1.
-    lam = free_parameters(body_for(1e-7)).lam
+    lam = free_parameters(body_for(1e-7)).lam.to_value(1 / u.s)
     slope = np.polyfit(-np.log(rows[-6:, 1]), rows[-6:, 2], 1)[0]
     lines += ["", f"slope d(T/2)/d(-ln(1-m)) for 1-m -> 0: {slope:.6f} s; "
               f"1/lambda = {1 / lam:.6f} s",
@@ -90,7 +92,7 @@ def main() -> None:
     # One flip sequence in time, from the exact solution.
     body = body_for(1e-3)
     par = free_parameters(body)
-    t = np.linspace(0.0, 3 * par.period, 3000) * u.s
+    t = np.linspace(0.0, 3 * par.period.to_value(u.s), 3000) * u.s
     _, w = free_motion(body, t)
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
@@ -98,7 +100,7 @@ def main() -> None:
     ax1.plot(t, w[:, 0] / SPIN, label=r"$\omega_1 / \Omega$", lw=0.8)
     ax1.plot(t, w[:, 2] / SPIN, label=r"$\omega_3 / \Omega$", lw=0.8)
     ax1.set_xlabel("t [s]")
-    ax1.set_title(f"exact motion, eps = 1e-3: T/2 = {par.flip_interval:.4f} s")
+    ax1.set_title(f"exact motion, eps = 1e-3: T/2 = {par.flip_interval.to_value(u.s):.4f} s")
     ax1.legend(fontsize=8)
     ax2.plot(-np.log(rows[:, 1]), rows[:, 2], "o-", label="exact 2K(m)/lambda")
     ax2.plot(-np.log(rows[:, 1]), rows[:, 3], "x", label="DOP853 zero crossings")

@@ -11,13 +11,18 @@ Conventions (shared by the whole ``rigid`` package):
 * ``moments = (A, B, C)`` in the order of the body axes; Euler's equations read
   ``A p' + (C - B) q r = N_x`` and cyclically (Cayley 1843).
 
-Units: Quantities are accepted (kg m^2 for the inertia, rad/s for omega).  Inside,
-and in every attribute, the values are plain SI floats (or the caller's own
-consistent units when plain floats were given).
+Units: a body built from Quantities (kg m^2 for the inertia, rad/s for omega, any
+units of those dimensions) answers in Quantities: ``moments``, ``omega`` and every
+derived quantity, and the functions that take it (``free_motion``, ``integrate``,
+``poinsot``, Sylvester's functions) answer in Quantities too, and refuse plain
+numbers for its times and rates.  A body built from plain floats is SI (kg m^2,
+rad/s, s) and answers in floats; given Quantity times it answers in Quantities.
+Inside, everything runs on SI floats.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import astropy.units as u
@@ -25,17 +30,78 @@ import numpy as np
 
 from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import strip
+from hamilton_orbits.units import (
+    ANGULAR_SPEED,
+    DIMENSIONLESS,
+    INERTIA,
+    require_consistent,
+)
 
-__all__ = ["RigidBody"]
+__all__ = ["RigidBody"]  # check_* and unit_quaternion: shared inside rigid only
 
 _EPS = np.finfo(np.float64).eps
+_I_UNIT = u.kg * u.m**2  # moment of inertia
+_W_UNIT = u.rad / u.s  # angular velocity
 _L_UNIT = u.kg * u.m**2 / u.s  # angular momentum
 # Slack for the symmetry and the triangle-inequality checks: a tensor built by
 # rotating a diagonal one in floating point is symmetric / flat only to a few
 # ulp of its largest entry, and a flat disk (C = A + B, Sylvester's limit case)
 # must pass.  64 ulp of the largest moment is far below any physical tolerance.
 _SLACK = 64.0 * _EPS
+# Smallest ratio of two moments: the free-motion kernel squares the ratios of the
+# moments and of the rates, so below ~1e-150 they would underflow.  (A body with
+# A / C < 1e-150 is a line, not a rigid body one can build.)
+_MIN_RATIO = 1e-150
+
+
+def check_moments(name: str, moments: np.ndarray) -> np.ndarray:
+    """Require principal moments: shape (3,), each > 0, and the triangle inequality.
+
+    ``A + B >= C`` for every permutation, Sylvester (1866): "each must be not
+    greater than the sum of the other two" (with a slack of 64 ulp of the sum, so
+    that a flat disk ``C = A + B`` built in floating point passes).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, the index and the value.
+
+    Examples
+    --------
+    >>> check_moments("moments", np.array([-1.0, 2.0, 3.0]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `moments` > 0, got -1.0 at index 0
+    """
+    if moments.shape != (3,):
+        raise ValueError(f"Expected `{name}` to have shape (3,), got {moments.shape}")
+    bad = ~(moments > 0.0)
+    if np.any(bad):
+        k = int(np.argwhere(bad)[0][0])
+        raise ValueError(f"Expected `{name}` > 0, got {float(moments[k])!r} at index {k}")
+    # compare on moments / max so that the sum cannot overflow
+    big = float(np.max(moments))
+    scaled = moments / big
+    total = float(np.sum(scaled))
+    for k in range(3):
+        others = total - scaled[k]
+        if scaled[k] > others + _SLACK * total:
+            raise ValueError(
+                f"Expected `{name}` to satisfy A + B >= C, got {float(moments[k])!r} "
+                f"at index {k} > {_sum_others(moments, k)!r}"
+            )
+    k = int(np.argmin(moments))
+    if scaled[k] < _MIN_RATIO:
+        raise ValueError(
+            f"Expected `{name}` within a ratio of {1 / _MIN_RATIO:.0e} of each other, got "
+            f"{float(moments[k])!r} at index {k} beside {big!r}"
+        )
+    return moments
+
+
+def _sum_others(moments: np.ndarray, k: int) -> float:
+    with np.errstate(over="ignore"):
+        return float(moments[(k + 1) % 3]) + float(moments[(k + 2) % 3])
 
 
 def _principal(name: str, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -49,15 +115,19 @@ def _principal(name: str, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray |
         axes = None
     elif inertia.shape == (3, 3):
         scale = float(np.max(np.abs(inertia)))
-        asym = np.abs(inertia - inertia.T)
-        if np.any(asym > _SLACK * scale):
-            i, j = (int(k) for k in np.argwhere(asym > _SLACK * scale)[0])
+        if scale == 0.0:
+            raise ValueError(f"Expected `{name}` to be positive definite, got a zero tensor")
+        asym = np.abs(inertia - inertia.T) / scale
+        if np.any(asym > _SLACK):
+            i, j = (int(k) for k in np.argwhere(asym > _SLACK)[0])
             raise ValueError(
                 f"Expected `{name}` to be a symmetric (3, 3) tensor, got "
                 f"{name}[{i}, {j}] = {inertia[i, j]!r} != {name}[{j}, {i}] = {inertia[j, i]!r}"
             )
-        sym = 0.5 * (inertia + inertia.T)
+        # eigh on the tensor / scale: homogeneous, and safe from over- and underflow
+        sym = 0.5 * (inertia + inertia.T) / scale
         moments, axes = np.linalg.eigh(sym)
+        moments = moments * scale
         if np.linalg.det(axes) < 0.0:
             axes[:, 2] = -axes[:, 2]
         if not np.all(moments > 0.0):
@@ -68,32 +138,103 @@ def _principal(name: str, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray |
             )
     else:
         raise ValueError(f"Expected `{name}` to have shape (3,) or (3, 3), got {inertia.shape}")
-    bad = ~(moments > 0.0)
-    if np.any(bad):
-        k = int(np.argwhere(bad)[0][0])
-        raise ValueError(f"Expected `{name}` > 0, got {float(moments[k])!r} at index {k}")
-    total = float(np.sum(moments))
-    for k in range(3):
-        others = total - moments[k]
-        if moments[k] > others + _SLACK * total:
-            raise ValueError(
-                f"Expected `{name}` to satisfy A + B >= C, got {float(moments[k])!r} "
-                f"at index {k} > {float(others)!r}"
-            )
-    return moments, axes
+    return check_moments(name, moments), axes
 
 
-def _as_quaternion_array(name: str, attitude: Any) -> np.ndarray:
+def unit_quaternion(name: str, attitude: Any) -> np.ndarray:
+    """A unit quaternion (4,) from a Quaternion or a dimensionless array_like.
+
+    The norm is taken of ``q / max|q_i|`` so that neither ``[1e300, 1e300, 0, 0]``
+    overflows nor ``[1e-300, 0, 0, 0]`` underflows.
+
+    Raises
+    ------
+    ValueError
+        For a wrong shape, NaN / inf or a zero quaternion, naming the argument.
+    astropy.units.UnitConversionError
+        For a Quantity that is not dimensionless.
+
+    Examples
+    --------
+    >>> unit_quaternion("attitude", [1e300, 1e300, 0.0, 0.0])
+    array([0.70710678, 0.70710678, 0.        , 0.        ])
+    """
     if attitude is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
-    arr = attitude.as_array() if isinstance(attitude, Quaternion) else attitude
-    arr = as_float_array(name, arr)
+    if isinstance(attitude, Quaternion):
+        arr = as_float_array(name, attitude.as_array())
+    else:
+        arr = DIMENSIONLESS(name, attitude)
     if arr.shape != (4,):
         raise ValueError(f"Expected `{name}` to have shape (4,), got {arr.shape}")
-    norm = float(np.sqrt(np.sum(arr * arr)))
-    if norm == 0.0:
-        raise ValueError(f"Expected `{name}` to be a nonzero quaternion, got {arr!r}")
-    return arr / norm
+    big = float(np.max(np.abs(arr)))
+    if big == 0.0:
+        raise ValueError(f"Expected `{name}` to be a nonzero quaternion, got {arr.tolist()}")
+    arr = arr / big
+    return arr / np.sqrt(np.sum(arr * arr))
+
+
+def call_units(body: RigidBody, names: tuple[str, ...], values: tuple[Any, ...]) -> bool:
+    """Whether a call on ``body`` with dimensional ``values`` answers in Quantities.
+
+    The values must not mix Quantities and plain numbers
+    (:func:`hamilton_orbits.units.require_consistent`); a body built from
+    Quantities needs Quantities (a plain time beside it has no unit); a body of
+    plain floats is SI and accepts either.  ``None`` values are ignored.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> call_units(RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2), ("t",), (2.0,))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `t` to be a Quantity like `body` ([1. 2. 3.] m2 kg), got the plain ...
+    """
+    quantity = require_consistent(names, values)
+    if body._quantity:
+        require_consistent(("body", *names), (body.moments, *values))
+        return True
+    return quantity
+
+
+def _pow2(x: np.ndarray) -> float:
+    """The power of two at or just below ``max|x|`` (1 for zeros): an exact scale.
+
+    ``x / _pow2(x)`` has its largest entry in [1, 2); the scale itself is always
+    finite and nonzero (down to the subnormals).
+    """
+    big = float(np.max(np.abs(x)))
+    return 1.0 if big == 0.0 else math.ldexp(1.0, math.frexp(big)[1] - 1)
+
+
+def _finite_result(what: str, scaled: Any, scale: tuple[float, ...], body: Any) -> Any:
+    """``scaled`` times each factor of ``scale``, or a ValueError beyond float64."""
+    out = np.asarray(scaled)
+    with np.errstate(over="ignore"):
+        for factor in scale:
+            out = out * factor
+    if not np.all(np.isfinite(out)):
+        raise ValueError(
+            f"Expected `omega` and `inertia` with a representable {what}, got moments "
+            f"{body._moments.tolist()} and omega {body._omega.tolist()} (beyond float64)"
+        )
+    return out
+
+
+def check_body(body: Any, name: str = "body") -> RigidBody:
+    """Require a :class:`RigidBody` (``ValueError`` naming the argument otherwise).
+
+    Examples
+    --------
+    >>> check_body(None)
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `body` to be a RigidBody, got None
+    """
+    if not isinstance(body, RigidBody):
+        got = "None" if body is None else f"{type(body).__name__} {body!r}"
+        raise ValueError(f"Expected `{name}` to be a RigidBody, got {got[:80]}")
+    return body
 
 
 class RigidBody:
@@ -109,22 +250,22 @@ class RigidBody:
         (the principal frame is right-handed).
     attitude : Quaternion or array_like, shape (4,), optional
         Scalar-first quaternion carrying body-frame vectors to space
-        (``v_space = q v_body q^-1``).  Normalised on input.  Default identity.
+        (``v_space = q v_body q^-1``).  Normalised on input (any nonzero finite
+        size).  Dimensionless.  Default identity.
     omega : array_like or Quantity, shape (3,), rad/s, optional
         Angular velocity ``(p, q, r)`` in the body frame in which ``inertia`` was
-        given.  Default zero.
+        given.  Default zero.  A Quantity exactly when ``inertia`` is one.
 
     Attributes
     ----------
-    moments : ndarray, shape (3,)
-        Principal moments (SI floats, or the caller's consistent units).  The
-        state (``moments``, ``omega``) is kept as floats; the derived quantities
-        (angular momenta, kinetic energy) come back as Quantities when the body
-        was built from Quantities.
+    moments : ndarray or Quantity, shape (3,), kg m^2
+        Principal moments: a Quantity (kg m^2) for a body built from
+        Quantities, else plain floats (SI).
     attitude : Quaternion
         Unit attitude quaternion, body (principal) frame to space.
-    omega : ndarray, shape (3,)
-        Angular velocity in the principal frame.
+    omega : ndarray or Quantity, shape (3,), rad/s
+        Angular velocity in the principal frame (rad/s as a Quantity for a body
+        built from Quantities).
 
     Raises
     ------
@@ -132,7 +273,10 @@ class RigidBody:
         For a wrong shape, NaN or inf, a non-symmetric or non-positive-definite
         tensor, a non-positive moment, a violation of the triangle inequality
         (``A + B >= C`` for every permutation, Sylvester 1866: "each must be not
-        greater than the sum of the other two"), or a zero quaternion.
+        greater than the sum of the other two"), a zero quaternion, or a plain
+        ``omega`` beside a Quantity ``inertia`` (or the reverse).
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong dimension (an attitude in metres, ...).
 
     References
     ----------
@@ -144,6 +288,8 @@ class RigidBody:
     --------
     >>> import astropy.units as u
     >>> body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.1, 0.0, 1.0] * u.rad / u.s)
+    >>> print(body)
+    RigidBody: moments [1. 2. 3.] m2 kg, omega [0.1 0.  1. ] rad / s, attitude [1. 0. 0. 0.]
     >>> print(round(body.kinetic_energy, 4))
     1.505 J
     >>> print(body.angular_momentum_space.round(3))
@@ -156,38 +302,72 @@ class RigidBody:
     ValueError: Expected `inertia` to satisfy A + B >= C, got 3.0 at index 2 > 2.0
     """
 
-    __slots__ = ("_quantity", "attitude", "moments", "omega")
+    __slots__ = ("_moments", "_omega", "_quantity", "attitude")
 
     def __init__(self, inertia: Any, attitude: Any = None, omega: Any = None) -> None:
-        inertia_arr = strip("inertia", inertia, u.kg * u.m**2)
-        omega_arr = (
-            np.zeros(3) if omega is None else strip("omega", omega, u.rad / u.s)
-        )
+        quantity = require_consistent(("inertia", "omega"), (inertia, omega))
+        inertia_arr = INERTIA("inertia", inertia)
+        omega_arr = np.zeros(3) if omega is None else ANGULAR_SPEED("omega", omega)
         if omega_arr.shape != (3,):
             raise ValueError(f"Expected `omega` to have shape (3,), got {omega_arr.shape}")
-        q = _as_quaternion_array("attitude", attitude)
+        q = unit_quaternion("attitude", attitude)
         moments, axes = _principal("inertia", inertia_arr)
         if axes is not None:
             # v_given = axes @ v_principal, so omega_principal = axes^T omega_given and
             # the new attitude composes q (given -> space) with axes (principal -> given).
             omega_arr = axes.T @ omega_arr
             qa = Quaternion.from_rotation_matrix(axes).as_array()
-            q = (Quaternion(q) * Quaternion(qa)).as_array()
-            q = q / np.sqrt(np.sum(q * q))
-        self.moments: np.ndarray = np.asarray(moments, dtype=np.float64)
-        self.omega: np.ndarray = np.asarray(omega_arr, dtype=np.float64).copy()
+            q = unit_quaternion("attitude", (Quaternion(q) * Quaternion(qa)).as_array())
+        self._moments: np.ndarray = np.asarray(moments, dtype=np.float64)
+        self._omega: np.ndarray = np.asarray(omega_arr, dtype=np.float64).copy()
         self.attitude: Quaternion = Quaternion(q)
-        # derived quantities come back as Quantities when the body was built from them
-        self._quantity = isinstance(inertia, u.Quantity) or isinstance(omega, u.Quantity)
+        self._quantity: bool = bool(quantity)
+
+    @classmethod
+    def _from_si(
+        cls, moments: np.ndarray, attitude: Any, omega: np.ndarray, quantity: bool
+    ) -> RigidBody:
+        """A body from SI floats (validated), answering in Quantities if ``quantity``."""
+        body = cls(moments, attitude, omega)
+        body._quantity = bool(quantity)
+        return body
+
+    @property
+    def moments(self) -> Any:
+        """Principal moments ``(A, B, C)``, shape (3,) (kg m^2 as a Quantity for a body
+        built from Quantities)."""
+        return self._out(self._moments.copy(), _I_UNIT)
+
+    @property
+    def omega(self) -> Any:
+        """Body-frame angular velocity ``(p, q, r)``, shape (3,) (rad/s as a Quantity
+        for a body built from Quantities)."""
+        return self._out(self._omega.copy(), _W_UNIT)
 
     def __repr__(self) -> str:
+        q = self.attitude.as_array().tolist()
+        if self._quantity:
+            return (
+                f"RigidBody({self._moments.tolist()} * u.Unit('{_I_UNIT}'), attitude={q}, "
+                f"omega={self._omega.tolist()} * u.Unit('{_W_UNIT}'))"
+            )
+        return f"RigidBody({self._moments.tolist()}, attitude={q}, omega={self._omega.tolist()})"
+
+    def __str__(self) -> str:
+        with np.printoptions(precision=6, suppress=False):
+            m, w = np.array2string(self._moments), np.array2string(self._omega)
+            q = np.array2string(self.attitude.as_array())
+        if self._quantity:
+            return f"RigidBody: moments {m} {_I_UNIT}, omega {w} {_W_UNIT}, attitude {q}"
         return (
-            f"RigidBody(moments={self.moments.tolist()}, "
-            f"attitude={self.attitude.as_array().tolist()}, omega={self.omega.tolist()})"
+            f"RigidBody: moments {m}, omega {w} (plain floats, SI: {_I_UNIT}, {_W_UNIT}), "
+            f"attitude {q}"
         )
 
     def with_state(self, attitude: Any = None, omega: Any = None) -> RigidBody:
         """A body with the same moments and a new attitude and/or omega.
+
+        ``omega`` is a Quantity exactly when the body was built from Quantities.
 
         Examples
         --------
@@ -195,26 +375,47 @@ class RigidBody:
         >>> print(b.omega)
         [0. 0. 2.]
         """
-        body = RigidBody(
-            self.moments,
-            self.attitude if attitude is None else attitude,
-            self.omega if omega is None else omega,
+        if omega is None:
+            w = self._omega
+        else:
+            if isinstance(omega, u.Quantity) != self._quantity:
+                kind = "a Quantity" if self._quantity else "plain floats"
+                raise ValueError(
+                    f"Expected `omega` as {kind} like the body's moments, got {omega!r}"
+                )
+            w = ANGULAR_SPEED("omega", omega)
+        return RigidBody._from_si(
+            self._moments, self.attitude if attitude is None else attitude, w, self._quantity
         )
-        body._quantity = self._quantity or isinstance(omega, u.Quantity)
-        return body
 
     # ------------------------------------------------------------ derived (floats)
+    # Computed on moments / sm and omega / sw (exact powers of two) and scaled back,
+    # so that nothing under- or overflows inside; a result beyond float64 raises.
+    def _scales(self) -> tuple[float, float]:
+        return _pow2(self._moments), _pow2(self._omega)
+
     def _l_body(self) -> np.ndarray:
-        return self.moments * self.omega
+        sm, sw = self._scales()
+        return _finite_result("angular momentum", (self._moments / sm) * (self._omega / sw),
+                              (sm, sw), self)
 
     def _l_space(self) -> np.ndarray:
-        return np.asarray(self.attitude.rotate(self._l_body()), dtype=np.float64)
+        sm, sw = self._scales()
+        lb = (self._moments / sm) * (self._omega / sw)
+        big = _pow2(lb)
+        ls = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
+        return _finite_result("angular momentum", ls, (big, sm, sw), self)
 
     def _energy(self) -> float:
-        return float(0.5 * np.sum(self.moments * self.omega * self.omega))
+        sm, sw = self._scales()
+        w = self._omega / sw
+        half = 0.5 * np.sum((self._moments / sm) * w * w)
+        return float(_finite_result("kinetic energy", half, (sm, sw, sw), self))
 
     def _l_norm(self) -> float:
-        return float(np.sqrt(np.sum(self._l_body() ** 2)))
+        sm, sw = self._scales()
+        lb = (self._moments / sm) * (self._omega / sw)
+        return float(_finite_result("angular momentum", np.sqrt(np.sum(lb * lb)), (sm, sw), self))
 
     def _out(self, value, unit: u.UnitBase):
         return u.Quantity(value, unit) if self._quantity else value
@@ -277,11 +478,14 @@ class RigidBody:
         >>> print(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 5.0]).invariable_plane)
         [0. 0. 1.]
         """
-        lvec = self._l_space()
+        sm, sw = self._scales()
+        lb = (self._moments / sm) * (self._omega / sw)
+        big = _pow2(lb)
+        lvec = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
         norm = float(np.sqrt(np.sum(lvec * lvec)))
         if norm == 0.0:
             raise ValueError(
                 "Expected `omega` to be nonzero: a body at rest has no invariable plane, "
-                f"got omega = {self.omega.tolist()}"
+                f"got omega = {self._omega.tolist()}"
             )
         return lvec / norm

@@ -23,10 +23,20 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array, check_positive, check_trailing
+from hamilton_orbits._validation import check_positive, check_trailing
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from hamilton_orbits.units import (
+    ANGLE,
+    ANGULAR_SPEED,
+    DIMENSIONLESS,
+    INERTIA,
+    TIME,
+    TORQUE,
+    Kind,
+    require_consistent,
+    wrap,
+)
+from rigid._kernels import euler as _k
 
 __all__ = [
     "BodyTorque",
@@ -38,12 +48,12 @@ __all__ = [
 ]
 
 _TORQUE = u.N * u.m
-_INERTIA = u.kg * u.m**2
 _RATE = u.rad / u.s
+_GM_OVER_R3 = Kind("a squared rate GM / r^3", u.s**-2)
 
 
 def _moments(moments: Any) -> np.ndarray:
-    m = check_trailing("moments", strip("moments", moments, _INERTIA), 3)
+    m = check_trailing("moments", INERTIA("moments", moments), 3)
     return check_positive("moments", m)
 
 
@@ -51,10 +61,27 @@ def _quat_array(name: str, attitude: Any) -> np.ndarray:
     if isinstance(attitude, Quaternion):
         a = attitude.as_array()
     else:
-        a = check_trailing(name, as_float_array(name, attitude), 4)
-    n = np.sqrt(np.sum(a * a, axis=-1))
-    check_positive(f"|{name}|", n)
+        a = check_trailing(name, DIMENSIONLESS(name, attitude), 4)
+    zero = ~(np.max(np.abs(a), axis=-1) > 0.0)  # (the max avoids overflow in |q|^2)
+    if np.any(zero):
+        index = tuple(int(i) for i in np.argwhere(np.atleast_1d(zero))[0]) if a.ndim > 1 else ()
+        raise ValueError(
+            f"Expected `{name}` to be a nonzero quaternion, got {a[index].tolist()}"
+            + (f" at index {index}" if index else "")
+        )
     return a
+
+
+def _finite(what: str, out: np.ndarray, names: tuple[str, ...]) -> None:
+    """A result beyond float64 (finite input) is refused, naming the arguments."""
+    bad = ~np.isfinite(out)
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        args = ", ".join(f"`{n}`" for n in names)
+        raise ValueError(
+            f"Expected {args} with a representable {what}, got {float(out[index])!r} at "
+            f"index {index} (beyond float64)"
+        )
 
 
 class _Torque:
@@ -75,7 +102,7 @@ class _ConstantTorque(_Torque):
     _params: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        t = strip("torque", self.torque, _TORQUE)
+        t = TORQUE("torque", self.torque)
         if t.shape != (3,):
             raise ValueError(f"Expected `torque` to have shape (3,), got {t.shape}")
         object.__setattr__(self, "_params", t.copy())
@@ -168,12 +195,12 @@ class GravityGradientTorque(_Torque):
     _params: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        k = strip("gm_over_r3", self.gm_over_r3, u.s**-2)
+        k = _GM_OVER_R3("gm_over_r3", self.gm_over_r3)
         check_positive("gm_over_r3", k, strict=False)
-        n = strip("mean_motion", self.mean_motion, _RATE)
-        ph = strip("phase", self.phase, u.rad)
-        e1 = as_float_array("e1", self.e1)
-        e2 = as_float_array("e2", self.e2)
+        n = ANGULAR_SPEED("mean_motion", self.mean_motion)
+        ph = ANGLE("phase", self.phase)
+        e1 = DIMENSIONLESS("e1", self.e1)
+        e2 = DIMENSIONLESS("e2", self.e2)
         for name, e in (("e1", e1), ("e2", e2)):
             if e.shape != (3,):
                 raise ValueError(f"Expected `{name}` to have shape (3,), got {e.shape}")
@@ -204,7 +231,7 @@ def _encode(torque: Any) -> tuple[int, np.ndarray]:
     )
 
 
-def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = 0.0) -> np.ndarray:
+def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.ndarray:
     """Body-frame torque of a torque object for arrays of attitudes.
 
     Parameters
@@ -216,7 +243,7 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = 0.0) -> np.ndar
     attitude : Quaternion or array_like, shape (..., 4)
         Body-to-space attitude (any nonzero scale).
     t : float or Quantity, shape (...), optional
-        Time (s when a Quantity).  Default 0.
+        Time (s when a Quantity).  Default 0.  A Quantity if ``moments`` is one.
 
     Returns
     -------
@@ -233,15 +260,24 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = 0.0) -> np.ndar
     >>> torque_on(BodyTorque([1.0, 2.0, 3.0]), [1.0, 1.0, 1.0], Quaternion([1, 0, 0, 0]))
     array([1., 2., 3.])
     """
+    quantity = require_consistent(("moments", "t"), (moments, t))
     m = _moments(moments)
     q = _quat_array("attitude", attitude)
-    tt = strip("t", t, u.s)
+    tt = np.zeros(()) if t is None else TIME("t", t)
     kind, params = _encode(torque)
-    out = _k.torque_gufunc(m, q, tt, kind, params)
-    return wrap(out, _TORQUE, is_quantity(moments))
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.torque_gufunc(m, q, tt, kind, params)
+    except ValueError as exc:
+        raise ValueError(
+            f"Expected `moments`, `attitude`, `t` to broadcast together, got shapes "
+            f"{m.shape}, {q.shape}, {tt.shape}"
+        ) from exc
+    _finite("torque", out, ("moments", "attitude", "torque"))
+    return wrap(out, _TORQUE, quantity)
 
 
-def euler_equations(moments: Any, omega: Any, torque: Any = 0.0) -> np.ndarray:
+def euler_equations(moments: Any, omega: Any, torque: Any = None) -> np.ndarray:
     """Angular acceleration from Euler's equations.
 
     A dp/dt + (C - B) q r = N_x, B dq/dt + (A - C) r p = N_y,
@@ -256,7 +292,8 @@ def euler_equations(moments: Any, omega: Any, torque: Any = 0.0) -> np.ndarray:
     omega : array_like or Quantity, shape (..., 3)
         Body-frame angular velocity (p, q, r) (rad/s).
     torque : array_like or Quantity, shape (..., 3), optional
-        Body-frame torque (N m).  Default 0.
+        Body-frame torque (N m).  Default 0.  ``moments``, ``omega`` and
+        ``torque`` are all Quantities or all plain numbers.
 
     Returns
     -------
@@ -274,20 +311,22 @@ def euler_equations(moments: Any, omega: Any, torque: Any = 0.0) -> np.ndarray:
     >>> np.round(euler_equations([1.0, 2.0, 3.0], [1.0, 1.0, 1.0]), 6)
     array([-1.      ,  1.      , -0.333333])
     """
-    quantity = is_quantity(moments) or is_quantity(omega) or is_quantity(torque)
+    quantity = require_consistent(("moments", "omega", "torque"), (moments, omega, torque))
     m = _moments(moments)
-    w = check_trailing("omega", strip("omega", omega, _RATE), 3)
-    n = strip("torque", torque, _TORQUE)
+    w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
+    n = np.zeros(3) if torque is None else TORQUE("torque", torque)
     if n.ndim == 0:
         n = np.broadcast_to(n, (3,))
     check_trailing("torque", n, 3)
     try:
-        out = _k.euler_gufunc(m, w, n)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.euler_gufunc(m, w, n)
     except ValueError as exc:
         raise ValueError(
             f"Expected `moments`, `omega`, `torque` to broadcast together, got shapes "
             f"{m.shape}, {w.shape}, {n.shape}"
         ) from exc
+    _finite("angular acceleration", out, ("moments", "omega", "torque"))
     return wrap(out, _RATE / u.s, quantity)
 
 
@@ -318,12 +357,14 @@ def quaternion_rate(attitude: Any, omega: Any) -> Quaternion:
     array([0., 0., 0., 1.])
     """
     q = _quat_array("attitude", attitude)
-    w = check_trailing("omega", strip("omega", omega, _RATE), 3)
+    w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
     try:
-        out = _k.qdot_gufunc(q, w)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = _k.qdot_gufunc(q, w)
     except ValueError as exc:
         raise ValueError(
             f"Expected `attitude`, `omega` to broadcast together, got shapes "
             f"{q.shape}, {w.shape}"
         ) from exc
+    _finite("quaternion rate", out, ("attitude", "omega"))
     return Quaternion(out)

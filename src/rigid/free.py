@@ -29,29 +29,61 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _free_kernels as _fk
-from rigid.body import RigidBody
+from hamilton_orbits.units import ANGULAR_SPEED, INERTIA, TIME, require_consistent, wrap
+from rigid._kernels import free as _fk
+from rigid.body import RigidBody, _pow2, call_units, check_body, check_moments, unit_quaternion
 
 __all__ = ["FreeParameters", "free_motion", "free_motion_arrays", "free_parameters"]
 
+_RATE = 1 / u.s
 
-def _check_state(moments: Any, q0: Any, omega0: Any) -> tuple[np.ndarray, ...]:
-    moments = as_float_array("moments", moments)
-    if moments.shape != (3,):
-        raise ValueError(f"Expected `moments` to have shape (3,), got {moments.shape}")
-    q0 = as_float_array("q0", q0)
-    if q0.shape != (4,):
-        raise ValueError(f"Expected `q0` to have shape (4,), got {q0.shape}")
-    nrm = float(np.sqrt(np.sum(q0 * q0)))
-    if nrm == 0.0:
-        raise ValueError(f"Expected `q0` to be a nonzero quaternion, got {q0!r}")
-    omega0 = as_float_array("omega0", omega0)
+
+def _check_state(
+    moments: Any, q0: Any, omega0: Any, names: tuple[str, str, str] = ("moments", "q0", "omega0")
+) -> tuple[np.ndarray, ...]:
+    moments = check_moments(names[0], INERTIA(names[0], moments))
+    q0 = unit_quaternion(names[1], q0)
+    omega0 = ANGULAR_SPEED(names[2], omega0)
     if omega0.shape != (3,):
-        raise ValueError(f"Expected `omega0` to have shape (3,), got {omega0.shape}")
-    return np.ascontiguousarray(moments), np.ascontiguousarray(q0 / nrm), omega0.copy()
+        raise ValueError(f"Expected `{names[2]}` to have shape (3,), got {omega0.shape}")
+    return np.ascontiguousarray(moments), np.ascontiguousarray(q0), omega0.copy()
+
+
+def _free_flow_scaled(
+    moments: np.ndarray, q0: np.ndarray, omega0: np.ndarray, flat_t: np.ndarray, t_name: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel on a homogeneously scaled problem (no over- or underflow inside).
+
+    The motion depends on the moments only through their ratios, and
+    ``omega(t; s omega0) = s omega(s t; omega0)``: with exact power-of-two scales
+    ``sm ~ max moment`` and ``sw ~ max|omega0|`` the kernel sees moments and rates
+    of order one, whatever the caller's magnitudes (1e-300 or 1e300 kg m^2,
+    1e-200 rad/s).
+    """
+    sm = _pow2(moments)
+    sw = _pow2(omega0)
+    with np.errstate(over="ignore"):
+        ts = flat_t * sw
+    bad = ~np.isfinite(ts)
+    if np.any(bad):
+        k = int(np.argwhere(bad)[0][0])
+        raise ValueError(
+            f"Expected `{t_name}` * |omega| to be finite (the angle turned), got "
+            f"{float(flat_t[k])!r} at index {k} with |omega| ~ {sw!r}"
+        )
+    out_q = np.empty((flat_t.size, 4))
+    out_w = np.empty((flat_t.size, 3))
+    _fk.free_flow(moments / sm, q0, omega0 / sw, ts, out_q, out_w)
+    out_w *= sw
+    bad = ~(np.isfinite(out_q).all(axis=-1) & np.isfinite(out_w).all(axis=-1))
+    if np.any(bad):  # pragma: no cover - a kernel failure is a bug, never a silent NaN
+        k = int(np.argwhere(bad)[0][0])
+        raise ValueError(
+            f"free motion failed for moments = {moments.tolist()}, omega = {omega0.tolist()} "
+            f"at `{t_name}`[{k}] = {float(flat_t[k])!r}: please report this case"
+        )
+    return out_q, out_w
 
 
 def free_motion_arrays(
@@ -61,26 +93,37 @@ def free_motion_arrays(
 
     Parameters
     ----------
-    moments : array_like, shape (3,)
-        Principal moments in the order of the body axes (any order of sizes).
+    moments : array_like or Quantity, shape (3,), kg m^2
+        Principal moments in the order of the body axes (any order of sizes),
+        each > 0, with ``A + B >= C`` for every permutation.
     q0 : array_like, shape (4,)
         Initial attitude, scalar first, body to space; normalised on input.
-    omega0 : array_like, shape (3,)
+    omega0 : array_like or Quantity, shape (3,), rad/s
         Initial body-frame angular velocity.
-    t : array_like, shape (n,) or any shape
-        Times since the initial state (same time unit as ``omega0``).
+    t : array_like or Quantity, shape (n,) or any shape, s
+        Times since the initial state (plain floats: the time unit of ``omega0``).
 
     Returns
     -------
     q : ndarray, shape t.shape + (4,)
         Unit attitude quaternions.  The sign is continuous in time.
-    omega : ndarray, shape t.shape + (3,)
-        Body-frame angular velocities.
+    omega : ndarray or Quantity, shape t.shape + (3,)
+        Body-frame angular velocities (rad/s if the call was in Quantities).
 
     Raises
     ------
     ValueError
-        For wrong shapes, NaN / inf or a zero quaternion.
+        For wrong shapes, NaN / inf, complex input, a non-positive moment, moments
+        that break the triangle inequality, a zero quaternion, ``|omega0| t``
+        beyond float64, or a mix of Quantities and plain numbers.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong dimension, naming the argument.
+
+    Notes
+    -----
+    The problem is homogeneous: the kernel runs on ``moments / sm``,
+    ``omega0 / sw`` and ``t sw`` (``sm, sw`` powers of two), so magnitudes from
+    1e-300 to 1e300 neither under- nor overflow.
 
     Examples
     --------
@@ -93,13 +136,13 @@ def free_motion_arrays(
     >>> print((moments * w**2).sum(axis=-1).round(14))  # 2T is conserved
     [3.1 3.1 3.1]
     """
+    quantity = require_consistent(("moments", "omega0", "t"), (moments, omega0, t))
     moments, q0, omega0 = _check_state(moments, q0, omega0)
-    t_arr = as_float_array("t", t)
+    t_arr = TIME("t", t)
     flat = np.ascontiguousarray(t_arr.reshape(-1))
-    out_q = np.empty((flat.size, 4))
-    out_w = np.empty((flat.size, 3))
-    _fk.free_flow(moments, q0, omega0, flat, out_q, out_w)
-    return out_q.reshape(t_arr.shape + (4,)), out_w.reshape(t_arr.shape + (3,))
+    out_q, out_w = _free_flow_scaled(moments, q0, omega0, flat, "t")
+    w = out_w.reshape(t_arr.shape + (3,))
+    return out_q.reshape(t_arr.shape + (4,)), wrap(w, u.rad / u.s, quantity)
 
 
 def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
@@ -158,11 +201,14 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
     [[1.  0.6 2.4]
      [1.  0.6 2.4]]
     """
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"Expected `body` to be a RigidBody, got {type(body).__name__}")
-    t_arr = strip("t", t, u.s)
-    q, w = free_motion_arrays(body.moments, body.attitude.as_array(), body.omega, t_arr)
-    return Quaternion(q), wrap(w, u.rad / u.s, is_quantity(t))
+    body = check_body(body)
+    quantity = call_units(body, ("t",), (t,))
+    t_arr = TIME("t", t)
+    flat = np.ascontiguousarray(t_arr.reshape(-1))
+    q, w = _free_flow_scaled(body._moments, body.attitude.as_array(), body._omega, flat, "t")
+    q = q.reshape(t_arr.shape + (4,))
+    w = w.reshape(t_arr.shape + (3,))
+    return Quaternion(q), wrap(w, u.rad / u.s, quantity)
 
 
 @dataclass(frozen=True)
@@ -181,13 +227,14 @@ class FreeParameters:
         Parameter and complementary parameter ``m1 = 1 - m`` (computed directly).
     K : float
         Complete elliptic integral ``K(m)`` (inf on the separatrix).
-    lam : float
-        Rate ``lambda`` of the argument ``u = u0 + lambda t`` (1 / time).
-    period : float
-        Period of omega in the body, ``4 K / lambda`` (inf on the separatrix).
-    flip_interval : float
+    lam : float or Quantity
+        Rate ``lambda`` of the argument ``u = u0 + lambda t`` (1/s; a Quantity
+        for a body built from Quantities, as are the two times below).
+    period : float or Quantity
+        Period of omega in the body, ``4 K / lambda`` (inf on the separatrix), s.
+    flip_interval : float or Quantity
         Half the period, ``2 K / lambda``: the time between two successive
-        reversals of the middle-axis component (the Dzhanibekov flip).
+        reversals of the middle-axis component (the Dzhanibekov flip), s.
     n : float
         Characteristic of the third-kind integral, ``-J3 (J2 - J1) / (J1 (J3 - J2))``.
     """
@@ -197,9 +244,9 @@ class FreeParameters:
     m: float
     m1: float
     K: float
-    lam: float
-    period: float
-    flip_interval: float
+    lam: Any
+    period: Any
+    flip_interval: Any
     n: float
 
 
@@ -213,7 +260,8 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     Returns
     -------
     FreeParameters
-        Times in seconds for SI bodies (plain floats).
+        ``lam`` in 1/s, ``period`` and ``flip_interval`` in s: Quantities for a
+        body built from Quantities, else plain SI floats.
 
     Examples
     --------
@@ -222,21 +270,25 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     >>> print(p.kind, p.polar_axis, round(p.m, 6), round(p.period, 6))
     periodic 2 0.542289 9.244135
     """
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"Expected `body` to be a RigidBody, got {type(body).__name__}")
-    prm = _fk.free_setup(body.moments, body.attitude.as_array(), body.omega)
+    body = check_body(body)
+    # homogeneous: the kernel sees moments / sm and omega / sw; rates scale back by sw
+    sm, sw = _pow2(body._moments), _pow2(body._omega)
+    prm = _fk.free_setup(body._moments / sm, body.attitude.as_array(), body._omega / sw)
     kind = int(prm[_fk._KIND])
+    q = body._quantity
+    inf = float("inf")
     if kind == 0:
-        inf = float("inf")
-        return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, 0.0, inf, inf, 0.0)
+        return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, wrap(0.0, _RATE, q),
+                              wrap(inf, u.s, q), wrap(inf, u.s, q), 0.0)
     pmat = prm[_fk._P : _fk._P + 9].reshape(3, 3)
     polar = int(np.argmax(np.abs(pmat[:, 2])))
-    lam = float(prm[_fk._LAM])
+    lam = float(prm[_fk._LAM]) * sw
     if kind == 1:
         kk = float(prm[_fk._K])
         return FreeParameters(
-            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk, lam,
-            4.0 * kk / lam, 2.0 * kk / lam, float(prm[_fk._N]),
+            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk,
+            wrap(lam, _RATE, q), wrap(4.0 * kk / lam, u.s, q), wrap(2.0 * kk / lam, u.s, q),
+            float(prm[_fk._N]),
         )
-    inf = float("inf")
-    return FreeParameters("separatrix", polar, 1.0, 0.0, inf, lam, inf, inf, float(prm[_fk._N]))
+    return FreeParameters("separatrix", polar, 1.0, 0.0, inf, wrap(lam, _RATE, q),
+                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk._N]))

@@ -31,7 +31,7 @@ depends on (t, attitude) only, the fixed-step methods keep their order):
 All splittings fuse the neighbouring flows of one part (also across steps) and
 keep their rounding error at a few ulp per *run*: each rotation is applied as a
 compensated (TwoSum) increment with cos - 1 and sin from the half angle, so it
-is orthogonal to O(eps h^2) (see :mod:`rigid._euler_kernels`).  The attitude is
+is orthogonal to O(eps h^2) (see :mod:`rigid._kernels.euler`).  The attitude is
 normalised on output only (it is not projected inside the run);
 ``norm_drift`` reports max | |q| - 1 | before that.
 ``"exact_kick"``
@@ -63,10 +63,11 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array, check_positive
+from hamilton_orbits._validation import check_positive
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
+from rigid._kernels import euler as _k
+from rigid.body import call_units, check_body
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, _encode
 
 __all__ = [
@@ -92,13 +93,14 @@ class RigidTrajectory:
     Attributes
     ----------
     t : ndarray or Quantity, shape (n,)
-        Output times (s when the call used Quantities).
+        Output times (a Quantity in the unit of ``t_end`` when the call used
+        Quantities).
     attitude : Quaternion, shape (n,)
         Unit body-to-space attitudes.
     omega : ndarray or Quantity, shape (n, 3)
         Body-frame angular velocities (rad/s when the call used Quantities).
-    moments : ndarray, shape (3,)
-        Principal moments (A, B, C) (plain floats, SI if Quantities were used).
+    moments : ndarray or Quantity, shape (3,)
+        Principal moments (A, B, C) (kg m^2 when the call used Quantities).
     method : str
         Integrator name.
     n_steps : int
@@ -123,25 +125,53 @@ class RigidTrajectory:
     norm_drift: float = 0.0
     nfev: int = 0
 
+    def _quantity(self) -> bool:
+        return isinstance(self.t, u.Quantity)
+
     def _omega_f(self) -> np.ndarray:
         w = self.omega
         return w.to_value(u.rad / u.s) if isinstance(w, u.Quantity) else np.asarray(w)
 
-    @property
-    def angular_momentum_body(self) -> np.ndarray:
-        """L = I omega in the body frame, shape (n, 3) (plain floats)."""
-        return self.moments * self._omega_f()
+    def _moments_f(self) -> np.ndarray:
+        m = self.moments
+        return m.to_value(u.kg * u.m**2) if isinstance(m, u.Quantity) else np.asarray(m)
 
     @property
-    def angular_momentum_space(self) -> np.ndarray:
-        """q L q^-1, Cayley's (g, g', g''), shape (n, 3) (plain floats)."""
-        return self.attitude.rotate(self.angular_momentum_body)
+    def angular_momentum_body(self) -> Any:
+        """L = I omega in the body frame, shape (n, 3) (kg m^2/s for Quantity calls)."""
+        return wrap(self._moments_f() * self._omega_f(), _L_UNIT, self._quantity())
 
     @property
-    def kinetic_energy(self) -> np.ndarray:
-        """T = (A p^2 + B q^2 + C r^2) / 2, shape (n,) (plain floats)."""
+    def angular_momentum_space(self) -> Any:
+        """q L q^-1, Cayley's (g, g', g''), shape (n, 3) (kg m^2/s for Quantity calls)."""
+        ell = self.attitude.rotate(self._moments_f() * self._omega_f())
+        return wrap(np.asarray(ell), _L_UNIT, self._quantity())
+
+    @property
+    def kinetic_energy(self) -> Any:
+        """T = (A p^2 + B q^2 + C r^2) / 2, shape (n,) (J for Quantity calls)."""
         w = self._omega_f()
-        return 0.5 * np.sum(self.moments * w * w, axis=-1)
+        return wrap(0.5 * np.sum(self._moments_f() * w * w, axis=-1), u.J, self._quantity())
+
+
+_L_UNIT = u.kg * u.m**2 / u.s
+_MAX_STEPS = 1e12  # beyond this a fixed-step run is a typo, not a plan (days of CPU)
+
+
+def _scalar_positive(name: str, value: np.ndarray) -> float:
+    if value.shape != ():
+        raise ValueError(f"Expected `{name}` to be a scalar, got shape {value.shape}")
+    check_positive(name, value)
+    return float(value)
+
+
+def _n_out(n_out: Any) -> int:
+    ok = isinstance(n_out, (int, np.integer)) and not isinstance(n_out, bool)
+    if isinstance(n_out, (float, np.floating)) and float(n_out).is_integer():
+        ok = True
+    if not ok or n_out < 2 or n_out > 1e9:
+        raise ValueError(f"Expected `n_out` to be an integer in [2, 1e9], got {n_out!r}")
+    return int(n_out)
 
 
 def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]:
@@ -217,7 +247,7 @@ def _split_ops(
     """(types, fractions of h, time offsets in h, inverse moments) of one step.
 
     Types 0-2 are principal-axis rotations, 3 a torque kick, 4 the Casimir flow
-    (see :func:`rigid._euler_kernels.run_splitting`).
+    (see :func:`rigid._kernels.euler.run_splitting`).
     """
     inv = np.concatenate([1.0 / moments, [0.0, 0.0]])  # axes 0-2, (kick), Casimir
     # Time (for time-dependent torques) is carried by one part: the one with the
@@ -404,11 +434,12 @@ def integrate(
     body : RigidBody
         Initial state: ``moments`` (3,), ``attitude`` (Quaternion), ``omega`` (3,).
     t_end : float or Quantity
-        Time span, > 0 (s when a Quantity).
+        Time span, > 0 (s for plain floats).  Must be a Quantity if ``body`` was
+        built from Quantities.
     dt : float or Quantity, optional
         Step of the fixed-step methods (required for them; ignored by
         ``"dop853"``).  Rounded down so that a whole number of steps spans
-        ``t_end``.
+        ``t_end``.  A Quantity exactly when ``t_end`` is one.
     method : str, optional
         One of :data:`METHODS` (see the module docstring).  Default
         ``"splitting4"``.
@@ -428,12 +459,19 @@ def integrate(
     Returns
     -------
     RigidTrajectory
+        In Quantities (``t`` in the unit of ``t_end``, omega in rad/s, moments in
+        kg m^2) when the call was; else plain SI floats.
 
     Raises
     ------
     ValueError
-        For an unknown method, a non-positive or NaN ``t_end`` / ``dt``, a missing
-        ``dt``, ``n_out < 2``, or an unsupported torque.
+        For ``body`` not a RigidBody, an unknown method, a non-positive or NaN
+        ``t_end`` / ``dt``, a missing ``dt``, more than 1e12 steps, ``n_out`` not
+        an integer in [2, 1e9], a plain ``dt`` beside a Quantity ``t_end`` (or
+        the reverse, or plain times for a body with units), or an unsupported
+        torque.
+    astropy.units.UnitConversionError
+        For a time of the wrong dimension, naming the argument.
 
     References
     ----------
@@ -454,40 +492,50 @@ def integrate(
     >>> bool(np.all(np.abs(L / L[0] - 1.0) < 1e-14))
     True
     """
-    if method not in METHODS:
+    body = check_body(body)
+    body._energy()  # a body whose I omega^2 or I omega leaves float64 is refused here
+    body._l_norm()
+    if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
-    quantity = is_quantity(t_end)
-    te = strip("t_end", t_end, u.s)
-    if te.shape != ():
-        raise ValueError(f"Expected `t_end` to be a scalar, got shape {te.shape}")
-    check_positive("t_end", te)
+    quantity = call_units(body, ("t_end", "dt"), (t_end, dt))
+    te = _scalar_positive("t_end", TIME("t_end", t_end))
     if method in _FIXED:
         if dt is None:
             raise ValueError(f"Expected `dt` for method {method!r}, got None")
-        h = strip("dt", dt, u.s)
-        if h.shape != ():
-            raise ValueError(f"Expected `dt` to be a scalar, got shape {h.shape}")
-        check_positive("dt", h)
-        dtf: float | None = float(h)
+        dtf: float | None = float(_scalar_positive("dt", TIME("dt", dt)))
+        if not math.isfinite(te / dtf) or te / dtf > _MAX_STEPS:
+            raise ValueError(
+                f"Expected `dt` to give at most {_MAX_STEPS:.0e} steps over `t_end`, got "
+                f"dt = {dtf!r} s for t_end = {te!r} s"
+            )
     else:
         dtf = None
-    if int(n_out) != n_out or n_out < 2:
-        raise ValueError(f"Expected `n_out` to be an integer >= 2, got {n_out!r}")
-    for name, v in (("rtol", rtol), ("atol", atol), ("recentre", recentre)):
-        check_positive(name, as_float_array(name, v))
-    kind, params = _encode(torque)
-    moments = np.asarray(body.moments, dtype=np.float64)
-    q0 = body.attitude.as_array().astype(np.float64)
-    w0 = np.asarray(body.omega, dtype=np.float64)
-    t, q, w, n_steps, count, drift = integrate_arrays(
-        moments, q0, w0, float(te), method=method, dt=dtf, n_out=int(n_out), kind=kind,
-        params=params, rtol=rtol, atol=atol, recentre=float(recentre), progress=progress,
+    n_out = _n_out(n_out)
+    rtol, atol, recentre = (
+        float(_scalar_positive(name, DIMENSIONLESS(name, v)))
+        for name, v in (("rtol", rtol), ("atol", atol), ("recentre", recentre))
     )
+    kind, params = _encode(torque)
+    moments = body._moments
+    q0 = body.attitude.as_array().astype(np.float64)
+    w0 = body._omega.copy()
+    t, q, w, n_steps, count, drift = integrate_arrays(
+        moments, q0, w0, te, method=method, dt=dtf, n_out=n_out, kind=kind,
+        params=params, rtol=rtol, atol=atol, recentre=recentre, progress=progress,
+    )
+    bad = ~(np.isfinite(q).all(axis=-1) & np.isfinite(w).all(axis=-1))
+    if np.any(bad):
+        k = int(np.argwhere(bad)[0][0])
+        raise ValueError(
+            f"Expected `dt` small enough for a finite solution, got a non-finite state at "
+            f"t = {float(t[k])!r} s with method {method!r} and dt = {dtf!r} s"
+        )
+    t_unit = t_end.unit if quantity and isinstance(t_end, u.Quantity) else u.s
     return RigidTrajectory(
-        t=wrap(t, u.s, quantity),
+        t=wrap(t * u.s.to(t_unit), t_unit, quantity),
         attitude=Quaternion(q),
         omega=wrap(w, u.rad / u.s, quantity),
-        moments=moments.copy(),
+        moments=wrap(moments.copy(), u.kg * u.m**2, quantity),
         method=method,
         n_steps=n_steps,
         n_recentre=count if method == "cayley_rk4" else 0,

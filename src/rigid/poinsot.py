@@ -14,10 +14,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import astropy.units as u
 import numpy as np
 
-from rigid.body import RigidBody
-from rigid.free import free_motion
+from hamilton_orbits.quaternion import Quaternion
+from hamilton_orbits.units import TIME, wrap
+from rigid.body import RigidBody, _pow2, call_units, check_body
+from rigid.free import _free_flow_scaled
+
+_RHO_UNIT = (u.kg * u.m**2) ** -0.5  # x . I x = 1 on the inertia ellipsoid
 
 __all__ = ["PoinsotPaths", "plot_poinsot", "poinsot"]
 
@@ -26,31 +31,37 @@ __all__ = ["PoinsotPaths", "plot_poinsot", "poinsot"]
 class PoinsotPaths:
     """Arrays of Poinsot's construction, all for the times ``t`` (n,).
 
+    The lengths (``polhode``, ``contact``, ``herpolhode``, ``distance``) live in
+    the space of the inertia ellipsoid ``x . I x = 1``, so their unit is
+    ``(kg m^2)^(-1/2)``; they are Quantities in that unit when the call was in
+    Quantities, else plain floats.
+
     Attributes
     ----------
-    t : ndarray (n,)
-    polhode : ndarray (n, 3)
+    t : ndarray or Quantity (n,)
+        The times as given (a Quantity keeps its unit).
+    polhode : ndarray or Quantity (n, 3)
         ``rho = omega / sqrt(2T)`` in the body frame (on the inertia ellipsoid).
-    contact : ndarray (n, 3)
+    contact : ndarray or Quantity (n, 3)
         The same point in space (the point of contact with the invariable plane).
-    herpolhode : ndarray (n, 2)
+    herpolhode : ndarray or Quantity (n, 2)
         Its coordinates in the invariable plane, about the foot of the normal,
         in the basis ``(e1, e2)``.
     plane_normal : ndarray (3,)
         ``L_hat`` in space.
     plane_basis : ndarray (2, 3)
         ``e1, e2``: an orthonormal basis of the plane with ``e1 x e2 = L_hat``.
-    distance : float
+    distance : float or Quantity
         ``sqrt(2T) / |L|``, the distance from the centre to the invariable plane.
     """
 
-    t: np.ndarray
-    polhode: np.ndarray
-    contact: np.ndarray
-    herpolhode: np.ndarray
+    t: Any
+    polhode: Any
+    contact: Any
+    herpolhode: Any
     plane_normal: np.ndarray
     plane_basis: np.ndarray
-    distance: float
+    distance: Any
 
 
 def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
@@ -61,15 +72,20 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     body : RigidBody
         Not at rest.
     t : array_like (n,) or Quantity, s
+        A Quantity if ``body`` was built from Quantities.
 
     Returns
     -------
     PoinsotPaths
+        In Quantities when ``body`` or ``t`` is (``t`` kept in its own unit).
 
     Raises
     ------
     ValueError
-        If the body is at rest (no invariable plane).
+        If ``body`` is not a RigidBody or is at rest (no invariable plane), or
+        ``t`` is not finite or is a plain number beside a body with units.
+    astropy.units.UnitConversionError
+        If ``t`` is not a time.
 
     Examples
     --------
@@ -79,22 +95,33 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     >>> print(round(float(np.sqrt(3.1 / 7.12)), 9))  # by hand: sqrt(2T) / |L|
     0.659843359
     """
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"Expected `body` to be a RigidBody, got {type(body).__name__}")
+    body = check_body(body)
+    quantity = call_units(body, ("t",), (t,))
     normal = body.invariable_plane
-    att, w = free_motion(body, t)
-    w = np.asarray(getattr(w, "value", w))
-    t_arr = np.asarray(getattr(t, "value", t), dtype=float)
-    scale = 1.0 / np.sqrt(2.0 * body._energy())
-    rho = w * scale
-    contact = np.asarray(att.rotate(rho))
+    t_s = TIME("t", t)  # validated, in seconds for the computation
+    t_unit = t.unit if isinstance(t, u.Quantity) else u.s
+    t_given = np.array(t.value, dtype=np.float64) if isinstance(t, u.Quantity) else t_s
+    flat = np.ascontiguousarray(t_s.reshape(-1))
+    q, w = _free_flow_scaled(body._moments, body.attitude.as_array(), body._omega, flat, "t")
+    # rho = omega / sqrt(2T) on moments / sm and omega / sw (no under- or overflow):
+    # rho = (omega / sw) / sqrt(2T / (sm sw^2)) / sqrt(sm)
+    sm, sw = _pow2(body._moments), _pow2(body._omega)
+    two_t = float(np.sum((body._moments / sm) * (body._omega / sw) ** 2))
+    rho = (w / sw) / np.sqrt(two_t) / np.sqrt(sm)
+    rho = rho.reshape(t_given.shape + (3,))
+    contact = np.asarray(Quaternion(q.reshape(t_given.shape + (4,))).rotate(rho))
     helper = np.eye(3)[int(np.argmin(np.abs(normal)))]
     e1 = np.cross(helper, normal)
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(normal, e1)
     herp = np.stack([contact @ e1, contact @ e2], axis=-1)
-    dist = np.sqrt(2.0 * body._energy()) / body._l_norm()
-    return PoinsotPaths(t_arr, rho, contact, herp, normal, np.stack([e1, e2]), float(dist))
+    l_scaled = float(np.linalg.norm((body._moments / sm) * (body._omega / sw)))
+    dist = np.sqrt(two_t) / l_scaled / np.sqrt(sm)
+    return PoinsotPaths(
+        wrap(t_given, t_unit, quantity), wrap(rho, _RHO_UNIT, quantity),
+        wrap(contact, _RHO_UNIT, quantity), wrap(herp, _RHO_UNIT, quantity), normal,
+        np.stack([e1, e2]), wrap(np.float64(dist), _RHO_UNIT, quantity),
+    )
 
 
 def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
@@ -106,21 +133,25 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
     -------
     matplotlib.figure.Figure
     """
+    paths = poinsot(body, t)  # validates first: bad input fails before matplotlib loads
+
     import matplotlib.pyplot as plt  # lazy: optional dependency
 
-    paths = poinsot(body, t)
     if fig is None:
         fig = plt.figure(figsize=(10, 4.5))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
     uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
-    semi = 1.0 / np.sqrt(body.moments)
+    semi = 1.0 / np.sqrt(body._moments)
+    polhode = np.asarray(getattr(paths.polhode, "value", paths.polhode))
+    herpolhode = np.asarray(getattr(paths.herpolhode, "value", paths.herpolhode))
+    distance = float(getattr(paths.distance, "value", paths.distance))
     ax1.plot_wireframe(semi[0] * np.cos(uu) * np.sin(vv), semi[1] * np.sin(uu) * np.sin(vv),
                        semi[2] * np.cos(vv), color="0.8", linewidth=0.4)
-    ax1.plot(*paths.polhode.T, color="C3", linewidth=1.5)
+    ax1.plot(*polhode.T, color="C3", linewidth=1.5)
     ax1.set_title("polhode on the inertia ellipsoid (body)")
     ax2 = fig.add_subplot(1, 2, 2)
-    ax2.plot(*paths.herpolhode.T, color="C0", linewidth=0.8)
+    ax2.plot(*herpolhode.T, color="C0", linewidth=0.8)
     ax2.set_aspect("equal")
-    ax2.set_title(f"herpolhode (invariable plane at d = {paths.distance:.4g})")
+    ax2.set_title(f"herpolhode (invariable plane at d = {distance:.4g})")
     fig.tight_layout()
     return fig

@@ -47,8 +47,8 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._validation import _first_index, as_float_array, check_trailing
-from hamilton_orbits.units import is_quantity, strip, wrap
-from rigid import _euler_kernels as _k
+from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
+from rigid._kernels import euler as _k
 
 __all__ = [
     "cayley_propagate",
@@ -61,7 +61,22 @@ __all__ = [
 
 
 def _vec(name: str, value: Any) -> np.ndarray:
-    return check_trailing(name, as_float_array(name, value), 3)
+    return check_trailing(name, DIMENSIONLESS(name, value), 3)
+
+
+def _guarded(names: tuple[str, ...], what: str, compute: Any) -> np.ndarray:
+    """``compute()`` without floating-point warnings; a result beyond float64 raises."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        out = np.asarray(compute())
+    bad = ~np.isfinite(out)
+    if np.any(bad):
+        index = tuple(int(i) for i in np.argwhere(np.atleast_1d(bad))[0])
+        args = ", ".join(f"`{n}`" for n in names)
+        raise ValueError(
+            f"Expected {args} with a representable {what}, got "
+            f"{float(np.atleast_1d(out)[index])!r} at index {index} (beyond float64)"
+        )
+    return out
 
 
 def _pair(names: tuple[str, str], a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,9 +121,10 @@ def gibbs_rate(gibbs: Any, omega: Any) -> np.ndarray:
     array([0.1, 0.2, 0.3])
     """
     g = _vec("gibbs", gibbs)
-    w = check_trailing("omega", strip("omega", omega, u.rad / u.s), 3)
+    w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
     g, w = _pair(("gibbs", "omega"), g, w)
-    return wrap(_k.gibbs_dot_gufunc(g, w), 1 / u.s, is_quantity(omega))
+    out = _guarded(("gibbs", "omega"), "Gibbs rate", lambda: _k.gibbs_dot_gufunc(g, w))
+    return wrap(out, 1 / u.s, is_quantity(omega))
 
 
 def omega_from_gibbs_rate(gibbs: Any, gibbs_dot: Any) -> np.ndarray:
@@ -143,7 +159,7 @@ def omega_from_gibbs_rate(gibbs: Any, gibbs_dot: Any) -> np.ndarray:
     g = _vec("gibbs", gibbs)
     d = _vec("gibbs_dot", gibbs_dot)
     g, d = _pair(("gibbs", "gibbs_dot"), g, d)
-    return _k.gibbs_omega_gufunc(g, d)
+    return _guarded(("gibbs", "gibbs_dot"), "omega", lambda: _k.gibbs_omega_gufunc(g, d))
 
 
 def direction_cosines(gibbs: Any) -> np.ndarray:
@@ -180,32 +196,39 @@ def direction_cosines(gibbs: Any) -> np.ndarray:
            [ 0.,  0.,  1.]])
     """
     g = _vec("gibbs", gibbs)
-    lam, mu, nu = g[..., 0], g[..., 1], g[..., 2]
-    kap = 1.0 + lam * lam + mu * mu + nu * nu
+    # Homogeneous of degree 0 in (1, lambda, mu, nu): divide all four by
+    # s = max(1, |lambda|, |mu|, |nu|) so that nothing overflows for large Gibbs
+    # vectors (near a half-turn); w = 1/s stands for Cayley's 1.
+    sc = np.maximum(1.0, np.max(np.abs(g), axis=-1))
+    w = 1.0 / sc
+    lam, mu, nu = g[..., 0] / sc, g[..., 1] / sc, g[..., 2] / sc
+    kap = w * w + lam * lam + mu * mu + nu * nu
+    ww = w * w
     r = np.empty(g.shape[:-1] + (3, 3))
     # column 0: alpha, alpha', alpha''
-    r[..., 0, 0] = 1.0 + lam * lam - mu * mu - nu * nu
-    r[..., 1, 0] = 2.0 * (lam * mu + nu)
-    r[..., 2, 0] = 2.0 * (nu * lam - mu)
+    r[..., 0, 0] = ww + lam * lam - mu * mu - nu * nu
+    r[..., 1, 0] = 2.0 * (lam * mu + w * nu)
+    r[..., 2, 0] = 2.0 * (nu * lam - w * mu)
     # column 1: beta, beta', beta''
-    r[..., 0, 1] = 2.0 * (lam * mu - nu)
-    r[..., 1, 1] = 1.0 + mu * mu - nu * nu - lam * lam
-    r[..., 2, 1] = 2.0 * (mu * nu + lam)
+    r[..., 0, 1] = 2.0 * (lam * mu - w * nu)
+    r[..., 1, 1] = ww + mu * mu - nu * nu - lam * lam
+    r[..., 2, 1] = 2.0 * (mu * nu + w * lam)
     # column 2: gamma, gamma', gamma''
-    r[..., 0, 2] = 2.0 * (nu * lam + mu)
-    r[..., 1, 2] = 2.0 * (mu * nu - lam)
-    r[..., 2, 2] = 1.0 + nu * nu - lam * lam - mu * mu
+    r[..., 0, 2] = 2.0 * (nu * lam + w * mu)
+    r[..., 1, 2] = 2.0 * (mu * nu - w * lam)
+    r[..., 2, 2] = ww + nu * nu - lam * lam - mu * mu
     return r / kap[..., None, None]
 
 
-def _check_pi(pi: np.ndarray, what: str) -> None:
+def _check_pi(pi: np.ndarray, what: str, names: tuple[str, str]) -> None:
     bad = ~(np.abs(pi) > 0.0)
     if np.any(bad):
         index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
         where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
         raise ValueError(
-            f"The {what} is a half-turn{where} (Cayley's Pi = 0): its Gibbs vector is "
-            "infinite. Compose quaternions (Quaternion.from_gibbs) instead."
+            f"Expected `{names[0]}`, `{names[1]}` whose {what} is not a half-turn, got "
+            f"Cayley's Pi = {float(np.atleast_1d(pi)[index] if index else pi)!r}{where}: its "
+            "Gibbs vector is infinite. Compose quaternions (Quaternion.from_gibbs) instead."
         )
 
 
@@ -243,9 +266,11 @@ def compose_gibbs(first: Any, second: Any) -> np.ndarray:
     a = _vec("first", first)
     b = _vec("second", second)
     a, b = _pair(("first", "second"), a, b)
-    pi = 1.0 - np.sum(a * b, axis=-1)
-    _check_pi(pi, "composition")
-    return (a + b + np.cross(a, b)) / pi[..., None]
+    with np.errstate(over="ignore", invalid="ignore"):
+        pi = 1.0 - np.sum(a * b, axis=-1)
+    _check_pi(pi, "composition", ("first", "second"))
+    return _guarded(("first", "second"), "composition",
+                    lambda: (a + b + np.cross(a, b)) / pi[..., None])
 
 
 def relative_gibbs(gibbs: Any, gibbs0: Any) -> np.ndarray:
@@ -281,9 +306,11 @@ def relative_gibbs(gibbs: Any, gibbs0: Any) -> np.ndarray:
     g = _vec("gibbs", gibbs)
     g0 = _vec("gibbs0", gibbs0)
     g, g0 = _pair(("gibbs", "gibbs0"), g, g0)
-    den = 1.0 + np.sum(g * g0, axis=-1)
-    _check_pi(den, "relative rotation")
-    return (g - g0 - np.cross(g, g0)) / den[..., None]
+    with np.errstate(over="ignore", invalid="ignore"):
+        den = 1.0 + np.sum(g * g0, axis=-1)
+    _check_pi(den, "relative rotation", ("gibbs", "gibbs0"))
+    return _guarded(("gibbs", "gibbs0"), "relative rotation",
+                    lambda: (g - g0 - np.cross(g, g0)) / den[..., None])
 
 
 def cayley_propagate(

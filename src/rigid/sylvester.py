@@ -12,42 +12,67 @@ from __future__ import annotations
 
 from typing import Any
 
+import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
-from rigid import _free_kernels as _fk
-from rigid.body import RigidBody
+from hamilton_orbits.units import ANGULAR_SPEED, TIME, Kind, wrap
+from rigid._kernels import free as _fk
+from rigid.body import RigidBody, _pow2, call_units, check_body, check_moments
 
 __all__ = ["confocal", "confocal_rotation", "contrafocal", "disk_equivalent", "time_between"]
 
 
-def _check_body(body: Any) -> RigidBody:
-    if not isinstance(body, RigidBody):
-        raise ValueError(f"Expected `body` to be a RigidBody, got {type(body).__name__}")
-    return body
+_RECIP = Kind("a reciprocal moment of inertia", 1 / (u.kg * u.m**2))
+_RECIP_UNIT = 1 / (u.kg * u.m**2)
+_W_UNIT = u.rad / u.s
 
 
-def _related(body: RigidBody, recip: np.ndarray, ell: np.ndarray, name: str) -> RigidBody:
+def _lam(body: RigidBody, lam: Any, extra: tuple[tuple[str, Any], ...] = ()) -> tuple[float, bool]:
+    """``lam`` as a float in 1/(kg m^2) (SI) and whether the call is in Quantities."""
+    names = ("lam", *(n for n, _ in extra))
+    quantity = call_units(body, names, (lam, *(v for _, v in extra)))
+    value = _RECIP("lam", lam)
+    if value.shape != ():
+        raise ValueError(f"Expected `lam` to be a scalar, got shape {value.shape}")
+    return float(value), quantity
+
+
+def _related(body: RigidBody, recip: np.ndarray, ell: np.ndarray, quantity: bool) -> RigidBody:
+    """The body with reciprocal moments ``recip`` and body angular momentum ``ell``."""
     bad = ~(recip > 0.0)
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])
         raise ValueError(
-            f"Expected `lam` to leave every reciprocal moment positive, got 1/{name}[{k}] = "
+            f"Expected `lam` to leave every reciprocal moment positive, got 1/A'[{k}] = "
             f"{float(recip[k])!r} at index {k}"
         )
-    moments = 1.0 / recip
-    return RigidBody(moments, body.attitude, ell / moments)
+    with np.errstate(over="ignore", divide="ignore"):
+        moments = 1.0 / recip
+    if not np.all(np.isfinite(moments)):
+        k = int(np.argwhere(~np.isfinite(moments))[0][0])
+        raise ValueError(
+            f"Expected `lam` to give finite moments, got 1/A'[{k}] = {float(recip[k])!r}"
+        )
+    try:
+        check_moments("moments", moments)
+    except ValueError as exc:
+        raise ValueError(f"Expected `lam` to give a realisable body: {exc}") from None
+    with np.errstate(over="ignore"):
+        omega = ell / moments
+    if not np.all(np.isfinite(omega)):
+        raise ValueError(f"Expected `lam` to give a finite omega, got moments {moments.tolist()}")
+    return RigidBody._from_si(moments, body.attitude, omega, quantity)
 
 
-def confocal(body: RigidBody, lam: float) -> RigidBody:
+def confocal(body: RigidBody, lam: Any) -> RigidBody:
     """The body confocal to ``body``: ``1/A' = 1/A + lam`` (and B, C), same couple.
 
     Parameters
     ----------
     body : RigidBody
-    lam : float
-        Difference of the reciprocal moments, 1 / (kg m^2) for SI bodies.
+    lam : float or Quantity, 1/(kg m^2)
+        Difference of the reciprocal moments (a Quantity for a body with units).
 
     Returns
     -------
@@ -77,12 +102,12 @@ def confocal(body: RigidBody, lam: float) -> RigidBody:
     >>> print(confocal(b, 0.1).omega.round(6))
     [1.1  0.6  0.25]
     """
-    body = _check_body(body)
-    lam = float(as_float_array("lam", lam))
-    return _related(body, 1.0 / body.moments + lam, body._l_body(), "A'")
+    body = check_body(body)
+    lam, quantity = _lam(body, lam)
+    return _related(body, 1.0 / body._moments + lam, body._l_body(), quantity)
 
 
-def contrafocal(body: RigidBody, lam: float) -> RigidBody:
+def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
     """The contrafocal body: ``1/A' = lam - 1/A`` (and B, C), with the contrary couple.
 
     Returns
@@ -105,16 +130,29 @@ def contrafocal(body: RigidBody, lam: float) -> RigidBody:
     >>> print(contrafocal(b, 2.0).moments.round(6))  # 1 / (2 - 1/A) ...
     [1.       0.666667 0.625   ]
     """
-    body = _check_body(body)
-    lam = float(as_float_array("lam", lam))
-    return _related(body, lam - 1.0 / body.moments, -body._l_body(), "A'")
+    body = check_body(body)
+    lam, quantity = _lam(body, lam)
+    return _related(body, lam - 1.0 / body._moments, -body._l_body(), quantity)
 
 
-def confocal_rotation(body: RigidBody, lam: float, t: Any) -> Quaternion:
+def confocal_rotation(body: RigidBody, lam: Any, t: Any) -> Quaternion:
     """The rotation ``exp(lam |L| t L_hat / 2)`` taking ``body``'s attitude to its confocal one.
 
     ``confocal_att(t) = confocal_rotation(body, lam, t) * att(t)``; for the
     contrafocal body use ``-lam``.
+
+    Parameters
+    ----------
+    body : RigidBody
+    lam : float or Quantity, 1/(kg m^2)
+        The constant of the confocal relation (:func:`confocal`).
+    t : array_like or Quantity, s
+        Times (Quantities if ``body`` was built from Quantities).
+
+    Returns
+    -------
+    Quaternion, shape t.shape
+        Identity for a body at rest.
 
     Examples
     --------
@@ -122,11 +160,24 @@ def confocal_rotation(body: RigidBody, lam: float, t: Any) -> Quaternion:
     >>> print(confocal_rotation(b, 0.1, 2.0).as_array().round(6))
     [0.968912 0.       0.       0.247404]
     """
-    body = _check_body(body)
-    t = as_float_array("t", t)
+    body = check_body(body)
+    lam_f, _ = _lam(body, lam, (("t", t),))
+    t_s = TIME("t", t)
     ell = body._l_space()
-    norm = float(np.linalg.norm(ell))
-    return Quaternion.from_axis_angle(ell / norm, float(lam) * norm * t)
+    big = float(np.max(np.abs(ell)))
+    if big == 0.0:
+        return Quaternion(np.broadcast_to([1.0, 0.0, 0.0, 0.0], t_s.shape + (4,)).copy())
+    norm = big * float(np.linalg.norm(ell / big))
+    with np.errstate(over="ignore"):
+        angle = lam_f * norm * t_s
+    bad = ~np.isfinite(angle)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(np.atleast_1d(bad))[0]) if t_s.ndim else ()
+        raise ValueError(
+            f"Expected `lam` |L| `t` to be finite (the angle), got t = "
+            f"{float(t_s[idx])!r} with lam = {lam_f!r} and |L| = {norm!r}"
+        )
+    return Quaternion.from_axis_angle(ell / norm, angle)
 
 
 def _disk_lams(moments: np.ndarray) -> list[tuple[str, float]]:
@@ -144,7 +195,7 @@ def _disk_lams(moments: np.ndarray) -> list[tuple[str, float]]:
     return out
 
 
-def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, float, float]:
+def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
     """Sylvester's reduction of a free body to an equivalent flat disk (``C' = A' + B'``).
 
     Returns
@@ -154,9 +205,10 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, float, float]:
     relation : str
         ``"confocal"`` (Sylvester's direct reduction) or ``"contrafocal"``
         (his supplemental reduction).
-    lam : float
-        The constant of the relation (see :func:`confocal`, :func:`contrafocal`).
-    delta : float
+    lam : float or Quantity, 1/(kg m^2)
+        The constant of the relation (see :func:`confocal`, :func:`contrafocal`);
+        a Quantity for a body built from Quantities.
+    delta : float or Quantity, (rad/s)^2
         The constant ``|omega_disk|^2 - |omega_body|^2`` along the motion:
         ``lam (4T + lam L^2)`` (confocal, ``omega' = omega + lam L``) or
         ``lam (lam L^2 - 4T)`` (contrafocal, ``omega' = omega - lam L``), using
@@ -179,10 +231,14 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, float, float]:
     >>> print(rel, bool(abs(m[2] - m[0] - m[1]) < 1e-12 * m[2]))
     contrafocal True
     """
-    body = _check_body(body)
-    moments = body.moments
-    ell2 = float(np.sum(body._l_body()**2))
-    t2 = 2.0 * body._energy()
+    body = check_body(body)
+    # On moments / sm and omega / sw (powers of two): lam = lam_s / sm and
+    # delta = sw^2 delta_s, so nothing under- or overflows on the way.
+    sm, sw = _pow2(body._moments), _pow2(body._omega)
+    moments = body._moments / sm
+    lb = moments * (body._omega / sw)
+    ell2 = float(np.sum(lb * lb))
+    t2 = float(np.sum(lb * (body._omega / sw)))
     mid = float(np.sort(moments)[1])
     prefer = "confocal" if ell2 > t2 * mid else "contrafocal"
     valid = []
@@ -193,17 +249,25 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, float, float]:
     if not valid:  # pragma: no cover - a real root always exists (Sylvester 1866)
         raise ValueError(f"Expected `body` to admit a disk reduction, got moments {moments}")
     valid.sort()
-    _, rel, lam = valid[0]
-    if rel == "confocal":
-        disk = confocal(body, lam)
-        delta = lam * (2.0 * t2 + lam * ell2)
-    else:
-        disk = contrafocal(body, lam)
-        delta = lam * (lam * ell2 - 2.0 * t2)
-    return disk, rel, lam, delta
+    _, rel, lam_s = valid[0]
+    q = body._quantity
+    sign = 1.0 if rel == "confocal" else -1.0
+    recip = sign / moments + lam_s if rel == "confocal" else lam_s - 1.0 / moments
+    with np.errstate(over="ignore"):
+        disk_moments = (1.0 / recip) * sm
+        lam = lam_s / sm
+        delta = lam_s * (sign * 2.0 * t2 + lam_s * ell2) * sw * sw
+    if not (np.all(np.isfinite(disk_moments)) and np.isfinite(lam) and np.isfinite(delta)
+            and lam != 0.0):
+        raise ValueError(
+            f"Expected `body` to have a disk equivalent within float64, got moments "
+            f"{body._moments.tolist()} and omega {body._omega.tolist()}"
+        )
+    disk = RigidBody._from_si(disk_moments, body.attitude, sign * body._l_body() / disk_moments, q)
+    return disk, rel, wrap(lam, _RECIP_UNIT, q), wrap(delta, _W_UNIT**2, q)
 
 
-def time_between(body: RigidBody, omega1: Any, omega2: Any) -> float:
+def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     """Time for ``body`` to pass from angular velocity ``omega1`` to ``omega2``.
 
     Both must lie on the same polhode (same ``T`` and ``|L|`` with the body's
@@ -212,10 +276,16 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> float:
     ``sn(phi) = omega_2 / b``, ``cn(phi) = omega_1 / a`` in the working frame,
     which is Sylvester's "time as an elliptic integral" (Sylvester 1866).
 
+    Parameters
+    ----------
+    body : RigidBody
+    omega1, omega2 : array_like or Quantity, shape (3,), rad/s
+        Body-frame angular velocities (Quantities for a body with units).
+
     Returns
     -------
-    float
-        ``0 <= t < period``.
+    float or Quantity, s
+        ``0 <= t < period`` (a Quantity in s when the call was in Quantities).
 
     Raises
     ------
@@ -232,13 +302,19 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> float:
     >>> print(round(time_between(body, body.omega, w), 12))
     2.5
     """
-    body = _check_body(body)
-    w1 = as_float_array("omega1", omega1)
-    w2 = as_float_array("omega2", omega2)
+    body = check_body(body)
+    quantity = call_units(body, ("omega1", "omega2"), (omega1, omega2))
+    w1 = ANGULAR_SPEED("omega1", omega1)
+    w2 = ANGULAR_SPEED("omega2", omega2)
     for name, w in (("omega1", w1), ("omega2", w2)):
         if w.shape != (3,):
             raise ValueError(f"Expected `{name}` to have shape (3,), got {w.shape}")
-    mom = body.moments
+    # homogeneous: moments / sm and omega / sw (powers of two), times scale by 1 / sw
+    sm = _pow2(body._moments)
+    sw = max(_pow2(w1), _pow2(w2))
+    mom = body._moments / sm
+    w1 = w1 / sw
+    w2 = w2 / sw
     e1, e2 = np.sum(mom * w1 * w1), np.sum(mom * w2 * w2)
     l1, l2 = np.sum((mom * w1) ** 2), np.sum((mom * w2) ** 2)
     if abs(e1 - e2) > 1e-10 * e1 or abs(l1 - l2) > 1e-10 * l1:
@@ -251,13 +327,22 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> float:
     p2 = _fk.free_setup(mom, q, np.ascontiguousarray(w2))
     kind = p1[_fk._KIND]
     if kind == 0.0:
-        raise ValueError("Expected a non-steady motion for `omega1`, got a steady rotation")
+        raise ValueError(
+            f"Expected a non-steady motion for `omega1`, got a steady rotation {omega1!r}"
+        )
     same_frame = np.array_equal(p1[_fk._P : _fk._P + 9], p2[_fk._P : _fk._P + 9])
     if p2[_fk._KIND] != kind or not same_frame:
-        raise ValueError("Expected `omega2` on the same branch of the polhode as `omega1`")
+        raise ValueError(
+            f"Expected `omega2` on the same branch of the polhode as `omega1`, got "
+            f"omega1 = {omega1!r}, omega2 = {omega2!r}"
+        )
     du = p2[_fk._U0] - p1[_fk._U0]
     if kind == 1.0:
-        return float(np.mod(du, 4.0 * p1[_fk._K]) / p1[_fk._LAM])
-    if du < 0.0:
-        raise ValueError("Expected `omega2` after `omega1` on the separatrix, got it before")
-    return float(du / p1[_fk._LAM])
+        dt = float(np.mod(du, 4.0 * p1[_fk._K]) / p1[_fk._LAM])
+    elif du < 0.0:
+        raise ValueError(
+            f"Expected `omega2` after `omega1` on the separatrix, got it before ({omega2!r})"
+        )
+    else:
+        dt = float(du / p1[_fk._LAM])
+    return wrap(np.float64(dt / sw), u.s, quantity)

@@ -26,8 +26,11 @@ def test_principal_moments_plain_and_quantity():
         [1.0, 2.0, 2.5] * u.g * u.cm**2, omega=[0.3, -0.2, 0.1] * u.deg / u.s
     )
     # 1 g cm^2 = 1e-7 kg m^2 exactly; deg -> rad by pi/180.
-    np.testing.assert_allclose(qb.moments, [1e-7, 2e-7, 2.5e-7], rtol=2 * EPS)
-    np.testing.assert_allclose(qb.omega, np.deg2rad([0.3, -0.2, 0.1]), rtol=2 * EPS)
+    # Quantities in, Quantities out (issue 9, item 6): the state in SI units.
+    assert qb.moments.unit == u.kg * u.m**2 and qb.omega.unit == u.rad / u.s
+    np.testing.assert_allclose(qb.moments.value, [1e-7, 2e-7, 2.5e-7], rtol=2 * EPS)
+    np.testing.assert_allclose(qb.omega.value, np.deg2rad([0.3, -0.2, 0.1]), rtol=2 * EPS)
+    assert not isinstance(body.moments, u.Quantity) and not isinstance(body.omega, u.Quantity)
 
 
 def test_derived_quantities_by_hand():
@@ -153,5 +156,9 @@ def test_derived_quantities_carry_units():
         1e7 * plain.angular_momentum_norm, rel=1e-15
     )
     assert not isinstance(plain.kinetic_energy, u.Quantity)
-    assert body.with_state(omega=[0.0, 0.0, 1.0]).kinetic_energy.unit == u.J
+    assert body.with_state(omega=[0.0, 0.0, 1.0] * u.rad / u.s).kinetic_energy.unit == u.J
+    with pytest.raises(ValueError, match="`omega` as a Quantity like the body's moments"):
+        body.with_state(omega=[0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match="`omega` as plain floats like the body's moments"):
+        plain.with_state(omega=[0.0, 0.0, 1.0] * u.rad / u.s)
     np.testing.assert_array_equal(body.invariable_plane, plain.invariable_plane)

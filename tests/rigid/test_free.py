@@ -1,4 +1,4 @@
-"""Tests for the exact torque-free motion (rigid.free, rigid._free_kernels)."""
+"""Tests for the exact torque-free motion (rigid.free, rigid._kernels.free)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from scipy.special import ellipj, ellipk, elliprf, elliprj
 
 from hamilton_orbits import Quaternion
 from rigid import RigidBody, free_motion, free_motion_arrays, free_parameters
-from rigid import _free_kernels as fk
+from rigid._kernels import free as fk
 
 EPS = np.finfo(float).eps
 
@@ -298,13 +298,20 @@ def test_shapes_units_and_errors():
     body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[1.0, 0.3, 0.8] * u.rad / u.s)
     att, w = free_motion(body, np.zeros((2, 3)) * u.min)
     assert att.shape == (2, 3) and w.shape == (2, 3, 3) and w.unit == u.rad / u.s
-    att, w = free_motion(body, 1.0)
+    plain = RigidBody([1.0, 2.0, 3.0], omega=[1.0, 0.3, 0.8])  # plain floats are SI
+    att, w = free_motion(plain, 1.0)
     assert att.shape == () and w.shape == (3,) and not isinstance(w, u.Quantity)
     _, w60 = free_motion(body, 1.0 * u.min)
-    _, w60s = free_motion(body, 60.0)
+    _, w60s = free_motion(plain, 60.0)
     np.testing.assert_array_equal(w60.value, w60s)
+    _, w60p = free_motion(plain, 1.0 * u.min)  # a float body with Quantity times
+    assert w60p.unit == u.rad / u.s
+    np.testing.assert_array_equal(w60p.value, w60s)
+    # a body with units needs times with units: a plain 60 could be s, min or days
+    with pytest.raises(ValueError, match="Expected `t` to be a Quantity like `body`"):
+        free_motion(body, 60.0)
     with pytest.raises(ValueError, match="`t` to be finite, got nan at index 1"):
-        free_motion(body, [0.0, np.nan])
+        free_motion(body, [0.0, np.nan] * u.s)
     with pytest.raises(ValueError, match="RigidBody"):
         free_motion([1.0, 2.0, 3.0], [0.0])
     with pytest.raises(ValueError, match=r"`q0` to have shape \(4,\)"):
@@ -359,3 +366,113 @@ def test_100_periods_against_high_precision():
     qm, wm = _mp_reference(moments, q0, w0, t, dps=20)
     err = max(np.abs(w - wm).max(), qdist(q, qm).max())
     assert err < 1e-11
+
+
+# --- thin symmetric bodies (issue 7, item 3) -----------------------------------------------
+
+
+def _mp_qmul(a, b):
+    return [a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+            a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+            a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+            a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]]
+
+
+def _mp_symmetric_top(a, c, q0, w0, t):
+    """Euler's symmetric top (A = B) in 50-digit arithmetic from the float inputs.
+
+    q(t) = exp(t L / (2A)) q0 exp(t nu e3 / 2), L the angular momentum in space and
+    nu = L3 (1/C - 1/A) (issue 7, item 3; the body-frame form of Euler's solution,
+    cf. test_axisymmetric_closed_form).  Returns the quaternion and the total angle
+    turned t (|L|/A + |nu|), the scale of the rounding error of any evaluation.
+    """
+    with mpmath.workdps(50):
+        a, c, t = mpmath.mpf(a), mpmath.mpf(c), mpmath.mpf(t)
+        q0 = [mpmath.mpf(x) for x in q0]
+        nrm = mpmath.sqrt(sum(x * x for x in q0))
+        q0 = [x / nrm for x in q0]
+        lb = [a * mpmath.mpf(w0[0]), a * mpmath.mpf(w0[1]), c * mpmath.mpf(w0[2])]
+        ls = _mp_qmul(_mp_qmul(q0, [0, *lb]), [q0[0], -q0[1], -q0[2], -q0[3]])[1:]
+        ell = mpmath.sqrt(sum(x * x for x in ls))
+        nu = lb[2] * (1 / c - 1 / a)
+        h1, h2 = t * ell / (2 * a), t * nu / 2
+        e1 = [mpmath.cos(h1)] + [mpmath.sin(h1) * x / ell for x in ls]
+        q = _mp_qmul(_mp_qmul(e1, q0), [mpmath.cos(h2), 0, 0, mpmath.sin(h2)])
+        return q, float(2 * h1 + 2 * abs(h2))
+
+
+def _mp_angle(ref, q):
+    """Rotation angle between an mpmath quaternion and a float one (sign-blind)."""
+    with mpmath.workdps(50):
+        d = _mp_qmul([ref[0], -ref[1], -ref[2], -ref[3]], [mpmath.mpf(float(x)) for x in q])
+        return float(2 * mpmath.atan2(mpmath.sqrt(d[1] ** 2 + d[2] ** 2 + d[3] ** 2),
+                                      abs(d[0])))
+
+
+@pytest.mark.parametrize("moments", [[1.0, 1.0, 1e-6], [1e6, 1e6, 1.0], [1.0, 1.0, 0.5],
+                                     [1.0, 1.0, 1.9], [1e-6, 1.0, 1.0]])
+@pytest.mark.parametrize("t", [1.0, 1e3, 1e9])
+def test_thin_symmetric_body_against_closed_form(moments, t):
+    # Issue 7 reproducer: [1, 1, 1e-6] was 2e-9 rad off at t = 1 s and 0.25 rad at
+    # t = 1e9 s (error ~ A/C: (L/C) t cancelled against itself).  Expected: a few eps
+    # times the angle turned, the conditioning of the closed form itself (1 ulp in
+    # C or t moves the angle by eps times the angle).  Measured: <= 1.4 eps * angle.
+    q0, w0 = [0.9, 0.1, -0.3, 0.2], [1.0, 0.5, 0.3]
+    sym = next(k for k in range(3) if moments.count(moments[k]) == 1)  # the symmetry axis
+    perm = [(sym + 1) % 3, (sym + 2) % 3, sym]  # cyclic: a proper relabelling
+    q, _ = free_motion_arrays(moments, q0, np.array(w0)[np.argsort(perm)], [t])
+    # the reference in the frame with the symmetry axis third (same cyclic relabelling)
+    qp = Quaternion.from_rotation_matrix(np.eye(3)[:, perm]).as_array()
+    qref, angle = _mp_symmetric_top(moments[perm[0]], moments[sym],
+                                    (Quaternion(q0) * Quaternion(qp)).as_array(), w0, t)
+    qref = _mp_qmul(qref, [qp[0], -qp[1], -qp[2], -qp[3]])
+    assert _mp_angle(qref, q[0]) <= 4 * EPS * (1.0 + angle)
+
+
+@pytest.mark.parametrize("c", [1e-6, 0.5, 1.9])
+def test_near_symmetric_body_is_continuous(c):
+    # B = A (1 + d): the attitude departs from the symmetric top linearly in d, with
+    # no jump at d = 0 (the elliptic branch, m ~ d, must join the closed form).  The
+    # slope |q_d - q_0| / d is the same for d = 2^-36 and 2^-32: 5e-4 relative covers
+    # the rounding of the smaller step (~2 ulp / (d * slope) <= 1.2e-4 for C = 1.9)
+    # and the curvature of the thin body's slope (~8e4 d = 2e-5 at d = 2^-32).
+    q0, w0 = [0.9, 0.1, -0.3, 0.2], [1.0, 0.5, 0.3]
+    q_sym, _ = free_motion_arrays([1.0, 1.0, c], q0, w0, [1.0])
+    slopes = []
+    for d in (2.0**-36, 2.0**-32):
+        q, _ = free_motion_arrays([1.0, 1.0 + d, c], q0, w0, [1.0])
+        slopes.append(Quaternion(q_sym[0]).inverse() * Quaternion(q[0]))
+        slopes[-1] = 2 * np.linalg.norm(slopes[-1].as_array()[1:]) / d
+    assert slopes[0] > 0.0
+    assert abs(slopes[0] / slopes[1] - 1.0) < 5e-4
+
+
+@pytest.mark.parametrize(("moments", "w0"), [
+    ([1.0, 1.0 + 5e-7, 1e-6], [1.0, 0.5, 0.3]),  # thin axis off the polar axis: n ~ -2e12
+    ([1e-6, 1.0, 1.0 + 5e-7], [1.0, 0.5, 0.3]),  # the same, polar axis the thin one
+    ([2.0, 1.0 + 1e-9, 1.0], [0.3, 0.5, 1.0]),  # J2 - J3 tiny: n ~ -1e9
+])
+def test_thin_triaxial_body_against_high_precision(moments, w0):
+    # A thin triaxial body is near-symmetric (B <= A + C), and then the characteristic n
+    # of the third-kind integral is huge and negative: Pi = F + (n/3) s^3 R_J cancelled
+    # to 1e-10 before (issue 7, item 3, the triaxial side).  Pi is now taken from DLMF
+    # 19.7.9 there and the secular rate from the form whose terms share a sign.  The
+    # reference is a 25-digit Taylor integration; measured error <= 1.5 eps.
+    q0 = np.array([0.9, 0.1, -0.3, 0.2]) / np.linalg.norm([0.9, 0.1, -0.3, 0.2])
+    qr, wr = _mp_reference(moments, q0, w0, [0.25])
+    q, w = free_motion_arrays(moments, q0, w0, [0.25])
+    assert qdist(q, qr).max() <= 8 * EPS
+    assert np.abs(w - wr).max() <= 8 * EPS * np.abs(w0).max()
+
+
+def test_third_kind_integral_for_large_negative_characteristic():
+    # the kernel's Pi(n; phi | m) for n < -1 (DLMF 19.7.9 form) against mpmath's ellippi
+    for n in (-1.5, -40.0, -2e12):
+        for phi in (-1.2, 0.3, np.pi / 2):
+            m = 0.3
+            s, c = np.sin(phi), np.cos(phi)
+            d = np.sqrt(1.0 - m * s * s)
+            ours = fk._pi_reduced(n, m, s, max(c, 0.0), d)
+            with mpmath.workdps(30):
+                ref = float(mpmath.ellippi(n, phi, m))
+            assert ours == pytest.approx(ref, rel=8 * EPS)

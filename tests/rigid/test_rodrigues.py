@@ -97,8 +97,19 @@ def test_relative_gibbs_printed_note_sign():
 
 
 def test_compose_half_turn_raises():
-    with pytest.raises(ValueError, match="half-turn at index 1"):
+    with pytest.raises(ValueError, match=r"`first`, `second` whose composition is not a "
+                                         r"half-turn, got Cayley's Pi = 0.0 at index 1"):
         compose_gibbs([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]], [[0.0, 0.0, 0.5], [0.0, 0.0, 1.0]])
+
+
+def test_direction_cosines_near_a_half_turn():
+    # Gibbs vector tan(theta/2) e: at 1e200 (theta = pi - 2e-200) the matrix is the
+    # half-turn about e, 2 e e^T - I, to rounding; before, lam^2 overflowed to NaN.
+    e = np.array([1.0, 2.0, 2.0]) / 3.0
+    r = direction_cosines(1e200 * e)
+    np.testing.assert_allclose(r, 2.0 * np.outer(e, e) - np.eye(3), atol=4 * EPS)
+    with pytest.raises(ValueError, match=r"`first`, `second` with a representable composition"):
+        compose_gibbs([1e200, 1e200, 0.0], [0.0, 1e200, 1e200])
 
 
 def test_sphere_through_half_turns_matches_exact():

@@ -32,7 +32,7 @@ import numpy as np
 from numba import guvectorize, njit
 
 from hamilton_orbits._kernels.quaternion import qmul, qrot
-from rigid._free_kernels import free_step
+from rigid._kernels.free import free_step
 
 TORQUE_NONE = 0
 TORQUE_BODY = 1

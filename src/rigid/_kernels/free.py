@@ -42,7 +42,7 @@ _LAM = 21
 _M = 22
 _M1 = 23
 _K = 24
-_PIC = 25  # complete Pi(n | m)
+_PIC = 25  # complete: Pi(n | m) (form A) or Pi(n | m) - K(m) (form B)
 _N = 26  # characteristic n = -J3 (J2 - J1) / (J1 (J3 - J2))
 _U0 = 27
 _L = 28
@@ -50,13 +50,14 @@ _J1 = 29
 _J2 = 30
 _J3 = 31
 _COEF = 32  # L (J3 - J1) / (J1 J3 lam)
-_PI0 = 33  # Pi(n; am u0 | m) (with its periodic part)
+_PI0 = 33  # Pi(n; am u0 | m) (form A) or Pi - u0 (form B), with its secular part
 _ALPHA0 = 34
 _RHO = 35  # signed ratio in the continuous azimuth of l in the W frame
 _SB = 36  # sign of b (= sign(J3 - J1))
 _W0 = 37  # 3 entries: omega in the body frame (steady case)
 _Q0 = 40  # 4 entries: q0 (steady case)
-NPARAM = 44
+_FORM = 44  # 1: secular (L/J3) t + coef Pi (J3 > J1); 0: (L/J1) t + coef (Pi - u)
+NPARAM = 45
 
 _R = 2.0**-53
 _QF = (3.0 * _R) ** (-1.0 / 6.0)
@@ -220,15 +221,43 @@ def ellipk_m1(m1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _pi_reduced(n, s, c, d):  # pragma: no cover - compiled
-    """``Pi(n; phi | m)`` for ``|phi| <= pi/2`` from ``sin, cos phi`` and ``d = dn``.
+def _pi_minus_f(n, s, c, d):  # pragma: no cover - compiled
+    """``Pi(n; phi | m) - F(phi | m)`` for ``|phi| <= pi/2`` from ``sin, cos phi``, ``dn``.
 
-    DLMF 19.25.14: Pi = s R_F(c^2, d^2, 1) + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2).
+    DLMF 19.25.14: Pi = s R_F(c^2, d^2, 1) + (n/3) s^3 R_J(c^2, d^2, 1, 1 - n s^2),
+    and s R_F(c^2, d^2, 1) = F(phi | m) (DLMF 19.25.5).  Only the difference is
+    computed: with ``phi = am r`` the ``F`` part is ``r`` itself, which the caller
+    adds *exactly* in the secular term (no cancellation for thin bodies).
     """
+    if n == 0.0 or s == 0.0:
+        return 0.0
     s2 = s * s
-    val = s * carlson_rf(c * c, d * d, 1.0)
-    if n != 0.0 and s != 0.0:
-        val += n / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - n * s2)
+    return n / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - n * s2)
+
+
+@njit(cache=True)
+def _pi_reduced(n, m, s, c, d):  # pragma: no cover - compiled
+    """``Pi(n; phi | m)`` for ``|phi| <= pi/2`` and ``n < -1``, from ``sin, cos phi``, ``dn``.
+
+    For ``-1 <= n <= 0`` the callers use ``r + (Pi - F)`` (:func:`_pi_minus_f`, with
+    ``F(phi) = r`` exact and ``Pi >= F / 2``: no cancellation).  For ``n < -1`` that
+    sum would cancel (``Pi ~ 1/sqrt(-n)`` while ``F ~ 1``), so ``Pi`` is taken from
+    DLMF 19.7.9 with ``alpha^2 = n``, ``omega^2 = m/n``:
+
+        Pi(n) = -(m/n)/3 s^3 R_J(c^2, d^2, 1, 1 - (m/n) s^2)
+                + atan(s sqrt(g) / (c d)) / sqrt(g),   g = 1 + m - n - m/n,
+
+    where the second term is ``s R_C(c^2 d^2, (1 - n s^2)(1 - (m/n) s^2))`` in closed
+    form (``y - x = s^2 g`` exactly; DLMF 19.2.18).  Both terms are small and of
+    one sign: full relative accuracy.
+    """
+    g = 1.0 + m - n - m / n
+    sg = math.sqrt(g)
+    val = math.atan2(s * sg, c * d) / sg
+    if m != 0.0 and s != 0.0:
+        nm = m / n
+        s2 = s * s
+        val -= nm / 3.0 * s * s2 * carlson_rj(c * c, d * d, 1.0, 1.0 - nm * s2)
     return val
 
 
@@ -270,7 +299,11 @@ def _quat_from_signed_permutation(p):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _periodic_at(prm, u):  # pragma: no cover - compiled
-    """Working-frame omega, Pi(n; am u | m) and the continuous azimuth at ``u``."""
+    """Working-frame omega, the third-kind term and the continuous azimuth at ``u``.
+
+    The third-kind term is ``Pi(n; am u | m)`` in form A and ``Pi - u`` in form B
+    (slot ``_FORM``), each summed from its complete part and the reduced argument.
+    """
     kk = prm[_K]
     k = math.floor((u + kk) / (2.0 * kk))
     r = u - 2.0 * kk * k
@@ -281,14 +314,21 @@ def _periodic_at(prm, u):  # pragma: no cover - compiled
     w1 = prm[_A] * sg * c
     w2 = prm[_B] * sg * s
     w3 = prm[_C] * d
-    pi_u = 2.0 * k * prm[_PIC] + _pi_reduced(prm[_N], s, c, d)
+    n = prm[_N]
+    if prm[_FORM] == 0.0:
+        pi_u = 2.0 * k * prm[_PIC] + _pi_minus_f(n, s, c, d)
+    elif n >= -1.0:
+        pi_u = 2.0 * k * prm[_PIC] + (r + _pi_minus_f(n, s, c, d))
+    else:
+        pi_u = 2.0 * k * prm[_PIC] + _pi_reduced(n, prm[_M], s, c, d)
     alpha = prm[_SB] * k * math.pi + math.atan2(prm[_RHO] * s, c)
     return w1, w2, w3, pi_u, alpha
 
 
 @njit(cache=True)
 def _separatrix_at(prm, u):  # pragma: no cover - compiled
-    """Working-frame omega, Pi(n; am u | 1) and the azimuth on the separatrix."""
+    """Working-frame omega, the third-kind term (as in :func:`_periodic_at`) and the
+    azimuth on the separatrix."""
     e = math.exp(-abs(u))
     sech = 2.0 * e / (1.0 + e * e)
     th = math.tanh(u)
@@ -298,7 +338,11 @@ def _separatrix_at(prm, u):  # pragma: no cover - compiled
     w3 = prm[_C] * sech
     nu = -prm[_N]
     snu = math.sqrt(nu)
-    pi_u = (u + snu * math.atan(snu * th)) / (1.0 + nu)
+    # Pi(n; am u | 1) = (u + sqrt(nu) atan(sqrt(nu) tanh u)) / (1 + nu), nu = -n.
+    if prm[_FORM] == 0.0:
+        pi_u = (snu * math.atan(snu * th) - nu * u) / (1.0 + nu)
+    else:
+        pi_u = (u + snu * math.atan(snu * th)) / (1.0 + nu)
     alpha = math.atan2(prm[_RHO] * th, sech)
     return w1, w2, w3, pi_u, alpha
 
@@ -383,6 +427,12 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
     prm[_J2] = j2
     prm[_J3] = j3
     prm[_COEF] = ell * (j3 - j1) / (j1 * j3 * lam)
+    # Psi' = L/J3 + L (J3 - J1)/(J1 J3) / (1 - n sn^2) = L/J1 + L (J3 - J1)/(J1 J3) n sn^2 /
+    # (1 - n sn^2), n <= 0: form A (secular L/J3 and Pi) has terms of one sign when
+    # J3 > J1, form B (secular L/J1 and Pi - u) when J3 < J1.  The other form would
+    # cancel a rate ~ L / min(J1, J3) against itself (thin bodies, error ~ J1/J3).
+    form = 1.0 if j3 > j1 else 0.0
+    prm[_FORM] = form
     # Continuous azimuth of l_W = atan2(J2 w2, J1 w1) written as atan2(rho sn, cn).
     rho = sb * (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
     if kind == 1.0:
@@ -391,9 +441,11 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
         m = min(max(m, 0.0), 1.0)
         m1 = min(max(m1, 0.0), 1.0)
         kk = ellipk_m1(m1)
-        pic = kk
+        pic = 0.0  # Pi(n | m) - K(m)
         if nchar != 0.0:
-            pic += nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+            pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+        if form == 1.0:  # the complete Pi(n | m) itself
+            pic = kk + pic if nchar >= -1.0 else _pi_reduced(nchar, m, 1.0, 0.0, math.sqrt(m1))
         prm[_A] = a
         prm[_B] = sb * b
         prm[_M] = m
@@ -487,7 +539,10 @@ def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
             w1, w2, w3, pi_u, alpha = _separatrix_at(prm, u)
         # Precession angle about the invariable line, in the shortest-arc gauge:
         # Psi = (L/J3) t + L (J3 - J1)/(J1 J3 lam) [Pi(u) - Pi(u0)] - (alpha - alpha0).
-        psi = ell / j3 * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
+        # Form B: with Pi(u) = u + D(u) and u - u0 = lam t the two secular terms add
+        # up to (L/J1) t exactly (see free_setup for the choice of the form).
+        sec = ell / j1 if prm[_FORM] == 0.0 else ell / j3
+        psi = sec * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
         l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
         nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
         # qa^-1 qP^-1
