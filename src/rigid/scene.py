@@ -171,11 +171,12 @@ def _flip_time(result: Result, omega: np.ndarray, t: u.Quantity, par) -> None:
     ts = t.to_value(u.s)
     k = np.flatnonzero(np.sign(w2[1:]) != np.sign(w2[:-1]))
     crossings = ts[k] - w2[k] * (ts[k + 1] - ts[k]) / (w2[k + 1] - w2[k])
-    result.metrics["exact flip interval 2K(m)/lambda"] = par.flip_interval * u.s
+    flip = u.Quantity(par.flip_interval, u.s)  # a Quantity for Quantity bodies, else SI
+    result.metrics["exact flip interval 2K(m)/lambda"] = flip
     if crossings.size >= 2:
         measured = np.mean(np.diff(crossings))
         result.metrics["simulated flip interval"] = measured * u.s
-        result.metrics["relative difference"] = float(measured / par.flip_interval - 1.0)
+        result.metrics["relative difference"] = float(measured / flip.to_value(u.s) - 1.0)
     else:
         result.metrics["simulated flip interval"] = "fewer than two flips in the run"
 
@@ -196,7 +197,7 @@ def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) 
     crossings = ts[k] - w1[k] * (ts[k + 1] - ts[k]) / (w1[k + 1] - w1[k])
     measured = (crossings[-1] - crossings[0]) / (crossings.size - 1) * u.d
     result.metrics["simulated wobble period"] = measured
-    result.metrics["exact free-motion period"] = (par.period * u.s).to(u.d)
+    result.metrics["exact free-motion period"] = u.Quantity(par.period, u.s).to(u.d)
     if spec["body"]["preset"] == "earth":
         from rigid import earth
 
