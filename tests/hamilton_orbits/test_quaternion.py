@@ -49,7 +49,8 @@ def test_hamilton_units_square_to_minus_one():
 
 def exact_dot(a, b) -> Fraction:
     """a.b in exact rational arithmetic (the reference for rounded products)."""
-    return sum((Fraction(float(x)) * Fraction(float(y)) for x, y in zip(a, b, strict=True)), Fraction(0))
+    terms = (Fraction(float(x)) * Fraction(float(y)) for x, y in zip(a, b, strict=True))
+    return sum(terms, Fraction(0))
 
 
 @settings(deadline=None, max_examples=200)
