@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
+import mpmath
 import numpy as np
 import pytest
 from hypothesis import assume, example, given, settings
@@ -275,9 +276,19 @@ def test_exp_log_small_angles(theta):
     axis = np.array([2.0, -3.0, 6.0]) / 7.0  # exactly representable up to rounding
     v = axis * theta
     q = Quaternion.from_vector(v).exp()
-    # exp(v) = (cos|v|, sin|v| v/|v|)
-    np.testing.assert_allclose(q.vector, np.sin(theta) * axis, rtol=4 * EPS)
-    assert abs(q.w - np.cos(theta)) <= 2 * EPS
+    # exp(v) = (cos|v|, sin|v| v/|v|), evaluated at 50 digits for the float vector
+    # v (whose norm is not exactly theta: at theta = 3, |v| = 3 - 2.9e-16, which
+    # moves sin|v| by 7 eps relative since cot 3 = -7)
+    with mpmath.workdps(50):
+        vm = [mpmath.mpf(float(x)) for x in v]
+        tm = mpmath.sqrt(sum(x * x for x in vm))
+        ref_v = np.array([float(mpmath.sin(tm) * x / tm) for x in vm])
+        ref_w = float(mpmath.cos(tm))
+    # 4 eps for the arithmetic, plus the rounding (<= 1 ulp) of the computed |v|
+    # amplified by the relative condition number |t cot t| of sin (21 at t = 3)
+    rtol = (4 + abs(theta / np.tan(theta))) * EPS
+    np.testing.assert_allclose(q.vector, ref_v, rtol=rtol)
+    assert abs(q.w - ref_w) <= 2 * EPS
     back = q.log()
     np.testing.assert_allclose(back.vector, v, rtol=8 * EPS)
     assert abs(back.w) <= 2 * EPS

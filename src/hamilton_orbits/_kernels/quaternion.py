@@ -8,6 +8,8 @@ dimensions without copies.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import guvectorize, njit
 
@@ -29,20 +31,8 @@ def qmul(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
 
 
 @njit(inline="always", cache=True)
-def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
-    """``q v q^-1`` for any nonzero ``q`` (the scale of ``q`` cancels).
-
-    Uses v' = v + (2/|q|^2) (w (u x v) + u x (u x v)) with u the vector part,
-    which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
-    """
+def _qrot_core(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     n2 = w * w + x * x + y * y + z * z
-    if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions (scale cancels)
-        m = max(abs(w), abs(x), abs(y), abs(z))
-        w = w / m
-        x = x / m
-        y = y / m
-        z = z / m
-        n2 = w * w + x * x + y * y + z * z
     cx = y * vz - z * vy
     cy = z * vx - x * vz
     cz = x * vy - y * vx
@@ -55,6 +45,48 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
         vy + s * (w * cy + ccy),
         vz + s * (w * cz + ccz),
     )
+
+
+# Inside these bounds on max|q_i| and max|v_i| every intermediate of _qrot_core
+# (|q|^2 |v| at most, |v| 1e-90 |q|^2 at least) stays between 1e-290 and 1e290:
+# no overflow, and no underflow that matters at the precision of the result.
+_Q_LO = 1e-100
+_Q_HI = 1e100
+_V_LO = 1e-90
+_V_HI = 1e90
+
+
+@njit(inline="always", cache=True)
+def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
+    """``q v q^-1`` for any nonzero ``q`` (the scale of ``q`` cancels).
+
+    Uses v' = v + (2/|q|^2) (w (u x v) + u x (u x v)) with u the vector part,
+    which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
+
+    Quaternions and vectors of extreme magnitude are first scaled by powers of
+    two (exact), q to max|q_i| in [1/2, 1) and v likewise, and the result is
+    scaled back: full precision from 1e-308 to 1e308 (issue 7, item 4).  A
+    result too large for a float is inf (the caller reports it); the zero
+    quaternion gives NaN (callers check for it first).
+    """
+    m = max(max(abs(w), abs(x)), max(abs(y), abs(z)))
+    mv = max(max(abs(vx), abs(vy)), abs(vz))
+    if _Q_LO < m < _Q_HI and _V_LO < mv < _V_HI:
+        return _qrot_core(w, x, y, z, vx, vy, vz)
+    if mv == 0.0:
+        return vx, vy, vz
+    eq = math.frexp(m)[1]
+    ev = math.frexp(mv)[1]
+    rx, ry, rz = _qrot_core(
+        math.ldexp(w, -eq),
+        math.ldexp(x, -eq),
+        math.ldexp(y, -eq),
+        math.ldexp(z, -eq),
+        math.ldexp(vx, -ev),
+        math.ldexp(vy, -ev),
+        math.ldexp(vz, -ev),
+    )
+    return math.ldexp(rx, ev), math.ldexp(ry, ev), math.ldexp(rz, ev)
 
 
 @guvectorize(
@@ -85,7 +117,8 @@ def rotate_flat(q, v, out):  # pragma: no cover - compiled
     """``q v q^-1`` for rows of ``q`` (N, 4) and ``v`` (N, 3) into ``out`` (N, 3).
 
     One pass that also validates: returns the first row index whose quaternion
-    is zero or whose vector is not finite (``out`` is then incomplete), else -1.
+    is zero, whose vector is not finite or whose rotated vector overflows
+    (``out`` is then incomplete), else -1.
     """
     for i in range(q.shape[0]):
         w = q[i, 0]
@@ -100,6 +133,8 @@ def rotate_flat(q, v, out):  # pragma: no cover - compiled
         if not (np.isfinite(vx) and np.isfinite(vy) and np.isfinite(vz)):
             return i
         rx, ry, rz = qrot(w, x, y, z, vx, vy, vz)
+        if not (np.isfinite(rx) and np.isfinite(ry) and np.isfinite(rz)):
+            return i
         out[i, 0] = rx
         out[i, 1] = ry
         out[i, 2] = rz
@@ -120,12 +155,12 @@ def to_matrix_flat(q, out):  # pragma: no cover - compiled
         if w == 0.0 and x == 0.0 and y == 0.0 and z == 0.0:
             return i
         n2 = w * w + x * x + y * y + z * z
-        if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions
-            m = max(abs(w), abs(x), abs(y), abs(z))
-            w = w / m
-            x = x / m
-            y = y / m
-            z = z / m
+        if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions (exactly)
+            e = math.frexp(max(max(abs(w), abs(x)), max(abs(y), abs(z))))[1]
+            w = math.ldexp(w, -e)
+            x = math.ldexp(x, -e)
+            y = math.ldexp(y, -e)
+            z = math.ldexp(z, -e)
             n2 = w * w + x * x + y * y + z * z
         s = 2.0 / n2
         xx = s * x * x
