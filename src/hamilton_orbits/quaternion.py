@@ -216,6 +216,9 @@ class Quaternion:
 
     __slots__ = ("_a",)
     __array_priority__ = 1000  # ndarray * Quaternion defers to __rmul__
+    # numpy (and astropy's Quantity) binary operators defer to our reflected ones,
+    # so that ``array * q`` and ``(2 * u.m) * q`` reach __rmul__ and its checks
+    __array_ufunc__ = None
 
     def __init__(self, array: Any) -> None:
         if isinstance(array, Quaternion):
@@ -474,8 +477,8 @@ class Quaternion:
             index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
             where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
             raise ValueError(
-                f"The Gibbs vector (Cayley's lambda, mu, nu) is infinite{where}: the rotation "
-                "is a half-turn (w = 0) or so near one that |V q / S q| overflows. "
+                f"Expected `self` not to be a half-turn: its Gibbs vector (Cayley's lambda, mu, "
+                f"nu) is infinite{where}: w = 0, or so small that |V q / S q| overflows. "
                 "Use `as_mrp()`, which stays bounded (|sigma| <= 1)."
             )
         return g
@@ -872,8 +875,25 @@ class Quaternion:
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        body = np.array2string(self._a, separator=", ", prefix="Quaternion(")
-        return f"Quaternion({body})"
+        """One quaternion: its components (round-trip exact); a batch: shape and ranges.
+
+        Examples
+        --------
+        >>> Quaternion.from_array([1.0, 0.0, -0.5, 0.25])
+        Quaternion([1.0, 0.0, -0.5, 0.25])
+        >>> Quaternion.from_axis_angle([0, 0, 1], [0.0, 0.5, 1.0])
+        Quaternion(shape=(3,), w in [0.877583, 1], x in [0, 0], y in [0, 0], z in [0, 0.479426])
+        """
+        if self._a.ndim == 1:
+            return "Quaternion([" + ", ".join(repr(float(c)) for c in self._a) + "])"
+        if self._a.size == 0:
+            return f"Quaternion(shape={self.shape})"
+        lo = self._a.reshape(-1, 4).min(axis=0)
+        hi = self._a.reshape(-1, 4).max(axis=0)
+        ranges = ", ".join(
+            f"{name} in [{a:.6g}, {b:.6g}]" for name, a, b in zip("wxyz", lo, hi, strict=True)
+        )
+        return f"Quaternion(shape={self.shape}, {ranges})"
 
 
 def slerp(q0: Quaternion, q1: Quaternion, t: Any) -> Quaternion:
