@@ -45,6 +45,7 @@ import numpy as np
 
 from hamilton_orbits._kernels.quaternion import (
     from_matrix_flat,
+    qmul_flat,
     qmul_gufunc,
     qrot_gufunc,
     rotate_flat,
@@ -132,10 +133,15 @@ def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     the operands are scaled by powers of two and the product scaled back, so
     that only a component that is itself too large stays infinite.
     """
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = qmul_gufunc(a, b)
-    if np.isfinite(out).all():
-        return out
+    if a.shape == b.shape:  # the common case: a compiled loop that reports overflow
+        out = np.empty(a.shape)
+        if qmul_flat(a.reshape(-1, 4), b.reshape(-1, 4), out.reshape(-1, 4)) < 0:
+            return out
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = qmul_gufunc(a, b)
+        if np.isfinite(out).all():
+            return out
     ea, eb = _exponent_wide(a), _exponent_wide(b)
     scaled = qmul_gufunc(np.ldexp(a, -ea[..., None]), np.ldexp(b, -eb[..., None]))
     with np.errstate(over="ignore"):
@@ -587,8 +593,11 @@ class Quaternion:
 
     def __mul__(self, other: Any) -> Quaternion:
         if isinstance(other, Quaternion):
-            broadcast_shapes(("self", "other"), self.shape, other.shape)
+            if self._a.shape != other._a.shape:
+                broadcast_shapes(("self", "other"), self.shape, other.shape)
             out = _product(self._a, other._a)
+            if np.isfinite(out).all():
+                return Quaternion._wrap(out)
             value = np.broadcast_to(other._a, out.shape)
         else:
             s = self._real(other)
@@ -695,28 +704,31 @@ class Quaternion:
         w = self._a[..., 0]
         v = self._a[..., 1:]
         wb = b[..., 0]
-        vb = _norm_last(b[..., 1:])
+        # |v| 2^-e; squares negligible next to wb^2 may underflow, which only
+        # touches terms below the rounding of atan2(vb, wb) or of the series
+        vb = np.sqrt(np.sum(b[..., 1:] ** 2, axis=-1))
+        # the unit direction of v from v scaled by its own power of two (exact
+        # even for subnormal v); zero where v = 0
+        uv, _, nv = _scaled(v)
+        has_v = nv > 0
+        direction = uv / np.where(has_v, nv, 1.0)[..., None]
         # atan2(|v|, w)/|v|: for |v| << w use the series of atan(x)/x, x = |v|/w,
         # applied to v/w of the original components (no scaling round-off).
         small = (vb <= _SERIES * wb) & (wb > 0)
         w_s = np.where(small, w, 1.0)
         x2 = (np.where(small, vb, 0.0) / np.where(small, wb, 1.0)) ** 2
-        vn_raw = np.max(np.abs(v), axis=-1)
-        direction = np.zeros(v.shape)
-        has_v = vn_raw > 0
-        if has_v.any():  # the unit direction, scaled exactly (fine for subnormal v)
-            direction[has_v] = _unit_last("self", v[has_v], "unreachable")
-        with np.errstate(under="ignore"):
-            a = np.empty(self._a.shape)
-            a[..., 1:] = np.where(
-                small[..., None],
-                (1.0 - x2 / 3.0)[..., None] * (v / w_s[..., None]),
-                np.arctan2(vb, wb)[..., None] * direction,
-            )
-        # log|q| = log|b| + e log 2; log of the product directly where it is a float
-        with np.errstate(over="ignore"):
+        a = np.empty(self._a.shape)
+        a[..., 1:] = np.where(
+            small[..., None],
+            (1.0 - x2 / 3.0)[..., None] * (v / w_s[..., None]),
+            np.arctan2(vb, wb)[..., None] * direction,
+        )
+        # log|q| = log(|b| 2^e), or log|b| + e log 2 where 2^e is beyond the floats
+        if np.all(np.abs(e) < 900):
+            a[..., 0] = np.log(np.ldexp(nb, e))
+        else:
             direct = np.log(np.ldexp(nb, np.clip(e, -900, 900)))
-        a[..., 0] = np.where(np.abs(e) < 900, direct, np.log(nb) + e * np.log(2.0))
+            a[..., 0] = np.where(np.abs(e) < 900, direct, np.log(nb) + e * np.log(2.0))
         negative_real = ~has_v & (w < 0)
         a[..., 1] = np.where(negative_real, np.pi, a[..., 1])
         return Quaternion._wrap(a)
@@ -789,7 +801,8 @@ class Quaternion:
         as_float_array("vectors", v)
         if not np.all(np.any(self._a != 0, axis=-1)):
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
-        out = qrot_gufunc(self._a, v)
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow: refused just below
+            out = qrot_gufunc(self._a, v)
         check_finite_result("vectors", out, "the rotated vector", np.broadcast_to(v, out.shape))
         return _with_unit(out, unit)
 
