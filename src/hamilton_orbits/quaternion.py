@@ -65,6 +65,11 @@ __all__ = ["Quaternion", "slerp"]
 # Below this angle the series for sin(t)/t and atan(t)/t are exact to rounding:
 # the first neglected terms are t^8/9! and t^6/7 relative, < 1e-50 for t < 1e-8.
 _SERIES = 1e-8
+# Rows whose largest component is inside these bounds need no scaling (_scaled).
+_SAFE_LO = 1e-140
+_SAFE_HI = 1e140
+_NO_SCALE = np.zeros((), dtype=np.int64)
+_CONJ = np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def _sinc(t: np.ndarray) -> np.ndarray:
@@ -91,14 +96,21 @@ def _dimensionless(name: str, value: Any, size: int | None = None) -> np.ndarray
 
 
 def _scaled(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``a = b 2**e`` over the last axis with max|b_i| in [1/2, 1), exactly.
+    """``a = b 2**e`` over the last axis, exactly, with |b| safe to square.
 
-    Returns ``(b, e, |b|)``; |b| is in [1/2, 2] (0 for a zero row).  Scaling by a
-    power of two is exact (up to components 2**-1074 below the largest), so
-    norms, units and reciprocals computed from ``b`` neither overflow nor
-    underflow, whatever the magnitude of ``a``.
+    Returns ``(b, e, |b|)``.  Where every row's largest component lies in
+    (1e-140, 1e140) (the common case) ``b`` is ``a`` itself (not a copy: never
+    modify it) and ``e = 0``: squares and their sums neither overflow nor lose
+    anything that matters (an underflowing square is below 1e-280 eps times the
+    largest).  Otherwise each row is scaled by a power of two (exact, up to
+    components 2**-1074 below the largest) to max|b_i| in [1/2, 1), so norms,
+    units and reciprocals computed from ``b`` neither overflow nor underflow,
+    whatever the magnitude of ``a``; |b| is then in [1/2, 2] (0 for a zero row).
     """
-    e = np.frexp(np.max(np.abs(a), axis=-1))[1]
+    m = np.max(np.abs(a), axis=-1)
+    if np.all((m > _SAFE_LO) & (m < _SAFE_HI)):
+        return a, _NO_SCALE, np.sqrt(np.sum(a * a, axis=-1))
+    e = np.frexp(m)[1]
     b = np.ldexp(a, -e[..., None])
     return b, e, np.sqrt(np.sum(b * b, axis=-1))
 
@@ -109,6 +121,8 @@ def _norm_last(a: np.ndarray) -> np.ndarray:
     Only a norm that is itself above the largest float is inf (callers check).
     """
     _, e, nb = _scaled(a)
+    if e is _NO_SCALE:
+        return nb
     with np.errstate(over="ignore"):
         return np.ldexp(nb, e)
 
@@ -125,8 +139,8 @@ def _exponent_wide(a: np.ndarray) -> np.ndarray:
     return np.frexp(np.max(np.abs(a), axis=-1))[1]
 
 
-def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a b; where a term overflows, redone on exactly scaled operands.
+def _product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Hamilton product a b and whether it is finite; overflow is retried on scaled operands.
 
     Every term a_i b_j is at most |a||b| in size, so the direct product can
     only overflow where |ab| = |a||b| is near or above the largest float; there
@@ -135,17 +149,18 @@ def _product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """
     if a.shape == b.shape:  # the common case: a compiled loop that reports overflow
         out = np.empty(a.shape)
-        if qmul_flat(a.reshape(-1, 4), b.reshape(-1, 4), out.reshape(-1, 4)) < 0:
-            return out
+        if qmul_flat(a.reshape(-1, 4), b.reshape(-1, 4), out.reshape(-1, 4)):
+            return out, True
     else:
         with np.errstate(over="ignore", invalid="ignore"):
             out = qmul_gufunc(a, b)
         if np.isfinite(out).all():
-            return out
+            return out, True
     ea, eb = _exponent_wide(a), _exponent_wide(b)
     scaled = qmul_gufunc(np.ldexp(a, -ea[..., None]), np.ldexp(b, -eb[..., None]))
     with np.errstate(over="ignore"):
-        return np.ldexp(scaled, (ea + eb)[..., None])
+        out = np.ldexp(scaled, (ea + eb)[..., None])
+    return out, bool(np.isfinite(out).all())
 
 
 def _exp(a: np.ndarray, name: str, value: np.ndarray) -> np.ndarray:
@@ -398,8 +413,13 @@ class Quaternion:
         array([-1.e+000,  2.e-200,  0.e+000,  0.e+000])
         """
         s = _dimensionless("mrp", mrp, 3)
-        b, e, nb = _scaled(s)
         a = np.empty(s.shape[:-1] + (4,))
+        if s.size == 0 or np.max(np.abs(s)) < _SAFE_HI:  # |sigma|^2 cannot overflow
+            s2 = np.sum(s * s, axis=-1)
+            a[..., 0] = (1.0 - s2) / (1.0 + s2)
+            a[..., 1:] = (2.0 / (1.0 + s2))[..., None] * s
+            return cls._wrap(a)
+        b, e, nb = _scaled(s)
         with np.errstate(all="ignore"):  # each branch is used only where it is finite
             n = np.ldexp(nb, e)
             s2 = np.sum(s * s, axis=-1)
@@ -581,9 +601,11 @@ class Quaternion:
         """K q / |q|^2 from the exactly scaled q = b 2^e: K b / |b|^2 2^-e (may be inf)."""
         b, e, nb = _scaled(self._a)
         _raise_zero("self", nb, "it has no inverse")
-        b[..., 1:] *= -1.0
+        inv = (b * _CONJ) / (nb * nb)[..., None]
+        if e is _NO_SCALE:
+            return inv
         with np.errstate(over="ignore"):
-            return np.ldexp(b / (nb * nb)[..., None], -e[..., None])
+            return np.ldexp(inv, -e[..., None])
 
     def _real(self, other: Any) -> np.ndarray:
         """A real operand as a float array broadcastable against the leading shape."""
@@ -595,8 +617,8 @@ class Quaternion:
         if isinstance(other, Quaternion):
             if self._a.shape != other._a.shape:
                 broadcast_shapes(("self", "other"), self.shape, other.shape)
-            out = _product(self._a, other._a)
-            if np.isfinite(out).all():
+            out, finite = _product(self._a, other._a)
+            if finite:
                 return Quaternion._wrap(out)
             value = np.broadcast_to(other._a, out.shape)
         else:
@@ -614,10 +636,11 @@ class Quaternion:
             broadcast_shapes(("self", "other"), self.shape, other.shape)
             b, e, nb = _scaled(other._a)
             _raise_zero("other", nb, "division by the zero quaternion")
-            b[..., 1:] *= -1.0
-            inv_scaled = b / (nb * nb)[..., None]  # (other / 2^e)^-1, of size ~1
+            inv_scaled = (b * _CONJ) / (nb * nb)[..., None]  # (other / 2^e)^-1
             with np.errstate(over="ignore"):
-                out = np.ldexp(_product(self._a, inv_scaled), -e[..., None])
+                out = _product(self._a, inv_scaled)[0]
+                if e is not _NO_SCALE:
+                    out = np.ldexp(out, -e[..., None])
             value = np.broadcast_to(other._a, out.shape)
         else:
             s = self._real(other)
@@ -724,7 +747,9 @@ class Quaternion:
             np.arctan2(vb, wb)[..., None] * direction,
         )
         # log|q| = log(|b| 2^e), or log|b| + e log 2 where 2^e is beyond the floats
-        if np.all(np.abs(e) < 900):
+        if e is _NO_SCALE:
+            a[..., 0] = np.log(nb)
+        elif np.all(np.abs(e) < 900):
             a[..., 0] = np.log(np.ldexp(nb, e))
         else:
             direct = np.log(np.ldexp(nb, np.clip(e, -900, 900)))

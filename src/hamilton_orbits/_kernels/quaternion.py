@@ -116,21 +116,20 @@ def qrot_gufunc(q, v, out):  # pragma: no cover - compiled
 def qmul_flat(a, b, out):  # pragma: no cover - compiled
     """Hamilton products of rows of ``a`` and ``b`` (N, 4) into ``out`` (N, 4).
 
-    Returns the first row index whose product is not finite (an overflow; the
-    caller retries on scaled operands), else -1.  No floating-point flags are
-    raised to numpy, so the common case needs no ``np.errstate``.
+    Returns True if every component is finite.  An overflow is detected by
+    accumulating ``component * 0`` (0 for finite values, NaN for inf), which
+    keeps the loop branch-free; no floating-point flags reach numpy, so the
+    common case needs no ``np.errstate``.
     """
-    bad = -1
+    acc = 0.0
     for i in range(a.shape[0]):
         w, x, y, z = qmul(a[i, 0], a[i, 1], a[i, 2], a[i, 3], b[i, 0], b[i, 1], b[i, 2], b[i, 3])
         out[i, 0] = w
         out[i, 1] = x
         out[i, 2] = y
         out[i, 3] = z
-        finite = np.isfinite(w) and np.isfinite(x) and np.isfinite(y) and np.isfinite(z)
-        if bad < 0 and not finite:
-            bad = i
-    return bad
+        acc += (w + x + y + z) * 0.0
+    return acc == 0.0
 
 
 @njit(cache=True)
