@@ -820,7 +820,7 @@ class Quaternion:
             flat_q = np.ascontiguousarray(self._a.reshape(-1, 4))
             flat_v = np.ascontiguousarray(v.reshape(-1, 3))
             out = np.empty(flat_v.shape)
-            if rotate_flat(flat_q, flat_v, out) < 0:
+            if rotate_flat(flat_q, flat_v, out) == -1:
                 return _with_unit(out.reshape(v.shape), unit)
         broadcast_shapes(("self", "vectors"), self.shape, v.shape[:-1])
         as_float_array("vectors", v)

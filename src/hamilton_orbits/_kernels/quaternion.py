@@ -31,8 +31,7 @@ def qmul(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
 
 
 @njit(inline="always", cache=True)
-def _qrot_core(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
-    n2 = w * w + x * x + y * y + z * z
+def _qrot_core(w, x, y, z, vx, vy, vz, n2):  # pragma: no cover - compiled
     cx = y * vz - z * vy
     cy = z * vx - x * vz
     cz = x * vy - y * vx
@@ -47,13 +46,14 @@ def _qrot_core(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     )
 
 
-# Inside these bounds on max|q_i| and max|v_i| every intermediate of _qrot_core
-# (|q|^2 |v| at most, |v| 1e-90 |q|^2 at least) stays between 1e-290 and 1e290:
-# no overflow, and no underflow that matters at the precision of the result.
-_Q_LO = 1e-100
-_Q_HI = 1e100
-_V_LO = 1e-90
-_V_HI = 1e90
+# Inside these bounds on |q|^2 and |v|^2 (so max|q_i| in (5e-101, 1e100) and
+# max|v_i| in (5e-91, 1e90)) every intermediate of _qrot_core (|q|^2 |v| at most,
+# |v| 1e-90 |q|^2 at least) stays between 1e-290 and 1e290: no overflow, and no
+# underflow that matters at the precision of the result.
+_Q2_LO = 1e-200
+_Q2_HI = 1e200
+_V2_LO = 1e-180
+_V2_HI = 1e180
 
 
 @njit(inline="always", cache=True)
@@ -69,22 +69,28 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     result too large for a float is inf (the caller reports it); the zero
     quaternion gives NaN (callers check for it first).
     """
-    m = max(max(abs(w), abs(x)), max(abs(y), abs(z)))
+    n2 = w * w + x * x + y * y + z * z
+    v2 = vx * vx + vy * vy + vz * vz
+    if _Q2_LO < n2 < _Q2_HI and _V2_LO < v2 < _V2_HI:
+        return _qrot_core(w, x, y, z, vx, vy, vz, n2)
     mv = max(max(abs(vx), abs(vy)), abs(vz))
-    if _Q_LO < m < _Q_HI and _V_LO < mv < _V_HI:
-        return _qrot_core(w, x, y, z, vx, vy, vz)
     if mv == 0.0:
         return vx, vy, vz
-    eq = math.frexp(m)[1]
+    eq = math.frexp(max(max(abs(w), abs(x)), max(abs(y), abs(z))))[1]
     ev = math.frexp(mv)[1]
+    w = math.ldexp(w, -eq)
+    x = math.ldexp(x, -eq)
+    y = math.ldexp(y, -eq)
+    z = math.ldexp(z, -eq)
     rx, ry, rz = _qrot_core(
-        math.ldexp(w, -eq),
-        math.ldexp(x, -eq),
-        math.ldexp(y, -eq),
-        math.ldexp(z, -eq),
+        w,
+        x,
+        y,
+        z,
         math.ldexp(vx, -ev),
         math.ldexp(vy, -ev),
         math.ldexp(vz, -ev),
+        w * w + x * x + y * y + z * z,
     )
     return math.ldexp(rx, ev), math.ldexp(ry, ev), math.ldexp(rz, ev)
 
@@ -137,9 +143,11 @@ def rotate_flat(q, v, out):  # pragma: no cover - compiled
     """``q v q^-1`` for rows of ``q`` (N, 4) and ``v`` (N, 3) into ``out`` (N, 3).
 
     One pass that also validates: returns the first row index whose quaternion
-    is zero, whose vector is not finite or whose rotated vector overflows
-    (``out`` is then incomplete), else -1.
+    is zero or whose vector is not finite (``out`` is then incomplete), -2 if a
+    rotated vector overflowed (or, rarely, three finite components summed past
+    the largest float: the caller then checks properly), else -1.
     """
+    acc = 0.0
     for i in range(q.shape[0]):
         w = q[i, 0]
         x = q[i, 1]
@@ -153,12 +161,11 @@ def rotate_flat(q, v, out):  # pragma: no cover - compiled
         if not (np.isfinite(vx) and np.isfinite(vy) and np.isfinite(vz)):
             return i
         rx, ry, rz = qrot(w, x, y, z, vx, vy, vz)
-        if not (np.isfinite(rx) and np.isfinite(ry) and np.isfinite(rz)):
-            return i
+        acc += (rx + ry + rz) * 0.0  # 0 while finite, NaN once a component overflowed
         out[i, 0] = rx
         out[i, 1] = ry
         out[i, 2] = rz
-    return -1
+    return -1 if acc == 0.0 else -2
 
 
 @njit(cache=True)
