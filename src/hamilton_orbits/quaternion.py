@@ -38,6 +38,7 @@ quaternions) raises ``ValueError`` naming the argument, never returns inf or NaN
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import astropy.units as u
@@ -163,17 +164,18 @@ def _product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, bool]:
     return out, bool(np.isfinite(out).all())
 
 
-def _exp(a: np.ndarray, name: str, value: np.ndarray) -> np.ndarray:
+def _exp(a: np.ndarray, name: str, value: Callable[[], np.ndarray]) -> np.ndarray:
     """exp(w) (cos|v|, sin|v| v/|v|) of components ``a`` (..., 4), finite or raising.
 
     Where exp(w) alone overflows (w > 709.78) but a component of the result is
     representable (a small cos|v|, say), exp(w) is split as exp(w/2)^2.  A
-    result that is not representable raises, naming ``name`` and ``value``.
+    result that is not representable raises, naming ``name`` and the values
+    ``value()`` (built only then).
     """
     w = a[..., 0]
     v = a[..., 1:]
     t = _norm_last(v)
-    check_finite_result(name, t[..., None], "the angle |V q| of the exponential", value)
+    _finite(name, t[..., None], "the angle |V q| of the exponential", value)
     c = np.cos(t)
     sc = _sinc(t)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -187,7 +189,14 @@ def _exp(a: np.ndarray, name: str, value: np.ndarray) -> np.ndarray:
             out[..., 0] = np.where(over, h * (h * c), out[..., 0])
             split = h[..., None] * ((h * sc)[..., None] * v)
             out[..., 1:] = np.where(over[..., None], split, out[..., 1:])
-    return check_finite_result(name, out, "the exponential", value)
+    return _finite(name, out, "the exponential", value)
+
+
+def _finite(name: str, out: np.ndarray, what: str, value: Any) -> np.ndarray:
+    """``out`` if finite, else the named error; ``value()`` builds the quoted values lazily."""
+    if np.isfinite(out).all():
+        return out
+    return check_finite_result(name, out, what, value())
 
 
 def _with_unit(value: np.ndarray, unit: Any) -> Any:
@@ -563,9 +572,7 @@ class Quaternion:
         >>> float(Quaternion.from_array([1e300, 1e300, 1e300, 1e300]).norm())
         2e+300
         """
-        return check_finite_result("self", _norm_last(self._a)[..., None], "the norm", self._a)[
-            ..., 0
-        ]
+        return _finite("self", _norm_last(self._a)[..., None], "the norm", lambda: self._a)[..., 0]
 
     def unit(self) -> Quaternion:
         """Hamilton's versor U q = q / |q|; the zero quaternion raises.
@@ -594,7 +601,7 @@ class Quaternion:
         array([1., 0., 0., 0.])
         """
         return Quaternion._wrap(
-            check_finite_result("self", self._inverse_array(), "the inverse", self._a)
+            _finite("self", self._inverse_array(), "the inverse", lambda: self._a)
         )
 
     def _inverse_array(self) -> np.ndarray:
@@ -610,7 +617,8 @@ class Quaternion:
     def _real(self, other: Any) -> np.ndarray:
         """A real operand as a float array broadcastable against the leading shape."""
         s = _dimensionless("other", other)
-        broadcast_shapes(("self", "other"), self.shape, s.shape)
+        if s.ndim:
+            broadcast_shapes(("self", "other"), self.shape, s.shape)
         return s
 
     def __mul__(self, other: Any) -> Quaternion:
@@ -620,13 +628,13 @@ class Quaternion:
             out, finite = _product(self._a, other._a)
             if finite:
                 return Quaternion._wrap(out)
-            value = np.broadcast_to(other._a, out.shape)
+            value = lambda: np.broadcast_to(other._a, out.shape)  # noqa: E731
         else:
             s = self._real(other)
             with np.errstate(over="ignore"):
                 out = self._a * s[..., None]
-            value = np.broadcast_to(s, out.shape[:-1])
-        return Quaternion._wrap(check_finite_result("other", out, "the product", value))
+            value = lambda: np.broadcast_to(s, out.shape[:-1])  # noqa: E731
+        return Quaternion._wrap(_finite("other", out, "the product", value))
 
     def __rmul__(self, other: Any) -> Quaternion:
         return self * other  # a real factor commutes with every quaternion
@@ -641,38 +649,39 @@ class Quaternion:
                 out = _product(self._a, inv_scaled)[0]
                 if e is not _NO_SCALE:
                     out = np.ldexp(out, -e[..., None])
-            value = np.broadcast_to(other._a, out.shape)
+            value = lambda: np.broadcast_to(other._a, out.shape)  # noqa: E731
         else:
             s = self._real(other)
             _raise_zero("other", np.abs(s), "division by zero")
             with np.errstate(over="ignore"):
                 out = self._a / s[..., None]
-            value = np.broadcast_to(s, out.shape[:-1])
-        return Quaternion._wrap(check_finite_result("other", out, "the quotient", value))
+            value = lambda: np.broadcast_to(s, out.shape[:-1])  # noqa: E731
+        return Quaternion._wrap(_finite("other", out, "the quotient", value))
 
     def __rtruediv__(self, other: Any) -> Quaternion:
         s = self._real(other)
         inv = self._inverse_array()
         with np.errstate(over="ignore", invalid="ignore"):
             out = s[..., None] * inv
-        value = np.broadcast_to(self._a, out.shape)
-        return Quaternion._wrap(check_finite_result("self", out, "the quotient", value))
+        value = lambda: np.broadcast_to(self._a, out.shape)  # noqa: E731
+        return Quaternion._wrap(_finite("self", out, "the quotient", value))
 
     def _sum(self, other: Any, sign: float) -> Quaternion:
         if isinstance(other, Quaternion):
-            broadcast_shapes(("self", "other"), self.shape, other.shape)
+            if self._a.shape != other._a.shape:
+                broadcast_shapes(("self", "other"), self.shape, other.shape)
             with np.errstate(over="ignore"):
                 out = self._a + sign * other._a
-            value = np.broadcast_to(other._a, out.shape)
+            value = lambda: np.broadcast_to(other._a, out.shape)  # noqa: E731
         else:
             s = self._real(other)
             shape = np.broadcast_shapes(self.shape, s.shape)
             out = np.array(np.broadcast_to(self._a, shape + (4,)))
             with np.errstate(over="ignore"):
                 out[..., 0] += sign * s
-            value = np.broadcast_to(s, shape)
+            value = lambda: np.broadcast_to(s, shape)  # noqa: E731
         what = "the sum" if sign > 0 else "the difference"
-        return Quaternion._wrap(check_finite_result("other", out, what, value))
+        return Quaternion._wrap(_finite("other", out, what, value))
 
     def __add__(self, other: Any) -> Quaternion:
         return self._sum(other, 1.0)
@@ -707,7 +716,7 @@ class Quaternion:
         >>> q.as_array()
         array([1.e+000, 0.e+000, 0.e+000, 1.e-300])
         """
-        return Quaternion._wrap(_exp(self._a, "self", self._a))
+        return Quaternion._wrap(_exp(self._a, "self", lambda: self._a))
 
     def log(self) -> Quaternion:
         """Principal logarithm (log|q|, atan2(|v|, w) v/|v|); the zero quaternion raises.
@@ -773,10 +782,12 @@ class Quaternion:
         t = _dimensionless("t", t)
         shape = broadcast_shapes(("self", "t"), self.shape, t.shape)
         lg = self.log()._a
-        tb = np.broadcast_to(t, shape)
+        def tb() -> np.ndarray:
+            return np.broadcast_to(t, shape)
+
         with np.errstate(over="ignore", invalid="ignore"):
             p = lg * t[..., None]
-        check_finite_result("t", p, "t log q", tb)
+        _finite("t", p, "t log q", tb)
         return Quaternion._wrap(_exp(p, "t", tb))
 
     # ------------------------------------------------------------ rotations
@@ -828,7 +839,7 @@ class Quaternion:
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
         with np.errstate(over="ignore", invalid="ignore"):  # overflow: refused just below
             out = qrot_gufunc(self._a, v)
-        check_finite_result("vectors", out, "the rotated vector", np.broadcast_to(v, out.shape))
+        _finite("vectors", out, "the rotated vector", lambda: np.broadcast_to(v, out.shape))
         return _with_unit(out, unit)
 
     def canonical(self) -> Quaternion:
