@@ -17,7 +17,7 @@ def test_version(capsys):
 def test_demo_runs(capsys):
     assert main(["demo"]) == 0
     out = capsys.readouterr().out
-    assert "ijk = Quaternion([-1.,  0.,  0.,  0.])" in out
+    assert "ijk = Quaternion([-1.0, 0.0, 0.0, 0.0])" in out
     # the round-trip error the demo reports is a measured number, at rounding level
     err = float(out.rsplit("largest geodesic error", 1)[1].split()[0])
     assert err < 1e-14

@@ -51,6 +51,8 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     ...
     ValueError: Expected `x` to be finite, got nan at index 1
     """
+    if value is None:  # np.asarray(None, dtype=float) would be a silent NaN
+        raise ValueError(f"Expected `{name}` to be numeric, got None")
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
     try:
@@ -119,3 +121,73 @@ def broadcast(names: tuple[str, ...], *arrays: np.ndarray) -> list[np.ndarray]:
         raise ValueError(
             f"Expected {names_s} to broadcast together, got shapes {shapes}"
         ) from exc
+
+
+def broadcast_shapes(names: tuple[str, ...], *shapes: tuple[int, ...]) -> tuple[int, ...]:
+    """The broadcast shape of ``shapes``, naming the arguments if they do not broadcast.
+
+    Like :func:`broadcast` but on shapes only (no arrays are built), for calls
+    into generalised ufuncs whose own message would be numpy's.
+
+    Examples
+    --------
+    >>> broadcast_shapes(("axis", "angle"), (2,), ())
+    (2,)
+    >>> broadcast_shapes(("axis", "angle"), (2,), (3,))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `axis`, `angle` to broadcast together, got shapes (2,), (3,)
+    """
+    try:
+        return tuple(np.broadcast_shapes(*shapes))
+    except ValueError as exc:
+        names_s = ", ".join(f"`{n}`" for n in names)
+        shapes_s = ", ".join(str(tuple(s)) for s in shapes)
+        raise ValueError(
+            f"Expected {names_s} to broadcast together, got shapes {shapes_s}"
+        ) from exc
+
+
+def check_finite_result(
+    name: str, result: np.ndarray, what: str, value: np.ndarray | None = None
+) -> np.ndarray:
+    """Refuse a result that overflowed: inf or NaN out of finite input.
+
+    Parameters
+    ----------
+    name : str
+        The argument whose value makes the result unrepresentable.
+    result : ndarray, shape (..., k)
+        The computed result, components on the last axis.
+    what : str
+        What overflowed, e.g. ``"the product"``.
+    value : ndarray, optional
+        The values of ``name``, of shape (...) or (..., j) with the leading
+        shape of ``result``, quoted at the first bad index.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, the first bad index (leading dimensions) and the value.
+
+    Examples
+    --------
+    >>> check_finite_result("t", np.array([[1.0, 2.0], [1.0, np.inf]]), "the power",
+    ...                     np.array([1.0, 1e300]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `t` to keep the power finite, got 1e+300 at index 1: it overflows
+    """
+    bad = ~np.isfinite(result)
+    if not bad.any():
+        return result
+    lead = np.any(bad, axis=-1)
+    index = _first_index(lead) if lead.ndim else ()
+    got = ""
+    if value is not None:
+        v = np.asarray(value, dtype=np.float64)[index]
+        shown = repr(float(v)) if v.ndim == 0 else np.array2string(v, separator=", ")
+        got = f", got {shown}"
+    raise ValueError(
+        f"Expected `{name}` to keep {what} finite{got}{_fmt_index(index)}: it overflows"
+    )

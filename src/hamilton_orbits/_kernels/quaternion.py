@@ -8,6 +8,8 @@ dimensions without copies.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import guvectorize, njit
 
@@ -29,20 +31,7 @@ def qmul(aw, ax, ay, az, bw, bx, by, bz):  # pragma: no cover - compiled
 
 
 @njit(inline="always", cache=True)
-def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
-    """``q v q^-1`` for any nonzero ``q`` (the scale of ``q`` cancels).
-
-    Uses v' = v + (2/|q|^2) (w (u x v) + u x (u x v)) with u the vector part,
-    which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
-    """
-    n2 = w * w + x * x + y * y + z * z
-    if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions (scale cancels)
-        m = max(abs(w), abs(x), abs(y), abs(z))
-        w = w / m
-        x = x / m
-        y = y / m
-        z = z / m
-        n2 = w * w + x * x + y * y + z * z
+def _qrot_core(w, x, y, z, vx, vy, vz, n2):  # pragma: no cover - compiled
     cx = y * vz - z * vy
     cy = z * vx - x * vz
     cz = x * vy - y * vx
@@ -55,6 +44,55 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
         vy + s * (w * cy + ccy),
         vz + s * (w * cz + ccz),
     )
+
+
+# Inside these bounds on |q|^2 and |v|^2 (so max|q_i| in (5e-101, 1e100) and
+# max|v_i| in (5e-91, 1e90)) every intermediate of _qrot_core (|q|^2 |v| at most,
+# |v| 1e-90 |q|^2 at least) stays between 1e-290 and 1e290: no overflow, and no
+# underflow that matters at the precision of the result.
+_Q2_LO = 1e-200
+_Q2_HI = 1e200
+_V2_LO = 1e-180
+_V2_HI = 1e180
+
+
+@njit(inline="always", cache=True)
+def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
+    """``q v q^-1`` for any nonzero ``q`` (the scale of ``q`` cancels).
+
+    Uses v' = v + (2/|q|^2) (w (u x v) + u x (u x v)) with u the vector part,
+    which for a unit quaternion is the familiar v + 2w(u x v) + 2u x (u x v).
+
+    Quaternions and vectors of extreme magnitude are first scaled by powers of
+    two (exact), q to max|q_i| in [1/2, 1) and v likewise, and the result is
+    scaled back: full precision from 1e-308 to 1e308 (issue 7, item 4).  A
+    result too large for a float is inf (the caller reports it); the zero
+    quaternion gives NaN (callers check for it first).
+    """
+    n2 = w * w + x * x + y * y + z * z
+    v2 = vx * vx + vy * vy + vz * vz
+    if _Q2_LO < n2 < _Q2_HI and _V2_LO < v2 < _V2_HI:
+        return _qrot_core(w, x, y, z, vx, vy, vz, n2)
+    mv = max(max(abs(vx), abs(vy)), abs(vz))
+    if mv == 0.0:
+        return vx, vy, vz
+    eq = math.frexp(max(max(abs(w), abs(x)), max(abs(y), abs(z))))[1]
+    ev = math.frexp(mv)[1]
+    w = math.ldexp(w, -eq)
+    x = math.ldexp(x, -eq)
+    y = math.ldexp(y, -eq)
+    z = math.ldexp(z, -eq)
+    rx, ry, rz = _qrot_core(
+        w,
+        x,
+        y,
+        z,
+        math.ldexp(vx, -ev),
+        math.ldexp(vy, -ev),
+        math.ldexp(vz, -ev),
+        w * w + x * x + y * y + z * z,
+    )
+    return math.ldexp(rx, ev), math.ldexp(ry, ev), math.ldexp(rz, ev)
 
 
 @guvectorize(
@@ -81,12 +119,35 @@ def qrot_gufunc(q, v, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def qmul_flat(a, b, out):  # pragma: no cover - compiled
+    """Hamilton products of rows of ``a`` and ``b`` (N, 4) into ``out`` (N, 4).
+
+    Returns True if every component is finite.  An overflow is detected by
+    accumulating ``component * 0`` (0 for finite values, NaN for inf), which
+    keeps the loop branch-free; no floating-point flags reach numpy, so the
+    common case needs no ``np.errstate``.
+    """
+    acc = 0.0
+    for i in range(a.shape[0]):
+        w, x, y, z = qmul(a[i, 0], a[i, 1], a[i, 2], a[i, 3], b[i, 0], b[i, 1], b[i, 2], b[i, 3])
+        out[i, 0] = w
+        out[i, 1] = x
+        out[i, 2] = y
+        out[i, 3] = z
+        acc += (w + x + y + z) * 0.0
+    return acc == 0.0
+
+
+@njit(cache=True)
 def rotate_flat(q, v, out):  # pragma: no cover - compiled
     """``q v q^-1`` for rows of ``q`` (N, 4) and ``v`` (N, 3) into ``out`` (N, 3).
 
     One pass that also validates: returns the first row index whose quaternion
-    is zero or whose vector is not finite (``out`` is then incomplete), else -1.
+    is zero or whose vector is not finite (``out`` is then incomplete), -2 if a
+    rotated vector overflowed (or, rarely, three finite components summed past
+    the largest float: the caller then checks properly), else -1.
     """
+    acc = 0.0
     for i in range(q.shape[0]):
         w = q[i, 0]
         x = q[i, 1]
@@ -100,10 +161,11 @@ def rotate_flat(q, v, out):  # pragma: no cover - compiled
         if not (np.isfinite(vx) and np.isfinite(vy) and np.isfinite(vz)):
             return i
         rx, ry, rz = qrot(w, x, y, z, vx, vy, vz)
+        acc += (rx + ry + rz) * 0.0  # 0 while finite, NaN once a component overflowed
         out[i, 0] = rx
         out[i, 1] = ry
         out[i, 2] = rz
-    return -1
+    return -1 if acc == 0.0 else -2
 
 
 @njit(cache=True)
@@ -120,12 +182,12 @@ def to_matrix_flat(q, out):  # pragma: no cover - compiled
         if w == 0.0 and x == 0.0 and y == 0.0 and z == 0.0:
             return i
         n2 = w * w + x * x + y * y + z * z
-        if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions
-            m = max(abs(w), abs(x), abs(y), abs(z))
-            w = w / m
-            x = x / m
-            y = y / m
-            z = z / m
+        if not (1e-280 < n2 < 1e280):  # rescale tiny or huge quaternions (exactly)
+            e = math.frexp(max(max(abs(w), abs(x)), max(abs(y), abs(z))))[1]
+            w = math.ldexp(w, -e)
+            x = math.ldexp(x, -e)
+            y = math.ldexp(y, -e)
+            z = math.ldexp(z, -e)
             n2 = w * w + x * x + y * y + z * z
         s = 2.0 / n2
         xx = s * x * x
