@@ -32,7 +32,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._validation import check_trailing
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 
 __all__ = ["Conic"]
 
@@ -99,7 +99,7 @@ class Conic:
                 f"Expected `{name}` as {kind} like the orbit this conic came from, "
                 f"got {type(value).__name__}"
             )
-        return strip(name, value, unit)
+        return LENGTH(name, value, unit)
 
     def _out(self, value: np.ndarray, unit: u.UnitBase):
         return wrap(value, unit, self._quantity)
@@ -200,7 +200,7 @@ class Conic:
     # ------------------------------------------------------ at a point
     def radius(self, nu: Any) -> np.ndarray:
         """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20)."""
-        nu = strip("nu", nu, u.rad)
+        nu = ANGLE("nu", nu)
         return self._out(self._p / (1.0 + self.e * np.cos(nu)), _L)
 
     def _chord(self, r: np.ndarray) -> np.ndarray:

@@ -34,12 +34,11 @@ import numpy as np
 from hamilton_orbits._kernels import kepler as _k
 from hamilton_orbits._validation import (
     ConvergenceError,
-    as_float_array,
     broadcast,
     check_positive,
     check_trailing,
 )
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
 
 __all__ = [
     "ConvergenceError",
@@ -63,8 +62,8 @@ def _angle_pair(
     name: str, x: Any, e: Any
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     quantity = is_quantity(x)
-    xa = strip(name, x, u.rad)
-    ea = strip("e", e, None)
+    xa = ANGLE(name, x)
+    ea = DIMENSIONLESS("e", e)
     check_positive("e", ea, strict=False)
     xa, ea = broadcast((name, "e"), xa, ea)
     return xa, ea, quantity
@@ -346,15 +345,10 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
         )
     if quantity:
         r_unit, v_unit = r.unit, v.unit
-        ra = strip("r", r, _M)
-        va = strip("v", v, _MS)
-        mua = strip("mu", mu, _MU)
-        dta = strip("dt", dt, u.s)
-    else:
-        ra = as_float_array("r", r)
-        va = as_float_array("v", v)
-        mua = as_float_array("mu", mu)
-        dta = as_float_array("dt", dt)
+    ra = LENGTH("r", r, _M)
+    va = SPEED("v", v, _MS)
+    mua = GM("mu", mu, _MU)
+    dta = TIME("dt", dt, u.s)
     check_trailing("r", ra, 3)
     check_trailing("v", va, 3)
     check_positive("mu", mua)

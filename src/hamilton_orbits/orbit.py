@@ -36,13 +36,22 @@ from hamilton_orbits._validation import (
     ConvergenceError,
     _first_index,
     _fmt_index,
-    as_float_array,
     broadcast,
     check_positive,
     check_trailing,
 )
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import (
+    ANGLE,
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    SPEED,
+    TIME,
+    is_quantity,
+    require_consistent,
+    wrap,
+)
 
 __all__ = [
     "KeplerOrbit",
@@ -85,9 +94,9 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
             "Expected `r`, `v`, `mu` to be all Quantities or all plain floats, got a mix"
         )
     quantity = all(q)
-    r = check_trailing("r", strip("r", r_in, _L), 3)
-    v = check_trailing("v", strip("v", v_in, _V), 3)
-    mu = strip("mu", mu_in, _MU)
+    r = check_trailing("r", LENGTH("r", r_in, _L), 3)
+    v = check_trailing("v", SPEED("v", v_in, _V), 3)
+    mu = GM("mu", mu_in, _MU)
     check_positive("mu", mu)
     lead = broadcast(("r", "v", "mu"), r[..., 0], v[..., 0], mu)[0].shape
     r = np.broadcast_to(r, (*lead, 3))
@@ -310,13 +319,13 @@ class KeplerOrbit:
             raise ValueError(
                 f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
             )
-        e_ = strip("e", e, None)
-        inc_ = strip("inc", inc, _RAD)
-        lan_ = strip("lan", lan, _RAD)
-        argp_ = strip("argp", argp, _RAD)
-        mu_ = strip("mu", mu, _MU)
-        len_ = strip(lname, lval, _L)
-        ang_ = strip(aname, aval, _RAD)
+        e_ = DIMENSIONLESS("e", e)
+        inc_ = ANGLE("inc", inc)
+        lan_ = ANGLE("lan", lan)
+        argp_ = ANGLE("argp", argp)
+        mu_ = GM("mu", mu, _MU)
+        len_ = LENGTH(lname, lval, _L)
+        ang_ = ANGLE(aname, aval)
         e_, inc_, lan_, argp_, mu_, len_, ang_ = broadcast(
             ("e", "inc", "lan", "argp", "mu", lname, aname),
             e_, inc_, lan_, argp_, mu_, len_, ang_,
@@ -605,7 +614,7 @@ class KeplerOrbit:
         """
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
-        dt_ = strip("dt", dt, _T)
+        dt_ = TIME("dt", dt, _T)
         r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
         mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
         return KeplerOrbit(r, v, mu, self._quantity)
@@ -664,11 +673,23 @@ def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
 # ---------------------------------------------------------------------------
 
 
-def _vec(name: str, x: Any) -> np.ndarray:
-    return check_trailing(name, as_float_array(name, x), 3)
+def _hamilton_args(r: Any, v: Any, *mu: Any):
+    """(r, v, mu) of Hamilton's integrals as floats (km, km/s, km^3/s^2 for
+    Quantities) and whether the call was in Quantities (no mixing)."""
+    quantity = require_consistent(("r", "v", "mu")[: 2 + len(mu)], (r, v, *mu))
+    r_ = check_trailing("r", LENGTH("r", r, _L), 3)
+    v_ = check_trailing("v", SPEED("v", v, _V), 3)
+    mu_ = check_positive("mu", GM("mu", mu[0], _MU)) if mu else None
+    return r_, v_, mu_, quantity
 
 
-def hamilton_beta(r: Any, v: Any) -> np.ndarray:
+def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    alpha = Quaternion.from_vector(r)
+    dalpha = Quaternion.from_vector(v)
+    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+
+
+def hamilton_beta(r: Any, v: Any):
     """Hamilton's areal vector ``beta = (alpha alpha' - alpha' alpha) / 2`` (seed eq. 3).
 
     Computed from two Hamilton products of the pure quaternions ``alpha = r``
@@ -676,25 +697,35 @@ def hamilton_beta(r: Any, v: Any) -> np.ndarray:
 
     Parameters
     ----------
-    r, v : array_like, shape (..., 3)
-        Position and velocity (plain floats, any consistent units).
+    r : array_like or Quantity (length), shape (..., 3)
+        Position.
+    v : array_like or Quantity (length/time), shape (..., 3)
+        Velocity (plain floats: the units of ``r`` per unit time).
 
     Returns
     -------
-    ndarray, shape (..., 3)
+    ndarray or Quantity (km^2/s), shape (..., 3)
         The vector part of the (pure) quaternion beta.
+
+    Raises
+    ------
+    ValueError
+        NaN / inf, trailing dimension not 3, or a mix of Quantities and floats.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong kind, naming the argument.
 
     Examples
     --------
     >>> hamilton_beta([1.0, 0, 0], [0, 2.0, 0]).tolist()
     [0.0, 0.0, 2.0]
+    >>> hamilton_beta([1.0, 0, 0] * u.km, [0, 2.0, 0] * u.km / u.s)
+    <Quantity [0., 0., 2.] km2 / s>
     """
-    alpha = Quaternion.from_vector(_vec("r", r))
-    dalpha = Quaternion.from_vector(_vec("v", v))
-    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+    r_, v_, _, quantity = _hamilton_args(r, v)
+    return wrap(_beta(r_, v_), _L * _V, quantity)
 
 
-def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any) -> np.ndarray:
+def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
     """Hamilton's ``epsilon = iota - alpha' beta / M`` (seed eq. 13), by quaternion products.
 
     ``iota = alpha / r`` is the unit vector of the position; in Hamilton's
@@ -704,38 +735,57 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any) -> np.ndarray:
 
     Parameters
     ----------
-    r, v : array_like, shape (..., 3)
-    mu : array_like, shape (...)
+    r : array_like or Quantity (length), shape (..., 3)
+        Position, nonzero.
+    v : array_like or Quantity (length/time), shape (..., 3)
+        Velocity.
+    mu : array_like or Quantity (length^3/time^2), shape (...)
         Hamilton's M, ``> 0``.
 
     Returns
     -------
-    ndarray, shape (..., 3)
+    ndarray or dimensionless Quantity, shape (..., 3)
+
+    Raises
+    ------
+    ValueError
+        NaN / inf, wrong shapes, ``mu <= 0``, ``r = 0``, or mixed Quantities and floats.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong kind, naming the argument.
 
     Examples
     --------
     >>> hamilton_epsilon_from_products([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12).tolist()
     [-0.44, 0.0, 0.0]
     """
-    r_ = _vec("r", r)
-    v_ = _vec("v", v)
-    mu_ = check_positive("mu", as_float_array("mu", mu))
+    r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
     rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
+    _raise_at("r", ~(rn > 0), rn, "nonzero (|r| > 0)")
     iota = Quaternion.from_vector(r_ / rn[..., None])
     dalpha = Quaternion.from_vector(v_)
-    beta = Quaternion.from_vector(hamilton_beta(r_, v_))
+    beta = Quaternion.from_vector(_beta(r_, v_))
     eps = iota - (dalpha * beta) * (1.0 / mu_)
-    return eps.vector
+    return wrap(eps.vector, u.dimensionless_unscaled, quantity)
 
 
-def hamilton_p(r: Any, v: Any, mu: Any) -> np.ndarray:
+def hamilton_p(r: Any, v: Any, mu: Any):
     """Hamilton's semi-parameter ``p = -beta^2 / M`` (seed eq. 16), ``beta^2`` a quaternion square.
+
+    Parameters
+    ----------
+    r : array_like or Quantity (length), shape (..., 3)
+    v : array_like or Quantity (length/time), shape (..., 3)
+    mu : array_like or Quantity (length^3/time^2), shape (...), ``> 0``
+
+    Returns
+    -------
+    ndarray or Quantity (km), shape (...)
 
     Examples
     --------
     >>> float(hamilton_p([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12))
     1.44
     """
-    beta = Quaternion.from_vector(hamilton_beta(r, v))
-    mu_ = check_positive("mu", as_float_array("mu", mu))
-    return -(beta * beta).scalar / mu_
+    r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
+    beta = Quaternion.from_vector(_beta(r_, v_))
+    return wrap(-(beta * beta).scalar / mu_, _L, quantity)
