@@ -643,27 +643,22 @@ def _ecc_vector(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
 def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
     """States of radial orbits from their mean anomaly (in place).
 
-    Kepler's equation for a rectilinear orbit (e = 1, a finite) is solved by
-    universal-variable propagation from a reference point: the apoapsis
-    (``M = pi``, at rest at ``r = 2a``) of the bound orbit, the point ``F = 1``
-    of the unbound one.
+    Kepler's equation of the rectilinear orbit (e = 1, a finite),
+    ``E - sin E = M`` or ``sinh F - F = M``, is solved directly
+    (:func:`hamilton_orbits._kernels.kepler.solve_radial`), and the state is
+    ``r = a (1 - cos E) = 2 a sin^2(E/2)`` (``|a| (cosh F - 1)``) on the line, so
+    that a tiny M keeps full relative precision (E ~ (6 M)^(1/3)).
     """
     idx = np.flatnonzero(radial)
-    inv_a = el[idx, 2]
-    ref = el[idx].copy()
-    ref[:, 0] = 0.0
-    bound = inv_a > 0
-    ref[:, 6] = np.where(bound, np.pi, 1.0)
-    r0 = np.empty((idx.size, 3))
-    v0 = np.empty((idx.size, 3))
-    _el.elements_to_state(np.ascontiguousarray(ref), np.ascontiguousarray(mu[idx]), r0, v0)
-    m0 = np.where(bound, np.pi, np.sinh(1.0) - 1.0)
-    ia = np.abs(inv_a)
-    n = np.sqrt(mu[idx]) * ia * np.sqrt(ia)
     mm = m[idx]
+    rows = np.ascontiguousarray(el[idx])
+    bound = rows[:, 2] > 0
     _raise_at("M", bound & ~((mm > -np.pi) & (mm <= np.pi)), mm, "in (-pi, pi] for a radial orbit")
-    dt = (mm - m0) / n
-    r1, v1 = _kepler.propagate(r0, v0, mu[idx], dt)
+    rows[:, 0] = 0.0
+    rows[:, 6] = _kk.solve_radial_ufunc(mm, rows[:, 2])
+    r1 = np.empty((idx.size, 3))
+    v1 = np.empty((idx.size, 3))
+    _el.elements_to_state(rows, np.ascontiguousarray(mu[idx]), r1, v1)
     r_out[idx] = r1
     v_out[idx] = v1
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, vectorize
 
 EPS = 2.220446049250313e-16
@@ -180,7 +181,12 @@ def _cubic_root(p, q):  # pragma: no cover - compiled
     ``x = 2 sqrt(p) sinh(asinh(q / p^(3/2)) / 3)``: no cancellation for any q.
     """
     sp = math.sqrt(p)
-    return 2.0 * sp * math.sinh(math.asinh(q / (p * sp)) / 3.0)
+    d = p * sp
+    if not (q < 1e100 * d):
+        # p -> 0 (e -> 1 in the callers, or p * sp underflows): x = (2 q)^(1/3),
+        # the limit of the form below (relative difference ~ (q/d)^(-2/3))
+        return np.cbrt(2.0 * q)
+    return 2.0 * sp * math.sinh(math.asinh(q / d) / 3.0)
 
 
 @njit(inline="always", cache=True)
@@ -227,7 +233,7 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
         hi = PI
     if lo > hi:
         lo = hi
-    a = lo
+    a = lo * (1.0 - 4.0 * EPS)  # the rounded cubic root may lie an ulp above E
     b = hi
     x = lo
     xp = math.nan
@@ -262,13 +268,17 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
     em = e - 1.0
     f1 = math.asinh(m / e)
     lo = math.asinh((m + f1) / e)
-    hi = min(math.asinh(m / em), _cubic_root(2.0 * em / e, 3.0 * m / e))
+    hi = _cubic_root(2.0 * em / e, 3.0 * m / e)
+    if em > 0.0:
+        hi = min(math.asinh(m / em), hi)
     if hi < lo:
         hi = lo
     flo = f1 - lo  # f(lo) up to rounding, <= 0
-    fhi = em * math.sinh(hi) + sinh_minus_x(hi) - m
+    fhi = sinh_minus_x(hi) - m
+    if em > 0.0:  # (em = 0: the radial orbit, whose cubic bound may overflow sinh)
+        fhi += em * math.sinh(hi)
     a = lo
-    b = hi
+    b = hi * (1.0 + 4.0 * EPS)  # the rounded cubic root may lie an ulp below F
     x = lo if abs(flo) <= abs(fhi) else hi
     xp = math.nan
     for _ in range(MAXIT):
@@ -325,6 +335,35 @@ def solve(m, e):  # pragma: no cover - compiled
     if m < 0.0:
         return -_solve_hyperbolic(-m, e)
     return _solve_hyperbolic(m, e)
+
+
+@njit(cache=True)
+def solve_radial(m, inv_a):  # pragma: no cover - compiled
+    """The anomaly of a radial (rectilinear, e = 1) orbit for mean anomaly ``m``.
+
+    Bound (``inv_a > 0``): E in [-pi, pi] with ``E - sin E = m`` for
+    |m| <= pi, so that ``r = a (1 - cos E)``; unbound (``inv_a < 0``): F with
+    ``sinh F - F = m``, ``r = |a| (cosh F - 1)``.  Solved directly (the
+    limits e -> 1 of the elliptic and hyperbolic solvers, started from the
+    cubic ``E^3/6 = m``), so a tiny m keeps full relative precision: the
+    anomaly is ``(6 m)^(1/3)`` to first order.  NaN outside the domain.
+    """
+    if not math.isfinite(m) or not (inv_a != 0.0) or not math.isfinite(inv_a):
+        return math.nan
+    am = abs(m)
+    if inv_a > 0.0:
+        if am > PI:
+            return math.nan
+        x = _solve_elliptic(am, 1.0)
+    else:
+        x = _solve_hyperbolic(am, 1.0)
+    return -x if m < 0.0 else x
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def solve_radial_ufunc(m, inv_a):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`solve_radial`."""
+    return solve_radial(m, inv_a)
 
 
 @vectorize(["float64(float64, float64)"], cache=True)
