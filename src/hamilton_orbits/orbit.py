@@ -102,8 +102,7 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
     r = np.broadcast_to(r, (*lead, 3))
     v = np.broadcast_to(v, (*lead, 3))
     mu = np.broadcast_to(mu, lead)
-    rn = np.sqrt(np.einsum("...i,...i->...", r, r))
-    bad = ~(rn > 0)
+    bad = ~np.any(r != 0, axis=-1)  # not |r| > 0: |r|^2 underflows at 1e-170
     if np.any(bad):
         index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
         raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{_fmt_index(index)}")
@@ -754,8 +753,14 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
     [-0.44, 0.0, 0.0]
     """
     r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
-    rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
-    _raise_at("r", ~(rn > 0), rn, "nonzero (|r| > 0)")
+    big = np.max(np.abs(r_), axis=-1)  # |r| without underflow of |r|^2 (r ~ 1e-170)
+    _raise_at("r", ~(big > 0), big, "nonzero (|r| > 0)")
+    with np.errstate(over="ignore", under="ignore"):
+        rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
+    tiny_or_huge = ~((big > 1e-150) & (big < 1e150))
+    if np.any(tiny_or_huge):
+        rs = r_ / big[..., None]
+        rn = np.where(tiny_or_huge, big * np.sqrt(np.einsum("...i,...i->...", rs, rs)), rn)
     iota = Quaternion.from_vector(r_ / rn[..., None])
     dalpha = Quaternion.from_vector(v_)
     beta = Quaternion.from_vector(_beta(r_, v_))

@@ -14,14 +14,15 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from hamilton_orbits import KeplerOrbit
+from hamilton_orbits import KeplerOrbit, solve_kepler
 
 EPS = np.finfo(float).eps
 
 
 def _radial_exact(a, m):
     """|r|, |v| of the radial orbit of semi-major axis a (mu = 1) at mean anomaly m."""
-    with mp.workdps(50):
+    # t - sin t cancels to ~t^3: carry 2 log10(1/t) extra digits (t ~ m^(1/3))
+    with mp.workdps(50 + int(abs(np.log10(abs(m))))):
         mm = mp.mpf(m)
         if a > 0:
             start = mp.sign(mm) * mp.cbrt(6 * abs(mm)) if abs(m) < 1 else mm
@@ -63,3 +64,119 @@ def test_radial_orbit_at_small_mean_anomaly_full_precision(a, m):
 def test_radial_mean_anomaly_outside_the_revolution_is_refused():
     with pytest.raises(ValueError, match=r"`M` in \(-pi, pi\] for a radial orbit, got 4.0"):
         KeplerOrbit.from_elements(a=1.0, e=1.0, inc=0.3, lan=0.2, argp=0.1, M=4.0, mu=1.0)
+
+
+# ---------------------------------------------------------------- magnitudes
+# Issue 7 items 4 and 5: states far from order 1 overflowed or underflowed inside
+# the kernels (e = 1 for a circle, "r is zero", a SystemError out of numba).
+
+
+@pytest.mark.parametrize(
+    ("r", "v"),
+    [(1e200, 1e-100), (1e-170, 1e85), (1e300, 1e-150), (1e-300, 1e150), (1e150, 1e-75)],
+)
+def test_circles_at_extreme_scales(r, v):
+    # mu = 1: the circular speed is 1/sqrt(r), which these pairs are to rounding
+    o = KeplerOrbit.from_state([r, 0.0, 0.0], [0.0, v, 0.0], 1.0)
+    assert o.e == 0.0  # below 4 eps: exactly the circle
+    # 1/a = 2/r - v^2 = (1 + O(eps))/r: a few eps from the rounding of v^2 r
+    assert abs(o.a / r - 1) <= 4 * EPS
+    assert abs(o.p / r - 1) <= 4 * EPS
+
+
+def _order1_cases():
+    """The non-radial hard cases at order 1 (|r| up to 2e12, mu ~ 1: no subnormal
+    after the scalings below)."""
+    from hard_cases import CASES
+
+    cases = [c for c in CASES if c.kind != "radial" and not c.name.startswith("scale")]
+    r = np.array([c.r for c in cases])
+    v = np.array([c.v for c in cases])
+    mu = np.array([c.mu for c in cases])
+    return r, v, mu
+
+
+def _power2_scaled(r, v, mu, er, ev):
+    return np.ldexp(r, er), np.ldexp(v, ev), np.ldexp(mu, er + 2 * ev)
+
+
+# (er, ev): r -> 2^er r, v -> 2^ev v, mu -> 2^(er + 2 ev) mu, t -> 2^(er - ev) t;
+# every scaled quantity stays a normal float
+SCALES = [(500, -250), (-500, 250), (600, -100), (-600, 100), (0, 450), (0, -450), (200, 200)]
+
+
+@pytest.mark.parametrize(("er", "ev"), SCALES)
+def test_elements_are_homogeneous_at_any_scale(er, ev):
+    """Scaling by powers of two scales p and a by 2^er and the time by 2^(er-ev),
+    and leaves e and every angle unchanged."""
+    r, v, mu = _order1_cases()
+    ref = KeplerOrbit.from_state(r, v, mu)
+    o = KeplerOrbit.from_state(*_power2_scaled(r, v, mu, er, ev))
+    # the kernel works on the state brought back to order 1 by powers of two: the
+    # same arithmetic up to the rounding of sqrt(mu) and a few divisions
+    np.testing.assert_allclose(o.e, ref.e, rtol=8 * EPS, atol=8 * EPS)
+    np.testing.assert_allclose(np.ldexp(o.p, -er), ref.p, rtol=8 * EPS)
+    np.testing.assert_allclose(np.ldexp(o.q, -er), ref.q, rtol=8 * EPS)
+    for name in ("inc", "argument_of_latitude", "nu", "M"):
+        np.testing.assert_allclose(getattr(o, name), getattr(ref, name), rtol=8 * EPS,
+                                   atol=8 * EPS)
+    # the time carries the mean motion's sqrt(mu) a^1.5 (a few more roundings)
+    np.testing.assert_allclose(np.ldexp(o.time_since_periapsis, ev - er),
+                               ref.time_since_periapsis, rtol=16 * EPS, atol=0)
+
+
+@pytest.mark.parametrize(("er", "ev"), SCALES)
+def test_propagation_is_homogeneous_at_any_scale(er, ev):
+    from hamilton_orbits.kepler import propagate
+
+    r, v, mu = _order1_cases()
+    dt = 0.37 * np.linalg.norm(r, axis=-1) ** 1.5 / np.sqrt(mu)  # a fraction of an orbit
+    r1, v1 = propagate(r, v, mu, dt)
+    rs, vs, mus = _power2_scaled(r, v, mu, er, ev)
+    r2, v2 = propagate(rs, vs, mus, np.ldexp(dt, er - ev))
+    # the same orbit at another scale: the two runs differ only by the rounding
+    # of the solver's chi (up to 16 eps measured, on the e = 1e6 hyperbola); 64 eps
+    nr = np.linalg.norm(r1, axis=-1)
+    nv = np.linalg.norm(v1, axis=-1)
+    assert np.all(np.linalg.norm(np.ldexp(r2, -er) - r1, axis=-1) <= 64 * EPS * nr)
+    assert np.all(np.linalg.norm(np.ldexp(v2, -ev) - v1, axis=-1) <= 64 * EPS * nv)
+
+
+def test_issue7_overflow_reproducers():
+    o = KeplerOrbit.from_state([1e300, 0, 0], [0, 1e-150, 0], 1.0)
+    assert o.e == 0.0  # was: SystemError from the kernel
+    o = KeplerOrbit.from_elements(a=1e200, e=0.1, inc=0.3, lan=0.2, argp=0.1, nu=0.5, mu=1.0)
+    r, v = o.state()
+    assert np.all(np.isfinite(r)) and np.all(np.isfinite(v))
+    assert abs(o.a / 1e200 - 1) <= 8 * EPS and abs(o.e - 0.1) <= 8 * EPS
+    # the direction of periapsis from the state is good to ~eps/e: nu to 8 eps / e
+    assert abs(o.nu - 0.5) <= 8 * EPS / 0.1
+    # radial orbit at M = 1e-300: r ~ 1e-200, v ~ 1e100 (|r|^2 underflows)
+    o = KeplerOrbit.from_elements(a=1.0, e=1.0, inc=0.3, lan=0.2, argp=0.1, M=1e-300, mu=1.0)
+    r, v = o.state()
+    r_ex, v_ex = _radial_exact(1.0, 1e-300)
+    assert abs(np.linalg.norm(r / 1e-200) * 1e-200 / float(r_ex) - 1) <= 6 * EPS
+    assert abs(np.linalg.norm(v / 1e100) * 1e100 / float(v_ex) - 1) <= 6 * EPS
+    assert abs(float(o.time_since_periapsis) / 1e-300 - 1) <= 8 * EPS
+
+
+def test_solve_kepler_at_the_float_range():
+    with mp.workdps(50):
+        m = mp.mpf(1.7e308)
+        # fixed points contracting by ~1/m per step (findroot's residual test
+        # cannot cope with |f| ~ 1e308)
+        f_ex = d_ex = f2 = mp.mpf(0)
+        for _ in range(6):
+            f_ex = mp.asinh((m + f_ex) / mp.mpf(1.5))  # 1.5 sinh F - F = m
+            d_ex = mp.cbrt(3 * (m - d_ex))  # D + D^3/3 = m
+            f2 = mp.asinh(mp.mpf(1e15) + f2)  # sinh F - F = 1e15
+    assert abs(solve_kepler(1.7e308, 1.5) / float(f_ex) - 1) <= 2 * EPS  # was inf
+    assert abs(solve_kepler(-1.7e308, 1.5) / -float(f_ex) - 1) <= 2 * EPS
+    assert abs(solve_kepler(1.7e308, 1.0) / float(d_ex) - 1) <= 4 * EPS
+    # beyond 2^53 the floats are 2 apart and |E - M| <= e < 1: E rounds to M
+    assert solve_kepler(1e300, 0.5) == 1e300  # was a RuntimeWarning
+    assert solve_kepler(-2.0**60, 0.9) == -(2.0**60)
+    # the radial limit e = 1 of the hyperbolic solver at large M (no overflow of the cubic)
+    from hamilton_orbits._kernels.kepler import solve_radial
+
+    assert abs(solve_radial(1e15, -1.0) / float(f2) - 1) <= 4 * EPS

@@ -268,9 +268,17 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
     em = e - 1.0
     f1 = math.asinh(m / e)
     lo = math.asinh((m + f1) / e)
+    if m > 1e20:
+        # F = asinh((m + F)/e) contracts by 1/(m + F) < 1e-20 per step: lo is two
+        # steps from F = 0, one more is F to rounding (and no sinh can overflow)
+        return math.asinh((m + lo) / e)
     hi = _cubic_root(2.0 * em / e, 3.0 * m / e)
     if em > 0.0:
         hi = min(math.asinh(m / em), hi)
+    if m > 2.5:
+        # sinh F - F >= sinh(F)/2 for F >= 2.2 (the root, as m > 2.26): the
+        # bound that keeps the radial orbit's (e = 1) cubic bound from overflowing
+        hi = min(math.asinh(2.0 * m), hi)
     if hi < lo:
         hi = lo
     flo = f1 - lo  # f(lo) up to rounding, <= 0
@@ -304,6 +312,8 @@ def solve_parabolic(m):  # pragma: no cover - compiled
     ``D = 2 sinh(asinh(3 m / 2) / 3)`` (Cardano's root written without the
     cancellation of ``w - 1/w``), then one Newton polish.
     """
+    if abs(m) > 1e300:  # 1.5 m may overflow; D^3 = 3 m to 1e-200 relative here
+        return np.cbrt(3.0) * np.cbrt(m)
     d = 2.0 * math.sinh(math.asinh(1.5 * m) / 3.0)
     if abs(d) < 1e100:
         d -= (d * (1.0 + d * d / 3.0) - m) / (1.0 + d * d)
@@ -320,7 +330,9 @@ def solve(m, e):  # pragma: no cover - compiled
     if not (e >= 0.0) or not math.isfinite(m) or not math.isfinite(e):
         return math.nan
     if e < 1.0:
-        if e == 0.0:
+        if e == 0.0 or abs(m) >= 9007199254740992.0:
+            # beyond 2^53 the spacing of floats is >= 2 > 2 e >= 2 |E - M|: M is
+            # the float nearest to E (and no reduction mod 2 pi is meaningful)
             return m
         k, r = _reduce_2pi(m)
         if r < 0.0:
@@ -646,12 +658,67 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     )
 
 
+# Below 1e-50 or above 1e50 a product of the kernels (h^2 ~ r^2 v^2, r.v h,
+# mu r, ...) may leave the float range; such states are scaled first.
+_SAFE_LO = 1e-50
+_SAFE_HI = 1e50
+
+
+@njit(cache=True)
+def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """Exponents ``(er, ev)`` of the powers of two that bring ``(r, v, mu)`` to order 1.
+
+    Two-body motion is homogeneous: ``r -> r / 2^er``, ``v -> v / 2^ev``,
+    ``mu -> mu / 2^(er + 2 ev)``, ``t -> t 2^(ev - er)`` leave every angle, the
+    eccentricity and the anomalies unchanged, so a kernel can work on the scaled
+    state and scale lengths, speeds and times back exactly (powers of two).
+    ``er`` makes ``|r| ~ 1``; ``ev`` makes ``|v| ~ 1`` unless ``mu`` would then
+    leave 2^(+-400) (a state nearly at rest, or extremely hyperbolic), in which
+    case ``mu ~ 1``.  ``(0, 0)`` when every magnitude lies in [1e-50, 1e50]
+    already (the common case: no scaling, bit for bit the unscaled kernels).
+    """
+    mr = max(abs(rx), abs(ry), abs(rz))
+    mv = max(abs(vx), abs(vy), abs(vz))
+    if (
+        _SAFE_LO < mr < _SAFE_HI and _SAFE_LO < mu < _SAFE_HI
+        and (_SAFE_LO < mv < _SAFE_HI or mv == 0.0)
+    ):
+        return 0, 0
+    er = math.frexp(mr)[1]
+    emu = math.frexp(mu)[1]
+    ev_mu = (emu - er) // 2
+    if mv == 0.0:
+        return er, ev_mu
+    ev = math.frexp(mv)[1]
+    if abs(emu - er - 2 * ev) > 400:
+        ev = ev_mu
+    return er, ev
+
+
+@njit(cache=True)
+def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
+    """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
+    so that no intermediate product overflows or underflows."""
+    er, ev = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    if er == 0 and ev == 0:
+        return propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt)
+    x, y, z, a, b, c = propagate_uv(
+        math.ldexp(rx, -er), math.ldexp(ry, -er), math.ldexp(rz, -er),
+        math.ldexp(vx, -ev), math.ldexp(vy, -ev), math.ldexp(vz, -ev),
+        math.ldexp(mu, -er - 2 * ev), math.ldexp(dt, ev - er),
+    )
+    return (
+        math.ldexp(x, er), math.ldexp(y, er), math.ldexp(z, er),
+        math.ldexp(a, ev), math.ldexp(b, ev), math.ldexp(c, ev),
+    )
+
+
 @njit(cache=True)
 def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
-    """Loop :func:`propagate_uv` over rows; returns the first failing row or -1."""
+    """Loop :func:`propagate_scaled` over rows; returns the first failing row or -1."""
     bad = -1
     for i in range(r.shape[0]):
-        x, y, z, a, b, c = propagate_uv(
+        x, y, z, a, b, c = propagate_scaled(
             r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], dt[i]
         )
         r_out[i, 0] = x
