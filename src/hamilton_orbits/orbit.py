@@ -220,6 +220,38 @@ class KeplerOrbit:
         astropy.units.UnitConversionError
             For a Quantity of the wrong kind.
 
+        Notes
+        -----
+        The state is the representation; the elements are derived from it.  Any
+        finite state is accepted at any scale (it is brought to order 1 by powers
+        of two inside the kernels, which is exact).
+
+        *Representation limit near a hyperbola's asymptote.*  Far out along an
+        open orbit, ``r`` and ``v`` are nearly parallel and the rounding of the
+        state itself leaves the areal vector ``h = r x v`` uncertain by about
+        ``eps |r| |v| / h`` relative (the condition number; ~1e12 for the
+        example below), and so ``p``, ``e - 1`` and ``nu`` near the asymptote
+        ``nu_inf = arccos(-1/e)``.  The ``(e, nu)`` returned can then lie on or
+        beyond the asymptote of the float ``e`` (``1 + e cos nu <= 0``), a pair
+        that :meth:`from_elements` refuses with ``nu``.  The mean anomaly ``M``
+        stays defined there: rebuild such an orbit with ``M`` (it reproduces the
+        position to the precision the state fixes), or keep the state.
+
+        >>> o = KeplerOrbit.from_state([-1.8881600011099116e16, -9735075058187862.0,
+        ...                             -2032451813774641.8],
+        ...                            [-0.00012134184429701539, -6.256206895793337e-05,
+        ...                             -1.306146996988154e-05], 1.0)
+        >>> bool(1 + o.e * np.cos(o.nu) <= 0)          # on the asymptote of the float e
+        True
+        >>> el = dict(p=o.p, e=o.e, inc=o.inc, lan=o.lan, argp=o.argp, mu=1.0)
+        >>> KeplerOrbit.from_elements(nu=o.nu, **el)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `nu` inside the asymptotes (1 + e cos nu > 0), got 3.14157...
+        >>> r, _ = KeplerOrbit.from_elements(M=o.M, **el).state()
+        >>> bool(np.all(np.isfinite(r)))
+        True
+
         Examples
         --------
         >>> o = KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.0, 0], 1.0)
@@ -292,6 +324,13 @@ class KeplerOrbit:
         ``y = sqrt(a p) sin E`` (and the hyperbolic / parabolic analogues), i.e.
         Hamilton's conic ``r = p / (1 + e cos v)`` (eq. 20) with ``p = a (1 - e^2)``
         (eq. 29).
+
+        ``nu`` of an open orbit must satisfy ``1 + e cos nu > 0`` for the float
+        ``e`` given.  Elements read off a state far out along a hyperbola's
+        asymptote may not (the state's rounding leaves ``h = r x v``, hence
+        ``e`` and ``nu``, uncertain there; see :meth:`from_state`): pass ``M``
+        for such orbits.  Lengths and ``mu`` of any magnitude are accepted
+        (scaled to order 1 by powers of two inside the kernel).
 
         Examples
         --------

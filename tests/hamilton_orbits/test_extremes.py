@@ -180,3 +180,37 @@ def test_solve_kepler_at_the_float_range():
     from hamilton_orbits._kernels.kepler import solve_radial
 
     assert abs(solve_radial(1e15, -1.0) / float(f2) - 1) <= 4 * EPS
+
+
+# ------------------------------------------------ the asymptote (issue 7 item 8)
+ASYMPTOTE_R = [-1.8881600011099116e16, -9735075058187862.0, -2032451813774641.8]
+ASYMPTOTE_V = [-0.00012134184429701539, -6.256206895793337e-05, -1.306146996988154e-05]
+
+
+def test_representation_limit_near_the_asymptote():
+    """Far out along a hyperbola (r ~ 2e16 q) the state's rounding fixes h = r x v
+    only to eps |r| |v| / h relative; (e, nu) may then lie on the asymptote of the
+    float e, which from_elements refuses with nu and accepts with M (documented in
+    from_state and from_elements)."""
+    o = KeplerOrbit.from_state(ASYMPTOTE_R, ASYMPTOTE_V, 1.0)
+    r = np.array(ASYMPTOTE_R)
+    v = np.array(ASYMPTOTE_V)
+    # p of the float state, exactly (mpmath), and the condition number of h
+    with mp.workdps(60):
+        rr = [mp.mpf(x) for x in r]
+        vv = [mp.mpf(x) for x in v]
+        h = [rr[1] * vv[2] - rr[2] * vv[1], rr[2] * vv[0] - rr[0] * vv[2],
+             rr[0] * vv[1] - rr[1] * vv[0]]
+        p_exact = float(sum(x * x for x in h))
+    kappa = np.linalg.norm(r) * np.linalg.norm(v) / np.sqrt(p_exact)
+    assert kappa > 1e11  # the state really is ill-conditioned here
+    # p from the rounded cross product: within a few eps kappa of the exact p (2 h dh)
+    assert abs(o.p / p_exact - 1) <= 8 * EPS * kappa
+    # the limit itself: 1 + e cos nu is not positive for these floats
+    assert 1 + o.e * np.cos(o.nu) <= 0
+    el = dict(p=o.p, e=o.e, inc=o.inc, lan=o.lan, argp=o.argp, mu=1.0)
+    with pytest.raises(ValueError, match=r"`nu` inside the asymptotes .* got 3.14157"):
+        KeplerOrbit.from_elements(nu=o.nu, **el)
+    # with M the orbit is rebuilt; its position agrees to the precision the state fixes
+    r2, _ = KeplerOrbit.from_elements(M=o.M, **el).state()
+    assert np.linalg.norm(r2 - r) <= 8 * EPS * kappa * np.linalg.norm(r)
