@@ -554,6 +554,18 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):  # pragma: no cover
+    """Whether ``g sqrt(mu) = r0 U1 + sigma0 U2`` is expected more accurate than
+    ``tau - U3`` (the two are equal by the universal Kepler equation): an error
+    dchi moves the first by ``(r - U2) dchi`` and the second by ``U2 dchi``, and
+    each carries the rounding of its own terms (the first cancels when moving
+    towards periapsis from far out)."""
+    e1 = abs(r - u2) * dchi_err + EPS * (abs(r0 * u1) + abs(sigma0 * u2))
+    e2 = abs(u2) * dchi_err + EPS * (abs(tau) + abs(u3))
+    return e1 <= e2
+
+
+@njit(cache=True)
 def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """Two-body state after time ``dt`` by universal variables (f and g series).
 
@@ -564,10 +576,12 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       |dt| may be many periods.
     * Moving away from periapsis (``sigma0 dt >= 0``, or a nearly circular
       orbit) the universal Kepler equation ``T(chi) = sqrt(mu) dt`` is a sum
-      of terms of one sign and is solved directly; g is then computed from chi
-      alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g = 1
-      holds identically and the state stays on the initial orbit whatever the
-      solver's last-bit error.
+      of terms of one sign and is solved directly.  g is computed either from
+      chi alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g
+      = 1 holds identically and the state stays on the initial orbit whatever
+      the solver's last-bit error, or as ``(tau - U3)/sqrt(mu)``, whichever the
+      last-bit error of chi and the rounding of the terms move least
+      (:func:`_g_first_form`; on a fast hyperbola U3 << tau and g ~ dt).
     * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4, and a step
       long enough, ``|sigma0 tau| > r0^2 / 10``, to matter), the terms of
       T(chi) cancel (for an open orbit that starts far out the loss is about
@@ -575,8 +589,8 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       periapsis, where all terms have one sign: chi0 of the initial state is
       found from sigma0 = e U1(chi0) (atan2 / asinh forms), and
       ``q U1(chi1) + U3(chi1) = q U1(chi0) + U3(chi0) + sqrt(mu) dt`` is solved
-      for chi1; f and g use dchi = chi1 - chi0 with ``g = dt - U3/sqrt(mu)``
-      and ``r = q U0(chi1) + U2(chi1)``.
+      for chi1; f and g use dchi = chi1 - chi0 (g chosen as above; radial
+      orbits keep ``g = dt - U3/sqrt(mu)``) and ``r = q U0(chi1) + U2(chi1)``.
     """
     nan = math.nan
     r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
@@ -623,12 +637,28 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
         r = sol[2]
         dchi = chi1 - chi0
         _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
-        g = (tau - u3) / smu
+        # as below: the form of g that the last-bit error of dchi moves least;
+        # r0 U1 + sigma0 U2 also keeps f gdot - fdot g = 1, i.e. the state on the
+        # orbit (a long parabolic step turned the eccentricity vector by 1.5e-13
+        # rad with tau - U3 alone).  Radial orbits (pp = 0) keep tau - U3, which
+        # measured better through the collision.
+        dchi_err = EPS * (abs(chi1) + abs(chi0))
+        if pp > 0.0 and _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):
+            g = (r0 * u1 + sigma0 * u2) / smu
+        else:
+            g = (tau - u3) / smu
     else:
-        chi, _t, r, _u0, u1, u2, _u3 = _solve_uv(tau, r0, sigma0, alpha)
+        chi, _t, r, _u0, u1, u2, u3 = _solve_uv(tau, r0, sigma0, alpha)
         if not math.isfinite(chi):
             return nan, nan, nan, nan, nan, nan
-        g = (r0 * u1 + sigma0 * u2) / smu
+        # g = (r0 U1 + sigma0 U2)/sqrt(mu) = (tau - U3)/sqrt(mu): the last-bit
+        # error of chi moves the first by (r - U2) dchi, the second by U2 dchi;
+        # take the smaller (on a fast hyperbola U3 << tau: g ~ dt exactly; the
+        # step r = (1, 0, 0), v = (0, 1e5, 0), dt = 1.234567 went from 54 ulp to 0.2)
+        if pp > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
+            g = (tau - u3) / smu
+        else:
+            g = (r0 * u1 + sigma0 * u2) / smu
     if not (r > 0.0) or not math.isfinite(r):
         return nan, nan, nan, nan, nan, nan
     f = 1.0 - u2 / r0
