@@ -385,3 +385,24 @@ def test_from_state_bad_input():
     with pytest.raises(u.UnitConversionError):
         KeplerOrbit.from_state([1.0, 0, 0] * u.s, [0, 1.0, 0] * u.km / u.s,
                                1.0 * u.km**3 / u.s**2)
+
+
+def test_time_since_periapsis_near_parabolic_and_near_periapsis():
+    """Issue 7 item 9: near e = 1 *and* near periapsis r.v cancels (r is nearly
+    perpendicular to v) and the time since periapsis was up to 152 eps off the
+    50-digit evaluation of the same float state (46 eps reported); with r.v
+    compensated it is within the documented 16 eps (measured <= 14 eps over
+    2000 random states, 1 - e = +-1e-15 ... 1e-2)."""
+    rng = np.random.default_rng(20261123)
+    worst = 0.0
+    cases = [(-1.56e-14, -0.0010), (-4.07e-08, -0.0012), (-2.64e-10, 0.0045)]
+    for _ in range(60):
+        delta = rng.choice([-1.0, 1.0]) * 10 ** rng.uniform(-15, -2)
+        lim = math.pi if delta < 0 else math.acos(-1 / (1 + delta))
+        cases.append((delta, rng.uniform(-1, 1) * 0.95 * lim * 10 ** rng.uniform(-3, 0)))
+    for delta, nu in cases:
+        r, v = perifocal_state(1.3, 1.0 + delta, 0.4, 1.1, 2.3, nu, 0.8)
+        o = KeplerOrbit.from_state(r, v, 0.8)
+        ref = _time_since_periapsis_mp(r, v, 0.8)
+        worst = max(worst, abs(o.time_since_periapsis - ref) / abs(ref))
+    assert worst <= 16 * EPS

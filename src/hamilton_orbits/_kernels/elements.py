@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit, prange
 
 from hamilton_orbits._kernels.kepler import (
+    _two_prod,
     anomaly_from_nu,
     mean_from_anomaly,
     nu_from_anomaly,
@@ -167,6 +168,25 @@ def _hyperbolic_anomaly(sn, cn, e, em1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _dot3_compensated(ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
+    """``a.b`` as if computed in twice the working precision (Ogita, Rump and
+    Oishi, SIAM J. Sci. Comput. 26 (2005), algorithm Dot2): exact products by
+    Dekker's splitting, TwoSum of the products, then the errors added.  Near
+    periapsis r.v cancels (r is nearly perpendicular to v); this keeps its
+    relative accuracy."""
+    p1, e1 = _two_prod(ax, bx)
+    p2, e2 = _two_prod(ay, by)
+    p3, e3 = _two_prod(az, bz)
+    s = p1 + p2
+    z = s - p1
+    t = (p1 - (s - z)) + (p2 - z)
+    s2 = s + p3
+    z = s2 - s
+    t += (s - (s2 - z)) + (p3 - z)
+    return s2 + (t + (e1 + e2 + e3))
+
+
+@njit(cache=True)
 def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
     """Elements of one state; returns the tuple of ``COLUMNS``.
 
@@ -181,7 +201,10 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     r2 = rx * rx + ry * ry + rz * rz
     r = math.sqrt(r2)
     v2 = vx * vx + vy * vy + vz * vz
-    rv = rx * vx + ry * vy + rz * vz
+    if accurate:  # the time since periapsis: r.v to full relative precision
+        rv = _dot3_compensated(rx, ry, rz, vx, vy, vz)
+    else:
+        rv = rx * vx + ry * vy + rz * vz
     hx = ry * vz - rz * vy
     hy = rz * vx - rx * vz
     hz = rx * vy - ry * vx
