@@ -453,7 +453,41 @@ class KeplerOrbit:
         return KeplerOrbit(self._r[key], self._v[key], self._mu[key], self._quantity)
 
     def __repr__(self) -> str:
-        return f"KeplerOrbit(shape={self.shape})"
+        """One orbit: its elements (with units if built from Quantities; angles
+        then in degrees); a batch: its shape and the range of each element.
+
+        Examples
+        --------
+        >>> KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+        KeplerOrbit(a=1.785714, e=0.44, inc=0, lan=0, argp=0, nu=0, mu=1)
+        >>> KeplerOrbit.from_elements(a=7000 * u.km, e=0.01, inc=98 * u.deg, lan=10 * u.deg,
+        ...                           argp=20 * u.deg, nu=30 * u.deg,
+        ...                           mu=398600.4418 * u.km**3 / u.s**2)
+        KeplerOrbit(a=7000 km, e=0.01, inc=98 deg, lan=10 deg, argp=20 deg, nu=30 deg, mu=398600.4 km3 / s2)
+        >>> KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.0, 0], 1.0)
+        KeplerOrbit(shape=(2,), a in [1, 3], e in [0, 0.5], inc in [0, 0], lan in [0, 0], argp in [0, 0], nu in [0, 0], mu in [1, 1])
+        """  # noqa: E501
+        if 0 in self.shape:
+            return f"KeplerOrbit(shape={self.shape})"
+        el = self._elements
+        inv = el[..., _COL["inv_a"]]
+        a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
+        q = el[..., _COL["p"]] / (1.0 + el[..., _COL["e"]])
+        length = "q" if np.all(inv == 0) else "a"
+        cols = [(length, q if length == "q" else a, str(_L)), ("e", el[..., _COL["e"]], "")]
+        scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
+        for name in ("inc", "lan", "argp", "nu"):
+            cols.append((name, el[..., _COL[name]] * scale, aunit))
+        cols.append(("mu", self._mu, str(_MU)))
+        parts = []
+        for name, x, unit in cols:
+            unit = f" {unit}" if (unit and self._quantity) else ""
+            if not self.shape:
+                parts.append(f"{name}={float(x):.7g}{unit}")
+            else:
+                parts.append(f"{name} in [{np.min(x):.7g}, {np.max(x):.7g}]{unit}")
+        head = "" if not self.shape else f"shape={self.shape}, "
+        return f"KeplerOrbit({head}{', '.join(parts)})"
 
     @property
     def mu(self):

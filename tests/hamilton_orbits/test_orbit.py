@@ -406,3 +406,28 @@ def test_time_since_periapsis_near_parabolic_and_near_periapsis():
         ref = _time_since_periapsis_mp(r, v, 0.8)
         worst = max(worst, abs(o.time_since_periapsis - ref) / abs(ref))
     assert worst <= 16 * EPS
+
+
+def test_repr_single_and_batch():
+    """Issue 7 item 14: print(orbit) showed only KeplerOrbit(shape=())."""
+    import astropy.units as u
+
+    o = KeplerOrbit.from_elements(a=7000 * u.km, e=0.01, inc=98 * u.deg, lan=10 * u.deg,
+                                  argp=20 * u.deg, nu=30 * u.deg,
+                                  mu=398600.4418 * u.km**3 / u.s**2)
+    text = repr(o)
+    for part in ("a=7000 km", "e=0.01", "inc=98 deg", "lan=10 deg", "argp=20 deg",
+                 "nu=30 deg", "mu=398600.4 km3 / s2"):
+        assert part in text
+    assert str(o) == text
+    plain = KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    assert repr(plain) == "KeplerOrbit(a=1.785714, e=0.44, inc=0, lan=0, argp=0, nu=0, mu=1)"
+    # the parabola has no finite a: its periapsis distance is shown
+    assert "q=0.5, e=1," in repr(KeplerOrbit.from_state([0.5, 0, 0], [0, 2.0, 0], 1.0))
+    batch = KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0], [3.0, 0, 0]], [0, 1.0, 0], 1.0)
+    text = repr(batch)
+    assert text.startswith("KeplerOrbit(shape=(3,), a in [")
+    # r = 1, 1.5, 3 at v = 1 (mu = 1): e = r v^2 - 1 = 0, 0.5, 2; a = r/(2 - r) = 1, 3, -3
+    assert "a in [-3, 3], e in [0, 2]" in text and "mu in [1, 1]" in text
+    assert repr(batch[:0]) == "KeplerOrbit(shape=(0,))"
+    assert "e=1" in repr(KeplerOrbit.from_state([1.0, 0, 0], [0.5, 0, 0], 1.0))  # radial
