@@ -46,6 +46,32 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
 
 
+def _in_range(method):
+    """A conic formula evaluated without floating-point warnings; a NaN or an
+    infinity the formula does not document (a parabola's r') means the value is
+    beyond float64 for this input: ValueError naming the argument."""
+
+    def guarded(self, x):
+        with np.errstate(all="ignore"):
+            out = method(self, x)
+        for part in out if isinstance(out, tuple) else (out,):
+            raw = part.value if isinstance(part, u.Quantity) else np.asarray(part)
+            ok = np.isfinite(raw)
+            if method.__name__ == "second_focal_distance":
+                ok |= np.isposinf(raw) & np.broadcast_to(self._inv_a == 0, raw.shape)
+            if not np.all(ok):
+                arg = "nu" if method.__name__ == "radius" else "r"
+                raise ValueError(
+                    f"Expected `{arg}` for which `{method.__name__}` fits in float64, "
+                    f"got {np.asarray(x).tolist() if not isinstance(x, u.Quantity) else x}"
+                )
+        return out
+
+    guarded.__name__ = method.__name__
+    guarded.__doc__ = method.__doc__
+    return guarded
+
+
 class Conic:
     """Hamilton's conic section, vectorised over leading dimensions.
 
@@ -198,6 +224,7 @@ class Conic:
         return self._out(np.where(self.e == 0, np.inf, self._p / safe), _L)
 
     # ------------------------------------------------------ at a point
+    @_in_range
     def radius(self, nu: Any) -> np.ndarray:
         """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20).
 
@@ -260,6 +287,7 @@ class Conic:
         # >= 0 on the conic; a rounding-level excursion beyond the apoapsis is 0
         return np.maximum(r * (2.0 - r * self._inv_a), 0.0)
 
+    @_in_range
     def focal_half_chord(self, r: Any) -> np.ndarray:
         """C = r r'/a = r (2 - r/a) (eq. 63), at focal distance ``r`` (``q <= r <= Q``).
 
@@ -275,23 +303,27 @@ class Conic:
         """
         return self._out(self._chord(self._on_conic(self._in("r", r, _L))), _L)
 
+    @_in_range
     def second_focal_distance(self, r: Any) -> np.ndarray:
         """``r' = 2a - r`` (eq. 53): negative for the hyperbola, inf for the parabola."""
         r = self._on_conic(self._in("r", r, _L))
         safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
         return self._out(np.where(self._inv_a == 0, np.inf, 2.0 / safe - r), _L)
 
+    @_in_range
     def normal_length(self, r: Any) -> np.ndarray:
         """N = sqrt(p r r'/a) (eq. 65), the normal between the curve and the axis."""
         c = self._chord(self._on_conic(self._in("r", r, _L)))
         return self._out(np.sqrt(self._p * c), _L)
 
+    @_in_range
     def radius_of_curvature(self, r: Any) -> np.ndarray:
         """R = C^2 / N = C sqrt(C / p) (eqs. 63-64); ``q <= r <= Q`` and ``p > 0``."""
         c = self._chord(self._on_conic(self._in("r", r, _L)))
         self._require_areal("radius_of_curvature")
         return self._out(c * np.sqrt(c / self._p), _L)
 
+    @_in_range
     def radial_speed_squared(self, r: Any) -> np.ndarray:
         """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66), at ``q <= r <= Q``."""
         r = self._on_conic(self._in("r", r, _L))
@@ -305,6 +337,7 @@ class Conic:
                 "orbit (p = 0: the conic is a segment of a line)"
             )
 
+    @_in_range
     def hodograph(self, r: Any) -> tuple[np.ndarray, np.ndarray]:
         """Hamilton's decomposition of the velocity at position ``r`` (after eq. 65).
 

@@ -181,7 +181,8 @@ def mean_anomaly(anomaly: Any, e: Any):
     (0.0, True)
     """
     xa, ea, quantity = _angle_pair("anomaly", anomaly, e)
-    out = np.asarray(_k.mean_from_anomaly_ufunc(xa, ea), dtype=np.float64)
+    with np.errstate(over="ignore"):  # e sinh F beyond float64: refused below
+        out = np.asarray(_k.mean_from_anomaly_ufunc(xa, ea), dtype=np.float64)
     if not np.all(np.isfinite(out)):
         i = int(np.flatnonzero(~np.isfinite(out).ravel())[0])
         raise ValueError(
@@ -370,6 +371,15 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
         if not np.any(rb[bad]):
             raise ValueError(
                 f"Expected `r` nonzero, got {rb[bad].tolist()!r}{_index(lead, bad)}"
+            )
+        # |r| |v|^2 / mu (~ e) beyond the kernels' range, or a state beyond float64
+        big_r = float(np.max(np.abs(rb[bad])))
+        big_v = float(np.max(np.abs(vb[bad])))
+        if math.log2(big_r) + 2 * math.log2(max(big_v, 1e-300)) - math.log2(mub[bad]) > 440:
+            raise ValueError(
+                f"Expected `v` with |r| |v|^2 / mu (~ e) below 2^450 ~ 3e135, got "
+                f"r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, mu={mub[bad]!r}"
+                f"{_index(lead, bad)}"
             )
         raise ConvergenceError(
             f"propagate failed for r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, "

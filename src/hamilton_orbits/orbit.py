@@ -149,6 +149,44 @@ def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     return None if bad else (r_out, v_out, mu_out)
 
 
+def _in_range(prop):
+    """Derived attribute computed without floating-point warnings; a NaN, or an
+    infinity where the attribute is not documented to be infinite (``a`` of a
+    parabola, ``period`` of an unbound orbit, ``n`` of a radial parabola), means
+    the value is beyond the float64 range for this state and raises ValueError
+    naming ``r``, ``v``, ``mu``."""
+    name = prop.__name__
+
+    def guarded(self):
+        with np.errstate(all="ignore"):
+            value = prop(self)
+        raw = value.value if isinstance(value, u.Quantity) else np.asarray(value)
+        finite = np.isfinite(raw)
+        if not np.all(finite):
+            kind = self._col("kind")
+            allowed = {
+                "a": (kind == _el.PARABOLA) | (kind == _el.RADIAL_PARABOLA),
+                "period": ~((kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)),
+                "n": kind == _el.RADIAL_PARABOLA,
+            }.get(name, np.zeros(kind.shape, dtype=bool))
+            if raw.ndim > kind.ndim:
+                allowed = allowed[..., None]
+            bad = ~finite & ~(np.isinf(raw) & allowed)
+            if np.any(bad):
+                i = _first_index(np.atleast_1d(bad))[: kind.ndim] if kind.ndim else ()
+                r, v = self._r[i], self._v[i]
+                raise ValueError(
+                    f"Expected `r`, `v`, `mu` for which `{name}` fits in float64, got "
+                    f"r={r.tolist()}, v={v.tolist()}, mu={float(self._mu[i])!r}"
+                    f"{_fmt_index(i)}"
+                )
+        return value
+
+    guarded.__name__ = name
+    guarded.__doc__ = prop.__doc__
+    return guarded
+
+
 class KeplerOrbit:
     """Two-body (Kepler) orbits, vectorised over leading dimensions.
 
@@ -426,6 +464,7 @@ class KeplerOrbit:
         flat_mu = self._mu.reshape(-1)
         out = np.empty((flat_r.shape[0], _el.NCOL))
         _el.state_to_elements(flat_r, flat_v, flat_mu, out)
+        _refuse_beyond_range(out, flat_r, flat_v, flat_mu, self._mu.shape)
         return out.reshape((*self._mu.shape, _el.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
@@ -509,6 +548,7 @@ class KeplerOrbit:
         return self._col("inv_a")
 
     @property
+    @_in_range
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
         inv = self._inv_a
@@ -569,11 +609,13 @@ class KeplerOrbit:
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
 
     @property
+    @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
         return self._out(self._n, _RAD / _T)
 
     @property
+    @_in_range
     def period(self):
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
         kind = self._col("kind")
@@ -582,6 +624,7 @@ class KeplerOrbit:
         return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
 
     @property
+    @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
         return self._out(-0.5 * self._mu * self._inv_a, _V**2)
@@ -593,6 +636,7 @@ class KeplerOrbit:
         flat_mu = self._mu.reshape(-1)
         out = np.empty(flat_r.shape[0])
         _el.state_to_time_since_periapsis(flat_r, flat_v, flat_mu, out)
+        _refuse_beyond_range(out[:, None], flat_r, flat_v, flat_mu, self._mu.shape)
         return out.reshape(self._mu.shape)
 
     @property
@@ -638,16 +682,19 @@ class KeplerOrbit:
         return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
 
     @property
+    @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
         return self._out(np.cross(self._r, self._v), _L * _V)
 
     @property
+    @_in_range
     def eccentricity_vector(self):
         """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
         return self._out(_ecc_vector(self._r, self._v, self._mu), None)
 
     @property
+    @_in_range
     def hamilton_epsilon(self):
         """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
         return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
@@ -697,6 +744,25 @@ class KeplerOrbit:
         from hamilton_orbits.conic import Conic
 
         return Conic._from_orbit(self)
+
+
+def _refuse_beyond_range(out, r, v, mu, shape) -> None:
+    """Raise if a kernel row is not finite: the state's elements do not fit in
+    float64 (``|r| |v|^2 / mu``, ~e, beyond 2^450, or ``p``, ``1/a`` or the time
+    beyond the float range).  One fast reduction in the common case."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(out.sum()):
+            return
+    rows = ~np.all(np.isfinite(out), axis=-1)
+    if not np.any(rows):
+        return
+    i = int(np.flatnonzero(rows)[0])
+    where = _fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
+    raise ValueError(
+        f"Expected `r`, `v`, `mu` whose elements fit in float64 (|r| |v|^2 / mu ~ e below "
+        f"2^450 ~ 3e135, p and a below 1e308), got r={r[i].tolist()}, v={v[i].tolist()}, "
+        f"mu={float(mu[i])!r}{where}"
+    )
 
 
 def _wrap2pi(x: np.ndarray) -> np.ndarray:
@@ -750,6 +816,19 @@ def _hamilton_args(r: Any, v: Any, *mu: Any):
     return r_, v_, mu_, quantity
 
 
+def _finite_or_raise(f, r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``f(r, v)`` without floating-point warnings; a result beyond float64
+    raises ValueError naming ``r`` and ``v``."""
+    with np.errstate(all="ignore"):
+        out = np.asarray(f(r, v))
+    if not np.all(np.isfinite(out)):
+        raise ValueError(
+            f"Expected `r`, `v` (and `mu`) for which Hamilton's {f.__name__.split('_')[0]} "
+            f"fits in float64, got r={r.tolist()}, v={v.tolist()}"
+        )
+    return out
+
+
 def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
     alpha = Quaternion.from_vector(r)
     dalpha = Quaternion.from_vector(v)
@@ -789,7 +868,7 @@ def hamilton_beta(r: Any, v: Any):
     <Quantity [0., 0., 2.] km2 / s>
     """
     r_, v_, _, quantity = _hamilton_args(r, v)
-    return wrap(_beta(r_, v_), _L * _V, quantity)
+    return wrap(_finite_or_raise(_beta, r_, v_), _L * _V, quantity)
 
 
 def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
@@ -834,11 +913,13 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
     if np.any(tiny_or_huge):
         rs = r_ / big[..., None]
         rn = np.where(tiny_or_huge, big * np.sqrt(np.einsum("...i,...i->...", rs, rs)), rn)
-    iota = Quaternion.from_vector(r_ / rn[..., None])
-    dalpha = Quaternion.from_vector(v_)
-    beta = Quaternion.from_vector(_beta(r_, v_))
-    eps = iota - (dalpha * beta) * (1.0 / mu_)
-    return wrap(eps.vector, u.dimensionless_unscaled, quantity)
+    def eps_of(r_, v_):
+        iota = Quaternion.from_vector(r_ / rn[..., None])
+        dalpha = Quaternion.from_vector(v_)
+        beta = Quaternion.from_vector(_beta(r_, v_))
+        return (iota - (dalpha * beta) * (1.0 / mu_)).vector
+
+    return wrap(_finite_or_raise(eps_of, r_, v_), u.dimensionless_unscaled, quantity)
 
 
 def hamilton_p(r: Any, v: Any, mu: Any):
@@ -860,5 +941,9 @@ def hamilton_p(r: Any, v: Any, mu: Any):
     1.44
     """
     r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
-    beta = Quaternion.from_vector(_beta(r_, v_))
-    return wrap(-(beta * beta).scalar / mu_, _L, quantity)
+
+    def p_of(r_, v_):
+        beta = Quaternion.from_vector(_beta(r_, v_))
+        return -(beta * beta).scalar / mu_
+
+    return wrap(_finite_or_raise(p_of, r_, v_), _L, quantity)

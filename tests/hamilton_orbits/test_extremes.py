@@ -214,3 +214,28 @@ def test_representation_limit_near_the_asymptote():
     # with M the orbit is rebuilt; its position agrees to the precision the state fixes
     r2, _ = KeplerOrbit.from_elements(M=o.M, **el).state()
     assert np.linalg.norm(r2 - r) <= 8 * EPS * kappa * np.linalg.norm(r)
+
+
+def test_contract_regressions_found_by_the_property_test():
+    """Examples hypothesis found (test_api_contract.py), kept as named cases."""
+    from hamilton_orbits.kepler import anomaly_from_true, mean_anomaly, propagate
+
+    # nearly radial, back through the collision: q^3 underflowed to a division by zero
+    r, v = propagate([-1.0, -1e-54, -1e-54], [-1.0, -1e-54, -1e-55], 1.0, -1.0)
+    assert np.all(np.isfinite(r)) and np.all(np.isfinite(v))
+    # e = 1e254: Halley's fp^2 overflowed; F = M/(e - 1) to first order
+    assert solve_kepler(-1e-50, 1e254) == pytest.approx(-1e-50 / 1e254, rel=4 * EPS)
+    with pytest.raises(ValueError, match="`anomaly` small enough"):
+        mean_anomaly(-1000.0, 2.0)  # e sinh F beyond float64
+    with pytest.raises(ValueError, match="`nu` inside the asymptotes"):
+        anomaly_from_true(-1e20, 1.0)
+    # |r| |v|^2 / mu ~ e = 1e155: e^2 does not fit; refused by name, not NaN
+    o = KeplerOrbit.from_state([1e51, 0, 0], [0, 0, 1e52], 1.0)
+    with pytest.raises(ValueError, match=r"`r`, `v`, `mu` whose elements fit in float64"):
+        _ = o.e
+    with pytest.raises(ValueError, match=r"`v` with \|r\| \|v\|\^2 / mu"):
+        propagate([1e51, 0, 0], [0, 0, 1e52], 1.0, 1.0)
+    # an energy beyond float64 is refused by name (the state itself is fine)
+    o = KeplerOrbit.from_state([1.0, 0, 0], [0, 1e160, 0], 1e300)  # e ~ 1e20, v^2 ~ 1e320
+    with pytest.raises(ValueError, match="`energy` fits in float64"):
+        _ = o.energy

@@ -378,7 +378,10 @@ def state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pra
     """:func:`state_to_elements_one` on the state scaled to order 1
     (:func:`hamilton_orbits._kernels.kepler.state_scales`): ``p``, ``inv_a`` and
     the time are scaled back exactly, every other column is scale-free."""
-    er, ev = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    if not ok:  # e beyond 2^MAX_E_EXPONENT: NaN row, refused by the caller
+        nan = math.nan
+        return nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
         return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate)
     p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau = state_to_elements_one(

@@ -113,6 +113,8 @@ def mean_from_anomaly(anom, e):  # pragma: no cover - compiled
     ``M = D + D^3/3``; hyperbolic ``M = (e-1) sinh F + (sinh F - F)``.
     """
     if e < 1.0:
+        if abs(anom) >= 9007199254740992.0:  # 2^53: |M - E| <= e < 1 <= half a spacing
+            return anom
         k, r = _reduce_2pi(anom)
         m = (1.0 - e) * r + e * x_minus_sin(r)
         if k == 0.0:
@@ -132,6 +134,12 @@ def anomaly_from_nu(nu, e):  # pragma: no cover - compiled
     ``tanh(F/2) = sqrt((e-1)/(e+1)) tan(nu/2)``.  For ``e >= 1`` a ``nu`` beyond
     the asymptote (``1 + e cos nu <= 0``) gives NaN.
     """
+    if e >= 1.0 and not abs(nu) < 9007199254740992.0:
+        return math.nan  # no open orbit's nu is resolved beyond 2^53 (refused)
+    if e < 1.0 and abs(nu) >= 9007199254740992.0:
+        # beyond 2^53 the floats are >= 2 apart: no revolution can be resolved and
+        # E (within pi of nu, same revolution) is nu to the input's precision
+        return nu
     k, r = _reduce_2pi(nu)
     h = 0.5 * r
     if e < 1.0:
@@ -163,6 +171,8 @@ def nu_from_anomaly(anom, e):  # pragma: no cover - compiled
     (no overflow for any finite F).
     """
     if e < 1.0:
+        if abs(anom) >= 9007199254740992.0:  # 2^53: as in anomaly_from_nu
+            return anom
         k, r = _reduce_2pi(anom)
         h = 0.5 * r
         a = 2.0 * math.atan2(math.sqrt(1.0 + e) * math.sin(h), math.sqrt(1.0 - e) * math.cos(h))
@@ -297,6 +307,10 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
             return x
         fp = em + 2.0 * e * sh * sh
         fpp = e * sx
+        if e > 1e100:  # f / e has the same root and Halley step; fp^2 cannot overflow
+            f /= e
+            fp /= e
+            fpp /= e
         xn, a, b, done = _halley_step(x, xp, f, fp, fpp, a, b)
         if done:
             return xn
@@ -481,10 +495,10 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
         big = math.inf
     # first guess: second-order Taylor series for short steps, otherwise the
     # mean-motion guess (elliptic) or a logarithmic one (hyperbolic)
-    if r0 > 0.0:
+    if r0 * r0 * r0 > 0.0:
         x = tau / r0 - sigma0 * tau * tau / (2.0 * r0 * r0 * r0)
         x1 = tau / r0
-    else:  # radial orbit anchored at the collision: T ~ chi^3/6
+    else:  # (near-)radial orbit anchored at the collision: T ~ chi^3/6
         x1 = sgn * (6.0 * abs(tau)) ** (1.0 / 3.0)
         x = x1
     if alpha > 0.0:
@@ -694,42 +708,55 @@ _SAFE_LO = 1e-50
 _SAFE_HI = 1e50
 
 
+# The kernels square e (1 - e^2 = p / a): |r| |v|^2 / mu ~ e must stay below
+# 2^450 ~ 3e135 so that e^2 and its companions fit in the float range.
+MAX_E_EXPONENT = 450
+
+
 @njit(cache=True)
 def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
-    """Exponents ``(er, ev)`` of the powers of two that bring ``(r, v, mu)`` to order 1.
+    """Exponents ``(er, ev, ok)`` of the powers of two that bring ``(r, v, mu)`` to order 1.
 
     Two-body motion is homogeneous: ``r -> r / 2^er``, ``v -> v / 2^ev``,
     ``mu -> mu / 2^(er + 2 ev)``, ``t -> t 2^(ev - er)`` leave every angle, the
     eccentricity and the anomalies unchanged, so a kernel can work on the scaled
     state and scale lengths, speeds and times back exactly (powers of two).
     ``er`` makes ``|r| ~ 1``; ``ev`` makes ``|v| ~ 1`` unless ``mu`` would then
-    leave 2^(+-400) (a state nearly at rest, or extremely hyperbolic), in which
-    case ``mu ~ 1``.  ``(0, 0)`` when every magnitude lies in [1e-50, 1e50]
-    already (the common case: no scaling, bit for bit the unscaled kernels).
+    leave 2^(+-400) (a state nearly at rest), in which case ``mu ~ 1``.
+    ``(0, 0, True)`` when every magnitude lies in [1e-50, 1e50] and
+    ``|r| |v|^2 / mu < 1e60`` already (the common case: no scaling, bit for bit
+    the unscaled kernels).  ``ok`` is False when ``|r| |v|^2 / mu`` (~ e, the
+    one dimensionless number of the state) exceeds 2^MAX_E_EXPONENT.
     """
     mr = max(abs(rx), abs(ry), abs(rz))
     mv = max(abs(vx), abs(vy), abs(vz))
     if (
         _SAFE_LO < mr < _SAFE_HI and _SAFE_LO < mu < _SAFE_HI
-        and (_SAFE_LO < mv < _SAFE_HI or mv == 0.0)
+        and (_SAFE_LO < mv < _SAFE_HI or mv == 0.0) and mr * mv * mv < 1e60 * mu
     ):
-        return 0, 0
+        return 0, 0, True
     er = math.frexp(mr)[1]
     emu = math.frexp(mu)[1]
     ev_mu = (emu - er) // 2
     if mv == 0.0:
-        return er, ev_mu
+        return er, ev_mu, True
     ev = math.frexp(mv)[1]
-    if abs(emu - er - 2 * ev) > 400:
+    eq = er + 2 * ev - emu  # exponent of |r| |v|^2 / mu
+    if eq > MAX_E_EXPONENT:
+        return er, ev, False
+    if eq < -400:
         ev = ev_mu
-    return er, ev
+    return er, ev, True
 
 
 @njit(cache=True)
 def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
     so that no intermediate product overflows or underflows."""
-    er, ev = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    if not ok:
+        nan = math.nan
+        return nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
         return propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt)
     x, y, z, a, b, c = propagate_uv(
