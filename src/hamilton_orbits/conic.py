@@ -26,6 +26,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import astropy.units as u
@@ -51,9 +52,11 @@ def _in_range(method):
     infinity the formula does not document (a parabola's r') means the value is
     beyond float64 for this input: ValueError naming the argument."""
 
-    def guarded(self, x):
+    @functools.wraps(method)
+    def guarded(self, *args, **kwargs):
+        x = args[0] if args else next(iter(kwargs.values()), None)
         with np.errstate(all="ignore"):
-            out = method(self, x)
+            out = method(self, *args, **kwargs)
         for part in out if isinstance(out, tuple) else (out,):
             raw = part.value if isinstance(part, u.Quantity) else np.asarray(part)
             ok = np.isfinite(raw)
@@ -67,8 +70,6 @@ def _in_range(method):
                 )
         return out
 
-    guarded.__name__ = method.__name__
-    guarded.__doc__ = method.__doc__
     return guarded
 
 

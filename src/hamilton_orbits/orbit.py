@@ -23,6 +23,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 
 from __future__ import annotations
 
+import functools
 from functools import cached_property
 from typing import Any
 
@@ -157,6 +158,7 @@ def _in_range(prop):
     naming ``r``, ``v``, ``mu``."""
     name = prop.__name__
 
+    @functools.wraps(prop)
     def guarded(self):
         with np.errstate(all="ignore"):
             value = prop(self)
@@ -182,8 +184,6 @@ def _in_range(prop):
                 )
         return value
 
-    guarded.__name__ = name
-    guarded.__doc__ = prop.__doc__
     return guarded
 
 
