@@ -55,8 +55,15 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
         raise ValueError(f"Expected `{name}` to be numeric, got None")
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
+    if value is None:  # np.asarray(None, float) is a silent NaN
+        raise ValueError(f"Expected `{name}` to be numeric, got None")
     try:
         arr = np.asarray(value, dtype=np.float64)
+    except OverflowError as exc:  # a Python int beyond the float64 range
+        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+        raise ValueError(
+            f"Expected `{name}` to be finite (within the float64 range), got {shown}"
+        ) from exc
     except (TypeError, ValueError) as exc:
         raise ValueError(f"Expected `{name}` to be numeric, got {value!r}") from exc
     if finite:

@@ -26,13 +26,14 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import check_trailing
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits._validation import _first_index, _fmt_index, check_trailing
+from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 
 __all__ = ["Conic"]
 
@@ -44,6 +45,32 @@ _V = u.km / u.s
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
+
+
+def _in_range(method):
+    """A conic formula evaluated without floating-point warnings; a NaN or an
+    infinity the formula does not document (a parabola's r') means the value is
+    beyond float64 for this input: ValueError naming the argument."""
+
+    @functools.wraps(method)
+    def guarded(self, *args, **kwargs):
+        x = args[0] if args else next(iter(kwargs.values()), None)
+        with np.errstate(all="ignore"):
+            out = method(self, *args, **kwargs)
+        for part in out if isinstance(out, tuple) else (out,):
+            raw = part.value if isinstance(part, u.Quantity) else np.asarray(part)
+            ok = np.isfinite(raw)
+            if method.__name__ == "second_focal_distance":
+                ok |= np.isposinf(raw) & np.broadcast_to(self._inv_a == 0, raw.shape)
+            if not np.all(ok):
+                arg = "nu" if method.__name__ == "radius" else "r"
+                raise ValueError(
+                    f"Expected `{arg}` for which `{method.__name__}` fits in float64, "
+                    f"got {np.asarray(x).tolist() if not isinstance(x, u.Quantity) else x}"
+                )
+        return out
+
+    return guarded
 
 
 class Conic:
@@ -99,7 +126,7 @@ class Conic:
                 f"Expected `{name}` as {kind} like the orbit this conic came from, "
                 f"got {type(value).__name__}"
             )
-        return strip(name, value, unit)
+        return LENGTH(name, value, unit)
 
     def _out(self, value: np.ndarray, unit: u.UnitBase):
         return wrap(value, unit, self._quantity)
@@ -198,38 +225,120 @@ class Conic:
         return self._out(np.where(self.e == 0, np.inf, self._p / safe), _L)
 
     # ------------------------------------------------------ at a point
+    @_in_range
     def radius(self, nu: Any) -> np.ndarray:
-        """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20)."""
-        nu = strip("nu", nu, u.rad)
-        return self._out(self._p / (1.0 + self.e * np.cos(nu)), _L)
+        """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20).
+
+        Parameters
+        ----------
+        nu : array_like or Quantity (angle)
+            True anomaly; for an open conic strictly inside the asymptotes,
+            ``|nu| < arccos(-1/e)`` (``|nu| < pi`` for the parabola).
+
+        Raises
+        ------
+        ValueError
+            For ``nu`` on or beyond an asymptote, naming the value and the range.
+
+        Examples
+        --------
+        >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+        >>> round(float(c.radius(np.pi)), 12)  # apoapsis p / (1 - e)
+        2.571428571429
+        >>> Conic.from_state([1.0, 0, 0], [0, 2.0, 0], 1.0).radius(np.pi)
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = 1.910633 rad (e = 3.0), got 3.141592653589793
+        """  # noqa: E501
+        nu = ANGLE("nu", nu)
+        den = 1.0 + self.e * np.cos(nu)
+        bad = ~(den > 0.0)
+        if np.any(bad):
+            e_b = np.broadcast_to(self.e, bad.shape)
+            nu_b = np.broadcast_to(nu, bad.shape)
+            i = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            e_i = float(e_b[i])
+            lim = np.arccos(-1.0 / e_i) if e_i > 0 else np.pi
+            raise ValueError(
+                f"Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = {lim:.7g} rad "
+                f"(e = {e_i!r}), got {float(nu_b[i])!r}{_fmt_index(i)}"
+            )
+        return self._out(self._p / den, _L)
+
+    def _on_conic(self, r: np.ndarray) -> np.ndarray:
+        """Refuse a focal distance off the conic: ``q <= r <= Q`` (periapsis and
+        apoapsis distances; ``Q = inf`` for open conics), to 16 eps of rounding."""
+        q = self._p / (1.0 + self.e)
+        safe = np.where(self._inv_a > 0, self._inv_a, 1.0)
+        big = np.where(self._inv_a > 0, 2.0 / safe - q, np.inf)
+        tol = 16.0 * np.finfo(float).eps
+        bad = ~((r >= q * (1.0 - tol)) & (r <= big * (1.0 + tol)) & (r > 0.0))
+        if np.any(bad):
+            q_b, big_b, r_b = np.broadcast_arrays(q, big, r)
+            i = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            unit = f" {_L}" if self._quantity else ""
+            raise ValueError(
+                f"Expected `r` on the conic, q <= r <= Q with the periapsis distance "
+                f"q = {float(q_b[i]):.17g} and the apoapsis distance Q = {float(big_b[i]):.17g}"
+                f"{unit}, got {float(r_b[i])!r}{unit}{_fmt_index(i)}"
+            )
+        return r
 
     def _chord(self, r: np.ndarray) -> np.ndarray:
-        return r * (2.0 - r * self._inv_a)
+        # >= 0 on the conic; a rounding-level excursion beyond the apoapsis is 0
+        return np.maximum(r * (2.0 - r * self._inv_a), 0.0)
 
+    @_in_range
     def focal_half_chord(self, r: Any) -> np.ndarray:
-        """C = r r'/a = r (2 - r/a) (eq. 63), at focal distance ``r``."""
-        return self._out(self._chord(self._in("r", r, _L)), _L)
+        """C = r r'/a = r (2 - r/a) (eq. 63), at focal distance ``r`` (``q <= r <= Q``).
 
+        Examples
+        --------
+        >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+        >>> round(float(c.focal_half_chord(1.0)), 12)
+        1.44
+        >>> c.normal_length(10.0)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `r` on the conic, q <= r <= Q with ..., got 10.0
+        """
+        return self._out(self._chord(self._on_conic(self._in("r", r, _L))), _L)
+
+    @_in_range
     def second_focal_distance(self, r: Any) -> np.ndarray:
         """``r' = 2a - r`` (eq. 53): negative for the hyperbola, inf for the parabola."""
-        r = self._in("r", r, _L)
+        r = self._on_conic(self._in("r", r, _L))
         safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
         return self._out(np.where(self._inv_a == 0, np.inf, 2.0 / safe - r), _L)
 
+    @_in_range
     def normal_length(self, r: Any) -> np.ndarray:
         """N = sqrt(p r r'/a) (eq. 65), the normal between the curve and the axis."""
-        return self._out(np.sqrt(self._p * self._chord(self._in("r", r, _L))), _L)
+        c = self._chord(self._on_conic(self._in("r", r, _L)))
+        return self._out(np.sqrt(self._p * c), _L)
 
+    @_in_range
     def radius_of_curvature(self, r: Any) -> np.ndarray:
-        """R = C^2 / N = C sqrt(C / p) (eqs. 63-64)."""
-        c = self._chord(self._in("r", r, _L))
+        """R = C^2 / N = C sqrt(C / p) (eqs. 63-64); ``q <= r <= Q`` and ``p > 0``."""
+        c = self._chord(self._on_conic(self._in("r", r, _L)))
+        self._require_areal("radius_of_curvature")
         return self._out(c * np.sqrt(c / self._p), _L)
 
+    @_in_range
     def radial_speed_squared(self, r: Any) -> np.ndarray:
-        """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66)."""
-        r = self._in("r", r, _L)
-        return self._out(self._mu * (2.0 / r - self._inv_a - self._p / (r * r)), _V**2)
+        """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66), at ``q <= r <= Q``."""
+        r = self._on_conic(self._in("r", r, _L))
+        w = self._mu * (2.0 / r - self._inv_a - self._p / (r * r))
+        return self._out(np.maximum(w, 0.0), _V**2)  # a rounding-level negative is 0
 
+    def _require_areal(self, what: str) -> None:
+        if np.any(~(self._p > 0)):
+            raise ValueError(
+                f"Expected a conic with angular momentum (p > 0) for `{what}`, got a radial "
+                "orbit (p = 0: the conic is a segment of a line)"
+            )
+
+    @_in_range
     def hodograph(self, r: Any) -> tuple[np.ndarray, np.ndarray]:
         """Hamilton's decomposition of the velocity at position ``r`` (after eq. 65).
 
@@ -252,6 +361,16 @@ class Conic:
         [0.0, 1.2, 0.0]
         """
         r = check_trailing("r", self._in("r", r, _L), 3)
+        nonzero = np.any(r != 0, axis=-1)
+        if not np.all(nonzero):
+            i = _first_index(np.atleast_1d(~nonzero)) if nonzero.ndim else ()
+            raise ValueError(
+                f"Expected `r` a nonzero position (the direction of the radius vector), "
+                f"got {r[i].tolist()}{_fmt_index(i)}"
+            )
+        self._require_areal("hodograph")
+        big = np.max(np.abs(r), axis=-1, keepdims=True)  # |r| without under/overflow
+        r = r / big
         h = np.sqrt(self._mu * self._p)
         k = (self._mu / h)[..., None]
         rhat = r / np.sqrt(_dot(r, r))[..., None]

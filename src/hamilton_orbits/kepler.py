@@ -34,12 +34,11 @@ import numpy as np
 from hamilton_orbits._kernels import kepler as _k
 from hamilton_orbits._validation import (
     ConvergenceError,
-    as_float_array,
     broadcast,
     check_positive,
     check_trailing,
 )
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
 
 __all__ = [
     "ConvergenceError",
@@ -63,8 +62,8 @@ def _angle_pair(
     name: str, x: Any, e: Any
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     quantity = is_quantity(x)
-    xa = strip(name, x, u.rad)
-    ea = strip("e", e, None)
+    xa = ANGLE(name, x)
+    ea = DIMENSIONLESS("e", e)
     check_positive("e", ea, strict=False)
     xa, ea = broadcast((name, "e"), xa, ea)
     return xa, ea, quantity
@@ -182,7 +181,8 @@ def mean_anomaly(anomaly: Any, e: Any):
     (0.0, True)
     """
     xa, ea, quantity = _angle_pair("anomaly", anomaly, e)
-    out = np.asarray(_k.mean_from_anomaly_ufunc(xa, ea), dtype=np.float64)
+    with np.errstate(over="ignore"):  # e sinh F beyond float64: refused below
+        out = np.asarray(_k.mean_from_anomaly_ufunc(xa, ea), dtype=np.float64)
     if not np.all(np.isfinite(out)):
         i = int(np.flatnonzero(~np.isfinite(out).ravel())[0])
         raise ValueError(
@@ -346,15 +346,10 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
         )
     if quantity:
         r_unit, v_unit = r.unit, v.unit
-        ra = strip("r", r, _M)
-        va = strip("v", v, _MS)
-        mua = strip("mu", mu, _MU)
-        dta = strip("dt", dt, u.s)
-    else:
-        ra = as_float_array("r", r)
-        va = as_float_array("v", v)
-        mua = as_float_array("mu", mu)
-        dta = as_float_array("dt", dt)
+    ra = LENGTH("r", r, _M)
+    va = SPEED("v", v, _MS)
+    mua = GM("mu", mu, _MU)
+    dta = TIME("dt", dt, u.s)
     check_trailing("r", ra, 3)
     check_trailing("v", va, 3)
     check_positive("mu", mua)
@@ -376,6 +371,15 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
         if not np.any(rb[bad]):
             raise ValueError(
                 f"Expected `r` nonzero, got {rb[bad].tolist()!r}{_index(lead, bad)}"
+            )
+        # |r| |v|^2 / mu (~ e) beyond the kernels' range, or a state beyond float64
+        big_r = float(np.max(np.abs(rb[bad])))
+        big_v = float(np.max(np.abs(vb[bad])))
+        if math.log2(big_r) + 2 * math.log2(max(big_v, 1e-300)) - math.log2(mub[bad]) > 440:
+            raise ValueError(
+                f"Expected `v` with |r| |v|^2 / mu (~ e) below 2^450 ~ 3e135, got "
+                f"r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, mu={mub[bad]!r}"
+                f"{_index(lead, bad)}"
             )
         raise ConvergenceError(
             f"propagate failed for r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, "

@@ -23,6 +23,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 
 from __future__ import annotations
 
+import functools
 from functools import cached_property
 from typing import Any
 
@@ -36,13 +37,22 @@ from hamilton_orbits._validation import (
     ConvergenceError,
     _first_index,
     _fmt_index,
-    as_float_array,
     broadcast,
     check_positive,
     check_trailing,
 )
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.units import (
+    ANGLE,
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    SPEED,
+    TIME,
+    is_quantity,
+    require_consistent,
+    wrap,
+)
 
 __all__ = [
     "KeplerOrbit",
@@ -85,16 +95,15 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
             "Expected `r`, `v`, `mu` to be all Quantities or all plain floats, got a mix"
         )
     quantity = all(q)
-    r = check_trailing("r", strip("r", r_in, _L), 3)
-    v = check_trailing("v", strip("v", v_in, _V), 3)
-    mu = strip("mu", mu_in, _MU)
+    r = check_trailing("r", LENGTH("r", r_in, _L), 3)
+    v = check_trailing("v", SPEED("v", v_in, _V), 3)
+    mu = GM("mu", mu_in, _MU)
     check_positive("mu", mu)
     lead = broadcast(("r", "v", "mu"), r[..., 0], v[..., 0], mu)[0].shape
     r = np.broadcast_to(r, (*lead, 3))
     v = np.broadcast_to(v, (*lead, 3))
     mu = np.broadcast_to(mu, lead)
-    rn = np.sqrt(np.einsum("...i,...i->...", r, r))
-    bad = ~(rn > 0)
+    bad = ~np.any(r != 0, axis=-1)  # not |r| > 0: |r|^2 underflows at 1e-170
     if np.any(bad):
         index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
         raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{_fmt_index(index)}")
@@ -139,6 +148,43 @@ def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
         r_out.reshape(-1, 3), v_out.reshape(-1, 3), mu_out.reshape(-1),
     )
     return None if bad else (r_out, v_out, mu_out)
+
+
+def _in_range(prop):
+    """Derived attribute computed without floating-point warnings; a NaN, or an
+    infinity where the attribute is not documented to be infinite (``a`` of a
+    parabola, ``period`` of an unbound orbit, ``n`` of a radial parabola), means
+    the value is beyond the float64 range for this state and raises ValueError
+    naming ``r``, ``v``, ``mu``."""
+    name = prop.__name__
+
+    @functools.wraps(prop)
+    def guarded(self):
+        with np.errstate(all="ignore"):
+            value = prop(self)
+        raw = value.value if isinstance(value, u.Quantity) else np.asarray(value)
+        finite = np.isfinite(raw)
+        if not np.all(finite):
+            kind = self._col("kind")
+            allowed = {
+                "a": (kind == _el.PARABOLA) | (kind == _el.RADIAL_PARABOLA),
+                "period": ~((kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)),
+                "n": kind == _el.RADIAL_PARABOLA,
+            }.get(name, np.zeros(kind.shape, dtype=bool))
+            if raw.ndim > kind.ndim:
+                allowed = allowed[..., None]
+            bad = ~finite & ~(np.isinf(raw) & allowed)
+            if np.any(bad):
+                i = _first_index(np.atleast_1d(bad))[: kind.ndim] if kind.ndim else ()
+                r, v = self._r[i], self._v[i]
+                raise ValueError(
+                    f"Expected `r`, `v`, `mu` for which `{name}` fits in float64, got "
+                    f"r={r.tolist()}, v={v.tolist()}, mu={float(self._mu[i])!r}"
+                    f"{_fmt_index(i)}"
+                )
+        return value
+
+    return guarded
 
 
 class KeplerOrbit:
@@ -211,6 +257,38 @@ class KeplerOrbit:
             incompatible shapes, or a mix of Quantities and plain floats.
         astropy.units.UnitConversionError
             For a Quantity of the wrong kind.
+
+        Notes
+        -----
+        The state is the representation; the elements are derived from it.  Any
+        finite state is accepted at any scale (it is brought to order 1 by powers
+        of two inside the kernels, which is exact).
+
+        *Representation limit near a hyperbola's asymptote.*  Far out along an
+        open orbit, ``r`` and ``v`` are nearly parallel and the rounding of the
+        state itself leaves the areal vector ``h = r x v`` uncertain by about
+        ``eps |r| |v| / h`` relative (the condition number; ~1e12 for the
+        example below), and so ``p``, ``e - 1`` and ``nu`` near the asymptote
+        ``nu_inf = arccos(-1/e)``.  The ``(e, nu)`` returned can then lie on or
+        beyond the asymptote of the float ``e`` (``1 + e cos nu <= 0``), a pair
+        that :meth:`from_elements` refuses with ``nu``.  The mean anomaly ``M``
+        stays defined there: rebuild such an orbit with ``M`` (it reproduces the
+        position to the precision the state fixes), or keep the state.
+
+        >>> o = KeplerOrbit.from_state([-1.8881600011099116e16, -9735075058187862.0,
+        ...                             -2032451813774641.8],
+        ...                            [-0.00012134184429701539, -6.256206895793337e-05,
+        ...                             -1.306146996988154e-05], 1.0)
+        >>> bool(1 + o.e * np.cos(o.nu) <= 0)          # on the asymptote of the float e
+        True
+        >>> el = dict(p=o.p, e=o.e, inc=o.inc, lan=o.lan, argp=o.argp, mu=1.0)
+        >>> KeplerOrbit.from_elements(nu=o.nu, **el)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `nu` inside the asymptotes (1 + e cos nu > 0), got 3.14157...
+        >>> r, _ = KeplerOrbit.from_elements(M=o.M, **el).state()
+        >>> bool(np.all(np.isfinite(r)))
+        True
 
         Examples
         --------
@@ -285,6 +363,13 @@ class KeplerOrbit:
         Hamilton's conic ``r = p / (1 + e cos v)`` (eq. 20) with ``p = a (1 - e^2)``
         (eq. 29).
 
+        ``nu`` of an open orbit must satisfy ``1 + e cos nu > 0`` for the float
+        ``e`` given.  Elements read off a state far out along a hyperbola's
+        asymptote may not (the state's rounding leaves ``h = r x v``, hence
+        ``e`` and ``nu``, uncertain there; see :meth:`from_state`): pass ``M``
+        for such orbits.  Lengths and ``mu`` of any magnitude are accepted
+        (scaled to order 1 by powers of two inside the kernel).
+
         Examples
         --------
         >>> o = KeplerOrbit.from_elements(a=1.0, e=0.5, inc=0.0, lan=0.0, argp=0.0,
@@ -310,13 +395,13 @@ class KeplerOrbit:
             raise ValueError(
                 f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
             )
-        e_ = strip("e", e, None)
-        inc_ = strip("inc", inc, _RAD)
-        lan_ = strip("lan", lan, _RAD)
-        argp_ = strip("argp", argp, _RAD)
-        mu_ = strip("mu", mu, _MU)
-        len_ = strip(lname, lval, _L)
-        ang_ = strip(aname, aval, _RAD)
+        e_ = DIMENSIONLESS("e", e)
+        inc_ = ANGLE("inc", inc)
+        lan_ = ANGLE("lan", lan)
+        argp_ = ANGLE("argp", argp)
+        mu_ = GM("mu", mu, _MU)
+        len_ = LENGTH(lname, lval, _L)
+        ang_ = ANGLE(aname, aval)
         e_, inc_, lan_, argp_, mu_, len_, ang_ = broadcast(
             ("e", "inc", "lan", "argp", "mu", lname, aname),
             e_, inc_, lan_, argp_, mu_, len_, ang_,
@@ -379,6 +464,7 @@ class KeplerOrbit:
         flat_mu = self._mu.reshape(-1)
         out = np.empty((flat_r.shape[0], _el.NCOL))
         _el.state_to_elements(flat_r, flat_v, flat_mu, out)
+        _refuse_beyond_range(out, flat_r, flat_v, flat_mu, self._mu.shape)
         return out.reshape((*self._mu.shape, _el.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
@@ -406,7 +492,41 @@ class KeplerOrbit:
         return KeplerOrbit(self._r[key], self._v[key], self._mu[key], self._quantity)
 
     def __repr__(self) -> str:
-        return f"KeplerOrbit(shape={self.shape})"
+        """One orbit: its elements (with units if built from Quantities; angles
+        then in degrees); a batch: its shape and the range of each element.
+
+        Examples
+        --------
+        >>> KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+        KeplerOrbit(a=1.785714, e=0.44, inc=0, lan=0, argp=0, nu=0, mu=1)
+        >>> KeplerOrbit.from_elements(a=7000 * u.km, e=0.01, inc=98 * u.deg, lan=10 * u.deg,
+        ...                           argp=20 * u.deg, nu=30 * u.deg,
+        ...                           mu=398600.4418 * u.km**3 / u.s**2)
+        KeplerOrbit(a=7000 km, e=0.01, inc=98 deg, lan=10 deg, argp=20 deg, nu=30 deg, mu=398600.4 km3 / s2)
+        >>> KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.0, 0], 1.0)
+        KeplerOrbit(shape=(2,), a in [1, 3], e in [0, 0.5], inc in [0, 0], lan in [0, 0], argp in [0, 0], nu in [0, 0], mu in [1, 1])
+        """  # noqa: E501
+        if 0 in self.shape:
+            return f"KeplerOrbit(shape={self.shape})"
+        el = self._elements
+        inv = el[..., _COL["inv_a"]]
+        a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
+        q = el[..., _COL["p"]] / (1.0 + el[..., _COL["e"]])
+        length = "q" if np.all(inv == 0) else "a"
+        cols = [(length, q if length == "q" else a, str(_L)), ("e", el[..., _COL["e"]], "")]
+        scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
+        for name in ("inc", "lan", "argp", "nu"):
+            cols.append((name, el[..., _COL[name]] * scale, aunit))
+        cols.append(("mu", self._mu, str(_MU)))
+        parts = []
+        for name, x, unit in cols:
+            unit = f" {unit}" if (unit and self._quantity) else ""
+            if not self.shape:
+                parts.append(f"{name}={float(x):.7g}{unit}")
+            else:
+                parts.append(f"{name} in [{np.min(x):.7g}, {np.max(x):.7g}]{unit}")
+        head = "" if not self.shape else f"shape={self.shape}, "
+        return f"KeplerOrbit({head}{', '.join(parts)})"
 
     @property
     def mu(self):
@@ -428,6 +548,7 @@ class KeplerOrbit:
         return self._col("inv_a")
 
     @property
+    @_in_range
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
         inv = self._inv_a
@@ -488,11 +609,13 @@ class KeplerOrbit:
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
 
     @property
+    @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
         return self._out(self._n, _RAD / _T)
 
     @property
+    @_in_range
     def period(self):
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
         kind = self._col("kind")
@@ -501,6 +624,7 @@ class KeplerOrbit:
         return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
 
     @property
+    @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
         return self._out(-0.5 * self._mu * self._inv_a, _V**2)
@@ -512,6 +636,7 @@ class KeplerOrbit:
         flat_mu = self._mu.reshape(-1)
         out = np.empty(flat_r.shape[0])
         _el.state_to_time_since_periapsis(flat_r, flat_v, flat_mu, out)
+        _refuse_beyond_range(out[:, None], flat_r, flat_v, flat_mu, self._mu.shape)
         return out.reshape(self._mu.shape)
 
     @property
@@ -557,16 +682,19 @@ class KeplerOrbit:
         return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
 
     @property
+    @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
         return self._out(np.cross(self._r, self._v), _L * _V)
 
     @property
+    @_in_range
     def eccentricity_vector(self):
         """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
         return self._out(_ecc_vector(self._r, self._v, self._mu), None)
 
     @property
+    @_in_range
     def hamilton_epsilon(self):
         """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
         return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
@@ -605,7 +733,7 @@ class KeplerOrbit:
         """
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
-        dt_ = strip("dt", dt, _T)
+        dt_ = TIME("dt", dt, _T)
         r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
         mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
         return KeplerOrbit(r, v, mu, self._quantity)
@@ -616,6 +744,25 @@ class KeplerOrbit:
         from hamilton_orbits.conic import Conic
 
         return Conic._from_orbit(self)
+
+
+def _refuse_beyond_range(out, r, v, mu, shape) -> None:
+    """Raise if a kernel row is not finite: the state's elements do not fit in
+    float64 (``|r| |v|^2 / mu``, ~e, beyond 2^450, or ``p``, ``1/a`` or the time
+    beyond the float range).  One fast reduction in the common case."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(out.sum()):
+            return
+    rows = ~np.all(np.isfinite(out), axis=-1)
+    if not np.any(rows):
+        return
+    i = int(np.flatnonzero(rows)[0])
+    where = _fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
+    raise ValueError(
+        f"Expected `r`, `v`, `mu` whose elements fit in float64 (|r| |v|^2 / mu ~ e below "
+        f"2^450 ~ 3e135, p and a below 1e308), got r={r[i].tolist()}, v={v[i].tolist()}, "
+        f"mu={float(mu[i])!r}{where}"
+    )
 
 
 def _wrap2pi(x: np.ndarray) -> np.ndarray:
@@ -634,27 +781,22 @@ def _ecc_vector(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
 def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
     """States of radial orbits from their mean anomaly (in place).
 
-    Kepler's equation for a rectilinear orbit (e = 1, a finite) is solved by
-    universal-variable propagation from a reference point: the apoapsis
-    (``M = pi``, at rest at ``r = 2a``) of the bound orbit, the point ``F = 1``
-    of the unbound one.
+    Kepler's equation of the rectilinear orbit (e = 1, a finite),
+    ``E - sin E = M`` or ``sinh F - F = M``, is solved directly
+    (:func:`hamilton_orbits._kernels.kepler.solve_radial`), and the state is
+    ``r = a (1 - cos E) = 2 a sin^2(E/2)`` (``|a| (cosh F - 1)``) on the line, so
+    that a tiny M keeps full relative precision (E ~ (6 M)^(1/3)).
     """
     idx = np.flatnonzero(radial)
-    inv_a = el[idx, 2]
-    ref = el[idx].copy()
-    ref[:, 0] = 0.0
-    bound = inv_a > 0
-    ref[:, 6] = np.where(bound, np.pi, 1.0)
-    r0 = np.empty((idx.size, 3))
-    v0 = np.empty((idx.size, 3))
-    _el.elements_to_state(np.ascontiguousarray(ref), np.ascontiguousarray(mu[idx]), r0, v0)
-    m0 = np.where(bound, np.pi, np.sinh(1.0) - 1.0)
-    ia = np.abs(inv_a)
-    n = np.sqrt(mu[idx]) * ia * np.sqrt(ia)
     mm = m[idx]
+    rows = np.ascontiguousarray(el[idx])
+    bound = rows[:, 2] > 0
     _raise_at("M", bound & ~((mm > -np.pi) & (mm <= np.pi)), mm, "in (-pi, pi] for a radial orbit")
-    dt = (mm - m0) / n
-    r1, v1 = _kepler.propagate(r0, v0, mu[idx], dt)
+    rows[:, 0] = 0.0
+    rows[:, 6] = _kk.solve_radial_ufunc(mm, rows[:, 2])
+    r1 = np.empty((idx.size, 3))
+    v1 = np.empty((idx.size, 3))
+    _el.elements_to_state(rows, np.ascontiguousarray(mu[idx]), r1, v1)
     r_out[idx] = r1
     v_out[idx] = v1
 
@@ -664,11 +806,36 @@ def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
 # ---------------------------------------------------------------------------
 
 
-def _vec(name: str, x: Any) -> np.ndarray:
-    return check_trailing(name, as_float_array(name, x), 3)
+def _hamilton_args(r: Any, v: Any, *mu: Any):
+    """(r, v, mu) of Hamilton's integrals as floats (km, km/s, km^3/s^2 for
+    Quantities) and whether the call was in Quantities (no mixing)."""
+    quantity = require_consistent(("r", "v", "mu")[: 2 + len(mu)], (r, v, *mu))
+    r_ = check_trailing("r", LENGTH("r", r, _L), 3)
+    v_ = check_trailing("v", SPEED("v", v, _V), 3)
+    mu_ = check_positive("mu", GM("mu", mu[0], _MU)) if mu else None
+    return r_, v_, mu_, quantity
 
 
-def hamilton_beta(r: Any, v: Any) -> np.ndarray:
+def _finite_or_raise(f, r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``f(r, v)`` without floating-point warnings; a result beyond float64
+    raises ValueError naming ``r`` and ``v``."""
+    with np.errstate(all="ignore"):
+        out = np.asarray(f(r, v))
+    if not np.all(np.isfinite(out)):
+        raise ValueError(
+            f"Expected `r`, `v` (and `mu`) for which Hamilton's {f.__name__.split('_')[0]} "
+            f"fits in float64, got r={r.tolist()}, v={v.tolist()}"
+        )
+    return out
+
+
+def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    alpha = Quaternion.from_vector(r)
+    dalpha = Quaternion.from_vector(v)
+    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+
+
+def hamilton_beta(r: Any, v: Any):
     """Hamilton's areal vector ``beta = (alpha alpha' - alpha' alpha) / 2`` (seed eq. 3).
 
     Computed from two Hamilton products of the pure quaternions ``alpha = r``
@@ -676,25 +843,35 @@ def hamilton_beta(r: Any, v: Any) -> np.ndarray:
 
     Parameters
     ----------
-    r, v : array_like, shape (..., 3)
-        Position and velocity (plain floats, any consistent units).
+    r : array_like or Quantity (length), shape (..., 3)
+        Position.
+    v : array_like or Quantity (length/time), shape (..., 3)
+        Velocity (plain floats: the units of ``r`` per unit time).
 
     Returns
     -------
-    ndarray, shape (..., 3)
+    ndarray or Quantity (km^2/s), shape (..., 3)
         The vector part of the (pure) quaternion beta.
+
+    Raises
+    ------
+    ValueError
+        NaN / inf, trailing dimension not 3, or a mix of Quantities and floats.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong kind, naming the argument.
 
     Examples
     --------
     >>> hamilton_beta([1.0, 0, 0], [0, 2.0, 0]).tolist()
     [0.0, 0.0, 2.0]
+    >>> hamilton_beta([1.0, 0, 0] * u.km, [0, 2.0, 0] * u.km / u.s)
+    <Quantity [0., 0., 2.] km2 / s>
     """
-    alpha = Quaternion.from_vector(_vec("r", r))
-    dalpha = Quaternion.from_vector(_vec("v", v))
-    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+    r_, v_, _, quantity = _hamilton_args(r, v)
+    return wrap(_finite_or_raise(_beta, r_, v_), _L * _V, quantity)
 
 
-def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any) -> np.ndarray:
+def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
     """Hamilton's ``epsilon = iota - alpha' beta / M`` (seed eq. 13), by quaternion products.
 
     ``iota = alpha / r`` is the unit vector of the position; in Hamilton's
@@ -704,38 +881,69 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any) -> np.ndarray:
 
     Parameters
     ----------
-    r, v : array_like, shape (..., 3)
-    mu : array_like, shape (...)
+    r : array_like or Quantity (length), shape (..., 3)
+        Position, nonzero.
+    v : array_like or Quantity (length/time), shape (..., 3)
+        Velocity.
+    mu : array_like or Quantity (length^3/time^2), shape (...)
         Hamilton's M, ``> 0``.
 
     Returns
     -------
-    ndarray, shape (..., 3)
+    ndarray or dimensionless Quantity, shape (..., 3)
+
+    Raises
+    ------
+    ValueError
+        NaN / inf, wrong shapes, ``mu <= 0``, ``r = 0``, or mixed Quantities and floats.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong kind, naming the argument.
 
     Examples
     --------
     >>> hamilton_epsilon_from_products([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12).tolist()
     [-0.44, 0.0, 0.0]
     """
-    r_ = _vec("r", r)
-    v_ = _vec("v", v)
-    mu_ = check_positive("mu", as_float_array("mu", mu))
-    rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
-    iota = Quaternion.from_vector(r_ / rn[..., None])
-    dalpha = Quaternion.from_vector(v_)
-    beta = Quaternion.from_vector(hamilton_beta(r_, v_))
-    eps = iota - (dalpha * beta) * (1.0 / mu_)
-    return eps.vector
+    r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
+    big = np.max(np.abs(r_), axis=-1)  # |r| without underflow of |r|^2 (r ~ 1e-170)
+    _raise_at("r", ~(big > 0), big, "nonzero (|r| > 0)")
+    with np.errstate(over="ignore", under="ignore"):
+        rn = np.sqrt(np.einsum("...i,...i->...", r_, r_))
+    tiny_or_huge = ~((big > 1e-150) & (big < 1e150))
+    if np.any(tiny_or_huge):
+        rs = r_ / big[..., None]
+        rn = np.where(tiny_or_huge, big * np.sqrt(np.einsum("...i,...i->...", rs, rs)), rn)
+    def eps_of(r_, v_):
+        iota = Quaternion.from_vector(r_ / rn[..., None])
+        dalpha = Quaternion.from_vector(v_)
+        beta = Quaternion.from_vector(_beta(r_, v_))
+        return (iota - (dalpha * beta) * (1.0 / mu_)).vector
+
+    return wrap(_finite_or_raise(eps_of, r_, v_), u.dimensionless_unscaled, quantity)
 
 
-def hamilton_p(r: Any, v: Any, mu: Any) -> np.ndarray:
+def hamilton_p(r: Any, v: Any, mu: Any):
     """Hamilton's semi-parameter ``p = -beta^2 / M`` (seed eq. 16), ``beta^2`` a quaternion square.
+
+    Parameters
+    ----------
+    r : array_like or Quantity (length), shape (..., 3)
+    v : array_like or Quantity (length/time), shape (..., 3)
+    mu : array_like or Quantity (length^3/time^2), shape (...), ``> 0``
+
+    Returns
+    -------
+    ndarray or Quantity (km), shape (...)
 
     Examples
     --------
     >>> float(hamilton_p([1.0, 0, 0], [0, 1.2, 0], 1.0).round(12))
     1.44
     """
-    beta = Quaternion.from_vector(hamilton_beta(r, v))
-    mu_ = check_positive("mu", as_float_array("mu", mu))
-    return -(beta * beta).scalar / mu_
+    r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
+
+    def p_of(r_, v_):
+        beta = Quaternion.from_vector(_beta(r_, v_))
+        return -(beta * beta).scalar / mu_
+
+    return wrap(_finite_or_raise(p_of, r_, v_), _L, quantity)

@@ -108,7 +108,8 @@ def test_parabola_limits():
     r, v = _states(1.0)
     c = Conic.from_state(r, v, 0.7)
     assert np.all(c.a == np.inf) and np.all(c.b == np.inf)
-    assert np.all(c.second_focal_distance(1.0) == np.inf)
+    # (r = 2 >= q = 1.3: on the conic; below q the point is not on it and is refused)
+    assert np.all(c.second_focal_distance(2.0) == np.inf)
     with pytest.raises(ValueError, match="parabola"):
         _ = c.second_focus
     # C = 2 r (harmonic mean of r and r' = inf), finite N and R
@@ -141,3 +142,43 @@ def test_quantities_in_quantities_out():
     assert c.focal_half_chord(rn.to(u.m)).unit == u.km
     with pytest.raises(ValueError, match="`r` as a Quantity"):
         c.focal_half_chord(7000.0)
+
+
+def test_points_off_the_conic_are_refused():
+    """Issue 7 item 6: outside the conic the formulas returned NaN, inf or a
+    negative radius; now a ValueError naming the argument, value and range."""
+    hyp = Conic.from_state([1.0, 0, 0], [0, 2.0, 0], 1.0)  # e = 3, q = 1
+    with pytest.raises(ValueError, match=r"`nu` inside the asymptotes, \|nu\| < arccos\(-1/e\) "
+                                         r"= 1.910633 rad \(e = 3.0\), got 3.14159"):
+        hyp.radius(math.pi)
+    # just inside the asymptote: a large but finite radius (p / (1 + e cos nu) > 0)
+    assert 0 < hyp.radius(math.acos(-1 / 3) - 1e-9) < np.inf
+    par = Conic.from_state([1.0, 0, 0], [0, math.sqrt(2.0), 0], 1.0)
+    with pytest.raises(ValueError, match="`nu` inside the asymptotes"):
+        par.radius([0.0, math.pi])
+    ell = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)  # q = 1, Q = 18/7
+    for method in ("normal_length", "focal_half_chord", "radius_of_curvature",
+                   "radial_speed_squared", "second_focal_distance"):
+        with pytest.raises(ValueError, match=r"`r` on the conic, q <= r <= Q .* got 10.0"):
+            getattr(ell, method)(10.0)  # beyond apoapsis
+        with pytest.raises(ValueError, match=r"got 0.5 at index 1"):
+            getattr(ell, method)([1.5, 0.5])  # inside periapsis
+        with pytest.raises(ValueError, match=r"Q = inf"):
+            getattr(hyp, method)(0.5)
+    # the end points themselves are on the conic: C = r (2 - r/a) = p there (eq. 63)
+    # up to the rounding of a = 1/inv_a and Q = 2a - q
+    assert ell.normal_length(18 / 7) == pytest.approx(math.sqrt(1.44 * 1.44), rel=16 * EPS)
+    assert ell.radial_speed_squared(1.0) == pytest.approx(0.0, abs=8 * EPS)
+    with pytest.raises(ValueError, match=r"`r` a nonzero position .*got \[0.0, 0.0, 0.0\]"):
+        ell.hodograph([0, 0, 0])
+    radial = Conic.from_state([1.0, 0, 0], [0.5, 0, 0], 1.0)
+    with pytest.raises(ValueError, match="angular momentum"):
+        radial.hodograph([1.0, 0, 0])
+
+
+def test_hodograph_scale_free():
+    # the direction of r is what matters: |r| = 1e-170 or 1e300 gives the same velocity
+    c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    for s in (1e-170, 1e300):
+        rot, fix = c.hodograph([s, 0, 0])
+        assert (rot + fix).tolist() == pytest.approx([0.0, 1.2, 0.0], abs=4 * EPS)

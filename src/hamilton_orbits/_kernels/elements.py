@@ -37,11 +37,13 @@ import numpy as np
 from numba import njit, prange
 
 from hamilton_orbits._kernels.kepler import (
+    _two_prod,
     anomaly_from_nu,
     mean_from_anomaly,
     nu_from_anomaly,
     sinh_minus_x,
     solve,
+    state_scales,
     x_minus_sin,
 )
 
@@ -156,11 +158,32 @@ def _hyperbolic_anomaly(sn, cn, e, em1):  # pragma: no cover - compiled
     k = math.hypot(sn, cn)
     if cn >= 0.0:
         th = math.sqrt(em1 / (e + 1.0)) * (sn / (k + cn))
-    else:
+    elif sn != 0.0:
         th = math.sqrt(em1 / (e + 1.0)) * ((k - cn) / sn)
+    else:  # nu = pi: beyond the asymptote by rounding (clamped below)
+        th = 1.0
     if abs(th) >= 1.0:
         th = math.copysign(1.0 - EPS / 2.0, th)
     return 2.0 * math.atanh(th)
+
+
+@njit(cache=True)
+def _dot3_compensated(ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
+    """``a.b`` as if computed in twice the working precision (Ogita, Rump and
+    Oishi, SIAM J. Sci. Comput. 26 (2005), algorithm Dot2): exact products by
+    Dekker's splitting, TwoSum of the products, then the errors added.  Near
+    periapsis r.v cancels (r is nearly perpendicular to v); this keeps its
+    relative accuracy."""
+    p1, e1 = _two_prod(ax, bx)
+    p2, e2 = _two_prod(ay, by)
+    p3, e3 = _two_prod(az, bz)
+    s = p1 + p2
+    z = s - p1
+    t = (p1 - (s - z)) + (p2 - z)
+    s2 = s + p3
+    z = s2 - s
+    t += (s - (s2 - z)) + (p3 - z)
+    return s2 + (t + (e1 + e2 + e3))
 
 
 @njit(cache=True)
@@ -178,7 +201,10 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     r2 = rx * rx + ry * ry + rz * rz
     r = math.sqrt(r2)
     v2 = vx * vx + vy * vy + vz * vz
-    rv = rx * vx + ry * vy + rz * vz
+    if accurate:  # the time since periapsis: r.v to full relative precision
+        rv = _dot3_compensated(rx, ry, rz, vx, vy, vz)
+    else:
+        rv = rx * vx + ry * vy + rz * vz
     hx = ry * vz - rz * vy
     hy = rz * vx - rx * vz
     hz = rx * vy - ry * vx
@@ -347,11 +373,35 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
 
 
+@njit(cache=True)
+def state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
+    """:func:`state_to_elements_one` on the state scaled to order 1
+    (:func:`hamilton_orbits._kernels.kepler.state_scales`): ``p``, ``inv_a`` and
+    the time are scaled back exactly, every other column is scale-free."""
+    er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    if not ok:  # e beyond 2^MAX_E_EXPONENT: NaN row, refused by the caller
+        nan = math.nan
+        return nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan
+    if er == 0 and ev == 0:
+        return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate)
+    p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau = state_to_elements_one(
+        math.ldexp(rx, -er), math.ldexp(ry, -er), math.ldexp(rz, -er),
+        math.ldexp(vx, -ev), math.ldexp(vy, -ev), math.ldexp(vz, -ev),
+        math.ldexp(mu, -er - 2 * ev), accurate,
+    )
+    return (
+        math.ldexp(p, er), e, math.ldexp(inv_a, -er), inc, lan, argp, nu, anom, m, u, kind,
+        math.ldexp(tau, er - ev),
+    )
+
+
 @njit(cache=True, parallel=True)
 def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
     """Rows of ``r`` (N, 3), ``v`` (N, 3), ``mu`` (N,) into ``out`` (N, NCOL)."""
     for i in prange(r.shape[0]):
-        res = state_to_elements_one(r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i])
+        res = state_to_elements_scaled(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i]
+        )
         for j in range(NCOL):
             out[i, j] = res[j]
 
@@ -364,7 +414,7 @@ def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
     also for near-parabolic orbits, continuous across e = 1.
     """
     for i in prange(r.shape[0]):
-        res = state_to_elements_one(
+        res = state_to_elements_scaled(
             r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], True
         )
         out[i] = res[NCOL - 1]
@@ -398,7 +448,7 @@ def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - comp
             math.isfinite(rx) and math.isfinite(ry) and math.isfinite(rz)
             and math.isfinite(vx) and math.isfinite(vy) and math.isfinite(vz)
             and math.isfinite(m) and m > 0.0
-            and (rx * rx > 0.0 or ry * ry > 0.0 or rz * rz > 0.0)
+            and (rx != 0.0 or ry != 0.0 or rz != 0.0)
         )
         if not ok:
             bad += 1
@@ -496,12 +546,35 @@ def elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: no 
     )
 
 
+@njit(cache=True)
+def elements_to_state_scaled(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: no cover
+    """:func:`elements_to_state_one` with the lengths (``p``, or ``1/|inv_a|`` of
+    a radial orbit) and ``mu`` scaled to order 1 by powers of two when they lie
+    outside [1e-50, 1e50], and the state scaled back exactly (see
+    :func:`hamilton_orbits._kernels.kepler.state_scales`)."""
+    length = p if p > 0.0 else (1.0 / abs(inv_a) if inv_a != 0.0 else 1.0)
+    if 1e-50 < length < 1e50 and 1e-50 < mu < 1e50 and abs(inv_a) < 1e50:
+        return elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu)
+    if not (0.0 < length < math.inf) or not (0.0 < mu < math.inf):
+        return elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu)
+    er = math.frexp(length)[1]
+    ev = (math.frexp(mu)[1] - er) // 2
+    x, y, z, a, b, c = elements_to_state_one(
+        math.ldexp(p, -er), e, math.ldexp(inv_a, er), inc, lan, argp, anom,
+        math.ldexp(mu, -er - 2 * ev),
+    )
+    return (
+        math.ldexp(x, er), math.ldexp(y, er), math.ldexp(z, er),
+        math.ldexp(a, ev), math.ldexp(b, ev), math.ldexp(c, ev),
+    )
+
+
 @njit(cache=True, parallel=True)
 def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
     """Rows of ``el`` (N, 7: p, e, inv_a, inc, lan, argp, anomaly) and ``mu``
     into ``r_out``, ``v_out`` (N, 3)."""
     for i in prange(el.shape[0]):
-        x, y, z, a, b, c = elements_to_state_one(
+        x, y, z, a, b, c = elements_to_state_scaled(
             el[i, 0], el[i, 1], el[i, 2], el[i, 3], el[i, 4], el[i, 5], el[i, 6], mu[i]
         )
         r_out[i, 0] = x

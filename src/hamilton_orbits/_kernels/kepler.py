@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, vectorize
 
 EPS = 2.220446049250313e-16
@@ -112,6 +113,8 @@ def mean_from_anomaly(anom, e):  # pragma: no cover - compiled
     ``M = D + D^3/3``; hyperbolic ``M = (e-1) sinh F + (sinh F - F)``.
     """
     if e < 1.0:
+        if abs(anom) >= 9007199254740992.0:  # 2^53: |M - E| <= e < 1 <= half a spacing
+            return anom
         k, r = _reduce_2pi(anom)
         m = (1.0 - e) * r + e * x_minus_sin(r)
         if k == 0.0:
@@ -131,6 +134,12 @@ def anomaly_from_nu(nu, e):  # pragma: no cover - compiled
     ``tanh(F/2) = sqrt((e-1)/(e+1)) tan(nu/2)``.  For ``e >= 1`` a ``nu`` beyond
     the asymptote (``1 + e cos nu <= 0``) gives NaN.
     """
+    if e >= 1.0 and not abs(nu) < 9007199254740992.0:
+        return math.nan  # no open orbit's nu is resolved beyond 2^53 (refused)
+    if e < 1.0 and abs(nu) >= 9007199254740992.0:
+        # beyond 2^53 the floats are >= 2 apart: no revolution can be resolved and
+        # E (within pi of nu, same revolution) is nu to the input's precision
+        return nu
     k, r = _reduce_2pi(nu)
     h = 0.5 * r
     if e < 1.0:
@@ -162,6 +171,8 @@ def nu_from_anomaly(anom, e):  # pragma: no cover - compiled
     (no overflow for any finite F).
     """
     if e < 1.0:
+        if abs(anom) >= 9007199254740992.0:  # 2^53: as in anomaly_from_nu
+            return anom
         k, r = _reduce_2pi(anom)
         h = 0.5 * r
         a = 2.0 * math.atan2(math.sqrt(1.0 + e) * math.sin(h), math.sqrt(1.0 - e) * math.cos(h))
@@ -180,7 +191,12 @@ def _cubic_root(p, q):  # pragma: no cover - compiled
     ``x = 2 sqrt(p) sinh(asinh(q / p^(3/2)) / 3)``: no cancellation for any q.
     """
     sp = math.sqrt(p)
-    return 2.0 * sp * math.sinh(math.asinh(q / (p * sp)) / 3.0)
+    d = p * sp
+    if not (q < 1e100 * d):
+        # p -> 0 (e -> 1 in the callers, or p * sp underflows): x = (2 q)^(1/3),
+        # the limit of the form below (relative difference ~ (q/d)^(-2/3))
+        return np.cbrt(2.0 * q)
+    return 2.0 * sp * math.sinh(math.asinh(q / d) / 3.0)
 
 
 @njit(inline="always", cache=True)
@@ -227,7 +243,7 @@ def _solve_elliptic(m, e):  # pragma: no cover - compiled
         hi = PI
     if lo > hi:
         lo = hi
-    a = lo
+    a = lo * (1.0 - 4.0 * EPS)  # the rounded cubic root may lie an ulp above E
     b = hi
     x = lo
     xp = math.nan
@@ -262,13 +278,25 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
     em = e - 1.0
     f1 = math.asinh(m / e)
     lo = math.asinh((m + f1) / e)
-    hi = min(math.asinh(m / em), _cubic_root(2.0 * em / e, 3.0 * m / e))
+    if m > 1e20:
+        # F = asinh((m + F)/e) contracts by 1/(m + F) < 1e-20 per step: lo is two
+        # steps from F = 0, one more is F to rounding (and no sinh can overflow)
+        return math.asinh((m + lo) / e)
+    hi = _cubic_root(2.0 * em / e, 3.0 * m / e)
+    if em > 0.0:
+        hi = min(math.asinh(m / em), hi)
+    if m > 2.5:
+        # sinh F - F >= sinh(F)/2 for F >= 2.2 (the root, as m > 2.26): the
+        # bound that keeps the radial orbit's (e = 1) cubic bound from overflowing
+        hi = min(math.asinh(2.0 * m), hi)
     if hi < lo:
         hi = lo
     flo = f1 - lo  # f(lo) up to rounding, <= 0
-    fhi = em * math.sinh(hi) + sinh_minus_x(hi) - m
+    fhi = sinh_minus_x(hi) - m
+    if em > 0.0:  # (em = 0: the radial orbit, whose cubic bound may overflow sinh)
+        fhi += em * math.sinh(hi)
     a = lo
-    b = hi
+    b = hi * (1.0 + 4.0 * EPS)  # the rounded cubic root may lie an ulp below F
     x = lo if abs(flo) <= abs(fhi) else hi
     xp = math.nan
     for _ in range(MAXIT):
@@ -279,6 +307,10 @@ def _solve_hyperbolic(m, e):  # pragma: no cover - compiled
             return x
         fp = em + 2.0 * e * sh * sh
         fpp = e * sx
+        if e > 1e100:  # f / e has the same root and Halley step; fp^2 cannot overflow
+            f /= e
+            fp /= e
+            fpp /= e
         xn, a, b, done = _halley_step(x, xp, f, fp, fpp, a, b)
         if done:
             return xn
@@ -294,6 +326,8 @@ def solve_parabolic(m):  # pragma: no cover - compiled
     ``D = 2 sinh(asinh(3 m / 2) / 3)`` (Cardano's root written without the
     cancellation of ``w - 1/w``), then one Newton polish.
     """
+    if abs(m) > 1e300:  # 1.5 m may overflow; D^3 = 3 m to 1e-200 relative here
+        return np.cbrt(3.0) * np.cbrt(m)
     d = 2.0 * math.sinh(math.asinh(1.5 * m) / 3.0)
     if abs(d) < 1e100:
         d -= (d * (1.0 + d * d / 3.0) - m) / (1.0 + d * d)
@@ -310,7 +344,9 @@ def solve(m, e):  # pragma: no cover - compiled
     if not (e >= 0.0) or not math.isfinite(m) or not math.isfinite(e):
         return math.nan
     if e < 1.0:
-        if e == 0.0:
+        if e == 0.0 or abs(m) >= 9007199254740992.0:
+            # beyond 2^53 the spacing of floats is >= 2 > 2 e >= 2 |E - M|: M is
+            # the float nearest to E (and no reduction mod 2 pi is meaningful)
             return m
         k, r = _reduce_2pi(m)
         if r < 0.0:
@@ -325,6 +361,35 @@ def solve(m, e):  # pragma: no cover - compiled
     if m < 0.0:
         return -_solve_hyperbolic(-m, e)
     return _solve_hyperbolic(m, e)
+
+
+@njit(cache=True)
+def solve_radial(m, inv_a):  # pragma: no cover - compiled
+    """The anomaly of a radial (rectilinear, e = 1) orbit for mean anomaly ``m``.
+
+    Bound (``inv_a > 0``): E in [-pi, pi] with ``E - sin E = m`` for
+    |m| <= pi, so that ``r = a (1 - cos E)``; unbound (``inv_a < 0``): F with
+    ``sinh F - F = m``, ``r = |a| (cosh F - 1)``.  Solved directly (the
+    limits e -> 1 of the elliptic and hyperbolic solvers, started from the
+    cubic ``E^3/6 = m``), so a tiny m keeps full relative precision: the
+    anomaly is ``(6 m)^(1/3)`` to first order.  NaN outside the domain.
+    """
+    if not math.isfinite(m) or not (inv_a != 0.0) or not math.isfinite(inv_a):
+        return math.nan
+    am = abs(m)
+    if inv_a > 0.0:
+        if am > PI:
+            return math.nan
+        x = _solve_elliptic(am, 1.0)
+    else:
+        x = _solve_hyperbolic(am, 1.0)
+    return -x if m < 0.0 else x
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def solve_radial_ufunc(m, inv_a):  # pragma: no cover - compiled
+    """Broadcasting ufunc of :func:`solve_radial`."""
+    return solve_radial(m, inv_a)
 
 
 @vectorize(["float64(float64, float64)"], cache=True)
@@ -430,10 +495,10 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
         big = math.inf
     # first guess: second-order Taylor series for short steps, otherwise the
     # mean-motion guess (elliptic) or a logarithmic one (hyperbolic)
-    if r0 > 0.0:
+    if r0 * r0 * r0 > 0.0:
         x = tau / r0 - sigma0 * tau * tau / (2.0 * r0 * r0 * r0)
         x1 = tau / r0
-    else:  # radial orbit anchored at the collision: T ~ chi^3/6
+    else:  # (near-)radial orbit anchored at the collision: T ~ chi^3/6
         x1 = sgn * (6.0 * abs(tau)) ** (1.0 / 3.0)
         x = x1
     if alpha > 0.0:
@@ -503,6 +568,18 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):  # pragma: no cover
+    """Whether ``g sqrt(mu) = r0 U1 + sigma0 U2`` is expected more accurate than
+    ``tau - U3`` (the two are equal by the universal Kepler equation): an error
+    dchi moves the first by ``(r - U2) dchi`` and the second by ``U2 dchi``, and
+    each carries the rounding of its own terms (the first cancels when moving
+    towards periapsis from far out)."""
+    e1 = abs(r - u2) * dchi_err + EPS * (abs(r0 * u1) + abs(sigma0 * u2))
+    e2 = abs(u2) * dchi_err + EPS * (abs(tau) + abs(u3))
+    return e1 <= e2
+
+
+@njit(cache=True)
 def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """Two-body state after time ``dt`` by universal variables (f and g series).
 
@@ -513,10 +590,12 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       |dt| may be many periods.
     * Moving away from periapsis (``sigma0 dt >= 0``, or a nearly circular
       orbit) the universal Kepler equation ``T(chi) = sqrt(mu) dt`` is a sum
-      of terms of one sign and is solved directly; g is then computed from chi
-      alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g = 1
-      holds identically and the state stays on the initial orbit whatever the
-      solver's last-bit error.
+      of terms of one sign and is solved directly.  g is computed either from
+      chi alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g
+      = 1 holds identically and the state stays on the initial orbit whatever
+      the solver's last-bit error, or as ``(tau - U3)/sqrt(mu)``, whichever the
+      last-bit error of chi and the rounding of the terms move least
+      (:func:`_g_first_form`; on a fast hyperbola U3 << tau and g ~ dt).
     * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4, and a step
       long enough, ``|sigma0 tau| > r0^2 / 10``, to matter), the terms of
       T(chi) cancel (for an open orbit that starts far out the loss is about
@@ -524,8 +603,8 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
       periapsis, where all terms have one sign: chi0 of the initial state is
       found from sigma0 = e U1(chi0) (atan2 / asinh forms), and
       ``q U1(chi1) + U3(chi1) = q U1(chi0) + U3(chi0) + sqrt(mu) dt`` is solved
-      for chi1; f and g use dchi = chi1 - chi0 with ``g = dt - U3/sqrt(mu)``
-      and ``r = q U0(chi1) + U2(chi1)``.
+      for chi1; f and g use dchi = chi1 - chi0 (g chosen as above; radial
+      orbits keep ``g = dt - U3/sqrt(mu)``) and ``r = q U0(chi1) + U2(chi1)``.
     """
     nan = math.nan
     r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
@@ -572,12 +651,28 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
         r = sol[2]
         dchi = chi1 - chi0
         _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
-        g = (tau - u3) / smu
+        # as below: the form of g that the last-bit error of dchi moves least;
+        # r0 U1 + sigma0 U2 also keeps f gdot - fdot g = 1, i.e. the state on the
+        # orbit (a long parabolic step turned the eccentricity vector by 1.5e-13
+        # rad with tau - U3 alone).  Radial orbits (pp = 0) keep tau - U3, which
+        # measured better through the collision.
+        dchi_err = EPS * (abs(chi1) + abs(chi0))
+        if pp > 0.0 and _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):
+            g = (r0 * u1 + sigma0 * u2) / smu
+        else:
+            g = (tau - u3) / smu
     else:
-        chi, _t, r, _u0, u1, u2, _u3 = _solve_uv(tau, r0, sigma0, alpha)
+        chi, _t, r, _u0, u1, u2, u3 = _solve_uv(tau, r0, sigma0, alpha)
         if not math.isfinite(chi):
             return nan, nan, nan, nan, nan, nan
-        g = (r0 * u1 + sigma0 * u2) / smu
+        # g = (r0 U1 + sigma0 U2)/sqrt(mu) = (tau - U3)/sqrt(mu): the last-bit
+        # error of chi moves the first by (r - U2) dchi, the second by U2 dchi;
+        # take the smaller (on a fast hyperbola U3 << tau: g ~ dt exactly; the
+        # step r = (1, 0, 0), v = (0, 1e5, 0), dt = 1.234567 went from 54 ulp to 0.2)
+        if pp > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
+            g = (tau - u3) / smu
+        else:
+            g = (r0 * u1 + sigma0 * u2) / smu
     if not (r > 0.0) or not math.isfinite(r):
         return nan, nan, nan, nan, nan, nan
     f = 1.0 - u2 / r0
@@ -607,12 +702,80 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     )
 
 
+# Below 1e-50 or above 1e50 a product of the kernels (h^2 ~ r^2 v^2, r.v h,
+# mu r, ...) may leave the float range; such states are scaled first.
+_SAFE_LO = 1e-50
+_SAFE_HI = 1e50
+
+
+# The kernels square e (1 - e^2 = p / a): |r| |v|^2 / mu ~ e must stay below
+# 2^450 ~ 3e135 so that e^2 and its companions fit in the float range.
+MAX_E_EXPONENT = 450
+
+
+@njit(cache=True)
+def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """Exponents ``(er, ev, ok)`` of the powers of two that bring ``(r, v, mu)`` to order 1.
+
+    Two-body motion is homogeneous: ``r -> r / 2^er``, ``v -> v / 2^ev``,
+    ``mu -> mu / 2^(er + 2 ev)``, ``t -> t 2^(ev - er)`` leave every angle, the
+    eccentricity and the anomalies unchanged, so a kernel can work on the scaled
+    state and scale lengths, speeds and times back exactly (powers of two).
+    ``er`` makes ``|r| ~ 1``; ``ev`` makes ``|v| ~ 1`` unless ``mu`` would then
+    leave 2^(+-400) (a state nearly at rest), in which case ``mu ~ 1``.
+    ``(0, 0, True)`` when every magnitude lies in [1e-50, 1e50] and
+    ``|r| |v|^2 / mu < 1e60`` already (the common case: no scaling, bit for bit
+    the unscaled kernels).  ``ok`` is False when ``|r| |v|^2 / mu`` (~ e, the
+    one dimensionless number of the state) exceeds 2^MAX_E_EXPONENT.
+    """
+    mr = max(abs(rx), abs(ry), abs(rz))
+    mv = max(abs(vx), abs(vy), abs(vz))
+    if (
+        _SAFE_LO < mr < _SAFE_HI and _SAFE_LO < mu < _SAFE_HI
+        and (_SAFE_LO < mv < _SAFE_HI or mv == 0.0) and mr * mv * mv < 1e60 * mu
+    ):
+        return 0, 0, True
+    er = math.frexp(mr)[1]
+    emu = math.frexp(mu)[1]
+    ev_mu = (emu - er) // 2
+    if mv == 0.0:
+        return er, ev_mu, True
+    ev = math.frexp(mv)[1]
+    eq = er + 2 * ev - emu  # exponent of |r| |v|^2 / mu
+    if eq > MAX_E_EXPONENT:
+        return er, ev, False
+    if eq < -400:
+        ev = ev_mu
+    return er, ev, True
+
+
+@njit(cache=True)
+def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
+    """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
+    so that no intermediate product overflows or underflows."""
+    er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
+    if not ok:
+        nan = math.nan
+        return nan, nan, nan, nan, nan, nan
+    if er == 0 and ev == 0:
+        return propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt)
+    x, y, z, a, b, c = propagate_uv(
+        math.ldexp(rx, -er), math.ldexp(ry, -er), math.ldexp(rz, -er),
+        math.ldexp(vx, -ev), math.ldexp(vy, -ev), math.ldexp(vz, -ev),
+        math.ldexp(mu, -er - 2 * ev), math.ldexp(dt, ev - er),
+    )
+    return (
+        math.ldexp(x, er), math.ldexp(y, er), math.ldexp(z, er),
+        math.ldexp(a, ev), math.ldexp(b, ev), math.ldexp(c, ev),
+    )
+
+
 @njit(cache=True)
 def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
-    """Loop :func:`propagate_uv` over rows; returns the first failing row or -1."""
+    """Loop :func:`propagate_scaled` over rows; returns the first failing row or -1."""
     bad = -1
     for i in range(r.shape[0]):
-        x, y, z, a, b, c = propagate_uv(
+        x, y, z, a, b, c = propagate_scaled(
             r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], dt[i]
         )
         r_out[i, 0] = x
