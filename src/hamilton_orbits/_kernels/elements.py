@@ -36,6 +36,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     anomaly_from_nu,
     mean_from_anomaly,
@@ -347,7 +348,7 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
     """Rows of ``r`` (N, 3), ``v`` (N, 3), ``mu`` (N,) into ``out`` (N, NCOL)."""
     for i in prange(r.shape[0]):
@@ -356,7 +357,7 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
     """Time since periapsis of rows of ``r``, ``v`` (N, 3), ``mu`` (N,) into ``out`` (N,).
 
@@ -370,7 +371,7 @@ def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
         out[i] = res[NCOL - 1]
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - compiled
     """Copy rows of ``r``, ``v`` (N, 3) and ``mu`` (N,) or (1,) (broadcast) into
     ``r_out``, ``v_out``, ``mu_out`` (N,) in one pass; return the number of rows
@@ -496,7 +497,7 @@ def elements_to_state_one(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: no 
     )
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
     """Rows of ``el`` (N, 7: p, e, inv_a, inc, lan, argp, anomaly) and ``mu``
     into ``r_out``, ``v_out`` (N, 3)."""

@@ -1,0 +1,148 @@
+"""Serial / parallel dispatch of the batch kernels, and a thread-safe threading layer.
+
+A loop over ``prange`` pays for itself only above some size: below it the
+start-up and join of the thread team cost more than the work, and on a loaded
+machine an OpenMP team can busy-wait for a core another process holds (calls
+on two orbits took up to 15 ms).  :func:`parallel_kernel` compiles a batch
+kernel twice, with ``parallel=True`` and without (``prange`` is then
+``range``), and calls the parallel one only for at least ``threshold`` rows.
+
+The threading layer must be chosen before numba starts its first thread team.
+``workqueue`` aborts the process when two Python threads launch parallel
+kernels at the same time; ``omp`` and ``tbb`` do not.  So, unless the user
+chose a layer (``NUMBA_THREADING_LAYER``), the package asks numba for a
+thread-safe one when one of them can be loaded.  If the layer in use is still
+``workqueue`` (chosen by the user, or nothing else available), parallel launches
+are serialised by a lock: a thread that finds the lock taken runs the serial
+variant instead of waiting.
+
+Both variants are cached on disk (``cache=True``): the serial one is compiled
+from a copy of the Python function under another ``__qualname__``, so that the
+two never share a cache entry.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import types
+from collections.abc import Callable
+from typing import Any
+
+import numba
+from numba import njit
+
+# Rows below which the serial variant runs.  Measured break-even on a 2-core
+# machine (benchmarks/bench_overhead.py): a parallel launch costs ~5-20 us idle
+# and more when the cores are busy, the elements kernel ~0.15 us a row.
+DEFAULT_THRESHOLD = 4096
+
+_SAFE_LAYERS = ("tbb", "omp")
+_layer_lock = threading.Lock()
+_launch_lock = threading.Lock()
+_state: dict[str, Any] = {"layer": None}
+
+
+def _loadable(layer: str) -> bool:
+    """Whether numba's ``layer`` threading backend can be loaded here."""
+    try:
+        if layer == "tbb":
+            from numba.np.ufunc import tbbpool  # noqa: F401
+        elif layer == "omp":
+            from numba.np.ufunc import omppool  # noqa: F401
+        else:  # pragma: no cover - only the two above are asked for
+            return False
+    except (ImportError, OSError):
+        return False
+    return True
+
+
+def _choose_layer() -> str:
+    """Pick a thread-safe layer (once, before numba's first thread launch) and
+    return the name of the layer numba then uses."""
+    with _layer_lock:
+        if _state["layer"] is not None:
+            return _state["layer"]
+        from numba.np.ufunc import parallel as _npar
+
+        user_chose = "NUMBA_THREADING_LAYER" in os.environ
+        if not user_chose and not _npar._is_initialized:
+            if numba.config.THREADING_LAYER == "default" and any(
+                _loadable(x) for x in _SAFE_LAYERS
+            ):
+                numba.config.THREADING_LAYER = "threadsafe"
+        _npar._launch_threads()
+        layer = numba.threading_layer()
+        _state["layer"] = layer
+        return layer
+
+
+def _serial_copy(func: Callable) -> Callable:
+    """A copy of ``func`` with its own ``__qualname__`` (its own cache entry)."""
+    copy = types.FunctionType(
+        func.__code__, func.__globals__, func.__name__ + "_serial",
+        func.__defaults__, func.__closure__,
+    )
+    copy.__qualname__ = func.__qualname__ + "_serial"
+    copy.__module__ = func.__module__
+    copy.__doc__ = func.__doc__
+    return copy
+
+
+class ParallelKernel:
+    """A batch kernel compiled twice; calls dispatch on the number of rows.
+
+    The number of rows is ``args[0].shape[0]``.  Attributes ``serial`` and
+    ``parallel`` are the two numba dispatchers, ``py_func`` the Python function.
+    """
+
+    def __init__(self, func: Callable, threshold: int) -> None:
+        self.py_func = func
+        self.threshold = threshold
+        self.parallel = njit(cache=True, parallel=True)(func)
+        self.serial = njit(cache=True)(_serial_copy(func))
+        self.__doc__ = func.__doc__
+        self.__name__ = func.__name__
+        self.__qualname__ = func.__qualname__
+        self.__module__ = func.__module__
+
+    def __call__(self, *args: Any) -> Any:
+        if args[0].shape[0] < self.threshold:
+            return self.serial(*args)
+        layer = _state["layer"] or _choose_layer()
+        if layer != "workqueue":
+            return self.parallel(*args)
+        # workqueue is not thread-safe: one parallel launch at a time
+        if not _launch_lock.acquire(blocking=False):
+            return self.serial(*args)
+        try:
+            return self.parallel(*args)
+        finally:
+            _launch_lock.release()
+
+    def __repr__(self) -> str:
+        return f"ParallelKernel({self.__qualname__}, threshold={self.threshold})"
+
+
+def parallel_kernel(
+    func: Callable | None = None, *, threshold: int = DEFAULT_THRESHOLD
+) -> Any:
+    """Decorator: ``@parallel_kernel`` or ``@parallel_kernel(threshold=n)``.
+
+    Replaces ``@njit(cache=True, parallel=True)`` on a batch kernel whose first
+    argument has one row per item.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hamilton_orbits._kernels.elements import state_to_elements, empty_elements
+    >>> state_to_elements  # doctest: +ELLIPSIS
+    ParallelKernel(state_to_elements, threshold=...)
+    >>> out = empty_elements(1)
+    >>> state_to_elements(np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]), np.ones(1), out)
+    >>> float(out[0, 1])  # a circle (served by the serial variant: one row)
+    0.0
+    """
+    if func is None:
+        return lambda f: ParallelKernel(f, threshold)
+    return ParallelKernel(func, threshold)
