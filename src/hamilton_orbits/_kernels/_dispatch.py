@@ -146,3 +146,73 @@ def parallel_kernel(
     if func is None:
         return lambda f: ParallelKernel(f, threshold)
     return ParallelKernel(func, threshold)
+
+
+class LazyUfunc:
+    """A numba (g)ufunc built on first use instead of at import.
+
+    ``@vectorize([...])`` and ``@guvectorize([...])`` with explicit signatures
+    compile (or load from the cache) when the module is imported, which costs
+    about a second before the first call of anything.  This wrapper defers that
+    to the first call; attributes (``nin``, ``reduce``, ...) are those of the
+    built ufunc.
+    """
+
+    def __init__(self, builder: Callable, args: tuple, kwargs: dict, func: Callable) -> None:
+        self._builder = builder
+        self._args = args
+        self._kwargs = kwargs
+        self._ufunc: Any = None
+        self._lock = threading.Lock()
+        self.py_func = func
+        self.__doc__ = func.__doc__
+        self.__name__ = func.__name__
+        self.__qualname__ = func.__qualname__
+        self.__module__ = func.__module__
+
+    def _build(self) -> Any:
+        with self._lock:
+            if self._ufunc is None:
+                self._ufunc = self._builder(*self._args, **self._kwargs)(self.py_func)
+        return self._ufunc
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return (self._ufunc or self._build())(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("_builder", "_args", "_kwargs", "_ufunc", "_lock"):
+            raise AttributeError(name)
+        return getattr(self._ufunc or self._build(), name)
+
+    def __repr__(self) -> str:
+        state = "built" if self._ufunc is not None else "not built"
+        return f"LazyUfunc({self.__qualname__}, {state})"
+
+
+def lazy_vectorize(*args: Any, **kwargs: Any) -> Callable[[Callable], LazyUfunc]:
+    """``numba.vectorize`` with its arguments, built on first use.
+
+    Examples
+    --------
+    >>> from hamilton_orbits._kernels.kepler import solve_ufunc
+    >>> float(solve_ufunc(0.0, 0.5))
+    0.0
+    """
+    from numba import vectorize
+
+    return lambda func: LazyUfunc(vectorize, args, kwargs, func)
+
+
+def lazy_guvectorize(*args: Any, **kwargs: Any) -> Callable[[Callable], LazyUfunc]:
+    """``numba.guvectorize`` with its arguments, built on first use.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hamilton_orbits._kernels.quaternion import qmul_gufunc
+    >>> qmul_gufunc(np.array([0.0, 1, 0, 0]), np.array([0.0, 0, 1, 0])).tolist()
+    [0.0, 0.0, 0.0, 1.0]
+    """
+    from numba import guvectorize
+
+    return lambda func: LazyUfunc(guvectorize, args, kwargs, func)

@@ -24,7 +24,9 @@ from __future__ import annotations
 
 import math
 
-from numba import njit, vectorize
+from numba import njit
+
+from hamilton_orbits._kernels._dispatch import lazy_vectorize
 
 EPS = 2.220446049250313e-16
 PI = math.pi
@@ -327,25 +329,25 @@ def solve(m, e):  # pragma: no cover - compiled
     return _solve_hyperbolic(m, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def solve_ufunc(m, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`solve`."""
     return solve(m, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def mean_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`mean_from_anomaly`."""
     return mean_from_anomaly(anom, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def anomaly_from_nu_ufunc(nu, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`anomaly_from_nu`."""
     return anomaly_from_nu(nu, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def nu_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`nu_from_anomaly`."""
     return nu_from_anomaly(anom, e)

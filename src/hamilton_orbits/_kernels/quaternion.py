@@ -9,7 +9,9 @@ dimensions without copies.
 from __future__ import annotations
 
 import numpy as np
-from numba import guvectorize, njit
+from numba import njit
+
+from hamilton_orbits._kernels._dispatch import lazy_guvectorize
 
 
 @njit(inline="always", cache=True)
@@ -57,7 +59,7 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     )
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
 )
 def qmul_gufunc(a, b, out):  # pragma: no cover - compiled
@@ -69,7 +71,7 @@ def qmul_gufunc(a, b, out):  # pragma: no cover - compiled
     out[3] = z
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(m)->(m)", cache=True, nopython=True
 )
 def qrot_gufunc(q, v, out):  # pragma: no cover - compiled
