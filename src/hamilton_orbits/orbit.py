@@ -23,6 +23,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 
 from __future__ import annotations
 
+import math
 from functools import cached_property
 from typing import Any
 
@@ -59,6 +60,7 @@ _MU = u.km**3 / u.s**2
 _RAD = u.rad
 
 _COL = {name: i for i, name in enumerate(_el.COLUMNS)}
+_LAZY_COLS = frozenset(("anomaly", "M", "tau"))
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -101,6 +103,23 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
     return r, v, mu, quantity
 
 
+def _plain_float_array(x: Any) -> np.ndarray | None:
+    """``x`` as a float64 ndarray if it is a plain real ndarray, list or tuple
+    (no Quantity, complex, bool, object or ragged input), else None."""
+    t = type(x)
+    if t is np.ndarray:
+        if x.dtype == np.float64:
+            return x
+    elif t is list or t is tuple:
+        try:
+            x = np.asarray(x)
+        except (ValueError, TypeError, OverflowError):
+            return None
+    else:
+        return None
+    return x.astype(np.float64) if x.dtype.kind in "fiu" else None
+
+
 def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     """The common case of :func:`_check_state` plus the copies ``KeplerOrbit``
     keeps, in one compiled pass: ``r`` and ``v`` float64 arrays of one shape
@@ -108,9 +127,9 @@ def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     Returns ``(r, v, mu)`` (fresh C-contiguous arrays, as ``__init__`` makes),
     or None when the input is of another kind or invalid; the caller then takes
     the general path, which names the first bad argument and index."""
-    if type(r_in) is not np.ndarray or type(v_in) is not np.ndarray:
-        return None
-    if r_in.dtype != np.float64 or v_in.dtype != np.float64:
+    r_in = _plain_float_array(r_in)
+    v_in = _plain_float_array(v_in)
+    if r_in is None or v_in is None:
         return None
     shape = r_in.shape
     if v_in.shape != shape or len(shape) == 0 or shape[-1] != 3:
@@ -374,18 +393,30 @@ class KeplerOrbit:
     # --------------------------------------------------------------- elements
     @cached_property
     def _elements(self) -> np.ndarray:
+        # the classical columns only; the anomaly, M and tau (NaN here) are
+        # filled in by _col on first request (about a third of the cost)
         flat_r = self._r.reshape(-1, 3)
         flat_v = self._v.reshape(-1, 3)
         flat_mu = self._mu.reshape(-1)
         out = np.empty((flat_r.shape[0], _el.NCOL))
-        _el.state_to_elements(flat_r, flat_v, flat_mu, out)
+        _el.state_to_elements_basic(flat_r, flat_v, flat_mu, out)
         return out.reshape((*self._mu.shape, _el.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
-        return self._elements[..., _COL[name]]
+        el = self._elements
+        if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
+            # every column, in place (the classical ones come out bit for bit the same)
+            _el.state_to_elements(
+                self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
+                el.reshape(-1, _el.NCOL),
+            )
+            self.__dict__["_all_columns"] = True
+        return el[..., _COL[name]]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
-        if self._quantity and unit is not None:
+        if not self._quantity:
+            return value[()] if value.ndim == 0 else value
+        if unit is not None:
             # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
             return wrap(np.array(value, dtype=np.float64), unit, True)
         return _scalar(np.asarray(value))
@@ -431,6 +462,9 @@ class KeplerOrbit:
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
         inv = self._inv_a
+        if inv.ndim == 0 and not self._quantity:
+            x = float(inv)
+            return np.float64(math.inf if x == 0.0 else 1.0 / x)
         safe = np.where(inv == 0, 1.0, inv)
         return self._out(np.where(inv == 0, np.inf, 1.0 / safe), _L)
 
@@ -603,12 +637,49 @@ class KeplerOrbit:
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        fast = self._propagate_fast(dt)
+        if fast is not None:
+            return fast
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
         dt_ = strip("dt", dt, _T)
         r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
         mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
         return KeplerOrbit(r, v, mu, self._quantity)
+
+    def _propagate_fast(self, dt: Any) -> KeplerOrbit | None:
+        """:meth:`propagate` for plain floats: ``dt`` a finite number or a float64
+        array of the orbit's shape; the state was validated when the orbit was
+        built.  None for anything else or on failure (the general path then
+        names the argument)."""
+        if self._quantity:
+            return None
+        lead = self._mu.shape
+        n = self._mu.size
+        if type(dt) is float or (type(dt) is int and -(2**53) <= dt <= 2**53):
+            if not math.isfinite(dt):
+                return None
+            dtb = np.full(n, dt, dtype=np.float64)
+        elif (
+            type(dt) is np.ndarray and dt.dtype == np.float64 and dt.shape in (lead, ())
+            and bool(np.isfinite(dt).all())
+        ):
+            dtb = np.ascontiguousarray(np.broadcast_to(dt, lead)).reshape(n)
+        else:
+            return None
+        r_out = np.empty((n, 3))
+        v_out = np.empty((n, 3))
+        if n and _kk.propagate_batch(
+            self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), dtb,
+            r_out, v_out,
+        ) >= 0:
+            return None
+        obj = KeplerOrbit.__new__(KeplerOrbit)
+        obj._r = r_out.reshape((*lead, 3))
+        obj._v = v_out.reshape((*lead, 3))
+        obj._mu = self._mu  # never written to
+        obj._quantity = False
+        return obj
 
     @property
     def conic(self):

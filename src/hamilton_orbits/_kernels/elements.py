@@ -165,8 +165,13 @@ def _hyperbolic_anomaly(sn, cn, e, em1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
+def state_to_elements_one(
+    rx, ry, rz, vx, vy, vz, mu, accurate=False, full=True
+):  # pragma: no cover - compiled
     """Elements of one state; returns the tuple of ``COLUMNS``.
+
+    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN (not
+    computed: :func:`state_to_elements_basic`); every other column is the same.
 
     With ``accurate=False`` the anomaly and M are those of the element set as
     floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
@@ -266,6 +271,12 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     else:
         nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
         argp = wrap_2pi(u - nu)
+    if not full:
+        if e == 1.0 and inv_a != 0.0:
+            kind = RADIAL_ELLIPSE if inv_a > 0.0 else RADIAL_HYPERBOLA
+        else:
+            kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
+        return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
     if e == 1.0 and inv_a != 0.0:
         # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
         c = r * v2 / mu - 1.0
@@ -353,6 +364,18 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
     """Rows of ``r`` (N, 3), ``v`` (N, 3), ``mu`` (N,) into ``out`` (N, NCOL)."""
     for i in prange(r.shape[0]):
         res = state_to_elements_one(r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i])
+        for j in range(NCOL):
+            out[i, j] = res[j]
+
+
+@parallel_kernel
+def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
+    """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
+    ``out`` for non-radial orbits): the classical elements at ~2/3 of the cost."""
+    for i in prange(r.shape[0]):
+        res = state_to_elements_one(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False, False
+        )
         for j in range(NCOL):
             out[i, j] = res[j]
 
