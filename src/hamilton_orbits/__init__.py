@@ -5,10 +5,13 @@ The curated public API.  Everything not listed in ``__all__`` is private.
 
 from typing import TYPE_CHECKING, Any
 
+from hamilton_orbits._firstrun import install as _install_compile_notice
 from hamilton_orbits.conic import Conic
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
+
+_install_compile_notice()  # one line on stderr while kernels compile for the first time
 
 if TYPE_CHECKING:  # pragma: no cover
     from hamilton_orbits.nbody import Body, System
