@@ -120,6 +120,32 @@ def _plain_float_array(x: Any) -> np.ndarray | None:
     return x.astype(np.float64) if x.dtype.kind in "fiu" else None
 
 
+def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
+    """One orbit in plain floats (``r``, ``v`` lists/tuples of three floats or
+    float64 arrays of shape (3,), ``mu`` a float) as 7 floats, if finite with
+    ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
+    if type(mu) is not float:
+        return None
+    if type(r) is np.ndarray and r.shape == (3,) and r.dtype == np.float64:
+        r = r.tolist()
+    if type(v) is np.ndarray and v.shape == (3,) and v.dtype == np.float64:
+        v = v.tolist()
+    tr = type(r)
+    tv = type(v)
+    if not ((tr is list or tr is tuple) and (tv is list or tv is tuple)):
+        return None
+    if len(r) != 3 or len(v) != 3:
+        return None
+    rx, ry, rz = r
+    vx, vy, vz = v
+    if not (type(rx) is type(ry) is type(rz) is type(vx) is type(vy) is type(vz) is float):
+        return None
+    s = rx + ry + rz + vx + vy + vz + mu  # inf or NaN if any is (or on overflow: then
+    if s - s != 0.0 or not mu > 0.0 or not (rx or ry or rz):  # the general path decides)
+        return None
+    return rx, ry, rz, vx, vy, vz, mu
+
+
 def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     """The common case of :func:`_check_state` plus the copies ``KeplerOrbit``
     keeps, in one compiled pass: ``r`` and ``v`` float64 arrays of one shape
@@ -197,6 +223,13 @@ class KeplerOrbit:
     """
 
 
+    # one orbit built from plain floats: its 7 floats (r, v, mu), else None; the
+    # arrays _r, _v, _mu (instance attributes otherwise) are then made on demand
+    _one: tuple[float, ...] | None = None
+    _r = cached_property(lambda self: np.array(self._one[:3]))
+    _v = cached_property(lambda self: np.array(self._one[3:6]))
+    _mu = cached_property(lambda self: np.array(self._one[6]))
+
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
         # np.array, not ascontiguousarray (which turns 0-d into 1-d)
         self._r = np.array(r, dtype=np.float64, order="C")
@@ -237,6 +270,12 @@ class KeplerOrbit:
         >>> o.shape, [round(float(x), 12) for x in o.e]
         ((2,), [0.0, 0.5])
         """
+        one = _one_state(r, v, mu)
+        if one is not None:
+            obj = cls.__new__(cls)
+            obj._quantity = False
+            obj._one = one  # _r, _v, _mu are made from it when first needed
+            return obj
         fast = _check_copy_state_fast(r, v, mu)
         if fast is not None:
             obj = cls.__new__(cls)
@@ -395,6 +434,9 @@ class KeplerOrbit:
     def _elements(self) -> np.ndarray:
         # the classical columns only; the anomaly, M and tau (NaN here) are
         # filled in by _col on first request (about a third of the cost)
+        one = self._one
+        if one is not None:  # one orbit from plain floats: no arrays for the kernel
+            return np.array(_el.state_to_elements_row(*one, False))
         flat_r = self._r.reshape(-1, 3)
         flat_v = self._v.reshape(-1, 3)
         flat_mu = self._mu.reshape(-1)
@@ -406,15 +448,21 @@ class KeplerOrbit:
         el = self._elements
         if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
             # every column, in place (the classical ones come out bit for bit the same)
-            _el.state_to_elements(
-                self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
-                el.reshape(-1, _el.NCOL),
-            )
+            one = self._one
+            if one is not None:
+                el[:] = _el.state_to_elements_row(*one, True)
+            else:
+                _el.state_to_elements(
+                    self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
+                    el.reshape(-1, _el.NCOL),
+                )
             self.__dict__["_all_columns"] = True
-        return el[..., _COL[name]]
+        return el[_COL[name]] if el.ndim == 1 else el[..., _COL[name]]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
         if not self._quantity:
+            if type(value) is np.float64:
+                return value
             return value[()] if value.ndim == 0 else value
         if unit is not None:
             # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those

@@ -60,11 +60,17 @@ def test_plain_inputs_match_general_path(kind):
     elif kind == "ndarray":
         r, v = np.array(r), np.array(v)
     fast = KeplerOrbit.from_state(r, v, 1.0)
-    # an object array takes the general path
-    slow = KeplerOrbit.from_state(np.array(r, dtype=object).astype(float).tolist(), v, 1.0)
-    for n in (*NAMES, "M", "time_since_periapsis"):
-        assert getattr(fast, n) == getattr(slow, n), n
+    slow = KeplerOrbit.from_state(np.array(r, dtype=object), v, 1.0)  # the general path
+    batch = KeplerOrbit.from_state(np.atleast_2d(r), np.atleast_2d(v), np.ones(1))  # arrays
+    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude"):
+        assert getattr(fast, n) == getattr(slow, n) == getattr(batch, n)[0], n
     assert type(fast.e) is np.float64 and type(fast.a) is np.float64
+    assert fast.shape == slow.shape == ()
+    for x, y in zip(fast.state(), slow.state(), strict=True):
+        np.testing.assert_array_equal(x, y)
+    for x, y in zip(fast.propagate(0.7).state(), slow.propagate(0.7).state(), strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert fast.conic.e == slow.conic.e
 
 
 def test_propagate_fast_matches_general_path():

@@ -368,6 +368,13 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
+@njit(cache=True)
+def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
+    """The columns of one orbit (``full=False``: no anomaly, M, tau), called
+    directly from Python for a single orbit (no arrays to build)."""
+    return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, False, full)
+
+
 @parallel_kernel
 def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
     """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
