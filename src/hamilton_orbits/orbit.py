@@ -513,8 +513,8 @@ class KeplerOrbit:
         if inv.ndim == 0 and not self._quantity:
             x = float(inv)
             return np.float64(math.inf if x == 0.0 else 1.0 / x)
-        safe = np.where(inv == 0, 1.0, inv)
-        return self._out(np.where(inv == 0, np.inf, 1.0 / safe), _L)
+        with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
+            return self._out(1.0 / inv, _L)
 
     @property
     def q(self):

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from hamilton_orbits import KeplerOrbit
+from hamilton_orbits._kernels import _dispatch
 from hamilton_orbits._kernels import elements as _el
 from hamilton_orbits._kernels._dispatch import ParallelKernel
 
@@ -27,6 +28,30 @@ def _states(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     r = rng.normal(size=(n, 3))
     v = rng.normal(size=(n, 3)) * 0.8
     return r, v
+
+
+def test_serial_when_cores_are_busy(monkeypatch):
+    monkeypatch.setattr(_dispatch, "_cores_busy", lambda: True)
+    calls = []
+    kernel = _el.state_to_elements
+    monkeypatch.setattr(kernel, "parallel", lambda *a: calls.append("parallel"))
+    monkeypatch.setattr(kernel, "serial", lambda *a: calls.append("serial"))
+    big = np.zeros((kernel.threshold, 3))
+    kernel(big, big, np.ones(len(big)), np.empty((len(big), _el.NCOL)))
+    kernel(big[:2], big[:2], np.ones(2), np.empty((2, _el.NCOL)))
+    assert calls == ["serial", "serial"]
+    monkeypatch.setattr(_dispatch, "_cores_busy", lambda: False)
+    kernel(big, big, np.ones(len(big)), np.empty((len(big), _el.NCOL)))
+    assert calls[-1] == "parallel"
+
+
+def test_load_average_is_read_at_most_once_a_second(monkeypatch):
+    reads = []
+    monkeypatch.setattr(_dispatch.os, "getloadavg", lambda: reads.append(1) or (0.0, 0.0, 0.0))
+    monkeypatch.setitem(_dispatch._state, "load_t", -1e9)
+    assert _dispatch._cores_busy() is False
+    assert _dispatch._cores_busy() is False
+    assert len(reads) == 1
 
 
 def test_batch_kernels_are_dispatched():
@@ -44,7 +69,7 @@ def test_serial_and_parallel_agree_bitwise():
     a = np.empty((n, _el.NCOL))
     b = np.empty((n, _el.NCOL))
     _el.state_to_elements.serial(r, v, mu, a)
-    _el.state_to_elements(r, v, mu, b)  # above the threshold: the parallel variant
+    _el.state_to_elements.parallel(r, v, mu, b)
     np.testing.assert_array_equal(a, b)
 
 
@@ -58,7 +83,8 @@ def _work(seed: int) -> list[np.ndarray]:
     return out
 
 
-def test_calls_from_four_threads():
+def test_calls_from_four_threads(monkeypatch):
+    monkeypatch.setattr(_dispatch, "_cores_busy", lambda: False)  # parallel above threshold
     expected = [_work(seed) for seed in range(8)]
     with ThreadPoolExecutor(max_workers=4) as pool:
         got = list(pool.map(_work, range(8)))
@@ -78,8 +104,9 @@ def test_threads_with_workqueue_layer_do_not_abort():
         import numpy as np
         import numba
         from hamilton_orbits import KeplerOrbit
-        from hamilton_orbits._kernels import elements as _el
+        from hamilton_orbits._kernels import elements as _el, _dispatch
 
+        _dispatch._cores_busy = lambda: False  # launch in parallel even on a loaded machine
         n = 4 * _el.state_to_elements.threshold
         def work(seed):
             rng = np.random.default_rng(seed)
@@ -91,6 +118,7 @@ def test_threads_with_workqueue_layer_do_not_abort():
         with ThreadPoolExecutor(max_workers=4) as pool:
             res = list(pool.map(work, range(8)))
         assert res == [work(i) for i in range(8)]
+        assert _dispatch._state["layer"] == "workqueue"  # parallel launches did happen
         print(numba.threading_layer())
         """
     )

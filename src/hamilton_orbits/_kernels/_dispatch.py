@@ -5,7 +5,8 @@ start-up and join of the thread team cost more than the work, and on a loaded
 machine an OpenMP team can busy-wait for a core another process holds (calls
 on two orbits took up to 15 ms).  :func:`parallel_kernel` compiles a batch
 kernel twice, with ``parallel=True`` and without (``prange`` is then
-``range``), and calls the parallel one only for at least ``threshold`` rows.
+``range``), and calls the parallel one only for at least ``threshold`` rows
+and only while the load average leaves a core free.
 
 The threading layer must be chosen before numba starts its first thread team.
 ``workqueue`` aborts the process when two Python threads launch parallel
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 import os
 import threading
+import time
 import types
 from collections.abc import Callable
 from typing import Any
@@ -32,15 +34,33 @@ from typing import Any
 import numba
 from numba import njit
 
-# Rows below which the serial variant runs.  Measured break-even on a 2-core
-# machine (benchmarks/bench_overhead.py): a parallel launch costs ~5-20 us idle
-# and more when the cores are busy, the elements kernel ~0.15 us a row.
-DEFAULT_THRESHOLD = 4096
+# Rows below which the serial variant runs.  The elements kernel costs ~0.15-0.25
+# us a row; a parallel launch some 10-50 us on idle cores, so it pays from a few
+# thousand rows on (8192 leaves a margin).  On cores that other processes hold it
+# costs a scheduler time slice instead (measured 15 ms per launch with a load of
+# 5 on 2 cores, where 65536 rows still ran faster serially): then the serial
+# variant runs whatever the size (see _cores_busy).
+DEFAULT_THRESHOLD = 8192
+_LOAD_TTL = 1.0  # seconds between two reads of the load average
 
 _SAFE_LAYERS = ("tbb", "omp")
 _layer_lock = threading.Lock()
 _launch_lock = threading.Lock()
-_state: dict[str, Any] = {"layer": None}
+_state: dict[str, Any] = {"layer": None, "load_t": -1e9, "busy": False}
+
+
+def _cores_busy() -> bool:
+    """Whether the 1-minute load average reaches the number of cores (read at
+    most once a second): a thread team would then wait for time slices."""
+    now = time.monotonic()
+    if now - _state["load_t"] > _LOAD_TTL:
+        try:
+            busy = os.getloadavg()[0] >= (os.cpu_count() or 1)
+        except (AttributeError, OSError):  # pragma: no cover - no load average (Windows)
+            busy = False
+        _state["busy"] = busy
+        _state["load_t"] = now
+    return _state["busy"]
 
 
 def _loadable(layer: str) -> bool:
@@ -107,7 +127,7 @@ class ParallelKernel:
         self.__module__ = func.__module__
 
     def __call__(self, *args: Any) -> Any:
-        if args[0].shape[0] < self.threshold:
+        if args[0].shape[0] < self.threshold or _cores_busy():
             return self.serial(*args)
         layer = _state["layer"] or _choose_layer()
         if layer != "workqueue":
