@@ -702,6 +702,15 @@ class KeplerOrbit:
         names the argument)."""
         if self._quantity:
             return None
+        one = self._one
+        if one is not None and type(dt) is float and math.isfinite(dt):
+            *state, ok = _kk.propagate_one(*one, dt)
+            if not ok or not (state[0] or state[1] or state[2]):
+                return None
+            obj = KeplerOrbit.__new__(KeplerOrbit)
+            obj._quantity = False
+            obj._one = (*state, one[6])
+            return obj
         lead = self._mu.shape
         n = self._mu.size
         if type(dt) is float or (type(dt) is int and -(2**53) <= dt <= 2**53):

@@ -370,8 +370,9 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
-    """The columns of one orbit (``full=False``: no anomaly, M, tau), called
-    directly from Python for a single orbit (no arrays to build)."""
+    """The columns of one orbit (``full=False``: no anomaly, M, tau): the row of
+    :func:`state_to_elements_basic`, also called directly from Python for a
+    single orbit (no arrays to build)."""
     return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, False, full)
 
 
@@ -380,8 +381,8 @@ def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
     """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
     ``out`` for non-radial orbits): the classical elements at ~2/3 of the cost."""
     for i in prange(r.shape[0]):
-        res = state_to_elements_one(
-            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False, False
+        res = state_to_elements_row(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False
         )
         for j in range(NCOL):
             out[i, j] = res[j]
