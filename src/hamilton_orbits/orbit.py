@@ -61,6 +61,8 @@ _RAD = u.rad
 
 _COL = {name: i for i, name in enumerate(_el.COLUMNS)}
 _LAZY_COLS = frozenset(("anomaly", "M", "tau"))
+_F64 = np.dtype(np.float64)
+_INF = np.float64(np.inf)
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -126,13 +128,17 @@ def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
     ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
     if type(mu) is not float:
         return None
-    if type(r) is np.ndarray and r.shape == (3,) and r.dtype == np.float64:
+    if type(r) is np.ndarray:
+        if r.shape != (3,) or r.dtype != _F64:
+            return None
         r = r.tolist()
-    if type(v) is np.ndarray and v.shape == (3,) and v.dtype == np.float64:
+    elif type(r) is not list and type(r) is not tuple:
+        return None
+    if type(v) is np.ndarray:
+        if v.shape != (3,) or v.dtype != _F64:
+            return None
         v = v.tolist()
-    tr = type(r)
-    tv = type(v)
-    if not ((tr is list or tr is tuple) and (tv is list or tv is tuple)):
+    elif type(v) is not list and type(v) is not tuple:
         return None
     if len(r) != 3 or len(v) != 3:
         return None
@@ -445,7 +451,9 @@ class KeplerOrbit:
         return out.reshape((*self._mu.shape, _el.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
-        el = self._elements
+        el = self.__dict__.get("_elements")
+        if el is None:  # as self._elements, without cached_property's lock (3.11)
+            el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
         if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
             # every column, in place (the classical ones come out bit for bit the same)
             one = self._one
@@ -510,9 +518,8 @@ class KeplerOrbit:
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
         inv = self._inv_a
-        if inv.ndim == 0 and not self._quantity:
-            x = float(inv)
-            return np.float64(math.inf if x == 0.0 else 1.0 / x)
+        if type(inv) is np.float64 and not self._quantity:  # one orbit
+            return 1.0 / inv if inv else _INF
         with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
             return self._out(1.0 / inv, _L)
 
