@@ -35,12 +35,15 @@ import numba
 from numba import njit
 
 # Rows below which the serial variant runs.  The elements kernel costs ~0.15-0.25
-# us a row; a parallel launch some 10-50 us on idle cores, so it pays from a few
-# thousand rows on (8192 leaves a margin).  On cores that other processes hold it
-# costs a scheduler time slice instead (measured 15 ms per launch with a load of
-# 5 on 2 cores, where 65536 rows still ran faster serially): then the serial
+# us a row; a parallel launch some 10-50 us on idle cores, so there it pays from a
+# few thousand rows on.  But when another process holds a core, a launch costs a
+# scheduler time slice instead: measured 15 ms per launch on the 2-core
+# development machine shared with other jobs, at 256 rows as at 16384, even with
+# a load average below the core count (the load average lags bursts).  65536
+# rows (~15 ms serially) bound that stall to about the work itself, and still
+# gain on free cores.  With the load average at the core count the serial
 # variant runs whatever the size (see _cores_busy).
-DEFAULT_THRESHOLD = 8192
+DEFAULT_THRESHOLD = 65536
 _LOAD_TTL = 1.0  # seconds between two reads of the load average
 
 _SAFE_LAYERS = ("tbb", "omp")
