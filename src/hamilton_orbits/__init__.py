@@ -3,22 +3,63 @@
 The curated public API.  Everything not listed in ``__all__`` is private.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING, Any
 
+from hamilton_orbits._firstrun import install as _install_compile_notice
 from hamilton_orbits.conic import Conic
-from hamilton_orbits.ensemble import Ensemble
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
-from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
-from hamilton_orbits.rebound_bridge import crosscheck
-from hamilton_orbits.scene import Result, Scene
-from hamilton_orbits.simulation import Trajectory, integrate
 
-try:
-    __version__ = version("hamilton-orbits")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0.0.0+unknown"
+_install_compile_notice()  # one line on stderr while kernels compile for the first time
+
+if TYPE_CHECKING:  # pragma: no cover
+    from hamilton_orbits.ensemble import Ensemble
+    from hamilton_orbits.nbody import Body, System
+    from hamilton_orbits.rebound_bridge import crosscheck
+    from hamilton_orbits.scene import Result, Scene
+    from hamilton_orbits.simulation import Trajectory, integrate
+
+# The n-body and scene names are imported on first use (PEP 562), so that
+# ``import hamilton_orbits`` does not pull in their dependencies (tomllib,
+# scipy.integrate, rebound, ...) nor importlib.metadata for the version.
+_LAZY = {
+    "Body": "hamilton_orbits.nbody",
+    "System": "hamilton_orbits.nbody",
+    "crosscheck": "hamilton_orbits.rebound_bridge",
+    "Ensemble": "hamilton_orbits.ensemble",
+    "Result": "hamilton_orbits.scene",
+    "Scene": "hamilton_orbits.scene",
+    "Trajectory": "hamilton_orbits.simulation",
+    "integrate": "hamilton_orbits.simulation",
+}
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("hamilton-orbits")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0.0.0+unknown"
+
+
+def __getattr__(name: str) -> Any:
+    if name == "__version__":
+        value = _version()
+    elif name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+    else:
+        raise AttributeError(f"module 'hamilton_orbits' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = [
     "Body",

@@ -24,6 +24,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 from __future__ import annotations
 
 import functools
+import math
 from functools import cached_property
 from typing import Any
 
@@ -69,6 +70,11 @@ _MU = u.km**3 / u.s**2
 _RAD = u.rad
 
 _COL = {name: i for i, name in enumerate(_el.COLUMNS)}
+_LAZY_COLS = frozenset(("anomaly", "M", "tau"))
+# the columns the basic kernel computes (the lazy ones are NaN until asked for)
+_BASIC_IDX = np.array([i for i, name in enumerate(_el.COLUMNS) if name not in _LAZY_COLS])
+_F64 = np.dtype(np.float64)
+_INF = np.float64(np.inf)
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -110,6 +116,53 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
     return r, v, mu, quantity
 
 
+def _plain_float_array(x: Any) -> np.ndarray | None:
+    """``x`` as a float64 ndarray if it is a plain real ndarray, list or tuple
+    (no Quantity, complex, bool, object or ragged input), else None."""
+    t = type(x)
+    if t is np.ndarray:
+        if x.dtype == np.float64:
+            return x
+    elif t is list or t is tuple:
+        try:
+            x = np.asarray(x)
+        except (ValueError, TypeError, OverflowError):
+            return None
+    else:
+        return None
+    return x.astype(np.float64) if x.dtype.kind in "fiu" else None
+
+
+def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
+    """One orbit in plain floats (``r``, ``v`` lists/tuples of three floats or
+    float64 arrays of shape (3,), ``mu`` a float) as 7 floats, if finite with
+    ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
+    if type(mu) is not float:
+        return None
+    if type(r) is np.ndarray:
+        if r.shape != (3,) or r.dtype != _F64:
+            return None
+        r = r.tolist()
+    elif type(r) is not list and type(r) is not tuple:
+        return None
+    if type(v) is np.ndarray:
+        if v.shape != (3,) or v.dtype != _F64:
+            return None
+        v = v.tolist()
+    elif type(v) is not list and type(v) is not tuple:
+        return None
+    if len(r) != 3 or len(v) != 3:
+        return None
+    rx, ry, rz = r
+    vx, vy, vz = v
+    if not (type(rx) is type(ry) is type(rz) is type(vx) is type(vy) is type(vz) is float):
+        return None
+    s = rx + ry + rz + vx + vy + vz + mu  # inf or NaN if any is (or on overflow: then
+    if s - s != 0.0 or not mu > 0.0 or not (rx or ry or rz):  # the general path decides)
+        return None
+    return rx, ry, rz, vx, vy, vz, mu
+
+
 def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     """The common case of :func:`_check_state` plus the copies ``KeplerOrbit``
     keeps, in one compiled pass: ``r`` and ``v`` float64 arrays of one shape
@@ -117,9 +170,9 @@ def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
     Returns ``(r, v, mu)`` (fresh C-contiguous arrays, as ``__init__`` makes),
     or None when the input is of another kind or invalid; the caller then takes
     the general path, which names the first bad argument and index."""
-    if type(r_in) is not np.ndarray or type(v_in) is not np.ndarray:
-        return None
-    if r_in.dtype != np.float64 or v_in.dtype != np.float64:
+    r_in = _plain_float_array(r_in)
+    v_in = _plain_float_array(v_in)
+    if r_in is None or v_in is None:
         return None
     shape = r_in.shape
     if v_in.shape != shape or len(shape) == 0 or shape[-1] != 3:
@@ -224,6 +277,13 @@ class KeplerOrbit:
     """
 
 
+    # one orbit built from plain floats: its 7 floats (r, v, mu), else None; the
+    # arrays _r, _v, _mu (instance attributes otherwise) are then made on demand
+    _one: tuple[float, ...] | None = None
+    _r = cached_property(lambda self: np.array(self._one[:3]))
+    _v = cached_property(lambda self: np.array(self._one[3:6]))
+    _mu = cached_property(lambda self: np.array(self._one[6]))
+
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
         # np.array, not ascontiguousarray (which turns 0-d into 1-d)
         self._r = np.array(r, dtype=np.float64, order="C")
@@ -296,6 +356,12 @@ class KeplerOrbit:
         >>> o.shape, [round(float(x), 12) for x in o.e]
         ((2,), [0.0, 0.5])
         """
+        one = _one_state(r, v, mu)
+        if one is not None:
+            obj = cls.__new__(cls)
+            obj._quantity = False
+            obj._one = one  # _r, _v, _mu are made from it when first needed
+            return obj
         fast = _check_copy_state_fast(r, v, mu)
         if fast is not None:
             obj = cls.__new__(cls)
@@ -459,19 +525,48 @@ class KeplerOrbit:
     # --------------------------------------------------------------- elements
     @cached_property
     def _elements(self) -> np.ndarray:
+        # the classical columns only; the anomaly, M and tau (NaN here) are
+        # filled in by _col on first request (about a third of the cost)
+        one = self._one
+        if one is not None:  # one orbit from plain floats: no arrays for the kernel
+            row = np.array(_el.state_to_elements_row(*one, False))
+            if not math.isfinite(row[_BASIC_IDX].sum()):
+                _refuse_beyond_range(row[None, _BASIC_IDX], np.array([one[:3]]),
+                                     np.array([one[3:6]]), np.array([one[6]]), ())
+            return row
         flat_r = self._r.reshape(-1, 3)
         flat_v = self._v.reshape(-1, 3)
         flat_mu = self._mu.reshape(-1)
         out = np.empty((flat_r.shape[0], _el.NCOL))
-        _el.state_to_elements(flat_r, flat_v, flat_mu, out)
-        _refuse_beyond_range(out, flat_r, flat_v, flat_mu, self._mu.shape)
+        _el.state_to_elements_basic(flat_r, flat_v, flat_mu, out)
+        _refuse_beyond_range(out[:, _BASIC_IDX], flat_r, flat_v, flat_mu, self._mu.shape)
         return out.reshape((*self._mu.shape, _el.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
-        return self._elements[..., _COL[name]]
+        el = self.__dict__.get("_elements")
+        if el is None:  # as self._elements, without cached_property's lock (3.11)
+            el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
+        if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
+            # every column, in place (the classical ones come out bit for bit the same)
+            one = self._one
+            if one is not None:
+                el[:] = _el.state_to_elements_row(*one, True)
+            else:
+                _el.state_to_elements(
+                    self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
+                    el.reshape(-1, _el.NCOL),
+                )
+            _refuse_beyond_range(el.reshape(-1, _el.NCOL), self._r.reshape(-1, 3),
+                                 self._v.reshape(-1, 3), self._mu.reshape(-1), self._mu.shape)
+            self.__dict__["_all_columns"] = True
+        return el[_COL[name]] if el.ndim == 1 else el[..., _COL[name]]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
-        if self._quantity and unit is not None:
+        if not self._quantity:
+            if type(value) is np.float64:
+                return value
+            return value[()] if value.ndim == 0 else value
+        if unit is not None:
             # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
             return wrap(np.array(value, dtype=np.float64), unit, True)
         return _scalar(np.asarray(value))
@@ -552,8 +647,10 @@ class KeplerOrbit:
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
         inv = self._inv_a
-        safe = np.where(inv == 0, 1.0, inv)
-        return self._out(np.where(inv == 0, np.inf, 1.0 / safe), _L)
+        if type(inv) is np.float64 and not self._quantity:  # one orbit
+            return 1.0 / inv if inv else _INF
+        with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
+            return self._out(1.0 / inv, _L)
 
     @property
     def q(self):
@@ -731,12 +828,58 @@ class KeplerOrbit:
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        fast = self._propagate_fast(dt)
+        if fast is not None:
+            return fast
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
         dt_ = TIME("dt", dt, _T)
         r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
         mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
         return KeplerOrbit(r, v, mu, self._quantity)
+
+    def _propagate_fast(self, dt: Any) -> KeplerOrbit | None:
+        """:meth:`propagate` for plain floats: ``dt`` a finite number or a float64
+        array of the orbit's shape; the state was validated when the orbit was
+        built.  None for anything else or on failure (the general path then
+        names the argument)."""
+        if self._quantity:
+            return None
+        one = self._one
+        if one is not None and type(dt) is float and math.isfinite(dt):
+            *state, ok = _kk.propagate_one(*one, dt)
+            if not ok or not (state[0] or state[1] or state[2]):
+                return None
+            obj = KeplerOrbit.__new__(KeplerOrbit)
+            obj._quantity = False
+            obj._one = (*state, one[6])
+            return obj
+        lead = self._mu.shape
+        n = self._mu.size
+        if type(dt) is float or (type(dt) is int and -(2**53) <= dt <= 2**53):
+            if not math.isfinite(dt):
+                return None
+            dtb = np.full(n, dt, dtype=np.float64)
+        elif (
+            type(dt) is np.ndarray and dt.dtype == np.float64 and dt.shape in (lead, ())
+            and bool(np.isfinite(dt).all())
+        ):
+            dtb = np.ascontiguousarray(np.broadcast_to(dt, lead)).reshape(n)
+        else:
+            return None
+        r_out = np.empty((n, 3))
+        v_out = np.empty((n, 3))
+        if n and _kk.propagate_batch(
+            self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), dtb,
+            r_out, v_out,
+        ) >= 0:
+            return None
+        obj = KeplerOrbit.__new__(KeplerOrbit)
+        obj._r = r_out.reshape((*lead, 3))
+        obj._v = v_out.reshape((*lead, 3))
+        obj._mu = self._mu  # never written to
+        obj._quantity = False
+        return obj
 
     @property
     def conic(self):

@@ -36,6 +36,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     _two_prod,
     anomaly_from_nu,
@@ -187,8 +188,13 @@ def _dot3_compensated(ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
+def state_to_elements_one(
+    rx, ry, rz, vx, vy, vz, mu, accurate=False, full=True
+):  # pragma: no cover - compiled
     """Elements of one state; returns the tuple of ``COLUMNS``.
+
+    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN (not
+    computed: :func:`state_to_elements_basic`); every other column is the same.
 
     With ``accurate=False`` the anomaly and M are those of the element set as
     floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
@@ -291,6 +297,12 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
     else:
         nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
         argp = wrap_2pi(u - nu)
+    if not full:
+        if e == 1.0 and inv_a != 0.0:
+            kind = RADIAL_ELLIPSE if inv_a > 0.0 else RADIAL_HYPERBOLA
+        else:
+            kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
+        return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
     if e == 1.0 and inv_a != 0.0:
         # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
         c = r * v2 / mu - 1.0
@@ -374,7 +386,9 @@ def state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma
 
 
 @njit(cache=True)
-def state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pragma: no cover
+def state_to_elements_scaled(
+    rx, ry, rz, vx, vy, vz, mu, accurate=False, full=True
+):  # pragma: no cover - compiled
     """:func:`state_to_elements_one` on the state scaled to order 1
     (:func:`hamilton_orbits._kernels.kepler.state_scales`): ``p``, ``inv_a`` and
     the time are scaled back exactly, every other column is scale-free."""
@@ -383,11 +397,11 @@ def state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pra
         nan = math.nan
         return nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
-        return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate)
+        return state_to_elements_one(rx, ry, rz, vx, vy, vz, mu, accurate, full)
     p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau = state_to_elements_one(
         math.ldexp(rx, -er), math.ldexp(ry, -er), math.ldexp(rz, -er),
         math.ldexp(vx, -ev), math.ldexp(vy, -ev), math.ldexp(vz, -ev),
-        math.ldexp(mu, -er - 2 * ev), accurate,
+        math.ldexp(mu, -er - 2 * ev), accurate, full,
     )
     return (
         math.ldexp(p, er), e, math.ldexp(inv_a, -er), inc, lan, argp, nu, anom, m, u, kind,
@@ -395,7 +409,7 @@ def state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, accurate=False):  # pra
     )
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
     """Rows of ``r`` (N, 3), ``v`` (N, 3), ``mu`` (N,) into ``out`` (N, NCOL)."""
     for i in prange(r.shape[0]):
@@ -406,7 +420,27 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
+def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
+    """The columns of one orbit (``full=False``: no anomaly, M, tau): the row of
+    :func:`state_to_elements_basic`, also called directly from Python for a
+    single orbit (no arrays to build)."""
+    return state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, False, full)
+
+
+@parallel_kernel
+def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
+    """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
+    ``out`` for non-radial orbits): the classical elements at ~2/3 of the cost."""
+    for i in prange(r.shape[0]):
+        res = state_to_elements_row(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False
+        )
+        for j in range(NCOL):
+            out[i, j] = res[j]
+
+
+@parallel_kernel
 def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
     """Time since periapsis of rows of ``r``, ``v`` (N, 3), ``mu`` (N,) into ``out`` (N,).
 
@@ -420,7 +454,7 @@ def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
         out[i] = res[NCOL - 1]
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - compiled
     """Copy rows of ``r``, ``v`` (N, 3) and ``mu`` (N,) or (1,) (broadcast) into
     ``r_out``, ``v_out``, ``mu_out`` (N,) in one pass; return the number of rows
@@ -569,7 +603,7 @@ def elements_to_state_scaled(p, e, inv_a, inc, lan, argp, anom, mu):  # pragma: 
     )
 
 
-@njit(cache=True, parallel=True)
+@parallel_kernel
 def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
     """Rows of ``el`` (N, 7: p, e, inv_a, inc, lan, argp, anomaly) and ``mu``
     into ``r_out``, ``v_out`` (N, 3)."""

@@ -25,7 +25,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, vectorize
+from numba import njit
+
+from hamilton_orbits._kernels._dispatch import lazy_vectorize
 
 EPS = 2.220446049250313e-16
 PI = math.pi
@@ -386,31 +388,31 @@ def solve_radial(m, inv_a):  # pragma: no cover - compiled
     return -x if m < 0.0 else x
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def solve_radial_ufunc(m, inv_a):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`solve_radial`."""
     return solve_radial(m, inv_a)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def solve_ufunc(m, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`solve`."""
     return solve(m, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def mean_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`mean_from_anomaly`."""
     return mean_from_anomaly(anom, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def anomaly_from_nu_ufunc(nu, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`anomaly_from_nu`."""
     return anomaly_from_nu(nu, e)
 
 
-@vectorize(["float64(float64, float64)"], cache=True)
+@lazy_vectorize(["float64(float64, float64)"], cache=True)
 def nu_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
     """Broadcasting ufunc of :func:`nu_from_anomaly`."""
     return nu_from_anomaly(anom, e)
@@ -792,6 +794,28 @@ def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
     return bad
 
 
+@njit(cache=True)
+def propagate_one(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
+    """One orbit through :func:`propagate_batch` (the same code, no arrays to
+    build in Python): ``(rx, ry, rz, vx, vy, vz, ok)``."""
+    r = np.empty((1, 3))
+    v = np.empty((1, 3))
+    r[0, 0] = rx
+    r[0, 1] = ry
+    r[0, 2] = rz
+    v[0, 0] = vx
+    v[0, 1] = vy
+    v[0, 2] = vz
+    m = np.full(1, mu)
+    d = np.full(1, dt)
+    r_out = np.empty((1, 3))
+    v_out = np.empty((1, 3))
+    bad = propagate_batch(r, v, m, d, r_out, v_out)
+    return (
+        r_out[0, 0], r_out[0, 1], r_out[0, 2], v_out[0, 0], v_out[0, 1], v_out[0, 2], bad < 0
+    )
+
+
 __all__ = [
     "EPS",
     "anomaly_from_nu",
@@ -801,6 +825,7 @@ __all__ = [
     "nu_from_anomaly",
     "nu_from_anomaly_ufunc",
     "propagate_batch",
+    "propagate_one",
     "propagate_uv",
     "sinh_minus_x",
     "solve",

@@ -11,7 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import guvectorize, njit
+from numba import njit
+
+from hamilton_orbits._kernels._dispatch import lazy_guvectorize
 
 
 @njit(inline="always", cache=True)
@@ -95,7 +97,7 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     return math.ldexp(rx, ev), math.ldexp(ry, ev), math.ldexp(rz, ev)
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
 )
 def qmul_gufunc(a, b, out):  # pragma: no cover - compiled
@@ -107,7 +109,7 @@ def qmul_gufunc(a, b, out):  # pragma: no cover - compiled
     out[3] = z
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(m)->(m)", cache=True, nopython=True
 )
 def qrot_gufunc(q, v, out):  # pragma: no cover - compiled

@@ -1,0 +1,283 @@
+"""Per-call overhead, throughput beside a minimal kernel, and the first run.
+
+Run:  python benchmarks/bench_overhead.py [--quick]
+
+One process for ours and rebound, same states for both.  Times are medians of
+several repeats (each repeat loops a call until it has run >= 20 ms), after a
+warm-up; ratios are peer time / our time (> 1: we are faster).
+
+1. Per call at N = 1, 10, ..., 1e7 (1e6 with --quick) orbits:
+   * elements: ``KeplerOrbit.from_state(r, v, mu)`` then reading a, e, inc,
+     lan, argp, nu, beside rebound's ``p.orbit(primary=star)`` for each of N
+     test particles (a Python loop over particles, reading the same six).
+   * propagation: ``orbit.propagate(dt)`` beside rebound WHFast's one step of
+     ``dt`` of N massless particles around one star (N_active = 1), the
+     Kepler drift of every particle in one C call (``sim.integrate``).
+   rebound stops at 1e5 (1e6 without --quick) orbits: its cost per orbit is
+   flat by then.
+2. Elements throughput at N = 1e6 on one thread (``numba.set_num_threads(1)``)
+   and on all cores: ours (the same call as in 1, and the kernel alone) beside
+   a minimal kernel written here (a, e, inc, lan, argp, nu of one state by the
+   textbook formulas, no special cases, no validation) as the yardstick, and
+   beside rebound per orbit (single-threaded), per core and on all cores.
+3. The main job (``hamilton-orbits``, the solar-system scene) in a subprocess:
+   cold (``NUMBA_CACHE_DIR`` a fresh empty folder) and warm, wall clock; and
+   ``import hamilton_orbits`` beside ``import numpy, scipy, astropy.units,
+   numba`` (median of 5 subprocesses each).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+
+# --------------------------------------------------------------- yardstick
+def _minimal_body(r, v, mu, out):  # pragma: no cover - compiled
+    """a, e, inc, lan, argp, nu of each state: the textbook formulas only."""
+    two_pi = 2.0 * math.pi
+    for i in prange(r.shape[0]):
+        rx, ry, rz = r[i, 0], r[i, 1], r[i, 2]
+        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
+        m = mu[i]
+        rr = math.sqrt(rx * rx + ry * ry + rz * rz)
+        v2 = vx * vx + vy * vy + vz * vz
+        rv = rx * vx + ry * vy + rz * vz
+        hx = ry * vz - rz * vy
+        hy = rz * vx - rx * vz
+        hz = rx * vy - ry * vx
+        h = math.sqrt(hx * hx + hy * hy + hz * hz)
+        inv_a = 2.0 / rr - v2 / m
+        f = v2 - m / rr
+        ex = (f * rx - rv * vx) / m
+        ey = (f * ry - rv * vy) / m
+        ez = (f * rz - rv * vz) / m
+        rho = math.hypot(hx, hy)
+        nx = -hy / rho
+        ny = hx / rho
+        u = math.atan2(hz * (ry * nx - rx * ny) + rz * rho, h * (rx * nx + ry * ny))
+        nu = math.atan2(rv * h, h * h - m * rr)
+        out[i, 0] = 1.0 / inv_a
+        out[i, 1] = math.sqrt(ex * ex + ey * ey + ez * ez)
+        out[i, 2] = math.atan2(rho, hz)
+        out[i, 3] = math.atan2(hx, -hy) % two_pi
+        out[i, 4] = (u - nu) % two_pi
+        out[i, 5] = nu
+
+
+minimal_parallel = njit(parallel=True)(_minimal_body)
+
+
+# ------------------------------------------------------------------ timing
+def _per_call(fn, repeat: int) -> float:
+    """Median over ``repeat`` of the time per call, each repeat >= 20 ms."""
+    fn()
+    t0 = time.perf_counter()
+    fn()
+    once = time.perf_counter() - t0
+    loops = max(1, int(0.02 / max(once, 1e-7)))
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(loops):
+            fn()
+        times.append((time.perf_counter() - t0) / loops)
+    return statistics.median(times)
+
+
+def _states(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Bound, inclined orbits around mu = 1 (a in [0.5, 5], e in [0, 0.9])."""
+    rng = np.random.default_rng(seed)
+    a = rng.uniform(0.5, 5.0, n)
+    e = rng.uniform(0.0, 0.9, n)
+    inc = rng.uniform(0.01, np.pi - 0.01, n)
+    lan = rng.uniform(0.0, 2 * np.pi, n)
+    nu = rng.uniform(-np.pi, np.pi, n)
+    p = a * (1 - e * e)
+    rr = p / (1 + e * np.cos(nu))
+    x, y = rr * np.cos(nu), rr * np.sin(nu)
+    k = np.sqrt(1.0 / p)
+    vx, vy = -k * np.sin(nu), k * (e + np.cos(nu))
+    ci, si, cl, sl = np.cos(inc), np.sin(inc), np.cos(lan), np.sin(lan)
+    r = np.stack([x * cl - y * ci * sl, x * sl + y * ci * cl, y * si], -1)
+    v = np.stack([vx * cl - vy * ci * sl, vx * sl + vy * ci * cl, vy * si], -1)
+    return np.ascontiguousarray(r), np.ascontiguousarray(v)
+
+
+def _rebound_sim(r: np.ndarray, v: np.ndarray):
+    import rebound
+
+    sim = rebound.Simulation()
+    sim.G = 1.0
+    sim.add(m=1.0)
+    for i in range(len(r)):
+        sim.add(m=0.0, x=r[i, 0], y=r[i, 1], z=r[i, 2], vx=v[i, 0], vy=v[i, 1], vz=v[i, 2])
+    sim.N_active = 1
+    sim.testparticle_type = 0
+    return sim
+
+
+# ------------------------------------------------------------------- parts
+def bench_per_call(nmax: int, nmax_rebound: int, repeat: int) -> None:
+    from hamilton_orbits import KeplerOrbit
+
+    print("\n1. Per call (median of repeats), ours beside rebound")
+    print(f"{'N':>9} | {'elements ours':>14} {'rebound':>12} {'ratio':>7} | "
+          f"{'propagate ours':>14} {'rebound':>12} {'ratio':>7}")
+    dt = 0.37
+    n = 1
+    while n <= nmax:
+        r, v = _states(n)
+        if n == 1:
+            r, v = r[0], v[0]
+        mu = 1.0
+
+        def ours_el(r=r, v=v, mu=mu):
+            o = KeplerOrbit.from_state(r, v, mu)
+            return o.a, o.e, o.inc, o.lan, o.argp, o.nu
+
+        orbit = KeplerOrbit.from_state(r, v, mu)
+        rep = repeat if n <= 100_000 else max(3, repeat // 2)
+        t_el = _per_call(ours_el, rep)
+        t_pr = _per_call(lambda orbit=orbit: orbit.propagate(dt), rep)
+        if n <= nmax_rebound:
+            sim = _rebound_sim(np.atleast_2d(r), np.atleast_2d(v))
+            ps = sim.particles
+            star = ps[0]
+            plist = [ps[i] for i in range(1, n + 1)]
+
+            def reb_el(plist=plist, star=star):
+                for p in plist:
+                    o = p.orbit(primary=star)
+                    o.a, o.e, o.inc, o.Omega, o.omega, o.f  # noqa: B018
+
+            sim.integrator = "whfast"
+            sim.dt = dt
+            xyz = np.zeros((n + 1, 3))
+            vxyz = np.zeros((n + 1, 3))
+            sim.serialize_particle_data(xyz=xyz, vxvyvz=vxyz)
+
+            def reb_pr(sim=sim, xyz=xyz, vxyz=vxyz):
+                sim.t = 0.0
+                sim.set_serialized_particle_data(xyz=xyz, vxvyvz=vxyz)
+                sim.integrate(dt)  # one WHFast step: the Kepler drift of each particle
+
+            t_rel = _per_call(reb_el, rep)
+            t_rpr = _per_call(reb_pr, rep)
+            print(f"{n:>9} | {t_el * 1e6:>11.2f} us {t_rel * 1e6:>9.2f} us {t_rel / t_el:>7.2f} | "
+                  f"{t_pr * 1e6:>11.2f} us {t_rpr * 1e6:>9.2f} us {t_rpr / t_pr:>7.2f}")
+        else:
+            print(f"{n:>9} | {t_el * 1e6:>11.2f} us {'-':>12} {'-':>7} | "
+                  f"{t_pr * 1e6:>11.2f} us {'-':>12} {'-':>7}")
+        n *= 10
+
+
+def bench_throughput(n: int, repeat: int) -> None:
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits._kernels import elements as _el
+
+    r, v = _states(n, seed=1)
+    mu = np.ones(n)
+    out6 = np.empty((n, 6))
+    out = np.empty((n, _el.NCOL))
+
+    def ours():
+        o = KeplerOrbit.from_state(r, v, mu)
+        return o.a, o.e, o.inc, o.lan, o.argp, o.nu
+
+    nr = min(n, 100_000)
+    sim = _rebound_sim(r[:nr], v[:nr])
+    ps = sim.particles
+    star = ps[0]
+    plist = [ps[i] for i in range(1, nr + 1)]
+
+    def reb():
+        for p in plist:
+            o = p.orbit(primary=star)
+            o.a, o.e, o.inc, o.Omega, o.omega, o.f  # noqa: B018
+
+    t_reb = _per_call(reb, max(3, repeat // 2)) / nr
+    all_threads = numba.config.NUMBA_NUM_THREADS
+    print(f"\n2. Elements throughput, N = {n:.0e} (ns per orbit; rebound "
+          f"{t_reb * 1e9:.0f} ns/orbit, one thread)")
+    print("minimal: the yardstick into a preallocated output; +alloc: allocating its output"
+          " (as an API returning fresh arrays must); kernel: our elements kernel alone;"
+          " ours: from_state + reading the six")
+    print(f"{'threads':>8} | {'minimal':>9} {'+alloc':>9} {'kernel':>9} {'ours':>9} | "
+          f"{'kernel/min':>10} {'ours/min':>8} {'ours/+alloc':>11} | {'rebound/ours':>12}")
+    for threads in sorted({1, all_threads}):
+        numba.set_num_threads(threads)
+        t_min = _per_call(lambda: minimal_parallel(r, v, mu, out6), repeat) / n
+        t_mina = _per_call(lambda: minimal_parallel(r, v, mu, np.empty((n, 6))), repeat) / n
+        t_k = _per_call(lambda: _el.state_to_elements_basic.parallel(r, v, mu, out), repeat) / n
+        t_o = _per_call(ours, repeat) / n
+        print(f"{threads:>8} | {t_min * 1e9:>9.1f} {t_mina * 1e9:>9.1f} {t_k * 1e9:>9.1f} "
+              f"{t_o * 1e9:>9.1f} | {t_k / t_min:>10.2f} {t_o / t_min:>8.2f} "
+              f"{t_o / t_mina:>11.2f} | {t_reb / t_o:>12.1f}")
+    numba.set_num_threads(all_threads)
+
+
+def _wall(cmd: list[str], env: dict, cwd: str) -> tuple[float, str]:
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, text=True, timeout=3600)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr[-2000:])
+    return wall, proc.stderr
+
+
+def bench_first_run(repeat_warm: int) -> None:
+    print("\n3. First run")
+    env = dict(os.environ, PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    imp = [sys.executable, "-c", "import hamilton_orbits"]
+    base = [sys.executable, "-c", "import numpy, scipy, astropy.units, numba"]
+    with tempfile.TemporaryDirectory() as cwd:
+        _wall(imp, env, cwd)
+        t_imp = statistics.median(_wall(imp, env, cwd)[0] for _ in range(5))
+        t_base = statistics.median(_wall(base, env, cwd)[0] for _ in range(5))
+    print(f"warm import hamilton_orbits {t_imp:.2f} s; numpy+scipy+astropy.units+numba "
+          f"{t_base:.2f} s (ratio {t_imp / t_base:.2f})")
+    job = [sys.executable, "-m", "hamilton_orbits.cli", "run", "--no-progress"]
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
+        cold_env = dict(env, NUMBA_CACHE_DIR=cache)
+        t_cold, err = _wall(job, cold_env, cwd)
+        notice = "notice printed" if "compiling numerical kernels" in err else "NO notice"
+        warm = [_wall(job, cold_env, cwd)[0] for _ in range(repeat_warm)]
+    print(f"hamilton-orbits (solar-system scene): cold {t_cold:.1f} s ({notice}), "
+          f"warm {statistics.median(warm):.1f} s (median of {repeat_warm})")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
+    parser.add_argument("--skip", nargs="*", default=[], choices=["calls", "throughput", "first"],
+                        help="parts to leave out")
+    args = parser.parse_args()
+    nmax = 10**6 if args.quick else 10**7
+    nmax_reb = 10**5 if args.quick else 10**6
+    repeat = 5 if args.quick else 9
+    print(f"numba {numba.__version__}, threading layer after first use; "
+          f"{numba.config.NUMBA_NUM_THREADS} threads; load average {os.getloadavg()[0]:.1f}")
+    if "calls" not in args.skip:
+        bench_per_call(nmax, nmax_reb, repeat)
+    if "throughput" not in args.skip:
+        bench_throughput(10**6, repeat)
+    if "first" not in args.skip:
+        bench_first_run(2 if args.quick else 5)
+
+
+if __name__ == "__main__":
+    main()

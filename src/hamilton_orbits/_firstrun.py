@@ -1,0 +1,67 @@
+"""A one-line notice on stderr while the package's kernels compile for the first time.
+
+With no numba cache, the first calls compile kernels for seconds (about 20 s
+for the main job), which otherwise looks like a hang.  A listener on numba's
+``numba:compile`` event (fired only when a function is really compiled, not
+when it is loaded from the on-disk cache) prints one line the first time a
+function of this package (or of ``rigid``) compiles, at most once per process.
+It is a plain line on stderr, not a warning (the test suite turns warnings into
+errors), and costs nothing once the cache is warm.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+
+from numba.core import event
+
+NOTICE = (
+    "hamilton-orbits: compiling numerical kernels for first use "
+    "(once; cached for later runs, can take ~20 s) ..."
+)
+PACKAGES = ("hamilton_orbits", "rigid")
+
+_lock = threading.Lock()
+_state = {"printed": False}
+
+
+def _ours(dispatcher: object) -> bool:
+    func = getattr(dispatcher, "py_func", None)
+    module = getattr(func, "__module__", None) or ""
+    return module.split(".", 1)[0] in PACKAGES
+
+
+class _CompileNotice(event.Listener):
+    def on_start(self, ev: event.Event) -> None:
+        if _state["printed"]:
+            return
+        data = ev.data if isinstance(ev.data, dict) else {}
+        if not _ours(data.get("dispatcher")):
+            return
+        with _lock:
+            if _state["printed"]:
+                return
+            _state["printed"] = True
+        try:
+            print(NOTICE, file=sys.stderr, flush=True)
+        except (OSError, ValueError):  # pragma: no cover - stderr closed
+            pass
+
+    def on_end(self, ev: event.Event) -> None:
+        pass
+
+
+def install() -> None:
+    """Register the listener (once).
+
+    Examples
+    --------
+    >>> install()
+    >>> install()  # idempotent
+    """
+    with _lock:
+        if _state.get("installed"):
+            return
+        event.register("numba:compile", _CompileNotice())
+        _state["installed"] = True

@@ -1,0 +1,108 @@
+"""Fast paths for plain floats and lazily computed columns must not change results.
+
+Invariants: the fast path and the general path give the same bits; the
+classical columns of the basic kernel equal those of the full kernel; errors
+still name the argument and index.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hamilton_orbits import KeplerOrbit
+from hamilton_orbits._kernels import elements as _el
+
+NAMES = ("a", "e", "p", "inc", "lan", "argp", "nu", "argument_of_latitude")
+
+
+def _states(n: int, seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    r = rng.normal(size=(n, 3))
+    v = rng.normal(size=(n, 3)) * rng.uniform(0.1, 1.6, size=(n, 1))
+    v[0] = [0.0, 1.0, 0.0]  # a circle
+    r[1], v[1] = [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]  # radial
+    return r, v
+
+
+def test_basic_kernel_columns_equal_full_kernel():
+    r, v = _states(200)
+    mu = np.ones(len(r))
+    full = np.empty((len(r), _el.NCOL))
+    basic = np.empty((len(r), _el.NCOL))
+    _el.state_to_elements(r, v, mu, full)
+    _el.state_to_elements_basic(r, v, mu, basic)
+    keep = [i for i, c in enumerate(_el.COLUMNS) if c not in ("anomaly", "M", "tau")]
+    np.testing.assert_array_equal(basic[:, keep], full[:, keep])
+
+
+def test_lazy_columns_same_in_any_order():
+    r, v = _states(50)
+    first = KeplerOrbit.from_state(r, v, 1.0)
+    m_first, anom_first = first.M, first.anomaly  # the anomalies before anything else
+    later = KeplerOrbit.from_state(r, v, 1.0)
+    classical = [getattr(later, n) for n in NAMES]
+    np.testing.assert_array_equal(later.M, m_first)
+    np.testing.assert_array_equal(later.anomaly, anom_first)
+    for n, x in zip(NAMES, classical, strict=True):  # unchanged by the fill
+        np.testing.assert_array_equal(getattr(later, n), x)
+        np.testing.assert_array_equal(getattr(first, n), x)
+    assert np.all(np.isfinite(later.M))
+
+
+@pytest.mark.parametrize("kind", ["list", "tuple", "int", "ndarray"])
+def test_plain_inputs_match_general_path(kind):
+    r, v = [1.0, 0.25, -0.5], [0.0, 1.0, 0.25]
+    if kind == "tuple":
+        r, v = tuple(r), tuple(v)
+    elif kind == "int":
+        r, v = [1, 0, 0], [0, 1, 0]
+    elif kind == "ndarray":
+        r, v = np.array(r), np.array(v)
+    fast = KeplerOrbit.from_state(r, v, 1.0)
+    slow = KeplerOrbit.from_state(np.array(r, dtype=object), v, 1.0)  # the general path
+    batch = KeplerOrbit.from_state(np.atleast_2d(r), np.atleast_2d(v), np.ones(1))  # arrays
+    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude"):
+        assert getattr(fast, n) == getattr(slow, n) == getattr(batch, n)[0], n
+    assert type(fast.e) is np.float64 and type(fast.a) is np.float64
+    assert fast.shape == slow.shape == ()
+    for x, y in zip(fast.state(), slow.state(), strict=True):
+        np.testing.assert_array_equal(x, y)
+    for x, y in zip(fast.propagate(0.7).state(), slow.propagate(0.7).state(), strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert fast.conic.e == slow.conic.e
+
+
+def test_propagate_fast_matches_general_path():
+    r, v = _states(20)
+    o = KeplerOrbit.from_state(r, v, 1.0)
+    dt = np.linspace(-3.0, 3.0, 20)
+    fast = o.propagate(dt)
+    general = o.propagate(dt.tolist())  # a list takes the general path
+    np.testing.assert_array_equal(fast.state()[0], general.state()[0])
+    np.testing.assert_array_equal(fast.state()[1], general.state()[1])
+    one = o[3].propagate(1.5)
+    np.testing.assert_array_equal(one.state()[0], o[3].propagate([1.5]).state()[0][0])
+
+
+@pytest.mark.parametrize(
+    ("r", "v", "mu", "match"),
+    [
+        ([1.0, float("nan"), 0.0], [0.0, 1.0, 0.0], 1.0, "`r`.*nan at index 1"),
+        ([1.0, 0.0, 0.0], [0.0, float("inf"), 0.0], 1.0, "`v`.*inf at index 1"),
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], -1.0, "`mu`"),
+        ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0, "`r`"),
+        ([1.0, 0.0], [0.0, 1.0, 0.0], 1.0, "`r`"),
+        ([1.0, 0.0, 1j], [0.0, 1.0, 0.0], 1.0, "`r`"),
+    ],
+)
+def test_fast_path_errors_name_the_argument(r, v, mu, match):
+    with pytest.raises(ValueError, match=match):
+        KeplerOrbit.from_state(r, v, mu)
+
+
+@pytest.mark.parametrize("dt", [float("nan"), np.array([np.inf])])
+def test_propagate_fast_path_errors_name_dt(dt):
+    o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0)
+    with pytest.raises(ValueError, match="`dt`"):
+        o.propagate(dt)
