@@ -963,7 +963,10 @@ def _finite_or_raise(f, r: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``f(r, v)`` without floating-point warnings; a result beyond float64
     raises ValueError naming ``r`` and ``v``."""
     with np.errstate(all="ignore"):
-        out = np.asarray(f(r, v))
+        try:
+            out = np.asarray(f(r, v))
+        except ValueError:  # a quaternion product beyond float64 inside f
+            out = np.asarray(np.inf)
     if not np.all(np.isfinite(out)):
         raise ValueError(
             f"Expected `r`, `v` (and `mu`) for which Hamilton's {f.__name__.split('_')[0]} "

@@ -197,7 +197,7 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
     >>> print(w.round(6))
     [[1.       0.3      0.8     ]
      [0.685247 0.787678 0.680579]] rad / s
-    >>> print(att.rotate(body.moments * w.value).round(12))  # L in space is constant
+    >>> print(att.rotate((body.moments * w).value).round(12))  # L in space is constant
     [[1.  0.6 2.4]
      [1.  0.6 2.4]]
     """
