@@ -38,12 +38,20 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     Massive pairs are visited once (both accelerations from one separation);
     test particles are summed over the massive bodies only.
     """
+    newtonian_rows(r, gm, massive_indices(gm), 0, acc)
+
+
+@njit(cache=True)
+def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
+    """:func:`newtonian` with the massive indices ``idx`` given (so that a
+    stepper computes them once, not every step) and the rows below ``first``
+    left out (their ``acc`` is not written; ``idx`` must not hold them).
+    The same arithmetic in the same order as :func:`newtonian`."""
     n = r.shape[0]
-    for k in range(n):
+    for k in range(first, n):
         acc[k, 0] = 0.0
         acc[k, 1] = 0.0
         acc[k, 2] = 0.0
-    idx = massive_indices(gm)
     nm = idx.shape[0]
     for a in range(nm):
         i = idx[a]
@@ -62,9 +70,9 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
             acc[j, 0] -= fj * dx
             acc[j, 1] -= fj * dy
             acc[j, 2] -= fj * dz
-    if nm == n:
+    if nm == n - first:
         return
-    for k in range(n):
+    for k in range(first, n):
         if gm[k] != 0.0:
             continue
         ax = 0.0

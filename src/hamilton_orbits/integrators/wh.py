@@ -134,6 +134,9 @@ def _advance(
     m_tot = 0.0
     for i in range(n):
         m_tot += gm[i]
+    # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
+    # row 0 (unused here) is left out of the interaction
+    idx = _nbody.massive_indices(gm_p)
     h = dt if n_steps > 1 else dt_last
     bad = _kepler_all(q, u, gm0, 0.5 * h)
     if bad >= 0:
@@ -143,7 +146,7 @@ def _advance(
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
         _jump(q, u, gm, 0.5 * h)
-        _nbody.newtonian(q, u, gm_p, acc)
+        _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
         for i in range(1, n):
             for k in range(3):
                 u[i, k] += h * acc[i, k]
@@ -233,12 +236,13 @@ def _kepler_jacobi(qj, uj, eta, tau):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _kick_jacobi(
-    extra, has_extra, qj, uj, gm, eta, h, move_com, acc, accj, acc_x, r_in, v_in
+    extra, has_extra, qj, uj, gm, idx, eta, h, move_com, acc, accj, acc_x, r_in, v_in
 ):  # pragma: no cover - compiled
-    """The interaction kick of length ``h`` in Jacobi coordinates."""
+    """The interaction kick of length ``h`` in Jacobi coordinates (``idx``: the
+    massive indices of ``gm``)."""
     n = qj.shape[0]
     _jacobi_to_inertial_pos(qj, gm, eta, r_in)
-    _nbody.newtonian(r_in, v_in, gm, acc)
+    _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
     if has_extra:
         for i in range(n):
             for k in range(3):
@@ -281,15 +285,20 @@ def _corrector_jacobi(extra, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: n
     acc_x = np.empty((n, 3))
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
+    idx = _nbody.massive_indices(gm)
     for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
         bad = _kepler_jacobi(qj, uj, eta, a)
         if bad >= 0:
             return bad
-        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, -b, False, acc, accj, acc_x, r_in, v_in)
+        _kick_jacobi(
+            extra, has_extra, qj, uj, gm, idx, eta, -b, False, acc, accj, acc_x, r_in, v_in
+        )
         bad = _kepler_jacobi(qj, uj, eta, -2.0 * a)
         if bad >= 0:
             return bad
-        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, b, False, acc, accj, acc_x, r_in, v_in)
+        _kick_jacobi(
+            extra, has_extra, qj, uj, gm, idx, eta, b, False, acc, accj, acc_x, r_in, v_in
+        )
         bad = _kepler_jacobi(qj, uj, eta, a)
         if bad >= 0:
             return bad
@@ -324,6 +333,7 @@ def _advance_jacobi(
     acc_x = np.empty((n, 3))
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
+    idx = _nbody.massive_indices(gm)
     h = dt if n_steps > 1 else dt_last
     bad = _kepler_jacobi(qj, uj, eta, 0.5 * h)
     if bad >= 0:
@@ -332,7 +342,7 @@ def _advance_jacobi(
         qj[0, k] += 0.5 * h * uj[0, k]
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _kick_jacobi(extra, has_extra, qj, uj, gm, eta, h, True, acc, accj, acc_x, r_in, v_in)
+        _kick_jacobi(extra, has_extra, qj, uj, gm, idx, eta, h, True, acc, accj, acc_x, r_in, v_in)
         if s < n_steps - 1:
             h_next = dt if s + 1 < n_steps - 1 else dt_last
             tau = 0.5 * (h + h_next)
