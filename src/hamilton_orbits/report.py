@@ -178,7 +178,7 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
             sim.add(m=float(gm[k]), x=r0[k, 0], y=r0[k, 1], z=r0[k, 2],
                     vx=v0[k, 0], vy=v0[k, 1], vz=v0[k, 2])
         if epsilon is not None:
-            sim.ri_ias15.epsilon = epsilon
+            sim.integrator.epsilon = epsilon
         sim.dt = dt
         sim.integrate(t_end, exact_finish_time=1)
         return np.array([p.xyz for p in sim.particles])
