@@ -17,10 +17,13 @@ Problems
    (IAS15, WHFast, leapfrog).  Reference: rebound IAS15 with ``epsilon = 0`` at
    a fixed step of 0.5 day.  Error: max over planets of the final heliocentric
    position difference over the heliocentric distance.
-3. Free rigid body (moments 1, 2, 3, spin near the intermediate axis, the
-   Dzhanibekov flip): ``rigid.integrate`` (splitting2, splitting4, exact_kick,
-   rk4, dop853) over dt / rtol.  Reference: ``rigid.free_motion`` (exact,
-   Jacobi elliptic functions).  Error: max attitude geodesic angle (rad).
+3. Free rigid body (the bundled ``dzhanibekov`` scene: moments 1, 2, 3, spin
+   about the intermediate axis), 20 s (quick) or 60 s, output every 0.01 s:
+   splitting2, splitting4, exact_kick, rk4 over dt as an :class:`Ensemble` of
+   the scene (``vary={"integrator.method": ..., "integrator.dt": ...}``, run one
+   member at a time); scipy DOP853 (``rigid.integrate(method="dop853")``) over
+   rtol directly.  Reference: ``rigid.free_motion`` (exact, Jacobi elliptic
+   functions).  Error: max attitude geodesic angle (rad).
 4. Rigid-Earth pole wander (``rigid.earth.rigid_body(0.2 arcsec)``), 10 years
    (quick) or 100 years, daily output: splitting4 over dt, scipy DOP853 (via
    ``rigid.integrate(method="dop853")``) over rtol.  Reference: the exact free
@@ -237,37 +240,51 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
 
 # --------------------------------------------------------------------------- 3. rigid body
 def _rigid(quick: bool, progress: bool) -> list[Row]:
-    from hamilton_orbits import Quaternion
+    from hamilton_orbits import Quaternion, Scene
+    from hamilton_orbits.ensemble import Ensemble
     from rigid import RigidBody, free_motion, integrate
 
     name = "free rigid body"
     measure = "max attitude angle to reference (rad)"
     reference = "rigid.free_motion (exact, Jacobi elliptic functions)"
-    body = RigidBody([1.0, 2.0, 3.0], omega=[0.01, 1.0, 0.01])
-    t_end = 20.0 if quick else 100.0
-    n_out = 201
-    t = np.linspace(0.0, t_end, n_out)
-    q_ref = free_motion(body, t)[0]
+    # the bundled Dzhanibekov scene: moments 1, 2, 3 kg m^2, spin 2 rad/s about the
+    # middle axis, output every 0.01 s; its runs measure the attitude error against
+    # the exact free motion at every output
+    scene = Scene.bundled("dzhanibekov")
+    duration = 20.0 if quick else 60.0
+    scene = scene.with_values({"duration": f"{duration:g} s"})
+    methods = ["splitting2", "splitting4", "exact_kick", "rk4"]
+    dts = ["0.05 s", "0.01 s"] if quick else ["0.1 s", "0.05 s", "0.02 s", "0.01 s", "0.005 s"]
+    # warm-up (compile / load the kernels), then the sweep one member at a time
+    # (workers=1) so that members do not share cores and their wall times compare
+    Ensemble(scene.with_values({"duration": "1 s"}),
+             vary={"integrator.method": methods}).run(progress=False, workers=1)
+    table = Ensemble(scene, vary={"integrator.method": methods, "integrator.dt": dts}).run(
+        progress=progress, workers=1)
+    rows = []
+    col = "max attitude error vs exact [rad]"
+    for rec in table.to_dict("records"):
+        if rec.get("error") is not None:
+            raise RuntimeError(f"ensemble member {rec} failed: {rec['error']}")
+        rows.append(Row(name, "hamilton-orbits", rec["integrator.method"],
+                        f"dt = {rec['integrator.dt']}", float(rec[col]), measure, reference,
+                        float(rec["wall time [s]"])))
+
+    # the same body, span and outputs, directly: the reference itself and scipy DOP853
+    body = RigidBody([1.0, 2.0, 3.0], omega=[0.001, 2.0, 0.001])
+    n_out = round(duration / 0.01) + 1
+    t = np.linspace(0.0, duration, n_out)
+    wt, (q_ref, _) = _timed(lambda: free_motion(body, t))
+    rows.insert(0, Row(name, "hamilton-orbits", "exact (free_motion)", f"{n_out} epochs", 0.0,
+                       measure, reference + " (is the reference)", wt))
 
     def err(tr: Any) -> float:
         return float(np.max(Quaternion(tr.attitude.as_array()).rotation_distance(q_ref)))
 
-    dts = (0.05, 0.01) if quick else (0.1, 0.05, 0.02, 0.01, 0.005)
-    rows = []
-    wt, _ = _timed(lambda: free_motion(body, t))
-    rows.append(Row(name, "hamilton-orbits", "exact (free_motion)", f"{n_out} epochs", 0.0,
-                    measure, reference + " (is the reference)", wt))
-    for method in ("splitting2", "splitting4", "exact_kick", "rk4"):
-        integrate(body, 1.0, dt=0.1, method=method, n_out=2)  # warm up
-        for dt in dts:
-            wt, tr = _timed(lambda m=method, dt=dt: integrate(body, t_end, dt=dt, method=m,
-                                                              n_out=n_out))
-            rows.append(Row(name, "hamilton-orbits", method, f"dt = {dt:g}", err(tr), measure,
-                            reference, wt))
     integrate(body, 1.0, method="dop853", n_out=2)
     for rtol in (1e-6, 1e-9, 1e-12):
-        wt, tr = _timed(lambda rtol=rtol: integrate(body, t_end, method="dop853", n_out=n_out,
-                                                    rtol=rtol, atol=rtol * 1e-3))
+        wt, tr = _timed(lambda rtol=rtol: integrate(body, duration, method="dop853",
+                                                    n_out=n_out, rtol=rtol, atol=rtol * 1e-3))
         rows.append(Row(name, "scipy (rigid.integrate)", "dop853", f"rtol = {rtol:g}", err(tr),
                         measure, reference, wt))
     _log(progress, f"{name}: {len(rows)} rows")
