@@ -401,12 +401,25 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
     list of Path
         The files written: one PNG per problem, ``report.md``, ``report.html``.
 
+    Raises
+    ------
+    ImportError
+        Without matplotlib, mpmath or pandas (the ``[report]`` extra).
+
     Examples
     --------
     >>> from hamilton_orbits.report import build_report
     >>> callable(build_report)
     True
     """
+    try:
+        import matplotlib  # noqa: F401
+        import mpmath  # noqa: F401
+        import pandas  # noqa: F401
+    except ImportError as exc:
+        raise ImportError(
+            f"The report needs {exc.name}: pip install 'hamilton-orbits[report]'"
+        ) from exc
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     problems = [("kepler", _kepler), ("solar_system", _solar), ("rigid_body", _rigid),
