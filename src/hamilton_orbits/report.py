@@ -354,12 +354,12 @@ def _figure(rows: list[Row], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(7, 5))
     groups: dict[tuple[str, str], list[Row]] = {}
     for r in rows:
-        groups.setdefault((r.code, r.method), []).append(r)
-    floor = min([r.error for r in rows if r.error > 0] or [1e-16]) / 10
+        if r.error > 0:  # the reference itself (error 0) has no place on a log axis
+            groups.setdefault((r.code, r.method), []).append(r)
     for (code, method), rs in groups.items():
         rs = sorted(rs, key=lambda r: r.wall_time)
         style = "-o" if code == "hamilton-orbits" else "--s"
-        ax.loglog([r.wall_time for r in rs], [max(r.error, floor) for r in rs], style,
+        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], style,
                   label=f"{method} ({code})")
     ax.set_xlabel("wall time (s)")
     ax.set_ylabel(rows[0].error_measure)
