@@ -256,6 +256,15 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
     return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
 
 
+def _report(quick: bool, out: str | None, progress: bool) -> int:
+    from hamilton_orbits.report import build_report
+
+    folder = out if out else "hamilton-orbits-output/report"
+    files = build_report(folder, quick=quick, progress=progress)
+    print("wrote " + ", ".join(f.name for f in files) + f" to {folder}/")
+    return EXIT_OK
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hamilton-orbits`` console script.
 
@@ -292,6 +301,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     en.add_argument("--dask", metavar="ADDRESS|local", help="run on a Dask cluster")
     en.add_argument("--out", help="output folder (default hamilton-orbits-output/SCENE-ensemble)")
     en.add_argument("--no-progress", action="store_true", help="no progress bar")
+    rp = sub.add_parser("report", help="the work-precision report: error against wall time")
+    rp.add_argument("--quick", action="store_true", help="short spans, few settings (~1 min)")
+    rp.add_argument("--out", help="output folder (default hamilton-orbits-output/report)")
+    rp.add_argument("--no-progress", action="store_true", help="no progress lines")
     sub.add_parser("scenes", help="list the bundled scenes")
     sub.add_parser("demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
@@ -302,6 +315,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _demo()
     if args.command == "scenes":
         return _list_scenes()
+    if args.command == "report":
+        return _report(args.quick, args.out, progress=not args.no_progress)
     if args.command == "ensemble":
         return _ensemble(args.scene, args.vary, args.dask, args.out,
                          progress=not args.no_progress)

@@ -1,0 +1,388 @@
+"""The work-precision report: what accuracy costs in time, ours beside the peers.
+
+:func:`build_report` runs four problems in one process, sweeps each method's step
+or tolerance, measures the error against a stated reference and the wall time,
+and writes one log-log diagram (error against wall time) per problem, a
+Markdown table (``report.md``) and one self-contained HTML page (``report.html``,
+figures embedded as base64 data URIs).
+
+Problems
+--------
+1. Two-body Kepler propagation (mu = 1, a = 2, e = 0.5, output at many epochs
+   over 10 periods): ours (``KeplerOrbit.propagate``, one batch call), rebound
+   WHFast (one test particle: the Kepler drift only) over dt, scipy DOP853 over
+   rtol.  Reference: Kepler's equation solved in mpmath at 40 digits.
+2. The solar system (Sun + 8 planets, ``System.solar_system("J2000")``), 10 years
+   (quick) or 1000 years: ours (radau15, wh, leapfrog, dop853) and rebound
+   (IAS15, WHFast in its default Jacobi coordinates and in the
+   democratic-heliocentric coordinates our ``wh`` uses, leapfrog).  Reference:
+   rebound IAS15 with ``epsilon = 0`` at a fixed step of 0.5 day.  Error: max
+   over planets of the final heliocentric position difference over the
+   heliocentric distance.
+3. Free rigid body (the bundled ``dzhanibekov`` scene: moments 1, 2, 3, spin
+   about the intermediate axis), 20 s (quick) or 60 s, output every 0.01 s:
+   splitting2, splitting4, exact_kick, rk4 over dt as an :class:`Ensemble` of
+   the scene (``vary={"integrator.method": ..., "integrator.dt": ...}``, run one
+   member at a time); scipy DOP853 (``rigid.integrate(method="dop853")``) over
+   rtol directly.  Reference: ``rigid.free_motion`` (exact, Jacobi elliptic
+   functions).  Error: max attitude geodesic angle (rad).
+4. Rigid-Earth pole wander (``rigid.earth.rigid_body(0.2 arcsec)``), 10 years
+   (quick) or 100 years, daily output: splitting4 over dt, scipy DOP853 (via
+   ``rigid.integrate(method="dop853")``) over rtol.  Reference: the exact free
+   motion.  Error: max pole offset difference (micro-arcseconds).
+
+Wall times are the shortest of a few repeats (one run if it exceeds 2 s); the
+kernels are compiled before timing.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Row", "build_report"]
+
+
+@dataclass
+class Row:
+    """One measured point of the report."""
+
+    problem: str
+    code: str
+    method: str
+    parameter: str
+    error: float
+    error_measure: str
+    reference: str
+    wall_time: float
+
+
+def _timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[float, Any]:
+    best = math.inf
+    out = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        dt = time.perf_counter() - t0
+        best = min(best, dt)
+        if dt > 2.0:
+            break
+    return best, out
+
+
+def _log(progress: bool, msg: str) -> None:
+    if progress:
+        print(f"[report] {msg}", flush=True)
+
+
+# --------------------------------------------------------------------------- 1. Kepler
+def _kepler(quick: bool, progress: bool) -> list[Row]:
+    import mpmath
+    import rebound
+    from scipy.integrate import solve_ivp
+
+    from hamilton_orbits.orbit import KeplerOrbit
+
+    name = "two-body Kepler"
+    measure = "max |r - r_ref| / a"
+    reference = "Kepler's equation in mpmath (40 digits)"
+    a, e, mu = 2.0, 0.5, 1.0
+    period = 2 * math.pi * a**1.5
+    n_t = 20 if quick else 200
+    t = np.linspace(0.0, 10 * period, n_t + 1)[1:]
+    r0 = np.array([a * (1 - e), 0.0, 0.0])
+    v0 = np.array([0.0, math.sqrt(mu * (1 + e) / (a * (1 - e))), 0.0])
+
+    mpmath.mp.dps = 40
+    ref = np.empty((n_t, 3))
+    b = mpmath.mpf(a) * mpmath.sqrt(1 - mpmath.mpf(e) ** 2)
+    n = mpmath.sqrt(mpmath.mpf(mu) / mpmath.mpf(a) ** 3)
+    for k, tk in enumerate(t):
+        m_anom = n * mpmath.mpf(tk)
+        ecc = mpmath.findroot(lambda x, m_anom=m_anom: x - e * mpmath.sin(x) - m_anom, m_anom)
+        ref[k] = [float(a * (mpmath.cos(ecc) - e)), float(b * mpmath.sin(ecc)), 0.0]
+
+    def err(r: np.ndarray) -> float:
+        return float(np.max(np.linalg.norm(r - ref, axis=1)) / a)
+
+    rows = []
+    orbit = KeplerOrbit.from_state(np.tile(r0, (n_t, 1)), np.tile(v0, (n_t, 1)), np.full(n_t, mu))
+    orbit.propagate(t)  # compile / warm up
+    wt, out = _timed(lambda: orbit.propagate(t).state()[0], 5)
+    rows.append(Row(name, "hamilton-orbits", "KeplerOrbit.propagate", f"batch of {n_t}",
+                    err(np.asarray(out)), measure, reference, wt))
+
+    def whfast(dt: float) -> np.ndarray:
+        sim = rebound.Simulation()
+        sim.G = 1.0
+        sim.integrator = "whfast"
+        sim.add(m=mu)
+        sim.add(m=0.0, x=r0[0], y=r0[1], z=r0[2], vx=v0[0], vy=v0[1], vz=v0[2])
+        sim.dt = dt
+        out = np.empty((n_t, 3))
+        for k, tk in enumerate(t):
+            sim.integrate(tk, exact_finish_time=1)
+            out[k] = np.array(sim.particles[1].xyz) - np.array(sim.particles[0].xyz)
+        return out
+
+    for frac in (10, 100) if quick else (10, 100, 1000):
+        dt = period / frac
+        wt, out = _timed(lambda dt=dt: whfast(dt))
+        rows.append(Row(name, "rebound", "WHFast", f"dt = P/{frac}", err(out), measure,
+                        reference, wt))
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        r = y[:3]
+        return np.concatenate([y[3:], -mu * r / np.dot(r, r) ** 1.5])
+
+    for rtol in (1e-6, 1e-9, 1e-12):
+        def dop(rtol: float = rtol) -> np.ndarray:
+            sol = solve_ivp(rhs, (0.0, t[-1]), np.concatenate([r0, v0]), method="DOP853",
+                            t_eval=t, rtol=rtol, atol=rtol * 1e-3)
+            return sol.y[:3].T
+        wt, out = _timed(dop)
+        rows.append(Row(name, "scipy", "DOP853", f"rtol = {rtol:g}", err(out), measure,
+                        reference, wt))
+    _log(progress, f"{name}: {len(rows)} rows")
+    return rows
+
+
+# --------------------------------------------------------------------------- 2. solar system
+def _solar(quick: bool, progress: bool) -> list[Row]:
+    import astropy.units as u
+    import rebound
+
+    from hamilton_orbits import System, integrate
+
+    name = "solar system"
+    years = 10 if quick else 1000
+    measure = "max_planet |r - r_ref| / |r_ref| (heliocentric, final)"
+    reference = "rebound IAS15, epsilon = 0, dt = 0.5 d"
+    system = System.solar_system("J2000")
+    r0 = system.r.to_value(u.au)
+    v0 = system.v.to_value(u.au / u.day)
+    gm = (system.gm).to_value(u.au**3 / u.day**2)
+    t_end = years * 365.25
+
+    def helio(r: np.ndarray) -> np.ndarray:
+        return r[1:] - r[0]
+
+    def rebound_run(integrator: str, dt: float, epsilon: float | None = None,
+                    coordinates: str | None = None) -> np.ndarray:
+        sim = rebound.Simulation()
+        sim.G = 1.0
+        sim.integrator = integrator
+        for k in range(len(gm)):
+            sim.add(m=float(gm[k]), x=r0[k, 0], y=r0[k, 1], z=r0[k, 2],
+                    vx=v0[k, 0], vy=v0[k, 1], vz=v0[k, 2])
+        if epsilon is not None:
+            sim.integrator.epsilon = epsilon
+        if coordinates is not None:
+            sim.integrator.coordinates = coordinates
+        sim.dt = dt
+        sim.integrate(t_end, exact_finish_time=1)
+        return np.array([p.xyz for p in sim.particles])
+
+    _log(progress, f"{name}: reference ({years} yr)")
+    ref = helio(rebound_run("ias15", 0.5, 0.0))
+    scale = np.linalg.norm(ref, axis=1)
+
+    def err(r: np.ndarray) -> float:
+        return float(np.max(np.linalg.norm(helio(r) - ref, axis=1) / scale))
+
+    cases: list[tuple[str, str, str, Callable[[], np.ndarray]]] = []
+
+    def ours(method: str, dt: float | None = None, tol: float | None = None):
+        def run() -> np.ndarray:
+            tr = integrate(system, t_end * u.day, method=method,
+                           dt=None if dt is None else dt * u.day, tol=tol)
+            return tr.final.r.to_value(u.au)
+        return run
+
+    tols = (1e-6, 1e-9) if quick else (1e-6, 1e-9, 1e-12)
+    for tol in tols:
+        cases.append(("hamilton-orbits", "radau15", f"tol = {tol:g}", ours("radau15", tol=tol)))
+    dts_wh = (8.0, 2.0) if quick else (8.0, 4.0, 2.0, 1.0)
+    dts_lf = (1.0, 0.25) if quick else (1.0, 0.5, 0.25)
+    for dt in dts_wh:
+        cases.append(("hamilton-orbits", "wh", f"dt = {dt:g} d", ours("wh", dt=dt)))
+    for dt in dts_lf:
+        cases.append(("hamilton-orbits", "leapfrog", f"dt = {dt:g} d", ours("leapfrog", dt=dt)))
+    for tol in (1e-8, 1e-11) if quick else (1e-8, 1e-10, 1e-12):
+        cases.append(("hamilton-orbits", "dop853", f"tol = {tol:g}", ours("dop853", tol=tol)))
+    for eps in (1e-6, 1e-9):
+        cases.append(("rebound", "IAS15", f"epsilon = {eps:g}",
+                      lambda eps=eps: rebound_run("ias15", 1.0, eps)))
+    for dt in dts_wh:  # rebound's default: Jacobi coordinates
+        cases.append(("rebound", "WHFast", f"dt = {dt:g} d",
+                      lambda dt=dt: rebound_run("whfast", dt)))
+    for dt in dts_wh:  # the map our ``wh`` uses by default
+        cases.append(("rebound", "WHFast (democratic heliocentric)", f"dt = {dt:g} d",
+                      lambda dt=dt: rebound_run("whfast", dt,
+                                                coordinates="democraticheliocentric")))
+    for dt in dts_lf:
+        cases.append(("rebound", "leapfrog", f"dt = {dt:g} d",
+                      lambda dt=dt: rebound_run("leapfrog", dt)))
+
+    # warm up (compile) our kernels on a short span
+    for method, kw in (("radau15", {}), ("wh", {"dt": 4 * u.day}),
+                       ("leapfrog", {"dt": 1 * u.day}), ("dop853", {})):
+        integrate(system, 10 * u.day, method=method, **kw)
+
+    rows = []
+    for code, method, param, fn in cases:
+        wt, out = _timed(fn, 2)
+        rows.append(Row(name, code, method, param, err(out), measure, reference, wt))
+        _log(progress, f"{name}: {code} {method} {param}: err {rows[-1].error:.2e} "
+                       f"time {wt:.3f} s")
+    return rows
+
+
+def _figure(rows: list[Row], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 5))
+    groups: dict[tuple[str, str], list[Row]] = {}
+    for r in rows:
+        if r.error > 0:  # the reference itself (error 0) has no place on a log axis
+            groups.setdefault((r.code, r.method), []).append(r)
+    for (code, method), rs in groups.items():
+        rs = sorted(rs, key=lambda r: r.wall_time)
+        style = "-o" if code == "hamilton-orbits" else "--s"
+        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], style,
+                  label=f"{method} ({code})")
+    ax.set_xlabel("wall time (s)")
+    ax.set_ylabel(rows[0].error_measure)
+    ax.set_title(f"{rows[0].problem}: error vs wall time\nreference: {rows[0].reference}",
+                 fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def _table(rows: list[Row]) -> list[list[str]]:
+    out = []
+    for r in rows:
+        out.append([r.problem, r.code, r.method, r.parameter, f"{r.error:.3e}",
+                    r.error_measure, r.reference, f"{r.wall_time:.4g}"])
+    return out
+
+
+_HEADER = ["problem", "code", "method", "parameter", "error", "error measure", "reference",
+           "wall time (s)"]
+
+
+def _registered_problems() -> list[tuple[str, Callable[[bool, bool], list[Row]]]]:
+    """Problems other packages add (``rigid``: the free body and the pole wander)
+    through the entry point group ``hamilton_orbits.report_problems``, so that
+    ``hamilton_orbits`` never imports them."""
+    from importlib.metadata import entry_points
+
+    out: list[tuple[str, Callable[[bool, bool], list[Row]]]] = []
+    for ep in sorted(entry_points(group="hamilton_orbits.report_problems"),
+                     key=lambda e: e.name):
+        out.extend(ep.load()())
+    return out
+
+
+def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> list[Path]:
+    """Run the work-precision study and write PNGs, ``report.md`` and ``report.html``.
+
+    Parameters
+    ----------
+    out_dir : str or path-like
+        Directory for the outputs (created if missing).
+    quick : bool, optional
+        Short spans and few settings (well under two minutes on 2 cores).
+    progress : bool, optional
+        Print a line per finished problem / setting.
+
+    Returns
+    -------
+    list of Path
+        The files written: one PNG per problem, ``report.md``, ``report.html``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib, mpmath or pandas (the ``[report]`` extra).
+
+    Examples
+    --------
+    >>> from hamilton_orbits.report import build_report
+    >>> callable(build_report)
+    True
+    """
+    try:
+        import matplotlib  # noqa: F401
+        import mpmath  # noqa: F401
+        import pandas  # noqa: F401
+    except ImportError as exc:
+        raise ImportError(
+            f"The report needs {exc.name}: pip install 'hamilton-orbits[report]'"
+        ) from exc
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    problems = [("kepler", _kepler), ("solar_system", _solar), *_registered_problems()]
+    all_rows: list[Row] = []
+    files: list[Path] = []
+    figures: list[tuple[str, Path]] = []
+    t_start = time.perf_counter()
+    for slug, fn in problems:
+        _log(progress, f"problem {slug} ...")
+        rows = fn(quick, progress)
+        all_rows.extend(rows)
+        png = out / f"{slug}.png"
+        _figure(rows, png)
+        files.append(png)
+        figures.append((rows[0].problem, png))
+    total = time.perf_counter() - t_start
+    stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    cores = os.cpu_count()
+    mode = "quick" if quick else "full"
+    intro = (f"Work-precision report ({mode}), {stamp}, {cores} cores, "
+             f"total {total:.1f} s. Wall time: shortest of up to 3 runs, same process.")
+    table = _table(all_rows)
+
+    md = ["# What accuracy costs in time", "", intro, "",
+          "| " + " | ".join(_HEADER) + " |", "|" + "---|" * len(_HEADER)]
+    md += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in table]
+    md.append("")
+    for title, png in figures:
+        md += [f"![{title}]({png.name})", ""]
+    md_path = out / "report.md"
+    md_path.write_text("\n".join(md), encoding="utf-8")
+
+    h = ["<!DOCTYPE html>", "<html><head><meta charset=\"utf-8\">",
+         "<title>hamilton-orbits work-precision report</title>",
+         "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
+         "td,th{border:1px solid #aaa;padding:2px 6px;font-size:12px}</style>",
+         "</head><body>", "<h1>What accuracy costs in time</h1>",
+         f"<p>{html.escape(intro)}</p>", "<table>",
+         "<tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in _HEADER) + "</tr>"]
+    h += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>" for row in table]
+    h.append("</table>")
+    for title, png in figures:
+        data = base64.b64encode(png.read_bytes()).decode("ascii")
+        h += [f"<h2>{html.escape(title)}</h2>",
+              f"<img alt=\"{html.escape(title)}\" src=\"data:image/png;base64,{data}\">"]
+    h.append("</body></html>")
+    html_path = out / "report.html"
+    html_path.write_text("\n".join(h), encoding="utf-8")
+    files += [md_path, html_path]
+    _log(progress, f"wrote {out} in {total:.1f} s")
+    return files
