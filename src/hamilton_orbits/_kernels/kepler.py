@@ -54,8 +54,11 @@ _SERIES_MAX = 3.0
 @njit(cache=True)
 def _series_s(z, sign):  # pragma: no cover - compiled
     """sum_k (sign z)^k / (2k+3)!  (Horner; 15 terms, 7 when |z| < 0.1 where
-    the 8th is below 0.1^7/17! ~ 3e-22 of the sum)."""
-    top = 6 if abs(z) < 0.1 else 14
+    the 8th is below 0.1^7/17! ~ 3e-22 of the sum, 5 when |z| < 0.01 (the 6th:
+    6e-12/13! ~ 1e-19) and 4 when |z| < 1e-3 (the 5th: 6e-12/11! ~ 2e-19); the
+    short sums serve the small psi of a Wisdom-Holman step)."""
+    az = abs(z)
+    top = (3 if az < 1e-3 else 4) if az < 0.01 else (6 if az < 0.1 else 14)
     acc = _S[top]
     for k in range(top - 1, -1, -1):
         acc = _S[k] + sign * z * acc
@@ -434,7 +437,10 @@ def stumpff_c2c3(psi):  # pragma: no cover - compiled
     """
     if abs(psi) < 1.0:
         z = -psi
-        top = 6 if abs(z) < 0.1 else 9  # 0.1^7/16! ~ 5e-21 of c2
+        # omitted terms relative to c2 = 1/2: 0.1^7/16! ~ 5e-21, 0.01^5/12! ~
+        # 4e-19, 0.001^4/10! ~ 6e-19
+        az = abs(z)
+        top = (3 if az < 1e-3 else 4) if az < 0.01 else (6 if az < 0.1 else 9)
         c2 = _C[top]
         for k in range(top - 1, -1, -1):
             c2 = _C[k] + z * c2
@@ -507,13 +513,13 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
     # series is not small (z >= 1 below).
     if r0 * r0 * r0 > 0.0:
         x1 = tau / r0
-        x = x1 - sigma0 * tau * tau / (2.0 * r0 * r0 * r0)
         ir = 1.0 / r0
-        z = abs(x1) * (abs(sigma0) * ir + math.sqrt(ir + abs(alpha)))
-        if z < 1.0:
-            c2 = 0.5 * sigma0 * ir
-            c3 = (1.0 - alpha * r0) * ir / 6.0
-            c4 = -alpha * sigma0 * ir / 24.0
+        c2 = 0.5 * sigma0 * ir
+        x = x1 - c2 * x1 * x1
+        # z^2 below 1 with z = |x1| (|sigma0|/r0 + sqrt(1/r0 + |alpha|))
+        if 2.0 * x1 * x1 * (4.0 * c2 * c2 + ir + abs(alpha)) < 1.0:
+            c3 = (1.0 - alpha * r0) * ir * (1.0 / 6.0)
+            c4 = -alpha * sigma0 * ir * (1.0 / 24.0)
             k3 = 2.0 * c2 * c2 - c3
             k4 = c2 * (5.0 * c3 - 5.0 * c2 * c2) - c4
             x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * k4)))
