@@ -335,3 +335,50 @@ def test_random_pairs_all_converge():
         res = np.abs(mean_anomaly(x, e) - m)
         dmdx = np.where(e < 1, np.abs(1 - e * np.cos(x)), np.abs(e * np.cosh(x) - 1))
         assert np.all(res <= EPS * (4 * np.maximum(1, np.abs(m)) + np.abs(x) * dmdx))
+
+
+def test_universal_anomaly_short_steps_against_mpmath():
+    """Short steps (|psi| < 1/4, the Wisdom-Holman drift) take Halley's method from
+    the reversed series and, after a step below 1e-6, carry the universal
+    functions to the new point by their Taylor series instead of evaluating them
+    again: chi against the 40-digit root of T(chi) = tau (to its conditioning),
+    and U0..U3, r returned with it against 40-digit values at that chi."""
+    import mpmath
+
+    mpmath.mp.dps = 40
+    rng = np.random.default_rng(11)
+    worst = 0.0
+    for _ in range(150):
+        r0 = 10.0 ** rng.uniform(-0.5, 1.5)
+        v2 = rng.uniform(0.3, 1.7) * 2.0 / r0  # bound and open orbits, mu = 1
+        sigma0 = rng.uniform(-0.9, 0.9) * math.sqrt(r0 * v2)
+        alpha = 2.0 / r0 - v2
+        tau = rng.choice([-1.0, 1.0]) * 10.0 ** rng.uniform(-4, -1) * r0**1.5
+        chi, _t, r, u0, u1, u2, u3 = K._solve_uv(tau, r0, sigma0, alpha)
+        assert alpha * chi * chi < 0.25
+        a, s0, x0, tm = (mpmath.mpf(w) for w in (alpha, sigma0, r0, tau))
+
+        def uv(x, a=a):
+            p = a * x * x
+            s = mpmath.sqrt(abs(p))
+            if p > 0:
+                c2, c3 = (1 - mpmath.cos(s)) / p, (s - mpmath.sin(s)) / s**3
+            else:
+                c2, c3 = (mpmath.cosh(s) - 1) / (-p), (mpmath.sinh(s) - s) / s**3
+            return 1 - p * c2, x * (1 - p * c3), x * x * c2, x**3 * c3
+
+        def T(x, s0=s0, x0=x0, tm=tm):
+            _w0, w1, w2, w3 = uv(x)
+            return x0 * w1 + s0 * w2 + w3 - tm
+
+        xr = float(mpmath.findroot(T, mpmath.mpf(chi)))
+        # T is known to the rounding of its terms, chi to that divided by T' = r
+        cond = EPS * (abs(r0 * u1) + abs(sigma0 * u2) + abs(u3)) / r
+        assert abs(chi - xr) <= 2 * EPS * abs(chi) + 2 * cond
+        ref = uv(mpmath.mpf(chi))
+        for got, want in zip((u0, u1, u2, u3), ref, strict=True):
+            err = abs(got - float(want)) / abs(float(want))
+            worst = max(worst, err)
+            assert err <= 4 * EPS
+        assert abs(r - float(x0 * ref[0] + s0 * ref[1] + ref[2])) <= 4 * EPS * r
+    assert worst > 0.0  # the values compared are not all exact

@@ -476,6 +476,66 @@ def _uv_eval(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
     return t, r, rp, u0, u1, u2, u3
 
 
+# Below this relative Halley step the universal functions are carried to the
+# new point by their Taylor series to second order instead of being evaluated
+# again: the omitted third-order terms and the error left by Halley's step (of
+# order step^3) are below 1e-18 of each function.
+_TAYLOR_STEP = 1e-6
+
+
+@njit(cache=True)
+def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """:func:`_solve_uv` for a short step from a first guess ``x`` on the right
+    side of 0 (the reversed series): Halley's method, T being increasing and
+    smooth there, at most 8 evaluations; chi = NaN if it does not settle (the
+    caller then takes the bracketed solver).
+
+    Convergence as in :func:`_solve_uv` (a step of at most 4 ulp with the
+    residual at rounding level).  When the step is below ``_TAYLOR_STEP``
+    relative, the point after it is not evaluated again: with
+    ``U0' = -alpha U1``, ``U1' = U0``, ``U2' = U1``, ``U3' = U2`` the functions
+    move to ``x + dx`` by their second-order Taylor series (the series guess of
+    a Wisdom-Holman step of the planets is within 1e-8 of the root, so this
+    saves the second evaluation that confirms it)."""
+    nan = math.nan
+    xp = nan
+    for _ in range(8):
+        t, r, rp, u0, u1, u2, u3 = _uv_eval(x, r0, sigma0, alpha)
+        f = t - tau
+        if f == 0.0:
+            return x, t, r, u0, u1, u2, u3
+        # Halley: dx = -f / (T' - f T'' / (2 T'))  with T' = r, T'' = r'
+        den = r * r - 0.5 * f * rp
+        if not (den > 0.0 and r > 0.0):
+            break
+        dx = -f * r / den
+        xn = x + dx
+        if xn * x <= 0.0:
+            break
+        small = abs(dx) <= 4.0 * EPS * abs(xn)
+        if small or xn == xp:
+            if abs(f) <= 2.0 * EPS * abs(tau) or xn == xp:
+                return x, t, r, u0, u1, u2, u3
+        if small or abs(dx) <= _TAYLOR_STEP * abs(x):
+            h2 = 0.5 * dx * dx
+            v0 = u0 - alpha * (dx * u1 + h2 * u0)
+            v1 = u1 + dx * u0 - alpha * h2 * u1
+            v2 = u2 + dx * u1 + h2 * u0
+            v3 = u3 + dx * u2 + h2 * u1
+            return (
+                xn,
+                r0 * v1 + sigma0 * v2 + v3,
+                r0 * v0 + sigma0 * v1 + v2,
+                v0,
+                v1,
+                v2,
+                v3,
+            )
+        xp = x
+        x = xn
+    return nan, nan, nan, nan, nan, nan, nan
+
+
 @njit(cache=True)
 def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
     """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``),
@@ -496,11 +556,6 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
     if tau == 0.0:
         return 0.0, 0.0, r0, 1.0, 0.0, 0.0, 0.0
     sgn = 1.0 if tau > 0.0 else -1.0
-    # bracket on the signed side of chi
-    if alpha > 0.0:
-        big = 2.0 * PI / math.sqrt(alpha)
-    else:
-        big = math.inf
     # first guess: the reversed Taylor series of T(chi) for short steps,
     # otherwise the mean-motion guess (elliptic) or a logarithmic one
     # (hyperbolic).  With T/r0 = chi + c2 chi^2 + c3 chi^3 + c4 chi^4 + ...
@@ -523,6 +578,12 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             k3 = 2.0 * c2 * c2 - c3
             k4 = c2 * (5.0 * c3 - 5.0 * c2 * c2) - c4
             x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * k4)))
+            # a short step (|psi| < 1/4 at the guess): Halley from the series
+            # guess, without the bracket (see _solve_uv_short)
+            if x * sgn > 0.0 and x * x * abs(alpha) < 0.25:
+                sol = _solve_uv_short(tau, x, r0, sigma0, alpha)
+                if math.isfinite(sol[0]):
+                    return sol
     else:  # (near-)radial orbit anchored at the collision: T ~ chi^3/6
         x1 = sgn * (6.0 * abs(tau)) ** (1.0 / 3.0)
         x = x1
@@ -539,6 +600,11 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             x = x1
     if x * sgn <= 0.0 or not math.isfinite(x):
         x = x1
+    # bracket on the signed side of chi
+    if alpha > 0.0:
+        big = 2.0 * PI / math.sqrt(alpha)
+    else:
+        big = math.inf
     if sgn > 0.0:
         a = 0.0
         b = big
