@@ -708,7 +708,12 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     sigma0 = (rx * vx + ry * vy + rz * vz) / smu
     alpha = 2.0 / r0 - v2 / mu
     t = dt
-    if alpha > 0.0:
+    # |t| > P/2 with P = 2 pi / (sqrt(mu) alpha^1.5) is only possible when
+    # t^2 mu alpha^3 > pi^2 (tested below pi^2 and NaN-safe, without the root
+    # and the division that the period costs; the exact test follows)
+    if alpha > 0.0 and not (
+        (t * alpha) * (t * alpha) * (mu * alpha) <= 0.2499 * TWO_PI_HI * TWO_PI_HI
+    ):
         sa = math.sqrt(alpha)
         period = TWO_PI_HI / (smu * alpha * sa)
         if abs(t) > 0.5 * period:
@@ -719,11 +724,18 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     hx = ry * vz - rz * vy
     hy = rz * vx - rx * vz
     hz = rx * vy - ry * vx
-    pp = (hx * hx + hy * hy + hz * hz) / mu
-    e2 = 1.0 - alpha * pp
+    h2 = hx * hx + hy * hy + hz * hz
     # anchor only when it matters: heading for periapsis with a step long
-    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20
-    if sigma0 * tau < 0.0 and e2 >= 0.25 and abs(sigma0 * tau) > 0.1 * r0 * r0:
+    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20,
+    # and e^2 = 1 - alpha p >= 1/4
+    anchor = False
+    pp = 0.0
+    e2 = 0.0
+    if sigma0 * tau < 0.0 and abs(sigma0 * tau) > 0.1 * r0 * r0:
+        pp = h2 / mu
+        e2 = 1.0 - alpha * pp
+        anchor = e2 >= 0.25
+    if anchor:
         ecc = math.sqrt(e2)
         q = pp / (1.0 + ecc)
         if alpha > 0.0:
@@ -760,7 +772,7 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
         # error of chi moves the first by (r - U2) dchi, the second by U2 dchi;
         # take the smaller (on a fast hyperbola U3 << tau: g ~ dt exactly; the
         # step r = (1, 0, 0), v = (0, 1e5, 0), dt = 1.234567 went from 54 ulp to 0.2)
-        if pp > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
+        if h2 > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
             g = (tau - u3) / smu
         else:
             g = (r0 * u1 + sigma0 * u2) / smu
