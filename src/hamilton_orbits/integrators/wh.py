@@ -189,8 +189,24 @@ def _advance(
 
 
 @njit(cache=True)
-def _jacobi_to_inertial_pos(qj, gm, eta, r):  # pragma: no cover - compiled
-    """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre).
+def _jacobi_factors(eta):  # pragma: no cover - compiled
+    """``(ratio, inv)`` with ``ratio_i = eta_{i-1} / eta_i`` (``ratio_0 = 1``) and
+    ``inv_i = 1 / eta_i``: the divisions of the coordinate changes, formed once
+    per run instead of every step."""
+    n = eta.shape[0]
+    ratio = np.ones(n)
+    inv = np.empty(n)
+    for i in range(n):
+        inv[i] = 1.0 / eta[i]
+        if i > 0:
+            ratio[i] = eta[i - 1] / eta[i]
+    return ratio, inv
+
+
+@njit(cache=True)
+def _jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - compiled
+    """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre);
+    ``ratio``, ``inv`` from :func:`_jacobi_factors`.
 
     With ``S_i = sum_{j<=i} m_j r_j``: ``S_{n-1} = eta_{n-1} qj_0`` and, going
     down, ``S_{i-1} = (S_i - m_i qj_i) eta_{i-1} / eta_i``,
@@ -199,19 +215,20 @@ def _jacobi_to_inertial_pos(qj, gm, eta, r):  # pragma: no cover - compiled
     for k in range(3):
         s = eta[n - 1] * qj[0, k]
         for i in range(n - 1, 0, -1):
-            s = (s - gm[i] * qj[i, k]) * (eta[i - 1] / eta[i])
-            r[i, k] = qj[i, k] + s / eta[i - 1]
+            s = (s - gm[i] * qj[i, k]) * ratio[i]
+            r[i, k] = qj[i, k] + s * inv[i - 1]
         r[0, k] = s / gm[0]
 
 
 @njit(cache=True)
-def _inertial_to_jacobi_acc(a, gm, eta, aj):  # pragma: no cover - compiled
-    """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1."""
+def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
+    """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1
+    (``inv_i = 1 / eta_i``)."""
     n = a.shape[0]
     for k in range(3):
         s = gm[0] * a[0, k]
         for i in range(1, n):
-            aj[i, k] = a[i, k] - s / eta[i - 1]
+            aj[i, k] = a[i, k] - s * inv[i - 1]
             s += gm[i] * a[i, k]
 
 
@@ -236,12 +253,12 @@ def _kepler_jacobi(qj, uj, eta, tau):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _kick_jacobi(
-    extra, has_extra, qj, uj, gm, idx, eta, h, move_com, acc, accj, acc_x, r_in, v_in
+    extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in, v_in
 ):  # pragma: no cover - compiled
     """The interaction kick of length ``h`` in Jacobi coordinates (``idx``: the
-    massive indices of ``gm``)."""
+    massive indices of ``gm``; ``ratio``, ``inv``: :func:`_jacobi_factors`)."""
     n = qj.shape[0]
-    _jacobi_to_inertial_pos(qj, gm, eta, r_in)
+    _jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
     _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
     if has_extra:
         for i in range(n):
@@ -257,7 +274,7 @@ def _kick_jacobi(
             if move_com:
                 # the effects' net force moves the barycentre
                 uj[0, k] += h * a_cm / m_tot
-    _inertial_to_jacobi_acc(acc, gm, eta, accj)
+    _inertial_to_jacobi_acc(acc, gm, inv, accj)
     for i in range(1, n):
         d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
         f = eta[i] / (d2 * math.sqrt(d2))
@@ -286,18 +303,21 @@ def _corrector_jacobi(extra, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: n
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
     idx = _nbody.massive_indices(gm)
+    ratio, inv = _jacobi_factors(eta)
     for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
         bad = _kepler_jacobi(qj, uj, eta, a)
         if bad >= 0:
             return bad
         _kick_jacobi(
-            extra, has_extra, qj, uj, gm, idx, eta, -b, False, acc, accj, acc_x, r_in, v_in
+            extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, -b, False,
+            acc, accj, acc_x, r_in, v_in,
         )
         bad = _kepler_jacobi(qj, uj, eta, -2.0 * a)
         if bad >= 0:
             return bad
         _kick_jacobi(
-            extra, has_extra, qj, uj, gm, idx, eta, b, False, acc, accj, acc_x, r_in, v_in
+            extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, b, False,
+            acc, accj, acc_x, r_in, v_in,
         )
         bad = _kepler_jacobi(qj, uj, eta, a)
         if bad >= 0:
@@ -334,6 +354,7 @@ def _advance_jacobi(
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
     idx = _nbody.massive_indices(gm)
+    ratio, inv = _jacobi_factors(eta)
     h = dt if n_steps > 1 else dt_last
     bad = _kepler_jacobi(qj, uj, eta, 0.5 * h)
     if bad >= 0:
@@ -342,7 +363,10 @@ def _advance_jacobi(
         qj[0, k] += 0.5 * h * uj[0, k]
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _kick_jacobi(extra, has_extra, qj, uj, gm, idx, eta, h, True, acc, accj, acc_x, r_in, v_in)
+        _kick_jacobi(
+            extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
+            acc, accj, acc_x, r_in, v_in,
+        )
         if s < n_steps - 1:
             h_next = dt if s + 1 < n_steps - 1 else dt_last
             tau = 0.5 * (h + h_next)
@@ -498,6 +522,7 @@ def run(
     jacobi = coordinates == "jacobi"
     if jacobi:
         eta = np.cumsum(g)
+        ratio, inv_eta = _jacobi_factors(eta)
         s_r = np.cumsum(g[:, None] * r, axis=0)
         s_v = np.cumsum(g[:, None] * v, axis=0)
         q = np.empty_like(r)
@@ -548,8 +573,8 @@ def run(
         if jacobi:
             rr = np.empty_like(q)
             vv = np.empty_like(u)
-            _jacobi_to_inertial_pos(q, g, eta, rr)
-            _jacobi_to_inertial_pos(u, g, eta, vv)
+            _jacobi_to_inertial_pos(q, g, eta, ratio, inv_eta, rr)
+            _jacobi_to_inertial_pos(u, g, eta, ratio, inv_eta, vv)
         else:
             r0_in = com[:3] - (g[1:] @ q[1:]) / m_tot
             v0_in = com[3:] - (g[1:] @ u[1:]) / g[0]
