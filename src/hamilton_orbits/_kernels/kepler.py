@@ -51,7 +51,7 @@ _SERIES_MAX = 3.0
 # ---------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _series_s(z, sign):  # pragma: no cover - compiled
     """sum_k (sign z)^k / (2k+3)!  (Horner; 15 terms, 7 when |z| < 0.1 where
     the 8th is below 0.1^7/17! ~ 3e-22 of the sum, 5 when |z| < 0.01 (the 6th:
@@ -426,6 +426,20 @@ def nu_from_anomaly_ufunc(anom, e):  # pragma: no cover - compiled
 # ---------------------------------------------------------------------------
 
 
+@njit(cache=True, inline="always")
+def _stumpff_series(psi):  # pragma: no cover - compiled
+    """``(c2, c3)`` by their power series, for |psi| < 1 (see :func:`stumpff_c2c3`)."""
+    z = -psi
+    # omitted terms relative to c2 = 1/2: 0.1^7/16! ~ 5e-21, 0.01^5/12! ~
+    # 4e-19, 0.001^4/10! ~ 6e-19
+    az = abs(z)
+    top = (3 if az < 1e-3 else 4) if az < 0.01 else (6 if az < 0.1 else 9)
+    c2 = _C[top]
+    for k in range(top - 1, -1, -1):
+        c2 = _C[k] + z * c2
+    return c2, _series_s(psi, -1.0)
+
+
 @njit(cache=True)
 def stumpff_c2c3(psi):  # pragma: no cover - compiled
     """Stumpff functions ``c2(psi) = (1 - cos sqrt psi)/psi`` and
@@ -436,15 +450,7 @@ def stumpff_c2c3(psi):  # pragma: no cover - compiled
     from :func:`x_minus_sin`, so there is no cancellation anywhere.
     """
     if abs(psi) < 1.0:
-        z = -psi
-        # omitted terms relative to c2 = 1/2: 0.1^7/16! ~ 5e-21, 0.01^5/12! ~
-        # 4e-19, 0.001^4/10! ~ 6e-19
-        az = abs(z)
-        top = (3 if az < 1e-3 else 4) if az < 0.01 else (6 if az < 0.1 else 9)
-        c2 = _C[top]
-        for k in range(top - 1, -1, -1):
-            c2 = _C[k] + z * c2
-        return c2, _series_s(psi, -1.0)
+        return _stumpff_series(psi)
     if psi > 0.0:
         s = math.sqrt(psi)
         sh = math.sin(0.5 * s)
@@ -452,6 +458,19 @@ def stumpff_c2c3(psi):  # pragma: no cover - compiled
     s = math.sqrt(-psi)
     sh = math.sinh(0.5 * s)
     return 2.0 * sh * sh / (-psi), sinh_minus_x(s) / (-psi * s)
+
+
+@njit(cache=True, inline="always")
+def _uv_from_stumpff(chi, chi2, psi, c2, c3, r0, sigma0, alpha):  # pragma: no cover
+    """The tuple of :func:`_uv_eval` from ``c2(psi)``, ``c3(psi)``."""
+    u0 = 1.0 - psi * c2
+    u1 = chi * (1.0 - psi * c3)
+    u2 = chi2 * c2
+    u3 = chi2 * chi * c3
+    t = r0 * u1 + sigma0 * u2 + u3
+    r = r0 * u0 + sigma0 * u1 + u2
+    rp = sigma0 * u0 + (1.0 - alpha * r0) * u1
+    return t, r, rp, u0, u1, u2, u3
 
 
 @njit(cache=True)
@@ -466,14 +485,17 @@ def _uv_eval(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
     chi2 = chi * chi
     psi = alpha * chi2
     c2, c3 = stumpff_c2c3(psi)
-    u0 = 1.0 - psi * c2
-    u1 = chi * (1.0 - psi * c3)
-    u2 = chi2 * c2
-    u3 = chi2 * chi * c3
-    t = r0 * u1 + sigma0 * u2 + u3
-    r = r0 * u0 + sigma0 * u1 + u2
-    rp = sigma0 * u0 + (1.0 - alpha * r0) * u1
-    return t, r, rp, u0, u1, u2, u3
+    return _uv_from_stumpff(chi, chi2, psi, c2, c3, r0, sigma0, alpha)
+
+
+@njit(cache=True, inline="always")
+def _uv_eval_series(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """:func:`_uv_eval` for ``|alpha chi^2| < 1`` (the Stumpff series only, no
+    branch to the trigonometric forms; inlined into the short-step solver)."""
+    chi2 = chi * chi
+    psi = alpha * chi2
+    c2, c3 = _stumpff_series(psi)
+    return _uv_from_stumpff(chi, chi2, psi, c2, c3, r0, sigma0, alpha)
 
 
 # Below this relative Halley step the universal functions are carried to the
@@ -483,7 +505,7 @@ def _uv_eval(chi, r0, sigma0, alpha):  # pragma: no cover - compiled
 _TAYLOR_STEP = 1e-6
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
     """:func:`_solve_uv` for a short step from a first guess ``x`` on the right
     side of 0 (the reversed series): Halley's method, T being increasing and
@@ -500,7 +522,9 @@ def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
     nan = math.nan
     xp = nan
     for _ in range(8):
-        t, r, rp, u0, u1, u2, u3 = _uv_eval(x, r0, sigma0, alpha)
+        if not (x * x * abs(alpha) < 1.0):
+            break
+        t, r, rp, u0, u1, u2, u3 = _uv_eval_series(x, r0, sigma0, alpha)
         f = t - tau
         if f == 0.0:
             return x, t, r, u0, u1, u2, u3
@@ -658,7 +682,7 @@ def solve_universal(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
     return _solve_uv(tau, r0, sigma0, alpha)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):  # pragma: no cover
     """Whether ``g sqrt(mu) = r0 U1 + sigma0 U2`` is expected more accurate than
     ``tau - U3`` (the two are equal by the universal Kepler equation): an error
