@@ -8,7 +8,8 @@ into
 
 - the Kepler part, each body on a Kepler orbit about ``G M_0`` (advanced
   exactly by the universal-variable kernel
-  :func:`hamilton_orbits._kernels.kepler.propagate_uv`, shared, not copied);
+  :func:`hamilton_orbits._kernels.kepler.propagate_uv`, shared, not copied:
+  the drift loop inlines its body, ``propagate_uv_inline``);
 - the interaction part, the mutual attraction of the bodies ``i >= 1``
   (Hamilton's equation (B) without the central body), a kick of the ``u_i``;
 - the "jump" ``|sum_i m_i u_i|^2 / (2 m_0)``, a drift of every ``Q_i`` by
@@ -65,13 +66,14 @@ def _no_extra(r, v, gm, acc):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _kepler_all(q, u, gm0, tau):  # pragma: no cover - compiled
-    """Advance every body ``i >= 1`` on its Kepler orbit about ``gm0`` by ``tau``.
+def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
+    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` by ``tau``
+    (the shared kernel inlined: the bodies' solves overlap in the processor).
 
     Returns the index of the first failure (NaN from the kernel), else -1."""
     for i in range(1, q.shape[0]):
-        x, y, z, vx, vy, vz = _kepler.propagate_uv(
-            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], gm0, tau
+        x, y, z, vx, vy, vz = _kepler.propagate_uv_inline(
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[i], tau
         )
         if not math.isfinite(x + y + z + vx + vy + vz):
             return i
@@ -137,8 +139,9 @@ def _advance(
     # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
     # row 0 (unused here) is left out of the interaction
     idx = _nbody.massive_indices(gm_p)
+    mu = np.full(n, gm0)
     h = dt if n_steps > 1 else dt_last
-    bad = _kepler_all(q, u, gm0, 0.5 * h)
+    bad = _kepler_all(q, u, mu, 0.5 * h)
     if bad >= 0:
         return 0, bad
     for k in range(3):
@@ -180,7 +183,7 @@ def _advance(
             tau = 0.5 * (h + h_next)
         else:
             tau = 0.5 * h
-        bad = _kepler_all(q, u, gm0, tau)
+        bad = _kepler_all(q, u, mu, tau)
         if bad >= 0:
             return s, bad
         for k in range(3):
@@ -230,25 +233,6 @@ def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
         for i in range(1, n):
             aj[i, k] = a[i, k] - s * inv[i - 1]
             s += gm[i] * a[i, k]
-
-
-@njit(cache=True)
-def _kepler_jacobi(qj, uj, eta, tau):  # pragma: no cover - compiled
-    """Each Jacobi body ``i >= 1`` on its Kepler orbit about ``G eta_i`` by ``tau``;
-    returns the first failing index or -1."""
-    for i in range(1, qj.shape[0]):
-        x, y, z, vx, vy, vz = _kepler.propagate_uv(
-            qj[i, 0], qj[i, 1], qj[i, 2], uj[i, 0], uj[i, 1], uj[i, 2], eta[i], tau
-        )
-        if not math.isfinite(x + y + z + vx + vy + vz):
-            return i
-        qj[i, 0] = x
-        qj[i, 1] = y
-        qj[i, 2] = z
-        uj[i, 0] = vx
-        uj[i, 1] = vy
-        uj[i, 2] = vz
-    return -1
 
 
 @njit(cache=True)
@@ -305,21 +289,21 @@ def _corrector_jacobi(extra, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: n
     idx = _nbody.massive_indices(gm)
     ratio, inv = _jacobi_factors(eta)
     for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
-        bad = _kepler_jacobi(qj, uj, eta, a)
+        bad = _kepler_all(qj, uj, eta, a)
         if bad >= 0:
             return bad
         _kick_jacobi(
             extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, -b, False,
             acc, accj, acc_x, r_in, v_in,
         )
-        bad = _kepler_jacobi(qj, uj, eta, -2.0 * a)
+        bad = _kepler_all(qj, uj, eta, -2.0 * a)
         if bad >= 0:
             return bad
         _kick_jacobi(
             extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, b, False,
             acc, accj, acc_x, r_in, v_in,
         )
-        bad = _kepler_jacobi(qj, uj, eta, a)
+        bad = _kepler_all(qj, uj, eta, a)
         if bad >= 0:
             return bad
     return -1
@@ -356,7 +340,7 @@ def _advance_jacobi(
     idx = _nbody.massive_indices(gm)
     ratio, inv = _jacobi_factors(eta)
     h = dt if n_steps > 1 else dt_last
-    bad = _kepler_jacobi(qj, uj, eta, 0.5 * h)
+    bad = _kepler_all(qj, uj, eta, 0.5 * h)
     if bad >= 0:
         return 0, bad
     for k in range(3):
@@ -372,7 +356,7 @@ def _advance_jacobi(
             tau = 0.5 * (h + h_next)
         else:
             tau = 0.5 * h
-        bad = _kepler_jacobi(qj, uj, eta, tau)
+        bad = _kepler_all(qj, uj, eta, tau)
         if bad >= 0:
             return s, bad
         for k in range(3):
