@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numba import njit, types
 
-from hamilton_orbits.integrators._setup import ACCEL_TYPE
+from hamilton_orbits.integrators._setup import ACCEL_TYPE, accel_arg
 
 NAME = "leapfrog"
 ACCEPTS_VELOCITY_DEPENDENT = False
@@ -99,8 +99,9 @@ def run(
     out_r[0] = r
     out_v[0] = v
     steps = 0
+    accel = accel_arg(rhs.accel)
     for i in range(1, len(t_out)):
-        steps += int(_advance(rhs.accel, r, v, gm, float(t_out[i - 1]), float(t_out[i]), dt))
+        steps += int(_advance(accel, r, v, gm, float(t_out[i - 1]), float(t_out[i]), dt))
         out_r[i] = r
         out_v[i] = v
         if on_output is not None:

@@ -642,9 +642,10 @@ def run(
     w = np.ascontiguousarray(v0.copy())
     need_v = bool(rhs.velocity_dependent)
     total = 0
+    accel = _setup.accel_arg(rhs.accel)
     for i in range(1, nt):
         steps, status = _advance(
-            rhs.accel, x, w, gm, t_out[i], st, b, e, br, er, g, csx, csv, need_v, max_steps
+            accel, x, w, gm, t_out[i], st, b, e, br, er, g, csx, csv, need_v, max_steps
         )
         total += steps
         if status != STATUS_OK:

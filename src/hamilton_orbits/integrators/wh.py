@@ -521,7 +521,7 @@ def run(
         u = np.ascontiguousarray(v - com[3:])
         g_p = g.copy()
         g_p[0] = 0.0
-    extra = rhs.extra if rhs.extra is not None else _no_extra
+    extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _no_extra)
     nt = t_out.shape[0]
     r_out = np.empty((nt, n, 3))
     v_out = np.empty((nt, n, 3))
