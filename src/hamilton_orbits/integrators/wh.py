@@ -86,7 +86,7 @@ def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _jump(q, u, gm, tau):  # pragma: no cover - compiled
     """The drift of the ``Q_i`` under ``|sum m_i u_i|^2 / (2 m_0)`` for a time ``tau``."""
     n = q.shape[0]
@@ -206,7 +206,7 @@ def _jacobi_factors(eta):  # pragma: no cover - compiled
     return ratio, inv
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - compiled
     """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre);
     ``ratio``, ``inv`` from :func:`_jacobi_factors`.
@@ -223,7 +223,7 @@ def _jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - c
         r[0, k] = s / gm[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
     """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1
     (``inv_i = 1 / eta_i``)."""
@@ -235,7 +235,7 @@ def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
             s += gm[i] * a[i, k]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _kick_jacobi(
     extra, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in, v_in
 ):  # pragma: no cover - compiled
