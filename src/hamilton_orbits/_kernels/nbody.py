@@ -55,21 +55,34 @@ def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
     nm = idx.shape[0]
     for a in range(nm):
         i = idx[a]
+        # body i's sum kept in registers (j != i: the compiler cannot know that
+        # acc[i] and acc[j] differ and would store and reload it every pair);
+        # the same additions in the same order
+        xi = r[i, 0]
+        yi = r[i, 1]
+        zi = r[i, 2]
+        gi = gm[i]
+        ax = acc[i, 0]
+        ay = acc[i, 1]
+        az = acc[i, 2]
         for b in range(a + 1, nm):
             j = idx[b]
-            dx = r[j, 0] - r[i, 0]
-            dy = r[j, 1] - r[i, 1]
-            dz = r[j, 2] - r[i, 2]
+            dx = r[j, 0] - xi
+            dy = r[j, 1] - yi
+            dz = r[j, 2] - zi
             d2 = dx * dx + dy * dy + dz * dz
             inv3 = 1.0 / (d2 * np.sqrt(d2))
             fi = gm[j] * inv3
-            fj = gm[i] * inv3
-            acc[i, 0] += fi * dx
-            acc[i, 1] += fi * dy
-            acc[i, 2] += fi * dz
+            fj = gi * inv3
+            ax += fi * dx
+            ay += fi * dy
+            az += fi * dz
             acc[j, 0] -= fj * dx
             acc[j, 1] -= fj * dy
             acc[j, 2] -= fj * dz
+        acc[i, 0] = ax
+        acc[i, 1] = ay
+        acc[i, 2] = az
     if nm == n - first:
         return
     for k in range(first, n):
