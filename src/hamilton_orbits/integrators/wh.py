@@ -215,12 +215,23 @@ def _jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - c
     down, ``S_{i-1} = (S_i - m_i qj_i) eta_{i-1} / eta_i``,
     ``r_i = qj_i + S_{i-1} / eta_{i-1}``, ``r_0 = S_0 / m_0``."""
     n = qj.shape[0]
-    for k in range(3):
-        s = eta[n - 1] * qj[0, k]
-        for i in range(n - 1, 0, -1):
-            s = (s - gm[i] * qj[i, k]) * ratio[i]
-            r[i, k] = qj[i, k] + s * inv[i - 1]
-        r[0, k] = s / gm[0]
+    # the three coordinates side by side (three independent recurrences)
+    sx = eta[n - 1] * qj[0, 0]
+    sy = eta[n - 1] * qj[0, 1]
+    sz = eta[n - 1] * qj[0, 2]
+    for i in range(n - 1, 0, -1):
+        gi = gm[i]
+        ri = ratio[i]
+        ie = inv[i - 1]
+        sx = (sx - gi * qj[i, 0]) * ri
+        sy = (sy - gi * qj[i, 1]) * ri
+        sz = (sz - gi * qj[i, 2]) * ri
+        r[i, 0] = qj[i, 0] + sx * ie
+        r[i, 1] = qj[i, 1] + sy * ie
+        r[i, 2] = qj[i, 2] + sz * ie
+    r[0, 0] = sx / gm[0]
+    r[0, 1] = sy / gm[0]
+    r[0, 2] = sz / gm[0]
 
 
 @njit(cache=True, inline="always")
@@ -228,11 +239,18 @@ def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
     """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1
     (``inv_i = 1 / eta_i``)."""
     n = a.shape[0]
-    for k in range(3):
-        s = gm[0] * a[0, k]
-        for i in range(1, n):
-            aj[i, k] = a[i, k] - s * inv[i - 1]
-            s += gm[i] * a[i, k]
+    sx = gm[0] * a[0, 0]
+    sy = gm[0] * a[0, 1]
+    sz = gm[0] * a[0, 2]
+    for i in range(1, n):
+        ie = inv[i - 1]
+        aj[i, 0] = a[i, 0] - sx * ie
+        aj[i, 1] = a[i, 1] - sy * ie
+        aj[i, 2] = a[i, 2] - sz * ie
+        gi = gm[i]
+        sx += gi * a[i, 0]
+        sy += gi * a[i, 1]
+        sz += gi * a[i, 2]
 
 
 @njit(cache=True, inline="always")
