@@ -582,14 +582,16 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
     sgn = 1.0 if tau > 0.0 else -1.0
     # first guess: the reversed Taylor series of T(chi) for short steps,
     # otherwise the mean-motion guess (elliptic) or a logarithmic one
-    # (hyperbolic).  With T/r0 = chi + c2 chi^2 + c3 chi^3 + c4 chi^4 + ...
-    # (c2 = sigma0/(2 r0), c3 = (1 - alpha r0)/(6 r0), c4 = -alpha sigma0/(24 r0))
-    # and y = tau/r0: chi = y - c2 y^2 + (2 c2^2 - c3) y^3
-    # + (5 c2 c3 - c4 - 5 c2^3) y^4 + O(y^5).  The fourth-order guess is within
-    # ~1e-8 (Venus..Mars) to 1e-15 (Uranus, Neptune) of the root for a 4-day
-    # step of the planets, which saves the solver one or two evaluations per
-    # call (the Wisdom-Holman drift); the second-order one is kept when the
-    # series is not small (z >= 1 below).
+    # (hyperbolic).  With T/r0 = chi + c2 chi^2 + c3 chi^3 + c4 chi^4 + c5 chi^5
+    # + ... (c2 = sigma0/(2 r0), c3 = (1 - alpha r0)/(6 r0), c4 = -alpha sigma0/
+    # (24 r0), c5 = -alpha c3 / 20) and y = tau/r0: chi = y - c2 y^2
+    # + (2 c2^2 - c3) y^3 + (5 c2 c3 - c4 - 5 c2^3) y^4 + (14 c2^4 - 21 c2^2 c3
+    # + 6 c2 c4 + 3 c3^2 - c5) y^5 + O(y^6) (series reversion).  The
+    # fifth-order guess is within 3e-9 (Mercury) and 2e-10 (Venus..Mars) of the
+    # root for a 4-day step of the planets (the fourth-order one: 3e-6 and
+    # 6e-9), so that the short-step solver needs one evaluation for each of
+    # them (the Wisdom-Holman drift); the second-order one is
+    # kept when the series is not small (z >= 1 below).
     if r0 * r0 * r0 > 0.0:
         x1 = tau / r0
         ir = 1.0 / r0
@@ -601,7 +603,10 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             c4 = -alpha * sigma0 * ir * (1.0 / 24.0)
             k3 = 2.0 * c2 * c2 - c3
             k4 = c2 * (5.0 * c3 - 5.0 * c2 * c2) - c4
-            x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * k4)))
+            c5 = -alpha * c3 * (1.0 / 20.0)
+            s2 = c2 * c2
+            k5 = s2 * (14.0 * s2 - 21.0 * c3) + 6.0 * c2 * c4 + 3.0 * c3 * c3 - c5
+            x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
             # a short step (|psi| < 1/4 at the guess): Halley from the series
             # guess, without the bracket (see _solve_uv_short)
             if x * sgn > 0.0 and x * x * abs(alpha) < 0.25:
