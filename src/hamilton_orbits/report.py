@@ -13,7 +13,9 @@ Problems
    WHFast (one test particle: the Kepler drift only) over dt, scipy DOP853 over
    rtol.  Reference: Kepler's equation solved in mpmath at 40 digits.
 2. The solar system (Sun + 8 planets, ``System.solar_system("J2000")``), 10 years
-   (quick) or 1000 years: ours (radau15, wh, leapfrog, dop853) and rebound
+   (quick) or 1000 years: ours (radau15; wh in democratic-heliocentric and in
+   Jacobi coordinates, the latter also with the third-order corrector;
+   leapfrog; dop853) and rebound
    (IAS15, WHFast in its default Jacobi coordinates and in the
    democratic-heliocentric coordinates our ``wh`` uses, leapfrog) and, where it
    is installed, heyoka's adaptive Taylor integrator.  Reference:
@@ -204,10 +206,10 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
 
     cases: list[tuple[str, str, str, Callable[[], np.ndarray]]] = []
 
-    def ours(method: str, dt: float | None = None, tol: float | None = None):
+    def ours(method: str, dt: float | None = None, tol: float | None = None, **options: Any):
         def run() -> np.ndarray:
             tr = integrate(system, t_end * u.day, method=method,
-                           dt=None if dt is None else dt * u.day, tol=tol)
+                           dt=None if dt is None else dt * u.day, tol=tol, **options)
             return tr.final.r.to_value(u.au)
         return run
 
@@ -218,6 +220,12 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     dts_lf = (1.0, 0.25) if quick else (1.0, 0.5, 0.25)
     for dt in dts_wh:
         cases.append(("hamilton-orbits", "wh", f"dt = {dt:g} d", ours("wh", dt=dt)))
+    for dt in dts_wh:  # the coordinates of rebound's default WHFast
+        cases.append(("hamilton-orbits", "wh (Jacobi)", f"dt = {dt:g} d",
+                      ours("wh", dt=dt, coordinates="jacobi")))
+    for dt in dts_wh:
+        cases.append(("hamilton-orbits", "wh (Jacobi, corrector 3)", f"dt = {dt:g} d",
+                      ours("wh", dt=dt, coordinates="jacobi", corrector=3)))
     for dt in dts_lf:
         cases.append(("hamilton-orbits", "leapfrog", f"dt = {dt:g} d", ours("leapfrog", dt=dt)))
     for tol in (1e-8, 1e-11) if quick else (1e-10, 1e-12, 1e-14):
