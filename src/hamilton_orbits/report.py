@@ -335,17 +335,22 @@ def _draw(ax: Any, rows: list[Row]) -> None:
     for r in rows:
         if r.error > 0:  # the reference itself (error 0) has no place on a log axis
             groups.setdefault((r.code, r.method), []).append(r)
-    for (code, method), rs in groups.items():
+    import matplotlib
+
+    colours = matplotlib.colormaps["tab20"].colors  # 20 distinct: a problem has up to ~12 lines
+    for k, ((code, method), rs) in enumerate(groups.items()):
         rs = sorted(rs, key=lambda r: r.wall_time)
-        style = "-o" if code == "hamilton-orbits" else "--s"
-        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], style,
+        ours = code == "hamilton-orbits"
+        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], "-o" if ours else "--s",
+                  color=colours[(2 * k) % 20 if k < 10 else (2 * k + 1) % 20],
                   label=f"{method} ({code})")
+    first = next((r for r in rows if r.error > 0), rows[0])  # not the reference's own row
     ax.set_xlabel("wall time (s)")
-    ax.set_ylabel(rows[0].error_measure)
-    ax.set_title(f"{rows[0].problem}: error vs wall time\nreference: {rows[0].reference}",
+    ax.set_ylabel(first.error_measure)
+    ax.set_title(f"{first.problem}: error vs wall time\nreference: {first.reference}",
                  fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="best", framealpha=0.6)
 
 
 def _table(rows: list[Row]) -> list[list[str]]:
