@@ -69,6 +69,9 @@ SCHEMA: dict[str, S.Field] = {
             "method": S.Choice(choices=METHODS, default="radau15"),
             "tol": S.Number(positive=True),
             "dt": S.Quantity(kind=TIME, positive=True),
+            # options of ``wh`` (integrate(..., coordinates=, corrector=))
+            "coordinates": S.Choice(choices=("democratic_heliocentric", "jacobi")),
+            "corrector": S.Number(integer=True, minimum=0),
         },
     ),
     "initial": S.Table(
@@ -198,6 +201,16 @@ def _check(spec: dict, problems: S.Problems) -> None:
                 f"effect {eff['name']!r} depends on velocities and integrator {method!r} "
                 f"cannot take it; use one of {', '.join(ok)}",
             )
+    integ = spec["integrator"]
+    for option in ("coordinates", "corrector"):
+        if integ[option] is not None and integ["method"] != "wh":
+            problems.add(f"integrator.{option}",
+                         f"an option of method 'wh' only, not of {integ['method']!r}")
+    if integ["corrector"] not in (None, 0, 3):
+        problems.add("integrator.corrector", f"expected 0 or 3, got {integ['corrector']!r}")
+    elif integ["corrector"] == 3 and integ["coordinates"] != "jacobi":
+        problems.add("integrator.corrector",
+                     "the corrector needs integrator.coordinates = 'jacobi'")
     for i, an in enumerate(spec["analysis"]):
         for key in ("body", "primary", "other"):
             if an.get(key) is not None and an[key] not in names:
@@ -285,6 +298,9 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         kw["tol"] = integ["tol"]
     if integ["dt"] is not None:
         kw["dt"] = integ["dt"]
+    for option in ("coordinates", "corrector"):
+        if integ[option] is not None:
+            kw[option] = integ[option]
     # chunks: a progress bar over the whole run, and Ctrl-C keeps finished chunks
     n_chunks = min(len(t_all) - 1, 50)
     edges = np.unique(np.linspace(0, len(t_all) - 1, n_chunks + 1).round().astype(int))

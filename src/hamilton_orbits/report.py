@@ -13,9 +13,12 @@ Problems
    WHFast (one test particle: the Kepler drift only) over dt, scipy DOP853 over
    rtol.  Reference: Kepler's equation solved in mpmath at 40 digits.
 2. The solar system (Sun + 8 planets, ``System.solar_system("J2000")``), 10 years
-   (quick) or 1000 years: ours (radau15, wh, leapfrog, dop853) and rebound
+   (quick) or 1000 years: ours (radau15; wh in democratic-heliocentric and in
+   Jacobi coordinates, the latter also with the third-order corrector;
+   leapfrog; dop853) and rebound
    (IAS15, WHFast in its default Jacobi coordinates and in the
-   democratic-heliocentric coordinates our ``wh`` uses, leapfrog).  Reference:
+   democratic-heliocentric coordinates our ``wh`` uses, leapfrog) and, where it
+   is installed, heyoka's adaptive Taylor integrator.  Reference:
    rebound IAS15 with ``epsilon = 0`` at a fixed step of 0.5 day.  Error: max
    over planets of the final heliocentric position difference over the
    heliocentric distance.
@@ -39,8 +42,10 @@ from __future__ import annotations
 
 import base64
 import html
+import json
 import math
 import os
+import shutil
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -49,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Row", "build_report"]
+__all__ = ["Row", "build_report", "readme_section", "update_readme"]
 
 
 @dataclass
@@ -201,10 +206,10 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
 
     cases: list[tuple[str, str, str, Callable[[], np.ndarray]]] = []
 
-    def ours(method: str, dt: float | None = None, tol: float | None = None):
+    def ours(method: str, dt: float | None = None, tol: float | None = None, **options: Any):
         def run() -> np.ndarray:
             tr = integrate(system, t_end * u.day, method=method,
-                           dt=None if dt is None else dt * u.day, tol=tol)
+                           dt=None if dt is None else dt * u.day, tol=tol, **options)
             return tr.final.r.to_value(u.au)
         return run
 
@@ -215,9 +220,15 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     dts_lf = (1.0, 0.25) if quick else (1.0, 0.5, 0.25)
     for dt in dts_wh:
         cases.append(("hamilton-orbits", "wh", f"dt = {dt:g} d", ours("wh", dt=dt)))
+    for dt in dts_wh:  # the coordinates of rebound's default WHFast
+        cases.append(("hamilton-orbits", "wh (Jacobi)", f"dt = {dt:g} d",
+                      ours("wh", dt=dt, coordinates="jacobi")))
+    for dt in dts_wh:
+        cases.append(("hamilton-orbits", "wh (Jacobi, corrector 3)", f"dt = {dt:g} d",
+                      ours("wh", dt=dt, coordinates="jacobi", corrector=3)))
     for dt in dts_lf:
         cases.append(("hamilton-orbits", "leapfrog", f"dt = {dt:g} d", ours("leapfrog", dt=dt)))
-    for tol in (1e-8, 1e-11) if quick else (1e-8, 1e-10, 1e-12):
+    for tol in (1e-8, 1e-11) if quick else (1e-10, 1e-12, 1e-14):
         cases.append(("hamilton-orbits", "dop853", f"tol = {tol:g}", ours("dop853", tol=tol)))
     for eps in (1e-6, 1e-9):
         cases.append(("rebound", "IAS15", f"epsilon = {eps:g}",
@@ -232,6 +243,7 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     for dt in dts_lf:
         cases.append(("rebound", "leapfrog", f"dt = {dt:g} d",
                       lambda dt=dt: rebound_run("leapfrog", dt)))
+    cases += _heyoka_cases(r0, v0, gm, t_end, quick, progress)
 
     # warm up (compile) our kernels on a short span
     for method, kw in (("radau15", {}), ("wh", {"dt": 4 * u.day}),
@@ -247,6 +259,43 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     return rows
 
 
+_Case = tuple[str, str, str, Callable[[], np.ndarray]]
+
+
+def _heyoka_cases(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
+                  quick: bool, progress: bool) -> list[_Case]:
+    """heyoka's adaptive Taylor integrator on the same system, where heyoka is installed.
+
+    The Taylor integrator is built (LLVM compilation, reported, not timed) once per
+    tolerance, in heyoka's ``high_accuracy`` mode (compensated summation, its
+    recommendation for long integrations: without it the 10-year error at
+    tol = 1e-15 is ~1e-11 instead of ~1e-13); each timed run resets its state and
+    propagates to ``t_end``.
+    """
+    try:
+        import heyoka as hy
+    except ImportError:
+        _log(progress, "solar system: heyoka not installed, its rows are left out")
+        return []
+    n = len(gm)
+    state0 = np.hstack([r0, v0]).ravel()
+    model = hy.model.nbody(n, masses=[float(m) for m in gm], Gconst=1.0)
+    out = []
+    for tol in (1e-9, 1e-15) if quick else (1e-9, 1e-12, 1e-15):
+        t0 = time.perf_counter()
+        ta = hy.taylor_adaptive(model, state0, tol=tol, compact_mode=True, high_accuracy=True)
+        _log(progress, f"solar system: heyoka tol = {tol:g} compiled in "
+                       f"{time.perf_counter() - t0:.2f} s (not timed)")
+
+        def run(ta: Any = ta) -> np.ndarray:
+            ta.time = 0.0
+            ta.state[:] = state0
+            ta.propagate_until(t_end)
+            return np.array(ta.state).reshape(n, 6)[:, :3]
+        out.append(("heyoka", "taylor_adaptive", f"tol = {tol:g}", run))
+    return out
+
+
 def _figure(rows: list[Row], path: Path) -> None:
     import matplotlib
 
@@ -254,24 +303,54 @@ def _figure(rows: list[Row], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
+    _draw(ax, rows)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def _summary_figure(rows: list[Row], path: Path, title: str) -> None:
+    """All problems of the report in one figure (the diagram the README shows)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    problems = list(dict.fromkeys(r.problem for r in rows))
+    ncol = 2
+    nrow = (len(problems) + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(12, 4.6 * nrow), squeeze=False)
+    for ax, problem in zip(axes.ravel()[: len(problems)], problems, strict=True):
+        _draw(ax, [r for r in rows if r.problem == problem])
+    for ax in axes.ravel()[len(problems):]:
+        ax.set_visible(False)
+    fig.suptitle(f"What accuracy costs in time: error against wall time ({title})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def _draw(ax: Any, rows: list[Row]) -> None:
     groups: dict[tuple[str, str], list[Row]] = {}
     for r in rows:
         if r.error > 0:  # the reference itself (error 0) has no place on a log axis
             groups.setdefault((r.code, r.method), []).append(r)
-    for (code, method), rs in groups.items():
+    import matplotlib
+
+    colours = matplotlib.colormaps["tab20"].colors  # 20 distinct: a problem has up to ~12 lines
+    for k, ((code, method), rs) in enumerate(groups.items()):
         rs = sorted(rs, key=lambda r: r.wall_time)
-        style = "-o" if code == "hamilton-orbits" else "--s"
-        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], style,
+        ours = code == "hamilton-orbits"
+        ax.loglog([r.wall_time for r in rs], [r.error for r in rs], "-o" if ours else "--s",
+                  color=colours[(2 * k) % 20 if k < 10 else (2 * k + 1) % 20],
                   label=f"{method} ({code})")
+    first = next((r for r in rows if r.error > 0), rows[0])  # not the reference's own row
     ax.set_xlabel("wall time (s)")
-    ax.set_ylabel(rows[0].error_measure)
-    ax.set_title(f"{rows[0].problem}: error vs wall time\nreference: {rows[0].reference}",
+    ax.set_ylabel(first.error_measure)
+    ax.set_title(f"{first.problem}: error vs wall time\nreference: {first.reference}",
                  fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    ax.legend(fontsize=7, loc="best", framealpha=0.6)
 
 
 def _table(rows: list[Row]) -> list[list[str]]:
@@ -314,7 +393,9 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
     Returns
     -------
     list of Path
-        The files written: one PNG per problem, ``report.md``, ``report.html``.
+        The files written: one PNG per problem, ``work_precision.png`` (all
+        problems in one figure), ``report.md``, ``report.json`` (the rows and
+        the date, mode and core count) and ``report.html``.
 
     Raises
     ------
@@ -357,6 +438,9 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
     intro = (f"Work-precision report ({mode}), {stamp}, {cores} cores, "
              f"total {total:.1f} s. Wall time: shortest of up to 3 runs, same process.")
     table = _table(all_rows)
+    summary_png = out / "work_precision.png"
+    _summary_figure(all_rows, summary_png, f"{mode} report, {stamp}, {cores} cores")
+    figures.insert(0, ("All problems", summary_png))
 
     md = ["# What accuracy costs in time", "", intro, "",
           "| " + " | ".join(_HEADER) + " |", "|" + "---|" * len(_HEADER)]
@@ -366,6 +450,10 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
         md += [f"![{title}]({png.name})", ""]
     md_path = out / "report.md"
     md_path.write_text("\n".join(md), encoding="utf-8")
+    meta = {"mode": mode, "date": stamp, "cores": cores, "total_seconds": total}
+    json_path = out / "report.json"
+    json_path.write_text(json.dumps({"meta": meta, "rows": [vars(r) for r in all_rows]},
+                                    indent=1), encoding="utf-8")
 
     h = ["<!DOCTYPE html>", "<html><head><meta charset=\"utf-8\">",
          "<title>hamilton-orbits work-precision report</title>",
@@ -383,6 +471,126 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
     h.append("</body></html>")
     html_path = out / "report.html"
     html_path.write_text("\n".join(h), encoding="utf-8")
-    files += [md_path, html_path]
+    files += [summary_png, md_path, json_path, html_path]
     _log(progress, f"wrote {out} in {total:.1f} s")
     return files
+
+
+_BEGIN = "<!-- report:begin (generated by `hamilton-orbits report --readme`) -->"
+_END = "<!-- report:end -->"
+
+
+def _fmt_time(seconds: float) -> str:
+    if seconds >= 1:
+        return f"{seconds:.3g} s"
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds * 1e6:.3g} us"
+
+
+def readme_section(report_dir: Any, diagram: str = "docs/work_precision.png") -> str:
+    """The README's generated part of "What accuracy costs in time", from a report.
+
+    One row per problem and method: the most accurate setting that was run (its
+    error and wall time) and the cheapest one.  Each problem's error measure and
+    reference are stated once, above its rows.
+
+    Parameters
+    ----------
+    report_dir : str or path-like
+        A folder written by :func:`build_report` (it reads ``report.json``).
+    diagram : str, optional
+        Path of the combined diagram, relative to the README.
+
+    Returns
+    -------
+    str
+        Markdown, without the begin/end markers.
+
+    Examples
+    --------
+    >>> import json, tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> row = dict(problem="p", code="c", method="m", parameter="dt = 1", error=1e-9,
+    ...            error_measure="|dr|", reference="exact", wall_time=0.5)
+    >>> meta = dict(mode="full", date="2026-11-23 12:00 UTC", cores=2, total_seconds=9.0)
+    >>> _ = (d / "report.json").write_text(json.dumps({"meta": meta, "rows": [row]}))
+    >>> print(readme_section(d).splitlines()[-1])
+    | c | m | dt = 1: 1.0e-09 in 500 ms | dt = 1: 1.0e-09 in 500 ms |
+    """
+    data = json.loads((Path(report_dir) / "report.json").read_text(encoding="utf-8"))
+    meta = data["meta"]
+    rows = [Row(**r) for r in data["rows"]]
+    lines = [
+        f"Generated by `hamilton-orbits report --readme README.md` ({meta['mode']} run, "
+        f"{meta['date']}, a {meta['cores']}-core machine, {_fmt_time(meta['total_seconds'])} "
+        "in all; every wall time is the shortest of up to three runs in one process, so "
+        "ours and the peers' met the same machine load).  Each cell: the setting, the "
+        "error it reached and its wall time.",
+        "",
+        f"![error against wall time for every problem and method]({diagram})",
+    ]
+    for problem in dict.fromkeys(r.problem for r in rows):
+        mine = [r for r in rows if r.problem == problem]
+        first = next((r for r in mine if r.error > 0), mine[0])  # not the reference's own row
+        lines += ["", f"**{problem}**: error = {first.error_measure}; reference: "
+                      f"{first.reference}.", "",
+                  "| code | method | most accurate | cheapest |", "|---|---|---|---|"]
+        for key in dict.fromkeys((r.code, r.method) for r in mine):
+            group = [r for r in mine if (r.code, r.method) == key]
+            best = min(group, key=lambda r: (r.error, r.wall_time))
+            cheap = min(group, key=lambda r: r.wall_time)
+            cells = [f"{r.parameter}: {r.error:.1e} in {_fmt_time(r.wall_time)}"
+                     for r in (best, cheap)]
+            lines.append(f"| {key[0]} | {key[1]} | {cells[0]} | {cells[1]} |")
+    return "\n".join(lines)
+
+
+def update_readme(report_dir: Any, readme: Any) -> Path:
+    """Copy the combined diagram and the full table under ``docs/`` and rewrite the
+    README's generated section between its markers.
+
+    Parameters
+    ----------
+    report_dir : str or path-like
+        A folder written by :func:`build_report`.
+    readme : str or path-like
+        The README to update; it must hold the markers ``<!-- report:begin ... -->``
+        and ``<!-- report:end -->``.  ``docs/`` is taken next to it.
+
+    Returns
+    -------
+    Path
+        The README.
+
+    Raises
+    ------
+    ValueError
+        If the README is missing or lacks the markers.
+
+    Examples
+    --------
+    >>> from hamilton_orbits.report import update_readme
+    >>> callable(update_readme)
+    True
+    """
+    src = Path(report_dir)
+    path = Path(readme)
+    if not path.is_file():
+        raise ValueError(f"`readme` {str(path)!r} is not a file")
+    text = path.read_text(encoding="utf-8")
+    begin = text.find(_BEGIN)
+    end = text.find(_END)
+    if begin < 0 or end < begin:
+        raise ValueError(f"`readme` {str(path)!r} has no generated section: add the lines "
+                         f"{_BEGIN!r} and {_END!r} where it belongs")
+    docs = path.parent / "docs"
+    docs.mkdir(exist_ok=True)
+    shutil.copyfile(src / "work_precision.png", docs / "work_precision.png")
+    shutil.copyfile(src / "report.md", docs / "work_precision.md")
+    body = readme_section(src, "docs/work_precision.png")
+    body += ("\n\nThe full table (every setting): [docs/work_precision.md]"
+             "(docs/work_precision.md).")
+    path.write_text(text[: begin + len(_BEGIN)] + "\n\n" + body + "\n\n" + text[end:],
+                    encoding="utf-8")
+    return path

@@ -145,6 +145,20 @@ def _diagnostics(system: System, r: np.ndarray, v: np.ndarray, t: np.ndarray):
     return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
 
 
+def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
+    """Refuse an option the integrator's ``run`` does not take, listing those it does."""
+    import inspect
+
+    common = {"dt", "tol", "on_output"}
+    takes = [name for name, p in inspect.signature(module.run).parameters.items()
+             if p.kind is p.KEYWORD_ONLY and name not in common]
+    for key, value in options.items():
+        if key not in takes:
+            raise ValueError(
+                f"Unknown option `{key}` = {value!r} for method {method!r}; it takes: "
+                + (", ".join(takes) if takes else "no options beyond dt and tol"))
+
+
 def integrate(
     system: System,
     t: Any,
@@ -154,6 +168,7 @@ def integrate(
     effects: Sequence[str | Mapping[str, Any]] = (),
     progress: bool = False,
     on_output: Any = None,
+    **options: Any,
 ) -> Trajectory:
     """Integrate Hamilton's equation (B) (plus the listed effects) for ``system``.
 
@@ -177,6 +192,10 @@ def integrate(
         Show a progress bar (tqdm, on stderr) over the output times.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` (for scenes and interfaces).
+    **options
+        Options of the chosen integrator, e.g. for ``wh``
+        ``coordinates="jacobi"`` and ``corrector=3`` (see its ``run``).  An option
+        the method does not take raises ``ValueError`` listing those it takes.
 
     Returns
     -------
@@ -198,6 +217,9 @@ def integrate(
     >>> traj = integrate(s, 2 * np.pi, method="leapfrog", dt=2 * np.pi / 2000)
     >>> bool(np.allclose(traj.final["dust"].r, [1, 0, 0], atol=1e-4))
     True
+    >>> jac = integrate(s, 2 * np.pi, method="wh", dt=0.1, coordinates="jacobi", corrector=3)
+    >>> bool(np.allclose(jac.final["dust"].r, [1, 0, 0], atol=1e-12))  # a Kepler orbit: exact
+    True
     >>> integrate(s, 1.0, method="leapfrog", dt=0.1, effects=["gr"])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -206,6 +228,7 @@ def integrate(
     if not isinstance(system, System):
         raise ValueError(f"Expected `system` to be a System, got {system!r}")
     module = integrator_module(method)
+    _check_options(module, method, options)
     normal = normalize_effects(effects, "nbody")
     if not module.ACCEPTS_VELOCITY_DEPENDENT:
         for name, _ in normal:
@@ -249,7 +272,8 @@ def integrate(
     gm = np.array(system._gm, dtype=np.float64)
     try:
         if sign > 0:
-            r, v, steps = module.run(rhs, r0, v0, gm, times, dt=step, tol=tol, on_output=report)
+            r, v, steps = module.run(rhs, r0, v0, gm, times, dt=step, tol=tol, on_output=report,
+                                     **options)
         else:
             # integrate backwards as forwards with the velocities reversed; exact for
             # conservative forces; velocity-dependent ones are odd in v: handled by
@@ -259,7 +283,7 @@ def integrate(
                 raise ValueError("Backward integration with a velocity-dependent effect is not "
                                  "supported; integrate forwards from the final state")
             r, v, steps = module.run(rhs, r0, -v0, gm, -times, dt=step, tol=tol,
-                                     on_output=report)
+                                     on_output=report, **options)
             v = -v
     finally:
         if bar is not None:

@@ -67,6 +67,12 @@ CATALOGUE = [
     ("effect the integrator cannot take",
      (('method = "radau15"', 'method = "wh"'), ("effects = []", 'effects = ["gr"]')),
      r"effects\[0\]: effect 'gr' depends on velocities and integrator 'wh' cannot take it"),
+    ("wh option given to another method", ('method = "radau15"', 'method = "radau15"\n'
+                                           'coordinates = "jacobi"'),
+     r"integrator\.coordinates: an option of method 'wh' only, not of 'radau15'"),
+    ("corrector without Jacobi coordinates", ('method = "radau15"', 'method = "wh"\n'
+                                              'corrector = 3'),
+     r"integrator\.corrector: the corrector needs integrator\.coordinates = 'jacobi'"),
     ("elements orbit a missing body", ('primary = "sun"', 'primary = "sol"'),
      r"bodies\[1\]\.primary: no body named 'sol' \(valid: 'sun'\)"),
     ("unknown key in a body", ("e = 0.0167", "ecc = 0.0167"),

@@ -112,6 +112,32 @@ def test_hyperbolic_flyby_matches_two_body():
     assert np.linalg.norm(traj.final._r[1] - exact) < 1e-10 * np.linalg.norm(exact)
 
 
+def test_dop853_tolerance_is_per_body():
+    """A far massless body does not loosen the error control of an inner orbit.
+
+    The inner orbit (a = 1, e = 0.3, ten periods) is checked against the exact
+    Kepler propagation.  A second, massless body at 1e4 (no force on the first)
+    must leave its error unchanged: with one absolute tolerance scaled by the
+    largest coordinate (the former rule) the inner error grew ~1e3-fold.
+    """
+    orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.1, argp=0.4, M=0.0,
+                                      mu=1.0)
+    r0, v0 = orbit.state()
+    star = Body("star", 1.0, [0, 0, 0], [0, 0, 0])
+    far = Body("far", 0.0, [1e4, 0, 0], [0, 1e-2, 0])
+    t = 20 * np.pi
+    exact, _ = orbit.propagate(t).state()
+    errs = []
+    for bodies in ([star, Body("p", 0.0, r0, v0)], [star, Body("p", 0.0, r0, v0), far]):
+        traj = integrate(System(bodies), t, method="dop853", tol=1e-10)
+        errs.append(np.linalg.norm(traj.final._r[1] - exact))
+    # ~270 steps at rtol 1e-10; the along-track error grows with the phase swept
+    # (n t = 20 pi): bound steps x tol x n t = 1.7e-6 (measured 3.5e-7)
+    assert errs[0] < 1.7e-6
+    # same step sequence up to the far body's own (smooth) demands
+    assert errs[1] < 2 * errs[0]
+
+
 def test_close_encounter_at_1e_4_au():
     """Two small bodies passing within 1e-4 au at 0.2 au/day relative speed.
 

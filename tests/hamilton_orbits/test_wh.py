@@ -207,3 +207,29 @@ def test_corrector_needs_jacobi():
         wh.run(*args, dt=0.1, corrector=3)
     with pytest.raises(ValueError, match=r"`corrector` to be 0 or 3, got 5"):
         wh.run(*args, dt=0.1, coordinates="jacobi", corrector=5)
+
+
+def test_integrate_passes_the_wh_options_and_refuses_others():
+    """``integrate(..., coordinates=, corrector=)`` runs the same map as ``wh.run``,
+    bit for bit; an option a method does not take names itself and what it takes."""
+    import astropy.units as u
+
+    from hamilton_orbits import System, integrate
+
+    s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
+    traj = integrate(s, 400 * u.day, method="wh", dt=4 * u.day, coordinates="jacobi",
+                     corrector=3)
+    r0 = s.r.to_value(u.au)
+    v0 = s.v.to_value(u.au / u.day)
+    gm = s.gm.to_value(u.au**3 / u.day**2)
+    r, _, _ = wh.run(newtonian_rhs(), r0, v0, gm, np.array([0.0, 400.0]), dt=4.0,
+                     coordinates="jacobi", corrector=3)
+    np.testing.assert_array_equal(traj.final.r.to_value(u.au), r[-1])
+    default = integrate(s, 400 * u.day, method="wh", dt=4 * u.day)
+    assert not np.array_equal(default.final.r.to_value(u.au), r[-1])  # a different map
+    with pytest.raises(ValueError, match=r"Unknown option `coordinates` = 'jacobi' for method "
+                                         r"'radau15'; it takes: max_steps, criterion"):
+        integrate(s, 4 * u.day, coordinates="jacobi")
+    with pytest.raises(ValueError, match=r"Unknown option `corector` = 3 for method 'wh'; "
+                                         r"it takes: coordinates, corrector"):
+        integrate(s, 4 * u.day, method="wh", dt=1 * u.day, corector=3)

@@ -1,9 +1,13 @@
 """DOP853 (Dormand-Prince 8(5,3)) through :func:`scipy.integrate.solve_ivp`.
 
 For anything generic: it accepts every effect, velocity-dependent ones included,
-and controls its local error with ``rtol = tol`` and ``atol = tol * scale`` where
-``scale`` is the largest position or velocity of the initial state; ``tol`` is
-raised to scipy's floor of 100 eps.  ``dt``, if
+and controls its local error with ``rtol = tol`` and a per-body absolute
+tolerance ``atol = tol * |r_i|`` on the three position components of body ``i``
+and ``tol * |v_i|`` on its velocity components (initial state; bodies at rest
+at the origin take the largest of the others).  One absolute tolerance for all
+components would let an inner planet's velocity go with an error set by the
+outer planets' distances; a pure relative tolerance would stall where one
+component crosses zero.  ``tol`` is raised to scipy's floor of 100 eps.  ``dt``, if
 given, caps the step (``max_step``).  Not symplectic: its energy error drifts
 linearly with time.
 """
@@ -57,7 +61,7 @@ def run(
         accel(r, v, gm, acc)
         return np.concatenate((y[3 * n :], acc.ravel()))
 
-    scale = max(float(np.max(np.abs(r0))), float(np.max(np.abs(v0))), 1e-300)
+    atol = tol * np.concatenate((_body_scale(r0), _body_scale(v0)))
     out_r = np.empty((len(t_out), n, 3))
     out_v = np.empty_like(out_r)
     out_r[0] = r0
@@ -71,7 +75,7 @@ def run(
             y,
             method="DOP853",
             rtol=tol,
-            atol=tol * scale,
+            atol=atol,
             max_step=np.inf if dt is None else float(dt),
         )
         if not sol.success:
@@ -84,3 +88,12 @@ def run(
         if on_output is not None:
             on_output(i, steps)
     return out_r, out_v, steps
+
+
+def _body_scale(x: np.ndarray) -> np.ndarray:
+    """|x_i| for each body, repeated over its three components (a zero row takes the
+    largest, so that a body at rest at the origin does not demand zero error)."""
+    norm = np.linalg.norm(x, axis=1)
+    top = float(np.max(norm)) if norm.size else 0.0
+    norm = np.where(norm > 0, norm, top if top > 0 else 1.0)
+    return np.repeat(norm, 3)
