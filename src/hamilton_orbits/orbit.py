@@ -74,7 +74,7 @@ _LAZY_COLS = frozenset(("anomaly", "M", "tau"))
 # the columns the basic kernel computes (the lazy ones are NaN until asked for)
 _BASIC_IDX = np.array([i for i, name in enumerate(_el.COLUMNS) if name not in _LAZY_COLS])
 _F64 = np.dtype(np.float64)
-_INF = np.float64(np.inf)
+_A1 = _el.NCOL  # one orbit: index of ``a`` in the row of ``classical_one``
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -209,7 +209,7 @@ def _in_range(prop):
     parabola, ``period`` of an unbound orbit, ``n`` of a radial parabola), means
     the value is beyond the float64 range for this state and raises ValueError
     naming ``r``, ``v``, ``mu``."""
-    name = prop.__name__
+    name = prop.__name__.removeprefix("_").removesuffix("_general")  # _a_general: a
 
     @functools.wraps(prop)
     def guarded(self):
@@ -283,6 +283,26 @@ class KeplerOrbit:
     _r = cached_property(lambda self: np.array(self._one[:3]))
     _v = cached_property(lambda self: np.array(self._one[3:6]))
     _mu = cached_property(lambda self: np.array(self._one[6]))
+    # one orbit from plain floats, once its elements are asked for: the row of
+    # _el.classical_one (the classical columns, then a) as float64, so that
+    # reading an element is an index into it
+    _c1: np.ndarray | None = None
+
+    def _one_classical(self) -> np.ndarray | None:
+        """The row ``_c1`` of a single orbit built from plain floats (computed
+        once, in one kernel call that flags any value beyond float64), or None
+        for a batch, a Quantity orbit or a flagged state (the general path then
+        computes the attribute or names the arguments)."""
+        one = self._one
+        if one is None:
+            return None
+        res = _el.classical_one(*one)
+        if res[_A1] != res[_A1]:  # NaN: beyond float64
+            return None
+        c = np.array(res)
+        self._c1 = c
+        self.__dict__.setdefault("_elements", c[:_A1])
+        return c
 
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
         # np.array, not ascontiguousarray (which turns 0-d into 1-d)
@@ -631,11 +651,17 @@ class KeplerOrbit:
     @property
     def e(self):
         """Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[1]
         return self._out(self._col("e"), None)
 
     @property
     def p(self):
         """Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16)."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[0]
         return self._out(self._col("p"), _L)
 
     @property
@@ -643,14 +669,18 @@ class KeplerOrbit:
         return self._col("inv_a")
 
     @property
-    @_in_range
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
-        inv = self._inv_a
-        if type(inv) is np.float64 and not self._quantity:  # one orbit
-            return 1.0 / inv if inv else _INF
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[_A1]
+        return self._a_general
+
+    @property
+    @_in_range
+    def _a_general(self):
         with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
-            return self._out(1.0 / inv, _L)
+            return self._out(1.0 / self._inv_a, _L)
 
     @property
     def q(self):
@@ -660,21 +690,33 @@ class KeplerOrbit:
     @property
     def inc(self):
         """Inclination in [0, pi] (rad)."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[3]
         return self._out(self._col("inc"), _RAD)
 
     @property
     def lan(self):
         """Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[4]
         return self._out(self._col("lan"), _RAD)
 
     @property
     def argp(self):
         """Argument of periapsis in [0, 2 pi); 0 when ``e = 0``."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[5]
         return self._out(self._col("argp"), _RAD)
 
     @property
     def nu(self):
         """True anomaly in (-pi, pi] (Hamilton's v, eq. 18)."""
+        c = self._c1 if self._c1 is not None else self._one_classical()
+        if c is not None:
+            return c[6]
         return self._out(self._col("nu"), _RAD)
 
     @property

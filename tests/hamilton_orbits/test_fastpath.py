@@ -106,3 +106,38 @@ def test_propagate_fast_path_errors_name_dt(dt):
     o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0)
     with pytest.raises(ValueError, match="`dt`"):
         o.propagate(dt)
+
+
+ONE_STATES = [
+    ([1.0, 0.25, -0.5], [0.0, 1.0, 0.25]),  # ellipse
+    ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),  # circle (e = 0, argp = 0)
+    ([1.0, 0.0, 0.0], [0.0, 2.0**0.5, 0.0]),  # parabola (a = inf)
+    ([1.0, 0.0, 0.0], [0.0, 3.0, 0.3]),  # hyperbola
+    ([1.0, 2.0, 0.5], [0.5, 1.0, 0.25]),  # radial (h = 0)
+    ([1e200, 0.0, 0.0], [0.0, 1e-100, 0.0]),  # scaled inside the kernel (a = 1e200)
+]
+
+
+@pytest.mark.parametrize(("r", "v"), ONE_STATES)
+def test_one_orbit_row_matches_batch_bits(r, v):
+    """One orbit of plain floats reads its elements from one kernel row
+    (``classical_one``): the same bits as the batch kernel, the same types."""
+    one = KeplerOrbit.from_state(r, v, 1.0)
+    batch = KeplerOrbit.from_state(np.array([r]), np.array([v]), np.ones(1))
+    for n in ("a", "e", "p", "inc", "lan", "argp", "nu"):
+        x = getattr(one, n)
+        assert type(x) is np.float64, n
+        y = getattr(batch, n)[0]
+        assert x == y or (np.isnan(x) and np.isnan(y)), n
+    # the lazy columns afterwards leave the classical ones as they were
+    assert one.M == batch.M[0] and one.anomaly == batch.anomaly[0]
+    assert one.e == batch.e[0] and one.nu == batch.nu[0]
+
+
+def test_one_orbit_beyond_float64_names_the_state():
+    """A state whose elements overflow (e ~ 1e155) is flagged by the one-orbit
+    kernel and refused by the general path by name, from any first attribute."""
+    for name in ("a", "e", "inc", "nu"):
+        o = KeplerOrbit.from_state([1e51, 0.0, 0.0], [0.0, 0.0, 1e52], 1.0)
+        with pytest.raises(ValueError, match=r"`r`, `v`, `mu` whose elements fit in float64"):
+            getattr(o, name)

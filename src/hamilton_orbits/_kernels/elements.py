@@ -428,6 +428,32 @@ def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
     return state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, False, full)
 
 
+@njit(cache=True)
+def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """One orbit's row of :func:`state_to_elements_basic` (the ``NCOL`` columns,
+    bit for bit), then ``a``: ``NCOL + 1`` floats.
+
+    ``a = 1/inv_a`` (``inf`` for the parabolas, ``inv_a = 0``).  ``a`` is NaN when
+    a classical column is not finite or ``a`` is infinite for an orbit that is
+    not a parabola: the state's elements do not fit in float64, and the caller
+    takes the general path, which names the arguments.  So nothing out of this
+    kernel needs a floating-point-error guard.
+    """
+    p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau = state_to_elements_scaled(
+        rx, ry, rz, vx, vy, vz, mu, False, False
+    )
+    if inv_a == 0.0:
+        a = math.inf if kind == PARABOLA or kind == RADIAL_PARABOLA else math.nan
+    else:
+        a = 1.0 / inv_a
+        if not math.isfinite(a):
+            a = math.nan
+    s = p + e + inv_a + inc + lan + argp + nu + u + kind
+    if s - s != 0.0:  # NaN for any inf or NaN
+        a = math.nan
+    return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau, a
+
+
 @parallel_kernel
 def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
     """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
