@@ -28,12 +28,11 @@ import math
 from functools import cached_property
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
+from hamilton_orbits import _columns
 from hamilton_orbits import kepler as _kepler
-from hamilton_orbits._kernels import elements as _el
-from hamilton_orbits._kernels import kepler as _kk
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
     ConvergenceError,
     _first_index,
@@ -55,6 +54,11 @@ from hamilton_orbits.units import (
     wrap,
 )
 
+# numba and astropy are imported on first use (hamilton_orbits._lazy)
+_el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
+_kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
+u = LazyModule("astropy.units", globals(), "u")
+
 __all__ = [
     "KeplerOrbit",
     "hamilton_beta",
@@ -63,18 +67,18 @@ __all__ = [
 ]
 
 # internal units when Quantities come in
-_L = u.km
-_T = u.s
-_V = u.km / u.s
-_MU = u.km**3 / u.s**2
-_RAD = u.rad
+_L = "km"
+_T = "s"
+_V = "km / s"
+_MU = "km3 / s2"
+_RAD = "rad"
 
-_COL = {name: i for i, name in enumerate(_el.COLUMNS)}
+_COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
 _LAZY_COLS = frozenset(("anomaly", "M", "tau"))
 # the columns the basic kernel computes (the lazy ones are NaN until asked for)
-_BASIC_IDX = np.array([i for i, name in enumerate(_el.COLUMNS) if name not in _LAZY_COLS])
+_BASIC_IDX = np.array([i for i, name in enumerate(_columns.COLUMNS) if name not in _LAZY_COLS])
 _F64 = np.dtype(np.float64)
-_A1 = _el.NCOL  # one orbit: index of ``a`` in the row of ``classical_one``
+_A1 = _columns.NCOL  # one orbit: index of ``a`` in the row of ``classical_one``
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -215,7 +219,7 @@ def _in_range(prop):
     def guarded(self):
         with np.errstate(all="ignore"):
             value = prop(self)
-        raw = value.value if isinstance(value, u.Quantity) else np.asarray(value)
+        raw = value.value if is_quantity(value) else np.asarray(value)
         finite = np.isfinite(raw)
         if not np.all(finite):
             kind = self._col("kind")
@@ -751,7 +755,7 @@ class KeplerOrbit:
     @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
-        return self._out(self._n, _RAD / _T)
+        return self._out(self._n, "rad / s")
 
     @property
     @_in_range
@@ -766,7 +770,7 @@ class KeplerOrbit:
     @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
-        return self._out(-0.5 * self._mu * self._inv_a, _V**2)
+        return self._out(-0.5 * self._mu * self._inv_a, "km2 / s2")
 
     @cached_property
     def _tau(self) -> np.ndarray:
@@ -824,7 +828,7 @@ class KeplerOrbit:
     @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
-        return self._out(np.cross(self._r, self._v), _L * _V)
+        return self._out(np.cross(self._r, self._v), "km2 / s")
 
     @property
     @_in_range
@@ -1056,7 +1060,7 @@ def hamilton_beta(r: Any, v: Any):
     <Quantity [0., 0., 2.] km2 / s>
     """
     r_, v_, _, quantity = _hamilton_args(r, v)
-    return wrap(_finite_or_raise(_beta, r_, v_), _L * _V, quantity)
+    return wrap(_finite_or_raise(_beta, r_, v_), "km2 / s", quantity)
 
 
 def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
@@ -1107,7 +1111,7 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
         beta = Quaternion.from_vector(_beta(r_, v_))
         return (iota - (dalpha * beta) * (1.0 / mu_)).vector
 
-    return wrap(_finite_or_raise(eps_of, r_, v_), u.dimensionless_unscaled, quantity)
+    return wrap(_finite_or_raise(eps_of, r_, v_), "", quantity)
 
 
 def hamilton_p(r: Any, v: Any, mu: Any):

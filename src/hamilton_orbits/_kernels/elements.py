@@ -36,6 +36,17 @@ import math
 import numpy as np
 from numba import njit, prange
 
+# the column layout and the conic kinds are numba-free (for the Python side)
+from hamilton_orbits._columns import (
+    COLUMNS,  # noqa: F401  (re-exported)
+    ELLIPSE,
+    HYPERBOLA,
+    NCOL,
+    PARABOLA,
+    RADIAL_ELLIPSE,
+    RADIAL_HYPERBOLA,
+    RADIAL_PARABOLA,
+)
 from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     _two_prod,
@@ -52,30 +63,6 @@ EPS = 2.220446049250313e-16
 PI = math.pi
 TWO_PI = 2.0 * math.pi
 FOUR_PI = 4.0 * math.pi
-
-# conic kinds
-ELLIPSE = 0.0
-PARABOLA = 1.0
-HYPERBOLA = 2.0
-RADIAL_ELLIPSE = 3.0
-RADIAL_PARABOLA = 4.0
-RADIAL_HYPERBOLA = 5.0
-
-COLUMNS = (
-    "p",
-    "e",
-    "inv_a",
-    "inc",
-    "lan",
-    "argp",
-    "nu",
-    "anomaly",
-    "M",
-    "u",
-    "kind",
-    "tau",
-)
-NCOL = len(COLUMNS)
 
 _CIRC_TOL = 4.0 * EPS
 # |1/a| below this many eps of (2/r + v^2/mu), the rounding bound of vis viva
