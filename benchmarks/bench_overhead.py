@@ -185,14 +185,14 @@ def bench_per_call(nmax: int, nmax_rebound: int, repeat: int) -> None:
         n *= 10
 
 
-def bench_throughput(n: int, repeat: int) -> None:
+def bench_throughput(n: int, repeat: int, rounds: int) -> None:
     from hamilton_orbits import KeplerOrbit
     from hamilton_orbits._kernels import elements as _el
 
     r, v = _states(n, seed=1)
     mu = np.ones(n)
     out6 = np.empty((n, 6))
-    out = np.empty((n, _el.NCOL))
+    out = np.empty((n, _el.NCOL + 1))  # the classical columns and a
 
     def ours():
         o = KeplerOrbit.from_state(r, v, mu)
@@ -215,18 +215,39 @@ def bench_throughput(n: int, repeat: int) -> None:
           f"{t_reb * 1e9:.0f} ns/orbit, one thread)")
     print("minimal: the yardstick into a preallocated output; +alloc: allocating its output"
           " (as an API returning fresh arrays must); kernel: our elements kernel alone;"
-          " ours: from_state + reading the six")
+          " ours: from_state + reading the six.  The variants run in turn in each of"
+          f" {rounds} rounds; times are medians, ratios medians of the per-round ratios"
+          " (so that load that varies between rounds cancels).  rebound/ours: rebound on"
+          " one core against ours on the threads; per core: against ours x threads.")
     print(f"{'threads':>8} | {'minimal':>9} {'+alloc':>9} {'kernel':>9} {'ours':>9} | "
-          f"{'kernel/min':>10} {'ours/min':>8} {'ours/+alloc':>11} | {'rebound/ours':>12}")
+          f"{'kernel/min':>10} {'ours/min':>8} {'ours/+alloc':>11} | {'rebound/ours':>12} "
+          f"{'per core':>8}")
+    variants = {
+        "min": lambda: minimal_parallel(r, v, mu, out6),
+        "mina": lambda: minimal_parallel(r, v, mu, np.empty((n, 6))),
+        "kernel": lambda: _el.state_to_elements_classical.parallel(r, v, mu, out),
+        "ours": ours,
+    }
     for threads in sorted({1, all_threads}):
         numba.set_num_threads(threads)
-        t_min = _per_call(lambda: minimal_parallel(r, v, mu, out6), repeat) / n
-        t_mina = _per_call(lambda: minimal_parallel(r, v, mu, np.empty((n, 6))), repeat) / n
-        t_k = _per_call(lambda: _el.state_to_elements_basic.parallel(r, v, mu, out), repeat) / n
-        t_o = _per_call(ours, repeat) / n
-        print(f"{threads:>8} | {t_min * 1e9:>9.1f} {t_mina * 1e9:>9.1f} {t_k * 1e9:>9.1f} "
-              f"{t_o * 1e9:>9.1f} | {t_k / t_min:>10.2f} {t_o / t_min:>8.2f} "
-              f"{t_o / t_mina:>11.2f} | {t_reb / t_o:>12.1f}")
+        for f in variants.values():  # warm-up
+            f()
+        times: dict[str, list[float]] = {k: [] for k in variants}
+        for _ in range(rounds):
+            for k, f in variants.items():
+                t0 = time.perf_counter()
+                f()
+                times[k].append((time.perf_counter() - t0) / n)
+        med = {k: statistics.median(x) for k, x in times.items()}
+
+        def ratio(a: str, b: str, times=times) -> float:
+            return statistics.median(x / y for x, y in zip(times[a], times[b], strict=True))
+
+        print(f"{threads:>8} | {med['min'] * 1e9:>9.1f} {med['mina'] * 1e9:>9.1f} "
+              f"{med['kernel'] * 1e9:>9.1f} {med['ours'] * 1e9:>9.1f} | "
+              f"{ratio('kernel', 'min'):>10.2f} {ratio('ours', 'min'):>8.2f} "
+              f"{ratio('ours', 'mina'):>11.2f} | {t_reb / med['ours']:>12.1f} "
+              f"{t_reb / (med['ours'] * threads):>8.1f}")
     numba.set_num_threads(all_threads)
 
 
@@ -274,7 +295,7 @@ def main() -> None:
     if "calls" not in args.skip:
         bench_per_call(nmax, nmax_reb, repeat)
     if "throughput" not in args.skip:
-        bench_throughput(10**6, repeat)
+        bench_throughput(10**6, repeat, 9 if args.quick else 15)
     if "first" not in args.skip:
         bench_first_run(2 if args.quick else 5)
 

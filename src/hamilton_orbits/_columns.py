@@ -28,3 +28,9 @@ COLUMNS = (
     "tau",
 )
 NCOL = len(COLUMNS)
+
+# the columns of state_to_elements_classical / classical_one: the classical
+# elements (no anomaly, M, tau: those cost a third more, computed when asked),
+# and a = 1/inv_a
+CLASSICAL = ("p", "e", "inv_a", "inc", "lan", "argp", "nu", "u", "kind", "a")
+NCLASSICAL = len(CLASSICAL)

@@ -149,13 +149,10 @@ class Conic:
 
     @classmethod
     def _from_orbit(cls, orbit) -> Conic:
-        el = orbit._elements
-        from hamilton_orbits._kernels.elements import COLUMNS
-
-        col = {k: i for i, k in enumerate(COLUMNS)}
-        inc = el[..., col["inc"]]
-        lan = el[..., col["lan"]]
-        argp = el[..., col["argp"]]
+        col = orbit._col
+        inc = col("inc")
+        lan = col("lan")
+        argp = col("argp")
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))
@@ -163,7 +160,7 @@ class Conic:
         P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
         h = np.stack([si * sl, -si * cl, ci], axis=-1)
         return cls(
-            el[..., col["p"]], el[..., col["e"]], el[..., col["inv_a"]], P, h, orbit._mu,
+            col("p"), col("e"), col("inv_a"), P, h, orbit._mu,
             quantity=orbit._quantity,
         )
 

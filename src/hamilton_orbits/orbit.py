@@ -73,12 +73,12 @@ _V = "km / s"
 _MU = "km3 / s2"
 _RAD = "rad"
 
+# _elements: the CLASSICAL columns (p, e, inv_a, inc, lan, argp, nu, u, kind, a);
+# _full: all COLUMNS (the anomaly, M and tau too), computed when one is asked for
+_CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
-_LAZY_COLS = frozenset(("anomaly", "M", "tau"))
-# the columns the basic kernel computes (the lazy ones are NaN until asked for)
-_BASIC_IDX = np.array([i for i, name in enumerate(_columns.COLUMNS) if name not in _LAZY_COLS])
 _F64 = np.dtype(np.float64)
-_A1 = _columns.NCOL  # one orbit: index of ``a`` in the row of ``classical_one``
+_A1 = _CI["a"]  # the last column
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -305,7 +305,7 @@ class KeplerOrbit:
             return None
         c = np.array(res)
         self._c1 = c
-        self.__dict__.setdefault("_elements", c[:_A1])
+        self.__dict__.setdefault("_elements", c)
         return c
 
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
@@ -549,41 +549,52 @@ class KeplerOrbit:
     # --------------------------------------------------------------- elements
     @cached_property
     def _elements(self) -> np.ndarray:
-        # the classical columns only; the anomaly, M and tau (NaN here) are
-        # filled in by _col on first request (about a third of the cost)
+        # the CLASSICAL columns (_el.classical_one), shape (..., NCLASSICAL)
         one = self._one
         if one is not None:  # one orbit from plain floats: no arrays for the kernel
-            row = np.array(_el.state_to_elements_row(*one, False))
-            if not math.isfinite(row[_BASIC_IDX].sum()):
-                _refuse_beyond_range(row[None, _BASIC_IDX], np.array([one[:3]]),
+            row = np.array(_el.classical_one(*one))
+            if not math.isfinite(row[:_A1].sum()):
+                _refuse_beyond_range(row[None, :_A1], np.array([one[:3]]),
                                      np.array([one[3:6]]), np.array([one[6]]), ())
             return row
         flat_r = self._r.reshape(-1, 3)
         flat_v = self._v.reshape(-1, 3)
         flat_mu = self._mu.reshape(-1)
-        out = np.empty((flat_r.shape[0], _el.NCOL))
-        _el.state_to_elements_basic(flat_r, flat_v, flat_mu, out)
-        _refuse_beyond_range(out[:, _BASIC_IDX], flat_r, flat_v, flat_mu, self._mu.shape)
-        return out.reshape((*self._mu.shape, _el.NCOL))
+        out = np.empty((flat_r.shape[0], _columns.NCLASSICAL))
+        bad = _el.state_to_elements_classical(flat_r, flat_v, flat_mu, out)
+        if bad:  # a NaN a: a row beyond float64 is refused here, naming the first;
+            # else a is beyond float64 somewhere, refused when it is read (a)
+            _refuse_beyond_range(out[:, :_A1], flat_r, flat_v, flat_mu, self._mu.shape)
+        self.__dict__["_a_bad"] = bad
+        return out.reshape((*self._mu.shape, _columns.NCLASSICAL))
+
+    @cached_property
+    def _full(self) -> np.ndarray:
+        # every column of COLUMNS (the classical ones bit for bit as in _elements)
+        one = self._one
+        if one is not None:
+            out = np.array(_el.state_to_elements_row(*one, True))[None]
+        else:
+            out = np.empty((self._mu.size, _columns.NCOL))
+            _el.state_to_elements(
+                self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), out
+            )
+        _refuse_beyond_range(out, self._r.reshape(-1, 3), self._v.reshape(-1, 3),
+                             self._mu.reshape(-1), self._mu.shape)
+        return out.reshape((*self._mu.shape, _columns.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
-        el = self.__dict__.get("_elements")
-        if el is None:  # as self._elements, without cached_property's lock (3.11)
-            el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
-        if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
-            # every column, in place (the classical ones come out bit for bit the same)
-            one = self._one
-            if one is not None:
-                el[:] = _el.state_to_elements_row(*one, True)
-            else:
-                _el.state_to_elements(
-                    self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
-                    el.reshape(-1, _el.NCOL),
-                )
-            _refuse_beyond_range(el.reshape(-1, _el.NCOL), self._r.reshape(-1, 3),
-                                 self._v.reshape(-1, 3), self._mu.reshape(-1), self._mu.shape)
-            self.__dict__["_all_columns"] = True
-        return el[_COL[name]] if el.ndim == 1 else el[..., _COL[name]]
+        i = _CI.get(name)
+        if i is not None:
+            el = self.__dict__.get("_elements")
+            if el is None:  # as self._elements, without cached_property's lock (3.11)
+                el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
+            return el[i] if el.ndim == 1 else el[..., i]
+        full = self.__dict__.get("_full")
+        if full is None:
+            full = self.__dict__["_full"] = KeplerOrbit._full.func(self)
+        i = _COL[name]
+        return full[i] if full.ndim == 1 else full[..., i]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
         if not self._quantity:
@@ -627,15 +638,15 @@ class KeplerOrbit:
         """  # noqa: E501
         if 0 in self.shape:
             return f"KeplerOrbit(shape={self.shape})"
-        el = self._elements
-        inv = el[..., _COL["inv_a"]]
+        col = self._col
+        inv = col("inv_a")
         a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
-        q = el[..., _COL["p"]] / (1.0 + el[..., _COL["e"]])
+        q = col("p") / (1.0 + col("e"))
         length = "q" if np.all(inv == 0) else "a"
-        cols = [(length, q if length == "q" else a, str(_L)), ("e", el[..., _COL["e"]], "")]
+        cols = [(length, q if length == "q" else a, str(_L)), ("e", col("e"), "")]
         scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
         for name in ("inc", "lan", "argp", "nu"):
-            cols.append((name, el[..., _COL[name]] * scale, aunit))
+            cols.append((name, col(name) * scale, aunit))
         cols.append(("mu", self._mu, str(_MU)))
         parts = []
         for name, x, unit in cols:
@@ -678,6 +689,9 @@ class KeplerOrbit:
         c = self._c1 if self._c1 is not None else self._one_classical()
         if c is not None:
             return c[_A1]
+        a = self._col("a")
+        if self.__dict__.get("_a_bad") == 0:  # the kernel's a is finite (or a parabola's inf)
+            return self._out(a, _L)
         return self._a_general
 
     @property

@@ -141,3 +141,22 @@ def test_one_orbit_beyond_float64_names_the_state():
         o = KeplerOrbit.from_state([1e51, 0.0, 0.0], [0.0, 0.0, 1e52], 1.0)
         with pytest.raises(ValueError, match=r"`r`, `v`, `mu` whose elements fit in float64"):
             getattr(o, name)
+
+
+def test_batch_a_from_the_kernel_is_one_over_inv_a():
+    """A batch reads ``a`` straight from the kernel's column: 1/inv_a bit for bit,
+    +inf for the parabola (no warning: the suite turns warnings into errors), and
+    the classical columns are those of the basic kernel (no anomaly computed)."""
+    r = np.array([s[0] for s in ONE_STATES])
+    v = np.array([s[1] for s in ONE_STATES])
+    o = KeplerOrbit.from_state(r, v, 1.0)
+    a = o.a
+    basic = np.empty((len(r), _el.NCOL))
+    _el.state_to_elements_basic(r, v, np.ones(len(r)), basic)
+    inv = basic[:, _el.COLUMNS.index("inv_a")]
+    assert a[2] == np.inf and inv[2] == 0.0  # the parabola
+    finite = inv != 0
+    np.testing.assert_array_equal(a[finite], 1.0 / inv[finite])
+    for n in ("e", "p", "inc", "lan", "argp", "nu"):
+        np.testing.assert_array_equal(getattr(o, n), basic[:, _el.COLUMNS.index(n)])
+    assert "_full" not in o.__dict__  # the anomaly, M and tau were not computed

@@ -37,10 +37,12 @@ import numpy as np
 from numba import njit, prange
 
 # the column layout and the conic kinds are numba-free (for the Python side)
-from hamilton_orbits._columns import (
-    COLUMNS,  # noqa: F401  (re-exported)
+from hamilton_orbits._columns import (  # noqa: F401  (re-exported)
+    CLASSICAL,
+    COLUMNS,
     ELLIPSE,
     HYPERBOLA,
+    NCLASSICAL,
     NCOL,
     PARABOLA,
     RADIAL_ELLIPSE,
@@ -417,16 +419,16 @@ def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
 
 @njit(cache=True)
 def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
-    """One orbit's row of :func:`state_to_elements_basic` (the ``NCOL`` columns,
-    bit for bit), then ``a``: ``NCOL + 1`` floats.
+    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_basic`
+    but the anomaly, M and tau (bit for bit), then ``a``.
 
     ``a = 1/inv_a`` (``inf`` for the parabolas, ``inv_a = 0``).  ``a`` is NaN when
-    a classical column is not finite or ``a`` is infinite for an orbit that is
-    not a parabola: the state's elements do not fit in float64, and the caller
-    takes the general path, which names the arguments.  So nothing out of this
-    kernel needs a floating-point-error guard.
+    another column is not finite or ``a`` is infinite for an orbit that is not a
+    parabola: the state's elements do not fit in float64, and the caller takes
+    the general path, which names the arguments.  So nothing out of this kernel
+    needs a floating-point-error guard.
     """
-    p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau = state_to_elements_scaled(
+    p, e, inv_a, inc, lan, argp, nu, _anom, _m, u, kind, _tau = state_to_elements_scaled(
         rx, ry, rz, vx, vy, vz, mu, False, False
     )
     if inv_a == 0.0:
@@ -438,7 +440,7 @@ def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
     s = p + e + inv_a + inc + lan + argp + nu + u + kind
     if s - s != 0.0:  # NaN for any inf or NaN
         a = math.nan
-    return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau, a
+    return p, e, inv_a, inc, lan, argp, nu, u, kind, a
 
 
 @parallel_kernel
@@ -451,6 +453,36 @@ def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
         )
         for j in range(NCOL):
             out[i, j] = res[j]
+
+
+@parallel_kernel
+def state_to_elements_classical(r, v, mu, out):  # pragma: no cover - compiled
+    """Rows of :func:`classical_one` into ``out`` (N, NCLASSICAL): the
+    ``CLASSICAL`` columns, ``a`` NaN where it or another column is beyond float64.
+
+    Returns the number of rows with such a NaN ``a`` (0 in the common case), so
+    that the caller needs no second pass over ``out`` to find out (it then
+    names the first such row, or refuses to read ``a`` there).
+    """
+    bad = 0
+    for i in prange(r.shape[0]):
+        p, e, inv_a, inc, lan, argp, nu, u, kind, a = classical_one(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i]
+        )
+        # one store per column (no loop over a tuple: faster under parallel=True)
+        out[i, 0] = p
+        out[i, 1] = e
+        out[i, 2] = inv_a
+        out[i, 3] = inc
+        out[i, 4] = lan
+        out[i, 5] = argp
+        out[i, 6] = nu
+        out[i, 7] = u
+        out[i, 8] = kind
+        out[i, 9] = a
+        if a != a:
+            bad += 1
+    return bad
 
 
 @parallel_kernel
