@@ -78,6 +78,8 @@ _RAD = "rad"
 _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
 _F64 = np.dtype(np.float64)
+_SHAPE3 = (3,)
+_f64 = np.float64  # one orbit's elements are read as float64 scalars
 _A1 = _CI["a"]  # the last column
 
 
@@ -137,30 +139,34 @@ def _plain_float_array(x: Any) -> np.ndarray | None:
     return x.astype(np.float64) if x.dtype.kind in "fiu" else None
 
 
+def _three(x: Any) -> list | tuple | None:
+    """``x`` as three Python floats if it is a float64 array of shape (3,) or a
+    list/tuple of three Python floats, else None."""
+    t = type(x)
+    if t is np.ndarray:
+        # dtype identity: the native float64 (any other dtype takes the general path)
+        if x.dtype is _F64 and x.shape == _SHAPE3:
+            return x.tolist()
+        return None
+    if (t is list or t is tuple) and len(x) == 3:
+        a, b, c = x
+        if type(a) is float and type(b) is float and type(c) is float:
+            return x
+    return None
+
+
 def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
     """One orbit in plain floats (``r``, ``v`` lists/tuples of three floats or
     float64 arrays of shape (3,), ``mu`` a float) as 7 floats, if finite with
     ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
     if type(mu) is not float:
         return None
-    if type(r) is np.ndarray:
-        if r.shape != (3,) or r.dtype != _F64:
-            return None
-        r = r.tolist()
-    elif type(r) is not list and type(r) is not tuple:
-        return None
-    if type(v) is np.ndarray:
-        if v.shape != (3,) or v.dtype != _F64:
-            return None
-        v = v.tolist()
-    elif type(v) is not list and type(v) is not tuple:
-        return None
-    if len(r) != 3 or len(v) != 3:
+    r = _three(r)
+    v = _three(v)
+    if r is None or v is None:
         return None
     rx, ry, rz = r
     vx, vy, vz = v
-    if not (type(rx) is type(ry) is type(rz) is type(vx) is type(vy) is type(vz) is float):
-        return None
     s = rx + ry + rz + vx + vy + vz + mu  # inf or NaN if any is (or on overflow: then
     if s - s != 0.0 or not mu > 0.0 or not (rx or ry or rz):  # the general path decides)
         return None
@@ -287,10 +293,10 @@ class KeplerOrbit:
     _r = cached_property(lambda self: np.array(self._one[:3]))
     _v = cached_property(lambda self: np.array(self._one[3:6]))
     _mu = cached_property(lambda self: np.array(self._one[6]))
-    # one orbit from plain floats, once its elements are asked for: the row of
-    # _el.classical_one (the classical columns, then a) as float64, so that
-    # reading an element is an index into it
-    _c1: np.ndarray | None = None
+    # one orbit from plain floats, once its elements are asked for: the tuple of
+    # _el.classical_one (the CLASSICAL columns), so that reading an element is
+    # an index into it (as a float64 scalar, like the general path's)
+    _c1: tuple[float, ...] | None = None
 
     def _one_classical(self) -> np.ndarray | None:
         """The row ``_c1`` of a single orbit built from plain floats (computed
@@ -300,12 +306,10 @@ class KeplerOrbit:
         one = self._one
         if one is None:
             return None
-        res = _el.classical_one(*one)
-        if res[_A1] != res[_A1]:  # NaN: beyond float64
+        c = _el.classical_one(*one)
+        if c[_A1] != c[_A1]:  # NaN: beyond float64
             return None
-        c = np.array(res)
         self._c1 = c
-        self.__dict__.setdefault("_elements", c)
         return c
 
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
@@ -382,7 +386,7 @@ class KeplerOrbit:
         """
         one = _one_state(r, v, mu)
         if one is not None:
-            obj = cls.__new__(cls)
+            obj = object.__new__(cls)
             obj._quantity = False
             obj._one = one  # _r, _v, _mu are made from it when first needed
             return obj
@@ -552,7 +556,7 @@ class KeplerOrbit:
         # the CLASSICAL columns (_el.classical_one), shape (..., NCLASSICAL)
         one = self._one
         if one is not None:  # one orbit from plain floats: no arrays for the kernel
-            row = np.array(_el.classical_one(*one))
+            row = np.array(self._c1 or _el.classical_one(*one))
             if not math.isfinite(row[:_A1].sum()):
                 _refuse_beyond_range(row[None, :_A1], np.array([one[:3]]),
                                      np.array([one[3:6]]), np.array([one[6]]), ())
@@ -666,17 +670,17 @@ class KeplerOrbit:
     @property
     def e(self):
         """Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[1]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[1])
         return self._out(self._col("e"), None)
 
     @property
     def p(self):
         """Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16)."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[0]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[0])
         return self._out(self._col("p"), _L)
 
     @property
@@ -686,9 +690,9 @@ class KeplerOrbit:
     @property
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[_A1]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[_A1])
         a = self._col("a")
         if self.__dict__.get("_a_bad") == 0:  # the kernel's a is finite (or a parabola's inf)
             return self._out(a, _L)
@@ -708,33 +712,33 @@ class KeplerOrbit:
     @property
     def inc(self):
         """Inclination in [0, pi] (rad)."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[3]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[3])
         return self._out(self._col("inc"), _RAD)
 
     @property
     def lan(self):
         """Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[4]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[4])
         return self._out(self._col("lan"), _RAD)
 
     @property
     def argp(self):
         """Argument of periapsis in [0, 2 pi); 0 when ``e = 0``."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[5]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[5])
         return self._out(self._col("argp"), _RAD)
 
     @property
     def nu(self):
         """True anomaly in (-pi, pi] (Hamilton's v, eq. 18)."""
-        c = self._c1 if self._c1 is not None else self._one_classical()
-        if c is not None:
-            return c[6]
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[6])
         return self._out(self._col("nu"), _RAD)
 
     @property
