@@ -23,7 +23,8 @@ warm-up; ratios are peer time / our time (> 1: we are faster).
 3. The main job (``hamilton-orbits``, the solar-system scene) in a subprocess:
    cold (``NUMBA_CACHE_DIR`` a fresh empty folder) and warm, wall clock; and
    ``import hamilton_orbits`` beside ``import numpy, scipy, astropy.units,
-   numba`` (median of 5 subprocesses each).
+   numba`` and numpy alone, and a whole process computing one orbit's
+   elements, ours beside rebound (median of 5 subprocesses each).
 """
 
 from __future__ import annotations
@@ -263,14 +264,30 @@ def _wall(cmd: list[str], env: dict, cwd: str) -> tuple[float, str]:
 def bench_first_run(repeat_warm: int) -> None:
     print("\n3. First run")
     env = dict(os.environ, PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    imp = [sys.executable, "-c", "import hamilton_orbits"]
-    base = [sys.executable, "-c", "import numpy, scipy, astropy.units, numba"]
+    py = [sys.executable, "-c"]
+    imp = [*py, "import hamilton_orbits"]
+    imp_names = [*py, "from hamilton_orbits import KeplerOrbit, Quaternion"]
+    first = [*py, "from hamilton_orbits import KeplerOrbit\n"
+             "o = KeplerOrbit.from_state([1.0, 0.2, 0.1], [-0.1, 1.1, 0.05], 1.0)\n"
+             "o.a, o.e, o.inc, o.lan, o.argp, o.nu"]
+    first_reb = [*py, "import rebound\nsim = rebound.Simulation()\nsim.G = 1.0\n"
+                 "sim.add(m=1.0)\nsim.add(m=0.0, x=1.0, y=0.2, z=0.1, vx=-0.1, vy=1.1, vz=0.05)\n"
+                 "o = sim.particles[1].orbit(primary=sim.particles[0])\n"
+                 "o.a, o.e, o.inc, o.Omega, o.omega, o.f"]
+    base = [*py, "import numpy, scipy, astropy.units, numba"]
+    numpy_only = [*py, "import numpy"]
     with tempfile.TemporaryDirectory() as cwd:
-        _wall(imp, env, cwd)
-        t_imp = statistics.median(_wall(imp, env, cwd)[0] for _ in range(5))
-        t_base = statistics.median(_wall(base, env, cwd)[0] for _ in range(5))
-    print(f"warm import hamilton_orbits {t_imp:.2f} s; numpy+scipy+astropy.units+numba "
-          f"{t_base:.2f} s (ratio {t_imp / t_base:.2f})")
+        _wall(first, env, cwd)  # the numba cache warm
+        t = {}
+        for name, cmd in (("imp", imp), ("names", imp_names), ("first", first),
+                          ("reb", first_reb), ("base", base), ("numpy", numpy_only)):
+            t[name] = statistics.median(_wall(cmd, env, cwd)[0] for _ in range(5))
+    print(f"warm import hamilton_orbits {t['imp']:.2f} s (median of 5 processes, wall clock); "
+          f"from hamilton_orbits import KeplerOrbit, Quaternion {t['names']:.2f} s; "
+          f"numpy alone {t['numpy']:.2f} s; numpy+scipy+astropy.units+numba {t['base']:.2f} s "
+          f"(ratio {t['imp'] / t['base']:.2f})")
+    print(f"process that imports and computes one orbit's elements: ours {t['first']:.2f} s "
+          f"(numba's first kernel load included), rebound {t['reb']:.2f} s")
     job = [sys.executable, "-m", "hamilton_orbits.cli", "run", "--no-progress"]
     with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
         cold_env = dict(env, NUMBA_CACHE_DIR=cache)

@@ -205,10 +205,10 @@ def state_to_elements_one(
     hz = rx * vy - ry * vx
     h = math.sqrt(hx * hx + hy * hy + hz * hz)
     inv_a = 2.0 / r - v2 / mu
-    smu = math.sqrt(mu)
 
     if h <= _RADIAL_TOL * r * math.sqrt(v2):
         # ---- radial (rectilinear) orbit: e = 1, p = 0, body at nu = pi ----
+        smu = math.sqrt(mu)
         dx = -rx / r
         dy = -ry / r
         dz = -rz / r
@@ -292,6 +292,7 @@ def state_to_elements_one(
         else:
             kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
         return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
+    smu = math.sqrt(mu)  # only here: the classical columns do not need it
     if e == 1.0 and inv_a != 0.0:
         # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
         c = r * v2 / mu - 1.0
