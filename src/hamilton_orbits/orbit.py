@@ -79,6 +79,7 @@ _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
 _F64 = np.dtype(np.float64)
 _SHAPE3 = (3,)
+_TWO_PI = 2.0 * math.pi
 _f64 = np.float64  # one orbit's elements are read as float64 scalars
 _A1 = _CI["a"]  # the last column
 
@@ -769,25 +770,65 @@ class KeplerOrbit:
         )
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
 
+    def _n_one(self) -> float | None:
+        """Mean motion of one orbit from plain floats, in Python floats (the
+        formula of ``_n``, bit for bit); None for a batch, a parabola or a value
+        beyond float64 (the general path then answers or names the state)."""
+        c = self._c1
+        if c is None and (c := self._one_classical()) is None:
+            return None
+        kind = c[8]
+        if kind == _columns.PARABOLA or kind == _columns.RADIAL_PARABOLA:
+            return None
+        inv = abs(c[2])
+        n = math.sqrt(self._one[6]) * inv * math.sqrt(inv)
+        return n if 0.0 < n < math.inf else None
+
     @property
-    @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
-        return self._out(self._n, "rad / s")
+        n = self._n_one()
+        return self._n_general if n is None else _f64(n)
 
     @property
     @_in_range
+    def _n_general(self):
+        return self._out(self._n, "rad / s")
+
+    @property
     def period(self):
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            kind = c[8]
+            if kind != _columns.ELLIPSE and kind != _columns.RADIAL_ELLIPSE:
+                return _f64(math.inf)
+            n = self._n_one()
+            if n is not None and (t := 2.0 * math.pi / n) < math.inf:
+                return _f64(t)
+        return self._period_general
+
+    @property
+    @_in_range
+    def _period_general(self):
         kind = self._col("kind")
         bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
         n = np.where(bound, self._n, 1.0)
         return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
 
     @property
-    @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            w = -0.5 * self._one[6] * c[2]
+            if abs(w) < math.inf:
+                return _f64(w)
+        return self._energy_general
+
+    @property
+    @_in_range
+    def _energy_general(self):
         return self._out(-0.5 * self._mu * self._inv_a, "km2 / s2")
 
     @cached_property
@@ -821,6 +862,10 @@ class KeplerOrbit:
     @property
     def varpi(self):
         """Longitude of periapsis ``lan + argp`` (``lan - argp`` for inc > pi/2), [0, 2 pi)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            y = (c[4] + (1.0 if c[3] <= 0.5 * math.pi else -1.0) * c[5]) % _TWO_PI  # as _wrap2pi
+            return _f64(0.0 if y >= _TWO_PI else y)
         return self._out(_wrap2pi(self._col("lan") + self._sign * self._col("argp")), _RAD)
 
     @property

@@ -62,7 +62,8 @@ def test_plain_inputs_match_general_path(kind):
     fast = KeplerOrbit.from_state(r, v, 1.0)
     slow = KeplerOrbit.from_state(np.array(r, dtype=object), v, 1.0)  # the general path
     batch = KeplerOrbit.from_state(np.atleast_2d(r), np.atleast_2d(v), np.ones(1))  # arrays
-    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude"):
+    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude",
+              "energy", "varpi"):
         assert getattr(fast, n) == getattr(slow, n) == getattr(batch, n)[0], n
     assert type(fast.e) is np.float64 and type(fast.a) is np.float64
     assert fast.shape == slow.shape == ()
@@ -124,7 +125,7 @@ def test_one_orbit_row_matches_batch_bits(r, v):
     (``classical_one``): the same bits as the batch kernel, the same types."""
     one = KeplerOrbit.from_state(r, v, 1.0)
     batch = KeplerOrbit.from_state(np.array([r]), np.array([v]), np.ones(1))
-    for n in ("a", "e", "p", "inc", "lan", "argp", "nu"):
+    for n in ("a", "e", "p", "inc", "lan", "argp", "nu", "n", "period", "energy", "varpi"):
         x = getattr(one, n)
         assert type(x) is np.float64, n
         y = getattr(batch, n)[0]
