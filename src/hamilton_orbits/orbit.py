@@ -888,22 +888,56 @@ class KeplerOrbit:
         return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
 
     @property
-    @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
+        one = self._one
+        if one is not None:  # Python floats, as np.cross computes them
+            rx, ry, rz, vx, vy, vz, _ = one
+            h = (ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
+            if abs(h[0] + h[1] + h[2]) < math.inf:
+                return np.array(h)
+        return self._areal_vector_general
+
+    @property
+    @_in_range
+    def _areal_vector_general(self):
         return self._out(np.cross(self._r, self._v), "km2 / s")
 
     @property
-    @_in_range
     def eccentricity_vector(self):
         """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
-        return self._out(_ecc_vector(self._r, self._v, self._mu), None)
+        e = self._ecc_vector_one()
+        return self._eccentricity_vector_general if e is None else np.array(e)
 
     @property
     @_in_range
+    def _eccentricity_vector_general(self):
+        return self._out(_ecc_vector(self._r, self._v, self._mu), None)
+
+    @property
     def hamilton_epsilon(self):
         """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
+        e = self._ecc_vector_one()
+        return self._hamilton_epsilon_general if e is None else -np.array(e)
+
+    @property
+    @_in_range
+    def _hamilton_epsilon_general(self):
         return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
+
+    def _ecc_vector_one(self) -> tuple[float, float, float] | None:
+        """:func:`_ecc_vector` of one orbit from plain floats in Python floats (the
+        same operations in the same order), or None (a batch, a Quantity orbit,
+        or a value beyond float64: the general path then answers or names it)."""
+        one = self._one
+        if one is None:
+            return None
+        rx, ry, rz, vx, vy, vz, m = one
+        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
+        f = vx * vx + vy * vy + vz * vz - m / rn
+        rv = rx * vx + ry * vy + rz * vz
+        e = ((f * rx - rv * vx) / m, (f * ry - rv * vy) / m, (f * rz - rv * vz) / m)
+        return e if abs(e[0] + e[1] + e[2]) < math.inf else None
 
     # ----------------------------------------------------------------- methods
     def state(self) -> tuple[Any, Any]:

@@ -161,3 +161,24 @@ def test_batch_a_from_the_kernel_is_one_over_inv_a():
     for n in ("e", "p", "inc", "lan", "argp", "nu"):
         np.testing.assert_array_equal(getattr(o, n), basic[:, _el.COLUMNS.index(n)])
     assert "_full" not in o.__dict__  # the anomaly, M and tau were not computed
+
+
+@pytest.mark.parametrize(("r", "v"), ONE_STATES)
+def test_one_orbit_vectors_match_batch_bits(r, v):
+    """The areal and eccentricity vectors of one orbit of plain floats (Python
+    floats, no floating-point-error guard) equal the batch path's bits."""
+    one = KeplerOrbit.from_state(r, v, 1.0)
+    batch = KeplerOrbit.from_state(np.array([r]), np.array([v]), np.ones(1))
+    for n in ("areal_vector", "eccentricity_vector", "hamilton_epsilon"):
+        x = getattr(one, n)
+        assert x.shape == (3,) and x.dtype == np.float64, n
+        np.testing.assert_array_equal(x, getattr(batch, n)[0], err_msg=n)
+
+
+def test_one_orbit_vectors_beyond_float64_are_named():
+    """|r x v| = 1e400: the general path refuses it by name (such a state's p =
+    h^2/mu is beyond float64 too, so the elements' message may come first)."""
+    o = KeplerOrbit.from_state([1e200, 0.0, 0.0], [0.0, 1e200, 0.0], 1.0)
+    for name in ("areal_vector", "eccentricity_vector", "hamilton_epsilon"):
+        with pytest.raises(ValueError, match=r"`r`, `v`, `mu` .*fits? in float64"):
+            getattr(o, name)
