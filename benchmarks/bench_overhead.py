@@ -23,7 +23,8 @@ warm-up; ratios are peer time / our time (> 1: we are faster).
 3. The main job (``hamilton-orbits``, the solar-system scene) in a subprocess:
    cold (``NUMBA_CACHE_DIR`` a fresh empty folder) and warm, wall clock; and
    ``import hamilton_orbits`` beside ``import numpy, scipy, astropy.units,
-   numba`` (median of 5 subprocesses each).
+   numba`` and numpy alone, and a whole process computing one orbit's
+   elements, ours beside rebound (median of 5 subprocesses each).
 """
 
 from __future__ import annotations
@@ -185,14 +186,14 @@ def bench_per_call(nmax: int, nmax_rebound: int, repeat: int) -> None:
         n *= 10
 
 
-def bench_throughput(n: int, repeat: int) -> None:
+def bench_throughput(n: int, repeat: int, rounds: int) -> None:
     from hamilton_orbits import KeplerOrbit
     from hamilton_orbits._kernels import elements as _el
 
     r, v = _states(n, seed=1)
     mu = np.ones(n)
     out6 = np.empty((n, 6))
-    out = np.empty((n, _el.NCOL))
+    out = np.empty((n, _el.NCOL + 1))  # the classical columns and a
 
     def ours():
         o = KeplerOrbit.from_state(r, v, mu)
@@ -215,18 +216,39 @@ def bench_throughput(n: int, repeat: int) -> None:
           f"{t_reb * 1e9:.0f} ns/orbit, one thread)")
     print("minimal: the yardstick into a preallocated output; +alloc: allocating its output"
           " (as an API returning fresh arrays must); kernel: our elements kernel alone;"
-          " ours: from_state + reading the six")
+          " ours: from_state + reading the six.  The variants run in turn in each of"
+          f" {rounds} rounds; times are medians, ratios medians of the per-round ratios"
+          " (so that load that varies between rounds cancels).  rebound/ours: rebound on"
+          " one core against ours on the threads; per core: against ours x threads.")
     print(f"{'threads':>8} | {'minimal':>9} {'+alloc':>9} {'kernel':>9} {'ours':>9} | "
-          f"{'kernel/min':>10} {'ours/min':>8} {'ours/+alloc':>11} | {'rebound/ours':>12}")
+          f"{'kernel/min':>10} {'ours/min':>8} {'ours/+alloc':>11} | {'rebound/ours':>12} "
+          f"{'per core':>8}")
+    variants = {
+        "min": lambda: minimal_parallel(r, v, mu, out6),
+        "mina": lambda: minimal_parallel(r, v, mu, np.empty((n, 6))),
+        "kernel": lambda: _el.state_to_elements_classical.parallel(r, v, mu, out),
+        "ours": ours,
+    }
     for threads in sorted({1, all_threads}):
         numba.set_num_threads(threads)
-        t_min = _per_call(lambda: minimal_parallel(r, v, mu, out6), repeat) / n
-        t_mina = _per_call(lambda: minimal_parallel(r, v, mu, np.empty((n, 6))), repeat) / n
-        t_k = _per_call(lambda: _el.state_to_elements_basic.parallel(r, v, mu, out), repeat) / n
-        t_o = _per_call(ours, repeat) / n
-        print(f"{threads:>8} | {t_min * 1e9:>9.1f} {t_mina * 1e9:>9.1f} {t_k * 1e9:>9.1f} "
-              f"{t_o * 1e9:>9.1f} | {t_k / t_min:>10.2f} {t_o / t_min:>8.2f} "
-              f"{t_o / t_mina:>11.2f} | {t_reb / t_o:>12.1f}")
+        for f in variants.values():  # warm-up
+            f()
+        times: dict[str, list[float]] = {k: [] for k in variants}
+        for _ in range(rounds):
+            for k, f in variants.items():
+                t0 = time.perf_counter()
+                f()
+                times[k].append((time.perf_counter() - t0) / n)
+        med = {k: statistics.median(x) for k, x in times.items()}
+
+        def ratio(a: str, b: str, times=times) -> float:
+            return statistics.median(x / y for x, y in zip(times[a], times[b], strict=True))
+
+        print(f"{threads:>8} | {med['min'] * 1e9:>9.1f} {med['mina'] * 1e9:>9.1f} "
+              f"{med['kernel'] * 1e9:>9.1f} {med['ours'] * 1e9:>9.1f} | "
+              f"{ratio('kernel', 'min'):>10.2f} {ratio('ours', 'min'):>8.2f} "
+              f"{ratio('ours', 'mina'):>11.2f} | {t_reb / med['ours']:>12.1f} "
+              f"{t_reb / (med['ours'] * threads):>8.1f}")
     numba.set_num_threads(all_threads)
 
 
@@ -242,14 +264,30 @@ def _wall(cmd: list[str], env: dict, cwd: str) -> tuple[float, str]:
 def bench_first_run(repeat_warm: int) -> None:
     print("\n3. First run")
     env = dict(os.environ, PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    imp = [sys.executable, "-c", "import hamilton_orbits"]
-    base = [sys.executable, "-c", "import numpy, scipy, astropy.units, numba"]
+    py = [sys.executable, "-c"]
+    imp = [*py, "import hamilton_orbits"]
+    imp_names = [*py, "from hamilton_orbits import KeplerOrbit, Quaternion"]
+    first = [*py, "from hamilton_orbits import KeplerOrbit\n"
+             "o = KeplerOrbit.from_state([1.0, 0.2, 0.1], [-0.1, 1.1, 0.05], 1.0)\n"
+             "o.a, o.e, o.inc, o.lan, o.argp, o.nu"]
+    first_reb = [*py, "import rebound\nsim = rebound.Simulation()\nsim.G = 1.0\n"
+                 "sim.add(m=1.0)\nsim.add(m=0.0, x=1.0, y=0.2, z=0.1, vx=-0.1, vy=1.1, vz=0.05)\n"
+                 "o = sim.particles[1].orbit(primary=sim.particles[0])\n"
+                 "o.a, o.e, o.inc, o.Omega, o.omega, o.f"]
+    base = [*py, "import numpy, scipy, astropy.units, numba"]
+    numpy_only = [*py, "import numpy"]
     with tempfile.TemporaryDirectory() as cwd:
-        _wall(imp, env, cwd)
-        t_imp = statistics.median(_wall(imp, env, cwd)[0] for _ in range(5))
-        t_base = statistics.median(_wall(base, env, cwd)[0] for _ in range(5))
-    print(f"warm import hamilton_orbits {t_imp:.2f} s; numpy+scipy+astropy.units+numba "
-          f"{t_base:.2f} s (ratio {t_imp / t_base:.2f})")
+        _wall(first, env, cwd)  # the numba cache warm
+        t = {}
+        for name, cmd in (("imp", imp), ("names", imp_names), ("first", first),
+                          ("reb", first_reb), ("base", base), ("numpy", numpy_only)):
+            t[name] = statistics.median(_wall(cmd, env, cwd)[0] for _ in range(5))
+    print(f"warm import hamilton_orbits {t['imp']:.2f} s (median of 5 processes, wall clock); "
+          f"from hamilton_orbits import KeplerOrbit, Quaternion {t['names']:.2f} s; "
+          f"numpy alone {t['numpy']:.2f} s; numpy+scipy+astropy.units+numba {t['base']:.2f} s "
+          f"(ratio {t['imp'] / t['base']:.2f})")
+    print(f"process that imports and computes one orbit's elements: ours {t['first']:.2f} s "
+          f"(numba's first kernel load included), rebound {t['reb']:.2f} s")
     job = [sys.executable, "-m", "hamilton_orbits.cli", "run", "--no-progress"]
     with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as cwd:
         cold_env = dict(env, NUMBA_CACHE_DIR=cache)
@@ -274,7 +312,7 @@ def main() -> None:
     if "calls" not in args.skip:
         bench_per_call(nmax, nmax_reb, repeat)
     if "throughput" not in args.skip:
-        bench_throughput(10**6, repeat)
+        bench_throughput(10**6, repeat, 9 if args.quick else 15)
     if "first" not in args.skip:
         bench_first_run(2 if args.quick else 5)
 

@@ -5,13 +5,13 @@ The curated public API.  Everything not listed in ``__all__`` is private.
 
 from typing import TYPE_CHECKING, Any
 
-from hamilton_orbits._firstrun import install as _install_compile_notice
 from hamilton_orbits.conic import Conic
 from hamilton_orbits.kepler import ConvergenceError, solve_kepler
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.quaternion import Quaternion, slerp
 
-_install_compile_notice()  # one line on stderr while kernels compile for the first time
+# numba and astropy are imported on first use, not here (hamilton_orbits._lazy);
+# the first-compile notice is installed with the kernels (hamilton_orbits._kernels)
 
 if TYPE_CHECKING:  # pragma: no cover
     from hamilton_orbits.ensemble import Ensemble

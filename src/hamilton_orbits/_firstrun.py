@@ -65,3 +65,9 @@ def install() -> None:
             return
         event.register("numba:compile", _CompileNotice())
         _state["installed"] = True
+
+
+# Installed when this module is imported: by hamilton_orbits._kernels, before
+# any kernel of the package exists (a bare ``import hamilton_orbits`` imports
+# neither numba nor this module).
+install()

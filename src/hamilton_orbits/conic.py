@@ -29,18 +29,19 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import _first_index, _fmt_index, check_trailing
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 
 __all__ = ["Conic"]
 
+u = LazyModule("astropy.units", globals(), "u")  # imported on first use
 
 # internal units of a conic built from a Quantity orbit (those of KeplerOrbit)
-_L = u.km
-_V = u.km / u.s
+_L = "km"
+_V = "km / s"
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -58,7 +59,7 @@ def _in_range(method):
         with np.errstate(all="ignore"):
             out = method(self, *args, **kwargs)
         for part in out if isinstance(out, tuple) else (out,):
-            raw = part.value if isinstance(part, u.Quantity) else np.asarray(part)
+            raw = part.value if is_quantity(part) else np.asarray(part)
             ok = np.isfinite(raw)
             if method.__name__ == "second_focal_distance":
                 ok |= np.isposinf(raw) & np.broadcast_to(self._inv_a == 0, raw.shape)
@@ -66,7 +67,7 @@ def _in_range(method):
                 arg = "nu" if method.__name__ == "radius" else "r"
                 raise ValueError(
                     f"Expected `{arg}` for which `{method.__name__}` fits in float64, "
-                    f"got {np.asarray(x).tolist() if not isinstance(x, u.Quantity) else x}"
+                    f"got {np.asarray(x).tolist() if not is_quantity(x) else x}"
                 )
         return out
 
@@ -139,22 +140,19 @@ class Conic:
     @property
     def inv_a(self):
         """``1/a`` (0 for the parabola)."""
-        return self._out(self._inv_a, 1 / _L)
+        return self._out(self._inv_a, "1 / km")
 
     @property
     def mu(self):
         """Gravitational parameter (Hamilton's M)."""
-        return self._out(self._mu, _L**3 / u.s**2)
+        return self._out(self._mu, "km3 / s2")
 
     @classmethod
     def _from_orbit(cls, orbit) -> Conic:
-        el = orbit._elements
-        from hamilton_orbits._kernels.elements import COLUMNS
-
-        col = {k: i for i, k in enumerate(COLUMNS)}
-        inc = el[..., col["inc"]]
-        lan = el[..., col["lan"]]
-        argp = el[..., col["argp"]]
+        col = orbit._col
+        inc = col("inc")
+        lan = col("lan")
+        argp = col("argp")
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))
@@ -162,7 +160,7 @@ class Conic:
         P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
         h = np.stack([si * sl, -si * cl, ci], axis=-1)
         return cls(
-            el[..., col["p"]], el[..., col["e"]], el[..., col["inv_a"]], P, h, orbit._mu,
+            col("p"), col("e"), col("inv_a"), P, h, orbit._mu,
             quantity=orbit._quantity,
         )
 
@@ -329,7 +327,7 @@ class Conic:
         """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66), at ``q <= r <= Q``."""
         r = self._on_conic(self._in("r", r, _L))
         w = self._mu * (2.0 / r - self._inv_a - self._p / (r * r))
-        return self._out(np.maximum(w, 0.0), _V**2)  # a rounding-level negative is 0
+        return self._out(np.maximum(w, 0.0), "km2 / s2")  # a rounding-level negative is 0
 
     def _require_areal(self, what: str) -> None:
         if np.any(~(self._p > 0)):

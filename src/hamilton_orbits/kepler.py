@@ -28,10 +28,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._kernels import kepler as _k
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
     ConvergenceError,
     broadcast,
@@ -39,6 +38,10 @@ from hamilton_orbits._validation import (
     check_trailing,
 )
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
+
+# numba and astropy are imported on first use (hamilton_orbits._lazy)
+_k = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_k")
+u = LazyModule("astropy.units", globals(), "u")
 
 __all__ = [
     "ConvergenceError",
@@ -71,7 +74,7 @@ def _angle_pair(
 
 def _out(value: np.ndarray, quantity: bool):
     if quantity:
-        return wrap(value, u.rad, True)
+        return wrap(value, "rad", True)
     return value[()] if value.ndim == 0 else value
 
 
@@ -274,9 +277,9 @@ def true_from_anomaly(anomaly: Any, e: Any):
     return _out(out, quantity)
 
 
-_M = u.m
-_MS = u.m / u.s
-_MU = u.m**3 / u.s**2
+_M = "m"
+_MS = "m / s"
+_MU = "m3 / s2"
 
 
 def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
@@ -349,7 +352,7 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
     ra = LENGTH("r", r, _M)
     va = SPEED("v", v, _MS)
     mua = GM("mu", mu, _MU)
-    dta = TIME("dt", dt, u.s)
+    dta = TIME("dt", dt, "s")
     check_trailing("r", ra, 3)
     check_trailing("v", va, 3)
     check_positive("mu", mua)
@@ -388,5 +391,5 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
     r_out = r_out.reshape((*lead, 3))
     v_out = v_out.reshape((*lead, 3))
     if quantity:
-        return (r_out * _M).to(r_unit), (v_out * _MS).to(v_unit)
+        return wrap(r_out, _M, True).to(r_unit), wrap(v_out, _MS, True).to(v_unit)
     return r_out, v_out

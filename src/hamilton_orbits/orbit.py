@@ -28,12 +28,11 @@ import math
 from functools import cached_property
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
+from hamilton_orbits import _columns
 from hamilton_orbits import kepler as _kepler
-from hamilton_orbits._kernels import elements as _el
-from hamilton_orbits._kernels import kepler as _kk
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
     ConvergenceError,
     _first_index,
@@ -55,6 +54,11 @@ from hamilton_orbits.units import (
     wrap,
 )
 
+# numba and astropy are imported on first use (hamilton_orbits._lazy)
+_el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
+_kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
+u = LazyModule("astropy.units", globals(), "u")
+
 __all__ = [
     "KeplerOrbit",
     "hamilton_beta",
@@ -63,18 +67,21 @@ __all__ = [
 ]
 
 # internal units when Quantities come in
-_L = u.km
-_T = u.s
-_V = u.km / u.s
-_MU = u.km**3 / u.s**2
-_RAD = u.rad
+_L = "km"
+_T = "s"
+_V = "km / s"
+_MU = "km3 / s2"
+_RAD = "rad"
 
-_COL = {name: i for i, name in enumerate(_el.COLUMNS)}
-_LAZY_COLS = frozenset(("anomaly", "M", "tau"))
-# the columns the basic kernel computes (the lazy ones are NaN until asked for)
-_BASIC_IDX = np.array([i for i, name in enumerate(_el.COLUMNS) if name not in _LAZY_COLS])
+# _elements: the CLASSICAL columns (p, e, inv_a, inc, lan, argp, nu, u, kind, a);
+# _full: all COLUMNS (the anomaly, M and tau too), computed when one is asked for
+_CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
+_COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
 _F64 = np.dtype(np.float64)
-_INF = np.float64(np.inf)
+_SHAPE3 = (3,)
+_TWO_PI = 2.0 * math.pi
+_f64 = np.float64  # one orbit's elements are read as float64 scalars
+_A1 = _CI["a"]  # the last column
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -133,30 +140,34 @@ def _plain_float_array(x: Any) -> np.ndarray | None:
     return x.astype(np.float64) if x.dtype.kind in "fiu" else None
 
 
+def _three(x: Any) -> list | tuple | None:
+    """``x`` as three Python floats if it is a float64 array of shape (3,) or a
+    list/tuple of three Python floats, else None."""
+    t = type(x)
+    if t is np.ndarray:
+        # dtype identity: the native float64 (any other dtype takes the general path)
+        if x.dtype is _F64 and x.shape == _SHAPE3:
+            return x.tolist()
+        return None
+    if (t is list or t is tuple) and len(x) == 3:
+        a, b, c = x
+        if type(a) is float and type(b) is float and type(c) is float:
+            return x
+    return None
+
+
 def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
     """One orbit in plain floats (``r``, ``v`` lists/tuples of three floats or
     float64 arrays of shape (3,), ``mu`` a float) as 7 floats, if finite with
     ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
     if type(mu) is not float:
         return None
-    if type(r) is np.ndarray:
-        if r.shape != (3,) or r.dtype != _F64:
-            return None
-        r = r.tolist()
-    elif type(r) is not list and type(r) is not tuple:
-        return None
-    if type(v) is np.ndarray:
-        if v.shape != (3,) or v.dtype != _F64:
-            return None
-        v = v.tolist()
-    elif type(v) is not list and type(v) is not tuple:
-        return None
-    if len(r) != 3 or len(v) != 3:
+    r = _three(r)
+    v = _three(v)
+    if r is None or v is None:
         return None
     rx, ry, rz = r
     vx, vy, vz = v
-    if not (type(rx) is type(ry) is type(rz) is type(vx) is type(vy) is type(vz) is float):
-        return None
     s = rx + ry + rz + vx + vy + vz + mu  # inf or NaN if any is (or on overflow: then
     if s - s != 0.0 or not mu > 0.0 or not (rx or ry or rz):  # the general path decides)
         return None
@@ -209,13 +220,13 @@ def _in_range(prop):
     parabola, ``period`` of an unbound orbit, ``n`` of a radial parabola), means
     the value is beyond the float64 range for this state and raises ValueError
     naming ``r``, ``v``, ``mu``."""
-    name = prop.__name__
+    name = prop.__name__.removeprefix("_").removesuffix("_general")  # _a_general: a
 
     @functools.wraps(prop)
     def guarded(self):
         with np.errstate(all="ignore"):
             value = prop(self)
-        raw = value.value if isinstance(value, u.Quantity) else np.asarray(value)
+        raw = value.value if is_quantity(value) else np.asarray(value)
         finite = np.isfinite(raw)
         if not np.all(finite):
             kind = self._col("kind")
@@ -283,6 +294,24 @@ class KeplerOrbit:
     _r = cached_property(lambda self: np.array(self._one[:3]))
     _v = cached_property(lambda self: np.array(self._one[3:6]))
     _mu = cached_property(lambda self: np.array(self._one[6]))
+    # one orbit from plain floats, once its elements are asked for: the tuple of
+    # _el.classical_one (the CLASSICAL columns), so that reading an element is
+    # an index into it (as a float64 scalar, like the general path's)
+    _c1: tuple[float, ...] | None = None
+
+    def _one_classical(self) -> np.ndarray | None:
+        """The row ``_c1`` of a single orbit built from plain floats (computed
+        once, in one kernel call that flags any value beyond float64), or None
+        for a batch, a Quantity orbit or a flagged state (the general path then
+        computes the attribute or names the arguments)."""
+        one = self._one
+        if one is None:
+            return None
+        c = _el.classical_one(*one)
+        if c[_A1] != c[_A1]:  # NaN: beyond float64
+            return None
+        self._c1 = c
+        return c
 
     def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
         # np.array, not ascontiguousarray (which turns 0-d into 1-d)
@@ -358,7 +387,7 @@ class KeplerOrbit:
         """
         one = _one_state(r, v, mu)
         if one is not None:
-            obj = cls.__new__(cls)
+            obj = object.__new__(cls)
             obj._quantity = False
             obj._one = one  # _r, _v, _mu are made from it when first needed
             return obj
@@ -525,41 +554,52 @@ class KeplerOrbit:
     # --------------------------------------------------------------- elements
     @cached_property
     def _elements(self) -> np.ndarray:
-        # the classical columns only; the anomaly, M and tau (NaN here) are
-        # filled in by _col on first request (about a third of the cost)
+        # the CLASSICAL columns (_el.classical_one), shape (..., NCLASSICAL)
         one = self._one
         if one is not None:  # one orbit from plain floats: no arrays for the kernel
-            row = np.array(_el.state_to_elements_row(*one, False))
-            if not math.isfinite(row[_BASIC_IDX].sum()):
-                _refuse_beyond_range(row[None, _BASIC_IDX], np.array([one[:3]]),
+            row = np.array(self._c1 or _el.classical_one(*one))
+            if not math.isfinite(row[:_A1].sum()):
+                _refuse_beyond_range(row[None, :_A1], np.array([one[:3]]),
                                      np.array([one[3:6]]), np.array([one[6]]), ())
             return row
         flat_r = self._r.reshape(-1, 3)
         flat_v = self._v.reshape(-1, 3)
         flat_mu = self._mu.reshape(-1)
-        out = np.empty((flat_r.shape[0], _el.NCOL))
-        _el.state_to_elements_basic(flat_r, flat_v, flat_mu, out)
-        _refuse_beyond_range(out[:, _BASIC_IDX], flat_r, flat_v, flat_mu, self._mu.shape)
-        return out.reshape((*self._mu.shape, _el.NCOL))
+        out = np.empty((flat_r.shape[0], _columns.NCLASSICAL))
+        bad = _el.state_to_elements_classical(flat_r, flat_v, flat_mu, out)
+        if bad:  # a NaN a: a row beyond float64 is refused here, naming the first;
+            # else a is beyond float64 somewhere, refused when it is read (a)
+            _refuse_beyond_range(out[:, :_A1], flat_r, flat_v, flat_mu, self._mu.shape)
+        self.__dict__["_a_bad"] = bad
+        return out.reshape((*self._mu.shape, _columns.NCLASSICAL))
+
+    @cached_property
+    def _full(self) -> np.ndarray:
+        # every column of COLUMNS (the classical ones bit for bit as in _elements)
+        one = self._one
+        if one is not None:
+            out = np.array(_el.state_to_elements_row(*one, True))[None]
+        else:
+            out = np.empty((self._mu.size, _columns.NCOL))
+            _el.state_to_elements(
+                self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), out
+            )
+        _refuse_beyond_range(out, self._r.reshape(-1, 3), self._v.reshape(-1, 3),
+                             self._mu.reshape(-1), self._mu.shape)
+        return out.reshape((*self._mu.shape, _columns.NCOL))
 
     def _col(self, name: str) -> np.ndarray:
-        el = self.__dict__.get("_elements")
-        if el is None:  # as self._elements, without cached_property's lock (3.11)
-            el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
-        if name in _LAZY_COLS and "_all_columns" not in self.__dict__:
-            # every column, in place (the classical ones come out bit for bit the same)
-            one = self._one
-            if one is not None:
-                el[:] = _el.state_to_elements_row(*one, True)
-            else:
-                _el.state_to_elements(
-                    self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1),
-                    el.reshape(-1, _el.NCOL),
-                )
-            _refuse_beyond_range(el.reshape(-1, _el.NCOL), self._r.reshape(-1, 3),
-                                 self._v.reshape(-1, 3), self._mu.reshape(-1), self._mu.shape)
-            self.__dict__["_all_columns"] = True
-        return el[_COL[name]] if el.ndim == 1 else el[..., _COL[name]]
+        i = _CI.get(name)
+        if i is not None:
+            el = self.__dict__.get("_elements")
+            if el is None:  # as self._elements, without cached_property's lock (3.11)
+                el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
+            return el[i] if el.ndim == 1 else el[..., i]
+        full = self.__dict__.get("_full")
+        if full is None:
+            full = self.__dict__["_full"] = KeplerOrbit._full.func(self)
+        i = _COL[name]
+        return full[i] if full.ndim == 1 else full[..., i]
 
     def _out(self, value: np.ndarray, unit: u.UnitBase | None):
         if not self._quantity:
@@ -603,15 +643,15 @@ class KeplerOrbit:
         """  # noqa: E501
         if 0 in self.shape:
             return f"KeplerOrbit(shape={self.shape})"
-        el = self._elements
-        inv = el[..., _COL["inv_a"]]
+        col = self._col
+        inv = col("inv_a")
         a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
-        q = el[..., _COL["p"]] / (1.0 + el[..., _COL["e"]])
+        q = col("p") / (1.0 + col("e"))
         length = "q" if np.all(inv == 0) else "a"
-        cols = [(length, q if length == "q" else a, str(_L)), ("e", el[..., _COL["e"]], "")]
+        cols = [(length, q if length == "q" else a, str(_L)), ("e", col("e"), "")]
         scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
         for name in ("inc", "lan", "argp", "nu"):
-            cols.append((name, el[..., _COL[name]] * scale, aunit))
+            cols.append((name, col(name) * scale, aunit))
         cols.append(("mu", self._mu, str(_MU)))
         parts = []
         for name, x, unit in cols:
@@ -631,11 +671,17 @@ class KeplerOrbit:
     @property
     def e(self):
         """Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[1])
         return self._out(self._col("e"), None)
 
     @property
     def p(self):
         """Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[0])
         return self._out(self._col("p"), _L)
 
     @property
@@ -643,14 +689,21 @@ class KeplerOrbit:
         return self._col("inv_a")
 
     @property
-    @_in_range
     def a(self):
         """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
-        inv = self._inv_a
-        if type(inv) is np.float64 and not self._quantity:  # one orbit
-            return 1.0 / inv if inv else _INF
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[_A1])
+        a = self._col("a")
+        if self.__dict__.get("_a_bad") == 0:  # the kernel's a is finite (or a parabola's inf)
+            return self._out(a, _L)
+        return self._a_general
+
+    @property
+    @_in_range
+    def _a_general(self):
         with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
-            return self._out(1.0 / inv, _L)
+            return self._out(1.0 / self._inv_a, _L)
 
     @property
     def q(self):
@@ -660,21 +713,33 @@ class KeplerOrbit:
     @property
     def inc(self):
         """Inclination in [0, pi] (rad)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[3])
         return self._out(self._col("inc"), _RAD)
 
     @property
     def lan(self):
         """Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[4])
         return self._out(self._col("lan"), _RAD)
 
     @property
     def argp(self):
         """Argument of periapsis in [0, 2 pi); 0 when ``e = 0``."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[5])
         return self._out(self._col("argp"), _RAD)
 
     @property
     def nu(self):
         """True anomaly in (-pi, pi] (Hamilton's v, eq. 18)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            return _f64(c[6])
         return self._out(self._col("nu"), _RAD)
 
     @property
@@ -705,26 +770,66 @@ class KeplerOrbit:
         )
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
 
+    def _n_one(self) -> float | None:
+        """Mean motion of one orbit from plain floats, in Python floats (the
+        formula of ``_n``, bit for bit); None for a batch, a parabola or a value
+        beyond float64 (the general path then answers or names the state)."""
+        c = self._c1
+        if c is None and (c := self._one_classical()) is None:
+            return None
+        kind = c[8]
+        if kind == _columns.PARABOLA or kind == _columns.RADIAL_PARABOLA:
+            return None
+        inv = abs(c[2])
+        n = math.sqrt(self._one[6]) * inv * math.sqrt(inv)
+        return n if 0.0 < n < math.inf else None
+
     @property
-    @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
-        return self._out(self._n, _RAD / _T)
+        n = self._n_one()
+        return self._n_general if n is None else _f64(n)
 
     @property
     @_in_range
+    def _n_general(self):
+        return self._out(self._n, "rad / s")
+
+    @property
     def period(self):
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            kind = c[8]
+            if kind != _columns.ELLIPSE and kind != _columns.RADIAL_ELLIPSE:
+                return _f64(math.inf)
+            n = self._n_one()
+            if n is not None and (t := 2.0 * math.pi / n) < math.inf:
+                return _f64(t)
+        return self._period_general
+
+    @property
+    @_in_range
+    def _period_general(self):
         kind = self._col("kind")
         bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
         n = np.where(bound, self._n, 1.0)
         return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
 
     @property
-    @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
-        return self._out(-0.5 * self._mu * self._inv_a, _V**2)
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            w = -0.5 * self._one[6] * c[2]
+            if abs(w) < math.inf:
+                return _f64(w)
+        return self._energy_general
+
+    @property
+    @_in_range
+    def _energy_general(self):
+        return self._out(-0.5 * self._mu * self._inv_a, "km2 / s2")
 
     @cached_property
     def _tau(self) -> np.ndarray:
@@ -757,6 +862,10 @@ class KeplerOrbit:
     @property
     def varpi(self):
         """Longitude of periapsis ``lan + argp`` (``lan - argp`` for inc > pi/2), [0, 2 pi)."""
+        c = self._c1
+        if c is not None or (c := self._one_classical()) is not None:
+            y = (c[4] + (1.0 if c[3] <= 0.5 * math.pi else -1.0) * c[5]) % _TWO_PI  # as _wrap2pi
+            return _f64(0.0 if y >= _TWO_PI else y)
         return self._out(_wrap2pi(self._col("lan") + self._sign * self._col("argp")), _RAD)
 
     @property
@@ -779,22 +888,56 @@ class KeplerOrbit:
         return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
 
     @property
-    @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
-        return self._out(np.cross(self._r, self._v), _L * _V)
+        one = self._one
+        if one is not None:  # Python floats, as np.cross computes them
+            rx, ry, rz, vx, vy, vz, _ = one
+            h = (ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
+            if abs(h[0] + h[1] + h[2]) < math.inf:
+                return np.array(h)
+        return self._areal_vector_general
 
     @property
     @_in_range
+    def _areal_vector_general(self):
+        return self._out(np.cross(self._r, self._v), "km2 / s")
+
+    @property
     def eccentricity_vector(self):
         """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
+        e = self._ecc_vector_one()
+        return self._eccentricity_vector_general if e is None else np.array(e)
+
+    @property
+    @_in_range
+    def _eccentricity_vector_general(self):
         return self._out(_ecc_vector(self._r, self._v, self._mu), None)
 
     @property
-    @_in_range
     def hamilton_epsilon(self):
         """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
+        e = self._ecc_vector_one()
+        return self._hamilton_epsilon_general if e is None else -np.array(e)
+
+    @property
+    @_in_range
+    def _hamilton_epsilon_general(self):
         return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
+
+    def _ecc_vector_one(self) -> tuple[float, float, float] | None:
+        """:func:`_ecc_vector` of one orbit from plain floats in Python floats (the
+        same operations in the same order), or None (a batch, a Quantity orbit,
+        or a value beyond float64: the general path then answers or names it)."""
+        one = self._one
+        if one is None:
+            return None
+        rx, ry, rz, vx, vy, vz, m = one
+        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
+        f = vx * vx + vy * vy + vz * vz - m / rn
+        rv = rx * vx + ry * vy + rz * vz
+        e = ((f * rx - rv * vx) / m, (f * ry - rv * vy) / m, (f * rz - rv * vz) / m)
+        return e if abs(e[0] + e[1] + e[2]) < math.inf else None
 
     # ----------------------------------------------------------------- methods
     def state(self) -> tuple[Any, Any]:
@@ -1014,7 +1157,7 @@ def hamilton_beta(r: Any, v: Any):
     <Quantity [0., 0., 2.] km2 / s>
     """
     r_, v_, _, quantity = _hamilton_args(r, v)
-    return wrap(_finite_or_raise(_beta, r_, v_), _L * _V, quantity)
+    return wrap(_finite_or_raise(_beta, r_, v_), "km2 / s", quantity)
 
 
 def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
@@ -1065,7 +1208,7 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
         beta = Quaternion.from_vector(_beta(r_, v_))
         return (iota - (dalpha * beta) * (1.0 / mu_)).vector
 
-    return wrap(_finite_or_raise(eps_of, r_, v_), u.dimensionless_unscaled, quantity)
+    return wrap(_finite_or_raise(eps_of, r_, v_), "", quantity)
 
 
 def hamilton_p(r: Any, v: Any, mu: Any):

@@ -41,17 +41,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._kernels.quaternion import (
-    from_matrix_flat,
-    qmul_flat,
-    qmul_gufunc,
-    qrot_gufunc,
-    rotate_flat,
-    to_matrix_flat,
-)
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
     _first_index,
     as_float_array,
@@ -59,7 +51,11 @@ from hamilton_orbits._validation import (
     check_finite_result,
     check_trailing,
 )
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, is_quantity
+
+# numba and astropy are imported on first use (hamilton_orbits._lazy)
+_kq = LazyModule("hamilton_orbits._kernels.quaternion", globals(), "_kq")
+u = LazyModule("astropy.units", globals(), "u")
 
 __all__ = ["Quaternion", "slerp"]
 
@@ -150,15 +146,15 @@ def _product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, bool]:
     """
     if a.shape == b.shape:  # the common case: a compiled loop that reports overflow
         out = np.empty(a.shape)
-        if qmul_flat(a.reshape(-1, 4), b.reshape(-1, 4), out.reshape(-1, 4)):
+        if _kq.qmul_flat(a.reshape(-1, 4), b.reshape(-1, 4), out.reshape(-1, 4)):
             return out, True
     else:
         with np.errstate(over="ignore", invalid="ignore"):
-            out = qmul_gufunc(a, b)
+            out = _kq.qmul_gufunc(a, b)
         if np.isfinite(out).all():
             return out, True
     ea, eb = _exponent_wide(a), _exponent_wide(b)
-    scaled = qmul_gufunc(np.ldexp(a, -ea[..., None]), np.ldexp(b, -eb[..., None]))
+    scaled = _kq.qmul_gufunc(np.ldexp(a, -ea[..., None]), np.ldexp(b, -eb[..., None]))
     with np.errstate(over="ignore"):
         out = np.ldexp(scaled, (ea + eb)[..., None])
     return out, bool(np.isfinite(out).all())
@@ -327,7 +323,7 @@ class Quaternion:
         >>> float(p.rotation_distance(q))
         0.0
         """
-        if degrees and isinstance(angle, u.Quantity):
+        if degrees and is_quantity(angle):
             raise ValueError(
                 f"Expected `angle` to be a plain number with degrees=True, got the Quantity "
                 f"{angle!r}: its unit already says how to read it (drop degrees=True)"
@@ -380,7 +376,7 @@ class Quaternion:
             )
         flat = np.ascontiguousarray(m.reshape(-1, 3, 3))
         out = np.empty((flat.shape[0], 4))
-        from_matrix_flat(flat, out)
+        _kq.from_matrix_flat(flat, out)
         return cls._wrap(out.reshape(m.shape[:-2] + (4,)))
 
     @classmethod
@@ -466,7 +462,7 @@ class Quaternion:
         """
         flat = np.ascontiguousarray(self._a.reshape(-1, 4))
         out = np.empty((flat.shape[0], 3, 3))
-        if to_matrix_flat(flat, out) >= 0:
+        if _kq.to_matrix_flat(flat, out) >= 0:
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
         return out.reshape(self.shape + (3, 3))
 
@@ -822,7 +818,7 @@ class Quaternion:
         array([[ 0.,  1.,  0.],
                [-1.,  0.,  0.]])
         """
-        unit = vectors.unit if isinstance(vectors, u.Quantity) else None
+        unit = vectors.unit if is_quantity(vectors) else None
         raw = vectors.value if unit is not None else vectors
         # complex and non-numeric input refused here; finiteness checked in the kernel
         v = check_trailing("vectors", as_float_array("vectors", raw, finite=False), 3)
@@ -831,14 +827,14 @@ class Quaternion:
             flat_q = np.ascontiguousarray(self._a.reshape(-1, 4))
             flat_v = np.ascontiguousarray(v.reshape(-1, 3))
             out = np.empty(flat_v.shape)
-            if rotate_flat(flat_q, flat_v, out) == -1:
+            if _kq.rotate_flat(flat_q, flat_v, out) == -1:
                 return _with_unit(out.reshape(v.shape), unit)
         broadcast_shapes(("self", "vectors"), self.shape, v.shape[:-1])
         as_float_array("vectors", v)
         if not np.all(np.any(self._a != 0, axis=-1)):
             _raise_zero("self", _norm_last(self._a), "the zero quaternion is no rotation")
         with np.errstate(over="ignore", invalid="ignore"):  # overflow: refused just below
-            out = qrot_gufunc(self._a, v)
+            out = _kq.qrot_gufunc(self._a, v)
         _finite("vectors", out, "the rotated vector", lambda: np.broadcast_to(v, out.shape))
         return _with_unit(out, unit)
 

@@ -24,14 +24,19 @@ Every public function converts its arguments through these kinds, e.g.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+import functools
+import sys
+from collections.abc import Callable, Sequence
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
+from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import as_float_array
+
+# astropy.units is imported on first use: a caller that has not imported it
+# cannot have passed a Quantity (is_quantity), so plain-float calls never need it
+u = LazyModule("astropy.units", globals(), "u")
 
 __all__ = [
     "ACCELERATION",
@@ -48,6 +53,7 @@ __all__ = [
     "TIME",
     "TORQUE",
     "Kind",
+    "UnitLike",
     "any_quantity",
     "is_quantity",
     "require_consistent",
@@ -56,15 +62,48 @@ __all__ = [
 ]
 
 
+UnitLike = Any
+"""An astropy unit, or its name as a string (parsed, and astropy imported, on first use)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _parse_unit(text: str):
+    return u.Unit(text)
+
+
+def as_unit(unit: UnitLike):
+    """``unit`` as an astropy unit (a string is parsed, once).
+
+    Unit constants inside the package are strings (``"km / s"``), so that
+    defining them does not import astropy.
+
+    Examples
+    --------
+    >>> as_unit("km3 / s2") == u.km**3 / u.s**2
+    True
+    >>> as_unit(u.deg)
+    Unit("deg")
+    """
+    return _parse_unit(unit) if isinstance(unit, str) else unit
+
+
+def _quantity_class() -> type | None:
+    """astropy's Quantity if astropy.units is imported, else None."""
+    units = sys.modules.get("astropy.units")
+    return None if units is None else getattr(units, "Quantity", None)
+
+
 def is_quantity(value: Any) -> bool:
-    """True if ``value`` is an astropy Quantity.
+    """True if ``value`` is an astropy Quantity (False, without importing astropy,
+    when astropy.units has not been imported: then no Quantity exists).
 
     Examples
     --------
     >>> is_quantity(1.0 * u.km), is_quantity(1.0)
     (True, False)
     """
-    return isinstance(value, u.Quantity)
+    q = _quantity_class()
+    return q is not None and isinstance(value, q)
 
 
 def any_quantity(*values: Any) -> bool:
@@ -75,10 +114,10 @@ def any_quantity(*values: Any) -> bool:
     >>> any_quantity(1.0, 2.0 * u.s), any_quantity(1.0, None)
     (True, False)
     """
-    return any(isinstance(v, u.Quantity) for v in values)
+    q = _quantity_class()
+    return q is not None and any(isinstance(v, q) for v in values)
 
 
-@dataclass(frozen=True)
 class Kind:
     """One kind of physical argument: its dimension and default internal unit.
 
@@ -86,10 +125,12 @@ class Kind:
     ----------
     name : str
         What the kind is called in messages ("an angle", "a length", ...).
-    unit : astropy unit
-        The default internal unit a Quantity is converted to.
-    equivalencies : list, optional
-        Unit equivalencies this kind allows (only ``ANGULAR_SPEED`` has any).
+    unit : astropy unit or str
+        The default internal unit a Quantity is converted to (a string is
+        parsed on first use; the attribute ``unit`` is always an astropy unit).
+    equivalencies : list or callable, optional
+        Unit equivalencies this kind allows (a callable returning the list is
+        called on first use), e.g. ``u.dimensionless_angles`` for the rates.
 
     Calling a kind, ``KIND(name, value, unit=None, finite=True)``, returns a
     float64 array: Quantities are converted to ``unit`` (default: the kind's
@@ -122,15 +163,32 @@ class Kind:
     astropy.units.errors.UnitConversionError: Expected `a` to be a length (convertible to m), got s
     """
 
-    name: str
-    unit: u.UnitBase
-    equivalencies: list = field(default_factory=list)
+    def __init__(
+        self, name: str, unit: UnitLike, equivalencies: list | Callable[[], list] | None = None
+    ) -> None:
+        self.name = name
+        self._unit = unit
+        self._equivalencies = [] if equivalencies is None else equivalencies
+
+    @property
+    def unit(self):
+        """The default internal unit (an astropy unit)."""
+        return as_unit(self._unit)
+
+    @property
+    def equivalencies(self) -> list:
+        """The unit equivalencies this kind allows."""
+        eq = self._equivalencies
+        return eq() if callable(eq) else eq
+
+    def __repr__(self) -> str:
+        return f"Kind({self.name!r}, {str(self._unit)!r})"
 
     def __call__(
-        self, name: str, value: Any, unit: u.UnitBase | None = None, *, finite: bool = True
+        self, name: str, value: Any, unit: UnitLike | None = None, *, finite: bool = True
     ) -> np.ndarray:
-        target = self.unit if unit is None else unit
-        if isinstance(value, u.Quantity):
+        if is_quantity(value):
+            target = self.unit if unit is None else as_unit(unit)
             if self is DIMENSIONLESS and value.unit.physical_type == "angle":
                 raise u.UnitConversionError(
                     f"Expected `{name}` to be dimensionless, got {_short(value)} (an angle)"
@@ -154,19 +212,23 @@ def _short(q: u.Quantity) -> str:
     return f"{q.unit} values"
 
 
-ANGLE = Kind("an angle", u.rad)
-LENGTH = Kind("a length", u.m)
-TIME = Kind("a time", u.s)
-SPEED = Kind("a speed", u.m / u.s)
-ACCELERATION = Kind("an acceleration", u.m / u.s**2)
-GM = Kind("a gravitational parameter GM", u.m**3 / u.s**2)
-MASS = Kind("a mass", u.kg)
-DIMENSIONLESS = Kind("dimensionless", u.dimensionless_unscaled)
-INERTIA = Kind("a moment of inertia", u.kg * u.m**2)
-ANGULAR_SPEED = Kind("an angular speed", u.rad / u.s, u.dimensionless_angles())
-ANGULAR_MOMENTUM = Kind("an angular momentum", u.kg * u.m**2 / u.s, u.dimensionless_angles())
-ENERGY = Kind("an energy", u.J, u.dimensionless_angles())
-TORQUE = Kind("a torque", u.N * u.m, u.dimensionless_angles())
+def _dimensionless_angles() -> list:
+    return u.dimensionless_angles()
+
+
+ANGLE = Kind("an angle", "rad")
+LENGTH = Kind("a length", "m")
+TIME = Kind("a time", "s")
+SPEED = Kind("a speed", "m / s")
+ACCELERATION = Kind("an acceleration", "m / s2")
+GM = Kind("a gravitational parameter GM", "m3 / s2")
+MASS = Kind("a mass", "kg")
+DIMENSIONLESS = Kind("dimensionless", "")
+INERTIA = Kind("a moment of inertia", "kg m2")
+ANGULAR_SPEED = Kind("an angular speed", "rad / s", _dimensionless_angles)
+ANGULAR_MOMENTUM = Kind("an angular momentum", "kg m2 / s", _dimensionless_angles)
+ENERGY = Kind("an energy", "J", _dimensionless_angles)
+TORQUE = Kind("a torque", "N m", _dimensionless_angles)
 
 
 def require_consistent(names: Sequence[str], values: Sequence[Any]) -> bool:
@@ -196,12 +258,12 @@ def require_consistent(names: Sequence[str], values: Sequence[Any]) -> bool:
     ValueError: Expected `dt` to be a Quantity like `t` (10.0 s), got the plain number 0.1
     """
     given = [(n, v) for n, v in zip(names, values, strict=True) if v is not None]
-    quantities = [(n, v) for n, v in given if isinstance(v, u.Quantity)]
+    quantities = [(n, v) for n, v in given if is_quantity(v)]
     if not quantities:
         return False
     qname, qvalue = quantities[0]
     for n, v in given:
-        if not isinstance(v, u.Quantity):
+        if not is_quantity(v):
             raise ValueError(
                 f"Expected `{n}` to be a Quantity like `{qname}` ({qvalue}), "
                 f"got the plain number {v!r}"
@@ -209,7 +271,7 @@ def require_consistent(names: Sequence[str], values: Sequence[Any]) -> bool:
     return True
 
 
-def strip(name: str, value: Any, unit: u.UnitBase | None, *, finite: bool = True) -> np.ndarray:
+def strip(name: str, value: Any, unit: UnitLike | None, *, finite: bool = True) -> np.ndarray:
     """Return ``value`` as float64 in ``unit`` (Quantities) or as given (floats).
 
     The kind is read off ``unit``: ``None`` or a dimensionless unit is
@@ -240,6 +302,9 @@ def strip(name: str, value: Any, unit: u.UnitBase | None, *, finite: bool = True
     >>> strip("r", [1.0, 2.0], u.m)
     array([1., 2.])
     """
+    if not is_quantity(value):  # plain numbers: the kind cannot matter
+        return as_float_array(name, value, finite=finite)
+    unit = None if unit is None else as_unit(unit)
     if unit is None or unit.physical_type == "dimensionless":
         return DIMENSIONLESS(name, value, unit, finite=finite)
     if unit.physical_type == "angle":
@@ -249,7 +314,7 @@ def strip(name: str, value: Any, unit: u.UnitBase | None, *, finite: bool = True
     return Kind("a quantity", unit)(name, value, finite=finite)
 
 
-def wrap(value: np.ndarray, unit: u.UnitBase | None, quantity: bool):
+def wrap(value: np.ndarray, unit: UnitLike | None, quantity: bool):
     """Attach ``unit`` if the call came in with Quantities, else return floats.
 
     Examples
@@ -260,5 +325,5 @@ def wrap(value: np.ndarray, unit: u.UnitBase | None, quantity: bool):
     3.0
     """
     if quantity and unit is not None:
-        return u.Quantity(value, unit)
+        return u.Quantity(value, as_unit(unit))
     return value

@@ -62,7 +62,8 @@ def test_plain_inputs_match_general_path(kind):
     fast = KeplerOrbit.from_state(r, v, 1.0)
     slow = KeplerOrbit.from_state(np.array(r, dtype=object), v, 1.0)  # the general path
     batch = KeplerOrbit.from_state(np.atleast_2d(r), np.atleast_2d(v), np.ones(1))  # arrays
-    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude"):
+    for n in (*NAMES, "M", "anomaly", "time_since_periapsis", "n", "period", "mean_longitude",
+              "energy", "varpi"):
         assert getattr(fast, n) == getattr(slow, n) == getattr(batch, n)[0], n
     assert type(fast.e) is np.float64 and type(fast.a) is np.float64
     assert fast.shape == slow.shape == ()
@@ -106,3 +107,78 @@ def test_propagate_fast_path_errors_name_dt(dt):
     o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0)
     with pytest.raises(ValueError, match="`dt`"):
         o.propagate(dt)
+
+
+ONE_STATES = [
+    ([1.0, 0.25, -0.5], [0.0, 1.0, 0.25]),  # ellipse
+    ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),  # circle (e = 0, argp = 0)
+    ([1.0, 0.0, 0.0], [0.0, 2.0**0.5, 0.0]),  # parabola (a = inf)
+    ([1.0, 0.0, 0.0], [0.0, 3.0, 0.3]),  # hyperbola
+    ([1.0, 2.0, 0.5], [0.5, 1.0, 0.25]),  # radial (h = 0)
+    ([1e200, 0.0, 0.0], [0.0, 1e-100, 0.0]),  # scaled inside the kernel (a = 1e200)
+]
+
+
+@pytest.mark.parametrize(("r", "v"), ONE_STATES)
+def test_one_orbit_row_matches_batch_bits(r, v):
+    """One orbit of plain floats reads its elements from one kernel row
+    (``classical_one``): the same bits as the batch kernel, the same types."""
+    one = KeplerOrbit.from_state(r, v, 1.0)
+    batch = KeplerOrbit.from_state(np.array([r]), np.array([v]), np.ones(1))
+    for n in ("a", "e", "p", "inc", "lan", "argp", "nu", "n", "period", "energy", "varpi"):
+        x = getattr(one, n)
+        assert type(x) is np.float64, n
+        y = getattr(batch, n)[0]
+        assert x == y or (np.isnan(x) and np.isnan(y)), n
+    # the lazy columns afterwards leave the classical ones as they were
+    assert one.M == batch.M[0] and one.anomaly == batch.anomaly[0]
+    assert one.e == batch.e[0] and one.nu == batch.nu[0]
+
+
+def test_one_orbit_beyond_float64_names_the_state():
+    """A state whose elements overflow (e ~ 1e155) is flagged by the one-orbit
+    kernel and refused by the general path by name, from any first attribute."""
+    for name in ("a", "e", "inc", "nu"):
+        o = KeplerOrbit.from_state([1e51, 0.0, 0.0], [0.0, 0.0, 1e52], 1.0)
+        with pytest.raises(ValueError, match=r"`r`, `v`, `mu` whose elements fit in float64"):
+            getattr(o, name)
+
+
+def test_batch_a_from_the_kernel_is_one_over_inv_a():
+    """A batch reads ``a`` straight from the kernel's column: 1/inv_a bit for bit,
+    +inf for the parabola (no warning: the suite turns warnings into errors), and
+    the classical columns are those of the basic kernel (no anomaly computed)."""
+    r = np.array([s[0] for s in ONE_STATES])
+    v = np.array([s[1] for s in ONE_STATES])
+    o = KeplerOrbit.from_state(r, v, 1.0)
+    a = o.a
+    basic = np.empty((len(r), _el.NCOL))
+    _el.state_to_elements_basic(r, v, np.ones(len(r)), basic)
+    inv = basic[:, _el.COLUMNS.index("inv_a")]
+    assert a[2] == np.inf and inv[2] == 0.0  # the parabola
+    finite = inv != 0
+    np.testing.assert_array_equal(a[finite], 1.0 / inv[finite])
+    for n in ("e", "p", "inc", "lan", "argp", "nu"):
+        np.testing.assert_array_equal(getattr(o, n), basic[:, _el.COLUMNS.index(n)])
+    assert "_full" not in o.__dict__  # the anomaly, M and tau were not computed
+
+
+@pytest.mark.parametrize(("r", "v"), ONE_STATES)
+def test_one_orbit_vectors_match_batch_bits(r, v):
+    """The areal and eccentricity vectors of one orbit of plain floats (Python
+    floats, no floating-point-error guard) equal the batch path's bits."""
+    one = KeplerOrbit.from_state(r, v, 1.0)
+    batch = KeplerOrbit.from_state(np.array([r]), np.array([v]), np.ones(1))
+    for n in ("areal_vector", "eccentricity_vector", "hamilton_epsilon"):
+        x = getattr(one, n)
+        assert x.shape == (3,) and x.dtype == np.float64, n
+        np.testing.assert_array_equal(x, getattr(batch, n)[0], err_msg=n)
+
+
+def test_one_orbit_vectors_beyond_float64_are_named():
+    """|r x v| = 1e400: the general path refuses it by name (such a state's p =
+    h^2/mu is beyond float64 too, so the elements' message may come first)."""
+    o = KeplerOrbit.from_state([1e200, 0.0, 0.0], [0.0, 1e200, 0.0], 1.0)
+    for name in ("areal_vector", "eccentricity_vector", "hamilton_epsilon"):
+        with pytest.raises(ValueError, match=r"`r`, `v`, `mu` .*fits? in float64"):
+            getattr(o, name)

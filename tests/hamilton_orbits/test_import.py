@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 
 # modules that a plain import must not load (each costs 0.05-1 s)
@@ -59,6 +61,51 @@ def test_import_is_light():
     got = _modules_after("import hamilton_orbits")
     assert _heavy(got["modules"]) == []
     assert got["built"] == []  # no ufunc compiled or loaded at import
+
+
+def _bare_modules(code: str) -> list[str]:
+    """``sys.modules`` right after ``code`` in a fresh interpreter."""
+    probe = f"import sys, json\n{code}\nprint(json.dumps(sorted(sys.modules)))\n"
+    env = dict(os.environ, PYTHONPATH=SRC)
+    proc = subprocess.run(
+        [sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout.splitlines()[-1])
+
+
+# what a bare import must not load: numba with the kernels (~0.5 s) is imported
+# when a kernel is first called, astropy (~0.5 s) when a Quantity comes in
+NOT_AT_IMPORT = ("numba", "llvmlite", "astropy", "scipy", "hamilton_orbits._kernels")
+
+
+def _loaded(modules: list[str], roots: tuple[str, ...]) -> list[str]:
+    return [m for m in modules if m in roots or m.startswith(tuple(r + "." for r in roots))]
+
+
+@pytest.mark.parametrize(
+    "code", ["import hamilton_orbits", "from hamilton_orbits import KeplerOrbit, Quaternion"]
+)
+def test_bare_import_loads_no_numba_no_astropy(code):
+    assert _loaded(_bare_modules(code), NOT_AT_IMPORT) == []
+
+
+def test_plain_float_calls_never_import_astropy():
+    """A caller that never imported astropy cannot pass a Quantity: the unit
+    boundary does not import it for plain floats (numba comes with the kernels).
+    The values are smoke checks only (precision is tested in test_orbit etc.)."""
+    got = _bare_modules(
+        "from hamilton_orbits import KeplerOrbit, Quaternion, solve_kepler\n"
+        "o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.2, 0.0], 1.0)\n"
+        "assert abs(o.e - 0.44) < 1e-15 and o.propagate(0.5).e == o.e\n"
+        "o = KeplerOrbit.from_elements(a=1.0, e=0.5, inc=0.1, lan=0.2, argp=0.3, M=0.4, mu=1.0)\n"
+        "assert abs(o.M - 0.4) < 1e-14 and o.conic.p > 0 and solve_kepler(0.5, 0.1) > 0\n"
+        "q = Quaternion.from_axis_angle([0.0, 0.0, 1.0], 0.5)\n"
+        "assert abs(q.rotate([1.0, 0.0, 0.0])[1] - 0.479425538604203) < 1e-15\n"
+        "repr(o), repr(q)\n"
+    )
+    assert _loaded(got, ("astropy",)) == []
+    assert "numba" in got  # the kernels did run
 
 
 def test_public_names_still_import():

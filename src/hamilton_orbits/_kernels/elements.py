@@ -36,6 +36,19 @@ import math
 import numpy as np
 from numba import njit, prange
 
+# the column layout and the conic kinds are numba-free (for the Python side)
+from hamilton_orbits._columns import (  # noqa: F401  (re-exported)
+    CLASSICAL,
+    COLUMNS,
+    ELLIPSE,
+    HYPERBOLA,
+    NCLASSICAL,
+    NCOL,
+    PARABOLA,
+    RADIAL_ELLIPSE,
+    RADIAL_HYPERBOLA,
+    RADIAL_PARABOLA,
+)
 from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     _two_prod,
@@ -52,30 +65,6 @@ EPS = 2.220446049250313e-16
 PI = math.pi
 TWO_PI = 2.0 * math.pi
 FOUR_PI = 4.0 * math.pi
-
-# conic kinds
-ELLIPSE = 0.0
-PARABOLA = 1.0
-HYPERBOLA = 2.0
-RADIAL_ELLIPSE = 3.0
-RADIAL_PARABOLA = 4.0
-RADIAL_HYPERBOLA = 5.0
-
-COLUMNS = (
-    "p",
-    "e",
-    "inv_a",
-    "inc",
-    "lan",
-    "argp",
-    "nu",
-    "anomaly",
-    "M",
-    "u",
-    "kind",
-    "tau",
-)
-NCOL = len(COLUMNS)
 
 _CIRC_TOL = 4.0 * EPS
 # |1/a| below this many eps of (2/r + v^2/mu), the rounding bound of vis viva
@@ -216,10 +205,10 @@ def state_to_elements_one(
     hz = rx * vy - ry * vx
     h = math.sqrt(hx * hx + hy * hy + hz * hz)
     inv_a = 2.0 / r - v2 / mu
-    smu = math.sqrt(mu)
 
     if h <= _RADIAL_TOL * r * math.sqrt(v2):
         # ---- radial (rectilinear) orbit: e = 1, p = 0, body at nu = pi ----
+        smu = math.sqrt(mu)
         dx = -rx / r
         dy = -ry / r
         dz = -rz / r
@@ -303,6 +292,7 @@ def state_to_elements_one(
         else:
             kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
         return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
+    smu = math.sqrt(mu)  # only here: the classical columns do not need it
     if e == 1.0 and inv_a != 0.0:
         # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
         c = r * v2 / mu - 1.0
@@ -428,6 +418,32 @@ def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
     return state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, False, full)
 
 
+@njit(cache=True)
+def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_basic`
+    but the anomaly, M and tau (bit for bit), then ``a``.
+
+    ``a = 1/inv_a`` (``inf`` for the parabolas, ``inv_a = 0``).  ``a`` is NaN when
+    another column is not finite or ``a`` is infinite for an orbit that is not a
+    parabola: the state's elements do not fit in float64, and the caller takes
+    the general path, which names the arguments.  So nothing out of this kernel
+    needs a floating-point-error guard.
+    """
+    p, e, inv_a, inc, lan, argp, nu, _anom, _m, u, kind, _tau = state_to_elements_scaled(
+        rx, ry, rz, vx, vy, vz, mu, False, False
+    )
+    if inv_a == 0.0:
+        a = math.inf if kind == PARABOLA or kind == RADIAL_PARABOLA else math.nan
+    else:
+        a = 1.0 / inv_a
+        if not math.isfinite(a):
+            a = math.nan
+    s = p + e + inv_a + inc + lan + argp + nu + u + kind
+    if s - s != 0.0:  # NaN for any inf or NaN
+        a = math.nan
+    return p, e, inv_a, inc, lan, argp, nu, u, kind, a
+
+
 @parallel_kernel
 def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
     """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
@@ -438,6 +454,36 @@ def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
         )
         for j in range(NCOL):
             out[i, j] = res[j]
+
+
+@parallel_kernel
+def state_to_elements_classical(r, v, mu, out):  # pragma: no cover - compiled
+    """Rows of :func:`classical_one` into ``out`` (N, NCLASSICAL): the
+    ``CLASSICAL`` columns, ``a`` NaN where it or another column is beyond float64.
+
+    Returns the number of rows with such a NaN ``a`` (0 in the common case), so
+    that the caller needs no second pass over ``out`` to find out (it then
+    names the first such row, or refuses to read ``a`` there).
+    """
+    bad = 0
+    for i in prange(r.shape[0]):
+        p, e, inv_a, inc, lan, argp, nu, u, kind, a = classical_one(
+            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i]
+        )
+        # one store per column (no loop over a tuple: faster under parallel=True)
+        out[i, 0] = p
+        out[i, 1] = e
+        out[i, 2] = inv_a
+        out[i, 3] = inc
+        out[i, 4] = lan
+        out[i, 5] = argp
+        out[i, 6] = nu
+        out[i, 7] = u
+        out[i, 8] = kind
+        out[i, 9] = a
+        if a != a:
+            bad += 1
+    return bad
 
 
 @parallel_kernel
