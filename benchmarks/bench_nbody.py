@@ -528,17 +528,19 @@ def bench_effects_cost(years: float, repeat: int) -> None:
     for rhs_ in variants.values():  # compile every variant before timing
         radau15.run(rhs_, r0, v0, gm, np.array([0.0, 1.0]), dt=0.5)
     print(f"[6] what an effect costs: radau15 at a fixed 1-day step, {years:g} years "
-          "(time per step, median of repeats)")
-    base = None
-    for name, rhs_ in variants.items():
-        times = []
-        for _ in range(repeat):
+          "(time per step, median of interleaved repeats; x: median of per-round ratios)")
+    # the variants take turns in each round, so that load varying between rounds
+    # meets them all; the ratio is the median of the per-round ratios
+    times: dict[str, list[float]] = {name: [] for name in variants}
+    for _ in range(repeat):
+        for name, rhs_ in variants.items():
             t0 = time.perf_counter()
             _, _, steps = radau15.run(rhs_, r0, v0, gm, t, dt=1.0)
-            times.append((time.perf_counter() - t0) / steps)
-        med = float(np.median(times))
-        base = base or med
-        print(f"    {name:<32}{med * 1e6:8.2f} us/step   x{med / base:5.2f}")
+            times[name].append((time.perf_counter() - t0) / steps)
+    base = np.array(times["effects=()"])
+    for name, ts in times.items():
+        ratio = float(np.median(np.array(ts) / base))
+        print(f"    {name:<32}{np.median(ts) * 1e6:8.2f} us/step   x{ratio:5.2f}")
 
 
 def main() -> None:

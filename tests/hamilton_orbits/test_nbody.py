@@ -31,9 +31,10 @@ def direct_accelerations(r: np.ndarray, gm: np.ndarray) -> np.ndarray:
     return np.einsum("j,ijk->ik", gm, d / dist[:, :, None] ** 3)
 
 
+@pytest.mark.parametrize("n_massless", [0, 3])  # two paths: all massive, or with test particles
 @pytest.mark.parametrize("seed", range(5))
-def test_kernel_against_direct_and_quaternion_form(seed):
-    s = random_system(7, seed, n_massless=3)
+def test_kernel_against_direct_and_quaternion_form(seed, n_massless):
+    s = random_system(7, seed, n_massless=n_massless)
     acc = s.accelerations()
     ref = direct_accelerations(s._r, s._gm)
     quat = accelerations_quaternion(s._r, s._gm)

@@ -36,9 +36,57 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     """Newtonian accelerations of equation (B); overwrites ``acc``.
 
     Massive pairs are visited once (both accelerations from one separation);
-    test particles are summed over the massive bodies only.
+    test particles are summed over the massive bodies only.  With no test
+    particle (the common case) nothing is allocated: this runs once per force
+    evaluation, where a small allocation costs as much as the 36 pairs of the
+    solar system.
     """
-    newtonian_rows(r, gm, massive_indices(gm), 0, acc)
+    n = r.shape[0]
+    for k in range(n):
+        if gm[k] == 0.0:
+            newtonian_rows(r, gm, massive_indices(gm), 0, acc)
+            return
+    for k in range(n):
+        acc[k, 0] = 0.0
+        acc[k, 1] = 0.0
+        acc[k, 2] = 0.0
+    for i in range(n):
+        _massive_row(r, gm, i, acc, n, n, False, gm)
+
+
+@njit(inline="always", cache=True)
+def _massive_row(r, gm, i, acc, start, nm, use_idx, idx):  # pragma: no cover - compiled
+    """Body ``i`` against the massive bodies after it: ``j = idx[b]`` for ``b`` in
+    ``(start, nm)`` (``use_idx``), else ``j = b`` from ``i + 1``.  Body ``i``'s sum
+    is kept in registers (``j != i``: the compiler cannot know that ``acc[i]`` and
+    ``acc[j]`` differ and would store and reload it every pair); the same
+    additions in the same order on both paths."""
+    xi = r[i, 0]
+    yi = r[i, 1]
+    zi = r[i, 2]
+    gi = gm[i]
+    ax = acc[i, 0]
+    ay = acc[i, 1]
+    az = acc[i, 2]
+    first = start if use_idx else i + 1
+    for b in range(first, nm):
+        j = int(idx[b]) if use_idx else b
+        dx = r[j, 0] - xi
+        dy = r[j, 1] - yi
+        dz = r[j, 2] - zi
+        d2 = dx * dx + dy * dy + dz * dz
+        inv3 = 1.0 / (d2 * np.sqrt(d2))
+        fi = gm[j] * inv3
+        fj = gi * inv3
+        ax += fi * dx
+        ay += fi * dy
+        az += fi * dz
+        acc[j, 0] -= fj * dx
+        acc[j, 1] -= fj * dy
+        acc[j, 2] -= fj * dz
+    acc[i, 0] = ax
+    acc[i, 1] = ay
+    acc[i, 2] = az
 
 
 @njit(cache=True)
@@ -54,35 +102,7 @@ def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
         acc[k, 2] = 0.0
     nm = idx.shape[0]
     for a in range(nm):
-        i = idx[a]
-        # body i's sum kept in registers (j != i: the compiler cannot know that
-        # acc[i] and acc[j] differ and would store and reload it every pair);
-        # the same additions in the same order
-        xi = r[i, 0]
-        yi = r[i, 1]
-        zi = r[i, 2]
-        gi = gm[i]
-        ax = acc[i, 0]
-        ay = acc[i, 1]
-        az = acc[i, 2]
-        for b in range(a + 1, nm):
-            j = idx[b]
-            dx = r[j, 0] - xi
-            dy = r[j, 1] - yi
-            dz = r[j, 2] - zi
-            d2 = dx * dx + dy * dy + dz * dz
-            inv3 = 1.0 / (d2 * np.sqrt(d2))
-            fi = gm[j] * inv3
-            fj = gi * inv3
-            ax += fi * dx
-            ay += fi * dy
-            az += fi * dz
-            acc[j, 0] -= fj * dx
-            acc[j, 1] -= fj * dy
-            acc[j, 2] -= fj * dz
-        acc[i, 0] = ax
-        acc[i, 1] = ay
-        acc[i, 2] = az
+        _massive_row(r, gm, idx[a], acc, a + 1, nm, True, idx)
     if nm == n - first:
         return
     for k in range(first, n):
