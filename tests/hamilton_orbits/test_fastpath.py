@@ -182,3 +182,31 @@ def test_one_orbit_vectors_beyond_float64_are_named():
     for name in ("areal_vector", "eccentricity_vector", "hamilton_epsilon"):
         with pytest.raises(ValueError, match=r"`r`, `v`, `mu` .*fits? in float64"):
             getattr(o, name)
+
+
+def test_check_copy_state_counts_exactly_the_invalid_rows():
+    """The branch-free validity test of the batch copy: every non-finite entry,
+    ``mu <= 0`` and ``r = 0`` are counted, extreme finite values are not (0 * x
+    stays 0 for x = +-1.7e308 and for subnormals), and the copy is exact."""
+    r, v = _states(64)
+    mu = np.full(64, 2.0)
+    r[2], v[3] = [1.7e308, -1.7e308, 5e-324], [-1.7e308, 0.0, 5e-324]  # finite: valid
+    bad_rows = []
+    for k, x in enumerate([np.nan, np.inf, -np.inf]):
+        for col in range(7):
+            row = 4 + 7 * k + col
+            bad_rows.append(row)
+            if col < 3:
+                r[row, col] = x
+            elif col < 6:
+                v[row, col - 3] = x
+            else:
+                mu[row] = x
+    mu[30], mu[31], r[32] = 0.0, -1.0, 0.0
+    bad_rows += [30, 31, 32]
+    outs = np.empty_like(r), np.empty_like(v), np.empty_like(mu)
+    assert _el.check_copy_state(r, v, mu, *outs) == len(bad_rows) == 24
+    for got, want in zip(outs, (r, v, mu), strict=True):
+        np.testing.assert_array_equal(got, want)
+    ok = np.setdiff1d(np.arange(64), bad_rows)
+    assert _el.check_copy_state(r[ok], v[ok], mu[ok], *(x[ok] for x in outs)) == 0

@@ -524,14 +524,11 @@ def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - comp
         v_out[i, 1] = vy
         v_out[i, 2] = vz
         mu_out[i] = m
-        ok = (
-            math.isfinite(rx) and math.isfinite(ry) and math.isfinite(rz)
-            and math.isfinite(vx) and math.isfinite(vy) and math.isfinite(vz)
-            and math.isfinite(m) and m > 0.0
-            and (rx != 0.0 or ry != 0.0 or rz != 0.0)
-        )
-        if not ok:
-            bad += 1
+        # without branches (so that the loop vectorises): 0 * x is +-0 for a
+        # finite x and NaN for inf or NaN, so the sum z is 0 iff all are finite
+        z = (rx * 0.0 + ry * 0.0 + rz * 0.0) + (vx * 0.0 + vy * 0.0 + vz * 0.0) + m * 0.0
+        ok = (z == 0.0) & (m > 0.0) & ((rx != 0.0) | (ry != 0.0) | (rz != 0.0))
+        bad += np.int64(not ok)
     return bad
 
 
