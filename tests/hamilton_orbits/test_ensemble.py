@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import pytest
 
@@ -84,3 +85,13 @@ def test_ensemble_command(tmp_path, capsys):
     exact = df["exact flip interval 2K(m)/lambda [s]"]
     assert (abs(df["simulated flip interval [s]"] / exact - 1) < 1e-8).all()
     assert main(["ensemble", "dzhanibekov", "--vary", "duration"]) == 2
+
+
+def test_dask_option_without_dask_names_the_extra(monkeypatch, capsys):
+    """Dask is an extra: without it `--dask` says which one to install (None in
+    sys.modules makes the import fail as if the package were absent)."""
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    code = main(["ensemble", "dzhanibekov", "--vary", "duration=40 s", "--dask", "local",
+                 "--no-progress"])
+    assert code != 0
+    assert "pip install 'hamilton-orbits[dask]'" in capsys.readouterr().err
