@@ -50,7 +50,7 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
         acc[k, 0] = 0.0
         acc[k, 1] = 0.0
         acc[k, 2] = 0.0
-    for i in range(n):
+    for i in range(n):  # j = i + 1 .. n - 1 (``start`` and ``idx`` unused: gm stands in)
         _massive_row(r, gm, i, acc, n, n, False, gm)
 
 
