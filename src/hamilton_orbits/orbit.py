@@ -73,8 +73,9 @@ _V = "km / s"
 _MU = "km3 / s2"
 _RAD = "rad"
 
-# _elements: the CLASSICAL columns (p, e, inv_a, inc, lan, argp, nu, u, kind, a);
-# _full: all COLUMNS (the anomaly, M and tau too), computed when one is asked for
+# _elements: the CLASSICAL columns (p, e, inv_a, inc, lan, argp, nu, a);
+# _full: all COLUMNS (u, the anomaly, M and tau too), computed when one is asked
+# for; _kind: the kind column derived from the classical ones (_columns.kind_of)
 _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
 _F64 = np.dtype(np.float64)
@@ -588,7 +589,21 @@ class KeplerOrbit:
                              self._mu.reshape(-1), self._mu.shape)
         return out.reshape((*self._mu.shape, _columns.NCOL))
 
+    @cached_property
+    def _kind(self) -> np.ndarray:
+        # _columns.kind_of on every orbit (the kind column of _full, bit for bit)
+        p, e, inv_a, nu = (self._col(n) for n in ("p", "e", "inv_a", "nu"))
+        radial = np.where(
+            inv_a > 0.0, _el.RADIAL_ELLIPSE, np.where(inv_a < 0.0, _el.RADIAL_HYPERBOLA, np.where(
+                (p == 0.0) & (nu == math.pi), _el.RADIAL_PARABOLA, _el.PARABOLA)))
+        return np.where(e < 1.0, _el.ELLIPSE, np.where(e > 1.0, _el.HYPERBOLA, radial))
+
     def _col(self, name: str) -> np.ndarray:
+        if name == "kind":
+            kind = self.__dict__.get("_kind")
+            if kind is None:
+                kind = self.__dict__["_kind"] = KeplerOrbit._kind.func(self)
+            return kind
         i = _CI.get(name)
         if i is not None:
             el = self.__dict__.get("_elements")
@@ -777,7 +792,7 @@ class KeplerOrbit:
         c = self._c1
         if c is None and (c := self._one_classical()) is None:
             return None
-        kind = c[8]
+        kind = _columns.kind_of(c[0], c[1], c[2], c[6])
         if kind == _columns.PARABOLA or kind == _columns.RADIAL_PARABOLA:
             return None
         inv = abs(c[2])
@@ -800,7 +815,7 @@ class KeplerOrbit:
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
         c = self._c1
         if c is not None or (c := self._one_classical()) is not None:
-            kind = c[8]
+            kind = _columns.kind_of(c[0], c[1], c[2], c[6])
             if kind != _columns.ELLIPSE and kind != _columns.RADIAL_ELLIPSE:
                 return _f64(math.inf)
             n = self._n_one()
