@@ -193,7 +193,7 @@ def bench_throughput(n: int, repeat: int, rounds: int) -> None:
     r, v = _states(n, seed=1)
     mu = np.ones(n)
     out6 = np.empty((n, 6))
-    out = np.empty((n, _el.NCOL + 1))  # the classical columns and a
+    out = np.empty((n, _el.NCLASSICAL))  # the classical columns (a the last)
 
     def ours():
         o = KeplerOrbit.from_state(r, v, mu)

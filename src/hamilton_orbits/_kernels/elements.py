@@ -57,6 +57,7 @@ from hamilton_orbits._kernels.kepler import (
     nu_from_anomaly,
     sinh_minus_x,
     solve,
+    state_in_safe_range,
     state_scales,
     x_minus_sin,
 )
@@ -431,7 +432,8 @@ def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
 # constant flags (the classical columns): the branches on ``accurate`` and
 # ``full`` then fold away and the tuple never leaves registers.  Measured on one
 # thread, 1e6 orbits against the minimal kernel of benchmarks/bench_overhead.py:
-# 1.06x inlined against 1.17x as a call.
+# 1.06x inlined against 1.17x as a call; with the range test inline and the
+# scaling path a call only where the test fails, 1.035x.
 _elements_one_inlined = njit(inline="always")(state_to_elements_one.py_func)
 
 
@@ -446,26 +448,14 @@ def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
     the general path, which names the arguments.  So nothing out of this kernel
     needs a floating-point-error guard.
     """
-    # the scaling of state_to_elements_scaled, written out around the inlined call
-    er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
-    if not ok:  # e beyond 2^MAX_E_EXPONENT: NaN row, refused by the caller
-        nan = math.nan
-        return nan, nan, nan, nan, nan, nan, nan, nan
-    scaled = er != 0 or ev != 0
-    if scaled:
-        rx = math.ldexp(rx, -er)
-        ry = math.ldexp(ry, -er)
-        rz = math.ldexp(rz, -er)
-        vx = math.ldexp(vx, -ev)
-        vy = math.ldexp(vy, -ev)
-        vz = math.ldexp(vz, -ev)
-        mu = math.ldexp(mu, -er - 2 * ev)
-    p, e, inv_a, inc, lan, argp, nu, _anom, _m, _u, kind, _tau = _elements_one_inlined(
-        rx, ry, rz, vx, vy, vz, mu, False, False
-    )
-    if scaled:
-        p = math.ldexp(p, er)
-        inv_a = math.ldexp(inv_a, -er)
+    if state_in_safe_range(rx, ry, rz, vx, vy, vz, mu):  # the common case: inlined
+        p, e, inv_a, inc, lan, argp, nu, _anom, _m, _u, kind, _tau = _elements_one_inlined(
+            rx, ry, rz, vx, vy, vz, mu, False, False
+        )
+    else:  # scaled first (a NaN row if e is beyond 2^MAX_E_EXPONENT): a call
+        p, e, inv_a, inc, lan, argp, nu, _anom, _m, _u, kind, _tau = state_to_elements_scaled(
+            rx, ry, rz, vx, vy, vz, mu, False, False
+        )
     if inv_a == 0.0:
         a = math.inf if kind == PARABOLA or kind == RADIAL_PARABOLA else math.nan
     else:
