@@ -210,3 +210,68 @@ def test_check_copy_state_counts_exactly_the_invalid_rows():
         np.testing.assert_array_equal(got, want)
     ok = np.setdiff1d(np.arange(64), bad_rows)
     assert _el.check_copy_state(r[ok], v[ok], mu[ok], *(x[ok] for x in outs)) == 0
+
+
+def _kind_states() -> tuple[np.ndarray, np.ndarray]:
+    """Random states and one of every kind: circle, radial ellipse, parabola,
+    radial parabola, radial hyperbola, quasi-rectilinear ellipse, hyperbola,
+    and states the kernel scales (1e200, 1e-300)."""
+    r, v = _states(400, seed=11)
+    extra = [
+        ([1.0, 0.0, 0.0], [0.5, 0.0, 0.0]),  # radial ellipse
+        ([1.0, 0.0, 0.0], [2.0**0.5, 0.0, 0.0]),  # radial parabola
+        ([1.0, 0.0, 0.0], [3.0, 0.0, 0.0]),  # radial hyperbola
+        ([1.0, 0.0, 0.0], [0.0, 2.0**0.5, 0.0]),  # parabola
+        ([1.0, 0.0, 0.0], [1.0, 1e-17, 0.0]),  # quasi-rectilinear (e = 1, 1/a > 0)
+        ([1.0, 0.0, 0.0], [0.0, 3.0, 0.3]),  # hyperbola
+        ([1e200, 0.0, 0.0], [0.0, 1e-100, 0.0]),  # scaled: a circle, a = 1e200
+        ([1e-300, 0.0, 0.0], [1e-50, 2.0**0.5 * 1e150, 0.0]),  # scaled parabola
+    ]
+    return (np.vstack([r, [x[0] for x in extra]]), np.vstack([v, [x[1] for x in extra]]))
+
+
+def test_kind_derived_from_the_classical_columns_equals_the_kernel_kind():
+    """The batch stores no kind column: ``_columns.kind_of`` (and its numpy form
+    in ``KeplerOrbit._kind``) derives it from p, e, 1/a, nu, bit for bit the
+    kind the full kernel decides, for every kind of conic."""
+    from hamilton_orbits._columns import kind_of
+
+    r, v = _kind_states()
+    full = np.empty((len(r), _el.NCOL))
+    _el.state_to_elements(r, v, np.ones(len(r)), full)
+    kernel_kind = full[:, _el.COLUMNS.index("kind")]
+    assert set(np.unique(kernel_kind)) == {0.0, 1.0, 2.0, 3.0, 4.0, 5.0}  # all six kinds
+    o = KeplerOrbit.from_state(r, v, 1.0)
+    np.testing.assert_array_equal(o._kind, kernel_kind)
+    c = [full[:, _el.COLUMNS.index(n)] for n in ("p", "e", "inv_a", "nu")]
+    assert [kind_of(*row) for row in zip(*c, strict=True)] == kernel_kind.tolist()
+    assert "_full" not in o.__dict__  # derived without the full kernel
+
+
+def test_parabola_with_underflowed_p_is_not_radial():
+    """A parabola nearly along its axis at |r| = 1e-300 has p = h^2/mu below the
+    smallest subnormal (p = 0) without being radial (h > 8 eps |r| |v|): the
+    derived kind keeps it a parabola, as the kernel does (nu is not pi)."""
+    from hamilton_orbits._columns import PARABOLA
+
+    r = np.array([[1e-300, 0.0, 0.0]])
+    v = np.array([[2.0**0.5 * 1e150, 1e137, 0.0]])  # h = 1e-163: p ~ 1e-326 -> 0
+    full = np.empty((1, _el.NCOL))
+    _el.state_to_elements(r, v, np.ones(1), full)
+    names = ("p", "e", "inv_a", "nu", "kind")
+    p, e, inv_a, nu, kind = (full[0, _el.COLUMNS.index(n)] for n in names)
+    assert p == 0.0 and e == 1.0 and inv_a == 0.0 and nu != np.pi and kind == PARABOLA
+    assert KeplerOrbit.from_state(r, v, 1.0)._kind[0] == PARABOLA
+
+
+def test_argument_of_latitude_comes_from_the_full_kernel():
+    """u is not a column of the classical kernel: read, it comes from the full
+    kernel, bit for bit its u column (atan2 from the position, not argp + nu)."""
+    r, v = _kind_states()
+    full = np.empty((len(r), _el.NCOL))
+    _el.state_to_elements(r, v, np.ones(len(r)), full)
+    o = KeplerOrbit.from_state(r, v, 1.0)
+    o.e  # the classical columns first  # noqa: B018
+    np.testing.assert_array_equal(o.argument_of_latitude, full[:, _el.COLUMNS.index("u")])
+    one = KeplerOrbit.from_state(r[0].tolist(), v[0].tolist(), 1.0)
+    assert one.argument_of_latitude == full[0, _el.COLUMNS.index("u")]
