@@ -13,12 +13,12 @@ class ConvergenceError(ValueError):
     """An iterative solver did not reach its tolerance (never a silent NaN)."""
 
 
-def _first_index(mask: np.ndarray) -> tuple[int, ...]:
+def first_index(mask: np.ndarray) -> tuple[int, ...]:
     idx = np.argwhere(mask)[0]
     return tuple(int(i) for i in idx)
 
 
-def _fmt_index(index: tuple[int, ...]) -> str:
+def fmt_index(index: tuple[int, ...]) -> str:
     if len(index) == 0:
         return ""
     return " at index " + (str(index[0]) if len(index) == 1 else str(index))
@@ -69,9 +69,9 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     if finite:
         bad = ~np.isfinite(arr)
         if bad.any():
-            index = _first_index(bad) if arr.ndim else ()
+            index = first_index(bad) if arr.ndim else ()
             raise ValueError(
-                f"Expected `{name}` to be finite, got {float(arr[index])!r}{_fmt_index(index)}"
+                f"Expected `{name}` to be finite, got {float(arr[index])!r}{fmt_index(index)}"
             )
     return arr
 
@@ -103,10 +103,10 @@ def check_positive(name: str, arr: np.ndarray, *, strict: bool = True) -> np.nda
     """
     bad = ~(arr > 0) if strict else ~(arr >= 0)
     if np.any(bad):
-        index = _first_index(np.atleast_1d(bad)) if arr.ndim else ()
+        index = first_index(np.atleast_1d(bad)) if arr.ndim else ()
         value = arr[index] if arr.ndim else arr
         op = ">" if strict else ">="
-        raise ValueError(f"Expected `{name}` {op} 0, got {float(value)!r}{_fmt_index(index)}")
+        raise ValueError(f"Expected `{name}` {op} 0, got {float(value)!r}{fmt_index(index)}")
     return arr
 
 
@@ -189,12 +189,12 @@ def check_finite_result(
     if not bad.any():
         return result
     lead = np.any(bad, axis=-1)
-    index = _first_index(lead) if lead.ndim else ()
+    index = first_index(lead) if lead.ndim else ()
     got = ""
     if value is not None:
         v = np.asarray(value, dtype=np.float64)[index]
         shown = repr(float(v)) if v.ndim == 0 else np.array2string(v, separator=", ")
         got = f", got {shown}"
     raise ValueError(
-        f"Expected `{name}` to keep {what} finite{got}{_fmt_index(index)}: it overflows"
+        f"Expected `{name}` to keep {what} finite{got}{fmt_index(index)}: it overflows"
     )

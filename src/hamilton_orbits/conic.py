@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import _first_index, _fmt_index, check_trailing
+from hamilton_orbits._validation import check_trailing, first_index, fmt_index
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 
 __all__ = ["Conic"]
@@ -254,12 +254,12 @@ class Conic:
         if np.any(bad):
             e_b = np.broadcast_to(self.e, bad.shape)
             nu_b = np.broadcast_to(nu, bad.shape)
-            i = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             e_i = float(e_b[i])
             lim = np.arccos(-1.0 / e_i) if e_i > 0 else np.pi
             raise ValueError(
                 f"Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = {lim:.7g} rad "
-                f"(e = {e_i!r}), got {float(nu_b[i])!r}{_fmt_index(i)}"
+                f"(e = {e_i!r}), got {float(nu_b[i])!r}{fmt_index(i)}"
             )
         return self._out(self._p / den, _L)
 
@@ -273,12 +273,12 @@ class Conic:
         bad = ~((r >= q * (1.0 - tol)) & (r <= big * (1.0 + tol)) & (r > 0.0))
         if np.any(bad):
             q_b, big_b, r_b = np.broadcast_arrays(q, big, r)
-            i = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             unit = f" {_L}" if self._quantity else ""
             raise ValueError(
                 f"Expected `r` on the conic, q <= r <= Q with the periapsis distance "
                 f"q = {float(q_b[i]):.17g} and the apoapsis distance Q = {float(big_b[i]):.17g}"
-                f"{unit}, got {float(r_b[i])!r}{unit}{_fmt_index(i)}"
+                f"{unit}, got {float(r_b[i])!r}{unit}{fmt_index(i)}"
             )
         return r
 
@@ -361,10 +361,10 @@ class Conic:
         r = check_trailing("r", self._in("r", r, _L), 3)
         nonzero = np.any(r != 0, axis=-1)
         if not np.all(nonzero):
-            i = _first_index(np.atleast_1d(~nonzero)) if nonzero.ndim else ()
+            i = first_index(np.atleast_1d(~nonzero)) if nonzero.ndim else ()
             raise ValueError(
                 f"Expected `r` a nonzero position (the direction of the radius vector), "
-                f"got {r[i].tolist()}{_fmt_index(i)}"
+                f"got {r[i].tolist()}{fmt_index(i)}"
             )
         self._require_areal("hodograph")
         big = np.max(np.abs(r), axis=-1, keepdims=True)  # |r| without under/overflow

@@ -35,11 +35,11 @@ from hamilton_orbits import kepler as _kepler
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
     ConvergenceError,
-    _first_index,
-    _fmt_index,
     broadcast,
     check_positive,
     check_trailing,
+    first_index,
+    fmt_index,
 )
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import (
@@ -90,10 +90,10 @@ def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> Non
     if np.any(mask):
         mask = np.atleast_1d(mask)
         values = np.broadcast_to(np.atleast_1d(values), mask.shape)
-        index = _first_index(mask)
+        index = first_index(mask)
         shown = index if np.ndim(mask) and mask.size > 1 else ()
         raise ValueError(
-            f"Expected `{name}` {what}, got {float(values[index])!r}{_fmt_index(shown)}"
+            f"Expected `{name}` {what}, got {float(values[index])!r}{fmt_index(shown)}"
         )
 
 
@@ -119,8 +119,8 @@ def _check_state(r_in: Any, v_in: Any, mu_in: Any):
     mu = np.broadcast_to(mu, lead)
     bad = ~np.any(r != 0, axis=-1)  # not |r| > 0: |r|^2 underflows at 1e-170
     if np.any(bad):
-        index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
-        raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{_fmt_index(index)}")
+        index = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+        raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{fmt_index(index)}")
     return r, v, mu, quantity
 
 
@@ -240,12 +240,12 @@ def _in_range(prop):
                 allowed = allowed[..., None]
             bad = ~finite & ~(np.isinf(raw) & allowed)
             if np.any(bad):
-                i = _first_index(np.atleast_1d(bad))[: kind.ndim] if kind.ndim else ()
+                i = first_index(np.atleast_1d(bad))[: kind.ndim] if kind.ndim else ()
                 r, v = self._r[i], self._v[i]
                 raise ValueError(
                     f"Expected `r`, `v`, `mu` for which `{name}` fits in float64, got "
                     f"r={r.tolist()}, v={v.tolist()}, mu={float(self._mu[i])!r}"
-                    f"{_fmt_index(i)}"
+                    f"{fmt_index(i)}"
                 )
         return value
 
@@ -530,10 +530,10 @@ class KeplerOrbit:
                 anom = np.asarray(_kk.solve_ufunc(ang_, np.where(radial, 0.0, e_)))
             bad = ~np.isfinite(anom) & ~radial
             if np.any(bad):
-                index = _first_index(np.atleast_1d(bad))
+                index = first_index(np.atleast_1d(bad))
                 raise ConvergenceError(
                     f"Kepler's equation not solved for `M` = "
-                    f"{float(np.atleast_1d(ang_)[index])!r}{_fmt_index(index if bad.ndim else ())}"
+                    f"{float(np.atleast_1d(ang_)[index])!r}{fmt_index(index if bad.ndim else ())}"
                 )
         el = np.stack(
             [p_ * 1.0, e_ * 1.0, inv_a * 1.0, inc_, lan_, argp_, np.where(radial, 0.0, anom)],
@@ -1058,7 +1058,7 @@ def _refuse_beyond_range(out, r, v, mu, shape) -> None:
     if not np.any(rows):
         return
     i = int(np.flatnonzero(rows)[0])
-    where = _fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
+    where = fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
     raise ValueError(
         f"Expected `r`, `v`, `mu` whose elements fit in float64 (|r| |v|^2 / mu ~ e below "
         f"2^450 ~ 3e135, p and a below 1e308), got r={r[i].tolist()}, v={v[i].tolist()}, "

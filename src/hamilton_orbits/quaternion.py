@@ -45,11 +45,11 @@ import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import (
-    _first_index,
     as_float_array,
     broadcast_shapes,
     check_finite_result,
     check_trailing,
+    first_index,
 )
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, is_quantity
 
@@ -81,7 +81,7 @@ def _sinc(t: np.ndarray) -> np.ndarray:
 def _raise_zero(name: str, n: np.ndarray, what: str) -> None:
     bad = n == 0
     if np.any(bad):
-        index = _first_index(np.atleast_1d(bad)) if n.ndim else ()
+        index = first_index(np.atleast_1d(bad)) if n.ndim else ()
         where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
         raise ValueError(f"Expected `{name}` to be a nonzero quaternion{where}: {what}")
 
@@ -367,7 +367,7 @@ class Quaternion:
             det = np.linalg.det(m)
         bad = ~(err <= 1e-6) | ~(det > 0)
         if np.any(bad):
-            index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            index = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
             raise ValueError(
                 f"Expected `matrix` to be a rotation matrix{where}: "
@@ -505,7 +505,7 @@ class Quaternion:
             g = self._a[..., 1:] / self._a[..., :1]  # scale-free: one rounding
         bad = ~np.all(np.isfinite(g), axis=-1)
         if np.any(bad):
-            index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            index = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
             raise ValueError(
                 f"Expected `self` not to be a half-turn: its Gibbs vector (Cayley's lambda, mu, "

@@ -11,7 +11,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.report import Row, _log, _timed
+from hamilton_orbits.report import Row, log, timed
 
 
 def problems() -> list[tuple[str, Any]]:
@@ -54,7 +54,7 @@ def _rigid(quick: bool, progress: bool) -> list[Row]:
     body = RigidBody([1.0, 2.0, 3.0], omega=[0.001, 2.0, 0.001])
     n_out = round(duration / 0.01) + 1
     t = np.linspace(0.0, duration, n_out)
-    wt, (q_ref, _) = _timed(lambda: free_motion(body, t))
+    wt, (q_ref, _) = timed(lambda: free_motion(body, t))
     rows.insert(0, Row(name, "hamilton-orbits", "exact (free_motion)", f"{n_out} epochs", 0.0,
                        measure, reference + " (is the reference)", wt))
 
@@ -63,11 +63,11 @@ def _rigid(quick: bool, progress: bool) -> list[Row]:
 
     integrate(body, 1.0, method="dop853", n_out=2)
     for rtol in (1e-6, 1e-9, 1e-12):
-        wt, tr = _timed(lambda rtol=rtol: integrate(body, duration, method="dop853",
+        wt, tr = timed(lambda rtol=rtol: integrate(body, duration, method="dop853",
                                                     n_out=n_out, rtol=rtol, atol=rtol * 1e-3))
         rows.append(Row(name, "scipy (rigid.integrate)", "dop853", f"rtol = {rtol:g}", err(tr),
                         measure, reference, wt))
-    _log(progress, f"{name}: {len(rows)} rows")
+    log(progress, f"{name}: {len(rows)} rows")
     return rows
 
 
@@ -91,7 +91,7 @@ def _pole(quick: bool, progress: bool) -> list[Row]:
     integrate(body, 24 * hour, dt=hour, method="splitting4", n_out=2)
     integrate(body, hour, method="dop853", n_out=2)
 
-    wt, (_, w_ex) = _timed(lambda: free_motion(body, t_days))
+    wt, (_, w_ex) = timed(lambda: free_motion(body, t_days))
     m_ex = pole_path(w_ex)
 
     def err(tr: Any) -> float:
@@ -100,17 +100,17 @@ def _pole(quick: bool, progress: bool) -> list[Row]:
     rows = [Row(name, "hamilton-orbits", "exact (free_motion)", f"{n_days + 1} days", 0.0,
                 measure, reference + " (is the reference)", wt)]
     for dt_h in (24.0, 6.0) if quick else (24.0, 6.0, 1.0):
-        wt, tr = _timed(lambda dt_h=dt_h: integrate(body, t_end, dt=dt_h * hour,
+        wt, tr = timed(lambda dt_h=dt_h: integrate(body, t_end, dt=dt_h * hour,
                                                     method="splitting4", n_out=n_days + 1))
         rows.append(Row(name, "hamilton-orbits", "splitting4", f"dt = {dt_h:g} h", err(tr),
                         measure, reference, wt))
     for rtol in (1e-9,) if quick else (1e-9, 1e-12):
-        wt, tr = _timed(lambda rtol=rtol: integrate(body, t_end, method="dop853",
+        wt, tr = timed(lambda rtol=rtol: integrate(body, t_end, method="dop853",
                                                     n_out=n_days + 1, rtol=rtol,
                                                     atol=rtol * 1e-3), 1)
         rows.append(Row(name, "scipy (rigid.integrate)", "DOP853", f"rtol = {rtol:g}", err(tr),
                         measure, reference, wt))
-    _log(progress, f"{name}: {len(rows)} rows")
+    log(progress, f"{name}: {len(rows)} rows")
     return rows
 
 

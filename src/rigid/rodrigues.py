@@ -46,7 +46,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import _first_index, as_float_array, check_trailing
+from hamilton_orbits._validation import as_float_array, check_trailing, first_index
 from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
 from rigid._kernels import euler as _k
 
@@ -223,7 +223,7 @@ def direction_cosines(gibbs: Any) -> np.ndarray:
 def _check_pi(pi: np.ndarray, what: str, names: tuple[str, str]) -> None:
     bad = ~(np.abs(pi) > 0.0)
     if np.any(bad):
-        index = _first_index(np.atleast_1d(bad)) if bad.ndim else ()
+        index = first_index(np.atleast_1d(bad)) if bad.ndim else ()
         where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
         raise ValueError(
             f"Expected `{names[0]}`, `{names[1]}` whose {what} is not a half-turn, got "

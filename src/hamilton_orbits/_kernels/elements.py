@@ -51,7 +51,6 @@ from hamilton_orbits._columns import (  # noqa: F401  (re-exported)
 )
 from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
-    _two_prod,
     anomaly_from_nu,
     mean_from_anomaly,
     nu_from_anomaly,
@@ -59,6 +58,7 @@ from hamilton_orbits._kernels.kepler import (
     solve,
     state_in_safe_range,
     state_scales,
+    two_prod,
     x_minus_sin,
 )
 
@@ -165,9 +165,9 @@ def _dot3_compensated(ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
     Dekker's splitting, TwoSum of the products, then the errors added.  Near
     periapsis r.v cancels (r is nearly perpendicular to v); this keeps its
     relative accuracy."""
-    p1, e1 = _two_prod(ax, bx)
-    p2, e2 = _two_prod(ay, by)
-    p3, e3 = _two_prod(az, bz)
+    p1, e1 = two_prod(ax, bx)
+    p2, e2 = two_prod(ay, by)
+    p3, e3 = two_prod(az, bz)
     s = p1 + p2
     z = s - p1
     t = (p1 - (s - z)) + (p2 - z)

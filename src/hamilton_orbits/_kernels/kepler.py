@@ -92,7 +92,7 @@ def _reduce_2pi(x):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _two_prod(a, b):  # pragma: no cover - compiled
+def two_prod(a, b):  # pragma: no cover - compiled
     """Dekker's exact product: ``a * b = p + err`` exactly (no overflow assumed)."""
     p = a * b
     c = 134217729.0 * a
@@ -747,7 +747,7 @@ def propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - c
         period = TWO_PI_HI / (smu * alpha * sa)
         if abs(t) > 0.5 * period:
             k = math.floor(t / period + 0.5)
-            p, err = _two_prod(k, period)
+            p, err = two_prod(k, period)
             t = (t - p) - err
     tau = smu * t
     hx = ry * vz - rz * vy
