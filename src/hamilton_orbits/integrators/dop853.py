@@ -47,10 +47,8 @@ def run(
     >>> bool(np.allclose(r[-1, 1], [1, 0, 0], atol=1e-9))
     True
     """
-    from scipy.integrate import solve_ivp
-
     # scipy refuses rtol below 100 eps (with a warning); that is DOP853's floor here
-    tol = max(DEFAULT_TOL if tol is None else float(tol), 100 * np.finfo(float).eps)
+    tol = max(DEFAULT_TOL if tol is None else float(tol), RTOL_FLOOR)
     n = r0.shape[0]
     accel = rhs.accel
     acc = np.empty((n, 3))
@@ -62,32 +60,82 @@ def run(
         return np.concatenate((y[3 * n :], acc.ravel()))
 
     atol = tol * np.concatenate((_body_scale(r0), _body_scale(v0)))
-    out_r = np.empty((len(t_out), n, 3))
-    out_v = np.empty_like(out_r)
-    out_r[0] = r0
-    out_v[0] = v0
-    y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
-    steps = 0
+    y0 = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
+    y, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol,
+                        max_step=np.inf if dt is None else float(dt), on_output=on_output)
+    return y[:, : 3 * n].reshape(-1, n, 3), y[:, 3 * n :].reshape(-1, n, 3), steps
+
+
+#: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.
+RTOL_FLOOR = 100 * np.finfo(float).eps
+
+
+def solve(
+    f: Callable[[float, np.ndarray], np.ndarray],
+    y0: np.ndarray,
+    t_out: np.ndarray,
+    *,
+    rtol: float,
+    atol: Any,
+    max_step: float = np.inf,
+    on_output: Callable[[int, int], None] | None = None,
+) -> tuple[np.ndarray, int, int]:
+    """The one DOP853 driver of both packages: ``y' = f(t, y)`` from ``y0`` at
+    ``t_out[0]``, restarted at each output time (so that an output is a step end,
+    not an interpolation).
+
+    Parameters
+    ----------
+    f : callable
+        ``f(t, y) -> dy/dt`` on float64 arrays of shape (m,).
+    y0 : ndarray, shape (m,)
+    t_out : ndarray, shape (n_t,)
+        Output times, monotonic; ``t_out[0]`` is the start.
+    rtol, atol : float or ndarray
+        scipy's tolerances (``rtol`` at least :data:`RTOL_FLOOR`).
+    max_step : float
+        A cap on the step.
+    on_output : callable, optional
+        ``on_output(i, steps)`` after output ``i``.
+
+    Returns
+    -------
+    y : ndarray, shape (n_t, m)
+        The state at each output time (row 0 is ``y0``).
+    steps, nfev : int
+        Accepted steps and right-hand-side evaluations.
+
+    Raises
+    ------
+    ValueError
+        If scipy reports a failure, naming the interval.
+
+    Examples
+    --------
+    >>> y, steps, nfev = solve(lambda t, y: -y, np.array([1.0]), np.array([0.0, 1.0]),
+    ...                        rtol=1e-12, atol=1e-14)
+    >>> bool(abs(y[-1, 0] - np.exp(-1.0)) < 1e-12)
+    True
+    """
+    from scipy.integrate import solve_ivp
+
+    y_out = np.empty((len(t_out), len(y0)))
+    y_out[0] = y0
+    y = np.asarray(y0, dtype=np.float64)
+    steps = nfev = 0
     for i in range(1, len(t_out)):
-        sol = solve_ivp(
-            f,
-            (float(t_out[i - 1]), float(t_out[i])),
-            y,
-            method="DOP853",
-            rtol=tol,
-            atol=atol,
-            max_step=np.inf if dt is None else float(dt),
-        )
+        sol = solve_ivp(f, (float(t_out[i - 1]), float(t_out[i])), y, method="DOP853",
+                        rtol=max(float(rtol), RTOL_FLOOR), atol=atol, max_step=max_step)
         if not sol.success:
             raise ValueError(f"dop853 failed between t = {t_out[i - 1]} and {t_out[i]}: "
                              f"{sol.message}")
         y = sol.y[:, -1]
         steps += max(len(sol.t) - 1, 0)
-        out_r[i] = y[: 3 * n].reshape(n, 3)
-        out_v[i] = y[3 * n :].reshape(n, 3)
+        nfev += int(sol.nfev)
+        y_out[i] = y
         if on_output is not None:
             on_output(i, steps)
-    return out_r, out_v, steps
+    return y_out, steps, nfev
 
 
 def _body_scale(x: np.ndarray) -> np.ndarray:
