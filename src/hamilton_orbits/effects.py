@@ -65,12 +65,23 @@ class EffectSpec:
     parameters : Mapping[str, str]
         Parameter name -> description, for validation and documentation.
     build : callable or None
-        Kind-specific builder; for ``"nbody"``: ``build(system, params)`` returns
-        a compiled ``f(r, v, gm, acc)`` adding the effect's acceleration, where
-        ``system`` is a :class:`~hamilton_orbits.nbody.System` and ``params`` the
-        effect's mapping without its ``"name"``.
+        Kind-specific builder (``"rotation"`` effects: a model from keyword
+        parameters).
     reference : str
         The source of the model (paper, equation).
+    kernel : numba dispatcher or None
+        ``"nbody"`` effects: a module-level compiled ``kernel(r, v, gm, acc, p)``
+        that *adds* the effect's acceleration to ``acc`` (float64 arrays (n, 3),
+        (n, 3), (n,), (n, 3)); ``p`` is the effect's own float64 parameter vector.
+    params : callable or None
+        ``"nbody"`` effects: ``params(system, mapping) -> ndarray`` (1-d float64),
+        the parameter vector ``p`` for ``system`` (a
+        :class:`~hamilton_orbits.nbody.System`) from the effect's mapping without
+        its ``"name"``; raises ``ValueError`` for bad parameters.
+    replaces_newtonian : bool
+        True if ``kernel`` computes the whole point-mass interaction itself (as the
+        Einstein-Infeld-Hoffmann equations do): the Newtonian kernel is then left
+        out of the right-hand side.
     """
 
     name: str
@@ -80,6 +91,9 @@ class EffectSpec:
     parameters: Mapping[str, str] = field(default_factory=dict)
     build: Callable[..., Any] | None = None
     reference: str = ""
+    kernel: Any = None
+    params: Callable[..., np.ndarray] | None = None
+    replaces_newtonian: bool = False
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}
@@ -326,16 +340,18 @@ def _compile_cached(key: tuple, normal: tuple, system: Any) -> RHS:
         return _COMPILED[cache_key]
     adders = []
     velocity_dependent = False
+    newtonian = True
     for name, params in normal:
         spec = get("nbody", name)
-        if spec.build is None:
+        if spec.kernel is None or spec.params is None:
             raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
-        adders.append(spec.build(system, dict(params)))
+        adders.append(bind(spec.kernel, spec.params(system, dict(params))))
         velocity_dependent = velocity_dependent or spec.velocity_dependent
+        newtonian = newtonian and not spec.replaces_newtonian
     extra = adders[0]
     for adder in adders[1:]:
         extra = _chain(extra, adder)
-    accel = _chain(_nbody.newtonian, extra)
+    accel = _chain(_nbody.newtonian, extra) if newtonian else _chain(_nbody.zero, extra)
     rhs = RHS(accel, extra, velocity_dependent, ("newtonian",) + tuple(n for n, _ in normal))
     if len(_COMPILED) > 64:
         _COMPILED.clear()
@@ -387,19 +403,19 @@ def _speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> floa
     return value
 
 
-def _build_gr(system: Any, params: Mapping[str, Any]) -> Any:
+def _params_gr(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     s = _source_index(system, params, "source", "gr")
     c = _speed_of_light(system, params, "gr")
-    return bind(_nbody.gr_anderson, np.array([s, c]))
+    return np.array([s, c])
 
 
-def _build_gr_potential(system: Any, params: Mapping[str, Any]) -> Any:
+def _params_gr_potential(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     s = _source_index(system, params, "source", "gr_potential")
     c = _speed_of_light(system, params, "gr_potential")
-    return bind(_nbody.gr_potential, np.array([s, c]))
+    return np.array([s, c])
 
 
-def _build_j2(system: Any, params: Mapping[str, Any]) -> Any:
+def _params_j2(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     if "body" not in params:
         raise ValueError("Effect 'j2' needs the `body` whose oblateness acts, e.g. "
                          "{'name': 'j2', 'body': 'earth'}")
@@ -422,7 +438,7 @@ def _build_j2(system: Any, params: Mapping[str, Any]) -> Any:
     if not (np.isfinite(j2) and np.isfinite(radius) and radius > 0):
         raise ValueError(f"Effect 'j2': expected finite j2 and radius > 0, got {j2!r}, {radius!r}")
     pole = body.pole if body.pole is not None else (0.0, 0.0, 1.0)
-    return bind(_nbody.j2_field, np.array([b, j2, radius, *pole]))
+    return np.array([b, j2, radius, *pole])
 
 
 register(
@@ -435,7 +451,8 @@ register(
             "source": "the dominant body (default: the most massive)",
             "c": "speed of light (default: c in au/day for Quantity systems)",
         },
-        build=_build_gr,
+        kernel=_nbody.gr_anderson,
+        params=_params_gr,
         reference="Anderson et al. (1975), ApJ 200, 221; reboundx 'gr' (Tamayo et al. 2020)",
     )
 )
@@ -448,7 +465,8 @@ register(
             "source": "the dominant body (default: the most massive)",
             "c": "speed of light (default: c in au/day for Quantity systems)",
         },
-        build=_build_gr_potential,
+        kernel=_nbody.gr_potential,
+        params=_params_gr_potential,
         reference="Nobili & Roxburgh (1986), IAU Symp. 114, 105",
     )
 )
@@ -462,7 +480,8 @@ register(
             "j2": "J2 (default: the Body's j2)",
             "radius": "equatorial radius (default: the Body's radius)",
         },
-        build=_build_j2,
+        kernel=_nbody.j2_field,
+        params=_params_j2,
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )

@@ -171,7 +171,8 @@ def test_registry_plugs_in_new_effects():
     spec = fx.register(fx.EffectSpec(
         "constant_push", "nbody", "a uniform acceleration (test)",
         parameters={"g": "acceleration along x"},
-        build=lambda system, params: fx.bind(_push, np.array([params.get("g", 1.0)])),
+        kernel=_push,
+        params=lambda system, params: np.array([params.get("g", 1.0)]),
     ))
     try:
         s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])

@@ -32,6 +32,16 @@ def massive_indices(gm):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def zero(r, v, gm, acc):  # pragma: no cover - compiled
+    """Overwrites ``acc`` with zeros (the start of a right-hand side whose effects
+    compute the point-mass interaction themselves)."""
+    for k in range(acc.shape[0]):
+        acc[k, 0] = 0.0
+        acc[k, 1] = 0.0
+        acc[k, 2] = 0.0
+
+
+@njit(cache=True)
 def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     """Newtonian accelerations of equation (B); overwrites ``acc``.
 
