@@ -135,7 +135,7 @@ def median_ratio(ours, peer, repeat):
 
 
 def rhs():
-    from hamilton_orbits.effects import newtonian_rhs
+    from hamilton_orbits.rhs import newtonian_rhs
 
     return newtonian_rhs()
 
@@ -489,12 +489,13 @@ def bench_effects_cost(years: float, repeat: int) -> None:
     """effects=() against a Newtonian kernel written here, and the price of listed effects."""
     from numba import njit
 
-    from hamilton_orbits.effects import RHS, compile_rhs
+    from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
     from hamilton_orbits.integrators import radau15
     from hamilton_orbits.nbody import Body, System
+    from hamilton_orbits.rhs import RHS, compile_rhs
 
-    @njit
-    def plain_newton(r, v, gm, acc):  # gravity alone, written for this benchmark
+    @njit(ACCEL_SIGNATURE)
+    def plain_newton(r, v, gm, acc, p):  # gravity alone, written for this benchmark
         n = r.shape[0]
         for i in range(n):
             acc[i, 0] = 0.0
@@ -517,7 +518,7 @@ def bench_effects_cost(years: float, repeat: int) -> None:
     r0, v0, gm = solar_system()
     system = System([Body(f"b{k}", gm[k], r0[k], v0[k]) for k in range(len(gm))])
     t = np.array([0.0, years * 365.25])
-    plain = RHS(plain_newton, None, False, ("newtonian",))
+    plain = RHS(plain_newton, None, np.zeros(1), False, ("newtonian",))
     variants = {
         "effects=()": compile_rhs(system, ()),
         "hand-written Newtonian kernel": plain,

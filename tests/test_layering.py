@@ -48,3 +48,84 @@ def test_kernels_do_not_import_astropy():
         if any(m.split(".")[0] == "astropy" for m in imported_modules(p))
     ]
     assert offenders == []
+
+
+def _our_modules() -> dict[str, Path]:
+    """Dotted module name -> file, for both packages."""
+    out = {}
+    for package in ("hamilton_orbits", "rigid"):
+        for path in (SRC / package).rglob("*.py"):
+            parts = list(path.relative_to(SRC).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            out[".".join(parts)] = path
+    return out
+
+
+def _import_graph() -> dict[str, set[str]]:
+    """Every import between our modules, wherever it stands in the file (a
+    function-level import hides a circle from the interpreter, not from us).
+    ``from pkg import sub`` is an arrow to the submodule ``pkg.sub``; imports under
+    ``if TYPE_CHECKING:`` are not run and are left out."""
+    modules = _our_modules()
+    graph: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        tree = ast.parse(path.read_text())
+        skip = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
+                and "TYPE_CHECKING" in ast.unparse(node.test) for n in ast.walk(node)}
+        arrows: set[str] = set()
+        for node in ast.walk(tree):
+            if id(node) in skip:
+                continue
+            if isinstance(node, ast.Import):
+                arrows.update(a.name for a in node.names if a.name in modules)
+            elif isinstance(node, ast.ImportFrom) and node.module in modules:
+                subs = [f"{node.module}.{a.name}" for a in node.names]
+                found = [s for s in subs if s in modules]
+                arrows.update(found)
+                if len(found) < len(subs):
+                    arrows.add(node.module)
+        graph[name] = arrows - {name}
+    return graph
+
+
+def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_circle_in_either_package():
+    graph = _import_graph()
+    assert len(graph) > 40 and "hamilton_orbits.engine" in graph["hamilton_orbits.simulation"]
+    assert _circles(graph) == []
+
+
+def test_the_circle_finder_finds_a_circle():
+    assert _circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]

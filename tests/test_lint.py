@@ -14,7 +14,7 @@ def test_ruff_clean():
     if ruff is None:  # the test extra installs ruff; fail loudly rather than skip
         pytest.fail("ruff is not installed: pip install -e '.[test]'")
     res = subprocess.run(
-        [ruff, "check", "src", "tests", "benchmarks", "examples"],
+        [ruff, "check", "src", "tests", "benchmarks", "examples", "tools"],
         cwd=ROOT,
         capture_output=True,
         text=True,

@@ -21,6 +21,8 @@ NOTICE = (
     "(once; cached for later runs, can take ~20 s) ..."
 )
 PACKAGES = ("hamilton_orbits", "rigid")
+#: The modules of the generated right-hand sides (:mod:`hamilton_orbits.rhs`).
+GENERATED_PREFIX = "hamilton_orbits_rhs_"
 
 _lock = threading.Lock()
 _state = {"printed": False}
@@ -29,7 +31,7 @@ _state = {"printed": False}
 def _ours(dispatcher: object) -> bool:
     func = getattr(dispatcher, "py_func", None)
     module = getattr(func, "__module__", None) or ""
-    return module.split(".", 1)[0] in PACKAGES
+    return module.split(".", 1)[0] in PACKAGES or module.startswith(GENERATED_PREFIX)
 
 
 class _CompileNotice(event.Listener):

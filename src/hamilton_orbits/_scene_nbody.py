@@ -9,8 +9,6 @@ measures what the scene's ``[[analysis]]`` entries ask for.
 
 from __future__ import annotations
 
-import itertools
-import time
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +17,7 @@ import numpy as np
 
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
-from hamilton_orbits.scene import Result, Scene, SceneKind, format_table, register_kind
+from hamilton_orbits._scene_base import Result, SceneKind, format_table, register_kind
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
 
 METHODS = ("radau15", "wh", "leapfrog", "dop853")
@@ -134,66 +132,86 @@ def _initial_names(spec: dict) -> list[str]:
 
 
 def _check(spec: dict, problems: S.Problems) -> None:
-    init = spec["initial"]
+    """Checks across keys, every problem reported with its key path."""
+    _check_initial(spec["initial"], problems)
+    names = _initial_names(spec)
+    for i, b in enumerate(spec["bodies"]):
+        _check_body(b, f"bodies[{i}]", names, problems)
+        names.append(b["name"])
+    if not names and spec["initial"].get("rebound") is None:
+        problems.add("bodies", "the scene has no bodies")
+    _check_effects(spec, names, problems)
+    _check_integrator(spec["integrator"], problems)
+    for i, an in enumerate(spec["analysis"]):
+        for key in ("body", "primary", "other"):
+            if an.get(key) is not None and an[key] not in names:
+                problems.add(f"analysis[{i}].{key}",
+                             f"no body named {an[key]!r}{S.closest(str(an[key]), names)}")
+    if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
+        problems.add("cadence", f"the cadence {spec['cadence']} exceeds the duration "
+                                f"{spec['duration']}")
+
+
+def _check_initial(init: dict, problems: S.Problems) -> None:
     if init.get("rebound") is not None and init.get("solar_system") is not None:
         problems.add("initial", "give either `solar_system` or `rebound`, not both")
     rb = init.get("rebound")
-    if rb is not None:
-        if not Path(rb).is_file():
-            problems.add("initial.rebound", f"no such file {rb!r} (relative to {Path.cwd()})")
-        else:
-            try:
-                found = _rebound_names(rb)
-            except Exception as exc:
-                problems.add("initial.rebound", f"not a rebound binary: {exc}")
-            else:
-                given = init.get("names")
-                if given and len(given) != len(found):
-                    problems.add("initial.names", f"expected {len(found)} names (the file "
-                                 f"holds {len(found)} particles), got {len(given)}")
-                elif not given and len(set(found)) != len(found):
-                    problems.add("initial.names", "missing: the particle names read from "
-                                 f"the file are not unique ({found}); give `names`")
-    names = _initial_names(spec)
-    for i, b in enumerate(spec["bodies"]):
-        path = f"bodies[{i}]"
-        if b["name"] in names:
-            problems.add(f"{path}.name", f"a body named {b['name']!r} is already in the scene")
-        if b["gm"] is None:
-            problems.add(f"{path}.gm", 'missing: GM is required ("0 m3/s2" for a test particle)')
-        has_state = b["r"] is not None or b["v"] is not None
-        elements = [k for k in ("a", "p", "q", "e", *_ANGLE_KEYS) if b[k] is not None]
-        if has_state and elements:
-            problems.add(path, f"give either `r` and `v` or orbital elements, not both "
-                               f"({', '.join(elements)})")
-        elif has_state:
-            for k in ("r", "v"):
-                if b[k] is None:
-                    problems.add(f"{path}.{k}", "missing: `r` and `v` go together")
-        elif elements:
-            sizes = [k for k in ("a", "p", "q") if b[k] is not None]
-            if len(sizes) != 1:
-                problems.add(path, "give exactly one of `a`, `p`, `q` with the elements")
-            anomalies = [k for k in ("M", "nu") if b[k] is not None]
-            if len(anomalies) > 1:
-                problems.add(path, "give at most one of `M`, `nu`")
-            if b["primary"] is None:
-                problems.add(f"{path}.primary", "missing: elements need the body they orbit")
-            elif b["primary"] not in names:
-                problems.add(f"{path}.primary",
-                             f"no body named {b['primary']!r}{S.closest(b['primary'], names)}")
-        else:
-            problems.add(path, "missing: a state (`r`, `v`) or orbital elements (`a`, `e`, ...)")
-        names.append(b["name"])
-    if not names and init.get("rebound") is None:
-        problems.add("bodies", "the scene has no bodies")
+    if rb is None:
+        return
+    if not Path(rb).is_file():
+        problems.add("initial.rebound", f"no such file {rb!r} (relative to {Path.cwd()})")
+        return
+    try:
+        found = _rebound_names(rb)
+    except Exception as exc:
+        problems.add("initial.rebound", f"not a rebound binary: {exc}")
+        return
+    given = init.get("names")
+    if given and len(given) != len(found):
+        problems.add("initial.names", f"expected {len(found)} names (the file "
+                     f"holds {len(found)} particles), got {len(given)}")
+    elif not given and len(set(found)) != len(found):
+        problems.add("initial.names", "missing: the particle names read from "
+                     f"the file are not unique ({found}); give `names`")
+
+
+def _check_body(b: dict, path: str, names: list[str], problems: S.Problems) -> None:
+    if b["name"] in names:
+        problems.add(f"{path}.name", f"a body named {b['name']!r} is already in the scene")
+    if b["gm"] is None:
+        problems.add(f"{path}.gm", 'missing: GM is required ("0 m3/s2" for a test particle)')
+    has_state = b["r"] is not None or b["v"] is not None
+    elements = [k for k in ("a", "p", "q", "e", *_ANGLE_KEYS) if b[k] is not None]
+    if has_state and elements:
+        problems.add(path, f"give either `r` and `v` or orbital elements, not both "
+                           f"({', '.join(elements)})")
+    elif has_state:
+        for k in ("r", "v"):
+            if b[k] is None:
+                problems.add(f"{path}.{k}", "missing: `r` and `v` go together")
+    elif elements:
+        sizes = [k for k in ("a", "p", "q") if b[k] is not None]
+        if len(sizes) != 1:
+            problems.add(path, "give exactly one of `a`, `p`, `q` with the elements")
+        if len([k for k in ("M", "nu") if b[k] is not None]) > 1:
+            problems.add(path, "give at most one of `M`, `nu`")
+        if b["primary"] is None:
+            problems.add(f"{path}.primary", "missing: elements need the body they orbit")
+        elif b["primary"] not in names:
+            problems.add(f"{path}.primary",
+                         f"no body named {b['primary']!r}{S.closest(b['primary'], names)}")
+    else:
+        problems.add(path, "missing: a state (`r`, `v`) or orbital elements (`a`, `e`, ...)")
+
+
+def _check_effects(spec: dict, names: list[str], problems: S.Problems) -> None:
+    method = spec["integrator"]["method"]
     for i, eff in enumerate(spec["effects"]):
         for key in ("body", "primary"):
             if key in eff and eff[key] not in names:
                 problems.add(f"effects[{i}].{key}",
                              f"no body named {eff[key]!r}{S.closest(str(eff[key]), names)}")
         ek = _effects.get("nbody", eff["name"])
-        method = spec["integrator"]["method"]
         if ek.velocity_dependent and not _accepts_velocity_dependent(method):
             ok = [m for m in METHODS if _accepts_velocity_dependent(m)]
             problems.add(
@@ -201,7 +219,9 @@ def _check(spec: dict, problems: S.Problems) -> None:
                 f"effect {eff['name']!r} depends on velocities and integrator {method!r} "
                 f"cannot take it; use one of {', '.join(ok)}",
             )
-    integ = spec["integrator"]
+
+
+def _check_integrator(integ: dict, problems: S.Problems) -> None:
     for option in ("coordinates", "corrector"):
         if integ[option] is not None and integ["method"] != "wh":
             problems.add(f"integrator.{option}",
@@ -211,14 +231,6 @@ def _check(spec: dict, problems: S.Problems) -> None:
     elif integ["corrector"] == 3 and integ["coordinates"] != "jacobi":
         problems.add("integrator.corrector",
                      "the corrector needs integrator.coordinates = 'jacobi'")
-    for i, an in enumerate(spec["analysis"]):
-        for key in ("body", "primary", "other"):
-            if an.get(key) is not None and an[key] not in names:
-                problems.add(f"analysis[{i}].{key}",
-                             f"no body named {an[key]!r}{S.closest(str(an[key]), names)}")
-    if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
-        problems.add("cadence", f"the cadence {spec['cadence']} exceeds the duration "
-                                f"{spec['duration']}")
 
 
 def build_system(spec: dict):
@@ -283,91 +295,77 @@ def _progress_bar(total: int, enabled: bool):
         from tqdm import tqdm
     except ImportError:  # pragma: no cover - tqdm is in the [progress] extra
         return None
-    return tqdm(total=total, unit="chunk", disable=not sys.stderr.isatty(), leave=False)
+    return tqdm(total=total, unit="output", disable=not sys.stderr.isatty(), leave=False)
 
 
-def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
-    from hamilton_orbits import integrate
+def _integrator_args(spec: dict) -> tuple[str, dict[str, Any]]:
+    """The method and the engine's keyword arguments (internal units: days)."""
+    integ = spec["integrator"]
+    kw: dict[str, Any] = {
+        "tol": integ["tol"],
+        "dt": None if integ["dt"] is None else float(integ["dt"].to_value(u.d)),
+        "options": {k: integ[k] for k in ("coordinates", "corrector") if integ[k] is not None},
+    }
+    return integ["method"], kw
+
+
+def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
+    from hamilton_orbits import engine
+    from hamilton_orbits.rhs import compile_rhs
+    from hamilton_orbits.simulation import check_method
 
     spec = scene.spec
     system = build_system(spec)
-    t_all = _times(spec)
-    integ = spec["integrator"]
-    kw: dict[str, Any] = {"method": integ["method"], "effects": list(spec["effects"])}
-    if integ["tol"] is not None:
-        kw["tol"] = integ["tol"]
-    if integ["dt"] is not None:
-        kw["dt"] = integ["dt"]
-    for option in ("coordinates", "corrector"):
-        if integ[option] is not None:
-            kw[option] = integ[option]
-    # chunks: a progress bar over the whole run, and Ctrl-C keeps finished chunks
-    n_chunks = min(len(t_all) - 1, 50)
-    edges = np.unique(np.linspace(0, len(t_all) - 1, n_chunks + 1).round().astype(int))
-    bar = _progress_bar(len(edges) - 1, progress)
-    rs, vs, ts = [], [], []
-    steps = 0
-    complete = True
-    start = time.perf_counter()
-    current = system
+    t_all = _times(spec).to_value(u.d)
+    method, kw = _integrator_args(spec)
+    effects = check_method(method, spec["effects"], kw["options"])
+    rhs = compile_rhs(system, effects)
+    arrays = system.as_arrays()
+    bar = _progress_bar(len(t_all) - 1, progress)
     try:
-        for a, b in itertools.pairwise(edges):
-            if stop():
-                complete = False
-                break
-            traj = integrate(current, t_all[a : b + 1] - t_all[a], **kw)
-            first = 0 if not ts else 1
-            ts.append((t_all[a : b + 1])[first:])
-            rs.append(traj.r[first:])
-            vs.append(traj.v[first:])
-            steps += int(traj.steps)
-            current = traj.final
-            if bar is not None:
-                bar.update(1)
-    except KeyboardInterrupt:
-        complete = False
+        out = engine.run(arrays.r, arrays.v, arrays.gm, t_all, rhs, method, stop=stop,
+                         on_output=None if bar is None else (lambda i, steps: bar.update(1)),
+                         **kw)
     finally:
         if bar is not None:
             bar.close()
-    wall = time.perf_counter() - start
-    if not ts:
+    if len(out.t) < 2:
         raise KeyboardInterrupt
-    times = u.Quantity(np.concatenate([t.to_value(u.d) for t in ts]), u.d)
-    r = np.concatenate([np.asarray(getattr(x, "value", x)) for x in rs])
-    v = np.concatenate([np.asarray(getattr(x, "value", x)) for x in vs])
-    r_unit = getattr(rs[0], "unit", u.au)
-    v_unit = getattr(vs[0], "unit", u.au / u.d)
-    diag = _diagnostics(system, r, v, r_unit, v_unit, times)
-    result = Result(
-        scene=scene,
-        times=times,
-        diagnostics=diag,
-        states={"names": list(system.names), "r": r * r_unit, "v": v * v_unit},
-        wall_time=wall,
-        complete=complete,
-    )
-    result.metrics["integrator"] = integ["method"]
-    result.metrics["steps"] = steps
-    label = "max |relative energy error|"
-    if spec["effects"]:
-        label = "max |dE/E| of the Newtonian energy (effects do not conserve it)"
-    result.metrics[label] = float(np.max(np.abs(diag["energy_error"])))
+    result = _result(scene, system, out, method, effects)
     for an in spec["analysis"]:
         _ANALYSIS_FUNCS[an["name"]](result, system, an)
-    if spec["crosscheck"]:
-        from hamilton_orbits.simulation import Trajectory
+    if spec["crosscheck"] and result.complete:
+        _crosscheck_into(result, system, out, method, effects)
+    return result
 
-        ee, ae, bd = (diag[k] for k in ("energy_error", "angular_momentum_error",
-                                        "barycentre_drift"))
-        traj = Trajectory(times, r * r_unit, v * v_unit, system.names, current, ee, ae, bd,
-                          steps, wall, integ["method"], tuple(spec["effects"]))
-        _crosscheck_into(result, system, traj, kw)
+
+def _result(scene: Any, system, out, method: str, effects) -> Result:
+    """The :class:`Result` of an engine run: states, Hamilton's integrals, figures,
+    and the final state as a rebound binary."""
+    from hamilton_orbits.nbody import integral_errors
+
+    energy, ang, drift = integral_errors(out.r, out.v, system.as_arrays().gm, out.t)
+    result = Result(
+        scene=scene,
+        times=out.t * u.d,
+        diagnostics={"energy_error": energy, "angular_momentum_error": ang,
+                     "barycentre_drift": drift},
+        states={"names": list(system.names), "r": out.r * u.au, "v": out.v * (u.au / u.d)},
+        wall_time=out.wall_time,
+        complete=out.complete,
+    )
+    result.metrics["integrator"] = method
+    result.metrics["steps"] = out.steps
+    label = "max |relative energy error|"
+    if effects:
+        label = "max |dE/E| of the Newtonian energy (effects do not conserve it)"
+    result.metrics[label] = float(np.max(np.abs(energy)))
     result.plotters.append(_plot_orbits)
     result.plotters.append(_plot_energy)
-    final = current
+    final = system.with_state(out.r[-1], out.v[-1])
 
-    def write_rebound(_result: Result, out: Path) -> list[Path]:
-        path = out / "final.bin"
+    def write_rebound(_result: Result, folder: Path) -> list[Path]:
+        path = folder / "final.bin"
         if path.exists():
             path.unlink()  # rebound appends to an existing archive
         final.to_rebound().save_to_file(str(path))
@@ -375,21 +373,6 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
 
     result.writers.append(write_rebound)
     return result
-
-
-def _diagnostics(system, r, v, r_unit, v_unit, times: u.Quantity) -> dict[str, Any]:
-    """Hamilton's integrals (C), (D), (E) of every output state (see ``integrate``)."""
-    from hamilton_orbits.simulation import _diagnostics as integrals
-
-    if system.quantity:
-        r = r * r_unit.to(u.au)
-        v = v * v_unit.to(u.au / u.d)
-    energy, ang, drift = integrals(system, r, v, times.to_value(u.d))
-    return {
-        "energy_error": energy,
-        "angular_momentum_error": ang,
-        "barycentre_drift": drift,
-    }
 
 
 def _relative_orbits(result: Result, system, body: str, primary: str):
@@ -480,14 +463,13 @@ _ANALYSIS_FUNCS = {
 }
 
 
-def _crosscheck_into(result: Result, system, traj, kw: dict) -> None:
+def _crosscheck_into(result: Result, system, out, method: str, effects) -> None:
     """Integrate the same initial state with rebound (IAS15) at the same output times."""
     from hamilton_orbits import crosscheck
+    from hamilton_orbits.simulation import make_trajectory
 
-    if not result.complete:
-        return
-    table = crosscheck(system, None, method=kw["method"], effects=kw["effects"],
-                       trajectory=traj)
+    traj = make_trajectory(system, out, u.d, method, ("newtonian", *effects.names))
+    table = crosscheck(system, None, method=method, effects=effects, trajectory=traj)
     result.tables["cross-check against rebound: final position difference"] = table.rows
     result.tables["cross-check against rebound: codes"] = table.code_rows
     result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
@@ -533,7 +515,7 @@ def _plot_energy(result: Result):
     return fig
 
 
-def _crosscheck(scene: Scene) -> str:
+def _crosscheck(scene: Any) -> str:
     from hamilton_orbits import crosscheck
 
     spec = scene.spec

@@ -256,15 +256,12 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
     return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
 
 
-def _report(quick: bool, out: str | None, progress: bool, readme: str | None = None) -> int:
-    from hamilton_orbits.report import build_report, update_readme
+def _report(quick: bool, out: str | None, progress: bool) -> int:
+    from hamilton_orbits.report import build_report
 
     folder = out if out else "hamilton-orbits-output/report"
     files = build_report(folder, quick=quick, progress=progress)
     print("wrote " + ", ".join(f.name for f in files) + f" to {folder}/")
-    if readme:
-        update_readme(folder, readme)
-        print(f"updated {readme} and docs/work_precision.png, docs/work_precision.md")
     return EXIT_OK
 
 
@@ -308,8 +305,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     rp.add_argument("--quick", action="store_true", help="short spans, few settings (~1 min)")
     rp.add_argument("--out", help="output folder (default hamilton-orbits-output/report)")
     rp.add_argument("--no-progress", action="store_true", help="no progress lines")
-    rp.add_argument("--readme", metavar="README.md",
-                    help="also rewrite that README's generated section and its docs/ diagram")
     sub.add_parser("scenes", help="list the bundled scenes")
     sub.add_parser("demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
@@ -321,8 +316,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "scenes":
         return _list_scenes()
     if args.command == "report":
-        return _report(args.quick, args.out, progress=not args.no_progress,
-                           readme=args.readme)
+        return _report(args.quick, args.out, progress=not args.no_progress)
     if args.command == "ensemble":
         return _ensemble(args.scene, args.vary, args.dask, args.out,
                          progress=not args.no_progress)

@@ -14,15 +14,12 @@ importing them: an entry point in the group ``hamilton_orbits.effects`` names a
 callable that registers its effects when the kind is first looked up (``rigid``
 registers its rotation effects this way).
 
-The right-hand side contract
-----------------------------
-An :class:`RHS` carries compiled functions with the signature
-``f(r, v, gm, acc)`` (float64 arrays (n, 3), (n, 3), (n,), (n, 3)):
-
-- ``accel`` overwrites ``acc`` with the total acceleration (Newtonian plus the
-  listed effects);
-- ``extra`` *adds* the listed effects' accelerations only (``None`` when no
-  effect is listed); splitting integrators (Wisdom-Holman) use it for their kicks.
+Normalised once
+---------------
+:meth:`EffectSet.of` turns what a caller lists into an :class:`EffectSet`: a
+frozen, hashable value, checked against the registry once at the boundary.
+Everything downstream (the compiled right-hand side in :mod:`hamilton_orbits.rhs`,
+the integrators, rebound's cross-check, scenes) takes the :class:`EffectSet`.
 """
 
 from __future__ import annotations
@@ -32,19 +29,20 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from hamilton_orbits._kernels import nbody as _nbody
 
 __all__ = [
-    "RHS",
+    "C_AU_PER_DAY",
+    "EffectSet",
     "EffectSpec",
-    "compile_rhs",
+    "entry_problems",
     "get",
     "known",
-    "newtonian_rhs",
     "normalize_effects",
     "register",
+    "source_index",
+    "speed_of_light",
 ]
 
 
@@ -164,39 +162,6 @@ def get(kind: str, name: str) -> EffectSpec:
     return _REGISTRY[kind][name]
 
 
-@dataclass(frozen=True)
-class RHS:
-    """A compiled right-hand side built from exactly the listed effects.
-
-    Attributes
-    ----------
-    accel : numba dispatcher
-        ``accel(r, v, gm, acc)``: overwrites ``acc`` with the total acceleration.
-    extra : numba dispatcher or None
-        ``extra(r, v, gm, acc)``: adds the listed effects only; None if none.
-    velocity_dependent : bool
-        True if any listed effect depends on velocities.
-    effects : tuple of str
-        The names of what is computed, ``"newtonian"`` first.
-    """
-
-    accel: Any
-    extra: Any
-    velocity_dependent: bool
-    effects: tuple[str, ...]
-
-
-def newtonian_rhs() -> RHS:
-    """The right-hand side of Newtonian gravity alone (Hamilton's equation (B)).
-
-    Examples
-    --------
-    >>> newtonian_rhs().effects
-    ('newtonian',)
-    """
-    return RHS(_nbody.newtonian, None, False, ("newtonian",))
-
-
 register(
     EffectSpec(
         "newtonian",
@@ -209,6 +174,45 @@ register(
 
 # ----------------------------------------------------------------------------------
 # Composition: exactly the listed effects, nothing else.
+
+
+def entry_problems(item: Any, kind: str = "nbody") -> tuple[str | None, dict, list]:
+    """Check one listed effect: ``(name, params, problems)`` with ``problems`` a list
+    of ``(key, message)`` (``key`` ``""`` for the entry itself, ``"name"``, or the
+    parameter at fault); ``name`` is None when the entry has no valid name.
+
+    Examples
+    --------
+    >>> entry_problems({"name": "j2", "bdy": "earth"})[2]  # doctest: +ELLIPSIS
+    [('bdy', "unknown parameter of effect 'j2' (did you mean 'body'?); it takes: body, ...")]
+    >>> entry_problems("grr")[2]  # doctest: +ELLIPSIS
+    [('name', "unknown effect 'grr' (did you mean 'gr'...?); known: gr, gr_potential, ...")]
+    """
+    import difflib
+
+    if isinstance(item, str):
+        name, params = item, {}
+    elif isinstance(item, Mapping) and isinstance(item.get("name"), str):
+        name = item["name"]
+        params = {key: val for key, val in item.items() if key != "name"}
+    else:
+        return None, {}, [("", f"expected an effect name or a mapping with a 'name', got "
+                               f"{item!r}")]
+    names = known(kind)
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=3)
+        hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+        return None, params, [("name", f"unknown effect {name!r}{hint}; known: "
+                                       f"{', '.join(names) or 'none'}")]
+    takes = list(get(kind, name).parameters)
+    problems = []
+    for key in params:
+        if key not in takes:
+            close = difflib.get_close_matches(str(key), takes, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            problems.append((key, f"unknown parameter of effect {name!r}{hint}; it takes: "
+                                  f"{', '.join(takes) or 'none'}"))
+    return name, params, problems
 
 
 def normalize_effects(
@@ -232,32 +236,22 @@ def normalize_effects(
     >>> normalize_effects([{"name": "j2", "bdy": "earth"}])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: Effect 'j2' at index 0 takes no parameter 'bdy'; it takes: body, ...
+    ValueError: Effect at index 0, `bdy`: unknown parameter of effect 'j2' (did you mean 'body'?)...
     """
     if effects is None:
         return ()
     if isinstance(effects, (str, Mapping)):
         effects = [effects]
+    if not isinstance(effects, Sequence):
+        raise ValueError(f"Expected `effects` to be a list of names or mappings, got {effects!r}")
     out = []
     seen: set[str] = set()
     for k, item in enumerate(effects):
-        if isinstance(item, str):
-            name, params = item, {}
-        elif isinstance(item, Mapping) and isinstance(item.get("name"), str):
-            name = item["name"]
-            params = {key: val for key, val in item.items() if key != "name"}
-        else:
-            raise ValueError(
-                f"Expected `effects` to hold names or mappings with a 'name', got {item!r} "
-                f"at index {k}"
-            )
-        spec = get(kind, name)
-        for key in params:
-            if key not in spec.parameters:
-                takes = ", ".join(spec.parameters) or "none"
-                raise ValueError(
-                    f"Effect {name!r} at index {k} takes no parameter {key!r}; it takes: {takes}"
-                )
+        name, params, problems = entry_problems(item, kind)
+        if problems:
+            key, message = problems[0]
+            where = f", `{key}`" if key and key != "name" else ""
+            raise ValueError(f"Effect at index {k}{where}: {message}")
         if name == "newtonian":
             continue
         if name in seen:
@@ -267,126 +261,155 @@ def normalize_effects(
     return tuple(out)
 
 
-def _chain(first: Any, second: Any) -> Any:
-    """A compiled ``f(r, v, gm, acc)`` calling ``first`` then ``second``."""
-
-    @njit
-    def chained(r, v, gm, acc):  # pragma: no cover - compiled
-        first(r, v, gm, acc)
-        second(r, v, gm, acc)
-
-    return chained
-
-
-def bind(kernel: Any, p: np.ndarray) -> Any:
-    """A compiled ``f(r, v, gm, acc)`` calling ``kernel(r, v, gm, acc, p)``.
-
-    ``p`` is frozen into the compiled function as a constant.
-    """
-    p = np.ascontiguousarray(p, dtype=np.float64)
-
-    @njit
-    def bound(r, v, gm, acc):  # pragma: no cover - compiled
-        kernel(r, v, gm, acc, p)
-
-    return bound
+def _frozen(value: Any) -> Any:
+    """A hashable stand-in for a parameter value (a Quantity as value and unit, a
+    sequence as a tuple), for :class:`EffectSet`'s equality and hash."""
+    unit = getattr(value, "unit", None)
+    if unit is not None and hasattr(value, "value"):
+        return ("quantity", _frozen(np.asarray(value.value).tolist()), str(unit))
+    if isinstance(value, np.ndarray):
+        return _frozen(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    if isinstance(value, Mapping):
+        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
+    return value
 
 
-def _key(system: Any) -> tuple:
-    """What a compiled right-hand side depends on besides the state: bodies' shapes."""
-    return (
-        system.names,
-        tuple(system._gm.tolist()),
-        tuple((b._radius, b.j2, b.pole) for b in system.bodies),
-        system.quantity,
-    )
+@dataclass(frozen=True, eq=False)
+class EffectSet:
+    """The listed effects, normalised once: a frozen, hashable value.
 
+    Build it with :meth:`of`; iterate over ``(name, params)`` pairs.  Two sets are
+    equal when they list the same effects with the same parameters in the same
+    order; their hash follows.  The compiled right-hand side depends only on
+    :attr:`names` (see :mod:`hamilton_orbits.rhs`).
 
-def compile_rhs(system: Any, effects: Sequence[str | Mapping[str, Any]] | None = ()) -> RHS:
-    """The right-hand side of ``system`` with exactly the listed ``effects``.
-
-    With no effects this is the cached Newtonian kernel itself; otherwise each
-    listed effect's compiled adder is chained after it, so that an effect that is
-    not listed is not in the compiled function at all.
-
-    Parameters
+    Attributes
     ----------
-    system : hamilton_orbits.nbody.System
-    effects : sequence of str or mapping
-        Names (``"gr"``) or mappings with parameters (``{"name": "j2", "body":
-        "earth"}``).
+    kind : str
+        ``"nbody"`` or ``"rotation"``.
+    items : tuple of (str, tuple of (str, object))
+        ``(name, ((key, value), ...))`` per listed effect (``"newtonian"`` dropped).
 
     Examples
     --------
-    >>> from hamilton_orbits import Body, System
-    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
-    >>> compile_rhs(s).effects
-    ('newtonian',)
-    >>> compile_rhs(s, ["gr"]).velocity_dependent  # doctest: +SKIP
+    >>> eff = EffectSet.of(["gr", {"name": "j2", "body": "earth"}])
+    >>> eff.names
+    ('gr', 'j2')
+    >>> eff == EffectSet.of([{"name": "gr"}, {"body": "earth", "name": "j2"}])
     True
+    >>> len({eff, EffectSet.of(["gr", {"name": "j2", "body": "earth"}])})
+    1
+    >>> eff.as_list()
+    ['gr', {'name': 'j2', 'body': 'earth'}]
     """
-    normal = normalize_effects(effects, "nbody")
-    if not normal:
-        return newtonian_rhs()
-    return _compile_cached(_key(system), normal, system)
 
+    kind: str
+    items: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
 
-_COMPILED: dict[tuple, RHS] = {}
+    @classmethod
+    def of(cls, effects: Any, kind: str = "nbody") -> EffectSet:
+        """Normalise ``effects`` (an EffectSet of this kind passes through).
 
+        Raises
+        ------
+        ValueError
+            As :func:`normalize_effects`, or for an EffectSet of another kind.
+        """
+        if isinstance(effects, EffectSet):
+            if effects.kind != kind:
+                raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")
+            return effects
+        return cls(kind, normalize_effects(effects, kind))
 
-def _compile_cached(key: tuple, normal: tuple, system: Any) -> RHS:
-    cache_key = (key, normal)
-    if cache_key in _COMPILED:
-        return _COMPILED[cache_key]
-    adders = []
-    velocity_dependent = False
-    newtonian = True
-    for name, params in normal:
-        spec = get("nbody", name)
-        if spec.kernel is None or spec.params is None:
-            raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
-        adders.append(bind(spec.kernel, spec.params(system, dict(params))))
-        velocity_dependent = velocity_dependent or spec.velocity_dependent
-        newtonian = newtonian and not spec.replaces_newtonian
-    extra = adders[0]
-    for adder in adders[1:]:
-        extra = _chain(extra, adder)
-    accel = _chain(_nbody.newtonian, extra) if newtonian else _chain(_nbody.zero, extra)
-    rhs = RHS(accel, extra, velocity_dependent, ("newtonian",) + tuple(n for n, _ in normal))
-    if len(_COMPILED) > 64:
-        _COMPILED.clear()
-    _COMPILED[cache_key] = rhs
-    return rhs
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The listed effects' names, in order."""
+        return tuple(name for name, _ in self.items)
+
+    @property
+    def velocity_dependent(self) -> bool:
+        """True if any listed effect depends on velocities."""
+        return any(get(self.kind, name).velocity_dependent for name in self.names)
+
+    def as_list(self) -> list[str | dict[str, Any]]:
+        """The effects as a caller lists them (names, or mappings with parameters)."""
+        return [dict(name=n, **dict(p)) if p else n for n, p in self.items]
+
+    def __iter__(self):
+        return iter(self.items)
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def __bool__(self) -> bool:
+        return bool(self.items)
+
+    def _key(self) -> tuple:
+        return (self.kind, tuple((n, _frozen(dict(p))) for n, p in self.items))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, EffectSet):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return f"EffectSet({self.as_list()!r})"
 
 
 # ----------------------------------------------------------------------------------
 # Built-in n-body effects.
 
-_C_AU_PER_DAY = 299792458.0 * 86400.0 / 149597870700.0  # IAU 2012 au, SI c and day
+C_AU_PER_DAY = 299792458.0 * 86400.0 / 149597870700.0  # IAU 2012 au, SI c and day
 
 
-def _source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) -> int:
+def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) -> int:
+    """The index of the body that mapping ``params`` names under ``key`` (default: the
+    most massive), refusing a name not in ``system`` and a massless body.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 2.0, [1, 0, 0], [0, 0, 0])])
+    >>> source_index(s, {}, "source", "gr"), source_index(s, {"source": "a"}, "source", "gr")
+    (1, 0)
+    """
     name = params.get(key)
+    gm = system.as_arrays().gm
     if name is None:
-        return int(np.argmax(system._gm))
+        return int(np.argmax(gm))
     if name not in system.names:
         raise ValueError(
             f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
             f"bodies: {', '.join(system.names)}"
         )
     idx = system.names.index(name)
-    if not system._gm[idx] > 0:
+    if not gm[idx] > 0:
         raise ValueError(f"Effect {effect!r}: body {name!r} is massless (gm = 0)")
     return idx
 
 
-def _speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float:
+def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float:
+    """The speed of light in ``system``'s units from mapping ``params`` (key ``"c"``;
+    default c in au/day for a Quantity system).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> speed_of_light(s, {"c": 10.0}, "gr")
+    10.0
+    """
     from hamilton_orbits.units import SPEED, is_quantity
 
     c = params.get("c")
     if c is None:
         if system.quantity:
-            return _C_AU_PER_DAY
+            return C_AU_PER_DAY
         raise ValueError(
             f"Effect {effect!r}: a system of plain floats needs the speed of light `c` in "
             "its own units, e.g. {'name': 'gr', 'c': 10065.32}"
@@ -404,14 +427,14 @@ def _speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> floa
 
 
 def _params_gr(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    s = _source_index(system, params, "source", "gr")
-    c = _speed_of_light(system, params, "gr")
+    s = source_index(system, params, "source", "gr")
+    c = speed_of_light(system, params, "gr")
     return np.array([s, c])
 
 
 def _params_gr_potential(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    s = _source_index(system, params, "source", "gr_potential")
-    c = _speed_of_light(system, params, "gr_potential")
+    s = source_index(system, params, "source", "gr_potential")
+    c = speed_of_light(system, params, "gr_potential")
     return np.array([s, c])
 
 
@@ -419,10 +442,11 @@ def _params_j2(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     if "body" not in params:
         raise ValueError("Effect 'j2' needs the `body` whose oblateness acts, e.g. "
                          "{'name': 'j2', 'body': 'earth'}")
-    b = _source_index(system, params, "body", "j2")
+    b = source_index(system, params, "body", "j2")
+    arrays = system.as_arrays()
     body = system.bodies[b]
     j2 = params.get("j2", body.j2)
-    radius = params.get("radius", body._radius)
+    radius = params.get("radius", arrays.radius[b] if np.isfinite(arrays.radius[b]) else None)
     if j2 is None or radius is None:
         raise ValueError(
             f"Effect 'j2': body {body.name!r} needs `j2` and `radius` (give them to the "
@@ -431,8 +455,11 @@ def _params_j2(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     if "radius" in params:
         import astropy.units as u
 
-        from hamilton_orbits.units import LENGTH
+        from hamilton_orbits.units import LENGTH, is_quantity
 
+        if system.quantity and not is_quantity(radius):
+            raise ValueError(f"Effect 'j2': expected `radius` as a length Quantity for a "
+                             f"Quantity system, got {radius!r}")
         radius = float(LENGTH("radius", radius, u.au if system.quantity else None))
     j2 = float(j2)
     if not (np.isfinite(j2) and np.isfinite(radius) and radius > 0):

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import astropy.constants as const
 import astropy.units as u
@@ -68,6 +68,40 @@ def _as_vector(kind, name: str, value: Any, unit) -> np.ndarray:
     if arr.shape != (3,):
         raise ValueError(f"Expected `{name}` to have shape (3,), got {arr.shape}")
     return arr
+
+
+class SystemArrays(NamedTuple):
+    """A system's state as plain float64 arrays in its internal units (au, day and
+    au^3/day^2 for a Quantity system; the caller's own otherwise): what the
+    float-level engine, the effects' parameter builders and rebound's bridge read.
+    Read-only views; copy before changing.
+
+    Attributes
+    ----------
+    names : tuple of str, (n,)
+    gm : ndarray, (n,)
+    r, v : ndarray, (n, 3)
+    radius : ndarray, (n,)
+        Equatorial radii, NaN where a body has none.
+    j2 : ndarray, (n,)
+        J2, NaN where a body has none.
+    pole : ndarray, (n, 3)
+        Unit symmetry axes, NaN rows where a body has none.
+    quantity : bool
+        True for a system built from Quantities.
+    G : float
+        The gravitational constant (SI for a Quantity system).
+    """
+
+    names: tuple[str, ...]
+    gm: np.ndarray
+    r: np.ndarray
+    v: np.ndarray
+    radius: np.ndarray
+    j2: np.ndarray
+    pole: np.ndarray
+    quantity: bool
+    G: float
 
 
 @dataclass(frozen=True, init=False)
@@ -341,6 +375,26 @@ class System:
             k += 1
 
     # --------------------------------------------------------------- accessors
+    def as_arrays(self) -> SystemArrays:
+        """The state as plain float64 arrays in the internal units (read-only views).
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0], radius=0.5)])
+        >>> arrays = s.as_arrays()
+        >>> arrays.gm.tolist(), arrays.radius.tolist(), bool(np.isnan(arrays.j2[0]))
+        ([1.0], [0.5], True)
+        """
+        nan = float("nan")
+        radius = np.array([nan if b._radius is None else b._radius for b in self._bodies])
+        j2 = np.array([nan if b.j2 is None else b.j2 for b in self._bodies])
+        pole = np.array([(nan, nan, nan) if b.pole is None else b.pole
+                         for b in self._bodies]).reshape(-1, 3)
+        for arr in (radius, j2, pole):
+            arr.setflags(write=False)
+        return SystemArrays(self.names, self._gm, self._r, self._v, radius, j2, pole,
+                            self._quantity, self._G)
+
     @property
     def names(self) -> tuple[str, ...]:
         """The bodies' names, in order."""
@@ -445,11 +499,9 @@ class System:
         array([[ 0.  ,  0.  ,  0.  ],
                [-0.25,  0.  ,  0.  ]])
         """
-        from hamilton_orbits.effects import compile_rhs
+        from hamilton_orbits.rhs import compile_rhs
 
-        rhs = compile_rhs(self, effects)
-        acc = np.empty_like(self._r)
-        rhs.accel(np.ascontiguousarray(self._r), np.ascontiguousarray(self._v), self._gm, acc)
+        acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm)
         return acc * A_UNIT if self._quantity else acc
 
     def _energy_hamilton(self) -> float:
@@ -514,7 +566,7 @@ class System:
 
     # ------------------------------------------------------------- rebound
     def to_rebound(self):
-        """A ``rebound.Simulation`` of this system (see :mod:`hamilton_orbits.rebound_bridge`).
+        """A ``rebound.Simulation`` of this system (G = 1, m = gm, internal units: exact).
 
         Examples
         --------
@@ -522,26 +574,48 @@ class System:
         >>> s.to_rebound().particles["sun"].m
         1.0
         """
-        from hamilton_orbits.rebound_bridge import to_rebound
+        from hamilton_orbits._rebound import simulation_from_arrays
 
-        return to_rebound(self)
+        return simulation_from_arrays(self.names, self._gm, self._r, self._v)
 
     @classmethod
     def from_rebound(cls, sim, *, quantity: bool = False,
                      names: Sequence[str] | None = None) -> System:
-        """A System from a ``rebound.Simulation`` (exact: positions bit for bit).
+        """A System from a ``rebound.Simulation`` (``gm = G m``; exact for G = 1).
 
-        See :func:`hamilton_orbits.rebound_bridge.from_rebound`.
+        Parameters
+        ----------
+        sim : rebound.Simulation
+        quantity : bool
+            Read the simulation as au, day, au^3/day^2 (what :meth:`to_rebound` writes
+            for a Quantity system) and return a Quantity system.
+        names : sequence of str, optional
+            Names for particles; default their rebound names, else ``"body<k>"``.
+
+        Raises
+        ------
+        ValueError
+            If ``sim`` is not a ``rebound.Simulation`` or ``names`` has the wrong length.
 
         Examples
         --------
         >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
         >>> System.from_rebound(s.to_rebound()).names
         ('sun',)
+        >>> System.from_rebound("x")
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `sim` to be a rebound.Simulation, got 'x'
         """
-        from hamilton_orbits.rebound_bridge import from_rebound
+        from hamilton_orbits._rebound import arrays_from_simulation
 
-        return from_rebound(sim, quantity=quantity, names=names)
+        names, gm, r, v = arrays_from_simulation(sim, names)
+        if quantity:
+            bodies = [Body._from_floats(name, gm[k], r[k], v[k], None, None, None, True)
+                      for k, name in enumerate(names)]
+        else:
+            bodies = [Body(name, gm[k], r[k], v[k]) for k, name in enumerate(names)]
+        return cls(bodies)
 
     # -------------------------------------------------------- solar system
     @classmethod
@@ -674,6 +748,40 @@ def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
     return kinetic - (gm[idx][i] * gm[idx][j] / dist).sum(axis=1)
 
 
+def integral_errors(
+    r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """How well states ``r``, ``v`` (n_t, n, 3) at times ``t`` (n_t,) keep Hamilton's
+    integrals, relative to the first state.
+
+    Returns
+    -------
+    energy_error : ndarray, (n_t,)
+        ``(E(t) - E(0)) / |E(0)|``, vis viva (E); absolute where ``E(0) = 0``.
+    angular_momentum_error : ndarray, (n_t,)
+        ``|L(t) - L(0)| / |L(0)|``, areas (D); absolute where ``L(0) = 0``.
+    barycentre_drift : ndarray, (n_t,)
+        ``|R(t) - R(0) - V(0) t| / s`` with ``s`` the largest distance from the
+        initial centre of mass, centre of gravity (C).
+
+    Examples
+    --------
+    >>> r = np.array([[[0.0, 0, 0], [1.0, 0, 0]]] * 2); v = np.zeros((2, 2, 3))
+    >>> [x.tolist() for x in integral_errors(r, v, np.array([1.0, 1.0]), np.array([0.0, 1.0]))]
+    [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    """
+    from hamilton_orbits.trajectory import relative_change
+
+    energy_error = relative_change(energy_gm_many(r, v, gm))
+    am_error = relative_change(np.einsum("j,tjk->tk", gm, np.cross(r, v)))
+    total = gm.sum()
+    rc = np.einsum("j,tjk->tk", gm, r) / total
+    vc0 = gm @ v[0] / total
+    scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
+    drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
+    return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
+
+
 def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     """Equation (B) evaluated with :class:`~hamilton_orbits.quaternion.Quaternion` products.
 
@@ -714,6 +822,7 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     return acc[:, 1:]
 
 
-__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "energy_gm_many"]
+__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SystemArrays", "energy_gm_many",
+            "integral_errors"]
 _ = _nbody  # the kernels of equation (B) live in hamilton_orbits._kernels.nbody
 _ = any_quantity

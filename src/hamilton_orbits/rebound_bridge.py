@@ -16,13 +16,15 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.effects import normalize_effects
-from hamilton_orbits.nbody import Body, System
+from hamilton_orbits._rebound import particle_name
+from hamilton_orbits.effects import C_AU_PER_DAY, EffectSet, source_index, speed_of_light
+from hamilton_orbits.nbody import System, integral_errors
 
 __all__ = [
     "CrossCheck",
     "crosscheck",
     "from_rebound",
+    "particle_name",
     "rebound_accelerations",
     "rebound_trajectory",
     "to_rebound",
@@ -34,78 +36,29 @@ def to_rebound(system: System) -> Any:
 
     Examples
     --------
+    >>> from hamilton_orbits import Body
     >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
     ...             Body("dust", 0.0, [1.0, 0, 0], [0, 1.0, 0])])
     >>> sim = to_rebound(s)
     >>> sim.particles["dust"].x, sim.G
     (1.0, 1.0)
     """
-    import rebound
-
-    sim = rebound.Simulation()
-    sim.G = 1.0
-    for k, name in enumerate(system.names):
-        x, y, z = (float(c) for c in system._r[k])
-        vx, vy, vz = (float(c) for c in system._v[k])
-        sim.add(m=float(system._gm[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz)
-        # set through the particle in the simulation: rebound copies the name into
-        # memory the simulation owns (``add(name=...)`` keeps a pointer to a
-        # temporary Python buffer, which may be reused before the file is written)
-        sim.particles[k].name = name
-    return sim
-
-
-def particle_name(particle: Any) -> str | None:
-    """The name of a rebound particle, read from the C string it points to.
-
-    rebound's ``Particle.name`` getter can return a stale Python buffer for a
-    particle of a simulation loaded from a binary file (ctypes caches the
-    objects assigned to ``c_char_p`` fields); reading the pointer itself is exact.
-    """
-    import rebound
-
-    ptr = ctypes.c_void_p.from_buffer(particle, rebound.Particle._name.offset).value
-    return ctypes.string_at(ptr).decode("utf-8") if ptr else None
+    return system.to_rebound()
 
 
 def from_rebound(sim: Any, *, quantity: bool = False, names: Sequence[str] | None = None
                  ) -> System:
-    """A :class:`System` from a ``rebound.Simulation`` (``gm = G m``; exact for G = 1).
-
-    Parameters
-    ----------
-    sim : rebound.Simulation
-    quantity : bool
-        Read the simulation as au, day, au^3/day^2 (what :func:`to_rebound` writes
-        for a Quantity system) and return a Quantity system.
-    names : sequence of str, optional
-        Names for particles; default their rebound names, else ``"body<k>"``.
+    """A :class:`System` from a ``rebound.Simulation`` (see :meth:`System.from_rebound`).
 
     Examples
     --------
+    >>> from hamilton_orbits import Body
     >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
     ...             Body("dust", 0.0, [1.0, 0, 0], [0, 1.0, 0])])
     >>> from_rebound(to_rebound(s)).names
     ('sun', 'dust')
     """
-    import astropy.units as u
-
-    n = sim.N
-    if names is not None and len(names) != n:
-        raise ValueError(f"Expected `names` to hold {n} names, got {len(names)}")
-    bodies = []
-    for k in range(n):
-        p = sim.particles[k]
-        name = names[k] if names is not None else (particle_name(p) or f"body{k}")
-        gm = sim.G * p.m
-        r = [p.x, p.y, p.z]
-        v = [p.vx, p.vy, p.vz]
-        if quantity:
-            bodies.append(Body._from_floats(name, gm, r, v, None, None, None, True))
-        else:
-            bodies.append(Body(name, gm, r, v))
-    _ = u
-    return System(bodies)
+    return System.from_rebound(sim, quantity=quantity, names=names)
 
 
 def rebound_accelerations(system: System) -> np.ndarray:
@@ -113,6 +66,7 @@ def rebound_accelerations(system: System) -> np.ndarray:
 
     Examples
     --------
+    >>> from hamilton_orbits import Body
     >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
     ...             Body("dust", 0.0, [2.0, 0, 0], [0, 0.7, 0])])
     >>> rebound_accelerations(s)[1]
@@ -125,29 +79,28 @@ def rebound_accelerations(system: System) -> np.ndarray:
     return np.array([[p.ax, p.ay, p.az] for p in sim.particles])
 
 
-def _add_reboundx_effects(sim: Any, system: System, normal: tuple) -> Any:
+def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
     """Attach the reboundx equivalents of the listed effects; returns the Extras."""
-    if not normal:
+    if not effects:
         return None
     import reboundx
 
-    from hamilton_orbits.effects import _C_AU_PER_DAY, _source_index, _speed_of_light
-
+    arrays = system.as_arrays()
     rebx = reboundx.Extras(sim)
-    for name, params in normal:
+    for name, params in effects:
         params = dict(params)
         if name in ("gr", "gr_potential"):
             force = rebx.load_force(name)
             rebx.add_force(force)
-            c = _speed_of_light(system, params, name) if (
-                "c" in params or not system.quantity) else _C_AU_PER_DAY
+            c = speed_of_light(system, params, name) if (
+                "c" in params or not system.quantity) else C_AU_PER_DAY
             force.params["c"] = c
-            s = _source_index(system, params, "source", name)
+            s = source_index(system, params, "source", name)
             sim.particles[s].params["gr_source"] = 1
         elif name == "j2":
             force = rebx.load_force("gravitational_harmonics")
             rebx.add_force(force)
-            b = _source_index(system, params, "body", "j2")
+            b = source_index(system, params, "body", "j2")
             body = system.bodies[b]
             if body.pole not in (None, (0.0, 0.0, 1.0)):
                 raise ValueError(
@@ -155,7 +108,7 @@ def _add_reboundx_effects(sim: Any, system: System, normal: tuple) -> Any:
                     f"system so that body {body.name!r} has its pole on z to cross-check"
                 )
             sim.particles[b].params["J2"] = float(params.get("j2", body.j2))
-            sim.particles[b].params["R_eq"] = float(params.get("radius", body._radius))
+            sim.particles[b].params["R_eq"] = float(params.get("radius", arrays.radius[b]))
         else:
             raise ValueError(f"Effect {name!r} has no reboundx counterpart to cross-check")
     return rebx
@@ -193,12 +146,14 @@ class CrossCheck:
     peer: str
     rebound_energy_error: np.ndarray | None = None
     rebound_angular_momentum_error: np.ndarray | None = None
+    length_unit: str = ""
 
     @property
     def rows(self) -> list[dict[str, Any]]:
         """One row per body: final position difference (au for Quantity systems)."""
+        dr = f"|dr| ({self.length_unit})" if self.length_unit else "|dr|"
         return [
-            {"body": name, "|dr|": float(self.position_difference[k]),
+            {"body": name, dr: float(self.position_difference[k]),
              "|dr|/r": float(self.relative_position_difference[k])}
             for k, name in enumerate(self.names)
         ]
@@ -215,7 +170,8 @@ class CrossCheck:
         ]
 
     def __str__(self) -> str:
-        lines = [f"{'body':<24}{'|dr| (au)' :>14}{'|dr|/r':>12}"]
+        dr = f"|dr| ({self.length_unit})" if self.length_unit else "|dr|"
+        lines = [f"{'body':<24}{dr:>14}{'|dr|/r':>12}"]
         for k, name in enumerate(self.names):
             lines.append(
                 f"{name:<24}{self.position_difference[k]:>14.3e}"
@@ -235,12 +191,11 @@ class CrossCheck:
 def run_rebound(system: System, t_end: float, effects: Sequence[Any] = (),
                 integrator: str = "ias15", dt: float | None = None) -> tuple[Any, float]:
     """Integrate ``system`` in rebound to internal time ``t_end``; (simulation, seconds)."""
-    normal = normalize_effects(effects, "nbody")
     sim = to_rebound(system)
     sim.integrator = integrator
     if dt is not None:
         sim.dt = dt
-    rebx = _add_reboundx_effects(sim, system, normal)
+    rebx = _add_reboundx_effects(sim, system, EffectSet.of(effects, "nbody"))
     start = _time.perf_counter()
     sim.integrate(t_end, exact_finish_time=1)
     wall = _time.perf_counter() - start
@@ -254,11 +209,10 @@ def rebound_trajectory(system: System, t_out: np.ndarray, effects: Sequence[Any]
 
     Returns ``(r, v, wall_time, steps)`` with ``r``, ``v`` of shape (n_t, n, 3).
     """
-    normal = normalize_effects(effects, "nbody")
     sim = to_rebound(system)
     sim.integrator = integrator
     sim.t = float(t_out[0])
-    rebx = _add_reboundx_effects(sim, system, normal)
+    rebx = _add_reboundx_effects(sim, system, EffectSet.of(effects, "nbody"))
     n = len(system)
     r = np.empty((len(t_out), n, 3))
     v = np.empty_like(r)
@@ -309,27 +263,27 @@ def crosscheck(
     Examples
     --------
     >>> import numpy as np
+    >>> from hamilton_orbits import Body
     >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
     ...             Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
     >>> table = crosscheck(s, 2 * np.pi, method="dop853", tol=1e-13)
     >>> bool(table.relative_position_difference.max() < 1e-9)
     True
     """
-    from hamilton_orbits.simulation import _diagnostics, integrate
+    from hamilton_orbits.simulation import integrate
 
+    effects = EffectSet.of(effects, "nbody")
     if trajectory is None:
         trajectory = integrate(system, t, method=method, dt=dt, tol=tol, effects=effects,
                                progress=progress)
+    _check_same_start(system, trajectory)
     times = trajectory.t.to_value("day") if system.quantity else np.asarray(trajectory.t)
-    effects = normalize_effects(effects)
-    r_all, v_all, wall, steps = rebound_trajectory(
-        system, times, [dict(name=n, **dict(p)) for n, p in effects]
-    )
-    energy, ang, _ = _diagnostics(system, r_all, v_all, times)
-    final = trajectory.final
+    r_all, v_all, wall, steps = rebound_trajectory(system, times, effects)
+    arrays = system.as_arrays()
+    energy, ang, _ = integral_errors(r_all, v_all, arrays.gm, times)
     r_reb = r_all[-1]
-    dr = np.linalg.norm(final._r - r_reb, axis=1)
-    rc = system._gm @ r_reb / system._gm.sum()
+    dr = np.linalg.norm(trajectory.final.as_arrays().r - r_reb, axis=1)
+    rc = arrays.gm @ r_reb / arrays.gm.sum()
     dist = np.linalg.norm(r_reb - rc, axis=1)
     rel = dr / np.where(dist > 0, dist, 1.0)
     peer = "rebound ias15" + (" + reboundx" if effects else "")
@@ -345,4 +299,20 @@ def crosscheck(
         peer,
         rebound_energy_error=energy,
         rebound_angular_momentum_error=ang,
+        length_unit="au" if system.quantity else "",
     )
+
+
+def _check_same_start(system: System, trajectory: Any) -> None:
+    """Refuse a trajectory that did not start from ``system``'s bodies and state."""
+    if tuple(trajectory.names) != tuple(system.names):
+        raise ValueError(f"Expected `trajectory` of the bodies {list(system.names)}, got one "
+                         f"of {list(trajectory.names)}")
+    r0 = np.asarray(getattr(trajectory.r, "value", trajectory.r))[0]
+    v0 = np.asarray(getattr(trajectory.v, "value", trajectory.v))[0]
+    arrays = system.as_arrays()
+    if not (np.array_equal(r0, arrays.r) and np.array_equal(v0, arrays.v)):
+        k = int(np.argmax(np.any((r0 != arrays.r) | (v0 != arrays.v), axis=1)))
+        raise ValueError(f"Expected `trajectory` to start from `system`'s state; body "
+                         f"{system.names[k]!r} starts elsewhere ({r0[k].tolist()} against "
+                         f"{arrays.r[k].tolist()})")

@@ -45,7 +45,6 @@ import html
 import json
 import math
 import os
-import shutil
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -54,7 +53,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Row", "build_report", "log", "readme_section", "timed", "update_readme"]
+__all__ = ["Row", "build_report", "fmt_time", "log", "timed"]
 
 
 @dataclass
@@ -178,11 +177,13 @@ def _kepler(quick: bool, progress: bool) -> list[Row]:
 
 
 # --------------------------------------------------------------------------- 2. solar system
+_Case = tuple[str, str, str, Callable[[], np.ndarray]]
+
+
 def _solar(quick: bool, progress: bool) -> list[Row]:
     import astropy.units as u
-    import rebound
 
-    from hamilton_orbits import System, integrate
+    from hamilton_orbits import System
 
     name = "solar system"
     years = 10 if quick else 1000
@@ -193,89 +194,92 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     v0 = system.v.to_value(u.au / u.day)
     gm = (system.gm).to_value(u.au**3 / u.day**2)
     t_end = years * 365.25
-
-    def helio(r: np.ndarray) -> np.ndarray:
-        return r[1:] - r[0]
-
-    def rebound_run(integrator: str, dt: float, epsilon: float | None = None,
-                    coordinates: str | None = None) -> np.ndarray:
-        sim = rebound.Simulation()
-        sim.G = 1.0
-        sim.integrator = integrator
-        for k in range(len(gm)):
-            sim.add(m=float(gm[k]), x=r0[k, 0], y=r0[k, 1], z=r0[k, 2],
-                    vx=v0[k, 0], vy=v0[k, 1], vz=v0[k, 2])
-        if epsilon is not None:
-            sim.integrator.epsilon = epsilon
-        if coordinates is not None:
-            sim.integrator.coordinates = coordinates
-        sim.dt = dt
-        sim.integrate(t_end, exact_finish_time=1)
-        return np.array([p.xyz for p in sim.particles])
-
     log(progress, f"{name}: reference ({years} yr)")
-    ref = helio(rebound_run("ias15", 0.5, 0.0))
+    ref = _helio(_rebound_run(r0, v0, gm, t_end, "ias15", 0.5, 0.0))
     scale = np.linalg.norm(ref, axis=1)
-
-    def err(r: np.ndarray) -> float:
-        return float(np.max(np.linalg.norm(helio(r) - ref, axis=1) / scale))
-
-    cases: list[tuple[str, str, str, Callable[[], np.ndarray]]] = []
-
-    def ours(method: str, dt: float | None = None, tol: float | None = None, **options: Any):
-        def run() -> np.ndarray:
-            tr = integrate(system, t_end * u.day, method=method,
-                           dt=None if dt is None else dt * u.day, tol=tol, **options)
-            return tr.final.r.to_value(u.au)
-        return run
-
-    tols = (1e-6, 1e-9) if quick else (1e-6, 1e-9, 1e-12)
-    for tol in tols:
-        cases.append(("hamilton-orbits", "radau15", f"tol = {tol:g}", ours("radau15", tol=tol)))
-    dts_wh = (8.0, 2.0) if quick else (8.0, 4.0, 2.0, 1.0)
-    dts_lf = (1.0, 0.25) if quick else (1.0, 0.5, 0.25)
-    for dt in dts_wh:
-        cases.append(("hamilton-orbits", "wh", f"dt = {dt:g} d", ours("wh", dt=dt)))
-    for dt in dts_wh:  # the coordinates of rebound's default WHFast
-        cases.append(("hamilton-orbits", "wh (Jacobi)", f"dt = {dt:g} d",
-                      ours("wh", dt=dt, coordinates="jacobi")))
-    for dt in dts_wh:
-        cases.append(("hamilton-orbits", "wh (Jacobi, corrector 3)", f"dt = {dt:g} d",
-                      ours("wh", dt=dt, coordinates="jacobi", corrector=3)))
-    for dt in dts_lf:
-        cases.append(("hamilton-orbits", "leapfrog", f"dt = {dt:g} d", ours("leapfrog", dt=dt)))
-    for tol in (1e-8, 1e-11) if quick else (1e-10, 1e-12, 1e-14):
-        cases.append(("hamilton-orbits", "dop853", f"tol = {tol:g}", ours("dop853", tol=tol)))
-    for eps in (1e-6, 1e-9):
-        cases.append(("rebound", "IAS15", f"epsilon = {eps:g}",
-                      lambda eps=eps: rebound_run("ias15", 1.0, eps)))
-    for dt in dts_wh:  # rebound's default: Jacobi coordinates
-        cases.append(("rebound", "WHFast", f"dt = {dt:g} d",
-                      lambda dt=dt: rebound_run("whfast", dt)))
-    for dt in dts_wh:  # the map our ``wh`` uses by default
-        cases.append(("rebound", "WHFast (democratic heliocentric)", f"dt = {dt:g} d",
-                      lambda dt=dt: rebound_run("whfast", dt,
-                                                coordinates="democraticheliocentric")))
-    for dt in dts_lf:
-        cases.append(("rebound", "leapfrog", f"dt = {dt:g} d",
-                      lambda dt=dt: rebound_run("leapfrog", dt)))
-    cases += _heyoka_cases(r0, v0, gm, t_end, quick, progress)
-
-    # warm up (compile) our kernels on a short span
-    for method, kw in (("radau15", {}), ("wh", {"dt": 4 * u.day}),
-                       ("leapfrog", {"dt": 1 * u.day}), ("dop853", {})):
-        integrate(system, 10 * u.day, method=method, **kw)
-
+    cases = (_solar_ours(r0, v0, gm, t_end, quick) + _solar_rebound(r0, v0, gm, t_end, quick)
+             + _heyoka_cases(r0, v0, gm, t_end, quick, progress))
     rows = []
     for code, method, param, fn in cases:
         wt, out = timed(fn, 2)
-        rows.append(Row(name, code, method, param, err(out), measure, reference, wt))
-        log(progress, f"{name}: {code} {method} {param}: err {rows[-1].error:.2e} "
-                       f"time {wt:.3f} s")
+        error = float(np.max(np.linalg.norm(_helio(out) - ref, axis=1) / scale))
+        rows.append(Row(name, code, method, param, error, measure, reference, wt))
+        log(progress, f"{name}: {code} {method} {param}: err {error:.2e} time {wt:.3f} s")
     return rows
 
 
-_Case = tuple[str, str, str, Callable[[], np.ndarray]]
+def _helio(r: np.ndarray) -> np.ndarray:
+    return r[1:] - r[0]
+
+
+def _rebound_run(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
+                 integrator: str, dt: float, epsilon: float | None = None,
+                 coordinates: str | None = None) -> np.ndarray:
+    """rebound's final positions from the same state (G = 1, m = gm)."""
+    from hamilton_orbits._rebound import simulation_from_arrays
+
+    sim = simulation_from_arrays([f"b{k}" for k in range(len(gm))], gm, r0, v0)
+    sim.integrator = integrator
+    if epsilon is not None:
+        sim.integrator.epsilon = epsilon
+    if coordinates is not None:
+        sim.integrator.coordinates = coordinates
+    sim.dt = dt
+    sim.integrate(t_end, exact_finish_time=1)
+    return np.array([p.xyz for p in sim.particles])
+
+
+def _solar_ours(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
+                quick: bool) -> list[_Case]:
+    """Our integrators through the engine (the kernels compiled before timing)."""
+    from hamilton_orbits import engine
+    from hamilton_orbits.rhs import newtonian_rhs
+
+    rhs = newtonian_rhs()
+
+    def ours(method: str, dt: float | None = None, tol: float | None = None, **options: Any):
+        def run(t: float = t_end) -> np.ndarray:
+            return engine.run(r0, v0, gm, np.array([0.0, t]), rhs, method, dt=dt, tol=tol,
+                              options=options).r[-1]
+        run(10.0)  # warm up (compile) on a short span
+        return run
+
+    cases: list[_Case] = []
+    for tol in (1e-6, 1e-9) if quick else (1e-6, 1e-9, 1e-12):
+        cases.append(("hamilton-orbits", "radau15", f"tol = {tol:g}", ours("radau15", tol=tol)))
+    for label, options in (("wh", {}), ("wh (Jacobi)", {"coordinates": "jacobi"}),
+                           ("wh (Jacobi, corrector 3)", {"coordinates": "jacobi",
+                                                         "corrector": 3})):
+        for dt in _WH_STEPS[quick]:
+            cases.append(("hamilton-orbits", label, f"dt = {dt:g} d", ours("wh", dt, **options)))
+    for dt in _LEAPFROG_STEPS[quick]:
+        cases.append(("hamilton-orbits", "leapfrog", f"dt = {dt:g} d", ours("leapfrog", dt=dt)))
+    for tol in (1e-8, 1e-11) if quick else (1e-10, 1e-12, 1e-14):
+        cases.append(("hamilton-orbits", "dop853", f"tol = {tol:g}", ours("dop853", tol=tol)))
+    return cases
+
+
+_WH_STEPS = {True: (8.0, 2.0), False: (8.0, 4.0, 2.0, 1.0)}
+_LEAPFROG_STEPS = {True: (1.0, 0.25), False: (1.0, 0.5, 0.25)}
+
+
+def _solar_rebound(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
+                   quick: bool) -> list[_Case]:
+    """rebound's IAS15, WHFast (Jacobi and democratic heliocentric) and leapfrog."""
+    def reb(integrator: str, dt: float, epsilon: float | None = None,
+            coordinates: str | None = None) -> Callable[[], np.ndarray]:
+        return lambda: _rebound_run(r0, v0, gm, t_end, integrator, dt, epsilon, coordinates)
+
+    cases: list[_Case] = [("rebound", "IAS15", f"epsilon = {eps:g}", reb("ias15", 1.0, eps))
+                          for eps in (1e-6, 1e-9)]
+    for dt in _WH_STEPS[quick]:  # rebound's default: Jacobi coordinates
+        cases.append(("rebound", "WHFast", f"dt = {dt:g} d", reb("whfast", dt)))
+    for dt in _WH_STEPS[quick]:  # the map our ``wh`` uses by default
+        cases.append(("rebound", "WHFast (democratic heliocentric)", f"dt = {dt:g} d",
+                      reb("whfast", dt, coordinates="democraticheliocentric")))
+    for dt in _LEAPFROG_STEPS[quick]:
+        cases.append(("rebound", "leapfrog", f"dt = {dt:g} d", reb("leapfrog", dt)))
+    return cases
 
 
 def _heyoka_cases(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
@@ -492,121 +496,16 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
     return files
 
 
-_BEGIN = "<!-- report:begin (generated by `hamilton-orbits report --readme`) -->"
-_END = "<!-- report:end -->"
+def fmt_time(seconds: float) -> str:
+    """A wall time with a readable unit.
 
-
-def _fmt_time(seconds: float) -> str:
+    Examples
+    --------
+    >>> fmt_time(0.5), fmt_time(2.0e-5), fmt_time(12.34)
+    ('500 ms', '20 us', '12.3 s')
+    """
     if seconds >= 1:
         return f"{seconds:.3g} s"
     if seconds >= 1e-3:
         return f"{seconds * 1e3:.3g} ms"
     return f"{seconds * 1e6:.3g} us"
-
-
-def readme_section(report_dir: Any, diagram: str = "docs/work_precision.png") -> str:
-    """The README's generated part of "What accuracy costs in time", from a report.
-
-    One row per problem and method: the most accurate setting that was run (its
-    error and wall time) and the cheapest one.  Each problem's error measure and
-    reference are stated once, above its rows.
-
-    Parameters
-    ----------
-    report_dir : str or path-like
-        A folder written by :func:`build_report` (it reads ``report.json``).
-    diagram : str, optional
-        Path of the combined diagram, relative to the README.
-
-    Returns
-    -------
-    str
-        Markdown, without the begin/end markers.
-
-    Examples
-    --------
-    >>> import json, tempfile, pathlib
-    >>> d = pathlib.Path(tempfile.mkdtemp())
-    >>> row = dict(problem="p", code="c", method="m", parameter="dt = 1", error=1e-9,
-    ...            error_measure="|dr|", reference="exact", wall_time=0.5)
-    >>> meta = dict(mode="full", date="2026-11-23 12:00 UTC", cores=2, total_seconds=9.0)
-    >>> _ = (d / "report.json").write_text(json.dumps({"meta": meta, "rows": [row]}))
-    >>> print(readme_section(d).splitlines()[-1])
-    | c | m | dt = 1: 1.0e-09 in 500 ms | dt = 1: 1.0e-09 in 500 ms |
-    """
-    data = json.loads((Path(report_dir) / "report.json").read_text(encoding="utf-8"))
-    meta = data["meta"]
-    rows = [Row(**r) for r in data["rows"]]
-    lines = [
-        f"Generated by `hamilton-orbits report --readme README.md` ({meta['mode']} run, "
-        f"{meta['date']}, a {meta['cores']}-core machine, {_fmt_time(meta['total_seconds'])} "
-        "in all; every wall time is the shortest of up to three runs in one process, so "
-        "ours and the peers' met the same machine load).  Each cell: the setting, the "
-        "error it reached and its wall time.",
-        "",
-        f"![error against wall time for every problem and method]({diagram})",
-    ]
-    for problem in dict.fromkeys(r.problem for r in rows):
-        mine = [r for r in rows if r.problem == problem]
-        first = next((r for r in mine if r.error > 0), mine[0])  # not the reference's own row
-        lines += ["", f"**{problem}**: error = {first.error_measure}; reference: "
-                      f"{first.reference}.", "",
-                  "| code | method | most accurate | cheapest |", "|---|---|---|---|"]
-        for key in dict.fromkeys((r.code, r.method) for r in mine):
-            group = [r for r in mine if (r.code, r.method) == key]
-            best = min(group, key=lambda r: (r.error, r.wall_time))
-            cheap = min(group, key=lambda r: r.wall_time)
-            cells = [f"{r.parameter}: {r.error:.1e} in {_fmt_time(r.wall_time)}"
-                     for r in (best, cheap)]
-            lines.append(f"| {key[0]} | {key[1]} | {cells[0]} | {cells[1]} |")
-    return "\n".join(lines)
-
-
-def update_readme(report_dir: Any, readme: Any) -> Path:
-    """Copy the combined diagram and the full table under ``docs/`` and rewrite the
-    README's generated section between its markers.
-
-    Parameters
-    ----------
-    report_dir : str or path-like
-        A folder written by :func:`build_report`.
-    readme : str or path-like
-        The README to update; it must hold the markers ``<!-- report:begin ... -->``
-        and ``<!-- report:end -->``.  ``docs/`` is taken next to it.
-
-    Returns
-    -------
-    Path
-        The README.
-
-    Raises
-    ------
-    ValueError
-        If the README is missing or lacks the markers.
-
-    Examples
-    --------
-    >>> from hamilton_orbits.report import update_readme
-    >>> callable(update_readme)
-    True
-    """
-    src = Path(report_dir)
-    path = Path(readme)
-    if not path.is_file():
-        raise ValueError(f"`readme` {str(path)!r} is not a file")
-    text = path.read_text(encoding="utf-8")
-    begin = text.find(_BEGIN)
-    end = text.find(_END)
-    if begin < 0 or end < begin:
-        raise ValueError(f"`readme` {str(path)!r} has no generated section: add the lines "
-                         f"{_BEGIN!r} and {_END!r} where it belongs")
-    docs = path.parent / "docs"
-    docs.mkdir(exist_ok=True)
-    shutil.copyfile(src / "work_precision.png", docs / "work_precision.png")
-    shutil.copyfile(src / "report.md", docs / "work_precision.md")
-    body = readme_section(src, "docs/work_precision.png")
-    body += ("\n\nThe full table (every setting): [docs/work_precision.md]"
-             "(docs/work_precision.md).")
-    path.write_text(text[: begin + len(_BEGIN)] + "\n\n" + body + "\n\n" + text[end:],
-                    encoding="utf-8")
-    return path

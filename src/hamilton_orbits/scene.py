@@ -30,22 +30,21 @@ Scene *kinds* (``nbody`` here; ``rotation`` from ``rigid``) are registered in
 from __future__ import annotations
 
 import copy
-import json
-import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import astropy.units as u
-import numpy as np
 import tomllib
 
+from hamilton_orbits import _scene_nbody  # noqa: F401  (registers the "nbody" kind)
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
+from hamilton_orbits._scene_base import KINDS, Result, SceneKind, format_table, register_kind
 
-__all__ = ["KINDS", "Result", "Scene", "SceneError", "SceneKind", "register_kind"]
+__all__ = ["KINDS", "Result", "Scene", "SceneError", "SceneKind", "format_table",
+           "register_kind"]
 
 
 class SceneError(ValueError):
@@ -61,47 +60,7 @@ class SceneError(ValueError):
         super().__init__(f"invalid scene ({head}):\n  " + "\n  ".join(self.problems))
 
 
-@dataclass(frozen=True)
-class SceneKind:
-    """A kind of scene: its keys, its checks across keys, and how it runs.
-
-    Parameters
-    ----------
-    name : str
-        The ``kind = "..."`` value.
-    summary : str
-        One line for listings.
-    schema : Mapping[str, _schema.Field]
-        The kind's keys (besides ``kind``, ``description`` and ``effects``).
-    effect_kind : str
-        Which effect registry the kind's ``effects`` come from.
-    check : callable
-        ``check(spec, problems)``: checks across keys (a body an effect names
-        exists, the integrator accepts the effects), adding to ``problems``.
-    run : callable
-        ``run(scene, progress, stop) -> Result``; ``stop()`` is true once the
-        user asked to stop (Ctrl-C): the run ends early and keeps what it has.
-    crosscheck : callable or None
-        ``crosscheck(scene) -> str``: the same scene in a peer code, tabled.
-    """
-
-    name: str
-    summary: str
-    schema: Mapping[str, S.Field]
-    effect_kind: str
-    check: Callable[[dict, S.Problems], None]
-    run: Callable[..., Result]
-    crosscheck: Callable[[Scene], str] | None = None
-
-
-KINDS: dict[str, SceneKind] = {}
 _KIND_ENTRY_POINTS_LOADED = False
-
-
-def register_kind(kind: SceneKind) -> SceneKind:
-    """Register a scene kind (``rigid`` registers ``rotation`` through an entry point)."""
-    KINDS[kind.name] = kind
-    return kind
 
 
 def _kinds() -> dict[str, SceneKind]:
@@ -109,8 +68,6 @@ def _kinds() -> dict[str, SceneKind]:
     if not _KIND_ENTRY_POINTS_LOADED:
         _KIND_ENTRY_POINTS_LOADED = True
         from importlib.metadata import entry_points
-
-        from hamilton_orbits import _scene_nbody  # noqa: F401  (registers "nbody")
 
         for ep in entry_points(group="hamilton_orbits.scene_kinds"):
             ep.load()()
@@ -128,22 +85,11 @@ class _EffectField(S.Field):
     effect_kind: str = "nbody"
 
     def check(self, value: Any, path: str, problems: S.Problems) -> Any:
-        if isinstance(value, str):
-            value = {"name": value}
-        if not isinstance(value, Mapping) or not isinstance(value.get("name"), str):
-            problems.add(path, f'expected an effect name or a table with a "name", got {value!r}')
+        name, params, found = _effects.entry_problems(value, self.effect_kind)
+        for key, message in found:
+            problems.add(f"{path}.{key}" if key else path, message)
+        if name is None:
             return None
-        name = value["name"]
-        known = _effects.known(self.effect_kind)
-        if name not in known:
-            problems.add(f"{path}.name", f"unknown effect {name!r}{S.closest(name, known)}")
-            return None
-        spec = _effects.get(self.effect_kind, name)
-        params = {k: v for k, v in value.items() if k != "name"}
-        for key in params:
-            if key not in spec.parameters:
-                hint = S.closest(key, list(spec.parameters))
-                problems.add(f"{path}.{key}", f"unknown parameter of effect {name!r}{hint}")
         return {"name": name, **params}
 
 
@@ -307,6 +253,13 @@ class Scene:
         )
         spec = schema.check(data, "", problems)
         if not problems:
+            first: dict[str, int] = {}
+            for k, effect in enumerate(spec["effects"]):
+                if effect["name"] in first:
+                    problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
+                                                  f"(first at effects[{first[effect['name']]}])")
+                first.setdefault(effect["name"], k)
+        if not problems:
             kind.check(spec, problems)
         if problems:
             raise SceneError(problems.items)
@@ -345,196 +298,3 @@ class Scene:
         return kind.crosscheck(self)
 
 
-def _fmt(value: Any) -> str:
-    if isinstance(value, u.Quantity):
-        if value.isscalar:
-            return f"{value.value:.6g} {value.unit:unicode}".strip()
-        return str(value)
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
-
-
-def format_table(rows: Sequence[Mapping[str, Any]]) -> str:
-    """An aligned text table of ``rows`` (dicts with the same keys).
-
-    Examples
-    --------
-    >>> print(format_table([{"body": "sun", "dr": 1e-12}, {"body": "earth", "dr": 2.5e-10}]))
-    body   dr
-    -----  -------
-    sun    1e-12
-    earth  2.5e-10
-    """
-    if not rows:
-        return ""
-    keys = list(rows[0])
-    cells = [[_fmt(r.get(k, "")) for k in keys] for r in rows]
-    widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(keys)]
-    lines = ["  ".join(k.ljust(w) for k, w in zip(keys, widths, strict=True)).rstrip()]
-    lines.append("  ".join("-" * w for w in widths))
-    for c in cells:
-        lines.append("  ".join(x.ljust(w) for x, w in zip(c, widths, strict=True)).rstrip())
-    return "\n".join(lines)
-
-
-@dataclass
-class Result:
-    """What a scene's run produced.
-
-    Attributes
-    ----------
-    scene : Scene
-    times : Quantity
-        The output times.
-    diagnostics : dict
-        Named series on ``times`` (energy error, angular-momentum error, ...).
-    metrics : dict
-        Headline numbers (Quantities or floats), e.g. the perihelion advance.
-    tables : dict
-        Named tables (lists of row dicts), e.g. the per-body cross-check.
-    states : dict
-        Arrays to save (``names``, ``r``, ``v`` for n-body scenes).
-    wall_time : float
-        Seconds the simulation took.
-    complete : bool
-        False if the run was stopped early (Ctrl-C); what was done is kept.
-    """
-
-    scene: Scene
-    times: u.Quantity
-    diagnostics: dict[str, Any] = field(default_factory=dict)
-    metrics: dict[str, Any] = field(default_factory=dict)
-    tables: dict[str, list[dict]] = field(default_factory=dict)
-    states: dict[str, Any] = field(default_factory=dict)
-    wall_time: float = 0.0
-    complete: bool = True
-    plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
-    writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
-                                                                repr=False)
-
-    def summary(self) -> str:
-        """The summary table as text (what the command prints)."""
-        s = self.scene
-        lines = [f"scene {s.name} ({s.kind}): {s.spec.get('description', '').strip()}"]
-        effects = ", ".join(e["name"] for e in s.effects) or "none"
-        lines.append(f"effects: {effects}")
-        if not self.complete:
-            lines.append("STOPPED EARLY: the results cover the part that was run")
-        span = self.times[-1] - self.times[0] if len(self.times) else 0 * u.d
-        asked = s.spec.get("duration")
-        if isinstance(asked, u.Quantity) and asked.unit.physical_type == "time":
-            span = span.to(asked.unit)
-        elif span > 1 * u.yr:
-            span = span.to(u.yr)
-        lines.append(f"simulated: {_fmt(span)} in {self.wall_time:.2f} s")
-        if self.metrics:
-            lines.append("")
-            rows = [{"quantity": k, "value": v} for k, v in self.metrics.items()]
-            lines.append(format_table(rows))
-        for title, rows in self.tables.items():
-            lines.append("")
-            lines.append(title)
-            lines.append(format_table(rows))
-        return "\n".join(lines)
-
-    def plot(self) -> list:
-        """The scene's figures (matplotlib), one per plotter."""
-        try:
-            import matplotlib
-
-            matplotlib.use("Agg", force=False)
-        except ImportError as exc:  # pragma: no cover - depends on the install
-            raise ImportError(
-                "figures need matplotlib: python -m pip install 'hamilton-orbits[plot]'"
-            ) from exc
-        return [p(self) for p in self.plotters]
-
-    def _json(self) -> dict:
-        def conv(v: Any) -> Any:
-            if isinstance(v, u.Quantity):
-                return {"value": v.value.tolist(), "unit": str(v.unit)}
-            if isinstance(v, np.ndarray):
-                return v.tolist()
-            if isinstance(v, float) and not math.isfinite(v):
-                return str(v)
-            if isinstance(v, np.floating | np.integer):
-                return v.item()
-            return v
-
-        return {
-            "scene": self.scene.name,
-            "kind": self.scene.kind,
-            "description": self.scene.spec.get("description", ""),
-            "effects": [dict(e) for e in self.scene.effects],
-            "complete": self.complete,
-            "wall_time_s": self.wall_time,
-            "metrics": {k: conv(v) for k, v in self.metrics.items()},
-            "tables": {k: [{c: conv(x) for c, x in r.items()} for r in rows]
-                       for k, rows in self.tables.items()},
-        }
-
-    def save(self, directory: str | Path) -> list[Path]:
-        """Write the summary (Markdown, JSON), the figures (PNG) and the states (netCDF).
-
-        A scene kind may add files (n-body scenes: the final state as a rebound
-        binary, ``final.bin``).  Returns the paths written.  The states file is
-        netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.
-        """
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
-        written = []
-        md = out / "summary.md"
-        md.write_text(f"# {self.scene.name}\n\n```\n{self.summary()}\n```\n", encoding="utf-8")
-        written.append(md)
-        js = out / "summary.json"
-        js.write_text(json.dumps(self._json(), indent=2) + "\n", encoding="utf-8")
-        written.append(js)
-        if self.plotters:
-            import matplotlib.pyplot as plt
-
-            for i, fig in enumerate(self.plot()):
-                name = getattr(fig, "_hamilton_name", f"figure{i + 1}")
-                path = out / f"{name}.png"
-                fig.savefig(path, dpi=110, bbox_inches="tight")
-                plt.close(fig)
-                written.append(path)
-        written.extend(self._save_states(out))
-        for writer in self.writers:
-            written.extend(writer(self, out))
-        return written
-
-    def _save_states(self, out: Path) -> list[Path]:
-        from scipy.io import netcdf_file
-
-        path = out / "states.nc"
-        t = self.times.to_value(u.d)
-        with netcdf_file(path, "w") as f:
-            f.title = f"hamilton-orbits scene {self.scene.name}"
-            f.createDimension("time", len(t))
-            var = f.createVariable("time", "d", ("time",))
-            var[:] = t
-            var.units = "day"
-            for name, series in self.diagnostics.items():
-                arr = np.asarray(getattr(series, "value", series), dtype=float)
-                if arr.shape != t.shape:
-                    continue
-                var = f.createVariable(name, "d", ("time",))
-                var[:] = arr
-                var.units = str(getattr(series, "unit", ""))
-            for name, value in self.states.items():
-                arr = np.asarray(getattr(value, "value", value))
-                if arr.dtype.kind not in "fi" or arr.ndim == 0:
-                    continue
-                dims = ["time"] + [f"{name}_dim{k}" for k in range(1, arr.ndim)]
-                if arr.shape[0] != len(t):
-                    continue
-                for k in range(1, arr.ndim):
-                    f.createDimension(dims[k], arr.shape[k])
-                var = f.createVariable(name, "d", tuple(dims))
-                var[:] = arr
-                var.units = str(getattr(value, "unit", ""))
-            names = self.states.get("names")
-            if names is not None:
-                f.bodies = ",".join(str(n) for n in names)
-        return [path]

@@ -7,60 +7,40 @@ the total angular momentum (law of areas) and of the energy (vis viva).
 
 from __future__ import annotations
 
-import importlib
-import time as _time
-from collections.abc import Mapping, Sequence
+import contextlib
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.effects import compile_rhs, get, normalize_effects
-from hamilton_orbits.nbody import DAY, System, energy_gm_many
+from hamilton_orbits import engine
+from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.integrators import INTEGRATORS
+from hamilton_orbits.nbody import DAY, System, integral_errors
+from hamilton_orbits.rhs import compile_rhs
+from hamilton_orbits.trajectory import TrajectoryBase
 from hamilton_orbits.units import TIME, is_quantity
 
-__all__ = ["INTEGRATORS", "Trajectory", "integrate", "integrator_module"]
-
-INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
+__all__ = ["INTEGRATORS", "Trajectory", "check_method", "integrate", "make_trajectory"]
 
 
-def integrator_module(method: str) -> Any:
-    """The module of integrator ``method`` (ValueError listing the known ones).
-
-    Examples
-    --------
-    >>> integrator_module("leapfrog").NAME
-    'leapfrog'
-    """
-    if method not in INTEGRATORS:
-        raise ValueError(f"Unknown `method` {method!r}; known: {', '.join(INTEGRATORS)}")
-    try:
-        return importlib.import_module(f"hamilton_orbits.integrators.{method}")
-    except ModuleNotFoundError as exc:  # pragma: no cover - only while a method is missing
-        raise ValueError(f"Integrator {method!r} is not available in this build") from exc
+def _accepting_velocity_dependent() -> list[str]:
+    return [m for m in INTEGRATORS if engine.integrator(m).ACCEPTS_VELOCITY_DEPENDENT]
 
 
-def _accepting(velocity_dependent: bool) -> list[str]:
-    out = []
-    for name in INTEGRATORS:
-        try:
-            mod = integrator_module(name)
-        except ValueError:
-            continue
-        if mod.ACCEPTS_VELOCITY_DEPENDENT or not velocity_dependent:
-            out.append(name)
-    return out
-
-
-@dataclass(frozen=True, eq=False)
-class Trajectory:
+@dataclass(frozen=True, eq=False, kw_only=True)
+class Trajectory(TrajectoryBase):
     """The states of a system at the output times, with Hamilton's integrals.
 
-    Attributes
+    Attributes (beside those of :class:`~hamilton_orbits.trajectory.TrajectoryBase`:
+    ``t``, ``steps``, ``wall_time``, ``method``, ``energy_error``,
+    ``angular_momentum_error``)
     ----------
     t : ndarray or Quantity, shape (n_t,)
-        Output times (the first is the initial time).
+        Output times (the first is the initial time), in the unit the caller gave
+        ``t`` in (a Quantity system), or the caller's floats.
     r, v : ndarray or Quantity, shape (n_t, n, 3)
         Positions and velocities (au, au/day for Quantity systems).
     names : tuple of str
@@ -76,23 +56,17 @@ class Trajectory:
     steps : int
         Steps taken by the integrator.
     wall_time : float
-        Seconds of wall-clock time for the integration (JIT compilation included
-        on a first call).
+        Seconds of wall-clock time for the integration proper (the compilation
+        of a right-hand side for new effects and the checks are not counted).
     method : str
     effects : tuple of str
     """
 
-    t: Any
     r: Any
     v: Any
     names: tuple[str, ...]
     final: System
-    energy_error: np.ndarray
-    angular_momentum_error: np.ndarray
     barycentre_drift: np.ndarray
-    steps: int
-    wall_time: float
-    method: str
     effects: tuple[str, ...]
 
     def __repr__(self) -> str:
@@ -103,12 +77,16 @@ class Trajectory:
         )
 
 
-def _times(t: Any, quantity: bool) -> np.ndarray:
+def _times(t: Any, quantity: bool) -> tuple[np.ndarray, Any]:
+    """Output times in days (Quantity system) from ``t``, with the caller's unit."""
     if quantity and not is_quantity(t):
         raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
     if not quantity and is_quantity(t):
         raise ValueError(f"Expected `t` as plain floats for a system of plain floats, got {t!r}")
+    unit = t.unit if quantity else None
     arr = np.atleast_1d(TIME("t", t, DAY if quantity else None)).astype(np.float64)
+    if arr.size == 0:
+        raise ValueError("Expected `t` to be an end time or a non-empty array of times, got []")
     if arr.ndim != 1:
         raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
                          f"{arr.shape}")
@@ -125,31 +103,14 @@ def _times(t: Any, quantity: bool) -> np.ndarray:
             f"Expected `t` to be strictly monotonic (times after the start 0), got "
             f"{arr[k + 1]!r} after {arr[k]!r} at index {k + 1}"
         )
-    return arr
-
-
-def _diagnostics(system: System, r: np.ndarray, v: np.ndarray, t: np.ndarray):
-    gm = system._gm
-    e = energy_gm_many(r, v, gm)
-    e0 = e[0]
-    energy_error = (e - e0) / abs(e0) if e0 != 0 else e - e0
-    h = np.einsum("j,tjk->tk", gm, np.cross(r, v))
-    h0 = np.linalg.norm(h[0])
-    dh = np.linalg.norm(h - h[0], axis=1)
-    am_error = dh / h0 if h0 > 0 else dh
-    total = gm.sum()
-    rc = np.einsum("j,tjk->tk", gm, r) / total
-    vc0 = gm @ v[0] / total
-    scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
-    drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
-    return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
+    return arr, unit
 
 
 def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
     """Refuse an option the integrator's ``run`` does not take, listing those it does."""
     import inspect
 
-    common = {"dt", "tol", "on_output"}
+    common = {"dt", "tol", "on_output", "out"}
     takes = [name for name, p in inspect.signature(module.run).parameters.items()
              if p.kind is p.KEYWORD_ONLY and name not in common]
     for key, value in options.items():
@@ -207,6 +168,8 @@ def integrate(
         For an unknown method or effect, a velocity-dependent effect given to a
         symplectic integrator (naming the effect and the integrators that accept
         it), or bad times.
+    KeyboardInterrupt
+        On Ctrl-C (the run stops within a few thousand steps).
 
     Examples
     --------
@@ -227,18 +190,8 @@ def integrate(
     """
     if not isinstance(system, System):
         raise ValueError(f"Expected `system` to be a System, got {system!r}")
-    module = integrator_module(method)
-    _check_options(module, method, options)
-    normal = normalize_effects(effects, "nbody")
-    if not module.ACCEPTS_VELOCITY_DEPENDENT:
-        for name, _ in normal:
-            if get("nbody", name).velocity_dependent:
-                raise ValueError(
-                    f"Effect {name!r} depends on velocities and integrator {method!r} is "
-                    f"symplectic; integrators that accept it: {', '.join(_accepting(True))}"
-                    + (" (or use 'gr_potential')" if name == "gr" else "")
-                )
-    times = _times(t, system.quantity)
+    eff = check_method(method, effects, options)
+    times, unit = _times(t, system.quantity)
     step = None
     if dt is not None:
         step = float(TIME("dt", dt, DAY if system.quantity else None))
@@ -248,15 +201,57 @@ def integrate(
         tol = float(tol)
         if not (np.isfinite(tol) and tol > 0):
             raise ValueError(f"Expected `tol` > 0, got {tol!r}")
-    sign = 1.0 if times[-1] > times[0] else -1.0
-    rhs = compile_rhs(system, [dict(name=n, **dict(p)) for n, p in normal])
+    rhs = compile_rhs(system, eff)
+    arrays = system.as_arrays()
+    with _progress(progress, method, len(times) - 1, on_output) as report:
+        out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
+                         options=options, on_output=report)
+    if not out.complete:
+        raise KeyboardInterrupt
+    return make_trajectory(system, out, unit, method, rhs.effects)
 
+
+def check_method(method: str, effects: Any, options: Mapping[str, Any]) -> EffectSet:
+    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked
+    against ``method`` and its ``options``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, option or effect, or a velocity-dependent effect
+        given to a symplectic integrator (naming the effect and the integrators
+        that accept it).
+
+    Examples
+    --------
+    >>> check_method("wh", ["gr_potential"], {"coordinates": "jacobi"}).names
+    ('gr_potential',)
+    """
+    module = engine.integrator(method)
+    _check_options(module, method, dict(options))
+    eff = EffectSet.of(effects, "nbody")
+    if not module.ACCEPTS_VELOCITY_DEPENDENT:
+        for name in eff.names:
+            if get("nbody", name).velocity_dependent:
+                raise ValueError(
+                    f"Effect {name!r} depends on velocities and integrator {method!r} is "
+                    f"symplectic; integrators that accept it: "
+                    f"{', '.join(_accepting_velocity_dependent())}"
+                    + (" (or use 'gr_potential')" if name == "gr" else "")
+                )
+    return eff
+
+
+@contextlib.contextmanager
+def _progress(enabled: bool, method: str, total: int, on_output: Any) -> Iterator[Any]:
+    """An output callback that advances a tqdm bar (when ``enabled``) and calls
+    ``on_output``; the bar is closed on the way out."""
     bar = None
-    if progress:
+    if enabled:
         try:
             from tqdm.auto import tqdm
 
-            bar = tqdm(total=len(times) - 1, desc=f"{method}", unit="output", leave=False)
+            bar = tqdm(total=total, desc=method, unit="output", leave=False)
         except ImportError:  # pragma: no cover - tqdm is an optional extra
             bar = None
 
@@ -266,29 +261,24 @@ def integrate(
         if on_output is not None:
             on_output(i, steps)
 
-    start = _time.perf_counter()
-    r0 = np.array(system._r, dtype=np.float64)
-    v0 = np.array(system._v, dtype=np.float64)
-    gm = np.array(system._gm, dtype=np.float64)
     try:
-        if sign > 0:
-            r, v, steps = module.run(rhs, r0, v0, gm, times, dt=step, tol=tol, on_output=report,
-                                     **options)
-        else:
-            # integrate backwards as forwards with the velocities reversed; exact for
-            # conservative forces; velocity-dependent ones are odd in v: handled by
-            # integrating in -t with the dispatcher on reversed velocities is not
-            # generally valid, so refuse it.
-            if rhs.velocity_dependent:
-                raise ValueError("Backward integration with a velocity-dependent effect is not "
-                                 "supported; integrate forwards from the final state")
-            r, v, steps = module.run(rhs, r0, -v0, gm, -times, dt=step, tol=tol,
-                                     on_output=report, **options)
-            v = -v
+        yield report
     finally:
         if bar is not None:
             bar.close()
-    wall = _time.perf_counter() - start
+
+
+def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: str,
+                    effects: tuple[str, ...]) -> Trajectory:
+    """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
+    Quantity system, with times in ``unit``).
+
+    Raises
+    ------
+    ValueError
+        If the run lost a body's state (a non-finite position or velocity).
+    """
+    r, v, times = out.r, out.v, out.t
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
         bad = np.argwhere(~np.isfinite(r).all(axis=2) | ~np.isfinite(v).all(axis=2))[0]
         raise ValueError(
@@ -296,15 +286,16 @@ def integrate(
             f"{system.names[bad[1]]!r} at output {bad[0]} (t = {times[bad[0]]!r}): "
             "a collision or a step too long"
         )
-    ee, ae, bd = _diagnostics(system, r, v, times)
+    ee, ae, bd = integral_errors(r, v, system.as_arrays().gm, times)
     final = system.with_state(r[-1], v[-1])
     if system.quantity:
-        t_out: Any = times * u.day
+        t_out: Any = (times * u.day).to(unit)
         r_out: Any = r * u.au
         v_out: Any = v * (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
     return Trajectory(
-        t_out, r_out, v_out, system.names, final, ee, ae, bd, int(steps), wall, method,
-        rhs.effects,
+        t=t_out, r=r_out, v=v_out, names=system.names, final=final, energy_error=ee,
+        angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
+        wall_time=out.wall_time, method=method, effects=effects,
     )

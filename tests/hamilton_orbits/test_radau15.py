@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 from numpy.polynomial import legendre
 
+from hamilton_orbits._kernels.radau15 import coefficients
 from hamilton_orbits._validation import ConvergenceError
-from hamilton_orbits.effects import newtonian_rhs
 from hamilton_orbits.integrators import radau15
 from hamilton_orbits.orbit import KeplerOrbit
+from hamilton_orbits.rhs import newtonian_rhs
 
 EPS = np.finfo(float).eps
 # a fixed rotation (rows orthonormal: 3-4-5 triangles) so that no orbit lies in
@@ -52,7 +53,8 @@ def test_radau_spacings_are_the_gauss_radau_nodes():
 
 def test_coefficient_matrices_are_inverse():
     # b = C g and g = D b (Rein & Spiegel 2015, eqs. 4-5): D C = 1 to rounding.
-    np.testing.assert_allclose(radau15._D @ radau15._C, np.eye(7), rtol=0, atol=64 * EPS)
+    _, c, d = coefficients()
+    np.testing.assert_allclose(d @ c, np.eye(7), rtol=0, atol=64 * EPS)
 
 
 @pytest.mark.parametrize("e", [0.0, 0.3, 0.7])
@@ -258,16 +260,17 @@ def test_velocity_dependent_force_linear_drag():
     # x = x0 + v0 (1 - exp(-k t)) / k: the substep velocities are used.
     from numba import njit
 
-    from hamilton_orbits.effects import RHS
+    from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
+    from hamilton_orbits.rhs import RHS
 
-    @njit
-    def drag(r, v, gm, acc):  # pragma: no cover - compiled
+    @njit(ACCEL_SIGNATURE)
+    def drag(r, v, gm, acc, p):  # pragma: no cover - compiled
         for i in range(r.shape[0]):
             for k in range(3):
                 acc[i, k] = -0.3 * v[i, k]
 
     assert radau15.ACCEPTS_VELOCITY_DEPENDENT
-    rhs = RHS(drag, None, True, ("drag",))
+    rhs = RHS(drag, None, np.zeros(1), True, ("drag",))
     r0 = np.array([[1.0, 2.0, 3.0]])
     v0 = np.array([[0.5, -1.0, 2.0]])
     t = np.array([0.0, 1.0, 10.0])
@@ -353,7 +356,7 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
 
     code = (
         "import numpy as np\n"
-        "from hamilton_orbits.effects import newtonian_rhs\n"
+        "from hamilton_orbits.rhs import newtonian_rhs\n"
         "from hamilton_orbits.integrators import radau15, wh\n"
         "r = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[0.0, 0, 0], [0, 1.0, 0]])\n"
         "gm = np.array([1.0, 0.0]); t = np.array([0.0, 1.0])\n"
@@ -368,7 +371,7 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
     )
     out = res.stdout + res.stderr
-    for name in ("radau15._advance", "wh._advance", "wh._advance_jacobi", "wh._corrector_jacobi"):
+    for name in ("radau15.advance", "wh.advance_dh", "wh.advance_jacobi", "wh.corrector_jacobi"):
         loaded = [line for line in out.splitlines() if "data loaded" in line and name in line]
         assert loaded, out[-2000:]
         saved = [line for line in out.splitlines() if "saved" in line and name in line]

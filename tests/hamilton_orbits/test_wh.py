@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from numba import njit
 
-from hamilton_orbits.effects import RHS, newtonian_rhs
+from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 from hamilton_orbits.integrators import wh
 from hamilton_orbits.orbit import KeplerOrbit
+from hamilton_orbits.rhs import RHS, newtonian_rhs
 
 EPS = np.finfo(float).eps
 ROT = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
@@ -127,13 +128,13 @@ def test_listed_effect_joins_the_kick_and_moves_the_barycentre(solar, coordinate
     _, r0, v0, gm = solar
     g = np.array([1e-6, -2e-6, 3e-7])
 
-    @njit
-    def field(r, v, gm, acc):  # pragma: no cover - compiled
+    @njit(ACCEL_SIGNATURE)
+    def field(r, v, gm, acc, p):  # pragma: no cover - compiled
         for i in range(r.shape[0]):
             for k in range(3):
                 acc[i, k] += g[k]
 
-    rhs = RHS(newtonian_rhs().accel, field, False, ("newtonian", "field"))
+    rhs = RHS(newtonian_rhs().accel, field, np.zeros(1), False, ("newtonian", "field"))
     t = np.array([0.0, 400.0])
     r_f, v_f, _ = wh.run(rhs, r0, v0, gm, t, dt=4.0, coordinates=coordinates)
     r_n, v_n, _ = wh.run(newtonian_rhs(), r0, v0, gm, t, dt=4.0, coordinates=coordinates)
@@ -143,7 +144,8 @@ def test_listed_effect_joins_the_kick_and_moves_the_barycentre(solar, coordinate
 
 
 def test_velocity_dependent_effects_are_refused():
-    rhs = RHS(newtonian_rhs().accel, newtonian_rhs().accel, True, ("newtonian", "gr"))
+    rhs = RHS(newtonian_rhs().accel, newtonian_rhs().accel, np.zeros(1), True,
+              ("newtonian", "gr"))
     assert not wh.ACCEPTS_VELOCITY_DEPENDENT
     with pytest.raises(ValueError, match=r"refuses velocity-dependent.*gr.*radau15"):
         wh.run(rhs, np.zeros((1, 3)), np.zeros((1, 3)), np.ones(1), np.array([0.0, 1.0]))

@@ -14,8 +14,12 @@ No astropy here.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
+
+from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 
 
 @njit(cache=True)
@@ -142,12 +146,6 @@ def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
 # :mod:`hamilton_orbits.effects` documents.
 
 
-@njit(cache=True)
-def nothing(r, v, gm, acc):  # pragma: no cover - compiled
-    """The empty sum of effects (a start for chains that add effects only)."""
-    return
-
-
 @njit(inline="always", cache=True)
 def _push_pair(acc, i, s, ax, ay, az, back):  # pragma: no cover - compiled
     """Add ``a`` to body ``i`` and the reaction ``-back * a`` to the source ``s``."""
@@ -251,3 +249,38 @@ def j2_field(r, v, gm, acc, p):  # pragma: no cover - compiled
         g = 1.0 - 5.0 * z * z / d2
         _push_pair(acc, i, b, f * (g * dx + 2.0 * z * kx), f * (g * dy + 2.0 * z * ky),
                    f * (g * dz + 2.0 * z * kz), gm[i] / mu)
+
+
+@njit(cache=True)
+def min_pair_time(r, gm):  # pragma: no cover - compiled
+    """min over pairs (i massive, j != i) of sqrt(d^3 / (gm_i + gm_j)); O(n n_massive)."""
+    n = r.shape[0]
+    best = math.inf
+    for i in range(n):
+        if gm[i] == 0.0:
+            continue
+        for j in range(n):
+            if j == i or (gm[j] != 0.0 and j < i):
+                continue
+            dx = r[j, 0] - r[i, 0]
+            dy = r[j, 1] - r[i, 1]
+            dz = r[j, 2] - r[i, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 > 0.0:
+                t2 = d2 * math.sqrt(d2) / (gm[i] + gm[j])
+                if t2 < best:
+                    best = t2
+    return math.sqrt(best)
+
+
+# compiled eagerly (explicit signatures): after the kernels they call
+@njit(ACCEL_SIGNATURE, cache=True)
+def newtonian_only(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """The right-hand side with no effect listed: :func:`newtonian` (``p`` unused)."""
+    newtonian(r, v, gm, acc)
+
+
+@njit(ACCEL_SIGNATURE, cache=True)
+def no_effects(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """The effects part of a right-hand side with no effect listed: adds nothing."""
+    return

@@ -1,18 +1,77 @@
-"""N-body integrators on the compiled right-hand side of :mod:`hamilton_orbits.effects`.
+"""N-body integrators on the compiled right-hand side of :mod:`hamilton_orbits.rhs`.
 
-Each integrator is a module with
+Each integrator is a Python driver here (checks, set-up, the loop over output
+times) and a compiled step in :mod:`hamilton_orbits._kernels` (the loop over
+steps).  A driver module satisfies :class:`Integrator`:
 
 - ``NAME`` (``"leapfrog"``, ``"wh"``, ``"radau15"``, ``"dop853"``);
 - ``ACCEPTS_VELOCITY_DEPENDENT`` (bool): symplectic maps refuse velocity-dependent
   effects;
-- ``run(rhs, r0, v0, gm, t_out, *, dt=None, tol=None, on_output=None)``
-  returning ``(r, v, steps)``: ``rhs`` an :class:`~hamilton_orbits.effects.RHS`;
-  ``r0``, ``v0`` float64 (n, 3) and ``gm`` (n,) in the internal units;
-  ``t_out`` an increasing float64 array of output times with ``t_out[0]`` the
-  initial time (row 0 of the output is the initial state); ``r``, ``v`` of shape
-  (len(t_out), n, 3); ``steps`` the number of steps taken.  ``on_output(i,
-  steps)`` is called from Python after output ``i`` is reached (progress bars).
+- ``run(rhs, r0, v0, gm, t_out, *, dt=None, tol=None, on_output=None, out=None,
+  **options)`` returning ``(r, v, steps)``: ``rhs`` an
+  :class:`~hamilton_orbits.rhs.RHS`; ``r0``, ``v0`` float64 (n, 3) and ``gm``
+  (n,) in one consistent unit system; ``t_out`` an increasing float64 array of
+  output times with ``t_out[0]`` the initial time (row 0 of the output is the
+  initial state); ``r``, ``v`` of shape (len(t_out), n, 3), written into ``out``
+  when it is given (so that what was reached survives an interrupt); ``steps``
+  the number of steps taken.  ``on_output(i, steps)`` is called from Python
+  after output ``i`` is reached (progress bars, stopping early).
 
-The stepping itself is one compiled call per output interval; Python only loops
-over output times.
+Python only loops over output times (and, for radau15, over slices of many
+steps); the public entry point is :func:`hamilton_orbits.engine.run`.
 """
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import numpy as np
+
+__all__ = ["INTEGRATORS", "Integrator", "output_arrays"]
+
+#: The methods, in the order they are listed to users.
+INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
+
+
+class Integrator(Protocol):
+    """What a driver module provides (see the module's notes)."""
+
+    NAME: str
+    ACCEPTS_VELOCITY_DEPENDENT: bool
+
+    def run(
+        self,
+        rhs: Any,
+        r0: np.ndarray,
+        v0: np.ndarray,
+        gm: np.ndarray,
+        t_out: np.ndarray,
+        *,
+        dt: float | None = None,
+        tol: float | None = None,
+        on_output: Callable[[int, int], None] | None = None,
+        out: tuple[np.ndarray, np.ndarray] | None = None,
+        **options: Any,
+    ) -> tuple[np.ndarray, np.ndarray, int]: ...
+
+
+def output_arrays(
+    out: tuple[np.ndarray, np.ndarray] | None, n_t: int, r0: np.ndarray, v0: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The output arrays (``out``, or new ones) with row 0 the initial state.
+
+    Examples
+    --------
+    >>> r, v = output_arrays(None, 3, np.ones((2, 3)), np.zeros((2, 3)))
+    >>> r.shape, float(r[0, 0, 0])
+    ((3, 2, 3), 1.0)
+    """
+    if out is None:
+        r_out = np.empty((n_t,) + r0.shape)
+        v_out = np.empty_like(r_out)
+    else:
+        r_out, v_out = out
+    r_out[0] = r0
+    v_out[0] = v0
+    return r_out, v_out

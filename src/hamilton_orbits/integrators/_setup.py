@@ -7,22 +7,17 @@ import weakref
 from typing import Any
 
 import numpy as np
-from numba import njit, types
 from numba.core.types.function_type import CompileResultWAP
 from numba.core.typing.typeof import typeof_impl
 
+from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits._kernels.signatures import ACCEL_TYPE
 from hamilton_orbits._validation import as_float_array, check_positive
 
-#: The numba type of an acceleration function ``accel(r, v, gm, acc)`` as the
-#: stepping kernels take it: a first-class function type, so that a kernel
-#: compiled for it is cached once for every ``accel`` (a kernel specialised on
-#: a dispatcher argument is keyed by that dispatcher object and recompiled in
-#: every new process).
-ACCEL_TYPE = types.FunctionType(
-    types.void(
-        types.float64[:, ::1], types.float64[:, ::1], types.float64[::1], types.float64[:, ::1]
-    )
-)
+# ``ACCEL_TYPE``: the first-class function type of a right-hand side, so that a
+# stepping kernel compiled for it is cached once for every ``accel`` (a kernel
+# specialised on a dispatcher argument is keyed by that dispatcher object and
+# recompiled in every new process).
 
 
 class _AccelAddress(CompileResultWAP):
@@ -52,7 +47,7 @@ def accel_arg(fn: Any) -> Any:
     Examples
     --------
     >>> from hamilton_orbits._kernels import nbody
-    >>> accel_arg(nbody.newtonian) is accel_arg(nbody.newtonian)
+    >>> accel_arg(nbody.newtonian_only) is accel_arg(nbody.newtonian_only)
     True
     """
     if not hasattr(fn, "get_compile_result"):  # not a dispatcher: as it is
@@ -144,29 +139,7 @@ def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
     ...              np.array([1.0, 0.0]))
     0.01
     """
-    best = _min_pair_time(np.ascontiguousarray(r0), np.ascontiguousarray(gm))
+    best = _nbody.min_pair_time(np.ascontiguousarray(r0), np.ascontiguousarray(gm))
     if not math.isfinite(best):
         return 1.0
     return 0.01 * best
-
-
-@njit(cache=True)
-def _min_pair_time(r, gm):  # pragma: no cover - compiled
-    """min over pairs (i massive, j != i) of sqrt(d^3 / (gm_i + gm_j)); O(n n_massive)."""
-    n = r.shape[0]
-    best = math.inf
-    for i in range(n):
-        if gm[i] == 0.0:
-            continue
-        for j in range(n):
-            if j == i or (gm[j] != 0.0 and j < i):
-                continue
-            dx = r[j, 0] - r[i, 0]
-            dy = r[j, 1] - r[i, 1]
-            dz = r[j, 2] - r[i, 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if d2 > 0.0:
-                t2 = d2 * math.sqrt(d2) / (gm[i] + gm[j])
-                if t2 < best:
-                    best = t2
-    return math.sqrt(best)

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits.integrators import output_arrays
+
 NAME = "dop853"
 ACCEPTS_VELOCITY_DEPENDENT = True
 DEFAULT_TOL = 1e-12
@@ -34,13 +36,14 @@ def run(
     dt: float | None = None,
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
+    out: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with scipy's DOP853; see :mod:`hamilton_orbits.integrators`.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from hamilton_orbits.effects import newtonian_rhs
+    >>> from hamilton_orbits.rhs import newtonian_rhs
     >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v0 = np.array([[0.0, 0, 0], [0, 1.0, 0]])
     >>> r, v, steps = run(newtonian_rhs(), r0, v0, np.array([1.0, 0.0]),
     ...                   np.array([0.0, 2 * np.pi]), tol=1e-12)
@@ -52,18 +55,27 @@ def run(
     n = r0.shape[0]
     accel = rhs.accel
     acc = np.empty((n, 3))
+    p = rhs.p
 
     def f(_t: float, y: np.ndarray) -> np.ndarray:
         r = y[: 3 * n].reshape(n, 3)
         v = y[3 * n :].reshape(n, 3)
-        accel(r, v, gm, acc)
+        accel(r, v, gm, acc, p)
         return np.concatenate((y[3 * n :], acc.ravel()))
 
     atol = tol * np.concatenate((_body_scale(r0), _body_scale(v0)))
     y0 = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
-    y, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol,
-                        max_step=np.inf if dt is None else float(dt), on_output=on_output)
-    return y[:, : 3 * n].reshape(-1, n, 3), y[:, 3 * n :].reshape(-1, n, 3), steps
+    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
+
+    def store(i: int, steps: int, y: np.ndarray) -> None:
+        r_out[i] = y[: 3 * n].reshape(n, 3)
+        v_out[i] = y[3 * n :].reshape(n, 3)
+        if on_output is not None:
+            on_output(i, steps)
+
+    _, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol,
+                        max_step=np.inf if dt is None else float(dt), on_state=store)
+    return r_out, v_out, steps
 
 
 #: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.
@@ -79,6 +91,7 @@ def solve(
     atol: Any,
     max_step: float = np.inf,
     on_output: Callable[[int, int], None] | None = None,
+    on_state: Callable[[int, int, np.ndarray], None] | None = None,
 ) -> tuple[np.ndarray, int, int]:
     """The one DOP853 driver of both packages: ``y' = f(t, y)`` from ``y0`` at
     ``t_out[0]``, restarted at each output time (so that an output is a step end,
@@ -97,6 +110,8 @@ def solve(
         A cap on the step.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i``.
+    on_state : callable, optional
+        ``on_state(i, steps, y_i)`` after output ``i`` (instead of ``on_output``).
 
     Returns
     -------
@@ -133,7 +148,9 @@ def solve(
         steps += max(len(sol.t) - 1, 0)
         nfev += int(sol.nfev)
         y_out[i] = y
-        if on_output is not None:
+        if on_state is not None:
+            on_state(i, steps, y)
+        elif on_output is not None:
             on_output(i, steps)
     return y_out, steps, nfev
 

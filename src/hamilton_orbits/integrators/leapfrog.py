@@ -12,39 +12,15 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numba import njit, types
 
-from hamilton_orbits.integrators._setup import ACCEL_TYPE, accel_arg
+from hamilton_orbits._kernels import leapfrog as _k
+from hamilton_orbits.integrators import output_arrays
+from hamilton_orbits.integrators._setup import accel_arg
+
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "choose_dt", "run"]
 
 NAME = "leapfrog"
 ACCEPTS_VELOCITY_DEPENDENT = False
-
-
-_F2 = types.float64[:, ::1]
-
-
-# explicit signature with ``accel`` as a first-class function type: compiled once
-# and loaded from the cache in later processes, whatever the right-hand side
-@njit(types.int64(ACCEL_TYPE, _F2, _F2, types.float64[::1], types.float64, types.float64,
-                  types.float64), cache=True)
-def _advance(accel, r, v, gm, t0, t1, dt):  # pragma: no cover - compiled
-    """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the last one shortened)."""
-    n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
-    if n_steps < 1:
-        n_steps = 1
-    h = (t1 - t0) / n_steps
-    acc = np.empty_like(r)
-    n = r.shape[0]
-    for _ in range(n_steps):
-        for i in range(n):
-            for k in range(3):
-                r[i, k] += 0.5 * h * v[i, k]
-        accel(r, v, gm, acc)
-        for i in range(n):
-            for k in range(3):
-                v[i, k] += h * acc[i, k]
-                r[i, k] += 0.5 * h * v[i, k]
-    return n_steps
 
 
 def choose_dt(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float) -> float:
@@ -74,13 +50,14 @@ def run(
     dt: float | None = None,
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
+    out: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from hamilton_orbits.effects import newtonian_rhs
+    >>> from hamilton_orbits.rhs import newtonian_rhs
     >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v0 = np.array([[0.0, 0, 0], [0, 1.0, 0]])
     >>> r, v, steps = run(newtonian_rhs(), r0, v0, np.array([1.0, 0.0]),
     ...                   np.array([0.0, 2 * np.pi]), dt=2 * np.pi / 1000)
@@ -94,14 +71,11 @@ def run(
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
     gm = np.ascontiguousarray(gm, dtype=np.float64)
-    out_r = np.empty((len(t_out),) + r.shape)
-    out_v = np.empty_like(out_r)
-    out_r[0] = r
-    out_v[0] = v
+    out_r, out_v = output_arrays(out, len(t_out), r, v)
     steps = 0
     accel = accel_arg(rhs.accel)
     for i in range(1, len(t_out)):
-        steps += int(_advance(accel, r, v, gm, float(t_out[i - 1]), float(t_out[i]), dt))
+        steps += int(_k.advance(accel, rhs.p, r, v, gm, float(t_out[i - 1]), float(t_out[i]), dt))
         out_r[i] = r
         out_v[i] = v
         if on_output is not None:

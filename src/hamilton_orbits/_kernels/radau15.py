@@ -1,0 +1,482 @@
+"""The compiled step of the 15th-order Gauss-Radau integrator (IAS15-like).
+
+The driver is :mod:`hamilton_orbits.integrators.radau15`; the method and its
+references are described there.  This module holds the arithmetic: the
+predictor of the ``b`` coefficients (Rein & Spiegel 2015, section 2.5), the
+predictor-corrector iteration over the Gauss-Radau spacings (eqs. 4-7, section
+2.2), the two step-size rules (section 3.2, and Pham, Rein & Spiegel 2024), the
+compensated update of the state (section 2.4), and :func:`advance`, the loop
+over steps between two output times.
+
+Every function takes plain float64 arrays; the acceleration is a first-class
+function ``accel(r, v, gm, acc, p)`` of the type
+:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE`, so :func:`advance` is
+compiled once and cached for every right-hand side.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+from numba import njit, types
+
+from hamilton_orbits._kernels.signatures import ACCEL_TYPE
+
+__all__ = [
+    "DECIMAL_SPACINGS",
+    "NSTATE",
+    "STATUS_MAXSTEPS",
+    "STATUS_NONFINITE",
+    "STATUS_OK",
+    "STATUS_UNDERFLOW",
+    "advance",
+    "coefficients",
+]
+
+#: Gauss-Radau spacings on [0, 1] (Everhart 1985, table; Rein & Spiegel 2015,
+#: section 2.1): ``h_0 = 0`` and the 7 roots of ``P_7(2h - 1) + P_8(2h - 1)``
+#: other than ``h = 0`` (``P_n`` Legendre polynomials).
+DECIMAL_SPACINGS = (
+    "0",
+    "0.0562625605369221464656521910318",
+    "0.180240691736892364987579942780",
+    "0.352624717113169637373907769648",
+    "0.547153626330555383001448554766",
+    "0.734210177215410531523210605558",
+    "0.885320946839095768090359771030",
+    "0.977520613561287501891174488626",
+)
+
+STATUS_OK = 0
+STATUS_NONFINITE = 1
+STATUS_UNDERFLOW = 2
+STATUS_MAXSTEPS = 3
+
+#: The integrator state ``st`` that :func:`advance` reads and updates:
+#: ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters, prs23]``.
+NSTATE = 8
+
+_SAFETY = 0.25  # IAS15's safety factor: reject below a quarter, grow at most 4x
+_EPS = 2.220446049250313e-16
+
+
+def coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reciprocal differences ``1 / (h_n - h_i)``, and the matrices ``C`` (b = C g)
+    and ``D = C^-1`` (g = D b), computed exactly in rationals from the 30-digit
+    spacings and rounded once: a constant's rounding error is repeated in every
+    step, so it must be the smallest possible (a biased constant is a systematic
+    error, which breaks Brouwer's law).
+
+    ``C[k, j]`` is the coefficient of ``h^(k+1)`` in ``prod_{m=0..j} (h - h_m)``
+    (Rein & Spiegel 2015, eq. 5 expanded into eq. 4).
+    """
+    h = [Fraction(x) for x in DECIMAL_SPACINGS]
+    rr = np.zeros((8, 8))
+    for n in range(1, 8):
+        for i in range(n):
+            rr[n, i] = float(1 / (h[n] - h[i]))
+    c = [[Fraction(0)] * 7 for _ in range(7)]
+    for j in range(7):
+        poly = [Fraction(1)]  # coefficients, lowest order first
+        for m in range(j + 1):
+            new = [Fraction(0)] * (len(poly) + 1)
+            for p, coef in enumerate(poly):
+                new[p] -= h[m] * coef
+                new[p + 1] += coef
+            poly = new
+        for k in range(j + 1):
+            c[k][j] = poly[k + 1]
+    d = [[Fraction(0)] * 7 for _ in range(7)]
+    for j in range(7):
+        d[j][j] = Fraction(1)
+        for k in range(j - 1, -1, -1):
+            d[k][j] = -sum((c[k][m] * d[m][j] for m in range(k + 1, j + 1)), Fraction(0))
+    to_array = np.vectorize(float)
+    return rr, to_array(np.array(c, dtype=object)), to_array(np.array(d, dtype=object))
+
+
+_RINV, _C, _D = coefficients()
+_H = np.array([float(x) for x in DECIMAL_SPACINGS])
+
+_F1 = types.float64[::1]
+_F2 = types.float64[:, ::1]
+
+
+@njit(cache=True)
+def _kahan(p, cs, k, inp):  # pragma: no cover - compiled
+    """Compensated ``p[k] += inp`` (the true sum is ``p[k] - cs[k]``)."""
+    y = inp - cs[k]
+    t = p[k] + y
+    cs[k] = (t - p[k]) - y
+    p[k] = t
+
+
+@njit(cache=True)
+def _kahan2(p, cs, i, k, inp):  # pragma: no cover - compiled
+    """Compensated ``p[i, k] += inp``."""
+    y = inp - cs[i, k]
+    t = p[i, k] + y
+    cs[i, k] = (t - p[i, k]) - y
+    p[i, k] = t
+
+
+@njit(cache=True)
+def _predict(q, b, e, br, er):  # pragma: no cover - compiled
+    """Predict ``b`` (and save the prediction in ``e``) for a step ``q`` times the
+    last completed one, from that step's converged ``br`` and its prediction
+    ``er`` (Rein & Spiegel 2015, section 2.5).  ``q > 20``: start from zero."""
+    m = b.shape[1]
+    if q > 20.0:
+        b[:, :] = 0.0
+        e[:, :] = 0.0
+        return
+    q2 = q * q
+    q3 = q2 * q
+    q4 = q2 * q2
+    q5 = q4 * q
+    q6 = q3 * q3
+    q7 = q6 * q
+    for k in range(m):
+        b0, b1, b2, b3 = br[0, k], br[1, k], br[2, k], br[3, k]
+        b4, b5, b6 = br[4, k], br[5, k], br[6, k]
+        # a(1 + q h') expanded in powers of h'
+        e[0, k] = q * (7.0 * b6 + 6.0 * b5 + 5.0 * b4 + 4.0 * b3 + 3.0 * b2 + 2.0 * b1 + b0)
+        e[1, k] = q2 * (21.0 * b6 + 15.0 * b5 + 10.0 * b4 + 6.0 * b3 + 3.0 * b2 + b1)
+        e[2, k] = q3 * (35.0 * b6 + 20.0 * b5 + 10.0 * b4 + 4.0 * b3 + b2)
+        e[3, k] = q4 * (35.0 * b6 + 15.0 * b5 + 5.0 * b4 + b3)
+        e[4, k] = q5 * (21.0 * b6 + 6.0 * b5 + b4)
+        e[5, k] = q6 * (7.0 * b6 + b5)
+        e[6, k] = q7 * b6
+        for i in range(7):
+            b[i, k] = e[i, k] + (br[i, k] - er[i, k])
+
+
+@njit(cache=True)
+def _g_from_b(b, g):  # pragma: no cover - compiled
+    """``g = D b`` (Rein & Spiegel 2015, eq. 5 from eq. 4)."""
+    for k in range(b.shape[1]):
+        for j in range(7):
+            acc = b[j, k]
+            for i in range(j + 1, 7):
+                acc += _D[j, i] * b[i, k]
+            g[j, k] = acc
+
+
+@njit(cache=True)
+def _positions_at(hn, dt, b, a0, v0, x0, csx0, xs):  # pragma: no cover - compiled
+    """Positions at spacing ``hn``, eq. (6) of Rein & Spiegel (2015) in Horner form
+    (one rounding per coefficient, no large powers)."""
+    k8 = 7.0 * hn / 9.0
+    k7 = 3.0 * hn / 4.0
+    k6 = 5.0 * hn / 7.0
+    k5 = 2.0 * hn / 3.0
+    k4 = 3.0 * hn / 5.0
+    k3 = hn / 2.0
+    k2 = hn / 3.0
+    dth = dt * hn
+    dth2 = dth / 2.0
+    for k in range(xs.shape[0]):
+        poly = (((b[6, k] * k8 + b[5, k]) * k7 + b[4, k]) * k6 + b[3, k]) * k5 + b[2, k]
+        poly = ((poly * k4 + b[1, k]) * k3 + b[0, k]) * k2 + a0[k]
+        xs[k] = ((poly * dth2 + v0[k]) * dth - csx0[k]) + x0[k]
+
+
+@njit(cache=True)
+def _velocities_at(hn, dt, b, a0, v0, csv0, vs):  # pragma: no cover - compiled
+    """Velocities at spacing ``hn``, eq. (7) of Rein & Spiegel (2015) in Horner form."""
+    dth = dt * hn
+    for k in range(vs.shape[0]):
+        poly = b[4, k] / 6.0 + hn * (b[5, k] / 7.0 + hn * b[6, k] / 8.0)
+        poly = b[2, k] / 4.0 + hn * (b[3, k] / 5.0 + hn * poly)
+        poly = b[0, k] / 2.0 + hn * (b[1, k] / 3.0 + hn * poly)
+        vs[k] = (dth * (a0[k] + hn * poly) - csv0[k]) + v0[k]
+
+
+@njit(cache=True)
+def _correct(ns, at, a0, g, b, csb):  # pragma: no cover - compiled
+    """Update ``g[ns - 1]`` from the acceleration ``at`` at spacing ``ns`` and
+    carry the change into ``b`` with compensated sums (a biased rounding here
+    would be repeated every step).  Returns ``max |delta g|`` and ``max |at|``
+    over finite components (used at ``ns = 7`` as the convergence measure)."""
+    j = ns - 1
+    maxak = 0.0
+    maxdb = 0.0
+    for k in range(at.shape[0]):
+        gk = at[k] - a0[k]
+        for i in range(j):
+            gk = gk * _RINV[ns, i] - g[i, k]
+        gk = gk * _RINV[ns, j]
+        delta = gk - g[j, k]
+        g[j, k] = gk
+        for i in range(j):
+            _kahan2(b, csb, i, k, _C[i, j] * delta)
+        _kahan2(b, csb, j, k, delta)
+        ak = abs(at[k])
+        if ak > maxak and ak < math.inf:
+            maxak = ak
+        dk = abs(delta)
+        if dk > maxdb and dk < math.inf:
+            maxdb = dk
+    return maxdb, maxak
+
+
+@njit(cache=True)
+def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, need_v):
+    # pragma: no cover - compiled
+    """The predictor-corrector iteration of one step (Rein & Spiegel 2015,
+    section 2.2): stops when ``max |delta b6| / max |a|`` falls below 1e-16 or
+    stops decreasing (after 2 iterations), or after 12.  Returns the iterations.
+    ``xs``, ``vs``, ``at`` are (n, 3) work arrays (their flat views are used)."""
+    m = a0.shape[0]
+    xsf = xs.reshape(m)
+    vsf = vs.reshape(m)
+    atf = at.reshape(m)
+    pc_err = 2.0
+    pc_err_last = 3.0
+    iters = 0
+    while pc_err >= 1e-16 and iters < 12 and not (iters > 2 and pc_err_last <= pc_err):
+        pc_err_last = pc_err
+        iters += 1
+        for ns in range(1, 8):
+            _positions_at(_H[ns], dt, b, a0, v0, x0, csx0, xsf)
+            if need_v:
+                _velocities_at(_H[ns], dt, b, a0, v0, csv0, vsf)
+            accel(xs, vs, gm, at, p)
+            maxdb, maxak = _correct(ns, atf, a0, g, b, csb)
+        pc_err = maxdb / maxak if maxak > 0.0 else 0.0
+    return iters
+
+
+@njit(cache=True)
+def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
+    """Pham, Rein & Spiegel (2024): the shortest timescale
+    ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
+    from the polynomial at the end of the step (derivatives per unit h).  A body
+    whose acceleration at the start of the step is zero or subnormal (the third
+    body of the figure-eight at t = 0, a body at an equilibrium) is left out, as
+    rebound's IAS15 does: its timescale measures the zero crossing of ``a``, not
+    a fast motion.  Returns the next step."""
+    min_tau2 = math.inf
+    for i in range(n):
+        a0i = 0.0
+        y2 = 0.0
+        y3 = 0.0
+        y4 = 0.0
+        for k in range(3 * i, 3 * i + 3):
+            a0i += a0[k] * a0[k]
+            tmp = a0[k] + b[0, k] + b[1, k] + b[2, k] + b[3, k] + b[4, k] + b[5, k] + b[6, k]
+            y2 += tmp * tmp
+            tmp = (b[0, k] + 2.0 * b[1, k] + 3.0 * b[2, k] + 4.0 * b[3, k] + 5.0 * b[4, k]
+                   + 6.0 * b[5, k] + 7.0 * b[6, k])
+            y3 += tmp * tmp
+            tmp = (2.0 * b[1, k] + 6.0 * b[2, k] + 12.0 * b[3, k] + 20.0 * b[4, k]
+                   + 30.0 * b[5, k] + 42.0 * b[6, k])
+            y4 += tmp * tmp
+        if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
+            continue
+        if not (y2 > 0.0 and y2 < math.inf):
+            continue
+        tau2 = 2.0 * y2 / (y3 + math.sqrt(y4 * y2))
+        if tau2 > 0.0 and tau2 < min_tau2:
+            min_tau2 = tau2
+    if min_tau2 < math.inf:
+        return math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
+    return dt_done / _SAFETY
+
+
+@njit(cache=True)
+def _dt_global(at, b, x, v, n, dt_done, eps):  # pragma: no cover - compiled
+    """Rein & Spiegel (2015), section 3.2: ``dt (eps / (max |b6| / max |a|))^(1/7)``
+    over the normal components, leaving out bodies whose acceleration varies
+    slowly over the step (``|v|^2 dt^2 / |x|^2 < 1e-16``, as rebound's IAS15
+    does: their ``b6`` is rounding noise).  Returns the next step."""
+    maxak = 0.0
+    maxb6 = 0.0
+    for i in range(n):
+        v2 = v[3 * i] ** 2 + v[3 * i + 1] ** 2 + v[3 * i + 2] ** 2
+        x2 = x[3 * i] ** 2 + x[3 * i + 1] ** 2 + x[3 * i + 2] ** 2
+        if v2 * dt_done * dt_done < 1e-16 * x2:
+            continue
+        for k in range(3 * i, 3 * i + 3):
+            ak = abs(at[k])
+            if ak >= 2.2250738585072014e-308 and ak < math.inf and ak > maxak:
+                maxak = ak
+            bk = abs(b[6, k])
+            if bk >= 2.2250738585072014e-308 and bk < math.inf and bk > maxb6:
+                maxb6 = bk
+    err = maxb6 / maxak if maxak > 0.0 else 0.0
+    if err > 0.0 and err < math.inf:
+        return dt_done * (eps / err) ** (1.0 / 7.0)
+    return dt_done / _SAFETY
+
+
+@njit(cache=True)
+def _accept(x, v, csx, csv, b, a0, v0, dt):  # pragma: no cover - compiled
+    """Compensated update of positions and velocities at the end of an accepted
+    step (``dt^2`` is not precomputed: with a fixed step its rounding would be a
+    bias)."""
+    for k in range(x.shape[0]):
+        _kahan(x, csx, k, b[6, k] / 72.0 * dt * dt)
+        _kahan(x, csx, k, b[5, k] / 56.0 * dt * dt)
+        _kahan(x, csx, k, b[4, k] / 42.0 * dt * dt)
+        _kahan(x, csx, k, b[3, k] / 30.0 * dt * dt)
+        _kahan(x, csx, k, b[2, k] / 20.0 * dt * dt)
+        _kahan(x, csx, k, b[1, k] / 12.0 * dt * dt)
+        _kahan(x, csx, k, b[0, k] / 6.0 * dt * dt)
+        _kahan(x, csx, k, a0[k] / 2.0 * dt * dt)
+        _kahan(x, csx, k, v0[k] * dt)
+        _kahan(v, csv, k, b[6, k] / 8.0 * dt)
+        _kahan(v, csv, k, b[5, k] / 7.0 * dt)
+        _kahan(v, csv, k, b[4, k] / 6.0 * dt)
+        _kahan(v, csv, k, b[3, k] / 5.0 * dt)
+        _kahan(v, csv, k, b[2, k] / 4.0 * dt)
+        _kahan(v, csv, k, b[1, k] / 3.0 * dt)
+        _kahan(v, csv, k, b[0, k] / 2.0 * dt)
+        _kahan(v, csv, k, a0[k] * dt)
+
+
+@njit(cache=True)
+def _all_finite(x):  # pragma: no cover - compiled
+    for k in range(x.shape[0]):
+        if not math.isfinite(x[k]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
+    # pragma: no cover - compiled
+    """Save the state at the start of a step and evaluate its acceleration into
+    ``a0_2`` (n, 3); returns whether it is finite."""
+    m = x0.shape[0]
+    xf = r.reshape(m)
+    vf = v.reshape(m)
+    for k in range(m):
+        x0[k] = xf[k]
+        v0[k] = vf[k]
+        csx0[k] = csx[k]
+        csv0[k] = csv[k]
+    accel(r, v, gm, a0_2, p)
+    return _all_finite(a0_2.reshape(m))
+
+
+@njit(cache=True)
+def _restore(r, v, x0, v0):  # pragma: no cover - compiled
+    """Put the state back to the start of a rejected step."""
+    m = x0.shape[0]
+    xf = r.reshape(m)
+    vf = v.reshape(m)
+    for k in range(m):
+        xf[k] = x0[k]
+        vf[k] = v0[k]
+
+
+@njit(cache=True)
+def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
+    """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
+
+    Adaptive (``st[4] > 0``): rejects when the rule asks for less than a quarter
+    of the step; growth is limited to 4x relative to the step that was planned
+    (a step shortened to land on an output time does not slow the next one)."""
+    eps = st[4]
+    if not eps > 0.0:
+        return dt, True
+    n = r.shape[0]
+    m = 3 * n
+    if st[7] != 0.0:
+        dt_new = _dt_prs23(a0, b, n, dt_done, eps)
+    else:
+        dt_new = _dt_global(at.reshape(m), b, r.reshape(m), v.reshape(m), n, dt_done, eps)
+    if dt_new < _SAFETY * dt_done:
+        return dt_new, False
+    base = dt if landing else dt_done
+    return min(dt_new, base / _SAFETY), True
+
+
+@njit(
+    types.Tuple((types.int64, types.int64))(
+        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F2, _F1, _F1,
+        types.boolean, types.int64,
+    ),
+    cache=True,
+)
+def advance(
+    accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps
+):  # pragma: no cover - compiled
+    """Step from ``st[0]`` to ``t_end`` in place; returns ``(steps, status)``.
+
+    ``st`` is the :data:`NSTATE` state (``epsilon = 0``: fixed steps of ``dt``;
+    ``prs23 != 0``: the rule of Pham, Rein & Spiegel 2024, else the global one
+    of IAS15).  ``b, e, br, er, g`` are (7, 3n); ``csx, csv`` the Kahan
+    compensations (3n,).  ``r, v`` (n, 3) are updated.  ``status`` is one of the
+    ``STATUS_*`` codes; at ``STATUS_MAXSTEPS`` the state is consistent and the
+    call may be repeated to go on.
+    """
+    n = r.shape[0]
+    m = 3 * n
+    x0 = np.empty(m)
+    v0 = np.empty(m)
+    csx0 = np.empty(m)
+    csv0 = np.empty(m)
+    xs = np.empty((n, 3))
+    vs = np.empty((n, 3))
+    at = np.empty((n, 3))
+    a0_2 = np.empty((n, 3))
+    a0 = a0_2.reshape(m)
+    csb = np.zeros((7, m))
+    t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
+    have_last = st[5] != 0.0
+    steps = 0
+    status = STATUS_OK
+    while t < t_end:
+        if steps >= max_steps:
+            status = STATUS_MAXSTEPS
+            break
+        dt_try = min(dt, t_end - t)
+        landing = dt_try == t_end - t
+        if not (dt_try > 4.0 * _EPS * max(abs(t), abs(t_end))):
+            if landing and dt_try > 0.0 and dt_try <= dt:
+                t = t_end  # a remainder at rounding level of t: finish exactly
+                break
+            status = STATUS_UNDERFLOW
+            break
+        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
+            status = STATUS_NONFINITE
+            break
+        if have_last:
+            _predict(dt_try / dt_last, b, e, br, er)
+        else:
+            b[:, :] = 0.0
+            e[:, :] = 0.0
+        csb[:, :] = 0.0
+        _g_from_b(b, g)
+        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at,
+                          need_v)
+        if not _all_finite(b[6]):
+            status = STATUS_NONFINITE
+            break
+        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing)
+        if not ok:
+            _restore(r, v, x0, v0)
+            dt = dt_new
+            continue
+        _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
+        if landing:
+            t = t_end
+            t_cs = 0.0
+        else:
+            y = dt_try - t_cs
+            tn = t + y
+            t_cs = (tn - t) - y
+            t = tn
+        br[:, :] = b
+        er[:, :] = e
+        dt_last = dt_try
+        have_last = True
+        dt = dt_new
+        steps += 1
+    st[0], st[1], st[2], st[3] = t, t_cs, dt, dt_last
+    st[5] = 1.0 if have_last else 0.0
+    return steps, status

@@ -1,0 +1,347 @@
+"""The compiled steps of the Wisdom-Holman map (driver and method:
+:mod:`hamilton_orbits.integrators.wh`).
+
+Democratic-heliocentric steps (:func:`advance_dh`), Jacobi steps
+(:func:`advance_jacobi`) with the third-order corrector of Wisdom, Holman &
+Touma (1996) (:func:`corrector_jacobi`), and the Jacobi coordinate changes.
+The effects part of the right-hand side is a first-class function
+``extra(r, v, gm, acc, p)`` (:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types
+
+from hamilton_orbits._kernels import kepler as _kepler
+from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
+
+__all__ = [
+    "advance_dh",
+    "advance_jacobi",
+    "corrector_jacobi",
+    "jacobi_factors",
+    "jacobi_to_inertial_pos",
+]
+
+
+@njit(cache=True)
+def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
+    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` by ``tau``
+    (the shared kernel inlined: the bodies' solves overlap in the processor).
+
+    Returns the index of the first failure (NaN from the kernel), else -1."""
+    for i in range(1, q.shape[0]):
+        x, y, z, vx, vy, vz = _kepler.propagate_uv_inline(
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[i], tau
+        )
+        if not math.isfinite(x + y + z + vx + vy + vz):
+            return i
+        q[i, 0] = x
+        q[i, 1] = y
+        q[i, 2] = z
+        u[i, 0] = vx
+        u[i, 1] = vy
+        u[i, 2] = vz
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _jump(q, u, gm, tau):  # pragma: no cover - compiled
+    """The drift of the ``Q_i`` under ``|sum m_i u_i|^2 / (2 m_0)`` for a time ``tau``."""
+    n = q.shape[0]
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for i in range(1, n):
+        px += gm[i] * u[i, 0]
+        py += gm[i] * u[i, 1]
+        pz += gm[i] * u[i, 2]
+    f = tau / gm[0]
+    for i in range(1, n):
+        q[i, 0] += f * px
+        q[i, 1] += f * py
+        q[i, 2] += f * pz
+
+
+@njit(
+    types.Tuple((types.int64, types.int64))(
+        ACCEL_TYPE,
+        F1,
+        types.boolean,
+        F2,
+        F2,
+        F1,
+        F1,
+        F1,
+        types.float64,
+        types.int64,
+        types.float64,
+    ),
+    cache=True,
+)
+def advance_dh(
+    extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last
+):  # pragma: no cover - compiled
+    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
+    coordinates, in place.  ``q``, ``u``: heliocentric positions and
+    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
+    ``com``: barycentre position and velocity (6,).  Returns ``(steps, bad)``
+    with ``bad`` the index of a body whose Kepler step failed, else -1."""
+    n = q.shape[0]
+    gm0 = gm[0]
+    acc = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    m_tot = 0.0
+    for i in range(n):
+        m_tot += gm[i]
+    # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
+    # row 0 (unused here) is left out of the interaction
+    idx = _nbody.massive_indices(gm_p)
+    mu = np.full(n, gm0)
+    h = dt if n_steps > 1 else dt_last
+    bad = _kepler_all(q, u, mu, 0.5 * h)
+    if bad >= 0:
+        return 0, bad
+    for k in range(3):
+        com[k] += 0.5 * h * com[3 + k]
+    for s in range(n_steps):
+        h = dt if s < n_steps - 1 else dt_last
+        _jump(q, u, gm, 0.5 * h)
+        _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
+        for i in range(1, n):
+            for k in range(3):
+                u[i, k] += h * acc[i, k]
+        if has_extra:
+            # inertial state for the effects: r_0 = R - sum m_i Q_i / M
+            for k in range(3):
+                s_q = 0.0
+                s_u = 0.0
+                for i in range(1, n):
+                    s_q += gm[i] * q[i, k]
+                    s_u += gm[i] * u[i, k]
+                r_in[0, k] = com[k] - s_q / m_tot
+                v_in[0, k] = com[3 + k] - s_u / gm0
+                for i in range(1, n):
+                    r_in[i, k] = q[i, k] + r_in[0, k]
+                    v_in[i, k] = u[i, k] + com[3 + k]
+                for i in range(n):
+                    acc_x[i, k] = 0.0
+            extra(r_in, v_in, gm, acc_x, p)
+            for k in range(3):
+                a_cm = 0.0
+                for i in range(n):
+                    a_cm += gm[i] * acc_x[i, k]
+                a_cm /= m_tot
+                com[3 + k] += h * a_cm
+                for i in range(1, n):
+                    u[i, k] += h * (acc_x[i, k] - a_cm)
+        _jump(q, u, gm, 0.5 * h)
+        if s < n_steps - 1:
+            h_next = dt if s + 1 < n_steps - 1 else dt_last
+            tau = 0.5 * (h + h_next)
+        else:
+            tau = 0.5 * h
+        bad = _kepler_all(q, u, mu, tau)
+        if bad >= 0:
+            return s, bad
+        for k in range(3):
+            com[k] += tau * com[3 + k]
+    return n_steps, -1
+
+
+@njit(cache=True)
+def jacobi_factors(eta):  # pragma: no cover - compiled
+    """``(ratio, inv)`` with ``ratio_i = eta_{i-1} / eta_i`` (``ratio_0 = 1``) and
+    ``inv_i = 1 / eta_i``: the divisions of the coordinate changes, formed once
+    per run instead of every step."""
+    n = eta.shape[0]
+    ratio = np.ones(n)
+    inv = np.empty(n)
+    for i in range(n):
+        inv[i] = 1.0 / eta[i]
+        if i > 0:
+            ratio[i] = eta[i - 1] / eta[i]
+    return ratio, inv
+
+
+@njit(cache=True, inline="always")
+def jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - compiled
+    """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre);
+    ``ratio``, ``inv`` from :func:`_jacobi_factors`.
+
+    With ``S_i = sum_{j<=i} m_j r_j``: ``S_{n-1} = eta_{n-1} qj_0`` and, going
+    down, ``S_{i-1} = (S_i - m_i qj_i) eta_{i-1} / eta_i``,
+    ``r_i = qj_i + S_{i-1} / eta_{i-1}``, ``r_0 = S_0 / m_0``."""
+    n = qj.shape[0]
+    # the three coordinates side by side (three independent recurrences)
+    sx = eta[n - 1] * qj[0, 0]
+    sy = eta[n - 1] * qj[0, 1]
+    sz = eta[n - 1] * qj[0, 2]
+    for i in range(n - 1, 0, -1):
+        gi = gm[i]
+        ri = ratio[i]
+        ie = inv[i - 1]
+        sx = (sx - gi * qj[i, 0]) * ri
+        sy = (sy - gi * qj[i, 1]) * ri
+        sz = (sz - gi * qj[i, 2]) * ri
+        r[i, 0] = qj[i, 0] + sx * ie
+        r[i, 1] = qj[i, 1] + sy * ie
+        r[i, 2] = qj[i, 2] + sz * ie
+    r[0, 0] = sx / gm[0]
+    r[0, 1] = sy / gm[0]
+    r[0, 2] = sz / gm[0]
+
+
+@njit(cache=True, inline="always")
+def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
+    """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1
+    (``inv_i = 1 / eta_i``)."""
+    n = a.shape[0]
+    sx = gm[0] * a[0, 0]
+    sy = gm[0] * a[0, 1]
+    sz = gm[0] * a[0, 2]
+    for i in range(1, n):
+        ie = inv[i - 1]
+        aj[i, 0] = a[i, 0] - sx * ie
+        aj[i, 1] = a[i, 1] - sy * ie
+        aj[i, 2] = a[i, 2] - sz * ie
+        gi = gm[i]
+        sx += gi * a[i, 0]
+        sy += gi * a[i, 1]
+        sz += gi * a[i, 2]
+
+
+@njit(cache=True, inline="always")
+def _kick_jacobi(
+    extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in, v_in
+):  # pragma: no cover - compiled
+    """The interaction kick of length ``h`` in Jacobi coordinates (``idx``: the
+    massive indices of ``gm``; ``ratio``, ``inv``: :func:`_jacobi_factors`)."""
+    n = qj.shape[0]
+    jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
+    _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
+    if has_extra:
+        for i in range(n):
+            for k in range(3):
+                acc_x[i, k] = 0.0
+        extra(r_in, v_in, gm, acc_x, p)
+        m_tot = eta[n - 1]
+        for k in range(3):
+            a_cm = 0.0
+            for i in range(n):
+                a_cm += gm[i] * acc_x[i, k]
+                acc[i, k] += acc_x[i, k]
+            if move_com:
+                # the effects' net force moves the barycentre
+                uj[0, k] += h * a_cm / m_tot
+    _inertial_to_jacobi_acc(acc, gm, inv, accj)
+    for i in range(1, n):
+        d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
+        f = eta[i] / (d2 * math.sqrt(d2))
+        for k in range(3):
+            uj[i, k] += h * (accj[i, k] + f * qj[i, k])
+
+
+# Third-order symplectic corrector (Wisdom, Holman & Touma 1996, table 1 as
+# used by WHFast, Rein & Tamayo 2015): a = sqrt(7/40), b = -sqrt(10/7) / 48.
+_CORR_A = math.sqrt(7.0 / 40.0)
+_CORR_B = -math.sqrt(10.0 / 7.0) / 48.0
+
+
+@njit(
+    types.int64(ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64),
+    cache=True,
+)
+def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: no cover
+    """Apply the third-order corrector (``sign = 1``) or its inverse (``-1``):
+    ``Z(a dt, -sign b dt) Z(-a dt, sign b dt)`` with ``Z(a, b)`` = Kepler a,
+    kick -b, Kepler -2a, kick b, Kepler a.  Returns a failing index or -1."""
+    n = qj.shape[0]
+    acc = np.empty((n, 3))
+    accj = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.zeros((n, 3))
+    idx = _nbody.massive_indices(gm)
+    ratio, inv = jacobi_factors(eta)
+    for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
+        bad = _kepler_all(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(
+            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, -b, False,
+            acc, accj, acc_x, r_in, v_in,
+        )
+        bad = _kepler_all(qj, uj, eta, -2.0 * a)
+        if bad >= 0:
+            return bad
+        _kick_jacobi(
+            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, b, False,
+            acc, accj, acc_x, r_in, v_in,
+        )
+        bad = _kepler_all(qj, uj, eta, a)
+        if bad >= 0:
+            return bad
+    return -1
+
+
+@njit(
+    types.Tuple((types.int64, types.int64))(
+        ACCEL_TYPE,
+        F1,
+        types.boolean,
+        F2,
+        F2,
+        F1,
+        F1,
+        types.float64,
+        types.int64,
+        types.float64,
+    ),
+    cache=True,
+)
+def advance_jacobi(
+    extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last
+):  # pragma: no cover - compiled
+    """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
+    ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
+    sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
+    listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
+    removes the part the Kepler step already accounts for."""
+    n = qj.shape[0]
+    acc = np.empty((n, 3))
+    accj = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.zeros((n, 3))
+    idx = _nbody.massive_indices(gm)
+    ratio, inv = jacobi_factors(eta)
+    h = dt if n_steps > 1 else dt_last
+    bad = _kepler_all(qj, uj, eta, 0.5 * h)
+    if bad >= 0:
+        return 0, bad
+    for k in range(3):
+        qj[0, k] += 0.5 * h * uj[0, k]
+    for s in range(n_steps):
+        h = dt if s < n_steps - 1 else dt_last
+        _kick_jacobi(
+            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
+            acc, accj, acc_x, r_in, v_in,
+        )
+        if s < n_steps - 1:
+            h_next = dt if s + 1 < n_steps - 1 else dt_last
+            tau = 0.5 * (h + h_next)
+        else:
+            tau = 0.5 * h
+        bad = _kepler_all(qj, uj, eta, tau)
+        if bad >= 0:
+            return s, bad
+        for k in range(3):
+            qj[0, k] += tau * uj[0, k]
+    return n_steps, -1

@@ -1,0 +1,260 @@
+"""What every scene kind shares: :class:`SceneKind`, the registry :data:`KINDS`,
+:class:`Result` and :func:`format_table`.
+
+:mod:`hamilton_orbits.scene` (the :class:`~hamilton_orbits.scene.Scene` itself)
+and every kind (``nbody`` in :mod:`hamilton_orbits._scene_nbody`, ``rotation`` in
+``rigid``) import this module; it imports none of them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits import _schema as S
+
+__all__ = ["KINDS", "Result", "SceneKind", "format_table", "register_kind"]
+
+
+@dataclass(frozen=True)
+class SceneKind:
+    """A kind of scene: its keys, its checks across keys, and how it runs.
+
+    Parameters
+    ----------
+    name : str
+        The ``kind = "..."`` value.
+    summary : str
+        One line for listings.
+    schema : Mapping[str, _schema.Field]
+        The kind's keys (besides ``kind``, ``description`` and ``effects``).
+    effect_kind : str
+        Which effect registry the kind's ``effects`` come from.
+    check : callable
+        ``check(spec, problems)``: checks across keys (a body an effect names
+        exists, the integrator accepts the effects), adding to ``problems``.
+    run : callable
+        ``run(scene, progress, stop) -> Result``; ``stop()`` is true once the
+        user asked to stop (Ctrl-C): the run ends early and keeps what it has.
+    crosscheck : callable or None
+        ``crosscheck(scene) -> str``: the same scene in a peer code, tabled.
+    """
+
+    name: str
+    summary: str
+    schema: Mapping[str, S.Field]
+    effect_kind: str
+    check: Callable[[dict, S.Problems], None]
+    run: Callable[..., Any]
+    crosscheck: Callable[[Any], str] | None = None
+
+
+KINDS: dict[str, SceneKind] = {}
+
+
+def register_kind(kind: SceneKind) -> SceneKind:
+    """Register a scene kind (``rigid`` registers ``rotation`` through an entry point)."""
+    KINDS[kind.name] = kind
+    return kind
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, u.Quantity):
+        if value.isscalar:
+            return f"{value.value:.6g} {value.unit:unicode}".strip()
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def format_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """An aligned text table of ``rows`` (dicts with the same keys).
+
+    Examples
+    --------
+    >>> print(format_table([{"body": "sun", "dr": 1e-12}, {"body": "earth", "dr": 2.5e-10}]))
+    body   dr
+    -----  -------
+    sun    1e-12
+    earth  2.5e-10
+    """
+    if not rows:
+        return ""
+    keys = list(rows[0])
+    cells = [[_fmt(r.get(k, "")) for k in keys] for r in rows]
+    widths = [max(len(k), *(len(c[i]) for c in cells)) for i, k in enumerate(keys)]
+    lines = ["  ".join(k.ljust(w) for k, w in zip(keys, widths, strict=True)).rstrip()]
+    lines.append("  ".join("-" * w for w in widths))
+    for c in cells:
+        lines.append("  ".join(x.ljust(w) for x, w in zip(c, widths, strict=True)).rstrip())
+    return "\n".join(lines)
+
+
+@dataclass
+class Result:
+    """What a scene's run produced.
+
+    Attributes
+    ----------
+    scene : hamilton_orbits.scene.Scene
+    times : Quantity
+        The output times.
+    diagnostics : dict
+        Named series on ``times`` (energy error, angular-momentum error, ...).
+    metrics : dict
+        Headline numbers (Quantities or floats), e.g. the perihelion advance.
+    tables : dict
+        Named tables (lists of row dicts), e.g. the per-body cross-check.
+    states : dict
+        Arrays to save (``names``, ``r``, ``v`` for n-body scenes).
+    wall_time : float
+        Seconds the simulation took.
+    complete : bool
+        False if the run was stopped early (Ctrl-C); what was done is kept.
+    """
+
+    scene: Any
+    times: u.Quantity
+    diagnostics: dict[str, Any] = field(default_factory=dict)
+    metrics: dict[str, Any] = field(default_factory=dict)
+    tables: dict[str, list[dict]] = field(default_factory=dict)
+    states: dict[str, Any] = field(default_factory=dict)
+    wall_time: float = 0.0
+    complete: bool = True
+    plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
+    writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
+                                                                repr=False)
+
+    def summary(self) -> str:
+        """The summary table as text (what the command prints)."""
+        s = self.scene
+        lines = [f"scene {s.name} ({s.kind}): {s.spec.get('description', '').strip()}"]
+        effects = ", ".join(e["name"] for e in s.effects) or "none"
+        lines.append(f"effects: {effects}")
+        if not self.complete:
+            lines.append("STOPPED EARLY: the results cover the part that was run")
+        span = self.times[-1] - self.times[0] if len(self.times) else 0 * u.d
+        asked = s.spec.get("duration")
+        if isinstance(asked, u.Quantity) and asked.unit.physical_type == "time":
+            span = span.to(asked.unit)
+        elif span > 1 * u.yr:
+            span = span.to(u.yr)
+        lines.append(f"simulated: {_fmt(span)} in {self.wall_time:.2f} s")
+        if self.metrics:
+            lines.append("")
+            rows = [{"quantity": k, "value": v} for k, v in self.metrics.items()]
+            lines.append(format_table(rows))
+        for title, rows in self.tables.items():
+            lines.append("")
+            lines.append(title)
+            lines.append(format_table(rows))
+        return "\n".join(lines)
+
+    def plot(self) -> list:
+        """The scene's figures (matplotlib), one per plotter."""
+        try:
+            import matplotlib
+
+            matplotlib.use("Agg", force=False)
+        except ImportError as exc:  # pragma: no cover - depends on the install
+            raise ImportError(
+                "figures need matplotlib: python -m pip install 'hamilton-orbits[plot]'"
+            ) from exc
+        return [p(self) for p in self.plotters]
+
+    def _json(self) -> dict:
+        def conv(v: Any) -> Any:
+            if isinstance(v, u.Quantity):
+                return {"value": v.value.tolist(), "unit": str(v.unit)}
+            if isinstance(v, np.ndarray):
+                return v.tolist()
+            if isinstance(v, float) and not math.isfinite(v):
+                return str(v)
+            if isinstance(v, np.floating | np.integer):
+                return v.item()
+            return v
+
+        return {
+            "scene": self.scene.name,
+            "kind": self.scene.kind,
+            "description": self.scene.spec.get("description", ""),
+            "effects": [dict(e) for e in self.scene.effects],
+            "complete": self.complete,
+            "wall_time_s": self.wall_time,
+            "metrics": {k: conv(v) for k, v in self.metrics.items()},
+            "tables": {k: [{c: conv(x) for c, x in r.items()} for r in rows]
+                       for k, rows in self.tables.items()},
+        }
+
+    def save(self, directory: str | Path) -> list[Path]:
+        """Write the summary (Markdown, JSON), the figures (PNG) and the states (netCDF).
+
+        A scene kind may add files (n-body scenes: the final state as a rebound
+        binary, ``final.bin``).  Returns the paths written.  The states file is
+        netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.
+        """
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        written = []
+        md = out / "summary.md"
+        md.write_text(f"# {self.scene.name}\n\n```\n{self.summary()}\n```\n", encoding="utf-8")
+        written.append(md)
+        js = out / "summary.json"
+        js.write_text(json.dumps(self._json(), indent=2) + "\n", encoding="utf-8")
+        written.append(js)
+        if self.plotters:
+            import matplotlib.pyplot as plt
+
+            for i, fig in enumerate(self.plot()):
+                name = getattr(fig, "_hamilton_name", f"figure{i + 1}")
+                path = out / f"{name}.png"
+                fig.savefig(path, dpi=110, bbox_inches="tight")
+                plt.close(fig)
+                written.append(path)
+        written.extend(self._save_states(out))
+        for writer in self.writers:
+            written.extend(writer(self, out))
+        return written
+
+    def _save_states(self, out: Path) -> list[Path]:
+        from scipy.io import netcdf_file
+
+        path = out / "states.nc"
+        t = self.times.to_value(u.d)
+        with netcdf_file(path, "w") as f:
+            f.title = f"hamilton-orbits scene {self.scene.name}"
+            f.createDimension("time", len(t))
+            var = f.createVariable("time", "d", ("time",))
+            var[:] = t
+            var.units = "day"
+            for name, series in self.diagnostics.items():
+                arr = np.asarray(getattr(series, "value", series), dtype=float)
+                if arr.shape != t.shape:
+                    continue
+                var = f.createVariable(name, "d", ("time",))
+                var[:] = arr
+                var.units = str(getattr(series, "unit", ""))
+            for name, value in self.states.items():
+                arr = np.asarray(getattr(value, "value", value))
+                if arr.dtype.kind not in "fi" or arr.ndim == 0:
+                    continue
+                dims = ["time"] + [f"{name}_dim{k}" for k in range(1, arr.ndim)]
+                if arr.shape[0] != len(t):
+                    continue
+                for k in range(1, arr.ndim):
+                    f.createDimension(dims[k], arr.shape[k])
+                var = f.createVariable(name, "d", tuple(dims))
+                var[:] = arr
+                var.units = str(getattr(value, "unit", ""))
+            names = self.states.get("names")
+            if names is not None:
+                f.bodies = ",".join(str(n) for n in names)
+        return [path]
