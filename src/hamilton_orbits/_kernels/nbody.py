@@ -45,7 +45,7 @@ def zero(r, v, gm, acc):  # pragma: no cover - compiled
         acc[k, 2] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     """Newtonian accelerations of equation (B); overwrites ``acc``.
 
