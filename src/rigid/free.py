@@ -274,21 +274,21 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     # homogeneous: the kernel sees moments / sm and omega / sw; rates scale back by sw
     sm, sw = _pow2(body._moments), _pow2(body._omega)
     prm = _fk.free_setup(body._moments / sm, body.attitude.as_array(), body._omega / sw)
-    kind = int(prm[_fk._KIND])
+    kind = int(prm[_fk.KIND])
     q = body._quantity
     inf = float("inf")
     if kind == 0:
         return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, wrap(0.0, _RATE, q),
                               wrap(inf, u.s, q), wrap(inf, u.s, q), 0.0)
-    pmat = prm[_fk._P : _fk._P + 9].reshape(3, 3)
+    pmat = prm[_fk.P : _fk.P + 9].reshape(3, 3)
     polar = int(np.argmax(np.abs(pmat[:, 2])))
-    lam = float(prm[_fk._LAM]) * sw
+    lam = float(prm[_fk.LAM]) * sw
     if kind == 1:
-        kk = float(prm[_fk._K])
+        kk = float(prm[_fk.K])
         return FreeParameters(
-            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk,
+            "periodic", polar, float(prm[_fk.M]), float(prm[_fk.M1]), kk,
             wrap(lam, _RATE, q), wrap(4.0 * kk / lam, u.s, q), wrap(2.0 * kk / lam, u.s, q),
-            float(prm[_fk._N]),
+            float(prm[_fk.N]),
         )
     return FreeParameters("separatrix", polar, 1.0, 0.0, inf, wrap(lam, _RATE, q),
-                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk._N]))
+                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk.N]))

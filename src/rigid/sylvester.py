@@ -325,24 +325,24 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     q = np.array([1.0, 0.0, 0.0, 0.0])
     p1 = _fk.free_setup(mom, q, np.ascontiguousarray(w1))
     p2 = _fk.free_setup(mom, q, np.ascontiguousarray(w2))
-    kind = p1[_fk._KIND]
+    kind = p1[_fk.KIND]
     if kind == 0.0:
         raise ValueError(
             f"Expected a non-steady motion for `omega1`, got a steady rotation {omega1!r}"
         )
-    same_frame = np.array_equal(p1[_fk._P : _fk._P + 9], p2[_fk._P : _fk._P + 9])
-    if p2[_fk._KIND] != kind or not same_frame:
+    same_frame = np.array_equal(p1[_fk.P : _fk.P + 9], p2[_fk.P : _fk.P + 9])
+    if p2[_fk.KIND] != kind or not same_frame:
         raise ValueError(
             f"Expected `omega2` on the same branch of the polhode as `omega1`, got "
             f"omega1 = {omega1!r}, omega2 = {omega2!r}"
         )
-    du = p2[_fk._U0] - p1[_fk._U0]
+    du = p2[_fk.U0] - p1[_fk.U0]
     if kind == 1.0:
-        dt = float(np.mod(du, 4.0 * p1[_fk._K]) / p1[_fk._LAM])
+        dt = float(np.mod(du, 4.0 * p1[_fk.K]) / p1[_fk.LAM])
     elif du < 0.0:
         raise ValueError(
             f"Expected `omega2` after `omega1` on the separatrix, got it before ({omega2!r})"
         )
     else:
-        dt = float(du / p1[_fk._LAM])
+        dt = float(du / p1[_fk.LAM])
     return wrap(np.float64(dt / sw), u.s, quantity)
