@@ -68,7 +68,7 @@ from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
 from rigid._kernels import euler as _k
 from rigid.body import call_units, check_body
-from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, _encode
+from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
 
 __all__ = [
     "METHODS",
@@ -493,8 +493,9 @@ def integrate(
     True
     """
     body = check_body(body)
-    body._energy()  # a body whose I omega^2 or I omega leaves float64 is refused here
-    body._l_norm()
+    si = body.si
+    # a body whose I omega^2 or I omega leaves float64 is refused here
+    _ = (si.kinetic_energy, si.angular_momentum_norm)
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
     quantity = call_units(body, ("t_end", "dt"), (t_end, dt))
@@ -515,10 +516,8 @@ def integrate(
         float(_scalar_positive(name, DIMENSIONLESS(name, v)))
         for name, v in (("rtol", rtol), ("atol", atol), ("recentre", recentre))
     )
-    kind, params = _encode(torque)
-    moments = body._moments
-    q0 = body.attitude.as_array().astype(np.float64)
-    w0 = body._omega.copy()
+    kind, params = encode_torque(torque)
+    moments, q0, w0 = si.moments, si.attitude, si.omega
     t, q, w, n_steps, count, drift = integrate_arrays(
         moments, q0, w0, te, method=method, dt=dtf, n_out=n_out, kind=kind,
         params=params, rtol=rtol, atol=atol, recentre=recentre, progress=progress,
