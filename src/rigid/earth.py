@@ -41,6 +41,9 @@ import numpy as np
 
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, TIME
 from rigid.body import RigidBody
+from rigid.free import free_motion
+from rigid.integrators import integrate
+from rigid.wobble import free_period
 
 __all__ = [
     "C22_BAR",
@@ -302,7 +305,7 @@ class PolePath:
         return (-self.m.imag * u.rad).to(u.arcsec)
 
     def period(self) -> u.Quantity:
-        """The wobble period fitted to the path (see :func:`rigid.polar_motion.free_period`).
+        """The wobble period fitted to the path (see :func:`rigid.wobble.free_period`).
 
         Examples
         --------
@@ -310,8 +313,6 @@ class PolePath:
         >>> bool(abs(path.period() / euler_period() - 1) < 1e-10)
         True
         """
-        from rigid.polar_motion import free_period
-
         return free_period(self.t, self.m)
 
 
@@ -346,9 +347,6 @@ def simulate_wobble(
     >>> print(f"{path.period():.1f}")
     303.6 d
     """
-    from rigid.free import free_motion
-    from rigid.integrators import integrate
-
     t_end = TIME("duration", duration, u.day)
     if t_end.shape != () or not float(t_end) >= 1.0:
         raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
