@@ -24,7 +24,7 @@ exchanged in a right-handed relabelling of the axes.  On the separatrix
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import astropy.units as u
 import numpy as np
@@ -35,7 +35,8 @@ from rigid._kernels import free as _fk
 from rigid._shared import free_flow_scaled
 from rigid.body import RigidBody, call_units, check_body, check_moments, unit_quaternion
 
-__all__ = ["FreeParameters", "free_motion", "free_motion_arrays", "free_parameters"]
+__all__ = ["FreeMotion", "FreeParameters", "free_motion", "free_motion_arrays",
+           "free_parameters"]
 
 _RATE = 1 / u.s
 
@@ -110,7 +111,29 @@ def free_motion_arrays(
     return out_q.reshape(t_arr.shape + (4,)), wrap(w, u.rad / u.s, quantity)
 
 
-def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
+class FreeMotion(NamedTuple):
+    """The result of :func:`free_motion`: ``attitude, omega = free_motion(body, t)``.
+
+    Attributes
+    ----------
+    attitude : Quaternion, shape t.shape
+        Body-to-space attitude at each time.
+    omega : ndarray or Quantity, shape t.shape + (3,)
+        Body-frame angular velocity at each time (rad/s as a Quantity when the
+        call was in Quantities).
+
+    Examples
+    --------
+    >>> motion = free_motion(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0]), [0.0, 1.0])
+    >>> print(motion.omega[-1], motion.attitude.as_array()[-1].round(6))
+    [0. 0. 2.] [0.540302 0.       0.       0.841471]
+    """
+
+    attitude: Quaternion
+    omega: Any
+
+
+def free_motion(body: RigidBody, t: Any) -> FreeMotion:
     """The exact torque-free motion of ``body``, vectorised over ``t``.
 
     Parameters
@@ -122,10 +145,10 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
 
     Returns
     -------
-    attitude : Quaternion, shape t.shape
-        Body-to-space attitude at each time.
-    omega : ndarray or Quantity, shape t.shape + (3,), rad/s
-        Body-frame angular velocity at each time.
+    FreeMotion
+        A named tuple ``(attitude, omega)``: ``attitude`` (Quaternion, shape
+        t.shape), the body-to-space attitude at each time; ``omega`` (ndarray or
+        Quantity, shape t.shape + (3,), rad/s), the body-frame angular velocity.
 
     Raises
     ------
@@ -174,7 +197,7 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
     q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t")
     q = q.reshape(t_arr.shape + (4,))
     w = w.reshape(t_arr.shape + (3,))
-    return Quaternion(q), wrap(w, u.rad / u.s, quantity)
+    return FreeMotion(Quaternion(q), wrap(w, u.rad / u.s, quantity))
 
 
 @dataclass(frozen=True)

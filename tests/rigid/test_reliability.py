@@ -322,7 +322,7 @@ UNIT_TABLE = [
 # public callables of `rigid` without a dimensional argument of their own (the body
 # carries its units) or that are classes of results
 NO_DIMENSIONAL_ARGUMENT = {"free_parameters", "disk_equivalent", "FreeParameters",
-                           "PoinsotPaths", "RigidTrajectory"}
+                           "PoinsotPaths", "RigidTrajectory", "FreeMotion", "BodySI"}
 
 
 def test_unit_table_covers_the_public_api():
