@@ -127,14 +127,10 @@ def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]
 
 def _progress_chunks(n_steps: int, progress: bool):
     """Chunk boundaries (in steps) for an optional tqdm bar; one chunk without it."""
-    if not progress:
+    bar = _bar(n_steps, "step", progress)
+    if bar is None:
         return [0, n_steps], None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover - optional extra
-        return [0, n_steps], None
-    bounds = sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)})
-    return bounds, tqdm(total=n_steps, unit="step", leave=False)
+    return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
 
 
 # Yoshida (1990, Phys. Lett. A 150, 262, eq. 5.4) triple jump: a symmetric
