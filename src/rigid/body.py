@@ -22,8 +22,7 @@ Inside, everything runs on SI floats.
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import astropy.units as u
 import numpy as np
@@ -36,8 +35,9 @@ from hamilton_orbits.units import (
     INERTIA,
     require_consistent,
 )
+from rigid._shared import pow2
 
-__all__ = ["RigidBody"]  # check_* and unit_quaternion: shared inside rigid only
+__all__ = ["BodySI", "RigidBody"]  # check_*, call_units, unit_quaternion: shared inside rigid
 
 _EPS = np.finfo(np.float64).eps
 _I_UNIT = u.kg * u.m**2  # moment of inertia
@@ -197,17 +197,7 @@ def call_units(body: RigidBody, names: tuple[str, ...], values: tuple[Any, ...])
     return quantity
 
 
-def _pow2(x: np.ndarray) -> float:
-    """The power of two at or just below ``max|x|`` (1 for zeros): an exact scale.
-
-    ``x / _pow2(x)`` has its largest entry in [1, 2); the scale itself is always
-    finite and nonzero (down to the subnormals).
-    """
-    big = float(np.max(np.abs(x)))
-    return 1.0 if big == 0.0 else math.ldexp(1.0, math.frexp(big)[1] - 1)
-
-
-def _finite_result(what: str, scaled: Any, scale: tuple[float, ...], body: Any) -> Any:
+def _finite_result(what: str, scaled: Any, scale: tuple[float, ...], si: BodySI) -> Any:
     """``scaled`` times each factor of ``scale``, or a ValueError beyond float64."""
     out = np.asarray(scaled)
     with np.errstate(over="ignore"):
@@ -216,9 +206,83 @@ def _finite_result(what: str, scaled: Any, scale: tuple[float, ...], body: Any) 
     if not np.all(np.isfinite(out)):
         raise ValueError(
             f"Expected `omega` and `inertia` with a representable {what}, got moments "
-            f"{body._moments.tolist()} and omega {body._omega.tolist()} (beyond float64)"
+            f"{si.moments.tolist()} and omega {si.omega.tolist()} (beyond float64)"
         )
     return out
+
+
+class BodySI(NamedTuple):
+    """A rigid body's state as SI floats: the documented float view :attr:`RigidBody.si`.
+
+    For code on plain floats (kernels, integrators, Sylvester's relations): the
+    same state as the :class:`RigidBody` it came from, whether that answers in
+    Quantities or not.  The arrays are copies.
+
+    Attributes
+    ----------
+    moments : ndarray, shape (3,), kg m^2
+        Principal moments ``(A, B, C)``.
+    attitude : ndarray, shape (4,)
+        Unit attitude quaternion, scalar first, body to space.
+    omega : ndarray, shape (3,), rad/s
+        Body-frame angular velocity ``(p, q, r)``.
+
+    Notes
+    -----
+    The derived quantities are computed on ``moments / sm`` and ``omega / sw``
+    (``sm, sw`` exact powers of two, :meth:`scales`) and scaled back, so nothing
+    under- or overflows inside; a result beyond float64 raises ``ValueError``.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> si = RigidBody([1.0, 2.0, 3.0] * u.g * u.m**2, omega=[0.0, 0.0, 2.0] * u.rad / u.s).si
+    >>> print(si.moments, si.omega, si.attitude)
+    [0.001 0.002 0.003] [0. 0. 2.] [1. 0. 0. 0.]
+    >>> print(si.kinetic_energy, si.angular_momentum_body, si.angular_momentum_norm)
+    0.006 [0.    0.    0.006] 0.006
+    """
+
+    moments: np.ndarray
+    attitude: np.ndarray
+    omega: np.ndarray
+
+    def scales(self) -> tuple[float, float]:
+        """``(sm, sw)``: the powers of two at or below ``max moments`` and ``max|omega|``
+        (1 for zero omega), exact scales for homogeneous computations."""
+        return pow2(self.moments), pow2(self.omega)
+
+    @property
+    def angular_momentum_body(self) -> np.ndarray:
+        """``L = (A p, B q, C r)`` in the body frame, shape (3,), kg m^2/s."""
+        sm, sw = self.scales()
+        return _finite_result("angular momentum", (self.moments / sm) * (self.omega / sw),
+                              (sm, sw), self)
+
+    @property
+    def angular_momentum_space(self) -> np.ndarray:
+        """``q L q^-1``, Cayley's ``(g, g', g'')``, shape (3,), kg m^2/s."""
+        sm, sw = self.scales()
+        lb = (self.moments / sm) * (self.omega / sw)
+        big = pow2(lb)
+        ls = np.asarray(Quaternion(self.attitude).rotate(lb / big), dtype=np.float64)
+        return _finite_result("angular momentum", ls, (big, sm, sw), self)
+
+    @property
+    def kinetic_energy(self) -> float:
+        """``T = (A p^2 + B q^2 + C r^2) / 2``, J."""
+        sm, sw = self.scales()
+        w = self.omega / sw
+        half = 0.5 * np.sum((self.moments / sm) * w * w)
+        return float(_finite_result("kinetic energy", half, (sm, sw, sw), self))
+
+    @property
+    def angular_momentum_norm(self) -> float:
+        """``|L|``, kg m^2/s."""
+        sm, sw = self.scales()
+        lb = (self.moments / sm) * (self.omega / sw)
+        return float(_finite_result("angular momentum", np.sqrt(np.sum(lb * lb)), (sm, sw),
+                                    self))
 
 
 def check_body(body: Any, name: str = "body") -> RigidBody:
@@ -266,6 +330,11 @@ class RigidBody:
     omega : ndarray or Quantity, shape (3,), rad/s
         Angular velocity in the principal frame (rad/s as a Quantity for a body
         built from Quantities).
+    si : BodySI
+        The same state as SI floats (moments, attitude array, omega and the
+        derived integrals), for code on plain floats.
+    quantity : bool
+        Whether the body answers in Quantities.
 
     Raises
     ------
@@ -324,13 +393,50 @@ class RigidBody:
         self._quantity: bool = bool(quantity)
 
     @classmethod
-    def _from_si(
-        cls, moments: np.ndarray, attitude: Any, omega: np.ndarray, quantity: bool
+    def from_si(
+        cls, moments: Any, attitude: Any = None, omega: Any = None, *, quantity: bool = False
     ) -> RigidBody:
-        """A body from SI floats (validated), answering in Quantities if ``quantity``."""
+        """A body from SI floats, validated like the constructor.
+
+        Parameters
+        ----------
+        moments : array_like, shape (3,) or (3, 3), kg m^2
+            Plain floats (principal moments or a tensor, as for :class:`RigidBody`).
+        attitude : Quaternion or array_like, shape (4,), optional
+        omega : array_like, shape (3,), rad/s, optional
+            Plain floats.
+        quantity : bool, optional
+            Whether the new body answers in Quantities (kg m^2, rad/s, ...), as a
+            body built from Quantities does.  Default False.
+
+        Examples
+        --------
+        >>> RigidBody.from_si([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0], quantity=True).omega
+        <Quantity [0., 0., 2.] rad / s>
+        """
         body = cls(moments, attitude, omega)
         body._quantity = bool(quantity)
         return body
+
+    @property
+    def quantity(self) -> bool:
+        """Whether the body answers in Quantities (it was built from Quantities, or by
+        :meth:`from_si` with ``quantity=True``)."""
+        return self._quantity
+
+    @property
+    def si(self) -> BodySI:
+        """The state as SI floats (:class:`BodySI`: ``moments``, ``attitude``, ``omega``
+        and the derived integrals), whatever the body answers in.
+
+        Examples
+        --------
+        >>> import astropy.units as u
+        >>> RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2).si.moments
+        array([1., 2., 3.])
+        """
+        return BodySI(self._moments.copy(), self.attitude.as_array().astype(np.float64),
+                      self._omega.copy())
 
     @property
     def moments(self) -> Any:
@@ -384,39 +490,15 @@ class RigidBody:
                     f"Expected `omega` as {kind} like the body's moments, got {omega!r}"
                 )
             w = ANGULAR_SPEED("omega", omega)
-        return RigidBody._from_si(
-            self._moments, self.attitude if attitude is None else attitude, w, self._quantity
+        return RigidBody.from_si(
+            self._moments, self.attitude if attitude is None else attitude, w,
+            quantity=self._quantity,
         )
 
-    # ------------------------------------------------------------ derived (floats)
-    # Computed on moments / sm and omega / sw (exact powers of two) and scaled back,
-    # so that nothing under- or overflows inside; a result beyond float64 raises.
-    def _scales(self) -> tuple[float, float]:
-        return _pow2(self._moments), _pow2(self._omega)
-
-    def _l_body(self) -> np.ndarray:
-        sm, sw = self._scales()
-        return _finite_result("angular momentum", (self._moments / sm) * (self._omega / sw),
-                              (sm, sw), self)
-
-    def _l_space(self) -> np.ndarray:
-        sm, sw = self._scales()
-        lb = (self._moments / sm) * (self._omega / sw)
-        big = _pow2(lb)
-        ls = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
-        return _finite_result("angular momentum", ls, (big, sm, sw), self)
-
-    def _energy(self) -> float:
-        sm, sw = self._scales()
-        w = self._omega / sw
-        half = 0.5 * np.sum((self._moments / sm) * w * w)
-        return float(_finite_result("kinetic energy", half, (sm, sw, sw), self))
-
-    def _l_norm(self) -> float:
-        sm, sw = self._scales()
-        lb = (self._moments / sm) * (self._omega / sw)
-        return float(_finite_result("angular momentum", np.sqrt(np.sum(lb * lb)), (sm, sw), self))
-
+    # ------------------------------------------------------------ derived
+    # Computed by the float view (BodySI): on moments / sm and omega / sw (exact
+    # powers of two) and scaled back, so that nothing under- or overflows inside;
+    # a result beyond float64 raises.
     def _out(self, value, unit: u.UnitBase):
         return u.Quantity(value, unit) if self._quantity else value
 
@@ -424,7 +506,7 @@ class RigidBody:
     def angular_momentum_body(self) -> np.ndarray:
         """Angular momentum ``(A p, B q, C r)`` in the body frame, shape (3,)
         (kg m^2/s as a Quantity if the body was built from Quantities)."""
-        return self._out(self._l_body(), _L_UNIT)
+        return self._out(self.si.angular_momentum_body, _L_UNIT)
 
     @property
     def angular_momentum_space(self) -> np.ndarray:
@@ -432,7 +514,7 @@ class RigidBody:
 
         Constant in torque-free motion; equal to Cayley's ``(g, g', g'')``.
         """
-        return self._out(self._l_space(), _L_UNIT)
+        return self._out(self.si.angular_momentum_space, _L_UNIT)
 
     @property
     def cayley_g(self) -> np.ndarray:
@@ -456,13 +538,13 @@ class RigidBody:
     def kinetic_energy(self) -> float:
         """Kinetic energy ``T = (A p^2 + B q^2 + C r^2) / 2`` (J as a Quantity if the
         body was built from Quantities)."""
-        return self._out(self._energy(), u.J)
+        return self._out(self.si.kinetic_energy, u.J)
 
     @property
     def angular_momentum_norm(self) -> float:
         """``|L|``, the magnitude of the angular momentum (kg m^2/s as a Quantity if
         the body was built from Quantities)."""
-        return self._out(self._l_norm(), _L_UNIT)
+        return self._out(self.si.angular_momentum_norm, _L_UNIT)
 
     @property
     def invariable_plane(self) -> np.ndarray:
@@ -478,9 +560,9 @@ class RigidBody:
         >>> print(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 5.0]).invariable_plane)
         [0. 0. 1.]
         """
-        sm, sw = self._scales()
+        sm, sw = pow2(self._moments), pow2(self._omega)
         lb = (self._moments / sm) * (self._omega / sw)
-        big = _pow2(lb)
+        big = pow2(lb)
         lvec = np.asarray(self.attitude.rotate(lb / big), dtype=np.float64)
         norm = float(np.sqrt(np.sum(lvec * lvec)))
         if norm == 0.0:

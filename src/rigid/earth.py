@@ -41,6 +41,9 @@ import numpy as np
 
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, TIME
 from rigid.body import RigidBody
+from rigid.free import free_motion
+from rigid.integrators import integrate
+from rigid.wobble import free_period
 
 __all__ = [
     "C22_BAR",
@@ -302,7 +305,7 @@ class PolePath:
         return (-self.m.imag * u.rad).to(u.arcsec)
 
     def period(self) -> u.Quantity:
-        """The wobble period fitted to the path (see :func:`rigid.polar_motion.free_period`).
+        """The wobble period fitted to the path (see :func:`rigid.wobble.free_period`).
 
         Examples
         --------
@@ -310,8 +313,6 @@ class PolePath:
         >>> bool(abs(path.period() / euler_period() - 1) < 1e-10)
         True
         """
-        from rigid.polar_motion import free_period
-
         return free_period(self.t, self.m)
 
 
@@ -346,23 +347,20 @@ def simulate_wobble(
     >>> print(f"{path.period():.1f}")
     303.6 d
     """
-    from rigid.free import free_motion
-    from rigid.integrators import integrate
-
     t_end = TIME("duration", duration, u.day)
     if t_end.shape != () or not float(t_end) >= 1.0:
         raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
     n_out = int(np.floor(float(t_end))) + 1
     body = rigid_body(wobble, triaxial=triaxial)
+    t = np.arange(n_out) * 86400.0 * u.s
     if method == "exact":
-        t = np.arange(n_out) * 86400.0 * u.s
         _, omega = free_motion(body, t)
+    elif method == "dop853":  # adaptive: outputs at the days themselves
+        omega = integrate(body, t, method=method).omega
     else:
-        n_days = n_out - 1
         step = TIME("dt", dt, u.s)
         # a whole number of steps per day so that the output falls on whole days
         per_day = max(1, int(np.ceil(86400.0 / float(step))))
-        tr = integrate(body, n_days * 86400.0 * u.s, dt=86400.0 / per_day * u.s,
-                       method=method, n_out=n_out)
+        tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
         t, omega = tr.t, tr.omega
     return PolePath(t=u.Quantity(t, u.s).to(u.day), m=pole_path(omega), method=method)

@@ -219,8 +219,27 @@ class GravityGradientTorque(_Torque):
         return _k.TORQUE_GRAVITY_GRADIENT, self._params.copy()
 
 
-def _encode(torque: Any) -> tuple[int, np.ndarray]:
-    """(kind, params) of ``torque`` (None, a torque object)."""
+def encode_torque(torque: Any) -> tuple[int, np.ndarray]:
+    """``(kind, params)`` of ``torque`` for the compiled kernels (shared inside ``rigid``).
+
+    Parameters
+    ----------
+    torque : BodyTorque, SpaceTorque, GravityGradientTorque or None
+
+    Raises
+    ------
+    ValueError
+        For anything else, naming the argument and the type.
+
+    Examples
+    --------
+    >>> encode_torque(None)
+    (0, array([0.]))
+    >>> encode_torque([1.0, 0.0, 0.0])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `torque` to be None, BodyTorque, ... or GravityGradientTorque, got list
+    """
     if torque is None:
         return _k.TORQUE_NONE, np.zeros(1)
     if isinstance(torque, _Torque):
@@ -264,7 +283,7 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     m = _moments(moments)
     q = _quat_array("attitude", attitude)
     tt = np.zeros(()) if t is None else TIME("t", t)
-    kind, params = _encode(torque)
+    kind, params = encode_torque(torque)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             out = _k.torque_gufunc(m, q, tt, kind, params)

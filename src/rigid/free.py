@@ -24,7 +24,7 @@ exchanged in a right-handed relabelling of the axes.  On the separatrix
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import astropy.units as u
 import numpy as np
@@ -32,9 +32,11 @@ import numpy as np
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import ANGULAR_SPEED, INERTIA, TIME, require_consistent, wrap
 from rigid._kernels import free as _fk
-from rigid.body import RigidBody, _pow2, call_units, check_body, check_moments, unit_quaternion
+from rigid._shared import free_flow_scaled
+from rigid.body import RigidBody, call_units, check_body, check_moments, unit_quaternion
 
-__all__ = ["FreeParameters", "free_motion", "free_motion_arrays", "free_parameters"]
+__all__ = ["FreeMotion", "FreeParameters", "free_motion", "free_motion_arrays",
+           "free_parameters"]
 
 _RATE = 1 / u.s
 
@@ -48,42 +50,6 @@ def _check_state(
     if omega0.shape != (3,):
         raise ValueError(f"Expected `{names[2]}` to have shape (3,), got {omega0.shape}")
     return np.ascontiguousarray(moments), np.ascontiguousarray(q0), omega0.copy()
-
-
-def _free_flow_scaled(
-    moments: np.ndarray, q0: np.ndarray, omega0: np.ndarray, flat_t: np.ndarray, t_name: str
-) -> tuple[np.ndarray, np.ndarray]:
-    """The kernel on a homogeneously scaled problem (no over- or underflow inside).
-
-    The motion depends on the moments only through their ratios, and
-    ``omega(t; s omega0) = s omega(s t; omega0)``: with exact power-of-two scales
-    ``sm ~ max moment`` and ``sw ~ max|omega0|`` the kernel sees moments and rates
-    of order one, whatever the caller's magnitudes (1e-300 or 1e300 kg m^2,
-    1e-200 rad/s).
-    """
-    sm = _pow2(moments)
-    sw = _pow2(omega0)
-    with np.errstate(over="ignore"):
-        ts = flat_t * sw
-    bad = ~np.isfinite(ts)
-    if np.any(bad):
-        k = int(np.argwhere(bad)[0][0])
-        raise ValueError(
-            f"Expected `{t_name}` * |omega| to be finite (the angle turned), got "
-            f"{float(flat_t[k])!r} at index {k} with |omega| ~ {sw!r}"
-        )
-    out_q = np.empty((flat_t.size, 4))
-    out_w = np.empty((flat_t.size, 3))
-    _fk.free_flow(moments / sm, q0, omega0 / sw, ts, out_q, out_w)
-    out_w *= sw
-    bad = ~(np.isfinite(out_q).all(axis=-1) & np.isfinite(out_w).all(axis=-1))
-    if np.any(bad):  # pragma: no cover - a kernel failure is a bug, never a silent NaN
-        k = int(np.argwhere(bad)[0][0])
-        raise ValueError(
-            f"free motion failed for moments = {moments.tolist()}, omega = {omega0.tolist()} "
-            f"at `{t_name}`[{k}] = {float(flat_t[k])!r}: please report this case"
-        )
-    return out_q, out_w
 
 
 def free_motion_arrays(
@@ -140,12 +106,34 @@ def free_motion_arrays(
     moments, q0, omega0 = _check_state(moments, q0, omega0)
     t_arr = TIME("t", t)
     flat = np.ascontiguousarray(t_arr.reshape(-1))
-    out_q, out_w = _free_flow_scaled(moments, q0, omega0, flat, "t")
+    out_q, out_w = free_flow_scaled(moments, q0, omega0, flat, "t")
     w = out_w.reshape(t_arr.shape + (3,))
     return out_q.reshape(t_arr.shape + (4,)), wrap(w, u.rad / u.s, quantity)
 
 
-def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
+class FreeMotion(NamedTuple):
+    """The result of :func:`free_motion`: ``attitude, omega = free_motion(body, t)``.
+
+    Attributes
+    ----------
+    attitude : Quaternion, shape t.shape
+        Body-to-space attitude at each time.
+    omega : ndarray or Quantity, shape t.shape + (3,)
+        Body-frame angular velocity at each time (rad/s as a Quantity when the
+        call was in Quantities).
+
+    Examples
+    --------
+    >>> motion = free_motion(RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0]), [0.0, 1.0])
+    >>> print(motion.omega[-1], motion.attitude.as_array()[-1].round(6))
+    [0. 0. 2.] [0.540302 0.       0.       0.841471]
+    """
+
+    attitude: Quaternion
+    omega: Any
+
+
+def free_motion(body: RigidBody, t: Any) -> FreeMotion:
     """The exact torque-free motion of ``body``, vectorised over ``t``.
 
     Parameters
@@ -157,10 +145,10 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
 
     Returns
     -------
-    attitude : Quaternion, shape t.shape
-        Body-to-space attitude at each time.
-    omega : ndarray or Quantity, shape t.shape + (3,), rad/s
-        Body-frame angular velocity at each time.
+    FreeMotion
+        A named tuple ``(attitude, omega)``: ``attitude`` (Quaternion, shape
+        t.shape), the body-to-space attitude at each time; ``omega`` (ndarray or
+        Quantity, shape t.shape + (3,), rad/s), the body-frame angular velocity.
 
     Raises
     ------
@@ -205,10 +193,11 @@ def free_motion(body: RigidBody, t: Any) -> tuple[Quaternion, Any]:
     quantity = call_units(body, ("t",), (t,))
     t_arr = TIME("t", t)
     flat = np.ascontiguousarray(t_arr.reshape(-1))
-    q, w = _free_flow_scaled(body._moments, body.attitude.as_array(), body._omega, flat, "t")
+    si = body.si
+    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t")
     q = q.reshape(t_arr.shape + (4,))
     w = w.reshape(t_arr.shape + (3,))
-    return Quaternion(q), wrap(w, u.rad / u.s, quantity)
+    return FreeMotion(Quaternion(q), wrap(w, u.rad / u.s, quantity))
 
 
 @dataclass(frozen=True)
@@ -272,23 +261,24 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     """
     body = check_body(body)
     # homogeneous: the kernel sees moments / sm and omega / sw; rates scale back by sw
-    sm, sw = _pow2(body._moments), _pow2(body._omega)
-    prm = _fk.free_setup(body._moments / sm, body.attitude.as_array(), body._omega / sw)
-    kind = int(prm[_fk._KIND])
-    q = body._quantity
+    si = body.si
+    sm, sw = si.scales()
+    prm = _fk.free_setup(si.moments / sm, si.attitude, si.omega / sw)
+    kind = int(prm[_fk.KIND])
+    q = body.quantity
     inf = float("inf")
     if kind == 0:
         return FreeParameters("steady", -1, 0.0, 1.0, np.pi / 2, wrap(0.0, _RATE, q),
                               wrap(inf, u.s, q), wrap(inf, u.s, q), 0.0)
-    pmat = prm[_fk._P : _fk._P + 9].reshape(3, 3)
+    pmat = prm[_fk.P : _fk.P + 9].reshape(3, 3)
     polar = int(np.argmax(np.abs(pmat[:, 2])))
-    lam = float(prm[_fk._LAM]) * sw
+    lam = float(prm[_fk.LAM]) * sw
     if kind == 1:
-        kk = float(prm[_fk._K])
+        kk = float(prm[_fk.K])
         return FreeParameters(
-            "periodic", polar, float(prm[_fk._M]), float(prm[_fk._M1]), kk,
+            "periodic", polar, float(prm[_fk.M]), float(prm[_fk.M1]), kk,
             wrap(lam, _RATE, q), wrap(4.0 * kk / lam, u.s, q), wrap(2.0 * kk / lam, u.s, q),
-            float(prm[_fk._N]),
+            float(prm[_fk.N]),
         )
     return FreeParameters("separatrix", polar, 1.0, 0.0, inf, wrap(lam, _RATE, q),
-                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk._N]))
+                          wrap(inf, u.s, q), wrap(inf, u.s, q), float(prm[_fk.N]))

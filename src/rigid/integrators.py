@@ -39,36 +39,49 @@ normalised on output only (it is not projected inside the run);
     (:func:`rigid.free.free_motion_arrays`): exact for the free body (any h),
     second order in the torque.
 ``"dop853"``
-    scipy's ``solve_ivp(method="DOP853")`` on Euler's equations plus
-    dq/dt = q omega / 2 with tolerances ``rtol``, ``atol``.  Normalisation
-    policy: q is integrated *unconstrained* and normalised only on output.  The
-    exact flow conserves |q|, so | |q| - 1 | is a free error estimate
-    (returned as ``norm_drift``) rather than something to hide by projection,
-    and projecting inside solve_ivp's step control would need a restart per step.
+    scipy's DOP853 through the one driver of both packages,
+    :func:`hamilton_orbits.integrators.dop853.solve` (restarted at each output
+    time, so an output is a step end, not an interpolation), on Euler's
+    equations plus dq/dt = q omega / 2.  Tolerances from ``tol``: relative
+    ``tol``, absolute ``tol / 100`` on the (unit) quaternion and
+    ``tol / 100 max|omega0|`` on omega.  Normalisation policy: q is integrated
+    *unconstrained* and normalised only on output.  The exact flow conserves
+    |q|, so | |q| - 1 | is a free error estimate (returned as ``norm_drift``)
+    rather than something to hide by projection, and projecting inside the
+    step control would need a restart per step.
 ``"rk4"``, ``"cayley_rk4"``
     Classical fourth-order Runge-Kutta on Euler plus the quaternion
     kinematics, or plus Cayley's kinematics in (lambda, mu, nu) with re-centring
     (see :mod:`rigid.rodrigues`).  Reference/demonstration methods.
 
 Every fixed-step method runs its whole time loop in one compiled function.
+
+Output times and units (:func:`integrate`): ``t`` is an end time (101 equally
+spaced outputs from 0 to it) or an array of output times from the body's state
+(a start at 0 is added if missing).  Where the caller gave Quantities the
+result is in Quantities: ``t`` in the unit of the ``t`` given, omega in rad/s,
+moments in kg m^2; plain floats are SI.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+import time
+import warnings
 from typing import Any
 
 import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._validation import check_positive
+from hamilton_orbits.integrators import dop853
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
 from rigid._kernels import euler as _k
 from rigid.body import call_units, check_body
-from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, _encode
+from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
+from rigid.trajectory import RigidTrajectory, integral_errors
 
 __all__ = [
     "METHODS",
@@ -86,75 +99,6 @@ _SPLITTINGS = ("splitting2", "splitting4", "splitting4y")
 _FIXED = (*_SPLITTINGS, "exact_kick", "rk4", "cayley_rk4")
 
 
-@dataclass(frozen=True)
-class RigidTrajectory:
-    """The result of :func:`integrate`.
-
-    Attributes
-    ----------
-    t : ndarray or Quantity, shape (n,)
-        Output times (a Quantity in the unit of ``t_end`` when the call used
-        Quantities).
-    attitude : Quaternion, shape (n,)
-        Unit body-to-space attitudes.
-    omega : ndarray or Quantity, shape (n, 3)
-        Body-frame angular velocities (rad/s when the call used Quantities).
-    moments : ndarray or Quantity, shape (3,)
-        Principal moments (A, B, C) (kg m^2 when the call used Quantities).
-    method : str
-        Integrator name.
-    n_steps : int
-        Steps taken (fixed-step methods; 0 for DOP853, whose step count
-        scipy does not report: see ``nfev``).
-    n_recentre : int
-        Re-centrings of Cayley's parameters (``"cayley_rk4"`` only, else 0).
-    norm_drift : float
-        max | |q| - 1 | before the output normalisation (0 for ``"exact_kick"``,
-        which renormalises every step).
-    nfev : int
-        Right-hand-side evaluations (DOP853 only, else 0).
-    """
-
-    t: Any
-    attitude: Quaternion
-    omega: Any
-    moments: np.ndarray
-    method: str
-    n_steps: int
-    n_recentre: int = 0
-    norm_drift: float = 0.0
-    nfev: int = 0
-
-    def _quantity(self) -> bool:
-        return isinstance(self.t, u.Quantity)
-
-    def _omega_f(self) -> np.ndarray:
-        w = self.omega
-        return w.to_value(u.rad / u.s) if isinstance(w, u.Quantity) else np.asarray(w)
-
-    def _moments_f(self) -> np.ndarray:
-        m = self.moments
-        return m.to_value(u.kg * u.m**2) if isinstance(m, u.Quantity) else np.asarray(m)
-
-    @property
-    def angular_momentum_body(self) -> Any:
-        """L = I omega in the body frame, shape (n, 3) (kg m^2/s for Quantity calls)."""
-        return wrap(self._moments_f() * self._omega_f(), _L_UNIT, self._quantity())
-
-    @property
-    def angular_momentum_space(self) -> Any:
-        """q L q^-1, Cayley's (g, g', g''), shape (n, 3) (kg m^2/s for Quantity calls)."""
-        ell = self.attitude.rotate(self._moments_f() * self._omega_f())
-        return wrap(np.asarray(ell), _L_UNIT, self._quantity())
-
-    @property
-    def kinetic_energy(self) -> Any:
-        """T = (A p^2 + B q^2 + C r^2) / 2, shape (n,) (J for Quantity calls)."""
-        w = self._omega_f()
-        return wrap(0.5 * np.sum(self._moments_f() * w * w, axis=-1), u.J, self._quantity())
-
-
-_L_UNIT = u.kg * u.m**2 / u.s
 _MAX_STEPS = 1e12  # beyond this a fixed-step run is a typo, not a plan (days of CPU)
 
 
@@ -183,14 +127,10 @@ def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]
 
 def _progress_chunks(n_steps: int, progress: bool):
     """Chunk boundaries (in steps) for an optional tqdm bar; one chunk without it."""
-    if not progress:
+    bar = _bar(n_steps, "step", progress)
+    if bar is None:
         return [0, n_steps], None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover - optional extra
-        return [0, n_steps], None
-    bounds = sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)})
-    return bounds, tqdm(total=n_steps, unit="step", leave=False)
+    return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
 
 
 # Yoshida (1990, Phys. Lett. A 150, 262, eq. 5.4) triple jump: a symmetric
@@ -341,57 +281,10 @@ def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
     return q_out, w_out
 
 
-def integrate_arrays(
-    moments: np.ndarray,
-    q0: np.ndarray,
-    omega0: np.ndarray,
-    t_end: float,
-    *,
-    method: str = "splitting4",
-    dt: float | None = None,
-    n_out: int = 101,
-    kind: int = _k.TORQUE_NONE,
-    params: np.ndarray | None = None,
-    rtol: float = 1e-12,
-    atol: float = 1e-14,
-    recentre: float = 1.0,
-    progress: bool = False,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float]:
-    """Kernel-level integration on plain float arrays (no validation, no units).
-
-    Returns ``(t (n,), q (n, 4), omega (n, 3), n_steps, count, norm_drift)``
-    with unit quaternions; ``count`` is the number of re-centrings for
-    ``"cayley_rk4"`` and of right-hand-side evaluations for ``"dop853"``.
-    See :func:`integrate` for the methods.
-    """
-    params = np.zeros(1) if params is None else np.ascontiguousarray(params, dtype=np.float64)
-    m = np.ascontiguousarray(moments, dtype=np.float64)
-    q0 = np.ascontiguousarray(q0, dtype=np.float64)
-    q0 = q0 / np.sqrt(q0 @ q0)
-    w0 = np.ascontiguousarray(omega0, dtype=np.float64)
-    n_recentre = 0
+def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress):
+    """``(q, omega, count, drift)`` of a fixed-step method on the step grid."""
+    count = 0
     drift = 0.0
-    if method == "dop853":
-        from scipy.integrate import solve_ivp
-
-        t_out = np.linspace(0.0, t_end, n_out)
-        sol = solve_ivp(
-            lambda t, y: _k.rhs_quaternion(t, y, m, kind, params),
-            (0.0, t_end),
-            np.concatenate([q0, w0]),
-            method="DOP853",
-            t_eval=t_out,
-            rtol=rtol,
-            atol=atol,
-        )
-        if not sol.success:  # pragma: no cover - scipy failure
-            raise ValueError(f"DOP853 failed: {sol.message}")
-        y = sol.y.T
-        qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
-        drift = float(np.max(np.abs(qn - 1.0)))
-        return t_out, y[:, :4] / qn[:, None], y[:, 4:].copy(), 0, int(sol.nfev), drift
-    n_steps, h, out_steps = _steps(t_end, float(dt), n_out)
-    t_out = out_steps * h
     if method in _SPLITTINGS:
         q, w, drift = _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params,
                                      progress)
@@ -406,26 +299,218 @@ def integrate_arrays(
         q, w = y[:, :4] / qn[:, None], y[:, 4:]
     elif method == "cayley_rk4":
         y = np.empty((out_steps.size, 7))
-        n_recentre = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
-                                           recentre, y))
+        count = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
+                                      recentre, y))
         q, w = y[:, :4], y[:, 4:]
     else:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
-    return t_out, q, w, n_steps, n_recentre, drift
+    return q, w, count, drift
+
+
+def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
+    """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver (restarted at
+    each output time, :func:`hamilton_orbits.integrators.dop853.solve`)."""
+    bar = _bar(t_out.size - 1, "output", progress)
+    y, steps, nfev = dop853.solve(
+        lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
+        t_out, rtol=rtol, atol=atol, max_step=max_step,
+        on_output=None if bar is None else (lambda i, n: bar.update(1)),
+    )
+    if bar is not None:
+        bar.close()
+    qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
+    drift = float(np.max(np.abs(qn - 1.0)))
+    return y[:, :4] / qn[:, None], y[:, 4:].copy(), int(steps), int(nfev), drift
+
+
+def _bar(total: int, unit: str, progress: bool) -> Any:
+    """A tqdm bar (the ``progress`` extra), or None."""
+    if not progress:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:  # pragma: no cover - optional extra
+        return None
+    return tqdm(total=total, unit=unit, leave=False)
+
+
+def _grid(t: np.ndarray, dt: float, n_out: int | None) -> tuple[int, float, np.ndarray]:
+    """``(n_steps, h, out_steps)`` of a fixed-step run: a whole number of steps of
+    ``h <= dt`` spans the last time; each output at the step nearest its time.
+
+    An end time ``t`` (0-d) takes ``n_out`` (default 101) equally spaced outputs,
+    as :func:`integrate` always did; an array of times takes one output each.
+    """
+    if t.ndim == 0:
+        return _steps(float(t), dt, 101 if n_out is None else n_out)
+    n_steps = max(1, math.ceil(float(t[-1]) / dt * (1.0 - 1e-12)))
+    h = float(t[-1]) / n_steps
+    out_steps = np.minimum(np.round(t / h).astype(np.int64), n_steps)
+    return n_steps, h, out_steps
+
+
+def integrate_arrays(
+    moments: np.ndarray,
+    q0: np.ndarray,
+    omega0: np.ndarray,
+    t: Any,
+    *,
+    method: str = "splitting4",
+    dt: float | None = None,
+    n_out: int | None = None,
+    kind: int = _k.TORQUE_NONE,
+    params: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: Any = 1e-14,
+    recentre: float = 1.0,
+    progress: bool = False,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float]:
+    """Kernel-level integration on plain float arrays (no validation, no units).
+
+    ``t`` is an end time (``n_out`` equally spaced outputs, default 101) or an
+    increasing array of output times starting at 0.  ``dt`` is the step of the
+    fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
+    (7,) for ``(q, omega)``) are DOP853's tolerances.
+
+    Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
+    with unit quaternions; ``t`` the times reached; ``count`` is the number of
+    re-centrings for ``"cayley_rk4"`` and of right-hand-side evaluations for
+    ``"dop853"``.  See :func:`integrate` for the methods.
+
+    Examples
+    --------
+    >>> t, q, w, steps, count, drift = integrate_arrays(
+    ...     np.array([1.0, 2.0, 3.0]), np.array([1.0, 0, 0, 0]), np.array([0.0, 0.0, 1.0]),
+    ...     np.array([0.0, 0.5, 1.0]), method="rk4", dt=0.1)
+    >>> t, steps, q[-1].round(6)  # a spin about z: q = (cos t/2, 0, 0, sin t/2), RK4
+    (array([0. , 0.5, 1. ]), 10, array([0.877583, 0.      , 0.      , 0.479426]))
+    """
+    params = np.zeros(1) if params is None else np.ascontiguousarray(params, dtype=np.float64)
+    m = np.ascontiguousarray(moments, dtype=np.float64)
+    q0 = np.ascontiguousarray(q0, dtype=np.float64)
+    q0 = q0 / np.sqrt(q0 @ q0)
+    w0 = np.ascontiguousarray(omega0, dtype=np.float64)
+    t_arr = np.asarray(t, dtype=np.float64)
+    if method == "dop853":
+        t_out = (np.linspace(0.0, float(t_arr), 101 if n_out is None else n_out)
+                 if t_arr.ndim == 0 else t_arr)
+        q, w, steps, nfev, drift = _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol,
+                                               np.inf if dt is None else float(dt), progress)
+        return t_out, q, w, steps, nfev, drift
+    n_steps, h, out_steps = _grid(t_arr, float(dt), n_out)
+    q, w, count, drift = _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params,
+                                    recentre, progress)
+    return out_steps * h, q, w, n_steps, count, drift
+
+
+_UNSET: Any = object()  # the default of the deprecated keywords
+
+
+def _deprecated(t: Any, t_end: Any, n_out: Any, rtol: Any, atol: Any, tol: Any) -> tuple:
+    """``(t, n_out, rtol, atol)`` from the keywords of before issue 19, with a
+    DeprecationWarning naming the new one (None where not given)."""
+    def warn(old: str, new: str) -> None:
+        warnings.warn(f"`{old}=` is deprecated; {new}", DeprecationWarning, stacklevel=4)
+
+    if t_end is not _UNSET:
+        warn("t_end", "pass the end time (or an array of output times) as `t`")
+        if t is not None:
+            raise ValueError(f"Expected `t` or the deprecated `t_end`, got both: {t!r}, "
+                             f"{t_end!r}")
+        t = t_end
+    if t is None:
+        raise ValueError("Expected `t`, an end time or an array of output times, got None")
+    if n_out is not _UNSET:
+        warn("n_out", "pass an array of output times as `t`, e.g. "
+             "np.linspace(0, t_end, n_out)")
+        if np.ndim(getattr(t, "value", t)) != 0:
+            raise ValueError(f"Expected `n_out` only with an end time `t`, got an array `t` "
+                             f"of shape {np.shape(t)}")
+        n_out = _n_out(n_out)
+    old_tol = {k: v for k, v in (("rtol", rtol), ("atol", atol)) if v is not _UNSET}
+    for name, value in old_tol.items():
+        warn(name, "pass `tol` (DOP853's relative tolerance; the absolute one follows "
+             "from it)")
+        if tol is not None:
+            raise ValueError(f"Expected `tol` or the deprecated `{name}`, got both: "
+                             f"tol = {tol!r}, {name} = {value!r}")
+    return (t, None if n_out is _UNSET else n_out, old_tol.get("rtol"), old_tol.get("atol"))
+
+
+def _output_times(t_s: np.ndarray) -> np.ndarray:
+    """A validated end time (0-d, > 0) or times from 0, strictly increasing (a 0 is
+    prepended if missing)."""
+    if t_s.ndim == 0:
+        return np.asarray(_scalar_positive("t", t_s))
+    if t_s.ndim != 1 or t_s.size == 0:
+        raise ValueError(f"Expected `t` to be an end time or a 1-d array of output times, "
+                         f"got shape {t_s.shape}")
+    if not t_s[0] >= 0.0:
+        raise ValueError(f"Expected `t` >= 0 (times from the body's state), got "
+                         f"{float(t_s[0])!r} at index 0")
+    bad = np.nonzero(~(np.diff(t_s) > 0.0))[0]
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise ValueError(f"Expected `t` strictly increasing, got {float(t_s[k])!r} after "
+                         f"{float(t_s[k - 1])!r} at index {k}")
+    if t_s[-1] == 0.0:
+        raise ValueError("Expected `t` to reach beyond 0, got [0.0]")
+    return t_s if t_s[0] == 0.0 else np.concatenate([[0.0], t_s])
+
+
+def _step(method: str, dt: Any, t_last: float, tol: Any) -> float | None:
+    """The step (fixed-step methods, required) or DOP853's step cap (optional), s."""
+    if method in _FIXED:
+        if tol is not None:
+            raise ValueError(f"Expected `tol` only with method 'dop853' (a fixed-step method "
+                             f"takes `dt`), got tol = {tol!r} for method {method!r}")
+        if dt is None:
+            raise ValueError(f"Expected `dt` for method {method!r}, got None")
+    if dt is None:
+        return None
+    dtf = float(_scalar_positive("dt", TIME("dt", dt)))
+    if method in _FIXED and (not math.isfinite(t_last / dtf) or t_last / dtf > _MAX_STEPS):
+        raise ValueError(
+            f"Expected `dt` to give at most {_MAX_STEPS:.0e} steps over `t`, got "
+            f"dt = {dtf!r} s for t = {t_last!r} s"
+        )
+    return dtf
+
+
+def _tolerances(tol: Any, rtol: Any, atol: Any, w0: np.ndarray) -> tuple[float, Any]:
+    """DOP853's ``(rtol, atol)``: from ``tol`` (relative ``tol``; absolute ``tol / 100``
+    on the unit quaternion and ``tol / 100 max|omega0|`` on omega), or the
+    deprecated ``rtol``, ``atol`` as given (defaults 1e-12, 1e-14)."""
+    if rtol is not None or atol is not None:
+        r, a = (float(_scalar_positive(name, DIMENSIONLESS(name, v))) for name, v in
+                (("rtol", 1e-12 if rtol is None else rtol),
+                 ("atol", 1e-14 if atol is None else atol)))
+        return r, a
+    tol_f = DEFAULT_TOL if tol is None else float(_scalar_positive("tol", DIMENSIONLESS(
+        "tol", tol)))
+    w_scale = float(np.max(np.abs(w0)))
+    scale = np.array([1.0] * 4 + [w_scale if w_scale > 0.0 else 1.0] * 3)
+    return tol_f, 1e-2 * tol_f * scale
+
+
+#: DOP853's default ``tol`` (relative tolerance).
+DEFAULT_TOL = 1e-12
 
 
 def integrate(
     body: Any,
-    t_end: Any,
+    t: Any = None,
     *,
-    dt: Any = None,
     method: str = "splitting4",
+    dt: Any = None,
+    tol: float | None = None,
     torque: Any = None,
-    n_out: int = 101,
-    rtol: float = 1e-12,
-    atol: float = 1e-14,
-    recentre: float = 1.0,
     progress: bool = False,
+    recentre: float = 1.0,
+    t_end: Any = _UNSET,
+    n_out: Any = _UNSET,
+    rtol: Any = _UNSET,
+    atol: Any = _UNSET,
 ) -> RigidTrajectory:
     """Integrate a rigid body (free or torqued) from its current state.
 
@@ -433,43 +518,54 @@ def integrate(
     ----------
     body : RigidBody
         Initial state: ``moments`` (3,), ``attitude`` (Quaternion), ``omega`` (3,).
-    t_end : float or Quantity
-        Time span, > 0 (s for plain floats).  Must be a Quantity if ``body`` was
+    t : float, array_like or Quantity
+        An end time (> 0; 101 equally spaced outputs from 0 to it), or the output
+        times from the body's state, shape (n,), strictly increasing (a start at
+        0 is added if missing).  s for plain floats; a Quantity if ``body`` was
         built from Quantities.
-    dt : float or Quantity, optional
-        Step of the fixed-step methods (required for them; ignored by
-        ``"dop853"``).  Rounded down so that a whole number of steps spans
-        ``t_end``.  A Quantity exactly when ``t_end`` is one.
     method : str, optional
         One of :data:`METHODS` (see the module docstring).  Default
         ``"splitting4"``.
+    dt : float or Quantity, optional
+        Step of the fixed-step methods (required for them), rounded down so that
+        a whole number of steps spans the last time; for ``"dop853"`` a cap on
+        the step.  A Quantity exactly when ``t`` is one.
+    tol : float, optional
+        ``"dop853"`` only: its relative tolerance (default 1e-12; the absolute
+        tolerance is ``tol / 100`` on the unit quaternion and
+        ``tol / 100 max|omega0|`` on omega).  Refused by the fixed-step methods.
     torque : BodyTorque, SpaceTorque, GravityGradientTorque or None, optional
         External torque (see :mod:`rigid.euler`).  Default None (free body).
-    n_out : int, optional
-        Number of equally spaced output times, including 0 and ``t_end``
-        (fixed-step methods output at the nearest step).  Default 101.
-    rtol, atol : float, optional
-        Tolerances for ``"dop853"``.
+    progress : bool, optional
+        Show a tqdm progress bar (needs the ``progress`` extra).
     recentre : float, optional
         Re-centring threshold on |g_0| for ``"cayley_rk4"``.
-    progress : bool, optional
-        Show a tqdm progress bar (splitting and exact_kick methods; needs the
-        ``progress`` extra).
+
+    Other Parameters
+    ----------------
+    t_end, n_out, rtol, atol
+        Deprecated (DeprecationWarning): ``t_end=`` is ``t``; ``n_out=`` is an
+        array ``t = np.linspace(0, t_end, n_out)``; ``rtol=``, ``atol=`` are
+        ``tol`` (given, they are used as they are, as before).
 
     Returns
     -------
     RigidTrajectory
-        In Quantities (``t`` in the unit of ``t_end``, omega in rad/s, moments in
-        kg m^2) when the call was; else plain SI floats.
+        Units: where the caller gave Quantities the result is in Quantities, ``t``
+        in the unit of the ``t`` given (or of ``t_end``), omega in rad/s and
+        moments in kg m^2 (the units the body answers in); plain floats are SI.
+        Fixed-step methods output at the step nearest each time (``t`` holds the
+        times reached); ``"dop853"`` at the times themselves.
 
     Raises
     ------
     ValueError
-        For ``body`` not a RigidBody, an unknown method, a non-positive or NaN
-        ``t_end`` / ``dt``, a missing ``dt``, more than 1e12 steps, ``n_out`` not
-        an integer in [2, 1e9], a plain ``dt`` beside a Quantity ``t_end`` (or
-        the reverse, or plain times for a body with units), or an unsupported
-        torque.
+        For ``body`` not a RigidBody, an unknown method, a bad ``t`` (NaN,
+        not > 0, not increasing, naming the index and the value) or ``dt``, a
+        missing ``dt``, more than 1e12 steps, ``tol`` with a fixed-step method,
+        ``n_out`` not an integer in [2, 1e9], a plain ``dt`` beside a Quantity
+        ``t`` (or the reverse, or plain times for a body with units), or an
+        unsupported torque.
     astropy.units.UnitConversionError
         For a time of the wrong dimension, naming the argument.
 
@@ -485,60 +581,53 @@ def integrate(
     --------
     >>> from rigid import RigidBody
     >>> b = RigidBody([1.0, 2.0, 3.0], omega=[0.1, 1.0, 0.1])
-    >>> tr = integrate(b, 10.0, dt=0.01, method="splitting2", n_out=3)
+    >>> tr = integrate(b, [5.0, 10.0], dt=0.01, method="splitting2")
     >>> tr.t
     array([ 0.,  5., 10.])
-    >>> L = np.linalg.norm(tr.angular_momentum_body, axis=-1)
-    >>> bool(np.all(np.abs(L / L[0] - 1.0) < 1e-14))
+    >>> bool(np.all(tr.angular_momentum_error < 1e-14))  # L in space, to rounding
     True
+    >>> import astropy.units as u
+    >>> integrate(b, 10.0 * u.min, method="dop853", tol=1e-10).t[-1]  # the caller's unit
+    <Quantity 10. min>
     """
     body = check_body(body)
-    body._energy()  # a body whose I omega^2 or I omega leaves float64 is refused here
-    body._l_norm()
+    t, n_out, rtol, atol = _deprecated(t, t_end, n_out, rtol, atol, tol)
+    si = body.si
+    # a body whose I omega^2 or I omega leaves float64 is refused here
+    _ = (si.kinetic_energy, si.angular_momentum_norm)
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
-    quantity = call_units(body, ("t_end", "dt"), (t_end, dt))
-    te = _scalar_positive("t_end", TIME("t_end", t_end))
-    if method in _FIXED:
-        if dt is None:
-            raise ValueError(f"Expected `dt` for method {method!r}, got None")
-        dtf: float | None = float(_scalar_positive("dt", TIME("dt", dt)))
-        if not math.isfinite(te / dtf) or te / dtf > _MAX_STEPS:
-            raise ValueError(
-                f"Expected `dt` to give at most {_MAX_STEPS:.0e} steps over `t_end`, got "
-                f"dt = {dtf!r} s for t_end = {te!r} s"
-            )
-    else:
-        dtf = None
-    n_out = _n_out(n_out)
-    rtol, atol, recentre = (
-        float(_scalar_positive(name, DIMENSIONLESS(name, v)))
-        for name, v in (("rtol", rtol), ("atol", atol), ("recentre", recentre))
+    quantity = call_units(body, ("t", "dt"), (t, dt))
+    times = _output_times(TIME("t", t))
+    dtf = _step(method, dt, float(times.max()), tol)
+    rtol_f, atol_f = _tolerances(tol, rtol, atol, si.omega)
+    recentre = float(_scalar_positive("recentre", DIMENSIONLESS("recentre", recentre)))
+    kind, params = encode_torque(torque)
+    start = time.perf_counter()
+    t_f, q, w, steps, count, drift = integrate_arrays(
+        si.moments, si.attitude, si.omega, times, method=method, dt=dtf, n_out=n_out,
+        kind=kind, params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
+        progress=progress,
     )
-    kind, params = _encode(torque)
-    moments = body._moments
-    q0 = body.attitude.as_array().astype(np.float64)
-    w0 = body._omega.copy()
-    t, q, w, n_steps, count, drift = integrate_arrays(
-        moments, q0, w0, te, method=method, dt=dtf, n_out=n_out, kind=kind,
-        params=params, rtol=rtol, atol=atol, recentre=recentre, progress=progress,
+    wall = time.perf_counter() - start
+    _check_finite(t_f, q, w, method, dtf)
+    energy_error, am_error = integral_errors(si.moments, q, w)
+    t_unit = getattr(t, "unit", u.s) if quantity else u.s
+    return RigidTrajectory(
+        t=wrap(t_f / t_unit.to(u.s), t_unit, quantity), steps=int(steps), wall_time=wall,
+        method=method, energy_error=energy_error, angular_momentum_error=am_error,
+        attitude=Quaternion(q), omega=wrap(w, u.rad / u.s, quantity),
+        moments=wrap(si.moments, u.kg * u.m**2, quantity),
+        n_recentre=count if method == "cayley_rk4" else 0, norm_drift=drift,
+        nfev=count if method == "dop853" else 0,
     )
+
+
+def _check_finite(t: np.ndarray, q: np.ndarray, w: np.ndarray, method: str, dt: Any) -> None:
     bad = ~(np.isfinite(q).all(axis=-1) & np.isfinite(w).all(axis=-1))
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])
         raise ValueError(
             f"Expected `dt` small enough for a finite solution, got a non-finite state at "
-            f"t = {float(t[k])!r} s with method {method!r} and dt = {dtf!r} s"
+            f"t = {float(t[k])!r} s with method {method!r} and dt = {dt!r} s"
         )
-    t_unit = t_end.unit if quantity and isinstance(t_end, u.Quantity) else u.s
-    return RigidTrajectory(
-        t=wrap(t * u.s.to(t_unit), t_unit, quantity),
-        attitude=Quaternion(q),
-        omega=wrap(w, u.rad / u.s, quantity),
-        moments=wrap(moments.copy(), u.kg * u.m**2, quantity),
-        method=method,
-        n_steps=n_steps,
-        n_recentre=count if method == "cayley_rk4" else 0,
-        norm_drift=drift,
-        nfev=count if method == "dop853" else 0,
-    )

@@ -19,8 +19,8 @@ import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import TIME, wrap
-from rigid.body import RigidBody, _pow2, call_units, check_body
-from rigid.free import _free_flow_scaled
+from rigid._shared import free_flow_scaled
+from rigid.body import RigidBody, call_units, check_body
 
 _RHO_UNIT = (u.kg * u.m**2) ** -0.5  # x . I x = 1 on the inertia ellipsoid
 
@@ -102,11 +102,12 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     t_unit = t.unit if isinstance(t, u.Quantity) else u.s
     t_given = np.array(t.value, dtype=np.float64) if isinstance(t, u.Quantity) else t_s
     flat = np.ascontiguousarray(t_s.reshape(-1))
-    q, w = _free_flow_scaled(body._moments, body.attitude.as_array(), body._omega, flat, "t")
+    si = body.si
+    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t")
     # rho = omega / sqrt(2T) on moments / sm and omega / sw (no under- or overflow):
     # rho = (omega / sw) / sqrt(2T / (sm sw^2)) / sqrt(sm)
-    sm, sw = _pow2(body._moments), _pow2(body._omega)
-    two_t = float(np.sum((body._moments / sm) * (body._omega / sw) ** 2))
+    sm, sw = si.scales()
+    two_t = float(np.sum((si.moments / sm) * (si.omega / sw) ** 2))
     rho = (w / sw) / np.sqrt(two_t) / np.sqrt(sm)
     rho = rho.reshape(t_given.shape + (3,))
     contact = np.asarray(Quaternion(q.reshape(t_given.shape + (4,))).rotate(rho))
@@ -115,7 +116,7 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(normal, e1)
     herp = np.stack([contact @ e1, contact @ e2], axis=-1)
-    l_scaled = float(np.linalg.norm((body._moments / sm) * (body._omega / sw)))
+    l_scaled = float(np.linalg.norm((si.moments / sm) * (si.omega / sw)))
     dist = np.sqrt(two_t) / l_scaled / np.sqrt(sm)
     return PoinsotPaths(
         wrap(t_given, t_unit, quantity), wrap(rho, _RHO_UNIT, quantity),
@@ -141,7 +142,7 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
         fig = plt.figure(figsize=(10, 4.5))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
     uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
-    semi = 1.0 / np.sqrt(body._moments)
+    semi = 1.0 / np.sqrt(body.si.moments)
     polhode = np.asarray(getattr(paths.polhode, "value", paths.polhode))
     herpolhode = np.asarray(getattr(paths.herpolhode, "value", paths.herpolhode))
     distance = float(getattr(paths.distance, "value", paths.distance))

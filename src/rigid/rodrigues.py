@@ -49,6 +49,7 @@ import numpy as np
 from hamilton_orbits._validation import as_float_array, check_trailing, first_index
 from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
 from rigid._kernels import euler as _k
+from rigid.integrators import integrate
 
 __all__ = [
     "cayley_propagate",
@@ -337,12 +338,14 @@ def cayley_propagate(
     ----------
     body : RigidBody
         Initial state (moments, attitude, omega).
-    t_end : float or Quantity
-        Time span (s when a Quantity).
+    t_end : float, array_like or Quantity
+        Time span (s when a Quantity), or an array of output times as ``t`` of
+        :func:`rigid.integrators.integrate`.
     dt : float or Quantity
         Step (rounded so that a whole number of steps spans ``t_end``).
     n_out : int, optional
-        Number of equally spaced output times (including 0 and ``t_end``).
+        Number of equally spaced output times (including 0 and ``t_end``) for an
+        end time ``t_end``.  Default 101.
     torque : torque object or None, optional
         See :mod:`rigid.euler`.
     recentre : float, optional
@@ -369,10 +372,19 @@ def cayley_propagate(
     >>> round(float(tr.attitude[-1].as_axis_angle()[1]), 9), tr.n_recentre
     (2.283185307, 2)
     """
-    from rigid.integrators import integrate
-
     r = float(as_float_array("recentre", recentre))
     if not r > 0.0:
         raise ValueError(f"Expected `recentre` > 0, got {r!r}")
-    return integrate(body, t_end, dt=dt, method="cayley_rk4", n_out=n_out, torque=torque,
-                     recentre=r)
+    return integrate(body, _output_grid(t_end, n_out), dt=dt, method="cayley_rk4",
+                     torque=torque, recentre=r)
+
+
+def _output_grid(t_end: Any, n_out: Any) -> Any:
+    """``n_out`` equally spaced times from 0 to an end time ``t_end`` (an array of
+    times passes as it is)."""
+    if np.ndim(getattr(t_end, "value", t_end)) != 0:
+        return t_end
+    ok = isinstance(n_out, (int, np.integer)) and not isinstance(n_out, bool)
+    if not ok or not 2 <= n_out <= 1e9:
+        raise ValueError(f"Expected `n_out` to be an integer in [2, 1e9], got {n_out!r}")
+    return np.linspace(0.0 * t_end, t_end, int(n_out))

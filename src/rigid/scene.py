@@ -123,11 +123,11 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     cadence = spec["cadence"].to(u.s) if spec["cadence"] is not None else duration / 1000
     n_out = int(np.ceil((duration / cadence).to_value(u.one) - 1e-9)) + 1
     integ = spec["integrator"]
-    kw: dict[str, Any] = {"method": integ["method"], "n_out": n_out, "progress": progress}
+    kw: dict[str, Any] = {"method": integ["method"], "progress": progress}
     if integ["dt"] is not None:
         kw["dt"] = integ["dt"].to(u.s)
     start = time.perf_counter()
-    traj = integrate(body, duration, **kw)
+    traj = integrate(body, np.linspace(0.0 * duration, duration, n_out), **kw)
     wall = time.perf_counter() - start
     t = traj.t.to(u.s) if isinstance(traj.t, u.Quantity) else traj.t * u.s
     attitude, omega_exact = free_motion(body, t)

@@ -18,7 +18,8 @@ import numpy as np
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import ANGULAR_SPEED, TIME, Kind, wrap
 from rigid._kernels import free as _fk
-from rigid.body import RigidBody, _pow2, call_units, check_body, check_moments
+from rigid._shared import pow2
+from rigid.body import RigidBody, call_units, check_body, check_moments
 
 __all__ = ["confocal", "confocal_rotation", "contrafocal", "disk_equivalent", "time_between"]
 
@@ -62,7 +63,7 @@ def _related(body: RigidBody, recip: np.ndarray, ell: np.ndarray, quantity: bool
         omega = ell / moments
     if not np.all(np.isfinite(omega)):
         raise ValueError(f"Expected `lam` to give a finite omega, got moments {moments.tolist()}")
-    return RigidBody._from_si(moments, body.attitude, omega, quantity)
+    return RigidBody.from_si(moments, body.attitude, omega, quantity=quantity)
 
 
 def confocal(body: RigidBody, lam: Any) -> RigidBody:
@@ -104,7 +105,8 @@ def confocal(body: RigidBody, lam: Any) -> RigidBody:
     """
     body = check_body(body)
     lam, quantity = _lam(body, lam)
-    return _related(body, 1.0 / body._moments + lam, body._l_body(), quantity)
+    si = body.si
+    return _related(body, 1.0 / si.moments + lam, si.angular_momentum_body, quantity)
 
 
 def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
@@ -132,7 +134,8 @@ def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
     """
     body = check_body(body)
     lam, quantity = _lam(body, lam)
-    return _related(body, lam - 1.0 / body._moments, -body._l_body(), quantity)
+    si = body.si
+    return _related(body, lam - 1.0 / si.moments, -si.angular_momentum_body, quantity)
 
 
 def confocal_rotation(body: RigidBody, lam: Any, t: Any) -> Quaternion:
@@ -163,7 +166,7 @@ def confocal_rotation(body: RigidBody, lam: Any, t: Any) -> Quaternion:
     body = check_body(body)
     lam_f, _ = _lam(body, lam, (("t", t),))
     t_s = TIME("t", t)
-    ell = body._l_space()
+    ell = body.si.angular_momentum_space
     big = float(np.max(np.abs(ell)))
     if big == 0.0:
         return Quaternion(np.broadcast_to([1.0, 0.0, 0.0, 0.0], t_s.shape + (4,)).copy())
@@ -234,11 +237,12 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
     body = check_body(body)
     # On moments / sm and omega / sw (powers of two): lam = lam_s / sm and
     # delta = sw^2 delta_s, so nothing under- or overflows on the way.
-    sm, sw = _pow2(body._moments), _pow2(body._omega)
-    moments = body._moments / sm
-    lb = moments * (body._omega / sw)
+    si = body.si
+    sm, sw = si.scales()
+    moments = si.moments / sm
+    lb = moments * (si.omega / sw)
     ell2 = float(np.sum(lb * lb))
-    t2 = float(np.sum(lb * (body._omega / sw)))
+    t2 = float(np.sum(lb * (si.omega / sw)))
     mid = float(np.sort(moments)[1])
     prefer = "confocal" if ell2 > t2 * mid else "contrafocal"
     valid = []
@@ -250,7 +254,7 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
         raise ValueError(f"Expected `body` to admit a disk reduction, got moments {moments}")
     valid.sort()
     _, rel, lam_s = valid[0]
-    q = body._quantity
+    q = body.quantity
     sign = 1.0 if rel == "confocal" else -1.0
     recip = sign / moments + lam_s if rel == "confocal" else lam_s - 1.0 / moments
     with np.errstate(over="ignore"):
@@ -261,9 +265,10 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
             and lam != 0.0):
         raise ValueError(
             f"Expected `body` to have a disk equivalent within float64, got moments "
-            f"{body._moments.tolist()} and omega {body._omega.tolist()}"
+            f"{si.moments.tolist()} and omega {si.omega.tolist()}"
         )
-    disk = RigidBody._from_si(disk_moments, body.attitude, sign * body._l_body() / disk_moments, q)
+    disk = RigidBody.from_si(disk_moments, body.attitude,
+                             sign * si.angular_momentum_body / disk_moments, quantity=q)
     return disk, rel, wrap(lam, _RECIP_UNIT, q), wrap(delta, _W_UNIT**2, q)
 
 
@@ -310,9 +315,9 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
         if w.shape != (3,):
             raise ValueError(f"Expected `{name}` to have shape (3,), got {w.shape}")
     # homogeneous: moments / sm and omega / sw (powers of two), times scale by 1 / sw
-    sm = _pow2(body._moments)
-    sw = max(_pow2(w1), _pow2(w2))
-    mom = body._moments / sm
+    sm = pow2(body.si.moments)
+    sw = max(pow2(w1), pow2(w2))
+    mom = body.si.moments / sm
     w1 = w1 / sw
     w2 = w2 / sw
     e1, e2 = np.sum(mom * w1 * w1), np.sum(mom * w2 * w2)
@@ -325,24 +330,24 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     q = np.array([1.0, 0.0, 0.0, 0.0])
     p1 = _fk.free_setup(mom, q, np.ascontiguousarray(w1))
     p2 = _fk.free_setup(mom, q, np.ascontiguousarray(w2))
-    kind = p1[_fk._KIND]
+    kind = p1[_fk.KIND]
     if kind == 0.0:
         raise ValueError(
             f"Expected a non-steady motion for `omega1`, got a steady rotation {omega1!r}"
         )
-    same_frame = np.array_equal(p1[_fk._P : _fk._P + 9], p2[_fk._P : _fk._P + 9])
-    if p2[_fk._KIND] != kind or not same_frame:
+    same_frame = np.array_equal(p1[_fk.P : _fk.P + 9], p2[_fk.P : _fk.P + 9])
+    if p2[_fk.KIND] != kind or not same_frame:
         raise ValueError(
             f"Expected `omega2` on the same branch of the polhode as `omega1`, got "
             f"omega1 = {omega1!r}, omega2 = {omega2!r}"
         )
-    du = p2[_fk._U0] - p1[_fk._U0]
+    du = p2[_fk.U0] - p1[_fk.U0]
     if kind == 1.0:
-        dt = float(np.mod(du, 4.0 * p1[_fk._K]) / p1[_fk._LAM])
+        dt = float(np.mod(du, 4.0 * p1[_fk.K]) / p1[_fk.LAM])
     elif du < 0.0:
         raise ValueError(
             f"Expected `omega2` after `omega1` on the separatrix, got it before ({omega2!r})"
         )
     else:
-        dt = float(du / p1[_fk._LAM])
+        dt = float(du / p1[_fk.LAM])
     return wrap(np.float64(dt / sw), u.s, quantity)

@@ -162,3 +162,46 @@ def test_derived_quantities_carry_units():
     with pytest.raises(ValueError, match="`omega` as plain floats like the body's moments"):
         plain.with_state(omega=[0.0, 0.0, 1.0] * u.rad / u.s)
     np.testing.assert_array_equal(body.invariable_plane, plain.invariable_plane)
+
+
+def test_si_view_is_the_state_in_si_floats():
+    # 1 g cm^2 = 1e-7 kg m^2 and 180 deg/s = pi rad/s: the view holds SI floats for a
+    # body with units and the very same floats for a body of plain SI floats.
+    att = Quaternion.from_axis_angle([1.0, 2.0, 2.0], 0.4)
+    qb = RigidBody([1.0, 2.0, 2.5] * u.g * u.cm**2, attitude=att,
+                   omega=[180.0, 0.0, -90.0] * u.deg / u.s)
+    si = qb.si
+    np.testing.assert_allclose(si.moments, [1e-7, 2e-7, 2.5e-7], rtol=2 * EPS)
+    np.testing.assert_allclose(si.omega, [np.pi, 0.0, -np.pi / 2], rtol=2 * EPS)
+    assert np.array_equal(si.attitude, qb.attitude.as_array())
+    fb = RigidBody(si.moments, attitude=si.attitude, omega=si.omega)
+    assert np.array_equal(fb.si.moments, si.moments) and np.array_equal(fb.si.omega, si.omega)
+    # the derived integrals are the floats behind the Quantity properties, bit for bit
+    assert si.kinetic_energy == qb.kinetic_energy.to_value(u.J)
+    assert np.array_equal(si.angular_momentum_body,
+                          qb.angular_momentum_body.to_value(u.kg * u.m**2 / u.s))
+    assert np.array_equal(si.angular_momentum_space,
+                          qb.angular_momentum_space.to_value(u.kg * u.m**2 / u.s))
+    assert si.angular_momentum_norm == qb.angular_momentum_norm.to_value(u.kg * u.m**2 / u.s)
+    # copies: writing into the view does not change the body
+    si.moments[0] = 99.0
+    assert qb.si.moments[0] != 99.0
+    # exact power-of-two scales: 2.5e-7 -> 2^-22, pi -> 2
+    assert qb.si.scales() == (2.0**-22, 2.0)
+
+
+def test_from_si_and_quantity_flag():
+    b = RigidBody.from_si([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0], quantity=True)
+    assert b.quantity
+    assert b.omega.unit == u.rad / u.s and b.kinetic_energy == 6.0 * u.J
+    plain = RigidBody.from_si([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0])
+    assert not plain.quantity and plain.kinetic_energy == 6.0
+    assert RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2).quantity
+    with pytest.raises(ValueError, match=r"Expected `inertia` > 0, got -1.0 at index 0"):
+        RigidBody.from_si([-1.0, 2.0, 3.0])
+
+
+def test_si_view_refuses_integrals_beyond_float64():
+    body = RigidBody([1e300, 2e300, 2.5e300], omega=[1e10, 0.0, 0.0])
+    with pytest.raises(ValueError, match="representable kinetic energy"):
+        _ = body.si.kinetic_energy

@@ -14,7 +14,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk, elliprf, elliprj
 
 from hamilton_orbits import Quaternion
-from rigid import RigidBody, free_motion, free_motion_arrays, free_parameters
+from rigid import FreeMotion, RigidBody, free_motion, free_motion_arrays, free_parameters
 from rigid._kernels import free as fk
 
 EPS = np.finfo(float).eps
@@ -476,3 +476,19 @@ def test_third_kind_integral_for_large_negative_characteristic():
             with mpmath.workdps(30):
                 ref = float(mpmath.ellippi(n, phi, m))
             assert ours == pytest.approx(ref, rel=8 * EPS)
+
+
+def test_free_motion_is_a_named_result():
+    # issue 19: a NamedTuple, so that `attitude, omega = free_motion(...)` still works
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[1.0, 0.3, 0.8] * u.rad / u.s)
+    t = [[0.0, 1.0], [2.0, 3.0]] * u.s
+    motion = free_motion(body, t)
+    assert isinstance(motion, FreeMotion) and motion._fields == ("attitude", "omega")
+    attitude, omega = motion
+    assert attitude is motion.attitude and omega is motion.omega
+    assert motion.attitude.shape == (2, 2) and motion.omega.shape == (2, 2, 3)
+    assert motion.omega.unit == u.rad / u.s
+    # the same numbers as the kernel-level entry point
+    q, w = free_motion_arrays(body.moments, body.attitude, body.omega, t)
+    np.testing.assert_array_equal(motion.attitude.as_array(), q)
+    np.testing.assert_array_equal(motion.omega.value, w.value)

@@ -280,6 +280,59 @@ def _qturn(sh, vh, w, x, y, z, pw, px, py, pz, ew, ex, ey, ez):  # pragma: no co
     return w1, x1, y1, z1, ew, ex, ey, ez
 
 
+@njit(inline="always", cache=True, fastmath={"contract"})
+def _axis_turn(axis, fj, l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez):  # pragma: no cover
+    """Op types 0-2: the body L turned by -theta about ``axis`` and q <- q (cos theta/2,
+    sin theta/2 e_axis), theta/2 = ``fj`` L_axis; returns the new compensated state."""
+    if axis == 0:
+        sh, vh = sin_versin(fj * l0)
+        l1, l2, e1, e2 = _turn_pair(sh, vh, l1, l2, e1, e2)
+        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -x, w, z, -y, ew, ex, ey, ez)
+    elif axis == 1:
+        sh, vh = sin_versin(fj * l1)
+        l2, l0, e2, e0 = _turn_pair(sh, vh, l2, l0, e2, e0)
+        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -y, -z, w, x, ew, ex, ey, ez)
+    else:
+        sh, vh = sin_versin(fj * l2)
+        l0, l1, e0, e1 = _turn_pair(sh, vh, l0, l1, e0, e1)
+        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -z, y, -x, w, ew, ex, ey, ez)
+    return l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez
+
+
+@njit(inline="always", cache=True, fastmath={"contract"})
+def _casimir_turn(fj, l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez):  # pragma: no cover
+    """Op type 4: q <- q (cos phi, sin phi L / |L|), phi = ``fj`` |L|; L unchanged."""
+    lx = l0 + e0
+    ly = l1 + e1
+    lz = l2 + e2
+    nl = math.sqrt(lx * lx + ly * ly + lz * lz)
+    if nl > 0.0:
+        sh, vh = sin_versin(fj * nl)
+        pw, px, py, pz = qmul(w, x, y, z, 0.0, lx / nl, ly / nl, lz / nl)
+        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, pw, px, py, pz, ew, ex, ey, ez)
+    return w, x, y, z, ew, ex, ey, ez
+
+
+@njit(inline="always", cache=True, fastmath={"contract"})
+def _kick(fj, nx, ny, nz, l0, l1, l2, e0, e1, e2):  # pragma: no cover - compiled
+    """Op type 3: L <- L + N tau (``fj`` = tau), compensated; q is unchanged."""
+    l0, e0 = _two_sum(l0, fj * nx + e0)
+    l1, e1 = _two_sum(l1, fj * ny + e1)
+    l2, e2 = _two_sum(l2, fj * nz + e2)
+    return l0, l1, l2, e0, e1, e2
+
+
+@njit(inline="always", cache=True, fastmath={"contract"})
+def _op_factors(types, fracs, inv, h):  # pragma: no cover - compiled
+    """The factor of each op: tau = fracs h for a kick, theta/2 per unit L_axis
+    (inv[axis] tau / 2) for a rotation."""
+    nops = types.shape[0]
+    f = np.empty(nops)
+    for j in range(nops):
+        f[j] = fracs[j] * h if types[j] == 3 else 0.5 * fracs[j] * h * inv[types[j]]
+    return f
+
+
 @njit(cache=True, fastmath={"contract"})
 def run_splitting(
     types, fracs, toffs, inv, moments, qh, ql, lh, ll, t0, h, n_steps, out_steps, kind, params,
@@ -315,12 +368,9 @@ def run_splitting(
     not projected) and ``l_out[k]`` (body angular momentum).  Returns
     (max | |q| - 1 | over the outputs, ``pending`` for the next call).
     """
-    nops = types.shape[0]
-    f = np.empty(nops)
-    for j in range(nops):
-        f[j] = fracs[j] * h if types[j] == 3 else 0.5 * fracs[j] * h * inv[types[j]]
-    last = nops - 1
-    fuse = nops > 1 and types[0] == types[last]
+    f = _op_factors(types, fracs, inv, h)
+    last = types.shape[0] - 1
+    fuse = last > 0 and types[0] == types[last]
     f_fused = f[0] + f[last]
     a = moments[0]
     b = moments[1]
@@ -335,46 +385,23 @@ def run_splitting(
         if n > 0:
             ts = t0 + (n - 1) * h
             out_here = k < nout and out_steps[k] == n
-            for j in range(1 if pending else 0, nops):
-                typ = types[j]
+            for j in range(1 if pending else 0, last + 1):
                 fj = f[j]
                 if j == last:
-                    if fuse and (n < n_steps or more) and not out_here:
+                    pending = fuse and (n < n_steps or more) and not out_here
+                    if pending:
                         fj = f_fused
-                        pending = True
-                    else:
-                        pending = False
-                if typ == 0:
-                    sh, vh = sin_versin(fj * l0)
-                    l1, l2, e1, e2 = _turn_pair(sh, vh, l1, l2, e1, e2)
-                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -x, w, z, -y,
-                                                        ew, ex, ey, ez)
-                elif typ == 1:
-                    sh, vh = sin_versin(fj * l1)
-                    l2, l0, e2, e0 = _turn_pair(sh, vh, l2, l0, e2, e0)
-                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -y, -z, w, x,
-                                                        ew, ex, ey, ez)
-                elif typ == 2:
-                    sh, vh = sin_versin(fj * l2)
-                    l0, l1, e0, e1 = _turn_pair(sh, vh, l0, l1, e0, e1)
-                    w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, -z, y, -x, w,
-                                                        ew, ex, ey, ez)
+                typ = types[j]
+                if typ <= 2:
+                    l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez = _axis_turn(
+                        typ, fj, l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez)
                 elif typ == 3:
                     nx, ny, nz = torque_scalar(kind, params, a, b, c, ts + toffs[j] * h,
                                                w, x, y, z)
-                    l0, e0 = _two_sum(l0, fj * nx + e0)
-                    l1, e1 = _two_sum(l1, fj * ny + e1)
-                    l2, e2 = _two_sum(l2, fj * nz + e2)
+                    l0, l1, l2, e0, e1, e2 = _kick(fj, nx, ny, nz, l0, l1, l2, e0, e1, e2)
                 else:
-                    lx = l0 + e0
-                    ly = l1 + e1
-                    lz = l2 + e2
-                    nl = math.sqrt(lx * lx + ly * ly + lz * lz)
-                    if nl > 0.0:
-                        sh, vh = sin_versin(fj * nl)
-                        pw, px, py, pz = qmul(w, x, y, z, 0.0, lx / nl, ly / nl, lz / nl)
-                        w, x, y, z, ew, ex, ey, ez = _qturn(sh, vh, w, x, y, z, pw, px, py,
-                                                            pz, ew, ex, ey, ez)
+                    w, x, y, z, ew, ex, ey, ez = _casimir_turn(
+                        fj, l0, l1, l2, e0, e1, e2, w, x, y, z, ew, ex, ey, ez)
         while k < nout and out_steps[k] == n:
             qw = w + ew
             qx = x + ex

@@ -18,7 +18,11 @@ Contents
 
 Parameter vector layout (``free_setup``), in the working frame W (a proper
 signed permutation of the body axes, ``v_body = P v_W``; moments J1, J2, J3 with
-J3 the axis the polhode encircles, omega_W3 >= 0):
+J3 the axis the polhode encircles, omega_W3 >= 0).  The slot indices below are
+public: the callers (:mod:`rigid.free`, :mod:`rigid.sylvester`) read
+``prm[KIND]``, ``prm[P:P + 9]``, ``prm[LAM]``, ``prm[K]``, ``prm[M]``, ``prm[M1]``,
+``prm[N]`` and ``prm[U0]``; a slot's meaning is part of this module's contract.
+The rates (``LAM``, ``L``) are in the time unit of the ``omega`` given.
 """
 
 from __future__ import annotations
@@ -30,33 +34,33 @@ from numba import njit
 
 from hamilton_orbits._kernels.quaternion import qmul
 
-# Parameter-vector slots.
-_KIND = 0  # 0 steady (sphere, rest, rotation about a principal axis), 1 periodic, 2 separatrix
-_P = 1  # 9 entries, row-major, v_body = P v_W
-_C0 = 10  # 4 entries: q0 * qP * qa(0)
-_QPI = 14  # 4 entries: qP^-1
-_A = 18
-_B = 19
-_C = 20
-_LAM = 21
-_M = 22
-_M1 = 23
-_K = 24
-_PIC = 25  # complete: Pi(n | m) (form A) or Pi(n | m) - K(m) (form B)
-_N = 26  # characteristic n = -J3 (J2 - J1) / (J1 (J3 - J2))
-_U0 = 27
-_L = 28
-_J1 = 29
-_J2 = 30
-_J3 = 31
-_COEF = 32  # L (J3 - J1) / (J1 J3 lam)
-_PI0 = 33  # Pi(n; am u0 | m) (form A) or Pi - u0 (form B), with its secular part
-_ALPHA0 = 34
-_RHO = 35  # signed ratio in the continuous azimuth of l in the W frame
-_SB = 36  # sign of b (= sign(J3 - J1))
-_W0 = 37  # 3 entries: omega in the body frame (steady case)
-_Q0 = 40  # 4 entries: q0 (steady case)
-_FORM = 44  # 1: secular (L/J3) t + coef Pi (J3 > J1); 0: (L/J1) t + coef (Pi - u)
+# Parameter-vector slots (public: the layout that free_setup writes).
+KIND = 0  # 0 steady (sphere, rest, rotation about a principal axis), 1 periodic, 2 separatrix
+P = 1  # 9 entries, row-major, v_body = P v_W
+C0 = 10  # 4 entries: q0 * qP * qa(0)
+QPI = 14  # 4 entries: qP^-1
+A = 18  # amplitude a of omega_W1 = a cn u (signed on the separatrix)
+B = 19  # amplitude of omega_W2 = b sn u, signed
+C = 20  # amplitude c of omega_W3 = c dn u
+LAM = 21  # rate lambda of the argument u = u0 + lambda t
+M = 22  # parameter m
+M1 = 23  # complementary parameter m1 = 1 - m (computed directly)
+K = 24  # complete elliptic integral K(m)
+PIC = 25  # complete: Pi(n | m) (form A) or Pi(n | m) - K(m) (form B)
+N = 26  # characteristic n = -J3 (J2 - J1) / (J1 (J3 - J2))
+U0 = 27  # initial argument u0
+L = 28  # |L|
+J1 = 29  # moments in the working frame
+J2 = 30
+J3 = 31
+COEF = 32  # L (J3 - J1) / (J1 J3 lam)
+PI0 = 33  # Pi(n; am u0 | m) (form A) or Pi - u0 (form B), with its secular part
+ALPHA0 = 34  # azimuth of l_W at u0
+RHO = 35  # signed ratio in the continuous azimuth of l in the W frame
+SB = 36  # sign of b (= sign(J3 - J1))
+W0 = 37  # 3 entries: omega in the body frame (steady case)
+Q0 = 40  # 4 entries: q0 (steady case)
+FORM = 44  # 1: secular (L/J3) t + coef Pi (J3 > J1); 0: (L/J1) t + coef (Pi - u)
 NPARAM = 45
 
 _R = 2.0**-53
@@ -302,26 +306,26 @@ def _periodic_at(prm, u):  # pragma: no cover - compiled
     """Working-frame omega, the third-kind term and the continuous azimuth at ``u``.
 
     The third-kind term is ``Pi(n; am u | m)`` in form A and ``Pi - u`` in form B
-    (slot ``_FORM``), each summed from its complete part and the reduced argument.
+    (slot ``FORM``), each summed from its complete part and the reduced argument.
     """
-    kk = prm[_K]
+    kk = prm[K]
     k = math.floor((u + kk) / (2.0 * kk))
     r = u - 2.0 * kk * k
     if r > kk:  # rounding at the upper edge
         r = kk
-    s, c, d = jacobi_reduced(r, prm[_M], prm[_M1], kk)
+    s, c, d = jacobi_reduced(r, prm[M], prm[M1], kk)
     sg = 1.0 if (int(k) & 1) == 0 else -1.0
-    w1 = prm[_A] * sg * c
-    w2 = prm[_B] * sg * s
-    w3 = prm[_C] * d
-    n = prm[_N]
-    if prm[_FORM] == 0.0:
-        pi_u = 2.0 * k * prm[_PIC] + _pi_minus_f(n, s, c, d)
+    w1 = prm[A] * sg * c
+    w2 = prm[B] * sg * s
+    w3 = prm[C] * d
+    n = prm[N]
+    if prm[FORM] == 0.0:
+        pi_u = 2.0 * k * prm[PIC] + _pi_minus_f(n, s, c, d)
     elif n >= -1.0:
-        pi_u = 2.0 * k * prm[_PIC] + (r + _pi_minus_f(n, s, c, d))
+        pi_u = 2.0 * k * prm[PIC] + (r + _pi_minus_f(n, s, c, d))
     else:
-        pi_u = 2.0 * k * prm[_PIC] + _pi_reduced(n, prm[_M], s, c, d)
-    alpha = prm[_SB] * k * math.pi + math.atan2(prm[_RHO] * s, c)
+        pi_u = 2.0 * k * prm[PIC] + _pi_reduced(n, prm[M], s, c, d)
+    alpha = prm[SB] * k * math.pi + math.atan2(prm[RHO] * s, c)
     return w1, w2, w3, pi_u, alpha
 
 
@@ -332,46 +336,45 @@ def _separatrix_at(prm, u):  # pragma: no cover - compiled
     e = math.exp(-abs(u))
     sech = 2.0 * e / (1.0 + e * e)
     th = math.tanh(u)
-    a = prm[_A]
+    a = prm[A]
     w1 = a * sech
-    w2 = prm[_B] * th
-    w3 = prm[_C] * sech
-    nu = -prm[_N]
+    w2 = prm[B] * th
+    w3 = prm[C] * sech
+    nu = -prm[N]
     snu = math.sqrt(nu)
     # Pi(n; am u | 1) = (u + sqrt(nu) atan(sqrt(nu) tanh u)) / (1 + nu), nu = -n.
-    if prm[_FORM] == 0.0:
+    if prm[FORM] == 0.0:
         pi_u = (snu * math.atan(snu * th) - nu * u) / (1.0 + nu)
     else:
         pi_u = (u + snu * math.atan(snu * th)) / (1.0 + nu)
-    alpha = math.atan2(prm[_RHO] * th, sech)
+    alpha = math.atan2(prm[RHO] * th, sech)
     return w1, w2, w3, pi_u, alpha
 
 
 @njit(cache=True)
-def free_setup(moments, q0, w0):  # pragma: no cover - compiled
-    """Reduce ``(moments (3,), q0 (4,) unit, omega0 (3,))`` to the parameter vector."""
-    prm = np.zeros(NPARAM)
-    for i in range(3):
-        prm[_W0 + i] = w0[i]
-    for i in range(4):
-        prm[_Q0 + i] = q0[i]
+def _is_steady(moments, w0):  # pragma: no cover - compiled
+    """Whether ``I omega`` is parallel to ``omega`` (sphere, rest, principal axis).
+
+    Tested on omega / max|omega| so that nothing underflows, and with a relative
+    threshold of 1e-150: below it the polhode's squared amplitudes (p1, p3 in
+    :func:`_setup_shape`) underflow, while the departure from the steady spin, of
+    relative size 1e-150 * |omega| t, is invisible for any representable time.
+    """
     i0, i1, i2 = moments[0], moments[1], moments[2]
-    # Steady rotation when I omega is parallel to omega (sphere, rest, principal axis).
-    # Tested on omega / max|omega| so that nothing underflows, and with a relative
-    # threshold of 1e-150: below it the polhode's squared amplitudes (p1, p3 below)
-    # underflow, while the departure from the steady spin, of relative size
-    # 1e-150 * |omega| t, is invisible for any representable time.
     wn = max(abs(w0[0]), abs(w0[1]), abs(w0[2]))
     if wn == 0.0:
-        prm[_KIND] = 0.0
-        return prm
+        return True
     s0_, s1_, s2_ = w0[0] / wn, w0[1] / wn, w0[2] / wn
     cx = (i1 - i2) * s1_ * s2_
     cy = (i2 - i0) * s2_ * s0_
     cz = (i0 - i1) * s0_ * s1_
-    if max(abs(cx), abs(cy), abs(cz)) <= 1e-150 * max(i0, i1, i2):
-        prm[_KIND] = 0.0
-        return prm
+    return max(abs(cx), abs(cy), abs(cz)) <= 1e-150 * max(i0, i1, i2)
+
+
+@njit(cache=True)
+def _polar_order(moments, w0):  # pragma: no cover - compiled
+    """``(order, kind)``: the body axes in working-frame order (the polar axis last)
+    and the kind, 1.0 periodic or 2.0 on the separatrix (``L^2 = 2 T B``)."""
     # Sort the axes: imin, imid, imax (stable for ties).
     idx = np.array([0, 1, 2])
     for a in range(3):
@@ -390,6 +393,13 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
     else:
         order = (imin, imid, imax)
         kind = 2.0
+    return order, kind
+
+
+@njit(cache=True)
+def _working_frame(moments, w0, order):  # pragma: no cover - compiled
+    """``(pm, j1, j2, j3, v1, v2, v3)``: the proper signed permutation ``pm``
+    (``v_body = pm v_W``), the moments and omega in the working frame, ``v3 >= 0``."""
     # Proper signed permutation: columns e_o1, e_o2, s e_o3.
     pm = np.zeros((3, 3))
     o1, o2, o3 = order
@@ -404,9 +414,13 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
         pm[o3, 2] = -s3
         v2 = -v2
         v3 = -v3
-    for i in range(3):
-        for j in range(3):
-            prm[_P + 3 * i + j] = pm[i, j]
+    return pm, j1, j2, j3, v1, v2, v3
+
+
+@njit(cache=True)
+def _setup_shape(prm, kind, j1, j2, j3, v1, v2, v3):  # pragma: no cover - compiled
+    """Write the slots common to both kinds (KIND, C, LAM, N, L, J1-J3, COEF, FORM);
+    return ``(a, b, p1, p3, dm)`` for the kind-specific parts."""
     lsq = (j1 * v1) ** 2 + (j2 * v2) ** 2 + (j3 * v3) ** 2
     ell = math.sqrt(lsq)
     p3 = j1 * v1 * v1 * (j3 - j1) + j2 * v2 * v2 * (j3 - j2)  # 2 T J3 - L^2
@@ -417,96 +431,144 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
     c = math.sqrt(p1 / (j3 * (j3 - j1)))
     lam = math.sqrt((j3 - j2) * p1 / (j1 * j2 * j3))
     nchar = -j3 * (j2 - j1) / (j1 * (j3 - j2))
-    sb = _sign(j3 - j1)
-    prm[_KIND] = kind
-    prm[_C] = c
-    prm[_LAM] = lam
-    prm[_N] = nchar
-    prm[_L] = ell
-    prm[_J1] = j1
-    prm[_J2] = j2
-    prm[_J3] = j3
-    prm[_COEF] = ell * (j3 - j1) / (j1 * j3 * lam)
+    prm[KIND] = kind
+    prm[C] = c
+    prm[LAM] = lam
+    prm[N] = nchar
+    prm[L] = ell
+    prm[J1] = j1
+    prm[J2] = j2
+    prm[J3] = j3
+    prm[COEF] = ell * (j3 - j1) / (j1 * j3 * lam)
     # Psi' = L/J3 + L (J3 - J1)/(J1 J3) / (1 - n sn^2) = L/J1 + L (J3 - J1)/(J1 J3) n sn^2 /
     # (1 - n sn^2), n <= 0: form A (secular L/J3 and Pi) has terms of one sign when
     # J3 > J1, form B (secular L/J1 and Pi - u) when J3 < J1.  The other form would
     # cancel a rate ~ L / min(J1, J3) against itself (thin bodies, error ~ J1/J3).
-    form = 1.0 if j3 > j1 else 0.0
-    prm[_FORM] = form
+    prm[FORM] = 1.0 if j3 > j1 else 0.0
+    return a, b, p1, p3, dm
+
+
+@njit(cache=True)
+def _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm):  # pragma: no cover - compiled
+    """Write the slots of a periodic motion; return omega_W, Pi and alpha at ``u0``."""
+    nchar = prm[N]
+    sb = _sign(j3 - j1)
     # Continuous azimuth of l_W = atan2(J2 w2, J1 w1) written as atan2(rho sn, cn).
     rho = sb * (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
-    if kind == 1.0:
-        m = (j2 - j1) * p3 / ((j3 - j2) * p1)
-        m1 = (j3 - j1) * dm / ((j3 - j2) * p1)
-        m = min(max(m, 0.0), 1.0)
-        m1 = min(max(m1, 0.0), 1.0)
-        kk = ellipk_m1(m1)
-        pic = 0.0  # Pi(n | m) - K(m)
-        if nchar != 0.0:
-            pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
-        if form == 1.0:  # the complete Pi(n | m) itself
-            pic = kk + pic if nchar >= -1.0 else _pi_reduced(nchar, m, 1.0, 0.0, math.sqrt(m1))
-        prm[_A] = a
-        prm[_B] = sb * b
-        prm[_M] = m
-        prm[_M1] = m1
-        prm[_K] = kk
-        prm[_PIC] = pic
-        prm[_RHO] = rho
-        prm[_SB] = sb
-        # Initial phase u0 = F(phi0 | m), sn = omega2 / b, cn = omega1 / a.
-        s0 = v2 / (sb * b)
-        c0 = v1 / a
-        h = math.hypot(s0, c0)
-        s0 /= h
-        c0 /= h
-        dd = m1 + m * c0 * c0
-        f = s0 * carlson_rf(c0 * c0, dd, 1.0)
-        if c0 >= 0.0:
-            u0 = f
-        else:
-            u0 = _sign(s0) * 2.0 * kk - f
-        prm[_U0] = u0
-        _, _, _, pi0, alpha0 = _periodic_at(prm, u0)
-        w1, w2, w3, _, _ = _periodic_at(prm, u0)
+    m = (j2 - j1) * p3 / ((j3 - j2) * p1)
+    m1 = (j3 - j1) * dm / ((j3 - j2) * p1)
+    m = min(max(m, 0.0), 1.0)
+    m1 = min(max(m1, 0.0), 1.0)
+    kk = ellipk_m1(m1)
+    pic = 0.0  # Pi(n | m) - K(m)
+    if nchar != 0.0:
+        pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+    if prm[FORM] == 1.0:  # the complete Pi(n | m) itself
+        pic = kk + pic if nchar >= -1.0 else _pi_reduced(nchar, m, 1.0, 0.0, math.sqrt(m1))
+    prm[A] = a
+    prm[B] = sb * b
+    prm[M] = m
+    prm[M1] = m1
+    prm[K] = kk
+    prm[PIC] = pic
+    prm[RHO] = rho
+    prm[SB] = sb
+    # Initial phase u0 = F(phi0 | m), sn = omega2 / b, cn = omega1 / a.
+    s0 = v2 / (sb * b)
+    c0 = v1 / a
+    h = math.hypot(s0, c0)
+    s0 /= h
+    c0 /= h
+    dd = m1 + m * c0 * c0
+    f = s0 * carlson_rf(c0 * c0, dd, 1.0)
+    if c0 >= 0.0:
+        u0 = f
     else:
-        sa = _sign(v1)
-        prm[_A] = sa * a
-        prm[_B] = sa * b
-        prm[_M] = 1.0
-        prm[_M1] = 0.0
-        prm[_RHO] = (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
-        prm[_SB] = 1.0
-        # sinh u0 = tanh / sech = (omega2 / b) / (omega1 / a)
-        u0 = math.asinh((v2 / (sa * b)) / (v1 / (sa * a)))
-        prm[_U0] = u0
-        w1, w2, w3, pi0, alpha0 = _separatrix_at(prm, u0)
-    prm[_PI0] = pi0
-    prm[_ALPHA0] = alpha0
-    # qa(0): the shortest arc from e3 to l_W(0); C0 = q0 qP qa(0).
+        u0 = _sign(s0) * 2.0 * kk - f
+    prm[U0] = u0
+    _, _, _, pi0, alpha0 = _periodic_at(prm, u0)
+    w1, w2, w3, _, _ = _periodic_at(prm, u0)
+    return w1, w2, w3, pi0, alpha0
+
+
+@njit(cache=True)
+def _setup_separatrix(prm, j1, j2, j3, v1, v2, a, b):  # pragma: no cover - compiled
+    """Write the slots of a motion on the separatrix; return omega_W, Pi and alpha
+    at ``u0``."""
+    sa = _sign(v1)
+    prm[A] = sa * a
+    prm[B] = sa * b
+    prm[M] = 1.0
+    prm[M1] = 0.0
+    prm[RHO] = (j2 / j1) * math.sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)))
+    prm[SB] = 1.0
+    # sinh u0 = tanh / sech = (omega2 / b) / (omega1 / a)
+    u0 = math.asinh((v2 / (sa * b)) / (v1 / (sa * a)))
+    prm[U0] = u0
+    return _separatrix_at(prm, u0)
+
+
+@njit(cache=True)
+def _setup_attitude(prm, q0, pm, j1, j2, j3, w1, w2, w3):  # pragma: no cover - compiled
+    """Write C0 = q0 qP qa(0) and QPI = qP^-1 (qa(0) the shortest arc from e3 to
+    l_W(0), from omega_W at u0)."""
+    ell = prm[L]
     l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
     nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
     qaw, qax, qay = (1.0 + l3) / nq, -l2 / nq, l1 / nq
     pw, px, py, pz = _quat_from_signed_permutation(pm)
     tw, tx, ty, tz = qmul(q0[0], q0[1], q0[2], q0[3], pw, px, py, pz)
     cw, cx_, cy_, cz_ = qmul(tw, tx, ty, tz, qaw, qax, qay, 0.0)
-    prm[_C0] = cw
-    prm[_C0 + 1] = cx_
-    prm[_C0 + 2] = cy_
-    prm[_C0 + 3] = cz_
-    prm[_QPI] = pw
-    prm[_QPI + 1] = -px
-    prm[_QPI + 2] = -py
-    prm[_QPI + 3] = -pz
+    prm[C0] = cw
+    prm[C0 + 1] = cx_
+    prm[C0 + 2] = cy_
+    prm[C0 + 3] = cz_
+    prm[QPI] = pw
+    prm[QPI + 1] = -px
+    prm[QPI + 2] = -py
+    prm[QPI + 3] = -pz
+
+
+@njit(cache=True)
+def free_setup(moments, q0, w0):  # pragma: no cover - compiled
+    """Reduce ``(moments (3,), q0 (4,) unit, omega0 (3,))`` to the parameter vector.
+
+    Steady motion (:func:`_is_steady`) keeps only ``KIND = 0``, ``W0`` and ``Q0``;
+    otherwise the working frame (:func:`_polar_order`, :func:`_working_frame`),
+    the elliptic parameters (:func:`_setup_shape` and :func:`_setup_periodic` or
+    :func:`_setup_separatrix`) and the attitude constants
+    (:func:`_setup_attitude`) fill the slots listed in the module docstring.
+    """
+    prm = np.zeros(NPARAM)
+    for i in range(3):
+        prm[W0 + i] = w0[i]
+    for i in range(4):
+        prm[Q0 + i] = q0[i]
+    if _is_steady(moments, w0):
+        prm[KIND] = 0.0
+        return prm
+    order, kind = _polar_order(moments, w0)
+    pm, j1, j2, j3, v1, v2, v3 = _working_frame(moments, w0, order)
+    for i in range(3):
+        for j in range(3):
+            prm[P + 3 * i + j] = pm[i, j]
+    a, b, p1, p3, dm = _setup_shape(prm, kind, j1, j2, j3, v1, v2, v3)
+    if kind == 1.0:
+        w1, w2, w3, pi0, alpha0 = _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm)
+    else:
+        w1, w2, w3, pi0, alpha0 = _setup_separatrix(prm, j1, j2, j3, v1, v2, a, b)
+    prm[PI0] = pi0
+    prm[ALPHA0] = alpha0
+    _setup_attitude(prm, q0, pm, j1, j2, j3, w1, w2, w3)
     return prm
 
 
 @njit(cache=True)
 def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
     """Evaluate ``prm`` at times ``t`` (n,) into ``out_q`` (n, 4) and ``out_w`` (n, 3)."""
-    kind = prm[_KIND]
+    kind = prm[KIND]
     if kind == 0.0:
-        w1, w2, w3 = prm[_W0], prm[_W0 + 1], prm[_W0 + 2]
+        w1, w2, w3 = prm[W0], prm[W0 + 1], prm[W0 + 2]
         wn = math.sqrt(w1 * w1 + w2 * w2 + w3 * w3)
         for i in range(t.shape[0]):
             out_w[i, 0] = w1
@@ -519,17 +581,17 @@ def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
                 sh = math.sin(half) / wn
                 ew, ex, ey, ez = math.cos(half), sh * w1, sh * w2, sh * w3
             qw, qx, qy, qz = qmul(
-                prm[_Q0], prm[_Q0 + 1], prm[_Q0 + 2], prm[_Q0 + 3], ew, ex, ey, ez
+                prm[Q0], prm[Q0 + 1], prm[Q0 + 2], prm[Q0 + 3], ew, ex, ey, ez
             )
             out_q[i, 0] = qw
             out_q[i, 1] = qx
             out_q[i, 2] = qy
             out_q[i, 3] = qz
         return
-    ell = prm[_L]
-    j1, j2, j3 = prm[_J1], prm[_J2], prm[_J3]
-    lam = prm[_LAM]
-    u0 = prm[_U0]
+    ell = prm[L]
+    j1, j2, j3 = prm[J1], prm[J2], prm[J3]
+    lam = prm[LAM]
+    u0 = prm[U0]
     for i in range(t.shape[0]):
         ti = t[i]
         u = u0 + lam * ti
@@ -541,24 +603,24 @@ def free_eval(prm, t, out_q, out_w):  # pragma: no cover - compiled
         # Psi = (L/J3) t + L (J3 - J1)/(J1 J3 lam) [Pi(u) - Pi(u0)] - (alpha - alpha0).
         # Form B: with Pi(u) = u + D(u) and u - u0 = lam t the two secular terms add
         # up to (L/J1) t exactly (see free_setup for the choice of the form).
-        sec = ell / j1 if prm[_FORM] == 0.0 else ell / j3
-        psi = sec * ti + prm[_COEF] * (pi_u - prm[_PI0]) - (alpha - prm[_ALPHA0])
+        sec = ell / j1 if prm[FORM] == 0.0 else ell / j3
+        psi = sec * ti + prm[COEF] * (pi_u - prm[PI0]) - (alpha - prm[ALPHA0])
         l1, l2, l3 = j1 * w1 / ell, j2 * w2 / ell, j3 * w3 / ell
         nq = math.sqrt((1.0 + l3) ** 2 + l1 * l1 + l2 * l2)
         # qa^-1 qP^-1
         bw, bx, by, bz = qmul(
             (1.0 + l3) / nq, l2 / nq, -l1 / nq, 0.0,
-            prm[_QPI], prm[_QPI + 1], prm[_QPI + 2], prm[_QPI + 3],
+            prm[QPI], prm[QPI + 1], prm[QPI + 2], prm[QPI + 3],
         )
         zw, zz = math.cos(0.5 * psi), math.sin(0.5 * psi)
-        aw, ax, ay, az = qmul(prm[_C0], prm[_C0 + 1], prm[_C0 + 2], prm[_C0 + 3], zw, 0.0, 0.0, zz)
+        aw, ax, ay, az = qmul(prm[C0], prm[C0 + 1], prm[C0 + 2], prm[C0 + 3], zw, 0.0, 0.0, zz)
         qw, qx, qy, qz = qmul(aw, ax, ay, az, bw, bx, by, bz)
         out_q[i, 0] = qw
         out_q[i, 1] = qx
         out_q[i, 2] = qy
         out_q[i, 3] = qz
         for r in range(3):
-            out_w[i, r] = prm[_P + 3 * r] * w1 + prm[_P + 3 * r + 1] * w2 + prm[_P + 3 * r + 2] * w3
+            out_w[i, r] = prm[P + 3 * r] * w1 + prm[P + 3 * r + 1] * w2 + prm[P + 3 * r + 2] * w3
 
 
 @njit(cache=True)
