@@ -40,8 +40,9 @@ normalised on output only (it is not projected inside the run);
     second order in the torque.
 ``"dop853"``
     scipy's DOP853 through the one driver of both packages,
-    :func:`hamilton_orbits.integrators.dop853.solve` (restarted at each output
-    time, so an output is a step end, not an interpolation), on Euler's
+    :func:`hamilton_orbits.integrators.dop853.solve` (one integration, the
+    outputs from DOP853's 7th-order dense output, so that many closely spaced
+    outputs do not cap the step), on Euler's
     equations plus dq/dt = q omega / 2.  Tolerances from ``tol``: relative
     ``tol``, absolute ``tol / 100`` on the (unit) quaternion and
     ``tol / 100 max|omega0|`` on omega.  Normalisation policy: q is integrated
@@ -308,12 +309,12 @@ def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre,
 
 
 def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
-    """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver (restarted at
-    each output time, :func:`hamilton_orbits.integrators.dop853.solve`)."""
+    """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver
+    (:func:`hamilton_orbits.integrators.dop853.solve`, dense output)."""
     bar = _bar(t_out.size - 1, "output", progress)
     y, steps, nfev = dop853.solve(
         lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
-        t_out, rtol=rtol, atol=atol, max_step=max_step,
+        t_out, rtol=rtol, atol=atol, max_step=max_step, restart=False,
         on_output=None if bar is None else (lambda i, n: bar.update(1)),
     )
     if bar is not None:
