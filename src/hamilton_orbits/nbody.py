@@ -30,6 +30,7 @@ questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l: equations (A)-
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -61,6 +62,7 @@ _G_SI = const.G.to_value(u.m**3 / (u.kg * u.s**2))
 # energy of a Quantity system: (sum of gm v^2 terms in au^5/day^4) / G -> J
 _E_SI = (u.au**5 / u.day**4).to(u.m**5 / u.s**4) / _G_SI
 _L_SI = (u.au**5 / u.day**3).to(u.m**5 / u.s**3) / _G_SI
+_TINY = float(np.finfo(np.float64).tiny)  # the smallest normal float64
 
 
 def _as_vector(kind, name: str, value: Any, unit) -> np.ndarray:
@@ -347,32 +349,21 @@ class System:
 
     # ------------------------------------------------------------------ checks
     def _check_positions(self) -> None:
-        """Refuse two bodies at one position when one of them is massive."""
-        r = self._r
-        order = np.lexsort((r[:, 2], r[:, 1], r[:, 0]))
-        rs = r[order]
-        same = np.all(rs[1:] == rs[:-1], axis=1)
-        if not np.any(same):
+        """Refuse two bodies (one of them massive) at one position, or so close that
+        the cube of their separation underflows float64 (the force would be
+        infinite or undefined)."""
+        d2, i, j = _nbody.closest_pair(np.ascontiguousarray(self._r), self._gm)
+        if i < 0 or d2 * math.sqrt(d2) >= _TINY:
             return
-        massive = self._gm[order] > 0
-        # groups of equal rows: a group is bad if it holds a massive body
-        k = 0
-        n = len(order)
-        while k < n - 1:
-            if not same[k]:
-                k += 1
-                continue
-            start = k
-            while k < n - 1 and same[k]:
-                k += 1
-            group = order[start : k + 1]
-            if np.any(massive[start : k + 1]):
-                i, j = sorted(group[:2])
-                raise ValueError(
-                    f"Bodies {self.names[i]!r} and {self.names[j]!r} are at one position "
-                    f"{r[i].tolist()}"
-                )
-            k += 1
+        if np.array_equal(self._r[i], self._r[j]):
+            raise ValueError(f"Bodies {self.names[i]!r} and {self.names[j]!r} are at one "
+                             f"position {self._r[i].tolist()}")
+        apart = float(np.max(np.abs(self._r[i] - self._r[j])))  # d2 may underflow to 0
+        raise ValueError(
+            f"Bodies {self.names[i]!r} and {self.names[j]!r} are {apart:.3g} apart: "
+            f"the cube of their separation underflows float64 (below {_TINY ** (1 / 3):.3g} "
+            "in the system's length unit); use a smaller length unit or merge them"
+        )
 
     # --------------------------------------------------------------- accessors
     def as_arrays(self) -> SystemArrays:

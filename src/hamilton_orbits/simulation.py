@@ -21,7 +21,7 @@ from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, System, integral_errors
 from hamilton_orbits.rhs import compile_rhs
 from hamilton_orbits.trajectory import TrajectoryBase
-from hamilton_orbits.units import TIME, is_quantity
+from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 
 __all__ = ["INTEGRATORS", "Trajectory", "check_method", "integrate", "make_trajectory"]
 
@@ -192,15 +192,11 @@ def integrate(
         raise ValueError(f"Expected `system` to be a System, got {system!r}")
     eff = check_method(method, effects, options)
     times, unit = _times(t, system.quantity)
-    step = None
-    if dt is not None:
-        step = float(TIME("dt", dt, DAY if system.quantity else None))
-        if not (np.isfinite(step) and step > 0):
-            raise ValueError(f"Expected `dt` > 0, got {step!r}")
+    step = None if dt is None else _step(dt, system.quantity)
     if tol is not None:
-        tol = float(tol)
-        if not (np.isfinite(tol) and tol > 0):
-            raise ValueError(f"Expected `tol` > 0, got {tol!r}")
+        tol = float(DIMENSIONLESS("tol", tol))
+        if not 0.0 < tol < 1.0:
+            raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
     rhs = compile_rhs(system, eff)
     arrays = system.as_arrays()
     with _progress(progress, method, len(times) - 1, on_output) as report:
@@ -209,6 +205,21 @@ def integrate(
     if not out.complete:
         raise KeyboardInterrupt
     return make_trajectory(system, out, unit, method, rhs.effects)
+
+
+def _step(dt: Any, quantity: bool) -> float:
+    """``dt`` in days (a Quantity system: a time Quantity is required) or the
+    caller's float, positive and finite."""
+    if quantity and not is_quantity(dt):
+        raise ValueError(f"Expected `dt` as a time Quantity for a Quantity system, got {dt!r} "
+                         "(a bare number would be read as days)")
+    if not quantity and is_quantity(dt):
+        raise ValueError(f"Expected `dt` as a plain float for a system of plain floats, "
+                         f"got {dt!r}")
+    step = float(TIME("dt", dt, DAY if quantity else None))
+    if not (np.isfinite(step) and step > 0):
+        raise ValueError(f"Expected `dt` > 0, got {step!r}")
+    return step
 
 
 def check_method(method: str, effects: Any, options: Mapping[str, Any]) -> EffectSet:

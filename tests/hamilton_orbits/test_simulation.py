@@ -35,7 +35,7 @@ def test_trajectory_shapes_and_units():
     ("method", "kwargs", "e_tol", "l_tol"),
     [
         # leapfrog: energy error bounded, O(dt^2); 100 steps per Jupiter orbit
-        ("leapfrog", {"dt": 4332.6 / 400}, 1e-4, 1e-13),
+        ("leapfrog", {"dt": 4332.6 / 400 * u.day}, 1e-4, 1e-13),
         # dop853: not symplectic; local error at tol per step
         ("dop853", {"tol": 1e-13}, 1e-12, 1e-12),
     ],

@@ -14,7 +14,7 @@ __all__ = ["advance"]
 # explicit signature with ``accel`` as a first-class function type: compiled once
 # and loaded from the cache in later processes, whatever the right-hand side
 @njit(types.int64(ACCEL_TYPE, F1, F2, F2, F1, types.float64, types.float64, types.float64),
-      cache=True)
+      cache=True, error_model="numpy")
 def advance(accel, p, r, v, gm, t0, t1, dt):  # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.

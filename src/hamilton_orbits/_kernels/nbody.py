@@ -22,7 +22,7 @@ from numba import njit
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def massive_indices(gm):  # pragma: no cover - compiled
     """Indices of the bodies with ``gm != 0``, in order."""
     n = gm.shape[0]
@@ -35,7 +35,7 @@ def massive_indices(gm):  # pragma: no cover - compiled
     return idx[:nm]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def zero(r, v, gm, acc):  # pragma: no cover - compiled
     """Overwrites ``acc`` with zeros (the start of a right-hand side whose effects
     compute the point-mass interaction themselves)."""
@@ -45,7 +45,7 @@ def zero(r, v, gm, acc):  # pragma: no cover - compiled
         acc[k, 2] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     """Newtonian accelerations of equation (B); overwrites ``acc``.
 
@@ -68,7 +68,7 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
         _massive_row(r, gm, i, acc, n, n, False, gm)
 
 
-@njit(inline="always", cache=True)
+@njit(inline="always", cache=True, error_model="numpy")
 def _massive_row(r, gm, i, acc, start, nm, use_idx, idx):  # pragma: no cover - compiled
     """Body ``i`` against the massive bodies after it: ``j = idx[b]`` for ``b`` in
     ``(start, nm)`` (``use_idx``), else ``j = b`` from ``i + 1``.  Body ``i``'s sum
@@ -103,7 +103,7 @@ def _massive_row(r, gm, i, acc, start, nm, use_idx, idx):  # pragma: no cover - 
     acc[i, 2] = az
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
     """:func:`newtonian` with the massive indices ``idx`` given (so that a
     stepper computes them once, not every step) and the rows below ``first``
@@ -146,7 +146,7 @@ def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
 # :mod:`hamilton_orbits.effects` documents.
 
 
-@njit(inline="always", cache=True)
+@njit(inline="always", cache=True, error_model="numpy")
 def _push_pair(acc, i, s, ax, ay, az, back):  # pragma: no cover - compiled
     """Add ``a`` to body ``i`` and the reaction ``-back * a`` to the source ``s``."""
     acc[i, 0] += ax
@@ -157,7 +157,7 @@ def _push_pair(acc, i, s, ax, ay, az, back):  # pragma: no cover - compiled
     acc[s, 2] -= back * az
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gr_anderson(r, v, gm, acc, p):  # pragma: no cover - compiled
     """First post-Newtonian correction from one dominant body (one-body metric).
 
@@ -194,7 +194,7 @@ def gr_anderson(r, v, gm, acc, p):  # pragma: no cover - compiled
                    gm[i] / mu)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gr_potential(r, v, gm, acc, p):  # pragma: no cover - compiled
     """Nobili & Roxburgh (1986) potential ``Phi = -3 (mu / (c |d|))^2`` of one body.
 
@@ -216,7 +216,7 @@ def gr_potential(r, v, gm, acc, p):  # pragma: no cover - compiled
         _push_pair(acc, i, s, f * dx, f * dy, f * dz, gm[i] / mu)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def j2_field(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The J2 (oblateness) field of one body about its pole, on every other body.
 
@@ -251,7 +251,7 @@ def j2_field(r, v, gm, acc, p):  # pragma: no cover - compiled
                    f * (g * dz + 2.0 * z * kz), gm[i] / mu)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def min_pair_time(r, gm):  # pragma: no cover - compiled
     """min over pairs (i massive, j != i) of sqrt(d^3 / (gm_i + gm_j)); O(n n_massive)."""
     n = r.shape[0]
@@ -273,14 +273,39 @@ def min_pair_time(r, gm):  # pragma: no cover - compiled
     return math.sqrt(best)
 
 
+@njit(cache=True, error_model="numpy")
+def closest_pair(r, gm):  # pragma: no cover - compiled
+    """``(d2, i, j)``: the smallest squared separation over pairs with a massive
+    member, and the pair (``i < j``); ``(inf, -1, -1)`` without such a pair."""
+    n = r.shape[0]
+    best = math.inf
+    bi = -1
+    bj = -1
+    for i in range(n):
+        if gm[i] == 0.0:
+            continue
+        for j in range(n):
+            if j == i or (gm[j] != 0.0 and j < i):
+                continue
+            dx = r[j, 0] - r[i, 0]
+            dy = r[j, 1] - r[i, 1]
+            dz = r[j, 2] - r[i, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 < best:
+                best = d2
+                bi = min(i, j)
+                bj = max(i, j)
+    return best, bi, bj
+
+
 # compiled eagerly (explicit signatures): after the kernels they call
-@njit(ACCEL_SIGNATURE, cache=True)
+@njit(ACCEL_SIGNATURE, cache=True, error_model="numpy")
 def newtonian_only(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The right-hand side with no effect listed: :func:`newtonian` (``p`` unused)."""
     newtonian(r, v, gm, acc)
 
 
-@njit(ACCEL_SIGNATURE, cache=True)
+@njit(ACCEL_SIGNATURE, cache=True, error_model="numpy")
 def no_effects(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The effects part of a right-hand side with no effect listed: adds nothing."""
     return

@@ -104,7 +104,7 @@ _F1 = types.float64[::1]
 _F2 = types.float64[:, ::1]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _kahan(p, cs, k, inp):  # pragma: no cover - compiled
     """Compensated ``p[k] += inp`` (the true sum is ``p[k] - cs[k]``)."""
     y = inp - cs[k]
@@ -113,7 +113,7 @@ def _kahan(p, cs, k, inp):  # pragma: no cover - compiled
     p[k] = t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _kahan2(p, cs, i, k, inp):  # pragma: no cover - compiled
     """Compensated ``p[i, k] += inp``."""
     y = inp - cs[i, k]
@@ -122,7 +122,7 @@ def _kahan2(p, cs, i, k, inp):  # pragma: no cover - compiled
     p[i, k] = t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _predict(q, b, e, br, er):  # pragma: no cover - compiled
     """Predict ``b`` (and save the prediction in ``e``) for a step ``q`` times the
     last completed one, from that step's converged ``br`` and its prediction
@@ -153,7 +153,7 @@ def _predict(q, b, e, br, er):  # pragma: no cover - compiled
             b[i, k] = e[i, k] + (br[i, k] - er[i, k])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _g_from_b(b, g):  # pragma: no cover - compiled
     """``g = D b`` (Rein & Spiegel 2015, eq. 5 from eq. 4)."""
     for k in range(b.shape[1]):
@@ -164,7 +164,7 @@ def _g_from_b(b, g):  # pragma: no cover - compiled
             g[j, k] = acc
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _positions_at(hn, dt, b, a0, v0, x0, csx0, xs):  # pragma: no cover - compiled
     """Positions at spacing ``hn``, eq. (6) of Rein & Spiegel (2015) in Horner form
     (one rounding per coefficient, no large powers)."""
@@ -183,7 +183,7 @@ def _positions_at(hn, dt, b, a0, v0, x0, csx0, xs):  # pragma: no cover - compil
         xs[k] = ((poly * dth2 + v0[k]) * dth - csx0[k]) + x0[k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _velocities_at(hn, dt, b, a0, v0, csv0, vs):  # pragma: no cover - compiled
     """Velocities at spacing ``hn``, eq. (7) of Rein & Spiegel (2015) in Horner form."""
     dth = dt * hn
@@ -194,7 +194,7 @@ def _velocities_at(hn, dt, b, a0, v0, csv0, vs):  # pragma: no cover - compiled
         vs[k] = (dth * (a0[k] + hn * poly) - csv0[k]) + v0[k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _correct(ns, at, a0, g, b, csb):  # pragma: no cover - compiled
     """Update ``g[ns - 1]`` from the acceleration ``at`` at spacing ``ns`` and
     carry the change into ``b`` with compensated sums (a biased rounding here
@@ -223,7 +223,7 @@ def _correct(ns, at, a0, g, b, csb):  # pragma: no cover - compiled
     return maxdb, maxak
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, need_v):
     # pragma: no cover - compiled
     """The predictor-corrector iteration of one step (Rein & Spiegel 2015,
@@ -250,7 +250,7 @@ def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, ne
     return iters
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     """Pham, Rein & Spiegel (2024): the shortest timescale
     ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
@@ -287,7 +287,7 @@ def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     return dt_done / _SAFETY
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _dt_global(at, b, x, v, n, dt_done, eps):  # pragma: no cover - compiled
     """Rein & Spiegel (2015), section 3.2: ``dt (eps / (max |b6| / max |a|))^(1/7)``
     over the normal components, leaving out bodies whose acceleration varies
@@ -313,7 +313,7 @@ def _dt_global(at, b, x, v, n, dt_done, eps):  # pragma: no cover - compiled
     return dt_done / _SAFETY
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _accept(x, v, csx, csv, b, a0, v0, dt):  # pragma: no cover - compiled
     """Compensated update of positions and velocities at the end of an accepted
     step (``dt^2`` is not precomputed: with a fixed step its rounding would be a
@@ -338,7 +338,7 @@ def _accept(x, v, csx, csv, b, a0, v0, dt):  # pragma: no cover - compiled
         _kahan(v, csv, k, a0[k] * dt)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _copy2(src, dst):  # pragma: no cover - compiled
     """``dst[:, :] = src`` element by element (no temporary for an overlap check)."""
     for i in range(src.shape[0]):
@@ -346,7 +346,7 @@ def _copy2(src, dst):  # pragma: no cover - compiled
             dst[i, k] = src[i, k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _all_finite(x):  # pragma: no cover - compiled
     for k in range(x.shape[0]):
         if not math.isfinite(x[k]):
@@ -354,7 +354,7 @@ def _all_finite(x):  # pragma: no cover - compiled
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
     # pragma: no cover - compiled
     """Save the state at the start of a step and evaluate its acceleration into
@@ -371,7 +371,7 @@ def _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
     return _all_finite(a0_2.reshape(m))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _restore(r, v, x0, v0):  # pragma: no cover - compiled
     """Put the state back to the start of a rejected step."""
     m = x0.shape[0]
@@ -382,7 +382,7 @@ def _restore(r, v, x0, v0):  # pragma: no cover - compiled
         vf[k] = v0[k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
     """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
 
@@ -410,6 +410,7 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
         types.boolean, types.int64,
     ),
     cache=True,
+    error_model="numpy",
 )
 def advance(
     accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps
@@ -445,7 +446,7 @@ def advance(
             break
         dt_try = min(dt, t_end - t)
         landing = dt_try == t_end - t
-        if not (dt_try > 4.0 * _EPS * max(abs(t), abs(t_end))):
+        if not (dt_try > 4.0 * _EPS * abs(t)):  # t + dt_try would not advance t
             if landing and dt_try > 0.0 and dt_try <= dt:
                 t = t_end  # a remainder at rounding level of t: finish exactly
                 break

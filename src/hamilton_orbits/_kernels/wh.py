@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` by ``tau``
     (the shared kernel inlined: the bodies' solves overlap in the processor).
@@ -49,7 +49,7 @@ def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _jump(q, u, gm, tau):  # pragma: no cover - compiled
     """The drift of the ``Q_i`` under ``|sum m_i u_i|^2 / (2 m_0)`` for a time ``tau``."""
     n = q.shape[0]
@@ -82,6 +82,7 @@ def _jump(q, u, gm, tau):  # pragma: no cover - compiled
         types.float64,
     ),
     cache=True,
+    error_model="numpy",
 )
 def advance_dh(
     extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last
@@ -155,7 +156,7 @@ def advance_dh(
     return n_steps, -1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def jacobi_factors(eta):  # pragma: no cover - compiled
     """``(ratio, inv)`` with ``ratio_i = eta_{i-1} / eta_i`` (``ratio_0 = 1``) and
     ``inv_i = 1 / eta_i``: the divisions of the coordinate changes, formed once
@@ -170,7 +171,7 @@ def jacobi_factors(eta):  # pragma: no cover - compiled
     return ratio, inv
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - compiled
     """Inertial positions ``r`` from Jacobi positions ``qj`` (row 0: the barycentre);
     ``ratio``, ``inv`` from :func:`_jacobi_factors`.
@@ -198,7 +199,7 @@ def jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r):  # pragma: no cover - co
     r[0, 2] = sz / gm[0]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
     """Jacobi accelerations ``aj_i = a_i - (sum_{j<i} m_j a_j) / eta_{i-1}``, i >= 1
     (``inv_i = 1 / eta_i``)."""
@@ -217,7 +218,7 @@ def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
         sz += gi * a[i, 2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _kick_jacobi(
     extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in, v_in
 ):  # pragma: no cover - compiled
@@ -257,6 +258,7 @@ _CORR_B = -math.sqrt(10.0 / 7.0) / 48.0
 @njit(
     types.int64(ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64),
     cache=True,
+    error_model="numpy",
 )
 def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: no cover
     """Apply the third-order corrector (``sign = 1``) or its inverse (``-1``):
@@ -305,6 +307,7 @@ def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma:
         types.float64,
     ),
     cache=True,
+    error_model="numpy",
 )
 def advance_jacobi(
     extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last

@@ -143,3 +143,31 @@ def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
     if not math.isfinite(best):
         return 1.0
     return 0.01 * best
+
+
+#: Default limit on the steps of one run of a fixed-step method (refused up front).
+MAX_FIXED_STEPS = 1_000_000_000
+
+
+def check_step_count(span: float, dt: float, max_steps: int, method: str) -> int:
+    """The steps a fixed-step method needs for ``span`` at ``dt``, refused up front
+    above ``max_steps`` (a run of hours, or an integer overflow, caught before it
+    starts).
+
+    Examples
+    --------
+    >>> check_step_count(1.0, 0.25, 100, "leapfrog")
+    4
+    >>> check_step_count(1.0, 1e-12, 10**9, "leapfrog")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: leapfrog would take about 1e+12 steps of dt = 1e-12 over 1 (max_steps = ...
+    """
+    steps = abs(span) / dt
+    if not steps <= max_steps:
+        raise ValueError(
+            f"{method} would take about {steps:.3g} steps of dt = {dt:.6g} over "
+            f"{abs(span):.6g} (max_steps = {max_steps}); choose a longer `dt` or pass "
+            "max_steps=... to allow it"
+        )
+    return max(1, math.ceil(steps * (1.0 - 1e-12)))

@@ -14,8 +14,9 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels import leapfrog as _k
+from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.integrators import output_arrays
-from hamilton_orbits.integrators._setup import accel_arg
+from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "choose_dt", "run"]
 
@@ -29,14 +30,8 @@ def choose_dt(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float) -> flo
     ``dt = sqrt(tol) * min_{pairs} sqrt(d^3 / (gm_i + gm_j))``: the local error of a
     second-order method over one dynamical time scales like ``(dt / T)^2``.
     """
-    massive = np.flatnonzero(gm > 0)
-    best = np.inf
-    for i in range(len(r0)):
-        d = np.linalg.norm(r0[massive] - r0[i], axis=1)
-        mu = gm[massive] + gm[i]
-        keep = massive != i
-        if np.any(keep):
-            best = min(best, float(np.min(np.sqrt(d[keep] ** 3 / mu[keep]))))
+    best = _nbody.min_pair_time(np.ascontiguousarray(r0, dtype=np.float64),
+                                np.ascontiguousarray(gm, dtype=np.float64))
     return float(np.sqrt(tol) * best)
 
 
@@ -51,8 +46,12 @@ def run(
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
     out: tuple[np.ndarray, np.ndarray] | None = None,
+    max_steps: int = MAX_FIXED_STEPS,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
+
+    ``max_steps`` bounds the steps of the whole run; more are refused before the
+    run starts (``ValueError``).
 
     Examples
     --------
@@ -68,6 +67,7 @@ def run(
         if tol is None:
             raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
         dt = choose_dt(r0, v0, gm, tol)
+    check_step_count(float(t_out[-1] - t_out[0]), float(dt), max_steps, NAME)
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
     gm = np.ascontiguousarray(gm, dtype=np.float64)

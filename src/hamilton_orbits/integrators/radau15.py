@@ -35,6 +35,7 @@ step, the state between calls, and the output arrays.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -57,6 +58,9 @@ DEFAULT_CRITERION = "prs23"
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
+#: Default limit on the steps of one run (minutes to an hour of work): a run that
+#: would need more stops early with an error that says so (pass ``max_steps``).
+MAX_STEPS = 100_000_000
 
 
 def run(
@@ -70,7 +74,7 @@ def run(
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
     out: tuple[np.ndarray, np.ndarray] | None = None,
-    max_steps: int = 100_000_000,
+    max_steps: int = MAX_STEPS,
     criterion: str = DEFAULT_CRITERION,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the adaptive 15th-order Gauss-Radau scheme (IAS15-like).
@@ -96,7 +100,9 @@ def run(
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` is reached.
     max_steps : int, optional
-        Give up (``ConvergenceError``) after this many steps in one output interval.
+        Give up (``ConvergenceError``) after this many steps in the whole run, or
+        as soon as the pace so far projects more than 100 times as many
+        (default :data:`MAX_STEPS`).
     criterion : {"global", "prs23"}, optional
         The step-size control: ``"global"`` estimates the error from the last
         term, ``dt_new = dt (epsilon / (max |b6| / max |a|))^(1/7)`` (Rein &
@@ -165,14 +171,13 @@ def run(
     total = 0
     accel = _setup.accel_arg(rhs.accel)
     for i in range(1, nt):
-        done = 0
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             steps, status = _k.advance(accel, rhs.p, x, w, gm, t_out[i], st, *work, csx, csv,
-                                       need_v, min(SLICE, max_steps - done))
-            done += steps
-            if status != _k.STATUS_MAXSTEPS or done >= max_steps:
+                                       need_v, min(SLICE, max_steps - total))
+            total += steps
+            if status != _k.STATUS_MAXSTEPS:
                 break
-        total += done
+            _check_pace(total, max_steps, float(st[0]), t_out)
         if status != _k.STATUS_OK:
             raise ConvergenceError(
                 f"radau15 stopped at t = {float(st[0])!r} before t_out[{i}] = "
@@ -183,6 +188,19 @@ def run(
         if on_output is not None:
             on_output(i, total)
     return r_out, v_out, total
+
+
+def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None:
+    """Stop a run that cannot finish within ``max_steps``: at the budget, or early
+    when the pace so far projects more than 100 times the budget."""
+    covered = t - t_out[0]
+    projected = total * (t_out[-1] - t_out[0]) / covered if covered > 0 else math.inf
+    if total >= max_steps or projected > 100.0 * max_steps:
+        raise ConvergenceError(
+            f"radau15 reached t = {t!r} of {float(t_out[-1])!r} in {total} steps; at this pace "
+            f"the run needs about {projected:.3g} steps, more than max_steps = {max_steps} "
+            "(a step far shorter than the span: pass max_steps=... to go on, or a shorter span)"
+        )
 
 
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:

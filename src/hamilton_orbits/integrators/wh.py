@@ -101,6 +101,7 @@ def run(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     coordinates: str = "democratic_heliocentric",
     corrector: int = 0,
+    max_steps: int = _setup.MAX_FIXED_STEPS,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -133,6 +134,9 @@ def run(
         of Wisdom, Holman & Touma (1996) before the steps of each output
         interval and its inverse after them (so outputs are in true
         coordinates); it removes the leading O(eps dt^2) error term.
+    max_steps : int, optional
+        A bound on the steps of the whole run; more are refused before the run
+        starts (``ValueError``).
 
     Returns
     -------
@@ -170,6 +174,7 @@ def run(
         raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
     if dt_f is None:
         dt_f = default_step(r0, v0, gm, tol_f)
+    _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
     n = r0.shape[0]
     order = np.concatenate([[c], np.delete(np.arange(n), c)])  # the central body first
     split = _Split(np.ascontiguousarray(gm[order]), coordinates == "jacobi", corrector,

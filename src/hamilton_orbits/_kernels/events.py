@@ -1,0 +1,201 @@
+"""Events between steps: close approaches, contacts and escapes on the step's interpolant.
+
+:func:`scan` looks at one step (or one drift) from ``h = 0`` to ``h = 1`` of length
+``dt`` and, for every row of the watch table (see :mod:`hamilton_orbits.events`),
+finds what happened *inside* it, not only at its ends, on the integrator's own
+interpolant of the motion:
+
+- ``RADAU``: radau15's polynomial of the step (Rein & Spiegel 2015, eqs. 6, 7);
+- ``LINE``: straight lines at constant velocity (a leapfrog drift);
+- ``KEPLER``: every body on its Kepler arc about the origin with its own ``mu``
+  (a Wisdom-Holman drift in heliocentric coordinates; the central body at rest
+  at the origin);
+- ``HERMITE``: the cubic Hermite interpolant of the positions and velocities at
+  both ends (the generic case).
+
+A closest approach is a root of ``f(h) = d . w`` (``d``, ``w`` the relative
+position and velocity) where ``f`` goes from negative to non-negative; a contact a
+root of ``|d|^2 - R^2`` before the closest approach; an escape a root of
+``|x - x_cm|^2 - D^2`` going up.  Each root is bracketed and bisected to the last
+bit of ``h``: the time to rounding of ``t + h dt``, the distance at the minimum of
+a quadratic to rounding.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from hamilton_orbits._kernels import kepler as _kepler
+
+__all__ = ["HERMITE", "KEPLER", "LINE", "RADAU", "scan"]
+
+RADAU = 0
+LINE = 1
+KEPLER = 2
+HERMITE = 3
+
+_CODE_ENCOUNTER = 1
+_CODE_COLLISION = 2
+_CODE_ESCAPE = 3
+
+
+@njit(cache=True, error_model="numpy")
+def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
+    """Position and velocity of body ``k`` at ``h`` into ``out`` (6,)."""
+    if kind == KEPLER:
+        if mu[k] == 0.0:  # the central body (or a massless centre): at rest
+            for c in range(3):
+                out[c] = x0[k, c]
+                out[3 + c] = v0[k, c]
+            return
+        x, y, z, vx, vy, vz = _kepler.propagate_uv(x0[k, 0], x0[k, 1], x0[k, 2], v0[k, 0],
+                                                   v0[k, 1], v0[k, 2], mu[k], h * dt)
+        out[0], out[1], out[2], out[3], out[4], out[5] = x, y, z, vx, vy, vz
+        return
+    for c in range(3):
+        m = 3 * k + c
+        if kind == RADAU:
+            pos = b[4, m] / 42.0 + h * (b[5, m] / 56.0 + h * b[6, m] / 72.0)
+            pos = b[1, m] / 12.0 + h * (b[2, m] / 20.0 + h * (b[3, m] / 30.0 + h * pos))
+            pos = a0[m] / 2.0 + h * (b[0, m] / 6.0 + h * pos)
+            vel = b[4, m] / 6.0 + h * (b[5, m] / 7.0 + h * b[6, m] / 8.0)
+            vel = b[1, m] / 3.0 + h * (b[2, m] / 4.0 + h * (b[3, m] / 5.0 + h * vel))
+            vel = a0[m] + h * (b[0, m] / 2.0 + h * vel)
+            out[c] = x0[k, c] + h * dt * (v0[k, c] + h * dt * pos)
+            out[3 + c] = v0[k, c] + h * dt * vel
+        elif kind == LINE:
+            out[c] = x0[k, c] + h * dt * v0[k, c]
+            out[3 + c] = v0[k, c]
+        else:  # HERMITE
+            h2 = h * h
+            h3 = h2 * h
+            out[c] = ((2.0 * h3 - 3.0 * h2 + 1.0) * x0[k, c] + (h3 - 2.0 * h2 + h) * dt * v0[k, c]
+                      + (3.0 * h2 - 2.0 * h3) * x1[k, c] + (h3 - h2) * dt * v1[k, c])
+            out[3 + c] = ((6.0 * h2 - 6.0 * h) * (x0[k, c] - x1[k, c]) / dt
+                          + (3.0 * h2 - 4.0 * h + 1.0) * v0[k, c] + (3.0 * h2 - 2.0 * h) * v1[k, c])
+
+
+@njit(cache=True, error_model="numpy")
+def _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
+    # pragma: no cover - compiled
+    """``(|d|^2, d . w, |w|)`` of body ``i`` relative to body ``j`` (``j < 0``: the
+    centre of mass, ``cm = [x_cm(0), v_cm, x_cm(1) ...]`` moving uniformly)."""
+    _state(kind, i, h, dt, x0, v0, x1, v1, a0, b, mu, si)
+    if j >= 0:
+        _state(kind, j, h, dt, x0, v0, x1, v1, a0, b, mu, sj)
+    else:
+        for c in range(3):
+            sj[c] = cm[c] + h * (cm[6 + c] - cm[c])
+            sj[3 + c] = cm[3 + c]
+    d2 = 0.0
+    f = 0.0
+    w2 = 0.0
+    for c in range(3):
+        d = si[c] - sj[c]
+        w = si[3 + c] - sj[3 + c]
+        d2 += d * d
+        f += d * w
+        w2 += w * w
+    return d2, f, math.sqrt(w2)
+
+
+@njit(cache=True, error_model="numpy")
+def _bisect(which, kind, i, j, lo, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
+    # pragma: no cover - compiled
+    """The root in ``[lo, hi]`` of ``f`` (``which = 0``: ``d . w``, negative at ``lo``)
+    or of ``|d|^2 - target2`` (``which = 1``: sign at ``lo`` kept), bisected until
+    the bracket is two adjacent floats."""
+    d2, f, _ = _relative(kind, i, j, lo, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+    g_lo = f if which == 0 else d2 - target2
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if not (lo < mid < hi):
+            break
+        d2, f, _ = _relative(kind, i, j, mid, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+        g = f if which == 0 else d2 - target2
+        if (g < 0.0) == (g_lo < 0.0):
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+@njit(cache=True, error_model="numpy")
+def _record(out, count, code, i, j, t, dist, speed, action):  # pragma: no cover - compiled
+    """Append one event row; False when the buffer is full (the caller drains it)."""
+    k = count[0]
+    if k >= out.shape[0]:
+        return False
+    out[k, 0], out[k, 1], out[k, 2], out[k, 3] = code, i, j, t
+    out[k, 4], out[k, 5], out[k, 6] = dist, speed, action
+    count[0] = k + 1
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
+    # pragma: no cover - compiled
+    """Look for events in one step; returns ``(h, row)``: the earliest ``h`` at which
+    an event with an action (stop, merge, remove) occurred and its watch row, or
+    ``(2.0, -1)`` if none did.  ``(-1.0, -1)``: the buffer filled up (drain it and
+    scan the step again).
+
+    ``watch`` (m, 5): code, i, j, threshold, action.  ``x0, v0, x1, v1`` (n, 3): the
+    states at both ends; ``a0`` (3n,), ``b`` (7, 3n): radau15's polynomial;
+    ``mu`` (n,): the Kepler arcs' ``mu``; ``cm`` (9,): the centre of mass at both
+    ends and its velocity.
+    """
+    si = np.empty(6)
+    sj = np.empty(6)
+    first_h = 2.0
+    first_row = -1
+    for r in range(watch.shape[0]):
+        code = int(watch[r, 0])
+        i = int(watch[r, 1])
+        j = int(watch[r, 2])
+        thr2 = watch[r, 3] * watch[r, 3]
+        action = watch[r, 4]
+        d2a, fa, _ = _relative(kind, i, j, 0.0, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+        d2b, fb, _ = _relative(kind, i, j, 1.0, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+        h = -1.0
+        if code == _CODE_ESCAPE:
+            if d2a < thr2 <= d2b:
+                h = _bisect(1, kind, i, j, 0.0, 1.0, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
+                            si, sj)
+        else:
+            h_min = 1.0
+            if fa < 0.0 <= fb:
+                h_min = _bisect(0, kind, i, j, 0.0, 1.0, 0.0, dt, x0, v0, x1, v1, a0, b, mu,
+                                cm, si, sj)
+            elif not (fa < 0.0 and fb < 0.0):
+                continue  # receding all through the step
+            d2m, _, _ = _relative(kind, i, j, h_min, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+            if code == _CODE_ENCOUNTER:
+                if fa < 0.0 <= fb and d2m < thr2:
+                    h = h_min
+            elif d2a > thr2 >= d2m:
+                h = _bisect(1, kind, i, j, 0.0, h_min, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
+                            si, sj)
+        if h < 0.0:
+            continue
+        d2h, _, speed = _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+        if not _record(out, count, code, i, j, t0 + h * dt, math.sqrt(d2h), speed, action):
+            return -1.0, -1
+        if action != 0.0 and h < first_h:
+            first_h = h
+            first_row = r
+    return first_h, first_row
+
+
+@njit(cache=True, error_model="numpy")
+def state_at(kind, h, dt, x0, v0, x1, v1, a0, b, mu, r, v):  # pragma: no cover - compiled
+    """Every body's position and velocity at ``h`` into ``r``, ``v`` (n, 3)."""
+    s = np.empty(6)
+    for k in range(r.shape[0]):
+        _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, s)
+        for c in range(3):
+            r[k, c] = s[c]
+            v[k, c] = s[3 + c]

@@ -1,0 +1,310 @@
+"""Events found during a run: close encounters, collisions, escapes, from one registry.
+
+``integrate(system, t, events=[...])`` and scenes (``events = [...]``) list events
+by name or as mappings with parameters, like effects::
+
+    {"name": "close_encounter", "bodies": ["jupiter", "comet"], "distance": 0.1 * u.au}
+    {"name": "close_encounter", "distance": {"hill": 3}}
+    {"name": "collision", "action": "merge"}          # uses Body(radius=)
+    {"name": "escape", "distance": 1000 * u.au, "action": "remove"}
+
+What each finds
+---------------
+``close_encounter``
+    Every closest approach of a watched pair closer than ``distance``: the time
+    and distance of the minimum of ``|r_i - r_j|``, found *between* steps (a
+    flyby that begins and ends inside one step is still found) and refined on
+    the integrator's own interpolant to near rounding error.  Without
+    ``bodies``, every pair with at least one massive body is watched.  A
+    ``{"hill": k}`` distance is ``k`` Hill radii of the more massive body of the
+    pair about the most massive body of the system, ``a (m / 3 M)^(1/3)`` with
+    ``a`` its initial osculating semi-major axis.
+``collision``
+    The first contact of two bodies with radii (``|r_i - r_j| = R_i + R_j``),
+    solved on the interpolant.  ``"stop"`` ends the run there; ``"merge"``
+    replaces the pair by one body with their summed mass at their centre of
+    mass with their total momentum, and goes on.
+``escape``
+    A body's distance from the system's centre of mass crossing ``distance``
+    outwards.  ``"record"`` (default) goes on; ``"stop"`` ends the run;
+    ``"remove"`` takes the body out of the run.
+
+Where actions take effect
+-------------------------
+``radau15`` and ``dop853`` stop or merge at the event's time itself.  The
+symplectic maps (``wh``, ``leapfrog``) report every event at its refined time,
+but act (stop, merge, remove) at the end of the step in which it occurred: a
+step cut short, or a body changed mid-step, would break the map's symplecticity.
+Merging or removing bodies changes the Hamiltonian itself; the integrals'
+errors after such an event measure the change, not the integrator.
+
+Tables
+------
+``traj.events`` is an astropy ``QTable`` with one row per event: ``name``,
+``time``, ``bodies``, ``distance``, ``speed``, ``action``; ``traj.stopped_by`` is
+the row of the event that ended the run, or None.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "ACTIONS",
+    "EVENTS",
+    "EventLog",
+    "EventSet",
+    "watch_table",
+]
+
+#: The registered events: name -> (code, allowed actions (the first is the default),
+#: parameters with their descriptions).
+EVENTS: dict[str, tuple[int, tuple[str, ...], dict[str, str]]] = {
+    "close_encounter": (1, ("record", "stop"), {
+        "bodies": "two body names (default: every pair with a massive body)",
+        "distance": "a length, or {'hill': k} for k Hill radii",
+        "action": "'record' (default) or 'stop'",
+    }),
+    "collision": (2, ("stop", "merge"), {
+        "bodies": "two body names (default: every pair of bodies with radii)",
+        "action": "'stop' (default) or 'merge'",
+    }),
+    "escape": (3, ("record", "stop", "remove"), {
+        "bodies": "body names (default: every body but the most massive)",
+        "distance": "a length from the centre of mass (required)",
+        "action": "'record' (default), 'stop' or 'remove'",
+    }),
+}
+#: Action codes in the watch table.
+ACTIONS = {"record": 0, "stop": 1, "merge": 2, "remove": 3}
+NAMES = {code: name for name, (code, _, _) in EVENTS.items()}
+
+#: Columns of the watch table: event code, body i, body j (-1: the centre of
+#: mass), threshold distance, action code.
+W_CODE, W_I, W_J, W_DIST, W_ACTION = range(5)
+#: Columns of a recorded event: code, i, j, time, distance, speed, action.
+E_CODE, E_I, E_J, E_TIME, E_DIST, E_SPEED, E_ACTION = range(7)
+N_EVENT_COLUMNS = 7
+
+
+@dataclass(frozen=True)
+class EventSet:
+    """The listed events, checked once: ``(name, params)`` pairs.
+
+    Examples
+    --------
+    >>> EventSet.of(["collision", {"name": "escape", "distance": 10.0}]).names
+    ('collision', 'escape')
+    >>> EventSet.of([{"name": "escape"}])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Event at index 0 ('escape'): `distance` is required ...
+    """
+
+    items: tuple[tuple[str, dict[str, Any]], ...] = field(default=())
+
+    @classmethod
+    def of(cls, events: Any) -> EventSet:
+        """Check ``events`` (names or mappings with a ``"name"``)."""
+        if isinstance(events, EventSet):
+            return events
+        if events is None:
+            return cls(())
+        if isinstance(events, (str, Mapping)):
+            events = [events]
+        if not isinstance(events, Sequence):
+            raise ValueError(f"Expected `events` to be a list of names or mappings, got "
+                             f"{events!r}")
+        return cls(tuple(_check_entry(item, k) for k, item in enumerate(events)))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The listed events' names, in order."""
+        return tuple(name for name, _ in self.items)
+
+    def __bool__(self) -> bool:
+        return bool(self.items)
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+
+def _check_entry(item: Any, k: int) -> tuple[str, dict[str, Any]]:
+    if isinstance(item, str):
+        name, params = item, {}
+    elif isinstance(item, Mapping) and isinstance(item.get("name"), str):
+        name, params = item["name"], {key: v for key, v in item.items() if key != "name"}
+    else:
+        raise ValueError(f"Expected `events` to hold names or mappings with a 'name', got "
+                         f"{item!r} at index {k}")
+    if name not in EVENTS:
+        close = difflib.get_close_matches(name, list(EVENTS), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ValueError(f"Unknown event {name!r} at index {k}{hint}; known: "
+                         f"{', '.join(EVENTS)}")
+    _, actions, takes = EVENTS[name]
+    for key in params:
+        if key not in takes:
+            raise ValueError(f"Event at index {k} ({name!r}) takes no parameter {key!r}; it "
+                             f"takes: {', '.join(takes)}")
+    action = params.get("action", actions[0])
+    if action not in actions:
+        raise ValueError(f"Event at index {k} ({name!r}): expected `action` one of "
+                         f"{', '.join(map(repr, actions))}, got {action!r}")
+    if name == "escape" and "distance" not in params:
+        raise ValueError(f"Event at index {k} ({name!r}): `distance` is required (a length "
+                         "from the centre of mass)")
+    if name == "close_encounter" and "distance" not in params:
+        raise ValueError(f"Event at index {k} ({name!r}): `distance` is required (a length "
+                         "or {'hill': k})")
+    return name, {**params, "action": action}
+
+
+def watch_table(events: EventSet, system: Any) -> np.ndarray:
+    """The float rows the kernels watch, shape (m, 5): code, i, j, threshold, action.
+
+    Raises
+    ------
+    ValueError
+        For a body name not in the system, a non-positive distance, or a
+        collision watch with no body radii to collide.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+    ...             Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    >>> watch_table(EventSet.of([{"name": "close_encounter", "distance": 0.1}]), s).tolist()
+    [[1.0, 0.0, 1.0, 0.1, 0.0]]
+    """
+    rows: list[list[float]] = []
+    arrays = system.as_arrays()
+    for k, (name, params) in enumerate(events.items):
+        code, _, _ = EVENTS[name]
+        action = float(ACTIONS[params["action"]])
+        where = f"Event at index {k} ({name!r})"
+        if name == "escape":
+            dist = _length(params["distance"], system, where)
+            rows += [[code, i, -1, dist, action]
+                     for i in _bodies(params, system, where, single=True)]
+            continue
+        pairs = _pairs(params, system, where, name)
+        if name == "collision" and not pairs:
+            raise ValueError(f"{where}: no pair of bodies has radii (give Body(radius=...))")
+        for i, j in pairs:
+            if name == "collision":
+                dist = arrays.radius[i] + arrays.radius[j]
+            else:
+                dist = _encounter_distance(params["distance"], system, i, j, where)
+            rows.append([code, i, j, dist, action])
+    return np.array(rows, dtype=np.float64).reshape(-1, 5)
+
+
+def _bodies(params: Mapping[str, Any], system: Any, where: str, single: bool) -> list[int]:
+    names = params.get("bodies")
+    if names is None:
+        gm = system.as_arrays().gm
+        top = int(np.argmax(gm))
+        return [i for i in range(len(gm)) if i != top]
+    if isinstance(names, str):
+        names = [names]
+    out = []
+    for name in names:
+        if name not in system.names:
+            raise ValueError(f"{where}: `bodies` names {name!r}, which is not in the system; "
+                             f"bodies: {', '.join(system.names)}")
+        out.append(system.names.index(name))
+    return out
+
+
+def _pairs(params: Mapping[str, Any], system: Any, where: str, name: str) -> list[tuple[int, int]]:
+    arrays = system.as_arrays()
+    if params.get("bodies") is not None:
+        idx = _bodies(params, system, where, single=False)
+        if len(idx) != 2 or idx[0] == idx[1]:
+            raise ValueError(f"{where}: expected `bodies` to name two different bodies, got "
+                             f"{params['bodies']!r}")
+        i, j = sorted(idx)
+        if name == "collision" and not np.isfinite(arrays.radius[[i, j]]).all():
+            raise ValueError(f"{where}: bodies {system.names[i]!r} and {system.names[j]!r} "
+                             "need radii to collide (Body(radius=...))")
+        return [(i, j)]
+    n = len(arrays.gm)
+    massive = arrays.gm > 0
+    with_radius = np.isfinite(arrays.radius)
+    out = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            if not (massive[i] or massive[j]):
+                continue
+            if name == "collision" and not (with_radius[i] and with_radius[j]):
+                continue
+            out.append((i, j))
+    return out
+
+
+def _length(value: Any, system: Any, where: str) -> float:
+    import astropy.units as u
+
+    from hamilton_orbits.units import LENGTH, is_quantity
+
+    if system.quantity and not is_quantity(value):
+        raise ValueError(f"{where}: expected `distance` as a length Quantity for a Quantity "
+                         f"system, got {value!r}")
+    dist = float(LENGTH("distance", value, u.au if system.quantity else None))
+    if not (np.isfinite(dist) and dist > 0):
+        raise ValueError(f"{where}: expected `distance` > 0, got {value!r}")
+    return dist
+
+
+def _encounter_distance(value: Any, system: Any, i: int, j: int, where: str) -> float:
+    if not (isinstance(value, Mapping) and set(value) == {"hill"}):
+        return _length(value, system, where)
+    k = float(value["hill"])
+    if not (np.isfinite(k) and k > 0):
+        raise ValueError(f"{where}: expected {{'hill': k}} with k > 0, got {value!r}")
+    a = system.as_arrays()
+    top = int(np.argmax(a.gm))
+    big = i if a.gm[i] >= a.gm[j] else j
+    if big == top:
+        raise ValueError(f"{where}: a Hill radius about the most massive body itself is not "
+                         f"defined (pair {system.names[i]!r}-{system.names[j]!r})")
+    d = a.r[big] - a.r[top]
+    w = a.v[big] - a.v[top]
+    mu = a.gm[top] + a.gm[big]
+    inv_a = 2.0 / np.linalg.norm(d) - (w @ w) / mu
+    if not inv_a > 0:
+        raise ValueError(f"{where}: {system.names[big]!r} is not bound to "
+                         f"{system.names[top]!r}; its Hill radius is not defined")
+    return k * (1.0 / inv_a) * (a.gm[big] / (3.0 * a.gm[top])) ** (1.0 / 3.0)
+
+
+class EventLog:
+    """What a run records: the watch table, the events found, and why it stopped.
+
+    The drivers append the kernels' recorded rows with :meth:`extend`; the public
+    layer turns them into a table with :meth:`table`.
+    """
+
+    def __init__(self, watch: np.ndarray, capacity: int = 1024) -> None:
+        self.watch = np.ascontiguousarray(watch, dtype=np.float64)
+        self.buffer = np.zeros((capacity, N_EVENT_COLUMNS))
+        self.count = np.zeros(1, dtype=np.int64)
+        self.rows: list[np.ndarray] = []
+        self.stopped_by: int | None = None
+
+    def drain(self) -> None:
+        """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""
+        k = int(self.count[0])
+        self.rows.extend(self.buffer[:k].copy())
+        self.count[0] = 0
+
+    def recorded(self) -> np.ndarray:
+        """Every recorded row, shape (k, 7)."""
+        self.drain()
+        return np.array(self.rows).reshape(-1, N_EVENT_COLUMNS)
