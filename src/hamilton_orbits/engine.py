@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import INTEGRATORS, Integrator
 
 __all__ = ["EngineRun", "StopIntegration", "integrator", "run"]
@@ -60,6 +61,12 @@ class EngineRun:
         Seconds of the integration proper.
     complete : bool
         False if the run stopped early (``stop()`` or Ctrl-C).
+    events : EventLog or None
+        The events found (when any were watched); an event that stopped the run
+        is ``events.stopped_by``, and ``t[-1]`` is its time.
+    gm : ndarray, shape (n,) or (k, n)
+        ``G m`` of every body; per output, (k, n), when merges or removals
+        changed it during the run.
     """
 
     t: np.ndarray
@@ -68,6 +75,8 @@ class EngineRun:
     steps: int
     wall_time: float
     complete: bool
+    events: EventLog | None
+    gm: np.ndarray
 
 
 def integrator(method: str) -> Integrator:
@@ -100,6 +109,7 @@ def run(
     options: dict[str, Any] | None = None,
     on_output: Callable[[int, int], None] | None = None,
     stop: Callable[[], bool] | None = None,
+    events: EventLog | None = None,
 ) -> EngineRun:
     """Integrate from ``(r0, v0)`` at ``t_out[0]`` through the output times.
 
@@ -123,6 +133,9 @@ def run(
         :class:`StopIntegration`.
     stop : callable, optional
         ``stop()`` after every output; True ends the run there.
+    events : EventLog, optional
+        Events to watch (:mod:`hamilton_orbits.events`); an event whose action is
+        ``"stop"`` ends the run at its time (the last output row).
 
     Returns
     -------
@@ -160,14 +173,26 @@ def run(
         if stop is not None and stop():
             raise StopIntegration
 
+    kw = dict(options or {})
+    if events is not None and len(events.watch):
+        if backward:
+            raise ValueError("Events are watched forwards in time only; integrate forwards")
+        kw["events"] = events
+    t_reached = np.array(t_out, dtype=np.float64)
     start = time.perf_counter()
     complete = True
     try:
         _, _, steps = module.run(rhs, r0, sign * v0, gm, sign * t_out, dt=dt, tol=tol,
-                                 on_output=report, out=(r_out, v_out), **(options or {}))
+                                 on_output=report, out=(r_out, v_out), **kw)
         reached[0], reached[1] = n_t - 1, steps
+    except StopAtEvent as stopped:
+        reached[0], reached[1] = stopped.index, stopped.steps
+        t_reached[stopped.index] = stopped.t
     except (StopIntegration, KeyboardInterrupt):
         complete = False
     wall = time.perf_counter() - start
     k = reached[0] + 1
-    return EngineRun(t_out[:k].copy(), r_out[:k], sign * v_out[:k], reached[1], wall, complete)
+    gm_out = (events.gm_at(t_reached[:k], gm) if events is not None and events.gm_changes
+              else gm)
+    return EngineRun(t_reached[:k], r_out[:k], sign * v_out[:k], reached[1], wall, complete,
+                     events, gm_out)

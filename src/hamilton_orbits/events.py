@@ -59,6 +59,7 @@ __all__ = [
     "EVENTS",
     "EventLog",
     "EventSet",
+    "StopAtEvent",
     "watch_table",
 ]
 
@@ -284,19 +285,46 @@ def _encounter_distance(value: Any, system: Any, i: int, j: int, where: str) -> 
     return k * (1.0 / inv_a) * (a.gm[big] / (3.0 * a.gm[top])) ** (1.0 / 3.0)
 
 
+class StopAtEvent(Exception):
+    """Raised by a driver when an event stopped the run; ``index`` is the output
+    row that holds the state at the event's time ``t``, after ``steps`` steps."""
+
+    def __init__(self, index: int, t: float, steps: int) -> None:
+        super().__init__(index, t, steps)
+        self.index = index
+        self.t = t
+        self.steps = steps
+
+
 class EventLog:
     """What a run records: the watch table, the events found, and why it stopped.
 
-    The drivers append the kernels' recorded rows with :meth:`extend`; the public
-    layer turns them into a table with :meth:`table`.
+    The drivers pass :attr:`watch`, :attr:`buffer` and :attr:`count` to their
+    kernels, :meth:`drain` the buffer when asked, and call :meth:`act` for an
+    event with an action; the public layer reads :meth:`recorded`.
+
+    Parameters
+    ----------
+    watch : ndarray, shape (m, 5)
+        From :func:`watch_table`.
+    radius : ndarray, shape (n,)
+        The bodies' radii (NaN: none), for the contact distance of merged bodies.
     """
 
-    def __init__(self, watch: np.ndarray, capacity: int = 1024) -> None:
-        self.watch = np.ascontiguousarray(watch, dtype=np.float64)
-        self.buffer = np.zeros((capacity, N_EVENT_COLUMNS))
+    def __init__(self, watch: np.ndarray, radius: np.ndarray, capacity: int = 1024) -> None:
+        self.watch = np.ascontiguousarray(watch, dtype=np.float64).reshape(-1, 5)
+        self.radius = np.array(radius, dtype=np.float64)
+        self.buffer = np.zeros((max(capacity, 2 * len(self.watch)), N_EVENT_COLUMNS))
         self.count = np.zeros(1, dtype=np.int64)
         self.rows: list[np.ndarray] = []
         self.stopped_by: int | None = None
+        self.inactive = np.zeros(len(self.radius), dtype=bool)
+        self.gm_changes: list[tuple[float, np.ndarray]] = []
+
+    @classmethod
+    def none(cls, n: int) -> EventLog:
+        """A log that watches nothing (the kernels then skip the scan)."""
+        return cls(np.zeros((0, 5)), np.full(n, np.nan))
 
     def drain(self) -> None:
         """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""
@@ -308,3 +336,58 @@ class EventLog:
         """Every recorded row, shape (k, 7)."""
         self.drain()
         return np.array(self.rows).reshape(-1, N_EVENT_COLUMNS)
+
+    def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
+        """Carry out the action of watch row ``row`` at time ``t`` on the state
+        ``r``, ``v``, ``gm`` (changed in place); True if the run must stop.
+
+        ``"merge"`` keeps the lower-indexed body with the pair's summed ``gm`` at
+        their centre of mass, with their total momentum and the radius of their
+        summed volume; ``"remove"`` takes a body out.  A body taken out is parked
+        far away with ``gm = 0`` (it then pulls on nothing and is pulled by almost
+        nothing) and marked :attr:`inactive`; its outputs are NaN from then on.
+        """
+        self.drain()
+        # what the scan found later in the same step did not happen: the run goes on
+        # (or ends) from the event's time
+        self.rows = [x for x in self.rows if x[E_TIME] <= t]
+        _, i, j, _, action = self.watch[row]
+        i, j, action = int(i), int(j), int(action)
+        if action == ACTIONS["stop"]:
+            self.stopped_by = next(k for k in range(len(self.rows) - 1, -1, -1)
+                                   if self.rows[k][E_I] == i and self.rows[k][E_J] == j)
+            return True
+        if action == ACTIONS["merge"]:
+            m = gm[i] + gm[j]
+            wi, wj = (gm[i] / m, gm[j] / m) if m > 0 else (0.5, 0.5)
+            r[i] = wi * r[i] + wj * r[j]
+            v[i] = wi * v[i] + wj * v[j]
+            gm[i] = m
+            self.radius[i] = np.cbrt(self.radius[i] ** 3 + self.radius[j] ** 3)
+            gone = j
+        else:
+            gone = i
+        self._park(gone, r, v, gm)
+        self.gm_changes.append((t, gm.copy()))
+        return False
+
+    def _park(self, k: int, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> None:
+        scale = float(np.max(np.abs(r[~self.inactive]))) if np.any(~self.inactive) else 1.0
+        gm[k] = 0.0
+        r[k] = (1e8 * max(scale, 1.0)) * np.array([1.0 + k, 0.5, 0.25])
+        v[k] = 0.0
+        self.inactive[k] = True
+        keep = ~(self.inactive[self.watch[:, W_I].astype(int)]
+                 | ((self.watch[:, W_J] >= 0) & self.inactive[self.watch[:, W_J].astype(int)]))
+        self.watch = np.ascontiguousarray(self.watch[keep])
+        collision = self.watch[:, W_CODE] == EVENTS["collision"][0]
+        pairs = self.watch[collision][:, [W_I, W_J]].astype(int)
+        self.watch[collision, W_DIST] = self.radius[pairs[:, 0]] + self.radius[pairs[:, 1]]
+
+    def gm_at(self, times: np.ndarray, gm0: np.ndarray) -> np.ndarray:
+        """``G m`` of every body at each of ``times`` (n_t, n): changed by merges and
+        removals; ``gm0`` before the first."""
+        out = np.repeat(np.asarray(gm0, dtype=np.float64)[None, :], len(times), axis=0)
+        for t_change, gm in self.gm_changes:
+            out[times >= t_change] = gm
+        return out

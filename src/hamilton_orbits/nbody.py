@@ -451,8 +451,11 @@ class System:
     def __repr__(self) -> str:
         return f"System({list(self.names)!r}{', au/day' if self._quantity else ''})"
 
-    def with_state(self, r: np.ndarray, v: np.ndarray) -> System:
-        """The same bodies at internal-unit positions ``r`` and velocities ``v`` (n, 3).
+    def with_state(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray | None = None,
+                   keep: np.ndarray | None = None) -> System:
+        """The same bodies at internal-unit positions ``r`` and velocities ``v`` (n, 3);
+        with ``gm`` (n,) their new ``G m`` (after merges), and with the boolean
+        ``keep`` (n,) only the bodies it marks (after removals).
 
         Examples
         --------
@@ -462,9 +465,11 @@ class System:
         """
         r = np.asarray(r, dtype=float)
         v = np.asarray(v, dtype=float)
+        gm = self._gm if gm is None else np.asarray(gm, dtype=float)
+        keep = np.ones(len(self._bodies), dtype=bool) if keep is None else np.asarray(keep)
         bodies = [
-            Body._from_floats(b.name, b._gm, r[k], v[k], b._radius, b.j2, b.pole, b.quantity)
-            for k, b in enumerate(self._bodies)
+            Body._from_floats(b.name, gm[k], r[k], v[k], b._radius, b.j2, b.pole, b.quantity)
+            for k, b in enumerate(self._bodies) if keep[k]
         ]
         return System(bodies, G=None if self._quantity else self._G)
 
@@ -727,16 +732,20 @@ def _energy_gm(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> float:
 
 
 def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
-    """Hamilton's (E) in gm units for states ``r``, ``v`` of shape (n_t, n, 3)."""
-    kinetic = 0.5 * np.einsum("j,tjk,tjk->t", gm, v, v)
-    idx = np.flatnonzero(gm > 0)
+    """Hamilton's (E) in gm units for states ``r``, ``v`` of shape (n_t, n, 3);
+    ``gm`` (n,), or (n_t, n) where masses change between states."""
+    gm_t = np.broadcast_to(gm, r.shape[:2])
+    kinetic = 0.5 * np.einsum("tj,tjk,tjk->t", gm_t, v, v)
+    idx = np.flatnonzero((gm_t > 0).any(axis=0))
     if len(idx) < 2:
         return kinetic
     i, j = np.triu_indices(len(idx), 1)
     rm = r[:, idx]
     d = rm[:, i] - rm[:, j]
     dist = np.sqrt(np.einsum("tpk,tpk->tp", d, d))
-    return kinetic - (gm[idx][i] * gm[idx][j] / dist).sum(axis=1)
+    g = gm_t[:, idx]
+    pair = g[:, i] * g[:, j]
+    return kinetic - np.where(pair != 0.0, pair / np.where(dist > 0, dist, 1.0), 0.0).sum(axis=1)
 
 
 def integral_errors(
@@ -744,6 +753,9 @@ def integral_errors(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How well states ``r``, ``v`` (n_t, n, 3) at times ``t`` (n_t,) keep Hamilton's
     integrals, relative to the first state.
+
+    ``gm`` is (n,), or (n_t, n) where masses changed during the run (merges);
+    bodies with NaN states (taken out of the run) count as absent.
 
     Returns
     -------
@@ -763,11 +775,22 @@ def integral_errors(
     """
     from hamilton_orbits.trajectory import relative_change
 
-    energy_error = relative_change(energy_gm_many(r, v, gm))
-    am_error = relative_change(np.einsum("j,tjk->tk", gm, np.cross(r, v)))
-    total = gm.sum()
-    rc = np.einsum("j,tjk->tk", gm, r) / total
-    vc0 = gm @ v[0] / total
+    gm_t = np.broadcast_to(gm, r.shape[:2])
+    present = np.isfinite(r).all(axis=2) & np.isfinite(v).all(axis=2)
+    if not present.all():
+        gm_t = np.where(present, gm_t, 0.0)
+        r = np.where(present[..., None], r, 0.0)
+        v = np.where(present[..., None], v, 0.0)
+    if gm_t is gm or (np.ndim(gm) == 1 and present.all()):
+        energy = energy_gm_many(r, v, gm)
+    else:
+        energy = np.array([energy_gm_many(r[k : k + 1], v[k : k + 1], gm_t[k])[0]
+                           for k in range(len(t))])
+    energy_error = relative_change(energy)
+    am_error = relative_change(np.einsum("tj,tjk->tk", gm_t, np.cross(r, v)))
+    total = gm_t.sum(axis=1)
+    rc = np.einsum("tj,tjk->tk", gm_t, r) / total[:, None]
+    vc0 = gm_t[0] @ v[0] / total[0]
     scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
     drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
     return energy_error, am_error, drift / (scale if scale > 0 else 1.0)

@@ -17,6 +17,7 @@ import numpy as np
 
 from hamilton_orbits import engine
 from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, System, integral_errors
 from hamilton_orbits.rhs import compile_rhs
@@ -60,6 +61,11 @@ class Trajectory(TrajectoryBase):
         of a right-hand side for new effects and the checks are not counted).
     method : str
     effects : tuple of str
+    events : astropy.table.QTable
+        One row per event found (``name``, ``time``, ``bodies``, ``distance``,
+        ``speed``, ``action``); empty when none was listed or found.
+    stopped_by : astropy.table.Row or None
+        The row of the event that ended the run, if one did.
     """
 
     r: Any
@@ -68,6 +74,8 @@ class Trajectory(TrajectoryBase):
     final: System
     barycentre_drift: np.ndarray
     effects: tuple[str, ...]
+    events: Any = None
+    stopped_by: Any = None
 
     def __repr__(self) -> str:
         return (
@@ -110,7 +118,7 @@ def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
     """Refuse an option the integrator's ``run`` does not take, listing those it does."""
     import inspect
 
-    common = {"dt", "tol", "on_output", "out"}
+    common = {"dt", "tol", "on_output", "out", "events"}
     takes = [name for name, p in inspect.signature(module.run).parameters.items()
              if p.kind is p.KEYWORD_ONLY and name not in common]
     for key, value in options.items():
@@ -129,6 +137,7 @@ def integrate(
     effects: Sequence[str | Mapping[str, Any]] = (),
     progress: bool = False,
     on_output: Any = None,
+    events: Any = (),
     **options: Any,
 ) -> Trajectory:
     """Integrate Hamilton's equation (B) (plus the listed effects) for ``system``.
@@ -153,6 +162,11 @@ def integrate(
         Show a progress bar (tqdm, on stderr) over the output times.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` (for scenes and interfaces).
+    events : sequence of str or mapping, optional
+        Events to find during the run: ``close_encounter``, ``collision``,
+        ``escape`` (see :mod:`hamilton_orbits.events`); the trajectory's
+        ``events`` table lists them and ``stopped_by`` names the one that ended
+        the run, if any.
     **options
         Options of the chosen integrator, e.g. for ``wh``
         ``coordinates="jacobi"`` and ``corrector=3`` (see its ``run``).  An option
@@ -198,13 +212,31 @@ def integrate(
         if not 0.0 < tol < 1.0:
             raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
     rhs = compile_rhs(system, eff)
+    log = event_log(system, events)
     arrays = system.as_arrays()
     with _progress(progress, method, len(times) - 1, on_output) as report:
         out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
-                         options=options, on_output=report)
+                         options=options, on_output=report, events=log)
     if not out.complete:
         raise KeyboardInterrupt
     return make_trajectory(system, out, unit, method, rhs.effects)
+
+
+def event_log(system: System, events: Any) -> EventLog | None:
+    """The :class:`~hamilton_orbits.events.EventLog` of ``events`` for ``system``
+    (None when no event is listed).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+    >>> event_log(s, [{"name": "escape", "distance": 10.0}]).watch.tolist()
+    [[3.0, 1.0, -1.0, 10.0, 0.0]]
+    """
+    listed = EventSet.of(events)
+    if not listed:
+        return None
+    return EventLog(watch_table(listed, system), system.as_arrays().radius)
 
 
 def _step(dt: Any, quantity: bool) -> float:
@@ -290,23 +322,50 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         If the run lost a body's state (a non-finite position or velocity).
     """
     r, v, times = out.r, out.v, out.t
-    if not (np.all(np.isfinite(r)) and np.all(np.isfinite(v))):
-        bad = np.argwhere(~np.isfinite(r).all(axis=2) | ~np.isfinite(v).all(axis=2))[0]
+    gone = out.events.inactive if out.events is not None else np.zeros(r.shape[1], bool)
+    lost = (~np.isfinite(r).all(axis=2) | ~np.isfinite(v).all(axis=2)) & ~gone
+    if lost.any():
+        bad = np.argwhere(lost)[0]
         raise ValueError(
             f"The integration with {method!r} lost the state of body "
             f"{system.names[bad[1]]!r} at output {bad[0]} (t = {times[bad[0]]!r}): "
             "a collision or a step too long"
         )
-    ee, ae, bd = integral_errors(r, v, system.as_arrays().gm, times)
-    final = system.with_state(r[-1], v[-1])
+    ee, ae, bd = integral_errors(r, v, out.gm, times)
+    final = system.with_state(r[-1], v[-1], gm=np.atleast_2d(out.gm)[-1], keep=~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)
         r_out: Any = r * u.au
         v_out: Any = v * (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
+    table, stopped_by = event_table(out.events, system, unit)
     return Trajectory(
         t=t_out, r=r_out, v=v_out, names=system.names, final=final, energy_error=ee,
         angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
-        wall_time=out.wall_time, method=method, effects=effects,
+        wall_time=out.wall_time, method=method, effects=effects, events=table,
+        stopped_by=stopped_by,
     )
+
+
+def event_table(log: EventLog | None, system: System, unit: Any) -> tuple[Any, Any]:
+    """The events of a run as a ``QTable`` (times in ``unit``, distances in au and
+    speeds in au/day for a Quantity system) and the row that stopped it, or None."""
+    from astropy.table import QTable
+
+    from hamilton_orbits.events import ACTIONS, NAMES
+
+    rows = log.recorded() if log is not None else np.zeros((0, 7))
+    actions = {code: name for name, code in ACTIONS.items()}
+    names = list(system.names)
+    bodies = [names[int(i)] if j < 0 else f"{names[int(i)]}-{names[int(j)]}"
+              for i, j in rows[:, 1:3]]
+    table = QTable()
+    table["name"] = [NAMES[int(c)] for c in rows[:, 0]] if len(rows) else np.array([], str)
+    table["time"] = (rows[:, 3] * u.day).to(unit) if system.quantity else rows[:, 3]
+    table["bodies"] = bodies if len(rows) else np.array([], str)
+    table["distance"] = rows[:, 4] * u.au if system.quantity else rows[:, 4]
+    table["speed"] = rows[:, 5] * (u.au / u.day) if system.quantity else rows[:, 5]
+    table["action"] = [actions[int(a)] for a in rows[:, 6]] if len(rows) else np.array([], str)
+    stopped = log.stopped_by if log is not None else None
+    return table, (table[stopped] if stopped is not None else None)

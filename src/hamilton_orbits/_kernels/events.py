@@ -46,10 +46,10 @@ _CODE_ESCAPE = 3
 def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
     """Position and velocity of body ``k`` at ``h`` into ``out`` (6,)."""
     if kind == KEPLER:
-        if mu[k] == 0.0:  # the central body (or a massless centre): at rest
+        if mu[k] == 0.0:  # the central body: at rest at its place in these coordinates
             for c in range(3):
                 out[c] = x0[k, c]
-                out[3 + c] = v0[k, c]
+                out[3 + c] = 0.0
             return
         x, y, z, vx, vy, vz = _kepler.propagate_uv(x0[k, 0], x0[k, 1], x0[k, 2], v0[k, 0],
                                                    v0[k, 1], v0[k, 2], mu[k], h * dt)

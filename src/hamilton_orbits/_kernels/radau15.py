@@ -22,11 +22,14 @@ from fractions import Fraction
 import numpy as np
 from numba import njit, types
 
+from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE
 
 __all__ = [
     "DECIMAL_SPACINGS",
     "NSTATE",
+    "STATUS_DRAIN",
+    "STATUS_EVENT",
     "STATUS_MAXSTEPS",
     "STATUS_NONFINITE",
     "STATUS_OK",
@@ -53,10 +56,15 @@ STATUS_OK = 0
 STATUS_NONFINITE = 1
 STATUS_UNDERFLOW = 2
 STATUS_MAXSTEPS = 3
+#: An event with an action (stop, merge, remove) occurred: the state is at its
+#: time and ``st[8]`` holds its watch row.
+STATUS_EVENT = 4
+#: The event buffer may not hold another step's events: drain it and call again.
+STATUS_DRAIN = 5
 
 #: The integrator state ``st`` that :func:`advance` reads and updates:
-#: ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters, prs23]``.
-NSTATE = 8
+#: ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters, prs23, event_row]``.
+NSTATE = 9
 
 _SAFETY = 0.25  # IAS15's safety factor: reject below a quarter, grow at most 4x
 _EPS = 2.220446049250313e-16
@@ -404,16 +412,39 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
     return min(dt_new, base / _SAFETY), True
 
 
+@njit(cache=True, error_model="numpy")
+def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st):
+    # pragma: no cover - compiled
+    """Scan the accepted step for events; returns the ``h`` of the first event with an
+    action (its watch row in ``st[8]``), or 2 if none."""
+    n = r.shape[0]
+    cm = np.zeros(9)
+    total = 0.0
+    for k in range(n):
+        total += gm[k]
+        for c in range(3):
+            cm[c] += gm[k] * x0[3 * k + c]
+            cm[3 + c] += gm[k] * v0[3 * k + c]
+            cm[6 + c] += gm[k] * r[k, c]
+    for c in range(9):
+        cm[c] /= total
+    h, row = _ev.scan(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
+                      a0, b, gm, cm, ev_out, ev_count)
+    st[8] = row
+    return h
+
+
 @njit(
     types.Tuple((types.int64, types.int64))(
         ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F2, _F1, _F1,
-        types.boolean, types.int64,
+        types.boolean, types.int64, _F2, _F2, types.int64[::1],
     ),
     cache=True,
     error_model="numpy",
 )
 def advance(
-    accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps
+    accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps, watch, ev_out,
+    ev_count,
 ):  # pragma: no cover - compiled
     """Step from ``st[0]`` to ``t_end`` in place; returns ``(steps, status)``.
 
@@ -422,7 +453,10 @@ def advance(
     of IAS15).  ``b, e, br, er, g`` are (7, 3n); ``csx, csv`` the Kahan
     compensations (3n,).  ``r, v`` (n, 3) are updated.  ``status`` is one of the
     ``STATUS_*`` codes; at ``STATUS_MAXSTEPS`` the state is consistent and the
-    call may be repeated to go on.
+    call may be repeated to go on.  ``watch`` (m, 5) are the events to look for
+    after every step on the step's polynomial (:func:`hamilton_orbits._kernels.
+    events.scan`), recorded into ``ev_out`` / ``ev_count``; at ``STATUS_EVENT`` the
+    state is that of the event's time.
     """
     n = r.shape[0]
     m = 3 * n
@@ -440,9 +474,13 @@ def advance(
     have_last = st[5] != 0.0
     steps = 0
     status = STATUS_OK
+    n_watch = watch.shape[0]
     while t < t_end:
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
+            break
+        if n_watch > 0 and ev_count[0] + n_watch > ev_out.shape[0]:
+            status = STATUS_DRAIN
             break
         dt_try = min(dt, t_end - t)
         landing = dt_try == t_end - t
@@ -473,6 +511,19 @@ def advance(
             dt = dt_new
             continue
         _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
+        if n_watch > 0:
+            h_ev = _watch_step(watch, t, dt_try, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st)
+            if h_ev <= 1.0:  # an event with an action: stop the state at its time
+                _ev.state_at(_ev.RADAU, h_ev, dt_try, x0.reshape((n, 3)), v0.reshape((n, 3)),
+                             r, v, a0, b, gm, r, v)
+                csx[:] = 0.0
+                csv[:] = 0.0
+                t = t + h_ev * dt_try
+                t_cs = 0.0
+                have_last = False
+                steps += 1
+                status = STATUS_EVENT
+                break
         if landing:
             t = t_end
             t_cs = 0.0

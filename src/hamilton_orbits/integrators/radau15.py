@@ -43,6 +43,7 @@ import numpy as np
 
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits._validation import ConvergenceError
+from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import _setup, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RADAU_SPACINGS", "run"]
@@ -76,6 +77,7 @@ def run(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     max_steps: int = MAX_STEPS,
     criterion: str = DEFAULT_CRITERION,
+    events: EventLog | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the adaptive 15th-order Gauss-Radau scheme (IAS15-like).
 
@@ -112,6 +114,12 @@ def run(
         end of the step (Pham, Rein & Spiegel 2024, the criterion rebound's
         IAS15 uses by default), which takes about half the steps on eccentric
         orbits at the same energy error.
+    events : EventLog, optional
+        Events to look for after every step on the step's polynomial; an event
+        with an action stops or changes the run at its own time
+        (:mod:`hamilton_orbits.events`).  A stop raises
+        :class:`~hamilton_orbits.events.StopAtEvent` with the output row that
+        holds the state at that time.
 
     Returns
     -------
@@ -151,7 +159,6 @@ def run(
     dt_f, tol_f = _setup.check_dt_tol(dt, tol)
     if dt_f is None and tol_f is None:
         tol_f = DEFAULT_TOL
-    n = r0.shape[0]
     nt = t_out.shape[0]
     r_out, v_out = output_arrays(out, nt, r0, v0)
     if dt_f is None:
@@ -159,35 +166,61 @@ def run(
     span = t_out[-1] - t_out[0]
     if span > 0.0:
         dt_f = min(dt_f, span)
-    m = 3 * n
-    work = [np.zeros((7, m)) for _ in range(5)]  # b, e, br, er, g
-    csx = np.zeros(m)
-    csv = np.zeros(m)
-    st = np.zeros(_k.NSTATE)
-    st[[0, 2, 4, 7]] = t_out[0], dt_f, tol_f or 0.0, float(crit == "prs23")
-    x = np.ascontiguousarray(r0.copy())
-    w = np.ascontiguousarray(v0.copy())
-    need_v = bool(rhs.velocity_dependent)
-    total = 0
-    accel = _setup.accel_arg(rhs.accel)
+    log = events if events is not None else EventLog.none(r0.shape[0])
+    run_ = _Run(rhs, r0, v0, gm.copy(), t_out[0], dt_f, tol_f or 0.0, crit == "prs23", log)
     for i in range(1, nt):
-        while True:  # slices of SLICE steps: Ctrl-C is seen between them
-            steps, status = _k.advance(accel, rhs.p, x, w, gm, t_out[i], st, *work, csx, csv,
-                                       need_v, min(SLICE, max_steps - total))
-            total += steps
-            if status != _k.STATUS_MAXSTEPS:
-                break
-            _check_pace(total, max_steps, float(st[0]), t_out)
-        if status != _k.STATUS_OK:
-            raise ConvergenceError(
-                f"radau15 stopped at t = {float(st[0])!r} before t_out[{i}] = "
-                f"{float(t_out[i])!r}: {_why(status, st, max_steps)}"
-            )
-        r_out[i] = x
-        v_out[i] = w
+        stop = run_.advance_to(t_out, i, max_steps)
+        r_out[i] = run_.x
+        v_out[i] = run_.w
+        r_out[i, log.inactive] = np.nan
+        v_out[i, log.inactive] = np.nan
+        if stop:
+            raise StopAtEvent(i, float(run_.st[0]), run_.total)
         if on_output is not None:
-            on_output(i, total)
-    return r_out, v_out, total
+            on_output(i, run_.total)
+    return r_out, v_out, run_.total
+
+
+class _Run:
+    """The integrator's state between compiled calls (see :func:`run`)."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 dt: float, tol: float, prs23: bool, log: EventLog) -> None:
+        m = 3 * r0.shape[0]
+        self.rhs, self.gm, self.log = rhs, gm, log
+        self.accel = _setup.accel_arg(rhs.accel)
+        self.work = [np.zeros((7, m)) for _ in range(5)]  # b, e, br, er, g
+        self.csx = np.zeros(m)
+        self.csv = np.zeros(m)
+        self.st = np.zeros(_k.NSTATE)
+        self.st[[0, 2, 4, 7]] = t0, dt, tol, float(prs23)
+        self.x = np.ascontiguousarray(r0.copy())
+        self.w = np.ascontiguousarray(v0.copy())
+        self.total = 0
+
+    def advance_to(self, t_out: np.ndarray, i: int, max_steps: int) -> bool:
+        """Step to ``t_out[i]`` in slices; True if an event stopped the run."""
+        log = self.log
+        while True:  # slices of SLICE steps: Ctrl-C is seen between them
+            steps, status = _k.advance(
+                self.accel, self.rhs.p, self.x, self.w, self.gm, t_out[i], self.st, *self.work,
+                self.csx, self.csv, bool(self.rhs.velocity_dependent),
+                min(SLICE, max_steps - self.total), log.watch, log.buffer, log.count)
+            self.total += steps
+            if status == _k.STATUS_MAXSTEPS:
+                _check_pace(self.total, max_steps, float(self.st[0]), t_out)
+            elif status == _k.STATUS_DRAIN:
+                log.drain()
+            elif status == _k.STATUS_EVENT:
+                if log.act(int(self.st[8]), float(self.st[0]), self.x, self.w, self.gm):
+                    return True
+            elif status == _k.STATUS_OK:
+                return False
+            else:
+                raise ConvergenceError(
+                    f"radau15 stopped at t = {float(self.st[0])!r} before t_out[{i}] = "
+                    f"{float(t_out[i])!r}: {_why(status, self.st, max_steps)}"
+                )
 
 
 def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None:
