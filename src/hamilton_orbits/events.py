@@ -320,6 +320,9 @@ class EventLog:
         self.stopped_by: int | None = None
         self.inactive = np.zeros(len(self.radius), dtype=bool)
         self.gm_changes: list[tuple[float, np.ndarray]] = []
+        #: The kernel's body index -> the system's (a driver that reorders bodies
+        #: sets it, and passes :meth:`kernel_watch` to its kernel).
+        self.index_map: np.ndarray | None = None
 
     @classmethod
     def none(cls, n: int) -> EventLog:
@@ -329,8 +332,24 @@ class EventLog:
     def drain(self) -> None:
         """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""
         k = int(self.count[0])
-        self.rows.extend(self.buffer[:k].copy())
+        rows = self.buffer[:k].copy()
+        if self.index_map is not None:
+            rows[:, E_I] = self.index_map[rows[:, E_I].astype(int)]
+            pair = rows[:, E_J] >= 0
+            rows[pair, E_J] = self.index_map[rows[pair, E_J].astype(int)]
+        self.rows.extend(rows)
         self.count[0] = 0
+
+    def kernel_watch(self) -> np.ndarray:
+        """:attr:`watch` with the bodies numbered as the kernel numbers them."""
+        if self.index_map is None:
+            return self.watch
+        back = np.argsort(self.index_map)
+        w = self.watch.copy()
+        w[:, W_I] = back[w[:, W_I].astype(int)]
+        pair = w[:, W_J] >= 0
+        w[pair, W_J] = back[w[pair, W_J].astype(int)]
+        return np.ascontiguousarray(w)
 
     def recorded(self) -> np.ndarray:
         """Every recorded row, shape (k, 7)."""

@@ -11,7 +11,10 @@ interpolant of the motion:
   (a Wisdom-Holman drift in heliocentric coordinates; the central body at rest
   at the origin);
 - ``HERMITE``: the cubic Hermite interpolant of the positions and velocities at
-  both ends (the generic case).
+  both ends (the generic case);
+- ``JACOBI``: Jacobi coordinates on their Kepler arcs about ``mu = eta`` (the
+  partial sums of ``G m``; row 0 the barycentre in uniform motion), turned into
+  inertial positions (a Wisdom-Holman drift in Jacobi coordinates).
 
 A closest approach is a root of ``f(h) = d . w`` (``d``, ``w`` the relative
 position and velocity) where ``f`` goes from negative to non-negative; a contact a
@@ -30,12 +33,13 @@ from numba import njit
 
 from hamilton_orbits._kernels import kepler as _kepler
 
-__all__ = ["HERMITE", "KEPLER", "LINE", "RADAU", "scan"]
+__all__ = ["HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_steps", "state_at"]
 
 RADAU = 0
 LINE = 1
 KEPLER = 2
 HERMITE = 3
+JACOBI = 4
 
 _CODE_ENCOUNTER = 1
 _CODE_COLLISION = 2
@@ -45,6 +49,9 @@ _CODE_ESCAPE = 3
 @njit(cache=True, error_model="numpy")
 def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
     """Position and velocity of body ``k`` at ``h`` into ``out`` (6,)."""
+    if kind == JACOBI:
+        _jacobi_state(k, h * dt, x0, v0, mu, out)
+        return
     if kind == KEPLER:
         if mu[k] == 0.0:  # the central body: at rest at its place in these coordinates
             for c in range(3):
@@ -76,6 +83,40 @@ def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover 
                       + (3.0 * h2 - 2.0 * h3) * x1[k, c] + (h3 - h2) * dt * v1[k, c])
             out[3 + c] = ((6.0 * h2 - 6.0 * h) * (x0[k, c] - x1[k, c]) / dt
                           + (3.0 * h2 - 4.0 * h + 1.0) * v0[k, c] + (3.0 * h2 - 2.0 * h) * v1[k, c])
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobi_state(k, tau, qj, uj, eta, out):  # pragma: no cover - compiled
+    """Inertial position and velocity of body ``k`` after every Jacobi coordinate has
+    moved ``tau`` on its Kepler arc (``eta`` the partial sums of ``G m``, row 0 the
+    barycentre moving uniformly): ``r_k = qj_k + S_(k-1) / eta_(k-1)`` with the
+    partial centres of mass ``S`` unwound from the total down."""
+    n = qj.shape[0]
+    q = np.empty((n, 3))
+    u = np.empty((n, 3))
+    for m in range(n):
+        if m == 0:
+            for c in range(3):
+                q[0, c] = qj[0, c] + tau * uj[0, c]
+                u[0, c] = uj[0, c]
+            continue
+        x, y, z, vx, vy, vz = _kepler.propagate_uv(qj[m, 0], qj[m, 1], qj[m, 2], uj[m, 0],
+                                                   uj[m, 1], uj[m, 2], eta[m], tau)
+        q[m, 0], q[m, 1], q[m, 2], u[m, 0], u[m, 1], u[m, 2] = x, y, z, vx, vy, vz
+    for c in range(3):
+        sx = eta[n - 1] * q[0, c]  # the total centre of mass times the total mass
+        sv = eta[n - 1] * u[0, c]
+        for m in range(n - 1, k, -1):
+            g = eta[m] - eta[m - 1]
+            sx = (sx - g * q[m, c]) * (eta[m - 1] / eta[m])
+            sv = (sv - g * u[m, c]) * (eta[m - 1] / eta[m])
+        if k == 0:
+            out[c] = sx / eta[0]
+            out[3 + c] = sv / eta[0]
+        else:
+            g = eta[k] - eta[k - 1]
+            out[c] = q[k, c] + (sx - g * q[k, c]) * (eta[k - 1] / eta[k]) / eta[k - 1]
+            out[3 + c] = u[k, c] + (sv - g * u[k, c]) * (eta[k - 1] / eta[k]) / eta[k - 1]
 
 
 @njit(cache=True, error_model="numpy")
@@ -199,3 +240,32 @@ def state_at(kind, h, dt, x0, v0, x1, v1, a0, b, mu, r, v):  # pragma: no cover 
         for c in range(3):
             r[k, c] = s[c]
             v[k, c] = s[3 + c]
+
+
+@njit(cache=True, error_model="numpy")
+def scan_steps(watch, ts, xs, vs, gm, out, count):  # pragma: no cover - compiled
+    """:func:`scan` with the ``HERMITE`` interpolant over consecutive step states
+    ``xs``, ``vs`` (k+1, n, 3) at times ``ts`` (k+1,).  Returns ``(step, h, row)`` of
+    the first event with an action (``step = -1``: none); ``step = -2``: the
+    buffer filled up at ``ts[h]`` (drain it and scan again from there)."""
+    n = xs.shape[1]
+    no_a0 = np.zeros(1)
+    no_b = np.zeros((7, 1))
+    cm = np.zeros(9)
+    total = 0.0
+    for k in range(n):
+        total += gm[k]
+    for s in range(ts.shape[0] - 1):
+        if count[0] + watch.shape[0] > out.shape[0]:
+            return -2, float(s), -1
+        cm[:] = 0.0
+        for k in range(n):
+            for c in range(3):
+                cm[c] += gm[k] * xs[s, k, c] / total
+                cm[3 + c] += gm[k] * vs[s, k, c] / total
+                cm[6 + c] += gm[k] * xs[s + 1, k, c] / total
+        h, row = scan(watch, HERMITE, ts[s], ts[s + 1] - ts[s], xs[s], vs[s], xs[s + 1],
+                      vs[s + 1], no_a0, no_b, gm, cm, out, count)
+        if row >= 0:
+            return s, h, row
+    return -1, 2.0, -1

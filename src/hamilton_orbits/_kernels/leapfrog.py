@@ -6,32 +6,82 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
+from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
 
-__all__ = ["advance"]
+__all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "advance"]
+
+STATUS_OK = 0
+STATUS_EVENT = 4
+STATUS_DRAIN = 5
+
+_NO_A0 = np.zeros(1)
+_NO_B = np.zeros((7, 1))
+
+
+@njit(cache=True, error_model="numpy")
+def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no cover - compiled
+    """``r += h v``; with events watched, the straight segment is scanned (``ws``:
+    the time and watch row of the first event with an action, see
+    :func:`hamilton_orbits._kernels.wh._drift`)."""
+    n = r.shape[0]
+    n_watch = watch.shape[0]
+    if n_watch > 0:
+        for i in range(n):
+            for k in range(3):
+                x0[i, k] = r[i, k]
+    for i in range(n):
+        for k in range(3):
+            r[i, k] += h * v[i, k]
+    if n_watch > 0:
+        cm = np.zeros(9)
+        total = 0.0
+        for i in range(n):
+            total += cm_gm[i]
+            for k in range(3):
+                cm[k] += cm_gm[i] * x0[i, k]
+                cm[3 + k] += cm_gm[i] * v[i, k]
+                cm[6 + k] += cm_gm[i] * r[i, k]
+        for c in range(9):
+            cm[c] /= total
+        hh, row = _ev.scan(watch, _ev.LINE, t, h, x0, v, r, v, _NO_A0, _NO_B, cm_gm, cm, ev_out,
+                           ev_count)
+        if row >= 0 and t + hh * h < ws[1]:
+            ws[1] = t + hh * h
+            ws[3] = row
+        if ev_count[0] + 2 * n_watch > ev_out.shape[0]:
+            ws[2] = 1.0
 
 
 # explicit signature with ``accel`` as a first-class function type: compiled once
 # and loaded from the cache in later processes, whatever the right-hand side
-@njit(types.int64(ACCEL_TYPE, F1, F2, F2, F1, types.float64, types.float64, types.float64),
-      cache=True, error_model="numpy")
-def advance(accel, p, r, v, gm, t0, t1, dt):  # pragma: no cover - compiled
+@njit(types.Tuple((types.int64, types.int64))(
+    ACCEL_TYPE, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
+    types.int64[::1], F1), cache=True, error_model="numpy")
+def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws):
+    # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.
-    Returns the number of steps."""
+    Returns ``(steps, status)``; at ``STATUS_EVENT`` (an event with an action) or
+    ``STATUS_DRAIN`` the run stopped at the end of step ``steps``, the time in
+    ``ws[0]``.  Events are scanned on both straight drifts of every step."""
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
     if n_steps < 1:
         n_steps = 1
     h = (t1 - t0) / n_steps
     acc = np.empty_like(r)
+    x0 = np.empty_like(r)
     n = r.shape[0]
-    for _ in range(n_steps):
-        for i in range(n):
-            for k in range(3):
-                r[i, k] += 0.5 * h * v[i, k]
+    for s in range(n_steps):
+        t = t0 + s * h
+        _drift(r, v, 0.5 * h, t, watch, ev_out, ev_count, ws, x0, gm)
         accel(r, v, gm, acc, p)
         for i in range(n):
             for k in range(3):
                 v[i, k] += h * acc[i, k]
-                r[i, k] += 0.5 * h * v[i, k]
-    return n_steps
+        _drift(r, v, 0.5 * h, t + 0.5 * h, watch, ev_out, ev_count, ws, x0, gm)
+        if ws[1] <= t0 + (s + 1) * h or ws[2] > 0.0:
+            ws[0] = t0 + (s + 1) * h
+            return s + 1, STATUS_EVENT if ws[1] <= ws[0] else STATUS_DRAIN
+    ws[0] = t1
+    return n_steps, STATUS_OK

@@ -15,11 +15,15 @@ import math
 import numpy as np
 from numba import njit, types
 
+from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
 
 __all__ = [
+    "STATUS_DRAIN",
+    "STATUS_EVENT",
+    "STATUS_OK",
     "advance_dh",
     "advance_jacobi",
     "corrector_jacobi",
@@ -67,93 +71,139 @@ def _jump(q, u, gm, tau):  # pragma: no cover - compiled
         q[i, 2] += f * pz
 
 
-@njit(
-    types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE,
-        F1,
-        types.boolean,
-        F2,
-        F2,
-        F1,
-        F1,
-        F1,
-        types.float64,
-        types.int64,
-        types.float64,
-    ),
-    cache=True,
-    error_model="numpy",
-)
-def advance_dh(
-    extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last
-):  # pragma: no cover - compiled
-    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
-    coordinates, in place.  ``q``, ``u``: heliocentric positions and
-    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
-    ``com``: barycentre position and velocity (6,).  Returns ``(steps, bad)``
-    with ``bad`` the index of a body whose Kepler step failed, else -1."""
-    n = q.shape[0]
-    gm0 = gm[0]
-    acc = np.empty((n, 3))
-    r_in = np.empty((n, 3))
-    v_in = np.empty((n, 3))
-    acc_x = np.empty((n, 3))
-    m_tot = 0.0
-    for i in range(n):
-        m_tot += gm[i]
-    # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
-    # row 0 (unused here) is left out of the interaction
-    idx = _nbody.massive_indices(gm_p)
-    mu = np.full(n, gm0)
-    h = dt if n_steps > 1 else dt_last
-    bad = _kepler_all(q, u, mu, 0.5 * h)
-    if bad >= 0:
-        return 0, bad
-    for k in range(3):
-        com[k] += 0.5 * h * com[3 + k]
-    for s in range(n_steps):
-        h = dt if s < n_steps - 1 else dt_last
-        _jump(q, u, gm, 0.5 * h)
-        _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
-        for i in range(1, n):
-            for k in range(3):
-                u[i, k] += h * acc[i, k]
-        if has_extra:
-            # inertial state for the effects: r_0 = R - sum m_i Q_i / M
-            for k in range(3):
-                s_q = 0.0
-                s_u = 0.0
-                for i in range(1, n):
-                    s_q += gm[i] * q[i, k]
-                    s_u += gm[i] * u[i, k]
-                r_in[0, k] = com[k] - s_q / m_tot
-                v_in[0, k] = com[3 + k] - s_u / gm0
-                for i in range(1, n):
-                    r_in[i, k] = q[i, k] + r_in[0, k]
-                    v_in[i, k] = u[i, k] + com[3 + k]
-                for i in range(n):
-                    acc_x[i, k] = 0.0
-            extra(r_in, v_in, gm, acc_x, p)
-            for k in range(3):
-                a_cm = 0.0
-                for i in range(n):
-                    a_cm += gm[i] * acc_x[i, k]
-                a_cm /= m_tot
-                com[3 + k] += h * a_cm
-                for i in range(1, n):
-                    u[i, k] += h * (acc_x[i, k] - a_cm)
-        _jump(q, u, gm, 0.5 * h)
-        if s < n_steps - 1:
-            h_next = dt if s + 1 < n_steps - 1 else dt_last
-            tau = 0.5 * (h + h_next)
-        else:
-            tau = 0.5 * h
-        bad = _kepler_all(q, u, mu, tau)
-        if bad >= 0:
-            return s, bad
+#: Statuses of the stepping kernels (as radau15's): done, an event with an action
+#: occurred (the state is at the end of the step it occurred in), or the event
+#: buffer needs draining (the state is at a step end).
+STATUS_OK = 0
+STATUS_EVENT = 4
+STATUS_DRAIN = 5
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _drift(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
+    # pragma: no cover - compiled
+    """One Kepler drift of ``tau`` with the barycentre; with events watched, the
+    drift is scanned on the Kepler arcs themselves (heliocentric, or Jacobi turned
+    into inertial positions): exact for the drift.  ``ws = [t, t_action, drain,
+    row]``: the drift's start time (advanced here), the time and watch row of the
+    first event with an action, and whether the buffer must be drained.  Returns a
+    failing body or -1."""
+    if watch.shape[0] > 0:
+        return _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0,
+                              mu_s)
+    bad = _kepler_all(q, u, mu, tau)
+    if jacobi:
+        for k in range(3):
+            q[0, k] += tau * u[0, k]
+    else:
         for k in range(3):
             com[k] += tau * com[3 + k]
-    return n_steps, -1
+    ws[0] += tau
+    return bad
+
+
+@njit(cache=True, error_model="numpy")
+def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
+    # pragma: no cover - compiled
+    """:func:`_drift` with its events scanned."""
+    n_watch = watch.shape[0]
+    _copy(q, u, x0, v0)
+    bad = _kepler_all(q, u, mu, tau)
+    for k in range(3):
+        if jacobi:
+            q[0, k] += tau * u[0, k]
+        else:
+            com[k] += tau * com[3 + k]
+    if bad < 0:
+        cm = np.zeros(9)  # escapes: from the central body (heliocentric) ...
+        if jacobi:  # ... or from the barycentre, Jacobi row 0
+            for k in range(3):
+                cm[k], cm[3 + k], cm[6 + k] = x0[0, k], v0[0, k], q[0, k]
+        h, row = _ev.scan(watch, _ev.JACOBI if jacobi else _ev.KEPLER, ws[0], tau, x0, v0, q,
+                          u, _NO_A0, _NO_B, mu_s, cm, ev_out, ev_count)
+        if row >= 0 and ws[0] + h * tau < ws[1]:
+            ws[1] = ws[0] + h * tau
+            ws[3] = row
+        if ev_count[0] + 2 * n_watch > ev_out.shape[0]:
+            ws[2] = 1.0
+    ws[0] += tau
+    return bad
+
+
+_NO_A0 = np.zeros(1)
+_NO_B = np.zeros((7, 1))
+_ORIGIN = np.zeros(9)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _copy(q, u, x, v):  # pragma: no cover - compiled
+    """The drift's start state, kept for the scan."""
+    for i in range(q.shape[0]):
+        for k in range(3):
+            x[i, k] = q[i, k]
+            v[i, k] = u[i, k]
+
+
+@njit(cache=True, error_model="numpy")
+def _stop_here(q, u, mu, h_back, jacobi, com, ws, t_end_step, ev_out, ev_count):
+    # pragma: no cover - compiled
+    """After a merged drift, go back ``h_back`` (exact: Kepler drifts reverse) to the
+    end of the step, and forget the events the scan found beyond it (the next
+    call finds them again).  Returns the status to report."""
+    _kepler_all(q, u, mu, -h_back)
+    for k in range(3):
+        if jacobi:
+            q[0, k] -= h_back * u[0, k]
+        else:
+            com[k] -= h_back * com[3 + k]
+    ws[0] -= h_back
+    kept = 0
+    for e in range(ev_count[0]):
+        if ev_out[e, 3] <= t_end_step:
+            for c in range(ev_out.shape[1]):
+                ev_out[kept, c] = ev_out[e, c]
+            kept += 1
+    ev_count[0] = kept
+    return STATUS_EVENT if ws[1] <= t_end_step else STATUS_DRAIN
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x):
+    # pragma: no cover - compiled
+    """Jump h/2, the interaction kick h (and the listed effects, whose net force
+    moves the barycentre), jump h/2."""
+    n = q.shape[0]
+    gm0 = gm[0]
+    _jump(q, u, gm, 0.5 * h)
+    _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
+    for i in range(1, n):
+        for k in range(3):
+            u[i, k] += h * acc[i, k]
+    if has_extra:
+        # inertial state for the effects: r_0 = R - sum m_i Q_i / M
+        for k in range(3):
+            s_q = 0.0
+            s_u = 0.0
+            for i in range(1, n):
+                s_q += gm[i] * q[i, k]
+                s_u += gm[i] * u[i, k]
+            r_in[0, k] = com[k] - s_q / m_tot
+            v_in[0, k] = com[3 + k] - s_u / gm0
+            for i in range(1, n):
+                r_in[i, k] = q[i, k] + r_in[0, k]
+                v_in[i, k] = u[i, k] + com[3 + k]
+            for i in range(n):
+                acc_x[i, k] = 0.0
+        extra(r_in, v_in, gm, acc_x, p)
+        for k in range(3):
+            a_cm = 0.0
+            for i in range(n):
+                a_cm += gm[i] * acc_x[i, k]
+            a_cm /= m_tot
+            com[3 + k] += h * a_cm
+            for i in range(1, n):
+                u[i, k] += h * (acc_x[i, k] - a_cm)
+    _jump(q, u, gm, 0.5 * h)
 
 
 @njit(cache=True, error_model="numpy")
@@ -293,24 +343,73 @@ def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma:
     return -1
 
 
+_EVENT_ARGS = (F2, F2, types.int64[::1], F1)
+
+
 @njit(
-    types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE,
-        F1,
-        types.boolean,
-        F2,
-        F2,
-        F1,
-        F1,
-        types.float64,
-        types.int64,
-        types.float64,
+    types.Tuple((types.int64, types.int64, types.int64))(
+        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, F1, types.float64, types.int64,
+        types.float64, *_EVENT_ARGS,
+    ),
+    cache=True,
+    error_model="numpy",
+)
+def advance_dh(
+    extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+):  # pragma: no cover - compiled
+    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
+    coordinates, in place.  ``q``, ``u``: heliocentric positions and
+    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
+    ``com``: barycentre position and velocity (6,).  ``watch``, ``ev_out``,
+    ``ev_count``, ``ws``: the events (see :func:`_drift`; ``ws[0]`` the start
+    time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
+    whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
+    state is synchronised at the end of step ``steps``."""
+    n = q.shape[0]
+    acc = np.empty((n, 3))
+    r_in = np.empty((n, 3))
+    v_in = np.empty((n, 3))
+    acc_x = np.empty((n, 3))
+    x0, v0 = np.empty((n, 3)), np.empty((n, 3))
+    m_tot = 0.0
+    for i in range(n):
+        m_tot += gm[i]
+    # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
+    # row 0 (unused here) is left out of the interaction
+    idx = _nbody.massive_indices(gm_p)
+    mu = np.full(n, gm[0])
+    mu_s = mu.copy()
+    mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
+    t_step = ws[0]
+    h = dt if n_steps > 1 else dt_last
+    bad = _drift(q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0, mu_s)
+    if bad >= 0:
+        return 0, bad, STATUS_OK
+    for s in range(n_steps):
+        h = dt if s < n_steps - 1 else dt_last
+        _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x)
+        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+        bad = _drift(q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count, ws,
+                     x0, v0, mu_s)
+        if bad >= 0:
+            return s, bad, STATUS_OK
+        t_step += h
+        if ws[1] <= t_step or ws[2] > 0.0:
+            return s + 1, -1, _stop_here(q, u, mu, 0.5 * h_next, False, com, ws, t_step,
+                                         ev_out, ev_count)
+    return n_steps, -1, STATUS_OK
+
+
+@njit(
+    types.Tuple((types.int64, types.int64, types.int64))(
+        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
+        types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_jacobi(
-    extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last
+    extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
 ):  # pragma: no cover - compiled
     """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
     ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
@@ -323,28 +422,27 @@ def advance_jacobi(
     acc_x = np.empty((n, 3))
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
+    x0, v0 = np.empty((n, 3)), np.empty((n, 3))
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
+    t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
-    bad = _kepler_all(qj, uj, eta, 0.5 * h)
+    bad = _drift(qj, uj, eta, 0.5 * h, True, eta, watch, ev_out, ev_count, ws, x0, v0, eta)
     if bad >= 0:
-        return 0, bad
-    for k in range(3):
-        qj[0, k] += 0.5 * h * uj[0, k]
+        return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
         _kick_jacobi(
             extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
             acc, accj, acc_x, r_in, v_in,
         )
-        if s < n_steps - 1:
-            h_next = dt if s + 1 < n_steps - 1 else dt_last
-            tau = 0.5 * (h + h_next)
-        else:
-            tau = 0.5 * h
-        bad = _kepler_all(qj, uj, eta, tau)
+        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+        bad = _drift(qj, uj, eta, 0.5 * (h + h_next), True, eta, watch, ev_out, ev_count, ws,
+                     x0, v0, eta)
         if bad >= 0:
-            return s, bad
-        for k in range(3):
-            qj[0, k] += tau * uj[0, k]
-    return n_steps, -1
+            return s, bad, STATUS_OK
+        t_step += h
+        if ws[1] <= t_step or ws[2] > 0.0:
+            return s + 1, -1, _stop_here(qj, uj, eta, 0.5 * h_next, True, eta, ws, t_step,
+                                         ev_out, ev_count)
+    return n_steps, -1, STATUS_OK

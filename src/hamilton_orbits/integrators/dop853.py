@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._kernels import events as _ev
+from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import output_arrays
 
 NAME = "dop853"
@@ -37,8 +39,13 @@ def run(
     tol: float | None = None,
     on_output: Callable[[int, int], None] | None = None,
     out: tuple[np.ndarray, np.ndarray] | None = None,
+    events: EventLog | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with scipy's DOP853; see :mod:`hamilton_orbits.integrators`.
+
+    ``events`` (:mod:`hamilton_orbits.events`) are looked for in every step on the
+    cubic Hermite interpolant of the step's ends; actions take effect at the
+    event's time (the integration restarts there).
 
     Examples
     --------
@@ -53,6 +60,7 @@ def run(
     # scipy refuses rtol below 100 eps (with a warning); that is DOP853's floor here
     tol = max(DEFAULT_TOL if tol is None else float(tol), RTOL_FLOOR)
     n = r0.shape[0]
+    gm = np.array(gm, dtype=np.float64)  # merges change it
     accel = rhs.accel
     acc = np.empty((n, 3))
     p = rhs.p
@@ -73,9 +81,66 @@ def run(
         if on_output is not None:
             on_output(i, steps)
 
-    _, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol,
-                        max_step=np.inf if dt is None else float(dt), on_state=store)
+    max_step = np.inf if dt is None else float(dt)
+    if events is not None and len(events.watch):
+        steps = _run_with_events(f, y0, t_out, tol, atol, max_step, events, gm, store)
+    else:
+        _, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol, max_step=max_step,
+                            on_state=store)
     return r_out, v_out, steps
+
+
+def _run_with_events(f: Callable, y0: np.ndarray, t_out: np.ndarray, tol: float,
+                     atol: np.ndarray, max_step: float, log: EventLog, gm: np.ndarray,
+                     store: Callable[[int, int, np.ndarray], None]) -> int:
+    """DOP853 step by step (scipy's stepper, as ``solve_ivp`` drives it) with every
+    step scanned for events on the cubic Hermite interpolant of its ends, before
+    the next is taken; an event with an action restarts the integration at its
+    time (or stops the run there)."""
+    from scipy.integrate import DOP853
+
+    n = gm.shape[0]
+    y = np.asarray(y0, dtype=np.float64)
+    t = float(t_out[0])
+    steps = 0
+    for i in range(1, len(t_out)):
+        solver = DOP853(f, t, y, float(t_out[i]), rtol=tol, atol=atol, max_step=max_step)
+        while solver.status == "running":
+            t_prev, y_prev = solver.t, solver.y.copy()
+            if solver.step() is not None:
+                raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
+            steps += 1
+            if log.count[0] + len(log.watch) > log.buffer.shape[0]:
+                log.drain()
+            xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n].reshape(2, n, 3))
+            vs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, 3 * n :].reshape(2, n, 3))
+            k, h, row = _ev.scan_steps(log.watch, np.array([t_prev, solver.t]), xs, vs, gm,
+                                       log.buffer, log.count)
+            if k < 0:
+                continue
+            r, v = np.empty((n, 3)), np.empty((n, 3))
+            _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
+                         np.zeros(1), np.zeros((7, 1)), gm, r, v)
+            t = float(t_prev + h * (solver.t - t_prev))
+            stop = log.act(int(row), t, r, v, gm)
+            y = np.concatenate((r.ravel(), v.ravel()))
+            if stop:
+                store(i, steps, _nan_inactive(y, log, n))
+                raise StopAtEvent(i, t, steps)
+            solver = DOP853(f, t, y, float(t_out[i]), rtol=tol, atol=atol, max_step=max_step)
+        t, y = float(t_out[i]), solver.y.copy()
+        store(i, steps, _nan_inactive(y, log, n))
+    return steps
+
+
+def _nan_inactive(y: np.ndarray, log: EventLog, n: int) -> np.ndarray:
+    """The state with the bodies taken out of the run as NaN (for the outputs)."""
+    y = y.copy()
+    gone = np.flatnonzero(log.inactive)
+    for k in (0, 3 * n):
+        for c in range(3):
+            y[k + 3 * gone + c] = np.nan
+    return y
 
 
 #: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.

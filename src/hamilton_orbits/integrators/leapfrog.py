@@ -15,6 +15,7 @@ import numpy as np
 
 from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import output_arrays
 from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
 
@@ -47,11 +48,14 @@ def run(
     on_output: Callable[[int, int], None] | None = None,
     out: tuple[np.ndarray, np.ndarray] | None = None,
     max_steps: int = MAX_FIXED_STEPS,
+    events: EventLog | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
 
     ``max_steps`` bounds the steps of the whole run; more are refused before the
-    run starts (``ValueError``).
+    run starts (``ValueError``).  ``events`` (:mod:`hamilton_orbits.events`) are
+    looked for on both straight drifts of every step, exactly for the map's own
+    motion; actions take effect at the end of the step.
 
     Examples
     --------
@@ -74,10 +78,28 @@ def run(
     out_r, out_v = output_arrays(out, len(t_out), r, v)
     steps = 0
     accel = accel_arg(rhs.accel)
+    gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
+    log = events if events is not None else EventLog.none(r.shape[0])
     for i in range(1, len(t_out)):
-        steps += int(_k.advance(accel, rhs.p, r, v, gm, float(t_out[i - 1]), float(t_out[i]), dt))
+        t = float(t_out[i - 1])
+        while t < t_out[i]:
+            ws = np.array([t, np.inf, 0.0, -1.0])
+            done, status = _k.advance(accel, rhs.p, r, v, gm, t, float(t_out[i]), dt,
+                                      log.watch, log.buffer, log.count, ws)
+            steps += int(done)
+            t = float(ws[0])
+            if status == _k.STATUS_OK:
+                break  # t is t_out[i], exactly
+            log.drain()
+            if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, gm):
+                out_r[i], out_v[i] = r, v
+                out_r[i, log.inactive] = np.nan
+                out_v[i, log.inactive] = np.nan
+                raise StopAtEvent(i, t, steps)
         out_r[i] = r
         out_v[i] = v
+        out_r[i, log.inactive] = np.nan
+        out_v[i, log.inactive] = np.nan
         if on_output is not None:
             on_output(i, steps)
     return out_r, out_v, steps

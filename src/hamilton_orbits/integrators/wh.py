@@ -46,6 +46,7 @@ import numpy as np
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
+from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import _setup, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
@@ -102,6 +103,7 @@ def run(
     coordinates: str = "democratic_heliocentric",
     corrector: int = 0,
     max_steps: int = _setup.MAX_FIXED_STEPS,
+    events: EventLog | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -137,6 +139,11 @@ def run(
     max_steps : int, optional
         A bound on the steps of the whole run; more are refused before the run
         starts (``ValueError``).
+    events : EventLog, optional
+        Events to look for in every drift: on the Kepler arcs themselves
+        (democratic heliocentric; escapes measured from the central body) or on
+        the Hermite interpolant of the inertial states (Jacobi).  Actions take
+        effect at the end of the step the event occurred in.
 
     Returns
     -------
@@ -177,8 +184,11 @@ def run(
     _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
     n = r0.shape[0]
     order = np.concatenate([[c], np.delete(np.arange(n), c)])  # the central body first
-    split = _Split(np.ascontiguousarray(gm[order]), coordinates == "jacobi", corrector,
-                   _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects),
+    extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
+    gm = gm.copy()
+    log = events if events is not None else EventLog.none(n)
+    log.index_map = order
+    split = _Split(np.ascontiguousarray(gm[order]), coordinates == "jacobi", corrector, extra,
                    rhs.p, rhs.extra is not None)
     q, u = split.to_coordinates(r0[order], v0[order])
     nt = t_out.shape[0]
@@ -188,19 +198,44 @@ def run(
     for i in range(1, nt):
         span = t_out[i] - t_out[i - 1]
         n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
-        steps, bad = split.advance(q, u, dt_f, n_steps, span - (n_steps - 1) * dt_f)
-        total += steps
-        if bad >= 0:
-            raise ConvergenceError(
-                f"wh: the Kepler step of body {int(order[bad])} failed between "
-                f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = {float(t_out[i])!r}"
-            )
+        last = span - (n_steps - 1) * dt_f
+        done = 0
+        while done < n_steps:
+            ws = np.array([t_out[i - 1] + done * dt_f, np.inf, 0.0, -1.0])
+            steps, bad, status = split.advance(q, u, dt_f, n_steps - done, last,
+                                               log.kernel_watch(), log.buffer, log.count, ws)
+            done += steps
+            total += steps
+            if bad >= 0:
+                raise ConvergenceError(
+                    f"wh: the Kepler step of body {int(order[bad])} failed between "
+                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                    f"{float(t_out[i])!r}")
+            if status == _k.STATUS_DRAIN:
+                log.drain()
+            elif status == _k.STATUS_EVENT:
+                rr, vv = split.to_inertial(q, u)
+                r_now, v_now = rr[inv], vv[inv]
+                if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
+                    r_out[i], v_out[i] = _masked(r_now, v_now, log)
+                    raise StopAtEvent(i, float(ws[0]), total)
+                split = _Split(np.ascontiguousarray(gm[order]), split.jacobi, corrector, extra,
+                               rhs.p, rhs.extra is not None)
+                q, u = split.to_coordinates(r_now[order], v_now[order])
         rr, vv = split.to_inertial(q, u)
-        r_out[i] = rr[inv]
-        v_out[i] = vv[inv]
+        r_out[i], v_out[i] = _masked(rr[inv], vv[inv], log)
         if on_output is not None:
             on_output(i, total)
     return r_out, v_out, total
+
+
+def _masked(r: np.ndarray, v: np.ndarray, log: EventLog) -> tuple[np.ndarray, np.ndarray]:
+    """The state with the bodies taken out of the run as NaN."""
+    r = r.copy()
+    v = v.copy()
+    r[log.inactive] = np.nan
+    v[log.inactive] = np.nan
+    return r, v
 
 
 def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int):
@@ -258,19 +293,22 @@ class _Split:
         self.com = np.concatenate([(g @ r) / self.m_tot, (g @ v) / self.m_tot])
         return np.ascontiguousarray(r - r[0]), np.ascontiguousarray(v - self.com[3:])
 
-    def advance(self, q, u, dt, n_steps, last) -> tuple[int, int]:
-        """``n_steps`` steps (the last of length ``last``); ``(steps, bad body or -1)``."""
+    def advance(self, q, u, dt, n_steps, last, watch, ev_out, ev_count, ws
+                ) -> tuple[int, int, int]:
+        """``n_steps`` steps (the last of length ``last``), in true coordinates at both
+        ends (the corrector applied around them); ``(steps, bad body or -1, status)``."""
+        ev = (watch, ev_out, ev_count, ws)
         if not self.jacobi:
             return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.g_p,
-                                 self.com, dt, n_steps, last)
+                                 self.com, dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
         bad = _k.corrector_jacobi(*args, dt, 1.0) if self.corrector else -1
-        steps = 0
+        steps, status = 0, _k.STATUS_OK
         if bad < 0:
-            steps, bad = _k.advance_jacobi(*args, dt, n_steps, last)
+            steps, bad, status = _k.advance_jacobi(*args, dt, n_steps, last, *ev)
         if bad < 0 and self.corrector:
             bad = _k.corrector_jacobi(*args, dt, -1.0)
-        return steps, bad
+        return steps, bad, status
 
     def to_inertial(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Inertial positions and velocities (central body first)."""
