@@ -18,7 +18,8 @@ What each finds
     ``bodies``, every pair with at least one massive body is watched.  A
     ``{"hill": k}`` distance is ``k`` Hill radii of the more massive body of the
     pair about the most massive body of the system, ``a (m / 3 M)^(1/3)`` with
-    ``a`` its initial osculating semi-major axis.
+    ``a`` its initial osculating semi-major axis (pairs with the most massive body
+    itself are then not watched).
 ``collision``
     The first contact of two bodies with radii (``|r_i - r_j| = R_i + R_j``),
     solved on the interpolant.  ``"stop"`` ends the run there; ``"merge"``
@@ -195,6 +196,10 @@ def watch_table(events: EventSet, system: Any) -> np.ndarray:
                      for i in _bodies(params, system, where, single=True)]
             continue
         pairs = _pairs(params, system, where, name)
+        if _hill(params) and params.get("bodies") is None:
+            # in Hill radii, a pair with the most massive body has no encounter sphere
+            top = int(np.argmax(arrays.gm))
+            pairs = [(i, j) for i, j in pairs if top not in (i, j)]
         if name == "collision" and not pairs:
             raise ValueError(f"{where}: no pair of bodies has radii (give Body(radius=...))")
         for i, j in pairs:
@@ -261,6 +266,11 @@ def _length(value: Any, system: Any, where: str) -> float:
     if not (np.isfinite(dist) and dist > 0):
         raise ValueError(f"{where}: expected `distance` > 0, got {value!r}")
     return dist
+
+
+def _hill(params: Mapping[str, Any]) -> bool:
+    value = params.get("distance")
+    return isinstance(value, Mapping) and set(value) == {"hill"}
 
 
 def _encounter_distance(value: Any, system: Any, i: int, j: int, where: str) -> float:
