@@ -44,6 +44,7 @@ from hamilton_orbits._columns import (  # noqa: F401  (re-exported)
     HYPERBOLA,
     NCLASSICAL,
     NCOL,
+    ONE_ORBIT_SIZE,
     PARABOLA,
     RADIAL_ELLIPSE,
     RADIAL_HYPERBOLA,
@@ -53,9 +54,7 @@ from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     anomaly_from_nu,
     mean_from_anomaly,
-    nu_from_anomaly,
     sinh_minus_x,
-    solve,
     state_in_safe_range,
     state_scales,
     two_prod,
@@ -364,8 +363,8 @@ def state_to_elements_one(
 ):  # pragma: no cover - compiled
     """Elements of one state; returns the tuple of ``COLUMNS``.
 
-    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN (not
-    computed: :func:`state_to_elements_basic`); every other column is the same.
+    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN
+    (not computed); every other column is the same.
 
     With ``accurate=False`` the anomaly and M are those of the element set as
     floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
@@ -455,14 +454,6 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
-@njit(cache=True)
-def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
-    """The columns of one orbit (``full=False``: no anomaly, M, tau): the row of
-    :func:`state_to_elements_basic`, also called directly from Python for a
-    single orbit (no arrays to build)."""
-    return state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, False, full)
-
-
 # state_to_elements_one inlined at numba's IR level where it is called with
 # constant flags (the classical columns): the branches on ``accurate`` and
 # ``full`` then fold away and the tuple never leaves registers.  Measured on one
@@ -474,8 +465,8 @@ _elements_one_inlined = njit(inline="always")(state_to_elements_one.py_func)
 
 @njit(cache=True)
 def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
-    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_basic`
-    but the anomaly, M and tau (bit for bit), then ``a``.
+    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_one`
+    with ``full=False`` (bit for bit the full kernel's), then ``a``.
 
     ``a = 1/inv_a`` (``inf`` for the parabolas, ``inv_a = 0``).  ``a`` is NaN when
     another column is not finite or ``a`` is infinite for an orbit that is not a
@@ -504,18 +495,6 @@ def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
 
 
 _classical_inlined = njit(inline="always")(classical_one.py_func)
-
-
-@parallel_kernel
-def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
-    """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
-    ``out`` for non-radial orbits): the classical elements at ~2/3 of the cost."""
-    for i in prange(r.shape[0]):
-        res = state_to_elements_row(
-            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False
-        )
-        for j in range(NCOL):
-            out[i, j] = res[j]
 
 
 @parallel_kernel
@@ -560,12 +539,23 @@ def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
         out[i] = res[NCOL - 1]
 
 
+@njit(inline="always")
+def state_valid(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """Whether a state is one an orbit can be built from: every value finite,
+    ``mu > 0`` and ``r != 0`` (the one statement of the rule).
+
+    Without branches (so that a loop over rows vectorises): ``0 * x`` is +-0
+    for a finite x and NaN for inf or NaN, so the sum is 0 iff all are finite."""
+    z = (rx * 0.0 + ry * 0.0 + rz * 0.0) + (vx * 0.0 + vy * 0.0 + vz * 0.0) + mu * 0.0
+    return (z == 0.0) & (mu > 0.0) & ((rx != 0.0) | (ry != 0.0) | (rz != 0.0))
+
+
 @parallel_kernel
 def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - compiled
     """Copy rows of ``r``, ``v`` (N, 3) and ``mu`` (N,) or (1,) (broadcast) into
     ``r_out``, ``v_out``, ``mu_out`` (N,) in one pass; return the number of rows
-    with a non-finite value, ``mu <= 0`` or ``r = 0`` (the caller then finds
-    and names the first one)."""
+    that are not :func:`state_valid` (the caller then finds and names the first
+    one)."""
     n = r.shape[0]
     one = mu.shape[0] == 1
     bad = 0
@@ -584,12 +574,41 @@ def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - comp
         v_out[i, 1] = vy
         v_out[i, 2] = vz
         mu_out[i] = m
-        # without branches (so that the loop vectorises): 0 * x is +-0 for a
-        # finite x and NaN for inf or NaN, so the sum z is 0 iff all are finite
-        z = (rx * 0.0 + ry * 0.0 + rz * 0.0) + (vx * 0.0 + vy * 0.0 + vz * 0.0) + m * 0.0
-        ok = (z == 0.0) & (m > 0.0) & ((rx != 0.0) | (ry != 0.0) | (rz != 0.0))
-        bad += np.int64(not ok)
+        bad += np.int64(not state_valid(rx, ry, rz, vx, vy, vz, m))
     return bad
+
+
+@njit(cache=True)
+def one_orbit(out, rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """One orbit given as plain floats, checked and its elements computed in one call.
+
+    ``out`` (``ONE_ORBIT_SIZE``,) receives the state ``rx, ry, rz, vx, vy, vz,
+    mu`` and then, if the state is :func:`state_valid`, its ``CLASSICAL``
+    columns (:func:`classical_one`).  Returns 0 if the state is not valid (the
+    caller then names the bad value), 1 if it is, 2 if it is but an element is
+    beyond float64 (``a`` NaN: the caller then refuses it by name when it is
+    read).  Checking a state costs about as much as computing its elements
+    here, so one orbit's cost is one call, not two.
+    """
+    out[0] = rx
+    out[1] = ry
+    out[2] = rz
+    out[3] = vx
+    out[4] = vy
+    out[5] = vz
+    out[6] = mu
+    if not state_valid(rx, ry, rz, vx, vy, vz, mu):
+        return 0
+    p, e, inv_a, inc, lan, argp, nu, a = _classical_inlined(rx, ry, rz, vx, vy, vz, mu)
+    out[7] = p
+    out[8] = e
+    out[9] = inv_a
+    out[10] = inc
+    out[11] = lan
+    out[12] = argp
+    out[13] = nu
+    out[14] = a
+    return 1 if a == a else 2
 
 
 @njit(cache=True)
@@ -720,14 +739,6 @@ def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
         v_out[i, 0] = a
         v_out[i, 1] = b
         v_out[i, 2] = c
-
-
-@njit(cache=True)
-def nu_anomaly_from_mean(m, e):  # pragma: no cover - compiled
-    """``(nu, anomaly)`` for the mean anomaly ``m`` of a conic with ``e``
-    (Kepler's equation by :func:`hamilton_orbits._kernels.kepler.solve`)."""
-    anom = solve(m, e)
-    return nu_from_anomaly(anom, e), anom
 
 
 def empty_elements(n: int) -> np.ndarray:
