@@ -283,3 +283,37 @@ def test_argument_of_latitude_comes_from_the_full_kernel():
     np.testing.assert_array_equal(o.argument_of_latitude, full[:, _el.COLUMNS.index("u")])
     one = KeplerOrbit.from_state(r[0].tolist(), v[0].tolist(), 1.0)
     assert one.argument_of_latitude == full[0, _el.COLUMNS.index("u")]
+
+
+def test_one_orbit_kernel_checks_and_computes_in_one_call():
+    """elements.one_orbit: the state and classical_one's row in one array;
+    0 for a state the rule refuses (every value finite, mu > 0, r != 0), 1 for
+    a valid one, 2 when an element is beyond float64 (a NaN)."""
+    state = (1.0, 0.25, -0.5, 0.0, 1.0, 0.25, 1.0)
+    out = np.empty(_el.ONE_ORBIT_SIZE)
+    assert _el.one_orbit(out, *state) == 1
+    assert out.tolist() == [*state, *_el.classical_one(*state)]
+    nan, inf = float("nan"), float("inf")
+    for bad in [
+        (nan, 0.25, -0.5, 0.0, 1.0, 0.25, 1.0),
+        (1.0, 0.25, -0.5, 0.0, -inf, 0.25, 1.0),
+        (1.0, 0.25, -0.5, 0.0, 1.0, 0.25, 0.0),
+        (0.0, 0.0, 0.0, 0.0, 1.0, 0.25, 1.0),
+    ]:
+        assert _el.one_orbit(out, *bad) == 0, bad
+    assert _el.one_orbit(out, *A_BEYOND_R, *A_BEYOND_V, 1.0) == 2
+
+
+# 1/a of this state is subnormal (about 1e-310) but not zero to rounding: a is
+# beyond float64 while every other element is finite
+A_BEYOND_R = (1e300, 0.0, 0.0)
+A_BEYOND_V = (0.0, (2e-300 * (1 - 5e-11)) ** 0.5, 0.0)
+
+
+@pytest.mark.parametrize("batch", [False, True])
+def test_a_alone_beyond_float64_is_named_when_read(batch):
+    r, v = list(A_BEYOND_R), list(A_BEYOND_V)
+    o = KeplerOrbit.from_state([r], [v], 1.0) if batch else KeplerOrbit.from_state(r, v, 1.0)
+    assert np.all((o.e > 0.99) & (o.e < 1.0)) and np.all(np.isfinite(o.p)) and np.all(o.inc == 0)
+    with pytest.raises(ValueError, match=r"for which `a` fits in float64, got r=\[1e\+300"):
+        o.a  # noqa: B018
