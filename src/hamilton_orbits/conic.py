@@ -207,12 +207,12 @@ class Conic:
         >>> round(float(Conic.from_state([1.0, 0, 0], [0, 1.0, 0], 1.0).e), 12)
         0.0
         """
-        r, v, mu, quantity = check_state(r, v, mu)
-        c, _ = classical_columns(r, v, mu)
+        state, quantity = check_state(r, v, mu)
+        c, _ = classical_columns(state)
         p, e, inv_a, inc, lan, argp = (
             c[CLASSICAL.index(n)] for n in ("p", "e", "inv_a", "inc", "lan", "argp")
         )
-        return cls.from_elements(p, e, inv_a, inc, lan, argp, mu, quantity=quantity)
+        return cls.from_elements(p, e, inv_a, inc, lan, argp, state[..., 6], quantity=quantity)
 
     # ---------------------------------------------------------------- shape
     @property

@@ -437,16 +437,15 @@ def _copy_valid_state(r_in: Any, v_in: Any, mu_in: Any):
     v = check_trailing("v", SPEED("v", v_in, STATE_UNITS[1], finite=False), 3)
     mu = GM("mu", mu_in, STATE_UNITS[2], finite=False)
     lead = np.broadcast_shapes(r.shape[:-1], v.shape[:-1], mu.shape)
-    r_out = np.empty((*lead, 3))
-    v_out = np.empty((*lead, 3))
-    mu_out = np.empty(lead)
-    if r_out.size and _el.check_copy_state(
+    state = np.empty((*lead, 7))
+    rows = state.reshape(-1, 7)
+    if rows.shape[0] and _el.check_copy_state(
         _contiguous(r, (*lead, 3)).reshape(-1, 3), _contiguous(v, (*lead, 3)).reshape(-1, 3),
         (mu if mu.ndim == 0 else _contiguous(mu, lead)).reshape(-1),
-        r_out.reshape(-1, 3), v_out.reshape(-1, 3), mu_out.reshape(-1),
+        rows[:, :3], rows[:, 3:6], rows[:, 6],
     ):
         return None
-    return r_out, v_out, mu_out, quantity
+    return state, quantity
 
 
 def _refuse_state(r_in: Any, v_in: Any, mu_in: Any) -> None:
@@ -469,7 +468,7 @@ def _refuse_state(r_in: Any, v_in: Any, mu_in: Any) -> None:
 
 
 def check_state(r: Any, v: Any, mu: Any):
-    """The two-body state ``(r, v, mu)`` checked once, as the float arrays an orbit keeps.
+    """The two-body state ``(r, v, mu)`` checked once, as the float array an orbit keeps.
 
     Parameters
     ----------
@@ -482,11 +481,11 @@ def check_state(r: Any, v: Any, mu: Any):
 
     Returns
     -------
-    r, v : ndarray, shape (..., 3)
-    mu : ndarray, shape (...)
-        Fresh C-contiguous float64 arrays of one leading shape, the broadcast
-        of ``r[..., 0]``, ``v[..., 0]`` and ``mu``; Quantities are converted
-        to km, km/s and km^3/s^2 (``STATE_UNITS``).
+    state : ndarray, shape (..., 7)
+        A fresh C-contiguous float64 array ``[rx, ry, rz, vx, vy, vz, mu]``
+        for every state of the leading shape, the broadcast of ``r[..., 0]``,
+        ``v[..., 0]`` and ``mu``; Quantities are converted to km, km/s and
+        km^3/s^2 (``STATE_UNITS``).
     quantity : bool
         Whether the state came in Quantities.
 
@@ -501,7 +500,7 @@ def check_state(r: Any, v: Any, mu: Any):
 
     Notes
     -----
-    The values are checked in one compiled pass that also makes the copies
+    The values are checked in one compiled pass that also makes the copy
     (:func:`hamilton_orbits._kernels.elements.check_copy_state`, with the rule
     :func:`hamilton_orbits._kernels.elements.state_valid`).  Only when that
     pass or a conversion fails are the arguments checked one at a time, in the
@@ -509,26 +508,25 @@ def check_state(r: Any, v: Any, mu: Any):
 
     Examples
     --------
-    >>> r, v, mu, quantity = check_state([[1.0, 0, 0], [2.0, 0, 0]], [0, 1.0, 0], 1.0)
-    >>> r.shape, v.shape, mu.tolist(), quantity
-    ((2, 3), (2, 3), [1.0, 1.0], False)
+    >>> state, quantity = check_state([[1.0, 0, 0], [2.0, 0, 0]], [0, 1.0, 0], 1.0)
+    >>> state.tolist(), quantity
+    ([[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0], [2.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0]], False)
     >>> check_state([[1.0, 0, 0], [0.0, 0, 0]], [0, 1.0, 0], 1.0)
     Traceback (most recent call last):
     ...
     ValueError: Expected `r` to be nonzero, got [0.0, 0.0, 0.0] at index 1
     """
     try:
-        state = _copy_valid_state(r, v, mu)
+        checked = _copy_valid_state(r, v, mu)
     except ValueError:
         _refuse_state(r, v, mu)
         raise
-    if state is None:
+    if checked is None:
         _refuse_state(r, v, mu)
-    return state
+    return checked
 
 
-def refuse_beyond_range(rows: np.ndarray, r: np.ndarray, v: np.ndarray, mu: np.ndarray,
-                        shape: tuple[int, ...]) -> None:
+def refuse_beyond_range(rows: np.ndarray, state: np.ndarray, shape: tuple[int, ...]) -> None:
     """Raise if a row an elements kernel computed is not finite: that state's
     elements do not fit in float64.
 
@@ -536,9 +534,8 @@ def refuse_beyond_range(rows: np.ndarray, r: np.ndarray, v: np.ndarray, mu: np.n
     ----------
     rows : ndarray, shape (N, k)
         Kernel output, one row per state.
-    r, v : ndarray, shape (N, 3)
-    mu : ndarray, shape (N,)
-        The states of the rows.
+    state : ndarray, shape (N, 7)
+        The states of the rows (:func:`check_state`).
     shape : tuple of int
         Their leading shape (to name the index).
 
@@ -549,8 +546,7 @@ def refuse_beyond_range(rows: np.ndarray, r: np.ndarray, v: np.ndarray, mu: np.n
 
     Examples
     --------
-    >>> refuse_beyond_range(np.array([[1.0, np.nan]]), np.ones((1, 3)), np.ones((1, 3)),
-    ...                     np.ones(1), ())  # doctest: +ELLIPSIS
+    >>> refuse_beyond_range(np.array([[1.0, np.nan]]), np.ones((1, 7)), ())  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     ValueError: Expected `r`, `v`, `mu` whose elements fit in float64 (...), got r=[1.0, 1.0, 1.0], v=[1.0, 1.0, 1.0], mu=1.0
@@ -565,19 +561,19 @@ def refuse_beyond_range(rows: np.ndarray, r: np.ndarray, v: np.ndarray, mu: np.n
     where = fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
     raise ValueError(
         f"Expected `r`, `v`, `mu` whose elements fit in float64 (|r| |v|^2 / mu ~ e below "
-        f"2^450 ~ 3e135, p and a below 1e308), got r={r[i].tolist()}, v={v[i].tolist()}, "
-        f"mu={float(mu[i])!r}{where}"
+        f"2^450 ~ 3e135, p and a below 1e308), got r={state[i, :3].tolist()}, "
+        f"v={state[i, 3:6].tolist()}, mu={float(state[i, 6])!r}{where}"
     )
 
 
-def classical_columns(r: np.ndarray, v: np.ndarray, mu: np.ndarray):
+def classical_columns(state: np.ndarray):
     """The classical elements of checked states (:func:`check_state`) as float columns.
 
     Parameters
     ----------
-    r, v : ndarray, shape (..., 3)
-    mu : ndarray, shape (...)
-        Checked states (plain floats in one consistent unit system).
+    state : ndarray, shape (..., 7)
+        Checked states ``[rx, ry, rz, vx, vy, vz, mu]`` (plain floats in one
+        consistent unit system).
 
     Returns
     -------
@@ -596,16 +592,14 @@ def classical_columns(r: np.ndarray, v: np.ndarray, mu: np.ndarray):
 
     Examples
     --------
-    >>> c, _ = classical_columns(np.array([1.0, 0, 0]), np.array([0, 1.2, 0]), np.array(1.0))
+    >>> c, _ = classical_columns(np.array([1.0, 0, 0, 0, 1.2, 0, 1.0]))
     >>> [round(float(c[_columns.CLASSICAL.index(n)]), 12) for n in ("p", "e", "a")]
     [1.44, 0.44, 1.785714285714]
     """
-    lead = mu.shape
-    flat_r = r.reshape(-1, 3)
-    flat_v = v.reshape(-1, 3)
-    flat_mu = mu.reshape(-1)
-    out = np.empty((flat_mu.size, _columns.NCLASSICAL))
-    a_beyond = _el.state_to_elements_classical(flat_r, flat_v, flat_mu, out)
+    lead = state.shape[:-1]
+    rows = state.reshape(-1, 7)
+    out = np.empty((rows.shape[0], _columns.NCLASSICAL))
+    a_beyond = _el.state_to_elements_classical(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
     if a_beyond:  # a row with a NaN a: refused here if another value is not finite
-        refuse_beyond_range(out[:, :-1], flat_r, flat_v, flat_mu, lead)
+        refuse_beyond_range(out[:, :-1], rows, lead)
     return np.moveaxis(out.reshape((*lead, _columns.NCLASSICAL)), -1, 0), a_beyond

@@ -134,7 +134,7 @@ def _in_range(prop):
             value = prop(self)
         raw = value.value if is_quantity(value) else np.asarray(value)
         finite = np.isfinite(raw)
-        if not np.all(finite):
+        if not finite.all():
             kind = self._kind
             allowed = {
                 "period": ~((kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)),
@@ -152,24 +152,21 @@ def _element(name: str, unit: str | None, doc: str) -> property:
     """A classical element as a property of :class:`KeplerOrbit`, read from the
     orbit's element columns (computed on first use): a float64 for one orbit,
     an array of the leading shape for many, a Quantity in ``unit`` for an
-    orbit built from Quantities."""
+    orbit built from Quantities.  ``a`` where it alone is beyond float64 (NaN
+    in its column) names the state."""
     i = _CI[name]
+    is_a = name == "a"
 
     def read(orbit: KeplerOrbit):
         c = orbit._classical
         if c is None:
             c = orbit._elements()
+        if is_a and orbit._a_beyond:
+            orbit._refuse_not_finite("a", c[i] == c[i])
         return orbit._out(c[i], unit) if orbit._quantity else c[i]
 
-    def read_a(orbit: KeplerOrbit):  # a NaN a: beyond float64 for that state
-        a = read(orbit)
-        if orbit._a_beyond:
-            a_col = orbit._classical[_A]
-            orbit._refuse_not_finite("a", a_col == a_col)
-        return a
-
-    read.__name__ = read_a.__name__ = name
-    return property(read_a if name == "a" else read, doc=doc)
+    read.__name__ = name
+    return property(read, doc=doc)
 
 
 class KeplerOrbit:
@@ -201,8 +198,8 @@ class KeplerOrbit:
 
     Notes
     -----
-    One representation: the state as float64 arrays ``r`` (..., 3), ``v``
-    (..., 3) and ``mu`` (...) (km, km/s, km^3/s^2 for Quantities), and, once
+    One representation: the state as one float64 array (..., 7), ``[rx, ry,
+    rz, vx, vy, vz, mu]`` (km, km/s, km^3/s^2 for Quantities), and, once
     computed, the element columns, one row per element (``columns[i]`` is an
     element of every orbit).  One orbit's elements are a numpy float64, many
     orbits' an array of their leading shape.  Every attribute is computed the
@@ -224,21 +221,24 @@ class KeplerOrbit:
     _a_beyond = 0
 
     def __init__(
-        self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool,
-        classical: np.ndarray | None = None,
+        self, state: np.ndarray, quantity: bool, classical: np.ndarray | None = None
     ) -> None:
         """Keep a checked state; build orbits with :meth:`from_state` or
         :meth:`from_elements`.
 
-        ``r`` (..., 3), ``v`` (..., 3), ``mu`` (...): float64 arrays the
-        orbit keeps and never writes to; ``quantity``: whether it was built
-        from Quantities; ``classical``: its ``CLASSICAL`` columns, shape
-        (NCLASSICAL, ...), if already known."""
-        self._r = r
-        self._v = v
-        self._mu = mu
+        ``state``: float64 array (..., 7), ``[rx, ry, rz, vx, vy, vz, mu]``
+        (:func:`hamilton_orbits.kepler.check_state`), that the orbit keeps and
+        never writes to; ``quantity``: whether it was built from Quantities;
+        ``classical``: its ``CLASSICAL`` columns, shape (NCLASSICAL, ...), if
+        already known."""
+        self._state = state
         self._quantity = quantity
         self._classical = classical
+
+    # views of the state
+    _r = property(lambda self: self._state[..., :3])
+    _v = property(lambda self: self._state[..., 3:6])
+    _mu = property(lambda self: self._state[..., 6])
 
     # ------------------------------------------------------------------ build
     @classmethod
@@ -317,8 +317,7 @@ class KeplerOrbit:
                 out = np.empty(_ONE_ORBIT_SIZE)
                 status = _el.one_orbit(out, *r3, *v3, mu)
                 if status:  # 2: an element beyond float64, computed again and named when read
-                    return cls(out[:3], out[3:6], out[..., 6], False,
-                               out[7:] if status == 1 else None)
+                    return cls(out[:7], False, out[7:] if status == 1 else None)
         return cls(*check_state(r, v, mu))
 
     @classmethod
@@ -399,17 +398,17 @@ class KeplerOrbit:
         )
         p_, inv_a, radial = _p_and_inv_a(lname, length, e_)
         anom = _anomaly_of(aname, angle, e_, radial)
-        r, v = _state_of(p_, e_, inv_a, inc_, lan_, argp_, anom, radial, mu_, angle)
-        bad = ~np.all(np.isfinite(r) & np.isfinite(v), axis=-1)
+        state = _state_of(p_, e_, inv_a, inc_, lan_, argp_, anom, radial, mu_, angle)
+        bad = ~np.all(np.isfinite(state[..., :6]), axis=-1)
         _raise_at(lname, bad, length, "to give a finite state (check the elements)")
-        return cls(r, v, np.array(mu_, dtype=np.float64), quantity)
+        return cls(state, quantity)
 
     # --------------------------------------------------------------- elements
     def _elements(self) -> np.ndarray:
         """The ``CLASSICAL`` columns, shape (NCLASSICAL, ...), computed on first use."""
         c = self._classical
         if c is None:
-            c, self._a_beyond = classical_columns(self._r, self._v, self._mu)
+            c, self._a_beyond = classical_columns(self._state)
             self._classical = c
         return c
 
@@ -417,12 +416,10 @@ class KeplerOrbit:
     def _full(self) -> np.ndarray:
         """Every column of ``COLUMNS`` (the anomaly, M and u too), shape
         (NCOL, ...); the classical ones bit for bit those of :meth:`_elements`."""
-        flat_r = self._r.reshape(-1, 3)
-        flat_v = self._v.reshape(-1, 3)
-        flat_mu = self._mu.reshape(-1)
-        out = np.empty((flat_mu.size, _columns.NCOL))
-        _el.state_to_elements(flat_r, flat_v, flat_mu, out)
-        refuse_beyond_range(out, flat_r, flat_v, flat_mu, self.shape)
+        rows = self._state.reshape(-1, 7)
+        out = np.empty((rows.shape[0], _columns.NCOL))
+        _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        refuse_beyond_range(out, rows, self.shape)
         return np.moveaxis(out.reshape((*self.shape, _columns.NCOL)), -1, 0)
 
     @cached_property
@@ -465,7 +462,7 @@ class KeplerOrbit:
     @property
     def shape(self) -> tuple[int, ...]:
         """Leading shape (number of orbits in each dimension)."""
-        return self._mu.shape
+        return self._state.shape[:-1]
 
     def __len__(self) -> int:
         if not self.shape:
@@ -475,7 +472,9 @@ class KeplerOrbit:
     def __getitem__(self, key: Any) -> KeplerOrbit:
         if not self.shape:
             raise IndexError("a single KeplerOrbit cannot be indexed")
-        return KeplerOrbit(self._r[key], self._v[key], self._mu[key], self._quantity)
+        # the key indexes the leading dimensions (an Ellipsis in it too)
+        key = (*key, slice(None)) if type(key) is tuple else (key, slice(None))
+        return KeplerOrbit(self._state[key], self._quantity)
 
     def __repr__(self) -> str:
         """One orbit: its elements (with units if built from Quantities; angles
@@ -590,12 +589,10 @@ class KeplerOrbit:
 
     @cached_property
     def _tau(self) -> np.ndarray:
-        flat_r = self._r.reshape(-1, 3)
-        flat_v = self._v.reshape(-1, 3)
-        flat_mu = self._mu.reshape(-1)
-        out = np.empty(flat_r.shape[0])
-        _el.state_to_time_since_periapsis(flat_r, flat_v, flat_mu, out)
-        refuse_beyond_range(out[:, None], flat_r, flat_v, flat_mu, self.shape)
+        rows = self._state.reshape(-1, 7)
+        out = np.empty(rows.shape[0])
+        _el.state_to_time_since_periapsis(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        refuse_beyond_range(out[:, None], rows, self.shape)
         return out.reshape(self.shape)
 
     @property
@@ -702,26 +699,27 @@ class KeplerOrbit:
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
         dt_ = TIME("dt", dt, _T)
+        shape = self.shape
         try:
-            lead = np.broadcast_shapes(self.shape, dt_.shape)
+            lead = shape if dt_.shape in (shape, ()) else np.broadcast_shapes(shape, dt_.shape)
         except ValueError:
             lead = None
         if lead is not None:
-            mu = self._mu if lead == self.shape else np.array(np.broadcast_to(self._mu, lead))
-            r_out = np.empty((*lead, 3))
-            v_out = np.empty((*lead, 3))
-            if r_out.size == 0 or _kk.propagate_batch(  # views, as kepler.propagate passes
-                np.broadcast_to(self._r, (*lead, 3)).reshape(-1, 3),
-                np.broadcast_to(self._v, (*lead, 3)).reshape(-1, 3),
-                np.broadcast_to(self._mu, lead).reshape(-1),
-                np.broadcast_to(dt_, lead).reshape(-1),
-                r_out.reshape(-1, 3), v_out.reshape(-1, 3),
+            # a copy of the state, propagated in place (the kernel reads a row before
+            # it writes it)
+            new = self._state.copy() if lead == shape else np.array(
+                np.broadcast_to(self._state, (*lead, 7)))
+            rows = new.reshape(-1, 7)
+            dts = dt_ if dt_.shape == lead else np.broadcast_to(dt_, lead)
+            if not rows.shape[0] or _kk.propagate_batch(
+                rows[:, :3], rows[:, 3:6], rows[:, 6], dts.reshape(-1), rows[:, :3], rows[:, 3:6]
             ) < 0:
-                return KeplerOrbit(r_out, v_out, mu, self._quantity)
+                return KeplerOrbit(new, self._quantity)
         # shapes that do not broadcast, or a state the kernel cannot propagate:
-        # the public function names the argument (the same kernel, the same result)
+        # the public function names it (the same kernel, the same result)
         r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
-        return KeplerOrbit(r, v, np.array(np.broadcast_to(self._mu, r.shape[:-1])), self._quantity)
+        mu = np.broadcast_to(self._mu, r.shape[:-1])[..., None]
+        return KeplerOrbit(np.concatenate([r, v, mu], axis=-1), self._quantity)
 
     @property
     def conic(self) -> Conic:
@@ -830,21 +828,23 @@ def _anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray
 
 
 def _state_of(p, e, inv_a, inc, lan, argp, anom, radial, mu, m):
-    """The state ``(r, v)``, shapes (..., 3), of the elements (one compiled
-    pass; radial orbits from their mean anomaly ``m``)."""
+    """The state (..., 7) of the elements (one compiled pass; radial orbits
+    from their mean anomaly ``m``)."""
     shape = e.shape
     el = np.stack(
         [p * 1.0, e * 1.0, inv_a * 1.0, inc, lan, argp, np.where(radial, 0.0, anom)],
         axis=-1,
     ).reshape(-1, 7)
     flat_mu = np.ascontiguousarray(mu.reshape(-1), dtype=np.float64)
-    r_out = np.empty((el.shape[0], 3))
-    v_out = np.empty((el.shape[0], 3))
+    state = np.empty((*shape, 7))
+    rows = state.reshape(-1, 7)
+    rows[:, 6] = flat_mu
+    r_out, v_out = rows[:, :3], rows[:, 3:6]
     el[:, 0] = np.where(radial.reshape(-1), 0.0, el[:, 0])
     _el.elements_to_state(np.ascontiguousarray(el), flat_mu, r_out, v_out)
     if np.any(radial):
         _radial_from_mean(el, flat_mu, m.reshape(-1), radial.reshape(-1), r_out, v_out)
-    return r_out.reshape((*shape, 3)), v_out.reshape((*shape, 3))
+    return state
 
 
 def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:

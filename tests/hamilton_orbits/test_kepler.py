@@ -405,20 +405,21 @@ def test_propagate_uv_inline_is_propagate_uv():
 
 
 def test_check_state_copies_and_broadcasts():
-    """kepler.check_state: fresh C-contiguous float64 copies of one leading shape."""
+    """kepler.check_state: one fresh C-contiguous float64 array (..., 7) of the
+    broadcast leading shape, [r, v, mu] per state."""
     r = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
     v = np.array([0.0, 1.0, 0.0])
     mu = np.array([1.0, 2.0])
-    r_, v_, mu_, quantity = check_state(r, v, mu)
-    assert (r_.shape, v_.shape, mu_.shape, quantity) == ((2, 3), (2, 3), (2,), False)
-    for x, arg in ((r_, r), (v_, v), (mu_, mu)):
-        assert x.dtype == np.float64 and x.flags.c_contiguous and not np.shares_memory(x, arg)
+    state, quantity = check_state(r, v, mu)
+    assert state.shape == (2, 7) and state.dtype == np.float64 and state.flags.c_contiguous
+    assert quantity is False and not any(np.shares_memory(state, x) for x in (r, v, mu))
     r[0, 0] = 5.0
-    assert r_[0, 0] == 1.0
-    np.testing.assert_array_equal(v_, [[0.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
-    rq, _, muq, quantity = check_state([1.0, 0, 0] * u.au, [0, 30.0, 0] * u.km / u.s,
-                                       1.32712440018e20 * u.m**3 / u.s**2)
-    assert quantity and rq[0] == 149597870.7 and muq == pytest.approx(1.32712440018e11, rel=4e-16)
+    assert state.tolist() == [[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0],
+                              [2.0, 0.0, 0.0, 0.0, 1.0, 0.0, 2.0]]
+    sq, quantity = check_state([1.0, 0, 0] * u.au, [0, 30.0, 0] * u.km / u.s,
+                               1.32712440018e20 * u.m**3 / u.s**2)
+    assert quantity and sq[0] == 149597870.7 and sq[4] == 30.0
+    assert sq[6] == pytest.approx(1.32712440018e11, rel=4e-16)
 
 
 @pytest.mark.parametrize(
