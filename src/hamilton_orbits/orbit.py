@@ -105,18 +105,18 @@ def _scalar(a: np.ndarray):
     return a[()] if isinstance(a, np.ndarray) and a.ndim == 0 else a
 
 
-def _three(x: Any) -> list | tuple | None:
-    """``x`` as three Python floats if it is a float64 array of shape (3,) or a
-    list/tuple of three Python floats, else None."""
+def _three(x: Any) -> np.ndarray | tuple | None:
+    """``x`` if it is a float64 array of shape (3,), as a tuple if it is a list
+    or tuple of three Python floats, else None (the general path then takes
+    it): one orbit's ``r`` or ``v`` for :func:`hamilton_orbits._kernels.elements.one_orbit`."""
     t = type(x)
-    if t is list or t is tuple:
-        if len(x) == 3:
-            a, b, c = x
-            if type(a) is float and type(b) is float and type(c) is float:
-                return x
-    # dtype identity: the native float64 (any other dtype takes the general path)
-    elif t is np.ndarray and x.dtype is _F64 and x.shape == _SHAPE3:
-        return x.tolist()
+    if t is np.ndarray:
+        # dtype identity: the native float64 (any other dtype takes the general path)
+        return x if x.dtype is _F64 and x.shape == _SHAPE3 else None
+    if (t is list or t is tuple) and len(x) == 3:
+        a, b, c = x
+        if type(a) is float and type(b) is float and type(c) is float:
+            return (a, b, c)
     return None
 
 
@@ -315,7 +315,7 @@ class KeplerOrbit:
             v3 = _three(v)
             if r3 is not None and v3 is not None:
                 out = np.empty(_ONE_ORBIT_SIZE)
-                status = _el.one_orbit(out, *r3, *v3, mu)
+                status = _el.one_orbit(out, r3, v3, mu)
                 if status:  # 2: an element beyond float64, computed again and named when read
                     return cls(out[:7], False, out[7:] if status == 1 else None)
         return cls(*check_state(r, v, mu))

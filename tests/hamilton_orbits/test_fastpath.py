@@ -286,22 +286,26 @@ def test_argument_of_latitude_comes_from_the_full_kernel():
 
 
 def test_one_orbit_kernel_checks_and_computes_in_one_call():
-    """elements.one_orbit: the state and classical_one's row in one array;
-    0 for a state the rule refuses (every value finite, mu > 0, r != 0), 1 for
-    a valid one, 2 when an element is beyond float64 (a NaN)."""
-    state = (1.0, 0.25, -0.5, 0.0, 1.0, 0.25, 1.0)
+    """elements.one_orbit: the state and classical_one's row in one array, from
+    r and v as float64 arrays or tuples; 0 for a state the rule refuses (every
+    value finite, mu > 0, r != 0), 1 for a valid one, 2 when an element is
+    beyond float64 (a NaN)."""
+    r, v = (1.0, 0.25, -0.5), (0.0, 1.0, 0.25)
     out = np.empty(_el.ONE_ORBIT_SIZE)
-    assert _el.one_orbit(out, *state) == 1
-    assert out.tolist() == [*state, *_el.classical_one(*state)]
+    assert _el.one_orbit(out, r, v, 1.0) == 1
+    assert out.tolist() == [*r, *v, 1.0, *_el.classical_one(*r, *v, 1.0)]
+    same = np.empty(_el.ONE_ORBIT_SIZE)
+    assert _el.one_orbit(same, np.array(r), np.array(v), 1.0) == 1
+    np.testing.assert_array_equal(same, out)
     nan, inf = float("nan"), float("inf")
-    for bad in [
-        (nan, 0.25, -0.5, 0.0, 1.0, 0.25, 1.0),
-        (1.0, 0.25, -0.5, 0.0, -inf, 0.25, 1.0),
-        (1.0, 0.25, -0.5, 0.0, 1.0, 0.25, 0.0),
-        (0.0, 0.0, 0.0, 0.0, 1.0, 0.25, 1.0),
+    for bad_r, bad_v, mu in [
+        ((nan, 0.25, -0.5), v, 1.0),
+        (r, (0.0, -inf, 0.25), 1.0),
+        (r, v, 0.0),
+        ((0.0, 0.0, 0.0), v, 1.0),
     ]:
-        assert _el.one_orbit(out, *bad) == 0, bad
-    assert _el.one_orbit(out, *A_BEYOND_R, *A_BEYOND_V, 1.0) == 2
+        assert _el.one_orbit(out, bad_r, bad_v, mu) == 0, (bad_r, bad_v, mu)
+    assert _el.one_orbit(out, A_BEYOND_R, A_BEYOND_V, 1.0) == 2
 
 
 # 1/a of this state is subnormal (about 1e-310) but not zero to rounding: a is

@@ -579,17 +579,24 @@ def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - comp
 
 
 @njit(cache=True)
-def one_orbit(out, rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+def one_orbit(out, r, v, mu):  # pragma: no cover - compiled
     """One orbit given as plain floats, checked and its elements computed in one call.
 
-    ``out`` (``ONE_ORBIT_SIZE``,) receives the state ``rx, ry, rz, vx, vy, vz,
-    mu`` and then, if the state is :func:`state_valid`, its ``CLASSICAL``
-    columns (:func:`classical_one`).  Returns 0 if the state is not valid (the
-    caller then names the bad value), 1 if it is, 2 if it is but an element is
-    beyond float64 (``a`` NaN: the caller then refuses it by name when it is
-    read).  Checking a state costs about as much as computing its elements
-    here, so one orbit's cost is one call, not two.
+    ``r``, ``v``: three floats each, as a float64 array or a tuple; ``mu`` a
+    float.  ``out`` (``ONE_ORBIT_SIZE``,) receives the state ``rx, ry, rz,
+    vx, vy, vz, mu`` and then, if the state is :func:`state_valid`, its
+    ``CLASSICAL`` columns (:func:`classical_one`).  Returns 0 if the state is
+    not valid (the caller then names the bad value), 1 if it is, 2 if it is
+    but an element is beyond float64 (``a`` NaN: the caller then refuses it
+    by name when it is read).  Checking a state costs about as much as
+    computing its elements here, so one orbit's cost is one call, not two.
     """
+    rx = r[0]
+    ry = r[1]
+    rz = r[2]
+    vx = v[0]
+    vy = v[1]
+    vz = v[2]
     out[0] = rx
     out[1] = ry
     out[2] = rz
