@@ -303,8 +303,10 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     parser.add_argument("--skip", nargs="*", default=[], choices=["calls", "throughput", "first"],
                         help="parts to leave out")
+    parser.add_argument("--nmax", type=int, default=None,
+                        help="largest N of part 1 (default 1e7, 1e6 with --quick; 1: one orbit)")
     args = parser.parse_args()
-    nmax = 10**6 if args.quick else 10**7
+    nmax = args.nmax or (10**6 if args.quick else 10**7)
     nmax_reb = 10**5 if args.quick else 10**6
     repeat = 5 if args.quick else 9
     print(f"numba {numba.__version__}, threading layer after first use; "
