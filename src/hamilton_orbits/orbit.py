@@ -698,7 +698,7 @@ class KeplerOrbit:
         """
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
-        dt_ = TIME("dt", dt, _T)
+        dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below
         shape = self.shape
         try:
             lead = shape if dt_.shape in (shape, ()) else np.broadcast_shapes(shape, dt_.shape)
@@ -710,14 +710,14 @@ class KeplerOrbit:
             new = self._state.copy() if lead == shape else np.array(
                 np.broadcast_to(self._state, (*lead, 7)))
             rows = new.reshape(-1, 7)
+            r, v = rows[:, :3], rows[:, 3:6]
             dts = dt_ if dt_.shape == lead else np.broadcast_to(dt_, lead)
-            if not rows.shape[0] or _kk.propagate_batch(
-                rows[:, :3], rows[:, 3:6], rows[:, 6], dts.reshape(-1), rows[:, :3], rows[:, 3:6]
-            ) < 0:
+            if rows.shape[0] and _kk.propagate_batch(r, v, rows[:, 6], dts.reshape(-1), r, v) < 0:
                 return KeplerOrbit(new, self._quantity)
-        # shapes that do not broadcast, or a state the kernel cannot propagate:
-        # the public function names it (the same kernel, the same result)
-        r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
+        # dt not finite, shapes that do not broadcast, a state the kernel cannot
+        # propagate, or no orbit at all: the public function names the bad value
+        # (the same kernel, the same result)
+        r, v = _kepler.propagate(self._r, self._v, self._mu, TIME("dt", dt, _T))
         mu = np.broadcast_to(self._mu, r.shape[:-1])[..., None]
         return KeplerOrbit(np.concatenate([r, v, mu], axis=-1), self._quantity)
 

@@ -968,9 +968,10 @@ def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
 @njit(cache=True)
 def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
-    so that no intermediate product overflows or underflows."""
+    so that no intermediate product overflows or underflows; NaN for a ``dt``
+    that is not finite."""
     er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
-    if not ok:
+    if not ok or not math.isfinite(dt):
         nan = math.nan
         return nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
@@ -1008,28 +1009,6 @@ def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
     return bad
 
 
-@njit(cache=True)
-def propagate_one(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
-    """One orbit through :func:`propagate_batch` (the same code, no arrays to
-    build in Python): ``(rx, ry, rz, vx, vy, vz, ok)``."""
-    r = np.empty((1, 3))
-    v = np.empty((1, 3))
-    r[0, 0] = rx
-    r[0, 1] = ry
-    r[0, 2] = rz
-    v[0, 0] = vx
-    v[0, 1] = vy
-    v[0, 2] = vz
-    m = np.full(1, mu)
-    d = np.full(1, dt)
-    r_out = np.empty((1, 3))
-    v_out = np.empty((1, 3))
-    bad = propagate_batch(r, v, m, d, r_out, v_out)
-    return (
-        r_out[0, 0], r_out[0, 1], r_out[0, 2], v_out[0, 0], v_out[0, 1], v_out[0, 2], bad < 0
-    )
-
-
 __all__ = [
     "EPS",
     "anomaly_from_nu",
@@ -1039,7 +1018,6 @@ __all__ = [
     "nu_from_anomaly",
     "nu_from_anomaly_ufunc",
     "propagate_batch",
-    "propagate_one",
     "propagate_uv",
     "propagate_uv_inline",
     "sinh_minus_x",
