@@ -436,7 +436,9 @@ def _copy_valid_state(r_in: Any, v_in: Any, mu_in: Any):
     r = check_trailing("r", LENGTH("r", r_in, STATE_UNITS[0], finite=False), 3)
     v = check_trailing("v", SPEED("v", v_in, STATE_UNITS[1], finite=False), 3)
     mu = GM("mu", mu_in, STATE_UNITS[2], finite=False)
-    lead = np.broadcast_shapes(r.shape[:-1], v.shape[:-1], mu.shape)
+    lead = r.shape[:-1]
+    if v.shape[:-1] != lead or mu.shape not in (lead, ()):
+        lead = np.broadcast_shapes(lead, v.shape[:-1], mu.shape)
     state = np.empty((*lead, 7))
     rows = state.reshape(-1, 7)
     if rows.shape[0] and _el.check_copy_state(
@@ -602,4 +604,4 @@ def classical_columns(state: np.ndarray):
     a_beyond = _el.state_to_elements_classical(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
     if a_beyond:  # a row with a NaN a: refused here if another value is not finite
         refuse_beyond_range(out[:, :-1], rows, lead)
-    return np.moveaxis(out.reshape((*lead, _columns.NCLASSICAL)), -1, 0), a_beyond
+    return out.T.reshape((_columns.NCLASSICAL, *lead)), a_beyond  # a view

@@ -420,7 +420,7 @@ class KeplerOrbit:
         out = np.empty((rows.shape[0], _columns.NCOL))
         _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
         refuse_beyond_range(out, rows, self.shape)
-        return np.moveaxis(out.reshape((*self.shape, _columns.NCOL)), -1, 0)
+        return out.T.reshape((_columns.NCOL, *self.shape))  # a view
 
     @cached_property
     def _kind(self) -> np.ndarray:
@@ -711,8 +711,13 @@ class KeplerOrbit:
                 np.broadcast_to(self._state, (*lead, 7)))
             rows = new.reshape(-1, 7)
             r, v = rows[:, :3], rows[:, 3:6]
-            dts = dt_ if dt_.shape == lead else np.broadcast_to(dt_, lead)
-            if rows.shape[0] and _kk.propagate_batch(r, v, rows[:, 6], dts.reshape(-1), r, v) < 0:
+            if dt_.shape == lead:
+                dts = dt_.reshape(-1)
+            elif dt_.ndim == 0:  # one dt for every orbit
+                dts = np.full(rows.shape[0], dt_)
+            else:
+                dts = np.broadcast_to(dt_, lead).reshape(-1)
+            if rows.shape[0] and _kk.propagate_batch(r, v, rows[:, 6], dts, r, v) < 0:
                 return KeplerOrbit(new, self._quantity)
         # dt not finite, shapes that do not broadcast, a state the kernel cannot
         # propagate, or no orbit at all: the public function names the bad value
