@@ -7,6 +7,8 @@ without importing numba.
 
 import math
 
+import numpy as np
+
 # conic kinds (the ``kind`` column)
 ELLIPSE = 0.0
 PARABOLA = 1.0
@@ -39,30 +41,41 @@ NCOL = len(COLUMNS)
 CLASSICAL = ("p", "e", "inv_a", "inc", "lan", "argp", "nu", "a")
 NCLASSICAL = len(CLASSICAL)
 
+# the output of the one-orbit kernel (elements.one_orbit): the state rx, ry, rz,
+# vx, vy, vz, mu, then the CLASSICAL columns
+ONE_ORBIT_SIZE = 7 + NCLASSICAL
 
-def kind_of(p: float, e: float, inv_a: float, nu: float) -> float:
-    """The ``kind`` column of one orbit from its classical columns.
+
+def kind_of(p, e, inv_a, nu):
+    """The ``kind`` column from the classical columns, for one orbit or many.
 
     As the kernel decides it: ``e < 1`` ellipse, ``e > 1`` hyperbola; ``e = 1``
     (exactly, as the kernel sets it) with ``1/a > 0`` or ``< 0`` a radial (or
     quasi-rectilinear) ellipse or hyperbola; with ``1/a = 0`` the radial
     parabola (``p = 0`` and ``nu = pi``, as the radial branch sets them; a
     parabola with ``p`` underflowed to 0 cannot have ``nu = pi``) or else the
-    parabola.
+    parabola.  The one place this rule is written on the Python side: numpy
+    selects, so floats and arrays (broadcast together) take the same path.
+
+    Parameters
+    ----------
+    p, e, inv_a, nu : float or ndarray, broadcastable
+        Semi-latus rectum, eccentricity, 1/a and true anomaly (kernel columns).
+
+    Returns
+    -------
+    numpy.float64 or ndarray
+        One of ``ELLIPSE`` ... ``RADIAL_HYPERBOLA``, of the broadcast shape.
 
     Examples
     --------
     >>> import math
-    >>> kind_of(1.0, 0.5, 1.0, 0.0) == ELLIPSE, kind_of(0.0, 1.0, 0.0, math.pi)
+    >>> bool(kind_of(1.0, 0.5, 1.0, 0.0) == ELLIPSE), float(kind_of(0.0, 1.0, 0.0, math.pi))
     (True, 4.0)
+    >>> kind_of(np.array([1.0, 0.0]), np.array([1.0, 1.0]), 0.0, math.pi).tolist()
+    [1.0, 4.0]
     """
-    if e < 1.0:
-        return ELLIPSE
-    if e > 1.0:
-        return HYPERBOLA
-    if inv_a > 0.0:
-        return RADIAL_ELLIPSE
-    if inv_a < 0.0:
-        return RADIAL_HYPERBOLA
-    return RADIAL_PARABOLA if p == 0.0 and nu == math.pi else PARABOLA
-
+    radial = np.where(
+        inv_a > 0.0, RADIAL_ELLIPSE, np.where(inv_a < 0.0, RADIAL_HYPERBOLA, np.where(
+            (p == 0.0) & (nu == math.pi), RADIAL_PARABOLA, PARABOLA)))
+    return np.where(e < 1.0, ELLIPSE, np.where(e > 1.0, HYPERBOLA, radial))[()]

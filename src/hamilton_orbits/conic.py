@@ -31,17 +31,18 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._validation import check_trailing, first_index, fmt_index
+from hamilton_orbits.kepler import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 
 __all__ = ["Conic"]
 
 u = LazyModule("astropy.units", globals(), "u")  # imported on first use
 
-# internal units of a conic built from a Quantity orbit (those of KeplerOrbit)
-_L = "km"
-_V = "km / s"
+# internal units of a conic built from Quantities (those of KeplerOrbit)
+_L, _V, _MU = STATE_UNITS
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -77,8 +78,9 @@ def _in_range(method):
 class Conic:
     """Hamilton's conic section, vectorised over leading dimensions.
 
-    Build from an orbit (``KeplerOrbit.conic``) or with :meth:`from_state`.
-    Plain floats in the orbit's internal units (km, km/s for Quantity orbits).
+    Build from an orbit (``KeplerOrbit.conic``), with :meth:`from_state` or
+    :meth:`from_elements`, or from its attributes.  Plain floats in the
+    orbit's internal units (km, km/s for Quantity orbits).
 
     Attributes
     ----------
@@ -145,37 +147,72 @@ class Conic:
     @property
     def mu(self):
         """Gravitational parameter (Hamilton's M)."""
-        return self._out(self._mu, "km3 / s2")
+        return self._out(self._mu, _MU)
 
     @classmethod
-    def _from_orbit(cls, orbit) -> Conic:
-        col = orbit._col
-        inc = col("inc")
-        lan = col("lan")
-        argp = col("argp")
+    def from_elements(
+        cls, p: Any, e: Any, inv_a: Any, inc: Any, lan: Any, argp: Any, mu: Any, *,
+        quantity: bool = False,
+    ) -> Conic:
+        """The conic of classical elements given as floats.
+
+        Parameters
+        ----------
+        p, e, inv_a : array_like, shape (...)
+            Semi-parameter, eccentricity and 1/a (0 for the parabola), as
+            :class:`~hamilton_orbits.orbit.KeplerOrbit` computes them.
+        inc, lan, argp : array_like, shape (...)
+            Inclination (``inc == pi``, the float, is exactly retrograde),
+            longitude of the ascending node, argument of periapsis, in rad.
+        mu : array_like, shape (...)
+            Gravitational parameter.
+        quantity : bool, optional
+            Whether the floats are in km and km^3/s^2 and the conic's lengths
+            and speeds are to be Quantities (as for a Quantity orbit).
+
+        Returns
+        -------
+        Conic
+            With the periapsis direction ``P = cos(argp) n + sin(argp) m`` and
+            the normal ``(sin inc sin lan, -sin inc cos lan, cos inc)``, where
+            ``n = (cos lan, sin lan, 0)`` points to the ascending node and
+            ``m`` is the normal times ``n``.
+
+        Examples
+        --------
+        >>> c = Conic.from_elements(1.44, 0.44, 0.56, 0.0, 0.0, 0.0, 1.0)
+        >>> c.periapsis_direction.tolist(), c.normal.tolist(), float(c.a)
+        ([1.0, 0.0, 0.0], [0.0, -0.0, 1.0], 1.7857142857142856)
+        """
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))
         cw, sw = np.cos(argp), np.sin(argp)
         P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
         h = np.stack([si * sl, -si * cl, ci], axis=-1)
-        return cls(
-            col("p"), col("e"), col("inv_a"), P, h, orbit._mu,
-            quantity=orbit._quantity,
-        )
+        return cls(p, e, inv_a, P, h, mu, quantity=quantity)
 
     @classmethod
     def from_state(cls, r: Any, v: Any, mu: Any) -> Conic:
-        """The conic through the state ``(r, v)`` (via :class:`KeplerOrbit`).
+        """The conic through the state ``(r, v)`` about ``mu``.
+
+        The state is checked as :meth:`KeplerOrbit.from_state
+        <hamilton_orbits.orbit.KeplerOrbit.from_state>` checks it
+        (:func:`hamilton_orbits.kepler.check_state`; Quantities in give a
+        conic of Quantities), and the elements are the orbit's
+        (:func:`hamilton_orbits.kepler.classical_columns`).
 
         Examples
         --------
         >>> round(float(Conic.from_state([1.0, 0, 0], [0, 1.0, 0], 1.0).e), 12)
         0.0
         """
-        from hamilton_orbits.orbit import KeplerOrbit
-
-        return KeplerOrbit.from_state(r, v, mu).conic
+        state, quantity = check_state(r, v, mu)
+        c, _ = classical_columns(state)
+        p, e, inv_a, inc, lan, argp = (
+            c[CLASSICAL.index(n)] for n in ("p", "e", "inv_a", "inc", "lan", "argp")
+        )
+        return cls.from_elements(p, e, inv_a, inc, lan, argp, state[..., 6], quantity=quantity)
 
     # ---------------------------------------------------------------- shape
     @property

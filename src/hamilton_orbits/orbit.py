@@ -1,9 +1,9 @@
 """Two-body orbits: state vectors <-> orbital elements for every conic.
 
-:class:`KeplerOrbit` stores the state ``(r, v, mu)`` as plain floats and derives
-all elements in one compiled pass (``hamilton_orbits._kernels.elements``), the
-first time one is asked for.  Hamilton's integrals are also available exactly
-as the seed writes them, as quaternion products: :func:`hamilton_beta`
+:class:`KeplerOrbit` keeps the state ``(r, v, mu)`` as float arrays and derives
+all elements from it in compiled passes (``hamilton_orbits._kernels.elements``),
+the first time one is asked for.  Hamilton's integrals are also available
+exactly as the seed writes them, as quaternion products: :func:`hamilton_beta`
 (eq. 3), :func:`hamilton_epsilon_from_products` (eq. 13) and
 :func:`hamilton_p` (eq. 16).
 
@@ -24,7 +24,6 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 from __future__ import annotations
 
 import functools
-import math
 from functools import cached_property
 from typing import Any
 
@@ -40,6 +39,13 @@ from hamilton_orbits._validation import (
     check_trailing,
     first_index,
     fmt_index,
+)
+from hamilton_orbits.conic import Conic
+from hamilton_orbits.kepler import (
+    STATE_UNITS,
+    check_state,
+    classical_columns,
+    refuse_beyond_range,
 )
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import (
@@ -67,22 +73,20 @@ __all__ = [
 ]
 
 # internal units when Quantities come in
-_L = "km"
+_L, _V, _MU = STATE_UNITS
 _T = "s"
-_V = "km / s"
-_MU = "km3 / s2"
 _RAD = "rad"
 
-# _elements: the CLASSICAL columns (p, e, inv_a, inc, lan, argp, nu, a);
-# _full: all COLUMNS (u, the anomaly, M and tau too), computed when one is asked
-# for; _kind: the kind column derived from the classical ones (_columns.kind_of)
+# the rows of an orbit's element columns: _CI for the CLASSICAL columns (computed
+# first, in one pass), _COL for all COLUMNS (u, the anomaly, M too, when asked)
 _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
+_P, _E, _INV_A, _INC, _LAN, _ARGP, _NU, _A = (
+    _CI[n] for n in ("p", "e", "inv_a", "inc", "lan", "argp", "nu", "a")
+)
 _F64 = np.dtype(np.float64)
 _SHAPE3 = (3,)
-_TWO_PI = 2.0 * math.pi
-_f64 = np.float64  # one orbit's elements are read as float64 scalars
-_A1 = _CI["a"]  # the last column
+_ONE_ORBIT_SIZE = _columns.ONE_ORBIT_SIZE
 
 
 def _raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
@@ -101,127 +105,28 @@ def _scalar(a: np.ndarray):
     return a[()] if isinstance(a, np.ndarray) and a.ndim == 0 else a
 
 
-def _check_state(r_in: Any, v_in: Any, mu_in: Any):
-    """Validate (r, v, mu); return float arrays broadcast to a common shape."""
-    q = [is_quantity(x) for x in (r_in, v_in, mu_in)]
-    if any(q) and not all(q):
-        raise ValueError(
-            "Expected `r`, `v`, `mu` to be all Quantities or all plain floats, got a mix"
-        )
-    quantity = all(q)
-    r = check_trailing("r", LENGTH("r", r_in, _L), 3)
-    v = check_trailing("v", SPEED("v", v_in, _V), 3)
-    mu = GM("mu", mu_in, _MU)
-    check_positive("mu", mu)
-    lead = broadcast(("r", "v", "mu"), r[..., 0], v[..., 0], mu)[0].shape
-    r = np.broadcast_to(r, (*lead, 3))
-    v = np.broadcast_to(v, (*lead, 3))
-    mu = np.broadcast_to(mu, lead)
-    bad = ~np.any(r != 0, axis=-1)  # not |r| > 0: |r|^2 underflows at 1e-170
-    if np.any(bad):
-        index = first_index(np.atleast_1d(bad)) if bad.ndim else ()
-        raise ValueError(f"Expected `r` to be nonzero, got {r[index].tolist()}{fmt_index(index)}")
-    return r, v, mu, quantity
-
-
-def _plain_float_array(x: Any) -> np.ndarray | None:
-    """``x`` as a float64 ndarray if it is a plain real ndarray, list or tuple
-    (no Quantity, complex, bool, object or ragged input), else None."""
-    t = type(x)
-    if t is np.ndarray:
-        if x.dtype == np.float64:
-            return x
-    elif t is list or t is tuple:
-        try:
-            x = np.asarray(x)
-        except (ValueError, TypeError, OverflowError):
-            return None
-    else:
-        return None
-    return x.astype(np.float64) if x.dtype.kind in "fiu" else None
-
-
-def _three(x: Any) -> list | tuple | None:
-    """``x`` as three Python floats if it is a float64 array of shape (3,) or a
-    list/tuple of three Python floats, else None."""
+def _three(x: Any) -> np.ndarray | tuple | None:
+    """``x`` if it is a float64 array of shape (3,), as a tuple if it is a list
+    or tuple of three Python floats, else None (the general path then takes
+    it): one orbit's ``r`` or ``v`` for :func:`hamilton_orbits._kernels.elements.one_orbit`."""
     t = type(x)
     if t is np.ndarray:
         # dtype identity: the native float64 (any other dtype takes the general path)
-        if x.dtype is _F64 and x.shape == _SHAPE3:
-            return x.tolist()
-        return None
+        return x if x.dtype is _F64 and x.shape == _SHAPE3 else None
     if (t is list or t is tuple) and len(x) == 3:
         a, b, c = x
         if type(a) is float and type(b) is float and type(c) is float:
-            return x
+            return (a, b, c)
     return None
-
-
-def _one_state(r: Any, v: Any, mu: Any) -> tuple[float, ...] | None:
-    """One orbit in plain floats (``r``, ``v`` lists/tuples of three floats or
-    float64 arrays of shape (3,), ``mu`` a float) as 7 floats, if finite with
-    ``mu > 0`` and ``r != 0``; else None (the general path then decides)."""
-    if type(mu) is not float:
-        return None
-    r = _three(r)
-    v = _three(v)
-    if r is None or v is None:
-        return None
-    rx, ry, rz = r
-    vx, vy, vz = v
-    s = rx + ry + rz + vx + vy + vz + mu  # inf or NaN if any is (or on overflow: then
-    if s - s != 0.0 or not mu > 0.0 or not (rx or ry or rz):  # the general path decides)
-        return None
-    return rx, ry, rz, vx, vy, vz, mu
-
-
-def _check_copy_state_fast(r_in: Any, v_in: Any, mu_in: Any):
-    """The common case of :func:`_check_state` plus the copies ``KeplerOrbit``
-    keeps, in one compiled pass: ``r`` and ``v`` float64 arrays of one shape
-    ``(..., 3)`` and ``mu`` a number or a float64 array of the leading shape.
-    Returns ``(r, v, mu)`` (fresh C-contiguous arrays, as ``__init__`` makes),
-    or None when the input is of another kind or invalid; the caller then takes
-    the general path, which names the first bad argument and index."""
-    r_in = _plain_float_array(r_in)
-    v_in = _plain_float_array(v_in)
-    if r_in is None or v_in is None:
-        return None
-    shape = r_in.shape
-    if v_in.shape != shape or len(shape) == 0 or shape[-1] != 3:
-        return None
-    lead = shape[:-1]
-    if isinstance(mu_in, (float, int)) and not isinstance(mu_in, bool):
-        try:
-            mu_flat = np.full(1, float(mu_in))
-        except OverflowError:
-            return None
-    elif (
-        type(mu_in) is np.ndarray and mu_in.dtype == np.float64
-        and (mu_in.shape == lead or mu_in.shape == ())
-    ):
-        mu_flat = mu_in.reshape(-1)
-    else:
-        return None
-    n = r_in.size // 3
-    r_out = np.empty(shape)
-    v_out = np.empty(shape)
-    mu_out = np.empty(lead)
-    if n == 0:
-        return r_out, v_out, mu_out
-    bad = _el.check_copy_state(
-        r_in.reshape(-1, 3), v_in.reshape(-1, 3), mu_flat,
-        r_out.reshape(-1, 3), v_out.reshape(-1, 3), mu_out.reshape(-1),
-    )
-    return None if bad else (r_out, v_out, mu_out)
 
 
 def _in_range(prop):
     """Derived attribute computed without floating-point warnings; a NaN, or an
-    infinity where the attribute is not documented to be infinite (``a`` of a
-    parabola, ``period`` of an unbound orbit, ``n`` of a radial parabola), means
-    the value is beyond the float64 range for this state and raises ValueError
-    naming ``r``, ``v``, ``mu``."""
-    name = prop.__name__.removeprefix("_").removesuffix("_general")  # _a_general: a
+    infinity where the attribute is not documented to be infinite (``period``
+    of an unbound orbit, ``n`` of a radial parabola), means the value is beyond
+    the float64 range for this state and raises ValueError naming ``r``, ``v``,
+    ``mu``."""
+    name = prop.__name__
 
     @functools.wraps(prop)
     def guarded(self):
@@ -229,27 +134,39 @@ def _in_range(prop):
             value = prop(self)
         raw = value.value if is_quantity(value) else np.asarray(value)
         finite = np.isfinite(raw)
-        if not np.all(finite):
-            kind = self._col("kind")
+        if not finite.all():
+            kind = self._kind
             allowed = {
-                "a": (kind == _el.PARABOLA) | (kind == _el.RADIAL_PARABOLA),
                 "period": ~((kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)),
                 "n": kind == _el.RADIAL_PARABOLA,
-            }.get(name, np.zeros(kind.shape, dtype=bool))
-            if raw.ndim > kind.ndim:
+            }.get(name, np.zeros(np.shape(kind), dtype=bool))
+            if raw.ndim > np.ndim(kind):
                 allowed = allowed[..., None]
-            bad = ~finite & ~(np.isinf(raw) & allowed)
-            if np.any(bad):
-                i = first_index(np.atleast_1d(bad))[: kind.ndim] if kind.ndim else ()
-                r, v = self._r[i], self._v[i]
-                raise ValueError(
-                    f"Expected `r`, `v`, `mu` for which `{name}` fits in float64, got "
-                    f"r={r.tolist()}, v={v.tolist()}, mu={float(self._mu[i])!r}"
-                    f"{fmt_index(i)}"
-                )
+            self._refuse_not_finite(name, finite | (np.isinf(raw) & allowed))
         return value
 
     return guarded
+
+
+def _element(name: str, unit: str | None, doc: str) -> property:
+    """A classical element as a property of :class:`KeplerOrbit`, read from the
+    orbit's element columns (computed on first use): a float64 for one orbit,
+    an array of the leading shape for many, a Quantity in ``unit`` for an
+    orbit built from Quantities.  ``a`` where it alone is beyond float64 (NaN
+    in its column) names the state."""
+    i = _CI[name]
+    is_a = name == "a"
+
+    def read(orbit: KeplerOrbit):
+        c = orbit._classical
+        if c is None:
+            c = orbit._elements()
+        if is_a and orbit._a_beyond:
+            orbit._refuse_not_finite("a", c[i] == c[i])
+        return orbit._out(c[i], unit) if orbit._quantity else c[i]
+
+    read.__name__ = name
+    return property(read, doc=doc)
 
 
 class KeplerOrbit:
@@ -279,6 +196,17 @@ class KeplerOrbit:
     hamilton_epsilon : Hamilton's epsilon = -eccentricity_vector, towards
         apoapsis (eq. 13).
 
+    Notes
+    -----
+    One representation: the state as one float64 array (..., 7), ``[rx, ry,
+    rz, vx, vy, vz, mu]`` (km, km/s, km^3/s^2 for Quantities), and, once
+    computed, the element columns, one row per element (``columns[i]`` is an
+    element of every orbit).  One orbit's elements are a numpy float64, many
+    orbits' an array of their leading shape.  Every attribute is computed the
+    same way for one orbit and for many; the one shortcut is in
+    :meth:`from_state`: one orbit of plain floats is checked and its classical
+    elements computed by one kernel call.
+
     Examples
     --------
     >>> o = KeplerOrbit.from_state([1.0, 0.0, 0.0], [0.0, 1.2, 0.0], 1.0)
@@ -288,38 +216,29 @@ class KeplerOrbit:
     [-0.44, 0.0, 0.0]
     """
 
+    # the number of orbits whose a alone is beyond float64 (NaN in its column),
+    # set when the classical columns are computed
+    _a_beyond = 0
 
-    # one orbit built from plain floats: its 7 floats (r, v, mu), else None; the
-    # arrays _r, _v, _mu (instance attributes otherwise) are then made on demand
-    _one: tuple[float, ...] | None = None
-    _r = cached_property(lambda self: np.array(self._one[:3]))
-    _v = cached_property(lambda self: np.array(self._one[3:6]))
-    _mu = cached_property(lambda self: np.array(self._one[6]))
-    # one orbit from plain floats, once its elements are asked for: the tuple of
-    # _el.classical_one (the CLASSICAL columns), so that reading an element is
-    # an index into it (as a float64 scalar, like the general path's)
-    _c1: tuple[float, ...] | None = None
+    def __init__(
+        self, state: np.ndarray, quantity: bool, classical: np.ndarray | None = None
+    ) -> None:
+        """Keep a checked state; build orbits with :meth:`from_state` or
+        :meth:`from_elements`.
 
-    def _one_classical(self) -> np.ndarray | None:
-        """The row ``_c1`` of a single orbit built from plain floats (computed
-        once, in one kernel call that flags any value beyond float64), or None
-        for a batch, a Quantity orbit or a flagged state (the general path then
-        computes the attribute or names the arguments)."""
-        one = self._one
-        if one is None:
-            return None
-        c = _el.classical_one(*one)
-        if c[_A1] != c[_A1]:  # NaN: beyond float64
-            return None
-        self._c1 = c
-        return c
-
-    def __init__(self, r: np.ndarray, v: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
-        # np.array, not ascontiguousarray (which turns 0-d into 1-d)
-        self._r = np.array(r, dtype=np.float64, order="C")
-        self._v = np.array(v, dtype=np.float64, order="C")
-        self._mu = np.array(mu, dtype=np.float64, order="C")
+        ``state``: float64 array (..., 7), ``[rx, ry, rz, vx, vy, vz, mu]``
+        (:func:`hamilton_orbits.kepler.check_state`), that the orbit keeps and
+        never writes to; ``quantity``: whether it was built from Quantities;
+        ``classical``: its ``CLASSICAL`` columns, shape (NCLASSICAL, ...), if
+        already known."""
+        self._state = state
         self._quantity = quantity
+        self._classical = classical
+
+    # views of the state
+    _r = property(lambda self: self._state[..., :3])
+    _v = property(lambda self: self._state[..., 3:6])
+    _mu = property(lambda self: self._state[..., 6])
 
     # ------------------------------------------------------------------ build
     @classmethod
@@ -352,7 +271,12 @@ class KeplerOrbit:
         -----
         The state is the representation; the elements are derived from it.  Any
         finite state is accepted at any scale (it is brought to order 1 by powers
-        of two inside the kernels, which is exact).
+        of two inside the kernels, which is exact).  The state is checked by
+        :func:`hamilton_orbits.kepler.check_state`; one orbit given as plain
+        floats (``r``, ``v`` three floats each, ``mu`` a float) is checked and
+        its classical elements computed in one kernel call instead
+        (:func:`hamilton_orbits._kernels.elements.one_orbit`, the same rule and
+        the same arithmetic).
 
         *Representation limit near a hyperbola's asymptote.*  Far out along an
         open orbit, ``r`` and ``v`` are nearly parallel and the rounding of the
@@ -386,20 +310,15 @@ class KeplerOrbit:
         >>> o.shape, [round(float(x), 12) for x in o.e]
         ((2,), [0.0, 0.5])
         """
-        one = _one_state(r, v, mu)
-        if one is not None:
-            obj = object.__new__(cls)
-            obj._quantity = False
-            obj._one = one  # _r, _v, _mu are made from it when first needed
-            return obj
-        fast = _check_copy_state_fast(r, v, mu)
-        if fast is not None:
-            obj = cls.__new__(cls)
-            obj._r, obj._v, obj._mu = fast
-            obj._quantity = False
-            return obj
-        r_, v_, mu_, quantity = _check_state(r, v, mu)
-        return cls(r_, v_, mu_, quantity)
+        if type(mu) is float:
+            r3 = _three(r)
+            v3 = _three(v)
+            if r3 is not None and v3 is not None:
+                out = np.empty(_ONE_ORBIT_SIZE)
+                status = _el.one_orbit(out, r3, v3, mu)
+                if status:  # 2: an element beyond float64, computed again and named when read
+                    return cls(out[:7], False, out[7:] if status == 1 else None)
+        return cls(*check_state(r, v, mu))
 
     @classmethod
     def from_elements(
@@ -474,162 +393,76 @@ class KeplerOrbit:
         >>> [round(float(x), 12) + 0.0 for x in r], [round(float(x), 12) + 0.0 for x in v]
         ([0.5, 0.0, 0.0], [0.0, 1.732050807569, 0.0])
         """
-        sizes = [x is not None for x in (a, p, q)]
-        if sum(sizes) != 1:
-            raise ValueError("Expected exactly one of `a`, `p`, `q`")
-        if (nu is None) == (M is None):
-            raise ValueError("Expected exactly one of `nu`, `M`")
-        given = {"a": a, "p": p, "q": q}
-        lname = next(k for k, x in given.items() if x is not None)
-        lval = given[lname]
-        aname = "nu" if nu is not None else "M"
-        aval = nu if nu is not None else M
-        inputs = {"e": e, "inc": inc, "lan": lan, "argp": argp, "mu": mu, lname: lval, aname: aval}
-        qs = {k: is_quantity(x) for k, x in inputs.items()}
-        quantity = qs[lname] or qs["mu"]
-        if quantity and not (qs[lname] and qs["mu"]):
-            raise ValueError(
-                f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
-            )
-        e_ = DIMENSIONLESS("e", e)
-        inc_ = ANGLE("inc", inc)
-        lan_ = ANGLE("lan", lan)
-        argp_ = ANGLE("argp", argp)
-        mu_ = GM("mu", mu, _MU)
-        len_ = LENGTH(lname, lval, _L)
-        ang_ = ANGLE(aname, aval)
-        e_, inc_, lan_, argp_, mu_, len_, ang_ = broadcast(
-            ("e", "inc", "lan", "argp", "mu", lname, aname),
-            e_, inc_, lan_, argp_, mu_, len_, ang_,
+        lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity = _element_inputs(
+            {"a": a, "p": p, "q": q}, {"nu": nu, "M": M}, e, inc, lan, argp, mu
         )
-        shape = e_.shape
-        _raise_at("e", ~(e_ >= 0), e_, ">= 0")
-        check_positive("mu", mu_)
-        _raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi]")
-        radial = np.zeros(shape, dtype=bool)
-        inv_a = np.zeros(shape)
-        if lname == "a":
-            _raise_at("a", len_ == 0, len_, "nonzero")
-            _raise_at("a", (len_ > 0) & (e_ > 1), len_, "< 0 for e > 1 (a and e inconsistent)")
-            _raise_at("a", (len_ < 0) & (e_ < 1), len_, "> 0 for e < 1 (a and e inconsistent)")
-            radial = e_ == 1.0
-            p_ = len_ * (1.0 - e_) * (1.0 + e_)
-            inv_a = np.where(radial, 1.0 / len_, (1.0 - e_) * (1.0 + e_) / np.where(radial, 1, p_))
-        else:
-            _raise_at(lname, ~(len_ > 0), len_, "> 0")
-            p_ = len_ if lname == "p" else len_ * (1.0 + e_)
-            inv_a = (1.0 - e_) * (1.0 + e_) / p_
-        if aname == "nu":
-            _raise_at(
-                "nu", radial, ang_, "to be replaced by `M` for a radial orbit (e == 1, a given)"
-            )
-            anom = np.asarray(_kk.anomaly_from_nu_ufunc(ang_, e_))
-            _raise_at("nu", ~np.isfinite(anom), ang_, "inside the asymptotes (1 + e cos nu > 0)")
-        else:
-            with np.errstate(invalid="ignore"):
-                anom = np.asarray(_kk.solve_ufunc(ang_, np.where(radial, 0.0, e_)))
-            bad = ~np.isfinite(anom) & ~radial
-            if np.any(bad):
-                index = first_index(np.atleast_1d(bad))
-                raise ConvergenceError(
-                    f"Kepler's equation not solved for `M` = "
-                    f"{float(np.atleast_1d(ang_)[index])!r}{fmt_index(index if bad.ndim else ())}"
-                )
-        el = np.stack(
-            [p_ * 1.0, e_ * 1.0, inv_a * 1.0, inc_, lan_, argp_, np.where(radial, 0.0, anom)],
-            axis=-1,
-        ).reshape(-1, 7)
-        flat_mu = np.ascontiguousarray(mu_.reshape(-1), dtype=np.float64)
-        r_out = np.empty((el.shape[0], 3))
-        v_out = np.empty((el.shape[0], 3))
-        el[:, 0] = np.where(radial.reshape(-1), 0.0, el[:, 0])
-        _el.elements_to_state(np.ascontiguousarray(el), flat_mu, r_out, v_out)
-        if np.any(radial):
-            _radial_from_mean(el, flat_mu, ang_.reshape(-1), radial.reshape(-1), r_out, v_out)
-        r_out = r_out.reshape((*shape, 3))
-        v_out = v_out.reshape((*shape, 3))
-        bad = ~np.all(np.isfinite(r_out) & np.isfinite(v_out), axis=-1)
-        _raise_at(lname, bad, len_, "to give a finite state (check the elements)")
-        return cls(r_out, v_out, mu_, quantity)
+        p_, inv_a, radial = _p_and_inv_a(lname, length, e_)
+        anom = _anomaly_of(aname, angle, e_, radial)
+        state = _state_of(p_, e_, inv_a, inc_, lan_, argp_, anom, radial, mu_, angle)
+        bad = ~np.all(np.isfinite(state[..., :6]), axis=-1)
+        _raise_at(lname, bad, length, "to give a finite state (check the elements)")
+        return cls(state, quantity)
 
     # --------------------------------------------------------------- elements
-    @cached_property
     def _elements(self) -> np.ndarray:
-        # the CLASSICAL columns (_el.classical_one), shape (..., NCLASSICAL)
-        one = self._one
-        if one is not None:  # one orbit from plain floats: no arrays for the kernel
-            row = np.array(self._c1 or _el.classical_one(*one))
-            if not math.isfinite(row[:_A1].sum()):
-                _refuse_beyond_range(row[None, :_A1], np.array([one[:3]]),
-                                     np.array([one[3:6]]), np.array([one[6]]), ())
-            return row
-        flat_r = self._r.reshape(-1, 3)
-        flat_v = self._v.reshape(-1, 3)
-        flat_mu = self._mu.reshape(-1)
-        out = np.empty((flat_r.shape[0], _columns.NCLASSICAL))
-        bad = _el.state_to_elements_classical(flat_r, flat_v, flat_mu, out)
-        if bad:  # a NaN a: a row beyond float64 is refused here, naming the first;
-            # else a is beyond float64 somewhere, refused when it is read (a)
-            _refuse_beyond_range(out[:, :_A1], flat_r, flat_v, flat_mu, self._mu.shape)
-        self.__dict__["_a_bad"] = bad
-        return out.reshape((*self._mu.shape, _columns.NCLASSICAL))
+        """The ``CLASSICAL`` columns, shape (NCLASSICAL, ...), computed on first use."""
+        c = self._classical
+        if c is None:
+            c, self._a_beyond = classical_columns(self._state)
+            self._classical = c
+        return c
 
     @cached_property
     def _full(self) -> np.ndarray:
-        # every column of COLUMNS (the classical ones bit for bit as in _elements)
-        one = self._one
-        if one is not None:
-            out = np.array(_el.state_to_elements_row(*one, True))[None]
-        else:
-            out = np.empty((self._mu.size, _columns.NCOL))
-            _el.state_to_elements(
-                self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), out
-            )
-        _refuse_beyond_range(out, self._r.reshape(-1, 3), self._v.reshape(-1, 3),
-                             self._mu.reshape(-1), self._mu.shape)
-        return out.reshape((*self._mu.shape, _columns.NCOL))
+        """Every column of ``COLUMNS`` (the anomaly, M and u too), shape
+        (NCOL, ...); the classical ones bit for bit those of :meth:`_elements`."""
+        rows = self._state.reshape(-1, 7)
+        out = np.empty((rows.shape[0], _columns.NCOL))
+        _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        refuse_beyond_range(out, rows, self.shape)
+        return out.T.reshape((_columns.NCOL, *self.shape))  # a view
 
     @cached_property
     def _kind(self) -> np.ndarray:
-        # _columns.kind_of on every orbit (the kind column of _full, bit for bit)
-        p, e, inv_a, nu = (self._col(n) for n in ("p", "e", "inv_a", "nu"))
-        radial = np.where(
-            inv_a > 0.0, _el.RADIAL_ELLIPSE, np.where(inv_a < 0.0, _el.RADIAL_HYPERBOLA, np.where(
-                (p == 0.0) & (nu == math.pi), _el.RADIAL_PARABOLA, _el.PARABOLA)))
-        return np.where(e < 1.0, _el.ELLIPSE, np.where(e > 1.0, _el.HYPERBOLA, radial))
+        """The kind of every orbit (``_columns.kind_of`` of the classical
+        columns: the kernel's kind column, without the full kernel)."""
+        c = self._elements()
+        return _columns.kind_of(c[_P], c[_E], c[_INV_A], c[_NU])
 
     def _col(self, name: str) -> np.ndarray:
-        if name == "kind":
-            kind = self.__dict__.get("_kind")
-            if kind is None:
-                kind = self.__dict__["_kind"] = KeplerOrbit._kind.func(self)
-            return kind
+        """The float column of element ``name`` (a ``COLUMNS`` name or ``a``)."""
         i = _CI.get(name)
         if i is not None:
-            el = self.__dict__.get("_elements")
-            if el is None:  # as self._elements, without cached_property's lock (3.11)
-                el = self.__dict__["_elements"] = KeplerOrbit._elements.func(self)
-            return el[i] if el.ndim == 1 else el[..., i]
-        full = self.__dict__.get("_full")
-        if full is None:
-            full = self.__dict__["_full"] = KeplerOrbit._full.func(self)
-        i = _COL[name]
-        return full[i] if full.ndim == 1 else full[..., i]
+            return self._elements()[i]
+        return self._full[_COL[name]]
 
-    def _out(self, value: np.ndarray, unit: u.UnitBase | None):
+    def _out(self, value: np.ndarray, unit: str | None):
+        """A float result as returned: a float64 for one orbit, an array for
+        many, a Quantity in ``unit`` (if not None) for an orbit of Quantities."""
         if not self._quantity:
-            if type(value) is np.float64:
-                return value
-            return value[()] if value.ndim == 0 else value
+            return value[()] if type(value) is np.ndarray and value.ndim == 0 else value
         if unit is not None:
             # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
             return wrap(np.array(value, dtype=np.float64), unit, True)
         return _scalar(np.asarray(value))
 
+    def _refuse_not_finite(self, name: str, finite: np.ndarray) -> None:
+        """Raise, if ``finite`` is not all true, naming ``r``, ``v``, ``mu`` of
+        the first orbit where attribute ``name`` is beyond the float64 range."""
+        if np.all(finite):
+            return
+        ndim = len(self.shape)
+        i = first_index(np.atleast_1d(~finite))[:ndim] if ndim else ()
+        raise ValueError(
+            f"Expected `r`, `v`, `mu` for which `{name}` fits in float64, got "
+            f"r={self._r[i].tolist()}, v={self._v[i].tolist()}, mu={float(self._mu[i])!r}"
+            f"{fmt_index(i)}"
+        )
+
     @property
     def shape(self) -> tuple[int, ...]:
         """Leading shape (number of orbits in each dimension)."""
-        return self._mu.shape
+        return self._state.shape[:-1]
 
     def __len__(self) -> int:
         if not self.shape:
@@ -639,7 +472,9 @@ class KeplerOrbit:
     def __getitem__(self, key: Any) -> KeplerOrbit:
         if not self.shape:
             raise IndexError("a single KeplerOrbit cannot be indexed")
-        return KeplerOrbit(self._r[key], self._v[key], self._mu[key], self._quantity)
+        # the key indexes the leading dimensions (an Ellipsis in it too)
+        key = (*key, slice(None)) if type(key) is tuple else (key, slice(None))
+        return KeplerOrbit(self._state[key], self._quantity)
 
     def __repr__(self) -> str:
         """One orbit: its elements (with units if built from Quantities; angles
@@ -683,79 +518,26 @@ class KeplerOrbit:
         """Gravitational parameter (length^3/time^2)."""
         return self._out(self._mu, _MU)
 
-    @property
-    def e(self):
-        """Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[1])
-        return self._out(self._col("e"), None)
+    e = _element(
+        "e", None, "Eccentricity (0 below 4 eps; exactly 1 for parabolic and radial orbits)."
+    )
+    p = _element("p", _L, "Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16).")
+    inc = _element("inc", _RAD, "Inclination in [0, pi] (rad).")
+    lan = _element(
+        "lan", _RAD, "Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."
+    )
+    argp = _element("argp", _RAD, "Argument of periapsis in [0, 2 pi); 0 when ``e = 0``.")
+    nu = _element("nu", _RAD, "True anomaly in (-pi, pi] (Hamilton's v, eq. 18).")
 
-    @property
-    def p(self):
-        """Semi-latus rectum ``p = h^2/mu`` (Hamilton's ``-beta^2/M``, eq. 16)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[0])
-        return self._out(self._col("p"), _L)
-
-    @property
-    def _inv_a(self) -> np.ndarray:
-        return self._col("inv_a")
-
-    @property
-    def a(self):
-        """Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[_A1])
-        a = self._col("a")
-        if self.__dict__.get("_a_bad") == 0:  # the kernel's a is finite (or a parabola's inf)
-            return self._out(a, _L)
-        return self._a_general
-
-    @property
-    @_in_range
-    def _a_general(self):
-        with np.errstate(divide="ignore"):  # inv_a is +0.0 exactly for the parabola: a = +inf
-            return self._out(1.0 / self._inv_a, _L)
+    a = _element(
+        "a", _L,
+        "Semi-major axis ``1/(2/r - v^2/mu)``; ``inf`` for the parabola, < 0 if hyperbolic.",
+    )
 
     @property
     def q(self):
         """Periapsis distance ``p / (1 + e)`` (0 for radial orbits)."""
         return self._out(self._col("p") / (1.0 + self._col("e")), _L)
-
-    @property
-    def inc(self):
-        """Inclination in [0, pi] (rad)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[3])
-        return self._out(self._col("inc"), _RAD)
-
-    @property
-    def lan(self):
-        """Longitude of the ascending node in [0, 2 pi); 0 when ``inc`` is 0 or pi."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[4])
-        return self._out(self._col("lan"), _RAD)
-
-    @property
-    def argp(self):
-        """Argument of periapsis in [0, 2 pi); 0 when ``e = 0``."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[5])
-        return self._out(self._col("argp"), _RAD)
-
-    @property
-    def nu(self):
-        """True anomaly in (-pi, pi] (Hamilton's v, eq. 18)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            return _f64(c[6])
-        return self._out(self._col("nu"), _RAD)
 
     @property
     def anomaly(self):
@@ -771,13 +553,12 @@ class KeplerOrbit:
         """Mean anomaly: ``E - e sin E``, ``D + D^3/3`` (Barker) or ``e sinh F - F``."""
         return self._out(self._col("M"), _RAD)
 
-    @property
-    def _n(self) -> np.ndarray:
-        kind = self._col("kind")
-        inv = np.abs(self._inv_a)
+    def _mean_motion(self) -> np.ndarray:
+        """n as floats (callers guard the float range)."""
+        kind = self._kind
+        inv = np.abs(self._col("inv_a"))
         p = self._col("p")
-        e = self._col("e")
-        q = np.where(p > 0, p / (1.0 + e), 1.0)
+        q = np.where(p > 0, p / (1.0 + self._col("e")), 1.0)
         n = np.where(
             kind == _el.PARABOLA,
             np.sqrt(self._mu / (2.0 * q**3)),
@@ -785,76 +566,34 @@ class KeplerOrbit:
         )
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
 
-    def _n_one(self) -> float | None:
-        """Mean motion of one orbit from plain floats, in Python floats (the
-        formula of ``_n``, bit for bit); None for a batch, a parabola or a value
-        beyond float64 (the general path then answers or names the state)."""
-        c = self._c1
-        if c is None and (c := self._one_classical()) is None:
-            return None
-        kind = _columns.kind_of(c[0], c[1], c[2], c[6])
-        if kind == _columns.PARABOLA or kind == _columns.RADIAL_PARABOLA:
-            return None
-        inv = abs(c[2])
-        n = math.sqrt(self._one[6]) * inv * math.sqrt(inv)
-        return n if 0.0 < n < math.inf else None
-
     @property
+    @_in_range
     def n(self):
         """Mean motion ``sqrt(mu/|a|^3)``; parabola ``sqrt(mu / (2 q^3))``; radial parabola inf."""
-        n = self._n_one()
-        return self._n_general if n is None else _f64(n)
+        return self._out(self._mean_motion(), "rad / s")
 
     @property
     @_in_range
-    def _n_general(self):
-        return self._out(self._n, "rad / s")
-
-    @property
     def period(self):
         """Orbital period ``2 pi / n`` (inf for unbound orbits)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            kind = _columns.kind_of(c[0], c[1], c[2], c[6])
-            if kind != _columns.ELLIPSE and kind != _columns.RADIAL_ELLIPSE:
-                return _f64(math.inf)
-            n = self._n_one()
-            if n is not None and (t := 2.0 * math.pi / n) < math.inf:
-                return _f64(t)
-        return self._period_general
-
-    @property
-    @_in_range
-    def _period_general(self):
-        kind = self._col("kind")
+        kind = self._kind
         bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
-        n = np.where(bound, self._n, 1.0)
+        n = np.where(bound, self._mean_motion(), 1.0)
         return self._out(np.where(bound, 2.0 * np.pi / n, np.inf), _T)
 
     @property
+    @_in_range
     def energy(self):
         """Specific orbital energy ``-mu / (2 a)`` (0 for the parabola)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            w = -0.5 * self._one[6] * c[2]
-            if abs(w) < math.inf:
-                return _f64(w)
-        return self._energy_general
-
-    @property
-    @_in_range
-    def _energy_general(self):
-        return self._out(-0.5 * self._mu * self._inv_a, "km2 / s2")
+        return self._out(-0.5 * self._mu * self._col("inv_a"), "km2 / s2")
 
     @cached_property
     def _tau(self) -> np.ndarray:
-        flat_r = self._r.reshape(-1, 3)
-        flat_v = self._v.reshape(-1, 3)
-        flat_mu = self._mu.reshape(-1)
-        out = np.empty(flat_r.shape[0])
-        _el.state_to_time_since_periapsis(flat_r, flat_v, flat_mu, out)
-        _refuse_beyond_range(out[:, None], flat_r, flat_v, flat_mu, self._mu.shape)
-        return out.reshape(self._mu.shape)
+        rows = self._state.reshape(-1, 7)
+        out = np.empty(rows.shape[0])
+        _el.state_to_time_since_periapsis(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        refuse_beyond_range(out[:, None], rows, self.shape)
+        return out.reshape(self.shape)
 
     @property
     def time_since_periapsis(self):
@@ -877,10 +616,6 @@ class KeplerOrbit:
     @property
     def varpi(self):
         """Longitude of periapsis ``lan + argp`` (``lan - argp`` for inc > pi/2), [0, 2 pi)."""
-        c = self._c1
-        if c is not None or (c := self._one_classical()) is not None:
-            y = (c[4] + (1.0 if c[3] <= 0.5 * math.pi else -1.0) * c[5]) % _TWO_PI  # as _wrap2pi
-            return _f64(0.0 if y >= _TWO_PI else y)
         return self._out(_wrap2pi(self._col("lan") + self._sign * self._col("argp")), _RAD)
 
     @property
@@ -898,61 +633,27 @@ class KeplerOrbit:
         """``varpi + M`` (``varpi - M`` for inc > pi/2); in [0, 2 pi) for bound orbits."""
         varpi = self._col("lan") + self._sign * self._col("argp")
         ml = varpi + self._sign * self._col("M")
-        kind = self._col("kind")
+        kind = self._kind
         bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)
         return self._out(np.where(bound, _wrap2pi(ml), ml), _RAD)
 
     @property
+    @_in_range
     def areal_vector(self):
         """Hamilton's beta = r x v (seed eq. 3), normal to the plane, twice the areal velocity."""
-        one = self._one
-        if one is not None:  # Python floats, as np.cross computes them
-            rx, ry, rz, vx, vy, vz, _ = one
-            h = (ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
-            if abs(h[0] + h[1] + h[2]) < math.inf:
-                return np.array(h)
-        return self._areal_vector_general
-
-    @property
-    @_in_range
-    def _areal_vector_general(self):
         return self._out(np.cross(self._r, self._v), "km2 / s")
 
     @property
+    @_in_range
     def eccentricity_vector(self):
         """Modern eccentricity vector ``((v^2 - mu/r) r - (r.v) v)/mu``, towards periapsis."""
-        e = self._ecc_vector_one()
-        return self._eccentricity_vector_general if e is None else np.array(e)
-
-    @property
-    @_in_range
-    def _eccentricity_vector_general(self):
         return self._out(_ecc_vector(self._r, self._v, self._mu), None)
 
     @property
+    @_in_range
     def hamilton_epsilon(self):
         """Hamilton's epsilon ``iota - v beta / M`` (eq. 13) = -eccentricity_vector, to apoapsis."""
-        e = self._ecc_vector_one()
-        return self._hamilton_epsilon_general if e is None else -np.array(e)
-
-    @property
-    @_in_range
-    def _hamilton_epsilon_general(self):
         return self._out(-_ecc_vector(self._r, self._v, self._mu), None)
-
-    def _ecc_vector_one(self) -> tuple[float, float, float] | None:
-        """:func:`_ecc_vector` of one orbit from plain floats in Python floats (the
-        same operations in the same order), or None (a batch, a Quantity orbit,
-        or a value beyond float64: the general path then answers or names it)."""
-        one = self._one
-        if one is None:
-            return None
-        rx, ry, rz, vx, vy, vz, m = one
-        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
-        f = vx * vx + vy * vy + vz * vz - m / rn
-        rv = rx * vx + ry * vy + rz * vz
-        e = ((f * rx - rv * vx) / m, (f * ry - rv * vy) / m, (f * rz - rv * vz) / m)
-        return e if abs(e[0] + e[1] + e[2]) < math.inf else None
 
     # ----------------------------------------------------------------- methods
     def state(self) -> tuple[Any, Any]:
@@ -969,7 +670,8 @@ class KeplerOrbit:
     def propagate(self, dt: Any) -> KeplerOrbit:
         """The orbit after time ``dt`` (any sign; broadcast over the leading dims).
 
-        By universal variables (:func:`hamilton_orbits.kepler.propagate`).
+        By universal variables, the kernel of :func:`hamilton_orbits.kepler.propagate`
+        on the orbit's state (checked when the orbit was built).
 
         Parameters
         ----------
@@ -979,6 +681,14 @@ class KeplerOrbit:
         -------
         KeplerOrbit
 
+        Raises
+        ------
+        ValueError
+            NaN / inf, shapes that do not broadcast, a Quantity ``dt`` for an
+            orbit of plain floats or the reverse.
+        ConvergenceError
+            As :func:`hamilton_orbits.kepler.propagate`.
+
         Examples
         --------
         >>> o = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.1, lan=0.2, argp=0.3,
@@ -986,84 +696,49 @@ class KeplerOrbit:
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
-        fast = self._propagate_fast(dt)
-        if fast is not None:
-            return fast
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
-        dt_ = TIME("dt", dt, _T)
-        r, v = _kepler.propagate(self._r, self._v, self._mu, dt_)
-        mu = np.broadcast_to(self._mu, np.shape(r)[:-1])
-        return KeplerOrbit(r, v, mu, self._quantity)
-
-    def _propagate_fast(self, dt: Any) -> KeplerOrbit | None:
-        """:meth:`propagate` for plain floats: ``dt`` a finite number or a float64
-        array of the orbit's shape; the state was validated when the orbit was
-        built.  None for anything else or on failure (the general path then
-        names the argument)."""
-        if self._quantity:
-            return None
-        one = self._one
-        if one is not None and type(dt) is float and math.isfinite(dt):
-            *state, ok = _kk.propagate_one(*one, dt)
-            if not ok or not (state[0] or state[1] or state[2]):
-                return None
-            obj = KeplerOrbit.__new__(KeplerOrbit)
-            obj._quantity = False
-            obj._one = (*state, one[6])
-            return obj
-        lead = self._mu.shape
-        n = self._mu.size
-        if type(dt) is float or (type(dt) is int and -(2**53) <= dt <= 2**53):
-            if not math.isfinite(dt):
-                return None
-            dtb = np.full(n, dt, dtype=np.float64)
-        elif (
-            type(dt) is np.ndarray and dt.dtype == np.float64 and dt.shape in (lead, ())
-            and bool(np.isfinite(dt).all())
-        ):
-            dtb = np.ascontiguousarray(np.broadcast_to(dt, lead)).reshape(n)
-        else:
-            return None
-        r_out = np.empty((n, 3))
-        v_out = np.empty((n, 3))
-        if n and _kk.propagate_batch(
-            self._r.reshape(-1, 3), self._v.reshape(-1, 3), self._mu.reshape(-1), dtb,
-            r_out, v_out,
-        ) >= 0:
-            return None
-        obj = KeplerOrbit.__new__(KeplerOrbit)
-        obj._r = r_out.reshape((*lead, 3))
-        obj._v = v_out.reshape((*lead, 3))
-        obj._mu = self._mu  # never written to
-        obj._quantity = False
-        return obj
+        dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below
+        shape = self.shape
+        try:
+            lead = shape if dt_.shape in (shape, ()) else np.broadcast_shapes(shape, dt_.shape)
+        except ValueError:
+            lead = None
+        if lead is not None:
+            # a copy of the state, propagated in place (the kernel reads a row before
+            # it writes it)
+            new = self._state.copy() if lead == shape else np.array(
+                np.broadcast_to(self._state, (*lead, 7)))
+            rows = new.reshape(-1, 7)
+            r, v = rows[:, :3], rows[:, 3:6]
+            if dt_.shape == lead:
+                dts = dt_.reshape(-1)
+            elif dt_.ndim == 0:  # one dt for every orbit
+                dts = np.full(rows.shape[0], dt_)
+            else:
+                dts = np.broadcast_to(dt_, lead).reshape(-1)
+            if rows.shape[0] and _kk.propagate_batch(r, v, rows[:, 6], dts, r, v) < 0:
+                return KeplerOrbit(new, self._quantity)
+        # dt not finite, shapes that do not broadcast, a state the kernel cannot
+        # propagate, or no orbit at all: the public function names the bad value
+        # (the same kernel, the same result)
+        r, v = _kepler.propagate(self._r, self._v, self._mu, TIME("dt", dt, _T))
+        mu = np.broadcast_to(self._mu, r.shape[:-1])[..., None]
+        return KeplerOrbit(np.concatenate([r, v, mu], axis=-1), self._quantity)
 
     @property
-    def conic(self):
-        """Hamilton's geometry of the orbit, a :class:`hamilton_orbits.conic.Conic`."""
-        from hamilton_orbits.conic import Conic
+    def conic(self) -> Conic:
+        """Hamilton's geometry of the orbit, a :class:`hamilton_orbits.conic.Conic`.
 
-        return Conic._from_orbit(self)
-
-
-def _refuse_beyond_range(out, r, v, mu, shape) -> None:
-    """Raise if a kernel row is not finite: the state's elements do not fit in
-    float64 (``|r| |v|^2 / mu``, ~e, beyond 2^450, or ``p``, ``1/a`` or the time
-    beyond the float range).  One fast reduction in the common case."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        if np.isfinite(out.sum()):
-            return
-    rows = ~np.all(np.isfinite(out), axis=-1)
-    if not np.any(rows):
-        return
-    i = int(np.flatnonzero(rows)[0])
-    where = fmt_index(tuple(int(k) for k in np.unravel_index(i, shape))) if shape else ""
-    raise ValueError(
-        f"Expected `r`, `v`, `mu` whose elements fit in float64 (|r| |v|^2 / mu ~ e below "
-        f"2^450 ~ 3e135, p and a below 1e308), got r={r[i].tolist()}, v={v[i].tolist()}, "
-        f"mu={float(mu[i])!r}{where}"
-    )
+        Examples
+        --------
+        >>> KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0).conic
+        Conic(p=1.44, e=0.44, inv_a=0.56)
+        """
+        c = self._elements()
+        return Conic.from_elements(
+            c[_P], c[_E], c[_INV_A], c[_INC], c[_LAN], c[_ARGP], self._mu, quantity=self._quantity
+        )
 
 
 def _wrap2pi(x: np.ndarray) -> np.ndarray:
@@ -1077,6 +752,104 @@ def _ecc_vector(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
     rv = np.einsum("...i,...i->...", r, v)[..., None]
     m = mu[..., None]
     return ((v2 - m / rn) * r - rv * v) / m
+
+
+# ---------------------------------------------------------------------------
+# the pieces of KeplerOrbit.from_elements
+# ---------------------------------------------------------------------------
+
+
+def _element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
+    """The arguments of :meth:`KeplerOrbit.from_elements` checked and as floats.
+
+    ``lengths`` maps ``a``, ``p``, ``q`` and ``anomalies`` ``nu``, ``M`` to the
+    values given (None if not); exactly one of each must be given.  Returns
+    ``(lname, length, aname, angle, e, inc, lan, argp, mu, quantity)``: the
+    name and value of the length and of the anomaly given, and every value as
+    float arrays broadcast together (km and km^3/s^2 if ``quantity``), with
+    ``e >= 0``, ``mu > 0`` and ``inc`` in [0, pi] checked."""
+    if sum(x is not None for x in lengths.values()) != 1:
+        raise ValueError("Expected exactly one of `a`, `p`, `q`")
+    if sum(x is not None for x in anomalies.values()) != 1:
+        raise ValueError("Expected exactly one of `nu`, `M`")
+    lname, lval = next((k, x) for k, x in lengths.items() if x is not None)
+    aname, aval = next((k, x) for k, x in anomalies.items() if x is not None)
+    quantity = is_quantity(lval) or is_quantity(mu)
+    if quantity and not (is_quantity(lval) and is_quantity(mu)):
+        raise ValueError(
+            f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
+        )
+    values = broadcast(
+        ("e", "inc", "lan", "argp", "mu", lname, aname),
+        DIMENSIONLESS("e", e), ANGLE("inc", inc), ANGLE("lan", lan), ANGLE("argp", argp),
+        GM("mu", mu, _MU), LENGTH(lname, lval, _L), ANGLE(aname, aval),
+    )
+    e_, inc_, lan_, argp_, mu_, length, angle = values
+    _raise_at("e", ~(e_ >= 0), e_, ">= 0")
+    check_positive("mu", mu_)
+    _raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi]")
+    return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
+
+
+def _p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray):
+    """``(p, 1/a, radial)`` from ``a``, ``p`` or ``q`` (``lname``) and ``e``;
+    ``radial`` where ``e == 1`` with ``a`` given (the rectilinear orbit of that
+    energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0."""
+    if lname != "a":
+        _raise_at(lname, ~(length > 0), length, "> 0")
+        p = length if lname == "p" else length * (1.0 + e)
+        return p, (1.0 - e) * (1.0 + e) / p, np.zeros(e.shape, dtype=bool)
+    _raise_at("a", length == 0, length, "nonzero")
+    _raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)")
+    _raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)")
+    radial = e == 1.0
+    p = length * (1.0 - e) * (1.0 + e)
+    inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
+    return p, inv_a, radial
+
+
+def _anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray):
+    """The anomaly (E, D or F by ``e``) from ``nu`` or ``M`` (``aname``); NaN
+    for a radial orbit (its M is solved by :func:`_radial_from_mean`).
+    Refuses ``nu`` for a radial orbit or beyond the asymptote, and a Kepler
+    equation not solved (ConvergenceError)."""
+    if aname == "nu":
+        _raise_at(
+            "nu", radial, angle, "to be replaced by `M` for a radial orbit (e == 1, a given)"
+        )
+        anom = np.asarray(_kk.anomaly_from_nu_ufunc(angle, e))
+        _raise_at("nu", ~np.isfinite(anom), angle, "inside the asymptotes (1 + e cos nu > 0)")
+        return anom
+    with np.errstate(invalid="ignore"):
+        anom = np.asarray(_kk.solve_ufunc(angle, np.where(radial, 0.0, e)))
+    bad = ~np.isfinite(anom) & ~radial
+    if np.any(bad):
+        index = first_index(np.atleast_1d(bad))
+        raise ConvergenceError(
+            f"Kepler's equation not solved for `M` = "
+            f"{float(np.atleast_1d(angle)[index])!r}{fmt_index(index if bad.ndim else ())}"
+        )
+    return anom
+
+
+def _state_of(p, e, inv_a, inc, lan, argp, anom, radial, mu, m):
+    """The state (..., 7) of the elements (one compiled pass; radial orbits
+    from their mean anomaly ``m``)."""
+    shape = e.shape
+    el = np.stack(
+        [p * 1.0, e * 1.0, inv_a * 1.0, inc, lan, argp, np.where(radial, 0.0, anom)],
+        axis=-1,
+    ).reshape(-1, 7)
+    flat_mu = np.ascontiguousarray(mu.reshape(-1), dtype=np.float64)
+    state = np.empty((*shape, 7))
+    rows = state.reshape(-1, 7)
+    rows[:, 6] = flat_mu
+    r_out, v_out = rows[:, :3], rows[:, 3:6]
+    el[:, 0] = np.where(radial.reshape(-1), 0.0, el[:, 0])
+    _el.elements_to_state(np.ascontiguousarray(el), flat_mu, r_out, v_out)
+    if np.any(radial):
+        _radial_from_mean(el, flat_mu, m.reshape(-1), radial.reshape(-1), r_out, v_out)
+    return state
 
 
 def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:

@@ -124,6 +124,40 @@ def test_orbit_conic_matches_state():
     assert np.allclose(c.normal, o.areal_vector / np.linalg.norm(o.areal_vector), atol=4 * EPS)
 
 
+@pytest.mark.parametrize("quantity", [False, True])
+def test_conic_from_state_and_from_elements_equal_the_orbits(quantity):
+    """Conic.from_state (built on kepler.check_state and classical_columns, not
+    on KeplerOrbit) and Conic.from_elements of the orbit's floats give the
+    orbit's conic bit for bit, units included."""
+    r, v = _states(1.5)
+    r, v = np.vstack([r, [[1.0, 0, 0]]]), np.vstack([v, [[0.5, 0, 0]]])  # and a radial one
+    mu = 0.7
+    if quantity:
+        r, v, mu = r * u.km, v * u.km / u.s, mu * u.km**3 / u.s**2
+    o = KeplerOrbit.from_state(r, v, mu)
+    ref = o.conic
+
+    def floats(x):
+        return x.value if quantity else x
+
+    built = Conic.from_elements(
+        floats(ref.p), ref.e, floats(ref.inv_a), floats(o.inc), floats(o.lan), floats(o.argp),
+        floats(o.mu), quantity=quantity,
+    )
+    for c in (Conic.from_state(r, v, mu), built):
+        for name in ("p", "e", "inv_a", "mu", "periapsis_direction", "normal"):
+            x, y = getattr(c, name), getattr(ref, name)
+            assert type(x) is type(y), name
+            np.testing.assert_array_equal(x, y, err_msg=name)
+
+
+def test_conic_from_state_refuses_bad_states_by_name():
+    with pytest.raises(ValueError, match=r"Expected `r` to be nonzero, got \[0.0, 0.0, 0.0\]"):
+        Conic.from_state([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0)
+    with pytest.raises(ValueError, match=r"`mu` > 0, got -1\.0"):
+        Conic.from_state([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], -1.0)
+
+
 def test_quantities_in_quantities_out():
     """A conic from a Quantity orbit speaks km and km/s; plain floats are not mixed in."""
     r = [6524.834, 6862.875, 6448.296] * u.km  # Vallado, 4th ed., Example 2-5

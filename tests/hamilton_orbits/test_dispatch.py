@@ -85,7 +85,7 @@ def _work(seed: int) -> list[np.ndarray]:
 
 def test_calls_from_four_threads(monkeypatch):
     monkeypatch.setattr(_dispatch, "_cores_busy", lambda: False)  # parallel above threshold
-    for name in ("state_to_elements", "state_to_elements_basic", "check_copy_state"):
+    for name in ("state_to_elements", "state_to_elements_classical", "check_copy_state"):
         monkeypatch.setattr(getattr(_el, name), "threshold", 1000)  # small parallel calls
     expected = [_work(seed) for seed in range(8)]
     with ThreadPoolExecutor(max_workers=4) as pool:
@@ -109,7 +109,7 @@ def test_threads_with_workqueue_layer_do_not_abort():
         from hamilton_orbits._kernels import elements as _el, _dispatch
 
         _dispatch._cores_busy = lambda: False  # launch in parallel even on a loaded machine
-        for k in (_el.state_to_elements_basic, _el.check_copy_state):
+        for k in (_el.state_to_elements_classical, _el.check_copy_state):
             k.threshold = 1000  # many small parallel launches, quickly
         n = 4000
         def work(seed):

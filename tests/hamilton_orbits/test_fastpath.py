@@ -25,13 +25,22 @@ def _states(n: int, seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
     return r, v
 
 
+def _basic_columns(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """The reference the classical columns are checked against: the one-state
+    kernel with ``full=False`` (no anomaly, M and tau: NaN for non-radial
+    orbits), row by row, shape (N, NCOL)."""
+    return np.array([
+        _el.state_to_elements_scaled(*ri, *vi, m, False, False)
+        for ri, vi, m in zip(r, v, mu, strict=True)
+    ])
+
+
 def test_basic_kernel_columns_equal_full_kernel():
     r, v = _states(200)
     mu = np.ones(len(r))
     full = np.empty((len(r), _el.NCOL))
-    basic = np.empty((len(r), _el.NCOL))
     _el.state_to_elements(r, v, mu, full)
-    _el.state_to_elements_basic(r, v, mu, basic)
+    basic = _basic_columns(r, v, mu)
     keep = [i for i, c in enumerate(_el.COLUMNS) if c not in ("anomaly", "M", "tau")]
     np.testing.assert_array_equal(basic[:, keep], full[:, keep])
 
@@ -152,8 +161,7 @@ def test_batch_a_from_the_kernel_is_one_over_inv_a():
     v = np.array([s[1] for s in ONE_STATES])
     o = KeplerOrbit.from_state(r, v, 1.0)
     a = o.a
-    basic = np.empty((len(r), _el.NCOL))
-    _el.state_to_elements_basic(r, v, np.ones(len(r)), basic)
+    basic = _basic_columns(r, v, np.ones(len(r)))
     inv = basic[:, _el.COLUMNS.index("inv_a")]
     assert a[2] == np.inf and inv[2] == 0.0  # the parabola
     finite = inv != 0
@@ -275,3 +283,41 @@ def test_argument_of_latitude_comes_from_the_full_kernel():
     np.testing.assert_array_equal(o.argument_of_latitude, full[:, _el.COLUMNS.index("u")])
     one = KeplerOrbit.from_state(r[0].tolist(), v[0].tolist(), 1.0)
     assert one.argument_of_latitude == full[0, _el.COLUMNS.index("u")]
+
+
+def test_one_orbit_kernel_checks_and_computes_in_one_call():
+    """elements.one_orbit: the state and classical_one's row in one array, from
+    r and v as float64 arrays or tuples; 0 for a state the rule refuses (every
+    value finite, mu > 0, r != 0), 1 for a valid one, 2 when an element is
+    beyond float64 (a NaN)."""
+    r, v = (1.0, 0.25, -0.5), (0.0, 1.0, 0.25)
+    out = np.empty(_el.ONE_ORBIT_SIZE)
+    assert _el.one_orbit(out, r, v, 1.0) == 1
+    assert out.tolist() == [*r, *v, 1.0, *_el.classical_one(*r, *v, 1.0)]
+    same = np.empty(_el.ONE_ORBIT_SIZE)
+    assert _el.one_orbit(same, np.array(r), np.array(v), 1.0) == 1
+    np.testing.assert_array_equal(same, out)
+    nan, inf = float("nan"), float("inf")
+    for bad_r, bad_v, mu in [
+        ((nan, 0.25, -0.5), v, 1.0),
+        (r, (0.0, -inf, 0.25), 1.0),
+        (r, v, 0.0),
+        ((0.0, 0.0, 0.0), v, 1.0),
+    ]:
+        assert _el.one_orbit(out, bad_r, bad_v, mu) == 0, (bad_r, bad_v, mu)
+    assert _el.one_orbit(out, A_BEYOND_R, A_BEYOND_V, 1.0) == 2
+
+
+# 1/a of this state is subnormal (about 1e-310) but not zero to rounding: a is
+# beyond float64 while every other element is finite
+A_BEYOND_R = (1e300, 0.0, 0.0)
+A_BEYOND_V = (0.0, (2e-300 * (1 - 5e-11)) ** 0.5, 0.0)
+
+
+@pytest.mark.parametrize("batch", [False, True])
+def test_a_alone_beyond_float64_is_named_when_read(batch):
+    r, v = list(A_BEYOND_R), list(A_BEYOND_V)
+    o = KeplerOrbit.from_state([r], [v], 1.0) if batch else KeplerOrbit.from_state(r, v, 1.0)
+    assert np.all((o.e > 0.99) & (o.e < 1.0)) and np.all(np.isfinite(o.p)) and np.all(o.inc == 0)
+    with pytest.raises(ValueError, match=r"for which `a` fits in float64, got r=\[1e\+300"):
+        o.a  # noqa: B018

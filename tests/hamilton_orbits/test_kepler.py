@@ -21,7 +21,12 @@ from hypothesis import strategies as st
 
 from hamilton_orbits import ConvergenceError, solve_kepler
 from hamilton_orbits._kernels import kepler as K
-from hamilton_orbits.kepler import anomaly_from_true, mean_anomaly, true_from_anomaly
+from hamilton_orbits.kepler import (
+    anomaly_from_true,
+    check_state,
+    mean_anomaly,
+    true_from_anomaly,
+)
 
 EPS = np.finfo(float).eps
 
@@ -382,3 +387,55 @@ def test_universal_anomaly_short_steps_against_mpmath():
             assert err <= 4 * EPS
         assert abs(r - float(x0 * ref[0] + s0 * ref[1] + ref[2])) <= 4 * EPS * r
     assert worst > 0.0  # the values compared are not all exact
+
+
+def test_propagate_uv_inline_is_propagate_uv():
+    """One definition: ``propagate_uv_inline`` (what the Wisdom-Holman drift
+    inlines) is ``propagate_uv``'s Python function compiled for inlining, and
+    gives its bits, anchored steps and radial orbits included."""
+    assert K.propagate_uv_inline.py_func is K.propagate_uv.py_func
+    states = [
+        (1.0, 0.2, 0.1, -0.1, 1.1, 0.05, 1.0, 0.37),  # short step
+        (1.0, 0.2, 0.1, -0.1, 1.1, 0.05, 1.0, 123.4),  # many periods
+        (1e3, 0.0, 0.0, -0.05, 0.01, 0.0, 1.0, 2e4),  # open orbit towards periapsis: anchored
+        (1.0, 0.0, 0.0, 0.5, 0.0, 0.0, 1.0, 3.0),  # radial, through the collision
+    ]
+    for s in states:
+        assert K.propagate_uv_inline(*s) == K.propagate_uv(*s), s
+
+
+def test_check_state_copies_and_broadcasts():
+    """kepler.check_state: one fresh C-contiguous float64 array (..., 7) of the
+    broadcast leading shape, [r, v, mu] per state."""
+    r = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    v = np.array([0.0, 1.0, 0.0])
+    mu = np.array([1.0, 2.0])
+    state, quantity = check_state(r, v, mu)
+    assert state.shape == (2, 7) and state.dtype == np.float64 and state.flags.c_contiguous
+    assert quantity is False and not any(np.shares_memory(state, x) for x in (r, v, mu))
+    r[0, 0] = 5.0
+    assert state.tolist() == [[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0],
+                              [2.0, 0.0, 0.0, 0.0, 1.0, 0.0, 2.0]]
+    sq, quantity = check_state([1.0, 0, 0] * u.au, [0, 30.0, 0] * u.km / u.s,
+                               1.32712440018e20 * u.m**3 / u.s**2)
+    assert quantity and sq[0] == 149597870.7 and sq[4] == 30.0
+    assert sq[6] == pytest.approx(1.32712440018e11, rel=4e-16)
+
+
+@pytest.mark.parametrize(
+    ("r", "v", "mu", "match"),
+    [  # the first bad argument in the order of the parameters, whatever else is wrong
+        ([np.nan, 0.0], [0.0, 1.0], -1.0, "`r` to be finite, got nan at index 0"),
+        ([1.0, 0.0, 0.0], [np.inf, 1.0], -1.0, "`v` to be finite, got inf at index 0"),
+        ([1.0, 0.0, 0.0], [0.0, 1.0], -1.0, r"`v` to have shape \(\.\.\., 3\), got \(2,\)"),
+        ([[0.0, 0, 0], [1.0, 0, 0]], [0.0, 1.0, 0.0], [1.0, 2.0, 3.0],
+         r"`r`, `v`, `mu` to broadcast together, got shapes \(2,\), \(\), \(3,\)"),
+        ([[0.0, 0, 0], [1.0, 0, 0]], [0.0, 1.0, 0.0], [1.0, 0.0], "`mu` > 0, got 0.0 at index 1"),
+        ([[1.0, 0, 0], [0.0, 0, 0]], [0.0, 1.0, 0.0], 1.0,
+         r"`r` to be nonzero, got \[0.0, 0.0, 0.0\] at index 1"),
+        ([1.0, 0, 0] * u.km, [0.0, 1.0, 0.0], 1.0, "all Quantities or all plain floats"),
+    ],
+)
+def test_check_state_names_the_first_bad_argument(r, v, mu, match):
+    with pytest.raises(ValueError, match=match):
+        check_state(r, v, mu)

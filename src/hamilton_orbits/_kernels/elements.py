@@ -44,6 +44,7 @@ from hamilton_orbits._columns import (  # noqa: F401  (re-exported)
     HYPERBOLA,
     NCLASSICAL,
     NCOL,
+    ONE_ORBIT_SIZE,
     PARABOLA,
     RADIAL_ELLIPSE,
     RADIAL_HYPERBOLA,
@@ -53,9 +54,7 @@ from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     anomaly_from_nu,
     mean_from_anomaly,
-    nu_from_anomaly,
     sinh_minus_x,
-    solve,
     state_in_safe_range,
     state_scales,
     two_prod,
@@ -177,83 +176,68 @@ def _dot3_compensated(ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
     return s2 + (t + (e1 + e2 + e3))
 
 
-@njit(cache=True)
-def state_to_elements_one(
-    rx, ry, rz, vx, vy, vz, mu, accurate=False, full=True
-):  # pragma: no cover - compiled
-    """Elements of one state; returns the tuple of ``COLUMNS``.
-
-    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN (not
-    computed: :func:`state_to_elements_basic`); every other column is the same.
-
-    With ``accurate=False`` the anomaly and M are those of the element set as
-    floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
-    state.  With ``accurate=True`` they use 1 - e to the accuracy of
-    1 - e^2 = p/a instead, i.e. the true mean anomaly of the state; the two
-    differ by ~eps/|1 - e| relative, which matters only near e = 1 (where a
-    float e cannot hold 1 - e).  The time since periapsis (last column) is
-    meaningful with ``accurate=True``.
-    """
-    r2 = rx * rx + ry * ry + rz * rz
-    r = math.sqrt(r2)
-    v2 = vx * vx + vy * vy + vz * vz
-    if accurate:  # the time since periapsis: r.v to full relative precision
-        rv = _dot3_compensated(rx, ry, rz, vx, vy, vz)
+@njit(cache=True, inline="always")
+def _rectilinear_anomaly(r, v2, rv, inv_a, mu, smu):  # pragma: no cover - compiled
+    """``(anomaly, M, kind, tau)`` of a radial or quasi-rectilinear orbit
+    (``e = 1``, ``inv_a != 0``): E with ``r = a (1 - cos E)``, ``cos E = 1 - r/a
+    = r v^2/mu - 1``, ``sin E = r.v / sqrt(mu a)`` (F with ``r = |a| (cosh F -
+    1)``, ``sinh F = r.v / sqrt(mu |a|)``), M = E - sin E (sinh F - F)."""
+    c = r * v2 / mu - 1.0  # cos E (cosh F): 1 - r/a
+    if inv_a > 0.0:
+        anom = math.atan2(rv * math.sqrt(inv_a) / smu, c)  # sin E = r.v / sqrt(mu a)
+        m = x_minus_sin(anom)
+        kind = RADIAL_ELLIPSE
     else:
-        rv = rx * vx + ry * vy + rz * vz
-    hx = ry * vz - rz * vy
-    hy = rz * vx - rx * vz
-    hz = rx * vy - ry * vx
-    h = math.sqrt(hx * hx + hy * hy + hz * hz)
-    inv_a = 2.0 / r - v2 / mu
+        anom = math.asinh(rv * math.sqrt(-inv_a) / smu)  # sinh F
+        m = sinh_minus_x(anom)
+        kind = RADIAL_HYPERBOLA
+    n = smu * abs(inv_a) * math.sqrt(abs(inv_a))
+    return anom, m, kind, m / n
 
-    if h <= _RADIAL_TOL * r * math.sqrt(v2):
-        # ---- radial (rectilinear) orbit: e = 1, p = 0, body at nu = pi ----
-        smu = math.sqrt(mu)
-        dx = -rx / r
-        dy = -ry / r
-        dz = -rz / r
-        nx_, ny_, nz_ = _radial_normal(dx, dy, dz)
-        inc, lan, nx, ny, mx, my, mz = _node_basis(nx_, ny_, nz_)
-        u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
-        argp = wrap_2pi(u - PI)
-        if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
-            # radial parabola: time since collision t = sqrt(2/mu) r^1.5 / 3
-            tau = math.sqrt(2.0 / mu) * r * math.sqrt(r) / 3.0
-            if rv < 0.0:
-                tau = -tau
-            return 0.0, 1.0, 0.0, inc, lan, argp, PI, 0.0, 0.0, u, RADIAL_PARABOLA, tau
-        c = r * v2 / mu - 1.0  # cos E (cosh F): 1 - r/a
-        if inv_a > 0.0:
-            s = rv * math.sqrt(inv_a) / smu  # sin E = r.v / sqrt(mu a)
-            anom = math.atan2(s, c)
-            m = x_minus_sin(anom)
-            n = smu * inv_a * math.sqrt(inv_a)
-            kind = RADIAL_ELLIPSE
-        else:
-            s = rv * math.sqrt(-inv_a) / smu  # sinh F
-            anom = math.asinh(s)
-            m = sinh_minus_x(anom)
-            n = smu * (-inv_a) * math.sqrt(-inv_a)
-            kind = RADIAL_HYPERBOLA
-        return 0.0, 1.0, inv_a, inc, lan, argp, PI, anom, m, u, kind, m / n
 
-    # ---- non-radial ----
-    p = h * h / mu
+@njit(cache=True, inline="always")
+def _radial_elements(rx, ry, rz, r, v2, rv, inv_a, mu):  # pragma: no cover - compiled
+    """The tuple of ``COLUMNS`` of a radial (rectilinear) orbit: e = 1, p = 0,
+    the body at nu = pi, the plane through the line least inclined to the
+    reference plane (:func:`_radial_normal`)."""
+    dx = -rx / r
+    dy = -ry / r
+    dz = -rz / r
+    nx_, ny_, nz_ = _radial_normal(dx, dy, dz)
+    inc, lan, nx, ny, mx, my, mz = _node_basis(nx_, ny_, nz_)
+    u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
+    argp = wrap_2pi(u - PI)
+    if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
+        # radial parabola: time since collision t = sqrt(2/mu) r^1.5 / 3
+        tau = math.sqrt(2.0 / mu) * r * math.sqrt(r) / 3.0
+        if rv < 0.0:
+            tau = -tau
+        return 0.0, 1.0, 0.0, inc, lan, argp, PI, 0.0, 0.0, u, RADIAL_PARABOLA, tau
+    anom, m, kind, tau = _rectilinear_anomaly(r, v2, rv, inv_a, mu, math.sqrt(mu))
+    return 0.0, 1.0, inv_a, inc, lan, argp, PI, anom, m, u, kind, tau
+
+
+@njit(cache=True, inline="always")
+def _eccentricity(rx, ry, rz, vx, vy, vz, r, v2, rv, h, p, inv_a, mu):  # pragma: no cover
+    """``(e, 1 - e, inv_a)`` of a non-radial orbit with the decisions of the
+    module docstring (circular: e = 0; parabolic: inv_a = 0, e = 1; e rounding
+    to 1 with inv_a != 0: quasi-rectilinear unless a parabola costs less).
+
+    ``e = |e_vec|`` below 1/2, else ``e = 1 - (1 - e^2)/(1 + e)``: the nearest
+    float to e, with 1 - e as accurate as ``1 - e^2 = p inv_a`` is
+    (``sqrt(1 - w)`` can be an ulp off); both are cheap, so both are computed
+    and one selected (no branch).  ``1 - e`` to the accuracy of p/a: near e = 1
+    the float e holds 1 - e only to eps absolute, which would spoil the
+    anomalies and M of near-parabolic orbits."""
     w = p * inv_a  # 1 - e^2
     f = v2 - mu / r
     ex = (f * rx - rv * vx) / mu
     ey = (f * ry - rv * vy) / mu
     ez = (f * rz - rv * vz) / mu
     ev = math.sqrt(ex * ex + ey * ey + ez * ez)
-    # e = ev below 1/2, else e = 1 - (1 - e^2)/(1 + e): the nearest float to e,
-    # with 1 - e as accurate as 1 - e^2 = p inv_a is (sqrt(1 - w) can be an ulp
-    # off); both are cheap, so both are computed and one selected (no branch)
     ome_w = w / (1.0 + math.sqrt(max(1.0 - w, 0.0)))  # 1 - e, from 1 - e^2 = p/a
     ew = 1.0 - ome_w
     e = ev if ev < 0.5 else ew
-    # 1 - e to the accuracy of p/a: near e = 1 the float e holds 1 - e only to
-    # eps absolute, which would spoil the anomalies and M of near-parabolic orbits
     ome = 1.0 - ev if ev < 0.5 else ome_w
     if e <= _CIRC_TOL:
         e = 0.0
@@ -266,10 +250,16 @@ def state_to_elements_one(
         # rectilinear orbit) unless treating it as a parabola costs less
         if abs(inv_a) * r <= h / (r * math.sqrt(v2)):
             inv_a = 0.0
-    # inc, lan and u are angles, so the areal vector need not be normalised
-    # (fewer roundings and divisions than through the unit normal):
-    # n = (-hy, hx)/rho towards the ascending node, h x n = h m with
-    # m = (-hz ny, hz nx, rho)/h, u = atan2(r.m, r.n)
+    return e, ome, inv_a
+
+
+@njit(cache=True, inline="always")
+def _plane(rx, ry, rz, hx, hy, hz, h):  # pragma: no cover - compiled
+    """``(inc, lan, u)`` from the areal vector ``h = r x v`` (not normalised:
+    inc, lan and u are angles, so fewer roundings and divisions than through
+    the unit normal): ``n = (-hy, hx)/rho`` towards the ascending node (x when
+    the plane is the reference plane: lan = 0), ``h x n = h m`` with ``m =
+    (-hz ny, hz nx, rho)/h``, ``u = atan2(r.m, r.n)``."""
     rho = math.hypot(hx, hy)
     inc = math.atan2(rho, hz)
     if rho > 0.0:
@@ -281,40 +271,22 @@ def state_to_elements_one(
         ny = 0.0
         lan = 0.0
     u = wrap_2pi(math.atan2(hz * (ry * nx - rx * ny) + rz * rho, h * (rx * nx + ry * ny)))
-    if e == 0.0:
-        nu = wrap_pi(u)
-        argp = 0.0
-    else:
-        nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
-        argp = wrap_2pi(u - nu)
-    if not full:
-        if e == 1.0 and inv_a != 0.0:
-            kind = RADIAL_ELLIPSE if inv_a > 0.0 else RADIAL_HYPERBOLA
-        else:
-            kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
-        return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
-    smu = math.sqrt(mu)  # only here: the classical columns do not need it
-    if e == 1.0 and inv_a != 0.0:
-        # quasi-rectilinear: anomaly as for the radial orbit (r = a(1 - cos E))
-        c = r * v2 / mu - 1.0
-        if inv_a > 0.0:
-            anom = math.atan2(rv * math.sqrt(inv_a) / smu, c)
-            m = x_minus_sin(anom)
-            kind = RADIAL_ELLIPSE
-        else:
-            anom = math.asinh(rv * math.sqrt(-inv_a) / smu)
-            m = sinh_minus_x(anom)
-            kind = RADIAL_HYPERBOLA
-        n = smu * abs(inv_a) * math.sqrt(abs(inv_a))
-        return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
-    # Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
-    # form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
-    # form e sin E = r.v/sqrt(mu a), e cos E = r v^2/mu - 1 is better, as
-    # inv_a has no cancellation (2/r and v^2/mu differ by r inv_a / 2).
-    # Estimated position errors (units of eps): |a sin E|/b for the first,
-    # (|a sin E|/r)^2 for the second; the vis-viva form only for e >= 1/2.
-    # Computed without branches (safe denominators where unused): whether
-    # e >= 1/2 is a coin toss in a batch.
+    return inc, lan, u
+
+
+@njit(cache=True, inline="always")
+def _conic_anomaly(p, e, ome, inv_a, nu, r, v2, rv, h, mu, smu, accurate):  # pragma: no cover
+    """The anomaly (E, F or D by ``e``) of a non-radial orbit that is not
+    quasi-rectilinear.
+
+    Near apoapsis and around E = pi/2 of an eccentric orbit the half-angle
+    form amplifies the rounding of nu by dE/dnu = r/b; there the vis-viva
+    form e sin E = r.v/sqrt(mu a), e cos E = r v^2/mu - 1 is better, as
+    inv_a has no cancellation (2/r and v^2/mu differ by r inv_a / 2).
+    Estimated position errors (units of eps): |a sin E|/b for the first,
+    (|a sin E|/r)^2 for the second; the vis-viva form only for e >= 1/2.
+    Computed without branches (safe denominators where unused): whether
+    e >= 1/2 is a coin toss in a batch."""
     ai = abs(inv_a)
     ok_sc = (e >= 0.5) & (ai != 0.0)
     ai_ = ai if ok_sc else 1.0
@@ -347,13 +319,22 @@ def state_to_elements_one(
         x_half = ce * (k + cn if pos else asn)
         y_ = s_ if use_sc else y_half
         x_ = r * v2 / mu - 1.0 if use_sc else x_half
-        anom = (1.0 if use_sc else 2.0) * math.atan2(y_, x_)
-    elif use_sc and inv_a < 0.0:
-        anom = math.asinh(s_ / e)
-    elif accurate and e > 1.0:
-        anom = _hyperbolic_anomaly(rv * h, h * h - mu * r, e, -ome)
-    else:
-        anom = anomaly_from_nu(nu, e)
+        return (1.0 if use_sc else 2.0) * math.atan2(y_, x_)
+    if use_sc and inv_a < 0.0:
+        return math.asinh(s_ / e)
+    if accurate and e > 1.0:
+        return _hyperbolic_anomaly(rv * h, h * h - mu * r, e, -ome)
+    return anomaly_from_nu(nu, e)
+
+
+@njit(cache=True, inline="always")
+def _anomaly_columns(p, e, ome, inv_a, nu, r, v2, rv, h, mu, accurate):  # pragma: no cover
+    """``(anomaly, M, kind, tau)`` of a non-radial orbit (``accurate``: with
+    ``1 - e = ome``, see :func:`state_to_elements_one`)."""
+    smu = math.sqrt(mu)  # only here: the classical columns do not need it
+    if e == 1.0 and inv_a != 0.0:  # quasi-rectilinear: as for the radial orbit
+        return _rectilinear_anomaly(r, v2, rv, inv_a, mu, smu)
+    anom = _conic_anomaly(p, e, ome, inv_a, nu, r, v2, rv, h, mu, smu, accurate)
     if e < 1.0 and -3.0 < anom < 3.0:
         # mean_from_anomaly without its 2 pi reduction (k = 0 here), bit for bit
         m = (ome if accurate else 1.0 - e) * anom + e * x_minus_sin(anom)
@@ -373,7 +354,60 @@ def state_to_elements_one(
     else:
         kind = HYPERBOLA
         n = smu * (-inv_a) * math.sqrt(-inv_a)
-    return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, m / n
+    return anom, m, kind, m / n
+
+
+@njit(cache=True)
+def state_to_elements_one(
+    rx, ry, rz, vx, vy, vz, mu, accurate=False, full=True
+):  # pragma: no cover - compiled
+    """Elements of one state; returns the tuple of ``COLUMNS``.
+
+    With ``full=False`` the anomaly, M and tau of a non-radial orbit are NaN
+    (not computed); every other column is the same.
+
+    With ``accurate=False`` the anomaly and M are those of the element set as
+    floats: computed with the float ``e``, so that ``(p, e, M)`` reproduce the
+    state.  With ``accurate=True`` they use 1 - e to the accuracy of
+    1 - e^2 = p/a instead, i.e. the true mean anomaly of the state; the two
+    differ by ~eps/|1 - e| relative, which matters only near e = 1 (where a
+    float e cannot hold 1 - e).  The time since periapsis (last column) is
+    meaningful with ``accurate=True``.
+
+    The pieces: :func:`_radial_elements` (``h = 0``), :func:`_eccentricity`,
+    :func:`_plane`, the true anomaly, then :func:`_anomaly_columns`.
+    """
+    r2 = rx * rx + ry * ry + rz * rz
+    r = math.sqrt(r2)
+    v2 = vx * vx + vy * vy + vz * vz
+    if accurate:  # the time since periapsis: r.v to full relative precision
+        rv = _dot3_compensated(rx, ry, rz, vx, vy, vz)
+    else:
+        rv = rx * vx + ry * vy + rz * vz
+    hx = ry * vz - rz * vy
+    hy = rz * vx - rx * vz
+    hz = rx * vy - ry * vx
+    h = math.sqrt(hx * hx + hy * hy + hz * hz)
+    inv_a = 2.0 / r - v2 / mu
+    if h <= _RADIAL_TOL * r * math.sqrt(v2):
+        return _radial_elements(rx, ry, rz, r, v2, rv, inv_a, mu)
+    p = h * h / mu
+    e, ome, inv_a = _eccentricity(rx, ry, rz, vx, vy, vz, r, v2, rv, h, p, inv_a, mu)
+    inc, lan, u = _plane(rx, ry, rz, hx, hy, hz, h)
+    if e == 0.0:
+        nu = wrap_pi(u)
+        argp = 0.0
+    else:
+        nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
+        argp = wrap_2pi(u - nu)
+    if not full:
+        if e == 1.0 and inv_a != 0.0:
+            kind = RADIAL_ELLIPSE if inv_a > 0.0 else RADIAL_HYPERBOLA
+        else:
+            kind = ELLIPSE if e < 1.0 else (PARABOLA if e == 1.0 else HYPERBOLA)
+        return p, e, inv_a, inc, lan, argp, nu, math.nan, math.nan, u, kind, math.nan
+    anom, m, kind, tau = _anomaly_columns(p, e, ome, inv_a, nu, r, v2, rv, h, mu, accurate)
+    return p, e, inv_a, inc, lan, argp, nu, anom, m, u, kind, tau
 
 
 @njit(cache=True)
@@ -420,14 +454,6 @@ def state_to_elements(r, v, mu, out):  # pragma: no cover - compiled
             out[i, j] = res[j]
 
 
-@njit(cache=True)
-def state_to_elements_row(rx, ry, rz, vx, vy, vz, mu, full):  # pragma: no cover
-    """The columns of one orbit (``full=False``: no anomaly, M, tau): the row of
-    :func:`state_to_elements_basic`, also called directly from Python for a
-    single orbit (no arrays to build)."""
-    return state_to_elements_scaled(rx, ry, rz, vx, vy, vz, mu, False, full)
-
-
 # state_to_elements_one inlined at numba's IR level where it is called with
 # constant flags (the classical columns): the branches on ``accurate`` and
 # ``full`` then fold away and the tuple never leaves registers.  Measured on one
@@ -439,8 +465,8 @@ _elements_one_inlined = njit(inline="always")(state_to_elements_one.py_func)
 
 @njit(cache=True)
 def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
-    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_basic`
-    but the anomaly, M and tau (bit for bit), then ``a``.
+    """One orbit's ``CLASSICAL`` columns: those of :func:`state_to_elements_one`
+    with ``full=False`` (bit for bit the full kernel's), then ``a``.
 
     ``a = 1/inv_a`` (``inf`` for the parabolas, ``inv_a = 0``).  ``a`` is NaN when
     another column is not finite or ``a`` is infinite for an orbit that is not a
@@ -469,18 +495,6 @@ def classical_one(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
 
 
 _classical_inlined = njit(inline="always")(classical_one.py_func)
-
-
-@parallel_kernel
-def state_to_elements_basic(r, v, mu, out):  # pragma: no cover - compiled
-    """As :func:`state_to_elements`, without the anomaly, M and tau (NaN in
-    ``out`` for non-radial orbits): the classical elements at ~2/3 of the cost."""
-    for i in prange(r.shape[0]):
-        res = state_to_elements_row(
-            r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], False
-        )
-        for j in range(NCOL):
-            out[i, j] = res[j]
 
 
 @parallel_kernel
@@ -525,12 +539,23 @@ def state_to_time_since_periapsis(r, v, mu, out):  # pragma: no cover - compiled
         out[i] = res[NCOL - 1]
 
 
+@njit(inline="always")
+def state_valid(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
+    """Whether a state is one an orbit can be built from: every value finite,
+    ``mu > 0`` and ``r != 0`` (the one statement of the rule).
+
+    Without branches (so that a loop over rows vectorises): ``0 * x`` is +-0
+    for a finite x and NaN for inf or NaN, so the sum is 0 iff all are finite."""
+    z = (rx * 0.0 + ry * 0.0 + rz * 0.0) + (vx * 0.0 + vy * 0.0 + vz * 0.0) + mu * 0.0
+    return (z == 0.0) & (mu > 0.0) & ((rx != 0.0) | (ry != 0.0) | (rz != 0.0))
+
+
 @parallel_kernel
 def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - compiled
     """Copy rows of ``r``, ``v`` (N, 3) and ``mu`` (N,) or (1,) (broadcast) into
     ``r_out``, ``v_out``, ``mu_out`` (N,) in one pass; return the number of rows
-    with a non-finite value, ``mu <= 0`` or ``r = 0`` (the caller then finds
-    and names the first one)."""
+    that are not :func:`state_valid` (the caller then finds and names the first
+    one)."""
     n = r.shape[0]
     one = mu.shape[0] == 1
     bad = 0
@@ -549,12 +574,48 @@ def check_copy_state(r, v, mu, r_out, v_out, mu_out):  # pragma: no cover - comp
         v_out[i, 1] = vy
         v_out[i, 2] = vz
         mu_out[i] = m
-        # without branches (so that the loop vectorises): 0 * x is +-0 for a
-        # finite x and NaN for inf or NaN, so the sum z is 0 iff all are finite
-        z = (rx * 0.0 + ry * 0.0 + rz * 0.0) + (vx * 0.0 + vy * 0.0 + vz * 0.0) + m * 0.0
-        ok = (z == 0.0) & (m > 0.0) & ((rx != 0.0) | (ry != 0.0) | (rz != 0.0))
-        bad += np.int64(not ok)
+        bad += np.int64(not state_valid(rx, ry, rz, vx, vy, vz, m))
     return bad
+
+
+@njit(cache=True)
+def one_orbit(out, r, v, mu):  # pragma: no cover - compiled
+    """One orbit given as plain floats, checked and its elements computed in one call.
+
+    ``r``, ``v``: three floats each, as a float64 array or a tuple; ``mu`` a
+    float.  ``out`` (``ONE_ORBIT_SIZE``,) receives the state ``rx, ry, rz,
+    vx, vy, vz, mu`` and then, if the state is :func:`state_valid`, its
+    ``CLASSICAL`` columns (:func:`classical_one`).  Returns 0 if the state is
+    not valid (the caller then names the bad value), 1 if it is, 2 if it is
+    but an element is beyond float64 (``a`` NaN: the caller then refuses it
+    by name when it is read).  Checking a state costs about as much as
+    computing its elements here, so one orbit's cost is one call, not two.
+    """
+    rx = r[0]
+    ry = r[1]
+    rz = r[2]
+    vx = v[0]
+    vy = v[1]
+    vz = v[2]
+    out[0] = rx
+    out[1] = ry
+    out[2] = rz
+    out[3] = vx
+    out[4] = vy
+    out[5] = vz
+    out[6] = mu
+    if not state_valid(rx, ry, rz, vx, vy, vz, mu):
+        return 0
+    p, e, inv_a, inc, lan, argp, nu, a = _classical_inlined(rx, ry, rz, vx, vy, vz, mu)
+    out[7] = p
+    out[8] = e
+    out[9] = inv_a
+    out[10] = inc
+    out[11] = lan
+    out[12] = argp
+    out[13] = nu
+    out[14] = a
+    return 1 if a == a else 2
 
 
 @njit(cache=True)
@@ -685,14 +746,6 @@ def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
         v_out[i, 0] = a
         v_out[i, 1] = b
         v_out[i, 2] = c
-
-
-@njit(cache=True)
-def nu_anomaly_from_mean(m, e):  # pragma: no cover - compiled
-    """``(nu, anomaly)`` for the mean anomaly ``m`` of a conic with ``e``
-    (Kepler's equation by :func:`hamilton_orbits._kernels.kepler.solve`)."""
-    anom = solve(m, e)
-    return nu_from_anomaly(anom, e), anom
 
 
 def empty_elements(n: int) -> np.ndarray:

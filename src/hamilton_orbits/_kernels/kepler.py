@@ -560,62 +560,50 @@ def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
     return nan, nan, nan, nan, nan, nan, nan
 
 
-@njit(cache=True)
-def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
-    """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``),
-    returned with the universal functions evaluated there:
-    ``(chi, T, r, U0, U1, U2, U3)``.
+@njit(cache=True, inline="always")
+def _series_guess(tau, sgn, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """First guesses ``(x1, x, short)`` of the universal anomaly for :func:`_solve_uv`.
 
-    T is increasing (dT/dchi = r >= 0).  Laguerre's method (n = 5, Conway 1986)
-    inside a bracket that starts as (0, chi_max) with chi_max = 2 pi/sqrt(alpha)
-    for a bound orbit whose |tau| is at most half a period, else (0, inf) and is
-    grown by doubling; a step that leaves the bracket is replaced by bisection.
-    On convergence (a step of at most 4 ulp, a 2-cycle between neighbouring
-    floats, or a bracket of 8 ulp) the last evaluated point is returned if its
-    residual T - tau is already at rounding level (2 ulp of tau), which saves
-    one evaluation; otherwise the refined point is evaluated.  chi = NaN on
-    failure.
-    """
-    nan = math.nan
-    if tau == 0.0:
-        return 0.0, 0.0, r0, 1.0, 0.0, 0.0, 0.0
-    sgn = 1.0 if tau > 0.0 else -1.0
-    # first guess: the reversed Taylor series of T(chi) for short steps,
-    # otherwise the mean-motion guess (elliptic) or a logarithmic one
-    # (hyperbolic).  With T/r0 = chi + c2 chi^2 + c3 chi^3 + c4 chi^4 + c5 chi^5
-    # + ... (c2 = sigma0/(2 r0), c3 = (1 - alpha r0)/(6 r0), c4 = -alpha sigma0/
-    # (24 r0), c5 = -alpha c3 / 20) and y = tau/r0: chi = y - c2 y^2
-    # + (2 c2^2 - c3) y^3 + (5 c2 c3 - c4 - 5 c2^3) y^4 + (14 c2^4 - 21 c2^2 c3
-    # + 6 c2 c4 + 3 c3^2 - c5) y^5 + O(y^6) (series reversion).  The
-    # fifth-order guess is within 3e-9 (Mercury) and 2e-10 (Venus..Mars) of the
-    # root for a 4-day step of the planets (the fourth-order one: 3e-6 and
-    # 6e-9), so that the short-step solver needs one evaluation for each of
-    # them (the Wisdom-Holman drift); the second-order one is
-    # kept when the series is not small (z >= 1 below).
-    if r0 * r0 * r0 > 0.0:
-        x1 = tau / r0
-        ir = 1.0 / r0
-        c2 = 0.5 * sigma0 * ir
-        x = x1 - c2 * x1 * x1
-        # z^2 below 1 with z = |x1| (|sigma0|/r0 + sqrt(1/r0 + |alpha|))
-        if 2.0 * x1 * x1 * (4.0 * c2 * c2 + ir + abs(alpha)) < 1.0:
-            c3 = (1.0 - alpha * r0) * ir * (1.0 / 6.0)
-            c4 = -alpha * sigma0 * ir * (1.0 / 24.0)
-            k3 = 2.0 * c2 * c2 - c3
-            k4 = c2 * (5.0 * c3 - 5.0 * c2 * c2) - c4
-            c5 = -alpha * c3 * (1.0 / 20.0)
-            s2 = c2 * c2
-            k5 = s2 * (14.0 * s2 - 21.0 * c3) + 6.0 * c2 * c4 + 3.0 * c3 * c3 - c5
-            x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
-            # a short step (|psi| < 1/4 at the guess): Halley from the series
-            # guess, without the bracket (see _solve_uv_short)
-            if x * sgn > 0.0 and x * x * abs(alpha) < 0.25:
-                sol = _solve_uv_short(tau, x, r0, sigma0, alpha)
-                if math.isfinite(sol[0]):
-                    return sol
-    else:  # (near-)radial orbit anchored at the collision: T ~ chi^3/6
+    ``x1 = tau / r0`` (a radial orbit anchored at the collision, ``r0 = 0``:
+    ``x1 = (6 tau)^(1/3)``, as ``T ~ chi^3/6`` there) and ``x`` the reversed
+    Taylor series of ``T(chi)``: with ``T/r0 = chi + c2 chi^2 + c3 chi^3 + c4
+    chi^4 + c5 chi^5 + ...`` (``c2 = sigma0/(2 r0)``, ``c3 = (1 - alpha r0)/(6
+    r0)``, ``c4 = -alpha sigma0/(24 r0)``, ``c5 = -alpha c3 / 20``) and ``y =
+    tau/r0``: ``chi = y - c2 y^2 + (2 c2^2 - c3) y^3 + (5 c2 c3 - c4 - 5 c2^3)
+    y^4 + (14 c2^4 - 21 c2^2 c3 + 6 c2 c4 + 3 c3^2 - c5) y^5 + O(y^6)``.  The
+    fifth-order guess is within 3e-9 (Mercury) and 2e-10 (Venus..Mars) of the
+    root for a 4-day step of the planets (the fourth-order one: 3e-6 and
+    6e-9), so that the short-step solver needs one evaluation for each of them
+    (the Wisdom-Holman drift); the second-order one is kept when the series is
+    not small.  ``short``: the fifth-order guess is on the right side of 0 with
+    ``|psi| < 1/4`` (Halley from it, :func:`_solve_uv_short`, without the
+    bracket)."""
+    if not (r0 * r0 * r0 > 0.0):  # (near-)radial orbit anchored at the collision
         x1 = sgn * (6.0 * abs(tau)) ** (1.0 / 3.0)
-        x = x1
+        return x1, x1, False
+    x1 = tau / r0
+    ir = 1.0 / r0
+    c2 = 0.5 * sigma0 * ir
+    # z^2 below 1 with z = |x1| (|sigma0|/r0 + sqrt(1/r0 + |alpha|))
+    if not (2.0 * x1 * x1 * (4.0 * c2 * c2 + ir + abs(alpha)) < 1.0):
+        return x1, x1 - c2 * x1 * x1, False
+    c3 = (1.0 - alpha * r0) * ir * (1.0 / 6.0)
+    c4 = -alpha * sigma0 * ir * (1.0 / 24.0)
+    k3 = 2.0 * c2 * c2 - c3
+    k4 = c2 * (5.0 * c3 - 5.0 * c2 * c2) - c4
+    c5 = -alpha * c3 * (1.0 / 20.0)
+    s2 = c2 * c2
+    k5 = s2 * (14.0 * s2 - 21.0 * c3) + 6.0 * c2 * c4 + 3.0 * c3 * c3 - c5
+    x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
+    return x1, x, x * sgn > 0.0 and x * x * abs(alpha) < 0.25
+
+
+@njit(cache=True, inline="always")
+def _long_guess(tau, sgn, x1, x, alpha):  # pragma: no cover - compiled
+    """The first guess of the bracketed solver: ``x`` from :func:`_series_guess`
+    unless the step is long (``|x1| sqrt|alpha| > 1/2``) or ``x`` is on the wrong
+    side of 0: then the mean-motion guess ``tau alpha`` (elliptic) or a
+    logarithmic one (hyperbolic), else ``x1``."""
     if alpha > 0.0:
         if abs(x1) * math.sqrt(alpha) > 0.5 or x * sgn <= 0.0:
             x = tau * alpha
@@ -629,11 +617,17 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             x = x1
     if x * sgn <= 0.0 or not math.isfinite(x):
         x = x1
-    # bracket on the signed side of chi
-    if alpha > 0.0:
-        big = 2.0 * PI / math.sqrt(alpha)
-    else:
-        big = math.inf
+    return x
+
+
+@njit(cache=True, inline="always")
+def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """:func:`_solve_uv` by Laguerre's method inside a bracket, from the guess ``x``.
+
+    The bracket starts as (0, chi_max) on the side of ``sgn`` with chi_max =
+    2 pi/sqrt(alpha) for a bound orbit, else (0, inf), grown by doubling from
+    ``max(|x|, |x1|)``; a step that leaves it is replaced by bisection."""
+    big = 2.0 * PI / math.sqrt(alpha) if alpha > 0.0 else math.inf
     if sgn > 0.0:
         a = 0.0
         b = big
@@ -677,7 +671,37 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
             return x, t, r, u0, u1, u2, u3
         xp = x
         x = xn
+    nan = math.nan
     return nan, nan, nan, nan, nan, nan, nan
+
+
+@njit(cache=True)
+def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The universal anomaly chi with ``T(chi) = tau`` (``tau = sqrt(mu) dt``),
+    returned with the universal functions evaluated there:
+    ``(chi, T, r, U0, U1, U2, U3)``.
+
+    T is increasing (dT/dchi = r >= 0).  A short step is solved by Halley's
+    method from the reversed Taylor series (:func:`_series_guess`,
+    :func:`_solve_uv_short`); otherwise, or if that does not settle, by
+    Laguerre's method (n = 5, Conway 1986) inside a bracket
+    (:func:`_solve_uv_bracketed`) from the guess of :func:`_long_guess`.  On
+    convergence (a step of at most 4 ulp, a 2-cycle between neighbouring
+    floats, or a bracket of 8 ulp) the last evaluated point is returned if its
+    residual T - tau is already at rounding level (2 ulp of tau), which saves
+    one evaluation; otherwise the refined point is evaluated.  chi = NaN on
+    failure.
+    """
+    if tau == 0.0:
+        return 0.0, 0.0, r0, 1.0, 0.0, 0.0, 0.0
+    sgn = 1.0 if tau > 0.0 else -1.0
+    x1, x, short = _series_guess(tau, sgn, r0, sigma0, alpha)
+    if short:
+        sol = _solve_uv_short(tau, x, r0, sigma0, alpha)
+        if math.isfinite(sol[0]):
+            return sol
+    x = _long_guess(tau, sgn, x1, x, alpha)
+    return _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha)
 
 
 @njit(cache=True)
@@ -700,46 +724,14 @@ def _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):  # pragma: no cover
 
 
 @njit(cache=True, inline="always")
-def propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
-    """Two-body state after time ``dt`` by universal variables (f and g series).
-
-    Returns ``(rx, ry, rz, vx, vy, vz)``, all NaN on failure.
-
-    * A bound orbit's ``dt`` is first reduced modulo the period
-      ``P = 2 pi / (sqrt(mu) alpha^1.5)`` with an exact (Dekker) product, so
-      |dt| may be many periods.
-    * Moving away from periapsis (``sigma0 dt >= 0``, or a nearly circular
-      orbit) the universal Kepler equation ``T(chi) = sqrt(mu) dt`` is a sum
-      of terms of one sign and is solved directly.  g is computed either from
-      chi alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``, so that f gdot - fdot g
-      = 1 holds identically and the state stays on the initial orbit whatever
-      the solver's last-bit error, or as ``(tau - U3)/sqrt(mu)``, whichever the
-      last-bit error of chi and the rounding of the terms move least
-      (:func:`_g_first_form`; on a fast hyperbola U3 << tau and g ~ dt).
-    * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4, and a step
-      long enough, ``|sigma0 tau| > r0^2 / 10``, to matter), the terms of
-      T(chi) cancel (for an open orbit that starts far out the loss is about
-      r0/q in relative accuracy).  The equation is then anchored at
-      periapsis, where all terms have one sign: chi0 of the initial state is
-      found from sigma0 = e U1(chi0) (atan2 / asinh forms), and
-      ``q U1(chi1) + U3(chi1) = q U1(chi0) + U3(chi0) + sqrt(mu) dt`` is solved
-      for chi1; f and g use dchi = chi1 - chi0 (g chosen as above; radial
-      orbits keep ``g = dt - U3/sqrt(mu)``) and ``r = q U0(chi1) + U2(chi1)``.
-    """
-    nan = math.nan
-    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
-    if not (r0 > 0.0):
-        return nan, nan, nan, nan, nan, nan
-    if dt == 0.0:
-        return rx, ry, rz, vx, vy, vz
-    v2 = vx * vx + vy * vy + vz * vz
-    smu = math.sqrt(mu)
-    sigma0 = (rx * vx + ry * vy + rz * vz) / smu
-    alpha = 2.0 / r0 - v2 / mu
+def _reduce_period(dt, mu, smu, alpha):  # pragma: no cover - compiled
+    """``dt`` of a bound orbit (``alpha > 0``) reduced modulo the period
+    ``P = 2 pi / (sqrt(mu) alpha^1.5)`` with an exact (Dekker) product, when
+    ``|dt| > P/2``; ``dt`` itself otherwise."""
     t = dt
-    # |t| > P/2 with P = 2 pi / (sqrt(mu) alpha^1.5) is only possible when
-    # t^2 mu alpha^3 > pi^2 (tested below pi^2 and NaN-safe, without the root
-    # and the division that the period costs; the exact test follows)
+    # |t| > P/2 is only possible when t^2 mu alpha^3 > pi^2 (tested below pi^2
+    # and NaN-safe, without the root and the division that the period costs;
+    # the exact test follows)
     if alpha > 0.0 and not (
         (t * alpha) * (t * alpha) * (mu * alpha) <= 0.2499 * TWO_PI_HI * TWO_PI_HI
     ):
@@ -749,62 +741,76 @@ def propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - c
             k = math.floor(t / period + 0.5)
             p, err = two_prod(k, period)
             t = (t - p) - err
-    tau = smu * t
-    hx = ry * vz - rz * vy
-    hy = rz * vx - rx * vz
-    hz = rx * vy - ry * vx
-    h2 = hx * hx + hy * hy + hz * hz
-    # anchor only when it matters: heading for periapsis with a step long
-    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20,
-    # and e^2 = 1 - alpha p >= 1/4
-    anchor = False
-    pp = 0.0
-    e2 = 0.0
-    if sigma0 * tau < 0.0 and abs(sigma0 * tau) > 0.1 * r0 * r0:
-        pp = h2 / mu
-        e2 = 1.0 - alpha * pp
-        anchor = e2 >= 0.25
-    if anchor:
-        ecc = math.sqrt(e2)
-        q = pp / (1.0 + ecc)
-        if alpha > 0.0:
-            sa = math.sqrt(alpha)
-            chi0 = math.atan2(sigma0 * sa, 1.0 - r0 * alpha) / sa
-        elif alpha < 0.0:
-            sa = math.sqrt(-alpha)
-            chi0 = math.asinh(sigma0 * sa / ecc) / sa
-        else:
-            chi0 = sigma0 / ecc
-        tp0 = _uv_eval(chi0, q, 0.0, alpha)[0]
-        sol = _solve_uv(tp0 + tau, q, 0.0, alpha)
-        chi1 = sol[0]
-        if not math.isfinite(chi1):
-            return nan, nan, nan, nan, nan, nan
-        r = sol[2]
-        dchi = chi1 - chi0
-        _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
-        # as below: the form of g that the last-bit error of dchi moves least;
-        # r0 U1 + sigma0 U2 also keeps f gdot - fdot g = 1, i.e. the state on the
-        # orbit (a long parabolic step turned the eccentricity vector by 1.5e-13
-        # rad with tau - U3 alone).  Radial orbits (pp = 0) keep tau - U3, which
-        # measured better through the collision.
-        dchi_err = EPS * (abs(chi1) + abs(chi0))
-        if pp > 0.0 and _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):
-            g = (r0 * u1 + sigma0 * u2) / smu
-        else:
-            g = (tau - u3) / smu
+    return t
+
+
+@njit(cache=True, inline="always")
+def _step_anchored(tau, r0, sigma0, alpha, pp, e2, smu):  # pragma: no cover - compiled
+    """``(r, U1, U2, g)`` after ``tau = sqrt(mu) dt`` towards periapsis, with the
+    universal Kepler equation anchored at periapsis (all its terms of one sign
+    there): chi0 of the initial state from ``sigma0 = e U1(chi0)``, then
+    ``q U1(chi1) + U3(chi1) = q U1(chi0) + U3(chi0) + tau`` for chi1; the
+    functions at ``dchi = chi1 - chi0``.  ``pp = h^2/mu``, ``e2 = e^2``.
+    r = NaN on failure."""
+    ecc = math.sqrt(e2)
+    q = pp / (1.0 + ecc)
+    if alpha > 0.0:
+        sa = math.sqrt(alpha)
+        chi0 = math.atan2(sigma0 * sa, 1.0 - r0 * alpha) / sa
+    elif alpha < 0.0:
+        sa = math.sqrt(-alpha)
+        chi0 = math.asinh(sigma0 * sa / ecc) / sa
     else:
-        chi, _t, r, _u0, u1, u2, u3 = _solve_uv(tau, r0, sigma0, alpha)
-        if not math.isfinite(chi):
-            return nan, nan, nan, nan, nan, nan
-        # g = (r0 U1 + sigma0 U2)/sqrt(mu) = (tau - U3)/sqrt(mu): the last-bit
-        # error of chi moves the first by (r - U2) dchi, the second by U2 dchi;
-        # take the smaller (on a fast hyperbola U3 << tau: g ~ dt exactly; the
-        # step r = (1, 0, 0), v = (0, 1e5, 0), dt = 1.234567 went from 54 ulp to 0.2)
-        if h2 > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
-            g = (tau - u3) / smu
-        else:
-            g = (r0 * u1 + sigma0 * u2) / smu
+        chi0 = sigma0 / ecc
+    tp0 = _uv_eval(chi0, q, 0.0, alpha)[0]
+    sol = _solve_uv(tp0 + tau, q, 0.0, alpha)
+    chi1 = sol[0]
+    if not math.isfinite(chi1):
+        return math.nan, 0.0, 0.0, 0.0
+    r = sol[2]
+    dchi = chi1 - chi0
+    _t, _r, _rp, _u0, u1, u2, u3 = _uv_eval(dchi, r0, sigma0, alpha)
+    # as in _step_direct: the form of g that the last-bit error of dchi moves
+    # least; r0 U1 + sigma0 U2 also keeps f gdot - fdot g = 1, i.e. the state on
+    # the orbit (a long parabolic step turned the eccentricity vector by 1.5e-13
+    # rad with tau - U3 alone).  Radial orbits (pp = 0) keep tau - U3, which
+    # measured better through the collision.
+    dchi_err = EPS * (abs(chi1) + abs(chi0))
+    if pp > 0.0 and _g_first_form(tau, r0, sigma0, u1, u2, u3, r, dchi_err):
+        g = (r0 * u1 + sigma0 * u2) / smu
+    else:
+        g = (tau - u3) / smu
+    return r, u1, u2, g
+
+
+@njit(cache=True, inline="always")
+def _step_direct(tau, r0, sigma0, alpha, h2, smu):  # pragma: no cover - compiled
+    """``(r, U1, U2, g)`` after ``tau = sqrt(mu) dt`` from the universal Kepler
+    equation ``T(chi) = tau`` solved directly; r = NaN on failure."""
+    chi, _t, r, _u0, u1, u2, u3 = _solve_uv(tau, r0, sigma0, alpha)
+    if not math.isfinite(chi):
+        return math.nan, 0.0, 0.0, 0.0
+    # g = (r0 U1 + sigma0 U2)/sqrt(mu) = (tau - U3)/sqrt(mu): the last-bit
+    # error of chi moves the first by (r - U2) dchi, the second by U2 dchi;
+    # take the smaller (on a fast hyperbola U3 << tau: g ~ dt exactly; the
+    # step r = (1, 0, 0), v = (0, 1e5, 0), dt = 1.234567 went from 54 ulp to 0.2)
+    if h2 > 0.0 and not _g_first_form(tau, r0, sigma0, u1, u2, u3, r, EPS * abs(chi)):
+        g = (tau - u3) / smu
+    else:
+        g = (r0 * u1 + sigma0 * u2) / smu
+    return r, u1, u2, g
+
+
+@njit(cache=True, inline="always")
+def _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz):  # pragma: no cover
+    """The state from Lagrange's f and g (``f = 1 - U2/r0``, ``fdot = -sqrt(mu)
+    U1/(r r0)``, ``gdot = 1 - U2/r``): the position ``f r0 + g v0``; the
+    velocity its radial part of the f-g velocity plus the exact transverse
+    part ``h x r / |r|^2`` (``h = r0 x v0`` is constant).  fdot r0 + gdot v0
+    cancels heavily in its transverse part when r >> r0; this form keeps
+    r x v = h to rounding (and gives exactly zero transverse velocity on radial
+    orbits).  NaN if ``r`` is not a positive float or ``|r|^2`` overflows."""
+    nan = math.nan
     if not (r > 0.0) or not math.isfinite(r):
         return nan, nan, nan, nan, nan, nan
     f = 1.0 - u2 / r0
@@ -816,10 +822,6 @@ def propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - c
     wx = fd * rx + gd * vx
     wy = fd * ry + gd * vy
     wz = fd * rz + gd * vz
-    # Velocity = radial part of the f-g velocity + the exact transverse part
-    # h x r / |r|^2 (h = r0 x v0 is constant).  fdot r0 + gdot v0 cancels
-    # heavily in its transverse part when r >> r0; this form keeps r x v = h
-    # to rounding (and gives exactly zero transverse velocity on radial orbits).
     rr = x * x + y * y + z * z
     if not (0.0 < rr < math.inf):  # |r|^2 overflows: report, never garbage
         return nan, nan, nan, nan, nan, nan
@@ -836,13 +838,71 @@ def propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - c
 
 @njit(cache=True)
 def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
-    """:func:`propagate_uv_inline` as a called function (the one compiled copy
-    that the public propagation uses).  A loop over many bodies with the same
-    ``mu`` and ``dt`` (the Wisdom-Holman drift) calls ``propagate_uv_inline``
-    instead: inlined there, the work on consecutive bodies overlaps and what
-    depends on ``mu`` and ``dt`` alone leaves the loop (about 20% less time per
-    body for the planets)."""
-    return propagate_uv_inline(rx, ry, rz, vx, vy, vz, mu, dt)
+    """Two-body state after time ``dt`` by universal variables (f and g series).
+
+    Returns ``(rx, ry, rz, vx, vy, vz)``, all NaN on failure.
+
+    * A bound orbit's ``dt`` is first reduced modulo the period
+      (:func:`_reduce_period`), so |dt| may be many periods.
+    * Moving away from periapsis (``sigma0 dt >= 0``, or a nearly circular
+      orbit) the universal Kepler equation ``T(chi) = sqrt(mu) dt`` is a sum
+      of terms of one sign and is solved directly (:func:`_step_direct`).
+      g is computed either from chi alone, ``g = (r0 U1 + sigma0 U2)/sqrt(mu)``,
+      so that f gdot - fdot g = 1 holds identically and the state stays on the
+      initial orbit whatever the solver's last-bit error, or as
+      ``(tau - U3)/sqrt(mu)``, whichever the last-bit error of chi and the
+      rounding of the terms move least (:func:`_g_first_form`; on a fast
+      hyperbola U3 << tau and g ~ dt).
+    * Moving towards periapsis (``sigma0 dt < 0``, e^2 >= 1/4, and a step
+      long enough, ``|sigma0 tau| > r0^2 / 10``, to matter), the terms of
+      T(chi) cancel (for an open orbit that starts far out the loss is about
+      r0/q in relative accuracy).  The equation is then anchored at
+      periapsis, where all terms have one sign (:func:`_step_anchored`;
+      radial orbits keep ``g = dt - U3/sqrt(mu)``) and
+      ``r = q U0(chi1) + U2(chi1)``.
+    * The state follows from f and g (:func:`_fg_state`).
+
+    :data:`propagate_uv_inline` is this function compiled to be inlined (at
+    numba's IR level) into the loop that calls it.
+    """
+    nan = math.nan
+    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
+    if not (r0 > 0.0):
+        return nan, nan, nan, nan, nan, nan
+    if dt == 0.0:
+        return rx, ry, rz, vx, vy, vz
+    v2 = vx * vx + vy * vy + vz * vz
+    smu = math.sqrt(mu)
+    sigma0 = (rx * vx + ry * vy + rz * vz) / smu
+    alpha = 2.0 / r0 - v2 / mu
+    tau = smu * _reduce_period(dt, mu, smu, alpha)
+    hx = ry * vz - rz * vy
+    hy = rz * vx - rx * vz
+    hz = rx * vy - ry * vx
+    h2 = hx * hx + hy * hy + hz * hz
+    # anchor only when it matters: heading for periapsis with a step long
+    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20,
+    # and e^2 = 1 - alpha p >= 1/4
+    anchor = False
+    pp = 0.0
+    e2 = 0.0
+    if sigma0 * tau < 0.0 and abs(sigma0 * tau) > 0.1 * r0 * r0:
+        pp = h2 / mu
+        e2 = 1.0 - alpha * pp
+        anchor = e2 >= 0.25
+    if anchor:
+        r, u1, u2, g = _step_anchored(tau, r0, sigma0, alpha, pp, e2, smu)
+    else:
+        r, u1, u2, g = _step_direct(tau, r0, sigma0, alpha, h2, smu)
+    return _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz)
+
+
+# The Wisdom-Holman drift loop (over bodies with the same mu and dt) calls this
+# one instead: propagate_uv's body inlined there, the work on consecutive bodies
+# overlaps and what depends on mu and dt alone leaves the loop (about 20% less
+# time per body for the planets).  The same Python function, so one definition;
+# not cached on its own (only ever compiled into its callers).
+propagate_uv_inline = njit(inline="always")(propagate_uv.py_func)
 
 
 # Below 1e-50 or above 1e50 a product of the kernels (h^2 ~ r^2 v^2, r.v h,
@@ -908,9 +968,10 @@ def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
 @njit(cache=True)
 def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
-    so that no intermediate product overflows or underflows."""
+    so that no intermediate product overflows or underflows; NaN for a ``dt``
+    that is not finite."""
     er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
-    if not ok:
+    if not ok or not math.isfinite(dt):
         nan = math.nan
         return nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
@@ -948,28 +1009,6 @@ def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
     return bad
 
 
-@njit(cache=True)
-def propagate_one(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
-    """One orbit through :func:`propagate_batch` (the same code, no arrays to
-    build in Python): ``(rx, ry, rz, vx, vy, vz, ok)``."""
-    r = np.empty((1, 3))
-    v = np.empty((1, 3))
-    r[0, 0] = rx
-    r[0, 1] = ry
-    r[0, 2] = rz
-    v[0, 0] = vx
-    v[0, 1] = vy
-    v[0, 2] = vz
-    m = np.full(1, mu)
-    d = np.full(1, dt)
-    r_out = np.empty((1, 3))
-    v_out = np.empty((1, 3))
-    bad = propagate_batch(r, v, m, d, r_out, v_out)
-    return (
-        r_out[0, 0], r_out[0, 1], r_out[0, 2], v_out[0, 0], v_out[0, 1], v_out[0, 2], bad < 0
-    )
-
-
 __all__ = [
     "EPS",
     "anomaly_from_nu",
@@ -979,7 +1018,6 @@ __all__ = [
     "nu_from_anomaly",
     "nu_from_anomaly_ufunc",
     "propagate_batch",
-    "propagate_one",
     "propagate_uv",
     "propagate_uv_inline",
     "sinh_minus_x",
