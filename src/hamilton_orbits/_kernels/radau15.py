@@ -413,10 +413,11 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
 
 
 @njit(cache=True, error_model="numpy")
-def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st):
+def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx, csv):
     # pragma: no cover - compiled
     """Scan the accepted step for events; returns the ``h`` of the first event with an
-    action (its watch row in ``st[8]``), or 2 if none."""
+    action (its watch row in ``st[8]``; ``r``, ``v`` then put at its time from the
+    step's polynomial), or 2 if none."""
     n = r.shape[0]
     cm = np.zeros(9)
     total = 0.0
@@ -431,6 +432,11 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st):
     h, row = _ev.scan(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
                       a0, b, gm, cm, ev_out, ev_count)
     st[8] = row
+    if h <= 1.0:
+        _ev.state_at(_ev.RADAU, h, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v, a0, b, gm,
+                     r, v)
+        csx[:] = 0.0
+        csv[:] = 0.0
     return h
 
 
@@ -460,14 +466,8 @@ def advance(
     """
     n = r.shape[0]
     m = 3 * n
-    x0 = np.empty(m)
-    v0 = np.empty(m)
-    csx0 = np.empty(m)
-    csv0 = np.empty(m)
-    xs = np.empty((n, 3))
-    vs = np.empty((n, 3))
-    at = np.empty((n, 3))
-    a0_2 = np.empty((n, 3))
+    x0, v0, csx0, csv0 = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     a0 = a0_2.reshape(m)
     csb = np.zeros((7, m))
     t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
@@ -512,15 +512,10 @@ def advance(
             continue
         _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
         if n_watch > 0:
-            h_ev = _watch_step(watch, t, dt_try, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st)
-            if h_ev <= 1.0:  # an event with an action: stop the state at its time
-                _ev.state_at(_ev.RADAU, h_ev, dt_try, x0.reshape((n, 3)), v0.reshape((n, 3)),
-                             r, v, a0, b, gm, r, v)
-                csx[:] = 0.0
-                csv[:] = 0.0
-                t = t + h_ev * dt_try
-                t_cs = 0.0
-                have_last = False
+            h_ev = _watch_step(watch, t, dt_try, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st,
+                               csx, csv)
+            if h_ev <= 1.0:  # an event with an action: the state is at its time
+                t, t_cs, have_last = t + h_ev * dt_try, 0.0, False
                 steps += 1
                 status = STATUS_EVENT
                 break
