@@ -9,6 +9,7 @@ measures what the scene's ``[[analysis]]`` entries ask for.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +58,24 @@ BODY = S.Table(
     }
 )
 
+@dataclass
+class _EventDistance(S.Field):
+    """An event's distance: a length (``"0.1 au"``) or ``{hill = k}``."""
+
+    def check(self, value: Any, path: str, problems: S.Problems) -> Any:
+        if isinstance(value, dict):
+            k = value.get("hill")
+            if set(value) != {"hill"} or isinstance(k, bool) or not isinstance(k, int | float) \
+                    or not k > 0:
+                problems.add(path, f"expected a length or {{hill = k}} with k > 0, got {value!r}")
+                return None
+            return {"hill": float(k)}
+        return S.Quantity(kind=LENGTH, positive=True).check(value, path, problems)
+
+    def type_name(self) -> str:
+        return 'a length ("0.1 au") or {hill = k}'
+
+
 SCHEMA: dict[str, S.Field] = {
     "duration": S.Quantity(kind=TIME, required=True, positive=True),
     "cadence": S.Quantity(kind=TIME, positive=True),
@@ -86,6 +105,12 @@ SCHEMA: dict[str, S.Field] = {
         },
     ),
     "bodies": S.Array(item=BODY, default=[]),
+    "events": S.Array(item=S.Table(fields={
+        "name": S.Choice(choices=("close_encounter", "collision", "escape"), required=True),
+        "bodies": S.Array(item=S.String()),
+        "distance": _EventDistance(),
+        "action": S.Choice(choices=("record", "stop", "merge", "remove")),
+    }), default=[]),
     "analysis": S.Array(
         default=[],
         item=S.Table(
@@ -141,6 +166,7 @@ def _check(spec: dict, problems: S.Problems) -> None:
     if not names and spec["initial"].get("rebound") is None:
         problems.add("bodies", "the scene has no bodies")
     _check_effects(spec, names, problems)
+    _check_events(spec, names, problems)
     _check_integrator(spec["integrator"], problems)
     for i, an in enumerate(spec["analysis"]):
         for key in ("body", "primary", "other"):
@@ -219,6 +245,20 @@ def _check_effects(spec: dict, names: list[str], problems: S.Problems) -> None:
                 f"effect {eff['name']!r} depends on velocities and integrator {method!r} "
                 f"cannot take it; use one of {', '.join(ok)}",
             )
+
+
+def _check_events(spec: dict, names: list[str], problems: S.Problems) -> None:
+    from hamilton_orbits.events import EventSet
+
+    for i, ev in enumerate(spec["events"]):
+        for name in ev.get("bodies") or []:
+            if name not in names:
+                problems.add(f"events[{i}].bodies",
+                             f"no body named {name!r}{S.closest(str(name), names)}")
+        try:
+            EventSet.of([{k: v for k, v in ev.items() if v is not None}])
+        except ValueError as exc:
+            problems.add(f"events[{i}]", str(exc).split(": ", 1)[-1])
 
 
 def _check_integrator(integ: dict, problems: S.Problems) -> None:
@@ -312,7 +352,7 @@ def _integrator_args(spec: dict) -> tuple[str, dict[str, Any]]:
 def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
     from hamilton_orbits import engine
     from hamilton_orbits.rhs import compile_rhs
-    from hamilton_orbits.simulation import check_method
+    from hamilton_orbits.simulation import check_method, event_log
 
     spec = scene.spec
     system = build_system(spec)
@@ -320,23 +360,47 @@ def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
     method, kw = _integrator_args(spec)
     effects = check_method(method, spec["effects"], kw["options"])
     rhs = compile_rhs(system, effects)
+    log = event_log(system, [{k: v for k, v in ev.items() if v is not None}
+                             for ev in spec["events"]])
     arrays = system.as_arrays()
     bar = _progress_bar(len(t_all) - 1, progress)
     try:
         out = engine.run(arrays.r, arrays.v, arrays.gm, t_all, rhs, method, stop=stop,
                          on_output=None if bar is None else (lambda i, steps: bar.update(1)),
-                         **kw)
+                         events=log, **kw)
     finally:
         if bar is not None:
             bar.close()
     if len(out.t) < 2:
         raise KeyboardInterrupt
     result = _result(scene, system, out, method, effects)
+    _events_into(result, system, out)
     for an in spec["analysis"]:
         _ANALYSIS_FUNCS[an["name"]](result, system, an)
     if spec["crosscheck"] and result.complete:
         _crosscheck_into(result, system, out, method, effects)
     return result
+
+
+def _events_into(result: Result, system, out) -> None:
+    """The events found: a table, their count, the first of each kind (what an
+    ``Ensemble`` row carries), and what stopped the run."""
+    from hamilton_orbits.simulation import event_table
+
+    if out.events is None:
+        return
+    table, stopped = event_table(out.events, system, u.yr)
+    result.metrics["events found"] = len(table)
+    for name in dict.fromkeys(table["name"]):
+        first = table[table["name"] == name][0]
+        result.metrics[f"first {name} at"] = first["time"]
+        result.metrics[f"first {name} bodies"] = str(first["bodies"])
+    if stopped is not None:
+        result.metrics["stopped by"] = f"{stopped['name']} of {stopped['bodies']}"
+    result.tables["events"] = [
+        {"event": str(row["name"]), "time": row["time"], "bodies": str(row["bodies"]),
+         "distance": row["distance"], "speed": row["speed"].to(u.km / u.s),
+         "action": str(row["action"])} for row in table]
 
 
 def _result(scene: Any, system, out, method: str, effects) -> Result:

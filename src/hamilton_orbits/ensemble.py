@@ -56,6 +56,8 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
             value, bool
         ):
             row[name] = float(value)
+        elif isinstance(value, str) and name.startswith("first "):
+            row[name] = value  # the bodies of a member's first event of a kind
     row["wall time [s]"] = result.wall_time
     row["complete"] = bool(result.complete)
     row["error"] = None

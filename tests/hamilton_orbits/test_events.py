@@ -163,3 +163,29 @@ def test_no_events_listed_is_an_empty_table():
     s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
     traj = integrate(s, 1.0)
     assert len(traj.events) == 0 and traj.stopped_by is None
+
+
+def test_a_scene_lists_its_events_and_an_ensemble_row_carries_them():
+    """Scenes take the same events; the summary tables them, and the first of each
+    kind is a metric (what an Ensemble row carries)."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.ensemble import run_member
+
+    data = {"kind": "nbody", "duration": "30 yr", "cadence": "10 d",
+            "initial": {"solar_system": {"bodies": ["sun", "jupiter"]}},
+            "bodies": [{"name": "comet", "gm": "0 m3/s2", "primary": "sun", "q": "4.9 au",
+                        "e": 0.99, "inc": "1 deg", "M": "-0.001 deg"}],
+            "events": [{"name": "escape", "distance": "30 au", "action": "stop"}]}
+    result = Scene.from_dict(data).run(progress=False)
+    assert result.metrics["events found"] == 1
+    assert result.metrics["stopped by"] == "escape of comet"
+    (row,) = result.tables["events"]
+    assert row["distance"].to_value(u.au) == pytest.approx(30.0, rel=1e-12)
+    assert result.times[-1].to_value(u.yr) == pytest.approx(
+        result.metrics["first escape at"].to_value(u.yr), rel=1e-12)
+    member = run_member(data, "<dict>", {})
+    assert member["events found"] == 1 and member["first escape bodies"] == "comet"
+    with pytest.raises(ValueError, match=r"events\[0\]\.distance: expected a length"):
+        Scene.from_dict({**data, "events": [{"name": "escape", "distance": {"hill": -1}}]})
+    with pytest.raises(ValueError, match=r"events\[0\]: .*`distance` is required"):
+        Scene.from_dict({**data, "events": [{"name": "escape"}]})
