@@ -3,7 +3,9 @@
 Every reproducer of the issue's n-body, scene, CLI and ensemble surfaces is here,
 as a named-error test (the exception type and the start of the message a user now
 gets) or a no-hang test (a subprocess with a timeout).  The rigid / pole
-reproducers are in ``tests/rigid/test_bad_input.py``.
+reproducers are in ``tests/rigid/test_bad_input_rigid.py`` (not
+``test_bad_input.py``: pytest imports test modules by their base name, and a
+``tests/rigid/__init__.py`` would shadow the ``rigid`` package).
 
 Conventions checked: bad input raises ``ValueError`` (or astropy's
 ``UnitConversionError``) naming the argument, the index and the value; a scene
