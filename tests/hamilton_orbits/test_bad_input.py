@@ -305,24 +305,29 @@ def test_set_paths_that_lead_nowhere_on_the_command_line():
     assert "bodies[7].gm: bodies has 2 entries" in res.stderr
 
 
-@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `tol` with float(); "
-                                       "DIMENSIONLESS.scalar('tol', tol) names it")
-def test_a_quantity_tolerance_names_tol():
-    with pytest.raises(u.UnitConversionError, match=r"`tol`"):
+def test_a_quantity_tolerance_names_tol():  # fixed in simulation.integrate by the lead
+    with pytest.raises(u.UnitConversionError, match=r"Expected `tol` to be dimensionless, got s"):
         integrate(quantities(), 1 * u.min, tol=1e-9 * u.s)
 
 
-@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `tol` with float() "
-                                       "('could not convert string to float: x')")
-def test_a_string_tolerance_names_tol():
-    with pytest.raises(ValueError, match=r"`tol`"):
+def test_a_string_tolerance_names_tol():  # was "could not convert string to float: 'x'"
+    with pytest.raises(ValueError, match=r"Expected `tol` to be numeric, got 'x'"):
         integrate(floats(), 0.1, tol="x")
 
 
-@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `dt` with float(); "
+@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `tol` with "
+                                       "float(DIMENSIONLESS(...)): an array is a TypeError; "
+                                       "DIMENSIONLESS.scalar('tol', tol) names it")
+def test_an_array_tolerance_names_tol():
+    with pytest.raises(ValueError, match=r"Expected `tol` to be one number, got shape \(2,\)"):
+        integrate(floats(), 0.1, tol=[1e-9, 1e-8])
+
+
+@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `dt` with "
+                                       "float(TIME(...)): an array is a TypeError; "
                                        "TIME.scalar('dt', dt, unit) names it")
 def test_an_array_step_names_dt():
-    with pytest.raises(ValueError, match=r"`dt`"):
+    with pytest.raises(ValueError, match=r"Expected `dt` to be one number, got shape \(2,\)"):
         integrate(floats(), 0.1, method="leapfrog", dt=[0.1, 0.2])
 
 
