@@ -79,7 +79,8 @@ def test_cli_end_to_end_in_a_subprocess(tmp_path):
     bad.write_text('kind = "nbody"\nduraton = "1 yr"\n')
     res = _cli("run", str(bad), "--no-progress")
     assert res.returncode == 2
-    assert "bad.toml: duraton: unknown key" in res.stderr
+    assert "bad.toml:2: duraton: unknown key" in res.stderr  # the file, the line, the key
+    assert "Traceback" not in res.stderr
     res = _cli("run", "leo-j2", "--set", "duration=0.5 d", "--out", str(tmp_path / "leo"),
                "--no-progress")
     assert res.returncode == 0, res.stderr

@@ -20,7 +20,8 @@ import numpy as np
 
 from hamilton_orbits import _schema as S
 
-__all__ = ["KINDS", "Result", "SceneKind", "format_table", "register_kind"]
+__all__ = ["KINDS", "OUTPUT_LIMIT", "Result", "SceneKind", "check_output_size", "format_table",
+           "register_kind"]
 
 
 @dataclass(frozen=True)
@@ -63,6 +64,51 @@ def register_kind(kind: SceneKind) -> SceneKind:
     """Register a scene kind (``rigid`` registers ``rotation`` through an entry point)."""
     KINDS[kind.name] = kind
     return kind
+
+
+OUTPUT_LIMIT = 2**30
+"""The most memory (bytes) a scene's outputs may take: 1 GiB of float64 values
+kept at the output times (the states, and as much again in ``states.nc``).  A
+scene asking for more is refused at loading, not after hours of running."""
+
+
+def _size(nbytes: float) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if nbytes < 1024 or unit == "PiB":
+            return f"{nbytes:.3g} {unit}"
+        nbytes /= 1024
+    return ""  # pragma: no cover
+
+
+def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output: int,
+                      what: str) -> None:
+    """Refuse a ``duration`` / ``cadence`` whose outputs would exceed :data:`OUTPUT_LIMIT`.
+
+    Parameters
+    ----------
+    spec : mapping
+        A scene's checked keys, with ``duration`` and ``cadence`` (None: 1000 outputs).
+    problems : _schema.Problems
+    per_output : int
+        float64 values kept at each output (n-body: 6 per body).
+    what : str
+        What each output holds, for the message (``"2 bodies"``).
+    """
+    duration, cadence = spec.get("duration"), spec.get("cadence")
+    if duration is None:
+        return
+    n = 1001.0 if cadence is None else math.ceil(
+        float((duration / cadence).to_value(u.one)) - 1e-9) + 1.0
+    nbytes = n * per_output * 8.0
+    if nbytes <= OUTPUT_LIMIT:
+        return
+    shortest = (duration * per_output * 8.0 / OUTPUT_LIMIT).to(
+        cadence.unit if cadence is not None else duration.unit)
+    problems.add(
+        "cadence" if cadence is not None else "duration",
+        f"{n:.4g} outputs of {what} would take {_size(nbytes)} of memory, beyond the limit of "
+        f"{_size(OUTPUT_LIMIT)}: choose a cadence of at least {shortest:.3g} or a shorter "
+        "duration")
 
 
 def _fmt(value: Any) -> str:
@@ -186,7 +232,7 @@ class Result:
             "scene": self.scene.name,
             "kind": self.scene.kind,
             "description": self.scene.spec.get("description", ""),
-            "effects": [dict(e) for e in self.scene.effects],
+            "effects": [{k: conv(v) for k, v in e.items()} for e in self.scene.effects],
             "complete": self.complete,
             "wall_time_s": self.wall_time,
             "metrics": {k: conv(v) for k, v in self.metrics.items()},

@@ -9,6 +9,7 @@ measures what the scene's ``[[analysis]]`` entries ask for.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,13 @@ import numpy as np
 
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
-from hamilton_orbits._scene_base import Result, SceneKind, format_table, register_kind
+from hamilton_orbits._scene_base import (
+    Result,
+    SceneKind,
+    check_output_size,
+    format_table,
+    register_kind,
+)
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
 
 METHODS = ("radau15", "wh", "leapfrog", "dop853")
@@ -31,6 +38,12 @@ ANALYSES = {
     "nodal_regression": "secular rate of the node of `body` about `primary`, beside the J2 formula",
     "close_approach": "the smallest distance between `body` and `other`, and when",
 }
+# the keys of each analysis besides its name: (required, optional)
+_ANALYSIS_KEYS = {
+    "perihelion_advance": (("body",), ("primary",)),
+    "nodal_regression": (("body",), ("primary",)),
+    "close_approach": (("body", "other"), ("primary",)),
+}
 
 
 def _accepts_velocity_dependent(method: str) -> bool:
@@ -42,19 +55,19 @@ def _accepts_velocity_dependent(method: str) -> bool:
 _ANGLE_KEYS = ("inc", "lan", "argp", "M", "nu")
 BODY = S.Table(
     fields={
-        "name": S.String(required=True),
-        "gm": S.Quantity(kind=GM),
+        "name": S.String(required=True, nonempty=True),
+        "gm": S.Quantity(kind=GM, nonnegative=True),
         "r": S.Vector(kind=LENGTH),
         "v": S.Vector(kind=SPEED),
         "primary": S.String(),
-        "a": S.Quantity(kind=LENGTH),
+        "a": S.Quantity(kind=LENGTH, nonzero=True),
         "p": S.Quantity(kind=LENGTH, positive=True),
         "q": S.Quantity(kind=LENGTH, positive=True),
-        "e": S.Quantity(kind=DIMENSIONLESS),
+        "e": S.Quantity(kind=DIMENSIONLESS, nonnegative=True),
         **{k: S.Quantity(kind=ANGLE) for k in _ANGLE_KEYS},
         "radius": S.Quantity(kind=LENGTH, positive=True),
         "j2": S.Quantity(kind=DIMENSIONLESS),
-        "pole": S.Vector(kind=DIMENSIONLESS),
+        "pole": S.Vector(kind=DIMENSIONLESS, nonzero=True),
     }
 )
 
@@ -152,12 +165,14 @@ def _initial_names(spec: dict) -> list[str]:
                 pass
     ss = spec["initial"].get("solar_system")
     if ss is not None:
-        names += list(ss.get("bodies") or _DEFAULT_SOLAR)
+        names += list(_DEFAULT_SOLAR if ss.get("bodies") is None else ss["bodies"])
     return names
 
 
 def _check(spec: dict, problems: S.Problems) -> None:
-    """Checks across keys, every problem reported with its key path."""
+    """Checks across keys, every problem reported with its key path; then, if the
+    scene is valid so far, the system and the effects' parameters are built as the
+    run will build them, so that nothing the run would refuse passes loading."""
     _check_initial(spec["initial"], problems)
     names = _initial_names(spec)
     for i, b in enumerate(spec["bodies"]):
@@ -168,19 +183,53 @@ def _check(spec: dict, problems: S.Problems) -> None:
     _check_effects(spec, names, problems)
     _check_events(spec, names, problems)
     _check_integrator(spec["integrator"], problems)
-    for i, an in enumerate(spec["analysis"]):
-        for key in ("body", "primary", "other"):
-            if an.get(key) is not None and an[key] not in names:
-                problems.add(f"analysis[{i}].{key}",
-                             f"no body named {an[key]!r}{S.closest(str(an[key]), names)}")
+    _check_analyses(spec["analysis"], names, problems)
     if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
         problems.add("cadence", f"the cadence {spec['cadence']} exceeds the duration "
                                 f"{spec['duration']}")
+    per_output = 6 * len(names) * (2 if spec["crosscheck"] else 1) + 4
+    check_output_size(spec, problems, per_output,
+                      f"{len(names)} bodies" + (" (and rebound's copy)" if spec["crosscheck"]
+                                                else ""))
+    if not problems:
+        _check_buildable(spec, problems)
+
+
+def _check_analyses(analyses: list, names: list[str], problems: S.Problems) -> None:
+    for i, an in enumerate(analyses):
+        required, optional = _ANALYSIS_KEYS[an["name"]]
+        for key in ("body", "primary", "other"):
+            where = f"analysis[{i}].{key}"
+            if an.get(key) is None:
+                if key in required:
+                    problems.add(where, f"missing: analysis {an['name']!r} needs `{key}` "
+                                        f"({ANALYSES[an['name']]})")
+            elif key not in required + optional:
+                problems.add(where, f"analysis {an['name']!r} takes no `{key}` (it takes "
+                                    f"{', '.join(required + optional)})")
+            elif an[key] not in names:
+                problems.add(where, f"no body named {an[key]!r}"
+                                    f"{S.closest(str(an[key]), names)}")
+            elif key != "body" and an[key] == an.get("body"):
+                problems.add(where, f"expected a body other than `body` ({an[key]!r})")
 
 
 def _check_initial(init: dict, problems: S.Problems) -> None:
+    from hamilton_orbits.nbody import solar_system_bodies, solar_system_epoch
+
     if init.get("rebound") is not None and init.get("solar_system") is not None:
         problems.add("initial", "give either `solar_system` or `rebound`, not both")
+    ss = init.get("solar_system")
+    if ss is not None:
+        checks = [("epoch", solar_system_epoch, ss.get("epoch")),
+                  ("bodies", solar_system_bodies, ss.get("bodies"))]
+        for key, check, value in checks:
+            if value is None or (key == "bodies" and None in value):
+                continue  # the default, or an item the schema refused (said already)
+            try:
+                check(value)
+            except ValueError as exc:
+                problems.add(f"initial.solar_system.{key}", _problem_text(exc))
     rb = init.get("rebound")
     if rb is None:
         return
@@ -219,6 +268,8 @@ def _check_body(b: dict, path: str, names: list[str], problems: S.Problems) -> N
         sizes = [k for k in ("a", "p", "q") if b[k] is not None]
         if len(sizes) != 1:
             problems.add(path, "give exactly one of `a`, `p`, `q` with the elements")
+        elif sizes == ["a"]:
+            _check_a_and_e(b, path, problems)
         if len([k for k in ("M", "nu") if b[k] is not None]) > 1:
             problems.add(path, "give at most one of `M`, `nu`")
         if b["primary"] is None:
@@ -228,6 +279,22 @@ def _check_body(b: dict, path: str, names: list[str], problems: S.Problems) -> N
                          f"no body named {b['primary']!r}{S.closest(b['primary'], names)}")
     else:
         problems.add(path, "missing: a state (`r`, `v`) or orbital elements (`a`, `e`, ...)")
+
+
+def _check_a_and_e(b: dict, path: str, problems: S.Problems) -> None:
+    """``a > 0`` is an ellipse (``e < 1``), ``a < 0`` a hyperbola (``e > 1``); a
+    parabola (``e = 1``) has no finite ``a``."""
+    a = b["a"]
+    e = 0.0 if b["e"] is None else float(b["e"].to_value(u.one))
+    shown = f"e = {e:g}" + ("" if b["e"] is not None else " (the default)")
+    if e == 1.0:
+        problems.add(f"{path}.a", f"a parabola ({shown}) has no finite `a`: give `p` or `q`")
+    elif e > 1.0 and a.value > 0:
+        problems.add(f"{path}.a", f"expected a < 0 for a hyperbola ({shown} > 1), got "
+                                  f"a = {a}; an ellipse (a > 0) has e < 1")
+    elif e < 1.0 and a.value < 0:
+        problems.add(f"{path}.a", f"expected a > 0 for an ellipse ({shown} < 1), got "
+                                  f"a = {a}; a hyperbola (a < 0) has e > 1")
 
 
 def _check_effects(spec: dict, names: list[str], problems: S.Problems) -> None:
@@ -266,6 +333,9 @@ def _check_integrator(integ: dict, problems: S.Problems) -> None:
         if integ[option] is not None and integ["method"] != "wh":
             problems.add(f"integrator.{option}",
                          f"an option of method 'wh' only, not of {integ['method']!r}")
+    if integ["method"] == "leapfrog" and integ["dt"] is None and integ["tol"] is None:
+        problems.add("integrator.dt", "missing: method 'leapfrog' takes a fixed step `dt` "
+                                      "(or a tolerance `tol` from which to choose one)")
     if integ["corrector"] not in (None, 0, 3):
         problems.add("integrator.corrector", f"expected 0 or 3, got {integ['corrector']!r}")
     elif integ["corrector"] == 3 and integ["coordinates"] != "jacobi":
@@ -273,11 +343,73 @@ def _check_integrator(integ: dict, problems: S.Problems) -> None:
                      "the corrector needs integrator.coordinates = 'jacobi'")
 
 
-def build_system(spec: dict):
-    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from."""
-    from astropy.time import Time
+def _check_buildable(spec: dict, problems: S.Problems) -> None:
+    """Build the system and every effect's parameters as the run will, each refusal
+    a problem at the key it comes from."""
+    system = build_system(spec, problems)
+    if system is None:
+        return
+    for i, eff in enumerate(spec["effects"]):
+        ek = _effects.get("nbody", eff["name"])
+        if ek.params is None:
+            continue
+        params = {k: v for k, v in eff.items() if k != "name"}
+        _attempt(problems, f"effects[{i}]", lambda ek=ek, p=params: ek.params(system, p),
+                 tuple(ek.parameters))
 
-    from hamilton_orbits import Body, KeplerOrbit, System
+
+def _problem_text(exc: Exception) -> str:
+    """An exception's message as a problem's text (after the key path: lower case)."""
+    msg = str(exc)
+    return "e" + msg[1:] if msg.startswith("Expected ") else msg
+
+
+def _attempt(problems: S.Problems | None, path: str, build, keys=()):
+    """``build()``, or with ``problems`` its ``ValueError`` as a problem at ``path``
+    (at ``path.key`` when the message names one of ``keys`` first) and None."""
+    if problems is None:
+        return build()
+    try:
+        return build()
+    except ValueError as exc:
+        msg = str(exc)
+        named = re.search(r"`(\w+)`", msg)
+        if named and named.group(1) in keys:
+            path = f"{path}.{named.group(1)}"
+        problems.add(path, _problem_text(exc))
+        return None
+
+
+def _scene_body(b: dict, by_name: dict):
+    """The :class:`~hamilton_orbits.nbody.Body` of one ``[[bodies]]`` table."""
+    from hamilton_orbits import Body, KeplerOrbit
+
+    extra = {k: b[k] for k in ("radius", "j2", "pole") if b[k] is not None}
+    if b["r"] is not None:
+        return Body(b["name"], gm=b["gm"], r=b["r"], v=b["v"], **extra)
+    prim = by_name[b["primary"]]
+    mu = (prim.gm + b["gm"]).to(u.km**3 / u.s**2)
+    kw = {k: b[k] for k in ("a", "p", "q", "M", "nu") if b[k] is not None}
+    orbit = KeplerOrbit.from_elements(
+        e=b["e"] if b["e"] is not None else 0.0,
+        inc=b["inc"] if b["inc"] is not None else 0 * u.rad,
+        lan=b["lan"] if b["lan"] is not None else 0 * u.rad,
+        argp=b["argp"] if b["argp"] is not None else 0 * u.rad,
+        mu=mu,
+        **({"M": 0 * u.rad} if "M" not in kw and "nu" not in kw else {}),
+        **kw,
+    )
+    r, v = orbit.state()
+    return Body(b["name"], gm=b["gm"], r=prim.r + r, v=prim.v + v, **extra)
+
+
+def build_system(spec: dict, problems: S.Problems | None = None):
+    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from.
+
+    With ``problems`` (while the scene is checked), a refusal of the system, a
+    body or its orbit is added there at its key path and None is returned.
+    """
+    from hamilton_orbits import System
 
     init = spec["initial"]
     bodies: list = []
@@ -285,37 +417,26 @@ def build_system(spec: dict):
         import rebound
 
         # lengths in au, times in days, G m in au^3/day^2 (what final.bin holds)
-        sim = rebound.Simulation(str(init["rebound"]))
-        base = System.from_rebound(sim, quantity=True, names=init.get("names"))
-        bodies = [base[n] for n in base.names]
+        base = _attempt(problems, "initial.rebound", lambda: System.from_rebound(
+            rebound.Simulation(str(init["rebound"])), quantity=True, names=init.get("names")))
+        bodies += [] if base is None else [base[n] for n in base.names]
     ss = init.get("solar_system")
     if ss is not None:
-        epoch = Time(ss["epoch"], scale="tdb")
-        base = System.solar_system(epoch, bodies=list(ss.get("bodies") or _DEFAULT_SOLAR))
-        bodies += [base[n] for n in base.names]
+        base = _attempt(problems, "initial.solar_system", lambda: System.solar_system(
+            ss["epoch"], bodies=ss.get("bodies")), ("epoch", "bodies"))
+        bodies += [] if base is None else [base[n] for n in base.names]
     by_name = {b.name: b for b in bodies}
-    for b in spec["bodies"]:
-        extra = {k: b[k] for k in ("radius", "j2", "pole") if b[k] is not None}
-        if b["r"] is not None:
-            body = Body(b["name"], gm=b["gm"], r=b["r"], v=b["v"], **extra)
-        else:
-            prim = by_name[b["primary"]]
-            mu = (prim.gm + b["gm"]).to(u.km**3 / u.s**2)
-            kw = {k: b[k] for k in ("a", "p", "q", "M", "nu") if b[k] is not None}
-            orbit = KeplerOrbit.from_elements(
-                e=b["e"] if b["e"] is not None else 0.0,
-                inc=b["inc"] if b["inc"] is not None else 0 * u.rad,
-                lan=b["lan"] if b["lan"] is not None else 0 * u.rad,
-                argp=b["argp"] if b["argp"] is not None else 0 * u.rad,
-                mu=mu,
-                **({"M": 0 * u.rad} if "M" not in kw and "nu" not in kw else {}),
-                **kw,
-            )
-            r, v = orbit.state()
-            body = Body(b["name"], gm=b["gm"], r=prim.r + r, v=prim.v + v, **extra)
-        bodies.append(body)
-        by_name[body.name] = body
-    return System(bodies)
+    for i, b in enumerate(spec["bodies"]):
+        if b["r"] is None and b["primary"] not in by_name:
+            continue  # its primary was refused: said already
+        body = _attempt(problems, f"bodies[{i}]", lambda b=b: _scene_body(b, by_name),
+                        tuple(BODY.fields))
+        if body is not None:
+            bodies.append(body)
+            by_name[body.name] = body
+    if problems:
+        return None
+    return _attempt(problems, "bodies", lambda: System(bodies))
 
 
 def _times(spec: dict) -> u.Quantity:

@@ -13,6 +13,7 @@ schema with these fields (``hamilton_orbits.scene``).
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,6 +34,8 @@ __all__ = [
     "Table",
     "Vector",
     "closest",
+    "key_lines",
+    "split_path",
 ]
 
 
@@ -53,14 +56,27 @@ def closest(name: str, valid: Sequence[str]) -> str:
 
 
 class Problems:
-    """The problems found in one file, each with its key path."""
+    """The problems found in one file, each with its key path and, where the
+    value comes from the file, its line: ``file:LINE: key.path: message``.
 
-    def __init__(self, source: str) -> None:
+    Parameters
+    ----------
+    source : str
+        The file (or ``<dict>``).
+    locate : callable, optional
+        ``locate(path) -> line or None``: the line of a key path in the file.
+    """
+
+    def __init__(self, source: str,
+                 locate: Callable[[str], int | None] | None = None) -> None:
         self.source = source
+        self.locate = locate
         self.items: list[str] = []
 
     def add(self, path: str, message: str) -> None:
-        where = f"{self.source}: {path}" if path else self.source
+        line = self.locate(path) if (self.locate is not None and path) else None
+        file = self.source if line is None else f"{self.source}:{line}"
+        where = f"{file}: {path}" if path else file
         self.items.append(f"{where}: {message}")
 
     def __bool__(self) -> bool:
@@ -93,11 +109,16 @@ class Field:
 
 @dataclass
 class String(Field):
-    """A string."""
+    """A string (``nonempty``: with something in it besides blanks)."""
+
+    nonempty: bool = False
 
     def check(self, value: Any, path: str, problems: Problems) -> Any:
         if not isinstance(value, str):
             problems.add(path, f"expected a string, got {value!r}")
+            return None
+        if self.nonempty and not value.strip():
+            problems.add(path, f"expected a non-empty string, got {value!r}")
             return None
         return value
 
@@ -180,10 +201,19 @@ class Quantity(Field):
         The dimension expected (LENGTH, TIME, ...).
     positive : bool
         Require a value > 0.
+    nonnegative : bool
+        Require a value >= 0.
+    nonzero : bool
+        Require a value other than 0.
+
+    Messages quote the value as the file gives it (``'-1 km3/s2'``), not in an
+    internal unit.
     """
 
     kind: Kind | None = None
     positive: bool = False
+    nonnegative: bool = False
+    nonzero: bool = False
 
     def check(self, value: Any, path: str, problems: Problems) -> Any:
         assert self.kind is not None
@@ -206,24 +236,30 @@ class Quantity(Field):
             except (ValueError, TypeError):
                 problems.add(path, f"cannot read {value!r} as a number with a unit")
                 return None
+        elif isinstance(value, u.Quantity):  # a scene built in Python (from_dict)
+            q = value
         else:
             problems.add(path, f"expected {self.type_name()}, got {value!r}")
             return None
         try:
             number = self.kind(path, q)
         except u.UnitConversionError:
-            problems.add(
-                path,
-                f"expected {self.kind.name} (a unit convertible to {self.kind.unit}), "
-                f"got {value!r}",
-            )
+            wanted = ("a dimensionless number" if self.kind.unit == u.dimensionless_unscaled
+                      else f"{self.kind.name} (a unit convertible to {self.kind.unit})")
+            problems.add(path, f"expected {wanted}, got {value!r}")
             return None
         except ValueError as exc:
             problems.add(path, str(exc))
             return None
-        if self.positive and not float(number) > 0:
-            problems.add(path, f"expected a value > 0, got {value!r}")
+        if number.shape != ():
+            problems.add(path, f"expected one value, got {value!r}")
             return None
+        for wanted, ok, text in ((self.positive, float(number) > 0, "a value > 0"),
+                                 (self.nonnegative, float(number) >= 0, "a value >= 0"),
+                                 (self.nonzero, float(number) != 0, "a nonzero value")):
+            if wanted and not ok:
+                problems.add(path, f"expected {text}, got {value!r}")
+                return None
         return q
 
     def type_name(self) -> str:
@@ -233,10 +269,11 @@ class Quantity(Field):
 
 @dataclass
 class Vector(Field):
-    """Three values with units, ``["1 au", "0 au", "0 au"]``."""
+    """Three values with units, ``["1 au", "0 au", "0 au"]`` (``nonzero``: not all 0)."""
 
     kind: Kind | None = None
     size: int = 3
+    nonzero: bool = False
 
     def check(self, value: Any, path: str, problems: Problems) -> Any:
         if not isinstance(value, list) or len(value) != self.size:
@@ -248,7 +285,11 @@ class Vector(Field):
         if len(problems.items) > before:
             return None
         unit = parts[0].unit
-        return u.Quantity([p.to_value(unit) for p in parts], unit)
+        out = u.Quantity([p.to_value(unit) for p in parts], unit)
+        if self.nonzero and not (out.value != 0).any():
+            problems.add(path, f"expected a nonzero direction, got {value!r}")
+            return None
+        return out
 
     def type_name(self) -> str:
         return f"a list of {self.size} values"
@@ -305,3 +346,140 @@ class Table(Field):
 
     def type_name(self) -> str:
         return "a table"
+
+
+# --- where a key is in the file -------------------------------------------------------
+
+_TOKEN = re.compile(
+    r"""(?P<comment>\#[^\n]*)
+      | (?P<ml>\"\"\"(?:.|\n)*?\"\"\"|\'\'\'(?:.|\n)*?\'\'\')
+      | (?P<str>"(?:\\.|[^"\\\n])*"|'[^'\n]*')
+      | (?P<nl>\n)
+      | (?P<ws>[ \t\r]+)
+      | (?P<punct>[\[\]{}=,.])
+      | (?P<bare>[A-Za-z0-9_+\-:]+(?:\.[A-Za-z0-9_+\-:]+)*)""",
+    re.VERBOSE,
+)
+
+
+def split_path(path: str) -> tuple[str | int, ...]:
+    """A key path as its components: ``"bodies[1].pole[2]"`` -> ``("bodies", 1, "pole", 2)``.
+
+    Examples
+    --------
+    >>> split_path("initial.solar_system.bodies[3]")
+    ('initial', 'solar_system', 'bodies', 3)
+    """
+    out: list[str | int] = []
+    for name, index in re.findall(r"([^.\[\]]+)|\[(\d+)\]", path):
+        out.append(int(index) if index else name)
+    return tuple(out)
+
+
+class _Lines:
+    """A pass over a TOML text (already known to parse) recording the line of every
+    key path: keys, tables, array items, keys in inline tables."""
+
+    def __init__(self, text: str) -> None:
+        self.toks: list[tuple[str, str, int]] = []
+        line = 1
+        for m in _TOKEN.finditer(text):
+            kind = m.lastgroup or ""
+            if kind not in ("comment", "ws"):
+                self.toks.append((kind, m.group(), line))
+            line += m.group().count("\n")
+        self.toks.append(("end", "", line))
+        self.pos = 0
+        self.lines: dict[tuple, int] = {}
+
+    def _peek(self) -> tuple[str, str, int]:
+        return self.toks[self.pos]
+
+    def _skip_newlines(self) -> None:
+        while self._peek()[0] == "nl":
+            self.pos += 1
+
+    def _key(self) -> tuple[str, ...]:
+        parts: list[str] = []
+        while True:
+            kind, text, _ = self._peek()
+            if kind == "bare":
+                parts += text.split(".")
+            elif kind == "str":
+                parts.append(text[1:-1])
+            elif text != ".":
+                return tuple(parts)
+            self.pos += 1
+
+    def _value(self, path: tuple) -> None:
+        kind, text, _ = self._peek()
+        if text in ("[", "{"):
+            self.pos += 1
+            close, index = ("]" if text == "[" else "}"), 0
+            while True:
+                self._skip_newlines()
+                kind, text, line = self._peek()
+                if text == close or kind == "end":
+                    self.pos += 1
+                    return
+                if close == "]":
+                    self.lines.setdefault((*path, index), line)
+                    self._value((*path, index))
+                    index += 1
+                else:
+                    sub = (*path, *self._key())
+                    self.lines.setdefault(sub, line)
+                    self.pos += 1  # "="
+                    self._value(sub)
+                self._skip_newlines()
+                if self._peek()[1] == ",":
+                    self.pos += 1
+        self.pos += 1
+        while self._peek()[0] == "bare":  # a date and a time: "1979-05-27 07:32:00"
+            self.pos += 1
+
+    def run(self) -> dict[tuple, int]:
+        table: tuple = ()
+        counts: dict[tuple, int] = {}
+        while self._peek()[0] != "end":
+            kind, text, line = self._peek()
+            if kind == "nl":
+                self.pos += 1
+            elif text == "[":
+                double = self.toks[self.pos + 1][1] == "["
+                self.pos += 2 if double else 1
+                name = self._key()
+                self.pos += 2 if double else 1
+                if double:
+                    counts[name] = counts.get(name, -1) + 1
+                    table = (*name, counts[name])
+                else:
+                    table = name
+                self.lines.setdefault(table, line)
+            else:
+                path = (*table, *self._key())
+                self.lines.setdefault(path, line)
+                self.pos += 1  # "="
+                self._value(path)
+        return self.lines
+
+
+def key_lines(text: str) -> dict[tuple, int]:
+    r"""The line of every key path of a TOML text (components as :func:`split_path`).
+
+    TOML's parser gives no lines; this reads the text once more.  A text it
+    cannot follow gives what it found until then.
+
+    Examples
+    --------
+    >>> lines = key_lines('kind = "nbody"\n[[bodies]]\nname = "a"\n[[bodies]]\n'
+    ...                   'name = "b"\ngm = "1 km3/s2"\neffects = [{ name = "gr" }]\n')
+    >>> lines[("bodies", 1, "gm")], lines[("bodies", 1)], lines[("bodies", 1, "effects", 0)]
+    (6, 4, 7)
+    """
+    reader = _Lines(text)
+    try:
+        reader.run()
+    except IndexError:  # a text beyond this reader: keep what it found
+        pass
+    return reader.lines

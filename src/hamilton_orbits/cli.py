@@ -10,8 +10,16 @@
 
 ``run`` prints the scene's summary table and writes its folder (``summary.md``,
 ``summary.json``, PNG figures, ``states.nc``), named in the output.  Exit codes:
-0 on success, 2 for a bad scene (every problem is listed, nothing is simulated),
-1 for a failure during the run, 130 after Ctrl-C (what was done is kept and saved).
+0 on success; 2 for a bad scene (every problem is listed, with file, line and
+key) or a bad command line (an ``--out`` that is a file, cannot be written, or
+is being written by another live run): nothing is simulated; 1 for a failure
+during the run, in one line; 130 after Ctrl-C (what was done is kept and saved).
+No command prints a traceback: every error is one ``hamilton-orbits: ...``
+message on stderr.
+
+The output folder is checked and claimed before the run (a lock file holding the
+run's PID, ``.hamilton-orbits.lock``, removed at the end): two runs never write
+into one folder at once, and a run never learns at the end that it cannot save.
 
 ``demo`` shows Hamilton's quaternion algebra and a rotation round trip, Hamilton's
 two-body integrals on a textbook orbit, then the demo sections that other packages
@@ -86,6 +94,20 @@ DEFAULT_SCENE = "solar-system"
 EXIT_OK, EXIT_FAILED, EXIT_BAD_SCENE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 
+class _CommandError(Exception):
+    """A failure the command explains itself (its message is the whole line)."""
+
+
+def _error(message: str) -> None:
+    print(f"hamilton-orbits: {message}", file=sys.stderr)
+
+
+def _one_line(exc: BaseException) -> str:
+    """An exception as one line: its type and its message, whitespace collapsed."""
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
 def _load_scene(ref: str, sets: Sequence[str]):
     """A scene from a bundled name or a file path, with ``--set`` overrides applied."""
     from pathlib import Path
@@ -127,13 +149,28 @@ def _list_scenes() -> int:
 def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
     from pathlib import Path
 
-    from hamilton_orbits.scene import SceneError
+    from hamilton_orbits._outdir import OutputFolder
 
-    try:
-        scene = _load_scene(ref, sets)
-    except SceneError as exc:
-        print(f"hamilton-orbits: {exc}", file=sys.stderr)
-        return EXIT_BAD_SCENE
+    scene = _load_scene(ref, sets)
+    folder = Path(out) if out else Path("hamilton-orbits-output") / scene.name
+    with OutputFolder(folder, "--out" if out else "output folder"):
+        result = _run_scene(scene, progress)
+        if result is None:
+            return EXIT_FAILED
+        print(result.summary())
+        try:
+            paths = result.save(folder)
+        except Exception as exc:
+            _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
+                   f"{_one_line(exc)}")
+            return EXIT_FAILED
+    print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+    return EXIT_OK if result.complete else EXIT_INTERRUPTED
+
+
+def _run_scene(scene, progress: bool):
+    """Run ``scene`` with Ctrl-C handled (the first stops after the current chunk);
+    None (after one line on stderr) if the run failed."""
     interrupted: list[int] = []
 
     def stop() -> bool:
@@ -154,38 +191,23 @@ def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
     except ValueError:  # not the main thread: leave Ctrl-C alone
         previous = None
     try:
-        result = scene.run(progress=progress and sys.stderr.isatty(), stop=stop)
-    except KeyboardInterrupt:  # pragma: no cover - the kinds turn Ctrl-C into a short result
-        print("hamilton-orbits: interrupted before any output was produced", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except SceneError as exc:
-        print(f"hamilton-orbits: {exc}", file=sys.stderr)
-        return EXIT_BAD_SCENE
+        return scene.run(progress=progress and sys.stderr.isatty(), stop=stop)
+    except KeyboardInterrupt:
+        raise
     except Exception as exc:
-        print(f"hamilton-orbits: the run of {scene.name} failed: {exc!r}", file=sys.stderr)
-        return EXIT_FAILED
+        _error(f"the run of {scene.name} failed: {_one_line(exc)}")
+        return None
     finally:
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
-    print(result.summary())
-    folder = Path(out) if out else Path("hamilton-orbits-output") / scene.name
-    paths = result.save(folder)
-    print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
-    return EXIT_OK if result.complete else EXIT_INTERRUPTED
 
 
 def _crosscheck(ref: str, sets: Sequence[str]) -> int:
-    from hamilton_orbits.scene import SceneError
-
-    try:
-        scene = _load_scene(ref, sets)
-    except SceneError as exc:
-        print(f"hamilton-orbits: {exc}", file=sys.stderr)
-        return EXIT_BAD_SCENE
+    scene = _load_scene(ref, sets)
     try:
         print(scene.crosscheck())
     except Exception as exc:
-        print(f"hamilton-orbits: the cross-check of {scene.name} failed: {exc!r}", file=sys.stderr)
+        _error(f"the cross-check of {scene.name} failed: {_one_line(exc)}")
         return EXIT_FAILED
     return EXIT_OK
 
@@ -215,52 +237,66 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
               progress: bool) -> int:
     from pathlib import Path
 
+    from hamilton_orbits._outdir import OutputFolder
     from hamilton_orbits.ensemble import Ensemble
-    from hamilton_orbits.scene import SceneError, format_table
+    from hamilton_orbits.scene import SceneError
 
     vary: dict[str, list[str]] = {}
+    scene = _load_scene(ref, [])
+    for item in varies:
+        key, sep, values = item.partition("=")
+        if not sep or not key.strip() or not _split_values(values):
+            raise SceneError([f"{scene.source}: --vary {item!r}: expected KEY=V1,V2,..."])
+        vary[key.strip()] = _split_values(values)
     try:
-        scene = _load_scene(ref, [])
-        for item in varies:
-            key, sep, values = item.partition("=")
-            if not sep or not key.strip() or not _split_values(values):
-                raise SceneError([f"{scene.source}: --vary {item!r}: expected KEY=V1,V2,..."])
-            vary[key.strip()] = _split_values(values)
         ens = Ensemble(scene, vary=vary)
-    except (SceneError, ValueError) as exc:
-        print(f"hamilton-orbits: {exc}", file=sys.stderr)
+    except ValueError as exc:  # a member that is not a valid scene, named
+        _error(str(exc))
         return EXIT_BAD_SCENE
-    client = None
-    if dask:
+    folder = Path(out) if out else Path("hamilton-orbits-output") / f"{scene.name}-ensemble"
+    with OutputFolder(folder, "--out" if out else "output folder"):
+        client = _dask_client(dask) if dask else None
         try:
-            from dask.distributed import Client, LocalCluster
-        except ImportError:
-            print("hamilton-orbits: --dask needs Dask: pip install 'hamilton-orbits[dask]'",
-                  file=sys.stderr)
-            return EXIT_FAILED
-        client = Client(LocalCluster()) if dask == "local" else Client(dask)
+            df = ens.run(client=client, progress=progress and sys.stderr.isatty())
+        finally:
+            if client is not None:
+                client.close()
+        _write_ensemble(scene, df, folder)
+    return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
+
+
+def _dask_client(address: str):
+    """A Dask client on ``address`` (``"local"``: a cluster on this machine)."""
     try:
-        df = ens.run(client=client, progress=progress and sys.stderr.isatty())
-    finally:
-        if client is not None:
-            client.close()
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise _CommandError("--dask needs Dask: pip install 'hamilton-orbits[dask]'") from None
+    try:
+        return Client(LocalCluster()) if address == "local" else Client(address)
+    except (OSError, ValueError, TypeError) as exc:
+        raise _CommandError(f"--dask {address}: cannot connect to the scheduler "
+                           f"({_one_line(exc)})") from None
+
+
+def _write_ensemble(scene, df, folder) -> None:
+    from hamilton_orbits.scene import format_table
+
     rows = df.to_dict("records")
     print(f"ensemble of {scene.name}: {len(df)} members, {df.attrs['failures']} failed")
     print(format_table(rows))
-    folder = Path(out) if out else Path("hamilton-orbits-output") / f"{scene.name}-ensemble"
-    folder.mkdir(parents=True, exist_ok=True)
     df.to_csv(folder / "ensemble.csv", index=False)
     (folder / "ensemble.md").write_text(
         f"# Ensemble of {scene.name}\n\n```\n{format_table(rows)}\n```\n", encoding="utf-8")
     print(f"\nwrote ensemble.csv, ensemble.md to {folder}/")
-    return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
 
 
 def _report(quick: bool, out: str | None, progress: bool) -> int:
+    from hamilton_orbits._outdir import OutputFolder
     from hamilton_orbits.report import build_report
 
     folder = out if out else "hamilton-orbits-output/report"
-    files = build_report(folder, quick=quick, progress=progress)
+    with OutputFolder(folder, "--out" if out else "output folder"):
+        files = build_report(folder, quick=quick, progress=progress)
     print("wrote " + ", ".join(f.name for f in files) + f" to {folder}/")
     return EXIT_OK
 
@@ -311,6 +347,34 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.version:
         print(f"hamilton-orbits {__version__}")
         return EXIT_OK
+    return _guarded(args)
+
+
+def _guarded(args: argparse.Namespace) -> int:
+    """Run the command; every error becomes one line on stderr and an exit code."""
+    from hamilton_orbits._outdir import FolderError
+    from hamilton_orbits.scene import SceneError
+
+    try:
+        return _dispatch(args)
+    except SceneError as exc:  # every problem, with file, line and key
+        _error(str(exc))
+        return EXIT_BAD_SCENE
+    except FolderError as exc:
+        _error(str(exc))
+        return EXIT_BAD_SCENE
+    except _CommandError as exc:
+        _error(str(exc))
+        return EXIT_FAILED
+    except KeyboardInterrupt:  # a second Ctrl-C, or one before any output
+        _error("interrupted (Ctrl-C)")
+        return EXIT_INTERRUPTED
+    except Exception as exc:
+        _error(_one_line(exc))
+        return EXIT_FAILED
+
+
+def _dispatch(args: argparse.Namespace) -> int:
     if args.command == "demo":
         return _demo()
     if args.command == "scenes":

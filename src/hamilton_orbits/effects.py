@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.units import DIMENSIONLESS, LENGTH, SPEED, Kind, is_quantity
 
 __all__ = [
     "C_AU_PER_DAY",
@@ -40,6 +41,7 @@ __all__ = [
     "get",
     "known",
     "normalize_effects",
+    "parameter_value",
     "register",
     "source_index",
     "speed_of_light",
@@ -80,6 +82,13 @@ class EffectSpec:
         True if ``kernel`` computes the whole point-mass interaction itself (as the
         Einstein-Infeld-Hoffmann equations do): the Newtonian kernel is then left
         out of the right-hand side.
+    parameter_kinds : Mapping[str, hamilton_orbits.units.Kind]
+        The dimension of each scalar parameter that has one (``"c"``: a speed):
+        a Quantity of that kind for a Quantity system, a plain number in the
+        system's own units otherwise (read by :func:`parameter_value`; a scene
+        reads ``"299792.458 km/s"`` into a Quantity of that kind).
+    name_parameters : tuple of str
+        The parameters that name a body of the system (``"body"``, ``"source"``).
     """
 
     name: str
@@ -92,6 +101,8 @@ class EffectSpec:
     kernel: Any = None
     params: Callable[..., np.ndarray] | None = None
     replaces_newtonian: bool = False
+    parameter_kinds: Mapping[str, Kind] = field(default_factory=dict)
+    name_parameters: tuple[str, ...] = ()
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}
@@ -245,7 +256,7 @@ def normalize_effects(
     if not isinstance(effects, Sequence):
         raise ValueError(f"Expected `effects` to be a list of names or mappings, got {effects!r}")
     out = []
-    seen: set[str] = set()
+    seen: dict[str, int] = {}
     for k, item in enumerate(effects):
         name, params, problems = entry_problems(item, kind)
         if problems:
@@ -255,8 +266,8 @@ def normalize_effects(
         if name == "newtonian":
             continue
         if name in seen:
-            raise ValueError(f"Effect {name!r} is listed twice (again at index {k})")
-        seen.add(name)
+            raise ValueError(f"Effect {name!r} is listed twice (at indices {seen[name]} and {k})")
+        seen[name] = k
         out.append((name, tuple(sorted(params.items()))))
     return tuple(out)
 
@@ -272,7 +283,11 @@ def _frozen(value: Any) -> Any:
     if isinstance(value, (list, tuple)):
         return tuple(_frozen(v) for v in value)
     if isinstance(value, Mapping):
-        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
+        return tuple(sorted((str(k), _frozen(v)) for k, v in value.items()))
+    try:
+        hash(value)
+    except TypeError:  # a set or another unhashable value: compared by its text
+        return ("unhashable", type(value).__name__, repr(value))
     return value
 
 
@@ -382,6 +397,9 @@ def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) 
     gm = system.as_arrays().gm
     if name is None:
         return int(np.argmax(gm))
+    if not isinstance(name, str):
+        raise ValueError(f"Effect {effect!r}: expected `{key}` to be the name of a body, got "
+                         f"{name!r}; bodies: {', '.join(system.names)}")
     if name not in system.names:
         raise ValueError(
             f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
@@ -393,9 +411,67 @@ def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) 
     return idx
 
 
+# the internal units of a Quantity system (hamilton_orbits.nbody: au, day)
+_SYSTEM_UNITS = {LENGTH: "au", SPEED: "au / d", DIMENSIONLESS: ""}
+
+
+def parameter_value(system: Any, params: Mapping[str, Any], key: str, effect: str,
+                    kind: Kind) -> float | None:
+    """The scalar parameter ``key`` of mapping ``params`` in ``system``'s own units,
+    or None if it is not given.
+
+    One rule for every dimensioned parameter of every effect: a Quantity of
+    ``kind`` for a Quantity system (converted to au, au/day), a plain number in
+    the caller's own units for a system of plain floats; a plain number for a
+    Quantity system and a Quantity for a system of plain floats are refused (a
+    unit cannot be guessed, nor dropped).  A dimensionless parameter takes either.
+
+    Raises
+    ------
+    ValueError
+        For the wrong kind of value, a value that is not one finite number,
+        naming the effect, the parameter and the value.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong dimension.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> parameter_value(s, {"c": 10.0}, "c", "gr", SPEED)
+    10.0
+    >>> parameter_value(s, {"c": 3e5 * u.km / u.s}, "c", "gr", SPEED)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'gr': expected `c` as a plain number in the units of the system ...
+    """
+    if key not in params:
+        return None
+    value = params[key]
+    if kind is not DIMENSIONLESS:
+        if system.quantity and not is_quantity(value):
+            raise ValueError(
+                f"Effect {effect!r}: expected `{key}` as a Quantity ({kind.name}, convertible "
+                f"to {kind.unit}) for a system of Quantities, got the plain number {value!r}")
+        if not system.quantity and is_quantity(value):
+            raise ValueError(
+                f"Effect {effect!r}: expected `{key}` as a plain number in the units of the "
+                f"system (a system of plain floats), got the Quantity {value}")
+    unit = _SYSTEM_UNITS[kind] if system.quantity else None
+    try:
+        arr = kind(key, value, unit)
+    except ValueError as exc:  # UnitConversionError included
+        raise type(exc)(f"Effect {effect!r}: {exc}") from None
+    if arr.shape != ():
+        raise ValueError(f"Effect {effect!r}: expected `{key}` to be one number, got "
+                         f"{value!r} (shape {arr.shape})")
+    return float(arr)
+
+
 def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float:
     """The speed of light in ``system``'s units from mapping ``params`` (key ``"c"``;
-    default c in au/day for a Quantity system).
+    default c in au/day for a Quantity system); see :func:`parameter_value`.
 
     Examples
     --------
@@ -404,9 +480,7 @@ def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float
     >>> speed_of_light(s, {"c": 10.0}, "gr")
     10.0
     """
-    from hamilton_orbits.units import SPEED, is_quantity
-
-    c = params.get("c")
+    c = parameter_value(system, params, "c", effect, SPEED)
     if c is None:
         if system.quantity:
             return C_AU_PER_DAY
@@ -414,16 +488,9 @@ def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float
             f"Effect {effect!r}: a system of plain floats needs the speed of light `c` in "
             "its own units, e.g. {'name': 'gr', 'c': 10065.32}"
         )
-    if system.quantity and not is_quantity(c):
-        raise ValueError(
-            f"Effect {effect!r}: expected `c` as a Quantity for a Quantity system, got {c!r}"
-        )
-    import astropy.units as u
-
-    value = float(SPEED("c", c, u.au / u.day if system.quantity else None))
-    if not (np.isfinite(value) and value > 0):
-        raise ValueError(f"Effect {effect!r}: expected `c` > 0 and finite, got {value!r}")
-    return value
+    if not c > 0:
+        raise ValueError(f"Effect {effect!r}: expected `c` > 0, got {params['c']!r}")
+    return c
 
 
 def _params_gr(system: Any, params: Mapping[str, Any]) -> np.ndarray:
@@ -445,25 +512,19 @@ def _params_j2(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     b = source_index(system, params, "body", "j2")
     arrays = system.as_arrays()
     body = system.bodies[b]
-    j2 = params.get("j2", body.j2)
-    radius = params.get("radius", arrays.radius[b] if np.isfinite(arrays.radius[b]) else None)
-    if j2 is None or radius is None:
+    j2 = parameter_value(system, params, "j2", "j2", DIMENSIONLESS)
+    radius = parameter_value(system, params, "radius", "j2", LENGTH)
+    j2 = body.j2 if j2 is None else j2
+    radius = (float(arrays.radius[b]) if np.isfinite(arrays.radius[b]) else None
+              ) if radius is None else radius
+    missing = [k for k, v in (("j2", j2), ("radius", radius)) if v is None]
+    if missing:
         raise ValueError(
-            f"Effect 'j2': body {body.name!r} needs `j2` and `radius` (give them to the "
-            "Body or in the effect's mapping)"
+            f"Effect 'j2': body {body.name!r} has no {' and no '.join(missing)} (give "
+            f"{' and '.join(missing)} to the Body, or in the effect's mapping)"
         )
-    if "radius" in params:
-        import astropy.units as u
-
-        from hamilton_orbits.units import LENGTH, is_quantity
-
-        if system.quantity and not is_quantity(radius):
-            raise ValueError(f"Effect 'j2': expected `radius` as a length Quantity for a "
-                             f"Quantity system, got {radius!r}")
-        radius = float(LENGTH("radius", radius, u.au if system.quantity else None))
-    j2 = float(j2)
-    if not (np.isfinite(j2) and np.isfinite(radius) and radius > 0):
-        raise ValueError(f"Effect 'j2': expected finite j2 and radius > 0, got {j2!r}, {radius!r}")
+    if not radius > 0:
+        raise ValueError(f"Effect 'j2': expected `radius` > 0, got {params['radius']!r}")
     pole = body.pole if body.pole is not None else (0.0, 0.0, 1.0)
     return np.array([b, j2, radius, *pole])
 
@@ -480,6 +541,8 @@ register(
         },
         kernel=_nbody.gr_anderson,
         params=_params_gr,
+        parameter_kinds={"c": SPEED},
+        name_parameters=("source",),
         reference="Anderson et al. (1975), ApJ 200, 221; reboundx 'gr' (Tamayo et al. 2020)",
     )
 )
@@ -494,6 +557,8 @@ register(
         },
         kernel=_nbody.gr_potential,
         params=_params_gr_potential,
+        parameter_kinds={"c": SPEED},
+        name_parameters=("source",),
         reference="Nobili & Roxburgh (1986), IAU Symp. 114, 105",
     )
 )
@@ -509,6 +574,8 @@ register(
         },
         kernel=_nbody.j2_field,
         params=_params_j2,
+        parameter_kinds={"j2": DIMENSIONLESS, "radius": LENGTH},
+        name_parameters=("body",),
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )

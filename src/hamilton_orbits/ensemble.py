@@ -64,6 +64,33 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     return row
 
 
+def _members(members: Any) -> list[dict[str, Any]]:
+    """``members`` as a list of dicts, refusing anything else with its index."""
+    if members is None:
+        return []
+    if isinstance(members, (str, bytes, Mapping)) or not isinstance(members, Sequence):
+        raise ValueError(f"Expected `members` to be a list of mappings {{key: value}}, got "
+                         f"{members!r}")
+    for k, m in enumerate(members):
+        if not isinstance(m, Mapping):
+            raise ValueError(f"Expected `members` to hold mappings {{key: value}}, got {m!r} "
+                             f"at index {k}")
+    return [dict(m) for m in members]
+
+
+def _check_run_args(client: Any, workers: Any) -> None:
+    """Refuse a ``client`` that is not a Dask client and a ``workers`` that is not a count."""
+    if client is not None and not (callable(getattr(client, "map", None))
+                                   and callable(getattr(client, "submit", None))):
+        hint = (f"; connect first: dask.distributed.Client({client!r})"
+                if isinstance(client, str) else "")
+        raise ValueError(f"Expected `client` to be a dask.distributed.Client, got {client!r}"
+                         + hint)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ValueError(f"Expected `workers` to be a number of processes >= 1, got {workers!r}")
+
+
 def _plain(value: Any) -> Any:
     if isinstance(value, u.Quantity):
         return str(value)
@@ -88,8 +115,9 @@ class Ensemble:
     Raises
     ------
     ValueError
-        For an empty variation, or a member that does not make a valid scene
-        (checked before anything runs, naming the member's index).
+        For a ``vary`` that is not a mapping of sequences, ``members`` that are
+        not mappings, an empty variation, or a member that does not make a valid
+        scene (checked before anything runs, naming the member's index).
 
     Examples
     --------
@@ -110,6 +138,8 @@ class Ensemble:
     ) -> None:
         if not isinstance(scene, Scene):
             raise ValueError(f"Expected `scene` to be a Scene, got {scene!r}")
+        if vary is not None and not isinstance(vary, Mapping):
+            raise ValueError(f"Expected `vary` to be a mapping of key -> values, got {vary!r}")
         grid: list[dict[str, Any]] = []
         if vary:
             keys = list(vary)
@@ -123,13 +153,13 @@ class Ensemble:
                     raise ValueError(f"Expected `vary[{key!r}]` to hold values, got none")
             grid = [dict(zip(keys, combo, strict=True))
                     for combo in itertools.product(*(vary[k] for k in keys))]
-        grid += [dict(m) for m in (members or [])]
+        grid += _members(members)
         if not grid:
             raise ValueError("Expected `vary` or `members` to give at least one member")
         for k, member in enumerate(grid):
             try:
                 scene.with_values(member)
-            except Exception as exc:
+            except ValueError as exc:  # SceneError: every problem, with the key
                 raise ValueError(f"Member {k} ({member}) is not a valid scene: {exc}") from exc
         self.scene = scene
         self.members: list[dict[str, Any]] = grid
@@ -158,7 +188,14 @@ class Ensemble:
             The varied keys, each member's metrics, ``wall time [s]``, ``complete``
             and ``error`` (None for members that ran).  ``df.attrs["failures"]``
             counts the members that failed.
+
+        Raises
+        ------
+        ValueError
+            For a ``client`` that is not a Dask client (an address must be
+            connected first: ``Client("tcp://...")``) or ``workers`` < 1.
         """
+        _check_run_args(client, workers)
         try:
             import pandas as pd
         except ImportError as exc:  # pragma: no cover - pandas comes with the extra

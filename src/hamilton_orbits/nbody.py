@@ -168,30 +168,30 @@ class Body:
             raise ValueError(f"Expected `name` to be a non-empty string, got {name!r}")
         try:
             quantity = require_consistent(("gm", "r", "v", "radius"), (gm, r, v, radius))
-            g = GM("gm", gm, GM_UNIT if quantity else None)
-            if g.shape != ():
-                raise ValueError(f"Expected `gm` to be a scalar, got shape {g.shape}")
+            g = GM.scalar("gm", gm, GM_UNIT if quantity else None)
             if not g >= 0:
-                raise ValueError(f"expected `gm` >= 0, got {float(g)!r}")
+                raise ValueError(f"expected `gm` >= 0, got {gm if quantity else repr(g)}")
             rr = _as_vector(LENGTH, "r", r, L_UNIT if quantity else None)
             vv = _as_vector(SPEED, "v", v, V_UNIT if quantity else None)
             rad = None
             if radius is not None:
-                rad = float(LENGTH("radius", radius, L_UNIT if quantity else None))
+                rad = LENGTH.scalar("radius", radius, L_UNIT if quantity else None)
                 if not rad > 0:
-                    raise ValueError(f"expected `radius` > 0, got {rad!r}")
+                    raise ValueError(
+                        f"expected `radius` > 0, got {radius if quantity else repr(rad)}")
             jj = None
             if j2 is not None:
-                jj = float(DIMENSIONLESS("j2", j2))
+                jj = DIMENSIONLESS.scalar("j2", j2)
             pl = None
             if pole is not None or jj is not None:
                 p = np.array([0.0, 0.0, 1.0]) if pole is None else _as_vector(
                     DIMENSIONLESS, "pole", pole, None
                 )
-                norm = float(np.sqrt(p @ p))
-                if not norm > 0:
+                big = float(np.max(np.abs(p)))
+                if not big > 0:
                     raise ValueError(f"expected `pole` to be nonzero, got {p.tolist()}")
-                pl = tuple(float(x) for x in p / norm)
+                p = p / big  # scaled first: no overflow (1e308) nor underflow (1e-320)
+                pl = tuple(float(x) for x in p / np.sqrt(p @ p))
         except (ValueError, u.UnitConversionError) as exc:
             msg = str(exc)
             if msg.startswith("Expected"):
@@ -331,9 +331,9 @@ class System:
                 )
             g = _G_SI
         else:
-            g = 1.0 if G is None else float(np.asarray(G, dtype=float))
-            if not (np.isfinite(g) and g > 0):
-                raise ValueError(f"Expected `G` > 0 and finite, got {G!r}")
+            g = 1.0 if G is None else DIMENSIONLESS.scalar("G", G)
+            if not g > 0:
+                raise ValueError(f"Expected `G` > 0, got {G!r}")
         self._bodies = tuple(bodies)
         self._index = seen
         self._quantity = quantity
@@ -632,12 +632,21 @@ class System:
         ----------
         epoch : astropy.time.Time or str, optional
             The epoch (TDB); a string is read by ``Time(epoch, scale="tdb")``,
-            ``"J2000"`` (default) is 2000-01-01 12:00 TDB.
-        bodies : sequence of str, optional
+            ``"J2000"`` (default) is 2000-01-01 12:00 TDB.  Within 1900-2100
+            (:data:`SOLAR_SYSTEM_SPAN`, see :func:`solar_system_epoch`).
+        bodies : sequence of str or str, optional
             Which bodies, from ``sun, mercury, venus, earth-moon-barycenter, earth, moon,
-            mars, jupiter, saturn, uranus, neptune``; default the Sun, the planets with
-            the Earth-Moon barycentre as one body.  Asking for ``"moon"`` (with
-            ``"earth"``) gives the Earth and the Moon separately.
+            mars, jupiter, saturn, uranus, neptune`` (one name alone is a list of one);
+            default the Sun, the planets with the Earth-Moon barycentre as one body.
+            Asking for ``"moon"`` (with ``"earth"``) gives the Earth and the Moon
+            separately.  See :func:`solar_system_bodies`.
+
+        Raises
+        ------
+        ValueError
+            For an epoch outside the ephemeris' span or one that cannot be read,
+            an unknown, repeated or empty list of bodies, or the Earth-Moon
+            barycentre together with the Earth or the Moon.
 
         Returns
         -------
@@ -660,37 +669,121 @@ class System:
         True
         """
         from astropy.coordinates import get_body_barycentric_posvel
-        from astropy.time import Time
 
-        if bodies is None:
-            bodies = DEFAULT_BODIES
-        bodies = [str(b).lower() for b in bodies]
-        for b in bodies:
-            if b not in SOLAR_SYSTEM_GM:
-                raise ValueError(
-                    f"Unknown solar-system body {b!r}; known: {', '.join(SOLAR_SYSTEM_GM)}"
-                )
-        if "earth-moon-barycenter" in bodies and ("earth" in bodies or "moon" in bodies):
-            raise ValueError(
-                "Expected either 'earth-moon-barycenter' or 'earth' and 'moon', got both"
-            )
-        if isinstance(epoch, Time):
-            t = epoch.tdb
-        elif isinstance(epoch, str) and epoch.upper() == "J2000":
-            t = Time("2000-01-01T12:00:00", scale="tdb")
-        else:
-            try:
-                t = Time(epoch, scale="tdb")
-            except ValueError as exc:
-                raise ValueError(f"Expected `epoch` to be a Time, got {epoch!r}") from exc
-        if not t.isscalar:
-            raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
+        bodies = solar_system_bodies(bodies)
+        t = solar_system_epoch(epoch)
         out = []
         for name in bodies:
             pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
             gm = SOLAR_SYSTEM_GM[name] * u.m**3 / u.s**2
             out.append(Body(name, gm=gm, r=pos.xyz.to(u.au), v=vel.xyz.to(u.au / u.day)))
         return cls(out)
+
+
+SOLAR_SYSTEM_SPAN = (1900, 2100)
+"""The years (TDB, J2000 +- 100 Julian years) over which astropy's built-in
+ephemeris is valid: it takes every body's barycentric state from ERFA's ``epv00``
+(the Earth's, and the Sun's as the Earth's barycentric minus heliocentric state),
+which ERFA states for 1900-2100 AD (status +1, "date outside the range 1900-2100
+AD", beyond; its errors against DE406 double by 1800 and 2200 and grow 60-fold by
+1000 and 3000); the planets add ``plan94``, stated for 1000-3000 AD, and the Moon
+``moon98``.  Outside the span the positions are not merely less accurate but
+wrong by up to the size of the orbits (the year 1e6 puts the Earth 100 au from
+the Sun), so :func:`solar_system_epoch` refuses it."""
+
+
+def solar_system_epoch(epoch: Any = "J2000"):
+    """``epoch`` as one astropy ``Time`` (TDB) within :data:`SOLAR_SYSTEM_SPAN`.
+
+    Raises
+    ------
+    ValueError
+        For an epoch that cannot be read, more than one epoch, or an epoch
+        outside 1900-2100, naming `epoch`, its value and the span.
+
+    Examples
+    --------
+    >>> solar_system_epoch("J2000").iso
+    '2000-01-01 12:00:00.000'
+    >>> solar_system_epoch("2500-01-01")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `epoch` within 1900-2100 (...), got '2500-01-01' (...
+    """
+    from astropy.time import Time
+
+    if isinstance(epoch, Time):
+        t = epoch.tdb
+    elif isinstance(epoch, str) and epoch.strip().upper() == "J2000":
+        t = Time("2000-01-01T12:00:00", scale="tdb")
+    else:
+        try:
+            t = Time(epoch, scale="tdb")
+        except (ValueError, TypeError) as exc:
+            raise ValueError(
+                f"Expected `epoch` to be a time (an astropy Time, 'J2000' or a date such as "
+                f"'2024-03-01' or '2024-03-01T12:00'), got {epoch!r}") from exc
+    if not t.isscalar:
+        raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
+    years = (t.jd1 - 2451545.0 + t.jd2) / 365.25  # Julian years from J2000, as epv00
+    if not abs(years) <= 100.0:
+        lo, hi = SOLAR_SYSTEM_SPAN
+        raise ValueError(
+            f"Expected `epoch` within {lo}-{hi} (the span of ERFA's epv00, behind astropy's "
+            f"built-in ephemeris), got {epoch!r} ({t.iso} TDB)")
+    return t
+
+
+def solar_system_bodies(bodies: Any = None) -> list[str]:
+    """The names of :meth:`System.solar_system`'s bodies, checked (lower case).
+
+    ``None`` is :data:`DEFAULT_BODIES`; one name alone is a list of one.
+
+    Raises
+    ------
+    ValueError
+        For an empty list, a name that is not a string or not known, a name given
+        twice, or the Earth-Moon barycentre together with the Earth or the Moon,
+        naming `bodies`, the index and the value.
+
+    Examples
+    --------
+    >>> solar_system_bodies("Sun")
+    ['sun']
+    >>> solar_system_bodies(["sun", "mars", "mars"])
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `bodies` to name each body once, got 'mars' at indices 1 and 2
+    """
+    if bodies is None:
+        return list(DEFAULT_BODIES)
+    if isinstance(bodies, str):
+        bodies = [bodies]
+    if not isinstance(bodies, Sequence):
+        raise ValueError(f"Expected `bodies` to be a list of names, got {bodies!r}")
+    if len(bodies) == 0:
+        raise ValueError("Expected `bodies` to name at least one body, got an empty list "
+                         "(leave it out for the Sun and the eight planets)")
+    names: list[str] = []
+    for k, b in enumerate(bodies):
+        if not isinstance(b, str):
+            raise ValueError(f"Expected `bodies` to hold names, got {b!r} at index {k}")
+        name = b.strip().lower()
+        if name not in SOLAR_SYSTEM_GM:
+            raise ValueError(f"Unknown solar-system body {b!r} at index {k} of `bodies`; "
+                             f"known: {', '.join(SOLAR_SYSTEM_GM)}")
+        if name in names:
+            raise ValueError(f"Expected `bodies` to name each body once, got {b!r} at indices "
+                             f"{names.index(name)} and {k}")
+        names.append(name)
+    if "earth-moon-barycenter" in names and ("earth" in names or "moon" in names):
+        other = "earth" if "earth" in names else "moon"
+        raise ValueError(
+            "Expected either 'earth-moon-barycenter' or 'earth' and 'moon' in `bodies`, got "
+            f"both ('earth-moon-barycenter' at index {names.index('earth-moon-barycenter')}, "
+            f"{other!r} at index {names.index(other)}): the barycentre holds the Earth and "
+            "the Moon")
+    return names
 
 
 # GM in m^3/s^2.  Sun: IAU 2015 Resolution B3 nominal (G M_sun)^N.  Planets: system GMs
@@ -836,7 +929,7 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     return acc[:, 1:]
 
 
-__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SystemArrays", "energy_gm_many",
-            "integral_errors"]
+__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN", "SystemArrays",
+            "energy_gm_many", "integral_errors", "solar_system_bodies", "solar_system_epoch"]
 _ = _nbody  # the kernels of equation (B) live in hamilton_orbits._kernels.nbody
 _ = any_quantity

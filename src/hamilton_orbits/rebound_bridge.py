@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._rebound import particle_name
-from hamilton_orbits.effects import C_AU_PER_DAY, EffectSet, source_index, speed_of_light
+from hamilton_orbits.effects import EffectSet, get
 from hamilton_orbits.nbody import System, integral_errors
 
 __all__ = [
@@ -85,30 +85,26 @@ def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
         return None
     import reboundx
 
-    arrays = system.as_arrays()
     rebx = reboundx.Extras(sim)
     for name, params in effects:
-        params = dict(params)
-        if name in ("gr", "gr_potential"):
+        # the effect's own parameter builder: one validation and one unit rule for both codes
+        p = get("nbody", name).params(system, dict(params))
+        if name in ("gr", "gr_potential"):  # p = [source, c]
             force = rebx.load_force(name)
             rebx.add_force(force)
-            c = speed_of_light(system, params, name) if (
-                "c" in params or not system.quantity) else C_AU_PER_DAY
-            force.params["c"] = c
-            s = source_index(system, params, "source", name)
-            sim.particles[s].params["gr_source"] = 1
-        elif name == "j2":
+            force.params["c"] = float(p[1])
+            sim.particles[int(p[0])].params["gr_source"] = 1
+        elif name == "j2":  # p = [body, j2, radius, pole]
             force = rebx.load_force("gravitational_harmonics")
             rebx.add_force(force)
-            b = source_index(system, params, "body", "j2")
-            body = system.bodies[b]
-            if body.pole not in (None, (0.0, 0.0, 1.0)):
+            b = int(p[0])
+            if tuple(p[3:]) != (0.0, 0.0, 1.0):
                 raise ValueError(
                     "reboundx's gravitational_harmonics takes the pole along z; rotate the "
-                    f"system so that body {body.name!r} has its pole on z to cross-check"
+                    f"system so that body {system.names[b]!r} has its pole on z to cross-check"
                 )
-            sim.particles[b].params["J2"] = float(params.get("j2", body.j2))
-            sim.particles[b].params["R_eq"] = float(params.get("radius", arrays.radius[b]))
+            sim.particles[b].params["J2"] = float(p[1])
+            sim.particles[b].params["R_eq"] = float(p[2])
         else:
             raise ValueError(f"Effect {name!r} has no reboundx counterpart to cross-check")
     return rebx

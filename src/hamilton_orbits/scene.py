@@ -30,6 +30,7 @@ Scene *kinds* (``nbody`` here; ``rotation`` from ``rigid``) are registered in
 from __future__ import annotations
 
 import copy
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -41,16 +42,25 @@ import tomllib
 from hamilton_orbits import _scene_nbody  # noqa: F401  (registers the "nbody" kind)
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
-from hamilton_orbits._scene_base import KINDS, Result, SceneKind, format_table, register_kind
+from hamilton_orbits._scene_base import (
+    KINDS,
+    OUTPUT_LIMIT,
+    Result,
+    SceneKind,
+    check_output_size,
+    format_table,
+    register_kind,
+)
 
-__all__ = ["KINDS", "Result", "Scene", "SceneError", "SceneKind", "format_table",
-           "register_kind"]
+__all__ = ["KINDS", "OUTPUT_LIMIT", "Result", "Scene", "SceneError", "SceneKind",
+           "check_output_size", "format_table", "register_kind"]
 
 
 class SceneError(ValueError):
     """A scene that is not valid; ``problems`` lists every problem found.
 
-    Each problem reads ``file: key.path: what is wrong``.
+    Each problem reads ``file:LINE: key.path: what is wrong`` (``file: key.path:
+    ...`` where the key is not in the file).
     """
 
     def __init__(self, problems: Sequence[str]) -> None:
@@ -80,7 +90,12 @@ def _effect_entry(effect_kind: str) -> S.Field:
 
 @dataclass
 class _EffectField(S.Field):
-    """An effect: a registered name, or a table ``{name = "j2", body = "earth"}``."""
+    """An effect: a registered name, or a table ``{name = "j2", body = "earth"}``.
+
+    A parameter with a dimension (the effect's ``parameter_kinds``: ``c``, a
+    speed) is read like any value with a unit (``c = "299792.458 km/s"``); a
+    parameter that names a body must be a string.
+    """
 
     effect_kind: str = "nbody"
 
@@ -90,7 +105,15 @@ class _EffectField(S.Field):
             problems.add(f"{path}.{key}" if key else path, message)
         if name is None:
             return None
-        return {"name": name, **params}
+        spec = _effects.get(self.effect_kind, name)
+        out = dict(params)
+        for key, val in params.items():
+            where = f"{path}.{key}"
+            if key in spec.parameter_kinds:
+                out[key] = S.Quantity(kind=spec.parameter_kinds[key]).check(val, where, problems)
+            elif key in spec.name_parameters:
+                out[key] = S.String(nonempty=True).check(val, where, problems)
+        return {"name": name, **out}
 
 
 def _parse_override(value: str) -> Any:
@@ -100,48 +123,85 @@ def _parse_override(value: str) -> Any:
         return value
 
 
-def _set_path(data: dict, key: str, value: Any, source: str) -> None:
-    """Set ``key`` ("integrator.tol", "bodies[2].gm", "bodies.mercury.e") in ``data``."""
+def _override_parts(key: str, source: str) -> list[str | int]:
+    """``"bodies[2].gm"`` -> ``["bodies", 2, "gm"]``; an unreadable path is a SceneError."""
     parts: list[str | int] = []
     for piece in key.split("."):
-        while "[" in piece and piece.endswith("]"):
-            head, _, idx = piece.partition("[")
-            if head:
-                parts.append(head)
-            parts.append(int(idx.split("]")[0]))
-            piece = piece[piece.index("]") + 1 :]
-        if piece:
-            parts.append(piece)
+        m = re.fullmatch(r"\s*([^\[\]\s]*)\s*((?:\[[^\[\]]*\]\s*)*)", piece)
+        if m is None or not (m.group(1) or m.group(2)):
+            raise SceneError([f"{source}: {key}: cannot read the key path (write it as "
+                              "integrator.tol, bodies[1].gm or bodies.earth.gm)"])
+        if m.group(1):
+            parts.append(m.group(1))
+        for index in re.findall(r"\[([^\[\]]*)\]", m.group(2)):
+            if not index.strip().isdigit():
+                raise SceneError([f"{source}: {key}: expected a number in [...], got "
+                                  f"[{index}] (a table in a list is addressed by its name: "
+                                  "bodies.earth.gm)"])
+            parts.append(int(index))
+    return parts
+
+
+def _path_text(parts: Sequence[str | int]) -> str:
+    """``("bodies", 1, "gm")`` -> ``"bodies[1].gm"`` (the key paths of problems)."""
+    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if k else p)
+                   for k, p in enumerate(parts))
+
+
+def _set_path(data: dict, key: str, value: Any, source: str) -> tuple[str | int, ...]:
+    """Set ``key`` ("integrator.tol", "bodies[2].gm", "bodies.mercury.e") in ``data``.
+
+    Returns the path set, with names of tables in lists resolved to indices.
+
+    Raises
+    ------
+    SceneError
+        For a path that cannot be read, an index beyond a list, a name not in a
+        list, or a key below a value, naming the key.
+    """
+    parts = _override_parts(key, source)
+    resolved: list[str | int] = []
     node: Any = data
-    for i, part in enumerate(parts[:-1]):
-        nxt = parts[i + 1]
+
+    def fail(message: str) -> SceneError:
+        return SceneError([f"{source}: {key}: {message}"])
+
+    for i, part in enumerate(parts):
+        where = _path_text(resolved) or "the scene"
+        last = i == len(parts) - 1
         if isinstance(node, list):
             if isinstance(part, str):  # a table in a list addressed by its name
-                match = [x for x in node if isinstance(x, dict) and x.get("name") == part]
-                if not match:
-                    names = [x.get("name", "?") for x in node if isinstance(x, dict)]
-                    where = ".".join(str(p) for p in parts[:i])
-                    raise SceneError(
-                        [f"{source}: {key}: no entry named {part!r} in {where}"
-                         f"{S.closest(part, names)}"]
-                    )
-                node = match[0]
-            else:
-                node = node[part]
+                names = [x.get("name") for x in node if isinstance(x, dict)]
+                if part not in names:
+                    raise fail(f"no entry named {part!r} in {where}"
+                               f"{S.closest(part, [str(n) for n in names])}")
+                part = names.index(part)
+            elif not part < len(node):
+                held = (f"{len(node)} entries (indices 0 to {len(node) - 1})" if node
+                        else "no entries")
+                raise fail(f"{where} has {held}; [{part}] is beyond it (an override "
+                           "changes an entry, it does not add one)")
+        elif isinstance(node, dict):
+            if isinstance(part, int):
+                raise fail(f"{where} is a table, not a list: name its key, not [{part}]")
+            if not last and part not in node:
+                node[part] = [] if isinstance(parts[i + 1], int) else {}
         else:
-            node = node.setdefault(part, [] if isinstance(nxt, int) else {})
-    last = parts[-1]
-    if isinstance(node, list) and isinstance(last, int):
-        node[last] = value
-    else:
-        node[last] = value
-
-
+            raise fail(f"{where} is a value ({node!r}), not a table: it has no key {part!r}")
+        resolved.append(part)
+        if last:
+            node[part] = value
+        else:
+            node = node[part]
+    return tuple(resolved)
 class Scene:
     """A validated description of one study.
 
     Build one with :meth:`from_toml`, :meth:`bundled` or :meth:`from_dict`;
-    nothing is simulated until :meth:`run`.
+    nothing is simulated until :meth:`run`.  Every problem of an invalid scene is
+    reported at once (:class:`SceneError`), as ``file:LINE: key.path: message``
+    (the line where the file sets the key; none for a key the file leaves out,
+    for a value set by :meth:`with_values`, or for a scene from a mapping).
 
     Examples
     --------
@@ -156,15 +216,28 @@ class Scene:
       ...
     """
 
-    def __init__(self, data: Mapping[str, Any], source: str = "<dict>") -> None:
+    def __init__(self, data: Mapping[str, Any], source: str = "<dict>", *,
+                 text: str | None = None, overrides: Sequence[tuple] = ()) -> None:
+        if not isinstance(data, Mapping):
+            raise SceneError([f"{source}: expected a mapping shaped like a scene file "
+                              f"(kind, duration, ...), got {data!r}"])
         self.source = source
         self.data = copy.deepcopy(dict(data))
+        # the file's text (for the lines of keys) and the key paths set since (no line)
+        self._text = text
+        self._overrides = tuple(overrides)
         self.spec = self._validate(self.data)
 
     # --- construction -------------------------------------------------
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
-        """A scene from a mapping shaped like the TOML file."""
+        """A scene from a mapping shaped like the TOML file.
+
+        Raises
+        ------
+        SceneError
+            For anything but a mapping, or any invalid key.
+        """
         return cls(data, source)
 
     @classmethod
@@ -182,11 +255,14 @@ class Scene:
             text = p.read_text(encoding="utf-8")
         except OSError as exc:
             raise SceneError([f"{p}: cannot read the scene file ({exc.strerror})"]) from exc
+        except UnicodeDecodeError as exc:
+            raise SceneError([f"{p}: not a scene file: not text in UTF-8 (byte "
+                              f"{exc.object[exc.start]:#04x} at offset {exc.start})"]) from None
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise SceneError([f"{p}: TOML syntax error: {exc}"]) from exc
-        return cls(data, str(p))
+        return cls(data, str(p), text=text)
 
     @staticmethod
     def _bundled_dir():
@@ -199,8 +275,8 @@ class Scene:
         if name not in names:
             raise SceneError([f"{name}: no bundled scene of that name{S.closest(name, names)}"])
         res = cls._bundled_dir() / f"{name}.toml"
-        data = tomllib.loads(res.read_text(encoding="utf-8"))
-        return cls(data, f"{name}.toml")
+        text = res.read_text(encoding="utf-8")
+        return cls(tomllib.loads(text), f"{name}.toml", text=text)
 
     @classmethod
     def list_bundled(cls) -> list[tuple[str, str]]:
@@ -223,16 +299,49 @@ class Scene:
 
         String values are read as TOML values where they parse (``"1e-10"`` is
         a number, ``"100 yr"`` stays a string), as ``--set KEY=VALUE`` does.
+
+        Raises
+        ------
+        SceneError
+            For a key path that cannot be read or does not lead to a key (an
+            index beyond a list, a name not in it, a key below a value), or an
+            invalid scene, naming the key.
         """
+        if not isinstance(values, Mapping):
+            raise SceneError([f"{self.source}: expected the values as a mapping "
+                              f"{{'key.path': value}}, got {values!r}"])
         data = copy.deepcopy(self.data)
+        overrides = list(self._overrides)
         for key, value in values.items():
+            if not isinstance(key, str):
+                raise SceneError([f"{self.source}: expected a key path such as "
+                                  f"'integrator.tol', got {key!r}"])
             v = _parse_override(value) if isinstance(value, str) else value
-            _set_path(data, key, v, self.source)
-        return Scene(data, self.source)
+            overrides.append(_set_path(data, key, v, self.source))
+        return Scene(data, self.source, text=self._text, overrides=overrides)
+
+    def _locate(self):
+        """``path -> line`` in the scene's file (None for keys set since, or no file)."""
+        if self._text is None:
+            return None
+        lines = S.key_lines(self._text)
+        overrides = self._overrides
+
+        def locate(path: str) -> int | None:
+            parts = S.split_path(path)
+            if any(parts[:len(o)] == o for o in overrides):
+                return None
+            while parts:
+                if parts in lines:
+                    return lines[parts]
+                parts = parts[:-1]
+            return None
+
+        return locate
 
     # --- validation ---------------------------------------------------
     def _validate(self, data: dict) -> dict:
-        problems = S.Problems(self.source)
+        problems = S.Problems(self.source, self._locate())
         kinds = _kinds()
         kind_name = data.get("kind")
         if kind_name is None:

@@ -205,6 +205,30 @@ class Kind:
                 ) from exc
         return as_float_array(name, value, finite=finite)
 
+    def scalar(self, name: str, value: Any, unit: UnitLike | None = None) -> float:
+        """One number of this kind, as a float (a Quantity converted to ``unit``).
+
+        Raises as calling the kind does, and ``ValueError`` for an array,
+        naming the argument and its shape.
+
+        Examples
+        --------
+        >>> DIMENSIONLESS.scalar("tol", 1e-9)
+        1e-09
+        >>> DIMENSIONLESS.scalar("tol", 1e-9 * u.s)
+        Traceback (most recent call last):
+        ...
+        astropy.units.errors.UnitConversionError: Expected `tol` to be dimensionless, got s
+        >>> LENGTH.scalar("radius", [1.0, 2.0])
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `radius` to be one number, got shape (2,)
+        """
+        arr = self(name, value, unit)
+        if arr.shape != ():
+            raise ValueError(f"Expected `{name}` to be one number, got shape {arr.shape}")
+        return float(arr)
+
 
 def _short(q: u.Quantity) -> str:
     if q.isscalar:

@@ -71,17 +71,40 @@ class PolarMotionRecord:
     def select(self, start: Any = None, end: Any = None) -> PolarMotionRecord:
         """The part of the record with ``start <= time < end`` (Time, or decimal years).
 
+        A window reaching beyond the record is refused rather than cut short: a
+        fit of 2020-2100 on a record that ends in 2026 would be a fit of
+        2020-2026 that does not say so.
+
+        Raises
+        ------
+        ValueError
+            For a ``start`` before the record or an ``end`` after it (by more than
+            one sampling interval), naming the record's span; for a window with
+            fewer than 2 epochs.
+
         Examples
         --------
         >>> print(load_c04().select(2000, 2001).time[0].iso[:10])
         2000-01-01
+        >>> load_c04().select(2020, 2100)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `end` within the record (1962.00-...), got 2100, after the record...
         """
         yr = decimal_year(self.time)
+        step = float(np.median(np.diff(yr))) if yr.size > 1 else 0.0
         keep = np.ones(yr.shape, dtype=bool)
-        if start is not None:
-            keep &= yr >= _year("start", start)
-        if end is not None:
-            keep &= yr < _year("end", end)
+        for name, value in (("start", start), ("end", end)):
+            if value is None:
+                continue
+            y = _year(name, value)
+            if not yr[0] - step <= y <= yr[-1] + step:
+                raise ValueError(
+                    f"Expected `{name}` within the record ({yr[0]:.2f}-{yr[-1]:.2f}, "
+                    f"{self.time[0].iso[:10]} to {self.time[-1].iso[:10]}), got {value!r}, "
+                    f"{'after the record ends' if y > yr[-1] else 'before it begins'} (leave "
+                    f"`{name}` out to {'end' if name == 'end' else 'start'} with the record)")
+            keep &= (yr >= y) if name == "start" else (yr < y)
         if keep.sum() < 2:
             raise ValueError(
                 f"Expected `start`, `end` to select at least 2 epochs of the record "
@@ -119,7 +142,7 @@ def _year(name: str, value: Any) -> float:
     if isinstance(value, Time):
         return float(decimal_year(value))
     if isinstance(value, u.Quantity):
-        return float(TIME(name, value, u.yr))
+        return TIME.scalar(name, value, u.yr)
     v = as_float_array(name, value)
     if v.shape != ():
         raise ValueError(f"Expected `{name}` to be a scalar, got shape {v.shape}")
@@ -142,6 +165,13 @@ def load_c04(path: Any = None) -> PolarMotionRecord:
     -------
     PolarMotionRecord
 
+    Raises
+    ------
+    ValueError
+        For a file that is not a C04 table (not text, missing columns, fewer
+        than 2 rows, epochs that do not increase, non-finite coordinates),
+        naming the file and what is wrong.
+
     Examples
     --------
     >>> rec = load_c04()
@@ -152,12 +182,45 @@ def load_c04(path: Any = None) -> PolarMotionRecord:
         from importlib.resources import files
 
         path = files("astropy_iers_data") / "data" / _C04_NAME
-    with open(str(path)) as fh:
-        data = np.loadtxt(fh, comments="#", usecols=(4, 5, 6))
-    if data.ndim != 2 or data.shape[0] < 2:
-        raise ValueError(f"Expected `path` to hold a C04 table, got {data.shape} values")
+    data = _read_c04(path)
     time = Time(data[:, 0], format="mjd", scale="utc")
-    return PolarMotionRecord(time, data[:, 1] * u.arcsec, data[:, 2] * u.arcsec, str(path))
+    try:
+        return PolarMotionRecord(time, data[:, 1] * u.arcsec, data[:, 2] * u.arcsec, str(path))
+    except ValueError as exc:
+        raise ValueError(f"Expected `path` ({path}) to hold finite pole coordinates: "
+                         f"{exc}") from None
+
+
+_C04_FORMAT = ("an IERS C04 table: columns year, month, day, 0h UTC, MJD, x_p (arcsec), "
+               "y_p (arcsec), ...")
+
+
+def _read_c04(path: Any) -> np.ndarray:
+    """``(MJD, x_p, y_p)`` rows of a C04 file, checked: text, the columns, >= 2 rows,
+    epochs increasing."""
+    import io
+
+    try:
+        with open(str(path), encoding="utf-8") as fh:
+            text = fh.read()
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"Expected `path` ({path}) to be {_C04_FORMAT}; got a file that is "
+                         f"not text (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start})") from None
+    try:
+        data = np.loadtxt(io.StringIO(text), comments="#", usecols=(4, 5, 6), ndmin=2)
+    except ValueError as exc:
+        raise ValueError(f"Expected `path` ({path}) to be {_C04_FORMAT}; "
+                         f"{' '.join(str(exc).split())}") from None
+    if data.shape[0] < 2:
+        raise ValueError(f"Expected `path` ({path}) to be {_C04_FORMAT} with at least 2 "
+                         f"rows, got {data.shape[0]}")
+    bad = np.nonzero(~(np.diff(data[:, 0]) > 0))[0]
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise ValueError(f"Expected the epochs (MJD) of `path` ({path}) to increase, got "
+                         f"{float(data[k, 0])!r} after {float(data[k - 1, 0])!r} at data row {k}")
+    return data
 
 
 # IERS Conventions (2010), sec. 7.1.4, eq. (7.25) and Table 7.7: the conventional mean

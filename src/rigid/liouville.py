@@ -17,6 +17,7 @@ pole path (the measure of a model's period), lives with the fits in
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import astropy.units as u
@@ -50,6 +51,10 @@ _PARAMETERS: dict[str, dict[str, str]] = {
         "chi": "complex chi at chi_t (angle), piecewise linear in between",
     },
 }
+
+# the scalar parameters with a dimension (a scene reads "433 d" into a Quantity)
+_KINDS = {"euler_period": TIME, "k2": DIMENSIONLESS, "chandler_period": TIME,
+          "Q": DIMENSIONLESS, "annual_period": TIME, "annual_epoch": TIME}
 
 _REFERENCES = {
     "free": "Euler (1765); Lambeck 1980, The Earth's Variable Rotation, sec. 3.1",
@@ -338,12 +343,18 @@ def _check_effects(effects: Any, params: dict[str, Any]) -> tuple[str, ...]:
     """The effects as a tuple of known names; every parameter belongs to a listed one."""
     if isinstance(effects, str):
         effects = (effects,)
+    if not isinstance(effects, Sequence):
+        raise ValueError(f"Expected `effects` to be a list of names from {EFFECTS}, got "
+                         f"{effects!r}")
     effects = tuple(effects)
     for i, name in enumerate(effects):
-        if name not in EFFECTS:
+        if not isinstance(name, str) or name not in EFFECTS:
             raise ValueError(
                 f"Expected `effects` from {EFFECTS}, got {name!r} at index {i}"
             )
+        if name in effects[:i]:  # as hamilton_orbits.effects.normalize_effects refuses it
+            raise ValueError(f"Effect {name!r} is listed twice (at indices "
+                             f"{effects.index(name)} and {i})")
     owner = {p: e for e, ps in _PARAMETERS.items() for p in ps}
     for p in params:
         if p not in owner:
@@ -368,7 +379,7 @@ def _wobble_period(effects: tuple[str, ...], params: dict[str, Any]) -> float:
             f"got {sorted(k for k in ('k2', 'chandler_period') if k in params)}"
         )
     if "k2" in params:
-        k2 = float(DIMENSIONLESS("k2", params["k2"]))
+        k2 = DIMENSIONLESS.scalar("k2", params["k2"])
         ks = float(secular_love_number())
         if not 0.0 <= k2 < ks:
             raise ValueError(f"Expected `k2` in [0, k_s = {ks:.6f}), got {k2!r}")
@@ -442,6 +453,7 @@ def register_effects() -> None:
             parameters=dict(_PARAMETERS[name]),
             build=_builder(name),
             reference=_REFERENCES[name],
+            parameter_kinds={p: _KINDS[p] for p in _PARAMETERS[name] if p in _KINDS},
         ))
 
 

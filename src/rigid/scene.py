@@ -32,7 +32,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import _schema as S
-from hamilton_orbits.scene import Result, Scene, SceneKind, register_kind
+from hamilton_orbits.scene import Result, Scene, SceneKind, check_output_size, register_kind
 from hamilton_orbits.units import ANGLE, ANGULAR_SPEED, DIMENSIONLESS, INERTIA, TIME
 
 ANALYSES = {
@@ -92,6 +92,8 @@ def _check(spec: dict, problems: S.Problems) -> None:
         problems.add("integrator.dt", f"missing: the method {method!r} takes a fixed step")
     for i, eff in enumerate(spec["effects"]):
         problems.add(f"effects[{i}]", f"the free rigid body takes no effects (got {eff['name']!r})")
+    # kept per output: the attitude and angular velocity, integrated and exact, 4 diagnostics
+    check_output_size(spec, problems, 2 * (4 + 3) + 4, "a rigid body")
 
 
 def build_body(spec: dict):

@@ -37,10 +37,20 @@ SCHEMA: dict[str, S.Field] = {
 
 
 def _check(spec: dict, problems: S.Problems) -> None:
+    from rigid.polar_motion import load_c04
+
     start, end = spec["start"], spec["end"]
     if start is not None and end is not None and not end - start >= 6:
         problems.add("end", f"expected at least 6 years after start = {start}, got {end}"
                      " (the Chandler and annual terms beat over 6.4 years)")
+    record = load_c04()
+    for key, value in (("start", start), ("end", end)):
+        if value is not None:
+            try:  # the record's own check: a window beyond it is refused, not cut short
+                record.select(**{key: value})
+            except ValueError as exc:
+                msg = str(exc)
+                problems.add(key, "e" + msg[1:] if msg.startswith("Expected") else msg)
     names = [e["name"] for e in spec["effects"]]
     if "damping" in names:
         damping = spec["effects"][names.index("damping")]

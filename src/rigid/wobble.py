@@ -262,7 +262,8 @@ def fit_wobble(
     record : PolarMotionRecord
         From :func:`load_c04`.
     start, end : Time, decimal year or None
-        The window (default: the whole record).
+        The window (default: the whole record); within the record (a window
+        beyond it is refused, see :meth:`~rigid.c04.PolarMotionRecord.select`).
     trend : {"linear", "iers2010"}
     chandler_guess : Quantity
         Centre of the grid search (+-10%).

@@ -51,9 +51,11 @@ def test_grid_local_and_on_an_in_process_dask_cluster_agree_bit_for_bit():
 
 
 def test_a_failing_member_leaves_the_others():
-    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9},
-                                     {"initial.solar_system.epoch": "not a date"},
+    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9}, {"integrator.tol": 1e-9},
                                      {"integrator.tol": 1e-8}])
+    # a bad epoch is refused when the ensemble is built (issue 20): put it in afterwards,
+    # to stand for a member that fails in its worker
+    ens.members[1] = {"initial.solar_system.epoch": "not a date"}
     df = ens.run(progress=False, workers=1)
     assert df.attrs["failures"] == 1
     assert df["error"].isna().tolist() == [True, False, True]

@@ -40,8 +40,8 @@ def test_polar_scene_refuses_unknown_effect_and_missing_q(tmp_path):
 
     path = tmp_path / "bad.toml"
     path.write_text('kind = "polar_motion"\neffects = ["elastik", {name = "damping"}]\n')
-    with pytest.raises(SceneError, match=r"bad.toml: effects\[0\].*'elastic'"):
+    with pytest.raises(SceneError, match=r"bad.toml:2: effects\[0\].*'elastic'"):
         Scene.from_toml(path)
     path.write_text('kind = "polar_motion"\neffects = [{name = "damping"}]\n')
-    with pytest.raises(SceneError, match=r"bad.toml: effects\[0\].Q"):
+    with pytest.raises(SceneError, match=r"bad.toml:2: effects\[0\].Q"):
         Scene.from_toml(path)

@@ -158,8 +158,10 @@ def test_units_degrees_work_and_metres_raise(record):
 def test_bad_windows_raise(record):
     with pytest.raises(ValueError, match="Chandler periods"):
         fit_wobble(record, 2000, 2002)
-    with pytest.raises(ValueError, match="at least 2 epochs"):
+    with pytest.raises(ValueError, match=r"`start` within the record .*got 2100, after"):
         fit_wobble(record, 2100, 2200)
+    with pytest.raises(ValueError, match="at least 2 epochs"):
+        record.select(2000, 2000.001)
     with pytest.raises(ValueError, match="trend"):
         fit_wobble(record, trend="quadratic")
 

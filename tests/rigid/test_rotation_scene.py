@@ -32,7 +32,7 @@ def test_rotation_scene_validation_names_the_keys(tmp_path):
     with pytest.raises(SceneError) as info:
         Scene.from_toml(path)
     text = str(info.value)
-    assert f"{path}: body.moments[2]: expected a moment of inertia" in text
+    assert f"{path}:4: body.moments[2]: expected a moment of inertia" in text  # file:LINE
     assert "body.omga: unknown key (did you mean 'omega'" in text
     assert "integrator.method: unknown value 'splitting' (did you mean 'splitting4'" in text
     assert np.all([p.startswith(str(path)) for p in info.value.problems])

@@ -1,0 +1,118 @@
+"""The output folder of a command, claimed before anything runs.
+
+A run that ends by writing into a folder should learn *before* it runs that it
+cannot: ``--out`` naming a file, or a folder that cannot be created or written,
+would lose the whole run at save time.  And two runs writing into one folder at
+once would mix their files.  :class:`OutputFolder` checks the folder, creates it
+and takes a lock file in it (``.hamilton-orbits.lock``, holding the PID and the
+host of the run), refused while the run that holds it is alive; a lock left by
+a run that has ended (its process is gone) is taken over.  The lock goes when
+the run ends.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+from pathlib import Path
+
+__all__ = ["LOCK_NAME", "FolderError", "OutputFolder"]
+
+LOCK_NAME = ".hamilton-orbits.lock"
+
+
+class FolderError(ValueError):
+    """An output folder that cannot be used (its message says why, naming it)."""
+
+
+def _alive(pid: int) -> bool:
+    """True if a process ``pid`` exists on this host."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # it exists, owned by someone else
+        return True
+    except OSError:  # pragma: no cover - platforms without signal 0
+        return True
+    return True
+
+
+class OutputFolder:
+    """Claim folder ``path`` for one run: ``with OutputFolder(path, "--out"): ...``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The folder (created with its parents if missing).
+    option : str
+        How the user named it, for messages (``"--out"``).
+
+    Raises
+    ------
+    FolderError
+        On entering: ``path`` is a file, cannot be created or written, or another
+        live run holds it (naming its PID and host).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     with OutputFolder(tmp) as folder:
+    ...         (folder.path / LOCK_NAME).exists()
+    ...     (folder.path / LOCK_NAME).exists()
+    True
+    False
+    """
+
+    def __init__(self, path: str | Path, option: str = "--out") -> None:
+        self.path = Path(path)
+        self.option = option
+        self._lock = self.path / LOCK_NAME
+        self._mine = f"{os.getpid()} {socket.gethostname()}\n"
+
+    def _fail(self, why: str) -> FolderError:
+        return FolderError(f"{self.option} {self.path}: {why}; nothing was run")
+
+    def __enter__(self) -> OutputFolder:
+        if self.path.exists() and not self.path.is_dir():
+            raise self._fail("is a file, not a folder")
+        try:
+            self.path.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
+        for _attempt in range(2):
+            try:
+                fd = os.open(self._lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                self._take_over_stale()
+                continue
+            except OSError as exc:
+                raise self._fail(f"cannot write in the folder ({exc.strerror or exc})") from None
+            with os.fdopen(fd, "w") as fh:
+                fh.write(self._mine)
+            return self
+        raise self._fail("another run keeps taking the folder")  # pragma: no cover
+
+    def _take_over_stale(self) -> None:
+        """Remove the lock of a run that has ended; refuse one of a live run."""
+        try:
+            held = self._lock.read_text(encoding="utf-8", errors="replace").split()
+        except FileNotFoundError:  # released meanwhile
+            return
+        pid = int(held[0]) if held and held[0].isdigit() else None
+        host = held[1] if len(held) > 1 else "?"
+        if pid is not None and host == socket.gethostname() and not _alive(pid):
+            self._lock.unlink(missing_ok=True)
+            return
+        who = f"PID {pid} on {host}" if pid is not None else "an unknown run"
+        raise self._fail(
+            f"another run ({who}) is writing into this folder; choose another folder, or "
+            f"wait for it to end (if it has ended on another machine, delete {self._lock})")
+
+    def __exit__(self, *exc_info: object) -> None:
+        try:
+            if self._lock.read_text(encoding="utf-8") == self._mine:
+                self._lock.unlink()
+        except OSError:  # gone already (a user removed it): nothing to release
+            pass

@@ -1,0 +1,537 @@
+"""Bad input, refused at its root (issue 20, deliverable 3).
+
+Every reproducer of the issue's n-body, scene, CLI and ensemble surfaces is here,
+as a named-error test (the exception type and the start of the message a user now
+gets) or a no-hang test (a subprocess with a timeout).  The rigid / pole
+reproducers are in ``tests/rigid/test_bad_input_rigid.py`` (not
+``test_bad_input.py``: pytest imports test modules by their base name, and a
+``tests/rigid/__init__.py`` would shadow the ``rigid`` package).
+
+Conventions checked: bad input raises ``ValueError`` (or astropy's
+``UnitConversionError``) naming the argument, the index and the value; a scene
+raises ``SceneError`` listing its problems as ``file:LINE: key: message``; no
+command prints a traceback (2: bad scene or command line, 1: a failure during
+the run, in one line).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+
+import astropy.units as u
+import numpy as np
+import pytest
+from astropy.time import Time
+
+from hamilton_orbits import Body, Ensemble, Scene, System, crosscheck, integrate
+from hamilton_orbits._outdir import LOCK_NAME, FolderError, OutputFolder
+from hamilton_orbits._schema import key_lines
+from hamilton_orbits.effects import normalize_effects
+from hamilton_orbits.scene import OUTPUT_LIMIT, SceneError
+
+
+def floats():
+    """A system of plain floats (G = 1) with an oblate planet."""
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                   Body("p", 1e-3, [1, 0, 0], [0, 1, 0], radius=0.01, j2=1e-3)])
+
+
+def quantities():
+    """A system of Quantities with an oblate Earth."""
+    return System([
+        Body("earth", 398600.4418 * u.km**3 / u.s**2, [0, 0, 0] * u.km, [0, 0, 0] * u.km / u.s,
+             radius=6378.1366 * u.km, j2=1.0826359e-3),
+        Body("sat", 0 * u.km**3 / u.s**2, [7000, 0, 0] * u.km, [0, 7.546, 0] * u.km / u.s),
+    ])
+
+
+def _cli(*args, timeout=300, cwd=None, code=None):
+    """The command in a subprocess (``code``: Python run before ``main`` instead)."""
+    if code is None:
+        cmd = [sys.executable, "-m", "hamilton_orbits.cli", *args]
+    else:
+        cmd = [sys.executable, "-c", code + "\nimport sys\nfrom hamilton_orbits.cli import main\n"
+               f"sys.exit(main({list(args)!r}))"]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=cwd)
+
+
+def _no_traceback(res):
+    assert "Traceback" not in res.stderr, res.stderr
+    assert res.stderr.startswith("hamilton-orbits: "), res.stderr
+
+
+# ---------------------------------------------------------------- silently wrong
+
+
+def test_a_plain_j2_radius_on_a_quantity_system_is_refused_not_read_as_au():
+    with pytest.raises(ValueError, match=r"Effect 'j2': expected `radius` as a Quantity \(a "
+                                         r"length.*got the plain number 6378.0"):
+        integrate(quantities(), 1 * u.min, effects=[{"name": "j2", "body": "earth",
+                                                     "radius": 6378.0}])
+
+
+def test_effect_quantities_follow_one_rule_both_ways():
+    """A Quantity where the system is of plain floats is refused, not dropped."""
+    with pytest.raises(ValueError, match=r"Effect 'gr': expected `c` as a plain number in the "
+                                         r"units of the system .*the Quantity 300000.0 km / s"):
+        integrate(floats(), 1.0, effects=[{"name": "gr", "c": 3e5 * u.km / u.s}])
+    with pytest.raises(ValueError, match=r"Effect 'j2': expected `radius` as a plain number"):
+        integrate(floats(), 1.0, effects=[{"name": "j2", "body": "p", "radius": 1 * u.km}])
+    with pytest.raises(u.UnitConversionError, match=r"Effect 'gr': Expected `c` to be a speed"):
+        integrate(quantities(), 1 * u.min, effects=[{"name": "gr", "c": 3 * u.km}])
+
+
+def test_an_effect_quantity_reaches_rebound_in_the_system_units():
+    """reboundx takes the effect's parameters from the effect's own builder: a Quantity
+    radius in the mapping is converted (it raised a TypeError before)."""
+    table = crosscheck(quantities(), 10 * u.min, method="dop853", tol=1e-12,
+                       effects=[{"name": "j2", "body": "earth", "radius": 6378.1366 * u.km}])
+    assert table.relative_position_difference.max() < 1e-9
+
+
+@pytest.mark.parametrize("epoch", ["J1000000", Time(1e6, format="jyear", scale="tdb"),
+                                   "2101-01-01", "1899-06-01"])
+def test_solar_system_refuses_epochs_outside_the_ephemeris_span(epoch):
+    # the year 1e6 put the Earth 100 au from the Sun (ERFA's epv00 holds 1900-2100)
+    with pytest.raises(ValueError, match=r"Expected `epoch` within 1900-2100 \(the span of "
+                                         r"ERFA's epv00"):
+        System.solar_system(epoch)
+
+
+def test_solar_system_takes_epochs_inside_the_span():
+    for epoch in ("1900-06-01", "2099-06-01"):
+        s = System.solar_system(epoch, bodies=["sun", "earth"])
+        d = np.linalg.norm((s.r[1] - s.r[0]).to_value(u.au))
+        assert 0.98 < d < 1.02
+
+
+@pytest.mark.parametrize(("pole", "expected"), [
+    ([1e308, 1e308, 0], [2**-0.5, 2**-0.5, 0.0]),  # stored (0, 0, 0) before: overflow
+    ([1e-320, 0, 0], [1.0, 0.0, 0.0]),              # a subnormal is still a direction
+    ([0, -3e-300, 4e-300], [0.0, -0.6, 0.8]),
+])
+def test_a_pole_is_normalised_with_scaling(pole, expected):
+    body = Body("x", 1.0, [0, 0, 0], [0, 0, 0], pole=pole)
+    np.testing.assert_allclose(body.pole, expected, rtol=1e-15)
+
+
+def test_only_a_true_zero_pole_is_refused():
+    with pytest.raises(ValueError, match=r"Body 'x': expected `pole` to be nonzero, got "
+                                         r"\[0.0, 0.0, 0.0\]"):
+        Body("x", 1.0, [0, 0, 0], [0, 0, 0], pole=[0, 0, 0])
+
+
+def test_crosscheck_refuses_a_trajectory_of_another_system():
+    s = floats()
+    other = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                    Body("q", 1e-3, [1, 0, 0], [0, 1, 0])])
+    moved = s.with_state(s.as_arrays().r + [[0, 0, 0], [0.1, 0, 0]], s.as_arrays().v)
+    with pytest.raises(ValueError, match=r"Expected `trajectory` of the bodies \['sun', 'p'\]"):
+        crosscheck(s, None, trajectory=integrate(other, 0.1, method="dop853"))
+    with pytest.raises(ValueError, match=r"start from `system`'s state; body 'p' starts "
+                                         r"elsewhere"):
+        crosscheck(s, None, trajectory=integrate(moved, 0.1, method="dop853"))
+
+
+def test_an_empty_list_of_solar_system_bodies_is_an_error():
+    """Decision: ``bodies = []`` is a mistake (no bodies from the ephemeris is said by
+    leaving ``solar_system`` out), never "all nine" as before."""
+    with pytest.raises(ValueError, match=r"Expected `bodies` to name at least one body, got "
+                                         r"an empty list \(leave it out"):
+        System.solar_system(bodies=[])
+    with pytest.raises(SceneError, match=r"initial.solar_system.bodies: expected `bodies` to "
+                                         r"name at least one body"):
+        Scene.from_dict({"kind": "nbody", "duration": "1 d",
+                         "initial": {"solar_system": {"bodies": []}}})
+
+
+# ---------------------------------------------------------------- lost work
+
+
+def test_a_cadence_that_would_fill_memory_is_refused_at_loading():
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict({"kind": "nbody", "duration": "1 yr", "cadence": "1e-9 d",
+                         "initial": {"solar_system": {}}})
+    (problem,) = info.value.problems
+    assert problem.startswith("<dict>: cadence: 3.653e+11 outputs of 9 bodies would take ")
+    assert "beyond the limit of 1 GiB: choose a cadence of at least" in problem
+    assert OUTPUT_LIMIT == 2**30
+
+
+def test_a_cadence_that_would_fill_memory_does_not_hang_the_command(tmp_path):
+    scene = tmp_path / "tiny.toml"
+    scene.write_text('kind = "nbody"\nduration = "1 yr"\ncadence = "1e-9 d"\n'
+                     '[initial]\nsolar_system = { epoch = "J2000" }\n')
+    res = _cli("run", str(scene), "--out", str(tmp_path / "out"), "--no-progress", timeout=120)
+    assert res.returncode == 2
+    _no_traceback(res)
+    assert f"{scene}:3: cadence: " in res.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_out_naming_a_file_is_refused_before_the_run(tmp_path):
+    target = tmp_path / "results.txt"
+    target.write_text("not a folder")
+    res = _cli("run", "leo-j2", "--out", str(target), "--no-progress")
+    assert res.returncode == 2
+    _no_traceback(res)
+    assert f"--out {target}: is a file, not a folder; nothing was run" in res.stderr
+    assert res.stdout == ""  # nothing simulated, no summary
+
+
+def test_a_folder_another_live_run_writes_into_is_refused(tmp_path):
+    (tmp_path / LOCK_NAME).write_text(f"{os.getpid()} {os.uname().nodename}\n")
+    res = _cli("run", "leo-j2", "--out", str(tmp_path), "--no-progress")
+    assert res.returncode == 2
+    _no_traceback(res)
+    assert f"another run (PID {os.getpid()} on " in res.stderr
+    assert (tmp_path / LOCK_NAME).exists()  # the other run's lock stays
+
+
+def test_the_lock_is_taken_released_and_taken_over_when_stale(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    lock = tmp_path / LOCK_NAME
+    lock.write_text(f"{int(dead.stdout)} {os.uname().nodename}\n")  # a run that has ended
+    with OutputFolder(tmp_path):
+        assert lock.read_text().split()[0] == str(os.getpid())
+        with pytest.raises(FolderError, match=rf"another run \(PID {os.getpid()}"), \
+                OutputFolder(tmp_path):
+            pass
+    assert not lock.exists()
+    lock.write_text("1234 elsewhere\n")  # another machine: its liveness is unknown
+    with pytest.raises(FolderError, match=r"PID 1234 on elsewhere.*delete .*lock"):
+        OutputFolder(tmp_path).__enter__()
+
+
+def test_an_output_folder_that_cannot_be_created_is_refused(tmp_path):
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(FolderError, match=r"cannot create the folder"):
+        OutputFolder(tmp_path / "file" / "below").__enter__()
+
+
+# ---------------------------------------------------------------- bare exceptions
+
+
+@pytest.mark.parametrize("data", [None, 3, ["kind", "nbody"], "kind = 'nbody'"])
+def test_scene_from_something_not_a_mapping(data):
+    with pytest.raises(SceneError, match=r"<dict>: expected a mapping shaped like a scene file"):
+        Scene.from_dict(data)
+
+
+def test_ensemble_members_and_vary_of_the_wrong_type():
+    scene = Scene.bundled("dzhanibekov")
+    with pytest.raises(ValueError, match=r"Expected `members` to be a list of mappings .*got 3"):
+        Ensemble(scene, members=3)
+    with pytest.raises(ValueError, match=r"Expected `members` to hold mappings .*got 3 at index 1"):
+        Ensemble(scene, members=[{"duration": "1 s"}, 3])
+    with pytest.raises(ValueError, match=r"Expected `vary` to be a mapping"):
+        Ensemble(scene, vary=["duration"])
+
+
+def test_ensemble_run_refuses_an_address_for_a_client():
+    ens = Ensemble(Scene.bundled("dzhanibekov"), vary={"duration": ["1 s"]})
+    with pytest.raises(ValueError, match=r"Expected `client` to be a dask.distributed.Client, "
+                                         r"got 'tcp://1.2.3.4:8786'; connect first"):
+        ens.run(client="tcp://1.2.3.4:8786", progress=False)
+    with pytest.raises(ValueError, match=r"Expected `workers` to be a number of processes >= 1"):
+        ens.run(workers=0, progress=False)
+
+
+def test_ensemble_refuses_a_member_that_only_the_run_used_to_refuse():
+    with pytest.raises(ValueError, match=r"(?s)Member 1 .* initial.solar_system.epoch: expected "
+                                         r"`epoch` to be a time"):
+        Ensemble(Scene.bundled("comet-encounter"),
+                 members=[{"duration": "1 d"}, {"initial.solar_system.epoch": "not a date"}])
+
+
+@pytest.mark.parametrize(("params", "pattern"), [
+    ({"name": "j2", "body": "p", "j2": [1e-3, 2e-3]},
+     r"Effect 'j2': expected `j2` to be one number, got \[0.001, 0.002\] \(shape \(2,\)\)"),
+    ({"name": "j2", "body": "p", "radius": [0.1, 0.2]},
+     r"Effect 'j2': expected `radius` to be one number"),
+    ({"name": "gr", "c": [1.0, 2.0]}, r"Effect 'gr': expected `c` to be one number"),
+    ({"name": "j2", "body": ["p"]}, r"Effect 'j2': expected `body` to be the name of a body, "
+                                    r"got \['p'\]"),
+    ({"name": "j2", "body": "p", "j2": "x"}, r"Effect 'j2': Expected `j2` to be numeric, "
+                                             r"got 'x'"),
+    ({"name": "gr", "c": {1, 2}}, r"Effect 'gr': Expected `c` to be numeric"),
+])
+def test_a_list_or_a_string_as_an_effect_parameter(params, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        integrate(floats(), 0.1, method="dop853", effects=[params])
+
+
+def test_from_rebound_of_something_else():
+    with pytest.raises(ValueError, match=r"Expected `sim` to be a rebound.Simulation, got 'x'"):
+        System.from_rebound("x")
+
+
+def test_a_binary_scene_file(tmp_path):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(bytes(range(256)))
+    with pytest.raises(SceneError, match=rf"{re.escape(str(path))}: not a scene file: not "
+                                         r"text in UTF-8 \(byte 0x80 at offset 128\)"):
+        Scene.from_toml(path)
+    res = _cli("run", str(path), "--no-progress")
+    assert res.returncode == 2
+    _no_traceback(res)
+
+
+@pytest.mark.parametrize(("key", "pattern"), [
+    ("bodies[7].gm", r"leo-j2.toml: bodies\[7\].gm: bodies has 2 entries \(indices 0 to 1\); "
+                     r"\[7\] is beyond it"),
+    ("duration.x", r"leo-j2.toml: duration.x: duration is a value \('10 d'\), not a table: it "
+                   r"has no key 'x'"),
+    ("bodies[x].gm", r"leo-j2.toml: bodies\[x\].gm: expected a number in \[...\], got \[x\] \(a "
+                     r"table in a list is addressed by its name"),
+    ("integrator[0]", r"leo-j2.toml: integrator\[0\]: integrator is a table, not a list"),
+    ("bodies.pluto.gm", r"leo-j2.toml: bodies.pluto.gm: no entry named 'pluto' in bodies"),
+    ("a..b", r"leo-j2.toml: a..b: cannot read the key path"),
+    ("analysis[3].body", r"analysis has 1 entries .*\[3\] is beyond it"),
+])
+def test_set_paths_that_lead_nowhere(key, pattern):
+    with pytest.raises(SceneError, match=pattern):
+        Scene.bundled("leo-j2").with_values({key: "1"})
+
+
+def test_set_paths_that_lead_nowhere_on_the_command_line():
+    res = _cli("run", "leo-j2", "--set", "bodies[7].gm=1 km3/s2", "--no-progress")
+    assert res.returncode == 2
+    _no_traceback(res)
+    assert "bodies[7].gm: bodies has 2 entries" in res.stderr
+
+
+def test_a_quantity_tolerance_names_tol():  # fixed in simulation.integrate by the lead
+    with pytest.raises(u.UnitConversionError, match=r"Expected `tol` to be dimensionless, got s"):
+        integrate(quantities(), 1 * u.min, tol=1e-9 * u.s)
+
+
+def test_a_string_tolerance_names_tol():  # was "could not convert string to float: 'x'"
+    with pytest.raises(ValueError, match=r"Expected `tol` to be numeric, got 'x'"):
+        integrate(floats(), 0.1, tol="x")
+
+
+@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `tol` with "
+                                       "float(DIMENSIONLESS(...)): an array is a TypeError; "
+                                       "DIMENSIONLESS.scalar('tol', tol) names it")
+def test_an_array_tolerance_names_tol():
+    with pytest.raises(ValueError, match=r"Expected `tol` to be one number, got shape \(2,\)"):
+        integrate(floats(), 0.1, tol=[1e-9, 1e-8])
+
+
+@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `dt` with "
+                                       "float(TIME(...)): an array is a TypeError; "
+                                       "TIME.scalar('dt', dt, unit) names it")
+def test_an_array_step_names_dt():
+    with pytest.raises(ValueError, match=r"Expected `dt` to be one number, got shape \(2,\)"):
+        integrate(floats(), 0.1, method="leapfrog", dt=[0.1, 0.2])
+
+
+def test_a_failure_during_a_run_is_one_line_and_exit_1(tmp_path):
+    boom = ("import hamilton_orbits.engine as engine\n"
+            "def run(*args, **kwargs):\n"
+            "    raise ValueError('the step underflowed\\n  at t = 1.5 d')\n"
+            "engine.run = run\n")
+    res = _cli("run", "leo-j2", "--out", str(tmp_path), "--no-progress", code=boom)
+    assert res.returncode == 1
+    _no_traceback(res)
+    assert res.stderr.strip() == ("hamilton-orbits: the run of leo-j2 failed: ValueError: the "
+                                  "step underflowed at t = 1.5 d")
+    assert not (tmp_path / LOCK_NAME).exists()  # released
+
+
+# ------------------------------------------- scenes that used to fail at run time
+
+GOOD = """\
+kind = "nbody"
+description = "bad input, one edit at a time"
+duration = "0.2 d"
+cadence = "1 h"
+effects = []
+
+[integrator]
+method = "radau15"
+
+[initial]
+solar_system = { epoch = "J2000", bodies = ["sun", "earth", "moon"] }
+
+[[bodies]]
+name = "satellite"
+gm = "0 km3/s2"
+primary = "earth"
+a = "7000 km"
+e = 0.001
+inc = "51.6 deg"
+
+[[analysis]]
+name = "close_approach"
+body = "satellite"
+other = "moon"
+"""
+
+# (case, (old, new), key, the text of the line the problem points at, regex of the message)
+SCENES = [
+    ("negative gm", ('gm = "0 km3/s2"', 'gm = "-1 km3/s2"'), "bodies[0].gm", "gm =",
+     r"expected a value >= 0, got '-1 km3/s2'"),
+    ("e = 2 with a > 0", ("e = 0.001", "e = 2"), "bodies[0].a", 'a = "7000 km"',
+     r"expected a < 0 for a hyperbola \(e = 2 > 1\), got a = 7000.0 km"),
+    ("e < 0", ("e = 0.001", "e = -0.1"), "bodies[0].e", "e = -0.1",
+     r"expected a value >= 0, got -0.1"),
+    ("a = 0", ('a = "7000 km"', 'a = "0 km"'), "bodies[0].a", "a = ",
+     r"expected a nonzero value, got '0 km'"),
+    ("a < 0 with e < 1", ('a = "7000 km"', 'a = "-7000 km"'), "bodies[0].a", "a = ",
+     r"expected a > 0 for an ellipse \(e = 0.001 < 1\)"),
+    ("e = 1 with a", ("e = 0.001", "e = 1"), "bodies[0].a", "a = ",
+     r"a parabola \(e = 1\) has no finite `a`: give `p` or `q`"),
+    ("an empty name", ('name = "satellite"', 'name = ""'), "bodies[0].name", 'name = ""',
+     r"expected a non-empty string, got ''"),
+    ("a zero pole", ('inc = "51.6 deg"', 'inc = "51.6 deg"\npole = [0, 0, 0]'),
+     "bodies[0].pole", "pole =", r"expected a nonzero direction, got \[0, 0, 0\]"),
+    ("a duplicated effect", ("effects = []", 'effects = ["gr", "gr"]'), "effects[1]",
+     "effects =", r"effect 'gr' is listed twice \(first at effects\[0\]\)"),
+    ("j2 without a body", ("effects = []", 'effects = ["j2"]'), "effects[0].body", "effects =",
+     r"Effect 'j2' needs the `body` whose oblateness acts"),
+    ("j2 on a body without radius",
+     ("effects = []", 'effects = [{ name = "j2", body = "earth" }]'), "effects[0]",
+     "effects =", r"Effect 'j2': body 'earth' has no j2 and no radius"),
+    ("a c without a unit", ("effects = []", 'effects = [{ name = "gr", c = 10065.3 }]'),
+     "effects[0].c", "effects =", r'expected a speed \(m / s\) with its unit'),
+    ("a c of another dimension", ("effects = []", 'effects = [{ name = "gr", c = "3 km" }]'),
+     "effects[0].c", "effects =", r"expected a speed \(a unit convertible to m / s\)"),
+    ("leapfrog without dt", ('method = "radau15"', 'method = "leapfrog"'), "integrator.dt",
+     "[integrator]", r"missing: method 'leapfrog' takes a fixed step `dt`"),
+    ("an unparsable epoch", ('epoch = "J2000"', 'epoch = "next tuesday"'),
+     "initial.solar_system.epoch", "solar_system =",
+     r"expected `epoch` to be a time .*got 'next tuesday'"),
+    ("an epoch beyond the ephemeris", ('epoch = "J2000"', 'epoch = "2500-01-01"'),
+     "initial.solar_system.epoch", "solar_system =", r"expected `epoch` within 1900-2100"),
+    ("duplicate bodies", ('"sun", "earth", "moon"', '"sun", "earth", "moon", "earth"'),
+     "initial.solar_system.bodies", "solar_system =",
+     r"expected `bodies` to name each body once, got 'earth' at indices 1 and 3"),
+    ("the Earth with the Earth-Moon barycentre",
+     ('"sun", "earth", "moon"', '"sun", "earth", "moon", "earth-moon-barycenter"'),
+     "initial.solar_system.bodies", "solar_system =",
+     r"expected either 'earth-moon-barycenter' or 'earth' and 'moon'"),
+    ("close_approach without other", ('other = "moon"\n', ""), "analysis[0].other",
+     "[[analysis]]", r"missing: analysis 'close_approach' needs `other`"),
+    ("close_approach of a body with itself", ('other = "moon"', 'other = "satellite"'),
+     "analysis[0].other", "other =", r"expected a body other than `body` \('satellite'\)"),
+    ("a cadence beyond memory", ('cadence = "1 h"', 'cadence = "1e-12 d"'), "cadence",
+     "cadence =", r"outputs of 4 bodies would take .* beyond the limit of 1 GiB"),
+]
+
+
+def _line_of(text: str, marker: str) -> int:
+    return next(k for k, line in enumerate(text.splitlines(), 1) if line.startswith(marker))
+
+
+@pytest.mark.parametrize(("case", "edit", "key", "marker", "pattern"), SCENES,
+                         ids=[c[0] for c in SCENES])
+def test_scenes_fail_at_loading_with_file_line_and_key(tmp_path, case, edit, key, marker,
+                                                       pattern):
+    text = GOOD.replace(*edit, 1)
+    assert text != GOOD
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    where = f"{path}:{_line_of(text, marker)}: {key}: "
+    found = [p for p in info.value.problems if p.startswith(where)]
+    assert found, (where, info.value.problems)
+    assert re.search(pattern, found[0]), found[0]
+
+
+def test_the_good_scene_runs():
+    path_free = Scene.from_dict(__import__("tomllib").loads(GOOD))
+    result = path_free.run(progress=False)
+    assert result.complete
+
+
+def test_a_bad_scene_exits_2_naming_file_line_and_key(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace('gm = "0 km3/s2"', 'gm = "-1 km3/s2"'))
+    res = _cli("run", str(path), "--no-progress", "--out", str(tmp_path / "out"))
+    assert res.returncode == 2
+    _no_traceback(res)
+    assert f"{path}:15: bodies[0].gm: expected a value >= 0, got '-1 km3/s2'" in res.stderr
+    assert not (tmp_path / "out").exists()  # nothing ran, no folder
+
+
+def test_gr_takes_c_as_a_quantity_string():
+    scene = Scene.from_dict({
+        "kind": "nbody", "duration": "10 d", "effects": [{"name": "gr", "c": "299792.458 km/s"}],
+        "initial": {"solar_system": {"bodies": ["sun", "mercury"]}}})
+    assert scene.effects[0]["c"] == 299792.458 * u.km / u.s
+    result = scene.run(progress=False)
+    assert result.complete
+    assert '"c": {' in __import__("json").dumps(result._json())  # saved as value and unit
+
+
+def test_a_value_set_after_loading_has_no_line(tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    scene = Scene.from_toml(path)
+    with pytest.raises(SceneError) as info:
+        scene.with_values({"bodies.satellite.gm": "-1 km3/s2"})
+    assert info.value.problems == [
+        f"{path}: bodies[0].gm: expected a value >= 0, got '-1 km3/s2'"]
+    with pytest.raises(SceneError) as info:  # a key the override did not touch keeps its line
+        scene.with_values({"bodies.satellite.e": 2})
+    assert info.value.problems[0].startswith(f"{path}:17: bodies[0].a: ")
+
+
+def test_key_lines_follow_strings_comments_and_inline_tables():
+    text = ('kind = "nbody"  # a [comment] = 1\n'
+            'description = """line [1] = 2\n{ x = 3 }\n"""\n'
+            'effects = [\n  "gr",  # c = 3\n  { name = "j2", body = "earth" },\n]\n'
+            "'quoted.key' = 1\n"
+            "[initial.solar_system]\nepoch = 2000-01-01 12:00:00\nbodies = [[1], [2]]\n"
+            "[[bodies]]\nname = 'a'\n[[bodies]]\nname = 'b'\n")
+    __import__("tomllib").loads(text)  # valid TOML
+    lines = key_lines(text)
+    assert lines[("description",)] == 2
+    assert lines[("effects",)] == 5
+    assert lines[("effects", 0)] == 6
+    assert lines[("effects", 1, "body")] == 7
+    assert lines[("quoted.key",)] == 9
+    assert lines[("initial", "solar_system", "epoch")] == 11
+    assert lines[("initial", "solar_system", "bodies", 1)] == 12
+    assert lines[("bodies", 1, "name")] == 16
+    assert ("x",) not in lines and ("line [1]",) not in lines
+
+
+# ---------------------------------------------------------------- unclear messages
+
+
+def test_strings_where_numbers_go_name_the_argument():
+    with pytest.raises(ValueError, match=r"Expected `G` to be numeric, got 'x'"):
+        System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])], G="x")
+    with pytest.raises(u.UnitConversionError, match=r"Expected `G` to be dimensionless"):
+        System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])], G=6.674e-11 * u.m**3 / u.kg / u.s**2)
+    with pytest.raises(ValueError, match=r"Body 'a': expected `j2` to be numeric, got 'x'"):
+        Body("a", 1.0, [0, 0, 0], [0, 0, 0], j2="x")
+    with pytest.raises(ValueError, match=r"Body 'a': expected `j2` to be one number, got "
+                                         r"shape \(2,\)"):
+        Body("a", 1.0, [0, 0, 0], [0, 0, 0], j2=[1e-3, 2e-3])
+    with pytest.raises(ValueError, match=r"Body 'a': expected `gm` >= 0, got -1.0 km3 / s2"):
+        Body("a", -1.0 * u.km**3 / u.s**2, [0, 0, 0] * u.km, [0, 0, 0] * u.km / u.s)
+
+
+def test_solar_system_bodies_takes_one_name_and_refuses_what_is_not_a_name():
+    assert System.solar_system(bodies="Sun").names == ("sun",)  # read "s" before
+    with pytest.raises(ValueError, match=r"Expected `bodies` to hold names, got 3 at index 1"):
+        System.solar_system(bodies=["sun", 3])
+    with pytest.raises(ValueError, match=r"Unknown solar-system body 'pluto' at index 1 of "
+                                         r"`bodies`"):
+        System.solar_system(bodies=["sun", "pluto"])
+    with pytest.raises(ValueError, match=r"Expected `bodies` to be a list of names, got 3"):
+        System.solar_system(bodies=3)
+
+
+def test_a_duplicated_effect_names_both_indices():
+    with pytest.raises(ValueError, match=r"Effect 'gr' is listed twice \(at indices 0 and 2\)"):
+        normalize_effects(["gr", {"name": "j2", "body": "earth"}, {"name": "gr"}])

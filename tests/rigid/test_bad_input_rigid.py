@@ -1,0 +1,119 @@
+"""Bad input on the rigid-body and pole surfaces, refused at its root (issue 20).
+
+The reproducers of the issue for ``rigid``: a wobble fit asked beyond the record,
+a C04 file that is not one, the Liouville model with an effect listed twice, and
+the rigid scene kinds; the n-body, scene and CLI ones are in
+``tests/hamilton_orbits/test_bad_input.py``.
+"""
+
+from __future__ import annotations
+
+import re
+
+import astropy.units as u
+import pytest
+from astropy.time import Time
+
+from hamilton_orbits import Scene
+from hamilton_orbits.scene import SceneError
+from rigid.polar_motion import LiouvillePole, fit_wobble, load_c04
+
+
+@pytest.fixture(scope="module")
+def record():
+    return load_c04()
+
+
+def _span(record) -> str:
+    first, last = record.time[0].iso[:10], record.time[-1].iso[:10]
+    return rf"within the record \(1962.00-\d{{4}}.\d\d, {first} to {last}\)"
+
+
+def test_a_fit_beyond_the_record_is_refused_not_cut_short(record):
+    # fit_wobble(rec, 2020, 2100) fitted 2020-2026 without saying so
+    with pytest.raises(ValueError, match=rf"Expected `end` {_span(record)}, got 2100, after "
+                                         r"the record ends \(leave `end` out"):
+        fit_wobble(record, start=2020, end=2100)
+    with pytest.raises(ValueError, match=rf"Expected `start` {_span(record)}, got 1950, before "
+                                         r"it begins"):
+        fit_wobble(record, start=1950, end=2000)
+    with pytest.raises(ValueError, match=r"Expected `start` within the record .*got <Time"):
+        record.select(Time("1961-06-01", scale="utc"), 2000)
+
+
+def test_a_window_to_the_end_of_the_record_is_taken(record):
+    last = float(2000 + (record.time[-1].mjd - 51544) / 365.25)
+    sub = record.select(2020, last + 1 / 365.25)  # one sample beyond the last epoch: all of it
+    assert sub.time[-1] == record.time[-1]
+
+
+@pytest.mark.parametrize(("content", "pattern"), [
+    (bytes(range(256)) * 4, r"to be an IERS C04 table.*got a file that is not text \(byte "
+                            r"0x80 at offset 128\)"),
+    (b"kind = 'nbody'\n", r"to be an IERS C04 table.*invalid column index 4"),
+    (b"1962 1 1 0 37665 -0.012700 0.213000\n", r"with at least 2 rows, got 1"),
+    (b"1962 1 1 0 37666 -0.0127 0.2130\n1962 1 1 0 37665 -0.0125 0.2140\n",
+     r"Expected the epochs \(MJD\) of `path` .* to increase, got 37665.0 after 37666.0 at data "
+     r"row 1"),
+    (b"1962 1 1 0 37665 nan 0.2130\n1962 1 2 0 37666 -0.0125 0.2140\n",
+     r"finite pole coordinates: Expected `x` to be finite, got nan at index 0"),
+])
+def test_a_file_that_is_not_a_c04_table(tmp_path, content, pattern):
+    path = tmp_path / "eopc04.txt"
+    path.write_bytes(content)
+    with pytest.raises(ValueError, match=pattern) as info:
+        load_c04(path)
+    assert str(path) in str(info.value)
+
+
+@pytest.mark.parametrize("effects", [("elastic", "elastic"), ("elastic", "damping", "elastic")])
+def test_liouville_refuses_an_effect_listed_twice_as_integrate_does(effects):
+    k = effects.index("elastic", 1)
+    with pytest.raises(ValueError, match=rf"Effect 'elastic' is listed twice \(at indices 0 and "
+                                         rf"{k}\)"):
+        LiouvillePole(effects, chandler_period=433.0, Q=100)
+
+
+def test_liouville_parameters_of_the_wrong_shape_or_kind():
+    with pytest.raises(ValueError, match=r"Expected `k2` to be one number, got shape \(2,\)"):
+        LiouvillePole(("elastic",), k2=[0.1, 0.2])
+    with pytest.raises(u.UnitConversionError, match=r"Expected `Q` to be dimensionless"):
+        LiouvillePole(("damping",), Q=100 * u.s)
+    with pytest.raises(ValueError, match=r"Expected `effects` to be a list of names"):
+        LiouvillePole(3)
+    with pytest.raises(ValueError, match=r"Expected `effects` from .* got 3 at index 1"):
+        LiouvillePole(("free", 3))
+
+
+def test_polar_scene_window_beyond_the_record_fails_at_loading(tmp_path):
+    path = tmp_path / "pole.toml"
+    path.write_text('kind = "polar_motion"\nstart = 2020\nend = 2100\n')
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    (problem,) = info.value.problems
+    assert problem.startswith(f"{path}:3: end: expected `end` within the record")
+
+
+def test_polar_scene_reads_periods_with_units_and_refuses_a_duplicate(tmp_path):
+    scene = Scene.from_dict({"kind": "polar_motion", "start": 1980, "end": 1990, "effects": [
+        {"name": "elastic", "chandler_period": "433 d"}, {"name": "damping", "Q": 100}]})
+    assert scene.effects[0]["chandler_period"] == 433 * u.day
+    result = scene.run(progress=False)
+    assert result.metrics["model period"].to_value(u.day) == pytest.approx(433, rel=1e-12)
+    with pytest.raises(SceneError, match=r"effects\[0\].chandler_period: expected a time"):
+        Scene.from_dict({"kind": "polar_motion",
+                         "effects": [{"name": "elastic", "chandler_period": "433 m"}]})
+    with pytest.raises(SceneError, match=r"effects\[1\]: effect 'elastic' is listed twice"):
+        Scene.from_dict({"kind": "polar_motion", "effects": ["elastic", "elastic"]})
+
+
+def test_rotation_scene_cadence_beyond_memory_fails_at_loading(tmp_path):
+    path = tmp_path / "spin.toml"
+    path.write_text('kind = "rotation"\nduration = "60 s"\ncadence = "1e-9 s"\n[body]\n'
+                    'moments = ["1 kg m2", "2 kg m2", "3 kg m2"]\n'
+                    'omega = ["0 rad/s", "1 rad/s", "0 rad/s"]\n[integrator]\ndt = "1 ms"\n')
+    with pytest.raises(SceneError) as info:
+        Scene.from_toml(path)
+    (problem,) = info.value.problems
+    assert re.match(rf"{re.escape(str(path))}:3: cadence: 6e\+10 outputs of a rigid body would "
+                    r"take .* beyond the limit of 1 GiB", problem), problem
