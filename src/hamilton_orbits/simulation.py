@@ -208,7 +208,7 @@ def integrate(
     times, unit = _times(t, system.quantity)
     step = None if dt is None else _step(dt, system.quantity)
     if tol is not None:
-        tol = float(DIMENSIONLESS("tol", tol))
+        tol = DIMENSIONLESS.scalar("tol", tol)
         if not 0.0 < tol < 1.0:
             raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
     rhs = compile_rhs(system, eff)
@@ -248,7 +248,7 @@ def _step(dt: Any, quantity: bool) -> float:
     if not quantity and is_quantity(dt):
         raise ValueError(f"Expected `dt` as a plain float for a system of plain floats, "
                          f"got {dt!r}")
-    step = float(TIME("dt", dt, DAY if quantity else None))
+    step = TIME.scalar("dt", dt, DAY if quantity else None)
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"Expected `dt` > 0, got {step!r}")
     return step

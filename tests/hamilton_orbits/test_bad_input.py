@@ -315,17 +315,11 @@ def test_a_string_tolerance_names_tol():  # was "could not convert string to flo
         integrate(floats(), 0.1, tol="x")
 
 
-@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `tol` with "
-                                       "float(DIMENSIONLESS(...)): an array is a TypeError; "
-                                       "DIMENSIONLESS.scalar('tol', tol) names it")
 def test_an_array_tolerance_names_tol():
     with pytest.raises(ValueError, match=r"Expected `tol` to be one number, got shape \(2,\)"):
         integrate(floats(), 0.1, tol=[1e-9, 1e-8])
 
 
-@pytest.mark.xfail(strict=True, reason="engine: simulation.integrate reads `dt` with "
-                                       "float(TIME(...)): an array is a TypeError; "
-                                       "TIME.scalar('dt', dt, unit) names it")
 def test_an_array_step_names_dt():
     with pytest.raises(ValueError, match=r"Expected `dt` to be one number, got shape \(2,\)"):
         integrate(floats(), 0.1, method="leapfrog", dt=[0.1, 0.2])
