@@ -485,3 +485,7 @@ register(
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )
+
+from hamilton_orbits.effects_solar_system import SPECS as _SOLAR_SYSTEM  # noqa: E402
+
+_ = [register(EffectSpec(**spec)) for spec in _SOLAR_SYSTEM]  # eih, zonal, tides, ... (DE440)
