@@ -54,7 +54,9 @@ def test_ladder_10_years_top_rung():
 
 
 STEPS_100 = [
-    *STEPS_10[:4],
+    *STEPS_10[:2],
+    ("sun_j2", "eih", ("mercury",)),  # Venus moves away over the century: docs/de440_ladder.md
+    STEPS_10[3],
     ("tides", "figures", ("moon",)),
     ("asteroids", "tides", ("mercury", "earth-moon-barycenter", "mars", "saturn", "uranus")),
     ("ring", "asteroids", ("uranus", "neptune")),
