@@ -59,6 +59,7 @@ __all__ = [
     "SPECS",
     "eih_energy",
     "kuiper_ring_gm",
+    "sun_spin",
 ]
 
 # IERS Conventions 2010, table 1.1: the Earth's nominal mean angular velocity, rad/s
@@ -222,6 +223,34 @@ def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([b, big_m, radius, *normal])
 
 
+def sun_spin(frame: str = "icrs") -> np.ndarray:
+    """The Sun's spin angular momentum per unit mass (au^2/day) from DE440's constants.
+
+    ``MOISUN * ASUN^2 * OMGSUN`` (moment-of-inertia factor, radius, rotation rate in
+    rad/day) along the Sun's IAU pole in ``frame``.
+
+    Examples
+    --------
+    >>> round(float(np.linalg.norm(sun_spin())) * 1e7, 3)  # au^2/day
+    3.688
+    """
+    radius = de.constant("ASUN") / de.constant("AU")
+    size = de.constant("MOISUN") * radius**2 * de.constant("OMGSUN")
+    return size * de.sun_pole(frame)
+
+
+def _params_lense_thirring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    b = _index(system, params, "body", "sun", "lense_thirring")
+    _require_de440_units(system, params, "lense_thirring", ("c", "spin"))
+    if system.names[b] != "sun" and "spin" not in params:
+        raise ValueError("Effect 'lense_thirring': a body other than the Sun needs `spin`")
+    spin = (_floats("spin", params["spin"], 3, "lense_thirring") if "spin" in params
+            else sun_spin(_frame(params, "lense_thirring")))
+    c = float(params.get("c", _c_au_per_day()))
+    gamma = float(params.get("gamma", de.constant("GAMMA")))
+    return np.array([b, c, gamma, *spin])
+
+
 _PARK = "Park et al. (2021), AJ 161, 105"
 SPECS: tuple[dict[str, Any], ...] = (
     {
@@ -237,6 +266,18 @@ SPECS: tuple[dict[str, Any], ...] = (
         "reference": f"Moyer (2003), DESCANSO monograph 2, eq. 4-26; {_PARK}",
     },
     {
+        "name": "lense_thirring", "kind": "nbody",
+        "summary": "the Sun's gravitomagnetic (Lense-Thirring) field, DE440's spin",
+        "velocity_dependent": True,
+        "parameters": {"body": "default 'sun'",
+                       "spin": "angular momentum per unit mass (default DE440's "
+                               "MOISUN ASUN^2 OMGSUN about the IAU pole)",
+                       "c": "default DE440's CLIGHT", "gamma": "default DE440's GAMMA",
+                       "frame": "'icrs' (default) or 'ecliptic': the system's axes"},
+        "kernel": _relativity.lense_thirring, "params": _params_lense_thirring,
+        "reference": f"IERS Conventions (2010), eq. 10.12; {_PARK}",
+    },
+    {
         "name": "zonal", "kind": "nbody",
         "summary": "zonal harmonics J2..Jn of one body (default the Earth's J2, J3, J4)",
         "parameters": {"body": "the body (default 'earth')",
@@ -250,6 +291,8 @@ SPECS: tuple[dict[str, Any], ...] = (
     {
         "name": "moon_figure", "kind": "nbody",
         "summary": "the Moon's J2 and C22 in axes from Cassini's laws, on every other body",
+        # its axes follow the orbit normal, from the Earth-Moon relative velocity
+        "velocity_dependent": True,
         "parameters": {"moon": "default 'moon'", "earth": "default 'earth'",
                        "radius": "default DE440's AM", "j2": "default DE440's J2M",
                        "c22": "default DE440's C22M",

@@ -13,12 +13,13 @@ effect list:
 2. ``gr``: plus the Sun's first post-Newtonian field (``gr``, one body);
 3. ``eih``: the Einstein-Infeld-Hoffmann equations for every body instead;
 4. ``sun_j2``: plus the Sun's J2 (``j2`` on the Sun, DE440's J2SUN);
-5. ``figures``: plus the Earth's J2-J4 (``zonal``) and the Moon's J2, C22
+5. ``sun_lt``: plus the Sun's Lense-Thirring field (DE440's MOISUN, OMGSUN);
+6. ``figures``: plus the Earth's J2-J4 (``zonal``) and the Moon's J2, C22
    (``moon_figure``);
-6. ``tides``: plus the tides raised on the Earth (``earth_tides``);
-7. ``asteroids``: plus the 16 most massive asteroids as bodies (JPL's sb441-n16;
+7. ``tides``: plus the tides raised on the Earth (``earth_tides``);
+8. ``asteroids``: plus the 16 most massive asteroids as bodies (JPL's sb441-n16;
    72% of the GM of DE440's 343), their own 1PN fields left out;
-8. ``ring``: plus DE440's Kuiper-belt ring (``kuiper_ring``).
+9. ``ring``: plus DE440's Kuiper-belt ring (``kuiper_ring``).
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ class Rung:
 
 
 _SUN_J2 = {"name": "j2", "body": "sun"}
+_SUN = (_SUN_J2, "lense_thirring")
 _FIGURES = ("zonal", "moon_figure")
 # with the asteroids as bodies, their own 1PN fields are left out (each is < 1e-9 of
 # the Sun's 1PN field on any planet, far below rounding); every body still feels the
@@ -60,10 +62,11 @@ RUNGS: tuple[Rung, ...] = (
     Rung("gr", False, ("gr",)),
     Rung("eih", False, ("eih",)),
     Rung("sun_j2", False, ("eih", _SUN_J2)),
-    Rung("figures", False, ("eih", _SUN_J2, *_FIGURES)),
-    Rung("tides", False, ("eih", _SUN_J2, *_FIGURES, "earth_tides")),
-    Rung("asteroids", True, (_EIH_MAJOR, _SUN_J2, *_FIGURES, "earth_tides")),
-    Rung("ring", True, (_EIH_MAJOR, _SUN_J2, *_FIGURES, "earth_tides", "kuiper_ring")),
+    Rung("sun_lt", False, ("eih", *_SUN)),
+    Rung("figures", False, ("eih", *_SUN, *_FIGURES)),
+    Rung("tides", False, ("eih", *_SUN, *_FIGURES, "earth_tides")),
+    Rung("asteroids", True, (_EIH_MAJOR, *_SUN, *_FIGURES, "earth_tides")),
+    Rung("ring", True, (_EIH_MAJOR, *_SUN, *_FIGURES, "earth_tides", "kuiper_ring")),
 )
 
 

@@ -125,3 +125,44 @@ def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
         acc[i, 0] += cx
         acc[i, 1] += cy
         acc[i, 2] += cz
+
+
+@njit(cache=True)
+def lense_thirring(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """The Lense-Thirring (gravitomagnetic) field of one rotating body, ADDED to ``acc``.
+
+    ``p = [b, c, gamma, Jx, Jy, Jz]``: ``J`` the body's spin angular momentum per unit
+    mass (length^2/time).  With ``d``, ``w`` a body's position and velocity relative
+    to ``b`` and ``mu = gm[b]`` (IERS Conventions 2010, eq. 10.12),
+
+        a = (1 + gamma) mu / (c^2 |d|^3) [3 / |d|^2 (d x w)(d . J) + w x J];
+
+    ``b`` receives ``-(gm_i / mu) a``.
+    """
+    b = int(p[0])
+    f0 = (1.0 + p[2]) * gm[b] / (p[1] * p[1])
+    jx = p[3]
+    jy = p[4]
+    jz = p[5]
+    for i in range(r.shape[0]):
+        if i == b:
+            continue
+        dx = r[i, 0] - r[b, 0]
+        dy = r[i, 1] - r[b, 1]
+        dz = r[i, 2] - r[b, 2]
+        wx = v[i, 0] - v[b, 0]
+        wy = v[i, 1] - v[b, 1]
+        wz = v[i, 2] - v[b, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        f = f0 / (d2 * np.sqrt(d2))
+        g = 3.0 * (dx * jx + dy * jy + dz * jz) / d2
+        ax = f * (g * (dy * wz - dz * wy) + (wy * jz - wz * jy))
+        ay = f * (g * (dz * wx - dx * wz) + (wz * jx - wx * jz))
+        az = f * (g * (dx * wy - dy * wx) + (wx * jy - wy * jx))
+        back = gm[i] / gm[b]
+        acc[i, 0] += ax
+        acc[i, 1] += ay
+        acc[i, 2] += az
+        acc[b, 0] -= back * ax
+        acc[b, 1] -= back * ay
+        acc[b, 2] -= back * az
