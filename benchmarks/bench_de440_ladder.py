@@ -35,15 +35,21 @@ SHORT = {"earth-moon-barycenter": "EMB"}
 
 
 def run(years: int, repeat: int) -> list[ladder.RungResult]:
+    """Every rung ``repeat`` times, the repeats interleaved (all rungs, then all
+    again) so that a change of load on the shared machine falls on every rung."""
+    runs: dict[str, list[ladder.RungResult]] = {r.name: [] for r in ladder.RUNGS}
+    for k in range(repeat):
+        for rung in ladder.RUNGS:
+            res = ladder.run_rung(rung, years)
+            runs[rung.name].append(res)
+            print(f"  [{k + 1}/{repeat}] {rung.name:10s} {res.wall_time:6.2f} s  "
+                  f"{res.steps} steps", flush=True)
     out = []
     for rung in ladder.RUNGS:
-        runs = [ladder.run_rung(rung, years) for _ in range(repeat)]
-        walls = sorted(r.wall_time for r in runs)
-        best = runs[0]
-        out.append(ladder.RungResult(best.rung, best.years, best.names, best.km, best.arcsec,
-                                     walls[len(walls) // 2], best.steps))
-        print(f"  {rung.name:10s} {walls[len(walls) // 2]:6.2f} s  {best.steps} steps",
-              flush=True)
+        first = runs[rung.name][0]
+        walls = sorted(r.wall_time for r in runs[rung.name])
+        out.append(ladder.RungResult(first.rung, first.years, first.names, first.km,
+                                     first.arcsec, walls[len(walls) // 2], first.steps))
     return out
 
 
