@@ -66,7 +66,8 @@ def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     to ``acc``.  ``p = [c, beta, gamma, j_1, j_2, ...]`` (c in the system's units of
     speed): the post-Newtonian terms of the sources ``j_1, j_2, ...`` (every massive
     body when none is given); every other massive body acts by Newton's law alone,
-    on every body."""
+    on every body.  One pass over the pairs for the Newtonian sums, one for the
+    corrections (both directions of a pair at once)."""
     ic2 = 1.0 / (p[0] * p[0])
     beta = p[1]
     gamma = p[2]
@@ -75,56 +76,69 @@ def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     phi = np.empty(n)
     inv_d = np.empty((n, n))
     newtonian_and_potential(r, gm, acc_n, phi, inv_d)
+    src = np.zeros(n, dtype=np.bool_)
+    if p.shape[0] > 3:
+        for b in range(3, p.shape[0]):
+            src[int(p[b])] = True
+    else:
+        for b in range(n):
+            src[b] = True
     for i in range(n):
-        acc[i, 0] += acc_n[i, 0]
-        acc[i, 1] += acc_n[i, 1]
-        acc[i, 2] += acc_n[i, 2]
-    k_phi_i = 2.0 * (beta + gamma)
-    k_phi_j = 2.0 * beta - 1.0
-    k_vj = 1.0 + gamma
-    k_vivj = 2.0 * (1.0 + gamma)
-    k_wi = 2.0 + 2.0 * gamma
-    k_wj = 1.0 + 2.0 * gamma
-    k_aj = 0.5 * (3.0 + 4.0 * gamma)
-    n_src = p.shape[0] - 3 if p.shape[0] > 3 else n
-    src = np.empty(n_src, dtype=np.int64)
-    for b in range(n_src):
-        src[b] = int(p[3 + b]) if p.shape[0] > 3 else b
+        if gm[i] == 0.0:
+            src[i] = False
+    k = np.empty(7)
+    k[0] = 2.0 * (beta + gamma) * ic2  # phi of the receiver
+    k[1] = (2.0 * beta - 1.0) * ic2  # phi of the source
+    k[2] = gamma * ic2  # v_receiver^2
+    k[3] = (1.0 + gamma) * ic2  # v_source^2
+    k[4] = 2.0 * (1.0 + gamma) * ic2  # v_i . v_j
+    k[5] = 2.0 + 2.0 * gamma  # (2 + 2 gamma) v_receiver - (1 + 2 gamma) v_source
+    k[6] = 1.0 + 2.0 * gamma
+    k_aj = 0.5 * (3.0 + 4.0 * gamma) * ic2
+    corr = np.zeros((n, 3))
     for i in range(n):
-        vix = v[i, 0]
-        viy = v[i, 1]
-        viz = v[i, 2]
-        vi2 = vix * vix + viy * viy + viz * viz
-        cx = 0.0
-        cy = 0.0
-        cz = 0.0
-        for b in range(n_src):
-            j = src[b]
-            if j == i or gm[j] == 0.0:
+        for j in range(i + 1, n):
+            if not (src[i] or src[j]):
                 continue
+            inv = inv_d[i, j]
             dx = r[j, 0] - r[i, 0]  # r_j - r_i
             dy = r[j, 1] - r[i, 1]
             dz = r[j, 2] - r[i, 2]
-            inv = inv_d[i, j]
-            f = gm[j] * inv * inv * inv
-            vjx = v[j, 0]
-            vjy = v[j, 1]
-            vjz = v[j, 2]
-            vj2 = vjx * vjx + vjy * vjy + vjz * vjz
-            vivj = vix * vjx + viy * vjy + viz * vjz
-            rvj = (dx * vjx + dy * vjy + dz * vjz) * inv  # -(r_i - r_j) . v_j / r_ij
-            raj = dx * acc_n[j, 0] + dy * acc_n[j, 1] + dz * acc_n[j, 2]
-            bracket = (-k_phi_i * phi[i] - k_phi_j * phi[j] + gamma * vi2 + k_vj * vj2
-                       - k_vivj * vivj - 1.5 * rvj * rvj + 0.5 * raj) * ic2
-            s = -(dx * (k_wi * vix - k_wj * vjx) + dy * (k_wi * viy - k_wj * vjy)
-                  + dz * (k_wi * viz - k_wj * vjz)) * f * ic2
-            g = k_aj * gm[j] * inv * ic2
-            cx += f * bracket * dx + s * (vix - vjx) + g * acc_n[j, 0]
-            cy += f * bracket * dy + s * (viy - vjy) + g * acc_n[j, 1]
-            cz += f * bracket * dz + s * (viz - vjz) + g * acc_n[j, 2]
-        acc[i, 0] += cx
-        acc[i, 1] += cy
-        acc[i, 2] += cz
+            vi2 = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1] + v[i, 2] * v[i, 2]
+            vj2 = v[j, 0] * v[j, 0] + v[j, 1] * v[j, 1] + v[j, 2] * v[j, 2]
+            vivj = v[i, 0] * v[j, 0] + v[i, 1] * v[j, 1] + v[i, 2] * v[j, 2]
+            dvi = dx * v[i, 0] + dy * v[i, 1] + dz * v[i, 2]
+            dvj = dx * v[j, 0] + dy * v[j, 1] + dz * v[j, 2]
+            common = -k[4] * vivj
+            inv3 = inv * inv * inv
+            if src[j]:  # j acts on i
+                f = gm[j] * inv3
+                rv = dvj * inv
+                bracket = (-k[0] * phi[i] - k[1] * phi[j] + k[2] * vi2 + k[3] * vj2 + common
+                           - 1.5 * ic2 * rv * rv
+                           + 0.5 * ic2 * (dx * acc_n[j, 0] + dy * acc_n[j, 1] + dz * acc_n[j, 2]))
+                sv = -(k[5] * dvi - k[6] * dvj) * f * ic2
+                g = k_aj * gm[j] * inv
+                fb = f * bracket
+                corr[i, 0] += fb * dx + sv * (v[i, 0] - v[j, 0]) + g * acc_n[j, 0]
+                corr[i, 1] += fb * dy + sv * (v[i, 1] - v[j, 1]) + g * acc_n[j, 1]
+                corr[i, 2] += fb * dz + sv * (v[i, 2] - v[j, 2]) + g * acc_n[j, 2]
+            if src[i]:  # i acts on j: the same with r_i - r_j = -d
+                f = gm[i] * inv3
+                rv = dvi * inv
+                bracket = (-k[0] * phi[j] - k[1] * phi[i] + k[2] * vj2 + k[3] * vi2 + common
+                           - 1.5 * ic2 * rv * rv
+                           - 0.5 * ic2 * (dx * acc_n[i, 0] + dy * acc_n[i, 1] + dz * acc_n[i, 2]))
+                sv = (k[5] * dvj - k[6] * dvi) * f * ic2
+                g = k_aj * gm[i] * inv
+                fb = -f * bracket
+                corr[j, 0] += fb * dx + sv * (v[j, 0] - v[i, 0]) + g * acc_n[i, 0]
+                corr[j, 1] += fb * dy + sv * (v[j, 1] - v[i, 1]) + g * acc_n[i, 1]
+                corr[j, 2] += fb * dz + sv * (v[j, 2] - v[i, 2]) + g * acc_n[i, 2]
+    for i in range(n):
+        acc[i, 0] += acc_n[i, 0] + corr[i, 0]
+        acc[i, 1] += acc_n[i, 1] + corr[i, 1]
+        acc[i, 2] += acc_n[i, 2] + corr[i, 2]
 
 
 @njit(cache=True)
