@@ -29,8 +29,9 @@ The Sun's J2 is the existing ``j2`` effect (``{"name": "j2", "body": "sun"}``):
 
 Parameters that name bodies take their names; defaults need a DE440 system
 (:meth:`~hamilton_orbits.nbody.System.from_ephemeris`, Quantity units au, day).
-Effects that need the ecliptic take ``frame`` (``"icrs"``, default, or
-``"ecliptic"``): the frame of the system's axes.
+Effects that need the ecliptic or the Sun's pole take ``frame`` (``"icrs"`` or
+``"ecliptic"``), the frame of the system's axes; by default it is recognised from
+the Sun's pole that ``from_ephemeris`` sets, else ``"icrs"``.
 
 References
 ----------
@@ -114,8 +115,17 @@ def _unit_vector(name: str, value: Any, effect: str) -> np.ndarray:
     return k / norm
 
 
-def _frame(params: Mapping[str, Any], effect: str) -> str:
-    frame = params.get("frame", "icrs")
+def _frame(system: Any, params: Mapping[str, Any], effect: str) -> str:
+    """The frame of the system's axes: ``params["frame"]``, else recognised from the
+    Sun's pole that :meth:`System.from_ephemeris` sets (IAU pole in that frame), else
+    ``"icrs"``."""
+    frame = params.get("frame")
+    if frame is None:
+        frame = "icrs"
+        if "sun" in system.names and system["sun"].pole is not None:
+            pole = np.array(system["sun"].pole)
+            if np.allclose(pole, de.sun_pole("ecliptic"), rtol=0, atol=1e-12):
+                frame = "ecliptic"
     if frame not in ("icrs", "ecliptic"):
         raise ValueError(f"Effect {effect!r}: expected `frame` 'icrs' or 'ecliptic', "
                          f"got {frame!r}")
@@ -152,7 +162,7 @@ def _pole(system: Any, b: int, params: Mapping[str, Any], effect: str) -> np.nda
     pole = system.bodies[b].pole
     if pole is not None:
         return np.array(pole)
-    return de.frame_rotation(_frame(params, effect)) @ [0.0, 0.0, 1.0]
+    return de.frame_rotation(_frame(system, params, effect)) @ [0.0, 0.0, 1.0]
 
 
 def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
@@ -178,7 +188,7 @@ def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     j2 = float(params.get("j2", de.constant("J2M")))
     c22 = float(params.get("c22", de.constant("C22M")))
     inc = np.deg2rad(float(params.get("inclination_deg", MOON_EQUATOR_INCLINATION_DEG)))
-    pole = de.ecliptic_pole(_frame(params, "moon_figure"))
+    pole = de.ecliptic_pole(_frame(system, params, "moon_figure"))
     return np.array([m, e, radius, j2, c22, *pole, inc])
 
 
@@ -219,7 +229,7 @@ def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
         raise ValueError(f"Effect 'kuiper_ring': expected gm >= 0 and radius > 0, got "
                          f"{big_m!r}, {radius!r}")
     normal = (_unit_vector("normal", params["normal"], "kuiper_ring") if "normal" in params
-              else de.ecliptic_pole(_frame(params, "kuiper_ring")))
+              else de.ecliptic_pole(_frame(system, params, "kuiper_ring")))
     return np.array([b, big_m, radius, *normal])
 
 
@@ -245,7 +255,7 @@ def _params_lense_thirring(system: Any, params: Mapping[str, Any]) -> np.ndarray
     if system.names[b] != "sun" and "spin" not in params:
         raise ValueError("Effect 'lense_thirring': a body other than the Sun needs `spin`")
     spin = (_floats("spin", params["spin"], 3, "lense_thirring") if "spin" in params
-            else sun_spin(_frame(params, "lense_thirring")))
+            else sun_spin(_frame(system, params, "lense_thirring")))
     c = float(params.get("c", _c_au_per_day()))
     gamma = float(params.get("gamma", de.constant("GAMMA")))
     return np.array([b, c, gamma, *spin])
@@ -273,7 +283,7 @@ SPECS: tuple[dict[str, Any], ...] = (
                        "spin": "angular momentum per unit mass (default DE440's "
                                "MOISUN ASUN^2 OMGSUN about the IAU pole)",
                        "c": "default DE440's CLIGHT", "gamma": "default DE440's GAMMA",
-                       "frame": "'icrs' (default) or 'ecliptic': the system's axes"},
+                       "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
         "kernel": _relativity.lense_thirring, "params": _params_lense_thirring,
         "reference": f"IERS Conventions (2010), eq. 10.12; {_PARK}",
     },
@@ -297,7 +307,7 @@ SPECS: tuple[dict[str, Any], ...] = (
                        "radius": "default DE440's AM", "j2": "default DE440's J2M",
                        "c22": "default DE440's C22M",
                        "inclination_deg": "lunar equator to ecliptic (default 1.5424)",
-                       "frame": "'icrs' (default) or 'ecliptic': the system's axes"},
+                       "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
         "kernel": _figures.moon_figure, "params": _params_moon_figure,
         "reference": f"Folkner et al. (2014), IPN PR 42-196, eq. 28; {_PARK}",
     },
@@ -320,7 +330,7 @@ SPECS: tuple[dict[str, Any], ...] = (
         "summary": "the Kuiper belt as DE440's ring (44 au, ecliptic, centred on the Sun)",
         "parameters": {"centre": "default 'sun'", "gm": "default DE440's 36 ring masses",
                        "radius": "default 44 au", "normal": "default the ecliptic pole",
-                       "frame": "'icrs' (default) or 'ecliptic': the system's axes"},
+                       "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
         "kernel": _figures.ring_field, "params": _params_kuiper_ring,
         "reference": f"{_PARK}, section 3 (ring masses MA8201..MA8236)",
     },

@@ -219,8 +219,13 @@ def ecliptic_pole(frame: str = "icrs") -> np.ndarray:
     --------
     >>> ecliptic_pole("ecliptic")
     array([0., 0., 1.])
+    >>> bool(np.allclose(ecliptic_pole("icrs"), [0.0, -0.3977771559, 0.9174820621]))
+    True
     """
-    return frame_rotation(frame).T[:, 2] if frame == "icrs" else np.array([0.0, 0.0, 1.0])
+    if frame == "ecliptic":
+        return np.array([0.0, 0.0, 1.0])
+    # the third row of the ICRS -> ecliptic rotation: the ecliptic z axis in ICRS
+    return frame_rotation(frame) @ frame_rotation("ecliptic")[2]
 
 
 def sun_pole(frame: str = "icrs") -> np.ndarray:

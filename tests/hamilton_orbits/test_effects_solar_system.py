@@ -364,3 +364,29 @@ def test_plain_float_system_needs_its_units():
         s.accelerations(["eih"])
     with pytest.raises(ValueError, match=r"radius, omega, tau"):
         s.accelerations(["earth_tides"])
+
+
+def test_every_effect_is_the_same_in_the_ecliptic_frame():
+    """Each DE440 effect in ecliptic axes is the ICRS one rotated (kernel by kernel,
+    to rounding): the ecliptic pole, the Sun's pole and spin and the Earth's pole
+    follow the system's frame (recognised from the Sun's pole that from_ephemeris
+    sets).  This caught an ecliptic pole given in the wrong frame."""
+    rot = de.frame_rotation("ecliptic")
+    systems = {f: System.from_ephemeris(frame=f) for f in ("icrs", "ecliptic")}
+    for name, params in (("eih", {}), ("j2", {"body": "sun"}), ("lense_thirring", {}),
+                         ("zonal", {}), ("moon_figure", {}), ("earth_tides", {}),
+                         ("kuiper_ring", {})):
+        spec = fx.get("nbody", name)
+        out = {}
+        for frame, s in systems.items():
+            r = np.ascontiguousarray(s.r.to_value(u.au))
+            v = np.ascontiguousarray(s.v.to_value(u.au / u.day))
+            acc = np.zeros_like(r)
+            spec.kernel(r, v, s.gm.to_value(u.au**3 / u.day**2), acc, spec.params(s, params))
+            out[frame] = acc
+        scale = np.abs(out["icrs"]).max()
+        assert np.abs(out["ecliptic"] - out["icrs"] @ rot.T).max() < 1e-12 * scale, name
+    # the ecliptic pole in ICRS axes is (0, -sin eps, cos eps)
+    p = fx.get("nbody", "kuiper_ring").params(systems["icrs"], {})
+    eps = np.deg2rad(84381.406 / 3600)
+    assert np.allclose(p[3:], [0.0, -np.sin(eps), np.cos(eps)], rtol=0, atol=1e-15)
