@@ -197,7 +197,7 @@ def entry_problems(item: Any, kind: str = "nbody") -> tuple[str | None, dict, li
     >>> entry_problems({"name": "j2", "bdy": "earth"})[2]  # doctest: +ELLIPSIS
     [('bdy', "unknown parameter of effect 'j2' (did you mean 'body'?); it takes: body, ...")]
     >>> entry_problems("grr")[2]  # doctest: +ELLIPSIS
-    [('name', "unknown effect 'grr' (did you mean 'gr'...?); known: gr, gr_potential, ...")]
+    [('name', "unknown effect 'grr' (did you mean 'gr'...?); known: ...gr, gr_potential, ...")]
     """
     import difflib
 
@@ -579,3 +579,7 @@ register(
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )
+
+from hamilton_orbits.effects_solar_system import SPECS as _SOLAR_SYSTEM  # noqa: E402
+
+_ = [register(EffectSpec(**spec)) for spec in _SOLAR_SYSTEM]  # eih, zonal, tides, ... (DE440)

