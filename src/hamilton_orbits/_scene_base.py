@@ -119,6 +119,11 @@ class Result:
         Seconds the simulation took.
     complete : bool
         False if the run was stopped early (Ctrl-C); what was done is kept.
+    frame : str
+        The axes of the states (and their origin), named in the summary.
+    compile_time : float
+        Seconds spent compiling kernels during the run (numba's compile events;
+        0 when everything came from the cache), apart from ``wall_time``.
     """
 
     scene: Any
@@ -129,6 +134,8 @@ class Result:
     states: dict[str, Any] = field(default_factory=dict)
     wall_time: float = 0.0
     complete: bool = True
+    frame: str = ""
+    compile_time: float = 0.0
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
                                                                 repr=False)
@@ -139,6 +146,8 @@ class Result:
         lines = [f"scene {s.name} ({s.kind}): {s.spec.get('description', '').strip()}"]
         effects = ", ".join(e["name"] for e in s.effects) or "none"
         lines.append(f"effects: {effects}")
+        if self.frame:
+            lines.append(f"frame: {self.frame}")
         if not self.complete:
             lines.append("STOPPED EARLY: the results cover the part that was run")
         span = self.times[-1] - self.times[0] if len(self.times) else 0 * u.d
@@ -188,7 +197,9 @@ class Result:
             "description": self.scene.spec.get("description", ""),
             "effects": [dict(e) for e in self.scene.effects],
             "complete": self.complete,
+            "frame": self.frame,
             "wall_time_s": self.wall_time,
+            "compile_time_s": self.compile_time,
             "metrics": {k: conv(v) for k, v in self.metrics.items()},
             "tables": {k: [{c: conv(x) for c, x in r.items()} for r in rows]
                        for k, rows in self.tables.items()},

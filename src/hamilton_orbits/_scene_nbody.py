@@ -18,6 +18,7 @@ import numpy as np
 from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
 from hamilton_orbits._scene_base import Result, SceneKind, format_table, register_kind
+from hamilton_orbits.frames import FRAMES, frame_label
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
 
 METHODS = ("radau15", "wh", "leapfrog", "dop853")
@@ -79,10 +80,13 @@ SCHEMA: dict[str, S.Field] = {
                 fields={
                     "epoch": S.String(default="J2000"),
                     "bodies": S.Array(item=S.Choice(choices=SOLAR_SYSTEM)),
+                    "origin": S.Choice(choices=("barycentre", "ssb"), default="barycentre"),
                 }
             ),
             "rebound": S.String(),
             "names": S.Array(item=S.String()),
+            # the axes of every state and element of the scene (hamilton_orbits.frames)
+            "frame": S.Choice(choices=tuple(FRAMES), default="icrs"),
         },
     ),
     "bodies": S.Array(item=BODY, default=[]),
@@ -251,7 +255,9 @@ def build_system(spec: dict):
     ss = init.get("solar_system")
     if ss is not None:
         epoch = Time(ss["epoch"], scale="tdb")
-        base = System.solar_system(epoch, bodies=list(ss.get("bodies") or _DEFAULT_SOLAR))
+        base = System.solar_system(epoch, bodies=list(ss.get("bodies") or _DEFAULT_SOLAR),
+                                   frame=scene_frame(spec),
+                                   origin=ss.get("origin") or "barycentre")
         bodies += [base[n] for n in base.names]
     by_name = {b.name: b for b in bodies}
     for b in spec["bodies"]:
@@ -276,6 +282,24 @@ def build_system(spec: dict):
         bodies.append(body)
         by_name[body.name] = body
     return System(bodies)
+
+
+def scene_frame(spec: dict) -> str:
+    """The frame of a validated n-body scene's states (``[initial] frame``)."""
+    return spec["initial"].get("frame") or "icrs"
+
+
+def frame_note(spec: dict) -> str:
+    """The frame line of a scene's summary: the axes, and the origin of the
+    solar-system bodies."""
+    note = frame_label(scene_frame(spec))
+    ss = spec["initial"].get("solar_system")
+    if ss is not None:
+        origin = ss.get("origin") or "barycentre"
+        note += ("; origin: the centre of mass of the scene's solar-system bodies, at rest"
+                 if origin == "barycentre" else
+                 "; origin: the solar-system barycentre (the ephemeris's)")
+    return note
 
 
 def _times(spec: dict) -> u.Quantity:
@@ -360,7 +384,10 @@ def _result(scene: Any, system, out, method: str, effects) -> Result:
     if effects:
         label = "max |dE/E| of the Newtonian energy (effects do not conserve it)"
     result.metrics[label] = float(np.max(np.abs(energy)))
-    result.plotters.append(_plot_orbits)
+    gm = system.as_arrays().gm.copy()
+    frame = scene_frame(scene.spec)
+    result.frame = frame_note(scene.spec)
+    result.plotters.append(lambda res: _plot_orbits(res, gm, frame))
     result.plotters.append(_plot_energy)
     final = system.with_state(out.r[-1], out.v[-1])
 
@@ -478,18 +505,141 @@ def _crosscheck_into(result: Result, system, out, method: str, effects) -> None:
         table.relative_position_difference.max())
 
 
-def _plot_orbits(result: Result):
+def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any]:
+    """What the orbit figure draws: positions relative to the primary (the most
+    massive body), in km below 0.01 au of extent and au above, and the bodies of an
+    inner panel (those inside the largest gap, by a factor 2.5 or more, in the
+    bodies' largest distances from the primary, when the outermost is 5 times
+    farther).
+
+    Parameters
+    ----------
+    names : list of str, (n,)
+    gm : ndarray, (n,)
+    r : ndarray, (n_t, n, 3)
+        Positions in au.
+
+    Examples
+    --------
+    >>> r = np.zeros((2, 3, 3)); r[:, 1, 0] = 1.0; r[:, 2, 0] = 30.0
+    >>> view = orbit_view(["sun", "earth", "neptune"], np.array([1.0, 3e-6, 5e-5]), r)
+    >>> view["primary"], view["unit"], view["inner"]
+    ('sun', 'au', ['earth'])
+    """
+    k = int(np.argmax(gm))
+    rel = r - r[:, k:k + 1]
+    reach = np.linalg.norm(rel, axis=-1).max(axis=0)
+    others = [i for i in range(len(names)) if i != k]
+    unit = "au" if reach.max(initial=0.0) > 0.01 else "km"
+    scale = 1.0 if unit == "au" else (1 * u.au).to_value(u.km)
+    inner: list[str] = []
+    if len(others) > 1:
+        order = sorted(others, key=lambda i: reach[i])
+        dist = np.maximum(reach[order], 1e-300)
+        ratios = dist[1:] / dist[:-1]
+        cut = int(np.argmax(ratios))
+        if ratios[cut] >= 2.5 and dist[-1] >= 5 * dist[cut]:
+            inner = [names[i] for i in order[:cut + 1]]
+    return {"primary": names[k], "rel": rel * scale, "unit": unit, "inner": inner,
+            "reach": reach * scale, "scale": scale, "index": k}
+
+
+def _coarse(cadence: float, r: np.ndarray, v: np.ndarray, mu: float) -> bool:
+    """True if the outputs are more than a 36th of the two-body period apart (10
+    degrees of mean anomaly: a line would draw chords, or, at a cadence near the
+    period, a short stroke where the orbit is): then dots are drawn."""
+    energy = 0.5 * float(v @ v) - mu / float(np.linalg.norm(r))
+    if not energy < 0:
+        return False
+    period = 2 * np.pi * np.sqrt((-mu / (2 * energy)) ** 3 / mu)
+    return bool(cadence > period / 36)
+
+
+def axis_label(axis: str, unit: str, frame: str, primary: str) -> str:
+    """A position axis's label: the axis, the origin, the frame and the unit.
+
+    Examples
+    --------
+    >>> axis_label("x", "au", "ecliptic", "sun")
+    'x from sun, J2000 mean ecliptic and equinox [au]'
+    """
+    return f"{axis} from {primary}, {frame_label(frame)} [{unit}]"
+
+
+def osculating_ellipse(r: np.ndarray, v: np.ndarray, mu: float, n: int = 361
+                       ) -> np.ndarray | None:
+    """Points of the two-body ellipse through the state ``r``, ``v`` (relative to the
+    primary, ``mu`` = G (m_primary + m)), shape (n, 3); None unless 0 <= e < 0.95.
+
+    ``r(E) = a (cos E - e) P + a sqrt(1 - e^2) sin E Q`` with ``P`` towards the
+    periapsis (the modern eccentricity vector) and ``Q = h x P / |h|``.
+
+    Examples
+    --------
+    >>> pts = osculating_ellipse(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), 1.0, 5)
+    >>> np.round(pts[:, :2], 12).tolist()
+    [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [-0.0, -1.0], [1.0, -0.0]]
+    """
+    h = np.cross(r, v)
+    dist = float(np.linalg.norm(r))
+    ecc = np.cross(v, h) / mu - r / dist
+    e = float(np.linalg.norm(ecc))
+    energy = 0.5 * float(v @ v) - mu / dist
+    if not (energy < 0 and e < 0.95 and np.linalg.norm(h) > 0):
+        return None
+    a = -mu / (2 * energy)
+    p_hat = ecc / e if e > 1e-12 else r / dist
+    q_hat = np.cross(h, p_hat) / np.linalg.norm(h)
+    big_e = np.linspace(0.0, 2 * np.pi, n)[:, None]
+    return a * (np.cos(big_e) - e) * p_hat + a * np.sqrt(1 - e * e) * np.sin(big_e) * q_hat
+
+
+def _draw_orbits(ax: Any, view: dict, names: list[str], frame: str) -> None:
+    primary = view["primary"]
+    for k, name in enumerate(view["names"]):
+        if name not in names or name == primary:
+            continue
+        xy = view["rel"][:, k, :2]
+        if not _coarse(view["cadence"], view["rel0"][k], view["vrel0"][k], view["mu"][k]):
+            ax.plot(xy[:, 0], xy[:, 1], lw=0.7, label=name)
+            continue
+        # outputs too far apart for a line: a dot per output, and the osculating
+        # two-body orbit of the first output as a thin line to read them against
+        (dots,) = ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.2, label=f"{name} (dots: outputs)")
+        ellipse = osculating_ellipse(view["rel0"][k], view["vrel0"][k], view["mu"][k])
+        if ellipse is not None:
+            ax.plot(ellipse[:, 0], ellipse[:, 1], lw=0.4, color=dots.get_color(), alpha=0.8)
+    ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
+            label=f"{primary} (origin)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
+    ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
+    ax.legend(fontsize=6, loc="upper right", framealpha=0.7)
+
+
+def _plot_orbits(result: Result, gm: np.ndarray, frame: str):
+    """The orbits about the primary, projected on the frame's x-y plane; an inner
+    panel where the inner bodies would be a blob beside the outer ones."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 6))
-    r = result.states["r"].to_value(u.au)
-    for k, name in enumerate(result.states["names"]):
-        ax.plot(r[:, k, 0], r[:, k, 1], lw=0.6, label=name)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [au]")
-    ax.set_ylabel("y [au]")
-    ax.set_title(f"{result.scene.name}: orbits")
-    ax.legend(fontsize=7, loc="upper right")
+    names = list(result.states["names"])
+    view = orbit_view(names, gm, result.states["r"].to_value(u.au))
+    view["names"] = names
+    k = view["index"]
+    v0 = result.states["v"][0].to_value(u.au / u.d)
+    view["rel0"] = view["rel"][0]  # in the figure's unit; velocities and mu to match
+    view["vrel0"] = (v0 - v0[k]) * view["scale"]
+    view["mu"] = (gm + gm[k]) * view["scale"] ** 3
+    view["cadence"] = float(np.median(np.diff(result.times.to_value(u.d))))
+    panels = [names] + ([view["inner"]] if view["inner"] else [])
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 6.2), squeeze=False)
+    for ax, shown in zip(axes[0], panels, strict=True):
+        _draw_orbits(ax, view, shown, frame)
+    axes[0, 0].set_title(f"{result.scene.name}: orbits about {view['primary']}, "
+                         f"projected on the frame's x-y plane", fontsize=10)
+    if view["inner"]:
+        axes[0, 1].set_title(f"inner bodies: {', '.join(view['inner'])}", fontsize=10)
+    fig.tight_layout()
     fig._hamilton_name = "orbits"
     return fig
 

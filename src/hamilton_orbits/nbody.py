@@ -39,6 +39,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.frames import check_frame, frame_rotation
 from hamilton_orbits.units import (
     DIMENSIONLESS,
     GM,
@@ -619,14 +620,23 @@ class System:
 
     # -------------------------------------------------------- solar system
     @classmethod
-    def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None) -> System:
+    def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None,
+                     frame: str = "icrs", origin: str = "barycentre") -> System:
         """The Sun and planets at ``epoch`` from astropy's built-in ephemeris (offline).
 
-        Positions and velocities are barycentric, ICRS axes (equatorial), from
+        Positions and velocities from
         ``astropy.coordinates.get_body_barycentric_posvel(..., ephemeris="builtin")``
         (the ERFA routines ``epv00`` and ``plan94``: no download, accuracy of order
         1e-7 au for the inner planets and worse for the outer ones, which is
-        ample for the dynamics but not an ephemeris).
+        ample for the dynamics but not an ephemeris), on the axes of ``frame``.
+
+        The origin: by default the chosen bodies' own centre of mass, at rest.
+        The ephemeris gives states about the solar-system barycentre, which is
+        the centre of mass of *all* the bodies; a subset of them (the Sun and
+        Mercury alone) has its centre of mass elsewhere and moving (for the Sun
+        and Mercury, at the Sun's barycentric 13 m/s: 0.3 au in 100 years), so
+        the whole subset would drift across the figures.  ``origin="ssb"`` keeps
+        the ephemeris's barycentric states as they are.
 
         GM values: the Sun's is the IAU 2015 nominal solar mass parameter (IAU 2015
         Resolution B3); the planets' are the system GMs (planet plus satellites) of
@@ -636,17 +646,30 @@ class System:
         ----------
         epoch : astropy.time.Time or str, optional
             The epoch (TDB); a string is read by ``Time(epoch, scale="tdb")``,
-            ``"J2000"`` (default) is 2000-01-01 12:00 TDB.
+            ``"J2000"`` (default) is 2000-01-01 12:00 TDB, ``"now"`` the present.
         bodies : sequence of str, optional
             Which bodies, from ``sun, mercury, venus, earth-moon-barycenter, earth, moon,
             mars, jupiter, saturn, uranus, neptune``; default the Sun, the planets with
             the Earth-Moon barycentre as one body.  Asking for ``"moon"`` (with
             ``"earth"``) gives the Earth and the Moon separately.
+        frame : {"icrs", "ecliptic"}, optional
+            The axes: the ICRS (equatorial; default) or the mean ecliptic and
+            equinox of J2000 (:mod:`hamilton_orbits.frames`; inclinations then
+            read as in tables of ecliptic elements: Mars 1.85 degrees).
+        origin : {"barycentre", "ssb"}, optional
+            ``"barycentre"`` (default): the chosen bodies' centre of mass at rest at
+            the origin; ``"ssb"``: the solar-system barycentre of the ephemeris.
 
         Returns
         -------
         System
             A Quantity system (au, day); the bodies' names are as asked.
+
+        Raises
+        ------
+        ValueError
+            For an unknown body, frame or origin, or an epoch that does not parse
+            (naming the argument and the value).
 
         References
         ----------
@@ -662,9 +685,16 @@ class System:
         >>> s = System.solar_system("J2000", bodies=["sun", "earth", "moon"])
         >>> 356000 < float(np.linalg.norm(s.r[2] - s.r[1]).to_value(u.km)) < 407000
         True
+        >>> pair = System.solar_system("J2000", bodies=["sun", "mercury"])
+        >>> bool(np.allclose(pair.barycentre()[1].to_value(u.au / u.d), 0.0, atol=1e-20))
+        True
+        >>> from hamilton_orbits import KeplerOrbit
+        >>> s = System.solar_system("J2000", bodies=["sun", "mars"], frame="ecliptic")
+        >>> mars = KeplerOrbit.from_state(s.r[1] - s.r[0], s.v[1] - s.v[0], s.gm.sum())
+        >>> print(f"{mars.inc.to(u.deg):.2f}")
+        1.85 deg
         """
         from astropy.coordinates import get_body_barycentric_posvel
-        from astropy.time import Time
 
         if bodies is None:
             bodies = DEFAULT_BODIES
@@ -678,23 +708,49 @@ class System:
             raise ValueError(
                 "Expected either 'earth-moon-barycenter' or 'earth' and 'moon', got both"
             )
-        if isinstance(epoch, Time):
-            t = epoch.tdb
-        elif isinstance(epoch, str) and epoch.upper() == "J2000":
-            t = Time("2000-01-01T12:00:00", scale="tdb")
-        else:
-            try:
-                t = Time(epoch, scale="tdb")
-            except ValueError as exc:
-                raise ValueError(f"Expected `epoch` to be a Time, got {epoch!r}") from exc
-        if not t.isscalar:
-            raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
-        out = []
-        for name in bodies:
+        rotation = frame_rotation(check_frame(frame))
+        if origin not in ("barycentre", "ssb"):
+            raise ValueError(f"Expected `origin` to be 'barycentre' or 'ssb', got {origin!r}")
+        t = _epoch(epoch)
+        gm = np.array([SOLAR_SYSTEM_GM[name] for name in bodies])
+        r = np.empty((len(bodies), 3))
+        v = np.empty_like(r)
+        for k, name in enumerate(bodies):
             pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
-            gm = SOLAR_SYSTEM_GM[name] * u.m**3 / u.s**2
-            out.append(Body(name, gm=gm, r=pos.xyz.to(u.au), v=vel.xyz.to(u.au / u.day)))
-        return cls(out)
+            r[k] = pos.xyz.to_value(u.au)
+            v[k] = vel.xyz.to_value(u.au / u.day)
+        if origin == "barycentre":
+            r -= gm @ r / gm.sum()
+            v -= gm @ v / gm.sum()
+        r, v = r @ rotation.T, v @ rotation.T
+        return cls([Body(name, gm=gm[k] * u.m**3 / u.s**2, r=r[k] * u.au, v=v[k] * (u.au / u.day))
+                    for k, name in enumerate(bodies)])
+
+
+def _epoch(epoch: Any) -> Any:
+    """``epoch`` as one astropy Time (TDB); ValueError naming the value if it does not
+    parse."""
+    from astropy.time import Time
+
+    if isinstance(epoch, Time):
+        t = epoch.tdb
+    elif isinstance(epoch, str) and epoch.strip().upper() == "J2000":
+        t = Time("2000-01-01T12:00:00", scale="tdb")
+    elif isinstance(epoch, str) and epoch.strip().lower() == "now":
+        t = Time.now().tdb
+    else:
+        try:
+            t = Time(epoch, scale="tdb")
+        except ValueError as exc:
+            what = "the string did not parse as a date" if isinstance(epoch, str) else (
+                "expected an astropy Time or a date string")
+            raise ValueError(
+                f"`epoch` {epoch!r}: {what}; give e.g. \"J2000\", \"now\", \"2024-03-01\", "
+                "\"2024-03-01T12:00\" (TDB) or an astropy Time"
+            ) from exc
+    if not t.isscalar:
+        raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
+    return t
 
 
 # GM in m^3/s^2.  Sun: IAU 2015 Resolution B3 nominal (G M_sun)^N.  Planets: system GMs
