@@ -368,7 +368,9 @@ def _result(scene: Any, system, out, method: str, effects) -> Result:
     and the final state as a rebound binary."""
     from hamilton_orbits.nbody import integral_errors
 
-    energy, ang, drift = integral_errors(out.r, out.v, system.as_arrays().gm, out.t)
+    gm = system.as_arrays().gm.copy()
+    extra = _effects.effect_energy(system, effects, out.r, out.v)
+    energy, ang, drift = integral_errors(out.r, out.v, gm, out.t, extra)
     result = Result(
         scene=scene,
         times=out.t * u.d,
@@ -380,15 +382,15 @@ def _result(scene: Any, system, out, method: str, effects) -> Result:
     )
     result.metrics["integrator"] = method
     result.metrics["steps"] = out.steps
-    label = "max |relative energy error|"
-    if effects:
-        label = "max |dE/E| of the Newtonian energy (effects do not conserve it)"
-    result.metrics[label] = float(np.max(np.abs(energy)))
-    gm = system.as_arrays().gm.copy()
+    what = _effects.energy_label(gm, effects, system.names)
+    conserved = extra is not None
+    result.metrics["energy"] = what
+    key = "max |relative energy error|" if conserved else "max |relative energy change|"
+    result.metrics[key] = float(np.max(np.abs(energy)))
     frame = scene_frame(scene.spec)
     result.frame = frame_note(scene.spec)
     result.plotters.append(lambda res: _plot_orbits(res, gm, frame))
-    result.plotters.append(_plot_energy)
+    result.plotters.append(lambda res: _plot_energy(res, what, conserved))
     final = system.with_state(out.r[-1], out.v[-1])
 
     def write_rebound(_result: Result, folder: Path) -> list[Path]:
@@ -495,7 +497,7 @@ def _crosscheck_into(result: Result, system, out, method: str, effects) -> None:
     from hamilton_orbits import crosscheck
     from hamilton_orbits.simulation import make_trajectory
 
-    traj = make_trajectory(system, out, u.d, method, ("newtonian", *effects.names))
+    traj = make_trajectory(system, out, u.d, method, ("newtonian", *effects.names), effects)
     table = crosscheck(system, None, method=method, effects=effects, trajectory=traj)
     result.tables["cross-check against rebound: final position difference"] = table.rows
     result.tables["cross-check against rebound: codes"] = table.code_rows
@@ -644,23 +646,36 @@ def _plot_orbits(result: Result, gm: np.ndarray, frame: str):
     return fig
 
 
-def _plot_energy(result: Result):
+def _plot_energy(result: Result, what: str, conserved: bool):
+    """The relative energy error against time (log scale).  Exact zeros (the
+    energy came back bit for bit) have no place on a log axis: they are counted
+    in the legend, not drawn at an invented floor."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
-    t = result.times.to_value(u.yr)
-    err = np.abs(result.diagnostics["energy_error"])
-    floor = 1e-18  # an exact zero is drawn at the floor
-    ax.semilogy(t[1:], np.maximum(err[1:], floor), ".", ms=2, label="hamilton-orbits")
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    span = result.times[-1] - result.times[0]
+    t_unit = u.yr if span > 1 * u.yr else u.d
+    t = result.times.to_value(t_unit)
+    series = [("hamilton-orbits", result.diagnostics["energy_error"], {})]
     peer = result.diagnostics.get("rebound_energy_error")
     if peer is not None:
-        ax.semilogy(t[1:], np.maximum(np.abs(peer[1:]), floor), ".", ms=2, alpha=0.6,
-                    label="rebound IAS15")
-    ax.axhline(np.finfo(float).eps, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("time [yr]")
-    ax.set_ylabel("|relative energy error|")
-    ax.set_title(f"{result.scene.name}: energy error")
-    ax.legend()
+        series.append(("rebound IAS15", peer, {"alpha": 0.6}))
+    for label, values, style in series:
+        err = np.abs(np.asarray(values[1:], dtype=float))
+        nonzero = err > 0
+        zeros = int(np.count_nonzero(~nonzero))
+        note = f" ({zeros} of {len(err)} outputs exactly 0, not drawn)" if zeros else ""
+        ax.semilogy(t[1:][nonzero], err[nonzero], ".", ms=2, label=label + note, **style)
+    eps = np.finfo(float).eps
+    ax.axhline(eps, color="0.5", lw=0.7, ls=":", label=f"machine epsilon {eps:.1e}")
+    if not ax.has_data() or not np.any(np.abs(result.diagnostics["energy_error"]) > 0):
+        ax.set_ylim(eps / 100, eps * 100)
+    ax.set_xlabel(f"time since the start [{t_unit}]")
+    ax.set_ylabel("|relative energy error|" if conserved else "|relative energy change|")
+    title = "energy error" if conserved else "energy change (not an error: not conserved)"
+    ax.set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
     fig._hamilton_name = "energy_error"
     return fig
 

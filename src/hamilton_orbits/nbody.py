@@ -805,15 +805,31 @@ def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
 
 
 def integral_errors(
-    r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray
+    r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray,
+    extra_energy: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How well states ``r``, ``v`` (n_t, n, 3) at times ``t`` (n_t,) keep Hamilton's
     integrals, relative to the first state.
+
+    Parameters
+    ----------
+    r, v : ndarray, shape (n_t, n, 3)
+    gm : ndarray, shape (n,)
+    t : ndarray, shape (n_t,)
+    extra_energy : ndarray, shape (n_t, n), optional
+        The effects' part of each body's specific energy
+        (:func:`hamilton_orbits.effects.effect_energy`), added so that the energy
+        compared is the one the equations of motion keep.
 
     Returns
     -------
     energy_error : ndarray, (n_t,)
         ``(E(t) - E(0)) / |E(0)|``, vis viva (E); absolute where ``E(0) = 0``.
+        With one massive body and test particles, whose masses do not enter
+        Hamilton's E (it would be constant, and its error a meaningless 0), the
+        specific orbital energies of the test particles about the massive body,
+        ``w^2 / 2 - mu / d`` (plus ``extra_energy``), each relative to its own
+        start: at each time the one of largest magnitude.
     angular_momentum_error : ndarray, (n_t,)
         ``|L(t) - L(0)| / |L(0)|``, areas (D); absolute where ``L(0) = 0``.
     barycentre_drift : ndarray, (n_t,)
@@ -825,10 +841,13 @@ def integral_errors(
     >>> r = np.array([[[0.0, 0, 0], [1.0, 0, 0]]] * 2); v = np.zeros((2, 2, 3))
     >>> [x.tolist() for x in integral_errors(r, v, np.array([1.0, 1.0]), np.array([0.0, 1.0]))]
     [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    >>> v[1, 1, 1] = 2.0**-10  # a test particle that gained speed: its energy changed
+    >>> integral_errors(r, v, np.array([1.0, 0.0]), np.array([0.0, 1.0]))[0].tolist()
+    [0.0, 4.76837158203125e-07]
     """
     from hamilton_orbits.trajectory import relative_change
 
-    energy_error = relative_change(energy_gm_many(r, v, gm))
+    energy_error = _energy_error(r, v, gm, extra_energy)
     am_error = relative_change(np.einsum("j,tjk->tk", gm, np.cross(r, v)))
     total = gm.sum()
     rc = np.einsum("j,tjk->tk", gm, r) / total
@@ -836,6 +855,30 @@ def integral_errors(
     scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
     drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
     return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
+
+
+def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                  extra: np.ndarray | None) -> np.ndarray:
+    """The energy part of :func:`integral_errors`."""
+    from hamilton_orbits.trajectory import relative_change
+
+    massive = np.flatnonzero(gm > 0)
+    if len(massive) != 1 or len(gm) == 1:
+        energy = energy_gm_many(r, v, gm)
+        if extra is not None:
+            energy = energy + extra @ gm
+        return relative_change(energy)
+    s = int(massive[0])
+    tp = np.flatnonzero(gm == 0)
+    d = r[:, tp] - r[:, s:s + 1]
+    w = v[:, tp] - v[:, s:s + 1]
+    eps = 0.5 * np.einsum("tij,tij->ti", w, w) - gm[s] / np.sqrt(np.einsum("tij,tij->ti", d, d))
+    if extra is not None:
+        eps = eps + extra[:, tp]
+    scale = np.abs(eps[0])
+    change = (eps - eps[0]) / np.where(scale > 0, scale, 1.0)
+    pick = np.argmax(np.abs(change), axis=1)
+    return change[np.arange(len(change)), pick]
 
 
 def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:

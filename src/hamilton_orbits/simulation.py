@@ -16,7 +16,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
-from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, System, integral_errors
 from hamilton_orbits.rhs import compile_rhs
@@ -47,7 +47,10 @@ class Trajectory(TrajectoryBase):
     final : System
         The system at the last output time.
     energy_error : ndarray, shape (n_t,)
-        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)).
+        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
+        energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
+        massive body, the test particles' specific orbital energies about it
+        (:func:`~hamilton_orbits.nbody.integral_errors`).
     angular_momentum_error : ndarray, shape (n_t,)
         ``|L(t) - L(0)| / |L(0)|`` (law of areas, (D)); absolute if ``L(0) = 0``.
     barycentre_drift : ndarray, shape (n_t,)
@@ -208,7 +211,7 @@ def integrate(
                          options=options, on_output=report)
     if not out.complete:
         raise KeyboardInterrupt
-    return make_trajectory(system, out, unit, method, rhs.effects)
+    return make_trajectory(system, out, unit, method, rhs.effects, eff)
 
 
 def check_method(method: str, effects: Any, options: Mapping[str, Any]) -> EffectSet:
@@ -269,9 +272,11 @@ def _progress(enabled: bool, method: str, total: int, on_output: Any) -> Iterato
 
 
 def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: str,
-                    effects: tuple[str, ...]) -> Trajectory:
+                    effects: tuple[str, ...], effect_set: Any = None) -> Trajectory:
     """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
-    Quantity system, with times in ``unit``).
+    Quantity system, with times in ``unit``); ``effect_set`` (the
+    :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
+    the energy whose error is reported, where they keep one.
 
     Raises
     ------
@@ -286,7 +291,8 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
             f"{system.names[bad[1]]!r} at output {bad[0]} (t = {times[bad[0]]!r}): "
             "a collision or a step too long"
         )
-    ee, ae, bd = integral_errors(r, v, system.as_arrays().gm, times)
+    extra = effect_energy(system, effect_set, r, v) if effect_set else None
+    ee, ae, bd = integral_errors(r, v, system.as_arrays().gm, times, extra)
     final = system.with_state(r[-1], v[-1])
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)

@@ -139,3 +139,46 @@ def test_ssb_origin_keeps_the_ephemeris_states():
     # the relative state is the same
     np.testing.assert_allclose((ssb.r[1] - ssb.r[0]).value, (own.r[1] - own.r[0]).value,
                                rtol=1e-13)
+
+
+def test_energy_of_a_lone_test_particle_is_its_specific_energy():
+    """One massive body and a massless one: Hamilton's E does not see the particle,
+    so its error was 0 whatever the integrator did.  The test particle's specific
+    orbital energy shows a coarse leapfrog's error and radau15's rounding."""
+    from hamilton_orbits import Body, integrate
+
+    mu = 398600.4418 * u.km**3 / u.s**2
+    orbit = KeplerOrbit.from_elements(a=7000 * u.km, e=0.1, inc=0 * u.deg, lan=0 * u.deg,
+                                      argp=0 * u.deg, M=0 * u.deg, mu=mu)
+    r, v = orbit.state()
+    s = System([Body("earth", mu, [0, 0, 0] * u.km, [0, 0, 0] * u.km / u.s),
+                Body("sat", 0 * mu, r, v)])
+    coarse = integrate(s, 1 * u.d, method="leapfrog", dt=60 * u.s)
+    assert 1e-6 < np.abs(coarse.energy_error).max() < 1e-2
+    fine = integrate(s, 1 * u.d, method="radau15")
+    # 1e-13: rounding over 15 orbits (~1e-15 per orbit, as the other radau15 tests)
+    assert 0 < np.abs(fine.energy_error).max() < 1e-13
+
+
+def test_gr_energy_is_the_conserved_1pn_quantity(mercury):
+    """With gr the Newtonian energy changes by 1e-7 over an orbit; the energy with
+    the 1PN terms is kept to rounding (1e-13: 41 orbits of ~1e-15 each)."""
+    assert "1PN" in mercury.metrics["energy"]
+    assert mercury.metrics["max |relative energy error|"] < 1e-13
+    from hamilton_orbits.nbody import integral_errors
+
+    r = mercury.states["r"].to_value(u.au)
+    v = mercury.states["v"].to_value(u.au / u.d)
+    gm = System.solar_system("J2000", bodies=["sun", "mercury"]).as_arrays().gm
+    newtonian = integral_errors(r, v, gm, mercury.times.to_value(u.d))[0]
+    assert np.abs(newtonian).max() > 1e-8
+
+
+def test_energy_figure_draws_no_invented_floor_and_names_its_lines(mercury):
+    ax = _figure(mercury, "energy_error").axes[0]
+    ys = np.concatenate([line.get_ydata() for line in ax.get_lines()
+                         if line.get_linestyle() == "None"])
+    assert ys.min() > 1e-17  # exact zeros are counted, not drawn at 1e-18
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert any(label.startswith("machine epsilon") for label in labels)
+    assert "gr (1PN)" in ax.get_title()
