@@ -287,8 +287,20 @@ class Scene:
 
     # --- running ------------------------------------------------------
     def run(self, progress: bool = True, stop: Callable[[], bool] | None = None) -> Result:
-        """Simulate the scene; returns a :class:`Result`."""
-        return KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        """Simulate the scene; returns a :class:`Result`.
+
+        ``result.compile_time`` holds the seconds numba spent compiling kernels
+        during the run (the first run on a machine; 0 once they are cached), and
+        ``result.compile_count`` how many compilations; the kinds take that
+        compilation out of ``result.wall_time``, the integration proper.
+        """
+        from hamilton_orbits._firstrun import compile_count, compile_seconds
+
+        seconds, count = compile_seconds(), compile_count()
+        result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        result.compile_time = compile_seconds() - seconds
+        result.compile_count = compile_count() - count
+        return result
 
     def crosscheck(self) -> str:
         """The same scene in a peer code, the differences tabled (text)."""

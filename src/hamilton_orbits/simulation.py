@@ -8,6 +8,7 @@ the total angular momentum (law of areas) and of the energy (vis viva).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -16,6 +17,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
+from hamilton_orbits._firstrun import compile_seconds
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, System, integral_errors
@@ -59,8 +61,9 @@ class Trajectory(TrajectoryBase):
     steps : int
         Steps taken by the integrator.
     wall_time : float
-        Seconds of wall-clock time for the integration proper (the compilation
-        of a right-hand side for new effects and the checks are not counted).
+        Seconds of wall-clock time for the integration proper (the checks and
+        any numba compilation, of the right-hand side or of the stepping kernel
+        on its first call, are not counted).
     method : str
     effects : tuple of str
     """
@@ -207,8 +210,11 @@ def integrate(
     rhs = compile_rhs(system, eff)
     arrays = system.as_arrays()
     with _progress(progress, method, len(times) - 1, on_output) as report:
+        compiled = compile_seconds()
         out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
                          options=options, on_output=report)
+        compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
+    out = dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
     if not out.complete:
         raise KeyboardInterrupt
     return make_trajectory(system, out, unit, method, rhs.effects, eff)
