@@ -136,3 +136,19 @@ def _run_env(code: str, cache_dir: str, extra: dict) -> subprocess.CompletedProc
     env = dict(os.environ, PYTHONPATH=SRC, NUMBA_CACHE_DIR=cache_dir, **extra)
     return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                           text=True, timeout=900)
+
+
+def test_session_notice_when_numba_cache_is_cold(tmp_path, monkeypatch):
+    """tests/conftest.py says in one line that the first tests compile kernels."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "suite_conftest", Path(__file__).resolve().parents[1] / "conftest.py")
+    conftest = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conftest)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert conftest.numba_cache_cold()
+    nested = tmp_path / "some" / "path"
+    nested.mkdir(parents=True)
+    (nested / "radau15.step-42.py311.nbi").write_bytes(b"")
+    assert not conftest.numba_cache_cold()
