@@ -495,7 +495,11 @@ def _close_approach(result: Result, system, an: dict) -> None:
         orbits = _relative_orbits(result, system, an["body"], primary)
         for label, idx in (("before", 0), ("after", -1)):
             o = orbits[idx]
+            # 1/a too: it is continuous through the parabola (a jumps from +inf to
+            # -inf there, as a clone that escapes does), and q, finite for every conic
             result.metrics[f"{an['body']} orbit {label}: a"] = o.a.to(u.au)
+            result.metrics[f"{an['body']} orbit {label}: 1/a"] = (1 / o.a).to(1 / u.au)
+            result.metrics[f"{an['body']} orbit {label}: q"] = o.q.to(u.au)
             result.metrics[f"{an['body']} orbit {label}: e"] = float(o.e)
 
 
