@@ -182,3 +182,17 @@ def test_energy_figure_draws_no_invented_floor_and_names_its_lines(mercury):
     labels = [line.get_label() for line in ax.get_lines()]
     assert any(label.startswith("machine epsilon") for label in labels)
     assert "gr (1PN)" in ax.get_title()
+
+
+def test_rigid_earth_figure_shows_the_wobble_in_mas_and_years():
+    """The spin about the figure axis is 1e6 times the wobble: drawn in rad/s the
+    wobble was a flat line at 0, on an axis of seconds times 1e8."""
+    result = Scene.bundled("earth-pole-rigid").with_values({"duration": "3 yr"}).run(
+        progress=False)
+    top, bottom = _figure(result, "spin").axes
+    assert top.get_ylabel().endswith("[mas]") and "body" in top.get_ylabel()
+    assert bottom.get_xlabel().endswith("[yr]")
+    amplitude = max(np.abs(line.get_ydata()).max() for line in top.get_lines())
+    # the scene's 0.2 arcsec offset of the rotation axis from the figure axis
+    assert amplitude == pytest.approx(200.0, rel=0.01)
+    assert "principal axes" in result.summary()
