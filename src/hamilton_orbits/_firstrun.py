@@ -33,7 +33,7 @@ GENERATED_PREFIX = "hamilton_orbits_rhs_"
 
 _lock = threading.Lock()
 _state = {"printed": False}
-_clock = {"seconds": 0.0, "count": 0}
+_clock = {"seconds": 0.0, "count": 0, "claimed_seconds": 0.0, "claimed_count": 0}
 _local = threading.local()
 
 
@@ -84,6 +84,29 @@ def compile_seconds() -> float:
     True
     """
     return _clock["seconds"]
+
+
+def claim_compilation() -> tuple[float, int]:
+    """The compilation not claimed before: ``(seconds, count)`` since the last call
+    (or since the process started), then marked as claimed.
+
+    A scene's run claims it at its end, so that its summary reports the
+    compilation that its first run in a process really cost, including kernels
+    compiled when their module was imported (those with explicit signatures
+    compile at import, before the run starts), and a second run reports none.
+
+    Examples
+    --------
+    >>> _ = claim_compilation()
+    >>> claim_compilation()
+    (0.0, 0)
+    """
+    with _lock:
+        seconds = _clock["seconds"] - _clock["claimed_seconds"]
+        count = _clock["count"] - _clock["claimed_count"]
+        _clock["claimed_seconds"] = _clock["seconds"]
+        _clock["claimed_count"] = _clock["count"]
+    return seconds, count
 
 
 def compile_count() -> int:

@@ -290,16 +290,16 @@ class Scene:
         """Simulate the scene; returns a :class:`Result`.
 
         ``result.compile_time`` holds the seconds numba spent compiling kernels
-        during the run (the first run on a machine; 0 once they are cached), and
-        ``result.compile_count`` how many compilations; the kinds take that
-        compilation out of ``result.wall_time``, the integration proper.
+        for the run (the first run on a machine; 0 once they are cached): during
+        the run, and before it, since the previous run in the process, when the
+        kernels' modules were imported; ``result.compile_count`` how many
+        compilations.  The kinds take the compilation inside the integration out
+        of ``result.wall_time``, the integration proper.
         """
-        from hamilton_orbits._firstrun import compile_count, compile_seconds
+        from hamilton_orbits._firstrun import claim_compilation
 
-        seconds, count = compile_seconds(), compile_count()
         result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
-        result.compile_time = compile_seconds() - seconds
-        result.compile_count = compile_count() - count
+        result.compile_time, result.compile_count = claim_compilation()
         return result
 
     def crosscheck(self) -> str:
