@@ -625,7 +625,8 @@ def _draw_orbits(ax: Any, view: dict, names: list[str], frame: str) -> None:
             continue
         # outputs too far apart for a line: a dot per output, and the osculating
         # two-body orbit of the first output as a thin line to read them against
-        (dots,) = ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.2, label=f"{name} (dots: outputs)")
+        (dots,) = ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.2,
+                          label=f"{name} (a dot every {view['cadence_text']})")
         ellipse = osculating_ellipse(view["rel0"][k], view["vrel0"][k], view["mu"][k])
         if ellipse is not None:
             ax.plot(ellipse[:, 0], ellipse[:, 1], lw=0.4, color=dots.get_color(), alpha=0.8)
@@ -634,7 +635,8 @@ def _draw_orbits(ax: Any, view: dict, names: list[str], frame: str) -> None:
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
     ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
-    ax.legend(fontsize=6, loc="upper right", framealpha=0.7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
+              frameon=False)
 
 
 def _plot_orbits(result: Result, gm: np.ndarray, frame: str):
@@ -651,8 +653,11 @@ def _plot_orbits(result: Result, gm: np.ndarray, frame: str):
     view["vrel0"] = (v0 - v0[k]) * view["scale"]
     view["mu"] = (gm + gm[k]) * view["scale"] ** 3
     view["cadence"] = float(np.median(np.diff(result.times.to_value(u.d))))
+    cadence = view["cadence"] * u.d
+    unit = u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d else u.min
+    view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
     panels = [names] + ([view["inner"]] if view["inner"] else [])
-    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 6.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 7.2), squeeze=False)
     for ax, shown in zip(axes[0], panels, strict=True):
         _draw_orbits(ax, view, shown, frame)
     axes[0, 0].set_title(f"{result.scene.name}: orbits about {view['primary']}, "
