@@ -389,6 +389,9 @@ def _draw(ax: Any, rows: list[Row]) -> None:
     ax.set_title(f"{first.problem}: error vs wall time\nreference: {first.reference}",
                  fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
+    from matplotlib.ticker import NullFormatter
+
+    ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels overlapped on short spans
     # below the axes: inside, a dozen entries hid the points they name
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
               frameon=False)
