@@ -76,11 +76,18 @@ def test_chandler_wobble_quick(tmp_path):
 
 @pytest.mark.slow  # four clones in worker processes: ~40 s on a loaded 2-core machine
 def test_ensemble_comet_clones_quick(tmp_path):
-    """Every clone runs; the encounter scatters the semi-major axis (some clones escape)."""
+    """Every clone runs; the encounter scatters 1/a (some clones escape: 1/a < 0),
+    reported as 1/a, which is smooth through the parabola, not as a, which jumps
+    through +-infinity there."""
     out = run("ensemble_comet_clones.py", str(tmp_path), "--quick")
     assert "4 clones, 0 failed" in out
-    rows = re.findall(r"^\s+(0\.999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s", out, flags=re.M)
+    rows = re.findall(r"^\s+(0\.999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)\s+(bound|escapes)",
+                      out, flags=re.M)
     assert len(rows) == 4
-    assert all(0.02 < float(c) < 0.04 for _, c, _ in rows)
-    assert len({round(float(a)) for _, _, a in rows}) == 4
+    assert all(0.02 < float(c) < 0.04 for _, c, _, _, _ in rows)
+    inv_a = [float(x) for _, _, x, _, _ in rows]
+    assert len({round(x, 5) for x in inv_a}) == 4
+    assert all((x > 0) == (kind == "bound") for x, (*_, kind) in zip(inv_a, rows, strict=True))
+    # the encounter lifts the perihelion from 0.01 au to 0.07-0.09 au (16 clones)
+    assert all(0.05 < float(q) < 0.12 for _, _, _, q, _ in rows)
     assert (tmp_path / "comet_clones.png").stat().st_size > 10_000
