@@ -24,14 +24,18 @@ Problems
    rebound IAS15 with ``epsilon = 0`` at a fixed step of 0.5 day.  Error: max
    over planets of the final heliocentric position difference over the
    heliocentric distance.
-3. Free rigid body (the bundled ``dzhanibekov`` scene: moments 1, 2, 3, spin
+3. Fidelity against DE440 (:mod:`hamilton_orbits.ladder`): each rung of the
+   physics ladder from DE440's J2000 state for 10 years (quick) or 100 years;
+   error: the largest planetary residual against DE440 as an angle seen from
+   the Sun (and the Moon's, seen from the Earth); see ``docs/de440_ladder.md``.
+4. Free rigid body (the bundled ``dzhanibekov`` scene: moments 1, 2, 3, spin
    about the intermediate axis), 20 s (quick) or 60 s, output every 0.01 s:
    splitting2, splitting4, exact_kick, rk4 over dt as an :class:`Ensemble` of
    the scene (``vary={"integrator.method": ..., "integrator.dt": ...}``, run one
    member at a time); scipy DOP853 (``rigid.integrate(method="dop853")``) over
    rtol directly.  Reference: ``rigid.free_motion`` (exact, Jacobi elliptic
    functions).  Error: max attitude geodesic angle (rad).
-4. Rigid-Earth pole wander (``rigid.earth.rigid_body(0.2 arcsec)``), 10 years
+5. Rigid-Earth pole wander (``rigid.earth.rigid_body(0.2 arcsec)``), 10 years
    (quick) or 100 years, daily output: splitting4 over dt, scipy DOP853 (via
    ``rigid.integrate(method="dop853")``) over rtol.  Reference: the exact free
    motion.  Error: max pole offset difference (µas, micro-arcseconds).
@@ -428,6 +432,35 @@ SETTINGS = (
 )
 
 
+# --------------------------------------------------------------------------- 3. DE440
+def _de440(quick: bool, progress: bool) -> list[Row]:
+    """Fidelity against DE440: each rung of the physics ladder
+    (:mod:`hamilton_orbits.ladder`) from DE440's J2000 state, its largest position
+    residual against DE440 over the planets and Pluto (as an angle seen from the
+    Sun, a relative error) and, on rows of their own, the Moon's (seen from the
+    Earth), against its wall time."""
+    from hamilton_orbits.ladder import BODIES, RUNGS, run_rung
+
+    years = 10 if quick else 100
+    name = "fidelity against DE440"
+    reference = "JPL DE440 (Park et al. 2021), its positions at whole years"
+    planets = [k for k, b in enumerate(BODIES) if b not in ("moon", "earth")]
+    moon = BODIES.index("moon")
+    measure = (f"|dr| / r against DE440 after {years} yr: the largest over the planets and "
+               "Pluto (heliocentric), and the Moon's (geocentric)")
+    rows = []
+    for rung in RUNGS:
+        res = run_rung(rung, years)
+        rad = np.radians(res.arcsec[-1] / 3600.0)
+        for code, error in (("hamilton-orbits radau15", rad[planets].max()),
+                            ("hamilton-orbits radau15 (the Moon)", rad[moon])):
+            rows.append(Row(name, code, rung.name, f"{years} yr", float(error), measure,
+                            reference, res.wall_time))
+        log(progress, f"{name}: {rung.name}: planets {rows[-2].error:.2e}, Moon "
+                      f"{rows[-1].error:.2e} in {res.wall_time:.2f} s")
+    return rows
+
+
 def _registered_problems() -> list[tuple[str, Callable[[bool, bool], list[Row]]]]:
     """Problems other packages add (``rigid``: the free body and the pole wander)
     through the entry point group ``hamilton_orbits.report_problems``, so that
@@ -481,7 +514,8 @@ def build_report(out_dir: Any, quick: bool = False, progress: bool = True) -> li
         ) from exc
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    problems = [("kepler", _kepler), ("solar_system", _solar), *_registered_problems()]
+    problems = [("kepler", _kepler), ("solar_system", _solar), ("de440", _de440),
+                *_registered_problems()]
     all_rows: list[Row] = []
     files: list[Path] = []
     figures: list[tuple[str, Path]] = []

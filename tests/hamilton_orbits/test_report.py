@@ -33,6 +33,10 @@ EXPECTED = [
     *[("solar system", "hamilton-orbits", m) for m in ("radau15", "wh", "leapfrog", "dop853")],
     *[("solar system", "rebound", m) for m in ("IAS15", "WHFast", "leapfrog",
                                                 "WHFast (Jacobi, corrector 11)")],
+    *[("fidelity against DE440", code, rung) for code in
+      ("hamilton-orbits radau15", "hamilton-orbits radau15 (the Moon)")
+      for rung in ("newtonian", "gr", "eih", "sun_j2", "sun_lt", "figures", "tides",
+                   "asteroids", "ring")],
     *[("free rigid body", "hamilton-orbits", m)
       for m in ("exact (free_motion)", "splitting2", "splitting4", "exact_kick", "rk4")],
     ("free rigid body", "scipy (rigid.integrate)", "dop853"),
@@ -79,7 +83,7 @@ def test_files_exist(report):
     names = {f.name for f in files}
     assert {"report.md", "report.html"} <= names
     pngs = [f for f in files if f.suffix == ".png"]
-    assert len(pngs) == 5  # one per problem, and all four in work_precision.png
+    assert len(pngs) == 6  # one per problem, and all five in work_precision.png
     for f in files:
         assert f.parent == out and f.stat().st_size > 0
     for f in pngs:
