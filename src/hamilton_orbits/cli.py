@@ -181,19 +181,20 @@ def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
 
 
 def _run_scene(scene, progress: bool):
-    """Run ``scene`` with Ctrl-C handled (the first stops after the current chunk);
+    """Run ``scene`` with Ctrl-C handled (the first stops the run soon and keeps what
+    it reached, the second aborts);
     None (after one line on stderr) if the run failed."""
     interrupted: list[int] = []
 
     def stop() -> bool:
         return bool(interrupted)
 
-    def on_sigint(signum, frame):  # first Ctrl-C: finish the current chunk, keep the rest
+    def on_sigint(signum, frame):  # first Ctrl-C: stop soon, keep what was reached
         if interrupted:
             raise KeyboardInterrupt
         interrupted.append(signum)
-        print("\nhamilton-orbits: stopping after the current chunk (Ctrl-C again to abort)",
-              file=sys.stderr)
+        print("\nhamilton-orbits: stopping (within a few thousand steps; what was reached is "
+              "kept; Ctrl-C again to abort)", file=sys.stderr)
 
     import signal
 

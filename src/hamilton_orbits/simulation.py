@@ -124,7 +124,7 @@ def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
     """Refuse an option the integrator's ``run`` does not take, listing those it does."""
     import inspect
 
-    common = {"dt", "tol", "on_output", "out", "events"}
+    common = {"dt", "tol", "on_output", "out", "events", "stop"}
     takes = [name for name, p in inspect.signature(module.run).parameters.items()
              if p.kind is p.KEYWORD_ONLY and name not in common]
     for key, value in options.items():

@@ -16,12 +16,14 @@ import numpy as np
 from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import output_arrays
+from hamilton_orbits.integrators import StopIntegration, output_arrays
 from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "choose_dt", "run"]
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run"]
 
 NAME = "leapfrog"
+#: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
+SLICE = 100_000
 ACCEPTS_VELOCITY_DEPENDENT = False
 
 
@@ -49,6 +51,7 @@ def run(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     max_steps: int = MAX_FIXED_STEPS,
     events: EventLog | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
 
@@ -85,11 +88,15 @@ def run(
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
             done, status = _k.advance(accel, rhs.p, r, v, gm, t, float(t_out[i]), dt,
-                                      log.watch, log.buffer, log.count, ws)
+                                      log.watch, log.buffer, log.count, ws, SLICE)
             steps += int(done)
             t = float(ws[0])
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
+            if status == _k.STATUS_SLICE:  # Ctrl-C and stop() are seen between slices
+                if stop is not None and stop():
+                    raise StopIntegration
+                continue
             log.drain()
             if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, gm):
                 out_r[i], out_v[i] = r, v

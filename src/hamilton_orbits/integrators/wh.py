@@ -47,11 +47,13 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _setup, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _setup, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
 
 NAME = "wh"
+#: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
+SLICE = 100_000
 ACCEPTS_VELOCITY_DEPENDENT = False
 COORDINATES = ("democratic_heliocentric", "jacobi")
 
@@ -104,6 +106,7 @@ def run(
     corrector: int = 0,
     max_steps: int = _setup.MAX_FIXED_STEPS,
     events: EventLog | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -201,9 +204,13 @@ def run(
         last = span - (n_steps - 1) * dt_f
         done = 0
         while done < n_steps:
+            if done and stop is not None and stop():
+                raise StopIntegration
             ws = np.array([t_out[i - 1] + done * dt_f, np.inf, 0.0, -1.0])
-            steps, bad, status = split.advance(q, u, dt_f, n_steps - done, last,
-                                               log.kernel_watch(), log.buffer, log.count, ws)
+            n_call = min(n_steps - done, SLICE)  # Ctrl-C and stop() are seen between calls
+            steps, bad, status = split.advance(
+                q, u, dt_f, n_call, last if done + n_call == n_steps else dt_f,
+                log.kernel_watch(), log.buffer, log.count, ws)
             done += steps
             total += steps
             if bad >= 0:
