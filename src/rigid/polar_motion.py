@@ -32,9 +32,11 @@ __all__ = [
     "WobbleFit",
     "fit_wobble",
     "free_period",
+    "hindcast",
     "iers2010_mean_pole",
     "load_c04",
     "periodogram",
+    "predict",
     "register_effects",
 ]
 
@@ -1029,3 +1031,6 @@ def periodogram(
         period = np.where(f != 0, 365.25 / np.where(f != 0, f, 1.0), np.inf)
     return QTable([f / u.yr, period * u.day, amp * u.mas],
                  names=("frequency", "period", "amplitude"))
+
+
+from rigid.pole_prediction import hindcast, predict  # noqa: E402

@@ -8,8 +8,8 @@ from its own model (``m = x_p - i y_p``, IERS sign convention, mas, days):
     preceding 10 years (the empirical structure function).
 ``"ls"``
     Least-squares harmonic extrapolation of each coordinate: a linear trend, the
-    Chandler (433.0 d), annual and semi-annual terms fitted to the last
-    :data:`LS_WINDOW` days.  Band: the least-squares prediction error with white residuals.
+    Chandler (433.0 d), annual and semi-annual terms fitted to the last years
+    (:data:`LS_SETTINGS`).  Band: the least-squares prediction error with white residuals.
 ``"ls+ar"``
     ``"ls"`` plus a univariate autoregressive model of each coordinate's residuals
     (Kosek et al. 2007; Kalarus et al. 2010, the reference method of the EOP prediction
@@ -54,8 +54,8 @@ from __future__ import annotations
 import functools
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import astropy.units as u
 import numpy as np
@@ -65,7 +65,9 @@ from scipy.signal import lfilter
 
 from hamilton_orbits.units import DIMENSIONLESS, TIME
 from rigid.ar_models import accumulate_covariance, fit_var
-from rigid.polar_motion import PolarMotionRecord
+
+if TYPE_CHECKING:  # the record's class; no import at run time (polar_motion re-exports us)
+    from rigid.polar_motion import PolarMotionRecord
 
 __all__ = [
     "DEFAULT_HORIZONS",
@@ -94,11 +96,12 @@ CHANDLER_Q = 80.0
 #: the seasonal excitation's period (d): one tropical year
 ANNUAL_PERIOD = 365.2422
 _YEAR = 365.25
-#: least-squares window of the "ls" family (d)
-LS_WINDOW = int(10 * _YEAR)
-#: AR / VAR order and window (d) of the "ls" family's residual models
-LS_AR_ORDER = 30
-LS_AR_WINDOW = int(5 * _YEAR)
+#: the "ls" family: least-squares window (d); order and window (d) of the residual AR / VAR
+LS_SETTINGS: dict[str, dict[str, int]] = {
+    "ls": {"window": int(10 * _YEAR)},
+    "ls+ar": {"window": int(10 * _YEAR), "order": 30, "ar_window": int(5 * _YEAR)},
+    "ls+var": {"window": int(10 * _YEAR), "order": 30, "ar_window": int(5 * _YEAR)},
+}
 #: the excitation windows (d) of "liouville" (their forecasts are averaged)
 EXCITATION_WINDOWS = (int(3 * _YEAR), int(5 * _YEAR), int(10 * _YEAR))
 #: order and window (d) of the VAR of the irregular excitation
@@ -238,10 +241,10 @@ def _fit_operator(kind: str, n: int, steps: int):
     return np.linalg.pinv(past), future, inv, past
 
 
-def _ls_fit(x: np.ndarray, y: np.ndarray, steps: int):
+def _ls_fit(x: np.ndarray, y: np.ndarray, steps: int, window: int):
     """Harmonic least squares of both coordinates: (mean (steps, 2), residuals (n, 2),
     residual variance (2,), leverage (steps,))."""
-    data = np.stack([x[-LS_WINDOW:], y[-LS_WINDOW:]], axis=-1)
+    data = np.stack([x[-window:], y[-window:]], axis=-1)
     n = data.shape[0]
     pinv, future, inv, design = _fit_operator("ls", n, steps)
     coef = pinv @ data
@@ -252,25 +255,27 @@ def _ls_fit(x: np.ndarray, y: np.ndarray, steps: int):
 
 
 def _ls(x: np.ndarray, y: np.ndarray, steps: int) -> Forecast:
-    mean, _, s2, leverage = _ls_fit(x, y, steps)
+    mean, _, s2, leverage = _ls_fit(x, y, steps, LS_SETTINGS["ls"]["window"])
     return mean[:, 0], mean[:, 1], s2[0] * (1 + leverage), s2[1] * (1 + leverage)
 
 
 def _ls_ar(x: np.ndarray, y: np.ndarray, steps: int) -> Forecast:
-    mean, resid, _, _ = _ls_fit(x, y, steps)
+    cfg = LS_SETTINGS["ls+ar"]
+    mean, resid, _, _ = _ls_fit(x, y, steps, cfg["window"])
     out = []
     for c in range(2):
-        series = resid[-LS_AR_WINDOW:, c]
-        model = fit_var(series, LS_AR_ORDER)
+        series = resid[-cfg["ar_window"]:, c]
+        model = fit_var(series, cfg["order"])
         var = accumulate_covariance(model.impulse_response(steps), model.cov)[:, 0, 0]
         out.append((mean[:, c] + model.forecast(series, steps)[:, 0], var))
     return out[0][0], out[1][0], out[0][1], out[1][1]
 
 
 def _ls_var(x: np.ndarray, y: np.ndarray, steps: int) -> Forecast:
-    mean, resid, _, _ = _ls_fit(x, y, steps)
-    series = resid[-LS_AR_WINDOW:]
-    model = fit_var(series, LS_AR_ORDER)
+    cfg = LS_SETTINGS["ls+var"]
+    mean, resid, _, _ = _ls_fit(x, y, steps, cfg["window"])
+    series = resid[-cfg["ar_window"]:]
+    model = fit_var(series, cfg["order"])
     mean = mean + model.forecast(series, steps)
     cov = accumulate_covariance(model.impulse_response(steps), model.cov)
     return mean[:, 0], mean[:, 1], cov[:, 0, 0], cov[:, 1, 1]
@@ -306,9 +311,12 @@ def _liouville(x: np.ndarray, y: np.ndarray, steps: int) -> Forecast:
     a = _step_factor(CHANDLER_PERIOD, CHANDLER_Q, 1.0)
     chi = (m[1:] - a * m[:-1]) / (1.0 - a)  # the excitation of each past day
     members = [_liouville_member(m, chi, w, steps, a) for w in EXCITATION_WINDOWS]
-    mean = np.mean([mm for mm, _ in members], axis=0)
-    cov = np.mean([cc for _, cc in members], axis=0)
-    return mean.real, -mean.imag, cov[:, 0, 0], cov[:, 1, 1]
+    means = np.array([mm for mm, _ in members])
+    mean = means.mean(axis=0)
+    # model averaging: the members' own error variance plus their spread about the mean
+    var_x = np.mean([cc[:, 0, 0] for _, cc in members], axis=0) + means.real.var(axis=0)
+    var_y = np.mean([cc[:, 1, 1] for _, cc in members], axis=0) + means.imag.var(axis=0)
+    return mean.real, -mean.imag, var_x, var_y
 
 
 _FORECASTERS: dict[str, Callable[[np.ndarray, np.ndarray, int], Forecast]] = {
@@ -318,13 +326,13 @@ _FORECASTERS: dict[str, Callable[[np.ndarray, np.ndarray, int], Forecast]] = {
     "ls+var": _ls_var,
     "liouville": _liouville,
 }
-_HISTORY = {
-    "persistence": PERSISTENCE_WINDOW,
-    "ls": LS_WINDOW,
-    "ls+ar": LS_WINDOW,
-    "ls+var": LS_WINDOW,
-    "liouville": max(EXCITATION_WINDOWS) + 1,
-}
+def _history(method: str) -> int:
+    """Days of record a method uses (its longest window)."""
+    if method == "persistence":
+        return PERSISTENCE_WINDOW
+    if method == "liouville":
+        return max(EXCITATION_WINDOWS) + 1
+    return LS_SETTINGS[method]["window"]
 
 
 # --------------------------------------------------------------------------
@@ -339,9 +347,13 @@ def _check_method(method: Any) -> str:
 
 
 def _check_record(record: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(UTC MJD, x, y in mas) of a PolarMotionRecord."""
-    if not isinstance(record, PolarMotionRecord):
-        raise ValueError(f"Expected `record` from load_c04(), got {type(record).__name__}")
+    """(UTC MJD, x, y in mas) of a PolarMotionRecord (or anything with its ``time``, ``x``
+    and ``y``: this module does not import rigid.polar_motion, which re-exports it)."""
+    if not (isinstance(getattr(record, "time", None), Time)
+            and isinstance(getattr(record, "x", None), u.Quantity)
+            and isinstance(getattr(record, "y", None), u.Quantity)):
+        raise ValueError(f"Expected `record` from load_c04() (time, x, y), got "
+                         f"{type(record).__name__}")
     mjd = np.asarray(record.time.utc.mjd, dtype=np.float64)
     return mjd, record.x.to_value(_MAS), record.y.to_value(_MAS)
 
@@ -357,7 +369,7 @@ def _whole_days(name: str, value: Any, *, minimum: int) -> np.ndarray:
     if np.any(bad):
         k = int(np.argmax(bad))
         raise ValueError(f"Expected `{name}` in whole days >= {minimum} d, got "
-                         f"{days[k]!r} d{f' at index {k}' if days.size > 1 else ''}")
+                         f"{float(days[k])!r} d{f' at index {k}' if days.size > 1 else ''}")
     return whole.astype(np.int64)
 
 
@@ -402,6 +414,13 @@ class PolePrediction:
     method : str
     newest_datum : Time
         The newest record epoch the prediction used (``at - latency``).
+    parameters : dict
+        The fitted model, complex amplitudes of ``m = x_p - i y_p`` (mas) at the
+        newest datum: for the ``"ls"`` family the trend (``"mean"``, ``"drift"`` per
+        year) and the prograde (``"+"``) and retrograde (``"-"``) Chandler, annual and
+        semi-annual terms of ``m``; for ``"liouville"`` the Chandler period and Q and,
+        per excitation window, the same terms of the excitation ``chi``; empty for
+        ``"persistence"``.
     """
 
     t: Time
@@ -411,11 +430,12 @@ class PolePrediction:
     sigma_y: u.Quantity
     method: str
     newest_datum: Time
+    parameters: dict = field(default_factory=dict)
 
 
 def _forecast_days(method: str, x: np.ndarray, y: np.ndarray, k: int, steps: int) -> Forecast:
     """The forecaster on the history that ends at index ``k`` (nothing after it)."""
-    h = _HISTORY[method]
+    h = _history(method)
     return _FORECASTERS[method](x[k - h + 1:k + 1], y[k - h + 1:k + 1], steps)
 
 
@@ -469,15 +489,49 @@ def predict(
         raise ValueError(f"Expected `at` to be a single Time, got {at_mjd.size} epochs")
     n_h = int(_whole_days("horizon", horizon, minimum=0)[0])
     lat = int(_whole_days("latency", latency, minimum=1)[0])
-    k = int(_newest_index("at", mjd, at_mjd, lat, _HISTORY[method])[0])
-    _check_finite(x, y, k, _HISTORY[method])
+    k = int(_newest_index("at", mjd, at_mjd, lat, _history(method))[0])
+    _check_finite(x, y, k, _history(method))
     mx, my, vx, vy = _forecast_days(method, x, y, k, lat + n_h)
     sl = slice(lat - 1, lat + n_h)
     t = Time(at_mjd[0] + np.arange(n_h + 1), format="mjd", scale="utc")
     return PolePrediction(
         t=t, x=mx[sl] * _MAS, y=my[sl] * _MAS, sigma_x=np.sqrt(vx[sl]) * _MAS,
         sigma_y=np.sqrt(vy[sl]) * _MAS, method=method,
-        newest_datum=Time(mjd[k], format="mjd", scale="utc"))
+        newest_datum=Time(mjd[k], format="mjd", scale="utc"),
+        parameters=_parameters(method, x[:k + 1], y[:k + 1]))
+
+
+def _terms(coef: np.ndarray, names: tuple[str, ...]) -> dict[str, u.Quantity]:
+    """Complex amplitudes (mas) of the harmonic terms from complex coefficients."""
+    return {name: complex(c) * _MAS for name, c in zip(names, coef, strict=True)}
+
+
+def _parameters(method: str, x: np.ndarray, y: np.ndarray) -> dict[str, Any]:
+    """The fitted model of a prediction (history ending at the newest datum)."""
+    terms = ("chandler+", "chandler-", "annual+", "annual-", "semiannual+", "semiannual-")
+    if method == "persistence":
+        return {}
+    if method == "liouville":
+        n = max(EXCITATION_WINDOWS) + 1
+        m = x[-n:] - 1j * y[-n:]
+        a = _step_factor(CHANDLER_PERIOD, CHANDLER_Q, 1.0)
+        chi = (m[1:] - a * m[:-1]) / (1.0 - a)
+        out: dict[str, Any] = {"chandler_period": CHANDLER_PERIOD * u.day, "Q": CHANDLER_Q}
+        for w in EXCITATION_WINDOWS:
+            coef = _fit_operator("excitation", w, 1)[0] @ chi[-w:]
+            fit = _terms(coef, ("mean", "drift", *terms[2:]))
+            fit["drift"] = fit["drift"] / u.yr
+            out[f"excitation, last {w} d"] = fit
+        return out
+    window = LS_SETTINGS[method]["window"]
+    data = x[-window:] - 1j * y[-window:]
+    coef = _fit_operator("ls", window, 1)[0] @ data  # [1, t, cos, sin] per period
+    out = {"mean": complex(coef[0]) * _MAS, "drift": complex(coef[1]) * _MAS / u.yr}
+    for i, name in enumerate(("chandler", "annual", "semiannual")):
+        c, s = coef[2 + 2 * i], coef[3 + 2 * i]  # m = c cos + s sin = A+ e^iwt + A- e^-iwt
+        out.update(_terms(np.array([(c - 1j * s) / 2, (c + 1j * s) / 2]),
+                          (f"{name}+", f"{name}-")))
+    return out
 
 
 def _check_finite(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
@@ -486,7 +540,7 @@ def _check_finite(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
         if not np.all(np.isfinite(part)):
             i = k - history + 1 + int(np.argmin(np.isfinite(part)))
             raise ValueError(f"Expected `{name}` finite in the history used, got "
-                             f"{arr[i]!r} at index {i}")
+                             f"{float(arr[i])!r} at index {i}")
 
 
 def weekly_starts(first: Any, last: Any) -> Time:
@@ -611,7 +665,7 @@ def hindcast(
     if hs.size == 0:
         raise ValueError("Expected `horizons` to hold at least one horizon, got none")
     lat = int(_whole_days("latency", latency, minimum=1)[0])
-    history = _HISTORY[method]
+    history = _history(method)
     ks = _newest_index("starts", mjd, at, lat, history)
     ex, ey, sx, sy = (np.full((at.size, hs.size), np.nan) for _ in range(4))
     steps = lat + int(hs.max())
