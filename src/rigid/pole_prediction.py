@@ -224,6 +224,12 @@ def _ls_design(t: np.ndarray) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` for a matrix and a vector or thin matrix, without BLAS: a multithreaded
+    BLAS on a loaded 2-core machine made these small products 10-100 times slower."""
+    return np.einsum("ij,j...->i...", a, b)
+
+
 @functools.lru_cache(maxsize=16)
 def _fit_operator(kind: str, n: int, steps: int):
     """(pseudo-inverse (k, n), future design (steps, k), inverse normal matrix) of a design.
@@ -247,8 +253,8 @@ def _ls_fit(x: np.ndarray, y: np.ndarray, steps: int, window: int):
     data = np.stack([x[-window:], y[-window:]], axis=-1)
     n = data.shape[0]
     pinv, future, inv, design = _fit_operator("ls", n, steps)
-    coef = pinv @ data
-    resid = data - design @ coef
+    coef = _dot(pinv, data)
+    resid = data - _dot(design, coef)
     s2 = np.sum(resid**2, axis=0) / (n - design.shape[1])
     leverage = np.einsum("ij,jk,ik->i", future, inv, future)
     return future @ coef, resid, s2, leverage
@@ -291,8 +297,9 @@ def _excitation_design(t: np.ndarray) -> np.ndarray:
 def _liouville_member(m: np.ndarray, chi: np.ndarray, window: int, steps: int, a: complex):
     """One excitation window: (mean pole (steps,), error covariance (steps, 2, 2))."""
     pinv, future, _, design = _fit_operator("excitation", window, steps)
-    coef = pinv @ chi[-window:]
-    resid = (chi[-window:] - design @ coef)[-EXCITATION_VAR_WINDOW:]
+    coef = _dot(pinv, chi[-window:])
+    nv = min(EXCITATION_VAR_WINDOW, window)
+    resid = chi[-nv:] - _dot(design[-nv:], coef)
     series = np.stack([resid.real, resid.imag], axis=-1)
     model = fit_var(series, EXCITATION_VAR_ORDER)
     noise = model.forecast(series, steps)
