@@ -164,7 +164,8 @@ def fit_var(series: Any, order: int) -> VARModel:
     ------
     ValueError
         For an order below 1, a series too short for the order (``n - p`` must exceed
-        ``p d``), or non-finite values.
+        ``p d``), non-finite values, or a series that does not determine the model (a
+        singular lagged regression, e.g. a constant series).
 
     Examples
     --------
@@ -198,7 +199,11 @@ def fit_var(series: Any, order: int) -> VARModel:
     normal, cross = _normal_equations(z, p)
     # normal equations: for the pole and excitation residuals fitted here cond(lagged) is
     # below ~1e5, so they lose < 1e-6 relative (forecasts within 1e-7 mas of a QR solution)
-    sol = np.linalg.solve(normal, cross)  # (p d, d)
+    sol = np.array(cross)  # (p d, d), solved in place (compiled Cholesky, one thread)
+    status = _vk.spd_solve(np.array(normal), sol)
+    if status:
+        raise ValueError(f"Expected `series` to determine a VAR({p}): the lagged regression "
+                         f"is singular (pivot {status} of {p * d})")
     resid = target - np.einsum("ni,ij->nj", lagged, sol)
     cov = np.einsum("ni,nj->ij", resid, resid) / (target.shape[0] - p * d)
     coef = np.ascontiguousarray(sol.T.reshape(d, p, d).transpose(1, 0, 2))
