@@ -55,7 +55,7 @@ import functools
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import astropy.units as u
 import numpy as np
@@ -66,8 +66,15 @@ from scipy.signal import lfilter
 from hamilton_orbits.units import DIMENSIONLESS, TIME
 from rigid.ar_models import accumulate_covariance, fit_var
 
-if TYPE_CHECKING:  # the record's class; no import at run time (polar_motion re-exports us)
-    from rigid.polar_motion import PolarMotionRecord
+
+class PoleRecord(Protocol):
+    """What a record needs here: a :class:`rigid.polar_motion.PolarMotionRecord` (from
+    ``load_c04()``) or anything with its attributes.  This module does not import the
+    record's module, which re-exports :func:`predict` and :func:`hindcast`."""
+
+    time: Time
+    x: u.Quantity
+    y: u.Quantity
 
 __all__ = [
     "DEFAULT_HORIZONS",
@@ -76,6 +83,7 @@ __all__ = [
     "RECENT_PERIOD",
     "HindcastScore",
     "PolePrediction",
+    "PoleRecord",
     "hindcast",
     "predict",
     "propagate_pole",
@@ -451,7 +459,7 @@ def _forecast_days(method: str, x: np.ndarray, y: np.ndarray, k: int, steps: int
 
 
 def predict(
-    record: PolarMotionRecord, *, at: Time, horizon: u.Quantity, method: str = "liouville",
+    record: PoleRecord, *, at: Time, horizon: u.Quantity, method: str = "liouville",
     latency: u.Quantity = 1 * u.day,
 ) -> PolePrediction:
     """Predict the pole from ``at`` to ``at + horizon`` with the record before ``at``.
@@ -622,7 +630,7 @@ def _score_table(h: np.ndarray, ex: np.ndarray, ey: np.ndarray, sx: np.ndarray,
 
 
 def hindcast(
-    record: PolarMotionRecord, starts: Time | None = None,
+    record: PoleRecord, starts: Time | None = None,
     horizons: u.Quantity = DEFAULT_HORIZONS, method: str = "liouville", *,
     latency: u.Quantity = 1 * u.day,
 ) -> HindcastScore:

@@ -79,8 +79,8 @@ def _check(spec: dict, problems: S.Problems) -> None:
 def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     from astropy.time import Time
 
-    from rigid.polar_motion import hindcast, load_c04, predict
-    from rigid.pole_prediction import weekly_starts
+    from rigid.polar_motion import load_c04
+    from rigid.pole_prediction import hindcast, predict, weekly_starts
 
     spec = scene.spec
     begin = time.perf_counter()
