@@ -91,3 +91,15 @@ def test_ensemble_comet_clones_quick(tmp_path):
     # the encounter lifts the perihelion from 0.01 au to 0.07-0.09 au (16 clones)
     assert all(0.05 < float(q) < 0.12 for _, _, _, q, _ in rows)
     assert (tmp_path / "comet_clones.png").stat().st_size > 10_000
+
+
+def test_pole_prediction_quick(tmp_path):
+    """The hindcast tables carry every method beside the published rows; figures written."""
+    out = run("pole_prediction.py", str(tmp_path), "--quick")
+    assert "126 weekly starts" in out
+    for name in ("persistence", "ls+ar", "ls+var", "liouville", "WLS+VAR (Lei et al. 2023)"):
+        assert re.search(rf"^{re.escape(name)}\s+[\d.]+", out, flags=re.M), name
+    assert re.search(r"at or below in \d+ of 10 cells", out)
+    for png in ("prediction_fan", "mae_vs_horizon", "coverage"):
+        assert (tmp_path / f"{png}.png").stat().st_size > 10_000
+    assert (tmp_path / "pole_prediction.txt").read_text().startswith("scene pole-prediction")

@@ -203,5 +203,9 @@ KIND = SceneKind(
 
 
 def register() -> None:
-    """Register the ``polar_motion`` scene kind."""
+    """Register the ``polar_motion`` scene kind (and, beside it, ``pole_prediction``)."""
     register_kind(KIND)
+    # issue 25: the prediction scenes live in their own module, registered with this kind
+    from rigid import scene_prediction
+
+    scene_prediction.register()
