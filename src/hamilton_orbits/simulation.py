@@ -200,8 +200,9 @@ def integrate(
         the run, if any.
     **options
         Options of the chosen integrator, e.g. for ``wh``
-        ``coordinates="jacobi"`` and ``corrector=3`` (see its ``run``).  An option
-        the method does not take raises ``ValueError`` listing those it takes.
+        ``coordinates="jacobi"`` and ``corrector=3`` (or 5, 7, 11, 17; see its
+        ``run``).  An option the method does not take raises ``ValueError``
+        listing those it takes.
 
     Returns
     -------
