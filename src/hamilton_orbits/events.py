@@ -341,7 +341,9 @@ class EventLog:
     def none(cls, n: int) -> EventLog:
         """A log that watches nothing (the kernels then skip the scan, and its
         buffer is empty)."""
-        return cls(_NO_WATCH, np.full(n, np.nan), capacity=0)
+        log = cls(_NO_WATCH, np.empty(0), capacity=0)  # no radii: nothing merges
+        log.inactive = np.zeros(n, dtype=bool)
+        return log
 
     def drain(self) -> None:
         """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""

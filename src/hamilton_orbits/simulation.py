@@ -48,7 +48,8 @@ class Trajectory(TrajectoryBase):
         Positions and velocities (au, au/day for Quantity systems).
     names : tuple of str
     final : System
-        The system at the last output time.
+        The system at the last output time (made on first access from the last
+        output row).
     energy_error : ndarray, shape (n_t,)
         ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)).
     angular_momentum_error : ndarray, shape (n_t,)
@@ -73,13 +74,22 @@ class Trajectory(TrajectoryBase):
     r: Any
     v: Any
     names: tuple[str, ...]
-    final: System
     barycentre_drift: np.ndarray
     effects: tuple[str, ...]
+    #: What :attr:`final` is made from on first access: the system, the last
+    #: state, masses and the bodies still in the run (a copy of the state made
+    #: only when asked for: 48 bytes a body).
+    final_source: Any = field(default=None, repr=False)
     #: What :attr:`events` and :attr:`stopped_by` are built from, on first access
     #: (the events log, the system and the time unit): an astropy table costs
     #: ~0.1 ms, more than the rest of a short call's wrapping.
     event_source: Any = field(default=None, repr=False)
+
+    @functools.cached_property
+    def final(self) -> System:
+        """The system at the last output time."""
+        system, r, v, gm, keep = self.final_source
+        return system.with_state(r, v, gm=gm, keep=keep, check=False)
 
     @functools.cached_property
     def events(self) -> Any:
@@ -368,16 +378,15 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
             f"{system.names[i]!r} at output {k} (t = {times[k]!r}): "
             "a collision or a step too long"
         ) from None
-    final = system.with_state(r[-1], v[-1], gm=np.atleast_2d(out.gm)[-1],
-                              keep=None if gone is None else ~gone, check=False)
+    final = (system, r[-1], v[-1], np.atleast_2d(out.gm)[-1], None if gone is None else ~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)
-        r_out: Any = r * u.au
-        v_out: Any = v * (u.au / u.day)
+        r_out: Any = r << u.au  # views: no second copy of the history
+        v_out: Any = v << (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
     return Trajectory(
-        t=t_out, r=r_out, v=v_out, names=system.names, final=final, energy_error=ee,
+        t=t_out, r=r_out, v=v_out, names=system.names, final_source=final, energy_error=ee,
         angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
         wall_time=out.wall_time, method=method, effects=effects,
         event_source=(out.events, system, unit),

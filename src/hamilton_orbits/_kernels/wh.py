@@ -38,13 +38,15 @@ __all__ = [
 
 @njit(cache=True, error_model="numpy")
 def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
-    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` by ``tau``
-    (the shared kernel inlined: the bodies' solves overlap in the processor).
+    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` (``mu[0]``
+    for all when ``mu`` has one element) by ``tau`` (the shared kernel inlined: the
+    bodies' solves overlap in the processor).
 
     Returns the index of the first failure (NaN from the kernel), else -1."""
+    one = mu.shape[0] == 1
     for i in range(1, q.shape[0]):
         x, y, z, vx, vy, vz = _kepler.propagate_uv_inline(
-            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[i], tau
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[0] if one else mu[i], tau
         )
         if not math.isfinite(x + y + z + vx + vy + vz):
             return i
@@ -172,17 +174,15 @@ def _stop_here(q, u, mu, h_back, jacobi, com, ws, t_end_step, ev_out, ev_count):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x):
+def _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x):
     # pragma: no cover - compiled
     """Jump h/2, the interaction kick h (and the listed effects, whose net force
-    moves the barycentre), jump h/2."""
+    moves the barycentre), jump h/2.  ``idx``: the massive rows >= 1 (row 0, the
+    central body, is not in the interaction)."""
     n = q.shape[0]
     gm0 = gm[0]
     _jump(q, u, gm, 0.5 * h)
-    _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
-    for i in range(1, n):
-        for k in range(3):
-            u[i, k] += h * acc[i, k]
+    _nbody.kick_rows(q, gm, idx, 1, h, u, acc_m)
     if has_extra:
         # inertial state for the effects: r_0 = R - sum m_i Q_i / M
         for k in range(3):
@@ -451,38 +451,44 @@ _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, F1, types.float64, types.int64,
+        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_dh(
-    extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
 ):  # pragma: no cover - compiled
     """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
     coordinates, in place.  ``q``, ``u``: heliocentric positions and
-    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
+    barycentric velocities (row 0 unused); ``gm[0]`` the central body's;
     ``com``: barycentre position and velocity (6,).  ``watch``, ``ev_out``,
     ``ev_count``, ``ws``: the events (see :func:`_drift`; ``ws[0]`` the start
     time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
     whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
     state is synchronised at the end of step ``steps``."""
     n = q.shape[0]
-    acc = np.empty((n, 3))
-    r_in = np.empty((n, 3))
-    v_in = np.empty((n, 3))
-    acc_x = np.empty((n, 3))
-    x0, v0 = np.empty((n, 3)), np.empty((n, 3))
+    watched = watch.shape[0] > 0
+    m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
+    r_in = np.empty((m, 3))
+    v_in = np.empty((m, 3))
+    acc_x = np.empty((m, 3))
+    w = n if watched else 0  # the drifts' start states for the events' scan
+    x0, v0 = np.empty((w, 3)), np.empty((w, 3))
     m_tot = 0.0
     for i in range(n):
         m_tot += gm[i]
     # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
     # row 0 (unused here) is left out of the interaction
-    idx = _nbody.massive_indices(gm_p)
-    mu = np.full(n, gm[0])
-    mu_s = mu.copy()
-    mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
+    idx = _nbody.massive_indices(gm)
+    if idx.shape[0] > 0 and idx[0] == 0:
+        idx = idx[1:]
+    acc_m = np.empty((idx.shape[0], 3))
+    mu = np.full(1, gm[0])  # every body about the central one
+    mu_s = np.full(w, gm[0])
+    if watched:
+        mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0, mu_s)
@@ -490,7 +496,7 @@ def advance_dh(
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x)
+        _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x)
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count, ws,
                      x0, v0, mu_s)

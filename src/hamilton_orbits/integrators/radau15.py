@@ -189,7 +189,7 @@ class _Run:
         m = 3 * r0.shape[0]
         self.rhs, self.gm, self.log = rhs, gm, log
         self.accel = _setup.accel_arg(rhs.accel)
-        self.work = [np.zeros((7, m)) for _ in range(5)]  # b, e, br, er, g
+        self.work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
         self.csx = np.zeros(m)
         self.csv = np.zeros(m)
         self.st = np.zeros(_k.NSTATE)

@@ -218,51 +218,75 @@ def run(
     # the central body first (row i of the coordinates is body order[i])
     order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
     extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
-    gm = gm.copy()
+    if events is not None:
+        gm = gm.copy()  # merges change it
     log = events if events is not None else EventLog.none(n)
     if c != 0:
         log.index_map = order
-    split = _Split(gm, order, coordinates == "jacobi", corrector, extra, rhs.p,
-                   rhs.extra is not None)
-    split.from_inertial(r0, v0)
     nt = t_out.shape[0]
     r_out, v_out = output_arrays(out, nt, r0, v0)
+    split = _Split(gm, order, coordinates == "jacobi", corrector, extra, rhs.p,
+                   rhs.extra is not None)
+    # the working coordinates live in the next output row when the central body is
+    # first (no copy of the state of its own: 48 bytes a body fewer), else apart
+    in_place = c == 0
+    if nt > 1:
+        split.from_inertial(r0, v0, *((r_out[1], v_out[1]) if in_place else
+                                      (np.empty_like(r0), np.empty_like(v0))))
     total = 0
     watch = log.kernel_watch()
     for i in range(1, nt):
-        span = t_out[i] - t_out[i - 1]
-        n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
-        last = span - (n_steps - 1) * dt_f
-        done = 0
-        while done < n_steps:
-            ws = np.array([t_out[i - 1] + done * dt_f, np.inf, 0.0, -1.0])
-            steps, bad, status = split.advance(dt_f, n_steps - done, last, watch, log.buffer,
-                                               log.count, ws)
-            done += steps
-            total += steps
-            if bad >= 0:
-                raise ConvergenceError(
-                    f"wh: the Kepler step of body {int(order[bad])} failed between "
-                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
-                    f"{float(t_out[i])!r}")
-            if status == _k.STATUS_DRAIN:
-                log.drain()
-            elif status == _k.STATUS_EVENT:
-                r_now, v_now = np.empty_like(r0), np.empty_like(v0)
-                split.to_inertial(r_now, v_now)
-                if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
-                    r_out[i], v_out[i] = r_now, v_now
-                    _mask(r_out[i], v_out[i], log)
-                    raise StopAtEvent(i, float(ws[0]), total)
-                split = _Split(gm, order, split.jacobi, corrector, extra, rhs.p,
-                               rhs.extra is not None)
-                split.from_inertial(r_now, v_now)
-                watch = log.kernel_watch()
-        split.to_inertial(r_out[i], v_out[i])
+        split, total, watch = _interval(split, i, t_out, dt_f, log, watch, gm, total,
+                                        (r_out[i], v_out[i]))
+        if in_place:
+            q, u = split.q, split.u
+            if i + 1 < nt:  # the state moves on to the next row
+                r_out[i + 1], v_out[i + 1] = q, u
+                split.q, split.u = r_out[i + 1], v_out[i + 1]
+            split.to_inertial(q, u, q, u)  # row i, in place
+        else:
+            split.to_inertial(r_out[i], v_out[i])
         _mask(r_out[i], v_out[i], log)
         if on_output is not None:
             on_output(i, total)
     return r_out, v_out, total
+
+
+def _interval(split: _Split, i: int, t_out: np.ndarray, dt: float, log: EventLog,
+              watch: np.ndarray, gm: np.ndarray, total: int,
+              row: tuple[np.ndarray, np.ndarray]) -> tuple[_Split, int, np.ndarray]:
+    """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land on
+    it), events acted on at the end of their step; the split (new after a merge or
+    a removal), the steps so far and the watch table.  An event that stops the run
+    leaves its state in ``row`` (output ``i``)."""
+    span = t_out[i] - t_out[i - 1]
+    n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+    last = span - (n_steps - 1) * dt
+    done = 0
+    while done < n_steps:
+        ws = np.array([t_out[i - 1] + done * dt, np.inf, 0.0, -1.0])
+        steps, bad, status = split.advance(dt, n_steps - done, last, watch, log.buffer,
+                                           log.count, ws)
+        done += steps
+        total += steps
+        if bad >= 0:
+            raise ConvergenceError(
+                f"wh: the Kepler step of body {int(split.order[bad])} failed between "
+                f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                f"{float(t_out[i])!r}")
+        if status == _k.STATUS_DRAIN:
+            log.drain()
+        elif status == _k.STATUS_EVENT:
+            r_now, v_now = np.empty_like(split.q), np.empty_like(split.u)
+            split.to_inertial(r_now, v_now)
+            if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
+                row[0][:], row[1][:] = r_now, v_now
+                _mask(row[0], row[1], log)
+                raise StopAtEvent(i, float(ws[0]), total)
+            split = split.renewed(gm)
+            split.from_inertial(r_now, v_now, split.q, split.u)
+            watch = log.kernel_watch()
+    return split, total, watch
 
 
 def _mask(r: np.ndarray, v: np.ndarray, log: EventLog) -> None:
@@ -396,33 +420,40 @@ def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int
 
 class _Split:
     """The coordinates of one splitting (central body first: row ``i`` is body
-    ``order[i]``) and its compiled steps."""
+    ``order[i]``), held in the arrays ``q``, ``u`` it is given, and its compiled
+    steps."""
 
     def __init__(self, gm: np.ndarray, order: np.ndarray, jacobi: bool, corrector: int,
                  extra: Any, p: np.ndarray, has_extra: bool) -> None:
-        g = np.ascontiguousarray(gm[order])
-        self.g, self.order, self.jacobi, self.corrector = g, order, jacobi, corrector
+        g = np.ascontiguousarray(gm[order])  # a writeable copy, the order of the rows
+        self.gm, self.g, self.order, self.jacobi, self.corrector = gm, g, order, jacobi, corrector
         self.extra, self.p, self.has_extra = extra, p, has_extra
-        n = g.shape[0]
-        self.q = np.empty((n, 3))
-        self.u = np.empty((n, 3))
+        self.q = self.u = np.empty((0, 3))
         if jacobi:
             self.eta = np.cumsum(g)
             self.ratio, self.inv_eta = _k.jacobi_factors(self.eta)
             if corrector:
                 self.coef = corrector_coefficients(corrector)
         else:
-            self.g_p = g.copy()
-            self.g_p[0] = 0.0
             self.com = np.empty(6)
 
-    def from_inertial(self, r: np.ndarray, v: np.ndarray) -> None:
-        """Jacobi positions and velocities (row 0 the barycentre), or heliocentric
-        positions and barycentric velocities (the barycentre kept in ``com``)."""
+    def renewed(self, gm: np.ndarray) -> _Split:
+        """The same splitting for new ``gm`` (after a merge or a removal), on the same
+        arrays."""
+        new = _Split(gm, self.order, self.jacobi, self.corrector, self.extra, self.p,
+                     self.has_extra)
+        new.q, new.u = self.q, self.u
+        return new
+
+    def from_inertial(self, r: np.ndarray, v: np.ndarray, q: np.ndarray, u: np.ndarray) -> None:
+        """Into ``q``, ``u`` (kept as the state): Jacobi positions and velocities (row 0
+        the barycentre), or heliocentric positions and barycentric velocities (the
+        barycentre kept in ``com``)."""
+        self.q, self.u = q, u
         if self.jacobi:
-            _k.jacobi_from_inertial(r, v, self.g, self.eta, self.order, self.q, self.u)
+            _k.jacobi_from_inertial(r, v, self.g, self.eta, self.order, q, u)
         else:
-            _k.dh_from_inertial(r, v, self.g, self.order, self.q, self.u, self.com)
+            _k.dh_from_inertial(r, v, self.g, self.order, q, u, self.com)
 
     def advance(self, dt, n_steps, last, watch, ev_out, ev_count, ws) -> tuple[int, int, int]:
         """``n_steps`` steps (the last of length ``last``), in true coordinates at both
@@ -430,8 +461,8 @@ class _Split:
         ev = (watch, ev_out, ev_count, ws)
         q, u = self.q, self.u
         if not self.jacobi:
-            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.g_p,
-                                 self.com, dt, n_steps, last, *ev)
+            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.com,
+                                 dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
         bad = _k.corrector_jacobi(*args, dt, 1.0, *self.coef) if self.corrector else -1
         steps, status = 0, _k.STATUS_OK
@@ -441,10 +472,19 @@ class _Split:
             bad = _k.corrector_jacobi(*args, dt, -1.0, *self.coef)
         return steps, bad, status
 
-    def to_inertial(self, r: np.ndarray, v: np.ndarray) -> None:
-        """Inertial positions and velocities into ``r``, ``v`` (the caller's order)."""
+    def to_inertial(self, r: np.ndarray, v: np.ndarray, q: np.ndarray | None = None,
+                    u: np.ndarray | None = None) -> None:
+        """Inertial positions and velocities into ``r``, ``v`` (the caller's order)
+        from the coordinates ``q``, ``u`` (default the state); ``r is q`` (in place)
+        when the central body is first."""
+        q = self.q if q is None else q
+        u = self.u if u is None else u
         if self.jacobi:
-            _k.jacobi_to_inertial(self.q, self.u, self.g, self.eta, self.ratio, self.inv_eta,
-                                  self.order, r, v)
+            if r is q:
+                _k.jacobi_to_inertial_pos(q, self.g, self.eta, self.ratio, self.inv_eta, q)
+                _k.jacobi_to_inertial_pos(u, self.g, self.eta, self.ratio, self.inv_eta, u)
+            else:
+                _k.jacobi_to_inertial(q, u, self.g, self.eta, self.ratio, self.inv_eta,
+                                      self.order, r, v)
         else:
-            _k.dh_to_inertial(self.q, self.u, self.g, self.com, self.order, r, v)
+            _k.dh_to_inertial(q, u, self.g, self.com, self.order, r, v)
