@@ -464,13 +464,24 @@ class _Split:
             return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.com,
                                  dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
-        bad = _k.corrector_jacobi(*args, dt, 1.0, *self.coef) if self.corrector else -1
-        steps, status = 0, _k.STATUS_OK
-        if bad < 0:
-            steps, bad, status = _k.advance_jacobi(*args, dt, n_steps, last, *ev)
-        if bad < 0 and self.corrector:
-            bad = _k.corrector_jacobi(*args, dt, -1.0, *self.coef)
-        return steps, bad, status
+        if not self.corrector:
+            return _k.advance_jacobi(*args, dt, n_steps, last, *ev)
+        # the corrector conjugates a run of equal steps: a shortened last step gets
+        # its own (C(dt) K(dt)^(n-1) C(dt)^-1, then C(h) K(h) C(h)^-1, as WHFast does
+        # when its step changes)
+        runs = ((dt, n_steps - 1), (last, 1)) if n_steps > 1 and last != dt else (
+            (dt if n_steps > 1 else last, n_steps),)
+        done, bad, status = 0, -1, _k.STATUS_OK
+        for h, k in runs:
+            bad = _k.corrector_jacobi(*args, h, 1.0, *self.coef)
+            if bad < 0:
+                steps, bad, status = _k.advance_jacobi(*args, h, k, h, *ev)
+                done += steps
+            if bad < 0:
+                bad = _k.corrector_jacobi(*args, h, -1.0, *self.coef)
+            if bad >= 0 or status != _k.STATUS_OK:
+                break
+        return done, bad, status
 
     def to_inertial(self, r: np.ndarray, v: np.ndarray, q: np.ndarray | None = None,
                     u: np.ndarray | None = None) -> None:
