@@ -47,7 +47,7 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _setup, output_arrays
+from hamilton_orbits.integrators import _setup, _tangent, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
 
@@ -104,6 +104,7 @@ def run(
     corrector: int = 0,
     max_steps: int = _setup.MAX_FIXED_STEPS,
     events: EventLog | None = None,
+    variational: Any = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -144,6 +145,12 @@ def run(
         (democratic heliocentric; escapes measured from the central body) or on
         the Hermite interpolant of the inertial states (Jacobi).  Actions take
         effect at the end of the step the event occurred in.
+    variational : Tangent, optional
+        Tangent vectors to carry through the exact tangent map of every step
+        (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled
+        with ``variational=True``): the Kepler drift's derivative and the kick's
+        Jacobian, symplectic as the map.  The steps are then synchronised one by
+        one (as WHFast's ``safe_mode``); not with ``events`` or ``corrector``.
 
     Returns
     -------
@@ -182,6 +189,12 @@ def run(
     if dt_f is None:
         dt_f = default_step(r0, v0, gm, tol_f)
     _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
+    if variational is not None:
+        if corrector:
+            raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
+                             "is not implemented); use corrector=0")
+        return _tangent.run_wh(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
+                               jacobi=coordinates == "jacobi", on_output=on_output, out=out)
     n = r0.shape[0]
     order = np.concatenate([[c], np.delete(np.arange(n), c)])  # the central body first
     extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
