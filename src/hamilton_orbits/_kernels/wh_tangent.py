@@ -1,9 +1,10 @@
 """The Wisdom-Holman map with its exact tangent map (``variational=True``).
 
-The same splittings as :mod:`hamilton_orbits._kernels.wh` (democratic
-heliocentric, Jacobi), step by step synchronised (Kepler ``dt/2``, kick ``dt``,
-Kepler ``dt/2``, as WHFast with ``safe_mode``), each part carrying the tangent
-vectors through its own derivative (Rein & Tamayo 2016, section 2.3):
+The same splittings and steps as :mod:`hamilton_orbits._kernels.wh` (democratic
+heliocentric, Jacobi; Kepler ``dt/2``, kick ``dt``, Kepler ``dt/2``, the Kepler
+halves of consecutive steps merged and the state synchronised at the end of a
+call), each part carrying the tangent vectors through its own derivative (Rein &
+Tamayo 2016, section 2.3):
 
 - the Kepler drift by :func:`hamilton_orbits._kernels.variational.kepler_tangent`
   (the derivative of the two-body flow), the barycentre's drift linearly;
@@ -12,10 +13,13 @@ vectors through its own derivative (Rein & Tamayo 2016, section 2.3):
   effects) at the kick's positions: ``delta u_i += h sum_j (da_i/dQ_j) delta Q_j``.
 
 Each is the derivative of a symplectic map, so the tangent map is symplectic too.
-After every step the MEGNO state is updated from tangent vector 0 in inertial
-coordinates.  Tangent vectors: rows ``m n + i`` of ``(dq, du)`` (k n, 3) in the
-splitting's coordinates; ``dcom`` (k, 6) the barycentre's (democratic heliocentric).
-No astropy here.
+MEGNO is updated from tangent vector 0 in inertial coordinates after every kick
+(the middle of the step: its tangent vector is that of the synchronised map
+conjugated by a half drift, a bounded near-identity map, so the limits of MEGNO
+and of the Lyapunov exponent are the same; WHFast instead synchronises every
+step, a second Kepler solve per body) and at the end of the call.  Tangent
+vectors: rows ``m n + i`` of ``(dq, du)`` (k n, 3) in the splitting's coordinates;
+``dcom`` (k, 6) the barycentre's (democratic heliocentric).  No astropy here.
 """
 
 from __future__ import annotations
@@ -158,9 +162,9 @@ def _ln_delta_dh(dq, du, dcom, gm, m_tot, r0, v0):  # pragma: no cover - compile
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
 def advance_dh(extra, tangent_extra, p, has_extra, q, u, gm, gm_p, com, dq, du, dcom, dt,
                n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
-    """``n_steps`` synchronised democratic-heliocentric steps (the last of length
-    ``dt_last``) from ``t0``, with the tangent vectors ``(dq, du, dcom)``; the
-    coordinates as :func:`hamilton_orbits._kernels.wh.advance_dh` takes them.
+    """``n_steps`` democratic-heliocentric steps (the last of length ``dt_last``) from
+    ``t0``, synchronised at both ends, with the tangent vectors ``(dq, du, dcom)``;
+    the coordinates as :func:`hamilton_orbits._kernels.wh.advance_dh` takes them.
     Returns ``(steps, bad)``, ``bad`` a body whose Kepler step failed or -1."""
     n = q.shape[0]
     kn = dq.shape[0]
@@ -172,19 +176,25 @@ def advance_dh(extra, tangent_extra, p, has_extra, q, u, gm, gm_p, com, dq, du, 
         m_tot += gm[i]
     idx = _nbody.massive_indices(gm_p)
     mu = np.full(n, gm[0])
-    t = t0
+    t = t0  # the start of the step
+    t_last = t0  # the time of the last MEGNO sample
+    h = dt if n_steps > 1 else dt_last
+    bad = _drift_dh(q, u, com, dq, du, dcom, mu, 0.5 * h, xa, va)
+    if bad >= 0:
+        return 0, bad
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        bad = _drift_dh(q, u, com, dq, du, dcom, mu, 0.5 * h, xa, va)
-        if bad >= 0:
-            return s, bad
         _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm_p, idx, h,
                  m_tot, w)
-        bad = _drift_dh(q, u, com, dq, du, dcom, mu, 0.5 * h, xa, va)
+        megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t + 0.5 * h,
+                       t + 0.5 * h - t_last)
+        t_last = t + 0.5 * h
+        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+        bad = _drift_dh(q, u, com, dq, du, dcom, mu, 0.5 * (h + h_next), xa, va)
         if bad >= 0:
             return s, bad
         t += h
-        megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t, h)
+    megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t, t - t_last)
     return n_steps, -1
 
 
@@ -259,6 +269,19 @@ def _drift_jacobi(qj, uj, dq, du, eta, tau, xa, va):  # pragma: no cover - compi
     return bad
 
 
+@njit(cache=True, error_model="numpy")
+def _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0):  # pragma: no cover - compiled
+    """``ln |delta|`` of tangent vector 0 in inertial coordinates."""
+    n = r0.shape[0]
+    jacobi_to_inertial_pos(dq[:n], gm, eta, ratio, inv, r0)
+    jacobi_to_inertial_pos(du[:n], gm, eta, ratio, inv, v0)
+    tot = 0.0
+    for i in range(n):
+        for c in range(3):
+            tot += r0[i, c] * r0[i, c] + v0[i, c] * v0[i, c]
+    return 0.5 * math.log(tot) if tot > 0.0 else -math.inf
+
+
 @njit(types.Tuple((types.int64, types.int64))(
     ACCEL_TYPE, TANGENT_TYPE, F1, types.boolean, F2, F2, F1, F1, F2, F2, types.float64,
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
@@ -276,22 +299,23 @@ def advance_jacobi(extra, tangent, p, has_extra, qj, uj, gm, eta, dq, du, dt, n_
     ratio, inv = jacobi_factors(eta)
     r0, v0 = np.empty((n, 3)), np.empty((n, 3))
     t = t0
+    t_last = t0
+    h = dt if n_steps > 1 else dt_last
+    bad = _drift_jacobi(qj, uj, dq, du, eta, 0.5 * h, xa, va)
+    if bad >= 0:
+        return 0, bad
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        bad = _drift_jacobi(qj, uj, dq, du, eta, 0.5 * h, xa, va)
-        if bad >= 0:
-            return s, bad
         _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv, h,
                      w)
-        bad = _drift_jacobi(qj, uj, dq, du, eta, 0.5 * h, xa, va)
+        megno_map_step(ms, _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0), t + 0.5 * h,
+                       t + 0.5 * h - t_last)
+        t_last = t + 0.5 * h
+        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+        bad = _drift_jacobi(qj, uj, dq, du, eta, 0.5 * (h + h_next), xa, va)
         if bad >= 0:
             return s, bad
         t += h
-        jacobi_to_inertial_pos(dq[:n], gm, eta, ratio, inv, r0)
-        jacobi_to_inertial_pos(du[:n], gm, eta, ratio, inv, v0)
-        tot = 0.0
-        for i in range(n):
-            for c in range(3):
-                tot += r0[i, c] * r0[i, c] + v0[i, c] * v0[i, c]
-        megno_map_step(ms, 0.5 * math.log(tot) if tot > 0.0 else -math.inf, t, h)
+    megno_map_step(ms, _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0), t, t - t_last)
     return n_steps, -1
+
