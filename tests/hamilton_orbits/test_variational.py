@@ -499,3 +499,46 @@ def test_variational_with_quantities():
     assert tr.lyapunov.unit == 1 / u.yr
     assert tr.stm.shape == (2, 18, 18)
     assert abs(tr.megno[-1] - 2) < 0.5
+
+
+# ---------------------------------------------------------------------------
+# Scenes and ensembles
+
+
+def test_scene_reports_megno_and_lyapunov_time():
+    """``variational = true`` in a scene: MEGNO, the Lyapunov exponent and time in the
+    summary and the metrics, MEGNO over time as a diagnostic and a figure."""
+    import astropy.units as u
+
+    from hamilton_orbits import Scene
+
+    res = Scene.bundled("stability-map").with_values({"duration": "1200 yr",
+                                                      "cadence": "300 yr"}).run(progress=False)
+    assert abs(res.metrics["MEGNO"] - 2.0) < 0.1  # a = 8 au, e = 0.05: regular
+    assert res.metrics["Lyapunov time"].unit == u.yr
+    assert res.diagnostics["megno"].shape == (5,)
+    assert "MEGNO" in res.summary() and "Lyapunov time" in res.summary()
+    assert [f._hamilton_name for f in res.plot()][-1] == "megno"
+
+
+def test_scene_variational_refuses_events():
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scene import SceneError
+
+    with pytest.raises(SceneError, match="variational"):
+        Scene.bundled("stability-map").with_values(
+            {"events": [{"name": "escape", "distance": "100 au"}]})
+
+
+def test_ensemble_rows_carry_megno():
+    """Numeric metrics flow into Ensemble rows: MEGNO and the Lyapunov time per
+    member (a regular cell, a = 8 au, e = 0.05, and chaotic ones at e = 0.35)."""
+    from hamilton_orbits import Ensemble, Scene
+
+    scene = Scene.bundled("stability-map").with_values({"duration": "2400 yr",
+                                                        "cadence": "1200 yr"})
+    df = Ensemble(scene, vary={"bodies.planet.a": ["8.0 au", "7.5 au"],
+                               "bodies.planet.e": [0.05, 0.35]}).run(progress=False, workers=1)
+    assert df.attrs["failures"] == 0
+    assert {"MEGNO", "Lyapunov time [yr]", "Lyapunov exponent [1 / yr]"} <= set(df.columns)
+    assert df["MEGNO"].iloc[0] < 2.2 and df["MEGNO"].max() > 4

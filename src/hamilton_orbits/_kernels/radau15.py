@@ -612,6 +612,34 @@ def _megno_radau(ms, t, dt, b, a0, x0, v0, lo, hi):  # pragma: no cover - compil
     megno_update(ms, dt * dy, t + dt, dt)
 
 
+@njit(cache=True)
+def _renormalise(r, v, b, e, br, er, g, csx, csv, n):  # pragma: no cover - compiled
+    """Scale MEGNO's tangent vector (rows ``n .. 2n-1``) down by its largest
+    component when that exceeds 1e100, in the state, the step's polynomial (``b``,
+    ``e`` and the last step's ``br``, ``er``, ``g``) and the compensations alike (the
+    tangent dynamics are linear; MEGNO depends on its direction only)."""
+    big = 0.0
+    for i in range(n, 2 * n):
+        for c in range(3):
+            big = max(big, abs(r[i, c]), abs(v[i, c]))
+    if not (big > 1e100 and big < math.inf):
+        return
+    f = 1.0 / big
+    for i in range(n, 2 * n):
+        for c in range(3):
+            r[i, c] *= f
+            v[i, c] *= f
+            k = 3 * i + c
+            csx[k] *= f
+            csv[k] *= f
+            for j in range(7):
+                b[j, k] *= f
+                e[j, k] *= f
+                br[j, k] *= f
+                er[j, k] *= f
+                g[j, k] *= f
+
+
 @njit(
     types.Tuple((types.int64, types.int64))(
         ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F2, _F1, _F1,
@@ -674,6 +702,7 @@ def advance_variational(
             continue
         _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
         _megno_radau(ms, t, dt_try, b, a0, x0, v0, 3 * n_phys, 6 * n_phys)
+        _renormalise(r, v, b, e, br, er, g, csx, csv, gm.shape[0])
         if landing:
             t = t_end
             t_cs = 0.0

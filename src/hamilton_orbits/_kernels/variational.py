@@ -26,12 +26,14 @@ from hamilton_orbits._kernels.jacobians import TANGENT_TYPE
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
 
 __all__ = [
+    "LN_RESCALE",
     "MEGNO_FIELDS",
     "advance_leapfrog",
     "kepler_tangent",
     "log_norm",
     "megno_map_step",
     "megno_update",
+    "renormalise",
     "stumpff_c4c5",
 ]
 
@@ -92,6 +94,30 @@ def megno_map_step(ms, lnd, t, dt):  # pragma: no cover - compiled
     dy = 2.0 * (t - 0.5 * dt - ms[0]) * (lnd - ms[8])
     ms[8] = lnd
     megno_update(ms, dy, t, dt)
+
+
+#: ``ln |delta|`` above which MEGNO's tangent vector is scaled back to unit length
+#: inside the kernels (|delta| ~ 1e100; it grows like exp(lambda t) on a chaotic
+#: orbit, and faster through a close encounter; MEGNO depends on its direction).
+LN_RESCALE = 230.0
+
+
+@njit(cache=True, error_model="numpy")
+def renormalise(ms, dr, dv, n):  # pragma: no cover - compiled
+    """Scale tangent vector 0 (rows ``0 .. n-1`` of ``dr``, ``dv``) to unit length when
+    ``ln |delta|`` (``ms[8]``, just updated) exceeds :data:`LN_RESCALE`; returns the
+    factor (1.0 when left alone).  The tangent dynamics are linear: the scaled
+    vector evolves as the original divided by the factor, and ``ms[8]`` is reduced
+    by its logarithm, so MEGNO's increments are unchanged."""
+    if not ms[8] > LN_RESCALE:
+        return 1.0
+    f = math.exp(-ms[8])
+    for i in range(n):
+        for c in range(3):
+            dr[i, c] *= f
+            dv[i, c] *= f
+    ms[8] = 0.0
+    return f
 
 
 @njit(cache=True, error_model="numpy")
@@ -231,4 +257,5 @@ def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms):
                 dv[a, c] += h * da[a, c]
         _drift(r, v, dr, dv, 0.5 * h)
         megno_map_step(ms, log_norm(dr, dv, n, 0), t0 + (s + 1) * h, h)
+        renormalise(ms, dr, dv, n)
     return n_steps

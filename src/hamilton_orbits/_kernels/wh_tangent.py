@@ -33,7 +33,7 @@ from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.jacobians import TANGENT_TYPE, newtonian_jvp
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
-from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step
+from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
 from hamilton_orbits._kernels.wh import jacobi_factors, jacobi_to_inertial_pos
 
 __all__ = ["advance_dh", "advance_jacobi"]
@@ -188,6 +188,10 @@ def advance_dh(extra, tangent_extra, p, has_extra, q, u, gm, gm_p, com, dq, du, 
                  m_tot, w)
         megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t + 0.5 * h,
                        t + 0.5 * h - t_last)
+        f = renormalise(ms, dq, du, n)
+        if f != 1.0:
+            for c in range(6):
+                dcom[0, c] *= f
         t_last = t + 0.5 * h
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift_dh(q, u, com, dq, du, dcom, mu, 0.5 * (h + h_next), xa, va)
@@ -310,6 +314,7 @@ def advance_jacobi(extra, tangent, p, has_extra, qj, uj, gm, eta, dq, du, dt, n_
                      w)
         megno_map_step(ms, _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0), t + 0.5 * h,
                        t + 0.5 * h - t_last)
+        renormalise(ms, dq, du, n)
         t_last = t + 0.5 * h
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift_jacobi(qj, uj, dq, du, eta, 0.5 * (h + h_next), xa, va)

@@ -38,15 +38,11 @@ from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.integrators import output_arrays
 from hamilton_orbits.integrators._setup import accel_arg
 
-__all__ = ["DEFAULT_SEED", "RESCALE_ABOVE", "Tangent", "run_dop853", "run_leapfrog",
+__all__ = ["DEFAULT_SEED", "Tangent", "run_dop853", "run_leapfrog",
            "run_radau15", "run_wh"]
 
 #: The seed of the random tangent vector of MEGNO when none is given.
 DEFAULT_SEED = 2275
-#: MEGNO's tangent vector is rescaled between compiled calls when a component
-#: exceeds this (it grows like exp(lambda t) on a chaotic orbit; MEGNO depends on
-#: its direction only).  The STM columns are never rescaled.
-RESCALE_ABOVE = 1e30
 
 
 class Tangent:
@@ -70,7 +66,9 @@ class Tangent:
     megno, lyapunov : ndarray, shape (n_t,)
         MEGNO ``<Y>`` and the Lyapunov exponent at the outputs (0 at the start).
     stm : ndarray, shape (n_t, 6n, 6n) or None
-        The state transition matrices at the outputs.
+        The state transition matrices at the outputs (never rescaled; MEGNO's
+        vector is, inside the kernels, when it passes 1e100: see
+        :func:`hamilton_orbits._kernels.variational.renormalise`).
     ms : ndarray
         The MEGNO state (:data:`hamilton_orbits._kernels.variational.MEGNO_FIELDS`).
 
@@ -125,19 +123,6 @@ class Tangent:
                                   axis=2)
             self.stm[i] = cols.reshape(6 * n, 6 * n).T
 
-    def rescale(self, dr: np.ndarray, dv: np.ndarray) -> float:
-        """Scale MEGNO's vector (rows ``0 .. n-1``) down when it exceeds
-        :data:`RESCALE_ABOVE`; the factor (1.0 when it was left alone)."""
-        n = self.n
-        big = max(float(np.max(np.abs(dr[:n]))), float(np.max(np.abs(dv[:n]))))
-        if not (big > RESCALE_ABOVE and math.isfinite(big)):
-            return 1.0
-        f = 1.0 / big
-        dr[:n] *= f
-        dv[:n] *= f
-        self.ms[8] += math.log(f)
-        return f
-
 
 def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
                 tangent: Tangent, *, dt: float, tol: float, prs23: bool, max_steps: int,
@@ -167,10 +152,6 @@ def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out:
                 bool(rhs.velocity_dependent), min(slice_steps, max_steps - total), n_phys,
                 tangent.ms)
             total += steps
-            f = tangent.rescale(x[n:], w[n:])
-            if f != 1.0:  # the step's polynomial and compensations of MEGNO's vector too
-                for arr in (*work, csx.reshape(-1, 3), csv.reshape(-1, 3)):
-                    arr.reshape(-1, x.shape[0], 3)[:, n:2 * n] *= f
             if status == _radau.STATUS_OK:
                 break
             if status != _radau.STATUS_MAXSTEPS or total >= max_steps:
@@ -213,7 +194,6 @@ def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out
     for i in range(1, t_out.shape[0]):
         steps += _var.advance_leapfrog(accel, jac, rhs.p, r, v, gm, dr, dv, float(t_out[i - 1]),
                                        float(t_out[i]), dt, tangent.ms)
-        tangent.rescale(dr, dv)
         r_out[i], v_out[i] = r, v
         tangent.record(i, float(t_out[i]), dr, dv)
         if on_output is not None:
@@ -312,11 +292,6 @@ def run_wh(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.n
         drr, dvv = _from_split(dq.reshape(k, n, 3), du.reshape(k, n, 3), dcom, g, jacobi)
         dr_in = np.ascontiguousarray(drr[:, inv_order].reshape(k * n, 3))
         dv_in = np.ascontiguousarray(dvv[:, inv_order].reshape(k * n, 3))
-        f = tangent.rescale(dr_in, dv_in)
-        if f != 1.0:
-            dq[:n] *= f
-            du[:n] *= f
-            dcom[0] *= f
         tangent.record(i, float(t_out[i]), dr_in, dv_in)
         if on_output is not None:
             on_output(i, total)
@@ -331,6 +306,8 @@ def run_dop853(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: 
     tangent vectors (:attr:`RHS.augmented`) and MEGNO's integral
     ``Ys' = 2 (t - t0) delta'.delta / |delta|^2``, step by step (scipy's stepper),
     MEGNO's averages and regression updated after every step as rebound does.
+    MEGNO's vector is not rescaled here (a chaotic run long enough to take it
+    past 1e308 overflows: use radau15 or wh for those).
     ``atol``: the bodies' absolute tolerances (6n,); the tangent components and
     ``Ys`` are left out of the error control (infinite ``atol``) unless ``control``."""
     from scipy.integrate import DOP853
