@@ -99,8 +99,9 @@ def newtonian_jvp(r, v, gm, dr, dv, da):  # pragma: no cover - compiled
             dy = r[j, 1] - r[i, 1]
             dz = r[j, 2] - r[i, 2]
             d2 = dx * dx + dy * dy + dz * dz
-            inv2 = 1.0 / d2
-            inv3 = inv2 / np.sqrt(d2)
+            inv1 = 1.0 / np.sqrt(d2)  # one division per pair
+            inv2 = inv1 * inv1
+            inv3 = inv2 * inv1
             c = -3.0 * inv3 * inv2
             t00 = inv3 + c * dx * dx
             t11 = inv3 + c * dy * dy
