@@ -194,7 +194,7 @@ def integrate(
         Integrate the first-order variational equations beside the system (every
         listed effect's Jacobian included): the trajectory then has ``megno`` and
         ``lyapunov`` (from one tangent vector, as rebound's MEGNO; see
-        :mod:`hamilton_orbits.variational`).  Forwards in time, without events.
+        ``docs/variational.md``).  Forwards in time, without events.
     stm : bool
         With ``variational``: also the state transition matrix ``traj.stm`` (6n
         more tangent vectors).
@@ -232,6 +232,9 @@ def integrate(
     >>> jac = integrate(s, 2 * np.pi, method="wh", dt=0.1, coordinates="jacobi", corrector=3)
     >>> bool(np.allclose(jac.final["dust"].r, [1, 0, 0], atol=1e-12))  # a Kepler orbit: exact
     True
+    >>> var = integrate(s, 2 * np.pi, method="wh", dt=0.1, variational=True, stm=True)
+    >>> var.stm.shape, var.megno.shape  # d(r, v)(t)/d(r, v)(0) of both bodies; MEGNO
+    ((2, 12, 12), (2,))
     >>> integrate(s, 1.0, method="leapfrog", dt=0.1, effects=["gr"])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...

@@ -467,6 +467,23 @@ def test_megno_of_mercury_with_and_without_gr_1000_years():
     assert abs(out[()][0][-1] - out[("gr",)][0][-1]) < 1e-4
 
 
+def test_tangent_vectors_do_not_drive_radau15s_steps():
+    """radau15 chooses its step from the bodies alone: with the variational
+    equations (55 tangent vectors that grow 100-fold) the same steps as without,
+    and the same trajectory to rounding (the predictor-corrector iteration, which
+    runs over every component as in rebound's IAS15, may stop one iteration
+    apart); ``tangent_control=True`` lets the tangent vectors in."""
+    s = _three()
+    t = 20 * 2 * np.pi
+    plain = integrate(s, t)
+    var = integrate(s, t, variational=True, stm=True)
+    assert var.steps == plain.steps
+    assert np.max(np.abs(var.r[-1] - plain.r[-1])) < 1e-12
+    ctrl = integrate(s, t, variational=True, stm=True, tangent_control=True)
+    assert ctrl.steps >= plain.steps
+    assert np.max(np.abs(ctrl.stm[-1] - var.stm[-1])) < 1e-8 * np.max(np.abs(var.stm[-1]))
+
+
 # ---------------------------------------------------------------------------
 # The API
 
