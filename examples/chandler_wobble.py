@@ -106,8 +106,8 @@ def main(argv: list[str] | None = None) -> str:
     fig, axes = plt.subplots(2, 2, figsize=(12, 9))
     ax = axes[0, 0]
     ax.plot(rec.x.to_value(u.mas), rec.y.to_value(u.mas), lw=0.3)
-    ax.set_xlabel("x_p (mas)")
-    ax.set_ylabel("y_p (mas)")
+    ax.set_xlabel("x_p, terrestrial axes, towards Greenwich (mas)")
+    ax.set_ylabel("y_p, terrestrial axes, towards 90° W (mas)")
     ax.set_aspect("equal")
     ax.set_title("observed pole, IERS 20 C04")
     ax = axes[0, 1]
@@ -130,7 +130,7 @@ def main(argv: list[str] | None = None) -> str:
     ax.plot(years, m_model.real.to_value(u.mas), lw=0.8,
             label=f"Liouville: elastic + damping (Q = {Q_CITED:.0f}) + annual")
     ax.set_xlabel("year")
-    ax.set_ylabel("m1 = x_p (mas)")
+    ax.set_ylabel("m1 = x_p, towards Greenwich (mas)")
     ax.legend(fontsize=8, loc="lower left")
     ax.set_title("linear Liouville model against the data")
     ax = axes[1, 1]

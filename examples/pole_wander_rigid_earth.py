@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> str:
         ("Euler period, axisymmetric", f"{earth.euler_period().to_value(u.day):.6f}", "d"),
         ("period fitted, splitting4", f"{p_split.to_value(u.day):.6f}", "d"),
         ("period fitted, exact free motion", f"{p_exact.to_value(u.day):.6f}", "d"),
-        ("max |m_split - m_exact|", f"{diff.to_value(u.uas):.3e}", "uas"),
+        ("max |m_split - m_exact|", f"{diff.to_value(u.uas):.3e}", "µas"),
         ("wobble amplitude", f"{np.max(np.abs(exact.m)) * 206264806.247:.3f}", "mas"),
         (f"wall time splitting4, {years} yr daily", f"{t_split:.3f}", "s"),
         (f"wall time exact, {years} yr daily", f"{t_exact:.3f}", "s"),
@@ -82,14 +82,14 @@ def main(argv: list[str] | None = None) -> str:
              label="splitting4")
     ax1.plot(exact.x[:n:10].to_value(u.mas), exact.y[:n:10].to_value(u.mas), "k.", ms=3,
              label="exact free motion")
-    ax1.set_xlabel("x_p (mas)")
-    ax1.set_ylabel("y_p (mas)")
+    ax1.set_xlabel("x_p, body axis 1 (mas)")
+    ax1.set_ylabel("y_p, body axis 2 (mas)")
     ax1.set_aspect("equal")
     ax1.set_title(f"rigid-Earth pole, period {p_split.to_value(u.day):.2f} d")
     ax1.legend(loc="center")
     ax2.semilogy(split.t.to_value(u.yr), np.abs(split.m - exact.m) * 206264806247.1, lw=0.5)
-    ax2.set_xlabel("time (yr)")
-    ax2.set_ylabel("|splitting - exact| (uas)")
+    ax2.set_xlabel("time since the start (yr)")
+    ax2.set_ylabel("|splitting - exact| (µas)")
     ax2.set_title("integrator against the exact motion")
     fig.tight_layout()
     fig.savefig(out / "pole_wander_rigid_earth.png", dpi=110)

@@ -4,12 +4,44 @@ Hypothesis runs with random examples on developers' machines (that is how it
 finds bugs: see the regression tests it left behind) and derandomised under CI
 (``CI`` set), so that a submission's CI verdict does not depend on the luck of
 one draw; the examples CI uses are still the same full budget per test.
+
+A first test run on a machine compiles the package's numba kernels (minutes on
+two cores) before the first tests report anything: the session says so in one
+line when numba's cache holds none of the kernels yet (:func:`numba_cache_cold`).
 """
 
+import importlib.util
 import os
+from pathlib import Path
 
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+COLD_NOTICE = (
+    "hamilton-orbits: numba's cache holds none of the package's kernels yet: the first "
+    "tests compile them (a few minutes on 2 cores, once; later runs load them)"
+)
+
+
+def numba_cache_cold() -> bool:
+    """True when numba's on-disk cache has no index file of the radau15 kernels
+    (numba writes ``<module>.<function>-<line>.pyXY.nbi`` beside the source, in
+    ``__pycache__``, or under ``NUMBA_CACHE_DIR``), found without importing numba."""
+    spec = importlib.util.find_spec("hamilton_orbits")
+    if spec is None or spec.origin is None:
+        return False
+    kernels = Path(spec.origin).parent / "_kernels"
+    custom = os.environ.get("NUMBA_CACHE_DIR")
+    if custom:
+        return not any(Path(custom).rglob("radau15.*.nbi"))
+    return not any((kernels / "__pycache__").glob("radau15.*.nbi"))
+
+
+def pytest_sessionstart(session):
+    if numba_cache_cold():
+        reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+        if reporter is not None:
+            reporter.write_line(COLD_NOTICE)

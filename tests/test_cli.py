@@ -1,7 +1,9 @@
 """The console script answers --version, --help, runs scenes and the demo."""
 
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -97,3 +99,58 @@ def test_crosscheck_command_on_an_nbody_scene(capsys):
     assert main(["crosscheck", "leo-j2", "--set", "duration=0.2 d"]) == 0
     out = capsys.readouterr().out
     assert "rebound ias15 + reboundx" in out and "satellite" in out
+
+
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+
+def _cli(*args: str, cwd: str | None = None) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=SRC)
+    return subprocess.run([sys.executable, "-m", "hamilton_orbits.cli", *args], env=env,
+                          cwd=cwd, capture_output=True, text=True, timeout=600)
+
+
+def test_no_progress_before_any_command(tmp_path):
+    """`hamilton-orbits --no-progress` parses (it was a flag of the subcommands only),
+    also before a command; after one, as before."""
+    for argv in (["--no-progress", "run", "leo-j2"], ["run", "leo-j2", "--no-progress"]):
+        code = main([*argv, "--out", str(tmp_path), "--set", "duration=1 h"])
+        assert code == 0, argv
+    res = _cli("--no-progress", "--version")
+    assert res.returncode == 0, res.stderr
+
+
+def test_scene_listing_keeps_words_whole(capsys):
+    from hamilton_orbits.scene import Scene
+
+    assert main(["scenes"]) == 0
+    out = capsys.readouterr().out
+    words = set(out.split())
+    for name, description in Scene.list_bundled():
+        assert set(description.split()) <= words, name  # no word cut in two
+
+
+def test_quoted_run_time_is_what_the_command_takes(tmp_path):
+    """The listing quoted 3-4x the measured times.  The quoted time of a quick scene
+    is the whole command's, warm, within a factor 3 either way (a loaded 2-core
+    machine runs 1.5-2x slower than an idle one)."""
+    import time
+
+    from hamilton_orbits.scene import Scene
+
+    quoted = float(Scene.bundled("leo-j2").spec["runtime"].strip("~ s"))
+    assert _cli("run", "leo-j2", "--set", "duration=1 h", cwd=str(tmp_path)).returncode == 0
+    start = time.perf_counter()
+    res = _cli("run", "leo-j2", cwd=str(tmp_path))
+    measured = time.perf_counter() - start
+    assert res.returncode == 0, res.stderr
+    assert measured / 3 < quoted < 3 * measured
+
+
+def test_report_without_its_extra_names_it_without_a_traceback(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "mpmath", None)  # as if mpmath were not installed
+    assert main(["report", "--quick", "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert "pip install 'hamilton-orbits[report]'" in err
+    assert "Traceback" not in err

@@ -76,13 +76,20 @@ def test_chandler_wobble_quick(tmp_path):
 
 @pytest.mark.slow  # four clones in worker processes: ~40 s on a loaded 2-core machine
 def test_ensemble_comet_clones_quick(tmp_path):
-    """Every clone runs; the encounter scatters the semi-major axis (some clones escape)."""
+    """Every clone runs; the encounter scatters 1/a (some clones escape: 1/a < 0),
+    reported as 1/a, which is smooth through the parabola, not as a, which jumps
+    through +-infinity there."""
     out = run("ensemble_comet_clones.py", str(tmp_path), "--quick")
     assert "4 clones, 0 failed" in out
-    rows = re.findall(r"^\s+(0\.999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s", out, flags=re.M)
+    rows = re.findall(r"^\s+(0\.999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)\s+(bound|escapes)",
+                      out, flags=re.M)
     assert len(rows) == 4
-    assert all(0.02 < float(c) < 0.04 for _, c, _ in rows)
-    assert len({round(float(a)) for _, _, a in rows}) == 4
+    assert all(0.02 < float(c) < 0.04 for _, c, _, _, _ in rows)
+    inv_a = [float(x) for _, _, x, _, _ in rows]
+    assert len({round(x, 5) for x in inv_a}) == 4
+    assert all((x > 0) == (kind == "bound") for x, (*_, kind) in zip(inv_a, rows, strict=True))
+    # the encounter lifts the perihelion from 0.01 au to 0.07-0.09 au (16 clones)
+    assert all(0.05 < float(q) < 0.12 for _, _, _, q, _ in rows)
     assert (tmp_path / "comet_clones.png").stat().st_size > 10_000
 
 
@@ -97,3 +104,15 @@ def test_stability_map_quick(tmp_path):
     for failed, chaotic, regular in rows:
         assert int(failed) == 0 and 10 < float(chaotic) < 90 and abs(float(regular) - 2) < 0.1
     assert (tmp_path / "stability_map.png").stat().st_size > 30_000
+
+
+def test_pole_prediction_quick(tmp_path):
+    """The hindcast tables carry every method beside the published rows; figures written."""
+    out = run("pole_prediction.py", str(tmp_path), "--quick")
+    assert "126 weekly starts" in out
+    for name in ("persistence", "ls+ar", "ls+var", "liouville", "WLS+VAR (Lei et al. 2023)"):
+        assert re.search(rf"^{re.escape(name)}\s+[\d.]+", out, flags=re.M), name
+    assert re.search(r"at or below in \d+ of 10 cells", out)
+    for png in ("prediction_fan", "mae_vs_horizon", "coverage"):
+        assert (tmp_path / f"{png}.png").stat().st_size > 10_000
+    assert (tmp_path / "pole_prediction.txt").read_text().startswith("scene pole-prediction")

@@ -7,12 +7,19 @@ when it is loaded from the on-disk cache) prints one line the first time a
 function of this package (or of ``rigid``) compiles, at most once per process.
 It is a plain line on stderr, not a warning (the test suite turns warnings into
 errors), and costs nothing once the cache is warm.
+
+The same listener keeps a clock of compilation (:func:`compile_seconds`,
+:func:`compile_count`): the seconds spent in numba's outermost compile events
+(a function compiling the functions it calls is one event), so that a run can
+report its integration time without the compilation that happened inside it,
+and the compilation on its own line.
 """
 
 from __future__ import annotations
 
 import sys
 import threading
+import time
 
 from numba.core import event
 
@@ -26,6 +33,8 @@ GENERATED_PREFIX = "hamilton_orbits_rhs_"
 
 _lock = threading.Lock()
 _state = {"printed": False}
+_clock = {"seconds": 0.0, "count": 0, "claimed_seconds": 0.0, "claimed_count": 0}
+_local = threading.local()
 
 
 def _ours(dispatcher: object) -> bool:
@@ -36,6 +45,10 @@ def _ours(dispatcher: object) -> bool:
 
 class _CompileNotice(event.Listener):
     def on_start(self, ev: event.Event) -> None:
+        depth = getattr(_local, "depth", 0)
+        if depth == 0:
+            _local.start = time.perf_counter()
+        _local.depth = depth + 1
         if _state["printed"]:
             return
         data = ev.data if isinstance(ev.data, dict) else {}
@@ -51,7 +64,61 @@ class _CompileNotice(event.Listener):
             pass
 
     def on_end(self, ev: event.Event) -> None:
-        pass
+        depth = getattr(_local, "depth", 0) - 1
+        _local.depth = max(depth, 0)
+        if depth == 0:
+            elapsed = time.perf_counter() - _local.start
+            with _lock:
+                _clock["seconds"] += elapsed
+                _clock["count"] += 1
+
+
+def compile_seconds() -> float:
+    """Seconds spent compiling with numba in this process so far (every package's
+    functions; nested compilations counted once).
+
+    Examples
+    --------
+    >>> before = compile_seconds()
+    >>> compile_seconds() >= before >= 0.0
+    True
+    """
+    return _clock["seconds"]
+
+
+def claim_compilation() -> tuple[float, int]:
+    """The compilation not claimed before: ``(seconds, count)`` since the last call
+    (or since the process started), then marked as claimed.
+
+    A scene's run claims it at its end, so that its summary reports the
+    compilation that its first run in a process really cost, including kernels
+    compiled when their module was imported (those with explicit signatures
+    compile at import, before the run starts), and a second run reports none.
+
+    Examples
+    --------
+    >>> _ = claim_compilation()
+    >>> claim_compilation()
+    (0.0, 0)
+    """
+    with _lock:
+        seconds = _clock["seconds"] - _clock["claimed_seconds"]
+        count = _clock["count"] - _clock["claimed_count"]
+        _clock["claimed_seconds"] = _clock["seconds"]
+        _clock["claimed_count"] = _clock["count"]
+    return seconds, count
+
+
+def compile_count() -> int:
+    """How many outermost numba compilations this process has run (0 in a process
+    whose kernels all came from the on-disk cache).
+
+    Examples
+    --------
+    >>> compile_count() >= 0
+    True
+    """
+    return _clock["count"]
 
 
 def install() -> None:

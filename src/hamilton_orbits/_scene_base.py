@@ -161,10 +161,17 @@ class Result:
         Named tables (lists of row dicts), e.g. the per-body cross-check.
     states : dict
         Arrays to save (``names``, ``r``, ``v`` for n-body scenes).
-    wall_time : float
-        Seconds the simulation took.
     complete : bool
         False if the run was stopped early (Ctrl-C); what was done is kept.
+    frame : str
+        The axes of the states (and their origin), named in the summary.
+    wall_time : float
+        Seconds of the integration proper: no compilation (see ``compile_time``).
+    compile_time : float
+        Seconds spent compiling kernels during the run (numba's compile events;
+        0 when everything came from the cache), apart from ``wall_time``.
+    compile_count : int
+        How many kernels were compiled during the run.
     """
 
     scene: Any
@@ -175,6 +182,9 @@ class Result:
     states: dict[str, Any] = field(default_factory=dict)
     wall_time: float = 0.0
     complete: bool = True
+    frame: str = ""
+    compile_time: float = 0.0
+    compile_count: int = 0
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
                                                                 repr=False)
@@ -185,6 +195,8 @@ class Result:
         lines = [f"scene {s.name} ({s.kind}): {s.spec.get('description', '').strip()}"]
         effects = ", ".join(e["name"] for e in s.effects) or "none"
         lines.append(f"effects: {effects}")
+        if self.frame:
+            lines.append(f"frame: {self.frame}")
         if not self.complete:
             lines.append("STOPPED EARLY: the results cover the part that was run")
         span = self.times[-1] - self.times[0] if len(self.times) else 0 * u.d
@@ -193,7 +205,13 @@ class Result:
             span = span.to(asked.unit)
         elif span > 1 * u.yr:
             span = span.to(u.yr)
-        lines.append(f"simulated: {_fmt(span)} in {self.wall_time:.2f} s")
+        lines.append(f"simulated: {_fmt(span)} in {self.wall_time:.2f} s of integration "
+                     "(compilation apart)")
+        if self.compile_count:
+            lines.append(f"compiled: {self.compile_count} numba kernels in "
+                         f"{self.compile_time:.2f} s (first run only: cached for later runs)")
+        else:
+            lines.append("compiled: nothing (every kernel loaded from numba's cache)")
         if self.metrics:
             lines.append("")
             rows = [{"quantity": k, "value": v} for k, v in self.metrics.items()]
@@ -234,7 +252,10 @@ class Result:
             "description": self.scene.spec.get("description", ""),
             "effects": [{k: conv(v) for k, v in e.items()} for e in self.scene.effects],
             "complete": self.complete,
+            "frame": self.frame,
             "wall_time_s": self.wall_time,
+            "compile_time_s": self.compile_time,
+            "compile_count": self.compile_count,
             "metrics": {k: conv(v) for k, v in self.metrics.items()},
             "tables": {k: [{c: conv(x) for c, x in r.items()} for r in rows]
                        for k, rows in self.tables.items()},

@@ -26,6 +26,7 @@ from hamilton_orbits._scene_base import (
     format_table,
     register_kind,
 )
+from hamilton_orbits.frames import FRAMES, frame_label
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
 
 METHODS = ("radau15", "wh", "leapfrog", "dop853")
@@ -37,12 +38,15 @@ ANALYSES = {
     "perihelion_advance": "secular rate of the longitude of perihelion of `body` about `primary`",
     "nodal_regression": "secular rate of the node of `body` about `primary`, beside the J2 formula",
     "close_approach": "the smallest distance between `body` and `other`, and when",
+    "de440_residuals": "the positions against JPL's DE440 at whole years from J2000 (needs "
+                       "[initial] ephemeris)",
 }
 # the keys of each analysis besides its name: (required, optional)
 _ANALYSIS_KEYS = {
     "perihelion_advance": (("body",), ("primary",)),
     "nodal_regression": (("body",), ("primary",)),
     "close_approach": (("body", "other"), ("primary",)),
+    "de440_residuals": ((), ()),
 }
 
 
@@ -113,10 +117,19 @@ SCHEMA: dict[str, S.Field] = {
                 fields={
                     "epoch": S.String(default="J2000"),
                     "bodies": S.Array(item=S.Choice(choices=SOLAR_SYSTEM)),
+                    "origin": S.Choice(choices=("barycentre", "ssb"), default="barycentre"),
+                }
+            ),
+            "ephemeris": S.Table(
+                fields={
+                    "epoch": S.String(default="J2000"),
+                    "bodies": S.Array(item=S.String()),
                 }
             ),
             "rebound": S.String(),
             "names": S.Array(item=S.String()),
+            # the axes of every state and element of the scene (hamilton_orbits.frames)
+            "frame": S.Choice(choices=tuple(FRAMES), default="icrs"),
         },
     ),
     "bodies": S.Array(item=BODY, default=[]),
@@ -131,7 +144,7 @@ SCHEMA: dict[str, S.Field] = {
         item=S.Table(
             fields={
                 "name": S.Choice(choices=tuple(ANALYSES), required=True),
-                "body": S.String(required=True),
+                "body": S.String(),
                 "primary": S.String(),
                 "other": S.String(),
             }
@@ -168,6 +181,11 @@ def _initial_names(spec: dict) -> list[str]:
     ss = spec["initial"].get("solar_system")
     if ss is not None:
         names += list(_DEFAULT_SOLAR if ss.get("bodies") is None else ss["bodies"])
+    eph = spec["initial"].get("ephemeris")
+    if eph is not None:
+        from hamilton_orbits.ephemeris import DEFAULT_BODIES
+
+        names += list(DEFAULT_BODIES if eph.get("bodies") is None else eph["bodies"])
     return names
 
 
@@ -225,8 +243,10 @@ def _check_analyses(analyses: list, names: list[str], problems: S.Problems) -> N
 def _check_initial(init: dict, problems: S.Problems) -> None:
     from hamilton_orbits.nbody import solar_system_bodies, solar_system_epoch
 
-    if init.get("rebound") is not None and init.get("solar_system") is not None:
-        problems.add("initial", "give either `solar_system` or `rebound`, not both")
+    given = [k for k in ("solar_system", "ephemeris", "rebound") if init.get(k) is not None]
+    if len(given) > 1:
+        problems.add("initial", f"give one of `solar_system`, `ephemeris`, `rebound`, not "
+                                f"{' and '.join(given)}")
     ss = init.get("solar_system")
     if ss is not None:
         checks = [("epoch", solar_system_epoch, ss.get("epoch")),
@@ -431,7 +451,14 @@ def build_system(spec: dict, problems: S.Problems | None = None):
     ss = init.get("solar_system")
     if ss is not None:
         base = _attempt(problems, "initial.solar_system", lambda: System.solar_system(
-            ss["epoch"], bodies=ss.get("bodies")), ("epoch", "bodies"))
+            ss["epoch"], bodies=ss.get("bodies"), frame=scene_frame(spec),
+            origin=ss.get("origin") or "barycentre"), ("epoch", "bodies"))
+        bodies += [] if base is None else [base[n] for n in base.names]
+    eph = init.get("ephemeris")
+    if eph is not None:
+        base = _attempt(problems, "initial.ephemeris", lambda: System.from_ephemeris(
+            eph["epoch"], bodies=eph.get("bodies"), frame=scene_frame(spec)),
+            ("epoch", "bodies"))
         bodies += [] if base is None else [base[n] for n in base.names]
     by_name = {b.name: b for b in bodies}
     for i, b in enumerate(spec["bodies"]):
@@ -445,6 +472,24 @@ def build_system(spec: dict, problems: S.Problems | None = None):
     if problems:
         return None
     return _attempt(problems, "bodies", lambda: System(bodies))
+
+
+def scene_frame(spec: dict) -> str:
+    """The frame of a validated n-body scene's states (``[initial] frame``)."""
+    return spec["initial"].get("frame") or "icrs"
+
+
+def frame_note(spec: dict) -> str:
+    """The frame line of a scene's summary: the axes, and the origin of the
+    solar-system bodies."""
+    note = frame_label(scene_frame(spec))
+    ss = spec["initial"].get("solar_system")
+    if ss is not None:
+        origin = ss.get("origin") or "barycentre"
+        note += ("; origin: the centre of mass of the scene's solar-system bodies, at rest"
+                 if origin == "barycentre" else
+                 "; origin: the solar-system barycentre (the ephemeris's)")
+    return note
 
 
 def _times(spec: dict) -> u.Quantity:
@@ -499,9 +544,10 @@ def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
     arrays = system.as_arrays()
     bar = _progress_bar(len(t_all) - 1, progress)
     try:
-        out = engine.run(arrays.r, arrays.v, arrays.gm, t_all, rhs, method, stop=stop,
-                         on_output=None if bar is None else (lambda i, steps: bar.update(1)),
-                         events=log, variational=tangent, **kw)
+        out = without_compilation(lambda: engine.run(
+            arrays.r, arrays.v, arrays.gm, t_all, rhs, method, stop=stop,
+            on_output=None if bar is None else (lambda i, steps: bar.update(1)), events=log,
+            variational=tangent, **kw))
     finally:
         if bar is not None:
             bar.close()
@@ -536,6 +582,20 @@ def _events_into(result: Result, system, out) -> None:
         {"event": str(row["name"]), "time": row["time"], "bodies": str(row["bodies"]),
          "distance": row["distance"], "speed": row["speed"].to(u.km / u.s),
          "action": str(row["action"])} for row in table]
+
+
+def without_compilation(run: Any) -> Any:
+    """``run()`` (an engine call), its ``wall_time`` less the numba compilation that
+    happened inside it (the integration proper: a first run compiles the stepping
+    kernels on their first call)."""
+    import dataclasses
+
+    from hamilton_orbits._firstrun import compile_seconds
+
+    before = compile_seconds()
+    out = run()
+    compiled = compile_seconds() - before
+    return dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
 
 
 def _chaos_into(result: Result, out) -> None:
@@ -576,7 +636,9 @@ def _result(scene: Any, system, out, method: str, effects) -> Result:
     and the final state as a rebound binary."""
     from hamilton_orbits.nbody import integral_errors
 
-    energy, ang, drift = integral_errors(out.r, out.v, system.as_arrays().gm, out.t)
+    gm = system.as_arrays().gm.copy()
+    extra = _effects.effect_energy(system, effects, out.r, out.v)
+    energy, ang, drift = integral_errors(out.r, out.v, gm, out.t, extra)
     result = Result(
         scene=scene,
         times=out.t * u.d,
@@ -588,12 +650,15 @@ def _result(scene: Any, system, out, method: str, effects) -> Result:
     )
     result.metrics["integrator"] = method
     result.metrics["steps"] = out.steps
-    label = "max |relative energy error|"
-    if effects:
-        label = "max |dE/E| of the Newtonian energy (effects do not conserve it)"
-    result.metrics[label] = float(np.max(np.abs(energy)))
-    result.plotters.append(_plot_orbits)
-    result.plotters.append(_plot_energy)
+    what = _effects.energy_label(gm, effects, system.names)
+    conserved = extra is not None
+    result.metrics["energy"] = what
+    key = "max |relative energy error|" if conserved else "max |relative energy change|"
+    result.metrics[key] = float(np.max(np.abs(energy)))
+    frame = scene_frame(scene.spec)
+    result.frame = frame_note(scene.spec)
+    result.plotters.append(lambda res: _plot_orbits(res, gm, frame))
+    result.plotters.append(lambda res: _plot_energy(res, what, conserved))
     final = system.with_state(out.r[-1], out.v[-1])
 
     def write_rebound(_result: Result, folder: Path) -> list[Path]:
@@ -684,11 +749,74 @@ def _close_approach(result: Result, system, an: dict) -> None:
         orbits = _relative_orbits(result, system, an["body"], primary)
         for label, idx in (("before", 0), ("after", -1)):
             o = orbits[idx]
+            # 1/a too: it is continuous through the parabola (a jumps from +inf to
+            # -inf there, as a clone that escapes does), and q, finite for every conic
             result.metrics[f"{an['body']} orbit {label}: a"] = o.a.to(u.au)
+            result.metrics[f"{an['body']} orbit {label}: 1/a"] = (1 / o.a).to(1 / u.au)
+            result.metrics[f"{an['body']} orbit {label}: q"] = o.q.to(u.au)
             result.metrics[f"{an['body']} orbit {label}: e"] = float(o.e)
 
 
+def _de440_residuals(result: Result, system, an: dict) -> None:
+    """The positions against DE440's at the whole years from J2000 among the outputs:
+    km and arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100
+    years (those reached), and a figure of the residual against time."""
+    from hamilton_orbits.ladder import BODIES, residuals
+
+    years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start (J2000)
+    whole = np.flatnonzero(np.abs(years - np.round(years)) < 1e-9)
+    if result.scene.spec["initial"].get("ephemeris") is None or len(whole) < 2:
+        result.metrics["DE440 residuals"] = "need [initial] ephemeris and yearly outputs"
+        return
+    if scene_frame(result.scene.spec) != "icrs":
+        from hamilton_orbits.frames import frame_rotation
+
+        rot = frame_rotation(scene_frame(result.scene.spec))
+        r = result.states["r"].to_value(u.au)[whole] @ rot  # back to ICRS axes
+    else:
+        r = result.states["r"].to_value(u.au)[whole]
+    yrs = np.round(years[whole]).astype(int)
+    km, arcsec = residuals(system.names, r, yrs)
+    result.diagnostics["de440_years"] = yrs
+    result.diagnostics["de440_km"] = km
+    rows = []
+    for k, body in enumerate(BODIES):
+        row = {"body": body}
+        for y in (10, 50, 100):
+            if y in yrs:
+                i = int(np.flatnonzero(yrs == y)[0])
+                row[f"{y} yr"] = f"{km[i, k]:.3g} km ({arcsec[i, k]:.2g}\")"
+        rows.append(row)
+    result.tables["residuals against DE440 (heliocentric; the Moon geocentric)"] = rows
+    result.metrics["largest residual at the end"] = (
+        f"{BODIES[int(np.argmax(km[-1]))]}: {km[-1].max():.3g} km")
+    result.plotters.append(_plot_de440)
+
+
+def _plot_de440(result: Result):
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.ladder import BODIES
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    years = result.diagnostics["de440_years"]
+    km = result.diagnostics["de440_km"]
+    colors = plt.cm.tab20(np.arange(len(BODIES)) / len(BODIES))
+    for k, body in enumerate(BODIES):
+        moon = body == "moon"
+        ax.semilogy(years[1:], np.maximum(km[1:, k], 1e-6), lw=1.4 if moon else 1,
+                    ls="--" if moon else "-", color="k" if moon else colors[k],
+                    label="moon (from the earth)" if moon else body)
+    ax.set_xlabel("time from J2000 [yr]")
+    ax.set_ylabel("position residual against DE440 [km]")
+    ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), ICRS")
+    ax.legend(fontsize=7, ncol=2)
+    fig._hamilton_name = "de440_residuals"
+    return fig
+
+
 _ANALYSIS_FUNCS = {
+    "de440_residuals": _de440_residuals,
     "perihelion_advance": _perihelion_advance,
     "nodal_regression": _nodal_regression,
     "close_approach": _close_approach,
@@ -700,7 +828,7 @@ def _crosscheck_into(result: Result, system, out, method: str, effects) -> None:
     from hamilton_orbits import crosscheck
     from hamilton_orbits.simulation import make_trajectory
 
-    traj = make_trajectory(system, out, u.d, method, ("newtonian", *effects.names))
+    traj = make_trajectory(system, out, u.d, method, ("newtonian", *effects.names), effects)
     table = crosscheck(system, None, method=method, effects=effects, trajectory=traj)
     result.tables["cross-check against rebound: final position difference"] = table.rows
     result.tables["cross-check against rebound: codes"] = table.code_rows
@@ -710,39 +838,180 @@ def _crosscheck_into(result: Result, system, out, method: str, effects) -> None:
         table.relative_position_difference.max())
 
 
-def _plot_orbits(result: Result):
+def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any]:
+    """What the orbit figure draws: positions relative to the primary (the most
+    massive body), in km below 0.01 au of extent and au above, and the bodies of an
+    inner panel (those inside the largest gap, by a factor 2.5 or more, in the
+    bodies' largest distances from the primary, when the outermost is 5 times
+    farther).
+
+    Parameters
+    ----------
+    names : list of str, (n,)
+    gm : ndarray, (n,)
+    r : ndarray, (n_t, n, 3)
+        Positions in au.
+
+    Examples
+    --------
+    >>> r = np.zeros((2, 3, 3)); r[:, 1, 0] = 1.0; r[:, 2, 0] = 30.0
+    >>> view = orbit_view(["sun", "earth", "neptune"], np.array([1.0, 3e-6, 5e-5]), r)
+    >>> view["primary"], view["unit"], view["inner"]
+    ('sun', 'au', ['earth'])
+    """
+    k = int(np.argmax(gm))
+    rel = r - r[:, k:k + 1]
+    reach = np.linalg.norm(rel, axis=-1).max(axis=0)
+    others = [i for i in range(len(names)) if i != k]
+    unit = "au" if reach.max(initial=0.0) > 0.01 else "km"
+    scale = 1.0 if unit == "au" else (1 * u.au).to_value(u.km)
+    inner: list[str] = []
+    if len(others) > 1:
+        order = sorted(others, key=lambda i: reach[i])
+        dist = np.maximum(reach[order], 1e-300)
+        ratios = dist[1:] / dist[:-1]
+        cut = int(np.argmax(ratios))
+        if ratios[cut] >= 2.5 and dist[-1] >= 5 * dist[cut]:
+            inner = [names[i] for i in order[:cut + 1]]
+    return {"primary": names[k], "rel": rel * scale, "unit": unit, "inner": inner,
+            "reach": reach * scale, "scale": scale, "index": k}
+
+
+def _coarse(cadence: float, r: np.ndarray, v: np.ndarray, mu: float) -> bool:
+    """True if the outputs are more than a 36th of the two-body period apart (10
+    degrees of mean anomaly: a line would draw chords, or, at a cadence near the
+    period, a short stroke where the orbit is): then dots are drawn."""
+    energy = 0.5 * float(v @ v) - mu / float(np.linalg.norm(r))
+    if not energy < 0:
+        return False
+    period = 2 * np.pi * np.sqrt((-mu / (2 * energy)) ** 3 / mu)
+    return bool(cadence > period / 36)
+
+
+def axis_label(axis: str, unit: str, frame: str, primary: str) -> str:
+    """A position axis's label: the axis, the origin, the frame and the unit.
+
+    Examples
+    --------
+    >>> axis_label("x", "au", "ecliptic", "sun")
+    'x from sun, J2000 mean ecliptic and equinox [au]'
+    """
+    return f"{axis} from {primary}, {frame_label(frame)} [{unit}]"
+
+
+def osculating_ellipse(r: np.ndarray, v: np.ndarray, mu: float, n: int = 361
+                       ) -> np.ndarray | None:
+    """Points of the two-body ellipse through the state ``r``, ``v`` (relative to the
+    primary, ``mu`` = G (m_primary + m)), shape (n, 3); None unless 0 <= e < 0.95.
+
+    ``r(E) = a (cos E - e) P + a sqrt(1 - e^2) sin E Q`` with ``P`` towards the
+    periapsis (the modern eccentricity vector) and ``Q = h x P / |h|``.
+
+    Examples
+    --------
+    >>> pts = osculating_ellipse(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), 1.0, 5)
+    >>> np.round(pts[:, :2], 12).tolist()
+    [[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [-0.0, -1.0], [1.0, -0.0]]
+    """
+    h = np.cross(r, v)
+    dist = float(np.linalg.norm(r))
+    ecc = np.cross(v, h) / mu - r / dist
+    e = float(np.linalg.norm(ecc))
+    energy = 0.5 * float(v @ v) - mu / dist
+    if not (energy < 0 and e < 0.95 and np.linalg.norm(h) > 0):
+        return None
+    a = -mu / (2 * energy)
+    p_hat = ecc / e if e > 1e-12 else r / dist
+    q_hat = np.cross(h, p_hat) / np.linalg.norm(h)
+    big_e = np.linspace(0.0, 2 * np.pi, n)[:, None]
+    return a * (np.cos(big_e) - e) * p_hat + a * np.sqrt(1 - e * e) * np.sin(big_e) * q_hat
+
+
+def _draw_orbits(ax: Any, view: dict, names: list[str], frame: str) -> None:
+    primary = view["primary"]
+    for k, name in enumerate(view["names"]):
+        if name not in names or name == primary:
+            continue
+        xy = view["rel"][:, k, :2]
+        if not _coarse(view["cadence"], view["rel0"][k], view["vrel0"][k], view["mu"][k]):
+            ax.plot(xy[:, 0], xy[:, 1], lw=0.7, label=name)
+            continue
+        # outputs too far apart for a line: a dot per output, and the osculating
+        # two-body orbit of the first output as a thin line to read them against
+        (dots,) = ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.2,
+                          label=f"{name} (a dot every {view['cadence_text']})")
+        ellipse = osculating_ellipse(view["rel0"][k], view["vrel0"][k], view["mu"][k])
+        if ellipse is not None:
+            ax.plot(ellipse[:, 0], ellipse[:, 1], lw=0.4, color=dots.get_color(), alpha=0.8)
+    ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
+            label=f"{primary} (origin)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
+    ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
+              frameon=False)
+
+
+def _plot_orbits(result: Result, gm: np.ndarray, frame: str):
+    """The orbits about the primary, projected on the frame's x-y plane; an inner
+    panel where the inner bodies would be a blob beside the outer ones."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 6))
-    r = result.states["r"].to_value(u.au)
-    for k, name in enumerate(result.states["names"]):
-        ax.plot(r[:, k, 0], r[:, k, 1], lw=0.6, label=name)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [au]")
-    ax.set_ylabel("y [au]")
-    ax.set_title(f"{result.scene.name}: orbits")
-    ax.legend(fontsize=7, loc="upper right")
+    names = list(result.states["names"])
+    view = orbit_view(names, gm, result.states["r"].to_value(u.au))
+    view["names"] = names
+    k = view["index"]
+    v0 = result.states["v"][0].to_value(u.au / u.d)
+    view["rel0"] = view["rel"][0]  # in the figure's unit; velocities and mu to match
+    view["vrel0"] = (v0 - v0[k]) * view["scale"]
+    view["mu"] = (gm + gm[k]) * view["scale"] ** 3
+    view["cadence"] = float(np.median(np.diff(result.times.to_value(u.d))))
+    cadence = view["cadence"] * u.d
+    unit = u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d else u.min
+    view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
+    panels = [names] + ([view["inner"]] if view["inner"] else [])
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 7.2), squeeze=False)
+    for ax, shown in zip(axes[0], panels, strict=True):
+        _draw_orbits(ax, view, shown, frame)
+    axes[0, 0].set_title(f"{result.scene.name}: orbits about {view['primary']}, "
+                         f"projected on the frame's x-y plane", fontsize=10)
+    if view["inner"]:
+        axes[0, 1].set_title(f"inner bodies: {', '.join(view['inner'])}", fontsize=10)
+    fig.tight_layout()
     fig._hamilton_name = "orbits"
     return fig
 
 
-def _plot_energy(result: Result):
+def _plot_energy(result: Result, what: str, conserved: bool):
+    """The relative energy error against time (log scale).  Exact zeros (the
+    energy came back bit for bit) have no place on a log axis: they are counted
+    in the legend, not drawn at an invented floor."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
-    t = result.times.to_value(u.yr)
-    err = np.abs(result.diagnostics["energy_error"])
-    floor = 1e-18  # an exact zero is drawn at the floor
-    ax.semilogy(t[1:], np.maximum(err[1:], floor), ".", ms=2, label="hamilton-orbits")
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    span = result.times[-1] - result.times[0]
+    t_unit = u.yr if span > 1 * u.yr else u.d
+    t = result.times.to_value(t_unit)
+    series = [("hamilton-orbits", result.diagnostics["energy_error"], {})]
     peer = result.diagnostics.get("rebound_energy_error")
     if peer is not None:
-        ax.semilogy(t[1:], np.maximum(np.abs(peer[1:]), floor), ".", ms=2, alpha=0.6,
-                    label="rebound IAS15")
-    ax.axhline(np.finfo(float).eps, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("time [yr]")
-    ax.set_ylabel("|relative energy error|")
-    ax.set_title(f"{result.scene.name}: energy error")
-    ax.legend()
+        series.append(("rebound IAS15", peer, {"alpha": 0.6}))
+    for label, values, style in series:
+        err = np.abs(np.asarray(values[1:], dtype=float))
+        nonzero = err > 0
+        zeros = int(np.count_nonzero(~nonzero))
+        note = f" ({zeros} of {len(err)} outputs exactly 0, not drawn)" if zeros else ""
+        ax.semilogy(t[1:][nonzero], err[nonzero], ".", ms=2, label=label + note, **style)
+    eps = np.finfo(float).eps
+    ax.axhline(eps, color="0.5", lw=0.7, ls=":", label=f"machine epsilon {eps:.1e}")
+    if not ax.has_data() or not np.any(np.abs(result.diagnostics["energy_error"]) > 0):
+        ax.set_ylim(eps / 100, eps * 100)
+    ax.set_xlabel(f"time since the start [{t_unit}]")
+    ax.set_ylabel("|relative energy error|" if conserved else "|relative energy change|")
+    title = "energy error" if conserved else "energy change (not an error: not conserved)"
+    ax.set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
     fig._hamilton_name = "energy_error"
     return fig
 

@@ -2,7 +2,7 @@
 
 ::
 
-    hamilton-orbits                      # runs the default bundled scene (solar-system)
+    hamilton-orbits [--no-progress]      # runs the default bundled scene (solar-system)
     hamilton-orbits run [SCENE|FILE] [--out DIR] [--set KEY=VALUE ...] [--no-progress]
     hamilton-orbits crosscheck [SCENE|FILE]
     hamilton-orbits scenes               # the bundled scenes, their effects, run time
@@ -127,22 +127,34 @@ def _load_scene(ref: str, sets: Sequence[str]):
     return scene.with_values(values) if values else scene
 
 
+def _wrap(text: str, width: int) -> list[str]:
+    """``text`` in lines of at most ``width`` characters, broken between words."""
+    import textwrap
+
+    return textwrap.wrap(" ".join(text.split()), width) or [""]
+
+
 def _list_scenes() -> int:
     from hamilton_orbits.scene import Scene, format_table
 
     rows = []
     for name, description in Scene.list_bundled():
         scene = Scene.bundled(name)
+        lines = _wrap(description, 58)
         rows.append(
             {
                 "scene": name + (" (default)" if name == DEFAULT_SCENE else ""),
                 "kind": scene.kind,
                 "effects": ", ".join(e["name"] for e in scene.effects) or "none",
                 "run time": scene.spec.get("runtime") or "?",
-                "description": description[:70],
+                "description": lines[0],
             }
         )
+        rows += [{"scene": "", "kind": "", "effects": "", "run time": "", "description": line}
+                 for line in lines[1:]]
     print(format_table(rows))
+    print("\nrun time: the whole command, warm (kernels cached), on a 2-core machine; the "
+          "first run\non a machine adds the one-time compilation of the kernels (~20-60 s)")
     return EXIT_OK
 
 
@@ -169,19 +181,20 @@ def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
 
 
 def _run_scene(scene, progress: bool):
-    """Run ``scene`` with Ctrl-C handled (the first stops after the current chunk);
+    """Run ``scene`` with Ctrl-C handled (the first stops the run soon and keeps what
+    it reached, the second aborts);
     None (after one line on stderr) if the run failed."""
     interrupted: list[int] = []
 
     def stop() -> bool:
         return bool(interrupted)
 
-    def on_sigint(signum, frame):  # first Ctrl-C: finish the current chunk, keep the rest
+    def on_sigint(signum, frame):  # first Ctrl-C: stop soon, keep what was reached
         if interrupted:
             raise KeyboardInterrupt
         interrupted.append(signum)
-        print("\nhamilton-orbits: stopping after the current chunk (Ctrl-C again to abort)",
-              file=sys.stderr)
+        print("\nhamilton-orbits: stopping (within a few thousand steps; what was reached is "
+              "kept; Ctrl-C again to abort)", file=sys.stderr)
 
     import signal
 
@@ -261,7 +274,7 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
         finally:
             if client is not None:
                 client.close()
-        _write_ensemble(scene, df, folder)
+        _write_ensemble(scene, df, folder, list(vary))
     return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
 
 
@@ -278,16 +291,71 @@ def _dask_client(address: str):
                            f"({_one_line(exc)})") from None
 
 
-def _write_ensemble(scene, df, folder) -> None:
+def _write_ensemble(scene, df, folder, varied: Sequence[str]) -> None:
     from hamilton_orbits.scene import format_table
 
     rows = df.to_dict("records")
     print(f"ensemble of {scene.name}: {len(df)} members, {df.attrs['failures']} failed")
-    print(format_table(rows))
+    print(ensemble_table(rows, varied))
     df.to_csv(folder / "ensemble.csv", index=False)
     (folder / "ensemble.md").write_text(
         f"# Ensemble of {scene.name}\n\n```\n{format_table(rows)}\n```\n", encoding="utf-8")
     print(f"\nwrote ensemble.csv, ensemble.md to {folder}/")
+
+
+def ensemble_table(rows: Sequence[dict], varied: Sequence[str]) -> str:
+    """An ensemble's rows for the terminal: what is the same for every member said
+    once, the ``complete`` and ``error`` columns only where a member stopped or
+    failed, numbers to 4 digits, and one column per member (a row per quantity)
+    for up to 6 members, so that the table stays within a terminal's width.
+
+    Examples
+    --------
+    >>> rows = [{"dt": "1 ms", "err [rad]": 1.234567e-12, "T [s]": 14.966, "error": None},
+    ...         {"dt": "2 ms", "err [rad]": 2.5e-11, "T [s]": 14.966, "error": None}]
+    >>> print(ensemble_table(rows, ["dt"]))
+    quantity   dt = 1 ms  dt = 2 ms
+    ---------  ---------  ---------
+    err [rad]  1.235e-12  2.5e-11
+    <BLANKLINE>
+    the same for every member:
+      T [s] = 14.97
+    """
+    from hamilton_orbits.scene import format_table
+
+    def fmt(value: object) -> str:
+        if isinstance(value, float):
+            return f"{value:.4g}"
+        return str(value)
+
+    keys = [k for k in rows[0] if k not in varied]
+    failed = [i for i, r in enumerate(rows) if r.get("error") is not None]
+    shown, same = [], []
+    for key in keys:
+        values = [fmt(r.get(key)) for r in rows]
+        if key == "error" and not failed:
+            continue
+        if key == "complete" and all(r.get(key) is True for r in rows):
+            continue
+        if len(rows) > 1 and len(set(values)) == 1 and key not in ("error", "complete"):
+            same.append(f"{key} = {values[0]}")
+        else:
+            shown.append(key)
+    names = [", ".join(f"{k} = {r[k]}" for k in varied) or f"member {i}"
+             for i, r in enumerate(rows)]
+    if len(rows) <= 6:
+        table = [{"quantity": key, **{n: fmt(r.get(key)) for n, r in zip(names, rows,
+                                                                        strict=True)}}
+                 for key in shown]
+    else:
+        table = [{**{k: r[k] for k in varied}, **{k: fmt(r.get(k)) for k in shown}}
+                 for r in rows]
+    out = [format_table(table)] if table else []
+    if same:
+        out.append("\nthe same for every member:")
+        out += [f"  {item}" for item in same]
+    out += [f"member {i} ({names[i]}) failed: {rows[i]['error']}" for i in failed]
+    return "\n".join(out)
 
 
 def _report(quick: bool, out: str | None, progress: bool) -> int:
@@ -296,7 +364,11 @@ def _report(quick: bool, out: str | None, progress: bool) -> int:
 
     folder = out if out else "hamilton-orbits-output/report"
     with OutputFolder(folder, "--out" if out else "output folder"):
-        files = build_report(folder, quick=quick, progress=progress)
+        try:
+            files = build_report(folder, quick=quick, progress=progress)
+        except ImportError as exc:  # the [report] extra is missing: say which, no traceback
+            print(f"hamilton-orbits: {exc}", file=sys.stderr)
+            return EXIT_FAILED
     print("wrote " + ", ".join(f.name for f in files) + f" to {folder}/")
     return EXIT_OK
 
@@ -320,6 +392,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         ),
     )
     parser.add_argument("--version", action="store_true", help="print the version and exit")
+    parser.add_argument("--no-progress", dest="quiet", action="store_true",
+                        help="no progress bar (with no command, or before any command)")
     sub = parser.add_subparsers(dest="command")
     run = sub.add_parser("run", help="run a scene and write its folder")
     run.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
@@ -375,20 +449,20 @@ def _guarded(args: argparse.Namespace) -> int:
 
 
 def _dispatch(args: argparse.Namespace) -> int:
+    progress = not (args.quiet or getattr(args, "no_progress", False))
     if args.command == "demo":
         return _demo()
     if args.command == "scenes":
         return _list_scenes()
     if args.command == "report":
-        return _report(args.quick, args.out, progress=not args.no_progress)
+        return _report(args.quick, args.out, progress=progress)
     if args.command == "ensemble":
-        return _ensemble(args.scene, args.vary, args.dask, args.out,
-                         progress=not args.no_progress)
+        return _ensemble(args.scene, args.vary, args.dask, args.out, progress=progress)
     if args.command == "crosscheck":
         return _crosscheck(args.scene, args.set)
     if args.command == "run":
-        return _run(args.scene, args.out, args.set, progress=not args.no_progress)
-    return _run(DEFAULT_SCENE, None, [], progress=True)
+        return _run(args.scene, args.out, args.set, progress=progress)
+    return _run(DEFAULT_SCENE, None, [], progress=progress)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -38,6 +38,8 @@ __all__ = [
     "C_AU_PER_DAY",
     "EffectSet",
     "EffectSpec",
+    "effect_energy",
+    "energy_label",
     "entry_problems",
     "get",
     "known",
@@ -98,6 +100,12 @@ class EffectSpec:
         differentiate ``kernel`` by central differences along each tangent vector
         (compiled, generated in :mod:`hamilton_orbits.rhs`; about 1e-10 relative,
         and two or four evaluations of the kernel per tangent vector).
+    energy : callable or None
+        ``"nbody"`` effects that keep an energy: ``energy(r, v, gm, p) -> ndarray``
+        of shape (n_t, n) for states (n_t, n, 3): the effect's part of each body's
+        specific energy (per unit mass; zero for the source), so that Hamilton's
+        (E) plus ``sum(gm * energy)`` is conserved (:func:`effect_energy`).  None
+        if the effect keeps none (the energy is then reported as not conserved).
     """
 
     name: str
@@ -113,6 +121,7 @@ class EffectSpec:
     parameter_kinds: Mapping[str, Kind] = field(default_factory=dict)
     name_parameters: tuple[str, ...] = ()
     jacobian: Any = None
+    energy: Callable[..., np.ndarray] | None = None
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}
@@ -539,6 +548,115 @@ def _params_j2(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([b, j2, radius, *pole])
 
 
+def _relative(r: np.ndarray, v: np.ndarray, s: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions and velocities relative to body ``s``, and the distances (1 where
+    zero, at ``s`` itself), for states of shape (n_t, n, 3)."""
+    d = r - r[:, s:s + 1]
+    w = v - v[:, s:s + 1]
+    dist = np.sqrt(np.einsum("tij,tij->ti", d, d))
+    return d, w, np.where(dist > 0, dist, 1.0)
+
+
+def _energy_gr(r: np.ndarray, v: np.ndarray, gm: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The first post-Newtonian terms of the specific energy about the source,
+    ``(3/8 w^4 + 3/2 mu w^2 / d + 1/2 mu^2 / d^2) / c^2``: with ``w^2 / 2 - mu / d`` the
+    energy that the one-body metric's equations of motion (``gr_anderson``) keep
+    exactly for a test particle (its time derivative vanishes identically), and to
+    O(m / M v^2 / c^2) for a body of mass m."""
+    s, c2 = int(p[0]), p[1] * p[1]
+    mu = gm[s]
+    _, w, dist = _relative(r, v, s)
+    w2 = np.einsum("tij,tij->ti", w, w)
+    out = (0.375 * w2 * w2 + 1.5 * mu * w2 / dist + 0.5 * mu * mu / (dist * dist)) / c2
+    out[:, s] = 0.0
+    return out
+
+
+def _energy_gr_potential(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                         p: np.ndarray) -> np.ndarray:
+    """The potential ``-3 (mu / (c d))^2`` of Nobili & Roxburgh (1986)."""
+    s, c2 = int(p[0]), p[1] * p[1]
+    _, _, dist = _relative(r, v, s)
+    out = -3.0 * gm[s] ** 2 / (c2 * dist * dist)
+    out[:, s] = 0.0
+    return out
+
+
+def _energy_j2(r: np.ndarray, v: np.ndarray, gm: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The degree-2 zonal potential ``J2 mu R^2 (3 z^2 / d^2 - 1) / (2 d^3)`` (the
+    potential whose gradient ``j2_field`` applies; Vallado 2013, eq. 8-22)."""
+    b, j2, rad = int(p[0]), p[1], p[2]
+    d, _, dist = _relative(r, v, b)
+    z = d @ p[3:6]
+    out = 0.5 * j2 * gm[b] * rad * rad * (3.0 * z * z / (dist * dist) - 1.0) / dist**3
+    out[:, b] = 0.0
+    return out
+
+
+def effect_energy(system: Any, effects: Any, r: np.ndarray, v: np.ndarray
+                  ) -> np.ndarray | None:
+    """The listed effects' part of every body's specific energy, shape (n_t, n).
+
+    Parameters
+    ----------
+    system : hamilton_orbits.nbody.System
+        The system the effects' parameters are read from.
+    effects : EffectSet or sequence
+        The effects (normalised by :meth:`EffectSet.of`).
+    r, v : ndarray, shape (n_t, n, 3)
+        States in the system's internal units.
+
+    Returns
+    -------
+    ndarray or None
+        Zeros without effects; None if a listed effect keeps no energy.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [2.0, 0, 0],
+    ...                                                        [0, 1.0, 0])])
+    >>> r, v = s.as_arrays().r[None], s.as_arrays().v[None]
+    >>> effect_energy(s, [{"name": "gr_potential", "c": 1.0}], r, v).tolist()
+    [[0.0, -0.75]]
+    """
+    eff = EffectSet.of(effects, "nbody")
+    gm = system.as_arrays().gm
+    total = np.zeros(r.shape[:2])
+    for name, params in eff:
+        spec = get("nbody", name)
+        if spec.energy is None or spec.params is None:
+            return None
+        total += spec.energy(r, v, gm, spec.params(system, dict(params)))
+    return total
+
+
+def energy_label(gm: np.ndarray, effects: Any, names: Sequence[str] | None = None) -> str:
+    """What the relative energy error of a system with ``gm`` and ``effects`` measures.
+
+    Examples
+    --------
+    >>> energy_label(np.array([1.0, 1e-3]), ["gr"])
+    'the total energy with the gr (1PN) terms'
+    >>> energy_label(np.array([1.0, 0.0]), [], ["earth", "satellite"])
+    "the test particles' specific orbital energy about earth"
+    """
+    eff = EffectSet.of(effects, "nbody")
+    massive = np.flatnonzero(np.asarray(gm) > 0)
+    if len(massive) == 1 and len(gm) > 1:
+        primary = names[int(massive[0])] if names is not None else "the massive body"
+        base = f"the test particles' specific orbital energy about {primary}"
+    else:
+        base = "the total energy"
+    lacking = [n for n in eff.names if get("nbody", n).energy is None]
+    if lacking:
+        return f"{base}, Newtonian (not conserved under {', '.join(lacking)})"
+    if not eff:
+        return base
+    terms = ", ".join(f"{n} (1PN)" if n == "gr" else n for n in eff.names)
+    return f"{base} with the {terms} terms"
+
+
 register(
     EffectSpec(
         "gr",
@@ -554,6 +672,7 @@ register(
         params=_params_gr,
         parameter_kinds={"c": SPEED},
         name_parameters=("source",),
+        energy=_energy_gr,
         reference="Anderson et al. (1975), ApJ 200, 221; reboundx 'gr' (Tamayo et al. 2020)",
     )
 )
@@ -571,6 +690,7 @@ register(
         params=_params_gr_potential,
         parameter_kinds={"c": SPEED},
         name_parameters=("source",),
+        energy=_energy_gr_potential,
         reference="Nobili & Roxburgh (1986), IAU Symp. 114, 105",
     )
 )
@@ -589,6 +709,7 @@ register(
         params=_params_j2,
         parameter_kinds={"j2": DIMENSIONLESS, "radius": LENGTH},
         name_parameters=("body",),
+        energy=_energy_j2,
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     )
 )

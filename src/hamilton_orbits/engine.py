@@ -36,13 +36,9 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import INTEGRATORS, Integrator
+from hamilton_orbits.integrators import INTEGRATORS, Integrator, StopIntegration
 
 __all__ = ["EngineRun", "StopIntegration", "integrator", "run"]
-
-
-class StopIntegration(Exception):
-    """Raised by an output callback to end a run early (the engine catches it)."""
 
 
 @dataclass(frozen=True)
@@ -197,7 +193,7 @@ def run(
     complete = True
     try:
         _, _, steps = module.run(rhs, r0, sign * v0, gm, sign * t_out, dt=dt, tol=tol,
-                                 on_output=report, out=(r_out, v_out), **kw)
+                                 on_output=report, out=(r_out, v_out), stop=stop, **kw)
         reached[0], reached[1] = n_t - 1, steps
     except StopAtEvent as stopped:
         reached[0], reached[1] = stopped.index, stopped.steps

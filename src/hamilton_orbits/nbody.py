@@ -40,6 +40,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.frames import check_frame, frame_rotation
 from hamilton_orbits.units import (
     DIMENSIONLESS,
     GM,
@@ -676,14 +677,22 @@ class System:
 
     @classmethod
     def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None,
-                     frame: str = "icrs") -> System:
+                     frame: str = "icrs", origin: str = "barycentre") -> System:
         """The Sun and planets at ``epoch`` from astropy's built-in ephemeris (offline).
 
-        Positions and velocities are barycentric, ICRS axes (equatorial), from
+        Positions and velocities from
         ``astropy.coordinates.get_body_barycentric_posvel(..., ephemeris="builtin")``
         (the ERFA routines ``epv00`` and ``plan94``: no download, accuracy of order
         1e-7 au for the inner planets and worse for the outer ones, which is
-        ample for the dynamics but not an ephemeris).
+        ample for the dynamics but not an ephemeris), on the axes of ``frame``.
+
+        The origin: by default the chosen bodies' own centre of mass, at rest.
+        The ephemeris gives states about the solar-system barycentre, which is
+        the centre of mass of *all* the bodies; a subset of them (the Sun and
+        Mercury alone) has its centre of mass elsewhere and moving (for the Sun
+        and Mercury, at the Sun's barycentric 13 m/s: 0.3 au in 100 years), so
+        the whole subset would drift across the figures.  ``origin="ssb"`` keeps
+        the ephemeris's barycentric states as they are.
 
         GM values: the Sun's is the IAU 2015 nominal solar mass parameter (IAU 2015
         Resolution B3); the planets' are the system GMs (planet plus satellites) of
@@ -693,29 +702,32 @@ class System:
         ----------
         epoch : astropy.time.Time or str, optional
             The epoch (TDB); a string is read by ``Time(epoch, scale="tdb")``,
-            ``"J2000"`` (default) is 2000-01-01 12:00 TDB.  Within 1900-2100
-            (:data:`SOLAR_SYSTEM_SPAN`, see :func:`solar_system_epoch`).
-        frame : {"icrs", "ecliptic"}
-            ICRS axes (default) or the mean ecliptic and equinox of J2000 (IAU 2006
-            obliquity; see :func:`hamilton_orbits.ephemeris.frame_rotation`).
+            ``"J2000"`` (default) is 2000-01-01 12:00 TDB, ``"now"`` the present.
+            Within 1900-2100 (:data:`SOLAR_SYSTEM_SPAN`, see :func:`solar_system_epoch`).
         bodies : sequence of str or str, optional
             Which bodies, from ``sun, mercury, venus, earth-moon-barycenter, earth, moon,
             mars, jupiter, saturn, uranus, neptune`` (one name alone is a list of one);
             default the Sun, the planets with the Earth-Moon barycentre as one body.
             Asking for ``"moon"`` (with ``"earth"``) gives the Earth and the Moon
             separately.  See :func:`solar_system_bodies`.
-
-        Raises
-        ------
-        ValueError
-            For an epoch outside the ephemeris' span or one that cannot be read,
-            an unknown, repeated or empty list of bodies, or the Earth-Moon
-            barycentre together with the Earth or the Moon.
+        frame : {"icrs", "ecliptic"}, optional
+            The axes: the ICRS (equatorial; default) or the mean ecliptic and
+            equinox of J2000 (:mod:`hamilton_orbits.frames`; inclinations then
+            read as in tables of ecliptic elements: Mars 1.85 degrees).
+        origin : {"barycentre", "ssb"}, optional
+            ``"barycentre"`` (default): the chosen bodies' centre of mass at rest at
+            the origin; ``"ssb"``: the solar-system barycentre of the ephemeris.
 
         Returns
         -------
         System
             A Quantity system (au, day); the bodies' names are as asked.
+
+        Raises
+        ------
+        ValueError
+            For an unknown body, frame or origin, or an epoch that does not parse
+            (naming the argument and the value).
 
         References
         ----------
@@ -731,21 +743,35 @@ class System:
         >>> s = System.solar_system("J2000", bodies=["sun", "earth", "moon"])
         >>> 356000 < float(np.linalg.norm(s.r[2] - s.r[1]).to_value(u.km)) < 407000
         True
+        >>> pair = System.solar_system("J2000", bodies=["sun", "mercury"])
+        >>> bool(np.allclose(pair.barycentre()[1].to_value(u.au / u.d), 0.0, atol=1e-20))
+        True
+        >>> from hamilton_orbits import KeplerOrbit
+        >>> s = System.solar_system("J2000", bodies=["sun", "mars"], frame="ecliptic")
+        >>> mars = KeplerOrbit.from_state(s.r[1] - s.r[0], s.v[1] - s.v[0], s.gm.sum())
+        >>> print(f"{mars.inc.to(u.deg):.2f}")
+        1.85 deg
         """
         from astropy.coordinates import get_body_barycentric_posvel
 
-        from hamilton_orbits.ephemeris import frame_rotation
-
         bodies = solar_system_bodies(bodies)
+        rotation = frame_rotation(check_frame(frame))
+        if origin not in ("barycentre", "ssb"):
+            raise ValueError(f"Expected `origin` to be 'barycentre' or 'ssb', got {origin!r}")
         t = solar_system_epoch(epoch)
-        rot = frame_rotation(frame)
-        out = []
-        for name in bodies:
+        gm = np.array([SOLAR_SYSTEM_GM[name] for name in bodies])
+        r = np.empty((len(bodies), 3))
+        v = np.empty_like(r)
+        for k, name in enumerate(bodies):
             pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
-            gm = SOLAR_SYSTEM_GM[name] * u.m**3 / u.s**2
-            out.append(Body(name, gm=gm, r=rot @ pos.xyz.to(u.au),
-                            v=rot @ vel.xyz.to(u.au / u.day)))
-        return cls(out)
+            r[k] = pos.xyz.to_value(u.au)
+            v[k] = vel.xyz.to_value(u.au / u.day)
+        if origin == "barycentre":
+            r -= gm @ r / gm.sum()
+            v -= gm @ v / gm.sum()
+        r, v = r @ rotation.T, v @ rotation.T
+        return cls([Body(name, gm=gm[k] * u.m**3 / u.s**2, r=r[k] * u.au, v=v[k] * (u.au / u.day))
+                    for k, name in enumerate(bodies)])
 
 
 SOLAR_SYSTEM_SPAN = (1900, 2100)
@@ -784,13 +810,18 @@ def solar_system_epoch(epoch: Any = "J2000"):
         t = epoch.tdb
     elif isinstance(epoch, str) and epoch.strip().upper() == "J2000":
         t = Time("2000-01-01T12:00:00", scale="tdb")
+    elif isinstance(epoch, str) and epoch.strip().lower() == "now":
+        t = Time.now().tdb
     else:
         try:
             t = Time(epoch, scale="tdb")
         except (ValueError, TypeError) as exc:
+            what = "the string did not parse as a date" if isinstance(epoch, str) else (
+                "expected an astropy Time or a date string")
             raise ValueError(
-                f"Expected `epoch` to be a time (an astropy Time, 'J2000' or a date such as "
-                f"'2024-03-01' or '2024-03-01T12:00'), got {epoch!r}") from exc
+                f"Expected `epoch` to be a time (an astropy Time, 'J2000', 'now' or a date "
+                f"such as '2024-03-01' or '2024-03-01T12:00'), got {epoch!r}: {what}"
+            ) from exc
     if not t.isscalar:
         raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
     years = (t.jd1 - 2451545.0 + t.jd2) / 365.25  # Julian years from J2000, as epv00
@@ -910,7 +941,8 @@ def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
 
 
 def integral_errors(
-    r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray
+    r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray,
+    extra_energy: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How well states ``r``, ``v`` (n_t, n, 3) at times ``t`` (n_t,) keep Hamilton's
     integrals, relative to the first state.
@@ -918,10 +950,25 @@ def integral_errors(
     ``gm`` is (n,), or (n_t, n) where masses changed during the run (merges);
     bodies with NaN states (taken out of the run) count as absent.
 
+    Parameters
+    ----------
+    r, v : ndarray, shape (n_t, n, 3)
+    gm : ndarray, shape (n,) or (n_t, n)
+    t : ndarray, shape (n_t,)
+    extra_energy : ndarray, shape (n_t, n), optional
+        The effects' part of each body's specific energy
+        (:func:`hamilton_orbits.effects.effect_energy`), added so that the energy
+        compared is the one the equations of motion keep.
+
     Returns
     -------
     energy_error : ndarray, (n_t,)
         ``(E(t) - E(0)) / |E(0)|``, vis viva (E); absolute where ``E(0) = 0``.
+        With one massive body and test particles, whose masses do not enter
+        Hamilton's E (it would be constant, and its error a meaningless 0), the
+        specific orbital energies of the test particles about the massive body,
+        ``w^2 / 2 - mu / d`` (plus ``extra_energy``), each relative to its own
+        start: at each time the one of largest magnitude.
     angular_momentum_error : ndarray, (n_t,)
         ``|L(t) - L(0)| / |L(0)|``, areas (D); absolute where ``L(0) = 0``.
     barycentre_drift : ndarray, (n_t,)
@@ -933,6 +980,9 @@ def integral_errors(
     >>> r = np.array([[[0.0, 0, 0], [1.0, 0, 0]]] * 2); v = np.zeros((2, 2, 3))
     >>> [x.tolist() for x in integral_errors(r, v, np.array([1.0, 1.0]), np.array([0.0, 1.0]))]
     [[0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    >>> v[1, 1, 1] = 2.0**-10  # a test particle that gained speed: its energy changed
+    >>> integral_errors(r, v, np.array([1.0, 0.0]), np.array([0.0, 1.0]))[0].tolist()
+    [0.0, 4.76837158203125e-07]
     """
     from hamilton_orbits.trajectory import relative_change
 
@@ -942,12 +992,8 @@ def integral_errors(
         gm_t = np.where(present, gm_t, 0.0)
         r = np.where(present[..., None], r, 0.0)
         v = np.where(present[..., None], v, 0.0)
-    if gm_t is gm or (np.ndim(gm) == 1 and present.all()):
-        energy = energy_gm_many(r, v, gm)
-    else:
-        energy = np.array([energy_gm_many(r[k : k + 1], v[k : k + 1], gm_t[k])[0]
-                           for k in range(len(t))])
-    energy_error = relative_change(energy)
+    unchanged = np.ndim(gm) == 1 and bool(present.all())
+    energy_error = _energy_error(r, v, gm if unchanged else gm_t, extra_energy)
     am_error = relative_change(np.einsum("tj,tjk->tk", gm_t, np.cross(r, v)))
     total = gm_t.sum(axis=1)
     rc = np.einsum("tj,tjk->tk", gm_t, r) / total[:, None]
@@ -955,6 +1001,35 @@ def integral_errors(
     scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
     drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
     return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
+
+
+def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                  extra: np.ndarray | None) -> np.ndarray:
+    """The energy part of :func:`integral_errors`."""
+    from hamilton_orbits.trajectory import relative_change
+
+    if np.ndim(gm) == 2:  # masses changed (a merge, a removal): Hamilton's E as it is
+        energy = energy_gm_many(r, v, gm)
+        if extra is not None:
+            energy = energy + np.einsum("tj,tj->t", extra, gm)
+        return relative_change(energy)
+    massive = np.flatnonzero(gm > 0)
+    if len(massive) != 1 or len(gm) == 1:
+        energy = energy_gm_many(r, v, gm)
+        if extra is not None:
+            energy = energy + extra @ gm
+        return relative_change(energy)
+    s = int(massive[0])
+    tp = np.flatnonzero(gm == 0)
+    d = r[:, tp] - r[:, s:s + 1]
+    w = v[:, tp] - v[:, s:s + 1]
+    eps = 0.5 * np.einsum("tij,tij->ti", w, w) - gm[s] / np.sqrt(np.einsum("tij,tij->ti", d, d))
+    if extra is not None:
+        eps = eps + extra[:, tp]
+    scale = np.abs(eps[0])
+    change = (eps - eps[0]) / np.where(scale > 0, scale, 1.0)
+    pick = np.argmax(np.abs(change), axis=1)
+    return change[np.arange(len(change)), pick]
 
 
 def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:

@@ -17,7 +17,11 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._rebound import particle_name
-from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.effects import (
+    EffectSet,
+    effect_energy,
+    get,
+)
 from hamilton_orbits.nbody import System, integral_errors
 
 __all__ = [
@@ -276,7 +280,8 @@ def crosscheck(
     times = trajectory.t.to_value("day") if system.quantity else np.asarray(trajectory.t)
     r_all, v_all, wall, steps = rebound_trajectory(system, times, effects)
     arrays = system.as_arrays()
-    energy, ang, _ = integral_errors(r_all, v_all, arrays.gm, times)
+    energy, ang, _ = integral_errors(r_all, v_all, arrays.gm, times,
+                                     effect_energy(system, effects, r_all, v_all))
     r_reb = r_all[-1]
     dr = np.linalg.norm(trajectory.final.as_arrays().r - r_reb, axis=1)
     rc = arrays.gm @ r_reb / arrays.gm.sum()

@@ -396,8 +396,20 @@ class Scene:
 
     # --- running ------------------------------------------------------
     def run(self, progress: bool = True, stop: Callable[[], bool] | None = None) -> Result:
-        """Simulate the scene; returns a :class:`Result`."""
-        return KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        """Simulate the scene; returns a :class:`Result`.
+
+        ``result.compile_time`` holds the seconds numba spent compiling kernels
+        for the run (the first run on a machine; 0 once they are cached): during
+        the run, and before it, since the previous run in the process, when the
+        kernels' modules were imported; ``result.compile_count`` how many
+        compilations.  The kinds take the compilation inside the integration out
+        of ``result.wall_time``, the integration proper.
+        """
+        from hamilton_orbits._firstrun import claim_compilation
+
+        result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        result.compile_time, result.compile_count = claim_compilation()
+        return result
 
     def crosscheck(self) -> str:
         """The same scene in a peer code, the differences tabled (text)."""

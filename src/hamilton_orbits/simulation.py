@@ -8,6 +8,7 @@ the total angular momentum (law of areas) and of the energy (vis viva).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -16,8 +17,9 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
+from hamilton_orbits._firstrun import compile_seconds
 from hamilton_orbits._validation import as_float_array
-from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, System, integral_errors
@@ -49,7 +51,10 @@ class Trajectory(TrajectoryBase):
     final : System
         The system at the last output time.
     energy_error : ndarray, shape (n_t,)
-        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)).
+        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
+        energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
+        massive body, the test particles' specific orbital energies about it
+        (:func:`~hamilton_orbits.nbody.integral_errors`).
     angular_momentum_error : ndarray, shape (n_t,)
         ``|L(t) - L(0)| / |L(0)|`` (law of areas, (D)); absolute if ``L(0) = 0``.
     barycentre_drift : ndarray, shape (n_t,)
@@ -58,8 +63,9 @@ class Trajectory(TrajectoryBase):
     steps : int
         Steps taken by the integrator.
     wall_time : float
-        Seconds of wall-clock time for the integration proper (the compilation
-        of a right-hand side for new effects and the checks are not counted).
+        Seconds of wall-clock time for the integration proper (the checks and
+        any numba compilation, of the right-hand side or of the stepping kernel
+        on its first call, are not counted).
     method : str
     effects : tuple of str
     events : astropy.table.QTable
@@ -138,7 +144,7 @@ def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
     """Refuse an option the integrator's ``run`` does not take, listing those it does."""
     import inspect
 
-    common = {"dt", "tol", "on_output", "out", "events", "variational"}
+    common = {"dt", "tol", "on_output", "out", "events", "stop", "variational"}
     takes = [name for name, p in inspect.signature(module.run).parameters.items()
              if p.kind is p.KEYWORD_ONLY and name not in common]
     for key, value in options.items():
@@ -254,11 +260,14 @@ def integrate(
     log = event_log(system, events)
     arrays = system.as_arrays()
     with _progress(progress, method, len(times) - 1, on_output) as report:
+        compiled = compile_seconds()
         out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
                          options=options, on_output=report, events=log, variational=tan)
+        compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
+    out = dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
     if not out.complete:
         raise KeyboardInterrupt
-    return make_trajectory(system, out, unit, method, rhs.effects)
+    return make_trajectory(system, out, unit, method, rhs.effects, eff)
 
 
 def _tangent(system: System, n_t: int, variational: Any, stm: Any, vector: Any) -> Any:
@@ -377,9 +386,11 @@ def _progress(enabled: bool, method: str, total: int, on_output: Any) -> Iterato
 
 
 def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: str,
-                    effects: tuple[str, ...]) -> Trajectory:
+                    effects: tuple[str, ...], effect_set: Any = None) -> Trajectory:
     """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
-    Quantity system, with times in ``unit``).
+    Quantity system, with times in ``unit``); ``effect_set`` (the
+    :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
+    the energy whose error is reported, where they keep one.
 
     Raises
     ------
@@ -396,7 +407,8 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
             f"{system.names[bad[1]]!r} at output {bad[0]} (t = {times[bad[0]]!r}): "
             "a collision or a step too long"
         )
-    ee, ae, bd = integral_errors(r, v, out.gm, times)
+    extra = effect_energy(system, effect_set, r, v) if effect_set else None
+    ee, ae, bd = integral_errors(r, v, out.gm, times, extra)
     final = system.with_state(r[-1], v[-1], gm=np.atleast_2d(out.gm)[-1], keep=~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)

@@ -9,7 +9,9 @@ One import for the three concepts, each in its own module:
   :class:`PolarMotionRecord`, and the IERS 2010 mean pole
   :func:`iers2010_mean_pole`;
 * :mod:`rigid.wobble`: the Chandler and annual wobble fit :func:`fit_wobble` ->
-  :class:`WobbleFit`, the :func:`periodogram`, and :func:`free_period`.
+  :class:`WobbleFit`, the :func:`periodogram`, and :func:`free_period`;
+* :mod:`rigid.pole_prediction`: where the pole will be, :func:`predict`, and how
+  well that is done on data the model never saw, :func:`hindcast`.
 
 Conventions (IERS): the pole is ``m = m1 + i m2`` with ``m1 = x_p``,
 ``m2 = -y_p``; a prograde term is ``exp(+i sigma t)``.
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 from rigid.c04 import PolarMotionRecord, iers2010_mean_pole, load_c04
 from rigid.liouville import EFFECTS, LiouvillePole, free_period, register_effects
+from rigid.pole_prediction import hindcast, predict
 from rigid.wobble import WobbleFit, fit_wobble, periodogram
 
 __all__ = [
@@ -35,8 +38,10 @@ __all__ = [
     "WobbleFit",
     "fit_wobble",
     "free_period",
+    "hindcast",
     "iers2010_mean_pole",
     "load_c04",
     "periodogram",
+    "predict",
     "register_effects",
 ]

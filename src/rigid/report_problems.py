@@ -78,7 +78,7 @@ def _pole(quick: bool, progress: bool) -> list[Row]:
 
     name = "pole wander"
     years = 10 if quick else 100
-    measure = "max |m - m_ref| (uas)"
+    measure = "max |m - m_ref| (µas)"
     reference = "rigid.free_motion (exact), daily"
     rad_to_uas = (1 * u.rad).to_value(u.uas)
     body = earth.rigid_body(0.2 * u.arcsec)

@@ -130,6 +130,8 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
             u.mas)), "annual (mas)": float(row["annual_amplitude"].to_value(u.mas))}
         for row in fit.amplitude_by_decade
     ]
+    result.frame = ("pole coordinates on the terrestrial axes (IERS: x_p towards Greenwich, "
+                    "y_p towards 90° W)")
     result.plotters.append(_plot)
     return result
 
@@ -142,16 +144,18 @@ def _plot(result: Result):
     y = result.states["y_p"].to_value(u.mas)
     ax.plot(x, y, lw=0.3)
     ax.set_aspect("equal")
-    ax.set_xlabel("x_p [mas]")
-    ax.set_ylabel("y_p [mas]")
+    # IERS pole coordinates (IERS Conventions 2010, ch. 5): terrestrial axes, x_p
+    # towards the Greenwich meridian, y_p towards 90 degrees west
+    ax.set_xlabel("x_p, terrestrial axes, towards Greenwich [mas]")
+    ax.set_ylabel("y_p, terrestrial axes, towards 90° W [mas]")
     ax.set_title("observed pole, IERS 20 C04")
     years = result.times.to_value(u.yr)
     ax2.plot(years, result.diagnostics["observed_m1"].to_value(u.mas), lw=0.5,
              label="observed m1 (trend removed)")
     ax2.plot(years, result.diagnostics["model_m1"].to_value(u.mas), lw=0.8,
              label="Liouville model")
-    ax2.set_xlabel("years from the fit epoch")
-    ax2.set_ylabel("m1 = x_p [mas]")
+    ax2.set_xlabel("time from the fit epoch [yr]")
+    ax2.set_ylabel("m1 = x_p, towards Greenwich [mas]")
     ax2.legend(fontsize=8)
     ax2.set_title(f"{result.scene.name}: model against the record")
     fig._hamilton_name = "pole"
@@ -199,5 +203,9 @@ KIND = SceneKind(
 
 
 def register() -> None:
-    """Register the ``polar_motion`` scene kind."""
+    """Register the ``polar_motion`` scene kind (and, beside it, ``pole_prediction``)."""
     register_kind(KIND)
+    # issue 25: the prediction scenes live in their own module, registered with this kind
+    from rigid import scene_prediction
+
+    scene_prediction.register()

@@ -529,3 +529,47 @@ def test_solar_system_bodies_takes_one_name_and_refuses_what_is_not_a_name():
 def test_a_duplicated_effect_names_both_indices():
     with pytest.raises(ValueError, match=r"Effect 'gr' is listed twice \(at indices 0 and 2\)"):
         normalize_effects(["gr", {"name": "j2", "body": "earth"}, {"name": "gr"}])
+
+
+# ---------------------------------------------------------------- Ctrl-C in one interval
+
+
+@pytest.mark.parametrize(("method", "kw"), [("radau15", {}), ("wh", {"dt": 0.1}),
+                                             ("leapfrog", {"dt": 0.1})])
+def test_stop_is_seen_inside_one_long_output_interval(method, kw):
+    """A run with a single output interval used to run to its end whatever stop()
+    said: the drivers now ask between slices of steps, and the engine keeps what
+    was reached (here the start alone)."""
+    from hamilton_orbits import engine
+    from hamilton_orbits.rhs import newtonian_rhs
+
+    r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    v0 = np.array([[0.0, 0, 0], [0, 1.0, 0]])
+    asked = []
+
+    def stop() -> bool:
+        asked.append(1)
+        return True
+
+    out = engine.run(r0, v0, np.array([1.0, 0.0]), np.array([0.0, 1e7]), newtonian_rhs(),
+                     method, stop=stop, **kw)
+    assert not out.complete and len(out.t) == 1 and asked == [1]
+    assert out.steps == 0  # no output reached: the steps of the cut interval are not counted
+
+
+def test_ctrl_c_in_a_one_interval_run_stops_it_promptly(tmp_path):
+    """The reproducer: Ctrl-C printed "stopping" and then ran to the end.  Now the run
+    ends within a slice of steps (exit 130, nothing reached beyond the start)."""
+    import signal
+    import time
+
+    cmd = [sys.executable, "-m", "hamilton_orbits.cli", "run", "leo-j2", "--no-progress",
+           "--set", 'duration="100000 d"', "--set", 'cadence="100000 d"',
+           "--out", str(tmp_path / "out")]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(8.0)  # import, the scene's checks, and into the run
+    start = time.perf_counter()
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert time.perf_counter() - start < 30.0, err
+    assert proc.returncode == 130 and "stopping" in err, err

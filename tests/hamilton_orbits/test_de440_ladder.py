@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import pytest
 
 from hamilton_orbits import ladder
@@ -81,3 +82,22 @@ def test_ladder_100_years_goals_reached():
              "neptune": 100.0, "moon": 20.0}
     for body, goal in goals.items():
         assert _km("ring", 100, body) < goal, body
+
+
+def test_the_bundled_scene_is_the_top_rung():
+    """``de440-century`` is the ladder's top rung as a scene: over 10 years its table
+    holds the rung's residuals (same state, same effects, same integrator)."""
+    import astropy.units as u
+
+    from hamilton_orbits import Scene
+    from hamilton_orbits.ladder import BODIES, RUNGS, run_rung
+
+    result = Scene.bundled("de440-century").with_values({"duration": "10 yr"}).run(
+        progress=False)
+    rung = run_rung(RUNGS[-1], years=10)
+    assert RUNGS[-1].name == "ring"
+    km = result.diagnostics["de440_km"]
+    np.testing.assert_allclose(km[-1], rung.km[-1], rtol=1e-6)
+    assert result.diagnostics["de440_years"][-1] == 10
+    assert km[-1, BODIES.index("mercury")] < 0.1 and km[-1, BODIES.index("moon")] < 2.0
+    assert result.times[-1].to_value(u.yr) == 10.0

@@ -97,3 +97,17 @@ def test_dask_option_without_dask_names_the_extra(monkeypatch, capsys):
                  "--no-progress"])
     assert code != 0
     assert "pip install 'hamilton-orbits[dask]'" in capsys.readouterr().err
+
+
+def test_ensemble_command_table_fits_a_terminal(tmp_path, capsys):
+    """The table was 330 characters wide with an `error None` column: now one column
+    per member, what every member shares said once, no error column unless one
+    failed."""
+    code = main(["ensemble", "dzhanibekov", "--vary", "integrator.dt=1 ms,2 ms,4 ms",
+                 "--out", str(tmp_path), "--no-progress"])
+    assert code == 0
+    out = capsys.readouterr().out
+    table = out.split("failed\n", 1)[1].split("\nwrote", 1)[0]
+    assert max(len(line) for line in table.splitlines()) <= 100
+    assert "None" not in table and "error" not in table.split("\n", 1)[0]
+    assert "the same for every member:\n  exact flip interval" in table

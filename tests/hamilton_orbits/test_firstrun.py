@@ -69,3 +69,87 @@ def test_notice_on_cold_cache(tmp_path):
     assert cold.stderr.splitlines() == [_firstrun.NOTICE]
     warm = _run(CALL, str(tmp_path))
     assert warm.stderr == ""
+
+
+def _caller_of(module: str):
+    """A fresh function calling another fresh one (a nested compilation)."""
+    inner = njit(_fresh_function(module))
+    namespace: dict = {"__name__": module, "inner": inner}
+    exec(compile("def outer(x):\n    return inner(x) + 1.0\n", "<outer>", "exec"), namespace)
+    return namespace["outer"]
+
+
+def test_compile_clock_counts_outermost_compilations():
+    seconds, count = _firstrun.compile_seconds(), _firstrun.compile_count()
+    assert njit(_caller_of("someone_else"))(1.0) == 4.0
+    assert _firstrun.compile_count() - count == 1  # the callee's compilation is inside
+    assert _firstrun.compile_seconds() > seconds
+
+
+def test_integration_time_excludes_compilation():
+    """What the summary and the cross-check table call the integration time: the
+    engine's wall time less the compilation inside it (a first run compiles the
+    stepping kernel on its first call)."""
+    import time
+
+    import numpy as np
+
+    from hamilton_orbits._scene_nbody import without_compilation
+    from hamilton_orbits.engine import EngineRun
+
+    def run() -> EngineRun:
+        start = time.perf_counter()
+        assert njit(_caller_of("hamilton_orbits._probe_timing"))(1.0) == 4.0  # compiles
+        wall = time.perf_counter() - start
+        return EngineRun(np.zeros(1), np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), 0, wall, True,
+                         None, np.ones(1))
+
+    compiled = _firstrun.compile_seconds()
+    start = time.perf_counter()
+    out = without_compilation(run)
+    total = time.perf_counter() - start
+    compiled = _firstrun.compile_seconds() - compiled
+    assert compiled > 0.01  # numba needs tens of ms at least to compile two functions
+    # what is left is the call itself, not the compilation (both clocks are perf_counter)
+    assert out.wall_time < total - 0.9 * compiled
+
+
+@pytest.mark.slow  # a cold cache compiles the radau15 path: ~20-40 s on 2 loaded cores
+def test_cold_run_reports_compilation_apart(tmp_path):
+    code = ("from hamilton_orbits import Scene; "
+            "r = Scene.bundled('mercury-gr').with_values({'duration': '2 yr'}).run("
+            "progress=False); print(r.wall_time, r.compile_time, r.compile_count); "
+            "print(r.summary())")
+    env_dirs = {"HAMILTON_ORBITS_CACHE_DIR": str(tmp_path / "ho")}
+    cold = _run_env(code, str(tmp_path / "numba"), env_dirs)
+    assert cold.returncode == 0, cold.stderr[-2000:]
+    wall, compile_time, count = cold.stdout.splitlines()[0].split()
+    assert int(count) > 0 and float(compile_time) > 1.0
+    assert float(wall) < 0.5 * float(compile_time)
+    assert "compiled: " in cold.stdout and "first run only" in cold.stdout
+    warm = _run_env(code, str(tmp_path / "numba"), env_dirs)
+    assert warm.returncode == 0, warm.stderr[-2000:]
+    assert warm.stdout.splitlines()[0].split()[2] == "0"  # the second process compiles nothing
+    assert "compiled: nothing" in warm.stdout
+
+
+def _run_env(code: str, cache_dir: str, extra: dict) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_CACHE_DIR=cache_dir, **extra)
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=900)
+
+
+def test_session_notice_when_numba_cache_is_cold(tmp_path, monkeypatch):
+    """tests/conftest.py says in one line that the first tests compile kernels."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "suite_conftest", Path(__file__).resolve().parents[1] / "conftest.py")
+    conftest = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conftest)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert conftest.numba_cache_cold()
+    nested = tmp_path / "some" / "path"
+    nested.mkdir(parents=True)
+    (nested / "radau15.step-42.py311.nbi").write_bytes(b"")
+    assert not conftest.numba_cache_cold()

@@ -31,7 +31,12 @@ EXPECTED = [
     ("two-body Kepler", "rebound", "WHFast"),
     ("two-body Kepler", "scipy", "DOP853"),
     *[("solar system", "hamilton-orbits", m) for m in ("radau15", "wh", "leapfrog", "dop853")],
-    *[("solar system", "rebound", m) for m in ("IAS15", "WHFast", "leapfrog")],
+    *[("solar system", "rebound", m) for m in ("IAS15", "WHFast", "leapfrog",
+                                                "WHFast (Jacobi, corrector 11)")],
+    *[("fidelity against DE440", code, rung) for code in
+      ("hamilton-orbits radau15", "hamilton-orbits radau15 (the Moon)")
+      for rung in ("newtonian", "gr", "eih", "sun_j2", "sun_lt", "figures", "tides",
+                   "asteroids", "ring")],
     *[("free rigid body", "hamilton-orbits", m)
       for m in ("exact (free_motion)", "splitting2", "splitting4", "exact_kick", "rk4")],
     ("free rigid body", "scipy (rigid.integrate)", "dop853"),
@@ -78,7 +83,7 @@ def test_files_exist(report):
     names = {f.name for f in files}
     assert {"report.md", "report.html"} <= names
     pngs = [f for f in files if f.suffix == ".png"]
-    assert len(pngs) == 5  # one per problem, and all four in work_precision.png
+    assert len(pngs) == 6  # one per problem, and all five in work_precision.png
     for f in files:
         assert f.parent == out and f.stat().st_size > 0
     for f in pngs:
@@ -172,3 +177,39 @@ def test_readme_without_markers_is_refused(report, tmp_path):
         update_readme(out, readme)
     with pytest.raises(ValueError, match=r"`readme` .* is not a file"):
         update_readme(out, tmp_path / "missing.md")
+
+
+def test_units_and_notation_a_reader_can_trust(report):
+    """micro-arcseconds as µas (not "uas"); one notation per numeric column (the
+    wall time mixed 9.945e-06, 0.000176 and 1.908)."""
+    import re
+
+    out, _ = report
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "µas" in page and "(uas)" not in page
+    for r in _md_rows(out):
+        assert re.fullmatch(r"\d\.\d{3}e[+-]\d\d", r[4]), r
+        assert re.fullmatch(r"\d\.\d{3}e[+-]\d\d", r[7]), r
+
+
+def test_every_peer_is_given_its_best_setting_and_says_so(report):
+    """heyoka's tolerance is relative to the largest state component: tol = 1e-18 is
+    its best setting for the solar system, and the report says how each code is set."""
+    import importlib.util
+
+    from hamilton_orbits.report import SETTINGS
+
+    out, _ = report
+    text = (out / "report.md").read_text(encoding="utf-8")
+    assert all(line in text for line in SETTINGS)
+    rows = _md_rows(out)
+    if importlib.util.find_spec("heyoka") is not None:
+        hey = {r[3]: float(r[4]) for r in rows if r[1] == "heyoka"}
+        assert "tol = 1e-18" in hey
+        # 10 years at its best setting: as close to IAS15 at epsilon 0 as IAS15 itself
+        # is at its default (both ~4e-13 at 10 years); 1e-11 is 25 times that
+        assert hey["tol = 1e-18"] < 1e-11
+    solar = [r for r in rows if r[0] == "solar system"]
+    corrected = [float(r[4]) for r in solar if r[2] == "WHFast (Jacobi, corrector 11)"]
+    plain = [float(r[4]) for r in solar if r[2] == "WHFast"]
+    assert min(corrected) < min(plain) / 100  # the corrector is rebound's best map here

@@ -484,6 +484,66 @@ def test_tangent_vectors_do_not_drive_radau15s_steps():
     assert np.max(np.abs(ctrl.stm[-1] - var.stm[-1])) < 1e-8 * np.max(np.abs(var.stm[-1]))
 
 
+@pytest.mark.parametrize("method, run_kw", [
+    ("leapfrog", {}),
+    ("wh", {"jacobi": False}),
+    ("wh", {"jacobi": True}),
+])
+def test_tangent_maps_in_slices_and_stop(method, run_kw):
+    """The fixed-step tangent maps run in slices of steps as the plain drivers do
+    (``stop()`` and Ctrl-C are seen between them): slices of 7 steps give the
+    trajectory and the STM of one call to rounding (the same step count; each
+    slice recomputes the step from what is left, as the plain leapfrog kernel
+    does), and ``stop()`` ends the run inside an output interval; the engine,
+    which asks ``stop()`` after each output too, reports such a run incomplete."""
+    from hamilton_orbits import engine
+    from hamilton_orbits.integrators import StopIntegration, _tangent
+
+    s = _three()
+    gm = np.array(s.gm, dtype=np.float64)  # the drivers' own copy
+    rhs = compile_rhs(s, (), variational=True)
+    t_out = np.array([0.0, 1.0, 2.05])
+    runner = getattr(_tangent, f"run_{method}")
+    ends = []
+    for slice_steps in (_tangent.SLICE, 7):
+        tan = _tangent.Tangent(3, 3, stm=True)
+        r, v, steps = runner(rhs, s.r, s.v, gm, t_out, tan, dt=0.01, on_output=None, out=None,
+                             slice_steps=slice_steps, **run_kw)
+        ends.append((r[-1], v[-1], tan.stm[-1], tan.megno[-1], steps))
+    (r1, v1, m1, y1, n1), (r7, v7, m7, y7, n7) = ends
+    assert n1 == n7 == 205
+    assert np.max(np.abs(r1 - r7)) < 1e-13 and np.max(np.abs(v1 - v7)) < 1e-13
+    assert np.max(np.abs(m1 - m7)) < 1e-11
+    # MEGNO's samples restart at each synchronisation (wh): the sum, not each term
+    assert abs(y1 - y7) < 1e-2
+    asked = []
+    with pytest.raises(StopIntegration):
+        runner(rhs, s.r, s.v, gm, t_out, _tangent.Tangent(3, 3), dt=0.01, on_output=None,
+               out=None, slice_steps=7, stop=lambda: asked.append(1) or len(asked) > 2,
+               **run_kw)
+    assert len(asked) == 3
+    out = engine.run(s.r, s.v, gm, t_out, rhs, method, dt=0.01, stop=lambda: True,
+                     variational=_tangent.Tangent(3, 3))
+    assert not out.complete and len(out.t) == 2 and out.variational.megno[1] > 0
+
+
+def test_radau15_variational_asks_stop_between_slices():
+    """radau15's variational run asks ``stop()`` between its slices of steps, as
+    the plain run does."""
+    from hamilton_orbits.integrators import StopIntegration, _tangent
+
+    s = _three()
+    rhs = compile_rhs(s, (), variational=True)
+    asked = []
+    with pytest.raises(StopIntegration):
+        _tangent.run_radau15(rhs, s.r, s.v, np.array(s.gm, dtype=np.float64),
+                             np.array([0.0, 20.0]), _tangent.Tangent(3, 2), dt=0.01, tol=1e-9,
+                             prs23=False, max_steps=10_000, slice_steps=5, control=False,
+                             on_output=None, out=None,
+                             stop=lambda: asked.append(1) or len(asked) > 1)
+    assert len(asked) == 2
+
+
 # ---------------------------------------------------------------------------
 # The API
 

@@ -13,7 +13,7 @@ import importlib
 import importlib.metadata
 from pathlib import Path
 
-from rigid import c04, liouville, polar_motion, wobble
+from rigid import c04, liouville, polar_motion, pole_prediction, wobble
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -25,9 +25,11 @@ FACADE = [
     "WobbleFit",
     "fit_wobble",
     "free_period",
+    "hindcast",
     "iers2010_mean_pole",
     "load_c04",
     "periodogram",
+    "predict",
     "register_effects",
 ]
 
@@ -37,7 +39,7 @@ def test_facade_names_are_the_concept_modules_objects():
     home = {"EFFECTS": liouville, "LiouvillePole": liouville, "register_effects": liouville,
             "PolarMotionRecord": c04, "load_c04": c04, "iers2010_mean_pole": c04,
             "WobbleFit": wobble, "fit_wobble": wobble, "periodogram": wobble,
-            "free_period": wobble}
+            "free_period": wobble, "predict": pole_prediction, "hindcast": pole_prediction}
     for name in FACADE:
         assert getattr(polar_motion, name) is getattr(home[name], name), name
     assert liouville.free_period is wobble.free_period

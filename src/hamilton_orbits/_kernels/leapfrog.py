@@ -9,11 +9,12 @@ from numba import njit, types
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
 
-__all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "advance"]
+__all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance"]
 
 STATUS_OK = 0
 STATUS_EVENT = 4
 STATUS_DRAIN = 5
+STATUS_SLICE = 6  # ``max_steps`` steps done before ``t1``: call again from ``ws[0]``
 
 _NO_A0 = np.zeros(1)
 _NO_B = np.zeros((7, 1))
@@ -57,14 +58,15 @@ def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no co
 # and loaded from the cache in later processes, whatever the right-hand side
 @njit(types.Tuple((types.int64, types.int64))(
     ACCEL_TYPE, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
-    types.int64[::1], F1), cache=True, error_model="numpy")
-def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws):
+    types.int64[::1], F1, types.int64), cache=True, error_model="numpy")
+def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
     # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.
     Returns ``(steps, status)``; at ``STATUS_EVENT`` (an event with an action) or
     ``STATUS_DRAIN`` the run stopped at the end of step ``steps``, the time in
-    ``ws[0]``.  Events are scanned on both straight drifts of every step."""
+    ``ws[0]``; at ``STATUS_SLICE`` after ``max_steps`` steps.  Events are scanned on
+    both straight drifts of every step."""
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
     if n_steps < 1:
         n_steps = 1
@@ -83,5 +85,8 @@ def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws):
         if ws[1] <= t0 + (s + 1) * h or ws[2] > 0.0:
             ws[0] = t0 + (s + 1) * h
             return s + 1, STATUS_EVENT if ws[1] <= ws[0] else STATUS_DRAIN
+        if s + 1 >= max_steps and s + 1 < n_steps:
+            ws[0] = t0 + (s + 1) * h
+            return s + 1, STATUS_SLICE
     ws[0] = t1
     return n_steps, STATUS_OK

@@ -236,9 +236,9 @@ def _drift(r, v, dr, dv, h):  # pragma: no cover - compiled
 
 
 @njit(types.int64(ACCEL_TYPE, TANGENT_TYPE, F1, F2, F2, F1, F2, F2, types.float64,
-                  types.float64, types.float64, F1),
+                  types.float64, types.float64, F1, types.int64),
       cache=True, error_model="numpy")
-def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms):
+def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms, max_steps):
     # pragma: no cover - compiled
     """Leapfrog steps of at most ``dt`` from ``t0`` to exactly ``t1`` (as
     :func:`hamilton_orbits._kernels.leapfrog.advance`) with the exact tangent map
@@ -247,7 +247,9 @@ def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms):
     linear symplectic maps when the force derives from a potential, so the tangent
     flow is symplectic too (Rein & Tamayo 2016).  After every step the MEGNO state
     ``ms`` is updated from tangent vector 0 (:func:`megno_map_step`).  Returns the
-    steps taken."""
+    steps taken: ``max_steps`` of them, at ``t0 + max_steps h``, when fewer than
+    the ``n_steps`` to ``t1`` (a slice, as the plain kernel's ``STATUS_SLICE``:
+    call again from there)."""
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
     if n_steps < 1:
         n_steps = 1
@@ -268,4 +270,6 @@ def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms):
         _drift(r, v, dr, dv, 0.5 * h)
         megno_map_step(ms, log_norm(dr, dv, n, 0), t0 + (s + 1) * h, h)
         renormalise(ms, dr, dv, n)
+        if s + 1 >= max_steps and s + 1 < n_steps:
+            return s + 1
     return n_steps

@@ -15,7 +15,10 @@ steps).  A driver module satisfies :class:`Integrator`:
   initial state); ``r``, ``v`` of shape (len(t_out), n, 3), written into ``out``
   when it is given (so that what was reached survives an interrupt); ``steps``
   the number of steps taken.  ``on_output(i, steps)`` is called from Python
-  after output ``i`` is reached (progress bars, stopping early).
+  after output ``i`` is reached (progress bars, stopping early); ``stop()`` is
+  asked between slices of steps inside an output interval (radau15 every 20000
+  steps, wh every 100000, leapfrog every 100000; dop853 at outputs only), and
+  True ends the run there with :class:`StopIntegration`.
 
 Python only loops over output times (and, for radau15, over slices of many
 steps); the public entry point is :func:`hamilton_orbits.engine.run`.
@@ -28,10 +31,15 @@ from typing import Any, Protocol
 
 import numpy as np
 
-__all__ = ["INTEGRATORS", "Integrator", "output_arrays"]
+__all__ = ["INTEGRATORS", "Integrator", "StopIntegration", "output_arrays"]
 
 #: The methods, in the order they are listed to users.
 INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
+
+
+class StopIntegration(Exception):
+    """Raised to end a run early: by an output callback, or by a driver when its
+    ``stop()`` callback, asked between slices of steps, returns True."""
 
 
 class Integrator(Protocol):
@@ -52,6 +60,7 @@ class Integrator(Protocol):
         tol: float | None = None,
         on_output: Callable[[int, int], None] | None = None,
         out: tuple[np.ndarray, np.ndarray] | None = None,
+        stop: Callable[[], bool] | None = None,
         **options: Any,
     ) -> tuple[np.ndarray, np.ndarray, int]: ...
 

@@ -35,14 +35,17 @@ from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
 from hamilton_orbits._validation import ConvergenceError
-from hamilton_orbits.integrators import output_arrays
+from hamilton_orbits.integrators import StopIntegration, output_arrays
 from hamilton_orbits.integrators._setup import accel_arg
 
-__all__ = ["DEFAULT_SEED", "Tangent", "run_dop853", "run_leapfrog",
+__all__ = ["DEFAULT_SEED", "SLICE", "Tangent", "run_dop853", "run_leapfrog",
            "run_radau15", "run_wh"]
 
 #: The seed of the random tangent vector of MEGNO when none is given.
 DEFAULT_SEED = 2275
+#: Steps per compiled call of the fixed-step tangent maps (as the plain drivers of
+#: wh and leapfrog): ``stop()`` and Ctrl-C are seen between calls.
+SLICE = 100_000
 
 
 class Tangent:
@@ -128,10 +131,12 @@ def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out:
                 tangent: Tangent, *, dt: float, tol: float, prs23: bool, max_steps: int,
                 slice_steps: int, control: bool,
                 on_output: Callable[[int, int], None] | None,
-                out: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, int]:
+                out: tuple[np.ndarray, np.ndarray] | None,
+                stop: Callable[[], bool] | None = None) -> tuple[np.ndarray, np.ndarray, int]:
     """``radau15`` with the tangent vectors (:func:`hamilton_orbits._kernels.radau15.
     advance_variational`); the arguments as the driver has checked them, ``control``
-    True to let the tangent vectors take part in the step control."""
+    True to let the tangent vectors take part in the step control; ``stop()`` asked
+    between slices of ``slice_steps`` steps (True raises :class:`StopIntegration`)."""
     n = r0.shape[0]
     x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
     w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
@@ -159,6 +164,8 @@ def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out:
                     f"radau15 (variational) stopped at t = {float(st[0])!r} before t_out[{i}] "
                     f"= {float(t_out[i])!r} (status {status}: a non-finite acceleration, an "
                     f"underflowing step, or more than max_steps = {max_steps} steps)")
+            if stop is not None and stop():
+                raise StopIntegration
         r_out[i], v_out[i] = x[:n], w[:n]
         tangent.record(i, float(t_out[i]), x[n:], w[n:])
         if on_output is not None:
@@ -181,9 +188,12 @@ def _tangent_arg(fn: Any) -> Any:
 def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
                  tangent: Tangent, *, dt: float,
                  on_output: Callable[[int, int], None] | None,
-                 out: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, int]:
+                 out: tuple[np.ndarray, np.ndarray] | None,
+                 stop: Callable[[], bool] | None = None,
+                 slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
     """``leapfrog`` with the exact tangent map of each step
-    (:func:`hamilton_orbits._kernels.variational.advance_leapfrog`)."""
+    (:func:`hamilton_orbits._kernels.variational.advance_leapfrog`), in slices of
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
     dr, dv = tangent.dr0.copy(), tangent.dv0.copy()
@@ -192,8 +202,17 @@ def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out
     tangent.start(float(t_out[0]))
     steps = 0
     for i in range(1, t_out.shape[0]):
-        steps += _var.advance_leapfrog(accel, jac, rhs.p, r, v, gm, dr, dv, float(t_out[i - 1]),
-                                       float(t_out[i]), dt, tangent.ms)
+        t, t1 = float(t_out[i - 1]), float(t_out[i])
+        while True:  # the steps and times of the plain kernel's slices
+            n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
+            done = _var.advance_leapfrog(accel, jac, rhs.p, r, v, gm, dr, dv, t, t1, dt,
+                                         tangent.ms, slice_steps)
+            steps += done
+            if done >= n_left:
+                break
+            t = t + done * ((t1 - t) / n_left)
+            if stop is not None and stop():
+                raise StopIntegration
         r_out[i], v_out[i] = r, v
         tangent.record(i, float(t_out[i]), dr, dv)
         if on_output is not None:
@@ -246,9 +265,12 @@ def _from_split(q: np.ndarray, u: np.ndarray, com: np.ndarray, g: np.ndarray, ja
 def run_wh(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
            tangent: Tangent, *, dt: float, jacobi: bool,
            on_output: Callable[[int, int], None] | None,
-           out: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, int]:
+           out: tuple[np.ndarray, np.ndarray] | None,
+           stop: Callable[[], bool] | None = None,
+           slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
     """``wh`` (synchronised steps, :mod:`hamilton_orbits._kernels.wh_tangent`) with the
-    exact tangent map; the central body (largest GM) first inside."""
+    exact tangent map; the central body (largest GM) first inside; in slices of
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
     n, k = r0.shape[0], tangent.k
     c = int(np.argmax(gm))
     order = np.concatenate([[c], np.delete(np.arange(n), c)])
@@ -275,18 +297,27 @@ def run_wh(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.n
         span = t_out[i] - t_out[i - 1]
         n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
         last = span - (n_steps - 1) * dt
-        if jacobi:
-            steps, bad = _wht.advance_jacobi(extra, jac, rhs.p, has_extra, q, u, g, eta, dq, du,
-                                             dt, n_steps, last, float(t_out[i - 1]), tangent.ms)
-        else:
-            steps, bad = _wht.advance_dh(extra, jac, rhs.p, has_extra, q, u, g, g_p, com, dq,
-                                         du, dcom, dt, n_steps, last, float(t_out[i - 1]),
-                                         tangent.ms)
-        total += steps
-        if bad >= 0:
-            raise ConvergenceError(
-                f"wh: the Kepler step of body {int(order[bad])} failed between t_out[{i - 1}] "
-                f"= {float(t_out[i - 1])!r} and t_out[{i}] = {float(t_out[i])!r}")
+        done = 0
+        while done < n_steps:
+            if done and stop is not None and stop():
+                raise StopIntegration
+            n_call = min(n_steps - done, slice_steps)  # stop() is asked between calls
+            h_last = last if done + n_call == n_steps else dt
+            t_call = float(t_out[i - 1] + done * dt)
+            if jacobi:
+                steps, bad = _wht.advance_jacobi(extra, jac, rhs.p, has_extra, q, u, g, eta, dq,
+                                                 du, dt, n_call, h_last, t_call, tangent.ms)
+            else:
+                steps, bad = _wht.advance_dh(extra, jac, rhs.p, has_extra, q, u, g, g_p, com,
+                                             dq, du, dcom, dt, n_call, h_last, t_call,
+                                             tangent.ms)
+            done += steps
+            total += steps
+            if bad >= 0:
+                raise ConvergenceError(
+                    f"wh: the Kepler step of body {int(order[bad])} failed between "
+                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                    f"{float(t_out[i])!r}")
         rr, vv = _from_split(q, u, com, g, jacobi)
         r_out[i], v_out[i] = rr[inv_order], vv[inv_order]
         drr, dvv = _from_split(dq.reshape(k, n, 3), du.reshape(k, n, 3), dcom, g, jacobi)

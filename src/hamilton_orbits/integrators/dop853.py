@@ -42,6 +42,7 @@ def run(
     events: EventLog | None = None,
     tangent_control: bool = False,
     variational: Any = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with scipy's DOP853; see :mod:`hamilton_orbits.integrators`.
 
@@ -53,7 +54,9 @@ def run(
 
     ``events`` (:mod:`hamilton_orbits.events`) are looked for in every step on the
     cubic Hermite interpolant of the step's ends; actions take effect at the
-    event's time (the integration restarts there).
+    event's time (the integration restarts there).  ``stop`` is not asked inside
+    an output interval (scipy's solver runs it through): the run ends at the
+    next output.
 
     Examples
     --------

@@ -16,12 +16,14 @@ import numpy as np
 from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _tangent, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _tangent, output_arrays
 from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "choose_dt", "run"]
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run"]
 
 NAME = "leapfrog"
+#: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
+SLICE = 100_000
 ACCEPTS_VELOCITY_DEPENDENT = False
 
 
@@ -50,6 +52,7 @@ def run(
     max_steps: int = MAX_FIXED_STEPS,
     events: EventLog | None = None,
     variational: Any = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
 
@@ -79,7 +82,8 @@ def run(
     if variational is not None:
         return _tangent.run_leapfrog(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
                                      np.ascontiguousarray(gm, dtype=np.float64), t_out,
-                                     variational, dt=float(dt), on_output=on_output, out=out)
+                                     variational, dt=float(dt), on_output=on_output, out=out,
+                                     stop=stop)
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
     gm = np.ascontiguousarray(gm, dtype=np.float64)
@@ -93,11 +97,15 @@ def run(
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
             done, status = _k.advance(accel, rhs.p, r, v, gm, t, float(t_out[i]), dt,
-                                      log.watch, log.buffer, log.count, ws)
+                                      log.watch, log.buffer, log.count, ws, SLICE)
             steps += int(done)
             t = float(ws[0])
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
+            if status == _k.STATUS_SLICE:  # Ctrl-C and stop() are seen between slices
+                if stop is not None and stop():
+                    raise StopIntegration
+                continue
             log.drain()
             if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, gm):
                 out_r[i], out_v[i] = r, v

@@ -44,7 +44,7 @@ import numpy as np
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _setup, _tangent, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RADAU_SPACINGS", "run"]
 
@@ -80,6 +80,7 @@ def run(
     events: EventLog | None = None,
     tangent_control: bool = False,
     variational: Any = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the adaptive 15th-order Gauss-Radau scheme (IAS15-like).
 
@@ -181,9 +182,10 @@ def run(
         return _tangent.run_radau15(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
                                     tol=tol_f or 0.0, prs23=crit == "prs23", max_steps=max_steps,
                                     slice_steps=SLICE, control=bool(tangent_control),
-                                    on_output=on_output, out=out)
+                                    on_output=on_output, out=out, stop=stop)
     log = events if events is not None else EventLog.none(r0.shape[0])
     run_ = _Run(rhs, r0, v0, gm.copy(), t_out[0], dt_f, tol_f or 0.0, crit == "prs23", log)
+    run_.stop = stop
     for i in range(1, nt):
         stop = run_.advance_to(t_out, i, max_steps)
         r_out[i] = run_.x
@@ -213,6 +215,7 @@ class _Run:
         self.x = np.ascontiguousarray(r0.copy())
         self.w = np.ascontiguousarray(v0.copy())
         self.total = 0
+        self.stop: Callable[[], bool] | None = None
 
     def advance_to(self, t_out: np.ndarray, i: int, max_steps: int) -> bool:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run."""
@@ -225,6 +228,8 @@ class _Run:
             self.total += steps
             if status == _k.STATUS_MAXSTEPS:
                 _check_pace(self.total, max_steps, float(self.st[0]), t_out)
+                if self.stop is not None and self.stop():
+                    raise StopIntegration
             elif status == _k.STATUS_DRAIN:
                 log.drain()
             elif status == _k.STATUS_EVENT:

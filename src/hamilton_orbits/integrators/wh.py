@@ -47,11 +47,13 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _setup, _tangent, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
 
 NAME = "wh"
+#: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
+SLICE = 100_000
 ACCEPTS_VELOCITY_DEPENDENT = False
 COORDINATES = ("democratic_heliocentric", "jacobi")
 
@@ -105,6 +107,7 @@ def run(
     max_steps: int = _setup.MAX_FIXED_STEPS,
     events: EventLog | None = None,
     variational: Any = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
@@ -194,7 +197,8 @@ def run(
             raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
                              "is not implemented); use corrector=0")
         return _tangent.run_wh(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
-                               jacobi=coordinates == "jacobi", on_output=on_output, out=out)
+                               jacobi=coordinates == "jacobi", on_output=on_output, out=out,
+                               stop=stop)
     n = r0.shape[0]
     order = np.concatenate([[c], np.delete(np.arange(n), c)])  # the central body first
     extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
@@ -214,9 +218,13 @@ def run(
         last = span - (n_steps - 1) * dt_f
         done = 0
         while done < n_steps:
+            if done and stop is not None and stop():
+                raise StopIntegration
             ws = np.array([t_out[i - 1] + done * dt_f, np.inf, 0.0, -1.0])
-            steps, bad, status = split.advance(q, u, dt_f, n_steps - done, last,
-                                               log.kernel_watch(), log.buffer, log.count, ws)
+            n_call = min(n_steps - done, SLICE)  # Ctrl-C and stop() are seen between calls
+            steps, bad, status = split.advance(
+                q, u, dt_f, n_call, last if done + n_call == n_steps else dt_f,
+                log.kernel_watch(), log.buffer, log.count, ws)
             done += steps
             total += steps
             if bad >= 0:
