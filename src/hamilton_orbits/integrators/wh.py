@@ -185,7 +185,7 @@ def run(
     100
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    dt_f, tol_f = _check_options(rhs, dt, tol, coordinates, corrector)
+    dt_f, tol_f = _check_options(rhs, dt, tol, coordinates, corrector, variational is not None)
     c = int(np.argmax(gm))
     if not gm[c] > 0.0:
         raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
@@ -193,9 +193,6 @@ def run(
         dt_f = default_step(r0, v0, gm, tol_f)
     _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
     if variational is not None:
-        if corrector:
-            raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
-                             "is not implemented); use corrector=0")
         return _tangent.run_wh(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
                                jacobi=coordinates == "jacobi", on_output=on_output, out=out,
                                stop=stop)
@@ -259,7 +256,8 @@ def _masked(r: np.ndarray, v: np.ndarray, log: EventLog) -> tuple[np.ndarray, np
     return r, v
 
 
-def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int):
+def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int,
+                   variational: bool = False):
     if rhs.velocity_dependent:
         raise ValueError(
             f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
@@ -278,6 +276,9 @@ def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int
             f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
             "(the corrector is defined for the Jacobi splitting)"
         )
+    if corrector and variational:
+        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
+                         "is not implemented); use corrector=0")
     return dt_f, tol_f
 
 
