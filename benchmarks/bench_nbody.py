@@ -17,21 +17,37 @@ loading the numba cache, or compiling when there is none) is reported apart.
 3. Scaling, cost per step: 3, 10, 100, 1000 massive bodies, and 1e2 .. 1e5
    test particles around the solar system; radau15 (fixed dt: IAS15 with
    epsilon = 0) and wh vs WHFast.
-4. Work-precision sweep on the solar system (100 years; 20 with --quick):
-   every integrator present (radau15, wh in democratic-heliocentric and in
-   Jacobi coordinates with the third-order corrector, and leapfrog / dop853 if
-   the package has them) and rebound's IAS15, WHFast (the same two maps) and
-   leapfrog, over tol or dt; error
-   = max relative position difference against a reference (IAS15, default
-   epsilon) and relative energy error, against wall time (the shortest of 3
-   runs per setting).  Written to
+4. Work-precision sweep on the solar system (1000 years; 100 with --quick):
+   radau15 over tol, wh in democratic-heliocentric coordinates and in Jacobi
+   coordinates with every corrector (0, 3, 5, 7, 11, 17) over dt, rebound's
+   IAS15 over epsilon and WHFast (Jacobi, correctors 0, 3, 11, 17, safe_mode
+   0) over dt, and heyoka's Taylor integrator where installed (its best
+   setting here: high_accuracy=True, compact_mode=False, over tol); error = max
+   over planets of the heliocentric position error over the distance against
+   radau15 in double-double at 1 day (hamilton_orbits.reference, cached),
+   whose own uncertainty (its distance from 2 days) is printed beside every
+   error; CPU time, the shortest of 2 runs; and the CPU time each code needs
+   to reach 1e-6, 1e-8, 1e-10.  Written to
    benchmarks/results/nbody_work_precision.{md,png}.
+5. leapfrog against rebound's; 6. what an effect costs (radau15).
+7. Cost per call beyond its steps at N = 2, 10, 100 and 10 + 1e5 test
+   particles: ours ``integrate`` on a System, rebound ``sim.copy()``,
+   ``integrate``, ``synchronize`` and the states read out.
+8. Peak memory per test particle of one call (10 + 1e5; 1e4 with --quick),
+   each in its own process.
+9. KeplerOrbit.propagate of 1e6 orbits on one and two threads beside a
+   compute-only yardstick (what the shared machine's second core gives), in a
+   child process with two threads.
+10. One radau15 step of the N = 10 disc: its floating-point operations, the
+    fraction of the machine's scalar and SIMD throughput it reaches; the force
+    evaluation beside a SIMD form.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import itertools
 import math
 import time
 from pathlib import Path
@@ -107,9 +123,10 @@ def reb_state(sim):
 
 
 def timed(fn):
-    t0 = time.perf_counter()
+    """Process CPU time of one call (other jobs' time slices do not count)."""
+    t0 = time.process_time()
     out = fn()
-    return time.perf_counter() - t0, out
+    return time.process_time() - t0, out
 
 
 def timed_best(fn, repeat=3):
@@ -203,6 +220,8 @@ def bench_wh(years: float, repeat: int) -> None:
         ("democratic_heliocentric", 0, "democraticheliocentric", 1),
         ("jacobi", 0, "jacobi", 0),
         ("jacobi", 3, "jacobi", 0),
+        ("jacobi", 11, "jacobi", 0),
+        ("jacobi", 17, "jacobi", 0),
     ]
     for coords, corr, peer_coords, safe in cases:
 
@@ -338,93 +357,168 @@ def _ours_modules():
     return out
 
 
-def bench_work_precision(years: float) -> None:
+WH_DTS = (8.0, 4.0, 2.0, 1.0, 0.5)
+OUR_CORRECTORS = (0, 3, 5, 7, 11, 17)
+WHFAST_CORRECTORS = (0, 3, 11, 17)
+HEYOKA = "taylor_adaptive, high_accuracy=True, compact_mode=False"
+
+
+def _wp_ours(r0, v0, gm, t_end, quick):
+    """(code, method, parameter, value, run) of our integrators in the sweep."""
+    mods = _ours_modules()
+    t = np.array([0.0, t_end])
+    cases = []
+    for tol in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9) + (() if quick else (1e-10, 1e-11)):
+        cases.append(("ours", "radau15", "tol", tol,
+                      lambda tol=tol: mods["radau15"].run(rhs(), r0, v0, gm, t, tol=tol)))
+    for dt in WH_DTS:
+        cases.append(("ours", "wh", "dt", dt,
+                      lambda dt=dt: mods["wh"].run(rhs(), r0, v0, gm, t, dt=dt)))
+    for c in OUR_CORRECTORS:
+        for dt in WH_DTS:
+            cases.append(("ours", f"wh-jacobi-c{c}", "dt", dt,
+                          lambda dt=dt, c=c: mods["wh"].run(rhs(), r0, v0, gm, t, dt=dt,
+                                                            coordinates="jacobi", corrector=c)))
+    return cases
+
+
+def _wp_peers(r0, v0, gm, t_end, quick):
+    """rebound's IAS15 and WHFast (Jacobi, correctors 0, 3, 11, 17; safe_mode 0, the
+    corrector applied once as ours is) and heyoka where installed."""
+    cases = []
+
+    def ias15(eps):
+        sim = to_rebound(r0, v0, gm, "ias15")
+        sim.integrator.epsilon = eps
+        sim.dt = 1.0
+        sim.integrate(t_end, exact_finish_time=1)
+        return reb_state(sim)
+
+    def whfast(dt, c):
+        sim = to_rebound(r0, v0, gm, "whfast")
+        sim.dt = dt
+        sim.integrator.coordinates = "jacobi"
+        sim.integrator.safe_mode = 0
+        sim.integrator.corrector = c
+        sim.integrate(t_end, exact_finish_time=0)
+        sim.synchronize()
+        return reb_state(sim)
+
+    for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9):
+        cases.append(("rebound", "ias15", "epsilon", eps, lambda eps=eps: ias15(eps)))
+    for c in WHFAST_CORRECTORS:
+        for dt in WH_DTS:
+            cases.append(("rebound", f"whfast-jacobi-c{c}", "dt", dt,
+                          lambda dt=dt, c=c: whfast(dt, c)))
+    try:
+        import heyoka as hy
+    except ImportError:
+        print("    (heyoka not installed: its rows are left out)")
+        return cases
+    model = hy.model.nbody(len(gm), masses=[float(m) for m in gm], Gconst=1.0)
+    state0 = np.hstack([r0, v0]).ravel()
+    for tol in (1e-9, 1e-12, 1e-15):
+        ta = hy.taylor_adaptive(model, state0, tol=tol, compact_mode=False, high_accuracy=True)
+
+        def run(ta=ta):
+            ta.time = 0.0
+            ta.state[:] = state0
+            ta.propagate_until(t_end)
+            s = np.array(ta.state).reshape(len(gm), 6)
+            return s[:, :3], s[:, 3:]
+        cases.append(("heyoka", "taylor", "tol", tol, run))
+    return cases
+
+
+def _time_to_reach(points, target):
+    """The CPU time a method needs for ``target`` error, interpolated in log-log
+    between its two settings that bracket it (None if none reaches it)."""
+    pts = sorted(points)  # by time
+    best = None
+    for (t0, e0), (t1, e1) in itertools.pairwise(pts):
+        if e0 > target >= e1 > 0 and e0 > 0:
+            f = math.log(e0 / target) / math.log(e0 / e1)
+            t = math.exp(math.log(t0) + f * math.log(t1 / t0))
+            best = t if best is None else min(best, t)
+    reached = [t for t, e in pts if e <= target]
+    if reached:
+        best = min(reached) if best is None else min(best, min(reached))
+    return best
+
+
+def bench_work_precision(years: float, repeat: int = 2) -> None:
+    """Work-precision against radau15 in double-double (hamilton_orbits.reference),
+    whose own uncertainty (its distance from the run at twice the step) is
+    printed beside the errors; CPU time, the shortest of ``repeat`` runs."""
+    from hamilton_orbits.reference import reference
+
     r0, v0, gm = solar_system()
     t_end = 8.0 * math.floor(years * 365.25 / 8.0)  # a multiple of every fixed dt below
     e0 = energy(r0, v0, gm)
-    sim = to_rebound(r0, v0, gm, "ias15")
-    sim.integrate(t_end, exact_finish_time=1)
-    x_ref, _ = reb_state(sim)
-    scale = np.linalg.norm(x_ref - x_ref[0], axis=1)
-    scale[0] = np.linalg.norm(x_ref[0])
-    print(f"[4] work-precision, solar system {years:g} years (reference: IAS15, epsilon 1e-9)")
-    mods = _ours_modules()
-    sweeps = {
-        "radau15": ("tol", [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]),
-        "wh": ("dt", [8.0, 4.0, 2.0, 1.0, 0.5]),
-        "wh-jacobi-c3": ("dt", [8.0, 4.0, 2.0, 1.0, 0.5]),
-        "leapfrog": ("dt", [2.0, 1.0, 0.5, 0.25]),
-        "dop853": ("tol", [1e-8, 1e-10, 1e-12]),
-    }
+    ref = reference(r0, v0, gm, np.array([0.0, t_end]), 1.0)
+    x_ref = ref.r[-1]
+    h_ref = x_ref[1:] - x_ref[0]
+    scale = np.linalg.norm(h_ref, axis=1)
+    own = float(np.max(np.linalg.norm((ref.r_check[-1][1:] - ref.r_check[-1][0]) - h_ref, axis=1)
+                       / scale))
+    own_s = f"{own:.0e}" if own >= 1e-16 else "< 1e-16"  # the doubles compared resolve 1e-16
+    print(f"[4] work-precision, solar system {years:g} years; error = max over planets of the "
+          f"heliocentric position error / distance against radau15 in double-double at 1 d "
+          f"({'cached' if ref.cached else f'computed in {ref.seconds:.0f} s'}; its own "
+          f"uncertainty, the distance from 2 d: {own_s}); CPU time, best of {repeat}")
     rows = []
-
-    def record(code, method, par, value, secs, r, v):
-        err = float(np.max(np.linalg.norm(r - x_ref, axis=1) / scale))
+    for code, method, par, value, fn in (_wp_ours(r0, v0, gm, t_end, years < 500)
+                                         + _wp_peers(r0, v0, gm, t_end, years < 500)):
+        best = math.inf
+        for _ in range(repeat):
+            c0 = time.process_time()
+            out = fn()
+            best = min(best, time.process_time() - c0)
+            if best > 20.0:
+                break
+        r, v = out[0], out[1]
+        r, v = (r[-1], v[-1]) if np.ndim(r) == 3 else (r, v)
+        err = float(np.max(np.linalg.norm((r[1:] - r[0]) - h_ref, axis=1) / scale))
         de = abs(energy(r, v, gm) / e0 - 1)
-        rows.append((code, method, par, value, secs, err, de))
-        print(
-            f"    {code:8s} {method:9s} {par}={value:<8g} {secs:8.3f} s   "
-            f"pos err {err:8.1e}   |dE/E| {de:8.1e}"
-        )
+        rows.append((code, method, par, value, best, err, de))
+        print(f"    {code:8s} {method:18s} {par}={value:<8g} {best:8.3f} s   error {err:8.1e} "
+              f"(reference +- {own_s})   |dE/E| {de:8.1e}")
+    _equal_error(rows)
+    _write_work_precision(rows, years, own, own_s)
 
-    if "wh" in mods:
-        mods["wh-jacobi-c3"] = mods["wh"]
-    for name, mod in mods.items():
-        par, values = sweeps[name]
-        for val in values:
-            kw = {par: val}
-            if name == "wh-jacobi-c3":
-                kw.update(coordinates="jacobi", corrector=3)
-            try:
-                secs, (r, v, _) = timed_best(
-                    lambda kw=kw, mod=mod: mod.run(rhs(), r0, v0, gm, np.array([0.0, t_end]), **kw)
-                )
-            except Exception as exc:  # a method that cannot do this setting: report
-                print(f"    ours     {name:9s} {par}={val:g}: {type(exc).__name__}: {exc}")
-                continue
-            record("ours", name, par, val, secs, r[-1], v[-1])
-    peers = {
-        "ias15": ("epsilon", [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]),
-        "whfast": ("dt", [8.0, 4.0, 2.0, 1.0, 0.5]),
-        "whfast-jacobi-c3": ("dt", [8.0, 4.0, 2.0, 1.0, 0.5]),
-        "leapfrog": ("dt", [2.0, 1.0, 0.5, 0.25]),
-    }
-    for name, (par, values) in peers.items():
-        for val in values:
 
-            def peer(name=name, par=par, val=val):
-                sim = to_rebound(r0, v0, gm, "whfast" if name.startswith("whfast") else name)
-                if par == "epsilon":
-                    sim.integrator.epsilon = val
-                    sim.dt = 1.0
-                    sim.integrate(t_end, exact_finish_time=1)
-                else:
-                    sim.dt = val
-                    if name == "whfast":
-                        sim.integrator.coordinates = "democraticheliocentric"
-                        sim.integrator.safe_mode = 0
-                    if name == "whfast-jacobi-c3":
-                        sim.integrator.coordinates = "jacobi"
-                        sim.integrator.safe_mode = 0
-                        sim.integrator.corrector = 3
-                    sim.integrate(t_end, exact_finish_time=0)
-                    if name.startswith("whfast"):
-                        sim.synchronize()
-                return sim
+def _equal_error(rows):
+    """For each target error, the fastest setting of each code's families."""
+    groups: dict[tuple[str, str], list] = {}
+    for code, method, _, _, secs, err, _ in rows:
+        groups.setdefault((code, method), []).append((secs, err))
+    print("    CPU time to reach an error (log-log interpolation between settings):")
+    for target in (1e-6, 1e-8, 1e-10):
+        cells = []
+        for (code, method), pts in groups.items():
+            t = _time_to_reach(pts, target)
+            if t is not None:
+                cells.append((t, f"{code} {method}"))
+        cells.sort()
+        ours = next((c for c in cells if c[1].startswith("ours")), None)
+        peer = next((c for c in cells if not c[1].startswith("ours")), None)
+        text = ", ".join(f"{name} {t:.3g} s" for t, name in cells[:6])
+        ratio = f"; fastest peer / fastest ours = {peer[0] / ours[0]:.2f}" if ours and peer else ""
+        print(f"      {target:.0e}: {text}{ratio}")
 
-            secs, s = timed_best(peer)
-            x, w = reb_state(s)
-            record("rebound", name, par, val, secs, x, w)
+
+def _write_work_precision(rows, years, own, own_s):
     RESULTS.mkdir(exist_ok=True)
     md = RESULTS / "nbody_work_precision.md"
     with md.open("w") as f:
-        f.write(f"# Work-precision: solar system, {years:g} years (benchmarks/bench_nbody.py)\n\n")
-        f.write("| code | method | parameter | wall time (s) | max rel. pos. error | |dE/E| |\n")
+        f.write(f"# Work-precision: solar system, {years:g} years (benchmarks/bench_nbody.py)\n\n"
+                f"Reference: radau15 in double-double at 1-day steps; its own uncertainty (its "
+                f"distance from 2-day steps) {own_s}.  CPU time.  heyoka: {HEYOKA}.\n\n")
+        f.write("| code | method | parameter | CPU time (s) | max rel. pos. error | |dE/E| |\n")
         f.write("|---|---|---|---|---|---|\n")
         for code, method, par, value, secs, err, de in rows:
-            f.write(
-                f"| {code} | {method} | {par}={value:g} | {secs:.3f} | {err:.1e} | {de:.1e} |\n"
-            )
+            f.write(f"| {code} | {method} | {par}={value:g} | {secs:.3f} | {err:.1e} "
+                    f"| {de:.1e} |\n")
     try:
         import matplotlib
 
@@ -433,30 +527,24 @@ def bench_work_precision(years: float) -> None:
     except ImportError:
         print(f"    table: {md} (matplotlib not installed: no figure)")
         return
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, ax = plt.subplots(figsize=(9, 6))
     groups: dict[tuple[str, str], list] = {}
-    for code, method, _, _, secs, err, de in rows:
-        groups.setdefault((code, method), []).append((secs, err, de))
+    for code, method, _, _, secs, err, _ in rows:
+        groups.setdefault((code, method), []).append((secs, err))
     for (code, method), pts in groups.items():
-        # in sweep order (coarse to fine), not sorted by the (noisy) times
-        ls = "-" if code == "ours" else "--"
-        secs = [p[0] for p in pts]
-        axes[0].loglog(
-            secs, [max(p[1], 1e-17) for p in pts], ls, marker="o", label=f"{code} {method}"
-        )
-        axes[1].loglog(
-            secs, [max(p[2], 1e-17) for p in pts], ls, marker="o", label=f"{code} {method}"
-        )
-    axes[0].set_ylabel("max relative position error vs IAS15")
-    axes[1].set_ylabel("|relative energy error|")
-    for ax in axes:
-        ax.set_xlabel("wall time (s)")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.suptitle(f"Solar system, {years:g} years: what accuracy costs")
+        ax.loglog([p[0] for p in pts], [max(p[1], 1e-17) for p in pts],
+                  "-" if code == "ours" else "--", marker="o" if code == "ours" else "s",
+                  ms=3, label=f"{code} {method}")
+    ax.axhline(max(own, 1e-16), color="k", lw=0.8, ls=":",
+               label=f"reference's own uncertainty ({own_s})")
+    ax.set_xlabel("CPU time (s)")
+    ax.set_ylabel("max relative heliocentric position error")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6, ncol=2)
+    ax.set_title(f"Solar system, {years:g} years: what accuracy costs")
     fig.tight_layout()
     png = RESULTS / "nbody_work_precision.png"
-    fig.savefig(png, dpi=120)
+    fig.savefig(png, dpi=110)
     print(f"    table: {md}\n    figure: {png}")
 
 
@@ -544,19 +632,370 @@ def bench_effects_cost(years: float, repeat: int) -> None:
         print(f"    {name:<32}{np.median(ts) * 1e6:8.2f} us/step   x{ratio:5.2f}")
 
 
+def _cpu(fn, min_seconds=0.02, rounds=5):
+    """Median over ``rounds`` of the CPU time per call (each round loops ``fn`` until
+    it has run ``min_seconds``)."""
+    fn()
+    out = []
+    for _ in range(rounds):
+        k, c0 = 0, time.process_time()
+        while True:
+            fn()
+            k += 1
+            spent = time.process_time() - c0
+            if spent >= min_seconds:
+                break
+        out.append(spent / k)
+    return float(np.median(out)), float(min(out)), float(max(out))
+
+
+def bench_per_call(quick: bool) -> None:
+    """What a call costs beyond its steps: (one-step call) - (one step), one step
+    taken from a call of 21 steps; ours ``integrate(system, dt, ...)`` on a System
+    built before (validation, set-up, the integrals, the result), rebound's
+    ``sim.copy()`` of a Simulation built before (the equivalent of not changing
+    the input), ``integrate``, ``synchronize`` and the states read into arrays."""
+    from hamilton_orbits import System, integrate
+
+    rng = np.random.default_rng(1)
+    print("[7] cost per call beyond its steps (CPU, median of 5 rounds; ms); "
+          "ratio = rebound / ours")
+    print("    system                 method    ours    rebound   ratio   "
+          "(one step: ours / rebound)")
+    sizes = [(2, 0), (10, 0), (100, 0)] + ([] if quick else [(10, 100000)])
+    for nm, nt in sizes:
+        r, v, g = _disc(nm, nt, rng)
+        system = System.from_arrays(g, r, v)
+        for method, integ in (("radau15", "ias15"), ("wh", "whfast")):
+            dt = 0.01
+
+            def ours(k, method=method, system=system, dt=dt):
+                return integrate(system, k * dt, method=method, dt=dt)
+
+            sim = to_rebound(r, v, g, integ)
+            sim.dt = dt
+            if integ == "ias15":
+                sim.integrator.epsilon = 0.0
+            else:
+                sim.integrator.coordinates = "democraticheliocentric"
+                sim.integrator.safe_mode = 0
+
+            def peer(k, sim=sim, dt=dt):
+                s2 = sim.copy()
+                s2.integrate(k * dt, exact_finish_time=0)
+                if s2.integrator == "whfast":
+                    s2.synchronize()
+                x, w = np.empty((s2.N, 3)), np.empty((s2.N, 3))
+                s2.serialize_particle_data(xyz=x, vxvyvz=w)
+                return x
+
+            secs = 0.2 if nt else 0.02
+            o1, p1 = _cpu(lambda: ours(1), secs), _cpu(lambda: peer(1), secs)
+            o21, p21 = _cpu(lambda: ours(21), secs), _cpu(lambda: peer(21), secs)
+            so, sp = (o21[0] - o1[0]) / 20, (p21[0] - p1[0]) / 20
+            fo, fp = o1[0] - so, p1[0] - sp
+            print(f"    {nm:4d} + {nt:6d}          {method:8s} {fo * 1e3:7.3f}  {fp * 1e3:8.3f}  "
+                  f"{fp / fo:6.2f}   ({so * 1e3:.3f} / {sp * 1e3:.3f} ms)")
+
+
+_MEMORY_CHILD = """
+import sys, numpy as np
+sys.path.insert(0, {bench!r})
+from bench_nbody import _disc, to_rebound
+def rss():
+    with open("/proc/self/status") as f:
+        d = dict(line.split(":", 1) for line in f)
+    return int(d["VmRSS"].split()[0]) * 1024, int(d["VmHWM"].split()[0]) * 1024
+code, method, nt = sys.argv[1], sys.argv[2], int(sys.argv[3])
+r, v, g = _disc(10, 100, np.random.default_rng(1))
+if code == "ours":
+    from hamilton_orbits import System, integrate
+    integrate(System.from_arrays(g, r, v), 0.03, method=method, dt=0.01)  # load the kernels
+    base0 = rss()[0]
+    r, v, g = _disc(10, nt, np.random.default_rng(1))
+    system = System.from_arrays(g, r, v)
+else:
+    base0 = rss()[0]
+    r, v, g = _disc(10, nt, np.random.default_rng(1))
+    system = to_rebound(r, v, g, method)
+    system.dt = 0.01
+    if method == "whfast":
+        system.integrator.coordinates = "democraticheliocentric"
+        system.integrator.safe_mode = 0
+    else:
+        system.integrator.epsilon = 0.0
+del r, v, g
+base = rss()[0]
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")  # reset the peak (VmHWM) to the current RSS
+if code == "ours":
+    traj = integrate(system, 0.03, method=method, dt=0.01)
+else:
+    system.integrate(0.03, exact_finish_time=0)
+    if method == "whfast":
+        system.synchronize()
+    x, w = np.empty((system.N, 3)), np.empty((system.N, 3))
+    system.serialize_particle_data(xyz=x, vxvyvz=w)
+peak = rss()[1]
+print((base - base0) / (nt + 10), (peak - base) / (nt + 10))
+"""
+
+
+def bench_memory(quick: bool) -> None:
+    """Peak memory per test particle of one call (3 steps, two outputs), each case in
+    its own process: the peak RSS during the call (Linux: /proc/self/clear_refs
+    resets it) over the RSS with the input built (ours a System.from_arrays,
+    rebound a Simulation; rebound integrates it in place, ours leaves it as it is
+    and returns the history, two rows here)."""
+    import subprocess
+    import sys
+
+    nt = 10**4 if quick else 10**5
+    print(f"[8] memory per test particle, 10 bodies + {nt} test particles (bytes; input, "
+          "peak of one call)")
+    env = dict(__import__("os").environ)
+    script = _MEMORY_CHILD.format(bench=str(Path(__file__).resolve().parent))
+    for code, method in (("ours", "radau15"), ("rebound", "ias15"), ("ours", "wh"),
+                         ("rebound", "whfast")):
+        out = subprocess.run([sys.executable, "-c", script, code, method, str(nt)], env=env,
+                             capture_output=True, text=True, check=True).stdout.split()
+        print(f"    {code:8s} {method:8s} input {float(out[0]):6.0f}   call peak "
+              f"{float(out[1]):6.0f}")
+
+
+def bench_propagate(rounds: int) -> None:
+    """KeplerOrbit's batch kernel on 1e6 orbits on one and two threads, beside a
+    yardstick that only computes (no memory traffic) run the same way: its
+    speed-up is what the machine's second core gives at that moment (the machine
+    is shared), the kernel's is what it takes of it.  Wall time, medians of
+    interleaved rounds."""
+    import numba
+    from numba import njit, prange
+
+    @njit(parallel=True)
+    def burn(out, reps):  # pragma: no cover - compiled
+        for i in prange(out.shape[0]):
+            x = 0.1 + i * 1e-9
+            for _ in range(reps):
+                x = x * 1.0000001 + 1e-9
+                x = x - 1e-9 * x * x
+            out[i] = x
+
+    from hamilton_orbits import KeplerOrbit
+
+    n = 10**6
+    rng = np.random.default_rng(0)  # bound, inclined orbits (benchmarks/bench_overhead.py's)
+    a, e = rng.uniform(0.5, 5.0, n), rng.uniform(0.0, 0.9, n)
+    inc, lan, nu = (rng.uniform(0.01, np.pi - 0.01, n), rng.uniform(0.0, 2 * np.pi, n),
+                    rng.uniform(-np.pi, np.pi, n))
+    orbit = KeplerOrbit.from_elements(a=a, e=e, inc=inc, lan=lan, argp=np.zeros(n), nu=nu,
+                                      mu=1.0)
+    out = np.empty(4)
+    cases = {"KeplerOrbit.propagate 1e6": lambda: orbit.propagate(0.37),
+             "compute-only yardstick": lambda: burn(out, 5_000_000)}
+    for f in cases.values():
+        f()
+    times: dict[tuple[str, int], list[float]] = {}
+    threads = (1, min(2, numba.config.NUMBA_NUM_THREADS))
+    for _ in range(rounds):
+        for th in threads:
+            numba.set_num_threads(th)
+            for name, f in cases.items():
+                t0, c0 = time.perf_counter(), time.process_time()
+                f()
+                wall = time.perf_counter() - t0
+                times.setdefault((name, th), []).append(wall)
+                times.setdefault((name, -th), []).append((time.process_time() - c0) / wall)
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    print(f"[9] batch kernels on 1 and {threads[1]} threads (wall time, median of {rounds} "
+          f"interleaved rounds; load average {__import__('os').getloadavg()[0]:.1f})")
+    for name in cases:
+        one, two = np.array(times[(name, 1)]), np.array(times[(name, threads[1])])
+        s = one / two
+        busy = np.median(times[(name, -threads[1])])  # cores the run held on average
+        print(f"    {name:26s} {np.median(one) * 1e3:7.1f} ms / {np.median(two) * 1e3:7.1f} ms"
+              f"  speed-up {np.median(s):.2f} ({s.min():.2f}-{s.max():.2f}), CPU/wall {busy:.2f}"
+              + (f"   {np.median(one) / n * 1e9:.0f} / {np.median(two) / n * 1e9:.0f} ns/orbit"
+                 if name.startswith("Kepler") else ""))
+
+
+def _radau15_flops(n: int, rounds: float) -> tuple[float, float]:
+    """Floating-point operations of one radau15 step on ``n`` massive bodies with
+    ``rounds`` predictor-corrector rounds, counted from the kernels' formulas
+    (``_kernels/radau15.py``, ``_kernels/nbody.py``; a square root or a division
+    counts as one): ``(force part, the rest)``.
+
+    Per pair of one force evaluation: 3 differences, 5 for ``d^2``, square root,
+    product, division, 2 factors, 12 for the six accumulations = 25.  Per
+    component and round (7 substeps): positions 19 and the ``g``/``b`` update
+    with compensated sums 7 + 7 j at substep j + 1: 329.  Per component and
+    step: the prediction 57, ``g`` from ``b`` 42, the compensated update 111,
+    keeping ``d`` 57, the PRS23 step rule 40: 307."""
+    pairs = n * (n - 1) / 2
+    m = 3 * n
+    return (1 + 7 * rounds) * 25 * pairs, m * (329 * rounds + 307)
+
+
+_PEAK_CHILD = """
+import time, numpy as np
+from numba import njit
+@njit
+def poly(x, y, a, b, reps):
+    for _ in range(reps):
+        for i in range(x.shape[0]):
+            t = x[i]
+            t = t * a + b; t = t * a + b; t = t * a + b; t = t * a + b
+            t = t * a + b; t = t * a + b; t = t * a + b; t = t * a + b
+            y[i] = t
+x = np.random.default_rng(0).uniform(0.5, 1.0, 1024); y = np.empty_like(x)
+poly(x, y, 0.999, 1e-3, 1)
+best = 1e9
+for _ in range(7):
+    c0 = time.process_time()
+    poly(x, y, 0.999, 1e-3, 20000)
+    best = min(best, time.process_time() - c0)
+print(16 * 1024 * 20000 / best / 1e9)
+"""
+
+
+def _peak(vectorize: bool) -> float:
+    """GFlop/s of 8 dependent multiply-adds per element over 1024 elements (in L1):
+    compiled with numba's loop and SLP vectorisers on (SIMD) or off (scalar), in a
+    child process (the flags are read when numba starts)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_LOOP_VECTORIZE=str(int(vectorize)),
+               NUMBA_SLP_VECTORIZE=str(int(vectorize)), NUMBA_CACHE_DIR="")
+    out = subprocess.run([sys.executable, "-c", _PEAK_CHILD], env=env, capture_output=True,
+                         text=True, check=True)
+    return float(out.stdout.split()[-1])
+
+
+def bench_flops(quick: bool) -> None:
+    """One radau15 step of the N = 10 disc: its floating-point operations (counted,
+    :func:`_radau15_flops`, with the rounds a step takes, counted by a right-hand
+    side that counts its calls), its CPU time, and the fraction of the machine's
+    scalar and SIMD throughput (:func:`_peak`) it reaches; and the force
+    evaluation alone, ours (pairs once, both bodies updated) beside a SIMD form
+    (every body's whole row, 8-wide, twice the pairs, sums reassociated)."""
+    from numba import njit
+
+    from hamilton_orbits._kernels import nbody
+    from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
+    from hamilton_orbits.integrators import radau15
+    from hamilton_orbits.rhs import RHS
+
+    @njit(ACCEL_SIGNATURE)
+    def counting(r, v, gm, acc, p):  # pragma: no cover - compiled
+        p[0] += 1.0
+        nbody.newtonian(r, v, gm, acc)
+
+    rng = np.random.default_rng(1)
+    r, v, g = _disc(10, 0, rng)
+    t = np.array([0.0, 200.0])
+    count = RHS(counting, None, np.zeros(1), False, ("newtonian",))
+    _, _, steps = radau15.run(count, r, v, g, t)
+    rounds = (count.p[0] / steps - 1) / 7
+    per_step = _cpu(lambda: radau15.run(rhs(), r, v, g, t), 0.3)[0] / steps
+    force, rest = _radau15_flops(10, rounds)
+    scalar, simd = _peak(False), _peak(True)
+    achieved = (force + rest) / per_step / 1e9
+    print(f"[10] one radau15 step, N = 10 disc (PRS23, tol 1e-9: {rounds:.2f} rounds a step): "
+          f"{force + rest:.0f} flops ({force:.0f} in {1 + 7 * rounds:.1f} force evaluations), "
+          f"{per_step * 1e6:.2f} us CPU -> {achieved:.2f} GFlop/s")
+    print(f"     machine (one core, 8 dependent multiply-adds per element in L1): scalar "
+          f"{scalar:.2f} GFlop/s, SIMD {simd:.2f} GFlop/s; reached {achieved / scalar:.0%} of "
+          f"scalar, {achieved / simd:.0%} of SIMD")
+    _force_forms(rng)
+
+
+def _force_forms(rng) -> None:
+    from numba import njit
+
+    from hamilton_orbits._kernels import nbody
+
+    @njit(error_model="numpy", fastmath={"reassoc"})
+    def rows(x, y, z, gm, ax, ay, az):  # pragma: no cover - compiled
+        n = x.shape[0]
+        for i in range(n):
+            sx = sy = sz = 0.0
+            for j in range(n):
+                dx, dy, dz = x[j] - x[i], y[j] - y[i], z[j] - z[i]
+                d2 = dx * dx + dy * dy + dz * dz
+                d2 = d2 if j != i else 1.0
+                f = gm[j] / (d2 * np.sqrt(d2)) if j != i else 0.0
+                sx += f * dx
+                sy += f * dy
+                sz += f * dz
+            ax[i], ay[i], az[i] = sx, sy, sz
+
+    @njit(error_model="numpy")
+    def loop_rows(r, gm, soa, acc, reps):  # pragma: no cover - compiled
+        for _ in range(reps):
+            for i in range(r.shape[0]):
+                soa[0, i], soa[1, i], soa[2, i] = r[i, 0], r[i, 1], r[i, 2]
+            rows(soa[0], soa[1], soa[2], gm, soa[3], soa[4], soa[5])
+            for i in range(r.shape[0]):
+                acc[i, 0], acc[i, 1], acc[i, 2] = soa[3, i], soa[4, i], soa[5, i]
+
+    @njit(error_model="numpy")
+    def loop_pairs(r, v, gm, acc, reps):  # pragma: no cover - compiled
+        for _ in range(reps):
+            nbody.newtonian(r, v, gm, acc)
+
+    print("     the force evaluation alone (ns per pair; the SIMD form computes every pair "
+          "twice; relative difference of the accelerations):")
+    for n in (10, 30, 100):
+        r, v, g = _disc(n, 0, rng)
+        g[1:] = rng.uniform(1e-7, 1e-6, n - 1)
+        a1, a2, soa = np.empty_like(r), np.empty_like(r), np.empty((6, n))
+        reps = int(2e6 / n**2)
+        t_pairs = _cpu(lambda r=r, v=v, g=g, a1=a1, k=reps: loop_pairs(r, v, g, a1, k),
+                       0.05)[0] / reps
+        t_rows = _cpu(lambda r=r, g=g, soa=soa, a2=a2, k=reps: loop_rows(r, g, soa, a2, k),
+                      0.05)[0] / reps
+        pairs = n * (n - 1) / 2
+        diff = float(np.max(np.abs(a1 - a2)) / np.max(np.abs(a1)))
+        print(f"       N = {n:3d}: ours {t_pairs / pairs * 1e9:5.2f}, SIMD rows "
+              f"{t_rows / pairs * 1e9:5.2f}  (x{t_pairs / t_rows:.2f}; {diff:.0e})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter spans, fewer sizes")
+    parser.add_argument("--propagate-only", action="store_true", help="section [9] alone")
     args = parser.parse_args()
     quick = args.quick
+    if args.propagate_only:
+        bench_propagate(3 if quick else 7)
+        return
     repeat = 3
     bench_warmup()
     bench_solar(100.0 if quick else 1000.0, repeat)
     bench_wh(100.0 if quick else 1000.0, repeat)
     bench_scaling(quick, repeat)
-    bench_work_precision(20.0 if quick else 100.0)
+    bench_work_precision(100.0 if quick else 1000.0)
     bench_leapfrog(10.0 if quick else 100.0, repeat)
     bench_effects_cost(10.0 if quick else 100.0, repeat)
+    bench_per_call(quick)
+    bench_memory(quick)
+    _propagate_on_two_threads(quick)
+    bench_flops(quick)
+
+
+def _propagate_on_two_threads(quick: bool) -> None:
+    """Section [9] in a child process with two threads (the rest of the benchmark
+    runs with ``NUMBA_NUM_THREADS=1`` for its one-thread figures)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_NUM_THREADS=str(max(2, os.cpu_count() or 2)))
+    cmd = [sys.executable, __file__, "--propagate-only"] + (["--quick"] if quick else [])
+    print(subprocess.run(cmd, env=env, capture_output=True, text=True, check=True).stdout,
+          end="", flush=True)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ from hamilton_orbits._scene_base import (
     register_kind,
 )
 from hamilton_orbits.frames import FRAMES, frame_label
+from hamilton_orbits.integrators import WH_CORRECTORS
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME
 
 METHODS = ("radau15", "wh", "leapfrog", "dop853")
@@ -364,9 +365,10 @@ def _check_integrator(integ: dict, problems: S.Problems) -> None:
     if integ["method"] == "leapfrog" and integ["dt"] is None and integ["tol"] is None:
         problems.add("integrator.dt", "missing: method 'leapfrog' takes a fixed step `dt` "
                                       "(or a tolerance `tol` from which to choose one)")
-    if integ["corrector"] not in (None, 0, 3):
-        problems.add("integrator.corrector", f"expected 0 or 3, got {integ['corrector']!r}")
-    elif integ["corrector"] == 3 and integ["coordinates"] != "jacobi":
+    if integ["corrector"] not in (None, *WH_CORRECTORS):
+        problems.add("integrator.corrector", "expected one of "
+                     f"{', '.join(map(str, WH_CORRECTORS))}, got {integ['corrector']!r}")
+    elif integ["corrector"] and integ["coordinates"] != "jacobi":
         problems.add("integrator.corrector",
                      "the corrector needs integrator.coordinates = 'jacobi'")
 

@@ -91,9 +91,16 @@ def integrator(method: str) -> Integrator:
     ...
     ValueError: Unknown `method` 'rk4'; known: radau15, wh, leapfrog, dop853
     """
-    if method not in INTEGRATORS:
-        raise ValueError(f"Unknown `method` {method!r}; known: {', '.join(INTEGRATORS)}")
-    return importlib.import_module(f"hamilton_orbits.integrators.{method}")
+    module = _MODULES.get(method)
+    if module is None:
+        if method not in INTEGRATORS:
+            raise ValueError(f"Unknown `method` {method!r}; known: {', '.join(INTEGRATORS)}")
+        module = _MODULES[method] = importlib.import_module(
+            f"hamilton_orbits.integrators.{method}")
+    return module
+
+
+_MODULES: dict[str, Integrator] = {}
 
 
 def run(
@@ -160,12 +167,14 @@ def run(
     (False, True)
     """
     module = integrator(method)
-    r0, v0, gm = (np.require(x, np.float64, ["C", "W"]) for x in (r0, v0, gm))
+    # C-contiguous float64, not copied when it is already (read-only is fine: the
+    # drivers copy what they change)
+    r0, v0, gm = (x if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous
+                  else np.require(x, np.float64, ["C"]) for x in (r0, v0, gm))
     backward = t_out.shape[0] > 1 and t_out[-1] < t_out[0]
     if backward and rhs.velocity_dependent:
         raise ValueError("Backward integration with a velocity-dependent effect is not "
                          "supported; integrate forwards from the final state")
-    sign = -1.0 if backward else 1.0
     n_t = t_out.shape[0]
     r_out = np.empty((n_t,) + np.shape(r0))
     v_out = np.empty_like(r_out)
@@ -192,7 +201,8 @@ def run(
     start = time.perf_counter()
     complete = True
     try:
-        _, _, steps = module.run(rhs, r0, sign * v0, gm, sign * t_out, dt=dt, tol=tol,
+        _, _, steps = module.run(rhs, r0, -v0 if backward else v0, gm,
+                                 -t_out if backward else t_out, dt=dt, tol=tol,
                                  on_output=report, out=(r_out, v_out), stop=stop, **kw)
         reached[0], reached[1] = n_t - 1, steps
     except StopAtEvent as stopped:
@@ -204,5 +214,7 @@ def run(
     k = reached[0] + 1
     gm_out = (events.gm_at(t_reached[:k], gm) if events is not None and events.gm_changes
               else gm)
-    return EngineRun(t_reached[:k], r_out[:k], sign * v_out[:k], reached[1], wall, complete,
+    if backward:  # in place: no second copy of the history
+        np.negative(v_out, out=v_out)
+    return EngineRun(t_reached[:k], r_out[:k], v_out[:k], reached[1], wall, complete,
                      events, gm_out, variational)

@@ -306,6 +306,9 @@ class StopAtEvent(Exception):
         self.steps = steps
 
 
+_NO_WATCH = np.zeros((0, 5))
+
+
 class EventLog:
     """What a run records: the watch table, the events found, and why it stopped.
 
@@ -336,8 +339,11 @@ class EventLog:
 
     @classmethod
     def none(cls, n: int) -> EventLog:
-        """A log that watches nothing (the kernels then skip the scan)."""
-        return cls(np.zeros((0, 5)), np.full(n, np.nan))
+        """A log that watches nothing (the kernels then skip the scan, and its
+        buffer is empty)."""
+        log = cls(_NO_WATCH, np.empty(0), capacity=0)  # no radii: nothing merges
+        log.inactive = np.zeros(n, dtype=bool)
+        return log
 
     def drain(self) -> None:
         """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""

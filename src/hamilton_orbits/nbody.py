@@ -335,18 +335,104 @@ class System:
             g = 1.0 if G is None else DIMENSIONLESS.scalar("G", G)
             if not g > 0:
                 raise ValueError(f"Expected `G` > 0, got {G!r}")
-        self._bodies = tuple(bodies)
-        self._index = seen
-        self._quantity = quantity
-        self._G = g
-        self._gm = np.array([b._gm for b in bodies])
-        self._r = np.array([b._r for b in bodies]).reshape(-1, 3)
-        self._v = np.array([b._v for b in bodies]).reshape(-1, 3)
-        for arr in (self._gm, self._r, self._v):
-            arr.setflags(write=False)
+        self._set_arrays(
+            tuple(b.name for b in bodies), seen, quantity, g,
+            np.array([b._gm for b in bodies]),
+            np.array([b._r for b in bodies]).reshape(-1, 3),
+            np.array([b._v for b in bodies]).reshape(-1, 3),
+            np.array([math.nan if b._radius is None else b._radius for b in bodies]),
+            np.array([math.nan if b.j2 is None else b.j2 for b in bodies]),
+            np.array([(math.nan,) * 3 if b.pole is None else b.pole
+                      for b in bodies]).reshape(-1, 3),
+            tuple(bodies))
         if not np.any(self._gm > 0):
             raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
         self._check_positions()
+
+    @classmethod
+    def from_arrays(cls, gm: Any, r: Any, v: Any, names: Sequence[str] | None = None, *,
+                    radius: Any = None, G: float | None = None) -> System:
+        """A system from arrays, checked as a whole (no per-body Python work).
+
+        For large systems (1e5 test particles): the arrays are validated with
+        vectorised checks and held as they are; :class:`Body` objects are made only
+        when asked for.
+
+        Parameters
+        ----------
+        gm : Quantity or array_like, shape (n,)
+            ``G m >= 0`` (at least one > 0).
+        r, v : Quantity or array_like, shape (n, 3)
+            Positions and velocities (Quantities: any length and speed units; held
+            in au and au/day).
+        names : sequence of str, optional
+            Unique names; default ``"b0"``, ``"b1"``, ...
+        radius : Quantity or array_like, shape (n,), optional
+            Radii > 0, NaN for none.
+        G : float, optional
+            For a plain-float system, as in :class:`System`.
+
+        Raises
+        ------
+        ValueError
+            Naming the argument and index: non-finite values, wrong shapes,
+            negative ``gm``, no massive body, duplicate names, two bodies at one
+            position; a mix of Quantities and floats.
+
+        Examples
+        --------
+        >>> s = System.from_arrays([1.0, 0.0, 0.0], [[0, 0, 0], [1, 0, 0], [2, 0, 0]],
+        ...                        [[0, 0, 0], [0, 1, 0], [0, 0.7, 0]])
+        >>> s.names, s["b2"].r.tolist()
+        (('b0', 'b1', 'b2'), [2.0, 0.0, 0.0])
+        >>> System.from_arrays([1.0, -1.0], np.eye(2, 3), np.zeros((2, 3)))
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `gm` >= 0, got -1.0 at index 1
+        """
+        from hamilton_orbits._validation import check_positive
+
+        quantity = require_consistent(("gm", "r", "v", "radius"), (gm, r, v, radius))
+        gm_a = np.ascontiguousarray(GM("gm", gm, GM_UNIT if quantity else None))
+        n = gm_a.shape[0] if gm_a.ndim == 1 else -1
+        if gm_a.ndim != 1:
+            raise ValueError(f"Expected `gm` to have shape (n,), got {gm_a.shape}")
+        arrays = []
+        for name, kind, value, unit in (("r", LENGTH, r, L_UNIT), ("v", SPEED, v, V_UNIT)):
+            arr = np.array(kind(name, value, unit if quantity else None), dtype=np.float64)
+            if arr.shape != (n, 3):
+                raise ValueError(f"Expected `{name}` to have shape ({n}, 3), got {arr.shape}")
+            arrays.append(arr)
+        check_positive("gm", gm_a, strict=False)
+        if not np.any(gm_a > 0):
+            raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
+        rad = np.full(n, math.nan)
+        if radius is not None:
+            rad = np.array(LENGTH("radius", radius, L_UNIT if quantity else None, finite=False),
+                           dtype=np.float64)
+            if rad.shape != (n,):
+                raise ValueError(f"Expected `radius` to have shape ({n},), got {rad.shape}")
+            check_positive("radius", np.where(np.isnan(rad), 1.0, rad))
+        names_t = tuple(f"b{k}" for k in range(n)) if names is None else tuple(names)
+        if len(names_t) != n or not all(isinstance(x, str) and x for x in names_t):
+            raise ValueError(f"Expected `names` to be {n} non-empty strings, got {names!r}")
+        index = {name: k for k, name in enumerate(names_t)}
+        if len(index) != n:
+            dup = next(x for k, x in enumerate(names_t) if index[x] != k)
+            raise ValueError(f"Duplicate body name {dup!r} at indices {names_t.index(dup)} "
+                             f"and {index[dup]}")
+        if quantity and G is not None:
+            raise ValueError("Expected no `G` for a system of Quantities (astropy's G is "
+                             f"used), got {G!r}")
+        g = _G_SI if quantity else (1.0 if G is None else DIMENSIONLESS.scalar("G", G))
+        if not g > 0:
+            raise ValueError(f"Expected `G` > 0, got {G!r}")
+        out = object.__new__(cls)
+        nan3 = np.full((n, 3), math.nan)
+        out._set_arrays(names_t, index, quantity, g, gm_a.copy(), arrays[0], arrays[1], rad,
+                        np.full(n, math.nan), nan3, None)
+        out._check_positions()
+        return out
 
     # ------------------------------------------------------------------ checks
     def _check_positions(self) -> None:
@@ -367,6 +453,23 @@ class System:
         )
 
     # --------------------------------------------------------------- accessors
+    def _set_arrays(self, names: tuple[str, ...], index: dict[str, int] | None,
+                    quantity: bool, G: float, gm: np.ndarray, r: np.ndarray, v: np.ndarray,
+                    radius: np.ndarray, j2: np.ndarray, pole: np.ndarray,
+                    bodies: tuple[Body, ...] | None) -> None:
+        """Hold the state as read-only float64 arrays; the :class:`Body` objects are
+        made only when asked for (``bodies``, iteration, ``system[name]``), so that a
+        system of 1e5 test particles costs its arrays, not 1e5 Python objects."""
+        self._names = names
+        self._index = index
+        self._quantity = quantity
+        self._G = G
+        self._gm, self._r, self._v = gm, r, v
+        self._radius, self._j2, self._pole = radius, j2, pole
+        for arr in (gm, r, v, radius, j2, pole):
+            arr.setflags(write=False)
+        self._bodies = bodies
+
     def as_arrays(self) -> SystemArrays:
         """The state as plain float64 arrays in the internal units (read-only views).
 
@@ -377,25 +480,30 @@ class System:
         >>> arrays.gm.tolist(), arrays.radius.tolist(), bool(np.isnan(arrays.j2[0]))
         ([1.0], [0.5], True)
         """
-        nan = float("nan")
-        radius = np.array([nan if b._radius is None else b._radius for b in self._bodies])
-        j2 = np.array([nan if b.j2 is None else b.j2 for b in self._bodies])
-        pole = np.array([(nan, nan, nan) if b.pole is None else b.pole
-                         for b in self._bodies]).reshape(-1, 3)
-        for arr in (radius, j2, pole):
-            arr.setflags(write=False)
-        return SystemArrays(self.names, self._gm, self._r, self._v, radius, j2, pole,
-                            self._quantity, self._G)
+        return SystemArrays(self._names, self._gm, self._r, self._v, self._radius, self._j2,
+                            self._pole, self._quantity, self._G)
 
     @property
     def names(self) -> tuple[str, ...]:
         """The bodies' names, in order."""
-        return tuple(b.name for b in self._bodies)
+        return self._names
 
     @property
     def bodies(self) -> tuple[Body, ...]:
         """The bodies, in order."""
+        if self._bodies is None:
+            self._bodies = tuple(self._body(k) for k in range(len(self._names)))
         return self._bodies
+
+    def _body(self, k: int) -> Body:
+        if self._bodies is not None:
+            return self._bodies[k]
+        radius, j2 = float(self._radius[k]), float(self._j2[k])
+        pole = self._pole[k]
+        return Body._from_floats(
+            self._names[k], self._gm[k], self._r[k], self._v[k],
+            None if math.isnan(radius) else radius, None if math.isnan(j2) else j2,
+            None if math.isnan(pole[0]) else tuple(float(x) for x in pole), self._quantity)
 
     @property
     def quantity(self) -> bool:
@@ -423,18 +531,23 @@ class System:
         return self._v * V_UNIT if self._quantity else self._v.copy()
 
     def __len__(self) -> int:
-        return len(self._bodies)
+        return len(self._names)
 
     def __iter__(self):
-        return iter(self._bodies)
+        return iter(self.bodies)
 
     def __getitem__(self, name: str) -> Body:
         try:
-            return self._bodies[self._index[name]]
+            return self._body(self._name_index()[name])
         except (KeyError, TypeError):
             raise ValueError(
                 f"No body named {name!r} in the system; bodies: {', '.join(self.names)}"
             ) from None
+
+    def _name_index(self) -> dict[str, int]:
+        if self._index is None:
+            self._index = {name: k for k, name in enumerate(self._names)}
+        return self._index
 
     def index(self, name: str) -> int:
         """The position of body ``name`` in the arrays (ValueError naming the bodies).
@@ -447,32 +560,64 @@ class System:
         1
         """
         self[name]
-        return self._index[name]
+        return self._name_index()[name]
 
     def __repr__(self) -> str:
         return f"System({list(self.names)!r}{', au/day' if self._quantity else ''})"
 
     def with_state(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray | None = None,
-                   keep: np.ndarray | None = None) -> System:
+                   keep: np.ndarray | None = None, *, check: bool = True) -> System:
         """The same bodies at internal-unit positions ``r`` and velocities ``v`` (n, 3);
         with ``gm`` (n,) their new ``G m`` (after merges), and with the boolean
         ``keep`` (n,) only the bodies it marks (after removals).
+
+        The new system shares the names, radii, J2 and poles (read-only arrays) and
+        copies the state once: no :class:`Body` object is made until one is asked
+        for.  ``check=False`` skips the checks of the state (finite, shapes, no two
+        bodies at one position), for a state an integrator has just produced.
+
+        Raises
+        ------
+        ValueError
+            For a non-finite or ill-shaped ``r`` or ``v``, or two bodies (one of
+            them massive) at one position.
 
         Examples
         --------
         >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
         >>> s.with_state(np.ones((1, 3)), np.zeros((1, 3))).r
         array([[1., 1., 1.]])
+        >>> s.with_state(np.ones((2, 3)), np.zeros((2, 3)))
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `r` to have shape (1, 3), got (2, 3)
         """
-        r = np.asarray(r, dtype=float)
-        v = np.asarray(v, dtype=float)
-        gm = self._gm if gm is None else np.asarray(gm, dtype=float)
-        keep = np.ones(len(self._bodies), dtype=bool) if keep is None else np.asarray(keep)
-        bodies = [
-            Body._from_floats(b.name, gm[k], r[k], v[k], b._radius, b.j2, b.pole, b.quantity)
-            for k, b in enumerate(self._bodies) if keep[k]
-        ]
-        return System(bodies, G=None if self._quantity else self._G)
+        out = object.__new__(System)
+        r = np.array(r, dtype=np.float64)
+        v = np.array(v, dtype=np.float64)
+        gm = self._gm if gm is None else np.array(gm, dtype=np.float64)
+        arrays = (gm, r, v, self._radius, self._j2, self._pole)
+        names, index = self._names, self._index
+        if keep is not None and not np.all(keep):
+            keep = np.asarray(keep, dtype=bool)
+            arrays = tuple(np.ascontiguousarray(a[keep]) for a in arrays)
+            names, index = tuple(n for n, k in zip(names, keep, strict=True) if k), None
+        out._set_arrays(names, index, self._quantity, self._G, *arrays, None)
+        if check:
+            out._check_state()
+        return out
+
+    def _check_state(self) -> None:
+        n = len(self._names)
+        for name, arr in (("r", self._r), ("v", self._v)):
+            if arr.shape != (n, 3):
+                raise ValueError(f"Expected `{name}` to have shape ({n}, 3), got {arr.shape}")
+            bad = ~np.isfinite(arr)
+            if bad.any():
+                i, k = np.argwhere(bad)[0]
+                raise ValueError(f"Expected `{name}` to be finite, got {arr[i, k]!r} at index "
+                                 f"({i}, {k})")
+        self._check_positions()
 
     # ------------------------------------------------------------- physics
     def accelerations(self, effects: Sequence[str | Mapping[str, Any]] = ()):
@@ -943,12 +1088,15 @@ def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
 def integral_errors(
     r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray,
     extra_energy: np.ndarray | None = None,
+    gone: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How well states ``r``, ``v`` (n_t, n, 3) at times ``t`` (n_t,) keep Hamilton's
     integrals, relative to the first state.
 
     ``gm`` is (n,), or (n_t, n) where masses changed during the run (merges);
-    bodies with NaN states (taken out of the run) count as absent.
+    bodies with NaN states (taken out of the run) count as absent.  One compiled
+    pass over the states (:func:`hamilton_orbits._kernels.integrals.integral_sums`,
+    the energy's sums compensated).
 
     Parameters
     ----------
@@ -959,6 +1107,10 @@ def integral_errors(
         The effects' part of each body's specific energy
         (:func:`hamilton_orbits.effects.effect_energy`), added so that the energy
         compared is the one the equations of motion keep.
+    gone : ndarray of bool, shape (n,), optional
+        The bodies an event took out of the run.  When given, a non-finite state
+        of any other body raises ``LostStateError`` (a ``ValueError``) with the
+        output and body index in ``index``.
 
     Returns
     -------
@@ -984,23 +1136,45 @@ def integral_errors(
     >>> integral_errors(r, v, np.array([1.0, 0.0]), np.array([0.0, 1.0]))[0].tolist()
     [0.0, 4.76837158203125e-07]
     """
-    from hamilton_orbits.trajectory import relative_change
+    from hamilton_orbits._kernels import integrals
 
-    gm_t = np.broadcast_to(gm, r.shape[:2])
+    r = np.ascontiguousarray(r, dtype=np.float64)
+    v = np.ascontiguousarray(v, dtype=np.float64)
+    gm2 = np.ascontiguousarray(np.atleast_2d(np.asarray(gm, dtype=np.float64)))
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    k, n = r.shape[0], r.shape[1]
+    out = np.empty((3, k))
+    gone_b = np.zeros(n, np.bool_) if gone is None else np.ascontiguousarray(gone, np.bool_)
+    lost = integrals.integral_errors(r, v, gm2, t, gone_b, out[0], out[1], out[2])
+    if gone is not None and lost >= 0:
+        raise LostStateError(divmod(int(lost), n))
+    if extra_energy is not None or _one_centre(gm2):
+        out[0] = _energy_error(*_present(r, v, gm), extra_energy)
+    return out[0], out[1], out[2]
+
+
+def _one_centre(gm: np.ndarray) -> bool:
+    """One massive body and test particles, masses unchanged (``gm`` (1, n))."""
+    return gm.shape[0] == 1 and gm.shape[1] > 1 and int(np.count_nonzero(gm[0] > 0)) == 1
+
+
+def _present(r: np.ndarray, v: np.ndarray, gm: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The states with the bodies taken out of the run (non-finite) set to zero
+    mass at the origin; ``gm`` (n,) when nothing was taken out and it was (n,)."""
     present = np.isfinite(r).all(axis=2) & np.isfinite(v).all(axis=2)
-    if not present.all():
-        gm_t = np.where(present, gm_t, 0.0)
-        r = np.where(present[..., None], r, 0.0)
-        v = np.where(present[..., None], v, 0.0)
-    unchanged = np.ndim(gm) == 1 and bool(present.all())
-    energy_error = _energy_error(r, v, gm if unchanged else gm_t, extra_energy)
-    am_error = relative_change(np.einsum("tj,tjk->tk", gm_t, np.cross(r, v)))
-    total = gm_t.sum(axis=1)
-    rc = np.einsum("tj,tjk->tk", gm_t, r) / total[:, None]
-    vc0 = gm_t[0] @ v[0] / total[0]
-    scale = float(np.max(np.linalg.norm(r[0] - rc[0], axis=1)))
-    drift = np.linalg.norm(rc - rc[0] - np.outer(t - t[0], vc0), axis=1)
-    return energy_error, am_error, drift / (scale if scale > 0 else 1.0)
+    if present.all():
+        return r, v, gm
+    gm_t = np.where(present, np.broadcast_to(gm, r.shape[:2]), 0.0)
+    return (np.where(present[..., None], r, 0.0), np.where(present[..., None], v, 0.0), gm_t)
+
+
+class LostStateError(ValueError):
+    """A body's state became non-finite during a run; ``index`` is ``(output, body)``."""
+
+    def __init__(self, index: tuple[int, int]) -> None:
+        super().__init__(f"non-finite state at output {index[0]}, body {index[1]}")
+        self.index = index
 
 
 def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
@@ -1072,7 +1246,8 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     return acc[:, 1:]
 
 
-__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN", "SystemArrays",
-            "energy_gm_many", "integral_errors", "solar_system_bodies", "solar_system_epoch"]
+__all__ += ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN", "LostStateError",
+            "SystemArrays", "energy_gm_many", "integral_errors", "solar_system_bodies",
+            "solar_system_epoch"]
 _ = _nbody  # the kernels of equation (B) live in hamilton_orbits._kernels.nbody
 _ = any_quantity

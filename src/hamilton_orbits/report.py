@@ -14,16 +14,19 @@ Problems
    rtol.  Reference: Kepler's equation solved in mpmath at 40 digits.
 2. The solar system (Sun + 8 planets, ``System.solar_system("J2000")``), 10 years
    (quick) or 1000 years: ours (radau15; wh in democratic-heliocentric and in
-   Jacobi coordinates, the latter also with the third-order corrector;
+   Jacobi coordinates, the latter also with the correctors of order 3, 11, 17;
    leapfrog; dop853) and rebound
-   (IAS15, WHFast in its default Jacobi coordinates, alone and with its
-   symplectic corrector of order 11, and in the democratic-heliocentric
-   coordinates our ``wh`` uses, leapfrog) and, where it is installed, heyoka's
-   adaptive Taylor integrator down to tol = 1e-18, its best setting here
-   (:data:`SETTINGS` says how each peer is set, and the report prints it).  Reference:
-   rebound IAS15 with ``epsilon = 0`` at a fixed step of 0.5 day.  Error: max
-   over planets of the final heliocentric position difference over the
-   heliocentric distance.
+   (IAS15, WHFast in its default Jacobi coordinates, also with the correctors
+   of order 11 and 17, and in the democratic-heliocentric coordinates our
+   ``wh`` uses, leapfrog) and, where it
+   is installed, heyoka's adaptive Taylor integrator.  Reference: our radau15
+   in double-double arithmetic at 1-day steps (:mod:`hamilton_orbits.reference`,
+   computed once and cached), whose own uncertainty, its distance from the same
+   at 2-day steps in the same measure, is stated with it (a double-precision
+   reference, IAS15 at ``epsilon = 0``, cannot resolve errors below ~4e-11
+   after 1000 years: two step sizes differ by that much).  Error: max over
+   planets of the final heliocentric position difference over the heliocentric
+   distance.
 3. Fidelity against DE440 (:mod:`hamilton_orbits.ladder`): each rung of the
    physics ladder from DE440's J2000 state for 10 years (quick) or 100 years;
    error: the largest planetary residual against DE440 as an angle seen from
@@ -194,14 +197,12 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     name = "solar system"
     years = 10 if quick else 1000
     measure = "max_planet |r - r_ref| / |r_ref| (heliocentric, final)"
-    reference = "rebound IAS15, epsilon = 0, dt = 0.5 d"
     system = System.solar_system("J2000")
     r0 = system.r.to_value(u.au)
     v0 = system.v.to_value(u.au / u.day)
     gm = (system.gm).to_value(u.au**3 / u.day**2)
     t_end = years * 365.25
-    log(progress, f"{name}: reference ({years} yr)")
-    ref = _helio(_rebound_run(r0, v0, gm, t_end, "ias15", 0.5, 0.0))
+    ref, reference = _solar_reference(r0, v0, gm, t_end, progress)
     scale = np.linalg.norm(ref, axis=1)
     cases = (_solar_ours(r0, v0, gm, t_end, quick) + _solar_rebound(r0, v0, gm, t_end, quick)
              + _heyoka_cases(r0, v0, gm, t_end, quick, progress))
@@ -214,6 +215,26 @@ def _solar(quick: bool, progress: bool) -> list[Row]:
     return rows
 
 
+def _solar_reference(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
+                     progress: bool) -> tuple[np.ndarray, str]:
+    """The final heliocentric positions of radau15 in double-double at 1-day steps
+    (:func:`hamilton_orbits.reference.reference`, cached on disk), and the reference's
+    description with its own uncertainty: the same measure between the runs at 1
+    and 2 days (an upper bound: the error at 1 day is ~2^16 times smaller)."""
+    from hamilton_orbits.reference import reference
+
+    log(progress, f"solar system: reference, radau15 in double-double at 1 and 2 days "
+                  f"({t_end / 365.25:g} yr; minutes the first time, then from the cache)")
+    ref = reference(r0, v0, gm, np.array([0.0, t_end]), 1.0)
+    h, h_check = _helio(ref.r[-1]), _helio(ref.r_check[-1])
+    own = float(np.max(np.linalg.norm(h_check - h, axis=1) / np.linalg.norm(h, axis=1)))
+    log(progress, f"solar system: reference {'from the cache' if ref.cached else 'computed'}"
+                  f" ({ref.seconds:.0f} s), uncertainty {own:.1e}")
+    bound = f"{own:.0e}" if own >= 1e-16 else "< 1e-16"  # the doubles compared resolve 1e-16
+    return h, (f"radau15 in double-double, dt = 1 d (uncertainty {bound}: its distance from "
+               "dt = 2 d)")
+
+
 def _helio(r: np.ndarray) -> np.ndarray:
     return r[1:] - r[0]
 
@@ -221,7 +242,8 @@ def _helio(r: np.ndarray) -> np.ndarray:
 def _rebound_run(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
                  integrator: str, dt: float, epsilon: float | None = None,
                  coordinates: str | None = None, corrector: int = 0) -> np.ndarray:
-    """rebound's final positions from the same state (G = 1, m = gm)."""
+    """rebound's final positions from the same state (G = 1, m = gm); WHFast with
+    ``corrector`` runs with ``safe_mode = 0`` (the corrector applied once, as ours)."""
     from hamilton_orbits._rebound import simulation_from_arrays
 
     sim = simulation_from_arrays([f"b{k}" for k in range(len(gm))], gm, r0, v0)
@@ -257,8 +279,9 @@ def _solar_ours(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
     for tol in (1e-6, 1e-9) if quick else (1e-6, 1e-9, 1e-12):
         cases.append(("hamilton-orbits", "radau15", f"tol = {tol:g}", ours("radau15", tol=tol)))
     for label, options in (("wh", {}), ("wh (Jacobi)", {"coordinates": "jacobi"}),
-                           ("wh (Jacobi, corrector 3)", {"coordinates": "jacobi",
-                                                         "corrector": 3})):
+                           *((f"wh (Jacobi, corrector {c})", {"coordinates": "jacobi",
+                                                              "corrector": c})
+                             for c in (3, 11, 17))):
         for dt in _WH_STEPS[quick]:
             cases.append(("hamilton-orbits", label, f"dt = {dt:g} d", ours("wh", dt, **options)))
     for dt in _LEAPFROG_STEPS[quick]:
@@ -284,9 +307,10 @@ def _solar_rebound(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_end: float,
                           for eps in (1e-6, 1e-9)]
     for dt in _WH_STEPS[quick]:  # rebound's default: Jacobi coordinates
         cases.append(("rebound", "WHFast", f"dt = {dt:g} d", reb("whfast", dt)))
-    for dt in _WH_STEPS[quick]:  # rebound's best map here: Jacobi, symplectic corrector 11
-        cases.append(("rebound", "WHFast (Jacobi, corrector 11)", f"dt = {dt:g} d",
-                      reb("whfast", dt, corrector=11)))
+    for corrector in (11, 17):
+        for dt in _WH_STEPS[quick]:
+            cases.append(("rebound", f"WHFast (corrector {corrector})", f"dt = {dt:g} d",
+                          reb("whfast", dt, corrector=corrector)))
     for dt in _WH_STEPS[quick]:  # the map our ``wh`` uses by default
         cases.append(("rebound", "WHFast (democratic heliocentric)", f"dt = {dt:g} d",
                       reb("whfast", dt, coordinates="democraticheliocentric")))

@@ -360,9 +360,9 @@ def tangent_source(replaces_newtonian: bool, jac_refs: tuple[tuple[str, str], ..
     return lines
 
 
-def cache_dir() -> Path | None:
-    """The folder of the generated right-hand sides, created if needed; None if it
-    cannot be written.
+def cache_dir(name: str = "rhs") -> Path | None:
+    """The folder ``name`` in the user's cache folder (default: the generated
+    right-hand sides), created if needed; None if it cannot be written.
 
     Examples
     --------
@@ -374,7 +374,7 @@ def cache_dir() -> Path | None:
         base = Path(env)
     else:
         base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "hamilton-orbits"
-    folder = base / "rhs"
+    folder = base / name
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
+import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import astropy.units as u
@@ -22,7 +24,7 @@ from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.integrators import INTEGRATORS
-from hamilton_orbits.nbody import DAY, System, integral_errors
+from hamilton_orbits.nbody import DAY, LostStateError, System, integral_errors
 from hamilton_orbits.rhs import compile_rhs
 from hamilton_orbits.trajectory import TrajectoryBase
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
@@ -49,7 +51,8 @@ class Trajectory(TrajectoryBase):
         Positions and velocities (au, au/day for Quantity systems).
     names : tuple of str
     final : System
-        The system at the last output time.
+        The system at the last output time (made on first access from the last
+        output row).
     energy_error : ndarray, shape (n_t,)
         ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
         energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
@@ -94,14 +97,41 @@ class Trajectory(TrajectoryBase):
     r: Any
     v: Any
     names: tuple[str, ...]
-    final: System
     barycentre_drift: np.ndarray
     effects: tuple[str, ...]
-    events: Any = None
-    stopped_by: Any = None
+    #: What :attr:`final` is made from on first access: the system, the last
+    #: state, masses and the bodies still in the run (a copy of the state made
+    #: only when asked for: 48 bytes a body).
+    final_source: Any = field(default=None, repr=False)
+    #: What :attr:`events` and :attr:`stopped_by` are built from, on first access
+    #: (the events log, the system and the time unit): an astropy table costs
+    #: ~0.1 ms, more than the rest of a short call's wrapping.
+    event_source: Any = field(default=None, repr=False)
     megno: Any = None
     lyapunov: Any = None
     stm: Any = None
+
+    @functools.cached_property
+    def final(self) -> System:
+        """The system at the last output time."""
+        system, r, v, gm, keep = self.final_source
+        return system.with_state(r, v, gm=gm, keep=keep, check=False)
+
+    @functools.cached_property
+    def events(self) -> Any:
+        """One row per event found (a ``QTable``; empty when none was listed or found)."""
+        return self._event_tables()[0]
+
+    @functools.cached_property
+    def stopped_by(self) -> Any:
+        """The row of :attr:`events` of the event that ended the run, or None."""
+        return self._event_tables()[1]
+
+    def _event_tables(self) -> tuple[Any, Any]:
+        if "_tables" not in self.__dict__:
+            log, system, unit = self.event_source or (None, None, None)
+            self.__dict__["_tables"] = event_table(log, system, unit)
+        return self.__dict__["_tables"]
 
     def __repr__(self) -> str:
         return (
@@ -113,6 +143,8 @@ class Trajectory(TrajectoryBase):
 
 def _times(t: Any, quantity: bool) -> tuple[np.ndarray, Any]:
     """Output times in days (Quantity system) from ``t``, with the caller's unit."""
+    if type(t) is float and not quantity and t != 0.0 and math.isfinite(t):
+        return np.array([0.0, t]), None  # an end time in the caller's units: the common case
     if quantity and not is_quantity(t):
         raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
     if not quantity and is_quantity(t):
@@ -142,16 +174,25 @@ def _times(t: Any, quantity: bool) -> tuple[np.ndarray, Any]:
 
 def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
     """Refuse an option the integrator's ``run`` does not take, listing those it does."""
-    import inspect
-
-    common = {"dt", "tol", "on_output", "out", "events", "stop", "variational"}
-    takes = [name for name, p in inspect.signature(module.run).parameters.items()
-             if p.kind is p.KEYWORD_ONLY and name not in common]
+    if not options:
+        return
+    takes = _options_of(module.run)
     for key, value in options.items():
         if key not in takes:
             raise ValueError(
                 f"Unknown option `{key}` = {value!r} for method {method!r}; it takes: "
                 + (", ".join(takes) if takes else "no options beyond dt and tol"))
+
+
+@functools.cache
+def _options_of(run: Any) -> list[str]:
+    """The options a driver's ``run`` takes (its keyword-only parameters beyond the
+    common ones), read once per driver."""
+    import inspect
+
+    common = {"dt", "tol", "on_output", "out", "events", "stop", "variational"}
+    return [name for name, p in inspect.signature(run).parameters.items()
+            if p.kind is p.KEYWORD_ONLY and name not in common]
 
 
 def integrate(
@@ -210,8 +251,9 @@ def integrate(
         rebound's ``init_megno`` draws it (a fixed seed).
     **options
         Options of the chosen integrator, e.g. for ``wh``
-        ``coordinates="jacobi"`` and ``corrector=3`` (see its ``run``).  An option
-        the method does not take raises ``ValueError`` listing those it takes.
+        ``coordinates="jacobi"`` and ``corrector=3`` (or 5, 7, 11, 17; see its
+        ``run``).  An option the method does not take raises ``ValueError``
+        listing those it takes.
 
     Returns
     -------
@@ -322,7 +364,10 @@ def _step(dt: Any, quantity: bool) -> float:
     if not quantity and is_quantity(dt):
         raise ValueError(f"Expected `dt` as a plain float for a system of plain floats, "
                          f"got {dt!r}")
-    step = TIME.scalar("dt", dt, DAY if quantity else None)
+    if type(dt) is float and not quantity:
+        step = dt  # checked below
+    else:
+        step = TIME.scalar("dt", dt, DAY if quantity else None)
     if not (np.isfinite(step) and step > 0):
         raise ValueError(f"Expected `dt` > 0, got {step!r}")
     return step
@@ -398,25 +443,26 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         If the run lost a body's state (a non-finite position or velocity).
     """
     r, v, times = out.r, out.v, out.t
-    gone = out.events.inactive if out.events is not None else np.zeros(r.shape[1], bool)
-    lost = (~np.isfinite(r).all(axis=2) | ~np.isfinite(v).all(axis=2)) & ~gone
-    if lost.any():
-        bad = np.argwhere(lost)[0]
+    gone = out.events.inactive if out.events is not None else None
+    try:
+        ee, ae, bd = integral_errors(r, v, out.gm, times,
+                                     gone=np.zeros(r.shape[1], bool) if gone is None else gone)
+    except LostStateError as lost:
+        k, i = lost.index
         raise ValueError(
             f"The integration with {method!r} lost the state of body "
-            f"{system.names[bad[1]]!r} at output {bad[0]} (t = {times[bad[0]]!r}): "
+            f"{system.names[i]!r} at output {k} (t = {times[k]!r}): "
             "a collision or a step too long"
-        )
-    extra = effect_energy(system, effect_set, r, v) if effect_set else None
-    ee, ae, bd = integral_errors(r, v, out.gm, times, extra)
-    final = system.with_state(r[-1], v[-1], gm=np.atleast_2d(out.gm)[-1], keep=~gone)
+        ) from None
+    if effect_set:  # the energy the equations keep: the effects part added
+        ee = integral_errors(r, v, out.gm, times, effect_energy(system, effect_set, r, v))[0]
+    final = (system, r[-1], v[-1], np.atleast_2d(out.gm)[-1], None if gone is None else ~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)
-        r_out: Any = r * u.au
-        v_out: Any = v * (u.au / u.day)
+        r_out: Any = r << u.au  # views: no second copy of the history
+        v_out: Any = v << (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
-    table, stopped_by = event_table(out.events, system, unit)
     tan = out.variational
     megno = lyap = stm = None
     if tan is not None:
@@ -426,14 +472,14 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         if system.quantity:
             lyap = (lyap / u.day).to(1 / unit)
     return Trajectory(
-        t=t_out, r=r_out, v=v_out, names=system.names, final=final, energy_error=ee,
+        t=t_out, r=r_out, v=v_out, names=system.names, final_source=final, energy_error=ee,
         angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
-        wall_time=out.wall_time, method=method, effects=effects, events=table,
-        stopped_by=stopped_by, megno=megno, lyapunov=lyap, stm=stm,
+        wall_time=out.wall_time, method=method, effects=effects,
+        event_source=(out.events, system, unit), megno=megno, lyapunov=lyap, stm=stm,
     )
 
 
-def event_table(log: EventLog | None, system: System, unit: Any) -> tuple[Any, Any]:
+def event_table(log: EventLog | None, system: System | None, unit: Any) -> tuple[Any, Any]:
     """The events of a run as a ``QTable`` (times in ``unit``, distances in au and
     speeds in au/day for a Quantity system) and the row that stopped it, or None."""
     from astropy.table import QTable
@@ -442,15 +488,16 @@ def event_table(log: EventLog | None, system: System, unit: Any) -> tuple[Any, A
 
     rows = log.recorded() if log is not None else np.zeros((0, 7))
     actions = {code: name for name, code in ACTIONS.items()}
-    names = list(system.names)
+    names = list(system.names) if system is not None else []
+    quantity = system is not None and system.quantity
     bodies = [names[int(i)] if j < 0 else f"{names[int(i)]}-{names[int(j)]}"
               for i, j in rows[:, 1:3]]
     table = QTable()
     table["name"] = [NAMES[int(c)] for c in rows[:, 0]] if len(rows) else np.array([], str)
-    table["time"] = (rows[:, 3] * u.day).to(unit) if system.quantity else rows[:, 3]
+    table["time"] = (rows[:, 3] * u.day).to(unit) if quantity else rows[:, 3]
     table["bodies"] = bodies if len(rows) else np.array([], str)
-    table["distance"] = rows[:, 4] * u.au if system.quantity else rows[:, 4]
-    table["speed"] = rows[:, 5] * (u.au / u.day) if system.quantity else rows[:, 5]
+    table["distance"] = rows[:, 4] * u.au if quantity else rows[:, 4]
+    table["speed"] = rows[:, 5] * (u.au / u.day) if quantity else rows[:, 5]
     table["action"] = [actions[int(a)] for a in rows[:, 6]] if len(rows) else np.array([], str)
     stopped = log.stopped_by if log is not None else None
     return table, (table[stopped] if stopped is not None else None)

@@ -73,6 +73,12 @@ CATALOGUE = [
     ("corrector without Jacobi coordinates", ('method = "radau15"', 'method = "wh"\n'
                                               'corrector = 3'),
      r"integrator\.corrector: the corrector needs integrator\.coordinates = 'jacobi'"),
+    ("corrector of order 17 without Jacobi coordinates",
+     ('method = "radau15"', 'method = "wh"\ncorrector = 17'),
+     r"integrator\.corrector: the corrector needs integrator\.coordinates = 'jacobi'"),
+    ("corrector of an order that does not exist",
+     ('method = "radau15"', 'method = "wh"\ncoordinates = "jacobi"\ncorrector = 9'),
+     r"integrator\.corrector: expected one of 0, 3, 5, 7, 11, 17, got 9"),
     ("elements orbit a missing body", ('primary = "sun"', 'primary = "sol"'),
      r"bodies\[1\]\.primary: no body named 'sol' \(valid: 'sun'\)"),
     ("unknown key in a body", ("e = 0.0167", "ecc = 0.0167"),

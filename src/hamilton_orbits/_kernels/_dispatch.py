@@ -6,7 +6,8 @@ machine an OpenMP team can busy-wait for a core another process holds (calls
 on two orbits took up to 15 ms).  :func:`parallel_kernel` compiles a batch
 kernel twice, with ``parallel=True`` and without (``prange`` is then
 ``range``), and calls the parallel one only for at least ``threshold`` rows
-and only while the load average leaves a core free.
+and, while the load average leaves no core free, only for at least
+:data:`BUSY_THRESHOLD` rows.
 
 The threading layer must be chosen before numba starts its first thread team.
 ``workqueue`` aborts the process when two Python threads launch parallel
@@ -44,6 +45,13 @@ from numba import njit
 # gain on free cores.  With the load average at the core count the serial
 # variant runs whatever the size (see _cores_busy).
 DEFAULT_THRESHOLD = 65536
+# Rows from which the parallel variant runs even while the load average reaches
+# the core count.  Another process then holds a core, but the scheduler shares
+# the cores among runnable threads: a team of two gets two shares where one
+# thread gets one (measured with 4 other jobs on the 2-core machine: propagate of
+# 1e6 orbits 1.4-1.8x faster on two threads), and 2^19 rows (~45 ms of
+# propagation) make the launch's wait for a time slice (~15 ms) the smaller part.
+BUSY_THRESHOLD = 2**19
 _LOAD_TTL = 1.0  # seconds between two reads of the load average
 
 _SAFE_LAYERS = ("tbb", "omp")
@@ -130,7 +138,9 @@ class ParallelKernel:
         self.__module__ = func.__module__
 
     def __call__(self, *args: Any) -> Any:
-        if args[0].shape[0] < self.threshold or _cores_busy():
+        rows = args[0].shape[0]
+        if rows < self.threshold or (rows < max(BUSY_THRESHOLD, self.threshold)
+                                     and _cores_busy()):
             return self.serial(*args)
         layer = _state["layer"] or _choose_layer()
         if layer != "workqueue":

@@ -25,9 +25,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-from hamilton_orbits._kernels._dispatch import lazy_vectorize
+from hamilton_orbits._kernels._dispatch import lazy_vectorize, parallel_kernel
 
 EPS = 2.220446049250313e-16
 PI = math.pi
@@ -987,11 +987,12 @@ def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - comp
     )
 
 
-@njit(cache=True)
+@parallel_kernel
 def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
-    """Loop :func:`propagate_scaled` over rows; returns the first failing row or -1."""
-    bad = -1
-    for i in range(r.shape[0]):
+    """Loop :func:`propagate_scaled` over rows (threads share the rows from
+    :data:`hamilton_orbits._kernels._dispatch.DEFAULT_THRESHOLD` rows on); returns
+    the first failing row or -1."""
+    for i in prange(r.shape[0]):
         x, y, z, a, b, c = propagate_scaled(
             r[i, 0], r[i, 1], r[i, 2], v[i, 0], v[i, 1], v[i, 2], mu[i], dt[i]
         )
@@ -1001,12 +1002,14 @@ def propagate_batch(r, v, mu, dt, r_out, v_out):  # pragma: no cover - compiled
         v_out[i, 0] = a
         v_out[i, 1] = b
         v_out[i, 2] = c
-        if bad < 0 and not (
-            math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
-            and math.isfinite(a) and math.isfinite(b) and math.isfinite(c)
-        ):
-            bad = i
-    return bad
+    for i in range(r.shape[0]):  # after the threads: the first failure, in order
+        s = r_out[i, 0] + r_out[i, 1] + r_out[i, 2] + v_out[i, 0] + v_out[i, 1] + v_out[i, 2]
+        if not math.isfinite(s):
+            if not (math.isfinite(r_out[i, 0]) and math.isfinite(r_out[i, 1])
+                    and math.isfinite(r_out[i, 2]) and math.isfinite(v_out[i, 0])
+                    and math.isfinite(v_out[i, 1]) and math.isfinite(v_out[i, 2])):
+                return i
+    return -1
 
 
 __all__ = [

@@ -137,34 +137,58 @@ def _kahan2(p, cs, i, k, inp):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _predict(q, b, e, br, er):  # pragma: no cover - compiled
-    """Predict ``b`` (and save the prediction in ``e``) for a step ``q`` times the
-    last completed one, from that step's converged ``br`` and its prediction
-    ``er`` (Rein & Spiegel 2015, section 2.5).  ``q > 20``: start from zero."""
-    m = b.shape[1]
-    if q > 20.0:
-        b[:, :] = 0.0
-        e[:, :] = 0.0
-        return
+def _predicted(q, br, k):  # pragma: no cover - compiled
+    """The prediction of component ``k``'s ``b`` for a step ``q`` times the last
+    completed one, from that step's converged ``br`` (Rein & Spiegel 2015, section
+    2.5): ``a(1 + q h')`` expanded in powers of ``h'``."""
     q2 = q * q
     q3 = q2 * q
     q4 = q2 * q2
     q5 = q4 * q
     q6 = q3 * q3
     q7 = q6 * q
+    b0, b1, b2, b3 = br[0, k], br[1, k], br[2, k], br[3, k]
+    b4, b5, b6 = br[4, k], br[5, k], br[6, k]
+    return (q * (7.0 * b6 + 6.0 * b5 + 5.0 * b4 + 4.0 * b3 + 3.0 * b2 + 2.0 * b1 + b0),
+            q2 * (21.0 * b6 + 15.0 * b5 + 10.0 * b4 + 6.0 * b3 + 3.0 * b2 + b1),
+            q3 * (35.0 * b6 + 20.0 * b5 + 10.0 * b4 + 4.0 * b3 + b2),
+            q4 * (35.0 * b6 + 15.0 * b5 + 5.0 * b4 + b3),
+            q5 * (21.0 * b6 + 6.0 * b5 + b4),
+            q6 * (7.0 * b6 + b5),
+            q7 * b6)
+
+
+@njit(cache=True, inline="always")
+def _predict(q, b, br, d):  # pragma: no cover - compiled
+    """Predict ``b`` for a step ``q`` times the last completed one: the prediction
+    from that step's converged ``br`` plus ``d``, the difference between ``br`` and
+    the prediction it had started from (Rein & Spiegel 2015, section 2.5).  ``q >
+    20``: start from zero."""
+    m = b.shape[1]
+    if q > 20.0:
+        b[:, :] = 0.0
+        return
     for k in range(m):
-        b0, b1, b2, b3 = br[0, k], br[1, k], br[2, k], br[3, k]
-        b4, b5, b6 = br[4, k], br[5, k], br[6, k]
-        # a(1 + q h') expanded in powers of h'
-        e[0, k] = q * (7.0 * b6 + 6.0 * b5 + 5.0 * b4 + 4.0 * b3 + 3.0 * b2 + 2.0 * b1 + b0)
-        e[1, k] = q2 * (21.0 * b6 + 15.0 * b5 + 10.0 * b4 + 6.0 * b3 + 3.0 * b2 + b1)
-        e[2, k] = q3 * (35.0 * b6 + 20.0 * b5 + 10.0 * b4 + 4.0 * b3 + b2)
-        e[3, k] = q4 * (35.0 * b6 + 15.0 * b5 + 5.0 * b4 + b3)
-        e[4, k] = q5 * (21.0 * b6 + 6.0 * b5 + b4)
-        e[5, k] = q6 * (7.0 * b6 + b5)
-        e[6, k] = q7 * b6
+        e = _predicted(q, br, k)
         for i in range(7):
-            b[i, k] = e[i, k] + (br[i, k] - er[i, k])
+            b[i, k] = e[i] + d[i, k]
+
+
+@njit(cache=True, inline="always")
+def _keep(q, predicted, b, br, d):  # pragma: no cover - compiled
+    """At an accepted step: ``d = b - prediction`` (the prediction recomputed from
+    the old ``br`` with the same ``q``, rather than stored: 7 numbers a component
+    fewer; zero when the step started from zero) and ``br = b``."""
+    for k in range(b.shape[1]):
+        if predicted:
+            e = _predicted(q, br, k)
+            for i in range(7):
+                d[i, k] = b[i, k] - e[i]
+        else:
+            for i in range(7):
+                d[i, k] = b[i, k]
+        for i in range(7):
+            br[i, k] = b[i, k]
 
 
 @njit(cache=True, inline="always")
@@ -356,14 +380,6 @@ def _accept(x, v, csx, csv, b, a0, v0, dt):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _copy2(src, dst):  # pragma: no cover - compiled
-    """``dst[:, :] = src`` element by element (no temporary for an overlap check)."""
-    for i in range(src.shape[0]):
-        for k in range(src.shape[1]):
-            dst[i, k] = src[i, k]
-
-
-@njit(cache=True, inline="always")
 def _all_finite(x):  # pragma: no cover - compiled
     for k in range(x.shape[0]):
         if not math.isfinite(x[k]):
@@ -372,31 +388,21 @@ def _all_finite(x):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
-    # pragma: no cover - compiled
-    """Save the state at the start of a step and evaluate its acceleration into
-    ``a0_2`` (n, 3); returns whether it is finite."""
-    m = x0.shape[0]
-    xf = r.reshape(m)
-    vf = v.reshape(m)
-    for k in range(m):
-        x0[k] = xf[k]
-        v0[k] = vf[k]
-        csx0[k] = csx[k]
-        csv0[k] = csv[k]
+def _start_step(accel, p, r, v, gm, a0_2, x0, v0):  # pragma: no cover - compiled
+    """Evaluate the acceleration at the start of a step into ``a0_2`` (n, 3) and,
+    when events are watched (``x0``, ``v0`` not empty), save the start state for
+    their scan; returns whether the acceleration is finite.  (The state itself is
+    not changed before the step is accepted, so a rejected step needs no
+    restoring and the iteration reads the start state from ``r``, ``v``.)"""
+    m = a0_2.shape[0] * 3
+    if x0.shape[0] > 0:
+        xf = r.reshape(m)
+        vf = v.reshape(m)
+        for k in range(m):
+            x0[k] = xf[k]
+            v0[k] = vf[k]
     accel(r, v, gm, a0_2, p)
     return _all_finite(a0_2.reshape(m))
-
-
-@njit(cache=True, inline="always")
-def _restore(r, v, x0, v0):  # pragma: no cover - compiled
-    """Put the state back to the start of a rejected step."""
-    m = x0.shape[0]
-    xf = r.reshape(m)
-    vf = v.reshape(m)
-    for k in range(m):
-        xf[k] = x0[k]
-        vf[k] = v0[k]
 
 
 @njit(cache=True, inline="always")
@@ -451,32 +457,41 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
 
 @njit(
     types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F2, _F1, _F1,
+        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, _F2, _F2, types.int64[::1],
     ),
     cache=True,
 )
 def advance(
-    accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps, watch, ev_out,
+    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
     ev_count,
 ):  # pragma: no cover - compiled
     """Step from ``st[0]`` to ``t_end`` in place; returns ``(steps, status)``.
 
     ``st`` is the :data:`NSTATE` state (``epsilon = 0``: fixed steps of ``dt``;
     ``prs23 != 0``: the rule of Pham, Rein & Spiegel 2024, else the global one
-    of IAS15).  ``b, e, br, er, g`` are (7, 3n); ``csx, csv`` the Kahan
+    of IAS15).  ``b, br, d, g`` are (7, 3n): the step's ``b``, the last accepted
+    step's, its difference from the prediction it started from (for the next
+    prediction, :func:`_predict`), and ``g``; ``csx, csv`` the Kahan
     compensations (3n,).  ``r, v`` (n, 3) are updated.  ``status`` is one of the
     ``STATUS_*`` codes; at ``STATUS_MAXSTEPS`` the state is consistent and the
     call may be repeated to go on.  ``watch`` (m, 5) are the events to look for
     after every step on the step's polynomial (:func:`hamilton_orbits._kernels.
     events.scan`), recorded into ``ev_out`` / ``ev_count``; at ``STATUS_EVENT`` the
     state is that of the event's time.
+
+    Memory per body: the four (7, 3) arrays above and ``csb`` (840 bytes), the
+    work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
+    the start state only when events are watched.
     """
     n = r.shape[0]
     m = 3 * n
-    x0, v0, csx0, csv0 = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    w = m if watch.shape[0] > 0 else 0
+    x0, v0 = np.empty(w), np.empty(w)  # the start of a step, for the events' scan
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     a0 = a0_2.reshape(m)
+    xf = r.reshape(m)
+    vf = v.reshape(m)
     csb = np.zeros((7, m))
     t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
     have_last = st[5] != 0.0
@@ -498,27 +513,26 @@ def advance(
                 break
             status = STATUS_UNDERFLOW
             break
-        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
+        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
             status = STATUS_NONFINITE
             break
-        if have_last:
-            _predict(dt_try / dt_last, b, e, br, er)
+        q = dt_try / dt_last if have_last else math.inf
+        if q <= 20.0:
+            _predict(q, b, br, d)
         else:
             b[:, :] = 0.0
-            e[:, :] = 0.0
         csb[:, :] = 0.0
         _g_from_b(b, g)
-        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at,
+        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
                           need_v)
         if not _all_finite(b[6]):
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing)
         if not ok:
-            _restore(r, v, x0, v0)
             dt = dt_new
             continue
-        _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
+        _accept(xf, vf, csx, csv, b, a0, vf, dt_try)
         if n_watch > 0:
             h_ev = _watch_step(watch, t, dt_try, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st,
                                csx, csv)
@@ -535,8 +549,7 @@ def advance(
             tn = t + y
             t_cs = (tn - t) - y
             t = tn
-        _copy2(b, br)
-        _copy2(e, er)
+        _keep(q, q <= 20.0, b, br, d)
         dt_last = dt_try
         have_last = True
         dt = dt_new
@@ -613,11 +626,12 @@ def _megno_radau(ms, t, dt, b, a0, x0, v0, lo, hi):  # pragma: no cover - compil
 
 
 @njit(cache=True)
-def _renormalise(r, v, b, e, br, er, g, csx, csv, n):  # pragma: no cover - compiled
+def _renormalise(r, v, b, br, d, g, csx, csv, n):  # pragma: no cover - compiled
     """Scale MEGNO's tangent vector (rows ``n .. 2n-1``) down by its largest
     component when that exceeds 1e100, in the state, the step's polynomial (``b``,
-    ``e`` and the last step's ``br``, ``er``, ``g``) and the compensations alike (the
-    tangent dynamics are linear; MEGNO depends on its direction only)."""
+    ``g``, the last step's ``br`` and its difference from its prediction ``d``) and
+    the compensations alike (the tangent dynamics are linear; MEGNO depends on its
+    direction only)."""
     big = 0.0
     for i in range(n, 2 * n):
         for c in range(3):
@@ -634,21 +648,20 @@ def _renormalise(r, v, b, e, br, er, g, csx, csv, n):  # pragma: no cover - comp
             csv[k] *= f
             for j in range(7):
                 b[j, k] *= f
-                e[j, k] *= f
                 br[j, k] *= f
-                er[j, k] *= f
+                d[j, k] *= f
                 g[j, k] *= f
 
 
 @njit(
     types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F2, _F1, _F1,
+        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, types.int64, _F1,
     ),
     cache=True,
 )
 def advance_variational(
-    accel, p, r, v, gm, t_end, st, b, e, br, er, g, csx, csv, need_v, max_steps, n_phys, ms,
+    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, n_phys, ms,
 ):  # pragma: no cover - compiled
     """:func:`advance` for the state of ``n_phys`` bodies followed by tangent
     vectors (``r``, ``v`` of ``n_phys (1 + k)`` rows; ``accel`` the augmented
@@ -656,12 +669,16 @@ def advance_variational(
     predictor-corrector iteration over every component (as rebound's IAS15 with
     variational particles), the step size chosen from the bodies alone (the
     tangent vectors, which grow, do not drive it), and after each accepted step
-    the MEGNO update from tangent vector 0 (:func:`_megno_radau`).  No events."""
+    the MEGNO update from tangent vector 0 (:func:`_megno_radau`, from the step's
+    start state, which stays in ``r``, ``v`` until the step is accepted).  No
+    events."""
     n = r.shape[0]
     m = 3 * n
-    x0, v0, csx0, csv0 = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    x0, v0 = np.empty(0), np.empty(0)  # no events: the start state is not saved
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     a0 = a0_2.reshape(m)
+    xf = r.reshape(m)
+    vf = v.reshape(m)
     csb = np.zeros((7, m))
     t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
     have_last = st[5] != 0.0
@@ -679,17 +696,17 @@ def advance_variational(
                 break
             status = STATUS_UNDERFLOW
             break
-        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0, csx, csv, csx0, csv0):
+        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
             status = STATUS_NONFINITE
             break
-        if have_last:
-            _predict(dt_try / dt_last, b, e, br, er)
+        q = dt_try / dt_last if have_last else math.inf
+        if q <= 20.0:
+            _predict(q, b, br, d)
         else:
             b[:, :] = 0.0
-            e[:, :] = 0.0
         csb[:, :] = 0.0
         _g_from_b(b, g)
-        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at,
+        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
                           need_v)
         if not _all_finite(b[6]):
             status = STATUS_NONFINITE
@@ -697,12 +714,11 @@ def advance_variational(
         dt_new, ok = _next_dt(st, a0, b, at[:n_phys], r[:n_phys], v[:n_phys], dt_try, dt,
                               landing)
         if not ok:
-            _restore(r, v, x0, v0)
             dt = dt_new
             continue
-        _accept(r.reshape(m), v.reshape(m), csx, csv, b, a0, v0, dt_try)
-        _megno_radau(ms, t, dt_try, b, a0, x0, v0, 3 * n_phys, 6 * n_phys)
-        _renormalise(r, v, b, e, br, er, g, csx, csv, gm.shape[0])
+        _megno_radau(ms, t, dt_try, b, a0, xf, vf, 3 * n_phys, 6 * n_phys)
+        _accept(xf, vf, csx, csv, b, a0, vf, dt_try)
+        _renormalise(r, v, b, br, d, g, csx, csv, gm.shape[0])
         if landing:
             t = t_end
             t_cs = 0.0
@@ -711,8 +727,7 @@ def advance_variational(
             tn = t + y
             t_cs = (tn - t) - y
             t = tn
-        _copy2(b, br)
-        _copy2(e, er)
+        _keep(q, q <= 20.0, b, br, d)
         dt_last = dt_try
         have_last = True
         dt = dt_new

@@ -27,20 +27,26 @@ __all__ = [
     "advance_dh",
     "advance_jacobi",
     "corrector_jacobi",
+    "dh_from_inertial",
+    "dh_to_inertial",
     "jacobi_factors",
+    "jacobi_from_inertial",
+    "jacobi_to_inertial",
     "jacobi_to_inertial_pos",
 ]
 
 
 @njit(cache=True, error_model="numpy")
 def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
-    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` by ``tau``
-    (the shared kernel inlined: the bodies' solves overlap in the processor).
+    """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` (``mu[0]``
+    for all when ``mu`` has one element) by ``tau`` (the shared kernel inlined: the
+    bodies' solves overlap in the processor).
 
     Returns the index of the first failure (NaN from the kernel), else -1."""
+    one = mu.shape[0] == 1
     for i in range(1, q.shape[0]):
         x, y, z, vx, vy, vz = _kepler.propagate_uv_inline(
-            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[i], tau
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[0] if one else mu[i], tau
         )
         if not math.isfinite(x + y + z + vx + vy + vz):
             return i
@@ -168,17 +174,15 @@ def _stop_here(q, u, mu, h_back, jacobi, com, ws, t_end_step, ev_out, ev_count):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x):
+def _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x):
     # pragma: no cover - compiled
     """Jump h/2, the interaction kick h (and the listed effects, whose net force
-    moves the barycentre), jump h/2."""
+    moves the barycentre), jump h/2.  ``idx``: the massive rows >= 1 (row 0, the
+    central body, is not in the interaction)."""
     n = q.shape[0]
     gm0 = gm[0]
     _jump(q, u, gm, 0.5 * h)
-    _nbody.newtonian_rows(q, gm_p, idx, 1, acc)
-    for i in range(1, n):
-        for k in range(3):
-            u[i, k] += h * acc[i, k]
+    _nbody.kick_rows(q, gm, idx, 1, h, u, acc_m)
     if has_extra:
         # inertial state for the effects: r_0 = R - sum m_i Q_i / M
         for k in range(3):
@@ -299,21 +303,20 @@ def _kick_jacobi(
             uj[i, k] += h * (accj[i, k] + f * qj[i, k])
 
 
-# Third-order symplectic corrector (Wisdom, Holman & Touma 1996, table 1 as
-# used by WHFast, Rein & Tamayo 2015): a = sqrt(7/40), b = -sqrt(10/7) / 48.
-_CORR_A = math.sqrt(7.0 / 40.0)
-_CORR_B = -math.sqrt(10.0 / 7.0) / 48.0
-
-
 @njit(
-    types.int64(ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64),
+    types.int64(ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64,
+                F1, F1),
     cache=True,
     error_model="numpy",
 )
-def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma: no cover
-    """Apply the third-order corrector (``sign = 1``) or its inverse (``-1``):
-    ``Z(a dt, -sign b dt) Z(-a dt, sign b dt)`` with ``Z(a, b)`` = Kepler a,
-    kick -b, Kepler -2a, kick b, Kepler a.  Returns a failing index or -1."""
+def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
+    # pragma: no cover - compiled
+    """Apply a symplectic corrector (``sign = 1``) or its inverse (``-1``): the
+    product of ``Z(a_k dt, sign b_k dt)`` over the sequence ``a``, ``b`` (see
+    :func:`hamilton_orbits.integrators.wh.corrector_coefficients`), with ``Z(a,
+    b)`` = Kepler a, kick -b, Kepler -2a, kick b, Kepler a (Wisdom, Holman &
+    Touma 1996).  The sequence is antisymmetric (``(a, b)`` reversed is ``(-a,
+    -b)``), so ``sign = -1`` is the exact inverse.  Returns a failing index or -1."""
     n = qj.shape[0]
     acc = np.empty((n, 3))
     accj = np.empty((n, 3))
@@ -322,25 +325,125 @@ def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign):  # pragma:
     v_in = np.zeros((n, 3))
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
-    for a, b in ((_CORR_A * dt, -sign * _CORR_B * dt), (-_CORR_A * dt, sign * _CORR_B * dt)):
-        bad = _kepler_all(qj, uj, eta, a)
+    for k in range(a.shape[0]):
+        ak = a[k] * dt
+        bk = sign * b[k] * dt
+        bad = _kepler_all(qj, uj, eta, ak)
         if bad >= 0:
             return bad
         _kick_jacobi(
-            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, -b, False,
+            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, -bk, False,
             acc, accj, acc_x, r_in, v_in,
         )
-        bad = _kepler_all(qj, uj, eta, -2.0 * a)
+        bad = _kepler_all(qj, uj, eta, -2.0 * ak)
         if bad >= 0:
             return bad
         _kick_jacobi(
-            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, b, False,
+            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, bk, False,
             acc, accj, acc_x, r_in, v_in,
         )
-        bad = _kepler_all(qj, uj, eta, a)
+        bad = _kepler_all(qj, uj, eta, ak)
         if bad >= 0:
             return bad
     return -1
+
+
+@njit(cache=True, error_model="numpy")
+def dh_from_inertial(r, v, g, order, q, u, com):  # pragma: no cover - compiled
+    """Heliocentric positions ``q`` and barycentric velocities ``u`` (row ``i`` is
+    body ``order[i]``; ``order[0]`` the central body) and the barycentre ``com``
+    (position, velocity) from inertial ``r``, ``v``."""
+    n = r.shape[0]
+    m_tot = 0.0
+    s = np.zeros(6)
+    for i in range(n):  # row by row: one pass over memory
+        j = order[i]
+        gi = g[i]
+        m_tot += gi
+        if gi != 0.0:
+            for k in range(3):
+                s[k] += gi * r[j, k]
+                s[3 + k] += gi * v[j, k]
+    for k in range(6):
+        com[k] = s[k] / m_tot
+    c = order[0]
+    cx, cy, cz = r[c, 0], r[c, 1], r[c, 2]
+    wx, wy, wz = com[3], com[4], com[5]
+    for i in range(n):
+        j = order[i]
+        q[i, 0] = r[j, 0] - cx
+        q[i, 1] = r[j, 1] - cy
+        q[i, 2] = r[j, 2] - cz
+        u[i, 0] = v[j, 0] - wx
+        u[i, 1] = v[j, 1] - wy
+        u[i, 2] = v[j, 2] - wz
+
+
+@njit(cache=True, error_model="numpy")
+def dh_to_inertial(q, u, g, com, order, r, v):  # pragma: no cover - compiled
+    """Inertial ``r``, ``v`` (body ``order[i]`` from row ``i``) from the
+    coordinates of :func:`dh_from_inertial`."""
+    n = q.shape[0]
+    m_tot = g[0]
+    s = np.zeros(6)
+    for i in range(1, n):
+        gi = g[i]
+        m_tot += gi
+        if gi != 0.0:
+            for k in range(3):
+                s[k] += gi * q[i, k]
+                s[3 + k] += gi * u[i, k]
+    x0 = np.empty(6)
+    for k in range(3):
+        x0[k] = com[k] - s[k] / m_tot
+        x0[3 + k] = com[3 + k] - s[3 + k] / g[0]
+    c = order[0]
+    for k in range(3):
+        r[c, k] = x0[k]
+        v[c, k] = x0[3 + k]
+    for i in range(1, n):
+        j = order[i]
+        for k in range(3):
+            r[j, k] = q[i, k] + x0[k]
+            v[j, k] = u[i, k] + com[3 + k]
+
+
+@njit(cache=True, error_model="numpy")
+def jacobi_from_inertial(r, v, g, eta, order, q, u):  # pragma: no cover - compiled
+    """Jacobi positions and velocities (row 0 the barycentre; row ``i`` is body
+    ``order[i]``, ``eta_i = sum_{j<=i} g_j``) from inertial ``r``, ``v``."""
+    n = r.shape[0]
+    s = np.zeros(6)
+    for i in range(n):  # row by row: one pass over memory
+        j = order[i]
+        if i > 0:
+            e = eta[i - 1]
+            for k in range(3):
+                q[i, k] = r[j, k] - s[k] / e
+                u[i, k] = v[j, k] - s[3 + k] / e
+        gi = g[i]
+        for k in range(3):
+            s[k] += gi * r[j, k]
+            s[3 + k] += gi * v[j, k]
+    for k in range(3):
+        q[0, k] = s[k] / eta[n - 1]
+        u[0, k] = s[3 + k] / eta[n - 1]
+
+
+@njit(cache=True, error_model="numpy")
+def jacobi_to_inertial(q, u, g, eta, ratio, inv, order, r, v):  # pragma: no cover - compiled
+    """Inertial ``r``, ``v`` (body ``order[i]`` from row ``i``) from Jacobi ``q``,
+    ``u`` (:func:`jacobi_to_inertial_pos` for both)."""
+    n = q.shape[0]
+    w = np.empty((n, 3))
+    for which in range(2):
+        jacobi_to_inertial_pos(q if which == 0 else u, g, eta, ratio, inv, w)
+        out = r if which == 0 else v
+        for i in range(n):
+            j = order[i]
+            out[j, 0] = w[i, 0]
+            out[j, 1] = w[i, 1]
+            out[j, 2] = w[i, 2]
 
 
 _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
@@ -348,38 +451,44 @@ _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, F1, types.float64, types.int64,
+        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_dh(
-    extra, p, has_extra, q, u, gm, gm_p, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
 ):  # pragma: no cover - compiled
     """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
     coordinates, in place.  ``q``, ``u``: heliocentric positions and
-    barycentric velocities (row 0 unused); ``gm_p``: ``gm`` with ``gm_p[0] = 0``;
+    barycentric velocities (row 0 unused); ``gm[0]`` the central body's;
     ``com``: barycentre position and velocity (6,).  ``watch``, ``ev_out``,
     ``ev_count``, ``ws``: the events (see :func:`_drift`; ``ws[0]`` the start
     time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
     whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
     state is synchronised at the end of step ``steps``."""
     n = q.shape[0]
-    acc = np.empty((n, 3))
-    r_in = np.empty((n, 3))
-    v_in = np.empty((n, 3))
-    acc_x = np.empty((n, 3))
-    x0, v0 = np.empty((n, 3)), np.empty((n, 3))
+    watched = watch.shape[0] > 0
+    m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
+    r_in = np.empty((m, 3))
+    v_in = np.empty((m, 3))
+    acc_x = np.empty((m, 3))
+    w = n if watched else 0  # the drifts' start states for the events' scan
+    x0, v0 = np.empty((w, 3)), np.empty((w, 3))
     m_tot = 0.0
     for i in range(n):
         m_tot += gm[i]
     # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
     # row 0 (unused here) is left out of the interaction
-    idx = _nbody.massive_indices(gm_p)
-    mu = np.full(n, gm[0])
-    mu_s = mu.copy()
-    mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
+    idx = _nbody.massive_indices(gm)
+    if idx.shape[0] > 0 and idx[0] == 0:
+        idx = idx[1:]
+    acc_m = np.empty((idx.shape[0], 3))
+    mu = np.full(1, gm[0])  # every body about the central one
+    mu_s = np.full(w, gm[0])
+    if watched:
+        mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0, mu_s)
@@ -387,7 +496,7 @@ def advance_dh(
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _kick_dh(extra, p, has_extra, q, u, gm, gm_p, idx, com, h, m_tot, acc, r_in, v_in, acc_x)
+        _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x)
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count, ws,
                      x0, v0, mu_s)

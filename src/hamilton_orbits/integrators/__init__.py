@@ -31,10 +31,14 @@ from typing import Any, Protocol
 
 import numpy as np
 
-__all__ = ["INTEGRATORS", "Integrator", "StopIntegration", "output_arrays"]
+__all__ = ["INTEGRATORS", "WH_CORRECTORS", "Integrator", "StopIntegration", "output_arrays"]
 
 #: The methods, in the order they are listed to users.
 INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
+
+#: The orders of ``wh``'s symplectic correctors (Jacobi coordinates; 0: none),
+#: here so that a scene checks them without loading the kernels.
+WH_CORRECTORS = (0, 3, 5, 7, 11, 17)
 
 
 class StopIntegration(Exception):

@@ -10,6 +10,7 @@ import numpy as np
 from numba.core.types.function_type import CompileResultWAP
 from numba.core.typing.typeof import typeof_impl
 
+from hamilton_orbits._kernels import checks as _checks
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE
 from hamilton_orbits._validation import as_float_array, check_positive
@@ -78,6 +79,8 @@ def check_inputs(
     ...
     ValueError: Expected `gm` >= 0, got -1.0 at index 0
     """
+    if _fast_ok(r0, v0, gm, t_out):  # float64 arrays of the right shapes, all valid
+        return r0, v0, gm, t_out
     r0 = np.ascontiguousarray(as_float_array("r0", r0), dtype=np.float64)
     v0 = np.ascontiguousarray(as_float_array("v0", v0), dtype=np.float64)
     gm = np.ascontiguousarray(as_float_array("gm", gm), dtype=np.float64)
@@ -99,6 +102,19 @@ def check_inputs(
             f"after {float(t_out[i - 1])!r}"
         )
     return r0, v0, gm, t_out
+
+
+def _fast_ok(r0: Any, v0: Any, gm: Any, t_out: Any) -> bool:
+    """True for C-contiguous float64 arrays of the right shapes whose values pass
+    every check (one compiled pass, :func:`hamilton_orbits._kernels.checks.state_ok`)."""
+    for x in (r0, v0, gm, t_out):
+        if type(x) is not np.ndarray or x.dtype != np.float64 or not x.flags.c_contiguous:
+            return False
+    n = r0.shape[0] if r0.ndim == 2 else -1
+    if r0.shape != (n, 3) or v0.shape != (n, 3) or gm.shape != (n,) or t_out.ndim != 1 \
+            or t_out.shape[0] < 1:
+        return False
+    return bool(_checks.state_ok(r0, v0, gm, t_out))
 
 
 def check_dt_tol(dt: Any, tol: Any) -> tuple[float | None, float | None]:

@@ -138,10 +138,11 @@ def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out:
     True to let the tangent vectors take part in the step control; ``stop()`` asked
     between slices of ``slice_steps`` steps (True raises :class:`StopIntegration`)."""
     n = r0.shape[0]
+    gm = np.array(gm, dtype=np.float64)  # writable (the kernels' signatures take no read-only)
     x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
     w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
     m = 3 * x.shape[0]
-    work = [np.zeros((7, m)) for _ in range(5)]  # b, e, br, er, g
+    work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
     csx, csv = np.zeros(m), np.zeros(m)
     st = np.zeros(_radau.NSTATE)
     st[[0, 2, 4, 7]] = t_out[0], dt, tol, float(prs23)
@@ -196,6 +197,7 @@ def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out
     ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
+    gm = np.array(gm, dtype=np.float64)  # writable (the kernel's signature takes no read-only)
     dr, dv = tangent.dr0.copy(), tangent.dv0.copy()
     accel, jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
     r_out, v_out = output_arrays(out, t_out.shape[0], r, v)

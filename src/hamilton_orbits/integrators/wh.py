@@ -31,14 +31,33 @@ Jacobi form plus ``G eta_i r'_i / |r'_i|^3`` (the part the Kepler step already
 took), and there is no jump.
 
 Velocity-dependent effects are refused (the kick would not be symplectic).
-With Jacobi coordinates the third-order symplectic corrector of Wisdom,
-Holman & Touma (1996) is available (``corrector=3``).
+
+Symplectic correctors
+---------------------
+With Jacobi coordinates the symplectic correctors of Wisdom, Holman & Touma
+(1996) of order 3, 5, 7, 11 and 17 (the orders WHFast offers, Rein & Tamayo
+2015) are available (``corrector=``): the corrector ``C`` is applied at the
+start of each output interval and ``C^-1`` at its end, so the steps in between
+are those of the uncorrected map on corrected coordinates and every output is
+in true coordinates.  The coefficients are computed here
+(:func:`corrector_coefficients`): the corrector of order ``p`` removes the terms
+``eps dt^2, eps dt^4, ..., eps dt^(p-1)`` (``eps`` the planet-to-star mass ratio)
+of the map's error Hamiltonian; what remains is ``eps dt^(p+1)`` and the
+``eps^2 dt^2`` terms no corrector of this kind removes.  The democratic-heliocentric map has no
+corrector here: its kernel includes the "jump" term, whose error terms are not
+of the form the WHT96 construction removes (Wisdom 2006 derives correctors for
+heliocentric coordinates with a different kernel); WHFast likewise offers its
+correctors for Jacobi coordinates only.
 """
 
 from __future__ import annotations
 
+import decimal
+import functools
 import math
+import numbers
 from collections.abc import Callable
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -47,9 +66,25 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
+from hamilton_orbits.integrators import (
+    WH_CORRECTORS,
+    StopIntegration,
+    _setup,
+    _tangent,
+    output_arrays,
+)
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "COORDINATES", "NAME", "default_step", "run"]
+__all__ = [
+    "ACCEPTS_VELOCITY_DEPENDENT",
+    "COORDINATES",
+    "CORRECTORS",
+    "CORRECTOR_ALPHA_SQUARED",
+    "NAME",
+    "corrector_coefficients",
+    "corrector_series",
+    "default_step",
+    "run",
+]
 
 NAME = "wh"
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
@@ -135,11 +170,14 @@ def run(
         1998) or Jacobi (Wisdom & Holman 1991; the central body first, then the
         others in the order given, each on a Kepler orbit about the total mass
         inside it).  Both are WHFast's maps of the same names.
-    corrector : {0, 3}, optional
-        With Jacobi coordinates, 3 applies the third-order symplectic corrector
-        of Wisdom, Holman & Touma (1996) before the steps of each output
-        interval and its inverse after them (so outputs are in true
-        coordinates); it removes the leading O(eps dt^2) error term.
+    corrector : {0, 3, 5, 7, 11, 17}, optional
+        With Jacobi coordinates, the symplectic corrector of that order
+        (Wisdom, Holman & Touma 1996; see the module's notes) before the steps
+        of each output interval and its inverse after them (so outputs are in
+        true coordinates); order ``p`` removes the error terms ``eps dt^2``
+        ... ``eps dt^(p-1)``.  Each application costs about ``p - 1`` steps'
+        work (``3 (p - 1)`` Kepler solves, ``2 (p - 1)`` kicks), twice per
+        output interval.
     max_steps : int, optional
         A bound on the steps of the whole run; more are refused before the run
         starts (``ValueError``).
@@ -185,7 +223,8 @@ def run(
     100
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    dt_f, tol_f = _check_options(rhs, dt, tol, coordinates, corrector, variational is not None)
+    dt_f, tol_f, corrector = _check_options(rhs, dt, tol, coordinates, corrector,
+                                            variational is not None)
     c = int(np.argmax(gm))
     if not gm[c] > 0.0:
         raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
@@ -197,63 +236,188 @@ def run(
                                jacobi=coordinates == "jacobi", on_output=on_output, out=out,
                                stop=stop)
     n = r0.shape[0]
-    order = np.concatenate([[c], np.delete(np.arange(n), c)])  # the central body first
+    # the central body first (row i of the coordinates is body order[i])
+    order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
     extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
-    gm = gm.copy()
+    if events is not None:
+        gm = gm.copy()  # merges change it
     log = events if events is not None else EventLog.none(n)
-    log.index_map = order
-    split = _Split(np.ascontiguousarray(gm[order]), coordinates == "jacobi", corrector, extra,
-                   rhs.p, rhs.extra is not None)
-    q, u = split.to_coordinates(r0[order], v0[order])
+    if c != 0:
+        log.index_map = order
     nt = t_out.shape[0]
     r_out, v_out = output_arrays(out, nt, r0, v0)
+    split = _Split(gm, order, coordinates == "jacobi", corrector, extra, rhs.p,
+                   rhs.extra is not None)
+    # the working coordinates live in the next output row when the central body is
+    # first (no copy of the state of its own: 48 bytes a body fewer), else apart
+    in_place = c == 0
+    if nt > 1:
+        split.from_inertial(r0, v0, *((r_out[1], v_out[1]) if in_place else
+                                      (np.empty_like(r0), np.empty_like(v0))))
     total = 0
-    inv = np.argsort(order)
+    watch = log.kernel_watch()
     for i in range(1, nt):
-        span = t_out[i] - t_out[i - 1]
-        n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
-        last = span - (n_steps - 1) * dt_f
-        done = 0
-        while done < n_steps:
-            if done and stop is not None and stop():
-                raise StopIntegration
-            ws = np.array([t_out[i - 1] + done * dt_f, np.inf, 0.0, -1.0])
-            n_call = min(n_steps - done, SLICE)  # Ctrl-C and stop() are seen between calls
-            steps, bad, status = split.advance(
-                q, u, dt_f, n_call, last if done + n_call == n_steps else dt_f,
-                log.kernel_watch(), log.buffer, log.count, ws)
-            done += steps
-            total += steps
-            if bad >= 0:
-                raise ConvergenceError(
-                    f"wh: the Kepler step of body {int(order[bad])} failed between "
-                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
-                    f"{float(t_out[i])!r}")
-            if status == _k.STATUS_DRAIN:
-                log.drain()
-            elif status == _k.STATUS_EVENT:
-                rr, vv = split.to_inertial(q, u)
-                r_now, v_now = rr[inv], vv[inv]
-                if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
-                    r_out[i], v_out[i] = _masked(r_now, v_now, log)
-                    raise StopAtEvent(i, float(ws[0]), total)
-                split = _Split(np.ascontiguousarray(gm[order]), split.jacobi, corrector, extra,
-                               rhs.p, rhs.extra is not None)
-                q, u = split.to_coordinates(r_now[order], v_now[order])
-        rr, vv = split.to_inertial(q, u)
-        r_out[i], v_out[i] = _masked(rr[inv], vv[inv], log)
+        split, total, watch = _interval(split, i, t_out, dt_f, log, watch, gm, total,
+                                        (r_out[i], v_out[i]), stop)
+        if in_place:
+            q, u = split.q, split.u
+            if i + 1 < nt:  # the state moves on to the next row
+                r_out[i + 1], v_out[i + 1] = q, u
+                split.q, split.u = r_out[i + 1], v_out[i + 1]
+            split.to_inertial(q, u, q, u)  # row i, in place
+        else:
+            split.to_inertial(r_out[i], v_out[i])
+        _mask(r_out[i], v_out[i], log)
         if on_output is not None:
             on_output(i, total)
     return r_out, v_out, total
 
 
-def _masked(r: np.ndarray, v: np.ndarray, log: EventLog) -> tuple[np.ndarray, np.ndarray]:
-    """The state with the bodies taken out of the run as NaN."""
-    r = r.copy()
-    v = v.copy()
-    r[log.inactive] = np.nan
-    v[log.inactive] = np.nan
-    return r, v
+def _interval(split: _Split, i: int, t_out: np.ndarray, dt: float, log: EventLog,
+              watch: np.ndarray, gm: np.ndarray, total: int,
+              row: tuple[np.ndarray, np.ndarray], stop: Callable[[], bool] | None = None
+              ) -> tuple[_Split, int, np.ndarray]:
+    """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land on
+    it), events acted on at the end of their step; the split (new after a merge or
+    a removal), the steps so far and the watch table.  An event that stops the run
+    leaves its state in ``row`` (output ``i``).  The steps go in slices of
+    ``SLICE``: Ctrl-C and ``stop()`` are seen between them."""
+    span = t_out[i] - t_out[i - 1]
+    n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+    last = span - (n_steps - 1) * dt
+    done = 0
+    while done < n_steps:
+        if done and stop is not None and stop():
+            raise StopIntegration
+        ws = np.array([t_out[i - 1] + done * dt, np.inf, 0.0, -1.0])
+        n_call = min(n_steps - done, SLICE)
+        steps, bad, status = split.advance(dt, n_call, last if done + n_call == n_steps else dt,
+                                           watch, log.buffer, log.count, ws)
+        done += steps
+        total += steps
+        if bad >= 0:
+            raise ConvergenceError(
+                f"wh: the Kepler step of body {int(split.order[bad])} failed between "
+                f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                f"{float(t_out[i])!r}")
+        if status == _k.STATUS_DRAIN:
+            log.drain()
+        elif status == _k.STATUS_EVENT:
+            r_now, v_now = np.empty_like(split.q), np.empty_like(split.u)
+            split.to_inertial(r_now, v_now)
+            if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
+                row[0][:], row[1][:] = r_now, v_now
+                _mask(row[0], row[1], log)
+                raise StopAtEvent(i, float(ws[0]), total)
+            split = split.renewed(gm)
+            split.from_inertial(r_now, v_now, split.q, split.u)
+            watch = log.kernel_watch()
+    return split, total, watch
+
+
+def _mask(r: np.ndarray, v: np.ndarray, log: EventLog) -> None:
+    """Set the bodies taken out of the run to NaN (in place)."""
+    if log.inactive.any():
+        r[log.inactive] = np.nan
+        v[log.inactive] = np.nan
+
+
+#: The symplectic correctors' orders (Wisdom, Holman & Touma 1996; Rein & Tamayo 2015).
+CORRECTORS = WH_CORRECTORS
+
+
+#: The spacing of the correctors' Kepler drifts, ``a_k = k alpha dt`` with
+#: ``alpha = sqrt(7/40)`` (Wisdom, Holman & Touma 1996; Rein & Tamayo 2015).
+CORRECTOR_ALPHA_SQUARED = Fraction(7, 40)
+
+
+def corrector_series(k_max: int) -> list[Fraction]:
+    """The coefficients ``g_0, g_2, ..., g_{2 k_max}`` of ``(z/2) / sinh(z/2) =
+    sum_k g_{2k} z^{2k}``, exactly.
+
+    The Wisdom-Holman kernel ``K = exp(h/2 A) exp(h eps B) exp(h/2 A)`` is, to first
+    order in ``eps``, ``exp(h A + eps h g(h ad_A) B)`` with ``g(z) = (z/2) /
+    sinh(z/2)`` (the symmetric Baker-Campbell-Hausdorff formula), so its error
+    terms linear in ``eps`` are ``eps h^(2k+1) g_{2k} ad_A^(2k) B``, ``k >= 1``.
+
+    Examples
+    --------
+    >>> corrector_series(2)
+    [Fraction(1, 1), Fraction(-1, 24), Fraction(7, 5760)]
+    """
+    # 1 / (sinh(z/2) / (z/2)), the series in w = z^2 inverted term by term
+    s = [Fraction(1, math.factorial(2 * k + 1) * 4**k) for k in range(k_max + 1)]
+    g = [Fraction(1)]
+    for k in range(1, k_max + 1):
+        g.append(-sum((s[j] * g[k - j] for j in range(1, k + 1)), Fraction(0)))
+    return g
+
+
+@functools.cache
+def corrector_coefficients(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """The drifts and kicks ``(a, b)`` (in units of the step) of the symplectic
+    corrector of ``order`` 3, 5, 7, 11 or 17, as the sequence of ``Z(a_k, b_k)``
+    that :func:`hamilton_orbits._kernels.wh.corrector_jacobi` applies.
+
+    Construction (Wisdom, Holman & Touma 1996, section 3; the orders of Rein &
+    Tamayo 2015, section 4.1): the corrector ``C = exp(eps W)`` turns the kernel
+    into ``C K C^-1``, whose error terms linear in ``eps`` vanish through
+    ``eps h^p`` when ``ad_A W = g(h ad_A) B - B`` holds through ``h^p``
+    (:func:`corrector_series`), i.e. ``W = sum_k g_{2k} h^{2k} ad_A^(2k-1) B``,
+    ``k = 1 .. m``, ``m = (order - 1) / 2``.  ``Z(a, b)`` (Kepler ``a``, kick
+    ``-b``, Kepler ``-2a``, kick ``b``, Kepler ``a``) is ``exp(-2 b eps sum_{odd
+    n} a^n / n! ad_A^n B)`` to first order in ``eps``; the sequence ``(a_m, b_m)
+    ... (a_1, b_1), (-a_1, -b_1) ... (-a_m, -b_m)`` with ``a_i = i alpha``
+    therefore needs
+
+        sum_i b_i (i alpha)^n = -n! g_{n+1} / 4,      n = 1, 3, ..., 2m - 1,
+
+    a Vandermonde system in ``i^2`` solved here in rationals (``b_i alpha`` is
+    rational because ``alpha^2 = 7/40`` is) and rounded once.  The sequence
+    reversed with ``a`` negated is itself with ``b`` negated, so the corrector
+    with ``-b`` is its exact inverse.  The values agree with rebound's
+    ``reb_whfast_corrector_b_*`` to the last digit of a double.
+
+    Raises
+    ------
+    ValueError
+        For an order other than 3, 5, 7, 11, 17.
+
+    Examples
+    --------
+    >>> a, b = corrector_coefficients(3)
+    >>> a.tolist() == [math.sqrt(7 / 40), -math.sqrt(7 / 40)]
+    True
+    >>> float(b[0])  # 1 / (96 alpha) = sqrt(10/7) / 48 = 0.02490059602779986749...
+    0.024900596027799867
+    """
+    if order not in CORRECTORS or order == 0:
+        raise ValueError(f"Expected a corrector order in 3, 5, 7, 11, 17, got {order!r}")
+    m = (order - 1) // 2
+    g = corrector_series(m)
+    ns = [2 * j + 1 for j in range(m)]
+    # c_i = b_i alpha: sum_i c_i i^n = -n! g_{n+1} / (4 alpha^(n-1))
+    rows = [[Fraction(i) ** n for i in range(1, m + 1)]
+            + [-math.factorial(n) * g[(n + 1) // 2] / (4 * CORRECTOR_ALPHA_SQUARED ** (n // 2))]
+            for n in ns]
+    for col in range(m):  # Gauss-Jordan elimination, exact
+        pivot = rows[col][col]
+        rows[col] = [x / pivot for x in rows[col]]
+        for r in range(m):
+            if r != col and rows[r][col] != 0:
+                f = rows[r][col]
+                rows[r] = [x - f * y for x, y in zip(rows[r], rows[col], strict=True)]
+    with decimal.localcontext() as ctx:
+        ctx.prec = 40
+        alpha = (decimal.Decimal(CORRECTOR_ALPHA_SQUARED.numerator)
+                 / decimal.Decimal(CORRECTOR_ALPHA_SQUARED.denominator)).sqrt()
+        c = [decimal.Decimal(row[m].numerator) / decimal.Decimal(row[m].denominator)
+             for row in rows]
+        a_half = [float(i * alpha) for i in range(m, 0, -1)]
+        b_half = [float(c[i - 1] / alpha) for i in range(m, 0, -1)]
+    a = np.array(a_half + [-x for x in reversed(a_half)])
+    b = np.array(b_half + [-x for x in reversed(b_half)])
+    return a, b
 
 
 def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int,
@@ -269,83 +433,99 @@ def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int
             f"Expected `coordinates` to be one of {', '.join(map(repr, COORDINATES))}, "
             f"got {coordinates!r}"
         )
-    if corrector not in (0, 3):
-        raise ValueError(f"Expected `corrector` to be 0 or 3, got {corrector!r}")
+    if (isinstance(corrector, bool) or not isinstance(corrector, numbers.Integral)
+            or corrector not in CORRECTORS):
+        raise ValueError(f"Expected `corrector` to be one of "
+                         f"{', '.join(map(str, CORRECTORS))}, got {corrector!r}")
     if corrector and coordinates != "jacobi":
         raise ValueError(
             f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
-            "(the corrector is defined for the Jacobi splitting)"
+            "(the correctors are defined for the Jacobi splitting)"
         )
     if corrector and variational:
         raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
                          "is not implemented); use corrector=0")
-    return dt_f, tol_f
+    return dt_f, tol_f, int(corrector)
 
 
 class _Split:
-    """The coordinates of one splitting (central body first) and its compiled steps."""
+    """The coordinates of one splitting (central body first: row ``i`` is body
+    ``order[i]``), held in the arrays ``q``, ``u`` it is given, and its compiled
+    steps."""
 
-    def __init__(self, g: np.ndarray, jacobi: bool, corrector: int, extra: Any, p: np.ndarray,
-                 has_extra: bool) -> None:
-        self.g, self.jacobi, self.corrector = g, jacobi, corrector
+    def __init__(self, gm: np.ndarray, order: np.ndarray, jacobi: bool, corrector: int,
+                 extra: Any, p: np.ndarray, has_extra: bool) -> None:
+        g = np.ascontiguousarray(gm[order])  # a writeable copy, the order of the rows
+        self.gm, self.g, self.order, self.jacobi, self.corrector = gm, g, order, jacobi, corrector
         self.extra, self.p, self.has_extra = extra, p, has_extra
-        self.m_tot = g.sum()
+        self.q = self.u = np.empty((0, 3))
         if jacobi:
             self.eta = np.cumsum(g)
             self.ratio, self.inv_eta = _k.jacobi_factors(self.eta)
+            if corrector:
+                self.coef = corrector_coefficients(corrector)
         else:
-            self.g_p = g.copy()
-            self.g_p[0] = 0.0
+            self.com = np.empty(6)
 
-    def to_coordinates(self, r: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Jacobi positions and velocities (row 0 the barycentre), or heliocentric
-        positions and barycentric velocities (the barycentre kept in ``com``)."""
-        g = self.g
+    def renewed(self, gm: np.ndarray) -> _Split:
+        """The same splitting for new ``gm`` (after a merge or a removal), on the same
+        arrays."""
+        new = _Split(gm, self.order, self.jacobi, self.corrector, self.extra, self.p,
+                     self.has_extra)
+        new.q, new.u = self.q, self.u
+        return new
+
+    def from_inertial(self, r: np.ndarray, v: np.ndarray, q: np.ndarray, u: np.ndarray) -> None:
+        """Into ``q``, ``u`` (kept as the state): Jacobi positions and velocities (row 0
+        the barycentre), or heliocentric positions and barycentric velocities (the
+        barycentre kept in ``com``)."""
+        self.q, self.u = q, u
         if self.jacobi:
-            eta = self.eta
-            s_r = np.cumsum(g[:, None] * r, axis=0)
-            s_v = np.cumsum(g[:, None] * v, axis=0)
-            q = np.empty_like(r)
-            u = np.empty_like(v)
-            q[0] = s_r[-1] / eta[-1]
-            u[0] = s_v[-1] / eta[-1]
-            q[1:] = r[1:] - s_r[:-1] / eta[:-1, None]
-            u[1:] = v[1:] - s_v[:-1] / eta[:-1, None]
-            return q, u
-        self.com = np.concatenate([(g @ r) / self.m_tot, (g @ v) / self.m_tot])
-        return np.ascontiguousarray(r - r[0]), np.ascontiguousarray(v - self.com[3:])
+            _k.jacobi_from_inertial(r, v, self.g, self.eta, self.order, q, u)
+        else:
+            _k.dh_from_inertial(r, v, self.g, self.order, q, u, self.com)
 
-    def advance(self, q, u, dt, n_steps, last, watch, ev_out, ev_count, ws
-                ) -> tuple[int, int, int]:
+    def advance(self, dt, n_steps, last, watch, ev_out, ev_count, ws) -> tuple[int, int, int]:
         """``n_steps`` steps (the last of length ``last``), in true coordinates at both
         ends (the corrector applied around them); ``(steps, bad body or -1, status)``."""
         ev = (watch, ev_out, ev_count, ws)
+        q, u = self.q, self.u
         if not self.jacobi:
-            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.g_p,
-                                 self.com, dt, n_steps, last, *ev)
+            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.com,
+                                 dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
-        bad = _k.corrector_jacobi(*args, dt, 1.0) if self.corrector else -1
-        steps, status = 0, _k.STATUS_OK
-        if bad < 0:
-            steps, bad, status = _k.advance_jacobi(*args, dt, n_steps, last, *ev)
-        if bad < 0 and self.corrector:
-            bad = _k.corrector_jacobi(*args, dt, -1.0)
-        return steps, bad, status
+        if not self.corrector:
+            return _k.advance_jacobi(*args, dt, n_steps, last, *ev)
+        # the corrector conjugates a run of equal steps: a shortened last step gets
+        # its own (C(dt) K(dt)^(n-1) C(dt)^-1, then C(h) K(h) C(h)^-1, as WHFast does
+        # when its step changes)
+        runs = ((dt, n_steps - 1), (last, 1)) if n_steps > 1 and last != dt else (
+            (dt if n_steps > 1 else last, n_steps),)
+        done, bad, status = 0, -1, _k.STATUS_OK
+        for h, k in runs:
+            bad = _k.corrector_jacobi(*args, h, 1.0, *self.coef)
+            if bad < 0:
+                steps, bad, status = _k.advance_jacobi(*args, h, k, h, *ev)
+                done += steps
+            if bad < 0:
+                bad = _k.corrector_jacobi(*args, h, -1.0, *self.coef)
+            if bad >= 0 or status != _k.STATUS_OK:
+                break
+        return done, bad, status
 
-    def to_inertial(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Inertial positions and velocities (central body first)."""
-        g = self.g
+    def to_inertial(self, r: np.ndarray, v: np.ndarray, q: np.ndarray | None = None,
+                    u: np.ndarray | None = None) -> None:
+        """Inertial positions and velocities into ``r``, ``v`` (the caller's order)
+        from the coordinates ``q``, ``u`` (default the state); ``r is q`` (in place)
+        when the central body is first."""
+        q = self.q if q is None else q
+        u = self.u if u is None else u
         if self.jacobi:
-            rr = np.empty_like(q)
-            vv = np.empty_like(u)
-            _k.jacobi_to_inertial_pos(q, g, self.eta, self.ratio, self.inv_eta, rr)
-            _k.jacobi_to_inertial_pos(u, g, self.eta, self.ratio, self.inv_eta, vv)
-            return rr, vv
-        com = self.com
-        r0_in = com[:3] - (g[1:] @ q[1:]) / self.m_tot
-        v0_in = com[3:] - (g[1:] @ u[1:]) / g[0]
-        rr = q + r0_in
-        rr[0] = r0_in
-        vv = u + com[3:]
-        vv[0] = v0_in
-        return rr, vv
+            if r is q:
+                _k.jacobi_to_inertial_pos(q, self.g, self.eta, self.ratio, self.inv_eta, q)
+                _k.jacobi_to_inertial_pos(u, self.g, self.eta, self.ratio, self.inv_eta, u)
+            else:
+                _k.jacobi_to_inertial(q, u, self.g, self.eta, self.ratio, self.inv_eta,
+                                      self.order, r, v)
+        else:
+            _k.dh_to_inertial(q, u, self.g, self.com, self.order, r, v)

@@ -1,0 +1,128 @@
+"""Hamilton's integrals (C), (D), (E) of many states in one compiled pass.
+
+:func:`integral_sums` is what ``integrate`` computes for every trajectory: per
+output state, the vis-viva energy (E) ``sum gm v^2 / 2 - sum_{pairs} gm gm' / d``,
+the areal vector (D) ``sum gm r x v`` and the moments of the centre of gravity
+(C) ``sum gm``, ``sum gm r``, ``sum gm v``.  Bodies whose state is not finite
+(taken out of the run by an event) count as absent; test particles (``gm = 0``)
+add nothing and cost one pass over their rows.  The energy's sums are
+compensated (Neumaier), so that its rounding does not grow with the number of
+pairs.  No astropy here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["COLUMNS", "integral_errors", "integral_sums"]
+
+#: Columns of :func:`integral_sums`'s output.
+COLUMNS = ("energy", "lx", "ly", "lz", "gm", "rx", "ry", "rz", "vx", "vy", "vz")
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _add(s, c, x):  # pragma: no cover - compiled
+    """Neumaier's compensated ``s + x``: returns the new ``(s, c)``."""
+    t = s + x
+    if abs(s) >= abs(x):
+        c += (s - t) + x
+    else:
+        c += (x - t) + s
+    return t, c
+
+
+@njit(cache=True, error_model="numpy")
+def integral_sums(r, v, gm, gone, out):  # pragma: no cover - compiled
+    """Fill ``out`` (k, 11) with the sums of :data:`COLUMNS` for states ``r``,
+    ``v`` (k, n, 3); ``gm`` (m, n) with ``m = 1`` (one set of masses) or ``k``.
+
+    Returns the flat index ``t * n + i`` of the first body whose state is not
+    finite while ``gone[i]`` is False (a state lost by the integration), else -1.
+    """
+    k, n = r.shape[0], r.shape[1]
+    lost = -1
+    idx = np.empty(n, dtype=np.int64)
+    for t in range(k):
+        g = gm[t if gm.shape[0] > 1 else 0]
+        ek, ck = 0.0, 0.0
+        lx, ly, lz, total = 0.0, 0.0, 0.0, 0.0
+        rx, ry, rz, vx, vy, vz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        nm = 0
+        for i in range(n):
+            x0, x1, x2 = r[t, i, 0], r[t, i, 1], r[t, i, 2]
+            w0, w1, w2 = v[t, i, 0], v[t, i, 1], v[t, i, 2]
+            if not math.isfinite(x0 + x1 + x2 + w0 + w1 + w2):
+                if lost < 0 and not gone[i]:
+                    lost = t * n + i
+                continue
+            gi = g[i]
+            if gi == 0.0:
+                continue
+            idx[nm] = i
+            nm += 1
+            ek, ck = _add(ek, ck, 0.5 * gi * (w0 * w0 + w1 * w1 + w2 * w2))
+            lx += gi * (x1 * w2 - x2 * w1)
+            ly += gi * (x2 * w0 - x0 * w2)
+            lz += gi * (x0 * w1 - x1 * w0)
+            total += gi
+            rx += gi * x0
+            ry += gi * x1
+            rz += gi * x2
+            vx += gi * w0
+            vy += gi * w1
+            vz += gi * w2
+        ep, cp = 0.0, 0.0
+        for a in range(nm):
+            i = idx[a]
+            for b in range(a + 1, nm):
+                j = idx[b]
+                dx = r[t, i, 0] - r[t, j, 0]
+                dy = r[t, i, 1] - r[t, j, 1]
+                dz = r[t, i, 2] - r[t, j, 2]
+                d = math.sqrt(dx * dx + dy * dy + dz * dz)
+                if d > 0.0:
+                    ep, cp = _add(ep, cp, g[i] * g[j] / d)
+        out[t, 0] = (ek + ck) - (ep + cp)
+        out[t, 1], out[t, 2], out[t, 3], out[t, 4] = lx, ly, lz, total
+        out[t, 5], out[t, 6], out[t, 7] = rx, ry, rz
+        out[t, 8], out[t, 9], out[t, 10] = vx, vy, vz
+    return lost
+
+
+@njit(cache=True, error_model="numpy")
+def integral_errors(r, v, gm, t, gone, ee, ae, bd):  # pragma: no cover - compiled
+    """Hamilton's integrals' changes from the first state (the arithmetic of
+    :func:`hamilton_orbits.nbody.integral_errors`) into ``ee``, ``ae``, ``bd``
+    (k,): ``(E - E_0) / |E_0|``, ``|L - L_0| / |L_0|`` (absolute where the first
+    value is 0) and ``|R - R_0 - V_0 (t - t_0)| / s``, ``s`` the largest distance
+    of a finite body from the first centre of mass (1 if 0).  Returns as
+    :func:`integral_sums`."""
+    k = r.shape[0]
+    sums = np.empty((k, 11))
+    lost = integral_sums(r, v, gm, gone, sums)
+    e0 = abs(sums[0, 0])
+    l0 = math.sqrt(sums[0, 1] ** 2 + sums[0, 2] ** 2 + sums[0, 3] ** 2)
+    c0 = np.empty(6)
+    for c in range(6):
+        c0[c] = sums[0, 5 + c] / sums[0, 4]
+    scale = 0.0
+    for i in range(r.shape[1]):
+        d2 = (r[0, i, 0] - c0[0]) ** 2 + (r[0, i, 1] - c0[1]) ** 2 + (r[0, i, 2] - c0[2]) ** 2
+        if d2 > scale and d2 < math.inf:
+            scale = d2
+    scale = math.sqrt(scale) if scale > 0.0 else 1.0
+    for j in range(k):
+        de = sums[j, 0] - sums[0, 0]
+        ee[j] = de / e0 if e0 > 0.0 else de
+        dl = math.sqrt((sums[j, 1] - sums[0, 1]) ** 2 + (sums[j, 2] - sums[0, 2]) ** 2
+                       + (sums[j, 3] - sums[0, 3]) ** 2)
+        ae[j] = dl / l0 if l0 > 0.0 else dl
+        d2 = 0.0
+        for c in range(3):
+            x = sums[j, 5 + c] / sums[j, 4] - c0[c] - (t[j] - t[0]) * c0[3 + c]
+            d2 += x * x
+        bd[j] = math.sqrt(d2) / scale
+    return lost
