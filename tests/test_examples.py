@@ -93,6 +93,19 @@ def test_ensemble_comet_clones_quick(tmp_path):
     assert (tmp_path / "comet_clones.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow  # 2 x 64 cells in worker processes: ~15 s on a loaded 2-core machine
+def test_stability_map_quick(tmp_path):
+    """The MEGNO map runs (8 x 8 cells, both models), finds regular and chaotic
+    cells, and draws its figure."""
+    out = run("stability_map.py", str(tmp_path), "--quick")
+    rows = re.findall(r"(\d+) failed, chaotic \(MEGNO > 4\): ([\d.]+)%, median MEGNO of the "
+                      r"regular cells ([\d.]+)", out)
+    assert len(rows) == 2
+    for failed, chaotic, regular in rows:
+        assert int(failed) == 0 and 10 < float(chaotic) < 90 and abs(float(regular) - 2) < 0.1
+    assert (tmp_path / "stability_map.png").stat().st_size > 30_000
+
+
 def test_pole_prediction_quick(tmp_path):
     """The hindcast tables carry every method beside the published rows; figures written."""
     out = run("pole_prediction.py", str(tmp_path), "--quick")

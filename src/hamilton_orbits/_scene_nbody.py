@@ -98,6 +98,8 @@ SCHEMA: dict[str, S.Field] = {
     "duration": S.Quantity(kind=TIME, required=True, positive=True),
     "cadence": S.Quantity(kind=TIME, positive=True),
     "crosscheck": S.Bool(default=False),
+    # the variational equations: MEGNO and the Lyapunov time in the summary
+    "variational": S.Bool(default=False),
     "integrator": S.Table(
         default={},
         fields={
@@ -201,6 +203,12 @@ def _check(spec: dict, problems: S.Problems) -> None:
         problems.add("bodies", "the scene has no bodies")
     _check_effects(spec, names, problems)
     _check_events(spec, names, problems)
+    if spec["variational"] and spec["events"]:
+        problems.add("variational", "the variational equations are integrated without "
+                                    "events: remove `events` or set variational = false")
+    if spec["variational"] and spec["integrator"]["corrector"]:
+        problems.add("integrator.corrector", "not with variational = true (the corrector's "
+                                             "tangent map is not implemented)")
     _check_integrator(spec["integrator"], problems)
     _check_analyses(spec["analysis"], names, problems)
     if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
@@ -527,7 +535,12 @@ def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
     t_all = _times(spec).to_value(u.d)
     method, kw = _integrator_args(spec)
     effects = check_method(method, spec["effects"], kw["options"])
-    rhs = compile_rhs(system, effects)
+    tangent = None
+    if spec["variational"]:
+        from hamilton_orbits.integrators._tangent import Tangent
+
+        tangent = Tangent(len(system.names), len(t_all))
+    rhs = compile_rhs(system, effects, variational=tangent is not None)
     log = event_log(system, [{k: v for k, v in ev.items() if v is not None}
                              for ev in spec["events"]])
     arrays = system.as_arrays()
@@ -536,7 +549,7 @@ def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
         out = without_compilation(lambda: engine.run(
             arrays.r, arrays.v, arrays.gm, t_all, rhs, method, stop=stop,
             on_output=None if bar is None else (lambda i, steps: bar.update(1)), events=log,
-            **kw))
+            variational=tangent, **kw))
     finally:
         if bar is not None:
             bar.close()
@@ -544,6 +557,7 @@ def _run(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
         raise KeyboardInterrupt
     result = _result(scene, system, out, method, effects)
     _events_into(result, system, out)
+    _chaos_into(result, out)
     for an in spec["analysis"]:
         _ANALYSIS_FUNCS[an["name"]](result, system, an)
     if spec["crosscheck"] and result.complete:
@@ -570,6 +584,8 @@ def _events_into(result: Result, system, out) -> None:
         {"event": str(row["name"]), "time": row["time"], "bodies": str(row["bodies"]),
          "distance": row["distance"], "speed": row["speed"].to(u.km / u.s),
          "action": str(row["action"])} for row in table]
+
+
 def without_compilation(run: Any) -> Any:
     """``run()`` (an engine call), its ``wall_time`` less the numba compilation that
     happened inside it (the integration proper: a first run compiles the stepping
@@ -582,6 +598,39 @@ def without_compilation(run: Any) -> Any:
     out = run()
     compiled = compile_seconds() - before
     return dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
+
+
+def _chaos_into(result: Result, out) -> None:
+    """With ``variational = true``: MEGNO and the Lyapunov exponent at the end (as
+    rebound's ``sim.megno()`` and ``sim.lyapunov()``), the Lyapunov time
+    ``1 / lyapunov`` (infinite when the exponent is not positive: no exponential
+    growth measured), and MEGNO over time as a diagnostic and a figure."""
+    tan = out.variational
+    if tan is None:
+        return
+    k = len(out.t)
+    megno = tan.megno[:k]
+    lyap = float(tan.lyapunov[k - 1]) / u.d
+    result.diagnostics["megno"] = megno.copy()
+    result.metrics["MEGNO"] = float(megno[-1])
+    result.metrics["Lyapunov exponent"] = lyap.to(1 / u.yr)
+    result.metrics["Lyapunov time"] = (1 / lyap).to(u.yr) if lyap.value > 0 else np.inf * u.yr
+    result.plotters.append(_plot_megno)
+
+
+def _plot_megno(result: Result):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    t = result.times.to_value(u.yr)
+    ax.plot(t, result.diagnostics["megno"], lw=0.8, label="MEGNO <Y>")
+    ax.axhline(2.0, color="0.6", lw=0.6, ls=":", label="2 (quasi-periodic)")
+    ax.set_xlabel("time [yr]")
+    ax.set_ylabel("MEGNO <Y> (dimensionless)")
+    ax.set_title(f"{result.scene.name}: MEGNO")
+    ax.legend()
+    fig._hamilton_name = "megno"
+    return fig
 
 
 def _result(scene: Any, system, out, method: str, effects) -> Result:

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._kernels import jacobians as _jacobians
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.units import DIMENSIONLESS, LENGTH, SPEED, Kind, is_quantity
 
@@ -91,6 +92,14 @@ class EffectSpec:
         reads ``"299792.458 km/s"`` into a Quantity of that kind).
     name_parameters : tuple of str
         The parameters that name a body of the system (``"body"``, ``"source"``).
+    jacobian : numba dispatcher or None
+        ``"nbody"`` effects: a module-level compiled ``jacobian(r, v, gm, dr, dv,
+        da, p)`` that *adds* the effect's Jacobian times ``k`` tangent vectors to
+        ``da`` (see :mod:`hamilton_orbits._kernels.jacobians`), compiled only when
+        the variational equations are asked for.  None: the variational equations
+        differentiate ``kernel`` by central differences along each tangent vector
+        (compiled, generated in :mod:`hamilton_orbits.rhs`; about 1e-10 relative,
+        and two or four evaluations of the kernel per tangent vector).
     energy : callable or None
         ``"nbody"`` effects that keep an energy: ``energy(r, v, gm, p) -> ndarray``
         of shape (n_t, n) for states (n_t, n, 3): the effect's part of each body's
@@ -111,6 +120,7 @@ class EffectSpec:
     replaces_newtonian: bool = False
     parameter_kinds: Mapping[str, Kind] = field(default_factory=dict)
     name_parameters: tuple[str, ...] = ()
+    jacobian: Any = None
     energy: Callable[..., np.ndarray] | None = None
 
 
@@ -658,6 +668,7 @@ register(
             "c": "speed of light (default: c in au/day for Quantity systems)",
         },
         kernel=_nbody.gr_anderson,
+        jacobian=_jacobians.gr_anderson_jvp,
         params=_params_gr,
         parameter_kinds={"c": SPEED},
         name_parameters=("source",),
@@ -675,6 +686,7 @@ register(
             "c": "speed of light (default: c in au/day for Quantity systems)",
         },
         kernel=_nbody.gr_potential,
+        jacobian=_jacobians.gr_potential_jvp,
         params=_params_gr_potential,
         parameter_kinds={"c": SPEED},
         name_parameters=("source",),
@@ -693,6 +705,7 @@ register(
             "radius": "equatorial radius (default: the Body's radius)",
         },
         kernel=_nbody.j2_field,
+        jacobian=_jacobians.j2_field_jvp,
         params=_params_j2,
         parameter_kinds={"j2": DIMENSIONLESS, "radius": LENGTH},
         name_parameters=("body",),

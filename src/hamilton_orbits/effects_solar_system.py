@@ -23,6 +23,14 @@ effects, each computed only when listed:
     centred on the Sun, of the total GM of DE440's 36 ring masses (``MA8201`` ...
     ``MA8236``).
 
+Variational equations (``variational=True``): ``zonal`` and ``lense_thirring``
+have analytic Jacobians (:mod:`hamilton_orbits._kernels.jacobians`); ``eih``,
+``moon_figure``, ``earth_tides`` and ``kuiper_ring`` are differentiated by compiled
+central differences of their own kernels along each tangent vector (about 1e-10
+relative; see :class:`~hamilton_orbits.effects.EffectSpec`), which is what the
+time allowed: their analytic Jacobians (EIH's is three pages of terms, the Moon's
+frame and the tides' delays are nested functions of the state) are left for later.
+
 The Sun's J2 is the existing ``j2`` effect (``{"name": "j2", "body": "sun"}``):
 :meth:`~hamilton_orbits.nbody.System.from_ephemeris` gives the Sun DE440's
 ``J2SUN`` and ``ASUN`` about its IAU pole.
@@ -51,6 +59,7 @@ import numpy as np
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels import figures as _figures
+from hamilton_orbits._kernels import jacobians as _jacobians
 from hamilton_orbits._kernels import relativity as _relativity
 
 __all__ = [
@@ -285,6 +294,7 @@ SPECS: tuple[dict[str, Any], ...] = (
                        "c": "default DE440's CLIGHT", "gamma": "default DE440's GAMMA",
                        "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
         "kernel": _relativity.lense_thirring, "params": _params_lense_thirring,
+        "jacobian": _jacobians.lense_thirring_jvp,
         "reference": f"IERS Conventions (2010), eq. 10.12; {_PARK}",
     },
     {
@@ -296,6 +306,7 @@ SPECS: tuple[dict[str, Any], ...] = (
                        "pole": "pole vector (default the Body's pole)",
                        "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
         "kernel": _figures.zonal_field, "params": _params_zonal,
+        "jacobian": _jacobians.zonal_field_jvp,
         "reference": f"Moyer (1971), JPL TR 32-1527, eqs. 173-174; {_PARK}",
     },
     {

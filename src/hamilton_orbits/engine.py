@@ -63,6 +63,9 @@ class EngineRun:
     gm : ndarray, shape (n,) or (k, n)
         ``G m`` of every body; per output, (k, n), when merges or removals
         changed it during the run.
+    variational : Tangent or None
+        The variational equations of the run (MEGNO, the Lyapunov exponent and the
+        STM at the outputs), when they were asked for.
     """
 
     t: np.ndarray
@@ -73,6 +76,7 @@ class EngineRun:
     complete: bool
     events: EventLog | None
     gm: np.ndarray
+    variational: Any = None
 
 
 def integrator(method: str) -> Integrator:
@@ -113,6 +117,7 @@ def run(
     on_output: Callable[[int, int], None] | None = None,
     stop: Callable[[], bool] | None = None,
     events: EventLog | None = None,
+    variational: Any = None,
 ) -> EngineRun:
     """Integrate from ``(r0, v0)`` at ``t_out[0]`` through the output times.
 
@@ -139,6 +144,10 @@ def run(
     events : EventLog, optional
         Events to watch (:mod:`hamilton_orbits.events`); an event whose action is
         ``"stop"`` ends the run at its time (the last output row).
+    variational : Tangent, optional
+        Tangent vectors to integrate beside the state
+        (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
+        ``variational=True``); forwards in time and without events.
 
     Returns
     -------
@@ -179,6 +188,11 @@ def run(
             raise StopIntegration
 
     kw = dict(options or {})
+    if variational is not None:
+        if backward or (events is not None and len(events.watch)):
+            raise ValueError("The variational equations are integrated forwards in time and "
+                             "without events; integrate forwards, with no events listed")
+        kw["variational"] = variational
     if events is not None and len(events.watch):
         if backward:
             raise ValueError("Events are watched forwards in time only; integrate forwards")
@@ -203,4 +217,4 @@ def run(
     if backward:  # in place: no second copy of the history
         np.negative(v_out, out=v_out)
     return EngineRun(t_reached[:k], r_out[:k], v_out[:k], reached[1], wall, complete,
-                     events, gm_out)
+                     events, gm_out, variational)

@@ -20,6 +20,7 @@ import numpy as np
 
 from hamilton_orbits import engine
 from hamilton_orbits._firstrun import compile_seconds
+from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.integrators import INTEGRATORS
@@ -75,6 +76,22 @@ class Trajectory(TrajectoryBase):
         ``speed``, ``action``); empty when none was listed or found.
     stopped_by : astropy.table.Row or None
         The row of the event that ended the run, if one did.
+    megno : ndarray, shape (n_t,) or None
+        With ``variational=True``: MEGNO ``<Y>(t)`` (Cincotta & Simo 2000), as
+        rebound's ``sim.megno()``; it tends to 2 on a quasi-periodic orbit, 0 on a
+        stable periodic one, and grows like ``lambda t / 2`` on a chaotic one.  0 at
+        the start.
+    lyapunov : ndarray or Quantity, shape (n_t,) or None
+        With ``variational=True``: the Lyapunov exponent as rebound's
+        ``sim.lyapunov()`` defines it, the slope of the least-squares line through
+        ``<Y>(t)`` over the steps so far (Cincotta & Simo 2000, eq. 24), in 1/(the
+        unit of ``t``); ``1 / lyapunov`` is the Lyapunov time.  For ``|delta|``
+        growing like ``exp(lambda t)``, ``<Y> ~ lambda t / 2``: this slope is
+        ``lambda / 2`` of the growth rate of the tangent vector.
+    stm : ndarray, shape (n_t, 6n, 6n) or None
+        With ``stm=True``: the state transition matrix ``d(r, v)(t) / d(r, v)(0)``,
+        coordinates body by body (x, y, z, vx, vy, vz of body 0, then body 1, ...),
+        in the system's internal units (au and days for a Quantity system).
     """
 
     r: Any
@@ -90,6 +107,9 @@ class Trajectory(TrajectoryBase):
     #: (the events log, the system and the time unit): an astropy table costs
     #: ~0.1 ms, more than the rest of a short call's wrapping.
     event_source: Any = field(default=None, repr=False)
+    megno: Any = None
+    lyapunov: Any = None
+    stm: Any = None
 
     @functools.cached_property
     def final(self) -> System:
@@ -170,7 +190,7 @@ def _options_of(run: Any) -> list[str]:
     common ones), read once per driver."""
     import inspect
 
-    common = {"dt", "tol", "on_output", "out", "events", "stop"}
+    common = {"dt", "tol", "on_output", "out", "events", "stop", "variational"}
     return [name for name, p in inspect.signature(run).parameters.items()
             if p.kind is p.KEYWORD_ONLY and name not in common]
 
@@ -185,6 +205,9 @@ def integrate(
     progress: bool = False,
     on_output: Any = None,
     events: Any = (),
+    variational: bool = False,
+    stm: bool = False,
+    tangent: Any = None,
     **options: Any,
 ) -> Trajectory:
     """Integrate Hamilton's equation (B) (plus the listed effects) for ``system``.
@@ -214,6 +237,18 @@ def integrate(
         ``escape`` (see :mod:`hamilton_orbits.events`); the trajectory's
         ``events`` table lists them and ``stopped_by`` names the one that ended
         the run, if any.
+    variational : bool
+        Integrate the first-order variational equations beside the system (every
+        listed effect's Jacobian included): the trajectory then has ``megno`` and
+        ``lyapunov`` (from one tangent vector, as rebound's MEGNO; see
+        ``docs/variational.md``).  Forwards in time, without events.
+    stm : bool
+        With ``variational``: also the state transition matrix ``traj.stm`` (6n
+        more tangent vectors).
+    tangent : array_like, shape (n, 6), optional
+        MEGNO's initial tangent vector (x, y, z, vx, vy, vz per body, internal
+        units); default: random, each body's six components of unit length, as
+        rebound's ``init_megno`` draws it (a fixed seed).
     **options
         Options of the chosen integrator, e.g. for ``wh``
         ``coordinates="jacobi"`` and ``corrector=3`` (or 5, 7, 11, 17; see its
@@ -245,6 +280,9 @@ def integrate(
     >>> jac = integrate(s, 2 * np.pi, method="wh", dt=0.1, coordinates="jacobi", corrector=3)
     >>> bool(np.allclose(jac.final["dust"].r, [1, 0, 0], atol=1e-12))  # a Kepler orbit: exact
     True
+    >>> var = integrate(s, 2 * np.pi, method="wh", dt=0.1, variational=True, stm=True)
+    >>> var.stm.shape, var.megno.shape  # d(r, v)(t)/d(r, v)(0) of both bodies; MEGNO
+    ((2, 12, 12), (2,))
     >>> integrate(s, 1.0, method="leapfrog", dt=0.1, effects=["gr"])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -259,18 +297,45 @@ def integrate(
         tol = DIMENSIONLESS.scalar("tol", tol)
         if not 0.0 < tol < 1.0:
             raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
-    rhs = compile_rhs(system, eff)
+    tan = _tangent(system, len(times), variational, stm, tangent)
+    rhs = compile_rhs(system, eff, variational=tan is not None)
     log = event_log(system, events)
     arrays = system.as_arrays()
     with _progress(progress, method, len(times) - 1, on_output) as report:
         compiled = compile_seconds()
         out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
-                         options=options, on_output=report, events=log)
+                         options=options, on_output=report, events=log, variational=tan)
         compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
     out = dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
     if not out.complete:
         raise KeyboardInterrupt
     return make_trajectory(system, out, unit, method, rhs.effects, eff)
+
+
+def _tangent(system: System, n_t: int, variational: Any, stm: Any, vector: Any) -> Any:
+    """The :class:`~hamilton_orbits.integrators._tangent.Tangent` of a run, or None."""
+    if not isinstance(variational, bool) or not isinstance(stm, bool):
+        raise ValueError(f"Expected `variational` and `stm` to be True or False, got "
+                         f"{variational!r}, {stm!r}")
+    if stm and not variational:
+        raise ValueError("`stm=True` needs `variational=True` (the STM is integrated with "
+                         "the variational equations)")
+    if not variational:
+        if vector is not None:
+            raise ValueError("`tangent` is MEGNO's initial tangent vector: it needs "
+                             "`variational=True`")
+        return None
+    from hamilton_orbits.integrators._tangent import Tangent
+
+    n = len(system.names)
+    if vector is not None:
+        vec = as_float_array("tangent", vector)
+        if vec.size != 6 * n:
+            raise ValueError(f"Expected `tangent` to have shape ({n}, 6), got {vec.shape}")
+        if not np.any(vec):
+            raise ValueError("Expected `tangent` to be nonzero, got all zeros")
+        vector = vec.reshape(n, 6)
+    return Tangent(n, n_t, stm=stm, vector=vector)
 
 
 def event_log(system: System, events: Any) -> EventLog | None:
@@ -398,11 +463,19 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         v_out: Any = v << (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
+    tan = out.variational
+    megno = lyap = stm = None
+    if tan is not None:
+        k = len(times)
+        megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
+        stm = tan.stm[:k].copy() if tan.stm is not None else None
+        if system.quantity:
+            lyap = (lyap / u.day).to(1 / unit)
     return Trajectory(
         t=t_out, r=r_out, v=v_out, names=system.names, final_source=final, energy_error=ee,
         angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
         wall_time=out.wall_time, method=method, effects=effects,
-        event_source=(out.events, system, unit),
+        event_source=(out.events, system, unit), megno=megno, lyapunov=lyap, stm=stm,
     )
 
 

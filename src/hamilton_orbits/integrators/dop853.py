@@ -21,7 +21,7 @@ import numpy as np
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import output_arrays
+from hamilton_orbits.integrators import _tangent, output_arrays
 
 NAME = "dop853"
 ACCEPTS_VELOCITY_DEPENDENT = True
@@ -40,9 +40,17 @@ def run(
     on_output: Callable[[int, int], None] | None = None,
     out: tuple[np.ndarray, np.ndarray] | None = None,
     events: EventLog | None = None,
+    tangent_control: bool = False,
+    variational: Any = None,
     stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with scipy's DOP853; see :mod:`hamilton_orbits.integrators`.
+
+    ``variational`` (a :class:`hamilton_orbits.integrators._tangent.Tangent`, ``rhs``
+    compiled with ``variational=True``) integrates the augmented system (the
+    bodies, the tangent vectors and MEGNO's integral); the tangent vectors take
+    part in the error control only with ``tangent_control=True``.  Not with
+    ``events``.
 
     ``events`` (:mod:`hamilton_orbits.events`) are looked for in every step on the
     cubic Hermite interpolant of the step's ends; actions take effect at the
@@ -85,6 +93,10 @@ def run(
             on_output(i, steps)
 
     max_step = np.inf if dt is None else float(dt)
+    if variational is not None:
+        return _tangent.run_dop853(rhs, r0, v0, gm, t_out, variational, tol=tol, atol=atol,
+                                   max_step=max_step, control=bool(tangent_control),
+                                   on_output=on_output, out=out)
     if events is not None and len(events.watch):
         steps = _run_with_events(f, y0, t_out, tol, atol, max_step, events, gm, store)
     else:

@@ -16,7 +16,7 @@ import numpy as np
 from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _tangent, output_arrays
 from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run"]
@@ -51,6 +51,7 @@ def run(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     max_steps: int = MAX_FIXED_STEPS,
     events: EventLog | None = None,
+    variational: Any = None,
     stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
@@ -58,7 +59,10 @@ def run(
     ``max_steps`` bounds the steps of the whole run; more are refused before the
     run starts (``ValueError``).  ``events`` (:mod:`hamilton_orbits.events`) are
     looked for on both straight drifts of every step, exactly for the map's own
-    motion; actions take effect at the end of the step.
+    motion; actions take effect at the end of the step.  ``variational`` (a
+    :class:`hamilton_orbits.integrators._tangent.Tangent`, ``rhs`` compiled with
+    ``variational=True``) carries tangent vectors through the exact tangent map of
+    every step (symplectic, as the map); not with ``events``.
 
     Examples
     --------
@@ -75,6 +79,11 @@ def run(
             raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
         dt = choose_dt(r0, v0, gm, tol)
     check_step_count(float(t_out[-1] - t_out[0]), float(dt), max_steps, NAME)
+    if variational is not None:
+        return _tangent.run_leapfrog(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
+                                     np.ascontiguousarray(gm, dtype=np.float64), t_out,
+                                     variational, dt=float(dt), on_output=on_output, out=out,
+                                     stop=stop)
     r = np.ascontiguousarray(r0, dtype=np.float64).copy()
     v = np.ascontiguousarray(v0, dtype=np.float64).copy()
     gm = np.ascontiguousarray(gm, dtype=np.float64)

@@ -44,7 +44,7 @@ import numpy as np
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, _setup, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "PRECISIONS", "RADAU_SPACINGS",
            "run"]
@@ -79,6 +79,8 @@ def run(
     max_steps: int = MAX_STEPS,
     criterion: str = DEFAULT_CRITERION,
     events: EventLog | None = None,
+    tangent_control: bool = False,
+    variational: Any = None,
     stop: Callable[[], bool] | None = None,
     precision: str = "double",
 ) -> tuple[np.ndarray, np.ndarray, int]:
@@ -123,6 +125,15 @@ def run(
         (:mod:`hamilton_orbits.events`).  A stop raises
         :class:`~hamilton_orbits.events.StopAtEvent` with the output row that
         holds the state at that time.
+    tangent_control : bool, optional
+        With ``variational``: let the tangent vectors take part in the step-size
+        control (default False: the step is chosen from the bodies alone, and the
+        tangent vectors, integrated by the same steps, do not shorten it).
+    variational : Tangent, optional
+        The variational equations to integrate beside the state
+        (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
+        ``variational=True``); MEGNO, the Lyapunov exponent and the STM are written
+        into it at the outputs.  Not with ``events``.
     precision : {"double", "double-double"}, optional
         ``"double-double"``: every number a double-double (about 32 digits;
         :mod:`hamilton_orbits._kernels.radau15_dd`), at fixed steps of ``dt``
@@ -164,6 +175,9 @@ def run(
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
     if precision != "double":
+        if variational is not None:
+            raise ValueError("radau15 in double-double integrates no variational equations; "
+                             "use precision='double' with variational=True")
         return _run_double_double(rhs, r0, v0, gm, t_out, dt, tol, on_output, out, events,
                                   precision)
     if criterion not in CRITERIA:
@@ -181,6 +195,11 @@ def run(
     span = t_out[-1] - t_out[0]
     if span > 0.0:
         dt_f = min(dt_f, span)
+    if variational is not None:
+        return _tangent.run_radau15(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
+                                    tol=tol_f or 0.0, prs23=crit == "prs23", max_steps=max_steps,
+                                    slice_steps=SLICE, control=bool(tangent_control),
+                                    on_output=on_output, out=out, stop=stop)
     log = events if events is not None else EventLog.none(r0.shape[0])
     run_ = _Run(rhs, r0, v0, gm.copy(), t_out[0], dt_f, tol_f or 0.0, crit == "prs23", log)
     run_.stop = stop

@@ -66,7 +66,13 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import WH_CORRECTORS, StopIntegration, _setup, output_arrays
+from hamilton_orbits.integrators import (
+    WH_CORRECTORS,
+    StopIntegration,
+    _setup,
+    _tangent,
+    output_arrays,
+)
 
 __all__ = [
     "ACCEPTS_VELOCITY_DEPENDENT",
@@ -135,6 +141,7 @@ def run(
     corrector: int = 0,
     max_steps: int = _setup.MAX_FIXED_STEPS,
     events: EventLog | None = None,
+    variational: Any = None,
     stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
@@ -179,6 +186,12 @@ def run(
         (democratic heliocentric; escapes measured from the central body) or on
         the Hermite interpolant of the inertial states (Jacobi).  Actions take
         effect at the end of the step the event occurred in.
+    variational : Tangent, optional
+        Tangent vectors to carry through the exact tangent map of every step
+        (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled
+        with ``variational=True``): the Kepler drift's derivative and the kick's
+        Jacobian, symplectic as the map.  The steps are then synchronised one by
+        one (as WHFast's ``safe_mode``); not with ``events`` or ``corrector``.
 
     Returns
     -------
@@ -210,13 +223,18 @@ def run(
     100
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    dt_f, tol_f, corrector = _check_options(rhs, dt, tol, coordinates, corrector)
+    dt_f, tol_f, corrector = _check_options(rhs, dt, tol, coordinates, corrector,
+                                            variational is not None)
     c = int(np.argmax(gm))
     if not gm[c] > 0.0:
         raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
     if dt_f is None:
         dt_f = default_step(r0, v0, gm, tol_f)
     _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
+    if variational is not None:
+        return _tangent.run_wh(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
+                               jacobi=coordinates == "jacobi", on_output=on_output, out=out,
+                               stop=stop)
     n = r0.shape[0]
     # the central body first (row i of the coordinates is body order[i])
     order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
@@ -402,7 +420,8 @@ def corrector_coefficients(order: int) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
-def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int):
+def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int,
+                   variational: bool = False):
     if rhs.velocity_dependent:
         raise ValueError(
             f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
@@ -423,6 +442,9 @@ def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int
             f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
             "(the correctors are defined for the Jacobi splitting)"
         )
+    if corrector and variational:
+        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
+                         "is not implemented); use corrector=0")
     return dt_f, tol_f, int(corrector)
 
 

@@ -1,0 +1,389 @@
+"""The variational equations in every integrator (``variational=True``).
+
+:class:`Tangent` is what a run is asked for: one tangent vector for MEGNO and the
+Lyapunov exponent (random, as rebound's ``init_megno`` draws it, or given), and,
+with ``stm=True``, the ``6n`` columns of the state transition matrix (the
+identity at the start); it holds the MEGNO state and receives the outputs.  The
+drivers here carry the tangent vectors through each method, beside the state:
+
+- ``radau15`` integrates the augmented system (bodies, then tangent vectors) with
+  the same steps; the step size comes from the bodies alone unless
+  ``tangent_control=True`` (:func:`hamilton_orbits._kernels.radau15.advance_variational`);
+- ``wh`` and ``leapfrog`` apply the exact tangent map of each step (the Kepler
+  drift's derivative, the kick's Jacobian: :mod:`hamilton_orbits._kernels.wh_tangent`,
+  :func:`hamilton_orbits._kernels.variational.advance_leapfrog`), symplectic like
+  the map itself;
+- ``dop853`` integrates the augmented system, the MEGNO integral one more
+  component, with the tangent components left out of the error control unless
+  ``tangent_control=True``.
+
+Tangent vectors are ``(dr, dv)`` arrays of shape (k n, 3), row ``m n + i`` body
+``i`` of vector ``m``; vector 0 is MEGNO's, vectors ``1 + 6 i + c`` start as the
+unit displacement of coordinate ``c`` (x, y, z, vx, vy, vz) of body ``i``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits._kernels import radau15 as _radau
+from hamilton_orbits._kernels import variational as _var
+from hamilton_orbits._kernels import wh as _wh
+from hamilton_orbits._kernels import wh_tangent as _wht
+from hamilton_orbits._validation import ConvergenceError
+from hamilton_orbits.integrators import StopIntegration, output_arrays
+from hamilton_orbits.integrators._setup import accel_arg
+
+__all__ = ["DEFAULT_SEED", "SLICE", "Tangent", "run_dop853", "run_leapfrog",
+           "run_radau15", "run_wh"]
+
+#: The seed of the random tangent vector of MEGNO when none is given.
+DEFAULT_SEED = 2275
+#: Steps per compiled call of the fixed-step tangent maps (as the plain drivers of
+#: wh and leapfrog): ``stop()`` and Ctrl-C are seen between calls.
+SLICE = 100_000
+
+
+class Tangent:
+    """The tangent vectors of one run and what is computed from them.
+
+    Parameters
+    ----------
+    n : int
+        Bodies.
+    n_t : int
+        Output times.
+    stm : bool
+        Also carry the ``6n`` columns of the state transition matrix.
+    vector : ndarray, shape (n, 6), optional
+        MEGNO's initial tangent vector (x, y, z, vx, vy, vz per body).  Default: as
+        rebound's ``init_megno``, each body's six components drawn from a standard
+        normal distribution and scaled to unit length (seed :data:`DEFAULT_SEED`).
+
+    Attributes
+    ----------
+    megno, lyapunov : ndarray, shape (n_t,)
+        MEGNO ``<Y>`` and the Lyapunov exponent at the outputs (0 at the start).
+    stm : ndarray, shape (n_t, 6n, 6n) or None
+        The state transition matrices at the outputs (never rescaled; MEGNO's
+        vector is, inside the kernels, when it passes 1e100: see
+        :func:`hamilton_orbits._kernels.variational.renormalise`).
+    ms : ndarray
+        The MEGNO state (:data:`hamilton_orbits._kernels.variational.MEGNO_FIELDS`).
+
+    Examples
+    --------
+    >>> tan = Tangent(2, 3, stm=True)
+    >>> tan.k, tan.dr0.shape, tan.stm[0].tolist() == np.eye(12).tolist()
+    (13, (26, 3), True)
+    >>> bool(np.allclose(np.linalg.norm(np.hstack([tan.dr0[:2], tan.dv0[:2]]), axis=1), 1))
+    True
+    """
+
+    def __init__(self, n: int, n_t: int, *, stm: bool = False, vector: Any = None,
+                 seed: int = DEFAULT_SEED) -> None:
+        if vector is None:
+            vector = np.random.default_rng(seed).normal(size=(n, 6))
+            vector /= np.linalg.norm(vector, axis=1, keepdims=True)
+        vector = np.asarray(vector, dtype=np.float64).reshape(n, 6)
+        self.n = n
+        self.k = 1 + (6 * n if stm else 0)
+        self.dr0 = np.zeros((self.k * n, 3))
+        self.dv0 = np.zeros((self.k * n, 3))
+        self.dr0[:n] = vector[:, :3]
+        self.dv0[:n] = vector[:, 3:]
+        for j in range(6 * n if stm else 0):
+            i, c = divmod(j, 6)
+            (self.dr0 if c < 3 else self.dv0)[(1 + j) * n + i, c % 3] = 1.0
+        self.ms = np.zeros(len(_var.MEGNO_FIELDS))
+        self.megno = np.zeros(n_t)
+        self.lyapunov = np.zeros(n_t)
+        self.stm = np.zeros((n_t, 6 * n, 6 * n)) if stm else None
+        if stm:
+            self.stm[0] = np.eye(6 * n)
+
+    def start(self, t0: float) -> None:
+        """Start MEGNO at ``t0`` (``<Y> = 0`` there)."""
+        self.ms[:] = 0.0
+        self.ms[0] = t0
+        self.ms[8] = _var.log_norm(self.dr0, self.dv0, self.n, 0)
+
+    def record(self, i: int, t: float, dr: np.ndarray, dv: np.ndarray) -> None:
+        """Output ``i`` at time ``t``: ``<Y> = Yss / (t - t0)`` and the Lyapunov
+        exponent ``cov(t, <Y>) / var(t)`` from the MEGNO state, and the STM's
+        columns from tangent vectors 1 ... 6n."""
+        ms = self.ms
+        s = t - ms[0]
+        self.megno[i] = ms[2] / s if s > 0 else 0.0
+        self.lyapunov[i] = ms[6] / ms[7] if ms[7] > 0 else 0.0
+        if self.stm is not None:
+            n = self.n
+            cols = np.concatenate([dr[n:].reshape(6 * n, n, 3), dv[n:].reshape(6 * n, n, 3)],
+                                  axis=2)
+            self.stm[i] = cols.reshape(6 * n, 6 * n).T
+
+
+def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+                tangent: Tangent, *, dt: float, tol: float, prs23: bool, max_steps: int,
+                slice_steps: int, control: bool,
+                on_output: Callable[[int, int], None] | None,
+                out: tuple[np.ndarray, np.ndarray] | None,
+                stop: Callable[[], bool] | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """``radau15`` with the tangent vectors (:func:`hamilton_orbits._kernels.radau15.
+    advance_variational`); the arguments as the driver has checked them, ``control``
+    True to let the tangent vectors take part in the step control; ``stop()`` asked
+    between slices of ``slice_steps`` steps (True raises :class:`StopIntegration`)."""
+    n = r0.shape[0]
+    gm = np.array(gm, dtype=np.float64)  # writable (the kernels' signatures take no read-only)
+    x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
+    w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
+    m = 3 * x.shape[0]
+    work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
+    csx, csv = np.zeros(m), np.zeros(m)
+    st = np.zeros(_radau.NSTATE)
+    st[[0, 2, 4, 7]] = t_out[0], dt, tol, float(prs23)
+    accel = accel_arg(rhs.augmented)
+    n_phys = x.shape[0] if control else n
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    tangent.start(float(t_out[0]))
+    total = 0
+    for i in range(1, t_out.shape[0]):
+        while True:
+            steps, status = _radau.advance_variational(
+                accel, rhs.p, x, w, gm, t_out[i], st, *work, csx, csv,
+                bool(rhs.velocity_dependent), min(slice_steps, max_steps - total), n_phys,
+                tangent.ms)
+            total += steps
+            if status == _radau.STATUS_OK:
+                break
+            if status != _radau.STATUS_MAXSTEPS or total >= max_steps:
+                raise ConvergenceError(
+                    f"radau15 (variational) stopped at t = {float(st[0])!r} before t_out[{i}] "
+                    f"= {float(t_out[i])!r} (status {status}: a non-finite acceleration, an "
+                    f"underflowing step, or more than max_steps = {max_steps} steps)")
+            if stop is not None and stop():
+                raise StopIntegration
+        r_out[i], v_out[i] = x[:n], w[:n]
+        tangent.record(i, float(t_out[i]), x[n:], w[n:])
+        if on_output is not None:
+            on_output(i, total)
+    return r_out, v_out, total
+
+
+def _tangent_arg(fn: Any) -> Any:
+    """A tangent right-hand side in the form a kernel's first-class function
+    argument takes (the compile result's wrapper, as :func:`_setup.accel_arg`)."""
+    from numba.core.types.function_type import CompileResultWAP
+
+    from hamilton_orbits._kernels.jacobians import TANGENT_SIGNATURE
+
+    if not hasattr(fn, "get_compile_result"):
+        return fn
+    return CompileResultWAP(fn.get_compile_result(TANGENT_SIGNATURE))
+
+
+def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+                 tangent: Tangent, *, dt: float,
+                 on_output: Callable[[int, int], None] | None,
+                 out: tuple[np.ndarray, np.ndarray] | None,
+                 stop: Callable[[], bool] | None = None,
+                 slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
+    """``leapfrog`` with the exact tangent map of each step
+    (:func:`hamilton_orbits._kernels.variational.advance_leapfrog`), in slices of
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
+    r = np.ascontiguousarray(r0, dtype=np.float64).copy()
+    v = np.ascontiguousarray(v0, dtype=np.float64).copy()
+    gm = np.array(gm, dtype=np.float64)  # writable (the kernel's signature takes no read-only)
+    dr, dv = tangent.dr0.copy(), tangent.dv0.copy()
+    accel, jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
+    r_out, v_out = output_arrays(out, t_out.shape[0], r, v)
+    tangent.start(float(t_out[0]))
+    steps = 0
+    for i in range(1, t_out.shape[0]):
+        t, t1 = float(t_out[i - 1]), float(t_out[i])
+        while True:  # the steps and times of the plain kernel's slices
+            n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
+            done = _var.advance_leapfrog(accel, jac, rhs.p, r, v, gm, dr, dv, t, t1, dt,
+                                         tangent.ms, slice_steps)
+            steps += done
+            if done >= n_left:
+                break
+            t = t + done * ((t1 - t) / n_left)
+            if stop is not None and stop():
+                raise StopIntegration
+        r_out[i], v_out[i] = r, v
+        tangent.record(i, float(t_out[i]), dr, dv)
+        if on_output is not None:
+            on_output(i, steps)
+    return r_out, v_out, steps
+
+
+def _to_split(r: np.ndarray, v: np.ndarray, g: np.ndarray, jacobi: bool
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Jacobi coordinates (row 0 the barycentre), or heliocentric positions,
+    barycentric velocities and the barycentre (6,), of states ``(..., n, 3)`` with
+    the central body first; linear, so tangent vectors transform alike."""
+    m_tot = g.sum()
+    s_r = np.cumsum(g[:, None] * r, axis=-2)
+    s_v = np.cumsum(g[:, None] * v, axis=-2)
+    if jacobi:
+        eta = np.cumsum(g)
+        q, u = np.empty_like(r), np.empty_like(v)
+        q[..., 0, :], u[..., 0, :] = s_r[..., -1, :] / m_tot, s_v[..., -1, :] / m_tot
+        q[..., 1:, :] = r[..., 1:, :] - s_r[..., :-1, :] / eta[:-1, None]
+        u[..., 1:, :] = v[..., 1:, :] - s_v[..., :-1, :] / eta[:-1, None]
+        return q, u, np.zeros(r.shape[:-2] + (6,))
+    com = np.concatenate([s_r[..., -1, :], s_v[..., -1, :]], axis=-1) / m_tot
+    return r - r[..., :1, :], v - com[..., None, 3:], com
+
+
+def _from_split(q: np.ndarray, u: np.ndarray, com: np.ndarray, g: np.ndarray, jacobi: bool
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The inverse of :func:`_to_split` (inertial states, central body first)."""
+    if jacobi:
+        eta = np.cumsum(g)
+        ratio, inv = _wh.jacobi_factors(eta)
+        rr, vv = np.empty_like(q), np.empty_like(u)
+        for src, dst in ((q, rr), (u, vv)):
+            for blk in range(src.shape[0] if src.ndim == 3 else 1):
+                a = src[blk] if src.ndim == 3 else src
+                b = dst[blk] if dst.ndim == 3 else dst
+                _wh.jacobi_to_inertial_pos(np.ascontiguousarray(a), g, eta, ratio, inv, b)
+        return rr, vv
+    m_tot = g.sum()
+    r0 = com[..., :3] - np.einsum("i,...ic->...c", g[1:], q[..., 1:, :]) / m_tot
+    v0 = com[..., 3:] - np.einsum("i,...ic->...c", g[1:], u[..., 1:, :]) / g[0]
+    rr = q + r0[..., None, :]
+    rr[..., 0, :] = r0
+    vv = u + com[..., None, 3:]
+    vv[..., 0, :] = v0
+    return rr, vv
+
+
+def run_wh(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+           tangent: Tangent, *, dt: float, jacobi: bool,
+           on_output: Callable[[int, int], None] | None,
+           out: tuple[np.ndarray, np.ndarray] | None,
+           stop: Callable[[], bool] | None = None,
+           slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
+    """``wh`` (synchronised steps, :mod:`hamilton_orbits._kernels.wh_tangent`) with the
+    exact tangent map; the central body (largest GM) first inside; in slices of
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
+    n, k = r0.shape[0], tangent.k
+    c = int(np.argmax(gm))
+    order = np.concatenate([[c], np.delete(np.arange(n), c)])
+    inv_order = np.argsort(order)
+    g = np.ascontiguousarray(gm[order])
+    q, u, com = (np.ascontiguousarray(a) for a in _to_split(r0[order], v0[order], g, jacobi))
+    dq, du, dcom = (np.ascontiguousarray(a) for a in _to_split(
+        tangent.dr0.reshape(k, n, 3)[:, order], tangent.dv0.reshape(k, n, 3)[:, order], g,
+        jacobi))
+    dq, du = dq.reshape(k * n, 3), du.reshape(k * n, 3)
+    has_extra = rhs.extra is not None
+    extra = accel_arg(rhs.extra if has_extra else rhs.accel)
+    if jacobi:
+        eta = np.cumsum(g)
+        jac = _tangent_arg(rhs.tangent)
+    else:
+        g_p = g.copy()
+        g_p[0] = 0.0
+        jac = _tangent_arg(rhs.tangent_extra if has_extra else rhs.tangent)
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    tangent.start(float(t_out[0]))
+    total = 0
+    for i in range(1, t_out.shape[0]):
+        span = t_out[i] - t_out[i - 1]
+        n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+        last = span - (n_steps - 1) * dt
+        done = 0
+        while done < n_steps:
+            if done and stop is not None and stop():
+                raise StopIntegration
+            n_call = min(n_steps - done, slice_steps)  # stop() is asked between calls
+            h_last = last if done + n_call == n_steps else dt
+            t_call = float(t_out[i - 1] + done * dt)
+            if jacobi:
+                steps, bad = _wht.advance_jacobi(extra, jac, rhs.p, has_extra, q, u, g, eta, dq,
+                                                 du, dt, n_call, h_last, t_call, tangent.ms)
+            else:
+                steps, bad = _wht.advance_dh(extra, jac, rhs.p, has_extra, q, u, g, g_p, com,
+                                             dq, du, dcom, dt, n_call, h_last, t_call,
+                                             tangent.ms)
+            done += steps
+            total += steps
+            if bad >= 0:
+                raise ConvergenceError(
+                    f"wh: the Kepler step of body {int(order[bad])} failed between "
+                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                    f"{float(t_out[i])!r}")
+        rr, vv = _from_split(q, u, com, g, jacobi)
+        r_out[i], v_out[i] = rr[inv_order], vv[inv_order]
+        drr, dvv = _from_split(dq.reshape(k, n, 3), du.reshape(k, n, 3), dcom, g, jacobi)
+        dr_in = np.ascontiguousarray(drr[:, inv_order].reshape(k * n, 3))
+        dv_in = np.ascontiguousarray(dvv[:, inv_order].reshape(k * n, 3))
+        tangent.record(i, float(t_out[i]), dr_in, dv_in)
+        if on_output is not None:
+            on_output(i, total)
+    return r_out, v_out, total
+
+
+def run_dop853(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+               tangent: Tangent, *, tol: float, atol: np.ndarray, max_step: float,
+               control: bool, on_output: Callable[[int, int], None] | None,
+               out: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, int]:
+    """``dop853`` on the augmented system ``(r, dr, v, dv, Ys)``: the bodies, the
+    tangent vectors (:attr:`RHS.augmented`) and MEGNO's integral
+    ``Ys' = 2 (t - t0) delta'.delta / |delta|^2``, step by step (scipy's stepper),
+    MEGNO's averages and regression updated after every step as rebound does.
+    MEGNO's vector is not rescaled here (a chaotic run long enough to take it
+    past 1e308 overflows: use radau15 or wh for those).
+    ``atol``: the bodies' absolute tolerances (6n,); the tangent components and
+    ``Ys`` are left out of the error control (infinite ``atol``) unless ``control``."""
+    from scipy.integrate import DOP853
+
+    n, k = r0.shape[0], tangent.k
+    rows = n * (1 + k)
+    acc = np.empty((rows, 3))
+    t0 = float(t_out[0])
+
+    def f(t: float, y: np.ndarray) -> np.ndarray:
+        x = y[: 3 * rows].reshape(rows, 3)
+        w = y[3 * rows: 6 * rows].reshape(rows, 3)
+        rhs.augmented(x, w, gm, acc, rhs.p)
+        dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
+        den = float(np.sum(dx * dx) + np.sum(dw * dw))
+        rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0
+        return np.concatenate((y[3 * rows: 6 * rows], acc.ravel(), [2.0 * (t - t0) * rate]))
+
+    y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(), tangent.dv0.ravel(), [0.0]))
+    scale_t = np.full(6 * n * k, np.inf)
+    if control:
+        scale_t = tol * np.maximum(np.abs(np.concatenate((tangent.dr0.ravel(),
+                                                          tangent.dv0.ravel()))), 1.0)
+    atol_all = np.concatenate((atol[: 3 * n], scale_t[: 3 * n * k], atol[3 * n:],
+                               scale_t[3 * n * k:], [np.inf]))
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    tangent.start(t0)
+    steps = 0
+    for i in range(1, t_out.shape[0]):
+        solver = DOP853(f, float(t_out[i - 1]), y, float(t_out[i]), rtol=tol, atol=atol_all,
+                        max_step=max_step)
+        while solver.status == "running":
+            t_prev, ys_prev = solver.t, solver.y[-1]
+            if solver.step() is not None:
+                raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
+            steps += 1
+            _var.megno_update(tangent.ms, float(solver.y[-1] - ys_prev), float(solver.t),
+                              float(solver.t - t_prev))
+        y = solver.y.copy()
+        x = y[: 3 * rows].reshape(rows, 3)
+        w = y[3 * rows: 6 * rows].reshape(rows, 3)
+        r_out[i], v_out[i] = x[:n], w[:n]
+        tangent.record(i, float(t_out[i]), x[n:], w[n:])
+        if on_output is not None:
+            on_output(i, steps)
+    return r_out, v_out, steps
