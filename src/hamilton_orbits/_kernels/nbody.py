@@ -65,11 +65,17 @@ def zero(r, v, gm, acc):  # pragma: no cover - compiled
 @intrinsic
 def _stack_scratch(typingctx):  # pragma: no cover - compiled
     """A pointer to :data:`SCRATCH` float64 on the stack of the function that calls
-    it (so valid until that function returns: it must not hand the memory back)."""
+    it (so valid until that function returns: it must not hand the memory back),
+    aligned to 64 bytes (a cache line, the widest vector): the columns, multiples
+    of :data:`LANES` long, then start on cache lines wherever the stack is."""
 
     def codegen(context, builder, signature, args):
-        return cgutils.alloca_once(builder, context.get_value_type(types.float64),
-                                   size=SCRATCH)
+        with builder.goto_entry_block():  # a fixed frame slot, not filled
+            raw = builder.alloca(context.get_value_type(types.float64),
+                                 size=cgutils.intp_t(SCRATCH + LANES))
+        addr = builder.ptrtoint(raw, cgutils.intp_t)
+        aligned = builder.and_(builder.add(addr, addr.type(63)), addr.type(-64))
+        return builder.inttoptr(aligned, raw.type)
 
     return types.CPointer(types.float64)(), codegen
 
