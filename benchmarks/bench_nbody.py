@@ -952,7 +952,7 @@ def _force_forms(rng) -> None:
 
     print(f"     the force evaluation alone (ns per pair, CPU, median of 7 interleaved rounds; "
           f"SIMD form from N = {nbody.SIMD_FROM}):")
-    for n in (5, 9, 10, 30, 100):
+    for n in (9, 10, 30, 100):
         r, v, g = _disc(n, 0, rng)
         g[1:] = rng.uniform(1e-7, 1e-6, n - 1)
         a1, a2 = np.empty_like(r), np.empty_like(r)
