@@ -878,8 +878,7 @@ def bench_flops(quick: bool) -> None:
     :func:`_radau15_flops`, with the rounds a step takes, counted by a right-hand
     side that counts its calls), its CPU time, and the fraction of the machine's
     scalar and SIMD throughput (:func:`_peak`) it reaches; and the force
-    evaluation alone, ours (pairs once, both bodies updated) beside a SIMD form
-    (every body's whole row, 8-wide, twice the pairs, sums reassociated)."""
+    evaluation alone, the shipped kernel beside the pair form (:func:`_force_forms`)."""
     from numba import njit
 
     from hamilton_orbits._kernels import nbody
@@ -912,54 +911,66 @@ def bench_flops(quick: bool) -> None:
 
 
 def _force_forms(rng) -> None:
+    """The force evaluation alone: the shipped kernel (``nbody.newtonian``: from
+    ``nbody.SIMD_FROM`` bodies on the SIMD form, every pair twice, vectorised over
+    the bodies that receive, no sum reordered) beside the pair form it replaced
+    there (pairs once, both bodies updated; copied here), CPU time, medians of
+    interleaved rounds; the accelerations must be the same to the bit."""
     from numba import njit
 
     from hamilton_orbits._kernels import nbody
 
-    @njit(error_model="numpy", fastmath={"reassoc"})
-    def rows(x, y, z, gm, ax, ay, az):  # pragma: no cover - compiled
-        n = x.shape[0]
+    @njit(error_model="numpy")
+    def pairs_once(r, gm, acc):  # pragma: no cover - compiled
+        n = r.shape[0]
+        acc[:, :] = 0.0
         for i in range(n):
-            sx = sy = sz = 0.0
-            for j in range(n):
-                dx, dy, dz = x[j] - x[i], y[j] - y[i], z[j] - z[i]
+            xi, yi, zi, gi = r[i, 0], r[i, 1], r[i, 2], gm[i]
+            ax, ay, az = acc[i, 0], acc[i, 1], acc[i, 2]
+            for j in range(i + 1, n):
+                dx, dy, dz = r[j, 0] - xi, r[j, 1] - yi, r[j, 2] - zi
                 d2 = dx * dx + dy * dy + dz * dz
-                d2 = d2 if j != i else 1.0
-                f = gm[j] / (d2 * np.sqrt(d2)) if j != i else 0.0
-                sx += f * dx
-                sy += f * dy
-                sz += f * dz
-            ax[i], ay[i], az[i] = sx, sy, sz
+                inv3 = 1.0 / (d2 * np.sqrt(d2))
+                fi, fj = gm[j] * inv3, gi * inv3
+                ax += fi * dx
+                ay += fi * dy
+                az += fi * dz
+                acc[j, 0] -= fj * dx
+                acc[j, 1] -= fj * dy
+                acc[j, 2] -= fj * dz
+            acc[i, 0], acc[i, 1], acc[i, 2] = ax, ay, az
 
     @njit(error_model="numpy")
-    def loop_rows(r, gm, soa, acc, reps):  # pragma: no cover - compiled
+    def loop_pairs(r, gm, acc, reps):  # pragma: no cover - compiled
         for _ in range(reps):
-            for i in range(r.shape[0]):
-                soa[0, i], soa[1, i], soa[2, i] = r[i, 0], r[i, 1], r[i, 2]
-            rows(soa[0], soa[1], soa[2], gm, soa[3], soa[4], soa[5])
-            for i in range(r.shape[0]):
-                acc[i, 0], acc[i, 1], acc[i, 2] = soa[3, i], soa[4, i], soa[5, i]
+            pairs_once(r, gm, acc)
 
     @njit(error_model="numpy")
-    def loop_pairs(r, v, gm, acc, reps):  # pragma: no cover - compiled
+    def loop_shipped(r, v, gm, acc, reps):  # pragma: no cover - compiled
         for _ in range(reps):
             nbody.newtonian(r, v, gm, acc)
 
-    print("     the force evaluation alone (ns per pair; the SIMD form computes every pair "
-          "twice; relative difference of the accelerations):")
-    for n in (10, 30, 100):
+    print(f"     the force evaluation alone (ns per pair, CPU, median of 7 interleaved rounds; "
+          f"SIMD form from N = {nbody.SIMD_FROM}):")
+    for n in (9, 10, 30, 100):
         r, v, g = _disc(n, 0, rng)
         g[1:] = rng.uniform(1e-7, 1e-6, n - 1)
-        a1, a2, soa = np.empty_like(r), np.empty_like(r), np.empty((6, n))
-        reps = int(2e6 / n**2)
-        t_pairs = _cpu(lambda r=r, v=v, g=g, a1=a1, k=reps: loop_pairs(r, v, g, a1, k),
-                       0.05)[0] / reps
-        t_rows = _cpu(lambda r=r, g=g, soa=soa, a2=a2, k=reps: loop_rows(r, g, soa, a2, k),
-                      0.05)[0] / reps
-        pairs = n * (n - 1) / 2
-        diff = float(np.max(np.abs(a1 - a2)) / np.max(np.abs(a1)))
-        print(f"       N = {n:3d}: ours {t_pairs / pairs * 1e9:5.2f}, SIMD rows "
-              f"{t_rows / pairs * 1e9:5.2f}  (x{t_pairs / t_rows:.2f}; {diff:.0e})")
+        a1, a2 = np.empty_like(r), np.empty_like(r)
+        reps = int(4e5 / n**2) + 1
+        times: dict[str, list[float]] = {"pairs": [], "shipped": []}
+        loop_pairs(r, g, a1, 1)
+        loop_shipped(r, v, g, a2, 1)
+        for _ in range(7):
+            c0 = time.process_time()
+            loop_pairs(r, g, a1, reps)
+            times["pairs"].append(time.process_time() - c0)
+            c0 = time.process_time()
+            loop_shipped(r, v, g, a2, reps)
+            times["shipped"].append(time.process_time() - c0)
+        per = n * (n - 1) / 2 * reps / 1e9
+        t_pairs, t_ship = np.median(times["pairs"]) / per, np.median(times["shipped"]) / per
+        print(f"       N = {n:3d}: pair form {t_pairs:5.2f}, shipped {t_ship:5.2f}  "
+              f"(x{t_pairs / t_ship:.2f}; same bits: {np.array_equal(a1, a2)})")
 
 
 def main() -> None:

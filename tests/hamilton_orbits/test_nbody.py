@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
+
 import astropy.units as u
 import numpy as np
 import pytest
 
 from hamilton_orbits import Body, System
+from hamilton_orbits._kernels import nbody as kernels
 from hamilton_orbits.nbody import SOLAR_SYSTEM_GM, accelerations_quaternion
 from hamilton_orbits.rebound_bridge import from_rebound, rebound_accelerations, to_rebound
 
@@ -32,9 +35,10 @@ def direct_accelerations(r: np.ndarray, gm: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize("n_massless", [0, 3])  # two paths: all massive, or with test particles
-@pytest.mark.parametrize("seed", range(5))
-def test_kernel_against_direct_and_quaternion_form(seed, n_massless):
-    s = random_system(7, seed, n_massless=n_massless)
+@pytest.mark.parametrize(("n", "seed"), [(4, 0), (40, 0)] + [(7, k) for k in range(5)])
+def test_kernel_against_direct_and_quaternion_form(n, seed, n_massless):
+    # n = 4: the pair form; 7 and 40: the SIMD form (kernels.SIMD_FROM)
+    s = random_system(n, seed, n_massless=n_massless)
     acc = s.accelerations()
     ref = direct_accelerations(s._r, s._gm)
     quat = accelerations_quaternion(s._r, s._gm)
@@ -44,6 +48,61 @@ def test_kernel_against_direct_and_quaternion_form(seed, n_massless):
     tol = 8 * len(s) * EPS * scale[:, None]
     assert np.all(np.abs(acc - ref) <= tol)
     assert np.all(np.abs(acc - quat) <= tol)
+
+
+def pair_form(r: np.ndarray, gm: np.ndarray) -> np.ndarray:
+    """Equation (B) in Python floats with the additions of the pair form, in its
+    order: massive pairs once (``i < j``, body i's sum carried on from the pairs
+    before it), each test particle over the massive bodies from zero."""
+    acc = np.zeros_like(r)
+    massive = [k for k in range(len(gm)) if gm[k] != 0.0]
+    for a, i in enumerate(massive):
+        s = [float(acc[i, c]) for c in range(3)]
+        for j in massive[a + 1:]:
+            d = [float(r[j, c]) - float(r[i, c]) for c in range(3)]
+            d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            inv3 = 1.0 / (d2 * math.sqrt(d2))
+            fi, fj = float(gm[j]) * inv3, float(gm[i]) * inv3
+            for c in range(3):
+                s[c] += fi * d[c]
+                acc[j, c] -= fj * d[c]
+        acc[i] = s
+    for k in (k for k in range(len(gm)) if gm[k] == 0.0):
+        s = [0.0, 0.0, 0.0]
+        for i in massive:
+            d = [float(r[i, c]) - float(r[k, c]) for c in range(3)]
+            d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            f = float(gm[i]) / (d2 * math.sqrt(d2))
+            for c in range(3):
+                s[c] += f * d[c]
+        acc[k] = s
+    return acc
+
+
+@pytest.mark.parametrize(("n_massive", "n_test"), [
+    (2, 0), (5, 0), (6, 0), (9, 0), (40, 0), (kernels.STACK_MASSIVE + 2, 0),  # heap work space
+    (3, 2 * kernels.BLOCK + 5), (9, kernels.BLOCK + 1), (kernels.STACK_MASSIVE + 2, 40)])
+def test_simd_form_is_the_pair_form_to_the_bit(n_massive, n_test):
+    """The SIMD form (every pair twice, vectorised over the bodies that receive)
+    adds the pair form's terms in the pair form's order: the same bits, for the
+    massive bodies and the test particles (blocks of ``kernels.BLOCK``), with
+    the test particles anywhere among the massive bodies."""
+    s = random_system(n_massive, n_massive + n_test, n_massless=n_test)
+    order = np.random.default_rng(n_test).permutation(len(s))
+    r, gm = s._r[order].copy(), s._gm[order].copy()
+    want = pair_form(r, gm)
+    acc = np.full_like(r, np.nan)
+    kernels.newtonian(r, np.zeros_like(r), gm, acc)
+    np.testing.assert_array_equal(acc, want)
+    # the stepper's entries: rows from ``first`` on, and the kick u += h a
+    idx = np.flatnonzero(gm[1:]).astype(np.int64) + 1
+    rows = np.full_like(r, np.nan)
+    kernels.newtonian_rows(r, gm, idx, 1, rows)
+    np.testing.assert_array_equal(rows[1:], pair_form(r[1:], gm[1:]))
+    u = np.ones_like(r)
+    kernels.kick_rows(r, gm, idx, 1, 0.25, u, np.empty((len(idx), 3)))
+    np.testing.assert_array_equal(u[1:], 1.0 + 0.25 * pair_form(r[1:], gm[1:]))
+    assert np.all(u[0] == 1.0)
 
 
 def test_quaternion_form_squares_vectors_to_minus_their_length():

@@ -17,9 +17,26 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import carray, njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
+
+#: Massive bodies up to which the SIMD form's work space is on the stack (above,
+#: it is allocated: 7 float64 a body, beside ``n^2`` pair terms, it costs nothing).
+STACK_MASSIVE = 128
+#: Test particles summed per block (their work space, 6 float64 each, stays in L1).
+BLOCK = 128
+#: float64 of the stack work space: massive x, y, z, gm, ax, ay, az; a block's 6.
+SCRATCH = 7 * STACK_MASSIVE + 6 * BLOCK
+#: The SIMD loops run over a multiple of this many lanes (the columns padded):
+#: the widest vector (8 float64); a scalar remainder would cost as much as the
+#: vector part at N = 10.
+LANES = 8
+#: Below this many massive bodies the pair form (pairs once) is faster than the
+#: SIMD form (every pair twice, 8 at a time): measured, docs/nbody_integrators.md.
+SIMD_FROM = 7
 
 
 @njit(cache=True, error_model="numpy")
@@ -45,27 +62,172 @@ def zero(r, v, gm, acc):  # pragma: no cover - compiled
         acc[k, 2] = 0.0
 
 
+@intrinsic
+def _stack_scratch(typingctx):  # pragma: no cover - compiled
+    """A pointer to :data:`SCRATCH` float64 on the stack of the function that calls
+    it (so valid until that function returns: it must not hand the memory back),
+    aligned to 64 bytes (a cache line, the widest vector): the columns, multiples
+    of :data:`LANES` long, then start on cache lines wherever the stack is."""
+
+    def codegen(context, builder, signature, args):
+        with builder.goto_entry_block():  # a fixed frame slot, not filled
+            raw = builder.alloca(context.get_value_type(types.float64),
+                                 size=cgutils.intp_t(SCRATCH + LANES))
+        addr = builder.ptrtoint(raw, cgutils.intp_t)
+        aligned = builder.and_(builder.add(addr, addr.type(63)), addr.type(-64))
+        return builder.inttoptr(aligned, raw.type)
+
+    return types.CPointer(types.float64)(), codegen
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     """Newtonian accelerations of equation (B); overwrites ``acc``.
 
-    Massive pairs are visited once (both accelerations from one separation);
-    test particles are summed over the massive bodies only.  With no test
-    particle (the common case) nothing is allocated: this runs once per force
-    evaluation, where a small allocation costs as much as the 36 pairs of the
-    solar system.
+    From :data:`SIMD_FROM` massive bodies on, the SIMD form (:func:`_soa_massive`);
+    below, massive pairs are visited once (both accelerations from one separation).
+    Both add the same terms in the same order: the results are the same to the bit.
+    Test particles are summed over the massive bodies only.  With no test particle
+    (the common case) and up to :data:`STACK_MASSIVE` bodies nothing is allocated:
+    this runs once per force evaluation, where a small allocation costs as much as
+    the 36 pairs of the solar system.
     """
     n = r.shape[0]
     for k in range(n):
         if gm[k] == 0.0:
             newtonian_rows(r, gm, massive_indices(gm), 0, acc)
             return
+    if n >= SIMD_FROM:
+        w = (carray(_stack_scratch(), SCRATCH) if n <= STACK_MASSIVE
+             else np.empty(7 * _padded(n)))
+        _gather_massive(r, gm, gm, False, n, w)
+        _soa_massive(n, w)
+        _scatter_massive(acc, gm, False, n, w)
+        return
     for k in range(n):
         acc[k, 0] = 0.0
         acc[k, 1] = 0.0
         acc[k, 2] = 0.0
     for i in range(n):  # j = i + 1 .. n - 1 (``start`` and ``idx`` unused: gm stands in)
         _massive_row(r, gm, i, acc, n, n, False, gm)
+
+
+@njit(cache=True, error_model="numpy")
+def _gather_massive(r, gm, idx, use_idx, nm, w):  # pragma: no cover - compiled
+    """Positions and ``gm`` of the massive bodies (rows ``idx[a]``, or ``a``
+    without ``use_idx``) into the columns ``w[0:4 np]`` (structure of arrays,
+    ``np`` = :func:`_padded` ``(nm)``; the padding lanes at the origin)."""
+    m = _padded(nm)
+    for a in range(m):
+        i = (int(idx[a]) if use_idx else a) if a < nm else 0
+        pad = a >= nm
+        w[a] = 0.0 if pad else r[i, 0]
+        w[m + a] = 0.0 if pad else r[i, 1]
+        w[2 * m + a] = 0.0 if pad else r[i, 2]
+        w[3 * m + a] = 0.0 if pad else gm[i]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _padded(n):  # pragma: no cover - compiled
+    """``n`` rounded up to a multiple of :data:`LANES`."""
+    return (n + LANES - 1) // LANES * LANES
+
+
+@njit(cache=True, error_model="numpy")
+def _soa_massive(nm, w):  # pragma: no cover - compiled
+    """The accelerations of the massive bodies that :func:`_gather_massive` put in
+    ``w`` among themselves, in the SIMD form, summed in ``w[4 np:7 np]``.
+
+    For each source ``b`` in order, every body ``a`` at once (the loop over ``a``
+    is what the compiler vectorises: lanes are bodies, no sum is reordered) gets
+    ``gm_b (1 / (d^2 sqrt(d^2))) d``, ``d = r_b - r_a`` (zero for ``a = b``).  Body
+    ``a`` thus adds its terms in the order of the pair form, and each term is the
+    pair form's to the bit: ``d`` is minus the pair's separation exactly, ``d^2``
+    the same.  Every pair is computed twice, eight at a time."""
+    m = _padded(nm)
+    x = w[0:m]
+    y = w[m:2 * m]
+    z = w[2 * m:3 * m]
+    g = w[3 * m:4 * m]
+    ax = w[4 * m:5 * m]
+    ay = w[5 * m:6 * m]
+    az = w[6 * m:7 * m]
+    for a in range(m):
+        ax[a] = 0.0
+        ay[a] = 0.0
+        az[a] = 0.0
+    for b in range(nm):
+        xb = x[b]
+        yb = y[b]
+        zb = z[b]
+        gb = g[b]
+        for a in range(m):  # the padding lanes too (not finite, never read)
+            dx = xb - x[a]
+            dy = yb - y[a]
+            dz = zb - z[a]
+            d2 = dx * dx + dy * dy + dz * dz
+            same = a == b
+            d2 = 1.0 if same else d2
+            inv3 = 1.0 / (d2 * np.sqrt(d2))
+            f = 0.0 if same else gb * inv3
+            ax[a] += f * dx
+            ay[a] += f * dy
+            az[a] += f * dz
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _scatter_massive(acc, idx, use_idx, nm, w):  # pragma: no cover - compiled
+    """``acc[idx[a]] = `` the accelerations that :func:`_soa_massive` left in ``w``."""
+    m = _padded(nm)
+    for a in range(nm):
+        i = int(idx[a]) if use_idx else a
+        acc[i, 0] = w[4 * m + a]
+        acc[i, 1] = w[5 * m + a]
+        acc[i, 2] = w[6 * m + a]
+
+
+@njit(cache=True, error_model="numpy")
+def _soa_block(r, k0, k1, nm, w):  # pragma: no cover - compiled
+    """The accelerations of rows ``k0 .. k1 - 1`` (at most :data:`BLOCK`) from the
+    massive bodies that :func:`_gather_massive` copied into ``w``, into
+    ``w[7 np + (3 + c) BLOCK + t]`` for row ``k0 + t``, component ``c``
+    (``np`` = :func:`_padded` ``(nm)``).
+
+    Vectorised over the rows (lanes are particles): each adds the massive bodies'
+    ``gm_a / (d^2 sqrt(d^2)) d`` in order from zero, as the scalar loop does.  A
+    massive row in the block is computed too (against itself: not finite) and
+    must be ignored."""
+    o = 7 * _padded(nm)
+    m = _padded(k1 - k0)  # the padding lanes at the origin, never read
+    x = w[o:o + m]
+    y = w[o + BLOCK:o + BLOCK + m]
+    z = w[o + 2 * BLOCK:o + 2 * BLOCK + m]
+    ax = w[o + 3 * BLOCK:o + 3 * BLOCK + m]
+    ay = w[o + 4 * BLOCK:o + 4 * BLOCK + m]
+    az = w[o + 5 * BLOCK:o + 5 * BLOCK + m]
+    for t in range(m):
+        pad = k0 + t >= k1
+        x[t] = 0.0 if pad else r[k0 + t, 0]
+        y[t] = 0.0 if pad else r[k0 + t, 1]
+        z[t] = 0.0 if pad else r[k0 + t, 2]
+        ax[t] = 0.0
+        ay[t] = 0.0
+        az[t] = 0.0
+    mm = _padded(nm)
+    for a in range(nm):
+        xa = w[a]
+        ya = w[mm + a]
+        za = w[2 * mm + a]
+        ga = w[3 * mm + a]
+        for t in range(m):
+            dx = xa - x[t]
+            dy = ya - y[t]
+            dz = za - z[t]
+            d2 = dx * dx + dy * dy + dz * dz
+            f = ga / (d2 * np.sqrt(d2))
+            ax[t] += f * dx
+            ay[t] += f * dy
+            az[t] += f * dz
 
 
 @njit(inline="always", cache=True, error_model="numpy")
@@ -107,47 +269,86 @@ def _massive_row(r, gm, i, acc, start, nm, use_idx, idx):  # pragma: no cover - 
 def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
     """:func:`newtonian` with the massive indices ``idx`` given (so that a
     stepper computes them once, not every step) and the rows below ``first``
-    left out (their ``acc`` is not written; ``idx`` must not hold them).
-    The same arithmetic in the same order as :func:`newtonian`."""
+    left out (their ``acc`` is not written; ``idx`` must hold every massive row
+    from ``first`` on, and no other).  The same arithmetic in the same order as
+    :func:`newtonian`; test particles are summed :data:`BLOCK` at a time
+    (:func:`_soa_block`)."""
     n = r.shape[0]
-    for k in range(first, n):
-        acc[k, 0] = 0.0
-        acc[k, 1] = 0.0
-        acc[k, 2] = 0.0
     nm = idx.shape[0]
-    for a in range(nm):
-        _massive_row(r, gm, idx[a], acc, a + 1, nm, True, idx)
+    w = (carray(_stack_scratch(), SCRATCH) if nm <= STACK_MASSIVE
+         else np.empty(7 * _padded(nm) + 6 * BLOCK))
+    _massive_rows(r, gm, idx, acc, w)
     if nm == n - first:
         return
-    for k in range(first, n):
-        if gm[k] != 0.0:
-            continue
-        ax = 0.0
-        ay = 0.0
-        az = 0.0
-        for a in range(nm):
-            i = idx[a]
-            dx = r[i, 0] - r[k, 0]
-            dy = r[i, 1] - r[k, 1]
-            dz = r[i, 2] - r[k, 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            f = gm[i] / (d2 * np.sqrt(d2))
-            ax += f * dx
-            ay += f * dy
-            az += f * dz
-        acc[k, 0] = ax
-        acc[k, 1] = ay
-        acc[k, 2] = az
+    o = 7 * _padded(nm) + 3 * BLOCK
+    for k0 in range(first, n, BLOCK):
+        k1 = min(k0 + BLOCK, n)
+        _soa_block(r, k0, k1, nm, w)
+        for k in range(k0, k1):
+            if gm[k] == 0.0:
+                acc[k, 0] = w[o + k - k0]
+                acc[k, 1] = w[o + BLOCK + k - k0]
+                acc[k, 2] = w[o + 2 * BLOCK + k - k0]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _massive_rows(r, gm, idx, acc, w):  # pragma: no cover - compiled
+    """``acc[idx[a]]``: the massive bodies' accelerations among themselves, in the
+    SIMD form from :data:`SIMD_FROM` of them on, else in the pair form (the same
+    to the bit); their positions and ``gm`` left in ``w`` either way."""
+    nm = idx.shape[0]
+    _gather_massive(r, gm, idx, True, nm, w)
+    if nm >= SIMD_FROM:
+        _soa_massive(nm, w)
+        _scatter_massive(acc, idx, True, nm, w)
+        return
+    for a in range(nm):
+        acc[idx[a], 0] = 0.0
+        acc[idx[a], 1] = 0.0
+        acc[idx[a], 2] = 0.0
+    for a in range(nm):
+        _massive_row(r, gm, idx[a], acc, a + 1, nm, True, idx)
 
 
 @njit(cache=True, error_model="numpy")
 def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
     """``u[k] += h a_k`` for the rows ``k >= first``, ``a`` the Newtonian
     accelerations of :func:`newtonian_rows` (the same arithmetic in the same
-    order): the massive rows ``idx`` summed in ``acc_m`` (len(idx), 3), each test
-    particle's kicked as soon as it is summed, so that no (n, 3) array is needed
-    (a third of the working memory of a Wisdom-Holman run of test particles)."""
+    order): the massive rows ``idx`` summed in ``acc_m`` (len(idx), 3), the test
+    particles :data:`BLOCK` at a time, each block kicked as soon as it is summed,
+    so that no (n, 3) array is needed (a third of the working memory of a
+    Wisdom-Holman run of test particles)."""
     n = r.shape[0]
+    nm = idx.shape[0]
+    w = (carray(_stack_scratch(), SCRATCH) if nm <= STACK_MASSIVE
+         else np.empty(7 * _padded(nm) + 6 * BLOCK))
+    _gather_massive(r, gm, idx, True, nm, w)
+    if nm >= SIMD_FROM:
+        _soa_massive(nm, w)
+        _scatter_massive(acc_m, idx, False, nm, w)
+    else:
+        _compact_pairs(r, gm, idx, acc_m)
+    for a in range(nm):
+        i = idx[a]
+        u[i, 0] += h * acc_m[a, 0]
+        u[i, 1] += h * acc_m[a, 1]
+        u[i, 2] += h * acc_m[a, 2]
+    if nm == n - first:
+        return
+    o = 7 * _padded(nm) + 3 * BLOCK
+    for k0 in range(first, n, BLOCK):
+        k1 = min(k0 + BLOCK, n)
+        _soa_block(r, k0, k1, nm, w)
+        for k in range(k0, k1):
+            if gm[k] == 0.0:
+                u[k, 0] += h * w[o + k - k0]
+                u[k, 1] += h * w[o + BLOCK + k - k0]
+                u[k, 2] += h * w[o + 2 * BLOCK + k - k0]
+
+
+@njit(cache=True, error_model="numpy")
+def _compact_pairs(r, gm, idx, acc_m):  # pragma: no cover - compiled
+    """The pair form of :func:`_massive_row` into ``acc_m[a]`` for body ``idx[a]``."""
     nm = idx.shape[0]
     for a in range(nm):
         acc_m[a, 0] = 0.0
@@ -180,32 +381,6 @@ def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
         acc_m[a, 0] = ax
         acc_m[a, 1] = ay
         acc_m[a, 2] = az
-    for a in range(nm):
-        i = idx[a]
-        u[i, 0] += h * acc_m[a, 0]
-        u[i, 1] += h * acc_m[a, 1]
-        u[i, 2] += h * acc_m[a, 2]
-    if nm == n - first:
-        return
-    for k in range(first, n):
-        if gm[k] != 0.0:
-            continue
-        ax = 0.0
-        ay = 0.0
-        az = 0.0
-        for a in range(nm):
-            i = idx[a]
-            dx = r[i, 0] - r[k, 0]
-            dy = r[i, 1] - r[k, 1]
-            dz = r[i, 2] - r[k, 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            f = gm[i] / (d2 * np.sqrt(d2))
-            ax += f * dx
-            ay += f * dy
-            az += f * dz
-        u[k, 0] += h * ax
-        u[k, 1] += h * ay
-        u[k, 2] += h * az
 
 
 # ---------------------------------------------------------------------------
