@@ -406,6 +406,42 @@ def _start_step(accel, p, r, v, gm, a0_2, x0, v0):  # pragma: no cover - compile
 
 
 @njit(cache=True, inline="always")
+def _try_length(t, t_end, dt):  # pragma: no cover - compiled
+    """The next step's length (``dt``, or what is left to ``t_end``), whether it
+    lands on ``t_end``, and ``0`` to take it, ``1`` when what is left is at the
+    rounding level of ``t`` (finish exactly at ``t_end``), ``2`` when the step
+    would not advance ``t`` (an underflow)."""
+    dt_try = min(dt, t_end - t)
+    landing = dt_try == t_end - t
+    if dt_try > 4.0 * _EPS * abs(t):
+        return dt_try, landing, 0
+    if landing and dt_try > 0.0 and dt_try <= dt:
+        return dt_try, landing, 1
+    return dt_try, landing, 2
+
+
+@njit(cache=True, inline="always")
+def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb, a0, xf, vf,
+               csx, csv, xs, vs, at, need_v):  # pragma: no cover - compiled
+    """One step's attempt up to its acceptance test: the start's accelerations,
+    ``b`` predicted from the last step (:func:`_predict`, ``q`` the ratio of the
+    step lengths; zero after a change of more than 20x), the predictor-corrector
+    iteration (its rounds counted in ``st[6]``).  False when a number is not
+    finite."""
+    if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
+        return False
+    if q <= 20.0:
+        _predict(q, b, br, d)
+    else:
+        b[:, :] = 0.0
+    csb[:, :] = 0.0
+    _g_from_b(b, g)
+    st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
+                      need_v)
+    return _all_finite(b[6])
+
+
+@njit(cache=True, inline="always")
 def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
     """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
 
@@ -505,27 +541,16 @@ def advance(
         if n_watch > 0 and ev_count[0] + n_watch > ev_out.shape[0]:
             status = STATUS_DRAIN
             break
-        dt_try = min(dt, t_end - t)
-        landing = dt_try == t_end - t
-        if not (dt_try > 4.0 * _EPS * abs(t)):  # t + dt_try would not advance t
-            if landing and dt_try > 0.0 and dt_try <= dt:
+        dt_try, landing, short = _try_length(t, t_end, dt)
+        if short:
+            if short == 1:
                 t = t_end  # a remainder at rounding level of t: finish exactly
-                break
-            status = STATUS_UNDERFLOW
-            break
-        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
-            status = STATUS_NONFINITE
+            else:
+                status = STATUS_UNDERFLOW
             break
         q = dt_try / dt_last if have_last else math.inf
-        if q <= 20.0:
-            _predict(q, b, br, d)
-        else:
-            b[:, :] = 0.0
-        csb[:, :] = 0.0
-        _g_from_b(b, g)
-        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
-                          need_v)
-        if not _all_finite(b[6]):
+        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb,
+                          a0, xf, vf, csx, csv, xs, vs, at, need_v):
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing)
@@ -688,27 +713,16 @@ def advance_variational(
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
             break
-        dt_try = min(dt, t_end - t)
-        landing = dt_try == t_end - t
-        if not (dt_try > 4.0 * _EPS * abs(t)):
-            if landing and dt_try > 0.0 and dt_try <= dt:
-                t = t_end
-                break
-            status = STATUS_UNDERFLOW
-            break
-        if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
-            status = STATUS_NONFINITE
+        dt_try, landing, short = _try_length(t, t_end, dt)
+        if short:
+            if short == 1:
+                t = t_end  # a remainder at rounding level of t: finish exactly
+            else:
+                status = STATUS_UNDERFLOW
             break
         q = dt_try / dt_last if have_last else math.inf
-        if q <= 20.0:
-            _predict(q, b, br, d)
-        else:
-            b[:, :] = 0.0
-        csb[:, :] = 0.0
-        _g_from_b(b, g)
-        st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
-                          need_v)
-        if not _all_finite(b[6]):
+        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb,
+                          a0, xf, vf, csx, csv, xs, vs, at, need_v):
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at[:n_phys], r[:n_phys], v[:n_phys], dt_try, dt,
