@@ -284,10 +284,10 @@ def bench_scaling(quick: bool, repeat: int) -> None:
 
     rng = np.random.default_rng(1)
     dt = 0.05
-    cases = [(3, 0), (10, 0), (100, 0), (1000, 0)]
+    cases = [(2, 0), (3, 0), (10, 0), (30, 0), (100, 0), (1000, 0)]
     tests = [100, 1000, 10000, 100000]
     if quick:
-        cases = cases[:3]
+        cases = cases[:5]
         tests = tests[:3]
     rs, vs, gs = solar_system()
     print("[3] cost per step (us); ratio = rebound / ours")

@@ -265,14 +265,25 @@ def _massive_row(r, gm, i, acc, start, nm, use_idx, idx):  # pragma: no cover - 
     acc[i, 2] = az
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
     """:func:`newtonian` with the massive indices ``idx`` given (so that a
     stepper computes them once, not every step) and the rows below ``first``
     left out (their ``acc`` is not written; ``idx`` must hold every massive row
     from ``first`` on, and no other).  The same arithmetic in the same order as
     :func:`newtonian`; test particles are summed :data:`BLOCK` at a time
-    (:func:`_soa_block`)."""
+    (:func:`_soa_block`).  A few massive bodies and no test particle: the pair
+    form inlined into the caller (as :func:`kick_rows`)."""
+    nm = idx.shape[0]
+    if nm < SIMD_FROM and nm == r.shape[0] - first:
+        _pairs_rows(r, gm, idx, acc)
+    else:
+        _newtonian_rows_spaced(r, gm, idx, first, acc)
+
+
+@njit(cache=True, error_model="numpy")
+def _newtonian_rows_spaced(r, gm, idx, first, acc):  # pragma: no cover - compiled
+    """:func:`newtonian_rows` with its work space (SIMD columns, test-particle blocks)."""
     n = r.shape[0]
     nm = idx.shape[0]
     w = (carray(_stack_scratch(), SCRATCH) if nm <= STACK_MASSIVE
@@ -302,6 +313,13 @@ def _massive_rows(r, gm, idx, acc, w):  # pragma: no cover - compiled
         _soa_massive(nm, w)
         _scatter_massive(acc, idx, True, nm, w)
         return
+    _pairs_rows(r, gm, idx, acc)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _pairs_rows(r, gm, idx, acc):  # pragma: no cover - compiled
+    """``acc[idx[a]]`` in the pair form (each massive pair visited once)."""
+    nm = idx.shape[0]
     for a in range(nm):
         acc[idx[a], 0] = 0.0
         acc[idx[a], 1] = 0.0
@@ -310,14 +328,30 @@ def _massive_rows(r, gm, idx, acc, w):  # pragma: no cover - compiled
         _massive_row(r, gm, idx[a], acc, a + 1, nm, True, idx)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
     """``u[k] += h a_k`` for the rows ``k >= first``, ``a`` the Newtonian
     accelerations of :func:`newtonian_rows` (the same arithmetic in the same
     order): the massive rows ``idx`` summed in ``acc_m`` (len(idx), 3), the test
     particles :data:`BLOCK` at a time, each block kicked as soon as it is summed,
     so that no (n, 3) array is needed (a third of the working memory of a
-    Wisdom-Holman run of test particles)."""
+    Wisdom-Holman run of test particles).
+
+    A few massive bodies (below :data:`SIMD_FROM`) and no test particle: the
+    pairs inlined into the caller's step loop, without the work space (the call
+    and its setup cost as much as the one pair of N = 3); otherwise
+    :func:`_kick_rows_spaced`."""
+    nm = idx.shape[0]
+    if nm < SIMD_FROM and nm == r.shape[0] - first:
+        _compact_pairs(r, gm, idx, acc_m)
+        _kick_massive(u, idx, h, acc_m)
+    else:
+        _kick_rows_spaced(r, gm, idx, first, h, u, acc_m)
+
+
+@njit(cache=True, error_model="numpy")
+def _kick_rows_spaced(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
+    """:func:`kick_rows` with its work space (SIMD columns, test-particle blocks)."""
     n = r.shape[0]
     nm = idx.shape[0]
     w = (carray(_stack_scratch(), SCRATCH) if nm <= STACK_MASSIVE
@@ -328,11 +362,7 @@ def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
         _scatter_massive(acc_m, idx, False, nm, w)
     else:
         _compact_pairs(r, gm, idx, acc_m)
-    for a in range(nm):
-        i = idx[a]
-        u[i, 0] += h * acc_m[a, 0]
-        u[i, 1] += h * acc_m[a, 1]
-        u[i, 2] += h * acc_m[a, 2]
+    _kick_massive(u, idx, h, acc_m)
     if nm == n - first:
         return
     o = 7 * _padded(nm) + 3 * BLOCK
@@ -346,7 +376,17 @@ def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
                 u[k, 2] += h * w[o + 2 * BLOCK + k - k0]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
+def _kick_massive(u, idx, h, acc_m):  # pragma: no cover - compiled
+    """``u[idx[a]] += h acc_m[a]``."""
+    for a in range(idx.shape[0]):
+        i = idx[a]
+        u[i, 0] += h * acc_m[a, 0]
+        u[i, 1] += h * acc_m[a, 1]
+        u[i, 2] += h * acc_m[a, 2]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _compact_pairs(r, gm, idx, acc_m):  # pragma: no cover - compiled
     """The pair form of :func:`_massive_row` into ``acc_m[a]`` for body ``idx[a]``."""
     nm = idx.shape[0]
