@@ -80,7 +80,8 @@ def pair_form(r: np.ndarray, gm: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize(("n_massive", "n_test"), [
-    (2, 0), (5, 0), (6, 0), (9, 0), (40, 0), (kernels.STACK_MASSIVE + 2, 0),  # heap work space
+    (2, 0), (5, 0), (6, 0), (9, 0), (10, 0), (17, 0), (40, 0),  # 9, 17: one body by itself
+    (kernels.STACK_MASSIVE + 2, 0),  # heap work space
     (3, 2 * kernels.BLOCK + 5), (9, kernels.BLOCK + 1), (kernels.STACK_MASSIVE + 2, 40)])
 def test_simd_form_is_the_pair_form_to_the_bit(n_massive, n_test):
     """The SIMD form (every pair twice, vectorised over the bodies that receive)

@@ -143,7 +143,11 @@ def _soa_massive(nm, w):  # pragma: no cover - compiled
     ``gm_b (1 / (d^2 sqrt(d^2))) d``, ``d = r_b - r_a`` (zero for ``a = b``).  Body
     ``a`` thus adds its terms in the order of the pair form, and each term is the
     pair form's to the bit: ``d`` is minus the pair's separation exactly, ``d^2``
-    the same.  Every pair is computed twice, eight at a time."""
+    the same.  Every pair is computed twice, eight at a time.
+
+    One body beyond a multiple of eight (N = 9, 17, ...) is summed by itself
+    (in the same order), not as a vector of seven padding lanes: at N = 9 that
+    cost 80 ns of the 220."""
     m = _padded(nm)
     x = w[0:m]
     y = w[m:2 * m]
@@ -152,16 +156,19 @@ def _soa_massive(nm, w):  # pragma: no cover - compiled
     ax = w[4 * m:5 * m]
     ay = w[5 * m:6 * m]
     az = w[6 * m:7 * m]
+    mv = nm - 1 if nm % LANES == 1 else m  # the lanes summed as vectors
     for a in range(m):
         ax[a] = 0.0
         ay[a] = 0.0
         az[a] = 0.0
+    for a in range(mv, nm):
+        _soa_one(a, nm, w)
     for b in range(nm):
         xb = x[b]
         yb = y[b]
         zb = z[b]
         gb = g[b]
-        for a in range(m):  # the padding lanes too (not finite, never read)
+        for a in range(mv):  # the padding lanes too (not finite, never read)
             dx = xb - x[a]
             dy = yb - y[a]
             dz = zb - z[a]
@@ -173,6 +180,32 @@ def _soa_massive(nm, w):  # pragma: no cover - compiled
             ax[a] += f * dx
             ay[a] += f * dy
             az[a] += f * dz
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _soa_one(a, nm, w):  # pragma: no cover - compiled
+    """Body ``a``'s sum of :func:`_soa_massive` alone, the same terms in the same
+    order (sources ``b`` ascending, ``b != a``)."""
+    m = _padded(nm)
+    xa = w[a]
+    ya = w[m + a]
+    za = w[2 * m + a]
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for b in range(nm):
+        if b != a:
+            dx = w[b] - xa
+            dy = w[m + b] - ya
+            dz = w[2 * m + b] - za
+            d2 = dx * dx + dy * dy + dz * dz
+            f = w[3 * m + b] * (1.0 / (d2 * np.sqrt(d2)))
+            sx += f * dx
+            sy += f * dy
+            sz += f * dz
+    w[4 * m + a] = sx
+    w[5 * m + a] = sy
+    w[6 * m + a] = sz
 
 
 @njit(cache=True, inline="always", error_model="numpy")
