@@ -301,9 +301,11 @@ def bench_scaling(quick: bool, repeat: int) -> None:
         rows.append((9, nt, r, v, g))
     for nm, nt, r, v, g in rows:
         work = (nm + nt) * nm
-        # at least 50 steps, so that a call's fixed cost (input checks, setup:
-        # ~0.2 ms for ours) does not pass for cost per step
-        n_steps = int(max(50, min(5000, 2e6 / work / 20)))
+        # at least 50 steps, and ~10^6 pair evaluations at small N (10^4 steps at
+        # N = 10, 5 * 10^4 at N = 2-3), so that a call's fixed cost (input checks,
+        # setup: ~0.07 ms for ours, ~0.03 for rebound's, section [7]) does not
+        # pass for cost per step: with 1000 steps of 1 us at N = 10 it was 4% of it
+        n_steps = int(max(50, min(50_000, 2e7 / work / 20)))
         dtw = dt if nt == 0 else 1.0
         t_end = n_steps * dtw
 
