@@ -95,7 +95,8 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     n = r.shape[0]
     for k in range(n):
         if gm[k] == 0.0:
-            newtonian_rows(r, gm, massive_indices(gm), 0, acc)
+            # test particles: never the inlined pair form of newtonian_rows
+            _newtonian_rows_spaced(r, gm, massive_indices(gm), 0, acc)
             return
     if n >= SIMD_FROM:
         w = (carray(_stack_scratch(), SCRATCH) if n <= STACK_MASSIVE
@@ -349,7 +350,7 @@ def _massive_rows(r, gm, idx, acc, w):  # pragma: no cover - compiled
     _pairs_rows(r, gm, idx, acc)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _pairs_rows(r, gm, idx, acc):  # pragma: no cover - compiled
     """``acc[idx[a]]`` in the pair form (each massive pair visited once)."""
     nm = idx.shape[0]
