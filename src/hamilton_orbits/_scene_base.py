@@ -18,7 +18,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits import _schema as S
+from hamilton_orbits import schema as S
 
 __all__ = ["KINDS", "OUTPUT_LIMIT", "Result", "SceneKind", "check_output_size", "format_table",
            "register_kind"]
@@ -34,7 +34,7 @@ class SceneKind:
         The ``kind = "..."`` value.
     summary : str
         One line for listings.
-    schema : Mapping[str, _schema.Field]
+    schema : Mapping[str, schema.Field]
         The kind's keys (besides ``kind``, ``description`` and ``effects``).
     effect_kind : str
         Which effect registry the kind's ``effects`` come from.
@@ -88,7 +88,7 @@ def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output:
     ----------
     spec : mapping
         A scene's checked keys, with ``duration`` and ``cadence`` (None: 1000 outputs).
-    problems : _schema.Problems
+    problems : schema.Problems
     per_output : int
         float64 values kept at each output (n-body: 6 per body).
     what : str

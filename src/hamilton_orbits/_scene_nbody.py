@@ -17,8 +17,8 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
+from hamilton_orbits import schema as S
 from hamilton_orbits._scene_base import (
     Result,
     SceneKind,
@@ -592,7 +592,7 @@ def without_compilation(run: Any) -> Any:
     kernels on their first call)."""
     import dataclasses
 
-    from hamilton_orbits._firstrun import compile_seconds
+    from hamilton_orbits.firstrun import compile_seconds
 
     before = compile_seconds()
     out = run()

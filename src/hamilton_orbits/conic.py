@@ -33,9 +33,9 @@ import numpy as np
 
 from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import check_trailing, first_index, fmt_index
 from hamilton_orbits.kepler import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
+from hamilton_orbits.validation import check_trailing, first_index, fmt_index
 
 __all__ = ["Conic"]
 

@@ -38,7 +38,8 @@ import numpy as np
 
 from hamilton_orbits import _columns
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import (
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
+from hamilton_orbits.validation import (
     ConvergenceError,
     broadcast,
     check_positive,
@@ -46,7 +47,6 @@ from hamilton_orbits._validation import (
     first_index,
     fmt_index,
 )
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _k = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_k")

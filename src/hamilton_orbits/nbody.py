@@ -390,7 +390,7 @@ class System:
         ...
         ValueError: Expected `gm` >= 0, got -1.0 at index 1
         """
-        from hamilton_orbits._validation import check_positive
+        from hamilton_orbits.validation import check_positive
 
         quantity = require_consistent(("gm", "r", "v", "radius"), (gm, r, v, radius))
         gm_a = np.ascontiguousarray(GM("gm", gm, GM_UNIT if quantity else None))

@@ -32,14 +32,6 @@ import numpy as np
 from hamilton_orbits import _columns
 from hamilton_orbits import kepler as _kepler
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import (
-    ConvergenceError,
-    broadcast,
-    check_positive,
-    check_trailing,
-    first_index,
-    fmt_index,
-)
 from hamilton_orbits.conic import Conic
 from hamilton_orbits.kepler import (
     STATE_UNITS,
@@ -58,6 +50,14 @@ from hamilton_orbits.units import (
     is_quantity,
     require_consistent,
     wrap,
+)
+from hamilton_orbits.validation import (
+    ConvergenceError,
+    broadcast,
+    check_positive,
+    check_trailing,
+    first_index,
+    fmt_index,
 )
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)

@@ -44,14 +44,14 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import (
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, is_quantity
+from hamilton_orbits.validation import (
     as_float_array,
     broadcast_shapes,
     check_finite_result,
     check_trailing,
     first_index,
 )
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS, is_quantity
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _kq = LazyModule("hamilton_orbits._kernels.quaternion", globals(), "_kq")

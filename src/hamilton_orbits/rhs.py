@@ -56,8 +56,8 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._firstrun import GENERATED_PREFIX as MODULE_PREFIX
 from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.firstrun import GENERATED_PREFIX as MODULE_PREFIX
 
 __all__ = ["RHS", "cache_dir", "compile_rhs", "kernels_for", "newtonian_rhs",
            "parameter_vector", "source", "tangent_kernels_for", "tangent_source"]

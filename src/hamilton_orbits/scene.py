@@ -40,8 +40,8 @@ from typing import Any
 import tomllib
 
 from hamilton_orbits import _scene_nbody  # noqa: F401  (registers the "nbody" kind)
-from hamilton_orbits import _schema as S
 from hamilton_orbits import effects as _effects
+from hamilton_orbits import schema as S
 from hamilton_orbits._scene_base import (
     KINDS,
     OUTPUT_LIMIT,
@@ -405,7 +405,7 @@ class Scene:
         compilations.  The kinds take the compilation inside the integration out
         of ``result.wall_time``, the integration proper.
         """
-        from hamilton_orbits._firstrun import claim_compilation
+        from hamilton_orbits.firstrun import claim_compilation
 
         result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
         result.compile_time, result.compile_count = claim_compilation()

@@ -19,15 +19,15 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
-from hamilton_orbits._firstrun import compile_seconds
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
+from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS
 from hamilton_orbits.nbody import DAY, LostStateError, System, integral_errors
 from hamilton_orbits.rhs import compile_rhs
 from hamilton_orbits.trajectory import TrajectoryBase
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
+from hamilton_orbits.validation import as_float_array
 
 __all__ = ["INTEGRATORS", "Trajectory", "check_method", "integrate", "make_trajectory"]
 

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._validation import as_float_array
+from hamilton_orbits.validation import as_float_array
 
 # astropy.units is imported on first use: a caller that has not imported it
 # cannot have passed a Quantity (is_quantity), so plain-float calls never need it

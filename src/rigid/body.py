@@ -27,7 +27,6 @@ from typing import Any, NamedTuple
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import (
     ANGULAR_SPEED,
@@ -35,6 +34,7 @@ from hamilton_orbits.units import (
     INERTIA,
     require_consistent,
 )
+from hamilton_orbits.validation import as_float_array
 from rigid._shared import pow2
 
 __all__ = ["BodySI", "RigidBody"]  # check_*, call_units, unit_quaternion: shared inside rigid

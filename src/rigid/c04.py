@@ -17,8 +17,8 @@ import astropy.units as u
 import numpy as np
 from astropy.time import Time
 
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.units import ANGLE, TIME
+from hamilton_orbits.validation import as_float_array
 
 __all__ = ["PolarMotionRecord", "decimal_year", "iers2010_mean_pole", "load_c04", "mjd_utc"]
 

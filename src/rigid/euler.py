@@ -23,7 +23,6 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import check_positive, check_trailing
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import (
     ANGLE,
@@ -36,6 +35,7 @@ from hamilton_orbits.units import (
     require_consistent,
     wrap,
 )
+from hamilton_orbits.validation import check_positive, check_trailing
 from rigid._kernels import euler as _k
 
 __all__ = [

@@ -75,10 +75,10 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import check_positive
 from hamilton_orbits.integrators import dop853
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
+from hamilton_orbits.validation import check_positive
 from rigid._kernels import euler as _k
 from rigid.body import call_units, check_body
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque

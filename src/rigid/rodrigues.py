@@ -46,8 +46,8 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._validation import as_float_array, check_trailing, first_index
 from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
+from hamilton_orbits.validation import as_float_array, check_trailing, first_index
 from rigid._kernels import euler as _k
 from rigid.integrators import integrate
 

@@ -31,7 +31,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits import _schema as S
+from hamilton_orbits import schema as S
 from hamilton_orbits.scene import Result, Scene, SceneKind, check_output_size, register_kind
 from hamilton_orbits.units import ANGLE, ANGULAR_SPEED, DIMENSIONLESS, INERTIA, TIME
 
@@ -117,7 +117,7 @@ def _si(x: Any, unit: u.UnitBase) -> np.ndarray:
 
 
 def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
-    from hamilton_orbits._firstrun import compile_seconds
+    from hamilton_orbits.firstrun import compile_seconds
     from rigid import free_motion, free_parameters, integrate
 
     spec = scene.spec

@@ -27,7 +27,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits import _schema as S
+from hamilton_orbits import schema as S
 from hamilton_orbits.scene import Result, Scene, SceneKind, format_table, register_kind
 
 SCHEMA: dict[str, S.Field] = {

@@ -22,8 +22,8 @@ from astropy.table import QTable
 from astropy.time import Time
 from scipy.optimize import least_squares
 
-from hamilton_orbits._validation import as_float_array
 from hamilton_orbits.units import TIME
+from hamilton_orbits.validation import as_float_array
 from rigid._shared import positive_scalar
 from rigid.c04 import PolarMotionRecord, decimal_year, iers2010_mean_pole, mjd_utc
 

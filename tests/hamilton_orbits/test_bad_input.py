@@ -28,9 +28,9 @@ from astropy.time import Time
 
 from hamilton_orbits import Body, Ensemble, Scene, System, crosscheck, integrate
 from hamilton_orbits._outdir import LOCK_NAME, FolderError, OutputFolder
-from hamilton_orbits._schema import key_lines
 from hamilton_orbits.effects import normalize_effects
 from hamilton_orbits.scene import OUTPUT_LIMIT, SceneError
+from hamilton_orbits.schema import key_lines
 
 
 def floats():

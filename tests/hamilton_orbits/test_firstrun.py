@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from numba import njit
 
-from hamilton_orbits import _firstrun
+from hamilton_orbits import firstrun
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 
@@ -27,18 +27,18 @@ def _fresh_function(module: str):
 
 
 def test_notice_once_when_our_kernel_compiles(monkeypatch, capsys):
-    monkeypatch.setitem(_firstrun._state, "printed", False)
+    monkeypatch.setitem(firstrun._state, "printed", False)
     assert njit(_fresh_function("hamilton_orbits._probe"))(1.0) == 3.0
     assert njit(_fresh_function("hamilton_orbits._probe"))(2.0) == 5.0
     err = capsys.readouterr().err
-    assert err == _firstrun.NOTICE + "\n"  # one line, once
+    assert err == firstrun.NOTICE + "\n"  # one line, once
 
 
 def test_no_notice_for_other_packages(monkeypatch, capsys):
-    monkeypatch.setitem(_firstrun._state, "printed", False)
+    monkeypatch.setitem(firstrun._state, "printed", False)
     assert njit(_fresh_function("someone_else"))(1.0) == 3.0
     assert capsys.readouterr().err == ""
-    assert _firstrun._state["printed"] is False
+    assert firstrun._state["printed"] is False
 
 
 def _run(code: str, cache_dir: str | None = None) -> subprocess.CompletedProcess:
@@ -66,7 +66,7 @@ def test_no_notice_when_warm():
 def test_notice_on_cold_cache(tmp_path):
     cold = _run(CALL, str(tmp_path))
     assert cold.returncode == 0, cold.stderr[-2000:]
-    assert cold.stderr.splitlines() == [_firstrun.NOTICE]
+    assert cold.stderr.splitlines() == [firstrun.NOTICE]
     warm = _run(CALL, str(tmp_path))
     assert warm.stderr == ""
 
@@ -80,10 +80,10 @@ def _caller_of(module: str):
 
 
 def test_compile_clock_counts_outermost_compilations():
-    seconds, count = _firstrun.compile_seconds(), _firstrun.compile_count()
+    seconds, count = firstrun.compile_seconds(), firstrun.compile_count()
     assert njit(_caller_of("someone_else"))(1.0) == 4.0
-    assert _firstrun.compile_count() - count == 1  # the callee's compilation is inside
-    assert _firstrun.compile_seconds() > seconds
+    assert firstrun.compile_count() - count == 1  # the callee's compilation is inside
+    assert firstrun.compile_seconds() > seconds
 
 
 def test_integration_time_excludes_compilation():
@@ -104,11 +104,11 @@ def test_integration_time_excludes_compilation():
         return EngineRun(np.zeros(1), np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), 0, wall, True,
                          None, np.ones(1))
 
-    compiled = _firstrun.compile_seconds()
+    compiled = firstrun.compile_seconds()
     start = time.perf_counter()
     out = without_compilation(run)
     total = time.perf_counter() - start
-    compiled = _firstrun.compile_seconds() - compiled
+    compiled = firstrun.compile_seconds() - compiled
     assert compiled > 0.01  # numba needs tens of ms at least to compile two functions
     # what is left is the call itself, not the compilation (both clocks are perf_counter)
     assert out.wall_time < total - 0.9 * compiled

@@ -10,10 +10,10 @@ import pytest
 from numpy.polynomial import legendre
 
 from hamilton_orbits._kernels.radau15 import coefficients
-from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.integrators import radau15
 from hamilton_orbits.orbit import KeplerOrbit
 from hamilton_orbits.rhs import newtonian_rhs
+from hamilton_orbits.validation import ConvergenceError
 
 EPS = np.finfo(float).eps
 # a fixed rotation (rows orthonormal: 3-4-5 triangles) so that no orbit lies in

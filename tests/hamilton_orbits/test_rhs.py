@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from hamilton_orbits import Body, System
-from hamilton_orbits._firstrun import NOTICE
 from hamilton_orbits._kernels import nbody as kernels
 from hamilton_orbits.effects import EffectSet
+from hamilton_orbits.firstrun import NOTICE
 from hamilton_orbits.rhs import compile_rhs, kernels_for, parameter_vector, source
 
 SRC = Path(__file__).resolve().parents[2] / "src"

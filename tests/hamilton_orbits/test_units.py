@@ -1,17 +1,17 @@
-"""The unit boundary (units.py) and the shared input validation (_validation.py)."""
+"""The unit boundary (units.py) and the shared input validation (validation.py)."""
 
 import astropy.units as u
 import numpy as np
 import pytest
 
-from hamilton_orbits._validation import (
+from hamilton_orbits.units import is_quantity, strip, wrap
+from hamilton_orbits.validation import (
     ConvergenceError,
     as_float_array,
     broadcast,
     check_positive,
     check_trailing,
 )
-from hamilton_orbits.units import is_quantity, strip, wrap
 
 
 def test_strip_converts_quantities_and_passes_floats():

@@ -5,6 +5,6 @@ first use (:mod:`hamilton_orbits._lazy`).  The one-line notice on stderr while
 kernels compile for the first time is installed here, before any kernel exists.
 """
 
-from hamilton_orbits._firstrun import install as _install_compile_notice
+from hamilton_orbits.firstrun import install as _install_compile_notice
 
 _install_compile_notice()

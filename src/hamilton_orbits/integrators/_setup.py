@@ -13,7 +13,7 @@ from numba.core.typing.typeof import typeof_impl
 from hamilton_orbits._kernels import checks as _checks
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ACCEL_TYPE
-from hamilton_orbits._validation import as_float_array, check_positive
+from hamilton_orbits.validation import as_float_array, check_positive
 
 # ``ACCEL_TYPE``: the first-class function type of a right-hand side, so that a
 # stepping kernel compiled for it is cached once for every ``accel`` (a kernel

@@ -34,9 +34,9 @@ from hamilton_orbits._kernels import radau15 as _radau
 from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
-from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.integrators import StopIntegration, output_arrays
 from hamilton_orbits.integrators._setup import accel_arg
+from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["DEFAULT_SEED", "SLICE", "Tangent", "run_dop853", "run_leapfrog",
            "run_radau15", "run_wh"]

@@ -42,9 +42,9 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels import radau15 as _k
-from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
+from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "PRECISIONS", "RADAU_SPACINGS",
            "run"]

@@ -64,7 +64,6 @@ import numpy as np
 
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
-from hamilton_orbits._validation import ConvergenceError
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import (
     WH_CORRECTORS,
@@ -73,6 +72,7 @@ from hamilton_orbits.integrators import (
     _tangent,
     output_arrays,
 )
+from hamilton_orbits.validation import ConvergenceError
 
 __all__ = [
     "ACCEPTS_VELOCITY_DEPENDENT",

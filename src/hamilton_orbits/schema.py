@@ -8,6 +8,8 @@ astropy Quantities of the dimension the key expects.
 
 Nothing here knows about orbits or rigid bodies: scene kinds declare their
 schema with these fields (``hamilton_orbits.scene``).
+
+Public: both packages' scene kinds declare their schemas with it.
 """
 
 from __future__ import annotations

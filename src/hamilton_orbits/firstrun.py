@@ -13,6 +13,8 @@ The same listener keeps a clock of compilation (:func:`compile_seconds`,
 (a function compiling the functions it calls is one event), so that a run can
 report its integration time without the compilation that happened inside it,
 and the compilation on its own line.
+
+Public: ``rigid``'s kernels and scenes report their compilation through it.
 """
 
 from __future__ import annotations

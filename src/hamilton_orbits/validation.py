@@ -2,6 +2,8 @@
 
 Every check raises :class:`ValueError` naming the argument, the (first) offending
 index and the value, as the project's conventions require.
+
+Public: ``rigid`` stands on it as ``hamilton_orbits`` does (the core both packages share).
 """
 
 from __future__ import annotations
