@@ -1,28 +1,35 @@
 """The float-level engine under every public entry point.
 
-:func:`run` takes plain arrays (positions, velocities, GMs in one consistent unit
-system), a compiled right-hand side (:class:`hamilton_orbits.rhs.RHS`), the method
-and its options, the output times, an output callback and a stop callback, and
-returns plain arrays and step counts (:class:`EngineRun`).  It validates nothing
-the public layer has validated already and converts no units.
+:class:`Propagation` is one integration's whole state on plain arrays (positions,
+velocities, GMs in one consistent unit system), a compiled right-hand side
+(:class:`hamilton_orbits.rhs.RHS`), the method as a typed value
+(:mod:`hamilton_orbits.integrators.methods`), the events log and the variational
+equations; :meth:`Propagation.advance` takes it through output times and returns
+that leg's plain arrays and step count (:class:`EngineRun`), and the next call
+continues from where the last one ended exactly as one call through both legs'
+output times would have.  :func:`run` is one propagation advanced once.  Neither
+validates what the public layer has validated already, nor converts units.
 
-``integrate`` (:mod:`hamilton_orbits.simulation`), the scenes, the ensembles,
-``crosscheck`` and the report all call it; none of them calls another public
-entry point in a loop.
+:class:`hamilton_orbits.Simulation` (and through it ``integrate``, the scenes and
+the ensembles), ``crosscheck`` and the report stand on it; none of them calls
+another public entry point in a loop.
 
 Stopping early
 --------------
-``stop()`` is asked after every output; when it returns True, or when the user
-presses Ctrl-C (``KeyboardInterrupt``) during the run, the engine returns what
-was reached (``complete=False``) instead of losing it.  The integrators return
-to Python at least every few thousand steps (radau15) or every output (the
-fixed-step maps), so an interrupt is seen promptly.
+``stop()`` is asked after every output; when it returns True, when an output
+callback raises :class:`StopIntegration`, or when the user presses Ctrl-C
+(``KeyboardInterrupt``) during the run, the engine returns what was reached
+(``complete=False``; ``interrupted=True`` for Ctrl-C) instead of losing it.  The
+integrators return to Python at least every few thousand steps (radau15) or
+every output (the fixed-step maps), so an interrupt is seen promptly.
 
 Backward integration
 --------------------
 Output times that decrease are integrated as forward times with the velocities
 reversed, which is exact for forces that do not depend on velocities; a
-velocity-dependent right-hand side is refused there.
+velocity-dependent right-hand side is refused there.  A leg in the other
+direction from the one before starts the integrator afresh from the state
+reached.
 """
 
 from __future__ import annotations
@@ -36,14 +43,22 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import INTEGRATORS, Integrator, StopIntegration
+from hamilton_orbits.integrators import (
+    INTEGRATORS,
+    Integrator,
+    Method,
+    StopIntegration,
+    method_of,
+)
+from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
 
-__all__ = ["EngineRun", "StopIntegration", "integrator", "run"]
+__all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
 
 @dataclass(frozen=True)
 class EngineRun:
-    """What :func:`run` returns: the outputs reached, in the caller's units.
+    """What :func:`run` and :meth:`Propagation.advance` return: the outputs reached,
+    in the caller's units.
 
     Attributes
     ----------
@@ -52,11 +67,12 @@ class EngineRun:
     r, v : ndarray, shape (k, n, 3)
         The states at those times.
     steps : int
-        Steps taken.
+        Steps taken (in this call).
     wall_time : float
         Seconds of the integration proper.
     complete : bool
-        False if the run stopped early (``stop()`` or Ctrl-C).
+        False if the run stopped early (``stop()``, :class:`StopIntegration` from
+        an output callback, or Ctrl-C).
     events : EventLog or None
         The events found (when any were watched); an event that stopped the run
         is ``events.stopped_by``, and ``t[-1]`` is its time.
@@ -66,6 +82,10 @@ class EngineRun:
     variational : Tangent or None
         The variational equations of the run (MEGNO, the Lyapunov exponent and the
         STM at the outputs), when they were asked for.
+    interrupted : bool
+        True if Ctrl-C ended the run (``complete`` is then False).
+    first_event : int
+        The index in ``events.recorded()`` of the first event found in this call.
     """
 
     t: np.ndarray
@@ -77,6 +97,8 @@ class EngineRun:
     events: EventLog | None
     gm: np.ndarray
     variational: Any = None
+    interrupted: bool = False
+    first_event: int = 0
 
 
 def integrator(method: str) -> Integrator:
@@ -103,13 +125,166 @@ def integrator(method: str) -> Integrator:
 _MODULES: dict[str, Integrator] = {}
 
 
+class Propagation:
+    """One integration's state on plain arrays, advanced leg by leg.
+
+    Parameters
+    ----------
+    r0, v0 : ndarray, shape (n, 3)
+    gm : ndarray, shape (n,)
+    t0 : float
+        The time of ``r0``, ``v0``.
+    rhs : RHS
+        The compiled right-hand side (:func:`hamilton_orbits.rhs.compile_rhs`).
+    method : Method
+        The method and its options, checked
+        (:func:`hamilton_orbits.integrators.methods.method_of`).
+    dt, tol : float, optional
+        The integrator's step and tolerance, positive and finite (or None).
+    events : EventLog, optional
+        Events to watch (:mod:`hamilton_orbits.events`), forwards only.
+    variational : Tangent, optional
+        Tangent vectors to integrate beside the state
+        (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
+        ``variational=True``); forwards in time and without events.
+
+    Examples
+    --------
+    Two legs give the bits of one call through both legs' output times:
+
+    >>> from hamilton_orbits.integrators import Radau15
+    >>> from hamilton_orbits.rhs import newtonian_rhs
+    >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v0 = np.array([[0.0, 0, 0], [0, 1.0, 0]])
+    >>> gm = np.array([1.0, 0.0])
+    >>> legs = Propagation(r0, v0, gm, 0.0, newtonian_rhs(), Radau15())
+    >>> _ = legs.advance(np.array([0.0, 1.0]))
+    >>> second = legs.advance(np.array([1.0, 2.5]))
+    >>> once = Propagation(r0, v0, gm, 0.0, newtonian_rhs(), Radau15()).advance(
+    ...     np.array([0.0, 1.0, 2.5]))
+    >>> bool(np.array_equal(second.r[-1], once.r[-1])), legs.t, legs.steps == once.steps
+    (True, 2.5, True)
+    """
+
+    def __init__(self, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, rhs: Any,
+                 method: Method, *, dt: float | None = None, tol: float | None = None,
+                 events: EventLog | None = None, variational: Any = None) -> None:
+        # C-contiguous float64, not copied when it is already (read-only is fine: the
+        # drivers copy what they change)
+        self.r, self.v, self.gm0 = (
+            x if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous
+            else np.require(x, np.float64, ["C"]) for x in (r0, v0, gm))
+        self.gm = self.gm0
+        self.t, self.rhs, self.method, self.dt, self.tol = float(t0), rhs, method, dt, tol
+        self.events, self.variational = events, variational
+        self.module = integrator(method.name)
+        #: the driver's state (made on the first leg, when the direction is known)
+        self.driver: Any = None
+        self.backward = False
+        #: steps taken by earlier drivers (a change of direction starts a new one)
+        self.steps_before = 0
+
+    @property
+    def steps(self) -> int:
+        """Steps taken since the start."""
+        return self.steps_before + (self.driver.steps if self.driver is not None else 0)
+
+    def _check(self, backward: bool) -> None:
+        watched = self.events is not None and len(self.events.watch)
+        if backward and self.rhs.velocity_dependent:
+            raise ValueError("Backward integration with a velocity-dependent effect is not "
+                             "supported; integrate forwards from the final state")
+        if self.variational is not None and (backward or watched):
+            raise ValueError("The variational equations are integrated forwards in time and "
+                             "without events; integrate forwards, with no events listed")
+        if watched and backward:
+            raise ValueError("Events are watched forwards in time only; integrate forwards")
+
+    def _driver_for(self, backward: bool) -> Any:
+        """The driver's state for a leg in this direction (a new one from the state
+        reached when the direction changes)."""
+        if self.driver is not None and backward == self.backward:
+            return self.driver
+        self._check(backward)
+        if self.driver is not None:
+            self.steps_before += self.driver.steps
+        watched = self.events is not None and len(self.events.watch)
+        sign = -1.0 if backward else 1.0
+        self.driver = self.module.start(
+            self.rhs, self.r, -self.v if backward else self.v, self.gm, sign * self.t,
+            self.method, dt=self.dt, tol=self.tol, events=self.events if watched else None,
+            variational=self.variational)
+        self.backward = backward
+        return self.driver
+
+    def advance(self, t_out: np.ndarray, *, on_output: Callable[[int, int], None] | None = None,
+                stop: Callable[[], bool] | None = None) -> EngineRun:
+        """Integrate through ``t_out`` (strictly monotonic, ``t_out[0]`` the current
+        time :attr:`t`, forwards or backwards); see :func:`run`."""
+        n_t = t_out.shape[0]
+        backward = n_t > 1 and t_out[-1] < t_out[0]
+        driver = self._driver_for(backward)
+        r_out = np.empty((n_t,) + self.r.shape)
+        v_out = np.empty_like(r_out)
+        r_out[0], v_out[0] = self.r, self.v
+        if self.variational is not None:
+            self.variational.new_leg(n_t)
+        first_event = len(self.events.recorded()) if self.events is not None else 0
+        if self.events is not None:
+            self.events.stopped_by = None
+        reached = [0, 0]  # last output index, steps
+
+        def report(i: int, steps: int) -> None:
+            reached[0], reached[1] = i, steps
+            if on_output is not None:
+                on_output(i, steps)
+            if stop is not None and stop():
+                raise StopIntegration
+
+        t_reached = np.array(t_out, dtype=np.float64)
+        start, steps0 = time.perf_counter(), driver.steps
+        complete, interrupted = True, False
+        try:
+            driver.advance(-t_out if backward else t_out, r_out, v_out, report, stop)
+            reached[0] = n_t - 1
+        except StopAtEvent as stopped:
+            reached[0] = stopped.index
+            t_reached[stopped.index] = stopped.t
+        except StopIntegration:
+            complete = False
+        except KeyboardInterrupt:
+            complete, interrupted = False, True
+        wall = time.perf_counter() - start
+        k = reached[0] + 1
+        if backward:  # in place: no second copy of the history
+            np.negative(v_out, out=v_out)
+        self._reached(driver, r_out[k - 1], v_out[k - 1], float(t_reached[k - 1]))
+        gm_out = (self.events.gm_at(t_reached[:k], self.gm0)
+                  if self.events is not None and self.events.gm_changes else self.gm0)
+        return EngineRun(t_reached[:k], r_out[:k], v_out[:k], driver.steps - steps0, wall,
+                         complete, self.events, gm_out, self.variational, interrupted,
+                         first_event)
+
+    def _reached(self, driver: Any, r: np.ndarray, v: np.ndarray, t: float) -> None:
+        """Keep the state reached: the last output row when the driver stands at its
+        time, else (a leg stopped between outputs) the driver's own state at its own
+        time."""
+        sign = -1.0 if self.backward else 1.0
+        if driver.t == sign * t:
+            self.r, self.v, self.t = r, v, t
+            self.gm = self.events.gm_at(np.array([t]), self.gm0)[0] if (
+                self.events is not None and self.events.gm_changes) else self.gm0
+        else:
+            r_now, v_now, self.gm = driver.state()
+            self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
+
+
 def run(
     r0: np.ndarray,
     v0: np.ndarray,
     gm: np.ndarray,
     t_out: np.ndarray,
     rhs: Any,
-    method: str,
+    method: str | Method,
     *,
     dt: float | None = None,
     tol: float | None = None,
@@ -130,12 +305,13 @@ def run(
         backwards).
     rhs : RHS
         The compiled right-hand side (:func:`hamilton_orbits.rhs.compile_rhs`).
-    method : str
-        One of :data:`hamilton_orbits.integrators.INTEGRATORS`.
+    method : str or Method
+        One of :data:`hamilton_orbits.integrators.INTEGRATORS`, or its typed value.
     dt, tol : float, optional
         The integrator's step and tolerance (see each integrator).
     options : dict, optional
-        The integrator's own options (e.g. ``coordinates`` for ``wh``).
+        The integrator's own options (e.g. ``coordinates`` for ``wh``) beside a
+        method's name.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i``; may raise
         :class:`StopIntegration`.
@@ -166,55 +342,10 @@ def run(
     >>> half.complete, half.t.tolist() == [0.0, np.pi]
     (False, True)
     """
-    module = integrator(method)
-    # C-contiguous float64, not copied when it is already (read-only is fine: the
-    # drivers copy what they change)
-    r0, v0, gm = (x if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.c_contiguous
-                  else np.require(x, np.float64, ["C"]) for x in (r0, v0, gm))
-    backward = t_out.shape[0] > 1 and t_out[-1] < t_out[0]
-    if backward and rhs.velocity_dependent:
-        raise ValueError("Backward integration with a velocity-dependent effect is not "
-                         "supported; integrate forwards from the final state")
-    n_t = t_out.shape[0]
-    r_out = np.empty((n_t,) + np.shape(r0))
-    v_out = np.empty_like(r_out)
-    reached = [0, 0]  # last output index, steps
-
-    def report(i: int, steps: int) -> None:
-        reached[0], reached[1] = i, steps
-        if on_output is not None:
-            on_output(i, steps)
-        if stop is not None and stop():
-            raise StopIntegration
-
-    kw = dict(options or {})
-    if variational is not None:
-        if backward or (events is not None and len(events.watch)):
-            raise ValueError("The variational equations are integrated forwards in time and "
-                             "without events; integrate forwards, with no events listed")
-        kw["variational"] = variational
-    if events is not None and len(events.watch):
-        if backward:
-            raise ValueError("Events are watched forwards in time only; integrate forwards")
-        kw["events"] = events
-    t_reached = np.array(t_out, dtype=np.float64)
-    start = time.perf_counter()
-    complete = True
-    try:
-        _, _, steps = module.run(rhs, r0, -v0 if backward else v0, gm,
-                                 -t_out if backward else t_out, dt=dt, tol=tol,
-                                 on_output=report, out=(r_out, v_out), stop=stop, **kw)
-        reached[0], reached[1] = n_t - 1, steps
-    except StopAtEvent as stopped:
-        reached[0], reached[1] = stopped.index, stopped.steps
-        t_reached[stopped.index] = stopped.t
-    except (StopIntegration, KeyboardInterrupt):
-        complete = False
-    wall = time.perf_counter() - start
-    k = reached[0] + 1
-    gm_out = (events.gm_at(t_reached[:k], gm) if events is not None and events.gm_changes
-              else gm)
-    if backward:  # in place: no second copy of the history
-        np.negative(v_out, out=v_out)
-    return EngineRun(t_reached[:k], r_out[:k], v_out[:k], reached[1], wall, complete,
-                     events, gm_out, variational)
+    typed = method_of(method, options)
+    t_arr = np.ascontiguousarray(t_out, dtype=np.float64)
+    backward = t_arr.ndim == 1 and t_arr.shape[0] > 1 and t_arr[-1] < t_arr[0]
+    r0, v0, gm, _ = check_inputs(r0, v0, gm, -t_arr if backward else t_arr)
+    dt, tol = check_dt_tol(dt, tol)
+    return Propagation(r0, v0, gm, float(t_arr[0]), rhs, typed, dt=dt, tol=tol, events=events,
+                       variational=variational).advance(t_arr, on_output=on_output, stop=stop)

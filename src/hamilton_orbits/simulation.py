@@ -1,204 +1,273 @@
-"""Integrate a :class:`~hamilton_orbits.nbody.System`: :func:`integrate`, :class:`Trajectory`.
+"""The one front door: a prepared, stateful :class:`Simulation`, and :func:`integrate`.
+
+A :class:`Simulation` is validated and compiled once: the system, the method and
+its options (a typed value, :mod:`hamilton_orbits.integrators.methods`), the
+step or tolerance, the effects (their compiled right-hand side), the events to
+watch and the variational equations.  ``sim.integrate(t)`` advances it and
+returns that leg's :class:`~hamilton_orbits.trajectory.Trajectory`; the next call
+continues from the integrator's own state (radau15's step and predictor, the
+Wisdom-Holman coordinates, the MEGNO sums, the events found), so that
+
+    sim.integrate(t1); sim.integrate(t2)
+
+reaches ``t2`` with the same bits as one ``sim.integrate([t1, t2])``.  Times are
+the simulation's own, from 0 at the system given.  ``integrate(system, t, **kw)``
+is ``Simulation(system, **kw).integrate(t)``; scenes and ensembles stand on it.
 
 Every trajectory carries Hamilton's integrals as diagnostics (Hamilton 1845,
 equations (C), (D), (E)): the drift of the centre of mass, the relative error of
-the total angular momentum (law of areas) and of the energy (vis viva).
+the total angular momentum (law of areas) and of the energy (vis viva), from the
+start of the simulation.
 """
 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
+import copy
 import functools
 import math
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from types import ModuleType
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.firstrun import compile_seconds
-from hamilton_orbits.integrators import INTEGRATORS
-from hamilton_orbits.nbody import DAY, LostStateError, System, integral_errors
-from hamilton_orbits.rhs import compile_rhs
-from hamilton_orbits.trajectory import TrajectoryBase
+from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
+from hamilton_orbits.nbody import DAY, System, integral_errors
+from hamilton_orbits.rhs import RHS, compile_rhs
+from hamilton_orbits.trajectory import Trajectory, event_table
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 from hamilton_orbits.validation import as_float_array
 
-__all__ = ["INTEGRATORS", "Trajectory", "check_method", "integrate", "make_trajectory"]
+__all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
+           "event_table", "integrate", "make_trajectory"]
 
 
-def _accepting_velocity_dependent() -> list[str]:
-    return [m for m in INTEGRATORS if engine.integrator(m).ACCEPTS_VELOCITY_DEPENDENT]
+class Simulation:
+    """A prepared n-body integration that lives across calls.
 
-
-@dataclass(frozen=True, eq=False, kw_only=True)
-class Trajectory(TrajectoryBase):
-    """The states of a system at the output times, with Hamilton's integrals.
-
-    Attributes (beside those of :class:`~hamilton_orbits.trajectory.TrajectoryBase`:
-    ``t``, ``steps``, ``wall_time``, ``method``, ``energy_error``,
-    ``angular_momentum_error``)
+    Parameters
     ----------
-    t : ndarray or Quantity, shape (n_t,)
-        Output times (the first is the initial time), in the unit the caller gave
-        ``t`` in (a Quantity system), or the caller's floats.
-    r, v : ndarray or Quantity, shape (n_t, n, 3)
-        Positions and velocities (au, au/day for Quantity systems).
-    names : tuple of str
-    final : System
-        The system at the last output time (made on first access from the last
-        output row).
-    energy_error : ndarray, shape (n_t,)
-        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
-        energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
-        massive body, the test particles' specific orbital energies about it
-        (:func:`~hamilton_orbits.nbody.integral_errors`).
-    angular_momentum_error : ndarray, shape (n_t,)
-        ``|L(t) - L(0)| / |L(0)|`` (law of areas, (D)); absolute if ``L(0) = 0``.
-    barycentre_drift : ndarray, shape (n_t,)
-        ``|R(t) - R(0) - V(0) t| / s`` with ``s`` the largest distance from the
-        initial centre of mass (law of the centre of gravity, (C)).
+    system : System
+        The bodies at time 0 of the simulation.
+    method : str or Method
+        ``"radau15"`` (default), ``"wh"``, ``"leapfrog"``, ``"dop853"``, or a typed
+        value (:class:`~hamilton_orbits.integrators.Radau15`,
+        :class:`~hamilton_orbits.integrators.WH`, ...) that carries the options.
+    dt : Quantity or float, optional
+        A fixed step (``radau15``, ``wh``, ``leapfrog``) or a step cap
+        (``dop853``); a time Quantity for a Quantity system.
+    tol : float, optional
+        The integrator's tolerance (adaptive methods) or the accuracy from which a
+        fixed-step method chooses its step.
+    effects : sequence of str or mapping
+        Effects beyond Newtonian gravity (:mod:`hamilton_orbits.effects`).
+    events : sequence of str or mapping, optional
+        Events to find (:mod:`hamilton_orbits.events`).
+    variational : bool
+        Integrate the first-order variational equations beside the system (MEGNO,
+        the Lyapunov exponent; see ``docs/variational.md``).
+    stm : bool
+        With ``variational``: also the state transition matrix.
+    tangent : array_like, shape (n, 6), optional
+        MEGNO's initial tangent vector (default: random, as rebound's
+        ``init_megno`` draws it, a fixed seed).
+    **method_options
+        The method's options beside its name (``coordinates="jacobi"``,
+        ``corrector=11`` for ``wh``; see :mod:`hamilton_orbits.integrators.methods`).
+
+    Attributes
+    ----------
+    t : float or Quantity
+        The simulation's time (a Quantity in the unit of the last times given, days
+        at first, for a Quantity system).
+    system : System
+        The current state.
     steps : int
-        Steps taken by the integrator.
-    wall_time : float
-        Seconds of wall-clock time for the integration proper (the checks and
-        any numba compilation, of the right-hand side or of the stepping kernel
-        on its first call, are not counted).
-    method : str
-    effects : tuple of str
-    events : astropy.table.QTable
-        One row per event found (``name``, ``time``, ``bodies``, ``distance``,
-        ``speed``, ``action``); empty when none was listed or found.
-    stopped_by : astropy.table.Row or None
-        The row of the event that ended the run, if one did.
-    megno : ndarray, shape (n_t,) or None
-        With ``variational=True``: MEGNO ``<Y>(t)`` (Cincotta & Simo 2000), as
-        rebound's ``sim.megno()``; it tends to 2 on a quasi-periodic orbit, 0 on a
-        stable periodic one, and grows like ``lambda t / 2`` on a chaotic one.  0 at
-        the start.
-    lyapunov : ndarray or Quantity, shape (n_t,) or None
-        With ``variational=True``: the Lyapunov exponent as rebound's
-        ``sim.lyapunov()`` defines it, the slope of the least-squares line through
-        ``<Y>(t)`` over the steps so far (Cincotta & Simo 2000, eq. 24), in 1/(the
-        unit of ``t``); ``1 / lyapunov`` is the Lyapunov time.  For ``|delta|``
-        growing like ``exp(lambda t)``, ``<Y> ~ lambda t / 2``: this slope is
-        ``lambda / 2`` of the growth rate of the tangent vector.
-    stm : ndarray, shape (n_t, 6n, 6n) or None
-        With ``stm=True``: the state transition matrix ``d(r, v)(t) / d(r, v)(0)``,
-        coordinates body by body (x, y, z, vx, vy, vz of body 0, then body 1, ...),
-        in the system's internal units (au and days for a Quantity system).
+        Steps taken since time 0.
+    method : Method
+        The method and its options.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, option or effect, a velocity-dependent effect
+        given to a symplectic integrator, or a bad step or tolerance.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hamilton_orbits import Body, Simulation, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+    ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    >>> sim = Simulation(s, method="wh", dt=0.01)
+    >>> leg = sim.integrate(np.pi)       # to t = pi
+    >>> leg = sim.integrate(2 * np.pi)   # on to t = 2 pi: continues the same steps
+    >>> once = Simulation(s, method="wh", dt=0.01).integrate([np.pi, 2 * np.pi])
+    >>> bool(np.array_equal(leg.r[-1], once.r[-1])), sim.t, sim.steps
+    (True, 6.283185307179586, 629)
+    >>> branch = sim.copy()              # an independent copy, for ensembles
+    >>> _ = branch.integrate(3 * np.pi)
+    >>> sim.t, branch.t
+    (6.283185307179586, 9.42477796076938)
     """
 
-    r: Any
-    v: Any
-    names: tuple[str, ...]
-    barycentre_drift: np.ndarray
-    effects: tuple[str, ...]
-    #: What :attr:`final` is made from on first access: the system, the last
-    #: state, masses and the bodies still in the run (a copy of the state made
-    #: only when asked for: 48 bytes a body).
-    final_source: Any = field(default=None, repr=False)
-    #: What :attr:`events` and :attr:`stopped_by` are built from, on first access
-    #: (the events log, the system and the time unit): an astropy table costs
-    #: ~0.1 ms, more than the rest of a short call's wrapping.
-    event_source: Any = field(default=None, repr=False)
-    megno: Any = None
-    lyapunov: Any = None
-    stm: Any = None
+    def __init__(self, system: System, method: str | Method = "radau15", dt: Any = None,
+                 tol: float | None = None, effects: Sequence[str | Mapping[str, Any]] = (),
+                 events: Any = (), variational: bool = False, stm: bool = False,
+                 tangent: Any = None, **method_options: Any) -> None:
+        if not isinstance(system, System):
+            raise ValueError(f"Expected `system` to be a System, got {system!r}")
+        typed = method_of(method, method_options)
+        eff = check_effects(typed, effects)
+        step = None if dt is None else _step(dt, system.quantity)
+        tol = _tolerance(tol)
+        tan = _tangent(system, variational, stm, tangent, typed)
+        rhs = compile_rhs(system, eff, variational=tan is not None)
+        arrays = system.as_arrays()
+        self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
+                                        tol=tol, events=event_log(system, events),
+                                        variational=tan)
+        self._system, self._effects = system, eff
+        #: the state at time 0, from which Hamilton's integrals are measured (None
+        #: until a first leg has begun there)
+        self._start: Any = None
+        self._initial = (arrays.r, arrays.v, arrays.gm)
+        self._unit: Any = DAY if system.quantity else None
 
-    @functools.cached_property
-    def final(self) -> System:
-        """The system at the last output time."""
-        system, r, v, gm, keep = self.final_source
-        return system.with_state(r, v, gm=gm, keep=keep, check=False)
+    # ------------------------------------------------------------------ state
+    @property
+    def method(self) -> Method:
+        """The method and its options."""
+        return self._prop.method
 
-    @functools.cached_property
-    def events(self) -> Any:
-        """One row per event found (a ``QTable``; empty when none was listed or found)."""
-        return self._event_tables()[0]
+    @property
+    def t(self) -> Any:
+        """The simulation's time (see the class notes)."""
+        t = self._prop.t
+        return t if self._unit is None else (t * DAY).to(self._unit)
 
-    @functools.cached_property
-    def stopped_by(self) -> Any:
-        """The row of :attr:`events` of the event that ended the run, or None."""
-        return self._event_tables()[1]
+    @property
+    def steps(self) -> int:
+        """Steps taken since time 0."""
+        return self._prop.steps
 
-    def _event_tables(self) -> tuple[Any, Any]:
-        if "_tables" not in self.__dict__:
-            log, system, unit = self.event_source or (None, None, None)
-            self.__dict__["_tables"] = event_table(log, system, unit)
-        return self.__dict__["_tables"]
+    @property
+    def system(self) -> System:
+        """The current state as a :class:`~hamilton_orbits.nbody.System` (bodies an
+        event took out of the run are left out)."""
+        p = self._prop
+        keep = None if p.events is None or not p.events.inactive.any() else ~p.events.inactive
+        return self._system.with_state(p.r, p.v, gm=p.gm, keep=keep, check=False)
+
+    @property
+    def effects(self) -> EffectSet:
+        """The effects beyond Newtonian gravity."""
+        return self._effects
+
+    @property
+    def rhs(self) -> RHS:
+        """The compiled right-hand side."""
+        return self._prop.rhs
 
     def __repr__(self) -> str:
-        return (
-            f"Trajectory({len(self.names)} bodies, {len(self.energy_error)} outputs, "
-            f"method={self.method!r}, effects={self.effects!r}, steps={self.steps}, "
-            f"max |dE/E|={np.max(np.abs(self.energy_error)):.3g})"
-        )
+        return (f"Simulation({len(self._system.names)} bodies, method={self.method!r}, "
+                f"effects={self._effects.names!r}, t={self.t!r}, steps={self.steps})")
+
+    def copy(self) -> Simulation:
+        """An independent copy (its own state; the compiled right-hand side shared):
+        integrating one does not change the other."""
+        new = copy.copy(self)
+        new._prop = copy.deepcopy(self._prop, _shared(self._prop))
+        return new
+
+    # ------------------------------------------------------------------ run
+    def integrate(self, t: Any, *, progress: bool = False,
+                  on_output: Callable[[int, int], None] | None = None,
+                  stop: Callable[[], bool] | None = None) -> Trajectory:
+        """Advance to ``t`` and return the trajectory of this leg.
+
+        Parameters
+        ----------
+        t : Quantity or float or array_like
+            An end time, or output times (monotonic from the simulation's time
+            :attr:`t`, which is added as the first output if missing), in the
+            simulation's time (0 at the system given); a time Quantity for a
+            Quantity system, plain floats otherwise.  Backwards is allowed for
+            forces that do not depend on velocities.
+        progress : bool
+            Show a progress bar (tqdm, on stderr) over the output times.
+        on_output : callable, optional
+            ``on_output(i, steps)`` after output ``i``; it may raise
+            :class:`~hamilton_orbits.engine.StopIntegration` to end the leg there
+            (the trajectory then has ``complete == False``).
+        stop : callable, optional
+            ``stop()`` after every output and between slices of steps; True ends
+            the leg there (``complete == False``).
+
+        Returns
+        -------
+        Trajectory
+
+        Raises
+        ------
+        ValueError
+            For bad times, or a lost state (a collision or a step too long).
+        KeyboardInterrupt
+            On Ctrl-C (the run stops within a few thousand steps; the simulation
+            keeps the state reached).
+        """
+        times, unit = _leg_times(t, self._prop.t, self._system.quantity)
+        if unit is not None:
+            self._unit = unit
+        with _progress(progress, self.method.name, len(times) - 1, on_output) as report:
+            compiled = compile_seconds()
+            out = self._prop.advance(times, on_output=report, stop=stop)
+            compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
+        if out.interrupted:
+            raise KeyboardInterrupt
+        start, self._start = self._start, self._initial  # the first leg begins at time 0
+        return make_trajectory(self._system, out, unit, self.method.name, self.rhs.effects,
+                               self._effects, start=start,
+                               wall_time=max(out.wall_time - compiled, 0.0))
 
 
-def _times(t: Any, quantity: bool) -> tuple[np.ndarray, Any]:
-    """Output times in days (Quantity system) from ``t``, with the caller's unit."""
-    if type(t) is float and not quantity and t != 0.0 and math.isfinite(t):
-        return np.array([0.0, t]), None  # an end time in the caller's units: the common case
-    if quantity and not is_quantity(t):
-        raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
-    if not quantity and is_quantity(t):
-        raise ValueError(f"Expected `t` as plain floats for a system of plain floats, got {t!r}")
-    unit = t.unit if quantity else None
-    arr = np.atleast_1d(TIME("t", t, DAY if quantity else None)).astype(np.float64)
-    if arr.size == 0:
-        raise ValueError("Expected `t` to be an end time or a non-empty array of times, got []")
-    if arr.ndim != 1:
-        raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
-                         f"{arr.shape}")
-    if arr.size == 1:
-        if arr[0] == 0.0:
-            raise ValueError("Expected `t` to be a nonzero end time, got 0")
-        arr = np.array([0.0, arr[0]])
-    elif arr[0] != 0.0:
-        arr = np.concatenate(([0.0], arr))
-    d = np.diff(arr)
-    if not (np.all(d > 0) or np.all(d < 0)):
-        k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
-        raise ValueError(
-            f"Expected `t` to be strictly monotonic (times after the start 0), got "
-            f"{arr[k + 1]!r} after {arr[k]!r} at index {k + 1}"
-        )
-    return arr, unit
+def _shared(prop: engine.Propagation) -> dict[int, Any]:
+    """The memo of a deep copy of ``prop``: what a copy shares instead of copying
+    (the compiled right-hand side, the driver module, compiled functions and
+    their addresses, the method value)."""
+    memo: dict[int, Any] = {}
+    seen: set[int] = set()
 
+    def walk(obj: Any) -> None:
+        if id(obj) in seen:
+            return
+        seen.add(id(obj))
+        module = type(obj).__module__ or ""
+        if isinstance(obj, (RHS, Method, ModuleType)) or module.startswith("numba"):
+            memo[id(obj)] = obj
+        elif isinstance(obj, (list, tuple)):
+            for x in obj:
+                walk(x)
+        elif isinstance(obj, dict):
+            for x in obj.values():
+                walk(x)
+        elif hasattr(obj, "__dict__") and not isinstance(obj, (np.ndarray, type)):
+            for x in vars(obj).values():
+                walk(x)
 
-def _check_options(module: Any, method: str, options: dict[str, Any]) -> None:
-    """Refuse an option the integrator's ``run`` does not take, listing those it does."""
-    if not options:
-        return
-    takes = _options_of(module.run)
-    for key, value in options.items():
-        if key not in takes:
-            raise ValueError(
-                f"Unknown option `{key}` = {value!r} for method {method!r}; it takes: "
-                + (", ".join(takes) if takes else "no options beyond dt and tol"))
-
-
-@functools.cache
-def _options_of(run: Any) -> list[str]:
-    """The options a driver's ``run`` takes (its keyword-only parameters beyond the
-    common ones), read once per driver."""
-    import inspect
-
-    common = {"dt", "tol", "on_output", "out", "events", "stop", "variational"}
-    return [name for name, p in inspect.signature(run).parameters.items()
-            if p.kind is p.KEYWORD_ONLY and name not in common]
+    walk(prop)
+    return memo
 
 
 def integrate(
     system: System,
     t: Any,
-    method: str = "radau15",
+    method: str | Method = "radau15",
     dt: Any = None,
     tol: float | None = None,
     effects: Sequence[str | Mapping[str, Any]] = (),
@@ -210,7 +279,8 @@ def integrate(
     tangent: Any = None,
     **options: Any,
 ) -> Trajectory:
-    """Integrate Hamilton's equation (B) (plus the listed effects) for ``system``.
+    """Integrate Hamilton's equation (B) (plus the listed effects) for ``system``:
+    ``Simulation(system, ...).integrate(t)``.
 
     Parameters
     ----------
@@ -218,8 +288,9 @@ def integrate(
     t : Quantity or float or array_like
         An end time, or output times (monotonic; a start at 0 is added if missing).
         A time Quantity for a Quantity system, plain floats otherwise.
-    method : {"radau15", "wh", "leapfrog", "dop853"}
-        The integrator (see :mod:`hamilton_orbits.integrators`).
+    method : {"radau15", "wh", "leapfrog", "dop853"} or Method
+        The integrator (see :mod:`hamilton_orbits.integrators`), by name or as a
+        typed value with its options (``WH(coordinates="jacobi")``).
     dt : Quantity or float, optional
         A fixed step (``radau15``, ``wh``, ``leapfrog``) or a step cap (``dop853``).
     tol : float, optional
@@ -231,7 +302,9 @@ def integrate(
     progress : bool
         Show a progress bar (tqdm, on stderr) over the output times.
     on_output : callable, optional
-        ``on_output(i, steps)`` after output ``i`` (for scenes and interfaces).
+        ``on_output(i, steps)`` after output ``i`` (for scenes and interfaces); it
+        may raise :class:`~hamilton_orbits.engine.StopIntegration` to end the run
+        there, the trajectory then incomplete (``complete == False``).
     events : sequence of str or mapping, optional
         Events to find during the run: ``close_encounter``, ``collision``,
         ``escape`` (see :mod:`hamilton_orbits.events`); the trajectory's
@@ -251,9 +324,9 @@ def integrate(
         rebound's ``init_megno`` draws it (a fixed seed).
     **options
         Options of the chosen integrator, e.g. for ``wh``
-        ``coordinates="jacobi"`` and ``corrector=3`` (or 5, 7, 11, 17; see its
-        ``run``).  An option the method does not take raises ``ValueError``
-        listing those it takes.
+        ``coordinates="jacobi"`` and ``corrector=3`` (or 5, 7, 11, 17; see
+        :mod:`hamilton_orbits.integrators.methods`).  An option the method does not
+        take raises ``ValueError`` listing those it takes.
 
     Returns
     -------
@@ -288,31 +361,56 @@ def integrate(
     ...
     ValueError: Effect 'gr' depends on velocities and integrator 'leapfrog' is symplectic...
     """
-    if not isinstance(system, System):
-        raise ValueError(f"Expected `system` to be a System, got {system!r}")
-    eff = check_method(method, effects, options)
-    times, unit = _times(t, system.quantity)
-    step = None if dt is None else _step(dt, system.quantity)
-    if tol is not None:
-        tol = DIMENSIONLESS.scalar("tol", tol)
-        if not 0.0 < tol < 1.0:
-            raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
-    tan = _tangent(system, len(times), variational, stm, tangent)
-    rhs = compile_rhs(system, eff, variational=tan is not None)
-    log = event_log(system, events)
-    arrays = system.as_arrays()
-    with _progress(progress, method, len(times) - 1, on_output) as report:
-        compiled = compile_seconds()
-        out = engine.run(arrays.r, arrays.v, arrays.gm, times, rhs, method, dt=step, tol=tol,
-                         options=options, on_output=report, events=log, variational=tan)
-        compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
-    out = dataclasses.replace(out, wall_time=max(out.wall_time - compiled, 0.0))
-    if not out.complete:
-        raise KeyboardInterrupt
-    return make_trajectory(system, out, unit, method, rhs.effects, eff)
+    sim = Simulation(system, method, dt, tol, effects, events, variational, stm, tangent,
+                     **options)
+    return sim.integrate(t, progress=progress, on_output=on_output)
 
 
-def _tangent(system: System, n_t: int, variational: Any, stm: Any, vector: Any) -> Any:
+def _leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
+    """Output times in days (Quantity system) from ``t``, from the simulation's time
+    ``t_now`` (added first if missing), with the caller's unit."""
+    if type(t) is float and not quantity and t != t_now and math.isfinite(t):
+        return np.array([t_now, t]), None  # an end time in the caller's units: the common case
+    if quantity and not is_quantity(t):
+        raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
+    if not quantity and is_quantity(t):
+        raise ValueError(f"Expected `t` as plain floats for a system of plain floats, got {t!r}")
+    unit = t.unit if quantity else None
+    arr = np.atleast_1d(TIME("t", t, DAY if quantity else None)).astype(np.float64)
+    if arr.size == 0:
+        raise ValueError("Expected `t` to be an end time or a non-empty array of times, got []")
+    if arr.ndim != 1:
+        raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
+                         f"{arr.shape}")
+    if arr.size == 1:
+        if arr[0] == t_now:
+            raise ValueError("Expected `t` to be a nonzero end time, got 0" if t_now == 0.0
+                             else f"Expected `t` to differ from the simulation's time "
+                                  f"{t_now!r}, got {float(arr[0])!r}")
+        arr = np.array([t_now, arr[0]])
+    elif arr[0] != t_now:
+        arr = np.concatenate(([t_now], arr))
+    d = np.diff(arr)
+    if not (np.all(d > 0) or np.all(d < 0)):
+        k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
+        start = "0" if t_now == 0.0 else repr(t_now)
+        raise ValueError(
+            f"Expected `t` to be strictly monotonic (times after the start {start}), got "
+            f"{arr[k + 1]!r} after {arr[k]!r} at index {k + 1}"
+        )
+    return arr, unit
+
+
+def _tolerance(tol: Any) -> float | None:
+    if tol is None:
+        return None
+    tol = DIMENSIONLESS.scalar("tol", tol)
+    if not 0.0 < tol < 1.0:
+        raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
+    return tol
+
+
+def _tangent(system: System, variational: Any, stm: Any, vector: Any, method: Method) -> Any:
     """The :class:`~hamilton_orbits.integrators._tangent.Tangent` of a run, or None."""
     if not isinstance(variational, bool) or not isinstance(stm, bool):
         raise ValueError(f"Expected `variational` and `stm` to be True or False, got "
@@ -324,18 +422,21 @@ def _tangent(system: System, n_t: int, variational: Any, stm: Any, vector: Any) 
         if vector is not None:
             raise ValueError("`tangent` is MEGNO's initial tangent vector: it needs "
                              "`variational=True`")
+        if getattr(method, "tangent_control", False):
+            raise ValueError("`tangent_control=True` lets the tangent vectors take part in "
+                             "the step control: it needs `variational=True`")
         return None
     from hamilton_orbits.integrators._tangent import Tangent
 
     n = len(system.names)
     if vector is not None:
         vec = as_float_array("tangent", vector)
-        if vec.size != 6 * n:
+        if vec.shape not in ((n, 6), (6 * n,)):
             raise ValueError(f"Expected `tangent` to have shape ({n}, 6), got {vec.shape}")
         if not np.any(vec):
             raise ValueError("Expected `tangent` to be nonzero, got all zeros")
         vector = vec.reshape(n, 6)
-    return Tangent(n, n_t, stm=stm, vector=vector)
+    return Tangent(n, 1, stm=stm, vector=vector)
 
 
 def event_log(system: System, events: Any) -> EventLog | None:
@@ -373,7 +474,25 @@ def _step(dt: Any, quantity: bool) -> float:
     return step
 
 
-def check_method(method: str, effects: Any, options: Mapping[str, Any]) -> EffectSet:
+def check_effects(method: Method, effects: Any) -> EffectSet:
+    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked against
+    the typed ``method`` (a velocity-dependent effect refused by a symplectic map,
+    naming the integrators that accept it)."""
+    eff = EffectSet.of(effects, "nbody")
+    if not method.accepts_velocity_dependent:
+        for name in eff.names:
+            if get("nbody", name).velocity_dependent:
+                accepting = [m for m in INTEGRATORS
+                             if method_of(m).accepts_velocity_dependent]
+                raise ValueError(
+                    f"Effect {name!r} depends on velocities and integrator {method.name!r} is "
+                    f"symplectic; integrators that accept it: {', '.join(accepting)}"
+                    + (" (or use 'gr_potential')" if name == "gr" else "")
+                )
+    return eff
+
+
+def check_method(method: str | Method, effects: Any, options: Mapping[str, Any]) -> EffectSet:
     """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked
     against ``method`` and its ``options``.
 
@@ -389,73 +508,96 @@ def check_method(method: str, effects: Any, options: Mapping[str, Any]) -> Effec
     >>> check_method("wh", ["gr_potential"], {"coordinates": "jacobi"}).names
     ('gr_potential',)
     """
-    module = engine.integrator(method)
-    _check_options(module, method, dict(options))
-    eff = EffectSet.of(effects, "nbody")
-    if not module.ACCEPTS_VELOCITY_DEPENDENT:
-        for name in eff.names:
-            if get("nbody", name).velocity_dependent:
-                raise ValueError(
-                    f"Effect {name!r} depends on velocities and integrator {method!r} is "
-                    f"symplectic; integrators that accept it: "
-                    f"{', '.join(_accepting_velocity_dependent())}"
-                    + (" (or use 'gr_potential')" if name == "gr" else "")
-                )
-    return eff
+    return check_effects(method_of(method, options), effects)
 
 
 @contextlib.contextmanager
 def _progress(enabled: bool, method: str, total: int, on_output: Any) -> Iterator[Any]:
     """An output callback that advances a tqdm bar (when ``enabled``) and calls
-    ``on_output``; the bar is closed on the way out."""
-    bar = None
-    if enabled:
-        try:
-            from tqdm.auto import tqdm
+    ``on_output`` (``on_output`` itself when there is no bar); the bar is closed on
+    the way out."""
+    if not enabled:
+        yield on_output
+        return
+    try:
+        from tqdm.auto import tqdm
 
-            bar = tqdm(total=total, desc=method, unit="output", leave=False)
-        except ImportError:  # pragma: no cover - tqdm is an optional extra
-            bar = None
+        bar = tqdm(total=total, desc=method, unit="output", leave=False)
+    except ImportError:  # pragma: no cover - tqdm is an optional extra
+        yield on_output
+        return
 
     def report(i: int, steps: int) -> None:
-        if bar is not None:
-            bar.update(1)
+        bar.update(1)
         if on_output is not None:
             on_output(i, steps)
 
     try:
         yield report
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
+
+
+def _check_finite(system: System, method: str, r: np.ndarray, v: np.ndarray,
+                  times: np.ndarray, gone: np.ndarray | None) -> None:
+    """Refuse a run that lost a body's state (a non-finite position or velocity of a
+    body still in the run)."""
+    if gone is None and math.isfinite(float(np.add.reduce(r, axis=None))) \
+            and math.isfinite(float(np.add.reduce(v, axis=None))):
+        return  # the common case: one pass, no copy
+    ok = np.isfinite(r).all(axis=2) & np.isfinite(v).all(axis=2)
+    if gone is not None:
+        ok |= gone[None, :]
+    if ok.all():
+        return
+    k, i = (int(x) for x in np.argwhere(~ok)[0])
+    raise ValueError(
+        f"The integration with {method!r} lost the state of body "
+        f"{system.names[i]!r} at output {k} (t = {times[k]!r}): "
+        "a collision or a step too long"
+    )
+
+
+def _integrals(system: System, r: np.ndarray, v: np.ndarray, gm: np.ndarray, times: np.ndarray,
+               gone: np.ndarray | None, effect_set: Any, start: Any
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Hamilton's integrals' errors at the outputs, from the simulation's start
+    ``start = (r0, v0, gm0)`` at time 0 (None: the first output is the start)."""
+    if start is not None:  # measured from the simulation's start: prepend it, then drop it
+        r0, v0, gm0 = start
+        r = np.concatenate((r0[None], r))
+        v = np.concatenate((v0[None], v))
+        gm = (np.concatenate((gm0[None], gm)) if np.ndim(gm) == 2
+              else gm if np.array_equal(gm, gm0) else np.stack([gm0] + [gm] * (len(r) - 1)))
+        times = np.concatenate(([0.0], times))
+    extra = effect_energy(system, effect_set, r, v) if effect_set else None
+    errors = integral_errors(r, v, gm, times, extra,
+                             gone=np.zeros(r.shape[1], bool) if gone is None else gone)
+    return errors if start is None else (errors[0][1:], errors[1][1:], errors[2][1:])
 
 
 def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: str,
-                    effects: tuple[str, ...], effect_set: Any = None) -> Trajectory:
+                    effects: tuple[str, ...], effect_set: Any = None, *, start: Any = None,
+                    wall_time: float | None = None) -> Trajectory:
     """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
     Quantity system, with times in ``unit``); ``effect_set`` (the
     :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
-    the energy whose error is reported, where they keep one.
+    the energy whose error is reported, where they keep one; ``start`` (``(r0, v0,
+    gm0)`` at time 0) when the run did not begin there.
 
     Raises
     ------
     ValueError
         If the run lost a body's state (a non-finite position or velocity).
     """
+    import astropy.units as u
+
     r, v, times = out.r, out.v, out.t
-    gone = out.events.inactive if out.events is not None else None
-    try:
-        ee, ae, bd = integral_errors(r, v, out.gm, times,
-                                     gone=np.zeros(r.shape[1], bool) if gone is None else gone)
-    except LostStateError as lost:
-        k, i = lost.index
-        raise ValueError(
-            f"The integration with {method!r} lost the state of body "
-            f"{system.names[i]!r} at output {k} (t = {times[k]!r}): "
-            "a collision or a step too long"
-        ) from None
-    if effect_set:  # the energy the equations keep: the effects part added
-        ee = integral_errors(r, v, out.gm, times, effect_energy(system, effect_set, r, v))[0]
+    log = out.events
+    gone = log.inactive.copy() if log is not None else None  # the log goes on changing
+    _check_finite(system, method, r, v, times, gone)
+    integrals = functools.partial(_integrals, system, r, v, out.gm, times, gone, effect_set,
+                                  start)
     final = (system, r[-1], v[-1], np.atleast_2d(out.gm)[-1], None if gone is None else ~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)
@@ -471,33 +613,14 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         stm = tan.stm[:k].copy() if tan.stm is not None else None
         if system.quantity:
             lyap = (lyap / u.day).to(1 / unit)
+    events = None
+    if log is not None:
+        stopped = log.stopped_by
+        events = (log.recorded()[out.first_event:],
+                  None if stopped is None else stopped - out.first_event, system, unit)
     return Trajectory(
-        t=t_out, r=r_out, v=v_out, names=system.names, final_source=final, energy_error=ee,
-        angular_momentum_error=ae, barycentre_drift=bd, steps=int(out.steps),
-        wall_time=out.wall_time, method=method, effects=effects,
-        event_source=(out.events, system, unit), megno=megno, lyapunov=lyap, stm=stm,
+        t=t_out, r=r_out, v=v_out, names=system.names, steps=int(out.steps),
+        wall_time=out.wall_time if wall_time is None else wall_time, method=method,
+        effects=effects, complete=out.complete, integrals=integrals, final_source=final,
+        event_source=events, megno=megno, lyapunov=lyap, stm=stm,
     )
-
-
-def event_table(log: EventLog | None, system: System | None, unit: Any) -> tuple[Any, Any]:
-    """The events of a run as a ``QTable`` (times in ``unit``, distances in au and
-    speeds in au/day for a Quantity system) and the row that stopped it, or None."""
-    from astropy.table import QTable
-
-    from hamilton_orbits.events import ACTIONS, NAMES
-
-    rows = log.recorded() if log is not None else np.zeros((0, 7))
-    actions = {code: name for name, code in ACTIONS.items()}
-    names = list(system.names) if system is not None else []
-    quantity = system is not None and system.quantity
-    bodies = [names[int(i)] if j < 0 else f"{names[int(i)]}-{names[int(j)]}"
-              for i, j in rows[:, 1:3]]
-    table = QTable()
-    table["name"] = [NAMES[int(c)] for c in rows[:, 0]] if len(rows) else np.array([], str)
-    table["time"] = (rows[:, 3] * u.day).to(unit) if quantity else rows[:, 3]
-    table["bodies"] = bodies if len(rows) else np.array([], str)
-    table["distance"] = rows[:, 4] * u.au if quantity else rows[:, 4]
-    table["speed"] = rows[:, 5] * (u.au / u.day) if quantity else rows[:, 5]
-    table["action"] = [actions[int(a)] for a in rows[:, 6]] if len(rows) else np.array([], str)
-    stopped = log.stopped_by if log is not None else None
-    return table, (table[stopped] if stopped is not None else None)

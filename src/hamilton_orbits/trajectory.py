@@ -1,4 +1,5 @@
-"""The shape every trajectory shares: :class:`TrajectoryBase`.
+"""What a run returns: :class:`TrajectoryBase`, the shape every trajectory shares, and
+the n-body :class:`Trajectory`.
 
 An n-body :class:`~hamilton_orbits.simulation.Trajectory` and a rigid body's
 ``rigid.RigidTrajectory`` answer the same first questions the same way: at
@@ -15,17 +16,18 @@ caller gave plain floats, they are plain floats in the caller's own units.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-__all__ = ["TrajectoryBase", "relative_change"]
+__all__ = ["Trajectory", "TrajectoryBase", "event_table", "relative_change"]
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
 class TrajectoryBase:
-    """The attributes every trajectory has.
+    """The attributes every trajectory has (an n-body :class:`Trajectory`, a rigid
+    body's ``rigid.RigidTrajectory``).
 
     Attributes
     ----------
@@ -39,18 +41,9 @@ class TrajectoryBase:
     method : str
         The integrator's name.
     energy_error : ndarray, shape (n_t,)
-        Relative change of the energy integral from ``t[0]`` (see the subclass).
+        Relative change of the energy integral from the start (see the subclass).
     angular_momentum_error : ndarray, shape (n_t,)
-        Relative change of the angular momentum vector from ``t[0]``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> base = TrajectoryBase(t=np.array([0.0, 1.0]), steps=4, wall_time=0.0,
-    ...                       method="exact", energy_error=np.zeros(2),
-    ...                       angular_momentum_error=np.zeros(2))
-    >>> base.n_outputs, base.steps
-    (2, 4)
+        Relative change of the angular momentum vector from the start.
     """
 
     t: Any
@@ -91,3 +84,172 @@ def relative_change(values: np.ndarray) -> np.ndarray:
         scale = float(np.linalg.norm(x[0]))
         d = np.linalg.norm(x - x[0], axis=-1)
     return d / scale if scale > 0 else d
+
+
+class Trajectory(TrajectoryBase):
+    """The states of a system at the output times, with Hamilton's integrals.
+
+    What :meth:`hamilton_orbits.Simulation.integrate` (and ``integrate``) returns:
+    one leg of a run, its first row the state the leg started from.  Hamilton's
+    integrals are measured from the start of the simulation, so that a run
+    continued in legs reports the drift since its beginning; they, the final
+    system and the events table are computed on first access.
+
+    Attributes (beside those of :class:`TrajectoryBase`: ``t``, ``steps``,
+    ``wall_time``, ``method``, ``energy_error``, ``angular_momentum_error``)
+    ----------
+    t : ndarray or Quantity, shape (n_t,)
+        Output times (the first is the leg's start), in the unit the caller gave
+        ``t`` in (a Quantity system), or the caller's floats.
+    r, v : ndarray or Quantity, shape (n_t, n, 3)
+        Positions and velocities (au, au/day for Quantity systems).
+    names : tuple of str
+    final : System
+        The system at the last output time (made on first access from the last
+        output row).
+    energy_error : ndarray, shape (n_t,)
+        ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
+        energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
+        massive body, the test particles' specific orbital energies about it
+        (:func:`~hamilton_orbits.nbody.integral_errors`); ``E(0)`` at the start of
+        the simulation.
+    angular_momentum_error : ndarray, shape (n_t,)
+        ``|L(t) - L(0)| / |L(0)|`` (law of areas, (D)); absolute if ``L(0) = 0``.
+    barycentre_drift : ndarray, shape (n_t,)
+        ``|R(t) - R(0) - V(0) t| / s`` with ``s`` the largest distance from the
+        initial centre of mass (law of the centre of gravity, (C)).
+    steps : int
+        Steps taken by the integrator in this leg.
+    wall_time : float
+        Seconds of wall-clock time for the integration proper (the checks and
+        any numba compilation, of the right-hand side or of the stepping kernel
+        on its first call, are not counted).
+    method : str
+    effects : tuple of str
+    complete : bool
+        False when the leg ended early: ``stop()`` returned True, or an output
+        callback raised :class:`~hamilton_orbits.engine.StopIntegration` (the
+        outputs reached are kept; Ctrl-C raises ``KeyboardInterrupt`` instead).
+    events : astropy.table.QTable
+        One row per event found in this leg (``name``, ``time``, ``bodies``,
+        ``distance``, ``speed``, ``action``); empty when none was listed or found.
+    stopped_by : astropy.table.Row or None
+        The row of the event that ended the leg, if one did.
+    megno : ndarray, shape (n_t,) or None
+        With ``variational=True``: MEGNO ``<Y>(t)`` (Cincotta & Simo 2000), as
+        rebound's ``sim.megno()``; it tends to 2 on a quasi-periodic orbit, 0 on a
+        stable periodic one, and grows like ``lambda t / 2`` on a chaotic one.  0 at
+        the start.
+    lyapunov : ndarray or Quantity, shape (n_t,) or None
+        With ``variational=True``: the Lyapunov exponent as rebound's
+        ``sim.lyapunov()`` defines it, the slope of the least-squares line through
+        ``<Y>(t)`` over the steps so far (Cincotta & Simo 2000, eq. 24), in 1/(the
+        unit of ``t``); ``1 / lyapunov`` is the Lyapunov time.  For ``|delta|``
+        growing like ``exp(lambda t)``, ``<Y> ~ lambda t / 2``: this slope is
+        ``lambda / 2`` of the growth rate of the tangent vector.
+    stm : ndarray, shape (n_t, 6n, 6n) or None
+        With ``stm=True``: the state transition matrix ``d(r, v)(t) / d(r, v)(0)``,
+        coordinates body by body (x, y, z, vx, vy, vz of body 0, then body 1, ...),
+        in the system's internal units (au and days for a Quantity system).
+    """
+
+    def __init__(self, *, t: Any, r: Any, v: Any, names: tuple[str, ...], steps: int,
+                 wall_time: float, method: str, effects: tuple[str, ...], complete: bool = True,
+                 integrals: Callable[[], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                 final_source: Any = None, event_source: Any = None, megno: Any = None,
+                 lyapunov: Any = None, stm: Any = None) -> None:
+        # one dict update: a short leg's wrapping is part of the cost of a call
+        self.__dict__.update(
+            t=t, r=r, v=v, names=names, steps=steps, wall_time=wall_time, method=method,
+            effects=effects, complete=complete, megno=megno, lyapunov=lyapunov, stm=stm,
+            _integrals=integrals, _final_source=final_source, _event_source=event_source)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"Trajectory is read-only: cannot set {name!r}")
+
+    @functools.cached_property
+    def _errors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self._integrals()
+
+    @property
+    def energy_error(self) -> np.ndarray:  # type: ignore[override]
+        """Relative change of the energy since the start (see the class notes)."""
+        return self._errors[0]
+
+    @property
+    def angular_momentum_error(self) -> np.ndarray:  # type: ignore[override]
+        """Relative change of the angular momentum since the start."""
+        return self._errors[1]
+
+    @property
+    def barycentre_drift(self) -> np.ndarray:
+        """Drift of the centre of mass from uniform motion, relative to the size."""
+        return self._errors[2]
+
+    @functools.cached_property
+    def final(self) -> Any:
+        """The system at the last output time."""
+        system, r, v, gm, keep = self._final_source
+        return system.with_state(r, v, gm=gm, keep=keep, check=False)
+
+    @functools.cached_property
+    def _tables(self) -> tuple[Any, Any]:
+        rows, stopped, system, unit = self._event_source or (None, None, None, None)
+        return event_table(rows, system, unit, stopped)
+
+    @property
+    def events(self) -> Any:
+        """One row per event found (a ``QTable``; empty when none was listed or found)."""
+        return self._tables[0]
+
+    @property
+    def stopped_by(self) -> Any:
+        """The row of :attr:`events` of the event that ended the run, or None."""
+        return self._tables[1]
+
+    def __repr__(self) -> str:
+        return (
+            f"Trajectory({len(self.names)} bodies, {len(self.r)} outputs, "
+            f"method={self.method!r}, effects={self.effects!r}, steps={self.steps}, "
+            f"max |dE/E|={np.max(np.abs(self.energy_error)):.3g}"
+            + ("" if self.complete else ", incomplete") + ")"
+        )
+
+
+def event_table(rows: Any, system: Any, unit: Any, stopped: int | None = None
+                ) -> tuple[Any, Any]:
+    """The events as a ``QTable`` (times in ``unit``, distances in au and speeds in
+    au/day for a Quantity system) and the row ``stopped`` (that stopped the run), or
+    None.
+
+    ``rows`` is an :class:`~hamilton_orbits.events.EventLog` (every event it
+    recorded, and the one that stopped it), an array of recorded rows (k, 7), or
+    None (no event).
+
+    Examples
+    --------
+    >>> table, stopped = event_table(None, None, None)
+    >>> len(table), stopped is None
+    (0, True)
+    """
+    import astropy.units as u
+    from astropy.table import QTable
+
+    from hamilton_orbits.events import ACTIONS, N_EVENT_COLUMNS, NAMES
+
+    if hasattr(rows, "recorded"):  # an EventLog
+        rows, stopped = rows.recorded(), rows.stopped_by
+    rows = np.zeros((0, N_EVENT_COLUMNS)) if rows is None else rows
+    actions = {code: name for name, code in ACTIONS.items()}
+    names = list(system.names) if system is not None else []
+    quantity = system is not None and system.quantity
+    bodies = [names[int(i)] if j < 0 else f"{names[int(i)]}-{names[int(j)]}"
+              for i, j in rows[:, 1:3]]
+    table = QTable()
+    table["name"] = [NAMES[int(c)] for c in rows[:, 0]] if len(rows) else np.array([], str)
+    table["time"] = (rows[:, 3] * u.day).to(unit) if quantity else rows[:, 3]
+    table["bodies"] = bodies if len(rows) else np.array([], str)
+    table["distance"] = rows[:, 4] * u.au if quantity else rows[:, 4]
+    table["speed"] = rows[:, 5] * (u.au / u.day) if quantity else rows[:, 5]
+    table["action"] = [actions[int(a)] for a in rows[:, 6]] if len(rows) else np.array([], str)
+    return table, (table[stopped] if stopped is not None else None)

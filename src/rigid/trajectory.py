@@ -78,6 +78,12 @@ class RigidTrajectory(TrajectoryBase):
     True
     """
 
+    t: Any
+    steps: int
+    wall_time: float
+    method: str
+    energy_error: np.ndarray
+    angular_momentum_error: np.ndarray
     attitude: Quaternion
     omega: Any
     moments: Any

@@ -35,6 +35,15 @@ __all__ = [
     "STATUS_NONFINITE",
     "STATUS_OK",
     "STATUS_UNDERFLOW",
+    "ST_DT",
+    "ST_DT_LAST",
+    "ST_EPSILON",
+    "ST_EVENT_ROW",
+    "ST_HAVE_LAST",
+    "ST_PC_ITERS",
+    "ST_PRS23",
+    "ST_T",
+    "ST_T_CS",
     "advance",
     "advance_variational",
     "coefficients",
@@ -60,13 +69,18 @@ STATUS_NONFINITE = 1
 STATUS_UNDERFLOW = 2
 STATUS_MAXSTEPS = 3
 #: An event with an action (stop, merge, remove) occurred: the state is at its
-#: time and ``st[8]`` holds its watch row.
+#: time and ``st[ST_EVENT_ROW]`` holds its watch row.
 STATUS_EVENT = 4
 #: The event buffer may not hold another step's events: drain it and call again.
 STATUS_DRAIN = 5
 
-#: The integrator state ``st`` that :func:`advance` reads and updates:
-#: ``[t, t_cs, dt, dt_last_done, epsilon, have_last, pc_iters, prs23, event_row]``.
+#: The integrator state ``st`` that :func:`advance` reads and updates, slot by slot:
+#: the time, its Kahan compensation, the next step, the last step done, epsilon (0:
+#: fixed steps), whether a last step exists (for the predictor), the
+#: predictor-corrector rounds so far, the criterion (1: prs23, 0: global), and the
+#: watch row of the event that stopped a call.
+ST_T, ST_T_CS, ST_DT, ST_DT_LAST, ST_EPSILON, ST_HAVE_LAST, ST_PC_ITERS, ST_PRS23, \
+    ST_EVENT_ROW = range(9)
 NSTATE = 9
 
 _SAFETY = 0.25  # IAS15's safety factor: reject below a quarter, grow at most 4x
@@ -426,7 +440,7 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb
     """One step's attempt up to its acceptance test: the start's accelerations,
     ``b`` predicted from the last step (:func:`_predict`, ``q`` the ratio of the
     step lengths; zero after a change of more than 20x), the predictor-corrector
-    iteration (its rounds counted in ``st[6]``).  False when a number is not
+    iteration (its rounds counted in ``st[ST_PC_ITERS]``).  False when a number is not
     finite."""
     if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
         return False
@@ -436,7 +450,7 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb
         b[:, :] = 0.0
     csb[:, :] = 0.0
     _g_from_b(b, g)
-    st[6] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
+    st[ST_PC_ITERS] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
                       need_v)
     return _all_finite(b[6])
 
@@ -445,15 +459,15 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb
 def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
     """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
 
-    Adaptive (``st[4] > 0``): rejects when the rule asks for less than a quarter
+    Adaptive (``st[ST_EPSILON] > 0``): rejects when the rule asks for less than a quarter
     of the step; growth is limited to 4x relative to the step that was planned
     (a step shortened to land on an output time does not slow the next one)."""
-    eps = st[4]
+    eps = st[ST_EPSILON]
     if not eps > 0.0:
         return dt, True
     n = r.shape[0]
     m = 3 * n
-    if st[7] != 0.0:
+    if st[ST_PRS23] != 0.0:
         dt_new = _dt_prs23(a0, b, n, dt_done, eps)
     else:
         dt_new = _dt_global(at.reshape(m), b, r.reshape(m), v.reshape(m), n, dt_done, eps)
@@ -467,7 +481,7 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
 def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx, csv):
     # pragma: no cover - compiled
     """Scan the accepted step for events; returns the ``h`` of the first event with an
-    action (its watch row in ``st[8]``; ``r``, ``v`` then put at its time from the
+    action (its watch row in ``st[ST_EVENT_ROW]``; ``r``, ``v`` then put at its time from the
     step's polynomial), or 2 if none."""
     n = r.shape[0]
     cm = np.zeros(9)
@@ -482,7 +496,7 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
         cm[c] /= total
     h, row = _ev.scan(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
                       a0, b, gm, cm, ev_out, ev_count)
-    st[8] = row
+    st[ST_EVENT_ROW] = row
     if h <= 1.0:
         _ev.state_at(_ev.RADAU, h, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v, a0, b, gm,
                      r, v)
@@ -502,7 +516,7 @@ def advance(
     accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
     ev_count,
 ):  # pragma: no cover - compiled
-    """Step from ``st[0]`` to ``t_end`` in place; returns ``(steps, status)``.
+    """Step from ``st[ST_T]`` to ``t_end`` in place; returns ``(steps, status)``.
 
     ``st`` is the :data:`NSTATE` state (``epsilon = 0``: fixed steps of ``dt``;
     ``prs23 != 0``: the rule of Pham, Rein & Spiegel 2024, else the global one
@@ -529,8 +543,8 @@ def advance(
     xf = r.reshape(m)
     vf = v.reshape(m)
     csb = np.zeros((7, m))
-    t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
-    have_last = st[5] != 0.0
+    t, t_cs, dt, dt_last = st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST]
+    have_last = st[ST_HAVE_LAST] != 0.0
     steps = 0
     status = STATUS_OK
     n_watch = watch.shape[0]
@@ -579,8 +593,8 @@ def advance(
         have_last = True
         dt = dt_new
         steps += 1
-    st[0], st[1], st[2], st[3] = t, t_cs, dt, dt_last
-    st[5] = 1.0 if have_last else 0.0
+    st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST] = t, t_cs, dt, dt_last
+    st[ST_HAVE_LAST] = 1.0 if have_last else 0.0
     return steps, status
 
 
@@ -705,8 +719,8 @@ def advance_variational(
     xf = r.reshape(m)
     vf = v.reshape(m)
     csb = np.zeros((7, m))
-    t, t_cs, dt, dt_last = st[0], st[1], st[2], st[3]
-    have_last = st[5] != 0.0
+    t, t_cs, dt, dt_last = st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST]
+    have_last = st[ST_HAVE_LAST] != 0.0
     steps = 0
     status = STATUS_OK
     while t < t_end:
@@ -746,6 +760,6 @@ def advance_variational(
         have_last = True
         dt = dt_new
         steps += 1
-    st[0], st[1], st[2], st[3] = t, t_cs, dt, dt_last
-    st[5] = 1.0 if have_last else 0.0
+    st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST] = t, t_cs, dt, dt_last
+    st[ST_HAVE_LAST] = 1.0 if have_last else 0.0
     return steps, status

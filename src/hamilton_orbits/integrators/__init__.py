@@ -7,18 +7,24 @@ steps).  A driver module satisfies :class:`Integrator`:
 - ``NAME`` (``"leapfrog"``, ``"wh"``, ``"radau15"``, ``"dop853"``);
 - ``ACCEPTS_VELOCITY_DEPENDENT`` (bool): symplectic maps refuse velocity-dependent
   effects;
+- ``start(rhs, r0, v0, gm, t0, method, *, dt, tol, events=None, variational=None)``
+  returning a :class:`DriverState`: the integrator's whole state at ``t0`` for
+  arguments already checked (``method`` its typed value from
+  :mod:`~hamilton_orbits.integrators.methods`), advanced leg by leg across calls
+  exactly as one run through every output time (what
+  :class:`hamilton_orbits.Simulation` stands on);
 - ``run(rhs, r0, v0, gm, t_out, *, dt=None, tol=None, on_output=None, out=None,
-  **options)`` returning ``(r, v, steps)``: ``rhs`` an
-  :class:`~hamilton_orbits.rhs.RHS`; ``r0``, ``v0`` float64 (n, 3) and ``gm``
-  (n,) in one consistent unit system; ``t_out`` an increasing float64 array of
-  output times with ``t_out[0]`` the initial time (row 0 of the output is the
-  initial state); ``r``, ``v`` of shape (len(t_out), n, 3), written into ``out``
-  when it is given (so that what was reached survives an interrupt); ``steps``
-  the number of steps taken.  ``on_output(i, steps)`` is called from Python
-  after output ``i`` is reached (progress bars, stopping early); ``stop()`` is
-  asked between slices of steps inside an output interval (radau15 every 20000
-  steps, wh every 100000, leapfrog every 100000; dop853 at outputs only), and
-  True ends the run there with :class:`StopIntegration`.
+  **options)`` returning ``(r, v, steps)``: one run, its input checked (``start``
+  then one ``advance``): ``rhs`` an :class:`~hamilton_orbits.rhs.RHS`; ``r0``,
+  ``v0`` float64 (n, 3) and ``gm`` (n,) in one consistent unit system; ``t_out``
+  an increasing float64 array of output times with ``t_out[0]`` the initial time
+  (row 0 of the output is the initial state); ``r``, ``v`` of shape (len(t_out),
+  n, 3), written into ``out`` when it is given (so that what was reached survives
+  an interrupt); ``steps`` the number of steps taken.  ``on_output(i, steps)`` is
+  called from Python after output ``i`` is reached (progress bars, stopping
+  early); ``stop()`` is asked between slices of steps inside an output interval
+  (radau15 every 20000 steps, wh every 100000, leapfrog every 100000; dop853 at
+  outputs only), and True ends the run there with :class:`StopIntegration`.
 
 Python only loops over output times (and, for radau15, over slices of many
 steps); the public entry point is :func:`hamilton_orbits.engine.run`.
@@ -31,14 +37,19 @@ from typing import Any, Protocol
 
 import numpy as np
 
-__all__ = ["INTEGRATORS", "WH_CORRECTORS", "Integrator", "StopIntegration", "output_arrays"]
+from hamilton_orbits.integrators.methods import (
+    DOP853,
+    INTEGRATORS,
+    WH,
+    WH_CORRECTORS,
+    Leapfrog,
+    Method,
+    Radau15,
+    method_of,
+)
 
-#: The methods, in the order they are listed to users.
-INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
-
-#: The orders of ``wh``'s symplectic correctors (Jacobi coordinates; 0: none),
-#: here so that a scene checks them without loading the kernels.
-WH_CORRECTORS = (0, 3, 5, 7, 11, 17)
+__all__ = ["DOP853", "INTEGRATORS", "WH", "WH_CORRECTORS", "DriverState", "Integrator",
+           "Leapfrog", "Method", "Radau15", "StopIntegration", "method_of", "output_arrays"]
 
 
 class StopIntegration(Exception):
@@ -46,11 +57,38 @@ class StopIntegration(Exception):
     ``stop()`` callback, asked between slices of steps, returns True."""
 
 
+class DriverState(Protocol):
+    """An integrator's state between calls (what a driver's ``start`` returns).
+
+    ``t`` is the time of the state and ``steps`` the steps taken since ``start``;
+    ``advance(t_out, r_out, v_out, on_output, stop)`` steps through ``t_out``
+    (``t_out[0]`` is ``t``) and writes rows 1... of ``r_out``, ``v_out`` (row 0 is
+    the caller's), calling ``on_output(i, steps of this call)`` after output ``i``;
+    an event that stops the run raises
+    :class:`~hamilton_orbits.events.StopAtEvent`, ``stop()`` returning True
+    between slices raises :class:`StopIntegration`.  ``state()`` returns copies of
+    the current inertial positions, velocities and ``G m``.
+    """
+
+    t: float
+    steps: int
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None: ...
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
 class Integrator(Protocol):
     """What a driver module provides (see the module's notes)."""
 
     NAME: str
     ACCEPTS_VELOCITY_DEPENDENT: bool
+
+    def start(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+              method: Any, *, dt: float | None, tol: float | None, events: Any = None,
+              variational: Any = None) -> DriverState: ...
 
     def run(
         self,

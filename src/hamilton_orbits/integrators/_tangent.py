@@ -34,12 +34,13 @@ from hamilton_orbits._kernels import radau15 as _radau
 from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
-from hamilton_orbits.integrators import StopIntegration, output_arrays
-from hamilton_orbits.integrators._setup import accel_arg
+from hamilton_orbits.integrators import StopIntegration
+from hamilton_orbits.integrators._setup import accel_arg, check_step_count
+from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS
 from hamilton_orbits.validation import ConvergenceError
 
-__all__ = ["DEFAULT_SEED", "SLICE", "Tangent", "run_dop853", "run_leapfrog",
-           "run_radau15", "run_wh"]
+__all__ = ["DEFAULT_SEED", "SLICE", "DOP853Tangent", "LeapfrogTangent", "Radau15Tangent",
+           "Tangent", "WHTangent"]
 
 #: The seed of the random tangent vector of MEGNO when none is given.
 DEFAULT_SEED = 2275
@@ -100,11 +101,22 @@ class Tangent:
             i, c = divmod(j, 6)
             (self.dr0 if c < 3 else self.dv0)[(1 + j) * n + i, c % 3] = 1.0
         self.ms = np.zeros(len(_var.MEGNO_FIELDS))
+        #: MEGNO, the Lyapunov exponent and the STM at the last output recorded (the
+        #: first row of the next leg's outputs)
+        self.last: tuple[float, float, np.ndarray | None] = (
+            0.0, 0.0, np.eye(6 * n) if stm else None)
+        self.new_leg(n_t)
+
+    def new_leg(self, n_t: int) -> None:
+        """Fresh output arrays for a leg of ``n_t`` outputs, row 0 the last recorded."""
+        megno, lyapunov, stm = self.last
         self.megno = np.zeros(n_t)
         self.lyapunov = np.zeros(n_t)
-        self.stm = np.zeros((n_t, 6 * n, 6 * n)) if stm else None
-        if stm:
-            self.stm[0] = np.eye(6 * n)
+        self.megno[0], self.lyapunov[0] = megno, lyapunov
+        self.stm = None
+        if stm is not None:
+            self.stm = np.zeros((n_t,) + stm.shape)
+            self.stm[0] = stm
 
     def start(self, t0: float) -> None:
         """Start MEGNO at ``t0`` (``<Y> = 0`` there)."""
@@ -125,53 +137,72 @@ class Tangent:
             cols = np.concatenate([dr[n:].reshape(6 * n, n, 3), dv[n:].reshape(6 * n, n, 3)],
                                   axis=2)
             self.stm[i] = cols.reshape(6 * n, 6 * n).T
+        self.last = (self.megno[i], self.lyapunov[i],
+                     None if self.stm is None else self.stm[i])
 
 
-def run_radau15(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
-                tangent: Tangent, *, dt: float, tol: float, prs23: bool, max_steps: int,
-                slice_steps: int, control: bool,
-                on_output: Callable[[int, int], None] | None,
-                out: tuple[np.ndarray, np.ndarray] | None,
-                stop: Callable[[], bool] | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+class Radau15Tangent:
     """``radau15`` with the tangent vectors (:func:`hamilton_orbits._kernels.radau15.
-    advance_variational`); the arguments as the driver has checked them, ``control``
-    True to let the tangent vectors take part in the step control; ``stop()`` asked
+    advance_variational`): the augmented state (bodies, then tangent vectors)
+    between calls; the arguments as the driver has checked them, ``control`` True
+    to let the tangent vectors take part in the step control; ``stop()`` asked
     between slices of ``slice_steps`` steps (True raises :class:`StopIntegration`)."""
-    n = r0.shape[0]
-    gm = np.array(gm, dtype=np.float64)  # writable (the kernels' signatures take no read-only)
-    x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
-    w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
-    m = 3 * x.shape[0]
-    work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
-    csx, csv = np.zeros(m), np.zeros(m)
-    st = np.zeros(_radau.NSTATE)
-    st[[0, 2, 4, 7]] = t_out[0], dt, tol, float(prs23)
-    accel = accel_arg(rhs.augmented)
-    n_phys = x.shape[0] if control else n
-    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
-    tangent.start(float(t_out[0]))
-    total = 0
-    for i in range(1, t_out.shape[0]):
-        while True:
-            steps, status = _radau.advance_variational(
-                accel, rhs.p, x, w, gm, t_out[i], st, *work, csx, csv,
-                bool(rhs.velocity_dependent), min(slice_steps, max_steps - total), n_phys,
-                tangent.ms)
-            total += steps
-            if status == _radau.STATUS_OK:
-                break
-            if status != _radau.STATUS_MAXSTEPS or total >= max_steps:
-                raise ConvergenceError(
-                    f"radau15 (variational) stopped at t = {float(st[0])!r} before t_out[{i}] "
-                    f"= {float(t_out[i])!r} (status {status}: a non-finite acceleration, an "
-                    f"underflowing step, or more than max_steps = {max_steps} steps)")
-            if stop is not None and stop():
-                raise StopIntegration
-        r_out[i], v_out[i] = x[:n], w[:n]
-        tangent.record(i, float(t_out[i]), x[n:], w[n:])
-        if on_output is not None:
-            on_output(i, total)
-    return r_out, v_out, total
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 tangent: Tangent, *, dt: float, tol: float, prs23: bool, max_steps: int,
+                 slice_steps: int, control: bool) -> None:
+        self.n = n = r0.shape[0]
+        self.rhs, self.tangent, self.max_steps, self.slice = rhs, tangent, max_steps, slice_steps
+        self.gm = np.array(gm, dtype=np.float64)  # writable (the kernels take no read-only)
+        self.x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
+        self.w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
+        m = 3 * self.x.shape[0]
+        self.work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
+        self.csx, self.csv = np.zeros(m), np.zeros(m)
+        self.st = np.zeros(_radau.NSTATE)
+        self.st[[_radau.ST_T, _radau.ST_DT, _radau.ST_EPSILON, _radau.ST_PRS23]] = (
+            t0, dt, tol, float(prs23))
+        self.accel = accel_arg(rhs.augmented)
+        self.n_phys = self.x.shape[0] if control else n
+        tangent.start(t0)
+        self.steps = 0
+
+    @property
+    def t(self) -> float:
+        """The time of the state."""
+        return float(self.st[_radau.ST_T])
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The bodies' positions, velocities and ``G m`` (copies)."""
+        n = self.n
+        return self.x[:n].copy(), self.w[:n].copy(), self.gm.copy()
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` (and the tangent's outputs) at ``t_out[1:]``."""
+        n, x, w, st, first = self.n, self.x, self.w, self.st, self.steps
+        for i in range(1, t_out.shape[0]):
+            while True:
+                left = self.max_steps - (self.steps - first)
+                steps, status = _radau.advance_variational(
+                    self.accel, self.rhs.p, x, w, self.gm, t_out[i], st, *self.work, self.csx,
+                    self.csv, bool(self.rhs.velocity_dependent), min(self.slice, left),
+                    self.n_phys, self.tangent.ms)
+                self.steps += steps
+                if status == _radau.STATUS_OK:
+                    break
+                if status != _radau.STATUS_MAXSTEPS or steps >= left:
+                    raise ConvergenceError(
+                        f"radau15 (variational) stopped at t = {self.t!r} before t_out[{i}] "
+                        f"= {float(t_out[i])!r} (status {status}: a non-finite acceleration, an "
+                        f"underflowing step, or more than max_steps = {self.max_steps} steps)")
+                if stop is not None and stop():
+                    raise StopIntegration
+            r_out[i], v_out[i] = x[:n], w[:n]
+            self.tangent.record(i, float(t_out[i]), x[n:], w[n:])
+            if on_output is not None:
+                on_output(i, self.steps - first)
 
 
 def _tangent_arg(fn: Any) -> Any:
@@ -184,42 +215,6 @@ def _tangent_arg(fn: Any) -> Any:
     if not hasattr(fn, "get_compile_result"):
         return fn
     return CompileResultWAP(fn.get_compile_result(TANGENT_SIGNATURE))
-
-
-def run_leapfrog(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
-                 tangent: Tangent, *, dt: float,
-                 on_output: Callable[[int, int], None] | None,
-                 out: tuple[np.ndarray, np.ndarray] | None,
-                 stop: Callable[[], bool] | None = None,
-                 slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
-    """``leapfrog`` with the exact tangent map of each step
-    (:func:`hamilton_orbits._kernels.variational.advance_leapfrog`), in slices of
-    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
-    r = np.ascontiguousarray(r0, dtype=np.float64).copy()
-    v = np.ascontiguousarray(v0, dtype=np.float64).copy()
-    gm = np.array(gm, dtype=np.float64)  # writable (the kernel's signature takes no read-only)
-    dr, dv = tangent.dr0.copy(), tangent.dv0.copy()
-    accel, jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
-    r_out, v_out = output_arrays(out, t_out.shape[0], r, v)
-    tangent.start(float(t_out[0]))
-    steps = 0
-    for i in range(1, t_out.shape[0]):
-        t, t1 = float(t_out[i - 1]), float(t_out[i])
-        while True:  # the steps and times of the plain kernel's slices
-            n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
-            done = _var.advance_leapfrog(accel, jac, rhs.p, r, v, gm, dr, dv, t, t1, dt,
-                                         tangent.ms, slice_steps)
-            steps += done
-            if done >= n_left:
-                break
-            t = t + done * ((t1 - t) / n_left)
-            if stop is not None and stop():
-                raise StopIntegration
-        r_out[i], v_out[i] = r, v
-        tangent.record(i, float(t_out[i]), dr, dv)
-        if on_output is not None:
-            on_output(i, steps)
-    return r_out, v_out, steps
 
 
 def _to_split(r: np.ndarray, v: np.ndarray, g: np.ndarray, jacobi: bool
@@ -264,77 +259,143 @@ def _from_split(q: np.ndarray, u: np.ndarray, com: np.ndarray, g: np.ndarray, ja
     return rr, vv
 
 
-def run_wh(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
-           tangent: Tangent, *, dt: float, jacobi: bool,
-           on_output: Callable[[int, int], None] | None,
-           out: tuple[np.ndarray, np.ndarray] | None,
-           stop: Callable[[], bool] | None = None,
-           slice_steps: int = SLICE) -> tuple[np.ndarray, np.ndarray, int]:
+
+
+class LeapfrogTangent:
+    """``leapfrog`` with the exact tangent map of each step
+    (:func:`hamilton_orbits._kernels.variational.advance_leapfrog`), in slices of
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 tangent: Tangent, *, dt: float, max_steps: int = MAX_FIXED_STEPS,
+                 slice_steps: int = SLICE) -> None:
+        self.max_steps = max_steps
+        self.r = np.ascontiguousarray(r0, dtype=np.float64).copy()
+        self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
+        self.gm = np.array(gm, dtype=np.float64)  # writable (the kernel takes no read-only)
+        self.dr, self.dv = tangent.dr0.copy(), tangent.dv0.copy()
+        self.accel, self.jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
+        self.rhs, self.tangent, self.dt, self.slice = rhs, tangent, dt, slice_steps
+        tangent.start(t0)
+        self.t, self.steps = t0, 0
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current positions, velocities and ``G m`` (copies)."""
+        return self.r.copy(), self.v.copy(), self.gm.copy()
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` (and the tangent's outputs) at ``t_out[1:]``."""
+        dt, first = self.dt, self.steps
+        check_step_count(float(t_out[-1] - t_out[0]), dt, self.max_steps, "leapfrog")
+        for i in range(1, t_out.shape[0]):
+            t, t1 = float(t_out[i - 1]), float(t_out[i])
+            while True:  # the steps and times of the plain kernel's slices
+                n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
+                done = _var.advance_leapfrog(self.accel, self.jac, self.rhs.p, self.r, self.v,
+                                             self.gm, self.dr, self.dv, t, t1, dt,
+                                             self.tangent.ms, self.slice)
+                self.steps += done
+                if done >= n_left:
+                    break
+                t = t + done * ((t1 - t) / n_left)
+                self.t = t
+                if stop is not None and stop():
+                    raise StopIntegration
+            self.t = t1
+            r_out[i], v_out[i] = self.r, self.v
+            self.tangent.record(i, t1, self.dr, self.dv)
+            if on_output is not None:
+                on_output(i, self.steps - first)
+
+
+class WHTangent:
     """``wh`` (synchronised steps, :mod:`hamilton_orbits._kernels.wh_tangent`) with the
     exact tangent map; the central body (largest GM) first inside; in slices of
-    ``slice_steps`` steps as the plain driver (``stop()`` asked between them)."""
-    n, k = r0.shape[0], tangent.k
-    c = int(np.argmax(gm))
-    order = np.concatenate([[c], np.delete(np.arange(n), c)])
-    inv_order = np.argsort(order)
-    g = np.ascontiguousarray(gm[order])
-    q, u, com = (np.ascontiguousarray(a) for a in _to_split(r0[order], v0[order], g, jacobi))
-    dq, du, dcom = (np.ascontiguousarray(a) for a in _to_split(
-        tangent.dr0.reshape(k, n, 3)[:, order], tangent.dv0.reshape(k, n, 3)[:, order], g,
-        jacobi))
-    dq, du = dq.reshape(k * n, 3), du.reshape(k * n, 3)
-    has_extra = rhs.extra is not None
-    extra = accel_arg(rhs.extra if has_extra else rhs.accel)
-    if jacobi:
-        eta = np.cumsum(g)
-        jac = _tangent_arg(rhs.tangent)
-    else:
-        g_p = g.copy()
-        g_p[0] = 0.0
-        jac = _tangent_arg(rhs.tangent_extra if has_extra else rhs.tangent)
-    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
-    tangent.start(float(t_out[0]))
-    total = 0
-    for i in range(1, t_out.shape[0]):
-        span = t_out[i] - t_out[i - 1]
-        n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
-        last = span - (n_steps - 1) * dt
-        done = 0
-        while done < n_steps:
-            if done and stop is not None and stop():
-                raise StopIntegration
-            n_call = min(n_steps - done, slice_steps)  # stop() is asked between calls
-            h_last = last if done + n_call == n_steps else dt
-            t_call = float(t_out[i - 1] + done * dt)
-            if jacobi:
-                steps, bad = _wht.advance_jacobi(extra, jac, rhs.p, has_extra, q, u, g, eta, dq,
-                                                 du, dt, n_call, h_last, t_call, tangent.ms)
-            else:
-                steps, bad = _wht.advance_dh(extra, jac, rhs.p, has_extra, q, u, g, g_p, com,
-                                             dq, du, dcom, dt, n_call, h_last, t_call,
-                                             tangent.ms)
-            done += steps
-            total += steps
-            if bad >= 0:
-                raise ConvergenceError(
-                    f"wh: the Kepler step of body {int(order[bad])} failed between "
-                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
-                    f"{float(t_out[i])!r}")
-        rr, vv = _from_split(q, u, com, g, jacobi)
-        r_out[i], v_out[i] = rr[inv_order], vv[inv_order]
-        drr, dvv = _from_split(dq.reshape(k, n, 3), du.reshape(k, n, 3), dcom, g, jacobi)
-        dr_in = np.ascontiguousarray(drr[:, inv_order].reshape(k * n, 3))
-        dv_in = np.ascontiguousarray(dvv[:, inv_order].reshape(k * n, 3))
-        tangent.record(i, float(t_out[i]), dr_in, dv_in)
-        if on_output is not None:
-            on_output(i, total)
-    return r_out, v_out, total
+    ``slice_steps`` steps as the plain driver (``stop()`` asked between them).  The
+    state stays in the splitting's coordinates between calls."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 tangent: Tangent, *, dt: float, jacobi: bool, max_steps: int = MAX_FIXED_STEPS,
+                 slice_steps: int = SLICE) -> None:
+        self.max_steps = max_steps
+        n, k = r0.shape[0], tangent.k
+        c = int(np.argmax(gm))
+        self.order = order = np.concatenate([[c], np.delete(np.arange(n), c)])
+        self.inv_order = np.argsort(order)
+        self.g = g = np.ascontiguousarray(gm[order])
+        self.q, self.u, self.com = (np.ascontiguousarray(a)
+                                    for a in _to_split(r0[order], v0[order], g, jacobi))
+        dq, du, self.dcom = (np.ascontiguousarray(a) for a in _to_split(
+            tangent.dr0.reshape(k, n, 3)[:, order], tangent.dv0.reshape(k, n, 3)[:, order], g,
+            jacobi))
+        self.dq, self.du = dq.reshape(k * n, 3), du.reshape(k * n, 3)
+        self.has_extra = has_extra = rhs.extra is not None
+        self.extra = accel_arg(rhs.extra if has_extra else rhs.accel)
+        if jacobi:
+            self.eta = np.cumsum(g)
+            self.jac = _tangent_arg(rhs.tangent)
+        else:
+            self.g_p = g.copy()
+            self.g_p[0] = 0.0
+            self.jac = _tangent_arg(rhs.tangent_extra if has_extra else rhs.tangent)
+        self.rhs, self.tangent, self.dt, self.jacobi, self.slice = (rhs, tangent, dt, jacobi,
+                                                                     slice_steps)
+        tangent.start(t0)
+        self.t, self.steps = t0, 0
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current inertial positions, velocities and ``G m``, in the caller's order."""
+        rr, vv = _from_split(self.q, self.u, self.com, self.g, self.jacobi)
+        return rr[self.inv_order], vv[self.inv_order], self.g[self.inv_order]
+
+    def _steps(self, n_call: int, h_last: float, t_call: float) -> tuple[int, int]:
+        if self.jacobi:
+            return _wht.advance_jacobi(self.extra, self.jac, self.rhs.p, self.has_extra, self.q,
+                                       self.u, self.g, self.eta, self.dq, self.du, self.dt,
+                                       n_call, h_last, t_call, self.tangent.ms)
+        return _wht.advance_dh(self.extra, self.jac, self.rhs.p, self.has_extra, self.q, self.u,
+                               self.g, self.g_p, self.com, self.dq, self.du, self.dcom, self.dt,
+                               n_call, h_last, t_call, self.tangent.ms)
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` (and the tangent's outputs) at ``t_out[1:]``."""
+        dt, first, k, n = self.dt, self.steps, self.tangent.k, self.g.shape[0]
+        check_step_count(float(t_out[-1] - t_out[0]), dt, self.max_steps, "wh")
+        for i in range(1, t_out.shape[0]):
+            span = t_out[i] - t_out[i - 1]
+            n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+            last = span - (n_steps - 1) * dt
+            done = 0
+            while done < n_steps:
+                if done and stop is not None and stop():
+                    raise StopIntegration
+                n_call = min(n_steps - done, self.slice)  # stop() is asked between calls
+                h_last = last if done + n_call == n_steps else dt
+                steps, bad = self._steps(n_call, h_last, float(t_out[i - 1] + done * dt))
+                done += steps
+                self.steps += steps
+                self.t = float(t_out[i - 1] + done * dt)
+                if bad >= 0:
+                    raise ConvergenceError(
+                        f"wh: the Kepler step of body {int(self.order[bad])} failed between "
+                        f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                        f"{float(t_out[i])!r}")
+            self.t = float(t_out[i])
+            r_out[i], v_out[i], _ = self.state()
+            drr, dvv = _from_split(self.dq.reshape(k, n, 3), self.du.reshape(k, n, 3),
+                                   self.dcom, self.g, self.jacobi)
+            dr_in = np.ascontiguousarray(drr[:, self.inv_order].reshape(k * n, 3))
+            dv_in = np.ascontiguousarray(dvv[:, self.inv_order].reshape(k * n, 3))
+            self.tangent.record(i, self.t, dr_in, dv_in)
+            if on_output is not None:
+                on_output(i, self.steps - first)
 
 
-def run_dop853(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
-               tangent: Tangent, *, tol: float, atol: np.ndarray, max_step: float,
-               control: bool, on_output: Callable[[int, int], None] | None,
-               out: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, int]:
+class DOP853Tangent:
     """``dop853`` on the augmented system ``(r, dr, v, dv, Ys)``: the bodies, the
     tangent vectors (:attr:`RHS.augmented`) and MEGNO's integral
     ``Ys' = 2 (t - t0) delta'.delta / |delta|^2``, step by step (scipy's stepper),
@@ -343,47 +404,70 @@ def run_dop853(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: 
     past 1e308 overflows: use radau15 or wh for those).
     ``atol``: the bodies' absolute tolerances (6n,); the tangent components and
     ``Ys`` are left out of the error control (infinite ``atol``) unless ``control``."""
-    from scipy.integrate import DOP853
 
-    n, k = r0.shape[0], tangent.k
-    rows = n * (1 + k)
-    acc = np.empty((rows, 3))
-    t0 = float(t_out[0])
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 tangent: Tangent, *, tol: float, atol: np.ndarray, max_step: float,
+                 control: bool) -> None:
+        n, k = r0.shape[0], tangent.k
+        self.rows = rows = n * (1 + k)
+        self.n, self.gm, self.tangent, self.tol, self.max_step = (
+            n, np.array(gm, dtype=np.float64), tangent, tol, max_step)
+        self.f = self._rhs(rhs, n, rows, t0)
+        self.y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(),
+                                 tangent.dv0.ravel(), [0.0]))
+        scale_t = np.full(6 * n * k, np.inf)
+        if control:
+            scale_t = tol * np.maximum(np.abs(np.concatenate((tangent.dr0.ravel(),
+                                                              tangent.dv0.ravel()))), 1.0)
+        self.atol = np.concatenate((atol[: 3 * n], scale_t[: 3 * n * k], atol[3 * n:],
+                                    scale_t[3 * n * k:], [np.inf]))
+        tangent.start(t0)
+        self.t, self.steps = t0, 0
 
-    def f(t: float, y: np.ndarray) -> np.ndarray:
-        x = y[: 3 * rows].reshape(rows, 3)
-        w = y[3 * rows: 6 * rows].reshape(rows, 3)
-        rhs.augmented(x, w, gm, acc, rhs.p)
-        dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
-        den = float(np.sum(dx * dx) + np.sum(dw * dw))
-        rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0
-        return np.concatenate((y[3 * rows: 6 * rows], acc.ravel(), [2.0 * (t - t0) * rate]))
+    def _rhs(self, rhs: Any, n: int, rows: int, t0: float) -> Callable:
+        acc = np.empty((rows, 3))
+        gm = self.gm
 
-    y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(), tangent.dv0.ravel(), [0.0]))
-    scale_t = np.full(6 * n * k, np.inf)
-    if control:
-        scale_t = tol * np.maximum(np.abs(np.concatenate((tangent.dr0.ravel(),
-                                                          tangent.dv0.ravel()))), 1.0)
-    atol_all = np.concatenate((atol[: 3 * n], scale_t[: 3 * n * k], atol[3 * n:],
-                               scale_t[3 * n * k:], [np.inf]))
-    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
-    tangent.start(t0)
-    steps = 0
-    for i in range(1, t_out.shape[0]):
-        solver = DOP853(f, float(t_out[i - 1]), y, float(t_out[i]), rtol=tol, atol=atol_all,
-                        max_step=max_step)
-        while solver.status == "running":
-            t_prev, ys_prev = solver.t, solver.y[-1]
-            if solver.step() is not None:
-                raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
-            steps += 1
-            _var.megno_update(tangent.ms, float(solver.y[-1] - ys_prev), float(solver.t),
-                              float(solver.t - t_prev))
-        y = solver.y.copy()
-        x = y[: 3 * rows].reshape(rows, 3)
-        w = y[3 * rows: 6 * rows].reshape(rows, 3)
-        r_out[i], v_out[i] = x[:n], w[:n]
-        tangent.record(i, float(t_out[i]), x[n:], w[n:])
-        if on_output is not None:
-            on_output(i, steps)
-    return r_out, v_out, steps
+        def f(t: float, y: np.ndarray) -> np.ndarray:
+            x = y[: 3 * rows].reshape(rows, 3)
+            w = y[3 * rows: 6 * rows].reshape(rows, 3)
+            rhs.augmented(x, w, gm, acc, rhs.p)
+            dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
+            den = float(np.sum(dx * dx) + np.sum(dw * dw))
+            rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0
+            return np.concatenate((y[3 * rows: 6 * rows], acc.ravel(), [2.0 * (t - t0) * rate]))
+
+        return f
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current positions, velocities and ``G m`` (copies)."""
+        n, rows = self.n, self.rows
+        return (self.y[: 3 * n].reshape(n, 3).copy(),
+                self.y[3 * rows: 3 * rows + 3 * n].reshape(n, 3).copy(), self.gm.copy())
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` (and the tangent's outputs) at ``t_out[1:]``;
+        ``stop`` is asked at the outputs (by the engine)."""
+        from scipy.integrate import DOP853
+
+        n, rows, first = self.n, self.rows, self.steps
+        for i in range(1, t_out.shape[0]):
+            solver = DOP853(self.f, float(t_out[i - 1]), self.y, float(t_out[i]), rtol=self.tol,
+                            atol=self.atol, max_step=self.max_step)
+            while solver.status == "running":
+                t_prev, ys_prev = solver.t, solver.y[-1]
+                if solver.step() is not None:
+                    raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
+                self.steps += 1
+                _var.megno_update(self.tangent.ms, float(solver.y[-1] - ys_prev),
+                                  float(solver.t), float(solver.t - t_prev))
+            self.y = solver.y.copy()
+            self.t = float(t_out[i])
+            x = self.y[: 3 * rows].reshape(rows, 3)
+            w = self.y[3 * rows: 6 * rows].reshape(rows, 3)
+            r_out[i], v_out[i] = x[:n], w[:n]
+            self.tangent.record(i, self.t, x[n:], w[n:])
+            if on_output is not None:
+                on_output(i, self.steps - first)

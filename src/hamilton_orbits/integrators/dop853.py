@@ -22,6 +22,10 @@ import numpy as np
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import _tangent, output_arrays
+from hamilton_orbits.integrators.methods import DOP853
+
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RTOL_FLOOR", "run", "solve",
+           "start"]
 
 NAME = "dop853"
 ACCEPTS_VELOCITY_DEPENDENT = True
@@ -68,10 +72,117 @@ def run(
     >>> bool(np.allclose(r[-1, 1], [1, 0, 0], atol=1e-9))
     True
     """
+    state = start(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
+                  np.asarray(gm, np.float64), float(t_out[0]), DOP853(tangent_control),
+                  dt=dt, tol=tol, events=events, variational=variational)
+    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
+    state.advance(np.asarray(t_out, np.float64), r_out, v_out, on_output, stop)
+    return r_out, v_out, state.steps
+
+
+def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+          method: DOP853, *, dt: float | None, tol: float | None,
+          events: EventLog | None = None, variational: Any = None) -> Any:
+    """The integrator's state at ``t0`` (a :class:`~hamilton_orbits.integrators.
+    DriverState`); the absolute tolerances come from this first state and are kept
+    for the whole run, so that a run continued in legs takes the steps of one run."""
     # scipy refuses rtol below 100 eps (with a warning); that is DOP853's floor here
     tol = max(DEFAULT_TOL if tol is None else float(tol), RTOL_FLOOR)
-    n = r0.shape[0]
-    gm = np.array(gm, dtype=np.float64)  # merges change it
+    atol = tol * np.concatenate((_body_scale(r0), _body_scale(v0)))
+    max_step = np.inf if dt is None else float(dt)
+    if variational is not None:
+        return _tangent.DOP853Tangent(rhs, r0, v0, gm, t0, variational, tol=tol, atol=atol,
+                                      max_step=max_step, control=method.tangent_control)
+    return _State(rhs, r0, v0, gm, t0, tol, atol, max_step, events)
+
+
+class _State:
+    """The state between calls: ``y = (r, v)`` flattened, the masses (merges change
+    them), the tolerances, the events log."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 tol: float, atol: np.ndarray, max_step: float, events: EventLog | None) -> None:
+        self.n = n = r0.shape[0]
+        self.gm = np.array(gm, dtype=np.float64)  # merges change it
+        self.f = _rhs(rhs, n, self.gm)
+        self.y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
+        self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
+        self.t, self.steps = t0, 0
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current positions, velocities and ``G m`` (copies)."""
+        n = self.n
+        return (self.y[: 3 * n].reshape(n, 3).copy(), self.y[3 * n:].reshape(n, 3).copy(),
+                self.gm.copy())
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
+        time); ``stop`` is asked at the outputs only (by the engine)."""
+        n, first = self.n, self.steps
+
+        def store(i: int, steps: int, y: np.ndarray) -> None:
+            r_out[i] = y[: 3 * n].reshape(n, 3)
+            v_out[i] = y[3 * n :].reshape(n, 3)
+            if on_output is not None:
+                on_output(i, steps - first)
+
+        if self.log is not None and len(self.log.watch):
+            self._with_events(t_out, store, first)
+            return
+
+        def keep(i: int, steps: int, y: np.ndarray) -> None:
+            self.y, self.t, self.steps = y, float(t_out[i]), first + steps
+            store(i, first + steps, y)
+
+        solve(self.f, self.y, t_out, rtol=self.tol, atol=self.atol, max_step=self.max_step,
+              on_state=keep)
+
+    def _with_events(self, t_out: np.ndarray, store: Callable[[int, int, np.ndarray], None],
+                     first: int) -> None:
+        """DOP853 step by step (scipy's stepper, as ``solve_ivp`` drives it) with every
+        step scanned for events on the cubic Hermite interpolant of its ends, before
+        the next is taken; an event with an action restarts the integration at its
+        time (or stops the run there)."""
+        from scipy.integrate import DOP853 as Stepper
+
+        log, n = self.log, self.n
+        for i in range(1, len(t_out)):
+            solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
+                             atol=self.atol, max_step=self.max_step)
+            while solver.status == "running":
+                t_prev, y_prev = solver.t, solver.y.copy()
+                if solver.step() is not None:
+                    raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
+                self.steps += 1
+                if log.count[0] + len(log.watch) > log.buffer.shape[0]:
+                    log.drain()
+                xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n]
+                                          .reshape(2, n, 3))
+                vs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, 3 * n :]
+                                          .reshape(2, n, 3))
+                k, h, row = _ev.scan_steps(log.watch, np.array([t_prev, solver.t]), xs, vs,
+                                           self.gm, log.buffer, log.count)
+                if k < 0:
+                    continue
+                r, v = np.empty((n, 3)), np.empty((n, 3))
+                _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
+                             np.zeros(1), np.zeros((7, 1)), self.gm, r, v)
+                self.t = float(t_prev + h * (solver.t - t_prev))
+                stop = log.act(int(row), self.t, r, v, self.gm)
+                self.y = np.concatenate((r.ravel(), v.ravel()))
+                if stop:
+                    store(i, self.steps, _nan_inactive(self.y, log, n))
+                    raise StopAtEvent(i, self.t, self.steps - first)
+                solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
+                                 atol=self.atol, max_step=self.max_step)
+            self.t, self.y = float(t_out[i]), solver.y.copy()
+            store(i, self.steps, _nan_inactive(self.y, log, n))
+
+
+def _rhs(rhs: Any, n: int, gm: np.ndarray) -> Callable[[float, np.ndarray], np.ndarray]:
+    """``f(t, y)`` of the bodies (positions, then velocities, flattened)."""
     accel = rhs.accel
     acc = np.empty((n, 3))
     p = rhs.p
@@ -82,70 +193,7 @@ def run(
         accel(r, v, gm, acc, p)
         return np.concatenate((y[3 * n :], acc.ravel()))
 
-    atol = tol * np.concatenate((_body_scale(r0), _body_scale(v0)))
-    y0 = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
-    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
-
-    def store(i: int, steps: int, y: np.ndarray) -> None:
-        r_out[i] = y[: 3 * n].reshape(n, 3)
-        v_out[i] = y[3 * n :].reshape(n, 3)
-        if on_output is not None:
-            on_output(i, steps)
-
-    max_step = np.inf if dt is None else float(dt)
-    if variational is not None:
-        return _tangent.run_dop853(rhs, r0, v0, gm, t_out, variational, tol=tol, atol=atol,
-                                   max_step=max_step, control=bool(tangent_control),
-                                   on_output=on_output, out=out)
-    if events is not None and len(events.watch):
-        steps = _run_with_events(f, y0, t_out, tol, atol, max_step, events, gm, store)
-    else:
-        _, steps, _ = solve(f, y0, t_out, rtol=tol, atol=atol, max_step=max_step,
-                            on_state=store)
-    return r_out, v_out, steps
-
-
-def _run_with_events(f: Callable, y0: np.ndarray, t_out: np.ndarray, tol: float,
-                     atol: np.ndarray, max_step: float, log: EventLog, gm: np.ndarray,
-                     store: Callable[[int, int, np.ndarray], None]) -> int:
-    """DOP853 step by step (scipy's stepper, as ``solve_ivp`` drives it) with every
-    step scanned for events on the cubic Hermite interpolant of its ends, before
-    the next is taken; an event with an action restarts the integration at its
-    time (or stops the run there)."""
-    from scipy.integrate import DOP853
-
-    n = gm.shape[0]
-    y = np.asarray(y0, dtype=np.float64)
-    t = float(t_out[0])
-    steps = 0
-    for i in range(1, len(t_out)):
-        solver = DOP853(f, t, y, float(t_out[i]), rtol=tol, atol=atol, max_step=max_step)
-        while solver.status == "running":
-            t_prev, y_prev = solver.t, solver.y.copy()
-            if solver.step() is not None:
-                raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
-            steps += 1
-            if log.count[0] + len(log.watch) > log.buffer.shape[0]:
-                log.drain()
-            xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n].reshape(2, n, 3))
-            vs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, 3 * n :].reshape(2, n, 3))
-            k, h, row = _ev.scan_steps(log.watch, np.array([t_prev, solver.t]), xs, vs, gm,
-                                       log.buffer, log.count)
-            if k < 0:
-                continue
-            r, v = np.empty((n, 3)), np.empty((n, 3))
-            _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
-                         np.zeros(1), np.zeros((7, 1)), gm, r, v)
-            t = float(t_prev + h * (solver.t - t_prev))
-            stop = log.act(int(row), t, r, v, gm)
-            y = np.concatenate((r.ravel(), v.ravel()))
-            if stop:
-                store(i, steps, _nan_inactive(y, log, n))
-                raise StopAtEvent(i, t, steps)
-            solver = DOP853(f, t, y, float(t_out[i]), rtol=tol, atol=atol, max_step=max_step)
-        t, y = float(t_out[i]), solver.y.copy()
-        store(i, steps, _nan_inactive(y, log, n))
-    return steps
+    return f
 
 
 def _nan_inactive(y: np.ndarray, log: EventLog, n: int) -> np.ndarray:

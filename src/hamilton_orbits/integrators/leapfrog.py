@@ -17,9 +17,10 @@ from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _tangent, output_arrays
-from hamilton_orbits.integrators._setup import MAX_FIXED_STEPS, accel_arg, check_step_count
+from hamilton_orbits.integrators._setup import accel_arg, check_dt_tol, check_step_count
+from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, Leapfrog
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run"]
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run", "start"]
 
 NAME = "leapfrog"
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
@@ -74,32 +75,78 @@ def run(
     >>> steps, bool(np.allclose(r[-1, 1], [1, 0, 0], atol=1e-4))
     (1000, True)
     """
+    method = Leapfrog(max_steps=max_steps)
+    dt_f, tol_f = check_dt_tol(dt, tol)
+    state = start(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
+                  np.ascontiguousarray(gm, dtype=np.float64), float(t_out[0]), method, dt=dt_f,
+                  tol=tol_f, events=events, variational=variational)
+    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
+    state.advance(np.asarray(t_out, np.float64), r_out, v_out, on_output, stop)
+    return r_out, v_out, state.steps
+
+
+def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+          method: Leapfrog, *, dt: float | None, tol: float | None,
+          events: EventLog | None = None, variational: Any = None) -> Any:
+    """The map's state at ``t0`` (a :class:`~hamilton_orbits.integrators.DriverState`),
+    for arguments already checked (``method`` a :class:`Leapfrog`)."""
     if dt is None:
         if tol is None:
             raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
         dt = choose_dt(r0, v0, gm, tol)
-    check_step_count(float(t_out[-1] - t_out[0]), float(dt), max_steps, NAME)
     if variational is not None:
-        return _tangent.run_leapfrog(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
-                                     np.ascontiguousarray(gm, dtype=np.float64), t_out,
-                                     variational, dt=float(dt), on_output=on_output, out=out,
-                                     stop=stop)
-    r = np.ascontiguousarray(r0, dtype=np.float64).copy()
-    v = np.ascontiguousarray(v0, dtype=np.float64).copy()
-    gm = np.ascontiguousarray(gm, dtype=np.float64)
-    out_r, out_v = output_arrays(out, len(t_out), r, v)
-    steps = 0
-    accel = accel_arg(rhs.accel)
-    gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
-    log = events if events is not None else EventLog.none(r.shape[0])
-    for i in range(1, len(t_out)):
+        return _tangent.LeapfrogTangent(rhs, r0, v0, gm, t0, variational, dt=float(dt),
+                                        max_steps=method.max_steps)
+    return _State(rhs, r0, v0, gm, t0, float(dt), method.max_steps, events)
+
+
+class _State:
+    """The map's state between calls: positions, velocities, masses (merges change
+    them), the events log."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 dt: float, max_steps: int, events: EventLog | None) -> None:
+        self.r = np.ascontiguousarray(r0, dtype=np.float64).copy()
+        self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
+        self.gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
+        self.accel, self.p = accel_arg(rhs.accel), rhs.p
+        self.log = events if events is not None else EventLog.none(self.r.shape[0])
+        self.dt, self.max_steps, self.t, self.steps = dt, max_steps, t0, 0
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current positions, velocities and ``G m`` (copies)."""
+        return self.r.copy(), self.v.copy(), self.gm.copy()
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
+        time); an event that stops the run raises
+        :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
+        check_step_count(float(t_out[-1] - t_out[0]), self.dt, self.max_steps, NAME)
+        r, v, log, first = self.r, self.v, self.log, self.steps
+        for i in range(1, len(t_out)):
+            self._interval(t_out, i, stop, first, (r_out[i], v_out[i]))
+            r_out[i] = r
+            v_out[i] = v
+            r_out[i, log.inactive] = np.nan
+            v_out[i, log.inactive] = np.nan
+            if on_output is not None:
+                on_output(i, self.steps - first)
+
+    def _interval(self, t_out: np.ndarray, i: int, stop: Callable[[], bool] | None, first: int,
+                  row: tuple[np.ndarray, np.ndarray]) -> None:
+        """The steps from ``t_out[i - 1]`` to ``t_out[i]``, in slices (Ctrl-C and
+        ``stop()`` are seen between them); an event that stops the run leaves its
+        state in ``row``."""
+        r, v, log = self.r, self.v, self.log
         t = float(t_out[i - 1])
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
-            done, status = _k.advance(accel, rhs.p, r, v, gm, t, float(t_out[i]), dt,
-                                      log.watch, log.buffer, log.count, ws, SLICE)
-            steps += int(done)
-            t = float(ws[0])
+            done, status = _k.advance(self.accel, self.p, r, v, self.gm, t, float(t_out[i]),
+                                      self.dt, log.watch, log.buffer, log.count, ws, SLICE)
+            self.steps += int(done)
+            t = self.t = float(ws[0])
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
             if status == _k.STATUS_SLICE:  # Ctrl-C and stop() are seen between slices
@@ -107,15 +154,8 @@ def run(
                     raise StopIntegration
                 continue
             log.drain()
-            if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, gm):
-                out_r[i], out_v[i] = r, v
-                out_r[i, log.inactive] = np.nan
-                out_v[i, log.inactive] = np.nan
-                raise StopAtEvent(i, t, steps)
-        out_r[i] = r
-        out_v[i] = v
-        out_r[i, log.inactive] = np.nan
-        out_v[i, log.inactive] = np.nan
-        if on_output is not None:
-            on_output(i, steps)
-    return out_r, out_v, steps
+            if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, self.gm):
+                row[0][:], row[1][:] = r, v
+                row[0][log.inactive] = np.nan
+                row[1][log.inactive] = np.nan
+                raise StopAtEvent(i, t, self.steps - first)

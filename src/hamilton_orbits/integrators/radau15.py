@@ -44,25 +44,20 @@ import numpy as np
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
+from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
 from hamilton_orbits.validation import ConvergenceError
 
-__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "PRECISIONS", "RADAU_SPACINGS",
-           "run"]
+__all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "CRITERIA", "DEFAULT_TOL", "MAX_STEPS", "NAME",
+           "PRECISIONS", "RADAU_SPACINGS", "run", "start"]
 
 NAME = "radau15"
 ACCEPTS_VELOCITY_DEPENDENT = True
 DEFAULT_TOL = 1e-9  # IAS15's epsilon (Rein & Spiegel 2015, section 3.2)
-#: Step-size criteria: ``"global"`` (Rein & Spiegel 2015, section 3.2) and
-#: ``"prs23"`` (Pham, Rein & Spiegel 2024, IAS15's default since rebound 4).
-CRITERIA = ("global", "prs23")
 DEFAULT_CRITERION = "prs23"
 #: Gauss-Radau spacings on [0, 1] (see :data:`hamilton_orbits._kernels.radau15.DECIMAL_SPACINGS`).
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
-#: Default limit on the steps of one run (minutes to an hour of work): a run that
-#: would need more stops early with an error that says so (pass ``max_steps``).
-MAX_STEPS = 100_000_000
 
 
 def run(
@@ -174,140 +169,170 @@ def run(
     True
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    if precision != "double":
+    method = Radau15(max_steps=max_steps, criterion=criterion, tangent_control=tangent_control,
+                     precision=precision)
+    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
+    state = start(rhs, r0, v0, gm, float(t_out[0]), method, dt=dt_f, tol=tol_f, events=events,
+                  variational=variational)
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    state.advance(t_out, r_out, v_out, on_output, stop)
+    return r_out, v_out, state.steps
+
+
+def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+          method: Radau15, *, dt: float | None, tol: float | None,
+          events: EventLog | None = None, variational: Any = None) -> Any:
+    """The integrator's state at ``t0`` (a :class:`~hamilton_orbits.integrators.
+    DriverState`), for arguments already checked (``method`` a :class:`Radau15`,
+    ``dt`` and ``tol`` positive floats or None); it is advanced output interval by
+    output interval, across calls, exactly as one run through all of them.
+
+    The first trial step, when ``dt`` is not given, is :func:`_setup.initial_step`
+    (1/100 of the shortest pair free-fall time); the span of a first call does not
+    shorten it, so that a run continued in legs takes the steps of one run.
+    """
+    if method.precision != "double":
         if variational is not None:
             raise ValueError("radau15 in double-double integrates no variational equations; "
                              "use precision='double' with variational=True")
-        return _run_double_double(rhs, r0, v0, gm, t_out, dt, tol, on_output, out, events,
-                                  precision)
-    if criterion not in CRITERIA:
-        raise ValueError(
-            f"Expected `criterion` to be one of {', '.join(map(repr, CRITERIA))}, got {criterion!r}"
-        )
-    crit = criterion
-    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
-    if dt_f is None and tol_f is None:
-        tol_f = DEFAULT_TOL
-    nt = t_out.shape[0]
-    r_out, v_out = output_arrays(out, nt, r0, v0)
-    if dt_f is None:
-        dt_f = _setup.initial_step(r0, v0, gm)
-    span = t_out[-1] - t_out[0]
-    if span > 0.0:
-        dt_f = min(dt_f, span)
+        return _DoubleDouble(rhs, r0, v0, gm, t0, dt, tol, events)
+    if dt is None and tol is None:
+        tol = DEFAULT_TOL
+    if dt is None:
+        dt = _setup.initial_step(r0, v0, gm)
+    prs23 = method.criterion == "prs23"
     if variational is not None:
-        return _tangent.run_radau15(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
-                                    tol=tol_f or 0.0, prs23=crit == "prs23", max_steps=max_steps,
-                                    slice_steps=SLICE, control=bool(tangent_control),
-                                    on_output=on_output, out=out, stop=stop)
+        return _tangent.Radau15Tangent(rhs, r0, v0, gm, t0, variational, dt=dt, tol=tol or 0.0,
+                                       prs23=prs23, max_steps=method.max_steps,
+                                       slice_steps=SLICE, control=method.tangent_control)
     log = events if events is not None else EventLog.none(r0.shape[0])
-    run_ = _Run(rhs, r0, v0, gm.copy(), t_out[0], dt_f, tol_f or 0.0, crit == "prs23", log)
-    run_.stop = stop
-    for i in range(1, nt):
-        stop = run_.advance_to(t_out, i, max_steps)
-        r_out[i] = run_.x
-        v_out[i] = run_.w
-        r_out[i, log.inactive] = np.nan
-        v_out[i, log.inactive] = np.nan
-        if stop:
-            raise StopAtEvent(i, float(run_.st[0]), run_.total)
-        if on_output is not None:
-            on_output(i, run_.total)
-    return r_out, v_out, run_.total
+    return _Run(rhs, r0, v0, gm.copy(), t0, dt, tol or 0.0, prs23, log, method.max_steps)
 
 
-#: The arithmetics of :func:`run`.
-PRECISIONS = ("double", "double-double")
+class _DoubleDouble:
+    """radau15 in double-double (``precision="double-double"``, see :func:`run`): the
+    state between calls."""
 
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 dt: float | None, tol: float | None, events: EventLog | None) -> None:
+        if dt is None or tol is not None:
+            raise ValueError("radau15 in double-double runs fixed steps: give `dt` and no "
+                             f"`tol`, got dt = {dt!r}, tol = {tol!r}")
+        if rhs.effects != ("newtonian",):
+            raise ValueError("radau15 in double-double computes Newtonian gravity only; "
+                             f"listed: {', '.join(rhs.effects[1:])}")
+        if events is not None and len(events.watch):
+            raise ValueError("radau15 in double-double watches no events")
+        n = r0.shape[0]
+        self.x = np.zeros((n, 3, 2))
+        self.v = np.zeros((n, 3, 2))
+        self.x[:, :, 0], self.v[:, :, 0] = r0, v0
+        self.b, self.g = np.zeros((7, 3 * n, 2)), np.zeros((7, 3 * n, 2))
+        self.br, self.d = np.zeros((7, 3 * n)), np.zeros((7, 3 * n))
+        self.gm = np.array(gm, dtype=np.float64)
+        self.dt, self.h_last, self.t, self.steps = dt, 0.0, t0, 0
 
-def _run_double_double(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray,
-                       t_out: np.ndarray, dt: Any, tol: Any, on_output: Any, out: Any,
-                       events: EventLog | None, precision: str
-                       ) -> tuple[np.ndarray, np.ndarray, int]:
-    """:func:`run` with ``precision="double-double"`` (see there)."""
-    from hamilton_orbits._kernels import radau15_dd
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current state rounded to doubles (copies)."""
+        return (self.x[:, :, 0] + self.x[:, :, 1], self.v[:, :, 0] + self.v[:, :, 1],
+                self.gm.copy())
 
-    if precision not in PRECISIONS:
-        raise ValueError(f"Expected `precision` to be one of {', '.join(map(repr, PRECISIONS))}"
-                         f", got {precision!r}")
-    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
-    if dt_f is None or tol_f is not None:
-        raise ValueError("radau15 in double-double runs fixed steps: give `dt` and no `tol`, "
-                         f"got dt = {dt!r}, tol = {tol!r}")
-    if rhs.effects != ("newtonian",):
-        raise ValueError("radau15 in double-double computes Newtonian gravity only; listed: "
-                         f"{', '.join(rhs.effects[1:])}")
-    if events is not None and len(events.watch):
-        raise ValueError("radau15 in double-double watches no events")
-    n = r0.shape[0]
-    x = np.zeros((n, 3, 2))
-    v = np.zeros((n, 3, 2))
-    x[:, :, 0], v[:, :, 0] = r0, v0
-    b, g = np.zeros((7, 3 * n, 2)), np.zeros((7, 3 * n, 2))
-    br, d = np.zeros((7, 3 * n)), np.zeros((7, 3 * n))
-    gm = np.array(gm, dtype=np.float64)
-    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
-    total, h_last = 0, 0.0
-    for i in range(1, len(t_out)):
-        span = float(t_out[i] - t_out[i - 1])
-        n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
-        last = span - (n_steps - 1) * dt_f
-        done = 0
-        while done < n_steps:  # slices of SLICE // 100 steps: Ctrl-C is seen between them
-            k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1
-            h = dt_f if done < n_steps - 1 else last
-            radau15_dd.advance(x, v, gm, h, k, b, g, br, d, h / h_last if h_last else 0.0)
-            h_last = h
-            done += k
-        total += n_steps
-        r_out[i] = x[:, :, 0] + x[:, :, 1]
-        v_out[i] = v[:, :, 0] + v[:, :, 1]
-        if on_output is not None:
-            on_output(i, total)
-    return r_out, v_out, total
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Any, stop: Any) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
+        time), in slices of ``SLICE // 100`` steps (Ctrl-C is seen between them)."""
+        from hamilton_orbits._kernels import radau15_dd
+
+        dt_f, first = self.dt, self.steps
+        for i in range(1, len(t_out)):
+            span = float(t_out[i] - t_out[i - 1])
+            n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
+            last = span - (n_steps - 1) * dt_f
+            done = 0
+            while done < n_steps:
+                k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1
+                h = dt_f if done < n_steps - 1 else last
+                radau15_dd.advance(self.x, self.v, self.gm, h, k, self.b, self.g, self.br,
+                                   self.d, h / self.h_last if self.h_last else 0.0)
+                self.h_last = h
+                done += k
+            self.steps += n_steps
+            self.t = float(t_out[i])
+            r_out[i] = self.x[:, :, 0] + self.x[:, :, 1]
+            v_out[i] = self.v[:, :, 0] + self.v[:, :, 1]
+            if on_output is not None:
+                on_output(i, self.steps - first)
 
 
 class _Run:
     """The integrator's state between compiled calls (see :func:`run`)."""
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
-                 dt: float, tol: float, prs23: bool, log: EventLog) -> None:
+                 dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
         m = 3 * r0.shape[0]
-        self.rhs, self.gm, self.log = rhs, gm, log
+        self.rhs, self.gm, self.log, self.max_steps = rhs, gm, log, max_steps
         self.accel = _setup.accel_arg(rhs.accel)
         self.work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
         self.csx = np.zeros(m)
         self.csv = np.zeros(m)
         self.st = np.zeros(_k.NSTATE)
-        self.st[[0, 2, 4, 7]] = t0, dt, tol, float(prs23)
+        self.st[[_k.ST_T, _k.ST_DT, _k.ST_EPSILON, _k.ST_PRS23]] = t0, dt, tol, float(prs23)
         self.x = np.ascontiguousarray(r0.copy())
         self.w = np.ascontiguousarray(v0.copy())
-        self.total = 0
+        self.steps = 0
         self.stop: Callable[[], bool] | None = None
 
-    def advance_to(self, t_out: np.ndarray, i: int, max_steps: int) -> bool:
-        """Step to ``t_out[i]`` in slices; True if an event stopped the run."""
-        log = self.log
+    @property
+    def t(self) -> float:
+        """The time of the state."""
+        return float(self.st[_k.ST_T])
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current positions, velocities and ``G m`` (copies)."""
+        return self.x.copy(), self.w.copy(), self.gm.copy()
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Any, stop: Any) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
+        time); an event that stops the run raises
+        :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
+        log, first = self.log, self.steps
+        self.stop = stop
+        for i in range(1, t_out.shape[0]):
+            stopped = self.advance_to(t_out, i, first)
+            r_out[i] = self.x
+            v_out[i] = self.w
+            r_out[i, log.inactive] = np.nan
+            v_out[i, log.inactive] = np.nan
+            if stopped:
+                raise StopAtEvent(i, self.t, self.steps - first)
+            if on_output is not None:
+                on_output(i, self.steps - first)
+
+    def advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
+        """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
+        the steps before this call, for its budget of ``max_steps``)."""
+        log, max_steps = self.log, self.max_steps
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             steps, status = _k.advance(
                 self.accel, self.rhs.p, self.x, self.w, self.gm, t_out[i], self.st, *self.work,
                 self.csx, self.csv, bool(self.rhs.velocity_dependent),
-                min(SLICE, max_steps - self.total), log.watch, log.buffer, log.count)
-            self.total += steps
+                min(SLICE, max_steps - (self.steps - first)), log.watch, log.buffer, log.count)
+            self.steps += steps
             if status == _k.STATUS_MAXSTEPS:
-                _check_pace(self.total, max_steps, float(self.st[0]), t_out)
+                _check_pace(self.steps - first, max_steps, self.t, t_out)
                 if self.stop is not None and self.stop():
                     raise StopIntegration
             elif status == _k.STATUS_DRAIN:
                 log.drain()
             elif status == _k.STATUS_EVENT:
-                if log.act(int(self.st[8]), float(self.st[0]), self.x, self.w, self.gm):
+                if log.act(int(self.st[_k.ST_EVENT_ROW]), self.t, self.x, self.w, self.gm):
                     return True
             elif status == _k.STATUS_OK:
                 return False
             else:
                 raise ConvergenceError(
-                    f"radau15 stopped at t = {float(self.st[0])!r} before t_out[{i}] = "
+                    f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
                     f"{float(t_out[i])!r}: {_why(status, self.st, max_steps)}"
                 )
 
@@ -328,6 +353,6 @@ def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:
     return {
         _k.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
-        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[2])!r})",
+        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r})",
         _k.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
     }[status]

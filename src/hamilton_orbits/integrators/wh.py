@@ -52,12 +52,8 @@ correctors for Jacobi coordinates only.
 
 from __future__ import annotations
 
-import decimal
-import functools
 import math
-import numbers
 from collections.abc import Callable
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -65,12 +61,14 @@ import numpy as np
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import (
-    WH_CORRECTORS,
-    StopIntegration,
-    _setup,
-    _tangent,
-    output_arrays,
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
+from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, WH
+from hamilton_orbits.integrators.methods import WH_COORDINATES as COORDINATES
+from hamilton_orbits.integrators.wh_correctors import (
+    CORRECTOR_ALPHA_SQUARED,
+    CORRECTORS,
+    corrector_coefficients,
+    corrector_series,
 )
 from hamilton_orbits.validation import ConvergenceError
 
@@ -84,13 +82,14 @@ __all__ = [
     "corrector_series",
     "default_step",
     "run",
+    "start",
 ]
 
 NAME = "wh"
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 100_000
 ACCEPTS_VELOCITY_DEPENDENT = False
-COORDINATES = ("democratic_heliocentric", "jacobi")
+
 
 def default_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | None = None) -> float:
     """The step ``run`` takes when ``dt`` is not given.
@@ -139,7 +138,7 @@ def run(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     coordinates: str = "democratic_heliocentric",
     corrector: int = 0,
-    max_steps: int = _setup.MAX_FIXED_STEPS,
+    max_steps: int = MAX_FIXED_STEPS,
     events: EventLog | None = None,
     variational: Any = None,
     stop: Callable[[], bool] | None = None,
@@ -223,96 +222,132 @@ def run(
     100
     """
     r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    dt_f, tol_f, corrector = _check_options(rhs, dt, tol, coordinates, corrector,
-                                            variational is not None)
-    c = int(np.argmax(gm))
-    if not gm[c] > 0.0:
-        raise ValueError("wh needs a central body with `gm` > 0; all `gm` are 0")
-    if dt_f is None:
-        dt_f = default_step(r0, v0, gm, tol_f)
-    _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, max_steps, NAME)
+    method = WH(coordinates=coordinates, corrector=corrector, max_steps=max_steps)
+    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
+    state = start(rhs, r0, v0, gm, float(t_out[0]), method, dt=dt_f, tol=tol_f, events=events,
+                  variational=variational)
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    state.advance(t_out, r_out, v_out, on_output, stop)
+    return r_out, v_out, state.steps
+
+
+def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, method: WH, *,
+          dt: float | None, tol: float | None, events: EventLog | None = None,
+          variational: Any = None) -> Any:
+    """The map's state at ``t0`` (a :class:`~hamilton_orbits.integrators.DriverState`),
+    for arguments already checked (``method`` a :class:`WH`); it keeps the
+    splitting's coordinates between calls, so that a run continued in legs takes
+    the steps of one run and never goes through the inertial frame and back."""
+    if rhs.velocity_dependent:
+        raise ValueError(
+            f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
+            f"{', '.join(rhs.effects)}.  Use method='radau15' (or 'dop853') for them"
+        )
+    if method.corrector and variational is not None:
+        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
+                         "is not implemented); use corrector=0")
+    if r0.shape[0] == 0 or not np.max(gm) > 0.0:
+        raise ValueError("wh needs a central body with `gm` > 0; "
+                         + ("there are no bodies" if r0.shape[0] == 0 else "all `gm` are 0"))
+    if dt is None:
+        dt = default_step(r0, v0, gm, tol)
     if variational is not None:
-        return _tangent.run_wh(rhs, r0, v0, gm, t_out, variational, dt=dt_f,
-                               jacobi=coordinates == "jacobi", on_output=on_output, out=out,
-                               stop=stop)
-    n = r0.shape[0]
-    # the central body first (row i of the coordinates is body order[i])
-    order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
-    extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
-    if events is not None:
-        gm = gm.copy()  # merges change it
-    log = events if events is not None else EventLog.none(n)
-    if c != 0:
-        log.index_map = order
-    nt = t_out.shape[0]
-    r_out, v_out = output_arrays(out, nt, r0, v0)
-    split = _Split(gm, order, coordinates == "jacobi", corrector, extra, rhs.p,
-                   rhs.extra is not None)
-    # the working coordinates live in the next output row when the central body is
-    # first (no copy of the state of its own: 48 bytes a body fewer), else apart
-    in_place = c == 0
-    if nt > 1:
-        split.from_inertial(r0, v0, *((r_out[1], v_out[1]) if in_place else
-                                      (np.empty_like(r0), np.empty_like(v0))))
-    total = 0
-    watch = log.kernel_watch()
-    for i in range(1, nt):
-        split, total, watch = _interval(split, i, t_out, dt_f, log, watch, gm, total,
-                                        (r_out[i], v_out[i]), stop)
-        if in_place:
-            q, u = split.q, split.u
-            if i + 1 < nt:  # the state moves on to the next row
-                r_out[i + 1], v_out[i + 1] = q, u
-                split.q, split.u = r_out[i + 1], v_out[i + 1]
-            split.to_inertial(q, u, q, u)  # row i, in place
-        else:
-            split.to_inertial(r_out[i], v_out[i])
-        _mask(r_out[i], v_out[i], log)
-        if on_output is not None:
-            on_output(i, total)
-    return r_out, v_out, total
+        return _tangent.WHTangent(rhs, r0, v0, gm, t0, variational, dt=dt, jacobi=method.jacobi,
+                                  max_steps=method.max_steps)
+    return _State(rhs, r0, v0, gm, t0, method, dt, events)
 
 
-def _interval(split: _Split, i: int, t_out: np.ndarray, dt: float, log: EventLog,
-              watch: np.ndarray, gm: np.ndarray, total: int,
-              row: tuple[np.ndarray, np.ndarray], stop: Callable[[], bool] | None = None
-              ) -> tuple[_Split, int, np.ndarray]:
-    """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land on
-    it), events acted on at the end of their step; the split (new after a merge or
-    a removal), the steps so far and the watch table.  An event that stops the run
-    leaves its state in ``row`` (output ``i``).  The steps go in slices of
-    ``SLICE``: Ctrl-C and ``stop()`` are seen between them."""
-    span = t_out[i] - t_out[i - 1]
-    n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
-    last = span - (n_steps - 1) * dt
-    done = 0
-    while done < n_steps:
-        if done and stop is not None and stop():
-            raise StopIntegration
-        ws = np.array([t_out[i - 1] + done * dt, np.inf, 0.0, -1.0])
-        n_call = min(n_steps - done, SLICE)
-        steps, bad, status = split.advance(dt, n_call, last if done + n_call == n_steps else dt,
-                                           watch, log.buffer, log.count, ws)
-        done += steps
-        total += steps
-        if bad >= 0:
-            raise ConvergenceError(
-                f"wh: the Kepler step of body {int(split.order[bad])} failed between "
-                f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
-                f"{float(t_out[i])!r}")
-        if status == _k.STATUS_DRAIN:
-            log.drain()
-        elif status == _k.STATUS_EVENT:
-            r_now, v_now = np.empty_like(split.q), np.empty_like(split.u)
-            split.to_inertial(r_now, v_now)
-            if log.act(int(ws[3]), float(ws[0]), r_now, v_now, gm):
-                row[0][:], row[1][:] = r_now, v_now
-                _mask(row[0], row[1], log)
-                raise StopAtEvent(i, float(ws[0]), total)
-            split = split.renewed(gm)
-            split.from_inertial(r_now, v_now, split.q, split.u)
-            watch = log.kernel_watch()
-    return split, total, watch
+class _State:
+    """The map's state between calls: the splitting (its coordinates and compiled
+    steps), the events log and the masses (merges change them)."""
+
+    def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
+                 method: WH, dt: float, events: EventLog | None) -> None:
+        n = r0.shape[0]
+        c = int(np.argmax(gm))
+        # the central body first (row i of the coordinates is body order[i])
+        order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
+        extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
+        self.gm = np.array(gm, dtype=np.float64)  # merges change it
+        self.log = events if events is not None else EventLog.none(n)
+        if c != 0:
+            self.log.index_map = order
+        self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra, rhs.p,
+                            rhs.extra is not None)
+        self.split.from_inertial(r0, v0, np.empty_like(r0), np.empty_like(v0))
+        self.watch = self.log.kernel_watch()
+        self.dt, self.max_steps, self.t, self.steps = dt, method.max_steps, t0, 0
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current inertial positions, velocities and ``G m`` (copies)."""
+        r, v = np.empty_like(self.split.q), np.empty_like(self.split.u)
+        self.split.to_inertial(r, v)
+        return r, v, self.gm.copy()
+
+    def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
+                on_output: Callable[[int, int], None] | None,
+                stop: Callable[[], bool] | None) -> None:
+        """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
+        time); an event that stops the run raises
+        :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
+        _setup.check_step_count(float(t_out[-1] - t_out[0]), self.dt, self.max_steps, NAME)
+        first = self.steps
+        for i in range(1, t_out.shape[0]):
+            self._interval(i, t_out, (r_out[i], v_out[i]), stop, first)
+            self.t = float(t_out[i])
+            self.split.to_inertial(r_out[i], v_out[i])
+            _mask(r_out[i], v_out[i], self.log)
+            if on_output is not None:
+                on_output(i, self.steps - first)
+
+    def _interval(self, i: int, t_out: np.ndarray, row: tuple[np.ndarray, np.ndarray],
+                  stop: Callable[[], bool] | None, first: int) -> None:
+        """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land
+        on it), events acted on at the end of their step (a merge or a removal
+        renews the split).  An event that stops the run leaves its state in ``row``
+        (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
+        are seen between them."""
+        dt, log = self.dt, self.log
+        span = t_out[i] - t_out[i - 1]
+        n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+        last = span - (n_steps - 1) * dt
+        done = 0
+        while done < n_steps:
+            if done and stop is not None and stop():
+                raise StopIntegration
+            ws = np.array([t_out[i - 1] + done * dt, np.inf, 0.0, -1.0])
+            n_call = min(n_steps - done, SLICE)
+            steps, bad, status = self.split.advance(
+                dt, n_call, last if done + n_call == n_steps else dt, self.watch, log.buffer,
+                log.count, ws)
+            done += steps
+            self.steps += steps
+            self.t = float(t_out[i - 1] + done * dt)
+            if bad >= 0:
+                raise ConvergenceError(
+                    f"wh: the Kepler step of body {int(self.split.order[bad])} failed between "
+                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
+                    f"{float(t_out[i])!r}")
+            if status == _k.STATUS_DRAIN:
+                log.drain()
+            elif status == _k.STATUS_EVENT:
+                self._act(i, row, ws, first)
+
+    def _act(self, i: int, row: tuple[np.ndarray, np.ndarray], ws: np.ndarray,
+             first: int) -> None:
+        """The action of the event in ``ws`` at the end of its step: a stop leaves the
+        state in ``row`` and raises :class:`StopAtEvent`; a merge or a removal renews
+        the split from the changed inertial state."""
+        r_now, v_now = np.empty_like(self.split.q), np.empty_like(self.split.u)
+        self.split.to_inertial(r_now, v_now)
+        if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm):
+            row[0][:], row[1][:] = r_now, v_now
+            _mask(row[0], row[1], self.log)
+            self.t = float(ws[0])  # the end of the step (the split holds that state)
+            raise StopAtEvent(i, float(ws[0]), self.steps - first)
+        self.split = self.split.renewed(self.gm)
+        self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
+        self.watch = self.log.kernel_watch()
 
 
 def _mask(r: np.ndarray, v: np.ndarray, log: EventLog) -> None:
@@ -320,132 +355,6 @@ def _mask(r: np.ndarray, v: np.ndarray, log: EventLog) -> None:
     if log.inactive.any():
         r[log.inactive] = np.nan
         v[log.inactive] = np.nan
-
-
-#: The symplectic correctors' orders (Wisdom, Holman & Touma 1996; Rein & Tamayo 2015).
-CORRECTORS = WH_CORRECTORS
-
-
-#: The spacing of the correctors' Kepler drifts, ``a_k = k alpha dt`` with
-#: ``alpha = sqrt(7/40)`` (Wisdom, Holman & Touma 1996; Rein & Tamayo 2015).
-CORRECTOR_ALPHA_SQUARED = Fraction(7, 40)
-
-
-def corrector_series(k_max: int) -> list[Fraction]:
-    """The coefficients ``g_0, g_2, ..., g_{2 k_max}`` of ``(z/2) / sinh(z/2) =
-    sum_k g_{2k} z^{2k}``, exactly.
-
-    The Wisdom-Holman kernel ``K = exp(h/2 A) exp(h eps B) exp(h/2 A)`` is, to first
-    order in ``eps``, ``exp(h A + eps h g(h ad_A) B)`` with ``g(z) = (z/2) /
-    sinh(z/2)`` (the symmetric Baker-Campbell-Hausdorff formula), so its error
-    terms linear in ``eps`` are ``eps h^(2k+1) g_{2k} ad_A^(2k) B``, ``k >= 1``.
-
-    Examples
-    --------
-    >>> corrector_series(2)
-    [Fraction(1, 1), Fraction(-1, 24), Fraction(7, 5760)]
-    """
-    # 1 / (sinh(z/2) / (z/2)), the series in w = z^2 inverted term by term
-    s = [Fraction(1, math.factorial(2 * k + 1) * 4**k) for k in range(k_max + 1)]
-    g = [Fraction(1)]
-    for k in range(1, k_max + 1):
-        g.append(-sum((s[j] * g[k - j] for j in range(1, k + 1)), Fraction(0)))
-    return g
-
-
-@functools.cache
-def corrector_coefficients(order: int) -> tuple[np.ndarray, np.ndarray]:
-    """The drifts and kicks ``(a, b)`` (in units of the step) of the symplectic
-    corrector of ``order`` 3, 5, 7, 11 or 17, as the sequence of ``Z(a_k, b_k)``
-    that :func:`hamilton_orbits._kernels.wh.corrector_jacobi` applies.
-
-    Construction (Wisdom, Holman & Touma 1996, section 3; the orders of Rein &
-    Tamayo 2015, section 4.1): the corrector ``C = exp(eps W)`` turns the kernel
-    into ``C K C^-1``, whose error terms linear in ``eps`` vanish through
-    ``eps h^p`` when ``ad_A W = g(h ad_A) B - B`` holds through ``h^p``
-    (:func:`corrector_series`), i.e. ``W = sum_k g_{2k} h^{2k} ad_A^(2k-1) B``,
-    ``k = 1 .. m``, ``m = (order - 1) / 2``.  ``Z(a, b)`` (Kepler ``a``, kick
-    ``-b``, Kepler ``-2a``, kick ``b``, Kepler ``a``) is ``exp(-2 b eps sum_{odd
-    n} a^n / n! ad_A^n B)`` to first order in ``eps``; the sequence ``(a_m, b_m)
-    ... (a_1, b_1), (-a_1, -b_1) ... (-a_m, -b_m)`` with ``a_i = i alpha``
-    therefore needs
-
-        sum_i b_i (i alpha)^n = -n! g_{n+1} / 4,      n = 1, 3, ..., 2m - 1,
-
-    a Vandermonde system in ``i^2`` solved here in rationals (``b_i alpha`` is
-    rational because ``alpha^2 = 7/40`` is) and rounded once.  The sequence
-    reversed with ``a`` negated is itself with ``b`` negated, so the corrector
-    with ``-b`` is its exact inverse.  The values agree with rebound's
-    ``reb_whfast_corrector_b_*`` to the last digit of a double.
-
-    Raises
-    ------
-    ValueError
-        For an order other than 3, 5, 7, 11, 17.
-
-    Examples
-    --------
-    >>> a, b = corrector_coefficients(3)
-    >>> a.tolist() == [math.sqrt(7 / 40), -math.sqrt(7 / 40)]
-    True
-    >>> float(b[0])  # 1 / (96 alpha) = sqrt(10/7) / 48 = 0.02490059602779986749...
-    0.024900596027799867
-    """
-    if order not in CORRECTORS or order == 0:
-        raise ValueError(f"Expected a corrector order in 3, 5, 7, 11, 17, got {order!r}")
-    m = (order - 1) // 2
-    g = corrector_series(m)
-    ns = [2 * j + 1 for j in range(m)]
-    # c_i = b_i alpha: sum_i c_i i^n = -n! g_{n+1} / (4 alpha^(n-1))
-    rows = [[Fraction(i) ** n for i in range(1, m + 1)]
-            + [-math.factorial(n) * g[(n + 1) // 2] / (4 * CORRECTOR_ALPHA_SQUARED ** (n // 2))]
-            for n in ns]
-    for col in range(m):  # Gauss-Jordan elimination, exact
-        pivot = rows[col][col]
-        rows[col] = [x / pivot for x in rows[col]]
-        for r in range(m):
-            if r != col and rows[r][col] != 0:
-                f = rows[r][col]
-                rows[r] = [x - f * y for x, y in zip(rows[r], rows[col], strict=True)]
-    with decimal.localcontext() as ctx:
-        ctx.prec = 40
-        alpha = (decimal.Decimal(CORRECTOR_ALPHA_SQUARED.numerator)
-                 / decimal.Decimal(CORRECTOR_ALPHA_SQUARED.denominator)).sqrt()
-        c = [decimal.Decimal(row[m].numerator) / decimal.Decimal(row[m].denominator)
-             for row in rows]
-        a_half = [float(i * alpha) for i in range(m, 0, -1)]
-        b_half = [float(c[i - 1] / alpha) for i in range(m, 0, -1)]
-    a = np.array(a_half + [-x for x in reversed(a_half)])
-    b = np.array(b_half + [-x for x in reversed(b_half)])
-    return a, b
-
-
-def _check_options(rhs: Any, dt: Any, tol: Any, coordinates: str, corrector: int,
-                   variational: bool = False):
-    if rhs.velocity_dependent:
-        raise ValueError(
-            f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
-            f"{', '.join(rhs.effects)}.  Use method='radau15' (or 'dop853') for them"
-        )
-    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
-    if coordinates not in COORDINATES:
-        raise ValueError(
-            f"Expected `coordinates` to be one of {', '.join(map(repr, COORDINATES))}, "
-            f"got {coordinates!r}"
-        )
-    if (isinstance(corrector, bool) or not isinstance(corrector, numbers.Integral)
-            or corrector not in CORRECTORS):
-        raise ValueError(f"Expected `corrector` to be one of "
-                         f"{', '.join(map(str, CORRECTORS))}, got {corrector!r}")
-    if corrector and coordinates != "jacobi":
-        raise ValueError(
-            f"Expected coordinates='jacobi' with `corrector` = {corrector}, got {coordinates!r} "
-            "(the correctors are defined for the Jacobi splitting)"
-        )
-    if corrector and variational:
-        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
-                         "is not implemented); use corrector=0")
-    return dt_f, tol_f, int(corrector)
 
 
 class _Split:
