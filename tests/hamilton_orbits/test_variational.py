@@ -497,18 +497,26 @@ def test_tangent_maps_in_slices_and_stop(method, run_kw):
     does), and ``stop()`` ends the run inside an output interval; the engine,
     which asks ``stop()`` after each output too, reports such a run incomplete."""
     from hamilton_orbits import engine
-    from hamilton_orbits.integrators import StopIntegration, _tangent
+    from hamilton_orbits.integrators import StopIntegration, _tangent, output_arrays
 
     s = _three()
     gm = np.array(s.gm, dtype=np.float64)  # the drivers' own copy
     rhs = compile_rhs(s, (), variational=True)
     t_out = np.array([0.0, 1.0, 2.05])
-    runner = getattr(_tangent, f"run_{method}")
+    state = {"leapfrog": _tangent.LeapfrogTangent, "wh": _tangent.WHTangent}[method]
+
+    def runner(rhs, r0, v0, gm, t_out, tan, *, stop=None, **kw):
+        driver = state(rhs, r0, v0, gm, t_out[0], tan, **kw)
+        tan.new_leg(len(t_out))
+        r, v = output_arrays(None, len(t_out), r0, v0)
+        driver.advance(t_out, r, v, None, stop)
+        return r, v, driver.steps
+
     ends = []
     for slice_steps in (_tangent.SLICE, 7):
         tan = _tangent.Tangent(3, 3, stm=True)
-        r, v, steps = runner(rhs, s.r, s.v, gm, t_out, tan, dt=0.01, on_output=None, out=None,
-                             slice_steps=slice_steps, **run_kw)
+        r, v, steps = runner(rhs, s.r, s.v, gm, t_out, tan, dt=0.01, slice_steps=slice_steps,
+                             **run_kw)
         ends.append((r[-1], v[-1], tan.stm[-1], tan.megno[-1], steps))
     (r1, v1, m1, y1, n1), (r7, v7, m7, y7, n7) = ends
     assert n1 == n7 == 205
@@ -518,9 +526,8 @@ def test_tangent_maps_in_slices_and_stop(method, run_kw):
     assert abs(y1 - y7) < 1e-2
     asked = []
     with pytest.raises(StopIntegration):
-        runner(rhs, s.r, s.v, gm, t_out, _tangent.Tangent(3, 3), dt=0.01, on_output=None,
-               out=None, slice_steps=7, stop=lambda: asked.append(1) or len(asked) > 2,
-               **run_kw)
+        runner(rhs, s.r, s.v, gm, t_out, _tangent.Tangent(3, 3), dt=0.01, slice_steps=7,
+               stop=lambda: asked.append(1) or len(asked) > 2, **run_kw)
     assert len(asked) == 3
     out = engine.run(s.r, s.v, gm, t_out, rhs, method, dt=0.01, stop=lambda: True,
                      variational=_tangent.Tangent(3, 3))
@@ -535,12 +542,13 @@ def test_radau15_variational_asks_stop_between_slices():
     s = _three()
     rhs = compile_rhs(s, (), variational=True)
     asked = []
+    driver = _tangent.Radau15Tangent(rhs, s.r, s.v, np.array(s.gm, dtype=np.float64), 0.0,
+                                     _tangent.Tangent(3, 2), dt=0.01, tol=1e-9, prs23=False,
+                                     max_steps=10_000, slice_steps=5, control=False)
+    r, v = np.empty((2, 3, 3)), np.empty((2, 3, 3))
     with pytest.raises(StopIntegration):
-        _tangent.run_radau15(rhs, s.r, s.v, np.array(s.gm, dtype=np.float64),
-                             np.array([0.0, 20.0]), _tangent.Tangent(3, 2), dt=0.01, tol=1e-9,
-                             prs23=False, max_steps=10_000, slice_steps=5, control=False,
-                             on_output=None, out=None,
-                             stop=lambda: asked.append(1) or len(asked) > 1)
+        driver.advance(np.array([0.0, 20.0]), r, v, None,
+                       lambda: asked.append(1) or len(asked) > 1)
     assert len(asked) == 2
 
 
