@@ -67,7 +67,9 @@ class EngineRun:
     r, v : ndarray, shape (k, n, 3)
         The states at those times.
     steps : int
-        Steps taken (in this call).
+        Steps taken in this call up to the last output reached (a run stopped
+        inside an output interval took more: the propagation's ``steps`` counts
+        them).
     wall_time : float
         Seconds of the integration proper.
     complete : bool
@@ -245,9 +247,9 @@ class Propagation:
         complete, interrupted = True, False
         try:
             driver.advance(-t_out if backward else t_out, r_out, v_out, report, stop)
-            reached[0] = n_t - 1
+            reached[0], reached[1] = n_t - 1, driver.steps - steps0
         except StopAtEvent as stopped:
-            reached[0] = stopped.index
+            reached[0], reached[1] = stopped.index, stopped.steps
             t_reached[stopped.index] = stopped.t
         except StopIntegration:
             complete = False
@@ -260,7 +262,7 @@ class Propagation:
         self._reached(driver, r_out[k - 1], v_out[k - 1], float(t_reached[k - 1]))
         gm_out = (self.events.gm_at(t_reached[:k], self.gm0)
                   if self.events is not None and self.events.gm_changes else self.gm0)
-        return EngineRun(t_reached[:k], r_out[:k], v_out[:k], driver.steps - steps0, wall,
+        return EngineRun(t_reached[:k], r_out[:k], v_out[:k], reached[1], wall,
                          complete, self.events, gm_out, self.variational, interrupted,
                          first_event)
 

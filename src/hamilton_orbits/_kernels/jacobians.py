@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit, types
 
-from hamilton_orbits._kernels.signatures import F1, F2
+from hamilton_orbits._kernels.signatures import F1, F2, function_at
 
 __all__ = [
     "FD_EPS",
@@ -46,6 +46,7 @@ __all__ = [
     "j2_field_jvp",
     "lense_thirring_jvp",
     "newtonian_jvp",
+    "tangent_at",
     "zero_jvp",
     "zonal_field_jvp",
 ]
@@ -55,6 +56,10 @@ TANGENT_SIGNATURE = types.void(F2, F2, F1, F2, F2, F2, F1)
 
 #: The first-class function type of a tangent right-hand side.
 TANGENT_TYPE = types.FunctionType(TANGENT_SIGNATURE)
+
+#: ``tangent_at(c_addr, jit_addr)``: the tangent right-hand side at those addresses
+#: (see :mod:`hamilton_orbits._kernels.signatures`).
+tangent_at = function_at(TANGENT_TYPE)
 
 
 @njit(cache=True, error_model="numpy")

@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
 __all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance"]
 
@@ -57,9 +57,9 @@ def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no co
 # explicit signature with ``accel`` as a first-class function type: compiled once
 # and loaded from the cache in later processes, whatever the right-hand side
 @njit(types.Tuple((types.int64, types.int64))(
-    ACCEL_TYPE, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
+    ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
     types.int64[::1], F1, types.int64), cache=True, error_model="numpy")
-def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
+def advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
     # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.
@@ -67,6 +67,7 @@ def advance(accel, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_ste
     ``STATUS_DRAIN`` the run stopped at the end of step ``steps``, the time in
     ``ws[0]``; at ``STATUS_SLICE`` after ``max_steps`` steps.  Events are scanned on
     both straight drifts of every step."""
+    accel = accel_at(accel_addr[0], accel_addr[1])
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
     if n_steps < 1:
         n_steps = 1

@@ -10,7 +10,7 @@ over steps between two output times.
 
 Every function takes plain float64 arrays; the acceleration is a first-class
 function ``accel(r, v, gm, acc, p)`` of the type
-:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE`, so :func:`advance` is
+:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE` (by its addresses), so :func:`advance` is
 compiled once and cached for every right-hand side.
 """
 
@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE
+from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at
 from hamilton_orbits._kernels.variational import megno_update
 
 __all__ = [
@@ -507,13 +507,13 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
 
 @njit(
     types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
+        ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, _F2, _F2, types.int64[::1],
     ),
     cache=True,
 )
 def advance(
-    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
+    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
     ev_count,
 ):  # pragma: no cover - compiled
     """Step from ``st[ST_T]`` to ``t_end`` in place; returns ``(steps, status)``.
@@ -534,6 +534,7 @@ def advance(
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
     the start state only when events are watched.
     """
+    accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
     w = m if watch.shape[0] > 0 else 0
@@ -694,13 +695,13 @@ def _renormalise(r, v, b, br, d, g, csx, csv, n):  # pragma: no cover - compiled
 
 @njit(
     types.Tuple((types.int64, types.int64))(
-        ACCEL_TYPE, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
+        ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, types.int64, _F1,
     ),
     cache=True,
 )
 def advance_variational(
-    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, n_phys, ms,
+    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, n_phys, ms,
 ):  # pragma: no cover - compiled
     """:func:`advance` for the state of ``n_phys`` bodies followed by tangent
     vectors (``r``, ``v`` of ``n_phys (1 + k)`` rows; ``accel`` the augmented
@@ -711,6 +712,7 @@ def advance_variational(
     the MEGNO update from tangent vector 0 (:func:`_megno_radau`, from the step's
     start state, which stays in ``r``, ``v`` until the step is accepted).  No
     events."""
+    accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
     x0, v0 = np.empty(0), np.empty(0)  # no events: the start state is not saved

@@ -22,8 +22,8 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import kepler as _kepler
-from hamilton_orbits._kernels.jacobians import TANGENT_TYPE
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
+from hamilton_orbits._kernels.jacobians import tangent_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
 __all__ = [
     "LN_RESCALE",
@@ -235,10 +235,10 @@ def _drift(r, v, dr, dv, h):  # pragma: no cover - compiled
             dr[a, c] += h * dv[a, c]
 
 
-@njit(types.int64(ACCEL_TYPE, TANGENT_TYPE, F1, F2, F2, F1, F2, F2, types.float64,
+@njit(types.int64(ADDRESSES, ADDRESSES, F1, F2, F2, F1, F2, F2, types.float64,
                   types.float64, types.float64, F1, types.int64),
       cache=True, error_model="numpy")
-def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms, max_steps):
+def advance_leapfrog(accel_addr, tangent_addr, p, r, v, gm, dr, dv, t0, t1, dt, ms, max_steps):
     # pragma: no cover - compiled
     """Leapfrog steps of at most ``dt`` from ``t0`` to exactly ``t1`` (as
     :func:`hamilton_orbits._kernels.leapfrog.advance`) with the exact tangent map
@@ -250,6 +250,8 @@ def advance_leapfrog(accel, tangent, p, r, v, gm, dr, dv, t0, t1, dt, ms, max_st
     steps taken: ``max_steps`` of them, at ``t0 + max_steps h``, when fewer than
     the ``n_steps`` to ``t1`` (a slice, as the plain kernel's ``STATUS_SLICE``:
     call again from there)."""
+    accel = accel_at(accel_addr[0], accel_addr[1])
+    tangent = tangent_at(tangent_addr[0], tangent_addr[1])
     n_steps = int(np.ceil((t1 - t0) / dt - 1e-12))
     if n_steps < 1:
         n_steps = 1

@@ -18,7 +18,7 @@ from numba import njit, types
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
 __all__ = [
     "STATUS_DRAIN",
@@ -305,12 +305,12 @@ def _kick_jacobi(
 
 
 @njit(
-    types.int64(ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64,
+    types.int64(ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64,
                 F1, F1),
     cache=True,
     error_model="numpy",
 )
-def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
+def corrector_jacobi(extra_addr, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
     # pragma: no cover - compiled
     """Apply a symplectic corrector (``sign = 1``) or its inverse (``-1``): the
     product of ``Z(a_k dt, sign b_k dt)`` over the sequence ``a``, ``b`` (see
@@ -318,6 +318,7 @@ def corrector_jacobi(extra, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
     b)`` = Kepler a, kick -b, Kepler -2a, kick b, Kepler a (Wisdom, Holman &
     Touma 1996).  The sequence is antisymmetric (``(a, b)`` reversed is ``(-a,
     -b)``), so ``sign = -1`` is the exact inverse.  Returns a failing index or -1."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
     n = qj.shape[0]
     acc = np.empty((n, 3))
     accj = np.empty((n, 3))
@@ -507,14 +508,14 @@ _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
+        ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_dh(
-    extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra_addr, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
 ):  # pragma: no cover - compiled
     """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
     coordinates, in place.  ``q``, ``u``: heliocentric positions and
@@ -524,6 +525,7 @@ def advance_dh(
     time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
     whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
     state is synchronised at the end of step ``steps``."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
     n = q.shape[0]
     watched = watch.shape[0] > 0
     m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
@@ -557,20 +559,21 @@ def advance_dh(
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ACCEL_TYPE, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
+        ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_jacobi(
-    extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra_addr, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
 ):  # pragma: no cover - compiled
     """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
     ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
     sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
     listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
     removes the part the Kepler step already accounts for."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
     n = qj.shape[0]
     acc = np.empty((n, 3))
     accj = np.empty((n, 3))

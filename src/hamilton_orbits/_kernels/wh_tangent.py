@@ -31,8 +31,8 @@ from numba import njit, types
 
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
-from hamilton_orbits._kernels.jacobians import TANGENT_TYPE, newtonian_jvp
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE, F1, F2
+from hamilton_orbits._kernels.jacobians import newtonian_jvp, tangent_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
 from hamilton_orbits._kernels.wh import jacobi_factors, jacobi_to_inertial_pos
 
@@ -158,14 +158,16 @@ def _ln_delta_dh(dq, du, dcom, gm, m_tot, r0, v0):  # pragma: no cover - compile
 
 
 @njit(types.Tuple((types.int64, types.int64))(
-    ACCEL_TYPE, TANGENT_TYPE, F1, types.boolean, F2, F2, F1, F1, F1, F2, F2, F2, types.float64,
+    ADDRESSES, ADDRESSES, F1, types.boolean, F2, F2, F1, F1, F1, F2, F2, F2, types.float64,
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
-def advance_dh(extra, tangent_extra, p, has_extra, q, u, gm, gm_p, com, dq, du, dcom, dt,
-               n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
+def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, q, u, gm, gm_p, com, dq, du, dcom,
+               dt, n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
     """``n_steps`` democratic-heliocentric steps (the last of length ``dt_last``) from
     ``t0``, synchronised at both ends, with the tangent vectors ``(dq, du, dcom)``;
     the coordinates as :func:`hamilton_orbits._kernels.wh.advance_dh` takes them.
     Returns ``(steps, bad)``, ``bad`` a body whose Kepler step failed or -1."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    tangent_extra = tangent_at(tangent_extra_addr[0], tangent_extra_addr[1])
     n = q.shape[0]
     kn = dq.shape[0]
     w = (np.empty((n, 3)), np.empty((kn, 3)), np.empty((n, 3)), np.empty((n, 3)),
@@ -287,13 +289,15 @@ def _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0):  # pragma: no cover -
 
 
 @njit(types.Tuple((types.int64, types.int64))(
-    ACCEL_TYPE, TANGENT_TYPE, F1, types.boolean, F2, F2, F1, F1, F2, F2, types.float64,
+    ADDRESSES, ADDRESSES, F1, types.boolean, F2, F2, F1, F1, F2, F2, types.float64,
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
-def advance_jacobi(extra, tangent, p, has_extra, qj, uj, gm, eta, dq, du, dt, n_steps, dt_last,
-                   t0, ms):  # pragma: no cover - compiled
+def advance_jacobi(extra_addr, tangent_addr, p, has_extra, qj, uj, gm, eta, dq, du, dt, n_steps,
+                   dt_last, t0, ms):  # pragma: no cover - compiled
     """As :func:`advance_dh` in Jacobi coordinates (``qj``, ``uj``, row 0 the
     barycentre; ``eta_i = sum_{j<=i} G m_j``), ``tangent`` the whole tangent
     right-hand side (Newtonian and effects).  Returns ``(steps, bad)``."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    tangent = tangent_at(tangent_addr[0], tangent_addr[1])
     n = qj.shape[0]
     kn = dq.shape[0]
     w = (np.empty((n, 3)), np.empty((kn, 3)), np.empty((n, 3)), np.zeros((n, 3)),

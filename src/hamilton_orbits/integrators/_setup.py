@@ -7,57 +7,44 @@ import weakref
 from typing import Any
 
 import numpy as np
-from numba.core.types.function_type import CompileResultWAP
-from numba.core.typing.typeof import typeof_impl
 
 from hamilton_orbits._kernels import checks as _checks
 from hamilton_orbits._kernels import nbody as _nbody
-from hamilton_orbits._kernels.signatures import ACCEL_TYPE
+from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 from hamilton_orbits.validation import as_float_array, check_positive
 
-# ``ACCEL_TYPE``: the first-class function type of a right-hand side, so that a
-# stepping kernel compiled for it is cached once for every ``accel`` (a kernel
-# specialised on a dispatcher argument is keyed by that dispatcher object and
-# recompiled in every new process).
+_ADDRESSES: weakref.WeakKeyDictionary[Any, dict[Any, np.ndarray]] = weakref.WeakKeyDictionary()
 
 
-class _AccelAddress(CompileResultWAP):
-    """A compile result's wrapper whose numba type is :data:`ACCEL_TYPE`
-    itself (numba's generic ``typeof`` builds a new function type from the
-    signature on every call, ~20 us)."""
-
-
-@typeof_impl.register(_AccelAddress)
-def _typeof_accel_address(val: Any, c: Any) -> Any:
-    return ACCEL_TYPE
-
-
-_ADDRESSES: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
-
-
-def accel_arg(fn: Any) -> Any:
-    """``fn`` (a numba dispatcher of :data:`ACCEL_TYPE`'s signature) in the form
-    that a stepping kernel's first-class function argument takes cheaply.
-
-    A dispatcher passed as such an argument is converted on every call (its
-    compile result looked up and the function address asked of LLVM: about
-    0.1 ms, as long as 100 Wisdom-Holman steps of the solar system); the
-    compile result's wrapper (numba's ``CompileResultWAP``) holds the address
-    once, and is kept per dispatcher.
+def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
+    """The addresses ``[C wrapper, entry point]`` (int64) of the compiled function
+    ``fn`` (a numba dispatcher) for ``signature``, the form in which a stepping
+    kernel takes a right-hand side (:mod:`hamilton_orbits._kernels.signatures`),
+    found once per dispatcher and signature.
 
     Examples
     --------
     >>> from hamilton_orbits._kernels import nbody
     >>> accel_arg(nbody.newtonian_only) is accel_arg(nbody.newtonian_only)
     True
+    >>> bool(np.all(accel_arg(nbody.newtonian_only) > 0))
+    True
     """
-    if not hasattr(fn, "get_compile_result"):  # not a dispatcher: as it is
-        return fn
-    wap = _ADDRESSES.get(fn)
-    if wap is None:
-        wap = _AccelAddress(fn.get_compile_result(ACCEL_TYPE.signature))
-        _ADDRESSES[fn] = wap
-    return wap
+    known = _ADDRESSES.setdefault(fn, {})
+    found = known.get(signature)
+    if found is None:
+        cres = fn.get_compile_result(signature)
+        lib, names = cres.library, cres.fndesc
+        found = np.array([lib.get_pointer_to_function(names.llvm_cfunc_wrapper_name),
+                          lib.get_pointer_to_function(names.llvm_func_name)], dtype=np.int64)
+        known[signature] = found
+    return found
+
+
+def accel_arg(fn: Any) -> np.ndarray:
+    """The addresses of a right-hand side ``fn`` (:data:`ACCEL_SIGNATURE`) for a
+    stepping kernel (:func:`addresses`)."""
+    return addresses(fn, ACCEL_SIGNATURE)
 
 
 def check_inputs(

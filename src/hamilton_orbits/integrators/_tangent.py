@@ -35,7 +35,7 @@ from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
 from hamilton_orbits.integrators import StopIntegration
-from hamilton_orbits.integrators._setup import accel_arg, check_step_count
+from hamilton_orbits.integrators._setup import accel_arg, addresses, check_step_count
 from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS
 from hamilton_orbits.validation import ConvergenceError
 
@@ -205,16 +205,12 @@ class Radau15Tangent:
                 on_output(i, self.steps - first)
 
 
-def _tangent_arg(fn: Any) -> Any:
-    """A tangent right-hand side in the form a kernel's first-class function
-    argument takes (the compile result's wrapper, as :func:`_setup.accel_arg`)."""
-    from numba.core.types.function_type import CompileResultWAP
-
+def _tangent_arg(fn: Any) -> np.ndarray:
+    """The addresses of a tangent right-hand side for a stepping kernel (as
+    :func:`_setup.accel_arg`)."""
     from hamilton_orbits._kernels.jacobians import TANGENT_SIGNATURE
 
-    if not hasattr(fn, "get_compile_result"):
-        return fn
-    return CompileResultWAP(fn.get_compile_result(TANGENT_SIGNATURE))
+    return addresses(fn, TANGENT_SIGNATURE)
 
 
 def _to_split(r: np.ndarray, v: np.ndarray, g: np.ndarray, jacobi: bool
