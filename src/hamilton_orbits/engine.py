@@ -35,6 +35,7 @@ reached.
 from __future__ import annotations
 
 import importlib
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -55,7 +56,7 @@ from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class EngineRun:
     """What :func:`run` and :meth:`Propagation.advance` return: the outputs reached,
     in the caller's units.
@@ -88,6 +89,9 @@ class EngineRun:
         True if Ctrl-C ended the run (``complete`` is then False).
     first_event : int
         The index in ``events.recorded()`` of the first event found in this call.
+    finite : bool
+        True if every position and velocity of the outputs is finite (False also
+        when bodies taken out of the run are NaN).
     """
 
     t: np.ndarray
@@ -101,6 +105,7 @@ class EngineRun:
     variational: Any = None
     interrupted: bool = False
     first_event: int = 0
+    finite: bool = True
 
 
 def integrator(method: str) -> Integrator:
@@ -224,15 +229,18 @@ class Propagation:
         time :attr:`t`, forwards or backwards); see :func:`run`."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
-        driver = self._driver_for(backward)
-        r_out = np.empty((n_t,) + self.r.shape)
-        v_out = np.empty_like(r_out)
+        driver = self.driver if self.driver is not None and backward == self.backward \
+            else self._driver_for(backward)
+        rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
+        r_out, v_out = rows[0], rows[1]
         r_out[0], v_out[0] = self.r, self.v
+        events = self.events
+        first_event = 0
+        if events is not None:
+            first_event = len(events.recorded())
+            events.stopped_by = None
         if self.variational is not None:
             self.variational.new_leg(n_t)
-        first_event = len(self.events.recorded()) if self.events is not None else 0
-        if self.events is not None:
-            self.events.stopped_by = None
         reached = [0, 0]  # last output index, steps
 
         def report(i: int, steps: int) -> None:
@@ -242,7 +250,7 @@ class Propagation:
             if stop is not None and stop():
                 raise StopIntegration
 
-        t_reached = np.array(t_out, dtype=np.float64)
+        t_reached = t_out
         start, steps0 = time.perf_counter(), driver.steps
         complete, interrupted = True, False
         try:
@@ -250,6 +258,7 @@ class Propagation:
             reached[0], reached[1] = n_t - 1, driver.steps - steps0
         except StopAtEvent as stopped:
             reached[0], reached[1] = stopped.index, stopped.steps
+            t_reached = np.array(t_out, dtype=np.float64)  # the caller's array unchanged
             t_reached[stopped.index] = stopped.t
         except StopIntegration:
             complete = False
@@ -260,23 +269,25 @@ class Propagation:
         if backward:  # in place: no second copy of the history
             np.negative(v_out, out=v_out)
         self._reached(driver, r_out[k - 1], v_out[k - 1], float(t_reached[k - 1]))
-        gm_out = (self.events.gm_at(t_reached[:k], self.gm0)
-                  if self.events is not None and self.events.gm_changes else self.gm0)
-        return EngineRun(t_reached[:k], r_out[:k], v_out[:k], reached[1], wall,
-                         complete, self.events, gm_out, self.variational, interrupted,
-                         first_event)
+        gm_out = (events.gm_at(t_reached[:k], self.gm0)
+                  if events is not None and events.gm_changes else self.gm0)
+        if k < n_t:
+            t_reached, r_out, v_out, rows = t_reached[:k], r_out[:k], v_out[:k], rows[:, :k]
+        finite = math.isfinite(float(np.add.reduce(rows, axis=None)))  # one pass over both
+        return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
+                         self.variational, interrupted, first_event, finite)
 
     def _reached(self, driver: Any, r: np.ndarray, v: np.ndarray, t: float) -> None:
         """Keep the state reached: the last output row when the driver stands at its
         time, else (a leg stopped between outputs) the driver's own state at its own
         time."""
-        sign = -1.0 if self.backward else 1.0
-        if driver.t == sign * t:
+        if driver.t == (-t if self.backward else t):
             self.r, self.v, self.t = r, v, t
-            self.gm = self.events.gm_at(np.array([t]), self.gm0)[0] if (
-                self.events is not None and self.events.gm_changes) else self.gm0
+            if self.events is not None and self.events.gm_changes:
+                self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]
         else:
             r_now, v_now, self.gm = driver.state()
+            sign = -1.0 if self.backward else 1.0
             self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
 
 

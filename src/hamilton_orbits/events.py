@@ -332,6 +332,8 @@ class EventLog:
         self.rows: list[np.ndarray] = []
         self.stopped_by: int | None = None
         self.inactive = np.zeros(len(self.radius), dtype=bool)
+        #: True once a body has been taken out of the run (``inactive.any()``)
+        self.gone = False
         self.gm_changes: list[tuple[float, np.ndarray]] = []
         #: The kernel's body index -> the system's (a driver that reorders bodies
         #: sets it, and passes :meth:`kernel_watch` to its kernel).
@@ -355,6 +357,13 @@ class EventLog:
             rows[pair, E_J] = self.index_map[rows[pair, E_J].astype(int)]
         self.rows.extend(rows)
         self.count[0] = 0
+
+    def mask(self, r: np.ndarray, v: np.ndarray) -> None:
+        """Set the bodies taken out of the run to NaN in ``r``, ``v`` (one output row
+        each, (n, 3); in place; nothing to do while no body has left)."""
+        if self.gone:
+            r[self.inactive] = np.nan
+            v[self.inactive] = np.nan
 
     def kernel_watch(self) -> np.ndarray:
         """:attr:`watch` with the bodies numbered as the kernel numbers them."""
@@ -412,6 +421,7 @@ class EventLog:
         r[k] = (1e8 * max(scale, 1.0)) * np.array([1.0 + k, 0.5, 0.25])
         v[k] = 0.0
         self.inactive[k] = True
+        self.gone = True
         keep = ~(self.inactive[self.watch[:, W_I].astype(int)]
                  | ((self.watch[:, W_J] >= 0) & self.inactive[self.watch[:, W_J].astype(int)]))
         self.watch = np.ascontiguousarray(self.watch[keep])

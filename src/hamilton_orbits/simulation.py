@@ -22,11 +22,10 @@ start of the simulation.
 
 from __future__ import annotations
 
-import contextlib
 import copy
 import functools
 import math
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -224,10 +223,14 @@ class Simulation:
         times, unit = _leg_times(t, self._prop.t, self._system.quantity)
         if unit is not None:
             self._unit = unit
-        with _progress(progress, self.method.name, len(times) - 1, on_output) as report:
+        report, close = _progress(progress, self.method.name, len(times) - 1, on_output)
+        try:
             compiled = compile_seconds()
             out = self._prop.advance(times, on_output=report, stop=stop)
             compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
+        finally:
+            if close is not None:
+                close()
         if out.interrupted:
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
@@ -511,40 +514,31 @@ def check_method(method: str | Method, effects: Any, options: Mapping[str, Any])
     return check_effects(method_of(method, options), effects)
 
 
-@contextlib.contextmanager
-def _progress(enabled: bool, method: str, total: int, on_output: Any) -> Iterator[Any]:
+def _progress(enabled: bool, method: str, total: int, on_output: Any
+              ) -> tuple[Any, Callable[[], None] | None]:
     """An output callback that advances a tqdm bar (when ``enabled``) and calls
-    ``on_output`` (``on_output`` itself when there is no bar); the bar is closed on
-    the way out."""
+    ``on_output`` (``on_output`` itself when there is no bar), and the bar's
+    ``close`` (None without a bar)."""
     if not enabled:
-        yield on_output
-        return
+        return on_output, None
     try:
         from tqdm.auto import tqdm
-
-        bar = tqdm(total=total, desc=method, unit="output", leave=False)
     except ImportError:  # pragma: no cover - tqdm is an optional extra
-        yield on_output
-        return
+        return on_output, None
+    bar = tqdm(total=total, desc=method, unit="output", leave=False)
 
     def report(i: int, steps: int) -> None:
         bar.update(1)
         if on_output is not None:
             on_output(i, steps)
 
-    try:
-        yield report
-    finally:
-        bar.close()
+    return report, bar.close
 
 
 def _check_finite(system: System, method: str, r: np.ndarray, v: np.ndarray,
                   times: np.ndarray, gone: np.ndarray | None) -> None:
     """Refuse a run that lost a body's state (a non-finite position or velocity of a
     body still in the run)."""
-    if gone is None and math.isfinite(float(np.add.reduce(r, axis=None))) \
-            and math.isfinite(float(np.add.reduce(v, axis=None))):
-        return  # the common case: one pass, no copy
     ok = np.isfinite(r).all(axis=2) & np.isfinite(v).all(axis=2)
     if gone is not None:
         ok |= gone[None, :]
@@ -595,10 +589,11 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
     r, v, times = out.r, out.v, out.t
     log = out.events
     gone = log.inactive.copy() if log is not None else None  # the log goes on changing
-    _check_finite(system, method, r, v, times, gone)
+    if not out.finite:
+        _check_finite(system, method, r, v, times, gone)
     integrals = functools.partial(_integrals, system, r, v, out.gm, times, gone, effect_set,
                                   start)
-    final = (system, r[-1], v[-1], np.atleast_2d(out.gm)[-1], None if gone is None else ~gone)
+    final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
     if system.quantity:
         t_out: Any = (times * u.day).to(unit)
         r_out: Any = r << u.au  # views: no second copy of the history

@@ -190,7 +190,7 @@ class Trajectory(TrajectoryBase):
     def final(self) -> Any:
         """The system at the last output time."""
         system, r, v, gm, keep = self._final_source
-        return system.with_state(r, v, gm=gm, keep=keep, check=False)
+        return system.with_state(r, v, gm=np.atleast_2d(gm)[-1], keep=keep, check=False)
 
     @functools.cached_property
     def _tables(self) -> tuple[Any, Any]:

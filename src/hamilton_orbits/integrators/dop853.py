@@ -125,6 +125,8 @@ class _State:
         def store(i: int, steps: int, y: np.ndarray) -> None:
             r_out[i] = y[: 3 * n].reshape(n, 3)
             v_out[i] = y[3 * n :].reshape(n, 3)
+            if self.log is not None:
+                self.log.mask(r_out[i], v_out[i])
             if on_output is not None:
                 on_output(i, steps - first)
 
@@ -173,12 +175,12 @@ class _State:
                 stop = log.act(int(row), self.t, r, v, self.gm)
                 self.y = np.concatenate((r.ravel(), v.ravel()))
                 if stop:
-                    store(i, self.steps, _nan_inactive(self.y, log, n))
+                    store(i, self.steps, self.y)
                     raise StopAtEvent(i, self.t, self.steps - first)
                 solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
                                  atol=self.atol, max_step=self.max_step)
             self.t, self.y = float(t_out[i]), solver.y.copy()
-            store(i, self.steps, _nan_inactive(self.y, log, n))
+            store(i, self.steps, self.y)
 
 
 def _rhs(rhs: Any, n: int, gm: np.ndarray) -> Callable[[float, np.ndarray], np.ndarray]:
@@ -194,16 +196,6 @@ def _rhs(rhs: Any, n: int, gm: np.ndarray) -> Callable[[float, np.ndarray], np.n
         return np.concatenate((y[3 * n :], acc.ravel()))
 
     return f
-
-
-def _nan_inactive(y: np.ndarray, log: EventLog, n: int) -> np.ndarray:
-    """The state with the bodies taken out of the run as NaN (for the outputs)."""
-    y = y.copy()
-    gone = np.flatnonzero(log.inactive)
-    for k in (0, 3 * n):
-        for c in range(3):
-            y[k + 3 * gone + c] = np.nan
-    return y
 
 
 #: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.

@@ -129,8 +129,7 @@ class _State:
             self._interval(t_out, i, stop, first, (r_out[i], v_out[i]))
             r_out[i] = r
             v_out[i] = v
-            r_out[i, log.inactive] = np.nan
-            v_out[i, log.inactive] = np.nan
+            log.mask(r_out[i], v_out[i])
             if on_output is not None:
                 on_output(i, self.steps - first)
 
@@ -156,6 +155,5 @@ class _State:
             log.drain()
             if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, self.gm):
                 row[0][:], row[1][:] = r, v
-                row[0][log.inactive] = np.nan
-                row[1][log.inactive] = np.nan
+                log.mask(row[0], row[1])
                 raise StopAtEvent(i, t, self.steps - first)

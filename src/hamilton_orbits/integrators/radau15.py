@@ -302,8 +302,7 @@ class _Run:
             stopped = self.advance_to(t_out, i, first)
             r_out[i] = self.x
             v_out[i] = self.w
-            r_out[i, log.inactive] = np.nan
-            v_out[i, log.inactive] = np.nan
+            log.mask(r_out[i], v_out[i])
             if stopped:
                 raise StopAtEvent(i, self.t, self.steps - first)
             if on_output is not None:

@@ -276,6 +276,7 @@ class _State:
                             rhs.extra is not None)
         self.split.from_inertial(r0, v0, np.empty_like(r0), np.empty_like(v0))
         self.watch = self.log.kernel_watch()
+        self.ws = np.empty(4)  # the events' work space of the kernels (see _drift)
         self.dt, self.max_steps, self.t, self.steps = dt, method.max_steps, t0, 0
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -296,7 +297,7 @@ class _State:
             self._interval(i, t_out, (r_out[i], v_out[i]), stop, first)
             self.t = float(t_out[i])
             self.split.to_inertial(r_out[i], v_out[i])
-            _mask(r_out[i], v_out[i], self.log)
+            self.log.mask(r_out[i], v_out[i])
             if on_output is not None:
                 on_output(i, self.steps - first)
 
@@ -315,7 +316,8 @@ class _State:
         while done < n_steps:
             if done and stop is not None and stop():
                 raise StopIntegration
-            ws = np.array([t_out[i - 1] + done * dt, np.inf, 0.0, -1.0])
+            ws = self.ws
+            ws[0], ws[1], ws[2], ws[3] = t_out[i - 1] + done * dt, np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
             steps, bad, status = self.split.advance(
                 dt, n_call, last if done + n_call == n_steps else dt, self.watch, log.buffer,
@@ -342,19 +344,12 @@ class _State:
         self.split.to_inertial(r_now, v_now)
         if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm):
             row[0][:], row[1][:] = r_now, v_now
-            _mask(row[0], row[1], self.log)
+            self.log.mask(row[0], row[1])
             self.t = float(ws[0])  # the end of the step (the split holds that state)
             raise StopAtEvent(i, float(ws[0]), self.steps - first)
         self.split = self.split.renewed(self.gm)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
         self.watch = self.log.kernel_watch()
-
-
-def _mask(r: np.ndarray, v: np.ndarray, log: EventLog) -> None:
-    """Set the bodies taken out of the run to NaN (in place)."""
-    if log.inactive.any():
-        r[log.inactive] = np.nan
-        v[log.inactive] = np.nan
 
 
 class _Split:
