@@ -4,7 +4,7 @@ Every rung starts from DE440's own state at J2000 (:meth:`System.from_ephemeris`
 ICRF axes) and integrates with ``radau15``; the residuals are the heliocentric
 positions against DE440's (the Moon: geocentric), in km and in arcsec as seen
 from the Sun (the Moon: from the Earth).  Nothing is fitted: every constant is
-DE440's or a cited paper's (see :mod:`hamilton_orbits.effects_solar_system`).
+DE440's or a cited paper's (see :mod:`hamilton_orbits.effects`).
 
 Rungs (:data:`RUNGS`), each a name, whether the 16 asteroids are bodies, and the
 effect list:

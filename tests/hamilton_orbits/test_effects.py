@@ -182,7 +182,7 @@ def test_registry_plugs_in_new_effects():
         acc = s.accelerations([{"name": "constant_push", "g": 2.0}])
         np.testing.assert_allclose(acc[:, 0], [2.0, -1.0 + 2.0])
     finally:
-        fx._REGISTRY["nbody"].pop(spec.name)
+        fx.registry._REGISTRY["nbody"].pop(spec.name)
 
 
 from numba import njit  # noqa: E402
@@ -192,3 +192,46 @@ from numba import njit  # noqa: E402
 def _push(r, v, gm, acc, p):  # pragma: no cover - compiled
     for i in range(r.shape[0]):
         acc[i, 0] += p[0]
+
+
+def test_each_built_in_effect_lives_in_its_own_module():
+    """Issue 30: one effect in one place. Registered in a fixed order from
+    ``effects.BUILT_IN``; each effect's spec, builder and energy are in the module
+    named for it, and its kernel and Jacobian are imported there."""
+    import importlib
+
+    assert list(fx.registry._REGISTRY["nbody"])[:10] == [
+        "newtonian", "gr", "gr_potential", "j2", "eih", "lense_thirring", "zonal",
+        "moon_figure", "earth_tides", "kuiper_ring"]
+    homes = {"newtonian": "newtonian", "gr": "relativity", "gr_potential": "relativity",
+             "j2": "j2", "eih": "eih", "lense_thirring": "lense_thirring", "zonal": "zonal",
+             "moon_figure": "moon_figure", "earth_tides": "tides", "kuiper_ring": "kuiper_ring"}
+    for name, home in homes.items():
+        module = importlib.import_module(f"hamilton_orbits.effects.{home}")
+        spec = fx.get("nbody", name)
+        assert spec in module.SPECS and spec in fx.BUILT_IN, name
+        for part in (spec.params, spec.energy):
+            assert part is None or part.__module__ == module.__name__, (name, part)
+        for compiled in (spec.kernel, spec.jacobian):
+            assert compiled is None or compiled.py_func.__name__ in vars(module), (name, compiled)
+
+
+def test_the_old_solar_system_module_warns_and_gives_the_same_objects():
+    import importlib
+
+    from hamilton_orbits.effects import eih, kuiper_ring, lense_thirring, moon_figure, tides
+
+    old = importlib.import_module("hamilton_orbits.effects_solar_system")
+    moved = {"eih_energy": eih, "kuiper_ring_gm": kuiper_ring, "sun_spin": lense_thirring,
+             "KUIPER_RING_RADIUS_AU": kuiper_ring, "EARTH_ROTATION_RATE": tides,
+             "MOON_EQUATOR_INCLINATION_DEG": moon_figure}
+    for name, module in moved.items():
+        with pytest.warns(DeprecationWarning, match=rf"use {module.__name__}\.{name}"):
+            assert getattr(old, name) is getattr(module, name)
+    with pytest.warns(DeprecationWarning, match=r"BUILT_IN"):
+        specs = old.SPECS
+    assert [s["name"] for s in specs] == ["eih", "lense_thirring", "zonal", "moon_figure",
+                                          "earth_tides", "kuiper_ring"]
+    assert all(fx.EffectSpec(**s) == fx.get("nbody", s["name"]) for s in specs)
+    with pytest.raises(AttributeError):
+        old.nothing_here  # noqa: B018

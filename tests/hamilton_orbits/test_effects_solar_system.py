@@ -10,7 +10,8 @@ from hamilton_orbits import Body, System, integrate
 from hamilton_orbits import effects as fx
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels import figures
-from hamilton_orbits.effects_solar_system import eih_energy, kuiper_ring_gm
+from hamilton_orbits.effects.eih import eih_energy
+from hamilton_orbits.effects.kuiper_ring import kuiper_ring_gm
 from hamilton_orbits.rebound_bridge import to_rebound
 
 ARCSEC = np.pi / (180 * 3600)

@@ -23,6 +23,21 @@ function calls).  Where no cache folder can be written, or a kernel cannot be
 imported by name (one defined in ``__main__``), the same source is compiled in
 memory for the process.
 
+The source is written from templates with named fields (``string.Template``):
+only a field is ever filled, never text searched and replaced, and the names
+that fill them (kernel modules and functions, which plugins supply through
+entry points) are checked as Python names first (:func:`check_ref`).  The
+first lines of a file record the generator's version, the key and the kernels'
+source files, so that a file no run will use again (an older generator's, or
+one whose kernel sources changed or are gone) is recognised and removed, once
+per process and only when old enough that no other process can be importing it
+(:func:`remove_stale`).
+
+Where things are: this module compiles (:func:`compile_rhs`, :func:`kernels_for`,
+:func:`tangent_kernels_for`); :mod:`hamilton_orbits.rhs.codegen` writes the
+source (the templates, :func:`check_ref`); :mod:`hamilton_orbits.rhs.diskcache`
+keeps the files (:func:`cache_dir`, the digest, :func:`remove_stale`).
+
 The parameter vector
 --------------------
 ``p = [o_0, o_1, ..., o_m, params_0..., params_1..., ...]`` for ``m`` effects:
@@ -45,24 +60,27 @@ unless asked for: the source without ``variational`` is the one above.
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import os
-import sys
 import threading
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from hamilton_orbits.effects import EffectSet, get
-from hamilton_orbits.firstrun import GENERATED_PREFIX as MODULE_PREFIX
+from hamilton_orbits.rhs.codegen import check_ref, kernel_ref, source, tangent_source
+from hamilton_orbits.rhs.diskcache import (
+    MODULE_PREFIX,
+    STALE_AGE_SECONDS,
+    cache_dir,
+    digest,
+    load_module,
+    module_sources,
+    remove_stale,
+)
 
-__all__ = ["RHS", "cache_dir", "compile_rhs", "kernels_for", "newtonian_rhs",
-           "parameter_vector", "source", "tangent_kernels_for", "tangent_source"]
-
-_GENERATOR = "hamilton-orbits rhs v2"
+__all__ = ["RHS", "STALE_AGE_SECONDS", "cache_dir", "check_ref", "compile_rhs", "kernel_ref",
+           "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "source",
+           "tangent_kernels_for", "tangent_source"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,6 +207,9 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
     for spec in specs:
         if spec.kernel is None or spec.params is None:
             raise ValueError(f"Effect {spec.name!r} cannot be used in an n-body simulation")
+        kernel_ref(spec.kernel, spec.name)  # a plugin's names, checked before they are written
+        if variational and spec.jacobian is not None:
+            kernel_ref(spec.jacobian, spec.name)
     blocks = [spec.params(system, dict(params))
               for spec, (_, params) in zip(specs, eff.items, strict=True)]
     replaces = any(spec.replaces_newtonian for spec in specs)
@@ -207,11 +228,7 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
 
 _MEMO: dict[tuple, tuple[Any, Any]] = {}
 _LOCK = threading.Lock()
-
-
-def _ref(kernel: Any) -> tuple[str, str]:
-    func = getattr(kernel, "py_func", kernel)
-    return func.__module__, func.__name__
+_SWEPT: set[str] = set()  # the cache folders this process has removed stale files from
 
 
 def kernels_for(kernels: tuple[Any, ...], replaces_newtonian: bool = False) -> tuple[Any, Any]:
@@ -225,7 +242,7 @@ def kernels_for(kernels: tuple[Any, ...], replaces_newtonian: bool = False) -> t
     >>> kernels_for((nbody.gr_potential,))[0] is accel
     True
     """
-    key = (tuple(_ref(k) for k in kernels), bool(replaces_newtonian))
+    key = (tuple(kernel_ref(k) for k in kernels), bool(replaces_newtonian))
     with _LOCK:
         found = _MEMO.get(key)
         if found is None:
@@ -239,7 +256,7 @@ def _jac_ref(jacobian: Any, velocity_dependent: bool) -> tuple[str, str]:
     differences over positions (and velocities)."""
     if jacobian is None:
         return ("fd", "2" if velocity_dependent else "1")
-    return _ref(jacobian)
+    return kernel_ref(jacobian)
 
 
 def tangent_kernels_for(kernels: tuple[Any, ...], jacobians: tuple[tuple[Any, bool], ...],
@@ -257,7 +274,7 @@ def tangent_kernels_for(kernels: tuple[Any, ...], jacobians: tuple[tuple[Any, bo
     (5, True)
     """
     jac_key = tuple(_jac_ref(j, vd) for j, vd in jacobians)
-    key = (tuple(_ref(k) for k in kernels), bool(replaces_newtonian), jac_key)
+    key = (tuple(kernel_ref(k) for k in kernels), bool(replaces_newtonian), jac_key)
     with _LOCK:
         found = _MEMO.get(key)
         if found is None:
@@ -266,166 +283,21 @@ def tangent_kernels_for(kernels: tuple[Any, ...], jacobians: tuple[tuple[Any, bo
     return found
 
 
-def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: str,
-           jac_refs: tuple[tuple[str, str], ...] | None = None) -> str:
-    """The Python source of the module that defines ``accel`` and ``extra`` (and,
-    given ``jac_refs``, the tangent right-hand side: see :func:`tangent_source`).
-
-    Examples
-    --------
-    >>> print(source((("hamilton_orbits._kernels.nbody", "gr_potential"),), False, "x"))
-    ... # doctest: +ELLIPSIS
-    # Generated by hamilton-orbits rhs v2 (do not edit); digest x
-    ...
-    def extra(r, v, gm, acc, p):  # pragma: no cover - compiled
-        k0(r, v, gm, acc, p[int(p[0]):int(p[1])])
-    ...
-    """
-    base = "zero" if replaces_newtonian else "newtonian"
-    lines = [
-        f"# Generated by {_GENERATOR} (do not edit); digest {digest}",
-        "# The right-hand side " + " + ".join([base] + [name for _, name in refs]),
-        "from numba import njit",
-        "",
-        "from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE",
-        f"from hamilton_orbits._kernels.nbody import {base} as base",
-    ]
-    lines += [f"from {module} import {name} as k{i}" for i, (module, name) in enumerate(refs)]
-    lines += ["", "", "@njit(ACCEL_SIGNATURE, cache=CACHE, error_model='numpy')",
-              "def extra(r, v, gm, acc, p):  # pragma: no cover - compiled"]
-    lines += [f"    k{i}(r, v, gm, acc, p[int(p[{i}]):int(p[{i + 1}])])" for i in range(len(refs))]
-    lines += ["    return"] if not refs else []
-    lines += ["", "", "@njit(ACCEL_SIGNATURE, cache=CACHE, error_model='numpy')",
-              "def accel(r, v, gm, acc, p):  # pragma: no cover - compiled",
-              "    base(r, v, gm, acc)", "    extra(r, v, gm, acc, p)", ""]
-    if jac_refs is not None:
-        lines += tangent_source(replaces_newtonian, jac_refs)
-    return "\n".join(lines)
-
-
-def tangent_source(replaces_newtonian: bool, jac_refs: tuple[tuple[str, str], ...]) -> list[str]:
-    """The lines that define ``tangent``, ``tangent_extra`` and ``augmented``:
-    effect ``i`` by its Jacobian ``j{i}``, or (``("fd", parts)``) by ``fd{i}``, central
-    differences of its kernel ``k{i}`` along each tangent vector, over positions
-    (parts 1) or positions and velocities (parts 2).
-
-    Examples
-    --------
-    >>> print(*tangent_source(False, (("fd", "1"),)), sep=chr(10))  # doctest: +ELLIPSIS
-    <BLANKLINE>
-    import numpy as np
-    ...
-    def fd0(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled
-    ...
-            for part in range(1):
-    ...
-    """
-    base = "zero_jvp" if replaces_newtonian else "newtonian_jvp"
-    lines = ["", "import numpy as np",
-             "from hamilton_orbits._kernels.jacobians import TANGENT_SIGNATURE, fd_add, "
-             "fd_scales, fd_shift",
-             f"from hamilton_orbits._kernels.jacobians import {base} as base_jvp"]
-    lines += [f"from {module} import {name} as j{i}"
-              for i, (module, name) in enumerate(jac_refs) if module != "fd"]
-    sig = "@njit(TANGENT_SIGNATURE, cache=CACHE, error_model='numpy')"
-    for i, (module, parts) in enumerate(jac_refs):
-        if module != "fd":
-            continue
-        lines += ["", "", sig,
-                  f"def fd{i}(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled",
-                  "    n = r.shape[0]",
-                  "    rs, vs = np.empty_like(r), np.empty_like(v)",
-                  "    ap, am = np.empty_like(r), np.empty_like(r)",
-                  "    length, speed = fd_scales(r, v, gm)",
-                  "    for m in range(dr.shape[0] // n):",
-                  f"        for part in range({parts}):",
-                  "            h = fd_shift(r, v, dr, dv, m, part, length, speed, 1.0, rs, vs, ap)",
-                  f"            k{i}(rs, vs, gm, ap, p)",
-                  "            fd_shift(r, v, dr, dv, m, part, length, speed, -1.0, rs, vs, am)",
-                  f"            k{i}(rs, vs, gm, am, p)",
-                  "            fd_add(ap, am, h, da, m)"]
-    lines += ["", "", sig,
-              "def tangent_extra(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled"]
-    lines += [f"    {'fd' if module == 'fd' else 'j'}{i}(r, v, gm, dr, dv, da, "
-              f"p[int(p[{i}]):int(p[{i + 1}])])" for i, (module, _) in enumerate(jac_refs)]
-    lines += ["    return"] if not jac_refs else []
-    lines += ["", "", sig,
-              "def tangent(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled",
-              "    base_jvp(r, v, gm, dr, dv, da)", "    tangent_extra(r, v, gm, dr, dv, da, p)",
-              "", "", "@njit(ACCEL_SIGNATURE, cache=CACHE, error_model='numpy')",
-              "def augmented(r, v, gm, acc, p):  # pragma: no cover - compiled",
-              "    n = gm.shape[0]",
-              "    accel(r[:n], v[:n], gm, acc[:n], p)",
-              "    tangent(r[:n], v[:n], gm, r[n:], v[n:], acc[n:], p)", ""]
-    return lines
-
-
-def cache_dir(name: str = "rhs") -> Path | None:
-    """The folder ``name`` in the user's cache folder (default: the generated
-    right-hand sides), created if needed; None if it cannot be written.
-
-    Examples
-    --------
-    >>> cache_dir() is None or cache_dir().name == "rhs"
-    True
-    """
-    env = os.environ.get("HAMILTON_ORBITS_CACHE_DIR")
-    if env:
-        base = Path(env)
-    else:
-        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "hamilton-orbits"
-    folder = base / name
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        return None
-    return folder if os.access(folder, os.W_OK) else None
-
-
-def _digest(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool,
-            jac_refs: tuple[tuple[str, str], ...] | None = None) -> str | None:
-    """A digest of the generator and the kernels' source files; None if a kernel's
-    module has no importable source file."""
-    text = f"{_GENERATOR}|{refs}|{replaces_newtonian}"
-    modules = {"hamilton_orbits._kernels.nbody", "hamilton_orbits._kernels.signatures"}
-    if jac_refs is not None:
-        text += f"|{jac_refs}"
-        modules.add("hamilton_orbits._kernels.jacobians")
-        modules.update(module for module, _ in jac_refs if module != "fd")
-    h = hashlib.sha256(text.encode())
-    modules.update(module for module, _ in refs)
-    for module in sorted(modules):
-        mod = sys.modules.get(module)
-        path = getattr(mod, "__file__", None)
-        if module == "__main__" or path is None or not Path(path).is_file():
-            return None
-        h.update(Path(path).read_bytes())
-    return h.hexdigest()[:20]
-
-
 def _build(key: tuple, kernels: tuple[Any, ...],
            jacobians: tuple[Any, ...] | None = None) -> tuple[Any, ...]:
     refs, replaces_newtonian = key[:2]
     jac_refs = key[2] if len(key) > 2 else None
-    digest = _digest(refs, replaces_newtonian, jac_refs)
-    folder = cache_dir() if digest is not None else None
+    sources = module_sources(refs, replaces_newtonian, jac_refs)
+    folder = cache_dir() if sources is not None else None
     if folder is None:
         namespace = _in_memory(refs, replaces_newtonian, kernels, jac_refs, jacobians)
     else:
-        path = folder / f"{MODULE_PREFIX}{digest}.py"
-        if not path.exists():
-            tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_text(source(refs, replaces_newtonian, digest, jac_refs)
-                           .replace("CACHE", "True"))
-            os.replace(tmp, path)
-        name = path.stem
-        module = sys.modules.get(name)
-        if module is None:
-            spec = importlib.util.spec_from_file_location(name, path)
-            module = importlib.util.module_from_spec(spec)
-            sys.modules[name] = module
-            spec.loader.exec_module(module)
-        namespace = vars(module)
+        name = digest(refs, replaces_newtonian, jac_refs, sources)
+        text = source(refs, replaces_newtonian, name, jac_refs, sources=sources)
+        namespace = vars(load_module(folder / f"{MODULE_PREFIX}{name}.py", text))
+        if str(folder) not in _SWEPT:
+            _SWEPT.add(str(folder))
+            remove_stale(folder)
     names = ("accel", "extra") if jac_refs is None else (
         "accel", "extra", "tangent", "tangent_extra", "augmented")
     return tuple(namespace[name] for name in names)
@@ -434,11 +306,10 @@ def _build(key: tuple, kernels: tuple[Any, ...],
 def _in_memory(refs: tuple, replaces_newtonian: bool, kernels: tuple[Any, ...],
                jac_refs: tuple | None = None, jacobians: tuple | None = None) -> dict[str, Any]:
     """The same source compiled for this process only (no disk cache); its namespace."""
-    text = source(refs, replaces_newtonian, "in-memory", jac_refs).replace("CACHE", "False")
-    lines = [line for line in text.splitlines()
-             if not (line.startswith("from ") and (" as k" in line or " as j" in line))]
+    text = source(refs, replaces_newtonian, "in-memory", jac_refs, cache=False, imports=False)
     namespace: dict[str, Any] = {f"k{i}": k for i, k in enumerate(kernels)}
     namespace.update({f"j{i}": j for i, j in enumerate(jacobians or ()) if j is not None})
     namespace["__name__"] = f"{MODULE_PREFIX}in_memory"
-    exec(compile("\n".join(lines), f"<{MODULE_PREFIX}in-memory>", "exec"), namespace)
+    exec(compile(text, f"<{MODULE_PREFIX}in-memory>", "exec"), namespace)
     return namespace
+

@@ -1,0 +1,74 @@
+"""The effect ``kuiper_ring``: the Kuiper belt as DE440 models it.
+
+A ring of radius :data:`KUIPER_RING_RADIUS_AU` in the ecliptic, centred on the
+Sun, of the total GM of DE440's 36 ring masses (``MA8201`` ... ``MA8236``,
+:func:`kuiper_ring_gm`).  Kernel :func:`~hamilton_orbits._kernels.figures.ring_field`;
+no analytic Jacobian: the variational equations differentiate the kernel by
+compiled central differences (:mod:`hamilton_orbits.rhs`).  ``p = [centre index,
+GM, radius, normal x, y, z]``.  It keeps no registered energy.
+
+References
+----------
+R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs, AJ 161, 105 (2021), section 3.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits._kernels.figures import ring_field
+from hamilton_orbits.effects.parameters import (
+    PARK_2021,
+    axes_frame,
+    body_index,
+    require_de440_units,
+    unit_vector,
+)
+from hamilton_orbits.effects.registry import EffectSpec
+
+__all__ = ["KUIPER_RING_RADIUS_AU", "SPECS", "kuiper_ring_gm"]
+
+# Park et al. (2021), section 3: DE440's Kuiper-belt ring, 36 point masses at 44 au
+KUIPER_RING_RADIUS_AU = 44.0
+
+
+def kuiper_ring_gm() -> float:
+    """The GM of DE440's Kuiper-belt ring: the sum of its 36 ring masses, au^3/day^2.
+
+    Examples
+    --------
+    >>> round(kuiper_ring_gm() / de.constant("GMS") / 3.0034896e-6, 4)  # Earth masses
+    0.0224
+    """
+    c = de.constants()
+    return float(sum(c[f"MA{8200 + k}"] for k in range(1, 37)))
+
+
+def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    b = body_index(system, params, "centre", "sun", "kuiper_ring")
+    require_de440_units(system, params, "kuiper_ring", ("gm", "radius"))
+    big_m = float(params.get("gm", kuiper_ring_gm()))
+    radius = float(params.get("radius", KUIPER_RING_RADIUS_AU))
+    if not (big_m >= 0 and radius > 0):
+        raise ValueError(f"Effect 'kuiper_ring': expected gm >= 0 and radius > 0, got "
+                         f"{big_m!r}, {radius!r}")
+    normal = (unit_vector("normal", params["normal"], "kuiper_ring") if "normal" in params
+              else de.ecliptic_pole(axes_frame(system, params, "kuiper_ring")))
+    return np.array([b, big_m, radius, *normal])
+
+
+SPECS = (
+    EffectSpec(
+        name="kuiper_ring", kind="nbody",
+        summary="the Kuiper belt as DE440's ring (44 au, ecliptic, centred on the Sun)",
+        parameters={"centre": "default 'sun'", "gm": "default DE440's 36 ring masses",
+                    "radius": "default 44 au", "normal": "default the ecliptic pole",
+                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+        kernel=ring_field, params=_params_kuiper_ring,
+        reference=f"{PARK_2021}, section 3 (ring masses MA8201..MA8236)",
+    ),
+)

@@ -1,0 +1,71 @@
+"""The effect ``moon_figure``: the Moon's degree-2 figure acting on every other body.
+
+DE440's ``AM``, ``J2M``, ``C22M`` in principal axes built from the Earth-Moon
+geometry and Cassini's laws (the axes follow the orbit normal, from the
+Earth-Moon relative velocity: velocity dependent), with the lunar equator
+inclined by :data:`MOON_EQUATOR_INCLINATION_DEG` to the ecliptic.  Kernel
+:func:`~hamilton_orbits._kernels.figures.moon_figure`; no analytic Jacobian (the
+Moon's frame is a nested function of the state): the variational equations
+differentiate the kernel by compiled central differences
+(:mod:`hamilton_orbits.rhs`).  ``p = [moon index, earth index, radius, J2, C22,
+ecliptic pole x, y, z, inclination]``.  It keeps no registered energy.
+
+References
+----------
+W. M. Folkner, J. G. Williams, D. H. Boggs, R. S. Park, P. Kuchynka, "The Planetary
+and Lunar Ephemerides DE430 and DE431", IPN Progress Report 42-196 (2014), eq. 28.
+R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs, AJ 161, 105 (2021).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits._kernels.figures import moon_figure
+from hamilton_orbits.effects.parameters import (
+    PARK_2021,
+    axes_frame,
+    body_index,
+    require_de440_units,
+)
+from hamilton_orbits.effects.registry import EffectSpec
+
+__all__ = ["MOON_EQUATOR_INCLINATION_DEG", "SPECS"]
+
+# The mean inclination of the lunar equator to the ecliptic, I = 1.5424 deg
+# (Cassini's third law; the IAU lunar rotation model, Archinal et al. 2018, and
+# Eckhardt 1981's I = 1 deg 32' 33")
+MOON_EQUATOR_INCLINATION_DEG = 1.5424
+
+
+def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    m = body_index(system, params, "moon", "moon", "moon_figure")
+    e = body_index(system, params, "earth", "earth", "moon_figure")
+    require_de440_units(system, params, "moon_figure", ("radius",))
+    radius = float(params.get("radius", de.constant("AM") / de.constant("AU")))
+    j2 = float(params.get("j2", de.constant("J2M")))
+    c22 = float(params.get("c22", de.constant("C22M")))
+    inc = np.deg2rad(float(params.get("inclination_deg", MOON_EQUATOR_INCLINATION_DEG)))
+    pole = de.ecliptic_pole(axes_frame(system, params, "moon_figure"))
+    return np.array([m, e, radius, j2, c22, *pole, inc])
+
+
+SPECS = (
+    EffectSpec(
+        name="moon_figure", kind="nbody",
+        summary="the Moon's J2 and C22 in axes from Cassini's laws, on every other body",
+        # its axes follow the orbit normal, from the Earth-Moon relative velocity
+        velocity_dependent=True,
+        parameters={"moon": "default 'moon'", "earth": "default 'earth'",
+                    "radius": "default DE440's AM", "j2": "default DE440's J2M",
+                    "c22": "default DE440's C22M",
+                    "inclination_deg": "lunar equator to ecliptic (default 1.5424)",
+                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+        kernel=moon_figure, params=_params_moon_figure,
+        reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 28; {PARK_2021}",
+    ),
+)

@@ -1,0 +1,369 @@
+"""The effects registry: :class:`EffectSpec`, :func:`register`, :func:`get`, :class:`EffectSet`.
+
+Effects are registered per *kind* of simulation (``"nbody"``, ``"rotation"``)
+with :func:`register`.  Other packages add effects without ``hamilton_orbits``
+importing them: an entry point in the group ``hamilton_orbits.effects`` names a
+callable that registers its effects when the kind is first looked up (``rigid``
+registers its rotation effects this way).
+
+:meth:`EffectSet.of` turns what a caller lists into an :class:`EffectSet`: a
+frozen, hashable value, checked against the registry once at the boundary
+(:func:`entry_problems`, :func:`normalize_effects`).
+
+The built-in ``"nbody"`` effects are defined one module each beside this one
+and registered by :mod:`hamilton_orbits.effects` (the public face of all of it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits.units import Kind
+
+__all__ = [
+    "EffectSet",
+    "EffectSpec",
+    "entry_problems",
+    "get",
+    "known",
+    "normalize_effects",
+    "register",
+]
+
+
+@dataclass(frozen=True)
+class EffectSpec:
+    """One registered effect.
+
+    Parameters
+    ----------
+    name : str
+        The name a scene or a call uses (``"gr"``).
+    kind : str
+        The kind of simulation it belongs to (``"nbody"`` or ``"rotation"``).
+    summary : str
+        One line for listings (``hamilton-orbits scenes``).
+    velocity_dependent : bool
+        True if the force depends on velocities (refused by symplectic maps).
+    parameters : Mapping[str, str]
+        Parameter name -> description, for validation and documentation.
+    build : callable or None
+        Kind-specific builder (``"rotation"`` effects: a model from keyword
+        parameters).
+    reference : str
+        The source of the model (paper, equation).
+    kernel : numba dispatcher or None
+        ``"nbody"`` effects: a module-level compiled ``kernel(r, v, gm, acc, p)``
+        that *adds* the effect's acceleration to ``acc`` (float64 arrays (n, 3),
+        (n, 3), (n,), (n, 3)); ``p`` is the effect's own float64 parameter vector.
+    params : callable or None
+        ``"nbody"`` effects: ``params(system, mapping) -> ndarray`` (1-d float64),
+        the parameter vector ``p`` for ``system`` (a
+        :class:`~hamilton_orbits.nbody.System`) from the effect's mapping without
+        its ``"name"``; raises ``ValueError`` for bad parameters.
+    replaces_newtonian : bool
+        True if ``kernel`` computes the whole point-mass interaction itself (as the
+        Einstein-Infeld-Hoffmann equations do): the Newtonian kernel is then left
+        out of the right-hand side.
+    parameter_kinds : Mapping[str, hamilton_orbits.units.Kind]
+        The dimension of each scalar parameter that has one (``"c"``: a speed):
+        a Quantity of that kind for a Quantity system, a plain number in the
+        system's own units otherwise (read by :func:`parameter_value`; a scene
+        reads ``"299792.458 km/s"`` into a Quantity of that kind).
+    name_parameters : tuple of str
+        The parameters that name a body of the system (``"body"``, ``"source"``).
+    jacobian : numba dispatcher or None
+        ``"nbody"`` effects: a module-level compiled ``jacobian(r, v, gm, dr, dv,
+        da, p)`` that *adds* the effect's Jacobian times ``k`` tangent vectors to
+        ``da`` (see :mod:`hamilton_orbits._kernels.jacobians`), compiled only when
+        the variational equations are asked for.  None: the variational equations
+        differentiate ``kernel`` by central differences along each tangent vector
+        (compiled, generated in :mod:`hamilton_orbits.rhs`; about 1e-10 relative,
+        and two or four evaluations of the kernel per tangent vector).
+    energy : callable or None
+        ``"nbody"`` effects that keep an energy: ``energy(r, v, gm, p) -> ndarray``
+        of shape (n_t, n) for states (n_t, n, 3): the effect's part of each body's
+        specific energy (per unit mass; zero for the source), so that Hamilton's
+        (E) plus ``sum(gm * energy)`` is conserved (:func:`effect_energy`).  None
+        if the effect keeps none (the energy is then reported as not conserved).
+    """
+
+    name: str
+    kind: str
+    summary: str
+    velocity_dependent: bool = False
+    parameters: Mapping[str, str] = field(default_factory=dict)
+    build: Callable[..., Any] | None = None
+    reference: str = ""
+    kernel: Any = None
+    params: Callable[..., np.ndarray] | None = None
+    replaces_newtonian: bool = False
+    parameter_kinds: Mapping[str, Kind] = field(default_factory=dict)
+    name_parameters: tuple[str, ...] = ()
+    jacobian: Any = None
+    energy: Callable[..., np.ndarray] | None = None
+
+
+_REGISTRY: dict[str, dict[str, EffectSpec]] = {}
+_LOADED_ENTRY_POINTS: set[str] = set()
+
+
+def register(spec: EffectSpec) -> EffectSpec:
+    """Add ``spec`` to the registry (replacing one of the same kind and name).
+
+    Examples
+    --------
+    >>> spec = register(EffectSpec("example", "test-kind", "does nothing"))
+    >>> known("test-kind")
+    ('example',)
+    """
+    _REGISTRY.setdefault(spec.kind, {})[spec.name] = spec
+    return spec
+
+
+def _load_entry_points() -> None:
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group="hamilton_orbits.effects"):
+        if ep.name not in _LOADED_ENTRY_POINTS:
+            _LOADED_ENTRY_POINTS.add(ep.name)
+            ep.load()()
+
+
+def known(kind: str) -> tuple[str, ...]:
+    """The effect names registered for ``kind``, sorted.
+
+    Examples
+    --------
+    >>> "newtonian" in known("nbody")
+    True
+    """
+    if kind not in _REGISTRY:
+        _load_entry_points()
+    return tuple(sorted(_REGISTRY.get(kind, {})))
+
+
+def get(kind: str, name: str) -> EffectSpec:
+    """The registered effect ``name`` of ``kind``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, listing the known ones and the closest matches.
+
+    Examples
+    --------
+    >>> get("nbody", "newtonian").kind
+    'nbody'
+    >>> get("nbody", "newtonain")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Unknown nbody effect 'newtonain' (did you mean 'newtonian'?); known: ...
+    """
+    import difflib
+
+    names = known(kind)
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=3)
+        hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+        raise ValueError(
+            f"Unknown {kind} effect {name!r}{hint}; known: {', '.join(names) or 'none'}"
+        )
+    return _REGISTRY[kind][name]
+
+
+# ----------------------------------------------------------------------------------
+# Composition: exactly the listed effects, nothing else.
+
+
+def entry_problems(item: Any, kind: str = "nbody") -> tuple[str | None, dict, list]:
+    """Check one listed effect: ``(name, params, problems)`` with ``problems`` a list
+    of ``(key, message)`` (``key`` ``""`` for the entry itself, ``"name"``, or the
+    parameter at fault); ``name`` is None when the entry has no valid name.
+
+    Examples
+    --------
+    >>> entry_problems({"name": "j2", "bdy": "earth"})[2]  # doctest: +ELLIPSIS
+    [('bdy', "unknown parameter of effect 'j2' (did you mean 'body'?); it takes: body, ...")]
+    >>> entry_problems("grr")[2]  # doctest: +ELLIPSIS
+    [('name', "unknown effect 'grr' (did you mean 'gr'...?); known: ...gr, gr_potential, ...")]
+    """
+    import difflib
+
+    if isinstance(item, str):
+        name, params = item, {}
+    elif isinstance(item, Mapping) and isinstance(item.get("name"), str):
+        name = item["name"]
+        params = {key: val for key, val in item.items() if key != "name"}
+    else:
+        return None, {}, [("", f"expected an effect name or a mapping with a 'name', got "
+                               f"{item!r}")]
+    names = known(kind)
+    if name not in names:
+        close = difflib.get_close_matches(name, names, n=3)
+        hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
+        return None, params, [("name", f"unknown effect {name!r}{hint}; known: "
+                                       f"{', '.join(names) or 'none'}")]
+    takes = list(get(kind, name).parameters)
+    problems = []
+    for key in params:
+        if key not in takes:
+            close = difflib.get_close_matches(str(key), takes, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            problems.append((key, f"unknown parameter of effect {name!r}{hint}; it takes: "
+                                  f"{', '.join(takes) or 'none'}"))
+    return name, params, problems
+
+
+def normalize_effects(
+    effects: Sequence[str | Mapping[str, Any]] | None, kind: str = "nbody"
+) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
+    """Effects as ``((name, ((key, value), ...)), ...)``, checked against the registry.
+
+    ``"newtonian"`` may be listed and is dropped (it is always present).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (listing the known ones), an entry that is neither a
+        name nor a mapping with a ``"name"``, a parameter the effect does not take,
+        or an effect listed twice; naming the index and the value.
+
+    Examples
+    --------
+    >>> normalize_effects(["gr", {"name": "j2", "body": "earth"}])
+    (('gr', ()), ('j2', (('body', 'earth'),)))
+    >>> normalize_effects([{"name": "j2", "bdy": "earth"}])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect at index 0, `bdy`: unknown parameter of effect 'j2' (did you mean 'body'?)...
+    """
+    if effects is None:
+        return ()
+    if isinstance(effects, (str, Mapping)):
+        effects = [effects]
+    if not isinstance(effects, Sequence):
+        raise ValueError(f"Expected `effects` to be a list of names or mappings, got {effects!r}")
+    out = []
+    seen: dict[str, int] = {}
+    for k, item in enumerate(effects):
+        name, params, problems = entry_problems(item, kind)
+        if problems:
+            key, message = problems[0]
+            where = f", `{key}`" if key and key != "name" else ""
+            raise ValueError(f"Effect at index {k}{where}: {message}")
+        if name == "newtonian":
+            continue
+        if name in seen:
+            raise ValueError(f"Effect {name!r} is listed twice (at indices {seen[name]} and {k})")
+        seen[name] = k
+        out.append((name, tuple(sorted(params.items()))))
+    return tuple(out)
+
+
+def _frozen(value: Any) -> Any:
+    """A hashable stand-in for a parameter value (a Quantity as value and unit, a
+    sequence as a tuple), for :class:`EffectSet`'s equality and hash."""
+    unit = getattr(value, "unit", None)
+    if unit is not None and hasattr(value, "value"):
+        return ("quantity", _frozen(np.asarray(value.value).tolist()), str(unit))
+    if isinstance(value, np.ndarray):
+        return _frozen(value.tolist())
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    if isinstance(value, Mapping):
+        return tuple(sorted((str(k), _frozen(v)) for k, v in value.items()))
+    try:
+        hash(value)
+    except TypeError:  # a set or another unhashable value: compared by its text
+        return ("unhashable", type(value).__name__, repr(value))
+    return value
+
+
+@dataclass(frozen=True, eq=False)
+class EffectSet:
+    """The listed effects, normalised once: a frozen, hashable value.
+
+    Build it with :meth:`of`; iterate over ``(name, params)`` pairs.  Two sets are
+    equal when they list the same effects with the same parameters in the same
+    order; their hash follows.  The compiled right-hand side depends only on
+    :attr:`names` (see :mod:`hamilton_orbits.rhs`).
+
+    Attributes
+    ----------
+    kind : str
+        ``"nbody"`` or ``"rotation"``.
+    items : tuple of (str, tuple of (str, object))
+        ``(name, ((key, value), ...))`` per listed effect (``"newtonian"`` dropped).
+
+    Examples
+    --------
+    >>> eff = EffectSet.of(["gr", {"name": "j2", "body": "earth"}])
+    >>> eff.names
+    ('gr', 'j2')
+    >>> eff == EffectSet.of([{"name": "gr"}, {"body": "earth", "name": "j2"}])
+    True
+    >>> len({eff, EffectSet.of(["gr", {"name": "j2", "body": "earth"}])})
+    1
+    >>> eff.as_list()
+    ['gr', {'name': 'j2', 'body': 'earth'}]
+    """
+
+    kind: str
+    items: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+
+    @classmethod
+    def of(cls, effects: Any, kind: str = "nbody") -> EffectSet:
+        """Normalise ``effects`` (an EffectSet of this kind passes through).
+
+        Raises
+        ------
+        ValueError
+            As :func:`normalize_effects`, or for an EffectSet of another kind.
+        """
+        if isinstance(effects, EffectSet):
+            if effects.kind != kind:
+                raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")
+            return effects
+        return cls(kind, normalize_effects(effects, kind))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The listed effects' names, in order."""
+        return tuple(name for name, _ in self.items)
+
+    @property
+    def velocity_dependent(self) -> bool:
+        """True if any listed effect depends on velocities."""
+        return any(get(self.kind, name).velocity_dependent for name in self.names)
+
+    def as_list(self) -> list[str | dict[str, Any]]:
+        """The effects as a caller lists them (names, or mappings with parameters)."""
+        return [dict(name=n, **dict(p)) if p else n for n, p in self.items]
+
+    def __iter__(self):
+        return iter(self.items)
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def __bool__(self) -> bool:
+        return bool(self.items)
+
+    def _key(self) -> tuple:
+        return (self.kind, tuple((n, _frozen(dict(p))) for n, p in self.items))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, EffectSet):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return f"EffectSet({self.as_list()!r})"

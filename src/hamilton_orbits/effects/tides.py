@@ -1,0 +1,75 @@
+"""The effect ``earth_tides``: the tides raised on the Earth, acting on the Moon.
+
+The tides the Moon and the Sun raise on the Earth acting on the Moon, DE440's
+constant-time-lag model (``K2E0..2``, ``TAUE0..2``, ``TAUER1..2``): it gives the
+Moon its secular deceleration.  Kernel
+:func:`~hamilton_orbits._kernels.figures.earth_tides`; no analytic Jacobian (the
+tides' delays are nested functions of the state): the variational equations
+differentiate the kernel by compiled central differences
+(:mod:`hamilton_orbits.rhs`).  ``p = [earth index, moon index, sun index (-1: no
+Sun), radius, omega, pole x, y, z, k20, k21, k22, TAUE0, TAUE1, TAUE2, TAUER1,
+TAUER2]``.  It keeps no registered energy (tides dissipate).
+
+References
+----------
+W. M. Folkner, J. G. Williams, D. H. Boggs, R. S. Park, P. Kuchynka, "The Planetary
+and Lunar Ephemerides DE430 and DE431", IPN Progress Report 42-196 (2014), eq. 32.
+R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs, AJ 161, 105 (2021).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits._kernels.figures import earth_tides
+from hamilton_orbits.effects.parameters import (
+    PARK_2021,
+    body_index,
+    body_pole,
+    finite_floats,
+    require_de440_units,
+)
+from hamilton_orbits.effects.registry import EffectSpec
+
+__all__ = ["EARTH_ROTATION_RATE", "SPECS"]
+
+# IERS Conventions 2010, table 1.1: the Earth's nominal mean angular velocity, rad/s
+EARTH_ROTATION_RATE = 7.292115e-5
+
+
+def _params_earth_tides(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    e = body_index(system, params, "earth", "earth", "earth_tides")
+    m = body_index(system, params, "moon", "moon", "earth_tides")
+    require_de440_units(system, params, "earth_tides", ("radius", "omega", "tau"))
+    sun_name = params.get("sun", "sun")
+    sun = system.names.index(sun_name) if sun_name in system.names else -1
+    radius = float(params.get("radius", de.constant("RE") / de.constant("AU")))
+    omega = float(params.get("omega", EARTH_ROTATION_RATE * 86400.0))
+    k2 = finite_floats("k2", params.get("k2", [de.constant(f"K2E{j}") for j in range(3)]), 3,
+                 "earth_tides")
+    tau = finite_floats("tau", params.get("tau", [de.constant(k) for k in (
+        "TAUE0", "TAUE1", "TAUE2", "TAUER1", "TAUER2")]), 5, "earth_tides")
+    pole = body_pole(system, e, params, "earth_tides")
+    return np.array([e, m, sun, radius, omega, *pole, *k2, *tau])
+
+
+SPECS = (
+    EffectSpec(
+        name="earth_tides", kind="nbody",
+        summary="tides raised on the Earth by the Moon and Sun acting on the Moon (DE440)",
+        velocity_dependent=True,
+        parameters={"earth": "default 'earth'", "moon": "default 'moon'",
+                    "sun": "tide raiser besides the Moon (default 'sun' if present)",
+                    "radius": "default DE440's RE", "omega": "Earth's rotation rate",
+                    "k2": "[k20, k21, k22] (default DE440's K2E0..2)",
+                    "tau": "[TAUE0, TAUE1, TAUE2, TAUER1, TAUER2] (default DE440's)",
+                    "pole": "Earth's pole (default the Body's pole)",
+                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+        kernel=earth_tides, params=_params_earth_tides,
+        reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 32; {PARK_2021}",
+    ),
+)

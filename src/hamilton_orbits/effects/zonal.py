@@ -1,0 +1,60 @@
+"""The effect ``zonal``: zonal harmonics J2..Jn of one body about its pole.
+
+For the Earth (the default) DE440's ``RE``, ``J2E``, ``J3E``, ``J4E``, acting on
+every other body (the Moon above all); another body needs ``j`` and ``radius``.
+Kernel :func:`~hamilton_orbits._kernels.figures.zonal_field`, Jacobian
+:func:`~hamilton_orbits._kernels.jacobians.zonal_field_jvp`; ``p = [body index,
+radius, pole x, y, z, J2, J3, ...]``.  It keeps no registered energy.  J2 alone
+about any body: :mod:`hamilton_orbits.effects.j2`.
+
+References
+----------
+T. D. Moyer, JPL Technical Report 32-1527 (1971), eqs. 173-174.
+R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs, AJ 161, 105 (2021).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits._kernels.figures import zonal_field
+from hamilton_orbits._kernels.jacobians import zonal_field_jvp
+from hamilton_orbits.effects.parameters import PARK_2021, body_index, body_pole, finite_floats
+from hamilton_orbits.effects.registry import EffectSpec
+
+__all__ = ["SPECS"]
+
+
+def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    b = body_index(system, params, "body", "earth", "zonal")
+    if system.names[b] != "earth" or not system.quantity:
+        for key in ("j", "radius"):
+            if key not in params:
+                raise ValueError(f"Effect 'zonal': body {system.names[b]!r} needs `{key}` "
+                                 "(DE440's defaults are the Earth's, in au)")
+    j = finite_floats("j", params.get("j", [de.constant(f"J{n}E") for n in (2, 3, 4)]), None,
+                "zonal")
+    radius = float(params.get("radius", de.constant("RE") / de.constant("AU")))
+    if not radius > 0:
+        raise ValueError(f"Effect 'zonal': expected `radius` > 0, got {radius!r}")
+    return np.array([b, radius, *body_pole(system, b, params, "zonal"), *j])
+
+
+SPECS = (
+    EffectSpec(
+        name="zonal", kind="nbody",
+        summary="zonal harmonics J2..Jn of one body (default the Earth's J2, J3, J4)",
+        parameters={"body": "the body (default 'earth')",
+                    "j": "[J2, J3, ...] (default DE440's J2E, J3E, J4E)",
+                    "radius": "reference radius (default DE440's RE)",
+                    "pole": "pole vector (default the Body's pole)",
+                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+        kernel=zonal_field, params=_params_zonal,
+        jacobian=zonal_field_jvp,
+        reference=f"Moyer (1971), JPL TR 32-1527, eqs. 173-174; {PARK_2021}",
+    ),
+)
