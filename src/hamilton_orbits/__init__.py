@@ -15,10 +15,12 @@ from hamilton_orbits.quaternion import Quaternion, slerp
 
 if TYPE_CHECKING:  # pragma: no cover
     from hamilton_orbits.ensemble import Ensemble
+    from hamilton_orbits.integrators.methods import DOP853, WH, Leapfrog, Radau15
     from hamilton_orbits.nbody import Body, System
     from hamilton_orbits.rebound_bridge import crosscheck
     from hamilton_orbits.scene import Result, Scene
-    from hamilton_orbits.simulation import Trajectory, integrate
+    from hamilton_orbits.simulation import Simulation, integrate
+    from hamilton_orbits.trajectory import Trajectory
 
 # The n-body and scene names are imported on first use (PEP 562), so that
 # ``import hamilton_orbits`` does not pull in their dependencies (tomllib,
@@ -30,8 +32,13 @@ _LAZY = {
     "Ensemble": "hamilton_orbits.ensemble",
     "Result": "hamilton_orbits.scene",
     "Scene": "hamilton_orbits.scene",
-    "Trajectory": "hamilton_orbits.simulation",
+    "Simulation": "hamilton_orbits.simulation",
+    "Trajectory": "hamilton_orbits.trajectory",
     "integrate": "hamilton_orbits.simulation",
+    "Radau15": "hamilton_orbits.integrators.methods",
+    "WH": "hamilton_orbits.integrators.methods",
+    "Leapfrog": "hamilton_orbits.integrators.methods",
+    "DOP853": "hamilton_orbits.integrators.methods",
 }
 
 
@@ -62,14 +69,19 @@ def __dir__() -> list[str]:
 
 
 __all__ = [
+    "DOP853",
+    "WH",
     "Body",
     "Conic",
     "ConvergenceError",
     "Ensemble",
     "KeplerOrbit",
+    "Leapfrog",
     "Quaternion",
+    "Radau15",
     "Result",
     "Scene",
+    "Simulation",
     "System",
     "Trajectory",
     "__version__",

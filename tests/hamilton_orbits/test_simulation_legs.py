@@ -1,0 +1,240 @@
+"""Simulation: the prepared object that continues bit for bit, copies, stops early.
+
+The reference of every test here is the run that was never split: continuing a
+simulation in legs must reach the same bits (positions, velocities, steps, the
+integrals' errors measured from the start, MEGNO, the STM, the events found) as one
+call through every output time, for every method, with effects, events and the
+variational equations.
+"""
+
+from __future__ import annotations
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, Simulation, System, integrate
+from hamilton_orbits.engine import StopIntegration
+from hamilton_orbits.integrators import DOP853, WH, Leapfrog, Radau15
+
+
+def _disc(n: int = 6, seed: int = 11) -> System:
+    """A star and planets on near-circular, slightly inclined orbits (masses 1e-5 to
+    1e-3), the oblate star carrying a J2 (so that ``j2`` has something to do)."""
+    rng = np.random.default_rng(seed)
+    a = np.sort(rng.uniform(1.0, 6.0, n - 1))
+    ph = rng.uniform(0, 2 * np.pi, n - 1)
+    inc = rng.uniform(0, 0.05, n - 1)
+    bodies = [Body("star", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005, j2=1e-3, pole=[0, 0, 1])]
+    for k in range(n - 1):
+        r = a[k] * np.array([np.cos(ph[k]), np.sin(ph[k]) * np.cos(inc[k]),
+                             np.sin(ph[k]) * np.sin(inc[k])])
+        s = 1 / np.sqrt(a[k])
+        v = s * np.array([-np.sin(ph[k]), np.cos(ph[k]) * np.cos(inc[k]),
+                          np.cos(ph[k]) * np.sin(inc[k])])
+        bodies.append(Body(f"p{k}", 10.0 ** rng.uniform(-5, -3), r, v))
+    return System(bodies)
+
+
+def _merging() -> System:
+    """Two bodies falling into contact (they merge about t = 1.4) and a bystander."""
+    return System([Body("a", 1.0, [0, 0, 0], [0, 0.01, 0], radius=0.01),
+                   Body("b", 0.5, [1.0, 0, 0], [0, -0.02, 0.005], radius=0.02),
+                   Body("c", 0.0, [5.0, 0, 0], [0, 0.4, 0])])
+
+
+GR = {"name": "gr", "c": 100.0}
+GR_POTENTIAL = {"name": "gr_potential", "c": 100.0}
+J2 = {"name": "j2", "body": "star"}
+METHODS = {
+    "radau15": dict(method="radau15"),
+    "radau15-fixed": dict(method="radau15", dt=0.02),
+    "wh-dh": dict(method="wh", dt=0.02),
+    "wh-jacobi-11": dict(method="wh", dt=0.02, coordinates="jacobi", corrector=11),
+    "leapfrog": dict(method="leapfrog", dt=0.01),
+    "dop853": dict(method="dop853", tol=1e-10),
+}
+SYMPLECTIC = {"wh-dh", "wh-jacobi-11", "leapfrog"}
+
+
+def _variants():
+    for name, kw in METHODS.items():
+        effects = [GR_POTENTIAL, J2] if name in SYMPLECTIC else [GR, J2]
+        yield pytest.param(_disc, kw, id=f"{name}-plain")
+        yield pytest.param(_disc, dict(kw, effects=effects), id=f"{name}-effects")
+        yield pytest.param(_merging, dict(kw, events=[{"name": "collision", "action": "merge"}]),
+                           id=f"{name}-merge")
+        if name != "wh-jacobi-11":  # wh's tangent map takes no corrector
+            yield pytest.param(_disc, dict(kw, variational=True, stm=True),
+                               id=f"{name}-variational")
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    return bool(np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True))
+
+
+@pytest.mark.parametrize(("system", "kw"), _variants())
+def test_two_legs_reach_the_bits_of_one_call(system, kw):
+    system = system()
+    t1, t2, t3 = 1.3, 2.9, 4.0
+    sim = Simulation(system, **kw)
+    first = sim.integrate(t1)
+    second = sim.integrate([t2, t3])
+    once = Simulation(system, **kw).integrate([t1, t2, t3])
+    assert first.t.tolist() == [0.0, t1] and second.t.tolist() == [t1, t2, t3]
+    for leg, rows in ((first, slice(0, 2)), (second, slice(1, 4))):
+        assert _same(leg.r, once.r[rows]) and _same(leg.v, once.v[rows])
+        # Hamilton's integrals measured from the start of the simulation in both
+        assert _same(leg.energy_error, once.energy_error[rows])
+        assert _same(leg.angular_momentum_error, once.angular_momentum_error[rows])
+        assert _same(leg.barycentre_drift, once.barycentre_drift[rows])
+        if once.megno is not None:
+            assert _same(leg.megno, once.megno[rows]) and _same(leg.lyapunov, once.lyapunov[rows])
+            assert _same(leg.stm, once.stm[rows])
+    assert first.steps + second.steps == once.steps == sim.steps
+    assert sim.t == t3
+    events = list(first.events["time"]) + list(second.events["time"])
+    assert events == list(once.events["time"])
+    if "events" in kw:
+        assert len(events) == 1 and sim.system.names == ("a", "c")  # the merge happened
+    assert sim.system.names == once.final.names
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.final.as_arrays().r)
+
+
+def test_integrate_is_a_simulation_integrated_once():
+    s = _disc()
+    one = integrate(s, [0.5, 2.0], method="wh", dt=0.02, effects=[GR_POTENTIAL])
+    sim = Simulation(s, method="wh", dt=0.02, effects=[GR_POTENTIAL]).integrate([0.5, 2.0])
+    assert _same(one.r, sim.r) and _same(one.energy_error, sim.energy_error)
+
+
+def test_typed_methods_are_the_string_forms():
+    s = _disc()
+    for typed, name, options in ((WH(coordinates="jacobi", corrector=11), "wh",
+                                  {"coordinates": "jacobi", "corrector": 11}),
+                                 (Radau15(criterion="global"), "radau15", {"criterion": "global"}),
+                                 (Leapfrog(), "leapfrog", {}), (DOP853(), "dop853", {})):
+        kw = {"dt": 0.02} if name in ("wh", "leapfrog") else {}
+        a = integrate(s, 1.0, method=typed, **kw)
+        b = integrate(s, 1.0, method=name, **kw, **options)
+        assert _same(a.r, b.r) and a.method == b.method == name
+        assert Simulation(s, method=typed, **kw).method == typed
+
+
+@pytest.mark.parametrize(("kw", "match"), [
+    (dict(method=WH(), coordinates="jacobi"), r"Options coordinates given beside the method"),
+    (dict(method="wh", coordinates="Jacobians"), r"Expected `coordinates` to be one of"),
+    (dict(method="radau15", tangent_control="no"), r"Expected `tangent_control` to be True"),
+    (dict(method="radau15", tangent_control=True), r"`tangent_control=True` .* needs "
+                                                   r"`variational=True`"),
+    (dict(method="dop853", criterion="global"), r"Unknown option `criterion` = 'global' for "
+                                               r"method 'dop853'; it takes: tangent_control"),
+    (dict(method="radau15", max_steps=0), r"Expected `max_steps` to be a positive integer"),
+    (dict(method="leapfrog", dt=0.1, effects=[GR]), r"Effect 'gr' depends on velocities"),
+])
+def test_bad_simulations_are_refused_with_the_argument_named(kw, match):
+    with pytest.raises(ValueError, match=match):
+        Simulation(_disc(), **kw)
+
+
+def test_capital_jacobi_is_jacobi():
+    s = _disc()
+    a = integrate(s, 1.0, method="wh", dt=0.02, coordinates="Jacobi")
+    b = integrate(s, 1.0, method="wh", dt=0.02, coordinates="jacobi")
+    assert _same(a.r, b.r)
+
+
+@pytest.mark.parametrize("kw", [METHODS["radau15"], METHODS["wh-dh"],
+                                dict(METHODS["leapfrog"], variational=True)])
+def test_a_copy_is_independent_and_continues_alike(kw):
+    s = _disc()
+    sim = Simulation(s, **kw)
+    sim.integrate(1.0)
+    branch = sim.copy()
+    far = branch.integrate(3.0)  # the copy goes on ...
+    assert sim.t == 1.0 and sim.steps < branch.steps  # ... the original does not move
+    near = sim.integrate(3.0)
+    assert _same(far.r, near.r) and _same(far.energy_error, near.energy_error)
+    if far.megno is not None:
+        assert _same(far.megno, near.megno)
+
+
+def test_a_copy_with_events_keeps_its_own_log_and_masses():
+    sim = Simulation(_merging(), events=[{"name": "collision", "action": "merge"}])
+    sim.integrate(0.5)
+    branch = sim.copy()
+    merged = branch.integrate(3.0)
+    assert len(merged.events) == 1 and branch.system.names == ("a", "c")
+    assert sim.system.names == ("a", "b", "c")  # the original has not merged
+    again = sim.integrate(3.0)
+    assert _same(again.r, merged.r) and list(again.events["time"]) == list(merged.events["time"])
+
+
+@pytest.mark.parametrize("method", ["radau15", "wh", "leapfrog", "dop853"])
+def test_stop_integration_from_a_callback_returns_what_was_reached(method):
+    """An output callback that raises StopIntegration used to come out of integrate
+    as a bare KeyboardInterrupt with every output lost: the trajectory now ends at
+    the output reached, incomplete, and the simulation stands there."""
+    s = _disc()
+    kw = {"dt": 0.02} if method in ("wh", "leapfrog") else {}
+
+    def on_output(i: int, steps: int) -> None:
+        if i == 3:
+            raise StopIntegration
+
+    sim = Simulation(s, method=method, **kw)
+    traj = sim.integrate(np.linspace(0, 2, 9), on_output=on_output)
+    assert not traj.complete and len(traj.t) == 4 and traj.t[-1] == 0.75
+    assert "incomplete" in repr(traj)
+    whole = integrate(s, np.linspace(0, 2, 9), method=method, **kw)
+    assert whole.complete and _same(traj.r, whole.r[:4])
+    assert sim.t == 0.75  # and it continues from there, as one run would have
+    rest = sim.integrate(np.linspace(0, 2, 9)[4:])
+    assert _same(rest.r[-1], whole.r[-1])
+    stopped = integrate(s, np.linspace(0, 2, 9), method=method, on_output=on_output, **kw)
+    assert not stopped.complete and _same(stopped.r, whole.r[:4])
+
+
+def test_ctrl_c_still_raises_keyboard_interrupt():
+    def on_output(i: int, steps: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        integrate(_disc(), [1.0, 2.0], on_output=on_output)
+
+
+def test_time_steps_and_state_of_a_quantity_system():
+    s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
+    sim = Simulation(s, method="wh", dt=5 * u.day)
+    assert sim.t == 0 * u.day and sim.steps == 0 and sim.system.names == s.names
+    leg = sim.integrate(1 * u.yr)
+    assert sim.t.unit == u.yr and sim.t == 1 * u.yr and leg.t[0] == 0 * u.yr
+    assert sim.steps == leg.steps == 74  # 365.25 / 5 rounded up
+    np.testing.assert_array_equal(sim.system.r.value, leg.r[-1].value)
+    leg2 = sim.integrate(400 * u.day)  # in days from here on
+    assert leg2.t.unit == u.day and leg2.t[0].to_value(u.day) == pytest.approx(365.25)
+    with pytest.raises(ValueError, match=r"Expected `t` as a time Quantity"):
+        sim.integrate(500.0)
+    with pytest.raises(ValueError, match=r"Expected `t` to differ from the simulation's time"):
+        sim.integrate(400 * u.day)
+    with pytest.raises(ValueError, match=r"strictly monotonic \(times after the start 400"):
+        sim.integrate([500, 450] * u.day)
+
+
+def test_backward_legs_continue_and_a_turn_restarts_from_the_state_reached():
+    s = _disc()
+    sim = Simulation(s, method="radau15")
+    sim.integrate(-1.0)
+    back = sim.integrate(-2.5)
+    once = integrate(s, [-1.0, -2.5])
+    assert _same(back.r[-1], once.r[-1]) and sim.t == -2.5
+    home = sim.integrate(0.0)  # forwards again: a new integrator from the state reached
+    np.testing.assert_allclose(home.r[-1], s.as_arrays().r, rtol=0, atol=1e-9)
+    assert home.energy_error[0] == once.energy_error[-1]
+
+
+def test_repr_names_method_effects_time_and_steps():
+    sim = Simulation(_disc(), method="wh", dt=0.02, effects=[GR_POTENTIAL])
+    sim.integrate(0.1)
+    assert repr(sim).startswith("Simulation(6 bodies, method=WH(coordinates=")
+    assert "effects=('gr_potential',), t=0.1, steps=5)" in repr(sim)
