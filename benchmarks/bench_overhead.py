@@ -25,6 +25,16 @@ warm-up; ratios are peer time / our time (> 1: we are faster).
    a minimal kernel written here (a, e, inc, lan, argp, nu of one state by the
    textbook formulas, no special cases, no validation) as the yardstick, and
    beside rebound per orbit (single-threaded), per core and on all cores.
+4. The cost of an n-body call (10 bodies: a star and nine planets on a disc,
+   masses 1e-7, dt = 0.01), CPU time, one step per call: a continuing
+   ``sim.integrate(t + dt)`` of a prepared :class:`~hamilton_orbits.Simulation`
+   beside rebound's ``sim.integrate(t + dt, exact_finish_time=0)`` (radau15 at a
+   fixed step beside IAS15 with epsilon = 0; wh beside WHFast, democratic
+   heliocentric, safe_mode 0), and beside rebound's call plus what ours also
+   does (``synchronize()`` and the state read out: ``serialize_particle_data``);
+   and the one-shot ``integrate(system, dt)`` beside rebound's ``copy()`` +
+   ``integrate``.  Ratios rebound / ours (> 1: ours is cheaper), the median of
+   per-round ratios, ours and rebound's calls interleaved round by round.
 3. The main job (``hamilton-orbits``, the solar-system scene) in a subprocess:
    cold (``NUMBA_CACHE_DIR`` a fresh empty folder) and warm, wall clock; and
    ``import hamilton_orbits`` beside ``import numpy, scipy, astropy.units,
@@ -310,10 +320,108 @@ def bench_first_run(repeat_warm: int) -> None:
           f"warm {statistics.median(warm):.1f} s (median of {repeat_warm})")
 
 
+def _disc10() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A star (GM 1) and nine planets (GM 1e-7) on circular orbits at 1-10."""
+    rng = np.random.default_rng(1)
+    a = rng.uniform(1.0, 10.0, 9)
+    ph = rng.uniform(0, 2 * np.pi, 9)
+    r = np.zeros((10, 3))
+    v = np.zeros((10, 3))
+    r[1:, 0], r[1:, 1] = a * np.cos(ph), a * np.sin(ph)
+    v[1:, 0], v[1:, 1] = -np.sin(ph) / np.sqrt(a), np.cos(ph) / np.sqrt(a)
+    gm = np.full(10, 1e-7)
+    gm[0] = 1.0
+    return r, v, gm
+
+
+def _rebound_of(r: np.ndarray, v: np.ndarray, gm: np.ndarray, integrator: str, dt: float):
+    import rebound
+
+    sim = rebound.Simulation()
+    sim.G = 1.0
+    for i in range(len(gm)):
+        sim.add(m=gm[i], x=r[i, 0], y=r[i, 1], z=r[i, 2], vx=v[i, 0], vy=v[i, 1], vz=v[i, 2])
+    sim.integrator = integrator
+    sim.dt = dt
+    if integrator == "ias15":
+        sim.integrator.epsilon = 0.0
+    else:
+        sim.integrator.coordinates = "democraticheliocentric"
+        sim.integrator.safe_mode = 0
+    return sim
+
+
+def _interleaved(fns: dict, rounds: int, secs: float = 0.05) -> dict:
+    """CPU time per call of each of ``fns``, round by round in turn (each call looped
+    for ``secs``); per round the times, so that ratios can be taken per round."""
+    for fn in fns.values():
+        fn()
+    out: dict = {k: [] for k in fns}
+    for _ in range(rounds):
+        for k, fn in fns.items():
+            n, t0 = 0, time.process_time()
+            while True:
+                fn()
+                n += 1
+                spent = time.process_time() - t0
+                if spent >= secs:
+                    break
+            out[k].append(spent / n)
+    return out
+
+
+def bench_simulation_calls(rounds: int) -> None:
+    from hamilton_orbits import Simulation, System, integrate
+
+    r, v, gm = _disc10()
+    system = System.from_arrays(gm, r, v)
+    dt = 0.01
+    print("\n4. Cost of an n-body call, 10 bodies, one step of dt = 0.01 (CPU time, median of "
+          f"{rounds} rounds; ratio = rebound / ours, median of per-round ratios)")
+    print(f"{'method':>9} | {'ours continuing':>15} {'rebound':>9} {'ratio':>6} | "
+          f"{'rebound+state':>13} {'ratio':>6} | {'ours one-shot':>13} {'copy+integrate':>14} "
+          f"{'ratio':>6}")
+    for method, peer in (("radau15", "ias15"), ("wh", "whfast")):
+        sim = Simulation(system, method=method, dt=dt)
+        reb = _rebound_of(r, v, gm, peer, dt)
+        xyz, vxyz = np.empty((10, 3)), np.empty((10, 3))
+
+        def ours(sim=sim) -> None:
+            sim.integrate(sim.t + dt)
+
+        def theirs(reb=reb) -> None:
+            reb.integrate(reb.t + dt, exact_finish_time=0)
+
+        def theirs_state(reb=reb, peer=peer, xyz=xyz, vxyz=vxyz) -> None:
+            reb.integrate(reb.t + dt, exact_finish_time=0)
+            if peer == "whfast":
+                reb.synchronize()
+            reb.serialize_particle_data(xyz=xyz, vxvyvz=vxyz)
+
+        def ours_once(method=method) -> None:
+            integrate(system, dt, method=method, dt=dt)
+
+        def theirs_once(reb=reb) -> None:
+            copy = reb.copy()
+            copy.integrate(copy.t + dt, exact_finish_time=0)
+
+        t = _interleaved({"o": ours, "p": theirs, "ps": theirs_state, "o1": ours_once,
+                          "p1": theirs_once}, rounds)
+        med = {k: statistics.median(x) for k, x in t.items()}
+
+        def ratio(a: str, b: str, t=t) -> float:
+            return statistics.median(x / y for x, y in zip(t[a], t[b], strict=True))
+
+        print(f"{method:>9} | {med['o'] * 1e6:>12.2f} us {med['p'] * 1e6:>6.2f} us "
+              f"{ratio('p', 'o'):>6.2f} | {med['ps'] * 1e6:>10.2f} us {ratio('ps', 'o'):>6.2f} | "
+              f"{med['o1'] * 1e6:>10.2f} us {med['p1'] * 1e6:>11.2f} us {ratio('p1', 'o1'):>6.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
-    parser.add_argument("--skip", nargs="*", default=[], choices=["calls", "throughput", "first"],
+    parser.add_argument("--skip", nargs="*", default=[],
+                        choices=["calls", "throughput", "first", "simulation"],
                         help="parts to leave out")
     parser.add_argument("--nmax", type=int, default=None,
                         help="largest N of part 1 (default 1e7, 1e6 with --quick; 1: one orbit)")
@@ -332,6 +440,8 @@ def main() -> None:
         bench_per_call(nmax, nmax_reb, repeat)
     if "throughput" not in args.skip:
         bench_throughput(10**6, repeat, 9 if args.quick else 15)
+    if "simulation" not in args.skip:
+        bench_simulation_calls(5 if args.quick else 11)
     if "first" not in args.skip:
         bench_first_run(2 if args.quick else 5)
 

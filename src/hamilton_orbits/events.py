@@ -307,6 +307,8 @@ class StopAtEvent(Exception):
 
 
 _NO_WATCH = np.zeros((0, 5))
+_NO_RADIUS = np.zeros(0)
+_NO_BUFFER = np.zeros((0, N_EVENT_COLUMNS))
 
 
 class EventLog:
@@ -343,8 +345,12 @@ class EventLog:
     def none(cls, n: int) -> EventLog:
         """A log that watches nothing (the kernels then skip the scan, and its
         buffer is empty)."""
-        log = cls(_NO_WATCH, np.empty(0), capacity=0)  # no radii: nothing merges
+        log = cls.__new__(cls)  # no radii: nothing merges; nothing to record
+        log.watch, log.radius, log.buffer = _NO_WATCH, _NO_RADIUS, _NO_BUFFER
+        log.count = np.zeros(1, dtype=np.int64)
+        log.rows, log.stopped_by, log.gone, log.gm_changes = [], None, False, []
         log.inactive = np.zeros(n, dtype=bool)
+        log.index_map = None
         return log
 
     def drain(self) -> None:

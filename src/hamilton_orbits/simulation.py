@@ -131,7 +131,7 @@ class Simulation:
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
                                         tol=tol, events=event_log(system, events),
                                         variational=tan)
-        self._system, self._effects = system, eff
+        self._system, self._effects, self._quantity = system, eff, system.quantity
         #: the state at time 0, from which Hamilton's integrals are measured (None
         #: until a first leg has begun there)
         self._start: Any = None
@@ -220,13 +220,16 @@ class Simulation:
             On Ctrl-C (the run stops within a few thousand steps; the simulation
             keeps the state reached).
         """
-        times, unit = _leg_times(t, self._prop.t, self._system.quantity)
+        prop = self._prop
+        times, unit = _leg_times(t, prop.t, self._quantity)
         if unit is not None:
             self._unit = unit
-        report, close = _progress(progress, self.method.name, len(times) - 1, on_output)
+        close = None
+        if progress:
+            on_output, close = _progress(prop.method.name, len(times) - 1, on_output)
         try:
             compiled = compile_seconds()
-            out = self._prop.advance(times, on_output=report, stop=stop)
+            out = prop.advance(times, on_output=on_output, stop=stop)
             compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
         finally:
             if close is not None:
@@ -234,7 +237,7 @@ class Simulation:
         if out.interrupted:
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
-        return make_trajectory(self._system, out, unit, self.method.name, self.rhs.effects,
+        return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
                                self._effects, start=start,
                                wall_time=max(out.wall_time - compiled, 0.0))
 
@@ -453,6 +456,8 @@ def event_log(system: System, events: Any) -> EventLog | None:
     >>> event_log(s, [{"name": "escape", "distance": 10.0}]).watch.tolist()
     [[3.0, 1.0, -1.0, 10.0, 0.0]]
     """
+    if isinstance(events, (tuple, list)) and not events:
+        return None  # none listed (the common case)
     listed = EventSet.of(events)
     if not listed:
         return None
@@ -514,13 +519,9 @@ def check_method(method: str | Method, effects: Any, options: Mapping[str, Any])
     return check_effects(method_of(method, options), effects)
 
 
-def _progress(enabled: bool, method: str, total: int, on_output: Any
-              ) -> tuple[Any, Callable[[], None] | None]:
-    """An output callback that advances a tqdm bar (when ``enabled``) and calls
-    ``on_output`` (``on_output`` itself when there is no bar), and the bar's
-    ``close`` (None without a bar)."""
-    if not enabled:
-        return on_output, None
+def _progress(method: str, total: int, on_output: Any) -> tuple[Any, Callable[[], None] | None]:
+    """An output callback that advances a tqdm bar and calls ``on_output``, and the
+    bar's ``close`` (``on_output`` itself and None where tqdm is not installed)."""
     try:
         from tqdm.auto import tqdm
     except ImportError:  # pragma: no cover - tqdm is an optional extra
@@ -584,8 +585,6 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
     ValueError
         If the run lost a body's state (a non-finite position or velocity).
     """
-    import astropy.units as u
-
     r, v, times = out.r, out.v, out.t
     log = out.events
     gone = log.inactive.copy() if log is not None else None  # the log goes on changing
@@ -595,6 +594,8 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
                                   start)
     final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
     if system.quantity:
+        import astropy.units as u
+
         t_out: Any = (times * u.day).to(unit)
         r_out: Any = r << u.au  # views: no second copy of the history
         v_out: Any = v << (u.au / u.day)
@@ -607,7 +608,7 @@ def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: st
         megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
         stm = tan.stm[:k].copy() if tan.stm is not None else None
         if system.quantity:
-            lyap = (lyap / u.day).to(1 / unit)
+            lyap = (lyap / DAY).to(1 / unit)
     events = None
     if log is not None:
         stopped = log.stopped_by

@@ -13,7 +13,7 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 from hamilton_orbits.validation import as_float_array, check_positive
 
-_ADDRESSES: weakref.WeakKeyDictionary[Any, dict[Any, np.ndarray]] = weakref.WeakKeyDictionary()
+_ADDRESSES: weakref.WeakKeyDictionary[Any, dict[int, np.ndarray]] = weakref.WeakKeyDictionary()
 
 
 def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
@@ -30,14 +30,16 @@ def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
     >>> bool(np.all(accel_arg(nbody.newtonian_only) > 0))
     True
     """
-    known = _ADDRESSES.setdefault(fn, {})
-    found = known.get(signature)
+    known = _ADDRESSES.get(fn)
+    if known is None:
+        known = _ADDRESSES[fn] = {}
+    found = known.get(id(signature))  # the signatures are module constants (hashing one: us)
     if found is None:
         cres = fn.get_compile_result(signature)
         lib, names = cres.library, cres.fndesc
         found = np.array([lib.get_pointer_to_function(names.llvm_cfunc_wrapper_name),
                           lib.get_pointer_to_function(names.llvm_func_name)], dtype=np.int64)
-        known[signature] = found
+        known[id(signature)] = found
     return found
 
 

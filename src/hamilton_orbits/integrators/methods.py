@@ -221,6 +221,7 @@ class DOP853(Method):
 
 #: Method name -> its typed value's class.
 METHODS: dict[str, type[Method]] = {m.name: m for m in (Radau15, WH, Leapfrog, DOP853)}
+_DEFAULTS = {name: cls() for name, cls in METHODS.items()}
 
 
 def method_of(method: Any, options: Mapping[str, Any] | None = None) -> Method:
@@ -245,6 +246,8 @@ def method_of(method: Any, options: Mapping[str, Any] | None = None) -> Method:
     ...
     ValueError: Unknown `method` 'rk4'; known: radau15, wh, leapfrog, dop853
     """
+    if not options and isinstance(method, str) and method in _DEFAULTS:
+        return _DEFAULTS[method]  # the common case: a name alone (the values are frozen)
     options = dict(options or {})
     if isinstance(method, Method):
         if options:

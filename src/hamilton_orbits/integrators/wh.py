@@ -246,7 +246,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, m
     if method.corrector and variational is not None:
         raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
                          "is not implemented); use corrector=0")
-    if r0.shape[0] == 0 or not np.max(gm) > 0.0:
+    if r0.shape[0] == 0 or not gm[int(gm.argmax())] > 0.0:
         raise ValueError("wh needs a central body with `gm` > 0; "
                          + ("there are no bodies" if r0.shape[0] == 0 else "all `gm` are 0"))
     if dt is None:
@@ -264,7 +264,7 @@ class _State:
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  method: WH, dt: float, events: EventLog | None) -> None:
         n = r0.shape[0]
-        c = int(np.argmax(gm))
+        c = int(gm.argmax())
         # the central body first (row i of the coordinates is body order[i])
         order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
         extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
