@@ -242,7 +242,7 @@ def _check_analyses(analyses: list, names: list[str], problems: S.Problems) -> N
 
 
 def _check_initial(init: dict, problems: S.Problems) -> None:
-    from hamilton_orbits.nbody import solar_system_bodies, solar_system_epoch
+    from hamilton_orbits.initial_states import solar_system_bodies, solar_system_epoch
 
     given = [k for k in ("solar_system", "ephemeris", "rebound") if init.get(k) is not None]
     if len(given) > 1:
@@ -636,7 +636,7 @@ def _plot_megno(result: Result):
 def _result(scene: Any, system, out, method: str, effects) -> Result:
     """The :class:`Result` of an engine run: states, Hamilton's integrals, figures,
     and the final state as a rebound binary."""
-    from hamilton_orbits.nbody import integral_errors
+    from hamilton_orbits.integrals import integral_errors
 
     gm = system.as_arrays().gm.copy()
     extra = _effects.effect_energy(system, effects, out.r, out.v)
