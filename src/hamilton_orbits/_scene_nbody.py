@@ -763,7 +763,7 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
     """The positions against DE440's at the whole years from J2000 among the outputs:
     km and arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100
     years (those reached), and a figure of the residual against time."""
-    from hamilton_orbits.ladder import BODIES, residuals
+    from hamilton_orbits.studies.ladder import BODIES, residuals
 
     years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start (J2000)
     whole = np.flatnonzero(np.abs(years - np.round(years)) < 1e-9)
@@ -798,7 +798,7 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
 def _plot_de440(result: Result):
     import matplotlib.pyplot as plt
 
-    from hamilton_orbits.ladder import BODIES
+    from hamilton_orbits.studies.ladder import BODIES
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     years = result.diagnostics["de440_years"]

@@ -57,7 +57,7 @@ from hamilton_orbits._body import (
     body_arrays,
     body_from_floats,
 )
-from hamilton_orbits._deprecated import moved
+from hamilton_orbits._deprecated import moved_name
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.initial_states import InitialStates
 from hamilton_orbits.integrals import energy_gm
@@ -540,11 +540,16 @@ class System(InitialStates):
         return rc, vc
 
 
-# names that moved out of this module (they warn, naming their new module)
-__getattr__ = moved(__name__, {
+# the names that moved out of this module, and where to
+_MOVED = {
     **dict.fromkeys(("DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN",
                      "solar_system_bodies", "solar_system_epoch"),
                     "hamilton_orbits.initial_states"),
     **dict.fromkeys(("LostStateError", "accelerations_quaternion", "energy_gm_many",
                      "integral_errors"), "hamilton_orbits.integrals"),
-})
+}
+
+
+def __getattr__(name: str) -> Any:
+    """The names that moved out (a DeprecationWarning naming their new module)."""
+    return moved_name(__name__, _MOVED, name)

@@ -11,7 +11,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.report import Row, log, timed
+from hamilton_orbits.studies.report import Row, log, timed
 
 
 def problems() -> list[tuple[str, Any]]:

@@ -15,6 +15,12 @@ MOVED = [
     *[("hamilton_orbits.nbody", name, "hamilton_orbits.integrals")
       for name in ("LostStateError", "accelerations_quaternion", "energy_gm_many",
                    "integral_errors")],
+    *[(f"hamilton_orbits.{module}", name, f"hamilton_orbits.studies.{module}")
+      for module, names in (
+          ("report", ("SETTINGS", "Row", "build_report", "fmt_time", "log", "timed")),
+          ("ladder", ("BODIES", "RUNGS", "Rung", "RungResult", "residuals", "run_rung")),
+          ("reference", ("Reference", "reference")))
+      for name in names],
 ]
 
 
@@ -30,6 +36,31 @@ def test_old_path_warns_and_gives_the_same_object(old, name, new):
 def test_from_import_of_an_old_path_warns(old, name, new):
     with pytest.warns(DeprecationWarning, match=new):
         exec(f"from {old} import {name}", {})
+
+
+@pytest.mark.parametrize("module", ["report", "ladder", "reference"])
+def test_a_moved_module_still_imports_and_lists_its_names(module):
+    old = importlib.import_module(f"hamilton_orbits.{module}")
+    new = importlib.import_module(f"hamilton_orbits.studies.{module}")
+    assert old.__all__ == new.__all__
+    with pytest.warns(DeprecationWarning, match=f"hamilton_orbits.studies.{module}"):
+        star: dict = {}
+        exec(f"from hamilton_orbits.{module} import *", star)
+    assert all(star[name] is getattr(new, name) for name in new.__all__)
+
+
+def test_the_report_problems_plug_in_keeps_its_contract():
+    """rigid's problems (entry point group ``hamilton_orbits.report_problems``) build
+    the report's Row, from the report module's public names."""
+    from importlib.metadata import entry_points
+
+    from hamilton_orbits.studies import report, rows
+
+    assert report.Row is rows.Row and report.timed is rows.timed and report.log is rows.log
+    eps = list(entry_points(group="hamilton_orbits.report_problems"))
+    assert [ep.value for ep in eps] == ["rigid.report_problems:problems"]
+    slugs = [slug for slug, fn in eps[0].load()() if callable(fn)]
+    assert slugs == ["rigid_body", "pole_wander"]
 
 
 def test_unknown_names_still_raise_attribute_error():
