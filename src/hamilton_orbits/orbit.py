@@ -33,13 +33,13 @@ from hamilton_orbits import _columns
 from hamilton_orbits import kepler as _kepler
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits.conic import Conic
-from hamilton_orbits.kepler import (
+from hamilton_orbits.quaternion import Quaternion
+from hamilton_orbits.twobody import (
     STATE_UNITS,
     check_state,
     classical_columns,
     refuse_beyond_range,
 )
-from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import (
     ANGLE,
     DIMENSIONLESS,
@@ -227,7 +227,7 @@ class KeplerOrbit:
         :meth:`from_elements`.
 
         ``state``: float64 array (..., 7), ``[rx, ry, rz, vx, vy, vz, mu]``
-        (:func:`hamilton_orbits.kepler.check_state`), that the orbit keeps and
+        (:func:`hamilton_orbits.twobody.check_state`), that the orbit keeps and
         never writes to; ``quantity``: whether it was built from Quantities;
         ``classical``: its ``CLASSICAL`` columns, shape (NCLASSICAL, ...), if
         already known."""
@@ -272,7 +272,7 @@ class KeplerOrbit:
         The state is the representation; the elements are derived from it.  Any
         finite state is accepted at any scale (it is brought to order 1 by powers
         of two inside the kernels, which is exact).  The state is checked by
-        :func:`hamilton_orbits.kepler.check_state`; one orbit given as plain
+        :func:`hamilton_orbits.twobody.check_state`; one orbit given as plain
         floats (``r``, ``v`` three floats each, ``mu`` a float) is checked and
         its classical elements computed in one kernel call instead
         (:func:`hamilton_orbits._kernels.elements.one_orbit`, the same rule and

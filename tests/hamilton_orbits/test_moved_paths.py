@@ -15,6 +15,8 @@ MOVED = [
     *[("hamilton_orbits.nbody", name, "hamilton_orbits.integrals")
       for name in ("LostStateError", "accelerations_quaternion", "energy_gm_many",
                    "integral_errors")],
+    *[("hamilton_orbits.kepler", name, "hamilton_orbits.twobody")
+      for name in ("STATE_UNITS", "check_state", "classical_columns", "refuse_beyond_range")],
     *[(f"hamilton_orbits.{module}", name, f"hamilton_orbits.studies.{module}")
       for module, names in (
           ("report", ("SETTINGS", "Row", "build_report", "fmt_time", "log", "timed")),
