@@ -32,6 +32,7 @@ HEAVY = (
     "hamilton_orbits._body",
     "hamilton_orbits.initial_states",
     "hamilton_orbits.integrals",
+    "hamilton_orbits.studies",
     "hamilton_orbits.scene",
     "hamilton_orbits.simulation",
     "hamilton_orbits.rebound_bridge",
