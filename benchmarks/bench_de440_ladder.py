@@ -2,7 +2,7 @@
 
     PYTHONPATH=src python benchmarks/bench_de440_ladder.py [--years 100] [--repeat 3]
 
-Every rung (:data:`hamilton_orbits.ladder.RUNGS`) starts from DE440's own state at
+Every rung (:data:`hamilton_orbits.studies.ladder.RUNGS`) starts from DE440's own state at
 J2000 (ICRF), integrates with ``radau15`` for 100 years and compares heliocentric
 positions (the Moon: geocentric) with DE440's, every Julian year.  Prints the table
 of residuals after 10, 50 and 100 years (km, and arcsec as seen from the Sun; the
@@ -26,7 +26,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from hamilton_orbits import ladder  # noqa: E402
+from hamilton_orbits.studies import ladder  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results"
 GOALS_KM = {"mercury": 1, "venus": 1, "earth-moon-barycenter": 3, "mars": 3, "jupiter": 5,

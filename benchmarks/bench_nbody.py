@@ -24,7 +24,7 @@ loading the numba cache, or compiling when there is none) is reported apart.
    0) over dt, and heyoka's Taylor integrator where installed (its best
    setting here: high_accuracy=True, compact_mode=False, over tol); error = max
    over planets of the heliocentric position error over the distance against
-   radau15 in double-double at 1 day (hamilton_orbits.reference, cached),
+   radau15 in double-double at 1 day (hamilton_orbits.studies.reference, cached),
    whose own uncertainty (its distance from 2 days) is printed beside every
    error; CPU time, the shortest of 2 runs; and the CPU time each code needs
    to reach 1e-6, 1e-8, 1e-10.  Written to
@@ -449,10 +449,10 @@ def _time_to_reach(points, target):
 
 
 def bench_work_precision(years: float, repeat: int = 2) -> None:
-    """Work-precision against radau15 in double-double (hamilton_orbits.reference),
+    """Work-precision against radau15 in double-double (hamilton_orbits.studies.reference),
     whose own uncertainty (its distance from the run at twice the step) is
     printed beside the errors; CPU time, the shortest of ``repeat`` runs."""
-    from hamilton_orbits.reference import reference
+    from hamilton_orbits.studies.reference import reference
 
     r0, v0, gm = solar_system()
     t_end = 8.0 * math.floor(years * 365.25 / 8.0)  # a multiple of every fixed dt below

@@ -242,7 +242,7 @@ def _check_analyses(analyses: list, names: list[str], problems: S.Problems) -> N
 
 
 def _check_initial(init: dict, problems: S.Problems) -> None:
-    from hamilton_orbits.nbody import solar_system_bodies, solar_system_epoch
+    from hamilton_orbits.initial_states import solar_system_bodies, solar_system_epoch
 
     given = [k for k in ("solar_system", "ephemeris", "rebound") if init.get(k) is not None]
     if len(given) > 1:
@@ -636,7 +636,7 @@ def _plot_megno(result: Result):
 def _result(scene: Any, system, out, method: str, effects) -> Result:
     """The :class:`Result` of an engine run: states, Hamilton's integrals, figures,
     and the final state as a rebound binary."""
-    from hamilton_orbits.nbody import integral_errors
+    from hamilton_orbits.integrals import integral_errors
 
     gm = system.as_arrays().gm.copy()
     extra = _effects.effect_energy(system, effects, out.r, out.v)
@@ -763,7 +763,7 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
     """The positions against DE440's at the whole years from J2000 among the outputs:
     km and arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100
     years (those reached), and a figure of the residual against time."""
-    from hamilton_orbits.ladder import BODIES, residuals
+    from hamilton_orbits.studies.ladder import BODIES, residuals
 
     years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start (J2000)
     whole = np.flatnonzero(np.abs(years - np.round(years)) < 1e-9)
@@ -798,7 +798,7 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
 def _plot_de440(result: Result):
     import matplotlib.pyplot as plt
 
-    from hamilton_orbits.ladder import BODIES
+    from hamilton_orbits.studies.ladder import BODIES
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
     years = result.diagnostics["de440_years"]

@@ -360,7 +360,7 @@ def ensemble_table(rows: Sequence[dict], varied: Sequence[str]) -> str:
 
 def _report(quick: bool, out: str | None, progress: bool) -> int:
     from hamilton_orbits._outdir import OutputFolder
-    from hamilton_orbits.report import build_report
+    from hamilton_orbits.studies.report import build_report
 
     folder = out if out else "hamilton-orbits-output/report"
     with OutputFolder(folder, "--out" if out else "output folder"):

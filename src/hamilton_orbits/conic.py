@@ -33,7 +33,7 @@ import numpy as np
 
 from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits.kepler import STATE_UNITS, check_state, classical_columns
+from hamilton_orbits.twobody import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
 from hamilton_orbits.validation import check_trailing, first_index, fmt_index
 
@@ -198,9 +198,9 @@ class Conic:
 
         The state is checked as :meth:`KeplerOrbit.from_state
         <hamilton_orbits.orbit.KeplerOrbit.from_state>` checks it
-        (:func:`hamilton_orbits.kepler.check_state`; Quantities in give a
+        (:func:`hamilton_orbits.twobody.check_state`; Quantities in give a
         conic of Quantities), and the elements are the orbit's
-        (:func:`hamilton_orbits.kepler.classical_columns`).
+        (:func:`hamilton_orbits.twobody.classical_columns`).
 
         Examples
         --------

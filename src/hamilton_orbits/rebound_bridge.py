@@ -22,7 +22,8 @@ from hamilton_orbits.effects import (
     effect_energy,
     get,
 )
-from hamilton_orbits.nbody import System, integral_errors
+from hamilton_orbits.integrals import integral_errors
+from hamilton_orbits.nbody import System
 
 __all__ = [
     "CrossCheck",

@@ -35,8 +35,9 @@ from hamilton_orbits import engine
 from hamilton_orbits.effects import EffectSet, effect_energy, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.firstrun import compile_seconds
+from hamilton_orbits.integrals import integral_errors
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
-from hamilton_orbits.nbody import DAY, System, integral_errors
+from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
 from hamilton_orbits.trajectory import Trajectory, event_table
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity

@@ -111,7 +111,7 @@ class Trajectory(TrajectoryBase):
         ``(E(t) - E(0)) / |E(0)|`` (law of vis viva, (E)), with the listed effects'
         energies where they keep one (``gr``, ``gr_potential``, ``j2``); with one
         massive body, the test particles' specific orbital energies about it
-        (:func:`~hamilton_orbits.nbody.integral_errors`); ``E(0)`` at the start of
+        (:func:`~hamilton_orbits.integrals.integral_errors`); ``E(0)`` at the start of
         the simulation.
     angular_momentum_error : ndarray, shape (n_t,)
         ``|L(t) - L(0)| / |L(0)|`` (law of areas, (D)); absolute if ``L(0) = 0``.

@@ -1,7 +1,7 @@
 """The ``rigid`` problems of ``hamilton-orbits report``: the free rigid body and the
 rigid-Earth pole wander (entry point ``hamilton_orbits.report_problems``).
 
-See :mod:`hamilton_orbits.report` for the measures and the output.
+See :mod:`hamilton_orbits.studies.report` for the measures and the output.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.report import Row, log, timed
+from hamilton_orbits.studies.report import Row, log, timed
 
 
 def problems() -> list[tuple[str, Any]]:

@@ -126,7 +126,7 @@ def test_orbit_conic_matches_state():
 
 @pytest.mark.parametrize("quantity", [False, True])
 def test_conic_from_state_and_from_elements_equal_the_orbits(quantity):
-    """Conic.from_state (built on kepler.check_state and classical_columns, not
+    """Conic.from_state (built on twobody.check_state and classical_columns, not
     on KeplerOrbit) and Conic.from_elements of the orbit's floats give the
     orbit's conic bit for bit, units included."""
     r, v = _states(1.5)

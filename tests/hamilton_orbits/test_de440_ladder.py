@@ -14,7 +14,7 @@ import functools
 import numpy as np
 import pytest
 
-from hamilton_orbits import ladder
+from hamilton_orbits.studies import ladder
 
 
 @functools.cache
@@ -90,7 +90,7 @@ def test_the_bundled_scene_is_the_top_rung():
     import astropy.units as u
 
     from hamilton_orbits import Scene
-    from hamilton_orbits.ladder import BODIES, RUNGS, run_rung
+    from hamilton_orbits.studies.ladder import BODIES, RUNGS, run_rung
 
     result = Scene.bundled("de440-century").with_values({"duration": "10 yr"}).run(
         progress=False)

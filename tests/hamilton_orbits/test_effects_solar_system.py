@@ -83,7 +83,7 @@ def _eih_energy_drift(years: float) -> tuple[float, float]:
     v = tr.v.to_value(u.au / u.day)
     gm = s.gm.to_value(u.au**3 / u.day**2)
     e = np.array([eih_energy(r[k], v[k], gm, C_AU_DAY) for k in range(len(r))])
-    from hamilton_orbits.nbody import energy_gm_many
+    from hamilton_orbits.integrals import energy_gm_many
 
     newton = energy_gm_many(r, v, gm)
     return float(np.abs(e / e[0] - 1).max()), float(np.abs(newton / newton[0] - 1).max())

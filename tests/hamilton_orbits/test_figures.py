@@ -165,7 +165,7 @@ def test_gr_energy_is_the_conserved_1pn_quantity(mercury):
     the 1PN terms is kept to rounding (1e-13: 41 orbits of ~1e-15 each)."""
     assert "1PN" in mercury.metrics["energy"]
     assert mercury.metrics["max |relative energy error|"] < 1e-13
-    from hamilton_orbits.nbody import integral_errors
+    from hamilton_orbits.integrals import integral_errors
 
     r = mercury.states["r"].to_value(u.au)
     v = mercury.states["v"].to_value(u.au / u.d)

@@ -23,10 +23,10 @@ from hamilton_orbits import ConvergenceError, solve_kepler
 from hamilton_orbits._kernels import kepler as K
 from hamilton_orbits.kepler import (
     anomaly_from_true,
-    check_state,
     mean_anomaly,
     true_from_anomaly,
 )
+from hamilton_orbits.twobody import check_state
 
 EPS = np.finfo(float).eps
 
@@ -405,7 +405,7 @@ def test_propagate_uv_inline_is_propagate_uv():
 
 
 def test_check_state_copies_and_broadcasts():
-    """kepler.check_state: one fresh C-contiguous float64 array (..., 7) of the
+    """twobody.check_state: one fresh C-contiguous float64 array (..., 7) of the
     broadcast leading shape, [r, v, mu] per state."""
     r = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
     v = np.array([0.0, 1.0, 0.0])

@@ -10,7 +10,8 @@ import pytest
 
 from hamilton_orbits import Body, System
 from hamilton_orbits._kernels import nbody as kernels
-from hamilton_orbits.nbody import SOLAR_SYSTEM_GM, accelerations_quaternion
+from hamilton_orbits.initial_states import SOLAR_SYSTEM_GM
+from hamilton_orbits.integrals import accelerations_quaternion
 from hamilton_orbits.rebound_bridge import from_rebound, rebound_accelerations, to_rebound
 
 EPS = np.finfo(float).eps

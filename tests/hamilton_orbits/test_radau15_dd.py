@@ -14,8 +14,8 @@ from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits._kernels import radau15_dd as _dd
 from hamilton_orbits.events import EventLog
 from hamilton_orbits.integrators import radau15
-from hamilton_orbits.reference import reference
 from hamilton_orbits.rhs import compile_rhs, newtonian_rhs
+from hamilton_orbits.studies.reference import reference
 
 D = decimal.Decimal
 

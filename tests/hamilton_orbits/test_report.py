@@ -8,7 +8,7 @@ from html.parser import HTMLParser
 
 import pytest
 
-from hamilton_orbits.report import build_report
+from hamilton_orbits.studies.report import build_report
 
 
 def _tool(name: str):
@@ -198,7 +198,7 @@ def test_every_peer_is_given_its_best_setting_and_says_so(report):
     its best setting for the solar system, and the report says how each code is set."""
     import importlib.util
 
-    from hamilton_orbits.report import SETTINGS
+    from hamilton_orbits.studies.report import SETTINGS
 
     out, _ = report
     text = (out / "report.md").read_text(encoding="utf-8")

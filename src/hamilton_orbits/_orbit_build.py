@@ -1,0 +1,158 @@
+"""The pieces of :meth:`hamilton_orbits.orbit.KeplerOrbit.from_elements`: the elements
+checked and as floats (:func:`element_inputs`), ``p`` and ``1/a``
+(:func:`p_and_inv_a`), the anomaly (:func:`anomaly_of`) and the state they give
+(:func:`state_of`); and :func:`raise_at`, the error naming an argument's first bad
+index, which Hamilton's products (:mod:`hamilton_orbits._hamilton_products`) share.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hamilton_orbits._lazy import LazyModule
+from hamilton_orbits.twobody import STATE_UNITS
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, is_quantity
+from hamilton_orbits.validation import (
+    ConvergenceError,
+    broadcast,
+    check_positive,
+    first_index,
+    fmt_index,
+)
+
+# numba is imported on first use (hamilton_orbits._lazy)
+_el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
+_kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
+
+__all__ = ["anomaly_of", "element_inputs", "p_and_inv_a", "raise_at", "state_of"]
+
+# internal units when Quantities come in
+_L, _MU = STATE_UNITS[0], STATE_UNITS[2]
+
+
+def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
+    """Raise ValueError naming ``name``, the first index where ``mask`` and its value."""
+    if np.any(mask):
+        mask = np.atleast_1d(mask)
+        values = np.broadcast_to(np.atleast_1d(values), mask.shape)
+        index = first_index(mask)
+        shown = index if np.ndim(mask) and mask.size > 1 else ()
+        raise ValueError(
+            f"Expected `{name}` {what}, got {float(values[index])!r}{fmt_index(shown)}"
+        )
+
+
+def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
+    """The arguments of :meth:`KeplerOrbit.from_elements` checked and as floats.
+
+    ``lengths`` maps ``a``, ``p``, ``q`` and ``anomalies`` ``nu``, ``M`` to the
+    values given (None if not); exactly one of each must be given.  Returns
+    ``(lname, length, aname, angle, e, inc, lan, argp, mu, quantity)``: the
+    name and value of the length and of the anomaly given, and every value as
+    float arrays broadcast together (km and km^3/s^2 if ``quantity``), with
+    ``e >= 0``, ``mu > 0`` and ``inc`` in [0, pi] checked."""
+    if sum(x is not None for x in lengths.values()) != 1:
+        raise ValueError("Expected exactly one of `a`, `p`, `q`")
+    if sum(x is not None for x in anomalies.values()) != 1:
+        raise ValueError("Expected exactly one of `nu`, `M`")
+    lname, lval = next((k, x) for k, x in lengths.items() if x is not None)
+    aname, aval = next((k, x) for k, x in anomalies.items() if x is not None)
+    quantity = is_quantity(lval) or is_quantity(mu)
+    if quantity and not (is_quantity(lval) and is_quantity(mu)):
+        raise ValueError(
+            f"Expected `{lname}` and `mu` to be both Quantities or both plain floats"
+        )
+    values = broadcast(
+        ("e", "inc", "lan", "argp", "mu", lname, aname),
+        DIMENSIONLESS("e", e), ANGLE("inc", inc), ANGLE("lan", lan), ANGLE("argp", argp),
+        GM("mu", mu, _MU), LENGTH(lname, lval, _L), ANGLE(aname, aval),
+    )
+    e_, inc_, lan_, argp_, mu_, length, angle = values
+    raise_at("e", ~(e_ >= 0), e_, ">= 0")
+    check_positive("mu", mu_)
+    raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi]")
+    return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
+
+
+def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray):
+    """``(p, 1/a, radial)`` from ``a``, ``p`` or ``q`` (``lname``) and ``e``;
+    ``radial`` where ``e == 1`` with ``a`` given (the rectilinear orbit of that
+    energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0."""
+    if lname != "a":
+        raise_at(lname, ~(length > 0), length, "> 0")
+        p = length if lname == "p" else length * (1.0 + e)
+        return p, (1.0 - e) * (1.0 + e) / p, np.zeros(e.shape, dtype=bool)
+    raise_at("a", length == 0, length, "nonzero")
+    raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)")
+    raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)")
+    radial = e == 1.0
+    p = length * (1.0 - e) * (1.0 + e)
+    inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
+    return p, inv_a, radial
+
+
+def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray):
+    """The anomaly (E, D or F by ``e``) from ``nu`` or ``M`` (``aname``); NaN
+    for a radial orbit (its M is solved by :func:`_radial_from_mean`).
+    Refuses ``nu`` for a radial orbit or beyond the asymptote, and a Kepler
+    equation not solved (ConvergenceError)."""
+    if aname == "nu":
+        raise_at(
+            "nu", radial, angle, "to be replaced by `M` for a radial orbit (e == 1, a given)"
+        )
+        anom = np.asarray(_kk.anomaly_from_nu_ufunc(angle, e))
+        raise_at("nu", ~np.isfinite(anom), angle, "inside the asymptotes (1 + e cos nu > 0)")
+        return anom
+    with np.errstate(invalid="ignore"):
+        anom = np.asarray(_kk.solve_ufunc(angle, np.where(radial, 0.0, e)))
+    bad = ~np.isfinite(anom) & ~radial
+    if np.any(bad):
+        index = first_index(np.atleast_1d(bad))
+        raise ConvergenceError(
+            f"Kepler's equation not solved for `M` = "
+            f"{float(np.atleast_1d(angle)[index])!r}{fmt_index(index if bad.ndim else ())}"
+        )
+    return anom
+
+
+def state_of(p, e, inv_a, inc, lan, argp, anom, radial, mu, m):
+    """The state (..., 7) of the elements (one compiled pass; radial orbits
+    from their mean anomaly ``m``)."""
+    shape = e.shape
+    el = np.stack(
+        [p * 1.0, e * 1.0, inv_a * 1.0, inc, lan, argp, np.where(radial, 0.0, anom)],
+        axis=-1,
+    ).reshape(-1, 7)
+    flat_mu = np.ascontiguousarray(mu.reshape(-1), dtype=np.float64)
+    state = np.empty((*shape, 7))
+    rows = state.reshape(-1, 7)
+    rows[:, 6] = flat_mu
+    r_out, v_out = rows[:, :3], rows[:, 3:6]
+    el[:, 0] = np.where(radial.reshape(-1), 0.0, el[:, 0])
+    _el.elements_to_state(np.ascontiguousarray(el), flat_mu, r_out, v_out)
+    if np.any(radial):
+        _radial_from_mean(el, flat_mu, m.reshape(-1), radial.reshape(-1), r_out, v_out)
+    return state
+
+
+def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
+    """States of radial orbits from their mean anomaly (in place).
+
+    Kepler's equation of the rectilinear orbit (e = 1, a finite),
+    ``E - sin E = M`` or ``sinh F - F = M``, is solved directly
+    (:func:`hamilton_orbits._kernels.kepler.solve_radial`), and the state is
+    ``r = a (1 - cos E) = 2 a sin^2(E/2)`` (``|a| (cosh F - 1)``) on the line, so
+    that a tiny M keeps full relative precision (E ~ (6 M)^(1/3)).
+    """
+    idx = np.flatnonzero(radial)
+    mm = m[idx]
+    rows = np.ascontiguousarray(el[idx])
+    bound = rows[:, 2] > 0
+    raise_at("M", bound & ~((mm > -np.pi) & (mm <= np.pi)), mm, "in (-pi, pi] for a radial orbit")
+    rows[:, 0] = 0.0
+    rows[:, 6] = _kk.solve_radial_ufunc(mm, rows[:, 2])
+    r1 = np.empty((idx.size, 3))
+    v1 = np.empty((idx.size, 3))
+    _el.elements_to_state(rows, np.ascontiguousarray(mu[idx]), r1, v1)
+    r_out[idx] = r1
+    v_out[idx] = v1
