@@ -109,7 +109,7 @@ class Simulation:
     >>> leg = sim.integrate(2 * np.pi)   # on to t = 2 pi: continues the same steps
     >>> once = Simulation(s, method="wh", dt=0.01).integrate([np.pi, 2 * np.pi])
     >>> bool(np.array_equal(leg.r[-1], once.r[-1])), sim.t, sim.steps
-    (True, 6.283185307179586, 629)
+    (True, 6.283185307179586, 630)
     >>> branch = sim.copy()              # an independent copy, for ensembles
     >>> _ = branch.integrate(3 * np.pi)
     >>> sim.t, branch.t
