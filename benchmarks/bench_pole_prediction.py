@@ -1,4 +1,4 @@
-"""The full hindcast of rigid.pole_prediction: five methods, two periods, timed.
+"""The full hindcast of rigid.earth.prediction: five methods, two periods, timed.
 
 Run ``PYTHONPATH=src python benchmarks/bench_pole_prediction.py [--out FILE]``.
 
@@ -23,9 +23,9 @@ from pathlib import Path
 import astropy.units as u
 import numpy as np
 
+from rigid.earth.prediction import METHODS, PAPER_PERIOD, RECENT_PERIOD, hindcast, weekly_starts
+from rigid.earth.scene_pole_prediction import PUBLISHED, PUBLISHED_HORIZONS
 from rigid.polar_motion import load_c04
-from rigid.pole_prediction import METHODS, PAPER_PERIOD, RECENT_PERIOD, hindcast, weekly_starts
-from rigid.scene_prediction import PUBLISHED, PUBLISHED_HORIZONS
 
 HORIZONS = (10, 30, 90, 150, 270, 365)
 

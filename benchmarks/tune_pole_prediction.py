@@ -1,4 +1,4 @@
-"""How the constants of rigid.pole_prediction were chosen: hindcasts before the test periods.
+"""How the constants of rigid.earth.forecasters were chosen: hindcasts before the test periods.
 
 Run ``PYTHONPATH=src python benchmarks/tune_pole_prediction.py [--out FILE]``.
 
@@ -28,7 +28,7 @@ from pathlib import Path
 import astropy.units as u
 import numpy as np
 
-from rigid import pole_prediction as pp
+from rigid.earth import forecasters, prediction
 from rigid.polar_motion import load_c04
 
 Y = 365.25
@@ -66,19 +66,20 @@ def cells(record, method: str, starts) -> np.ndarray:
     """MAE (2 periods x 2 coordinates x 6 horizons) of ``method`` as configured now."""
     out = []
     for s in starts:
-        t = pp.hindcast(record, s, method=method).table
+        t = prediction.hindcast(record, s, method=method).table
         out.append([t["mae_x"].to_value(u.mas), t["mae_y"].to_value(u.mas)])
     return np.array(out)
 
 
 def setting(values: dict) -> None:
-    """Set module constants (``NAME``) or ``LS_SETTINGS`` entries (``method:key``)."""
+    """Set the constants (``NAME``) or ``LS_SETTINGS`` entries (``method:key``) of
+    :mod:`rigid.earth.forecasters`, where the methods read them."""
     for k, v in values.items():
         if ":" in k:
             method, key = k.split(":")
-            pp.LS_SETTINGS[method][key] = v
+            forecasters.LS_SETTINGS[method][key] = v
         else:
-            setattr(pp, k, v)
+            setattr(forecasters, k, v)
 
 
 def main(argv: list[str] | None = None) -> str:
@@ -86,10 +87,10 @@ def main(argv: list[str] | None = None) -> str:
     parser.add_argument("--out", default="benchmarks/results/tune_pole_prediction.md")
     args = parser.parse_args(argv)
     record = load_c04()
-    starts = [pp.weekly_starts(*p) for p in PERIODS]
+    starts = [prediction.weekly_starts(*p) for p in PERIODS]
     setting(FIRST_CUT)
     ref = cells(record, "ls+ar", starts)
-    lines = ["# Tuning rigid.pole_prediction (benchmarks/tune_pole_prediction.py)", "",
+    lines = ["# Tuning rigid.earth.forecasters (benchmarks/tune_pole_prediction.py)", "",
              f"Start dates: {', '.join(f'{a} .. {b}' for a, b in PERIODS)} "
              f"({sum(len(s) for s in starts)} weekly starts); score = mean MAE / MAE(ls+ar, "
              "first cut) over periods, coordinates and horizons 10-365 d (lower is better).", ""]

@@ -1,7 +1,7 @@
 """Where will the pole be next year?  Prediction methods hindcast against the IERS record.
 
-Runs the bundled scene ``pole-prediction`` (rigid.scene_prediction): five methods of
-rigid.pole_prediction (persistence, least-squares harmonics "ls", "ls+ar", "ls+var" and
+Runs the bundled scene ``pole-prediction`` (rigid.earth.scene_pole_prediction): five methods
+of rigid.earth.prediction (persistence, least-squares harmonics "ls", "ls+ar", "ls+var" and
 the Liouville equation with a stochastic excitation, "liouville") predict the pole from
 2019-01-01, and are hindcast from weekly start dates over the period assumed for Lei et
 al. (2023, Artificial Satellites 58, 42; the 1st EOP PCC's Oct 2005 - Mar 2008) and over
@@ -26,7 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from hamilton_orbits import Scene
-from rigid.scene_prediction import PUBLISHED, PUBLISHED_HORIZONS
+from rigid.earth.scene_pole_prediction import PUBLISHED, PUBLISHED_HORIZONS
 
 
 def verdict(result) -> list[str]:

@@ -7,7 +7,7 @@ Everything here works on plain floats (SI for the rigid body, days for the pole)
 * :func:`free_flow_scaled`: the exact torque-free kernel on such a scaled
   problem (used by :mod:`rigid.free` and :mod:`rigid.poinsot`);
 * :func:`positive_scalar`: the check of a positive scalar parameter (used by
-  :mod:`rigid.liouville` and :mod:`rigid.wobble`).
+  :mod:`rigid.earth.liouville` and :mod:`rigid.earth.wobble_fit`).
 
 Nothing here imports another ``rigid`` module but the kernels, so every module
 of the package may import it without an import circle.

@@ -62,11 +62,16 @@ spaced outputs from 0 to it) or an array of output times from the body's state
 (a start at 0 is added if missing).  Where the caller gave Quantities the
 result is in Quantities: ``t`` in the unit of the ``t`` given, omega in rad/s,
 moments in kg m^2; plain floats are SI.
+
+This module is the public layer (validation once, units, the deprecated keywords);
+each method runs on plain arrays in :mod:`rigid.drivers` (:func:`integrate_arrays`,
+re-exported here), and the splittings' compositions (:data:`~rigid.splitting.BM_A`,
+:data:`~rigid.splitting.BM_B`, :data:`~rigid.splitting.YOSHIDA_W`) are
+:mod:`rigid.splitting`.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 import warnings
@@ -75,13 +80,13 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.integrators import dop853
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
 from hamilton_orbits.validation import check_positive
-from rigid._kernels import euler as _k
 from rigid.body import call_units, check_body
+from rigid.drivers import METHODS, integrate_arrays
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
+from rigid.splitting import BM_A, BM_B, SPLITTINGS, YOSHIDA_W  # noqa: F401  (their old home)
 from rigid.trajectory import RigidTrajectory, integral_errors
 
 __all__ = [
@@ -94,10 +99,7 @@ __all__ = [
     "integrate_arrays",
 ]
 
-METHODS = ("splitting2", "splitting4", "splitting4y", "exact_kick", "dop853", "rk4",
-           "cayley_rk4")
-_SPLITTINGS = ("splitting2", "splitting4", "splitting4y")
-_FIXED = (*_SPLITTINGS, "exact_kick", "rk4", "cayley_rk4")
+_FIXED = (*SPLITTINGS, "exact_kick", "rk4", "cayley_rk4")
 
 
 _MAX_STEPS = 1e12  # beyond this a fixed-step run is a typo, not a plan (days of CPU)
@@ -117,291 +119,6 @@ def _n_out(n_out: Any) -> int:
     if not ok or n_out < 2 or n_out > 1e9:
         raise ValueError(f"Expected `n_out` to be an integer in [2, 1e9], got {n_out!r}")
     return int(n_out)
-
-
-def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]:
-    n_steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
-    h = t_end / n_steps
-    out_steps = np.unique(np.round(np.linspace(0.0, n_steps, n_out)).astype(np.int64))
-    return n_steps, h, out_steps
-
-
-def _progress_chunks(n_steps: int, progress: bool):
-    """Chunk boundaries (in steps) for an optional tqdm bar; one chunk without it."""
-    bar = _bar(n_steps, "step", progress)
-    if bar is None:
-        return [0, n_steps], None
-    return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
-
-
-# Yoshida (1990, Phys. Lett. A 150, 262, eq. 5.4) triple jump: a symmetric
-# second-order map S2 composed as S2(w1 h) S2(w0 h) S2(w1 h) is of order four.
-_CBRT2 = 2.0 ** (1.0 / 3.0)
-YOSHIDA_W = (1.0 / (2.0 - _CBRT2), -_CBRT2 / (2.0 - _CBRT2), 1.0 / (2.0 - _CBRT2))
-
-# Blanes & Moan (2002), J. Comput. Appl. Math. 142, 313-330, Table 2, method
-# S6 (order 4, 6 stages, symmetric): for H = A + B,
-#   e^{a1 A} e^{b1 B} e^{a2 A} e^{b2 B} e^{a3 A} e^{b3 B} e^{a4 A} e^{b3 B} ... e^{a1 A},
-# a4 = 1 - 2 (a1 + a2 + a3), b3 = 1/2 - (b1 + b2).
-BM_A = (0.0792036964311957, 0.353172906049774, -0.0420650803577195)
-BM_B = (0.209515106613362, -0.143851773179818)
-_BM_A = (*BM_A, 1.0 - 2.0 * sum(BM_A), *BM_A[::-1])
-_BM_B = (*BM_B, 0.5 - sum(BM_B), 0.5 - sum(BM_B), *BM_B[::-1])
-
-
-def _bm_lie_coefficients() -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """S6 as a composition Phi*_{d6} Phi_{c6} ... Phi*_{d1} Phi_{c1} (c_i, d_i).
-
-    With Phi_c = e^{cB} e^{cA} (A first) and Phi*_d = e^{dA} e^{dB} its adjoint,
-    the product runs A(c1) B(c1 + d1) A(d1 + c2) ... B(c6 + d6) A(d6): so
-    c1 = a1, d_i = b_i - c_i, c_{i+1} = a_{i+1} - d_i (McLachlan 1995, SIAM J.
-    Sci. Comput. 16, 151; Hairer, Lubich & Wanner, GNI, sec. III.5).  With Phi
-    the Lie-Trotter product of *any* number of exact flows, this composition is
-    of order 4 (its order conditions coincide with those of the two-part
-    splitting up to order 4; checked by the halving tests).
-    """
-    c: list[float] = []
-    d: list[float] = []
-    prev = 0.0
-    for a, b in zip(_BM_A[:6], _BM_B, strict=True):
-        c.append(a - prev)
-        d.append(b - c[-1])
-        prev = d[-1]
-    return tuple(c), tuple(d)
-
-
-_BM_C, _BM_D = _bm_lie_coefficients()
-
-_KICK = 3
-_CASIMIR = 4
-
-
-def _strang(w: float, torqued: bool) -> list[tuple[int, float]]:
-    """S2(w h) = K(w/2) R1(w/2) R2(w/2) R3(w) R2(w/2) R1(w/2) K(w/2)."""
-    ops = [(0, 0.5 * w), (1, 0.5 * w), (2, w), (1, 0.5 * w), (0, 0.5 * w)]
-    return [(_KICK, 0.5 * w), *ops, (_KICK, 0.5 * w)] if torqued else ops
-
-
-def _split_ops(
-    method: str, moments: np.ndarray, torqued: bool
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(types, fractions of h, time offsets in h, inverse moments) of one step.
-
-    Types 0-2 are principal-axis rotations, 3 a torque kick, 4 the Casimir flow
-    (see :func:`rigid._kernels.euler.run_splitting`).
-    """
-    inv = np.concatenate([1.0 / moments, [0.0, 0.0]])  # axes 0-2, (kick), Casimir
-    # Time (for time-dependent torques) is carried by one part: the one with the
-    # full step in the Strang splitting, the Casimir flow in "splitting4".
-    time_part = 2
-    if method == "splitting2":
-        ops = _strang(1.0, torqued)
-    elif method == "splitting4y":
-        ops = [op for w in YOSHIDA_W for op in _strang(w, torqued)]
-    elif method == "splitting4":
-        # T = |L|^2 / (2 I_m) + sum over the two other axes of (1/I_k - 1/I_m) L_k^2 / 2,
-        # I_m the middle moment: the Casimir part commutes with everything (free
-        # body) and the two axis parts are smaller than 1/I_k.  S6 of Blanes &
-        # Moan on the two axis parts, in its Lie-Trotter/adjoint form; with a
-        # torque the Lie-Trotter product is kick, axis, Casimir, axis.
-        ref = int(np.argsort(moments, kind="stable")[1])
-        inv[:3] -= 1.0 / moments[ref]
-        inv[_CASIMIR] = 1.0 / moments[ref]
-        ax = [k for k in range(3) if k != ref]
-        parts = [_KICK, ax[0], _CASIMIR, ax[1]] if torqued else ax
-        ops = []
-        for c, d in zip(_BM_C, _BM_D, strict=True):
-            ops += [(p, c) for p in parts]  # Phi_c
-            ops += [(p, d) for p in parts[::-1]]  # Phi*_d
-        if not torqued:  # the Casimir flow commutes: one per step
-            ops.insert(len(ops) // 2, (_CASIMIR, 1.0))
-        time_part = _CASIMIR
-    else:  # pragma: no cover - guarded by the callers
-        raise ValueError(method)
-    fused: list[list[float]] = []
-    for typ, fr in ops:  # flows of the same part commute: fuse neighbours
-        if fused and fused[-1][0] == typ:
-            fused[-1][1] += fr
-        else:
-            fused.append([typ, fr])
-    types = np.array([int(t) for t, _ in fused], dtype=np.int64)
-    fracs = np.array([fr for _, fr in fused])
-    toffs = np.concatenate([[0.0], np.cumsum(np.where(types == time_part, fracs, 0.0))[:-1]])
-    return types, fracs, toffs, inv
-
-
-def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress):
-    types, fracs, toffs, inv = _split_ops(method, m, kind != _k.TORQUE_NONE)
-    qh = q0.copy()
-    ql = np.zeros(4)
-    lh = m * w0
-    ll = np.zeros(3)
-    nout = out_steps.shape[0]
-    q_out = np.empty((nout, 4))
-    l_out = np.empty((nout, 3))
-    drift = 0.0
-    pending = False
-    bounds, bar = _progress_chunks(n_steps, progress)
-    for a, b in itertools.pairwise(bounds):
-        sel = (out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b)
-        idx = np.nonzero(sel)[0]
-        qo = np.empty((idx.size, 4))
-        lo = np.empty((idx.size, 3))
-        d, pending = _k.run_splitting(types, fracs, toffs, inv, m, qh, ql, lh, ll, a * h, h,
-                                      b - a, out_steps[idx] - a, kind, params, qo, lo,
-                                      pending, b < n_steps)
-        drift = max(drift, float(d))
-        q_out[idx] = qo
-        l_out[idx] = lo
-        if bar is not None:
-            bar.update(b - a)
-    if bar is not None:
-        bar.close()
-    return q_out, l_out / m, drift
-
-
-def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
-    quat = q0.copy()
-    omega = w0.copy()
-    nout = out_steps.shape[0]
-    q_out = np.empty((nout, 4))
-    w_out = np.empty((nout, 3))
-    bounds, bar = _progress_chunks(n_steps, progress)
-    for a, b in itertools.pairwise(bounds):
-        idx = np.nonzero((out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b))[0]
-        qo = np.empty((idx.size, 4))
-        wo = np.empty((idx.size, 3))
-        _k.run_exact_kick(m, quat, omega, a * h, h, b - a, out_steps[idx] - a, kind, params,
-                          qo, wo)
-        q_out[idx] = qo
-        w_out[idx] = wo
-        if bar is not None:
-            bar.update(b - a)
-    if bar is not None:
-        bar.close()
-    return q_out, w_out
-
-
-def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress):
-    """``(q, omega, count, drift)`` of a fixed-step method on the step grid."""
-    count = 0
-    drift = 0.0
-    if method in _SPLITTINGS:
-        q, w, drift = _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params,
-                                     progress)
-    elif method == "exact_kick":
-        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress)
-    elif method == "rk4":
-        y = np.empty((out_steps.size, 7))
-        _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
-                              params, y)
-        qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
-        drift = float(np.max(np.abs(qn - 1.0)))
-        q, w = y[:, :4] / qn[:, None], y[:, 4:]
-    elif method == "cayley_rk4":
-        y = np.empty((out_steps.size, 7))
-        count = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
-                                      recentre, y))
-        q, w = y[:, :4], y[:, 4:]
-    else:
-        raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
-    return q, w, count, drift
-
-
-def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
-    """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver
-    (:func:`hamilton_orbits.integrators.dop853.solve`, dense output)."""
-    bar = _bar(t_out.size - 1, "output", progress)
-    y, steps, nfev = dop853.solve(
-        lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
-        t_out, rtol=rtol, atol=atol, max_step=max_step, restart=False,
-        on_output=None if bar is None else (lambda i, n: bar.update(1)),
-    )
-    if bar is not None:
-        bar.close()
-    qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
-    drift = float(np.max(np.abs(qn - 1.0)))
-    return y[:, :4] / qn[:, None], y[:, 4:].copy(), int(steps), int(nfev), drift
-
-
-def _bar(total: int, unit: str, progress: bool) -> Any:
-    """A tqdm bar (the ``progress`` extra), or None."""
-    if not progress:
-        return None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover - optional extra
-        return None
-    return tqdm(total=total, unit=unit, leave=False)
-
-
-def _grid(t: np.ndarray, dt: float, n_out: int | None) -> tuple[int, float, np.ndarray]:
-    """``(n_steps, h, out_steps)`` of a fixed-step run: a whole number of steps of
-    ``h <= dt`` spans the last time; each output at the step nearest its time.
-
-    An end time ``t`` (0-d) takes ``n_out`` (default 101) equally spaced outputs,
-    as :func:`integrate` always did; an array of times takes one output each.
-    """
-    if t.ndim == 0:
-        return _steps(float(t), dt, 101 if n_out is None else n_out)
-    n_steps = max(1, math.ceil(float(t[-1]) / dt * (1.0 - 1e-12)))
-    h = float(t[-1]) / n_steps
-    out_steps = np.minimum(np.round(t / h).astype(np.int64), n_steps)
-    return n_steps, h, out_steps
-
-
-def integrate_arrays(
-    moments: np.ndarray,
-    q0: np.ndarray,
-    omega0: np.ndarray,
-    t: Any,
-    *,
-    method: str = "splitting4",
-    dt: float | None = None,
-    n_out: int | None = None,
-    kind: int = _k.TORQUE_NONE,
-    params: np.ndarray | None = None,
-    rtol: float = 1e-12,
-    atol: Any = 1e-14,
-    recentre: float = 1.0,
-    progress: bool = False,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float]:
-    """Kernel-level integration on plain float arrays (no validation, no units).
-
-    ``t`` is an end time (``n_out`` equally spaced outputs, default 101) or an
-    increasing array of output times starting at 0.  ``dt`` is the step of the
-    fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
-    (7,) for ``(q, omega)``) are DOP853's tolerances.
-
-    Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
-    with unit quaternions; ``t`` the times reached; ``count`` is the number of
-    re-centrings for ``"cayley_rk4"`` and of right-hand-side evaluations for
-    ``"dop853"``.  See :func:`integrate` for the methods.
-
-    Examples
-    --------
-    >>> t, q, w, steps, count, drift = integrate_arrays(
-    ...     np.array([1.0, 2.0, 3.0]), np.array([1.0, 0, 0, 0]), np.array([0.0, 0.0, 1.0]),
-    ...     np.array([0.0, 0.5, 1.0]), method="rk4", dt=0.1)
-    >>> t, steps, q[-1].round(6)  # a spin about z: q = (cos t/2, 0, 0, sin t/2), RK4
-    (array([0. , 0.5, 1. ]), 10, array([0.877583, 0.      , 0.      , 0.479426]))
-    """
-    params = np.zeros(1) if params is None else np.ascontiguousarray(params, dtype=np.float64)
-    m = np.ascontiguousarray(moments, dtype=np.float64)
-    q0 = np.ascontiguousarray(q0, dtype=np.float64)
-    q0 = q0 / np.sqrt(q0 @ q0)
-    w0 = np.ascontiguousarray(omega0, dtype=np.float64)
-    t_arr = np.asarray(t, dtype=np.float64)
-    if method == "dop853":
-        t_out = (np.linspace(0.0, float(t_arr), 101 if n_out is None else n_out)
-                 if t_arr.ndim == 0 else t_arr)
-        q, w, steps, nfev, drift = _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol,
-                                               np.inf if dt is None else float(dt), progress)
-        return t_out, q, w, steps, nfev, drift
-    n_steps, h, out_steps = _grid(t_arr, float(dt), n_out)
-    q, w, count, drift = _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params,
-                                    recentre, progress)
-    return out_steps * h, q, w, n_steps, count, drift
 
 
 _UNSET: Any = object()  # the default of the deprecated keywords

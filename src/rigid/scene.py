@@ -279,8 +279,12 @@ KIND = SceneKind(
 
 
 def register() -> None:
-    """Register the ``rotation`` and ``polar_motion`` scene kinds (entry point)."""
-    from rigid import scene_polar
+    """Register the ``rotation`` and ``polar_motion`` scene kinds (entry point).
+
+    The Earth-orientation kinds live in :mod:`rigid.earth.scene_polar_motion`
+    (which registers ``pole_prediction`` beside ``polar_motion``).
+    """
+    from rigid.earth import scene_polar_motion
 
     register_kind(KIND)
-    scene_polar.register()
+    scene_polar_motion.register()

@@ -1,11 +1,11 @@
-"""Vector autoregressions (rigid.ar_models): fit, forecast, impulse responses, error growth."""
+"""Vector autoregressions (rigid.earth.ar_models): fit, forecast, impulses, error growth."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rigid.ar_models import VARModel, accumulate_covariance, fit_var
+from rigid.earth.ar_models import VARModel, accumulate_covariance, fit_var
 
 A1 = np.array([[0.5, 0.2], [-0.1, 0.6]])
 A2 = np.array([[0.1, 0.0], [0.05, -0.2]])

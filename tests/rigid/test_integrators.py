@@ -16,8 +16,8 @@ from rigid import (
     integrate,
 )
 from rigid._kernels.euler import sin_versin
+from rigid.drivers import integrate_arrays
 from rigid.free import free_motion_arrays
-from rigid.integrators import integrate_arrays
 
 EPS = np.finfo(float).eps
 MOMENTS = np.array([1.0, 2.0, 3.0])

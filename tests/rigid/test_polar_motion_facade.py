@@ -1,9 +1,11 @@
-"""rigid.polar_motion is a facade over rigid.liouville, rigid.c04 and rigid.wobble (issue 19).
+"""rigid.polar_motion is a facade over the Earth-orientation modules of rigid.earth (issues 19, 30).
 
 Outside code calls ``polar_motion.load_c04()`` and friends and the
 ``hamilton_orbits.effects`` entry point names ``rigid.polar_motion:register_effects``:
-the facade keeps exactly its names.  And no module of ``rigid`` imports another
-in a circle, function-level imports included (earth <-> polar_motion was one).
+the facade keeps exactly its names, now served by ``rigid.earth.liouville``,
+``rigid.earth.c04``, ``rigid.earth.wobble_fit`` and ``rigid.earth.prediction``.  And no
+module of ``rigid`` imports another in a circle, function-level imports included
+(earth <-> polar_motion was one).
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ import importlib
 import importlib.metadata
 from pathlib import Path
 
-from rigid import c04, liouville, polar_motion, pole_prediction, wobble
+from rigid import polar_motion
+from rigid.earth import c04, liouville, prediction, wobble_fit
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -38,11 +41,11 @@ def test_facade_names_are_the_concept_modules_objects():
     assert sorted(polar_motion.__all__) == FACADE
     home = {"EFFECTS": liouville, "LiouvillePole": liouville, "register_effects": liouville,
             "PolarMotionRecord": c04, "load_c04": c04, "iers2010_mean_pole": c04,
-            "WobbleFit": wobble, "fit_wobble": wobble, "periodogram": wobble,
-            "free_period": wobble, "predict": pole_prediction, "hindcast": pole_prediction}
+            "WobbleFit": wobble_fit, "fit_wobble": wobble_fit, "periodogram": wobble_fit,
+            "free_period": wobble_fit, "predict": prediction, "hindcast": prediction}
     for name in FACADE:
         assert getattr(polar_motion, name) is getattr(home[name], name), name
-    assert liouville.free_period is wobble.free_period
+    assert liouville.free_period is wobble_fit.free_period
 
 
 def test_entry_point_still_registers_the_rotation_effects():
@@ -94,6 +97,15 @@ def test_no_import_circle_in_rigid():
     for m in sorted(graph):
         if m not in state:
             visit(m)
-    assert {"rigid.earth", "rigid.liouville", "rigid.wobble"} <= set(graph)
-    assert "rigid.liouville" not in graph["rigid.earth"]
-    assert importlib.import_module("rigid.earth").free_period is wobble.free_period
+    earth = {"rigid.earth", "rigid.earth.constants", "rigid.earth.liouville",
+             "rigid.earth.wobble_fit", "rigid.earth.prediction"}
+    assert earth <= set(graph)
+    # the constants stand below the Liouville pole, which takes its defaults from them
+    assert "rigid.earth.constants" in graph["rigid.earth.liouville"]
+    assert not graph["rigid.earth.constants"] & earth
+    # nothing in rigid.earth imports the facade (or the old paths) that stands on it
+    olds = {f"rigid.{m}" for m in ("polar_motion", "c04", "liouville", "wobble", "ar_models",
+                                   "pole_prediction", "scene_polar", "scene_prediction")}
+    for name in (m for m in graph if m.startswith("rigid.earth")):
+        assert not graph[name] & olds, name
+    assert importlib.import_module("rigid.earth.free_wobble").free_period is wobble_fit.free_period

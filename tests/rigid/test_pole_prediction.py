@@ -1,4 +1,4 @@
-"""Polar-motion prediction and hindcasts (rigid.pole_prediction, issue 25).
+"""Polar-motion prediction and hindcasts (rigid.earth.prediction, issue 25).
 
 The published bar (Lei et al. 2023, Artificial Satellites 58, 42, table of mean absolute
 errors; C04 only) and the campaigns' scoring (Kalarus et al. 2010; Śliwińska et al. 2022)
@@ -18,10 +18,8 @@ from astropy.time import Time
 from astropy.utils import iers
 
 from rigid import polar_motion
-from rigid.polar_motion import LiouvillePole, PolarMotionRecord, load_c04
-from rigid.pole_prediction import (
-    CHANDLER_PERIOD,
-    LS_SETTINGS,
+from rigid.earth.forecasters import CHANDLER_PERIOD, LS_SETTINGS
+from rigid.earth.prediction import (
     METHODS,
     PAPER_PERIOD,
     RECENT_PERIOD,
@@ -30,6 +28,7 @@ from rigid.pole_prediction import (
     propagate_pole,
     weekly_starts,
 )
+from rigid.polar_motion import LiouvillePole, PolarMotionRecord, load_c04
 
 AT = Time("2019-01-01")
 

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import guvectorize, njit
 
-from hamilton_orbits._kernels.quaternion import qmul, qrot
+from hamilton_orbits.quaternion_kernels import qmul, qrot
 from rigid._kernels.free import free_step
 
 TORQUE_NONE = 0
@@ -194,7 +194,7 @@ def torque_gufunc(moments, quat, t, kind, params, out):  # pragma: no cover - co
 # --------------------------------------------------------------------------
 #
 # A splitting method is a sequence of "ops" per step, built in Python
-# (rigid.integrators._split_ops): op type 0, 1, 2 is the exact flow of
+# (rigid.splitting.split_ops): op type 0, 1, 2 is the exact flow of
 # g L_axis^2 / 2 (a rotation about that principal axis; g = 1 / I_axis in the
 # plain splitting), type 3 the exact flow of the torque (a kick), type 4 that of
 # the Casimir part g |L|^2 / 2 (a rotation of the attitude about L).  Rounding

@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from hamilton_orbits._kernels.quaternion import qmul
+from hamilton_orbits.quaternion_kernels import qmul
 
 # Parameter-vector slots (public: the layout that free_setup writes).
 KIND = 0  # 0 steady (sphere, rest, rotation about a principal axis), 1 periodic, 2 separatrix

@@ -1,5 +1,7 @@
 """The Earth as a rigid body: cited constants, moments, the Euler and Chandler periods.
 
+Re-exported by :mod:`rigid.earth` (``rigid.earth.moments()``, ``rigid.earth.OMEGA``, ...).
+
 Constants (astropy Quantities) follow the IERS Conventions (2010), G. Petit &
 B. Luzum (eds.), IERS Technical Note 36, Table 1.1 (numerical standards):
 
@@ -32,18 +34,14 @@ Sylvester (1866, last paragraph) names exactly this use of the free rigid body:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import astropy.constants as const
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS, TIME
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS
 from rigid.body import RigidBody
-from rigid.free import free_motion
-from rigid.integrators import integrate
-from rigid.wobble import free_period
 
 __all__ = [
     "C22_BAR",
@@ -53,15 +51,12 @@ __all__ = [
     "R_EQ",
     "S22_BAR",
     "H",
-    "PolePath",
     "chandler_period",
     "euler_period",
     "mass",
     "moments",
-    "pole_path",
     "rigid_body",
     "secular_love_number",
-    "simulate_wobble",
 ]
 
 #: Geocentric gravitational constant (IERS Conventions 2010, Table 1.1).
@@ -243,124 +238,3 @@ def rigid_body(wobble: Any = 0.2 * u.arcsec, *, triaxial: bool = True) -> RigidB
     om = OMEGA.to_value(u.rad / u.s)
     omega = om * np.array([np.sin(float(w)), 0.0, np.cos(float(w))]) * u.rad / u.s
     return RigidBody(mom, omega=omega)
-
-
-def _float(x: Any, unit: u.UnitBase) -> np.ndarray:
-    """SI floats from a Quantity or from the SI floats of RigidBody/RigidTrajectory."""
-    if isinstance(x, u.Quantity):
-        return x.to_value(unit, equivalencies=u.dimensionless_angles())
-    return np.asarray(x, dtype=np.float64)
-
-
-def pole_path(omega: Any) -> np.ndarray:
-    """The rotation pole in the body frame, ``m = (omega_x + i omega_y) / omega_z``.
-
-    Parameters
-    ----------
-    omega : array_like or Quantity, shape (..., 3)
-        Body-frame angular velocity (rad/s if a Quantity).
-
-    Returns
-    -------
-    ndarray, complex, shape (...)
-        ``m = m1 + i m2`` in radians (IERS: ``x_p = m1``, ``y_p = -m2``).
-
-    Examples
-    --------
-    >>> pole_path([[1e-6, 0.0, 1.0], [0.0, -2e-6, 1.0]])
-    array([1.e-06+0.e+00j, 0.e+00-2.e-06j])
-    """
-    w = _float(omega, u.rad / u.s)
-    if w.shape[-1:] != (3,):
-        raise ValueError(f"Expected `omega` to have shape (..., 3), got {w.shape}")
-    return (w[..., 0] + 1j * w[..., 1]) / w[..., 2]
-
-
-@dataclass(frozen=True)
-class PolePath:
-    """A simulated pole path (see :func:`simulate_wobble`).
-
-    Attributes
-    ----------
-    t : Quantity, shape (n,), day
-        Output times.
-    m : ndarray, complex, shape (n,)
-        ``m1 + i m2`` in radians.
-    method : str
-        The integrator (``"splitting4"``, ``"exact"``, ...).
-    """
-
-    t: u.Quantity
-    m: np.ndarray
-    method: str
-
-    @property
-    def x(self) -> u.Quantity:
-        """``x_p = m1`` in arcsec."""
-        return (self.m.real * u.rad).to(u.arcsec)
-
-    @property
-    def y(self) -> u.Quantity:
-        """``y_p = -m2`` in arcsec."""
-        return (-self.m.imag * u.rad).to(u.arcsec)
-
-    def period(self) -> u.Quantity:
-        """The wobble period fitted to the path (see :func:`rigid.wobble.free_period`).
-
-        Examples
-        --------
-        >>> path = simulate_wobble(2 * u.yr, method="exact", triaxial=False)
-        >>> bool(abs(path.period() / euler_period() - 1) < 1e-10)
-        True
-        """
-        return free_period(self.t, self.m)
-
-
-def simulate_wobble(
-    duration: Any = 100 * u.yr,
-    *,
-    wobble: Any = 0.2 * u.arcsec,
-    dt: Any = 1 * u.hour,
-    method: str = "splitting4",
-    triaxial: bool = True,
-) -> PolePath:
-    """Integrate the free rigid Earth and return its pole path with daily output.
-
-    Parameters
-    ----------
-    duration : Quantity
-        Time span (default 100 years).
-    wobble : Quantity
-        Initial angle between the rotation and figure axes (default 0.2 arcsec).
-    dt : Quantity
-        Step of the fixed-step integrator (default 1 hour; ignored for
-        ``"exact"`` and ``"dop853"``).
-    method : str
-        A method of :func:`rigid.integrate`, or ``"exact"`` for
-        :func:`rigid.free_motion`.
-    triaxial : bool
-        Triaxial (default) or axisymmetric Earth.
-
-    Examples
-    --------
-    >>> path = simulate_wobble(3 * u.yr, method="exact")
-    >>> print(f"{path.period():.1f}")
-    303.6 d
-    """
-    t_end = TIME("duration", duration, u.day)
-    if t_end.shape != () or not float(t_end) >= 1.0:
-        raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
-    n_out = int(np.floor(float(t_end))) + 1
-    body = rigid_body(wobble, triaxial=triaxial)
-    t = np.arange(n_out) * 86400.0 * u.s
-    if method == "exact":
-        _, omega = free_motion(body, t)
-    elif method == "dop853":  # adaptive: outputs at the days themselves
-        omega = integrate(body, t, method=method).omega
-    else:
-        step = TIME("dt", dt, u.s)
-        # a whole number of steps per day so that the output falls on whole days
-        per_day = max(1, int(np.ceil(86400.0 / float(step))))
-        tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
-        t, omega = tr.t, tr.omega
-    return PolePath(t=u.Quantity(t, u.s).to(u.day), m=pole_path(omega), method=method)

@@ -1,0 +1,218 @@
+"""The float-level drivers of the rigid-body integrators: each method's run on plain arrays.
+
+:func:`integrate_arrays` is :func:`rigid.integrate` below validation and units: moments,
+attitude and angular velocity as float64 arrays in one unit system, output times, a
+method (see :mod:`rigid.integrators`).  The fixed-step methods run their whole time
+loop in one compiled function of :mod:`rigid._kernels.euler` (the splittings with the
+composition of :func:`rigid.splitting.split_ops`, the exact flow plus kicks, RK4 with
+quaternion or Cayley kinematics), in chunks only when a progress bar is shown; DOP853
+is the shared driver of both packages, :func:`hamilton_orbits.integrators.dop853.solve`,
+on Euler's equations plus ``dq/dt = q omega / 2``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits.integrators import dop853
+from rigid._kernels import euler as _k
+from rigid.splitting import SPLITTINGS, split_ops
+
+__all__ = ["METHODS", "integrate_arrays"]
+
+METHODS = ("splitting2", "splitting4", "splitting4y", "exact_kick", "dop853", "rk4",
+           "cayley_rk4")
+
+
+def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]:
+    n_steps = max(1, math.ceil(t_end / dt * (1.0 - 1e-12)))
+    h = t_end / n_steps
+    out_steps = np.unique(np.round(np.linspace(0.0, n_steps, n_out)).astype(np.int64))
+    return n_steps, h, out_steps
+
+
+def _progress_chunks(n_steps: int, progress: bool):
+    """Chunk boundaries (in steps) for an optional tqdm bar; one chunk without it."""
+    bar = _bar(n_steps, "step", progress)
+    if bar is None:
+        return [0, n_steps], None
+    return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
+
+
+def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress):
+    types, fracs, toffs, inv = split_ops(method, m, kind != _k.TORQUE_NONE)
+    qh = q0.copy()
+    ql = np.zeros(4)
+    lh = m * w0
+    ll = np.zeros(3)
+    nout = out_steps.shape[0]
+    q_out = np.empty((nout, 4))
+    l_out = np.empty((nout, 3))
+    drift = 0.0
+    pending = False
+    bounds, bar = _progress_chunks(n_steps, progress)
+    for a, b in itertools.pairwise(bounds):
+        sel = (out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b)
+        idx = np.nonzero(sel)[0]
+        qo = np.empty((idx.size, 4))
+        lo = np.empty((idx.size, 3))
+        d, pending = _k.run_splitting(types, fracs, toffs, inv, m, qh, ql, lh, ll, a * h, h,
+                                      b - a, out_steps[idx] - a, kind, params, qo, lo,
+                                      pending, b < n_steps)
+        drift = max(drift, float(d))
+        q_out[idx] = qo
+        l_out[idx] = lo
+        if bar is not None:
+            bar.update(b - a)
+    if bar is not None:
+        bar.close()
+    return q_out, l_out / m, drift
+
+
+def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
+    quat = q0.copy()
+    omega = w0.copy()
+    nout = out_steps.shape[0]
+    q_out = np.empty((nout, 4))
+    w_out = np.empty((nout, 3))
+    bounds, bar = _progress_chunks(n_steps, progress)
+    for a, b in itertools.pairwise(bounds):
+        idx = np.nonzero((out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b))[0]
+        qo = np.empty((idx.size, 4))
+        wo = np.empty((idx.size, 3))
+        _k.run_exact_kick(m, quat, omega, a * h, h, b - a, out_steps[idx] - a, kind, params,
+                          qo, wo)
+        q_out[idx] = qo
+        w_out[idx] = wo
+        if bar is not None:
+            bar.update(b - a)
+    if bar is not None:
+        bar.close()
+    return q_out, w_out
+
+
+def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress):
+    """``(q, omega, count, drift)`` of a fixed-step method on the step grid."""
+    count = 0
+    drift = 0.0
+    if method in SPLITTINGS:
+        q, w, drift = _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params,
+                                     progress)
+    elif method == "exact_kick":
+        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress)
+    elif method == "rk4":
+        y = np.empty((out_steps.size, 7))
+        _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
+                              params, y)
+        qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
+        drift = float(np.max(np.abs(qn - 1.0)))
+        q, w = y[:, :4] / qn[:, None], y[:, 4:]
+    elif method == "cayley_rk4":
+        y = np.empty((out_steps.size, 7))
+        count = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
+                                      recentre, y))
+        q, w = y[:, :4], y[:, 4:]
+    else:
+        raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
+    return q, w, count, drift
+
+
+def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
+    """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver
+    (:func:`hamilton_orbits.integrators.dop853.solve`, dense output)."""
+    bar = _bar(t_out.size - 1, "output", progress)
+    y, steps, nfev = dop853.solve(
+        lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
+        t_out, rtol=rtol, atol=atol, max_step=max_step, restart=False,
+        on_output=None if bar is None else (lambda i, n: bar.update(1)),
+    )
+    if bar is not None:
+        bar.close()
+    qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
+    drift = float(np.max(np.abs(qn - 1.0)))
+    return y[:, :4] / qn[:, None], y[:, 4:].copy(), int(steps), int(nfev), drift
+
+
+def _bar(total: int, unit: str, progress: bool) -> Any:
+    """A tqdm bar (the ``progress`` extra), or None."""
+    if not progress:
+        return None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:  # pragma: no cover - optional extra
+        return None
+    return tqdm(total=total, unit=unit, leave=False)
+
+
+def _grid(t: np.ndarray, dt: float, n_out: int | None) -> tuple[int, float, np.ndarray]:
+    """``(n_steps, h, out_steps)`` of a fixed-step run: a whole number of steps of
+    ``h <= dt`` spans the last time; each output at the step nearest its time.
+
+    An end time ``t`` (0-d) takes ``n_out`` (default 101) equally spaced outputs,
+    as :func:`integrate` always did; an array of times takes one output each.
+    """
+    if t.ndim == 0:
+        return _steps(float(t), dt, 101 if n_out is None else n_out)
+    n_steps = max(1, math.ceil(float(t[-1]) / dt * (1.0 - 1e-12)))
+    h = float(t[-1]) / n_steps
+    out_steps = np.minimum(np.round(t / h).astype(np.int64), n_steps)
+    return n_steps, h, out_steps
+
+
+def integrate_arrays(
+    moments: np.ndarray,
+    q0: np.ndarray,
+    omega0: np.ndarray,
+    t: Any,
+    *,
+    method: str = "splitting4",
+    dt: float | None = None,
+    n_out: int | None = None,
+    kind: int = _k.TORQUE_NONE,
+    params: np.ndarray | None = None,
+    rtol: float = 1e-12,
+    atol: Any = 1e-14,
+    recentre: float = 1.0,
+    progress: bool = False,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float]:
+    """Kernel-level integration on plain float arrays (no validation, no units).
+
+    ``t`` is an end time (``n_out`` equally spaced outputs, default 101) or an
+    increasing array of output times starting at 0.  ``dt`` is the step of the
+    fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
+    (7,) for ``(q, omega)``) are DOP853's tolerances.
+
+    Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
+    with unit quaternions; ``t`` the times reached; ``count`` is the number of
+    re-centrings for ``"cayley_rk4"`` and of right-hand-side evaluations for
+    ``"dop853"``.  See :func:`rigid.integrate` for the methods.
+
+    Examples
+    --------
+    >>> t, q, w, steps, count, drift = integrate_arrays(
+    ...     np.array([1.0, 2.0, 3.0]), np.array([1.0, 0, 0, 0]), np.array([0.0, 0.0, 1.0]),
+    ...     np.array([0.0, 0.5, 1.0]), method="rk4", dt=0.1)
+    >>> t, steps, q[-1].round(6)  # a spin about z: q = (cos t/2, 0, 0, sin t/2), RK4
+    (array([0. , 0.5, 1. ]), 10, array([0.877583, 0.      , 0.      , 0.479426]))
+    """
+    params = np.zeros(1) if params is None else np.ascontiguousarray(params, dtype=np.float64)
+    m = np.ascontiguousarray(moments, dtype=np.float64)
+    q0 = np.ascontiguousarray(q0, dtype=np.float64)
+    q0 = q0 / np.sqrt(q0 @ q0)
+    w0 = np.ascontiguousarray(omega0, dtype=np.float64)
+    t_arr = np.asarray(t, dtype=np.float64)
+    if method == "dop853":
+        t_out = (np.linspace(0.0, float(t_arr), 101 if n_out is None else n_out)
+                 if t_arr.ndim == 0 else t_arr)
+        q, w, steps, nfev, drift = _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol,
+                                               np.inf if dt is None else float(dt), progress)
+        return t_out, q, w, steps, nfev, drift
+    n_steps, h, out_steps = _grid(t_arr, float(dt), n_out)
+    q, w, count, drift = _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params,
+                                    recentre, progress)
+    return out_steps * h, q, w, n_steps, count, drift
+

@@ -1,0 +1,148 @@
+"""The free wobble of the rigid Earth: its pole path, integrated or exact.
+
+:func:`simulate_wobble` spins the rigid Earth of :mod:`rigid.earth.constants`
+(:func:`~rigid.earth.constants.rigid_body`) with :func:`rigid.integrate` or the
+exact :func:`rigid.free_motion` and returns the rotation pole in the body frame
+as a :class:`PolePath`; :func:`pole_path` turns any body-frame angular velocity
+into the pole ``m = m1 + i m2`` (IERS: ``x_p = m1``, ``y_p = -m2``).  A free
+wobble of an axisymmetric rigid Earth is ``m(t) = m0 exp(i sigma_E t)``,
+prograde, with the Euler frequency ``sigma_E = OMEGA (C - A) / A`` (Euler 1765);
+:meth:`PolePath.period` fits its period (:func:`rigid.earth.wobble_fit.free_period`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits.units import TIME
+from rigid.earth.constants import rigid_body
+from rigid.earth.wobble_fit import free_period
+from rigid.free import free_motion
+from rigid.integrators import integrate
+
+__all__ = ["PolePath", "pole_path", "simulate_wobble"]
+
+def _float(x: Any, unit: u.UnitBase) -> np.ndarray:
+    """SI floats from a Quantity or from the SI floats of RigidBody/RigidTrajectory."""
+    if isinstance(x, u.Quantity):
+        return x.to_value(unit, equivalencies=u.dimensionless_angles())
+    return np.asarray(x, dtype=np.float64)
+
+
+def pole_path(omega: Any) -> np.ndarray:
+    """The rotation pole in the body frame, ``m = (omega_x + i omega_y) / omega_z``.
+
+    Parameters
+    ----------
+    omega : array_like or Quantity, shape (..., 3)
+        Body-frame angular velocity (rad/s if a Quantity).
+
+    Returns
+    -------
+    ndarray, complex, shape (...)
+        ``m = m1 + i m2`` in radians (IERS: ``x_p = m1``, ``y_p = -m2``).
+
+    Examples
+    --------
+    >>> pole_path([[1e-6, 0.0, 1.0], [0.0, -2e-6, 1.0]])
+    array([1.e-06+0.e+00j, 0.e+00-2.e-06j])
+    """
+    w = _float(omega, u.rad / u.s)
+    if w.shape[-1:] != (3,):
+        raise ValueError(f"Expected `omega` to have shape (..., 3), got {w.shape}")
+    return (w[..., 0] + 1j * w[..., 1]) / w[..., 2]
+
+
+@dataclass(frozen=True)
+class PolePath:
+    """A simulated pole path (see :func:`simulate_wobble`).
+
+    Attributes
+    ----------
+    t : Quantity, shape (n,), day
+        Output times.
+    m : ndarray, complex, shape (n,)
+        ``m1 + i m2`` in radians.
+    method : str
+        The integrator (``"splitting4"``, ``"exact"``, ...).
+    """
+
+    t: u.Quantity
+    m: np.ndarray
+    method: str
+
+    @property
+    def x(self) -> u.Quantity:
+        """``x_p = m1`` in arcsec."""
+        return (self.m.real * u.rad).to(u.arcsec)
+
+    @property
+    def y(self) -> u.Quantity:
+        """``y_p = -m2`` in arcsec."""
+        return (-self.m.imag * u.rad).to(u.arcsec)
+
+    def period(self) -> u.Quantity:
+        """The wobble period fitted to the path (see :func:`rigid.earth.wobble_fit.free_period`).
+
+        Examples
+        --------
+        >>> from rigid.earth import euler_period
+        >>> path = simulate_wobble(2 * u.yr, method="exact", triaxial=False)
+        >>> bool(abs(path.period() / euler_period() - 1) < 1e-10)
+        True
+        """
+        return free_period(self.t, self.m)
+
+
+def simulate_wobble(
+    duration: Any = 100 * u.yr,
+    *,
+    wobble: Any = 0.2 * u.arcsec,
+    dt: Any = 1 * u.hour,
+    method: str = "splitting4",
+    triaxial: bool = True,
+) -> PolePath:
+    """Integrate the free rigid Earth and return its pole path with daily output.
+
+    Parameters
+    ----------
+    duration : Quantity
+        Time span (default 100 years).
+    wobble : Quantity
+        Initial angle between the rotation and figure axes (default 0.2 arcsec).
+    dt : Quantity
+        Step of the fixed-step integrator (default 1 hour; ignored for
+        ``"exact"`` and ``"dop853"``).
+    method : str
+        A method of :func:`rigid.integrate`, or ``"exact"`` for
+        :func:`rigid.free_motion`.
+    triaxial : bool
+        Triaxial (default) or axisymmetric Earth.
+
+    Examples
+    --------
+    >>> path = simulate_wobble(3 * u.yr, method="exact")
+    >>> print(f"{path.period():.1f}")
+    303.6 d
+    """
+    t_end = TIME("duration", duration, u.day)
+    if t_end.shape != () or not float(t_end) >= 1.0:
+        raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
+    n_out = int(np.floor(float(t_end))) + 1
+    body = rigid_body(wobble, triaxial=triaxial)
+    t = np.arange(n_out) * 86400.0 * u.s
+    if method == "exact":
+        _, omega = free_motion(body, t)
+    elif method == "dop853":  # adaptive: outputs at the days themselves
+        omega = integrate(body, t, method=method).omega
+    else:
+        step = TIME("dt", dt, u.s)
+        # a whole number of steps per day so that the output falls on whole days
+        per_day = max(1, int(np.ceil(86400.0 / float(step))))
+        tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
+        t, omega = tr.t, tr.omega
+    return PolePath(t=u.Quantity(t, u.s).to(u.day), m=pole_path(omega), method=method)

@@ -1,0 +1,388 @@
+"""Where will the pole be next year?  Polar-motion prediction and honest hindcasts.
+
+Five methods (:data:`METHODS`), each from the IERS C04 pole coordinates alone, each with
+a 1-sigma band from its own model (``m = x_p - i y_p``, IERS sign convention, mas, days):
+``"persistence"``, least-squares harmonics ``"ls"``, ``"ls+ar"``, ``"ls+var"`` and the
+package's physics, the linearised Liouville equation ``"liouville"`` (each described in
+:mod:`rigid.earth.forecasters`, which computes them on plain floats).  This module is
+their public layer: :func:`predict` from one start date, :func:`hindcast` from many,
+scored against the record.
+
+Every method uses only record epochs at least ``latency`` before the start date ``at``
+(default 1 day: data strictly before the start, as in a C04-only hindcast; the
+prediction campaigns start from data a few days old, ``latency=3 * u.day`` say).
+The horizon counts from ``at``: horizon ``h`` is ``h + latency`` days after the newest
+datum.  No parameter is fitted to data after the newest datum; the fixed constants
+(periods, Q, window lengths, orders) were chosen on hindcasts with start dates in
+1985-2004, before both test periods (``docs/pole_wander.md``).
+
+References
+----------
+Kalarus, M., et al. 2010, J. Geodesy 84, 587 (the 1st EOP PCC, Oct 2005 - Mar 2008).
+Śliwińska, J., et al. 2022, Artificial Satellites 57, 237 (the 2nd EOP PCC overview).
+Lei, Y., Zhao, D., Guo, M. 2023, Artificial Satellites 58, 42, doi 10.2478/arsa-2023-0004
+(LS + AR, LS + VAR and WLS + VAR from C04).
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import astropy.units as u
+import numpy as np
+from astropy.table import QTable
+from astropy.time import Time
+
+from hamilton_orbits.units import TIME
+from rigid.earth.forecasters import (
+    METHODS,
+    fitted_parameters,
+    forecast,
+    history_days,
+    propagate_pole,
+)
+
+
+class PoleRecord(Protocol):
+    """What a record needs here: a :class:`rigid.polar_motion.PolarMotionRecord` (from
+    ``load_c04()``) or anything with its attributes.  This module does not import the
+    record's module, which re-exports :func:`predict` and :func:`hindcast`."""
+
+    time: Time
+    x: u.Quantity
+    y: u.Quantity
+
+__all__ = [
+    "DEFAULT_HORIZONS",
+    "METHODS",
+    "PAPER_PERIOD",
+    "RECENT_PERIOD",
+    "HindcastScore",
+    "PolePrediction",
+    "PoleRecord",
+    "hindcast",
+    "predict",
+    "propagate_pole",
+    "weekly_starts",
+]
+
+DEFAULT_HORIZONS = np.array([10, 30, 90, 150, 270, 365]) * u.day
+#: start dates of the 1st EOP PCC (Kalarus et al. 2010), assumed for Lei et al. 2023's test
+PAPER_PERIOD = ("2005-10-01", "2008-03-01")
+#: the second test period: eight years of weekly starts
+RECENT_PERIOD = ("2016-01-01", "2024-01-01")
+
+_MAS = u.mas
+
+
+# --------------------------------------------------------------------------
+# The public layer: validation, predict, hindcast
+# --------------------------------------------------------------------------
+
+def _check_method(method: Any) -> str:
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"Expected `method` one of {', '.join(map(repr, METHODS))}, "
+                         f"got {method!r}")
+    return method
+
+
+def _check_record(record: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(UTC MJD, x, y in mas) of a PolarMotionRecord (or anything with its ``time``, ``x``
+    and ``y``: this module does not import rigid.polar_motion, which re-exports it)."""
+    if not (isinstance(getattr(record, "time", None), Time)
+            and isinstance(getattr(record, "x", None), u.Quantity)
+            and isinstance(getattr(record, "y", None), u.Quantity)):
+        raise ValueError(f"Expected `record` from load_c04() (time, x, y), got "
+                         f"{type(record).__name__}")
+    mjd = np.asarray(record.time.utc.mjd, dtype=np.float64)
+    return mjd, record.x.to_value(_MAS), record.y.to_value(_MAS)
+
+
+def _whole_days(name: str, value: Any, *, minimum: int) -> np.ndarray:
+    """A time (Quantity or days) as whole days >= minimum (int array)."""
+    if not isinstance(value, u.Quantity):
+        raise ValueError(f"Expected `{name}` to be a time Quantity (e.g. 365 * u.day), "
+                         f"got {value!r}")
+    days = np.atleast_1d(TIME(name, value, u.day))
+    whole = np.round(days)
+    bad = (np.abs(days - whole) > 1e-9) | (whole < minimum)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise ValueError(f"Expected `{name}` in whole days >= {minimum} d, got "
+                         f"{float(days[k])!r} d{f' at index {k}' if days.size > 1 else ''}")
+    return whole.astype(np.int64)
+
+
+def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
+                  history: int) -> np.ndarray:
+    """Index of the newest datum ``at - latency`` for each start; checks the span."""
+    target = at - latency
+    k = np.searchsorted(mjd, target)
+    k_safe = np.minimum(k, mjd.size - 1)
+    ok = (k < mjd.size) & (mjd[k_safe] == target) & (k_safe - history + 1 >= 0)
+    ok &= mjd[k_safe] - mjd[np.maximum(k_safe - history + 1, 0)] == history - 1
+    if not np.all(ok):
+        i = int(np.argmin(ok))
+        first = Time(mjd[0] + history - 1 + latency, format="mjd", scale="utc").iso[:10]
+        last = Time(mjd[-1] + latency, format="mjd", scale="utc").iso[:10]
+        raise ValueError(
+            f"Expected `{name}` at 0h UTC within the record, from {first} ({history} days "
+            f"of history plus the {latency} d latency) to {last}, got "
+            f"{Time(at[i], format='mjd', scale='utc').iso}"
+            f"{f' at index {i}' if at.size > 1 else ''}")
+    return k
+
+
+def _as_mjd(name: str, value: Any) -> np.ndarray:
+    if not isinstance(value, Time):
+        raise ValueError(f"Expected `{name}` to be an astropy Time, got {value!r}")
+    return np.atleast_1d(np.asarray(value.utc.mjd, dtype=np.float64))
+
+
+@dataclass(frozen=True)
+class PolePrediction:
+    """A predicted pole path and its 1-sigma band (see :func:`predict`).
+
+    Attributes
+    ----------
+    t : Time, shape (n,)
+        Daily epochs from ``at`` (horizon 0) to ``at + horizon``.
+    x, y : Quantity, shape (n,), mas
+        The predicted pole coordinates ``x_p``, ``y_p``.
+    sigma_x, sigma_y : Quantity, shape (n,), mas
+        The method's own 1-sigma prediction error.
+    method : str
+    newest_datum : Time
+        The newest record epoch the prediction used (``at - latency``).
+    parameters : dict
+        The fitted model, complex amplitudes of ``m = x_p - i y_p`` (mas) at the
+        newest datum: for the ``"ls"`` family the trend (``"mean"``, ``"drift"`` per
+        year) and the prograde (``"+"``) and retrograde (``"-"``) Chandler, annual and
+        semi-annual terms of ``m``; for ``"liouville"`` the Chandler period and Q and,
+        per excitation window, the same terms of the excitation ``chi``; empty for
+        ``"persistence"``.
+    """
+
+    t: Time
+    x: u.Quantity
+    y: u.Quantity
+    sigma_x: u.Quantity
+    sigma_y: u.Quantity
+    method: str
+    newest_datum: Time
+    parameters: dict = field(default_factory=dict)
+
+
+def predict(
+    record: PoleRecord, *, at: Time, horizon: u.Quantity, method: str = "liouville",
+    latency: u.Quantity = 1 * u.day,
+) -> PolePrediction:
+    """Predict the pole from ``at`` to ``at + horizon`` with the record before ``at``.
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+        From :func:`rigid.polar_motion.load_c04`.
+    at : Time
+        The start date (0h UTC).  Only epochs up to ``at - latency`` are used.
+    horizon : Quantity
+        Whole days >= 0.
+    method : {"persistence", "ls", "ls+ar", "ls+var", "liouville"}
+        See the module docstring.
+    latency : Quantity
+        Age of the newest datum at ``at``; whole days >= 1 (default 1 day).
+
+    Returns
+    -------
+    PolePrediction
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, ``at`` outside the record (or without the method's
+        history before it), a negative or fractional horizon, a latency below a day,
+        or non-finite data in the history used.
+
+    Examples
+    --------
+    >>> from rigid.polar_motion import load_c04
+    >>> rec = load_c04()
+    >>> pred = predict(rec, at=Time("2019-01-01"), horizon=30 * u.day, method="persistence")
+    >>> print(pred.t[0].iso[:10], pred.t[-1].iso[:10], len(pred.x), pred.x.unit)
+    2019-01-01 2019-01-31 31 mas
+    >>> predict(rec, at=Time("2019-01-01"), horizon=30 * u.day, method="ar")
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `method` one of 'persistence', 'ls', ..., 'liouville', got 'ar'
+    """
+    method = _check_method(method)
+    mjd, x, y = _check_record(record)
+    at_mjd = _as_mjd("at", at)
+    if at_mjd.size != 1:
+        raise ValueError(f"Expected `at` to be a single Time, got {at_mjd.size} epochs")
+    n_h = int(_whole_days("horizon", horizon, minimum=0)[0])
+    lat = int(_whole_days("latency", latency, minimum=1)[0])
+    k = int(_newest_index("at", mjd, at_mjd, lat, history_days(method))[0])
+    _check_finite(x, y, k, history_days(method))
+    mx, my, vx, vy = forecast(method, x, y, k, lat + n_h)
+    sl = slice(lat - 1, lat + n_h)
+    t = Time(at_mjd[0] + np.arange(n_h + 1), format="mjd", scale="utc")
+    return PolePrediction(
+        t=t, x=mx[sl] * _MAS, y=my[sl] * _MAS, sigma_x=np.sqrt(vx[sl]) * _MAS,
+        sigma_y=np.sqrt(vy[sl]) * _MAS, method=method,
+        newest_datum=Time(mjd[k], format="mjd", scale="utc"),
+        parameters=fitted_parameters(method, x[:k + 1], y[:k + 1]))
+
+
+def _check_finite(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
+    for name, arr in (("record.x", x), ("record.y", y)):
+        part = arr[k - history + 1:k + 1]
+        if not np.all(np.isfinite(part)):
+            i = k - history + 1 + int(np.argmin(np.isfinite(part)))
+            raise ValueError(f"Expected `{name}` finite in the history used, got "
+                             f"{float(arr[i])!r} at index {i}")
+
+
+def weekly_starts(first: Any, last: Any) -> Time:
+    """Start dates every 7 days from ``first`` (included) to ``last`` (excluded).
+
+    Examples
+    --------
+    >>> s = weekly_starts(*PAPER_PERIOD)
+    >>> print(len(s), s[0].iso[:10], s[-1].iso[:10])
+    126 2005-10-01 2008-02-23
+    """
+    a, b = (Time(v, scale="utc") if not isinstance(v, Time) else v.utc for v in (first, last))
+    return Time(np.arange(a.mjd, b.mjd, 7.0), format="mjd", scale="utc")
+
+
+@dataclass(frozen=True)
+class HindcastScore:
+    """Predictions from weekly (or any) start dates scored against the record.
+
+    Attributes
+    ----------
+    table : QTable
+        One row per horizon: ``horizon`` (d), ``mae_x``, ``mae_y`` (mean absolute error,
+        mas), ``rms_2d`` (``sqrt(mean(dx^2 + dy^2))``, mas), ``coverage_x``,
+        ``coverage_y`` (fraction of outcomes within the 1-sigma band) and ``count``
+        (start dates whose outcome the record holds).
+    method : str
+    starts : Time, shape (n,)
+    horizons : Quantity, shape (h,), d
+    latency : Quantity, d
+    errors_x, errors_y : Quantity, shape (n, h), mas
+        Prediction minus record; NaN where the record ends before the outcome (those
+        entries are left out of ``table``, as ``count`` says).
+    sigma_x, sigma_y : Quantity, shape (n, h), mas
+        The method's own 1-sigma at each start and horizon.
+    wall_time : float
+        Seconds the hindcast took.
+    """
+
+    table: QTable
+    method: str
+    starts: Time
+    horizons: u.Quantity
+    latency: u.Quantity
+    errors_x: u.Quantity
+    errors_y: u.Quantity
+    sigma_x: u.Quantity
+    sigma_y: u.Quantity
+    wall_time: float
+
+
+def _score_table(h: np.ndarray, ex: np.ndarray, ey: np.ndarray, sx: np.ndarray,
+                 sy: np.ndarray) -> QTable:
+    ok = np.isfinite(ex)
+    count = ok.sum(axis=0)
+    with np.errstate(invalid="ignore"):  # a horizon no start reaches has count 0
+        def mean(v: np.ndarray) -> np.ndarray:
+            return np.where(count > 0, np.nansum(np.where(ok, v, 0.0), axis=0)
+                            / np.maximum(count, 1), np.nan)
+
+        inside_x = np.where(ok, np.abs(ex) <= sx, False).astype(float)
+        inside_y = np.where(ok, np.abs(ey) <= sy, False).astype(float)
+        return QTable(
+            [h * u.day, mean(np.abs(ex)) * _MAS, mean(np.abs(ey)) * _MAS,
+             np.sqrt(mean(ex**2 + ey**2)) * _MAS, mean(inside_x), mean(inside_y), count],
+            names=("horizon", "mae_x", "mae_y", "rms_2d", "coverage_x", "coverage_y",
+                   "count"))
+
+
+def hindcast(
+    record: PoleRecord, starts: Time | None = None,
+    horizons: u.Quantity = DEFAULT_HORIZONS, method: str = "liouville", *,
+    latency: u.Quantity = 1 * u.day,
+) -> HindcastScore:
+    """Score a method's predictions from many start dates against the record.
+
+    Each start date is predicted exactly as :func:`predict` would (the newest datum
+    ``latency`` before it, nothing later); the prediction at ``start + horizon`` is
+    compared with the record there, as in the EOP prediction comparison campaigns
+    (mean absolute error per horizon, Kalarus et al. 2010; Śliwińska et al. 2022).
+    One forecast per start (a few vectorised calls; no Python loop over days).
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+    starts : Time, optional
+        Start dates (0h UTC).  Default: weekly over :data:`PAPER_PERIOD` (the 1st EOP
+        PCC's Oct 2005 - Mar 2008, assumed for Lei et al. 2023); the second period is
+        ``weekly_starts(*RECENT_PERIOD)``.
+    horizons : Quantity
+        Whole days >= 0 (default 10, 30, 90, 150, 270, 365 d).
+    method : str
+        One of :data:`METHODS`.
+    latency : Quantity
+        Age of the newest datum at each start (default 1 day).
+
+    Returns
+    -------
+    HindcastScore
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, no start dates, a start date outside the record (naming
+        its index), negative or fractional horizons, or a latency below a day.
+
+    Examples
+    --------
+    >>> from rigid.polar_motion import load_c04
+    >>> score = hindcast(load_c04(), weekly_starts("2019-01-01", "2019-03-01"),
+    ...                  [10, 30] * u.day, "persistence")
+    >>> print(score.table["count"].tolist(), score.table["mae_x"].unit)
+    [9, 9] mas
+    """
+    begin = _time.perf_counter()
+    method = _check_method(method)
+    mjd, x, y = _check_record(record)
+    at = _as_mjd("starts", weekly_starts(*PAPER_PERIOD) if starts is None else starts)
+    if at.size == 0:
+        raise ValueError("Expected `starts` to hold at least one start date, got none")
+    hs = _whole_days("horizons", horizons, minimum=0)
+    if hs.size == 0:
+        raise ValueError("Expected `horizons` to hold at least one horizon, got none")
+    lat = int(_whole_days("latency", latency, minimum=1)[0])
+    history = history_days(method)
+    ks = _newest_index("starts", mjd, at, lat, history)
+    ex, ey, sx, sy = (np.full((at.size, hs.size), np.nan) for _ in range(4))
+    steps = lat + int(hs.max())
+    for i, k in enumerate(ks):  # per start: a few vectorised calls
+        _check_finite(x, y, int(k), history)
+        mx, my, vx, vy = forecast(method, x, y, int(k), steps)
+        j = lat + hs - 1  # forecast index of each horizon
+        truth = k + lat + hs
+        seen = truth < mjd.size
+        jj, tt = j[seen], truth[seen]
+        ex[i, seen], ey[i, seen] = mx[jj] - x[tt], my[jj] - y[tt]
+        sx[i, seen], sy[i, seen] = np.sqrt(vx[jj]), np.sqrt(vy[jj])
+    table = _score_table(hs, ex, ey, sx, sy)
+    return HindcastScore(
+        table=table, method=method, starts=Time(at, format="mjd", scale="utc"),
+        horizons=hs * u.day, latency=lat * u.day, errors_x=ex * _MAS, errors_y=ey * _MAS,
+        sigma_x=sx * _MAS, sigma_y=sy * _MAS, wall_time=_time.perf_counter() - begin)

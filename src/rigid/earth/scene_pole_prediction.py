@@ -1,0 +1,259 @@
+"""The ``pole_prediction`` scene kind: where will the pole be next year?
+
+Registered beside ``polar_motion`` by :func:`rigid.earth.scene_polar_motion.register`.
+The prediction methods of :mod:`rigid.earth.prediction` are run from one start date (the
+prediction fan, against the record that followed) and hindcast from weekly start dates
+over one or more periods, scored like the EOP prediction comparison campaigns (mean
+absolute error per horizon, and how often the outcome falls inside the method's own
+1-sigma band), beside the published C04-only results of Lei et al. 2023.  Keys
+(``docs/scenes.md``)::
+
+    kind = "pole_prediction"
+    start = "2019-01-01"          # the fan's start date (0h UTC)
+    horizon = "365 d"
+    methods = ["persistence", "ls", "ls+ar", "ls+var", "liouville"]
+    periods = ["2005-10-01..2008-03-01", "2016-01-01..2024-01-01"]   # weekly starts
+    latency = "1 d"
+
+Nothing downloads: the IERS 20 C04 record ships with astropy-iers-data.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits import schema as S
+from hamilton_orbits.scene import Result, Scene, SceneKind, register_kind
+from hamilton_orbits.units import TIME
+
+#: Lei et al. 2023 (Artificial Satellites 58, 42), table of mean absolute errors (mas),
+#: predictions from the C04 series; horizons 10, 30, 150, 270, 365 d
+PUBLISHED_HORIZONS = (10, 30, 150, 270, 365)
+PUBLISHED = {
+    "LS+AR (Lei et al. 2023)": ((2.93, 7.71, 21.83, 24.57, 30.86),
+                                (1.94, 5.43, 21.90, 24.04, 27.90)),
+    "WLS+VAR (Lei et al. 2023)": ((2.87, 7.03, 13.97, 18.47, 20.52),
+                                  (1.81, 4.41, 15.41, 21.17, 21.82)),
+}
+TABLE_HORIZONS = (10, 30, 90, 150, 270, 365)
+_METHODS = ("persistence", "ls", "ls+ar", "ls+var", "liouville")
+
+SCHEMA: dict[str, S.Field] = {
+    "start": S.String(default="2019-01-01"),
+    "horizon": S.Quantity(kind=TIME, default="365 d", positive=True),
+    "methods": S.Array(item=S.Choice(choices=_METHODS), default=list(_METHODS)),
+    "periods": S.Array(item=S.String(), default=["2005-10-01..2008-03-01",
+                                                 "2016-01-01..2024-01-01"]),
+    "latency": S.Quantity(kind=TIME, default="1 d", positive=True),
+}
+
+
+def _check(spec: dict, problems: S.Problems) -> None:
+    from astropy.time import Time
+
+    for i, text in enumerate(spec["periods"]):
+        parts = text.split("..") if isinstance(text, str) else []
+        try:
+            first, last = (Time(p.strip(), scale="utc") for p in parts)
+            ok = len(parts) == 2 and last > first
+        except ValueError:
+            ok = False
+        if not ok:
+            problems.add(f"periods[{i}]", f'expected "YYYY-MM-DD..YYYY-MM-DD", got {text!r}')
+    try:
+        Time(spec["start"], scale="utc")
+    except ValueError:
+        problems.add("start", f'expected a date "YYYY-MM-DD", got {spec["start"]!r}')
+    if not spec["methods"]:
+        problems.add("methods", f"expected at least one of {', '.join(_METHODS)}")
+    for key in ("horizon", "latency"):
+        days = float(spec[key].to_value(u.day))
+        if days != round(days):
+            problems.add(key, f"expected whole days, got {spec[key]}")
+
+
+def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
+    from astropy.time import Time
+
+    from rigid.earth.c04 import load_c04
+    from rigid.earth.prediction import hindcast, predict, weekly_starts
+
+    spec = scene.spec
+    begin = time.perf_counter()
+    record = load_c04()
+    start = Time(spec["start"], scale="utc")
+    horizon = spec["horizon"].to(u.day)
+    fans = {m: predict(record, at=start, horizon=horizon, method=m, latency=spec["latency"])
+            for m in spec["methods"]}
+    dense = np.arange(0, int(horizon.to_value(u.day)) + 1) * u.day
+    scores: dict[str, dict[str, Any]] = {}
+    for text in spec["periods"]:
+        first, last = (p.strip() for p in text.split(".."))
+        starts = weekly_starts(first, last)
+        scores[text] = {m: hindcast(record, starts, dense, m, latency=spec["latency"])
+                        for m in spec["methods"]}
+        if stop():
+            break
+    wall = time.perf_counter() - begin
+    result = Result(scene=scene, times=dense, wall_time=wall)
+    for i, by_method in enumerate(scores.values()):  # the MAE curves, saved to states.nc
+        for method, score in by_method.items():
+            key = method.replace("+", "_")
+            result.diagnostics[f"mae_x_{key}_period{i + 1}"] = score.table["mae_x"]
+            result.diagnostics[f"mae_y_{key}_period{i + 1}"] = score.table["mae_y"]
+    result.metrics["fan start date (newest datum)"] = (
+        f"{start.iso[:10]} ({next(iter(fans.values())).newest_datum.iso[:10]})")
+    result.metrics["latency"] = spec["latency"].to(u.day)
+    for text, by_method in scores.items():
+        n = len(next(iter(by_method.values())).starts)
+        hind = sum(s.wall_time for s in by_method.values())
+        result.metrics[f"hindcast {text}"] = f"{n} weekly starts, {hind:.1f} s for all methods"
+    _tables(result, scores)
+    result.plotters.extend([lambda r: _plot_fan(r, record, fans, start),
+                            lambda r: _plot_mae(r, scores), lambda r: _plot_coverage(r, scores)])
+    return result
+
+
+def _tables(result: Result, scores: dict) -> None:
+    """MAE (x, y) and coverage per method and horizon, the published rows beside them."""
+    cols = [h for h in TABLE_HORIZONS if h < len(result.times)]
+    for text, by_method in scores.items():
+        rows = []
+        for method, score in by_method.items():
+            t = score.table
+            row: dict[str, Any] = {"method": method}
+            for h in cols:
+                row[f"x {h} d"] = float(t["mae_x"][h].to_value(u.mas))
+            for h in cols:
+                row[f"y {h} d"] = float(t["mae_y"][h].to_value(u.mas))
+            rows.append(row)
+        if text.startswith("2005-10-01"):
+            for name, (px, py) in PUBLISHED.items():
+                row = {"method": name}
+                for h in cols:
+                    k = PUBLISHED_HORIZONS.index(h) if h in PUBLISHED_HORIZONS else None
+                    row[f"x {h} d"] = px[k] if k is not None else "-"
+                for h in cols:
+                    k = PUBLISHED_HORIZONS.index(h) if h in PUBLISHED_HORIZONS else None
+                    row[f"y {h} d"] = py[k] if k is not None else "-"
+                rows.append(row)
+        result.tables[f"MAE (mas), weekly starts {text}"] = rows
+        result.tables[f"1-sigma coverage (x, y), weekly starts {text}"] = [
+            {"method": method, **{f"{h} d": "{:.2f}, {:.2f}".format(
+                float(s.table["coverage_x"][h]), float(s.table["coverage_y"][h]))
+                for h in cols}} for method, s in by_method.items()]
+
+
+_COLOURS = {"persistence": "0.5", "ls": "tab:orange", "ls+ar": "tab:green",
+            "ls+var": "tab:purple", "liouville": "tab:blue"}
+
+
+def _plot_fan(result: Result, record: Any, fans: dict, start: Any):
+    """The predictions from the start date, with their 1-sigma bands, over the record."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(10, 8), sharex=True)
+    days = record.time.utc.mjd - start.utc.mjd
+    span = (days >= -365) & (days <= len(result.times) + 30)
+    for ax, coord in zip(axes, ("x", "y"), strict=True):
+        ax.plot(days[span], getattr(record, coord)[span].to_value(u.mas), "k", lw=1.2,
+                label="IERS 20 C04 (observed)")
+        for method, pred in fans.items():
+            d = pred.t.utc.mjd - start.utc.mjd
+            mid = getattr(pred, coord).to_value(u.mas)
+            sig = getattr(pred, f"sigma_{coord}").to_value(u.mas)
+            ax.plot(d, mid, color=_COLOURS[method], lw=1.2, label=method)
+            if method in ("liouville", "ls+ar"):
+                ax.fill_between(d, mid - sig, mid + sig, color=_COLOURS[method], alpha=0.15,
+                                lw=0, label=f"{method} 1-sigma")
+        ax.axvline(0, color="k", ls=":", lw=0.8)
+        ax.set_ylabel(f"{coord}_p (mas; CIP in the ITRS, IERS convention)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, ncol=3, loc="best")
+    axes[1].set_xlabel(f"days from the start date {start.iso[:10]} (data before it only)")
+    axes[0].set_title(f"{result.scene.name}: the prediction fan from {start.iso[:10]} "
+                      "against the record that followed")
+    fig.tight_layout()
+    fig._hamilton_name = "prediction_fan"
+    return fig
+
+
+def _plot_mae(result: Result, scores: dict):
+    """MAE against horizon for every method and period, the published rows as markers."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(scores), 2, figsize=(12, 4.2 * len(scores)), squeeze=False)
+    for row, (text, by_method) in enumerate(scores.items()):
+        for col, coord in enumerate(("x", "y")):
+            ax = axes[row, col]
+            top = 0.0
+            for method, score in by_method.items():
+                t = score.table
+                mae = t[f"mae_{coord}"].to_value(u.mas)
+                label = method
+                if method == "persistence" and len(by_method) > 1:
+                    label += " (runs off the top)"
+                else:
+                    top = max(top, float(np.nanmax(mae)))
+                ax.plot(t["horizon"].to_value(u.day), mae, color=_COLOURS[method], lw=1.4,
+                        label=label)
+            if text.startswith("2005-10-01"):
+                for (name, values), marker in zip(PUBLISHED.items(), ("s", "D"), strict=True):
+                    ax.plot(PUBLISHED_HORIZONS, values[col], marker, color="k", ms=6,
+                            mfc="none" if marker == "s" else "k", label=name)
+                    top = max(top, max(values[col]))
+            n = len(next(iter(by_method.values())).starts)
+            ax.set_title(f"{coord}_p: weekly starts {text} ({n} start dates)")
+            ax.set_xlabel("horizon (days after the start date)")
+            ax.set_ylabel(f"mean absolute error of {coord}_p (mas)")
+            ax.set_ylim(0, 1.15 * top if top > 0 else None)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8, loc="upper left")
+    fig.suptitle(f"{result.scene.name}: hindcast error against horizon (IERS 20 C04)")
+    fig.tight_layout()
+    fig._hamilton_name = "mae_vs_horizon"
+    return fig
+
+
+def _plot_coverage(result: Result, scores: dict):
+    """Fraction of outcomes within each method's own 1-sigma band."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(scores), figsize=(6 * len(scores), 5.2), squeeze=False)
+    for ax, (text, by_method) in zip(axes[0], scores.items(), strict=True):
+        for method, score in by_method.items():
+            t = score.table
+            h = t["horizon"].to_value(u.day)
+            cover = 0.5 * (np.asarray(t["coverage_x"]) + np.asarray(t["coverage_y"]))
+            ax.plot(h, cover, color=_COLOURS[method], lw=1.4, label=method)
+        ax.axhline(0.683, color="k", ls="--", lw=1, label="68.3% (Gaussian 1-sigma)")
+        ax.axhspan(0.60, 0.75, color="k", alpha=0.06, label="60-75% target")
+        ax.set_ylim(0, 1)
+        ax.set_xlabel("horizon (days after the start date)")
+        ax.set_ylabel("fraction of outcomes within 1-sigma (mean of x_p, y_p)")
+        ax.set_title(f"band coverage, weekly starts {text}")
+        ax.grid(alpha=0.3)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=4)
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
+    fig._hamilton_name = "coverage"
+    return fig
+
+
+KIND = SceneKind(
+    name="pole_prediction",
+    summary="polar-motion prediction methods and their hindcasts against the IERS record",
+    schema=SCHEMA,
+    effect_kind="rotation",
+    check=_check,
+    run=_run,
+)
+
+
+def register() -> None:
+    """Register the ``pole_prediction`` scene kind."""
+    register_kind(KIND)

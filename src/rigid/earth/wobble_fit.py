@@ -1,0 +1,451 @@
+"""The wobble fit of an observed pole path: Chandler and annual terms, spectrum, Q.
+
+:func:`fit_wobble` fits the Chandler and annual wobbles (periods, amplitudes,
+phases, a trend) to a :class:`~rigid.earth.c04.PolarMotionRecord`, with the amplitudes
+by decade and a resolution-limited Q estimate (:class:`WobbleFit`);
+:func:`periodogram` is the two-sided amplitude spectrum of the pole path;
+:func:`free_period` fits the period of a free wobble to any pole path (a
+simulated one, :meth:`rigid.earth.PolePath.period`, or a model's,
+:class:`rigid.earth.liouville.LiouvillePole`).  Conventions (IERS): ``m = x_p - i y_p``,
+a prograde term is ``exp(+i sigma t)``.  The public facade is
+:mod:`rigid.polar_motion`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+from astropy.table import QTable
+from astropy.time import Time
+from scipy.optimize import least_squares
+
+from hamilton_orbits.units import TIME
+from hamilton_orbits.validation import as_float_array
+from rigid._shared import positive_scalar
+from rigid.earth.c04 import PolarMotionRecord, decimal_year, iers2010_mean_pole, mjd_utc
+
+__all__ = ["WobbleFit", "fit_wobble", "free_period", "periodogram"]
+
+
+def _harmonic_design(t: np.ndarray, freqs: np.ndarray, n_trend: int) -> np.ndarray:
+    cols = [t**k for k in range(n_trend)]
+    cols += [np.exp(1j * f * t) for f in freqs]
+    return np.stack(cols, axis=-1).astype(np.complex128)
+
+
+def _project(t: np.ndarray, m: np.ndarray, freqs: np.ndarray, n_trend: int):
+    """Complex linear least squares at fixed frequencies: (coefficients, residual)."""
+    design = _harmonic_design(t, freqs, n_trend)
+    coef, *_ = np.linalg.lstsq(design, m, rcond=None)
+    return coef, m - design @ coef
+
+
+def free_period(t: Any, m: Any) -> u.Quantity:
+    """The period of a free wobble fitted to a pole path.
+
+    The model is ``m(t) = a exp(i sigma t) + b exp(-i sigma t)`` (the ellipse
+    of the triaxial linear theory; ``b = 0`` for an axisymmetric body), fitted by
+    nonlinear least squares in ``sigma`` with the amplitudes projected out.  The
+    starting value is the mean rate of the unwrapped phase of ``m``.
+
+    Parameters
+    ----------
+    t : Quantity or array_like, shape (n,)
+        Times (days if plain floats).
+    m : array_like, complex, shape (n,)
+        The pole path ``m1 + i m2`` (any angular unit; only the phase matters).
+
+    Returns
+    -------
+    Quantity, day
+        ``2 pi / sigma``.
+
+    Raises
+    ------
+    ValueError
+        For fewer than 8 points, mismatched shapes or a path without a wobble.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 2000.0)
+    >>> print(f"{free_period(t, 1e-6 * np.exp(2j * np.pi * t / 433.0)):.6f}")
+    433.000000 d
+    """
+    tt = TIME("t", t, u.day)
+    mm = np.asarray(m.value if isinstance(m, u.Quantity) else m, dtype=np.complex128)
+    if tt.ndim != 1 or mm.shape != tt.shape or tt.size < 8:
+        raise ValueError(
+            f"Expected `t` and `m` of one shape (n,), n >= 8, got {tt.shape} and {mm.shape}"
+        )
+    if not np.all(np.isfinite(mm)):
+        k = int(np.argmin(np.isfinite(mm)))
+        raise ValueError(f"Expected `m` to be finite, got {mm[k]!r} at index {k}")
+    scale = float(np.max(np.abs(mm)))
+    if scale == 0.0:
+        raise ValueError("Expected `m` to wobble, got a path identically zero")
+    t0 = tt - tt[0]
+    phase = np.unwrap(np.angle(mm))
+    sigma0 = float(np.polyfit(t0, phase, 1)[0])
+    if sigma0 == 0.0:
+        raise ValueError("Expected `m` to turn about the figure axis, got no mean rotation")
+    mn = mm / scale
+
+    def resid(x):
+        _, r = _project(t0, mn, np.array([x[0], -x[0]]), 0)
+        return np.concatenate([r.real, r.imag])
+
+    sol = least_squares(resid, [sigma0], x_scale=[abs(sigma0)], xtol=1e-15, ftol=1e-15,
+                        gtol=1e-15)
+    return (2.0 * np.pi / abs(float(sol.x[0]))) * u.day
+
+
+
+@dataclass(frozen=True)
+class WobbleFit:
+    """The least-squares wobble fit of :func:`fit_wobble`.
+
+    Periods and their errors are in days, amplitudes in mas, phases in degrees
+    (the argument of the complex amplitude at ``epoch``; prograde terms are
+    ``A exp(i (w (t - epoch) + phase))``, the retrograde annual term
+    ``A exp(-i (w (t - epoch)) + i phase)``).
+
+    ``rms_residual`` is per component (x or y) of the residual.  The errors are the
+    formal ones scaled by the residual scatter and by an
+    AR(1) effective sample size ``n (1 - rho) / (1 + rho)`` (``rho`` the lag-one
+    autocorrelation of the residuals, close to 1 for daily data).  The residuals
+    remain correlated over months (unmodelled excitation), so even these
+    errors are indicative, not rigorous.
+    """
+
+    chandler_period: u.Quantity
+    chandler_period_error: u.Quantity
+    chandler_period_error_formal: u.Quantity
+    annual_period: u.Quantity
+    annual_period_error: u.Quantity
+    chandler_amplitude: u.Quantity
+    chandler_phase: u.Quantity
+    annual_amplitude: u.Quantity
+    annual_phase: u.Quantity
+    annual_retrograde_amplitude: u.Quantity
+    annual_retrograde_phase: u.Quantity
+    mean_pole: u.Quantity
+    drift: u.Quantity
+    rms_residual: u.Quantity
+    residual_autocorrelation: float
+    epoch: Time
+    start: Time
+    end: Time
+    n: int
+    trend: str
+    amplitude_by_decade: QTable
+    q_estimate: float
+    q_caveat: str
+
+    def model(self, time: Time) -> u.Quantity:
+        """The fitted ``m(t)`` (complex, mas) at ``time``, trend included.
+
+        Examples
+        --------
+        >>> from rigid.earth.c04 import load_c04
+        >>> rec = load_c04().select(1980, 2000)
+        >>> fit = fit_wobble(rec)
+        >>> res = rec.m - fit.model(rec.time)
+        >>> bool(np.sqrt(np.mean(np.abs(res) ** 2) / 2) < 1.01 * fit.rms_residual)
+        True
+        """
+        t = mjd_utc(time) - float(self.epoch.mjd)
+        mean = self.mean_pole.to_value(u.mas) + self.drift.to_value(u.mas / u.yr) * t / 365.25
+        if self.trend == "iers2010":
+            xb, yb = iers2010_mean_pole(time)
+            mean = mean + xb.to_value(u.mas) - 1j * yb.to_value(u.mas)
+        wc = 2 * np.pi / self.chandler_period.to_value(u.day)
+        wa = 2 * np.pi / self.annual_period.to_value(u.day)
+
+        def c(a, p):
+            return a.to_value(u.mas) * np.exp(1j * p.to_value(u.rad))
+
+        return (mean + c(self.chandler_amplitude, self.chandler_phase) * np.exp(1j * wc * t)
+                + c(self.annual_amplitude, self.annual_phase) * np.exp(1j * wa * t)
+                + c(self.annual_retrograde_amplitude, self.annual_retrograde_phase)
+                * np.exp(-1j * wa * t)) * u.mas
+
+
+def _wobble_resid(x, t, m, n_trend):
+    """Residuals and Jacobian of the model for real parameters
+    x = [w_c, w_a, Re/Im of (trend..., chandler, annual+, annual-)]."""
+    wc, wa = x[0], x[1]
+    coef = x[2::2] + 1j * x[3::2]
+    design = _harmonic_design(t, np.array([wc, wa, -wa]), n_trend)
+    r = m - design @ coef
+    n_c = n_trend
+    jac_c = np.empty((t.size, x.size), dtype=np.complex128)
+    jac_c[:, 0] = -coef[n_c] * 1j * t * design[:, n_c]
+    jac_c[:, 1] = -(coef[n_c + 1] * 1j * t * design[:, n_c + 1]
+                    - coef[n_c + 2] * 1j * t * design[:, n_c + 2])
+    jac_c[:, 2::2] = -design
+    jac_c[:, 3::2] = -1j * design
+    return r, jac_c
+
+
+def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: float):
+    """Nonlinear least squares; returns (x, covariance (scaled), residual, rho, rms)."""
+    # start: the highest prograde line within +-10% of the guess, once the trend and the
+    # annual terms are removed (one matrix product instead of a nonlinear search)
+    _, detrended = _project(t, m, 2 * np.pi / np.array([t_a0, -t_a0]), n_trend)
+    grid = np.linspace(0.9 * t_c0, 1.1 * t_c0, 61)  # 0.33% steps; the line is ~2% wide
+    amp = np.abs(np.exp(-2j * np.pi * np.outer(1.0 / grid, t)) @ detrended)
+    tc = float(grid[int(np.argmax(amp))])
+    freqs = 2 * np.pi / np.array([tc, t_a0, -t_a0])
+    coef, _ = _project(t, m, freqs, n_trend)
+    x0 = np.concatenate([[freqs[0], freqs[1]], np.column_stack([coef.real, coef.imag]).ravel()])
+
+    cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+    def evaluate(x):  # fun and jac at the same x share one evaluation
+        key = x.tobytes()
+        if key not in cache:
+            cache.clear()
+            r, j = _wobble_resid(x, t, m, n_trend)
+            cache[key] = (np.concatenate([r.real, r.imag]), np.concatenate([j.real, j.imag]))
+        return cache[key]
+
+    def fun(x):
+        return evaluate(x)[0]
+
+    def jac(x):
+        return evaluate(x)[1]
+
+    scale = np.concatenate([[1e-4 * freqs[0], 1e-4 * freqs[1]],
+                            np.full(x0.size - 2, max(np.std(np.abs(m)), 1e-300))])
+    sol = least_squares(fun, x0, jac=jac, x_scale=scale, xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                        method="lm")
+    r, jc = _wobble_resid(sol.x, t, m, n_trend)
+    jr = np.concatenate([jc.real, jc.imag])
+    dof = 2 * t.size - sol.x.size
+    s2 = float(np.sum(np.abs(r) ** 2)) / dof
+    cov = np.linalg.inv(jr.T @ jr) * s2
+    rc = r - r.mean()
+    rho = float(np.real(np.vdot(rc[:-1], rc[1:])) / np.real(np.vdot(rc, rc)))
+    return sol.x, cov, r, rho, np.sqrt(s2)
+
+
+def _amp_phase(c: complex) -> tuple[u.Quantity, u.Quantity]:
+    return abs(c) * u.mas, (np.degrees(np.angle(c)) * u.deg)
+
+
+def fit_wobble(
+    record: PolarMotionRecord,
+    start: Any = None,
+    end: Any = None,
+    *,
+    trend: str = "linear",
+    chandler_guess: Any = 433 * u.day,
+) -> WobbleFit:
+    """Fit the Chandler and annual wobbles to an observed pole path.
+
+    Model (complex, ``m = x_p - i y_p``, mas, ``t`` in days from the window's
+    mid epoch)::
+
+        m(t) = mean + drift t + c_C exp(i w_C t) + c_A exp(i w_A t) + c_R exp(-i w_A t)
+
+    with ``mean + drift t`` a linear trend (``trend="linear"``), or the IERS 2010
+    mean pole (``trend="iers2010"``, IERS Conventions 2010 eq. 7.25) plus a
+    constant offset.  ``w_C`` and ``w_A`` are fitted nonlinearly (Levenberg-
+    Marquardt, scipy ``least_squares``, from a grid search of ``w_C`` with the
+    linear parameters projected out).
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+        From :func:`load_c04`.
+    start, end : Time, decimal year or None
+        The window (default: the whole record); within the record (a window
+        beyond it is refused, see :meth:`~rigid.earth.c04.PolarMotionRecord.select`).
+    trend : {"linear", "iers2010"}
+    chandler_guess : Quantity
+        Centre of the grid search (+-10%).
+
+    Returns
+    -------
+    WobbleFit
+        Also ``amplitude_by_decade`` (the Chandler and annual amplitudes fitted per
+        calendar decade with the periods of the whole window held fixed) and a Q
+        estimate with its caveat.
+
+    Examples
+    --------
+    >>> from rigid.earth.c04 import load_c04
+    >>> fit = fit_wobble(load_c04(), 1970, 2010)
+    >>> print(round(fit.chandler_period.to_value(u.day)), round(fit.annual_period.to_value(u.day)))
+    433 365
+    """
+    if not isinstance(record, PolarMotionRecord):
+        raise ValueError(f"Expected `record` from load_c04(), got {type(record).__name__}")
+    if trend not in ("linear", "iers2010"):
+        raise ValueError(f"Expected `trend` 'linear' or 'iers2010', got {trend!r}")
+    rec = record.select(start, end)
+    t_c0 = float(positive_scalar("chandler_guess", TIME("chandler_guess", chandler_guess,
+                                                         u.day)))
+    days = mjd_utc(rec.time)
+    mid = 0.5 * (days[0] + days[-1])
+    epoch = Time(mid, format="mjd", scale="utc")
+    t = days - mid
+    span = float(t[-1] - t[0])
+    if span < 3 * t_c0:
+        raise ValueError(
+            f"Expected a window of at least 3 Chandler periods ({3 * t_c0:.0f} d) to separate "
+            f"the Chandler and annual terms, got {span:.0f} d"
+        )
+    m = rec.m.to_value(u.mas)
+    n_trend = 2
+    if trend == "iers2010":
+        xb, yb = iers2010_mean_pole(rec.time)
+        m = m - (xb.to_value(u.mas) - 1j * yb.to_value(u.mas))
+        n_trend = 1
+    x, cov, _r, rho, rms = _fit_core(t, m, n_trend, t_c0, 365.25)
+    wc, wa = x[0], x[1]
+    coef = x[2::2] + 1j * x[3::2]
+    inflate = np.sqrt((1 + rho) / (1 - rho)) if rho < 1 else np.inf
+    err_wc = np.sqrt(cov[0, 0])
+    err_wa = np.sqrt(cov[1, 1])
+    t_c = 2 * np.pi / wc
+    t_a = 2 * np.pi / wa
+    ca, cp = _amp_phase(coef[n_trend])
+    aa, ap = _amp_phase(coef[n_trend + 1])
+    ra, rp = _amp_phase(coef[n_trend + 2])
+    drift = (coef[1] * 365.25 if n_trend == 2 else 0j) * u.mas / u.yr
+    decades = _amplitude_by_decade(rec, wc, wa)
+    q, caveat = _q_estimate(rec, t_c)
+    return WobbleFit(
+        chandler_period=t_c * u.day,
+        chandler_period_error=t_c * err_wc / wc * inflate * u.day,
+        chandler_period_error_formal=t_c * err_wc / wc * u.day,
+        annual_period=t_a * u.day,
+        annual_period_error=t_a * err_wa / wa * inflate * u.day,
+        chandler_amplitude=ca, chandler_phase=cp,
+        annual_amplitude=aa, annual_phase=ap,
+        annual_retrograde_amplitude=ra, annual_retrograde_phase=rp,
+        mean_pole=coef[0] * u.mas, drift=drift,
+        rms_residual=rms * u.mas,
+        residual_autocorrelation=rho,
+        epoch=epoch, start=rec.time[0], end=rec.time[-1], n=len(rec), trend=trend,
+        amplitude_by_decade=decades, q_estimate=q, q_caveat=caveat,
+    )
+
+
+def _amplitude_by_decade(rec: PolarMotionRecord, wc: float, wa: float) -> QTable:
+    """Chandler and annual amplitudes per calendar decade, periods held fixed."""
+    yr = decimal_year(rec.time)
+    rows = []
+    first = int(np.floor(yr[0] / 10.0) * 10)
+    for dec in range(first, int(yr[-1]) + 1, 10):
+        sel = (yr >= dec) & (yr < dec + 10)
+        if sel.sum() < 2 * 365:  # under two years: the terms cannot be separated
+            continue
+        sub = PolarMotionRecord(rec.time[sel], rec.x[sel], rec.y[sel])
+        days = mjd_utc(sub.time)
+        t = days - 0.5 * (days[0] + days[-1])
+        coef, _ = _project(t, sub.m.to_value(u.mas), np.array([wc, wa, -wa]), 2)
+        rows.append((dec, float(yr[sel][0]), float(yr[sel][-1]), abs(coef[2]), abs(coef[3]),
+                     abs(coef[4])))
+    cols = list(zip(*rows, strict=True)) if rows else [[]] * 6
+    return QTable(
+        [np.array(cols[0], dtype=int), np.array(cols[1]) * u.yr, np.array(cols[2]) * u.yr,
+         np.array(cols[3]) * u.mas, np.array(cols[4]) * u.mas, np.array(cols[5]) * u.mas],
+        names=("decade", "from", "to", "chandler_amplitude", "annual_amplitude",
+               "annual_retrograde_amplitude"),
+    )
+
+
+def _q_estimate(rec: PolarMotionRecord, t_c: float) -> tuple[float, str]:
+    """Q from the half-power width of the Chandler line (resolution limited)."""
+    days = mjd_utc(rec.time)
+    years = (days[-1] - days[0]) / 365.25
+    f_c = 365.25 / t_c
+    freqs = np.linspace(f_c - 0.04, f_c + 0.04, 81)
+    pg = periodogram(rec, freqs / u.yr)
+    power = pg["amplitude"].to_value(u.mas) ** 2
+    k = int(np.argmax(power))
+    half = power[k] / 2
+    lo = k
+    while lo > 0 and power[lo] > half:
+        lo -= 1
+    hi = k
+    while hi < power.size - 1 and power[hi] > half:
+        hi += 1
+    fwhm = float(freqs[hi] - freqs[lo])
+    q = f_c / fwhm
+    caveat = (
+        f"Q = f_C / FWHM of the Chandler line = {q:.0f}.  The window's own resolution "
+        f"({1 / years:.3f} cycles/yr over {years:.1f} yr) limits the width, so this is of "
+        "the order of the largest Q the record can resolve, not a measurement of the "
+        "damping: the wobble is re-excited continuously (atmosphere, ocean, hydrology), so a "
+        "line width mixes damping and excitation.  Published estimates range from ~50 to "
+        "~200 (e.g. Wilson & Vicente 1990, GJI 102, 29: Q ~ 179; Furuya & Chao 1996, GJI "
+        "127, 693: Q ~ 49-250)."
+    )
+    return q, caveat
+
+
+def periodogram(
+    record: PolarMotionRecord, frequency: Any = None, *, trend: str = "linear"
+) -> QTable:
+    """The complex (two-sided) amplitude spectrum of the pole path.
+
+    ``A(f) = |(1/n) sum_k (m_k - trend_k) exp(-2 pi i f t_k)|`` (mas), ``f`` in
+    cycles per year: positive ``f`` is prograde, negative retrograde.  For a pure
+    term ``a exp(2 pi i f0 t)``, ``A(f0) = |a|``.
+
+    Parameters
+    ----------
+    record : PolarMotionRecord
+    frequency : Quantity, optional
+        Frequencies (1/yr, 1/day ...); default -1.5 .. 1.5 cycles/yr, 1201 points.
+    trend : {"linear", "iers2010"}
+        What is removed first (a least-squares line, or the IERS 2010 mean pole).
+
+    Returns
+    -------
+    astropy.table.QTable
+        Columns ``frequency`` (1/yr), ``period`` (d, signed) and ``amplitude`` (mas).
+
+    Examples
+    --------
+    >>> from rigid.earth.c04 import load_c04
+    >>> pg = periodogram(load_c04(), np.linspace(0.8, 0.9, 101) / u.yr)
+    >>> print(f'{pg["period"][np.argmax(pg["amplitude"])]:.0f}')  # the Chandler line
+    432 d
+    """
+    if not isinstance(record, PolarMotionRecord):
+        raise ValueError(f"Expected `record` from load_c04(), got {type(record).__name__}")
+    if frequency is None:
+        f = np.linspace(-1.5, 1.5, 1201)
+    else:
+        if not isinstance(frequency, u.Quantity):
+            raise u.UnitConversionError(
+                f"Expected `frequency` to be a Quantity of 1/time, got {frequency!r}"
+            )
+        f = as_float_array("frequency", frequency.to_value(1 / u.yr))
+    days = mjd_utc(record.time)
+    t = (days - days[0]) / 365.25
+    m = record.m.to_value(u.mas)
+    if trend == "iers2010":
+        xb, yb = iers2010_mean_pole(record.time)
+        m = m - (xb.to_value(u.mas) - 1j * yb.to_value(u.mas))
+        m = m - m.mean()
+    elif trend == "linear":
+        _coef, m = _project(t, m, np.zeros(0), 2)
+    else:
+        raise ValueError(f"Expected `trend` 'linear' or 'iers2010', got {trend!r}")
+    amp = np.empty(f.size)
+    chunk = max(1, 2_000_000 // max(t.size, 1))
+    for i in range(0, f.size, chunk):  # chunks of frequencies, vectorised over time
+        fs = f[i:i + chunk]
+        amp[i:i + chunk] = np.abs(np.exp(-2j * np.pi * np.outer(fs, t)) @ m) / t.size
+    with np.errstate(divide="ignore"):
+        period = np.where(f != 0, 365.25 / np.where(f != 0, f, 1.0), np.inf)
+    return QTable([f / u.yr, period * u.day, amp * u.mas],
+                 names=("frequency", "period", "amplitude"))
