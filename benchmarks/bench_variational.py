@@ -100,7 +100,7 @@ def _rebound_cell(args: tuple) -> float:
 
 
 def stability_map(n: int, orbits: float) -> None:
-    from hamilton_orbits._scene_nbody import build_system
+    from hamilton_orbits.scenes.nbody.build import build_system
 
     a = [f"{float(x)!r} au" for x in np.linspace(7.0, 10.0, n)]
     e = [float(x) for x in np.linspace(0.0, 0.5, n)]

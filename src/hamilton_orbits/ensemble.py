@@ -22,6 +22,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
+from hamilton_orbits._progress import progress_bar
 from hamilton_orbits.scene import Scene
 
 __all__ = ["Ensemble", "run_member"]
@@ -203,7 +204,7 @@ class Ensemble:
                 "Ensemble tables need pandas: pip install 'hamilton-orbits[dask]'"
             ) from exc
         args = [(self.scene.data, self.scene.source, m) for m in self.members]
-        bar = _bar(len(args), progress)
+        bar = progress_bar(len(args), progress, "member")
         rows: list[dict | None] = [None] * len(args)
         try:
             if client is not None:
@@ -255,15 +256,3 @@ def _pool(n: int, executor: Any, mp: Any) -> Any:
         _POOLS[n] = pool
         atexit.register(pool.shutdown, wait=False, cancel_futures=True)
     return pool
-
-
-def _bar(total: int, enabled: bool):
-    if not enabled:
-        return None
-    import sys
-
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is in the [progress] extra
-        return None
-    return tqdm(total=total, unit="member", disable=not sys.stderr.isatty(), leave=False)

@@ -46,7 +46,7 @@ def test_solar_system_quick_against_ias15():
 
 def test_scene_effects_are_exactly_what_is_compiled():
     """`scene.effects` is what runs: the compiled right-hand side holds just those."""
-    from hamilton_orbits._scene_nbody import build_system
+    from hamilton_orbits.scenes.nbody.build import build_system
 
     for name, expected in (("solar-system", ("newtonian",)),
                            ("mercury-gr", ("newtonian", "gr")),

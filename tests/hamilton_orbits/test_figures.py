@@ -107,7 +107,7 @@ def test_ecliptic_frame_gives_table_inclinations():
 def test_scene_frame_key_rotates_the_solar_system():
     base = {"kind": "nbody", "duration": "1 d",
             "initial": {"solar_system": {"bodies": ["sun", "mars"]}}}
-    from hamilton_orbits._scene_nbody import build_system
+    from hamilton_orbits.scenes.nbody.build import build_system
 
     ecl = build_system(Scene.from_dict({**base, "initial": {**base["initial"],
                                                              "frame": "ecliptic"}}).spec)

@@ -94,8 +94,8 @@ def test_integration_time_excludes_compilation():
 
     import numpy as np
 
-    from hamilton_orbits._scene_nbody import without_compilation
     from hamilton_orbits.engine import EngineRun
+    from hamilton_orbits.scenes.nbody.run import without_compilation
 
     def run() -> EngineRun:
         start = time.perf_counter()

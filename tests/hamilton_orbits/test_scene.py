@@ -198,3 +198,38 @@ def test_rebound_binary_in_and_out(tmp_path):
     bad = Scene.from_dict
     with pytest.raises(SceneError, match=r"initial.rebound: no such file"):
         bad({"kind": "nbody", "duration": "1 d", "initial": {"rebound": "nope.bin"}})
+
+
+def test_the_public_path_gives_the_objects_of_the_scenes_package():
+    """``hamilton_orbits.scene`` re-exports the objects of ``hamilton_orbits.scenes``
+    (the same objects, no warning: DESIGN.md and user code name it)."""
+    import warnings
+
+    import hamilton_orbits.scene as public
+    from hamilton_orbits.scenes import base, result, scene
+
+    homes = {"Scene": scene, "SceneError": scene, "Result": result}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in public.__all__:
+            assert getattr(public, name) is getattr(homes.get(name, base), name), name
+    assert public.Scene is Scene
+
+
+def test_the_nbody_kind_registers_through_the_entry_point_group():
+    """``nbody`` is declared in the group ``hamilton_orbits.scene_kinds`` as
+    ``rigid``'s ``rotation`` is; where the installed metadata lacks it, the registry
+    loads the same entry point from :data:`~hamilton_orbits.scenes.base.BUILT_IN`."""
+    from pathlib import Path
+
+    import tomllib
+
+    from hamilton_orbits.scenes import base
+    from hamilton_orbits.scenes.nbody import kind
+
+    pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
+    declared = tomllib.loads(pyproject.read_text())["project"]["entry-points"][base.GROUP]
+    assert {ep.name: ep.value for ep in base.BUILT_IN} == {"nbody": declared["nbody"]}
+    assert base.BUILT_IN[0].load() is kind.register
+    assert base.registered_kinds()["nbody"] is kind.KIND
+    assert {"nbody", "rotation"} <= set(base.KINDS)

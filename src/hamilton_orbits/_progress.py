@@ -1,0 +1,20 @@
+"""The progress bar of the scene runs and ensembles (:func:`progress_bar`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def progress_bar(total: int, enabled: bool, unit: str) -> Any:
+    """A tqdm bar on stderr counting ``total`` of ``unit`` ("output", "member"),
+    quiet when stderr is not a terminal; None when not ``enabled`` or without tqdm
+    (the ``[progress]`` extra)."""
+    import sys
+
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is in the [progress] extra
+        return None
+    return tqdm(total=total, unit=unit, disable=not sys.stderr.isatty(), leave=False)

@@ -1,0 +1,143 @@
+"""What the ``[[analysis]]`` entries of an ``nbody`` scene measure
+(:data:`ANALYSIS_FUNCTIONS`): the perihelion advance, the nodal regression, the
+closest approach, the residuals against DE440."""
+
+from __future__ import annotations
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits.scenes.nbody.build import scene_frame
+from hamilton_orbits.scenes.nbody.figures import plot_de440
+from hamilton_orbits.scenes.result import Result
+
+
+def _relative_orbits(result: Result, system, body: str, primary: str):
+    from hamilton_orbits import KeplerOrbit
+
+    names = list(system.names)
+    i, j = names.index(body), names.index(primary)
+    r = result.states["r"][:, i] - result.states["r"][:, j]
+    v = result.states["v"][:, i] - result.states["v"][:, j]
+    gm = system.gm
+    mu = gm[i] + gm[j]
+    return KeplerOrbit.from_state(r.to(u.km), v.to(u.km / u.s), mu.to(u.km**3 / u.s**2))
+
+
+CENTURY = u.def_unit("century", 100 * u.yr)
+
+
+def _rate(times: u.Quantity, angle: u.Quantity) -> u.Quantity:
+    """Least-squares slope of an unwrapped angle against time."""
+    y = np.unwrap(angle.to_value(u.rad))
+    t = times.to_value(u.d)
+    slope = np.polyfit(t - t.mean(), y, 1)[0]
+    return slope * u.rad / u.d
+
+
+def _perihelion_advance(result: Result, system, an: dict) -> None:
+    primary = an.get("primary") or system.names[int(np.argmax(np.asarray(
+        getattr(system.gm, "value", system.gm))))]
+    orbits = _relative_orbits(result, system, an["body"], primary)
+    rate = _rate(result.times, orbits.varpi).to(u.arcsec / CENTURY)
+    result.metrics[f"perihelion advance of {an['body']}"] = rate
+
+
+def _nodal_regression(result: Result, system, an: dict) -> None:
+    primary = an.get("primary") or system.names[0]
+    orbits = _relative_orbits(result, system, an["body"], primary)
+    rate = _rate(result.times, orbits.lan).to(u.deg / u.d)
+    result.metrics[f"nodal regression of {an['body']}"] = rate
+    prim = system[primary]
+    j2 = getattr(prim, "j2", None)
+    if j2 is not None and getattr(prim, "radius", None) is not None:
+        # first-order secular rate: dOmega/dt = -3/2 n J2 (R/p)^2 cos i (Vallado 4th ed. 9-41)
+        o = orbits[0]
+        j2v = float(getattr(j2, "value", j2))
+        formula = (-1.5 * o.n * j2v * (prim.radius / o.p).to(u.one) ** 2 * np.cos(o.inc))
+        formula = formula.to(u.deg / u.d)
+        result.metrics["J2 first-order formula"] = formula
+        result.metrics["ratio simulated / formula"] = float(rate / formula)
+
+
+def _close_approach(result: Result, system, an: dict) -> None:
+    """Smallest distance between two bodies, refined between outputs.
+
+    Around the closest sampled output the relative motion is taken as straight
+    (``d + w t``) over at most half a cadence either side, which is accurate when
+    the cadence is short beside the encounter's duration; the heliocentric (or
+    ``primary``-centric) orbit of ``body`` before and after is reported too.
+    """
+    names = list(system.names)
+    i, j = names.index(an["body"]), names.index(an["other"])
+    r = result.states["r"].to_value(u.au)
+    v = result.states["v"].to_value(u.au / u.d)
+    t = result.times.to_value(u.d)
+    d = r[:, i] - r[:, j]
+    w = v[:, i] - v[:, j]
+    dist = np.linalg.norm(d, axis=-1)
+    k = int(np.argmin(dist))
+    lo = 0.5 * (t[max(k - 1, 0)] - t[k])  # half-way to the neighbouring outputs,
+    hi = 0.5 * (t[min(k + 1, len(t) - 1)] - t[k])  # never beyond the run's ends
+    ww = float(w[k] @ w[k])
+    tau = float(np.clip(-(d[k] @ w[k]) / ww, lo, hi)) if ww > 0 else 0.0
+    closest = float(np.linalg.norm(d[k] + w[k] * tau))
+    result.metrics[f"closest approach {an['body']}-{an['other']}"] = closest * u.au
+    result.metrics["at time"] = ((t[k] + tau) * u.d).to(u.yr)
+    primary = an.get("primary")
+    if primary:
+        orbits = _relative_orbits(result, system, an["body"], primary)
+        for label, idx in (("before", 0), ("after", -1)):
+            o = orbits[idx]
+            # 1/a too: it is continuous through the parabola (a jumps from +inf to
+            # -inf there, as a clone that escapes does), and q, finite for every conic
+            result.metrics[f"{an['body']} orbit {label}: a"] = o.a.to(u.au)
+            result.metrics[f"{an['body']} orbit {label}: 1/a"] = (1 / o.a).to(1 / u.au)
+            result.metrics[f"{an['body']} orbit {label}: q"] = o.q.to(u.au)
+            result.metrics[f"{an['body']} orbit {label}: e"] = float(o.e)
+
+
+def _de440_residuals(result: Result, system, an: dict) -> None:
+    """The positions against DE440's at the whole years from J2000 among the outputs:
+    km and arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100
+    years (those reached), and a figure of the residual against time."""
+    from hamilton_orbits.studies.ladder import BODIES, residuals
+
+    years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start (J2000)
+    whole = np.flatnonzero(np.abs(years - np.round(years)) < 1e-9)
+    if result.scene.spec["initial"].get("ephemeris") is None or len(whole) < 2:
+        result.metrics["DE440 residuals"] = "need [initial] ephemeris and yearly outputs"
+        return
+    if scene_frame(result.scene.spec) != "icrs":
+        from hamilton_orbits.frames import frame_rotation
+
+        rot = frame_rotation(scene_frame(result.scene.spec))
+        r = result.states["r"].to_value(u.au)[whole] @ rot  # back to ICRS axes
+    else:
+        r = result.states["r"].to_value(u.au)[whole]
+    yrs = np.round(years[whole]).astype(int)
+    km, arcsec = residuals(system.names, r, yrs)
+    result.diagnostics["de440_years"] = yrs
+    result.diagnostics["de440_km"] = km
+    rows = []
+    for k, body in enumerate(BODIES):
+        row = {"body": body}
+        for y in (10, 50, 100):
+            if y in yrs:
+                i = int(np.flatnonzero(yrs == y)[0])
+                row[f"{y} yr"] = f"{km[i, k]:.3g} km ({arcsec[i, k]:.2g}\")"
+        rows.append(row)
+    result.tables["residuals against DE440 (heliocentric; the Moon geocentric)"] = rows
+    result.metrics["largest residual at the end"] = (
+        f"{BODIES[int(np.argmax(km[-1]))]}: {km[-1].max():.3g} km")
+    result.plotters.append(plot_de440)
+
+
+
+ANALYSIS_FUNCTIONS = {
+    "de440_residuals": _de440_residuals,
+    "perihelion_advance": _perihelion_advance,
+    "nodal_regression": _nodal_regression,
+    "close_approach": _close_approach,
+}
+

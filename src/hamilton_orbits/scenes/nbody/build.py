@@ -1,0 +1,158 @@
+"""The :class:`~hamilton_orbits.nbody.System` a validated ``nbody`` scene starts
+from (:func:`build_system`), the bodies its ``[initial]`` table names, and the
+frame of its states."""
+
+from __future__ import annotations
+
+import re
+
+import astropy.units as u
+
+from hamilton_orbits import schema as S
+from hamilton_orbits.frames import frame_label
+from hamilton_orbits.scenes.nbody.schema import BODY
+
+# the Sun and the planets with the Earth-Moon barycentre as one body (System.solar_system)
+_DEFAULT_SOLAR = ("sun", "mercury", "venus", "earth-moon-barycenter", "mars", "jupiter",
+                  "saturn", "uranus", "neptune")
+
+
+def rebound_names(path: str) -> list[str]:
+    """Names of the particles in a rebound binary (``body<k>`` for unnamed ones)."""
+    import rebound
+
+    from hamilton_orbits.rebound_bridge import particle_name
+
+    sim = rebound.Simulation(str(path))
+    return [particle_name(sim.particles[k]) or f"body{k}" for k in range(sim.N)]
+
+
+def initial_names(spec: dict) -> list[str]:
+    """The names of the bodies the ``[initial]`` table brings in, in order."""
+    names: list[str] = []
+    rb = spec["initial"].get("rebound")
+    if rb is not None:
+        if spec["initial"].get("names"):
+            names += list(spec["initial"]["names"])
+        else:
+            try:
+                names += rebound_names(rb)
+            except Exception:  # checked with a message in check.py
+                pass
+    ss = spec["initial"].get("solar_system")
+    if ss is not None:
+        names += list(_DEFAULT_SOLAR if ss.get("bodies") is None else ss["bodies"])
+    eph = spec["initial"].get("ephemeris")
+    if eph is not None:
+        from hamilton_orbits.ephemeris import DEFAULT_BODIES
+
+        names += list(DEFAULT_BODIES if eph.get("bodies") is None else eph["bodies"])
+    return names
+
+
+
+def problem_text(exc: Exception) -> str:
+    """An exception's message as a problem's text (after the key path: lower case)."""
+    msg = str(exc)
+    return "e" + msg[1:] if msg.startswith("Expected ") else msg
+
+
+def attempt(problems: S.Problems | None, path: str, build, keys=()):
+    """``build()``, or with ``problems`` its ``ValueError`` as a problem at ``path``
+    (at ``path.key`` when the message names one of ``keys`` first) and None."""
+    if problems is None:
+        return build()
+    try:
+        return build()
+    except ValueError as exc:
+        msg = str(exc)
+        named = re.search(r"`(\w+)`", msg)
+        if named and named.group(1) in keys:
+            path = f"{path}.{named.group(1)}"
+        problems.add(path, problem_text(exc))
+        return None
+
+
+def _scene_body(b: dict, by_name: dict):
+    """The :class:`~hamilton_orbits.nbody.Body` of one ``[[bodies]]`` table."""
+    from hamilton_orbits import Body, KeplerOrbit
+
+    extra = {k: b[k] for k in ("radius", "j2", "pole") if b[k] is not None}
+    if b["r"] is not None:
+        return Body(b["name"], gm=b["gm"], r=b["r"], v=b["v"], **extra)
+    prim = by_name[b["primary"]]
+    mu = (prim.gm + b["gm"]).to(u.km**3 / u.s**2)
+    kw = {k: b[k] for k in ("a", "p", "q", "M", "nu") if b[k] is not None}
+    orbit = KeplerOrbit.from_elements(
+        e=b["e"] if b["e"] is not None else 0.0,
+        inc=b["inc"] if b["inc"] is not None else 0 * u.rad,
+        lan=b["lan"] if b["lan"] is not None else 0 * u.rad,
+        argp=b["argp"] if b["argp"] is not None else 0 * u.rad,
+        mu=mu,
+        **({"M": 0 * u.rad} if "M" not in kw and "nu" not in kw else {}),
+        **kw,
+    )
+    r, v = orbit.state()
+    return Body(b["name"], gm=b["gm"], r=prim.r + r, v=prim.v + v, **extra)
+
+
+def build_system(spec: dict, problems: S.Problems | None = None):
+    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from.
+
+    With ``problems`` (while the scene is checked), a refusal of the system, a
+    body or its orbit is added there at its key path and None is returned.
+    """
+    from hamilton_orbits import System
+
+    init = spec["initial"]
+    bodies: list = []
+    if init.get("rebound") is not None:
+        import rebound
+
+        # lengths in au, times in days, G m in au^3/day^2 (what final.bin holds)
+        base = attempt(problems, "initial.rebound", lambda: System.from_rebound(
+            rebound.Simulation(str(init["rebound"])), quantity=True, names=init.get("names")))
+        bodies += [] if base is None else [base[n] for n in base.names]
+    ss = init.get("solar_system")
+    if ss is not None:
+        base = attempt(problems, "initial.solar_system", lambda: System.solar_system(
+            ss["epoch"], bodies=ss.get("bodies"), frame=scene_frame(spec),
+            origin=ss.get("origin") or "barycentre"), ("epoch", "bodies"))
+        bodies += [] if base is None else [base[n] for n in base.names]
+    eph = init.get("ephemeris")
+    if eph is not None:
+        base = attempt(problems, "initial.ephemeris", lambda: System.from_ephemeris(
+            eph["epoch"], bodies=eph.get("bodies"), frame=scene_frame(spec)),
+            ("epoch", "bodies"))
+        bodies += [] if base is None else [base[n] for n in base.names]
+    by_name = {b.name: b for b in bodies}
+    for i, b in enumerate(spec["bodies"]):
+        if b["r"] is None and b["primary"] not in by_name:
+            continue  # its primary was refused: said already
+        body = attempt(problems, f"bodies[{i}]", lambda b=b: _scene_body(b, by_name),
+                        tuple(BODY.fields))
+        if body is not None:
+            bodies.append(body)
+            by_name[body.name] = body
+    if problems:
+        return None
+    return attempt(problems, "bodies", lambda: System(bodies))
+
+
+def scene_frame(spec: dict) -> str:
+    """The frame of a validated n-body scene's states (``[initial] frame``)."""
+    return spec["initial"].get("frame") or "icrs"
+
+
+def frame_note(spec: dict) -> str:
+    """The frame line of a scene's summary: the axes, and the origin of the
+    solar-system bodies."""
+    note = frame_label(scene_frame(spec))
+    ss = spec["initial"].get("solar_system")
+    if ss is not None:
+        origin = ss.get("origin") or "barycentre"
+        note += ("; origin: the centre of mass of the scene's solar-system bodies, at rest"
+                 if origin == "barycentre" else
+                 "; origin: the solar-system barycentre (the ephemeris's)")
+    return note
+

@@ -1,0 +1,400 @@
+"""Scenes: a file says what to simulate and which effects; ``run`` does it.
+
+A scene is a short TOML file (``docs/scenes.md`` documents the format)::
+
+    kind = "nbody"
+    description = "Mercury's relativistic perihelion advance"
+    duration = "100 yr"
+    cadence = "10 d"
+    effects = ["gr"]
+
+    [integrator]
+    method = "radau15"
+
+    [initial]
+    solar_system = { epoch = "J2000", bodies = ["sun", "mercury"] }
+
+    [[analysis]]
+    name = "perihelion_advance"
+    body = "mercury"
+
+Every key is checked before anything is simulated; every problem is reported
+with the file, the key path (``bodies[2].gm``) and, for an unknown name, the
+closest valid names.  Only the listed effects are computed.
+Scene *kinds* (``nbody``; ``rotation`` from ``rigid``) come from the registry of
+:mod:`hamilton_orbits.scenes.base`, which every package (this one too) fills
+through the entry-point group ``hamilton_orbits.scene_kinds``, so that
+``hamilton_orbits`` never imports them.  This module holds :class:`Scene`,
+:class:`SceneError`, the ``effects`` key every kind shares, and the overrides
+(:meth:`Scene.with_values`, ``--set KEY=VALUE``).
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import tomllib
+
+from hamilton_orbits import effects as _effects
+from hamilton_orbits import schema as S
+from hamilton_orbits.scenes.base import KINDS, registered_kinds
+from hamilton_orbits.scenes.result import Result
+
+__all__ = ["Scene", "SceneError"]
+
+
+class SceneError(ValueError):
+    """A scene that is not valid; ``problems`` lists every problem found.
+
+    Each problem reads ``file:LINE: key.path: what is wrong`` (``file: key.path:
+    ...`` where the key is not in the file).
+    """
+
+    def __init__(self, problems: Sequence[str]) -> None:
+        self.problems = list(problems)
+        n = len(self.problems)
+        head = "1 problem" if n == 1 else f"{n} problems"
+        super().__init__(f"invalid scene ({head}):\n  " + "\n  ".join(self.problems))
+
+
+def _effect_entry(effect_kind: str) -> S.Field:
+    return _EffectField(effect_kind=effect_kind)
+
+
+@dataclass
+class _EffectField(S.Field):
+    """An effect: a registered name, or a table ``{name = "j2", body = "earth"}``.
+
+    A parameter with a dimension (the effect's ``parameter_kinds``: ``c``, a
+    speed) is read like any value with a unit (``c = "299792.458 km/s"``); a
+    parameter that names a body must be a string.
+    """
+
+    effect_kind: str = "nbody"
+
+    def check(self, value: Any, path: str, problems: S.Problems) -> Any:
+        name, params, found = _effects.entry_problems(value, self.effect_kind)
+        for key, message in found:
+            problems.add(f"{path}.{key}" if key else path, message)
+        if name is None:
+            return None
+        spec = _effects.get(self.effect_kind, name)
+        out = dict(params)
+        for key, val in params.items():
+            where = f"{path}.{key}"
+            if key in spec.parameter_kinds:
+                out[key] = S.Quantity(kind=spec.parameter_kinds[key]).check(val, where, problems)
+            elif key in spec.name_parameters:
+                out[key] = S.String(nonempty=True).check(val, where, problems)
+        return {"name": name, **out}
+
+
+def _parse_override(value: str) -> Any:
+    try:
+        return tomllib.loads(f"x = {value}")["x"]
+    except tomllib.TOMLDecodeError:
+        return value
+
+
+def _override_parts(key: str, source: str) -> list[str | int]:
+    """``"bodies[2].gm"`` -> ``["bodies", 2, "gm"]``; an unreadable path is a SceneError."""
+    parts: list[str | int] = []
+    for piece in key.split("."):
+        m = re.fullmatch(r"\s*([^\[\]\s]*)\s*((?:\[[^\[\]]*\]\s*)*)", piece)
+        if m is None or not (m.group(1) or m.group(2)):
+            raise SceneError([f"{source}: {key}: cannot read the key path (write it as "
+                              "integrator.tol, bodies[1].gm or bodies.earth.gm)"])
+        if m.group(1):
+            parts.append(m.group(1))
+        for index in re.findall(r"\[([^\[\]]*)\]", m.group(2)):
+            if not index.strip().isdigit():
+                raise SceneError([f"{source}: {key}: expected a number in [...], got "
+                                  f"[{index}] (a table in a list is addressed by its name: "
+                                  "bodies.earth.gm)"])
+            parts.append(int(index))
+    return parts
+
+
+def _path_text(parts: Sequence[str | int]) -> str:
+    """``("bodies", 1, "gm")`` -> ``"bodies[1].gm"`` (the key paths of problems)."""
+    return "".join(f"[{p}]" if isinstance(p, int) else (f".{p}" if k else p)
+                   for k, p in enumerate(parts))
+
+
+def _set_path(data: dict, key: str, value: Any, source: str) -> tuple[str | int, ...]:
+    """Set ``key`` ("integrator.tol", "bodies[2].gm", "bodies.mercury.e") in ``data``.
+
+    Returns the path set, with names of tables in lists resolved to indices.
+
+    Raises
+    ------
+    SceneError
+        For a path that cannot be read, an index beyond a list, a name not in a
+        list, or a key below a value, naming the key.
+    """
+    parts = _override_parts(key, source)
+    resolved: list[str | int] = []
+    node: Any = data
+
+    def fail(message: str) -> SceneError:
+        return SceneError([f"{source}: {key}: {message}"])
+
+    for i, part in enumerate(parts):
+        where = _path_text(resolved) or "the scene"
+        last = i == len(parts) - 1
+        if isinstance(node, list):
+            if isinstance(part, str):  # a table in a list addressed by its name
+                names = [x.get("name") for x in node if isinstance(x, dict)]
+                if part not in names:
+                    raise fail(f"no entry named {part!r} in {where}"
+                               f"{S.closest(part, [str(n) for n in names])}")
+                part = names.index(part)
+            elif not part < len(node):
+                held = (f"{len(node)} entries (indices 0 to {len(node) - 1})" if node
+                        else "no entries")
+                raise fail(f"{where} has {held}; [{part}] is beyond it (an override "
+                           "changes an entry, it does not add one)")
+        elif isinstance(node, dict):
+            if isinstance(part, int):
+                raise fail(f"{where} is a table, not a list: name its key, not [{part}]")
+            if not last and part not in node:
+                node[part] = [] if isinstance(parts[i + 1], int) else {}
+        else:
+            raise fail(f"{where} is a value ({node!r}), not a table: it has no key {part!r}")
+        resolved.append(part)
+        if last:
+            node[part] = value
+        else:
+            node = node[part]
+
+
+    return tuple(resolved)
+class Scene:
+    """A validated description of one study.
+
+    Build one with :meth:`from_toml`, :meth:`bundled` or :meth:`from_dict`;
+    nothing is simulated until :meth:`run`.  Every problem of an invalid scene is
+    reported at once (:class:`SceneError`), as ``file:LINE: key.path: message``
+    (the line where the file sets the key; none for a key the file leaves out,
+    for a value set by :meth:`with_values`, or for a scene from a mapping).
+
+    Examples
+    --------
+    >>> scene = Scene.bundled("mercury-gr")
+    >>> scene.kind, [e["name"] for e in scene.effects]
+    ('nbody', ['gr'])
+    >>> Scene.from_dict({"kind": "nbody", "duraton": "1 yr"})  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    hamilton_orbits.scenes.scene.SceneError: invalid scene (...):
+      <dict>: duraton: unknown key (did you mean 'duration'...?)
+      ...
+    """
+
+    def __init__(self, data: Mapping[str, Any], source: str = "<dict>", *,
+                 text: str | None = None, overrides: Sequence[tuple] = ()) -> None:
+        if not isinstance(data, Mapping):
+            raise SceneError([f"{source}: expected a mapping shaped like a scene file "
+                              f"(kind, duration, ...), got {data!r}"])
+        self.source = source
+        self.data = copy.deepcopy(dict(data))
+        # the file's text (for the lines of keys) and the key paths set since (no line)
+        self._text = text
+        self._overrides = tuple(overrides)
+        self.spec = self._validate(self.data)
+
+    # --- construction -------------------------------------------------
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+        """A scene from a mapping shaped like the TOML file.
+
+        Raises
+        ------
+        SceneError
+            For anything but a mapping, or any invalid key.
+        """
+        return cls(data, source)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scene:
+        """Read and validate a scene file.
+
+        Raises
+        ------
+        SceneError
+            For a missing file, a TOML syntax error (with the line), or any
+            invalid key, naming the file.
+        """
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise SceneError([f"{p}: cannot read the scene file ({exc.strerror})"]) from exc
+        except UnicodeDecodeError as exc:
+            raise SceneError([f"{p}: not a scene file: not text in UTF-8 (byte "
+                              f"{exc.object[exc.start]:#04x} at offset {exc.start})"]) from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError([f"{p}: TOML syntax error: {exc}"]) from exc
+        return cls(data, str(p), text=text)
+
+    @staticmethod
+    def _bundled_dir():
+        return resources.files("hamilton_orbits") / "data" / "scenes"
+
+    @classmethod
+    def bundled(cls, name: str) -> Scene:
+        """One of the scenes that ship with the package (see :meth:`list_bundled`)."""
+        names = [n for n, _ in cls.list_bundled()]
+        if name not in names:
+            raise SceneError([f"{name}: no bundled scene of that name{S.closest(name, names)}"])
+        res = cls._bundled_dir() / f"{name}.toml"
+        text = res.read_text(encoding="utf-8")
+        return cls(tomllib.loads(text), f"{name}.toml", text=text)
+
+    @classmethod
+    def list_bundled(cls) -> list[tuple[str, str]]:
+        """The bundled scenes: ``(name, one-line description)``, sorted by name.
+
+        Examples
+        --------
+        >>> "solar-system" in dict(Scene.list_bundled())
+        True
+        """
+        out = []
+        for res in cls._bundled_dir().iterdir():
+            if res.name.endswith(".toml"):
+                data = tomllib.loads(res.read_text(encoding="utf-8"))
+                out.append((res.name[:-5], str(data.get("description", "")).split("\n")[0]))
+        return sorted(out)
+
+    def with_values(self, values: Mapping[str, Any]) -> Scene:
+        """A copy with some keys replaced: ``{"integrator.tol": 1e-10}``.
+
+        String values are read as TOML values where they parse (``"1e-10"`` is
+        a number, ``"100 yr"`` stays a string), as ``--set KEY=VALUE`` does.
+
+        Raises
+        ------
+        SceneError
+            For a key path that cannot be read or does not lead to a key (an
+            index beyond a list, a name not in it, a key below a value), or an
+            invalid scene, naming the key.
+        """
+        if not isinstance(values, Mapping):
+            raise SceneError([f"{self.source}: expected the values as a mapping "
+                              f"{{'key.path': value}}, got {values!r}"])
+        data = copy.deepcopy(self.data)
+        overrides = list(self._overrides)
+        for key, value in values.items():
+            if not isinstance(key, str):
+                raise SceneError([f"{self.source}: expected a key path such as "
+                                  f"'integrator.tol', got {key!r}"])
+            v = _parse_override(value) if isinstance(value, str) else value
+            overrides.append(_set_path(data, key, v, self.source))
+        return Scene(data, self.source, text=self._text, overrides=overrides)
+
+    def _locate(self):
+        """``path -> line`` in the scene's file (None for keys set since, or no file)."""
+        if self._text is None:
+            return None
+        lines = S.key_lines(self._text)
+        overrides = self._overrides
+
+        def locate(path: str) -> int | None:
+            parts = S.split_path(path)
+            if any(parts[:len(o)] == o for o in overrides):
+                return None
+            while parts:
+                if parts in lines:
+                    return lines[parts]
+                parts = parts[:-1]
+            return None
+
+        return locate
+
+    # --- validation ---------------------------------------------------
+    def _validate(self, data: dict) -> dict:
+        problems = S.Problems(self.source, self._locate())
+        kinds = registered_kinds()
+        kind_name = data.get("kind")
+        if kind_name is None:
+            problems.add("kind", f"missing: one of {', '.join(map(repr, sorted(kinds)))}")
+            raise SceneError(problems.items)
+        if kind_name not in kinds:
+            problems.add("kind", f"unknown kind {kind_name!r}{S.closest(str(kind_name), kinds)}")
+            raise SceneError(problems.items)
+        kind = kinds[kind_name]
+        schema = S.Table(
+            fields={
+                "kind": S.String(required=True),
+                "description": S.String(default=""),
+                "runtime": S.String(default=""),
+                "effects": S.Array(item=_effect_entry(kind.effect_kind), default=[]),
+                **kind.schema,
+            }
+        )
+        spec = schema.check(data, "", problems)
+        if not problems:
+            first: dict[str, int] = {}
+            for k, effect in enumerate(spec["effects"]):
+                if effect["name"] in first:
+                    problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
+                                                  f"(first at effects[{first[effect['name']]}])")
+                first.setdefault(effect["name"], k)
+        if not problems:
+            kind.check(spec, problems)
+        if problems:
+            raise SceneError(problems.items)
+        return spec
+
+    # --- what it is ---------------------------------------------------
+    @property
+    def kind(self) -> str:
+        """The scene's kind (``"nbody"``, ``"rotation"``)."""
+        return self.spec["kind"]
+
+    @property
+    def name(self) -> str:
+        """The scene's name: its file name without ``.toml``."""
+        return Path(self.source).name.removesuffix(".toml")
+
+    @property
+    def effects(self) -> tuple[dict, ...]:
+        """Exactly what will be computed besides the kind's base model, as mappings."""
+        return tuple(self.spec["effects"])
+
+    def __repr__(self) -> str:
+        names = ", ".join(e["name"] for e in self.effects) or "none"
+        return f"Scene({self.name!r}, kind={self.kind!r}, effects=[{names}])"
+
+    # --- running ------------------------------------------------------
+    def run(self, progress: bool = True, stop: Callable[[], bool] | None = None) -> Result:
+        """Simulate the scene; returns a :class:`Result`.
+
+        ``result.compile_time`` holds the seconds numba spent compiling kernels
+        for the run (the first run on a machine; 0 once they are cached): during
+        the run, and before it, since the previous run in the process, when the
+        kernels' modules were imported; ``result.compile_count`` how many
+        compilations.  The kinds take the compilation inside the integration out
+        of ``result.wall_time``, the integration proper.
+        """
+        from hamilton_orbits.firstrun import claim_compilation
+
+        result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        result.compile_time, result.compile_count = claim_compilation()
+        return result
+
+    def crosscheck(self) -> str:
+        """The same scene in a peer code, the differences tabled (text)."""
+        kind = KINDS[self.kind]
+        if kind.crosscheck is None:
+            return f"{self.name}: no peer code to cross-check a {self.kind} scene against"
+        return kind.crosscheck(self)
