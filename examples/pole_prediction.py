@@ -62,7 +62,7 @@ def main(argv: list[str] | None = None) -> str:
         scene = scene.with_values({"periods": ["2005-10-01..2008-03-01"]})
     result = scene.run(progress=False)
     for fig in result.plot():
-        fig.savefig(out / f"{fig._hamilton_name}.png", dpi=110, bbox_inches="tight")
+        fig.savefig(out / f"{fig.get_label()}.png", dpi=110, bbox_inches="tight")
         plt.close(fig)
     text = "\n".join([result.summary(), "", *verdict(result)])
     (out / "pole_prediction.txt").write_text(text + "\n")

@@ -1,6 +1,8 @@
 """Ensembles: a grid (or a list) of variations of one scene, run in parallel.
 
-Each member is the scene with some keys replaced (:meth:`Scene.with_values`), run
+Each member is the scene with some keys replaced (:meth:`Scene.from_values`:
+checked once, its system built once, one :class:`~hamilton_orbits.Simulation` run
+once; the compiled right-hand side is shared by every member a worker runs), run
 in a worker process; its row holds the varied values, the member's headline
 metrics (numbers; Quantities as plain numbers in the unit named in the column),
 its wall time, and the error if it failed.  A member that fails does not lose
@@ -44,7 +46,7 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     row: dict[str, Any] = {key: _plain(v) for key, v in values.items()}
     start = time.perf_counter()
     try:
-        scene = Scene(data, source).with_values(dict(values))
+        scene = Scene.from_values(data, source, dict(values))  # checked once, built once
         result = scene.run(progress=False)
     except Exception as exc:  # a member's failure is data, not the end of the run
         row["wall time [s]"] = time.perf_counter() - start

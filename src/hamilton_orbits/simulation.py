@@ -188,7 +188,8 @@ class Simulation:
     # ------------------------------------------------------------------ run
     def integrate(self, t: Any, *, progress: bool = False,
                   on_output: Callable[[int, int], None] | None = None,
-                  stop: Callable[[], bool] | None = None) -> Trajectory:
+                  stop: Callable[[], bool] | None = None,
+                  on_interrupt: str = "raise") -> Trajectory:
         """Advance to ``t`` and return the trajectory of this leg.
 
         Parameters
@@ -208,6 +209,10 @@ class Simulation:
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
             the leg there (``complete == False``).
+        on_interrupt : {"raise", "keep"}
+            What Ctrl-C does: raise ``KeyboardInterrupt`` (default), or end the leg
+            at the last output reached and return it (``complete == False``), as a
+            scene does.
 
         Returns
         -------
@@ -219,8 +224,11 @@ class Simulation:
             For bad times, or a lost state (a collision or a step too long).
         KeyboardInterrupt
             On Ctrl-C (the run stops within a few thousand steps; the simulation
-            keeps the state reached).
+            keeps the state reached), unless ``on_interrupt="keep"``.
         """
+        if on_interrupt not in ("raise", "keep"):
+            raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
+                             f"{on_interrupt!r}")
         prop = self._prop
         times, unit = _leg_times(t, prop.t, self._quantity)
         if unit is not None:
@@ -235,7 +243,7 @@ class Simulation:
         finally:
             if close is not None:
                 close()
-        if out.interrupted:
+        if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
         return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,

@@ -249,7 +249,7 @@ def _plot_omega(result: Result):
     ax.set_title(f"{result.scene.name}: {result.metrics.get('integrator', '')} against the "
                  "exact free motion", fontsize=10)
     fig.tight_layout()
-    fig._hamilton_name = "spin"
+    fig.set_label("spin")  # the file name Result.save gives it
     return fig
 
 

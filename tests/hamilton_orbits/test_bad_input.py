@@ -327,9 +327,9 @@ def test_an_array_step_names_dt():
 
 def test_a_failure_during_a_run_is_one_line_and_exit_1(tmp_path):
     boom = ("import hamilton_orbits.engine as engine\n"
-            "def run(*args, **kwargs):\n"
+            "def advance(*args, **kwargs):\n"
             "    raise ValueError('the step underflowed\\n  at t = 1.5 d')\n"
-            "engine.run = run\n")
+            "engine.Propagation.advance = advance\n")
     res = _cli("run", "leo-j2", "--out", str(tmp_path), "--no-progress", code=boom)
     assert res.returncode == 1
     _no_traceback(res)

@@ -26,7 +26,7 @@ def mercury():
 
 def _figure(result, name):
     figs = result.plot()
-    found = [f for f in figs if getattr(f, "_hamilton_name", "") == name]
+    found = [f for f in figs if f.get_label() == name]
     assert len(found) == 1
     return found[0]
 

@@ -603,7 +603,7 @@ def test_scene_reports_megno_and_lyapunov_time():
     assert res.metrics["Lyapunov time"].unit == u.yr
     assert res.diagnostics["megno"].shape == (5,)
     assert "MEGNO" in res.summary() and "Lyapunov time" in res.summary()
-    assert [f._hamilton_name for f in res.plot()][-1] == "megno"
+    assert [f.get_label() for f in res.plot()][-1] == "megno"
 
 
 def test_scene_variational_refuses_events():

@@ -1,9 +1,12 @@
-"""Input checks and the starting step shared by the ``radau15`` and ``wh`` modules."""
+"""What the drivers share: their input checks, the starting step, the addresses of a
+right-hand side for the stepping kernels, and :func:`runner`, which makes each
+driver's one-call ``run`` from its ``start``."""
 
 from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -176,3 +179,29 @@ def check_step_count(span: float, dt: float, max_steps: int, method: str) -> int
             "max_steps=... to allow it"
         )
     return max(1, math.ceil(steps * (1.0 - 1e-12)))
+
+
+
+def run_once(start: Callable[..., Any], method: type, rhs: Any, r0: Any, v0: Any, gm: Any,
+             t_out: Any, *, dt: Any = None, tol: Any = None,
+             on_output: Callable[[int, int], None] | None = None,
+             out: tuple[np.ndarray, np.ndarray] | None = None, events: Any = None,
+             variational: Any = None, stop: Callable[[], bool] | None = None,
+             **options: Any) -> tuple[np.ndarray, np.ndarray, int]:
+    """What every driver's ``run`` is (the protocol of :mod:`hamilton_orbits.integrators`):
+    one run through ``t_out``, its input checked (:func:`check_inputs`,
+    :func:`check_dt_tol`), its ``options`` made the typed ``method`` (a
+    :class:`~hamilton_orbits.integrators.methods.Method` class; an option it does not
+    take is refused, naming those it takes), then the driver's ``start`` and one
+    ``advance``; returns ``(r, v, steps)``."""
+    from hamilton_orbits.integrators import output_arrays
+    from hamilton_orbits.integrators.methods import method_of
+
+    r0, v0, gm, t_out = check_inputs(r0, v0, gm, t_out)
+    typed = method_of(method.name, options)
+    dt_f, tol_f = check_dt_tol(dt, tol)
+    state = start(rhs, r0, v0, gm, float(t_out[0]), typed, dt=dt_f, tol=tol_f, events=events,
+                  variational=variational)
+    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
+    state.advance(t_out, r_out, v_out, on_output, stop)
+    return r_out, v_out, state.steps

@@ -21,7 +21,7 @@ import numpy as np
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import _tangent, output_arrays
+from hamilton_orbits.integrators import _setup, _tangent
 from hamilton_orbits.integrators.methods import DOP853
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RTOL_FLOOR", "run", "solve",
@@ -32,22 +32,8 @@ ACCEPTS_VELOCITY_DEPENDENT = True
 DEFAULT_TOL = 1e-12
 
 
-def run(
-    rhs: Any,
-    r0: np.ndarray,
-    v0: np.ndarray,
-    gm: np.ndarray,
-    t_out: np.ndarray,
-    *,
-    dt: float | None = None,
-    tol: float | None = None,
-    on_output: Callable[[int, int], None] | None = None,
-    out: tuple[np.ndarray, np.ndarray] | None = None,
-    events: EventLog | None = None,
-    tangent_control: bool = False,
-    variational: Any = None,
-    stop: Callable[[], bool] | None = None,
-) -> tuple[np.ndarray, np.ndarray, int]:
+def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+        **options: Any) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with scipy's DOP853; see :mod:`hamilton_orbits.integrators`.
 
     ``variational`` (a :class:`hamilton_orbits.integrators._tangent.Tangent`, ``rhs``
@@ -72,12 +58,7 @@ def run(
     >>> bool(np.allclose(r[-1, 1], [1, 0, 0], atol=1e-9))
     True
     """
-    state = start(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
-                  np.asarray(gm, np.float64), float(t_out[0]), DOP853(tangent_control),
-                  dt=dt, tol=tol, events=events, variational=variational)
-    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
-    state.advance(np.asarray(t_out, np.float64), r_out, v_out, on_output, stop)
-    return r_out, v_out, state.steps
+    return _setup.run_once(start, DOP853, rhs, r0, v0, gm, t_out, **options)
 
 
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,

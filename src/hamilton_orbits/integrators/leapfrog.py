@@ -16,9 +16,9 @@ import numpy as np
 from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, _tangent, output_arrays
-from hamilton_orbits.integrators._setup import accel_arg, check_dt_tol, check_step_count
-from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, Leapfrog
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
+from hamilton_orbits.integrators._setup import accel_arg, check_step_count
+from hamilton_orbits.integrators.methods import Leapfrog
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run", "start"]
 
@@ -39,22 +39,8 @@ def choose_dt(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float) -> flo
     return float(np.sqrt(tol) * best)
 
 
-def run(
-    rhs: Any,
-    r0: np.ndarray,
-    v0: np.ndarray,
-    gm: np.ndarray,
-    t_out: np.ndarray,
-    *,
-    dt: float | None = None,
-    tol: float | None = None,
-    on_output: Callable[[int, int], None] | None = None,
-    out: tuple[np.ndarray, np.ndarray] | None = None,
-    max_steps: int = MAX_FIXED_STEPS,
-    events: EventLog | None = None,
-    variational: Any = None,
-    stop: Callable[[], bool] | None = None,
-) -> tuple[np.ndarray, np.ndarray, int]:
+def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+        **options: Any) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with drift-kick-drift leapfrog; see :mod:`hamilton_orbits.integrators`.
 
     ``max_steps`` bounds the steps of the whole run; more are refused before the
@@ -75,14 +61,7 @@ def run(
     >>> steps, bool(np.allclose(r[-1, 1], [1, 0, 0], atol=1e-4))
     (1000, True)
     """
-    method = Leapfrog(max_steps=max_steps)
-    dt_f, tol_f = check_dt_tol(dt, tol)
-    state = start(rhs, np.asarray(r0, np.float64), np.asarray(v0, np.float64),
-                  np.ascontiguousarray(gm, dtype=np.float64), float(t_out[0]), method, dt=dt_f,
-                  tol=tol_f, events=events, variational=variational)
-    r_out, v_out = output_arrays(out, len(t_out), r0, v0)
-    state.advance(np.asarray(t_out, np.float64), r_out, v_out, on_output, stop)
-    return r_out, v_out, state.steps
+    return _setup.run_once(start, Leapfrog, rhs, r0, v0, gm, t_out, **options)
 
 
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,

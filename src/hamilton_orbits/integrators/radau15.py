@@ -43,7 +43,7 @@ import numpy as np
 
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
 from hamilton_orbits.validation import ConvergenceError
 
@@ -60,25 +60,8 @@ RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 SLICE = 20000
 
 
-def run(
-    rhs: Any,
-    r0: np.ndarray,
-    v0: np.ndarray,
-    gm: np.ndarray,
-    t_out: np.ndarray,
-    *,
-    dt: float | None = None,
-    tol: float | None = None,
-    on_output: Callable[[int, int], None] | None = None,
-    out: tuple[np.ndarray, np.ndarray] | None = None,
-    max_steps: int = MAX_STEPS,
-    criterion: str = DEFAULT_CRITERION,
-    events: EventLog | None = None,
-    tangent_control: bool = False,
-    variational: Any = None,
-    stop: Callable[[], bool] | None = None,
-    precision: str = "double",
-) -> tuple[np.ndarray, np.ndarray, int]:
+def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+        **options: Any) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the adaptive 15th-order Gauss-Radau scheme (IAS15-like).
 
     Parameters
@@ -168,15 +151,7 @@ def run(
     >>> bool(np.allclose(r[-1], r0, atol=1e-12))
     True
     """
-    r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    method = Radau15(max_steps=max_steps, criterion=criterion, tangent_control=tangent_control,
-                     precision=precision)
-    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
-    state = start(rhs, r0, v0, gm, float(t_out[0]), method, dt=dt_f, tol=tol_f, events=events,
-                  variational=variational)
-    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
-    state.advance(t_out, r_out, v_out, on_output, stop)
-    return r_out, v_out, state.steps
+    return _setup.run_once(start, Radau15, rhs, r0, v0, gm, t_out, **options)
 
 
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,

@@ -61,8 +61,8 @@ import numpy as np
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
-from hamilton_orbits.integrators import StopIntegration, _setup, _tangent, output_arrays
-from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, WH
+from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
+from hamilton_orbits.integrators.methods import WH
 from hamilton_orbits.integrators.methods import WH_COORDINATES as COORDINATES
 from hamilton_orbits.integrators.wh_correctors import (
     CORRECTOR_ALPHA_SQUARED,
@@ -125,24 +125,8 @@ def default_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | No
     return period * frac
 
 
-def run(
-    rhs: Any,
-    r0: np.ndarray,
-    v0: np.ndarray,
-    gm: np.ndarray,
-    t_out: np.ndarray,
-    *,
-    dt: float | None = None,
-    tol: float | None = None,
-    on_output: Callable[[int, int], None] | None = None,
-    out: tuple[np.ndarray, np.ndarray] | None = None,
-    coordinates: str = "democratic_heliocentric",
-    corrector: int = 0,
-    max_steps: int = MAX_FIXED_STEPS,
-    events: EventLog | None = None,
-    variational: Any = None,
-    stop: Callable[[], bool] | None = None,
-) -> tuple[np.ndarray, np.ndarray, int]:
+def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
+        **options: Any) -> tuple[np.ndarray, np.ndarray, int]:
     """Integrate with the Wisdom-Holman map (democratic-heliocentric or Jacobi).
 
     Parameters
@@ -221,14 +205,7 @@ def run(
     >>> steps
     100
     """
-    r0, v0, gm, t_out = _setup.check_inputs(r0, v0, gm, t_out)
-    method = WH(coordinates=coordinates, corrector=corrector, max_steps=max_steps)
-    dt_f, tol_f = _setup.check_dt_tol(dt, tol)
-    state = start(rhs, r0, v0, gm, float(t_out[0]), method, dt=dt_f, tol=tol_f, events=events,
-                  variational=variational)
-    r_out, v_out = output_arrays(out, t_out.shape[0], r0, v0)
-    state.advance(t_out, r_out, v_out, on_output, stop)
-    return r_out, v_out, state.steps
+    return _setup.run_once(start, WH, rhs, r0, v0, gm, t_out, **options)
 
 
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, method: WH, *,

@@ -46,6 +46,11 @@ class Result:
         0 when everything came from the cache), apart from ``wall_time``.
     compile_count : int
         How many kernels were compiled during the run.
+    units : dict
+        The unit system the times and states are held in (``{"time": u.d,
+        "length": u.au, ...}``): the arrays are the run's own floats, wrapped as
+        Quantities without a copy; what reads them as floats in these units gets
+        the same memory back.
     """
 
     scene: Any
@@ -59,6 +64,7 @@ class Result:
     frame: str = ""
     compile_time: float = 0.0
     compile_count: int = 0
+    units: dict[str, Any] = field(default_factory=dict)
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
                                                                 repr=False)
@@ -155,7 +161,7 @@ class Result:
             import matplotlib.pyplot as plt
 
             for i, fig in enumerate(self.plot()):
-                name = getattr(fig, "_hamilton_name", f"figure{i + 1}")
+                name = fig.get_label() or f"figure{i + 1}"
                 path = out / f"{name}.png"
                 fig.savefig(path, dpi=110, bbox_inches="tight")
                 plt.close(fig)

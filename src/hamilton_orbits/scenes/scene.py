@@ -175,6 +175,23 @@ def _set_path(data: dict, key: str, value: Any, source: str) -> tuple[str | int,
 
 
     return tuple(resolved)
+def _with_values(data: Mapping[str, Any], source: str, values: Mapping[str, Any],
+                 overrides: Sequence[tuple]) -> tuple[dict, list[tuple]]:
+    """A copy of ``data`` with ``values`` set at their key paths, and the key paths set."""
+    if not isinstance(values, Mapping):
+        raise SceneError([f"{source}: expected the values as a mapping "
+                          f"{{'key.path': value}}, got {values!r}"])
+    data = copy.deepcopy(dict(data))
+    overrides = list(overrides)
+    for key, value in values.items():
+        if not isinstance(key, str):
+            raise SceneError([f"{source}: expected a key path such as "
+                              f"'integrator.tol', got {key!r}"])
+        v = _parse_override(value) if isinstance(value, str) else value
+        overrides.append(_set_path(data, key, v, source))
+    return data, overrides
+
+
 class Scene:
     """A validated description of one study.
 
@@ -288,18 +305,24 @@ class Scene:
             index beyond a list, a name not in it, a key below a value), or an
             invalid scene, naming the key.
         """
-        if not isinstance(values, Mapping):
-            raise SceneError([f"{self.source}: expected the values as a mapping "
-                              f"{{'key.path': value}}, got {values!r}"])
-        data = copy.deepcopy(self.data)
-        overrides = list(self._overrides)
-        for key, value in values.items():
-            if not isinstance(key, str):
-                raise SceneError([f"{self.source}: expected a key path such as "
-                                  f"'integrator.tol', got {key!r}"])
-            v = _parse_override(value) if isinstance(value, str) else value
-            overrides.append(_set_path(data, key, v, self.source))
+        data, overrides = _with_values(self.data, self.source, values, self._overrides)
         return Scene(data, self.source, text=self._text, overrides=overrides)
+
+    @classmethod
+    def from_values(cls, data: Mapping[str, Any], source: str,
+                    values: Mapping[str, Any]) -> Scene:
+        """The scene of ``data`` with some keys replaced, checked once (what
+        ``Scene(data, source).with_values(values)`` gives, without checking the
+        scene of ``data`` first: an ensemble's member).
+
+        Examples
+        --------
+        >>> base = Scene.bundled("dzhanibekov")
+        >>> Scene.from_values(base.data, base.source, {"duration": "40 s"}).spec["duration"]
+        <Quantity 40. s>
+        """
+        data, overrides = _with_values(data, source, values, ())
+        return cls(data, source, overrides=overrides)
 
     def _locate(self):
         """``path -> line`` in the scene's file (None for keys set since, or no file)."""

@@ -99,10 +99,11 @@ class RungResult:
     steps: int
 
 
-def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray
+def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray, frame: str = "icrs"
               ) -> tuple[np.ndarray, np.ndarray]:
     """Residuals (km, arcsec) of simulated barycentric positions ``r`` (n_t, n, 3), au,
-    at whole Julian ``years`` against DE440's shipped reference.
+    on the axes of ``frame`` (:func:`hamilton_orbits.frames.frame_rotation`), at whole
+    Julian ``years`` against DE440's shipped reference (turned onto those axes).
 
     Examples
     --------
@@ -114,6 +115,10 @@ def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray
     """
     _, ref_names, ref = de.reference_table()
     ref = ref[np.asarray(years, dtype=int)]
+    if frame != "icrs":
+        from hamilton_orbits.frames import frame_rotation
+
+        ref = ref @ frame_rotation(frame).T  # v_frame = M v_icrs, row by row
     au_km = de.constant("AU")
     idx = {n: k for k, n in enumerate(names)}
     helio = r - r[:, idx["sun"]][:, None, :]

@@ -159,7 +159,7 @@ def _plot(result: Result):
     ax2.set_ylabel("m1 = x_p, towards Greenwich [mas]")
     ax2.legend(fontsize=8)
     ax2.set_title(f"{result.scene.name}: model against the record")
-    fig._hamilton_name = "pole"
+    fig.set_label("pole")  # the file name Result.save gives it
     return fig
 
 

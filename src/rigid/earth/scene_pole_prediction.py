@@ -178,7 +178,7 @@ def _plot_fan(result: Result, record: Any, fans: dict, start: Any):
     axes[0].set_title(f"{result.scene.name}: the prediction fan from {start.iso[:10]} "
                       "against the record that followed")
     fig.tight_layout()
-    fig._hamilton_name = "prediction_fan"
+    fig.set_label("prediction_fan")  # the file name Result.save gives it
     return fig
 
 
@@ -215,7 +215,7 @@ def _plot_mae(result: Result, scores: dict):
             ax.legend(fontsize=8, loc="upper left")
     fig.suptitle(f"{result.scene.name}: hindcast error against horizon (IERS 20 C04)")
     fig.tight_layout()
-    fig._hamilton_name = "mae_vs_horizon"
+    fig.set_label("mae_vs_horizon")  # the file name Result.save gives it
     return fig
 
 
@@ -240,7 +240,7 @@ def _plot_coverage(result: Result, scores: dict):
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=4)
     fig.tight_layout(rect=(0, 0.12, 1, 1))
-    fig._hamilton_name = "coverage"
+    fig.set_label("coverage")  # the file name Result.save gives it
     return fig
 
 

@@ -108,15 +108,9 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
     if result.scene.spec["initial"].get("ephemeris") is None or len(whole) < 2:
         result.metrics["DE440 residuals"] = "need [initial] ephemeris and yearly outputs"
         return
-    if scene_frame(result.scene.spec) != "icrs":
-        from hamilton_orbits.frames import frame_rotation
-
-        rot = frame_rotation(scene_frame(result.scene.spec))
-        r = result.states["r"].to_value(u.au)[whole] @ rot  # back to ICRS axes
-    else:
-        r = result.states["r"].to_value(u.au)[whole]
+    r = result.states["r"].to_value(u.au)[whole]
     yrs = np.round(years[whole]).astype(int)
-    km, arcsec = residuals(system.names, r, yrs)
+    km, arcsec = residuals(system.names, r, yrs, frame=scene_frame(result.scene.spec))
     result.diagnostics["de440_years"] = yrs
     result.diagnostics["de440_km"] = km
     rows = []

@@ -5,6 +5,7 @@ frame of its states."""
 from __future__ import annotations
 
 import re
+from typing import Any
 
 import astropy.units as u
 
@@ -96,12 +97,32 @@ def _scene_body(b: dict, by_name: dict):
     return Body(b["name"], gm=b["gm"], r=prim.r + r, v=prim.v + v, **extra)
 
 
+#: The systems built for the last few scenes' specs: a scene builds its system
+#: once, while it is checked, and its run takes that one (``id(spec)`` -> (spec,
+#: system); the spec is held, so its id is not reused while it is here).
+_BUILT: dict[int, tuple[dict, Any]] = {}
+_KEEP = 8
+
+
 def build_system(spec: dict, problems: S.Problems | None = None):
-    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from.
+    """The :class:`~hamilton_orbits.nbody.System` a validated n-body scene starts from
+    (built once per spec: the check builds it, the run takes it).
 
     With ``problems`` (while the scene is checked), a refusal of the system, a
     body or its orbit is added there at its key path and None is returned.
     """
+    known = _BUILT.get(id(spec))
+    if known is not None and known[0] is spec:
+        return known[1]
+    system = _build(spec, problems)
+    if system is not None:
+        while len(_BUILT) >= _KEEP:
+            del _BUILT[next(iter(_BUILT))]
+        _BUILT[id(spec)] = (spec, system)
+    return system
+
+
+def _build(spec: dict, problems: S.Problems | None):
     from hamilton_orbits import System
 
     init = spec["initial"]

@@ -25,7 +25,7 @@ def plot_megno(result: Result):
     ax.set_ylabel("MEGNO <Y> (dimensionless)")
     ax.set_title(f"{result.scene.name}: MEGNO")
     ax.legend()
-    fig._hamilton_name = "megno"
+    fig.set_label("megno")  # the file name Result.save gives it
     return fig
 
 
@@ -49,7 +49,7 @@ def plot_de440(result: Result):
     ax.set_ylabel("position residual against DE440 [km]")
     ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), ICRS")
     ax.legend(fontsize=7, ncol=2)
-    fig._hamilton_name = "de440_residuals"
+    fig.set_label("de440_residuals")  # the file name Result.save gives it
     return fig
 
 
@@ -194,7 +194,7 @@ def plot_orbits(result: Result, gm: np.ndarray, frame: str):
     if view["inner"]:
         axes[0, 1].set_title(f"inner bodies: {', '.join(view['inner'])}", fontsize=10)
     fig.tight_layout()
-    fig._hamilton_name = "orbits"
+    fig.set_label("orbits")  # the file name Result.save gives it
     return fig
 
 
@@ -228,6 +228,6 @@ def plot_energy(result: Result, what: str, conserved: bool):
     ax.set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig._hamilton_name = "energy_error"
+    fig.set_label("energy_error")  # the file name Result.save gives it
     return fig
 
