@@ -83,6 +83,8 @@ import numpy as np
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
 from hamilton_orbits.validation import check_positive
+from rigid._kernels import euler as _euler_k
+from rigid._shared import pow2
 from rigid.body import call_units, check_body
 from rigid.drivers import METHODS, integrate_arrays
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
@@ -321,9 +323,15 @@ def integrate(
     rtol_f, atol_f = _tolerances(tol, rtol, atol, si.omega)
     recentre = float(_scalar_positive("recentre", DIMENSIONLESS("recentre", recentre)))
     kind, params = encode_torque(torque)
+    # Euler's equations of a free body, and under the gravity gradient (a torque
+    # proportional to the moments), depend on the moments' ratios only: they run on
+    # the moments scaled by a power of two (exact: the same bits for every body whose
+    # moments are normal numbers; 1e-300 kg m^2 no longer underflows in the kernels)
+    homogeneous = kind in (_euler_k.TORQUE_NONE, _euler_k.TORQUE_GRAVITY_GRADIENT)
+    moments = si.moments / pow2(si.moments) if homogeneous else si.moments
     start = time.perf_counter()
     t_f, q, w, steps, count, drift = integrate_arrays(
-        si.moments, si.attitude, si.omega, times, method=method, dt=dtf, n_out=n_out,
+        moments, si.attitude, si.omega, times, method=method, dt=dtf, n_out=n_out,
         kind=kind, params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
         progress=progress,
     )
