@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["LostStateError", "accelerations_quaternion", "energy_gm",
-           "energy_gm_many", "integral_errors"]
+           "energy_gm_many", "integral_errors", "relative_change"]
 
 
 def energy_gm(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> float:
@@ -151,8 +151,6 @@ class LostStateError(ValueError):
 def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
                   extra: np.ndarray | None) -> np.ndarray:
     """The energy part of :func:`integral_errors`."""
-    from hamilton_orbits.trajectory import relative_change
-
     if np.ndim(gm) == 2:  # masses changed (a merge, a removal): Hamilton's E as it is
         energy = energy_gm_many(r, v, gm)
         if extra is not None:
@@ -216,3 +214,29 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     np.add.at(acc, i, term.as_array())
     return acc[:, 1:]
 
+
+def relative_change(values: np.ndarray) -> np.ndarray:
+    """``(x(t) - x(0)) / |x(0)|`` for scalars, ``|x(t) - x(0)| / |x(0)|`` for
+    vectors (last axis), and the absolute change where ``x(0) = 0``.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n_t,) or (n_t, k)
+
+    Examples
+    --------
+    >>> relative_change(np.array([2.0, 2.0, 3.0])).tolist()
+    [0.0, 0.0, 0.5]
+    >>> relative_change(np.array([[0.0, 2.0], [0.0, 2.0], [2.0, 2.0]])).tolist()
+    [0.0, 0.0, 1.0]
+    >>> relative_change(np.zeros(2)).tolist()
+    [0.0, 0.0]
+    """
+    x = np.asarray(values, dtype=np.float64)
+    if x.ndim == 1:
+        scale = abs(x[0])
+        d = x - x[0]
+    else:
+        scale = float(np.linalg.norm(x[0]))
+        d = np.linalg.norm(x - x[0], axis=-1)
+    return d / scale if scale > 0 else d

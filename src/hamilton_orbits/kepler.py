@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._deprecated import moved_name
 from hamilton_orbits._lazy import LazyModule
+from hamilton_orbits.deprecation import moved_name
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
 from hamilton_orbits.validation import (
     ConvergenceError,

@@ -57,8 +57,8 @@ from hamilton_orbits._body import (
     body_arrays,
     body_from_floats,
 )
-from hamilton_orbits._deprecated import moved_name
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits.deprecation import moved_name
 from hamilton_orbits.initial_states import InitialStates
 from hamilton_orbits.integrals import energy_gm
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent

@@ -6,7 +6,7 @@ module.
 
 from typing import Any
 
-from hamilton_orbits._deprecated import moved_name
+from hamilton_orbits.deprecation import moved_name
 
 # served by __getattr__ below, each with its warning
 __all__ = ["Reference", "reference"]  # noqa: F822

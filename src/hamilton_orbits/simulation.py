@@ -23,7 +23,6 @@ start of the simulation.
 from __future__ import annotations
 
 import copy
-import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from types import ModuleType
@@ -32,14 +31,13 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits import engine
-from hamilton_orbits.effects import EffectSet, effect_energy, get
+from hamilton_orbits.effects import EffectSet, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.firstrun import compile_seconds
-from hamilton_orbits.integrals import integral_errors
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
-from hamilton_orbits.trajectory import Trajectory, event_table
+from hamilton_orbits.trajectory import Trajectory, event_table, make_trajectory
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 from hamilton_orbits.validation import as_float_array
 
@@ -543,89 +541,3 @@ def _progress(method: str, total: int, on_output: Any) -> tuple[Any, Callable[[]
             on_output(i, steps)
 
     return report, bar.close
-
-
-def _check_finite(system: System, method: str, r: np.ndarray, v: np.ndarray,
-                  times: np.ndarray, gone: np.ndarray | None) -> None:
-    """Refuse a run that lost a body's state (a non-finite position or velocity of a
-    body still in the run)."""
-    ok = np.isfinite(r).all(axis=2) & np.isfinite(v).all(axis=2)
-    if gone is not None:
-        ok |= gone[None, :]
-    if ok.all():
-        return
-    k, i = (int(x) for x in np.argwhere(~ok)[0])
-    raise ValueError(
-        f"The integration with {method!r} lost the state of body "
-        f"{system.names[i]!r} at output {k} (t = {times[k]!r}): "
-        "a collision or a step too long"
-    )
-
-
-def _integrals(system: System, r: np.ndarray, v: np.ndarray, gm: np.ndarray, times: np.ndarray,
-               gone: np.ndarray | None, effect_set: Any, start: Any
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Hamilton's integrals' errors at the outputs, from the simulation's start
-    ``start = (r0, v0, gm0)`` at time 0 (None: the first output is the start)."""
-    if start is not None:  # measured from the simulation's start: prepend it, then drop it
-        r0, v0, gm0 = start
-        r = np.concatenate((r0[None], r))
-        v = np.concatenate((v0[None], v))
-        gm = (np.concatenate((gm0[None], gm)) if np.ndim(gm) == 2
-              else gm if np.array_equal(gm, gm0) else np.stack([gm0] + [gm] * (len(r) - 1)))
-        times = np.concatenate(([0.0], times))
-    extra = effect_energy(system, effect_set, r, v) if effect_set else None
-    errors = integral_errors(r, v, gm, times, extra,
-                             gone=np.zeros(r.shape[1], bool) if gone is None else gone)
-    return errors if start is None else (errors[0][1:], errors[1][1:], errors[2][1:])
-
-
-def make_trajectory(system: System, out: engine.EngineRun, unit: Any, method: str,
-                    effects: tuple[str, ...], effect_set: Any = None, *, start: Any = None,
-                    wall_time: float | None = None) -> Trajectory:
-    """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
-    Quantity system, with times in ``unit``); ``effect_set`` (the
-    :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
-    the energy whose error is reported, where they keep one; ``start`` (``(r0, v0,
-    gm0)`` at time 0) when the run did not begin there.
-
-    Raises
-    ------
-    ValueError
-        If the run lost a body's state (a non-finite position or velocity).
-    """
-    r, v, times = out.r, out.v, out.t
-    log = out.events
-    gone = log.inactive.copy() if log is not None else None  # the log goes on changing
-    if not out.finite:
-        _check_finite(system, method, r, v, times, gone)
-    integrals = functools.partial(_integrals, system, r, v, out.gm, times, gone, effect_set,
-                                  start)
-    final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
-    if system.quantity:
-        import astropy.units as u
-
-        t_out: Any = (times * u.day).to(unit)
-        r_out: Any = r << u.au  # views: no second copy of the history
-        v_out: Any = v << (u.au / u.day)
-    else:
-        t_out, r_out, v_out = times, r, v
-    tan = out.variational
-    megno = lyap = stm = None
-    if tan is not None:
-        k = len(times)
-        megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
-        stm = tan.stm[:k].copy() if tan.stm is not None else None
-        if system.quantity:
-            lyap = (lyap / DAY).to(1 / unit)
-    events = None
-    if log is not None:
-        stopped = log.stopped_by
-        events = (log.recorded()[out.first_event:],
-                  None if stopped is None else stopped - out.first_event, system, unit)
-    return Trajectory(
-        t=t_out, r=r_out, v=v_out, names=system.names, steps=int(out.steps),
-        wall_time=out.wall_time if wall_time is None else wall_time, method=method,
-        effects=effects, complete=out.complete, integrals=integrals, final_source=final,
-        event_source=events, megno=megno, lyapunov=lyap, stm=stm,
-    )

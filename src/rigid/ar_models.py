@@ -3,6 +3,6 @@
 Importing a name from here still works and warns (DeprecationWarning) with the new path.
 """
 
-from rigid._moved import forward
+from hamilton_orbits.deprecation import forward
 
 __getattr__ = forward(__name__, "rigid.earth.ar_models")

@@ -4,6 +4,6 @@
 Importing a name from here still works and warns (DeprecationWarning) with the new path.
 """
 
-from rigid._moved import forward
+from hamilton_orbits.deprecation import forward
 
 __getattr__ = forward(__name__, "rigid.earth.prediction", "rigid.earth.forecasters")

@@ -46,15 +46,16 @@ CASES = [(old, new, name) for old, (new, names) in MOVED.items() for name in nam
 @pytest.mark.parametrize(("old", "new", "name"), CASES)
 def test_old_path_warns_and_gives_the_same_object(old, new, name):
     module = importlib.import_module(old)
-    with pytest.warns(DeprecationWarning, match=re.escape(f"import {name} from {new}")) as rec:
+    message = re.escape(f"{old}.{name} moved to {new}.{name}")
+    with pytest.warns(DeprecationWarning, match=message) as rec:
         value = getattr(module, name)
     assert value is getattr(importlib.import_module(new), name)
     assert rec[0].filename == __file__  # stacklevel=2: the warning points at the caller
 
 
 def test_from_import_of_an_old_path_warns():
-    with pytest.warns(DeprecationWarning, match=r"rigid\.c04 is deprecated: import load_c04 "
-                                                r"from rigid\.earth\.c04"):
+    with pytest.warns(DeprecationWarning, match=r"rigid\.c04\.load_c04 moved to "
+                                                r"rigid\.earth\.c04\.load_c04"):
         from rigid.c04 import load_c04
     from rigid.earth.c04 import load_c04 as new
 
@@ -82,7 +83,7 @@ def test_old_paths_refuse_private_and_unknown_names_without_warning():
 
 def test_star_import_names_of_an_old_path_are_the_new_modules():
     old = importlib.import_module("rigid.wobble")
-    with pytest.warns(DeprecationWarning, match=r"use rigid\.earth\.wobble_fit"):
+    with pytest.warns(DeprecationWarning, match=r"rigid\.wobble moved to rigid\.earth\.wobble_fit"):
         names = old.__all__
     assert names == importlib.import_module("rigid.earth.wobble_fit").__all__
 
