@@ -35,7 +35,6 @@ reached.
 from __future__ import annotations
 
 import importlib
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -43,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._kernels.checks import all_finite
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import (
     INTEGRATORS,
@@ -268,27 +268,27 @@ class Propagation:
         k = reached[0] + 1
         if backward:  # in place: no second copy of the history
             np.negative(v_out, out=v_out)
-        self._reached(driver, r_out[k - 1], v_out[k - 1], float(t_reached[k - 1]))
+        t_end = float(t_reached[k - 1])
+        if driver.t == (-t_end if backward else t_end):  # the driver stands at the last output
+            self.r, self.v, self.t = r_out[k - 1], v_out[k - 1], t_end
+            if events is not None and events.gm_changes:
+                self.gm = events.gm_at(np.array([t_end]), self.gm0)[0]
+        else:
+            self._between_outputs(driver)
         gm_out = (events.gm_at(t_reached[:k], self.gm0)
                   if events is not None and events.gm_changes else self.gm0)
         if k < n_t:
             t_reached, r_out, v_out, rows = t_reached[:k], r_out[:k], v_out[:k], rows[:, :k]
-        finite = math.isfinite(float(np.add.reduce(rows, axis=None)))  # one pass over both
+        finite = all_finite(rows.reshape(-1))  # one compiled pass over both
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
 
-    def _reached(self, driver: Any, r: np.ndarray, v: np.ndarray, t: float) -> None:
-        """Keep the state reached: the last output row when the driver stands at its
-        time, else (a leg stopped between outputs) the driver's own state at its own
-        time."""
-        if driver.t == (-t if self.backward else t):
-            self.r, self.v, self.t = r, v, t
-            if self.events is not None and self.events.gm_changes:
-                self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]
-        else:
-            r_now, v_now, self.gm = driver.state()
-            sign = -1.0 if self.backward else 1.0
-            self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
+    def _between_outputs(self, driver: Any) -> None:
+        """Keep the state of a leg stopped between outputs: the driver's own state at
+        its own time."""
+        r_now, v_now, self.gm = driver.state()
+        sign = -1.0 if self.backward else 1.0
+        self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
 
 
 def run(

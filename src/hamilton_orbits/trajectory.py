@@ -17,7 +17,6 @@ caller gave plain floats, they are plain floats in the caller's own units.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -68,7 +67,9 @@ class Trajectory(TrajectoryBase):
     one leg of a run, its first row the state the leg started from.  Hamilton's
     integrals are measured from the start of the simulation, so that a run
     continued in legs reports the drift since its beginning; they, the final
-    system and the events table are computed on first access.
+    system and the events table are computed on first access (made by
+    :func:`make_trajectory`, whose ``integrals`` is what they are computed from: the
+    engine run's arrays, or a callable returning the three error arrays).
 
     Attributes (beside those of :class:`TrajectoryBase`: ``t``, ``steps``,
     ``wall_time``, ``method``, ``energy_error``, ``angular_momentum_error``)
@@ -130,7 +131,7 @@ class Trajectory(TrajectoryBase):
 
     def __init__(self, *, t: Any, r: Any, v: Any, names: tuple[str, ...], steps: int,
                  wall_time: float, method: str, effects: tuple[str, ...], complete: bool = True,
-                 integrals: Callable[[], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                 integrals: Any,
                  final_source: Any = None, event_source: Any = None, megno: Any = None,
                  lyapunov: Any = None, stm: Any = None) -> None:
         # one dict update: a short leg's wrapping is part of the cost of a call
@@ -144,7 +145,8 @@ class Trajectory(TrajectoryBase):
 
     @functools.cached_property
     def _errors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return self._integrals()
+        source = self._integrals
+        return source() if callable(source) else _integrals(*source)
 
     @property
     def energy_error(self) -> np.ndarray:  # type: ignore[override]
@@ -287,8 +289,7 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
     gone = log.inactive.copy() if log is not None else None  # the log goes on changing
     if not out.finite:
         _check_finite(system, method, r, v, times, gone)
-    integrals = functools.partial(_integrals, system, r, v, out.gm, times, gone, effect_set,
-                                  start)
+    integrals = (system, r, v, out.gm, times, gone, effect_set, start)  # for _integrals
     final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
     if system.quantity:
         import astropy.units as u

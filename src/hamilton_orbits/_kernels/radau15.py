@@ -477,6 +477,30 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
     return min(dt_new, base / _SAFETY), True
 
 
+@njit(cache=True, inline="always")
+def _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d):  # pragma: no cover - compiled
+    """The time after an accepted step (exactly ``t_end`` when it landed there, else
+    with Kahan's compensation ``t_cs``), and the step's ``b`` kept for the next
+    prediction (:func:`_keep`)."""
+    if landing:
+        t = t_end
+        t_cs = 0.0
+    else:
+        y = dt_try - t_cs
+        tn = t + y
+        t_cs = (tn - t) - y
+        t = tn
+    _keep(q, q <= 20.0, b, br, d)
+    return t, t_cs
+
+
+@njit(cache=True, inline="always")
+def _save(st, t, t_cs, dt, dt_last, have_last):  # pragma: no cover - compiled
+    """The step state back into ``st`` at the end of a call."""
+    st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST] = t, t_cs, dt, dt_last
+    st[ST_HAVE_LAST] = 1.0 if have_last else 0.0
+
+
 @njit(cache=True)
 def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx, csv):
     # pragma: no cover - compiled
@@ -581,21 +605,12 @@ def advance(
                 steps += 1
                 status = STATUS_EVENT
                 break
-        if landing:
-            t = t_end
-            t_cs = 0.0
-        else:
-            y = dt_try - t_cs
-            tn = t + y
-            t_cs = (tn - t) - y
-            t = tn
-        _keep(q, q <= 20.0, b, br, d)
+        t, t_cs = _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d)
         dt_last = dt_try
         have_last = True
         dt = dt_new
         steps += 1
-    st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST] = t, t_cs, dt, dt_last
-    st[ST_HAVE_LAST] = 1.0 if have_last else 0.0
+    _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status
 
 
@@ -749,19 +764,10 @@ def advance_variational(
         _megno_radau(ms, t, dt_try, b, a0, xf, vf, 3 * n_phys, 6 * n_phys)
         _accept(xf, vf, csx, csv, b, a0, vf, dt_try)
         _renormalise(r, v, b, br, d, g, csx, csv, gm.shape[0])
-        if landing:
-            t = t_end
-            t_cs = 0.0
-        else:
-            y = dt_try - t_cs
-            tn = t + y
-            t_cs = (tn - t) - y
-            t = tn
-        _keep(q, q <= 20.0, b, br, d)
+        t, t_cs = _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d)
         dt_last = dt_try
         have_last = True
         dt = dt_new
         steps += 1
-    st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST] = t, t_cs, dt, dt_last
-    st[ST_HAVE_LAST] = 1.0 if have_last else 0.0
+    _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status

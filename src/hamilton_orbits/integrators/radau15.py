@@ -256,6 +256,10 @@ class _Run:
         self.w = np.ascontiguousarray(v0.copy())
         self.steps = 0
         self.stop: Callable[[], bool] | None = None
+        # the kernel's arguments that stay the same objects between calls (a short
+        # call's cost is mostly its arguments; see docs/design.md, "One front door")
+        self.before_t = (self.accel, rhs.p, self.x, self.w, gm)
+        self.after_t = (self.st, *self.work, self.csx, self.csv, bool(rhs.velocity_dependent))
 
     @property
     def t(self) -> float:
@@ -289,8 +293,7 @@ class _Run:
         log, max_steps = self.log, self.max_steps
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             steps, status = _k.advance(
-                self.accel, self.rhs.p, self.x, self.w, self.gm, t_out[i], self.st, *self.work,
-                self.csx, self.csv, bool(self.rhs.velocity_dependent),
+                *self.before_t, t_out[i], *self.after_t,
                 min(SLICE, max_steps - (self.steps - first)), log.watch, log.buffer, log.count)
             self.steps += steps
             if status == _k.STATUS_MAXSTEPS:
