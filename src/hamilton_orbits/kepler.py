@@ -33,6 +33,7 @@ The compiled kernels live in :mod:`hamilton_orbits._kernels.kepler`.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -84,6 +85,18 @@ def _out(value: np.ndarray, quantity: bool):
     if quantity:
         return wrap(value, "rad", True)
     return value[()] if value.ndim == 0 else value
+
+
+def _solved(ufunc: Any, name: str, x: Any, e: Any,
+            refuse: Callable[[float, float, str], Exception]) -> Any:
+    """``ufunc(x, e)`` on the angle pair (``name`` the angle's argument name), refusing
+    the first NaN it returns with ``refuse(x_i, e_i, " at index ...")``."""
+    xa, ea, quantity = _angle_pair(name, x, e)
+    out = np.asarray(ufunc(xa, ea), dtype=np.float64)
+    i = _first_nan(out)
+    if i is not None:
+        raise refuse(xa.ravel()[i], ea.ravel()[i], _index(out.shape, i))
+    return _out(out, quantity)
 
 
 def _first_nan(out: np.ndarray) -> int | None:
@@ -143,15 +156,8 @@ def solve_kepler(M: Any, e: Any):
     >>> [f"{x:.10g}" for x in solve_kepler([1e-12, 2.0], [1.0, 3.0])]  # D, then F
     ['1e-12', '0.8441608952']
     """
-    Ma, ea, quantity = _angle_pair("M", M, e)
-    out = np.asarray(_k.solve_ufunc(Ma, ea), dtype=np.float64)
-    i = _first_nan(out)
-    if i is not None:
-        raise ConvergenceError(
-            f"solve_kepler did not converge for M={Ma.ravel()[i]!r}, "
-            f"e={ea.ravel()[i]!r}{_index(out.shape, i)}"
-        )
-    return _out(out, quantity)
+    return _solved(_k.solve_ufunc, "M", M, e, lambda m, e_, at: ConvergenceError(
+        f"solve_kepler did not converge for M={m!r}, e={e_!r}{at}"))
 
 
 def mean_anomaly(anomaly: Any, e: Any):
@@ -238,15 +244,8 @@ def anomaly_from_true(nu: Any, e: Any):
     >>> round(float(anomaly_from_true(np.pi / 2, 1.0)), 12)  # D = tan(pi/4)
     1.0
     """
-    xa, ea, quantity = _angle_pair("nu", nu, e)
-    out = np.asarray(_k.anomaly_from_nu_ufunc(xa, ea), dtype=np.float64)
-    i = _first_nan(out)
-    if i is not None:
-        raise ValueError(
-            f"Expected `nu` inside the asymptotes (1 + e cos nu > 0), got "
-            f"{xa.ravel()[i]!r} with e={ea.ravel()[i]!r}{_index(out.shape, i)}"
-        )
-    return _out(out, quantity)
+    return _solved(_k.anomaly_from_nu_ufunc, "nu", nu, e, lambda x, e_, at: ValueError(
+        f"Expected `nu` inside the asymptotes (1 + e cos nu > 0), got {x!r} with e={e_!r}{at}"))
 
 
 def true_from_anomaly(anomaly: Any, e: Any):
