@@ -6,6 +6,9 @@ Democratic-heliocentric steps (:func:`advance_dh`), Jacobi steps
 Touma (1996) (:func:`corrector_jacobi`), and the Jacobi coordinate changes.
 The effects part of the right-hand side is a first-class function
 ``extra(r, v, gm, acc, p)`` (:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE`).
+A drift of :data:`LANES_FROM` bodies or more solves their Kepler steps side by
+side in vector lanes (:func:`hamilton_orbits._kernels.kepler.propagate_lanes`),
+to the bits of the scalar kernel.
 """
 
 from __future__ import annotations
