@@ -41,6 +41,14 @@ loading the numba cache, or compiling when there is none) is reported apart.
 10. One radau15 step of the N = 10 disc: its floating-point operations, the
     fraction of the machine's scalar and SIMD throughput it reaches; the force
     evaluation beside a SIMD form.
+11. wh against WHFast over a seeded spread of independent discs (N = 3 and 10;
+    planet masses log-uniform 1e-7 .. 1e-3; tight or wide spacings;
+    near-circular or eccentric orbits; dt 1/1000 .. 1/20 of the innermost
+    period), democratic heliocentric for both (WHFast safe_mode 0), the same
+    steps on both sides: per disc us/step and the ratio WHFast / ours, then
+    the spread (min, median, max).
+
+``--only 2 11`` runs those sections alone ([0], the warm-up, always first).
 """
 
 from __future__ import annotations
@@ -977,27 +985,171 @@ def _force_forms(rng) -> None:
               f"(x{t_pairs / t_ship:.2f}; same bits: {np.array_equal(a1, a2)})")
 
 
+# ---------------------------------------------------------------------------
+# wh against WHFast over a spread of discs
+
+
+def _spread_disc(n: int, tight: bool, ecc: bool, rng):
+    """A star (GM 1) and ``n - 1`` planets: GM log-uniform 1e-7 .. 1e-3, the
+    innermost at a = 1 .. 2, the others outwards at ratios ``a_{i+1} / a_i`` of
+    8-12 mutual Hill radii (``tight``) or 1.3-2.0 (N = 3) / reaching a = 10
+    (N = 10) (wide), and never less than 1.1 times the ratio at which the orbits
+    would cross; e uniform in 0 .. 0.3 (``ecc``) or 0 .. 0.02; inclinations
+    below 0.05 rad; the other angles uniform.  Heliocentric elements made into
+    inertial states by rebound (both sides start from the same floats).
+    Returns ``r, v, gm, a, e, P_in`` (P_in the innermost period)."""
+    import rebound
+
+    k = n - 1
+    gm = 10.0 ** rng.uniform(-7.0, -3.0, k)
+    e = rng.uniform(0.0, 0.3 if ecc else 0.02, k)
+    a = np.empty(k)
+    a[0] = rng.uniform(1.0, 2.0)
+    wide = 10.0 ** (math.log10(10.0 / a[0]) / max(1, k - 1))  # N = 10: reach a = 10
+    for i in range(1, k):
+        cross = 1.1 * (1.0 + e[i - 1]) / (1.0 - e[i])
+        if tight:
+            x = 0.5 * rng.uniform(8.0, 12.0) * ((gm[i - 1] + gm[i]) / 3.0) ** (1.0 / 3.0)
+            ratio = (1.0 + x) / (1.0 - x)
+        else:
+            ratio = rng.uniform(1.3, 2.0) if k == 2 else wide
+        a[i] = a[i - 1] * max(ratio, cross)
+    sim = rebound.Simulation()
+    sim.G = 1.0
+    sim.add(m=1.0)
+    for i in range(k):
+        # the star fetched anew for every add (adding reallocates the particles)
+        sim.add(m=float(gm[i]), a=float(a[i]), e=float(e[i]),
+                inc=float(rng.uniform(0.0, 0.05)), Omega=float(rng.uniform(0, 2 * np.pi)),
+                omega=float(rng.uniform(0, 2 * np.pi)), M=float(rng.uniform(0, 2 * np.pi)),
+                primary=sim.particles[0])
+    sim.move_to_com()
+    r, v = reb_state(sim)
+    g = np.concatenate([[1.0], gm])
+    return r, v, g, a, e, 2.0 * np.pi * a[0] ** 1.5 / math.sqrt(1.0 + gm[0])
+
+
+def spread_discs(quick: bool, seed: int = 11):
+    """The discs of section [11]: for N = 3 and 10, every combination of tight /
+    wide and near-circular / eccentric (three times each; once with ``quick``),
+    with dt = P_in / K, K log-uniform in 20 .. 1000 (from the coarsest step a
+    user would take to dt = 0.01 at a = 2).  Each disc's own generator (seeded
+    from ``seed`` and its place), so that ``quick`` gives the first ones of the
+    full list."""
+    out = []
+    reps = 1 if quick else 3
+    for n in (3, 10):
+        for rep in range(reps):
+            for c, (tight, ecc) in enumerate(itertools.product((True, False), (False, True))):
+                rng = np.random.default_rng([seed, n, rep, c])
+                r, v, g, a, e, p_in = _spread_disc(n, tight, ecc, rng)
+                per = 10.0 ** rng.uniform(math.log10(20.0), 3.0)
+                out.append(dict(n=n, tight=tight, ecc=ecc, r=r, v=v, gm=g, a=a, e=e,
+                                dt=p_in / per, per=per))
+    return out
+
+
+def _disc_pair(d):
+    """``(ours, peer, n_steps)`` for one disc of :func:`spread_discs`: the same steps
+    on both sides, ~10^6 pair evaluations (``N (N - 1) / 2`` a step)."""
+    from hamilton_orbits.integrators import wh
+
+    n = d["n"]
+    n_steps = int(1e6 / (n * (n - 1) / 2))
+    dt = d["dt"]
+    t_end = n_steps * dt
+    r, v, g = d["r"], d["v"], d["gm"]
+    f = rhs()
+    sim0 = to_rebound(r, v, g, "whfast")
+    sim0.dt = dt
+    sim0.integrator.coordinates = "democraticheliocentric"
+    sim0.integrator.safe_mode = 0
+
+    def ours():
+        return wh.run(f, r, v, g, np.array([0.0, t_end]), dt=dt)
+
+    def peer():
+        sim = sim0.copy()
+        # half a step short of t_end: rebound steps while its summed t is below
+        # the target, which the rounding of n_steps sums of dt may leave it
+        sim.integrate(t_end - 0.5 * dt, exact_finish_time=0)
+        sim.synchronize()
+        return sim
+
+    return ours, peer, n_steps
+
+
+def bench_discs(quick: bool, rounds: int) -> list[float]:
+    """Section [11]; returns the per-disc ratios WHFast / ours."""
+    discs = spread_discs(quick)
+    print(f"[11] wh vs WHFast over {len(discs)} discs (democratic heliocentric, WHFast "
+          f"safe_mode 0; CPU time, median of {rounds} interleaved per-round ratios; "
+          "ratio = WHFast / ours)")
+    print("     N  spacing  e max  a_in..a_out   log10 GM (min..max)   P_in/dt   steps"
+          "      ours   WHFast (us/step)  ratio   |dE/E| ours")
+    ratios = []
+    for d in discs:
+        ours, peer, n_steps = _disc_pair(d)
+        ours()  # warm: the first call of a size loads its kernels
+        peer()
+        ts_o, ts_p = [], []
+        for _ in range(rounds):
+            t, (r, v, steps) = timed(ours)
+            ts_o.append(t)
+            t, sim = timed(peer)
+            ts_p.append(t)
+        if steps != n_steps or sim.steps_done != n_steps:
+            print(f"     (steps differ: ours {steps}, WHFast {sim.steps_done}, asked {n_steps})")
+        ts_o, ts_p = np.array(ts_o), np.array(ts_p)
+        ratio = float(np.median(ts_p / ts_o))
+        ratios.append(ratio)
+        de = abs(energy(r[-1], v[-1], d["gm"]) / energy(d["r"], d["v"], d["gm"]) - 1)
+        lg = np.log10(d["gm"][1:])
+        print(f"    {d['n']:2d}  {'tight' if d['tight'] else 'wide':7s}  {d['e'].max():5.2f}"
+              f"  {d['a'][0]:4.2f}..{d['a'][-1]:5.2f}   {lg.min():5.2f}..{lg.max():5.2f}"
+              f"          {d['per']:6.1f}  {n_steps:6d}  {np.median(ts_o) / n_steps * 1e6:8.3f}"
+              f"  {np.median(ts_p) / n_steps * 1e6:8.3f}          {ratio:5.2f}   {de:.1e}")
+    q = np.array(ratios)
+    print(f"    spread of the ratio: min {q.min():.2f}, median {np.median(q):.2f}, "
+          f"max {q.max():.2f}" + "".join(
+              f"; N = {n}: {q[[d['n'] == n for d in discs]].min():.2f}.."
+              f"{q[[d['n'] == n for d in discs]].max():.2f}" for n in (3, 10)))
+    return ratios
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter spans, fewer sizes")
     parser.add_argument("--propagate-only", action="store_true", help="section [9] alone")
+    parser.add_argument("--only", type=int, nargs="+", metavar="N",
+                        help="these sections alone (after the warm-up [0])")
     args = parser.parse_args()
     quick = args.quick
     if args.propagate_only:
         bench_propagate(3 if quick else 7)
         return
     repeat = 3
+    years, short = (100.0, 10.0) if quick else (1000.0, 100.0)
+    sections = {
+        1: lambda: bench_solar(years, repeat),
+        2: lambda: bench_wh(years, repeat),
+        3: lambda: bench_scaling(quick, repeat),
+        4: lambda: bench_work_precision(years),
+        5: lambda: bench_leapfrog(short, repeat),
+        6: lambda: bench_effects_cost(short, repeat),
+        7: lambda: bench_per_call(quick),
+        8: lambda: bench_memory(quick),
+        9: lambda: _propagate_on_two_threads(quick),
+        10: lambda: bench_flops(quick),
+        11: lambda: bench_discs(quick, 5 if quick else 7),
+    }
+    chosen = args.only if args.only else sorted(sections)
+    unknown = sorted(set(chosen) - set(sections))
+    if unknown:
+        parser.error(f"no section {unknown}; the sections are 1 .. {max(sections)}")
     bench_warmup()
-    bench_solar(100.0 if quick else 1000.0, repeat)
-    bench_wh(100.0 if quick else 1000.0, repeat)
-    bench_scaling(quick, repeat)
-    bench_work_precision(100.0 if quick else 1000.0)
-    bench_leapfrog(10.0 if quick else 100.0, repeat)
-    bench_effects_cost(10.0 if quick else 100.0, repeat)
-    bench_per_call(quick)
-    bench_memory(quick)
-    _propagate_on_two_threads(quick)
-    bench_flops(quick)
+    for k in chosen:
+        sections[k]()
 
 
 def _propagate_on_two_threads(quick: bool) -> None:

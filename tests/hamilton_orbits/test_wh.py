@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from numba import njit
 
+from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _kw
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
@@ -400,3 +401,38 @@ def test_integrate_passes_the_wh_options_and_refuses_others():
     with pytest.raises(ValueError, match=r"Unknown option `corector` = 3 for method 'wh'; "
                                          r"it takes: coordinates, corrector"):
         integrate(s, 4 * u.day, method="wh", dt=1 * u.day, corector=3)
+
+
+@pytest.mark.parametrize("bodies", [_kw.LANES_FROM, 9, 70, 150])
+@pytest.mark.parametrize("per_row_mu", [False, True])
+def test_drift_side_by_side_is_the_kernel_one_by_one(bodies, per_row_mu):
+    """The drift of many bodies (their Kepler steps side by side, in blocks of
+    ``LANE_BLOCK`` lanes) gives the bits of the shared kernel called body by body,
+    the bodies the lanes leave (eccentric orbits heading for periapsis, long steps,
+    an open orbit) included; one ``mu`` for all (democratic heliocentric) or one a
+    row (Jacobi).  A failing body is reported first in order, as by the loop: the
+    rows before it moved, those after it not."""
+    rng = np.random.default_rng(bodies)
+    n = bodies + 1
+    a = rng.uniform(0.5, 30.0, n)
+    e = np.where(rng.uniform(size=n) < 0.8, rng.uniform(0.0, 0.3, n), rng.uniform(0.9, 1.5, n))
+    p = a * np.abs(1.0 - e * e)
+    nu = rng.uniform(-1.5, 1.5, n)
+    rad = p / (1 + e * np.cos(nu))
+    q = np.stack([rad * np.cos(nu), rad * np.sin(nu), rng.normal(0.0, 0.01, n)], 1) @ ROT.T
+    u = np.stack([-np.sin(nu), e + np.cos(nu), rng.normal(0.0, 0.01, n)], 1) / np.sqrt(p)[:, None]
+    u = u @ ROT.T
+    mu = np.cumsum(rng.uniform(1e-7, 1e-3, n)) + 1.0 if per_row_mu else np.array([1.0])
+    for tau in (0.05, -0.3, 4.0, 0.0):
+        q1, u1 = q.copy(), u.copy()
+        assert _kw._kepler_all(q1, u1, mu, tau) == -1
+        for i in range(1, n):
+            want = _kepler.propagate_uv(*q[i], *u[i], mu[-1 if mu.shape[0] == 1 else i], tau)
+            assert tuple(q1[i]) + tuple(u1[i]) == want, (i, tau)
+        np.testing.assert_array_equal(q1[0], q[0])
+    bad = n // 2
+    q[bad] = 0.0  # at the centre: the kernel gives NaN
+    q1, u1 = q.copy(), u.copy()
+    assert _kw._kepler_all(q1, u1, mu, 0.05) == bad
+    assert not np.array_equal(q1[bad - 1], q[bad - 1])
+    np.testing.assert_array_equal(q1[bad:], q[bad:])

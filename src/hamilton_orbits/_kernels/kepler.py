@@ -506,6 +506,18 @@ _TAYLOR_STEP = 1e-6
 
 
 @njit(cache=True, inline="always")
+def _taylor_carry(xn, dx, u0, u1, u2, u3, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """``(xn, T, r, U0, U1, U2, U3)`` at ``xn = x + dx`` from the functions at ``x``
+    by their second-order Taylor series (see :func:`_solve_uv_short`)."""
+    h2 = 0.5 * dx * dx
+    v0 = u0 - alpha * (dx * u1 + h2 * u0)
+    v1 = u1 + dx * u0 - alpha * h2 * u1
+    v2 = u2 + dx * u1 + h2 * u0
+    v3 = u3 + dx * u2 + h2 * u1
+    return xn, r0 * v1 + sigma0 * v2 + v3, r0 * v0 + sigma0 * v1 + v2, v0, v1, v2, v3
+
+
+@njit(cache=True, inline="always")
 def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
     """:func:`_solve_uv` for a short step from a first guess ``x`` on the right
     side of 0 (the reversed series): Halley's method, T being increasing and
@@ -541,20 +553,7 @@ def _solve_uv_short(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
             if abs(f) <= 2.0 * EPS * abs(tau) or xn == xp:
                 return x, t, r, u0, u1, u2, u3
         if small or abs(dx) <= _TAYLOR_STEP * abs(x):
-            h2 = 0.5 * dx * dx
-            v0 = u0 - alpha * (dx * u1 + h2 * u0)
-            v1 = u1 + dx * u0 - alpha * h2 * u1
-            v2 = u2 + dx * u1 + h2 * u0
-            v3 = u3 + dx * u2 + h2 * u1
-            return (
-                xn,
-                r0 * v1 + sigma0 * v2 + v3,
-                r0 * v0 + sigma0 * v1 + v2,
-                v0,
-                v1,
-                v2,
-                v3,
-            )
+            return _taylor_carry(xn, dx, u0, u1, u2, u3, r0, sigma0, alpha)
         xp = x
         x = xn
     return nan, nan, nan, nan, nan, nan, nan
@@ -587,6 +586,14 @@ def _series_guess(tau, sgn, r0, sigma0, alpha):  # pragma: no cover - compiled
     # z^2 below 1 with z = |x1| (|sigma0|/r0 + sqrt(1/r0 + |alpha|))
     if not (2.0 * x1 * x1 * (4.0 * c2 * c2 + ir + abs(alpha)) < 1.0):
         return x1, x1 - c2 * x1 * x1, False
+    x = _series_x(x1, ir, c2, r0, sigma0, alpha)
+    return x1, x, x * sgn > 0.0 and x * x * abs(alpha) < 0.25
+
+
+@njit(cache=True, inline="always")
+def _series_x(x1, ir, c2, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The fifth-order reversed series of :func:`_series_guess` at ``x1 = tau / r0``
+    (``ir = 1 / r0``, ``c2 = sigma0 / (2 r0)``)."""
     c3 = (1.0 - alpha * r0) * ir * (1.0 / 6.0)
     c4 = -alpha * sigma0 * ir * (1.0 / 24.0)
     k3 = 2.0 * c2 * c2 - c3
@@ -594,8 +601,7 @@ def _series_guess(tau, sgn, r0, sigma0, alpha):  # pragma: no cover - compiled
     c5 = -alpha * c3 * (1.0 / 20.0)
     s2 = c2 * c2
     k5 = s2 * (14.0 * s2 - 21.0 * c3) + 6.0 * c2 * c4 + 3.0 * c3 * c3 - c5
-    x = x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
-    return x1, x, x * sgn > 0.0 and x * x * abs(alpha) < 0.25
+    return x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
 
 
 @njit(cache=True, inline="always")
@@ -813,6 +819,16 @@ def _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz):  # pra
     nan = math.nan
     if not (r > 0.0) or not math.isfinite(r):
         return nan, nan, nan, nan, nan, nan
+    x, y, z, wx, wy, wz, rr = _fg_sums(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu)
+    if not (0.0 < rr < math.inf):  # |r|^2 overflows: report, never garbage
+        return nan, nan, nan, nan, nan, nan
+    return _fg_velocity(x, y, z, wx, wy, wz, rr, hx, hy, hz)
+
+
+@njit(cache=True, inline="always")
+def _fg_sums(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu):  # pragma: no cover - compiled
+    """The position ``f r0 + g v0``, the f-g velocity ``fdot r0 + gdot v0`` and
+    ``|r|^2`` (:func:`_fg_state` without its checks)."""
     f = 1.0 - u2 / r0
     fd = -smu * u1 / (r * r0)
     gd = 1.0 - u2 / r
@@ -822,9 +838,13 @@ def _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz):  # pra
     wx = fd * rx + gd * vx
     wy = fd * ry + gd * vy
     wz = fd * rz + gd * vz
-    rr = x * x + y * y + z * z
-    if not (0.0 < rr < math.inf):  # |r|^2 overflows: report, never garbage
-        return nan, nan, nan, nan, nan, nan
+    return x, y, z, wx, wy, wz, x * x + y * y + z * z
+
+
+@njit(cache=True, inline="always")
+def _fg_velocity(x, y, z, wx, wy, wz, rr, hx, hy, hz):  # pragma: no cover - compiled
+    """The state of :func:`_fg_state`: the radial part of the f-g velocity ``w`` plus
+    ``h x r / |r|^2`` (``rr = |r|^2``)."""
     vr = (x * wx + y * wy + z * wz) / rr
     return (
         x,
@@ -903,6 +923,148 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
 # time per body for the planets).  The same Python function, so one definition;
 # not cached on its own (only ever compiled into its callers).
 propagate_uv_inline = njit(inline="always")(propagate_uv.py_func)
+
+
+# ---------------------------------------------------------------------------
+# propagate_uv for many states at once (the Wisdom-Holman drift)
+
+#: The columns of :func:`propagate_lanes`' work array, each ``m`` lanes long: the
+#: input position and velocity (0-5), ``mu`` (6) and ``sqrt(mu)`` (7), the output
+#: position and velocity (8-13) and whether a lane is done (14: 1.0 or 0.0).
+LANE_COLUMNS = 15
+
+
+@njit(cache=True, error_model="numpy")
+def propagate_lanes(w, m, dt):  # pragma: no cover - compiled
+    """:func:`propagate_uv` by ``dt`` for the ``m`` states in the columns of ``w``
+    (:data:`LANE_COLUMNS` of them, each ``m`` long), on its common path
+    only: moving away from periapsis or a short step (no anchoring), no period to
+    reduce, a short step whose first Halley evaluation settles
+    (:func:`_solve_uv_short`).  A lane done (``w[14 m + i] = 1``) holds
+    propagate_uv's result to the bit: the same operations in the same order,
+    each branch of the scalar path a comparison here; the others are left to the
+    scalar kernel (``dt = 0`` too).
+
+    Lanes are states: the loop is straight-line code that the compiler turns into
+    vector instructions (8 states at once; the scalar solves of consecutive
+    bodies, chains of divisions and Stumpff sums, hardly overlap).  The loop runs
+    over all ``m`` lanes: the compiler proves the columns apart only then."""
+    for i in range(m):
+        rx, ry, rz = w[i], w[m + i], w[2 * m + i]
+        vx, vy, vz = w[3 * m + i], w[4 * m + i], w[5 * m + i]
+        mu, smu = w[6 * m + i], w[7 * m + i]
+        r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
+        v2 = vx * vx + vy * vy + vz * vz
+        sigma0 = (rx * vx + ry * vy + rz * vz) / smu
+        alpha = 2.0 / r0 - v2 / mu
+        tau = smu * dt
+        hx = ry * vz - rz * vy
+        hy = rz * vx - rx * vz
+        hz = rx * vy - ry * vx
+        h2 = hx * hx + hy * hy + hz * hz
+        ok = _lane_direct(r0, sigma0, alpha, mu, dt, tau, h2)
+        sgn = 1.0 if tau > 0.0 else -1.0
+        x1 = tau / r0
+        ir = 1.0 / r0
+        c2 = 0.5 * sigma0 * ir
+        ok = ok & (2.0 * x1 * x1 * (4.0 * c2 * c2 + ir + abs(alpha)) < 1.0)
+        x = _series_x(x1, ir, c2, r0, sigma0, alpha)
+        ok = ok & (x * sgn > 0.0) & (x * x * abs(alpha) < 0.25)
+        chi, r, u1, u2, u3, settled = _lane_halley(tau, x, r0, sigma0, alpha)
+        ok = ok & settled & (abs(chi) < math.inf) & (r > 0.0) & (r < math.inf)
+        # _step_direct's choice of g, both forms formed
+        ga = (tau - u3) / smu
+        gb = (r0 * u1 + sigma0 * u2) / smu
+        second = (h2 > 0.0) & (not _g_first_form(tau, r0, sigma0, u1, u2, u3, r,
+                                                  EPS * abs(chi)))
+        g = ga if second else gb
+        x, y, z, wx, wy, wz, rr = _fg_sums(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu)
+        ok = ok & (0.0 < rr) & (rr < math.inf)
+        x, y, z, wx, wy, wz = _fg_velocity(x, y, z, wx, wy, wz, rr, hx, hy, hz)
+        w[8 * m + i], w[9 * m + i], w[10 * m + i] = x, y, z
+        w[11 * m + i], w[12 * m + i], w[13 * m + i] = wx, wy, wz
+        w[14 * m + i] = 1.0 if ok else 0.0
+
+
+@njit(cache=True, inline="always")
+def _lane_direct(r0, sigma0, alpha, mu, dt, tau, h2):  # pragma: no cover - compiled
+    """Whether :func:`propagate_uv` takes the path of :func:`propagate_lanes`
+    before its solver: ``r0 > 0`` (and not radial, ``r0^3 > 0``), no period to
+    reduce (:func:`_reduce_period`'s test) and no anchoring."""
+    ok = (r0 > 0.0) & (r0 * r0 * r0 > 0.0)
+    reduce = (alpha > 0.0) & (not ((dt * alpha) * (dt * alpha) * (mu * alpha)
+                                   <= 0.2499 * TWO_PI_HI * TWO_PI_HI))
+    e2 = 1.0 - alpha * (h2 / mu)
+    anchor = (sigma0 * tau < 0.0) & (abs(sigma0 * tau) > 0.1 * r0 * r0) & (e2 >= 0.25)
+    return ok & (not reduce) & (not anchor)
+
+
+@njit(cache=True, inline="always")
+def _lane_halley(tau, x, r0, sigma0, alpha):  # pragma: no cover - compiled
+    """The first iteration of :func:`_solve_uv_short` from ``x`` without its
+    branches: ``(chi, r, U1, U2, U3, settled)``, ``settled`` when the scalar
+    solver returns after it (its result, to the bit, then)."""
+    chi2 = x * x
+    psi = alpha * chi2
+    c2, c3 = _stumpff_lanes(psi)
+    t, r, rp, u0, u1, u2, u3 = _uv_from_stumpff(x, chi2, psi, c2, c3, r0, sigma0, alpha)
+    f = t - tau
+    exact = f == 0.0
+    den = r * r - 0.5 * f * rp
+    dx = -f * r / den
+    xn = x + dx
+    small = abs(dx) <= 4.0 * EPS * abs(xn)
+    done = small & (abs(f) <= 2.0 * EPS * abs(tau))
+    taylor = small | (abs(dx) <= _TAYLOR_STEP * abs(x))
+    moved = (den > 0.0) & (r > 0.0) & (xn * x > 0.0) & (done | taylor)
+    carry = (not exact) & (not done)
+    xc, _t, rc, _v0, v1, v2, v3 = _taylor_carry(xn, dx, u0, u1, u2, u3, r0, sigma0, alpha)
+    return (xc if carry else x, rc if carry else r, v1 if carry else u1,
+            v2 if carry else u2, v3 if carry else u3, exact | moved)
+
+
+@njit(cache=True, inline="always")
+def _stumpff_lanes(psi):  # pragma: no cover - compiled
+    """:func:`_stumpff_series` without branches: every lane sums the longest series
+    it may need, and restarts it where :func:`_stumpff_series` and :func:`_series_s`
+    start theirs for its ``|psi|`` (their ``top``), so that it adds the same terms
+    in the same order.  Written out term by term: a loop over the coefficients
+    (a tuple indexed by the loop variable compiles to a switch, and the loop is
+    not unrolled) keeps the loop of :func:`propagate_lanes` from being vectorised."""
+    z = -psi
+    az = abs(z)
+    m1 = az >= 1e-3
+    m2 = az >= 0.01
+    m3 = az >= 0.1
+    c2 = _masked(_C[8], z, _C[9], m3)
+    c2 = _masked(_C[7], z, c2, m3)
+    c2 = _masked(_C[6], z, c2, m3)
+    zs = -1.0 * psi
+    c3 = _S[14]
+    for k in (13, 12, 11, 10, 9, 8, 7, 6):  # a tuple of constants: unrolled
+        c3 = _masked(_S[k], zs, c3, m3)
+    return _masked_tail(_C, z, c2, m1, m2), _masked_tail(_S, zs, c3, m1, m2)
+
+
+@njit(cache=True, inline="always")
+def _masked_tail(c, z, acc, m1, m2):  # pragma: no cover - compiled
+    """The last six Horner steps (coefficients ``c[5] .. c[0]``) of
+    :func:`_stumpff_lanes`' series: both series start at ``c[5]`` from ``|psi| =
+    0.01`` on and at ``c[3]`` from ``1e-3``."""
+    acc = _masked(c[5], z, acc, m2)
+    acc = _masked(c[4], z, acc, m2)
+    acc = _masked(c[3], z, acc, m1)
+    acc = c[2] + z * acc
+    acc = c[1] + z * acc
+    return c[0] + z * acc
+
+
+@njit(cache=True, inline="always")
+def _masked(c, z, acc, use):  # pragma: no cover - compiled
+    """One Horner step ``c + z acc`` where the series has begun (``use``), else its
+    first coefficient ``c``."""
+    nxt = c + z * acc
+    return nxt if use else c
 
 
 # Below 1e-50 or above 1e50 a product of the kernels (h^2 ~ r^2 v^2, r.v h,
@@ -1021,6 +1183,7 @@ __all__ = [
     "nu_from_anomaly",
     "nu_from_anomaly_ufunc",
     "propagate_batch",
+    "propagate_lanes",
     "propagate_uv",
     "propagate_uv_inline",
     "sinh_minus_x",

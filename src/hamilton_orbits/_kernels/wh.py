@@ -6,6 +6,9 @@ Democratic-heliocentric steps (:func:`advance_dh`), Jacobi steps
 Touma (1996) (:func:`corrector_jacobi`), and the Jacobi coordinate changes.
 The effects part of the right-hand side is a first-class function
 ``extra(r, v, gm, acc, p)`` (:data:`hamilton_orbits._kernels.signatures.ACCEL_TYPE`).
+A drift of :data:`LANES_FROM` bodies or more solves their Kepler steps side by
+side in vector lanes (:func:`hamilton_orbits._kernels.kepler.propagate_lanes`),
+to the bits of the scalar kernel.
 """
 
 from __future__ import annotations
@@ -13,7 +16,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import carray, njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels import kepler as _kepler
@@ -36,27 +41,113 @@ __all__ = [
 ]
 
 
+#: From this many bodies on (besides the central one or the barycentre) a drift
+#: solves their Kepler steps side by side (:func:`_kepler_lanes`); below, one
+#: after the other (measured: docs/nbody_integrators.md).
+LANES_FROM = 4
+#: The lanes of a vector (8 float64): the lane columns are a multiple of it long.
+LANES = 8
+#: The most lanes at a time (the bodies in blocks of as many): the work space,
+#: :data:`_kepler.LANE_COLUMNS` float64 a lane, is on the stack (7.5 KB).
+LANE_BLOCK = 64
+
+
 @njit(cache=True, error_model="numpy")
 def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` (``mu[0]``
-    for all when ``mu`` has one element) by ``tau`` (the shared kernel inlined: the
-    bodies' solves overlap in the processor).
+    for all when ``mu`` has one element) by ``tau``: from :data:`LANES_FROM`
+    bodies on side by side (:func:`_kepler_lanes`), else the shared kernel inlined
+    (the bodies' solves overlap in the processor).  The same bits either way.
 
     Returns the index of the first failure (NaN from the kernel), else -1."""
+    n = q.shape[0]
+    if n - 1 >= LANES_FROM and tau != 0.0:
+        return _kepler_lanes(q, u, mu, tau)
     one = mu.shape[0] == 1
-    for i in range(1, q.shape[0]):
-        x, y, z, vx, vy, vz = _kepler.propagate_uv_inline(
+    for i in range(1, n):
+        state = _kepler.propagate_uv_inline(
             q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[0] if one else mu[i], tau
         )
-        if not math.isfinite(x + y + z + vx + vy + vz):
+        if not _store(q, u, i, state):
             return i
-        q[i, 0] = x
-        q[i, 1] = y
-        q[i, 2] = z
-        u[i, 0] = vx
-        u[i, 1] = vy
-        u[i, 2] = vz
     return -1
+
+
+@njit(cache=True, error_model="numpy")
+def _kepler_lanes(q, u, mu, tau):  # pragma: no cover - compiled
+    """:func:`_kepler_all` in blocks of up to :data:`LANE_BLOCK` bodies side by side
+    (:func:`_kepler.propagate_lanes`, lanes padded to a multiple of :data:`LANES`);
+    the few bodies the lanes leave (a step towards periapsis to anchor, a long
+    step, a solve that needs a second evaluation) by the shared kernel, called
+    (one copy of it, not inlined)."""
+    n = q.shape[0]
+    m = min((n - 1 + LANES - 1) // LANES * LANES, LANE_BLOCK)
+    lw = carray(_lane_scratch(), _kepler.LANE_COLUMNS * m)
+    one = mu.shape[0] == 1
+    for b0 in range(1, n, m):
+        b1 = min(b0 + m, n)
+        _to_lanes(q, u, mu, b0, b1, lw, m)
+        _kepler.propagate_lanes(lw, m, tau)
+        for i in range(b0, b1):
+            a = i - b0
+            if lw[14 * m + a] != 0.0:
+                state = (lw[8 * m + a], lw[9 * m + a], lw[10 * m + a], lw[11 * m + a],
+                         lw[12 * m + a], lw[13 * m + a])
+            else:
+                state = _kepler.propagate_uv(q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1],
+                                             u[i, 2], mu[0] if one else mu[i], tau)
+            if not _store(q, u, i, state):
+                return i
+    return -1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _store(q, u, i, state):  # pragma: no cover - compiled
+    """Row ``i`` of ``q``, ``u`` from a Kepler step's ``state`` (6 floats), if it is
+    finite (else the row is left, and False)."""
+    x, y, z, vx, vy, vz = state
+    if not math.isfinite(x + y + z + vx + vy + vz):
+        return False
+    q[i, 0] = x
+    q[i, 1] = y
+    q[i, 2] = z
+    u[i, 0] = vx
+    u[i, 1] = vy
+    u[i, 2] = vz
+    return True
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _to_lanes(q, u, mu, b0, b1, lw, m):  # pragma: no cover - compiled
+    """Rows ``b0 .. b1 - 1`` into the ``m`` lanes of ``lw``, the lanes beyond them a
+    copy of row ``b0``, with their ``mu`` and ``sqrt(mu)``."""
+    one = mu.shape[0] == 1
+    s0 = math.sqrt(mu[0])
+    for a in range(m):
+        i = b0 + a if b0 + a < b1 else b0
+        for c in range(3):
+            lw[c * m + a] = q[i, c]
+            lw[(3 + c) * m + a] = u[i, c]
+        lw[6 * m + a] = mu[0] if one else mu[i]
+        lw[7 * m + a] = s0 if one else math.sqrt(mu[i])
+
+
+@intrinsic
+def _lane_scratch(typingctx):  # pragma: no cover - compiled
+    """A pointer to ``LANE_COLUMNS * LANE_BLOCK`` float64 on the stack of the
+    function that calls it (valid until it returns), aligned to 64 bytes (the
+    widest vector); no allocation per drift."""
+
+    def codegen(context, builder, signature, args):
+        size = _kepler.LANE_COLUMNS * LANE_BLOCK + LANES
+        with builder.goto_entry_block():  # a fixed frame slot, not filled
+            raw = builder.alloca(context.get_value_type(types.float64),
+                                 size=cgutils.intp_t(size))
+        addr = builder.ptrtoint(raw, cgutils.intp_t)
+        aligned = builder.and_(builder.add(addr, addr.type(63)), addr.type(-64))
+        return builder.inttoptr(aligned, raw.type)
+
+    return types.CPointer(types.float64)(), codegen
 
 
 @njit(cache=True, inline="always", error_model="numpy")
