@@ -52,6 +52,7 @@ from hamilton_orbits.integrators import (
     method_of,
 )
 from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
+from hamilton_orbits.rhs import RHS
 
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
@@ -356,8 +357,15 @@ def run(
     (False, True)
     """
     typed = method_of(method, options)
-    t_arr = np.ascontiguousarray(t_out, dtype=np.float64)
-    backward = t_arr.ndim == 1 and t_arr.shape[0] > 1 and t_arr[-1] < t_arr[0]
+    if not isinstance(rhs, RHS):
+        raise ValueError(f"Expected `rhs` to be a compiled right-hand side "
+                         f"(hamilton_orbits.rhs.compile_rhs), got {rhs!r}")
+    t_arr = np.asarray(t_out, dtype=np.float64)
+    if t_arr.ndim != 1 or t_arr.shape[0] < 1:
+        raise ValueError(f"Expected `t_out` to be a 1-d array of output times (the start "
+                         f"first), got {t_out!r}")
+    t_arr = np.ascontiguousarray(t_arr)
+    backward = t_arr.shape[0] > 1 and t_arr[-1] < t_arr[0]
     r0, v0, gm, _ = check_inputs(r0, v0, gm, -t_arr if backward else t_arr)
     dt, tol = check_dt_tol(dt, tol)
     return Propagation(r0, v0, gm, float(t_arr[0]), rhs, typed, dt=dt, tol=tol, events=events,
