@@ -334,7 +334,7 @@ def _disc10() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return r, v, gm
 
 
-def _rebound_of(r: np.ndarray, v: np.ndarray, gm: np.ndarray, integrator: str, dt: float):
+def rebound_of(r: np.ndarray, v: np.ndarray, gm: np.ndarray, integrator: str, dt: float):
     import rebound
 
     sim = rebound.Simulation()
@@ -383,7 +383,7 @@ def bench_simulation_calls(rounds: int) -> None:
           f"{'ratio':>6}")
     for method, peer in (("radau15", "ias15"), ("wh", "whfast")):
         sim = Simulation(system, method=method, dt=dt)
-        reb = _rebound_of(r, v, gm, peer, dt)
+        reb = rebound_of(r, v, gm, peer, dt)
         xyz, vxyz = np.empty((10, 3)), np.empty((10, 3))
 
         def ours(sim=sim) -> None:

@@ -19,6 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 import rebound
+from bench_overhead import rebound_of  # the same rebound set-up as there
 
 from hamilton_orbits.integrators import radau15, wh
 from hamilton_orbits.rhs import newtonian_rhs
@@ -40,21 +41,6 @@ def disc(n: int, seed: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     gm = np.full(n, 1e-7)
     gm[0] = 1.0
     return r, v, gm
-
-
-def peer(r: np.ndarray, v: np.ndarray, gm: np.ndarray, integrator: str) -> rebound.Simulation:
-    sim = rebound.Simulation()
-    sim.G = 1.0
-    for i in range(len(gm)):
-        sim.add(m=gm[i], x=r[i, 0], y=r[i, 1], z=r[i, 2], vx=v[i, 0], vy=v[i, 1], vz=v[i, 2])
-    sim.integrator = integrator
-    sim.dt = DT
-    if integrator == "ias15":
-        sim.integrator.epsilon = 0.0
-    else:
-        sim.integrator.coordinates = "democraticheliocentric"
-        sim.integrator.safe_mode = 0
-    return sim
 
 
 def cpu(fn: Callable[[], object]) -> float:
@@ -81,7 +67,7 @@ def main() -> None:
         r, v, gm = disc(n)
         steps = int(max(50, min(50_000, 2e7 / (n * n) / 20)))  # ~10^6 pair evaluations
         t_out = np.array([0.0, steps * DT])
-        ias, whf = peer(r, v, gm, "ias15"), peer(r, v, gm, "whfast")
+        ias, whf = rebound_of(r, v, gm, "ias15", DT), rebound_of(r, v, gm, "whfast", DT)
 
         def whfast(whf: rebound.Simulation = whf, t_end: float = t_out[1]) -> None:
             copy = whf.copy()

@@ -182,6 +182,22 @@ def check_step_count(span: float, dt: float, max_steps: int, method: str) -> int
 
 
 
+
+def fixed_steps(span: float, dt: float) -> tuple[int, float]:
+    """The steps of a fixed-step method over an output interval ``span``: ``n`` steps of
+    ``dt``, the last shortened to ``span - (n - 1) dt`` to land on the output (``n``
+    rounded up; a remainder within 1e-12 of a step is not a step of its own).
+
+    Examples
+    --------
+    >>> fixed_steps(1.0, 0.3)
+    (4, 0.10000000000000009)
+    >>> fixed_steps(0.9, 0.3)
+    (3, 0.30000000000000004)
+    """
+    n = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
+    return n, span - (n - 1) * dt
+
 def run_once(start: Callable[..., Any], method: type, rhs: Any, r0: Any, v0: Any, gm: Any,
              t_out: Any, *, dt: Any = None, tol: Any = None,
              on_output: Callable[[int, int], None] | None = None,

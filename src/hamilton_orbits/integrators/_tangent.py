@@ -35,7 +35,12 @@ from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
 from hamilton_orbits.integrators import StopIntegration
-from hamilton_orbits.integrators._setup import accel_arg, addresses, check_step_count
+from hamilton_orbits.integrators._setup import (
+    accel_arg,
+    addresses,
+    check_step_count,
+    fixed_steps,
+)
 from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS
 from hamilton_orbits.validation import ConvergenceError
 
@@ -362,9 +367,7 @@ class WHTangent:
         dt, first, k, n = self.dt, self.steps, self.tangent.k, self.g.shape[0]
         check_step_count(float(t_out[-1] - t_out[0]), dt, self.max_steps, "wh")
         for i in range(1, t_out.shape[0]):
-            span = t_out[i] - t_out[i - 1]
-            n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
-            last = span - (n_steps - 1) * dt
+            n_steps, last = fixed_steps(t_out[i] - t_out[i - 1], dt)
             done = 0
             while done < n_steps:
                 if done and stop is not None and stop():

@@ -220,9 +220,7 @@ class _DoubleDouble:
 
         dt_f, first = self.dt, self.steps
         for i in range(1, len(t_out)):
-            span = float(t_out[i] - t_out[i - 1])
-            n_steps = max(1, math.ceil(span / dt_f * (1.0 - 1e-12)))
-            last = span - (n_steps - 1) * dt_f
+            n_steps, last = _setup.fixed_steps(float(t_out[i] - t_out[i - 1]), dt_f)
             done = 0
             while done < n_steps:
                 k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1

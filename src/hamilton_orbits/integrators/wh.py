@@ -286,9 +286,7 @@ class _State:
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
         dt, log = self.dt, self.log
-        span = t_out[i] - t_out[i - 1]
-        n_steps = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
-        last = span - (n_steps - 1) * dt
+        n_steps, last = _setup.fixed_steps(t_out[i] - t_out[i - 1], dt)
         done = 0
         while done < n_steps:
             if done and stop is not None and stop():
