@@ -411,7 +411,7 @@ class DOP853Tangent:
         self.rows = rows = n * (1 + k)
         self.n, self.gm, self.tangent, self.tol, self.max_step = (
             n, np.array(gm, dtype=np.float64), tangent, tol, max_step)
-        self.f = self._rhs(rhs, n, rows, t0)
+        self.rhs, self.t0, self.acc = rhs, t0, np.empty((rows, 3))
         self.y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(),
                                  tangent.dv0.ravel(), [0.0]))
         scale_t = np.full(6 * n * k, np.inf)
@@ -423,20 +423,18 @@ class DOP853Tangent:
         tangent.start(t0)
         self.t, self.steps = t0, 0
 
-    def _rhs(self, rhs: Any, n: int, rows: int, t0: float) -> Callable:
-        acc = np.empty((rows, 3))
-        gm = self.gm
-
-        def f(t: float, y: np.ndarray) -> np.ndarray:
-            x = y[: 3 * rows].reshape(rows, 3)
-            w = y[3 * rows: 6 * rows].reshape(rows, 3)
-            rhs.augmented(x, w, gm, acc, rhs.p)
-            dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
-            den = float(np.sum(dx * dx) + np.sum(dw * dw))
-            rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0
-            return np.concatenate((y[3 * rows: 6 * rows], acc.ravel(), [2.0 * (t - t0) * rate]))
-
-        return f
+    def f(self, t: float, y: np.ndarray) -> np.ndarray:
+        """``dy/dt`` of the augmented system (a method, not a closure: a copy of the
+        state computes with its own arrays)."""
+        n, rows, acc, rhs = self.n, self.rows, self.acc, self.rhs
+        x = y[: 3 * rows].reshape(rows, 3)
+        w = y[3 * rows: 6 * rows].reshape(rows, 3)
+        rhs.augmented(x, w, self.gm, acc, rhs.p)
+        dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
+        den = float(np.sum(dx * dx) + np.sum(dw * dw))
+        rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0
+        return np.concatenate((y[3 * rows: 6 * rows], acc.ravel(),
+                               [2.0 * (t - self.t0) * rate]))
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The current positions, velocities and ``G m`` (copies)."""

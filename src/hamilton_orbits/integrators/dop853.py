@@ -85,10 +85,20 @@ class _State:
                  tol: float, atol: np.ndarray, max_step: float, events: EventLog | None) -> None:
         self.n = n = r0.shape[0]
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
-        self.f = _rhs(rhs, n, self.gm)
+        self.rhs, self.acc = rhs, np.empty((n, 3))
         self.y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
         self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
         self.t, self.steps = t0, 0
+
+    def f(self, _t: float, y: np.ndarray) -> np.ndarray:
+        """``dy/dt`` of the bodies (positions, then velocities, flattened), with the
+        masses of now (a method, not a closure: a copy of the state computes with its
+        own masses)."""
+        n = self.n
+        r = y[: 3 * n].reshape(n, 3)
+        v = y[3 * n :].reshape(n, 3)
+        self.rhs.accel(r, v, self.gm, self.acc, self.rhs.p)
+        return np.concatenate((y[3 * n :], self.acc.ravel()))
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The current positions, velocities and ``G m`` (copies)."""
@@ -162,21 +172,6 @@ class _State:
                                  atol=self.atol, max_step=self.max_step)
             self.t, self.y = float(t_out[i]), solver.y.copy()
             store(i, self.steps, self.y)
-
-
-def _rhs(rhs: Any, n: int, gm: np.ndarray) -> Callable[[float, np.ndarray], np.ndarray]:
-    """``f(t, y)`` of the bodies (positions, then velocities, flattened)."""
-    accel = rhs.accel
-    acc = np.empty((n, 3))
-    p = rhs.p
-
-    def f(_t: float, y: np.ndarray) -> np.ndarray:
-        r = y[: 3 * n].reshape(n, 3)
-        v = y[3 * n :].reshape(n, 3)
-        accel(r, v, gm, acc, p)
-        return np.concatenate((y[3 * n :], acc.ravel()))
-
-    return f
 
 
 #: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.
