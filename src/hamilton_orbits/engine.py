@@ -207,7 +207,7 @@ class Propagation:
         if watched and backward:
             raise ValueError("Events are watched forwards in time only; integrate forwards")
 
-    def _driver_for(self, backward: bool) -> Any:
+    def driver_for(self, backward: bool) -> Any:
         """The driver's state for a leg in this direction (a new one from the state
         reached when the direction changes)."""
         if self.driver is not None and backward == self.backward:
@@ -225,13 +225,17 @@ class Propagation:
         return self.driver
 
     def advance(self, t_out: np.ndarray, *, on_output: Callable[[int, int], None] | None = None,
-                stop: Callable[[], bool] | None = None) -> EngineRun:
+                stop: Callable[[], bool] | None = None,
+                checkpoint: Callable[[int], None] | None = None) -> EngineRun:
         """Integrate through ``t_out`` (strictly monotonic, ``t_out[0]`` the current
-        time :attr:`t`, forwards or backwards); see :func:`run`."""
+        time :attr:`t`, forwards or backwards); see :func:`run`.  ``checkpoint(i)``
+        (forwards only) is called at output ``i`` with the propagation standing there
+        as a leg ending at ``t_out[i]`` would leave it (a snapshot taken then
+        continues bit for bit)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         driver = self.driver if self.driver is not None and backward == self.backward \
-            else self._driver_for(backward)
+            else self.driver_for(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
         r_out, v_out = rows[0], rows[1]
         r_out[0], v_out[0] = self.r, self.v
@@ -246,6 +250,9 @@ class Propagation:
 
         def report(i: int, steps: int) -> None:
             reached[0], reached[1] = i, steps
+            if checkpoint is not None:
+                self._stand_at(float(t_out[i]), r_out[i], v_out[i])
+                checkpoint(i)
             if on_output is not None:
                 on_output(i, steps)
             if stop is not None and stop():
@@ -283,6 +290,12 @@ class Propagation:
         finite = all_finite(rows.reshape(-1))  # one compiled pass over both
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
+
+    def _stand_at(self, t: float, r: np.ndarray, v: np.ndarray) -> None:
+        """Stand at output time ``t`` with its state (forwards), as a leg ending there."""
+        self.r, self.v, self.t = r, v, t
+        if self.events is not None and self.events.gm_changes:
+            self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]
 
     def _between_outputs(self, driver: Any) -> None:
         """Keep the state of a leg stopped between outputs: the driver's own state at

@@ -267,6 +267,37 @@ class System(InitialStates):
         out._check_positions()
         return out
 
+    @classmethod
+    def from_system_arrays(cls, arrays: SystemArrays) -> System:
+        """The system of :meth:`as_arrays`' fields, bit for bit (the inverse of
+        :meth:`as_arrays`; a saved simulation is rebuilt from it).
+
+        Examples
+        --------
+        >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0], radius=0.5, j2=1e-3),
+        ...             Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+        >>> again = System.from_system_arrays(s.as_arrays())
+        >>> again.names, again["a"].j2, bool(np.array_equal(again.as_arrays().r, s.r))
+        (('a', 'b'), 0.001, True)
+        """
+        names = tuple(str(x) for x in arrays.names)
+        n = len(names)
+        fields = [np.array(x, dtype=np.float64) for x in (arrays.gm, arrays.r, arrays.v,
+                                                           arrays.radius, arrays.j2,
+                                                           arrays.pole)]
+        shapes = [(n,), (n, 3), (n, 3), (n,), (n,), (n, 3)]
+        labels = ("gm", "r", "v", "radius", "j2", "pole")
+        for name, arr, shape in zip(labels, fields, shapes, strict=True):
+            if arr.shape != shape:
+                raise ValueError(f"Expected `{name}` to have shape {shape}, got {arr.shape}")
+        index = {name: k for k, name in enumerate(names)}
+        if len(index) != n:
+            raise ValueError(f"Expected unique body names, got {names!r}")
+        out = object.__new__(cls)
+        out._set_arrays(names, index, bool(arrays.quantity), float(arrays.G), *fields, None)
+        out._check_state()
+        return out
+
     # ------------------------------------------------------------------ checks
     def _check_positions(self) -> None:
         """Refuse two bodies (one of them massive) at one position, or so close that

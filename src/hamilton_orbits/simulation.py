@@ -23,23 +23,35 @@ start of the simulation.
 from __future__ import annotations
 
 import copy
-import math
+import os
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
+from hamilton_orbits._legs import (
+    event_list,
+    leg_times,
+    requested_rows,
+    rows_of,
+    tangent_of,
+    time_step,
+    tolerance,
+)
+from hamilton_orbits.checkpoint import ArchiveWriter, last_snapshot, record, spec
 from hamilton_orbits.effects import EffectSet, get
 from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
+from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.rhs import RHS, compile_rhs
+from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory, event_table, make_trajectory
-from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
-from hamilton_orbits.validation import as_float_array
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -117,14 +129,16 @@ class Simulation:
     def __init__(self, system: System, method: str | Method = "radau15", dt: Any = None,
                  tol: float | None = None, effects: Sequence[str | Mapping[str, Any]] = (),
                  events: Any = (), variational: bool = False, stm: bool = False,
-                 tangent: Any = None, **method_options: Any) -> None:
+                 tangent: Any = None, archive: Any = None, every: Any = None,
+                 every_steps: int | None = None, every_wall: float | None = None,
+                 **method_options: Any) -> None:
         if not isinstance(system, System):
             raise ValueError(f"Expected `system` to be a System, got {system!r}")
         typed = method_of(method, method_options)
         eff = check_effects(typed, effects)
-        step = None if dt is None else _step(dt, system.quantity)
-        tol = _tolerance(tol)
-        tan = _tangent(system, variational, stm, tangent, typed)
+        step = None if dt is None else time_step(dt, system.quantity)
+        tol = tolerance(tol)
+        tan = tangent_of(system, variational, stm, tangent, typed)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
@@ -136,6 +150,8 @@ class Simulation:
         self._start: Any = None
         self._initial = (arrays.r, arrays.v, arrays.gm)
         self._unit: Any = DAY if system.quantity else None
+        self._spec = (typed, step, tol, eff.as_list(), event_list(events), variational, stm)
+        self._archive = _archive_of(archive, every, every_steps, every_wall, system.quantity)
 
     # ------------------------------------------------------------------ state
     @property
@@ -228,25 +244,148 @@ class Simulation:
             raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
                              f"{on_interrupt!r}")
         prop = self._prop
-        times, unit = _leg_times(t, prop.t, self._quantity)
+        times, unit = leg_times(t, prop.t, self._quantity)
         if unit is not None:
             self._unit = unit
         close = None
         if progress:
             on_output, close = _progress(prop.method.name, len(times) - 1, on_output)
+        archived = None if self._archive is None else self._archived_times(times)
         try:
             compiled = compile_seconds()
-            out = prop.advance(times, on_output=on_output, stop=stop)
+            if archived is None:
+                out = prop.advance(times, on_output=on_output, stop=stop)
+            else:
+                out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
+                                   stop=stop, checkpoint=self._checkpoint(archived[2]))
+                out = requested_rows(out, archived[1])
             compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
         finally:
             if close is not None:
                 close()
+            if self._archive is not None:
+                self._archive.close()
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
         return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
                                self._effects, start=start,
                                wall_time=max(out.wall_time - compiled, 0.0))
+
+
+    # ------------------------------------------------------------------ saving
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Save everything needed to continue: ``Simulation.load(path).integrate(t)``
+        gives the bits this simulation's ``integrate(t)`` would.
+
+        The file is a self-describing netCDF file (``t``, ``r``, ``v``, ``gm`` readable
+        by any netCDF reader; the method, effects, events and the integrator's own
+        state for this package), written atomically (``docs/archive.md``).
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> from hamilton_orbits import Body, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> sim = Simulation(s, method="wh", dt=0.01)
+        >>> _ = sim.integrate(1.0)
+        >>> with tempfile.TemporaryDirectory() as tmp:
+        ...     sim.save(os.path.join(tmp, "sim.nc"))
+        ...     again = Simulation.load(os.path.join(tmp, "sim.nc"))
+        >>> a, b = sim.integrate(2.0), again.integrate(2.0)
+        >>> bool(np.array_equal(a.r, b.r)), again.steps
+        (True, 200)
+        """
+        write(path, *self._record(), sync=True)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Simulation:
+        """The simulation saved in ``path`` (:meth:`save`), or the last snapshot of an
+        archive folder (continuing that archive on its schedule).
+
+        Raises
+        ------
+        SnapshotError
+            For a missing, damaged or foreign file, naming it.
+        """
+        path = Path(path)
+        folder = path if path.is_dir() else None
+        if folder is not None:
+            path = last_snapshot(folder)
+        meta, arrays = read(path)
+        sim = cls._rebuild(meta, arrays, path)
+        schedule = meta.get("archive")
+        if folder is not None and schedule:
+            sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync")}
+            sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
+            sim._archive.last_steps = sim.steps
+        return sim
+
+    @classmethod
+    def _rebuild(cls, meta: dict[str, Any], arrays: dict[str, np.ndarray],
+                 path: Path) -> Simulation:
+        sp = spec(meta, arrays)
+        system = System.from_system_arrays(sp["system"])
+        days = (lambda x: x) if not system.quantity else (lambda x: x * DAY)
+        sim = cls(system, method_of(sp["method"], sp["options"]),
+                  dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
+                  effects=sp["effects"], events=sp["events"], variational=sp["variational"],
+                  stm=sp["stm"])
+        prop, layout = sim._prop, sp["layout"]
+        if "class" in layout["attrs"]["driver"]:
+            prop.driver_for(bool(layout["attrs"]["backward"]["value"]))
+        try:
+            restore(prop, layout, sp["state"])
+        except LayoutMismatch as exc:
+            raise SnapshotError(f"{path}: the integrator state was saved by another version "
+                                f"({exc})") from None
+        if meta.get("started"):
+            sim._start = sim._initial
+        if meta.get("unit"):
+            sim._unit = u.Unit(meta["unit"])
+        return sim
+
+    def _record(self) -> tuple[Any, ...]:
+        extra = {"started": self._start is not None,
+                 "unit": None if self._unit is None else self._unit.to_string(),
+                 "archive": None if self._archive is None else self._archive.schedule()}
+        return record(self._system, *self._spec, self._prop, extra)
+
+    def _archived_times(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The output times with the archive's snapshot times merged in, which rows
+        were asked for, and which are scheduled snapshots; the archive's folder
+        claimed, and its first snapshot (the start) written if it has none."""
+        if times[-1] < times[0]:
+            raise ValueError("A simulation with an archive integrates forwards in time")
+        arch = self._archive
+        arch.open()
+        if arch.count == 0:
+            arch.write(*self._record())
+        extra = arch.times(float(times[0]), float(times[-1]))
+        merged = np.union1d(times, extra)
+        return merged, np.isin(merged, times), np.isin(merged, extra)
+
+    def _checkpoint(self, scheduled: np.ndarray) -> Callable[[int], None]:
+        arch = self._archive
+
+        def at(i: int) -> None:
+            if i > 0 and (scheduled[i] or arch.due(self._prop.steps)):
+                arch.write(*self._record())
+
+        return at
+
+
+def _archive_of(path: Any, every: Any, every_steps: Any, every_wall: Any,
+                quantity: bool) -> ArchiveWriter | None:
+    """The archive a simulation writes while it runs (None without ``path``)."""
+    if path is None:
+        if (every, every_steps, every_wall) != (None, None, None):
+            raise ValueError("`every`, `every_steps` and `every_wall` schedule an archive: "
+                             "give `archive` (a folder) too")
+        return None
+    return ArchiveWriter(path, every=None if every is None else time_step(every, quantity, "every"),
+                         every_steps=every_steps, every_wall=every_wall)
 
 
 def _shared(prop: engine.Propagation) -> dict[int, Any]:
@@ -379,79 +518,6 @@ def integrate(
     return sim.integrate(t, progress=progress, on_output=on_output)
 
 
-def _leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
-    """Output times in days (Quantity system) from ``t``, from the simulation's time
-    ``t_now`` (added first if missing), with the caller's unit."""
-    if type(t) is float and not quantity and t != t_now and math.isfinite(t):
-        return np.array([t_now, t]), None  # an end time in the caller's units: the common case
-    if quantity and not is_quantity(t):
-        raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
-    if not quantity and is_quantity(t):
-        raise ValueError(f"Expected `t` as plain floats for a system of plain floats, got {t!r}")
-    unit = t.unit if quantity else None
-    arr = np.atleast_1d(TIME("t", t, DAY if quantity else None)).astype(np.float64)
-    if arr.size == 0:
-        raise ValueError("Expected `t` to be an end time or a non-empty array of times, got []")
-    if arr.ndim != 1:
-        raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
-                         f"{arr.shape}")
-    if arr.size == 1:
-        if arr[0] == t_now:
-            raise ValueError("Expected `t` to be a nonzero end time, got 0" if t_now == 0.0
-                             else f"Expected `t` to differ from the simulation's time "
-                                  f"{t_now!r}, got {float(arr[0])!r}")
-        arr = np.array([t_now, arr[0]])
-    elif arr[0] != t_now:
-        arr = np.concatenate(([t_now], arr))
-    d = np.diff(arr)
-    if not (np.all(d > 0) or np.all(d < 0)):
-        k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
-        start = "0" if t_now == 0.0 else repr(t_now)
-        raise ValueError(
-            f"Expected `t` to be strictly monotonic (times after the start {start}), got "
-            f"{arr[k + 1]!r} after {arr[k]!r} at index {k + 1}"
-        )
-    return arr, unit
-
-
-def _tolerance(tol: Any) -> float | None:
-    if tol is None:
-        return None
-    tol = DIMENSIONLESS.scalar("tol", tol)
-    if not 0.0 < tol < 1.0:
-        raise ValueError(f"Expected `tol` (a relative tolerance) in (0, 1), got {tol!r}")
-    return tol
-
-
-def _tangent(system: System, variational: Any, stm: Any, vector: Any, method: Method) -> Any:
-    """The :class:`~hamilton_orbits.integrators._tangent.Tangent` of a run, or None."""
-    if not isinstance(variational, bool) or not isinstance(stm, bool):
-        raise ValueError(f"Expected `variational` and `stm` to be True or False, got "
-                         f"{variational!r}, {stm!r}")
-    if stm and not variational:
-        raise ValueError("`stm=True` needs `variational=True` (the STM is integrated with "
-                         "the variational equations)")
-    if not variational:
-        if vector is not None:
-            raise ValueError("`tangent` is MEGNO's initial tangent vector: it needs "
-                             "`variational=True`")
-        if getattr(method, "tangent_control", False):
-            raise ValueError("`tangent_control=True` lets the tangent vectors take part in "
-                             "the step control: it needs `variational=True`")
-        return None
-    from hamilton_orbits.integrators._tangent import Tangent
-
-    n = len(system.names)
-    if vector is not None:
-        vec = as_float_array("tangent", vector)
-        if vec.shape not in ((n, 6), (6 * n,)):
-            raise ValueError(f"Expected `tangent` to have shape ({n}, 6), got {vec.shape}")
-        if not np.any(vec):
-            raise ValueError("Expected `tangent` to be nonzero, got all zeros")
-        vector = vec.reshape(n, 6)
-    return Tangent(n, 1, stm=stm, vector=vector)
-
-
 def event_log(system: System, events: Any) -> EventLog | None:
     """The :class:`~hamilton_orbits.events.EventLog` of ``events`` for ``system``
     (None when no event is listed).
@@ -469,24 +535,6 @@ def event_log(system: System, events: Any) -> EventLog | None:
     if not listed:
         return None
     return EventLog(watch_table(listed, system), system.as_arrays().radius)
-
-
-def _step(dt: Any, quantity: bool) -> float:
-    """``dt`` in days (a Quantity system: a time Quantity is required) or the
-    caller's float, positive and finite."""
-    if quantity and not is_quantity(dt):
-        raise ValueError(f"Expected `dt` as a time Quantity for a Quantity system, got {dt!r} "
-                         "(a bare number would be read as days)")
-    if not quantity and is_quantity(dt):
-        raise ValueError(f"Expected `dt` as a plain float for a system of plain floats, "
-                         f"got {dt!r}")
-    if type(dt) is float and not quantity:
-        step = dt  # checked below
-    else:
-        step = TIME.scalar("dt", dt, DAY if quantity else None)
-    if not (np.isfinite(step) and step > 0):
-        raise ValueError(f"Expected `dt` > 0, got {step!r}")
-    return step
 
 
 def check_effects(method: Method, effects: Any) -> EffectSet:

@@ -17,6 +17,8 @@ from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 from hamilton_orbits.validation import as_float_array, check_positive
 
 _ADDRESSES: weakref.WeakKeyDictionary[Any, dict[int, np.ndarray]] = weakref.WeakKeyDictionary()
+#: the ids of the address arrays handed out (they live as long as their dispatcher)
+_ADDRESS_IDS: set[int] = set()
 
 
 def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
@@ -43,7 +45,21 @@ def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
         found = np.array([lib.get_pointer_to_function(names.llvm_cfunc_wrapper_name),
                           lib.get_pointer_to_function(names.llvm_func_name)], dtype=np.int64)
         known[id(signature)] = found
+        _ADDRESS_IDS.add(id(found))
     return found
+
+
+def is_address(arr: np.ndarray) -> bool:
+    """True if ``arr`` is an array of compiled-function addresses (:func:`addresses`):
+    a value of this process that a saved state must not carry.
+
+    Examples
+    --------
+    >>> from hamilton_orbits._kernels import nbody
+    >>> is_address(accel_arg(nbody.newtonian_only)), is_address(np.zeros(2, np.int64))
+    (True, False)
+    """
+    return id(arr) in _ADDRESS_IDS and arr.dtype == np.int64 and arr.shape == (2,)
 
 
 def accel_arg(fn: Any) -> np.ndarray:

@@ -1,0 +1,271 @@
+"""What a saved simulation holds, and the archive a simulation writes while it runs.
+
+:func:`record` turns a simulation's parts (the system at time 0, the method, the
+effects, the events, the propagation's whole state) into a snapshot's ``meta``
+and arrays (:mod:`hamilton_orbits.snapshot`); :func:`spec` reads them back into
+the arguments that rebuild it.  Values that may be Quantities (effect and event
+parameters) go through a JSON form that keeps their unit and every bit of their
+value.
+
+:class:`ArchiveWriter` is the schedule of an archive (every ``every`` of
+simulation time, every ``every_steps`` steps, every ``every_wall`` seconds) and
+its folder: snapshots ``snapshot-000000.nc``, ``snapshot-000001.nc``, ... each
+written whole or not at all, the folder claimed with a lock file (two processes
+cannot write one archive; a lock left by a killed run is taken over), a
+read-only folder or a full disk refused at the first write.
+
+Examples
+--------
+>>> import astropy.units as u
+>>> import json
+>>> text = json.dumps(to_json({"c": 299792.458 * u.km / u.s, "body": "sun"}))
+>>> from_json(json.loads(text))["c"]
+<Quantity 299792.458 km / s>
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits._outdir import FolderError, OutputFolder
+from hamilton_orbits.restart import flatten
+from hamilton_orbits.snapshot import SnapshotError, read, write
+from hamilton_orbits.units import is_quantity
+
+__all__ = [
+    "SNAPSHOT_NAME",
+    "ArchiveWriter",
+    "from_json",
+    "last_snapshot",
+    "record",
+    "snapshot_files",
+    "spec",
+    "to_json",
+]
+
+SNAPSHOT_NAME = "snapshot-{:06d}.nc"
+_SNAPSHOT_RE = re.compile(r"^snapshot-(\d{6})\.nc$")
+_SYSTEM_FIELDS = ("gm", "r", "v", "radius", "j2", "pole")
+
+
+def to_json(value: Any) -> Any:
+    """``value`` in a JSON form that keeps Quantities (value and unit) and arrays."""
+    if is_quantity(value):
+        return {"__quantity__": np.asarray(value.value).tolist(),
+                "unit": value.unit.to_string()}
+    if isinstance(value, np.ndarray):
+        return {"__array__": value.tolist()}
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {str(k): to_json(x) for k, x in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_json(x) for x in value]
+    return value
+
+
+def from_json(value: Any) -> Any:
+    """The inverse of :func:`to_json`."""
+    if isinstance(value, dict):
+        if "__quantity__" in value:
+            import astropy.units as u
+
+            return u.Quantity(value["__quantity__"], u.Unit(value["unit"]), dtype=np.float64)
+        if "__array__" in value:
+            return np.array(value["__array__"], dtype=np.float64)
+        return {k: from_json(x) for k, x in value.items()}
+    if isinstance(value, list):
+        return [from_json(x) for x in value]
+    return value
+
+
+def record(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,
+           events: list, variational: bool, stm: bool, prop: Any,
+           extra: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, np.ndarray],
+                                              dict[str, tuple[str, ...]], dict[str, str]]:
+    """The ``meta``, arrays, dimensions and units of a snapshot of a simulation whose
+    system at time 0 is ``system`` and whose propagation is ``prop``."""
+    from hamilton_orbits import __version__
+
+    layout, state = flatten(prop)
+    sa = system.as_arrays()
+    quantity = bool(sa.quantity)
+    meta = {"kind": "simulation", "version": __version__,
+            "system": {"names": list(sa.names), "quantity": quantity, "G": float(sa.G)},
+            "method": {"name": method.name, "options": to_json(method.options())},
+            "dt": dt, "tol": tol, "effects": to_json(effects), "events": to_json(events),
+            "variational": variational, "stm": stm, "t": float(prop.t),
+            "steps": int(prop.steps), "layout": layout, **to_json(dict(extra))}
+    arrays: dict[str, np.ndarray] = {f"initial_{k}": getattr(sa, k) for k in _SYSTEM_FIELDS}
+    active = np.ones(len(sa.names), dtype=bool)
+    if prop.events is not None:
+        active = ~prop.events.inactive
+    arrays.update(t=np.float64(prop.t), r=prop.r, v=prop.v, gm=prop.gm, active=active)
+    arrays.update({f"state_{k}": a for k, a in enumerate(state)})
+    dims = {"r": ("body", "xyz"), "v": ("body", "xyz"), "gm": ("body",),
+            "active": ("body",), "initial_r": ("body", "xyz"), "initial_v": ("body", "xyz"),
+            "initial_gm": ("body",), "initial_radius": ("body",), "initial_j2": ("body",),
+            "initial_pole": ("body", "xyz")}
+    units = {}
+    if quantity:
+        units = {"t": "day", "r": "au", "v": "au/day", "gm": "au3/day2",
+                 "initial_r": "au", "initial_v": "au/day", "initial_gm": "au3/day2",
+                 "initial_radius": "au"}
+    return meta, arrays, dims, units
+
+
+def spec(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """The parts that rebuild a recorded simulation: ``system`` (a SystemArrays),
+    ``method``/``options``, ``dt``, ``tol``, ``effects``, ``events``,
+    ``variational``, ``stm``, ``layout`` and ``state`` (the propagation's arrays)."""
+    from hamilton_orbits.nbody import SystemArrays
+
+    s = meta["system"]
+    system = SystemArrays(tuple(s["names"]), *(arrays[f"initial_{k}"] for k in ("gm", "r", "v",
+                                                                                "radius", "j2",
+                                                                                "pole")),
+                          bool(s["quantity"]), float(s["G"]))
+    count = sum(1 for k in arrays if k.startswith("state_"))
+    return {"system": system, "method": meta["method"]["name"],
+            "options": from_json(meta["method"]["options"]), "dt": meta["dt"],
+            "tol": meta["tol"], "effects": from_json(meta["effects"]),
+            "events": from_json(meta["events"]), "variational": meta["variational"],
+            "stm": meta["stm"], "layout": meta["layout"],
+            "state": [arrays[f"state_{k}"] for k in range(count)]}
+
+
+def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
+    """The snapshot files of an archive folder, by number."""
+    found = []
+    for p in folder.iterdir() if folder.is_dir() else ():
+        m = _SNAPSHOT_RE.match(p.name)
+        if m:
+            found.append((int(m.group(1)), p))
+    return sorted(found)
+
+
+class ArchiveWriter:
+    """The schedule and folder of an archive written while a simulation runs.
+
+    Parameters
+    ----------
+    path : path
+        The archive folder (created if missing).
+    every : float, optional
+        A snapshot at every multiple of this interval of simulation time (in the
+        simulation's internal time unit: days for a Quantity system), counted from
+        ``origin``.
+    every_steps : int, optional
+        A snapshot at the first output after every ``every_steps`` steps.
+    every_wall : float, optional
+        A snapshot at the first output after every ``every_wall`` seconds.
+    origin : float
+        The time the simulation time schedule counts from.
+    sync : bool
+        Sync each snapshot to the disk before it counts (survives a power cut).
+    """
+
+    def __init__(self, path: str | Path, *, every: float | None = None,
+                 every_steps: int | None = None, every_wall: float | None = None,
+                 origin: float = 0.0, sync: bool = True) -> None:
+        given = [k for k, x in (("every", every), ("every_steps", every_steps),
+                                ("every_wall", every_wall)) if x is not None]
+        if len(given) != 1:
+            raise ValueError(f"An archive takes one of `every`, `every_steps`, `every_wall`, "
+                             f"got {', '.join(given) or 'none'}")
+        for name, x in (("every", every), ("every_wall", every_wall)):
+            if x is not None and not (isinstance(x, (int, float)) and math.isfinite(x)
+                                      and x > 0):
+                raise ValueError(f"Expected `{name}` > 0 and finite, got {x!r}")
+        if every_steps is not None and (isinstance(every_steps, bool)
+                                        or not isinstance(every_steps, (int, np.integer))
+                                        or every_steps < 1):
+            raise ValueError(f"Expected `every_steps` to be a whole number >= 1, got "
+                             f"{every_steps!r}")
+        self.path = Path(path)
+        self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
+        self.origin, self.sync = float(origin), sync
+        self.folder: OutputFolder | None = None
+        self.count = 0
+        self.last_steps, self.last_wall = 0, time.monotonic()
+
+    def schedule(self) -> dict[str, Any]:
+        """The schedule as JSON-able values (kept in every snapshot)."""
+        return {"path": str(self.path), "every": self.every, "every_steps": self.every_steps,
+                "every_wall": self.every_wall, "origin": self.origin, "sync": self.sync}
+
+    def open(self) -> None:
+        """Claim the folder (lock) and find the next snapshot number."""
+        if self.folder is not None:
+            return
+        folder = OutputFolder(self.path, "archive")
+        try:
+            folder.__enter__()
+        except FolderError as exc:
+            raise SnapshotError(str(exc).replace("; nothing was run", "")) from None
+        self.folder = folder
+        found = snapshot_files(self.path)
+        self.count = found[-1][0] + 1 if found else 0
+
+    def close(self) -> None:
+        """Release the folder's lock."""
+        if self.folder is not None:
+            self.folder.__exit__(None, None, None)
+            self.folder = None
+
+    def times(self, t0: float, t1: float) -> np.ndarray:
+        """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""
+        if self.every is None or not t1 > t0:
+            return np.empty(0)
+        k0 = math.floor((t0 - self.origin) / self.every) + 1
+        k1 = math.floor((t1 - self.origin) / self.every)
+        ts = self.origin + self.every * np.arange(k0, k1 + 1, dtype=np.float64)
+        return ts[(ts > t0) & (ts <= t1)]
+
+    def due(self, steps: int) -> bool:
+        """True if a steps or wall-clock snapshot is due after ``steps`` steps."""
+        if self.every_steps is not None:
+            return steps - self.last_steps >= self.every_steps
+        if self.every_wall is not None:
+            return time.monotonic() - self.last_wall >= self.every_wall
+        return False
+
+    def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
+              dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path:
+        """Write the next snapshot (numbered after the last one in the folder)."""
+        self.open()
+        path = self.path / SNAPSHOT_NAME.format(self.count)
+        meta = dict(meta, archive=self.schedule(), number=self.count)
+        write(path, meta, arrays, dims=dims, units=units, sync=self.sync)
+        self.count += 1
+        self.last_steps, self.last_wall = int(meta["steps"]), time.monotonic()
+        return path
+
+
+def last_snapshot(folder: str | Path) -> Path:
+    """The last snapshot of archive ``folder`` that reads whole (a damaged last one
+    is passed over for the one before).
+
+    Raises
+    ------
+    SnapshotError
+        When the folder has no snapshot that reads, naming it.
+    """
+    folder = Path(folder)
+    problems = []
+    for _, path in reversed(snapshot_files(folder)):
+        try:
+            read(path)
+        except SnapshotError as exc:
+            problems.append(str(exc))
+            continue
+        return path
+    why = f" ({'; '.join(problems)})" if problems else ""
+    raise SnapshotError(f"no readable snapshot in the archive {folder}{why}")

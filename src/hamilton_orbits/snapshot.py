@@ -1,0 +1,198 @@
+"""One snapshot file: a self-describing netCDF file, written whole or not at all.
+
+A snapshot holds a simulation's state readable by any netCDF reader (``t``,
+``r``, ``v``, ``gm`` and the body names, float64 stored exactly, with units) and
+what this package needs to continue it bit for bit: the specification (system at
+time 0, method and options, effects, events, variational equations) and the
+integrator's own state, as JSON in the global attribute ``meta`` and arrays
+``state_K``.  ``docs/archive.md`` says why the format is netCDF-3 (64-bit
+offset), one file per snapshot.
+
+Writing is atomic: the file is written under a temporary name in the same folder,
+flushed, synced and renamed over its final name, so a process killed at any moment
+leaves either the whole snapshot or none (and at most a temporary file, which
+:func:`read` never takes for a snapshot).  A SHA-256 of the contents (the
+``meta`` text and every variable's name, type, shape and bytes) is stored in the
+global attribute ``sha256`` and checked on reading: a truncated file, a flipped
+byte or another program's file is a :class:`SnapshotError` naming the path, never
+data.
+
+Examples
+--------
+>>> import tempfile, os
+>>> with tempfile.TemporaryDirectory() as tmp:
+...     path = os.path.join(tmp, "one.nc")
+...     write(path, {"kind": "demo"}, {"r": np.arange(6.0).reshape(2, 3)},
+...           dims={"r": ("body", "xyz")})
+...     meta, arrays = read(path)
+...     meta["kind"], arrays["r"].tolist()
+('demo', [[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]])
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "read", "write"]
+
+FORMAT = "hamilton-orbits snapshot"
+#: the version of the layout of a snapshot file; every later version reads every
+#: earlier one (tests/hamilton_orbits/data/snapshot-v1.nc)
+FORMAT_VERSION = 1
+_INT_EXACT = 2 ** 53
+
+
+class SnapshotError(ValueError):
+    """A snapshot file that cannot be read or written (the message names the path)."""
+
+
+def _canonical(arr: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(arr, dtype=arr.dtype.newbyteorder("<"))
+
+
+def checksum(meta_text: str, arrays: Mapping[str, np.ndarray]) -> str:
+    """The SHA-256 of a snapshot's contents (see the module notes)."""
+    h = hashlib.sha256(meta_text.encode("utf-8"))
+    for name in sorted(arrays):
+        a = _canonical(np.asarray(arrays[name]))
+        h.update(f"\0{name}\0{a.dtype.str}\0{a.shape}\0".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
+    """The array as netCDF-3 stores it (float64, int32 or int8) and its dtype."""
+    kind = arr.dtype.name
+    if arr.dtype == np.float64:
+        return arr, kind
+    if arr.dtype == np.bool_:
+        return arr.astype(np.int8), kind
+    if arr.dtype.kind in "iu":
+        if arr.size and np.max(np.abs(arr.astype(np.float64))) >= _INT_EXACT:
+            raise SnapshotError(f"array {name!r}: integers beyond 2**53 cannot be stored")
+        return arr.astype(np.float64), kind
+    raise SnapshotError(f"array {name!r}: dtype {arr.dtype} cannot be stored")
+
+
+def write(path: str | os.PathLike[str], meta: Mapping[str, Any],
+          arrays: Mapping[str, np.ndarray], dims: Mapping[str, tuple[str, ...]] | None = None,
+          units: Mapping[str, str] | None = None, *, sync: bool = True) -> None:
+    """Write a snapshot atomically (see the module notes).
+
+    Parameters
+    ----------
+    path : path
+        The file (replaced if it exists).
+    meta : mapping
+        JSON-able metadata (floats round-trip exactly).
+    arrays : mapping of str to ndarray
+        float64, integer (below 2**53) or bool arrays.
+    dims, units : mapping, optional
+        Dimension names and a ``units`` attribute of some arrays (for readers
+        without this package); other arrays get dimensions by their lengths.
+    sync : bool
+        ``os.fsync`` the file before the rename (survives a power cut, not only a
+        killed process).
+
+    Raises
+    ------
+    SnapshotError
+        When the folder cannot be written (a read-only folder, a full disk),
+        naming the path.
+    """
+    from scipy.io import netcdf_file
+
+    path = Path(path)
+    dims, units = dims or {}, units or {}
+    meta_text = json.dumps(meta, sort_keys=True, allow_nan=True)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        with open(tmp, "wb") as fh:
+            nc = netcdf_file(fh, "w", version=2)
+            nc.format, nc.format_version = FORMAT, FORMAT_VERSION
+            nc.meta = meta_text
+            nc.sha256 = checksum(meta_text, arrays)
+            for name, value in arrays.items():
+                _variable(nc, name, np.asarray(value), dims.get(name), units.get(name))
+            nc.flush()
+            fh.flush()
+            if sync:
+                os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise SnapshotError(f"cannot write the snapshot {path}: "
+                            f"{exc.strerror or exc}") from None
+
+
+def _variable(nc: Any, name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
+              unit: str | None) -> None:
+    data, kind = _stored(name, arr)
+    if arr.size == 0:  # netCDF-3 has no empty fixed dimension: a marker and the shape
+        var = nc.createVariable(name, "b", ())
+        var[...] = 0
+        var.empty_shape = ",".join(str(k) for k in arr.shape) or "0"
+    else:
+        names = dims or tuple(f"n{k}" for k in arr.shape)
+        for dim, k in zip(names, arr.shape, strict=True):
+            if dim not in nc.dimensions:
+                nc.createDimension(dim, k)
+        var = nc.createVariable(name, data.dtype.char, names)
+        var[...] = data
+    var.dtype_saved = kind
+    if unit is not None:
+        var.units = unit
+
+
+def _array(var: Any) -> np.ndarray:
+    kind = var.dtype_saved.decode() if isinstance(var.dtype_saved, bytes) else var.dtype_saved
+    shape_attr = getattr(var, "empty_shape", None)
+    if shape_attr is not None:
+        text = shape_attr.decode() if isinstance(shape_attr, bytes) else shape_attr
+        return np.zeros(tuple(int(k) for k in text.split(",")), dtype=kind)
+    return np.array(var[...], dtype=kind)
+
+
+def read(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """The ``meta`` and arrays of a snapshot, its checksum verified.
+
+    Raises
+    ------
+    SnapshotError
+        For a missing, truncated, corrupted or foreign file, naming the path.
+    """
+    from scipy.io import netcdf_file
+
+    path = Path(path)
+    if not path.is_file():
+        raise SnapshotError(f"no snapshot file {path}")
+    try:
+        with netcdf_file(path, "r", mmap=False) as nc:
+            fmt = getattr(nc, "format", b"")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt != FORMAT:
+                raise SnapshotError(f"{path} is not a hamilton-orbits snapshot "
+                                    f"(format {fmt!r})")
+            version = int(nc.format_version)
+            meta_text = nc.meta.decode("utf-8")
+            stored = nc.sha256.decode()
+            arrays = {name: _array(var) for name, var in nc.variables.items()}
+    except SnapshotError:
+        raise
+    except Exception as exc:  # scipy's parser: any damage surfaces as some error
+        raise SnapshotError(f"{path} cannot be read as a snapshot (damaged or not a "
+                            f"netCDF file: {type(exc).__name__}: {exc})") from None
+    if version > FORMAT_VERSION:
+        raise SnapshotError(f"{path} has format version {version}; this version of "
+                            f"hamilton-orbits reads up to {FORMAT_VERSION}")
+    if checksum(meta_text, arrays) != stored:
+        raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
+                            f"contents")
+    return json.loads(meta_text), arrays
