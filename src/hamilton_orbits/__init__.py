@@ -14,6 +14,7 @@ from hamilton_orbits.quaternion import Quaternion, slerp
 # the first-compile notice is installed with the kernels (hamilton_orbits._kernels)
 
 if TYPE_CHECKING:  # pragma: no cover
+    from hamilton_orbits.archive import Archive
     from hamilton_orbits.ensemble import Ensemble
     from hamilton_orbits.integrators.methods import DOP853, WH, Leapfrog, Radau15
     from hamilton_orbits.nbody import Body, System
@@ -26,6 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover
 # ``import hamilton_orbits`` does not pull in their dependencies (tomllib,
 # scipy.integrate, rebound, ...) nor importlib.metadata for the version.
 _LAZY = {
+    "Archive": "hamilton_orbits.archive",
     "Body": "hamilton_orbits.nbody",
     "System": "hamilton_orbits.nbody",
     "crosscheck": "hamilton_orbits.rebound_bridge",
@@ -71,6 +73,7 @@ def __dir__() -> list[str]:
 __all__ = [
     "DOP853",
     "WH",
+    "Archive",
     "Body",
     "Conic",
     "ConvergenceError",

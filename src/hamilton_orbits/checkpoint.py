@@ -44,10 +44,12 @@ __all__ = [
     "ArchiveWriter",
     "from_json",
     "last_snapshot",
+    "pack",
     "record",
     "snapshot_files",
     "spec",
     "to_json",
+    "unpack",
 ]
 
 SNAPSHOT_NAME = "snapshot-{:06d}.nc"
@@ -108,7 +110,7 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     if prop.events is not None:
         active = ~prop.events.inactive
     arrays.update(t=np.float64(prop.t), r=prop.r, v=prop.v, gm=prop.gm, active=active)
-    arrays.update({f"state_{k}": a for k, a in enumerate(state)})
+    arrays["state"], meta["state_arrays"] = pack(state)
     dims = {"r": ("body", "xyz"), "v": ("body", "xyz"), "gm": ("body",),
             "active": ("body",), "initial_r": ("body", "xyz"), "initial_v": ("body", "xyz"),
             "initial_gm": ("body",), "initial_radius": ("body",), "initial_j2": ("body",),
@@ -132,13 +134,33 @@ def spec(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray]) -> dict[str,
                                                                                 "radius", "j2",
                                                                                 "pole")),
                           bool(s["quantity"]), float(s["G"]))
-    count = sum(1 for k in arrays if k.startswith("state_"))
     return {"system": system, "method": meta["method"]["name"],
             "options": from_json(meta["method"]["options"]), "dt": meta["dt"],
             "tol": meta["tol"], "effects": from_json(meta["effects"]),
             "events": from_json(meta["events"]), "variational": meta["variational"],
             "stm": meta["stm"], "layout": meta["layout"],
-            "state": [arrays[f"state_{k}"] for k in range(count)]}
+            "state": unpack(arrays["state"], meta["state_arrays"])}
+
+
+def pack(arrays: list[np.ndarray]) -> tuple[np.ndarray, list[list[Any]]]:
+    """The arrays of a propagation's state as one float64 vector (integers below
+    2**53 and booleans exactly) and each one's ``[offset, shape, dtype]``."""
+    index, start = [], 0
+    for a in arrays:
+        index.append([start, list(a.shape), a.dtype.name])
+        start += a.size
+    flat = np.empty(start)
+    for a, (offset, _, _) in zip(arrays, index, strict=True):
+        if a.dtype.kind in "iu" and a.size and np.max(np.abs(a)) >= 2**53:
+            raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
+        flat[offset:offset + a.size] = a.reshape(-1)
+    return flat, index
+
+
+def unpack(flat: np.ndarray, index: list[list[Any]]) -> list[np.ndarray]:
+    """The arrays :func:`pack` packed."""
+    return [flat[offset:offset + math.prod(shape)].astype(kind).reshape(shape)
+            for offset, shape, kind in index]
 
 
 def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
@@ -156,8 +178,10 @@ class ArchiveWriter:
 
     Parameters
     ----------
-    path : path
-        The archive folder (created if missing).
+    path : path or None
+        The archive folder (created if missing); None: the schedule only, nothing
+        written (a snapshot of an archived run loaded alone keeps its run's output
+        times, so that it continues with that run's bits).
     every : float, optional
         A snapshot at every multiple of this interval of simulation time (in the
         simulation's internal time unit: days for a Quantity system), counted from
@@ -169,12 +193,14 @@ class ArchiveWriter:
     origin : float
         The time the simulation time schedule counts from.
     sync : bool
-        Sync each snapshot to the disk before it counts (survives a power cut).
+        Sync each snapshot to the disk before it counts (survives a power cut, not
+        only a killed process; about 10 ms a snapshot on a common disk, against
+        under 1 ms without).
     """
 
-    def __init__(self, path: str | Path, *, every: float | None = None,
+    def __init__(self, path: str | Path | None, *, every: float | None = None,
                  every_steps: int | None = None, every_wall: float | None = None,
-                 origin: float = 0.0, sync: bool = True) -> None:
+                 origin: float = 0.0, sync: bool = False) -> None:
         given = [k for k, x in (("every", every), ("every_steps", every_steps),
                                 ("every_wall", every_wall)) if x is not None]
         if len(given) != 1:
@@ -189,7 +215,7 @@ class ArchiveWriter:
                                         or every_steps < 1):
             raise ValueError(f"Expected `every_steps` to be a whole number >= 1, got "
                              f"{every_steps!r}")
-        self.path = Path(path)
+        self.path = None if path is None else Path(path)
         self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
         self.origin, self.sync = float(origin), sync
         self.folder: OutputFolder | None = None
@@ -198,12 +224,13 @@ class ArchiveWriter:
 
     def schedule(self) -> dict[str, Any]:
         """The schedule as JSON-able values (kept in every snapshot)."""
-        return {"path": str(self.path), "every": self.every, "every_steps": self.every_steps,
-                "every_wall": self.every_wall, "origin": self.origin, "sync": self.sync}
+        return {"path": None if self.path is None else str(self.path), "every": self.every,
+                "every_steps": self.every_steps, "every_wall": self.every_wall,
+                "origin": self.origin, "sync": self.sync}
 
     def open(self) -> None:
         """Claim the folder (lock) and find the next snapshot number."""
-        if self.folder is not None:
+        if self.folder is not None or self.path is None:
             return
         folder = OutputFolder(self.path, "archive")
         try:
@@ -238,9 +265,12 @@ class ArchiveWriter:
         return False
 
     def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
-              dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path:
-        """Write the next snapshot (numbered after the last one in the folder)."""
+              dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path | None:
+        """Write the next snapshot (numbered after the last one in the folder);
+        nothing without a folder."""
         self.open()
+        if self.path is None:
+            return None
         path = self.path / SNAPSHOT_NAME.format(self.count)
         meta = dict(meta, archive=self.schedule(), number=self.count)
         write(path, meta, arrays, dims=dims, units=units, sync=self.sync)

@@ -302,7 +302,11 @@ class Simulation:
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Simulation:
         """The simulation saved in ``path`` (:meth:`save`), or the last snapshot of an
-        archive folder (continuing that archive on its schedule).
+        archive folder, which then continues that archive on its schedule.
+
+        A snapshot of an archived run keeps the run's schedule: its snapshot times
+        stay among the output times of later legs (nothing is written unless the
+        folder itself was loaded), so that it continues with the run's bits.
 
         Raises
         ------
@@ -316,7 +320,7 @@ class Simulation:
         meta, arrays = read(path)
         sim = cls._rebuild(meta, arrays, path)
         schedule = meta.get("archive")
-        if folder is not None and schedule:
+        if schedule:  # the archived run's schedule: written on when its folder is loaded
             sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync")}
             sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
             sim._archive.last_steps = sim.steps
@@ -360,7 +364,7 @@ class Simulation:
             raise ValueError("A simulation with an archive integrates forwards in time")
         arch = self._archive
         arch.open()
-        if arch.count == 0:
+        if arch.count == 0 and arch.path is not None:
             arch.write(*self._record())
         extra = arch.times(float(times[0]), float(times[-1]))
         merged = np.union1d(times, extra)

@@ -1,0 +1,144 @@
+"""Reading an archive: the snapshots a simulation wrote while it ran.
+
+``Simulation(system, ..., archive="run.archive", every=1000 * u.yr)`` writes a
+snapshot at every multiple of ``every`` (``docs/archive.md``); :class:`Archive`
+opens the folder, lists the snapshots that read whole (each one's checksum
+verified), says which were torn by a killed write or damaged afterwards, returns
+any snapshot as a :class:`~hamilton_orbits.simulation.Simulation`, and opens the
+whole as an ``xarray.Dataset`` (the ``archive`` extra).  ``Simulation.load``
+of the folder continues the run from its last snapshot, on the same schedule.
+
+Examples
+--------
+>>> import tempfile
+>>> import numpy as np
+>>> from hamilton_orbits import Body, Simulation, System
+>>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+>>> with tempfile.TemporaryDirectory() as tmp:
+...     sim = Simulation(s, method="wh", dt=0.01, archive=tmp, every=1.0)
+...     _ = sim.integrate(3.5)
+...     archive = Archive(tmp)
+...     middle = archive[2]              # the snapshot at t = 2, as a Simulation
+...     _ = middle.integrate(3.5)
+...     print(len(archive), archive.times.tolist(), middle.steps == sim.steps)
+4 [0.0, 1.0, 2.0, 3.0] True
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits.checkpoint import snapshot_files
+from hamilton_orbits.simulation import Simulation
+from hamilton_orbits.snapshot import SnapshotError, read
+
+__all__ = ["Archive", "Snapshot"]
+
+_TORN_RE = re.compile(r"^\.snapshot-\d{6}\.nc\.tmp-\d+$")
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """One snapshot of an archive: its number, file, simulation time and steps."""
+
+    number: int
+    path: Path
+    t: float
+    steps: int
+
+
+class Archive:
+    """The snapshots of an archive folder.
+
+    Parameters
+    ----------
+    path : path
+        The folder a simulation with ``archive=path`` wrote.
+
+    Attributes
+    ----------
+    snapshots : list of Snapshot
+        The snapshots that read whole, in the order written.
+    damaged : list of (Path, str)
+        Snapshot files that do not read (a flipped byte, a truncated file), with
+        the reason: never read as data.
+    torn : list of Path
+        Temporary files of writes that never finished (the process was killed
+        while writing): the snapshot they were to become does not exist.
+
+    Raises
+    ------
+    SnapshotError
+        When ``path`` is not a folder.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        if not self.path.is_dir():
+            raise SnapshotError(f"no archive folder {self.path}")
+        self.snapshots: list[Snapshot] = []
+        self.damaged: list[tuple[Path, str]] = []
+        self._arrays: list[dict[str, np.ndarray]] = []
+        self._names: tuple[str, ...] = ()
+        self._quantity = False
+        for number, file in snapshot_files(self.path):
+            try:
+                meta, arrays = read(file)
+            except SnapshotError as exc:
+                self.damaged.append((file, str(exc)))
+                continue
+            self.snapshots.append(Snapshot(number, file, float(meta["t"]), int(meta["steps"])))
+            self._arrays.append({k: arrays[k] for k in ("t", "r", "v", "gm", "active")})
+            self._names = tuple(meta["system"]["names"])
+            self._quantity = bool(meta["system"]["quantity"])
+        self.torn = sorted(p for p in self.path.iterdir() if _TORN_RE.match(p.name))
+
+    def __len__(self) -> int:
+        return len(self.snapshots)
+
+    @property
+    def times(self) -> np.ndarray:
+        """The simulation times of the snapshots (days for a Quantity system)."""
+        return np.array([s.t for s in self.snapshots])
+
+    def __getitem__(self, k: int) -> Simulation:
+        """Snapshot ``k`` (of :attr:`snapshots`) as a Simulation, not attached to the
+        archive (``Simulation.load(folder)`` continues the archive itself)."""
+        return Simulation.load(self.snapshots[k].path)
+
+    def __repr__(self) -> str:
+        span = f"t = {self.times[0]!r} ... {self.times[-1]!r}" if self.snapshots else "empty"
+        more = "".join(f", {len(x)} {what}" for x, what in ((self.damaged, "damaged"),
+                                                           (self.torn, "torn")) if x)
+        return f"Archive({str(self.path)!r}: {len(self)} snapshots, {span}{more})"
+
+    def to_xarray(self) -> Any:
+        """The snapshots' states as an ``xarray.Dataset`` (dimensions ``time``,
+        ``body``, ``xyz``; variables ``r``, ``v``, ``gm``, ``active``; body names
+        as a coordinate; units in the attributes for a Quantity system)."""
+        try:
+            import xarray as xr
+        except ImportError:
+            raise ImportError("Archive.to_xarray needs xarray: pip install "
+                              "'hamilton-orbits[archive]'") from None
+        stack = {k: np.stack([a[k] for a in self._arrays]) for k in ("r", "v", "gm", "active")}
+        units = ({"r": "au", "v": "au/day", "gm": "au3/day2", "time": "day"}
+                 if self._quantity else {})
+        data = {"r": (("time", "body", "xyz"), stack["r"], _units(units, "r")),
+                "v": (("time", "body", "xyz"), stack["v"], _units(units, "v")),
+                "gm": (("time", "body"), stack["gm"], _units(units, "gm")),
+                "active": (("time", "body"), stack["active"])}
+        coords = {"time": ("time", self.times, _units(units, "time")),
+                  "body": ("body", list(self._names)), "xyz": ("xyz", ["x", "y", "z"]),
+                  "steps": ("time", np.array([s.steps for s in self.snapshots]))}
+        return xr.Dataset(data, coords=coords, attrs={"archive": str(self.path)})
+
+
+def _units(units: dict[str, str], name: str) -> dict[str, str]:
+    return {"units": units[name]} if name in units else {}

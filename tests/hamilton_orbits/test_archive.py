@@ -1,0 +1,207 @@
+"""An archive written while a simulation runs: kills lose at most one snapshot.
+
+The reference is the same archived run never interrupted: an archive left by a
+process killed (SIGKILL) at any moment opens, holds only whole snapshots (each
+equal, bit for bit, to the reference's snapshot of that number), and the run
+resumed from its last snapshot ends on the reference's bits.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import time
+
+import numpy as np
+import pytest
+from test_simulation_legs import _disc, _same
+
+from hamilton_orbits import Archive, Simulation
+from hamilton_orbits.checkpoint import SNAPSHOT_NAME
+from hamilton_orbits.snapshot import SnapshotError, read
+
+T = np.linspace(0.0, 60.0, 13)[1:]  # the caller's outputs: every 5
+KW = dict(method="radau15", every=2.5)
+
+
+def _run_archived(folder, kw=KW, times=T):
+    sim = Simulation(_disc(), archive=folder, **kw)
+    return sim, sim.integrate(times)
+
+
+def _snapshot_state(path):
+    """t, r, v and the integrator's own arrays of a snapshot."""
+    _, arrays = read(path)
+    return [arrays["t"], arrays["r"], arrays["v"], arrays["state"]]
+
+
+def test_snapshots_land_on_the_schedule_and_the_caller_sees_only_its_outputs(tmp_path):
+    sim, traj = _run_archived(tmp_path)
+    assert traj.t.tolist() == [0.0, *T.tolist()]  # no snapshot rows in the trajectory
+    archive = Archive(tmp_path)
+    np.testing.assert_array_equal(archive.times, 2.5 * np.arange(25))
+    assert archive.damaged == [] and archive.torn == []
+    assert archive.snapshots[-1].steps == sim.steps
+    # a snapshot is the simulation at that time: continuing from snapshot 12 (t = 30)
+    # reaches the end's bits
+    again = archive[12]
+    assert again.t == 30.0
+    end = again.integrate(T[T > 30.0])
+    assert _same(end.r[-1], traj.r[-1]) and again.steps == sim.steps
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.05, every=2.5),
+                                dict(method="dop853", every=2.5),
+                                dict(method="leapfrog", dt=0.05, every=2.5),
+                                dict(method="radau15", every=2.5, variational=True)],
+                         ids=["wh", "dop853", "leapfrog", "radau15-variational"])
+def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_path, kw):
+    ref, whole = _run_archived(tmp_path / "whole", kw)
+    cut = Simulation(_disc(), archive=tmp_path / "cut", **kw)
+    cut.integrate(T[:5])  # to t = 25: the last snapshot at t = 25
+    resumed = Simulation.load(tmp_path / "cut")
+    assert resumed.t == 25.0
+    rest = resumed.integrate(T[T > resumed.t])
+    assert _same(rest.r[-1], whole.r[-1]) and _same(rest.v[-1], whole.v[-1])
+    assert resumed.steps == ref.steps
+    if "variational" in kw:
+        assert _same(rest.megno[-1], whole.megno[-1])
+    # the resumed run wrote on, on the same schedule: the same snapshots as the whole
+    whole_files = sorted(p.name for p in (tmp_path / "whole").glob("snapshot-*.nc"))
+    cut_files = sorted(p.name for p in (tmp_path / "cut").glob("snapshot-*.nc"))
+    assert whole_files == cut_files
+    for name in whole_files:
+        a = _snapshot_state(tmp_path / "whole" / name)
+        b = _snapshot_state(tmp_path / "cut" / name)
+        assert all(_same(x, y) for x, y in zip(a[:3], b[:3], strict=True))
+
+
+def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path):
+    """20 runs killed with SIGKILL at random moments (before, between and during
+    writes): each archive opens, its snapshots are the reference's, and the run
+    resumed from it ends on the reference's bits."""
+    _, whole = _run_archived(tmp_path / "ref")
+    reference = Archive(tmp_path / "ref")
+    t_run = _timed_run(tmp_path / "timing")
+    rng = np.random.default_rng(20261128)
+    seen_partial = 0
+    for k in range(20):
+        folder = tmp_path / f"kill{k}"
+        pid = os.fork()
+        if pid == 0:  # the child: run and exit without cleaning up
+            try:
+                _run_archived(folder)
+            finally:
+                os._exit(0)
+        time.sleep(rng.uniform(0.0, 1.1) * t_run)
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        if not folder.exists() or not any(folder.glob("snapshot-*.nc")):
+            sim = Simulation(_disc(), archive=folder, **KW)  # killed before the first
+        else:
+            archive = Archive(folder)
+            assert archive.damaged == []  # whole snapshots or none: never a damaged one
+            seen_partial += len(archive) < len(reference)
+            for snap in archive.snapshots:
+                ref = reference.snapshots[snap.number]
+                assert all(_same(x, y) for x, y in zip(_snapshot_state(snap.path),
+                                                       _snapshot_state(ref.path), strict=True))
+            sim = Simulation.load(folder)
+        if sim.t < T[-1]:  # (a kill after the last snapshot leaves nothing to do)
+            sim.integrate(T[T > sim.t])
+        assert _same(sim.system.as_arrays().r, whole.r[-1]), f"kill {k} at t = {sim.t}"
+        assert len(Archive(folder)) == len(reference)
+    assert seen_partial >= 5  # the kills did fall inside the runs
+
+
+def _timed_run(folder) -> float:
+    start = time.perf_counter()
+    _run_archived(folder)
+    return time.perf_counter() - start
+
+
+def test_an_archive_lists_damaged_and_torn_snapshots_and_never_reads_them(tmp_path):
+    _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
+    path = tmp_path / SNAPSHOT_NAME.format(6)
+    data = bytearray(path.read_bytes())
+    _, arrays = read(path)
+    at = bytes(data).find(arrays["r"].astype(">f8").tobytes())  # netCDF: big-endian
+    data[at + 20] ^= 0x01  # one flipped bit in the positions
+    path.write_bytes(bytes(data))
+    (tmp_path / ".snapshot-000007.nc.tmp-12345").write_bytes(b"CDF\x02")  # a killed write
+    archive = Archive(tmp_path)
+    assert [s.number for s in archive.snapshots] == [0, 1, 2, 3, 4, 5]
+    assert archive.damaged[0][0] == path and "checksum" in archive.damaged[0][1]
+    assert [p.name for p in archive.torn] == [".snapshot-000007.nc.tmp-12345"]
+    assert "6 snapshots" in repr(archive) and "1 damaged, 1 torn" in repr(archive)
+    # resuming passes over the damaged last snapshot for the one before
+    assert Simulation.load(tmp_path).t == 50.0
+
+
+def test_an_archive_opens_as_an_xarray_dataset(tmp_path):
+    sim, _ = _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
+    ds = Archive(tmp_path).to_xarray()
+    assert ds.r.dims == ("time", "body", "xyz") and ds.sizes["time"] == 7
+    assert list(ds.body.values) == list(sim.system.names)
+    np.testing.assert_array_equal(ds.r.isel(time=-1).values, sim.system.as_arrays().r)
+    np.testing.assert_array_equal(ds.time.values, 10.0 * np.arange(7))
+
+
+def test_step_and_wall_clock_schedules(tmp_path):
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "steps",
+                     every_steps=200)
+    sim.integrate(np.arange(1.0, 61.0))  # 20 steps per output
+    steps = [s.steps for s in Archive(tmp_path / "steps").snapshots]
+    assert steps == list(range(0, 1201, 200))
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "wall", every_wall=1e-9)
+    sim.integrate(np.arange(1.0, 6.0))
+    assert len(Archive(tmp_path / "wall")) == 6  # the start and every output
+
+
+def test_two_writers_cannot_share_an_archive(tmp_path):
+    (tmp_path / ".hamilton-orbits.lock").write_text(f"1 {socket.gethostname()}\n")  # PID 1 lives
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0)
+    with pytest.raises(SnapshotError, match=r"archive .*: another run \(PID 1 on "):
+        sim.integrate(2.0)
+    assert not any(tmp_path.glob("snapshot-*"))
+
+
+def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    os.waitpid(pid, 0)  # a process that has ended
+    (tmp_path / ".hamilton-orbits.lock").write_text(f"{pid} {socket.gethostname()}\n")
+    Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0).integrate(2.0)
+    assert len(Archive(tmp_path)) == 3 and not (tmp_path / ".hamilton-orbits.lock").exists()
+
+
+@pytest.mark.parametrize(("kw", "match"), [
+    (dict(every=1.0), r"`every`, `every_steps` and `every_wall` schedule an archive: give "
+                      r"`archive`"),
+    (dict(archive="x"), r"An archive takes one of `every`, `every_steps`, `every_wall`, got "
+                        r"none"),
+    (dict(archive="x", every=1.0, every_steps=3), r"got every, every_steps"),
+    (dict(archive="x", every=-1.0), r"Expected `every` > 0, got -1.0"),
+    (dict(archive="x", every_steps=0), r"Expected `every_steps` to be a whole number >= 1, "
+                                       r"got 0"),
+    (dict(archive="x", every_steps=2.5), r"got 2.5"),
+    (dict(archive="x", every_wall=float("nan")), r"Expected `every_wall` > 0 and finite"),
+])
+def test_bad_schedules_are_refused_naming_the_argument(kw, match):
+    with pytest.raises(ValueError, match=match):
+        Simulation(_disc(), method="wh", dt=0.05, **kw)
+
+
+def test_an_archived_simulation_integrates_forwards(tmp_path):
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path, every=1.0)
+    with pytest.raises(ValueError, match=r"with an archive integrates forwards"):
+        sim.integrate(-2.0)
+
+
+def test_an_empty_or_missing_archive_is_named(tmp_path):
+    with pytest.raises(SnapshotError, match=r"no archive folder .*missing"):
+        Archive(tmp_path / "missing")
+    with pytest.raises(SnapshotError, match=r"no readable snapshot in the archive"):
+        Simulation.load(tmp_path)
