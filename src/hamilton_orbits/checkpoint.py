@@ -36,7 +36,7 @@ import numpy as np
 
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.restart import flatten
-from hamilton_orbits.snapshot import SnapshotError, read, write
+from hamilton_orbits.snapshot import SnapshotError, encode_snapshot, read, write_bytes
 from hamilton_orbits.units import is_quantity
 
 __all__ = [
@@ -222,6 +222,13 @@ class ArchiveWriter:
         self.count = 0
         self.last_steps, self.last_wall = 0, time.monotonic()
 
+    def schedule_only(self) -> ArchiveWriter:
+        """The same schedule writing nothing (for a copy of the simulation)."""
+        sched = {k: getattr(self, k) for k in ("every", "every_steps", "every_wall", "sync")}
+        out = ArchiveWriter(None, origin=self.origin, **sched)
+        out.last_steps = self.last_steps
+        return out
+
     def schedule(self) -> dict[str, Any]:
         """The schedule as JSON-able values (kept in every snapshot)."""
         return {"path": None if self.path is None else str(self.path), "every": self.every,
@@ -273,7 +280,7 @@ class ArchiveWriter:
             return None
         path = self.path / SNAPSHOT_NAME.format(self.count)
         meta = dict(meta, archive=self.schedule(), number=self.count)
-        write(path, meta, arrays, dims=dims, units=units, sync=self.sync)
+        write_bytes(path, encode_snapshot(meta, arrays, dims, units), sync=self.sync)
         self.count += 1
         self.last_steps, self.last_wall = int(meta["steps"]), time.monotonic()
         return path

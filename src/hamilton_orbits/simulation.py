@@ -194,9 +194,12 @@ class Simulation:
 
     def copy(self) -> Simulation:
         """An independent copy (its own state; the compiled right-hand side shared):
-        integrating one does not change the other."""
+        integrating one does not change the other.  The copy of an archived
+        simulation keeps its schedule but writes nothing."""
         new = copy.copy(self)
         new._prop = copy.deepcopy(self._prop, _shared(self._prop))
+        if self._archive is not None:  # the same output times; only the original writes
+            new._archive = self._archive.schedule_only()
         return new
 
     # ------------------------------------------------------------------ run

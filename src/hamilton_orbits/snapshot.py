@@ -40,7 +40,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "read", "write"]
+from hamilton_orbits._netcdf3 import encode
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "read", "write",
+           "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
@@ -74,6 +77,8 @@ def _stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
         return arr, kind
     if arr.dtype == np.bool_:
         return arr.astype(np.int8), kind
+    if arr.dtype == np.int8:
+        return arr, kind
     if arr.dtype.kind in "iu":
         if arr.size and np.max(np.abs(arr.astype(np.float64))) >= _INT_EXACT:
             raise SnapshotError(f"array {name!r}: integers beyond 2**53 cannot be stored")
@@ -107,21 +112,30 @@ def write(path: str | os.PathLike[str], meta: Mapping[str, Any],
         When the folder cannot be written (a read-only folder, a full disk),
         naming the path.
     """
-    from scipy.io import netcdf_file
+    write_bytes(path, encode_snapshot(meta, arrays, dims, units), sync=sync)
 
-    path = Path(path)
+
+def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
+                    dims: Mapping[str, tuple[str, ...]] | None = None,
+                    units: Mapping[str, str] | None = None) -> bytes:
+    """The bytes of a snapshot file (see :func:`write`): a copy, so the arrays may
+    change as soon as it returns."""
     dims, units = dims or {}, units or {}
     meta_text = json.dumps(meta, sort_keys=True, allow_nan=True)
+    variables = [_variable(name, np.asarray(value), dims.get(name), units.get(name))
+                 for name, value in arrays.items()]
+    return encode({"format": FORMAT, "format_version": FORMAT_VERSION, "meta": meta_text,
+                   "sha256": checksum(meta_text, arrays)}, variables)
+
+
+def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True) -> None:
+    """Write ``data`` to ``path`` atomically: under a temporary name in the same
+    folder, then renamed over ``path`` (see :func:`write`)."""
+    path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     try:
         with open(tmp, "wb") as fh:
-            nc = netcdf_file(fh, "w", version=2)
-            nc.format, nc.format_version = FORMAT, FORMAT_VERSION
-            nc.meta = meta_text
-            nc.sha256 = checksum(meta_text, arrays)
-            for name, value in arrays.items():
-                _variable(nc, name, np.asarray(value), dims.get(name), units.get(name))
-            nc.flush()
+            fh.write(data)
             fh.flush()
             if sync:
                 os.fsync(fh.fileno())
@@ -132,23 +146,17 @@ def write(path: str | os.PathLike[str], meta: Mapping[str, Any],
                             f"{exc.strerror or exc}") from None
 
 
-def _variable(nc: Any, name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
-              unit: str | None) -> None:
+def _variable(name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
+              unit: str | None) -> tuple[str, tuple[str, ...], np.ndarray, dict[str, Any]]:
+    """A variable of the file: its dimensions, stored values and attributes."""
     data, kind = _stored(name, arr)
+    attrs: dict[str, Any] = {"dtype_saved": kind}
     if arr.size == 0:  # netCDF-3 has no empty fixed dimension: a marker and the shape
-        var = nc.createVariable(name, "b", ())
-        var[...] = 0
-        var.empty_shape = ",".join(str(k) for k in arr.shape) or "0"
-    else:
-        names = dims or tuple(f"n{k}" for k in arr.shape)
-        for dim, k in zip(names, arr.shape, strict=True):
-            if dim not in nc.dimensions:
-                nc.createDimension(dim, k)
-        var = nc.createVariable(name, data.dtype.char, names)
-        var[...] = data
-    var.dtype_saved = kind
+        attrs["empty_shape"] = ",".join(str(k) for k in arr.shape) or "0"
+        return name, (), np.zeros((), np.int8), attrs
     if unit is not None:
-        var.units = unit
+        attrs["units"] = unit
+    return name, dims or tuple(f"n{k}" for k in arr.shape), data, attrs
 
 
 def _array(var: Any) -> np.ndarray:

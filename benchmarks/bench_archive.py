@@ -1,0 +1,164 @@
+"""Archives against rebound's Simulationarchive, same runs, same process.
+
+Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py
+
+What it prints (medians over interleaved rounds; the machine is shared):
+
+[1] one snapshot of the 10-body disc: ours (a netCDF file written whole, with its
+    SHA-256; ``sync=False`` as an archive writes, and ``sync=True``) against
+    rebound's ``save_to_file`` (a blob appended to one file);
+[2] a run with a snapshot every 100 steps: radau15 against IAS15 (adaptive,
+    default tolerances) and wh against WHFast (dt = 0.05), each as the ratio of
+    the archived run's time to the same run without an archive (ours: snapshots at
+    every multiple of 100 mean steps, ``every=``; rebound: ``step=100``);
+[3] loading the last snapshot: ``Simulation.load(folder)`` against
+    ``rebound.Simulation(file)``.
+"""
+
+from __future__ import annotations
+
+import shutil
+import statistics
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import rebound
+from bench_overhead import rebound_of
+
+from hamilton_orbits import Body, Simulation, System
+
+T_END = 2000.0
+DT = 0.05
+
+
+def disc10() -> System:
+    """A star (GM 1) and nine planets (GM 1e-5) on near-circular orbits at 1-10."""
+    rng = np.random.default_rng(1)
+    a = rng.uniform(1.0, 10.0, 9)
+    ph = rng.uniform(0, 2 * np.pi, 9)
+    bodies = [Body("star", 1.0, [0, 0, 0], [0, 0, 0])]
+    for k in range(9):
+        r = [a[k] * np.cos(ph[k]), a[k] * np.sin(ph[k]), 0.01 * k]
+        v = [-np.sin(ph[k]) / np.sqrt(a[k]), np.cos(ph[k]) / np.sqrt(a[k]), 0.0]
+        bodies.append(Body(f"p{k}", 1e-5, r, v))
+    return System(bodies)
+
+
+def timed(fn: Callable[[], object]) -> float:
+    start = time.perf_counter()
+    fn()
+    return time.perf_counter() - start
+
+
+def interleaved(fns: dict[str, Callable[[], object]], rounds: int) -> dict[str, list[float]]:
+    for fn in fns.values():
+        fn()
+    out: dict[str, list[float]] = {k: [] for k in fns}
+    for _ in range(rounds):
+        for k, fn in fns.items():
+            out[k].append(timed(fn))
+    return out
+
+
+def one_snapshot(tmp: Path, repeat: int) -> None:
+    s = disc10()
+    arrays = s.as_arrays()
+    sim = Simulation(s, method="radau15")
+    sim.integrate(10.0)
+    reb = rebound_of(arrays.r, arrays.v, arrays.gm, "ias15", DT)
+    reb.integrate(10.0)
+    reb_file = tmp / "rebound-one.bin"
+
+    def ours(sync: bool) -> Callable[[], None]:
+        from hamilton_orbits.snapshot import write
+
+        def go() -> None:
+            write(tmp / "ours-one.nc", *sim._record(), sync=sync)
+        return go
+
+    def theirs() -> None:
+        reb.save_to_file(str(reb_file))
+
+    t = interleaved({"ours": ours(False), "ours-sync": ours(True), "rebound": theirs}, repeat)
+    med = {k: statistics.median(v) * 1e3 for k, v in t.items()}
+    print("[1] one snapshot of 10 bodies (ms, median of", repeat, "):")
+    print(f"    ours {med['ours']:.3f} (sync=True {med['ours-sync']:.3f}), rebound "
+          f"{med['rebound']:.3f}; ours / rebound = {med['ours'] / med['rebound']:.2f}")
+
+
+def runs(tmp: Path, rounds: int) -> None:
+    s = disc10()
+    arrays = s.as_arrays()
+    probe = Simulation(s, method="radau15")
+    probe.integrate(T_END)
+    mean_step = T_END / probe.steps
+    every = {"radau15": 100 * mean_step, "wh": 100 * DT}
+
+    def ours(method: str, archived: bool) -> Callable[[], None]:
+        count = iter(range(10**6))
+
+        def go() -> None:
+            folder = tmp / f"ours-{method}-{next(count)}"  # a new folder each run
+            kw = dict(archive=folder, every=every[method]) if archived else {}
+            sim = Simulation(s, method=method, dt=DT if method == "wh" else None, **kw)
+            sim.integrate(T_END)
+        return go
+
+    def theirs(integrator: str, archived: bool) -> Callable[[], None]:
+        def go() -> None:
+            reb = rebound_of(arrays.r, arrays.v, arrays.gm, integrator, DT)
+            if integrator == "ias15":
+                reb.integrator.epsilon = 1e-9  # rebound's default
+            if archived:
+                reb.save_to_file(str(tmp / f"reb-{integrator}.bin"), step=100, delete_file=True)
+            reb.integrate(T_END, exact_finish_time=1)
+        return go
+
+    print(f"[2] a run of {T_END:g} (10 bodies) with a snapshot every 100 steps: archived / "
+          f"plain (median of {rounds} rounds)")
+    for method, peer in (("radau15", "ias15"), ("wh", "whfast")):
+        t = interleaved({"ours": ours(method, False), "ours-archived": ours(method, True),
+                         "theirs": theirs(peer, False), "theirs-archived": theirs(peer, True)},
+                        rounds)
+        r_ours = statistics.median(a / b for a, b in zip(t["ours-archived"], t["ours"],
+                                                          strict=True))
+        r_theirs = statistics.median(a / b for a, b in zip(t["theirs-archived"], t["theirs"],
+                                                            strict=True))
+        n_ours = len(list((tmp / f"ours-{method}-1").glob("snapshot-*.nc")))
+        print(f"    {method:8s} x{r_ours:.3f} ({n_ours} snapshots, plain "
+              f"{statistics.median(t['ours']) * 1e3:.1f} ms);  {peer} x{r_theirs:.3f} "
+              f"(plain {statistics.median(t['theirs']) * 1e3:.1f} ms)")
+
+
+def loading(tmp: Path, repeat: int) -> None:
+    folder, reb_file = tmp / "ours-radau15-1", tmp / "reb-ias15.bin"
+
+    def ours() -> None:
+        Simulation.load(folder)
+
+    def theirs() -> None:
+        sa = rebound.Simulationarchive(str(reb_file))
+        sa[-1]
+
+    t = interleaved({"ours": ours, "theirs": theirs}, repeat)
+    med = {k: statistics.median(v) * 1e3 for k, v in t.items()}
+    print(f"[3] loading the last snapshot (ms): ours {med['ours']:.2f} (the whole snapshot "
+          f"verified, the simulation rebuilt), rebound {med['theirs']:.2f}")
+
+
+def main() -> None:
+    print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
+    tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
+    try:
+        one_snapshot(tmp, 200)
+        runs(tmp, 5)
+        loading(tmp, 30)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
