@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -235,3 +237,17 @@ def test_the_old_solar_system_module_warns_and_gives_the_same_objects():
     assert all(fx.EffectSpec(**s) == fx.get("nbody", s["name"]) for s in specs)
     with pytest.raises(AttributeError):
         old.nothing_here  # noqa: B018
+
+
+def test_a_bad_parameter_names_the_effect_the_value_and_its_index():
+    """Issue 32: a refusal names the argument (`effects`), the index and the value."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    effects = [{"name": "gr", "c": 10.0}, {"name": "j2", "body": "sun", "j2": 1e-3,
+                                           "radius": -0.1}]
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'j2': expected `radius` > 0, got -0.1 (effects[1])")):
+        integrate(s, 1.0, effects=effects)
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'j2' needs the `body` whose oblateness acts, e.g. {'name': 'j2', 'body': "
+            "'earth'} (effects[0])")):
+        fx.EffectSet.of(["j2"]).parameters(s)

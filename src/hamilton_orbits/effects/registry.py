@@ -341,6 +341,43 @@ class EffectSet:
         """True if any listed effect depends on velocities."""
         return any(get(self.kind, name).velocity_dependent for name in self.names)
 
+    def parameters(self, system: Any) -> list[np.ndarray]:
+        """Each listed effect's parameter vector for ``system`` (its
+        :attr:`EffectSpec.params`), in order.
+
+        Raises
+        ------
+        ValueError
+            For an effect without a parameter builder, or bad parameters: the
+            builder's message, naming the effect and the parameter, and the
+            effect's index in the set (``"Effect 'eih': expected `c` ...
+            (effects[0])"``; an explicit ``"newtonian"``, dropped from the set,
+            is not counted).
+
+        Examples
+        --------
+        >>> from hamilton_orbits import Body, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+        >>> EffectSet.of([{"name": "j2", "body": "sun", "j2": 1e-3, "radius": 0.1},
+        ...               {"name": "gr", "c": -1.0}]).parameters(s)
+        Traceback (most recent call last):
+        ...
+        ValueError: Effect 'gr': expected `c` > 0, got -1.0 (effects[1])
+        """
+        out = []
+        for k, (name, params) in enumerate(self.items):
+            spec = get(self.kind, name)
+            if spec.params is None:
+                raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
+            try:
+                out.append(spec.params(system, dict(params)))
+            except ValueError as exc:  # astropy's UnitConversionError included
+                msg = str(exc)
+                if not msg.startswith(f"Effect {name!r}"):
+                    msg = f"Effect {name!r}: {msg}"
+                raise type(exc)(f"{msg} (effects[{k}])") from None
+        return out
+
     def as_list(self) -> list[str | dict[str, Any]]:
         """The effects as a caller lists them (names, or mappings with parameters)."""
         return [dict(name=n, **dict(p)) if p else n for n, p in self.items]
