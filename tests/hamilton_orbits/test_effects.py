@@ -251,3 +251,17 @@ def test_a_bad_parameter_names_the_effect_the_value_and_its_index():
             "Effect 'j2' needs the `body` whose oblateness acts, e.g. {'name': 'j2', 'body': "
             "'earth'} (effects[0])")):
         fx.EffectSet.of(["j2"]).parameters(s)
+
+
+def test_effects_that_exclude_each_other():
+    """``EffectSpec.excludes``: listing both would count the same terms twice."""
+    assert fx.get("nbody", "eih").excludes.keys() == {"gr", "gr_potential"}
+    assert fx.exclusion_problems(["gr", "j2"]) == []
+    assert [k for k, _ in fx.exclusion_problems(["gr_potential", "eih", "gr"])] == [1, 2]
+    fx.register(fx.EffectSpec("ex_a", "test-excl", "a", excludes={"ex_b": "b's terms"}))
+    fx.register(fx.EffectSpec("ex_b", "test-excl", "b"))
+    assert fx.exclusion_problems(["ex_b", "ex_a"], "test-excl") == [
+        (1, "effect 'ex_b' (at index 0) is refused beside 'ex_a' (at index 1): 'ex_a' already "
+            "computes b's terms, which would count twice; list one of them")]
+    with pytest.raises(ValueError, match=r"^Effect 'ex_b' \(at index 0\) is refused"):
+        fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")

@@ -1,5 +1,5 @@
-"""Effects in scene files: parameters with their units, checked at load (issue 32,
-classes 3 and 17)."""
+"""Effects in scene files: parameters with their units, the scene's frame, and the
+effects that exclude each other, all checked at load (issue 32, classes 3 and 17)."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import tomllib
 
 from hamilton_orbits import Scene, System, integrate
 from hamilton_orbits import effects as fx
+from hamilton_orbits import ephemeris as de
 from hamilton_orbits.scene import SceneError
 from hamilton_orbits.scenes.nbody.build import build_system
 
@@ -65,6 +66,40 @@ def test_a_list_is_read_value_by_value():
     scene = _scene('[{ name = "earth_tides", tau = ["0.077 d", "-0.01 d", "-0.2 d", '
                    '"1 h", "0 s"] }]', initial='ephemeris = { bodies = ["sun", "earth", "moon"] }')
     assert np.allclose(_params(scene)[-5:], [0.077, -0.01, -0.2, 1 / 24, 0.0], rtol=1e-15)
+
+
+def test_eih_and_gr_together_are_refused_at_load():
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[2]: effect 'gr' (at index 2) is refused beside 'eih' (at index 0): 'eih' "
+            "already computes the first post-Newtonian terms")):
+        _scene('["eih", "kuiper_ring", "gr"]')
+
+
+def test_the_scene_frame_reaches_kuiper_ring():
+    """``[initial] frame = "ecliptic"`` was not passed to ``kuiper_ring``: the ring's
+    normal was the ICRS's ecliptic pole on ecliptic axes, 23.4 deg off.  The ring's
+    field in the ecliptic scene is the ICRS scene's rotated."""
+    out = {}
+    for frame in ("icrs", "ecliptic"):
+        scene = _scene('["kuiper_ring"]', frame=frame)
+        assert scene.effects[0]["frame"] == frame
+        p = _params(scene)
+        assert np.allclose(p[3:], de.ecliptic_pole(frame), rtol=0, atol=1e-15)
+        system = build_system(scene.spec)
+        r = np.ascontiguousarray(system.r.to_value(u.au))
+        acc = np.zeros_like(r)
+        fx.get("nbody", "kuiper_ring").kernel(
+            r, np.zeros_like(r), system.gm.to_value(u.au**3 / u.day**2), acc, p)
+        out[frame] = acc
+    rot = de.frame_rotation("ecliptic")
+    assert np.abs(out["ecliptic"] - out["icrs"] @ rot.T).max() < 1e-12 * np.abs(out["icrs"]).max()
+
+
+def test_an_effect_frame_against_the_scene_frame_is_a_problem():
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[0].frame: 'icrs', but the scene's states are in 'ecliptic' axes "
+            "([initial] frame)")):
+        _scene('[{ name = "kuiper_ring", frame = "icrs" }]', frame="ecliptic")
 
 
 def test_a_scene_runs_with_quantity_parameters():

@@ -460,6 +460,7 @@ def test_a_bare_earth_radius_is_refused_not_read_as_6378_au():
     ({"radius": "1738 kg"}, "Effect 'moon_figure': Expected `radius` to be a length"),
     ({"radius": "big"}, "Effect 'moon_figure': cannot read `radius` = 'big' as a number with "
                         "a unit (e.g. '6378.1366 km')"),
+    ({"moon": "earth"}, "Effect 'moon_figure': `moon` and `earth` name one body, 'earth'"),
 ])
 def test_moon_figure_refuses_bad_parameters(params, message):
     """A negative radius ran; NaN J2 or inclination stopped with "(a collision?)"."""
@@ -543,3 +544,65 @@ def test_a_plain_float_system_refuses_quantities_for_the_solar_system_effects():
             "Effect 'moon_figure': expected `radius` as a plain number in the units of the "
             "system (a system of plain floats), got the Quantity 1738.0 km (effects[0])")):
         s.accelerations([{"name": "moon_figure", "radius": 1738 * u.km, "frame": "icrs"}])
+
+
+def test_earth_tides_refuses_a_sun_not_in_the_system():
+    """``sun="Sun"`` silently dropped the solar tide (issue 32); ``"none"`` leaves it out
+    on purpose, and the Sun's tide is there by default."""
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon"])
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'earth_tides': `sun` names body 'Sun', which is not in the system (did you "
+            "mean 'sun'?); bodies: sun, earth, moon (effects[0])")):
+        s.accelerations([{"name": "earth_tides", "sun": "Sun"}])
+    base = _accelerations(s, [])
+    both = _accelerations(s, ["earth_tides"])[2] - base[2]
+    lunar = _accelerations(s, [{"name": "earth_tides", "sun": "none"}])[2] - base[2]
+    assert fx.get("nbody", "earth_tides").params(s, {})[2] == 0  # the Sun's index
+    assert fx.get("nbody", "earth_tides").params(s, {"sun": None})[2] == -1
+    # the solar tide is a part of the whole: smaller than the lunar, not nothing
+    assert 1e-3 < np.linalg.norm(both - lunar) / np.linalg.norm(lunar) < 1.0
+
+
+@pytest.mark.parametrize("other", ["gr", "gr_potential",
+                                   {"name": "gr", "c": C_AU_DAY * u.au / u.d}])
+def test_eih_refuses_gr_beside_it(other):
+    """``["eih", "gr"]`` counted the 1PN terms twice (issue 32)."""
+    s = System.from_ephemeris(bodies=["sun", "mercury"])
+    name = other if isinstance(other, str) else other["name"]
+    with pytest.raises(ValueError, match=re.escape(
+            f"Effect {name!r} (at index 1) is refused beside 'eih' (at index 0): 'eih' already "
+            "computes")):
+        integrate(s, 1 * u.day, effects=["eih", other])
+    with pytest.raises(ValueError, match=re.escape(f"Effect {name!r} (at index 0) is refused "
+                                                   "beside 'eih' (at index 2)")):
+        integrate(s, 1 * u.day, effects=[other, "newtonian", "eih"])
+
+
+def test_moon_figure_on_an_ecliptic_earth_and_moon_without_the_sun():
+    """Without the Sun the frame was not recognised and the ICRS's ecliptic pole was used
+    on ecliptic axes (27% of the effect wrong): it is recognised from the Earth's and
+    the Moon's DE440 poles, and the effect is the ICRS one rotated."""
+    rot = de.frame_rotation("ecliptic")
+    out = {}
+    for frame in ("icrs", "ecliptic"):
+        s = System.from_ephemeris(bodies=["earth", "moon"], frame=frame)
+        assert fx.parameters.axes_frame(s, {}, "moon_figure") == frame
+        out[frame] = _alone(s, "moon_figure", {})
+    scale = np.abs(out["icrs"]).max()
+    assert np.abs(out["ecliptic"] - out["icrs"] @ rot.T).max() < 1e-12 * scale
+
+
+def test_an_unknown_frame_whose_orbits_lie_in_x_y_asks_for_frame():
+    """``System.solar_system(frame="ecliptic")`` has no poles to recognise its axes by;
+    the ring's normal was put along the ICRS's ecliptic pole, 23.4 deg off.  Now the
+    effect asks for ``frame``; given, it is the ICRS one rotated."""
+    ecl = System.solar_system(bodies=["sun", "jupiter", "neptune"], frame="ecliptic")
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'kuiper_ring': expected `frame` ('icrs' or 'ecliptic'): the system's axes "
+            "are not known")):
+        ecl.accelerations(["kuiper_ring"])
+    icrs = System.solar_system(bodies=["sun", "jupiter", "neptune"])
+    a_icrs = _alone(icrs, "kuiper_ring", {})  # ICRS axes: taken as such, as before
+    a_ecl = _alone(ecl, "kuiper_ring", {"frame": "ecliptic"})
+    rot = de.frame_rotation("ecliptic")
+    assert np.abs(a_ecl - a_icrs @ rot.T).max() < 1e-12 * np.abs(a_icrs).max()

@@ -2,7 +2,8 @@
 
 Newtonian gravity plus its first post-Newtonian correction, PPN beta = gamma = 1
 as DE440 has them, *replacing* Newtonian gravity (``replaces_newtonian``: the
-right-hand side starts from zero); do not list ``gr`` with it.  Kernel
+right-hand side starts from zero); ``gr`` and ``gr_potential`` are refused beside
+it (their terms are in it already).  Kernel
 :func:`~hamilton_orbits._kernels.relativity.eih`; no analytic Jacobian (three
 pages of terms): the variational equations differentiate the kernel by compiled
 central differences (:mod:`hamilton_orbits.rhs`).  ``p = [c, beta, gamma,
@@ -70,6 +71,8 @@ SPECS = (
                                "massive body; the others act by Newton's law)"},
         kernel=eih, params=_params_eih,
         parameter_kinds={"c": SPEED, "beta": DIMENSIONLESS, "gamma": DIMENSIONLESS},
+        excludes={"gr": "the first post-Newtonian terms of the dominant body",
+                  "gr_potential": "the relativistic perihelion advance"},
         reference=f"Moyer (2003), DESCANSO monograph 2, eq. 4-26; {PARK_2021}",
     ),
 )

@@ -22,6 +22,7 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import ring_field
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     axes_frame,
     body_index,
@@ -68,7 +69,7 @@ SPECS = (
         summary="the Kuiper belt as DE440's ring (44 au, ecliptic, centred on the Sun)",
         parameters={"centre": "default 'sun'", "gm": "a GM (default DE440's 36 ring masses)",
                     "radius": "a length (default 44 au)", "normal": "default the ecliptic pole",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=ring_field, params=_params_kuiper_ring,
         parameter_kinds={"gm": GM, "radius": LENGTH}, name_parameters=("centre",),
         reference=f"{PARK_2021}, section 3 (ring masses MA8201..MA8236)",

@@ -23,6 +23,7 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.jacobians import lense_thirring_jvp
 from hamilton_orbits._kernels.relativity import lense_thirring
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     SPECIFIC_ANGULAR_MOMENTUM,
     axes_frame,
@@ -82,7 +83,7 @@ SPECS = (
                             "MOISUN ASUN^2 OMGSUN about the IAU pole)",
                     "c": "speed of light, a speed (default DE440's CLIGHT)",
                     "gamma": "default DE440's GAMMA",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=lense_thirring, params=_params_lense_thirring,
         parameter_kinds={"spin": SPECIFIC_ANGULAR_MOMENTUM, "c": SPEED,
                          "gamma": DIMENSIONLESS},

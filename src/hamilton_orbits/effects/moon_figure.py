@@ -27,9 +27,11 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import moon_figure
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     axes_frame,
     body_index,
+    distinct_bodies,
     require_de440_units,
     scalar_parameter,
 )
@@ -47,6 +49,7 @@ MOON_EQUATOR_INCLINATION_DEG = 1.5424
 def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     m = body_index(system, params, "moon", "moon", "moon_figure")
     e = body_index(system, params, "earth", "earth", "moon_figure")
+    distinct_bodies(system, {"moon": m, "earth": e}, "moon_figure")
     require_de440_units(system, params, "moon_figure", ("radius",))
     radius = scalar_parameter(system, params, "radius", "moon_figure", LENGTH,
                               de.constant("AM") / de.constant("AU"), positive=True)
@@ -70,7 +73,7 @@ SPECS = (
                     "radius": "a length (default DE440's AM)", "j2": "default DE440's J2M",
                     "c22": "default DE440's C22M",
                     "inclination_deg": "lunar equator to ecliptic, degrees (default 1.5424)",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=moon_figure, params=_params_moon_figure,
         parameter_kinds={"radius": LENGTH, "j2": DIMENSIONLESS, "c22": DIMENSIONLESS},
         name_parameters=("moon", "earth"),

@@ -4,7 +4,8 @@ Every built-in effect's parameter builder (``params(system, mapping) ->
 ndarray``) reads its mapping with these helpers, so that a body name, a speed of
 light or a length is read, refused and reported the same way by every effect:
 
-- :func:`source_index`, :func:`body_index`: the index of the body a parameter names;
+- :func:`source_index`, :func:`body_index`, :func:`optional_body_index`: the
+  index of the body a parameter names;
 - :func:`parameter_value`, :func:`parameter_array`, :func:`scalar_parameter`,
   :func:`speed_of_light`: numbers with a dimension (:data:`SYSTEM_UNITS`);
 - DE440's defaults (the solar-system effects): :func:`require_de440_units`,
@@ -54,6 +55,7 @@ from hamilton_orbits.units import (
 
 __all__ = [
     "C_AU_PER_DAY",
+    "FRAME_PARAMETER",
     "PARK_2021",
     "SPECIFIC_ANGULAR_MOMENTUM",
     "SYSTEM_UNITS",
@@ -61,7 +63,9 @@ __all__ = [
     "body_index",
     "body_pole",
     "de440_c_au_per_day",
+    "distinct_bodies",
     "finite_floats",
+    "optional_body_index",
     "parameter_array",
     "parameter_value",
     "require_de440_units",
@@ -304,6 +308,21 @@ def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float
 #: The source of DE440's models and constants.
 PARK_2021 = "Park et al. (2021), AJ 161, 105"
 
+#: What the ``frame`` parameter of the solar-system effects is (:func:`axes_frame`).
+FRAME_PARAMETER = ("the system's axes, 'icrs' or 'ecliptic' (default: a scene's [initial] "
+                   "frame, else recognised from DE440's poles, else 'icrs')")
+
+
+def _not_a_body(system: Any, key: str, name: Any, effect: str) -> ValueError:
+    import difflib
+
+    close = difflib.get_close_matches(str(name), system.names, n=3)
+    if not close:
+        close = [n for n in system.names if n.lower() == str(name).lower()]
+    hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+    return ValueError(f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the "
+                      f"system{hint}; bodies: {', '.join(system.names)}")
+
 
 def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
                effect: str) -> int:
@@ -319,12 +338,56 @@ def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
     1
     """
     name = params.get(key, default)
-    if name not in system.names:
-        raise ValueError(
-            f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
-            f"bodies: {', '.join(system.names)}"
-        )
+    if not isinstance(name, str) or name not in system.names:
+        raise _not_a_body(system, key, name, effect)
     return system.names.index(name)
+
+
+def optional_body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
+                        effect: str) -> int:
+    """The index of the body that mapping ``params`` names under ``key``, or -1 for
+    none: given as None or ``"none"``, or not given and no body is named ``default``.
+    A name given that is not in ``system`` is refused (``earth_tides``'s ``sun =
+    "Sun"`` once dropped the solar tide without a word).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("earth", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> optional_body_index(s, {}, "sun", "sun", "earth_tides")
+    -1
+    >>> optional_body_index(s, {"sun": "Sun"}, "sun", "sun", "earth_tides")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'earth_tides': `sun` names body 'Sun', which is not in the system; ...
+    """
+    if key not in params:
+        return system.names.index(default) if default in system.names else -1
+    name = params[key]
+    if name is None or name == "none":
+        return -1
+    return body_index(system, params, key, default, effect)
+
+
+def distinct_bodies(system: Any, indices: Mapping[str, int], effect: str) -> None:
+    """Refuse one body named by two of an effect's parameters (``indices``: parameter
+    -> body index, -1 for none).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("earth", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> distinct_bodies(s, {"earth": 0, "moon": 0}, "earth_tides")
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'earth_tides': `earth` and `moon` name one body, 'earth'
+    """
+    seen: dict[int, str] = {}
+    for key, b in indices.items():
+        if b >= 0 and b in seen:
+            raise ValueError(f"Effect {effect!r}: `{seen[b]}` and `{key}` name one body, "
+                             f"{system.names[b]!r}")
+        seen.setdefault(b, key)
 
 
 def require_de440_units(system: Any, params: Mapping[str, Any], effect: str,
@@ -379,18 +442,70 @@ def unit_vector(name: str, value: Any, effect: str) -> np.ndarray:
     return k / norm
 
 
+def _frame_of_poles(system: Any) -> str | None:
+    """The frame recognised from a pole :meth:`System.from_ephemeris` gives the Sun,
+    the Earth or the Moon (:func:`hamilton_orbits.ephemeris.pole` in that frame), or
+    None."""
+    for name in ("sun", "earth", "moon"):
+        if name in system.names and system[name].pole is not None:
+            pole = np.array(system[name].pole)
+            for frame in ("icrs", "ecliptic"):
+                if np.allclose(pole, de.pole(name, frame), rtol=0, atol=1e-12):
+                    return frame
+    return None
+
+
+def _refuse_ecliptic_looking(system: Any, effect: str) -> None:
+    """Refuse to take as ICRS axes a system whose orbits lie near its x-y plane (its
+    angular momentum about the barycentre within 10 degrees of z, nearer z than the
+    ICRS's ecliptic pole): such axes are ecliptic ones, or the system is not the
+    solar system, and the effect's default directions (the ecliptic pole, the Sun's
+    and the Earth's poles) would be wrong by the obliquity."""
+    arrays = system.as_arrays()
+    gm = arrays.gm
+    if not gm.sum() > 0:
+        return
+    r = arrays.r - gm @ arrays.r / gm.sum()
+    v = arrays.v - gm @ arrays.v / gm.sum()
+    h = gm @ np.cross(r, v)
+    norm = float(np.linalg.norm(h))
+    if not (np.isfinite(norm) and norm > 0):
+        return
+    k = h / norm
+    to_z = float(np.degrees(np.arccos(np.clip(k[2], -1.0, 1.0))))
+    to_ecliptic = float(np.degrees(np.arccos(np.clip(k @ de.ecliptic_pole("icrs"), -1.0, 1.0))))
+    if to_z < 10.0 and to_z < to_ecliptic:
+        raise ValueError(
+            f"Effect {effect!r}: expected `frame` ('icrs' or 'ecliptic'): the system's axes "
+            f"are not known (no DE440 pole of the Sun, the Earth or the Moon to recognise "
+            f"them by), and its orbits lie {to_z:.1f} deg from its x-y plane, as in "
+            "ecliptic axes, not the ICRS's that the effect would take by default")
+
+
 def axes_frame(system: Any, params: Mapping[str, Any], effect: str) -> str:
-    """The frame of the system's axes: ``params["frame"]``, else recognised from the
-    Sun's pole that :meth:`System.from_ephemeris` sets (IAU pole in that frame), else
-    ``"icrs"``."""
+    """The frame of the system's axes, for an effect's default directions.
+
+    ``params["frame"]``; else recognised from a pole :meth:`System.from_ephemeris`
+    sets (the Sun's, the Earth's or the Moon's, :func:`hamilton_orbits.ephemeris.pole`
+    in that frame); else ``"icrs"``, unless the system's orbits lie near its x-y
+    plane (its angular momentum within 10 degrees of z): those are not ICRS axes
+    (the ecliptic is inclined 23.4 degrees to the ICRS's x-y plane), and a
+    ``ValueError`` asks for ``frame``.  A scene passes its ``[initial] frame``.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import System
+    >>> axes_frame(System.from_ephemeris(bodies=["earth", "moon"], frame="ecliptic"), {},
+    ...            "moon_figure")
+    'ecliptic'
+    """
     frame = params.get("frame")
     if frame is None:
-        frame = "icrs"
-        if "sun" in system.names and system["sun"].pole is not None:
-            pole = np.array(system["sun"].pole)
-            if np.allclose(pole, de.sun_pole("ecliptic"), rtol=0, atol=1e-12):
-                frame = "ecliptic"
-    if frame not in ("icrs", "ecliptic"):
+        frame = _frame_of_poles(system)
+        if frame is None:
+            _refuse_ecliptic_looking(system, effect)
+            frame = "icrs"
+    if not isinstance(frame, str) or frame not in ("icrs", "ecliptic"):
         raise ValueError(f"Effect {effect!r}: expected `frame` 'icrs' or 'ecliptic', "
                          f"got {frame!r}")
     return frame

@@ -27,10 +27,13 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import earth_tides
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     body_index,
     body_pole,
+    distinct_bodies,
     finite_floats,
+    optional_body_index,
     parameter_array,
     require_de440_units,
     scalar_parameter,
@@ -50,8 +53,8 @@ def _params_earth_tides(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     e = body_index(system, params, "earth", "earth", "earth_tides")
     m = body_index(system, params, "moon", "moon", "earth_tides")
     require_de440_units(system, params, "earth_tides", ("radius", "omega", "tau"))
-    sun_name = params.get("sun", "sun")
-    sun = system.names.index(sun_name) if sun_name in system.names else -1
+    sun = optional_body_index(system, params, "sun", "sun", "earth_tides")
+    distinct_bodies(system, {"earth": e, "moon": m, "sun": sun}, "earth_tides")
     radius = scalar_parameter(system, params, "radius", "earth_tides", LENGTH,
                               de.constant("RE") / de.constant("AU"), positive=True)
     omega = scalar_parameter(system, params, "omega", "earth_tides", ANGULAR_SPEED,
@@ -74,14 +77,15 @@ SPECS = (
         summary="tides raised on the Earth by the Moon and Sun acting on the Moon (DE440)",
         velocity_dependent=True,
         parameters={"earth": "default 'earth'", "moon": "default 'moon'",
-                    "sun": "tide raiser besides the Moon (default 'sun' if present)",
+                    "sun": "tide raiser besides the Moon (default 'sun' if present; "
+                           "'none' for none)",
                     "radius": "a length (default DE440's RE)",
                     "omega": "Earth's rotation rate (default IERS's, 7.292115e-5 rad/s)",
                     "k2": "[k20, k21, k22] (default DE440's K2E0..2)",
                     "tau": "time lags [TAUE0, TAUE1, TAUE2, TAUER1, TAUER2] (default "
                            "DE440's)",
                     "pole": "Earth's pole (default the Body's pole)",
-                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=earth_tides, params=_params_earth_tides,
         parameter_kinds={"radius": LENGTH, "omega": ANGULAR_SPEED, "tau": TIME},
         name_parameters=("earth", "moon"),

@@ -24,6 +24,7 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import zonal_field
 from hamilton_orbits._kernels.jacobians import zonal_field_jvp
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     body_index,
     body_pole,
@@ -58,7 +59,7 @@ SPECS = (
                     "j": "[J2, J3, ...] (default DE440's J2E, J3E, J4E)",
                     "radius": "reference radius, a length (default DE440's RE)",
                     "pole": "pole vector (default the Body's pole)",
-                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=zonal_field, params=_params_zonal,
         parameter_kinds={"radius": LENGTH}, name_parameters=("body",),
         jacobian=zonal_field_jvp,

@@ -392,6 +392,9 @@ class Scene:
                     problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
                                                   f"(first at effects[{first[effect['name']]}])")
                 first.setdefault(effect["name"], k)
+            names = [effect["name"] for effect in spec["effects"]]
+            for k, message in _effects.exclusion_problems(names, kind.effect_kind):
+                problems.add(f"effects[{k}]", message)
         if not problems:
             kind.check(spec, problems)
         if problems:
