@@ -251,6 +251,11 @@ def test_a_bad_parameter_names_the_effect_the_value_and_its_index():
             "Effect 'j2' needs the `body` whose oblateness acts, e.g. {'name': 'j2', 'body': "
             "'earth'} (effects[0])")):
         fx.EffectSet.of(["j2"]).parameters(s)
+    # the index is the caller's, an explicit "newtonian" counted
+    with pytest.raises(ValueError, match=re.escape("expected `c` > 0, got 0.0 (effects[2])")):
+        integrate(s, 1.0, effects=["newtonian", {"name": "j2", "body": "sun", "j2": 1e-3,
+                                                 "radius": 0.1}, {"name": "gr", "c": 0.0}])
+    assert fx.EffectSet.of(["newtonian", "gr"]) == fx.EffectSet.of(["gr"])
 
 
 def test_effects_that_exclude_each_other():

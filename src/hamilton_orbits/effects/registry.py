@@ -353,6 +353,9 @@ class EffectSet:
 
     kind: str
     items: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+    #: each item's index in the list it was built from (``"newtonian"`` counted),
+    #: for messages; not part of the value (equality, hash)
+    indices: tuple[int, ...] = field(default=(), compare=False)
 
     @classmethod
     def of(cls, effects: Any, kind: str = "nbody") -> EffectSet:
@@ -367,7 +370,10 @@ class EffectSet:
             if effects.kind != kind:
                 raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")
             return effects
-        return cls(kind, normalize_effects(effects, kind))
+        items = normalize_effects(effects, kind)
+        indices = tuple(k for k, item in enumerate(effects)
+                        if (item if isinstance(item, str) else item["name"]) != "newtonian")
+        return cls(kind, items, indices)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -388,9 +394,8 @@ class EffectSet:
         ValueError
             For an effect without a parameter builder, or bad parameters: the
             builder's message, naming the effect and the parameter, and the
-            effect's index in the set (``"Effect 'eih': expected `c` ...
-            (effects[0])"``; an explicit ``"newtonian"``, dropped from the set,
-            is not counted).
+            effect's index in the list the set was built from (``"Effect 'eih':
+            expected `c` ... (effects[0])"``).
 
         Examples
         --------
@@ -403,7 +408,8 @@ class EffectSet:
         ValueError: Effect 'gr': expected `c` > 0, got -1.0 (effects[1])
         """
         out = []
-        for k, (name, params) in enumerate(self.items):
+        indices = self.indices or range(len(self.items))
+        for k, (name, params) in zip(indices, self.items, strict=True):
             spec = get(self.kind, name)
             if spec.params is None:
                 raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
