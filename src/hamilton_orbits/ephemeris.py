@@ -48,7 +48,9 @@ __all__ = [
     "EXTRA_HINT",
     "OBLIQUITY_J2000_ARCSEC",
     "barycentric_states",
+    "body_names",
     "body_specs",
+    "checked_names",
     "constant",
     "constants",
     "ecliptic_pole",
@@ -57,7 +59,9 @@ __all__ = [
     "gm",
     "heliocentric_positions",
     "kernel_available",
+    "pole",
     "reference_table",
+    "refuse_barycentre_twice",
     "sun_pole",
 ]
 
@@ -168,6 +172,103 @@ def _check_names(names: Sequence[str]) -> None:
             )
 
 
+def checked_names(bodies: Any, known: Sequence[str], default: Sequence[str],
+                  what: str) -> list[str]:
+    """``bodies`` as a list of names from ``known`` (lower case, stripped), checked.
+
+    ``None`` is ``default``; one name alone is a list of one (``"sun"``, not the
+    letters of ``"sun"``).  ``what`` names the catalogue in messages
+    (``"DE440"``, ``"solar-system"``).
+
+    Raises
+    ------
+    ValueError
+        For an empty list, a name that is not a string or not known, or a name
+        given twice, naming `bodies`, the index and the value.
+
+    Examples
+    --------
+    >>> checked_names("Sun", BODIES, DEFAULT_BODIES, "DE440")
+    ['sun']
+    >>> checked_names(["sun", 3], BODIES, DEFAULT_BODIES, "DE440")
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `bodies` to hold names, got 3 at index 1
+    """
+    import difflib
+
+    if bodies is None:
+        return list(default)
+    if isinstance(bodies, str):
+        bodies = [bodies]
+    if not isinstance(bodies, Sequence):
+        raise ValueError(f"Expected `bodies` to be a list of names, got {bodies!r}")
+    if len(bodies) == 0:
+        raise ValueError("Expected `bodies` to name at least one body, got an empty list "
+                         "(leave it out for the default bodies)")
+    names: list[str] = []
+    for k, b in enumerate(bodies):
+        if not isinstance(b, str):
+            raise ValueError(f"Expected `bodies` to hold names, got {b!r} at index {k}")
+        name = b.strip().lower()
+        if name not in known:
+            close = difflib.get_close_matches(name, known, n=3)
+            hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+            raise ValueError(f"Unknown {what} body {b!r} at index {k} of `bodies`{hint}; "
+                             f"known: {', '.join(known)}")
+        if name in names:
+            raise ValueError(f"Expected `bodies` to name each body once, got {b!r} at indices "
+                             f"{names.index(name)} and {k}")
+        names.append(name)
+    return names
+
+
+def refuse_barycentre_twice(names: Sequence[str]) -> None:
+    """Refuse the Earth-Moon barycentre beside the Earth or the Moon: its GM is theirs,
+    so a system of both would count that mass twice.
+
+    Examples
+    --------
+    >>> refuse_barycentre_twice(["sun", "earth-moon-barycenter", "mars"])
+    >>> refuse_barycentre_twice(["sun", "moon", "earth-moon-barycenter"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected either 'earth-moon-barycenter' or 'earth' and 'moon' in `bodies`, ...
+    """
+    emb = "earth-moon-barycenter"
+    if emb in names and ("earth" in names or "moon" in names):
+        other = "earth" if "earth" in names else "moon"
+        raise ValueError(
+            f"Expected either {emb!r} or 'earth' and 'moon' in `bodies`, got both ({emb!r} at "
+            f"index {list(names).index(emb)}, {other!r} at index {list(names).index(other)}): "
+            "the barycentre holds the Earth and the Moon, whose mass would count twice")
+
+
+def body_names(bodies: Any = None) -> list[str]:
+    """The names of :func:`body_specs`'s (and :meth:`System.from_ephemeris
+    <hamilton_orbits.nbody.System.from_ephemeris>`'s) bodies, checked: names from
+    :data:`BODIES` (any case), each once, one name alone a list of one, and not the
+    Earth-Moon barycentre beside the Earth or the Moon (its mass would count twice).
+
+    Raises
+    ------
+    ValueError
+        Naming `bodies`, the index and the value.
+
+    Examples
+    --------
+    >>> body_names("sun")
+    ['sun']
+    >>> body_names(["sun", "vesat"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Unknown DE440 body 'vesat' at index 1 of `bodies` (did you mean 'vesta'...
+    """
+    names = checked_names(bodies, BODIES, DEFAULT_BODIES, "DE440")
+    refuse_barycentre_twice(names)
+    return names
+
+
 def epoch_jd(epoch: Any) -> float:
     """The TDB Julian date of ``epoch`` (an astropy ``Time``, ``"J2000"`` or a ``Time``
     string read on the TDB scale).
@@ -219,6 +320,29 @@ def sun_pole(frame: str = "icrs") -> np.ndarray:
     ra, dec = np.deg2rad(SUN_POLE_RA_DEG), np.deg2rad(SUN_POLE_DEC_DEG)
     k = np.array([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])
     return frame_rotation(frame) @ k
+
+
+def pole(name: str, frame: str = "icrs") -> np.ndarray:
+    """The pole :func:`body_specs` gives body ``name`` (``"sun"``, ``"earth"``,
+    ``"moon"``), in ``frame``: the Sun's IAU pole (:func:`sun_pole`), the Earth's
+    mean pole of J2000 (the ICRF z axis to 0.02"), the Moon's mean pole of J2000
+    (IAU WGCCRE 2015: RA 269.9949 deg, Dec 66.5392 deg).
+
+    Examples
+    --------
+    >>> pole("earth", "icrs").tolist()
+    [0.0, 0.0, 1.0]
+    >>> bool(np.allclose(pole("earth", "ecliptic"), [0.0, 0.3977771559, 0.9174820621]))
+    True
+    """
+    if name == "sun":
+        return sun_pole(frame)
+    rot = frame_rotation(frame)
+    if name == "earth":
+        return rot @ np.array([0.0, 0.0, 1.0])
+    if name == "moon":
+        return rot @ _radec(269.9949, 66.5392)
+    raise ValueError(f"Expected `name` to be 'sun', 'earth' or 'moon', got {name!r}")
 
 
 def kernel_available() -> bool:
@@ -347,8 +471,7 @@ def barycentric_states(
     >>> bool(356000 < d_km < 407000)
     True
     """
-    names = tuple(DEFAULT_BODIES if bodies is None else (str(b).lower() for b in bodies))
-    _check_names(names)
+    names = tuple(checked_names(bodies, BODIES, DEFAULT_BODIES, "DE440"))
     rot = frame_rotation(frame)
     jd = epoch_jd(epoch)
     if abs(jd - J2000_JD) < 1e-9:  # 0.1 ms: the shipped epoch
@@ -442,13 +565,12 @@ def body_specs(
 
     if ephemeris != "de440":
         raise ValueError(f"Expected `ephemeris` to be 'de440', got {ephemeris!r}")
-    names, gms, r, v = barycentric_states(epoch, bodies, frame)
-    rot = frame_rotation(frame)
+    names, gms, r, v = barycentric_states(epoch, body_names(bodies), frame)
     au_km = constant("AU")
     shape = {
-        "sun": (constant("ASUN"), constant("J2SUN"), sun_pole(frame)),
-        "earth": (constant("RE"), constant("J2E"), rot @ [0.0, 0.0, 1.0]),
-        "moon": (constant("AM"), constant("J2M"), rot @ _radec(269.9949, 66.5392)),
+        "sun": (constant("ASUN"), constant("J2SUN"), pole("sun", frame)),
+        "earth": (constant("RE"), constant("J2E"), pole("earth", frame)),
+        "moon": (constant("AM"), constant("J2M"), pole("moon", frame)),
     }
     out = []
     for k, name in enumerate(names):
@@ -457,8 +579,8 @@ def body_specs(
             "v": v[k] * u.au / u.day,
         }
         if name in shape:
-            radius_km, j2, pole = shape[name]
-            spec.update(radius=radius_km / au_km * u.au, j2=j2, pole=pole)
+            radius_km, j2, axis = shape[name]
+            spec.update(radius=radius_km / au_km * u.au, j2=j2, pole=axis)
         out.append(spec)
     return out
 

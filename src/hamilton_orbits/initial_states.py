@@ -116,13 +116,16 @@ class InitialStates:
         ----------
         epoch : astropy.time.Time or str
             TDB epoch; ``"J2000"`` (default) needs no extra.
-        bodies : sequence of str, optional
+        bodies : sequence of str or str, optional
             From ``hamilton_orbits.ephemeris.BODIES``: ``sun, mercury, venus, earth,
             moon, earth-moon-barycenter, mars, jupiter, saturn, uranus, neptune,
             pluto`` (Mars to Pluto are their system barycentres with their system
             GMs, as DE440 integrates them) and the 16 asteroids of
-            ``ephemeris.ASTEROIDS``; default ``ephemeris.DEFAULT_BODIES`` (the Sun,
-            the planets, the Earth and the Moon separately, Pluto).
+            ``ephemeris.ASTEROIDS``, any case, each once (one name alone is a list
+            of one); not the Earth-Moon barycentre beside the Earth or the Moon (its
+            GM is theirs: the mass would count twice).  Default
+            ``ephemeris.DEFAULT_BODIES`` (the Sun, the planets, the Earth and the
+            Moon separately, Pluto).  See :func:`hamilton_orbits.ephemeris.body_names`.
         ephemeris : {"de440"}
         frame : {"icrs", "ecliptic"}
             ICRF axes, or the mean ecliptic and equinox of J2000 (IAU 2006
@@ -136,8 +139,10 @@ class InitialStates:
         Raises
         ------
         ValueError
-            For an unknown body, ephemeris or frame, or an epoch other than J2000
-            without the ``[ephemeris]`` extra (naming it).
+            For an unknown body (naming `bodies`, the index and the value), a body
+            named twice, the Earth-Moon barycentre beside the Earth or the Moon, an
+            unknown ephemeris or frame, or an epoch other than J2000 without the
+            ``[ephemeris]`` extra (naming it).
 
         References
         ----------
@@ -319,34 +324,10 @@ def solar_system_bodies(bodies: Any = None) -> list[str]:
     ...
     ValueError: Expected `bodies` to name each body once, got 'mars' at indices 1 and 2
     """
-    if bodies is None:
-        return list(DEFAULT_BODIES)
-    if isinstance(bodies, str):
-        bodies = [bodies]
-    if not isinstance(bodies, Sequence):
-        raise ValueError(f"Expected `bodies` to be a list of names, got {bodies!r}")
-    if len(bodies) == 0:
-        raise ValueError("Expected `bodies` to name at least one body, got an empty list "
-                         "(leave it out for the Sun and the eight planets)")
-    names: list[str] = []
-    for k, b in enumerate(bodies):
-        if not isinstance(b, str):
-            raise ValueError(f"Expected `bodies` to hold names, got {b!r} at index {k}")
-        name = b.strip().lower()
-        if name not in SOLAR_SYSTEM_GM:
-            raise ValueError(f"Unknown solar-system body {b!r} at index {k} of `bodies`; "
-                             f"known: {', '.join(SOLAR_SYSTEM_GM)}")
-        if name in names:
-            raise ValueError(f"Expected `bodies` to name each body once, got {b!r} at indices "
-                             f"{names.index(name)} and {k}")
-        names.append(name)
-    if "earth-moon-barycenter" in names and ("earth" in names or "moon" in names):
-        other = "earth" if "earth" in names else "moon"
-        raise ValueError(
-            "Expected either 'earth-moon-barycenter' or 'earth' and 'moon' in `bodies`, got "
-            f"both ('earth-moon-barycenter' at index {names.index('earth-moon-barycenter')}, "
-            f"{other!r} at index {names.index(other)}): the barycentre holds the Earth and "
-            "the Moon")
+    from hamilton_orbits.ephemeris import checked_names, refuse_barycentre_twice
+
+    names = checked_names(bodies, tuple(SOLAR_SYSTEM_GM), DEFAULT_BODIES, "solar-system")
+    refuse_barycentre_twice(names)
     return names
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -235,3 +237,36 @@ def test_the_old_solar_system_module_warns_and_gives_the_same_objects():
     assert all(fx.EffectSpec(**s) == fx.get("nbody", s["name"]) for s in specs)
     with pytest.raises(AttributeError):
         old.nothing_here  # noqa: B018
+
+
+def test_a_bad_parameter_names_the_effect_the_value_and_its_index():
+    """Issue 32: a refusal names the argument (`effects`), the index and the value."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    effects = [{"name": "gr", "c": 10.0}, {"name": "j2", "body": "sun", "j2": 1e-3,
+                                           "radius": -0.1}]
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'j2': expected `radius` > 0, got -0.1 (effects[1])")):
+        integrate(s, 1.0, effects=effects)
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'j2' needs the `body` whose oblateness acts, e.g. {'name': 'j2', 'body': "
+            "'earth'} (effects[0])")):
+        fx.EffectSet.of(["j2"]).parameters(s)
+    # the index is the caller's, an explicit "newtonian" counted
+    with pytest.raises(ValueError, match=re.escape("expected `c` > 0, got 0.0 (effects[2])")):
+        integrate(s, 1.0, effects=["newtonian", {"name": "j2", "body": "sun", "j2": 1e-3,
+                                                 "radius": 0.1}, {"name": "gr", "c": 0.0}])
+    assert fx.EffectSet.of(["newtonian", "gr"]) == fx.EffectSet.of(["gr"])
+
+
+def test_effects_that_exclude_each_other():
+    """``EffectSpec.excludes``: listing both would count the same terms twice."""
+    assert fx.get("nbody", "eih").excludes.keys() == {"gr", "gr_potential"}
+    assert fx.exclusion_problems(["gr", "j2"]) == []
+    assert [k for k, _ in fx.exclusion_problems(["gr_potential", "eih", "gr"])] == [1, 2]
+    fx.register(fx.EffectSpec("ex_a", "test-excl", "a", excludes={"ex_b": "b's terms"}))
+    fx.register(fx.EffectSpec("ex_b", "test-excl", "b"))
+    assert fx.exclusion_problems(["ex_b", "ex_a"], "test-excl") == [
+        (1, "effect 'ex_b' (at index 0) is refused beside 'ex_a' (at index 1): 'ex_a' already "
+            "computes b's terms, which would count twice; list one of them")]
+    with pytest.raises(ValueError, match=r"^Effect 'ex_b' \(at index 0\) is refused"):
+        fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -12,6 +14,7 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels import figures
 from hamilton_orbits.effects.eih import eih_energy
 from hamilton_orbits.effects.kuiper_ring import kuiper_ring_gm
+from hamilton_orbits.effects.lense_thirring import sun_spin
 from hamilton_orbits.rebound_bridge import to_rebound
 
 ARCSEC = np.pi / (180 * 3600)
@@ -391,3 +394,215 @@ def test_every_effect_is_the_same_in_the_ecliptic_frame():
     p = fx.get("nbody", "kuiper_ring").params(systems["icrs"], {})
     eps = np.deg2rad(84381.406 / 3600)
     assert np.allclose(p[3:], [0.0, -np.sin(eps), np.cos(eps)], rtol=0, atol=1e-15)
+
+
+# ------------------------------------------------------------------ issue 32: units, names
+# Effect parameters in the wrong unit (class 3), as Quantities or strings (class 17):
+# one rule for every effect (docs/effects.md), each refusal naming the effect, the
+# parameter, the value and the effect's index in the list.
+
+
+def _accelerations(system: System, effects: list) -> np.ndarray:
+    return system.accelerations(effects).to_value(u.au / u.day**2)
+
+
+def _alone(system: System, name: str, params: dict) -> np.ndarray:
+    """The effect's own acceleration (its kernel on zeros; au/day^2)."""
+    spec = fx.get("nbody", name)
+    r = np.ascontiguousarray(system.r.to_value(u.au))
+    acc = np.zeros_like(r)
+    spec.kernel(r, np.ascontiguousarray(system.v.to_value(u.au / u.day)),
+                system.gm.to_value(u.au**3 / u.day**2), acc, spec.params(system, params))
+    return acc
+
+
+def test_a_bare_speed_of_light_on_a_quantity_system_is_refused_not_read_as_au_per_day():
+    """``{"name": "eih", "c": 1.0}`` ran as 1 au/day (issue 32)."""
+    s = System.from_ephemeris(bodies=["sun", "mercury"])
+    msg = ("Effect 'eih': expected `c` as a Quantity (a speed, convertible to m / s; e.g. a "
+           "string such as '299792.458 km/s') for a system of Quantities, got the plain "
+           "number 1.0 (effects[0])")
+    with pytest.raises(ValueError, match=re.escape(msg)):
+        s.accelerations([{"name": "eih", "c": 1.0}])
+
+
+@pytest.mark.parametrize("c", [299792.458 * u.km / u.s, "299792.458 km/s", C_AU_DAY * u.au / u.d])
+def test_eih_takes_the_speed_of_light_as_a_quantity_or_a_string(c):
+    """DE440's CLIGHT in any unit is the default (a bare TypeError or "could not
+    convert string to float" before)."""
+    s = System.from_ephemeris(bodies=["sun", "mercury", "venus"])
+    p = fx.get("nbody", "eih").params(s, {"c": c})
+    assert p[0] == pytest.approx(C_AU_DAY, rel=1e-15)
+    assert np.allclose(_accelerations(s, [{"name": "eih", "c": c}]),
+                       _accelerations(s, ["eih"]), rtol=1e-15, atol=0)
+
+
+def test_a_bare_earth_radius_is_refused_not_read_as_6378_au():
+    """``zonal`` ``radius=6378`` was 6378 au and died of "step underflowed"."""
+    s = System.from_ephemeris(bodies=["earth", "moon"])
+    with pytest.raises(ValueError, match=r"Effect 'zonal': expected `radius` as a Quantity "
+                                         r"\(a length.*got the plain number 6378 \(effects\[0\]\)"):
+        s.accelerations([{"name": "zonal", "radius": 6378}])
+    p = fx.get("nbody", "zonal").params(s, {"radius": 6378.1366 * u.km})
+    assert p[1] == pytest.approx(de.constant("RE") / de.constant("AU"), rel=1e-15)
+
+
+@pytest.mark.parametrize(("params", "message"), [
+    ({"radius": -1738 * u.km}, "Effect 'moon_figure': expected `radius` > 0, got -1738.0 km"),
+    ({"radius": 0 * u.km}, "Effect 'moon_figure': expected `radius` > 0, got 0.0 km"),
+    ({"radius": -1e-5}, "Effect 'moon_figure': expected `radius` as a Quantity"),
+    ({"j2": np.nan}, "Effect 'moon_figure': Expected `j2` to be finite, got nan"),
+    ({"c22": "x"}, "Effect 'moon_figure': Expected `c22` to be numeric"),
+    ({"inclination_deg": np.nan},
+     "Effect 'moon_figure': Expected `inclination_deg` to be finite, got nan"),
+    ({"inclination_deg": 1 * u.m},
+     "Effect 'moon_figure': Expected `inclination_deg` to be an angle"),
+    ({"radius": "1738 kg"}, "Effect 'moon_figure': Expected `radius` to be a length"),
+    ({"radius": "big"}, "Effect 'moon_figure': cannot read `radius` = 'big' as a number with "
+                        "a unit (e.g. '6378.1366 km')"),
+    ({"moon": "earth"}, "Effect 'moon_figure': `moon` and `earth` name one body, 'earth'"),
+])
+def test_moon_figure_refuses_bad_parameters(params, message):
+    """A negative radius ran; NaN J2 or inclination stopped with "(a collision?)"."""
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon"])
+    with pytest.raises(ValueError, match=re.escape(message)):
+        integrate(s, 1 * u.day, effects=[{"name": "moon_figure", **params}])
+
+
+def test_moon_figure_takes_its_radius_and_inclination_in_any_unit():
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon"])
+    spec = fx.get("nbody", "moon_figure")
+    p = spec.params(s, {"radius": 1738 * u.km, "inclination_deg": 5552.64 * u.arcsec})
+    assert np.allclose(p, spec.params(s, {}), rtol=1e-15, atol=0)
+    assert spec.params(s, {"inclination_deg": "1.5424 deg"})[-1] == spec.params(s, {})[-1]
+
+
+@pytest.mark.parametrize(("effect", "params", "message"), [
+    ("earth_tides", {"omega": np.nan}, "Effect 'earth_tides': expected `omega` as a Quantity"),
+    ("earth_tides", {"omega": np.nan * u.rad / u.s},
+     "Effect 'earth_tides': Expected `omega` to be finite, got nan"),
+    ("earth_tides", {"tau": [0.07, 0, 0, 0, 0]},
+     "Effect 'earth_tides': expected `tau` as a Quantity (a time"),
+    ("earth_tides", {"tau": ["0.07 d"] * 4},
+     "Effect 'earth_tides': expected `tau` to be 5 finite numbers"),
+    ("earth_tides", {"tau": ["0.07 d", 1, 0, 0, 0]},
+     "Effect 'earth_tides': expected `tau` to be values of one dimension"),
+    ("lense_thirring", {"c": 0}, "Effect 'lense_thirring': expected `c` as a Quantity"),
+    ("lense_thirring", {"c": 0 * u.km / u.s},
+     "Effect 'lense_thirring': expected `c` > 0, got 0.0 km / s"),
+    ("lense_thirring", {"gamma": np.inf}, "Effect 'lense_thirring': Expected `gamma` to be "
+                                          "finite, got inf"),
+    ("lense_thirring", {"spin": [0, 0, 1e-7]},
+     "Effect 'lense_thirring': expected `spin` as a Quantity (an angular momentum per unit mass"),
+    ("kuiper_ring", {"gm": 1e-11}, "Effect 'kuiper_ring': expected `gm` as a Quantity"),
+    ("kuiper_ring", {"gm": -1e-11 * u.au**3 / u.d**2},
+     "Effect 'kuiper_ring': expected `gm` >= 0, got -1e-11 AU3 / d2"),
+    ("kuiper_ring", {"radius": "44 d"}, "Effect 'kuiper_ring': Expected `radius` to be a length"),
+    ("eih", {"c": -1 * u.km / u.s}, "Effect 'eih': expected `c` > 0, got -1.0 km / s"),
+    ("eih", {"beta": np.nan}, "Effect 'eih': Expected `beta` to be finite, got nan"),
+    ("eih", {"sources": 3}, "Effect 'eih': expected `sources` to be a list of body names"),
+    ("zonal", {"j": ["x"]}, "Effect 'zonal': Expected `j` to be numeric, got ['x']"),
+    ("zonal", {"j": [np.nan]}, "Effect 'zonal': expected `j` to be some finite number(s), "
+                               "got [nan]"),
+    ("earth_tides", {"k2": [0.3, 0.3, 0.3] * u.km},
+     "Effect 'earth_tides': Expected `k2` to be dimensionless, got km"),
+    ("earth_tides", {"omega": "fast"}, "Effect 'earth_tides': cannot read `omega` = 'fast' as "
+                                       "a number with a unit (e.g. '7.292115e-5 rad/s')"),
+    ("kuiper_ring", {"normal": ["a", 0, 1]},
+     "Effect 'kuiper_ring': Expected `normal` to be numeric, got ['a', 0, 1]"),
+])
+def test_solar_system_effects_refuse_bad_parameters(effect, params, message):
+    """NaN omega and c = 0 stopped with "(a collision?)"; Quantities gave a bare TypeError."""
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon", "neptune"])
+    with pytest.raises(ValueError, match=re.escape(message)):
+        integrate(s, 1 * u.day, effects=[{"name": effect, **params}])
+
+
+def test_solar_system_effects_take_quantities_in_any_unit():
+    """Each dimensioned default, given back as a Quantity in other units, is the default."""
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon", "neptune"])
+    c = 299792.458 * u.km / u.s
+    day = u.day.to(u.s)
+    tau = [de.constant(k) * day for k in ("TAUE0", "TAUE1", "TAUE2", "TAUER1", "TAUER2")]
+    cases = {
+        "lense_thirring": {"c": c, "spin": sun_spin() * (u.au**2 / u.d).to(u.km**2 / u.s)
+                           * u.km**2 / u.s},
+        "kuiper_ring": {"gm": kuiper_ring_gm() * (u.au**3 / u.d**2).to(u.km**3 / u.s**2)
+                        * u.km**3 / u.s**2, "radius": 44 * u.au.to(u.km) * u.km},
+        "earth_tides": {"omega": 7.292115e-5 * u.rad / u.s, "tau": tau * u.s,
+                        "radius": "6378.1366 km"},
+    }
+    for name, params in cases.items():
+        spec = fx.get("nbody", name)
+        assert np.allclose(spec.params(s, params), spec.params(s, {}), rtol=1e-14, atol=0), name
+
+
+def test_a_plain_float_system_refuses_quantities_for_the_solar_system_effects():
+    s = System([Body("earth", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("moon", 0.01, [60, 0, 0], [0, 0.13, 0.01])])
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'moon_figure': expected `radius` as a plain number in the units of the "
+            "system (a system of plain floats), got the Quantity 1738.0 km (effects[0])")):
+        s.accelerations([{"name": "moon_figure", "radius": 1738 * u.km, "frame": "icrs"}])
+
+
+def test_earth_tides_refuses_a_sun_not_in_the_system():
+    """``sun="Sun"`` silently dropped the solar tide (issue 32); ``"none"`` leaves it out
+    on purpose, and the Sun's tide is there by default."""
+    s = System.from_ephemeris(bodies=["sun", "earth", "moon"])
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'earth_tides': `sun` names body 'Sun', which is not in the system (did you "
+            "mean 'sun'?); bodies: sun, earth, moon (effects[0])")):
+        s.accelerations([{"name": "earth_tides", "sun": "Sun"}])
+    base = _accelerations(s, [])
+    both = _accelerations(s, ["earth_tides"])[2] - base[2]
+    lunar = _accelerations(s, [{"name": "earth_tides", "sun": "none"}])[2] - base[2]
+    assert fx.get("nbody", "earth_tides").params(s, {})[2] == 0  # the Sun's index
+    assert fx.get("nbody", "earth_tides").params(s, {"sun": None})[2] == -1
+    # the solar tide is a part of the whole: smaller than the lunar, not nothing
+    assert 1e-3 < np.linalg.norm(both - lunar) / np.linalg.norm(lunar) < 1.0
+
+
+@pytest.mark.parametrize("other", ["gr", "gr_potential",
+                                   {"name": "gr", "c": C_AU_DAY * u.au / u.d}])
+def test_eih_refuses_gr_beside_it(other):
+    """``["eih", "gr"]`` counted the 1PN terms twice (issue 32)."""
+    s = System.from_ephemeris(bodies=["sun", "mercury"])
+    name = other if isinstance(other, str) else other["name"]
+    with pytest.raises(ValueError, match=re.escape(
+            f"Effect {name!r} (at index 1) is refused beside 'eih' (at index 0): 'eih' already "
+            "computes")):
+        integrate(s, 1 * u.day, effects=["eih", other])
+    with pytest.raises(ValueError, match=re.escape(f"Effect {name!r} (at index 0) is refused "
+                                                   "beside 'eih' (at index 2)")):
+        integrate(s, 1 * u.day, effects=[other, "newtonian", "eih"])
+
+
+def test_moon_figure_on_an_ecliptic_earth_and_moon_without_the_sun():
+    """Without the Sun the frame was not recognised and the ICRS's ecliptic pole was used
+    on ecliptic axes (27% of the effect wrong): it is recognised from the Earth's and
+    the Moon's DE440 poles, and the effect is the ICRS one rotated."""
+    rot = de.frame_rotation("ecliptic")
+    out = {}
+    for frame in ("icrs", "ecliptic"):
+        s = System.from_ephemeris(bodies=["earth", "moon"], frame=frame)
+        assert fx.parameters.axes_frame(s, {}, "moon_figure") == frame
+        out[frame] = _alone(s, "moon_figure", {})
+    scale = np.abs(out["icrs"]).max()
+    assert np.abs(out["ecliptic"] - out["icrs"] @ rot.T).max() < 1e-12 * scale
+
+
+def test_an_unknown_frame_whose_orbits_lie_in_x_y_asks_for_frame():
+    """``System.solar_system(frame="ecliptic")`` has no poles to recognise its axes by;
+    the ring's normal was put along the ICRS's ecliptic pole, 23.4 deg off.  Now the
+    effect asks for ``frame``; given, it is the ICRS one rotated."""
+    ecl = System.solar_system(bodies=["sun", "jupiter", "neptune"], frame="ecliptic")
+    with pytest.raises(ValueError, match=re.escape(
+            "Effect 'kuiper_ring': expected `frame` ('icrs' or 'ecliptic'): the system's axes "
+            "are not known")):
+        ecl.accelerations(["kuiper_ring"])
+    icrs = System.solar_system(bodies=["sun", "jupiter", "neptune"])
+    a_icrs = _alone(icrs, "kuiper_ring", {})  # ICRS axes: taken as such, as before
+    a_ecl = _alone(ecl, "kuiper_ring", {"frame": "ecliptic"})
+    rot = de.frame_rotation("ecliptic")
+    assert np.abs(a_ecl - a_icrs @ rot.T).max() < 1e-12 * np.abs(a_icrs).max()

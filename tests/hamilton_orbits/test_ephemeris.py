@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -175,3 +177,54 @@ def test_asteroid_share_of_the_belt():
     belt = sum(v for k, v in c.items() if k.startswith("MA") and not k.startswith("MA8"))
     ours = sum(de.gm(name) for name in de.ASTEROIDS)
     assert ours / belt == pytest.approx(0.716, abs=0.001)
+
+
+# ------------------------------------------------------------------ issue 32, class 4
+
+
+def test_from_ephemeris_refuses_the_earth_moon_barycentre_beside_the_earth_or_the_moon():
+    """Its GM is the Earth's and the Moon's: with them it counted that mass twice (as
+    ``System.solar_system`` already refused)."""
+    msg = ("Expected either 'earth-moon-barycenter' or 'earth' and 'moon' in `bodies`, got both "
+           "('earth-moon-barycenter' at index 3, 'earth' at index 1): the barycentre holds the "
+           "Earth and the Moon, whose mass would count twice")
+    with pytest.raises(ValueError, match=re.escape(msg)):
+        System.from_ephemeris(bodies=["sun", "earth", "moon", "earth-moon-barycenter"])
+    with pytest.raises(ValueError, match=r"'moon' at index 0\): the barycentre"):
+        System.from_ephemeris(bodies=["moon", "earth-moon-barycenter"])
+    # alone, the barycentre carries both masses once: DE440's GMB
+    s = System.from_ephemeris(bodies=["sun", "earth-moon-barycenter"])
+    assert s.gm.to_value(u.au**3 / u.day**2)[1] == de.constant("GMB")
+    pair = System.from_ephemeris(bodies=["earth", "moon"]).gm.to_value(u.au**3 / u.day**2)
+    assert pair.sum() == pytest.approx(de.constant("GMB"), rel=1e-15)
+
+
+def test_from_ephemeris_takes_one_name_and_names_what_it_refuses():
+    """``bodies="sun"`` said "Unknown DE440 body 's'" (its letters were read as names)."""
+    assert System.from_ephemeris(bodies="sun").names == ("sun",)
+    assert System.from_ephemeris(bodies=["Sun", " Mars "]).names == ("sun", "mars")
+    with pytest.raises(ValueError, match=re.escape(
+            "Unknown DE440 body 'jupyter' at index 1 of `bodies` (did you mean 'jupiter'?)")):
+        System.from_ephemeris(bodies=["sun", "jupyter"])
+    with pytest.raises(ValueError, match=re.escape(
+            "Expected `bodies` to name each body once, got 'Sun' at indices 0 and 1")):
+        System.from_ephemeris(bodies=["sun", "Sun"])
+    with pytest.raises(ValueError, match=re.escape(
+            "Expected `bodies` to hold names, got None at index 1")):
+        System.from_ephemeris(bodies=["sun", None])
+    with pytest.raises(ValueError, match=r"Expected `bodies` to name at least one body"):
+        System.from_ephemeris(bodies=[])
+    with pytest.raises(ValueError, match=r"Expected `bodies` to be a list of names, got 3"):
+        System.from_ephemeris(bodies=3)
+
+
+def test_the_poles_from_ephemeris_gives_are_ephemeris_pole():
+    """The poles the Sun, the Earth and the Moon carry (normalised by Body: to rounding),
+    by which the effects recognise the frame (``effects.parameters.axes_frame``)."""
+    for frame in ("icrs", "ecliptic"):
+        s = System.from_ephemeris(bodies=["sun", "earth", "moon"], frame=frame)
+        for name in ("sun", "earth", "moon"):
+            assert np.allclose(s[name].pole, de.pole(name, frame), rtol=0, atol=1e-15)
+    # the Earth's pole in ecliptic axes is the ICRS z rotated: 23.44 deg from the z axis
+    tilt = np.degrees(np.arccos(de.pole("earth", "ecliptic")[2])) * 3600
+    assert tilt == pytest.approx(84381.406, abs=1e-6)

@@ -33,7 +33,7 @@ module                     holds
 =========================  ===================================================
 ``effects.registry``       :class:`EffectSpec`, :func:`register`, :func:`get`,
                            :func:`known`, :class:`EffectSet`, normalisation,
-                           the entry points
+                           :func:`exclusion_problems`, the entry points
 ``effects.parameters``     :func:`source_index`, :func:`parameter_value`,
                            :func:`speed_of_light`, DE440's defaults
 ``effects.energy``         :func:`effect_energy`, :func:`energy_label`
@@ -79,6 +79,7 @@ from hamilton_orbits.effects.registry import (
     EffectSet,
     EffectSpec,
     entry_problems,
+    exclusion_problems,
     get,
     known,
     normalize_effects,
@@ -93,6 +94,7 @@ __all__ = [
     "effect_energy",
     "energy_label",
     "entry_problems",
+    "exclusion_problems",
     "get",
     "known",
     "normalize_effects",

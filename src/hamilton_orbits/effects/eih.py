@@ -2,7 +2,8 @@
 
 Newtonian gravity plus its first post-Newtonian correction, PPN beta = gamma = 1
 as DE440 has them, *replacing* Newtonian gravity (``replaces_newtonian``: the
-right-hand side starts from zero); do not list ``gr`` with it.  Kernel
+right-hand side starts from zero); ``gr`` and ``gr_potential`` are refused beside
+it (their terms are in it already).  Kernel
 :func:`~hamilton_orbits._kernels.relativity.eih`; no analytic Jacobian (three
 pages of terms): the variational equations differentiate the kernel by compiled
 central differences (:mod:`hamilton_orbits.rhs`).  ``p = [c, beta, gamma,
@@ -31,24 +32,25 @@ from hamilton_orbits.effects.parameters import (
     body_index,
     de440_c_au_per_day,
     require_de440_units,
+    scalar_parameter,
 )
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import DIMENSIONLESS, SPEED
 
 __all__ = ["SPECS", "eih_energy"]
 
 
 def _params_eih(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     require_de440_units(system, params, "eih", ("c",))
-    c = float(params.get("c", de440_c_au_per_day()))
-    beta = float(params.get("beta", de.constant("BETA")))
-    gamma = float(params.get("gamma", de.constant("GAMMA")))
-    if not (np.isfinite(c) and c > 0 and np.isfinite(beta) and np.isfinite(gamma)):
-        raise ValueError(f"Effect 'eih': expected c > 0 and finite beta, gamma; got "
-                         f"{c!r}, {beta!r}, {gamma!r}")
+    c = scalar_parameter(system, params, "c", "eih", SPEED, de440_c_au_per_day(),
+                         positive=True)
+    beta = scalar_parameter(system, params, "beta", "eih", DIMENSIONLESS, de.constant("BETA"))
+    gamma = scalar_parameter(system, params, "gamma", "eih", DIMENSIONLESS,
+                             de.constant("GAMMA"))
     sources: list[int] = []
     if "sources" in params:
         names = params["sources"]
-        if isinstance(names, str) or not all(isinstance(x, str) for x in names):
+        if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
             raise ValueError(f"Effect 'eih': expected `sources` to be a list of body names, "
                              f"got {names!r}")
         sources = [body_index(system, {"sources": x}, "sources", "", "eih") for x in names]
@@ -62,12 +64,15 @@ SPECS = (
         name="eih", kind="nbody",
         summary="Einstein-Infeld-Hoffmann 1PN n-body gravity (replaces Newtonian; radau15)",
         velocity_dependent=True, replaces_newtonian=True,
-        parameters={"c": "speed of light (default DE440's CLIGHT in au/day)",
+        parameters={"c": "speed of light, a speed (default DE440's CLIGHT)",
                     "beta": "PPN beta (default DE440's, 1)",
                     "gamma": "PPN gamma (default DE440's, 1)",
                     "sources": "bodies whose 1PN field is computed (default every "
                                "massive body; the others act by Newton's law)"},
         kernel=eih, params=_params_eih,
+        parameter_kinds={"c": SPEED, "beta": DIMENSIONLESS, "gamma": DIMENSIONLESS},
+        excludes={"gr": "the first post-Newtonian terms of the dominant body",
+                  "gr_potential": "the relativistic perihelion advance"},
         reference=f"Moyer (2003), DESCANSO monograph 2, eq. 4-26; {PARK_2021}",
     ),
 )

@@ -22,13 +22,16 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import ring_field
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     axes_frame,
     body_index,
     require_de440_units,
+    scalar_parameter,
     unit_vector,
 )
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import GM, LENGTH
 
 __all__ = ["KUIPER_RING_RADIUS_AU", "SPECS", "kuiper_ring_gm"]
 
@@ -51,11 +54,10 @@ def kuiper_ring_gm() -> float:
 def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     b = body_index(system, params, "centre", "sun", "kuiper_ring")
     require_de440_units(system, params, "kuiper_ring", ("gm", "radius"))
-    big_m = float(params.get("gm", kuiper_ring_gm()))
-    radius = float(params.get("radius", KUIPER_RING_RADIUS_AU))
-    if not (big_m >= 0 and radius > 0):
-        raise ValueError(f"Effect 'kuiper_ring': expected gm >= 0 and radius > 0, got "
-                         f"{big_m!r}, {radius!r}")
+    big_m = scalar_parameter(system, params, "gm", "kuiper_ring", GM, kuiper_ring_gm(),
+                             nonnegative=True)
+    radius = scalar_parameter(system, params, "radius", "kuiper_ring", LENGTH,
+                              KUIPER_RING_RADIUS_AU, positive=True)
     normal = (unit_vector("normal", params["normal"], "kuiper_ring") if "normal" in params
               else de.ecliptic_pole(axes_frame(system, params, "kuiper_ring")))
     return np.array([b, big_m, radius, *normal])
@@ -65,10 +67,11 @@ SPECS = (
     EffectSpec(
         name="kuiper_ring", kind="nbody",
         summary="the Kuiper belt as DE440's ring (44 au, ecliptic, centred on the Sun)",
-        parameters={"centre": "default 'sun'", "gm": "default DE440's 36 ring masses",
-                    "radius": "default 44 au", "normal": "default the ecliptic pole",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+        parameters={"centre": "default 'sun'", "gm": "a GM (default DE440's 36 ring masses)",
+                    "radius": "a length (default 44 au)", "normal": "default the ecliptic pole",
+                    "frame": FRAME_PARAMETER},
         kernel=ring_field, params=_params_kuiper_ring,
+        parameter_kinds={"gm": GM, "radius": LENGTH}, name_parameters=("centre",),
         reference=f"{PARK_2021}, section 3 (ring masses MA8201..MA8236)",
     ),
 )

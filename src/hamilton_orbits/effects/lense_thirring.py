@@ -23,14 +23,18 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.jacobians import lense_thirring_jvp
 from hamilton_orbits._kernels.relativity import lense_thirring
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
+    SPECIFIC_ANGULAR_MOMENTUM,
     axes_frame,
     body_index,
     de440_c_au_per_day,
-    finite_floats,
+    parameter_array,
     require_de440_units,
+    scalar_parameter,
 )
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import DIMENSIONLESS, SPEED
 
 __all__ = ["SPECS", "sun_spin"]
 
@@ -56,10 +60,16 @@ def _params_lense_thirring(system: Any, params: Mapping[str, Any]) -> np.ndarray
     require_de440_units(system, params, "lense_thirring", ("c", "spin"))
     if system.names[b] != "sun" and "spin" not in params:
         raise ValueError("Effect 'lense_thirring': a body other than the Sun needs `spin`")
-    spin = (finite_floats("spin", params["spin"], 3, "lense_thirring") if "spin" in params
-            else sun_spin(axes_frame(system, params, "lense_thirring")))
-    c = float(params.get("c", de440_c_au_per_day()))
-    gamma = float(params.get("gamma", de.constant("GAMMA")))
+    spin = parameter_array(system, params, "spin", "lense_thirring", SPECIFIC_ANGULAR_MOMENTUM)
+    if spin is None:
+        spin = sun_spin(axes_frame(system, params, "lense_thirring"))
+    elif spin.shape != (3,):
+        raise ValueError(f"Effect 'lense_thirring': expected `spin` to be 3 finite numbers, "
+                         f"got {params['spin']!r}")
+    c = scalar_parameter(system, params, "c", "lense_thirring", SPEED, de440_c_au_per_day(),
+                         positive=True)
+    gamma = scalar_parameter(system, params, "gamma", "lense_thirring", DIMENSIONLESS,
+                             de.constant("GAMMA"))
     return np.array([b, c, gamma, *spin])
 
 
@@ -71,9 +81,13 @@ SPECS = (
         parameters={"body": "default 'sun'",
                     "spin": "angular momentum per unit mass (default DE440's "
                             "MOISUN ASUN^2 OMGSUN about the IAU pole)",
-                    "c": "default DE440's CLIGHT", "gamma": "default DE440's GAMMA",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+                    "c": "speed of light, a speed (default DE440's CLIGHT)",
+                    "gamma": "default DE440's GAMMA",
+                    "frame": FRAME_PARAMETER},
         kernel=lense_thirring, params=_params_lense_thirring,
+        parameter_kinds={"spin": SPECIFIC_ANGULAR_MOMENTUM, "c": SPEED,
+                         "gamma": DIMENSIONLESS},
+        name_parameters=("body",),
         jacobian=lense_thirring_jvp,
         reference=f"IERS Conventions (2010), eq. 10.12; {PARK_2021}",
     ),

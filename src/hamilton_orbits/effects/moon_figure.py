@@ -27,12 +27,16 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import moon_figure
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     axes_frame,
     body_index,
+    distinct_bodies,
     require_de440_units,
+    scalar_parameter,
 )
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, LENGTH
 
 __all__ = ["MOON_EQUATOR_INCLINATION_DEG", "SPECS"]
 
@@ -45,11 +49,16 @@ MOON_EQUATOR_INCLINATION_DEG = 1.5424
 def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     m = body_index(system, params, "moon", "moon", "moon_figure")
     e = body_index(system, params, "earth", "earth", "moon_figure")
+    distinct_bodies(system, {"moon": m, "earth": e}, "moon_figure")
     require_de440_units(system, params, "moon_figure", ("radius",))
-    radius = float(params.get("radius", de.constant("AM") / de.constant("AU")))
-    j2 = float(params.get("j2", de.constant("J2M")))
-    c22 = float(params.get("c22", de.constant("C22M")))
-    inc = np.deg2rad(float(params.get("inclination_deg", MOON_EQUATOR_INCLINATION_DEG)))
+    radius = scalar_parameter(system, params, "radius", "moon_figure", LENGTH,
+                              de.constant("AM") / de.constant("AU"), positive=True)
+    j2 = scalar_parameter(system, params, "j2", "moon_figure", DIMENSIONLESS,
+                          de.constant("J2M"))
+    c22 = scalar_parameter(system, params, "c22", "moon_figure", DIMENSIONLESS,
+                           de.constant("C22M"))
+    inc = np.deg2rad(scalar_parameter(system, params, "inclination_deg", "moon_figure", ANGLE,
+                                      MOON_EQUATOR_INCLINATION_DEG))
     pole = de.ecliptic_pole(axes_frame(system, params, "moon_figure"))
     return np.array([m, e, radius, j2, c22, *pole, inc])
 
@@ -61,11 +70,13 @@ SPECS = (
         # its axes follow the orbit normal, from the Earth-Moon relative velocity
         velocity_dependent=True,
         parameters={"moon": "default 'moon'", "earth": "default 'earth'",
-                    "radius": "default DE440's AM", "j2": "default DE440's J2M",
+                    "radius": "a length (default DE440's AM)", "j2": "default DE440's J2M",
                     "c22": "default DE440's C22M",
-                    "inclination_deg": "lunar equator to ecliptic (default 1.5424)",
-                    "frame": "'icrs' or 'ecliptic' (default: from the Sun's pole)"},
+                    "inclination_deg": "lunar equator to ecliptic, degrees (default 1.5424)",
+                    "frame": FRAME_PARAMETER},
         kernel=moon_figure, params=_params_moon_figure,
+        parameter_kinds={"radius": LENGTH, "j2": DIMENSIONLESS, "c22": DIMENSIONLESS},
+        name_parameters=("moon", "earth"),
         reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 28; {PARK_2021}",
     ),
 )

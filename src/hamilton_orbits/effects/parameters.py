@@ -4,13 +4,33 @@ Every built-in effect's parameter builder (``params(system, mapping) ->
 ndarray``) reads its mapping with these helpers, so that a body name, a speed of
 light or a length is read, refused and reported the same way by every effect:
 
-- :func:`source_index`, :func:`body_index`: the index of the body a parameter names;
-- :func:`parameter_value`, :func:`speed_of_light`: a scalar with a dimension, a
-  Quantity for a Quantity system and a plain number in the system's own units
-  otherwise;
+- :func:`source_index`, :func:`body_index`, :func:`optional_body_index`: the
+  index of the body a parameter names;
+- :func:`parameter_value`, :func:`parameter_array`, :func:`scalar_parameter`,
+  :func:`speed_of_light`: numbers with a dimension (:data:`SYSTEM_UNITS`);
 - DE440's defaults (the solar-system effects): :func:`require_de440_units`,
   :func:`finite_floats`, :func:`unit_vector`, :func:`axes_frame`,
   :func:`body_pole`, :func:`de440_c_au_per_day`.
+
+The unit rule (``docs/effects.md``)
+-----------------------------------
+A parameter with a dimension (a length, a speed, a time, a GM, a rotation rate,
+a spin: the effect's ``parameter_kinds``) is
+
+- for a system of Quantities: a Quantity of that dimension, or a string that
+  reads as one (``"299792.458 km/s"``), converted to the system's internal
+  units (au, au/day, day, au^3/day^2, rad/day, au^2/day); a bare number is
+  refused (``c = 1.0`` cannot say whether it is au/day or km/s: it was once read
+  as au/day, and a radius of 6378 as 6378 au);
+- for a system of plain floats: a bare number in the system's own units (those
+  of its positions, velocities and GMs); a Quantity is refused (the system has
+  no unit to convert it to);
+- a dimensionless parameter (J2, C22, Love numbers, PPN beta and gamma) is a
+  bare number; an angle named ``..._deg`` is a bare number of degrees or a
+  Quantity of any angular unit.
+
+Every value must be finite; a refusal names the effect, its index in the list,
+the parameter, the value and the unit expected.
 """
 
 from __future__ import annotations
@@ -21,20 +41,38 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits import ephemeris as de
-from hamilton_orbits.units import DIMENSIONLESS, LENGTH, SPEED, Kind, is_quantity
+from hamilton_orbits.units import (
+    ANGLE,
+    ANGULAR_SPEED,
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    SPEED,
+    TIME,
+    Kind,
+    is_quantity,
+)
 
 __all__ = [
     "C_AU_PER_DAY",
+    "FRAME_PARAMETER",
     "PARK_2021",
+    "SPECIFIC_ANGULAR_MOMENTUM",
+    "SYSTEM_UNITS",
     "axes_frame",
     "body_index",
     "body_pole",
     "de440_c_au_per_day",
+    "distinct_bodies",
     "finite_floats",
+    "optional_body_index",
+    "parameter_array",
     "parameter_value",
     "require_de440_units",
+    "scalar_parameter",
     "source_index",
     "speed_of_light",
+    "unit_example",
     "unit_vector",
 ]
 
@@ -70,28 +108,128 @@ def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) 
     return idx
 
 
-# the internal units of a Quantity system (hamilton_orbits.nbody: au, day)
-_SYSTEM_UNITS = {LENGTH: "au", SPEED: "au / d", DIMENSIONLESS: ""}
+#: A spin: an angular momentum per unit mass (``lense_thirring``'s ``spin``).
+SPECIFIC_ANGULAR_MOMENTUM = Kind("an angular momentum per unit mass", "m2 / s")
+
+#: The internal unit of each dimension for a system of Quantities
+#: (:mod:`hamilton_orbits.nbody`: au and days), to which a Quantity parameter is
+#: converted; a system of plain floats takes bare numbers in its own units.
+SYSTEM_UNITS: dict[Kind, str] = {
+    LENGTH: "au", SPEED: "au / d", TIME: "d", GM: "au3 / d2", ANGULAR_SPEED: "rad / d",
+    SPECIFIC_ANGULAR_MOMENTUM: "au2 / d",
+}
+
+
+def _shown(value: Any) -> str:
+    text = repr(value) if not is_quantity(value) else str(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _with_units(value: Any, key: str, effect: str, kind: Kind) -> Any:
+    """``value`` with a string read as a Quantity (``"6378 km"``), and a list holding
+    Quantities or strings as one Quantity array."""
+    import astropy.units as u
+
+    def one(x: Any) -> Any:
+        if not isinstance(x, str):
+            return x
+        try:
+            return u.Quantity(x)
+        except (TypeError, ValueError):
+            raise ValueError(f"Effect {effect!r}: cannot read `{key}` = {value!r} as a number "
+                             f"with a unit (e.g. '{unit_example(kind)}')") from None
+
+    if isinstance(value, str):
+        return one(value)
+    if isinstance(value, (list, tuple)) and any(isinstance(x, str) or is_quantity(x)
+                                                for x in value):
+        try:
+            return u.Quantity([one(x) for x in value])
+        except (TypeError, ValueError):  # UnitConversionError included
+            raise ValueError(f"Effect {effect!r}: expected `{key}` to be values of one "
+                             f"dimension, each with its unit, got {_shown(value)}") from None
+    return value
+
+
+def parameter_array(system: Any, params: Mapping[str, Any], key: str, effect: str,
+                    kind: Kind) -> np.ndarray | None:
+    """Parameter ``key`` of mapping ``params`` as a float array in ``system``'s own
+    units, or None if it is not given (the unit rule of the module's notes).
+
+    One rule for every dimensioned parameter of every effect: a Quantity of
+    ``kind`` (or a string that reads as one) for a Quantity system, converted to
+    :data:`SYSTEM_UNITS`; a bare number in the caller's own units for a system of
+    plain floats; a bare number for a Quantity system and a Quantity for a system
+    of plain floats are refused (a unit cannot be guessed, nor dropped).  A
+    dimensionless parameter takes a bare number; an angle (``kind`` ANGLE) a bare
+    number of degrees or an angle Quantity, for either system.
+
+    Raises
+    ------
+    ValueError
+        For the wrong kind of value or a value that is not finite, naming the
+        effect, the parameter and the value.
+    astropy.units.UnitConversionError
+        For a Quantity of the wrong dimension.
+
+    Examples
+    --------
+    >>> import astropy.units as u
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("a", 1.0 * u.au**3 / u.d**2, [0, 0, 0] * u.au, [0, 0, 0] * u.au / u.d)])
+    >>> parameter_array(s, {"tau": ["0.5 d", 12 * u.h]}, "tau", "earth_tides", TIME).tolist()
+    [0.5, 0.5]
+    """
+    if key not in params:
+        return None
+    value = params[key]
+    if kind is not DIMENSIONLESS:
+        value = _with_units(value, key, effect, kind)
+    if kind is ANGLE:
+        unit = "deg"  # the parameter's name says degrees (inclination_deg)
+    elif kind is DIMENSIONLESS:
+        unit = ""
+    else:
+        if system.quantity and not is_quantity(value):
+            raise ValueError(
+                f"Effect {effect!r}: expected `{key}` as a Quantity ({kind.name}, convertible "
+                f"to {kind.unit}; e.g. a string such as '{unit_example(kind)}') for a system of "
+                f"Quantities, got the plain number {_shown(value)}")
+        if not system.quantity and is_quantity(value):
+            raise ValueError(
+                f"Effect {effect!r}: expected `{key}` as a plain number in the units of the "
+                f"system (a system of plain floats), got the Quantity {_shown(value)}")
+        unit = SYSTEM_UNITS[kind] if system.quantity else None
+    try:
+        return kind(key, value, unit)
+    except ValueError as exc:  # UnitConversionError included
+        raise type(exc)(f"Effect {effect!r}: {exc}") from None
+
+
+def unit_example(kind: Kind) -> str:
+    """A value of ``kind`` with its unit, for messages (``"6378.1366 km"``).
+
+    Examples
+    --------
+    >>> unit_example(SPEED)
+    '299792.458 km/s'
+    """
+    return {LENGTH: "6378.1366 km", SPEED: "299792.458 km/s", TIME: "0.5 d",
+            GM: "398600.4418 km3/s2", ANGULAR_SPEED: "7.292115e-5 rad/s",
+            SPECIFIC_ANGULAR_MOMENTUM: "1e-7 au2/d", ANGLE: "1.5424 deg"}.get(
+                kind, f"1 {kind.unit}")
 
 
 def parameter_value(system: Any, params: Mapping[str, Any], key: str, effect: str,
                     kind: Kind) -> float | None:
     """The scalar parameter ``key`` of mapping ``params`` in ``system``'s own units,
-    or None if it is not given.
-
-    One rule for every dimensioned parameter of every effect: a Quantity of
-    ``kind`` for a Quantity system (converted to au, au/day), a plain number in
-    the caller's own units for a system of plain floats; a plain number for a
-    Quantity system and a Quantity for a system of plain floats are refused (a
-    unit cannot be guessed, nor dropped).  A dimensionless parameter takes either.
+    or None if it is not given (see :func:`parameter_array`).
 
     Raises
     ------
     ValueError
-        For the wrong kind of value, a value that is not one finite number,
-        naming the effect, the parameter and the value.
-    astropy.units.UnitConversionError
-        For a Quantity of the wrong dimension.
+        As :func:`parameter_array` (an ``astropy.units.UnitConversionError``
+        for the wrong dimension), and for more than one number.
 
     Examples
     --------
@@ -105,27 +243,38 @@ def parameter_value(system: Any, params: Mapping[str, Any], key: str, effect: st
     ...
     ValueError: Effect 'gr': expected `c` as a plain number in the units of the system ...
     """
-    if key not in params:
+    arr = parameter_array(system, params, key, effect, kind)
+    if arr is None:
         return None
-    value = params[key]
-    if kind is not DIMENSIONLESS:
-        if system.quantity and not is_quantity(value):
-            raise ValueError(
-                f"Effect {effect!r}: expected `{key}` as a Quantity ({kind.name}, convertible "
-                f"to {kind.unit}) for a system of Quantities, got the plain number {value!r}")
-        if not system.quantity and is_quantity(value):
-            raise ValueError(
-                f"Effect {effect!r}: expected `{key}` as a plain number in the units of the "
-                f"system (a system of plain floats), got the Quantity {value}")
-    unit = _SYSTEM_UNITS[kind] if system.quantity else None
-    try:
-        arr = kind(key, value, unit)
-    except ValueError as exc:  # UnitConversionError included
-        raise type(exc)(f"Effect {effect!r}: {exc}") from None
     if arr.shape != ():
         raise ValueError(f"Effect {effect!r}: expected `{key}` to be one number, got "
-                         f"{value!r} (shape {arr.shape})")
+                         f"{_shown(params[key])} (shape {arr.shape})")
     return float(arr)
+
+
+def scalar_parameter(system: Any, params: Mapping[str, Any], key: str, effect: str,
+                     kind: Kind, default: float, *, positive: bool = False,
+                     nonnegative: bool = False) -> float:
+    """:func:`parameter_value`, ``default`` when not given (in the system's units),
+    refusing a value that is not > 0 (``positive``) or not >= 0 (``nonnegative``).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("moon", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> scalar_parameter(s, {"radius": -1.0}, "radius", "moon_figure", LENGTH, 1.0,
+    ...                  positive=True)
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'moon_figure': expected `radius` > 0, got -1.0
+    """
+    value = parameter_value(system, params, key, effect, kind)
+    if value is None:
+        return float(default)
+    if (positive and not value > 0) or (nonnegative and not value >= 0):
+        raise ValueError(f"Effect {effect!r}: expected `{key}` {'>' if positive else '>='} 0, "
+                         f"got {_shown(params[key])}")
+    return value
 
 
 def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float:
@@ -159,6 +308,21 @@ def speed_of_light(system: Any, params: Mapping[str, Any], effect: str) -> float
 #: The source of DE440's models and constants.
 PARK_2021 = "Park et al. (2021), AJ 161, 105"
 
+#: What the ``frame`` parameter of the solar-system effects is (:func:`axes_frame`).
+FRAME_PARAMETER = ("the system's axes, 'icrs' or 'ecliptic' (default: a scene's [initial] "
+                   "frame, else recognised from DE440's poles, else 'icrs')")
+
+
+def _not_a_body(system: Any, key: str, name: Any, effect: str) -> ValueError:
+    import difflib
+
+    close = difflib.get_close_matches(str(name), system.names, n=3)
+    if not close:
+        close = [n for n in system.names if n.lower() == str(name).lower()]
+    hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+    return ValueError(f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the "
+                      f"system{hint}; bodies: {', '.join(system.names)}")
+
 
 def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
                effect: str) -> int:
@@ -174,12 +338,56 @@ def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
     1
     """
     name = params.get(key, default)
-    if name not in system.names:
-        raise ValueError(
-            f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
-            f"bodies: {', '.join(system.names)}"
-        )
+    if not isinstance(name, str) or name not in system.names:
+        raise _not_a_body(system, key, name, effect)
     return system.names.index(name)
+
+
+def optional_body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
+                        effect: str) -> int:
+    """The index of the body that mapping ``params`` names under ``key``, or -1 for
+    none: given as None or ``"none"``, or not given and no body is named ``default``.
+    A name given that is not in ``system`` is refused (``earth_tides``'s ``sun =
+    "Sun"`` once dropped the solar tide without a word).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("earth", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> optional_body_index(s, {}, "sun", "sun", "earth_tides")
+    -1
+    >>> optional_body_index(s, {"sun": "Sun"}, "sun", "sun", "earth_tides")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'earth_tides': `sun` names body 'Sun', which is not in the system; ...
+    """
+    if key not in params:
+        return system.names.index(default) if default in system.names else -1
+    name = params[key]
+    if name is None or name == "none":
+        return -1
+    return body_index(system, params, key, default, effect)
+
+
+def distinct_bodies(system: Any, indices: Mapping[str, int], effect: str) -> None:
+    """Refuse one body named by two of an effect's parameters (``indices``: parameter
+    -> body index, -1 for none).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("earth", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> distinct_bodies(s, {"earth": 0, "moon": 0}, "earth_tides")
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'earth_tides': `earth` and `moon` name one body, 'earth'
+    """
+    seen: dict[int, str] = {}
+    for key, b in indices.items():
+        if b >= 0 and b in seen:
+            raise ValueError(f"Effect {effect!r}: `{seen[b]}` and `{key}` name one body, "
+                             f"{system.names[b]!r}")
+        seen.setdefault(b, key)
 
 
 def require_de440_units(system: Any, params: Mapping[str, Any], effect: str,
@@ -203,12 +411,19 @@ def finite_floats(name: str, value: Any, size: int | None, effect: str) -> np.nd
     --------
     >>> finite_floats("k2", [0.3, 0.3, 0.3], 3, "earth_tides").tolist()
     [0.3, 0.3, 0.3]
+    >>> finite_floats("k2", ["a", 0.3, 0.3], 3, "earth_tides")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'earth_tides': Expected `k2` to be numeric...
     """
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    try:  # a string or a Quantity with a dimension: named, not "could not convert"
+        arr = np.atleast_1d(DIMENSIONLESS(name, value, finite=False))
+    except ValueError as exc:  # UnitConversionError included
+        raise type(exc)(f"Effect {effect!r}: {exc}") from None
     if arr.ndim != 1 or (size is not None and arr.shape[0] != size) or not np.all(
             np.isfinite(arr)):
         raise ValueError(f"Effect {effect!r}: expected `{name}` to be "
-                         f"{size or 'some'} finite number(s), got {value!r}")
+                         f"{size or 'some'} finite number(s), got {_shown(value)}")
     return arr
 
 
@@ -227,18 +442,70 @@ def unit_vector(name: str, value: Any, effect: str) -> np.ndarray:
     return k / norm
 
 
+def _frame_of_poles(system: Any) -> str | None:
+    """The frame recognised from a pole :meth:`System.from_ephemeris` gives the Sun,
+    the Earth or the Moon (:func:`hamilton_orbits.ephemeris.pole` in that frame), or
+    None."""
+    for name in ("sun", "earth", "moon"):
+        if name in system.names and system[name].pole is not None:
+            pole = np.array(system[name].pole)
+            for frame in ("icrs", "ecliptic"):
+                if np.allclose(pole, de.pole(name, frame), rtol=0, atol=1e-12):
+                    return frame
+    return None
+
+
+def _refuse_ecliptic_looking(system: Any, effect: str) -> None:
+    """Refuse to take as ICRS axes a system whose orbits lie near its x-y plane (its
+    angular momentum about the barycentre within 10 degrees of z, nearer z than the
+    ICRS's ecliptic pole): such axes are ecliptic ones, or the system is not the
+    solar system, and the effect's default directions (the ecliptic pole, the Sun's
+    and the Earth's poles) would be wrong by the obliquity."""
+    arrays = system.as_arrays()
+    gm = arrays.gm
+    if not gm.sum() > 0:
+        return
+    r = arrays.r - gm @ arrays.r / gm.sum()
+    v = arrays.v - gm @ arrays.v / gm.sum()
+    h = gm @ np.cross(r, v)
+    norm = float(np.linalg.norm(h))
+    if not (np.isfinite(norm) and norm > 0):
+        return
+    k = h / norm
+    to_z = float(np.degrees(np.arccos(np.clip(k[2], -1.0, 1.0))))
+    to_ecliptic = float(np.degrees(np.arccos(np.clip(k @ de.ecliptic_pole("icrs"), -1.0, 1.0))))
+    if to_z < 10.0 and to_z < to_ecliptic:
+        raise ValueError(
+            f"Effect {effect!r}: expected `frame` ('icrs' or 'ecliptic'): the system's axes "
+            f"are not known (no DE440 pole of the Sun, the Earth or the Moon to recognise "
+            f"them by), and its orbits lie {to_z:.1f} deg from its x-y plane, as in "
+            "ecliptic axes, not the ICRS's that the effect would take by default")
+
+
 def axes_frame(system: Any, params: Mapping[str, Any], effect: str) -> str:
-    """The frame of the system's axes: ``params["frame"]``, else recognised from the
-    Sun's pole that :meth:`System.from_ephemeris` sets (IAU pole in that frame), else
-    ``"icrs"``."""
+    """The frame of the system's axes, for an effect's default directions.
+
+    ``params["frame"]``; else recognised from a pole :meth:`System.from_ephemeris`
+    sets (the Sun's, the Earth's or the Moon's, :func:`hamilton_orbits.ephemeris.pole`
+    in that frame); else ``"icrs"``, unless the system's orbits lie near its x-y
+    plane (its angular momentum within 10 degrees of z): those are not ICRS axes
+    (the ecliptic is inclined 23.4 degrees to the ICRS's x-y plane), and a
+    ``ValueError`` asks for ``frame``.  A scene passes its ``[initial] frame``.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import System
+    >>> axes_frame(System.from_ephemeris(bodies=["earth", "moon"], frame="ecliptic"), {},
+    ...            "moon_figure")
+    'ecliptic'
+    """
     frame = params.get("frame")
     if frame is None:
-        frame = "icrs"
-        if "sun" in system.names and system["sun"].pole is not None:
-            pole = np.array(system["sun"].pole)
-            if np.allclose(pole, de.sun_pole("ecliptic"), rtol=0, atol=1e-12):
-                frame = "ecliptic"
-    if frame not in ("icrs", "ecliptic"):
+        frame = _frame_of_poles(system)
+        if frame is None:
+            _refuse_ecliptic_looking(system, effect)
+            frame = "icrs"
+    if not isinstance(frame, str) or frame not in ("icrs", "ecliptic"):
         raise ValueError(f"Effect {effect!r}: expected `frame` 'icrs' or 'ecliptic', "
                          f"got {frame!r}")
     return frame

@@ -28,6 +28,7 @@ __all__ = [
     "EffectSet",
     "EffectSpec",
     "entry_problems",
+    "exclusion_problems",
     "get",
     "known",
     "normalize_effects",
@@ -90,6 +91,10 @@ class EffectSpec:
         specific energy (per unit mass; zero for the source), so that Hamilton's
         (E) plus ``sum(gm * energy)`` is conserved (:func:`effect_energy`).  None
         if the effect keeps none (the energy is then reported as not conserved).
+    excludes : Mapping[str, str]
+        The effects this one already computes (name -> what both would compute),
+        refused beside it: ``eih`` holds the 1PN terms that ``gr`` adds, so
+        ``["eih", "gr"]`` would count them twice (:func:`exclusion_problems`).
     """
 
     name: str
@@ -106,6 +111,7 @@ class EffectSpec:
     name_parameters: tuple[str, ...] = ()
     jacobian: Any = None
     energy: Callable[..., np.ndarray] | None = None
+    excludes: Mapping[str, str] = field(default_factory=dict)
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}
@@ -219,6 +225,33 @@ def entry_problems(item: Any, kind: str = "nbody") -> tuple[str | None, dict, li
     return name, params, problems
 
 
+def exclusion_problems(names: Sequence[str], kind: str = "nbody") -> list[tuple[int, str]]:
+    """``(index, message)`` for each listed effect that another listed one already
+    computes (:attr:`EffectSpec.excludes`), at the later of the two indices.
+
+    Examples
+    --------
+    >>> exclusion_problems(["eih", "j2", "gr"])  # doctest: +NORMALIZE_WHITESPACE
+    [(2, "effect 'gr' (at index 2) is refused beside 'eih' (at index 0): 'eih' already
+      computes the first post-Newtonian terms of the dominant body, which would count
+      twice; list one of them")]
+    """
+    out = []
+    first: dict[str, int] = {}
+    for k, name in enumerate(names):
+        first.setdefault(name, k)
+    for k, name in enumerate(names):
+        if name not in known(kind):
+            continue
+        for other, what in get(kind, name).excludes.items():
+            if other in first:
+                j = first[other]
+                out.append((max(j, k), f"effect {other!r} (at index {j}) is refused beside "
+                                       f"{name!r} (at index {k}): {name!r} already computes "
+                                       f"{what}, which would count twice; list one of them"))
+    return sorted(out)
+
+
 def normalize_effects(
     effects: Sequence[str | Mapping[str, Any]] | None, kind: str = "nbody"
 ) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
@@ -231,7 +264,8 @@ def normalize_effects(
     ValueError
         For an unknown name (listing the known ones), an entry that is neither a
         name nor a mapping with a ``"name"``, a parameter the effect does not take,
-        or an effect listed twice; naming the index and the value.
+        an effect listed twice, or one listed beside an effect that already
+        computes it (:func:`exclusion_problems`); naming the index and the value.
 
     Examples
     --------
@@ -249,6 +283,7 @@ def normalize_effects(
     if not isinstance(effects, Sequence):
         raise ValueError(f"Expected `effects` to be a list of names or mappings, got {effects!r}")
     out = []
+    listed: list[str] = []
     seen: dict[str, int] = {}
     for k, item in enumerate(effects):
         name, params, problems = entry_problems(item, kind)
@@ -256,12 +291,15 @@ def normalize_effects(
             key, message = problems[0]
             where = f", `{key}`" if key and key != "name" else ""
             raise ValueError(f"Effect at index {k}{where}: {message}")
+        listed.append(name)
         if name == "newtonian":
             continue
         if name in seen:
             raise ValueError(f"Effect {name!r} is listed twice (at indices {seen[name]} and {k})")
         seen[name] = k
         out.append((name, tuple(sorted(params.items()))))
+    for _, message in exclusion_problems(listed, kind)[:1]:
+        raise ValueError(message[0].upper() + message[1:])
     return tuple(out)
 
 
@@ -315,6 +353,9 @@ class EffectSet:
 
     kind: str
     items: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]
+    #: each item's index in the list it was built from (``"newtonian"`` counted),
+    #: for messages; not part of the value (equality, hash)
+    indices: tuple[int, ...] = field(default=(), compare=False)
 
     @classmethod
     def of(cls, effects: Any, kind: str = "nbody") -> EffectSet:
@@ -329,7 +370,10 @@ class EffectSet:
             if effects.kind != kind:
                 raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")
             return effects
-        return cls(kind, normalize_effects(effects, kind))
+        items = normalize_effects(effects, kind)
+        indices = tuple(k for k, item in enumerate(effects)
+                        if (item if isinstance(item, str) else item["name"]) != "newtonian")
+        return cls(kind, items, indices)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -340,6 +384,43 @@ class EffectSet:
     def velocity_dependent(self) -> bool:
         """True if any listed effect depends on velocities."""
         return any(get(self.kind, name).velocity_dependent for name in self.names)
+
+    def parameters(self, system: Any) -> list[np.ndarray]:
+        """Each listed effect's parameter vector for ``system`` (its
+        :attr:`EffectSpec.params`), in order.
+
+        Raises
+        ------
+        ValueError
+            For an effect without a parameter builder, or bad parameters: the
+            builder's message, naming the effect and the parameter, and the
+            effect's index in the list the set was built from (``"Effect 'eih':
+            expected `c` ... (effects[0])"``).
+
+        Examples
+        --------
+        >>> from hamilton_orbits import Body, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+        >>> EffectSet.of([{"name": "j2", "body": "sun", "j2": 1e-3, "radius": 0.1},
+        ...               {"name": "gr", "c": -1.0}]).parameters(s)
+        Traceback (most recent call last):
+        ...
+        ValueError: Effect 'gr': expected `c` > 0, got -1.0 (effects[1])
+        """
+        out = []
+        indices = self.indices or range(len(self.items))
+        for k, (name, params) in zip(indices, self.items, strict=True):
+            spec = get(self.kind, name)
+            if spec.params is None:
+                raise ValueError(f"Effect {name!r} cannot be used in an n-body simulation")
+            try:
+                out.append(spec.params(system, dict(params)))
+            except ValueError as exc:  # astropy's UnitConversionError included
+                msg = str(exc)
+                if not msg.startswith(f"Effect {name!r}"):
+                    msg = f"Effect {name!r}: {msg}"
+                raise type(exc)(f"{msg} (effects[{k}])") from None
+        return out
 
     def as_list(self) -> list[str | dict[str, Any]]:
         """The effects as a caller lists them (names, or mappings with parameters)."""

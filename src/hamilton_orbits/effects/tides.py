@@ -27,32 +27,46 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import earth_tides
 from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
     PARK_2021,
     body_index,
     body_pole,
+    distinct_bodies,
     finite_floats,
+    optional_body_index,
+    parameter_array,
     require_de440_units,
+    scalar_parameter,
 )
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import ANGULAR_SPEED, LENGTH, TIME
 
 __all__ = ["EARTH_ROTATION_RATE", "SPECS"]
 
 # IERS Conventions 2010, table 1.1: the Earth's nominal mean angular velocity, rad/s
 EARTH_ROTATION_RATE = 7.292115e-5
+# DE440's time lags of the Earth's tides (days), in the order of `tau`
+_TAU = ("TAUE0", "TAUE1", "TAUE2", "TAUER1", "TAUER2")
 
 
 def _params_earth_tides(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     e = body_index(system, params, "earth", "earth", "earth_tides")
     m = body_index(system, params, "moon", "moon", "earth_tides")
     require_de440_units(system, params, "earth_tides", ("radius", "omega", "tau"))
-    sun_name = params.get("sun", "sun")
-    sun = system.names.index(sun_name) if sun_name in system.names else -1
-    radius = float(params.get("radius", de.constant("RE") / de.constant("AU")))
-    omega = float(params.get("omega", EARTH_ROTATION_RATE * 86400.0))
+    sun = optional_body_index(system, params, "sun", "sun", "earth_tides")
+    distinct_bodies(system, {"earth": e, "moon": m, "sun": sun}, "earth_tides")
+    radius = scalar_parameter(system, params, "radius", "earth_tides", LENGTH,
+                              de.constant("RE") / de.constant("AU"), positive=True)
+    omega = scalar_parameter(system, params, "omega", "earth_tides", ANGULAR_SPEED,
+                             EARTH_ROTATION_RATE * 86400.0)
     k2 = finite_floats("k2", params.get("k2", [de.constant(f"K2E{j}") for j in range(3)]), 3,
                  "earth_tides")
-    tau = finite_floats("tau", params.get("tau", [de.constant(k) for k in (
-        "TAUE0", "TAUE1", "TAUE2", "TAUER1", "TAUER2")]), 5, "earth_tides")
+    tau = parameter_array(system, params, "tau", "earth_tides", TIME)
+    if tau is None:
+        tau = np.array([de.constant(k) for k in _TAU])
+    elif tau.shape != (5,):
+        raise ValueError(f"Effect 'earth_tides': expected `tau` to be 5 finite numbers, got "
+                         f"{params['tau']!r}")
     pole = body_pole(system, e, params, "earth_tides")
     return np.array([e, m, sun, radius, omega, *pole, *k2, *tau])
 
@@ -63,13 +77,18 @@ SPECS = (
         summary="tides raised on the Earth by the Moon and Sun acting on the Moon (DE440)",
         velocity_dependent=True,
         parameters={"earth": "default 'earth'", "moon": "default 'moon'",
-                    "sun": "tide raiser besides the Moon (default 'sun' if present)",
-                    "radius": "default DE440's RE", "omega": "Earth's rotation rate",
+                    "sun": "tide raiser besides the Moon (default 'sun' if present; "
+                           "'none' for none)",
+                    "radius": "a length (default DE440's RE)",
+                    "omega": "Earth's rotation rate (default IERS's, 7.292115e-5 rad/s)",
                     "k2": "[k20, k21, k22] (default DE440's K2E0..2)",
-                    "tau": "[TAUE0, TAUE1, TAUE2, TAUER1, TAUER2] (default DE440's)",
+                    "tau": "time lags [TAUE0, TAUE1, TAUE2, TAUER1, TAUER2] (default "
+                           "DE440's)",
                     "pole": "Earth's pole (default the Body's pole)",
-                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=earth_tides, params=_params_earth_tides,
+        parameter_kinds={"radius": LENGTH, "omega": ANGULAR_SPEED, "tau": TIME},
+        name_parameters=("earth", "moon"),
         reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 32; {PARK_2021}",
     ),
 )

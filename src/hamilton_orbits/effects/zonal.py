@@ -23,8 +23,16 @@ import numpy as np
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.figures import zonal_field
 from hamilton_orbits._kernels.jacobians import zonal_field_jvp
-from hamilton_orbits.effects.parameters import PARK_2021, body_index, body_pole, finite_floats
+from hamilton_orbits.effects.parameters import (
+    FRAME_PARAMETER,
+    PARK_2021,
+    body_index,
+    body_pole,
+    finite_floats,
+    scalar_parameter,
+)
 from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import LENGTH
 
 __all__ = ["SPECS"]
 
@@ -38,9 +46,8 @@ def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
                                  "(DE440's defaults are the Earth's, in au)")
     j = finite_floats("j", params.get("j", [de.constant(f"J{n}E") for n in (2, 3, 4)]), None,
                 "zonal")
-    radius = float(params.get("radius", de.constant("RE") / de.constant("AU")))
-    if not radius > 0:
-        raise ValueError(f"Effect 'zonal': expected `radius` > 0, got {radius!r}")
+    radius = scalar_parameter(system, params, "radius", "zonal", LENGTH,
+                              de.constant("RE") / de.constant("AU"), positive=True)
     return np.array([b, radius, *body_pole(system, b, params, "zonal"), *j])
 
 
@@ -50,10 +57,11 @@ SPECS = (
         summary="zonal harmonics J2..Jn of one body (default the Earth's J2, J3, J4)",
         parameters={"body": "the body (default 'earth')",
                     "j": "[J2, J3, ...] (default DE440's J2E, J3E, J4E)",
-                    "radius": "reference radius (default DE440's RE)",
+                    "radius": "reference radius, a length (default DE440's RE)",
                     "pole": "pole vector (default the Body's pole)",
-                    "frame": "'icrs' or 'ecliptic' (pole default without a Body pole)"},
+                    "frame": FRAME_PARAMETER},
         kernel=zonal_field, params=_params_zonal,
+        parameter_kinds={"radius": LENGTH}, name_parameters=("body",),
         jacobian=zonal_field_jvp,
         reference=f"Moyer (1971), JPL TR 32-1527, eqs. 173-174; {PARK_2021}",
     ),

@@ -210,8 +210,7 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
         kernel_ref(spec.kernel, spec.name)  # a plugin's names, checked before they are written
         if variational and spec.jacobian is not None:
             kernel_ref(spec.jacobian, spec.name)
-    blocks = [spec.params(system, dict(params))
-              for spec, (_, params) in zip(specs, eff.items, strict=True)]
+    blocks = eff.parameters(system)
     replaces = any(spec.replaces_newtonian for spec in specs)
     kernels = tuple(spec.kernel for spec in specs)
     p = parameter_vector(blocks)

@@ -43,8 +43,10 @@ import tomllib
 
 from hamilton_orbits import effects as _effects
 from hamilton_orbits import schema as S
+from hamilton_orbits.effects.parameters import unit_example
 from hamilton_orbits.scenes.base import KINDS, registered_kinds
 from hamilton_orbits.scenes.result import Result
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS
 
 __all__ = ["Scene", "SceneError"]
 
@@ -72,8 +74,10 @@ class _EffectField(S.Field):
     """An effect: a registered name, or a table ``{name = "j2", body = "earth"}``.
 
     A parameter with a dimension (the effect's ``parameter_kinds``: ``c``, a
-    speed) is read like any value with a unit (``c = "299792.458 km/s"``); a
-    parameter that names a body must be a string.
+    speed) is read like any value with a unit (``c = "299792.458 km/s"``; a list,
+    such as ``earth_tides``'s time lags ``tau``, value by value); a bare number
+    is refused for it (``docs/effects.md``).  A parameter that names a body must
+    be a string.
     """
 
     effect_kind: str = "nbody"
@@ -89,10 +93,26 @@ class _EffectField(S.Field):
         for key, val in params.items():
             where = f"{path}.{key}"
             if key in spec.parameter_kinds:
-                out[key] = S.Quantity(kind=spec.parameter_kinds[key]).check(val, where, problems)
+                out[key] = _effect_quantity(spec.parameter_kinds[key], val, where, problems)
             elif key in spec.name_parameters:
                 out[key] = S.String(nonempty=True).check(val, where, problems)
         return {"name": name, **out}
+
+
+def _effect_quantity(kind: Any, value: Any, path: str, problems: S.Problems) -> Any:
+    """An effect's parameter with a dimension: a value with its unit, or a list of
+    them; a bare number is refused, naming the unit it needs (a scene's system is
+    in Quantities: ``docs/effects.md``)."""
+    items = value if isinstance(value, list) else [value]
+    bare = [v for v in items if isinstance(v, int | float) and not isinstance(v, bool)]
+    if bare and kind not in (DIMENSIONLESS, ANGLE):
+        problems.add(path, f"expected {kind.name} ({kind.unit}) with its unit, e.g. "
+                           f"\"{unit_example(kind)}\", got the bare number {bare[0]!r} (a unit "
+                           "cannot be guessed)")
+        return None
+    field = (S.Vector(kind=kind, size=len(value)) if isinstance(value, list)
+             else S.Quantity(kind=kind))
+    return field.check(value, path, problems)
 
 
 def _parse_override(value: str) -> Any:
@@ -372,6 +392,9 @@ class Scene:
                     problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
                                                   f"(first at effects[{first[effect['name']]}])")
                 first.setdefault(effect["name"], k)
+            names = [effect["name"] for effect in spec["effects"]]
+            for k, message in _effects.exclusion_problems(names, kind.effect_kind):
+                problems.add(f"effects[{k}]", message)
         if not problems:
             kind.check(spec, problems)
         if problems:

@@ -19,6 +19,7 @@ from hamilton_orbits.scenes.nbody.build import (
     initial_names,
     problem_text,
     rebound_names,
+    scene_frame,
 )
 from hamilton_orbits.scenes.nbody.schema import ANALYSES, ANALYSIS_KEYS, ANGLE_KEYS, METHODS
 
@@ -42,6 +43,7 @@ def check(spec: dict, problems: S.Problems) -> None:
     if not names and spec["initial"].get("rebound") is None:
         problems.add("bodies", "the scene has no bodies")
     _check_effects(spec, names, problems)
+    _effects_in_scene_frame(spec, problems)
     _check_events(spec, names, problems)
     if spec["variational"] and spec["events"]:
         problems.add("variational", "the variational equations are integrated without "
@@ -181,6 +183,20 @@ def _check_effects(spec: dict, names: list[str], problems: S.Problems) -> None:
                 f"effect {eff['name']!r} depends on velocities and integrator {method!r} "
                 f"cannot take it; use one of {', '.join(ok)}",
             )
+
+
+def _effects_in_scene_frame(spec: dict, problems: S.Problems) -> None:
+    """The axes of the scene's states (``[initial] frame``) are those of every effect
+    that takes a ``frame`` (its default directions: the ecliptic pole, the Sun's
+    and the Earth's poles): filled in where the effect does not say, a problem
+    where it says otherwise."""
+    frame = scene_frame(spec)
+    for i, eff in enumerate(spec["effects"]):
+        if "frame" not in _effects.get("nbody", eff["name"]).parameters:
+            continue
+        if eff.setdefault("frame", frame) != frame:
+            problems.add(f"effects[{i}].frame", f"{eff['frame']!r}, but the scene's states are "
+                                                f"in {frame!r} axes ([initial] frame)")
 
 
 def _check_events(spec: dict, names: list[str], problems: S.Problems) -> None:

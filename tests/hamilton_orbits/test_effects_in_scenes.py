@@ -1,0 +1,112 @@
+"""Effects in scene files: parameters with their units, the scene's frame, and the
+effects that exclude each other, all checked at load (issue 32, classes 3 and 17)."""
+
+from __future__ import annotations
+
+import re
+
+import astropy.units as u
+import numpy as np
+import pytest
+import tomllib
+
+from hamilton_orbits import Scene, System, integrate
+from hamilton_orbits import effects as fx
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits.scene import SceneError
+from hamilton_orbits.scenes.nbody.build import build_system
+
+
+def _scene(effects: str, frame: str = "icrs",
+           initial: str = 'solar_system = { epoch = "J2000", bodies = ["sun", "neptune"] }'
+           ) -> Scene:
+    return Scene.from_dict(tomllib.loads(f"""
+kind = "nbody"
+duration = "10 d"
+effects = {effects}
+[integrator]
+method = "radau15"
+[initial]
+frame = "{frame}"
+{initial}
+"""))
+
+
+def _params(scene: Scene, k: int = 0) -> np.ndarray:
+    """The parameter vector the run gives effect ``k`` of ``scene``."""
+    eff = scene.effects[k]
+    system = build_system(scene.spec)
+    return fx.get("nbody", eff["name"]).params(system, {a: b for a, b in eff.items()
+                                                        if a != "name"})
+
+
+def test_eih_c_is_written_with_its_unit():
+    """``eih c = "299792.458 km/s"`` could not be written (its c had no kind)."""
+    scene = _scene('[{ name = "eih", c = "299792.458 km/s" }]')
+    assert scene.effects[0]["c"] == 299792.458 * u.km / u.s
+    assert _params(scene)[0] == pytest.approx(fx.parameters.de440_c_au_per_day(), rel=1e-15)
+
+
+@pytest.mark.parametrize(("effect", "message"), [
+    ('{ name = "eih", c = 173.1 }', 'effects[0].c: expected a speed (m / s) with its unit, e.g. '
+                                    '"299792.458 km/s", got the bare number 173.1'),
+    ('{ name = "kuiper_ring", radius = 44 }', 'effects[0].radius: expected a length (m) with '
+                                              'its unit, e.g. "6378.1366 km", got the bare '
+                                              'number 44'),
+    ('{ name = "earth_tides", tau = [0.07, 0, 0, 0, 0] }', "effects[0].tau: expected a time"),
+    ('{ name = "eih", c = "fast" }', "effects[0].c: cannot read 'fast' as a number with a unit"),
+    ('{ name = "lense_thirring", c = "3 km" }', "effects[0].c: expected a speed"),
+])
+def test_a_bare_number_or_a_wrong_unit_is_a_problem_at_load(effect, message):
+    with pytest.raises(SceneError, match=re.escape(message)):
+        _scene(f"[{effect}]", initial='ephemeris = { bodies = ["sun", "earth", "moon"] }')
+
+
+def test_a_list_is_read_value_by_value():
+    scene = _scene('[{ name = "earth_tides", tau = ["0.077 d", "-0.01 d", "-0.2 d", '
+                   '"1 h", "0 s"] }]', initial='ephemeris = { bodies = ["sun", "earth", "moon"] }')
+    assert np.allclose(_params(scene)[-5:], [0.077, -0.01, -0.2, 1 / 24, 0.0], rtol=1e-15)
+
+
+def test_eih_and_gr_together_are_refused_at_load():
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[2]: effect 'gr' (at index 2) is refused beside 'eih' (at index 0): 'eih' "
+            "already computes the first post-Newtonian terms")):
+        _scene('["eih", "kuiper_ring", "gr"]')
+
+
+def test_the_scene_frame_reaches_kuiper_ring():
+    """``[initial] frame = "ecliptic"`` was not passed to ``kuiper_ring``: the ring's
+    normal was the ICRS's ecliptic pole on ecliptic axes, 23.4 deg off.  The ring's
+    field in the ecliptic scene is the ICRS scene's rotated."""
+    out = {}
+    for frame in ("icrs", "ecliptic"):
+        scene = _scene('["kuiper_ring"]', frame=frame)
+        assert scene.effects[0]["frame"] == frame
+        p = _params(scene)
+        assert np.allclose(p[3:], de.ecliptic_pole(frame), rtol=0, atol=1e-15)
+        system = build_system(scene.spec)
+        r = np.ascontiguousarray(system.r.to_value(u.au))
+        acc = np.zeros_like(r)
+        fx.get("nbody", "kuiper_ring").kernel(
+            r, np.zeros_like(r), system.gm.to_value(u.au**3 / u.day**2), acc, p)
+        out[frame] = acc
+    rot = de.frame_rotation("ecliptic")
+    assert np.abs(out["ecliptic"] - out["icrs"] @ rot.T).max() < 1e-12 * np.abs(out["icrs"]).max()
+
+
+def test_an_effect_frame_against_the_scene_frame_is_a_problem():
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[0].frame: 'icrs', but the scene's states are in 'ecliptic' axes "
+            "([initial] frame)")):
+        _scene('[{ name = "kuiper_ring", frame = "icrs" }]', frame="ecliptic")
+
+
+def test_a_scene_runs_with_quantity_parameters():
+    """The run takes the converted parameters: the same Moon as the Python call's."""
+    scene = _scene('[{ name = "moon_figure", radius = "1738 km", inclination_deg = 1.5424 }]',
+                   initial='ephemeris = { bodies = ["earth", "moon"] }')
+    result = scene.run(progress=False)
+    s = System.from_ephemeris(bodies=["earth", "moon"])
+    tr = integrate(s, result.times, effects=["moon_figure"])
+    assert np.array_equal(np.asarray(result.states["r"]), tr.r.to_value(u.au))
