@@ -1,5 +1,5 @@
 """The arguments of a :class:`~hamilton_orbits.simulation.Simulation` checked, and a
-leg's output times and rows.
+leg's output times, rows and progress bar.
 
 :func:`leg_times` makes the output times of a leg from what the caller gave (an end
 time or times, a Quantity for a Quantity system); :func:`time_step`, :func:`tolerance`,
@@ -12,21 +12,24 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
-from types import SimpleNamespace
+from collections.abc import Callable, Mapping
+from types import ModuleType, SimpleNamespace
 from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.engine import EngineRun
-from hamilton_orbits.events import EventSet
-from hamilton_orbits.integrators import Method
+from hamilton_orbits.effects import EffectSet, get
+from hamilton_orbits.engine import EngineRun, Propagation
+from hamilton_orbits.events import EventLog, EventSet, watch_table
+from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
+from hamilton_orbits.rhs import RHS
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 from hamilton_orbits.validation import as_float_array
 
-__all__ = ["event_list", "leg_times", "requested_rows", "rows_of", "tangent_of", "time_step",
-           "tolerance"]
+__all__ = ["check_effects", "check_method", "event_list", "event_log", "leg_times",
+           "progress_reporter", "requested_rows", "rows_of", "shared_memo", "tangent_of",
+           "time_step", "tolerance"]
 
 
 def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
@@ -164,3 +167,105 @@ def requested_rows(out: EngineRun, asked: np.ndarray) -> EngineRun:
     gm = out.gm[keep] if np.ndim(out.gm) == 2 else out.gm
     return dataclasses.replace(out, t=out.t[keep], r=out.r[keep], v=out.v[keep], gm=gm,
                                variational=tan)
+
+
+def shared_memo(prop: Propagation) -> dict[int, Any]:
+    """The memo of a deep copy of ``prop``: what a copy shares instead of copying
+    (the compiled right-hand side, the driver module, compiled functions and
+    their addresses, the method value)."""
+    memo: dict[int, Any] = {}
+    seen: set[int] = set()
+
+    def walk(obj: Any) -> None:
+        if id(obj) in seen:
+            return
+        seen.add(id(obj))
+        module = type(obj).__module__ or ""
+        if isinstance(obj, (RHS, Method, ModuleType)) or module.startswith("numba"):
+            memo[id(obj)] = obj
+        elif isinstance(obj, (list, tuple)):
+            for x in obj:
+                walk(x)
+        elif isinstance(obj, dict):
+            for x in obj.values():
+                walk(x)
+        elif hasattr(obj, "__dict__") and not isinstance(obj, (np.ndarray, type)):
+            for x in vars(obj).values():
+                walk(x)
+
+    walk(prop)
+    return memo
+
+
+def event_log(system: System, events: Any) -> EventLog | None:
+    """The :class:`~hamilton_orbits.events.EventLog` of ``events`` for ``system``
+    (None when no event is listed).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body
+    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+    >>> event_log(s, [{"name": "escape", "distance": 10.0}]).watch.tolist()
+    [[3.0, 1.0, -1.0, 10.0, 0.0]]
+    """
+    if isinstance(events, (tuple, list)) and not events:
+        return None  # none listed (the common case)
+    listed = EventSet.of(events)
+    if not listed:
+        return None
+    return EventLog(watch_table(listed, system), system.as_arrays().radius)
+
+
+def check_effects(method: Method, effects: Any) -> EffectSet:
+    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked against
+    the typed ``method`` (a velocity-dependent effect refused by a symplectic map,
+    naming the integrators that accept it)."""
+    eff = EffectSet.of(effects, "nbody")
+    if not method.accepts_velocity_dependent:
+        for name in eff.names:
+            if get("nbody", name).velocity_dependent:
+                accepting = [m for m in INTEGRATORS
+                             if method_of(m).accepts_velocity_dependent]
+                raise ValueError(
+                    f"Effect {name!r} depends on velocities and integrator {method.name!r} is "
+                    f"symplectic; integrators that accept it: {', '.join(accepting)}"
+                    + (" (or use 'gr_potential')" if name == "gr" else "")
+                )
+    return eff
+
+
+def check_method(method: str | Method, effects: Any, options: Mapping[str, Any]) -> EffectSet:
+    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked
+    against ``method`` and its ``options``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, option or effect, or a velocity-dependent effect
+        given to a symplectic integrator (naming the effect and the integrators
+        that accept it).
+
+    Examples
+    --------
+    >>> check_method("wh", ["gr_potential"], {"coordinates": "jacobi"}).names
+    ('gr_potential',)
+    """
+    return check_effects(method_of(method, options), effects)
+
+
+def progress_reporter(method: str, total: int,
+                      on_output: Any) -> tuple[Any, Callable[[], None] | None]:
+    """An output callback that advances a tqdm bar and calls ``on_output``, and the
+    bar's ``close`` (``on_output`` itself and None where tqdm is not installed)."""
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:  # pragma: no cover - tqdm is an optional extra
+        return on_output, None
+    bar = tqdm(total=total, desc=method, unit="output", leave=False)
+
+    def report(i: int, steps: int) -> None:
+        bar.update(1)
+        if on_output is not None:
+            on_output(i, steps)
+
+    return report, bar.close

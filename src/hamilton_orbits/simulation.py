@@ -26,7 +26,6 @@ import copy
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import astropy.units as u
@@ -34,17 +33,21 @@ import numpy as np
 
 from hamilton_orbits import engine
 from hamilton_orbits._legs import (
+    check_effects,
+    check_method,
     event_list,
+    event_log,
     leg_times,
+    progress_reporter,
     requested_rows,
     rows_of,
+    shared_memo,
     tangent_of,
     time_step,
     tolerance,
 )
 from hamilton_orbits.checkpoint import ArchiveWriter, last_snapshot, record, spec
-from hamilton_orbits.effects import EffectSet, get
-from hamilton_orbits.events import EventLog, EventSet, watch_table
+from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
@@ -197,7 +200,7 @@ class Simulation:
         integrating one does not change the other.  The copy of an archived
         simulation keeps its schedule but writes nothing."""
         new = copy.copy(self)
-        new._prop = copy.deepcopy(self._prop, _shared(self._prop))
+        new._prop = copy.deepcopy(self._prop, shared_memo(self._prop))
         if self._archive is not None:  # the same output times; only the original writes
             new._archive = self._archive.schedule_only()
         return new
@@ -252,7 +255,7 @@ class Simulation:
             self._unit = unit
         close = None
         if progress:
-            on_output, close = _progress(prop.method.name, len(times) - 1, on_output)
+            on_output, close = progress_reporter(prop.method.name, len(times) - 1, on_output)
         archived = None if self._archive is None else self._archived_times(times)
         try:
             compiled = compile_seconds()
@@ -395,34 +398,6 @@ def _archive_of(path: Any, every: Any, every_steps: Any, every_wall: Any,
                          every_steps=every_steps, every_wall=every_wall)
 
 
-def _shared(prop: engine.Propagation) -> dict[int, Any]:
-    """The memo of a deep copy of ``prop``: what a copy shares instead of copying
-    (the compiled right-hand side, the driver module, compiled functions and
-    their addresses, the method value)."""
-    memo: dict[int, Any] = {}
-    seen: set[int] = set()
-
-    def walk(obj: Any) -> None:
-        if id(obj) in seen:
-            return
-        seen.add(id(obj))
-        module = type(obj).__module__ or ""
-        if isinstance(obj, (RHS, Method, ModuleType)) or module.startswith("numba"):
-            memo[id(obj)] = obj
-        elif isinstance(obj, (list, tuple)):
-            for x in obj:
-                walk(x)
-        elif isinstance(obj, dict):
-            for x in obj.values():
-                walk(x)
-        elif hasattr(obj, "__dict__") and not isinstance(obj, (np.ndarray, type)):
-            for x in vars(obj).values():
-                walk(x)
-
-    walk(prop)
-    return memo
-
-
 def integrate(
     system: System,
     t: Any,
@@ -525,74 +500,3 @@ def integrate(
     return sim.integrate(t, progress=progress, on_output=on_output)
 
 
-def event_log(system: System, events: Any) -> EventLog | None:
-    """The :class:`~hamilton_orbits.events.EventLog` of ``events`` for ``system``
-    (None when no event is listed).
-
-    Examples
-    --------
-    >>> from hamilton_orbits import Body
-    >>> s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
-    >>> event_log(s, [{"name": "escape", "distance": 10.0}]).watch.tolist()
-    [[3.0, 1.0, -1.0, 10.0, 0.0]]
-    """
-    if isinstance(events, (tuple, list)) and not events:
-        return None  # none listed (the common case)
-    listed = EventSet.of(events)
-    if not listed:
-        return None
-    return EventLog(watch_table(listed, system), system.as_arrays().radius)
-
-
-def check_effects(method: Method, effects: Any) -> EffectSet:
-    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked against
-    the typed ``method`` (a velocity-dependent effect refused by a symplectic map,
-    naming the integrators that accept it)."""
-    eff = EffectSet.of(effects, "nbody")
-    if not method.accepts_velocity_dependent:
-        for name in eff.names:
-            if get("nbody", name).velocity_dependent:
-                accepting = [m for m in INTEGRATORS
-                             if method_of(m).accepts_velocity_dependent]
-                raise ValueError(
-                    f"Effect {name!r} depends on velocities and integrator {method.name!r} is "
-                    f"symplectic; integrators that accept it: {', '.join(accepting)}"
-                    + (" (or use 'gr_potential')" if name == "gr" else "")
-                )
-    return eff
-
-
-def check_method(method: str | Method, effects: Any, options: Mapping[str, Any]) -> EffectSet:
-    """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked
-    against ``method`` and its ``options``.
-
-    Raises
-    ------
-    ValueError
-        For an unknown method, option or effect, or a velocity-dependent effect
-        given to a symplectic integrator (naming the effect and the integrators
-        that accept it).
-
-    Examples
-    --------
-    >>> check_method("wh", ["gr_potential"], {"coordinates": "jacobi"}).names
-    ('gr_potential',)
-    """
-    return check_effects(method_of(method, options), effects)
-
-
-def _progress(method: str, total: int, on_output: Any) -> tuple[Any, Callable[[], None] | None]:
-    """An output callback that advances a tqdm bar and calls ``on_output``, and the
-    bar's ``close`` (``on_output`` itself and None where tqdm is not installed)."""
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover - tqdm is an optional extra
-        return on_output, None
-    bar = tqdm(total=total, desc=method, unit="output", leave=False)
-
-    def report(i: int, steps: int) -> None:
-        bar.update(1)
-        if on_output is not None:
-            on_output(i, steps)
-
-    return report, bar.close
