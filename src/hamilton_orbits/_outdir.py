@@ -81,17 +81,23 @@ class OutputFolder:
             self.path.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
-        for _attempt in range(2):
-            try:
-                fd = os.open(self._lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-            except FileExistsError:
-                self._take_over_stale()
-                continue
-            except OSError as exc:
-                raise self._fail(f"cannot write in the folder ({exc.strerror or exc})") from None
-            with os.fdopen(fd, "w") as fh:
-                fh.write(self._mine)
-            return self
+        # the lock is written whole under a name of its own, then linked to its name
+        # (atomic, and refused if the name exists): a run killed at any moment leaves
+        # no empty lock that would look like an unknown run's
+        mine = self.path / f"{LOCK_NAME}.{os.getpid()}"
+        try:
+            mine.write_text(self._mine, encoding="utf-8")
+            for _attempt in range(2):
+                try:
+                    os.link(mine, self._lock)
+                except FileExistsError:
+                    self._take_over_stale()
+                    continue
+                return self
+        except OSError as exc:
+            raise self._fail(f"cannot write in the folder ({exc.strerror or exc})") from None
+        finally:
+            mine.unlink(missing_ok=True)
         raise self._fail("another run keeps taking the folder")  # pragma: no cover
 
     def _take_over_stale(self) -> None:
