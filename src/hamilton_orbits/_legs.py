@@ -27,9 +27,21 @@ from hamilton_orbits.rhs import RHS
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 from hamilton_orbits.validation import as_float_array
 
-__all__ = ["check_effects", "check_method", "event_list", "event_log", "leg_times",
-           "progress_reporter", "requested_rows", "rows_of", "shared_memo", "tangent_of",
-           "time_step", "tolerance"]
+__all__ = [
+    "check_effects",
+    "check_method",
+    "event_list",
+    "event_log",
+    "leg_run",
+    "leg_times",
+    "progress_reporter",
+    "requested_rows",
+    "rows_of",
+    "shared_memo",
+    "tangent_of",
+    "time_step",
+    "tolerance",
+]
 
 
 def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
@@ -269,3 +281,28 @@ def progress_reporter(method: str, total: int,
             on_output(i, steps)
 
     return report, bar.close
+
+
+def leg_run(rows: dict[str, np.ndarray], out: EngineRun | None, prop: Propagation,
+            steps: int, first_event: int) -> EngineRun:
+    """A resumed leg as one engine run: its rows from the archive (``out_*``) and
+    those of ``out``, the run from the last snapshot (its first row, the snapshot's
+    own time, dropped: the archive holds the rows asked for up to it)."""
+    t, r, v = rows["out_t"], rows["out_r"], rows["out_v"]
+    megno, lyap, stm = rows.get("out_megno"), rows.get("out_lyapunov"), rows.get("out_stm")
+    if out is not None:
+        k = len(out.t)
+        t, r, v = (np.concatenate((a, b[1:])) for a, b in ((t, out.t), (r, out.r), (v, out.v)))
+        tan = out.variational
+        if tan is not None:
+            megno = np.concatenate((megno, tan.megno[1:k]))
+            lyap = np.concatenate((lyap, tan.lyapunov[1:k]))
+            stm = None if tan.stm is None else np.concatenate((stm, tan.stm[1:k]))
+    events = prop.events
+    gm = (events.gm_at(t, prop.gm0) if events is not None and events.gm_changes
+          else prop.gm0)
+    tangent = None if megno is None else SimpleNamespace(megno=megno, lyapunov=lyap, stm=stm)
+    done = out is None or out.complete
+    return EngineRun(t, r, v, steps, 0.0 if out is None else out.wall_time, done, events, gm,
+                     tangent, out is not None and out.interrupted, first_event,
+                     bool(np.isfinite(r).all() and np.isfinite(v).all()))

@@ -42,8 +42,10 @@ from hamilton_orbits.units import is_quantity
 __all__ = [
     "SNAPSHOT_NAME",
     "ArchiveWriter",
+    "LegRows",
     "from_json",
     "last_snapshot",
+    "leg_rows",
     "pack",
     "record",
     "snapshot_files",
@@ -140,6 +142,74 @@ def spec(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray]) -> dict[str,
             "events": from_json(meta["events"]), "variational": meta["variational"],
             "stm": meta["stm"], "layout": meta["layout"],
             "state": unpack(arrays["state"], meta["state_arrays"])}
+
+
+class LegRows:
+    """The caller's output rows of an archived ``integrate`` call (a *leg*), kept
+    until the next snapshot takes them, and what resuming the leg needs.
+
+    Every snapshot carries the rows asked for since the snapshot before (O(rows
+    since then), never the whole history), and the number of the snapshot where
+    its leg began, which carries the leg's output times: from them a leg
+    interrupted by a kill is resumed and returned whole
+    (:meth:`hamilton_orbits.Simulation.resume`).
+    """
+
+    def __init__(self, info: dict[str, Any], times: np.ndarray | None = None) -> None:
+        #: number of the leg's first snapshot, time unit, steps and events before it,
+        #: whether it began at time 0
+        self.info = info
+        #: the leg's output times (written in its first snapshot only)
+        self.times = times
+        self.rows: list[tuple[Any, ...]] = []
+
+    def add(self, t: float, r: np.ndarray, v: np.ndarray, tangent: Any) -> None:
+        """Output row at ``t`` (copied); ``tangent``: the variational equations."""
+        row: tuple[Any, ...] = (t, r.copy(), v.copy())
+        if tangent is not None:
+            megno, lyapunov, stm = tangent.last
+            row += (megno, lyapunov, None if stm is None else stm.copy())
+        self.rows.append(row)
+
+    def take(self) -> dict[str, np.ndarray]:
+        """The rows since the last snapshot as arrays ``out_*`` (and the leg's times
+        in its first snapshot), and start afresh."""
+        rows, self.rows = self.rows, []
+        out: dict[str, np.ndarray] = {}
+        if self.times is not None:
+            out["leg_times"], self.times = self.times, None
+        out["out_t"] = np.array([x[0] for x in rows], dtype=np.float64)
+        for k, name in ((1, "out_r"), (2, "out_v"), (3, "out_megno"), (4, "out_lyapunov"),
+                        (5, "out_stm")):
+            if rows and len(rows[0]) > k and rows[0][k] is not None:
+                out[name] = np.array([x[k] for x in rows], dtype=np.float64)
+        return out
+
+
+def leg_rows(files: list[tuple[int, Path]], start: int, upto: int) -> tuple[
+        np.ndarray, dict[str, np.ndarray]]:
+    """The output times of the leg that began at snapshot ``start`` and its rows
+    archived up to snapshot ``upto`` (each snapshot read whole).
+
+    Raises
+    ------
+    SnapshotError
+        When one of those snapshots is missing or damaged (its rows are lost).
+    """
+    by_number = dict(files)
+    parts: dict[str, list[np.ndarray]] = {}
+    times = None
+    for k in range(start, upto + 1):
+        if k not in by_number:
+            raise SnapshotError(f"snapshot {k} of the leg being resumed is missing")
+        _, arrays = read(by_number[k])
+        if k == start:
+            times = arrays["leg_times"]
+        for name, a in arrays.items():
+            if name.startswith("out_") and a.shape[0]:
+                parts.setdefault(name, []).append(a)
+    rows = {name: np.concatenate(a) for name, a in parts.items()}
+    return times, rows
 
 
 def pack(arrays: list[np.ndarray]) -> tuple[np.ndarray, list[list[Any]]]:

@@ -37,6 +37,7 @@ from hamilton_orbits._legs import (
     check_method,
     event_list,
     event_log,
+    leg_run,
     leg_times,
     progress_reporter,
     requested_rows,
@@ -46,7 +47,15 @@ from hamilton_orbits._legs import (
     time_step,
     tolerance,
 )
-from hamilton_orbits.checkpoint import ArchiveWriter, last_snapshot, record, spec
+from hamilton_orbits.checkpoint import (
+    ArchiveWriter,
+    LegRows,
+    last_snapshot,
+    leg_rows,
+    record,
+    snapshot_files,
+    spec,
+)
 from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
@@ -155,6 +164,9 @@ class Simulation:
         self._unit: Any = DAY if system.quantity else None
         self._spec = (typed, step, tol, eff.as_list(), event_list(events), variational, stm)
         self._archive = _archive_of(archive, every, every_steps, every_wall, system.quantity)
+        #: the archived leg in progress, and what resume() finishes (after a load)
+        self._leg: LegRows | None = None
+        self._resumable: Any = None
 
     # ------------------------------------------------------------------ state
     @property
@@ -253,6 +265,21 @@ class Simulation:
         times, unit = leg_times(t, prop.t, self._quantity)
         if unit is not None:
             self._unit = unit
+        if self._archive is not None:
+            self._new_leg(times)
+        out, compiled = self._advance(times, progress, on_output, stop)
+        if out.interrupted and on_interrupt == "raise":
+            raise KeyboardInterrupt
+        start, self._start = self._start, self._initial  # the first leg begins at time 0
+        return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
+                               self._effects, start=start,
+                               wall_time=max(out.wall_time - compiled, 0.0))
+
+    def _advance(self, times: np.ndarray, progress: bool, on_output: Any,
+                 stop: Any) -> tuple[engine.EngineRun, float]:
+        """The propagation through ``times`` (the archive's snapshots taken on the
+        way), and the seconds spent compiling."""
+        prop = self._prop
         close = None
         if progress:
             on_output, close = progress_reporter(prop.method.name, len(times) - 1, on_output)
@@ -263,7 +290,7 @@ class Simulation:
                 out = prop.advance(times, on_output=on_output, stop=stop)
             else:
                 out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
-                                   stop=stop, checkpoint=self._checkpoint(archived[2]))
+                                   stop=stop, checkpoint=self._checkpoint(*archived[1:]))
                 out = requested_rows(out, archived[1])
             compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
         finally:
@@ -271,13 +298,54 @@ class Simulation:
                 close()
             if self._archive is not None:
                 self._archive.close()
-        if out.interrupted and on_interrupt == "raise":
-            raise KeyboardInterrupt
-        start, self._start = self._start, self._initial  # the first leg begins at time 0
-        return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
-                               self._effects, start=start,
-                               wall_time=max(out.wall_time - compiled, 0.0))
+        return out, compiled
 
+    def resume(self, *, progress: bool = False, on_output: Any = None, stop: Any = None,
+               on_interrupt: str = "raise") -> Trajectory:
+        """Finish the ``integrate`` call a killed run was in, from the archive's last
+        snapshot (``Simulation.load(folder)``), and return that call's whole
+        trajectory: the rows archived before the kill and the rest, the bits of the
+        call that was never interrupted.  A kill during ``resume`` is resumed alike.
+
+        Raises
+        ------
+        ValueError
+            When this simulation was not loaded from an archive folder.
+        SnapshotError
+            When a snapshot of the leg is missing or damaged (its rows are lost).
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from hamilton_orbits import Body, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> folder = tempfile.mkdtemp()
+        >>> whole = Simulation(s, method="wh", dt=0.01, archive=folder, every=2.0).integrate(
+        ...     np.arange(0.0, 7.0))
+        >>> again = Simulation.load(folder)              # as after a kill at t = 6.5
+        >>> traj = again.resume()                         # the whole call, t = 0 ... 6
+        >>> bool(np.array_equal(traj.r, whole.r)), traj.t.tolist() == whole.t.tolist()
+        (True, True)
+        """
+        if self._resumable is None:
+            raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
+                             "simulation loaded from its archive folder")
+        times, rows, info = self._resumable
+        prop = self._prop
+        rest = times[times > prop.t]
+        out, compiled = None, 0.0
+        if rest.size:
+            out, compiled = self._advance(np.concatenate(([prop.t], rest)), progress,
+                                          on_output, stop)
+            if out.interrupted and on_interrupt == "raise":
+                raise KeyboardInterrupt
+        whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
+        self._start = self._initial
+        unit = u.Unit(info["unit"]) if info["unit"] else None
+        return make_trajectory(self._system, whole, unit, prop.method.name, prop.rhs.effects,
+                               self._effects, start=None if info["first"] else self._initial,
+                               wall_time=max(whole.wall_time - compiled, 0.0))
 
     # ------------------------------------------------------------------ saving
     def save(self, path: str | os.PathLike[str]) -> None:
@@ -330,6 +398,11 @@ class Simulation:
             sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync")}
             sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
             sim._archive.last_steps = sim.steps
+        leg = meta.get("leg")
+        if folder is not None and leg is not None:  # the leg a kill interrupted
+            times, rows = leg_rows(snapshot_files(folder), leg["start"], meta["number"])
+            sim._resumable = (times, rows, leg)
+            sim._leg = LegRows(leg)
         return sim
 
     @classmethod
@@ -356,32 +429,55 @@ class Simulation:
             sim._unit = u.Unit(meta["unit"])
         return sim
 
-    def _record(self) -> tuple[Any, ...]:
+    def _record(self, rows: Any = None) -> tuple[Any, ...]:
         extra = {"started": self._start is not None,
                  "unit": None if self._unit is None else self._unit.to_string(),
                  "archive": None if self._archive is None else self._archive.schedule()}
-        return record(self._system, *self._spec, self._prop, extra)
+        if rows is not None:
+            extra["leg"] = rows.info
+        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra)
+        if rows is not None:
+            arrays.update(rows.take())
+            dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))
+        return meta, arrays, dims, units
+
+    def _new_leg(self, times: np.ndarray) -> None:
+        """Begin an archived leg through ``times``: its first snapshot (the leg's
+        times, its start) written, so a folder that cannot take it fails now."""
+        arch, prop = self._archive, self._prop
+        if times[-1] < times[0]:
+            raise ValueError("A simulation with an archive integrates forwards in time")
+        try:
+            arch.open()
+            info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
+                    "unit": None if self._unit is None else self._unit.to_string(),
+                    "first_event": 0 if prop.events is None else len(prop.events.recorded())}
+            self._leg = LegRows(info, times)
+            self._leg.add(prop.t, prop.r, prop.v, prop.variational)
+            arch.write(*self._record(self._leg))
+        except BaseException:
+            arch.close()
+            raise
 
     def _archived_times(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The output times with the archive's snapshot times merged in, which rows
-        were asked for, and which are scheduled snapshots; the archive's folder
-        claimed, and its first snapshot (the start) written if it has none."""
-        if times[-1] < times[0]:
-            raise ValueError("A simulation with an archive integrates forwards in time")
+        were asked for, and which are scheduled snapshots (the folder claimed)."""
         arch = self._archive
         arch.open()
-        if arch.count == 0 and arch.path is not None:
-            arch.write(*self._record())
         extra = arch.times(float(times[0]), float(times[-1]))
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 
-    def _checkpoint(self, scheduled: np.ndarray) -> Callable[[int], None]:
-        arch = self._archive
+    def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
+        arch, prop, rows = self._archive, self._prop, self._leg
 
         def at(i: int) -> None:
-            if i > 0 and (scheduled[i] or arch.due(self._prop.steps)):
-                arch.write(*self._record())
+            if i == 0:
+                return
+            if asked[i] and rows is not None:
+                rows.add(prop.t, prop.r, prop.v, prop.variational)
+            if scheduled[i] or arch.due(prop.steps):
+                arch.write(*self._record(rows))
 
         return at
 

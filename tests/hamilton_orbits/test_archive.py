@@ -15,10 +15,11 @@ import time
 
 import numpy as np
 import pytest
-from test_simulation_legs import _disc, _same
+from test_simulation_legs import _disc, _merging, _same
 
 from hamilton_orbits import Archive, Simulation
 from hamilton_orbits.checkpoint import SNAPSHOT_NAME
+from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.snapshot import SnapshotError, read
 
 T = np.linspace(0.0, 60.0, 13)[1:]  # the caller's outputs: every 5
@@ -67,20 +68,18 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
     assert resumed.steps == ref.steps
     if "variational" in kw:
         assert _same(rest.megno[-1], whole.megno[-1])
-    # the resumed run wrote on, on the same schedule: the same snapshots as the whole
-    whole_files = sorted(p.name for p in (tmp_path / "whole").glob("snapshot-*.nc"))
-    cut_files = sorted(p.name for p in (tmp_path / "cut").glob("snapshot-*.nc"))
-    assert whole_files == cut_files
-    for name in whole_files:
-        a = _snapshot_state(tmp_path / "whole" / name)
-        b = _snapshot_state(tmp_path / "cut" / name)
+    # the resumed run wrote on, on the same schedule: a snapshot at every time of the
+    # whole run's (its new call began with one more, at t = 25), with the same state
+    cut = {float(s.t): s for s in Archive(tmp_path / "cut").snapshots}
+    for snap in Archive(tmp_path / "whole").snapshots:
+        a, b = _snapshot_state(snap.path), _snapshot_state(cut[snap.t].path)
         assert all(_same(x, y) for x, y in zip(a[:3], b[:3], strict=True))
 
 
 def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path):
     """20 runs killed with SIGKILL at random moments (before, between and during
-    writes): each archive opens, its snapshots are the reference's, and the run
-    resumed from it ends on the reference's bits."""
+    writes): each archive opens, its snapshots are the reference's, and the call
+    resumed from it returns the reference's trajectory, every row to the bit."""
     _, whole = _run_archived(tmp_path / "ref")
     reference = Archive(tmp_path / "ref")
     t_run = _timed_run(tmp_path / "timing")
@@ -98,7 +97,7 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
         os.kill(pid, signal.SIGKILL)
         os.waitpid(pid, 0)
         if not folder.exists() or not any(folder.glob("snapshot-*.nc")):
-            sim = Simulation(_disc(), archive=folder, **KW)  # killed before the first
+            _, traj = _run_archived(folder)  # killed before the first snapshot: anew
         else:
             archive = Archive(folder)
             assert archive.damaged == []  # whole snapshots or none: never a damaged one
@@ -107,10 +106,10 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
                 ref = reference.snapshots[snap.number]
                 assert all(_same(x, y) for x, y in zip(_snapshot_state(snap.path),
                                                        _snapshot_state(ref.path), strict=True))
-            sim = Simulation.load(folder)
-        if sim.t < T[-1]:  # (a kill after the last snapshot leaves nothing to do)
-            sim.integrate(T[T > sim.t])
-        assert _same(sim.system.as_arrays().r, whole.r[-1]), f"kill {k} at t = {sim.t}"
+            traj = Simulation.load(folder).resume()  # the call the kill interrupted, whole
+        assert traj.t.tolist() == whole.t.tolist(), f"kill {k}"
+        assert _same(traj.r, whole.r) and _same(traj.v, whole.v), f"kill {k}"
+        assert _same(traj.energy_error, whole.energy_error) and traj.steps == whole.steps
         assert len(Archive(folder)) == len(reference)
     assert seen_partial >= 5  # the kills did fall inside the runs
 
@@ -205,3 +204,51 @@ def test_an_empty_or_missing_archive_is_named(tmp_path):
         Archive(tmp_path / "missing")
     with pytest.raises(SnapshotError, match=r"no readable snapshot in the archive"):
         Simulation.load(tmp_path)
+
+
+@pytest.mark.parametrize("kw", [
+    dict(method="radau15", variational=True, stm=True),
+    dict(method="radau15", events=[{"name": "collision", "action": "merge"}]),
+    dict(method="wh", dt=0.01, events=[{"name": "collision", "action": "merge"}]),
+    dict(method="dop853", events=[{"name": "collision", "action": "merge"}]),
+], ids=["radau15-variational-stm", "radau15-merge", "wh-merge", "dop853-merge"])
+def test_resume_returns_the_interrupted_call_whole_even_after_a_second_interruption(tmp_path,
+                                                                                    kw):
+    """A call stopped twice (as a kill would: the process's own state discarded, only
+    the archive kept) and resumed from the archive each time returns the whole
+    call's trajectory: rows, MEGNO, the STM, the merge, its energy errors."""
+    system = _merging() if "events" in kw else _disc()
+    times = np.linspace(0.0, 4.0, 17)[1:]
+    whole = Simulation(system, archive=tmp_path / "whole", every=0.3, **kw).integrate(times)
+
+    def stopper(after: int):
+        def on_output(i: int, steps: int) -> None:
+            if i >= after:
+                raise StopIntegration
+        return on_output
+
+    Simulation(system, archive=tmp_path / "cut", every=0.3, **kw).integrate(
+        times, on_output=stopper(5))
+    first = Simulation.load(tmp_path / "cut")
+    t_first = first.t
+    assert 0.0 < t_first < 4.0
+    first.resume(on_output=stopper(4))  # interrupted again
+    second = Simulation.load(tmp_path / "cut")
+    assert second.t > t_first
+    traj = second.resume()
+    assert traj.t.tolist() == whole.t.tolist() and traj.complete
+    for name in ("r", "v", "energy_error", "angular_momentum_error", "megno", "lyapunov",
+                 "stm"):
+        x, y = getattr(traj, name), getattr(whole, name)
+        assert (x is None and y is None) or _same(x, y), name
+    assert list(traj.events["time"]) == list(whole.events["time"])
+    assert traj.final.names == whole.final.names
+
+
+def test_resume_needs_a_simulation_loaded_from_its_archive(tmp_path):
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0)
+    with pytest.raises(ValueError, match=r"Nothing to resume"):
+        sim.resume()
+    whole = sim.integrate(3.0)
+    done = Simulation.load(tmp_path).resume()  # the call had ended: nothing to integrate
+    assert _same(done.r, whole.r) and done.t.tolist() == whole.t.tolist()
