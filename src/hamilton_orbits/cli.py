@@ -4,6 +4,7 @@
 
     hamilton-orbits [--no-progress]      # runs the default bundled scene (solar-system)
     hamilton-orbits run [SCENE|FILE] [--out DIR] [--set KEY=VALUE ...] [--no-progress]
+    hamilton-orbits resume OUTDIR        # a killed run of a scene with [output] archive_every
     hamilton-orbits crosscheck [SCENE|FILE]
     hamilton-orbits scenes               # the bundled scenes, their effects, run time
     hamilton-orbits demo                 # the quaternion tour
@@ -166,21 +167,71 @@ def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
     scene = _load_scene(ref, sets)
     folder = Path(out) if out else Path("hamilton-orbits-output") / scene.name
     with OutputFolder(folder, "--out" if out else "output folder"):
-        result = _run_scene(scene, progress)
-        if result is None:
-            return EXIT_FAILED
-        print(result.summary())
-        try:
-            paths = result.save(folder)
-        except Exception as exc:
-            _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
-                   f"{_one_line(exc)}")
-            return EXIT_FAILED
+        archive = _archive_for(scene, folder, ref, sets)
+        result = _run_scene(scene, progress, archive)
+        return _finish(scene, result, folder, archive)
+
+
+def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
+    """The archive folder of a scene run with ``[output] archive_every`` (None
+    without), the scene's source recorded in it for ``hamilton-orbits resume``."""
+    import json
+    from pathlib import Path
+
+    every = scene.spec.get("output", {}).get("archive_every")
+    if every is None:
+        return None
+    archive = Path(folder) / "archive"
+    if any(archive.glob("snapshot-*.nc")):
+        raise _CommandError(f"{archive} holds the snapshots of an earlier run: resume it "
+                            f"(hamilton-orbits resume {folder}) or choose another --out")
+    archive.mkdir(parents=True, exist_ok=True)
+    source = str(Path(ref).resolve()) if ref.endswith(".toml") or Path(ref).exists() else ref
+    (archive / "scene.json").write_text(json.dumps({"scene": source, "set": list(sets)}),
+                                        encoding="utf-8")
+    print(f"archiving every {every} to {archive}/ (a killed run resumes with: "
+          f"hamilton-orbits resume {folder})", file=sys.stderr)
+    return archive
+
+
+def _resume(out: str, progress: bool) -> int:
+    """Resume the killed run of the scene whose output folder is ``out``."""
+    import json
+    from pathlib import Path
+
+    from hamilton_orbits._outdir import OutputFolder
+
+    folder = Path(out)
+    record = folder / "archive" / "scene.json"
+    if not record.is_file():
+        raise _CommandError(f"{folder} is not the output folder of a scene run with an "
+                            f"archive (no {record})")
+    source = json.loads(record.read_text(encoding="utf-8"))
+    scene = _load_scene(source["scene"], source["set"])
+    with OutputFolder(folder, "output folder"):
+        result = _run_scene(scene, progress, folder / "archive")
+        return _finish(scene, result, folder, folder / "archive")
+
+
+def _finish(scene, result, folder, archive) -> int:
+    """Print the summary, save the result into ``folder``; the exit code."""
+    if result is None:
+        return EXIT_FAILED
+    print(result.summary())
+    try:
+        paths = result.save(folder)
+    except Exception as exc:
+        _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
+               f"{_one_line(exc)}")
+        return EXIT_FAILED
     print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+    if not result.complete and archive is not None:
+        print(f"the run was interrupted; its archive is {archive}/: continue it with "
+              f"hamilton-orbits resume {folder}")
     return EXIT_OK if result.complete else EXIT_INTERRUPTED
 
 
-def _run_scene(scene, progress: bool):
+def _run_scene(scene, progress: bool, archive=None):
     """Run ``scene`` with Ctrl-C handled (the first stops the run soon and keeps what
     it reached, the second aborts);
     None (after one line on stderr) if the run failed."""
@@ -204,7 +255,7 @@ def _run_scene(scene, progress: bool):
     except ValueError:  # not the main thread: leave Ctrl-C alone
         previous = None
     try:
-        return scene.run(progress=progress and sys.stderr.isatty(), stop=stop)
+        return scene.run(progress=progress and sys.stderr.isatty(), stop=stop, archive=archive)
     except KeyboardInterrupt:
         raise
     except Exception as exc:
@@ -415,6 +466,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     rp.add_argument("--quick", action="store_true", help="short spans, few settings (~1 min)")
     rp.add_argument("--out", help="output folder (default hamilton-orbits-output/report)")
     rp.add_argument("--no-progress", action="store_true", help="no progress lines")
+    rs = sub.add_parser("resume", help="resume a killed scene run from its archive "
+                                       "([output] archive_every)")
+    rs.add_argument("out", help="the output folder of the run")
+    rs.add_argument("--no-progress", action="store_true", help="no progress bar")
     sub.add_parser("scenes", help="list the bundled scenes")
     sub.add_parser("demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
@@ -462,6 +517,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         return _crosscheck(args.scene, args.set)
     if args.command == "run":
         return _run(args.scene, args.out, args.set, progress=progress)
+    if args.command == "resume":
+        return _resume(args.out, progress=progress)
     return _run(DEFAULT_SCENE, None, [], progress=progress)
 
 

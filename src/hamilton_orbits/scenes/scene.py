@@ -422,8 +422,13 @@ class Scene:
         return f"Scene({self.name!r}, kind={self.kind!r}, effects=[{names}])"
 
     # --- running ------------------------------------------------------
-    def run(self, progress: bool = True, stop: Callable[[], bool] | None = None) -> Result:
+    def run(self, progress: bool = True, stop: Callable[[], bool] | None = None,
+            archive: str | Path | None = None) -> Result:
         """Simulate the scene; returns a :class:`Result`.
+
+        ``archive``: the folder of the archive an ``nbody`` scene with ``[output]
+        archive_every`` writes while it runs; when it holds a killed run's
+        snapshots, the run is resumed from the last one (``docs/archive.md``).
 
         ``result.compile_time`` holds the seconds numba spent compiling kernels
         for the run (the first run on a machine; 0 once they are cached): during
@@ -434,7 +439,9 @@ class Scene:
         """
         from hamilton_orbits.firstrun import claim_compilation
 
-        result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False))
+        extra = {} if archive is None else {"archive": archive}
+        result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False),
+                                      **extra)
         result.compile_time, result.compile_count = claim_compilation()
         return result
 

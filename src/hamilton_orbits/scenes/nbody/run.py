@@ -31,31 +31,49 @@ def _times(spec: dict) -> u.Quantity:
     return t * u.d
 
 
-def simulation(spec: dict, system: Any) -> Any:
-    """The :class:`~hamilton_orbits.Simulation` of a validated ``nbody`` scene."""
+def simulation(spec: dict, system: Any, archive: Any = None) -> Any:
+    """The :class:`~hamilton_orbits.Simulation` of a validated ``nbody`` scene (writing
+    its archive into ``archive`` when the scene asks for one)."""
     from hamilton_orbits import Simulation
 
     integ = spec["integrator"]
     options = {k: integ[k] for k in ("coordinates", "corrector") if integ[k] is not None}
     events = [{k: v for k, v in ev.items() if v is not None} for ev in spec["events"]]
+    every = spec["output"]["archive_every"]
+    if archive is not None and every is not None:
+        options.update(archive=archive, every=every)
     return Simulation(system, integ["method"], dt=integ["dt"], tol=integ["tol"],
                       effects=spec["effects"], events=events,
                       variational=bool(spec["variational"]), **options)
 
 
-def run_scene(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
+def resumable(folder: Any) -> bool:
+    """True if archive ``folder`` holds a snapshot (a run to resume)."""
+    return folder is not None and any(Path(folder).glob("snapshot-*.nc"))
+
+
+def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
+              archive: Any = None) -> Result:
     """Run a validated ``nbody`` scene (the kind's ``run``): its system and its
     :class:`~hamilton_orbits.Simulation`, one call over the output times, the
     analyses the scene asks for; ``stop()`` true (or Ctrl-C) ends the run early,
-    keeping what is done."""
+    keeping what is done.  With ``[output] archive_every`` the run writes an archive
+    into ``archive``, and an archive holding a killed run's snapshots is resumed
+    (the same result as the run never interrupted, its states to the bit)."""
+    from hamilton_orbits import Simulation
+
     spec = scene.spec
     system = build_system(spec)
-    sim = simulation(spec, system)
     times = _times(spec)
     bar = progress_bar(len(times) - 1, progress, "output")
+    on_output = None if bar is None else (lambda i, steps: bar.update(1))
     try:
-        traj = sim.integrate(times, stop=stop, on_interrupt="keep",
-                             on_output=None if bar is None else (lambda i, steps: bar.update(1)))
+        if spec["output"]["archive_every"] is not None and resumable(archive):
+            sim = Simulation.load(archive)
+            traj = sim.resume(stop=stop, on_interrupt="keep", on_output=on_output)
+        else:
+            sim = simulation(spec, system, archive)
+            traj = sim.integrate(times, stop=stop, on_interrupt="keep", on_output=on_output)
     finally:
         if bar is not None:
             bar.close()

@@ -76,6 +76,11 @@ SCHEMA: dict[str, S.Field] = {
     "crosscheck": S.Bool(default=False),
     # the variational equations: MEGNO and the Lyapunov time in the summary
     "variational": S.Bool(default=False),
+    # an archive written while the scene runs (docs/archive.md): a killed run resumes
+    # with ``hamilton-orbits resume OUTDIR``
+    "output": S.Table(default={}, fields={
+        "archive_every": S.Quantity(kind=TIME, positive=True),
+    }),
     "integrator": S.Table(
         default={},
         fields={
