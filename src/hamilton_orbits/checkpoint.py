@@ -46,6 +46,7 @@ __all__ = [
     "from_json",
     "last_snapshot",
     "leg_rows",
+    "on_step_grid",
     "pack",
     "record",
     "snapshot_files",
@@ -212,6 +213,23 @@ def leg_rows(files: list[tuple[int, Path]], start: int, upto: int) -> tuple[
     return times, rows
 
 
+def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
+    """Snapshot times ``extra`` moved to the end of the step at or after each, for a
+    fixed-step method whose steps start afresh at each output time ``times`` (as
+    :func:`hamilton_orbits.integrators._setup.fixed_steps` lays them): the run's
+    steps are then its own, to the rounding of a step's length.
+
+    Examples
+    --------
+    >>> on_step_grid(np.array([1.0, 2.5]), np.array([0.0, 3.0]), 0.3).round(12).tolist()
+    [1.2, 2.7]
+    """
+    k = np.clip(np.searchsorted(times, extra, side="right") - 1, 0, len(times) - 2)
+    a, b = times[k], times[k + 1]
+    moved = a + np.ceil((extra - a) / dt * (1.0 - 1e-12)) * dt
+    return np.unique(np.where(moved >= b, b, moved))
+
+
 def pack(arrays: list[np.ndarray]) -> tuple[np.ndarray, list[list[Any]]]:
     """The arrays of a propagation's state as one float64 vector (integers below
     2**53 and booleans exactly) and each one's ``[offset, shape, dtype]``."""
@@ -262,6 +280,10 @@ class ArchiveWriter:
         A snapshot at the first output after every ``every_wall`` seconds.
     origin : float
         The time the simulation time schedule counts from.
+    exact : bool
+        Snapshots at exactly the scheduled times (a fixed-step method shortens the
+        step before each); False: at the end of the step at or after each (see
+        :func:`on_step_grid`).
     sync : bool
         Sync each snapshot to the disk before it counts (survives a power cut, not
         only a killed process; about 10 ms a snapshot on a common disk, against
@@ -270,7 +292,7 @@ class ArchiveWriter:
 
     def __init__(self, path: str | Path | None, *, every: float | None = None,
                  every_steps: int | None = None, every_wall: float | None = None,
-                 origin: float = 0.0, sync: bool = False) -> None:
+                 origin: float = 0.0, sync: bool = False, exact: bool = True) -> None:
         given = [k for k, x in (("every", every), ("every_steps", every_steps),
                                 ("every_wall", every_wall)) if x is not None]
         if len(given) != 1:
@@ -287,14 +309,17 @@ class ArchiveWriter:
                              f"{every_steps!r}")
         self.path = None if path is None else Path(path)
         self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
-        self.origin, self.sync = float(origin), sync
+        if not isinstance(exact, bool):
+            raise ValueError(f"Expected `exact_times` to be True or False, got {exact!r}")
+        self.origin, self.sync, self.exact = float(origin), sync, exact
         self.folder: OutputFolder | None = None
         self.count = 0
         self.last_steps, self.last_wall = 0, time.monotonic()
 
     def schedule_only(self) -> ArchiveWriter:
         """The same schedule writing nothing (for a copy of the simulation)."""
-        sched = {k: getattr(self, k) for k in ("every", "every_steps", "every_wall", "sync")}
+        sched = {k: getattr(self, k) for k in ("every", "every_steps", "every_wall", "sync",
+                                               "exact")}
         out = ArchiveWriter(None, origin=self.origin, **sched)
         out.last_steps = self.last_steps
         return out
@@ -303,7 +328,7 @@ class ArchiveWriter:
         """The schedule as JSON-able values (kept in every snapshot)."""
         return {"path": None if self.path is None else str(self.path), "every": self.every,
                 "every_steps": self.every_steps, "every_wall": self.every_wall,
-                "origin": self.origin, "sync": self.sync}
+                "origin": self.origin, "sync": self.sync, "exact": self.exact}
 
     def open(self) -> None:
         """Claim the folder (lock) and find the next snapshot number."""

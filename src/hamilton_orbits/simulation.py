@@ -23,12 +23,9 @@ start of the simulation.
 from __future__ import annotations
 
 import copy
-import os
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
-import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
@@ -37,7 +34,6 @@ from hamilton_orbits._legs import (
     check_method,
     event_list,
     event_log,
-    leg_run,
     leg_times,
     progress_reporter,
     requested_rows,
@@ -47,29 +43,23 @@ from hamilton_orbits._legs import (
     time_step,
     tolerance,
 )
+from hamilton_orbits._saving import Saving
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
     LegRows,
-    last_snapshot,
-    leg_rows,
-    record,
-    snapshot_files,
-    spec,
 )
 from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
-from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.rhs import RHS, compile_rhs
-from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory, event_table, make_trajectory
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
 
 
-class Simulation:
+class Simulation(Saving):
     """A prepared n-body integration that lives across calls.
 
     Parameters
@@ -98,6 +88,20 @@ class Simulation:
     tangent : array_like, shape (n, 6), optional
         MEGNO's initial tangent vector (default: random, as rebound's
         ``init_megno`` draws it, a fixed seed).
+    archive : path, optional
+        A folder to write snapshots into while the simulation integrates
+        (``docs/archive.md``), on one of these schedules:
+    every : Quantity or float, optional
+        A snapshot at every multiple of this much simulation time;
+    every_steps : int, optional
+        or at the first output after every so many steps;
+    every_wall : float, optional
+        or at the first output after every so many seconds of wall-clock time.
+    exact_times : bool, optional
+        Snapshots at exactly the scheduled times (the default of the adaptive
+        methods, which end a step there by their own step control), or at the end
+        of the step at or after each (the default of the fixed-step methods, whose
+        steps then stay their own).
     **method_options
         The method's options beside its name (``coordinates="jacobi"``,
         ``corrector=11`` for ``wh``; see :mod:`hamilton_orbits.integrators.methods`).
@@ -143,7 +147,7 @@ class Simulation:
                  events: Any = (), variational: bool = False, stm: bool = False,
                  tangent: Any = None, archive: Any = None, every: Any = None,
                  every_steps: int | None = None, every_wall: float | None = None,
-                 **method_options: Any) -> None:
+                 exact_times: bool | None = None, **method_options: Any) -> None:
         if not isinstance(system, System):
             raise ValueError(f"Expected `system` to be a System, got {system!r}")
         typed = method_of(method, method_options)
@@ -163,7 +167,10 @@ class Simulation:
         self._initial = (arrays.r, arrays.v, arrays.gm)
         self._unit: Any = DAY if system.quantity else None
         self._spec = (typed, step, tol, eff.as_list(), event_list(events), variational, stm)
-        self._archive = _archive_of(archive, every, every_steps, every_wall, system.quantity)
+        fixed = step is not None and typed.name != "dop853"
+        self._archive = _archive_of(archive, (every, every_steps, every_wall),
+                                    not fixed if exact_times is None else exact_times,
+                                    system.quantity)
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
         self._resumable: Any = None
@@ -300,198 +307,17 @@ class Simulation:
                 self._archive.close()
         return out, compiled
 
-    def resume(self, *, progress: bool = False, on_output: Any = None, stop: Any = None,
-               on_interrupt: str = "raise") -> Trajectory:
-        """Finish the ``integrate`` call a killed run was in, from the archive's last
-        snapshot (``Simulation.load(folder)``), and return that call's whole
-        trajectory: the rows archived before the kill and the rest, the bits of the
-        call that was never interrupted.  A kill during ``resume`` is resumed alike.
-
-        Raises
-        ------
-        ValueError
-            When this simulation was not loaded from an archive folder.
-        SnapshotError
-            When a snapshot of the leg is missing or damaged (its rows are lost).
-
-        Examples
-        --------
-        >>> import tempfile
-        >>> from hamilton_orbits import Body, System
-        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
-        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
-        >>> folder = tempfile.mkdtemp()
-        >>> whole = Simulation(s, method="wh", dt=0.01, archive=folder, every=2.0).integrate(
-        ...     np.arange(0.0, 7.0))
-        >>> again = Simulation.load(folder)              # as after a kill at t = 6.5
-        >>> traj = again.resume()                         # the whole call, t = 0 ... 6
-        >>> bool(np.array_equal(traj.r, whole.r)), traj.t.tolist() == whole.t.tolist()
-        (True, True)
-        """
-        if self._resumable is None:
-            raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
-                             "simulation loaded from its archive folder")
-        times, rows, info = self._resumable
-        prop = self._prop
-        rest = times[times > prop.t]
-        out, compiled = None, 0.0
-        if rest.size:
-            out, compiled = self._advance(np.concatenate(([prop.t], rest)), progress,
-                                          on_output, stop)
-            if out.interrupted and on_interrupt == "raise":
-                raise KeyboardInterrupt
-        whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
-        self._start = self._initial
-        unit = u.Unit(info["unit"]) if info["unit"] else None
-        return make_trajectory(self._system, whole, unit, prop.method.name, prop.rhs.effects,
-                               self._effects, start=None if info["first"] else self._initial,
-                               wall_time=max(whole.wall_time - compiled, 0.0))
-
-    # ------------------------------------------------------------------ saving
-    def save(self, path: str | os.PathLike[str]) -> None:
-        """Save everything needed to continue: ``Simulation.load(path).integrate(t)``
-        gives the bits this simulation's ``integrate(t)`` would.
-
-        The file is a self-describing netCDF file (``t``, ``r``, ``v``, ``gm`` readable
-        by any netCDF reader; the method, effects, events and the integrator's own
-        state for this package), written atomically (``docs/archive.md``).
-
-        Examples
-        --------
-        >>> import os, tempfile
-        >>> from hamilton_orbits import Body, System
-        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
-        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
-        >>> sim = Simulation(s, method="wh", dt=0.01)
-        >>> _ = sim.integrate(1.0)
-        >>> with tempfile.TemporaryDirectory() as tmp:
-        ...     sim.save(os.path.join(tmp, "sim.nc"))
-        ...     again = Simulation.load(os.path.join(tmp, "sim.nc"))
-        >>> a, b = sim.integrate(2.0), again.integrate(2.0)
-        >>> bool(np.array_equal(a.r, b.r)), again.steps
-        (True, 200)
-        """
-        write(path, *self._record(), sync=True)
-
-    @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Simulation:
-        """The simulation saved in ``path`` (:meth:`save`), or the last snapshot of an
-        archive folder, which then continues that archive on its schedule.
-
-        A snapshot of an archived run keeps the run's schedule: its snapshot times
-        stay among the output times of later legs (nothing is written unless the
-        folder itself was loaded), so that it continues with the run's bits.
-
-        Raises
-        ------
-        SnapshotError
-            For a missing, damaged or foreign file, naming it.
-        """
-        path = Path(path)
-        folder = path if path.is_dir() else None
-        if folder is not None:
-            path = last_snapshot(folder)
-        meta, arrays = read(path)
-        sim = cls._rebuild(meta, arrays, path)
-        schedule = meta.get("archive")
-        if schedule:  # the archived run's schedule: written on when its folder is loaded
-            sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync")}
-            sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
-            sim._archive.last_steps = sim.steps
-        leg = meta.get("leg")
-        if folder is not None and leg is not None:  # the leg a kill interrupted
-            times, rows = leg_rows(snapshot_files(folder), leg["start"], meta["number"])
-            sim._resumable = (times, rows, leg)
-            sim._leg = LegRows(leg)
-        return sim
-
-    @classmethod
-    def _rebuild(cls, meta: dict[str, Any], arrays: dict[str, np.ndarray],
-                 path: Path) -> Simulation:
-        sp = spec(meta, arrays)
-        system = System.from_system_arrays(sp["system"])
-        days = (lambda x: x) if not system.quantity else (lambda x: x * DAY)
-        sim = cls(system, method_of(sp["method"], sp["options"]),
-                  dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
-                  effects=sp["effects"], events=sp["events"], variational=sp["variational"],
-                  stm=sp["stm"])
-        prop, layout = sim._prop, sp["layout"]
-        if "class" in layout["attrs"]["driver"]:
-            prop.driver_for(bool(layout["attrs"]["backward"]["value"]))
-        try:
-            restore(prop, layout, sp["state"])
-        except LayoutMismatch as exc:
-            raise SnapshotError(f"{path}: the integrator state was saved by another version "
-                                f"({exc})") from None
-        if meta.get("started"):
-            sim._start = sim._initial
-        if meta.get("unit"):
-            sim._unit = u.Unit(meta["unit"])
-        return sim
-
-    def _record(self, rows: Any = None) -> tuple[Any, ...]:
-        extra = {"started": self._start is not None,
-                 "unit": None if self._unit is None else self._unit.to_string(),
-                 "archive": None if self._archive is None else self._archive.schedule()}
-        if rows is not None:
-            extra["leg"] = rows.info
-        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra)
-        if rows is not None:
-            arrays.update(rows.take())
-            dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))
-        return meta, arrays, dims, units
-
-    def _new_leg(self, times: np.ndarray) -> None:
-        """Begin an archived leg through ``times``: its first snapshot (the leg's
-        times, its start) written, so a folder that cannot take it fails now."""
-        arch, prop = self._archive, self._prop
-        if times[-1] < times[0]:
-            raise ValueError("A simulation with an archive integrates forwards in time")
-        try:
-            arch.open()
-            info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
-                    "unit": None if self._unit is None else self._unit.to_string(),
-                    "first_event": 0 if prop.events is None else len(prop.events.recorded())}
-            self._leg = LegRows(info, times)
-            self._leg.add(prop.t, prop.r, prop.v, prop.variational)
-            arch.write(*self._record(self._leg))
-        except BaseException:
-            arch.close()
-            raise
-
-    def _archived_times(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The output times with the archive's snapshot times merged in, which rows
-        were asked for, and which are scheduled snapshots (the folder claimed)."""
-        arch = self._archive
-        arch.open()
-        extra = arch.times(float(times[0]), float(times[-1]))
-        merged = np.union1d(times, extra)
-        return merged, np.isin(merged, times), np.isin(merged, extra)
-
-    def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
-        arch, prop, rows = self._archive, self._prop, self._leg
-
-        def at(i: int) -> None:
-            if i == 0:
-                return
-            if asked[i] and rows is not None:
-                rows.add(prop.t, prop.r, prop.v, prop.variational)
-            if scheduled[i] or arch.due(prop.steps):
-                arch.write(*self._record(rows))
-
-        return at
-
-
-def _archive_of(path: Any, every: Any, every_steps: Any, every_wall: Any,
+def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact: Any,
                 quantity: bool) -> ArchiveWriter | None:
     """The archive a simulation writes while it runs (None without ``path``)."""
+    every, every_steps, every_wall = schedule
     if path is None:
-        if (every, every_steps, every_wall) != (None, None, None):
+        if schedule != (None, None, None):
             raise ValueError("`every`, `every_steps` and `every_wall` schedule an archive: "
                              "give `archive` (a folder) too")
         return None
     return ArchiveWriter(path, every=None if every is None else time_step(every, quantity, "every"),
-                         every_steps=every_steps, every_wall=every_wall)
+                         every_steps=every_steps, every_wall=every_wall, exact=exact)
 
 
 def integrate(

@@ -252,3 +252,25 @@ def test_resume_needs_a_simulation_loaded_from_its_archive(tmp_path):
     whole = sim.integrate(3.0)
     done = Simulation.load(tmp_path).resume()  # the call had ended: nothing to integrate
     assert _same(done.r, whole.r) and done.t.tolist() == whole.t.tolist()
+
+
+def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_times(tmp_path):
+    """wh's snapshots at the end of the step at or after each scheduled time keep its
+    steps (the run agrees with the unarchived one to rounding); exact times shorten
+    the step before each snapshot, which changes the run at the method's own error."""
+    plain = Simulation(_disc(), method="wh", dt=0.05).integrate(T)
+    grid = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "grid", every=0.77)
+    on_grid = grid.integrate(T)
+    times = Archive(tmp_path / "grid").times[1:]
+    steps = times / 0.05
+    np.testing.assert_allclose(steps, np.round(steps), rtol=0, atol=1e-9)  # on the grid
+    assert np.all(times - 0.77 * np.arange(1, len(times) + 1) < 0.05)      # at or after
+    np.testing.assert_allclose(on_grid.r, plain.r, rtol=0, atol=1e-12)
+    exact = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "exact", every=0.77,
+                       exact_times=True).integrate(T)
+    np.testing.assert_array_equal(Archive(tmp_path / "exact").times[1:],
+                                  0.77 * np.arange(1, 78))
+    assert np.max(np.abs(exact.r - plain.r)) > 1e-9  # the shortened steps' cost
+    with pytest.raises(ValueError, match=r"Expected `exact_times` to be True or False"):
+        Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "x", every=1.0,
+                   exact_times="yes")

@@ -1,0 +1,232 @@
+"""Saving, loading, archives and resuming: the part of
+:class:`~hamilton_orbits.simulation.Simulation` that never loses a run
+(``docs/archive.md``).
+
+:class:`Saving` is a mixin of ``Simulation``: ``save`` and ``load`` (a snapshot
+file, or the last snapshot of an archive folder), the archive written while it
+integrates (a leg's first snapshot, the scheduled ones, the caller's rows in each)
+and ``resume`` (the ``integrate`` call a kill interrupted, finished and returned
+whole).  The state itself is flattened by :mod:`hamilton_orbits.restart`, written
+by :mod:`hamilton_orbits.snapshot` and scheduled by
+:mod:`hamilton_orbits.checkpoint`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import astropy.units as u
+import numpy as np
+
+from hamilton_orbits._legs import leg_run
+from hamilton_orbits.checkpoint import (
+    ArchiveWriter,
+    LegRows,
+    last_snapshot,
+    leg_rows,
+    on_step_grid,
+    record,
+    snapshot_files,
+    spec,
+)
+from hamilton_orbits.integrators import method_of
+from hamilton_orbits.nbody import DAY, System
+from hamilton_orbits.restart import LayoutMismatch, restore
+from hamilton_orbits.snapshot import SnapshotError, read, write
+from hamilton_orbits.trajectory import Trajectory, make_trajectory
+
+__all__ = ["Saving"]
+
+
+class Saving:
+    """Saving, loading, the archive and ``resume`` of a
+    :class:`~hamilton_orbits.simulation.Simulation` (a mixin: it stands on the
+    simulation's propagation, system and specification)."""
+
+    def resume(self, *, progress: bool = False, on_output: Any = None, stop: Any = None,
+               on_interrupt: str = "raise") -> Trajectory:
+        """Finish the ``integrate`` call a killed run was in, from the archive's last
+        snapshot (``Simulation.load(folder)``), and return that call's whole
+        trajectory: the rows archived before the kill and the rest, the bits of the
+        call that was never interrupted.  A kill during ``resume`` is resumed alike.
+
+        Raises
+        ------
+        ValueError
+            When this simulation was not loaded from an archive folder.
+        SnapshotError
+            When a snapshot of the leg is missing or damaged (its rows are lost).
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> import numpy as np
+        >>> from hamilton_orbits import Body, Simulation, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> folder = tempfile.mkdtemp()
+        >>> whole = Simulation(s, method="wh", dt=0.01, archive=folder, every=2.0).integrate(
+        ...     np.arange(0.0, 7.0))
+        >>> again = Simulation.load(folder)              # as after a kill at t = 6.5
+        >>> traj = again.resume()                         # the whole call, t = 0 ... 6
+        >>> bool(np.array_equal(traj.r, whole.r)), traj.t.tolist() == whole.t.tolist()
+        (True, True)
+        """
+        if self._resumable is None:
+            raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
+                             "simulation loaded from its archive folder")
+        times, rows, info = self._resumable
+        prop = self._prop
+        rest = times[times > prop.t]
+        out, compiled = None, 0.0
+        if rest.size:
+            out, compiled = self._advance(np.concatenate(([prop.t], rest)), progress,
+                                          on_output, stop)
+            if out.interrupted and on_interrupt == "raise":
+                raise KeyboardInterrupt
+        whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
+        self._start = self._initial
+        unit = u.Unit(info["unit"]) if info["unit"] else None
+        return make_trajectory(self._system, whole, unit, prop.method.name, prop.rhs.effects,
+                               self._effects, start=None if info["first"] else self._initial,
+                               wall_time=max(whole.wall_time - compiled, 0.0))
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Save everything needed to continue: ``Simulation.load(path).integrate(t)``
+        gives the bits this simulation's ``integrate(t)`` would.
+
+        The file is a self-describing netCDF file (``t``, ``r``, ``v``, ``gm`` readable
+        by any netCDF reader; the method, effects, events and the integrator's own
+        state for this package), written atomically (``docs/archive.md``).
+
+        Examples
+        --------
+        >>> import os, tempfile
+        >>> import numpy as np
+        >>> from hamilton_orbits import Body, Simulation, System
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> sim = Simulation(s, method="wh", dt=0.01)
+        >>> _ = sim.integrate(1.0)
+        >>> with tempfile.TemporaryDirectory() as tmp:
+        ...     sim.save(os.path.join(tmp, "sim.nc"))
+        ...     again = Simulation.load(os.path.join(tmp, "sim.nc"))
+        >>> a, b = sim.integrate(2.0), again.integrate(2.0)
+        >>> bool(np.array_equal(a.r, b.r)), again.steps
+        (True, 200)
+        """
+        write(path, *self._record(), sync=True)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Any:
+        """The simulation saved in ``path`` (:meth:`save`), or the last snapshot of an
+        archive folder, which then continues that archive on its schedule.
+
+        A snapshot of an archived run keeps the run's schedule: its snapshot times
+        stay among the output times of later legs (nothing is written unless the
+        folder itself was loaded), so that it continues with the run's bits.
+
+        Raises
+        ------
+        SnapshotError
+            For a missing, damaged or foreign file, naming it.
+        """
+        path = Path(path)
+        folder = path if path.is_dir() else None
+        if folder is not None:
+            path = last_snapshot(folder)
+        meta, arrays = read(path)
+        sim = cls._rebuild(meta, arrays, path)
+        schedule = meta.get("archive")
+        if schedule:  # the archived run's schedule: written on when its folder is loaded
+            sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync",
+                                              "exact")}
+            sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
+            sim._archive.last_steps = sim.steps
+        leg = meta.get("leg")
+        if folder is not None and leg is not None:  # the leg a kill interrupted
+            times, rows = leg_rows(snapshot_files(folder), leg["start"], meta["number"])
+            sim._resumable = (times, rows, leg)
+            sim._leg = LegRows(leg)
+        return sim
+
+    @classmethod
+    def _rebuild(cls, meta: dict[str, Any], arrays: dict[str, np.ndarray],
+                 path: Path) -> Any:
+        sp = spec(meta, arrays)
+        system = System.from_system_arrays(sp["system"])
+        days = (lambda x: x) if not system.quantity else (lambda x: x * DAY)
+        sim = cls(system, method_of(sp["method"], sp["options"]),
+                  dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
+                  effects=sp["effects"], events=sp["events"], variational=sp["variational"],
+                  stm=sp["stm"])
+        prop, layout = sim._prop, sp["layout"]
+        if "class" in layout["attrs"]["driver"]:
+            prop.driver_for(bool(layout["attrs"]["backward"]["value"]))
+        try:
+            restore(prop, layout, sp["state"])
+        except LayoutMismatch as exc:
+            raise SnapshotError(f"{path}: the integrator state was saved by another version "
+                                f"({exc})") from None
+        if meta.get("started"):
+            sim._start = sim._initial
+        if meta.get("unit"):
+            sim._unit = u.Unit(meta["unit"])
+        return sim
+
+    def _record(self, rows: Any = None) -> tuple[Any, ...]:
+        extra = {"started": self._start is not None,
+                 "unit": None if self._unit is None else self._unit.to_string(),
+                 "archive": None if self._archive is None else self._archive.schedule()}
+        if rows is not None:
+            extra["leg"] = rows.info
+        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra)
+        if rows is not None:
+            arrays.update(rows.take())
+            dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))
+        return meta, arrays, dims, units
+
+    def _new_leg(self, times: np.ndarray) -> None:
+        """Begin an archived leg through ``times``: its first snapshot (the leg's
+        times, its start) written, so a folder that cannot take it fails now."""
+        arch, prop = self._archive, self._prop
+        if times[-1] < times[0]:
+            raise ValueError("A simulation with an archive integrates forwards in time")
+        try:
+            arch.open()
+            info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
+                    "unit": None if self._unit is None else self._unit.to_string(),
+                    "first_event": 0 if prop.events is None else len(prop.events.recorded())}
+            self._leg = LegRows(info, times)
+            self._leg.add(prop.t, prop.r, prop.v, prop.variational)
+            arch.write(*self._record(self._leg))
+        except BaseException:
+            arch.close()
+            raise
+
+    def _archived_times(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The output times with the archive's snapshot times merged in, which rows
+        were asked for, and which are scheduled snapshots (the folder claimed)."""
+        arch = self._archive
+        arch.open()
+        extra = arch.times(float(times[0]), float(times[-1]))
+        if not arch.exact and self._prop.dt is not None and self._prop.method.name != "dop853":
+            extra = on_step_grid(extra, times, self._prop.dt)
+        merged = np.union1d(times, extra)
+        return merged, np.isin(merged, times), np.isin(merged, extra)
+
+    def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
+        arch, prop, rows = self._archive, self._prop, self._leg
+
+        def at(i: int) -> None:
+            if i == 0:
+                return
+            if asked[i] and rows is not None:
+                rows.add(prop.t, prop.r, prop.v, prop.variational)
+            if scheduled[i] or arch.due(prop.steps):
+                arch.write(*self._record(rows))
+
+        return at
