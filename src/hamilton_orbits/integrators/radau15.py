@@ -328,6 +328,8 @@ def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:
     return {
         _k.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
-        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r})",
+        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r}; a "
+                             "collision, or an encounter closer than float64 resolves at this "
+                             "time?)",
         _k.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
     }[status]
