@@ -57,15 +57,14 @@ from hamilton_orbits._body import (
     body_arrays,
     body_from_floats,
 )
-from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.deprecation import moved_name
 from hamilton_orbits.initial_states import InitialStates
 from hamilton_orbits.integrals import energy_gm
+from hamilton_orbits.integrators import _setup
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent
 
 __all__ = ["Body", "System", "SystemArrays"]
 
-_TINY = float(np.finfo(np.float64).tiny)  # the smallest normal float64
 _ = AU, DAY  # the internal units of Quantity systems (hamilton_orbits._body), here too
 
 
@@ -271,19 +270,8 @@ class System(InitialStates):
     def _check_positions(self) -> None:
         """Refuse two bodies (one of them massive) at one position, or so close that
         the cube of their separation underflows float64 (the force would be
-        infinite or undefined)."""
-        d2, i, j = _nbody.closest_pair(np.ascontiguousarray(self._r), self._gm)
-        if i < 0 or d2 * math.sqrt(d2) >= _TINY:
-            return
-        if np.array_equal(self._r[i], self._r[j]):
-            raise ValueError(f"Bodies {self.names[i]!r} and {self.names[j]!r} are at one "
-                             f"position {self._r[i].tolist()}")
-        apart = float(np.max(np.abs(self._r[i] - self._r[j])))  # d2 may underflow to 0
-        raise ValueError(
-            f"Bodies {self.names[i]!r} and {self.names[j]!r} are {apart:.3g} apart: "
-            f"the cube of their separation underflows float64 (below {_TINY ** (1 / 3):.3g} "
-            "in the system's length unit); use a smaller length unit or merge them"
-        )
+        infinite or undefined): :func:`hamilton_orbits.integrators._setup.check_apart`."""
+        _setup.check_apart(self._r, self._gm, self.names)
 
     # --------------------------------------------------------------- accessors
     def _set_arrays(self, names: tuple[str, ...], index: dict[str, int] | None,

@@ -168,3 +168,38 @@ def test_the_1000_year_reference_agrees_with_itself_to_1e_13(solar):
     h = ref.r[-1][1:] - ref.r[-1][0]
     h_check = ref.r_check[-1][1:] - ref.r_check[-1][0]
     assert np.max(np.linalg.norm(h_check - h, axis=1) / np.linalg.norm(h, axis=1)) < 1e-13
+
+
+# Issue 32: the double-double step guard (class 12), its options (class 14) and the
+# reference cache (class 15).
+
+def test_double_double_counts_its_steps_before_the_first():
+    """``dt = 1e-12`` over a unit span never returned (1e12 steps of 0.5 ms) and
+    ``max_steps=5`` was ignored (100 steps ran): both are refused up front, naming
+    the steps, ``dt`` and ``max_steps``; 100 steps with ``max_steps=100`` run."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    with pytest.raises(ValueError, match=r"radau15 in double-double would take about 1e\+12 "
+                                         r"steps of dt = 1e-12 over 1 \(max_steps = 100000000\)"):
+        integrate(s, 1.0, precision="double-double", dt=1e-12)
+    with pytest.raises(ValueError, match=r"about 100 steps of dt = 0.01 over 1 \(max_steps = 5\)"):
+        integrate(s, 1.0, precision="double-double", dt=0.01, max_steps=5)
+    traj = integrate(s, 1.0, precision="double-double", dt=0.01, max_steps=100)
+    assert traj.steps == 100
+    # the circular orbit: exact cos t, sin t
+    np.testing.assert_allclose(traj.final["p"].r, [math.cos(1.0), math.sin(1.0), 0.0],
+                               rtol=0, atol=1e-15)
+
+
+def test_double_double_names_a_collision():
+    """Two bodies at one point reach the double-double kernel only past the checks
+    (a Propagation made directly): its division by zero is a ConvergenceError."""
+    from hamilton_orbits import engine
+    from hamilton_orbits.integrators import Radau15
+    from hamilton_orbits.validation import ConvergenceError
+
+    prop = engine.Propagation(np.zeros((2, 3)), np.array([[0.0, 0, 0], [0, 1.0, 0]]),
+                              np.array([1.0, 1.0]), 0.0, newtonian_rhs(),
+                              Radau15(precision="double-double"), dt=0.1)
+    with pytest.raises(ConvergenceError, match=r"double-double stopped before t_out\[1\] = 1.0: "
+                                               r"two bodies met"):
+        prop.advance(np.array([0.0, 1.0]))
