@@ -190,6 +190,19 @@ def test_double_double_counts_its_steps_before_the_first():
                                rtol=0, atol=1e-15)
 
 
+def test_double_double_options_are_checked_by_name():
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    with pytest.raises(ValueError, match=r"Expected `criterion` to be one of 'global', 'prs23', "
+                                         r"got 'bogus'"):
+        integrate(s, 1.0, precision="double-double", dt=0.1, criterion="bogus")
+    # the precision is named, not double-double
+    with pytest.raises(ValueError, match=r"Expected `precision` to be one of 'double', "
+                                         r"'double-double', got 'quad'"):
+        integrate(s, 1.0, precision="quad", variational=True)
+    with pytest.raises(ValueError, match=r"double-double integrates no variational equations"):
+        integrate(s, 1.0, precision="double-double", dt=0.1, variational=True)
+
+
 def test_double_double_names_a_collision():
     """Two bodies at one point reach the double-double kernel only past the checks
     (a Propagation made directly): its division by zero is a ConvergenceError."""
