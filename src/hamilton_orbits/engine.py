@@ -190,6 +190,8 @@ class Propagation:
         self.backward = False
         #: steps taken by earlier drivers (a change of direction starts a new one)
         self.steps_before = 0
+        #: a collision at the start stops the first leg there
+        self.stop_at_start = False
 
     @property
     def steps(self) -> int:
@@ -217,12 +219,23 @@ class Propagation:
             self.steps_before += self.driver.steps
         watched = self.events is not None and len(self.events.watch)
         sign = -1.0 if backward else 1.0
+        if self.driver is None and watched:
+            self._collisions_at_start()
         self.driver = self.module.start(
             self.rhs, self.r, -self.v if backward else self.v, self.gm, sign * self.t,
             self.method, dt=self.dt, tol=self.tol, events=self.events if watched else None,
             variational=self.variational)
         self.backward = backward
         return self.driver
+
+    def _collisions_at_start(self) -> None:
+        """Bodies that overlap at the start: their collisions happen here, at the first
+        leg's start (:meth:`~hamilton_orbits.events.EventLog.at_start`), on copies of
+        the state; a stop is kept for :meth:`advance` to end the leg at its start."""
+        r, v, gm = self.r.copy(), self.v.copy(), self.gm.copy()
+        self.stop_at_start = self.events.at_start(self.t, r, v, gm)
+        if self.events.gm_changes:
+            self.r, self.v, self.gm = r, v, gm
 
     def advance(self, t_out: np.ndarray, *, on_output: Callable[[int, int], None] | None = None,
                 stop: Callable[[], bool] | None = None,
@@ -234,16 +247,18 @@ class Propagation:
         continues bit for bit)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
-        driver = self.driver if self.driver is not None and backward == self.backward \
-            else self.driver_for(backward)
-        rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
-        r_out, v_out = rows[0], rows[1]
-        r_out[0], v_out[0] = self.r, self.v
         events = self.events
         first_event = 0
         if events is not None:
             first_event = len(events.recorded())
             events.stopped_by = None
+        driver = self.driver if self.driver is not None and backward == self.backward \
+            else self.driver_for(backward)
+        rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
+        r_out, v_out = rows[0], rows[1]
+        r_out[0], v_out[0] = self.r, self.v
+        if events is not None:
+            events.mask(r_out[0], v_out[0])
         if self.variational is not None:
             self.variational.new_leg(n_t)
         reached = [0, 0]  # last output index, steps
@@ -262,6 +277,9 @@ class Propagation:
         start, steps0 = time.perf_counter(), driver.steps
         complete, interrupted = True, False
         try:
+            if self.stop_at_start:  # a collision at the start stops the run there
+                self.stop_at_start = False
+                raise StopAtEvent(0, self.t, 0)
             driver.advance(-t_out if backward else t_out, r_out, v_out, report, stop)
             reached[0], reached[1] = n_t - 1, driver.steps - steps0
         except StopAtEvent as stopped:

@@ -24,7 +24,8 @@ What each finds
     The first contact of two bodies with radii (``|r_i - r_j| = R_i + R_j``),
     solved on the interpolant.  ``"stop"`` ends the run there; ``"merge"``
     replaces the pair by one body with their summed mass at their centre of
-    mass with their total momentum, and goes on.
+    mass with their total momentum, and goes on.  Bodies that already overlap
+    at the start of a run collide there, at its first time.
 ``escape``
     A body's distance from the system's centre of mass crossing ``distance``
     outwards.  ``"record"`` (default) goes on; ``"stop"`` ends the run;
@@ -49,6 +50,8 @@ the row of the event that ended the run, or None.
 from __future__ import annotations
 
 import difflib
+import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -164,7 +167,20 @@ def _check_entry(item: Any, k: int) -> tuple[str, dict[str, Any]]:
     if name == "close_encounter" and "distance" not in params:
         raise ValueError(f"Event at index {k} ({name!r}): `distance` is required (a length "
                          "or {'hill': k})")
+    if isinstance(params.get("distance"), Mapping):
+        _check_hill(params["distance"], f"Event at index {k} ({name!r})", name)
     return name, {**params, "action": action}
+
+
+def _check_hill(value: Mapping[str, Any], where: str, name: str) -> None:
+    """A ``{"hill": k}`` distance: one key, ``k`` a finite number > 0."""
+    if name != "close_encounter" or set(value) != {"hill"}:
+        form = "a length or {'hill': k}" if name == "close_encounter" else "a length"
+        raise ValueError(f"{where}: expected `distance` to be {form}, got {value!r}")
+    k = value["hill"]
+    if isinstance(k, bool) or not isinstance(k, numbers.Real) or not 0.0 < float(k) < math.inf:
+        raise ValueError(f"{where}: expected `distance` {{'hill': k}} with `hill` a number "
+                         f"k > 0 (Hill radii), got {k!r}")
 
 
 def watch_table(events: EventSet, system: Any) -> np.ndarray:
@@ -219,11 +235,17 @@ def _bodies(params: Mapping[str, Any], system: Any, where: str, single: bool) ->
         return [i for i in range(len(gm)) if i != top]
     if isinstance(names, str):
         names = [names]
+    if not isinstance(names, (Sequence, np.ndarray)) or not all(isinstance(x, str)
+                                                                 for x in names):
+        raise ValueError(f"{where}: expected `bodies` to be body names, got {names!r}")
     out = []
-    for name in names:
+    for k, name in enumerate(names):
         if name not in system.names:
             raise ValueError(f"{where}: `bodies` names {name!r}, which is not in the system; "
                              f"bodies: {', '.join(system.names)}")
+        if single and name in names[:k]:
+            raise ValueError(f"{where}: `bodies` names {name!r} twice (at indices "
+                             f"{list(names).index(name)} and {k})")
         out.append(system.names.index(name))
     return out
 
@@ -262,7 +284,11 @@ def _length(value: Any, system: Any, where: str) -> float:
     if system.quantity and not is_quantity(value):
         raise ValueError(f"{where}: expected `distance` as a length Quantity for a Quantity "
                          f"system, got {value!r}")
-    dist = float(LENGTH("distance", value, u.au if system.quantity else None))
+    try:
+        dist = float(LENGTH("distance", value, u.au if system.quantity else None))
+    except (ValueError, TypeError, u.UnitsError) as exc:
+        msg = str(exc)
+        raise ValueError(f"{where}: {msg[:1].lower()}{msg[1:]}") from None
     if not (np.isfinite(dist) and dist > 0):
         raise ValueError(f"{where}: expected `distance` > 0, got {value!r}")
     return dist
@@ -276,9 +302,8 @@ def _hill(params: Mapping[str, Any]) -> bool:
 def _encounter_distance(value: Any, system: Any, i: int, j: int, where: str) -> float:
     if not (isinstance(value, Mapping) and set(value) == {"hill"}):
         return _length(value, system, where)
+    _check_hill(value, where, "close_encounter")
     k = float(value["hill"])
-    if not (np.isfinite(k) and k > 0):
-        raise ValueError(f"{where}: expected {{'hill': k}} with k > 0, got {value!r}")
     a = system.as_arrays()
     top = int(np.argmax(a.gm))
     big = i if a.gm[i] >= a.gm[j] else j
@@ -386,6 +411,29 @@ class EventLog:
         """Every recorded row, shape (k, 7)."""
         self.drain()
         return np.array(self.rows).reshape(-1, N_EVENT_COLUMNS)
+
+    def at_start(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
+        """Collisions already made at the start ``t`` of a run: every watched pair that
+        overlaps there (``|r_i - r_j| <= R_i + R_j``, which no crossing will reveal) is
+        recorded at ``t`` and its action carried out on ``r``, ``v``, ``gm`` (in place;
+        a merged body that overlaps another collides with it in turn).  True if the
+        run must stop there."""
+        code = EVENTS["collision"][0]
+        while True:
+            rows = np.flatnonzero(self.watch[:, W_CODE] == code)
+            pairs = self.watch[rows][:, [W_I, W_J]].astype(int)
+            d = np.linalg.norm(r[pairs[:, 0]] - r[pairs[:, 1]], axis=1)
+            inside = np.flatnonzero(d <= self.watch[rows, W_DIST])
+            if not inside.size:
+                return False
+            row = int(rows[inside[0]])
+            i, j = pairs[inside[0]]
+            speed = float(np.linalg.norm(v[i] - v[j]))
+            self.drain()
+            self.rows.append(np.array([code, i, j, t, d[inside[0]], speed,
+                                       self.watch[row, W_ACTION]]))
+            if self.act(row, t, r, v, gm):
+                return True
 
     def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
         """Carry out the action of watch row ``row`` at time ``t`` on the state

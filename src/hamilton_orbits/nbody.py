@@ -57,15 +57,14 @@ from hamilton_orbits._body import (
     body_arrays,
     body_from_floats,
 )
-from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.deprecation import moved_name
 from hamilton_orbits.initial_states import InitialStates
 from hamilton_orbits.integrals import energy_gm
+from hamilton_orbits.integrators import _setup
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent
 
 __all__ = ["Body", "System", "SystemArrays"]
 
-_TINY = float(np.finfo(np.float64).tiny)  # the smallest normal float64
 _ = AU, DAY  # the internal units of Quantity systems (hamilton_orbits._body), here too
 
 
@@ -201,16 +200,16 @@ class System(InitialStates):
         names : sequence of str, optional
             Unique names; default ``"b0"``, ``"b1"``, ...
         radius : Quantity or array_like, shape (n,), optional
-            Radii > 0, NaN for none.
+            Finite radii > 0, NaN for none.
         G : float, optional
             For a plain-float system, as in :class:`System`.
 
         Raises
         ------
         ValueError
-            Naming the argument and index: non-finite values, wrong shapes,
-            negative ``gm``, no massive body, duplicate names, two bodies at one
-            position; a mix of Quantities and floats.
+            Naming the argument and index: non-finite values (an infinite
+            ``radius``), wrong shapes, negative ``gm``, no massive body, duplicate
+            names, two bodies at one position; a mix of Quantities and floats.
 
         Examples
         --------
@@ -246,6 +245,7 @@ class System(InitialStates):
             if rad.shape != (n,):
                 raise ValueError(f"Expected `radius` to have shape ({n},), got {rad.shape}")
             check_positive("radius", np.where(np.isnan(rad), 1.0, rad))
+            _finite("radius", rad[~np.isnan(rad)], np.flatnonzero(~np.isnan(rad)))
         names_t = tuple(f"b{k}" for k in range(n)) if names is None else tuple(names)
         if len(names_t) != n or not all(isinstance(x, str) and x for x in names_t):
             raise ValueError(f"Expected `names` to be {n} non-empty strings, got {names!r}")
@@ -302,19 +302,8 @@ class System(InitialStates):
     def _check_positions(self) -> None:
         """Refuse two bodies (one of them massive) at one position, or so close that
         the cube of their separation underflows float64 (the force would be
-        infinite or undefined)."""
-        d2, i, j = _nbody.closest_pair(np.ascontiguousarray(self._r), self._gm)
-        if i < 0 or d2 * math.sqrt(d2) >= _TINY:
-            return
-        if np.array_equal(self._r[i], self._r[j]):
-            raise ValueError(f"Bodies {self.names[i]!r} and {self.names[j]!r} are at one "
-                             f"position {self._r[i].tolist()}")
-        apart = float(np.max(np.abs(self._r[i] - self._r[j])))  # d2 may underflow to 0
-        raise ValueError(
-            f"Bodies {self.names[i]!r} and {self.names[j]!r} are {apart:.3g} apart: "
-            f"the cube of their separation underflows float64 (below {_TINY ** (1 / 3):.3g} "
-            "in the system's length unit); use a smaller length unit or merge them"
-        )
+        infinite or undefined): :func:`hamilton_orbits.integrators._setup.check_apart`."""
+        _setup.check_apart(self._r, self._gm, self.names)
 
     # --------------------------------------------------------------- accessors
     def _set_arrays(self, names: tuple[str, ...], index: dict[str, int] | None,
@@ -443,8 +432,9 @@ class System(InitialStates):
         Raises
         ------
         ValueError
-            For a non-finite or ill-shaped ``r`` or ``v``, or two bodies (one of
-            them massive) at one position.
+            For a non-finite or ill-shaped ``r``, ``v`` or ``gm``, a negative
+            ``gm``, no massive body left, or two bodies (one of them massive) at
+            one position.
 
         Examples
         --------
@@ -455,11 +445,17 @@ class System(InitialStates):
         Traceback (most recent call last):
         ...
         ValueError: Expected `r` to have shape (1, 3), got (2, 3)
+        >>> s.with_state(np.ones((1, 3)), np.zeros((1, 3)), gm=[-1.0])
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `gm` >= 0, got -1.0 at index 0
         """
         out = object.__new__(System)
         r = np.array(r, dtype=np.float64)
         v = np.array(v, dtype=np.float64)
         gm = self._gm if gm is None else np.array(gm, dtype=np.float64)
+        if check and gm.shape != self._gm.shape:
+            raise ValueError(f"Expected `gm` to have shape {self._gm.shape}, got {gm.shape}")
         arrays = (gm, r, v, self._radius, self._j2, self._pole)
         names, index = self._names, self._index
         if keep is not None and not np.all(keep):
@@ -472,7 +468,13 @@ class System(InitialStates):
         return out
 
     def _check_state(self) -> None:
+        from hamilton_orbits.validation import check_positive
+
         n = len(self._names)
+        _finite("gm", self._gm)
+        check_positive("gm", self._gm, strict=False)
+        if not np.any(self._gm > 0):
+            raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
         for name, arr in (("r", self._r), ("v", self._v)):
             if arr.shape != (n, 3):
                 raise ValueError(f"Expected `{name}` to have shape ({n}, 3), got {arr.shape}")
@@ -579,6 +581,17 @@ _MOVED = {
     **dict.fromkeys(("LostStateError", "accelerations_quaternion", "energy_gm_many",
                      "integral_errors"), "hamilton_orbits.integrals"),
 }
+
+
+def _finite(name: str, arr: np.ndarray, where: np.ndarray | None = None) -> None:
+    """Refuse a NaN or infinite entry of the 1-d ``arr``, naming ``name``, the index
+    (``where[k]`` for entry ``k`` when given) and the value."""
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        k = int(bad[0])
+        index = k if where is None else int(where[k])
+        raise ValueError(f"Expected `{name}` to be finite, got {float(arr[k])!r} at index "
+                         f"{index}")
 
 
 def __getattr__(name: str) -> Any:

@@ -44,3 +44,37 @@ def test_a_propagation_continues_and_counts_its_steps():
     once = engine.run(R0, V0, GM, [0.0, 1.0, 2.0], newtonian_rhs(), "radau15", dt=0.1)
     assert first.steps + second.steps == legs.steps == once.steps == 20
     assert np.array_equal(second.r[-1], once.r[-1]) and legs.t == 2.0
+
+
+# Issue 32, classes 12 and 16: two massive bodies at one point ran dop853 for
+# minutes (scipy turned the NaN derivative into a NaN first step and looped on it).
+
+@pytest.mark.parametrize("method", ["radau15", "wh", "leapfrog", "dop853"])
+def test_two_bodies_at_one_point_are_refused_by_name(method):
+    r0 = np.array([[0.0, 0, 0], [0.5, 0, 0], [0.5, 0, 0]])
+    v0 = np.array([[0.0, 0, 0], [0, 1.0, 0], [0, 1.2, 0]])
+    with pytest.raises(ValueError, match=r"Bodies at indices 1 and 2 of `r0` are at one "
+                                         r"position \[0.5, 0.0, 0.0\]"):
+        engine.run(r0, v0, np.array([1.0, 1e-3, 1e-3]), [0.0, 1.0], newtonian_rhs(), method,
+                   dt=0.01)
+    # a test particle on a massive body: its acceleration is infinite as well
+    with pytest.raises(ValueError, match=r"Bodies at indices 0 and 1 of `r0`"):
+        engine.run(R0[[0, 0]], V0, GM, [0.0, 1.0], newtonian_rhs(), method, dt=0.01)
+    # two test particles at one point pull on nothing: allowed
+    out = engine.run(np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0]]), np.array(
+        [[0.0, 0, 0], [0, 1.0, 0], [0, 1.0, 0]]), np.array([1.0, 0.0, 0.0]), [0.0, 1.0],
+        newtonian_rhs(), method, dt=0.01)
+    np.testing.assert_allclose(out.r[-1, 1], out.r[-1, 2], rtol=0, atol=1e-15)
+
+
+def test_dop853_stops_at_a_non_finite_acceleration_instead_of_looping():
+    """Past the checks (a Propagation made directly), two bodies at one point give
+    dop853 a non-finite acceleration: a ConvergenceError at once, naming the time."""
+    from hamilton_orbits.integrators import DOP853
+    from hamilton_orbits.validation import ConvergenceError
+
+    prop = engine.Propagation(np.zeros((2, 3)), V0, np.array([1.0, 1.0]), 0.0,
+                              newtonian_rhs(), DOP853())
+    with pytest.raises(ConvergenceError, match=r"dop853 stopped at t = 0.0: the acceleration "
+                                               r"became non-finite"):
+        prop.advance(np.array([0.0, 1.0]))

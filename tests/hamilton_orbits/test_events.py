@@ -152,11 +152,62 @@ def test_events_with_quantities_and_hill_radii():
     ([{"name": "close_encounter", "distance": 0.1, "bodies": ["a", "x"]}], r"'x', which is not"),
     (["collision"], r"no pair of bodies has radii"),
     ([{"name": "close_encounter", "distance": -1.0}], r"`distance` > 0"),
+    # issue 32, class 13: a bare TypeError, a message not naming `hill`, an escape
+    # recorded twice
+    ([{"name": "close_encounter", "distance": {"hill": None}}],
+     r"^Event at index 0 \('close_encounter'\): expected `distance` \{'hill': k\} with `hill` "
+     r"a number k > 0 \(Hill radii\), got None$"),
+    ([{"name": "close_encounter", "distance": {"hill": "three"}}],
+     r"expected `distance` \{'hill': k\} with `hill` a number k > 0 \(Hill radii\), "
+     r"got 'three'$"),
+    ([{"name": "close_encounter", "distance": {"hill": 3, "au": 1}}],
+     r"expected `distance` to be a length or \{'hill': k\}, got \{'hill': 3, 'au': 1\}"),
+    ([{"name": "escape", "distance": {"hill": 3}}],
+     r"Event at index 0 \('escape'\): expected `distance` to be a length, got \{'hill': 3\}"),
+    ([{"name": "escape", "distance": "far"}], r"^Event at index 0 \('escape'\): .*'far'"),
+    ([{"name": "escape", "distance": 3.0, "bodies": ["b", "b"]}],
+     r"^Event at index 0 \('escape'\): `bodies` names 'b' twice \(at indices 0 and 1\)$"),
+    ([{"name": "escape", "distance": 3.0, "bodies": [1]}],
+     r"^Event at index 0 \('escape'\): expected `bodies` to be body names, got \[1\]$"),
 ])
 def test_bad_events_are_named(events, match):
     s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
     with pytest.raises(ValueError, match=match):
         integrate(s, 1.0, events=events)
+
+
+@pytest.mark.parametrize(("method", "kw"), [("radau15", {}), ("dop853", {}),
+                                           ("leapfrog", {"dt": 0.01}), ("wh", {"dt": 0.01})])
+def test_bodies_overlapping_at_the_start_collide_there(method, kw):
+    """Issue 32, class 13: two bodies that already overlap at t = 0 never cross
+    their contact distance, and were never reported.  Their collision is now at
+    the start: ``"stop"`` ends the run there (one output, t = 0), ``"merge"``
+    merges them there, conserving mass, momentum and the centre of mass."""
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0], radius=0.1),
+                     Body("b", 1e-3, [0.05, 0, 0], [0, 1.0, 0], radius=0.1),
+                     Body("c", 0.0, [2.0, 0, 0], [0, 0.7, 0])])
+    traj = integrate(system, 1.0, method=method, events=["collision"], **kw)
+    assert traj.t.tolist() == [0.0] and len(traj.events) == 1
+    row = traj.stopped_by
+    assert (row["name"], row["bodies"], row["time"]) == ("collision", "a-b", 0.0)
+    assert (row["distance"], row["speed"]) == (0.05, 1.0)
+    merged = integrate(system, 1.0, method=method,
+                       events=[{"name": "collision", "action": "merge"}], **kw)
+    assert merged.stopped_by is None and merged.t[-1] == 1.0
+    assert len(merged.events) == 1 and merged.events["time"][0] == 0.0
+    a = merged.final["a"]
+    assert merged.final.names == ("a", "c") and a.gm == 1.001
+    # the merged body alone (c is massless): uniform motion of the pair's centre of mass
+    np.testing.assert_allclose(a.v, [0, 1e-3 / 1.001, 0], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(a.r, [0.05e-3 / 1.001, 1e-3 / 1.001, 0], rtol=1e-14,
+                               atol=1e-18)
+
+
+def test_an_escape_of_one_body_is_recorded_once():
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 2, 0])])
+    traj = integrate(system, 10.0, events=[{"name": "escape", "distance": 3.0,
+                                            "bodies": np.array(["p"])}])
+    assert len(traj.events) == 1 and traj.events["bodies"][0] == "p"
 
 
 def test_no_events_listed_is_an_empty_table():

@@ -192,11 +192,35 @@ def test_quantity_system_units():
         (lambda: System([Body("a", 0.0, [0, 0, 0], [0, 0, 0])]), r"gm"),
         (lambda: System([Body("a", 1.0, [0, 0, 0], [0, 0, 0])])["b"], r"No body named 'b'"),
         (lambda: System.solar_system("J2000", bodies=["sun", "pluto"]), r"'pluto'"),
+        # issue 32, class 6: an infinite radius and a negative gm were accepted
+        (lambda: System.from_arrays([1.0, 0.0], [[0, 0, 0], [1, 0, 0]], [[0, 0, 0], [0, 1, 0]],
+                                    radius=[np.inf, 0.1]),
+         r"^Expected `radius` to be finite, got inf at index 0$"),
+        (lambda: System.from_arrays([1.0, 0.0], [[0, 0, 0], [1, 0, 0]], [[0, 0, 0], [0, 1, 0]],
+                                    radius=[np.nan, -np.inf]), r"`radius`.*-inf at index 1"),
+        (lambda: _pair().with_state(_pair().as_arrays().r, _pair().as_arrays().v, gm=[-1, 1e-3]),
+         r"^Expected `gm` >= 0, got -1.0 at index 0$"),
+        (lambda: _pair().with_state(_pair().as_arrays().r, _pair().as_arrays().v,
+                                    gm=[1.0, np.nan]),
+         r"^Expected `gm` to be finite, got nan at index 1$"),
+        (lambda: _pair().with_state(_pair().as_arrays().r, _pair().as_arrays().v, gm=[0.0, 0.0]),
+         r"^Expected at least one body with `gm` > 0, got only massless bodies$"),
+        (lambda: _pair().with_state(_pair().as_arrays().r, _pair().as_arrays().v, gm=[1.0]),
+         r"^Expected `gm` to have shape \(2,\), got \(1,\)$"),
     ],
 )
 def test_bad_input_names_the_body_and_value(make, match):
     with pytest.raises((ValueError, u.UnitConversionError), match=match):
         make()
+
+
+def _pair() -> System:
+    return System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1e-3, [1, 0, 0], [0, 1, 0])])
+
+
+def test_with_state_takes_new_masses():
+    s = _pair().with_state(_pair().as_arrays().r, _pair().as_arrays().v, gm=[2.0, 0.0])
+    assert s.as_arrays().gm.tolist() == [2.0, 0.0]
 
 
 def test_two_massless_particles_may_share_a_position():

@@ -376,3 +376,82 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
         assert loaded, out[-2000:]
         saved = [line for line in out.splitlines() if "saved" in line and name in line]
         assert saved == [], saved
+
+
+# Issue 32, class 5: bodies 1e-100 apart were accepted and radau15 returned them
+# 1.6e50 apart with dE/E = 3.7 and no error.  The squares in the prs23 step rule
+# (|a|^2 ~ 1e400 there) overflowed, the bodies were left out of the step control,
+# and the steps grew fourfold through the collision.  Newtonian gravity has no
+# length scale: r -> L r, t -> L^1.5 t maps solutions to solutions.
+
+
+@pytest.mark.parametrize("criterion", ["prs23", "global"])
+@pytest.mark.parametrize("k", [-332, -200, 200, 332])
+def test_a_system_scaled_by_a_power_of_two_takes_the_very_same_steps(criterion, k):
+    """Scaled by L = 2^k (1e-100 to 1e100) in length and L^1.5 in time, a
+    three-body run (a star, a planet, a test particle) is the run at scale 1,
+    scaled: the same steps and, bit for bit, the same states."""
+    from hamilton_orbits import engine
+
+    r0 = np.array([[0.0, 0, 0], [1.0, 0, 0], [0, 2.5, 0.1]])
+    v0 = np.array([[0.0, 0, 0], [0, 0.7, 0], [-0.6, 0, 0]])
+    gm = np.array([1.0, 1e-3, 0.0])
+    t = np.array([0.0, 3.0, 10.0])
+    length, time = 2.0**k, 2.0 ** (1.5 * k)
+    opts = {"criterion": criterion}
+    one = engine.run(r0, v0, gm, t, newtonian_rhs(), "radau15", options=opts)
+    scaled = engine.run(r0 * length, v0 * (length / time), gm, t * time, newtonian_rhs(),
+                        "radau15", options=opts)
+    assert scaled.steps == one.steps
+    assert np.array_equal(scaled.r / length, one.r)
+    assert np.array_equal(scaled.v * (time / length), one.v)
+
+
+@pytest.mark.parametrize("length", [1.0, 1e-100])
+def test_a_head_on_fall_1e_100_across_follows_the_radial_kepler_fall_then_stops(length):
+    """Two bodies of G m = 1 at rest ``length`` apart (the issue's 1e-100) fall on a
+    degenerate Kepler ellipse: with mu = 2, ``d = L (1 + cos eta) / 2`` at
+    ``t = sqrt(L^3 / 8 mu) (eta + sin eta)``, contact at ``t_c = pi sqrt(L^3 / 8 mu)``.
+    The separations follow it to 1e-12 up to 0.999 t_c, at both scales; the run
+    on past the contact stops there with a ConvergenceError (at 1e-100 the cube
+    of the separation underflows 3e-4 t_c before it)."""
+    import re
+
+    from scipy.optimize import brentq
+
+    from hamilton_orbits import Body, Simulation, System
+
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("b", 1.0, [length, 0, 0], [0, 0, 0])])
+    t_c = math.pi * math.sqrt(length**3 / 16.0)
+    frac = np.array([0.25, 0.5, 0.9, 0.99, 0.999])
+    eta = np.array([brentq(lambda e, f=f: (e + math.sin(e)) / math.pi - f, 0.0, math.pi,
+                           xtol=1e-15) for f in frac])
+    sim = Simulation(system)
+    traj = sim.integrate(frac * t_c)
+    d = np.linalg.norm(traj.r[1:, 1] - traj.r[1:, 0], axis=1)
+    np.testing.assert_allclose(d, length * (1.0 + np.cos(eta)) / 2.0, rtol=1e-12, atol=0)
+    with pytest.raises(ConvergenceError, match=r"radau15 stopped at t = .*collision") as err:
+        sim.integrate(2.0 * t_c)
+    t_stop = float(re.search(r"at t = (\S+) before", str(err.value)).group(1))
+    assert abs(t_stop / t_c - 1.0) < 1e-4
+
+
+def test_the_issue_reproducer_stops_or_reports_an_infinite_energy_error():
+    """The issue's run itself: two bodies of G m = 1 at rest 1e-100 apart, to t = 1.
+    radau15 stops at their contact (the radial fall's ``t_c = pi sqrt(L^3 / 16)``)
+    instead of returning them 1.6e50 apart; leapfrog at dt = 1e-3 (1e147 times the
+    fall) flings them apart at 1e197, where the kinetic energy overflows: its
+    energy error is infinite, no longer NaN (the compensated sum turned inf - inf
+    into NaN)."""
+    from hamilton_orbits import Body, System, integrate
+
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("b", 1.0, [1e-100, 0, 0], [0, 0, 0])])
+    t_c = math.pi * math.sqrt(1e-300 / 16.0)
+    with pytest.raises(ConvergenceError, match=r"radau15 stopped at t = (\S+) before t_out\[1\] "
+                                               r"= 1.0: the acceleration became non-finite") as err:
+        integrate(system, 1.0)
+    assert float(str(err.value).split()[5]) == pytest.approx(t_c, rel=1e-4)
+    traj = integrate(system, 1.0, method="leapfrog", dt=1e-3)
+    assert traj.energy_error.tolist() == [0.0, math.inf]

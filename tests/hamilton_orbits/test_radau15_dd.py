@@ -168,3 +168,132 @@ def test_the_1000_year_reference_agrees_with_itself_to_1e_13(solar):
     h = ref.r[-1][1:] - ref.r[-1][0]
     h_check = ref.r_check[-1][1:] - ref.r_check[-1][0]
     assert np.max(np.linalg.norm(h_check - h, axis=1) / np.linalg.norm(h, axis=1)) < 1e-13
+
+
+# Issue 32: the double-double step guard (class 12), its options (class 14) and the
+# reference cache (class 15).
+
+def test_double_double_counts_its_steps_before_the_first():
+    """``dt = 1e-12`` over a unit span never returned (1e12 steps of 0.5 ms) and
+    ``max_steps=5`` was ignored (100 steps ran): both are refused up front, naming
+    the steps, ``dt`` and ``max_steps``; 100 steps with ``max_steps=100`` run."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    with pytest.raises(ValueError, match=r"radau15 in double-double would take about 1e\+12 "
+                                         r"steps of dt = 1e-12 over 1 \(max_steps = 100000000\)"):
+        integrate(s, 1.0, precision="double-double", dt=1e-12)
+    with pytest.raises(ValueError, match=r"about 100 steps of dt = 0.01 over 1 \(max_steps = 5\)"):
+        integrate(s, 1.0, precision="double-double", dt=0.01, max_steps=5)
+    traj = integrate(s, 1.0, precision="double-double", dt=0.01, max_steps=100)
+    assert traj.steps == 100
+    # the circular orbit: exact cos t, sin t
+    np.testing.assert_allclose(traj.final["p"].r, [math.cos(1.0), math.sin(1.0), 0.0],
+                               rtol=0, atol=1e-15)
+
+
+def test_double_double_options_are_checked_by_name():
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 0.0, [1, 0, 0], [0, 1, 0])])
+    with pytest.raises(ValueError, match=r"Expected `criterion` to be one of 'global', 'prs23', "
+                                         r"got 'bogus'"):
+        integrate(s, 1.0, precision="double-double", dt=0.1, criterion="bogus")
+    # the precision is named, not double-double
+    with pytest.raises(ValueError, match=r"Expected `precision` to be one of 'double', "
+                                         r"'double-double', got 'quad'"):
+        integrate(s, 1.0, precision="quad", variational=True)
+    with pytest.raises(ValueError, match=r"double-double integrates no variational equations"):
+        integrate(s, 1.0, precision="double-double", dt=0.1, variational=True)
+
+
+def test_double_double_names_a_collision():
+    """Two bodies at one point reach the double-double kernel only past the checks
+    (a Propagation made directly): its division by zero is a ConvergenceError."""
+    from hamilton_orbits import engine
+    from hamilton_orbits.integrators import Radau15
+    from hamilton_orbits.validation import ConvergenceError
+
+    prop = engine.Propagation(np.zeros((2, 3)), np.array([[0.0, 0, 0], [0, 1.0, 0]]),
+                              np.array([1.0, 1.0]), 0.0, newtonian_rhs(),
+                              Radau15(precision="double-double"), dt=0.1)
+    with pytest.raises(ConvergenceError, match=r"double-double stopped before t_out\[1\] = 1.0: "
+                                               r"two bodies met"):
+        prop.advance(np.array([0.0, 1.0]))
+
+
+def _problem():
+    r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    v0 = np.array([[0.0, 0, 0], [0, 1.1, 0]])
+    return r0, v0, np.array([1.0, 1e-3]), np.array([0.0, 1.0])
+
+
+@pytest.mark.parametrize("damage", [b"", b"PK\x03\x04cut", b"\x93NUMPY" + b"\x00" * 40,
+                                    "other-shape"])
+def test_a_damaged_cached_reference_is_named_and_computed_again(tmp_path, monkeypatch, damage):
+    """A cache file cut short (an EOFError, a BadZipFile), overwritten with other bytes
+    (numpy's "pickled data" error) or holding arrays of another problem's shape: a
+    RuntimeWarning naming the file, the reference computed again (the same bits as
+    without a cache) and the file replaced."""
+    monkeypatch.setenv("HAMILTON_ORBITS_CACHE_DIR", str(tmp_path))
+    fresh = reference(*_problem(), 0.1, cache=False)
+    assert not reference(*_problem(), 0.1).cached
+    (path,) = (tmp_path / "reference").glob("*.npz")
+    if damage == "other-shape":
+        np.savez(path, r=np.zeros((3, 2, 3)), v=fresh.v, r_check=fresh.r_check,
+                 v_check=fresh.v_check)
+    else:
+        path.write_bytes(damage)
+    with pytest.warns(RuntimeWarning, match=rf"The cached reference {path} is damaged .*; "
+                                            r"computing it again"):
+        again = reference(*_problem(), 0.1)
+    assert not again.cached
+    assert np.array_equal(again.r, fresh.r) and np.array_equal(again.r_check, fresh.r_check)
+    assert reference(*_problem(), 0.1).cached
+    assert [p.name for p in path.parent.iterdir()] == [path.name]
+
+
+def test_reference_input_is_named(tmp_path, monkeypatch):
+    monkeypatch.setenv("HAMILTON_ORBITS_CACHE_DIR", str(tmp_path))
+    r0, v0, gm, t = _problem()
+    with pytest.raises(ValueError, match=r"Expected `dt` > 0, got 0.0"):
+        reference(r0, v0, gm, t, 0.0)
+    with pytest.raises(ValueError, match=r"Expected `dt` > 0, got None"):
+        reference(r0, v0, gm, t, None)
+    with pytest.raises(ValueError, match=r"Bodies at indices 0 and 1 of `r0` are at one "
+                                         r"position \[0.0, 0.0, 0.0\]"):
+        reference(np.zeros((2, 3)), v0, gm, t, 0.1)
+    with pytest.raises(ValueError, match=r"Expected `t_out` to be strictly increasing, got 0.5 "
+                                         r"at index 2 after 1.0"):
+        reference(r0, v0, gm, [0.0, 1.0, 0.5], 0.1)
+
+
+def test_two_writers_of_one_reference_write_through_files_of_their_own(tmp_path, monkeypatch):
+    """Two processes computing the same reference wrote one shared temporary file
+    name: the second's rename could move a file the first was still writing.
+    Each writer now has a temporary file of its own: two writers held inside
+    ``np.savez`` at once write two files, and the one left is whole."""
+    import threading
+
+    from hamilton_orbits.studies import reference as module
+
+    monkeypatch.setenv("HAMILTON_ORBITS_CACHE_DIR", str(tmp_path))
+    both_inside = threading.Barrier(2, timeout=30)
+    names: list[str] = []
+    savez = np.savez
+
+    def held(f, **arrays):
+        names.append(f.name)
+        both_inside.wait()
+        savez(f, **arrays)
+
+    monkeypatch.setattr(module.np, "savez", held)
+    r = reference(*_problem(), 0.1, cache=False)
+    path = tmp_path / "one.npz"
+    writers = [threading.Thread(target=module._write, args=(path,),
+                                kwargs=dict(r=r.r, v=r.v, r_check=r.r_check, v_check=r.v_check))
+               for _ in range(2)]
+    for w in writers:
+        w.start()
+    for w in writers:
+        w.join()
+    assert len(set(names)) == 2 and all(str(tmp_path) in n for n in names)
+    with np.load(path) as z:
+        assert np.array_equal(z["r"], r.r)
+    assert [p.name for p in tmp_path.iterdir()] == ["one.npz"]

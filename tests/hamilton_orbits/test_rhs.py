@@ -100,6 +100,10 @@ def test_effect_sets_are_equal_and_hashable_with_quantities_and_lists():
     assert EffectSet.of(["gr", "newtonian"]).names == ("gr",)
     with pytest.raises(ValueError, match=r"rotation effects, got an EffectSet of 'nbody'"):
         EffectSet.of(a, "rotation")
+    # issue 32, class 16: an unknown kind was blamed on the effect
+    with pytest.raises(ValueError, match=r"^Unknown effect `kind` 'bogus-kind'; known: nbody, "
+                                         r"rotation$"):
+        EffectSet.of(["gr"], "bogus-kind")
 
 
 def _run_twice(tmp_path: Path, code: str) -> list[str]:

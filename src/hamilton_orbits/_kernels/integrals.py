@@ -25,8 +25,11 @@ COLUMNS = ("energy", "lx", "ly", "lz", "gm", "rx", "ry", "rz", "vx", "vy", "vz")
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _add(s, c, x):  # pragma: no cover - compiled
-    """Neumaier's compensated ``s + x``: returns the new ``(s, c)``."""
+    """Neumaier's compensated ``s + x``: returns the new ``(s, c)`` (an overflowed sum
+    is infinite, not NaN: its compensation is dropped)."""
     t = s + x
+    if not abs(t) < math.inf:
+        return t, 0.0
     if abs(s) >= abs(x):
         c += (s - t) + x
     else:

@@ -303,30 +303,62 @@ def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, ne
 
 
 @njit(cache=True, inline="always")
+def _prs23_sums(a0, b, i, f):  # pragma: no cover - compiled
+    """Body ``i``'s ``|a0|^2`` and the ``|a|^2``, ``|a'|^2``, ``|a''|^2`` of the
+    polynomial at the end of the step, every component multiplied by ``f`` before
+    it is squared (``f = 1``: the plain sums), and the largest magnitude of those
+    components before ``f``."""
+    a0i = 0.0
+    y2 = 0.0
+    y3 = 0.0
+    y4 = 0.0
+    top = 0.0
+    for k in range(3 * i, 3 * i + 3):
+        tmp = a0[k]
+        top = max(top, abs(tmp))
+        tmp *= f
+        a0i += tmp * tmp
+        tmp = a0[k] + b[0, k] + b[1, k] + b[2, k] + b[3, k] + b[4, k] + b[5, k] + b[6, k]
+        top = max(top, abs(tmp))
+        tmp *= f
+        y2 += tmp * tmp
+        tmp = (b[0, k] + 2.0 * b[1, k] + 3.0 * b[2, k] + 4.0 * b[3, k] + 5.0 * b[4, k]
+               + 6.0 * b[5, k] + 7.0 * b[6, k])
+        top = max(top, abs(tmp))
+        tmp *= f
+        y3 += tmp * tmp
+        tmp = (2.0 * b[1, k] + 6.0 * b[2, k] + 12.0 * b[3, k] + 20.0 * b[4, k]
+               + 30.0 * b[5, k] + 42.0 * b[6, k])
+        top = max(top, abs(tmp))
+        tmp *= f
+        y4 += tmp * tmp
+    return a0i, y2, y3, y4, top
+
+
+@njit(cache=True, inline="always")
 def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     """Pham, Rein & Spiegel (2024): the shortest timescale
     ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
     from the polynomial at the end of the step (derivatives per unit h).  A body
-    whose acceleration at the start of the step is zero or subnormal (the third
-    body of the figure-eight at t = 0, a body at an equilibrium) is left out, as
-    rebound's IAS15 does: its timescale measures the zero crossing of ``a``, not
-    a fast motion.  Returns the next step."""
+    whose acceleration at the start of the step is zero (the third body of the
+    figure-eight at t = 0, a body at an equilibrium) is left out, as rebound's
+    IAS15 does: its timescale measures the zero crossing of ``a``, not a fast
+    motion.  Where the squares over- or underflow (a system of a very small or
+    very large length scale: accelerations beyond 1e150 or below 1e-150) the
+    components are first scaled by a power of two (``tau`` is a ratio, the scale
+    cancels), so that the step follows the motion at every scale instead of
+    leaving the body out.  Returns the next step."""
     min_tau2 = math.inf
     for i in range(n):
-        a0i = 0.0
-        y2 = 0.0
-        y3 = 0.0
-        y4 = 0.0
-        for k in range(3 * i, 3 * i + 3):
-            a0i += a0[k] * a0[k]
-            tmp = a0[k] + b[0, k] + b[1, k] + b[2, k] + b[3, k] + b[4, k] + b[5, k] + b[6, k]
-            y2 += tmp * tmp
-            tmp = (b[0, k] + 2.0 * b[1, k] + 3.0 * b[2, k] + 4.0 * b[3, k] + 5.0 * b[4, k]
-                   + 6.0 * b[5, k] + 7.0 * b[6, k])
-            y3 += tmp * tmp
-            tmp = (2.0 * b[1, k] + 6.0 * b[2, k] + 12.0 * b[3, k] + 20.0 * b[4, k]
-                   + 30.0 * b[5, k] + 42.0 * b[6, k])
-            y4 += tmp * tmp
+        if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
+            continue
+        a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, 1.0)
+        if not (2.2250738585072014e-308 <= a0i < math.inf
+                and 2.2250738585072014e-308 <= y2 < math.inf and y3 < math.inf
+                and (y4 == 0.0 or 2.2250738585072014e-308 <= y4 * y2 < math.inf)):
+            if not (top > 0.0 and top < math.inf):
+                continue
+            a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, math.ldexp(1.0, -math.frexp(top)[1]))
         if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
             continue
         if not (y2 > 0.0 and y2 < math.inf):

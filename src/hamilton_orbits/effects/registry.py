@@ -364,8 +364,19 @@ class EffectSet:
         Raises
         ------
         ValueError
-            As :func:`normalize_effects`, or for an EffectSet of another kind.
+            As :func:`normalize_effects`, for an unknown ``kind`` (listing the known
+            ones), or for an EffectSet of another kind.
+
+        Examples
+        --------
+        >>> EffectSet.of(["gr"], "bogus-kind")  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Unknown effect `kind` 'bogus-kind'; known: nbody...
         """
+        if not _REGISTRY.get(kind) and not known(kind):
+            kinds = sorted(k for k, specs in _REGISTRY.items() if specs)
+            raise ValueError(f"Unknown effect `kind` {kind!r}; known: {', '.join(kinds)}")
         if isinstance(effects, EffectSet):
             if effects.kind != kind:
                 raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")

@@ -14,7 +14,7 @@ import numpy as np
 from hamilton_orbits._kernels import checks as _checks
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
-from hamilton_orbits.validation import as_float_array, check_positive
+from hamilton_orbits.validation import ConvergenceError, as_float_array, check_positive
 
 _ADDRESSES: weakref.WeakKeyDictionary[Any, dict[int, np.ndarray]] = weakref.WeakKeyDictionary()
 #: the ids of the address arrays handed out (they live as long as their dispatcher)
@@ -88,6 +88,7 @@ def check_inputs(
     ValueError: Expected `gm` >= 0, got -1.0 at index 0
     """
     if _fast_ok(r0, v0, gm, t_out):  # float64 arrays of the right shapes, all valid
+        check_apart(r0, gm)
         return r0, v0, gm, t_out
     r0 = np.ascontiguousarray(as_float_array("r0", r0), dtype=np.float64)
     v0 = np.ascontiguousarray(as_float_array("v0", v0), dtype=np.float64)
@@ -109,7 +110,39 @@ def check_inputs(
             f"Expected `t_out` to be strictly increasing, got {float(t_out[i])!r} at index {i} "
             f"after {float(t_out[i - 1])!r}"
         )
+    check_apart(r0, gm)
     return r0, v0, gm, t_out
+
+
+_TINY = float(np.finfo(np.float64).tiny)  # the smallest normal float64
+
+
+def check_apart(r: np.ndarray, gm: np.ndarray, names: Any = None, arg: str = "r0") -> None:
+    """Refuse two bodies (one of them massive) at one position, or so close that the
+    cube of their separation underflows float64 (the force between them would be
+    infinite or undefined); ``r`` (n, 3) and ``gm`` (n,) float64, the bodies named
+    by ``names`` or else by their indices in ``arg``.
+
+    Examples
+    --------
+    >>> check_apart(np.array([[1.0, 0, 0], [1.0, 0, 0]]), np.array([0.0, 1.0]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Bodies at indices 0 and 1 of `r0` are at one position [1.0, 0.0, 0.0]
+    """
+    d2, i, j = _nbody.closest_pair(np.ascontiguousarray(r), np.ascontiguousarray(gm))
+    if i < 0 or d2 * math.sqrt(d2) >= _TINY:
+        return
+    who = (f"Bodies {names[i]!r} and {names[j]!r}" if names is not None
+           else f"Bodies at indices {i} and {j} of `{arg}`")
+    if np.array_equal(r[i], r[j]):
+        raise ValueError(f"{who} are at one position {r[i].tolist()}")
+    apart = float(np.max(np.abs(r[i] - r[j])))  # d2 may underflow to 0
+    raise ValueError(
+        f"{who} are {apart:.3g} apart: the cube of their separation underflows float64 "
+        f"(below {_TINY ** (1 / 3):.3g} in the system's length unit); use a smaller length "
+        "unit or merge them"
+    )
 
 
 def _fast_ok(r0: Any, v0: Any, gm: Any, t_out: Any) -> bool:
@@ -123,6 +156,24 @@ def _fast_ok(r0: Any, v0: Any, gm: Any, t_out: Any) -> bool:
             or t_out.shape[0] < 1:
         return False
     return bool(_checks.state_ok(r0, v0, gm, t_out))
+
+
+def check_finite(acc: np.ndarray, t: float, method: str) -> None:
+    """Raise ``ConvergenceError`` for a non-finite acceleration ``acc`` (C-contiguous)
+    at time ``t`` (two bodies at one point), naming ``method`` and the time.  (scipy's
+    solver would take a NaN derivative at the start of an interval into a NaN first
+    step and loop on it for ever.)
+
+    Examples
+    --------
+    >>> check_finite(np.array([[0.0, np.inf, 0.0]]), 0.5, "dop853")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    hamilton_orbits.validation.ConvergenceError: dop853 stopped at t = 0.5: the acceleration...
+    """
+    if not _checks.all_finite(acc.reshape(-1)):
+        raise ConvergenceError(f"{method} stopped at t = {float(t)!r}: the acceleration "
+                               "became non-finite (two bodies at one point: a collision?)")
 
 
 def check_dt_tol(dt: Any, tol: Any) -> tuple[float | None, float | None]:

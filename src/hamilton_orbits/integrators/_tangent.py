@@ -38,6 +38,7 @@ from hamilton_orbits.integrators import StopIntegration
 from hamilton_orbits.integrators._setup import (
     accel_arg,
     addresses,
+    check_finite,
     check_step_count,
     fixed_steps,
 )
@@ -430,6 +431,7 @@ class DOP853Tangent:
         x = y[: 3 * rows].reshape(rows, 3)
         w = y[3 * rows: 6 * rows].reshape(rows, 3)
         rhs.augmented(x, w, self.gm, acc, rhs.p)
+        check_finite(acc, t, "dop853")
         dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
         den = float(np.sum(dx * dx) + np.sum(dw * dw))
         rate = float(np.sum(dx * dw) + np.sum(dw * da)) / den if den > 0 else 0.0

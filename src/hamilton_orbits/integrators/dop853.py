@@ -90,14 +90,16 @@ class _State:
         self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
         self.t, self.steps = t0, 0
 
-    def f(self, _t: float, y: np.ndarray) -> np.ndarray:
+    def f(self, t: float, y: np.ndarray) -> np.ndarray:
         """``dy/dt`` of the bodies (positions, then velocities, flattened), with the
         masses of now (a method, not a closure: a copy of the state computes with its
-        own masses)."""
+        own masses); a non-finite acceleration raises
+        (:func:`~hamilton_orbits.integrators._setup.check_finite`)."""
         n = self.n
         r = y[: 3 * n].reshape(n, 3)
         v = y[3 * n :].reshape(n, 3)
         self.rhs.accel(r, v, self.gm, self.acc, self.rhs.p)
+        _setup.check_finite(self.acc, t, NAME)
         return np.concatenate((y[3 * n :], self.acc.ravel()))
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -115,7 +115,8 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
     precision : {"double", "double-double"}, optional
         ``"double-double"``: every number a double-double (about 32 digits;
         :mod:`hamilton_orbits._kernels.radau15_dd`), at fixed steps of ``dt``
-        (required; ``tol`` refused), Newtonian gravity only (no effects, no
+        (required; ``tol`` refused; more than ``max_steps`` of them refused
+        before the first, ``ValueError``), Newtonian gravity only (no effects, no
         events), about 200 times the cost of a double-precision step.  What
         is left is the truncation error, which falls as ``dt^16``: two runs at
         ``dt`` and ``dt / 2`` measure it.  For references (the report's solar
@@ -170,7 +171,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
         if variational is not None:
             raise ValueError("radau15 in double-double integrates no variational equations; "
                              "use precision='double' with variational=True")
-        return _DoubleDouble(rhs, r0, v0, gm, t0, dt, tol, events)
+        return _DoubleDouble(rhs, r0, v0, gm, t0, dt, tol, events, method.max_steps)
     if dt is None and tol is None:
         tol = DEFAULT_TOL
     if dt is None:
@@ -189,7 +190,8 @@ class _DoubleDouble:
     state between calls."""
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
-                 dt: float | None, tol: float | None, events: EventLog | None) -> None:
+                 dt: float | None, tol: float | None, events: EventLog | None,
+                 max_steps: int) -> None:
         if dt is None or tol is not None:
             raise ValueError("radau15 in double-double runs fixed steps: give `dt` and no "
                              f"`tol`, got dt = {dt!r}, tol = {tol!r}")
@@ -206,6 +208,21 @@ class _DoubleDouble:
         self.br, self.d = np.zeros((7, 3 * n)), np.zeros((7, 3 * n))
         self.gm = np.array(gm, dtype=np.float64)
         self.dt, self.h_last, self.t, self.steps = dt, 0.0, t0, 0
+        self.max_steps = max_steps
+
+    def _steps(self, h: float, k: int, t_out: np.ndarray, i: int) -> None:
+        """``k`` steps of ``h`` (the kernel), a collision named (its double-double
+        arithmetic raises ZeroDivisionError where two bodies meet)."""
+        from hamilton_orbits._kernels import radau15_dd
+
+        try:
+            radau15_dd.advance(self.x, self.v, self.gm, h, k, self.b, self.g, self.br,
+                               self.d, h / self.h_last if self.h_last else 0.0)
+        except ZeroDivisionError:
+            raise ConvergenceError(
+                f"radau15 in double-double stopped before t_out[{i}] = {float(t_out[i])!r}: "
+                "two bodies met (a division by zero in the acceleration: a collision?)"
+            ) from None
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The current state rounded to doubles (copies)."""
@@ -215,18 +232,18 @@ class _DoubleDouble:
     def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
                 on_output: Any, stop: Any) -> None:
         """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
-        time), in slices of ``SLICE // 100`` steps (Ctrl-C is seen between them)."""
-        from hamilton_orbits._kernels import radau15_dd
-
+        time), in slices of ``SLICE // 100`` steps (Ctrl-C is seen between them); more
+        than ``max_steps`` steps are refused before the first."""
         dt_f, first = self.dt, self.steps
+        _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, self.max_steps,
+                                "radau15 in double-double")
         for i in range(1, len(t_out)):
             n_steps, last = _setup.fixed_steps(float(t_out[i] - t_out[i - 1]), dt_f)
             done = 0
             while done < n_steps:
                 k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1
                 h = dt_f if done < n_steps - 1 else last
-                radau15_dd.advance(self.x, self.v, self.gm, h, k, self.b, self.g, self.br,
-                                   self.d, h / self.h_last if self.h_last else 0.0)
+                self._steps(h, k, t_out, i)
                 self.h_last = h
                 done += k
             self.steps += n_steps
@@ -328,6 +345,8 @@ def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:
     return {
         _k.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
-        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r})",
+        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r}; a "
+                             "collision, or an encounter closer than float64 resolves at this "
+                             "time?)",
         _k.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
     }[status]

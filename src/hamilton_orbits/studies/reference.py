@@ -22,7 +22,12 @@ system at 1 day) is paid once.
 from __future__ import annotations
 
 import hashlib
+import os
+import tempfile
 import time
+import warnings
+import zipfile
+from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -93,6 +98,19 @@ def reference(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
     -------
     Reference
 
+    Raises
+    ------
+    ValueError
+        For bad input, naming the argument, index and value (non-finite values,
+        shapes, negative ``gm``, two bodies at one position, ``t_out`` not
+        increasing, ``dt <= 0``).
+
+    Warns
+    -----
+    RuntimeWarning
+        When the cached file cannot be read (it names the file); the reference is
+        then computed again and the file replaced.
+
     Examples
     --------
     >>> r0 = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v0 = np.array([[0.0, 0, 0], [0, 1.0, 0]])
@@ -101,15 +119,19 @@ def reference(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
     >>> bool(np.abs(ref.r[-1] - r0).max() < 1e-14), bool(np.abs(ref.r - ref.r_check).max() < 1e-14)
     (True, True)
     """
-    from hamilton_orbits.integrators import radau15
+    from hamilton_orbits.integrators import _setup, radau15
     from hamilton_orbits.rhs import cache_dir, newtonian_rhs
 
-    arrays = [np.ascontiguousarray(a, dtype=np.float64) for a in (r0, v0, gm, t_out)]
+    arrays = list(_setup.check_inputs(r0, v0, gm, t_out))
+    dt = _setup.check_dt_tol(dt, None)[0]
+    if dt is None:
+        raise ValueError("Expected `dt` > 0, got None")
     folder = cache_dir("reference") if cache else None
-    path = folder / f"{_key(*arrays, float(dt))}.npz" if folder is not None else None
+    path = folder / f"{_key(*arrays, dt)}.npz" if folder is not None else None
     if path is not None and path.exists():
-        with np.load(path) as z:
-            return Reference(z["r"], z["v"], z["r_check"], z["v_check"], float(dt), 0.0, True)
+        found = _read(path, (len(arrays[3]), *arrays[0].shape), dt)
+        if found is not None:
+            return found
     rhs = newtonian_rhs()
     r0, v0, gm, t_out = arrays
     radau15.run(rhs, r0, v0, gm, t_out[:1].repeat(2) + [0.0, dt], dt=dt,
@@ -122,7 +144,40 @@ def reference(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,
     seconds = time.perf_counter() - start
     (r, v, _), (rc, vc, _) = runs
     if path is not None:
-        tmp = path.with_suffix(".tmp.npz")
-        np.savez(tmp, r=r, v=v, r_check=rc, v_check=vc)
-        tmp.replace(path)
-    return Reference(r, v, rc, vc, float(dt), seconds, False)
+        _write(path, r=r, v=v, r_check=rc, v_check=vc)
+    return Reference(r, v, rc, vc, dt, seconds, False)
+
+
+def _read(path: Path, shape: tuple[int, ...], dt: float) -> Reference | None:
+    """The cached reference in ``path``, or None (with a warning naming the file and
+    what is wrong) when the file cannot be read as one of the expected ``shape``
+    (cut short by a full disk or a killed writer, overwritten): it is then computed
+    again and replaced."""
+    try:
+        with open(path, "rb") as f:  # closed here whatever np.load makes of it
+            z = np.load(f)
+            if not isinstance(z, Mapping):
+                raise ValueError("not an .npz archive")
+            found = [np.array(z[key]) for key in ("r", "v", "r_check", "v_check")]
+        bad = [a.shape for a in found if a.shape != shape or a.dtype != np.float64]
+        if bad:
+            raise ValueError(f"arrays of shape {bad[0]}, expected {shape} float64")
+    except (OSError, EOFError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        warnings.warn(f"The cached reference {path} is damaged ({type(exc).__name__}: "
+                      f"{exc}); computing it again", RuntimeWarning, stacklevel=3)
+        return None
+    return Reference(*found, dt, 0.0, True)
+
+
+def _write(path: Path, **arrays: np.ndarray) -> None:
+    """Write ``arrays`` to ``path`` through a temporary file of its own in the same
+    folder (two writers never share one), renamed into place in one step."""
+    fd, tmp = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        with open(tmp, "wb") as f:
+            np.savez(f, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
