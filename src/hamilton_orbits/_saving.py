@@ -14,6 +14,7 @@ by :mod:`hamilton_orbits.snapshot` and scheduled by
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -35,10 +36,29 @@ from hamilton_orbits.checkpoint import (
 from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
-from hamilton_orbits.snapshot import SnapshotError, read, write
+from hamilton_orbits.snapshot import read, write
 from hamilton_orbits.trajectory import Trajectory, make_trajectory
 
-__all__ = ["Saving"]
+__all__ = ["RestartWarning", "Saving"]
+
+
+class RestartWarning(UserWarning):
+    """A snapshot continued from its physical state only (its integrator state was
+    written by a version with other integrator internals)."""
+
+
+def _from_state(prop: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    """Put a snapshot's physical state (time, positions, velocities, masses, the
+    bodies taken out of the run, the step count) into a fresh propagation."""
+    prop.r, prop.v = arrays["r"].copy(), arrays["v"].copy()
+    prop.gm, prop.t = arrays["gm"].copy(), float(arrays["t"])
+    prop.steps_before = int(meta["steps"])
+    gone = np.flatnonzero(~arrays["active"])
+    if prop.events is not None and gone.size:
+        prop.r[gone], prop.v[gone] = 0.0, 0.0  # (NaN in the snapshot: masked)
+        for k in gone:  # the bodies an event took out, parked as the event parks them
+            prop.events.park(int(k), prop.r, prop.v, prop.gm)
+        prop.events.gm_changes.append((prop.t, prop.gm.copy()))
 
 
 class Saving:
@@ -159,18 +179,27 @@ class Saving:
         sp = spec(meta, arrays)
         system = System.from_system_arrays(sp["system"])
         days = (lambda x: x) if not system.quantity else (lambda x: x * DAY)
-        sim = cls(system, method_of(sp["method"], sp["options"]),
-                  dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
-                  effects=sp["effects"], events=sp["events"], variational=sp["variational"],
-                  stm=sp["stm"])
+
+        def fresh() -> Any:
+            return cls(system, method_of(sp["method"], sp["options"]),
+                       dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
+                       effects=sp["effects"], events=sp["events"],
+                       variational=sp["variational"], stm=sp["stm"])
+
+        sim = fresh()
         prop, layout = sim._prop, sp["layout"]
         if "class" in layout["attrs"]["driver"]:
             prop.driver_for(bool(layout["attrs"]["backward"]["value"]))
         try:
             restore(prop, layout, sp["state"])
-        except LayoutMismatch as exc:
-            raise SnapshotError(f"{path}: the integrator state was saved by another version "
-                                f"({exc})") from None
+        except LayoutMismatch as exc:  # another version's integrator: from the state
+            sim = fresh()
+            _from_state(sim._prop, meta, arrays)
+            warnings.warn(RestartWarning(
+                f"{path} holds the integrator state of another version ({exc}); continuing "
+                "from its positions, velocities and masses with the integrator started "
+                "afresh: not bit for bit the run that wrote it, and events found and MEGNO "
+                "sums before it are not carried over"), stacklevel=3)
         if meta.get("started"):
             sim._start = sim._initial
         if meta.get("unit"):

@@ -221,10 +221,13 @@ class Propagation:
         sign = -1.0 if backward else 1.0
         if self.driver is None and watched:
             self._collisions_at_start()
+        # the log also masks the bodies taken out of the run in the outputs, after the
+        # last watched pair has gone with them
+        log = self.events if watched or (self.events is not None and self.events.gone
+                                         and not backward) else None
         self.driver = self.module.start(
             self.rhs, self.r, -self.v if backward else self.v, self.gm, sign * self.t,
-            self.method, dt=self.dt, tol=self.tol, events=self.events if watched else None,
-            variational=self.variational)
+            self.method, dt=self.dt, tol=self.tol, events=log, variational=self.variational)
         self.backward = backward
         return self.driver
 

@@ -469,6 +469,12 @@ class EventLog:
         self.gm_changes.append((t, gm.copy()))
         return False
 
+    def park(self, k: int, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> None:
+        """Take body ``k`` out of the run (in place in ``r``, ``v``, ``gm``): parked far
+        away with ``gm = 0``, no longer watched (a run continued from a saved state
+        whose body ``k`` had left)."""
+        self._park(k, r, v, gm)
+
     def _park(self, k: int, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> None:
         scale = float(np.max(np.abs(r[~self.inactive]))) if np.any(~self.inactive) else 1.0
         gm[k] = 0.0

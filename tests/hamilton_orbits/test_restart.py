@@ -15,8 +15,9 @@ import pytest
 from test_simulation_legs import _disc, _merging, _same, _variants
 
 from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits._saving import RestartWarning
 from hamilton_orbits.restart import LayoutMismatch, flatten, restore
-from hamilton_orbits.snapshot import SnapshotError
+from hamilton_orbits.snapshot import SnapshotError, read, write
 
 
 @pytest.mark.parametrize(("system", "kw"), _variants())
@@ -101,3 +102,26 @@ def test_load_names_a_missing_or_foreign_file(tmp_path):
     (tmp_path / "other.nc").write_bytes(b"CDF\x01" + b"\0" * 60)
     with pytest.raises(SnapshotError, match=r"other.nc"):
         Simulation.load(tmp_path / "other.nc")
+
+
+@pytest.mark.parametrize("system", [_disc, _merging], ids=["disc", "merged"])
+def test_a_snapshot_of_other_internals_continues_from_its_state_with_a_warning(system,
+                                                                              tmp_path):
+    """A snapshot whose integrator state this version cannot take (written by a
+    version with other internals) is continued from its physical state."""
+    kw = {"events": [{"name": "collision", "action": "merge"}]} if system is _merging else {}
+    sim = Simulation(system(), method="radau15", **kw)
+    sim.integrate(1.7)
+    sim.save(tmp_path / "s.nc")
+    meta, arrays = read(tmp_path / "s.nc")
+    attrs = meta["layout"]["attrs"]
+    attrs["renamed"] = attrs.pop("tol")  # as another version's Propagation would be
+    write(tmp_path / "s.nc", meta, arrays)
+    with pytest.warns(RestartWarning, match=r"another version .* not bit for bit"):
+        again = Simulation.load(tmp_path / "s.nc")
+    assert again.t == sim.t and again.steps == sim.steps
+    assert again.system.names == sim.system.names
+    np.testing.assert_array_equal(again.system.as_arrays().r, sim.system.as_arrays().r)
+    a, b = sim.integrate(4.0), again.integrate(4.0)
+    # radau15 from the same state with a fresh first step: the method's accuracy
+    np.testing.assert_allclose(b.r[-1], a.r[-1], rtol=0, atol=1e-10)

@@ -8,6 +8,7 @@ cannot be written is a SnapshotError at the write, naming the path.
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ import pytest
 from scipy.io import netcdf_file
 
 from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits._saving import RestartWarning
 from hamilton_orbits.snapshot import FORMAT_VERSION, SnapshotError, read, write
 
 DATA = Path(__file__).parent / "data"
@@ -154,7 +156,11 @@ def test_the_first_format_is_read_by_this_version():
     path = DATA / "snapshot-v1.nc"
     meta, _ = read(path)
     assert meta["method"]["name"] == "wh"
-    sim = Simulation.load(path)
+    with warnings.catch_warnings():
+        # a later version with other integrator internals continues from the state
+        # (RestartWarning, tested in test_restart.py): what must last is the state
+        warnings.simplefilter("ignore", RestartWarning)
+        sim = Simulation.load(path)
     assert sim.t == 10.0
     # wh is exact on a test particle's Kepler orbit (a single Kepler drift per step),
     # so the state agrees with the ellipse to rounding (Murray & Dermott 1999, 2.4)
