@@ -120,9 +120,18 @@ class Trajectory(TrajectoryBase):
         With ``variational=True``: the Lyapunov exponent as rebound's
         ``sim.lyapunov()`` defines it, the slope of the least-squares line through
         ``<Y>(t)`` over the steps so far (Cincotta & Simo 2000, eq. 24), in 1/(the
-        unit of ``t``); ``1 / lyapunov`` is the Lyapunov time.  For ``|delta|``
-        growing like ``exp(lambda t)``, ``<Y> ~ lambda t / 2``: this slope is
-        ``lambda / 2`` of the growth rate of the tangent vector.
+        unit of ``t``).  For ``|delta|`` growing like ``exp(lambda t)``,
+        ``<Y> ~ lambda t / 2``: this slope is ``lambda / 2`` of the growth rate of
+        the tangent vector.  On a regular orbit ``<Y>`` levels off and the slope
+        tends to 0 from either side: a negative value means no exponential growth
+        was measured (``<Y>`` still settling towards its plateau), and its inverse
+        is not a time (use ``lyapunov_time``).
+    lyapunov_time : ndarray or Quantity, shape (n_t,) or None
+        With ``variational=True``: the Lyapunov time ``1 / lyapunov`` where the
+        run so far has lasted at least that long (``lyapunov t >= 1``, ``t`` from
+        the simulation's start), ``inf`` where it has not or the exponent is not
+        positive (no exponential growth measured: the orbit looks regular over
+        the run); in the unit of ``t``.
     stm : ndarray, shape (n_t, 6n, 6n) or None
         With ``stm=True``: the state transition matrix ``d(r, v)(t) / d(r, v)(0)``,
         coordinates body by body (x, y, z, vx, vy, vz of body 0, then body 1, ...),
@@ -133,12 +142,13 @@ class Trajectory(TrajectoryBase):
                  wall_time: float, method: str, effects: tuple[str, ...], complete: bool = True,
                  integrals: Any,
                  final_source: Any = None, event_source: Any = None, megno: Any = None,
-                 lyapunov: Any = None, stm: Any = None) -> None:
+                 lyapunov: Any = None, stm: Any = None, lyapunov_time: Any = None) -> None:
         # one dict update: a short leg's wrapping is part of the cost of a call
         self.__dict__.update(
             t=t, r=r, v=v, names=names, steps=steps, wall_time=wall_time, method=method,
             effects=effects, complete=complete, megno=megno, lyapunov=lyapunov, stm=stm,
-            _integrals=integrals, _final_source=final_source, _event_source=event_source)
+            lyapunov_time=lyapunov_time, _integrals=integrals, _final_source=final_source,
+            _event_source=event_source)
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(f"Trajectory is read-only: cannot set {name!r}")
@@ -300,13 +310,15 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
     else:
         t_out, r_out, v_out = times, r, v
     tan = out.variational
-    megno = lyap = stm = None
+    megno = lyap = stm = lyap_time = None
     if tan is not None:
         k = len(times)
         megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
+        lyap_time = tan.lyapunov_time[:k].copy()
         stm = tan.stm[:k].copy() if tan.stm is not None else None
         if system.quantity:
             lyap = (lyap / u.day).to(1 / unit)
+            lyap_time = (lyap_time * u.day).to(unit)
     events = None
     if log is not None:
         stopped = log.stopped_by
@@ -316,5 +328,5 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         t=t_out, r=r_out, v=v_out, names=system.names, steps=int(out.steps),
         wall_time=out.wall_time if wall_time is None else wall_time, method=method,
         effects=effects, complete=out.complete, integrals=integrals, final_source=final,
-        event_source=events, megno=megno, lyapunov=lyap, stm=stm,
+        event_source=events, megno=megno, lyapunov=lyap, stm=stm, lyapunov_time=lyap_time,
     )

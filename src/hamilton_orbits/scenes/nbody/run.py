@@ -92,16 +92,27 @@ def _events_into(result: Result, traj: Any) -> None:
 
 def _chaos_into(result: Result, traj: Any) -> None:
     """With ``variational = true``: MEGNO and the Lyapunov exponent at the end (as
-    rebound's ``sim.megno()`` and ``sim.lyapunov()``), the Lyapunov time
-    ``1 / lyapunov`` (infinite when the exponent is not positive: no exponential
-    growth measured), and MEGNO over time as a diagnostic and a figure."""
+    rebound's ``sim.megno()`` and ``sim.lyapunov()``), the trajectory's Lyapunov
+    time (``1 / lyapunov`` where the run lasted that long; infinite otherwise,
+    with a note saying so: a non-positive exponent is the slope of a levelled-off
+    MEGNO, not the inverse of a time), and MEGNO over time as a diagnostic and a
+    figure."""
     if traj.megno is None:
         return
-    lyap = traj.lyapunov[-1]
+    lyap = traj.lyapunov[-1].to(1 / u.yr)
+    lyap_time = traj.lyapunov_time[-1].to(u.yr)
     result.diagnostics["megno"] = traj.megno
     result.metrics["MEGNO"] = float(traj.megno[-1])
-    result.metrics["Lyapunov exponent"] = lyap.to(1 / u.yr)
-    result.metrics["Lyapunov time"] = (1 / lyap).to(u.yr) if lyap.value > 0 else np.inf * u.yr
+    result.metrics["Lyapunov exponent"] = lyap
+    result.metrics["Lyapunov time"] = lyap_time
+    if not np.isfinite(lyap_time):
+        span = (traj.t[-1] - traj.t[0]).to(u.yr)
+        why = ("the exponent is not positive" if lyap.value <= 0
+               else f"1 / exponent = {(1 / lyap).to_value(u.yr):.4g} yr is longer than the run")
+        result.metrics["Lyapunov note"] = (
+            f"no exponential growth measured over {span.value:.6g} yr ({why}): the orbit "
+            "looks regular; a negative exponent is the slope of a MEGNO settling to its "
+            "plateau, not the inverse of a time")
     result.plotters.append(plot_megno)
 
 
