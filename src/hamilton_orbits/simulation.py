@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import copy
 import math
+import sys
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from types import ModuleType
 from typing import Any
@@ -37,7 +39,13 @@ from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
-from hamilton_orbits.trajectory import Trajectory, event_table, make_trajectory
+from hamilton_orbits.trajectory import (
+    Trajectory,
+    encounter_check,
+    encounter_warning,
+    event_table,
+    make_trajectory,
+)
 from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
 from hamilton_orbits.validation import as_float_array
 
@@ -244,9 +252,25 @@ class Simulation:
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
-        return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
+        traj = make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
                                self._effects, start=start,
-                               wall_time=max(out.wall_time - compiled, 0.0))
+                               wall_time=max(out.wall_time - compiled, 0.0),
+                               encounters=encounter_check(prop.method, prop.dt, prop.tol,
+                                                          *self._initial[::2]))
+        warning = encounter_warning(traj)
+        if warning is not None and not getattr(self, "_warned", False):
+            self._warned = True  # once per simulation
+            warnings.warn(warning, stacklevel=_caller_level())
+        return traj
+
+
+def _caller_level() -> int:
+    """The ``stacklevel`` of a warning from :meth:`Simulation.integrate` that names
+    the line that called into this module (``integrate`` or ``Simulation.integrate``)."""
+    level, frame = 2, sys._getframe(2)
+    while frame is not None and frame.f_code.co_filename == __file__:
+        level, frame = level + 1, frame.f_back
+    return level
 
 
 def _shared(prop: engine.Propagation) -> dict[int, Any]:

@@ -140,6 +140,7 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     result.metrics["energy"] = what
     key = "max |relative energy error|" if conserved else "max |relative energy change|"
     result.metrics[key] = float(np.max(np.abs(traj.energy_error)))
+    _particles_into(result, traj, gm)
     frame = scene_frame(scene.spec)
     result.frame = frame_note(scene.spec)
     result.plotters.append(lambda res: plot_orbits(res, gm, frame))
@@ -154,6 +155,39 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
 
     result.writers.append(write_rebound)
     return result
+
+
+def _particles_into(result: Result, traj: Any, gm: np.ndarray) -> None:
+    """The test particles' own checks, which Hamilton's integrals leave out (the
+    worst particle's, beside the massive bodies' energy), and the close approaches
+    a fixed step was too long for (a count and a table; the run also warned)."""
+    checks = traj.particle_check
+    tp = [i for i, c in enumerate(checks) if c]
+    if not tp:
+        return
+    err = np.abs(traj.particle_error[:, tp])
+    worst = int(np.nanargmax(np.nanmax(err, axis=0))) if np.isfinite(err).any() else 0
+    jacobi = checks[tp[0]] == "Jacobi constant"
+    if jacobi or np.count_nonzero(gm > 0) == 1:  # conserved: its change is an error
+        key = ("max |relative Jacobi constant error| of a test particle" if jacobi
+               else "max |relative energy error| of a test particle")
+    else:  # several massive bodies: how much they changed its orbit
+        key = "max |relative change of a test particle's energy about its primary|"
+    result.metrics[key] = float(np.nanmax(err)) if np.isfinite(err).any() else float("nan")
+    result.metrics["test particle of largest change"] = (
+        f"{traj.names[tp[worst]]} ({checks[tp[worst]]})")
+    table = traj.under_resolved
+    if not len(table):
+        return
+    result.metrics["under-resolved encounters"] = len(table)
+    result.tables["under-resolved encounters (a step too long: the orbit after each is not "
+                  "to be trusted)"] = [
+        {"particle": str(row["particle"]), "body": str(row["body"]),
+         "time": row["time"].to(u.yr), "distance": row["distance"],
+         "step / time scale": float(row["step"] / row["timescale"]),
+         "1/a before": row["inv_a_before"], "1/a after": row["inv_a_after"],
+         "e before": float(row["e_before"]), "e after": float(row["e_after"])}
+        for row in table]
 
 
 def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> None:
