@@ -396,8 +396,11 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     states ``r``, ``v`` (n_t, n, 3) at times ``t``, that a fixed ``step`` was too long
     for.
 
-    An approach is one to the particle's primary (:func:`primaries`), or within
-    three Hill radii (about that primary) of another massive body.  The time
+    An approach is a pericentre passage about the particle's primary
+    (:func:`primaries`) whose time scale is under a tenth of the orbit's own pace
+    ``1 / n`` (any, on an unbound orbit: a step too long for a bound orbit's pace
+    is what the particle's own check shows), or one within three Hill radii
+    (about that primary) of another massive body.  The time
     scale of an approach at distance ``d`` and relative speed ``u`` to a body of
     ``mu`` is ``min(d / u, sqrt(d^3 / mu))`` (the time to cross the distance,
     or to fall through it): the time over which that body's pull turns.  It is
@@ -421,10 +424,10 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     --------
     >>> t = np.array([0.0, 1.0]); gm = np.array([1.0, 0.0])
     >>> r = np.array([[[0.0, 0, 0], [0.01, 0, 0]]] * 2); v = np.zeros((2, 2, 3))
-    >>> v[:, 1, 1] = 10.0
+    >>> v[:, 1, 1] = 20.0  # unbound: twice the speed of a circular orbit
     >>> [(e.particle, e.body, e.timescale) for e in under_resolved_encounters(r, v, gm, t, 0.1)]
-    [(1, 0, 0.001)]
-    >>> under_resolved_encounters(r, v, gm, t, 0.00003)
+    [(1, 0, 0.0005)]
+    >>> under_resolved_encounters(r, v, gm, t, 0.00001)
     []
     """
     gm0 = np.atleast_2d(np.asarray(gm, dtype=np.float64))[0]

@@ -175,8 +175,10 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
     approach's time scale, with the distance and time scale in ``dist``, ``tau``
     (n_t, n_tp, n_m; not stored when ``dist`` has no rows); returns the count.
 
-    An approach is one to the particle's primary ``prim[tp[p]]`` or within three
-    Hill radii of another body, not to ``exempt`` beyond ``exempt_dist``; at an
+    An approach is one to the particle's primary ``prim[tp[p]]`` faster than a
+    tenth of the orbit's pace ``1 / n`` at the first output (any, unbound), or
+    within three Hill radii of another body, not to ``exempt`` beyond
+    ``exempt_dist``; at an
     output its distance is ``|d|``, between outputs where the radial velocity
     turned from negative to positive the larger two-body periapsis of the two
     outputs; its time scale ``min(dist / speed, sqrt(dist^3 / mu))``."""
@@ -189,9 +191,17 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
         for jj in range(len(m)):
             j = m[jj]
             mu = gm[j]
-            hill3 = 0.0
+            hill3, pace = 0.0, math.inf
             if j != c:
                 hill3 = 3.0 * (gm[j] / (3.0 * gm[c])) ** (1.0 / 3.0)
+            else:  # the orbit's own pace 1 / n at the first output (inf: unbound)
+                d2, u2 = 0.0, 0.0
+                for k in range(3):
+                    d2 += (r[0, i, k] - r[0, j, k]) ** 2
+                    u2 += (v[0, i, k] - v[0, j, k]) ** 2
+                inv_a0 = 2.0 / math.sqrt(d2) - u2 / mu
+                if inv_a0 > 0:
+                    pace = 1.0 / math.sqrt(inv_a0 ** 3 * mu)
             q0, inv0, rad0, dn0 = 0.0, 0.0, 0.0, 0.0
             for t in range(n_t):
                 d2, u2, rad = 0.0, 0.0, 0.0
@@ -219,6 +229,8 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
                         sep2 += (r[t, j, k] - r[t, c, k]) ** 2
                     if not dd <= hill3 * math.sqrt(sep2):
                         ts = math.inf
+                elif not ts < 0.1 * pace:  # not faster than the orbit: its pace, not an approach
+                    ts = math.inf
                 if j == exempt and dd > exempt_dist:
                     ts = math.inf
                 flag = h[t] > fraction * ts
