@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from collections.abc import Callable, Mapping
 from types import ModuleType, SimpleNamespace
 from typing import Any
@@ -306,3 +307,16 @@ def leg_run(rows: dict[str, np.ndarray], out: EngineRun | None, prop: Propagatio
     return EngineRun(t, r, v, steps, 0.0 if out is None else out.wall_time, done, events, gm,
                      tangent, out is not None and out.interrupted, first_event,
                      bool(np.isfinite(r).all() and np.isfinite(v).all()))
+
+
+#: the modules between a caller and the warnings of Simulation.integrate
+_OWN = ("hamilton_orbits.simulation", "hamilton_orbits._saving", "hamilton_orbits._legs")
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` of a warning raised in the simulation's modules that names
+    the caller's line (of ``integrate``, ``Simulation.integrate`` or ``resume``)."""
+    level, frame = 2, sys._getframe(2)
+    while frame is not None and frame.f_globals.get("__name__") in _OWN:
+        level, frame = level + 1, frame.f_back
+    return level

@@ -37,7 +37,7 @@ from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.snapshot import read, write
-from hamilton_orbits.trajectory import Trajectory, make_trajectory
+from hamilton_orbits.trajectory import Trajectory
 
 __all__ = ["RestartWarning", "Saving"]
 
@@ -110,9 +110,8 @@ class Saving:
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
         self._start = self._initial
         unit = u.Unit(info["unit"]) if info["unit"] else None
-        return make_trajectory(self._system, whole, unit, prop.method.name, prop.rhs.effects,
-                               self._effects, start=None if info["first"] else self._initial,
-                               wall_time=max(whole.wall_time - compiled, 0.0))
+        return self._trajectory(whole, unit, None if info["first"] else self._initial,
+                                max(whole.wall_time - compiled, 0.0))
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Save everything needed to continue: ``Simulation.load(path).integrate(t)``

@@ -23,6 +23,7 @@ start of the simulation.
 from __future__ import annotations
 
 import copy
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -30,6 +31,7 @@ import numpy as np
 
 from hamilton_orbits import engine
 from hamilton_orbits._legs import (
+    caller_level,
     check_effects,
     check_method,
     event_list,
@@ -53,7 +55,13 @@ from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
-from hamilton_orbits.trajectory import Trajectory, event_table, make_trajectory
+from hamilton_orbits.trajectory import (
+    Trajectory,
+    encounter_check,
+    encounter_warning,
+    event_table,
+    make_trajectory,
+)
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -174,6 +182,7 @@ class Simulation(Saving):
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
         self._resumable: Any = None
+        self._warned = False  # an under-resolved encounter is warned of once
 
     # ------------------------------------------------------------------ state
     @property
@@ -278,9 +287,22 @@ class Simulation(Saving):
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
-        return make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
-                               self._effects, start=start,
-                               wall_time=max(out.wall_time - compiled, 0.0))
+        return self._trajectory(out, unit, start, max(out.wall_time - compiled, 0.0))
+
+    def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,
+                    wall_time: float) -> Trajectory:
+        """The Trajectory of a leg, its test particles' approaches checked against the
+        step (a warning, once per simulation, of an encounter a step was too long for)."""
+        prop = self._prop
+        traj = make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
+                               self._effects, start=start, wall_time=wall_time,
+                               encounters=encounter_check(prop.method, prop.dt, prop.tol,
+                                                          *self._initial[::2]))
+        warning = encounter_warning(traj)
+        if warning is not None and not self._warned:
+            self._warned = True  # once per simulation
+            warnings.warn(warning, stacklevel=caller_level())
+        return traj
 
     def _advance(self, times: np.ndarray, progress: bool, on_output: Any,
                  stop: Any) -> tuple[engine.EngineRun, float]:

@@ -23,7 +23,8 @@ import numpy as np
 
 from hamilton_orbits.integrals import relative_change
 
-__all__ = ["Trajectory", "TrajectoryBase", "event_table", "make_trajectory", "relative_change"]
+__all__ = ["Trajectory", "TrajectoryBase", "encounter_check", "encounter_warning", "event_table",
+           "make_trajectory", "relative_change"]
 
 
 class TrajectoryBase:
@@ -94,6 +95,25 @@ class Trajectory(TrajectoryBase):
     barycentre_drift : ndarray, shape (n_t,)
         ``|R(t) - R(0) - V(0) t| / s`` with ``s`` the largest distance from the
         initial centre of mass (law of the centre of gravity, (C)).
+    particle_error : ndarray, shape (n_t, n)
+        Each test particle's own check, which Hamilton's integrals leave out (a
+        massless body does not enter them): the relative change since the start of
+        the simulation of its Jacobi constant (two massive bodies on a circular
+        orbit: an error), else of its two-body energy about its primary (one
+        massive body: an error; several: how much the others changed its orbit);
+        NaN for the massive bodies
+        (:func:`~hamilton_orbits.integrals.particle_errors`).
+    particle_check : tuple of str
+        What ``particle_error`` measures for each body: ``"Jacobi constant"``,
+        ``"energy about <name>"``, or ``""`` (a massive body).
+    under_resolved : astropy.table.QTable
+        The test particles' close approaches to massive bodies that a fixed step
+        was too long for (longer than 1/30 of the approach's time scale), seen
+        at the outputs of this leg: ``particle``, ``body``, ``time``, ``distance``,
+        ``timescale``, ``step``, and the particle's osculating ``1/a`` and ``e``
+        about ``primary`` before and after; empty for adaptive methods.  A run
+        that crosses one warns (:class:`~hamilton_orbits.integrals.UnderResolvedEncounterWarning`,
+        once per simulation) (:func:`~hamilton_orbits.integrals.under_resolved_encounters`).
     steps : int
         Steps taken by the integrator in this leg.
     wall_time : float
@@ -120,9 +140,18 @@ class Trajectory(TrajectoryBase):
         With ``variational=True``: the Lyapunov exponent as rebound's
         ``sim.lyapunov()`` defines it, the slope of the least-squares line through
         ``<Y>(t)`` over the steps so far (Cincotta & Simo 2000, eq. 24), in 1/(the
-        unit of ``t``); ``1 / lyapunov`` is the Lyapunov time.  For ``|delta|``
-        growing like ``exp(lambda t)``, ``<Y> ~ lambda t / 2``: this slope is
-        ``lambda / 2`` of the growth rate of the tangent vector.
+        unit of ``t``).  For ``|delta|`` growing like ``exp(lambda t)``,
+        ``<Y> ~ lambda t / 2``: this slope is ``lambda / 2`` of the growth rate of
+        the tangent vector.  On a regular orbit ``<Y>`` levels off and the slope
+        tends to 0 from either side: a negative value means no exponential growth
+        was measured (``<Y>`` still settling towards its plateau), and its inverse
+        is not a time (use ``lyapunov_time``).
+    lyapunov_time : ndarray or Quantity, shape (n_t,) or None
+        With ``variational=True``: the Lyapunov time ``1 / lyapunov`` where the
+        run so far has lasted at least that long (``lyapunov t >= 1``, ``t`` from
+        the simulation's start), ``inf`` where it has not or the exponent is not
+        positive (no exponential growth measured: the orbit looks regular over
+        the run); in the unit of ``t``.
     stm : ndarray, shape (n_t, 6n, 6n) or None
         With ``stm=True``: the state transition matrix ``d(r, v)(t) / d(r, v)(0)``,
         coordinates body by body (x, y, z, vx, vy, vz of body 0, then body 1, ...),
@@ -133,12 +162,14 @@ class Trajectory(TrajectoryBase):
                  wall_time: float, method: str, effects: tuple[str, ...], complete: bool = True,
                  integrals: Any,
                  final_source: Any = None, event_source: Any = None, megno: Any = None,
-                 lyapunov: Any = None, stm: Any = None) -> None:
+                 lyapunov: Any = None, stm: Any = None, lyapunov_time: Any = None,
+                 under_resolved: Any = ()) -> None:
         # one dict update: a short leg's wrapping is part of the cost of a call
         self.__dict__.update(
             t=t, r=r, v=v, names=names, steps=steps, wall_time=wall_time, method=method,
             effects=effects, complete=complete, megno=megno, lyapunov=lyapunov, stm=stm,
-            _integrals=integrals, _final_source=final_source, _event_source=event_source)
+            lyapunov_time=lyapunov_time, _integrals=integrals, _final_source=final_source,
+            _event_source=event_source, _under_resolved=under_resolved)
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(f"Trajectory is read-only: cannot set {name!r}")
@@ -162,6 +193,35 @@ class Trajectory(TrajectoryBase):
     def barycentre_drift(self) -> np.ndarray:
         """Drift of the centre of mass from uniform motion, relative to the size."""
         return self._errors[2]
+
+    @functools.cached_property
+    def _particles(self) -> tuple[np.ndarray, tuple[str, ...]]:
+        source = self._integrals
+        if callable(source):
+            n = len(self.names)
+            return np.full((len(self.r), n), np.nan), ("",) * n
+        errors, checks = _particle_errors(*source)
+        names = self.names
+        checks = tuple("Jacobi constant" if c == "jacobi"
+                       else f"energy about {names[int(c.rsplit(' ', 1)[1])]}" if c else ""
+                       for c in checks)
+        return errors, checks
+
+    @property
+    def particle_error(self) -> np.ndarray:
+        """Each test particle's own check (see the class notes); NaN for massive bodies."""
+        return self._particles[0]
+
+    @property
+    def particle_check(self) -> tuple[str, ...]:
+        """What :attr:`particle_error` measures for each body."""
+        return self._particles[1]
+
+    @functools.cached_property
+    def under_resolved(self) -> Any:
+        """The close approaches a fixed step was too long for (a ``QTable``)."""
+        return _encounter_table(self._under_resolved, self._final_source[0],
+                                getattr(self.t, "unit", None))
 
     @functools.cached_property
     def final(self) -> Any:
@@ -249,18 +309,27 @@ def _check_finite(system: Any, method: str, r: np.ndarray, v: np.ndarray,
     )
 
 
+def _from_start(r: np.ndarray, v: np.ndarray, gm: np.ndarray, times: np.ndarray, start: Any
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The outputs with the simulation's start ``start = (r0, v0, gm0)`` at time 0
+    prepended (None: the first output is the start)."""
+    if start is None:
+        return r, v, gm, times
+    r0, v0, gm0 = start
+    r = np.concatenate((r0[None], r))
+    v = np.concatenate((v0[None], v))
+    gm = (np.concatenate((gm0[None], gm)) if np.ndim(gm) == 2
+          else gm if np.array_equal(gm, gm0) else np.stack([gm0] + [gm] * (len(r) - 1)))
+    return r, v, gm, np.concatenate(([0.0], times))
+
+
 def _integrals(system: Any, r: np.ndarray, v: np.ndarray, gm: np.ndarray, times: np.ndarray,
                gone: np.ndarray | None, effect_set: Any, start: Any
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Hamilton's integrals' errors at the outputs, from the simulation's start
     ``start = (r0, v0, gm0)`` at time 0 (None: the first output is the start)."""
-    if start is not None:  # measured from the simulation's start: prepend it, then drop it
-        r0, v0, gm0 = start
-        r = np.concatenate((r0[None], r))
-        v = np.concatenate((v0[None], v))
-        gm = (np.concatenate((gm0[None], gm)) if np.ndim(gm) == 2
-              else gm if np.array_equal(gm, gm0) else np.stack([gm0] + [gm] * (len(r) - 1)))
-        times = np.concatenate(([0.0], times))
+    # measured from the simulation's start: prepend it, then drop it
+    r, v, gm, times = _from_start(r, v, gm, times, start)
     from hamilton_orbits.effects import effect_energy
     from hamilton_orbits.integrals import integral_errors
 
@@ -270,14 +339,101 @@ def _integrals(system: Any, r: np.ndarray, v: np.ndarray, gm: np.ndarray, times:
     return errors if start is None else (errors[0][1:], errors[1][1:], errors[2][1:])
 
 
+def _particle_errors(system: Any, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                     times: np.ndarray, gone: np.ndarray | None, effect_set: Any, start: Any
+                     ) -> tuple[np.ndarray, tuple[str, ...]]:
+    """The test particles' own checks at the outputs, from the simulation's start."""
+    r, v, gm, times = _from_start(r, v, gm, times, start)
+    from hamilton_orbits.effects import effect_energy
+    from hamilton_orbits.integrals import particle_errors
+
+    if not (np.atleast_2d(gm)[0] == 0).any():
+        return np.full(r.shape[:2], np.nan)[int(start is not None):], ("",) * r.shape[1]
+    extra = effect_energy(system, effect_set, r, v) if effect_set else None
+    errors, checks = particle_errors(r, v, gm, extra)
+    return (errors if start is None else errors[1:]), checks
+
+
+def encounter_check(method: Any, dt: float | None, tol: float | None, r0: np.ndarray,
+                    gm: np.ndarray) -> tuple[float | None, Any, float] | None:
+    """What :func:`make_trajectory` checks the test particles' approaches with, for a
+    run from positions ``r0``: None for an adaptive method, else ``(step, exempt,
+    fraction)``: the fixed step (None: the leg's mean step), ``(body, distance)``,
+    the body whose approaches beyond that distance the method integrates exactly
+    (``wh``'s central body), or None, and the largest fraction of an approach's
+    time scale a step may be (see
+    :func:`~hamilton_orbits.integrals.under_resolved_encounters`; 1/3 for
+    radau15's fixed steps, of order 15)."""
+    from hamilton_orbits.integrals import ENCOUNTER_STEP_FRACTION
+
+    name = getattr(method, "name", method)
+    if name == "wh" and np.any(gm > 0):
+        c = int(np.argmax(gm))
+        if getattr(method, "coordinates", "") == "democratic_heliocentric":
+            return dt, (c, 0.0), ENCOUNTER_STEP_FRACTION
+        centre = gm @ r0 / gm.sum()  # Kepler motions about the inner bodies' centre of mass
+        return dt, (c, 10.0 * float(np.linalg.norm(r0[c] - centre))), ENCOUNTER_STEP_FRACTION
+    if name == "leapfrog":
+        return dt, None, ENCOUNTER_STEP_FRACTION
+    if name == "radau15" and dt is not None and tol is None:
+        return dt, None, 1.0 / 3.0
+    return None
+
+
+def encounter_warning(traj: Trajectory) -> Any:
+    """An :class:`~hamilton_orbits.integrals.UnderResolvedEncounterWarning` saying
+    which close approaches of ``traj`` a fixed step was too long for, or None."""
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    found = traj._under_resolved
+    if not found:
+        return None
+    names = traj.names
+    first = found[0]
+    day, au = (" d", " au") if traj._final_source[0].quantity else ("", "")
+    more = f" (and {len(found) - 1} more: see `under_resolved`)" if len(found) > 1 else ""
+    return UnderResolvedEncounterWarning(
+        f"The step ({first.step:.4g}{day}) was too long for the close approach of "
+        f"{names[first.particle]!r} to {names[first.body]!r} ({first.distance:.4g}{au} at "
+        f"t = {first.time:.6g}{day}, time scale {first.timescale:.4g}{day}){more}; across it "
+        f"the osculating 1/a of {names[first.particle]!r} about {names[first.primary]!r} went "
+        f"from {first.inv_a[0]:.6g} to {first.inv_a[1]:.6g}{' /au' if au else ''} and e from "
+        f"{first.e[0]:.6g} to {first.e[1]:.6g}: not to be trusted; shorten the step or use "
+        "an adaptive method (radau15)")
+
+
+def _encounter_table(found: Any, system: Any, unit: Any) -> Any:
+    """The under-resolved approaches as a ``QTable`` (Quantities for a Quantity system)."""
+    import astropy.units as u
+    from astropy.table import QTable
+
+    names = list(system.names)
+    rows = np.array([[e.time, e.distance, e.timescale, e.step, *e.inv_a, *e.e]
+                     for e in found]).reshape(-1, 8)
+    q = system.quantity and unit is not None
+    table = QTable()
+    for col, key in (("particle", "particle"), ("body", "body"), ("primary", "primary")):
+        table[col] = [names[getattr(e, key)] for e in found] if found else np.array([], str)
+    table["time"] = (rows[:, 0] * u.day).to(unit) if q else rows[:, 0]
+    table["distance"] = rows[:, 1] * u.au if q else rows[:, 1]
+    table["timescale"] = (rows[:, 2] * u.day).to(unit) if q else rows[:, 2]
+    table["step"] = (rows[:, 3] * u.day).to(unit) if q else rows[:, 3]
+    for k, col in enumerate(("inv_a_before", "inv_a_after")):
+        table[col] = rows[:, 4 + k] / u.au if q else rows[:, 4 + k]
+    table["e_before"], table["e_after"] = rows[:, 6], rows[:, 7]
+    return table
+
+
 def make_trajectory(system: Any, out: Any, unit: Any, method: str,
                     effects: tuple[str, ...], effect_set: Any = None, *, start: Any = None,
-                    wall_time: float | None = None) -> Trajectory:
+                    wall_time: float | None = None, encounters: Any = None) -> Trajectory:
     """The :class:`Trajectory` of an engine run from ``system`` (Quantities for a
     Quantity system, with times in ``unit``); ``effect_set`` (the
     :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
     the energy whose error is reported, where they keep one; ``start`` (``(r0, v0,
-    gm0)`` at time 0) when the run did not begin there.
+    gm0)`` at time 0) when the run did not begin there; ``encounters`` (from
+    :func:`encounter_check`) to find the test particles' close approaches a fixed
+    step was too long for (``under_resolved``).
 
     Raises
     ------
@@ -290,6 +446,14 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
     if not out.finite:
         _check_finite(system, method, r, v, times, gone)
     integrals = (system, r, v, out.gm, times, gone, effect_set, start)  # for _integrals
+    found: Any = ()
+    if encounters is not None and (np.atleast_2d(out.gm)[0] == 0).any():
+        from hamilton_orbits.integrals import under_resolved_encounters
+
+        step = encounters[0]
+        if step is None:
+            step = abs(times[-1] - times[0]) / max(int(out.steps), 1)
+        found = under_resolved_encounters(r, v, out.gm, times, step, *encounters[1:])
     final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
     if system.quantity:
         import astropy.units as u
@@ -300,13 +464,15 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
     else:
         t_out, r_out, v_out = times, r, v
     tan = out.variational
-    megno = lyap = stm = None
+    megno = lyap = stm = lyap_time = None
     if tan is not None:
         k = len(times)
         megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
+        lyap_time = tan.lyapunov_time[:k].copy()
         stm = tan.stm[:k].copy() if tan.stm is not None else None
         if system.quantity:
             lyap = (lyap / u.day).to(1 / unit)
+            lyap_time = (lyap_time * u.day).to(unit)
     events = None
     if log is not None:
         stopped = log.stopped_by
@@ -316,5 +482,6 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         t=t_out, r=r_out, v=v_out, names=system.names, steps=int(out.steps),
         wall_time=out.wall_time if wall_time is None else wall_time, method=method,
         effects=effects, complete=out.complete, integrals=integrals, final_source=final,
-        event_source=events, megno=megno, lyapunov=lyap, stm=stm,
+        event_source=events, megno=megno, lyapunov=lyap, stm=stm, lyapunov_time=lyap_time,
+        under_resolved=found,
     )

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import astropy.units as u
+import mpmath as mp
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -89,7 +90,96 @@ def test_answer_is_best_float(e):
     for d in (-np.inf, np.inf):
         y = np.nextafter(x, d)
         res_y = np.abs(mean_anomaly(y, e) - m)
-        assert np.all(res <= res_y + 2.0 * EPS * np.maximum(1.0, np.abs(m)))
+        # "clearly": beyond the evaluation's own rounding (4 ulp of max(1, |M|), as
+        # in test_residual_dense_grid); the elliptic answer is checked against the
+        # exact root in test_elliptic_answer_is_the_nearest_float
+        assert np.all(res <= res_y + 4.0 * EPS * np.maximum(1.0, np.abs(m)))
+
+
+def _ulps_from_root(m: float, e: float, x: float) -> float:
+    """``(x - E) / ulp(x)`` with E the exact root of ``E - e sin E = m`` (mpmath)."""
+    with mp.workdps(40):
+        mm, ee = mp.mpf(m), mp.mpf(e)
+        root = mp.findroot(lambda t: t - ee * mp.sin(t) - mm, mp.mpf(x))
+        return float((mp.mpf(x) - root) / mp.mpf(float(np.spacing(abs(x)))))
+
+
+# Tudat's unitTestConvertMeanAnomalyToEccentricAnomaly ("DoubleEccentric"): M
+# uniform in [0, 2 pi), e uniform in [0, 1 - 1e-11], and |M - (E - e sin E)| < 1e-15
+# in plain floats for every draw.  Draws (seeded here) that failed it, E 1.0-1.6
+# ulp from the root: the solver stopped within a few ulp, and 2 pi k + E rounds twice.
+TUDAT_FAILED = [
+    (5.027758242051444, 0.9781994878020432),
+    (2.266339894676634, 0.9391402090951412),
+    (3.7815964884804045, 0.9790332029478392),
+    (2.7040102694516777, 0.7470782934448645),
+    (3.4479915971735697, 0.9873596333947078),
+    (4.702441324590372, 0.9012133134253256),
+]
+
+
+def test_tudat_random_draws_within_1e_15():
+    """Issue 32 item 10: Tudat's random test, 1e5 draws (34-56 failed per 1e5 before)."""
+    rng = np.random.default_rng(32)
+    m = rng.uniform(0.0, 2.0 * np.pi, 100_000)
+    e = rng.uniform(0.0, 1.0 - 1e-11, 100_000)
+    x = solve_kepler(m, e)
+    assert np.count_nonzero(~(np.abs(m - (x - e * np.sin(x))) < 1e-15)) == 0
+    for mi, ei in TUDAT_FAILED:
+        xi = float(solve_kepler(mi, ei))
+        assert abs(mi - (xi - ei * np.sin(xi))) < 1e-15
+        assert abs(_ulps_from_root(mi, ei, xi)) <= 0.5  # now the nearest float
+
+
+def test_elliptic_answer_is_the_nearest_float():
+    """Where Kepler's equation is well conditioned (1 - e cos E not small), E is
+    within 0.7 ulp of the exact root: the nearest float, or its neighbour when
+    the root lies within a fraction of an ulp of the midpoint between the two."""
+    rng = np.random.default_rng(7)
+    m = rng.uniform(-20.0, 20.0, 300)
+    e = rng.uniform(0.0, 0.999, 300)
+    x = solve_kepler(m, e)
+    worst = max(abs(_ulps_from_root(a, b, c)) for a, b, c in zip(m, e, x, strict=True))
+    assert worst <= 0.7
+
+
+@pytest.mark.parametrize(("e", "m_deg", "nu_deg"), [
+    # poliastro's ELLIPTIC_ANGLES_DATA (tests/tests_twobody/test_angles.py, from
+    # Schlesinger & Udick 1912), used by its test_mean_to_true at rtol 1e-4
+    (0.0, 0.0, 0.0), (0.05, 10.0, 11.06), (0.06, 30.0, 33.67), (0.04, 120.0, 123.87),
+    (0.14, 65.0, 80.50), (0.19, 21.0, 30.94), (0.35, 65.0, 105.71), (0.48, 180.0, 180.0),
+    (0.75, 125.0, 167.57), (0.9, 180.0, 180.0),
+])
+def test_poliastro_mean_to_true(e, m_deg, nu_deg):
+    """Issue 32 item 10: M = 180 deg gave E one ulp beyond pi (past apoapsis) at
+    e = 0.48 and 0.9, so nu = -180 deg, outside the documented (-pi, pi]."""
+    from hamilton_orbits import KeplerOrbit
+
+    m = m_deg * u.deg
+    nu = true_from_anomaly(solve_kepler(m, e), e).to(u.deg)
+    assert nu.value == pytest.approx(nu_deg, rel=1e-4, abs=1e-12)
+    orbit = KeplerOrbit.from_elements(a=1.0, e=e, inc=0.0, lan=0.0, argp=0.0, M=m.to_value(u.rad),
+                                      mu=1.0)
+    assert np.degrees(orbit.nu) == pytest.approx(nu_deg, rel=1e-4, abs=1e-12)
+    assert np.degrees(orbit.M) == pytest.approx(m_deg, rel=1e-4, abs=1e-12)
+
+
+def test_apoapsis_is_plus_pi():
+    """M = pi is apoapsis: E = pi (the float) for every e, and a KeplerOrbit there,
+    in any orientation, has nu, E and M in (-pi, pi] near +pi, not -pi (a state
+    rounded a hair past apoapsis is at apoapsis to its precision)."""
+    from hamilton_orbits import KeplerOrbit
+
+    e = np.linspace(0.0, 0.99, 100)
+    assert np.all(solve_kepler(np.pi, e) == np.pi)
+    assert np.all(true_from_anomaly(solve_kepler(np.pi, e), e) == np.pi)
+    for inc, lan, argp in ((0.0, 0.0, 0.0), (0.3, 0.2, 0.1), (1.0, 2.0, 3.0), (2.5, 5.0, 0.7)):
+        o = KeplerOrbit.from_elements(a=np.ones_like(e), e=e, inc=inc, lan=lan, argp=argp,
+                                      M=np.pi, mu=1.0)
+        for angle in (o.nu[1:], o.anomaly[1:], o.M[1:]):  # e = 0: nu = u - argp, argp = 0
+            assert np.all(angle > np.pi - 1e-12) and np.all(angle <= np.pi)
+    o = KeplerOrbit.from_state([-1.0, 0.0, 0.0], [-0.0, -0.5, 0.0], 1.0)  # r.v = -0.0
+    assert (o.nu, o.anomaly) == (np.pi, np.pi)
 
 
 @pytest.mark.parametrize("e", E_LIST)

@@ -183,3 +183,165 @@ def test_progress_and_output_callback():
               dt=1 * u.day, on_output=lambda i, steps: seen.append((i, steps)))
     assert [i for i, _ in seen] == [1, 2, 3, 4, 5]
     assert seen[-1][1] == 100
+
+
+# -- issue 32 item 8: each test particle's own check; under-resolved encounters --------
+
+def _comet_scene_system() -> System:
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scenes.nbody.build import build_system
+
+    return build_system(Scene.bundled("comet-encounter").spec)
+
+
+def _inv_a(traj: Trajectory, body: str, about: str = "sun") -> float:
+    """The last state's osculating 1/a of ``body`` about ``about`` (1/au)."""
+    names = list(traj.names)
+    i, c = names.index(body), names.index(about)
+    gm = traj.final.as_arrays().gm[c]
+    d = (traj.r[-1, i] - traj.r[-1, c]).to_value(u.au)
+    w = (traj.v[-1, i] - traj.v[-1, c]).to_value(u.au / u.day)
+    return 2 / np.linalg.norm(d) - w @ w / gm
+
+
+def test_comet_ruined_by_wh_reports_its_own_check_and_warns():
+    """The issue's reproducer: ``run comet-encounter`` with ``wh`` at 1 d (output
+    steps 0.25 d) ends on a = -1080 au where radau15 gives +138.6 au, and reported
+    only the massive bodies' energy error, 1.4e-12.  Now the comet's own check
+    (its energy about the Sun: no conserved quantity with three massive bodies)
+    stands beside it, the encounter with Jupiter is listed as under-resolved, and
+    the run warns, once, naming the comet, Jupiter and the 1/a across it."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    scene = Scene.bundled("comet-encounter")
+    ref = scene.with_values({"crosscheck": False}).run(progress=False)
+    assert "under-resolved encounters" not in ref.metrics  # radau15: adaptive steps
+    bad = scene.with_values({"integrator.method": "wh", "integrator.dt": "1 d",
+                             "crosscheck": False})
+    with pytest.warns(UnderResolvedEncounterWarning) as caught:
+        res = bad.run(progress=False)
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert "'comet' to 'jupiter'" in message and "1/a of 'comet' about 'sun'" in message
+    assert res.metrics["max |relative energy error|"] < 1e-11  # the massive bodies: clean
+    key = "max |relative change of a test particle's energy about its primary|"
+    assert res.metrics[key] > 1.0 and "comet (energy about sun)" in res.summary()
+    assert res.metrics["under-resolved encounters"] == 1
+    (row,) = next(rows for title, rows in res.tables.items() if "under-resolved" in title)
+    assert row["particle"] == "comet" and row["body"] == "jupiter"
+    assert abs(row["time"].to_value(u.day) - 329.5) < 5  # radau15's closest approach
+    assert row["1/a after"].value < 0  # what wh ended on: hyperbolic
+    # the reference (radau15) ends on 1/a = 1/138.6 au, the wh run far from it
+    assert ref.metrics["comet orbit after: a"].to_value(u.au) == pytest.approx(138.62, rel=1e-3)
+    assert res.metrics["comet orbit after: a"].to_value(u.au) < 0
+
+
+@pytest.mark.parametrize(("method", "options", "dt"), [
+    ("wh", {"coordinates": "jacobi"}, 1.0),  # Kepler about the inner bodies' centre of mass
+    ("leapfrog", {}, 1.0),
+    ("wh", {}, 0.1),  # 1/a off by twice the encounter's change (0.02 d: 3e-6 of it)
+])
+def test_under_resolved_approaches_are_found(method, options, dt):
+    """The issue's variants that "found no encounter" (the Jacobi splitting and
+    leapfrog, ending on a = -0.15 au: the perihelion at 0.01 au, time scale
+    0.041 d, crossed in 1-day steps) and wh at 0.1 d past Jupiter (a = 79 au where
+    radau15 gives 138.6) warn; wh at 0.01 d does not, and matches radau15."""
+    from hamilton_orbits import Simulation
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    s = _comet_scene_system()
+    t = np.arange(0, 548.0001, 0.25) * u.day
+    sim = Simulation(s, method, dt=dt * u.day, **options)
+    with pytest.warns(UnderResolvedEncounterWarning) as caught:
+        traj = sim.integrate(t)
+    assert caught[0].filename == __file__  # stacklevel=2: the caller's line
+    body = "jupiter" if dt < 1 else "sun"
+    assert body in set(traj.under_resolved["body"])
+    assert abs(_inv_a(traj, "comet") - 1 / 138.6245981906832) > 1e-3
+    good = Simulation(s, "wh", dt=0.01 * u.day).integrate(t)  # warns not (warnings are errors)
+    assert len(good.under_resolved) == 0
+    assert _inv_a(good, "comet") == pytest.approx(1 / 138.6245981906832, rel=1e-6)
+
+
+def test_under_resolved_warns_once_per_simulation_and_tables_in_units():
+    """Once per simulation however many legs cross encounters; the table in the
+    trajectory's units (times in the unit of ``t``, distances in au, 1/a in 1/au)."""
+    import warnings
+
+    from hamilton_orbits import Simulation
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    sim = Simulation(_comet_scene_system(), "leapfrog", dt=1 * u.day)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        first = sim.integrate(np.arange(0, 30.0001, 0.25) * u.day)
+        sim.integrate(np.arange(30, 548.0001, 0.25) * u.day)
+    assert [w.category for w in caught] == [UnderResolvedEncounterWarning]
+    table = first.under_resolved
+    assert table["time"].unit == u.day and table["distance"].unit == u.au
+    assert table["inv_a_before"].unit == 1 / u.au and table["step"].unit == u.day
+    assert table["distance"][0].to_value(u.au) == pytest.approx(0.01, rel=0.1)  # q
+
+
+def test_particle_error_with_one_massive_body_is_its_energy_error():
+    """With one massive body, each particle's check is its two-body energy about
+    it, and ``energy_error`` is, at each time, the largest of them: the same
+    numbers (checked against the formula computed here)."""
+    sun = Body("sun", gm=1.0, r=[0, 0, 0], v=[0, 0, 0])
+    p1 = Body("p1", gm=0.0, r=[1.0, 0, 0], v=[0, 1.0, 0])
+    p2 = Body("p2", gm=0.0, r=[0, 2.0, 0], v=[-0.6, 0, 0.1])
+    traj = integrate(System([sun, p1, p2]), np.linspace(0, 20, 41), method="leapfrog",
+                     dt=0.01)
+    assert traj.particle_check == ("", "energy about sun", "energy about sun")
+    err = traj.particle_error
+    assert np.isnan(err[:, 0]).all()
+    eps = (0.5 * np.sum((traj.v[:, 1:] - traj.v[:, :1]) ** 2, axis=2)
+           - 1.0 / np.linalg.norm(traj.r[:, 1:] - traj.r[:, :1], axis=2))
+    np.testing.assert_allclose(err[:, 1:], (eps - eps[0]) / np.abs(eps[0]), rtol=1e-9,
+                               atol=1e-15)
+    pick = np.argmax(np.abs(err[:, 1:]), axis=1) + 1
+    np.testing.assert_array_equal(traj.energy_error, err[np.arange(41), pick])
+    assert len(traj.under_resolved) == 0  # 630 steps per orbit: resolved
+
+
+def test_particle_error_is_the_jacobi_constant_in_the_circular_restricted_problem():
+    """Two massive bodies on a circular orbit: each test particle's check is its
+    Jacobi constant, checked against the rotating-frame formula
+    ``C = 2 U + n^2 (x^2 + y^2) - |v_rot|^2``; radau15 keeps it to 1e-12 and a
+    leapfrog with 60 steps per period does not (the massive pair's energy does), and
+    warns that its step was too long for the particle's approaches."""
+    mu = 0.01
+    n = 1.0  # the pair's angular velocity: unit separation, G(m1 + m2) = 1
+    b1 = Body("m1", gm=1 - mu, r=[-mu, 0, 0], v=[0, -mu * n, 0])
+    b2 = Body("m2", gm=mu, r=[1 - mu, 0, 0], v=[0, (1 - mu) * n, 0])
+    tp = Body("tp", gm=0.0, r=[0.45, 0.5, 0.02], v=[-0.4, 0.3, 0.0])
+    s = System([b1, b2, tp])
+    t = np.linspace(0, 4 * np.pi, 21)
+    traj = integrate(s, t, method="radau15", tol=1e-12)
+    assert traj.particle_check == ("", "", "Jacobi constant")
+    ang = -n * t
+    c, sn = np.cos(ang), np.sin(ang)
+    x, v = traj.r[:, 2], traj.v[:, 2]
+    rot = np.stack([c * x[:, 0] - sn * x[:, 1], sn * x[:, 0] + c * x[:, 1]], axis=1)
+    vin = np.stack([c * v[:, 0] - sn * v[:, 1], sn * v[:, 0] + c * v[:, 1]], axis=1)
+    vrot = vin - n * np.stack([-rot[:, 1], rot[:, 0]], axis=1)
+    pot = ((1 - mu) / np.linalg.norm(x - traj.r[:, 0], axis=1)
+           + mu / np.linalg.norm(x - traj.r[:, 1], axis=1))
+    jac = 2 * pot + n**2 * np.sum(rot**2, axis=1) - np.sum(vrot**2, axis=1) - v[:, 2] ** 2
+    np.testing.assert_allclose(traj.particle_error[:, 2], (jac - jac[0]) / abs(jac[0]),
+                               atol=1e-12)
+    assert np.max(np.abs(traj.particle_error[:, 2])) < 1e-12
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    with pytest.warns(UnderResolvedEncounterWarning, match="'tp' to 'm1'") as caught:
+        coarse = integrate(s, t, method="leapfrog", dt=2 * np.pi / 60)
+    assert caught[0].filename == __file__  # through integrate(): still the caller's line
+    assert np.max(np.abs(coarse.energy_error)) < 1e-3  # the pair: only itself
+    assert np.max(np.abs(coarse.particle_error[:, 2])) > 1e-3
+
+
+def test_no_test_particles_no_particle_check():
+    traj = integrate(sun_jupiter_saturn(), 100 * u.day, method="wh", dt=10 * u.day)
+    assert traj.particle_check == ("", "", "") and np.isnan(traj.particle_error).all()
+    assert len(traj.under_resolved) == 0

@@ -415,6 +415,44 @@ def test_megno_chaotic_against_rebound(method, theirs):
     assert abs(ours.megno[-1] / theirs_out[-1, 0] - 1) < 0.05
     lt_theirs, lt_ours = 1 / theirs_out[-1, 1], 1 / ours.lyapunov[-1]
     assert 0 < lt_ours and abs(lt_ours / lt_theirs - 1) < 0.2, (lt_ours, lt_theirs)
+    # the reported Lyapunov time is that inverse, the run spanning ~12 of them
+    assert ours.lyapunov_time[-1] == lt_ours and t[-1] * ours.lyapunov[-1] > 10
+
+
+def test_lyapunov_time_of_a_regular_orbit_is_not_a_negative_time():
+    """Issue 32 item 9: on a regular orbit the exponent (the slope of a MEGNO
+    settling to 2) comes back negative, so ``1 / lyapunov`` is a negative "time"
+    while the scene said inf.  The trajectory's ``lyapunov_time`` is the one
+    definition: ``1 / lyapunov`` where ``lyapunov t >= 1`` (the run lasted that
+    long), ``inf`` elsewhere; and the quasi-periodic pair's exponent is negative
+    at the end (rebound's ``sim.lyapunov()`` too: the same definition)."""
+    pytest.importorskip("rebound")
+    t = np.linspace(0.0, 1000.0, 11)[1:] * 2 * np.pi
+    theirs, start = _megno_rebound(_rebound_pair(2.5, 0.01), "whfast", t)
+    ours = _ours(_rebound_pair(2.5, 0.01), "wh", t, tangent=start)
+    lyap = ours.lyapunov
+    assert lyap[-1] < 0 and theirs[-1, 1] < 0
+    tt = np.concatenate(([0.0], t))
+    expected = np.where(lyap * tt >= 1.0, 1.0 / np.where(lyap != 0, lyap, 1.0), np.inf)
+    np.testing.assert_array_equal(ours.lyapunov_time, expected)
+    assert np.all(np.isinf(ours.lyapunov_time))  # regular: no Lyapunov time measured
+
+
+def test_lyapunov_time_in_legs_and_quantities():
+    """``lyapunov_time`` in the unit of ``t`` (a Quantity system), continued across
+    legs exactly as one call."""
+    import astropy.units as u
+
+    from hamilton_orbits import Simulation
+
+    s = System.solar_system(bodies=["sun", "jupiter", "saturn"])
+    sim = Simulation(s, "wh", dt=100 * u.day, variational=True)
+    first = sim.integrate(500 * u.yr)
+    second = sim.integrate(1000 * u.yr)
+    once = Simulation(s, "wh", dt=100 * u.day, variational=True).integrate([500, 1000] * u.yr)
+    assert second.lyapunov_time.unit == u.yr
+    assert np.array_equal(second.lyapunov_time.value, once.lyapunov_time[1:].value)
+    assert first.lyapunov_time[0].value == np.inf
 
 
 def test_megno_is_the_same_for_every_integrator():
@@ -601,6 +639,12 @@ def test_scene_reports_megno_and_lyapunov_time():
                                                       "cadence": "300 yr"}).run(progress=False)
     assert abs(res.metrics["MEGNO"] - 2.0) < 0.1  # a = 8 au, e = 0.05: regular
     assert res.metrics["Lyapunov time"].unit == u.yr
+    # issue 32 item 9: the exponent is negative (-2.7e-4 per year), the time inf, and
+    # the summary says why (not -1/2.7e-4 = -3700 yr)
+    assert res.metrics["Lyapunov exponent"].value < 0
+    assert res.metrics["Lyapunov time"].value == np.inf
+    assert "exponent is not positive" in res.metrics["Lyapunov note"]
+    assert "Lyapunov note" in res.summary()
     assert res.diagnostics["megno"].shape == (5,)
     assert "MEGNO" in res.summary() and "Lyapunov time" in res.summary()
     assert [f.get_label() for f in res.plot()][-1] == "megno"

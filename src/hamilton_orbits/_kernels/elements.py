@@ -72,6 +72,10 @@ _CIRC_TOL = 4.0 * EPS
 # is indistinguishable from the parabola's 0
 _PARAB_TOL = 4.0 * EPS
 _RADIAL_TOL = 8.0 * EPS
+# |r.v| below this many eps of |r| |v| near apoapsis: the sign of r.v is not
+# fixed by the rounding of the state (and of r.v), so it is at apoapsis to its
+# precision, and nu, E, M are +pi there (the documented (-pi, pi])
+_APO_TOL = 4.0 * EPS
 
 
 @njit(cache=True)
@@ -345,6 +349,10 @@ def _anomaly_columns(p, e, ome, inv_a, nu, r, v2, rv, h, mu, accurate):  # pragm
     else:
         m = mean_from_anomaly(anom, e)
     if e < 1.0:
+        if abs(m) > abs(anom):
+            # |M| <= |E| for |E| <= pi (e sin E has the sign of E): only the
+            # rounding crosses it, and M of E = pi would leave (-pi, pi]
+            m = anom
         kind = ELLIPSE
         n = smu * inv_a * math.sqrt(inv_a)
     elif e == 1.0:
@@ -390,15 +398,22 @@ def state_to_elements_one(
     h = math.sqrt(hx * hx + hy * hy + hz * hz)
     inv_a = 2.0 / r - v2 / mu
     if h <= _RADIAL_TOL * r * math.sqrt(v2):
-        return _radial_elements(rx, ry, rz, r, v2, rv, inv_a, mu)
+        # + 0.0: r.v = -0.0 at the apex is +0.0, so that E there is +pi, not -pi
+        return _radial_elements(rx, ry, rz, r, v2, rv + 0.0, inv_a, mu)
     p = h * h / mu
     e, ome, inv_a = _eccentricity(rx, ry, rz, vx, vy, vz, r, v2, rv, h, p, inv_a, mu)
     inc, lan, u = _plane(rx, ry, rz, hx, hy, hz, h)
+    cn = h * h - mu * r
+    if cn < 0.0 and abs(rv) <= _APO_TOL * r * math.sqrt(v2):
+        # at apoapsis to the state's rounding (r.v = -0.0 there too): nu, the
+        # anomaly and M are +pi, as documented ((-pi, pi]), not the -pi of a
+        # state rounded a hair past it
+        rv = 0.0
     if e == 0.0:
         nu = wrap_pi(u)
         argp = 0.0
     else:
-        nu = math.atan2(rv * h, h * h - mu * r)  # (e sin nu, e cos nu) mu r / h
+        nu = math.atan2(rv * h, cn)  # (e sin nu, e cos nu) mu r / h
         argp = wrap_2pi(u - nu)
     if not full:
         if e == 1.0 and inv_a != 0.0:

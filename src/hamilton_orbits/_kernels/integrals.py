@@ -7,7 +7,9 @@ the areal vector (D) ``sum gm r x v`` and the moments of the centre of gravity
 (taken out of the run by an event) count as absent; test particles (``gm = 0``)
 add nothing and cost one pass over their rows.  The energy's sums are
 compensated (Neumaier), so that its rounding does not grow with the number of
-pairs.  No astropy here.
+pairs.  :func:`approaches` finds the test particles' close approaches a fixed
+step was too long for (:func:`hamilton_orbits.integrals.under_resolved_encounters`),
+:func:`primaries` each particle's primary.  No astropy here.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["COLUMNS", "integral_errors", "integral_sums"]
+__all__ = ["COLUMNS", "approaches", "integral_errors", "integral_sums", "primaries"]
 
 #: Columns of :func:`integral_sums`'s output.
 COLUMNS = ("energy", "lx", "ly", "lz", "gm", "rx", "ry", "rz", "vx", "vy", "vz")
@@ -129,3 +131,115 @@ def integral_errors(r, v, gm, t, gone, ee, ae, bd):  # pragma: no cover - compil
             d2 += x * x
         bd[j] = math.sqrt(d2) / scale
     return lost
+
+
+@njit(cache=True, error_model="numpy")
+def primaries(r, v, gm, out):  # pragma: no cover - compiled
+    """``out[i]``: the primary of test particle ``i`` in the state ``r``, ``v`` (n, 3)
+    (the massive body it is bound to with the largest ``1/a``, else the first of
+    largest GM), -1 for a massive body (:func:`hamilton_orbits.integrals.primaries`)."""
+    n = len(gm)
+    big = -1
+    for j in range(n):
+        if gm[j] > 0 and (big < 0 or gm[j] > gm[big]):
+            big = j
+    for i in range(n):
+        out[i] = -1
+        if gm[i] != 0 or big < 0:
+            continue
+        best, best_inv = big, 0.0
+        for j in range(n):
+            if gm[j] > 0:
+                d2, w2 = 0.0, 0.0
+                for k in range(3):
+                    d2 += (r[i, k] - r[j, k]) ** 2
+                    w2 += (v[i, k] - v[j, k]) ** 2
+                inv_a = 2.0 / math.sqrt(d2) - w2 / gm[j]
+                if inv_a > best_inv:
+                    best, best_inv = j, inv_a
+        out[i] = best
+    return out
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _periapsis(d2, u2, rad, mu):  # pragma: no cover - compiled
+    """The two-body periapsis ``q`` and ``1/a`` from ``|d|^2``, ``|u|^2``, ``d . u``."""
+    inv_a = 2.0 / math.sqrt(d2) - u2 / mu
+    h2 = max(d2 * u2 - rad * rad, 0.0)
+    ecc = math.sqrt(max(1.0 - h2 / mu * inv_a, 0.0))
+    return h2 / mu / (1.0 + ecc), inv_a
+
+
+@njit(cache=True, error_model="numpy")
+def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dist, tau
+               ):  # pragma: no cover - compiled
+    """For test particles ``tp`` and massive bodies ``m`` over states ``r``, ``v``
+    (n_t, n, 3): ``bad[t, p, j]`` where the step ``h[t]`` exceeds ``fraction`` of the
+    approach's time scale, with the distance and time scale in ``dist``, ``tau``
+    (n_t, n_tp, n_m; not stored when ``dist`` has no rows); returns the count.
+
+    An approach is one to the particle's primary ``prim[tp[p]]`` faster than a
+    tenth of the orbit's pace ``1 / n`` at the first output (any, unbound), or
+    within three Hill radii of another body, not to ``exempt`` beyond
+    ``exempt_dist``; at an
+    output its distance is ``|d|``, between outputs where the radial velocity
+    turned from negative to positive the larger two-body periapsis of the two
+    outputs; its time scale ``min(dist / speed, sqrt(dist^3 / mu))``."""
+    n_t = r.shape[0]
+    keep = dist.shape[0] > 0
+    count = 0
+    for p in range(len(tp)):
+        i = tp[p]
+        c = prim[i]
+        for jj in range(len(m)):
+            j = m[jj]
+            mu = gm[j]
+            hill3, pace = 0.0, math.inf
+            if j != c:
+                hill3 = 3.0 * (gm[j] / (3.0 * gm[c])) ** (1.0 / 3.0)
+            else:  # the orbit's own pace 1 / n at the first output (inf: unbound)
+                d2, u2 = 0.0, 0.0
+                for k in range(3):
+                    d2 += (r[0, i, k] - r[0, j, k]) ** 2
+                    u2 += (v[0, i, k] - v[0, j, k]) ** 2
+                inv_a0 = 2.0 / math.sqrt(d2) - u2 / mu
+                if inv_a0 > 0:
+                    pace = 1.0 / math.sqrt(inv_a0 ** 3 * mu)
+            q0, inv0, rad0, dn0 = 0.0, 0.0, 0.0, 0.0
+            for t in range(n_t):
+                d2, u2, rad = 0.0, 0.0, 0.0
+                for k in range(3):
+                    dk = r[t, i, k] - r[t, j, k]
+                    uk = v[t, i, k] - v[t, j, k]
+                    d2 += dk * dk
+                    u2 += uk * uk
+                    rad += dk * uk
+                dn = math.sqrt(d2)
+                q, inv_a = _periapsis(d2, u2, rad, mu)
+                dd, speed = dn, math.sqrt(u2)
+                if t > 0 and rad0 < 0 and rad > 0:
+                    qmax = max(q0, q)
+                    if qmax < min(dn0, dn):
+                        dd = qmax
+                        speed = math.sqrt(max(mu * (2.0 / qmax - max(inv0, inv_a)), 0.0))
+                q0, inv0, rad0, dn0 = q, inv_a, rad, dn
+                ts = math.sqrt(dd * dd * dd / mu)
+                if speed > 0:
+                    ts = min(dd / speed, ts)
+                if j != c:
+                    sep2 = 0.0
+                    for k in range(3):
+                        sep2 += (r[t, j, k] - r[t, c, k]) ** 2
+                    if not dd <= hill3 * math.sqrt(sep2):
+                        ts = math.inf
+                elif not ts < 0.1 * pace:  # not faster than the orbit: its pace, not an approach
+                    ts = math.inf
+                if j == exempt and dd > exempt_dist:
+                    ts = math.inf
+                flag = h[t] > fraction * ts
+                bad[t, p, jj] = flag
+                count += flag
+                if keep:
+                    dist[t, p, jj] = dd
+                    tau[t, p, jj] = ts
+    return count

@@ -75,6 +75,11 @@ class Tangent:
     ----------
     megno, lyapunov : ndarray, shape (n_t,)
         MEGNO ``<Y>`` and the Lyapunov exponent at the outputs (0 at the start).
+    lyapunov_time : ndarray, shape (n_t,)
+        ``1 / lyapunov`` where the run so far spans at least that time
+        (``lyapunov (t - t0) >= 1``), else ``inf``: no exponential growth measured
+        (a non-positive exponent is the slope of a ``<Y>`` that has levelled off,
+        not the inverse of a time; see :meth:`record`).
     stm : ndarray, shape (n_t, 6n, 6n) or None
         The state transition matrices at the outputs (never rescaled; MEGNO's
         vector is, inside the kernels, when it passes 1e100: see
@@ -109,16 +114,17 @@ class Tangent:
         self.ms = np.zeros(len(_var.MEGNO_FIELDS))
         #: MEGNO, the Lyapunov exponent and the STM at the last output recorded (the
         #: first row of the next leg's outputs)
-        self.last: tuple[float, float, np.ndarray | None] = (
-            0.0, 0.0, np.eye(6 * n) if stm else None)
+        self.last: tuple[float, float, float, np.ndarray | None] = (
+            0.0, 0.0, math.inf, np.eye(6 * n) if stm else None)
         self.new_leg(n_t)
 
     def new_leg(self, n_t: int) -> None:
         """Fresh output arrays for a leg of ``n_t`` outputs, row 0 the last recorded."""
-        megno, lyapunov, stm = self.last
+        megno, lyapunov, lyapunov_time, stm = self.last
         self.megno = np.zeros(n_t)
         self.lyapunov = np.zeros(n_t)
-        self.megno[0], self.lyapunov[0] = megno, lyapunov
+        self.lyapunov_time = np.full(n_t, math.inf)
+        self.megno[0], self.lyapunov[0], self.lyapunov_time[0] = megno, lyapunov, lyapunov_time
         self.stm = None
         if stm is not None:
             self.stm = np.zeros((n_t,) + stm.shape)
@@ -131,19 +137,31 @@ class Tangent:
         self.ms[8] = _var.log_norm(self.dr0, self.dv0, self.n, 0)
 
     def record(self, i: int, t: float, dr: np.ndarray, dv: np.ndarray) -> None:
-        """Output ``i`` at time ``t``: ``<Y> = Yss / (t - t0)`` and the Lyapunov
-        exponent ``cov(t, <Y>) / var(t)`` from the MEGNO state, and the STM's
-        columns from tangent vectors 1 ... 6n."""
+        """Output ``i`` at time ``t``: ``<Y> = Yss / (t - t0)``, the Lyapunov
+        exponent ``cov(t, <Y>) / var(t)`` from the MEGNO state (rebound's
+        ``sim.lyapunov()``), the Lyapunov time, and the STM's columns from tangent
+        vectors 1 ... 6n.
+
+        The exponent is the least-squares slope of ``<Y>(t)``: on a chaotic orbit
+        ``<Y>`` grows like ``lambda t`` and the slope measures it; on a regular one
+        ``<Y>`` levels off at 2 (0 if periodic) and the slope falls to zero from
+        either side, as ``<Y>`` settles (negative while it comes down to its
+        plateau: -1e-5 per year for a Saturn-mass planet at 8 au over 1000 orbits
+        of Jupiter).  Its inverse is then not a time: the Lyapunov time is
+        ``1 / lyapunov`` only where the run has lasted that long
+        (``lyapunov (t - t0) >= 1``), ``inf`` (none measured) otherwise."""
         ms = self.ms
         s = t - ms[0]
         self.megno[i] = ms[2] / s if s > 0 else 0.0
-        self.lyapunov[i] = ms[6] / ms[7] if ms[7] > 0 else 0.0
+        lam = ms[6] / ms[7] if ms[7] > 0 else 0.0
+        self.lyapunov[i] = lam
+        self.lyapunov_time[i] = 1.0 / lam if lam * s >= 1.0 else math.inf
         if self.stm is not None:
             n = self.n
             cols = np.concatenate([dr[n:].reshape(6 * n, n, 3), dv[n:].reshape(6 * n, n, 3)],
                                   axis=2)
             self.stm[i] = cols.reshape(6 * n, 6 * n).T
-        self.last = (self.megno[i], self.lyapunov[i],
+        self.last = (self.megno[i], self.lyapunov[i], self.lyapunov_time[i],
                      None if self.stm is None else self.stm[i])
 
 

@@ -110,16 +110,27 @@ def _events_into(result: Result, traj: Any) -> None:
 
 def _chaos_into(result: Result, traj: Any) -> None:
     """With ``variational = true``: MEGNO and the Lyapunov exponent at the end (as
-    rebound's ``sim.megno()`` and ``sim.lyapunov()``), the Lyapunov time
-    ``1 / lyapunov`` (infinite when the exponent is not positive: no exponential
-    growth measured), and MEGNO over time as a diagnostic and a figure."""
+    rebound's ``sim.megno()`` and ``sim.lyapunov()``), the trajectory's Lyapunov
+    time (``1 / lyapunov`` where the run lasted that long; infinite otherwise,
+    with a note saying so: a non-positive exponent is the slope of a levelled-off
+    MEGNO, not the inverse of a time), and MEGNO over time as a diagnostic and a
+    figure."""
     if traj.megno is None:
         return
-    lyap = traj.lyapunov[-1]
+    lyap = traj.lyapunov[-1].to(1 / u.yr)
+    lyap_time = traj.lyapunov_time[-1].to(u.yr)
     result.diagnostics["megno"] = traj.megno
     result.metrics["MEGNO"] = float(traj.megno[-1])
-    result.metrics["Lyapunov exponent"] = lyap.to(1 / u.yr)
-    result.metrics["Lyapunov time"] = (1 / lyap).to(u.yr) if lyap.value > 0 else np.inf * u.yr
+    result.metrics["Lyapunov exponent"] = lyap
+    result.metrics["Lyapunov time"] = lyap_time
+    if not np.isfinite(lyap_time):
+        span = (traj.t[-1] - traj.t[0]).to(u.yr)
+        why = ("the exponent is not positive" if lyap.value <= 0
+               else f"1 / exponent = {(1 / lyap).to_value(u.yr):.4g} yr is longer than the run")
+        result.metrics["Lyapunov note"] = (
+            f"no exponential growth measured over {span.value:.6g} yr ({why}): the orbit "
+            "looks regular; a negative exponent is the slope of a MEGNO settling to its "
+            "plateau, not the inverse of a time")
     result.plotters.append(plot_megno)
 
 
@@ -147,6 +158,7 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     result.metrics["energy"] = what
     key = "max |relative energy error|" if conserved else "max |relative energy change|"
     result.metrics[key] = float(np.max(np.abs(traj.energy_error)))
+    _particles_into(result, traj, gm)
     frame = scene_frame(scene.spec)
     result.frame = frame_note(scene.spec)
     result.plotters.append(lambda res: plot_orbits(res, gm, frame))
@@ -161,6 +173,39 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
 
     result.writers.append(write_rebound)
     return result
+
+
+def _particles_into(result: Result, traj: Any, gm: np.ndarray) -> None:
+    """The test particles' own checks, which Hamilton's integrals leave out (the
+    worst particle's, beside the massive bodies' energy), and the close approaches
+    a fixed step was too long for (a count and a table; the run also warned)."""
+    checks = traj.particle_check
+    tp = [i for i, c in enumerate(checks) if c]
+    if not tp:
+        return
+    err = np.abs(traj.particle_error[:, tp])
+    worst = int(np.nanargmax(np.nanmax(err, axis=0))) if np.isfinite(err).any() else 0
+    jacobi = checks[tp[0]] == "Jacobi constant"
+    if jacobi or np.count_nonzero(gm > 0) == 1:  # conserved: its change is an error
+        key = ("max |relative Jacobi constant error| of a test particle" if jacobi
+               else "max |relative energy error| of a test particle")
+    else:  # several massive bodies: how much they changed its orbit
+        key = "max |relative change of a test particle's energy about its primary|"
+    result.metrics[key] = float(np.nanmax(err)) if np.isfinite(err).any() else float("nan")
+    result.metrics["test particle of largest change"] = (
+        f"{traj.names[tp[worst]]} ({checks[tp[worst]]})")
+    table = traj.under_resolved
+    if not len(table):
+        return
+    result.metrics["under-resolved encounters"] = len(table)
+    result.tables["under-resolved encounters (a step too long: the orbit after each is not "
+                  "to be trusted)"] = [
+        {"particle": str(row["particle"]), "body": str(row["body"]),
+         "time": row["time"].to(u.yr), "distance": row["distance"],
+         "step / time scale": float(row["step"] / row["timescale"]),
+         "1/a before": row["inv_a_before"], "1/a after": row["inv_a_after"],
+         "e before": float(row["e_before"]), "e after": float(row["e_after"])}
+        for row in table]
 
 
 def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> None:
