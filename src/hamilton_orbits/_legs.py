@@ -176,6 +176,7 @@ def requested_rows(out: EngineRun, asked: np.ndarray) -> EngineRun:
     if tan is not None:
         k = len(out.t)
         tan = SimpleNamespace(megno=tan.megno[:k][keep], lyapunov=tan.lyapunov[:k][keep],
+                              lyapunov_time=tan.lyapunov_time[:k][keep],
                               stm=None if tan.stm is None else tan.stm[:k][keep])
     gm = out.gm[keep] if np.ndim(out.gm) == 2 else out.gm
     return dataclasses.replace(out, t=out.t[keep], r=out.r[keep], v=out.v[keep], gm=gm,
@@ -291,6 +292,7 @@ def leg_run(rows: dict[str, np.ndarray], out: EngineRun | None, prop: Propagatio
     own time, dropped: the archive holds the rows asked for up to it)."""
     t, r, v = rows["out_t"], rows["out_r"], rows["out_v"]
     megno, lyap, stm = rows.get("out_megno"), rows.get("out_lyapunov"), rows.get("out_stm")
+    lyap_time = rows.get("out_lyapunov_time")
     if out is not None:
         k = len(out.t)
         t, r, v = (np.concatenate((a, b[1:])) for a, b in ((t, out.t), (r, out.r), (v, out.v)))
@@ -298,11 +300,13 @@ def leg_run(rows: dict[str, np.ndarray], out: EngineRun | None, prop: Propagatio
         if tan is not None:
             megno = np.concatenate((megno, tan.megno[1:k]))
             lyap = np.concatenate((lyap, tan.lyapunov[1:k]))
+            lyap_time = np.concatenate((lyap_time, tan.lyapunov_time[1:k]))
             stm = None if tan.stm is None else np.concatenate((stm, tan.stm[1:k]))
     events = prop.events
     gm = (events.gm_at(t, prop.gm0) if events is not None and events.gm_changes
           else prop.gm0)
-    tangent = None if megno is None else SimpleNamespace(megno=megno, lyapunov=lyap, stm=stm)
+    tangent = None if megno is None else SimpleNamespace(
+        megno=megno, lyapunov=lyap, lyapunov_time=lyap_time, stm=stm)
     done = out is None or out.complete
     return EngineRun(t, r, v, steps, 0.0 if out is None else out.wall_time, done, events, gm,
                      tangent, out is not None and out.interrupted, first_event,

@@ -168,8 +168,8 @@ class LegRows:
         """Output row at ``t`` (copied); ``tangent``: the variational equations."""
         row: tuple[Any, ...] = (t, r.copy(), v.copy())
         if tangent is not None:
-            megno, lyapunov, stm = tangent.last
-            row += (megno, lyapunov, None if stm is None else stm.copy())
+            megno, lyapunov, lyapunov_time, stm = tangent.last
+            row += (megno, lyapunov, lyapunov_time, None if stm is None else stm.copy())
         self.rows.append(row)
 
     def take(self) -> dict[str, np.ndarray]:
@@ -181,7 +181,7 @@ class LegRows:
             out["leg_times"], self.times = self.times, None
         out["out_t"] = np.array([x[0] for x in rows], dtype=np.float64)
         for k, name in ((1, "out_r"), (2, "out_v"), (3, "out_megno"), (4, "out_lyapunov"),
-                        (5, "out_stm")):
+                        (5, "out_lyapunov_time"), (6, "out_stm")):
             if rows and len(rows[0]) > k and rows[0][k] is not None:
                 out[name] = np.array([x[k] for x in rows], dtype=np.float64)
         return out

@@ -212,6 +212,9 @@ def test_an_empty_or_missing_archive_is_named(tmp_path):
     dict(method="wh", dt=0.01, events=[{"name": "collision", "action": "merge"}]),
     dict(method="dop853", events=[{"name": "collision", "action": "merge"}]),
 ], ids=["radau15-variational-stm", "radau15-merge", "wh-merge", "dop853-merge"])
+# wh at this step passes the bystander close by the falling pair too fast to resolve
+# (the run says so); what is tested here is that the resumed call is the same run
+@pytest.mark.filterwarnings("ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")
 def test_resume_returns_the_interrupted_call_whole_even_after_a_second_interruption(tmp_path,
                                                                                     kw):
     """A call stopped twice (as a kill would: the process's own state discarded, only
