@@ -233,3 +233,81 @@ def test_the_nbody_kind_registers_through_the_entry_point_group():
     assert base.BUILT_IN[0].load() is kind.register
     assert base.registered_kinds()["nbody"] is kind.KIND
     assert {"nbody", "rotation"} <= set(base.KINDS)
+
+
+# --------------------------------------------------------------------------
+# Events that remove or merge bodies (issue 32, class 11): every output kept
+# --------------------------------------------------------------------------
+
+def _events_scene(kind: str, **changes):
+    """A star, a planet and a massless rogue on a hyperbola that leaves 5 au ("escape",
+    removed there), or a star and a comet that falls into it ("merge")."""
+    star = {"name": "star", "gm": "1.32712440018e20 m3 / s2", "radius": "700000 km",
+            "r": ["0 au", "0 au", "0 au"], "v": ["0 km/s", "0 km/s", "0 km/s"]}
+    if kind == "escape":
+        bodies = [star, {"name": "planet", "gm": "1e14 m3/s2", "primary": "star",
+                         "a": "1 au", "e": 0.0},
+                  {"name": "rogue", "gm": "0 m3/s2", "primary": "star", "a": "-0.2 au",
+                   "e": 1.5}]
+        events = [{"name": "escape", "distance": "5 au", "action": "remove"}]
+    else:
+        bodies = [star, {"name": "comet", "gm": "1e10 m3/s2", "primary": "star",
+                         "q": "0.001 au", "e": 0.99, "radius": "10 km", "M": "-5 deg"}]
+        events = [{"name": "collision", "action": "merge"}]
+    return Scene.from_dict({"kind": "nbody", "description": kind, "duration": "400 d",
+                            "effects": [], "integrator": {"method": "radau15"},
+                            "bodies": bodies, "events": events, **changes})
+
+
+def test_an_escape_that_removes_a_body_keeps_every_result(tmp_path):
+    """Issue 32, class 11: the run completed, then failed on "Expected `r` to be finite"
+    and saved nothing.  The analysis measures over the outputs where both bodies exist
+    (the same as the run without the event, up to the escape)."""
+    analysis = [{"name": "close_approach", "body": "rogue", "other": "planet",
+                 "primary": "star"},
+                {"name": "perihelion_advance", "body": "rogue", "primary": "star"}]
+    result = _events_scene("escape", crosscheck=True, analysis=analysis).run(progress=False)
+    assert result.complete
+    r = result.states["r"].to_value(u.au)
+    gone = ~np.isfinite(r[:, 2, 0])
+    k = int(np.argmax(gone))  # the first output after the escape
+    assert 0 < k and np.all(gone[k:]) and np.all(np.isfinite(r[:, :2]))
+    assert result.metrics["events found"] == 1
+    assert "skipped: events changed the bodies (remove)" in \
+        result.metrics["cross-check against rebound"]
+    assert result.metrics["closest approach rogue-planet: measured up to"] == \
+        result.times[k - 1].to(u.yr)
+    free = _events_scene("escape", events=[]).run(progress=False)
+    fr = free.states["r"].to_value(u.au)
+    closest = np.min(np.linalg.norm(fr[:k, 2] - fr[:k, 1], axis=-1))
+    assert result.metrics["closest approach rogue-planet"].to_value(u.au) == \
+        pytest.approx(closest, rel=1e-6)
+    assert np.isfinite(result.metrics["rogue orbit after: e"])
+    assert result.metrics["rogue orbit after: e"] == pytest.approx(1.5, rel=1e-3)
+    paths = result.save(tmp_path)
+    names = {p.name for p in paths}
+    assert {"summary.md", "summary.json", "states.nc", "final.bin", "orbits.png"} <= names
+    import rebound
+    assert rebound.Simulation(str(tmp_path / "final.bin")).N == 2
+
+
+def test_a_collision_that_merges_keeps_every_result(tmp_path):
+    analysis = [{"name": "close_approach", "body": "comet", "other": "star"},
+                {"name": "nodal_regression", "body": "comet", "primary": "star"}]
+    result = _events_scene("merge", crosscheck=True, analysis=analysis).run(progress=False)
+    assert result.complete
+    assert result.tables["events"][0]["action"] == "merge"
+    assert "skipped" in result.metrics["cross-check against rebound"]
+    # the comet is gone before the second output: one output to measure from
+    assert result.metrics["nodal regression of comet"].startswith("not measured: comet and "
+                                                                  "star together at 1 output")
+    assert np.all(np.isnan(result.states["r"][1:, 1].value))
+    paths = result.save(tmp_path)
+    assert (tmp_path / "states.nc") in paths and (tmp_path / "final.bin") in paths
+
+
+def test_events_that_do_not_change_the_bodies_keep_the_cross_check():
+    scene = _events_scene("escape", crosscheck=True, duration="20 d")
+    result = scene.run(progress=False)
+    assert "events found" in result.metrics and result.metrics["events found"] == 0
+    assert "max relative position difference" in result.metrics
