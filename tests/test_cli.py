@@ -113,6 +113,20 @@ def test_a_scene_whose_escape_removes_a_body_saves_everything(tmp_path, capsys):
         assert (out / name).exists(), name
 
 
+def test_a_scene_the_run_would_refuse_exits_2_before_running(tmp_path, capsys):
+    """Issue 32, class 18: a pole-prediction start after the record, a collision without
+    radii: refused at load (exit 2, as any bad scene), not after a run (exit 1)."""
+    code = main(["run", "pole-prediction", "--set", "start=2040-01-01", "--set", "periods=[]",
+                 "--out", str(tmp_path), "--no-progress"])
+    assert code == 2
+    assert "start: method 'persistence': expected the start date" in capsys.readouterr().err
+    path = tmp_path / "merge.toml"
+    path.write_text(ESCAPE_SCENE.replace('name = "escape"\ndistance = "5 au"\n'
+                                         'action = "remove"', 'name = "collision"'))
+    assert main(["run", str(path), "--no-progress"]) == 2
+    assert "events[0]: no pair of bodies has radii" in capsys.readouterr().err
+
+
 def test_bad_scene_and_setting(capsys):
     assert main(["run", "no-such-scene", "--no-progress"]) == 2
     assert "no-such-scene" in capsys.readouterr().err

@@ -5,6 +5,7 @@ error must name the file and the key path, and for an unknown name the closest
 valid names.  Nothing is simulated until the whole scene is valid.
 """
 
+import copy
 import re
 
 import astropy.units as u
@@ -311,3 +312,71 @@ def test_events_that_do_not_change_the_bodies_keep_the_cross_check():
     result = scene.run(progress=False)
     assert "events found" in result.metrics and result.metrics["events found"] == 0
     assert "max relative position difference" in result.metrics
+
+
+# --------------------------------------------------------------------------
+# What the run would refuse is refused at load (issue 32, class 18)
+# --------------------------------------------------------------------------
+
+def _merge_data(**changes):
+    data = copy.deepcopy(_events_scene("merge").data)
+    data.update(changes)
+    return data
+
+
+def _problems(data) -> list[str]:
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict(data)
+    return info.value.problems
+
+
+def test_a_collision_event_without_radii_is_refused_at_load():
+    data = _merge_data()
+    for b in data["bodies"]:
+        b.pop("radius")
+    assert _problems(data) == ["<dict>: events[0]: no pair of bodies has radii "
+                               "(give Body(radius=...))"]
+
+
+def test_a_hill_sphere_about_the_star_is_refused_at_load():
+    data = _merge_data(events=[{"name": "close_encounter", "distance": {"hill": 3},
+                                "bodies": ["star", "comet"]}])
+    assert _problems(data) == ["<dict>: events[0]: a Hill radius about the most massive "
+                               "body itself is not defined (pair 'star'-'comet')"]
+
+
+def test_a_non_finite_effect_parameter_is_refused_at_load():
+    data = {"kind": "nbody", "duration": "2 d", "initial": {"solar_system": {
+        "epoch": "J2000", "bodies": ["sun", "earth", "moon"]}},
+        "effects": [{"name": "moon_figure", "j2": float("nan")}]}
+    assert _problems(data) == ["<dict>: effects[0].j2: expected a finite value, got nan"]
+
+
+def test_de440_residuals_without_the_ephemeris_is_refused_at_load():
+    data = _merge_data(events=[], analysis=[{"name": "de440_residuals"}], duration="3 yr",
+                       cadence="0.5 yr")
+    assert _problems(data) == ["<dict>: analysis[0]: analysis 'de440_residuals' needs the "
+                               "start from DE440: give [initial] ephemeris"]
+    data = _merge_data(events=[], analysis=[{"name": "de440_residuals"}], duration="1.9 yr",
+                       cadence="0.7 yr")
+    assert "hold 1; give a cadence that divides a year" in _problems(data)[-1]
+
+
+def test_a_kind_that_is_not_a_string_is_named():
+    assert _problems({"kind": ["nbody"], "duration": "1 yr"}) == [
+        "<dict>: kind: expected a string, one of 'nbody', 'polar_motion', 'pole_prediction', "
+        "'rotation', got ['nbody']"]
+
+
+def test_problems_across_keys_come_with_the_others():
+    """A cross-key problem (an analysis about a body not in the scene) is reported with
+    a problem of a key on its own, not after it is fixed; a key refused on its own gives
+    no second message from the checks across keys."""
+    data = _merge_data(duration="-1 d", analysis=[{"name": "close_approach", "body": "zz",
+                                                   "other": "comet"}])
+    data["bodies"][1]["gm"] = "-1 km3/s2"
+    problems = _problems(data)
+    assert problems[0] == "<dict>: duration: expected a value > 0, got '-1 d'"
+    assert problems[-1] == "<dict>: analysis[0].body: no body named 'zz' (valid: 'star', 'comet')"
+    assert sum("bodies[1].gm" in p for p in problems) == 1, problems
+    assert len(problems) == 3, problems

@@ -427,3 +427,27 @@ def test_full_hindcast_runs_in_under_a_minute_and_liouville_leads(record):
         assert np.mean(both) < np.mean(np.concatenate([ls_ar["mae_x"], ls_ar["mae_y"]]))
         cover = np.concatenate([liou["coverage_x"], liou["coverage_y"]])
         assert np.all((cover > 0.35) & (cover < 0.85))  # see docs/pole_wander.md
+
+
+# --------------------------------------------------------------------------
+# The pole_prediction scene refuses at load what its run would (issue 32, class 18)
+# --------------------------------------------------------------------------
+
+def test_scene_start_and_periods_outside_the_record_are_refused_at_load(record):
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scene import SceneError
+
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict({"kind": "pole_prediction", "start": "2040-01-01", "methods": ["ls"],
+                         "periods": ["2024-01-01..2027-01-01"], "horizon": "30 d"})
+    assert info.value.problems == [
+        "<dict>: start: method 'ls': expected the start date at 0h UTC within the record, "
+        "from 1964-12-31 (1095 days of history plus the 1 d latency) to 2026-09-30, got "
+        "2040-01-01 00:00:00.000",
+        "<dict>: periods[0]: method 'ls': expected the weekly start dates at 0h UTC within "
+        "the record, from 1964-12-31 (1095 days of history plus the 1 d latency) to "
+        "2026-09-30, got 2026-10-05 00:00:00.000 at index 144"]
+    with pytest.raises(SceneError, match=r"horizon: method 'persistence': expected `horizon` "
+                                         r"in whole days from 0 d to 1825 d, got 2000.0 d"):
+        Scene.from_dict({"kind": "pole_prediction", "methods": ["persistence", "ls"],
+                         "periods": [], "horizon": "2000 d"})

@@ -74,6 +74,7 @@ __all__ = [
     "HindcastScore",
     "PolePrediction",
     "PoleRecord",
+    "check_inputs",
     "hindcast",
     "predict",
     "propagate_pole",
@@ -277,6 +278,31 @@ def predict(
         sigma_y=np.sqrt(vy[sl]) * _MAS, method=method,
         newest_datum=Time(mjd[k], format="mjd", scale="utc"),
         parameters=fitted_parameters(method, x[:k + 1], y[:k + 1]))
+
+
+def check_inputs(record: PoleRecord, starts: Time, horizons: u.Quantity, method: str, *,
+                 latency: u.Quantity = 1 * u.day) -> None:
+    """Raise the ``ValueError`` that :func:`hindcast` (or :func:`predict`, for one start)
+    would raise for these inputs, without forecasting (a scene's check at load).
+
+    Examples
+    --------
+    >>> from rigid.polar_motion import load_c04
+    >>> check_inputs(load_c04(), Time(["1963-01-01"]), [30] * u.day, "ls")
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `starts` at 0h UTC within the record, from ... got 1963-01-01 ...
+    """
+    method = _check_method(method)
+    mjd, x, y = _check_record(record)
+    at = _as_mjd("starts", starts)
+    _lead_days(method, horizons, latency, "horizons", single=False)
+    lat = int(_whole_days("latency", latency, minimum=1, maximum=max_lead(method),
+                          single=True)[0])
+    history = history_days(method)
+    for k in _newest_index("starts", mjd, at, lat, history):
+        _check_history(x, y, int(k), history)
 
 
 def _check_history(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:

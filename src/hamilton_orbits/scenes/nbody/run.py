@@ -15,20 +15,17 @@ import numpy as np
 from hamilton_orbits import effects as _effects
 from hamilton_orbits._progress import progress_bar
 from hamilton_orbits.scenes.nbody.analyses import ANALYSIS_FUNCTIONS
-from hamilton_orbits.scenes.nbody.build import build_system, frame_note, scene_frame
+from hamilton_orbits.scenes.nbody.build import (
+    build_system,
+    frame_note,
+    output_times,
+    scene_frame,
+)
 from hamilton_orbits.scenes.nbody.figures import plot_energy, plot_megno, plot_orbits
 from hamilton_orbits.scenes.result import Result
 
 #: The unit system of an ``nbody`` scene's states and times.
 UNITS = {"time": u.d, "length": u.au, "speed": u.au / u.d}
-
-
-def _times(spec: dict) -> u.Quantity:
-    duration = spec["duration"].to(u.d)
-    cadence = spec["cadence"].to(u.d) if spec["cadence"] is not None else duration / 1000
-    n = max(1, int(np.ceil((duration / cadence).to_value(u.one) - 1e-9)))
-    t = np.minimum(np.arange(n + 1) * cadence.value, duration.value)
-    return t * u.d
 
 
 def simulation(spec: dict, system: Any) -> Any:
@@ -51,7 +48,7 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False) -> Result:
     spec = scene.spec
     system = build_system(spec)
     sim = simulation(spec, system)
-    times = _times(spec)
+    times = output_times(spec)
     bar = progress_bar(len(times) - 1, progress, "output")
     try:
         traj = sim.integrate(times, stop=stop, on_interrupt="keep",
