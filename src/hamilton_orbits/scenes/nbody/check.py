@@ -257,7 +257,7 @@ def _check_buildable(spec: dict, problems: S.Problems) -> None:
         params = {k: v for k, v in eff.items() if k != "name"}
         attempt(problems, f"effects[{i}]", lambda ek=ek, p=params: ek.params(system, p),
                  tuple(ek.parameters))
-    if not problems:
+    if spec["events"] and not problems:  # (an ensemble's members: no set-up without events)
         _check_simulation(spec, system, problems)
 
 
