@@ -64,6 +64,69 @@ def test_run_a_short_scene_writes_outputs(tmp_path, capsys):
     assert summary["metrics"]["max relative position difference"] < 1e-9
 
 
+ESCAPE_SCENE = """\
+kind = "nbody"
+description = "escape remove"
+duration = "400 d"
+crosscheck = true
+effects = []
+[integrator]
+method = "radau15"
+[[bodies]]
+name = "star"
+gm = "1.32712440018e20 m3 / s2"
+r = ["0 au", "0 au", "0 au"]
+v = ["0 km/s", "0 km/s", "0 km/s"]
+[[bodies]]
+name = "planet"
+gm = "1e14 m3/s2"
+primary = "star"
+a = "1 au"
+e = 0.0
+[[bodies]]
+name = "rogue"
+gm = "0 m3/s2"
+primary = "star"
+a = "-0.2 au"
+e = 1.5
+[[events]]
+name = "escape"
+distance = "5 au"
+action = "remove"
+[[analysis]]
+name = "close_approach"
+body = "rogue"
+other = "planet"
+"""
+
+
+def test_a_scene_whose_escape_removes_a_body_saves_everything(tmp_path, capsys):
+    """Issue 32, class 11: the run completed, then exited 1 having saved nothing."""
+    path = tmp_path / "escape.toml"
+    path.write_text(ESCAPE_SCENE)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "escape" in text and "remove" in text and "skipped: events changed" in text
+    for name in ("summary.md", "summary.json", "orbits.png", "energy_error.png",
+                 "states.nc", "final.bin"):
+        assert (out / name).exists(), name
+
+
+def test_a_scene_the_run_would_refuse_exits_2_before_running(tmp_path, capsys):
+    """Issue 32, class 18: a pole-prediction start after the record, a collision without
+    radii: refused at load (exit 2, as any bad scene), not after a run (exit 1)."""
+    code = main(["run", "pole-prediction", "--set", "start=2040-01-01", "--set", "periods=[]",
+                 "--out", str(tmp_path), "--no-progress"])
+    assert code == 2
+    assert "start: method 'persistence': expected the start date" in capsys.readouterr().err
+    path = tmp_path / "merge.toml"
+    path.write_text(ESCAPE_SCENE.replace('name = "escape"\ndistance = "5 au"\n'
+                                         'action = "remove"', 'name = "collision"'))
+    assert main(["run", str(path), "--no-progress"]) == 2
+    assert "events[0]: no pair of bodies has radii" in capsys.readouterr().err
+
+
 def test_bad_scene_and_setting(capsys):
     assert main(["run", "no-such-scene", "--no-progress"]) == 2
     assert "no-such-scene" in capsys.readouterr().err

@@ -5,6 +5,7 @@ error must name the file and the key path, and for an unknown name the closest
 valid names.  Nothing is simulated until the whole scene is valid.
 """
 
+import copy
 import re
 
 import astropy.units as u
@@ -233,3 +234,149 @@ def test_the_nbody_kind_registers_through_the_entry_point_group():
     assert base.BUILT_IN[0].load() is kind.register
     assert base.registered_kinds()["nbody"] is kind.KIND
     assert {"nbody", "rotation"} <= set(base.KINDS)
+
+
+# --------------------------------------------------------------------------
+# Events that remove or merge bodies (issue 32, class 11): every output kept
+# --------------------------------------------------------------------------
+
+def _events_scene(kind: str, **changes):
+    """A star, a planet and a massless rogue on a hyperbola that leaves 5 au ("escape",
+    removed there), or a star and a comet that falls into it ("merge")."""
+    star = {"name": "star", "gm": "1.32712440018e20 m3 / s2", "radius": "700000 km",
+            "r": ["0 au", "0 au", "0 au"], "v": ["0 km/s", "0 km/s", "0 km/s"]}
+    if kind == "escape":
+        bodies = [star, {"name": "planet", "gm": "1e14 m3/s2", "primary": "star",
+                         "a": "1 au", "e": 0.0},
+                  {"name": "rogue", "gm": "0 m3/s2", "primary": "star", "a": "-0.2 au",
+                   "e": 1.5}]
+        events = [{"name": "escape", "distance": "5 au", "action": "remove"}]
+    else:
+        bodies = [star, {"name": "comet", "gm": "1e10 m3/s2", "primary": "star",
+                         "q": "0.001 au", "e": 0.99, "radius": "10 km", "M": "-5 deg"}]
+        events = [{"name": "collision", "action": "merge"}]
+    return Scene.from_dict({"kind": "nbody", "description": kind, "duration": "400 d",
+                            "effects": [], "integrator": {"method": "radau15"},
+                            "bodies": bodies, "events": events, **changes})
+
+
+def test_an_escape_that_removes_a_body_keeps_every_result(tmp_path):
+    """Issue 32, class 11: the run completed, then failed on "Expected `r` to be finite"
+    and saved nothing.  The analysis measures over the outputs where both bodies exist
+    (the same as the run without the event, up to the escape)."""
+    analysis = [{"name": "close_approach", "body": "rogue", "other": "planet",
+                 "primary": "star"},
+                {"name": "perihelion_advance", "body": "rogue", "primary": "star"}]
+    result = _events_scene("escape", crosscheck=True, analysis=analysis).run(progress=False)
+    assert result.complete
+    r = result.states["r"].to_value(u.au)
+    gone = ~np.isfinite(r[:, 2, 0])
+    k = int(np.argmax(gone))  # the first output after the escape
+    assert 0 < k and np.all(gone[k:]) and np.all(np.isfinite(r[:, :2]))
+    assert result.metrics["events found"] == 1
+    assert "skipped: events changed the bodies (remove)" in \
+        result.metrics["cross-check against rebound"]
+    assert result.metrics["closest approach rogue-planet: measured up to"] == \
+        result.times[k - 1].to(u.yr)
+    free = _events_scene("escape", events=[]).run(progress=False)
+    fr = free.states["r"].to_value(u.au)
+    closest = np.min(np.linalg.norm(fr[:k, 2] - fr[:k, 1], axis=-1))
+    assert result.metrics["closest approach rogue-planet"].to_value(u.au) == \
+        pytest.approx(closest, rel=1e-6)
+    assert np.isfinite(result.metrics["rogue orbit after: e"])
+    assert result.metrics["rogue orbit after: e"] == pytest.approx(1.5, rel=1e-3)
+    paths = result.save(tmp_path)
+    names = {p.name for p in paths}
+    assert {"summary.md", "summary.json", "states.nc", "final.bin", "orbits.png"} <= names
+    import rebound
+    assert rebound.Simulation(str(tmp_path / "final.bin")).N == 2
+
+
+def test_a_collision_that_merges_keeps_every_result(tmp_path):
+    analysis = [{"name": "close_approach", "body": "comet", "other": "star"},
+                {"name": "nodal_regression", "body": "comet", "primary": "star"}]
+    result = _events_scene("merge", crosscheck=True, analysis=analysis).run(progress=False)
+    assert result.complete
+    assert result.tables["events"][0]["action"] == "merge"
+    assert "skipped" in result.metrics["cross-check against rebound"]
+    # the comet is gone before the second output: one output to measure from
+    assert result.metrics["nodal regression of comet"].startswith("not measured: comet and "
+                                                                  "star together at 1 output")
+    assert np.all(np.isnan(result.states["r"][1:, 1].value))
+    paths = result.save(tmp_path)
+    assert (tmp_path / "states.nc") in paths and (tmp_path / "final.bin") in paths
+
+
+def test_events_that_do_not_change_the_bodies_keep_the_cross_check():
+    scene = _events_scene("escape", crosscheck=True, duration="20 d")
+    result = scene.run(progress=False)
+    assert "events found" in result.metrics and result.metrics["events found"] == 0
+    assert "max relative position difference" in result.metrics
+
+
+# --------------------------------------------------------------------------
+# What the run would refuse is refused at load (issue 32, class 18)
+# --------------------------------------------------------------------------
+
+def _merge_data(**changes):
+    data = copy.deepcopy(_events_scene("merge").data)
+    data.update(changes)
+    return data
+
+
+def _problems(data) -> list[str]:
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict(data)
+    return info.value.problems
+
+
+def test_a_collision_event_without_radii_is_refused_at_load():
+    data = _merge_data()
+    for b in data["bodies"]:
+        b.pop("radius")
+    assert _problems(data) == ["<dict>: events[0]: no pair of bodies has radii "
+                               "(give Body(radius=...))"]
+
+
+def test_a_hill_sphere_about_the_star_is_refused_at_load():
+    data = _merge_data(events=[{"name": "close_encounter", "distance": {"hill": 3},
+                                "bodies": ["star", "comet"]}])
+    assert _problems(data) == ["<dict>: events[0]: a Hill radius about the most massive "
+                               "body itself is not defined (pair 'star'-'comet')"]
+
+
+def test_a_non_finite_effect_parameter_is_refused_at_load():
+    data = {"kind": "nbody", "duration": "2 d", "initial": {"solar_system": {
+        "epoch": "J2000", "bodies": ["sun", "earth", "moon"]}},
+        "effects": [{"name": "moon_figure", "j2": float("nan")}]}
+    assert _problems(data) == ["<dict>: effects[0].j2: expected a finite value, got nan"]
+
+
+def test_de440_residuals_without_the_ephemeris_is_refused_at_load():
+    data = _merge_data(events=[], analysis=[{"name": "de440_residuals"}], duration="3 yr",
+                       cadence="0.5 yr")
+    assert _problems(data) == ["<dict>: analysis[0]: analysis 'de440_residuals' needs the "
+                               "start from DE440: give [initial] ephemeris"]
+    data = _merge_data(events=[], analysis=[{"name": "de440_residuals"}], duration="1.9 yr",
+                       cadence="0.7 yr")
+    assert "hold 1; give a cadence that divides a year" in _problems(data)[-1]
+
+
+def test_a_kind_that_is_not_a_string_is_named():
+    assert _problems({"kind": ["nbody"], "duration": "1 yr"}) == [
+        "<dict>: kind: expected a string, one of 'nbody', 'polar_motion', 'pole_prediction', "
+        "'rotation', got ['nbody']"]
+
+
+def test_problems_across_keys_come_with_the_others():
+    """A cross-key problem (an analysis about a body not in the scene) is reported with
+    a problem of a key on its own, not after it is fixed; a key refused on its own gives
+    no second message from the checks across keys."""
+    data = _merge_data(duration="-1 d", analysis=[{"name": "close_approach", "body": "zz",
+                                                   "other": "comet"}])
+    data["bodies"][1]["gm"] = "-1 km3/s2"
+    problems = _problems(data)
+    assert problems[0] == "<dict>: duration: expected a value > 0, got '-1 d'"
+    assert problems[-1] == "<dict>: analysis[0].body: no body named 'zz' (valid: 'star', 'comet')"
+    assert sum("bodies[1].gm" in p for p in problems) == 1, problems
+    assert len(problems) == 3, problems

@@ -7,6 +7,7 @@ are in docs/pole_wander.md; the full hindcasts are the slow tests at the end.
 
 from __future__ import annotations
 
+import re
 import socket
 import time
 from types import SimpleNamespace
@@ -23,6 +24,7 @@ from rigid.earth.prediction import (
     METHODS,
     PAPER_PERIOD,
     RECENT_PERIOD,
+    SPIKE_LIMIT,
     hindcast,
     predict,
     propagate_pole,
@@ -292,8 +294,8 @@ def test_start_dates_outside_the_record_name_the_index(record):
 
 
 @pytest.mark.parametrize(("horizon", "match"), [
-    (-1 * u.day, r"`horizon` in whole days >= 0 d, got -1.0 d"),
-    (10.5 * u.day, r"`horizon` in whole days >= 0 d, got 10.5 d"),
+    (-1 * u.day, r"`horizon` in whole days from 0 d to 3651 d, got -1.0 d"),
+    (10.5 * u.day, r"`horizon` in whole days from 0 d to 3651 d, got 10.5 d"),
     (365, r"`horizon` to be a time Quantity"),
 ])
 def test_bad_horizon(record, horizon, match):
@@ -303,14 +305,15 @@ def test_bad_horizon(record, horizon, match):
 
 def test_bad_horizons_latency_starts_and_record(record):
     starts = weekly_starts("2019-01-01", "2019-02-01")
-    with pytest.raises(ValueError, match=r"`horizons` in whole days >= 0 d, got -5.0 d at "
-                                         r"index 1"):
+    with pytest.raises(ValueError, match=r"`horizons` in whole days from 0 d to 3651 d, "
+                                         r"got -5.0 d at index 1"):
         hindcast(record, starts, [10, -5] * u.day)
     with pytest.raises(ValueError, match="`starts` to hold at least one start date"):
         hindcast(record, Time([], format="mjd"))
     with pytest.raises(ValueError, match="`horizons` to hold at least one horizon"):
         hindcast(record, starts, [] * u.day)
-    with pytest.raises(ValueError, match=r"`latency` in whole days >= 1 d, got 0.0 d"):
+    with pytest.raises(ValueError, match=r"`latency` in whole days from 1 d to 3652 d, "
+                                         r"got 0.0 d"):
         predict(record, at=AT, horizon=10 * u.day, latency=0 * u.day)
     with pytest.raises(ValueError, match="`record` from load_c04"):
         predict({"x": 1}, at=AT, horizon=10 * u.day)
@@ -327,6 +330,80 @@ def test_non_finite_history_is_refused(record):
     bad = SimpleNamespace(time=record.time, x=x, y=record.y)
     with pytest.raises(ValueError, match=rf"`record.x` finite .* got nan at index {stop - 100}"):
         predict(bad, at=AT, horizon=10 * u.day)
+
+
+def test_horizon_and_latency_must_be_single_times(record):
+    """Issue 32, class 7: a list of horizons (or latencies) was read as its first value."""
+    with pytest.raises(ValueError, match=r"`horizon` to be a single time, got .*10\., 30\."
+                                         r".* \(2 values\)"):
+        predict(record, at=AT, horizon=[10, 30] * u.day)
+    with pytest.raises(ValueError, match=r"`latency` to be a single time, got .*1\., 3\."):
+        predict(record, at=AT, horizon=30 * u.day, latency=[1, 3] * u.day)
+    with pytest.raises(ValueError, match=r"`latency` to be a single time"):
+        hindcast(record, weekly_starts("2019-01-01", "2019-02-01"), [10] * u.day,
+                 "persistence", latency=[1, 3] * u.day)
+
+
+@pytest.mark.parametrize("horizon", [1826, 3651, 3652, 1e12, 1e300])
+def test_persistence_refuses_a_lead_beyond_half_its_window(record, horizon):
+    """Issue 32, classes 7 and 19: a NaN sigma at 3651 d, an IndexError from 3652 d, a
+    MemoryError at 1e12 d, "negative dimensions" at 1e300 d."""
+    value = re.escape(repr(float(horizon)))
+    with pytest.raises(ValueError, match=rf"`horizon` in whole days from 0 d to 1825 d, got "
+                                         rf"{value} d \(method 'persistence' serves at most "
+                                         r"1826 d"):
+        predict(record, at=AT, horizon=horizon * u.day, method="persistence")
+    longest = predict(record, at=AT, horizon=1825 * u.day, method="persistence")
+    assert np.all(np.isfinite(longest.sigma_x)) and np.all(np.isfinite(longest.sigma_y))
+
+
+def test_every_method_refuses_a_lead_beyond_ten_years(record):
+    with pytest.raises(ValueError, match=r"`horizon` in whole days from 0 d to 3649 d, got "
+                                         r"1e\+300 d \(method 'ls' serves at most 3652 d"):
+        predict(record, at=AT, horizon=1e300 * u.day, method="ls", latency=3 * u.day)
+    with pytest.raises(ValueError, match=r"`horizons` .* got 9000.0 d at index 1"):
+        hindcast(record, Time(["2019-01-01"]), [10, 9000] * u.day, "ls")
+    longest = predict(record, at=AT, horizon=3651 * u.day, method="ls")
+    assert np.all(np.isfinite(longest.x)) and np.all(np.isfinite(longest.sigma_x))
+
+
+def test_an_empty_record_is_refused(record):
+    """Issue 32, class 19: an IndexError in both predict and hindcast."""
+    empty = SimpleNamespace(time=record.time[:0], x=record.x[:0], y=record.y[:0])
+    with pytest.raises(ValueError, match="`record` to hold at least one epoch, got an empty"):
+        predict(empty, at=AT, horizon=10 * u.day)
+    with pytest.raises(ValueError, match="`record` to hold at least one epoch, got an empty"):
+        hindcast(empty, Time(["2019-01-01"]), [10] * u.day)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_one_bad_datum_is_refused_not_extrapolated(record, method):
+    """Issue 32, class 7: a 1-arcsec spike in the newest datum made the ls+ar, ls+var and
+    liouville 30-day forecasts 1e10-1e15 mas; such a datum is now refused, by index."""
+    k = int(np.searchsorted(record.time.mjd, AT.mjd)) - 1  # the newest datum used
+    for where in (k, k - 100):
+        x = record.x.copy()
+        x[where] += 1 * u.arcsec
+        bad = SimpleNamespace(time=record.time, x=x, y=record.y)
+        value = float(x[where].to_value(u.mas))
+        with pytest.raises(ValueError, match=rf"`record.x` free of isolated jumps .* got "
+                                             rf"{value!r} mas at index {where} "):
+            predict(bad, at=AT, horizon=30 * u.day, method=method)
+    with pytest.raises(ValueError, match=rf"at index {k} "):
+        hindcast(SimpleNamespace(time=record.time, x=record.x, y=record.y + _spike(record.y, k)),
+                 Time(["2019-01-01"]), [30] * u.day, method)
+
+
+def _spike(y: u.Quantity, where: int) -> u.Quantity:
+    out = np.zeros(y.shape) * u.mas
+    out[where] = 150 * u.mas
+    return out
+
+
+def test_the_record_holds_no_jump_beyond_the_spike_limit(record):
+    """The limit is twice the largest second difference of the whole C04 record."""
+    for coord in (record.x, record.y):
+        assert np.max(np.abs(np.diff(coord.to_value(u.mas), 2))) < SPIKE_LIMIT / 2
 
 
 # --------------------------------------------------------------------------
@@ -350,3 +427,27 @@ def test_full_hindcast_runs_in_under_a_minute_and_liouville_leads(record):
         assert np.mean(both) < np.mean(np.concatenate([ls_ar["mae_x"], ls_ar["mae_y"]]))
         cover = np.concatenate([liou["coverage_x"], liou["coverage_y"]])
         assert np.all((cover > 0.35) & (cover < 0.85))  # see docs/pole_wander.md
+
+
+# --------------------------------------------------------------------------
+# The pole_prediction scene refuses at load what its run would (issue 32, class 18)
+# --------------------------------------------------------------------------
+
+def test_scene_start_and_periods_outside_the_record_are_refused_at_load(record):
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scene import SceneError
+
+    with pytest.raises(SceneError) as info:
+        Scene.from_dict({"kind": "pole_prediction", "start": "2040-01-01", "methods": ["ls"],
+                         "periods": ["2024-01-01..2027-01-01"], "horizon": "30 d"})
+    assert info.value.problems == [
+        "<dict>: start: method 'ls': expected the start date at 0h UTC within the record, "
+        "from 1964-12-31 (1095 days of history plus the 1 d latency) to 2026-09-30, got "
+        "2040-01-01 00:00:00.000",
+        "<dict>: periods[0]: method 'ls': expected the weekly start dates at 0h UTC within "
+        "the record, from 1964-12-31 (1095 days of history plus the 1 d latency) to "
+        "2026-09-30, got 2026-10-05 00:00:00.000 at index 144"]
+    with pytest.raises(SceneError, match=r"horizon: method 'persistence': expected `horizon` "
+                                         r"in whole days from 0 d to 1825 d, got 2000.0 d"):
+        Scene.from_dict({"kind": "pole_prediction", "methods": ["persistence", "ls"],
+                         "periods": [], "horizon": "2000 d"})

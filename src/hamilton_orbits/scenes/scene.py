@@ -212,6 +212,44 @@ def _with_values(data: Mapping[str, Any], source: str, values: Mapping[str, Any]
     return data, overrides
 
 
+class _Recorded(S.Problems):
+    """Problems with their key paths; true while ``earlier`` holds, so that a kind's
+    check does not build the system from keys that were refused."""
+
+    def __init__(self, source: str, locate, earlier: bool) -> None:
+        super().__init__(source, locate)
+        self.paths: list[str] = []
+        self.earlier = earlier
+
+    def add(self, path: str, message: str) -> None:
+        self.paths.append(path)
+        super().add(path, message)
+
+    def __bool__(self) -> bool:
+        return self.earlier or bool(self.items)
+
+
+def _related(a: str, b: str) -> bool:
+    """One key path is the other or under it (``bodies[1]`` and ``bodies[1].gm``)."""
+    short, long = sorted((a, b), key=len)
+    return long == short or long.startswith((short + ".", short + "[")) or not short
+
+
+def _cross_key_problems(kind: Any, spec: dict, problems: S.Problems) -> None:
+    """Add the problems across keys of a spec whose keys on their own already have
+    ``problems`` (their paths recorded): those not about a refused key (which reads as
+    missing in ``spec``), as far as the refused keys let the checks run."""
+    refused = list(getattr(problems, "paths", ()))
+    cross = _Recorded(problems.source, problems.locate, earlier=True)
+    try:
+        kind.check(spec, cross)
+    except (TypeError, AttributeError, KeyError, ValueError):
+        pass  # a check that needs a refused key: what it found before stays
+    for path, item in zip(cross.paths, cross.items, strict=True):
+        if not any(_related(path, r) for r in refused):
+            problems.items.append(item)
+
+
 class Scene:
     """A validated description of one study.
 
@@ -365,11 +403,15 @@ class Scene:
 
     # --- validation ---------------------------------------------------
     def _validate(self, data: dict) -> dict:
-        problems = S.Problems(self.source, self._locate())
+        problems = _Recorded(self.source, self._locate(), earlier=False)
         kinds = registered_kinds()
         kind_name = data.get("kind")
         if kind_name is None:
             problems.add("kind", f"missing: one of {', '.join(map(repr, sorted(kinds)))}")
+            raise SceneError(problems.items)
+        if not isinstance(kind_name, str):
+            problems.add("kind", f"expected a string, one of "
+                                 f"{', '.join(map(repr, sorted(kinds)))}, got {kind_name!r}")
             raise SceneError(problems.items)
         if kind_name not in kinds:
             problems.add("kind", f"unknown kind {kind_name!r}{S.closest(str(kind_name), kinds)}")
@@ -385,18 +427,20 @@ class Scene:
             }
         )
         spec = schema.check(data, "", problems)
-        if not problems:
-            first: dict[str, int] = {}
-            for k, effect in enumerate(spec["effects"]):
-                if effect["name"] in first:
-                    problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
-                                                  f"(first at effects[{first[effect['name']]}])")
-                first.setdefault(effect["name"], k)
-            names = [effect["name"] for effect in spec["effects"]]
-            for k, message in _effects.exclusion_problems(names, kind.effect_kind):
-                problems.add(f"effects[{k}]", message)
-        if not problems:
-            kind.check(spec, problems)
+        first: dict[str, int] = {}
+        listed = [(k, e) for k, e in enumerate(spec.get("effects") or []) if e is not None]
+        for k, effect in listed:  # (None: refused above)
+            if effect["name"] in first:
+                problems.add(f"effects[{k}]", f"effect {effect['name']!r} is listed twice "
+                                              f"(first at effects[{first[effect['name']]}])")
+            first.setdefault(effect["name"], k)
+        names = [effect["name"] for _, effect in listed]
+        for j, message in _effects.exclusion_problems(names, kind.effect_kind):
+            problems.add(f"effects[{listed[j][0]}]", message)
+        if problems:  # the keys together too, where the keys on their own allow it
+            _cross_key_problems(kind, spec, problems)
+            raise SceneError(problems.items)
+        kind.check(spec, problems)
         if problems:
             raise SceneError(problems.items)
         return spec

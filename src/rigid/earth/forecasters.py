@@ -71,12 +71,14 @@ __all__ = [
     "EXCITATION_VAR_WINDOW",
     "EXCITATION_WINDOWS",
     "LS_SETTINGS",
+    "MAX_LEAD",
     "METHODS",
     "PERSISTENCE_WINDOW",
     "Forecast",
     "fitted_parameters",
     "forecast",
     "history_days",
+    "max_lead",
     "propagate_pole",
 ]
 
@@ -106,6 +108,8 @@ EXCITATION_VAR_ORDER = 5
 EXCITATION_VAR_WINDOW = int(2 * _YEAR)
 #: window (d) of the persistence band (structure function)
 PERSISTENCE_WINDOW = int(10 * _YEAR)
+#: the longest lead (latency + horizon, d) of any method: ten years of extrapolation
+MAX_LEAD = int(10 * _YEAR)
 
 _MAS = u.mas
 
@@ -339,6 +343,16 @@ def history_days(method: str) -> int:
     if method == "liouville":
         return max(EXCITATION_WINDOWS) + 1
     return LS_SETTINGS[method]["window"]
+
+
+def max_lead(method: str) -> int:
+    """The longest lead (latency + horizon, days after the newest datum) a method serves.
+
+    Ten years (:data:`MAX_LEAD`) for every method but ``"persistence"``, whose band at
+    lag ``d`` averages the ``n - d`` pairs of its ``n``-day window: half the window, so
+    that every lag rests on at least half of the pairs.
+    """
+    return PERSISTENCE_WINDOW // 2 if method == "persistence" else MAX_LEAD
 
 
 def forecast(method: str, x: np.ndarray, y: np.ndarray, k: int, steps: int) -> Forecast:

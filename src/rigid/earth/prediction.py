@@ -12,7 +12,17 @@ Every method uses only record epochs at least ``latency`` before the start date 
 (default 1 day: data strictly before the start, as in a C04-only hindcast; the
 prediction campaigns start from data a few days old, ``latency=3 * u.day`` say).
 The horizon counts from ``at``: horizon ``h`` is ``h + latency`` days after the newest
-datum.  No parameter is fitted to data after the newest datum; the fixed constants
+datum.  The lead ``latency + horizon`` is at most ten years (five for ``"persistence"``,
+whose band needs pairs at that lag within its ten-year window).
+
+One bad datum: the fitted models extrapolate the newest days, so a spike there moves
+the ``"ls+ar"`` 30-day forecast ten times as far as the spike (a 1-arcsec spike made
+the ``"ls+ar"``, ``"ls+var"`` and ``"liouville"`` forecasts 1e10-1e15 mas).  A history
+whose day-to-day second difference exceeds :data:`SPIKE_LIMIT` (100 mas, twice the
+largest of the C04 series since 1962) is refused with a ``ValueError`` naming the
+coordinate, the index and the value; smaller errors in the data pass to the forecast.
+
+No parameter is fitted to data after the newest datum; the fixed constants
 (periods, Q, window lengths, orders) were chosen on hindcasts with start dates in
 1985-2004, before both test periods (``docs/pole_wander.md``).
 
@@ -41,6 +51,7 @@ from rigid.earth.forecasters import (
     fitted_parameters,
     forecast,
     history_days,
+    max_lead,
     propagate_pole,
 )
 
@@ -59,9 +70,11 @@ __all__ = [
     "METHODS",
     "PAPER_PERIOD",
     "RECENT_PERIOD",
+    "SPIKE_LIMIT",
     "HindcastScore",
     "PolePrediction",
     "PoleRecord",
+    "check_inputs",
     "hindcast",
     "predict",
     "propagate_pole",
@@ -73,6 +86,10 @@ DEFAULT_HORIZONS = np.array([10, 30, 90, 150, 270, 365]) * u.day
 PAPER_PERIOD = ("2005-10-01", "2008-03-01")
 #: the second test period: eight years of weekly starts
 RECENT_PERIOD = ("2016-01-01", "2024-01-01")
+
+#: the largest day-to-day second difference (mas) a record may hold in the history a
+#: method uses: twice the largest in the IERS 20 C04 series since 1962 (47 mas, 1990)
+SPIKE_LIMIT = 100.0
 
 _MAS = u.mas
 
@@ -96,23 +113,46 @@ def _check_record(record: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             and isinstance(getattr(record, "y", None), u.Quantity)):
         raise ValueError(f"Expected `record` from load_c04() (time, x, y), got "
                          f"{type(record).__name__}")
-    mjd = np.asarray(record.time.utc.mjd, dtype=np.float64)
-    return mjd, record.x.to_value(_MAS), record.y.to_value(_MAS)
+    mjd = np.atleast_1d(np.asarray(record.time.utc.mjd, dtype=np.float64))
+    x, y = np.atleast_1d(record.x.to_value(_MAS)), np.atleast_1d(record.y.to_value(_MAS))
+    if mjd.size == 0:
+        raise ValueError("Expected `record` to hold at least one epoch, got an empty record")
+    if x.shape != mjd.shape or y.shape != mjd.shape:
+        raise ValueError(f"Expected `record.x` and `record.y` of the shape of `record.time` "
+                         f"{mjd.shape}, got {x.shape} and {y.shape}")
+    return mjd, x, y
 
 
-def _whole_days(name: str, value: Any, *, minimum: int) -> np.ndarray:
-    """A time (Quantity or days) as whole days >= minimum (int array)."""
+def _whole_days(name: str, value: Any, *, minimum: int, maximum: int,
+                single: bool = False, note: str = "") -> np.ndarray:
+    """A time (Quantity or days) as whole days in [minimum, maximum] (int array)."""
     if not isinstance(value, u.Quantity):
         raise ValueError(f"Expected `{name}` to be a time Quantity (e.g. 365 * u.day), "
                          f"got {value!r}")
     days = np.atleast_1d(TIME(name, value, u.day))
+    if single and days.size != 1:
+        raise ValueError(f"Expected `{name}` to be a single time, got {value!r} "
+                         f"({days.size} values)")
     whole = np.round(days)
-    bad = (np.abs(days - whole) > 1e-9) | (whole < minimum)
+    bad = (np.abs(days - whole) > 1e-9) | (whole < minimum) | (whole > maximum)
     if np.any(bad):
         k = int(np.argmax(bad))
-        raise ValueError(f"Expected `{name}` in whole days >= {minimum} d, got "
-                         f"{float(days[k])!r} d{f' at index {k}' if days.size > 1 else ''}")
+        raise ValueError(f"Expected `{name}` in whole days from {minimum} d to {maximum} d, "
+                         f"got {float(days[k])!r} d{f' at index {k}' if days.size > 1 else ''}"
+                         f"{note}")
     return whole.astype(np.int64)
+
+
+def _lead_days(method: str, horizon: Any, latency: Any, name: str,
+               single: bool) -> tuple[np.ndarray, int]:
+    """(horizons, latency) in whole days, their sum within the method's longest lead."""
+    most = max_lead(method)
+    note = (f" (method {method!r} serves at most {most} d from the newest datum: "
+            f"latency + {name} <= {most} d)")
+    lat = int(_whole_days("latency", latency, minimum=1, maximum=most, single=True,
+                          note=note)[0])
+    return _whole_days(name, horizon, minimum=0, maximum=most - lat, single=single,
+                       note=note), lat
 
 
 def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
@@ -201,9 +241,12 @@ def predict(
     Raises
     ------
     ValueError
-        For an unknown method, ``at`` outside the record (or without the method's
-        history before it), a negative or fractional horizon, a latency below a day,
-        or non-finite data in the history used.
+        For an unknown method, an empty record, ``at`` outside the record (or without
+        the method's history before it), a horizon or latency that is not a single
+        whole number of days, a latency below a day, a lead ``latency + horizon`` beyond
+        the method's :func:`~rigid.earth.forecasters.max_lead` (ten years; five for
+        ``"persistence"``), or data in the history used that are not finite or jump
+        off their neighbours (:data:`SPIKE_LIMIT`).
 
     Examples
     --------
@@ -223,10 +266,10 @@ def predict(
     at_mjd = _as_mjd("at", at)
     if at_mjd.size != 1:
         raise ValueError(f"Expected `at` to be a single Time, got {at_mjd.size} epochs")
-    n_h = int(_whole_days("horizon", horizon, minimum=0)[0])
-    lat = int(_whole_days("latency", latency, minimum=1)[0])
+    hs, lat = _lead_days(method, horizon, latency, "horizon", single=True)
+    n_h = int(hs[0])
     k = int(_newest_index("at", mjd, at_mjd, lat, history_days(method))[0])
-    _check_finite(x, y, k, history_days(method))
+    _check_history(x, y, k, history_days(method))
     mx, my, vx, vy = forecast(method, x, y, k, lat + n_h)
     sl = slice(lat - 1, lat + n_h)
     t = Time(at_mjd[0] + np.arange(n_h + 1), format="mjd", scale="utc")
@@ -237,13 +280,49 @@ def predict(
         parameters=fitted_parameters(method, x[:k + 1], y[:k + 1]))
 
 
-def _check_finite(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
+def check_inputs(record: PoleRecord, starts: Time, horizons: u.Quantity, method: str, *,
+                 latency: u.Quantity = 1 * u.day) -> None:
+    """Raise the ``ValueError`` that :func:`hindcast` (or :func:`predict`, for one start)
+    would raise for these inputs, without forecasting (a scene's check at load).
+
+    Examples
+    --------
+    >>> from rigid.polar_motion import load_c04
+    >>> check_inputs(load_c04(), Time(["1963-01-01"]), [30] * u.day, "ls")
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `starts` at 0h UTC within the record, from ... got 1963-01-01 ...
+    """
+    method = _check_method(method)
+    mjd, x, y = _check_record(record)
+    at = _as_mjd("starts", starts)
+    _lead_days(method, horizons, latency, "horizons", single=False)
+    lat = int(_whole_days("latency", latency, minimum=1, maximum=max_lead(method),
+                          single=True)[0])
+    history = history_days(method)
+    for k in _newest_index("starts", mjd, at, lat, history):
+        _check_history(x, y, int(k), history)
+
+
+def _check_history(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
+    """The history used (``history`` days up to index ``k``): finite, and no datum off its
+    neighbours by more than :data:`SPIKE_LIMIT` (one bad datum ruins the fitted models'
+    forecasts: the ``ls+ar`` 30-day forecast moves ten times as far as the newest datum)."""
+    first = k - history + 1
     for name, arr in (("record.x", x), ("record.y", y)):
-        part = arr[k - history + 1:k + 1]
+        part = arr[first:k + 1]
         if not np.all(np.isfinite(part)):
-            i = k - history + 1 + int(np.argmin(np.isfinite(part)))
+            i = first + int(np.argmin(np.isfinite(part)))
             raise ValueError(f"Expected `{name}` finite in the history used, got "
                              f"{float(arr[i])!r} at index {i}")
+        curvature = np.abs(np.diff(part, 2))  # at index i: x[i] - 2 x[i-1] + x[i-2]
+        if curvature.size and curvature.max() > SPIKE_LIMIT:
+            i = first + 2 + int(np.argmax(curvature > SPIKE_LIMIT))  # where the jump shows
+            raise ValueError(
+                f"Expected `{name}` free of isolated jumps in the history used (second "
+                f"difference at most {SPIKE_LIMIT:g} mas), got {float(arr[i])!r} mas at "
+                f"index {i} (second difference {float(curvature[i - first - 2]):.6g} mas)")
 
 
 def weekly_starts(first: Any, last: Any) -> Time:
@@ -347,8 +426,10 @@ def hindcast(
     Raises
     ------
     ValueError
-        For an unknown method, no start dates, a start date outside the record (naming
-        its index), negative or fractional horizons, or a latency below a day.
+        For an unknown method, an empty record, no start dates, a start date outside
+        the record (naming its index), negative or fractional horizons or a lead beyond
+        the method's (as for :func:`predict`), a latency below a day, or a bad datum in
+        a history used (as for :func:`predict`).
 
     Examples
     --------
@@ -364,16 +445,15 @@ def hindcast(
     at = _as_mjd("starts", weekly_starts(*PAPER_PERIOD) if starts is None else starts)
     if at.size == 0:
         raise ValueError("Expected `starts` to hold at least one start date, got none")
-    hs = _whole_days("horizons", horizons, minimum=0)
+    hs, lat = _lead_days(method, horizons, latency, "horizons", single=False)
     if hs.size == 0:
         raise ValueError("Expected `horizons` to hold at least one horizon, got none")
-    lat = int(_whole_days("latency", latency, minimum=1)[0])
     history = history_days(method)
     ks = _newest_index("starts", mjd, at, lat, history)
     ex, ey, sx, sy = (np.full((at.size, hs.size), np.nan) for _ in range(4))
     steps = lat + int(hs.max())
     for i, k in enumerate(ks):  # per start: a few vectorised calls
-        _check_finite(x, y, int(k), history)
+        _check_history(x, y, int(k), history)
         mx, my, vx, vy = forecast(method, x, y, int(k), steps)
         j = lat + hs - 1  # forecast index of each horizon
         truth = k + lat + hs

@@ -20,7 +20,10 @@ Nothing downloads: the IERS 20 C04 record ships with astropy-iers-data.
 
 from __future__ import annotations
 
+import datetime
 import time
+import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import astropy.units as u
@@ -42,8 +45,18 @@ PUBLISHED = {
 TABLE_HORIZONS = (10, 30, 90, 150, 270, 365)
 _METHODS = ("persistence", "ls", "ls+ar", "ls+var", "liouville")
 
+@dataclass
+class _Date(S.String):
+    """A date: a string, or a TOML date (``start = 2019-01-01``, ``--set start=2019-01-01``)."""
+
+    def check(self, value: Any, path: str, problems: S.Problems) -> Any:
+        if isinstance(value, datetime.date) and not isinstance(value, datetime.datetime):
+            value = value.isoformat()
+        return super().check(value, path, problems)
+
+
 SCHEMA: dict[str, S.Field] = {
-    "start": S.String(default="2019-01-01"),
+    "start": _Date(default="2019-01-01"),
     "horizon": S.Quantity(kind=TIME, default="365 d", positive=True),
     "methods": S.Array(item=S.Choice(choices=_METHODS), default=list(_METHODS)),
     "periods": S.Array(item=S.String(), default=["2005-10-01..2008-03-01",
@@ -53,6 +66,16 @@ SCHEMA: dict[str, S.Field] = {
 
 
 def _check(spec: dict, problems: S.Problems) -> None:
+    from erfa import ErfaWarning
+
+    with warnings.catch_warnings():  # a date past the leap-second table: "dubious year"
+        warnings.simplefilter("ignore", ErfaWarning)
+        _check_keys(spec, problems)
+        if not problems:
+            _check_against_the_record(spec, problems)
+
+
+def _check_keys(spec: dict, problems: S.Problems) -> None:
     from astropy.time import Time
 
     for i, text in enumerate(spec["periods"]):
@@ -74,6 +97,36 @@ def _check(spec: dict, problems: S.Problems) -> None:
         days = float(spec[key].to_value(u.day))
         if days != round(days):
             problems.add(key, f"expected whole days, got {spec[key]}")
+
+
+def _check_against_the_record(spec: dict, problems: S.Problems) -> None:
+    """The start and the periods within the record (with each method's history before
+    them), the horizon within each method's reach: what the run would refuse."""
+    from astropy.time import Time
+
+    from rigid.earth.c04 import load_c04
+    from rigid.earth.prediction import check_inputs, weekly_starts
+
+    record = load_c04()
+    horizon = [spec["horizon"].to_value(u.day)] * u.day
+    trials = [("start", Time([spec["start"]], scale="utc"))]
+    for i, text in enumerate(spec["periods"]):
+        trials.append((f"periods[{i}]", weekly_starts(*(p.strip() for p in text.split("..")))))
+    said = set()
+    for method in spec["methods"]:
+        for key, starts in trials:
+            try:
+                check_inputs(record, starts, horizon, method, latency=spec["latency"])
+            except ValueError as exc:
+                starts_text = ("expected the start date" if key == "start"
+                               else "expected the weekly start dates")
+                text = (str(exc).replace("horizons", "horizon")
+                        .replace("Expected `starts`", starts_text))
+                where = "horizon" if "`horizon`" in text else (
+                    "latency" if "`latency`" in text else key)
+                if (where, method) not in said:
+                    said.add((where, method))
+                    problems.add(where, f"method {method!r}: {text[0].lower()}{text[1:]}")
 
 
 def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:

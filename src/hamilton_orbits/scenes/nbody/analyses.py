@@ -12,16 +12,38 @@ from hamilton_orbits.scenes.nbody.figures import plot_de440
 from hamilton_orbits.scenes.result import Result
 
 
-def _relative_orbits(result: Result, system, body: str, primary: str):
+def _present(result: Result, system, *bodies: str) -> np.ndarray:
+    """The output rows at which every one of ``bodies`` still exists: an event that
+    removes a body, or merges it into another, leaves NaN in its rows after it."""
+    names = list(system.names)
+    r = result.states["r"].value[:, [names.index(b) for b in bodies]]
+    return np.flatnonzero(np.all(np.isfinite(r), axis=(1, 2)))
+
+
+def _relative_orbits(result: Result, system, body: str, primary: str, rows: np.ndarray):
+    """The orbits of ``body`` about ``primary`` at the output ``rows``."""
     from hamilton_orbits import KeplerOrbit
 
     names = list(system.names)
     i, j = names.index(body), names.index(primary)
-    r = result.states["r"][:, i] - result.states["r"][:, j]
-    v = result.states["v"][:, i] - result.states["v"][:, j]
+    r = result.states["r"][rows, i] - result.states["r"][rows, j]
+    v = result.states["v"][rows, i] - result.states["v"][rows, j]
     gm = system.gm
     mu = gm[i] + gm[j]
     return KeplerOrbit.from_state(r.to(u.km), v.to(u.km / u.s), mu.to(u.km**3 / u.s**2))
+
+
+def _rows_of(result: Result, system, key: str, *bodies: str, least: int = 2):
+    """The rows where ``bodies`` all exist, or None (with a note under ``key``) when fewer
+    than ``least`` do; a note too when a body left the run before its end."""
+    rows = _present(result, system, *bodies)
+    if rows.size < least:
+        result.metrics[key] = (f"not measured: {' and '.join(bodies)} together at "
+                               f"{rows.size} output(s) (removed or merged by an event)")
+        return None
+    if rows[-1] != len(result.times) - 1:
+        result.metrics[f"{key}: measured up to"] = result.times[rows[-1]].to(u.yr)
+    return rows
 
 
 CENTURY = u.def_unit("century", 100 * u.yr)
@@ -38,16 +60,24 @@ def _rate(times: u.Quantity, angle: u.Quantity) -> u.Quantity:
 def _perihelion_advance(result: Result, system, an: dict) -> None:
     primary = an.get("primary") or system.names[int(np.argmax(np.asarray(
         getattr(system.gm, "value", system.gm))))]
-    orbits = _relative_orbits(result, system, an["body"], primary)
-    rate = _rate(result.times, orbits.varpi).to(u.arcsec / CENTURY)
-    result.metrics[f"perihelion advance of {an['body']}"] = rate
+    key = f"perihelion advance of {an['body']}"
+    rows = _rows_of(result, system, key, an["body"], primary)
+    if rows is None:
+        return
+    orbits = _relative_orbits(result, system, an["body"], primary, rows)
+    rate = _rate(result.times[rows], orbits.varpi).to(u.arcsec / CENTURY)
+    result.metrics[key] = rate
 
 
 def _nodal_regression(result: Result, system, an: dict) -> None:
     primary = an.get("primary") or system.names[0]
-    orbits = _relative_orbits(result, system, an["body"], primary)
-    rate = _rate(result.times, orbits.lan).to(u.deg / u.d)
-    result.metrics[f"nodal regression of {an['body']}"] = rate
+    key = f"nodal regression of {an['body']}"
+    rows = _rows_of(result, system, key, an["body"], primary)
+    if rows is None:
+        return
+    orbits = _relative_orbits(result, system, an["body"], primary, rows)
+    rate = _rate(result.times[rows], orbits.lan).to(u.deg / u.d)
+    result.metrics[key] = rate
     prim = system[primary]
     j2 = getattr(prim, "j2", None)
     if j2 is not None and getattr(prim, "radius", None) is not None:
@@ -68,11 +98,15 @@ def _close_approach(result: Result, system, an: dict) -> None:
     the cadence is short beside the encounter's duration; the heliocentric (or
     ``primary``-centric) orbit of ``body`` before and after is reported too.
     """
+    key = f"closest approach {an['body']}-{an['other']}"
+    rows = _rows_of(result, system, key, an["body"], an["other"], least=1)
+    if rows is None:
+        return
     names = list(system.names)
     i, j = names.index(an["body"]), names.index(an["other"])
-    r = result.states["r"].to_value(u.au)
-    v = result.states["v"].to_value(u.au / u.d)
-    t = result.times.to_value(u.d)
+    r = result.states["r"].to_value(u.au)[rows]
+    v = result.states["v"].to_value(u.au / u.d)[rows]
+    t = result.times.to_value(u.d)[rows]
     d = r[:, i] - r[:, j]
     w = v[:, i] - v[:, j]
     dist = np.linalg.norm(d, axis=-1)
@@ -82,11 +116,14 @@ def _close_approach(result: Result, system, an: dict) -> None:
     ww = float(w[k] @ w[k])
     tau = float(np.clip(-(d[k] @ w[k]) / ww, lo, hi)) if ww > 0 else 0.0
     closest = float(np.linalg.norm(d[k] + w[k] * tau))
-    result.metrics[f"closest approach {an['body']}-{an['other']}"] = closest * u.au
+    result.metrics[key] = closest * u.au
     result.metrics["at time"] = ((t[k] + tau) * u.d).to(u.yr)
     primary = an.get("primary")
     if primary:
-        orbits = _relative_orbits(result, system, an["body"], primary)
+        rows = _rows_of(result, system, f"{an['body']} orbit", an["body"], primary, least=1)
+        if rows is None:
+            return
+        orbits = _relative_orbits(result, system, an["body"], primary, rows)
         for label, idx in (("before", 0), ("after", -1)):
             o = orbits[idx]
             # 1/a too: it is continuous through the parabola (a jumps from +inf to

@@ -8,6 +8,7 @@ import re
 from typing import Any
 
 import astropy.units as u
+import numpy as np
 
 from hamilton_orbits import schema as S
 from hamilton_orbits.frames import frame_label
@@ -50,6 +51,16 @@ def initial_names(spec: dict) -> list[str]:
         names += list(DEFAULT_BODIES if eph.get("bodies") is None else eph["bodies"])
     return names
 
+
+
+def output_times(spec: dict) -> u.Quantity:
+    """The output times of a validated ``nbody`` scene: every ``cadence`` (a thousandth
+    of the duration by default) from 0 to ``duration``, the end included."""
+    duration = spec["duration"].to(u.d)
+    cadence = spec["cadence"].to(u.d) if spec["cadence"] is not None else duration / 1000
+    n = max(1, int(np.ceil((duration / cadence).to_value(u.one) - 1e-9)))
+    t = np.minimum(np.arange(n + 1) * cadence.value, duration.value)
+    return t * u.d
 
 
 def problem_text(exc: Exception) -> str:

@@ -5,9 +5,12 @@ are built as the run will build them."""
 
 from __future__ import annotations
 
+import math
+import re
 from pathlib import Path
 
 import astropy.units as u
+import numpy as np
 
 from hamilton_orbits import effects as _effects
 from hamilton_orbits import schema as S
@@ -17,6 +20,7 @@ from hamilton_orbits.scenes.nbody.build import (
     attempt,
     build_system,
     initial_names,
+    output_times,
     problem_text,
     rebound_names,
     scene_frame,
@@ -53,6 +57,7 @@ def check(spec: dict, problems: S.Problems) -> None:
                                              "tangent map is not implemented)")
     _check_integrator(spec["integrator"], problems)
     _check_analyses(spec["analysis"], names, problems)
+    _check_de440_residuals(spec, problems)
     if spec["cadence"] is not None and spec["cadence"] > spec["duration"]:
         problems.add("cadence", f"the cadence {spec['cadence']} exceeds the duration "
                                 f"{spec['duration']}")
@@ -81,6 +86,27 @@ def _check_analyses(analyses: list, names: list[str], problems: S.Problems) -> N
                                     f"{S.closest(str(an[key]), names)}")
             elif key != "body" and an[key] == an.get("body"):
                 problems.add(where, f"expected a body other than `body` ({an[key]!r})")
+
+
+def _check_de440_residuals(spec: dict, problems: S.Problems) -> None:
+    """``de440_residuals`` compares with DE440 at whole years from the start: it needs
+    the start from the ephemeris and at least two outputs at whole years."""
+    for i, an in enumerate(spec["analysis"]):
+        if an["name"] != "de440_residuals":
+            continue
+        if spec["initial"].get("ephemeris") is None:
+            problems.add(f"analysis[{i}]", "analysis 'de440_residuals' needs the start from "
+                                           "DE440: give [initial] ephemeris")
+        if spec["duration"] is None:
+            continue
+        years = output_times(spec).to_value(u.yr)
+        whole = int(np.count_nonzero(np.abs(years - np.round(years)) < 1e-9))
+        if whole < 2:
+            every = "thousandth" if spec["cadence"] is None else spec["cadence"]
+            problems.add(f"analysis[{i}]", f"analysis 'de440_residuals' compares at whole "
+                                           f"years from the start: the outputs (every "
+                                           f"{every} over {spec['duration']}) hold {whole}; "
+                                           "give a cadence that divides a year")
 
 
 def _check_initial(init: dict, problems: S.Problems) -> None:
@@ -237,9 +263,31 @@ def _check_buildable(spec: dict, problems: S.Problems) -> None:
         return
     for i, eff in enumerate(spec["effects"]):
         ek = _effects.get("nbody", eff["name"])
-        if ek.params is None:
+        for key, value in eff.items():
+            number = getattr(value, "value", value)
+            if isinstance(number, float | int) and not isinstance(number, bool) \
+                    and not math.isfinite(number):
+                problems.add(f"effects[{i}].{key}", f"expected a finite value, got {value!r}")
+        if ek.params is None or problems:
             continue
         params = {k: v for k, v in eff.items() if k != "name"}
         attempt(problems, f"effects[{i}]", lambda ek=ek, p=params: ek.params(system, p),
                  tuple(ek.parameters))
+    if spec["events"] and not problems:  # (an ensemble's members: no set-up without events)
+        _check_simulation(spec, system, problems)
+
+
+def _check_simulation(spec: dict, system, problems: S.Problems) -> None:
+    """Prepare the run's :class:`~hamilton_orbits.Simulation` (its events against the
+    bodies: radii for a collision, a Hill sphere about a body that has one)."""
+    from hamilton_orbits.scenes.nbody.run import simulation
+
+    try:
+        simulation(spec, system)
+    except ValueError as exc:
+        event = re.match(r"Event at index (\d+) \([^)]*\): (.*)", str(exc), re.S)
+        if event:
+            problems.add(f"events[{event.group(1)}]", event.group(2))
+        else:
+            problems.add("integrator", problem_text(exc))
 
