@@ -349,7 +349,8 @@ def test_a_non_finite_effect_parameter_is_refused_at_load():
     data = {"kind": "nbody", "duration": "2 d", "initial": {"solar_system": {
         "epoch": "J2000", "bodies": ["sun", "earth", "moon"]}},
         "effects": [{"name": "moon_figure", "j2": float("nan")}]}
-    assert _problems(data) == ["<dict>: effects[0].j2: expected a finite value, got nan"]
+    assert _problems(data) == ["<dict>: effects[0].j2: Expected `effects[0].j2` to be finite, "
+                               "got nan"]
 
 
 def test_de440_residuals_without_the_ephemeris_is_refused_at_load():
