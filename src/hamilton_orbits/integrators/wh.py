@@ -335,6 +335,7 @@ class _Split:
     def __init__(self, gm: np.ndarray, order: np.ndarray, jacobi: bool, corrector: int,
                  extra: Any, p: np.ndarray, has_extra: bool) -> None:
         g = np.ascontiguousarray(gm[order])  # a writeable copy, the order of the rows
+        order = np.ascontiguousarray(order, dtype=np.int64)
         self.gm, self.g, self.order, self.jacobi, self.corrector = gm, g, order, jacobi, corrector
         self.extra, self.p, self.has_extra = extra, p, has_extra
         self.q = self.u = np.empty((0, 3))
@@ -370,9 +371,9 @@ class _Split:
         ev = (watch, ev_out, ev_count, ws)
         q, u = self.q, self.u
         if not self.jacobi:
-            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.com,
-                                 dt, n_steps, last, *ev)
-        args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
+            return _k.advance_dh(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
+                                 self.com, dt, n_steps, last, *ev)
+        args = (self.extra, self.p, self.has_extra, self.order, q, u, self.g, self.eta)
         if not self.corrector:
             return _k.advance_jacobi(*args, dt, n_steps, last, *ev)
         # the corrector conjugates a run of equal steps: a shortened last step gets
