@@ -181,18 +181,20 @@ STATUS_DRAIN = 5
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
-    # pragma: no cover - compiled
+def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
+           jump):  # pragma: no cover - compiled
     """One Kepler drift of ``tau`` with the barycentre; with events watched
     (``watched``, a constant where the step loops inline this: the loop without
     events has no trace of them), the drift is scanned on the Kepler arcs
-    themselves (heliocentric, or Jacobi turned into inertial positions): exact for
-    the drift.  ``ws = [t, t_action, drain, row]``: the drift's start time
-    (advanced here), the time and watch row of the first event with an action, and
-    whether the buffer must be drained.  Returns a failing body or -1."""
+    themselves (Jacobi turned into inertial positions; democratic heliocentric
+    with the jumps around the drift spread over it, ``jump`` the one before it:
+    :func:`hamilton_orbits._kernels.events._dh_constants`; ``g`` the rows' ``G m``).
+    ``ws = [t, t_action, drain, row]``: the drift's start time (advanced here),
+    the time and watch row of the first event with an action, and whether the
+    buffer must be drained.  Returns a failing body or -1."""
     if watched:
         return _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0,
-                              mu_s)
+                              mu_s, g, jump)
     bad = _kepler_all(q, u, mu, tau)
     if jacobi:
         for k in range(3):
@@ -205,8 +207,8 @@ def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0,
 
 
 @njit(cache=True, error_model="numpy")
-def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
-    # pragma: no cover - compiled
+def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
+                   jump):  # pragma: no cover - compiled
     """:func:`_drift` with its events scanned."""
     n_watch = watch.shape[0]
     _copy(q, u, x0, v0)
@@ -217,12 +219,16 @@ def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, 
         else:
             com[k] += tau * com[3 + k]
     if bad < 0:
-        cm = np.zeros(9)  # escapes: from the central body (heliocentric) ...
-        if jacobi:  # ... or from the barycentre, Jacobi row 0
+        cm = np.zeros(9)
+        if jacobi:  # escapes from the barycentre, Jacobi row 0
             for k in range(3):
                 cm[k], cm[3 + k], cm[6 + k] = x0[0, k], v0[0, k], q[0, k]
-        h, row = _ev.scan(watch, _ev.JACOBI if jacobi else _ev.KEPLER, ws[0], tau, x0, v0, q,
-                          u, _NO_A0, _NO_B, mu_s, cm, ev_out, ev_count)
+            h, row = _ev.scan(watch, _ev.JACOBI, ws[0], tau, x0, v0, q, u, _NO_A0, _NO_B, mu_s,
+                              cm, ev_out, ev_count)
+        else:  # the jump before the drift in cm[0], the masses in place of a0
+            cm[0] = jump
+            h, row = _ev.scan(watch, _ev.DH, ws[0], tau, x0, v0, q, u, g, _NO_B, mu_s, cm,
+                              ev_out, ev_count)
         if row >= 0 and ws[0] + h * tau < ws[1]:
             ws[1] = ws[0] + h * tau
             ws[3] = row
@@ -597,7 +603,7 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(watched, q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0,
-                 mu_s)
+                 mu_s, gm, 0.0)
     if bad >= 0:
         return 0, bad, STATUS_OK
     for s in range(n_steps):
@@ -606,7 +612,7 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
                  order, gm_c)
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(watched, q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count,
-                     ws, x0, v0, mu_s)
+                     ws, x0, v0, mu_s, gm, 0.5 * h)
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h
@@ -624,7 +630,7 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(watched, qj, uj, eta, 0.5 * h, True, eta, watch, ev_out, ev_count, ws, x0, v0,
-                 eta)
+                 eta, gm, 0.0)
     if bad >= 0:
         return 0, bad, STATUS_OK
     for s in range(n_steps):
@@ -635,7 +641,7 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
         )
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(watched, qj, uj, eta, 0.5 * (h + h_next), True, eta, watch, ev_out,
-                     ev_count, ws, x0, v0, eta)
+                     ev_count, ws, x0, v0, eta, gm, 0.0)
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h

@@ -165,10 +165,12 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
         A bound on the steps of the whole run; more are refused before the run
         starts (``ValueError``).
     events : EventLog, optional
-        Events to look for in every drift: on the Kepler arcs themselves
-        (democratic heliocentric; escapes measured from the central body) or on
-        the Hermite interpolant of the inertial states (Jacobi).  Actions take
-        effect at the end of the step the event occurred in.
+        Events to look for in every drift, on its Kepler arcs: heliocentric
+        (democratic heliocentric, with the jump that the steps apply around the
+        kick spread over the drift, so that relative velocities and the centre
+        of mass are the inertial ones) or Jacobi coordinates turned into
+        inertial positions.  Escapes are measured from the centre of mass.
+        Actions take effect at the end of the step the event occurred in.
     variational : Tangent, optional
         Tangent vectors to carry through the exact tangent map of every step
         (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled
