@@ -144,6 +144,39 @@ def test_wh_democratic_heliocentric_escapes_from_the_centre_of_mass():
         assert ev["distance"][0] == pytest.approx(5.0, rel=1e-13)
 
 
+@pytest.mark.parametrize("coordinates", ["democratic_heliocentric", "jacobi"])
+def test_wh_events_with_a_test_particle_first_and_the_central_body_last(coordinates):
+    """The head-on fall and the escape of the two tests above with a test particle in
+    the first slot and the central body listed last (``[tp, b, a]``): the events
+    name the caller's bodies, the massless row adds nothing to the jump or to the
+    centre of mass.
+
+    References: the radial Kepler fall's contact speed (``mu = 1.5``, 9.8489) and
+    time, to the tolerances above; the run listed ``[a, tp, b]`` (the kernel's rows
+    are the same: the same event bits); radau15's escape time."""
+    system, t_contact = _head_on()
+    a, b = system.bodies
+    tp = Body("tp", 0.0, [0, 3.0, 0], [0.6, 0, 0])
+    v_contact = np.sqrt(2 * 1.5 * (1 / 0.03 - 1 / 1.0))
+    kw = {"method": "wh", "dt": 1e-4, "coordinates": coordinates}
+    ev = integrate(System([tp, b, a]), 2.0, events=["collision"], **kw).stopped_by
+    ref = integrate(System([a, tp, b]), 2.0, events=["collision"], **kw).stopped_by
+    assert set(ev["bodies"].split("-")) == {"a", "b"}
+    assert (ev["time"], ev["distance"], ev["speed"]) == (ref["time"], ref["distance"],
+                                                         ref["speed"])
+    assert ev["speed"] == pytest.approx(v_contact, rel=5e-5)
+    assert ev["time"] == pytest.approx(t_contact, rel=1e-7)
+    escape = [{"name": "escape", "distance": 5.0, "bodies": ["b"]}]
+    moving = System([tp, Body("b", 0.5, [1, 0, 0], [0, 2, 0]), Body("a", 1.0, [0, 0, 0],
+                                                                      [0, 0, 0])])
+    t_ref = integrate(moving, 10.0, events=escape).events["time"][0]
+    out = integrate(moving, 10.0, method="wh", dt=1e-3, coordinates=coordinates,
+                    events=escape).events
+    assert list(out["bodies"]) == ["b"]
+    assert out["time"][0] == pytest.approx(t_ref, rel=2e-7)
+    assert t_ref == pytest.approx(5.7145, abs=1e-4)
+
+
 def test_a_merge_conserves_mass_momentum_and_the_centre_of_mass():
     system = System([Body("a", 1.0, [0, 0, 0], [0, 0.01, 0], radius=0.01),
                      Body("b", 0.5, [1.0, 0, 0], [0, -0.02, 0.005], radius=0.02),
