@@ -99,6 +99,84 @@ def test_the_symplectic_maps_stop_at_the_end_of_the_contact_step(method, kw):
     assert t_event <= traj.t[-1] < t_event + kw["dt"]
 
 
+def test_wh_democratic_heliocentric_reports_the_inertial_contact():
+    """Issue 32: wh's democratic-heliocentric drift was scanned in heliocentric
+    positions with barycentric velocities, so the head-on fall of GM 1 and 0.5
+    reported the contact speed of body b relative to the barycentre, 6.56 (2/3 of
+    the relative speed), and a contact time off by 1e-5.  The scan now moves the
+    heliocentric positions by the jump the drift leaves to the steps' ends, whose
+    rate makes the velocities relative to the central body.
+
+    References: the radial Kepler fall (the contact speed from the energy,
+    ``sqrt(2 mu (1/d - 1/d0))``, mu = 1.5: 9.8489; the contact time); the Jacobi
+    run (for two bodies the exact Kepler motion).  Measured at dt = 1e-4: speed
+    2.8e-5, time 4.0e-8 relative; the time's error falls as dt^2 (1.6e-7 at
+    dt = 2e-4)."""
+    system, t_contact = _head_on()
+    v_contact = np.sqrt(2 * 1.5 * (1 / 0.03 - 1 / 1.0))
+    jacobi = integrate(system, 2.0, method="wh", dt=1e-4, coordinates="jacobi",
+                       events=["collision"]).stopped_by
+    assert jacobi["speed"] == pytest.approx(v_contact, rel=1e-12)
+    errors = []
+    for dt in (2e-4, 1e-4):
+        ev = integrate(system, 2.0, method="wh", dt=dt, events=["collision"]).stopped_by
+        assert ev["distance"] == pytest.approx(0.03, rel=1e-14)
+        errors.append(abs(ev["time"] / t_contact - 1))
+    assert ev["speed"] == pytest.approx(v_contact, rel=5e-5)
+    assert errors[1] < 1e-7 and 3.0 < errors[0] / errors[1] < 5.0, errors
+
+
+def test_wh_democratic_heliocentric_escapes_from_the_centre_of_mass():
+    """Issue 32: an escape at 5 from the centre of mass (GM 1 at rest, GM 0.5 at 1
+    moving at 2) was reported at t = 3.59 (the distance from the central body);
+    radau15, and the Jacobi run, find 5.7145.  Measured 5.1e-8 relative at
+    dt = 1e-3 (time and speed)."""
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.5, [1, 0, 0], [0, 2, 0])])
+    events = [{"name": "escape", "distance": 5.0}]
+    ref = integrate(system, 10.0, events=events).events
+    assert ref["time"][0] == pytest.approx(5.7145, abs=1e-4)
+    for coordinates in ("democratic_heliocentric", "jacobi"):
+        ev = integrate(system, 10.0, method="wh", dt=1e-3, events=events,
+                       coordinates=coordinates).events
+        assert len(ev) == 1 and ev["bodies"][0] == "b"
+        assert ev["time"][0] == pytest.approx(ref["time"][0], rel=2e-7)
+        assert ev["speed"][0] == pytest.approx(ref["speed"][0], rel=2e-7)
+        assert ev["distance"][0] == pytest.approx(5.0, rel=1e-13)
+
+
+@pytest.mark.parametrize("coordinates", ["democratic_heliocentric", "jacobi"])
+def test_wh_events_with_a_test_particle_first_and_the_central_body_last(coordinates):
+    """The head-on fall and the escape of the two tests above with a test particle in
+    the first slot and the central body listed last (``[tp, b, a]``): the events
+    name the caller's bodies, the massless row adds nothing to the jump or to the
+    centre of mass.
+
+    References: the radial Kepler fall's contact speed (``mu = 1.5``, 9.8489) and
+    time, to the tolerances above; the run listed ``[a, tp, b]`` (the kernel's rows
+    are the same: the same event bits); radau15's escape time."""
+    system, t_contact = _head_on()
+    a, b = system.bodies
+    tp = Body("tp", 0.0, [0, 3.0, 0], [0.6, 0, 0])
+    v_contact = np.sqrt(2 * 1.5 * (1 / 0.03 - 1 / 1.0))
+    kw = {"method": "wh", "dt": 1e-4, "coordinates": coordinates}
+    ev = integrate(System([tp, b, a]), 2.0, events=["collision"], **kw).stopped_by
+    ref = integrate(System([a, tp, b]), 2.0, events=["collision"], **kw).stopped_by
+    assert set(ev["bodies"].split("-")) == {"a", "b"}
+    assert (ev["time"], ev["distance"], ev["speed"]) == (ref["time"], ref["distance"],
+                                                         ref["speed"])
+    assert ev["speed"] == pytest.approx(v_contact, rel=5e-5)
+    assert ev["time"] == pytest.approx(t_contact, rel=1e-7)
+    escape = [{"name": "escape", "distance": 5.0, "bodies": ["b"]}]
+    moving = System([tp, Body("b", 0.5, [1, 0, 0], [0, 2, 0]), Body("a", 1.0, [0, 0, 0],
+                                                                      [0, 0, 0])])
+    t_ref = integrate(moving, 10.0, events=escape).events["time"][0]
+    out = integrate(moving, 10.0, method="wh", dt=1e-3, coordinates=coordinates,
+                    events=escape).events
+    assert list(out["bodies"]) == ["b"]
+    assert out["time"][0] == pytest.approx(t_ref, rel=2e-7)
+    assert t_ref == pytest.approx(5.7145, abs=1e-4)
+
+
 def test_a_merge_conserves_mass_momentum_and_the_centre_of_mass():
     system = System([Body("a", 1.0, [0, 0, 0], [0, 0.01, 0], radius=0.01),
                      Body("b", 0.5, [1.0, 0, 0], [0, -0.02, 0.005], radius=0.02),

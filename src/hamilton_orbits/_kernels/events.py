@@ -8,8 +8,15 @@ interpolant of the motion:
 - ``RADAU``: radau15's polynomial of the step (Rein & Spiegel 2015, eqs. 6, 7);
 - ``LINE``: straight lines at constant velocity (a leapfrog drift);
 - ``KEPLER``: every body on its Kepler arc about the origin with its own ``mu``
-  (a Wisdom-Holman drift in heliocentric coordinates; the central body at rest
-  at the origin);
+  (the central body at rest at the origin);
+- ``DH``: a Wisdom-Holman drift in democratic-heliocentric coordinates (see
+  :func:`_dh_constants`): heliocentric positions on their Kepler arcs about the
+  central body, moved together by the "jump" ``sum m_k u_k / m_0`` that the
+  drift leaves to the steps' ends, so that relative positions and velocities
+  are the inertial ones (with barycentric velocities ``u`` alone, a body's
+  velocity relative to the central body would lack ``sum m_k u_k / m_0``: a
+  third of it when ``m_1 = m_0 / 2``), and the centre of mass where the masses
+  put it;
 - ``HERMITE``: the cubic Hermite interpolant of the positions and velocities at
   both ends (the generic case);
 - ``JACOBI``: Jacobi coordinates on their Kepler arcs about ``mu = eta`` (the
@@ -33,13 +40,15 @@ from numba import njit
 
 from hamilton_orbits._kernels import kepler as _kepler
 
-__all__ = ["HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_steps", "state_at"]
+__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_steps",
+           "state_at"]
 
 RADAU = 0
 LINE = 1
 KEPLER = 2
 HERMITE = 3
 JACOBI = 4
+DH = 5
 
 _CODE_ENCOUNTER = 1
 _CODE_COLLISION = 2
@@ -48,7 +57,10 @@ _CODE_ESCAPE = 3
 
 @njit(cache=True, error_model="numpy")
 def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
-    """Position and velocity of body ``k`` at ``h`` into ``out`` (6,)."""
+    """Position and velocity of body ``k`` at ``h`` into ``out`` (6,) (not ``DH``:
+    :func:`_dh_state`)."""
+    if kind == DH:
+        raise ValueError("events: the DH interpolant needs the drift's constants (_dh_state)")
     if kind == JACOBI:
         _jacobi_state(k, h * dt, x0, v0, mu, out)
         return
@@ -134,17 +146,120 @@ def _jacobi_all(tau, qj, uj, eta, r, v):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
+def _dh_sums(h, dt, x0, v0, x1, v1, g, mu, out):  # pragma: no cover - compiled
+    """``sum g_k (x_k(h) - x_k(0))`` into ``out[0:3]`` and ``sum g_k u_k(h)`` into
+    ``out[3:6]`` over the massive rows ``k >= 1`` on their Kepler arcs (the ends
+    themselves at ``h = 0`` and ``1``)."""
+    for c in range(6):
+        out[c] = 0.0
+    for k in range(1, x0.shape[0]):
+        if g[k] == 0.0 or mu[k] == 0.0:
+            continue
+        if h == 0.0 or h == 1.0:
+            xe, ve = (x0, v0) if h == 0.0 else (x1, v1)
+            x, y, z, vx, vy, vz = xe[k, 0], xe[k, 1], xe[k, 2], ve[k, 0], ve[k, 1], ve[k, 2]
+        else:
+            x, y, z, vx, vy, vz = _kepler.propagate_uv(x0[k, 0], x0[k, 1], x0[k, 2], v0[k, 0],
+                                                       v0[k, 1], v0[k, 2], mu[k], h * dt)
+        out[0] += g[k] * (x - x0[k, 0])
+        out[1] += g[k] * (y - x0[k, 1])
+        out[2] += g[k] * (z - x0[k, 2])
+        out[3] += g[k] * vx
+        out[4] += g[k] * vy
+        out[5] += g[k] * vz
+
+
+@njit(cache=True, error_model="numpy")
+def _dh_constants(x0, v0, x1, v1, g, mu, a, dt):  # pragma: no cover - compiled
+    """The constants of a democratic-heliocentric drift's interpolant:
+    ``[m_0, M, a, dt, P_s (3), c (3), S_0 (3)]``.
+
+    The map is ``... kick, jump a, drift dt, jump b, kick ...`` (``a`` the jump
+    before the drift: 0 after a synchronised state, else half the step before;
+    ``b = dt - a`` the one after it), and a jump moves every heliocentric position
+    ``Q_k`` by its time times ``P / m_0``, ``P = sum_k m_k u_k``.  The interpolant
+    moves all ``Q_k`` together by ``(-a P_s + sum_k m_k (x_k(h) - x_k(0)) + h c) /
+    m_0`` besides their Kepler arcs ``x_k``: it starts where the kick before saw
+    the bodies (``-a P_s / m_0``), ends where the kick after sees them (``b P_e /
+    m_0``: ``c`` closes the gap, ``O(dt^2)``), and its rate is ``(P(h) + c / dt) /
+    m_0``, the central body's velocity relative to the barycentre to ``O(dt^2)``.
+    ``S_0 = sum_k m_k x_k(0)`` places the centre of mass."""
+    out = np.zeros(13)
+    m0 = g[0]
+    total = 0.0
+    for k in range(g.shape[0]):
+        total += g[k]
+    s = np.empty(6)
+    _dh_sums(1.0, dt, x0, v0, x1, v1, g, mu, s)
+    out[0], out[1], out[2], out[3] = m0, total, a, dt
+    for k in range(1, g.shape[0]):
+        if g[k] == 0.0 or mu[k] == 0.0:
+            continue
+        for c in range(3):
+            out[4 + c] += g[k] * v0[k, c]
+            out[10 + c] += g[k] * x0[k, c]
+    for c in range(3):
+        out[7 + c] = (dt - a) * s[3 + c] - (s[c] - a * out[4 + c])
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _dh_frame(h, dt, x0, v0, x1, v1, g, mu, fc, fr):  # pragma: no cover - compiled
+    """At ``h``: the common offset of the heliocentric positions and its rate
+    (``fr[0:6]``) and the centre of mass's position and velocity relative to the
+    central body (``fr[6:12]``); ``fc`` from :func:`_dh_constants`."""
+    s = np.empty(6)
+    _dh_sums(h, dt, x0, v0, x1, v1, g, mu, s)
+    m0, total, a, tau = fc[0], fc[1], fc[2], fc[3]
+    for c in range(3):
+        off = (s[c] - a * fc[4 + c] + h * fc[7 + c]) / m0
+        rate = (s[3 + c] + fc[7 + c] / tau) / m0
+        fr[c] = off
+        fr[3 + c] = rate
+        fr[6 + c] = (fc[10 + c] + s[c] + (total - m0) * off) / total
+        fr[9 + c] = (s[3 + c] + (total - m0) * rate) / total
+
+
+@njit(cache=True, error_model="numpy")
+def _dh_state(k, h, dt, x0, v0, mu, fr, out):  # pragma: no cover - compiled
+    """Body ``k``'s position and velocity relative to the central body at ``h`` (the
+    central body itself at rest at the origin); ``fr`` from :func:`_dh_frame`."""
+    if mu[k] == 0.0:
+        for c in range(6):
+            out[c] = 0.0
+        return
+    x, y, z, vx, vy, vz = _kepler.propagate_uv(x0[k, 0], x0[k, 1], x0[k, 2], v0[k, 0],
+                                               v0[k, 1], v0[k, 2], mu[k], h * dt)
+    out[0], out[1], out[2] = x + fr[0], y + fr[1], z + fr[2]
+    out[3], out[4], out[5] = vx + fr[3], vy + fr[4], vz + fr[5]
+
+
+@njit(cache=True, error_model="numpy")
 def _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
     # pragma: no cover - compiled
     """``(|d|^2, d . w, |w|)`` of body ``i`` relative to body ``j`` (``j < 0``: the
-    centre of mass, ``cm = [x_cm(0), v_cm, x_cm(1) ...]`` moving uniformly)."""
-    _state(kind, i, h, dt, x0, v0, x1, v1, a0, b, mu, si)
-    if j >= 0:
-        _state(kind, j, h, dt, x0, v0, x1, v1, a0, b, mu, sj)
+    centre of mass, ``cm = [x_cm(0), v_cm, x_cm(1) ...]`` moving uniformly; for
+    ``DH``, ``a0`` the rows' ``G m`` and ``cm`` from :func:`_dh_constants`)."""
+    if kind == DH and (j < 0 or mu[i] == 0.0 or mu[j] == 0.0):
+        fr = np.empty(12)
+        _dh_frame(h, dt, x0, v0, x1, v1, a0, mu, cm, fr)
+        _dh_state(i, h, dt, x0, v0, mu, fr, si)
+        if j >= 0:
+            _dh_state(j, h, dt, x0, v0, mu, fr, sj)
+        else:
+            for c in range(6):
+                sj[c] = fr[6 + c]
+    elif kind == DH:  # neither is the central body: the common offset cancels
+        _state(KEPLER, i, h, dt, x0, v0, x1, v1, a0, b, mu, si)
+        _state(KEPLER, j, h, dt, x0, v0, x1, v1, a0, b, mu, sj)
     else:
-        for c in range(3):
-            sj[c] = cm[c] + h * (cm[6 + c] - cm[c])
-            sj[3 + c] = cm[3 + c]
+        _state(kind, i, h, dt, x0, v0, x1, v1, a0, b, mu, si)
+        if j >= 0:
+            _state(kind, j, h, dt, x0, v0, x1, v1, a0, b, mu, sj)
+        else:
+            for c in range(3):
+                sj[c] = cm[c] + h * (cm[6 + c] - cm[c])
+                sj[3 + c] = cm[3 + c]
     d2 = 0.0
     f = 0.0
     w2 = 0.0
@@ -158,9 +273,25 @@ def _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
 
 
 @njit(cache=True, error_model="numpy")
-def _ends(kind, x0, v0, x1, v1, mu):  # pragma: no cover - compiled
+def _ends(kind, x0, v0, x1, v1, mu, a0, cm, ce):  # pragma: no cover - compiled
     """The positions and velocities at both ends of the step in the frame the
-    events are watched in (computed once per step: O(n), not O(n) per pair)."""
+    events are watched in (computed once per step: O(n), not O(n) per pair), and
+    into ``ce`` (12,) the centre of mass's position and velocity at both ends."""
+    for c in range(3):  # uniform motion (every kind but DH)
+        ce[c], ce[3 + c], ce[6 + c], ce[9 + c] = cm[c], cm[3 + c], cm[6 + c], cm[3 + c]
+    if kind == DH:  # relative to the central body, the common offset added
+        p0, w0, p1, w1 = x0.copy(), v0.copy(), x1.copy(), v1.copy()
+        fr = np.empty(12)
+        for end in range(2):
+            _dh_frame(float(end), cm[3], x0, v0, x1, v1, a0, mu, cm, fr)
+            p, w = (p0, w0) if end == 0 else (p1, w1)
+            for k in range(mu.shape[0]):
+                for c in range(3):
+                    p[k, c] = 0.0 if mu[k] == 0.0 else p[k, c] + fr[c]
+                    w[k, c] = 0.0 if mu[k] == 0.0 else w[k, c] + fr[3 + c]
+            for c in range(6):
+                ce[6 * end + c] = fr[6 + c]
+        return p0, w0, p1, w1
     if kind == JACOBI:
         n = x0.shape[0]
         p0, w0, p1, w1 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
@@ -183,8 +314,10 @@ def _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b):  # pragma: no cover -
     within the step (``a dt^2 / 2`` with ``a`` a bound on its acceleration): for
     radau15's polynomial, ``|a0| + sum |b_k|``; for the Kepler arcs,
     ``mu / r_min^2`` with ``r_min`` the smallest distance from the centre over the
-    step (the periapsis where it is passed), doubled for Jacobi coordinates;
-    infinite (no filter) for the other interpolants."""
+    step (the periapsis where it is passed), doubled for Jacobi coordinates, for
+    ``DH`` (given the arcs themselves) with the common offset's own,
+    ``sum m_k bound_k / m_0`` (``a0`` the rows' ``G m``), added; infinite (no
+    filter) for the other interpolants."""
     n = p0.shape[0]
     out = np.full(n, np.inf)
     if kind == RADAU:  # |a(h)| <= |a0| + sum |b_k| on [0, 1], per component
@@ -198,7 +331,7 @@ def _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b):  # pragma: no cover -
                 a2 += amax * amax
             out[k] = 0.5 * math.sqrt(a2) * dt * dt
         return out
-    if kind != KEPLER and kind != JACOBI:
+    if kind != KEPLER and kind != JACOBI and kind != DH:
         return out
     for k in range(n):
         if mu[k] == 0.0:
@@ -216,6 +349,14 @@ def _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b):  # pragma: no cover -
             r_min = min(r_min, max(h2, 0.0) / (mu[k] * (1.0 + e)))
         scale = 2.0 if kind == JACOBI else 1.0
         out[k] = scale * 0.5 * mu[k] / (r_min * r_min) * dt * dt
+    if kind == DH:  # the common offset's deviation: sum m_k bound_k / m_0
+        shift = 0.0
+        for k in range(1, n):
+            if mu[k] != 0.0:
+                shift += a0[k] * out[k] / a0[0]
+        for k in range(n):
+            if mu[k] != 0.0:
+                out[k] += shift
     return out
 
 
@@ -239,9 +380,9 @@ def _too_far(i, j, p0, w0, dt, d2a, fa, thr2, bound):  # pragma: no cover - comp
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _at_end(i, j, p, w, cm, at):  # pragma: no cover - compiled
+def _at_end(i, j, p, w, ce, at):  # pragma: no cover - compiled
     """``(|d|^2, d . w)`` at an end of the step, from its states (``at``: 0 at the
-    start, 6 at the end, the centre of mass's slot in ``cm``)."""
+    start, 6 at the end, the centre of mass's slot in ``ce``, see :func:`_ends`)."""
     d2 = 0.0
     f = 0.0
     for c in range(3):
@@ -249,8 +390,8 @@ def _at_end(i, j, p, w, cm, at):  # pragma: no cover - compiled
             d = p[i, c] - p[j, c]
             dw = w[i, c] - w[j, c]
         else:
-            d = p[i, c] - cm[at + c]
-            dw = w[i, c] - cm[3 + c]
+            d = p[i, c] - ce[at + c]
+            dw = w[i, c] - ce[at + 3 + c]
         d2 += d * d
         f += d * dw
     return d2, f
@@ -326,12 +467,20 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
     ``watch`` (m, 5): code, i, j, threshold, action.  ``x0, v0, x1, v1`` (n, 3): the
     states at both ends; ``a0`` (3n,), ``b`` (7, 3n): radau15's polynomial;
     ``mu`` (n,): the Kepler arcs' ``mu``; ``cm`` (9,): the centre of mass at both
-    ends and its velocity.
+    ends and its velocity.  ``DH``: ``x``, ``v`` heliocentric positions and
+    barycentric velocities (row 0 the central body, ``mu[0] = 0``), ``a0`` (n,) the
+    rows' ``G m``, ``cm[0]`` the jump before the drift (see :func:`_dh_constants`).
     """
     si = np.empty(6)
     sj = np.empty(6)
-    p0, w0, p1, w1 = _ends(kind, x0, v0, x1, v1, mu)
-    bound = _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b)
+    ce = np.empty(12)
+    if kind == DH:  # the drift's constants take the place of the centre of mass
+        cm = _dh_constants(x0, v0, x1, v1, a0, mu, cm[0], dt)
+    p0, w0, p1, w1 = _ends(kind, x0, v0, x1, v1, mu, a0, cm, ce)
+    if kind == DH:
+        bound = _deviation_bound(kind, x0, v0, x1, v1, mu, dt, a0, b)
+    else:
+        bound = _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b)
     first_h = 2.0
     first_row = -1
     for r in range(watch.shape[0]):
@@ -340,8 +489,8 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
         j = int(watch[r, 2])
         thr2 = watch[r, 3] * watch[r, 3]
         action = watch[r, 4]
-        d2a, fa = _at_end(i, j, p0, w0, cm, 0)
-        d2b, fb = _at_end(i, j, p1, w1, cm, 6)
+        d2a, fa = _at_end(i, j, p0, w0, ce, 0)
+        d2b, fb = _at_end(i, j, p1, w1, ce, 6)
         h = -1.0
         if code == _CODE_ESCAPE:
             if d2a < thr2 <= d2b:
@@ -379,7 +528,8 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
 
 @njit(cache=True, error_model="numpy")
 def state_at(kind, h, dt, x0, v0, x1, v1, a0, b, mu, r, v):  # pragma: no cover - compiled
-    """Every body's position and velocity at ``h`` into ``r``, ``v`` (n, 3)."""
+    """Every body's position and velocity at ``h`` into ``r``, ``v`` (n, 3) (any kind
+    but ``DH``)."""
     s = np.empty(6)
     for k in range(r.shape[0]):
         _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, s)

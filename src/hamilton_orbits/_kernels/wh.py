@@ -25,15 +25,19 @@ from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
+_I1 = types.int64[::1]
+
 __all__ = [
     "STATUS_DRAIN",
     "STATUS_EVENT",
     "STATUS_OK",
     "advance_dh",
     "advance_jacobi",
+    "caller_gm",
     "corrector_jacobi",
     "dh_from_inertial",
     "dh_to_inertial",
+    "effects_in_order",
     "jacobi_factors",
     "jacobi_from_inertial",
     "jacobi_to_inertial",
@@ -177,18 +181,20 @@ STATUS_DRAIN = 5
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
-    # pragma: no cover - compiled
+def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
+           jump):  # pragma: no cover - compiled
     """One Kepler drift of ``tau`` with the barycentre; with events watched
     (``watched``, a constant where the step loops inline this: the loop without
     events has no trace of them), the drift is scanned on the Kepler arcs
-    themselves (heliocentric, or Jacobi turned into inertial positions): exact for
-    the drift.  ``ws = [t, t_action, drain, row]``: the drift's start time
-    (advanced here), the time and watch row of the first event with an action, and
-    whether the buffer must be drained.  Returns a failing body or -1."""
+    themselves (Jacobi turned into inertial positions; democratic heliocentric
+    with the jumps around the drift spread over it, ``jump`` the one before it:
+    :func:`hamilton_orbits._kernels.events._dh_constants`; ``g`` the rows' ``G m``).
+    ``ws = [t, t_action, drain, row]``: the drift's start time (advanced here),
+    the time and watch row of the first event with an action, and whether the
+    buffer must be drained.  Returns a failing body or -1."""
     if watched:
         return _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0,
-                              mu_s)
+                              mu_s, g, jump)
     bad = _kepler_all(q, u, mu, tau)
     if jacobi:
         for k in range(3):
@@ -201,8 +207,8 @@ def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0,
 
 
 @njit(cache=True, error_model="numpy")
-def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s):
-    # pragma: no cover - compiled
+def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
+                   jump):  # pragma: no cover - compiled
     """:func:`_drift` with its events scanned."""
     n_watch = watch.shape[0]
     _copy(q, u, x0, v0)
@@ -213,12 +219,16 @@ def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, 
         else:
             com[k] += tau * com[3 + k]
     if bad < 0:
-        cm = np.zeros(9)  # escapes: from the central body (heliocentric) ...
-        if jacobi:  # ... or from the barycentre, Jacobi row 0
+        cm = np.zeros(9)
+        if jacobi:  # escapes from the barycentre, Jacobi row 0
             for k in range(3):
                 cm[k], cm[3 + k], cm[6 + k] = x0[0, k], v0[0, k], q[0, k]
-        h, row = _ev.scan(watch, _ev.JACOBI if jacobi else _ev.KEPLER, ws[0], tau, x0, v0, q,
-                          u, _NO_A0, _NO_B, mu_s, cm, ev_out, ev_count)
+            h, row = _ev.scan(watch, _ev.JACOBI, ws[0], tau, x0, v0, q, u, _NO_A0, _NO_B, mu_s,
+                              cm, ev_out, ev_count)
+        else:  # the jump before the drift in cm[0], the masses in place of a0
+            cm[0] = jump
+            h, row = _ev.scan(watch, _ev.DH, ws[0], tau, x0, v0, q, u, g, _NO_B, mu_s, cm,
+                              ev_out, ev_count)
         if row >= 0 and ws[0] + h * tau < ws[1]:
             ws[1] = ws[0] + h * tau
             ws[3] = row
@@ -266,40 +276,83 @@ def _stop_here(q, u, mu, h_back, jacobi, com, ws, t_end_step, ev_out, ev_count):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x):
-    # pragma: no cover - compiled
+def _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x,
+             order, gm_c):  # pragma: no cover - compiled
     """Jump h/2, the interaction kick h (and the listed effects, whose net force
     moves the barycentre), jump h/2.  ``idx``: the massive rows >= 1 (row 0, the
-    central body, is not in the interaction)."""
+    central body, is not in the interaction).  The effects see the bodies in the
+    caller's order (row ``i`` is body ``order[i]``; ``gm_c`` the caller's ``G m``):
+    their parameters name bodies by the caller's indices."""
     n = q.shape[0]
     gm0 = gm[0]
     _jump(q, u, gm, 0.5 * h)
     _nbody.kick_rows(q, gm, idx, 1, h, u, acc_m)
     if has_extra:
         # inertial state for the effects: r_0 = R - sum m_i Q_i / M
+        c = order[0]
         for k in range(3):
             s_q = 0.0
             s_u = 0.0
             for i in range(1, n):
                 s_q += gm[i] * q[i, k]
                 s_u += gm[i] * u[i, k]
-            r_in[0, k] = com[k] - s_q / m_tot
-            v_in[0, k] = com[3 + k] - s_u / gm0
+            r_in[c, k] = com[k] - s_q / m_tot
+            v_in[c, k] = com[3 + k] - s_u / gm0
             for i in range(1, n):
-                r_in[i, k] = q[i, k] + r_in[0, k]
-                v_in[i, k] = u[i, k] + com[3 + k]
+                r_in[order[i], k] = q[i, k] + r_in[c, k]
+                v_in[order[i], k] = u[i, k] + com[3 + k]
             for i in range(n):
                 acc_x[i, k] = 0.0
-        extra(r_in, v_in, gm, acc_x, p)
+        extra(r_in, v_in, gm_c, acc_x, p)
         for k in range(3):
             a_cm = 0.0
             for i in range(n):
-                a_cm += gm[i] * acc_x[i, k]
+                a_cm += gm[i] * acc_x[order[i], k]
             a_cm /= m_tot
             com[3 + k] += h * a_cm
             for i in range(1, n):
-                u[i, k] += h * (acc_x[i, k] - a_cm)
+                u[i, k] += h * (acc_x[order[i], k] - a_cm)
     _jump(q, u, gm, 0.5 * h)
+
+
+@njit(cache=True, error_model="numpy")
+def caller_gm(gm, order):  # pragma: no cover - compiled
+    """``G m`` in the caller's order from the rows of a splitting (row ``i`` is body
+    ``order[i]``): what the effects' kernels index with their parameters."""
+    out = np.empty(gm.shape[0])
+    for i in range(gm.shape[0]):
+        out[order[i]] = gm[i]
+    return out
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def effects_in_order(extra, p, r, v, acc, perm):  # pragma: no cover - compiled
+    """The effects' accelerations at the rows ``r``, ``v`` of a splitting (row ``i``
+    is body ``order[i]``) into ``acc`` (zeroed first), evaluated with the bodies in
+    the caller's order: ``perm = (order, gm_c, r_c, v_c, acc_c)``, ``gm_c`` from
+    :func:`caller_gm`, the others work arrays (n, 3).  Copies only: with the
+    central body first (``order`` the identity) the bits of a call on ``r``, ``v``."""
+    order, gm_c, r_c, v_c, acc_c = perm
+    n = r.shape[0]
+    for i in range(n):
+        j = order[i]
+        for k in range(3):
+            r_c[j, k] = r[i, k]
+            v_c[j, k] = v[i, k]
+            acc_c[i, k] = 0.0
+    extra(r_c, v_c, gm_c, acc_c, p)
+    for i in range(n):
+        j = order[i]
+        for k in range(3):
+            acc[i, k] = acc_c[j, k]
+
+
+@njit(cache=True, error_model="numpy")
+def _perm(has_extra, order, gm):  # pragma: no cover - compiled
+    """The ``perm`` of :func:`effects_in_order` (its work arrays empty without
+    effects)."""
+    m = gm.shape[0] if has_extra else 0
+    return order, caller_gm(gm, order), np.empty((m, 3)), np.zeros((m, 3)), np.empty((m, 3))
 
 
 @njit(cache=True, error_model="numpy")
@@ -366,18 +419,18 @@ def _inertial_to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _kick_jacobi(
-    extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in, v_in
+    extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, move_com, acc, accj, acc_x, r_in,
+    v_in, perm,
 ):  # pragma: no cover - compiled
     """The interaction kick of length ``h`` in Jacobi coordinates (``idx``: the
-    massive indices of ``gm``; ``ratio``, ``inv``: :func:`_jacobi_factors`)."""
+    massive indices of ``gm``; ``ratio``, ``inv``: :func:`_jacobi_factors`); the
+    effects evaluated with the bodies in the caller's order (``perm``: see
+    :func:`effects_in_order`)."""
     n = qj.shape[0]
     jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
     _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
     if has_extra:
-        for i in range(n):
-            for k in range(3):
-                acc_x[i, k] = 0.0
-        extra(r_in, v_in, gm, acc_x, p)
+        effects_in_order(extra, p, r_in, v_in, acc_x, perm)
         m_tot = eta[n - 1]
         for k in range(3):
             a_cm = 0.0
@@ -396,19 +449,21 @@ def _kick_jacobi(
 
 
 @njit(
-    types.int64(ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.float64,
+    types.int64(ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.float64,
                 F1, F1),
     cache=True,
     error_model="numpy",
 )
-def corrector_jacobi(extra_addr, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
+def corrector_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, sign, a, b):
     # pragma: no cover - compiled
     """Apply a symplectic corrector (``sign = 1``) or its inverse (``-1``): the
     product of ``Z(a_k dt, sign b_k dt)`` over the sequence ``a``, ``b`` (see
     :func:`hamilton_orbits.integrators.wh.corrector_coefficients`), with ``Z(a,
     b)`` = Kepler a, kick -b, Kepler -2a, kick b, Kepler a (Wisdom, Holman &
     Touma 1996).  The sequence is antisymmetric (``(a, b)`` reversed is ``(-a,
-    -b)``), so ``sign = -1`` is the exact inverse.  Returns a failing index or -1."""
+    -b)``), so ``sign = -1`` is the exact inverse.  ``order``: row ``i`` is the
+    caller's body ``order[i]`` (the effects see the caller's order).  Returns a
+    failing index or -1."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     n = qj.shape[0]
     acc = np.empty((n, 3))
@@ -416,6 +471,7 @@ def corrector_jacobi(extra_addr, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
     acc_x = np.empty((n, 3))
     r_in = np.empty((n, 3))
     v_in = np.zeros((n, 3))
+    perm = _perm(has_extra, order, gm)
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
     for k in range(a.shape[0]):
@@ -426,14 +482,14 @@ def corrector_jacobi(extra_addr, p, has_extra, qj, uj, gm, eta, dt, sign, a, b):
             return bad
         _kick_jacobi(
             extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, -bk, False,
-            acc, accj, acc_x, r_in, v_in,
+            acc, accj, acc_x, r_in, v_in, perm,
         )
         bad = _kepler_all(qj, uj, eta, -2.0 * ak)
         if bad >= 0:
             return bad
         _kick_jacobi(
             extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, bk, False,
-            acc, accj, acc_x, r_in, v_in,
+            acc, accj, acc_x, r_in, v_in, perm,
         )
         bad = _kepler_all(qj, uj, eta, ak)
         if bad >= 0:
@@ -543,19 +599,20 @@ def jacobi_to_inertial(q, u, g, eta, ratio, inv, order, r, v):  # pragma: no cov
 def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out,
               ev_count, ws, x0, v0, mu, mu_s, kick):  # pragma: no cover - compiled
     """The steps of :func:`advance_dh` (``kick``: its work arrays)."""
-    idx, m_tot, acc_m, r_in, v_in, acc_x = kick
+    idx, m_tot, acc_m, r_in, v_in, acc_x, order, gm_c = kick
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(watched, q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0,
-                 mu_s)
+                 mu_s, gm, 0.0)
     if bad >= 0:
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
-        _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x)
+        _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x,
+                 order, gm_c)
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(watched, q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count,
-                     ws, x0, v0, mu_s)
+                     ws, x0, v0, mu_s, gm, 0.5 * h)
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h
@@ -569,22 +626,22 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
 def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last, watch,
                   ev_out, ev_count, ws, x0, v0, kick):  # pragma: no cover - compiled
     """The steps of :func:`advance_jacobi` (``kick``: its work arrays)."""
-    idx, ratio, inv, acc, accj, acc_x, r_in, v_in = kick
+    idx, ratio, inv, acc, accj, acc_x, r_in, v_in, perm = kick
     t_step = ws[0]
     h = dt if n_steps > 1 else dt_last
     bad = _drift(watched, qj, uj, eta, 0.5 * h, True, eta, watch, ev_out, ev_count, ws, x0, v0,
-                 eta)
+                 eta, gm, 0.0)
     if bad >= 0:
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
         _kick_jacobi(
             extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
-            acc, accj, acc_x, r_in, v_in,
+            acc, accj, acc_x, r_in, v_in, perm,
         )
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
         bad = _drift(watched, qj, uj, eta, 0.5 * (h + h_next), True, eta, watch, ev_out,
-                     ev_count, ws, x0, v0, eta)
+                     ev_count, ws, x0, v0, eta, gm, 0.0)
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h
@@ -599,19 +656,22 @@ _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
+        ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_dh(
-    extra_addr, p, has_extra, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
+    ws,
 ):  # pragma: no cover - compiled
     """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
     coordinates, in place.  ``q``, ``u``: heliocentric positions and
     barycentric velocities (row 0 unused); ``gm[0]`` the central body's;
-    ``com``: barycentre position and velocity (6,).  ``watch``, ``ev_out``,
+    ``com``: barycentre position and velocity (6,); ``order``: row ``i`` is the
+    caller's body ``order[i]`` (the listed effects see the caller's order: their
+    parameters name bodies by its indices).  ``watch``, ``ev_out``,
     ``ev_count``, ``ws``: the events (see :func:`_drift`; ``ws[0]`` the start
     time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
     whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
@@ -638,7 +698,7 @@ def advance_dh(
     mu_s = np.full(w, gm[0])
     if watched:
         mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
-    kick = (idx, m_tot, acc_m, r_in, v_in, acc_x)
+    kick = (idx, m_tot, acc_m, r_in, v_in, acc_x, order, caller_gm(gm, order))
     # two copies of the loop: the one without events and effects has no trace of
     # them (their branches cost up to 30% of a step at N = 2-3)
     if watched or has_extra:
@@ -650,14 +710,15 @@ def advance_dh(
 
 @njit(
     types.Tuple((types.int64, types.int64, types.int64))(
-        ADDRESSES, F1, types.boolean, F2, F2, F1, F1, types.float64, types.int64,
+        ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
     ),
     cache=True,
     error_model="numpy",
 )
 def advance_jacobi(
-    extra_addr, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out, ev_count, ws
+    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
+    ev_count, ws,
 ):  # pragma: no cover - compiled
     """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
     ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
@@ -674,7 +735,7 @@ def advance_jacobi(
     x0, v0 = np.empty((n, 3)), np.empty((n, 3))
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
-    kick = (idx, ratio, inv, acc, accj, acc_x, r_in, v_in)
+    kick = (idx, ratio, inv, acc, accj, acc_x, r_in, v_in, _perm(has_extra, order, gm))
     # as advance_dh: the loop without events and effects has no trace of them
     watched = watch.shape[0] > 0
     if watched or has_extra:

@@ -34,7 +34,9 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.jacobians import newtonian_jvp, tangent_at
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
-from hamilton_orbits._kernels.wh import jacobi_factors, jacobi_to_inertial_pos
+from hamilton_orbits._kernels.wh import caller_gm, jacobi_factors, jacobi_to_inertial_pos
+
+_I1 = types.int64[::1]
 
 __all__ = ["advance_dh", "advance_jacobi"]
 
@@ -93,10 +95,54 @@ def _inertial_dh(q, u, com, gm, m_tot, r_in, v_in):  # pragma: no cover - compil
 
 
 @njit(cache=True, error_model="numpy")
+def _in_order(extra, tangent, p, r, v, dr, dv, acc, da, perm):  # pragma: no cover - compiled
+    """The effects' accelerations (``extra``, into ``acc``) and the tangent
+    right-hand side ``tangent`` (into ``da``) at the rows
+    of a splitting (row ``i`` is body ``order[i]``), evaluated with the bodies in
+    the caller's order, whose indices the effects' parameters use: ``perm =
+    (order, gm_c, r_c, v_c, acc_c, dr_c, dv_c, da_c)`` (``gm_c`` the caller's ``G
+    m``, the others work arrays).  ``acc`` and ``da`` are zeroed first.  Copies
+    only: with the central body first, the bits of calls on ``r`` ... directly."""
+    order, gm_c, r_c, v_c, acc_c, dr_c, dv_c, da_c = perm
+    n = r.shape[0]
+    for blk in range(dr.shape[0] // n + 1):
+        x = r if blk == 0 else dr[(blk - 1) * n:blk * n]
+        w = v if blk == 0 else dv[(blk - 1) * n:blk * n]
+        xc = r_c if blk == 0 else dr_c[(blk - 1) * n:blk * n]
+        wc = v_c if blk == 0 else dv_c[(blk - 1) * n:blk * n]
+        for i in range(n):
+            j = order[i]
+            for c in range(3):
+                xc[j, c] = x[i, c]
+                wc[j, c] = w[i, c]
+    acc_c[:, :] = 0.0
+    da_c[:, :] = 0.0
+    extra(r_c, v_c, gm_c, acc_c, p)
+    tangent(r_c, v_c, gm_c, dr_c, dv_c, da_c, p)
+    for blk in range(dr.shape[0] // n + 1):
+        a = acc if blk == 0 else da[(blk - 1) * n:blk * n]
+        ac = acc_c if blk == 0 else da_c[(blk - 1) * n:blk * n]
+        for i in range(n):
+            j = order[i]
+            for c in range(3):
+                a[i, c] = ac[j, c]
+
+
+@njit(cache=True, error_model="numpy")
+def _perm(has_extra, order, gm, kn):  # pragma: no cover - compiled
+    """The ``perm`` of :func:`_in_order` (its work arrays empty without effects)."""
+    n = gm.shape[0] if has_extra else 0
+    k = kn if has_extra else 0
+    return (order, caller_gm(gm, order), np.empty((n, 3)), np.zeros((n, 3)), np.empty((n, 3)),
+            np.empty((k, 3)), np.zeros((k, 3)), np.empty((k, 3)))
+
+
+@njit(cache=True, error_model="numpy")
 def _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm_p, idx, h,
-             m_tot, w):  # pragma: no cover - compiled
+             m_tot, w, perm):  # pragma: no cover - compiled
     """Jump h/2, interaction kick h (and the effects), jump h/2, with tangents.
-    ``w``: work arrays (acc, da, r_in, v_in, acc_x, dr_in, dv_in, da_x)."""
+    ``w``: work arrays (acc, da, r_in, v_in, acc_x, dr_in, dv_in, da_x); ``perm``:
+    the bodies in the caller's order for the effects (:func:`_in_order`)."""
     acc, da, r_in, v_in, acc_x, dr_in, dv_in, da_x = w
     n = q.shape[0]
     k = dq.shape[0] // n
@@ -115,10 +161,7 @@ def _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm
         for m in range(k):
             _inertial_dh(dq[m * n:(m + 1) * n], du[m * n:(m + 1) * n], dcom[m], gm, m_tot,
                          dr_in[m * n:(m + 1) * n], dv_in[m * n:(m + 1) * n])
-        acc_x[:, :] = 0.0
-        da_x[:, :] = 0.0
-        extra(r_in, v_in, gm, acc_x, p)
-        tangent_extra(r_in, v_in, gm, dr_in, dv_in, da_x, p)
+        _in_order(extra, tangent_extra, p, r_in, v_in, dr_in, dv_in, acc_x, da_x, perm)
         for blk in range(k + 1):
             a = acc_x if blk == 0 else da_x[(blk - 1) * n:blk * n]
             uu = u if blk == 0 else du[(blk - 1) * n:blk * n]
@@ -158,13 +201,15 @@ def _ln_delta_dh(dq, du, dcom, gm, m_tot, r0, v0):  # pragma: no cover - compile
 
 
 @njit(types.Tuple((types.int64, types.int64))(
-    ADDRESSES, ADDRESSES, F1, types.boolean, F2, F2, F1, F1, F1, F2, F2, F2, types.float64,
-    types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
-def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, q, u, gm, gm_p, com, dq, du, dcom,
-               dt, n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
+    ADDRESSES, ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, F1, F2, F2, F2,
+    types.float64, types.int64, types.float64, types.float64, F1), cache=True,
+    error_model="numpy")
+def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, order, q, u, gm, gm_p, com, dq, du,
+               dcom, dt, n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
     """``n_steps`` democratic-heliocentric steps (the last of length ``dt_last``) from
     ``t0``, synchronised at both ends, with the tangent vectors ``(dq, du, dcom)``;
-    the coordinates as :func:`hamilton_orbits._kernels.wh.advance_dh` takes them.
+    the coordinates (and ``order``) as :func:`hamilton_orbits._kernels.wh.advance_dh`
+    takes them.
     Returns ``(steps, bad)``, ``bad`` a body whose Kepler step failed or -1."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     tangent_extra = tangent_at(tangent_extra_addr[0], tangent_extra_addr[1])
@@ -173,6 +218,7 @@ def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, q, u, gm, gm_p, com
     w = (np.empty((n, 3)), np.empty((kn, 3)), np.empty((n, 3)), np.empty((n, 3)),
          np.empty((n, 3)), np.empty((kn, 3)), np.empty((kn, 3)), np.empty((kn, 3)))
     xa, va = np.empty(3), np.empty(3)
+    perm = _perm(has_extra, order, gm, kn)
     m_tot = 0.0
     for i in range(n):
         m_tot += gm[i]
@@ -187,7 +233,7 @@ def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, q, u, gm, gm_p, com
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
         _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm_p, idx, h,
-                 m_tot, w)
+                 m_tot, w, perm)
         megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t + 0.5 * h,
                        t + 0.5 * h - t_last)
         f = renormalise(ms, dq, du, n)
@@ -216,13 +262,14 @@ def _to_jacobi_acc(a, gm, inv, aj):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv, h, w):
-    # pragma: no cover - compiled
+def _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv, h, w,
+                 perm):  # pragma: no cover - compiled
     """The interaction kick in Jacobi coordinates (as
     :mod:`hamilton_orbits._kernels.wh`) with its tangent: the inertial Jacobian
     (Newtonian and effects) at the inertial positions, in Jacobi form, plus the
     derivative of ``G eta_i qj_i / |qj_i|^3``,
-    ``eta_i (e / |q|^3 - 3 (q.e) q / |q|^5)``."""
+    ``eta_i (e / |q|^3 - 3 (q.e) q / |q|^5)``.  With effects, they and the
+    Jacobian see the bodies in the caller's order (``perm``: :func:`_in_order`)."""
     acc, da, r_in, v_in, acc_x, dr_in, dv_in, aj = w
     n = qj.shape[0]
     k = dq.shape[0] // n
@@ -232,10 +279,10 @@ def _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, rat
         jacobi_to_inertial_pos(dq[m * n:(m + 1) * n], gm, eta, ratio, inv,
                                dr_in[m * n:(m + 1) * n])
     _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
-    tangent(r_in, v_in, gm, dr_in, dv_in, da, p)
-    if has_extra:
-        acc_x[:, :] = 0.0
-        extra(r_in, v_in, gm, acc_x, p)
+    if not has_extra:
+        tangent(r_in, v_in, gm, dr_in, dv_in, da, p)
+    else:
+        _in_order(extra, tangent, p, r_in, v_in, dr_in, dv_in, acc_x, da, perm)
         for i in range(n):
             for c in range(3):
                 acc[i, c] += acc_x[i, c]
@@ -289,10 +336,10 @@ def _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0):  # pragma: no cover -
 
 
 @njit(types.Tuple((types.int64, types.int64))(
-    ADDRESSES, ADDRESSES, F1, types.boolean, F2, F2, F1, F1, F2, F2, types.float64,
+    ADDRESSES, ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, F2, F2, types.float64,
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
-def advance_jacobi(extra_addr, tangent_addr, p, has_extra, qj, uj, gm, eta, dq, du, dt, n_steps,
-                   dt_last, t0, ms):  # pragma: no cover - compiled
+def advance_jacobi(extra_addr, tangent_addr, p, has_extra, order, qj, uj, gm, eta, dq, du, dt,
+                   n_steps, dt_last, t0, ms):  # pragma: no cover - compiled
     """As :func:`advance_dh` in Jacobi coordinates (``qj``, ``uj``, row 0 the
     barycentre; ``eta_i = sum_{j<=i} G m_j``), ``tangent`` the whole tangent
     right-hand side (Newtonian and effects).  Returns ``(steps, bad)``."""
@@ -306,6 +353,7 @@ def advance_jacobi(extra_addr, tangent_addr, p, has_extra, qj, uj, gm, eta, dq, 
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
     r0, v0 = np.empty((n, 3)), np.empty((n, 3))
+    perm = _perm(has_extra, order, gm, kn)
     t = t0
     t_last = t0
     h = dt if n_steps > 1 else dt_last
@@ -315,7 +363,7 @@ def advance_jacobi(extra_addr, tangent_addr, p, has_extra, qj, uj, gm, eta, dq, 
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
         _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv, h,
-                     w)
+                     w, perm)
         megno_map_step(ms, _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0), t + 0.5 * h,
                        t + 0.5 * h - t_last)
         renormalise(ms, dq, du, n)

@@ -342,7 +342,7 @@ class WHTangent:
         self.max_steps = max_steps
         n, k = r0.shape[0], tangent.k
         c = int(np.argmax(gm))
-        self.order = order = np.concatenate([[c], np.delete(np.arange(n), c)])
+        self.order = order = np.concatenate([[c], np.delete(np.arange(n), c)]).astype(np.int64)
         self.inv_order = np.argsort(order)
         self.g = g = np.ascontiguousarray(gm[order])
         self.q, self.u, self.com = (np.ascontiguousarray(a)
@@ -372,12 +372,12 @@ class WHTangent:
 
     def _steps(self, n_call: int, h_last: float, t_call: float) -> tuple[int, int]:
         if self.jacobi:
-            return _wht.advance_jacobi(self.extra, self.jac, self.rhs.p, self.has_extra, self.q,
-                                       self.u, self.g, self.eta, self.dq, self.du, self.dt,
-                                       n_call, h_last, t_call, self.tangent.ms)
-        return _wht.advance_dh(self.extra, self.jac, self.rhs.p, self.has_extra, self.q, self.u,
-                               self.g, self.g_p, self.com, self.dq, self.du, self.dcom, self.dt,
-                               n_call, h_last, t_call, self.tangent.ms)
+            return _wht.advance_jacobi(self.extra, self.jac, self.rhs.p, self.has_extra,
+                                       self.order, self.q, self.u, self.g, self.eta, self.dq,
+                                       self.du, self.dt, n_call, h_last, t_call, self.tangent.ms)
+        return _wht.advance_dh(self.extra, self.jac, self.rhs.p, self.has_extra, self.order,
+                               self.q, self.u, self.g, self.g_p, self.com, self.dq, self.du,
+                               self.dcom, self.dt, n_call, h_last, t_call, self.tangent.ms)
 
     def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
                 on_output: Callable[[int, int], None] | None,

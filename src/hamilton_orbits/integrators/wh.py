@@ -165,10 +165,12 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
         A bound on the steps of the whole run; more are refused before the run
         starts (``ValueError``).
     events : EventLog, optional
-        Events to look for in every drift: on the Kepler arcs themselves
-        (democratic heliocentric; escapes measured from the central body) or on
-        the Hermite interpolant of the inertial states (Jacobi).  Actions take
-        effect at the end of the step the event occurred in.
+        Events to look for in every drift, on its Kepler arcs: heliocentric
+        (democratic heliocentric, with the jump that the steps apply around the
+        kick spread over the drift, so that relative velocities and the centre
+        of mass are the inertial ones) or Jacobi coordinates turned into
+        inertial positions.  Escapes are measured from the centre of mass.
+        Actions take effect at the end of the step the event occurred in.
     variational : Tangent, optional
         Tangent vectors to carry through the exact tangent map of every step
         (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled
@@ -335,6 +337,7 @@ class _Split:
     def __init__(self, gm: np.ndarray, order: np.ndarray, jacobi: bool, corrector: int,
                  extra: Any, p: np.ndarray, has_extra: bool) -> None:
         g = np.ascontiguousarray(gm[order])  # a writeable copy, the order of the rows
+        order = np.ascontiguousarray(order, dtype=np.int64)
         self.gm, self.g, self.order, self.jacobi, self.corrector = gm, g, order, jacobi, corrector
         self.extra, self.p, self.has_extra = extra, p, has_extra
         self.q = self.u = np.empty((0, 3))
@@ -370,9 +373,9 @@ class _Split:
         ev = (watch, ev_out, ev_count, ws)
         q, u = self.q, self.u
         if not self.jacobi:
-            return _k.advance_dh(self.extra, self.p, self.has_extra, q, u, self.g, self.com,
-                                 dt, n_steps, last, *ev)
-        args = (self.extra, self.p, self.has_extra, q, u, self.g, self.eta)
+            return _k.advance_dh(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
+                                 self.com, dt, n_steps, last, *ev)
+        args = (self.extra, self.p, self.has_extra, self.order, q, u, self.g, self.eta)
         if not self.corrector:
             return _k.advance_jacobi(*args, dt, n_steps, last, *ev)
         # the corrector conjugates a run of equal steps: a shortened last step gets
