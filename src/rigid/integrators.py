@@ -386,11 +386,12 @@ def _scaled_problem(
     sm = pow2(si.moments)
     if kind in (_euler_k.TORQUE_BODY, _euler_k.TORQUE_SPACE):
         with np.errstate(over="ignore"):
-            params = params / sm
-        if not np.all(np.isfinite(params)):
+            scaled = params / sm
+        if not np.all(np.isfinite(scaled)):
             raise ValueError(f"Expected `torque` / the moments within float64, got torque "
-                             f"{(params * sm).tolist()} N m beside moments "
-                             f"{si.moments.tolist()} kg m^2")
+                             f"{params.tolist()} N m beside moments {si.moments.tolist()} "
+                             f"kg m^2")
+        params = scaled
     moments = si.moments / sm
     sw = _rate_scale(moments, si.omega, kind, params, method, times, dt)
     if sw != 1.0:
