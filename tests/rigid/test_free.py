@@ -441,6 +441,45 @@ def test_thin_symmetric_body_against_closed_form(moments, t):
     assert _mp_angle(qref, q[0]) <= 4 * EPS * (1.0 + angle)
 
 
+@pytest.mark.parametrize(("a", "c", "w0"), [
+    # the property test's reproducer (moments 1e-12, 1e-12 and 1.9e-114 about the axis,
+    # omega (0, 1, 1.9e-114)), axes relabelled cyclically so that the needle's axis is
+    # the third: C w3^2 (A - C) = 7e-342 underflowed, the kernel divided by zero
+    (1e-12, 1.914711231811873e-114, [0.0, 1.0, 1.914711231811873e-114]),
+    (1.0, 1e-60, [1.0, 0.5, 1e-130]),  # 1e-320: subnormal, the motion silently wrong
+    (1.0, 1e-150, [0.6, -0.8, 1.1e-150]),  # the thinnest body at the slowest axial spin
+])
+@pytest.mark.parametrize("t", [1.0, 1e3, 1e9])
+def test_needle_with_a_slow_axial_spin_against_closed_form(a, c, w0, t):
+    # A needle (C / A down to 1e-150) tumbling at ~1 rad/s and spinning about its axis
+    # at 1e-130 of that: the kernel's polhode terms J w^2 (J' - J) of the axial spin
+    # fall below float64's normal range, so it now takes the rates 2^53 .. 2^268 times
+    # larger (exact: the motion is homogeneous in the rates).  The reference is Euler's
+    # symmetric top in 50 digits; the bound is a few eps times the angle turned.
+    q0 = [0.9, 0.1, -0.3, 0.2]
+    q, w = free_motion_arrays([a, a, c], q0, w0, [t])
+    qref, angle = _mp_symmetric_top(a, c, q0, w0, t)
+    assert _mp_angle(qref, q[0]) <= 4 * EPS * (1.0 + angle)
+    # the body-frame omega: the transverse part turns at nu = w3 (1 - C / A) about the
+    # axis, w3 constant (to eps of |omega|; the axial angle nu t is tiny up to t = 1e9)
+    nu = w0[2] * (1.0 - c / a)
+    ref = Quaternion.from_axis_angle([0.0, 0.0, 1.0], -nu * t).rotate(w0)
+    np.testing.assert_allclose(w[0], ref, rtol=0, atol=4 * EPS * np.abs(w0).max())
+    assert w[0][2] == w0[2]
+
+
+def test_needle_axial_spin_over_its_own_period():
+    # The slow axial rotation of the needle above, over times where it turns by radians:
+    # omega_W in the body frame against the closed form, to eps times the angle nu t.
+    a, c, w0 = 1.0, 1e-60, np.array([1.0, 0.5, 1e-130])
+    nu = w0[2] * (1.0 - c / a)
+    t = np.array([0.5, 2.0, 7.0]) / nu
+    _, w = free_motion_arrays([a, a, c], [1.0, 0.0, 0.0, 0.0], w0, t)
+    for ti, wi in zip(t, w, strict=True):
+        ref = Quaternion.from_axis_angle([0.0, 0.0, 1.0], -nu * ti).rotate(w0)
+        np.testing.assert_allclose(wi, ref, rtol=0, atol=8 * EPS * (1.0 + nu * ti))
+
+
 @pytest.mark.parametrize("c", [1e-6, 0.5, 1.9])
 def test_near_symmetric_body_is_continuous(c):
     # B = A (1 + d): the attitude departs from the symmetric top linearly in d, with
