@@ -187,6 +187,50 @@ def test_extreme_moments_scale_out(scale):
     assert np.isfinite(body.kinetic_energy) and body.kinetic_energy > 0.0
 
 
+INTEGRATE_METHODS = ["splitting2", "splitting4", "exact_kick", "rk4", "cayley_rk4", "dop853"]
+
+
+@pytest.mark.parametrize("method", INTEGRATE_METHODS)
+@pytest.mark.parametrize("s", [2.0**-660, 2.0**-500, 2.0**500])
+def test_integrate_is_homogeneous_in_the_rates(method, s):
+    # omega(t; s omega0) = s omega(s t; omega0), the gravity gradient's GM/R^3 by s^2 and
+    # its mean motion by s: integrate scales the rates by powers of two before the
+    # kernels, so the run on 2^-660 rad/s (Euler's equations underflowed: exact_kick
+    # divided by zero) and on 2^500 rad/s (overflowed) is the unit run bit for bit.
+    # (The gravity gradient where GM/R^3 s^2 is a normal number: s >= 2^-511.)
+    t = np.linspace(0.0, 10.0, 5)
+    cases = [(None, None)]
+    if s >= 2.0**-511:
+        cases.append((GravityGradientTorque(0.5, mean_motion=0.1),
+                      GravityGradientTorque(0.5 * s * s, mean_motion=0.1 * s)))
+    for torque, scaled in cases:
+        ref = integrate(RigidBody([1.0, 2.0, 3.0], Q0, [1.0, 0.3, 0.8]), t, dt=0.01,
+                        method=method, torque=torque)
+        got = integrate(RigidBody([1.0, 2.0, 3.0], Q0, np.array([1.0, 0.3, 0.8]) * s), t / s,
+                        dt=0.01 / s, method=method, torque=scaled)
+        np.testing.assert_array_equal(got.omega / s, ref.omega)
+        np.testing.assert_array_equal(got.attitude.as_array(), ref.attitude.as_array())
+
+
+@pytest.mark.parametrize("method", INTEGRATE_METHODS)
+@pytest.mark.parametrize("s", [2.0**-1000, 2.0**1000])
+def test_integrate_is_homogeneous_in_the_moments(method, s):
+    # I omega' = N - omega x I omega is homogeneous in (I, N): moments 2^-1000 with the
+    # torque 2^-1000 times as large run as the unit body, bit for bit, for a body- and
+    # a space-fixed torque and the gravity gradient (which does not depend on I's scale).
+    t = np.linspace(0.0, 10.0, 5)
+    n = np.array([0.1, 0.0, 0.2])
+    for torque, scaled in ((BodyTorque(n), BodyTorque(n * s)),
+                           (SpaceTorque(n), SpaceTorque(n * s)),
+                           (GravityGradientTorque(0.5), GravityGradientTorque(0.5))):
+        ref = integrate(RigidBody([1.0, 2.0, 3.0], Q0, [1.0, 0.3, 0.8]), t, dt=0.01,
+                        method=method, torque=torque)
+        got = integrate(RigidBody(np.array([1.0, 2.0, 3.0]) * s, Q0, [1.0, 0.3, 0.8]), t,
+                        dt=0.01, method=method, torque=scaled)
+        np.testing.assert_array_equal(got.omega, ref.omega)
+        np.testing.assert_array_equal(got.attitude.as_array(), ref.attitude.as_array())
+
+
 @pytest.mark.parametrize(
     ("moments", "match"),
     [
