@@ -289,8 +289,10 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
         disk_moments = (1.0 / recip) * sm
         lam = lam_s / sm
         delta = lam_s * (sign * 2.0 * t2 + lam_s * ell2) * sw * sw
+    # lam = 0 from a lam_s != 0 is an underflow; lam_s = 0 is a body that is a disk
+    # already (C = A + B in floats): its own disk equivalent, confocal with lam = 0
     if not (np.all(np.isfinite(disk_moments)) and np.isfinite(lam) and np.isfinite(delta)
-            and lam != 0.0):
+            and (lam != 0.0 or lam_s == 0.0)):
         raise ValueError(
             f"Expected `body` to have a disk equivalent within float64, got moments "
             f"{si.moments.tolist()} and omega {si.omega.tolist()}"
