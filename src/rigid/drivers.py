@@ -24,6 +24,9 @@ from rigid.splitting import SPLITTINGS, split_ops
 
 __all__ = ["METHODS", "integrate_arrays"]
 
+# the square root of float64's smallest normal: a norm below it had a subnormal square
+_NORMAL_ROOT = float(np.sqrt(np.finfo(np.float64).tiny))
+
 METHODS = ("splitting2", "splitting4", "splitting4y", "exact_kick", "dop853", "rk4",
            "cayley_rk4")
 
@@ -95,6 +98,38 @@ def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
     return q_out, w_out
 
 
+def _unit_rows(y: np.ndarray) -> tuple[np.ndarray, float]:
+    """``(y / |y|, max | |y| - 1 |)`` over the rows of ``y`` (n, 4): the quaternions of
+    an unconstrained run, normalised on output, and the drift of their norm.
+
+    A row whose squared norm leaves float64's normal range (RK4 with a step far too
+    long: |q| beyond 1e154 or below 1e-154) is normalised on the row scaled by a
+    power of two (exact); a norm beyond float64 gives an infinite drift, a zero row
+    a NaN row (no attitude): :func:`rigid.integrate` refuses both, naming ``dt``.
+
+    Examples
+    --------
+    >>> y = np.array([[2.0, 0.0, 0.0, 0.0], np.ldexp([0.0, 3.0, 4.0, 0.0], 700)])
+    >>> q, drift = _unit_rows(y)  # |y|^2 of the second row, 25 x 2^1400, overflows
+    >>> q.tolist(), drift == 5.0 * 2.0**700
+    ([[1.0, 0.0, 0.0, 0.0], [0.0, 0.6, 0.8, 0.0]], True)
+    """
+    with np.errstate(over="ignore"):  # those rows are taken again below
+        qn = np.sqrt(np.sum(y**2, axis=-1))
+    odd = ~(qn >= _NORMAL_ROOT) | ~np.isfinite(qn)
+    if not np.any(odd):  # the usual case, untouched
+        return y / qn[:, None], float(np.max(np.abs(qn - 1.0)))
+    big = np.max(np.abs(y[odd]), axis=-1)
+    scale = np.ldexp(1.0, np.frexp(np.where(big > 0.0, big, 1.0))[1] - 1)  # powers of two
+    ys = y[odd] / scale[:, None]
+    ns = np.sqrt(np.sum(ys**2, axis=-1))
+    with np.errstate(over="ignore", invalid="ignore"):  # a zero row: no attitude (NaN)
+        qn[odd] = ns * scale
+        q = y / qn[:, None]
+        q[odd] = ys / ns[:, None]
+    return q, float(np.max(np.abs(qn - 1.0)))
+
+
 def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress):
     """``(q, omega, count, drift)`` of a fixed-step method on the step grid."""
     count = 0
@@ -108,9 +143,8 @@ def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre,
         y = np.empty((out_steps.size, 7))
         _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
                               params, y)
-        qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
-        drift = float(np.max(np.abs(qn - 1.0)))
-        q, w = y[:, :4] / qn[:, None], y[:, 4:]
+        q, drift = _unit_rows(y[:, :4])
+        w = y[:, 4:]
     elif method == "cayley_rk4":
         y = np.empty((out_steps.size, 7))
         count = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
@@ -132,9 +166,8 @@ def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
     )
     if bar is not None:
         bar.close()
-    qn = np.sqrt(np.sum(y[:, :4] ** 2, axis=-1))
-    drift = float(np.max(np.abs(qn - 1.0)))
-    return y[:, :4] / qn[:, None], y[:, 4:].copy(), int(steps), int(nfev), drift
+    q, drift = _unit_rows(y[:, :4])
+    return q, y[:, 4:].copy(), int(steps), int(nfev), drift
 
 
 def _bar(total: int, unit: str, progress: bool) -> Any:

@@ -23,6 +23,7 @@ exchanged in a right-handed relabelling of the axes.  On the separatrix
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -32,7 +33,7 @@ import numpy as np
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import ANGULAR_SPEED, INERTIA, TIME, require_consistent, wrap
 from rigid._kernels import free as _fk
-from rigid._shared import free_flow_scaled
+from rigid._shared import free_flow_scaled, free_setup_scaled
 from rigid.body import RigidBody, call_units, check_body, check_moments, unit_quaternion
 
 __all__ = ["FreeMotion", "FreeParameters", "free_motion", "free_motion_arrays",
@@ -81,7 +82,9 @@ def free_motion_arrays(
     ValueError
         For wrong shapes, NaN / inf, complex input, a non-positive moment, moments
         that break the triangle inequality, a zero quaternion, ``|omega0| t``
-        beyond float64, or a mix of Quantities and plain numbers.
+        beyond float64, an angular velocity along the motion beyond float64, a
+        needle too thin for rates this uneven (the polhode beyond float64), or a
+        mix of Quantities and plain numbers.
     astropy.units.UnitConversionError
         For a Quantity of the wrong dimension, naming the argument.
 
@@ -153,7 +156,9 @@ def free_motion(body: RigidBody, t: Any) -> FreeMotion:
     Raises
     ------
     ValueError
-        If ``body`` is not a RigidBody or ``t`` has NaN / inf.
+        If ``body`` is not a RigidBody, ``t`` has NaN / inf or ``|omega| t`` is
+        beyond float64, or the motion is beyond float64 (see
+        :func:`free_motion_arrays`).
 
     Notes
     -----
@@ -194,7 +199,7 @@ def free_motion(body: RigidBody, t: Any) -> FreeMotion:
     t_arr = TIME("t", t)
     flat = np.ascontiguousarray(t_arr.reshape(-1))
     si = body.si
-    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t")
+    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t", "`body`")
     q = q.reshape(t_arr.shape + (4,))
     w = w.reshape(t_arr.shape + (3,))
     return FreeMotion(Quaternion(q), wrap(w, u.rad / u.s, quantity))
@@ -252,6 +257,12 @@ def free_parameters(body: RigidBody) -> FreeParameters:
         ``lam`` in 1/s, ``period`` and ``flip_interval`` in s: Quantities for a
         body built from Quantities, else plain SI floats.
 
+    Raises
+    ------
+    ValueError
+        If ``body`` is not a RigidBody, or its motion's rate ``lam`` or its polhode
+        is beyond float64 (see :func:`free_motion_arrays`).
+
     Examples
     --------
     >>> p = free_parameters(RigidBody([1.0, 2.0, 3.0], omega=[1.0, 0.3, 0.8]))
@@ -262,8 +273,7 @@ def free_parameters(body: RigidBody) -> FreeParameters:
     body = check_body(body)
     # homogeneous: the kernel sees moments / sm and omega / sw; rates scale back by sw
     si = body.si
-    sm, sw = si.scales()
-    prm = _fk.free_setup(si.moments / sm, si.attitude, si.omega / sw)
+    prm, sw = free_setup_scaled(si.moments, si.attitude, si.omega, "`body`")
     kind = int(prm[_fk.KIND])
     q = body.quantity
     inf = float("inf")
@@ -272,7 +282,12 @@ def free_parameters(body: RigidBody) -> FreeParameters:
                               wrap(inf, u.s, q), wrap(inf, u.s, q), 0.0)
     pmat = prm[_fk.P : _fk.P + 9].reshape(3, 3)
     polar = int(np.argmax(np.abs(pmat[:, 2])))
-    lam = float(prm[_fk.LAM]) * sw
+    lam = float(prm[_fk.LAM]) * sw  # (a Python float: beyond float64 it is inf, no warning)
+    if not math.isfinite(lam):
+        raise ValueError(
+            f"Expected `body` with the rate of its polhode within float64, got lambda = "
+            f"{float(prm[_fk.LAM])!r} x {sw!r} rad/s for omega {si.omega.tolist()}"
+        )
     if kind == 1:
         kk = float(prm[_fk.K])
         return FreeParameters(

@@ -84,7 +84,7 @@ from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
 from hamilton_orbits.validation import check_positive
 from rigid._kernels import euler as _euler_k
-from rigid._shared import pow2
+from rigid._shared import free_scale, pow2
 from rigid.body import call_units, check_body
 from rigid.drivers import METHODS, integrate_arrays
 from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
@@ -284,8 +284,10 @@ def integrate(
         not > 0, not increasing, naming the index and the value) or ``dt``, a
         missing ``dt``, more than 1e12 steps, ``tol`` with a fixed-step method,
         ``n_out`` not an integer in [2, 1e9], a plain ``dt`` beside a Quantity
-        ``t`` (or the reverse, or plain times for a body with units), or an
-        unsupported torque.
+        ``t`` (or the reverse, or plain times for a body with units), an
+        unsupported torque or one beyond float64 beside the moments, an angle
+        turned ``t |omega|`` beyond float64, or a run whose state leaves float64
+        (a step far too long for the method: naming ``dt``).
     astropy.units.UnitConversionError
         For a time of the wrong dimension, naming the argument.
 
@@ -323,21 +325,32 @@ def integrate(
     rtol_f, atol_f = _tolerances(tol, rtol, atol, si.omega)
     recentre = float(_scalar_positive("recentre", DIMENSIONLESS("recentre", recentre)))
     kind, params = encode_torque(torque)
-    # Euler's equations of a free body, and under the gravity gradient (a torque
-    # proportional to the moments), depend on the moments' ratios only: they run on
-    # the moments scaled by a power of two (exact: the same bits for every body whose
-    # moments are normal numbers; 1e-300 kg m^2 no longer underflows in the kernels)
-    homogeneous = kind in (_euler_k.TORQUE_NONE, _euler_k.TORQUE_GRAVITY_GRADIENT)
-    moments = si.moments / pow2(si.moments) if homogeneous else si.moments
+    moments, params, sw = _scaled_problem(si, kind, params, method, times, dtf)
     start = time.perf_counter()
-    t_f, q, w, steps, count, drift = integrate_arrays(
-        moments, si.attitude, si.omega, times, method=method, dt=dtf, n_out=n_out,
-        kind=kind, params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
-        progress=progress,
-    )
+    try:
+        # a value beyond float64 on the way leaves a non-finite result, refused below
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            t_f, q, w, steps, count, drift = integrate_arrays(
+                moments, si.attitude, si.omega / sw, times * sw, method=method,
+                dt=None if dtf is None else dtf * sw, n_out=n_out, kind=kind,
+                params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
+                progress=progress,
+            )
+    except ZeroDivisionError:  # a kernel's state left float64 (its norm 0 or inf)
+        raise _failed(method, dtf, "a division by zero in the kernel") from None
+    except ValueError as exc:  # the shared DOP853 driver: scipy's step size collapsed
+        if method != "dop853":  # pragma: no cover - the fixed-step drivers raise none
+            raise
+        raise _failed(method, dtf, str(exc)) from None
     wall = time.perf_counter() - start
-    _check_finite(t_f, q, w, method, dtf)
-    energy_error, am_error = integral_errors(si.moments, q, w)
+    t_f = t_f / sw
+    with np.errstate(over="ignore"):  # a rate beyond float64: refused by _check_finite
+        w = w * sw
+    _check_finite(t_f, q, w, method, dtf, drift)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        energy_error, am_error = integral_errors(si.moments, q, w)
+    if not (np.all(np.isfinite(energy_error)) and np.all(np.isfinite(am_error))):
+        raise _failed(method, dtf, "a change of the energy or of L beyond float64")
     t_unit = getattr(t, "unit", u.s) if quantity else u.s
     return RigidTrajectory(
         t=wrap(t_f / t_unit.to(u.s), t_unit, quantity), steps=int(steps), wall_time=wall,
@@ -349,7 +362,102 @@ def integrate(
     )
 
 
-def _check_finite(t: np.ndarray, q: np.ndarray, w: np.ndarray, method: str, dt: Any) -> None:
+def _scaled_problem(
+    si: Any, kind: int, params: np.ndarray, method: str, times: np.ndarray, dt: float | None
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """``(moments, params, sw)``: the run's moments, torque and rates scaled by powers of
+    two (exact: the same bits for every problem whose numbers stay normal).
+
+    Euler's equations ``I omega' = N - omega x I omega`` keep their solution when the
+    moments and the torque are scaled alike (the gravity gradient is proportional to
+    the moments already): the kernels see moments of order one, and 1e-300 kg m^2 no
+    longer underflows.  The motion is also homogeneous in the rates, ``omega(t; s
+    omega0) = s omega(s t; omega0)`` with the torque's rates scaled alike (GM/R^3 and a
+    constant torque by s^2, the mean motion by s): the kernels see ``omega / sw`` over
+    the times ``t sw`` (:func:`_rate_scale`), so 1e-200 rad/s no longer underflows in
+    Euler's equations (omega^2), nor 1e154 rad/s overflows.
+
+    Raises
+    ------
+    ValueError
+        If the torque is beyond float64 beside the moments (``torque``), or the angle
+        turned is (``t``).
+    """
+    sm = pow2(si.moments)
+    if kind in (_euler_k.TORQUE_BODY, _euler_k.TORQUE_SPACE):
+        with np.errstate(over="ignore"):
+            scaled = params / sm
+        if not np.all(np.isfinite(scaled)):
+            raise ValueError(f"Expected `torque` / the moments within float64, got torque "
+                             f"{params.tolist()} N m beside moments {si.moments.tolist()} "
+                             f"kg m^2")
+        params = scaled
+    moments = si.moments / sm
+    sw = _rate_scale(moments, si.omega, kind, params, method, times, dt)
+    if sw != 1.0:
+        params = params.copy()
+        if kind == _euler_k.TORQUE_GRAVITY_GRADIENT:
+            params[0] = params[0] / sw / sw  # GM / R^3, a rate squared
+            params[1] = params[1] / sw  # the mean motion
+        elif kind != _euler_k.TORQUE_NONE:
+            params[:3] = params[:3] / sw / sw  # N / I, a rate squared
+    return moments, params, sw
+
+
+def _rate_scale(moments: np.ndarray, omega: np.ndarray, kind: int, params: np.ndarray,
+                method: str, times: np.ndarray, dt: float | None) -> float:
+    """The power of two ``sw`` by which the kernels take the rates (1: unscaled).
+
+    The free body: :func:`rigid._shared.free_scale` (the largest rate in [1, 2),
+    smaller for a needle whose polhode would underflow); with a torque the largest of
+    ``|omega|``, ``sqrt(GM / R^3)``, ``n`` and ``sqrt(|N| / I)``.  The step stays a
+    normal number (a rate of 1e-300 rad/s over steps of 1e-300 s turns by 1e-600 rad:
+    the kernels then see smaller rates instead).  DOP853's step-size heuristics hold
+    absolute constants: its rates are scaled only beyond 2^-64 .. 2^64.
+
+    Raises
+    ------
+    ValueError
+        If ``t`` times ``|omega|`` or the torque's rate, the angle turned, is beyond
+        float64, naming ``t``.
+    """
+    if kind == _euler_k.TORQUE_NONE:
+        sw = free_scale(moments, omega, "`body`")
+    else:
+        rates = [float(np.max(np.abs(omega)))]
+        if kind == _euler_k.TORQUE_GRAVITY_GRADIENT:
+            rates += [math.sqrt(params[0]), abs(params[1])]
+        else:
+            rates.append(math.sqrt(np.max(np.abs(params[:3]))) / math.sqrt(np.min(moments)))
+        sw = pow2(np.array(rates))
+    if method not in _FIXED and 2.0**-64 <= sw <= 2.0**64:
+        return 1.0
+    t_end = float(times.max())
+    shortest = t_end if dt is None or method not in _FIXED else min(t_end, dt / 4.0)
+    floor = math.ldexp(1.0, -960) / shortest  # no step of a fixed-step run is below dt / 4
+    if sw < floor:
+        sw = 2.0 * pow2(np.array([floor]))
+    rate = max(pow2(omega), sw)  # |omega|, or the torque's rate where that is faster
+    if not math.isfinite(t_end * rate):
+        raise ValueError(f"Expected `t` * |omega| to be finite (the angle turned), got "
+                         f"t = {t_end!r} s with |omega| (or the torque's rate) ~ {rate!r} "
+                         f"rad/s")
+    return sw
+
+
+def _failed(method: str, dt: Any, what: str) -> ValueError:
+    """The refusal of a run whose state left float64 (a step far too long)."""
+    if method == "dop853":
+        return ValueError(f"Expected `tol` and `dt` within DOP853's reach, got {what}")
+    if method == "exact_kick":  # its drift is the exact flow: a state beyond its range
+        return ValueError(f"Expected `body` and `torque` within the range of the exact free "
+                          f"flow of method 'exact_kick' (dt = {dt!r} s), got {what}")
+    return ValueError(f"Expected `dt` small enough for a representable solution, got {what} "
+                      f"with method {method!r} and dt = {dt!r} s")
+
+
+def _check_finite(t: np.ndarray, q: np.ndarray, w: np.ndarray, method: str, dt: Any,
+                  drift: float) -> None:
     bad = ~(np.isfinite(q).all(axis=-1) & np.isfinite(w).all(axis=-1))
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])
@@ -357,3 +465,5 @@ def _check_finite(t: np.ndarray, q: np.ndarray, w: np.ndarray, method: str, dt: 
             f"Expected `dt` small enough for a finite solution, got a non-finite state at "
             f"t = {float(t[k])!r} s with method {method!r} and dt = {dt!r} s"
         )
+    if not math.isfinite(drift):
+        raise _failed(method, dt, "|q| beyond float64 (its norm drift)")

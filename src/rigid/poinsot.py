@@ -103,7 +103,7 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     t_given = np.array(t.value, dtype=np.float64) if isinstance(t, u.Quantity) else t_s
     flat = np.ascontiguousarray(t_s.reshape(-1))
     si = body.si
-    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t")
+    q, w = free_flow_scaled(si.moments, si.attitude, si.omega, flat, "t", "`body`")
     # rho = omega / sqrt(2T) on moments / sm and omega / sw (no under- or overflow):
     # rho = (omega / sw) / sqrt(2T / (sm sw^2)) / sqrt(sm)
     sm, sw = si.scales()

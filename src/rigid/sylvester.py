@@ -18,7 +18,7 @@ import numpy as np
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import ANGULAR_SPEED, TIME, Kind, wrap
 from rigid._kernels import free as _fk
-from rigid._shared import pow2
+from rigid._shared import free_scale, free_setup_scaled, pow2
 from rigid.body import RigidBody, call_units, check_body, check_moments
 
 __all__ = ["confocal", "confocal_rotation", "contrafocal", "disk_equivalent", "time_between"]
@@ -37,6 +37,29 @@ def _lam(body: RigidBody, lam: Any, extra: tuple[tuple[str, Any], ...] = ()) -> 
     if value.shape != ():
         raise ValueError(f"Expected `lam` to be a scalar, got shape {value.shape}")
     return float(value), quantity
+
+
+def _reciprocals(moments: np.ndarray, lam: float, sign: float) -> np.ndarray:
+    """``1/A + lam`` (``sign`` +1, confocal) or ``lam - 1/A`` (``sign`` -1, contrafocal).
+
+    Raises
+    ------
+    ValueError
+        If a reciprocal moment (``1/A`` or the sum) is beyond float64 (positive),
+        naming ``lam``, the index and the values.
+    """
+    with np.errstate(over="ignore"):  # beyond float64: refused below (-inf: not positive)
+        inv = 1.0 / moments
+        recip = inv + lam if sign > 0.0 else lam - inv
+    bad = recip == np.inf
+    if np.any(bad):
+        k = int(np.argwhere(bad)[0][0])
+        raise ValueError(
+            f"Expected `lam` to keep the reciprocal moments within float64, got 1/A'[{k}] ="
+            f" {'1/A + lam' if sign > 0.0 else 'lam - 1/A'} beyond it at index {k}, with "
+            f"A = {float(moments[k])!r} and lam = {lam!r}"
+        )
+    return recip
 
 
 def _related(body: RigidBody, recip: np.ndarray, ell: np.ndarray, quantity: bool) -> RigidBody:
@@ -87,8 +110,9 @@ def confocal(body: RigidBody, lam: Any) -> RigidBody:
     Raises
     ------
     ValueError
-        If a reciprocal moment becomes non-positive, or the new moments break
-        the triangle inequality (not a realisable body).
+        If a reciprocal moment becomes non-positive or leaves float64 (``1/A + lam``
+        beyond 1.8e308), or the new moments break the triangle inequality (not a
+        realisable body); the same for :func:`contrafocal`.
 
     Notes
     -----
@@ -106,7 +130,8 @@ def confocal(body: RigidBody, lam: Any) -> RigidBody:
     body = check_body(body)
     lam, quantity = _lam(body, lam)
     si = body.si
-    return _related(body, 1.0 / si.moments + lam, si.angular_momentum_body, quantity)
+    return _related(body, _reciprocals(si.moments, lam, 1.0), si.angular_momentum_body,
+                    quantity)
 
 
 def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
@@ -135,7 +160,8 @@ def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
     body = check_body(body)
     lam, quantity = _lam(body, lam)
     si = body.si
-    return _related(body, lam - 1.0 / si.moments, -si.angular_momentum_body, quantity)
+    return _related(body, _reciprocals(si.moments, lam, -1.0), -si.angular_momentum_body,
+                    quantity)
 
 
 def confocal_rotation(body: RigidBody, lam: Any, t: Any) -> Quaternion:
@@ -171,8 +197,10 @@ def confocal_rotation(body: RigidBody, lam: Any, t: Any) -> Quaternion:
     if big == 0.0:
         return Quaternion(np.broadcast_to([1.0, 0.0, 0.0, 0.0], t_s.shape + (4,)).copy())
     norm = big * float(np.linalg.norm(ell / big))
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):
         angle = lam_f * norm * t_s
+    # NaN only as inf x 0: lam |L| beyond float64 at t = 0, where the angle is 0
+    angle = np.where(np.isnan(angle), 0.0, angle)
     bad = ~np.isfinite(angle)
     if np.any(bad):
         idx = tuple(int(i) for i in np.argwhere(np.atleast_1d(bad))[0]) if t_s.ndim else ()
@@ -261,8 +289,10 @@ def disk_equivalent(body: RigidBody) -> tuple[RigidBody, str, Any, Any]:
         disk_moments = (1.0 / recip) * sm
         lam = lam_s / sm
         delta = lam_s * (sign * 2.0 * t2 + lam_s * ell2) * sw * sw
+    # lam = 0 from a lam_s != 0 is an underflow; lam_s = 0 is a body that is a disk
+    # already (C = A + B in floats): its own disk equivalent, confocal with lam = 0
     if not (np.all(np.isfinite(disk_moments)) and np.isfinite(lam) and np.isfinite(delta)
-            and lam != 0.0):
+            and (lam != 0.0 or lam_s == 0.0)):
         raise ValueError(
             f"Expected `body` to have a disk equivalent within float64, got moments "
             f"{si.moments.tolist()} and omega {si.omega.tolist()}"
@@ -318,18 +348,22 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     sm = pow2(body.si.moments)
     sw = max(pow2(w1), pow2(w2))
     mom = body.si.moments / sm
-    w1 = w1 / sw
-    w2 = w2 / sw
-    e1, e2 = np.sum(mom * w1 * w1), np.sum(mom * w2 * w2)
-    l1, l2 = np.sum((mom * w1) ** 2), np.sum((mom * w2) ** 2)
+    w1s = w1 / sw
+    w2s = w2 / sw
+    e1, e2 = np.sum(mom * w1s * w1s), np.sum(mom * w2s * w2s)
+    l1, l2 = np.sum((mom * w1s) ** 2), np.sum((mom * w2s) ** 2)
     if abs(e1 - e2) > 1e-10 * e1 or abs(l1 - l2) > 1e-10 * l1:
         raise ValueError(
             f"Expected `omega2` on the polhode of `omega1` (same T and |L|), got 2T = {e2!r}"
             f" vs {e1!r} and L^2 = {l2!r} vs {l1!r}"
         )
+    # one scale for both states (the kernel's rates and phases must compare), lifted
+    # when a thin body needs larger rates than max|omega| / sw (see free_scale)
+    sw *= min(free_scale(body.si.moments, w, f"`{n}`") / pow2(w)
+              for n, w in (("omega1", w1), ("omega2", w2)))
     q = np.array([1.0, 0.0, 0.0, 0.0])
-    p1 = _fk.free_setup(mom, q, np.ascontiguousarray(w1))
-    p2 = _fk.free_setup(mom, q, np.ascontiguousarray(w2))
+    p1, _ = free_setup_scaled(body.si.moments, q, w1, "`omega1`", sw)
+    p2, _ = free_setup_scaled(body.si.moments, q, w2, "`omega2`", sw)
     kind = p1[_fk.KIND]
     if kind == 0.0:
         raise ValueError(

@@ -8,7 +8,7 @@ import astropy.units as u
 import mpmath
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk, elliprf, elliprj
@@ -262,6 +262,9 @@ def test_sphere_and_steady_rotations():
     st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3),
     st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4),
 )
+@example([1.0, 1.0, 0.5], [0.0, 0.0, 5.229002104183297e-162], [0.0, 0.0, 0.0, 1.0])
+@example([1.0, 1.0, 1.0], [0.0, 0.0, 3.4233491821067394e-156], [0.0, 0.0, 0.0, 1.0])
+@example([1.0, 1.5, 2.0], [1e-320, 2e-320, 0.0], [0.5, 0.5, 0.5, 0.5])  # subnormal omega
 def test_invariants_to_a_few_ulp(moments, w0, q0):
     moments = np.array(moments)
     assume(moments.max() <= moments.sum() - moments.max() and np.linalg.norm(q0) >= 0.1)
@@ -271,13 +274,22 @@ def test_invariants_to_a_few_ulp(moments, w0, q0):
     att, w = free_motion(body, t)
     qa = att.as_array()
     np.testing.assert_allclose(np.linalg.norm(qa, axis=-1), 1.0, atol=4 * EPS)
-    energy = 0.5 * np.sum(moments * w * w, axis=-1)
-    assert np.all(np.abs(energy - body.kinetic_energy) <= 16 * EPS * body.kinetic_energy)
-    l_space = att.rotate(moments * w)
-    lnorm = body.angular_momentum_norm
-    assert np.all(np.abs(l_space - body.angular_momentum_space) <= 32 * EPS * lnorm)
+    # The integrals on omega / s, s the power of two above max|omega0| (exact): for a
+    # tiny omega0 (hypothesis drew 5.2e-162) omega^2 underflowed, and with it a
+    # tolerance relative to T.  Below 2.2e-308 omega itself lies on the subnormal grid
+    # 2^-1074 (2^-1074 / s after scaling): a floor for that rounding of the result.
+    s = 2.0 ** float(np.frexp(np.abs(w0).max())[1]) if np.any(w0) else 1.0
+    grid = 2.0**-1074 / s
+    ws, w0s = w / s, w0 / s
+    energy = 0.5 * np.sum(moments * ws * ws, axis=-1)
+    e0 = 0.5 * np.sum(moments * w0s * w0s)
+    assert np.all(np.abs(energy - e0) <= 16 * EPS * e0 + 8 * moments.max() * grid)
+    l_space = att.rotate(moments * ws)
+    l0 = body.attitude.rotate(moments * w0s)
+    lnorm = np.linalg.norm(moments * w0s)
+    assert np.all(np.abs(l_space - l0) <= 32 * EPS * lnorm + 4 * moments.max() * grid)
     # The initial state is reproduced.
-    np.testing.assert_allclose(w[0], w0, rtol=0, atol=8 * EPS * np.abs(w0).max())
+    np.testing.assert_allclose(ws[0], w0s, rtol=0, atol=8 * EPS * np.abs(w0s).max() + grid)
     assert qdist(qa[0], body.attitude.as_array()) <= 8 * EPS
 
 
@@ -427,6 +439,45 @@ def test_thin_symmetric_body_against_closed_form(moments, t):
                                     (Quaternion(q0) * Quaternion(qp)).as_array(), w0, t)
     qref = _mp_qmul(qref, [qp[0], -qp[1], -qp[2], -qp[3]])
     assert _mp_angle(qref, q[0]) <= 4 * EPS * (1.0 + angle)
+
+
+@pytest.mark.parametrize(("a", "c", "w0"), [
+    # the property test's reproducer (moments 1e-12, 1e-12 and 1.9e-114 about the axis,
+    # omega (0, 1, 1.9e-114)), axes relabelled cyclically so that the needle's axis is
+    # the third: C w3^2 (A - C) = 7e-342 underflowed, the kernel divided by zero
+    (1e-12, 1.914711231811873e-114, [0.0, 1.0, 1.914711231811873e-114]),
+    (1.0, 1e-60, [1.0, 0.5, 1e-130]),  # 1e-320: subnormal, the motion silently wrong
+    (1.0, 1e-150, [0.6, -0.8, 1.1e-150]),  # the thinnest body at the slowest axial spin
+])
+@pytest.mark.parametrize("t", [1.0, 1e3, 1e9])
+def test_needle_with_a_slow_axial_spin_against_closed_form(a, c, w0, t):
+    # A needle (C / A down to 1e-150) tumbling at ~1 rad/s and spinning about its axis
+    # at 1e-130 of that: the kernel's polhode terms J w^2 (J' - J) of the axial spin
+    # fall below float64's normal range, so it now takes the rates 2^53 .. 2^268 times
+    # larger (exact: the motion is homogeneous in the rates).  The reference is Euler's
+    # symmetric top in 50 digits; the bound is a few eps times the angle turned.
+    q0 = [0.9, 0.1, -0.3, 0.2]
+    q, w = free_motion_arrays([a, a, c], q0, w0, [t])
+    qref, angle = _mp_symmetric_top(a, c, q0, w0, t)
+    assert _mp_angle(qref, q[0]) <= 4 * EPS * (1.0 + angle)
+    # the body-frame omega: the transverse part turns at nu = w3 (1 - C / A) about the
+    # axis, w3 constant (to eps of |omega|; the axial angle nu t is tiny up to t = 1e9)
+    nu = w0[2] * (1.0 - c / a)
+    ref = Quaternion.from_axis_angle([0.0, 0.0, 1.0], -nu * t).rotate(w0)
+    np.testing.assert_allclose(w[0], ref, rtol=0, atol=4 * EPS * np.abs(w0).max())
+    assert w[0][2] == w0[2]
+
+
+def test_needle_axial_spin_over_its_own_period():
+    # The slow axial rotation of the needle above, over times where it turns by radians:
+    # omega_W in the body frame against the closed form, to eps times the angle nu t.
+    a, c, w0 = 1.0, 1e-60, np.array([1.0, 0.5, 1e-130])
+    nu = w0[2] * (1.0 - c / a)
+    t = np.array([0.5, 2.0, 7.0]) / nu
+    _, w = free_motion_arrays([a, a, c], [1.0, 0.0, 0.0, 0.0], w0, t)
+    for ti, wi in zip(t, w, strict=True):
+        ref = Quaternion.from_axis_angle([0.0, 0.0, 1.0], -nu * ti).rotate(w0)
+        np.testing.assert_allclose(wi, ref, rtol=0, atol=8 * EPS * (1.0 + nu * ti))
 
 
 @pytest.mark.parametrize("c", [1e-6, 0.5, 1.9])

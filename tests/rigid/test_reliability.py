@@ -14,7 +14,7 @@ import warnings
 import astropy.units as u
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import rigid
@@ -185,6 +185,50 @@ def test_extreme_moments_scale_out(scale):
     np.testing.assert_allclose(w, ref_w, rtol=0, atol=tol)
     np.testing.assert_allclose(att.as_array(), ref_q, rtol=0, atol=tol)
     assert np.isfinite(body.kinetic_energy) and body.kinetic_energy > 0.0
+
+
+INTEGRATE_METHODS = ["splitting2", "splitting4", "exact_kick", "rk4", "cayley_rk4", "dop853"]
+
+
+@pytest.mark.parametrize("method", INTEGRATE_METHODS)
+@pytest.mark.parametrize("s", [2.0**-660, 2.0**-500, 2.0**500])
+def test_integrate_is_homogeneous_in_the_rates(method, s):
+    # omega(t; s omega0) = s omega(s t; omega0), the gravity gradient's GM/R^3 by s^2 and
+    # its mean motion by s: integrate scales the rates by powers of two before the
+    # kernels, so the run on 2^-660 rad/s (Euler's equations underflowed: exact_kick
+    # divided by zero) and on 2^500 rad/s (overflowed) is the unit run bit for bit.
+    # (The gravity gradient where GM/R^3 s^2 is a normal number: s >= 2^-511.)
+    t = np.linspace(0.0, 10.0, 5)
+    cases = [(None, None)]
+    if s >= 2.0**-511:
+        cases.append((GravityGradientTorque(0.5, mean_motion=0.1),
+                      GravityGradientTorque(0.5 * s * s, mean_motion=0.1 * s)))
+    for torque, scaled in cases:
+        ref = integrate(RigidBody([1.0, 2.0, 3.0], Q0, [1.0, 0.3, 0.8]), t, dt=0.01,
+                        method=method, torque=torque)
+        got = integrate(RigidBody([1.0, 2.0, 3.0], Q0, np.array([1.0, 0.3, 0.8]) * s), t / s,
+                        dt=0.01 / s, method=method, torque=scaled)
+        np.testing.assert_array_equal(got.omega / s, ref.omega)
+        np.testing.assert_array_equal(got.attitude.as_array(), ref.attitude.as_array())
+
+
+@pytest.mark.parametrize("method", INTEGRATE_METHODS)
+@pytest.mark.parametrize("s", [2.0**-1000, 2.0**1000])
+def test_integrate_is_homogeneous_in_the_moments(method, s):
+    # I omega' = N - omega x I omega is homogeneous in (I, N): moments 2^-1000 with the
+    # torque 2^-1000 times as large run as the unit body, bit for bit, for a body- and
+    # a space-fixed torque and the gravity gradient (which does not depend on I's scale).
+    t = np.linspace(0.0, 10.0, 5)
+    n = np.array([0.1, 0.0, 0.2])
+    for torque, scaled in ((BodyTorque(n), BodyTorque(n * s)),
+                           (SpaceTorque(n), SpaceTorque(n * s)),
+                           (GravityGradientTorque(0.5), GravityGradientTorque(0.5))):
+        ref = integrate(RigidBody([1.0, 2.0, 3.0], Q0, [1.0, 0.3, 0.8]), t, dt=0.01,
+                        method=method, torque=torque)
+        got = integrate(RigidBody(np.array([1.0, 2.0, 3.0]) * s, Q0, [1.0, 0.3, 0.8]), t,
+                        dt=0.01, method=method, torque=scaled)
+        np.testing.assert_array_equal(got.omega, ref.omega)
+        np.testing.assert_array_equal(got.attitude.as_array(), ref.attitude.as_array())
 
 
 @pytest.mark.parametrize(
@@ -362,6 +406,64 @@ def test_any_unit_of_the_right_dimension_works():
     np.testing.assert_array_equal(gg.encode()[1], gr.encode()[1])
 
 
+# --- found by the property test on extreme inputs (issue 32) --------------------------------
+
+TINY_SPHERE = ([1e-300] * 3, [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("method", ["splitting2", "splitting4", "exact_kick", "rk4",
+                                    "cayley_rk4"])
+def test_step_far_too_long_on_tiny_moments(method):
+    # Hypothesis' reproducer: moments 1e-300, h |omega| = 1.9e10 with rk4 overflowed
+    # in |q|^2 (RuntimeWarning in drivers._run_fixed).  A sphere keeps omega exactly,
+    # and its motion does not depend on the moments: the run on 1e-300 equals the run
+    # on 1 bit for bit, attitudes of unit norm.
+    t = np.linspace(0.0, 7.6e10, 3)
+    tiny = integrate(RigidBody(*TINY_SPHERE), t, dt=1.9e10, method=method)
+    unit = integrate(RigidBody([1.0] * 3, *TINY_SPHERE[1:]), t, dt=1.9e10, method=method)
+    np.testing.assert_array_equal(tiny.omega, [[0.0, 0.0, 1.0]] * 3)
+    np.testing.assert_array_equal(tiny.attitude.as_array(), unit.attitude.as_array())
+    np.testing.assert_allclose(np.linalg.norm(tiny.attitude.as_array(), axis=-1), 1.0,
+                               rtol=0, atol=4 * EPS)
+
+
+@pytest.mark.parametrize("method", ["rk4", "cayley_rk4"])
+@pytest.mark.parametrize("torque", [None, GravityGradientTorque(1.0)])
+def test_step_far_too_long_for_a_finite_state_names_dt(method, torque):
+    # An asymmetric body at h |omega| = 1e5: the Runge-Kutta state leaves float64 (or
+    # Cayley's re-centring divides by zero): a ValueError naming `dt`, not a warning.
+    body = RigidBody([1e-300, 2e-300, 3e-300], Q0, [1.0, 0.3, 0.8])
+    with pytest.raises(ValueError, match=r"Expected `dt` small enough for a (finite|repre"
+                                         r"sentable) solution, got .* dt = 100000.0 s"):
+        integrate(body, np.linspace(0.0, 4e5, 3), dt=1e5, method=method, torque=torque)
+
+
+def test_confocal_bodies_at_the_end_of_float64():
+    # Hypothesis' reproducer: confocal(body, 1.797e308) and contrafocal(body, -1.797e308)
+    # with moments 1e-300 warned of an overflow in 1/A + lam.  1/A' = 1/A + lam is now
+    # refused beyond float64 naming `lam`, the index and the values; below it, the body
+    # is finite (its moments subnormal, ~5.6e-309, to 2^-1074).
+    body = RigidBody([1e-300, 2e-300, 3e-300], Q0, [1.0, 0.3, 0.8])
+    big = np.finfo(float).max
+    with pytest.raises(ValueError, match=r"Expected `lam` to keep the reciprocal moments "
+                                         r"within float64, got 1/A'\[0\] = 1/A \+ lam beyond "
+                                         r"it at index 0, with A = 1e-300 and lam = 1.79769"):
+        confocal(body, big)
+    for f, lam in ((confocal, -big), (confocal, -1.797e308), (contrafocal, -1.797e308)):
+        with pytest.raises(ValueError, match=r"Expected `lam` to leave every reciprocal "
+                                             r"moment positive, got 1/A'\[0\] = -1.79"):
+            f(body, lam)
+    cb = confocal(body, 1.797e308)
+    recip = 1.0 / body.moments + 1.797e308
+    np.testing.assert_allclose(cb.moments, 1.0 / recip, rtol=0, atol=4 * 2.0**-1074)
+    np.testing.assert_allclose(cb.angular_momentum_body, body.angular_momentum_body,
+                               rtol=4 * EPS)
+    assert np.all(np.isfinite(cb.omega))
+    assert np.all(np.isfinite(contrafocal(body, 1.797e308).omega))
+    # at t = 0 the confocal rotation is the identity, whatever lam |L|
+    assert confocal_rotation(body, big, 0.0).as_array().tolist() == [1.0, 0.0, 0.0, 0.0]
+
+
 # --- the contract, as a property -------------------------------------------------------------
 
 NAMES = ("inertia", "omega", "attitude", "body", "t", "moments", "q0", "omega0", "lam",
@@ -395,6 +497,10 @@ def _check(call):
 
 
 @settings(deadline=None, max_examples=150)
+@example(moments=TINY_SPHERE[0], attitude=TINY_SPHERE[1], omega=TINY_SPHERE[2], t=7.6e10,
+         lam=1.797e308, method="rk4")
+@example(moments=TINY_SPHERE[0], attitude=TINY_SPHERE[1], omega=TINY_SPHERE[2], t=7.6e10,
+         lam=-1.797e308, method="cayley_rk4")
 @given(moments=vec3, attitude=vec4, omega=vec3, t=value, lam=value,
        method=st.sampled_from(["splitting2", "splitting4", "exact_kick", "rk4", "cayley_rk4"]))
 def test_public_api_contract(moments, attitude, omega, t, lam, method):

@@ -106,6 +106,27 @@ def test_disk_theorem(omega):
                                sgn * _axes_cosines(att, body.invariable_plane), atol=1e-13)
 
 
+@pytest.mark.parametrize("moments", [
+    [542514.1220844062, 815675.8214228445, 1358189.9435072506],  # C = A + B in floats
+    [1.0, 1.5, 2.5],
+])
+def test_disk_equivalent_of_a_disk_is_itself(moments):
+    # A body already flat: Sylvester's root lam is 0 (or a rounding of it, 1e-16).
+    # Where it came out exactly 0 the disk was refused as "beyond float64" while its
+    # neighbour with lam = -1.1e-16 was returned: now both are the body itself, confocal.
+    body = RigidBody(moments, [0.8, 0.2, -0.4, 0.4], [7.3e-8, 7.0e-6, -4.2e-6])
+    disk, rel, lam, delta = disk_equivalent(body)
+    assert rel == "confocal"
+    assert abs(lam) <= 4 * EPS / min(moments)
+    np.testing.assert_allclose(disk.moments, body.moments, rtol=4 * EPS)
+    np.testing.assert_allclose(disk.omega, body.omega, rtol=4 * EPS)
+    assert abs(delta) <= 8 * EPS * np.sum(body.omega**2)
+    if lam == 0.0:  # the exact root: the very same body
+        np.testing.assert_array_equal(disk.moments, body.moments)
+        np.testing.assert_array_equal(disk.omega, body.omega)
+        assert delta == 0.0
+
+
 def test_time_between_positions():
     body = BODY
     period = free_parameters(body).period
