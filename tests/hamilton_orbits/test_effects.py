@@ -265,8 +265,11 @@ def test_effects_that_exclude_each_other():
     assert [k for k, _ in fx.exclusion_problems(["gr_potential", "eih", "gr"])] == [1, 2]
     fx.register(fx.EffectSpec("ex_a", "test-excl", "a", excludes={"ex_b": "b's terms"}))
     fx.register(fx.EffectSpec("ex_b", "test-excl", "b"))
-    assert fx.exclusion_problems(["ex_b", "ex_a"], "test-excl") == [
-        (1, "effect 'ex_b' (at index 0) is refused beside 'ex_a' (at index 1): 'ex_a' already "
-            "computes b's terms, which would count twice; list one of them")]
-    with pytest.raises(ValueError, match=r"^Effect 'ex_b' \(at index 0\) is refused"):
-        fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")
+    try:
+        assert fx.exclusion_problems(["ex_b", "ex_a"], "test-excl") == [
+            (1, "effect 'ex_b' (at index 0) is refused beside 'ex_a' (at index 1): 'ex_a' "
+                "already computes b's terms, which would count twice; list one of them")]
+        with pytest.raises(ValueError, match=r"^Effect 'ex_b' \(at index 0\) is refused"):
+            fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")
+    finally:  # the registry is the process's: leave no kind behind for later tests
+        fx.registry._REGISTRY.pop("test-excl", None)
