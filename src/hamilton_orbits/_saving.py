@@ -98,7 +98,8 @@ class Saving:
         if self._resumable is None:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder")
-        times, rows, info = self._resumable
+        folder, info, upto = self._resumable  # the leg's rows read now, not at load
+        times, rows = leg_rows(snapshot_files(folder), info["start"], upto)
         prop = self._prop
         rest = times[times > prop.t]
         out, compiled = None, 0.0
@@ -167,8 +168,7 @@ class Saving:
             sim._archive.last_steps = sim.steps
         leg = meta.get("leg")
         if folder is not None and leg is not None:  # the leg a kill interrupted
-            times, rows = leg_rows(snapshot_files(folder), leg["start"], meta["number"])
-            sim._resumable = (times, rows, leg)
+            sim._resumable = (folder, leg, meta["number"])
             sim._leg = LegRows(leg)
         return sim
 
