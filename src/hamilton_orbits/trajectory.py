@@ -244,6 +244,14 @@ class Trajectory(TrajectoryBase):
         """The row of :attr:`events` of the event that ended the run, or None."""
         return self._tables[1]
 
+    def plot(self, plane: str = "xy", ax: Any = None) -> Any:
+        """Every body's path about the primary, its start (with the direction of
+        motion) and its end: a matplotlib Figure
+        (:func:`hamilton_orbits.trajectory_plot.plot_trajectory`)."""
+        from hamilton_orbits.trajectory_plot import plot_trajectory
+
+        return plot_trajectory(self, plane, ax)
+
     def __repr__(self) -> str:
         return (
             f"Trajectory({len(self.names)} bodies, {len(self.r)} outputs, "

@@ -1,0 +1,108 @@
+"""The figure of a :class:`~hamilton_orbits.trajectory.Trajectory`: every body's
+path about the primary (:func:`plot_trajectory`, ``Trajectory.plot()``).
+
+What it draws: each body's positions relative to the primary (the most massive
+body at the end of the run) in the chosen plane, a line through the outputs (dots
+when they are too sparse for a line to follow the orbit), an open circle where
+the body starts with an arrow along its first motion, a filled dot where it ends,
+and the primary as a cross at the origin.  Every axis names its origin and unit
+(au for a Quantity system, the system's own length unit otherwise); the aspect is
+equal, so that a circle looks like one; the legend is placed outside the axes
+when there are more than a few bodies.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["plot_trajectory"]
+
+_PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
+
+
+def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
+    """Draw ``traj``'s paths about its primary; returns the matplotlib Figure.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    plane : {"xy", "xz", "yz"}
+        The coordinate plane drawn.
+    ax : matplotlib Axes, optional
+        Draw into these axes (default: a new figure).
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``plane``.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from hamilton_orbits import Body, System, integrate
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+    ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    >>> fig = integrate(s, np.linspace(0, 2 * np.pi, 100)).plot()
+    >>> fig.axes[0].get_xlabel()
+    'x from sun'
+    """
+    import matplotlib.pyplot as plt
+
+    if plane not in _PLANES:
+        raise ValueError(f"Expected `plane` to be one of {sorted(_PLANES)}, got {plane!r}")
+    i, j = _PLANES[plane]
+    r = np.asarray(getattr(traj.r, "value", traj.r))
+    unit = traj.r.unit.to_string() if hasattr(traj.r, "unit") else None
+    v = np.asarray(getattr(traj.v, "value", traj.v))
+    primary = _primary(traj)
+    rel = r - r[:, primary:primary + 1]
+    vel = v[0] - v[0, primary]
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.5, 6))
+    else:
+        fig = ax.figure
+    for k, name in enumerate(traj.names):
+        if k != primary:
+            _path(ax, rel[:, k, i], rel[:, k, j], (vel[k, i], vel[k, j]), name)
+    ax.plot([0.0], [0.0], "k+", ms=10, mew=1.5, label=f"{traj.names[primary]} (primary)")
+    suffix = "" if unit is None else f" [{unit}]"
+    ax.set_xlabel(f"{'xyz'[i]} from {traj.names[primary]}{suffix}")
+    ax.set_ylabel(f"{'xyz'[j]} from {traj.names[primary]}{suffix}")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title(f"{traj.method}: paths about {traj.names[primary]} "
+                 f"(open circle: start; dot: end)", fontsize=10)
+    if len(traj.names) > 5:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+    else:
+        ax.legend(loc="best", fontsize=8)
+    return fig
+
+
+def _primary(traj: Any) -> int:
+    """The index of the most massive body at the end of the run."""
+    gm = np.atleast_1d(traj.final.as_arrays().gm)
+    return int(traj.names.index(traj.final.names[int(np.argmax(gm))]))
+
+
+def _path(ax: Any, x: np.ndarray, y: np.ndarray, v0: tuple[float, float], name: str) -> None:
+    """One body's path: a line (dots when the outputs are sparse), its start with an
+    arrow along its velocity there, and its end."""
+    ok = np.isfinite(x) & np.isfinite(y)  # a body an event took out ends there
+    x, y = x[ok], y[ok]
+    if x.size == 0:
+        return
+    steps = np.hypot(np.diff(x), np.diff(y))
+    extent = max(float(np.ptp(x)), float(np.ptp(y)), float(np.hypot(x[0], y[0])), 1e-300)
+    sparse = steps.size > 0 and float(np.median(steps)) > 0.2 * extent
+    (line,) = ax.plot(x, y, "." if sparse else "-", lw=0.9, ms=3, label=name)
+    color = line.get_color()
+    ax.plot(x[0], y[0], "o", mfc="none", mec=color, ms=7)
+    ax.plot(x[-1], y[-1], "o", color=color, ms=4)
+    speed = float(np.hypot(*v0))
+    if speed > 0 and np.isfinite(speed):  # the direction of motion at the start
+        d = 0.12 * extent / speed
+        ax.annotate("", xy=(x[0] + v0[0] * d, y[0] + v0[1] * d), xytext=(x[0], y[0]),
+                    arrowprops={"arrowstyle": "->", "color": color, "lw": 1.2})

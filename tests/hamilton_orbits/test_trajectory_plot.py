@@ -1,0 +1,82 @@
+"""Trajectory.plot: every body's path about the primary, its start with the direction
+of motion, its end; axes with origin and unit; the legend off the data."""
+
+from __future__ import annotations
+
+import astropy.units as u
+import matplotlib
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, System, integrate
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # (after the backend is chosen)
+
+
+def _lines(ax, label):
+    return [ln for ln in ax.lines if ln.get_label() == label]
+
+
+def test_paths_about_the_primary_with_units_start_direction_and_end():
+    s = System.solar_system("J2000", bodies=["sun", "earth", "mars"])
+    traj = integrate(s, np.linspace(0, 2, 200) * u.yr)
+    fig = traj.plot()
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "x from sun [AU]" and ax.get_ylabel() == "y from sun [AU]"
+    rel = (traj.r - traj.r[:, :1]).to_value(u.au)
+    for k, name in ((1, "earth"), (2, "mars")):
+        (path,) = _lines(ax, name)
+        np.testing.assert_array_equal(path.get_xdata(), rel[:, k, 0])  # every output
+        np.testing.assert_array_equal(path.get_ydata(), rel[:, k, 1])
+    starts = [ln for ln in ax.lines
+              if ln.get_marker() == "o" and ln.get_markerfacecolor() == "none"]
+    assert sorted((float(ln.get_xdata()[0]), float(ln.get_ydata()[0])) for ln in starts) == \
+        sorted((float(rel[0, k, 0]), float(rel[0, k, 1])) for k in (1, 2))
+    # the arrows point along each body's velocity relative to the sun at the start
+    vel = (traj.v[0] - traj.v[0, 0]).to_value(u.au / u.d)
+    arrows = sorted(ax.texts, key=lambda a: a.xyann[0])
+    assert len(arrows) == 2
+    for arrow in arrows:
+        k = 1 if np.isclose(arrow.xyann[0], rel[0, 1, 0]) else 2
+        d = np.subtract(arrow.xy, arrow.xyann)
+        cos = d @ vel[k, :2] / np.linalg.norm(d) / np.linalg.norm(vel[k, :2])
+        assert cos > 1 - 1e-12
+    (sun,) = _lines(ax, "sun (primary)")
+    assert sun.get_xdata()[0] == sun.get_ydata()[0] == 0.0
+    plt.close(fig)
+
+
+def test_many_bodies_put_the_legend_outside_the_axes():
+    s = System.solar_system("J2000")
+    fig = integrate(s, np.linspace(0, 1, 50) * u.yr, method="wh", dt=2 * u.day).plot()
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    legend = ax.get_legend().get_window_extent()
+    assert legend.x0 >= ax.get_window_extent().x1  # not over the data
+    plt.close(fig)
+
+
+def test_a_plane_is_chosen_and_a_bad_one_named():
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 0.6, 0.8])])
+    traj = integrate(s, np.linspace(0, 3, 60))
+    fig = traj.plot(plane="xz")
+    assert fig.axes[0].get_ylabel() == "z from sun"  # plain floats: no unit to name
+    np.testing.assert_array_equal(_lines(fig.axes[0], "p")[0].get_ydata(),
+                                  traj.r[:, 1, 2] - traj.r[:, 0, 2])
+    plt.close(fig)
+    with pytest.raises(ValueError, match=r"Expected `plane` to be one of \['xy', 'xz', 'yz'\], "
+                                         r"got 'xw'"):
+        traj.plot(plane="xw")
+
+
+def test_a_body_an_event_took_out_ends_where_it_left():
+    s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("b", 1e-3, [2.0, 0, 0], [0, 1.2, 0])])
+    traj = integrate(s, np.linspace(0, 20, 200),
+                     events=[{"name": "escape", "distance": 4.0, "action": "remove"}])
+    fig = traj.plot()
+    (path,) = _lines(fig.axes[0], "b")
+    assert 0 < len(path.get_xdata()) < 200 and np.isfinite(path.get_xdata()).all()
+    plt.close(fig)
