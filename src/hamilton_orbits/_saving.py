@@ -230,7 +230,8 @@ class Saving:
                     "first_event": 0 if prop.events is None else len(prop.events.recorded())}
             self._leg = LegRows(info, times)
             self._leg.add(prop.t, prop.r, prop.v, prop.variational)
-            arch.write(*self._record(self._leg))
+            if arch.path is not None:
+                arch.write(*self._record(self._leg))
         except BaseException:
             arch.close()
             raise
@@ -254,7 +255,7 @@ class Saving:
                 return
             if asked[i] and rows is not None:
                 rows.add(prop.t, prop.r, prop.v, prop.variational)
-            if scheduled[i] or arch.due(prop.steps):
-                arch.write(*self._record(rows))
+            if arch.path is not None and (scheduled[i] or arch.due(prop.steps)):
+                arch.write(*self._record(rows))  # (a schedule alone writes nothing)
 
         return at
