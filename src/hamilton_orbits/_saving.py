@@ -253,7 +253,7 @@ class Saving:
         def at(i: int) -> None:
             if i == 0:
                 return
-            if asked[i] and rows is not None:
+            if asked[i] and rows is not None and arch.path is not None:
                 rows.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None and (scheduled[i] or arch.due(prop.steps)):
                 arch.write(*self._record(rows))  # (a schedule alone writes nothing)
