@@ -15,6 +15,7 @@ from hamilton_orbits.quaternion import Quaternion, slerp
 
 if TYPE_CHECKING:  # pragma: no cover
     from hamilton_orbits.archive import Archive
+    from hamilton_orbits.citations import cite
     from hamilton_orbits.ensemble import Ensemble
     from hamilton_orbits.integrators.methods import DOP853, WH, Leapfrog, Radau15
     from hamilton_orbits.nbody import Body, System
@@ -29,6 +30,7 @@ if TYPE_CHECKING:  # pragma: no cover
 _LAZY = {
     "Archive": "hamilton_orbits.archive",
     "Body": "hamilton_orbits.nbody",
+    "cite": "hamilton_orbits.citations",
     "System": "hamilton_orbits.nbody",
     "crosscheck": "hamilton_orbits.rebound_bridge",
     "Ensemble": "hamilton_orbits.ensemble",
@@ -88,6 +90,7 @@ __all__ = [
     "System",
     "Trajectory",
     "__version__",
+    "cite",
     "crosscheck",
     "integrate",
     "slerp",
