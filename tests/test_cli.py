@@ -42,6 +42,14 @@ def test_console_script_help():
     assert "usage: hamilton-orbits" in res.stdout
 
 
+def test_python_dash_m_package_runs_the_cli():
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(Path(hamilton_orbits.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    res = subprocess.run([sys.executable, "-m", "hamilton_orbits", "--version"],
+                         capture_output=True, text=True, check=True, env=env)
+    assert res.stdout.strip() == f"hamilton-orbits {hamilton_orbits.__version__}"
+
+
 def test_scenes_listing(capsys):
     assert main(["scenes"]) == 0
     out = capsys.readouterr().out
