@@ -186,6 +186,9 @@ def test_rebound_binary_in_and_out(tmp_path):
     first = Scene.bundled("comet-encounter").with_values(
         {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)
     first.save(tmp_path / "a")
+    text = repr(first)  # a few lines: names and sizes, the arrays not printed
+    assert len(text) < 500 and text.count("\n") <= 3, text
+    assert "comet-encounter" in text and "states: " in text
     path = tmp_path / "a" / "final.bin"
     scene = Scene.from_dict({
         "kind": "nbody", "description": "from a rebound binary", "duration": "0.1 yr",

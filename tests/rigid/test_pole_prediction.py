@@ -84,6 +84,13 @@ def test_latency_moves_the_newest_datum(record):
     assert pred.t[0] == AT and len(pred.t) == 11
 
 
+def test_repr_is_a_few_lines_with_the_arrays_summarised(record):
+    pred = predict(record, at=AT, horizon=365 * u.day, method="liouville")
+    text = repr(pred)
+    assert len(text) < 400 and text.count("\n") <= 3, text
+    assert "liouville" in text and "366 days" in text and "2018-12-31" in text
+
+
 # --------------------------------------------------------------------------
 # "ls" on a synthetic record with a known answer
 # --------------------------------------------------------------------------

@@ -214,6 +214,15 @@ class PolePrediction:
     newest_datum: Time
     parameters: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:  # a few lines: the arrays summarised, not printed
+        n = len(self.x)
+        span = (f"{self.t[0].utc.iso[:10]} .. {self.t[-1].utc.iso[:10]}" if n else "empty")
+        last = (f"; at the end x = {self.x[-1]:.1f} +- {self.sigma_x[-1]:.1f}, "
+                f"y = {self.y[-1]:.1f} +- {self.sigma_y[-1]:.1f}" if n else "")
+        return (f"PolePrediction(method={self.method!r}, {n} days {span}, newest datum "
+                f"{self.newest_datum.utc.iso[:10]}{last}; parameters: "
+                f"{', '.join(map(str, self.parameters)) or 'none'})")
+
 
 def predict(
     record: PoleRecord, *, at: Time, horizon: u.Quantity, method: str = "liouville",
