@@ -384,3 +384,12 @@ def test_problems_across_keys_come_with_the_others():
     assert problems[-1] == "<dict>: analysis[0].body: no body named 'zz' (valid: 'star', 'comet')"
     assert sum("bodies[1].gm" in p for p in problems) == 1, problems
     assert len(problems) == 3, problems
+
+
+def test_a_scene_origin_is_barycenter_or_barycentre():
+    for spelling in ("barycenter", "barycentre"):
+        data = {"kind": "nbody", "duration": "2 d", "crosscheck": False, "initial": {
+            "solar_system": {"epoch": "J2000", "bodies": ["sun", "mercury"],
+                             "origin": spelling}}}
+        result = Scene.from_dict(data).run(progress=False)
+        assert "centre of mass of the scene's solar-system bodies" in result.frame
