@@ -84,6 +84,18 @@ def test_latency_moves_the_newest_datum(record):
     assert pred.t[0] == AT and len(pred.t) == 11
 
 
+def test_a_date_string_is_a_time(record):
+    for method in ("ls", "liouville"):
+        by_string = predict(record, at="2019-01-01", horizon=30 * u.day, method=method)
+        by_time = predict(record, at=AT, horizon=30 * u.day, method=method)
+        for name in ("x", "y", "sigma_x", "sigma_y"):  # bit for bit
+            np.testing.assert_array_equal(getattr(by_string, name), getattr(by_time, name))
+    starts = ["2019-01-01", "2019-01-08"]
+    a = hindcast(record, starts, [10] * u.day, method="ls")
+    b = hindcast(record, Time(starts), [10] * u.day, method="ls")
+    np.testing.assert_array_equal(a.errors_x, b.errors_x)
+
+
 def test_repr_is_a_few_lines_with_the_arrays_summarised(record):
     pred = predict(record, at=AT, horizon=365 * u.day, method="liouville")
     text = repr(pred)
@@ -324,8 +336,8 @@ def test_bad_horizons_latency_starts_and_record(record):
         predict(record, at=AT, horizon=10 * u.day, latency=0 * u.day)
     with pytest.raises(ValueError, match="`record` from load_c04"):
         predict({"x": 1}, at=AT, horizon=10 * u.day)
-    with pytest.raises(ValueError, match="`at` to be an astropy Time, got '2019-01-01'"):
-        predict(record, at="2019-01-01", horizon=10 * u.day)
+    with pytest.raises(ValueError, match="`at` to be an astropy Time or a date, got 'soon'"):
+        predict(record, at="soon", horizon=10 * u.day)
     with pytest.raises(u.UnitConversionError, match="horizon"):
         predict(record, at=AT, horizon=10 * u.m)
 

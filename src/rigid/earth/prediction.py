@@ -176,8 +176,12 @@ def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
 
 
 def _as_mjd(name: str, value: Any) -> np.ndarray:
-    if not isinstance(value, Time):
-        raise ValueError(f"Expected `{name}` to be an astropy Time, got {value!r}")
+    if not isinstance(value, Time):  # a date string ("2019-01-01") or a list of them
+        try:
+            value = Time(value, scale="utc")
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"Expected `{name}` to be an astropy Time or a date, got "
+                             f"{value!r}") from exc
     return np.atleast_1d(np.asarray(value.utc.mjd, dtype=np.float64))
 
 
