@@ -470,3 +470,18 @@ def test_scene_start_and_periods_outside_the_record_are_refused_at_load(record):
                                          r"in whole days from 0 d to 1825 d, got 2000.0 d"):
         Scene.from_dict({"kind": "pole_prediction", "methods": ["persistence", "ls"],
                          "periods": [], "horizon": "2000 d"})
+
+
+def test_hindcast_docstring_imports_what_it_uses():
+    """The example of hindcast (reached through rigid.polar_motion) imports weekly_starts
+    from where it lives: the docstring runs as written in a fresh namespace (issue 34)."""
+    import doctest
+
+    from rigid.earth import prediction
+
+    assert "from rigid.earth.prediction import weekly_starts" in polar_motion.hindcast.__doc__
+    assert prediction.weekly_starts.__module__ == "rigid.earth.prediction"
+    assert "weekly_starts" in prediction.__all__
+    (test,) = doctest.DocTestFinder().find(polar_motion.hindcast, "hindcast",
+                                           globs={"u": u, "hindcast": polar_motion.hindcast})
+    assert doctest.DocTestRunner().run(test).failed == 0

@@ -238,8 +238,9 @@ def predict(
     ----------
     record : PolarMotionRecord
         From :func:`rigid.polar_motion.load_c04`.
-    at : Time
-        The start date (0h UTC).  Only epochs up to ``at - latency`` are used.
+    at : Time or str
+        The start date (0h UTC), e.g. ``"2019-01-01"``.  Only epochs up to
+        ``at - latency`` are used.
     horizon : Quantity
         Whole days >= 0.
     method : {"persistence", "ls", "ls+ar", "ls+var", "liouville"}
@@ -421,10 +422,10 @@ def hindcast(
     Parameters
     ----------
     record : PolarMotionRecord
-    starts : Time, optional
+    starts : Time or date strings, optional
         Start dates (0h UTC).  Default: weekly over :data:`PAPER_PERIOD` (the 1st EOP
         PCC's Oct 2005 - Mar 2008, assumed for Lei et al. 2023); the second period is
-        ``weekly_starts(*RECENT_PERIOD)``.
+        ``weekly_starts(*RECENT_PERIOD)`` (:func:`rigid.earth.prediction.weekly_starts`).
     horizons : Quantity
         Whole days >= 0 (default 10, 30, 90, 150, 270, 365 d).
     method : str
@@ -446,6 +447,7 @@ def hindcast(
 
     Examples
     --------
+    >>> from rigid.earth.prediction import weekly_starts
     >>> from rigid.polar_motion import load_c04
     >>> score = hindcast(load_c04(), weekly_starts("2019-01-01", "2019-03-01"),
     ...                  [10, 30] * u.day, "persistence")
