@@ -31,6 +31,22 @@ __all__ = ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN", "InitialSta
            "solar_system_bodies", "solar_system_epoch", "solar_system_specs"]
 
 
+def names_repr(names: Sequence[str], most: int = 12) -> str:
+    """The list of ``names`` as its repr, or, past ``most`` names, the first and last
+    few and how many (a repr of a few lines however many bodies).
+
+    >>> names_repr(["sun", "earth"])
+    "['sun', 'earth']"
+    >>> names_repr([f"p{i}" for i in range(1000)])
+    "['p0', 'p1', 'p2', 'p3', 'p4', ..., 'p997', 'p998', 'p999'] (1000 bodies)"
+    """
+    names = list(names)
+    if len(names) <= most:
+        return repr(names)
+    shown = [repr(n) for n in names[:5]] + ["..."] + [repr(n) for n in names[-3:]]
+    return f"[{', '.join(shown)}] ({len(names)} bodies)"
+
+
 class InitialStates:
     """The classmethods of :class:`~hamilton_orbits.nbody.System` that build a system
     from the states others hold (:meth:`solar_system`: astropy's built-in ephemeris;
