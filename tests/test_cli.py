@@ -42,6 +42,14 @@ def test_console_script_help():
     assert "usage: hamilton-orbits" in res.stdout
 
 
+def test_python_dash_m_package_runs_the_cli():
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(Path(hamilton_orbits.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    res = subprocess.run([sys.executable, "-m", "hamilton_orbits", "--version"],
+                         capture_output=True, text=True, check=True, env=env)
+    assert res.stdout.strip() == f"hamilton-orbits {hamilton_orbits.__version__}"
+
+
 def test_scenes_listing(capsys):
     assert main(["scenes"]) == 0
     out = capsys.readouterr().out
@@ -221,3 +229,54 @@ def test_report_without_its_extra_names_it_without_a_traceback(monkeypatch, caps
     err = capsys.readouterr().err
     assert "pip install 'hamilton-orbits[report]'" in err
     assert "Traceback" not in err
+
+
+def _subcommands():
+    import argparse
+
+    parser = None
+
+    def capture(self, *a, **k):
+        nonlocal parser
+        parser = self
+        raise SystemExit(0)
+
+    from unittest import mock
+    with mock.patch.object(argparse.ArgumentParser, "parse_args", capture):
+        try:
+            main([])
+        except SystemExit:
+            pass
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return parser, sub
+
+
+def test_every_subcommand_and_option_has_a_help_text():
+    parser, sub = _subcommands()
+    assert set(sub.choices) >= {"run", "crosscheck", "ensemble", "report", "resume", "scenes",
+                                "demo"}
+    for name, command in sub.choices.items():
+        assert command.description, f"`{name} --help` says nothing of what {name} does"
+        for action in command._actions:
+            assert action.help, f"{name} {action.option_strings or action.dest} has no help"
+    for action in parser._actions:
+        assert action.help, f"{action.option_strings or action.dest} has no help"
+
+
+def test_subcommand_help_describes_it(capsys):
+    import pytest
+
+    for name, words in (("scenes", "list the bundled scenes"), ("demo", "rotation tour")):
+        with pytest.raises(SystemExit):
+            main([name, "--help"])
+        assert words in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["crosscheck", "--help"])
+    assert "override one key" in capsys.readouterr().out
+
+
+def test_ensemble_without_vary_names_the_option(capsys):
+    assert main(["ensemble", "dzhanibekov"]) == 2
+    err = capsys.readouterr().err
+    assert "--vary" in err
+    assert "`vary`" not in err and "members" not in err

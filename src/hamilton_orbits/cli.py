@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -312,6 +313,9 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
         if not sep or not key.strip() or not _split_values(values):
             raise SceneError([f"{scene.source}: --vary {item!r}: expected KEY=V1,V2,..."])
         vary[key.strip()] = _split_values(values)
+    if not vary:  # name the command-line option, not Ensemble's Python arguments
+        raise SceneError([f"{scene.source}: ensemble needs at least one --vary KEY=V1,V2,... "
+                          "(the values of a key to run)"])
     try:
         ens = Ensemble(scene, vary=vary)
     except ValueError as exc:  # a member that is not a valid scene, named
@@ -424,6 +428,11 @@ def _report(quick: bool, out: str | None, progress: bool) -> int:
     return EXIT_OK
 
 
+def _command(sub: Any, name: str, help: str) -> argparse.ArgumentParser:
+    """A subcommand whose ``--help`` says what it does (its help line as description)."""
+    return sub.add_parser(name, help=help, description=help)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``hamilton-orbits`` console script.
 
@@ -445,33 +454,35 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--version", action="store_true", help="print the version and exit")
     parser.add_argument("--no-progress", dest="quiet", action="store_true",
                         help="no progress bar (with no command, or before any command)")
-    sub = parser.add_subparsers(dest="command")
-    run = sub.add_parser("run", help="run a scene and write its folder")
+    sub = parser.add_subparsers(dest="command",
+                                help="what to do (`COMMAND --help` for its options)")
+    run = _command(sub, "run", help="run a scene and write its folder")
     run.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
     run.add_argument("--out", help="output folder (default hamilton-orbits-output/SCENE)")
     run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                      help='override one key, e.g. --set duration="100 yr" (repeatable)')
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
-    cc = sub.add_parser("crosscheck", help="run a scene here and in rebound/reboundx; differences")
+    cc = _command(sub, "crosscheck", help="run a scene here and in rebound/reboundx; differences")
     cc.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help="bundled name or TOML file")
-    cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    en = sub.add_parser("ensemble", help="run a grid of variations of a scene in parallel")
+    cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help='override one key, e.g. --set duration="100 yr" (repeatable)')
+    en = _command(sub, "ensemble", help="run a grid of variations of a scene in parallel")
     en.add_argument("scene", help="bundled name or TOML file")
     en.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
                     help="values of one key (repeatable: the grid of all combinations)")
     en.add_argument("--dask", metavar="ADDRESS|local", help="run on a Dask cluster")
     en.add_argument("--out", help="output folder (default hamilton-orbits-output/SCENE-ensemble)")
     en.add_argument("--no-progress", action="store_true", help="no progress bar")
-    rp = sub.add_parser("report", help="the work-precision report: error against wall time")
+    rp = _command(sub, "report", help="the work-precision report: error against wall time")
     rp.add_argument("--quick", action="store_true", help="short spans, few settings (~1 min)")
     rp.add_argument("--out", help="output folder (default hamilton-orbits-output/report)")
     rp.add_argument("--no-progress", action="store_true", help="no progress lines")
-    rs = sub.add_parser("resume", help="resume a killed scene run from its archive "
-                                       "([output] archive_every)")
+    rs = _command(sub, "resume", help="resume a killed scene run from its archive "
+                                     "([output] archive_every)")
     rs.add_argument("out", help="the output folder of the run")
     rs.add_argument("--no-progress", action="store_true", help="no progress bar")
-    sub.add_parser("scenes", help="list the bundled scenes")
-    sub.add_parser("demo", help="the quaternion / rotation tour")
+    _command(sub, "scenes", help="list the bundled scenes")
+    _command(sub, "demo", help="the quaternion / rotation tour")
     args = parser.parse_args(argv)
     if args.version:
         print(f"hamilton-orbits {__version__}")

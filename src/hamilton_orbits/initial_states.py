@@ -31,6 +31,22 @@ __all__ = ["DEFAULT_BODIES", "SOLAR_SYSTEM_GM", "SOLAR_SYSTEM_SPAN", "InitialSta
            "solar_system_bodies", "solar_system_epoch", "solar_system_specs"]
 
 
+def names_repr(names: Sequence[str], most: int = 12) -> str:
+    """The list of ``names`` as its repr, or, past ``most`` names, the first and last
+    few and how many (a repr of a few lines however many bodies).
+
+    >>> names_repr(["sun", "earth"])
+    "['sun', 'earth']"
+    >>> names_repr([f"p{i}" for i in range(1000)])
+    "['p0', 'p1', 'p2', 'p3', 'p4', ..., 'p997', 'p998', 'p999'] (1000 bodies)"
+    """
+    names = list(names)
+    if len(names) <= most:
+        return repr(names)
+    shown = [repr(n) for n in names[:5]] + ["..."] + [repr(n) for n in names[-3:]]
+    return f"[{', '.join(shown)}] ({len(names)} bodies)"
+
+
 class InitialStates:
     """The classmethods of :class:`~hamilton_orbits.nbody.System` that build a system
     from the states others hold (:meth:`solar_system`: astropy's built-in ephemeris;
@@ -164,7 +180,7 @@ class InitialStates:
 
     @classmethod
     def solar_system(cls, epoch: Any = "J2000", bodies: Sequence[str] | None = None,
-                     frame: str = "icrs", origin: str = "barycentre") -> System:
+                     frame: str = "icrs", origin: str = "barycenter") -> System:
         """The Sun and planets at ``epoch`` from astropy's built-in ephemeris (offline).
 
         Positions and velocities from
@@ -201,9 +217,10 @@ class InitialStates:
             The axes: the ICRS (equatorial; default) or the mean ecliptic and
             equinox of J2000 (:mod:`hamilton_orbits.frames`; inclinations then
             read as in tables of ecliptic elements: Mars 1.85 degrees).
-        origin : {"barycentre", "ssb"}, optional
-            ``"barycentre"`` (default): the chosen bodies' centre of mass at rest at
-            the origin; ``"ssb"``: the solar-system barycentre of the ephemeris.
+        origin : {"barycenter", "ssb"}, optional
+            ``"barycenter"`` (default; ``"barycentre"`` is accepted too): the chosen
+            bodies' center of mass at rest at the origin; ``"ssb"``: the solar-system
+            barycenter of the ephemeris.
 
         Returns
         -------
@@ -358,7 +375,7 @@ DEFAULT_BODIES = (
 
 
 def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None,
-                       frame: str = "icrs", origin: str = "barycentre") -> list[dict[str, Any]]:
+                       frame: str = "icrs", origin: str = "barycenter") -> list[dict[str, Any]]:
     """The keyword arguments of one :class:`~hamilton_orbits.nbody.Body` per body of
     :meth:`System.solar_system <hamilton_orbits.nbody.System.solar_system>` (which
     documents the arguments and what they refuse): the name, ``gm``, ``r`` and ``v``
@@ -373,8 +390,9 @@ def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None
 
     bodies = solar_system_bodies(bodies)
     rotation = frame_rotation(check_frame(frame))
-    if origin not in ("barycentre", "ssb"):
-        raise ValueError(f"Expected `origin` to be 'barycentre' or 'ssb', got {origin!r}")
+    origin = "barycenter" if origin == "barycentre" else origin  # either spelling
+    if origin not in ("barycenter", "ssb"):
+        raise ValueError(f"Expected `origin` to be 'barycenter' or 'ssb', got {origin!r}")
     t = solar_system_epoch(epoch)
     gm = np.array([SOLAR_SYSTEM_GM[name] for name in bodies])
     r = np.empty((len(bodies), 3))
@@ -383,7 +401,7 @@ def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None
         pos, vel = get_body_barycentric_posvel(name, t, ephemeris="builtin")
         r[k] = pos.xyz.to_value(u.au)
         v[k] = vel.xyz.to_value(u.au / u.day)
-    if origin == "barycentre":
+    if origin == "barycenter":
         r -= gm @ r / gm.sum()
         v -= gm @ v / gm.sum()
     r, v = r @ rotation.T, v @ rotation.T

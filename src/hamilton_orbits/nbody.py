@@ -58,7 +58,7 @@ from hamilton_orbits._body import (
     body_from_floats,
 )
 from hamilton_orbits.deprecation import moved_name
-from hamilton_orbits.initial_states import InitialStates
+from hamilton_orbits.initial_states import InitialStates, names_repr
 from hamilton_orbits.integrals import energy_gm
 from hamilton_orbits.integrators import _setup
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent
@@ -416,7 +416,7 @@ class System(InitialStates):
         return self._name_index()[name]
 
     def __repr__(self) -> str:
-        return f"System({list(self.names)!r}{', au/day' if self._quantity else ''})"
+        return f"System({names_repr(self.names)}{', au/day' if self._quantity else ''})"
 
     def with_state(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray | None = None,
                    keep: np.ndarray | None = None, *, check: bool = True) -> System:

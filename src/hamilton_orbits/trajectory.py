@@ -297,6 +297,8 @@ def event_table(rows: Any, system: Any, unit: Any, stopped: int | None = None
     table["distance"] = rows[:, 4] * u.au if quantity else rows[:, 4]
     table["speed"] = rows[:, 5] * (u.au / u.day) if quantity else rows[:, 5]
     table["action"] = [actions[int(a)] for a in rows[:, 6]] if len(rows) else np.array([], str)
+    for column in ("time", "distance", "speed"):  # printed in 80 columns: none behind "..."
+        table[column].info.format = ".7g"
     return table, (table[stopped] if stopped is not None else None)
 
 

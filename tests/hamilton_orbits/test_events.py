@@ -318,3 +318,30 @@ def test_a_scene_lists_its_events_and_an_ensemble_row_carries_them():
         Scene.from_dict({**data, "events": [{"name": "escape", "distance": {"hill": -1}}]})
     with pytest.raises(ValueError, match=r"events\[0\]: .*`distance` is required"):
         Scene.from_dict({**data, "events": [{"name": "escape"}]})
+
+
+def test_the_events_table_prints_every_column_in_80_characters():
+    """The default print of Trajectory.events shows the distance and the speed, not "..."
+    (full-precision floats pushed them off an 80-column terminal; issue 34)."""
+    from types import SimpleNamespace
+
+    import astropy.units as u
+
+    from hamilton_orbits.events import ACTIONS, N_EVENT_COLUMNS
+    from hamilton_orbits.trajectory import event_table
+
+    rows = np.zeros((3, N_EVENT_COLUMNS))
+    rows[:, 0] = 1  # close_encounter
+    rows[:, 1:3] = [[1, 2], [1, 2], [0, -1]]
+    rows[:, 3] = [123.456789012345, 4567.89012345678, 36524.2199999]
+    rows[:, 4] = [1.234567890123e-6, 0.0123456789012345, 3.14159265358979]
+    rows[:, 5] = [0.0172020989484, 1.23456789e-3, 2.2e-2]
+    rows[:, 6] = ACTIONS["record"]
+    system = SimpleNamespace(names=["sun", "comet", "jupiter"], quantity=True)
+    table, _ = event_table(rows, system, u.yr)
+    text = "\n".join(table.pformat(max_width=80))
+    assert "..." not in text
+    for column in ("name", "time", "bodies", "distance", "speed", "action"):
+        assert column in text.splitlines()[0]
+    assert max(len(line) for line in text.splitlines()) <= 80
+    np.testing.assert_array_equal(table["distance"].to_value(u.au), rows[:, 4])  # values kept

@@ -141,6 +141,17 @@ def test_ssb_origin_keeps_the_ephemeris_states():
                                rtol=1e-13)
 
 
+def test_barycenter_origin_is_spelled_either_way():
+    """``barycenter`` as astropy and JPL write it (the default); ``barycentre`` accepted."""
+    default = System.solar_system("J2000", bodies=["sun", "mercury"])
+    for spelling in ("barycenter", "barycentre"):
+        other = System.solar_system("J2000", bodies=["sun", "mercury"], origin=spelling)
+        np.testing.assert_array_equal(other.r.value, default.r.value)
+        np.testing.assert_array_equal(other.v.value, default.v.value)
+    with pytest.raises(ValueError, match=r"'barycenter' or 'ssb'"):
+        System.solar_system("J2000", origin="centre")
+
+
 def test_energy_of_a_lone_test_particle_is_its_specific_energy():
     """One massive body and a massless one: Hamilton's E does not see the particle,
     so its error was 0 whatever the integrator did.  The test particle's specific

@@ -227,3 +227,13 @@ def test_two_massless_particles_may_share_a_position():
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
                 Body("p", 0.0, [1, 0, 0], [0, 1, 0]), Body("q", 0.0, [1, 0, 0], [0, 1.1, 0])])
     assert np.all(np.isfinite(s.accelerations()))
+
+
+def test_repr_of_a_thousand_bodies_is_one_short_line():
+    from hamilton_orbits import Body, System
+
+    bodies = [Body("sun", 1.0, [0, 0, 0], [0, 0, 0])] + [
+        Body(f"p{i}", 0.0, [1 + 0.01 * i, 0, 0], [0, 1, 0]) for i in range(999)]
+    text = repr(System(bodies))
+    assert len(text) < 120 and "\n" not in text and "(1000 bodies)" in text, text
+    assert repr(System(bodies[:2])) == "System(['sun', 'p0'])"  # a few bodies: all named

@@ -186,6 +186,9 @@ def test_rebound_binary_in_and_out(tmp_path):
     first = Scene.bundled("comet-encounter").with_values(
         {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)
     first.save(tmp_path / "a")
+    text = repr(first)  # a few lines: names and sizes, the arrays not printed
+    assert len(text) < 500 and text.count("\n") <= 3, text
+    assert "comet-encounter" in text and "states: " in text
     path = tmp_path / "a" / "final.bin"
     scene = Scene.from_dict({
         "kind": "nbody", "description": "from a rebound binary", "duration": "0.1 yr",
@@ -381,3 +384,12 @@ def test_problems_across_keys_come_with_the_others():
     assert problems[-1] == "<dict>: analysis[0].body: no body named 'zz' (valid: 'star', 'comet')"
     assert sum("bodies[1].gm" in p for p in problems) == 1, problems
     assert len(problems) == 3, problems
+
+
+def test_a_scene_origin_is_barycenter_or_barycentre():
+    for spelling in ("barycenter", "barycentre"):
+        data = {"kind": "nbody", "duration": "2 d", "crosscheck": False, "initial": {
+            "solar_system": {"epoch": "J2000", "bodies": ["sun", "mercury"],
+                             "origin": spelling}}}
+        result = Scene.from_dict(data).run(progress=False)
+        assert "centre of mass of the scene's solar-system bodies" in result.frame

@@ -33,6 +33,11 @@ def test_chandler_wobble_scene_against_published_period():
     # 0.28 (REFERENCES.md, Munk & MacDonald 1960)
     assert 0.25 < result.metrics["effective k2 = k_s (1 - T_E / T_C)"] < 0.31
     assert result.metrics["model period"].to_value(u.day) == pytest.approx(period, rel=1e-12)
+    # "Q from the line width (see caveat)": the caveat is printed with the summary
+    assert "Q from the line width (see caveat)" in result.metrics
+    summary = result.summary()
+    assert "\ncaveat\nQ from the line width" in summary
+    assert "not a measurement of the" in summary and "damping" in summary
 
 
 def test_polar_scene_refuses_unknown_effect_and_missing_q(tmp_path):

@@ -176,6 +176,10 @@ def test_iers2010_mean_pole_branches():
     tau = (55197.5 - 51544.5) / 365.25
     assert abs(x[1] - (23.513 + 7.6141 * tau) * u.mas) < 1e-9 * u.mas
     assert abs(y[1] - (358.891 - 0.6287 * tau) * u.mas) < 1e-9 * u.mas
+    # a date string is a Time (UTC), the same numbers
+    xs, ys = iers2010_mean_pole(["2000-01-01T12:00:00", "2010-01-01T12:00:00"])
+    np.testing.assert_array_equal(xs, x)
+    np.testing.assert_array_equal(ys, y)
 
 
 def test_fit_recovers_a_synthetic_wobble_exactly():

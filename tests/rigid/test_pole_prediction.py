@@ -84,6 +84,25 @@ def test_latency_moves_the_newest_datum(record):
     assert pred.t[0] == AT and len(pred.t) == 11
 
 
+def test_a_date_string_is_a_time(record):
+    for method in ("ls", "liouville"):
+        by_string = predict(record, at="2019-01-01", horizon=30 * u.day, method=method)
+        by_time = predict(record, at=AT, horizon=30 * u.day, method=method)
+        for name in ("x", "y", "sigma_x", "sigma_y"):  # bit for bit
+            np.testing.assert_array_equal(getattr(by_string, name), getattr(by_time, name))
+    starts = ["2019-01-01", "2019-01-08"]
+    a = hindcast(record, starts, [10] * u.day, method="ls")
+    b = hindcast(record, Time(starts), [10] * u.day, method="ls")
+    np.testing.assert_array_equal(a.errors_x, b.errors_x)
+
+
+def test_repr_is_a_few_lines_with_the_arrays_summarised(record):
+    pred = predict(record, at=AT, horizon=365 * u.day, method="liouville")
+    text = repr(pred)
+    assert len(text) < 400 and text.count("\n") <= 3, text
+    assert "liouville" in text and "366 days" in text and "2018-12-31" in text
+
+
 # --------------------------------------------------------------------------
 # "ls" on a synthetic record with a known answer
 # --------------------------------------------------------------------------
@@ -317,8 +336,8 @@ def test_bad_horizons_latency_starts_and_record(record):
         predict(record, at=AT, horizon=10 * u.day, latency=0 * u.day)
     with pytest.raises(ValueError, match="`record` from load_c04"):
         predict({"x": 1}, at=AT, horizon=10 * u.day)
-    with pytest.raises(ValueError, match="`at` to be an astropy Time, got '2019-01-01'"):
-        predict(record, at="2019-01-01", horizon=10 * u.day)
+    with pytest.raises(ValueError, match="`at` to be an astropy Time or a date, got 'soon'"):
+        predict(record, at="soon", horizon=10 * u.day)
     with pytest.raises(u.UnitConversionError, match="horizon"):
         predict(record, at=AT, horizon=10 * u.m)
 
@@ -451,3 +470,18 @@ def test_scene_start_and_periods_outside_the_record_are_refused_at_load(record):
                                          r"in whole days from 0 d to 1825 d, got 2000.0 d"):
         Scene.from_dict({"kind": "pole_prediction", "methods": ["persistence", "ls"],
                          "periods": [], "horizon": "2000 d"})
+
+
+def test_hindcast_docstring_imports_what_it_uses():
+    """The example of hindcast (reached through rigid.polar_motion) imports weekly_starts
+    from where it lives: the docstring runs as written in a fresh namespace (issue 34)."""
+    import doctest
+
+    from rigid.earth import prediction
+
+    assert "from rigid.earth.prediction import weekly_starts" in polar_motion.hindcast.__doc__
+    assert prediction.weekly_starts.__module__ == "rigid.earth.prediction"
+    assert "weekly_starts" in prediction.__all__
+    (test,) = doctest.DocTestFinder().find(polar_motion.hindcast, "hindcast",
+                                           globs={"u": u, "hindcast": polar_motion.hindcast})
+    assert doctest.DocTestRunner().run(test).failed == 0

@@ -69,6 +69,14 @@ class Result:
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
                                                                 repr=False)
 
+    def __repr__(self) -> str:  # a few lines: names and sizes, not the arrays
+        n = len(self.times)
+        span = f"{format_value(self.times[-1] - self.times[0])}" if n else "no time"
+        return (f"Result(scene {self.scene.name!r}, {n} outputs over {span}, "
+                f"complete={self.complete}; diagnostics: {', '.join(self.diagnostics) or 'none'}"
+                f"; {len(self.metrics)} metrics (see .summary()); tables: "
+                f"{', '.join(self.tables) or 'none'}; states: {', '.join(self.states) or 'none'})")
+
     def summary(self) -> str:
         """The summary table as text (what the command prints)."""
         s = self.scene

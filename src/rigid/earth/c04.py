@@ -245,8 +245,12 @@ def iers2010_mean_pole(time: Any) -> tuple[u.Quantity, u.Quantity]:
     >>> print(np.round(x, 3), np.round(y, 3))
     55.974 mas 346.346 mas
     """
-    if not isinstance(time, Time):
-        raise ValueError(f"Expected `time` to be an astropy Time, got {type(time).__name__}")
+    if not isinstance(time, Time):  # a date string, or a list of them, is read as UTC
+        try:
+            time = Time(time, scale="utc")
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"Expected `time` to be an astropy Time or a date, got "
+                             f"{type(time).__name__}") from exc
     # tau in Julian years from J2000.0 (MJD 51544.5); the UTC-TT offset (~1 min) is
     # irrelevant at the mas level
     tau = (mjd_utc(time) - 51544.5) / 365.25

@@ -176,8 +176,12 @@ def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
 
 
 def _as_mjd(name: str, value: Any) -> np.ndarray:
-    if not isinstance(value, Time):
-        raise ValueError(f"Expected `{name}` to be an astropy Time, got {value!r}")
+    if not isinstance(value, Time):  # a date string ("2019-01-01") or a list of them
+        try:
+            value = Time(value, scale="utc")
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"Expected `{name}` to be an astropy Time or a date, got "
+                             f"{value!r}") from exc
     return np.atleast_1d(np.asarray(value.utc.mjd, dtype=np.float64))
 
 
@@ -214,6 +218,15 @@ class PolePrediction:
     newest_datum: Time
     parameters: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:  # a few lines: the arrays summarised, not printed
+        n = len(self.x)
+        span = (f"{self.t[0].utc.iso[:10]} .. {self.t[-1].utc.iso[:10]}" if n else "empty")
+        last = (f"; at the end x = {self.x[-1]:.1f} +- {self.sigma_x[-1]:.1f}, "
+                f"y = {self.y[-1]:.1f} +- {self.sigma_y[-1]:.1f}" if n else "")
+        return (f"PolePrediction(method={self.method!r}, {n} days {span}, newest datum "
+                f"{self.newest_datum.utc.iso[:10]}{last}; parameters: "
+                f"{', '.join(map(str, self.parameters)) or 'none'})")
+
 
 def predict(
     record: PoleRecord, *, at: Time, horizon: u.Quantity, method: str = "liouville",
@@ -225,8 +238,9 @@ def predict(
     ----------
     record : PolarMotionRecord
         From :func:`rigid.polar_motion.load_c04`.
-    at : Time
-        The start date (0h UTC).  Only epochs up to ``at - latency`` are used.
+    at : Time or str
+        The start date (0h UTC), e.g. ``"2019-01-01"``.  Only epochs up to
+        ``at - latency`` are used.
     horizon : Quantity
         Whole days >= 0.
     method : {"persistence", "ls", "ls+ar", "ls+var", "liouville"}
@@ -408,10 +422,10 @@ def hindcast(
     Parameters
     ----------
     record : PolarMotionRecord
-    starts : Time, optional
+    starts : Time or date strings, optional
         Start dates (0h UTC).  Default: weekly over :data:`PAPER_PERIOD` (the 1st EOP
         PCC's Oct 2005 - Mar 2008, assumed for Lei et al. 2023); the second period is
-        ``weekly_starts(*RECENT_PERIOD)``.
+        ``weekly_starts(*RECENT_PERIOD)`` (:func:`rigid.earth.prediction.weekly_starts`).
     horizons : Quantity
         Whole days >= 0 (default 10, 30, 90, 150, 270, 365 d).
     method : str
@@ -433,6 +447,7 @@ def hindcast(
 
     Examples
     --------
+    >>> from rigid.earth.prediction import weekly_starts
     >>> from rigid.polar_motion import load_c04
     >>> score = hindcast(load_c04(), weekly_starts("2019-01-01", "2019-03-01"),
     ...                  [10, 30] * u.day, "persistence")

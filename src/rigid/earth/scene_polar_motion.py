@@ -21,6 +21,7 @@ sigma_c``, for ``"annual_excitation"``.
 
 from __future__ import annotations
 
+import textwrap
 import time
 from typing import Any
 
@@ -131,6 +132,8 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
             u.mas)), "annual (mas)": float(row["annual_amplitude"].to_value(u.mas))}
         for row in fit.amplitude_by_decade
     ]
+    result.tables["caveat"] = [  # what "see caveat" points at
+        {"Q from the line width": line} for line in textwrap.wrap(fit.q_caveat, 88)]
     result.frame = ("pole coordinates on the terrestrial axes (IERS: x_p towards Greenwich, "
                     "y_p towards 90° W)")
     result.plotters.append(_plot)

@@ -149,7 +149,7 @@ def _build(spec: dict, problems: S.Problems | None):
     if ss is not None:
         base = attempt(problems, "initial.solar_system", lambda: System.solar_system(
             ss["epoch"], bodies=ss.get("bodies"), frame=scene_frame(spec),
-            origin=ss.get("origin") or "barycentre"), ("epoch", "bodies"))
+            origin=ss.get("origin") or "barycenter"), ("epoch", "bodies"))
         bodies += [] if base is None else [base[n] for n in base.names]
     eph = init.get("ephemeris")
     if eph is not None:
@@ -182,9 +182,9 @@ def frame_note(spec: dict) -> str:
     note = frame_label(scene_frame(spec))
     ss = spec["initial"].get("solar_system")
     if ss is not None:
-        origin = ss.get("origin") or "barycentre"
+        origin = ss.get("origin") or "barycenter"
         note += ("; origin: the centre of mass of the scene's solar-system bodies, at rest"
-                 if origin == "barycentre" else
-                 "; origin: the solar-system barycentre (the ephemeris's)")
+                 if origin in ("barycenter", "barycentre") else
+                 "; origin: the solar-system barycenter (the ephemeris's)")
     return note
 

@@ -99,7 +99,8 @@ SCHEMA: dict[str, S.Field] = {
                 fields={
                     "epoch": S.String(default="J2000"),
                     "bodies": S.Array(item=S.Choice(choices=SOLAR_SYSTEM)),
-                    "origin": S.Choice(choices=("barycentre", "ssb"), default="barycentre"),
+                    "origin": S.Choice(choices=("barycenter", "barycentre", "ssb"),
+                                      default="barycenter"),
                 }
             ),
             "ephemeris": S.Table(
