@@ -346,9 +346,10 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
     # The kernels take `accel` as a first-class function type so that they are
     # compiled once and then loaded from numba's on-disk cache in every new
     # process (a kernel specialised on a dispatcher argument is recompiled in
-    # each process: ~8 s).  Both kernels have explicit signatures, so importing
-    # them here has already compiled and saved them if the cache was empty; a
-    # fresh process must then load both and compile (save) nothing of them.
+    # each process: ~8 s).  They compile at their first call (not at import:
+    # hamilton_orbits._kernels.entry), so a first process calls each of them
+    # (compiling and saving what the cache lacks); a second process must then load
+    # every one and compile (save) none.
     import os
     import subprocess
     import sys
@@ -361,12 +362,12 @@ def test_stepping_kernels_are_loaded_from_the_numba_cache():
         "r = np.array([[0.0, 0, 0], [1.0, 0, 0]]); v = np.array([[0.0, 0, 0], [0, 1.0, 0]])\n"
         "gm = np.array([1.0, 0.0]); t = np.array([0.0, 1.0])\n"
         "radau15.run(newtonian_rhs(), r, v, gm, t); wh.run(newtonian_rhs(), r, v, gm, t, dt=0.1)\n"
+        "wh.run(newtonian_rhs(), r, v, gm, t, dt=0.1, coordinates='jacobi', corrector=11)\n"
     )
     src = str(Path(radau15.__file__).resolve().parents[2])
     env = {**os.environ, "NUMBA_DEBUG_CACHE": "1"}
     env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
-    from hamilton_orbits.integrators import wh  # noqa: F401 - compiles / caches wh._advance
-
+    subprocess.run([sys.executable, "-c", code], capture_output=True, env=env, check=True)
     res = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
     )

@@ -7,6 +7,7 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
+from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
 __all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance"]
@@ -56,7 +57,7 @@ def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no co
 
 # explicit signature with ``accel`` as a first-class function type: compiled once
 # and loaded from the cache in later processes, whatever the right-hand side
-@njit(types.Tuple((types.int64, types.int64))(
+@entry(types.Tuple((types.int64, types.int64))(
     ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
     types.int64[::1], F1, types.int64), cache=True, error_model="numpy")
 def advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
+from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at
 from hamilton_orbits._kernels.variational import megno_update
 
@@ -46,6 +47,7 @@ __all__ = [
     "ST_T_CS",
     "advance",
     "advance_variational",
+    "advance_watched",
     "coefficients",
     "radau_weights",
 ]
@@ -561,18 +563,14 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
     return h
 
 
-@njit(
-    types.Tuple((types.int64, types.int64))(
-        ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
-        types.boolean, types.int64, _F2, _F2, types.int64[::1],
-    ),
-    cache=True,
-)
-def advance(
-    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
+@njit(cache=True)
+def _steps(
+    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
     ev_count,
 ):  # pragma: no cover - compiled
-    """Step from ``st[ST_T]`` to ``t_end`` in place; returns ``(steps, status)``.
+    """The loop of :func:`advance` and :func:`advance_watched`: step from ``st[ST_T]``
+    to ``t_end`` in place; returns ``(steps, status)``.  ``accel`` is the right-hand
+    side (a first-class function); ``watch`` None (no events) or an array.
 
     ``st`` is the :data:`NSTATE` state (``epsilon = 0``: fixed steps of ``dt``;
     ``prs23 != 0``: the rule of Pham, Rein & Spiegel 2024, else the global one
@@ -590,11 +588,13 @@ def advance(
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
     the start state only when events are watched.
     """
-    accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
-    w = m if watch.shape[0] > 0 else 0
-    x0, v0 = np.empty(w), np.empty(w)  # the start of a step, for the events' scan
+    # the start of a step, for the events' scan (``watch is None`` is decided at
+    # compile time: numba prunes the branches, so no event code is compiled)
+    n_watch = 0 if watch is None else watch.shape[0]
+    w = m if n_watch > 0 else 0
+    x0, v0 = np.empty(w), np.empty(w)
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     a0 = a0_2.reshape(m)
     xf = r.reshape(m)
@@ -604,12 +604,11 @@ def advance(
     have_last = st[ST_HAVE_LAST] != 0.0
     steps = 0
     status = STATUS_OK
-    n_watch = watch.shape[0]
     while t < t_end:
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
             break
-        if n_watch > 0 and ev_count[0] + n_watch > ev_out.shape[0]:
+        if watch is not None and n_watch > 0 and ev_count[0] + n_watch > ev_out.shape[0]:
             status = STATUS_DRAIN
             break
         dt_try, landing, short = _try_length(t, t_end, dt)
@@ -629,7 +628,7 @@ def advance(
             dt = dt_new
             continue
         _accept(xf, vf, csx, csv, b, a0, vf, dt_try)
-        if n_watch > 0:
+        if watch is not None and n_watch > 0:
             h_ev = _watch_step(watch, t, dt_try, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st,
                                csx, csv)
             if h_ev <= 1.0:  # an event with an action: the state is at its time
@@ -644,6 +643,34 @@ def advance(
         steps += 1
     _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status
+
+
+_ADVANCE_ARGS = (ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
+                 types.boolean, types.int64)
+
+
+@entry(types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS), cache=True)
+def advance(
+    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps,
+):  # pragma: no cover - compiled
+    """Step from ``st[ST_T]`` to ``t_end`` in place, watching no events; returns
+    ``(steps, status)`` (see :func:`_steps`).  No event code is compiled into it."""
+    return _steps(accel_at(accel_addr[0], accel_addr[1]), p, r, v, gm, t_end, st, b, br, d,
+                  g, csx, csv, need_v, max_steps, None, None, None)
+
+
+@entry(
+    types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
+    cache=True,
+)
+def advance_watched(
+    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
+    ev_count,
+):  # pragma: no cover - compiled
+    """:func:`advance` watching the events ``watch`` (at least one row), recorded into
+    ``ev_out`` / ``ev_count``."""
+    return _steps(accel_at(accel_addr[0], accel_addr[1]), p, r, v, gm, t_end, st, b, br, d,
+                  g, csx, csv, need_v, max_steps, watch, ev_out, ev_count)
 
 
 # ---------------------------------------------------------------------------
@@ -740,7 +767,7 @@ def _renormalise(r, v, b, br, d, g, csx, csv, n):  # pragma: no cover - compiled
                 g[j, k] *= f
 
 
-@njit(
+@entry(
     types.Tuple((types.int64, types.int64))(
         ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, types.int64, _F1,

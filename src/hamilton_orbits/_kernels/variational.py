@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit, types
 
 from hamilton_orbits._kernels import kepler as _kepler
+from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.jacobians import tangent_at
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
@@ -235,7 +236,7 @@ def _drift(r, v, dr, dv, h):  # pragma: no cover - compiled
             dr[a, c] += h * dv[a, c]
 
 
-@njit(types.int64(ADDRESSES, ADDRESSES, F1, F2, F2, F1, F2, F2, types.float64,
+@entry(types.int64(ADDRESSES, ADDRESSES, F1, F2, F2, F1, F2, F2, types.float64,
                   types.float64, types.float64, F1, types.int64),
       cache=True, error_model="numpy")
 def advance_leapfrog(accel_addr, tangent_addr, p, r, v, gm, dr, dv, t0, t1, dt, ms, max_steps):

@@ -23,6 +23,7 @@ from numba.extending import intrinsic
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
 _I1 = types.int64[::1]
@@ -448,7 +449,7 @@ def _kick_jacobi(
             uj[i, k] += h * (accj[i, k] + f * qj[i, k])
 
 
-@njit(
+@entry(
     types.int64(ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.float64,
                 F1, F1),
     cache=True,
@@ -654,7 +655,7 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
 _EVENT_ARGS = (F2, F2, types.int64[::1], F1)
 
 
-@njit(
+@entry(
     types.Tuple((types.int64, types.int64, types.int64))(
         ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,
@@ -708,7 +709,7 @@ def advance_dh(
                      watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
 
 
-@njit(
+@entry(
     types.Tuple((types.int64, types.int64, types.int64))(
         ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
         types.float64, *_EVENT_ARGS,

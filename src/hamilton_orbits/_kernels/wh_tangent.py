@@ -31,6 +31,7 @@ from numba import njit, types
 
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
+from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.jacobians import newtonian_jvp, tangent_at
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
@@ -200,7 +201,7 @@ def _ln_delta_dh(dq, du, dcom, gm, m_tot, r0, v0):  # pragma: no cover - compile
     return 0.5 * math.log(s) if s > 0.0 else -math.inf
 
 
-@njit(types.Tuple((types.int64, types.int64))(
+@entry(types.Tuple((types.int64, types.int64))(
     ADDRESSES, ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, F1, F2, F2, F2,
     types.float64, types.int64, types.float64, types.float64, F1), cache=True,
     error_model="numpy")
@@ -335,7 +336,7 @@ def _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0):  # pragma: no cover -
     return 0.5 * math.log(tot) if tot > 0.0 else -math.inf
 
 
-@njit(types.Tuple((types.int64, types.int64))(
+@entry(types.Tuple((types.int64, types.int64))(
     ADDRESSES, ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, F2, F2, types.float64,
     types.int64, types.float64, types.float64, F1), cache=True, error_model="numpy")
 def advance_jacobi(extra_addr, tangent_addr, p, has_extra, order, qj, uj, gm, eta, dq, du, dt,

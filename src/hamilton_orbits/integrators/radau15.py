@@ -307,9 +307,13 @@ class _Run:
         the steps before this call, for its budget of ``max_steps``)."""
         log, max_steps = self.log, self.max_steps
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
-            steps, status = _k.advance(
-                *self.before_t, t_out[i], *self.after_t,
-                min(SLICE, max_steps - (self.steps - first)), log.watch, log.buffer, log.count)
+            budget = min(SLICE, max_steps - (self.steps - first))
+            if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
+                steps, status = _k.advance_watched(
+                    *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
+                    log.count)
+            else:
+                steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget)
             self.steps += steps
             if status == _k.STATUS_MAXSTEPS:
                 _check_pace(self.steps - first, max_steps, self.t, t_out)
