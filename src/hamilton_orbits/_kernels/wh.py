@@ -33,7 +33,9 @@ __all__ = [
     "STATUS_EVENT",
     "STATUS_OK",
     "advance_dh",
+    "advance_dh_watched",
     "advance_jacobi",
+    "advance_jacobi_watched",
     "caller_gm",
     "corrector_jacobi",
     "dh_from_inertial",
@@ -185,15 +187,15 @@ STATUS_DRAIN = 5
 def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
            jump):  # pragma: no cover - compiled
     """One Kepler drift of ``tau`` with the barycentre; with events watched
-    (``watched``, a constant where the step loops inline this: the loop without
-    events has no trace of them), the drift is scanned on the Kepler arcs
+    (``watch`` not None and ``watched``; ``watch`` None is decided at compile time:
+    the loops without events have no trace of them), the drift is scanned on the Kepler arcs
     themselves (Jacobi turned into inertial positions; democratic heliocentric
     with the jumps around the drift spread over it, ``jump`` the one before it:
     :func:`hamilton_orbits._kernels.events._dh_constants`; ``g`` the rows' ``G m``).
     ``ws = [t, t_action, drain, row]``: the drift's start time (advanced here),
     the time and watch row of the first event with an action, and whether the
     buffer must be drained.  Returns a failing body or -1."""
-    if watched:
+    if watch is not None and watched:
         return _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0,
                               mu_s, g, jump)
     bad = _kepler_all(q, u, mu, tau)
@@ -617,7 +619,7 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h
-        if ws[1] <= t_step or ws[2] > 0.0:
+        if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
             return s + 1, -1, _stop_here(q, u, mu, 0.5 * h_next, False, com, ws, t_step,
                                          ev_out, ev_count)
     return n_steps, -1, STATUS_OK
@@ -646,45 +648,33 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
         if bad >= 0:
             return s, bad, STATUS_OK
         t_step += h
-        if ws[1] <= t_step or ws[2] > 0.0:
+        if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
             return s + 1, -1, _stop_here(qj, uj, eta, 0.5 * h_next, True, eta, ws, t_step,
                                          ev_out, ev_count)
     return n_steps, -1, STATUS_OK
 
 
-_EVENT_ARGS = (F2, F2, types.int64[::1], F1)
+_SPLIT_ARGS = (ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
+               types.float64)
+_RESULT = types.Tuple((types.int64, types.int64, types.int64))
+_EVENT_ARGS = (F2, F2, types.int64[::1])
 
 
-@entry(
-    types.Tuple((types.int64, types.int64, types.int64))(
-        ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
-        types.float64, *_EVENT_ARGS,
-    ),
-    cache=True,
-    error_model="numpy",
-)
-def advance_dh(
+@njit(cache=True, error_model="numpy")
+def _advance_dh(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
     ws,
 ):  # pragma: no cover - compiled
-    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
-    coordinates, in place.  ``q``, ``u``: heliocentric positions and
-    barycentric velocities (row 0 unused); ``gm[0]`` the central body's;
-    ``com``: barycentre position and velocity (6,); ``order``: row ``i`` is the
-    caller's body ``order[i]`` (the listed effects see the caller's order: their
-    parameters name bodies by its indices).  ``watch``, ``ev_out``,
-    ``ev_count``, ``ws``: the events (see :func:`_drift`; ``ws[0]`` the start
-    time).  Returns ``(steps, bad, status)`` with ``bad`` the index of a body
-    whose Kepler step failed, else -1; at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
-    state is synchronised at the end of step ``steps``."""
+    """The body of :func:`advance_dh` (``watch`` None: no events) and of
+    :func:`advance_dh_watched`.  ``watch is None`` is decided at compile time, so
+    the entry without events compiles none of their code."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     n = q.shape[0]
-    watched = watch.shape[0] > 0
     m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
     r_in = np.empty((m, 3))
     v_in = np.empty((m, 3))
     acc_x = np.empty((m, 3))
-    w = n if watched else 0  # the drifts' start states for the events' scan
+    w = 0 if watch is None else n  # the drifts' start states for the events' scan
     x0, v0 = np.empty((w, 3)), np.empty((w, 3))
     m_tot = 0.0
     for i in range(n):
@@ -697,35 +687,56 @@ def advance_dh(
     acc_m = np.empty((idx.shape[0], 3))
     mu = np.full(1, gm[0])  # every body about the central one
     mu_s = np.full(w, gm[0])
-    if watched:
+    if watch is not None:
         mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
     kick = (idx, m_tot, acc_m, r_in, v_in, acc_x, order, caller_gm(gm, order))
-    # two copies of the loop: the one without events and effects has no trace of
-    # them (their branches cost up to 30% of a step at N = 2-3)
-    if watched or has_extra:
-        return _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
-                         watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
+    if watch is not None:
+        return _dh_steps(watch.shape[0] > 0, extra, p, has_extra, q, u, gm, com, dt, n_steps,
+                         dt_last, watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
+    # two copies of the loop: the one without effects has no trace of them (their
+    # branches cost up to 30% of a step at N = 2-3)
+    if has_extra:
+        return _dh_steps(False, extra, p, True, q, u, gm, com, dt, n_steps, dt_last,
+                         None, None, None, ws, x0, v0, mu, mu_s, kick)
     return _dh_steps(False, extra, p, False, q, u, gm, com, dt, n_steps, dt_last,
-                     watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
+                     None, None, None, ws, x0, v0, mu, mu_s, kick)
 
 
-@entry(
-    types.Tuple((types.int64, types.int64, types.int64))(
-        ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
-        types.float64, *_EVENT_ARGS,
-    ),
-    cache=True,
-    error_model="numpy",
-)
-def advance_jacobi(
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+def advance_dh(
+    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """``n_steps`` steps (the last of length ``dt_last``) from and to synchronised
+    coordinates, in place, watching no events.  ``q``, ``u``: heliocentric
+    positions and barycentric velocities (row 0 unused); ``gm[0]`` the central
+    body's; ``com``: barycentre position and velocity (6,); ``order``: row ``i``
+    is the caller's body ``order[i]`` (the listed effects see the caller's order:
+    their parameters name bodies by its indices); ``ws``: see :func:`_drift`
+    (``ws[0]`` the start time).  Returns ``(steps, bad, status)`` with ``bad`` the
+    index of a body whose Kepler step failed, else -1."""
+    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
+                       None, None, None, ws)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
+def advance_dh_watched(
+    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
+    ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_dh` watching the events ``watch``, recorded into ``ev_out`` /
+    ``ev_count`` (see :func:`_drift`); at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
+    state is synchronised at the end of step ``steps``."""
+    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
+                       watch, ev_out, ev_count, ws)
+
+
+@njit(cache=True, error_model="numpy")
+def _advance_jacobi(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
     ev_count, ws,
 ):  # pragma: no cover - compiled
-    """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
-    ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
-    sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
-    listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
-    removes the part the Kepler step already accounts for."""
+    """The body of :func:`advance_jacobi` and :func:`advance_jacobi_watched`, as
+    :func:`_advance_dh`."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     n = qj.shape[0]
     acc = np.empty((n, 3))
@@ -737,10 +748,36 @@ def advance_jacobi(
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
     kick = (idx, ratio, inv, acc, accj, acc_x, r_in, v_in, _perm(has_extra, order, gm))
-    # as advance_dh: the loop without events and effects has no trace of them
-    watched = watch.shape[0] > 0
-    if watched or has_extra:
-        return _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps,
-                             dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)
+    if watch is not None:
+        return _jacobi_steps(watch.shape[0] > 0, extra, p, has_extra, qj, uj, gm, eta, dt,
+                             n_steps, dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)
+    # as _advance_dh: the loop without effects has no trace of them
+    if has_extra:
+        return _jacobi_steps(False, extra, p, True, qj, uj, gm, eta, dt, n_steps, dt_last,
+                             None, None, None, ws, x0, v0, kick)
     return _jacobi_steps(False, extra, p, False, qj, uj, gm, eta, dt, n_steps, dt_last,
-                         watch, ev_out, ev_count, ws, x0, v0, kick)
+                         None, None, None, ws, x0, v0, kick)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+def advance_jacobi(
+    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """As :func:`advance_dh` in Jacobi coordinates (Wisdom & Holman 1991): ``qj``,
+    ``uj`` Jacobi positions and velocities, row 0 the barycentre; ``eta_i =
+    sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
+    listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
+    removes the part the Kepler step already accounts for."""
+    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
+                           dt_last, None, None, None, ws)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
+def advance_jacobi_watched(
+    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
+    ev_count, ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_jacobi` watching the events ``watch`` (see
+    :func:`advance_dh_watched`)."""
+    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
+                           dt_last, watch, ev_out, ev_count, ws)

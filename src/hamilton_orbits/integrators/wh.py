@@ -370,14 +370,18 @@ class _Split:
     def advance(self, dt, n_steps, last, watch, ev_out, ev_count, ws) -> tuple[int, int, int]:
         """``n_steps`` steps (the last of length ``last``), in true coordinates at both
         ends (the corrector applied around them); ``(steps, bad body or -1, status)``."""
-        ev = (watch, ev_out, ev_count, ws)
+        # the kernels with the events' code are compiled apart, for runs that watch some
+        watched = watch.shape[0] > 0
+        ev = (watch, ev_out, ev_count, ws) if watched else (ws,)
         q, u = self.q, self.u
         if not self.jacobi:
-            return _k.advance_dh(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
-                                 self.com, dt, n_steps, last, *ev)
+            kernel = _k.advance_dh_watched if watched else _k.advance_dh
+            return kernel(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
+                          self.com, dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, self.order, q, u, self.g, self.eta)
+        advance = _k.advance_jacobi_watched if watched else _k.advance_jacobi
         if not self.corrector:
-            return _k.advance_jacobi(*args, dt, n_steps, last, *ev)
+            return advance(*args, dt, n_steps, last, *ev)
         # the corrector conjugates a run of equal steps: a shortened last step gets
         # its own (C(dt) K(dt)^(n-1) C(dt)^-1, then C(h) K(h) C(h)^-1, as WHFast does
         # when its step changes)
@@ -387,7 +391,7 @@ class _Split:
         for h, k in runs:
             bad = _k.corrector_jacobi(*args, h, 1.0, *self.coef)
             if bad < 0:
-                steps, bad, status = _k.advance_jacobi(*args, h, k, h, *ev)
+                steps, bad, status = advance(*args, h, k, h, *ev)
                 done += steps
             if bad < 0:
                 bad = _k.corrector_jacobi(*args, h, -1.0, *self.coef)
