@@ -156,7 +156,9 @@ def _list_scenes() -> int:
                  for line in lines[1:]]
     print(format_table(rows))
     print("\nrun time: the whole command, warm (kernels cached), on a 2-core machine; the "
-          "first run\non a machine adds the one-time compilation of the kernels (~20-60 s)")
+          "first run\non a machine adds the one-time compilation of the kernels it uses (its "
+          "summary says\nwhich and how long; the main job's is measured by "
+          "benchmarks/bench_first_run.py)")
     return EXIT_OK
 
 

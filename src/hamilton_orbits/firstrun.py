@@ -1,7 +1,8 @@
 """A one-line notice on stderr while the package's kernels compile for the first time.
 
-With no numba cache, the first calls compile kernels for seconds (about 20 s
-for the main job), which otherwise looks like a hang.  A listener on numba's
+With no numba cache, the first calls compile kernels for seconds (about 14 s
+for the main job on two cores: ``benchmarks/bench_first_run.py``), which otherwise
+looks like a hang.  A listener on numba's
 ``numba:compile`` event (fired only when a function is really compiled, not
 when it is loaded from the on-disk cache) prints one line the first time a
 function of this package (or of ``rigid``) compiles, at most once per process.
@@ -25,9 +26,12 @@ import time
 
 from numba.core import event
 
+#: No estimate: what a run compiles depends on its method, effects and events (the
+#: main job's, measured by ``benchmarks/bench_first_run.py``, is in the README); the
+#: summary of a scene's run names what was compiled and how long it took.
 NOTICE = (
     "hamilton-orbits: compiling numerical kernels for first use "
-    "(once; cached for later runs, can take ~20 s) ..."
+    "(once; cached for later runs) ..."
 )
 PACKAGES = ("hamilton_orbits", "rigid")
 #: The modules of the generated right-hand sides (:mod:`hamilton_orbits.rhs`).
@@ -36,6 +40,10 @@ GENERATED_PREFIX = "hamilton_orbits_rhs_"
 _lock = threading.Lock()
 _state = {"printed": False}
 _clock = {"seconds": 0.0, "count": 0, "claimed_seconds": 0.0, "claimed_count": 0}
+#: ``(function, seconds)`` of every outermost compilation, in order; and those of the
+#: last claim (:func:`last_claim`)
+_compiled: list[tuple[str, float]] = []
+_claimed: dict[str, list[tuple[str, float]]] = {"last": []}
 _local = threading.local()
 
 
@@ -45,11 +53,26 @@ def _ours(dispatcher: object) -> bool:
     return module.split(".", 1)[0] in PACKAGES or module.startswith(GENERATED_PREFIX)
 
 
+def _name(ev: event.Event) -> str:
+    """``module.function`` of the function a compile event is about, without the
+    package's own prefixes (``hamilton_orbits._kernels.radau15.advance`` ->
+    ``radau15.advance``)."""
+    data = ev.data if isinstance(ev.data, dict) else {}
+    func = getattr(data.get("dispatcher"), "py_func", None)
+    module = getattr(func, "__module__", None) or "?"
+    for prefix in ("hamilton_orbits._kernels.", "rigid._kernels.", "hamilton_orbits."):
+        if module.startswith(prefix):
+            module = module[len(prefix):]
+            break
+    return f"{module}.{getattr(func, '__qualname__', '?')}"
+
+
 class _CompileNotice(event.Listener):
     def on_start(self, ev: event.Event) -> None:
         depth = getattr(_local, "depth", 0)
         if depth == 0:
             _local.start = time.perf_counter()
+            _local.name = _name(ev)
         _local.depth = depth + 1
         if _state["printed"]:
             return
@@ -73,6 +96,7 @@ class _CompileNotice(event.Listener):
             with _lock:
                 _clock["seconds"] += elapsed
                 _clock["count"] += 1
+                _compiled.append((getattr(_local, "name", "?"), elapsed))
 
 
 def compile_seconds() -> float:
@@ -106,9 +130,41 @@ def claim_compilation() -> tuple[float, int]:
     with _lock:
         seconds = _clock["seconds"] - _clock["claimed_seconds"]
         count = _clock["count"] - _clock["claimed_count"]
+        _claimed["last"] = _compiled[len(_compiled) - count:] if count else []
         _clock["claimed_seconds"] = _clock["seconds"]
         _clock["claimed_count"] = _clock["count"]
     return seconds, count
+
+
+def last_claim() -> list[tuple[str, float]]:
+    """What the last :func:`claim_compilation` covered: ``(function, seconds)`` of each
+    outermost compilation (a kernel with the functions it calls), in order.
+
+    Examples
+    --------
+    >>> _ = claim_compilation()
+    >>> last_claim()
+    []
+    """
+    with _lock:
+        return list(_claimed["last"])
+
+
+def describe(compiled: list[tuple[str, float]], shown: int = 3) -> str:
+    """The longest compilations of ``compiled`` by name, the rest counted.
+
+    Examples
+    --------
+    >>> describe([("radau15.advance", 8.84), ("nbody.newtonian_only", 3.1),
+    ...           ("checks.all_finite", 0.1), ("nbody.closest_pair", 0.2)], shown=2)
+    'radau15.advance 8.8 s, nbody.newtonian_only 3.1 s, 2 more 0.3 s'
+    """
+    ranked = sorted(compiled, key=lambda item: -item[1])
+    parts = [f"{name} {seconds:.1f} s" for name, seconds in ranked[:shown]]
+    rest = ranked[shown:]
+    if rest:
+        parts.append(f"{len(rest)} more {sum(s for _, s in rest):.1f} s")
+    return ", ".join(parts)
 
 
 def compile_count() -> int:

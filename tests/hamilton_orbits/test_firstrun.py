@@ -86,6 +86,20 @@ def test_compile_clock_counts_outermost_compilations():
     assert firstrun.compile_seconds() > seconds
 
 
+def test_claim_names_what_was_compiled():
+    """The summary's line names the kernels compiled since the last claim (the
+    outermost function of each compilation), with their seconds."""
+    firstrun.claim_compilation()
+    assert njit(_caller_of("hamilton_orbits._probe_claim"))(1.0) == 4.0
+    seconds, count = firstrun.claim_compilation()
+    named = firstrun.last_claim()
+    assert count == 1 and [name for name, _ in named] == ["_probe_claim.outer"]
+    assert named[0][1] == pytest.approx(seconds, rel=1e-12)
+    assert firstrun.describe(named).startswith("_probe_claim.outer ")
+    firstrun.claim_compilation()
+    assert firstrun.last_claim() == []  # nothing compiled since
+
+
 def test_integration_time_excludes_compilation():
     """What the summary and the cross-check table call the integration time: the
     trajectory's wall time less the compilation inside the integrator's call (a first

@@ -46,6 +46,9 @@ class Result:
         0 when everything came from the cache), apart from ``wall_time``.
     compile_count : int
         How many kernels were compiled during the run.
+    compiled : list of (str, float)
+        Which kernels were compiled (``module.function``, with the functions it
+        calls) and the seconds of each, in order.
     units : dict
         The unit system the times and states are held in (``{"time": u.d,
         "length": u.au, ...}``): the arrays are the run's own floats, wrapped as
@@ -64,6 +67,7 @@ class Result:
     frame: str = ""
     compile_time: float = 0.0
     compile_count: int = 0
+    compiled: list[tuple[str, float]] = field(default_factory=list)
     units: dict[str, Any] = field(default_factory=dict)
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
@@ -96,8 +100,12 @@ class Result:
         lines.append(f"simulated: {format_value(span)} in {self.wall_time:.2f} s of integration "
                      "(compilation apart)")
         if self.compile_count:
+            from hamilton_orbits.firstrun import describe  # numba: only once compiled
+
+            what = f" ({describe(self.compiled)})" if self.compiled else ""
             lines.append(f"compiled: {self.compile_count} numba kernels in "
-                         f"{self.compile_time:.2f} s (first run only: cached for later runs)")
+                         f"{self.compile_time:.2f} s{what}; first run only: cached for later "
+                         "runs")
         else:
             lines.append("compiled: nothing (every kernel loaded from numba's cache)")
         if self.metrics:

@@ -478,15 +478,17 @@ class Scene:
         for the run (the first run on a machine; 0 once they are cached): during
         the run, and before it, since the previous run in the process, when the
         kernels' modules were imported; ``result.compile_count`` how many
-        compilations.  The kinds take the compilation inside the integration out
-        of ``result.wall_time``, the integration proper.
+        compilations, ``result.compiled`` which, with their seconds.  The kinds
+        take the compilation inside the integration out of ``result.wall_time``,
+        the integration proper.
         """
-        from hamilton_orbits.firstrun import claim_compilation
+        from hamilton_orbits.firstrun import claim_compilation, last_claim
 
         extra = {} if archive is None else {"archive": archive}
         result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False),
                                       **extra)
         result.compile_time, result.compile_count = claim_compilation()
+        result.compiled = last_claim()
         return result
 
     def crosscheck(self) -> str:
