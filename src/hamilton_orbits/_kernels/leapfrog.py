@@ -10,7 +10,8 @@ from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
 
-__all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance"]
+__all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance",
+           "advance_watched"]
 
 STATUS_OK = 0
 STATUS_EVENT = 4
@@ -25,17 +26,18 @@ _NO_B = np.zeros((7, 1))
 def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no cover - compiled
     """``r += h v``; with events watched, the straight segment is scanned (``ws``:
     the time and watch row of the first event with an action, see
-    :func:`hamilton_orbits._kernels.wh._drift`)."""
+    :func:`hamilton_orbits._kernels.wh._drift`).  ``watch`` None: no events (decided
+    at compile time: no event code is compiled)."""
     n = r.shape[0]
-    n_watch = watch.shape[0]
-    if n_watch > 0:
+    n_watch = 0 if watch is None else watch.shape[0]
+    if watch is not None and n_watch > 0:
         for i in range(n):
             for k in range(3):
                 x0[i, k] = r[i, k]
     for i in range(n):
         for k in range(3):
             r[i, k] += h * v[i, k]
-    if n_watch > 0:
+    if watch is not None and n_watch > 0:
         cm = np.zeros(9)
         total = 0.0
         for i in range(n):
@@ -55,12 +57,8 @@ def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no co
             ws[2] = 1.0
 
 
-# explicit signature with ``accel`` as a first-class function type: compiled once
-# and loaded from the cache in later processes, whatever the right-hand side
-@entry(types.Tuple((types.int64, types.int64))(
-    ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64, F2, F2,
-    types.int64[::1], F1, types.int64), cache=True, error_model="numpy")
-def advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
+@njit(cache=True, error_model="numpy")
+def _advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
     # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.
@@ -84,7 +82,7 @@ def advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, ma
             for k in range(3):
                 v[i, k] += h * acc[i, k]
         _drift(r, v, 0.5 * h, t + 0.5 * h, watch, ev_out, ev_count, ws, x0, gm)
-        if ws[1] <= t0 + (s + 1) * h or ws[2] > 0.0:
+        if watch is not None and (ws[1] <= t0 + (s + 1) * h or ws[2] > 0.0):
             ws[0] = t0 + (s + 1) * h
             return s + 1, STATUS_EVENT if ws[1] <= ws[0] else STATUS_DRAIN
         if s + 1 >= max_steps and s + 1 < n_steps:
@@ -92,3 +90,26 @@ def advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, ma
             return s + 1, STATUS_SLICE
     ws[0] = t1
     return n_steps, STATUS_OK
+
+
+# explicit signatures with ``accel`` by its addresses: compiled once and loaded from
+# the cache in later processes, whatever the right-hand side
+_ARGS = (ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64)
+_RESULT = types.Tuple((types.int64, types.int64))
+
+
+@entry(_RESULT(*_ARGS, F1, types.int64), cache=True, error_model="numpy")
+def advance(accel_addr, p, r, v, gm, t0, t1, dt, ws, max_steps):  # pragma: no cover - compiled
+    """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` watching no events (see
+    :func:`_advance`); no event code is compiled into it."""
+    return _advance(accel_addr, p, r, v, gm, t0, t1, dt, None, None, None, ws, max_steps)
+
+
+@entry(_RESULT(*_ARGS, F2, F2, types.int64[::1], F1, types.int64), cache=True,
+       error_model="numpy")
+def advance_watched(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws,
+                    max_steps):  # pragma: no cover - compiled
+    """:func:`advance` watching the events ``watch``, recorded into ``ev_out`` /
+    ``ev_count``."""
+    return _advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws,
+                    max_steps)

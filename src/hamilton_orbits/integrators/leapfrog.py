@@ -121,8 +121,12 @@ class _State:
         t = float(t_out[i - 1])
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
-            done, status = _k.advance(self.accel, self.p, r, v, self.gm, t, float(t_out[i]),
-                                      self.dt, log.watch, log.buffer, log.count, ws, SLICE)
+            args = (self.accel, self.p, r, v, self.gm, t, float(t_out[i]), self.dt)
+            if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
+                done, status = _k.advance_watched(*args, log.watch, log.buffer, log.count, ws,
+                                                  SLICE)
+            else:
+                done, status = _k.advance(*args, ws, SLICE)
             self.steps += int(done)
             t = self.t = float(ws[0])
             if status == _k.STATUS_OK:
