@@ -128,6 +128,7 @@ def coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 _RINV, _C, _D = coefficients()
+assert all(_C[j, j] == 1.0 for j in range(7))  # relied on by _correct
 _H = np.array([float(x) for x in DECIMAL_SPACINGS])
 
 _F1 = types.float64[::1]
@@ -264,9 +265,8 @@ def _correct(ns, at, a0, g, b, csb):  # pragma: no cover - compiled
         gk = gk * _RINV[ns, j]
         delta = gk - g[j, k]
         g[j, k] = gk
-        for i in range(j):
+        for i in range(j + 1):  # _C[j, j] = 1 (a monic polynomial): delta itself
             _kahan2(b, csb, i, k, _C[i, j] * delta)
-        _kahan2(b, csb, j, k, delta)
         if ns == 7:  # the convergence measure, on the last substep only
             ak = abs(at[k])
             if ak > maxak and ak < math.inf:
@@ -338,6 +338,14 @@ def _prs23_sums(a0, b, i, f):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
+def _squares_ok(a0i, y2, y3, y4):  # pragma: no cover - compiled
+    """Whether the sums of :func:`_prs23_sums` neither over- nor underflowed."""
+    return (2.2250738585072014e-308 <= a0i < math.inf
+            and 2.2250738585072014e-308 <= y2 < math.inf and y3 < math.inf
+            and (y4 == 0.0 or 2.2250738585072014e-308 <= y4 * y2 < math.inf))
+
+
+@njit(cache=True, inline="always")
 def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     """Pham, Rein & Spiegel (2024): the shortest timescale
     ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
@@ -354,13 +362,18 @@ def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     for i in range(n):
         if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
             continue
-        a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, 1.0)
-        if not (2.2250738585072014e-308 <= a0i < math.inf
-                and 2.2250738585072014e-308 <= y2 < math.inf and y3 < math.inf
-                and (y4 == 0.0 or 2.2250738585072014e-308 <= y4 * y2 < math.inf)):
+        skip = False
+        f = 1.0
+        for attempt in range(2):  # one call site (inlined once): plain, then scaled
+            a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, f)
+            if attempt == 1 or _squares_ok(a0i, y2, y3, y4):
+                break
             if not (top > 0.0 and top < math.inf):
-                continue
-            a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, math.ldexp(1.0, -math.frexp(top)[1]))
+                skip = True
+                break
+            f = math.ldexp(1.0, -math.frexp(top)[1])
+        if skip:
+            continue
         if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
             continue
         if not (y2 > 0.0 and y2 < math.inf):
@@ -402,28 +415,25 @@ def _dt_global(at, b, x, v, n, dt_done, eps):  # pragma: no cover - compiled
     return dt_done / _SAFETY
 
 
+#: ``b[j] / _XDIV[j]`` and ``b[j] / _VDIV[j]``: the coefficients of eqs. (6) and (7) of
+#: Rein & Spiegel (2015) at ``h = 1``
+_XDIV = np.array([6.0, 12.0, 20.0, 30.0, 42.0, 56.0, 72.0])
+_VDIV = np.array([2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0])
+
+
 @njit(cache=True, inline="always")
 def _accept(x, v, csx, csv, b, a0, v0, dt):  # pragma: no cover - compiled
     """Compensated update of positions and velocities at the end of an accepted
-    step (``dt^2`` is not precomputed: with a fixed step its rounding would be a
-    bias)."""
+    step, the smallest terms first (``dt^2`` is not precomputed: with a fixed step
+    its rounding would be a bias).  ``v0`` may be ``v`` itself: each component's
+    position is updated before its velocity."""
     for k in range(x.shape[0]):
-        _kahan(x, csx, k, b[6, k] / 72.0 * dt * dt)
-        _kahan(x, csx, k, b[5, k] / 56.0 * dt * dt)
-        _kahan(x, csx, k, b[4, k] / 42.0 * dt * dt)
-        _kahan(x, csx, k, b[3, k] / 30.0 * dt * dt)
-        _kahan(x, csx, k, b[2, k] / 20.0 * dt * dt)
-        _kahan(x, csx, k, b[1, k] / 12.0 * dt * dt)
-        _kahan(x, csx, k, b[0, k] / 6.0 * dt * dt)
+        for j in range(6, -1, -1):
+            _kahan(x, csx, k, b[j, k] / _XDIV[j] * dt * dt)
         _kahan(x, csx, k, a0[k] / 2.0 * dt * dt)
         _kahan(x, csx, k, v0[k] * dt)
-        _kahan(v, csv, k, b[6, k] / 8.0 * dt)
-        _kahan(v, csv, k, b[5, k] / 7.0 * dt)
-        _kahan(v, csv, k, b[4, k] / 6.0 * dt)
-        _kahan(v, csv, k, b[3, k] / 5.0 * dt)
-        _kahan(v, csv, k, b[2, k] / 4.0 * dt)
-        _kahan(v, csv, k, b[1, k] / 3.0 * dt)
-        _kahan(v, csv, k, b[0, k] / 2.0 * dt)
+        for j in range(6, -1, -1):
+            _kahan(v, csv, k, b[j, k] / _VDIV[j] * dt)
         _kahan(v, csv, k, a0[k] * dt)
 
 
