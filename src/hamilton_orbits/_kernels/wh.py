@@ -33,8 +33,10 @@ __all__ = [
     "STATUS_EVENT",
     "STATUS_OK",
     "advance_dh",
+    "advance_dh_effects",
     "advance_dh_watched",
     "advance_jacobi",
+    "advance_jacobi_effects",
     "advance_jacobi_watched",
     "caller_gm",
     "corrector_jacobi",
@@ -663,11 +665,12 @@ _EVENT_ARGS = (F2, F2, types.int64[::1])
 @njit(cache=True, error_model="numpy")
 def _advance_dh(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
-    ws,
+    ws, effects,
 ):  # pragma: no cover - compiled
-    """The body of :func:`advance_dh` (``watch`` None: no events) and of
-    :func:`advance_dh_watched`.  ``watch is None`` is decided at compile time, so
-    the entry without events compiles none of their code."""
+    """The body of :func:`advance_dh` (``watch`` and ``effects`` None: no events, no
+    effects), :func:`advance_dh_effects` (``effects`` True) and
+    :func:`advance_dh_watched`.  ``watch is None`` and ``effects is None`` are
+    decided at compile time, so an entry compiles only its own loop."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     n = q.shape[0]
     m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
@@ -693,9 +696,9 @@ def _advance_dh(
     if watch is not None:
         return _dh_steps(watch.shape[0] > 0, extra, p, has_extra, q, u, gm, com, dt, n_steps,
                          dt_last, watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
-    # two copies of the loop: the one without effects has no trace of them (their
-    # branches cost up to 30% of a step at N = 2-3)
-    if has_extra:
+    # the loop without effects has no trace of them (their branches cost up to 30%
+    # of a step at N = 2-3)
+    if effects is not None:
         return _dh_steps(False, extra, p, True, q, u, gm, com, dt, n_steps, dt_last,
                          None, None, None, ws, x0, v0, mu, mu_s, kick)
     return _dh_steps(False, extra, p, False, q, u, gm, com, dt, n_steps, dt_last,
@@ -715,7 +718,16 @@ def advance_dh(
     (``ws[0]`` the start time).  Returns ``(steps, bad, status)`` with ``bad`` the
     index of a body whose Kepler step failed, else -1."""
     return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       None, None, None, ws)
+                       None, None, None, ws, None)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+def advance_dh_effects(
+    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_dh` with the listed effects (``has_extra`` True)."""
+    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
+                       None, None, None, ws, True)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
@@ -727,13 +739,13 @@ def advance_dh_watched(
     ``ev_count`` (see :func:`_drift`); at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
     state is synchronised at the end of step ``steps``."""
     return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       watch, ev_out, ev_count, ws)
+                       watch, ev_out, ev_count, ws, None)
 
 
 @njit(cache=True, error_model="numpy")
 def _advance_jacobi(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
-    ev_count, ws,
+    ev_count, ws, effects,
 ):  # pragma: no cover - compiled
     """The body of :func:`advance_jacobi` and :func:`advance_jacobi_watched`, as
     :func:`_advance_dh`."""
@@ -752,7 +764,7 @@ def _advance_jacobi(
         return _jacobi_steps(watch.shape[0] > 0, extra, p, has_extra, qj, uj, gm, eta, dt,
                              n_steps, dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)
     # as _advance_dh: the loop without effects has no trace of them
-    if has_extra:
+    if effects is not None:
         return _jacobi_steps(False, extra, p, True, qj, uj, gm, eta, dt, n_steps, dt_last,
                              None, None, None, ws, x0, v0, kick)
     return _jacobi_steps(False, extra, p, False, qj, uj, gm, eta, dt, n_steps, dt_last,
@@ -769,7 +781,16 @@ def advance_jacobi(
     listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
     removes the part the Kepler step already accounts for."""
     return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, None, None, None, ws)
+                           dt_last, None, None, None, ws, None)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+def advance_jacobi_effects(
+    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_jacobi` with the listed effects (``has_extra`` True)."""
+    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
+                           dt_last, None, None, None, ws, True)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
@@ -780,4 +801,4 @@ def advance_jacobi_watched(
     """:func:`advance_jacobi` watching the events ``watch`` (see
     :func:`advance_dh_watched`)."""
     return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, watch, ev_out, ev_count, ws)
+                           dt_last, watch, ev_out, ev_count, ws, None)

@@ -370,16 +370,19 @@ class _Split:
     def advance(self, dt, n_steps, last, watch, ev_out, ev_count, ws) -> tuple[int, int, int]:
         """``n_steps`` steps (the last of length ``last``), in true coordinates at both
         ends (the corrector applied around them); ``(steps, bad body or -1, status)``."""
-        # the kernels with the events' code are compiled apart, for runs that watch some
+        # the kernels with the events' code and with the effects' are compiled apart,
+        # each for the runs that need it
         watched = watch.shape[0] > 0
         ev = (watch, ev_out, ev_count, ws) if watched else (ws,)
         q, u = self.q, self.u
         if not self.jacobi:
-            kernel = _k.advance_dh_watched if watched else _k.advance_dh
+            kernel = (_k.advance_dh_watched if watched else
+                      _k.advance_dh_effects if self.has_extra else _k.advance_dh)
             return kernel(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
                           self.com, dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, self.order, q, u, self.g, self.eta)
-        advance = _k.advance_jacobi_watched if watched else _k.advance_jacobi
+        advance = (_k.advance_jacobi_watched if watched else
+                   _k.advance_jacobi_effects if self.has_extra else _k.advance_jacobi)
         if not self.corrector:
             return advance(*args, dt, n_steps, last, *ev)
         # the corrector conjugates a run of equal steps: a shortened last step gets
