@@ -1,4 +1,4 @@
-"""Architecture contracts from DESIGN.md, checked on the source.
+"""Architecture contracts from docs/design.md, checked on the source.
 
 - nothing in ``hamilton_orbits`` imports ``rigid`` (rigid registers itself);
 - compiled kernels never import astropy (units stay at the boundary).

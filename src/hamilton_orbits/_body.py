@@ -70,7 +70,7 @@ class Body:
         G times the mass (Hamilton's m), >= 0; 0 makes a massless test particle.
     r, v : Quantity or array_like, shape (3,)
         Position and velocity (barycentric for
-        :meth:`~hamilton_orbits.nbody.System.solar_system`).
+        ``System.solar_system``).
     radius : Quantity or float, optional
         Equatorial radius (needed by the ``j2`` effect).
     j2 : float, optional

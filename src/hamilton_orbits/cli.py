@@ -26,7 +26,7 @@ into one folder at once, and a run never learns at the end that it cannot save.
 two-body integrals on a textbook orbit, then the demo sections that other packages
 register under the entry-point group ``hamilton_orbits.demos`` (``rigid`` adds the
 flip of a free rigid body), so that ``hamilton_orbits`` never imports ``rigid``
-itself (DESIGN.md).
+itself (docs/design.md).
 """
 
 from __future__ import annotations

@@ -197,10 +197,10 @@ class Conic:
         """The conic through the state ``(r, v)`` about ``mu``.
 
         The state is checked as :meth:`KeplerOrbit.from_state
-        <hamilton_orbits.orbit.KeplerOrbit.from_state>` checks it
-        (:func:`hamilton_orbits.twobody.check_state`; Quantities in give a
+        <hamilton_orbits.KeplerOrbit.from_state>` checks it
+        (``hamilton_orbits.twobody.check_state``; Quantities in give a
         conic of Quantities), and the elements are the orbit's
-        (:func:`hamilton_orbits.twobody.classical_columns`).
+        (``hamilton_orbits.twobody.classical_columns``).
 
         Examples
         --------

@@ -339,14 +339,14 @@ _NO_BUFFER = np.zeros((0, N_EVENT_COLUMNS))
 class EventLog:
     """What a run records: the watch table, the events found, and why it stopped.
 
-    The drivers pass :attr:`watch`, :attr:`buffer` and :attr:`count` to their
+    The drivers pass ``watch``, ``buffer`` and ``count`` to their
     kernels, :meth:`drain` the buffer when asked, and call :meth:`act` for an
     event with an action; the public layer reads :meth:`recorded`.
 
     Parameters
     ----------
     watch : ndarray, shape (m, 5)
-        From :func:`watch_table`.
+        From ``watch_table``.
     radius : ndarray, shape (n,)
         The bodies' radii (NaN: none), for the contact distance of merged bodies.
     """
@@ -379,7 +379,7 @@ class EventLog:
         return log
 
     def drain(self) -> None:
-        """Move the kernel's buffered rows into :attr:`rows` and empty the buffer."""
+        """Move the kernel's buffered rows into ``rows`` and empty the buffer."""
         k = int(self.count[0])
         rows = self.buffer[:k].copy()
         if self.index_map is not None:
@@ -397,7 +397,7 @@ class EventLog:
             v[self.inactive] = np.nan
 
     def kernel_watch(self) -> np.ndarray:
-        """:attr:`watch` with the bodies numbered as the kernel numbers them."""
+        """``watch`` with the bodies numbered as the kernel numbers them."""
         if self.index_map is None:
             return self.watch
         back = np.argsort(self.index_map)
@@ -443,7 +443,7 @@ class EventLog:
         their centre of mass, with their total momentum and the radius of their
         summed volume; ``"remove"`` takes a body out.  A body taken out is parked
         far away with ``gm = 0`` (it then pulls on nothing and is pulled by almost
-        nothing) and marked :attr:`inactive`; its outputs are NaN from then on.
+        nothing) and marked ``inactive``; its outputs are NaN from then on.
         """
         self.drain()
         # what the scan found later in the same step did not happen: the run goes on

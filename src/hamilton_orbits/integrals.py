@@ -5,7 +5,7 @@ gravity (C), of areas (D) and of vis viva (E); a
 :class:`~hamilton_orbits.nbody.System` gives them for its state
 (``barycentre()``, ``angular_momentum()``, ``energy()``).  This module measures
 how well the states of a run keep them (:func:`integral_errors`, one compiled
-pass of :mod:`hamilton_orbits._kernels.integrals`; :class:`LostStateError` for a
+pass of ``hamilton_orbits._kernels.integrals``; :class:`LostStateError` for a
 state that became non-finite), gives (E) on plain arrays (:func:`energy_gm`,
 :func:`energy_gm_many`), and evaluates (B) itself with quaternion products
 (:func:`accelerations_quaternion`), a reference for the compiled kernel.
@@ -84,7 +84,7 @@ def integral_errors(
 
     ``gm`` is (n,), or (n_t, n) where masses changed during the run (merges);
     bodies with NaN states (taken out of the run) count as absent.  One compiled
-    pass over the states (:func:`hamilton_orbits._kernels.integrals.integral_sums`,
+    pass over the states (``hamilton_orbits._kernels.integrals.integral_sums``,
     the energy's sums compensated).
 
     Parameters
@@ -94,7 +94,7 @@ def integral_errors(
     t : ndarray, shape (n_t,)
     extra_energy : ndarray, shape (n_t, n), optional
         The effects' part of each body's specific energy
-        (:func:`hamilton_orbits.effects.effect_energy`), added so that the energy
+        (``hamilton_orbits.effects.effect_energy``), added so that the energy
         compared is the one the equations of motion keep.
     gone : ndarray of bool, shape (n,), optional
         The bodies an event took out of the run.  When given, a non-finite state

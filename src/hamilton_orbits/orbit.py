@@ -76,7 +76,7 @@ _ONE_ORBIT_SIZE = _columns.ONE_ORBIT_SIZE
 def _three(x: Any) -> np.ndarray | tuple | None:
     """``x`` if it is a float64 array of shape (3,), as a tuple if it is a list
     or tuple of three Python floats, else None (the general path then takes
-    it): one orbit's ``r`` or ``v`` for :func:`hamilton_orbits._kernels.elements.one_orbit`."""
+    it): one orbit's ``r`` or ``v`` for ``hamilton_orbits._kernels.elements.one_orbit``."""
     t = type(x)
     if t is np.ndarray:
         # dtype identity: the native float64 (any other dtype takes the general path)
@@ -94,26 +94,31 @@ class KeplerOrbit(OrbitElements):
     Build with :meth:`from_state` or :meth:`from_elements`.  The object keeps
     the state; elements are computed once, in one compiled pass, on first use.
 
-    Attributes (shape = the leading dims; Quantities if built from Quantities)
+    The attributes have the leading dimensions as their shape, and are Quantities
+    if the orbit was built from Quantities.
+
+    Attributes
     ----------
-    a : semi-major axis (``inf`` for the parabola, negative for the hyperbola).
-    e, p, q : eccentricity, semi-latus rectum (Hamilton's p, eq. 16), periapsis
-        distance.
-    inc, lan, argp, nu, M, anomaly : inclination, longitude of the ascending
-        node, argument of periapsis, true anomaly, mean anomaly and the
-        eccentric (e < 1), parabolic ``D = tan(nu/2)`` (e = 1) or hyperbolic
-        (e > 1) anomaly.
-    n, period, energy : mean motion (parabola: ``sqrt(mu / (2 q^3))``, so that
-        ``M = n (t - t_peri)`` with Barker's ``M = D + D^3/3``), period (``inf``
-        if unbound), specific orbital energy.
-    varpi, argument_of_latitude, true_longitude, mean_longitude : the
-        combinations that stay defined when ``e = 0`` or ``inc`` in {0, pi}.
-    time_since_periapsis : ``M / n`` (for the radial parabola the time since
-        the collision).
-    areal_vector : Hamilton's beta = r x v (twice the areal velocity, eq. 3).
-    eccentricity_vector : the modern eccentricity vector, towards periapsis.
-    hamilton_epsilon : Hamilton's epsilon = -eccentricity_vector, towards
-        apoapsis (eq. 13).
+    a : ndarray or Quantity
+        Semi-major axis (``inf`` for the parabola, negative for the hyperbola).
+    e, p, q : ndarray or Quantity
+        Eccentricity, semi-latus rectum (Hamilton's p, eq. 16), periapsis distance.
+    inc, lan, argp, nu, M, anomaly : ndarray or Quantity
+        Inclination, longitude of the ascending node, argument of periapsis, true
+        anomaly, mean anomaly and the eccentric (e < 1), parabolic ``D = tan(nu/2)``
+        (e = 1) or hyperbolic (e > 1) anomaly.
+    n, period, energy : ndarray or Quantity
+        Mean motion (parabola: ``sqrt(mu / (2 q^3))``, so that ``M = n (t -
+        t_peri)`` with Barker's ``M = D + D^3/3``), period (``inf`` if unbound),
+        specific orbital energy.
+    varpi, argument_of_latitude, true_longitude, mean_longitude : ndarray or Quantity
+        The combinations that stay defined when ``e = 0`` or ``inc`` in {0, pi}.
+    time_since_periapsis, areal_vector, eccentricity_vector, hamilton_epsilon : ndarray
+        ``M / n`` (for the radial parabola the time since the collision);
+        Hamilton's beta = r x v (twice the areal velocity, eq. 3); the modern
+        eccentricity vector, towards periapsis; Hamilton's epsilon =
+        -eccentricity_vector, towards apoapsis (eq. 13).  Quantities if the orbit
+        was built from Quantities.
 
     Notes
     -----
@@ -142,7 +147,7 @@ class KeplerOrbit(OrbitElements):
         :meth:`from_elements`.
 
         ``state``: float64 array (..., 7), ``[rx, ry, rz, vx, vy, vz, mu]``
-        (:func:`hamilton_orbits.twobody.check_state`), that the orbit keeps and
+        (``hamilton_orbits.twobody.check_state``), that the orbit keeps and
         never writes to; ``quantity``: whether it was built from Quantities;
         ``classical``: its ``CLASSICAL`` columns, shape (NCLASSICAL, ...), if
         already known."""
@@ -182,10 +187,10 @@ class KeplerOrbit(OrbitElements):
         The state is the representation; the elements are derived from it.  Any
         finite state is accepted at any scale (it is brought to order 1 by powers
         of two inside the kernels, which is exact).  The state is checked by
-        :func:`hamilton_orbits.twobody.check_state`; one orbit given as plain
+        ``hamilton_orbits.twobody.check_state``; one orbit given as plain
         floats (``r``, ``v`` three floats each, ``mu`` a float) is checked and
         its classical elements computed in one kernel call instead
-        (:func:`hamilton_orbits._kernels.elements.one_orbit`, the same rule and
+        (``hamilton_orbits._kernels.elements.one_orbit``, the same rule and
         the same arithmetic).
 
         *Representation limit near a hyperbola's asymptote.*  Far out along an
@@ -377,7 +382,7 @@ class KeplerOrbit(OrbitElements):
     def propagate(self, dt: Any) -> KeplerOrbit:
         """The orbit after time ``dt`` (any sign; broadcast over the leading dims).
 
-        By universal variables, the kernel of :func:`hamilton_orbits.kepler.propagate`
+        By universal variables, the kernel of ``hamilton_orbits.kepler.propagate``
         on the orbit's state (checked when the orbit was built).
 
         Parameters
@@ -394,7 +399,7 @@ class KeplerOrbit(OrbitElements):
             NaN / inf, shapes that do not broadcast, a Quantity ``dt`` for an
             orbit of plain floats or the reverse.
         ConvergenceError
-            As :func:`hamilton_orbits.kepler.propagate`.
+            As ``hamilton_orbits.kepler.propagate``.
 
         Examples
         --------

@@ -193,7 +193,7 @@ class Quaternion(RotationForms):
         return self._a[..., 3]
 
     def norm(self) -> np.ndarray:
-        """Hamilton's tensor T q = |q| = sqrt(w^2 + x^2 + y^2 + z^2), without overflow.
+        """Hamilton's tensor ``T q = |q| = sqrt(w^2 + x^2 + y^2 + z^2)``, without overflow.
 
         Examples
         --------
@@ -204,7 +204,7 @@ class Quaternion(RotationForms):
         return finite_or_raise("self", norm, "the norm", lambda: self._a)[..., 0]
 
     def unit(self) -> Quaternion:
-        """Hamilton's versor U q = q / |q|; the zero quaternion raises.
+        """Hamilton's versor ``U q = q / |q|``; the zero quaternion raises.
 
         Examples
         --------
@@ -221,7 +221,7 @@ class Quaternion(RotationForms):
         return Quaternion._wrap(a)
 
     def inverse(self) -> Quaternion:
-        """Reciprocal q^-1 = K q / |q|^2; the zero quaternion raises.
+        """Reciprocal ``q^-1 = K q / |q|^2``; the zero quaternion raises.
 
         Examples
         --------
@@ -328,7 +328,7 @@ class Quaternion(RotationForms):
         return Quaternion._wrap(-self._a)
 
     def exp(self) -> Quaternion:
-        """Exponential: exp(w) (cos|v|, sin|v| v/|v|), exact to rounding for tiny |v|.
+        """Exponential: ``exp(w) (cos|v|, sin|v| v/|v|)``, exact to rounding for tiny ``|v|``.
 
         Raises
         ------
@@ -337,7 +337,7 @@ class Quaternion(RotationForms):
             709.78, e.g. ``Quaternion([1e3, 0, 0, 0]).exp()``: e^1000 is not
             representable), naming ``self``, the index and the quaternion.
             Components that are representable although exp(w) alone is not
-            (exp(710) cos|v| with a small cosine) are computed.
+            (``exp(710) cos|v|`` with a small cosine) are computed.
 
         Examples
         --------
@@ -348,7 +348,7 @@ class Quaternion(RotationForms):
         return Quaternion._wrap(exp_components(self._a, "self", lambda: self._a))
 
     def log(self) -> Quaternion:
-        """Principal logarithm (log|q|, atan2(|v|, w) v/|v|); the zero quaternion raises.
+        """Principal logarithm ``(log|q|, atan2(|v|, w) v/|v|)``; the zero quaternion raises.
 
         Accurate at angles down to 1e-300 (series for atan(t)/t) and near pi
         (atan2 is well conditioned there).  For a negative real q the direction
@@ -438,7 +438,7 @@ class Quaternion(RotationForms):
     def rotation_distance(self, other: Quaternion) -> np.ndarray:
         """Geodesic distance (the rotation angle of self^-1 other) in [0, pi].
 
-        q and -q are at distance 0.  Computed as 2 atan2(|V d|, |S d|) of
+        q and -q are at distance 0.  Computed as ``2 atan2(|V d|, |S d|)`` of
         d = U(self)^-1 U(other), accurate for tiny and near-pi angles.
 
         Examples

@@ -76,8 +76,8 @@ class Simulation(Saving):
         The bodies at time 0 of the simulation.
     method : str or Method
         ``"radau15"`` (default), ``"wh"``, ``"leapfrog"``, ``"dop853"``, or a typed
-        value (:class:`~hamilton_orbits.integrators.Radau15`,
-        :class:`~hamilton_orbits.integrators.WH`, ...) that carries the options.
+        value (:class:`~hamilton_orbits.Radau15`,
+        :class:`~hamilton_orbits.WH`, ...) that carries the options.
     dt : Quantity or float, optional
         A fixed step (``radau15``, ``wh``, ``leapfrog``) or a step cap
         (``dop853``); a time Quantity for a Quantity system.
@@ -252,7 +252,7 @@ class Simulation(Saving):
             Show a progress bar (tqdm, on stderr) over the output times.
         on_output : callable, optional
             ``on_output(i, steps)`` after output ``i``; it may raise
-            :class:`~hamilton_orbits.engine.StopIntegration` to end the leg there
+            :class:`~hamilton_orbits.integrators.StopIntegration` to end the leg there
             (the trajectory then has ``complete == False``).
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
@@ -381,7 +381,7 @@ def integrate(
         Show a progress bar (tqdm, on stderr) over the output times.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` (for scenes and interfaces); it
-        may raise :class:`~hamilton_orbits.engine.StopIntegration` to end the run
+        may raise :class:`~hamilton_orbits.integrators.StopIntegration` to end the run
         there, the trajectory then incomplete (``complete == False``).
     events : sequence of str or mapping, optional
         Events to find during the run: ``close_encounter``, ``collision``,

@@ -1,4 +1,4 @@
-"""What a run returns: :class:`TrajectoryBase`, the shape every trajectory shares, and
+"""What a run returns: ``TrajectoryBase``, the shape every trajectory shares, and
 the n-body :class:`Trajectory`.
 
 An n-body :class:`~hamilton_orbits.simulation.Trajectory` and a rigid body's
@@ -69,11 +69,14 @@ class Trajectory(TrajectoryBase):
     integrals are measured from the start of the simulation, so that a run
     continued in legs reports the drift since its beginning; they, the final
     system and the events table are computed on first access (made by
-    :func:`make_trajectory`, whose ``integrals`` is what they are computed from: the
+    ``make_trajectory``, whose ``integrals`` is what they are computed from: the
     engine run's arrays, or a callable returning the three error arrays).
 
-    Attributes (beside those of :class:`TrajectoryBase`: ``t``, ``steps``,
-    ``wall_time``, ``method``, ``energy_error``, ``angular_momentum_error``)
+    The attributes below come beside those of ``TrajectoryBase`` (``t``,
+    ``steps``, ``wall_time``, ``method``, ``energy_error``,
+    ``angular_momentum_error``).
+
+    Attributes
     ----------
     t : ndarray or Quantity, shape (n_t,)
         Output times (the first is the leg's start), in the unit the caller gave
@@ -124,7 +127,7 @@ class Trajectory(TrajectoryBase):
     effects : tuple of str
     complete : bool
         False when the leg ended early: ``stop()`` returned True, or an output
-        callback raised :class:`~hamilton_orbits.engine.StopIntegration` (the
+        callback raised :class:`~hamilton_orbits.integrators.StopIntegration` (the
         outputs reached are kept; Ctrl-C raises ``KeyboardInterrupt`` instead).
     events : astropy.table.QTable
         One row per event found in this leg (``name``, ``time``, ``bodies``,
@@ -247,7 +250,7 @@ class Trajectory(TrajectoryBase):
     def plot(self, plane: str = "xy", ax: Any = None) -> Any:
         """Every body's path about the primary, its start (with the direction of
         motion) and its end: a matplotlib Figure
-        (:func:`hamilton_orbits.trajectory_plot.plot_trajectory`)."""
+        (``hamilton_orbits.trajectory_plot.plot_trajectory``)."""
         from hamilton_orbits.trajectory_plot import plot_trajectory
 
         return plot_trajectory(self, plane, ax)
@@ -366,7 +369,7 @@ def _particle_errors(system: Any, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
 
 def encounter_check(method: Any, dt: float | None, tol: float | None, r0: np.ndarray,
                     gm: np.ndarray) -> tuple[float | None, Any, float] | None:
-    """What :func:`make_trajectory` checks the test particles' approaches with, for a
+    """What ``make_trajectory`` checks the test particles' approaches with, for a
     run from positions ``r0``: None for an adaptive method, else ``(step, exempt,
     fraction)``: the fixed step (None: the leg's mean step), ``(body, distance)``,
     the body whose approaches beyond that distance the method integrates exactly

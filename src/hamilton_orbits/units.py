@@ -5,7 +5,7 @@ are taken in the caller's own consistent units; Quantities are converted to the
 internal unit of the argument, and results come back as Quantities in that
 system.  Kernels never see astropy.
 
-There is one boundary per *kind* of argument (DESIGN.md, "Conventions"): a
+There is one boundary per *kind* of argument (docs/design.md): a
 :class:`Kind` knows its physical dimension and which unit equivalencies it
 allows, so that
 

@@ -11,7 +11,7 @@ omega = (p, q, r) is the angular velocity in the body frame (Cayley's letters).
 
 Torques are small immutable objects (:class:`BodyTorque`, :class:`SpaceTorque`,
 :class:`GravityGradientTorque`) that encode themselves for the compiled time
-loops of :mod:`rigid.integrators`; :func:`torque_on` evaluates any of them on
+loops of ``rigid.integrators``; ``torque_on`` evaluates any of them on
 arrays of attitudes.  All of them depend on (t, attitude) only, not on omega.
 """
 

@@ -244,7 +244,7 @@ def integrate(
         0 is added if missing).  s for plain floats; a Quantity if ``body`` was
         built from Quantities.
     method : str, optional
-        One of :data:`METHODS` (see the module docstring).  Default
+        One of ``METHODS`` (see the module docstring).  Default
         ``"splitting4"``.
     dt : float or Quantity, optional
         Step of the fixed-step methods (required for them), rounded down so that
@@ -259,7 +259,7 @@ def integrate(
     progress : bool, optional
         Show a tqdm progress bar (needs the ``progress`` extra).
     recentre : float, optional
-        Re-centring threshold on |g_0| for ``"cayley_rk4"``.
+        Re-centring threshold on ``|g_0|`` for ``"cayley_rk4"``.
 
     Other Parameters
     ----------------

@@ -1,19 +1,19 @@
 """Polar motion: the public facade over the Liouville pole, the C04 record and the fit.
 
 One import for the concepts of Earth orientation, each in its own module of
-:mod:`rigid.earth`:
+``rigid.earth``:
 
 * :mod:`rigid.earth.liouville`: the linearised Liouville equation solved exactly,
   :class:`LiouvillePole`, its effects (:data:`EFFECTS`, registered as
   ``"rotation"`` effects by :func:`register_effects` on import);
-* :mod:`rigid.earth.c04`: the IERS 20 C04 record, :func:`load_c04` ->
+* ``rigid.earth.c04``: the IERS 20 C04 record, :func:`load_c04` ->
   :class:`PolarMotionRecord`, and the IERS 2010 mean pole
   :func:`iers2010_mean_pole`;
-* :mod:`rigid.earth.wobble_fit`: the Chandler and annual wobble fit :func:`fit_wobble` ->
+* ``rigid.earth.wobble_fit``: the Chandler and annual wobble fit :func:`fit_wobble` ->
   :class:`WobbleFit`, the :func:`periodogram`, and :func:`free_period`;
-* :mod:`rigid.earth.prediction`: where the pole will be, :func:`predict`, and how
+* ``rigid.earth.prediction``: where the pole will be, :func:`predict`, and how
   well that is done on data the model never saw, :func:`hindcast` (the methods
-  themselves in :mod:`rigid.earth.forecasters`).
+  themselves in ``rigid.earth.forecasters``).
 
 Conventions (IERS): the pole is ``m = m1 + i m2`` with ``m1 = x_p``,
 ``m2 = -y_p``; a prograde term is ``exp(+i sigma t)``.

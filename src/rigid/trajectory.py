@@ -60,7 +60,7 @@ class RigidTrajectory(TrajectoryBase):
     n_recentre : int
         Re-centrings of Cayley's parameters (``"cayley_rk4"`` only, else 0).
     norm_drift : float
-        max | |q| - 1 | before the output normalisation (0 for ``"exact_kick"``,
+        ``max | |q| - 1 |`` before the output normalisation (0 for ``"exact_kick"``,
         which renormalises every step).
     nfev : int
         Right-hand-side evaluations (``"dop853"`` only, else 0).
@@ -104,7 +104,7 @@ class RigidTrajectory(TrajectoryBase):
 
     @property
     def n_steps(self) -> int:
-        """Deprecated: use :attr:`steps`."""
+        """Deprecated: use ``steps``."""
         warnings.warn("`RigidTrajectory.n_steps` is deprecated; use `steps`",
                       DeprecationWarning, stacklevel=2)
         return self.steps

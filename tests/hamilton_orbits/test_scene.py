@@ -206,7 +206,7 @@ def test_rebound_binary_in_and_out(tmp_path):
 
 def test_the_public_path_gives_the_objects_of_the_scenes_package():
     """``hamilton_orbits.scene`` re-exports the objects of ``hamilton_orbits.scenes``
-    (the same objects, no warning: DESIGN.md and user code name it)."""
+    (the same objects, no warning: docs/design.md and user code name it)."""
     import warnings
 
     import hamilton_orbits.scene as public

@@ -185,7 +185,7 @@ def test_overflow_backwards_raises_instead_of_inf():
 
 def test_entry_point_declared_for_the_registry():
     """hamilton_orbits finds the rotation effects through its entry-point group, not an
-    import of rigid (DESIGN.md): the declared target exists and registers them."""
+    import of rigid (docs/design.md): the declared target exists and registers them."""
     import importlib
     import re
     from pathlib import Path

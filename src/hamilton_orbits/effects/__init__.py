@@ -2,51 +2,46 @@
 
 A scene or an ``integrate`` call lists effects by name (``"gr"``) or as mappings
 with parameters (``{"name": "j2", "body": "earth"}``).  Only what is listed is
-computed: :func:`~hamilton_orbits.rhs.compile_rhs` builds the right-hand side
+computed: ``hamilton_orbits.rhs.compile_rhs`` builds the right-hand side
 from the listed effects' kernels alone, so an effect that is not listed is not in
 the compiled function at all (not called, nothing branches on it).
 
 Registry
 --------
 Effects are registered per *kind* of simulation (``"nbody"``, ``"rotation"``)
-with :func:`register`.  Other packages add effects without ``hamilton_orbits``
+with ``register``.  Other packages add effects without ``hamilton_orbits``
 importing them: an entry point in the group ``hamilton_orbits.effects`` names a
 callable that registers its effects when the kind is first looked up (``rigid``
 registers its rotation effects this way).
 
 Normalised once
 ---------------
-:meth:`EffectSet.of` turns what a caller lists into an :class:`EffectSet`: a
+``EffectSet.of`` turns what a caller lists into an ``EffectSet``: a
 frozen, hashable value, checked against the registry once at the boundary.
-Everything downstream (the compiled right-hand side in :mod:`hamilton_orbits.rhs`,
-the integrators, rebound's cross-check, scenes) takes the :class:`EffectSet`.
+Everything downstream (the compiled right-hand side in ``hamilton_orbits.rhs``,
+the integrators, rebound's cross-check, scenes) takes the ``EffectSet``.
 
 Where things are
 ----------------
-One module per effect holds everything about it: its :class:`EffectSpec`
+One module per effect holds everything about it: its ``EffectSpec``
 (summary, parameters and their kinds, reference), its parameter builder, its
 energy, and its kernel and Jacobian (imported there from
-:mod:`hamilton_orbits._kernels` by name).
+``hamilton_orbits._kernels`` by name).
 
-=========================  ===================================================
-module                     holds
-=========================  ===================================================
-``effects.registry``       :class:`EffectSpec`, :func:`register`, :func:`get`,
-                           :func:`known`, :class:`EffectSet`, normalisation,
-                           :func:`exclusion_problems`, the entry points
-``effects.parameters``     :func:`source_index`, :func:`parameter_value`,
-                           :func:`speed_of_light`, DE440's defaults
-``effects.energy``         :func:`effect_energy`, :func:`energy_label`
-``effects.newtonian``      ``newtonian`` (always present)
-``effects.relativity``     ``gr``, ``gr_potential``
-``effects.j2``             ``j2``
-``effects.eih``            ``eih`` (and :func:`~hamilton_orbits.effects.eih.eih_energy`)
-``effects.lense_thirring`` ``lense_thirring`` (and ``sun_spin``)
-``effects.zonal``          ``zonal``
-``effects.moon_figure``    ``moon_figure``
-``effects.tides``          ``earth_tides``
-``effects.kuiper_ring``    ``kuiper_ring`` (and ``kuiper_ring_gm``)
-=========================  ===================================================
+- ``effects.registry``: ``EffectSpec``, ``register``, :func:`get`, :func:`known`, ``EffectSet``,
+  normalisation, :func:`exclusion_problems`, the entry points
+- ``effects.parameters``: :func:`source_index`, :func:`parameter_value`, :func:`speed_of_light`,
+  DE440's defaults
+- ``effects.energy``: :func:`effect_energy`, :func:`energy_label`
+- ``effects.newtonian``: ``newtonian`` (always present)
+- ``effects.relativity``: ``gr``, ``gr_potential``
+- ``effects.j2``: ``j2``
+- ``effects.eih``: ``eih`` (and ``eih_energy``)
+- ``effects.lense_thirring``: ``lense_thirring`` (and ``sun_spin``)
+- ``effects.zonal``: ``zonal``
+- ``effects.moon_figure``: ``moon_figure``
+- ``effects.tides``: ``earth_tides``
+- ``effects.kuiper_ring``: ``kuiper_ring`` (and ``kuiper_ring_gm``)
 
 Examples
 --------

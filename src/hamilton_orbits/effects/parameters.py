@@ -6,7 +6,7 @@ light or a length is read, refused and reported the same way by every effect:
 
 - :func:`source_index`, :func:`body_index`, :func:`optional_body_index`: the
   index of the body a parameter names;
-- :func:`parameter_value`, :func:`parameter_array`, :func:`scalar_parameter`,
+- :func:`parameter_value`, ``parameter_array``, :func:`scalar_parameter`,
   :func:`speed_of_light`: numbers with a dimension (:data:`SYSTEM_UNITS`);
 - DE440's defaults (the solar-system effects): :func:`require_de440_units`,
   :func:`finite_floats`, :func:`unit_vector`, :func:`axes_frame`,
@@ -223,12 +223,12 @@ def unit_example(kind: Kind) -> str:
 def parameter_value(system: Any, params: Mapping[str, Any], key: str, effect: str,
                     kind: Kind) -> float | None:
     """The scalar parameter ``key`` of mapping ``params`` in ``system``'s own units,
-    or None if it is not given (see :func:`parameter_array`).
+    or None if it is not given (see ``parameter_array``).
 
     Raises
     ------
     ValueError
-        As :func:`parameter_array` (an ``astropy.units.UnitConversionError``
+        As ``parameter_array`` (an ``astropy.units.UnitConversionError``
         for the wrong dimension), and for more than one number.
 
     Examples

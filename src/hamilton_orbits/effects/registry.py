@@ -80,10 +80,10 @@ class EffectSpec:
     jacobian : numba dispatcher or None
         ``"nbody"`` effects: a module-level compiled ``jacobian(r, v, gm, dr, dv,
         da, p)`` that *adds* the effect's Jacobian times ``k`` tangent vectors to
-        ``da`` (see :mod:`hamilton_orbits._kernels.jacobians`), compiled only when
+        ``da`` (see ``hamilton_orbits._kernels.jacobians``), compiled only when
         the variational equations are asked for.  None: the variational equations
         differentiate ``kernel`` by central differences along each tangent vector
-        (compiled, generated in :mod:`hamilton_orbits.rhs`; about 1e-10 relative,
+        (compiled, generated in ``hamilton_orbits.rhs``; about 1e-10 relative,
         and two or four evaluations of the kernel per tangent vector).
     energy : callable or None
         ``"nbody"`` effects that keep an energy: ``energy(r, v, gm, p) -> ndarray``
@@ -227,7 +227,7 @@ def entry_problems(item: Any, kind: str = "nbody") -> tuple[str | None, dict, li
 
 def exclusion_problems(names: Sequence[str], kind: str = "nbody") -> list[tuple[int, str]]:
     """``(index, message)`` for each listed effect that another listed one already
-    computes (:attr:`EffectSpec.excludes`), at the later of the two indices.
+    computes (``EffectSpec.excludes``), at the later of the two indices.
 
     Examples
     --------
@@ -329,7 +329,7 @@ class EffectSet:
     Build it with :meth:`of`; iterate over ``(name, params)`` pairs.  Two sets are
     equal when they list the same effects with the same parameters in the same
     order; their hash follows.  The compiled right-hand side depends only on
-    :attr:`names` (see :mod:`hamilton_orbits.rhs`).
+    :attr:`names` (see ``hamilton_orbits.rhs``).
 
     Attributes
     ----------
@@ -398,7 +398,7 @@ class EffectSet:
 
     def parameters(self, system: Any) -> list[np.ndarray]:
         """Each listed effect's parameter vector for ``system`` (its
-        :attr:`EffectSpec.params`), in order.
+        ``EffectSpec.params``), in order.
 
         Raises
         ------

@@ -1,21 +1,21 @@
-"""N-body integrators on the compiled right-hand side of :mod:`hamilton_orbits.rhs`.
+"""N-body integrators on the compiled right-hand side of ``hamilton_orbits.rhs``.
 
 Each integrator is a Python driver here (checks, set-up, the loop over output
-times) and a compiled step in :mod:`hamilton_orbits._kernels` (the loop over
-steps).  A driver module satisfies :class:`Integrator`:
+times) and a compiled step in ``hamilton_orbits._kernels`` (the loop over
+steps).  A driver module satisfies ``Integrator``:
 
 - ``NAME`` (``"leapfrog"``, ``"wh"``, ``"radau15"``, ``"dop853"``);
 - ``ACCEPTS_VELOCITY_DEPENDENT`` (bool): symplectic maps refuse velocity-dependent
   effects;
 - ``start(rhs, r0, v0, gm, t0, method, *, dt, tol, events=None, variational=None)``
-  returning a :class:`DriverState`: the integrator's whole state at ``t0`` for
+  returning a ``DriverState``: the integrator's whole state at ``t0`` for
   arguments already checked (``method`` its typed value from
   :mod:`~hamilton_orbits.integrators.methods`), advanced leg by leg across calls
   exactly as one run through every output time (what
   :class:`hamilton_orbits.Simulation` stands on);
 - ``run(rhs, r0, v0, gm, t_out, *, dt=None, tol=None, on_output=None, out=None,
   **options)`` returning ``(r, v, steps)``: one run, its input checked (``start``
-  then one ``advance``): ``rhs`` an :class:`~hamilton_orbits.rhs.RHS`; ``r0``,
+  then one ``advance``): ``rhs`` an ``hamilton_orbits.rhs.RHS``; ``r0``,
   ``v0`` float64 (n, 3) and ``gm`` (n,) in one consistent unit system; ``t_out``
   an increasing float64 array of output times with ``t_out[0]`` the initial time
   (row 0 of the output is the initial state); ``r``, ``v`` of shape (len(t_out),
@@ -27,7 +27,7 @@ steps).  A driver module satisfies :class:`Integrator`:
   outputs only), and True ends the run there with :class:`StopIntegration`.
 
 Python only loops over output times (and, for radau15, over slices of many
-steps); the public entry point is :func:`hamilton_orbits.engine.run`.
+steps); the public entry point is ``hamilton_orbits.engine.run``.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 One step of length ``h``: ``r += h/2 v``; ``v += h a(r)``; ``r += h/2 v``.  The
 map is symplectic for forces that derive from a potential, so velocity-dependent
 effects are refused.  With ``tol`` and no ``dt``, the step is chosen from the
-shortest dynamical time of the initial state (see :func:`choose_dt`).
+shortest dynamical time of the initial state (see ``choose_dt``).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ them::
     Simulation(system, method=WH(coordinates="jacobi", corrector=11), dt=0.01)
     Simulation(system, method="wh", coordinates="jacobi", corrector=11, dt=0.01)  # the same
 
-The string form with keyword options keeps working: :func:`method_of` turns it
+The string form with keyword options keeps working: ``method_of`` turns it
 into the typed value (an option the method does not take is refused, naming the
 options it does take).  The step ``dt`` and the tolerance ``tol`` are not part of
 the method: every method takes them, in the system's units.
@@ -225,7 +225,7 @@ _DEFAULTS = {name: cls() for name, cls in METHODS.items()}
 
 
 def method_of(method: Any, options: Mapping[str, Any] | None = None) -> Method:
-    """The typed method of ``method`` (a name or a :class:`Method`) and ``options``.
+    """The typed method of ``method`` (a name or a ``Method``) and ``options``.
 
     Raises
     ------

@@ -27,7 +27,7 @@ difference between the last prediction and its converged values added as a
 correction.
 
 The stepping loop between two output times is one compiled call
-(:func:`hamilton_orbits._kernels.radau15.advance`, which takes the acceleration
+(``hamilton_orbits._kernels.radau15.advance``, which takes the acceleration
 function as its first argument); the last step before an output time is
 shortened to land on it exactly.  This module is the driver: checks, the first
 step, the state between calls, and the output arrays.

@@ -8,7 +8,7 @@ into
 
 - the Kepler part, each body on a Kepler orbit about ``G M_0`` (advanced
   exactly by the universal-variable kernel
-  :func:`hamilton_orbits._kernels.kepler.propagate_uv`, shared, not copied:
+  ``hamilton_orbits._kernels.kepler.propagate_uv``, shared, not copied:
   the drift loop inlines its body, ``propagate_uv_inline``);
 - the interaction part, the mutual attraction of the bodies ``i >= 1``
   (Hamilton's equation (B) without the central body), a kick of the ``u_i``;
@@ -40,7 +40,7 @@ With Jacobi coordinates the symplectic correctors of Wisdom, Holman & Touma
 start of each output interval and ``C^-1`` at its end, so the steps in between
 are those of the uncorrected map on corrected coordinates and every output is
 in true coordinates.  The coefficients are computed here
-(:func:`corrector_coefficients`): the corrector of order ``p`` removes the terms
+(``corrector_coefficients``): the corrector of order ``p`` removes the terms
 ``eps dt^2, eps dt^4, ..., eps dt^(p-1)`` (``eps`` the planet-to-star mass ratio)
 of the map's error Hamiltonian; what remains is ``eps dt^(p+1)`` and the
 ``eps^2 dt^2`` terms no corrector of this kind removes.  The democratic-heliocentric map has no

@@ -25,7 +25,7 @@ Scene *kinds* (``nbody``; ``rotation`` from ``rigid``) come from the registry of
 :mod:`hamilton_orbits.scenes.base`, which every package (this one too) fills
 through the entry-point group ``hamilton_orbits.scene_kinds``, so that
 ``hamilton_orbits`` never imports them.  This module holds :class:`Scene`,
-:class:`SceneError`, the ``effects`` key every kind shares, and the overrides
+``SceneError``, the ``effects`` key every kind shares, and the overrides
 (:meth:`Scene.with_values`, ``--set KEY=VALUE``).
 """
 
@@ -255,7 +255,7 @@ class Scene:
 
     Build one with :meth:`from_toml`, :meth:`bundled` or :meth:`from_dict`;
     nothing is simulated until :meth:`run`.  Every problem of an invalid scene is
-    reported at once (:class:`SceneError`), as ``file:LINE: key.path: message``
+    reported at once (``SceneError``), as ``file:LINE: key.path: message``
     (the line where the file sets the key; none for a key the file leaves out,
     for a value set by :meth:`with_values`, or for a scene from a mapping).
 

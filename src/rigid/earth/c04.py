@@ -154,7 +154,7 @@ def load_c04(path: Any = None) -> PolarMotionRecord:
 
     The file ``eopc04.1962-now`` (daily since 1962-01-01, columns x_p, y_p in
     arcsec; Bizouard et al. 2019, J. Geodesy 93, 621) is found with
-    :mod:`importlib.resources` and parsed here; nothing is downloaded.
+    ``importlib.resources`` and parsed here; nothing is downloaded.
 
     Parameters
     ----------

@@ -7,7 +7,7 @@ as a :class:`PolePath`; :func:`pole_path` turns any body-frame angular velocity
 into the pole ``m = m1 + i m2`` (IERS: ``x_p = m1``, ``y_p = -m2``).  A free
 wobble of an axisymmetric rigid Earth is ``m(t) = m0 exp(i sigma_E t)``,
 prograde, with the Euler frequency ``sigma_E = OMEGA (C - A) / A`` (Euler 1765);
-:meth:`PolePath.period` fits its period (:func:`rigid.earth.wobble_fit.free_period`).
+:meth:`PolePath.period` fits its period (``rigid.earth.wobble_fit.free_period``).
 """
 
 from __future__ import annotations
@@ -86,7 +86,7 @@ class PolePath:
         return (-self.m.imag * u.rad).to(u.arcsec)
 
     def period(self) -> u.Quantity:
-        """The wobble period fitted to the path (see :func:`rigid.earth.wobble_fit.free_period`).
+        """The wobble period fitted to the path (see ``rigid.earth.wobble_fit.free_period``).
 
         Examples
         --------

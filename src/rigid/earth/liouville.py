@@ -8,10 +8,10 @@ Gross 2007, Treatise on Geophysics 3, 239, eq. 7)
     m + (i / sigma_c) dm/dt = chi,   sigma_c = (2 pi / T_c)(1 + i / (2 Q))
 
 is solved exactly by :class:`LiouvillePole`, whose effects are registered as
-``"rotation"`` effects in :mod:`hamilton_orbits.effects` (:func:`register_effects`,
-called on import).  :func:`free_period`, the period of a free wobble fitted to a
+``"rotation"`` effects in :mod:`hamilton_orbits.effects` (``register_effects``,
+called on import).  ``free_period``, the period of a free wobble fitted to a
 pole path (the measure of a model's period), lives with the fits in
-:mod:`rigid.earth.wobble_fit` and is re-exported here.  The public facade is
+``rigid.earth.wobble_fit`` and is re-exported here.  The public facade is
 :mod:`rigid.polar_motion`.
 """
 

@@ -1,6 +1,6 @@
 """Where will the pole be next year?  Polar-motion prediction and honest hindcasts.
 
-Five methods (:data:`METHODS`), each from the IERS C04 pole coordinates alone, each with
+Five methods (``METHODS``), each from the IERS C04 pole coordinates alone, each with
 a 1-sigma band from its own model (``m = x_p - i y_p``, IERS sign convention, mas, days):
 ``"persistence"``, least-squares harmonics ``"ls"``, ``"ls+ar"``, ``"ls+var"`` and the
 package's physics, the linearised Liouville equation ``"liouville"`` (each described in
@@ -18,7 +18,7 @@ whose band needs pairs at that lag within its ten-year window).
 One bad datum: the fitted models extrapolate the newest days, so a spike there moves
 the ``"ls+ar"`` 30-day forecast ten times as far as the spike (a 1-arcsec spike made
 the ``"ls+ar"``, ``"ls+var"`` and ``"liouville"`` forecasts 1e10-1e15 mas).  A history
-whose day-to-day second difference exceeds :data:`SPIKE_LIMIT` (100 mas, twice the
+whose day-to-day second difference exceeds ``SPIKE_LIMIT`` (100 mas, twice the
 largest of the C04 series since 1962) is refused with a ``ValueError`` naming the
 coordinate, the index and the value; smaller errors in the data pass to the forecast.
 
@@ -258,9 +258,9 @@ def predict(
         For an unknown method, an empty record, ``at`` outside the record (or without
         the method's history before it), a horizon or latency that is not a single
         whole number of days, a latency below a day, a lead ``latency + horizon`` beyond
-        the method's :func:`~rigid.earth.forecasters.max_lead` (ten years; five for
+        the method's ``rigid.earth.forecasters.max_lead`` (ten years; five for
         ``"persistence"``), or data in the history used that are not finite or jump
-        off their neighbours (:data:`SPIKE_LIMIT`).
+        off their neighbours (``SPIKE_LIMIT``).
 
     Examples
     --------
@@ -321,7 +321,7 @@ def check_inputs(record: PoleRecord, starts: Time, horizons: u.Quantity, method:
 
 def _check_history(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
     """The history used (``history`` days up to index ``k``): finite, and no datum off its
-    neighbours by more than :data:`SPIKE_LIMIT` (one bad datum ruins the fitted models'
+    neighbours by more than ``SPIKE_LIMIT`` (one bad datum ruins the fitted models'
     forecasts: the ``ls+ar`` 30-day forecast moves ten times as far as the newest datum)."""
     first = k - history + 1
     for name, arr in (("record.x", x), ("record.y", y)):
@@ -423,13 +423,13 @@ def hindcast(
     ----------
     record : PolarMotionRecord
     starts : Time or date strings, optional
-        Start dates (0h UTC).  Default: weekly over :data:`PAPER_PERIOD` (the 1st EOP
+        Start dates (0h UTC).  Default: weekly over ``PAPER_PERIOD`` (the 1st EOP
         PCC's Oct 2005 - Mar 2008, assumed for Lei et al. 2023); the second period is
-        ``weekly_starts(*RECENT_PERIOD)`` (:func:`rigid.earth.prediction.weekly_starts`).
+        ``weekly_starts(*RECENT_PERIOD)`` (``rigid.earth.prediction.weekly_starts``).
     horizons : Quantity
         Whole days >= 0 (default 10, 30, 90, 150, 270, 365 d).
     method : str
-        One of :data:`METHODS`.
+        One of ``METHODS``.
     latency : Quantity
         Age of the newest datum at each start (default 1 day).
 

@@ -263,7 +263,7 @@ def fit_wobble(
         From :func:`load_c04`.
     start, end : Time, decimal year or None
         The window (default: the whole record); within the record (a window
-        beyond it is refused, see :meth:`~rigid.earth.c04.PolarMotionRecord.select`).
+        beyond it is refused, see ``rigid.earth.c04.PolarMotionRecord.select``).
     trend : {"linear", "iers2010"}
     chandler_guess : Quantity
         Centre of the grid search (+-10%).
