@@ -1,18 +1,20 @@
-"""Regenerate the README's "What accuracy costs in time" section from a report.
+"""Regenerate the "What accuracy costs in time" benchmark page from a report.
 
 Developer tooling, not part of the installed package::
 
     hamilton-orbits report --out /tmp/report          # the full report (minutes)
-    python tools/update_readme.py /tmp/report README.md
+    python tools/update_readme.py /tmp/report         # docs/benchmarks/accuracy.md
 
-copies the combined diagram and the full table under ``docs/`` and rewrites the
-README between its markers (``<!-- report:begin ... -->`` and ``<!-- report:end -->``).
+copies the combined diagram and the full table under ``docs/`` and rewrites the page
+(or a README given instead) between its markers (``<!-- report:begin ... -->`` and
+``<!-- report:end -->``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -83,17 +85,20 @@ def readme_section(report_dir: Any, diagram: str = "docs/work_precision.png") ->
     return "\n".join(lines)
 
 
-def update_readme(report_dir: Any, readme: Any) -> Path:
+def update_readme(report_dir: Any, readme: Any, docs: Any = None) -> Path:
     """Copy the combined diagram and the full table under ``docs/`` and rewrite the
-    README's generated section between its markers.
+    page's generated section between its markers.
 
     Parameters
     ----------
     report_dir : str or path-like
         A folder written by :func:`build_report`.
     readme : str or path-like
-        The README to update; it must hold the markers ``<!-- report:begin ... -->``
-        and ``<!-- report:end -->``.  ``docs/`` is taken next to it.
+        The page to update (a benchmark page or a README); it must hold the
+        markers ``<!-- report:begin ... -->`` and ``<!-- report:end -->``.
+    docs : str or path-like, optional
+        Where the diagram and the full table go (default: ``docs/`` next to
+        ``readme``); the page links to them by relative paths.
 
     Returns
     -------
@@ -116,13 +121,14 @@ def update_readme(report_dir: Any, readme: Any) -> Path:
     if begin < 0 or end < begin:
         raise ValueError(f"`readme` {str(path)!r} has no generated section: add the lines "
                          f"{_BEGIN!r} and {_END!r} where it belongs")
-    docs = path.parent / "docs"
+    docs = path.parent / "docs" if docs is None else Path(docs)
     docs.mkdir(exist_ok=True)
     shutil.copyfile(src / "work_precision.png", docs / "work_precision.png")
     shutil.copyfile(src / "report.md", docs / "work_precision.md")
-    body = readme_section(src, "docs/work_precision.png")
-    body += ("\n\nThe full table (every setting): [docs/work_precision.md]"
-             "(docs/work_precision.md).")
+    png = Path(os.path.relpath(docs / "work_precision.png", path.parent)).as_posix()
+    table = Path(os.path.relpath(docs / "work_precision.md", path.parent)).as_posix()
+    body = readme_section(src, png)
+    body += f"\n\nThe full table (every setting): [{table}]({table})."
     path.write_text(text[: begin + len(_BEGIN)] + "\n\n" + body + "\n\n" + text[end:],
                     encoding="utf-8")
     return path
@@ -132,10 +138,11 @@ def main(argv: list[str] | None = None) -> int:
     """``python tools/update_readme.py REPORT_DIR [README]``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("report_dir", help="a folder written by `hamilton-orbits report`")
-    parser.add_argument("readme", nargs="?", default="README.md")
+    parser.add_argument("page", nargs="?", default="docs/benchmarks/accuracy.md")
+    parser.add_argument("--docs", default="docs", help="where the diagram and table go")
     args = parser.parse_args(argv)
-    path = update_readme(args.report_dir, args.readme)
-    print(f"updated {path} and docs/work_precision.png, docs/work_precision.md")
+    path = update_readme(args.report_dir, args.page, args.docs)
+    print(f"updated {path} and {args.docs}/work_precision.png, {args.docs}/work_precision.md")
     return 0
 
 
