@@ -17,6 +17,7 @@ caller gave plain floats, they are plain floats in the caller's own units.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -251,6 +252,28 @@ class Trajectory(TrajectoryBase):
         from hamilton_orbits.trajectory_plot import plot_trajectory
 
         return plot_trajectory(self, plane, ax)
+
+    def plot3d(self, bodies: Sequence[str] | None = None, origin: str = "primary",
+               unit: Any = None, max_frames: int = 200) -> Any:
+        """An interactive 3-D view (plotly, the ``plot3d`` extra): every body's path,
+        its start, its position at the last output and a time slider that moves it
+        along the path (at most ``max_frames`` steps: the outputs are subsampled);
+        axes named with origin and unit, equal aspect.  A plotly Figure
+        (:func:`hamilton_orbits.trajectory_plot3d.plot_trajectory3d`, which
+        documents the arguments).
+
+        Examples
+        --------
+        >>> from hamilton_orbits import Body, System, integrate
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> fig = integrate(s, np.linspace(0, 2 * np.pi, 50)).plot3d()
+        >>> [trace.name for trace in fig.data]
+        ['earth', 'earth start', 'earth now', 'sun (origin)']
+        """
+        from hamilton_orbits.trajectory_plot3d import plot_trajectory3d
+
+        return plot_trajectory3d(self, bodies, origin, unit, max_frames)
 
     def __repr__(self) -> str:
         return (
