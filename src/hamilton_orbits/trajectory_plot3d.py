@@ -53,7 +53,9 @@ def plot_trajectory3d(traj: Any, bodies: Sequence[str] | None = None,
         Per body three traces, in this order: its path (named after it), its
         start (``"<name> start"``) and its position (``"<name> now"``, at the last
         output; the frames move it).  Show it with ``fig.show()``, or save a
-        page that works offline with ``fig.write_html(path, include_plotlyjs=True)``.
+        page that works offline with ``fig.write_html(path, include_plotlyjs=True)``
+        (about 5 MB, most of it plotly.js; add ``auto_play=False`` for the page to
+        open at the last output rather than play the frames from the start).
 
     Raises
     ------
@@ -216,9 +218,10 @@ def _layout(fig: Any, traj: Any, names: tuple[str, ...], centre: int | None,
         scene={"aspectmode": "data", **axes},
         title={"text": f"{traj.method}: paths{where} (open circle: start)"},
         sliders=[{"active": len(steps) - 1, "steps": steps, "currentvalue": {"prefix": "t = "},
-                  "pad": {"t": 30}}],
+                  "x": 0.16, "len": 0.84, "pad": {"t": 30}}],
         updatemenus=[{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0,
-                      "xanchor": "right", "yanchor": "top",
+                      "xanchor": "left", "yanchor": "top", "direction": "left",
+                      "pad": {"t": 60, "r": 10},
                       "buttons": [{"label": "play", "method": "animate",
                                    "args": [None, play]},
                                   {"label": "pause", "method": "animate",
