@@ -266,12 +266,13 @@ def site_url(site: Path, browser: Any) -> Iterator[str]:
 
 
 def _links(page: Path) -> list[str]:
-    return re.findall(r'href="([^"#]+)(?:#[^"]*)?"', page.read_text(errors="replace"))
+    return re.findall(r'href="([^"]+)"', page.read_text(errors="replace"))
 
 
 def api_page(site: Path, name: str) -> str:
-    """The site-relative path of ``name``'s API page: the autosummary page
-    ``api/generated/<name>.html``, else the page a link of api/index.html names it in."""
+    """The site-relative address of ``name``'s API page: the autosummary page
+    ``api/generated/<name>.html``, else where a link of api/index.html leads for it
+    (a page named after it, or an anchor ``#<name>`` on a page of several names)."""
     generated = f"api/generated/{name}.html"
     if (site / generated).exists():
         return generated
@@ -279,12 +280,37 @@ def api_page(site: Path, name: str) -> str:
     if index.exists():
         short = name.rsplit(".", 1)[-1]
         for href in _links(index):
-            stem = Path(urlsplit(href).path).stem
-            if stem in (name, short) or stem.endswith("." + short):
-                target = (index.parent / href).resolve()
-                if target.exists():
-                    return target.relative_to(site.resolve()).as_posix()
+            parts = urlsplit(href)
+            if parts.scheme or parts.netloc:
+                continue
+            stem = Path(parts.path).stem
+            if parts.fragment == name or stem == name or stem.endswith("." + short):
+                target = (index.parent / parts.path).resolve() if parts.path else index
+                if target.is_file():
+                    where = target.relative_to(site.resolve()).as_posix()
+                    return f"{where}#{parts.fragment}" if parts.fragment == name else where
     pytest.fail(f"no API page of {name}: neither {generated} nor a link to it in api/index.html")
+
+
+def test_api_pages_are_found_by_either_convention(tmp_path):
+    site = tmp_path / "html"
+    (site / "api" / "generated").mkdir(parents=True)
+    (site / "api" / "generated" / "hamilton_orbits.Simulation.html").write_text("<p>S</p>")
+    (site / "api" / "index.html").write_text(
+        '<a href="https://example.org/hamilton_orbits.integrate.html">elsewhere</a>'
+        '<a href="flows.html#hamilton_orbits.integrate">integrate</a>'
+        '<a href="#hamilton_orbits.KeplerOrbit">KeplerOrbit</a>'
+        '<a href="gone.html#hamilton_orbits.Archive">a page that is not there</a>')
+    (site / "api" / "flows.html").write_text("<p>I</p>")
+    assert api_page(site, "hamilton_orbits.Simulation") == \
+        "api/generated/hamilton_orbits.Simulation.html"
+    assert api_page(site, "hamilton_orbits.integrate") == \
+        "api/flows.html#hamilton_orbits.integrate"
+    assert api_page(site, "hamilton_orbits.KeplerOrbit") == \
+        "api/index.html#hamilton_orbits.KeplerOrbit"
+    for name in ("hamilton_orbits.Archive", "hamilton_orbits.System"):
+        with pytest.raises(pytest.fail.Exception, match=f"no API page of {name}"):
+            api_page(site, name)
 
 
 def gallery_page(site: Path) -> str:
@@ -350,18 +376,19 @@ def test_plot3d_page(browser, site, site_url, artifacts, tmp_path):
 
 def test_search_finds_kepler_orbit(browser, site, site_url, artifacts):
     """Sphinx's search (searchindex.js, run in the page) lists KeplerOrbit's API page."""
-    target = Path(api_page(site, "hamilton_orbits.KeplerOrbit")).name
+    path, _, anchor = api_page(site, "hamilton_orbits.KeplerOrbit").partition("#")
     found: list[str] = []
 
     def results(page):
         page.wait_for_function(
-            """(target) => Array.from(document.querySelectorAll('#search-results a'))
-                   .some(a => new URL(a.href).pathname.endsWith('/' + target))""",
-            arg=target, timeout=TIMEOUT_MS)
+            """([path, anchor]) => Array.from(document.querySelectorAll('#search-results a'))
+                   .some(a => { const u = new URL(a.href);
+                                return u.pathname === '/' + path
+                                       && (!anchor || u.hash === '#' + anchor); })""",
+            arg=[path, anchor], timeout=TIMEOUT_MS)
         found.extend(page.eval_on_selector_all("#search-results a", "as => as.map(a => a.href)"))
 
     assert_page_ok(browser, urljoin(site_url, "search.html?q=KeplerOrbit"),
                    artifacts / "search-KeplerOrbit.png", results)
-    link = next(h for h in found if urlsplit(h).path.endswith("/" + target))
+    link = next(h for h in found if urlsplit(h).path == "/" + path)
     assert_page_ok(browser, link, artifacts / "search-result-KeplerOrbit.png")
-
