@@ -255,12 +255,37 @@ class Trajectory(TrajectoryBase):
 
     def plot3d(self, bodies: Sequence[str] | None = None, origin: str = "primary",
                unit: Any = None, max_frames: int = 200) -> Any:
-        """An interactive 3-D view (plotly, the ``plot3d`` extra): every body's path,
-        its start, its position at the last output and a time slider that moves it
-        along the path (at most ``max_frames`` steps: the outputs are subsampled);
-        axes named with origin and unit, equal aspect.  A plotly Figure
-        (:func:`hamilton_orbits.trajectory_plot3d.plot_trajectory3d`, which
-        documents the arguments).
+        """An interactive 3-D view of the paths, with a time slider (plotly).
+
+        Every body's path as a line, its start (open circle), its position at the
+        last output (a marker the slider moves along the path) and the origin body
+        as a cross; the axes name their origin and unit and keep the data's aspect
+        (:func:`hamilton_orbits.trajectory_plot3d.plot_trajectory3d`).
+
+        Parameters
+        ----------
+        bodies : sequence of str, optional
+            The bodies drawn (default: all but the origin body).
+        origin : str, default "primary"
+            ``"primary"`` (the most massive body), a body's name, or ``"frame"``
+            (the integration frame's origin).
+        unit : str or astropy.units.Unit, optional
+            Length unit of the axes (Quantity trajectories only; default au).
+        max_frames : int, default 200
+            The most slider steps: the outputs are subsampled evenly to at most
+            this many animation frames so that the figure stays small (the lines
+            use every output).
+
+        Returns
+        -------
+        plotly.graph_objects.Figure
+
+        Raises
+        ------
+        ImportError
+            Without plotly: ``pip install 'hamilton-orbits[plot3d]'``.
+        ValueError
+            For an unknown body or origin, a bad unit, or ``max_frames`` < 2.
 
         Examples
         --------
