@@ -17,6 +17,7 @@ caller gave plain floats, they are plain floats in the caller's own units.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -254,6 +255,53 @@ class Trajectory(TrajectoryBase):
         from hamilton_orbits.trajectory_plot import plot_trajectory
 
         return plot_trajectory(self, plane, ax)
+
+    def plot3d(self, bodies: Sequence[str] | None = None, origin: str = "primary",
+               unit: Any = None, max_frames: int = 200) -> Any:
+        """An interactive 3-D view of the paths, with a time slider (plotly).
+
+        Every body's path as a line, its start (open circle), its position at the
+        last output (a marker the slider moves along the path) and the origin body
+        as a cross; the axes name their origin and unit and keep the data's aspect
+        (:func:`hamilton_orbits.trajectory_plot3d.plot_trajectory3d`).
+
+        Parameters
+        ----------
+        bodies : sequence of str, optional
+            The bodies drawn (default: all but the origin body).
+        origin : str, default "primary"
+            ``"primary"`` (the most massive body), a body's name, or ``"frame"``
+            (the integration frame's origin).
+        unit : str or astropy.units.Unit, optional
+            Length unit of the axes (Quantity trajectories only; default au).
+        max_frames : int, default 200
+            The most slider steps: the outputs are subsampled evenly to at most
+            this many animation frames so that the figure stays small (the lines
+            use every output).
+
+        Returns
+        -------
+        plotly.graph_objects.Figure
+
+        Raises
+        ------
+        ImportError
+            Without plotly: ``pip install 'hamilton-orbits[plot3d]'``.
+        ValueError
+            For an unknown body or origin, a bad unit, or ``max_frames`` < 2.
+
+        Examples
+        --------
+        >>> from hamilton_orbits import Body, System, integrate
+        >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+        >>> fig = integrate(s, np.linspace(0, 2 * np.pi, 50)).plot3d()
+        >>> [trace.name for trace in fig.data]
+        ['earth', 'earth start', 'earth now', 'sun (origin)']
+        """
+        from hamilton_orbits.trajectory_plot3d import plot_trajectory3d
+
+        return plot_trajectory3d(self, bodies, origin, unit, max_frames)
 
     def __repr__(self) -> str:
         return (
