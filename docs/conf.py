@@ -84,5 +84,8 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": [],
 }
+# without a default mode pydata-sphinx-theme 0.16 logs a console error on a first
+# visit ("Got invalid theme mode"), which the browser test counts as a broken page
+html_context = {"default_mode": "auto"}
 html_static_path: list[str] = []
 html_last_updated_fmt = None

@@ -263,7 +263,7 @@ class Trajectory(TrajectoryBase):
         Every body's path as a line, its start (open circle), its position at the
         last output (a marker the slider moves along the path) and the origin body
         as a cross; the axes name their origin and unit and keep the data's aspect
-        (:func:`hamilton_orbits.trajectory_plot3d.plot_trajectory3d`).
+        (``hamilton_orbits.trajectory_plot3d.plot_trajectory3d``).
 
         Parameters
         ----------
