@@ -125,6 +125,6 @@ def test_orbit_plots_mark_start_and_direction(figures):
             arrows = [t for t in ax.texts if t.get_gid() == "direction"]
             tracks = [line for line in _data_lines(ax) if line.get_gid() is None
                       and line.get_linestyle() not in ("None", "")]
-            assert len(starts) == len(tracks) >= 1, scene
-            assert len(arrows) == len(tracks), scene
+            assert len(starts) >= len(tracks) >= 1, scene  # a moon is drawn as dots
+            assert len(arrows) == len(starts), scene
             assert any("start" in t.get_text() for t in ax.get_legend().get_texts())

@@ -72,21 +72,27 @@ def plot_perihelion(result: Result):
     t = per["times"].to_value(u.yr)
     adv = (per["varpi"] - per["varpi"][0]).to_value(u.arcsec)
     rate = per["rate"].to_value(u.arcsec / (100 * u.yr)) / 100  # arcsec per year
-    fig, ax = plt.subplots(figsize=(7.5, 4.6))
-    ax.plot(t, adv, lw=0.7, color="C0",
-            label=f"{per['body']}: osculating perihelion longitude at each output")
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True,
+                                  height_ratios=(2, 1))
     fit = adv.mean() + rate * (t - t.mean())
-    ax.plot(t, fit, lw=1.2, color="C3", ls="--",
-            label=f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)")
+    lines = [(adv, dict(lw=0.7, color="C0"),
+              f"{per['body']}: osculating perihelion longitude at each output"),
+             (fit, dict(lw=1.2, color="C3", ls="--"),
+              f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)")]
     if per["body"] == "mercury" and per["gr"]:
-        ax.plot(t, GR_MERCURY / 100 * (t - t[0]), lw=1.0, color="k", ls=":",
-                label=f"general relativity: {GR_MERCURY}\"/century (Einstein 1915; "
-                      "REFERENCES.md)")
-    ax.set_xlabel("time since the start [yr]")
-    ax.set_ylabel("advance of the longitude of\nperihelion since the start [arcsec]")
+        lines.append((GR_MERCURY / 100 * (t - t[0]), dict(lw=1.0, color="k", ls=":"),
+                      f"general relativity: {GR_MERCURY}\"/century (Einstein 1915; "
+                      "REFERENCES.md)"))
+    for y, style, label in lines:
+        ax.plot(t, y, label=label, **style)
+        ax2.plot(t, y - fit, **style)
+    ax.set_ylabel("advance of the longitude of\nperihelion since the start [arcsec]",
+                  fontsize=9)
+    ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
+    ax2.set_xlabel("time since the start [yr]")
     ax.set_title(f"{result.scene.name}: perihelion advance of {per['body']}", fontsize=10)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1,
-              frameon=False)
+    ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
+               bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
     fig.tight_layout()
     fig.set_label("perihelion")  # the file name Result.save gives it
     return fig
@@ -262,14 +268,38 @@ def _labelled(view: dict, shown: list[str], most: int = 12) -> list[str]:
     return [n for n in bodies if n in heavy]  # in the system's order
 
 
-def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> bool:
+def _host(view: dict, k: int) -> str | None:
+    """The body other than the primary inside whose Hill sphere body ``k`` starts,
+    if any (the Moon's host is the Earth)."""
+    p = view["index"]
+    r0 = view["rel"][0]
+    for j, name in enumerate(view["names"]):
+        if j in (k, p) or view["gm"][j] <= view["gm"][k]:
+            continue
+        hill = np.linalg.norm(r0[j]) * (view["gm"][j] / (3 * view["gm"][p])) ** (1 / 3)
+        if np.linalg.norm(r0[k] - r0[j]) < hill:
+            return name
+    return None
+
+
+def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> str:
     """One body's track, its start marker and an arrow along its first velocity;
-    True if Kepler arcs were drawn between its outputs."""
-    pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
-                                 view["mu"][k])
-    ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
-            label=label or "_nolegend_")
-    if refined:  # the outputs themselves, on the arcs
+    "dots" if its outputs are drawn as dots on Kepler arcs, "arcs" if Kepler arcs
+    are drawn only between some outputs (near periapsis), "" if neither."""
+    host = _host(view, k)
+    if host is not None:  # a moon: its two-body orbit about the primary means nothing
+        ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=2, color=color,
+                label=f"{label}: the outputs (it goes round {host})" if label
+                else "_nolegend_")
+        pts, refined = view["rel"][:, k], False
+    else:
+        pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
+                                     view["mu"][k])
+        ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
+                label=label or "_nolegend_")
+    period = _period(view["rel"][:1, k], view["vrel"][:1, k], view["mu"][k])[0]
+    dots = refined and np.mean(np.diff(view["t"])) > period / PER_ORBIT  # sparse outputs
+    if dots:
         ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=1.5, color=color,
                 gid="outputs", label="_nolegend_")
     x0, y0 = view["rel"][0, k, :2]
@@ -281,7 +311,7 @@ def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> bo
         ax.annotate("", xy=(x0 + d[0], y0 + d[1]), xytext=(x0, y0), gid="direction",
                     arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.0,
                                 "shrinkA": 0, "shrinkB": 0})
-    return refined
+    return "dots" if dots else "arcs" if refined else ""
 
 
 def _draw_encounter(ax: Any, view: dict, shown: list[str]) -> list:
@@ -307,11 +337,11 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     primary = view["primary"]
     named = [n for n in view["named"] if n in shown]
     rest = [n for n in shown if n != primary and n not in named]
-    refined_any = False
+    drawn = set()
     for name in [n for n in shown if n != primary]:
         k = view["names"].index(name)
         color = PALETTE[view["named"].index(name) % len(PALETTE)] if name in named else "0.55"
-        refined_any |= _draw_body(ax, view, k, color, name if name in named else None)
+        drawn.add(_draw_body(ax, view, k, color, name if name in named else None))
     handles = [h for h in ax.get_lines() if not h.get_label().startswith("_")]
     if rest:
         handles.append(Line2D([], [], color="0.55", lw=0.6, label=(
@@ -323,10 +353,16 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     handles.append(sun)
     handles.append(Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
                           label="start (t = 0); arrow: direction of motion"))
-    if refined_any:
+    if "dots" in drawn:
         handles.append(Line2D([], [], color="k", lw=0.6, marker=".", ms=3, label=(
-            f"dots: the outputs (every {view['cadence_text']});\nline: the two-body "
-            "(Kepler) orbit\nfrom each output to the next")))
+            f"dots: the outputs (every {view['cadence_text']}), more\nthan a {PER_ORBIT}th "
+            "of an orbit apart: the line\nis the two-body (Kepler) orbit\nfrom each "
+            "output to the next")))
+    elif "arcs" in drawn:
+        handles.append(Line2D([], [], color="k", lw=0.6, label=(
+            f"where outputs (every {view['cadence_text']}) are more than\na {PER_ORBIT}th "
+            "of an orbit apart (near periapsis),\nthe line is the two-body (Kepler) orbit "
+            "\nfrom each output to the next")))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
     ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
@@ -344,13 +380,48 @@ def _orbit_data(result: Result, gm: np.ndarray) -> dict:
                 vrel=(v - v[:, k:k + 1]) * view["scale"],  # in the figure's unit per day
                 mu=(gm + gm[k]) * view["scale"] ** 3, t=result.times.to_value(u.d))
     cadence = float(np.median(np.diff(view["t"]))) * u.d if len(view["t"]) > 1 else 0 * u.d
-    unit = u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d else u.min
+    unit = (u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d
+            else u.h if cadence >= 1 * u.h else u.min)
     view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
     enc = result.diagnostics.get("close_approach")
     if enc is not None:
         view["encounter"] = {**enc, "text": f"{enc['distance'].to_value(u.au):.3g} au "
                                             f"at {enc['time'].to_value(u.yr):.3g} yr"}
     return view
+
+
+def _draw_flyby(ax: Any, view: dict, frame: str) -> None:
+    """The closest approach seen from the body passed: the track within 10 times
+    the closest distance, refined with the two-body motion about that body."""
+    from matplotlib.lines import Line2D
+
+    enc = view["encounter"]
+    i, j = view["names"].index(enc["body"]), view["names"].index(enc["other"])
+    d = view["rel"][:, i] - view["rel"][:, j]
+    w = view["vrel"][:, i] - view["vrel"][:, j]
+    near = np.flatnonzero(np.linalg.norm(d, axis=-1) <= 10 * enc["distance"].to_value(u.au)
+                          * (1 * u.au).to_value(view["unit"]))
+    rows = np.arange(near.min(), near.max() + 1)
+    mu = (view["gm"][i] + view["gm"][j]) * view["scale"] ** 3
+    sub = dict(view, t=view["t"][rows], rel=d[rows][:, None], vrel=w[rows][:, None],
+               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max())
+    color = PALETTE[view["named"].index(enc["body"]) % len(PALETTE)]
+    _draw_body(ax, sub, 0, color, f"{enc['body']}, from {enc['other']}")
+    x, y = d[enc["row"], :2]
+    ax.plot([x], [y], "*", ms=11, mfc="none", mec="crimson", mew=1.2, gid="encounter",
+            label=f"the output nearest the closest approach ({enc['text']})")
+    ax.plot([0.0], [0.0], "P", color="0.3", ms=8, label=f"{enc['other']} (origin)")
+    handles = ax.get_lines()
+    handles = [h for h in handles if not h.get_label().startswith("_")] + [
+        Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
+               label=f"{enc['body']} {view['t'][rows[0]] / 365.25:.3g} yr after the start;"
+                     " arrow: its motion")]
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(axis_label("x", view["unit"], frame, enc["other"]), fontsize=8)
+    ax.set_ylabel(axis_label("y", view["unit"], frame, enc["other"]), fontsize=8)
+    ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09),
+              ncol=1, frameon=False)
+    ax.set_title(f"the encounter, about {enc['other']}", fontsize=10)
 
 
 def plot_orbits(result: Result, gm: np.ndarray, frame: str):
@@ -365,8 +436,12 @@ def plot_orbits(result: Result, gm: np.ndarray, frame: str):
     names = view["names"]
     panels = [names] + ([view["inner"] + [view["primary"]]] if view["inner"] else [])
     view["named"] = _labelled(view, names)
-    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 7.6), squeeze=False)
-    for ax, shown in zip(axes[0], panels, strict=True):
+    flyby = "encounter" in view and view["encounter"]["other"] in names
+    fig, axes = plt.subplots(1, len(panels) + flyby, figsize=(6.2 * (len(panels) + flyby), 7.6),
+                             squeeze=False)
+    if flyby:
+        _draw_flyby(axes[0, -1], view, frame)
+    for ax, shown in zip(axes[0], panels, strict=False):
         view["extent"] = max(view["reach"][names.index(n)] for n in shown)
         _draw_orbits(ax, view, shown, frame)
     axes[0, 0].set_title(f"{result.scene.name}: orbits about {view['primary']}, "
