@@ -240,13 +240,14 @@ def _plot_omega(result: Result):
         for i in range(3):
             ax.plot(t, w[:, i], lw=0.8, label=f"omega_{i + 1}")
         ax.set_ylabel("angular velocity,\nbody (principal) axes [rad/s]", fontsize=9)
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3,
+              frameon=False)  # above the axes, off the data
     err = result.diagnostics["attitude_error"].to_value(u.rad)[1:]
     shown = err > 0  # an exact zero has no place on a log axis: not drawn
     ax2.semilogy(t[1:][shown], err[shown], lw=0.8)
     ax2.set_ylabel("attitude error vs the exact\nmotion (angle) [rad]", fontsize=9)
     ax2.set_xlabel(f"time since the start [{t_unit}]")
-    ax.set_title(f"{result.scene.name}: {result.metrics.get('integrator', '')} against the "
+    fig.suptitle(f"{result.scene.name}: {result.metrics.get('integrator', '')} against the "
                  "exact free motion", fontsize=10)
     fig.tight_layout()
     fig.set_label("spin")  # the file name Result.save gives it

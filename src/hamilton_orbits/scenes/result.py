@@ -199,6 +199,8 @@ class Result:
             var[:] = t
             var.units = "day"
             for name, series in self.diagnostics.items():
+                if isinstance(series, dict):  # what a figure marks, not a time series
+                    continue
                 arr = np.asarray(getattr(series, "value", series), dtype=float)
                 if arr.shape != t.shape:
                     continue

@@ -227,7 +227,7 @@ def _plot_fan(result: Result, record: Any, fans: dict, start: Any):
         ax.set_ylabel(f"{coord}_p (mas; CIP in the ITRS, IERS convention)")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8, ncol=3, loc="best")
-    axes[1].set_xlabel(f"days from the start date {start.iso[:10]} (data before it only)")
+    axes[1].set_xlabel(f"time from the start date {start.iso[:10]} (data before it only) [d]")
     axes[0].set_title(f"{result.scene.name}: the prediction fan from {start.iso[:10]} "
                       "against the record that followed")
     fig.tight_layout()
@@ -261,13 +261,17 @@ def _plot_mae(result: Result, scores: dict):
                     top = max(top, max(values[col]))
             n = len(next(iter(by_method.values())).starts)
             ax.set_title(f"{coord}_p: weekly starts {text} ({n} start dates)")
-            ax.set_xlabel("horizon (days after the start date)")
+            ax.set_xlabel("horizon, time after the start date [d]")
             ax.set_ylabel(f"mean absolute error of {coord}_p (mas)")
             ax.set_ylim(0, 1.15 * top if top > 0 else None)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=8, loc="upper left")
+    found = {}  # one legend under the panels, off the data (each method once)
+    for ax in axes.flat:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            found.setdefault(label, handle)
+    fig.legend(list(found.values()), list(found), fontsize=8, loc="lower center", ncol=4)
     fig.suptitle(f"{result.scene.name}: hindcast error against horizon (IERS 20 C04)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
     fig.set_label("mae_vs_horizon")  # the file name Result.save gives it
     return fig
 
@@ -286,7 +290,7 @@ def _plot_coverage(result: Result, scores: dict):
         ax.axhline(0.683, color="k", ls="--", lw=1, label="68.3% (Gaussian 1-sigma)")
         ax.axhspan(0.60, 0.75, color="k", alpha=0.06, label="60-75% target")
         ax.set_ylim(0, 1)
-        ax.set_xlabel("horizon (days after the start date)")
+        ax.set_xlabel("horizon, time after the start date [d]")
         ax.set_ylabel("fraction of outcomes within 1-sigma (mean of x_p, y_p)")
         ax.set_title(f"band coverage, weekly starts {text}")
         ax.grid(alpha=0.3)

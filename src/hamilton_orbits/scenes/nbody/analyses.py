@@ -8,7 +8,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.scenes.nbody.build import scene_frame
-from hamilton_orbits.scenes.nbody.figures import plot_de440
+from hamilton_orbits.scenes.nbody.figures import plot_de440, plot_perihelion
 from hamilton_orbits.scenes.result import Result
 
 
@@ -67,6 +67,11 @@ def _perihelion_advance(result: Result, system, an: dict) -> None:
     orbits = _relative_orbits(result, system, an["body"], primary, rows)
     rate = _rate(result.times[rows], orbits.varpi).to(u.arcsec / CENTURY)
     result.metrics[key] = rate
+    result.diagnostics["perihelion"] = {  # for the figure of the advance
+        "body": an["body"], "times": result.times[rows],
+        "varpi": np.unwrap(orbits.varpi.to_value(u.rad)) * u.rad, "rate": rate,
+        "gr": any(e.get("name") == "gr" for e in result.scene.effects)}
+    result.plotters.append(plot_perihelion)
 
 
 def _nodal_regression(result: Result, system, an: dict) -> None:
@@ -118,6 +123,9 @@ def _close_approach(result: Result, system, an: dict) -> None:
     closest = float(np.linalg.norm(d[k] + w[k] * tau))
     result.metrics[key] = closest * u.au
     result.metrics["at time"] = ((t[k] + tau) * u.d).to(u.yr)
+    result.diagnostics["close_approach"] = {  # marked on the orbit figure
+        "body": an["body"], "other": an["other"], "row": int(rows[k]),
+        "distance": closest * u.au, "time": ((t[k] + tau) * u.d).to(u.yr)}
     primary = an.get("primary")
     if primary:
         rows = _rows_of(result, system, f"{an['body']} orbit", an["body"], primary, least=1)

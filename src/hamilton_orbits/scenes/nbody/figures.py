@@ -17,14 +17,16 @@ def plot_megno(result: Result):
     """MEGNO against time (``variational = true``)."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(7, 4.4))
     t = result.times.to_value(u.yr)
     ax.plot(t, result.diagnostics["megno"], lw=0.8, label="MEGNO <Y>")
     ax.axhline(2.0, color="0.6", lw=0.6, ls=":", label="2 (quasi-periodic)")
     ax.set_xlabel("time [yr]")
     ax.set_ylabel("MEGNO <Y> (dimensionless)")
     ax.set_title(f"{result.scene.name}: MEGNO")
-    ax.legend()
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
+              frameon=False)
+    fig.tight_layout()
     fig.set_label("megno")  # the file name Result.save gives it
     return fig
 
@@ -36,22 +38,64 @@ def plot_de440(result: Result):
 
     from hamilton_orbits.studies.ladder import BODIES
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(9.5, 4.8))
     years = result.diagnostics["de440_years"]
     km = result.diagnostics["de440_km"]
     colors = plt.cm.tab20(np.arange(len(BODIES)) / len(BODIES))
     for k, body in enumerate(BODIES):
         moon = body == "moon"
-        ax.semilogy(years[1:], np.maximum(km[1:, k], 1e-6), lw=1.4 if moon else 1,
+        ax.semilogy(years[1:], np.maximum(km[1:, k], 1e-6), lw=1.4 if moon else 1, marker=".",
+                    ms=3,
                     ls="--" if moon else "-", color="k" if moon else colors[k],
                     label="moon (from the earth)" if moon else body)
     ax.set_xlabel("time from J2000 [yr]")
     ax.set_ylabel("position residual against DE440 [km]")
     ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), ICRS")
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+              frameon=False)
+    fig.tight_layout()
     fig.set_label("de440_residuals")  # the file name Result.save gives it
     return fig
 
+
+
+GR_MERCURY = 42.98  # arcsec per century: 6 pi GM / (c^2 a (1 - e^2)) per orbit (REFERENCES.md)
+
+
+def plot_perihelion(result: Result):
+    """The advance of the longitude of perihelion against time (the osculating
+    two-body orbit at each output), the least-squares line whose slope is the
+    scene's rate, and, for Mercury with ``gr``, the relativistic 42.98"/cy."""
+    import matplotlib.pyplot as plt
+
+    per = result.diagnostics["perihelion"]
+    t = per["times"].to_value(u.yr)
+    adv = (per["varpi"] - per["varpi"][0]).to_value(u.arcsec)
+    rate = per["rate"].to_value(u.arcsec / (100 * u.yr)) / 100  # arcsec per year
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True,
+                                  height_ratios=(2, 1))
+    fit = adv.mean() + rate * (t - t.mean())
+    lines = [(adv, dict(lw=0.7, color="C0"),
+              f"{per['body']}: osculating perihelion longitude at each output"),
+             (fit, dict(lw=1.2, color="C3", ls="--"),
+              f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)")]
+    if per["body"] == "mercury" and per["gr"]:
+        lines.append((GR_MERCURY / 100 * (t - t[0]), dict(lw=1.0, color="k", ls=":"),
+                      f"general relativity: {GR_MERCURY}\"/century (Einstein 1915; "
+                      "REFERENCES.md)"))
+    for y, style, label in lines:
+        ax.plot(t, y, label=label, **style)
+        ax2.plot(t, y - fit, **style)
+    ax.set_ylabel("advance of the longitude of\nperihelion since the start [arcsec]",
+                  fontsize=9)
+    ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
+    ax2.set_xlabel("time since the start [yr]")
+    ax.set_title(f"{result.scene.name}: perihelion advance of {per['body']}", fontsize=10)
+    ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
+               bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
+    fig.tight_layout()
+    fig.set_label("perihelion")  # the file name Result.save gives it
+    return fig
 
 
 def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any]:
@@ -59,7 +103,8 @@ def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any
     massive body), in km below 0.01 au of extent and au above, and the bodies of an
     inner panel (those inside the largest gap, by a factor 2.5 or more, in the
     bodies' largest distances from the primary, when the outermost is 5 times
-    farther).
+    farther; without such a gap, when the outermost is 20 times farther than the
+    innermost, those within an eighth of its distance).
 
     Parameters
     ----------
@@ -89,19 +134,10 @@ def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any
         cut = int(np.argmax(ratios))
         if ratios[cut] >= 2.5 and dist[-1] >= 5 * dist[cut]:
             inner = [names[i] for i in order[:cut + 1]]
+        elif dist[-1] >= 20 * dist[0]:  # no gap, a wide spread: the inner eighth
+            inner = [names[i] for i, d in zip(order, dist, strict=True) if d < dist[-1] / 8]
     return {"primary": names[k], "rel": rel * scale, "unit": unit, "inner": inner,
             "reach": reach * scale, "scale": scale, "index": k}
-
-
-def _coarse(cadence: float, r: np.ndarray, v: np.ndarray, mu: float) -> bool:
-    """True if the outputs are more than a 36th of the two-body period apart (10
-    degrees of mean anomaly: a line would draw chords, or, at a cadence near the
-    period, a short stroke where the orbit is): then dots are drawn."""
-    energy = 0.5 * float(v @ v) - mu / float(np.linalg.norm(r))
-    if not energy < 0:
-        return False
-    period = 2 * np.pi * np.sqrt((-mu / (2 * energy)) ** 3 / mu)
-    return bool(cadence > period / 36)
 
 
 def axis_label(axis: str, unit: str, frame: str, primary: str) -> str:
@@ -143,56 +179,279 @@ def osculating_ellipse(r: np.ndarray, v: np.ndarray, mu: float, n: int = 361
     return a * (np.cos(big_e) - e) * p_hat + a * np.sqrt(1 - e * e) * np.sin(big_e) * q_hat
 
 
-def _draw_orbits(ax: Any, view: dict, names: list[str], frame: str) -> None:
+# a body's colour (the unnamed rest are grey, so no grey here)
+PALETTE = ("C0", "C1", "C2", "C3", "C4", "C5", "C6", "C8", "C9", "navy", "darkgoldenrod",
+           "teal")
+PER_ORBIT = 90  # points drawn per revolution, at least (60 read as an ellipse; 90 leave
+#                room for projection and eccentricity)
+
+
+def _period(r: np.ndarray, v: np.ndarray, mu: float) -> float:
+    """The two-body period of the state (inf when unbound), shape (n,) from (n, 3)."""
+    energy = 0.5 * np.einsum("ij,ij->i", v, v) - mu / np.linalg.norm(r, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = -mu / (2 * energy)
+        return np.where(energy < 0, 2 * np.pi * np.sqrt(np.abs(a) ** 3 / mu), np.inf)
+
+
+def _turn(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The angle between rows of ``a`` and ``b``, in revolutions."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=-1)
+                                             * np.linalg.norm(b, axis=-1))
+    return np.nan_to_num(np.arccos(np.clip(cos, -1, 1))) / (2 * np.pi)
+
+
+def refined_track(t: np.ndarray, r: np.ndarray, v: np.ndarray, mu: float
+                  ) -> tuple[np.ndarray, bool]:
+    """The track drawn for a body: its outputs, and, between outputs further apart
+    than a 90th of an orbit (in time, or in the angle turned in space or as
+    projected on x-y), the two-body (Kepler) motion from the earlier output
+    (at most one revolution of it; a NaN breaks the line where a whole revolution
+    is drawn, instead of a chord to the next output).  Returns the points (m, 3)
+    and whether any arc was inserted.
+
+    Examples
+    --------
+    >>> t = np.array([0.0, 2 * np.pi]); r = np.array([[1.0, 0, 0]] * 2)
+    >>> v = np.array([[0, 1.0, 0]] * 2)
+    >>> pts, refined = refined_track(t, r, v, 1.0)
+    >>> refined, len(pts) >= 60
+    (True, True)
+    """
+    from hamilton_orbits.kepler import propagate
+
+    ok = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(v), axis=-1)
+    if len(t) < 2 or not ok.all() or mu <= 0:
+        return r, False
+    dt = np.diff(t)
+    period = _period(r[:-1], v[:-1], mu)
+    swept = np.where(np.isfinite(period), np.minimum(dt / period, 1.0), 0.0)
+    angle = np.maximum(_turn(r[:-1], r[1:]), _turn(r[:-1, :2], r[1:, :2]))  # as drawn too
+    # the fastest turn, at periapsis, is (1 + e)^2 / (1 - e^2)^(3/2) times the mean
+    h = np.cross(r[:-1], v[:-1])
+    e = np.linalg.norm(np.cross(v[:-1], h) / mu - r[:-1] / np.linalg.norm(
+        r[:-1], axis=-1)[:, None], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        peak = np.where(e < 1, (1 + e) ** 2 / np.abs(1 - e * e) ** 1.5, 1.0)
+    n_sub = np.ceil(PER_ORBIT * np.maximum(swept * peak, angle)).astype(int)
+    n_sub = np.minimum(n_sub, 5000)
+    if n_sub.max(initial=1) <= 1:
+        return r, False
+    pieces = []
+    for i in range(len(dt)):
+        pieces.append(r[i:i + 1])
+        if n_sub[i] > 1:
+            span = min(dt[i], period[i])
+            tau = np.linspace(0.0, span, n_sub[i] + 1)[1:-1]
+            pieces.append(propagate(np.broadcast_to(r[i], (len(tau), 3)),
+                                    np.broadcast_to(v[i], (len(tau), 3)), mu, tau)[0])
+            if dt[i] >= period[i]:  # a whole orbit drawn: close it, break the line
+                pieces.append(np.vstack([r[i], np.full(3, np.nan)]))
+            else:  # no chord to the next output where the arc ends elsewhere
+                end = propagate(r[i], v[i], mu, dt[i])[0]
+                if max(_turn(end[None], r[i + 1:i + 2])[0],
+                       _turn(end[None, :2], r[i + 1:i + 2, :2])[0]) > 1 / PER_ORBIT:
+                    pieces.append(np.vstack([end, np.full(3, np.nan)]))
+    pieces.append(r[-1:])
+    return np.vstack(pieces), True
+
+
+def _labelled(view: dict, shown: list[str], most: int = 12) -> list[str]:
+    """The bodies the legend names: all, or the ``most - 1`` most massive and the
+    rest in one grey entry."""
+    bodies = [n for n in shown if n != view["primary"]]
+    if len(bodies) <= most:
+        return bodies
+    gm = {n: view["gm"][view["names"].index(n)] for n in bodies}
+    heavy = sorted(bodies, key=lambda n: -gm[n])[:most - 1]
+    return [n for n in bodies if n in heavy]  # in the system's order
+
+
+def _host(view: dict, k: int) -> str | None:
+    """The body other than the primary inside whose Hill sphere body ``k`` starts,
+    if any (the Moon's host is the Earth)."""
+    p = view["index"]
+    r0 = view["rel"][0]
+    for j, name in enumerate(view["names"]):
+        if j in (k, p) or view["gm"][j] <= view["gm"][k]:
+            continue
+        hill = np.linalg.norm(r0[j]) * (view["gm"][j] / (3 * view["gm"][p])) ** (1 / 3)
+        if np.linalg.norm(r0[k] - r0[j]) < hill:
+            return name
+    return None
+
+
+def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> str:
+    """One body's track, its start marker and an arrow along its first velocity;
+    "dots" if its outputs are drawn as dots on Kepler arcs, "arcs" if Kepler arcs
+    are drawn only between some outputs (near periapsis), "" if neither."""
+    host = _host(view, k)
+    if host is not None:  # a moon: its two-body orbit about the primary means nothing
+        ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=2, color=color,
+                label=f"{label}: the outputs (it goes round {host})" if label
+                else "_nolegend_")
+        pts, refined = view["rel"][:, k], False
+    else:
+        pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
+                                     view["mu"][k])
+        ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
+                label=label or "_nolegend_")
+    period = _period(view["rel"][:1, k], view["vrel"][:1, k], view["mu"][k])[0]
+    dots = refined and np.mean(np.diff(view["t"])) > period / PER_ORBIT  # sparse outputs
+    if dots:
+        ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=1.5, color=color,
+                gid="outputs", label="_nolegend_")
+    x0, y0 = view["rel"][0, k, :2]
+    ax.plot([x0], [y0], "o", ms=5, mfc=color, mec="k", mew=0.6, gid="start",
+            label="_nolegend_")
+    vel = view["vrel"][0, k, :2]
+    if np.hypot(*vel) > 0:
+        d = vel / np.hypot(*vel) * 0.07 * view["extent"]
+        ax.annotate("", xy=(x0 + d[0], y0 + d[1]), xytext=(x0, y0), gid="direction",
+                    arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.0,
+                                "shrinkA": 0, "shrinkB": 0})
+    return "dots" if dots else "arcs" if refined else ""
+
+
+def _draw_encounter(ax: Any, view: dict, shown: list[str]) -> list:
+    """A star at each body of the closest approach (the scene's ``close_approach``
+    analysis), at the output nearest to it."""
+    enc = view.get("encounter")
+    if not enc or enc["body"] not in shown:
+        return []
+    handles = []
+    for name, marker in ((enc["body"], "*"), (enc["other"], "P")):
+        if name in shown and name != view["primary"]:
+            x, y = view["rel"][enc["row"], view["names"].index(name), :2]
+            (h,) = ax.plot([x], [y], marker, ms=11, mfc="none", mec="crimson", mew=1.2,
+                           gid="encounter", label=f"{name} at the closest approach" +
+                           (f" ({enc['text']})" if name == enc["body"] else ""))
+            handles.append(h)
+    return handles
+
+
+def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
+    from matplotlib.lines import Line2D
+
     primary = view["primary"]
-    for k, name in enumerate(view["names"]):
-        if name not in names or name == primary:
-            continue
-        xy = view["rel"][:, k, :2]
-        if not _coarse(view["cadence"], view["rel0"][k], view["vrel0"][k], view["mu"][k]):
-            ax.plot(xy[:, 0], xy[:, 1], lw=0.7, label=name)
-            continue
-        # outputs too far apart for a line: a dot per output, and the osculating
-        # two-body orbit of the first output as a thin line to read them against
-        (dots,) = ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.2,
-                          label=f"{name} (a dot every {view['cadence_text']})")
-        ellipse = osculating_ellipse(view["rel0"][k], view["vrel0"][k], view["mu"][k])
-        if ellipse is not None:
-            ax.plot(ellipse[:, 0], ellipse[:, 1], lw=0.4, color=dots.get_color(), alpha=0.8)
-    ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
-            label=f"{primary} (origin)")
+    named = [n for n in view["named"] if n in shown]
+    rest = [n for n in shown if n != primary and n not in named]
+    drawn = set()
+    for name in [n for n in shown if n != primary]:
+        k = view["names"].index(name)
+        color = PALETTE[view["named"].index(name) % len(PALETTE)] if name in named else "0.55"
+        drawn.add(_draw_body(ax, view, k, color, name if name in named else None))
+    handles = [h for h in ax.get_lines() if not h.get_label().startswith("_")]
+    if rest:
+        handles.append(Line2D([], [], color="0.55", lw=0.6, label=(
+            f"{len(rest)} more: {', '.join(rest[:3])}, ..." if len(rest) > 3
+            else ", ".join(rest))))
+    handles += _draw_encounter(ax, view, shown)
+    (sun,) = ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
+                     label=f"{primary} (origin)")
+    handles.append(sun)
+    handles.append(Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
+                          label="start (t = 0); arrow: direction of motion"))
+    if "dots" in drawn:
+        handles.append(Line2D([], [], color="k", lw=0.6, marker=".", ms=3, label=(
+            f"dots: the outputs (every {view['cadence_text']}), more\nthan a {PER_ORBIT}th "
+            "of an orbit apart: the line\nis the two-body (Kepler) orbit\nfrom each "
+            "output to the next")))
+    elif "arcs" in drawn:
+        handles.append(Line2D([], [], color="k", lw=0.6, label=(
+            f"where outputs (every {view['cadence_text']}) are more than\na {PER_ORBIT}th "
+            "of an orbit apart (near periapsis),\nthe line is the two-body (Kepler) orbit "
+            "\nfrom each output to the next")))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
     ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
-              frameon=False)
+    ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09),
+              ncol=2, frameon=False)
+
+
+def _orbit_data(result: Result, gm: np.ndarray) -> dict:
+    """:func:`orbit_view` with the velocities, times, GMs and cadence the figure needs."""
+    names = list(result.states["names"])
+    view = orbit_view(names, gm, result.states["r"].to_value(u.au))
+    k = view["index"]
+    v = result.states["v"].to_value(u.au / u.d)
+    view.update(names=names, gm=np.asarray(gm, dtype=float),
+                vrel=(v - v[:, k:k + 1]) * view["scale"],  # in the figure's unit per day
+                mu=(gm + gm[k]) * view["scale"] ** 3, t=result.times.to_value(u.d))
+    cadence = float(np.median(np.diff(view["t"]))) * u.d if len(view["t"]) > 1 else 0 * u.d
+    unit = (u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d
+            else u.h if cadence >= 1 * u.h else u.min)
+    view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
+    enc = result.diagnostics.get("close_approach")
+    if enc is not None:
+        view["encounter"] = {**enc, "text": f"{enc['distance'].to_value(u.au):.3g} au "
+                                            f"at {enc['time'].to_value(u.yr):.3g} yr"}
+    return view
+
+
+def _draw_flyby(ax: Any, view: dict, frame: str) -> None:
+    """The closest approach seen from the body passed: the track within 10 times
+    the closest distance, refined with the two-body motion about that body."""
+    from matplotlib.lines import Line2D
+
+    enc = view["encounter"]
+    i, j = view["names"].index(enc["body"]), view["names"].index(enc["other"])
+    d = view["rel"][:, i] - view["rel"][:, j]
+    w = view["vrel"][:, i] - view["vrel"][:, j]
+    near = np.flatnonzero(np.linalg.norm(d, axis=-1) <= 10 * enc["distance"].to_value(u.au)
+                          * (1 * u.au).to_value(view["unit"]))
+    rows = np.arange(near.min(), near.max() + 1)
+    mu = (view["gm"][i] + view["gm"][j]) * view["scale"] ** 3
+    sub = dict(view, t=view["t"][rows], rel=d[rows][:, None], vrel=w[rows][:, None],
+               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max())
+    color = PALETTE[view["named"].index(enc["body"]) % len(PALETTE)]
+    _draw_body(ax, sub, 0, color, f"{enc['body']}, from {enc['other']}")
+    x, y = d[enc["row"], :2]
+    ax.plot([x], [y], "*", ms=11, mfc="none", mec="crimson", mew=1.2, gid="encounter",
+            label=f"the output nearest the closest approach ({enc['text']})")
+    ax.plot([0.0], [0.0], "P", color="0.3", ms=8, label=f"{enc['other']} (origin)")
+    handles = ax.get_lines()
+    handles = [h for h in handles if not h.get_label().startswith("_")] + [
+        Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
+               label=f"{enc['body']} {view['t'][rows[0]] / 365.25:.3g} yr after the start;"
+                     " arrow: its motion")]
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(axis_label("x", view["unit"], frame, enc["other"]), fontsize=8)
+    ax.set_ylabel(axis_label("y", view["unit"], frame, enc["other"]), fontsize=8)
+    ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09),
+              ncol=1, frameon=False)
+    ax.set_title(f"the encounter, about {enc['other']}", fontsize=10)
 
 
 def plot_orbits(result: Result, gm: np.ndarray, frame: str):
-    """The orbits about the primary, projected on the frame's x-y plane; an inner
-    panel where the inner bodies would be a blob beside the outer ones."""
+    """The orbits about the primary, projected on the frame's x-y plane, each with a
+    marker where it starts and an arrow along its first velocity; an inner panel
+    where the inner bodies would be a blob beside the outer ones.  Between outputs
+    further apart than a 90th of an orbit the two-body orbit from each output is
+    drawn (:func:`refined_track`), and the legend says so."""
     import matplotlib.pyplot as plt
 
-    names = list(result.states["names"])
-    view = orbit_view(names, gm, result.states["r"].to_value(u.au))
-    view["names"] = names
-    k = view["index"]
-    v0 = result.states["v"][0].to_value(u.au / u.d)
-    view["rel0"] = view["rel"][0]  # in the figure's unit; velocities and mu to match
-    view["vrel0"] = (v0 - v0[k]) * view["scale"]
-    view["mu"] = (gm + gm[k]) * view["scale"] ** 3
-    view["cadence"] = float(np.median(np.diff(result.times.to_value(u.d))))
-    cadence = view["cadence"] * u.d
-    unit = u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d else u.min
-    view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
-    panels = [names] + ([view["inner"]] if view["inner"] else [])
-    fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 7.2), squeeze=False)
-    for ax, shown in zip(axes[0], panels, strict=True):
+    view = _orbit_data(result, gm)
+    names = view["names"]
+    panels = [names] + ([view["inner"] + [view["primary"]]] if view["inner"] else [])
+    view["named"] = _labelled(view, names)
+    flyby = "encounter" in view and view["encounter"]["other"] in names
+    fig, axes = plt.subplots(1, len(panels) + flyby, figsize=(6.2 * (len(panels) + flyby), 7.6),
+                             squeeze=False)
+    if flyby:
+        _draw_flyby(axes[0, -1], view, frame)
+    for ax, shown in zip(axes[0], panels, strict=False):
+        view["extent"] = max(view["reach"][names.index(n)] for n in shown)
         _draw_orbits(ax, view, shown, frame)
     axes[0, 0].set_title(f"{result.scene.name}: orbits about {view['primary']}, "
                          f"projected on the frame's x-y plane", fontsize=10)
     if view["inner"]:
-        axes[0, 1].set_title(f"inner bodies: {', '.join(view['inner'])}", fontsize=10)
+        inner = view["inner"]
+        axes[0, 1].set_title(f"inner bodies: {', '.join(inner)}" if len(inner) <= 6 else
+                             f"the {len(inner)} inner bodies (within "
+                             f"{max(view['reach'][names.index(n)] for n in inner):.2g} "
+                             f"{view['unit']})", fontsize=10)
     fig.tight_layout()
     fig.set_label("orbits")  # the file name Result.save gives it
     return fig
@@ -204,7 +463,7 @@ def plot_energy(result: Result, what: str, conserved: bool):
     in the legend, not drawn at an invented floor."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
     span = result.times[-1] - result.times[0]
     t_unit = u.yr if span > 1 * u.yr else u.d
     t = result.times.to_value(t_unit)
@@ -219,14 +478,19 @@ def plot_energy(result: Result, what: str, conserved: bool):
         note = f" ({zeros} of {len(err)} outputs exactly 0, not drawn)" if zeros else ""
         ax.semilogy(t[1:][nonzero], err[nonzero], ".", ms=2, label=label + note, **style)
     eps = np.finfo(float).eps
-    ax.axhline(eps, color="0.5", lw=0.7, ls=":", label=f"machine epsilon {eps:.1e}")
-    if not ax.has_data() or not np.any(np.abs(result.diagnostics["energy_error"]) > 0):
+    drawn = [line.get_ydata() for line in ax.get_lines() if len(line.get_ydata())]
+    top = max((float(np.max(y)) for y in drawn), default=0.0)
+    if top < 1e3 * eps:  # the line only where the data come near it
+        ax.axhline(eps, color="0.5", lw=0.7, ls=":", label=f"machine epsilon {eps:.1e}")
+    if not drawn:
         ax.set_ylim(eps / 100, eps * 100)
     ax.set_xlabel(f"time since the start [{t_unit}]")
-    ax.set_ylabel("|relative energy error|" if conserved else "|relative energy change|")
+    ax.set_ylabel("|relative energy error| (dimensionless)" if conserved
+                  else "|relative energy change| (dimensionless)")
     title = "energy error" if conserved else "energy change (not an error: not conserved)"
     ax.set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
+              frameon=False)
     fig.tight_layout()
     fig.set_label("energy_error")  # the file name Result.save gives it
     return fig
