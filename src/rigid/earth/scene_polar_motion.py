@@ -143,11 +143,19 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
 def _plot(result: Result):
     import matplotlib.pyplot as plt
 
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5.6))
     x = result.states["x_p"].to_value(u.mas)
     y = result.states["y_p"].to_value(u.mas)
-    ax.plot(x, y, lw=0.3)
-    ax.set_aspect("equal")
+    (path,) = ax.plot(x, y, lw=0.3, label="pole path")
+    # where the path starts and which way the pole moves
+    ax.plot(x[:1], y[:1], "o", ms=6, mfc=path.get_color(), mec="k", gid="start",
+            label=f"start ({result.scene.spec.get('start')}); arrow: the next 20 days")
+    k = min(20, len(x) - 1)
+    ax.annotate("", xy=(x[k], y[k]), xytext=(x[0], y[0]), gid="direction",
+                arrowprops={"arrowstyle": "-|>", "color": "k", "lw": 1.0})
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
+              frameon=False)
     # IERS pole coordinates (IERS Conventions 2010, ch. 5): terrestrial axes, x_p
     # towards the Greenwich meridian, y_p towards 90 degrees west
     ax.set_xlabel("x_p, terrestrial axes, towards Greenwich [mas]")
@@ -160,8 +168,10 @@ def _plot(result: Result):
              label="Liouville model")
     ax2.set_xlabel("time from the fit epoch [yr]")
     ax2.set_ylabel("m1 = x_p, towards Greenwich [mas]")
-    ax2.legend(fontsize=8)
+    ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
+               frameon=False)
     ax2.set_title(f"{result.scene.name}: model against the record")
+    fig.tight_layout()
     fig.set_label("pole")  # the file name Result.save gives it
     return fig
 

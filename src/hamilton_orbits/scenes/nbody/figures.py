@@ -282,11 +282,31 @@ def _host(view: dict, k: int) -> str | None:
     return None
 
 
-def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> str:
+def _draw_ends(ax: Any, view: dict, k: int, color: Any) -> None:
+    """For a body that goes round more than 20 times: the two-body orbits at its
+    first (bold) and last (dashed) outputs, over the pale track."""
+    from hamilton_orbits.kepler import propagate
+
+    for row, style in ((0, "-"), (-1, "--")):
+        r, v, mu = view["rel"][row, k], view["vrel"][row, k], view["mu"][k]
+        period = _period(r[None], v[None], mu)[0]
+        if not np.isfinite(period):
+            continue
+        tau = np.linspace(0.0, period, PER_ORBIT * 2 + 1)
+        pts = propagate(np.broadcast_to(r, (len(tau), 3)), np.broadcast_to(v, (len(tau), 3)),
+                        mu, tau)[0]
+        ax.plot(pts[:, 0], pts[:, 1], lw=1.3, color=color, ls=style, gid="ends",
+                label="_nolegend_")
+
+
+def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> set[str]:
     """One body's track, its start marker and an arrow along its first velocity;
-    "dots" if its outputs are drawn as dots on Kepler arcs, "arcs" if Kepler arcs
-    are drawn only between some outputs (near periapsis), "" if neither."""
+    what was drawn: "dots" if its outputs are drawn as dots on Kepler arcs, "arcs"
+    if Kepler arcs are drawn only between some outputs (near periapsis), "ends" if
+    its first and last orbits are drawn bold over a pale track."""
     host = _host(view, k)
+    period = _period(view["rel"][:1, k], view["vrel"][:1, k], view["mu"][k])[0]
+    many = host is None and (view["t"][-1] - view["t"][0]) > 20 * period
     if host is not None:  # a moon: its two-body orbit about the primary means nothing
         ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=2, color=color,
                 label=f"{label}: the outputs (it goes round {host})" if label
@@ -296,12 +316,13 @@ def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> st
         pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
                                      view["mu"][k])
         ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
-                label=label or "_nolegend_")
-    period = _period(view["rel"][:1, k], view["vrel"][:1, k], view["mu"][k])[0]
+                alpha=0.3 if many else 1.0, label=label or "_nolegend_")
     dots = refined and np.mean(np.diff(view["t"])) > period / PER_ORBIT  # sparse outputs
     if dots:
         ax.plot(view["rel"][:, k, 0], view["rel"][:, k, 1], ".", ms=1.5, color=color,
-                gid="outputs", label="_nolegend_")
+                alpha=0.3 if many else 1.0, gid="outputs", label="_nolegend_")
+    if many:
+        _draw_ends(ax, view, k, color)
     x0, y0 = view["rel"][0, k, :2]
     ax.plot([x0], [y0], "o", ms=5, mfc=color, mec="k", mew=0.6, gid="start",
             label="_nolegend_")
@@ -311,7 +332,7 @@ def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> st
         ax.annotate("", xy=(x0 + d[0], y0 + d[1]), xytext=(x0, y0), gid="direction",
                     arrowprops={"arrowstyle": "-|>", "color": color, "lw": 1.0,
                                 "shrinkA": 0, "shrinkB": 0})
-    return "dots" if dots else "arcs" if refined else ""
+    return {"dots" if dots else "arcs" if refined else "", "ends" if many else ""}
 
 
 def _draw_encounter(ax: Any, view: dict, shown: list[str]) -> list:
@@ -341,7 +362,7 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     for name in [n for n in shown if n != primary]:
         k = view["names"].index(name)
         color = PALETTE[view["named"].index(name) % len(PALETTE)] if name in named else "0.55"
-        drawn.add(_draw_body(ax, view, k, color, name if name in named else None))
+        drawn |= _draw_body(ax, view, k, color, name if name in named else None)
     handles = [h for h in ax.get_lines() if not h.get_label().startswith("_")]
     if rest:
         handles.append(Line2D([], [], color="0.55", lw=0.6, label=(
@@ -353,6 +374,10 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     handles.append(sun)
     handles.append(Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
                           label="start (t = 0); arrow: direction of motion"))
+    if "ends" in drawn:
+        handles.append(Line2D([], [], color="k", lw=1.3, label=(
+            "bold, dashed: the two-body orbit at the first,\nthe last output "
+            "(pale: the whole track)")))
     if "dots" in drawn:
         handles.append(Line2D([], [], color="k", lw=0.6, marker=".", ms=3, label=(
             f"dots: the outputs (every {view['cadence_text']}), more\nthan a {PER_ORBIT}th "
@@ -366,8 +391,10 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(axis_label("x", view["unit"], frame, primary), fontsize=8)
     ax.set_ylabel(axis_label("y", view["unit"], frame, primary), fontsize=8)
-    ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.09),
-              ncol=2, frameon=False)
+    legend = ax.legend(handles=handles, fontsize=7, loc="upper center",
+                       bbox_to_anchor=(0.5, -0.09), ncol=2, frameon=False)
+    for handle in legend.legend_handles:
+        handle.set_alpha(1.0)  # a pale track has a legend entry in full colour
 
 
 def _orbit_data(result: Result, gm: np.ndarray) -> dict:
