@@ -16,8 +16,10 @@ verdict.
 Writes <out>/stability_map.png (the two maps, how much GR moves MEGNO and the
 cells whose verdict it changes) and <out>/stability_map.csv (one row per cell
 and model).
-Run: python examples/chaos/stability_map.py [out_dir] [--n 64] [--orbits 10000] [--dask]
-     python examples/chaos/stability_map.py [out_dir] --quick      (8 x 8, 200 orbits)
+Run::
+
+    python examples/chaos/stability_map.py [out_dir] [--n 64] [--orbits 10000] [--dask]
+    python examples/chaos/stability_map.py [out_dir] --quick      (8 x 8, 200 orbits)
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 Pole wander of a rigid Earth: the Euler period
 ==============================================
 
-A century of the free wobble, integrated and exact.  
+A century of the free wobble, integrated and exact.
 The Earth of rigid.earth (IERS 2010 constants, EGM2008 triaxiality) spins at
 OMEGA with its rotation axis 0.2 arcsec off the figure axis.  Euler's equations
 are integrated with the fourth-order Lie-Poisson splitting (rigid.integrate,

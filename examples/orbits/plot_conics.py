@@ -36,9 +36,9 @@ for e, a, p, period in zip(ecc, orbits.a, orbits.p, orbits.period, strict=True):
 # -----------------------
 # ``propagate`` broadcasts over times.  The ellipses are followed for one full
 # period from apoapsis (half a period before periapsis), the open orbits from 200
-# days before periapsis to 200 days after.  Every orbit moves counter-clockwise in this frame (its angular
-# momentum is along +z); the energy is a constant of the motion and
-# ``propagate`` keeps it to rounding.
+# days before periapsis to 200 days after.  Every orbit moves counter-clockwise
+# in this frame (its angular momentum is along +z); the energy is a constant of
+# the motion and ``propagate`` keeps it to rounding.
 fig, ax = plt.subplots(figsize=(7.5, 6))
 worst = 0.0
 for k, e in enumerate(ecc):
