@@ -82,9 +82,9 @@ print(text)
 # %%
 # The figure
 # ----------
-# Two Euler periods of the pole about the figure axis (it turns prograde,
-# counter-clockwise seen from above the north pole), and the integrator's
-# departure from the exact motion over the whole run.
+# Two Euler periods of the pole about the figure axis (the start is marked and
+# the arrow gives its sense in these axes), and the integrator's departure from
+# the exact motion over the whole run.
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 5))
 n = int(2 * t_e.to_value(u.day))
 ax1.plot(split.x[:n].to_value(u.mas), split.y[:n].to_value(u.mas), lw=1.5,

@@ -115,7 +115,7 @@ ax1.plot(t, w[:, 0] / SPIN, label=r"$\omega_1 / \Omega$", lw=0.8)
 ax1.plot(t, w[:, 2] / SPIN, label=r"$\omega_3 / \Omega$", lw=0.8)
 ax1.set_xlabel("t (s)")
 ax1.set_title(f"exact motion, eps = 1e-3: T/2 = {par.flip_interval.to_value(u.s):.4f} s")
-ax1.set_ylabel("angular velocity on the principal (body) axes / spin (dimensionless)")
+ax1.set_ylabel("body-frame ω / spin Ω (dimensionless)")
 ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3,
            frameon=False)
 ax2.plot(-np.log(rows[:, 1]), rows[:, 2], "o-", label="exact 2K(m)/lambda")
