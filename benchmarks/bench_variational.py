@@ -6,7 +6,7 @@
    ``radau15`` (100 yr), beside rebound's WHFast and IAS15 with ``init_megno()``
    (one set of variational particles) on the same state; best of ``--repeats``.
    Also ``wh`` with ``stm=True`` (55 tangent vectors).
-2. The stability map of ``examples/stability_map.py`` (Jupiter and a Saturn-mass
+2. The stability map of ``examples/chaos/stability_map.py`` (Jupiter and a Saturn-mass
    planet over (a, e)), ``--n`` x ``--n`` cells of ``--orbits`` orbits of Jupiter:
    ours through ``Ensemble`` on the local cores, rebound's WHFast MEGNO (Jacobi,
    the same 120-day step) over a ``multiprocessing`` pool of as many processes,

@@ -1,4 +1,4 @@
-"""The runnable studies in examples/ run and report what they claim.
+"""The runnable studies in examples/<section>/ run and report what they claim.
 
 Each example is run as a user would (a subprocess); the assertions read its
 printed summary, so an example that rots (or whose numbers drift) fails here.
@@ -25,21 +25,21 @@ def run(name: str, *args: str) -> str:
     return res.stdout
 
 
-def test_dzhanibekov_flip():
+def test_dzhanibekov_flip(tmp_path):
     """The slope of T/2 against -ln(1 - m) approaches 1/lambda (DLMF 19.12.1)."""
-    out = run("dzhanibekov_flip.py")
+    out = run("rigid/plot_dzhanibekov_flip.py", "--out", str(tmp_path))
     slope, inv_lam = map(float, re.search(r"([\d.]+) s; 1/lambda = ([\d.]+) s", out).groups())
     assert abs(slope - inv_lam) <= 1e-5 * inv_lam
     # the exact interval agrees with DOP853 where DOP853 is reliable (1 - m >= 2e-5)
     rows = re.findall(r"^\s*\S+\s+(\S+)\s+\S+\s+\S+\s+(\S+)$", out, flags=re.M)
     diffs = {float(one_minus_m): float(d) for one_minus_m, d in rows}
     assert all(d < 1e-10 for m1, d in diffs.items() if m1 >= 2e-5)
-    assert (EXAMPLES / "out" / "dzhanibekov_flip.png").stat().st_size > 10_000
+    assert (tmp_path / "dzhanibekov_flip.png").stat().st_size > 10_000
 
 
 def test_elements_crosscheck_quick():
     """The cross-check against rebound runs and names cases rebound cannot do."""
-    out = run("elements_crosscheck.py", "--quick")
+    out = run("nbody/elements_crosscheck.py", "--quick")
     # random orbits: no NaN on our side, and a, e agree with rebound to rounding
     assert re.search(r"NaN: rebound \d+, ours 0\b", out)
     lines = out.splitlines()
@@ -53,7 +53,7 @@ def test_elements_crosscheck_quick():
 
 def test_pole_wander_rigid_earth_quick(tmp_path):
     """The integrated rigid-Earth wobble has the linear Euler period (~304.5 sidereal d)."""
-    out = run("pole_wander_rigid_earth.py", str(tmp_path), "--quick")
+    out = run("earth_pole/plot_pole_wander_rigid_earth.py", "--out", str(tmp_path), "--quick")
     value = {m[0].strip(): float(m[1]) for m in re.findall(r"^(.+?)\s{2,}([-\d.e+]+)\s", out,
                                                            flags=re.M)}
     t_e = value["Euler period, linear (triaxial)"]
@@ -65,7 +65,7 @@ def test_pole_wander_rigid_earth_quick(tmp_path):
 
 def test_chandler_wobble_quick(tmp_path):
     """The fitted Chandler period is within the published 430-436 d (Wilson & Vicente 1990)."""
-    out = run("chandler_wobble.py", str(tmp_path), "--quick")
+    out = run("earth_pole/chandler_wobble.py", str(tmp_path), "--quick")
     t_c = float(re.search(r"^Chandler period\s+([\d.]+) \+- ([\d.]+)\s+d", out,
                           flags=re.M).group(1))
     assert 430 < t_c < 436
@@ -79,7 +79,7 @@ def test_ensemble_comet_clones_quick(tmp_path):
     """Every clone runs; the encounter scatters 1/a (some clones escape: 1/a < 0),
     reported as 1/a, which is smooth through the parabola, not as a, which jumps
     through +-infinity there."""
-    out = run("ensemble_comet_clones.py", str(tmp_path), "--quick")
+    out = run("ensembles/ensemble_comet_clones.py", str(tmp_path), "--quick")
     assert "4 clones, 0 failed" in out
     rows = re.findall(r"^\s+(0\.999\d+)\s+([\d.]+)\s+(-?[\d.]+)\s+([\d.]+)\s+(bound|escapes)",
                       out, flags=re.M)
@@ -97,7 +97,7 @@ def test_ensemble_comet_clones_quick(tmp_path):
 def test_stability_map_quick(tmp_path):
     """The MEGNO map runs (8 x 8 cells, both models), finds regular and chaotic
     cells, and draws its figure."""
-    out = run("stability_map.py", str(tmp_path), "--quick")
+    out = run("chaos/stability_map.py", str(tmp_path), "--quick")
     rows = re.findall(r"(\d+) failed, chaotic \(MEGNO > 4\): ([\d.]+)%, median MEGNO of the "
                       r"regular cells ([\d.]+)", out)
     assert len(rows) == 2
@@ -108,7 +108,7 @@ def test_stability_map_quick(tmp_path):
 
 def test_pole_prediction_quick(tmp_path):
     """The hindcast tables carry every method beside the published rows; figures written."""
-    out = run("pole_prediction.py", str(tmp_path), "--quick")
+    out = run("earth_pole/pole_prediction.py", str(tmp_path), "--quick")
     assert "126 weekly starts" in out
     for name in ("persistence", "ls+ar", "ls+var", "liouville", "WLS+VAR (Lei et al. 2023)"):
         assert re.search(rf"^{re.escape(name)}\s+[\d.]+", out, flags=re.M), name

@@ -1,4 +1,6 @@
-"""Clones of a near-parabolic comet past Jupiter: an ensemble of one scene.
+"""
+Clones of a near-parabolic comet past Jupiter: an ensemble of one scene.
+========================================================================
 
 The bundled scene ``comet-encounter`` (q = 0.01 au, e = 0.9999, then 0.03 au past
 Jupiter) is run for clones whose eccentricity differs by a few 1e-6: the
@@ -9,7 +11,7 @@ parallel (hamilton_orbits.Ensemble; a Dask client can be given instead of the
 local pool).
 
 Writes <out>/comet_clones.png and <out>/comet_clones.csv.
-Run: python examples/ensemble_comet_clones.py [out_dir] [--quick]
+Run: python examples/ensembles/ensemble_comet_clones.py [out_dir] [--quick]
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ from hamilton_orbits import Ensemble, Scene
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", nargs="?", default=str(Path(__file__).parent / "out"))
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument("out", nargs="?", default=str(Path(__file__).resolve().parents[1] / "out"))
     parser.add_argument("--quick", action="store_true", help="4 clones instead of 16")
     args = parser.parse_args(argv)
     out = Path(args.out)

@@ -1,4 +1,6 @@
-"""The Chandler wobble in the IERS 20 C04 record, against the rigid and elastic Earth.
+"""
+The Chandler wobble in the IERS 20 C04 record, against the rigid and elastic Earth.
+===================================================================================
 
 The observed pole since 1962 (astropy-iers-data, read offline) is fitted with a
 linear trend, a prograde Chandler term and prograde and retrograde annual terms
@@ -14,7 +16,7 @@ while the observed one is re-excited (and collapsed after 2010, see the
 amplitude per decade).
 
 Writes <out>/chandler_wobble.png and <out>/chandler_wobble.txt.
-Run: python examples/chandler_wobble.py [out_dir] [--quick]
+Run: python examples/earth_pole/chandler_wobble.py [out_dir] [--quick]
 (--quick uses 1980-2010 and a coarser periodogram).
 """
 
@@ -37,8 +39,8 @@ Q_CITED = 179.0  # Wilson & Vicente 1990 (68% range about 74-789)
 
 
 def main(argv: list[str] | None = None) -> str:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", nargs="?", default=str(Path(__file__).parent / "out"),
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument("out", nargs="?", default=str(Path(__file__).resolve().parents[1] / "out"),
                         help="output directory (default examples/out)")
     parser.add_argument("--quick", action="store_true", help="1980-2010, coarser spectrum")
     args = parser.parse_args(argv)

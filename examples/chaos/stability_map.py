@@ -1,4 +1,6 @@
-"""A MEGNO stability map: a Saturn-mass planet beside Jupiter over a grid of (a, e).
+"""
+A MEGNO stability map: a Saturn-mass planet beside Jupiter over a grid of (a, e).
+=================================================================================
 
 Each cell is the bundled scene ``stability-map`` (the Sun and Jupiter at J2000 and
 a planet of Saturn's mass, coplanar with Jupiter) with the planet's semi-major
@@ -14,8 +16,10 @@ verdict.
 Writes <out>/stability_map.png (the two maps, how much GR moves MEGNO and the
 cells whose verdict it changes) and <out>/stability_map.csv (one row per cell
 and model).
-Run: python examples/stability_map.py [out_dir] [--n 64] [--orbits 10000] [--dask]
-     python examples/stability_map.py [out_dir] --quick      (8 x 8, 200 orbits)
+Run::
+
+    python examples/chaos/stability_map.py [out_dir] [--n 64] [--orbits 10000] [--dask]
+    python examples/chaos/stability_map.py [out_dir] --quick      (8 x 8, 200 orbits)
 """
 
 from __future__ import annotations
@@ -99,8 +103,8 @@ def plot(a, e, maps: dict, out: Path, orbits: float) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", nargs="?", default=str(Path(__file__).parent / "out"))
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument("out", nargs="?", default=str(Path(__file__).resolve().parents[1] / "out"))
     parser.add_argument("--n", type=int, default=64, help="cells along a and along e")
     parser.add_argument("--orbits", type=float, default=1e4, help="orbits of Jupiter")
     parser.add_argument("--quick", action="store_true", help="8 x 8 cells, 200 orbits")

@@ -1,10 +1,12 @@
-"""Cross-check KeplerOrbit's elements against rebound's ``sim.orbits()``.
+"""
+Cross-check KeplerOrbit's elements against rebound's ``sim.orbits()``.
+======================================================================
 
 Runs on random orbits and on the hard-case catalogue (tests/hamilton_orbits/
 hard_cases.py); prints a table of the largest differences and the cases rebound
 cannot do, and writes the same text to ``examples/out/elements_crosscheck.txt``.
 
-    python examples/elements_crosscheck.py [--quick]
+    python examples/nbody/elements_crosscheck.py [--quick]
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import rebound
 from hamilton_orbits.orbit import KeplerOrbit
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent / "tests" / "hamilton_orbits"))
+sys.path.insert(0, str(HERE.parents[1] / "tests" / "hamilton_orbits"))
 from hard_cases import CASES  # noqa: E402
 
 NAMES = ("a", "e", "inc", "lan", "argp", "nu", "M")
@@ -97,7 +99,7 @@ def main(argv=None) -> str:
                 lines.append(f"  {c.name:44s} {name:8s} {A[i, j]:12.5g} {B[i, j]:12.5g}")
     lines.append("  (lan/argp differences at degenerate inc or e are convention: ours are 0)")
     text = "\n".join(lines)
-    out = HERE / "out"
+    out = HERE.parent / "out"
     out.mkdir(exist_ok=True)
     (out / "elements_crosscheck.txt").write_text(text + "\n")
     print(text)

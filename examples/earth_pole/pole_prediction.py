@@ -1,4 +1,6 @@
-"""Where will the pole be next year?  Prediction methods hindcast against the IERS record.
+"""
+Where will the pole be next year?  Prediction methods hindcast against the IERS record.
+=======================================================================================
 
 Runs the bundled scene ``pole-prediction`` (rigid.earth.scene_pole_prediction): five methods
 of rigid.earth.prediction (persistence, least-squares harmonics "ls", "ls+ar", "ls+var" and
@@ -11,7 +13,7 @@ Writes <out>/prediction_fan.png (the fan from 2019-01-01 against the record that
 <out>/mae_vs_horizon.png (mean absolute error against horizon, the published LS+AR and
 WLS+VAR rows beside them), <out>/coverage.png (fraction of outcomes inside each method's
 own 1-sigma band) and <out>/pole_prediction.txt (the tables).
-Run: python examples/pole_prediction.py [out_dir] [--quick]
+Run: python examples/earth_pole/pole_prediction.py [out_dir] [--quick]
 (--quick: the paper's period only).
 """
 
@@ -49,8 +51,8 @@ def verdict(result) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> str:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", nargs="?", default=str(Path(__file__).parent / "out"),
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
+    parser.add_argument("out", nargs="?", default=str(Path(__file__).resolve().parents[1] / "out"),
                         help="output directory (default examples/out)")
     parser.add_argument("--quick", action="store_true", help="the paper's period only")
     args = parser.parse_args(argv)
