@@ -40,6 +40,7 @@ extensions = [
     "sphinx.ext.viewcode",
     "numpydoc",
     "sphinx_copybutton",
+    "sphinx_gallery.gen_gallery",
     "scene_reference",
 ]
 
@@ -75,6 +76,29 @@ nitpick_ignore_regex = [
      r"float64|int64|ArrayLike|NDArray|function|object|None|bool|int|float|str|dict|list|"
      r"tuple|complex|bytes|type|Exception|ValueError|TypeError|KeyError)"),
 ]
+
+# The gallery: examples/<section>/plot_*.py are run and their figures shown; the
+# other scripts of examples/ are rendered without running (slow, or they start
+# worker processes).  Its output (docs/gallery/) is kept in the repository with
+# each example's checksum, so that a build re-runs only the examples that changed:
+# CI builds the site without running any.
+_SECTIONS = ("orbits", "nbody", "effects", "events", "chaos", "ensembles", "accuracy",
+             "rigid", "earth_pole")
+sphinx_gallery_conf = {
+    "examples_dirs": "../examples",
+    "gallery_dirs": "gallery",
+    "filename_pattern": r"/plot_",
+    "ignore_pattern": r"(__init__|/out/)",
+    "subsection_order": [f"../examples/{s}" for s in _SECTIONS
+                         if (ROOT / "examples" / s).is_dir()],
+    "within_subsection_order": "FileNameSortKey",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "matplotlib_animations": False,
+    "image_scrapers": ("matplotlib",),
+    "run_stale_examples": False,
+    "show_memory": False,
+}
 
 html_theme = "pydata_sphinx_theme"
 html_title = "hamilton-orbits"

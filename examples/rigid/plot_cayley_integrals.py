@@ -8,7 +8,7 @@ space, ``L_s = q (A p, B q, C r) q^-1``, Cayley's integrals ``(g, g', g'')``
 flips, as in the Dzhanibekov example) is integrated for 200 time units with the
 same step by four methods of :func:`rigid.integrate`: classical Runge-Kutta on
 the quaternion (``rk4``) and on Cayley's parameters ``(lambda, mu, nu)`` with
-re-centring (``cayley_rk4``, see :mod:`rigid.rodrigues`), the fourth-order
+re-centring (``cayley_rk4``, see ``rigid.rodrigues``), the fourth-order
 Lie-Poisson splitting (``splitting4``; McLachlan 1993) and the exact free flow
 with kicks (``exact_kick``).  The splitting keeps the angular momentum in
 space to rounding and its energy error bounded, oscillating with the flips;
