@@ -12,8 +12,10 @@ line when numba's cache holds none of the kernels yet (:func:`numba_cache_cold`)
 
 import importlib.util
 import os
+import sys
 from pathlib import Path
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, print_blob=True)
@@ -45,3 +47,15 @@ def pytest_sessionstart(session):
         reporter = session.config.pluginmanager.get_plugin("terminalreporter")
         if reporter is not None:
             reporter.write_line(COLD_NOTICE)
+
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Close the figures a test left open (a scene's ``plot()`` returns its figures
+    open, for the caller): with more than 20 open, matplotlib warns, and the suite
+    turns that warning into an error in whichever later test opens the 21st."""
+    yield
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close("all")
