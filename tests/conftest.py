@@ -52,10 +52,15 @@ def pytest_sessionstart(session):
 
 @pytest.fixture(autouse=True)
 def _close_figures():
-    """Close the figures a test left open (a scene's ``plot()`` returns its figures
-    open, for the caller): with more than 20 open, matplotlib warns, and the suite
-    turns that warning into an error in whichever later test opens the 21st."""
+    """Close the figures a test opened and left open (a scene's ``plot()`` returns its
+    figures open, for the caller): with more than 20 open, matplotlib warns, and the
+    suite turns that warning into an error in whichever later test opens the 21st.
+    Figures that existed before the test (a module fixture's, shared by its tests)
+    are left alone."""
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    before = set(pyplot.get_fignums()) if pyplot is not None else set()
     yield
     pyplot = sys.modules.get("matplotlib.pyplot")
     if pyplot is not None:
-        pyplot.close("all")
+        for num in set(pyplot.get_fignums()) - before:
+            pyplot.close(num)
