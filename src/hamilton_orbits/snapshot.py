@@ -42,8 +42,8 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "meta_json", "read", "write",
-           "write_bytes"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "meta_json", "read",
+           "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
