@@ -188,6 +188,8 @@ class Simulation(Saving):
         #: the parts of a snapshot that never change, made at the first (checkpoint.record)
         self._record_cache: dict[str, Any] = {}
         self._encounters = encounter_check(typed, step, tol, arrays.r, arrays.gm)
+        if self._prop.events is None and not (arrays.gm == 0).any():
+            self._encounters = None  # no test particle, ever: nothing to check per leg
 
     # ------------------------------------------------------------------ state
     @property
