@@ -211,7 +211,8 @@ class Saving:
                  "archive": None if self._archive is None else self._archive.schedule()}
         if rows is not None:
             extra["leg"] = rows.info
-        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra)
+        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra,
+                                           self._record_cache)
         if rows is not None:
             arrays.update(rows.take())
             dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))

@@ -93,21 +93,23 @@ def from_json(value: Any) -> Any:
 
 def record(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,
            events: list, variational: bool, stm: bool, prop: Any,
-           extra: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, np.ndarray],
-                                              dict[str, tuple[str, ...]], dict[str, str]]:
+           extra: Mapping[str, Any], cache: dict[str, Any] | None = None
+           ) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, tuple[str, ...]],
+                      dict[str, str]]:
     """The ``meta``, arrays, dimensions and units of a snapshot of a simulation whose
-    system at time 0 is ``system`` and whose propagation is ``prop``."""
-    from hamilton_orbits import __version__
-
+    system at time 0 is ``system`` and whose propagation is ``prop``; ``cache``: a
+    dict kept by the simulation, where the parts that never change (the system at
+    time 0, the method, the effects and events as JSON) are made once."""
     layout, state = flatten(prop)
-    sa = system.as_arrays()
+    fixed = None if cache is None else cache.get("fixed")
+    if fixed is None:
+        fixed = _fixed(system, method, dt, tol, effects, events, variational, stm)
+        if cache is not None:
+            cache["fixed"] = fixed
+    head, sa = fixed
     quantity = bool(sa.quantity)
-    meta = {"kind": "simulation", "version": __version__,
-            "system": {"names": list(sa.names), "quantity": quantity, "G": float(sa.G)},
-            "method": {"name": method.name, "options": to_json(method.options())},
-            "dt": dt, "tol": tol, "effects": to_json(effects), "events": to_json(events),
-            "variational": variational, "stm": stm, "t": float(prop.t),
-            "steps": int(prop.steps), "layout": layout, **to_json(dict(extra))}
+    meta = {**head, "t": float(prop.t), "steps": int(prop.steps), "layout": layout,
+            **to_json(dict(extra))}
     arrays: dict[str, np.ndarray] = {f"initial_{k}": getattr(sa, k) for k in _SYSTEM_FIELDS}
     active = np.ones(len(sa.names), dtype=bool)
     if prop.events is not None:
@@ -124,6 +126,22 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
                  "initial_r": "au", "initial_v": "au/day", "initial_gm": "au3/day2",
                  "initial_radius": "au"}
     return meta, arrays, dims, units
+
+
+def _fixed(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,
+           events: list, variational: bool, stm: bool) -> tuple[dict[str, Any], Any]:
+    """The part of a snapshot's ``meta`` that a simulation never changes, and its
+    system's arrays at time 0."""
+    from hamilton_orbits import __version__
+
+    sa = system.as_arrays()
+    head = {"kind": "simulation", "version": __version__,
+            "system": {"names": list(sa.names), "quantity": bool(sa.quantity),
+                       "G": float(sa.G)},
+            "method": {"name": method.name, "options": to_json(method.options())},
+            "dt": dt, "tol": tol, "effects": to_json(effects), "events": to_json(events),
+            "variational": variational, "stm": stm}
+    return head, sa
 
 
 def spec(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray]) -> dict[str, Any]:
@@ -315,6 +333,8 @@ class ArchiveWriter:
         self.folder: OutputFolder | None = None
         self.count = 0
         self.last_steps, self.last_wall = 0, time.monotonic()
+        #: the JSON text of the parts of ``meta`` that repeat from snapshot to snapshot
+        self.texts: dict[str, tuple[Any, str]] = {}
 
     def schedule_only(self) -> ArchiveWriter:
         """The same schedule writing nothing (for a copy of the simulation)."""
@@ -375,7 +395,8 @@ class ArchiveWriter:
             return None
         path = self.path / SNAPSHOT_NAME.format(self.count)
         meta = dict(meta, archive=self.schedule(), number=self.count)
-        write_bytes(path, encode_snapshot(meta, arrays, dims, units), sync=self.sync)
+        write_bytes(path, encode_snapshot(meta, arrays, dims, units, self.texts),
+                    sync=self.sync)
         self.count += 1
         self.last_steps, self.last_wall = int(meta["steps"]), time.monotonic()
         return path

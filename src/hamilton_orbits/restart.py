@@ -80,7 +80,19 @@ def flatten(obj: Any) -> tuple[dict[str, Any], list[np.ndarray]]:
     return _node(obj, arrays, seen), arrays
 
 
+_PLAIN = frozenset(_SCALARS)
+
+
 def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int]) -> dict[str, Any]:
+    kind = type(obj)
+    if kind in _PLAIN:  # the common leaves first (what _built decides for them: not built)
+        return {"value": obj}
+    if kind is np.ndarray and not is_address(obj):
+        if id(obj) in seen:
+            return {"alias": seen[id(obj)]}
+        seen[id(obj)] = len(arrays)
+        arrays.append(obj)
+        return {"array": len(arrays) - 1}
     if _built(obj):
         return {"built": True}
     if isinstance(obj, _SCALARS):

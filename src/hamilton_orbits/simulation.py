@@ -183,6 +183,13 @@ class Simulation(Saving):
         self._leg: LegRows | None = None
         self._resumable: Any = None
         self._warned = False  # an under-resolved encounter is warned of once
+        #: how a leg's test-particle approaches are checked: fixed for the simulation
+        #: (method, step, tolerance, the state at time 0), so found once, not per call
+        #: the parts of a snapshot that never change, made at the first (checkpoint.record)
+        self._record_cache: dict[str, Any] = {}
+        self._encounters = encounter_check(typed, step, tol, arrays.r, arrays.gm)
+        if self._prop.events is None and not (arrays.gm == 0).any():
+            self._encounters = None  # no test particle, ever: nothing to check per leg
 
     # ------------------------------------------------------------------ state
     @property
@@ -296,8 +303,7 @@ class Simulation(Saving):
         prop = self._prop
         traj = make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
                                self._effects, start=start, wall_time=wall_time,
-                               encounters=encounter_check(prop.method, prop.dt, prop.tol,
-                                                          *self._initial[::2]))
+                               encounters=self._encounters)
         warning = encounter_warning(traj)
         if warning is not None and not self._warned:
             self._warned = True  # once per simulation

@@ -42,8 +42,8 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "read", "write",
-           "write_bytes"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "meta_json", "read",
+           "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
@@ -117,15 +117,44 @@ def write(path: str | os.PathLike[str], meta: Mapping[str, Any],
 
 def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
                     dims: Mapping[str, tuple[str, ...]] | None = None,
-                    units: Mapping[str, str] | None = None) -> bytes:
+                    units: Mapping[str, str] | None = None,
+                    texts: dict[str, tuple[Any, str]] | None = None) -> bytes:
     """The bytes of a snapshot file (see :func:`write`): a copy, so the arrays may
-    change as soon as it returns."""
+    change as soon as it returns.  ``texts``: a cache of the JSON text of ``meta``'s
+    values that repeat from one snapshot to the next (:func:`meta_json`)."""
     dims, units = dims or {}, units or {}
-    meta_text = json.dumps(meta, sort_keys=True, allow_nan=True)
+    meta_text = (json.dumps(meta, sort_keys=True, allow_nan=True) if texts is None
+                 else meta_json(meta, texts))
     variables = [_variable(name, np.asarray(value), dims.get(name), units.get(name))
                  for name, value in arrays.items()]
     return encode({"format": FORMAT, "format_version": FORMAT_VERSION, "meta": meta_text,
                    "sha256": checksum(meta_text, arrays)}, variables)
+
+
+def meta_json(meta: Mapping[str, Any], texts: dict[str, tuple[Any, str]]) -> str:
+    """``json.dumps(meta, sort_keys=True)``, character for character, with the text
+    of a value the same object as (or, for a dict, equal to) the one of the last call
+    taken from ``texts`` instead of encoded again.
+
+    Examples
+    --------
+    >>> meta, texts = {"b": [1.5, None], "a": {"y": 1, "x": "s"}}, {}
+    >>> meta_json(meta, texts) == json.dumps(meta, sort_keys=True) == meta_json(meta, texts)
+    True
+    """
+    parts = []
+    for key in sorted(meta):
+        value = meta[key]
+        known = texts.get(key)
+        if known is not None and (known[0] is value or (type(value) is dict
+                                                        and known[0] == value)):
+            text = known[1]
+        else:
+            text = json.dumps(value, sort_keys=True, allow_nan=True)
+            if isinstance(value, (dict, list)):
+                texts[key] = (value, text)
+        parts.append(f"{json.dumps(key)}: {text}")
+    return "{" + ", ".join(parts) + "}"
 
 
 def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True) -> None:
