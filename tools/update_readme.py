@@ -3,7 +3,7 @@
 Developer tooling, not part of the installed package::
 
     hamilton-orbits report --out /tmp/report          # the full report (minutes)
-    python tools/update_readme.py /tmp/report         # docs/benchmarks/accuracy.md
+    python tools/update_readme.py /tmp/report         # docs/benchmarks/work-precision.md
 
 copies the combined diagram and the full table under ``docs/`` and rewrites the page
 (or a README given instead) between its markers (``<!-- report:begin ... -->`` and
@@ -138,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     """``python tools/update_readme.py REPORT_DIR [README]``."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("report_dir", help="a folder written by `hamilton-orbits report`")
-    parser.add_argument("page", nargs="?", default="docs/benchmarks/accuracy.md")
+    parser.add_argument("page", nargs="?", default="docs/benchmarks/work-precision.md")
     parser.add_argument("--docs", default="docs", help="where the diagram and table go")
     args = parser.parse_args(argv)
     path = update_readme(args.report_dir, args.page, args.docs)
