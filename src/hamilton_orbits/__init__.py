@@ -1,6 +1,26 @@
 """hamilton-orbits: celestial mechanics on Hamilton's quaternion core.
 
-The curated public API.  Everything not listed in ``__all__`` is private.
+Where to start
+--------------
+- Two bodies: :class:`KeplerOrbit` (elements from a state and back, propagation,
+  vectorised), :func:`solve_kepler`, :class:`Conic`.
+- N bodies: build a :class:`System` of :class:`Body` objects (or
+  ``System.solar_system`` / ``System.from_ephemeris``), then :func:`integrate` it,
+  or make a :class:`Simulation` to run in legs, with effects and events; the
+  result is a :class:`Trajectory` with Hamilton's integrals as error checks.
+- Integrators: :class:`Radau15` (adaptive, default), :class:`WH` (Wisdom-Holman
+  with correctors), :class:`Leapfrog`, :class:`DOP853`.
+- Scene files (TOML) from Python: :class:`Scene` and its :class:`Result`; many
+  runs at once: :class:`Ensemble`; long runs on disk: :class:`Archive`.
+- Rotations: :class:`Quaternion`, :func:`slerp`.
+- Checks against a peer code: :func:`crosscheck`; what to cite: :func:`cite`.
+
+Public modules users import from: ``hamilton_orbits.integrators``,
+``hamilton_orbits.effects``, ``hamilton_orbits.scenes``,
+``hamilton_orbits.events``, ``hamilton_orbits.archive``, ``hamilton_orbits.schema``.
+Everything not listed in ``__all__`` (and every module whose name starts with an
+underscore) is private.  Rigid-body rotation is the sibling package ``rigid``.
+The command line is ``hamilton-orbits`` (``python -m hamilton_orbits``).
 """
 
 from typing import TYPE_CHECKING, Any

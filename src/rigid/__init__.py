@@ -1,6 +1,23 @@
 """rigid: rigid-body attitude dynamics on the hamilton_orbits quaternion core.
 
-Cayley (1843) and Sylvester (1866) made executable.  The curated public API.
+Cayley (1843) and Sylvester (1866) made executable.
+
+Where to start
+--------------
+- A body: :class:`RigidBody` (principal moments; :func:`disk_equivalent`).
+- Torque-free motion in closed form: :func:`free_motion` (and
+  :func:`free_motion_arrays`, :func:`free_parameters`, :class:`FreeMotion`,
+  :class:`FreeParameters`, :func:`time_between`); Poinsot's construction:
+  :func:`poinsot`, :class:`PoinsotPaths`, :func:`plot_poinsot`;
+  Sylvester's confocal quadrics: :func:`confocal`, :func:`contrafocal`,
+  :func:`confocal_rotation`.
+- Numerical integration with torques: :func:`integrate` with
+  :class:`BodyTorque`, :class:`SpaceTorque`, :class:`GravityGradientTorque`
+  (or :class:`BodySI` units); the result is a :class:`RigidTrajectory`.
+
+The Earth's pole (polar motion, the Chandler wobble, prediction) is in
+``rigid.polar_motion`` and ``rigid.earth``.  Everything not listed in
+``__all__`` is private.
 """
 
 
