@@ -139,3 +139,26 @@ def test_the_html_embeds_plotly_and_holds_the_frames(inner, tmp_path):
     assert re.findall(r"<script[^>]*\ssrc=", html) == []
     assert len(html) > 1_000_000  # plotly.js itself (some MB)
     assert "Plotly.newPlot" in html and html.count('"name":"') >= 20
+
+
+def test_a_notebook_displays_it_as_a_plotly_figure():
+    """In Jupyter the figure displays itself: executed in a real IPython kernel
+    (nbclient), a cell ending with ``traj.plot3d()`` outputs plotly's own MIME type,
+    which JupyterLab and Notebook 7 render with their built-in plotly renderer."""
+    pytest.importorskip("plotly", reason="plotly is in the test extra")
+    nbformat = pytest.importorskip("nbformat", reason="nbformat is in the test extra")
+    nbclient = pytest.importorskip("nbclient", reason="nbclient is in the test extra")
+    pytest.importorskip("ipykernel", reason="ipykernel is in the test extra")
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell(
+        "import numpy as np\n"
+        "from hamilton_orbits import Body, System, integrate\n"
+        "s = System([Body('sun', 1.0, [0, 0, 0], [0, 0, 0]),\n"
+        "            Body('p', 1e-3, [1.0, 0, 0], [0, 1.0, 0])])\n"
+        "integrate(s, np.linspace(0, 6.0, 50)).plot3d()")]
+    nbclient.NotebookClient(nb, timeout=600, kernel_name="python3").execute()
+    outputs = nb.cells[0].outputs
+    assert [o["output_type"] for o in outputs] == ["display_data"], outputs
+    figure = outputs[0]["data"]["application/vnd.plotly.v1+json"]
+    assert {t["name"] for t in figure["data"]} >= {"p", "p now", "sun (origin)"}  # the bodies
+    assert figure["layout"]["sliders"], "the time slider"
