@@ -55,6 +55,9 @@ def test_coefficient_matrices_are_inverse():
     # b = C g and g = D b (Rein & Spiegel 2015, eqs. 4-5): D C = 1 to rounding.
     _, c, d = coefficients()
     np.testing.assert_allclose(d @ c, np.eye(7), rtol=0, atol=64 * EPS)
+    # C's diagonal: the leading coefficients of monic polynomials (eq. 5 expanded),
+    # exactly 1, on which the kernel's compensated update of b relies (_correct)
+    np.testing.assert_array_equal(np.diag(c), np.ones(7))
 
 
 @pytest.mark.parametrize("e", [0.0, 0.3, 0.7])
