@@ -4,9 +4,11 @@ Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py
 
 What it prints (medians over interleaved rounds; the machine is shared):
 
-[1] one snapshot of the 10-body disc: ours (a netCDF file written whole, with its
-    SHA-256; ``sync=False`` as an archive writes, and ``sync=True``) against
-    rebound's ``save_to_file`` (a blob appended to one file);
+[1] one snapshot of the 10-body disc appended to an archive: ours (the state
+    captured, a record appended to the segment with its CRC-32, the count in the
+    header updated; ``sync=False`` as an archive writes by default) against
+    rebound's ``save_to_file`` (a blob appended to one file); and ours saved alone
+    (``Simulation.save``: a netCDF file written whole with its SHA-256, synced);
 [2] a run with a snapshot every 100 steps: radau15 against IAS15 (adaptive,
     default tolerances) and wh against WHFast (dt = 0.05), each as the ratio of
     the archived run's time to the same run without an archive (ours: snapshots at
@@ -28,7 +30,7 @@ import numpy as np
 import rebound
 from bench_overhead import rebound_of
 
-from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits import Archive, Body, Simulation, System
 
 T_END = 2000.0
 DT = 0.05
@@ -64,6 +66,8 @@ def interleaved(fns: dict[str, Callable[[], object]], rounds: int) -> dict[str, 
 
 
 def one_snapshot(tmp: Path, repeat: int) -> None:
+    from hamilton_orbits.checkpoint import ArchiveWriter
+
     s = disc10()
     arrays = s.as_arrays()
     sim = Simulation(s, method="radau15")
@@ -71,22 +75,25 @@ def one_snapshot(tmp: Path, repeat: int) -> None:
     reb = rebound_of(arrays.r, arrays.v, arrays.gm, "ias15", DT)
     reb.integrate(10.0)
     reb_file = tmp / "rebound-one.bin"
+    writer = ArchiveWriter(tmp / "ours-one", every=1.0)
+    writer.open()
 
-    def ours(sync: bool) -> Callable[[], None]:
-        from hamilton_orbits.snapshot import write
+    def ours() -> None:
+        writer.write(*sim._record(archive=True))
 
-        def go() -> None:
-            write(tmp / "ours-one.nc", *sim._record(), sync=sync)
-        return go
+    def saved() -> None:
+        sim.save(tmp / "ours-one.nc")
 
     def theirs() -> None:
         reb.save_to_file(str(reb_file))
 
-    t = interleaved({"ours": ours(False), "ours-sync": ours(True), "rebound": theirs}, repeat)
+    t = interleaved({"ours": ours, "saved": saved, "rebound": theirs}, repeat)
+    writer.close()
     med = {k: statistics.median(v) * 1e3 for k, v in t.items()}
-    print("[1] one snapshot of 10 bodies (ms, median of", repeat, "):")
-    print(f"    ours {med['ours']:.3f} (sync=True {med['ours-sync']:.3f}), rebound "
-          f"{med['rebound']:.3f}; ours / rebound = {med['ours'] / med['rebound']:.2f}")
+    print("[1] one snapshot of 10 bodies appended to an archive (ms, median of", repeat, "):")
+    print(f"    ours {med['ours']:.3f}, rebound {med['rebound']:.3f}; ours / rebound = "
+          f"{med['ours'] / med['rebound']:.2f}  (Simulation.save, a synced file: "
+          f"{med['saved']:.3f})")
 
 
 def runs(tmp: Path, rounds: int) -> None:
@@ -127,7 +134,7 @@ def runs(tmp: Path, rounds: int) -> None:
                                                           strict=True))
         r_theirs = statistics.median(a / b for a, b in zip(t["theirs-archived"], t["theirs"],
                                                             strict=True))
-        n_ours = len(list((tmp / f"ours-{method}-1").glob("snapshot-*.nc")))
+        n_ours = len(Archive(tmp / f"ours-{method}-1"))
         print(f"    {method:8s} x{r_ours:.3f} ({n_ours} snapshots, plain "
               f"{statistics.median(t['ours']) * 1e3:.1f} ms);  {peer} x{r_theirs:.3f} "
               f"(plain {statistics.median(t['theirs']) * 1e3:.1f} ms)")

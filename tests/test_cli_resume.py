@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from scipy.io import netcdf_file
 
+from hamilton_orbits import Archive
 from hamilton_orbits.cli import main
 
 SETS = ["--set", "duration=30 d", "--set", "cadence=0.5 d", "--set", "crosscheck=false",
@@ -25,7 +26,7 @@ def _states(folder) -> dict[str, np.ndarray]:
 
 def _kill_after_snapshots(pid: int, archive, count: int) -> None:
     """SIGKILL ``pid`` as soon as ``archive`` holds ``count`` snapshots."""
-    while len(list(archive.glob("snapshot-*.nc"))) < count:
+    while not archive.is_dir() or len(Archive(archive)) < count:
         if os.waitpid(pid, os.WNOHANG) != (0, 0):
             raise AssertionError("the run ended before it was killed")
         time.sleep(0.002)

@@ -1,18 +1,26 @@
-"""Write tests/hamilton_orbits/data/snapshot-v<FORMAT_VERSION>.nc: the snapshot that
-tests/hamilton_orbits/test_snapshot.py reads with every later version of the format.
+"""Write tests/hamilton_orbits/data/snapshot-v<FORMAT_VERSION>.nc and
+archive-v<ARCHIVE_VERSION>/: the snapshot and the archive that
+tests/hamilton_orbits/test_snapshot.py and test_archive.py read with every later
+version of the formats.
 
 A planet of zero mass on a Kepler ellipse (a = 1, e = 0.3, inc = 0.2, lan = 0.5,
-argp = 1.0, nu = 0 at t = 0) about a star of GM 1, integrated by wh (dt = 0.01) to
-t = 10 and saved.  Run once per new format version:
+argp = 1.0, nu = 0 at t = 0) about a star of GM 1, integrated by wh (dt = 0.01):
+saved at t = 10; archived every 2 time units through the output times 0, 1, ..., 5
+(a kill after the snapshot at t = 4 is what the archive looks like).  Run once per
+new format version:
 
     python tools/make_snapshot_fixture.py
 """
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
+import numpy as np
+
 from hamilton_orbits import Body, KeplerOrbit, Simulation, System
+from hamilton_orbits.checkpoint import ARCHIVE_VERSION
 from hamilton_orbits.snapshot import FORMAT_VERSION
 
 
@@ -25,6 +33,11 @@ def main() -> None:
     out = Path(__file__).resolve().parents[1] / "tests" / "hamilton_orbits" / "data"
     out.mkdir(parents=True, exist_ok=True)
     sim.save(out / f"snapshot-v{FORMAT_VERSION}.nc")
+    folder = out / f"archive-v{ARCHIVE_VERSION}"
+    if folder.exists():
+        shutil.rmtree(folder)
+    archived = Simulation(system, method="wh", dt=0.01, archive=folder, every=2.0)
+    archived.integrate(np.arange(6.0))
 
 
 if __name__ == "__main__":

@@ -30,13 +30,13 @@ from hamilton_orbits.checkpoint import (
     leg_rows,
     on_step_grid,
     record,
-    snapshot_files,
+    snapshot_at,
     spec,
 )
 from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
-from hamilton_orbits.snapshot import read, write
+from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory
 
 __all__ = ["RestartWarning", "Saving"]
@@ -99,7 +99,7 @@ class Saving:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder")
         folder, info, upto = self._resumable  # the leg's rows read now, not at load
-        times, rows = leg_rows(snapshot_files(folder), info["start"], upto)
+        times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop
         rest = times[times > prop.t]
         out, compiled = None, 0.0
@@ -141,7 +141,7 @@ class Saving:
         write(path, *self._record(), sync=True)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Any:
+    def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:
         """The simulation saved in ``path`` (:meth:`save`), or the last snapshot of an
         archive folder, which then continues that archive on its schedule.
 
@@ -149,16 +149,36 @@ class Saving:
         stay among the output times of later legs (nothing is written unless the
         folder itself was loaded), so that it continues with the run's bits.
 
+        Parameters
+        ----------
+        path : path
+            A snapshot file, or an archive folder.
+        number : int, optional
+            For a folder: snapshot ``number`` of the archive instead of the last
+            one, not attached to the folder (it writes nothing;
+            ``Archive(folder)[k]``).
+
         Raises
         ------
         SnapshotError
-            For a missing, damaged or foreign file, naming it.
+            For a missing, damaged or foreign file, naming it; for a ``number``
+            the folder does not hold whole.
         """
         path = Path(path)
         folder = path if path.is_dir() else None
-        if folder is not None:
-            path = last_snapshot(folder)
-        meta, arrays = read(path)
+        if folder is None:
+            if number is not None:
+                raise ValueError(f"`number` picks a snapshot of an archive folder; {path} "
+                                 f"is not a folder")
+            meta, arrays = read(path)
+        elif number is None:
+            path, meta, arrays = last_snapshot(folder)
+        else:
+            found = snapshot_at(folder, number)
+            if found is None:
+                raise SnapshotError(f"the archive {folder} has no whole snapshot {number!r}")
+            path, meta, arrays = found
+            folder = None  # not attached: a snapshot of the run, writing nothing
         sim = cls._rebuild(meta, arrays, path)
         schedule = meta.get("archive")
         if schedule:  # the archived run's schedule: written on when its folder is loaded
@@ -205,14 +225,22 @@ class Saving:
             sim._unit = u.Unit(meta["unit"])
         return sim
 
-    def _record(self, rows: Any = None) -> tuple[Any, ...]:
-        extra = {"started": self._start is not None,
-                 "unit": None if self._unit is None else self._unit.to_string(),
+    def _unit_text(self) -> str | None:
+        """The caller's time unit as text (made once per unit)."""
+        if self._unit is None:
+            return None
+        known = self._record_cache.get("unit")
+        if known is None or known[0] is not self._unit:
+            known = self._record_cache["unit"] = (self._unit, self._unit.to_string())
+        return known[1]
+
+    def _record(self, rows: Any = None, archive: bool = False) -> tuple[Any, ...]:
+        extra = {"started": self._start is not None, "unit": self._unit_text(),
                  "archive": None if self._archive is None else self._archive.schedule()}
         if rows is not None:
             extra["leg"] = rows.info
         meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra,
-                                           self._record_cache)
+                                           self._record_cache, split=archive)
         if rows is not None:
             arrays.update(rows.take())
             dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))
@@ -227,12 +255,12 @@ class Saving:
         try:
             arch.open()
             info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
-                    "unit": None if self._unit is None else self._unit.to_string(),
+                    "unit": self._unit_text(),
                     "first_event": 0 if prop.events is None else len(prop.events.recorded())}
             self._leg = LegRows(info, times)
             self._leg.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None:
-                arch.write(*self._record(self._leg))
+                arch.write(*self._record(self._leg, archive=True))
         except BaseException:
             arch.close()
             raise
@@ -257,6 +285,6 @@ class Saving:
             if asked[i] and rows is not None and arch.path is not None:
                 rows.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None and (scheduled[i] or arch.due(prop.steps)):
-                arch.write(*self._record(rows))  # (a schedule alone writes nothing)
+                arch.write(*self._record(rows, archive=True))  # (a schedule alone writes nothing)
 
         return at

@@ -27,25 +27,23 @@ Examples
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.checkpoint import snapshot_files
+from hamilton_orbits.checkpoint import contents
 from hamilton_orbits.simulation import Simulation
-from hamilton_orbits.snapshot import SnapshotError, read
+from hamilton_orbits.snapshot import SnapshotError
 
 __all__ = ["Archive", "Snapshot"]
-
-_TORN_RE = re.compile(r"^\.snapshot-\d{6}\.nc\.tmp-\d+$")
 
 
 @dataclass(frozen=True)
 class Snapshot:
-    """One snapshot of an archive: its number, file, simulation time and steps."""
+    """One snapshot of an archive: its number, file (a segment holds many),
+    simulation time and steps."""
 
     number: int
     path: Path
@@ -66,11 +64,12 @@ class Archive:
     snapshots : list of Snapshot
         The snapshots that read whole, in the order written.
     damaged : list of (Path, str)
-        Snapshot files that do not read (a flipped byte, a truncated file), with
+        Files or snapshots that do not read (a flipped byte, a truncated file), with
         the reason: never read as data.
     torn : list of Path
-        Temporary files of writes that never finished (the process was killed
-        while writing): the snapshot they were to become does not exist.
+        Files ending in a write that never finished (the process was killed while
+        writing): the snapshot it was to become does not exist, and those bytes are
+        never read.
 
     Raises
     ------
@@ -82,22 +81,15 @@ class Archive:
         self.path = Path(path)
         if not self.path.is_dir():
             raise SnapshotError(f"no archive folder {self.path}")
-        self.snapshots: list[Snapshot] = []
-        self.damaged: list[tuple[Path, str]] = []
-        self._arrays: list[dict[str, np.ndarray]] = []
-        self._names: tuple[str, ...] = ()
-        self._quantity = False
-        for number, file in snapshot_files(self.path):
-            try:
-                meta, arrays = read(file)
-            except SnapshotError as exc:
-                self.damaged.append((file, str(exc)))
-                continue
-            self.snapshots.append(Snapshot(number, file, float(meta["t"]), int(meta["steps"])))
-            self._arrays.append({k: arrays[k] for k in ("t", "r", "v", "gm", "active")})
-            self._names = tuple(meta["system"]["names"])
-            self._quantity = bool(meta["system"]["quantity"])
-        self.torn = sorted(p for p in self.path.iterdir() if _TORN_RE.match(p.name))
+        found = contents(self.path, keep=("t", "r", "v", "gm", "active"))
+        self.snapshots = [Snapshot(number, file, float(meta["t"]), int(meta["steps"]))
+                          for number, file, meta, _ in found.snapshots]
+        self.damaged: list[tuple[Path, str]] = found.damaged
+        self.torn: list[Path] = found.torn
+        self._arrays = [arrays for *_, arrays in found.snapshots]
+        last = found.snapshots[-1][2] if found.snapshots else None
+        self._names: tuple[str, ...] = () if last is None else tuple(last["system"]["names"])
+        self._quantity = False if last is None else bool(last["system"]["quantity"])
 
     def __len__(self) -> int:
         return len(self.snapshots)
@@ -110,7 +102,7 @@ class Archive:
     def __getitem__(self, k: int) -> Simulation:
         """Snapshot ``k`` (of :attr:`snapshots`) as a Simulation, not attached to the
         archive (``Simulation.load(folder)`` continues the archive itself)."""
-        return Simulation.load(self.snapshots[k].path)
+        return Simulation.load(self.path, number=self.snapshots[k].number)
 
     def __repr__(self) -> str:
         span = f"t = {self.times[0]!r} ... {self.times[-1]!r}" if self.snapshots else "empty"

@@ -25,43 +25,59 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
 import re
+import struct
 import time
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
-from hamilton_orbits.restart import flatten
-from hamilton_orbits.snapshot import SnapshotError, encode_snapshot, read, write_bytes
+from hamilton_orbits.restart import flatten, inline
+from hamilton_orbits.segment import SEGMENT_RE, Segment, SegmentWriter, read_segment
+from hamilton_orbits.snapshot import SnapshotError, read
 from hamilton_orbits.units import is_quantity
 
 __all__ = [
     "SNAPSHOT_NAME",
     "ArchiveWriter",
+    "Contents",
     "LegRows",
+    "contents",
     "from_json",
     "last_snapshot",
     "leg_rows",
     "on_step_grid",
     "pack",
     "record",
+    "snapshot_at",
     "snapshot_files",
     "spec",
     "to_json",
     "unpack",
 ]
 
+#: the layout of an archive folder: 1, a netCDF file per snapshot; 2, segments of
+#: snapshots appended (:mod:`hamilton_orbits.segment`); every version reads both
+ARCHIVE_VERSION = 2
 SNAPSHOT_NAME = "snapshot-{:06d}.nc"
 _SNAPSHOT_RE = re.compile(r"^snapshot-(\d{6})\.nc$")
+_TORN_RE = re.compile(r"^\.(snapshot|segment|rows)-\d{6}\.nc\.tmp-\d+$")
 _SYSTEM_FIELDS = ("gm", "r", "v", "radius", "j2", "pole")
+_DTYPE_NAMES: dict[np.dtype, str] = {}  # (dtype.name is slow to compute)
+_JSON_PLAIN = frozenset((str, int, float, bool, type(None)))
 
 
 def to_json(value: Any) -> Any:
     """``value`` in a JSON form that keeps Quantities (value and unit) and arrays."""
+    if type(value) in _JSON_PLAIN:
+        return value
     if is_quantity(value):
         return {"__quantity__": np.asarray(value.value).tolist(),
                 "unit": value.unit.to_string()}
@@ -93,14 +109,17 @@ def from_json(value: Any) -> Any:
 
 def record(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,
            events: list, variational: bool, stm: bool, prop: Any,
-           extra: Mapping[str, Any], cache: dict[str, Any] | None = None
-           ) -> tuple[dict[str, Any], dict[str, np.ndarray], dict[str, tuple[str, ...]],
-                      dict[str, str]]:
+           extra: Mapping[str, Any], cache: dict[str, Any] | None = None,
+           split: bool = False) -> tuple[dict[str, Any], dict[str, np.ndarray],
+                                         dict[str, tuple[str, ...]], dict[str, str]]:
     """The ``meta``, arrays, dimensions and units of a snapshot of a simulation whose
     system at time 0 is ``system`` and whose propagation is ``prop``; ``cache``: a
     dict kept by the simulation, where the parts that never change (the system at
-    time 0, the method, the effects and events as JSON) are made once."""
-    layout, state = flatten(prop)
+    time 0, the method, the effects and events as JSON) are made once; ``split``:
+    the numbers of the state in an array ``scalars``, out of the layout (for an
+    archive segment, whose snapshots share their layout)."""
+    scalars: list[Any] | None = [] if split else None
+    layout, state = flatten(prop, scalars)
     fixed = None if cache is None else cache.get("fixed")
     if fixed is None:
         fixed = _fixed(system, method, dt, tol, effects, events, variational, stm)
@@ -116,6 +135,8 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
         active = ~prop.events.inactive
     arrays.update(t=np.float64(prop.t), r=prop.r, v=prop.v, gm=prop.gm, active=active)
     arrays["state"], meta["state_arrays"] = pack(state)
+    if scalars is not None:
+        arrays["scalars"] = np.array(scalars, dtype=np.float64)
     dims = {"r": ("body", "xyz"), "v": ("body", "xyz"), "gm": ("body",),
             "active": ("body",), "initial_r": ("body", "xyz"), "initial_v": ("body", "xyz"),
             "initial_gm": ("body",), "initial_radius": ("body",), "initial_j2": ("body",),
@@ -205,30 +226,36 @@ class LegRows:
         return out
 
 
-def leg_rows(files: list[tuple[int, Path]], start: int, upto: int) -> tuple[
-        np.ndarray, dict[str, np.ndarray]]:
-    """The output times of the leg that began at snapshot ``start`` and its rows
-    archived up to snapshot ``upto`` (each snapshot read whole).
+def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The output times of the leg that began at snapshot ``start`` of archive
+    ``folder`` and its rows archived up to snapshot ``upto`` (each file read once).
 
     Raises
     ------
     SnapshotError
         When one of those snapshots is missing or damaged (its rows are lost).
     """
-    by_number = dict(files)
+    files = snapshot_files(folder)
+    found: dict[int, dict[str, np.ndarray]] = {}
+    for i, (first, path) in enumerate(files):
+        after = files[i + 1][0] if i + 1 < len(files) else upto + 1
+        if first > upto or after <= start:
+            continue
+        try:
+            seg = _read_file(path)
+        except SnapshotError:
+            continue
+        found.update((k, arrays) for k, _, arrays in seg.snapshots if start <= k <= upto)
     parts: dict[str, list[np.ndarray]] = {}
-    times = None
     for k in range(start, upto + 1):
-        if k not in by_number:
-            raise SnapshotError(f"snapshot {k} of the leg being resumed is missing")
-        _, arrays = read(by_number[k])
-        if k == start:
-            times = arrays["leg_times"]
-        for name, a in arrays.items():
+        if k not in found:
+            raise SnapshotError(f"snapshot {k} of the leg being resumed is missing or "
+                                f"damaged")
+        for name, a in found[k].items():
             if name.startswith("out_") and a.shape[0]:
                 parts.setdefault(name, []).append(a)
     rows = {name: np.concatenate(a) for name, a in parts.items()}
-    return times, rows
+    return found[start]["leg_times"], rows
 
 
 def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
@@ -253,14 +280,17 @@ def pack(arrays: list[np.ndarray]) -> tuple[np.ndarray, list[list[Any]]]:
     2**53 and booleans exactly) and each one's ``[offset, shape, dtype]``."""
     index, start = [], 0
     for a in arrays:
-        index.append([start, list(a.shape), a.dtype.name])
-        start += a.size
-    flat = np.empty(start)
-    for a, (offset, _, _) in zip(arrays, index, strict=True):
-        if a.dtype.kind in "iu" and a.size and np.max(np.abs(a)) >= 2**53:
+        kind = a.dtype
+        name = _DTYPE_NAMES.get(kind)
+        if name is None:
+            name = _DTYPE_NAMES.setdefault(kind, kind.name)
+        if kind.kind in "iu" and a.size and max(-int(a.min()), int(a.max())) >= 2**53:
             raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
-        flat[offset:offset + a.size] = a.reshape(-1)
-    return flat, index
+        index.append([start, list(a.shape), name])
+        start += a.size
+    if not arrays:
+        return np.empty(0), index
+    return np.concatenate([a.reshape(-1) for a in arrays], dtype=np.float64), index
 
 
 def unpack(flat: np.ndarray, index: list[list[Any]]) -> list[np.ndarray]:
@@ -270,13 +300,101 @@ def unpack(flat: np.ndarray, index: list[list[Any]]) -> list[np.ndarray]:
 
 
 def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
-    """The snapshot files of an archive folder, by number."""
+    """The files of an archive folder by the number of their (first) snapshot:
+    snapshot files (format 1) and segments (format 2)."""
     found = []
     for p in folder.iterdir() if folder.is_dir() else ():
-        m = _SNAPSHOT_RE.match(p.name)
+        m = _SNAPSHOT_RE.match(p.name) or SEGMENT_RE.match(p.name)
         if m:
             found.append((int(m.group(1)), p))
     return sorted(found)
+
+
+def _read_file(path: Path) -> Segment:
+    """A file of an archive folder as a segment (a snapshot file: one snapshot)."""
+    if SEGMENT_RE.match(path.name):
+        return read_segment(path)
+    meta, arrays = read(path)
+    number = int(meta.get("number", _SNAPSHOT_RE.match(path.name).group(1)))
+    return Segment(path, number, 1, [(number, meta, arrays)])
+
+
+def _whole(meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> tuple[
+        dict[str, Any], dict[str, np.ndarray]]:
+    """A snapshot of a segment as a snapshot file holds it: the numbers of its state
+    put back into its layout."""
+    if "scalars" not in arrays:
+        return meta, arrays
+    arrays = dict(arrays)
+    return dict(meta, layout=inline(meta["layout"], arrays.pop("scalars"))), arrays
+
+
+@dataclass
+class Contents:
+    """What an archive folder holds: its snapshots ``(number, file, meta, arrays)``,
+    the files or records that do not read (with the reason) and the torn writes."""
+
+    snapshots: list[tuple[int, Path, dict[str, Any], dict[str, np.ndarray]]]
+    damaged: list[tuple[Path, str]]
+    torn: list[Path]
+
+
+def contents(folder: Path, keep: tuple[str, ...] | None = None) -> Contents:
+    """Every snapshot of archive ``folder``, each checked (``keep``: keep only these
+    arrays of each, to hold a long archive in memory)."""
+    out = Contents([], [], sorted(p for p in folder.iterdir() if _TORN_RE.match(p.name)))
+    for _, path in snapshot_files(folder):
+        try:
+            seg = _read_file(path)
+        except SnapshotError as exc:
+            out.damaged.append((path, str(exc)))
+            continue
+        out.damaged += seg.damaged
+        out.torn += seg.torn
+        for number, meta, arrays in seg.snapshots:
+            if keep is not None:
+                arrays = {k: arrays[k] for k in keep}
+            out.snapshots.append((number, path, meta, arrays))
+    return out
+
+
+def snapshot_at(folder: Path, number: int) -> tuple[Path, dict[str, Any],
+                                                     dict[str, np.ndarray]] | None:
+    """Snapshot ``number`` of archive ``folder`` (file, meta, arrays), or None when it
+    is missing or does not read."""
+    files = [(first, p) for first, p in snapshot_files(folder) if first <= number]
+    for _, path in reversed(files):
+        try:
+            seg = _read_file(path)
+        except SnapshotError:
+            continue
+        for k, meta, arrays in seg.snapshots:
+            if k == number:
+                return (path, *_whole(meta, arrays))
+        if seg.first <= number < seg.first + seg.count:
+            return None  # its file holds it, damaged
+    return None
+
+
+def _next_number(folder: Path) -> int:
+    """The number after the last snapshot of archive ``folder``."""
+    files = snapshot_files(folder)
+    if not files:
+        return 0
+    first, path = files[-1]
+    if not SEGMENT_RE.match(path.name):
+        return first + 1
+    try:  # (a segment of no snapshot, begun by a killed run, is replaced)
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+            try:
+                header = parse(head)
+            except (ValueError, struct.error):  # a header longer than that
+                header = parse(head + fh.read())
+        held = (path.stat().st_size - header.record_begin) // max(header.record_size, 1)
+        return first + max(min(header.numrecs, held), 0)
+    except (OSError, ValueError, struct.error):
+        return first + 1
 
 
 class ArchiveWriter:
@@ -331,10 +449,10 @@ class ArchiveWriter:
             raise ValueError(f"Expected `exact_times` to be True or False, got {exact!r}")
         self.origin, self.sync, self.exact = float(origin), sync, exact
         self.folder: OutputFolder | None = None
+        #: the segment being appended to
+        self.segment: SegmentWriter | None = None
         self.count = 0
         self.last_steps, self.last_wall = 0, time.monotonic()
-        #: the JSON text of the parts of ``meta`` that repeat from snapshot to snapshot
-        self.texts: dict[str, tuple[Any, str]] = {}
 
     def schedule_only(self) -> ArchiveWriter:
         """The same schedule writing nothing (for a copy of the simulation)."""
@@ -360,11 +478,13 @@ class ArchiveWriter:
         except FolderError as exc:
             raise SnapshotError(str(exc).replace("; nothing was run", "")) from None
         self.folder = folder
-        found = snapshot_files(self.path)
-        self.count = found[-1][0] + 1 if found else 0
+        self.count = _next_number(self.path)
 
     def close(self) -> None:
-        """Release the folder's lock."""
+        """Close the segment being written and release the folder's lock."""
+        if self.segment is not None:
+            self.segment.close()
+            self.segment = None
         if self.folder is not None:
             self.folder.__exit__(None, None, None)
             self.folder = None
@@ -388,23 +508,38 @@ class ArchiveWriter:
 
     def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
               dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path | None:
-        """Write the next snapshot (numbered after the last one in the folder);
-        nothing without a folder."""
+        """Append the next snapshot (numbered after the last one in the folder) to the
+        segment being written, or begin a segment (a new leg, or a change in what the
+        snapshots share); nothing without a folder.  Returns the segment's path."""
         self.open()
         if self.path is None:
             return None
-        path = self.path / SNAPSHOT_NAME.format(self.count)
-        meta = dict(meta, archive=self.schedule(), number=self.count)
-        write_bytes(path, encode_snapshot(meta, arrays, dims, units, self.texts),
-                    sync=self.sync)
+        shared = {k: x for k, x in meta.items() if k not in ("t", "steps")}
+        shared["archive"] = self.schedule()
+        seg, arrays = self.segment, {**arrays, "steps": meta["steps"]}
+        if seg is None or "leg_times" in arrays or not _same(seg, shared):
+            if seg is not None:
+                seg.close()
+            fixed = {k: x for k, x in arrays.items()
+                     if k.startswith("initial_") or k == "leg_times"}
+            seg = self.segment = SegmentWriter(self.path, self.count, shared, fixed, arrays,
+                                               dims, units, self.sync)
+        seg.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
         self.count += 1
         self.last_steps, self.last_wall = int(meta["steps"]), time.monotonic()
-        return path
+        return seg.path
 
 
-def last_snapshot(folder: str | Path) -> Path:
-    """The last snapshot of archive ``folder`` that reads whole (a damaged last one
-    is passed over for the one before).
+def _same(seg: SegmentWriter, shared: dict[str, Any]) -> bool:
+    """Whether a snapshot sharing ``shared`` belongs in segment ``seg`` (compared as
+    values, then as JSON text: a NaN is not equal to itself)."""
+    return seg.shared == shared or seg.text == json.dumps(shared, sort_keys=True,
+                                                           allow_nan=True)
+
+
+def last_snapshot(folder: str | Path) -> tuple[Path, dict[str, Any], dict[str, np.ndarray]]:
+    """The last snapshot of archive ``folder`` that reads whole (file, meta, arrays):
+    a damaged last one is passed over for the one before.
 
     Raises
     ------
@@ -415,10 +550,13 @@ def last_snapshot(folder: str | Path) -> Path:
     problems = []
     for _, path in reversed(snapshot_files(folder)):
         try:
-            read(path)
+            seg = _read_file(path)
         except SnapshotError as exc:
             problems.append(str(exc))
             continue
-        return path
+        problems += [why for _, why in seg.damaged]
+        if seg.snapshots:
+            _, meta, arrays = seg.snapshots[-1]
+            return (path, *_whole(meta, arrays))
     why = f" ({'; '.join(problems)})" if problems else ""
     raise SnapshotError(f"no readable snapshot in the archive {folder}{why}")

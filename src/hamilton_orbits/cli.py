@@ -181,11 +181,13 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     import json
     from pathlib import Path
 
+    from hamilton_orbits.checkpoint import snapshot_files
+
     every = scene.spec.get("output", {}).get("archive_every")
     if every is None:
         return None
     archive = Path(folder) / "archive"
-    if any(archive.glob("snapshot-*.nc")):
+    if snapshot_files(archive):
         raise _CommandError(f"{archive} holds the snapshots of an earlier run: resume it "
                             f"(hamilton-orbits resume {folder}) or choose another --out")
     archive.mkdir(parents=True, exist_ok=True)

@@ -47,10 +47,12 @@ from hamilton_orbits.integrators import Method
 from hamilton_orbits.integrators._setup import is_address
 from hamilton_orbits.rhs import RHS
 
-__all__ = ["LayoutMismatch", "flatten", "restore"]
+__all__ = ["LayoutMismatch", "flatten", "inline", "restore"]
 
 _SCALARS = (bool, int, float, str, type(None))
 _NUMPY_SCALARS = {np.float64: "float64", np.bool_: "bool", np.int64: "int64"}
+_NUMBERS = frozenset((bool, int, float))
+_TYPES = {"float64": "float", "bool": "bool", "int64": "int"}
 
 
 class LayoutMismatch(ValueError):
@@ -73,51 +75,128 @@ def _fields(obj: Any) -> dict[str, Any]:
     return {k: getattr(obj, k) for k in type(obj).__slots__ if hasattr(obj, k)}
 
 
-def flatten(obj: Any) -> tuple[dict[str, Any], list[np.ndarray]]:
-    """The layout of ``obj``'s state and its arrays (see the module notes)."""
+def flatten(obj: Any, scalars: list[Any] | None = None) -> tuple[dict[str, Any],
+                                                                 list[np.ndarray]]:
+    """The layout of ``obj``'s state and its arrays (see the module notes).
+
+    ``scalars``: a list that takes the numbers of the state (times, step counts,
+    flags), each leaf then ``{"scalar": k, "type": ...}`` instead of its value, so
+    that the layout stays the same from one snapshot to the next (an archive
+    segment shares it); :func:`inline` puts the values back.
+
+    Examples
+    --------
+    >>> class Leaf:
+    ...     def __init__(self):
+    ...         self.t, self.name, self.x = 2.5, "a", np.zeros(1)
+    >>> numbers = []
+    >>> layout, _ = flatten(Leaf(), numbers)
+    >>> layout["attrs"]["t"], layout["attrs"]["name"], numbers
+    ({'scalar': 0, 'type': 'float'}, {'value': 'a'}, [2.5])
+    >>> inline(layout, np.array(numbers)) == flatten(Leaf())[0]
+    True
+    """
     arrays: list[np.ndarray] = []
     seen: dict[int, int] = {}
-    return _node(obj, arrays, seen), arrays
+    return _node(obj, arrays, seen, scalars), arrays
+
+
+def inline(layout: dict[str, Any], values: np.ndarray) -> dict[str, Any]:
+    """The layout :func:`flatten` gives without ``scalars``, from the one it gives
+    with them and their ``values``."""
+    if "scalar" in layout:
+        x = values[layout["scalar"]]
+        kind = layout["type"]
+        out = {"value": float(x) if kind == "float" else int(x) if kind == "int" else bool(x)}
+        if "numpy" in layout:
+            out["numpy"] = layout["numpy"]
+        return out
+    if "attrs" in layout:
+        return {**layout, "attrs": {k: inline(x, values) for k, x in layout["attrs"].items()}}
+    if "items" in layout:
+        return {**layout, "items": [inline(x, values) for x in layout["items"]]}
+    if "dict" in layout:
+        return {"dict": {k: inline(x, values) for k, x in layout["dict"].items()}}
+    return layout
 
 
 _PLAIN = frozenset(_SCALARS)
 
 
-def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int]) -> dict[str, Any]:
-    kind = type(obj)
-    if kind in _PLAIN:  # the common leaves first (what _built decides for them: not built)
-        return {"value": obj}
-    if kind is np.ndarray and not is_address(obj):
-        if id(obj) in seen:
-            return {"alias": seen[id(obj)]}
-        seen[id(obj)] = len(arrays)
-        arrays.append(obj)
-        return {"array": len(arrays) - 1}
+def _scalar(obj: Any, kind: str, scalars: list[Any] | None,
+            numpy: str | None = None) -> dict[str, Any] | None:
+    """``obj`` as an entry of ``scalars`` (None: keep it inline)."""
+    if scalars is None or (kind == "int" and abs(obj) >= 2**53):
+        return None
+    scalars.append(obj)
+    node = {"scalar": len(scalars) - 1, "type": kind}
+    if numpy is not None:
+        node["numpy"] = numpy
+    return node
+
+
+#: how a value of each type is flattened (what _built decides for a non-array type
+#: depends on its type alone): filled as types are met
+_PLAN: dict[type, str] = {}
+
+
+def _plan(kind: type, obj: Any) -> str:
+    if kind in _PLAIN:
+        return "number" if kind in _NUMBERS else "plain"
+    if kind is np.ndarray:
+        return "array"
     if _built(obj):
-        return {"built": True}
-    if isinstance(obj, _SCALARS):
+        return "built"
+    if kind in _NUMPY_SCALARS:
+        return "numpy"
+    if issubclass(kind, _SCALARS):
+        return "plain"
+    if issubclass(kind, np.ndarray):
+        return "array"
+    if issubclass(kind, (list, tuple)):
+        return "sequence"
+    if issubclass(kind, dict):
+        return "dict"
+    if hasattr(obj, "__dict__") or hasattr(kind, "__slots__"):
+        return "object"
+    raise TypeError(f"cannot flatten a {kind.__name__}")
+
+
+def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int],
+          scalars: list[Any] | None = None) -> dict[str, Any]:
+    kind = type(obj)
+    how = _PLAN.get(kind)
+    if how is None:
+        how = _PLAN.setdefault(kind, _plan(kind, obj))
+    if how == "number":
+        node = _scalar(obj, kind.__name__, scalars)
+        return node if node is not None else {"value": obj}
+    if how == "plain":
         return {"value": obj}
-    kind = _NUMPY_SCALARS.get(type(obj))
-    if kind is not None:
-        return {"value": obj.item(), "numpy": kind}
-    if isinstance(obj, np.ndarray):
+    if how == "array":
+        if is_address(obj):
+            return {"built": True}
         if id(obj) in seen:
             return {"alias": seen[id(obj)]}
         seen[id(obj)] = len(arrays)
         arrays.append(obj)
         return {"array": len(arrays) - 1}
-    if isinstance(obj, (list, tuple)):
+    if how == "built":
+        return {"built": True}
+    if how == "numpy":
+        name = _NUMPY_SCALARS[kind]
+        node = _scalar(obj.item(), _TYPES[name], scalars, name)
+        return node if node is not None else {"value": obj.item(), "numpy": name}
+    if how == "sequence":
         return {"tuple" if isinstance(obj, tuple) else "list":
-                True, "items": [_node(x, arrays, seen) for x in obj]}
-    if isinstance(obj, dict):
+                True, "items": [_node(x, arrays, seen, scalars) for x in obj]}
+    if how == "dict":
         if not all(isinstance(k, str) for k in obj):
             raise TypeError(f"cannot flatten a dict with keys {list(obj)!r}")
-        return {"dict": {k: _node(x, arrays, seen) for k, x in obj.items()}}
-    if hasattr(obj, "__dict__") or hasattr(type(obj), "__slots__"):
-        cls = type(obj)
-        return {"class": f"{cls.__module__}.{cls.__qualname__}",
-                "attrs": {k: _node(x, arrays, seen) for k, x in _fields(obj).items()}}
-    raise TypeError(f"cannot flatten a {type(obj).__name__}")
+        return {"dict": {k: _node(x, arrays, seen, scalars) for k, x in obj.items()}}
+    fields = obj.__dict__ if hasattr(obj, "__dict__") else _fields(obj)
+    return {"class": f"{kind.__module__}.{kind.__qualname__}",
+            "attrs": {k: _node(x, arrays, seen, scalars) for k, x in fields.items()}}
 
 
 def restore(obj: Any, layout: dict[str, Any], arrays: list[np.ndarray]) -> None:

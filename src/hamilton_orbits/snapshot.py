@@ -6,7 +6,9 @@ what this package needs to continue it bit for bit: the specification (system at
 time 0, method and options, effects, events, variational equations) and the
 integrator's own state, as JSON in the global attribute ``meta`` and arrays
 ``state_K``.  ``docs/archive.md`` says why the format is netCDF-3 (64-bit
-offset), one file per snapshot.
+offset).  This is a snapshot saved alone (``Simulation.save``), and each snapshot
+of an archive of format 1; an archive now appends its snapshots to segments
+(:mod:`hamilton_orbits.segment`).
 
 Writing is atomic: the file is written under a temporary name in the same folder,
 flushed, synced and renamed over its final name, so a process killed at any moment
@@ -42,8 +44,8 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "encode_snapshot", "meta_json", "read",
-           "write", "write_bytes"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "checksum", "encode_snapshot",
+           "read", "variable", "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
@@ -117,44 +119,15 @@ def write(path: str | os.PathLike[str], meta: Mapping[str, Any],
 
 def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
                     dims: Mapping[str, tuple[str, ...]] | None = None,
-                    units: Mapping[str, str] | None = None,
-                    texts: dict[str, tuple[Any, str]] | None = None) -> bytes:
+                    units: Mapping[str, str] | None = None) -> bytes:
     """The bytes of a snapshot file (see :func:`write`): a copy, so the arrays may
-    change as soon as it returns.  ``texts``: a cache of the JSON text of ``meta``'s
-    values that repeat from one snapshot to the next (:func:`meta_json`)."""
+    change as soon as it returns."""
     dims, units = dims or {}, units or {}
-    meta_text = (json.dumps(meta, sort_keys=True, allow_nan=True) if texts is None
-                 else meta_json(meta, texts))
-    variables = [_variable(name, np.asarray(value), dims.get(name), units.get(name))
+    meta_text = json.dumps(meta, sort_keys=True, allow_nan=True)
+    variables = [variable(name, np.asarray(value), dims.get(name), units.get(name))
                  for name, value in arrays.items()]
     return encode({"format": FORMAT, "format_version": FORMAT_VERSION, "meta": meta_text,
                    "sha256": checksum(meta_text, arrays)}, variables)
-
-
-def meta_json(meta: Mapping[str, Any], texts: dict[str, tuple[Any, str]]) -> str:
-    """``json.dumps(meta, sort_keys=True)``, character for character, with the text
-    of a value the same object as (or, for a dict, equal to) the one of the last call
-    taken from ``texts`` instead of encoded again.
-
-    Examples
-    --------
-    >>> meta, texts = {"b": [1.5, None], "a": {"y": 1, "x": "s"}}, {}
-    >>> meta_json(meta, texts) == json.dumps(meta, sort_keys=True) == meta_json(meta, texts)
-    True
-    """
-    parts = []
-    for key in sorted(meta):
-        value = meta[key]
-        known = texts.get(key)
-        if known is not None and (known[0] is value or (type(value) is dict
-                                                        and known[0] == value)):
-            text = known[1]
-        else:
-            text = json.dumps(value, sort_keys=True, allow_nan=True)
-            if isinstance(value, (dict, list)):
-                texts[key] = (value, text)
-        parts.append(f"{json.dumps(key)}: {text}")
-    return "{" + ", ".join(parts) + "}"
 
 
 def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True) -> None:
@@ -175,9 +148,10 @@ def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True)
                             f"{exc.strerror or exc}") from None
 
 
-def _variable(name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
+def variable(name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
               unit: str | None) -> tuple[str, tuple[str, ...], np.ndarray, dict[str, Any]]:
-    """A variable of the file: its dimensions, stored values and attributes."""
+    """A variable of a netCDF file: its dimensions, stored values and attributes
+    (``dtype_saved``; an empty array as a marker with its ``empty_shape``)."""
     data, kind = _stored(name, arr)
     attrs: dict[str, Any] = {"dtype_saved": kind}
     if arr.size == 0:  # netCDF-3 has no empty fixed dimension: a marker and the shape

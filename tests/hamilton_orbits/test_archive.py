@@ -12,15 +12,18 @@ import os
 import signal
 import socket
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 from test_simulation_legs import _disc, _merging, _same
 
-from hamilton_orbits import Archive, Simulation
-from hamilton_orbits.checkpoint import SNAPSHOT_NAME
+from hamilton_orbits import Archive, Body, Simulation, System
+from hamilton_orbits._netcdf3 import parse
+from hamilton_orbits.checkpoint import snapshot_at, snapshot_files
 from hamilton_orbits.engine import StopIntegration
-from hamilton_orbits.snapshot import SnapshotError, read
+from hamilton_orbits.segment import read_segment
+from hamilton_orbits.snapshot import SnapshotError
 
 T = np.linspace(0.0, 60.0, 13)[1:]  # the caller's outputs: every 5
 KW = dict(method="radau15", every=2.5)
@@ -31,9 +34,9 @@ def _run_archived(folder, kw=KW, times=T):
     return sim, sim.integrate(times)
 
 
-def _snapshot_state(path):
-    """t, r, v and the integrator's own arrays of a snapshot."""
-    _, arrays = read(path)
+def _snapshot_state(folder, number):
+    """t, r, v and the integrator's own arrays of snapshot ``number``."""
+    _, _, arrays = snapshot_at(folder, number)
     return [arrays["t"], arrays["r"], arrays["v"], arrays["state"]]
 
 
@@ -72,7 +75,8 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
     # whole run's (its new call began with one more, at t = 25), with the same state
     cut = {float(s.t): s for s in Archive(tmp_path / "cut").snapshots}
     for snap in Archive(tmp_path / "whole").snapshots:
-        a, b = _snapshot_state(snap.path), _snapshot_state(cut[snap.t].path)
+        a = _snapshot_state(tmp_path / "whole", snap.number)
+        b = _snapshot_state(tmp_path / "cut", cut[snap.t].number)
         assert all(_same(x, y) for x, y in zip(a[:3], b[:3], strict=True))
 
 
@@ -96,16 +100,16 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
         time.sleep(rng.uniform(0.0, 1.1) * t_run)
         os.kill(pid, signal.SIGKILL)
         os.waitpid(pid, 0)
-        if not folder.exists() or not any(folder.glob("snapshot-*.nc")):
+        if not folder.exists() or not Archive(folder).snapshots:
             _, traj = _run_archived(folder)  # killed before the first snapshot: anew
         else:
             archive = Archive(folder)
             assert archive.damaged == []  # whole snapshots or none: never a damaged one
             seen_partial += len(archive) < len(reference)
             for snap in archive.snapshots:
-                ref = reference.snapshots[snap.number]
-                assert all(_same(x, y) for x, y in zip(_snapshot_state(snap.path),
-                                                       _snapshot_state(ref.path), strict=True))
+                assert all(_same(x, y) for x, y in zip(
+                    _snapshot_state(folder, snap.number),
+                    _snapshot_state(tmp_path / "ref", snap.number), strict=True))
             traj = Simulation.load(folder).resume()  # the call the kill interrupted, whole
         assert traj.t.tolist() == whole.t.tolist(), f"kill {k}"
         assert _same(traj.r, whole.r) and _same(traj.v, whole.v), f"kill {k}"
@@ -122,20 +126,58 @@ def _timed_run(folder) -> float:
 
 def test_an_archive_lists_damaged_and_torn_snapshots_and_never_reads_them(tmp_path):
     _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
-    path = tmp_path / SNAPSHOT_NAME.format(6)
+    # (two segments: the first snapshot's, before the driver was made, and the rest)
+    path, _, arrays = snapshot_at(tmp_path, 6)
     data = bytearray(path.read_bytes())
-    _, arrays = read(path)
     at = bytes(data).find(arrays["r"].astype(">f8").tobytes())  # netCDF: big-endian
-    data[at + 20] ^= 0x01  # one flipped bit in the positions
-    path.write_bytes(bytes(data))
-    (tmp_path / ".snapshot-000007.nc.tmp-12345").write_bytes(b"CDF\x02")  # a killed write
+    data[at + 20] ^= 0x01  # one flipped bit in the positions of snapshot 6
+    path.write_bytes(bytes(data) + b"\x00\x01")  # and a torn write after the last record
+    (tmp_path / ".segment-000007.nc.tmp-12345").write_bytes(b"CDF\x02")  # a killed creation
     archive = Archive(tmp_path)
     assert [s.number for s in archive.snapshots] == [0, 1, 2, 3, 4, 5]
-    assert archive.damaged[0][0] == path and "checksum" in archive.damaged[0][1]
-    assert [p.name for p in archive.torn] == [".snapshot-000007.nc.tmp-12345"]
-    assert "6 snapshots" in repr(archive) and "1 damaged, 1 torn" in repr(archive)
+    assert archive.damaged[0][0] == path and "snapshot 6 is damaged" in archive.damaged[0][1]
+    assert sorted(p.name for p in archive.torn) == [".segment-000007.nc.tmp-12345",
+                                                   path.name]
+    assert "6 snapshots" in repr(archive) and "1 damaged, 2 torn" in repr(archive)
     # resuming passes over the damaged last snapshot for the one before
     assert Simulation.load(tmp_path).t == 50.0
+
+
+def test_a_flipped_byte_anywhere_in_a_segment_is_never_read_as_data(tmp_path):
+    """Every byte of a segment and of its rows file flipped in turn (of the shared
+    JSON text, summed by SHA-256 as one, every 16th): what the segment gives is the
+    original snapshots' bits (a flip in the format's padding changes nothing read),
+    and a snapshot that is missing is listed as damaged or torn."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, method="wh", dt=0.05, archive=tmp_path, every=2.0)
+    sim.integrate(np.arange(0.0, 7.0, 3.0))
+    path = max(tmp_path.glob("segment-*.nc"))  # the segment of the driver made
+    rows = path.with_name(path.name.replace("segment", "rows"))
+    original = read_segment(path).snapshots
+    assert len(original) == 3 and all(a["out_t"].size for _, _, a in original[1:])
+    for file in (path, rows):
+        data = file.read_bytes()
+        text = parse(data).attrs["meta"].encode()
+        m0 = data.find(text)
+        m1 = m0 + len(text)
+        for i in (*range(m0), *range(m0, m1, 16), *range(m1, len(data))):
+            flipped = bytearray(data)
+            flipped[i] ^= 0x10
+            file.write_bytes(bytes(flipped))
+            try:
+                seg = read_segment(path)
+            except SnapshotError:
+                continue  # the header or the shared part: nothing read
+            by_number = {n: (m, a) for n, m, a in original}
+            for n, meta, arrays in seg.snapshots:
+                assert meta == by_number[n][0], (file.name, i)
+                assert arrays.keys() == by_number[n][1].keys(), (file.name, i)
+                assert all(np.array_equal(a, by_number[n][1][k], equal_nan=True)
+                           for k, a in arrays.items()), (file.name, i)
+            if len(seg.snapshots) < len(original):
+                assert seg.damaged or seg.torn, (file.name, i)
+        file.write_bytes(data)
 
 
 def test_an_archive_opens_as_an_xarray_dataset(tmp_path):
@@ -145,6 +187,28 @@ def test_an_archive_opens_as_an_xarray_dataset(tmp_path):
     assert list(ds.body.values) == list(sim.system.names)
     np.testing.assert_array_equal(ds.r.isel(time=-1).values, sim.system.as_arrays().r)
     np.testing.assert_array_equal(ds.time.values, 10.0 * np.arange(7))
+
+
+def test_a_segment_is_read_without_this_package(tmp_path):
+    """A segment is a plain netCDF-3 file: xarray (through scipy's reader, not this
+    package) opens it, its record dimension holding the snapshots' t, r and v, with
+    their units for a system of Quantities."""
+    import astropy.units as u
+    import xarray as xr
+
+    gm_sun = 1.32712440018e11 * u.km**3 / u.s**2
+    s = System([Body("sun", gm_sun, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                Body("earth", 3e-6 * gm_sun, [1, 0, 0] * u.au, [0, 29.78, 0] * u.km / u.s)])
+    Simulation(s, method="wh", dt=1 * u.day, archive=tmp_path, every=10 * u.day).integrate(
+        np.arange(0, 70, 5) * u.day)
+    path = max(tmp_path.glob("segment-*.nc"))  # the segment of snapshots 1 ... 6
+    with xr.open_dataset(path, engine="scipy") as ds:
+        assert ds.r.dims == ("snapshot", "body", "xyz") and ds.r.attrs["units"] == "au"
+        assert ds.t.attrs["units"] == "day"
+        archive = Archive(tmp_path)
+        np.testing.assert_array_equal(ds.t.values, archive.times[1:])
+        np.testing.assert_array_equal(ds.r.values[-1], archive.to_xarray().r.values[-1])
+        assert ds.attrs["format"] == "hamilton-orbits archive segment"
 
 
 def test_step_and_wall_clock_schedules(tmp_path):
@@ -163,7 +227,7 @@ def test_two_writers_cannot_share_an_archive(tmp_path):
     sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0)
     with pytest.raises(SnapshotError, match=r"archive .*: another run \(PID 1 on "):
         sim.integrate(2.0)
-    assert not any(tmp_path.glob("snapshot-*"))
+    assert not snapshot_files(tmp_path)
 
 
 def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
@@ -277,3 +341,39 @@ def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_t
     with pytest.raises(ValueError, match=r"Expected `exact_times` to be True or False"):
         Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "x", every=1.0,
                    exact_times="yes")
+
+
+def test_an_archive_of_the_first_format_is_read_and_continued(tmp_path):
+    """``data/archive-v1`` was written by archive format 1, a netCDF file per
+    snapshot (tools/make_snapshot_fixture.py): a planet on a Kepler ellipse (a = 1,
+    e = 0.3) about a star of GM 1, integrated by wh (dt = 0.01) through the output
+    times 0, 1, ..., 5, a snapshot every 2.  This version lists it, continues it
+    (appending segments to the same folder) and resumes its call whole."""
+    import shutil
+    import warnings
+
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits._saving import RestartWarning
+
+    folder = tmp_path / "archive"
+    shutil.copytree(Path(__file__).parent / "data" / "archive-v1", folder)
+    archive = Archive(folder)
+    assert archive.times.tolist() == [0.0, 2.0, 4.0] and not archive.damaged
+    orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.5, argp=1.0, nu=0.0, mu=1.0)
+    with warnings.catch_warnings():
+        # a later version with other integrator internals continues from the state
+        # (RestartWarning, tested in test_restart.py): what must last is the state
+        warnings.simplefilter("ignore", RestartWarning)
+        traj = Simulation.load(folder).resume()
+    assert traj.t.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    # wh is exact on a test particle's Kepler orbit (a single Kepler drift per step),
+    # so the state agrees with the ellipse to rounding (Murray & Dermott 1999, 2.4)
+    for t, r in zip(traj.t, traj.r[:, 1], strict=True):
+        np.testing.assert_allclose(r, orbit.propagate(float(t)).state()[0], rtol=0, atol=1e-12)
+    assert Archive(folder).times.tolist() == [0.0, 2.0, 4.0]  # no new snapshot before 6
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RestartWarning)
+        sim = Simulation.load(folder)
+    sim.integrate(8.0)  # on the same schedule, appended as a segment
+    assert Archive(folder).times.tolist() == [0.0, 2.0, 4.0, 4.0, 6.0, 8.0]
+    assert any(folder.glob("segment-*.nc")) and len(list(folder.glob("snapshot-*.nc"))) == 3

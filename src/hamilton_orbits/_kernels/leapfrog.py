@@ -98,14 +98,14 @@ _ARGS = (ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64)
 _RESULT = types.Tuple((types.int64, types.int64))
 
 
-@entry(_RESULT(*_ARGS, F1, types.int64), cache=True, error_model="numpy")
+@entry(_RESULT(*_ARGS, F1, types.int64), cache=True, nogil=True, error_model="numpy")
 def advance(accel_addr, p, r, v, gm, t0, t1, dt, ws, max_steps):  # pragma: no cover - compiled
     """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` watching no events (see
     :func:`_advance`); no event code is compiled into it."""
     return _advance(accel_addr, p, r, v, gm, t0, t1, dt, None, None, None, ws, max_steps)
 
 
-@entry(_RESULT(*_ARGS, F2, F2, types.int64[::1], F1, types.int64), cache=True,
+@entry(_RESULT(*_ARGS, F2, F2, types.int64[::1], F1, types.int64), cache=True, nogil=True,
        error_model="numpy")
 def advance_watched(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws,
                     max_steps):  # pragma: no cover - compiled

@@ -658,7 +658,7 @@ _ADVANCE_ARGS = (ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F
                  types.boolean, types.int64)
 
 
-@entry(types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS), cache=True)
+@entry(types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS), cache=True, nogil=True)
 def advance(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps,
 ):  # pragma: no cover - compiled
@@ -670,7 +670,7 @@ def advance(
 
 @entry(
     types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
-    cache=True,
+    cache=True, nogil=True,
 )
 def advance_watched(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
@@ -781,7 +781,7 @@ def _renormalise(r, v, b, br, d, g, csx, csv, n):  # pragma: no cover - compiled
         ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
         types.boolean, types.int64, types.int64, _F1,
     ),
-    cache=True,
+    cache=True, nogil=True,
 )
 def advance_variational(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, n_phys, ms,

@@ -456,7 +456,7 @@ def _kick_jacobi(
 @entry(
     types.int64(ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.float64,
                 F1, F1),
-    cache=True,
+    cache=True, nogil=True,
     error_model="numpy",
 )
 def corrector_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, sign, a, b):
@@ -705,7 +705,7 @@ def _advance_dh(
                      None, None, None, ws, x0, v0, mu, mu_s, kick)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_dh(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
@@ -721,7 +721,7 @@ def advance_dh(
                        None, None, None, ws, None)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_dh_effects(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
@@ -730,7 +730,7 @@ def advance_dh_effects(
                        None, None, None, ws, True)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_dh_watched(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
     ws,
@@ -771,7 +771,7 @@ def _advance_jacobi(
                          None, None, None, ws, x0, v0, kick)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_jacobi(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
@@ -784,7 +784,7 @@ def advance_jacobi(
                            dt_last, None, None, None, ws, None)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_jacobi_effects(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
@@ -793,7 +793,7 @@ def advance_jacobi_effects(
                            dt_last, None, None, None, ws, True)
 
 
-@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, error_model="numpy")
+@entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_jacobi_watched(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
     ev_count, ws,

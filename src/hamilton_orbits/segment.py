@@ -1,0 +1,380 @@
+"""Archive segments: snapshots appended to one netCDF file while a run goes on.
+
+An archive folder (``docs/archive.md``) of format 2 holds *segments*.  A segment
+``segment-NNNNNN.nc`` (``NNNNNN``: the number of its first snapshot) is a netCDF-3
+file (64-bit offsets) with an unlimited dimension ``snapshot``:
+
+- written once, when the segment begins: the global attribute ``meta`` (JSON: what
+  every snapshot of the segment shares, i.e. the system's names, the method and its
+  options, the effects, the events, the integrator state's layout, the leg and the
+  archive's schedule) and the fixed variables (the system at time 0, ``initial_*``;
+  the leg's output times ``leg_times`` when the segment begins a leg), with their
+  SHA-256 in the attribute ``sha256``;
+- one record per snapshot: ``t``, ``r(body, xyz)``, ``v``, ``gm``, ``active``, the
+  integrator's packed ``state`` and the numbers of its state ``scalars`` (times,
+  step counts: :func:`hamilton_orbits.restart.flatten`), ``steps``, ``rows`` (the
+  first and the end of the caller's output rows in the companion file that belong
+  to it) and ``check``, the CRC-32 of the record's other bytes.
+
+The caller's output rows go to a companion ``rows-NNNNNN.nc`` of the same form
+(unlimited dimension ``row``: ``t``, ``r``, ``v``, the variational equations'
+values, ``check``).  A segment begins when a leg begins, or when what its
+snapshots share changes (an event merged two bodies: the layout changed); a new
+process never appends to another's segment.
+
+Appending a snapshot writes its record after the last one, then the number of
+records in the header (a 4-byte write): O(snapshot), whatever the size of the
+archive.  A kill during the record leaves bytes past the counted records: the
+segment is then listed as torn and those bytes are never read; a kill between the
+two writes loses that one snapshot.  A record whose CRC does not match its bytes
+is damaged, listed, never read as data.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> fixed = {"initial_gm": np.array([1.0, 1e-3])}
+>>> snap = {"t": np.float64(0.5), "steps": 5, "r": np.zeros((2, 3)), "active": np.ones(2, bool)}
+>>> seg = SegmentWriter(folder, 0, {"kind": "demo"}, fixed, snap, {"r": ("body", "xyz")})
+>>> seg.append(snap, {}); seg.append(dict(snap, t=np.float64(1.0), steps=10), {})
+>>> seg.close()
+>>> [(n, meta["t"], meta["steps"]) for n, meta, _ in read_segment(seg.path).snapshots]
+[(0, 0.5, 5), (1, 1.0, 10)]
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import struct
+import zlib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, encode, parse, record
+from hamilton_orbits.snapshot import SnapshotError, checksum, variable, write_bytes
+
+__all__ = ["SEGMENT_FORMAT", "SEGMENT_RE", "Segment", "SegmentWriter", "read_segment"]
+
+SEGMENT_FORMAT = "hamilton-orbits archive segment"
+#: the archive format that segments are: 2 (1 was a file per snapshot)
+SEGMENT_VERSION = 2
+SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
+SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
+_ROWS = ("out_t", "out_r", "out_v", "out_megno", "out_lyapunov", "out_lyapunov_time",
+         "out_stm")
+_KINDS = {"t": "float64", "steps": "int64", "active": "bool", "rows": "int64"}
+
+
+class _Appender:
+    """One netCDF file of records appended (a segment, or its rows): its header
+    (with the SHA-256 of its text attributes and of ``summed``, the fixed variables'
+    values) written once, atomically."""
+
+    def __init__(self, path: Path, attrs: dict[str, Any], fixed: list[Any],
+                 template: list[tuple[str, tuple[str, ...], np.ndarray]],
+                 record_dim: str, sync: bool,
+                 summed: Mapping[str, np.ndarray] | None = None,
+                 units: Mapping[str, str] | None = None) -> None:
+        units = units or {}
+        records = [(name, dims, values, {"dtype_saved": _KINDS.get(name, "float64")}
+                    | ({"units": units[name]} if name in units else {}))
+                   for name, dims, values in template]
+        records.append(("check", (), np.zeros((), np.float64), {"dtype_saved": "uint32"}))
+        attrs = dict(attrs, records=_record_text([(n, v.shape, a["dtype_saved"])
+                                                  for n, _, v, a in records]))
+        attrs["sha256"] = checksum(_signed(attrs), summed or {})
+        header = encode(attrs, fixed, records, record_dim=record_dim)
+        write_bytes(path, header, sync=sync)
+        self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
+        self.fd = os.open(path, os.O_RDWR)
+
+    def append(self, rows: list[list[np.ndarray]]) -> None:
+        """Append records (each its record variables' values but ``check``), then
+        count them in the header."""
+        parts = []
+        for values in rows:
+            data = record(values)
+            parts.append(data + struct.pack(">d", zlib.crc32(data)))
+        data = b"".join(parts)
+        try:
+            os.pwrite(self.fd, data, self.end)
+            if self.sync:
+                os.fsync(self.fd)
+            os.pwrite(self.fd, struct.pack(">i", self.count + len(rows)), NUMRECS_AT)
+            if self.sync:
+                os.fsync(self.fd)
+        except OSError as exc:
+            raise SnapshotError(f"cannot write the snapshot to {self.path}: "
+                                f"{exc.strerror or exc}") from None
+        self.count += len(rows)
+        self.end += len(data)
+
+    def close(self) -> None:
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
+
+
+def _record_text(variables: list[tuple[str, tuple[int, ...], str]]) -> str:
+    """The record variables' names, shapes and saved types as JSON (kept in the
+    header and checked on reading: the format's own entries are not summed)."""
+    return json.dumps([[n, list(shape), kind] for n, shape, kind in variables])
+
+
+def _signed(attrs: Mapping[str, Any]) -> str:
+    """The text the header's SHA-256 covers, beside the fixed variables."""
+    return "\0".join(str(attrs.get(k, "")) for k in ("format", "first", "meta", "records"))
+
+
+def _stored(name: str, value: Any) -> np.ndarray:
+    """A record variable's values as stored (bool as int8, integers as float64)."""
+    arr = np.asarray(value)
+    if arr.dtype == np.bool_:
+        return arr.astype(np.int8)
+    if arr.dtype != np.float64:
+        return arr.astype(np.float64)
+    return arr
+
+
+class SegmentWriter:
+    """A segment being written: its snapshots (and their output rows) appended.
+
+    Parameters
+    ----------
+    folder : Path
+        The archive folder.
+    first : int
+        The number of the segment's first snapshot.
+    shared : dict
+        What the segment's snapshots share (JSON-able: the global attribute ``meta``).
+    fixed : mapping of str to ndarray
+        The fixed variables (``initial_*``, ``leg_times``).
+    like : mapping of str to ndarray
+        A snapshot's record values (``t``, ``steps``, ``r``, ...), for their shapes.
+    dims, units : mapping, optional
+        Dimension names and ``units`` attributes of the variables.
+    sync : bool
+        ``fsync`` each append (survives a power cut, not only a killed process).
+    """
+
+    def __init__(self, folder: Path, first: int, shared: dict[str, Any],
+                 fixed: Mapping[str, np.ndarray], like: Mapping[str, Any],
+                 dims: Mapping[str, tuple[str, ...]] | None = None,
+                 units: Mapping[str, str] | None = None, sync: bool = False) -> None:
+        dims, units = dict(dims or {}), dict(units or {})
+        self.shared, self.first, self.folder, self.sync = shared, first, folder, sync
+        self.dims, self.units = dims, units
+        text = json.dumps(shared, sort_keys=True, allow_nan=True)
+        fixed_vars = [variable(k, np.asarray(a), dims.get(k), units.get(k))
+                      for k, a in fixed.items()]
+        attrs = {"format": SEGMENT_FORMAT, "format_version": SEGMENT_VERSION, "first": first,
+                 "meta": text}
+        #: the record variables: the snapshot's values but the fixed ones and the rows
+        self.names = [k for k in like if k not in fixed and not k.startswith("out_")]
+        template = [(k, self._dims(k, like[k]), _stored(k, like[k])) for k in self.names]
+        template.append(("rows", ("from_to",), np.zeros(2, np.float64)))
+        self.text = text
+        self.path = folder / SEGMENT_NAME.format(first)
+        self._file = _Appender(self.path, attrs, fixed_vars, template, "snapshot", sync, fixed,
+                               units)
+        self._rows: _Appender | None = None
+        # (rows of a segment of this number that a killed run began and this replaces)
+        (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
+
+    def _dims(self, name: str, value: Any) -> tuple[str, ...]:
+        shape = np.shape(value)
+        given = self.dims.get(name.removeprefix("out_"), ())
+        if len(given) == len(shape):
+            return given
+        return tuple(f"{name}_{k}" for k in range(len(shape)))
+
+    @property
+    def count(self) -> int:
+        """The snapshots appended."""
+        return self._file.count
+
+    def append(self, snapshot: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
+        """Append the caller's output ``rows`` (``out_t``, ``out_r``, ... of
+        :meth:`~hamilton_orbits.checkpoint.LegRows.take`) and then the snapshot."""
+        n = len(rows.get("out_t", ()))
+        start = 0 if self._rows is None else self._rows.count
+        if n:
+            names = [k for k in _ROWS if k in rows]
+            if self._rows is None:
+                template = [(k, self._dims(k, rows[k][0]), np.asarray(rows[k][0]))
+                            for k in names]
+                self._rows = _Appender(self.folder / ROWS_NAME.format(self.first),
+                                       {"format": SEGMENT_FORMAT + " rows",
+                                        "format_version": SEGMENT_VERSION, "first": self.first,
+                                        "meta": "{}"}, [], template, "row", self.sync,
+                                       units={f"out_{k}": x for k, x in self.units.items()})
+            self._rows.append([[np.asarray(rows[k][i], np.float64) for k in names]
+                               for i in range(n)])
+        span = np.array([start, start + n], dtype=np.float64)
+        self._file.append([[_stored(k, snapshot[k]) for k in self.names] + [span]])
+
+    def close(self) -> None:
+        """Close the files (what was appended stays)."""
+        self._file.close()
+        if self._rows is not None:
+            self._rows.close()
+
+
+@dataclass
+class Segment:
+    """A segment read back: its snapshots as ``(number, meta, arrays)`` (the
+    ``meta`` and arrays a single snapshot file holds), the ones damaged, and whether
+    it ends in a torn write."""
+
+    path: Path
+    first: int
+    count: int  # the records counted in the header, damaged ones included
+    snapshots: list[tuple[int, dict[str, Any], dict[str, np.ndarray]]] = field(
+        default_factory=list)
+    damaged: list[tuple[Path, str]] = field(default_factory=list)
+    torn: list[Path] = field(default_factory=list)
+
+
+def _fixed_array(header: Header, data: bytes, name: str) -> np.ndarray:
+    var = header.variables[name]
+    kind = var.attrs.get("dtype_saved", "float64")
+    shape = var.attrs.get("empty_shape")
+    if shape is not None:
+        return np.zeros(tuple(int(k) for k in shape.split(",")), dtype=kind)
+    return header.values(data, name).astype(kind)
+
+
+def _records(header: Header, data: bytes) -> tuple[list[dict[str, np.ndarray]],
+                                                    list[tuple[int, str]], bool]:
+    """The records that check, the damaged ones (index, reason), and a torn tail."""
+    names = [k for k, v in header.variables.items() if v.is_record and k != "check"]
+    end = header.record_begin + header.numrecs * header.record_size
+    good, bad = [], []
+    held = max(len(data) - header.record_begin, 0) // max(header.record_size, 1)
+    if header.numrecs > held:  # a header counting records the file does not hold
+        bad.append((held, f"the header counts {header.numrecs} records, the file holds "
+                          f"{held}"))
+    for k in range(min(header.numrecs, held)):
+        at = k * header.record_size  # (each variable's bytes where the header says)
+        raw = b"".join(data[v.begin + at:v.begin + at + v.size]
+                       for v in (header.variables[n] for n in names))
+        check = header.variables.get("check")
+        stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
+        try:
+            if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
+                raise ValueError("its CRC-32 does not match")
+            rec = {n: header.values(data, n, k).astype(
+                header.variables[n].attrs.get("dtype_saved", "float64")) for n in names}
+        except Exception as exc:  # damaged: a sum that does not match, or types
+            bad.append((k, str(exc)))
+            continue
+        rec["_index"] = np.int64(k)
+        good.append(rec)
+    return good, bad, len(data) > end
+
+
+def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
+    """A segment's or rows file's header, bytes and fixed variables, its SHA-256 and
+    its record variables checked."""
+    try:
+        data = path.read_bytes()
+        header = parse(data)
+        fmt = header.attrs.get("format")
+        if fmt not in (SEGMENT_FORMAT, SEGMENT_FORMAT + " rows"):
+            raise SnapshotError(f"{path} is not a hamilton-orbits archive segment "
+                                f"(format {fmt!r})")
+        if int(header.attrs.get("format_version", 0)) > SEGMENT_VERSION:
+            raise SnapshotError(f"{path} has format version {header.attrs['format_version']};"
+                                f" this version of hamilton-orbits reads up to "
+                                f"{SEGMENT_VERSION}")
+        fixed = {k: _fixed_array(header, data, k) for k, v in header.variables.items()
+                 if not v.is_record}
+        good = checksum(_signed(header.attrs), fixed) == header.attrs.get("sha256")
+        records = _record_text([(n, v.shape, v.attrs.get("dtype_saved", ""))
+                                for n, v in header.variables.items() if v.is_record])
+    except SnapshotError:
+        raise
+    except Exception as exc:  # any damage of the header surfaces as some error
+        raise SnapshotError(f"{path} cannot be read as an archive segment (damaged: "
+                            f"{type(exc).__name__}: {exc})") from None
+    if not good or records != header.attrs.get("records"):
+        raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
+                            f"shared contents")
+    return header, data, fixed
+
+
+def read_segment(path: Path) -> Segment:
+    """A segment and its rows, every checksum verified (see the module notes).
+
+    Raises
+    ------
+    SnapshotError
+        When the segment's header or shared part does not read or check (then none
+        of its snapshots can be trusted), naming the path.
+    """
+    header, data, fixed = _open(path)
+    try:
+        text, first = header.attrs["meta"], int(header.attrs["first"])
+        shared = json.loads(text)
+    except Exception as exc:  # (summed: only another program's file gets here)
+        raise SnapshotError(f"{path} cannot be read as an archive segment ({exc})") from None
+    seg = Segment(path, first, min(header.numrecs, len(data)))
+    records, bad, torn = _records(header, data)
+    seg.damaged = [(path, f"{path}: snapshot {first + k} is damaged ({why})")
+                   for k, why in bad]
+    if torn:
+        seg.torn.append(path)
+    rows, rows_torn = _rows(path.with_name(ROWS_NAME.format(first)))
+    seg.torn += rows_torn
+    _split(seg, shared, fixed, records, rows)
+    return seg
+
+
+def _split(seg: Segment, shared: dict[str, Any], fixed: dict[str, np.ndarray],
+           records: list[dict[str, np.ndarray]], rows: dict[str, np.ndarray] | None) -> None:
+    """Each record of ``seg`` as a snapshot's ``(number, meta, arrays)``, its output
+    rows the ones of the rows file its record names."""
+    leg_times = fixed.pop("leg_times", None)
+    for rec in records:
+        k = int(rec.pop("_index"))
+        before, end = (int(x) for x in rec.pop("rows"))
+        number = seg.first + k
+        meta = {**shared, "t": float(rec["t"]), "steps": int(rec["steps"]), "number": number}
+        arrays = {**fixed, **rec}
+        arrays["t"] = np.float64(rec["t"])
+        if k == 0 and leg_times is not None:
+            arrays["leg_times"] = leg_times
+        if rows is not None and (not rows or end > len(rows["out_t"])):
+            seg.damaged.append((seg.path, f"{seg.path}: the output rows of snapshot "
+                                          f"{number} are missing or damaged"))
+        else:
+            if rows is not None:
+                arrays.update({n: a[before:end] for n, a in rows.items()})
+            seg.snapshots.append((number, meta, arrays))
+
+
+def _rows(path: Path) -> tuple[dict[str, np.ndarray] | None, list[Path]]:
+    """The output rows of a segment's companion file up to the first that does not
+    check (None without the file; an empty dict when its header is damaged: the
+    segment's snapshots are then damaged), and the file if it ends in a torn
+    write."""
+    if not path.exists():
+        return None, []
+    try:
+        header, data, _ = _open(path)
+        records, bad, torn = _records(header, data)
+        if bad:
+            records = records[:bad[0][0]]
+        names = [k for k, v in header.variables.items() if v.is_record and k != "check"]
+        out = {n: np.array([r[n] for r in records], dtype=np.float64).reshape(
+            (len(records), *header.variables[n].shape)) for n in names}
+        out["out_t"].shape  # noqa: B018 - (a rows file without times is damaged)
+    except Exception:  # a damaged header: no row can be trusted
+        return {}, []
+    return out, [path] if torn else []
