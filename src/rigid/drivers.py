@@ -163,6 +163,7 @@ def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
         lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
         t_out, rtol=rtol, atol=atol, max_step=max_step, restart=False,
         on_output=None if bar is None else (lambda i, n: bar.update(1)),
+        hint="a shorter span, or a fixed-step method with its dt",
     )
     if bar is not None:
         bar.close()

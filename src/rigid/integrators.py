@@ -82,7 +82,7 @@ import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
-from hamilton_orbits.validation import check_positive
+from hamilton_orbits.validation import ConvergenceError, check_positive
 from rigid._kernels import euler as _euler_k
 from rigid._shared import free_scale, pow2
 from rigid.body import call_units, check_body
@@ -288,6 +288,9 @@ def integrate(
         unsupported torque or one beyond float64 beside the moments, an angle
         turned ``t |omega|`` beyond float64, or a run whose state leaves float64
         (a step far too long for the method: naming ``dt``).
+    hamilton_orbits.validation.ConvergenceError
+        For ``"dop853"`` over a span it cannot finish: more than 1e8 steps, or a
+        pace after its first steps that projects more than 1e10 (a ValueError).
     astropy.units.UnitConversionError
         For a time of the wrong dimension, naming the argument.
 
@@ -338,6 +341,8 @@ def integrate(
             )
     except ZeroDivisionError:  # a kernel's state left float64 (its norm 0 or inf)
         raise _failed(method, dtf, "a division by zero in the kernel") from None
+    except ConvergenceError as exc:  # DOP853's step budget (times in the scaled unit)
+        raise ConvergenceError(f"method 'dop853' cannot finish this span: {exc}") from None
     except ValueError as exc:  # the shared DOP853 driver: scipy's step size collapsed
         if method != "dop853":  # pragma: no cover - the fixed-step drivers raise none
             raise

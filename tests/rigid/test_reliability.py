@@ -427,6 +427,23 @@ def test_step_far_too_long_on_tiny_moments(method):
                                rtol=0, atol=4 * EPS)
 
 
+def test_dop853_over_a_span_it_cannot_finish_stops_at_once():
+    # 7.6e10 rad of steady spin at tol 1e-12 is some 1e11 DOP853 steps: scipy's
+    # solver takes no budget, and this run used to go on for days; the pace after
+    # its first 100 steps projects far beyond 100 times the budget (1e8 steps)
+    import time
+
+    from hamilton_orbits.validation import ConvergenceError
+
+    start = time.perf_counter()
+    with pytest.raises(ConvergenceError, match=r"method 'dop853' cannot finish this span: "
+                                               r"dop853 reached t = .* of 76000000000.0 in "
+                                               r"\d+ steps; .* \(a step far shorter than the "
+                                               r"span: a shorter span, or a fixed-step method"):
+        integrate(RigidBody(*TINY_SPHERE), np.linspace(0.0, 7.6e10, 3), method="dop853")
+    assert time.perf_counter() - start < 10.0
+
+
 @pytest.mark.parametrize("method", ["rk4", "cayley_rk4"])
 @pytest.mark.parametrize("torque", [None, GravityGradientTorque(1.0)])
 def test_step_far_too_long_for_a_finite_state_names_dt(method, torque):

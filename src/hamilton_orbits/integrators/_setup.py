@@ -224,6 +224,64 @@ def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
 MAX_FIXED_STEPS = 1_000_000_000
 
 
+_HINT = "pass max_steps=... to go on, or a shorter span"
+
+
+def check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray, method: str,
+               hint: str = _HINT) -> None:
+    """Stop a run of an adaptive method that cannot finish within ``max_steps``: at
+    the budget, or early when the pace so far (``total`` steps to reach ``t``)
+    projects more than 100 times the budget over the span of ``t_out``; ``hint``
+    says what to do about it.
+
+    Examples
+    --------
+    >>> check_pace(1000, 10**6, 0.5, np.array([0.0, 1.0]), "dop853")  # 2000 projected
+    >>> check_pace(1000, 10**6, 1e-6, np.array([0.0, 1e3]), "dop853")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    hamilton_orbits.validation.ConvergenceError: dop853 reached t = 1e-06 of 1000.0 in 1000 ...
+    """
+    covered = abs(t - t_out[0])
+    projected = total * abs(t_out[-1] - t_out[0]) / covered if covered > 0 else math.inf
+    if total >= max_steps or projected > 100.0 * max_steps:
+        raise ConvergenceError(
+            f"{method} reached t = {t!r} of {float(t_out[-1])!r} in {total} steps; at this "
+            f"pace the run needs about {projected:.3g} steps, more than max_steps = "
+            f"{max_steps} (a step far shorter than the span: {hint})"
+        )
+
+
+class StepBudget:
+    """A right-hand side ``f(t, y)`` that counts its evaluations and stops a run
+    whose steps exceed ``max_steps`` (:func:`check_pace`), for a solver that takes
+    no step budget of its own (scipy's ``solve_ivp``).  DOP853 evaluates ``f`` 12
+    times a step, rejected steps included: the steps counted are never fewer than
+    the solver's.
+
+    Examples
+    --------
+    >>> f = StepBudget(lambda t, y: -y, np.array([0.0, 1.0]), 10**6, "dop853")
+    >>> f(0.0, np.ones(2)).tolist(), f.calls
+    ([-1.0, -1.0], 1)
+    """
+
+    #: evaluations of a DOP853 step; the pace is checked every 100 steps
+    PER_STEP, EVERY = 12, 1200
+
+    def __init__(self, f: Callable[[float, np.ndarray], np.ndarray], t_out: np.ndarray,
+                 max_steps: int, method: str, hint: str = _HINT) -> None:
+        self.f, self.t_out, self.max_steps, self.method = f, t_out, max_steps, method
+        self.hint, self.calls = hint, 0
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        self.calls += 1
+        if self.calls % self.EVERY == 0:
+            check_pace(self.calls // self.PER_STEP, self.max_steps, float(t), self.t_out,
+                       self.method, self.hint)
+        return self.f(t, y)
+
+
 def check_step_count(span: float, dt: float, max_steps: int, method: str) -> int:
     """The steps a fixed-step method needs for ``span`` at ``dt``, refused up front
     above ``max_steps`` (a run of hours, or an integer overflow, caught before it

@@ -39,10 +39,11 @@ from hamilton_orbits.integrators._setup import (
     accel_arg,
     addresses,
     check_finite,
+    check_pace,
     check_step_count,
     fixed_steps,
 )
-from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS
+from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, MAX_STEPS
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["DEFAULT_SEED", "SLICE", "DOP853Tangent", "LeapfrogTangent", "Radau15Tangent",
@@ -425,11 +426,12 @@ class DOP853Tangent:
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  tangent: Tangent, *, tol: float, atol: np.ndarray, max_step: float,
-                 control: bool) -> None:
+                 control: bool, max_steps: int = MAX_STEPS) -> None:
         n, k = r0.shape[0], tangent.k
         self.rows = rows = n * (1 + k)
         self.n, self.gm, self.tangent, self.tol, self.max_step = (
             n, np.array(gm, dtype=np.float64), tangent, tol, max_step)
+        self.max_steps = max_steps
         self.rhs, self.t0, self.acc = rhs, t0, np.empty((rows, 3))
         self.y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(),
                                  tangent.dv0.ravel(), [0.0]))
@@ -478,6 +480,8 @@ class DOP853Tangent:
                 if solver.step() is not None:
                     raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
                 self.steps += 1
+                if (self.steps - first) % 100 == 0:
+                    check_pace(self.steps - first, self.max_steps, solver.t, t_out, "dop853")
                 _var.megno_update(self.tangent.ms, float(solver.y[-1] - ys_prev),
                                   float(solver.t), float(solver.t - t_prev))
             self.y = solver.y.copy()

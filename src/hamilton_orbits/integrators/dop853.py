@@ -73,8 +73,9 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
     max_step = np.inf if dt is None else float(dt)
     if variational is not None:
         return _tangent.DOP853Tangent(rhs, r0, v0, gm, t0, variational, tol=tol, atol=atol,
-                                      max_step=max_step, control=method.tangent_control)
-    return _State(rhs, r0, v0, gm, t0, tol, atol, max_step, events)
+                                      max_step=max_step, control=method.tangent_control,
+                                      max_steps=method.max_steps)
+    return _State(rhs, r0, v0, gm, t0, tol, atol, max_step, events, method.max_steps)
 
 
 class _State:
@@ -82,13 +83,14 @@ class _State:
     them), the tolerances, the events log."""
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
-                 tol: float, atol: np.ndarray, max_step: float, events: EventLog | None) -> None:
+                 tol: float, atol: np.ndarray, max_step: float, events: EventLog | None,
+                 max_steps: int = DOP853.max_steps) -> None:
         self.n = n = r0.shape[0]
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
         self.rhs, self.acc = rhs, np.empty((n, 3))
         self.y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
         self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
-        self.t, self.steps = t0, 0
+        self.t, self.steps, self.max_steps = t0, 0, max_steps
 
     def f(self, t: float, y: np.ndarray) -> np.ndarray:
         """``dy/dt`` of the bodies (positions, then velocities, flattened), with the
@@ -132,7 +134,7 @@ class _State:
             store(i, first + steps, y)
 
         solve(self.f, self.y, t_out, rtol=self.tol, atol=self.atol, max_step=self.max_step,
-              on_state=keep)
+              on_state=keep, max_steps=self.max_steps)
 
     def _with_events(self, t_out: np.ndarray, store: Callable[[int, int, np.ndarray], None],
                      first: int) -> None:
@@ -151,6 +153,8 @@ class _State:
                 if solver.step() is not None:
                     raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
                 self.steps += 1
+                if (self.steps - first) % 100 == 0:
+                    _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
                 if log.count[0] + len(log.watch) > log.buffer.shape[0]:
                     log.drain()
                 xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n]
@@ -191,6 +195,8 @@ def solve(
     on_output: Callable[[int, int], None] | None = None,
     on_state: Callable[[int, int, np.ndarray], None] | None = None,
     restart: bool = True,
+    max_steps: int = DOP853.max_steps,
+    hint: str | None = None,
 ) -> tuple[np.ndarray, int, int]:
     """The one DOP853 driver of both packages: ``y' = f(t, y)`` from ``y0`` at
     ``t_out[0]``, restarted at each output time (so that an output is a step end,
@@ -216,6 +222,10 @@ def solve(
         output is a step end.  False: one integration, the outputs read from
         DOP853's 7th-order dense output (many closely spaced outputs then do not
         cap the step); the callbacks are called at the end.
+    max_steps : int, optional
+        Give up after about this many steps, or as soon as the pace projects more
+        than 100 times as many (:class:`~hamilton_orbits.integrators._setup.
+        StepBudget`); ``hint``: what the error then advises.
 
     Returns
     -------
@@ -228,6 +238,8 @@ def solve(
     ------
     ValueError
         If scipy reports a failure, naming the interval.
+    ConvergenceError
+        When the run needs more than ``max_steps`` steps (a ValueError).
 
     Examples
     --------
@@ -238,6 +250,8 @@ def solve(
     """
     from scipy.integrate import solve_ivp
 
+    f = (_setup.StepBudget(f, t_out, max_steps, NAME) if hint is None
+         else _setup.StepBudget(f, t_out, max_steps, NAME, hint))
     y_out = np.empty((len(t_out), len(y0)))
     y_out[0] = y0
     y = np.asarray(y0, dtype=np.float64)

@@ -200,6 +200,10 @@ class DOP853(Method):
 
     Parameters
     ----------
+    max_steps : int
+        Give up (``ConvergenceError``) after this many steps in one call, or as soon
+        as the pace projects more than 100 times as many (scipy's solver has no
+        budget of its own: a run of far too many steps would never end).
     tangent_control : bool
         With ``variational=True``: let the tangent vectors take part in the error
         control.
@@ -214,9 +218,11 @@ class DOP853(Method):
 
     name: ClassVar[str] = "dop853"
     tangent_control: bool = False
+    max_steps: int = MAX_STEPS
 
     def __post_init__(self) -> None:
         _flag("tangent_control", self.tangent_control)
+        _count("max_steps", self.max_steps)
 
 
 #: Method name -> its typed value's class.

@@ -35,7 +35,6 @@ step, the state between calls, and the output arrays.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -316,7 +315,7 @@ class _Run:
                 steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget)
             self.steps += steps
             if status == _k.STATUS_MAXSTEPS:
-                _check_pace(self.steps - first, max_steps, self.t, t_out)
+                _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
                 if self.stop is not None and self.stop():
                     raise StopIntegration
             elif status == _k.STATUS_DRAIN:
@@ -331,19 +330,6 @@ class _Run:
                     f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
                     f"{float(t_out[i])!r}: {_why(status, self.st, max_steps)}"
                 )
-
-
-def _check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray) -> None:
-    """Stop a run that cannot finish within ``max_steps``: at the budget, or early
-    when the pace so far projects more than 100 times the budget."""
-    covered = t - t_out[0]
-    projected = total * (t_out[-1] - t_out[0]) / covered if covered > 0 else math.inf
-    if total >= max_steps or projected > 100.0 * max_steps:
-        raise ConvergenceError(
-            f"radau15 reached t = {t!r} of {float(t_out[-1])!r} in {total} steps; at this pace "
-            f"the run needs about {projected:.3g} steps, more than max_steps = {max_steps} "
-            "(a step far shorter than the span: pass max_steps=... to go on, or a shorter span)"
-        )
 
 
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:

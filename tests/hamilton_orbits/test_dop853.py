@@ -1,0 +1,49 @@
+"""DOP853's step budget: scipy's solver takes none, so a run of far too many steps
+(a step far shorter than the span) used to run for ever; it now stops with a
+ConvergenceError naming ``max_steps``, at the budget or as soon as its pace projects
+more than 100 times the budget, on each of DOP853's paths (plain, with events,
+with the variational equations)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits.integrators.methods import DOP853
+from hamilton_orbits.validation import ConvergenceError
+
+
+def _pair() -> System:
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=1e-3),
+                   Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0], radius=1e-5)])
+
+
+@pytest.mark.parametrize("kw", [{}, {"events": [{"name": "collision", "action": "stop"}]},
+                                {"variational": True}], ids=["plain", "events", "variational"])
+def test_a_run_beyond_the_step_budget_stops_naming_max_steps(kw):
+    # 2 pi / 1000 per orbit at tol 1e-12 is some 50 steps an orbit: 1e4 orbits are
+    # ~5e5 steps, 5000 times a budget of 100
+    sim = Simulation(_pair(), method=DOP853(max_steps=100), **kw)
+    start = time.perf_counter()
+    with pytest.raises(ConvergenceError, match=r"dop853 reached t = .* of 62831.8\d* in "
+                                               r"\d+ steps; at this pace the run needs about "
+                                               r".* more than max_steps = 100"):
+        sim.integrate(2e4 * np.pi)
+    assert time.perf_counter() - start < 10.0  # stopped at its first check, not after hours
+
+
+def test_a_run_within_the_budget_is_unchanged():
+    """The budget only counts: the same run with and without a tight-enough budget
+    gives the same bits."""
+    free = Simulation(_pair(), method="dop853").integrate(10.0)
+    capped = Simulation(_pair(), method=DOP853(max_steps=1000)).integrate(10.0)
+    np.testing.assert_array_equal(free.r, capped.r)
+    assert free.steps == capped.steps < 1000
+
+
+def test_max_steps_is_checked_naming_it():
+    with pytest.raises(ValueError, match=r"Expected `max_steps` to be a positive integer, got 0"):
+        DOP853(max_steps=0)
