@@ -306,6 +306,10 @@ def test_a_collision_that_merges_keeps_every_result(tmp_path):
     assert result.metrics["nodal regression of comet"].startswith("not measured: comet and "
                                                                   "star together at 1 output")
     assert np.all(np.isnan(result.states["r"][1:, 1].value))
+    # a merge is an inelastic collision: the energy's change is not called an error
+    assert "max |relative energy error|" not in result.metrics
+    assert result.metrics["max |relative energy change|"] > 1e-6
+    assert "merges are inelastic" in result.metrics["energy"]
     paths = result.save(tmp_path)
     assert (tmp_path / "states.nc") in paths and (tmp_path / "final.bin") in paths
 

@@ -152,7 +152,10 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     what = _effects.energy_label(gm, effects, system.names)
     conserved = _effects.effect_energy(system, effects, traj.r.value[:1],
                                        traj.v.value[:1]) is not None
-    result.metrics["energy"] = what
+    merged = "merge" in list(traj.events["action"]) if len(traj.events) else False
+    conserved = conserved and not merged  # a merge is an inelastic collision
+    result.metrics["energy"] = what + (" (merges are inelastic: not conserved)" if merged
+                                       else "")
     key = "max |relative energy error|" if conserved else "max |relative energy change|"
     result.metrics[key] = float(np.max(np.abs(traj.energy_error)))
     _particles_into(result, traj, gm)
