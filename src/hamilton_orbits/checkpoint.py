@@ -119,6 +119,8 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     the numbers of the state in an array ``scalars``, out of the layout (for an
     archive segment, whose snapshots share their layout)."""
     scalars: list[Any] | None = [] if split else None
+    if prop.events is not None:
+        prop.events.drain()  # (its buffer is then empty: not saved)
     layout, state = flatten(prop, scalars)
     fixed = None if cache is None else cache.get("fixed")
     if fixed is None:

@@ -351,6 +351,10 @@ class EventLog:
         The bodies' radii (NaN: none), for the contact distance of merged bodies.
     """
 
+    #: working space a saved state leaves out (:mod:`hamilton_orbits.restart`): the
+    #: buffer holds nothing after :meth:`drain`, which a snapshot does first
+    RESTART_SCRATCH = ("buffer",)
+
     def __init__(self, watch: np.ndarray, radius: np.ndarray, capacity: int = 1024) -> None:
         self.watch = np.ascontiguousarray(watch, dtype=np.float64).reshape(-1, 5)
         self.radius = np.array(radius, dtype=np.float64)

@@ -16,7 +16,9 @@ callables, and the addresses of compiled functions (int64 arrays that differ
 from one process to the next; :func:`hamilton_orbits.integrators._setup.is_address`).
 An array reached twice (a tuple of kernel arguments holding the same arrays as the
 driver's attributes) is restored as one array reached twice: the layout records
-the alias.
+the alias.  A class may name attributes that are working space, not state, in
+``RESTART_SCRATCH`` (the events log's buffer, empty after a drain): they are left
+out, and the fresh build's are kept (a layout that holds them is still restored).
 
 The layout names classes; :func:`restore` refuses a layout whose classes or
 attributes differ from the fresh build's (:class:`LayoutMismatch`), which is what
@@ -195,6 +197,9 @@ def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int],
             raise TypeError(f"cannot flatten a dict with keys {list(obj)!r}")
         return {"dict": {k: _node(x, arrays, seen, scalars) for k, x in obj.items()}}
     fields = obj.__dict__ if hasattr(obj, "__dict__") else _fields(obj)
+    scratch = getattr(kind, "RESTART_SCRATCH", ())
+    if scratch:  # working space the object's own state does not depend on
+        fields = {k: x for k, x in fields.items() if k not in scratch}
     return {"class": f"{kind.__module__}.{kind.__qualname__}",
             "attrs": {k: _node(x, arrays, seen, scalars) for k, x in fields.items()}}
 
@@ -221,7 +226,8 @@ def _fill(obj: Any, layout: dict[str, Any], arrays: list[np.ndarray],
                              f"{name!r}")
     fresh = _fields(obj)
     saved = layout["attrs"]
-    if set(saved) != set(fresh):
+    scratch = set(getattr(cls, "RESTART_SCRATCH", ()))
+    if set(saved) - scratch != set(fresh) - scratch:
         raise LayoutMismatch(f"{where}: saved attributes {sorted(saved)}, this version has "
                              f"{sorted(fresh)}")
     for key, node in saved.items():

@@ -377,3 +377,32 @@ def test_an_archive_of_the_first_format_is_read_and_continued(tmp_path):
     sim.integrate(8.0)  # on the same schedule, appended as a segment
     assert Archive(folder).times.tolist() == [0.0, 2.0, 4.0, 4.0, 6.0, 8.0]
     assert any(folder.glob("segment-*.nc")) and len(list(folder.glob("snapshot-*.nc"))) == 3
+
+
+@pytest.mark.parametrize("method", [dict(method="radau15"), dict(method="wh", dt=0.02)],
+                         ids=["radau15", "wh"])
+def test_events_recorded_before_a_snapshot_are_kept_and_the_buffer_is_not_saved(tmp_path,
+                                                                                  method):
+    """Close encounters are recorded (no action) into the kernel's buffer; a snapshot
+    drains it first and leaves the buffer (1024 rows of working space) out: the
+    snapshot is small, and a run continued from it finds the same events table, to
+    the bit, as the run never interrupted."""
+    watch = [{"name": "close_encounter", "distance": 2.0}]
+    whole = Simulation(_disc(), events=watch, **method).integrate(T)
+    sim = Simulation(_disc(), events=watch, archive=tmp_path, every=10.0, **method)
+    sim.integrate(T)
+    _, meta, _ = snapshot_at(tmp_path, 3)
+    assert all(shape != [1024, 7] for _, shape, _ in meta["state_arrays"])
+    again = Simulation.load(tmp_path, number=3)  # t = 30: continued to the end
+    rest = again.integrate(T[T > 30.0])
+    assert len(whole.events) > 0 and len(rest.events) > 0
+    later = whole.events[np.asarray(whole.events["time"]) > 30.0]
+    for col in ("time", "distance", "speed"):
+        np.testing.assert_array_equal(np.asarray(rest.events[col]), np.asarray(later[col]))
+    assert _same(rest.r[-1], whole.r[-1])
+    # the events of the whole call, those found before the last snapshot included,
+    # come back from the archive (resume: the call from its first snapshot)
+    traj = Simulation.load(tmp_path).resume()
+    for col in ("time", "distance", "speed"):
+        np.testing.assert_array_equal(np.asarray(traj.events[col]),
+                                      np.asarray(whole.events[col]))
