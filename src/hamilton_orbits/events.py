@@ -351,7 +351,7 @@ class EventLog:
         The bodies' radii (NaN: none), for the contact distance of merged bodies.
     """
 
-    #: working space a saved state leaves out (:mod:`hamilton_orbits.restart`): the
+    #: working space a saved state leaves out (``hamilton_orbits.restart``): the
     #: buffer holds nothing after :meth:`drain`, which a snapshot does first
     RESTART_SCRATCH = ("buffer",)
 
