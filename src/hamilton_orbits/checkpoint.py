@@ -312,10 +312,11 @@ def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
     return sorted(found)
 
 
-def _read_file(path: Path) -> Segment:
-    """A file of an archive folder as a segment (a snapshot file: one snapshot)."""
+def _read_file(path: Path, last: bool = False) -> Segment:
+    """A file of an archive folder as a segment (a snapshot file: one snapshot);
+    ``last``: of a segment's snapshots that read, the last only."""
     if SEGMENT_RE.match(path.name):
-        return read_segment(path)
+        return read_segment(path, last)
     meta, arrays = read(path)
     number = int(meta.get("number", _SNAPSHOT_RE.match(path.name).group(1)))
     return Segment(path, number, 1, [(number, meta, arrays)])
@@ -552,7 +553,9 @@ def last_snapshot(folder: str | Path) -> tuple[Path, dict[str, Any], dict[str, n
     problems = []
     for _, path in reversed(snapshot_files(folder)):
         try:
-            seg = _read_file(path)
+            seg = _read_file(path, last=True)
+            if not seg.snapshots and seg.count:  # (the last one's rows damaged: all)
+                seg = _read_file(path)
         except SnapshotError as exc:
             problems.append(str(exc))
             continue

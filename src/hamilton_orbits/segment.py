@@ -250,9 +250,10 @@ def _fixed_array(header: Header, data: bytes, name: str) -> np.ndarray:
     return header.values(data, name).astype(kind)
 
 
-def _records(header: Header, data: bytes) -> tuple[list[dict[str, np.ndarray]],
-                                                    list[tuple[int, str]], bool]:
-    """The records that check, the damaged ones (index, reason), and a torn tail."""
+def _records(header: Header, data: bytes, last: bool = False) -> tuple[
+        list[dict[str, np.ndarray]], list[tuple[int, str]], bool]:
+    """The records that check (``last``: the last of them only), the damaged ones
+    (index, reason), and a torn tail."""
     names = [k for k, v in header.variables.items() if v.is_record and k != "check"]
     end = header.record_begin + header.numrecs * header.record_size
     good, bad = [], []
@@ -266,17 +267,15 @@ def _records(header: Header, data: bytes) -> tuple[list[dict[str, np.ndarray]],
                        for v in (header.variables[n] for n in names))
         check = header.variables.get("check")
         stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
-        try:
-            if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
-                raise ValueError("its CRC-32 does not match")
-            rec = {n: header.values(data, n, k).astype(
-                header.variables[n].attrs.get("dtype_saved", "float64")) for n in names}
-        except Exception as exc:  # damaged: a sum that does not match, or types
-            bad.append((k, str(exc)))
-            continue
-        rec["_index"] = np.int64(k)
-        good.append(rec)
-    return good, bad, len(data) > end
+        if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
+            bad.append((k, "its CRC-32 does not match"))
+        else:
+            good.append(k)
+    # (the types and shapes were checked with the header: a record that checks decodes)
+    records = [dict({n: header.values(data, n, k).astype(
+        header.variables[n].attrs.get("dtype_saved", "float64")) for n in names},
+        _index=np.int64(k)) for k in (good[-1:] if last else good)]
+    return records, bad, len(data) > end
 
 
 def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
@@ -309,8 +308,9 @@ def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
     return header, data, fixed
 
 
-def read_segment(path: Path) -> Segment:
-    """A segment and its rows, every checksum verified (see the module notes).
+def read_segment(path: Path, last: bool = False) -> Segment:
+    """A segment and its rows, every checksum verified (see the module notes);
+    ``last``: of its snapshots that read, the last only.
 
     Raises
     ------
@@ -325,7 +325,7 @@ def read_segment(path: Path) -> Segment:
     except Exception as exc:  # (summed: only another program's file gets here)
         raise SnapshotError(f"{path} cannot be read as an archive segment ({exc})") from None
     seg = Segment(path, first, min(header.numrecs, len(data)))
-    records, bad, torn = _records(header, data)
+    records, bad, torn = _records(header, data, last)
     seg.damaged = [(path, f"{path}: snapshot {first + k} is damaged ({why})")
                    for k, why in bad]
     if torn:
