@@ -406,3 +406,19 @@ def test_events_recorded_before_a_snapshot_are_kept_and_the_buffer_is_not_saved(
     for col in ("time", "distance", "speed"):
         np.testing.assert_array_equal(np.asarray(traj.events[col]),
                                       np.asarray(whole.events[col]))
+
+
+def test_damaged_rows_of_the_last_snapshot_fall_back_to_the_one_before(tmp_path):
+    """The rows a snapshot carries are part of it: the last snapshot's rows damaged,
+    loading the archive takes the snapshot before (in the same segment)."""
+    _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
+    path, _, arrays = snapshot_at(tmp_path, 6)  # t = 60, with the row at t = 60
+    rows = path.with_name(path.name.replace("segment", "rows"))
+    data = bytearray(rows.read_bytes())
+    at = bytes(data).rfind(arrays["out_r"][-1].astype(">f8").tobytes())
+    data[at + 3] ^= 0x04
+    rows.write_bytes(bytes(data))
+    archive = Archive(tmp_path)
+    assert [s.number for s in archive.snapshots] == [0, 1, 2, 3, 4, 5]
+    assert "output rows of snapshot 6" in archive.damaged[0][1]
+    assert Simulation.load(tmp_path).t == 50.0
