@@ -81,9 +81,10 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
 
 
 def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path):
-    """20 runs killed with SIGKILL at random moments (before, between and during
-    writes): each archive opens, its snapshots are the reference's, and the call
-    resumed from it returns the reference's trajectory, every row to the bit."""
+    """20 runs killed with SIGKILL, half at random moments (before, between and
+    during writes), half as soon as the archive holds a random number of snapshots:
+    each archive opens, its snapshots are the reference's, and the call resumed
+    from it returns the reference's trajectory, every row to the bit."""
     _, whole = _run_archived(tmp_path / "ref")
     reference = Archive(tmp_path / "ref")
     t_run = _timed_run(tmp_path / "timing")
@@ -91,15 +92,26 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
     seen_partial = 0
     for k in range(20):
         folder = tmp_path / f"kill{k}"
+        ready, go = os.pipe()
         pid = os.fork()
         if pid == 0:  # the child: run and exit without cleaning up
             try:
-                _run_archived(folder)
+                os.close(ready)
+                os.write(go, b"!")  # the random moment counts from the run's start,
+                _run_archived(folder)  # not from the fork (slow for a large process)
             finally:
                 os._exit(0)
-        time.sleep(rng.uniform(0.0, 1.1) * t_run)
-        os.kill(pid, signal.SIGKILL)
-        os.waitpid(pid, 0)
+        os.close(go)
+        os.read(ready, 1)
+        os.close(ready)
+        ended = False
+        if k % 2:  # at a random moment of the run: before, between or during writes
+            time.sleep(rng.uniform(0.0, 1.1) * t_run)
+        else:  # as soon as it holds a random number of its 25 snapshots: a partial run
+            ended = _wait_for_snapshots(folder, int(rng.integers(1, 20)), pid)
+        if not ended:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
         if not folder.exists() or not Archive(folder).snapshots:
             _, traj = _run_archived(folder)  # killed before the first snapshot: anew
         else:
@@ -118,10 +130,24 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
     assert seen_partial >= 5  # the kills did fall inside the runs
 
 
+def _wait_for_snapshots(folder, count: int, pid: int) -> bool:
+    """Wait until archive ``folder`` holds ``count`` snapshots; True if the run
+    ``pid`` ended first (and was reaped)."""
+    while not (folder.is_dir() and len(Archive(folder)) >= count):
+        if os.waitpid(pid, os.WNOHANG) != (0, 0):
+            return True
+        time.sleep(0.0005)
+    return False
+
+
 def _timed_run(folder) -> float:
-    start = time.perf_counter()
-    _run_archived(folder)
-    return time.perf_counter() - start
+    """The median time of three archived runs (each into a folder of its own)."""
+    times = []
+    for k in range(3):
+        start = time.perf_counter()
+        _run_archived(folder / str(k))
+        times.append(time.perf_counter() - start)
+    return sorted(times)[1]
 
 
 def test_an_archive_lists_damaged_and_torn_snapshots_and_never_reads_them(tmp_path):
