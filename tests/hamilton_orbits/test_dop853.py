@@ -32,7 +32,8 @@ def test_a_run_beyond_the_step_budget_stops_naming_max_steps(kw):
                                                r"\d+ steps; at this pace the run needs about "
                                                r".* more than max_steps = 100"):
         sim.integrate(2e4 * np.pi)
-    assert time.perf_counter() - start < 10.0  # stopped at its first check, not after hours
+    # stopped at its first check, not after hours (60 s: a cold cache compiles here too)
+    assert time.perf_counter() - start < 60.0
 
 
 def test_a_run_within_the_budget_is_unchanged():

