@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, encode, parse, record
-from hamilton_orbits.snapshot import SnapshotError, checksum, variable, write_bytes
+from hamilton_orbits.snapshot import SnapshotError, checksum, stored, variable, write_bytes
 
 __all__ = ["SEGMENT_FORMAT", "SEGMENT_RE", "Segment", "SegmentWriter", "read_segment"]
 
@@ -68,7 +68,6 @@ SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
 _ROWS = ("out_t", "out_r", "out_v", "out_megno", "out_lyapunov", "out_lyapunov_time",
          "out_stm")
-_KINDS = {"t": "float64", "steps": "int64", "active": "bool", "rows": "int64"}
 
 
 class _Appender:
@@ -77,14 +76,14 @@ class _Appender:
     values) written once, atomically."""
 
     def __init__(self, path: Path, attrs: dict[str, Any], fixed: list[Any],
-                 template: list[tuple[str, tuple[str, ...], np.ndarray]],
+                 template: list[tuple[str, tuple[str, ...], np.ndarray, str]],
                  record_dim: str, sync: bool,
                  summed: Mapping[str, np.ndarray] | None = None,
                  units: Mapping[str, str] | None = None) -> None:
         units = units or {}
-        records = [(name, dims, values, {"dtype_saved": _KINDS.get(name, "float64")}
+        records = [(name, dims, values, {"dtype_saved": kind}
                     | ({"units": units[name]} if name in units else {}))
-                   for name, dims, values in template]
+                   for name, dims, values, kind in template]
         records.append(("check", (), np.zeros((), np.float64), {"dtype_saved": "uint32"}))
         attrs = dict(attrs, records=_record_text([(n, v.shape, a["dtype_saved"])
                                                   for n, _, v, a in records]))
@@ -133,13 +132,8 @@ def _signed(attrs: Mapping[str, Any]) -> str:
 
 
 def _stored(name: str, value: Any) -> np.ndarray:
-    """A record variable's values as stored (bool as int8, integers as float64)."""
-    arr = np.asarray(value)
-    if arr.dtype == np.bool_:
-        return arr.astype(np.int8)
-    if arr.dtype != np.float64:
-        return arr.astype(np.float64)
-    return arr
+    """A record variable's values as the file stores them."""
+    return stored(name, np.asarray(value))[0]
 
 
 class SegmentWriter:
@@ -177,8 +171,9 @@ class SegmentWriter:
                  "meta": text}
         #: the record variables: the snapshot's values but the fixed ones and the rows
         self.names = [k for k in like if k not in fixed and not k.startswith("out_")]
-        template = [(k, self._dims(k, like[k]), _stored(k, like[k])) for k in self.names]
-        template.append(("rows", ("from_to",), np.zeros(2, np.float64)))
+        template = [(k, self._dims(k, like[k]), *stored(k, np.asarray(like[k])))
+                    for k in self.names]
+        template.append(("rows", ("from_to",), np.zeros(2, np.float64), "int64"))
         self.text = text
         self.path = folder / SEGMENT_NAME.format(first)
         self._file = _Appender(self.path, attrs, fixed_vars, template, "snapshot", sync, fixed,
@@ -207,7 +202,7 @@ class SegmentWriter:
         if n:
             names = [k for k in _ROWS if k in rows]
             if self._rows is None:
-                template = [(k, self._dims(k, rows[k][0]), np.asarray(rows[k][0]))
+                template = [(k, self._dims(k, rows[k][0]), np.asarray(rows[k][0]), "float64")
                             for k in names]
                 self._rows = _Appender(self.folder / ROWS_NAME.format(self.first),
                                        {"format": SEGMENT_FORMAT + " rows",

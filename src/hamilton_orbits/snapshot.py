@@ -45,7 +45,7 @@ import numpy as np
 from hamilton_orbits._netcdf3 import encode
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "checksum", "encode_snapshot",
-           "read", "variable", "write", "write_bytes"]
+           "read", "stored", "variable", "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
@@ -72,7 +72,7 @@ def checksum(meta_text: str, arrays: Mapping[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
-def _stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
+def stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
     """The array as netCDF-3 stores it (float64, int32 or int8) and its dtype."""
     kind = arr.dtype.name
     if arr.dtype == np.float64:
@@ -152,7 +152,7 @@ def variable(name: str, arr: np.ndarray, dims: tuple[str, ...] | None,
               unit: str | None) -> tuple[str, tuple[str, ...], np.ndarray, dict[str, Any]]:
     """A variable of a netCDF file: its dimensions, stored values and attributes
     (``dtype_saved``; an empty array as a marker with its ``empty_shape``)."""
-    data, kind = _stored(name, arr)
+    data, kind = stored(name, arr)
     attrs: dict[str, Any] = {"dtype_saved": kind}
     if arr.size == 0:  # netCDF-3 has no empty fixed dimension: a marker and the shape
         attrs["empty_shape"] = ",".join(str(k) for k in arr.shape) or "0"

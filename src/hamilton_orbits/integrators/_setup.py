@@ -228,7 +228,7 @@ _HINT = "pass max_steps=... to go on, or a shorter span"
 
 
 def check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray, method: str,
-               hint: str = _HINT) -> None:
+               hint: str | None = None) -> None:
     """Stop a run of an adaptive method that cannot finish within ``max_steps``: at
     the budget, or early when the pace so far (``total`` steps to reach ``t``)
     projects more than 100 times the budget over the span of ``t_out``; ``hint``
@@ -248,7 +248,7 @@ def check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray, method: 
         raise ConvergenceError(
             f"{method} reached t = {t!r} of {float(t_out[-1])!r} in {total} steps; at this "
             f"pace the run needs about {projected:.3g} steps, more than max_steps = "
-            f"{max_steps} (a step far shorter than the span: {hint})"
+            f"{max_steps} (a step far shorter than the span: {hint or _HINT})"
         )
 
 
@@ -270,7 +270,7 @@ class StepBudget:
     PER_STEP, EVERY = 12, 1200
 
     def __init__(self, f: Callable[[float, np.ndarray], np.ndarray], t_out: np.ndarray,
-                 max_steps: int, method: str, hint: str = _HINT) -> None:
+                 max_steps: int, method: str, hint: str | None = None) -> None:
         self.f, self.t_out, self.max_steps, self.method = f, t_out, max_steps, method
         self.hint, self.calls = hint, 0
 

@@ -250,8 +250,7 @@ def solve(
     """
     from scipy.integrate import solve_ivp
 
-    f = (_setup.StepBudget(f, t_out, max_steps, NAME) if hint is None
-         else _setup.StepBudget(f, t_out, max_steps, NAME, hint))
+    f = _setup.StepBudget(f, t_out, max_steps, NAME, hint)
     y_out = np.empty((len(t_out), len(y0)))
     y_out[0] = y0
     y = np.asarray(y0, dtype=np.float64)
