@@ -154,8 +154,9 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
                                        traj.v.value[:1]) is not None
     merged = "merge" in list(traj.events["action"]) if len(traj.events) else False
     conserved = conserved and not merged  # a merge is an inelastic collision
-    result.metrics["energy"] = what + (" (merges are inelastic: not conserved)" if merged
-                                       else "")
+    if merged:
+        what += " (not conserved: merges are inelastic)"
+    result.metrics["energy"] = what
     key = "max |relative energy error|" if conserved else "max |relative energy change|"
     result.metrics[key] = float(np.max(np.abs(traj.energy_error)))
     _particles_into(result, traj, gm)
