@@ -12,7 +12,10 @@ What it prints (medians over interleaved rounds; the machine is shared):
 [2] a run with a snapshot every 100 steps: radau15 against IAS15 (adaptive,
     default tolerances) and wh against WHFast (dt = 0.05), each as the ratio of
     the archived run's time to the same run without an archive (ours: snapshots at
-    every multiple of 100 mean steps, ``every=``; rebound: ``step=100``);
+    every multiple of 100 mean steps, ``every=``, and for radau15 also
+    ``every_steps=100``, snapshots between two steps; rebound: ``step=100``), over
+    ``T_END`` (2000: 4-9 ms of fixed cost per archived call weigh on a 40 ms run)
+    and ``10 * T_END`` (a run of 0.4 s);
 [3] loading the last snapshot: ``Simulation.load(folder)`` against
     ``rebound.Simulation(file)``.
 """
@@ -96,15 +99,15 @@ def one_snapshot(tmp: Path, repeat: int) -> None:
           f"{med['saved']:.3f})")
 
 
-def runs(tmp: Path, rounds: int) -> None:
+def runs(tmp: Path, rounds: int, t_end: float = T_END) -> None:
     s = disc10()
     arrays = s.as_arrays()
     probe = Simulation(s, method="radau15")
-    probe.integrate(T_END)
-    mean_step = T_END / probe.steps
+    probe.integrate(t_end)
+    mean_step = t_end / probe.steps
     every = {"radau15": 100 * mean_step, "wh": 100 * DT}
 
-    def ours(method: str, archived: bool | None) -> Callable[[], None]:
+    def ours(method: str, archived: bool | str | None) -> Callable[[], None]:
         count = iter(range(10**6))
 
         def go() -> None:
@@ -113,8 +116,10 @@ def runs(tmp: Path, rounds: int) -> None:
             kw = dict(archive=folder, every=every[method] if archived else 1e9)
             if archived is False:
                 kw = {}
+            elif archived == "steps":
+                kw = dict(archive=folder, every_steps=100)
             sim = Simulation(s, method=method, dt=DT if method == "wh" else None, **kw)
-            sim.integrate(T_END)
+            sim.integrate(t_end)
         return go
 
     def theirs(integrator: str, archived: bool) -> Callable[[], None]:
@@ -124,16 +129,18 @@ def runs(tmp: Path, rounds: int) -> None:
                 reb.integrator.epsilon = 1e-9  # rebound's default
             if archived:
                 reb.save_to_file(str(tmp / f"reb-{integrator}.bin"), step=100, delete_file=True)
-            reb.integrate(T_END, exact_finish_time=1)
+            reb.integrate(t_end, exact_finish_time=1)
         return go
 
-    print(f"[2] a run of {T_END:g} (10 bodies) with a snapshot every 100 steps: archived / "
+    print(f"[2] a run of {t_end:g} (10 bodies) with a snapshot every 100 steps: archived / "
           f"plain (median of {rounds} rounds)")
     for method, peer in (("radau15", "ias15"), ("wh", "whfast")):
-        t = interleaved({"ours": ours(method, False), "ours-archived": ours(method, True),
-                         "ours-once": ours(method, None),
-                         "theirs": theirs(peer, False), "theirs-archived": theirs(peer, True)},
-                        rounds)
+        cases = {"ours": ours(method, False), "ours-archived": ours(method, True),
+                 "ours-once": ours(method, None),
+                 "theirs": theirs(peer, False), "theirs-archived": theirs(peer, True)}
+        if method == "radau15":
+            cases["ours-steps"] = ours(method, "steps")
+        t = interleaved(cases, rounds)
         fixed = statistics.median(a - b for a, b in zip(t["ours-once"], t["ours"],
                                                         strict=True))
         r_ours = statistics.median(a / b for a, b in zip(t["ours-archived"], t["ours"],
@@ -145,6 +152,12 @@ def runs(tmp: Path, rounds: int) -> None:
               f"{statistics.median(t['ours']) * 1e3:.1f} ms; of which the archive's fixed "
               f"cost, its folder and first snapshot, {fixed * 1e3:.2f} ms);  {peer} "
               f"x{r_theirs:.3f} (plain {statistics.median(t['theirs']) * 1e3:.1f} ms)")
+        if "ours-steps" in t:
+            r_steps = statistics.median(a / b for a, b in zip(t["ours-steps"], t["ours"],
+                                                               strict=True))
+            n_steps = len(Archive(tmp / f"ours-{method}-steps-1"))
+            print(f"    {method:8s} every_steps=100: x{r_steps:.3f} ({n_steps} snapshots, "
+                  f"between two steps)")
 
 
 def loading(tmp: Path, repeat: int) -> None:
@@ -170,6 +183,8 @@ def main() -> None:
         one_snapshot(tmp, 200)
         runs(tmp, 5)
         loading(tmp, 30)
+        (tmp / "long").mkdir()
+        runs(tmp / "long", 5, 10 * T_END)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

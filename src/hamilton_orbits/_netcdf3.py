@@ -33,7 +33,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["NUMRECS_AT", "Header", "Variable", "encode", "parse", "record"]
+__all__ = ["NUMRECS_AT", "Header", "Parts", "RecordBuffer", "Variable", "encode", "parse",
+           "record"]
 
 _ABSENT = b"\0" * 8
 _DIMENSION, _VARIABLE, _ATTRIBUTE = 10, 11, 12
@@ -131,6 +132,92 @@ def record(values: Sequence[np.ndarray]) -> bytes:
     """The bytes of one record: the record variables' values in the order given to
     :func:`encode`, each padded to four bytes."""
     return b"".join(_bytes(v) for v in values)
+
+
+class Parts(tuple):
+    """A record variable's values given as arrays to be concatenated, flattened, into
+    it (:meth:`RecordBuffer.fill`), which saves building the whole first."""
+
+    __slots__ = ()
+
+
+class RecordBuffer:
+    """One record's bytes kept for reuse: :meth:`fill` writes each record variable's
+    values into its big-endian view, giving the bytes :func:`record` gives for the
+    same values, without building them anew (an archive appends many records of one
+    layout).
+
+    Examples
+    --------
+    >>> like = [np.zeros(2), np.zeros(3, np.int8)]
+    >>> buf = RecordBuffer(like)
+    >>> values = [np.array([1.5, -2.0]), np.array([1, 0, 1], np.int8)]
+    >>> bytes(buf.fill(values)) == record(values)
+    True
+    >>> bytes(buf.fill([Parts([np.array([1.5]), np.array([-2.0])]), values[1]])) == record(values)
+    True
+    """
+
+    def __init__(self, like: Sequence[np.ndarray]) -> None:
+        sizes = [v.size * v.dtype.itemsize for v in like]
+        self.data = bytearray(sum(n + _pad(n) for n in sizes))
+        self.views: list[np.ndarray] = []
+        starts, at = [], 0
+        for v, n in zip(like, sizes, strict=True):
+            self.views.append(np.frombuffer(self.data, v.dtype.newbyteorder(">"), v.size,
+                                            at).reshape(v.shape))
+            starts.append(at)
+            at += n + _pad(n)
+        #: consecutive float64 variables, each run filled by one concatenation:
+        #: (first, end, the run's values as one flat view), or (k, k + 1, None)
+        self.runs: list[tuple[int, int, np.ndarray | None]] = []
+        k = 0
+        while k < len(like):
+            end = k
+            while end < len(like) and like[end].dtype == np.float64:
+                end += 1
+            if end - k > 1:
+                self.runs.append((k, end, np.frombuffer(self.data, ">f8",
+                                                        sum(sizes[k:end]) // 8, starts[k])))
+            else:
+                end = k + 1
+                self.runs.append((k, end, None))
+            k = end
+
+    def fill(self, values: Sequence[Any]) -> bytearray:
+        """The record of ``values`` (each of its variable's shape, or :class:`Parts`
+        of its size, cast to its type).
+
+        Raises
+        ------
+        ValueError
+            When a value's shape (the size of :class:`Parts`) is not its variable's.
+        """
+        if len(values) != len(self.views):
+            raise ValueError(f"{len(values)} values for a record of {len(self.views)}")
+        for first, end, flat in self.runs:
+            parts: list[np.ndarray] = []
+            for k in range(first, end):
+                parts += self._flat(k, values[k])
+            if flat is None:
+                flat = self.views[first].reshape(-1)
+            np.concatenate(parts, out=flat, casting="unsafe")
+        return self.data
+
+    def _flat(self, k: int, x: Any) -> list[np.ndarray]:
+        """Value ``x`` of variable ``k`` as flat arrays, its size checked."""
+        view = self.views[k]
+        if type(x) is Parts:
+            out = [a.reshape(-1) for a in x]
+            if sum(a.size for a in out) != view.size:
+                raise ValueError(f"record variable {k}: parts of {sum(a.size for a in out)} "
+                                 f"values, the record holds {view.size}")
+            return out
+        x = np.asarray(x)
+        if x.shape != view.shape:
+            raise ValueError(f"record variable {k}: shape {x.shape}, the record holds "
+                             f"{view.shape}")
+        return [x.reshape(-1)]
 
 
 class Variable(NamedTuple):

@@ -32,6 +32,7 @@ from hamilton_orbits.checkpoint import (
     record,
     snapshot_at,
     spec,
+    state_values,
 )
 from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
@@ -234,13 +235,44 @@ class Saving:
             known = self._record_cache["unit"] = (self._unit, self._unit.to_string())
         return known[1]
 
-    def _record(self, rows: Any = None, archive: bool = False) -> tuple[Any, ...]:
+    def _extra(self, rows: Any) -> dict[str, Any]:
+        """What a snapshot's ``meta`` holds of the simulation beside its propagation."""
         extra = {"started": self._start is not None, "unit": self._unit_text(),
                  "archive": None if self._archive is None else self._archive.schedule()}
         if rows is not None:
             extra["leg"] = rows.info
-        meta, arrays, dims, units = record(self._system, *self._spec, self._prop, extra,
-                                           self._record_cache, split=archive)
+        return extra
+
+    def _snapshot(self, rows: Any) -> None:
+        """Append the archive's next snapshot (``rows``: the leg's rows since the last).
+
+        When the segment being written was begun or last appended to by this
+        simulation and the propagation's layout is still the one it shares (the
+        usual case between two outputs or two slices of steps), only what changes
+        is taken (:class:`~hamilton_orbits.restart.Capture`) and appended; otherwise
+        the whole snapshot is made, which begins a new segment if its shared part
+        changed."""
+        arch, prop, cache = self._archive, self._prop, self._record_cache
+        extra = self._extra(rows)
+        known = cache.get("appended")
+        if known is not None and known[0] is arch.segment and known[1] == extra and (
+                rows is None or rows.times is None):
+            capture, _, index = known[2]
+            if prop.events is not None:
+                prop.events.drain()  # (as a whole snapshot does)
+            taken = capture.take(prop)
+            if taken is not None:
+                values = state_values(prop, taken[0], index, taken[1], capture.ints)
+                values["steps"] = prop.steps
+                arch.append(values, {} if rows is None else rows.take())
+                return
+        arch.write(*self._record(rows, archive=True))
+        cache["appended"] = (arch.segment, extra, cache["capture"])
+
+    def _record(self, rows: Any = None, archive: bool = False) -> tuple[Any, ...]:
+        meta, arrays, dims, units = record(self._system, *self._spec, self._prop,
+                                           self._extra(rows), self._record_cache,
+                                           split=archive)
         if rows is not None:
             arrays.update(rows.take())
             dims.update(out_r=("out", "body", "xyz"), out_v=("out", "body", "xyz"))
@@ -260,7 +292,7 @@ class Saving:
             self._leg = LegRows(info, times)
             self._leg.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None:
-                arch.write(*self._record(self._leg, archive=True))
+                self._snapshot(self._leg)
         except BaseException:
             arch.close()
             raise
@@ -276,6 +308,14 @@ class Saving:
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 
+    def _step_snapshots(self) -> _EverySteps | None:
+        """The pause that takes an ``every_steps`` snapshot between two steps (None
+        without that schedule, or when nothing is written)."""
+        arch = self._archive
+        if arch is None or arch.every_steps is None or arch.path is None:
+            return None
+        return _EverySteps(self)
+
     def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
         arch, prop, rows = self._archive, self._prop, self._leg
 
@@ -285,6 +325,22 @@ class Saving:
             if asked[i] and rows is not None and arch.path is not None:
                 rows.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None and (scheduled[i] or arch.due(prop.steps)):
-                arch.write(*self._record(rows, archive=True))  # (a schedule alone writes nothing)
+                self._snapshot(rows)  # (a schedule alone writes nothing)
 
         return at
+
+
+class _EverySteps:
+    """An archive's ``every_steps`` snapshots taken between two steps, for a driver
+    that can pause there (:meth:`~hamilton_orbits.engine.Propagation.advance`)."""
+
+    def __init__(self, sim: Saving) -> None:
+        self.sim, self.arch = sim, sim._archive
+
+    @property
+    def at(self) -> int:
+        """The propagation's step count at which the next snapshot is due."""
+        return self.arch.last_steps + self.arch.every_steps
+
+    def __call__(self) -> None:
+        self.sim._snapshot(self.sim._leg)

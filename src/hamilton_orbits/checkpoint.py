@@ -37,9 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._netcdf3 import parse
+from hamilton_orbits._netcdf3 import Parts, parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
-from hamilton_orbits.restart import flatten, inline
+from hamilton_orbits.restart import Capture, flatten, inline
 from hamilton_orbits.segment import SEGMENT_RE, Segment, SegmentWriter, read_segment
 from hamilton_orbits.snapshot import SnapshotError, read
 from hamilton_orbits.units import is_quantity
@@ -59,6 +59,7 @@ __all__ = [
     "snapshot_at",
     "snapshot_files",
     "spec",
+    "state_values",
     "to_json",
     "unpack",
 ]
@@ -121,7 +122,7 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     scalars: list[Any] | None = [] if split else None
     if prop.events is not None:
         prop.events.drain()  # (its buffer is then empty: not saved)
-    layout, state = flatten(prop, scalars)
+    layout, state, index = _state(prop, scalars, cache if split else None)
     fixed = None if cache is None else cache.get("fixed")
     if fixed is None:
         fixed = _fixed(system, method, dt, tol, effects, events, variational, stm)
@@ -132,13 +133,8 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     meta = {**head, "t": float(prop.t), "steps": int(prop.steps), "layout": layout,
             **to_json(dict(extra))}
     arrays: dict[str, np.ndarray] = {f"initial_{k}": getattr(sa, k) for k in _SYSTEM_FIELDS}
-    active = np.ones(len(sa.names), dtype=bool)
-    if prop.events is not None:
-        active = ~prop.events.inactive
-    arrays.update(t=np.float64(prop.t), r=prop.r, v=prop.v, gm=prop.gm, active=active)
-    arrays["state"], meta["state_arrays"] = pack(state)
-    if scalars is not None:
-        arrays["scalars"] = np.array(scalars, dtype=np.float64)
+    arrays.update(state_values(prop, state, index, scalars))
+    meta["state_arrays"] = arrays.pop("state_arrays")
     dims = {"r": ("body", "xyz"), "v": ("body", "xyz"), "gm": ("body",),
             "active": ("body",), "initial_r": ("body", "xyz"), "initial_v": ("body", "xyz"),
             "initial_gm": ("body",), "initial_radius": ("body",), "initial_j2": ("body",),
@@ -149,6 +145,55 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
                  "initial_r": "au", "initial_v": "au/day", "initial_gm": "au3/day2",
                  "initial_radius": "au"}
     return meta, arrays, dims, units
+
+
+def state_values(prop: Any, state: list[np.ndarray], index: list[list[Any]] | None,
+                 scalars: list[Any] | None, ints: list[int] | None = None) -> dict[str, Any]:
+    """What a snapshot of propagation ``prop`` holds that changes from one snapshot
+    to the next: ``t``, ``r``, ``v``, ``gm``, ``active``, the packed ``state`` (of the
+    arrays of its layout) and its ``state_arrays`` index, ``scalars`` when given.
+
+    ``ints``: the positions of the integer arrays of ``state``, when known (an
+    archive's record, whose index its segment holds): ``state`` is then given as
+    :class:`~hamilton_orbits._netcdf3.Parts`, packed only into the record."""
+    active = np.ones(prop.r.shape[0], dtype=bool)
+    if prop.events is not None:
+        active = ~prop.events.inactive
+    out = {"t": np.float64(prop.t), "r": prop.r, "v": prop.v, "gm": prop.gm, "active": active}
+    if ints is None:
+        out["state"], out["state_arrays"] = pack(state, index)
+    else:
+        _exact_integers([state[k] for k in ints])
+        out["state"] = Parts(state)
+    if scalars is not None:
+        out["scalars"] = np.array(scalars, dtype=np.float64)
+    return out
+
+
+def _exact_integers(arrays: list[np.ndarray]) -> None:
+    """Refuse integer arrays a float64 would not hold exactly."""
+    for a in arrays:
+        if a.dtype.kind in "iu" and a.size and max(-int(a.min()), int(a.max())) >= 2**53:
+            raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
+
+
+def _state(prop: Any, scalars: list[Any] | None, cache: dict[str, Any] | None) -> tuple[
+        dict[str, Any], list[np.ndarray], list[list[Any]] | None]:
+    """The layout and arrays of ``prop``'s state, its numbers put in ``scalars``
+    (:func:`~hamilton_orbits.restart.flatten`), and the index of the packed arrays
+    when it is known; with a ``cache`` (an archive's snapshots, which share their
+    layout), the graph is walked afresh only when its shape changed
+    (:class:`~hamilton_orbits.restart.Capture`)."""
+    known = None if cache is None else cache.get("capture")
+    if known is not None and scalars is not None:
+        taken = known[0].take(prop)
+        if taken is not None:
+            scalars += taken[1]
+            return known[1], taken[0], known[2]
+    layout, state = flatten(prop, scalars)
+    if cache is not None:
+        cache["capture"] = (Capture(prop, layout), layout, pack(state)[1])
+    return layout, state, None
 
 
 def _fixed(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,
@@ -277,19 +322,20 @@ def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
     return np.unique(np.where(moved >= b, b, moved))
 
 
-def pack(arrays: list[np.ndarray]) -> tuple[np.ndarray, list[list[Any]]]:
+def pack(arrays: list[np.ndarray], index: list[list[Any]] | None = None) -> tuple[
+        np.ndarray, list[list[Any]]]:
     """The arrays of a propagation's state as one float64 vector (integers below
-    2**53 and booleans exactly) and each one's ``[offset, shape, dtype]``."""
-    index, start = [], 0
-    for a in arrays:
-        kind = a.dtype
-        name = _DTYPE_NAMES.get(kind)
-        if name is None:
-            name = _DTYPE_NAMES.setdefault(kind, kind.name)
-        if kind.kind in "iu" and a.size and max(-int(a.min()), int(a.max())) >= 2**53:
-            raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
-        index.append([start, list(a.shape), name])
-        start += a.size
+    2**53 and booleans exactly) and each one's ``[offset, shape, dtype]`` (``index``:
+    those, when known)."""
+    _exact_integers(arrays)
+    if index is None:
+        index, start = [], 0
+        for a in arrays:
+            name = _DTYPE_NAMES.get(a.dtype)
+            if name is None:
+                name = _DTYPE_NAMES.setdefault(a.dtype, a.dtype.name)
+            index.append([start, list(a.shape), name])
+            start += a.size
     if not arrays:
         return np.empty(0), index
     return np.concatenate([a.reshape(-1) for a in arrays], dtype=np.float64), index
@@ -527,10 +573,17 @@ class ArchiveWriter:
                      if k.startswith("initial_") or k == "leg_times"}
             seg = self.segment = SegmentWriter(self.path, self.count, shared, fixed, arrays,
                                                dims, units, self.sync)
-        seg.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
-        self.count += 1
-        self.last_steps, self.last_wall = int(meta["steps"]), time.monotonic()
+        seg.shared = shared  # (equal: its parts now the ones a next snapshot may share)
+        self.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
         return seg.path
+
+    def append(self, values: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
+        """Append a snapshot that shares everything but ``values`` (its record: ``t``,
+        ``steps``, ``r``, ... as :func:`state_values` gives them) and its output ``rows``
+        with the last one, to the segment being written."""
+        self.segment.append(values, rows)
+        self.count += 1
+        self.last_steps, self.last_wall = int(values["steps"]), time.monotonic()
 
 
 def _same(seg: SegmentWriter, shared: dict[str, Any]) -> bool:

@@ -242,12 +242,16 @@ class Propagation:
 
     def advance(self, t_out: np.ndarray, *, on_output: Callable[[int, int], None] | None = None,
                 stop: Callable[[], bool] | None = None,
-                checkpoint: Callable[[int], None] | None = None) -> EngineRun:
+                checkpoint: Callable[[int], None] | None = None,
+                pause: Any = None) -> EngineRun:
         """Integrate through ``t_out`` (strictly monotonic, ``t_out[0]`` the current
         time :attr:`t`, forwards or backwards); see :func:`run`.  ``checkpoint(i)``
         (forwards only) is called at output ``i`` with the propagation standing there
         as a leg ending at ``t_out[i]`` would leave it (a snapshot taken then
-        continues bit for bit)."""
+        continues bit for bit).  ``pause()`` (forwards only; a driver that can pause
+        between steps, radau15's) is called between two steps once :attr:`steps`
+        reaches ``pause.at``, the propagation standing at the driver's own state
+        (the steps unchanged: a snapshot taken then continues bit for bit)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         events = self.events
@@ -283,7 +287,8 @@ class Propagation:
             if self.stop_at_start:  # a collision at the start stops the run there
                 self.stop_at_start = False
                 raise StopAtEvent(0, self.t, 0)
-            driver.advance(-t_out if backward else t_out, r_out, v_out, report, stop)
+            self._drive(driver, -t_out if backward else t_out, (r_out, v_out), report, stop,
+                        pause)
             reached[0], reached[1] = n_t - 1, driver.steps - steps0
         except StopAtEvent as stopped:
             reached[0], reached[1] = stopped.index, stopped.steps
@@ -312,6 +317,19 @@ class Propagation:
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
 
+    def _drive(self, driver: Any, t_out: np.ndarray, rows: tuple[np.ndarray, np.ndarray],
+               report: Callable[[int, int], None], stop: Any, pause: Any) -> None:
+        """``driver.advance`` through ``t_out``, ``pause`` set on a driver that takes
+        it (and cleared after)."""
+        pausing = pause is not None and hasattr(driver, "pause")
+        if pausing:
+            driver.pause = _Pause(self, pause)
+        try:
+            driver.advance(t_out, *rows, report, stop)
+        finally:
+            if pausing:
+                driver.pause = None
+
     def _stand_at(self, t: float, r: np.ndarray, v: np.ndarray) -> None:
         """Stand at output time ``t`` with its state (forwards), as a leg ending there."""
         self.r, self.v, self.t = r, v, t
@@ -324,6 +342,24 @@ class Propagation:
         r_now, v_now, self.gm = driver.state()
         sign = -1.0 if self.backward else 1.0
         self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
+
+
+class _Pause:
+    """A caller's ``pause`` as the driver sees it: ``at`` counted in the driver's own
+    steps, and the propagation made to stand at the driver's state before it."""
+
+    def __init__(self, prop: Propagation, pause: Any) -> None:
+        self.prop, self.pause = prop, pause
+
+    @property
+    def at(self) -> int:
+        return self.pause.at - self.prop.steps_before
+
+    def __call__(self) -> None:
+        prop = self.prop
+        r, v, _ = prop.driver.state()
+        prop._stand_at(prop.driver.t, r, v)
+        self.pause()
 
 
 def run(

@@ -49,7 +49,7 @@ from hamilton_orbits.integrators import Method
 from hamilton_orbits.integrators._setup import is_address
 from hamilton_orbits.rhs import RHS
 
-__all__ = ["LayoutMismatch", "flatten", "inline", "restore"]
+__all__ = ["Capture", "LayoutMismatch", "flatten", "inline", "restore"]
 
 _SCALARS = (bool, int, float, str, type(None))
 _NUMPY_SCALARS = {np.float64: "float64", np.bool_: "bool", np.int64: "int64"}
@@ -202,6 +202,127 @@ def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int],
         fields = {k: x for k, x in fields.items() if k not in scratch}
     return {"class": f"{kind.__module__}.{kind.__qualname__}",
             "attrs": {k: _node(x, arrays, seen, scalars) for k, x in fields.items()}}
+
+
+# the steps of a Capture: what each node of the layout is
+_OBJ, _SEQ, _DICT, _ARR, _ALIAS, _NUM, _NPNUM, _VAL, _BUILT = range(9)
+_EXACT = 2**53
+
+
+class Capture:
+    """What :func:`flatten` gives with ``scalars`` for a graph of the shape it had once,
+    found again without walking it anew (an archive takes many snapshots of one
+    propagation, whose layout changes seldom).
+
+    Made from ``obj`` and the layout :func:`flatten` gave for it, :meth:`take` reads
+    the same attributes, items, arrays and numbers again, checking at each node that
+    the graph still has the layout's shape: the same classes and attribute names,
+    the same lengths and keys, arrays of the same shapes and types reached by the
+    same aliases, the same plain values.  Where anything differs it returns None,
+    and the caller flattens afresh: what it returns is then always what ``flatten``
+    would give.
+
+    Examples
+    --------
+    >>> class Leaf:
+    ...     def __init__(self):
+    ...         self.t, self.x = 2.5, np.zeros(2); self.pair = (self.x, 3)
+    >>> leaf, numbers = Leaf(), []
+    >>> layout, arrays = flatten(leaf, numbers)
+    >>> capture = Capture(leaf, layout)
+    >>> leaf.t = 3.0
+    >>> capture.take(leaf)[1] == [3.0, 3]
+    True
+    >>> leaf.pair = (np.zeros(2), 3)   # no longer the alias of x: flatten afresh
+    >>> capture.take(leaf) is None
+    True
+    """
+
+    def __init__(self, obj: Any, layout: dict[str, Any]) -> None:
+        self.root = (type(obj), obj.__dict__.keys() | set())
+        self.ops: list[tuple[int, int, Any, bool, Any]] = []
+        self.usable = True
+        self._compile(obj, layout, 0)
+        #: the positions of the integer arrays among those :meth:`take` returns
+        self.ints = [k for k, (code, expect, *_) in enumerate(
+            op for op in self.ops if op[0] == _ARR) if expect[2].kind in "iu"]
+
+    def _compile(self, obj: Any, layout: dict[str, Any], slot: int) -> None:
+        if "attrs" in layout:
+            if not hasattr(obj, "__dict__"):
+                self.usable = False  # (a class with __slots__: always flattened)
+                return
+            children = [(k, True, getattr(obj, k), x) for k, x in layout["attrs"].items()]
+        elif "items" in layout:
+            children = [(i, False, x, n) for i, (x, n) in enumerate(zip(obj, layout["items"],
+                                                                         strict=True))]
+        else:
+            children = [(k, False, obj[k], n) for k, n in layout["dict"].items()]
+        for key, attr, x, node in children:
+            self.ops.append((*_step(x, node), slot, key, attr))
+            if "attrs" in node or "items" in node or "dict" in node:
+                self._compile(x, node, len(self.ops))
+
+    def take(self, obj: Any) -> tuple[list[np.ndarray], list[Any]] | None:
+        """The arrays and numbers ``flatten(obj, scalars)`` would give (its layout the
+        one this capture was made from), or None where the graph's shape differs."""
+        if not self.usable or type(obj) is not self.root[0] or \
+                obj.__dict__.keys() != self.root[1]:
+            return None
+        slots, arrays, scalars, seen = [obj], [], [], set()
+        for code, expect, parent, key, attr in self.ops:
+            x = getattr(slots[parent], key) if attr else slots[parent][key]
+            slots.append(x)
+            if code == _ALIAS:
+                if x is not arrays[expect]:
+                    return None
+                continue
+            if type(x) is not expect[0]:
+                return None
+            if code == _ARR:
+                if x.shape != expect[1] or x.dtype != expect[2] or id(x) in seen or (
+                        expect[2] == np.int64 and is_address(x)):
+                    return None
+                seen.add(id(x))
+                arrays.append(x)
+            elif code == _NUM or code == _NPNUM:
+                value = x if code == _NUM else x.item()
+                if expect[1] and not -_EXACT < value < _EXACT:
+                    return None
+                scalars.append(value)
+            elif code == _OBJ or code == _DICT:
+                if x.__dict__.keys() != expect[1] if code == _OBJ else x.keys() != expect[1]:
+                    return None
+            elif code == _SEQ:
+                if len(x) != expect[1]:
+                    return None
+            elif code == _VAL:
+                if not (x is expect[1] or x == expect[1]):
+                    return None
+            elif code == _BUILT and expect[0] is np.ndarray and not is_address(x):
+                return None
+        return arrays, scalars
+
+
+def _step(x: Any, node: dict[str, Any]) -> tuple[int, Any]:
+    """The code of a :class:`Capture` step for value ``x`` at layout ``node``, and
+    what it expects to find there."""
+    kind = type(x)
+    if "alias" in node:
+        return _ALIAS, node["alias"]
+    if "array" in node:
+        return _ARR, (kind, x.shape, x.dtype)
+    if "scalar" in node:
+        return (_NPNUM if "numpy" in node else _NUM), (kind, node["type"] == "int")
+    if "attrs" in node:
+        return _OBJ, (kind, x.__dict__.keys() | set())
+    if "items" in node:
+        return _SEQ, (kind, len(x))
+    if "dict" in node:
+        return _DICT, (kind, x.keys() | set())
+    if "built" in node:
+        return _BUILT, (kind,)
+    return _VAL, (kind, x)
 
 
 def restore(obj: Any, layout: dict[str, Any], arrays: list[np.ndarray]) -> None:

@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, encode, parse, record
+from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, encode, parse
 from hamilton_orbits.snapshot import SnapshotError, checksum, stored, variable, write_bytes
 
 __all__ = ["SEGMENT_FORMAT", "SEGMENT_RE", "Segment", "SegmentWriter", "read_segment"]
@@ -91,16 +91,19 @@ class _Appender:
         header = encode(attrs, fixed, records, record_dim=record_dim)
         write_bytes(path, header, sync=sync)
         self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
+        #: one record's bytes, reused (its last variable the CRC-32 of the others)
+        self.buffer = RecordBuffer([values for _, _, values, _ in records])
         self.fd = os.open(path, os.O_RDWR)
 
-    def append(self, rows: list[list[np.ndarray]]) -> None:
-        """Append records (each its record variables' values but ``check``), then
-        count them in the header."""
-        parts = []
+    def append(self, rows: list[list[Any]]) -> None:
+        """Append records (each its record variables' values but ``check``, cast to
+        the types they are stored as), then count them in the header."""
+        buffer, parts = self.buffer, []
         for values in rows:
-            data = record(values)
-            parts.append(data + struct.pack(">d", zlib.crc32(data)))
-        data = b"".join(parts)
+            data = buffer.fill([*values, 0.0])
+            buffer.views[-1][...] = zlib.crc32(memoryview(data)[:-8])
+            parts.append(data if len(rows) == 1 else bytes(data))  # (the buffer is reused)
+        data = parts[0] if len(parts) == 1 else b"".join(parts)
         try:
             os.pwrite(self.fd, data, self.end)
             if self.sync:
@@ -132,8 +135,13 @@ def _signed(attrs: Mapping[str, Any]) -> str:
 
 
 def _stored(name: str, value: Any) -> np.ndarray:
-    """A record variable's values as the file stores them."""
-    return stored(name, np.asarray(value))[0]
+    """A record variable's values as the file can store them (cast into the record by
+    :class:`~hamilton_orbits._netcdf3.RecordBuffer`): integers checked below 2**53,
+    other types than float and bool refused (:func:`~hamilton_orbits.snapshot.stored`)."""
+    if type(value) is Parts or (type(value) is int and abs(value) < 2**53):
+        return value  # (the parts of a record variable, checked; a step count)
+    a = np.asarray(value)
+    return a if a.dtype.kind in "fb" else stored(name, a)[0]
 
 
 class SegmentWriter:
@@ -170,10 +178,13 @@ class SegmentWriter:
         attrs = {"format": SEGMENT_FORMAT, "format_version": SEGMENT_VERSION, "first": first,
                  "meta": text}
         #: the record variables: the snapshot's values but the fixed ones and the rows
-        self.names = [k for k in like if k not in fixed and not k.startswith("out_")]
+        names = [k for k in like if k not in fixed and not k.startswith("out_")]
         template = [(k, self._dims(k, like[k]), *stored(k, np.asarray(like[k])))
-                    for k in self.names]
+                    for k in names]
         template.append(("rows", ("from_to",), np.zeros(2, np.float64), "int64"))
+        # (the float64 variables first: a record is then filled by few concatenations)
+        template.sort(key=lambda var: var[2].dtype != np.float64)
+        self.names = [var[0] for var in template]
         self.text = text
         self.path = folder / SEGMENT_NAME.format(first)
         self._file = _Appender(self.path, attrs, fixed_vars, template, "snapshot", sync, fixed,
@@ -212,7 +223,8 @@ class SegmentWriter:
             self._rows.append([[np.asarray(rows[k][i], np.float64) for k in names]
                                for i in range(n)])
         span = np.array([start, start + n], dtype=np.float64)
-        self._file.append([[_stored(k, snapshot[k]) for k in self.names] + [span]])
+        self._file.append([[span if k == "rows" else _stored(k, snapshot[k])
+                            for k in self.names]])
 
     def close(self) -> None:
         """Close the files (what was appended stays)."""

@@ -325,7 +325,8 @@ class Simulation(Saving):
                 out = prop.advance(times, on_output=on_output, stop=stop)
             else:
                 out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
-                                   stop=stop, checkpoint=self._checkpoint(*archived[1:]))
+                                   stop=stop, checkpoint=self._checkpoint(*archived[1:]),
+                                   pause=self._step_snapshots())
                 out = requested_rows(out, archived[1])
             compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
         finally:

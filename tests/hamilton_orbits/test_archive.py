@@ -448,3 +448,66 @@ def test_damaged_rows_of_the_last_snapshot_fall_back_to_the_one_before(tmp_path)
     assert [s.number for s in archive.snapshots] == [0, 1, 2, 3, 4, 5]
     assert "output rows of snapshot 6" in archive.damaged[0][1]
     assert Simulation.load(tmp_path).t == 50.0
+
+
+RADAU15_STEPPED = {
+    "radau15": (_disc, dict(method="radau15")),
+    "radau15-fixed": (_disc, dict(method="radau15", dt=0.02)),
+    "radau15-effects": (_disc, dict(method="radau15", effects=[{"name": "gr", "c": 100.0},
+                                                              {"name": "j2", "body": "star"}])),
+    "radau15-events": (_disc, dict(method="radau15",
+                                   events=[{"name": "close_encounter", "distance": 2.0}])),
+    "radau15-merge": (_merging, dict(method="radau15",
+                                     events=[{"name": "collision", "action": "merge"}])),
+}
+
+
+@pytest.mark.parametrize("case", list(RADAU15_STEPPED))
+def test_radau15_snapshots_every_n_steps_between_outputs_without_changing_a_step(tmp_path,
+                                                                                case):
+    """``every_steps`` with radau15: a snapshot at the end of every N-th step, between
+    the outputs (the compiled call's budget ends there: no step is shortened), the
+    run's bits those of the run without an archive, and each snapshot continuing to
+    the whole run's rows, bit for bit."""
+    system, kw = RADAU15_STEPPED[case]
+    times = np.linspace(0.0, 4.0, 5)[1:]
+    plain = Simulation(system(), **kw)
+    whole = plain.integrate(times)
+    sim = Simulation(system(), archive=tmp_path, every_steps=7, **kw)
+    traj = sim.integrate(times)
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and sim.steps == plain.steps
+    archive = Archive(tmp_path)
+    steps = [s.steps for s in archive.snapshots]
+    assert steps == list(range(0, sim.steps + 1, 7))
+    assert archive.damaged == [] and archive.torn == []
+    between = [s for s in archive.snapshots if s.t not in times]
+    assert len(between) > len(archive) // 2  # most of them between two outputs
+    for snap in between[:: max(len(between) // 4, 1)]:
+        again = Simulation.load(tmp_path, number=snap.number)
+        assert again.t == snap.t and again.steps == snap.steps
+        rest = again.integrate(times[times > again.t])
+        k = len(rest.t) - 1  # (its first row is the snapshot's own time)
+        assert _same(rest.r[1:], whole.r[-k:]) and _same(rest.v[1:], whole.v[-k:])
+        assert again.steps == plain.steps
+        if "events" in kw:
+            later = whole.events[np.asarray(whole.events["time"]) > snap.t]
+            assert list(rest.events["time"]) == list(later["time"])
+
+
+@pytest.mark.parametrize("case", ["radau15", "radau15-merge"])
+def test_a_call_stopped_between_two_outputs_is_resumed_whole(tmp_path, case):
+    """Stopped right after a snapshot taken between outputs (as a kill then would
+    leave it), the call resumed from the archive returns the whole call's rows."""
+    system, kw = RADAU15_STEPPED[case]
+    times = np.linspace(0.0, 4.0, 9)[1:]
+    whole = Simulation(system(), **kw).integrate(times)
+    pauses = iter(range(10**6))
+    sim = Simulation(system(), archive=tmp_path, every_steps=5, **kw)
+    cut = sim.integrate(times, stop=lambda: next(pauses) == 6)  # asked after each pause
+    assert not cut.complete
+    again = Simulation.load(tmp_path)
+    assert again.t not in times and 0.0 < again.t < 4.0
+    traj = again.resume()
+    assert traj.t.tolist() == whole.t.tolist() and traj.complete
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v)
+    assert _same(traj.energy_error, whole.energy_error)

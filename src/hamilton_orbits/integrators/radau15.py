@@ -254,7 +254,14 @@ class _DoubleDouble:
 
 
 class _Run:
-    """The integrator's state between compiled calls (see :func:`run`)."""
+    """The integrator's state between compiled calls (see :func:`run`).
+
+    ``pause``, when set (an archive's step schedule), is called between two steps
+    once ``steps`` reaches ``pause.at``: the compiled call's budget ends there, so
+    the steps are the same as without it."""
+
+    #: not state: the hook a run sets and clears (:meth:`Propagation.advance`)
+    RESTART_SCRATCH = ("pause",)
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
@@ -270,6 +277,7 @@ class _Run:
         self.w = np.ascontiguousarray(v0.copy())
         self.steps = 0
         self.stop: Callable[[], bool] | None = None
+        self.pause: Any = None
         # the kernel's arguments that stay the same objects between calls (a short
         # call's cost is mostly its arguments; see docs/design.md, "One front door")
         self.before_t = (self.accel, rhs.p, self.x, self.w, gm)
@@ -304,9 +312,13 @@ class _Run:
     def advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
         the steps before this call, for its budget of ``max_steps``)."""
-        log, max_steps = self.log, self.max_steps
+        log, max_steps, pause = self.log, self.max_steps, self.pause
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             budget = min(SLICE, max_steps - (self.steps - first))
+            if pause is not None:
+                if self.steps >= pause.at:
+                    pause()
+                budget = min(budget, max(pause.at - self.steps, 1))
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
                     *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
