@@ -196,28 +196,47 @@ class RecordBuffer:
         if len(values) != len(self.views):
             raise ValueError(f"{len(values)} values for a record of {len(self.views)}")
         for first, end, flat in self.runs:
-            parts: list[np.ndarray] = []
+            if flat is None and type(values[first]) is not Parts:  # a variable alone
+                self.views[first][...] = self._shaped(first, values[first])
+                continue
+            parts: list[Any] = []
+            given = 0  # (Parts in this run: one is checked by the run's size)
             for k in range(first, end):
-                parts += self._flat(k, values[k])
-            if flat is None:
-                flat = self.views[first].reshape(-1)
-            np.concatenate(parts, out=flat, casting="unsafe")
+                x = values[k]
+                if type(x) is Parts:
+                    given += 1
+                    if given > 1:
+                        self._sized(k, x)
+                    parts += [a.reshape(-1) for a in x]
+                else:
+                    x = self._shaped(k, x)
+                    parts.append(x.reshape(-1) if type(x) is np.ndarray else np.ravel(x))
+            try:  # (the other values' shapes checked, parts of a wrong size change the run's)
+                np.concatenate(parts, out=self.views[first].reshape(-1) if flat is None
+                               else flat, casting="unsafe")
+            except ValueError:
+                for k in range(first, end):
+                    if type(values[k]) is Parts:
+                        self._sized(k, values[k])
+                raise
         return self.data
 
-    def _flat(self, k: int, x: Any) -> list[np.ndarray]:
-        """Value ``x`` of variable ``k`` as flat arrays, its size checked."""
-        view = self.views[k]
-        if type(x) is Parts:
-            out = [a.reshape(-1) for a in x]
-            if sum(a.size for a in out) != view.size:
-                raise ValueError(f"record variable {k}: parts of {sum(a.size for a in out)} "
-                                 f"values, the record holds {view.size}")
-            return out
-        x = np.asarray(x)
-        if x.shape != view.shape:
-            raise ValueError(f"record variable {k}: shape {x.shape}, the record holds "
-                             f"{view.shape}")
-        return [x.reshape(-1)]
+    def _shaped(self, k: int, x: Any) -> Any:
+        """Value ``x`` of variable ``k``, its shape checked."""
+        kind = type(x)
+        shape = x.shape if kind is np.ndarray or kind is np.float64 else () if (
+            kind is float or kind is int) else np.shape(x)
+        if shape != self.views[k].shape:
+            raise ValueError(f"record variable {k}: shape {shape}, the record holds "
+                             f"{self.views[k].shape}")
+        return x
+
+    def _sized(self, k: int, x: Parts) -> None:
+        """The parts ``x`` of variable ``k``, their size checked."""
+        size = sum(a.size for a in x)
+        if size != self.views[k].size:
+            raise ValueError(f"record variable {k}: parts of {size} values, the record "
+                             f"holds {self.views[k].size}")
 
 
 class Variable(NamedTuple):

@@ -291,6 +291,8 @@ class Saving:
                     "first_event": 0 if prop.events is None else len(prop.events.recorded())}
             self._leg = LegRows(info, times)
             self._leg.add(prop.t, prop.r, prop.v, prop.variational)
+            if prop.driver is None and (prop.events is None or not len(prop.events.watch)):
+                prop.driver_for(False)  # (made now, not after this snapshot: one segment)
             if arch.path is not None:
                 self._snapshot(self._leg)
         except BaseException:

@@ -173,7 +173,9 @@ def state_values(prop: Any, state: list[np.ndarray], index: list[list[Any]] | No
 def _exact_integers(arrays: list[np.ndarray]) -> None:
     """Refuse integer arrays a float64 would not hold exactly."""
     for a in arrays:
-        if a.dtype.kind in "iu" and a.size and max(-int(a.min()), int(a.max())) >= 2**53:
+        if a.dtype.kind in "iu" and a.size and max(
+                map(abs, a.ravel().tolist()) if a.size < 64 else (-int(a.min()), int(a.max()))
+        ) >= 2**53:
             raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
 
 

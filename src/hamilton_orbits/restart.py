@@ -40,6 +40,7 @@ Examples
 
 from __future__ import annotations
 
+import keyword
 import types
 from typing import Any
 
@@ -243,6 +244,10 @@ class Capture:
         self.ops: list[tuple[int, int, Any, bool, Any]] = []
         self.usable = True
         self._compile(obj, layout, 0)
+        if self.usable:
+            source, known = self._source()
+            exec(compile(source, f"<capture of {self.root[0].__qualname__}>", "exec"), known)
+            self._take = known["take"]
         #: the positions of the integer arrays among those :meth:`take` returns
         self.ints = [k for k, (code, expect, *_) in enumerate(
             op for op in self.ops if op[0] == _ARR) if expect[2].kind in "iu"]
@@ -266,42 +271,69 @@ class Capture:
     def take(self, obj: Any) -> tuple[list[np.ndarray], list[Any]] | None:
         """The arrays and numbers ``flatten(obj, scalars)`` would give (its layout the
         one this capture was made from), or None where the graph's shape differs."""
-        if not self.usable or type(obj) is not self.root[0] or \
-                obj.__dict__.keys() != self.root[1]:
-            return None
-        slots, arrays, scalars, seen = [obj], [], [], set()
-        for code, expect, parent, key, attr in self.ops:
-            x = getattr(slots[parent], key) if attr else slots[parent][key]
-            slots.append(x)
+        return self._take(obj) if self.usable else None
+
+    def _source(self) -> tuple[str, dict[str, Any]]:
+        """The text of :meth:`take`'s function, written out from :attr:`ops` (one
+        line per read and per check: several times faster than interpreting the
+        steps), and the values it compares against (by name, never as text)."""
+        known: dict[str, Any] = {"np": np, "is_address": is_address, "E": _EXACT,
+                                 "T0": self.root[0], "K0": self.root[1]}
+        lines = ["def take(x0):",
+                 "    if type(x0) is not T0 or x0.__dict__.keys() != K0: return None"]
+        arrays, numbers = [], []
+        for i, (code, expect, parent, key, attr) in enumerate(self.ops, start=1):
+            x, at = f"x{i}", f"x{parent}"
+            if attr and key.isidentifier() and not keyword.iskeyword(key):
+                lines.append(f"    {x} = {at}.{key}")
+            elif type(key) is int:
+                lines.append(f"    {x} = {at}[{key}]")
+            else:
+                known[f"A{i}"] = key
+                lines.append(f"    {x} = getattr({at}, A{i})" if attr else f"    {x} = {at}[A{i}]")
             if code == _ALIAS:
-                if x is not arrays[expect]:
-                    return None
+                lines.append(f"    if {x} is not {arrays[expect]}: return None")
                 continue
-            if type(x) is not expect[0]:
-                return None
+            known[f"T{i}"] = expect[0]
+            lines.append(f"    if type({x}) is not T{i}: return None")
+            lines += _checks(code, expect, x, i, known)
             if code == _ARR:
-                if x.shape != expect[1] or x.dtype != expect[2] or id(x) in seen or (
-                        expect[2] == np.int64 and is_address(x)):
-                    return None
-                seen.add(id(x))
                 arrays.append(x)
-            elif code == _NUM or code == _NPNUM:
-                value = x if code == _NUM else x.item()
-                if expect[1] and not -_EXACT < value < _EXACT:
-                    return None
-                scalars.append(value)
-            elif code == _OBJ or code == _DICT:
-                if x.__dict__.keys() != expect[1] if code == _OBJ else x.keys() != expect[1]:
-                    return None
-            elif code == _SEQ:
-                if len(x) != expect[1]:
-                    return None
-            elif code == _VAL:
-                if not (x is expect[1] or x == expect[1]):
-                    return None
-            elif code == _BUILT and expect[0] is np.ndarray and not is_address(x):
-                return None
-        return arrays, scalars
+            elif code == _NUM:
+                numbers.append(x)
+            elif code == _NPNUM:
+                numbers.append(f"{x}.item()")
+        lines.append(f"    arrays = [{', '.join(arrays)}]")
+        lines.append(f"    if len(set(map(id, arrays))) != {len(arrays)}: return None")
+        lines.append(f"    return arrays, [{', '.join(numbers)}]")
+        return "\n".join(lines) + "\n", known
+
+
+def _checks(code: int, expect: Any, x: str, i: int, known: dict[str, Any]) -> list[str]:
+    """The lines of :meth:`Capture._source` that check value ``x`` of step ``i``
+    beyond its type (what they compare against put in ``known``)."""
+    known[f"V{i}"] = expect[1] if len(expect) > 1 else None
+    if code == _ARR:
+        known[f"D{i}"] = expect[2]
+        out = [f"    if {x}.shape != V{i} or {x}.dtype != D{i}: return None"]
+        if expect[2] == np.int64:
+            out.append(f"    if is_address({x}): return None")
+        return out
+    if code in (_NUM, _NPNUM):
+        value = x if code == _NUM else f"{x}.item()"
+        return [f"    if not -E < {value} < E: return None"] if expect[1] else []
+    if code == _OBJ:
+        return [f"    if {x}.__dict__.keys() != V{i}: return None"]
+    if code == _DICT:
+        return [f"    if {x}.keys() != V{i}: return None"]
+    if code == _SEQ:
+        return [f"    if len({x}) != V{i}: return None"]
+    if code == _VAL:  # (None: its type said it all)
+        return [] if expect[1] is None else [
+            f"    if not ({x} is V{i} or {x} == V{i}): return None"]
+    if expect[0] is np.ndarray:  # (built: an array of compiled functions' addresses)
+        return [f"    if not is_address({x}): return None"]
+    return []
 
 
 def _step(x: Any, node: dict[str, Any]) -> tuple[int, Any]:

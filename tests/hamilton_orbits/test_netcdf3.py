@@ -45,3 +45,9 @@ def test_a_value_of_another_shape_or_size_is_refused():
         buf.fill([good[0], good[1], np.zeros(5, np.int8)])
     with pytest.raises(ValueError, match=r"2 values for a record of 3"):
         buf.fill(good[:2])
+
+
+def test_parts_of_sizes_that_make_up_for_each_other_are_refused():
+    buf = RecordBuffer([np.zeros(3), np.zeros(2)])
+    with pytest.raises(ValueError, match=r"record variable 1: parts of 1 values"):
+        buf.fill([Parts([np.zeros(4)]), Parts([np.zeros(1)])])
