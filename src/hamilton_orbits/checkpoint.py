@@ -462,7 +462,9 @@ class ArchiveWriter:
         simulation's internal time unit: days for a Quantity system), counted from
         ``origin``.
     every_steps : int, optional
-        A snapshot at the first output after every ``every_steps`` steps.
+        A snapshot every ``every_steps`` steps: between two steps for a driver
+        that can pause there (radau15's in double precision), else at the first
+        output after.
     every_wall : float, optional
         A snapshot at the first output after every ``every_wall`` seconds.
     origin : float

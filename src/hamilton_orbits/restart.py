@@ -205,6 +205,9 @@ def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int],
             "attrs": {k: _node(x, arrays, seen, scalars) for k, x in fields.items()}}
 
 
+#: the compiled text of Capture.take's functions, by text (the values it compares
+#: against are bound by name when it is run)
+_CODE: dict[str, types.CodeType] = {}
 # the steps of a Capture: what each node of the layout is
 _OBJ, _SEQ, _DICT, _ARR, _ALIAS, _NUM, _NPNUM, _VAL, _BUILT = range(9)
 _EXACT = 2**53
@@ -244,10 +247,8 @@ class Capture:
         self.ops: list[tuple[int, int, Any, bool, Any]] = []
         self.usable = True
         self._compile(obj, layout, 0)
-        if self.usable:
-            source, known = self._source()
-            exec(compile(source, f"<capture of {self.root[0].__qualname__}>", "exec"), known)
-            self._take = known["take"]
+        self._take: Any = None  # (written out at the first take: a layout met once
+        # costs nothing more)
         #: the positions of the integer arrays among those :meth:`take` returns
         self.ints = [k for k, (code, expect, *_) in enumerate(
             op for op in self.ops if op[0] == _ARR) if expect[2].kind in "iu"]
@@ -271,7 +272,18 @@ class Capture:
     def take(self, obj: Any) -> tuple[list[np.ndarray], list[Any]] | None:
         """The arrays and numbers ``flatten(obj, scalars)`` would give (its layout the
         one this capture was made from), or None where the graph's shape differs."""
-        return self._take(obj) if self.usable else None
+        if not self.usable:
+            return None
+        if self._take is None:
+            source, known = self._source()
+            code = _CODE.get(source)
+            if code is None:  # (the same shape of graph in another leg: compiled once)
+                code = _CODE[source] = compile(source, "<restart.Capture>", "exec")
+                if len(_CODE) > 64:
+                    del _CODE[next(iter(_CODE))]
+            exec(code, known)
+            self._take = known["take"]
+        return self._take(obj)
 
     def _source(self) -> tuple[str, dict[str, Any]]:
         """The text of :meth:`take`'s function, written out from :attr:`ops` (one

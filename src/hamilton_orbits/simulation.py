@@ -102,7 +102,10 @@ class Simulation(Saving):
     every : Quantity or float, optional
         A snapshot at every multiple of this much simulation time;
     every_steps : int, optional
-        or at the first output after every so many steps;
+        or every so many steps: radau15 (double precision, without the
+        variational equations) takes it between two steps, at the end of every
+        ``every_steps``-th, its steps unchanged; the other methods at the first
+        output after;
     every_wall : float, optional
         or at the first output after every so many seconds of wall-clock time.
     exact_times : bool, optional
