@@ -29,14 +29,12 @@ from hamilton_orbits.checkpoint import (
     last_snapshot,
     leg_rows,
     on_step_grid,
-    record,
     snapshot_at,
-    spec,
-    state_values,
 )
 from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
+from hamilton_orbits.simulation_record import record, spec, state_values
 from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory
 
