@@ -210,7 +210,8 @@ class RecordBuffer:
                     parts += [a.reshape(-1) for a in x]
                 else:
                     x = self._shaped(k, x)
-                    parts.append(x.reshape(-1) if type(x) is np.ndarray else np.ravel(x))
+                    parts.append(x.reshape(-1) if type(x) is np.ndarray or type(x) is np.float64
+                                 else np.ravel(x))
             try:  # (the other values' shapes checked, parts of a wrong size change the run's)
                 np.concatenate(parts, out=self.views[first].reshape(-1) if flat is None
                                else flat, casting="unsafe")

@@ -138,8 +138,11 @@ def _stored(name: str, value: Any) -> np.ndarray:
     """A record variable's values as the file can store them (cast into the record by
     :class:`~hamilton_orbits._netcdf3.RecordBuffer`): integers checked below 2**53,
     other types than float and bool refused (:func:`~hamilton_orbits.snapshot.stored`)."""
-    if type(value) is Parts or (type(value) is int and abs(value) < 2**53):
-        return value  # (the parts of a record variable, checked; a step count)
+    kind = type(value)
+    if kind is Parts or (kind is np.ndarray and value.dtype.kind in "fb"):
+        return value  # (parts of a record variable, checked: cast when it is filled)
+    if kind is int and abs(value) < 2**53:
+        return np.float64(value)  # (a step count)
     a = np.asarray(value)
     return a if a.dtype.kind in "fb" else stored(name, a)[0]
 
