@@ -248,6 +248,24 @@ class Trajectory(TrajectoryBase):
         """The row of :attr:`events` of the event that ended the run, or None."""
         return self._tables[1]
 
+    def covariance(self, cov0: Any) -> np.ndarray:
+        """Each body's covariance of ``(x, y, z, vx, vy, vz)`` at every output, the
+        initial one ``cov0`` (``(6, 6)`` for every body or ``(n, 6, 6)``, floats in
+        the state's units: au and au/day for a Quantity system) mapped through
+        :attr:`stm` to first order (:func:`hamilton_orbits.covariance.propagate`):
+        shape ``(n_t, n, 6, 6)``.
+
+        Raises
+        ------
+        ValueError
+            Without the STM (integrate with ``stm=True``), or for a bad ``cov0``.
+        """
+        from hamilton_orbits.covariance import propagate
+
+        if self.stm is None:
+            raise ValueError("covariance() maps through the STM: integrate with stm=True")
+        return propagate(self.stm, cov0, len(self.names))
+
     def plot(self, plane: str = "xy", ax: Any = None) -> Any:
         """Every body's path about the primary, its start (with the direction of
         motion) and its end: a matplotlib Figure

@@ -1,0 +1,88 @@
+"""Covariance of the bodies' states mapped through the state transition matrix.
+
+To first order in a small deviation ``d(r, v)(0)`` of the initial state, the
+deviation at time ``t`` is ``Phi(t) d(r, v)(0)``, ``Phi`` the state transition
+matrix of the variational equations (:attr:`Trajectory.stm`); an initial
+covariance ``C0`` of the state is therefore carried to ``Phi(t) C0 Phi(t)^T``
+(the linear covariance propagation of orbit determination: e.g. Montenbruck &
+Gill, *Satellite Orbits*, 2000, sec. 7.2.1, eq. 7.28; Milani & Gronchi, *Theory
+of Orbit Determination*, 2010, sec. 5.2).  The bodies' initial errors are taken
+independent of each other (a block-diagonal ``C0``); each body's 6 x 6 block at
+``t`` sums what every body's initial error contributes to it through the
+gravitational coupling.
+
+Examples
+--------
+>>> import numpy as np
+>>> phi = np.tile(np.eye(6), (2, 1, 1))          # no motion: Phi = 1 at both times
+>>> phi[1, 0, 3] = 10.0                          # x(t) = x0 + 10 vx0
+>>> c0 = np.diag([1e-12, 0, 0, 1e-16, 0, 0])
+>>> c = propagate(phi, c0, 1)
+>>> c.shape, float(c[1, 0, 0, 0])                # 1e-12 + 10**2 1e-16
+((2, 1, 6, 6), 1.01e-12)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["propagate"]
+
+
+def propagate(stm: np.ndarray, cov0: Any, n: int) -> np.ndarray:
+    """Each body's covariance of ``(x, y, z, vx, vy, vz)`` at every output time.
+
+    Parameters
+    ----------
+    stm : ndarray, shape (n_t, 6n, 6n)
+        The state transition matrix at each output time, coordinates body by body.
+    cov0 : array_like, shape (6, 6) or (n, 6, 6)
+        The initial covariance of every body's state (the same for each), or one
+        per body, symmetric and positive semi-definite, in the units of the
+        state (au and au/day for a Quantity system); the bodies' errors are
+        independent of each other.
+    n : int
+        The number of bodies.
+
+    Returns
+    -------
+    ndarray, shape (n_t, n, 6, 6)
+        ``C_i(t) = sum_j Phi_ij(t) C0_j Phi_ij(t)^T``, symmetrised.
+
+    Raises
+    ------
+    ValueError
+        For a ``cov0`` of another shape, not finite, not symmetric or not positive
+        semi-definite, naming the body and the value.
+    """
+    c0 = _checked(cov0, n)
+    phi = np.asarray(stm, dtype=np.float64).reshape(stm.shape[0], n, 6, n, 6)
+    out = np.einsum("tiajb,jbc,tidjc->tiad", phi, c0, phi, optimize=True)
+    return 0.5 * (out + np.swapaxes(out, -1, -2))
+
+
+def _checked(cov0: Any, n: int) -> np.ndarray:
+    """``cov0`` as (n, 6, 6) floats, checked."""
+    if hasattr(cov0, "unit"):
+        raise ValueError("Expected `cov0` as floats in the state's units (au and au/day "
+                         "for a Quantity system): its blocks mix units, got a Quantity")
+    c0 = np.asarray(cov0, dtype=np.float64)
+    if c0.shape == (6, 6):
+        c0 = np.broadcast_to(c0, (n, 6, 6))
+    if c0.shape != (n, 6, 6):
+        raise ValueError(f"Expected `cov0` of shape (6, 6) or ({n}, 6, 6), got {c0.shape}")
+    for i, c in enumerate(c0):
+        scale = float(np.max(np.abs(c)))
+        if not np.isfinite(c).all():
+            raise ValueError(f"Expected `cov0` finite, got {c.tolist()} for body {i}")
+        asym = float(np.max(np.abs(c - c.T)))
+        if asym > 1e-12 * scale:
+            raise ValueError(f"Expected `cov0` symmetric, got a difference of {asym:.3g} "
+                             f"between its transposed entries for body {i}")
+        low = float(np.linalg.eigvalsh(0.5 * (c + c.T))[0])
+        if low < -1e-12 * scale:
+            raise ValueError(f"Expected `cov0` positive semi-definite, got an eigenvalue "
+                             f"{low:.3g} for body {i}")
+    return c0
