@@ -101,3 +101,38 @@ def test_the_bundled_scene_is_the_top_rung():
     assert result.diagnostics["de440_years"][-1] == 10
     assert km[-1, BODIES.index("mercury")] < 0.1 and km[-1, BODIES.index("moon")] < 2.0
     assert result.times[-1].to_value(u.yr) == 10.0
+
+
+def test_residuals_are_taken_at_the_runs_own_dates():
+    """Positions are compared with DE440 at the start's epoch plus the years (issue
+    35 item 7: a run started in 1950 was compared with the J2000 table).  DE440's
+    own J2000 states, as a run started ten years before J2000 would hold them ten
+    years on, have no residual; the same states as year 10 of a run started at
+    J2000 have residuals of the size of the orbits."""
+    from hamilton_orbits import System
+    from hamilton_orbits import ephemeris as de
+
+    s = System.from_ephemeris()
+    r = s.r.value[None]
+    km, _ = ladder.residuals(s.names, r, np.array([10]), start_jd=de.J2000_JD - 3652.5)
+    assert float(km.max()) < 1e-6
+    km, _ = ladder.residuals(s.names, r, np.array([10]))
+    assert float(km[0, ladder.BODIES.index("mars")]) > 1e7
+
+
+def test_residuals_at_dates_the_package_does_not_ship_need_the_extra():
+    from hamilton_orbits import System
+    from hamilton_orbits import ephemeris as de
+
+    s = System.from_ephemeris()
+    start = de.J2000_JD - 18262.5  # 1950, as the issue's run
+    if de.kernel_available():  # (the extra installed: DE440's kernel at those dates)
+        from astropy.time import Time
+
+        then = System.from_ephemeris(epoch=Time(start + 365.25, format="jd", scale="tdb"))
+        km, _ = ladder.residuals(then.names, then.r.value[None], np.array([1]),
+                                 start_jd=start)
+        assert float(km.max()) < 1e-6
+    else:
+        with pytest.raises(ValueError, match=r"needs the kernel: .*hamilton-orbits\[ephemeris\]"):
+            ladder.residuals(s.names, s.r.value[None], np.array([1]), start_jd=start)

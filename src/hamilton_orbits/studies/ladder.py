@@ -99,11 +99,14 @@ class RungResult:
     steps: int
 
 
-def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray, frame: str = "icrs"
-              ) -> tuple[np.ndarray, np.ndarray]:
+def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray, frame: str = "icrs",
+              start_jd: float = de.J2000_JD) -> tuple[np.ndarray, np.ndarray]:
     """Residuals (km, arcsec) of simulated barycentric positions ``r`` (n_t, n, 3), au,
-    on the axes of ``frame`` (:func:`hamilton_orbits.frames.frame_rotation`), at whole
-    Julian ``years`` against DE440's shipped reference (turned onto those axes).
+    on the axes of ``frame`` (:func:`hamilton_orbits.frames.frame_rotation`), at
+    ``years`` (Julian years) after the run's start ``start_jd`` (TDB Julian date)
+    against DE440 at those dates (turned onto those axes): its shipped table at
+    J2000 and whole years after, the ``[ephemeris]`` extra's kernel at any other
+    date (a ValueError naming the extra without it).
 
     Examples
     --------
@@ -112,13 +115,14 @@ def residuals(names: Sequence[str], r: np.ndarray, years: np.ndarray, frame: str
     >>> km, arcsec = residuals(s.names, s.r.value[None], np.array([0]))
     >>> float(km.max()) < 1e-6
     True
+    >>> km, _ = residuals(s.names, s.r.value[None], np.array([10]),  # (started 1990)
+    ...                   start_jd=de.J2000_JD - 3652.5)
+    >>> float(km.max()) < 1e-6
+    True
     """
-    _, ref_names, ref = de.reference_table()
-    ref = ref[np.asarray(years, dtype=int)]
-    if frame != "icrs":
-        from hamilton_orbits.frames import frame_rotation
-
-        ref = ref @ frame_rotation(frame).T  # v_frame = M v_icrs, row by row
+    _, ref_names, _ = de.reference_table()
+    jd = start_jd + 365.25 * np.asarray(years, dtype=np.float64)
+    ref = de.heliocentric_positions(jd, ref_names, frame)
     au_km = de.constant("AU")
     idx = {n: k for k, n in enumerate(names)}
     helio = r - r[:, idx["sun"]][:, None, :]

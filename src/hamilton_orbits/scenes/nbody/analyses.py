@@ -143,19 +143,23 @@ def _close_approach(result: Result, system, an: dict) -> None:
 
 
 def _de440_residuals(result: Result, system, an: dict) -> None:
-    """The positions against DE440's at the whole years from J2000 among the outputs:
-    km and arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100
-    years (those reached), and a figure of the residual against time."""
+    """The positions against DE440's at the whole years from the start among the
+    outputs, at the run's own dates (the start's epoch plus those years): km and
+    arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100 years
+    (those reached), and a figure of the residual against time."""
+    from hamilton_orbits import ephemeris as de
     from hamilton_orbits.studies.ladder import BODIES, residuals
 
-    years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start (J2000)
+    years = result.times.to_value(u.yr)  # Julian years of 365.25 d from the start
     whole = np.flatnonzero(np.abs(years - np.round(years)) < 1e-9)
-    if result.scene.spec["initial"].get("ephemeris") is None or len(whole) < 2:
+    start = result.scene.spec["initial"].get("ephemeris")
+    if start is None or len(whole) < 2:
         result.metrics["DE440 residuals"] = "need [initial] ephemeris and yearly outputs"
         return
     r = result.states["r"].to_value(u.au)[whole]
     yrs = np.round(years[whole]).astype(int)
-    km, arcsec = residuals(system.names, r, yrs, frame=scene_frame(result.scene.spec))
+    km, arcsec = residuals(system.names, r, yrs, frame=scene_frame(result.scene.spec),
+                           start_jd=de.epoch_jd(start["epoch"]))
     result.diagnostics["de440_years"] = yrs
     result.diagnostics["de440_km"] = km
     rows = []

@@ -19,8 +19,8 @@ ANALYSES = {
     "perihelion_advance": "secular rate of the longitude of perihelion of `body` about `primary`",
     "nodal_regression": "secular rate of the node of `body` about `primary`, beside the J2 formula",
     "close_approach": "the smallest distance between `body` and `other`, and when",
-    "de440_residuals": "the positions against JPL's DE440 at whole years from J2000 (needs "
-                       "[initial] ephemeris)",
+    "de440_residuals": "the positions against JPL's DE440 at whole years from the start, "
+                       "at the run's own dates (needs [initial] ephemeris)",
 }
 # the keys of each analysis besides its name: (required, optional)
 ANALYSIS_KEYS = {
