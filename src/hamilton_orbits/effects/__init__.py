@@ -42,12 +42,13 @@ energy, and its kernel and Jacobian (imported there from
 - ``effects.moon_figure``: ``moon_figure``
 - ``effects.tides``: ``earth_tides``
 - ``effects.kuiper_ring``: ``kuiper_ring`` (and ``kuiper_ring_gm``)
+- ``effects.nongrav``: ``nongrav`` (and ``COMET_G``)
 
 Examples
 --------
 >>> known("nbody")  # doctest: +NORMALIZE_WHITESPACE
 ('earth_tides', 'eih', 'gr', 'gr_potential', 'j2', 'kuiper_ring', 'lense_thirring',
- 'moon_figure', 'newtonian', 'zonal')
+ 'moon_figure', 'newtonian', 'nongrav', 'zonal')
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ from hamilton_orbits.effects import (
     lense_thirring,
     moon_figure,
     newtonian,
+    nongrav,
     relativity,
     tides,
     zonal,
@@ -110,5 +112,6 @@ BUILT_IN: tuple[EffectSpec, ...] = (
     *moon_figure.SPECS,
     *tides.SPECS,
     *kuiper_ring.SPECS,
+    *nongrav.SPECS,
 )
 _ = [register(spec) for spec in BUILT_IN]

@@ -42,6 +42,7 @@ import numpy as np
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits.units import (
+    ACCELERATION,
     ANGLE,
     ANGULAR_SPEED,
     DIMENSIONLESS,
@@ -116,7 +117,7 @@ SPECIFIC_ANGULAR_MOMENTUM = Kind("an angular momentum per unit mass", "m2 / s")
 #: converted; a system of plain floats takes bare numbers in its own units.
 SYSTEM_UNITS: dict[Kind, str] = {
     LENGTH: "au", SPEED: "au / d", TIME: "d", GM: "au3 / d2", ANGULAR_SPEED: "rad / d",
-    SPECIFIC_ANGULAR_MOMENTUM: "au2 / d",
+    SPECIFIC_ANGULAR_MOMENTUM: "au2 / d", ACCELERATION: "au / d2",
 }
 
 

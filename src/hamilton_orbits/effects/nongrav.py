@@ -1,0 +1,106 @@
+"""The effect ``nongrav``: comets' and asteroids' non-gravitational accelerations.
+
+Marsden, Sekanina & Yeomans (1973), AJ 78, 211, eq. (1)-(2): a body's acceleration
+relative to the centre (the Sun) ``g(r) (A1 r^ + A2 t^ + A3 n^)``, radial,
+transverse (in the orbit's plane, along the motion) and normal (along ``r x v``),
+with ``g(r) = alpha (r / r0)^-m (1 + (r / r0)^n)^-k``.  The default ``g`` is the
+asteroid form of JPL's small-body solutions, ``(1 au / r)^2`` (``alpha = 1``,
+``r0 = 1 au``, ``m = 2``, ``n = k = 0``), the form of a Yarkovsky ``A2``; the
+comet form of the paper (water-ice sublimation) is ``alpha = 0.1112620426``,
+``r0 = 2.808 au``, ``m = 2.15``, ``n = 5.093``, ``k = 4.6142``
+(:data:`COMET_G`).  Nothing acts back on the centre (the momentum leaves with the
+gas or the photons), so the system's energy and momentum are not conserved.
+
+Kernel :func:`~hamilton_orbits._kernels.nongrav.nongrav`; no analytic Jacobian
+(the variational equations differentiate the kernel by compiled central
+differences, :mod:`hamilton_orbits.rhs`); velocity dependent.  ``p = [centre,
+m, then per body: index, A1, A2, A3, alpha, r0, m, n, k]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits._kernels.nongrav import nongrav
+from hamilton_orbits.effects.parameters import body_index, parameter_array, scalar_parameter
+from hamilton_orbits.effects.registry import EffectSpec
+from hamilton_orbits.units import ACCELERATION, DIMENSIONLESS, LENGTH
+
+__all__ = ["COMET_G", "SPECS"]
+
+#: Marsden, Sekanina & Yeomans (1973), eq. (2): g(r) of water-ice sublimation,
+#: normalised to g(1 au) = 1
+COMET_G = {"alpha": 0.1112620426, "r0": 2.808, "m": 2.15, "n": 5.093, "k": 4.6142}
+MSY_1973 = "Marsden, Sekanina & Yeomans (1973), AJ 78, 211, eq. (1)-(2)"
+
+
+def _bodies(system: Any, params: Mapping[str, Any]) -> list[int]:
+    names = params.get("body")
+    if names is None:
+        raise ValueError("Effect 'nongrav': expected `body`, the body (or a list of the "
+                         "bodies) it acts on")
+    names = [names] if isinstance(names, str) else list(names)
+    out = [body_index(system, {"body": n}, "body", "", "nongrav") for n in names]
+    for k, b in enumerate(out):
+        if out.index(b) != k:
+            raise ValueError(f"Effect 'nongrav': expected each body once in `body`, got "
+                             f"{names[k]!r} twice (at indices {out.index(b)} and {k})")
+    return out
+
+
+def _coefficients(system: Any, params: Mapping[str, Any], n: int) -> np.ndarray:
+    """A1, A2, A3 of each of ``n`` bodies, (n, 3), in the system's units."""
+    out = np.zeros((n, 3))
+    for j, key in enumerate(("A1", "A2", "A3")):
+        value = parameter_array(system, params, key, "nongrav", ACCELERATION)
+        if value is None:
+            continue
+        if value.shape not in ((), (n,)):
+            raise ValueError(f"Effect 'nongrav': expected `{key}` to be one value or {n} "
+                             f"(one per body), got {params[key]!r}")
+        out[:, j] = value
+    return out
+
+
+def _params_nongrav(system: Any, params: Mapping[str, Any]) -> np.ndarray:
+    centre = body_index(system, params, "centre", "sun", "nongrav")
+    bodies = _bodies(system, params)
+    if centre in bodies:
+        raise ValueError(f"Effect 'nongrav': the centre {system.names[centre]!r} cannot be "
+                         f"one of the bodies it acts on")
+    a = _coefficients(system, params, len(bodies))
+    form = [scalar_parameter(system, params, "alpha", "nongrav", DIMENSIONLESS, 1.0,
+                             positive=True),
+            scalar_parameter(system, params, "r0", "nongrav", LENGTH, 1.0,  # (1 au, or 1
+                             positive=True)]  # in the units of a system of plain floats)
+    form += [scalar_parameter(system, params, key, "nongrav", DIMENSIONLESS, default,
+                              nonnegative=True)
+             for key, default in (("m", 2.0), ("n", 0.0), ("k", 0.0))]
+    rows = [[b, *a[j], *form] for j, b in enumerate(bodies)]
+    return np.array([centre, len(bodies), *np.ravel(rows)], dtype=np.float64)
+
+
+SPECS = (
+    EffectSpec(
+        name="nongrav", kind="nbody",
+        summary="non-gravitational accelerations A1, A2, A3 g(r) of comets and asteroids "
+                "(Marsden, Sekanina & Yeomans 1973)",
+        velocity_dependent=True,
+        parameters={"body": "the body it acts on (a list of them outside scenes)",
+                    "A1": "radial acceleration at r0, an acceleration (default 0)",
+                    "A2": "transverse acceleration at r0 (default 0)",
+                    "A3": "normal acceleration at r0 (default 0)",
+                    "centre": "default 'sun'",
+                    "alpha": "g's scale, default 1", "r0": "a length, default 1 au",
+                    "m": "default 2", "n": "default 0", "k": "default 0"},
+        kernel=nongrav, params=_params_nongrav,
+        parameter_kinds={"A1": ACCELERATION, "A2": ACCELERATION, "A3": ACCELERATION,
+                         "r0": LENGTH, "alpha": DIMENSIONLESS, "m": DIMENSIONLESS,
+                         "n": DIMENSIONLESS, "k": DIMENSIONLESS},
+        name_parameters=("body", "centre"),
+        reference=MSY_1973,
+    ),
+)

@@ -1,0 +1,135 @@
+"""The effect ``nongrav``: Marsden, Sekanina & Yeomans (1973) A1, A2, A3 g(r).
+
+References are closed-form solutions of a massless body about a unit-GM Sun at
+rest, with g = (1 / r)^2 (the asteroid form) on a circular orbit of radius 1:
+- A1 (radial) is a weaker Sun, GM' = 1 - A1: the circle of that GM stays exact;
+- A2 (transverse) drifts the semi-major axis by Gauss's equation,
+  da/dt = 2 A2 g / n = 2 A2 a^-1/2, so a(t) = (1 + 3 A2 t)^(2/3);
+- A3 (normal) lifts the orbit out of its plane, z(t) = A3 (1 - cos t) to first order.
+"""
+
+from __future__ import annotations
+
+import astropy.units as u
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits._kernels.nongrav import nongrav
+from hamilton_orbits.effects.nongrav import COMET_G
+
+
+def _circle(speed: float = 1.0) -> System:
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                   Body("rock", 0.0, [1.0, 0, 0], [0, speed, 0])])
+
+
+def _run(effect: dict, times, speed: float = 1.0, **kw):
+    return Simulation(_circle(speed), method="radau15",
+                      effects=[{"name": "nongrav", "body": "rock", **effect}], **kw
+                      ).integrate(times)
+
+
+def test_a_radial_acceleration_is_a_weaker_sun():
+    a1 = 1e-3
+    w = np.sqrt(1.0 - a1)
+    t = np.linspace(0.0, 10.0, 6)
+    traj = _run({"A1": a1}, t, speed=w)
+    circle = np.stack([np.cos(w * t), np.sin(w * t), 0 * t], axis=1)
+    assert np.abs(traj.r[:, 1] - circle).max() < 1e-12  # (radau15's error on a circle)
+
+
+def test_a_transverse_acceleration_drifts_the_semi_major_axis_as_gauss_says():
+    a2 = 1e-6
+    t = np.linspace(0.0, 200.0, 41)  # 32 orbits
+    traj = _run({"A2": a2}, t)
+    r = np.linalg.norm(traj.r[:, 1], axis=1)
+    a = 1.0 / (2.0 / r - np.sum(traj.v[:, 1] ** 2, axis=1))
+    want = (1.0 + 3.0 * a2 * t) ** (2.0 / 3.0)
+    # the osculating a oscillates about the mean drift by O(A2 / n^2) relative to it
+    assert np.abs(a - want).max() < 1e-6 * (want[-1] - 1.0)
+    slower = _run({"A2": -a2}, t)  # (an Apophis-like negative A2 shrinks the orbit)
+    assert np.linalg.norm(slower.v[-1, 1]) > np.linalg.norm(traj.v[-1, 1])
+
+
+def test_a_normal_acceleration_lifts_the_orbit_out_of_its_plane():
+    a3 = 1e-6
+    t = np.linspace(0.0, 2 * np.pi, 9)
+    traj = _run({"A3": a3}, t)
+    # first order in A3: the relative error is O(A3)
+    np.testing.assert_allclose(traj.r[:, 1, 2], a3 * (1 - np.cos(t)), rtol=0,
+                               atol=1e-6 * 2 * a3)
+
+
+def test_the_comet_form_of_g_is_normalised_at_one_au():
+    """Marsden et al. (1973) chose alpha so that g(1 au) = 1; the kernel applies
+    A1 g(r) along r^ (here at 1 and 3 au, pure A1)."""
+    p = [0, 1, 1, 1.0, 0.0, 0.0, *(COMET_G[k] for k in ("alpha", "r0", "m", "n", "k"))]
+    for d, g in ((1.0, 1.0000000023534097), (3.0, 0.0016973748092543766)):
+        r = np.array([[0.0, 0, 0], [0, d, 0]])
+        acc = np.zeros((2, 3))
+        nongrav(r, np.zeros((2, 3)), np.array([1.0, 0.0]), acc, np.array(p, dtype=float))
+        np.testing.assert_allclose(acc[1], [0, g, 0], rtol=1e-15)
+        assert not acc[0].any()  # (nothing acts back on the Sun)
+    assert abs(1.0000000023534097 - 1.0) < 1e-8
+
+
+def test_a_quantity_system_takes_accelerations_with_units():
+    gm_sun = 1.32712440018e11 * u.km**3 / u.s**2
+    s = System([Body("sun", gm_sun, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                Body("apophis", 0 * gm_sun, [0.92, 0, 0] * u.au, [0, 31.0, 0] * u.km / u.s)])
+    kw = dict(method="radau15")
+    plain = Simulation(s, **kw).integrate([0, 3650] * u.day)
+    pushed = Simulation(s, effects=[{"name": "nongrav", "body": "apophis",
+                                     "A2": "-2.9e-14 au/day2"}], **kw).integrate(
+        [0, 3650] * u.day)
+    shift = np.linalg.norm((pushed.r[-1, 1] - plain.r[-1, 1]).to_value(u.km))
+    # Gauss: da/dt = 2 A2 g / n on this near-circular orbit, so the mean longitude
+    # falls behind by (3/4) (n / a) (da/dt) t^2: about 102 km after ten years (the
+    # radial part, da t, is 2 km of it)
+    a = 0.92
+    n = np.sqrt(s.gm[0].to_value(u.au**3 / u.day**2) / a**3)
+    dadt = 2 * 2.9e-14 * a**-2 / n
+    along = 0.75 * (n / a) * dadt * 3650.0**2 * a * u.au.to(u.km)
+    assert abs(shift - along) < 0.03 * along, (shift, along)
+
+
+def test_the_variational_equations_follow_the_effect():
+    """The STM (central differences of the kernel) against finite differences of
+    whole runs, to the accuracy of a difference quotient."""
+    eff = [{"name": "nongrav", "body": "rock", "A1": 1e-4, "A2": 3e-5, "A3": 2e-5}]
+    times = [0.0, 5.0]
+    traj = Simulation(_circle(), method="radau15", effects=eff, variational=True,
+                      stm=True).integrate(times)
+    h = 1e-7
+    for k, axis in [(1, 0), (1, 1)]:  # d / dx0, d / dy0 of the rock
+        runs = []
+        for sign in (1, -1):
+            s = _circle()
+            r0 = np.array(s.r)
+            r0[k, axis] += sign * h
+            moved = System([Body(n, g, rr, vv) for n, g, rr, vv in
+                            zip(s.names, s.gm, r0, s.v, strict=True)])
+            runs.append(Simulation(moved, method="radau15", effects=eff).integrate(times))
+        fd = (runs[0].r[-1, 1] - runs[1].r[-1, 1]) / (2 * h)
+        np.testing.assert_allclose(traj.stm[-1, 6:9, 6 + axis], fd, rtol=1e-6, atol=1e-8)
+
+
+@pytest.mark.parametrize(("effect", "match"), [
+    ({}, r"expected `body`"),
+    ({"body": "comet"}, r"comet"),
+    ({"body": "sun"}, r"the centre 'sun' cannot be one of the bodies"),
+    ({"body": ["rock", "rock"]}, r"each body once .* 'rock' twice"),
+    ({"body": "rock", "A2": [1e-8, 2e-8]}, r"`A2` to be one value or 1"),
+    ({"body": "rock", "r0": -1.0}, r"r0"),
+    ({"body": "rock", "A1": float("nan")}, r"A1"),
+])
+def test_bad_parameters_are_refused_naming_them(effect, match):
+    with pytest.raises(ValueError, match=match):
+        Simulation(_circle(), method="radau15", effects=[{"name": "nongrav", **effect}])
+
+
+def test_a_symplectic_map_refuses_it():
+    with pytest.raises(ValueError, match=r"nongrav"):
+        Simulation(_circle(), method="wh", dt=0.01,
+                   effects=[{"name": "nongrav", "body": "rock", "A2": 1e-8}])
