@@ -52,7 +52,7 @@ from hamilton_orbits.integrators import (
     method_of,
 )
 from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
-from hamilton_orbits.rhs import RHS
+from hamilton_orbits.rhs import RHS, time_reversed
 
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
@@ -200,9 +200,6 @@ class Propagation:
 
     def _check(self, backward: bool) -> None:
         watched = self.events is not None and len(self.events.watch)
-        if backward and self.rhs.velocity_dependent:
-            raise ValueError("Backward integration with a velocity-dependent effect is not "
-                             "supported; integrate forwards from the final state")
         if self.variational is not None and (backward or watched):
             raise ValueError("The variational equations are integrated forwards in time and "
                              "without events; integrate forwards, with no events listed")
@@ -225,8 +222,10 @@ class Propagation:
         # last watched pair has gone with them
         log = self.events if watched or (self.events is not None and self.events.gone
                                          and not backward) else None
+        # backwards: the motion in s = -t, on w = -v (its effects at the velocity -w)
         self.driver = self.module.start(
-            self.rhs, self.r, -self.v if backward else self.v, self.gm, sign * self.t,
+            time_reversed(self.rhs) if backward else self.rhs, self.r,
+            -self.v if backward else self.v, self.gm, sign * self.t,
             self.method, dt=self.dt, tol=self.tol, events=log, variational=self.variational)
         self.backward = backward
         return self.driver
@@ -264,6 +263,8 @@ class Propagation:
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
         r_out, v_out = rows[0], rows[1]
         r_out[0], v_out[0] = self.r, self.v
+        if backward:  # (stored as the driver's rows are, turned back below with them)
+            np.negative(v_out[0], out=v_out[0])
         if events is not None:
             events.mask(r_out[0], v_out[0])
         if self.variational is not None:

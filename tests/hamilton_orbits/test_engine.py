@@ -78,3 +78,25 @@ def test_dop853_stops_at_a_non_finite_acceleration_instead_of_looping():
     with pytest.raises(ConvergenceError, match=r"dop853 stopped at t = 0.0: the acceleration "
                                                r"became non-finite"):
         prop.advance(np.array([0.0, 1.0]))
+
+
+@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="wh", dt=0.01),
+                                dict(method="leapfrog", dt=0.01), dict(method="dop853")],
+                         ids=["radau15", "wh", "leapfrog", "dop853"])
+def test_a_backward_legs_first_row_is_the_state_it_starts_from(kw):
+    """The first output of a backward leg is the state it starts from, velocity
+    included (it came out negated: the driver's reversed velocities are turned back
+    row by row, and the first row was not reversed)."""
+    from hamilton_orbits import Body, Simulation, System
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("rock", 0.0, [1.0, 0, 0.1], [0, 1.05, 0.02])])
+    back = Simulation(s, **kw).integrate([0.0, -1.0])
+    assert np.array_equal(back.v[0], np.asarray(s.v)) and np.array_equal(back.r[0],
+                                                                         np.asarray(s.r))
+    assert np.abs(back.angular_momentum_error).max() < 1e-12
+    sim = Simulation(s, **kw)
+    there = sim.integrate(1.0)
+    again = sim.integrate(0.0)
+    assert np.array_equal(again.v[0], there.v[-1]) and np.array_equal(again.r[0],
+                                                                       there.r[-1])

@@ -80,7 +80,7 @@ from hamilton_orbits.rhs.diskcache import (
 
 __all__ = ["RHS", "STALE_AGE_SECONDS", "cache_dir", "check_ref", "compile_rhs", "kernel_ref",
            "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "source",
-           "tangent_kernels_for", "tangent_source"]
+           "tangent_kernels_for", "tangent_source", "time_reversed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -225,6 +225,37 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
                tangent_extra if eff else None, augmented)
 
 
+def time_reversed(rhs: RHS) -> RHS:
+    """The right-hand side of the time-reversed motion of ``rhs`` (the same effects
+    and parameters), which a backward run integrates forwards in ``s = -t`` on the
+    velocities ``w = -v``: ``d2r/ds2 = a(r, -w)``, the effects evaluated at the true
+    velocity (:func:`~hamilton_orbits.rhs.codegen.source`, ``reverse``).  ``rhs``
+    itself when no effect depends on velocities (``a(r, -w) = a(r, w)``).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+    >>> rhs = compile_rhs(s, [{"name": "nongrav", "body": "b", "A2": 1e-3}])
+    >>> r, v, gm = np.array(s.r), np.array(s.v), np.array(s.gm)
+    >>> back = time_reversed(rhs).acceleration(r, -v, gm)  # (at w = -v)
+    >>> bool(np.array_equal(back, rhs.acceleration(r, v, gm)))
+    True
+    """
+    if not rhs.velocity_dependent:
+        return rhs
+    specs = [get("nbody", name) for name in rhs.effects[1:]]
+    kernels = tuple(spec.kernel for spec in specs)
+    key = (tuple(kernel_ref(k) for k in kernels),
+           any(spec.replaces_newtonian for spec in specs), None, "reversed")
+    with _LOCK:
+        found = _MEMO.get(key)
+        if found is None:
+            found = _build(key, kernels)
+            _MEMO[key] = found
+    return RHS(*found, rhs.p, rhs.velocity_dependent, rhs.effects)
+
+
 _MEMO: dict[tuple, tuple[Any, Any]] = {}
 _LOCK = threading.Lock()
 _SWEPT: set[str] = set()  # the cache folders this process has removed stale files from
@@ -286,13 +317,16 @@ def _build(key: tuple, kernels: tuple[Any, ...],
            jacobians: tuple[Any, ...] | None = None) -> tuple[Any, ...]:
     refs, replaces_newtonian = key[:2]
     jac_refs = key[2] if len(key) > 2 else None
+    reverse = key[3:] == ("reversed",)
     sources = module_sources(refs, replaces_newtonian, jac_refs)
     folder = cache_dir() if sources is not None else None
     if folder is None:
-        namespace = _in_memory(refs, replaces_newtonian, kernels, jac_refs, jacobians)
+        namespace = _in_memory(refs, replaces_newtonian, kernels, jac_refs, jacobians,
+                               reverse)
     else:
-        name = digest(refs, replaces_newtonian, jac_refs, sources)
-        text = source(refs, replaces_newtonian, name, jac_refs, sources=sources)
+        name = digest(refs, replaces_newtonian, jac_refs, sources, reverse)
+        text = source(refs, replaces_newtonian, name, jac_refs, sources=sources,
+                      reverse=reverse)
         namespace = vars(load_module(folder / f"{MODULE_PREFIX}{name}.py", text))
         if str(folder) not in _SWEPT:
             _SWEPT.add(str(folder))
@@ -303,9 +337,11 @@ def _build(key: tuple, kernels: tuple[Any, ...],
 
 
 def _in_memory(refs: tuple, replaces_newtonian: bool, kernels: tuple[Any, ...],
-               jac_refs: tuple | None = None, jacobians: tuple | None = None) -> dict[str, Any]:
+               jac_refs: tuple | None = None, jacobians: tuple | None = None,
+               reverse: bool = False) -> dict[str, Any]:
     """The same source compiled for this process only (no disk cache); its namespace."""
-    text = source(refs, replaces_newtonian, "in-memory", jac_refs, cache=False, imports=False)
+    text = source(refs, replaces_newtonian, "in-memory", jac_refs, cache=False, imports=False,
+                  reverse=reverse)
     namespace: dict[str, Any] = {f"k{i}": k for i, k in enumerate(kernels)}
     namespace.update({f"j{i}": j for i, j in enumerate(jacobians or ()) if j is not None})
     namespace["__name__"] = f"{MODULE_PREFIX}in_memory"

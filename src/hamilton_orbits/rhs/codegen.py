@@ -96,7 +96,7 @@ ${imports}
 
 @njit(ACCEL_SIGNATURE, cache=$cache, error_model='numpy')
 def extra(r, v, gm, acc, p):  # pragma: no cover - compiled
-${calls}
+${reverse}${calls}
 
 
 @njit(ACCEL_SIGNATURE, cache=$cache, error_model='numpy')
@@ -168,9 +168,15 @@ def _checked(refs: tuple, jac_refs: tuple | None) -> None:
 
 def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: str,
            jac_refs: tuple[tuple[str, str], ...] | None = None, *, cache: bool = True,
-           sources: dict[str, str] | None = None, imports: bool = True) -> str:
+           sources: dict[str, str] | None = None, imports: bool = True,
+           reverse: bool = False) -> str:
     """The Python source of the module that defines ``accel`` and ``extra`` (and,
     given ``jac_refs``, the tangent right-hand side: see :func:`tangent_source`).
+
+    ``reverse``: the right-hand side of the time-reversed motion, integrated forwards
+    in ``s = -t`` on the velocities ``w = dr/ds = -v``: ``d2r/ds2 = a(r, -w)``, so
+    ``extra`` evaluates the effects at ``-w`` (the Newtonian part does not depend
+    on velocities).  A backward run with a velocity-dependent effect uses it.
 
     ``cache`` is numba's ``cache=`` flag of every function; ``sources`` (module ->
     file) is recorded in the header, with the key, so that a stale file can be
@@ -197,12 +203,16 @@ def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: 
     base = "zero" if replaces_newtonian else "newtonian"
     text = _ACCEL.substitute(
         generator=GENERATOR, digest=digest, cache=bool(cache),
-        key=repr((tuple(refs), bool(replaces_newtonian), jac_refs)),
+        key=repr((tuple(refs), bool(replaces_newtonian), jac_refs)
+                 + (("reversed",) if reverse else ())),
         sources=repr(dict(sorted((sources or {}).items()))),
-        chain=" + ".join([base] + [name for _, name in refs]), base=base,
+        chain=" + ".join([base] + [name for _, name in refs])
+        + (", time-reversed" if reverse else ""), base=base,
         imports="".join(f"from {module} import {name} as k{i}\n"
                         for i, (module, name) in enumerate(refs)) if imports else "",
-        calls=_slice_calls(["k"] * len(refs), "r, v, gm, acc"))
+        reverse="    w = -v  # (the time-reversed motion: the velocity is -w)\n"
+        if reverse and refs else "",
+        calls=_slice_calls(["k"] * len(refs), "r, w, gm, acc" if reverse else "r, v, gm, acc"))
     if jac_refs is not None:
         text += _tangent(replaces_newtonian, jac_refs, bool(cache), imports)
     return text

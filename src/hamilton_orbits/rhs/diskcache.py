@@ -69,9 +69,11 @@ def module_sources(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool,
 
 
 def digest(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool,
-           jac_refs: tuple[tuple[str, str], ...] | None, sources: dict[str, str]) -> str:
+           jac_refs: tuple[tuple[str, str], ...] | None, sources: dict[str, str],
+           reverse: bool = False) -> str:
     """A digest of the generator, the key and the kernels' source files (``sources``:
-    module -> file, as :func:`module_sources` gives them); its first 20 hex digits.
+    module -> file, as :func:`module_sources` gives them); its first 20 hex digits
+    (``reverse``: of the time-reversed right-hand side).
 
     Raises
     ------
@@ -81,6 +83,8 @@ def digest(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool,
     text = f"{GENERATOR}|{refs}|{replaces_newtonian}"
     if jac_refs is not None:
         text += f"|{jac_refs}"
+    if reverse:
+        text += "|reversed"
     h = hashlib.sha256(text.encode())
     for module in sorted(sources):
         h.update(Path(sources[module]).read_bytes())
