@@ -136,3 +136,31 @@ def test_residuals_at_dates_the_package_does_not_ship_need_the_extra():
     else:
         with pytest.raises(ValueError, match=r"needs the kernel: .*hamilton-orbits\[ephemeris\]"):
             ladder.residuals(s.names, s.r.value[None], np.array([1]), start_jd=start)
+
+
+def test_the_scene_analysis_compares_at_the_runs_own_dates():
+    """The de440_residuals analysis takes the start's epoch from the scene: a run
+    started ten years before J2000 whose outputs at years 10 and 11 hold DE440's own
+    positions at J2000 and J2000 + 1 yr has no residual (the shipped table; it read
+    against years 10 and 11 after J2000 before)."""
+    from types import SimpleNamespace
+
+    import astropy.units as u
+
+    from hamilton_orbits import System
+    from hamilton_orbits import ephemeris as de
+    from hamilton_orbits.scenes.nbody.analyses import ANALYSIS_FUNCTIONS
+
+    s = System.from_ephemeris()
+    _, ref_names, ref = de.reference_table()
+    r = np.zeros((2, len(s.names), 3))  # barycentric: the Sun at 0, the rest from it
+    for k, name in enumerate(s.names):
+        if name in ref_names:
+            r[:, k] = ref[[0, 1], ref_names.index(name)]
+    result = SimpleNamespace(
+        times=[10.0, 11.0] * u.yr, states={"r": r * u.au}, metrics={}, tables={},
+        diagnostics={}, plotters=[],
+        scene=SimpleNamespace(name="t", spec={"initial": {
+            "ephemeris": {"epoch": "1990-01-01T00:00:00"}, "frame": "icrs"}}))  # (J2000 - 3652.5 d)
+    ANALYSIS_FUNCTIONS["de440_residuals"](result, s, {"name": "de440_residuals"})
+    assert np.max(result.diagnostics["de440_km"]) < 1e-6, result.metrics

@@ -48,7 +48,9 @@ def plot_de440(result: Result):
                     ms=3,
                     ls="--" if moon else "-", color="k" if moon else colors[k],
                     label="moon (from the earth)" if moon else body)
-    ax.set_xlabel("time from J2000 [yr]")
+    epoch = str(result.scene.spec["initial"]["ephemeris"]["epoch"])
+    start = "J2000" if epoch.strip().upper() == "J2000" else f"the start, {epoch} TDB"
+    ax.set_xlabel(f"time from {start} [yr]")
     ax.set_ylabel("position residual against DE440 [km]")
     ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), ICRS")
     ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0),
