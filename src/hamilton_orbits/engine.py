@@ -25,11 +25,12 @@ every output (the fixed-step maps), so an interrupt is seen promptly.
 
 Backward integration
 --------------------
-Output times that decrease are integrated as forward times with the velocities
-reversed, which is exact for forces that do not depend on velocities; a
-velocity-dependent right-hand side is refused there.  A leg in the other
-direction from the one before starts the integrator afresh from the state
-reached.
+Output times that decrease are integrated as the time-reversed motion: forwards
+in ``s = -t`` on the reversed velocities ``w = -v``, ``d2r/ds2 = a(r, -w)`` (the
+velocity-dependent effects evaluated at the true velocity by
+:func:`hamilton_orbits.rhs.time_reversed`; for forces that do not depend on
+velocities this is the same right-hand side).  A leg in the other direction from
+the one before starts the integrator afresh from the state reached.
 """
 
 from __future__ import annotations

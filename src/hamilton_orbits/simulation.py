@@ -256,8 +256,10 @@ class Simulation(Saving):
             An end time, or output times (monotonic from the simulation's time
             :attr:`t`, which is added as the first output if missing), in the
             simulation's time (0 at the system given); a time Quantity for a
-            Quantity system, plain floats otherwise.  Backwards is allowed for
-            forces that do not depend on velocities.
+            Quantity system, plain floats otherwise.  Backwards is allowed with
+            every effect (the time-reversed motion is integrated, velocity-dependent
+            effects at the true velocity), not with events or the variational
+            equations.
         progress : bool
             Show a progress bar (tqdm, on stderr) over the output times.
         on_output : callable, optional
