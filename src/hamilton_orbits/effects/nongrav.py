@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels.nongrav import nongrav
-from hamilton_orbits.effects.parameters import body_index, parameter_array, scalar_parameter
+from hamilton_orbits.effects.parameters import body_index, parameter_array
 from hamilton_orbits.effects.registry import EffectSpec
 from hamilton_orbits.units import ACCELERATION, DIMENSIONLESS, LENGTH
 
@@ -51,17 +51,32 @@ def _bodies(system: Any, params: Mapping[str, Any]) -> list[int]:
     return out
 
 
-def _coefficients(system: Any, params: Mapping[str, Any], n: int) -> np.ndarray:
-    """A1, A2, A3 of each of ``n`` bodies, (n, 3), in the system's units."""
-    out = np.zeros((n, 3))
-    for j, key in enumerate(("A1", "A2", "A3")):
-        value = parameter_array(system, params, key, "nongrav", ACCELERATION)
-        if value is None:
-            continue
+#: the parameters of each body's row beside its index: (name, kind, default, check)
+_ROW = (("A1", ACCELERATION, 0.0, ""), ("A2", ACCELERATION, 0.0, ""),
+        ("A3", ACCELERATION, 0.0, ""), ("alpha", DIMENSIONLESS, 1.0, "positive"),
+        ("r0", LENGTH, 1.0, "positive"),  # (1 au; 1 in the units of plain floats)
+        ("m", DIMENSIONLESS, 2.0, "nonnegative"), ("n", DIMENSIONLESS, 0.0, "nonnegative"),
+        ("k", DIMENSIONLESS, 0.0, "nonnegative"))
+
+
+def _rows(system: Any, params: Mapping[str, Any], n: int) -> np.ndarray:
+    """Each of ``n`` bodies' A1, A2, A3, alpha, r0, m, n, k, (n, 8), in the system's
+    units: every parameter one value for all, or a list of one per body."""
+    out = np.empty((n, len(_ROW)))
+    for j, (key, kind, default, check) in enumerate(_ROW):
+        value = parameter_array(system, params, key, "nongrav", kind)
+        value = np.float64(default) if value is None else value
         if value.shape not in ((), (n,)):
             raise ValueError(f"Effect 'nongrav': expected `{key}` to be one value or {n} "
                              f"(one per body), got {params[key]!r}")
         out[:, j] = value
+        bad = (out[:, j] <= 0) if check == "positive" else (
+            out[:, j] < 0) if check == "nonnegative" else np.zeros(n, bool)
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            need = "> 0" if check == "positive" else ">= 0"
+            raise ValueError(f"Effect 'nongrav': expected `{key}` {need}, got "
+                             f"{params[key]!r} (body {k})")
     return out
 
 
@@ -71,16 +86,9 @@ def _params_nongrav(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     if centre in bodies:
         raise ValueError(f"Effect 'nongrav': the centre {system.names[centre]!r} cannot be "
                          f"one of the bodies it acts on")
-    a = _coefficients(system, params, len(bodies))
-    form = [scalar_parameter(system, params, "alpha", "nongrav", DIMENSIONLESS, 1.0,
-                             positive=True),
-            scalar_parameter(system, params, "r0", "nongrav", LENGTH, 1.0,  # (1 au, or 1
-                             positive=True)]  # in the units of a system of plain floats)
-    form += [scalar_parameter(system, params, key, "nongrav", DIMENSIONLESS, default,
-                              nonnegative=True)
-             for key, default in (("m", 2.0), ("n", 0.0), ("k", 0.0))]
-    rows = [[b, *a[j], *form] for j, b in enumerate(bodies)]
-    return np.array([centre, len(bodies), *np.ravel(rows)], dtype=np.float64)
+    rows = _rows(system, params, len(bodies))
+    table = np.column_stack([np.asarray(bodies, dtype=np.float64), rows])
+    return np.array([centre, len(bodies), *table.ravel()], dtype=np.float64)
 
 
 SPECS = (
@@ -95,7 +103,8 @@ SPECS = (
                     "A3": "normal acceleration at r0 (default 0)",
                     "centre": "default 'sun'",
                     "alpha": "g's scale, default 1", "r0": "a length, default 1 au",
-                    "m": "default 2", "n": "default 0", "k": "default 0"},
+                    "m": "default 2", "n": "default 0",
+                    "k": "default 0 (A1 ... k: one value, or a list of one per body)"},
         kernel=nongrav, params=_params_nongrav,
         parameter_kinds={"A1": ACCELERATION, "A2": ACCELERATION, "A3": ACCELERATION,
                          "r0": LENGTH, "alpha": DIMENSIONLESS, "m": DIMENSIONLESS,
