@@ -8,8 +8,7 @@ processes cannot write one archive; a lock left by a killed run is taken over), 
 read-only folder or a full disk refused at the first write.  :class:`LegRows` are
 the caller's output rows each snapshot carries; :func:`contents`,
 :func:`snapshot_at` and :func:`last_snapshot` read a folder back.  What a snapshot
-holds is :mod:`hamilton_orbits.simulation_record`'s (its names are found here too,
-where they were first).
+holds is :mod:`hamilton_orbits.simulation_record`'s.
 
 Examples
 --------
@@ -41,15 +40,6 @@ from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.restart import inline
 from hamilton_orbits.segment import SEGMENT_RE, Segment, SegmentWriter, read_segment
-from hamilton_orbits.simulation_record import (
-    from_json,
-    pack,
-    record,
-    spec,
-    state_values,
-    to_json,
-    unpack,
-)
 from hamilton_orbits.snapshot import SnapshotError, read
 
 __all__ = [
@@ -58,18 +48,11 @@ __all__ = [
     "Contents",
     "LegRows",
     "contents",
-    "from_json",
     "last_snapshot",
     "leg_rows",
     "on_step_grid",
-    "pack",
-    "record",
     "snapshot_at",
     "snapshot_files",
-    "spec",
-    "state_values",
-    "to_json",
-    "unpack",
 ]
 
 #: the layout of an archive folder: 1, a netCDF file per snapshot; 2, segments of

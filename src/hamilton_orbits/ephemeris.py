@@ -44,6 +44,7 @@ from hamilton_orbits.frames import OBLIQUITY_J2000_ARCSEC, frame_rotation
 __all__ = [
     "ASTEROIDS",
     "BODIES",
+    "CHAINS",
     "DEFAULT_BODIES",
     "EXTRA_HINT",
     "OBLIQUITY_J2000_ARCSEC",
@@ -95,8 +96,8 @@ _GM_KEY = {
 }
 _ASTEROID_NUMBER = dict(zip(ASTEROIDS, (1, 2, 3, 4, 7, 10, 15, 16, 31, 52, 65, 87, 88,
                                         107, 511, 704), strict=True))
-# kernel segments (center, target) from the solar-system barycentre
-_CHAIN = {
+#: each body's chain of kernel segments (center, target) from the solar-system barycentre
+CHAINS = {
     "sun": ((0, 10),), "mercury": ((0, 1), (1, 199)), "venus": ((0, 2), (2, 299)),
     "earth": ((0, 3), (3, 399)), "moon": ((0, 3), (3, 301)),
     "earth-moon-barycenter": ((0, 3),), "mars": ((0, 4),), "jupiter": ((0, 5),),
@@ -405,7 +406,7 @@ def _kernel_states(jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np
     jd1 = np.floor(jd)
     jd2 = jd - jd1
     for k, name in enumerate(names):
-        chain = _CHAIN["sun"] if name in _ASTEROID_NUMBER else _CHAIN[name]
+        chain = CHAINS["sun"] if name in _ASTEROID_NUMBER else CHAINS[name]
         for seg in chain:
             try:
                 p, dp = kernel[seg].compute_and_differentiate(jd1, jd2)

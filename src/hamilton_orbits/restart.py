@@ -49,6 +49,7 @@ import numpy as np
 from hamilton_orbits.integrators import Method
 from hamilton_orbits.integrators._setup import is_address
 from hamilton_orbits.rhs import RHS
+from hamilton_orbits.snapshot import INT_EXACT
 
 __all__ = ["Capture", "LayoutMismatch", "flatten", "inline", "restore"]
 
@@ -129,7 +130,7 @@ _PLAIN = frozenset(_SCALARS)
 def _scalar(obj: Any, kind: str, scalars: list[Any] | None,
             numpy: str | None = None) -> dict[str, Any] | None:
     """``obj`` as an entry of ``scalars`` (None: keep it inline)."""
-    if scalars is None or (kind == "int" and abs(obj) >= 2**53):
+    if scalars is None or (kind == "int" and abs(obj) >= INT_EXACT):
         return None
     scalars.append(obj)
     node = {"scalar": len(scalars) - 1, "type": kind}
@@ -210,7 +211,6 @@ def _node(obj: Any, arrays: list[np.ndarray], seen: dict[int, int],
 _CODE: dict[str, types.CodeType] = {}
 # the steps of a Capture: what each node of the layout is
 _OBJ, _SEQ, _DICT, _ARR, _ALIAS, _NUM, _NPNUM, _VAL, _BUILT = range(9)
-_EXACT = 2**53
 
 
 class Capture:
@@ -289,7 +289,7 @@ class Capture:
         """The text of :meth:`take`'s function, written out from :attr:`ops` (one
         line per read and per check: several times faster than interpreting the
         steps), and the values it compares against (by name, never as text)."""
-        known: dict[str, Any] = {"np": np, "is_address": is_address, "E": _EXACT,
+        known: dict[str, Any] = {"np": np, "is_address": is_address, "E": INT_EXACT,
                                  "T0": self.root[0], "K0": self.root[1]}
         lines = ["def take(x0):",
                  "    if type(x0) is not T0 or x0.__dict__.keys() != K0: return None"]

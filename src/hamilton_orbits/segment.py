@@ -57,7 +57,14 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, encode, parse
-from hamilton_orbits.snapshot import SnapshotError, checksum, stored, variable, write_bytes
+from hamilton_orbits.snapshot import (
+    INT_EXACT,
+    SnapshotError,
+    checksum,
+    stored,
+    variable,
+    write_bytes,
+)
 
 __all__ = ["SEGMENT_FORMAT", "SEGMENT_RE", "Segment", "SegmentWriter", "read_segment"]
 
@@ -141,7 +148,7 @@ def _stored(name: str, value: Any) -> np.ndarray:
     kind = type(value)
     if kind is Parts or (kind is np.ndarray and value.dtype.kind in "fb"):
         return value  # (parts of a record variable, checked: cast when it is filled)
-    if kind is int and abs(value) < 2**53:
+    if kind is int and abs(value) < INT_EXACT:
         return np.float64(value)  # (a step count)
     a = np.asarray(value)
     return a if a.dtype.kind in "fb" else stored(name, a)[0]

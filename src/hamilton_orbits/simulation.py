@@ -188,7 +188,7 @@ class Simulation(Saving):
         self._warned = False  # an under-resolved encounter is warned of once
         #: how a leg's test-particle approaches are checked: fixed for the simulation
         #: (method, step, tolerance, the state at time 0), so found once, not per call
-        #: the parts of a snapshot that never change, made at the first (checkpoint.record)
+        #: the parts of a snapshot that never change, made at the first (simulation_record.record)
         self._record_cache: dict[str, Any] = {}
         self._encounters = encounter_check(typed, step, tol, arrays.r, arrays.gm)
         if self._prop.events is None and not (arrays.gm == 0).any():

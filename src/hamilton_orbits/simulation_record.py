@@ -27,7 +27,7 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import Parts
 from hamilton_orbits.restart import Capture, flatten
-from hamilton_orbits.snapshot import SnapshotError
+from hamilton_orbits.snapshot import INT_EXACT, SnapshotError
 from hamilton_orbits.units import is_quantity
 
 __all__ = ["from_json", "pack", "record", "spec", "state_values", "to_json", "unpack"]
@@ -137,7 +137,7 @@ def _exact_integers(arrays: list[np.ndarray]) -> None:
     for a in arrays:
         if a.dtype.kind in "iu" and a.size and max(
                 map(abs, a.ravel().tolist()) if a.size < 64 else (-int(a.min()), int(a.max()))
-        ) >= 2**53:
+        ) >= INT_EXACT:
             raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
 
 

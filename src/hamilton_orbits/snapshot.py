@@ -44,14 +44,15 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "SnapshotError", "checksum", "encode_snapshot",
-           "read", "stored", "variable", "write", "write_bytes"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "INT_EXACT", "SnapshotError", "checksum",
+           "encode_snapshot", "read", "stored", "variable", "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
 #: earlier one (tests/hamilton_orbits/data/snapshot-v1.nc)
 FORMAT_VERSION = 1
-_INT_EXACT = 2 ** 53
+#: integers a float64 holds exactly are below this in magnitude
+INT_EXACT = 2 ** 53
 
 
 class SnapshotError(ValueError):
@@ -82,7 +83,7 @@ def stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
     if arr.dtype == np.int8:
         return arr, kind
     if arr.dtype.kind in "iu":
-        if arr.size and np.max(np.abs(arr.astype(np.float64))) >= _INT_EXACT:
+        if arr.size and np.max(np.abs(arr.astype(np.float64))) >= INT_EXACT:
             raise SnapshotError(f"array {name!r}: integers beyond 2**53 cannot be stored")
         return arr.astype(np.float64), kind
     raise SnapshotError(f"array {name!r}: dtype {arr.dtype} cannot be stored")

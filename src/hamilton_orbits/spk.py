@@ -34,17 +34,9 @@ import numpy as np
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.chebyshev import add_states
+from hamilton_orbits.ephemeris import CHAINS
 
-__all__ = ["CHAINS", "Segment", "Segments"]
-
-#: each body's chain of (center, target) segments from the solar-system barycentre
-CHAINS = {
-    "sun": ((0, 10),), "mercury": ((0, 1), (1, 199)), "venus": ((0, 2), (2, 299)),
-    "earth": ((0, 3), (3, 399)), "moon": ((0, 3), (3, 301)),
-    "earth-moon-barycenter": ((0, 3),), "mars": ((0, 4),), "jupiter": ((0, 5),),
-    "saturn": ((0, 6),), "uranus": ((0, 7),), "neptune": ((0, 8),), "pluto": ((0, 9),),
-}
-
+__all__ = ["Segment", "Segments"]
 
 @dataclass(frozen=True)
 class Segment:

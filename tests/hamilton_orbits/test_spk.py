@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from hamilton_orbits import ephemeris as de
-from hamilton_orbits.spk import CHAINS, Segments
+from hamilton_orbits.ephemeris import CHAINS
+from hamilton_orbits.spk import Segments
 
 EXCERPT = Path(__file__).parent / "data" / "de440_excerpt.npz"
 NAMES = [n for n in CHAINS if n != "sun"]

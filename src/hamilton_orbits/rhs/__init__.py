@@ -248,12 +248,7 @@ def time_reversed(rhs: RHS) -> RHS:
     kernels = tuple(spec.kernel for spec in specs)
     key = (tuple(kernel_ref(k) for k in kernels),
            any(spec.replaces_newtonian for spec in specs), None, "reversed")
-    with _LOCK:
-        found = _MEMO.get(key)
-        if found is None:
-            found = _build(key, kernels)
-            _MEMO[key] = found
-    return RHS(*found, rhs.p, rhs.velocity_dependent, rhs.effects)
+    return RHS(*_memoised(key, kernels), rhs.p, rhs.velocity_dependent, rhs.effects)
 
 
 _MEMO: dict[tuple, tuple[Any, Any]] = {}
@@ -273,10 +268,16 @@ def kernels_for(kernels: tuple[Any, ...], replaces_newtonian: bool = False) -> t
     True
     """
     key = (tuple(kernel_ref(k) for k in kernels), bool(replaces_newtonian))
+    return _memoised(key, kernels)
+
+
+def _memoised(key: tuple, kernels: tuple[Any, ...],
+              jacobians: tuple[Any, ...] | None = None) -> tuple[Any, ...]:
+    """The compiled functions of ``key``, built once per process (:func:`_build`)."""
     with _LOCK:
         found = _MEMO.get(key)
         if found is None:
-            found = _build(key, kernels)
+            found = _build(key, kernels, jacobians)
             _MEMO[key] = found
     return found
 
@@ -305,12 +306,7 @@ def tangent_kernels_for(kernels: tuple[Any, ...], jacobians: tuple[tuple[Any, bo
     """
     jac_key = tuple(_jac_ref(j, vd) for j, vd in jacobians)
     key = (tuple(kernel_ref(k) for k in kernels), bool(replaces_newtonian), jac_key)
-    with _LOCK:
-        found = _MEMO.get(key)
-        if found is None:
-            found = _build(key, kernels, tuple(j for j, _ in jacobians))
-            _MEMO[key] = found
-    return found
+    return _memoised(key, kernels, tuple(j for j, _ in jacobians))
 
 
 def _build(key: tuple, kernels: tuple[Any, ...],

@@ -52,7 +52,8 @@ def plot_de440(result: Result):
     start = "J2000" if epoch.strip().upper() == "J2000" else f"the start, {epoch} TDB"
     ax.set_xlabel(f"time from {start} [yr]")
     ax.set_ylabel("position residual against DE440 [km]")
-    ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), ICRS")
+    # (distances: the same on any axes, so no frame is named)
+    ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric)")
     ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0),
               frameon=False)
     fig.tight_layout()
