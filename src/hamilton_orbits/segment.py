@@ -45,6 +45,7 @@ Examples
 from __future__ import annotations
 
 import json
+import operator
 import os
 import re
 import struct
@@ -73,6 +74,8 @@ SEGMENT_FORMAT = "hamilton-orbits archive segment"
 SEGMENT_VERSION = 2
 SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
+#: the record of a snapshot of a propagation's state, in its stored order
+_STATE_RECORD = ["t", "r", "v", "gm", "state", "scalars", "steps", "rows", "active"]
 _ROWS = ("out_t", "out_r", "out_v", "out_megno", "out_lyapunov", "out_lyapunov_time",
          "out_stm")
 
@@ -107,21 +110,30 @@ class _Appender:
         the types they are stored as), then count them in the header."""
         buffer, parts = self.buffer, []
         for values in rows:
-            data = buffer.fill([*values, 0.0])
-            buffer.views[-1][...] = zlib.crc32(memoryview(data)[:-8])
-            parts.append(data if len(rows) == 1 else bytes(data))  # (the buffer is reused)
-        data = parts[0] if len(parts) == 1 else b"".join(parts)
+            buffer.fill([*values, 0.0])
+            parts.append(self.checked() if len(rows) == 1 else bytes(self.checked()))
+            # (the buffer is reused)
+        self.write(parts[0] if len(parts) == 1 else b"".join(parts), len(rows))
+
+    def checked(self) -> bytearray:
+        """The buffer's record with its CRC-32 put in its ``check``."""
+        data = self.buffer.data
+        self.buffer.views[-1][...] = zlib.crc32(memoryview(data)[:-8])
+        return data
+
+    def write(self, data: bytes | bytearray, count: int) -> None:
+        """Write ``count`` whole records ``data`` after the last, then count them."""
         try:
             os.pwrite(self.fd, data, self.end)
             if self.sync:
                 os.fsync(self.fd)
-            os.pwrite(self.fd, struct.pack(">i", self.count + len(rows)), NUMRECS_AT)
+            os.pwrite(self.fd, struct.pack(">i", self.count + count), NUMRECS_AT)
             if self.sync:
                 os.fsync(self.fd)
         except OSError as exc:
             raise SnapshotError(f"cannot write the snapshot to {self.path}: "
                                 f"{exc.strerror or exc}") from None
-        self.count += len(rows)
+        self.count += count
         self.end += len(data)
 
     def close(self) -> None:
@@ -200,6 +212,11 @@ class SegmentWriter:
         self._file = _Appender(self.path, attrs, fixed_vars, template, "snapshot", sync, fixed,
                                units)
         self._rows: _Appender | None = None
+        #: a record of a propagation's state is filled by :meth:`_append_state`, the
+        #: flat views of its state's arrays kept while they are the same arrays
+        self._direct = (self.names == _STATE_RECORD
+                        and self._file.buffer.runs[0][:2] == (0, 8))
+        self._kept: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
         # (rows of a segment of this number that a killed run began and this replaces)
         (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
 
@@ -232,9 +249,39 @@ class SegmentWriter:
                                        units={f"out_{k}": x for k, x in self.units.items()})
             self._rows.append([[np.asarray(rows[k][i], np.float64) for k in names]
                                for i in range(n)])
+        if not n and self._direct and type(snapshot["state"]) is Parts and self._append_state(
+                snapshot, start):
+            return
         span = np.array([start, start + n], dtype=np.float64)
         self._file.append([[span if k == "rows" else _stored(k, snapshot[k])
                             for k in self.names]])
+
+    def _append_state(self, snap: Mapping[str, Any], start: int) -> bool:
+        """Append a snapshot of a propagation's state with no output rows (the bytes
+        :meth:`append` writes): the float64 variables, ``t`` to ``rows``, filled by
+        one concatenation, then ``active``.  False, nothing written, where a value is
+        not of its variable's shape or a step count not exact in a float64 (the
+        general path then says why)."""
+        file = self._file
+        views, state, kept = file.buffer.views, snap["state"], self._kept
+        if len(kept[0]) != len(state) or not all(map(operator.is_, kept[0], state)):
+            flat = [a.reshape(-1) for a in state]
+            if sum(a.size for a in flat) != views[4].size:
+                return False
+            kept = self._kept = (list(state), flat)
+        r, v, gm, scalars, active, steps = (snap["r"], snap["v"], snap["gm"], snap["scalars"],
+                                            snap["active"], snap["steps"])
+        if (r.shape != views[1].shape or v.shape != views[2].shape or gm.shape != views[3].shape
+                or scalars.shape != views[5].shape or np.shape(active) != views[8].shape
+                or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT):
+            return False
+        head = file.buffer.runs[0][2]  # (t, r, v, gm, state, scalars, steps, rows)
+        head[0] = snap["t"]
+        np.concatenate([r.reshape(-1), v.reshape(-1), gm, *kept[1], scalars,
+                        (steps, start, start)], out=head[1:], casting="unsafe")
+        views[8][...] = active
+        file.write(file.checked(), 1)
+        return True
 
     def close(self) -> None:
         """Close the files (what was appended stays)."""
