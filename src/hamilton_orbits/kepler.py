@@ -289,7 +289,7 @@ _MS = "m / s"
 _MU = "m3 / s2"
 
 
-def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
+def propagate(r: Any, v: Any, mu: Any, dt: Any, *, threads: bool = True) -> tuple[Any, Any]:
     """Two-body state after a time ``dt``, by universal variables.
 
     Parameters
@@ -303,6 +303,10 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
     dt : array_like or Quantity (time), shape (...)
         Time step, any sign and size (a bound orbit's dt is reduced modulo the
         exact period first, so 1e6 periods cost the same as one).
+    threads : bool
+        Share many rows (from 65536) among threads (the default); False: one
+        thread whatever the rows, so the threaded kernel is never compiled (worth
+        it for a few calls, such as a figure's points).  The results are the same.
 
     Either all four are Quantities or all are plain floats in one consistent
     unit system.  Leading dimensions broadcast.
@@ -376,7 +380,10 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any) -> tuple[Any, Any]:
     dtb = np.broadcast_to(dta, lead).reshape(n)
     r_out = np.empty((n, 3))
     v_out = np.empty((n, 3))
-    bad = _k.propagate_batch(rb, vb, mub, dtb, r_out, v_out)
+    if not isinstance(threads, bool):
+        raise ValueError(f"Expected `threads` to be True or False, got {threads!r}")
+    batch = _k.propagate_batch if threads else _k.propagate_batch.serial
+    bad = batch(rb, vb, mub, dtb, r_out, v_out)
     if bad >= 0:
         if not np.any(rb[bad]):
             raise ValueError(

@@ -263,3 +263,18 @@ def test_hypothesis_round_trip(e, nu0, dt):
     assert _rel(rb, r0) < slack
     dh = np.linalg.norm(np.cross(r1, v1) - np.cross(r0, v0))
     assert dh <= 4 * EPS * np.linalg.norm(r1) * np.linalg.norm(v1)
+
+
+def test_one_thread_gives_the_bits_of_the_threaded_kernel():
+    """``threads=False`` runs the serial copy of the batch kernel on a batch large
+    enough for threads: every row the same bits (and a non-bool refused)."""
+    rng = np.random.default_rng(7)
+    n = 70_000  # (above the threaded kernel's 65536 rows)
+    r = rng.normal(size=(n, 3))
+    v = rng.normal(size=(n, 3)) * 0.8
+    dt = rng.uniform(-20.0, 20.0, n)
+    threaded = propagate(r, v, 1.0, dt)
+    serial = propagate(r, v, 1.0, dt, threads=False)
+    assert np.array_equal(threaded[0], serial[0]) and np.array_equal(threaded[1], serial[1])
+    with pytest.raises(ValueError, match="`threads`"):
+        propagate(r[0], v[0], 1.0, 1.0, threads=1)

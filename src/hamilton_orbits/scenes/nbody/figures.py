@@ -222,8 +222,6 @@ def refined_track(t: np.ndarray, r: np.ndarray, v: np.ndarray, mu: float
     >>> refined, len(pts) >= 60
     (True, True)
     """
-    from hamilton_orbits.kepler import propagate
-
     ok = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(v), axis=-1)
     if len(t) < 2 or not ok.all() or mu <= 0:
         return r, False
@@ -241,23 +239,101 @@ def refined_track(t: np.ndarray, r: np.ndarray, v: np.ndarray, mu: float
     n_sub = np.minimum(n_sub, 5000)
     if n_sub.max(initial=1) <= 1:
         return r, False
-    pieces = []
-    for i in range(len(dt)):
-        pieces.append(r[i:i + 1])
-        if n_sub[i] > 1:
-            span = min(dt[i], period[i])
-            tau = np.linspace(0.0, span, n_sub[i] + 1)[1:-1]
-            pieces.append(propagate(np.broadcast_to(r[i], (len(tau), 3)),
-                                    np.broadcast_to(v[i], (len(tau), 3)), mu, tau)[0])
-            if dt[i] >= period[i]:  # a whole orbit drawn: close it, break the line
-                pieces.append(np.vstack([r[i], np.full(3, np.nan)]))
-            else:  # no chord to the next output where the arc ends elsewhere
-                end = propagate(r[i], v[i], mu, dt[i])[0]
-                if max(_turn(end[None], r[i + 1:i + 2])[0],
-                       _turn(end[None, :2], r[i + 1:i + 2, :2])[0]) > 1 / PER_ORBIT:
-                    pieces.append(np.vstack([end, np.full(3, np.nan)]))
-    pieces.append(r[-1:])
-    return np.vstack(pieces), True
+    return _with_arcs(r, v, mu, dt, period, n_sub), True
+
+
+def _with_arcs(r: np.ndarray, v: np.ndarray, mu: float, dt: np.ndarray,
+               period: np.ndarray, n_sub: np.ndarray) -> np.ndarray:
+    """The outputs ``r`` with ``n_sub[i] - 1`` points of the two-body arc from output
+    ``i`` inserted after it where ``n_sub[i] > 1`` (over ``min(dt[i], period[i])``,
+    :func:`_arcs`), then a NaN row after a whole revolution (its first point
+    repeated before it) or after an arc that ends away from the next output (its
+    end before it)."""
+    sub = n_sub > 1
+    k = np.where(sub, n_sub - 1, 0)  # the arc's points between the two ends
+    whole = sub & (dt >= period)
+    arcs = np.flatnonzero(sub)
+    pts, ends = _arcs(r[arcs], v[arcs], mu, np.minimum(dt, period)[arcs], n_sub[arcs])
+    part = ~whole[arcs]  # (the arcs that end before a revolution: is the end away?)
+    nxt = r[arcs[part] + 1]
+    away = np.zeros(len(arcs), bool)
+    away[part] = np.maximum(_turn(ends[part], nxt), _turn(ends[part, :2], nxt[:, :2])) > (
+        1 / PER_ORBIT)
+    closed = whole.astype(int)
+    closed[arcs[away]] = 1  # (a point and a NaN row after the arc)
+    start = np.concatenate([[0], np.cumsum(1 + k + 2 * closed)])
+    out = np.empty((start[-1] + 1, 3))
+    out[start[:-1]] = r[:-1]
+    at = np.repeat(arcs, k[arcs])
+    j = np.arange(len(at)) - np.repeat(np.cumsum(k[arcs]) - k[arcs], k[arcs])  # 0 ... k - 1
+    out[start[at] + 1 + j] = pts
+    last = start[:-1] + 1 + k  # (after the arc)
+    shut = np.flatnonzero(whole)
+    out[last[shut]] = r[shut]
+    out[last[arcs[away]]] = ends[away]
+    out[last[closed == 1] + 1] = np.nan
+    out[-1] = r[-1]
+    return out
+
+
+def _arcs(r: np.ndarray, v: np.ndarray, mu: float, span: np.ndarray, n: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """The two-body motion from each state ``r[i], v[i]`` over ``span[i]``: its
+    ``n[i] - 1`` points strictly inside (one arc after another), and each arc's end.
+
+    A bound orbit of ``e < 0.95`` (every planet's) is drawn on its ellipse at equal
+    steps of the eccentric anomaly (:func:`_on_ellipse`: no compiled kernel to wait
+    for on a first run); a steep or unbound one by the universal Kepler solver at
+    equal steps of time (:func:`hamilton_orbits.kepler.propagate`)."""
+    h = np.cross(r, v)
+    e = np.linalg.norm(np.cross(v, h) / mu - r / np.linalg.norm(r, axis=-1)[:, None], axis=-1)
+    energy = 0.5 * np.einsum("ij,ij->i", v, v) - mu / np.linalg.norm(r, axis=-1)
+    ellipse = (energy < 0) & (e < 0.95) & (np.linalg.norm(h, axis=-1) > 0)
+    row = np.repeat(np.arange(len(n)), n)  # (each point's arc; the last of each its end)
+    frac = (np.arange(len(row)) - np.repeat(np.cumsum(n) - n, n) + 1) / n[row]
+    out = np.empty((len(row), 3))
+    pick = ellipse[row]
+    if pick.any():
+        local = (np.cumsum(ellipse) - 1)[row[pick]]  # (the arc among the elliptic ones)
+        out[pick] = _on_ellipse(r[ellipse], v[ellipse], mu, span[ellipse], frac[pick], local)
+    if not pick.all():
+        from hamilton_orbits.kepler import propagate
+
+        rest = row[~pick]
+        out[~pick] = propagate(r[rest], v[rest], mu, frac[~pick] * span[rest],
+                               threads=False)[0]
+    last = np.cumsum(n) - 1
+    inner = np.ones(len(row), bool)
+    inner[last] = False
+    return out[inner], out[last]
+
+
+def _on_ellipse(r: np.ndarray, v: np.ndarray, mu: float, span: np.ndarray,
+                frac: np.ndarray, row: np.ndarray) -> np.ndarray:
+    """Points of the two-body motion from the bound states ``r, v`` (``e < 0.95``)
+    over ``span``: at the fractions ``frac`` of each arc's change of the eccentric
+    anomaly ``E`` (point ``j`` on arc ``row[j]``), on ``r(E) = a (cos E - e) P +
+    a sqrt(1 - e^2) sin E Q`` (as :func:`osculating_ellipse`); the arc's end from
+    Kepler's equation ``E - e sin E = E0 - e sin E0 + sqrt(mu / a^3) span`` by
+    Newton's method (from ``M + e sin M``: converged to rounding within 30 steps for
+    ``e < 0.95``)."""
+    h = np.cross(r, v)
+    dist = np.linalg.norm(r, axis=-1)
+    ecc = np.cross(v, h) / mu - r / dist[:, None]
+    e = np.linalg.norm(ecc, axis=-1)
+    a = -mu / (2 * (0.5 * np.einsum("ij,ij->i", v, v) - mu / dist))
+    round_ = (e <= 1e-12)[:, None]  # (a circle: P towards the state)
+    p_hat = np.where(round_, r / dist[:, None], ecc / np.where(round_[:, 0], 1.0, e)[:, None])
+    q_hat = np.cross(h, p_hat) / np.linalg.norm(h, axis=-1)[:, None]
+    b = a * np.sqrt(1 - e * e)
+    e0 = np.arctan2(np.einsum("ij,ij->i", r, q_hat) / b, np.einsum("ij,ij->i", r, p_hat) / a + e)
+    m1 = e0 - e * np.sin(e0) + np.sqrt(mu / a**3) * span
+    e1 = m1 + e * np.sin(m1)
+    for _ in range(30):
+        e1 = e1 - (e1 - e * np.sin(e1) - m1) / (1 - e * np.cos(e1))
+    big_e = (e0[row] + frac * (e1 - e0)[row])[:, None]
+    return (a[row, None] * (np.cos(big_e) - e[row, None]) * p_hat[row]
+            + b[row, None] * np.sin(big_e) * q_hat[row])
 
 
 def _labelled(view: dict, shown: list[str], most: int = 12) -> list[str]:
@@ -288,16 +364,13 @@ def _host(view: dict, k: int) -> str | None:
 def _draw_ends(ax: Any, view: dict, k: int, color: Any) -> None:
     """For a body that goes round more than 20 times: the two-body orbits at its
     first (bold) and last (dashed) outputs, over the pale track."""
-    from hamilton_orbits.kepler import propagate
-
     for row, style in ((0, "-"), (-1, "--")):
         r, v, mu = view["rel"][row, k], view["vrel"][row, k], view["mu"][k]
-        period = _period(r[None], v[None], mu)[0]
-        if not np.isfinite(period):
+        period = _period(r[None], v[None], mu)
+        if not np.isfinite(period[0]):
             continue
-        tau = np.linspace(0.0, period, PER_ORBIT * 2 + 1)
-        pts = propagate(np.broadcast_to(r, (len(tau), 3)), np.broadcast_to(v, (len(tau), 3)),
-                        mu, tau)[0]
+        inner, end = _arcs(r[None], v[None], mu, period, np.array([PER_ORBIT * 2]))
+        pts = np.vstack([r, inner, end])
         ax.plot(pts[:, 0], pts[:, 1], lw=1.3, color=color, ls=style, gid="ends",
                 label="_nolegend_")
 
