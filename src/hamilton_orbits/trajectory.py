@@ -181,6 +181,8 @@ class Trajectory(TrajectoryBase):
     @functools.cached_property
     def _errors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         source = self._integrals
+        if source is None:
+            raise ValueError(_NO_INTEGRALS)
         return source() if callable(source) else _integrals(*source)
 
     @property
@@ -201,6 +203,8 @@ class Trajectory(TrajectoryBase):
     @functools.cached_property
     def _particles(self) -> tuple[np.ndarray, tuple[str, ...]]:
         source = self._integrals
+        if source is None:
+            raise ValueError(_NO_INTEGRALS)
         if callable(source):
             n = len(self.names)
             return np.full((len(self.r), n), np.nan), ("",) * n
@@ -324,10 +328,16 @@ class Trajectory(TrajectoryBase):
     def __repr__(self) -> str:
         return (
             f"Trajectory({len(self.names)} bodies, {len(self.r)} outputs, "
-            f"method={self.method!r}, effects={self.effects!r}, steps={self.steps}, "
-            f"max |dE/E|={np.max(np.abs(self.energy_error)):.3g}"
+            f"method={self.method!r}, effects={self.effects!r}, steps={self.steps}"
+            + ("" if self._integrals is None
+               else f", max |dE/E|={np.max(np.abs(self.energy_error)):.3g}")
             + ("" if self.complete else ", incomplete") + ")"
         )
+
+
+_NO_INTEGRALS = ("This trajectory keeps no integrals (bodies in a field that changes with "
+                 "time, such as small bodies in an ephemeris's): no energy, angular momentum "
+                 "or barycentre error")
 
 
 def event_table(rows: Any, system: Any, unit: Any, stopped: int | None = None

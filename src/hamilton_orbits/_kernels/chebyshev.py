@@ -26,32 +26,43 @@ def add_states(coef, init, intlen, jd1, jd2, out):  # pragma: no cover - compile
     of ``intlen`` days from the Julian date ``init``.  Returns the index of the first
     time outside the segment (its states left alone), or -1.
     """
-    n, m = coef.shape[1], coef.shape[2]
+    m = coef.shape[2]
     t = np.empty(m)
     u = np.empty(m)
     for i in range(jd1.shape[0]):
-        d = (jd1[i] - init) + jd2[i]
-        k = int(np.floor(d / intlen))
-        if k == n and d <= n * intlen:  # (the segment's last instant)
-            k = n - 1
-        if k < 0 or k >= n or not np.isfinite(d):
+        if not add_state(coef, init, intlen, jd1[i], jd2[i], out[i], t, u):
             return i
-        s = 2.0 * (d - k * intlen) / intlen - 1.0
-        t[0] = 1.0
-        u[0] = 1.0
-        if m > 1:
-            t[1] = s
-            u[1] = 2.0 * s
-        for j in range(2, m):
-            t[j] = 2.0 * s * t[j - 1] - t[j - 2]
-            u[j] = 2.0 * s * u[j - 1] - u[j - 2]
-        for c in range(3):
-            x = 0.0
-            dx = 0.0
-            for j in range(m - 1, -1, -1):  # (small terms first)
-                x += coef[c, k, j] * t[j]
-                if j > 0:
-                    dx += j * coef[c, k, j] * u[j - 1]
-            out[i, c] += x
-            out[i, 3 + c] += dx * 2.0 / intlen
     return -1
+
+
+@njit(cache=True, inline="always")
+def add_state(coef, init, intlen, jd1, jd2, out, t, u):  # pragma: no cover - compiled
+    """ADD one segment's state at the time ``jd1 + jd2`` to ``out`` (6,) (as
+    :func:`add_states`, ``t``, ``u`` work space of the coefficients' length); False,
+    ``out`` left alone, for a time outside the segment."""
+    n, m = coef.shape[1], coef.shape[2]
+    d = (jd1 - init) + jd2
+    k = int(np.floor(d / intlen))
+    if k == n and d <= n * intlen:  # (the segment's last instant)
+        k = n - 1
+    if k < 0 or k >= n or not np.isfinite(d):
+        return False
+    s = 2.0 * (d - k * intlen) / intlen - 1.0
+    t[0] = 1.0
+    u[0] = 1.0
+    if m > 1:
+        t[1] = s
+        u[1] = 2.0 * s
+    for j in range(2, m):
+        t[j] = 2.0 * s * t[j - 1] - t[j - 2]
+        u[j] = 2.0 * s * u[j - 1] - u[j - 2]
+    for c in range(3):
+        x = 0.0
+        dx = 0.0
+        for j in range(m - 1, -1, -1):  # (small terms first)
+            x += coef[c, k, j] * t[j]
+            if j > 0:
+                dx += j * coef[c, k, j] * u[j - 1]
+        out[c] += x
+        out[3 + c] += dx * 2.0 / intlen
+    return True

