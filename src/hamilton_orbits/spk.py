@@ -56,31 +56,42 @@ class Segments:
 
     @classmethod
     def from_kernel(cls, start_jd: float, end_jd: float,
-                    pairs: Sequence[tuple[int, int]] | None = None) -> Segments:
-        """The records of the extra's DE440 kernel that cover TDB Julian dates
-        ``start_jd`` to ``end_jd`` (every chain's segments unless ``pairs``).
+                    pairs: Sequence[tuple[int, int]] | None = None,
+                    small_bodies: bool = False) -> Segments:
+        """The records of the extra's DE440 kernel (with ``small_bodies``: of JPL's
+        sb441-n16, the 16 asteroids about the Sun) that cover TDB Julian dates
+        ``start_jd`` to ``end_jd`` (every chain's segments unless ``pairs``; of a
+        pair the kernel holds in several segments, the one covering the span).
 
         Raises
         ------
         ValueError
-            Without the ``[ephemeris]`` extra, or for a span DE440 does not cover.
+            Without the kernel's extra, or for a span it does not cover.
         """
         if not de.kernel_available():
             raise ValueError(f"DE440's segments need the kernel: {de.EXTRA_HINT}")
-        kernel = de.spk_kernel()
-        wanted = set(pairs or [p for chain in CHAINS.values() for p in chain])
-        out = {}
+        kernel = de.small_kernel() if small_bodies else de.spk_kernel()
+        default = ([chain[-1] for chain in de.ASTEROID_CHAINS.values()] if small_bodies
+                   else [p for chain in CHAINS.values() for p in chain])
+        wanted = set(pairs or default)
+        out, seen = {}, {}
         for seg in kernel.segments:
-            if (seg.center, seg.target) not in wanted:
+            pair = (seg.center, seg.target)
+            if pair not in wanted or pair in out:
+                continue
+            seen[pair] = (seg.start_jd, seg.end_jd)
+            if not seg.start_jd <= start_jd <= end_jd <= seg.end_jd:
                 continue
             init, intlen, coef = seg.load_array()
             first = int(np.floor((start_jd - init) / intlen))
-            last = int(np.floor((end_jd - init) / intlen))
-            if first < 0 or last >= coef.shape[1]:
-                raise ValueError(f"DE440 covers JD {init}..{init + intlen * coef.shape[1]}, "
-                                 f"not {start_jd}..{end_jd}")
-            out[(seg.center, seg.target)] = Segment(
-                init + first * intlen, intlen, np.ascontiguousarray(coef[:, first:last + 1]))
+            last = min(int(np.floor((end_jd - init) / intlen)), coef.shape[1] - 1)
+            out[pair] = Segment(init + first * intlen, intlen,
+                                np.ascontiguousarray(coef[:, first:last + 1]))
+        for pair in sorted(wanted - set(out)):
+            span = seen.get(pair)
+            raise ValueError(f"Expected the kernel to cover JD {start_jd}..{end_jd} with the "
+                             f"segment {pair}, got "
+                             f"{'no such segment' if span is None else f'JD {span[0]}..{span[1]}'}")
         return cls(out)
 
     def save(self, path: Path) -> None:
@@ -120,7 +131,7 @@ class Segments:
         au = de.constant("AU")
         out = np.zeros((len(names), jd.shape[0], 6))
         for k, name in enumerate(names):
-            chain = CHAINS.get(str(name).lower())
+            chain = CHAINS.get(str(name).lower()) or de.ASTEROID_CHAINS.get(str(name).lower())
             if chain is None or any(pair not in self.segments for pair in chain):
                 raise ValueError(f"Expected `names` among the bodies of these segments, got "
                                  f"{name!r} at index {k}")
