@@ -23,13 +23,14 @@ Newton's law: their own 1PN fields are left out, each below 1e-9 of the Sun's);
 a small body that is one of them (named so, or starting within 1 km of one) is
 propagated without it, the others still pulling on it.
 
-Not yet here (issue 35): non-gravitational forces, events and the variational
+``nongrav`` adds the comets' and asteroids' non-gravitational accelerations (the
+``nongrav`` effect).  Not yet here (issue 35): events and the variational
 equations (each refused by name).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -74,12 +75,14 @@ def _chain(name: str) -> tuple[tuple[int, int], ...]:
 
 def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
               epoch: tuple[float, float], effects: Sequence[str],
-              perturbers: Sequence[str] = PERTURBERS, without: str | None = None) -> Any:
+              perturbers: Sequence[str] = PERTURBERS, without: str | None = None,
+              nongrav: Any = None) -> Any:
     """The right-hand side of the small bodies ``names`` (their states ``r0``, ``v0``
     in au and au/day, only for the effects' parameters) and the clock, in the field
     of ``perturbers`` (:data:`PERTURBERS`, then any of the 16 asteroids) read from
     ``segments`` from TDB Julian date ``epoch`` (two parts), with ``effects`` (keys
-    of :data:`EFFECTS`), ``without`` one perturber's pull (its GM 0); its
+    of :data:`EFFECTS`), ``without`` one perturber's pull (its GM 0), ``nongrav``
+    the non-gravitational accelerations (as :func:`propagate` takes them); its
     time-reversed form attached (``hamilton_orbits.rhs.time_reversed``).
 
     Raises
@@ -96,26 +99,73 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
             raise ValueError(f"Expected `effects` among {sorted(EFFECTS)}, got {name!r} at "
                              f"index {k}")
     system = _combined_system(names, r0, v0, perturbers)
-    blocks = dict(zip(effects, EffectSet.of([EFFECTS[e] for e in effects], "nbody")
-                      .parameters(system), strict=True))
+    listed = {e: EFFECTS[e] for e in effects}
+    outgassing = _nongrav_effect(nongrav, len(names))
+    if outgassing is not None:
+        listed["nongrav"] = outgassing
+    blocks = dict(zip(listed, EffectSet.of(list(listed.values()), "nbody").parameters(system),
+                      strict=True))
     head = np.zeros(HEADER)
     head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(perturbers)
     head[5] = de.constant("AU")
     parts, at = [head], HEADER
-    for slot, name in ((6, "eih"), (8, "sun_j2"), (10, "earth_zonal")):
+    for slot, name in ((6, "eih"), (8, "sun_j2"), (10, "earth_zonal"), (12, "nongrav")):
         block = blocks.get(name, np.empty(0))
         head[slot], head[slot + 1] = at, at + len(block)
         parts.append(block)
         at += len(block)
     seg_table, pert_table, coefs = _tables(segments, at, perturbers, without)
-    head[13], head[12] = at, at + len(seg_table)
+    head[15], head[14] = at, at + len(seg_table)
     p = np.concatenate([*parts, seg_table, pert_table, coefs])
     back = p.copy()
     back[1] = 1.0
-    velocity = "eih" in effects
-    tag = ("newtonian", "small_bodies", *effects)
+    velocity = "eih" in effects or outgassing is not None
+    tag = ("newtonian", "small_bodies", *listed)
     reverse = RHS(small_bodies_field, None, back, velocity, tag)
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
+
+
+#: the parameters of one body's non-gravitational acceleration and their kinds
+NONGRAV_KEYS = {"A1": "acceleration", "A2": "acceleration", "A3": "acceleration",
+                "alpha": "", "r0": "length", "m": "", "n": "", "k": ""}
+_NONGRAV_DEFAULTS = {"A1": 0.0, "A2": 0.0, "A3": 0.0, "alpha": 1.0, "r0": 1.0, "m": 2.0,
+                     "n": 0.0, "k": 0.0}
+
+
+def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
+    """The ``nongrav`` effect of the ``n`` small bodies from ``nongrav``: one mapping
+    for every body, or one mapping (or None) per body; None where no body has one."""
+    import astropy.units as u
+
+    from hamilton_orbits.units import is_quantity
+
+    if nongrav is None:
+        return None
+    rows = [nongrav] * n if isinstance(nongrav, Mapping) else list(nongrav)
+    if len(rows) != n:
+        raise ValueError(f"Expected `nongrav` to be a mapping or one per body ({n}), got "
+                         f"{len(rows)}")
+    bodies, values = [], {key: [] for key in NONGRAV_KEYS}
+    for k, row in enumerate(rows):
+        if row is None:
+            continue
+        if not isinstance(row, Mapping) or set(row) - set(NONGRAV_KEYS):
+            raise ValueError(f"Expected `nongrav` mappings of {sorted(NONGRAV_KEYS)}, got "
+                             f"{row!r} at index {k}")
+        bodies.append(f"small body {k}")
+        for key, kind in NONGRAV_KEYS.items():
+            x = row.get(key, _NONGRAV_DEFAULTS[key])
+            unit = {"acceleration": u.au / u.day**2, "length": u.au}.get(kind)
+            x = x.to_value(unit) if is_quantity(x) and unit is not None else x
+            if not isinstance(x, (int, float, np.floating, np.integer)) or not np.isfinite(x):
+                raise ValueError(f"Expected `nongrav` {key} a finite number (or Quantity), "
+                                 f"got {row[key]!r} at index {k}")
+            values[key].append(float(x))
+    if not bodies:
+        return None
+    units = {"acceleration": u.au / u.day**2, "length": u.au, "": u.dimensionless_unscaled}
+    return {"name": "nongrav", "body": bodies,
+            **{key: np.array(x) * units[NONGRAV_KEYS[key]] for key, x in values.items()}}
 
 
 def _tables(segments: Segments, at: int, perturbers: Sequence[str], without: str | None
@@ -174,8 +224,14 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     effects : sequence of str
         Beside Newton's law: ``"eih"`` (the Einstein-Infeld-Hoffmann equations of
         every perturber), ``"sun_j2"``, ``"earth_zonal"`` (:data:`EFFECTS`).
-    nongrav, events, variational, stm
-        Not yet supported (None, (), False, False).
+    nongrav : mapping or sequence of (mapping or None), optional
+        Marsden, Sekanina & Yeomans (1973) accelerations ``A1``, ``A2``, ``A3``
+        (Quantities of acceleration, or floats in au/day^2) with ``g(r)``'s
+        ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
+        r)^2``; :data:`hamilton_orbits.effects.nongrav.COMET_G` the comets'): one
+        mapping for every body, or one (or None) per body.
+    events, variational, stm
+        Not yet supported ((), False, False).
     method : {"radau15", "dop853"}
         The integrator.
     tol : float, optional
@@ -208,7 +264,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     """
     r, v = _states(r0, v0)
     names = _names(names, len(r))
-    _refuse_unsupported(asteroids, nongrav, method, events, variational, stm)
+    _refuse_unsupported(asteroids, method, events, variational, stm)
+    if nongrav is not None and not isinstance(nongrav, Mapping) and len(list(nongrav)) != len(r):
+        raise ValueError(f"Expected `nongrav` to be a mapping or one per body ({len(r)}), got "
+                         f"{len(list(nongrav))}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
@@ -219,8 +278,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         groups.setdefault(without, []).append(k)
     runs = []
     for without, rows in groups.items():  # (each asteroid propagated without its own pull)
+        mine = nongrav if nongrav is None or isinstance(nongrav, Mapping) else [
+            list(nongrav)[k] for k in rows]
         rhs = field_rhs(segments, [names[k] for k in rows], r[rows], v[rows], (jd1, jd2),
-                        tuple(effects), perturbers, without)
+                        tuple(effects), perturbers, without, mine)
         runs.append((rows, _run(names, rows, r[rows], v[rows], days, rhs, method, tol)))
     return _trajectory(names, runs, method, tuple(effects))
 
@@ -274,12 +335,12 @@ def _names(names: Sequence[str] | None, n: int) -> list[str]:
     return names
 
 
-def _refuse_unsupported(asteroids: Any, nongrav: Any, method: Any, events: Any,
-                        variational: Any, stm: Any) -> None:
+def _refuse_unsupported(asteroids: Any, method: Any, events: Any, variational: Any,
+                        stm: Any) -> None:
     """The options not yet supported, refused by name (issue 35)."""
     if not isinstance(asteroids, bool):
         raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
-    for name, value, ok in (("nongrav", nongrav, None), ("events", tuple(events), ()),
+    for name, value, ok in (("events", tuple(events), ()),
                             ("variational", variational, False), ("stm", stm, False)):
         if value != ok:
             raise ValueError(f"`{name}` is not supported yet by small_bodies.propagate, got "

@@ -26,16 +26,23 @@ def _asteroids():
     return r, v
 
 
-@pytest.mark.parametrize("effects", [(), ("eih",), ("eih", "sun_j2", "earth_zonal"),
-                                     ("sun_j2",)])
-def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects):
+COMET = {"A1": 2e-12, "A2": -3e-13, "A3": 1e-13, "alpha": 0.1112620426, "r0": 2.808,
+         "m": 2.15, "n": 5.093, "k": 4.6142}  # (g(r) of Marsden, Sekanina & Yeomans 1973)
+
+
+@pytest.mark.parametrize(("effects", "nongrav"), [
+    ((), None), (("eih",), None), (("eih", "sun_j2", "earth_zonal"), None), (("sun_j2",), None),
+    (("eih",), [{"A2": -2.9e-14}, None, COMET]), ((), {"A2": 5e-14 * u.au / u.day**2}),
+])
+def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects, nongrav):
     """At a time inside the excerpt, the small bodies' accelerations are those the
     n-body right-hand side of the same effects gives for the perturbers placed at
     DE440's states of that time (read by :meth:`Segments.states`) and the small
     bodies: the same kernels on the same numbers, bit for bit; the clock's is 0."""
     segments = Segments.load(EXCERPT)
     r, v = _asteroids()
-    rhs = field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0), effects)
+    rhs = field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0), effects,
+                    nongrav=nongrav)
     t = 100.25  # days from the epoch (exact: the same Julian date both ways)
     rs = np.vstack([r, [t, 0.0, 0.0]])
     vs = np.vstack([v, [1.0, 0.0, 0.0]])
@@ -48,8 +55,17 @@ def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects):
                for k, n in enumerate("abc")]
     system = System(bodies)
     arrays = system.as_arrays()
-    ref = compile_rhs(system, [EFFECTS[e] for e in effects]).acceleration(
-        arrays.r, arrays.v, arrays.gm)
+    listed = [EFFECTS[e] for e in effects]
+    if nongrav is not None:  # (the n-body effect's own form: one list per parameter)
+        rows = [nongrav] * 3 if isinstance(nongrav, dict) else nongrav
+        keys = ("A1", "A2", "A3", "alpha", "r0", "m", "n", "k")
+        defaults = (0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 0.0, 0.0)
+        units = (u.au / u.day**2,) * 3 + (u.one, u.au, u.one, u.one, u.one)
+        named = [n for n, x in zip("abc", rows, strict=True) if x]
+        listed.append({"name": "nongrav", "body": named,
+                       **{k: u.Quantity([x.get(k, d) for x in rows if x], unit)
+                          for k, d, unit in zip(keys, defaults, units, strict=True)}})
+    ref = compile_rhs(system, listed).acceleration(arrays.r, arrays.v, arrays.gm)
     assert np.array_equal(acc[:3], ref[len(PERTURBERS):]) and not acc[3].any()
     assert np.all(np.abs(acc[:3]) > 0)
     # the time-reversed motion: the velocities given are -v, the field the same
@@ -110,7 +126,8 @@ def test_a_small_body_about_one_moving_point_follows_kepler_at_the_right_times(m
 
 
 def test_a_run_forward_then_backward_returns_to_its_start():
-    """Three small bodies, every effect, 400 days forward and back from the end (the
+    """Three small bodies, every effect and a comet's and a Yarkovsky push, 400 days
+    forward and back from the end (the
     time-reversed motion: the field's velocities negated, the clock read as it
     runs back): the start again to radau15's error over 800 days (measured 1.3e-15
     au and 1.0e-17 au/day; the bounds leave 7-10x)."""
@@ -121,11 +138,12 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     segments = Segments.load(EXCERPT)
     r, v = _asteroids()
     epoch = Time(2451545.0, 0.25, format="jd", scale="tdb")
+    push = [None, COMET, {"A2": -2.9e-14}]  # (velocity dependent: transverse, normal)
     there = propagate(r * u.au, v * u.au / u.day, epoch, 400 * u.day, ephemeris=segments,
-                      asteroids=False)
+                      asteroids=False, nongrav=push)
     later = Time(2451545.0, 400.25, format="jd", scale="tdb")
     back = propagate(there.r[-1], there.v[-1], later, -400 * u.day, ephemeris=segments,
-                     asteroids=False)
+                     asteroids=False, nongrav=push)
     assert back.t[-1].to_value(u.day) == -400.0 and back.complete
     np.testing.assert_allclose(back.r[-1].to_value(u.au), r, rtol=0, atol=1e-14)
     np.testing.assert_allclose(back.v[-1].to_value(u.au / u.day), v, rtol=0, atol=1e-16)
@@ -137,7 +155,9 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(asteroids=None), "`asteroids`"),
     (dict(effects=("eih", "gr")), r"`effects`.*'gr' at index 1"),
     (dict(method="wh"), "`method`"),
-    (dict(nongrav={"A2": 1e-14}), "`nongrav`"),
+    (dict(nongrav={"A4": 1e-14}), "`nongrav` mappings"),
+    (dict(nongrav=[None, {"A2": np.nan}, None]), "`nongrav` A2 .* at index 1"),
+    (dict(nongrav=[None]), "`nongrav` to be a mapping or one per body"),
     (dict(variational=True), "`variational`"),
     (dict(names=["a", "a", "b"]), r"`names`.*'a' at index 1"),
     (dict(names=["sun", "b", "c"]), "`names`.*'sun' at index 0"),

@@ -19,11 +19,12 @@ kept, the perturbers' dropped (they follow the ephemeris).  No astropy here.
   1.0 for the time-reversed motion (the velocities given are ``-v``), ``p[2]``,
   ``p[3]`` the epoch's TDB Julian date in two parts, ``p[4]`` the number of
   perturbers ``K``, ``p[5]`` the kilometres in an au;
-- ``p[6:12]`` three (start, end) pairs: the parameters of ``eih``, ``j2_field`` and
-  ``zonal_field`` in ``p`` (start = end: not applied; no ``eih``: Newton);
-- ``p[12]`` the start of the perturbers' table, rows ``(gm, links, segment,
+- ``p[6:14]`` four (start, end) pairs: the parameters of ``eih``, ``j2_field``,
+  ``zonal_field`` and ``nongrav`` in ``p`` (start = end: not applied; no ``eih``:
+  Newton);
+- ``p[14]`` the start of the perturbers' table, rows ``(gm, links, segment,
   segment)`` (the chain of segments whose states add up to the barycentric one,
-  one or two); ``p[13]`` the start of the segments' table, rows ``(init, intlen,
+  one or two); ``p[15]`` the start of the segments' table, rows ``(init, intlen,
   records, coefficients, start of the coefficients (3, records, coefficients))``
   (km, days).
 """
@@ -36,12 +37,13 @@ from numba import njit
 from hamilton_orbits._kernels.chebyshev import add_state
 from hamilton_orbits._kernels.figures import zonal_field
 from hamilton_orbits._kernels.nbody import j2_field, newtonian
+from hamilton_orbits._kernels.nongrav import nongrav
 from hamilton_orbits._kernels.relativity import eih
 
 __all__ = ["HEADER", "small_bodies_field"]
 
 #: the entries of ``p`` before the tables
-HEADER = 14
+HEADER = 16
 
 
 @njit(cache=True, error_model="numpy")
@@ -65,6 +67,8 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
         j2_field(big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])])
     if p[11] > p[10]:
         zonal_field(big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])])
+    if p[13] > p[12]:
+        nongrav(big_r, big_v, big_gm, big_a, p[int(p[12]):int(p[13])])
     for i in range(nb):
         for c in range(3):
             acc[i, c] = big_a[k_p + i, c]
@@ -77,7 +81,7 @@ def _perturbers(p, days, out_r, out_v, out_gm):  # pragma: no cover - compiled
     """The perturbers' barycentric states (au, au/day) and GMs at ``days`` from the
     epoch into the first rows of ``out_r``, ``out_v``, ``out_gm``; NaN for a time
     outside their segments (the run then stops as on a non-finite force)."""
-    au, k_p, table, segs = p[5], int(p[4]), int(p[12]), int(p[13])
+    au, k_p, table, segs = p[5], int(p[4]), int(p[14]), int(p[15])
     jd1, jd2 = p[2], p[3] + days
     state = np.empty(6)
     width = 1
