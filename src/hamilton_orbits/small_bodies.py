@@ -30,6 +30,7 @@ equations (each refused by name).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -68,6 +69,21 @@ def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
     return System(bodies)
 
 
+@functools.lru_cache(maxsize=32)
+def _blocks(perturbers: tuple[str, ...], effects: tuple[str, ...], n: int
+            ) -> tuple[tuple[str, np.ndarray], ...]:
+    """The parameter vectors of ``effects`` for ``perturbers`` and ``n`` small bodies
+    (they depend on nothing else: made once per process)."""
+    from hamilton_orbits.effects import EffectSet
+
+    system = _combined_system([f"small body {k}" for k in range(n)], np.ones((n, 3)),
+                              np.zeros((n, 3)), perturbers)
+    blocks = EffectSet.of([EFFECTS[e] for e in effects], "nbody").parameters(system)
+    for block in blocks:
+        block.setflags(write=False)
+    return tuple(zip(effects, blocks, strict=True))
+
+
 def _chain(name: str) -> tuple[tuple[int, int], ...]:
     """The segments whose states add up to a perturber's barycentric state."""
     return de.CHAINS.get(name) or de.ASTEROID_CHAINS[name]
@@ -90,7 +106,7 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
     ValueError
         For an unknown effect, or a perturber the segments do not hold.
     """
-    from hamilton_orbits._kernels.perturbers import HEADER, small_bodies_field
+    from hamilton_orbits._kernels.perturbers import HEADER, cache_size, small_bodies_field
     from hamilton_orbits.effects import EffectSet
     from hamilton_orbits.rhs import RHS
 
@@ -98,13 +114,11 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
         if name not in EFFECTS:
             raise ValueError(f"Expected `effects` among {sorted(EFFECTS)}, got {name!r} at "
                              f"index {k}")
-    system = _combined_system(names, r0, v0, perturbers)
-    listed = {e: EFFECTS[e] for e in effects}
+    blocks = dict(_blocks(tuple(perturbers), tuple(effects), len(names)))
     outgassing = _nongrav_effect(nongrav, len(names))
-    if outgassing is not None:
-        listed["nongrav"] = outgassing
-    blocks = dict(zip(listed, EffectSet.of(list(listed.values()), "nbody").parameters(system),
-                      strict=True))
+    if outgassing is not None:  # (its parameters are the bodies' own: made each time)
+        system = _combined_system(names, r0, v0, perturbers)
+        blocks["nongrav"] = EffectSet.of([outgassing], "nbody").parameters(system)[0]
     head = np.zeros(HEADER)
     head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(perturbers)
     head[5] = de.constant("AU")
@@ -116,11 +130,14 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
         at += len(block)
     seg_table, pert_table, coefs = _tables(segments, at, perturbers, without)
     head[15], head[14] = at, at + len(seg_table)
-    p = np.concatenate([*parts, seg_table, pert_table, coefs])
+    head[16] = at + len(seg_table) + len(pert_table) + len(coefs)
+    cache = np.full(cache_size(len(perturbers)), np.nan)
+    cache[0] = 0.0  # (the next slot; a NaN time matches no time)
+    p = np.concatenate([*parts, seg_table, pert_table, coefs, cache])
     back = p.copy()
     back[1] = 1.0
     velocity = "eih" in effects or outgassing is not None
-    tag = ("newtonian", "small_bodies", *listed)
+    tag = ("newtonian", "small_bodies", *blocks)
     reverse = RHS(small_bodies_field, None, back, velocity, tag)
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
 

@@ -236,3 +236,25 @@ def test_three_asteroids_follow_jpls_own_integration_of_them():
     again = propagate(r[0] * u.au, v[0] * u.au / u.day, Time(jd0, format="jd", scale="tdb"),
                       days * u.day, names=["x", "y", "z"], ephemeris=segs)
     assert np.array_equal(again.r, traj.r)
+
+
+def test_the_cache_of_stage_times_gives_the_field_evaluated_afresh():
+    """The kernel keeps the perturbers' states of its last 8 times in ``p``: a time
+    met again (a corrector iteration at the same stage) gives the bits of a fresh
+    evaluation, whatever the small body's position, before and after the slots have
+    all been overwritten."""
+    segments = Segments.load(EXCERPT)
+    r, v = _asteroids()
+    effects = ("eih", "sun_j2", "earth_zonal")
+    rhs = field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0), effects)
+    rng = np.random.default_rng(8)
+    times = rng.uniform(-30.0, 700.0, 12)
+    for t in [*times[:3], times[0], *times[3:], times[1], times[11], times[0]]:
+        rs = np.vstack([r + rng.normal(0, 0.01, r.shape), [t, 0.0, 0.0]])
+        vs = np.vstack([v, [1.0, 0.0, 0.0]])
+        cached, fresh = np.empty_like(rs), np.empty_like(rs)
+        small_bodies_field(rs, vs, np.zeros(4), cached, rhs.p)
+        small_bodies_field(rs, vs, np.zeros(4), fresh,
+                           field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0),
+                                     effects).p)
+        assert np.array_equal(cached, fresh)
