@@ -42,7 +42,7 @@ from numba import njit
 
 from hamilton_orbits._kernels.chebyshev import add_state
 from hamilton_orbits._kernels.figures import zonal_field
-from hamilton_orbits._kernels.nbody import j2_field, newtonian
+from hamilton_orbits._kernels.nbody import j2_field, newtonian_only
 from hamilton_orbits._kernels.nongrav import nongrav
 
 __all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_field"]
@@ -74,7 +74,7 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
     if p[7] > p[6]:
         eih_on_particles(big_r, big_v, big_gm, big_a, p[int(p[6]):int(p[7])], k_p)
     else:
-        newtonian(big_r, big_v, big_gm, big_a)
+        newtonian_only(big_r, big_v, big_gm, big_a, p[0:0])  # (compiled apart: not inlined)
     if p[9] > p[8]:
         j2_field(big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])])
     if p[11] > p[10]:
