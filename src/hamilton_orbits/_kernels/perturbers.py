@@ -44,6 +44,7 @@ from hamilton_orbits._kernels.chebyshev import add_state
 from hamilton_orbits._kernels.figures import zonal_field
 from hamilton_orbits._kernels.nbody import j2_field, newtonian_only
 from hamilton_orbits._kernels.nongrav import nongrav
+from hamilton_orbits._kernels.relativity import eih_sources
 
 __all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_field"]
 
@@ -100,16 +101,7 @@ def eih_on_particles(r, v, gm, acc, p, k_p):  # pragma: no cover - compiled
     ic2 = 1.0 / (p[0] * p[0])
     beta, gamma = p[1], p[2]
     n = r.shape[0]
-    src = np.zeros(n, dtype=np.bool_)
-    if p.shape[0] > 3:
-        for b in range(3, p.shape[0]):
-            src[int(p[b])] = True
-    else:
-        for b in range(k_p):
-            src[b] = True
-    for i in range(n):
-        if gm[i] == 0.0:
-            src[i] = False
+    src = eih_sources(p, gm)  # (the massless rows never: their gm is 0)
     acc_n, phi = np.zeros((n, 3)), np.zeros(n)
     for m in range(n):
         if m < k_p and not src[m]:

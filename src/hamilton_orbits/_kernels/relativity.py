@@ -60,6 +60,24 @@ def newtonian_and_potential(r, gm, acc_n, phi, inv_d):  # pragma: no cover - com
             phi[j] += gm[i] * inv
 
 
+@njit(cache=True, inline="always")
+def eih_sources(p, gm):  # pragma: no cover - compiled
+    """Which bodies are the post-Newtonian sources of :func:`eih`'s ``p = [c, beta,
+    gamma, j_1, j_2, ...]``: those listed (every body when none is), massive."""
+    n = gm.shape[0]
+    src = np.zeros(n, dtype=np.bool_)
+    if p.shape[0] > 3:
+        for b in range(3, p.shape[0]):
+            src[int(p[b])] = True
+    else:
+        for b in range(n):
+            src[b] = True
+    for i in range(n):
+        if gm[i] == 0.0:
+            src[i] = False
+    return src
+
+
 @njit(cache=True)
 def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     """Newtonian plus first post-Newtonian accelerations (Moyer 2003, eq. 4-26), ADDED
@@ -76,16 +94,7 @@ def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     phi = np.empty(n)
     inv_d = np.empty((n, n))
     newtonian_and_potential(r, gm, acc_n, phi, inv_d)
-    src = np.zeros(n, dtype=np.bool_)
-    if p.shape[0] > 3:
-        for b in range(3, p.shape[0]):
-            src[int(p[b])] = True
-    else:
-        for b in range(n):
-            src[b] = True
-    for i in range(n):
-        if gm[i] == 0.0:
-            src[i] = False
+    src = eih_sources(p, gm)
     k = np.empty(7)
     k[0] = 2.0 * (beta + gamma) * ic2  # phi of the receiver
     k[1] = (2.0 * beta - 1.0) * ic2  # phi of the source
