@@ -53,19 +53,18 @@ EFFECTS = {"eih": {"name": "eih", "sources": list(PERTURBERS)},
 MARGIN_DAYS = 32.0
 
 
-def _combined_system(names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
-                     perturbers: Sequence[str]) -> Any:
-    """The perturbers (DE440's GMs, radii, J2 and poles; their J2000 states, never
-    used) and the small bodies (massless): the System the effects' parameters are
-    made for."""
+def _combined_system(n: int, perturbers: Sequence[str]) -> Any:
+    """The perturbers (DE440's GMs, radii, J2 and poles) and ``n`` massless small
+    bodies: the System the effects' parameters are made for (they depend on the
+    bodies' indices and constants, not on their states: placeholders here)."""
     import astropy.units as u
 
     from hamilton_orbits.nbody import Body, System
 
     bodies = [Body(**spec) for spec in de.body_specs("J2000", list(perturbers))]
-    for k in range(len(names)):  # (named apart: a small body may be an asteroid perturber)
-        bodies.append(Body(f"small body {k}", 0.0 * u.au**3 / u.day**2, r0[k] * u.au,
-                           v0[k] * u.au / u.day))
+    for k in range(n):  # (named apart: a small body may be an asteroid perturber)
+        bodies.append(Body(f"small body {k}", 0.0 * u.au**3 / u.day**2, [1.0, 0, 0] * u.au,
+                           [0, 0.01, 0] * u.au / u.day))
     return System(bodies)
 
 
@@ -76,8 +75,7 @@ def _blocks(perturbers: tuple[str, ...], effects: tuple[str, ...], n: int
     (they depend on nothing else: made once per process)."""
     from hamilton_orbits.effects import EffectSet
 
-    system = _combined_system([f"small body {k}" for k in range(n)], np.ones((n, 3)),
-                              np.zeros((n, 3)), perturbers)
+    system = _combined_system(n, perturbers)
     blocks = EffectSet.of([EFFECTS[e] for e in effects], "nbody").parameters(system)
     for block in blocks:
         block.setflags(write=False)
@@ -89,12 +87,11 @@ def _chain(name: str) -> tuple[tuple[int, int], ...]:
     return de.CHAINS.get(name) or de.ASTEROID_CHAINS[name]
 
 
-def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.ndarray,
-              epoch: tuple[float, float], effects: Sequence[str],
+def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, float],
+              effects: Sequence[str],
               perturbers: Sequence[str] = PERTURBERS, without: str | None = None,
               nongrav: Any = None) -> Any:
-    """The right-hand side of the small bodies ``names`` (their states ``r0``, ``v0``
-    in au and au/day, only for the effects' parameters) and the clock, in the field
+    """The right-hand side of the small bodies ``names`` and the clock, in the field
     of ``perturbers`` (:data:`PERTURBERS`, then any of the 16 asteroids) read from
     ``segments`` from TDB Julian date ``epoch`` (two parts), with ``effects`` (keys
     of :data:`EFFECTS`), ``without`` one perturber's pull (its GM 0), ``nongrav``
@@ -117,7 +114,7 @@ def field_rhs(segments: Segments, names: Sequence[str], r0: np.ndarray, v0: np.n
     blocks = dict(_blocks(tuple(perturbers), tuple(effects), len(names)))
     outgassing = _nongrav_effect(nongrav, len(names))
     if outgassing is not None:  # (its parameters are the bodies' own: made each time)
-        system = _combined_system(names, r0, v0, perturbers)
+        system = _combined_system(len(names), perturbers)
         blocks["nongrav"] = EffectSet.of([outgassing], "nbody").parameters(system)[0]
     head = np.zeros(HEADER)
     head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(perturbers)
@@ -297,8 +294,8 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     for without, rows in groups.items():  # (each asteroid propagated without its own pull)
         mine = nongrav if nongrav is None or isinstance(nongrav, Mapping) else [
             list(nongrav)[k] for k in rows]
-        rhs = field_rhs(segments, [names[k] for k in rows], r[rows], v[rows], (jd1, jd2),
-                        tuple(effects), perturbers, without, mine)
+        rhs = field_rhs(segments, [names[k] for k in rows], (jd1, jd2), tuple(effects),
+                        perturbers, without, mine)
         runs.append((rows, _run(names, rows, r[rows], v[rows], days, rhs, method, tol)))
     return _trajectory(names, runs, method, tuple(effects))
 
@@ -357,7 +354,8 @@ def _refuse_unsupported(asteroids: Any, method: Any, events: Any, variational: A
     """The options not yet supported, refused by name (issue 35)."""
     if not isinstance(asteroids, bool):
         raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
-    for name, value, ok in (("events", tuple(events), ()),
+    events = tuple(events) if isinstance(events, (list, tuple)) else events
+    for name, value, ok in (("events", events, ()),
                             ("variational", variational, False), ("stm", stm, False)):
         if value != ok:
             raise ValueError(f"`{name}` is not supported yet by small_bodies.propagate, got "

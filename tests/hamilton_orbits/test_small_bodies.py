@@ -41,7 +41,7 @@ def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects, nongra
     bodies: the same kernels on the same numbers, bit for bit; the clock's is 0."""
     segments = Segments.load(EXCERPT)
     r, v = _asteroids()
-    rhs = field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0), effects,
+    rhs = field_rhs(segments, ["a", "b", "c"], (2451545.0, 0.0), effects,
                     nongrav=nongrav)
     t = 100.25  # days from the epoch (exact: the same Julian date both ways)
     rs = np.vstack([r, [t, 0.0, 0.0]])
@@ -246,7 +246,7 @@ def test_the_cache_of_stage_times_gives_the_field_evaluated_afresh():
     segments = Segments.load(EXCERPT)
     r, v = _asteroids()
     effects = ("eih", "sun_j2", "earth_zonal")
-    rhs = field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0), effects)
+    rhs = field_rhs(segments, ["a", "b", "c"], (2451545.0, 0.0), effects)
     rng = np.random.default_rng(8)
     times = rng.uniform(-30.0, 700.0, 12)
     for t in [*times[:3], times[0], *times[3:], times[1], times[11], times[0]]:
@@ -255,7 +255,7 @@ def test_the_cache_of_stage_times_gives_the_field_evaluated_afresh():
         cached, fresh = np.empty_like(rs), np.empty_like(rs)
         small_bodies_field(rs, vs, np.zeros(4), cached, rhs.p)
         small_bodies_field(rs, vs, np.zeros(4), fresh,
-                           field_rhs(segments, ["a", "b", "c"], r, v, (2451545.0, 0.0),
+                           field_rhs(segments, ["a", "b", "c"], (2451545.0, 0.0),
                                      effects).p)
         assert np.array_equal(cached, fresh)
 
