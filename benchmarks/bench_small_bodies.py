@@ -13,7 +13,8 @@ from 2.2 to 3.2 au, seed 1) over ten years from 2020-01-01 TDB:
 
 - our time (``small_bodies.propagate`` with its defaults: the 16 asteroids, eih,
   the Sun's J2, the Earth's zonal field; the segments read beforehand) and
-  ASSIST's (its default forces), medians of ``--repeat`` runs, and the ratio;
+  ASSIST's (its default forces with ``gr_eih_sources = 11``: the same model),
+  medians of ``--repeat`` runs, and the ratio;
 - the distance between the two final positions (two codes, one force model).
 """
 
@@ -89,10 +90,11 @@ def main() -> None:
         line = f"{n} asteroid(s): ours {mine * 1e3:7.1f} ms"
         if args.assist_python:
             res = theirs(args.assist_python, r, v, args.repeat)
-            km = np.linalg.norm(final - np.array(res["final"])[:, :3], axis=1) * de.constant("AU")
+            apart = np.linalg.norm(final - np.array(res["final"])[:, :3], axis=1)
+            m = apart * de.constant("AU") * 1e3
             line += (f", ASSIST {res['version']} {res['seconds'] * 1e3:7.1f} ms, ours / ASSIST "
-                     f"{mine / res['seconds']:.2f}; final positions apart {km.min():.3f}-"
-                     f"{km.max():.3f} km (ASSIST's forces: {', '.join(res['forces'])})")
+                     f"{mine / res['seconds']:.2f}; final positions apart {m.min():.3f}-"
+                     f"{m.max():.3f} m (ASSIST's forces: {', '.join(res['forces'])})")
         print(line, flush=True)
 
 

@@ -5,7 +5,10 @@ virtual environment of its own (``python -m venv /tmp/assist_venv &&
 /tmp/assist_venv/bin/pip install assist``) and this script is its entry: it reads
 one job as JSON on stdin (barycentric ICRS states ``r``, ``v`` in au and au/day,
 TDB Julian date ``jd``, ``days``, ``repeat``, the kernels' paths ``planets`` and
-``asteroids``), integrates each body with ASSIST's default forces and prints the
+``asteroids``), integrates each body with ASSIST's default forces, the post-Newtonian terms of
+the Sun, the planets, the Moon and Pluto (``gr_eih_sources = 11``: our force
+model, and that of ASSIST's own tests against JPL; its default is the Sun's alone)
+and prints the
 final states, the median seconds of ``repeat`` runs of all of them, and ASSIST's
 force list as JSON.
 """
@@ -24,6 +27,7 @@ def run(ephem, x, jd, days):
     sim.add(x=x[0], y=x[1], z=x[2], vx=x[3], vy=x[4], vz=x[5])
     sim.t = jd - ephem.jd_ref
     extras = assist.Extras(sim, ephem)
+    extras.gr_eih_sources = 11  # the Sun, planets, Moon, Pluto: ours, and ASSIST's JPL cases
     sim.integrate(sim.t + days)
     p = sim.particles[0]
     return [p.x, p.y, p.z, p.vx, p.vy, p.vz], list(extras.forces)

@@ -31,6 +31,7 @@ equations (each refused by name).
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -125,17 +126,19 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
         head[slot], head[slot + 1] = at, at + len(block)
         parts.append(block)
         at += len(block)
-    seg_table, pert_table, coefs = _tables(segments, at, perturbers, without)
+    seg_rows, pert_table, coefs = _tables(segments, tuple(perturbers), without)
+    seg_table = seg_rows.copy()
+    seg_table[4::5] += at + len(seg_table) + len(pert_table)  # (the coefficients' starts)
     head[15], head[14] = at, at + len(seg_table)
     head[16] = at + len(seg_table) + len(pert_table) + len(coefs)
     cache = np.full(cache_size(len(perturbers)), np.nan)
     cache[0] = 0.0  # (the next slot; a NaN time matches no time)
     p = np.concatenate([*parts, seg_table, pert_table, coefs, cache])
-    back = p.copy()
-    back[1] = 1.0
     velocity = "eih" in effects or outgassing is not None
     tag = ("newtonian", "small_bodies", *blocks)
-    reverse = RHS(small_bodies_field, None, back, velocity, tag)
+    # the time-reversed motion: the same kernel and parameters, the clock's velocity
+    # (-1) says which (and one run at a time uses the cache)
+    reverse = RHS(small_bodies_field, None, p, velocity, tag)
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
 
 
@@ -182,16 +185,40 @@ def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
             **{key: np.array(x) * units[NONGRAV_KEYS[key]] for key, x in values.items()}}
 
 
-def _tables(segments: Segments, at: int, perturbers: Sequence[str], without: str | None
+def _tables(segments: Segments, perturbers: tuple[str, ...], without: str | None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The segments' table, the perturbers' and the coefficients (see
-    ``hamilton_orbits._kernels.perturbers``), the tables starting at ``at``."""
+    """The segments' table (the coefficients' starts from 0), the perturbers' and
+    the coefficients (see ``hamilton_orbits._kernels.perturbers``), kept for the
+    last few ``segments`` (a run's fixed cost: the coefficients of ten years are
+    1.4 MB)."""
+    key = (id(segments), perturbers, without)
+    kept = _TABLES.get(key)
+    if kept is not None and kept[0]() is segments:
+        return kept[1]
+    made = _make_tables(segments, perturbers, without)
+    if len(_TABLES) >= 8:
+        _TABLES.pop(next(iter(_TABLES)))
+    _TABLES[key] = (weakref.ref(segments), made)
+    return made
+
+
+#: :func:`_tables` kept, by the segments' identity (checked through a weak reference)
+_TABLES: dict[tuple[Any, ...], tuple[Any, tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
+
+
+def _make_tables(segments: Segments, perturbers: tuple[str, ...], without: str | None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_tables`, made."""
     pairs = sorted({pair for name in perturbers for pair in _chain(name)})
     missing = [p for p in pairs if p not in segments.segments]
     if missing:
         raise ValueError(f"Expected `ephemeris` to hold the segments {missing} (of the "
                          f"perturbers {list(perturbers)})")
-    first = at + 5 * len(pairs) + 4 * len(perturbers)
+    # segments on one grid of records side by side: the kernel computes their
+    # Chebyshev polynomials once
+    pairs.sort(key=lambda pair: (segments.segments[pair].init, segments.segments[pair].intlen,
+                                 segments.segments[pair].coef.shape[1], pair))
+    first = 0
     seg_rows, coefs = [], []
     for pair in pairs:
         seg = segments.segments[pair]

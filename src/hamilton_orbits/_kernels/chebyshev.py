@@ -41,12 +41,25 @@ def add_state(coef, init, intlen, jd1, jd2, out, t, u):  # pragma: no cover - co
     :func:`add_states`, ``t``, ``u`` work space of the coefficients' length); False,
     ``out`` left alone, for a time outside the segment."""
     n, m = coef.shape[1], coef.shape[2]
+    k = basis(init, intlen, n, jd1, jd2, m, t, u)
+    if k < 0:
+        return False
+    add_record(coef, k, intlen, t, u, out)
+    return True
+
+
+@njit(cache=True, inline="always")
+def basis(init, intlen, n, jd1, jd2, m, t, u):  # pragma: no cover - compiled
+    """The record ``k`` of a segment of ``n`` records of ``intlen`` days from
+    ``init`` that holds the time ``jd1 + jd2`` (-1 outside the segment), and the
+    Chebyshev polynomials ``T_j(s)``, ``U_j(s)``, ``j < m``, at its ``s`` into
+    ``t``, ``u`` (the same for every segment of the same ``init`` and ``intlen``)."""
     d = (jd1 - init) + jd2
     k = int(np.floor(d / intlen))
     if k == n and d <= n * intlen:  # (the segment's last instant)
         k = n - 1
     if k < 0 or k >= n or not np.isfinite(d):
-        return False
+        return -1
     s = 2.0 * (d - k * intlen) / intlen - 1.0
     t[0] = 1.0
     u[0] = 1.0
@@ -56,6 +69,14 @@ def add_state(coef, init, intlen, jd1, jd2, out, t, u):  # pragma: no cover - co
     for j in range(2, m):
         t[j] = 2.0 * s * t[j - 1] - t[j - 2]
         u[j] = 2.0 * s * u[j - 1] - u[j - 2]
+    return k
+
+
+@njit(cache=True, inline="always")
+def add_record(coef, k, intlen, t, u, out):  # pragma: no cover - compiled
+    """ADD record ``k`` of ``coef`` (3, n, m) at the polynomials ``t``, ``u`` of
+    :func:`basis` to ``out`` (6,): position, and velocity per day."""
+    m = coef.shape[2]
     for c in range(3):
         x = 0.0
         dx = 0.0
@@ -65,4 +86,3 @@ def add_state(coef, init, intlen, jd1, jd2, out, t, u):  # pragma: no cover - co
                 dx += j * coef[c, k, j] * u[j - 1]
         out[c] += x
         out[3 + c] += dx * 2.0 / intlen
-    return True

@@ -325,6 +325,28 @@ def _newtonian_rows_spaced(r, gm, idx, first, acc):  # pragma: no cover - compil
     _massive_rows(r, gm, idx, acc, w)
     if nm == n - first:
         return
+    _test_blocks(r, gm, first, nm, w, acc)
+
+
+@njit(cache=True, error_model="numpy")
+def massless_rows(r, gm, first, acc):  # pragma: no cover - compiled
+    """The test particles' rows (``gm == 0``, from ``first`` on) of :func:`newtonian`
+    alone, the same to the bit; every other row of ``acc`` left alone.  For a field
+    of many bodies that pull on each other but whose own accelerations are not
+    wanted (perturbers read from an ephemeris): the massive pairs are not summed."""
+    idx = massive_indices(gm)
+    nm = idx.shape[0]
+    w = (carray(_stack_scratch(), SCRATCH) if nm <= STACK_MASSIVE
+         else np.empty(7 * _padded(nm) + 6 * BLOCK))
+    _gather_massive(r, gm, idx, True, nm, w)
+    _test_blocks(r, gm, first, nm, w, acc)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _test_blocks(r, gm, first, nm, w, acc):  # pragma: no cover - compiled
+    """The test particles' rows from ``first`` on, :data:`BLOCK` at a time
+    (:func:`_soa_block`), from the ``nm`` massive bodies gathered in ``w``."""
+    n = r.shape[0]
     o = 7 * _padded(nm) + 3 * BLOCK
     for k0 in range(first, n, BLOCK):
         k1 = min(k0 + BLOCK, n)

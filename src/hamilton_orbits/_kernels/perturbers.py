@@ -15,8 +15,9 @@ kept, the perturbers' dropped (they follow the ephemeris).  No astropy here.
 
 ``p`` (float64):
 
-- ``p[0]`` the number of small bodies ``nb`` (the clock is row ``nb``), ``p[1]``
-  1.0 for the time-reversed motion (the velocities given are ``-v``), ``p[2]``,
+- ``p[0]`` the number of small bodies ``nb`` (the clock is row ``nb``; its
+  velocity -1 says that the motion is the time-reversed one, the velocities
+  given ``-v``), ``p[1]`` unused, ``p[2]``,
   ``p[3]`` the epoch's TDB Julian date in two parts, ``p[4]`` the number of
   perturbers ``K``, ``p[5]`` the kilometres in an au;
 - ``p[6:14]`` four (start, end) pairs: the parameters of ``eih``, ``j2_field``,
@@ -28,11 +29,18 @@ kept, the perturbers' dropped (they follow the ephemeris).  No astropy here.
   records, coefficients, start of the coefficients (3, records, coefficients))``
   (km, days);
 - ``p[16]`` the start of a cache the kernel writes: the next slot, then
-  :data:`CACHE_SLOTS` slots of (time, the perturbers' positions and velocities).
-  An integrator's corrector iterations evaluate the field again and again at the
-  same stage times: the perturbers' states of a time met in the last
-  ``CACHE_SLOTS`` are copied, not evaluated again (the same numbers).  One ``p``
+  :data:`CACHE_SLOTS` slots of (time, the perturbers' positions and velocities,
+  and, with ``eih``, the sources' Newtonian accelerations and potentials).  An
+  integrator's corrector iterations evaluate the field again and again at the
+  same stage times: what depends on the time alone, for a time met in the last
+  ``CACHE_SLOTS``, is copied, not computed again (the same numbers).  One ``p``
   must therefore serve one run at a time.
+
+What is computed per call is what the small bodies feel: Newton's law from the
+perturbers alone (:func:`hamilton_orbits._kernels.nbody.massless_rows`; the
+perturbers' mutual pull, which the ephemeris already holds, is never summed),
+or, with ``eih``, the small bodies' Newtonian sums and corrections
+(:func:`eih_on_particles`) on the sources' sums of the cache.
 """
 
 from __future__ import annotations
@@ -40,13 +48,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hamilton_orbits._kernels.chebyshev import add_state
+from hamilton_orbits._kernels.chebyshev import add_record, basis
 from hamilton_orbits._kernels.figures import zonal_field
-from hamilton_orbits._kernels.nbody import j2_field, newtonian_only
+from hamilton_orbits._kernels.nbody import j2_field, massless_rows
 from hamilton_orbits._kernels.nongrav import nongrav
 from hamilton_orbits._kernels.relativity import eih_sources
 
-__all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_field"]
+__all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_field",
+           "source_sums"]
 
 #: the entries of ``p`` before the tables
 HEADER = 17
@@ -55,8 +64,9 @@ CACHE_SLOTS = 8
 
 
 def cache_size(k_p: int) -> int:
-    """The floats of the cache of ``k_p`` perturbers (see the module)."""
-    return 1 + CACHE_SLOTS * (1 + 6 * k_p)
+    """The floats of the cache of ``k_p`` perturbers (see the module): a slot holds
+    the time, then ``(r, v, a_N, phi)`` of each (10 floats)."""
+    return 1 + CACHE_SLOTS * (1 + 10 * k_p)
 
 
 @njit(cache=True, error_model="numpy")
@@ -64,22 +74,25 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The accelerations of the small bodies (and 0 for the clock), see the module."""
     nb, k_p = int(p[0]), int(p[4])
     n = k_p + nb
-    big_r, big_v, big_a = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
-    big_gm = np.zeros(n)
-    _cached_perturbers(p, r[nb, 0], big_r, big_v, big_gm)
-    sign = -1.0 if p[1] != 0.0 else 1.0
+    work = np.zeros(14 * n)  # (one allocation: it costs as much as the sums of a hit)
+    big_r, big_v = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
+    big_a, acc_n = work[6 * n:9 * n].reshape((n, 3)), work[9 * n:12 * n].reshape((n, 3))
+    big_gm, phi = work[12 * n:13 * n], work[13 * n:14 * n]
+    eih = p[7] > p[6]
+    _cached_perturbers(p, r[nb, 0], big_r, big_v, big_gm, acc_n, phi)
+    sign = v[nb, 0]  # (the clock's velocity: 1, or -1 in the time-reversed motion)
     for i in range(nb):
         for c in range(3):
             big_r[k_p + i, c] = r[i, c]
             big_v[k_p + i, c] = sign * v[i, c]
-    if p[7] > p[6]:
-        eih_on_particles(big_r, big_v, big_gm, big_a, p[int(p[6]):int(p[7])], k_p)
+    if eih:
+        eih_on_particles(big_r, big_v, big_gm, big_a, p[int(p[6]):int(p[7])], k_p, acc_n, phi)
     else:
-        newtonian_only(big_r, big_v, big_gm, big_a, p[0:0])  # (compiled apart: not inlined)
+        massless_rows(big_r, big_gm, k_p, big_a)
     if p[9] > p[8]:
-        j2_field(big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])])
+        _figure_on_particles(False, big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])], k_p)
     if p[11] > p[10]:
-        zonal_field(big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])])
+        _figure_on_particles(True, big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])], k_p)
     if p[13] > p[12]:
         nongrav(big_r, big_v, big_gm, big_a, p[int(p[12]):int(p[13])])
     for i in range(nb):
@@ -90,40 +103,110 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def eih_on_particles(r, v, gm, acc, p, k_p):  # pragma: no cover - compiled
+def _figure_on_particles(zonal, r, v, gm, acc, q, k_p):  # pragma: no cover - compiled
+    """:func:`~hamilton_orbits._kernels.figures.zonal_field` (``zonal``) or
+    :func:`~hamilton_orbits._kernels.nbody.j2_field` of the body ``q[0]`` ADDED to
+    the rows ``k_p``... alone (the same bits: each row's term depends on that row
+    and the body only): both run on the body and those rows, not on every
+    perturber."""
+    b, n = int(q[0]), r.shape[0] - k_p + 1
+    work = np.empty(10 * n)
+    sr, sv = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
+    sa, sg = work[6 * n:9 * n].reshape((n, 3)), work[9 * n:10 * n]
+    for i in range(n):
+        row = b if i == 0 else k_p + i - 1
+        sg[i] = gm[row]
+        for c in range(3):
+            sr[i, c], sv[i, c], sa[i, c] = r[row, c], v[row, c], acc[row, c]
+    here = q.copy()
+    here[0] = 0.0
+    if zonal:
+        zonal_field(sr, sv, sg, sa, here)
+    else:
+        j2_field(sr, sv, sg, sa, here)
+    for i in range(1, n):
+        for c in range(3):
+            acc[k_p + i - 1, c] = sa[i, c]
+
+
+@njit(cache=True, error_model="numpy")
+def source_sums(r, gm, p, k_p, acc_n, phi):  # pragma: no cover - compiled
+    """The Newtonian accelerations ``acc_n`` and potentials ``phi`` of the
+    post-Newtonian sources among the first ``k_p`` rows (:func:`~hamilton_orbits.
+    _kernels.relativity.eih`'s ``p``), summed over their partners among those rows
+    in increasing order, as the pair loop of :func:`~hamilton_orbits._kernels.
+    relativity.newtonian_and_potential` sums them (the massless rows after them
+    add nothing: +-0 to each sum); the other rows left alone.
+
+    Every source at once for each partner (the loop the compiler vectorises): a
+    term is the pair loop's to the bit, ``r_k - r_m`` being minus its separation
+    exactly when ``k < m``, and a source's own row adds ``+0``."""
+    src = eih_sources(p, gm)
+    ns = 0
+    for m in range(k_p):
+        ns += 1 if src[m] else 0
+    w = np.zeros((8, ns))  # x, y, z, the sums of a_x, a_y, a_z and phi, the row
+    a = 0
+    for m in range(k_p):
+        if src[m]:
+            w[0, a], w[1, a], w[2, a], w[7, a] = r[m, 0], r[m, 1], r[m, 2], m
+            a += 1
+    for k in range(k_p):
+        xk, yk, zk, gk = r[k, 0], r[k, 1], r[k, 2], gm[k]
+        for a in range(ns):
+            dx = xk - w[0, a]
+            dy = yk - w[1, a]
+            dz = zk - w[2, a]
+            d2 = dx * dx + dy * dy + dz * dz
+            own = w[7, a] == k
+            inv = 1.0 / np.sqrt(1.0 if own else d2)
+            g = 0.0 if own else gk
+            f = g * (inv * inv * inv)
+            w[3, a] += f * dx
+            w[4, a] += f * dy
+            w[5, a] += f * dz
+            w[6, a] += g * inv
+    for a in range(ns):
+        m = int(w[7, a])
+        acc_n[m, 0], acc_n[m, 1], acc_n[m, 2], phi[m] = w[3, a], w[4, a], w[5, a], w[6, a]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _newtonian_sum(r, gm, m, k_p, acc_n, phi):  # pragma: no cover - compiled
+    """Row ``m``'s Newtonian acceleration and potential from rows ``0 .. k_p - 1``
+    (see :func:`source_sums`)."""
+    for k in range(k_p):
+        if k == m or (gm[k] == 0.0 and gm[m] == 0.0):
+            continue
+        lo, hi = (k, m) if k < m else (m, k)
+        dx = r[hi, 0] - r[lo, 0]
+        dy = r[hi, 1] - r[lo, 1]
+        dz = r[hi, 2] - r[lo, 2]
+        inv = 1.0 / np.sqrt(dx * dx + dy * dy + dz * dz)
+        f = gm[k] * (inv * inv * inv)
+        if k > m:
+            acc_n[m, 0] += f * dx
+            acc_n[m, 1] += f * dy
+            acc_n[m, 2] += f * dz
+        else:
+            acc_n[m, 0] -= f * dx
+            acc_n[m, 1] -= f * dy
+            acc_n[m, 2] -= f * dz
+        phi[m] += gm[k] * inv
+
+
+@njit(cache=True, error_model="numpy")
+def eih_on_particles(r, v, gm, acc, p, k_p, acc_n, phi):  # pragma: no cover - compiled
     """:func:`hamilton_orbits._kernels.relativity.eih` for the massless rows ``k_p``...
     alone, ADDED to their ``acc`` (the massive rows ``0 .. k_p - 1``, whose own
-    accelerations are not wanted, left alone): the same terms in the same order,
-    so the same bits, without the massive bodies' mutual corrections.  The sources'
-    Newtonian accelerations and potentials, which the corrections use, are summed
-    over their partners in increasing order as the pair loop of
-    :func:`~hamilton_orbits._kernels.relativity.newtonian_and_potential` sums them."""
+    accelerations are not wanted, left alone), the sources' sums ``acc_n``, ``phi``
+    given (:func:`source_sums`): the same terms in the same order, so the same bits,
+    without the massive bodies' mutual corrections."""
     ic2 = 1.0 / (p[0] * p[0])
     beta, gamma = p[1], p[2]
-    n = r.shape[0]
     src = eih_sources(p, gm)  # (the massless rows never: their gm is 0)
-    acc_n, phi = np.zeros((n, 3)), np.zeros(n)
-    for m in range(n):
-        if m < k_p and not src[m]:
-            continue  # (a perturber that is no source: its own field is not needed)
-        for k in range(k_p):  # (the massless rows add nothing: +-0 to each sum)
-            if k == m or (gm[k] == 0.0 and gm[m] == 0.0):
-                continue
-            lo, hi = (k, m) if k < m else (m, k)
-            dx = r[hi, 0] - r[lo, 0]
-            dy = r[hi, 1] - r[lo, 1]
-            dz = r[hi, 2] - r[lo, 2]
-            inv = 1.0 / np.sqrt(dx * dx + dy * dy + dz * dz)
-            f = gm[k] * (inv * inv * inv)
-            if k > m:
-                acc_n[m, 0] += f * dx
-                acc_n[m, 1] += f * dy
-                acc_n[m, 2] += f * dz
-            else:
-                acc_n[m, 0] -= f * dx
-                acc_n[m, 1] -= f * dy
-                acc_n[m, 2] -= f * dz
-            phi[m] += gm[k] * inv
+    for m in range(k_p, r.shape[0]):
+        _newtonian_sum(r, gm, m, k_p, acc_n, phi)
     _particle_corrections(r, v, gm, acc, acc_n, phi, src, k_p, ic2, beta, gamma)
 
 
@@ -174,30 +257,46 @@ def _particle_corrections(r, v, gm, acc, acc_n, phi, src, k_p, ic2, beta,
 
 
 @njit(cache=True, error_model="numpy")
-def _cached_perturbers(p, days, out_r, out_v, out_gm):  # pragma: no cover - compiled
-    """:func:`_perturbers`, through the cache of the last stage times (see the
-    module): a time met again is copied."""
+def _cached_perturbers(p, days, out_r, out_v, out_gm, acc_n, phi):  # pragma: no cover
+    """:func:`_perturbers` (and, with ``eih``, :func:`source_sums` into ``acc_n``,
+    ``phi``, zeros), through the cache of the last stage times (see the module): a
+    time met again is copied."""
     k_p, at = int(p[4]), int(p[16])
-    size = 1 + 6 * k_p
+    size = 1 + 10 * k_p
     for k in range(k_p):
         out_gm[k] = p[int(p[14]) + 4 * k]
     for slot in range(CACHE_SLOTS):
         row = at + 1 + slot * size
         if p[row] == days:
-            for k in range(k_p):
-                for c in range(3):
-                    out_r[k, c] = p[row + 1 + 6 * k + c]
-                    out_v[k, c] = p[row + 4 + 6 * k + c]
+            _slot_copy(p, row + 1, k_p, out_r, out_v, acc_n, phi, False)
             return
     _perturbers(p, days, out_r, out_v, out_gm)
+    if p[7] > p[6]:
+        source_sums(out_r, out_gm, p[int(p[6]):int(p[7])], k_p, acc_n, phi)
     slot = int(p[at])
     row = at + 1 + slot * size
     p[row] = days
-    for k in range(k_p):
-        for c in range(3):
-            p[row + 1 + 6 * k + c] = out_r[k, c]
-            p[row + 4 + 6 * k + c] = out_v[k, c]
+    _slot_copy(p, row + 1, k_p, out_r, out_v, acc_n, phi, True)
     p[at] = (slot + 1) % CACHE_SLOTS
+
+
+@njit(cache=True, inline="always")
+def _slot_copy(p, at, k_p, out_r, out_v, acc_n, phi, store):  # pragma: no cover - compiled
+    """Copy the cache slot's values from ``p[at:]`` to the first ``k_p`` rows of
+    ``out_r``, ``out_v``, ``acc_n``, ``phi`` (``store``: the other way)."""
+    for k in range(k_p):
+        base = at + 10 * k
+        for c in range(3):
+            if store:
+                p[base + c], p[base + 3 + c] = out_r[k, c], out_v[k, c]
+                p[base + 6 + c] = acc_n[k, c]
+            else:
+                out_r[k, c], out_v[k, c] = p[base + c], p[base + 3 + c]
+                acc_n[k, c] = p[base + 6 + c]
+        if store:
+            p[base + 9] = phi[k]
+        else:
+            phi[k] = p[base + 9]
 
 
 @njit(cache=True, error_model="numpy")
@@ -214,12 +313,18 @@ def _perturbers(p, days, out_r, out_v, out_gm):  # pragma: no cover - compiled
         width = max(width, int(p[segs + 5 * s + 3]))
     t, u = np.empty(width), np.empty(width)
     seg_state = np.zeros((n_seg, 6))
+    k = -1
     for s in range(n_seg):
         at = segs + 5 * s
         n_rec, m, first = int(p[at + 2]), int(p[at + 3]), int(p[at + 4])
-        coef = p[first:first + 3 * n_rec * m].reshape((3, n_rec, m))
-        if not add_state(coef, p[at], p[at + 1], jd1, jd2, seg_state[s], t, u):
+        if s == 0 or p[at] != p[at - 5] or p[at + 1] != p[at - 4] or p[at + 2] != p[at - 3]:
+            # (a new grid of records; the segments are sorted by grid, small_bodies._tables)
+            k = basis(p[at], p[at + 1], n_rec, jd1, jd2, width, t, u)
+        if k < 0:
             seg_state[s, :] = np.nan
+            continue
+        coef = p[first:first + 3 * n_rec * m].reshape((3, n_rec, m))
+        add_record(coef, k, p[at + 1], t, u, seg_state[s])
     state = np.empty(6)
     for k in range(k_p):
         row = table + 4 * k
