@@ -37,8 +37,9 @@ def main():
     job = json.load(sys.stdin)
     ephem = assist.Ephem(job["planets"], job["asteroids"])
     states = [r + v for r, v in zip(job["r"], job["v"], strict=True)]
+    start = time.perf_counter()
     final = [run(ephem, x, job["jd"], job["days"]) for x in states]
-    seconds = []
+    seconds = [time.perf_counter() - start] if job["repeat"] == 0 else []  # (0: that run)
     for _ in range(job["repeat"]):
         start = time.perf_counter()
         for x in states:

@@ -25,6 +25,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._progress import progress_bar
+from hamilton_orbits.batches import check_client, check_workers
 from hamilton_orbits.scene import Scene
 
 __all__ = ["Ensemble", "run_member"]
@@ -83,15 +84,8 @@ def _members(members: Any) -> list[dict[str, Any]]:
 
 def _check_run_args(client: Any, workers: Any) -> None:
     """Refuse a ``client`` that is not a Dask client and a ``workers`` that is not a count."""
-    if client is not None and not (callable(getattr(client, "map", None))
-                                   and callable(getattr(client, "submit", None))):
-        hint = (f"; connect first: dask.distributed.Client({client!r})"
-                if isinstance(client, str) else "")
-        raise ValueError(f"Expected `client` to be a dask.distributed.Client, got {client!r}"
-                         + hint)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
-        raise ValueError(f"Expected `workers` to be a number of processes >= 1, got {workers!r}")
+    check_client(client)
+    check_workers(workers, "processes")
 
 
 def _plain(value: Any) -> Any:
