@@ -26,8 +26,9 @@ propagated without it, the others still pulling on it.
 ``nongrav`` adds the comets' and asteroids' non-gravitational accelerations (the
 ``nongrav`` effect).  Many bodies go in chunks (``chunk``, 100), each an
 independent run (:func:`run_job`), one after another, on threads or on a Dask
-cluster (:func:`hamilton_orbits.batches.run_jobs`).  Not yet here (issue 35):
-events and the variational equations (each refused by name).
+cluster (:func:`hamilton_orbits.batches.run_jobs`).  ``stm=True`` adds the state
+transition matrix (the field's Jacobian by central differences), ``variational``
+MEGNO.  Not yet here (issue 35): events (refused by name).
 """
 
 from __future__ import annotations
@@ -93,20 +94,27 @@ def _chain(name: str) -> tuple[tuple[int, int], ...]:
 def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, float],
               effects: Sequence[str],
               perturbers: Sequence[str] = PERTURBERS, without: str | None = None,
-              nongrav: Any = None) -> Any:
+              nongrav: Any = None, variational: bool = False) -> Any:
     """The right-hand side of the small bodies ``names`` and the clock, in the field
     of ``perturbers`` (:data:`PERTURBERS`, then any of the 16 asteroids) read from
     ``segments`` from TDB Julian date ``epoch`` (two parts), with ``effects`` (keys
     of :data:`EFFECTS`), ``without`` one perturber's pull (its GM 0), ``nongrav``
     the non-gravitational accelerations (as :func:`propagate` takes them); its
-    time-reversed form attached (``hamilton_orbits.rhs.time_reversed``).
+    time-reversed form attached (``hamilton_orbits.rhs.time_reversed``), and with
+    ``variational`` the variational equations (``augmented``, for radau15 and
+    dop853).
 
     Raises
     ------
     ValueError
         For an unknown effect, or a perturber the segments do not hold.
     """
-    from hamilton_orbits._kernels.perturbers import HEADER, cache_size, small_bodies_field
+    from hamilton_orbits._kernels.perturbers import (
+        HEADER,
+        cache_size,
+        small_bodies_augmented,
+        small_bodies_field,
+    )
     from hamilton_orbits.effects import EffectSet
     from hamilton_orbits.rhs import RHS
 
@@ -141,7 +149,8 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     # the time-reversed motion: the same kernel and parameters, the clock's velocity
     # (-1) says which (and one run at a time uses the cache)
     reverse = RHS(small_bodies_field, None, p, velocity, tag)
-    return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse)
+    return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse,
+               augmented=small_bodies_augmented if variational else None)
 
 
 #: the parameters of one body's non-gravitational acceleration and their kinds
@@ -274,8 +283,16 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
         r)^2``; ``hamilton_orbits.effects.nongrav.COMET_G`` the comets'): one
         mapping for every body, or one (or None) per body.
-    events, variational, stm
-        Not yet supported ((), False, False).
+    events
+        Not yet supported (``()``).
+    variational : bool
+        Also integrate the variational equations: MEGNO and the Lyapunov exponent
+        of the bodies together (``traj.megno``, ...; they must then run as one:
+        ``chunk`` at least their number).  The Jacobian is applied by central
+        differences of the field.  Forwards in time only.
+    stm : bool
+        The state transition matrix ``traj.stm`` (n_t, 6n, 6n), block-diagonal
+        body by body, and so ``traj.covariance(cov0)``.  Forwards in time only.
     method : {"radau15", "dop853"}
         The integrator.
     tol : float, optional
@@ -335,6 +352,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                          f"{len(list(nongrav))}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
+    if (stm or variational) and days[-1] < days[0]:
+        raise ValueError(f"`stm` and `variational` are integrated forwards in time: got `t` "
+                         f"ending {float(days[-1])!r} days from the epoch (run forwards from "
+                         f"the earlier state)")
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     segments = _segments(ephemeris, jd1 + jd2 + min(days[0], days[-1]),
                          jd1 + jd2 + max(days[0], days[-1]), asteroids)
@@ -349,7 +370,12 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                 list(nongrav)[k] for k in part]
             parts.append(part)
             jobs.append(Job([names[k] for k in part], r[part], v[part], days, (jd1, jd2),
-                            tuple(effects), perturbers, without, mine, method, tol))
+                            tuple(effects), perturbers, without, mine, method, tol, stm,
+                            variational))
+    if variational and len(jobs) > 1:
+        raise ValueError(f"`variational=True` (MEGNO of the bodies together) needs them in "
+                         f"one run, got {len(jobs)} (`chunk` = {chunk}, and a body that is one "
+                         f"of the 16 asteroids runs apart); `stm=True` alone has no such limit")
     outs = run_jobs(run_job, segments, jobs, workers=workers, client=client,
                     progress=progress, unit="chunk")
     return _trajectory(names, list(zip(parts, outs, strict=True)), method, tuple(effects))
@@ -369,6 +395,8 @@ class Job(NamedTuple):
     nongrav: Any
     method: str
     tol: float | None
+    stm: bool = False
+    variational: bool = False
 
 
 def run_job(segments: Segments, job: Job) -> Any:
@@ -378,9 +406,11 @@ def run_job(segments: Segments, job: Job) -> Any:
     the clock's row dropped."""
     import dataclasses
 
+    tangent = job.stm or job.variational
     rhs = field_rhs(segments, job.names, job.epoch, job.effects, job.perturbers, job.without,
-                    job.nongrav)
-    out = _run(job.names, job.r, job.v, job.days, rhs, job.method, job.tol)
+                    job.nongrav, variational=tangent)
+    out = _run(job.names, job.r, job.v, job.days, rhs, job.method, job.tol,
+               _tangent(len(job.names), len(job.days), job.stm) if tangent else None)
     n = len(job.names)
     return dataclasses.replace(out, r=out.r[:, :n], v=out.v[:, :n], gm=out.gm[:n])
 
@@ -440,11 +470,12 @@ def _refuse_unsupported(asteroids: Any, method: Any, events: Any, variational: A
     if not isinstance(asteroids, bool):
         raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
     events = tuple(events) if isinstance(events, (list, tuple)) else events
-    for name, value, ok in (("events", events, ()),
-                            ("variational", variational, False), ("stm", stm, False)):
-        if value != ok:
-            raise ValueError(f"`{name}` is not supported yet by small_bodies.propagate, got "
-                             f"{value!r}")
+    if events != ():
+        raise ValueError(f"`events` is not supported yet by small_bodies.propagate, got "
+                         f"{events!r}")
+    for name, value in (("variational", variational), ("stm", stm)):
+        if not isinstance(value, bool):
+            raise ValueError(f"Expected `{name}` to be True or False, got {value!r}")
     if method not in ("radau15", "dop853"):
         raise ValueError(f"Expected `method` to be 'radau15' or 'dop853' (no central body "
                          f"to split about), got {method!r}")
@@ -517,10 +548,22 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
     return Segments({**major.segments, **small.segments})
 
 
+def _tangent(n: int, n_t: int, stm: bool) -> Any:
+    """The variational equations of ``n`` small bodies and the clock: MEGNO's vector
+    (rebound's form, ``Tangent``'s seed) on the bodies alone (the time is not varied), and with
+    ``stm`` the ``6 (n + 1)`` columns of the STM (the clock's 6 dropped after)."""
+    from hamilton_orbits.integrators._tangent import DEFAULT_SEED, Tangent
+
+    vector = np.zeros((n + 1, 6))
+    vector[:n] = np.random.default_rng(DEFAULT_SEED).normal(size=(n, 6))
+    vector[:n] /= np.linalg.norm(vector[:n], axis=1, keepdims=True)
+    return Tangent(n + 1, n_t, stm=stm, vector=vector)
+
+
 def _run(names: list[str], r: np.ndarray, v: np.ndarray, days: np.ndarray,
-         rhs: Any, method: str, tol: float | None) -> Any:
+         rhs: Any, method: str, tol: float | None, tangent: Any = None) -> Any:
     """The run of the small bodies ``names`` (states ``r``, ``v``) and the clock
-    through ``days``."""
+    through ``days`` (with ``tangent``: its variational equations too)."""
     from hamilton_orbits import engine
 
     n = len(names)
@@ -530,7 +573,7 @@ def _run(names: list[str], r: np.ndarray, v: np.ndarray, days: np.ndarray,
     # encounter with Ceres (and misses it by 14,000 km; global: 500 m, as ASSIST)
     options = {"criterion": "global"} if method == "radau15" else None
     out = engine.run(np.vstack([r, clock_r]), np.vstack([v, clock_v]), np.zeros(n + 1), days,
-                     rhs, method, tol=tol, options=options)
+                     rhs, method, tol=tol, options=options, variational=tangent)
     if not out.finite:
         bad = np.argwhere(~np.isfinite(out.r).all(axis=-1) | ~np.isfinite(out.v).all(axis=-1))
         k, b = (int(x) for x in bad[0])
@@ -557,4 +600,28 @@ def _trajectory(names: list[str], runs: list[tuple[list[int], Any]], method: str
                       steps=sum(int(out.steps) for _, out in runs),
                       wall_time=sum(out.wall_time for _, out in runs), method=method,
                       effects=("small_bodies", *effects),
-                      complete=all(out.complete for _, out in runs), integrals=None)
+                      complete=all(out.complete for _, out in runs), integrals=None,
+                      **_variational(len(names), runs))
+
+
+def _variational(n: int, runs: list[tuple[list[int], Any]]) -> dict[str, Any]:
+    """The Trajectory's MEGNO, Lyapunov exponent (one run) and STM of the runs'
+    variational equations (none: {}).  The STM of ``n`` bodies none of which pulls
+    on another is block-diagonal, body by body; each run's clock dropped."""
+    import astropy.units as u
+
+    tan = runs[0][1].variational
+    if tan is None:
+        return {}
+    k = len(runs[0][1].t)
+    out: dict[str, Any] = {}
+    if len(runs) == 1:
+        out.update(megno=tan.megno[:k].copy(), lyapunov=tan.lyapunov[:k] / u.day,
+                   lyapunov_time=tan.lyapunov_time[:k] * u.day)
+    if tan.stm is not None:
+        stm = np.zeros((k, 6 * n, 6 * n))
+        for rows, run in runs:
+            mine = np.concatenate([np.arange(6 * b, 6 * b + 6) for b in rows])
+            stm[np.ix_(np.arange(k), mine, mine)] = run.variational.stm[:k, :-6, :-6]
+        out["stm"] = stm
+    return out

@@ -50,12 +50,13 @@ from numba import njit
 
 from hamilton_orbits._kernels.chebyshev import add_record, basis
 from hamilton_orbits._kernels.figures import zonal_field
+from hamilton_orbits._kernels.jacobians import fd_add, fd_scales, fd_shift
 from hamilton_orbits._kernels.nbody import j2_field, massless_rows
 from hamilton_orbits._kernels.nongrav import nongrav
 from hamilton_orbits._kernels.relativity import eih_sources
 
-__all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_field",
-           "source_sums"]
+__all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bodies_augmented",
+           "small_bodies_field", "source_sums"]
 
 #: the entries of ``p`` before the tables
 HEADER = 17
@@ -100,6 +101,69 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
             acc[i, c] = big_a[k_p + i, c]
     for c in range(3):
         acc[nb, c] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def small_bodies_augmented(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """:func:`small_bodies_field` and its variational equations on ``n + k n`` rows
+    (``n = nb + 1``: the small bodies and the clock, then ``k`` tangent vectors of
+    ``n`` rows; the form of :func:`hamilton_orbits.rhs.compile_rhs`'s
+    ``augmented``).
+
+    The Jacobian is applied by central differences of the field along each tangent
+    vector (:func:`~hamilton_orbits._kernels.jacobians.fd_shift`, its step a
+    :data:`~hamilton_orbits._kernels.jacobians.FD_EPS` of the closest distance to a
+    perturber, at this time), the small bodies all shifted at once: none pulls on
+    another, so each one's difference is its own.  The clock is never shifted and
+    its tangent rows get 0: a tangent vector that starts without a clock part keeps
+    none (the time is not varied)."""
+    nb = int(p[0])
+    n = nb + 1
+    rb, vb, gb, ab = r[:n], v[:n], gm[:n], acc[:n]
+    small_bodies_field(rb, vb, gb, ab, p)
+    k = r.shape[0] // n - 1
+    dr, dv, da = r[n:], v[n:], acc[n:]
+    da[:] = 0.0
+    if k == 0:
+        return
+    length, speed = _scales(rb, vb, p)
+    rs, vs, ap, am = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    parts = 2 if (p[7] > p[6] or p[13] > p[12]) else 1  # (velocities: eih, nongrav)
+    for m in range(k):
+        for part in range(parts):
+            h = fd_shift(rb, vb, dr, dv, m, part, length, speed, 1.0, rs, vs, ap)
+            if not h > 0.0:
+                continue
+            _keep_clock(rb, vb, rs, vs, nb)
+            small_bodies_field(rs, vs, gb, ap, p)
+            fd_shift(rb, vb, dr, dv, m, part, length, speed, -1.0, rs, vs, am)
+            _keep_clock(rb, vb, rs, vs, nb)
+            small_bodies_field(rs, vs, gb, am, p)
+            fd_add(ap, am, h, da, m)
+
+
+@njit(cache=True, inline="always")
+def _keep_clock(r, v, rs, vs, nb):  # pragma: no cover - compiled
+    """The clock's row of the shifted state put back (the time is not varied)."""
+    for c in range(3):
+        rs[nb, c], vs[nb, c] = r[nb, c], v[nb, c]
+
+
+@njit(cache=True, error_model="numpy")
+def _scales(r, v, p):  # pragma: no cover - compiled
+    """:func:`~hamilton_orbits._kernels.jacobians.fd_scales` of the perturbers (at the
+    clock's time) and the small bodies together."""
+    nb, k_p = int(p[0]), int(p[4])
+    n = k_p + nb
+    work = np.zeros(14 * n)
+    big_r, big_v = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
+    acc_n = work[9 * n:12 * n].reshape((n, 3))
+    big_gm, phi = work[12 * n:13 * n], work[13 * n:14 * n]
+    _cached_perturbers(p, r[nb, 0], big_r, big_v, big_gm, acc_n, phi)
+    for i in range(nb):
+        for c in range(3):
+            big_r[k_p + i, c], big_v[k_p + i, c] = r[i, c], v[i, c]
+    return fd_scales(big_r, big_v, big_gm)
 
 
 @njit(cache=True, error_model="numpy")
