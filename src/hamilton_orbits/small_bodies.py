@@ -10,7 +10,8 @@ effects on the whole (the perturbers first, then the small bodies): Newton's law
 or with ``"eih"`` the Einstein-Infeld-Hoffmann equations (the perturbers'
 accelerations in them from their own Newtonian field), ``"sun_j2"`` the Sun's J2
 and ``"earth_zonal"`` the Earth's J2, J3, J4 (DE440's constants; the Earth's pole
-of J2000 until the effects know the time).
+of J2000, as JPL's small-body code takes it, or with ``earth_pole="IAU2006"`` the
+pole of date).
 
 The time enters the force through a *clock*: a massless last row of the state
 whose x coordinate is the time from the epoch in days (velocity 1, acceleration
@@ -94,7 +95,8 @@ def _chain(name: str) -> tuple[tuple[int, int], ...]:
 def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, float],
               effects: Sequence[str],
               perturbers: Sequence[str] = PERTURBERS, without: str | None = None,
-              nongrav: Any = None, variational: bool = False) -> Any:
+              nongrav: Any = None, variational: bool = False,
+              earth_pole: str = "J2000") -> Any:
     """The right-hand side of the small bodies ``names`` and the clock, in the field
     of ``perturbers`` (:data:`PERTURBERS`, then any of the 16 asteroids) read from
     ``segments`` from TDB Julian date ``epoch`` (two parts), with ``effects`` (keys
@@ -102,7 +104,7 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     the non-gravitational accelerations (as :func:`propagate` takes them); its
     time-reversed form attached (``hamilton_orbits.rhs.time_reversed``), and with
     ``variational`` the variational equations (``augmented``, for radau15 and
-    dop853).
+    dop853); ``earth_pole`` as :func:`propagate` takes it.
 
     Raises
     ------
@@ -130,6 +132,7 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     head = np.zeros(HEADER)
     head[0], head[2], head[3], head[4] = len(names), epoch[0], epoch[1], len(perturbers)
     head[5] = de.constant("AU")
+    head[1] = 1.0 if earth_pole == "IAU2006" else 0.0  # (the zonal field's pole of date)
     parts, at = [head], HEADER
     for slot, name in ((6, "eih"), (8, "sun_j2"), (10, "earth_zonal"), (12, "nongrav")):
         block = blocks.get(name, np.empty(0))
@@ -250,8 +253,8 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
               effects: Sequence[str] = ("eih", "sun_j2", "earth_zonal"),
               nongrav: Any = None, method: str = "radau15", tol: float | None = None,
               events: Sequence[Any] = (), variational: bool = False,
-              stm: bool = False, chunk: int = 100, workers: int | None = None,
-              client: Any = None, progress: bool = False) -> Any:
+              stm: bool = False, earth_pole: str = "J2000", chunk: int = 100,
+              workers: int | None = None, client: Any = None, progress: bool = False) -> Any:
     """Small bodies from ``epoch`` through ``t`` in the field of DE440's bodies.
 
     Parameters
@@ -297,6 +300,11 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         The integrator.
     tol : float, optional
         Its tolerance (default: the method's own).
+    earth_pole : {"J2000", "IAU2006"}
+        The pole of ``"earth_zonal"``: the ICRS pole, J2000's, as JPL Horizons
+        and ASSIST take it (the default); or the pole of each stage's date by the
+        IAU 2006 precession (IERS Conventions 2010, eq. 5.16, without nutation),
+        20" a year from it.
     chunk : int
         At most this many small bodies integrated together, on shared steps.
         Together they share each step's reading of the ephemeris; apart, a body's
@@ -347,6 +355,8 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         raise ValueError(f"Expected `chunk` to be a number of bodies >= 1, got {chunk!r}")
     check_workers(workers, "threads")
     check_client(client)
+    if earth_pole not in ("J2000", "IAU2006"):
+        raise ValueError(f"Expected `earth_pole` to be 'J2000' or 'IAU2006', got {earth_pole!r}")
     if nongrav is not None and not isinstance(nongrav, Mapping) and len(list(nongrav)) != len(r):
         raise ValueError(f"Expected `nongrav` to be a mapping or one per body ({len(r)}), got "
                          f"{len(list(nongrav))}")
@@ -371,7 +381,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
             parts.append(part)
             jobs.append(Job([names[k] for k in part], r[part], v[part], days, (jd1, jd2),
                             tuple(effects), perturbers, without, mine, method, tol, stm,
-                            variational))
+                            variational, earth_pole))
     if variational and len(jobs) > 1:
         raise ValueError(f"`variational=True` (MEGNO of the bodies together) needs them in "
                          f"one run, got {len(jobs)} (`chunk` = {chunk}, and a body that is one "
@@ -397,6 +407,7 @@ class Job(NamedTuple):
     tol: float | None
     stm: bool = False
     variational: bool = False
+    earth_pole: str = "J2000"
 
 
 def run_job(segments: Segments, job: Job) -> Any:
@@ -408,7 +419,7 @@ def run_job(segments: Segments, job: Job) -> Any:
 
     tangent = job.stm or job.variational
     rhs = field_rhs(segments, job.names, job.epoch, job.effects, job.perturbers, job.without,
-                    job.nongrav, variational=tangent)
+                    job.nongrav, variational=tangent, earth_pole=job.earth_pole)
     out = _run(job.names, job.r, job.v, job.days, rhs, job.method, job.tol,
                _tangent(len(job.names), len(job.days), job.stm) if tangent else None)
     n = len(job.names)

@@ -472,11 +472,11 @@ def encounter_check(method: Any, dt: float | None, tol: float | None, r0: np.nda
 def encounter_warning(traj: Trajectory) -> Any:
     """An :class:`~hamilton_orbits.integrals.UnderResolvedEncounterWarning` saying
     which close approaches of ``traj`` a fixed step was too long for, or None."""
+    found = traj._under_resolved
+    if not found:  # (before the import: this runs after every call of a simulation)
+        return None
     from hamilton_orbits.integrals import UnderResolvedEncounterWarning
 
-    found = traj._under_resolved
-    if not found:
-        return None
     names = traj.names
     first = found[0]
     day, au = (" d", " au") if traj._final_source[0].quantity else ("", "")

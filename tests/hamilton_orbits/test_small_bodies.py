@@ -74,6 +74,54 @@ def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects, nongra
     assert np.array_equal(back, acc)
 
 
+def test_the_earth_pole_of_date_is_the_iau_2006_precession_at_the_fields_own_time():
+    """``earth_pole="IAU2006"``: the pole (``precessed_pole``, IERS Conventions 2010
+    eq. 5.16) is ERFA's bias-precession pole (``bp06``, third row) to 1 mas over
+    three centuries (measured 0.13 mas); the field is the n-body ``zonal`` effect
+    about that pole at the clock's time, bit for bit (a day off would move the
+    pole by 0.055"); it is 20" a year from the ICRS pole, J2000's."""
+    import erfa
+
+    from hamilton_orbits._kernels.figures import precessed_pole
+
+    mas = np.pi / 180 / 3600 / 1000
+    pole = np.empty(3)
+    for t in (-1.0, 0.0, 0.29, 2.0):
+        rbp = erfa.bp06(2451545.0 + 36525.0 * t, 0.0)[2]
+        precessed_pole(t, pole)
+        assert np.linalg.norm(pole - rbp[2]) < 1.0 * mas, t
+        assert abs(np.linalg.norm(pole) - 1.0) < 4e-16
+    precessed_pole(1.0, pole)
+    assert 1995 * 1000 * mas < np.hypot(pole[0], pole[1]) < 2010 * 1000 * mas
+
+    segments = Segments.load(EXCERPT)
+    r, v = _asteroids()
+    t = 400.5  # days from the epoch J2000
+    earth = segments.states(np.array([2451545.0 + t]), ["earth"])
+    r[2] = earth[0][0, 0] + [2e-4, 1e-4, 1.5e-4]  # (40,000 km away: the zonal field tells)
+    v[2] = earth[1][0, 0] + [0.0, 0.004, 0.0]
+    rhs = field_rhs(segments, ["a", "b", "c"], (2451545.0, 0.0), ("earth_zonal",),
+                    earth_pole="IAU2006")
+    acc = np.empty((4, 3))
+    small_bodies_field(np.vstack([r, [t, 0.0, 0.0]]), np.vstack([v, [1.0, 0.0, 0.0]]),
+                       np.zeros(4), acc, rhs.p)
+    precessed_pole(t / 36525.0, pole)
+    pr, pv = segments.states(np.array([2451545.0 + t]), list(PERTURBERS))
+    bodies = [Body(**dict(spec, r=pr[0, k] * u.au, v=pv[0, k] * u.au / u.day))
+              for k, spec in enumerate(de.body_specs("J2000", list(PERTURBERS)))]
+    bodies += [Body(n, 0.0 * u.au**3 / u.day**2, r[k] * u.au, v[k] * u.au / u.day)
+               for k, n in enumerate("abc")]
+    system = System(bodies)
+    arrays = system.as_arrays()
+    ref = compile_rhs(system, [{**EFFECTS["earth_zonal"], "pole": pole}]).acceleration(
+        arrays.r, arrays.v, arrays.gm)
+    assert np.array_equal(acc[:3], ref[len(PERTURBERS):])
+    fixed = field_rhs(segments, ["a", "b", "c"], (2451545.0, 0.0), ("earth_zonal",))
+    small_bodies_field(np.vstack([r, [t, 0.0, 0.0]]), np.vstack([v, [1.0, 0.0, 0.0]]),
+                       np.zeros(4), acc, fixed.p)
+    assert not np.array_equal(acc[2], ref[-1])  # (J2000's pole: another field)
+
+
 def _one_moving_point(p0_km, w_km_day, start=2451500.0, records=40, intlen=16.0):
     """Made-up segments putting every perturber at one point moving uniformly
     (``p0 + w (jd - start)``, km): the field is then a Kepler field of the sum of
@@ -160,6 +208,7 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(nongrav=[None]), "`nongrav` to be a mapping or one per body"),
     (dict(variational=1), "`variational` to be True or False"),
     (dict(stm="yes"), "`stm` to be True or False"),
+    (dict(earth_pole="of date"), "`earth_pole` to be 'J2000' or 'IAU2006', got 'of date'"),
     (dict(stm=True, t=-10 * u.day), "`stm` and `variational` are integrated forwards"),
     (dict(events=[{"name": "close"}]), "`events` is not supported"),
     (dict(names=["a", "a", "b"]), r"`names`.*'a' at index 1"),

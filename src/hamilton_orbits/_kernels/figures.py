@@ -13,7 +13,8 @@ a point mass act on both: the point mass ``i`` receives ``a`` and the extended b
 - :func:`earth_tides`: the tides the Moon and the Sun raise on the Earth acting on
   the Moon, DE430/DE440's constant-time-lag model in three frequency bands;
 - :func:`ring_field`: a uniform circular ring (the Kuiper belt as DE440 models it)
-  centred on one body.
+  centred on one body;
+- :func:`precessed_pole`: the Earth's pole of date by the IAU 2006 precession.
 
 No astropy here.
 """
@@ -22,6 +23,26 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+#: arcseconds in a radian
+_ARCSEC = np.pi / 648000.0
+
+
+@njit(cache=True, error_model="numpy")
+def precessed_pole(t, out):  # pragma: no cover - compiled
+    """The Earth's celestial intermediate pole of date without nutation, a unit
+    vector in the GCRS (ICRS) axes into ``out`` (3,), at ``t`` Julian centuries of TT
+    from J2000 (TDB serves: they differ by 2 ms).
+
+    Its coordinates ``X``, ``Y`` are the polynomial part of the IAU 2006/2000A
+    series (IERS Conventions 2010, eq. 5.16: the frame bias and the IAU 2006
+    precession; the pole of ERFA's ``bp06`` to 0.13 mas), ``Z = sqrt(1 - X^2 -
+    Y^2)``.  It moves 20" a year from the ICRS pole."""
+    x = (-0.016617 + t * (2004.191898 + t * (-0.4297829 + t * (-0.19861834 + t * (
+        0.000007578 + t * 0.0000059285))))) * _ARCSEC
+    y = (-0.006951 + t * (-0.025896 + t * (-22.4072747 + t * (0.00190059 + t * (
+        0.001112526 + t * 0.0000001358))))) * _ARCSEC
+    out[0], out[1], out[2] = x, y, np.sqrt(1.0 - x * x - y * y)
 
 
 @njit(inline="always", cache=True)

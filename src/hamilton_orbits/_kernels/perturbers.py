@@ -17,7 +17,9 @@ kept, the perturbers' dropped (they follow the ephemeris).  No astropy here.
 
 - ``p[0]`` the number of small bodies ``nb`` (the clock is row ``nb``; its
   velocity -1 says that the motion is the time-reversed one, the velocities
-  given ``-v``), ``p[1]`` unused, ``p[2]``,
+  given ``-v``), ``p[1]`` 1.0 for the zonal field about the Earth's pole of date
+  (:func:`~hamilton_orbits._kernels.figures.precessed_pole`; 0: the pole its
+  parameters give), ``p[2]``,
   ``p[3]`` the epoch's TDB Julian date in two parts, ``p[4]`` the number of
   perturbers ``K``, ``p[5]`` the kilometres in an au;
 - ``p[6:14]`` four (start, end) pairs: the parameters of ``eih``, ``j2_field``,
@@ -49,7 +51,7 @@ import numpy as np
 from numba import njit
 
 from hamilton_orbits._kernels.chebyshev import add_record, basis
-from hamilton_orbits._kernels.figures import zonal_field
+from hamilton_orbits._kernels.figures import precessed_pole, zonal_field
 from hamilton_orbits._kernels.jacobians import fd_add, fd_scales, fd_shift
 from hamilton_orbits._kernels.nbody import j2_field, massless_rows
 from hamilton_orbits._kernels.nongrav import nongrav
@@ -91,9 +93,12 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
     else:
         massless_rows(big_r, big_gm, k_p, big_a)
     if p[9] > p[8]:
-        _figure_on_particles(False, big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])], k_p)
+        _figure_on_particles(False, big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])], k_p,
+                             np.nan)
     if p[11] > p[10]:
-        _figure_on_particles(True, big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])], k_p)
+        of_date = ((p[2] - 2451545.0) + (p[3] + r[nb, 0])) / 36525.0 if p[1] != 0.0 else np.nan
+        _figure_on_particles(True, big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])], k_p,
+                             of_date)
     if p[13] > p[12]:
         nongrav(big_r, big_v, big_gm, big_a, p[int(p[12]):int(p[13])])
     for i in range(nb):
@@ -167,12 +172,13 @@ def _scales(r, v, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _figure_on_particles(zonal, r, v, gm, acc, q, k_p):  # pragma: no cover - compiled
+def _figure_on_particles(zonal, r, v, gm, acc, q, k_p, of_date):  # pragma: no cover
     """:func:`~hamilton_orbits._kernels.figures.zonal_field` (``zonal``) or
     :func:`~hamilton_orbits._kernels.nbody.j2_field` of the body ``q[0]`` ADDED to
     the rows ``k_p``... alone (the same bits: each row's term depends on that row
     and the body only): both run on the body and those rows, not on every
-    perturber."""
+    perturber.  A finite ``of_date`` (Julian centuries from J2000): the zonal field
+    about the pole of that date, not ``q``'s."""
     b, n = int(q[0]), r.shape[0] - k_p + 1
     work = np.empty(10 * n)
     sr, sv = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
@@ -184,6 +190,8 @@ def _figure_on_particles(zonal, r, v, gm, acc, q, k_p):  # pragma: no cover - co
             sr[i, c], sv[i, c], sa[i, c] = r[row, c], v[row, c], acc[row, c]
     here = q.copy()
     here[0] = 0.0
+    if zonal and np.isfinite(of_date):
+        precessed_pole(of_date, here[2:5])
     if zonal:
         zonal_field(sr, sv, sg, sa, here)
     else:
