@@ -1,8 +1,10 @@
 """Write the excerpt of DE440's and sb441-n16's segments the small-body tests use.
 
-The records that cover 2023-01-17 to 2023-02-16 TDB (ASSIST's test of asteroid
+The records that cover 2023-01-17 to 2023-04-28 TDB (ASSIST's tests of asteroid
 (3666) Holman against JPL Horizons, ``unit_tests/holman/problem.c`` of
-github.com/matthewholman/assist) with 40 days on each side: every chain's segment
+github.com/matthewholman/assist, 30 days, and of its variational equations,
+``unit_tests/variational_spk/problem.c``, 101 days) with 40 days on each side:
+every chain's segment
 of DE440 and the 16 asteroids' segments of sb441-n16, as
 :class:`hamilton_orbits.spk.Segments` saves them, into
 ``tests/hamilton_orbits/data/holman_excerpt.npz`` (tens of kB, so that the test
@@ -21,7 +23,7 @@ from hamilton_orbits.spk import Segments
 
 OUT = Path(__file__).resolve().parents[1] / "tests" / "hamilton_orbits" / "data" / \
     "holman_excerpt.npz"
-START, END = J2000_JD + 8416.5 - 40.0, J2000_JD + 8446.5 + 40.0
+START, END = J2000_JD + 8416.5 - 40.0, J2000_JD + 8517.5 + 40.0
 
 
 def main() -> None:
