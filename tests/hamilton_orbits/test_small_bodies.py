@@ -26,6 +26,18 @@ def _asteroids():
     return r, v
 
 
+def _n_body_system(segments, jd, r, v):
+    """The perturbers at DE440's states of ``jd`` (read by :meth:`Segments.states`)
+    and massless bodies ``a``, ``b``, ``c`` at ``r``, ``v``: a System, its arrays."""
+    pr, pv = segments.states(np.array([jd]), list(PERTURBERS))
+    bodies = [Body(**dict(spec, r=pr[0, k] * u.au, v=pv[0, k] * u.au / u.day))
+              for k, spec in enumerate(de.body_specs("J2000", list(PERTURBERS)))]
+    bodies += [Body(n, 0.0 * u.au**3 / u.day**2, r[k] * u.au, v[k] * u.au / u.day)
+               for k, n in enumerate("abc")]
+    system = System(bodies)
+    return system, system.as_arrays()
+
+
 COMET = {"A1": 2e-12, "A2": -3e-13, "A3": 1e-13, "alpha": 0.1112620426, "r0": 2.808,
          "m": 2.15, "n": 5.093, "k": 4.6142}  # (g(r) of Marsden, Sekanina & Yeomans 1973)
 
@@ -48,13 +60,7 @@ def test_the_field_is_the_n_body_effects_on_the_ephemeris_states(effects, nongra
     vs = np.vstack([v, [1.0, 0.0, 0.0]])
     acc = np.empty_like(rs)
     small_bodies_field(rs, vs, np.zeros(4), acc, rhs.p)
-    pr, pv = segments.states(np.array([2451545.0 + t]), list(PERTURBERS))
-    bodies = [Body(**dict(spec, r=pr[0, k] * u.au, v=pv[0, k] * u.au / u.day))
-              for k, spec in enumerate(de.body_specs("J2000", list(PERTURBERS)))]
-    bodies += [Body(n, 0.0 * u.au**3 / u.day**2, r[k] * u.au, v[k] * u.au / u.day)
-               for k, n in enumerate("abc")]
-    system = System(bodies)
-    arrays = system.as_arrays()
+    system, arrays = _n_body_system(segments, 2451545.0 + t, r, v)
     listed = [EFFECTS[e] for e in effects]
     if nongrav is not None:  # (the n-body effect's own form: one list per parameter)
         rows = [nongrav] * 3 if isinstance(nongrav, dict) else nongrav
@@ -106,13 +112,7 @@ def test_the_earth_pole_of_date_is_the_iau_2006_precession_at_the_fields_own_tim
     small_bodies_field(np.vstack([r, [t, 0.0, 0.0]]), np.vstack([v, [1.0, 0.0, 0.0]]),
                        np.zeros(4), acc, rhs.p)
     precessed_pole(t / 36525.0, pole)
-    pr, pv = segments.states(np.array([2451545.0 + t]), list(PERTURBERS))
-    bodies = [Body(**dict(spec, r=pr[0, k] * u.au, v=pv[0, k] * u.au / u.day))
-              for k, spec in enumerate(de.body_specs("J2000", list(PERTURBERS)))]
-    bodies += [Body(n, 0.0 * u.au**3 / u.day**2, r[k] * u.au, v[k] * u.au / u.day)
-               for k, n in enumerate("abc")]
-    system = System(bodies)
-    arrays = system.as_arrays()
+    system, arrays = _n_body_system(segments, 2451545.0 + t, r, v)
     ref = compile_rhs(system, [{**EFFECTS["earth_zonal"], "pole": pole}]).acceleration(
         arrays.r, arrays.v, arrays.gm)
     assert np.array_equal(acc[:3], ref[len(PERTURBERS):])

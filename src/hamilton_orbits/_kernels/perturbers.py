@@ -390,7 +390,7 @@ def _perturbers(p, days, out_r, out_v, out_gm):  # pragma: no cover - compiled
         at = segs + 5 * s
         n_rec, m, first = int(p[at + 2]), int(p[at + 3]), int(p[at + 4])
         if s == 0 or p[at] != p[at - 5] or p[at + 1] != p[at - 4] or p[at + 2] != p[at - 3]:
-            # (a new grid of records; the segments are sorted by grid, small_bodies._tables)
+            # (a new grid of records; the segments are sorted by grid, perturber_field._tables)
             k = basis(p[at], p[at + 1], n_rec, jd1, jd2, width, t, u)
         if k < 0:
             seg_state[s, :] = np.nan
