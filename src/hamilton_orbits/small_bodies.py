@@ -159,9 +159,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     check_client(client)
     if earth_pole not in ("J2000", "IAU2006"):
         raise ValueError(f"Expected `earth_pole` to be 'J2000' or 'IAU2006', got {earth_pole!r}")
-    if nongrav is not None and not isinstance(nongrav, Mapping) and len(list(nongrav)) != len(r):
+    per_body = None if nongrav is None or isinstance(nongrav, Mapping) else list(nongrav)
+    if per_body is not None and len(per_body) != len(r):
         raise ValueError(f"Expected `nongrav` to be a mapping or one per body ({len(r)}), got "
-                         f"{len(list(nongrav))}")
+                         f"{len(per_body)}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
     if (stm or variational) and days[-1] < days[0]:
@@ -178,8 +179,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     for without, rows in groups.items():  # (each asteroid propagated without its own pull)
         for lo in range(0, len(rows), chunk):
             part = rows[lo:lo + chunk]
-            mine = nongrav if nongrav is None or isinstance(nongrav, Mapping) else [
-                list(nongrav)[k] for k in part]
+            mine = nongrav if per_body is None else [per_body[k] for k in part]
             parts.append(part)
             jobs.append(Job([names[k] for k in part], r[part], v[part], days, (jd1, jd2),
                             tuple(effects), perturbers, without, mine, method, tol, stm,
@@ -363,13 +363,12 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
 
 def _tangent(n: int, n_t: int, stm: bool) -> Any:
     """The variational equations of ``n`` small bodies and the clock: MEGNO's vector
-    (rebound's form, ``Tangent``'s seed) on the bodies alone (the time is not varied), and with
-    ``stm`` the ``6 (n + 1)`` columns of the STM (the clock's 6 dropped after)."""
-    from hamilton_orbits.integrators._tangent import DEFAULT_SEED, Tangent
+    of ``n`` bodies on the bodies alone (the time is not varied), and with ``stm``
+    the ``6 (n + 1)`` columns of the STM (the clock's 6 dropped after)."""
+    from hamilton_orbits.integrators._tangent import Tangent, megno_vector
 
     vector = np.zeros((n + 1, 6))
-    vector[:n] = np.random.default_rng(DEFAULT_SEED).normal(size=(n, 6))
-    vector[:n] /= np.linalg.norm(vector[:n], axis=1, keepdims=True)
+    vector[:n] = megno_vector(n)
     return Tangent(n + 1, n_t, stm=stm, vector=vector)
 
 

@@ -64,6 +64,8 @@ __all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bod
 HEADER = 17
 #: the stage times whose perturbers' states the cache keeps (radau15 has 8)
 CACHE_SLOTS = 8
+#: J2000.0 as a TDB Julian date (the origin of the pole of date's centuries)
+_J2000 = 2451545.0
 
 
 def cache_size(k_p: int) -> int:
@@ -76,19 +78,9 @@ def cache_size(k_p: int) -> int:
 def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The accelerations of the small bodies (and 0 for the clock), see the module."""
     nb, k_p = int(p[0]), int(p[4])
-    n = k_p + nb
-    work = np.zeros(14 * n)  # (one allocation: it costs as much as the sums of a hit)
-    big_r, big_v = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
-    big_a, acc_n = work[6 * n:9 * n].reshape((n, 3)), work[9 * n:12 * n].reshape((n, 3))
-    big_gm, phi = work[12 * n:13 * n], work[13 * n:14 * n]
-    eih = p[7] > p[6]
-    _cached_perturbers(p, r[nb, 0], big_r, big_v, big_gm, acc_n, phi)
-    sign = v[nb, 0]  # (the clock's velocity: 1, or -1 in the time-reversed motion)
-    for i in range(nb):
-        for c in range(3):
-            big_r[k_p + i, c] = r[i, c]
-            big_v[k_p + i, c] = sign * v[i, c]
-    if eih:
+    # (the clock's velocity: 1, or -1 in the time-reversed motion)
+    big_r, big_v, big_a, big_gm, acc_n, phi = _whole(r, v, p, v[nb, 0])
+    if p[7] > p[6]:
         eih_on_particles(big_r, big_v, big_gm, big_a, p[int(p[6]):int(p[7])], k_p, acc_n, phi)
     else:
         massless_rows(big_r, big_gm, k_p, big_a)
@@ -96,7 +88,7 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
         _figure_on_particles(False, big_r, big_v, big_gm, big_a, p[int(p[8]):int(p[9])], k_p,
                              np.nan)
     if p[11] > p[10]:
-        of_date = ((p[2] - 2451545.0) + (p[3] + r[nb, 0])) / 36525.0 if p[1] != 0.0 else np.nan
+        of_date = ((p[2] - _J2000) + (p[3] + r[nb, 0])) / 36525.0 if p[1] != 0.0 else np.nan
         _figure_on_particles(True, big_r, big_v, big_gm, big_a, p[int(p[10]):int(p[11])], k_p,
                              of_date)
     if p[13] > p[12]:
@@ -158,17 +150,28 @@ def _keep_clock(r, v, rs, vs, nb):  # pragma: no cover - compiled
 def _scales(r, v, p):  # pragma: no cover - compiled
     """:func:`~hamilton_orbits._kernels.jacobians.fd_scales` of the perturbers (at the
     clock's time) and the small bodies together."""
+    big_r, big_v, _, big_gm, _, _ = _whole(r, v, p, 1.0)
+    return fd_scales(big_r, big_v, big_gm)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _whole(r, v, p, sign):  # pragma: no cover - compiled
+    """The perturbers at the clock's time (through the cache) followed by the small
+    bodies (their velocities times ``sign``): positions, velocities, accelerations
+    (zeros), GMs, and the sources' Newtonian sums and potentials, in one
+    allocation (it costs as much as the sums of a cache hit)."""
     nb, k_p = int(p[0]), int(p[4])
     n = k_p + nb
     work = np.zeros(14 * n)
     big_r, big_v = work[0:3 * n].reshape((n, 3)), work[3 * n:6 * n].reshape((n, 3))
-    acc_n = work[9 * n:12 * n].reshape((n, 3))
+    big_a, acc_n = work[6 * n:9 * n].reshape((n, 3)), work[9 * n:12 * n].reshape((n, 3))
     big_gm, phi = work[12 * n:13 * n], work[13 * n:14 * n]
     _cached_perturbers(p, r[nb, 0], big_r, big_v, big_gm, acc_n, phi)
     for i in range(nb):
         for c in range(3):
-            big_r[k_p + i, c], big_v[k_p + i, c] = r[i, c], v[i, c]
-    return fd_scales(big_r, big_v, big_gm)
+            big_r[k_p + i, c] = r[i, c]
+            big_v[k_p + i, c] = sign * v[i, c]
+    return big_r, big_v, big_a, big_gm, acc_n, phi
 
 
 @njit(cache=True, error_model="numpy")

@@ -47,13 +47,27 @@ from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, MAX_STEPS
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["DEFAULT_SEED", "SLICE", "DOP853Tangent", "LeapfrogTangent", "Radau15Tangent",
-           "Tangent", "WHTangent"]
+           "Tangent", "WHTangent", "megno_vector"]
 
 #: The seed of the random tangent vector of MEGNO when none is given.
 DEFAULT_SEED = 2275
 #: Steps per compiled call of the fixed-step tangent maps (as the plain drivers of
 #: wh and leapfrog): ``stop()`` and Ctrl-C are seen between calls.
 SLICE = 100_000
+
+
+def megno_vector(n: int, seed: int = DEFAULT_SEED) -> np.ndarray:
+    """MEGNO's default initial tangent vector of ``n`` bodies, (n, 6): as rebound's
+    ``init_megno``, each body's six components drawn from a standard normal
+    distribution (seed ``seed``) and scaled to unit length.
+
+    Examples
+    --------
+    >>> bool(np.allclose(np.linalg.norm(megno_vector(3), axis=1), 1.0))
+    True
+    """
+    vector = np.random.default_rng(seed).normal(size=(n, 6))
+    return vector / np.linalg.norm(vector, axis=1, keepdims=True)
 
 
 class Tangent:
@@ -100,8 +114,7 @@ class Tangent:
     def __init__(self, n: int, n_t: int, *, stm: bool = False, vector: Any = None,
                  seed: int = DEFAULT_SEED) -> None:
         if vector is None:
-            vector = np.random.default_rng(seed).normal(size=(n, 6))
-            vector /= np.linalg.norm(vector, axis=1, keepdims=True)
+            vector = megno_vector(n, seed)
         vector = np.asarray(vector, dtype=np.float64).reshape(n, 6)
         self.n = n
         self.k = 1 + (6 * n if stm else 0)
