@@ -34,7 +34,7 @@ from hamilton_orbits.checkpoint import (
 from hamilton_orbits.integrators import method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
-from hamilton_orbits.simulation_record import record, spec, state_values
+from hamilton_orbits.simulation_record import all_active, record, spec, state_values
 from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory
 
@@ -241,7 +241,7 @@ class Saving:
             extra["leg"] = rows.info
         return extra
 
-    def _snapshot(self, rows: Any) -> None:
+    def _snapshot(self, rows: Any, again: bool = False) -> None:
         """Append the archive's next snapshot (``rows``: the leg's rows since the last).
 
         When the segment being written was begun or last appended to by this
@@ -249,10 +249,20 @@ class Saving:
         usual case between two outputs or two slices of steps), only what changes
         is taken (:class:`~hamilton_orbits.restart.Capture`) and appended; otherwise
         the whole snapshot is made, which begins a new segment if its shared part
-        changed."""
+        changed.  ``again``: the driver paused again with only its steps run since
+        the last snapshot (``_Run.pause``), so the layout is known to be the same
+        and is read without its checks (without events: they would drain)."""
         arch, prop, cache = self._archive, self._prop, self._record_cache
-        extra = self._extra(rows)
         known = cache.get("appended")
+        if again and known is not None and known[0] is arch.segment and prop.events is None \
+                and (rows is None or rows.times is None):
+            capture = known[2][0]
+            taken = capture.reread(prop)
+            if taken is not None and arch.refill(prop.t, prop.r, prop.v, prop.gm,
+                                                 all_active(prop.r.shape[0]), *taken,
+                                                 prop.steps, capture.ints):
+                return
+        extra = self._extra(rows)
         if known is not None and known[0] is arch.segment and known[1] == extra and (
                 rows is None or rows.times is None):
             capture, _, index = known[2]
@@ -342,5 +352,5 @@ class _EverySteps:
         """The propagation's step count at which the next snapshot is due."""
         return self.arch.last_steps + self.arch.every_steps
 
-    def __call__(self) -> None:
-        self.sim._snapshot(self.sim._leg)
+    def __call__(self, again: bool = False) -> None:
+        self.sim._snapshot(self.sim._leg, again)

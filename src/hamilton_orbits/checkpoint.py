@@ -386,6 +386,19 @@ class ArchiveWriter:
         self.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
         return seg.path
 
+    def refill(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+               active: np.ndarray, state: list[np.ndarray], scalars: list[Any], steps: int,
+               ints: list[int]) -> bool:
+        """Append the snapshot after the last of the same arrays, their values changed
+        in place (:meth:`~hamilton_orbits.segment.SegmentWriter.refill`); False,
+        nothing written, where it cannot."""
+        if self.segment is None or not self.segment.refill(t, r, v, gm, active, state,
+                                                           scalars, steps, ints):
+            return False
+        self.count += 1
+        self.last_steps, self.last_wall = steps, time.monotonic()
+        return True
+
     def append(self, values: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append a snapshot that shares everything but ``values`` (its record: ``t``,
         ``steps``, ``r``, ... as :func:`state_values` gives them) and its output ``rows``

@@ -352,16 +352,24 @@ class _Pause:
 
     def __init__(self, prop: Propagation, pause: Any) -> None:
         self.prop, self.pause = prop, pause
+        self.mine: tuple[np.ndarray, np.ndarray] | None = None  # (the r, v it put)
 
     @property
     def at(self) -> int:
         return self.pause.at - self.prop.steps_before
 
-    def __call__(self) -> None:
-        prop = self.prop
+    def __call__(self, again: bool = False) -> None:
+        """Stand at the driver's state and pause (``again``: as the driver says, only
+        its steps since the last pause; then also only ``r``, ``v``, ``t`` of the
+        propagation were put in their places)."""
+        prop, mine = self.prop, self.mine
         r, v, _ = prop.driver.state()
+        if again and mine is not None and prop.r is mine[0] and prop.v is mine[1]:
+            mine[0][...], mine[1][...] = r, v  # (its own arrays, seen by no one else:
+            r, v = mine  # refilled, a snapshot's record then finds the same arrays)
+        self.mine = (r, v)
         prop._stand_at(prop.driver.t, r, v)
-        self.pause()
+        self.pause(again)
 
 
 def run(

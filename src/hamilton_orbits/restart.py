@@ -249,6 +249,7 @@ class Capture:
         self._compile(obj, layout, 0)
         self._take: Any = None  # (written out at the first take: a layout met once
         # costs nothing more)
+        self._reread: Any = None
         #: the positions of the integer arrays among those :meth:`take` returns
         self.ints = [k for k, (code, expect, *_) in enumerate(
             op for op in self.ops if op[0] == _ARR) if expect[2].kind in "iu"]
@@ -275,20 +276,38 @@ class Capture:
         if not self.usable:
             return None
         if self._take is None:
-            source, known = self._source()
-            code = _CODE.get(source)
-            if code is None:  # (the same shape of graph in another leg: compiled once)
-                code = _CODE[source] = compile(source, "<restart.Capture>", "exec")
-                if len(_CODE) > 64:
-                    del _CODE[next(iter(_CODE))]
-            exec(code, known)
-            self._take = known["take"]
+            self._take = self._function(checked=True)
         return self._take(obj)
 
-    def _source(self) -> tuple[str, dict[str, Any]]:
+    def reread(self, obj: Any) -> tuple[list[np.ndarray], list[Any]] | None:
+        """What :meth:`take` returns, read along the same paths without checking the
+        graph: only for a caller that knows the graph's shape is unchanged since a
+        :meth:`take` of ``obj`` that succeeded (arrays changed in place, numbers and
+        arrays of the same shape put in their places), as between two pauses of one
+        compiled run; None where :meth:`take` would always be."""
+        if not self.usable:
+            return None
+        if self._reread is None:
+            self._reread = self._function(checked=False)
+        return self._reread(obj)
+
+    def _function(self, checked: bool) -> Any:
+        """:meth:`take`'s function (``checked``) or :meth:`reread`'s, compiled once per
+        text (the same shape of graph in another leg is not compiled again)."""
+        source, known = self._source(checked)
+        code = _CODE.get(source)
+        if code is None:
+            code = _CODE[source] = compile(source, "<restart.Capture>", "exec")
+            if len(_CODE) > 64:
+                del _CODE[next(iter(_CODE))]
+        exec(code, known)
+        return known["take"]
+
+    def _source(self, checked: bool = True) -> tuple[str, dict[str, Any]]:
         """The text of :meth:`take`'s function, written out from :attr:`ops` (one
         line per read and per check: several times faster than interpreting the
-        steps), and the values it compares against (by name, never as text)."""
+        steps), and the values it compares against (by name, never as text);
+        without the checks (``checked`` False), :meth:`reread`'s."""
         known: dict[str, Any] = {"np": np, "is_address": is_address, "E": INT_EXACT,
                                  "T0": self.root[0], "K0": self.root[1]}
         lines = ["def take(x0):",
@@ -318,6 +337,8 @@ class Capture:
         lines.append(f"    arrays = [{', '.join(arrays)}]")
         lines.append(f"    if len(set(map(id, arrays))) != {len(arrays)}: return None")
         lines.append(f"    return arrays, [{', '.join(numbers)}]")
+        if not checked:  # (the reads alone: a check is the only line that returns None)
+            lines = [line for line in lines if not line.endswith(": return None")]
         return "\n".join(lines) + "\n", known
 
 

@@ -23,7 +23,8 @@ snapshots share changes (an event merged two bodies: the layout changed); a new
 process never appends to another's segment.
 
 Appending a snapshot writes its record after the last one, then the number of
-records in the header (a 4-byte write): O(snapshot), whatever the size of the
+records in the header (4 bytes stored through a mapping of the file's first
+bytes, or written and synced with ``sync``): O(snapshot), whatever the size of the
 archive.  A kill during the record leaves bytes past the counted records: the
 segment is then listed as torn and those bytes are never read; a kill between the
 two writes loses that one snapshot.  A record whose CRC does not match its bytes
@@ -45,6 +46,7 @@ Examples
 from __future__ import annotations
 
 import json
+import mmap
 import operator
 import os
 import re
@@ -104,6 +106,10 @@ class _Appender:
         #: one record's bytes, reused (its last variable the CRC-32 of the others)
         self.buffer = RecordBuffer([values for _, _, values, _ in records])
         self.fd = os.open(path, os.O_RDWR)
+        #: the count in the header, mapped (a store, not a system call, per append;
+        #: its page is the file's own: a killed process leaves it written), or None
+        #: (``sync``: a write then a sync, in order; or a file that does not map)
+        self.numrecs = None if sync else _mapped_count(self.fd)
 
     def append(self, rows: list[list[Any]]) -> None:
         """Append records (each its record variables' values but ``check``, cast to
@@ -125,11 +131,14 @@ class _Appender:
         """Write ``count`` whole records ``data`` after the last, then count them."""
         try:
             os.pwrite(self.fd, data, self.end)
-            if self.sync:
-                os.fsync(self.fd)
-            os.pwrite(self.fd, struct.pack(">i", self.count + count), NUMRECS_AT)
-            if self.sync:
-                os.fsync(self.fd)
+            if self.numrecs is not None:  # (after the records: the count never runs ahead)
+                self.numrecs[NUMRECS_AT:] = struct.pack(">i", self.count + count)
+            else:
+                if self.sync:
+                    os.fsync(self.fd)
+                os.pwrite(self.fd, struct.pack(">i", self.count + count), NUMRECS_AT)
+                if self.sync:
+                    os.fsync(self.fd)
         except OSError as exc:
             raise SnapshotError(f"cannot write the snapshot to {self.path}: "
                                 f"{exc.strerror or exc}") from None
@@ -137,9 +146,40 @@ class _Appender:
         self.end += len(data)
 
     def close(self) -> None:
+        if self.numrecs is not None:
+            self.numrecs.close()
+            self.numrecs = None
         if self.fd >= 0:
             os.close(self.fd)
             self.fd = -1
+
+
+def _mapped_count(fd: int) -> mmap.mmap | None:
+    """The first bytes of file ``fd``, through the count of records, mapped for
+    writing (None where the file system does not map files)."""
+    try:
+        return mmap.mmap(fd, NUMRECS_AT + 4, access=mmap.ACCESS_WRITE)
+    except (OSError, ValueError):
+        return None
+
+
+def _joinable(arrays: list[np.ndarray]) -> tuple[list[Any], list[tuple[int, np.ndarray]]]:
+    """``arrays`` as pieces whose native bytes join into float64 values: the
+    contiguous float64 arrays themselves (their values read when joined), and the
+    others (position, array), to convert at each join."""
+    pieces: list[Any] = []
+    convert = []
+    for k, a in enumerate(arrays):
+        live = a.dtype == np.float64 and a.dtype.isnative and a.flags.c_contiguous
+        pieces.append(a if live else None)
+        if not live:
+            convert.append((k, a))
+    return pieces, convert
+
+
+def _beyond_float(a: np.ndarray) -> bool:
+    """Whether integer array ``a`` holds a value a float64 would not hold exactly."""
+    return bool(a.size) and max(map(abs, a.ravel().tolist())) >= INT_EXACT
 
 
 def _record_text(variables: list[tuple[str, tuple[int, ...], str]]) -> str:
@@ -217,6 +257,8 @@ class SegmentWriter:
         self._direct = (self.names == _STATE_RECORD
                         and self._file.buffer.runs[0][:2] == (0, 8))
         self._kept: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
+        #: what the last :meth:`_append_state` filled from, for :meth:`refill`
+        self._last: tuple[Any, ...] | None = None
         # (rows of a segment of this number that a killed run began and this replaces)
         (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
 
@@ -264,11 +306,19 @@ class SegmentWriter:
         general path then says why)."""
         file = self._file
         views, state, kept = file.buffer.views, snap["state"], self._kept
-        if len(kept[0]) != len(state) or not all(map(operator.is_, kept[0], state)):
+        if len(kept[0]) != len(state):
             flat = [a.reshape(-1) for a in state]
             if sum(a.size for a in flat) != views[4].size:
                 return False
             kept = self._kept = (list(state), flat)
+        elif not all(map(operator.is_, kept[0], state)):
+            # (some arrays replaced, as the propagation's r and v at each pause: their
+            # flat views remade, the others kept, the total size unchanged)
+            for k, (old, a) in enumerate(zip(kept[0], state, strict=True)):
+                if old is not a:
+                    if a.shape != old.shape:
+                        return self._forget()
+                    kept[0][k], kept[1][k] = a, a.reshape(-1)
         r, v, gm, scalars, active, steps = (snap["r"], snap["v"], snap["gm"], snap["scalars"],
                                             snap["active"], snap["steps"])
         if (r.shape != views[1].shape or v.shape != views[2].shape or gm.shape != views[3].shape
@@ -277,11 +327,50 @@ class SegmentWriter:
             return False
         head = file.buffer.runs[0][2]  # (t, r, v, gm, state, scalars, steps, rows)
         head[0] = snap["t"]
-        np.concatenate([r.reshape(-1), v.reshape(-1), gm, *kept[1], scalars,
-                        (steps, start, start)], out=head[1:], casting="unsafe")
+        pieces = [r.reshape(-1), v.reshape(-1), gm, *kept[1]]
+        np.concatenate([*pieces, scalars, (steps, start, start)], out=head[1:],
+                       casting="unsafe")
         views[8][...] = active
         file.write(file.checked(), 1)
+        self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]), start)
         return True
+
+    def refill(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+               active: np.ndarray, state: list[np.ndarray], scalars: list[Any],
+               steps: int, ints: list[int]) -> bool:
+        """Append the snapshot after one :meth:`_append_state` appended, of the same
+        arrays (``r``, ``v``, ``gm``, ``active`` read-only, the ``state`` arrays: their
+        values changed in place) with their new numbers: what :meth:`append` would
+        write, without building the snapshot.  False, nothing written, where an
+        array is another or a number does not fit (``ints``: the positions of the
+        integer arrays of ``state``, checked below 2**53)."""
+        last, kept = self._last, self._kept[0]
+        if (last is None or r is not last[0] or v is not last[1] or gm is not last[2]
+                or active is not last[3] or active.flags.writeable
+                or len(state) != len(kept) or not all(map(operator.is_, kept, state))
+                or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT
+                or len(scalars) != self._file.buffer.views[5].size
+                or any(type(x) is int and not -INT_EXACT < x < INT_EXACT for x in scalars)
+                or any(_beyond_float(state[k]) for k in ints)):
+            return False
+        file, pieces, start = self._file, last[4], last[6]
+        if last[5]:  # (arrays not float64 or not contiguous: their values as float64)
+            pieces = pieces.copy()
+            for k, a in last[5]:
+                pieces[k] = np.ascontiguousarray(a, dtype=np.float64)
+        head = file.buffer.runs[0][2]
+        head[0] = t
+        # (the native bytes joined, then turned big-endian by one copy: the bytes the
+        # concatenation of :meth:`_append_state` gives, in a third of its time)
+        head[1:] = np.frombuffer(b"".join(
+            [*pieces, np.array([*scalars, steps, start, start], dtype=np.float64)]))
+        file.write(file.checked(), 1)
+        return True
+
+    def _forget(self) -> bool:
+        """Drop the kept views (a state of another shape: the general path follows)."""
+        self._kept, self._last = ([], []), None
+        return False
 
     def close(self) -> None:
         """Close the files (what was appended stays)."""

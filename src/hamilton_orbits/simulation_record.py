@@ -19,6 +19,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -30,7 +31,7 @@ from hamilton_orbits.restart import Capture, flatten
 from hamilton_orbits.snapshot import INT_EXACT, SnapshotError
 from hamilton_orbits.units import is_quantity
 
-__all__ = ["from_json", "pack", "record", "spec", "state_values", "to_json", "unpack"]
+__all__ = ["all_active", "from_json", "pack", "record", "spec", "state_values", "to_json", "unpack"]
 
 _SYSTEM_FIELDS = ("gm", "r", "v", "radius", "j2", "pole")
 _DTYPE_NAMES: dict[np.dtype, str] = {}  # (dtype.name is slow to compute)
@@ -118,9 +119,10 @@ def state_values(prop: Any, state: list[np.ndarray], index: list[list[Any]] | No
     ``ints``: the positions of the integer arrays of ``state``, when known (an
     archive's record, whose index its segment holds): ``state`` is then given as
     :class:`~hamilton_orbits._netcdf3.Parts`, packed only into the record."""
-    active = np.ones(prop.r.shape[0], dtype=bool)
     if prop.events is not None:
         active = ~prop.events.inactive
+    else:
+        active = all_active(prop.r.shape[0])
     out = {"t": np.float64(prop.t), "r": prop.r, "v": prop.v, "gm": prop.gm, "active": active}
     if ints is None:
         out["state"], out["state_arrays"] = pack(state, index)
@@ -129,6 +131,14 @@ def state_values(prop: Any, state: list[np.ndarray], index: list[list[Any]] | No
         out["state"] = Parts(state)
     if scalars is not None:
         out["scalars"] = np.array(scalars, dtype=np.float64)
+    return out
+
+
+@functools.lru_cache(maxsize=8)
+def all_active(n: int) -> np.ndarray:
+    """``n`` bodies all active (read-only: one array for every snapshot of them)."""
+    out = np.ones(n, dtype=bool)
+    out.flags.writeable = False
     return out
 
 

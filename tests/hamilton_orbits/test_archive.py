@@ -83,14 +83,19 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
         assert all(_same(x, y) for x, y in zip(a[:3], b[:3], strict=True))
 
 
-def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path):
+@pytest.mark.parametrize("kw", [KW, dict(method="radau15", every_steps=12)],
+                         ids=["every", "every_steps"])
+def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path, kw):
     """20 runs killed with SIGKILL, half at random moments (before, between and
     during writes), half as soon as the archive holds a random number of snapshots:
     each archive opens, its snapshots are the reference's, and the call resumed
-    from it returns the reference's trajectory, every row to the bit."""
-    _, whole = _run_archived(tmp_path / "ref")
+    from it returns the reference's trajectory, every row to the bit; with
+    snapshots at output times (``every``) and between two steps (``every_steps``:
+    most of them refilled between two pauses of one compiled run)."""
+    _, whole = _run_archived(tmp_path / "ref", kw)
     reference = Archive(tmp_path / "ref")
-    t_run = _timed_run(tmp_path / "timing")
+    assert len(reference) >= 25
+    t_run = _timed_run(tmp_path / "timing", kw)
     rng = np.random.default_rng(20261128)
     seen_partial = 0
     for k in range(20):
@@ -101,7 +106,7 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
             try:
                 os.close(ready)
                 os.write(go, b"!")  # the random moment counts from the run's start,
-                _run_archived(folder, paced=True)  # not from the fork (slow for a large
+                _run_archived(folder, kw, paced=True)  # not from the fork (slow for a large
                 # process)
             finally:
                 os._exit(0)
@@ -117,7 +122,7 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
             os.kill(pid, signal.SIGKILL)
             os.waitpid(pid, 0)
         if not folder.exists() or not Archive(folder).snapshots:
-            _, traj = _run_archived(folder)  # killed before the first snapshot: anew
+            _, traj = _run_archived(folder, kw)  # killed before the first snapshot: anew
         else:
             archive = Archive(folder)
             assert archive.damaged == []  # whole snapshots or none: never a damaged one
@@ -144,12 +149,12 @@ def _wait_for_snapshots(folder, count: int, pid: int) -> bool:
     return False
 
 
-def _timed_run(folder) -> float:
+def _timed_run(folder, kw=KW) -> float:
     """The median time of three archived runs (each into a folder of its own)."""
     times = []
     for k in range(3):
         start = time.perf_counter()
-        _run_archived(folder / str(k), paced=True)
+        _run_archived(folder / str(k), kw, paced=True)
         times.append(time.perf_counter() - start)
     return sorted(times)[1]
 

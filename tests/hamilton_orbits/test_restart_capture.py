@@ -108,6 +108,22 @@ def test_take_agrees_with_flatten_or_refuses(change):
     assert _agrees(capture, layout, root) == (change.__name__ in KEEPS)
 
 
+@pytest.mark.parametrize("change", [f for f in _mutations() if f.__name__ in KEEPS],
+                         ids=lambda f: f.__name__)
+def test_reread_gives_what_take_gives_after_a_change_that_keeps_the_layout(change):
+    """``reread`` (the reads without the checks, for a caller that knows only values
+    changed, as between two pauses of one compiled run) returns take's arrays (the
+    same objects) and numbers (the same values and types)."""
+    root = _Root()
+    layout, _ = flatten(root, [])
+    capture = Capture(root, layout)
+    change(root)
+    taken, again = capture.take(root), capture.reread(root)
+    assert taken is not None and again is not None
+    assert all(a is b for a, b in zip(again[0], taken[0], strict=True))
+    assert again[1] == taken[1] and [type(x) for x in again[1]] == [type(x) for x in taken[1]]
+
+
 def test_random_sequences_of_changes_never_give_another_state():
     rng = np.random.default_rng(20261128)
     changes = _mutations()

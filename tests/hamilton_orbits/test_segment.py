@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from test_archive import RADAU15_STEPPED
 
-from hamilton_orbits import Simulation
+from hamilton_orbits import Archive, Simulation
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits.segment import SegmentWriter
 
@@ -29,17 +29,55 @@ def test_a_state_filled_straight_into_its_record_is_the_record_of_the_general_pa
     begins a new segment)."""
     system, kw = RADAU15_STEPPED[case]
     times = np.linspace(0.0, 4.0, 5)[1:]
-    direct = SegmentWriter._append_state
-    taken = []
+    direct, refill = SegmentWriter._append_state, SegmentWriter.refill
+    taken, refilled = [], []
 
     def counted(self, snap, start):
         taken.append(direct(self, snap, start))
         return taken[-1]
 
+    def counted_refill(self, *args):
+        refilled.append(refill(self, *args))
+        return refilled[-1]
+
     monkeypatch.setattr(SegmentWriter, "_append_state", counted)
+    monkeypatch.setattr(SegmentWriter, "refill", counted_refill)
     Simulation(system(), archive=tmp_path / "direct", every_steps=1, **kw).integrate(times)
-    assert sum(taken) > 10  # (the straight fill was taken)
+    assert sum(taken) >= 4  # (the straight fill was taken, at least once per output)
+    if "events" not in kw:  # (the refill between two pauses of one compiled run)
+        assert sum(refilled) > 10
     monkeypatch.setattr(SegmentWriter, "_append_state", lambda self, snap, start: False)
+    monkeypatch.setattr(SegmentWriter, "refill", lambda self, *args: False)
     Simulation(system(), archive=tmp_path / "general", every_steps=1, **kw).integrate(times)
     one, other = _records(tmp_path / "direct"), _records(tmp_path / "general")
     assert len(one) == len(other) >= 1 and one == other
+
+
+def test_a_refill_writes_nothing_where_its_arrays_or_numbers_are_not_the_last_ones(
+        tmp_path, monkeypatch):
+    """``SegmentWriter.refill`` (the snapshot after the last, between two pauses of one
+    compiled run) refuses, writing nothing, an array that is another object (or a
+    writable ``active``), a step count or an integer number beyond 2**53, and a
+    number missing; the archive then holds exactly its snapshots."""
+    refill, refused = SegmentWriter.refill, []
+
+    def probing(self, t, r, v, gm, active, state, scalars, steps, ints):
+        count = self._file.count
+        bad = [(t, r.copy(), v, gm, active, state, scalars, steps, ints),
+               (t, r, v, gm, active.copy(), state, scalars, steps, ints),
+               (t, r, v, gm, active, [*state[:-1], state[-1].copy()], scalars, steps, ints),
+               (t, r, v, gm, active, state, scalars, 2**53, ints),
+               (t, r, v, gm, active, state, [*scalars[:-1], -(2**53)], steps, ints),
+               (t, r, v, gm, active, state, scalars[:-1], steps, ints)]
+        refused.extend(refill(self, *args) for args in bad)
+        assert self._file.count == count
+        return refill(self, t, r, v, gm, active, state, scalars, steps, ints)
+
+    monkeypatch.setattr(SegmentWriter, "refill", probing)
+    system, kw = RADAU15_STEPPED["radau15"]
+    sim = Simulation(system(), archive=tmp_path, every_steps=2, **kw)
+    sim.integrate(np.linspace(0.0, 2.0, 3))
+    archive = Archive(tmp_path)
+    assert len(refused) >= 6 and not any(refused)
+    assert [s.steps for s in archive.snapshots] == list(range(0, sim.steps + 1, 2))
+    assert archive.damaged == [] and archive.torn == []

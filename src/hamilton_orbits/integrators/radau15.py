@@ -258,7 +258,10 @@ class _Run:
 
     ``pause``, when set (an archive's step schedule), is called between two steps
     once ``steps`` reaches ``pause.at``: the compiled call's budget ends there, so
-    the steps are the same as without it."""
+    the steps are the same as without it.  ``pause(again)``: ``again`` True when
+    only the compiled steps ran since the last pause of the same call (no output,
+    no event: the state's arrays changed in place, its numbers changed, nothing was
+    put in another place; ``stop`` is a question and changes nothing)."""
 
     #: not state: the hook a run sets and clears (:meth:`Propagation.advance`)
     RESTART_SCRATCH = ("pause",)
@@ -313,11 +316,13 @@ class _Run:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
         the steps before this call, for its budget of ``max_steps``)."""
         log, max_steps, pause = self.log, self.max_steps, self.pause
+        again = False  # (a pause since which only the kernel ran: see pause's notes)
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             budget = min(SLICE, max_steps - (self.steps - first))
             if pause is not None:
                 if self.steps >= pause.at:
-                    pause()
+                    pause(again)
+                    again = True
                 budget = min(budget, max(pause.at - self.steps, 1))
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
@@ -332,7 +337,9 @@ class _Run:
                     raise StopIntegration
             elif status == _k.STATUS_DRAIN:
                 log.drain()
+                again = False
             elif status == _k.STATUS_EVENT:
+                again = False
                 if log.act(int(self.st[_k.ST_EVENT_ROW]), self.t, self.x, self.w, self.gm):
                     return True
             elif status == _k.STATUS_OK:
