@@ -17,7 +17,9 @@ What it prints (medians over interleaved rounds; the machine is shared):
     ``T_END`` (2000: 4-9 ms of fixed cost per archived call weigh on a 40 ms run)
     and ``10 * T_END`` (a run of 0.4 s);
 [3] loading the last snapshot: ``Simulation.load(folder)`` against
-    ``rebound.Simulation(file)``.
+    ``rebound.Simulation(file)``;
+[4] where an ``every_steps=100`` snapshot's time goes in the 0.4 s radau15 run:
+    the archive's fixed cost, the pauses alone, the whole (per snapshot).
 """
 
 from __future__ import annotations
@@ -176,6 +178,45 @@ def loading(tmp: Path, repeat: int) -> None:
           f"verified, the simulation rebuilt), rebound {med['theirs']:.2f}")
 
 
+def parts(tmp: Path, rounds: int, t_end: float = 10 * T_END) -> None:
+    """Where the time of an ``every_steps=100`` snapshot goes in a radau15 run: the
+    archive's fixed cost alone (one snapshot at the start), the pauses with nothing
+    written (the schedule kept), and the whole; per snapshot, against the plain run
+    (interleaved rounds, one process)."""
+    from hamilton_orbits import _saving
+
+    s, count, whole = disc10(), iter(range(10**6)), _saving.Saving._snapshot
+
+    def nothing(self: object, rows: object, again: bool = False) -> None:
+        if not again:
+            return whole(self, rows, again)
+        arch = self._archive  # (the schedule kept, nothing written)
+        arch.count += 1
+        arch.last_steps = self._prop.steps
+
+    folders: dict[str, Path] = {}
+
+    def go(every: int | None, snapshot: Callable[..., None] = whole) -> Callable[[], None]:
+        def run() -> None:
+            _saving.Saving._snapshot = snapshot
+            folder = folders[snapshot.__name__] = tmp / f"parts-{next(count)}"
+            kw = {} if every is None else dict(archive=folder, every_steps=every)
+            try:
+                Simulation(s, method="radau15", **kw).integrate(t_end)
+            finally:
+                _saving.Saving._snapshot = whole
+        return run
+
+    t = interleaved({"plain": go(None), "fixed": go(10**9), "pauses": go(100, nothing),
+                     "whole": go(100)}, rounds)
+    n = len(Archive(folders["_snapshot"]))  # (the whole: every snapshot written)
+    plain = statistics.median(t["plain"])
+    print(f"[4] an every_steps=100 snapshot in a radau15 run of {t_end:g}, per snapshot "
+          f"({n}), median of {rounds} rounds: " + ", ".join(
+              f"{k} {(statistics.median(t[k]) - plain) / n * 1e6:.1f} us"
+              for k in ("fixed", "pauses", "whole")))
+
+
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
@@ -185,6 +226,8 @@ def main() -> None:
         loading(tmp, 30)
         (tmp / "long").mkdir()
         runs(tmp / "long", 5, 10 * T_END)
+        (tmp / "parts").mkdir()
+        parts(tmp / "parts", 15)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

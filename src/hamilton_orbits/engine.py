@@ -362,13 +362,14 @@ class _Pause:
         """Stand at the driver's state and pause (``again``: as the driver says, only
         its steps since the last pause; then also only ``r``, ``v``, ``t`` of the
         propagation were put in their places)."""
-        prop, mine = self.prop, self.mine
-        r, v, _ = prop.driver.state()
+        prop, mine, driver = self.prop, self.mine, self.prop.driver
         if again and mine is not None and prop.r is mine[0] and prop.v is mine[1]:
-            mine[0][...], mine[1][...] = r, v  # (its own arrays, seen by no one else:
-            r, v = mine  # refilled, a snapshot's record then finds the same arrays)
-        self.mine = (r, v)
-        prop._stand_at(prop.driver.t, r, v)
+            r, v = mine  # (its own arrays, seen by no one else: refilled, a snapshot's
+            driver.state_into(r, v)  # record then finds the same arrays)
+        else:
+            r, v, _ = driver.state()
+            self.mine = (r, v)
+        prop._stand_at(driver.t, r, v)
         self.pause(again)
 
 

@@ -295,6 +295,12 @@ class _Run:
         """The current positions, velocities and ``G m`` (copies)."""
         return self.x.copy(), self.w.copy(), self.gm.copy()
 
+    def state_into(self, r: np.ndarray, v: np.ndarray) -> None:
+        """The current positions and velocities copied into ``r`` and ``v`` (a pause's
+        own arrays, refilled at each pause)."""
+        np.copyto(r, self.x)
+        np.copyto(v, self.w)
+
     def advance(self, t_out: np.ndarray, r_out: np.ndarray, v_out: np.ndarray,
                 on_output: Any, stop: Any) -> None:
         """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
