@@ -167,12 +167,44 @@ def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:
 
     from hamilton_orbits._outdir import OutputFolder
 
+    _compile_ahead(ref, sets)
     scene = _load_scene(ref, sets)
     folder = Path(out) if out else Path("hamilton-orbits-output") / scene.name
     with OutputFolder(folder, "--out" if out else "output folder"):
         archive = _archive_for(scene, folder, ref, sets)
         result = _run_scene(scene, progress, archive)
         return _finish(scene, result, folder, archive)
+
+
+def _compile_ahead(ref: str, sets: Sequence[str]) -> None:
+    """Before the scene loads (its imports take a second or two), the stepping kernel
+    of a radau15 ``nbody`` scene sent to compile in a second process on a first run,
+    from the scene's own text (the run itself sends it when this cannot tell)."""
+    from importlib import resources
+    from pathlib import Path
+
+    import tomllib
+
+    try:
+        path = (Path(ref) if ref.endswith(".toml") or Path(ref).exists() else
+                resources.files("hamilton_orbits") / "data" / "scenes" / f"{ref}.toml")
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        method = raw.get("integrator", {}).get("method")
+        for item in sets:
+            key, _, value = item.partition("=")
+            if key.strip() == "integrator.method":
+                method = value.strip().strip("\"'")
+        if (raw.get("kind", "nbody") != "nbody" or method != "radau15"
+                or raw.get("variational")):
+            return
+    except Exception:  # (a scene that does not read: its load says why, next)
+        return
+    from hamilton_orbits import integrals
+    from hamilton_orbits._kernels.entry import compile_ahead
+    from hamilton_orbits.integrators import radau15
+
+    compile_ahead(radau15.stepping_kernels(bool(raw.get("events"))),
+                  meanwhile=[integrals.prepare])
 
 
 def _archive_for(scene, folder, ref: str, sets: Sequence[str]):

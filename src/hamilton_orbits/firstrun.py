@@ -1,6 +1,6 @@
 """A one-line notice on stderr while the package's kernels compile for the first time.
 
-With no numba cache, the first calls compile kernels for seconds (about 14 s
+With no numba cache, the first calls compile kernels for seconds (about 9 s
 for the main job on two cores: ``benchmarks/bench_first_run.py``), which otherwise
 looks like a hang.  A listener on numba's
 ``numba:compile`` event (fired only when a function is really compiled, not
@@ -165,6 +165,37 @@ def describe(compiled: list[tuple[str, float]], shown: int = 3) -> str:
     if rest:
         parts.append(f"{len(rest)} more {sum(s for _, s in rest):.1f} s")
     return ", ".join(parts)
+
+
+def add_compilation(name: str, seconds: float) -> None:
+    """Count ``seconds`` spent waiting for ``name`` to compile in another process
+    (:func:`hamilton_orbits._kernels.entry.compile_ahead`) as compilation: the run's
+    summary then says what the first run waited for, and its integration time
+    leaves it out.
+
+    Examples
+    --------
+    >>> before = compile_seconds()
+    >>> add_compilation("demo.kernel (a second process)", 0.0)
+    >>> compile_seconds() == before
+    True
+    """
+    with _lock:
+        _clock["seconds"] += seconds
+        _clock["count"] += 1
+        _compiled.append((name, seconds))
+
+
+def notice() -> None:
+    """Print the first run's notice (once per process), as a first compilation does."""
+    with _lock:
+        if _state["printed"]:
+            return
+        _state["printed"] = True
+    try:
+        print(NOTICE, file=sys.stderr, flush=True)
+    except (OSError, ValueError):  # pragma: no cover - stderr closed
+        pass
 
 
 def compile_count() -> int:

@@ -30,7 +30,7 @@ import numpy as np
 
 __all__ = ["ENCOUNTER_STEP_FRACTION", "Encounter", "LostStateError",
            "UnderResolvedEncounterWarning", "accelerations_quaternion", "energy_gm",
-           "energy_gm_many", "integral_errors", "particle_errors", "primaries",
+           "energy_gm_many", "integral_errors", "particle_errors", "prepare", "primaries",
            "relative_change", "under_resolved_encounters"]
 
 #: A fixed step of a second-order map (``wh``, ``leapfrog``) is too long for a close
@@ -140,6 +140,23 @@ def integral_errors(
     if extra_energy is not None or _one_centre(gm2):
         out[0] = _energy_error(*_present(r, v, gm), extra_energy)
     return out[0], out[1], out[2]
+
+
+def prepare() -> None:
+    """Compile the kernel of :func:`integral_errors` for the types a run gives it
+    (``G m`` read-only, as a system's are), by a call on two states of two bodies:
+    a first run that has a core to spare compiles it while it waits for another
+    (:func:`hamilton_orbits._kernels.entry.compile_ahead`).
+
+    Examples
+    --------
+    >>> prepare()  # (compiled, or loaded from numba's cache)
+    """
+    r = np.zeros((2, 2, 3))
+    r[:, 1, 0] = 1.0
+    gm = np.array([1.0, 1e-3])
+    gm.flags.writeable = False
+    integral_errors(r, np.zeros((2, 2, 3)), gm, np.array([0.0, 1.0]))
 
 
 def _one_centre(gm: np.ndarray) -> bool:

@@ -165,3 +165,80 @@ def test_session_notice_when_numba_cache_is_cold(tmp_path, monkeypatch):
     nested.mkdir(parents=True)
     (nested / "radau15.step-42.py311.nbi").write_bytes(b"")
     assert not conftest.numba_cache_cold()
+
+
+_AHEAD_MODULE = """
+from numba import types
+from hamilton_orbits._kernels.entry import entry
+
+
+@entry(types.float64(types.float64), cache=True)
+def triple(x):
+    return 3.0 * x + {k}.0
+"""
+
+
+def _ahead_module(tmp_path, monkeypatch, name: str, k: int, importable_there: bool):
+    """A module with one entry kernel (cached), new to numba's cache, importable
+    here and (``importable_there``) in a second process."""
+    import importlib
+
+    (tmp_path / f"{name}.py").write_text(_AHEAD_MODULE.format(k=k))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    if importable_there:
+        monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+            [str(tmp_path), SRC, os.environ.get("PYTHONPATH", "")]))
+    return importlib.import_module(name)
+
+
+def test_a_kernel_compiled_ahead_is_loaded_from_the_cache_and_its_wait_counted(
+        tmp_path, monkeypatch):
+    """compile_ahead sends a kernel neither compiled nor cached to a second process;
+    its first call here waits for it and loads it from numba's cache (a hit, no
+    compilation here), and the wait counts as the first run's compilation."""
+    from hamilton_orbits._kernels.entry import compile_ahead
+
+    monkeypatch.delenv("HAMILTON_ORBITS_COMPILE_AHEAD", raising=False)
+    mod = _ahead_module(tmp_path, monkeypatch, "ahead_probe_sent", 1, True)
+    kernel = mod.triple
+    assert compile_ahead([kernel]) == ["ahead_probe_sent.triple"]
+    assert compile_ahead([kernel]) == []  # (already on its way: not sent twice)
+    before, count = firstrun.compile_seconds(), firstrun.compile_count()
+    assert kernel(2.0) == 7.0
+    stats = kernel.dispatcher().stats
+    assert sum(stats.cache_hits.values()) == 1 and sum(stats.cache_misses.values()) == 0
+    assert firstrun.compile_count() == count + 1 and firstrun.compile_seconds() > before
+    assert firstrun._compiled[-1][0] == ("ahead_probe_sent.triple (waited for, compiled in "
+                                          "a second process)")
+    assert compile_ahead([kernel]) == []  # compiled here now
+
+
+def test_a_kernel_the_second_process_cannot_compile_is_compiled_here(tmp_path, monkeypatch):
+    """A second process that fails (here: it cannot import the kernel's module)
+    costs nothing but its wait: the first call compiles the kernel as before."""
+    from hamilton_orbits._kernels.entry import compile_ahead
+
+    monkeypatch.delenv("HAMILTON_ORBITS_COMPILE_AHEAD", raising=False)
+    monkeypatch.setenv("PYTHONPATH", SRC)
+    mod = _ahead_module(tmp_path, monkeypatch, "ahead_probe_failed", 2, False)
+    kernel = mod.triple  # (the module's name is bound to numba's dispatcher at the call)
+    assert compile_ahead([kernel]) == ["ahead_probe_failed.triple"]
+    assert kernel(2.0) == 8.0
+    assert sum(kernel.dispatcher().stats.cache_misses.values()) == 1  # compiled here
+
+
+def test_compile_ahead_can_be_turned_off(tmp_path, monkeypatch):
+    from hamilton_orbits._kernels.entry import compile_ahead
+
+    monkeypatch.setenv("HAMILTON_ORBITS_COMPILE_AHEAD", "0")
+    mod = _ahead_module(tmp_path, monkeypatch, "ahead_probe_off", 3, True)
+    assert compile_ahead([mod.triple]) == [] and mod.triple(1.0) == 6.0
+
+
+def test_nothing_is_compiled_ahead_on_one_core(tmp_path, monkeypatch):
+    from hamilton_orbits._kernels import entry
+
+    monkeypatch.delenv("HAMILTON_ORBITS_COMPILE_AHEAD", raising=False)
+    monkeypatch.setattr(entry, "_cores", lambda: 1)
+    mod = _ahead_module(tmp_path, monkeypatch, "ahead_probe_one_core", 4, True)
+    assert entry.compile_ahead([mod.triple]) == [] and mod.triple(1.0) == 7.0

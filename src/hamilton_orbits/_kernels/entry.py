@@ -15,16 +15,26 @@ in its module under its own name, so that later calls through the module
 
 from __future__ import annotations
 
+import atexit
+import os
+import subprocess
 import sys
 import threading
+import time
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["entry"]
+__all__ = ["compile_ahead", "entry"]
 
 _lock = threading.Lock()
+#: Kernels being compiled into the on-disk cache by another process
+#: (:func:`compile_ahead`): ``module.name`` -> that process
+_AHEAD: dict[str, subprocess.Popen] = {}
+#: What to compile here while waiting for that process (:func:`compile_ahead`)
+_MEANWHILE: list[Callable[[], object]] = []
 
 
 class EntryKernel:
@@ -61,11 +71,28 @@ class EntryKernel:
         """Whether the signature has been compiled (or loaded from the cache)."""
         return self._compiled is not None
 
+    @property
+    def key(self) -> str:
+        """``module.name``, as :func:`compile_ahead` and its helper process name it."""
+        return f"{self.__module__}.{self.__name__}"
+
+    def cached(self) -> bool:
+        """Whether numba's on-disk cache holds the signature (True when it cannot
+        tell: nothing is then compiled ahead)."""
+        try:
+            disp = njit(**self.options)(self.py_func)
+            return disp._cache.load_overload(self.signature, disp.targetctx) is not None
+        except Exception:  # (numba's cache API is its own: never fail a run on it)
+            return True
+
     def dispatcher(self) -> CPUDispatcher:
-        """The numba dispatcher, its signature compiled and further compilation off."""
+        """The numba dispatcher, its signature compiled and further compilation off
+        (when another process is compiling it into the cache, after waiting for
+        it: then loaded, not compiled twice)."""
         if self._compiled is None:
             with _lock:
                 if self._compiled is None:
+                    _wait_for(self.key)
                     disp = njit(**self.options)(self.py_func)
                     disp.compile(self.signature)
                     disp.disable_compile()
@@ -81,6 +108,101 @@ class EntryKernel:
     def __repr__(self) -> str:
         state = "compiled" if self.compiled else "not compiled yet"
         return f"<entry kernel {self.__module__}.{self.__qualname__} ({state})>"
+
+
+def compile_ahead(kernels: Sequence[EntryKernel],
+                  meanwhile: Sequence[Callable[[], object]] = ()) -> list[str]:
+    """Compile ``kernels`` that are neither compiled here nor in numba's on-disk
+    cache in a second process, into that cache, while this one goes on (compiling
+    what it needs meanwhile: the first run's compilation then takes about the
+    longer of the two instead of their sum on two cores).  A first call of one of
+    them waits for that process and loads it from the cache; if the process
+    failed, the call compiles it as before.  ``meanwhile``: calls that compile
+    what this process will need later, made while it waits (their errors
+    ignored: the later call meets them).  The names of those sent ahead.
+
+    ``HAMILTON_ORBITS_COMPILE_AHEAD=0`` turns it off; on one core (nothing to gain),
+    with numba's JIT disabled, or for a kernel not cached on disk, nothing is sent.
+    """
+    if os.environ.get("HAMILTON_ORBITS_COMPILE_AHEAD", "1") == "0" or os.environ.get(
+            "NUMBA_DISABLE_JIT", "0") not in ("", "0") or _cores() < 2:
+        return []
+    todo = [k for k in kernels if isinstance(k, EntryKernel) and not k.compiled
+            and k.key not in _AHEAD and k.options.get("cache") and not k.cached()]
+    if not todo:
+        return []
+    code = ("import importlib, sys\n"
+            "for key in sys.argv[1:]:\n"
+            "    module, name = key.rsplit('.', 1)\n"
+            "    getattr(importlib.import_module(module), name).dispatcher()\n"
+            "    print(key, flush=True)\n")
+    try:
+        proc = subprocess.Popen([sys.executable, "-c", code, *(k.key for k in todo)],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                stdin=subprocess.DEVNULL, text=True)
+    except OSError:  # (no second process here: each is compiled at its first call)
+        return []
+    for k in todo:
+        _AHEAD[k.key] = proc
+    _MEANWHILE.extend(meanwhile)
+    from hamilton_orbits import firstrun
+
+    firstrun.notice()
+    return [k.key for k in todo]
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # (not on Linux)
+        return os.cpu_count() or 1
+
+
+def _wait_for(key: str) -> None:
+    """Wait until the process compiling ``key`` ahead has saved it (or ended)."""
+    proc = _AHEAD.pop(key, None)
+    if proc is None:
+        return
+    while _MEANWHILE:  # (compiled here, beside that process, before waiting on it)
+        try:
+            _MEANWHILE.pop(0)()
+        except Exception:
+            pass
+    start = time.perf_counter()
+    done = set()
+    while key not in done:  # (the keys it printed, in its order)
+        line = proc.stdout.readline() if proc.stdout is not None else ""
+        if not line:
+            break
+        done.add(line.strip())
+    for other in done - {key}:
+        _AHEAD.pop(other, None)
+    if not any(p is proc for p in _AHEAD.values()):
+        _end(proc)
+    from hamilton_orbits import firstrun  # (its clock: the wait is the first run's)
+
+    short = key.removeprefix("hamilton_orbits._kernels.")
+    firstrun.add_compilation(f"{short} (waited for, compiled in a second process)",
+                             time.perf_counter() - start)
+
+
+def _end(proc: subprocess.Popen, stop: bool = False) -> None:
+    """Wait for (``stop``: end) a process compiling ahead, its pipe closed."""
+    if stop:
+        proc.terminate()
+    if proc.stdout is not None:
+        proc.stdout.close()
+    proc.wait()
+
+
+@atexit.register
+def _stop_ahead() -> None:
+    """End the processes still compiling ahead when this one ends."""
+    for proc in set(_AHEAD.values()):
+        _end(proc, stop=True)
+    _AHEAD.clear()
+    _MEANWHILE.clear()
 
 
 def entry(signature: Any, **options: Any) -> Any:

@@ -47,7 +47,7 @@ from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS,
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "CRITERIA", "DEFAULT_TOL", "MAX_STEPS", "NAME",
-           "PRECISIONS", "RADAU_SPACINGS", "run", "start"]
+           "PRECISIONS", "RADAU_SPACINGS", "run", "start", "stepping_kernels"]
 
 NAME = "radau15"
 ACCEPTS_VELOCITY_DEPENDENT = True
@@ -57,6 +57,13 @@ DEFAULT_CRITERION = "prs23"
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
+
+
+def stepping_kernels(events: bool) -> list[Any]:
+    """The compiled stepping kernel a run in double precision without the
+    variational equations calls (with the events' code when ``events``), for
+    :func:`~hamilton_orbits._kernels.entry.compile_ahead`."""
+    return [_k.advance_watched if events else _k.advance]
 
 
 def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,

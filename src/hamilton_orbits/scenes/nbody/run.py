@@ -44,6 +44,19 @@ def simulation(spec: dict, system: Any, archive: Any = None) -> Any:
                       variational=bool(spec["variational"]), **options)
 
 
+def _compile_ahead(spec: dict) -> None:
+    """On a first run, the stepping kernel of a radau15 scene compiled in a second
+    process while this one compiles the right-hand side and the rest (the longer
+    of the two instead of their sum: ``docs/design.md``, "First run")."""
+    if spec["integrator"]["method"] != "radau15" or spec["variational"]:
+        return
+    from hamilton_orbits import integrals
+    from hamilton_orbits._kernels.entry import compile_ahead
+    from hamilton_orbits.integrators import radau15
+
+    compile_ahead(radau15.stepping_kernels(bool(spec["events"])), meanwhile=[integrals.prepare])
+
+
 def resumable(folder: Any) -> bool:
     """True if archive ``folder`` holds a snapshot (a run to resume)."""
     return folder is not None and any(Path(folder).glob("snapshot-*.nc"))
@@ -60,6 +73,7 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     from hamilton_orbits import Simulation
 
     spec = scene.spec
+    _compile_ahead(spec)
     system = build_system(spec)
     times = output_times(spec)
     bar = progress_bar(len(times) - 1, progress, "output")
