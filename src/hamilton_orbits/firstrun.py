@@ -77,26 +77,14 @@ class _CompileNotice(event.Listener):
         if _state["printed"]:
             return
         data = ev.data if isinstance(ev.data, dict) else {}
-        if not _ours(data.get("dispatcher")):
-            return
-        with _lock:
-            if _state["printed"]:
-                return
-            _state["printed"] = True
-        try:
-            print(NOTICE, file=sys.stderr, flush=True)
-        except (OSError, ValueError):  # pragma: no cover - stderr closed
-            pass
+        if _ours(data.get("dispatcher")):
+            notice()
 
     def on_end(self, ev: event.Event) -> None:
         depth = getattr(_local, "depth", 0) - 1
         _local.depth = max(depth, 0)
         if depth == 0:
-            elapsed = time.perf_counter() - _local.start
-            with _lock:
-                _clock["seconds"] += elapsed
-                _clock["count"] += 1
-                _compiled.append((getattr(_local, "name", "?"), elapsed))
+            add_compilation(getattr(_local, "name", "?"), time.perf_counter() - _local.start)
 
 
 def compile_seconds() -> float:
@@ -168,10 +156,10 @@ def describe(compiled: list[tuple[str, float]], shown: int = 3) -> str:
 
 
 def add_compilation(name: str, seconds: float) -> None:
-    """Count ``seconds`` spent waiting for ``name`` to compile in another process
-    (:func:`hamilton_orbits._kernels.entry.compile_ahead`) as compilation: the run's
-    summary then says what the first run waited for, and its integration time
-    leaves it out.
+    """Count ``seconds`` of compilation of ``name``: an outermost numba compilation,
+    or the wait for ``name`` to compile in another process
+    (:func:`hamilton_orbits._kernels.entry.compile_ahead`): the run's summary then
+    says what the first run waited for, and its integration time leaves it out.
 
     Examples
     --------
