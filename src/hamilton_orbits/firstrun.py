@@ -158,7 +158,7 @@ def describe(compiled: list[tuple[str, float]], shown: int = 3) -> str:
 def add_compilation(name: str, seconds: float) -> None:
     """Count ``seconds`` of compilation of ``name``: an outermost numba compilation,
     or the wait for ``name`` to compile in another process
-    (:func:`hamilton_orbits._kernels.entry.compile_ahead`): the run's summary then
+    (``hamilton_orbits._kernels.entry.compile_ahead``): the run's summary then
     says what the first run waited for, and its integration time leaves it out.
 
     Examples

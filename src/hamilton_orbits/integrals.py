@@ -146,7 +146,7 @@ def prepare() -> None:
     """Compile the kernel of :func:`integral_errors` for the types a run gives it
     (``G m`` read-only, as a system's are), by a call on two states of two bodies:
     a first run that has a core to spare compiles it while it waits for another
-    (:func:`hamilton_orbits._kernels.entry.compile_ahead`).
+    (``hamilton_orbits._kernels.entry.compile_ahead``).
 
     Examples
     --------

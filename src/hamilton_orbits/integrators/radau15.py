@@ -62,7 +62,7 @@ SLICE = 20000
 def stepping_kernels(events: bool) -> list[Any]:
     """The compiled stepping kernel a run in double precision without the
     variational equations calls (with the events' code when ``events``), for
-    :func:`~hamilton_orbits._kernels.entry.compile_ahead`."""
+    ``hamilton_orbits._kernels.entry.compile_ahead``."""
     return [_k.advance_watched if events else _k.advance]
 
 
