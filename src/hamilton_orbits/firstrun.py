@@ -167,6 +167,8 @@ def add_compilation(name: str, seconds: float) -> None:
     >>> add_compilation("demo.kernel (a second process)", 0.0)
     >>> compile_seconds() == before
     True
+    >>> ("demo.kernel (a second process)", 0.0) in (claim_compilation(), last_claim())[1]
+    True
     """
     with _lock:
         _clock["seconds"] += seconds
