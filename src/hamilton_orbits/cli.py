@@ -199,12 +199,9 @@ def _compile_ahead(ref: str, sets: Sequence[str]) -> None:
             return
     except Exception:  # (a scene that does not read: its load says why, next)
         return
-    from hamilton_orbits import integrals
-    from hamilton_orbits._kernels.entry import compile_ahead
     from hamilton_orbits.integrators import radau15
 
-    compile_ahead(radau15.stepping_kernels(bool(raw.get("events"))),
-                  meanwhile=[integrals.prepare])
+    radau15.compile_ahead(bool(raw.get("events")))
 
 
 def _archive_for(scene, folder, ref: str, sets: Sequence[str]):

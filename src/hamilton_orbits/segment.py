@@ -63,6 +63,7 @@ from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, en
 from hamilton_orbits.snapshot import (
     INT_EXACT,
     SnapshotError,
+    beyond_float,
     checksum,
     stored,
     variable,
@@ -175,11 +176,6 @@ def _joinable(arrays: list[np.ndarray]) -> tuple[list[Any], list[tuple[int, np.n
         if not live:
             convert.append((k, a))
     return pieces, convert
-
-
-def _beyond_float(a: np.ndarray) -> bool:
-    """Whether integer array ``a`` holds a value a float64 would not hold exactly."""
-    return bool(a.size) and max(map(abs, a.ravel().tolist())) >= INT_EXACT
 
 
 def _record_text(variables: list[tuple[str, tuple[int, ...], str]]) -> str:
@@ -327,9 +323,8 @@ class SegmentWriter:
             return False
         head = file.buffer.runs[0][2]  # (t, r, v, gm, state, scalars, steps, rows)
         head[0] = snap["t"]
-        pieces = [r.reshape(-1), v.reshape(-1), gm, *kept[1]]
-        np.concatenate([*pieces, scalars, (steps, start, start)], out=head[1:],
-                       casting="unsafe")
+        np.concatenate([r.reshape(-1), v.reshape(-1), gm, *kept[1], scalars,
+                        (steps, start, start)], out=head[1:], casting="unsafe")
         views[8][...] = active
         file.write(file.checked(), 1)
         self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]), start)
@@ -351,7 +346,7 @@ class SegmentWriter:
                 or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT
                 or len(scalars) != self._file.buffer.views[5].size
                 or any(type(x) is int and not -INT_EXACT < x < INT_EXACT for x in scalars)
-                or any(_beyond_float(state[k]) for k in ints)):
+                or any(beyond_float(state[k]) for k in ints)):
             return False
         file, pieces, start = self._file, last[4], last[6]
         if last[5]:  # (arrays not float64 or not contiguous: their values as float64)

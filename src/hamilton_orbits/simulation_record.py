@@ -28,7 +28,7 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import Parts
 from hamilton_orbits.restart import Capture, flatten
-from hamilton_orbits.snapshot import INT_EXACT, SnapshotError
+from hamilton_orbits.snapshot import SnapshotError, beyond_float
 from hamilton_orbits.units import is_quantity
 
 __all__ = ["all_active", "from_json", "pack", "record", "spec", "state_values", "to_json", "unpack"]
@@ -145,9 +145,7 @@ def all_active(n: int) -> np.ndarray:
 def _exact_integers(arrays: list[np.ndarray]) -> None:
     """Refuse integer arrays a float64 would not hold exactly."""
     for a in arrays:
-        if a.dtype.kind in "iu" and a.size and max(
-                map(abs, a.ravel().tolist()) if a.size < 64 else (-int(a.min()), int(a.max()))
-        ) >= INT_EXACT:
+        if beyond_float(a):
             raise SnapshotError(f"a state array holds integers beyond 2**53: {a!r}")
 
 

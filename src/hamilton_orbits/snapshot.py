@@ -44,7 +44,7 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "INT_EXACT", "SnapshotError", "checksum",
+__all__ = ["FORMAT", "FORMAT_VERSION", "INT_EXACT", "SnapshotError", "beyond_float", "checksum",
            "encode_snapshot", "read", "stored", "variable", "write", "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
@@ -53,6 +53,20 @@ FORMAT = "hamilton-orbits snapshot"
 FORMAT_VERSION = 1
 #: integers a float64 holds exactly are below this in magnitude
 INT_EXACT = 2 ** 53
+
+
+def beyond_float(a: np.ndarray) -> bool:
+    """Whether integer array ``a`` holds a value a float64 would not hold exactly
+    (False for other kinds).
+
+    Examples
+    --------
+    >>> beyond_float(np.array([2**53 - 1])), beyond_float(np.array([-2**53]))
+    (False, True)
+    """
+    return a.dtype.kind in "iu" and bool(a.size) and max(
+        map(abs, a.ravel().tolist()) if a.size < 64 else (-int(a.min()), int(a.max()))
+    ) >= INT_EXACT
 
 
 class SnapshotError(ValueError):

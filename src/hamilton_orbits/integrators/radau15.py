@@ -47,7 +47,7 @@ from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS,
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "CRITERIA", "DEFAULT_TOL", "MAX_STEPS", "NAME",
-           "PRECISIONS", "RADAU_SPACINGS", "run", "start", "stepping_kernels"]
+           "PRECISIONS", "RADAU_SPACINGS", "compile_ahead", "run", "start"]
 
 NAME = "radau15"
 ACCEPTS_VELOCITY_DEPENDENT = True
@@ -59,11 +59,15 @@ RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 SLICE = 20000
 
 
-def stepping_kernels(events: bool) -> list[Any]:
-    """The compiled stepping kernel a run in double precision without the
-    variational equations calls (with the events' code when ``events``), for
-    ``hamilton_orbits._kernels.entry.compile_ahead``."""
-    return [_k.advance_watched if events else _k.advance]
+def compile_ahead(events: bool) -> None:
+    """On a first run, the stepping kernel a run in double precision without the
+    variational equations calls (with the events' code when ``events``) sent to
+    compile in a second process (``hamilton_orbits._kernels.entry.compile_ahead``),
+    Hamilton's integrals compiled here while this process waits for it."""
+    from hamilton_orbits import integrals
+    from hamilton_orbits._kernels.entry import compile_ahead as send
+
+    send([_k.advance_watched if events else _k.advance], meanwhile=[integrals.prepare])
 
 
 def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndarray,

@@ -50,11 +50,9 @@ def _compile_ahead(spec: dict) -> None:
     of the two instead of their sum: ``docs/design.md``, "First run")."""
     if spec["integrator"]["method"] != "radau15" or spec["variational"]:
         return
-    from hamilton_orbits import integrals
-    from hamilton_orbits._kernels.entry import compile_ahead
     from hamilton_orbits.integrators import radau15
 
-    compile_ahead(radau15.stepping_kernels(bool(spec["events"])), meanwhile=[integrals.prepare])
+    radau15.compile_ahead(bool(spec["events"]))
 
 
 def resumable(folder: Any) -> bool:
