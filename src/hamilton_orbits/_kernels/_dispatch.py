@@ -25,15 +25,23 @@ two never share a cache entry.
 
 from __future__ import annotations
 
+import contextlib
+import inspect
 import os
+import tempfile
 import threading
 import time
 import types
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numba
 from numba import njit
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None  # type: ignore[assignment]
 
 # Rows below which the serial variant runs.  The elements kernel costs ~0.15-0.25
 # us a row; a parallel launch some 10-50 us on idle cores, so there it pays from a
@@ -181,6 +189,56 @@ def parallel_kernel(
     return ParallelKernel(func, threshold)
 
 
+@contextlib.contextmanager
+def _processes_one_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
+    """Hold an exclusive lock on a file beside numba's cache of ``func`` (where it
+    is cached) while the block runs: one process at a time builds a cached
+    (g)ufunc.
+
+    numba caches a generalised ufunc as two files, the kernel and its loop
+    wrapper, and the wrapper calls the kernel by a symbol whose tag counts the
+    compilations of the process that made it.  Two processes compiling the same
+    gufunc at once (Dask workers, a cluster's array job, a parallel test run,
+    all from a cold cache) can leave a kernel from one and a wrapper from the
+    other: every later call, in every later process, dies of a segmentation
+    fault (numba issue #10128, open in numba 0.68).  Under the lock the second
+    process finds both files written by the first and loads them.  Where files
+    cannot be locked (no ``fcntl``: Windows) the block runs unlocked."""
+    if not cached or fcntl is None:
+        yield
+        return
+    path = os.path.join(_cache_dir(func), "hamilton-orbits-ufuncs.lock")
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    except OSError:  # (a folder numba reads but cannot write: it compiles in memory)
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # (closing releases the lock)
+
+
+def _cache_dir(func: Callable) -> str:
+    """The folder numba caches ``func`` in: the first of its locators that
+    applies (``NUMBA_CACHE_DIR``, beside the source, the user's cache), as
+    numba's own cache chooses; the temporary folder if none does."""
+    from numba.core import caching
+
+    source = inspect.getfile(func)
+    for locator in (caching.UserProvidedCacheLocator, caching.InTreeCacheLocator,
+                    caching.UserWideCacheLocator):
+        try:
+            found = locator.from_function(func, source)
+            if found is not None:
+                found.ensure_cache_path()
+                return found.get_cache_path()
+        except OSError:
+            continue
+    return tempfile.gettempdir()
+
+
 class LazyUfunc:
     """A numba (g)ufunc built on first use instead of at import.
 
@@ -188,7 +246,10 @@ class LazyUfunc:
     compile (or load from the cache) when the module is imported, which costs
     about a second before the first call of anything.  This wrapper defers that
     to the first call; attributes (``nin``, ``reduce``, ...) are those of the
-    built ufunc.
+    built ufunc.  With ``cache=True`` the build holds a lock on a file beside
+    numba's cache, so that processes starting together from a cold cache build
+    it one after the other (numba issue #10128: a gufunc built by two at once can
+    leave a cache that crashes every later process).
     """
 
     def __init__(self, builder: Callable, args: tuple, kwargs: dict, func: Callable) -> None:
@@ -206,7 +267,8 @@ class LazyUfunc:
     def _build(self) -> Any:
         with self._lock:
             if self._ufunc is None:
-                self._ufunc = self._builder(*self._args, **self._kwargs)(self.py_func)
+                with _processes_one_at_a_time(self.py_func, self._kwargs.get("cache", False)):
+                    self._ufunc = self._builder(*self._args, **self._kwargs)(self.py_func)
         return self._ufunc
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
@@ -237,7 +299,8 @@ def lazy_vectorize(*args: Any, **kwargs: Any) -> Callable[[Callable], LazyUfunc]
 
 
 def lazy_guvectorize(*args: Any, **kwargs: Any) -> Callable[[Callable], LazyUfunc]:
-    """``numba.guvectorize`` with its arguments, built on first use.
+    """``numba.guvectorize`` with its arguments, built on first use (with
+    ``cache=True`` by one process at a time: see :class:`LazyUfunc`).
 
     Examples
     --------

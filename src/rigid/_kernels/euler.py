@@ -29,9 +29,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import guvectorize, njit
+from numba import njit
 
 from hamilton_orbits.quaternion_kernels import qmul, qrot
+from hamilton_orbits.ufuncs import lazy_guvectorize
 from rigid._kernels.free import free_step
 
 TORQUE_NONE = 0
@@ -118,7 +119,7 @@ def torque_scalar(kind, params, a, b, c, t, w, x, y, z):  # pragma: no cover - c
 # --------------------------------------------------------------------------
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:], float64[:])"],
     "(n),(n),(n)->(n)",
     cache=True,
@@ -135,7 +136,7 @@ def euler_gufunc(moments, omega, torque, out):  # pragma: no cover - compiled
     out[2] = dr
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(m)->(n)", cache=True, nopython=True
 )
 def qdot_gufunc(quat, omega, out):  # pragma: no cover - compiled
@@ -147,7 +148,7 @@ def qdot_gufunc(quat, omega, out):  # pragma: no cover - compiled
     out[3] = dz
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
 )
 def gibbs_dot_gufunc(gibbs, omega, out):  # pragma: no cover - compiled
@@ -158,7 +159,7 @@ def gibbs_dot_gufunc(gibbs, omega, out):  # pragma: no cover - compiled
     out[2] = c
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64[:])"], "(n),(n)->(n)", cache=True, nopython=True
 )
 def gibbs_omega_gufunc(gibbs, gdot, out):  # pragma: no cover - compiled
@@ -172,7 +173,7 @@ def gibbs_omega_gufunc(gibbs, gdot, out):  # pragma: no cover - compiled
     out[2] = 2.0 * (mu * gdot[0] - lam * gdot[1] + gdot[2]) / kap
 
 
-@guvectorize(
+@lazy_guvectorize(
     ["void(float64[:], float64[:], float64, int64, float64[:], float64[:])"],
     "(n),(m),(),(),(k)->(n)",
     cache=True,
