@@ -162,3 +162,27 @@ def test_a_propagation_is_captured_as_it_is_flattened(kw):
         # taken exactly when the graph kept its shape (events found change it)
         assert _agrees(capture, layout, prop) == same
         layout, arrays, capture = now, new, Capture(prop, now)
+
+
+def test_an_address_array_is_forgotten_with_its_kernel():
+    """The addresses of a kernel that was freed (a generated right-hand side no longer
+    used) are forgotten with it: a later array given the freed id, such as a user's
+    (2,) int64 array, is state again, saved and restored.  Before, the id stayed
+    known, and whether such an array was saved depended on the tests run before."""
+    import gc
+
+    from numba import njit
+
+    from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
+    from hamilton_orbits.integrators import _setup
+
+    @njit(ACCEL_SIGNATURE)
+    def no_force(r, v, gm, acc, p):  # pragma: no cover - compiled
+        acc[:] = 0.0
+
+    found = accel_arg(no_force)
+    gone = id(found)
+    assert _setup.is_address(found) and gone in _setup._ADDRESS_IDS
+    del found, no_force
+    gc.collect()
+    assert gone not in _setup._ADDRESS_IDS

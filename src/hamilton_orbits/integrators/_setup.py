@@ -46,6 +46,8 @@ def addresses(fn: Any, signature: Any = ACCEL_SIGNATURE) -> np.ndarray:
                           lib.get_pointer_to_function(names.llvm_func_name)], dtype=np.int64)
         known[id(signature)] = found
         _ADDRESS_IDS.add(id(found))
+        # (forgotten with the array: a later array given the freed id is not one)
+        weakref.finalize(found, _ADDRESS_IDS.discard, id(found))
     return found
 
 
