@@ -53,7 +53,7 @@ def test_a_cached_build_waits_for_the_lock(tmp_path, monkeypatch):
     func.__module__ = "gu_mod"
     gufunc = ufuncs.lazy_guvectorize(["void(float64[:], float64[:])"], "(n)->(n)",
                                      cache=True)(func)
-    lock = Path(_dispatch._cache_dir(func)) / "hamilton-orbits-ufuncs.lock"
+    lock = Path(_dispatch.lock_path(func))
     assert lock.parent.is_relative_to(tmp_path)
     fd = os.open(lock, os.O_RDWR | os.O_CREAT)
     fcntl.flock(fd, fcntl.LOCK_EX)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import contextlib
 import inspect
 import os
+import re
 import tempfile
 import threading
 import time
@@ -190,10 +191,10 @@ def parallel_kernel(
 
 
 @contextlib.contextmanager
-def _processes_one_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
-    """Hold an exclusive lock on a file beside numba's cache of ``func`` (where it
-    is cached) while the block runs: one process at a time builds a cached
-    (g)ufunc.
+def one_process_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
+    """Hold an exclusive lock on a file of ``func``'s own beside numba's cache of it
+    (:func:`lock_path`) while the block runs: one process at a time builds a
+    cached (g)ufunc; the others wait, then load what it wrote.
 
     numba caches a generalised ufunc as two files, the kernel and its loop
     wrapper, and the wrapper calls the kernel by a symbol whose tag counts the
@@ -202,22 +203,42 @@ def _processes_one_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
     all from a cold cache) can leave a kernel from one and a wrapper from the
     other: every later call, in every later process, dies of a segmentation
     fault (numba issue #10128, open in numba 0.68).  Under the lock the second
-    process finds both files written by the first and loads them.  Where files
-    cannot be locked (no ``fcntl``: Windows) the block runs unlocked."""
+    process finds both files written by the first and loads them.  (An entry
+    kernel is cached as one file and needs no lock to be safe; a lock tried to
+    spare the second process its compilation gained nothing measurable: the
+    suite's cold run on two workers took 363 s locked, 331 s unlocked, 2026-11-29,
+    a spread the machine shows alone.)  Where files cannot be locked (no ``fcntl``: Windows; a file system that refuses) the
+    block runs unlocked."""
     if not cached or fcntl is None:
         yield
         return
-    path = os.path.join(_cache_dir(func), "hamilton-orbits-ufuncs.lock")
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        fd = os.open(lock_path(func), os.O_RDWR | os.O_CREAT, 0o666)
     except OSError:  # (a folder numba reads but cannot write: it compiles in memory)
         yield
         return
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        except OSError:  # (no locks on this file system)
+            pass
         yield
     finally:
         os.close(fd)  # (closing releases the lock)
+
+
+def lock_path(func: Callable) -> str:
+    """The lock file of :func:`one_process_at_a_time` for ``func``: named for its
+    module and name, in the folder numba caches it in.
+
+    Examples
+    --------
+    >>> from hamilton_orbits._kernels.quaternion import qmul_gufunc
+    >>> os.path.basename(lock_path(qmul_gufunc.py_func))
+    'hamilton_orbits._kernels.quaternion.qmul_gufunc.lock'
+    """
+    name = re.sub(r"[^\w.-]", "_", f"{func.__module__}.{func.__qualname__}")
+    return os.path.join(_cache_dir(func), name + ".lock")
 
 
 def _cache_dir(func: Callable) -> str:
@@ -267,7 +288,7 @@ class LazyUfunc:
     def _build(self) -> Any:
         with self._lock:
             if self._ufunc is None:
-                with _processes_one_at_a_time(self.py_func, self._kwargs.get("cache", False)):
+                with one_process_at_a_time(self.py_func, self._kwargs.get("cache", False)):
                     self._ufunc = self._builder(*self._args, **self._kwargs)(self.py_func)
         return self._ufunc
 
