@@ -207,8 +207,8 @@ def one_process_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
     kernel is cached as one file and needs no lock to be safe; a lock tried to
     spare the second process its compilation gained nothing measurable: the
     suite's cold run on two workers took 363 s locked, 331 s unlocked, 2026-11-29,
-    a spread the machine shows alone.)  Where files cannot be locked (no ``fcntl``: Windows; a file system that refuses) the
-    block runs unlocked."""
+    a spread the machine shows alone.)  Where files cannot be locked (no
+    ``fcntl``: Windows; a file system that refuses) the block runs unlocked."""
     if not cached or fcntl is None:
         yield
         return
