@@ -218,10 +218,8 @@ def one_process_at_a_time(func: Callable, cached: bool) -> Iterator[None]:
         yield
         return
     try:
-        try:
+        with contextlib.suppress(OSError):  # (no locks on this file system)
             fcntl.flock(fd, fcntl.LOCK_EX)
-        except OSError:  # (no locks on this file system)
-            pass
         yield
     finally:
         os.close(fd)  # (closing releases the lock)
@@ -267,10 +265,8 @@ class LazyUfunc:
     compile (or load from the cache) when the module is imported, which costs
     about a second before the first call of anything.  This wrapper defers that
     to the first call; attributes (``nin``, ``reduce``, ...) are those of the
-    built ufunc.  With ``cache=True`` the build holds a lock on a file beside
-    numba's cache, so that processes starting together from a cold cache build
-    it one after the other (numba issue #10128: a gufunc built by two at once can
-    leave a cache that crashes every later process).
+    built ufunc.  With ``cache=True`` the build runs under
+    :func:`one_process_at_a_time` (why: numba issue #10128, told there).
     """
 
     def __init__(self, builder: Callable, args: tuple, kwargs: dict, func: Callable) -> None:
