@@ -266,7 +266,7 @@ class LazyUfunc:
     about a second before the first call of anything.  This wrapper defers that
     to the first call; attributes (``nin``, ``reduce``, ...) are those of the
     built ufunc.  With ``cache=True`` the build runs under
-    :func:`one_process_at_a_time` (why: numba issue #10128, told there).
+    ``_dispatch.one_process_at_a_time`` (why: numba issue #10128, told there).
     """
 
     def __init__(self, builder: Callable, args: tuple, kwargs: dict, func: Callable) -> None:
