@@ -51,10 +51,15 @@ def _blocks(perturbers: tuple[str, ...], effects: tuple[str, ...], n: int
             ) -> tuple[tuple[str, np.ndarray], ...]:
     """The parameter vectors of ``effects`` for ``perturbers`` and ``n`` small bodies
     (they depend on nothing else: made once per process)."""
+    from hamilton_orbits._kernels.figures import OF_DATE
     from hamilton_orbits.effects import EffectSet
 
     system = _combined_system(n, perturbers)
     blocks = EffectSet.of([EFFECTS[e] for e in effects], "nbody").parameters(system)
+    # (the zonal field's parameters after the pole of date's numbers: the field takes
+    # its pole of date from its clock row, :func:`field_rhs`'s ``earth_pole``)
+    blocks = [b[OF_DATE:] if e == "earth_zonal" else b for e, b in zip(effects, blocks,
+                                                                       strict=True)]
     for block in blocks:
         block.setflags(write=False)
     return tuple(zip(effects, blocks, strict=True))
@@ -121,7 +126,8 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     head[16] = at + len(seg_table) + len(pert_table) + len(coefs)
     cache = np.full(cache_size(len(perturbers)), np.nan)
     cache[0] = 0.0  # (the next slot; a NaN time matches no time)
-    p = np.concatenate([*parts, seg_table, pert_table, coefs, cache])
+    p = np.concatenate([*parts, seg_table, pert_table, coefs, cache, np.zeros(1)])  # (the
+    # integrators' clock last: this field reads the time from its clock row)
     velocity = "eih" in effects or outgassing is not None
     tag = ("newtonian", "small_bodies", *blocks)
     # the time-reversed motion: the same kernel and parameters, the clock's velocity

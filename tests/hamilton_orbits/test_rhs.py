@@ -60,9 +60,9 @@ def test_one_compiled_function_per_list_of_kernels():
     first = compile_rhs(_system(), [{"name": "gr", "c": 50.0}])
     other = compile_rhs(System([Body("a", 2.0, [0, 0, 0], [0, 0, 0])]), [{"name": "gr", "c": 9.0}])
     assert first.accel is other.accel
-    # p = [offsets..., parameters]: gr takes (source index, c)
-    assert first.p.tolist() == [2.0, 4.0, 0.0, 50.0]
-    assert other.p.tolist() == [2.0, 4.0, 0.0, 9.0]
+    # p = [offsets..., parameters, the clock]: gr takes (source index, c)
+    assert first.p.tolist() == [2.0, 4.0, 0.0, 50.0, 0.0]
+    assert other.p.tolist() == [2.0, 4.0, 0.0, 9.0, 0.0]
     assert compile_rhs(_system(), [{"name": "gr_potential", "c": 50.0}]).accel is not first.accel
 
 

@@ -14,7 +14,10 @@ a point mass act on both: the point mass ``i`` receives ``a`` and the extended b
   the Moon, DE430/DE440's constant-time-lag model in three frequency bands;
 - :func:`ring_field`: a uniform circular ring (the Kuiper belt as DE440 models it)
   centred on one body;
-- :func:`precessed_pole`: the Earth's pole of date by the IAU 2006 precession.
+- :func:`precessed_pole`: the Earth's pole of date by the IAU 2006 precession;
+- :func:`zonal_of_date`, :func:`earth_tides_of_date`: the effects' kernels, which
+  know the time (``f(r, v, gm, acc, p, t)``): the two above about the Earth's
+  pole of date, or about a fixed pole (:data:`OF_DATE` numbers lead ``p``).
 
 No astropy here.
 """
@@ -26,6 +29,12 @@ from numba import njit
 
 #: arcseconds in a radian
 _ARCSEC = np.pi / 648000.0
+
+#: The numbers that lead the ``p`` of a kernel about the Earth's pole of date: 1
+#: (0: the fixed pole that follows them), the days from J2000 (TDB) at the
+#: simulation's time 0, then the rotation from the ICRS to the system's axes (3 x
+#: 3, by rows).
+OF_DATE = 11
 
 
 @njit(cache=True, error_model="numpy")
@@ -387,3 +396,34 @@ def ring_field(r, v, gm, acc, p):  # pragma: no cover - compiled
             fy = 0.0
             fz = 0.0
         _push(acc, i, b, fx + az * kx, fy + az * ky, fz + az * kz, gm[i] / gm[b])
+
+
+@njit(cache=True, inline="always")
+def about_pole_of_date(p, t, at):  # pragma: no cover - compiled
+    """``p[OF_DATE:]``, a copy, its pole (3 numbers from ``at``) the Earth's at time
+    ``t`` (days after the simulation's time 0) when ``p[0]`` is 1
+    (:func:`precessed_pole` at ``p[1] + t`` days from J2000, turned into the
+    system's axes by ``p[2:11]``)."""
+    here = p[OF_DATE:].copy()
+    if p[0] != 0.0:
+        k = np.empty(3)
+        precessed_pole((p[1] + t) / 36525.0, k)
+        for i in range(3):
+            here[at + i] = p[2 + 3 * i] * k[0] + p[3 + 3 * i] * k[1] + p[4 + 3 * i] * k[2]
+    return here
+
+
+@njit(cache=True)
+def zonal_of_date(r, v, gm, acc, p, t):  # pragma: no cover - compiled
+    """:func:`zonal_field` about the Earth's pole at time ``t`` (``p``:
+    :data:`OF_DATE` numbers, then :func:`zonal_field`'s; a 0 first: its fixed
+    pole, the same bits as :func:`zonal_field`)."""
+    zonal_field(r, v, gm, acc, about_pole_of_date(p, t, 2))
+
+
+@njit(cache=True)
+def earth_tides_of_date(r, v, gm, acc, p, t):  # pragma: no cover - compiled
+    """:func:`earth_tides` about the Earth's pole at time ``t`` (``p``:
+    :data:`OF_DATE` numbers, then :func:`earth_tides`'s; a 0 first: its fixed
+    pole)."""
+    earth_tides(r, v, gm, acc, about_pole_of_date(p, t, 5))

@@ -32,6 +32,7 @@ import math
 import numpy as np
 from numba import njit, types
 
+from hamilton_orbits._kernels.figures import about_pole_of_date
 from hamilton_orbits._kernels.signatures import F1, F2, function_at
 
 __all__ = [
@@ -49,6 +50,7 @@ __all__ = [
     "tangent_at",
     "zero_jvp",
     "zonal_field_jvp",
+    "zonal_of_date_jvp",
 ]
 
 #: ``void(r, v, gm, dr, dv, da, p)``
@@ -495,3 +497,10 @@ def fd_add(ap, am, h, da, m):  # pragma: no cover - compiled
     for i in range(n):
         for c in range(3):
             da[m * n + i, c] += f * (ap[i, c] - am[i, c])
+
+
+@njit(cache=True)
+def zonal_of_date_jvp(r, v, gm, dr, dv, da, p, t):  # pragma: no cover - compiled
+    """Jacobian of :func:`hamilton_orbits._kernels.figures.zonal_of_date` (adds): that
+    of :func:`zonal_field_jvp` about the pole of time ``t``."""
+    zonal_field_jvp(r, v, gm, dr, dv, da, about_pole_of_date(p, t, 2))

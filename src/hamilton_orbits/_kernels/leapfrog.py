@@ -8,7 +8,7 @@ from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
-from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at, set_clock
 
 __all__ = ["STATUS_DRAIN", "STATUS_EVENT", "STATUS_OK", "STATUS_SLICE", "advance",
            "advance_watched"]
@@ -77,6 +77,7 @@ def _advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, m
     for s in range(n_steps):
         t = t0 + s * h
         _drift(r, v, 0.5 * h, t, watch, ev_out, ev_count, ws, x0, gm)
+        set_clock(p, t + 0.5 * h)
         accel(r, v, gm, acc, p)
         for i in range(n):
             for k in range(3):

@@ -24,7 +24,7 @@ from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
-from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at, set_clock
 from hamilton_orbits._kernels.variational import megno_update
 
 __all__ = [
@@ -277,9 +277,9 @@ def _correct(ns, at, a0, g, b, csb):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, need_v):
+def _iterate(accel, p, gm, t, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, need_v):
     # pragma: no cover - compiled
-    """The predictor-corrector iteration of one step (Rein & Spiegel 2015,
+    """The predictor-corrector iteration of one step from ``t`` (Rein & Spiegel 2015,
     section 2.2): stops when ``max |delta b6| / max |a|`` falls below 1e-16 or
     stops decreasing (after 2 iterations), or after 12.  Returns the iterations.
     ``xs``, ``vs``, ``at`` are (n, 3) work arrays (their flat views are used)."""
@@ -297,6 +297,7 @@ def _iterate(accel, p, gm, dt, b, g, csb, a0, x0, v0, csx0, csv0, xs, vs, at, ne
             _positions_at(_H[ns], dt, b, a0, v0, x0, csx0, xsf)
             if need_v:
                 _velocities_at(_H[ns], dt, b, a0, v0, csv0, vsf)
+            set_clock(p, t + _H[ns] * dt)
             accel(xs, vs, gm, at, p)
             maxdb, maxak = _correct(ns, atf, a0, g, b, csb)
         pc_err = maxdb / maxak if maxak > 0.0 else 0.0
@@ -478,13 +479,14 @@ def _try_length(t, t_end, dt):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb, a0, xf, vf,
-               csx, csv, xs, vs, at, need_v):  # pragma: no cover - compiled
-    """One step's attempt up to its acceptance test: the start's accelerations,
+def _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g, csb, a0, xf,
+               vf, csx, csv, xs, vs, at, need_v):  # pragma: no cover - compiled
+    """One step's attempt from ``t`` up to its acceptance test: the start's accelerations,
     ``b`` predicted from the last step (:func:`_predict`, ``q`` the ratio of the
     step lengths; zero after a change of more than 20x), the predictor-corrector
     iteration (its rounds counted in ``st[ST_PC_ITERS]``).  False when a number is not
     finite."""
+    set_clock(p, t)
     if not _start_step(accel, p, r, v, gm, a0_2, x0, v0):
         return False
     if q <= 20.0:
@@ -493,8 +495,8 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb
         b[:, :] = 0.0
     csb[:, :] = 0.0
     _g_from_b(b, g)
-    st[ST_PC_ITERS] += _iterate(accel, p, gm, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs, at,
-                      need_v)
+    st[ST_PC_ITERS] += _iterate(accel, p, gm, t, dt_try, b, g, csb, a0, xf, vf, csx, csv, xs, vs,
+                                at, need_v)
     return _all_finite(b[6])
 
 
@@ -628,8 +630,8 @@ def _steps(
                 status = STATUS_UNDERFLOW
             break
         q = dt_try / dt_last if have_last else math.inf
-        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb,
-                          a0, xf, vf, csx, csv, xs, vs, at, need_v):
+        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g,
+                          csb, a0, xf, vf, csx, csv, xs, vs, at, need_v):
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing)
@@ -820,8 +822,8 @@ def advance_variational(
                 status = STATUS_UNDERFLOW
             break
         q = dt_try / dt_last if have_last else math.inf
-        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, dt_try, q, st, b, br, d, g, csb,
-                          a0, xf, vf, csx, csv, xs, vs, at, need_v):
+        if not _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g,
+                          csb, a0, xf, vf, csx, csv, xs, vs, at, need_v):
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at[:n_phys], r[:n_phys], v[:n_phys], dt_try, dt,

@@ -2,7 +2,15 @@
 
 A right-hand side is ``accel(r, v, gm, acc, p)``: positions and velocities (n, 3),
 ``G m`` (n,), the output (n, 3) and the parameter vector of the listed effects
-(see :mod:`hamilton_orbits.rhs`), all C-contiguous float64.  The stepping kernels
+(see :mod:`hamilton_orbits.rhs`), all C-contiguous float64.
+
+The clock: ``p``'s last element.  Before every evaluation of a right-hand side
+(``accel``, ``extra``, ``augmented``) an integrator writes there the time of the
+state it passes, in its own time variable (``s = -t`` in a time-reversed run; the
+generated right-hand side turns it back), so that an effect may depend on the
+time (:func:`set_clock`).  Each run has its own ``p`` (the drivers copy it).
+
+The stepping kernels
 take it by its addresses (:data:`ADDRESSES`: the compiled function's C wrapper and
 its own entry point, two integers) and make the first-class function of
 :data:`ACCEL_TYPE` from them inside (:func:`accel_at`), so that each is compiled
@@ -19,12 +27,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from numba import types
+from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
 __all__ = ["ACCEL_SIGNATURE", "ACCEL_TYPE", "ADDRESSES", "F1", "F2", "accel_at",
-           "function_at"]
+           "function_at", "set_clock"]
 
 F1 = types.float64[::1]
 F2 = types.float64[:, ::1]
@@ -63,3 +71,10 @@ def function_at(ftype: types.FunctionType) -> Any:
 
 #: ``accel_at(c_addr, jit_addr)``: the right-hand side at those addresses.
 accel_at = function_at(ACCEL_TYPE)
+
+
+@njit(cache=True, inline="always")
+def set_clock(p, t):  # pragma: no cover - compiled
+    """Write the time ``t`` of the state about to be evaluated into ``p``'s clock,
+    its last element."""
+    p[p.shape[0] - 1] = t

@@ -24,7 +24,7 @@ from numba import njit, types
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.jacobians import tangent_at
-from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at, set_clock
 
 __all__ = [
     "LN_RESCALE",
@@ -262,6 +262,7 @@ def advance_leapfrog(accel_addr, tangent_addr, p, r, v, gm, dr, dv, t0, t1, dt, 
     da = np.empty_like(dr)
     for s in range(n_steps):
         _drift(r, v, dr, dv, 0.5 * h)
+        set_clock(p, t0 + s * h + 0.5 * h)  # (the plain kernel's kick time)
         accel(r, v, gm, acc, p)
         tangent(r, v, gm, dr, dv, da, p)
         for i in range(n):

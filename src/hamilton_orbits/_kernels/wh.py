@@ -24,7 +24,7 @@ from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.entry import entry
-from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at, set_clock
 
 _I1 = types.int64[::1]
 
@@ -613,6 +613,8 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
+        if has_extra:
+            set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
         _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x,
                  order, gm_c)
         h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
@@ -640,6 +642,8 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
         return 0, bad, STATUS_OK
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
+        if has_extra:
+            set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
         _kick_jacobi(
             extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
             acc, accj, acc_x, r_in, v_in, perm,

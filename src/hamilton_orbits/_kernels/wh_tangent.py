@@ -33,7 +33,7 @@ from hamilton_orbits._kernels import kepler as _kepler
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.jacobians import newtonian_jvp, tangent_at
-from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at
+from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at, set_clock
 from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
 from hamilton_orbits._kernels.wh import caller_gm, jacobi_factors, jacobi_to_inertial_pos
 
@@ -233,6 +233,7 @@ def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, order, q, u, gm, gm
         return 0, bad
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
+        set_clock(p, t + 0.5 * h)  # (the kick: the middle of the step)
         _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm_p, idx, h,
                  m_tot, w, perm)
         megno_map_step(ms, _ln_delta_dh(dq, du, dcom, gm, m_tot, w[2], w[3]), t + 0.5 * h,
@@ -363,6 +364,7 @@ def advance_jacobi(extra_addr, tangent_addr, p, has_extra, order, qj, uj, gm, et
         return 0, bad
     for s in range(n_steps):
         h = dt if s < n_steps - 1 else dt_last
+        set_clock(p, t + 0.5 * h)  # (the kick: the middle of the step)
         _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv, h,
                      w, perm)
         megno_map_step(ms, _ln_delta_jacobi(dq, du, gm, eta, ratio, inv, r0, v0), t + 0.5 * h,

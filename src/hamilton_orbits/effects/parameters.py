@@ -532,3 +532,57 @@ def body_pole(system: Any, b: int, params: Mapping[str, Any], effect: str) -> np
     if pole is not None:
         return np.array(pole)
     return de.frame_rotation(axes_frame(system, params, effect)) @ [0.0, 0.0, 1.0]
+
+
+#: ``pole`` of an effect about the Earth's pole of date
+POLE_OF_DATE = "IAU2006"
+POLE_PARAMETER = ("the Earth's pole: a vector (default the Body's pole), or 'IAU2006' for "
+                  "its pole of date by the IAU 2006 precession (IERS Conventions 2010, eq. "
+                  "5.16, without nutation; needs a Quantity system, its time in days)")
+EPOCH_PARAMETER = ("with pole = 'IAU2006': the TDB of the simulation's time 0, an astropy "
+                   "Time or a date (default 'J2000')")
+
+
+def pole_of_date(system: Any, b: int, params: Mapping[str, Any], effect: str) -> np.ndarray:
+    """The numbers that lead the ``p`` of a kernel about the Earth's pole of date
+    (:data:`hamilton_orbits._kernels.figures.OF_DATE`: 1, the days from J2000 TDB
+    of the system's time 0, then the rotation from the ICRS to the system's axes),
+    followed by the pole of body ``b`` at time 0: for ``params["pole"] ==
+    "IAU2006"``; else 0, 0 and the identity, then :func:`body_pole`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``effect``: ``"IAU2006"`` for a system of plain floats (its time unit
+        unknown), another text, or an ``epoch`` without it.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import System
+    >>> s = System.from_ephemeris(bodies=["earth", "moon"])
+    >>> lead = pole_of_date(s, 0, {"pole": "IAU2006", "epoch": "J2000"}, "zonal")
+    >>> lead[:2].tolist(), lead[2:11].tolist() == np.eye(3).ravel().tolist(), lead.shape
+    ([1.0, 0.0], True, (14,))
+    """
+    from hamilton_orbits._kernels.figures import precessed_pole
+
+    pole = params.get("pole")
+    if not isinstance(pole, str):
+        if "epoch" in params:
+            raise ValueError(f"Effect {effect!r}: `epoch` is the time of the pole of date; "
+                             f"give it with pole = {POLE_OF_DATE!r}, got pole {pole!r}")
+        return np.array([0.0, 0.0, *np.eye(3).ravel(), *body_pole(system, b, params, effect)])
+    if pole != POLE_OF_DATE:
+        raise ValueError(f"Effect {effect!r}: expected `pole` to be a vector or "
+                         f"{POLE_OF_DATE!r}, got {pole!r}")
+    if not system.quantity:
+        raise ValueError(f"Effect {effect!r}: pole = {POLE_OF_DATE!r} needs a system of "
+                         "Quantities (its time in days); this one is of plain floats")
+    try:
+        days = de.epoch_jd(params.get("epoch", "J2000")) - de.J2000_JD
+    except ValueError as exc:
+        raise ValueError(f"Effect {effect!r}: {exc}") from None
+    rotation = de.frame_rotation(axes_frame(system, params, effect))
+    k = np.empty(3)
+    precessed_pole(days / 36525.0, k)
+    return np.array([1.0, days, *rotation.ravel(), *(rotation @ k)])

@@ -3,12 +3,15 @@
 The tides the Moon and the Sun raise on the Earth acting on the Moon, DE440's
 constant-time-lag model (``K2E0..2``, ``TAUE0..2``, ``TAUER1..2``): it gives the
 Moon its secular deceleration.  Kernel
-:func:`~hamilton_orbits._kernels.figures.earth_tides`; no analytic Jacobian (the
-tides' delays are nested functions of the state): the variational equations
-differentiate the kernel by compiled central differences
-(:mod:`hamilton_orbits.rhs`).  ``p = [earth index, moon index, sun index (-1: no
-Sun), radius, omega, pole x, y, z, k20, k21, k22, TAUE0, TAUE1, TAUE2, TAUER1,
-TAUER2]``.  It keeps no registered energy (tides dissipate).
+:func:`~hamilton_orbits._kernels.figures.earth_tides_of_date` (it knows the time:
+with ``pole = "IAU2006"`` the Earth's pole is that of each time, by the IAU 2006
+precession, else fixed); no analytic Jacobian (the tides' delays are nested
+functions of the state): the variational equations differentiate the kernel by
+compiled central differences (:mod:`hamilton_orbits.rhs`).  ``p = [the pole of
+date's 10 numbers, earth index, moon index, sun index (-1: no Sun), radius,
+omega, pole x, y, z, k20, k21, k22, TAUE0, TAUE1, TAUE2, TAUER1, TAUER2]``
+(:func:`~hamilton_orbits.effects.parameters.pole_of_date`).  It keeps no
+registered energy (tides dissipate).
 
 References
 ----------
@@ -25,16 +28,18 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits import ephemeris as de
-from hamilton_orbits._kernels.figures import earth_tides
+from hamilton_orbits._kernels.figures import OF_DATE, earth_tides_of_date
 from hamilton_orbits.effects.parameters import (
+    EPOCH_PARAMETER,
     FRAME_PARAMETER,
     PARK_2021,
+    POLE_PARAMETER,
     body_index,
-    body_pole,
     distinct_bodies,
     finite_floats,
     optional_body_index,
     parameter_array,
+    pole_of_date,
     require_de440_units,
     scalar_parameter,
 )
@@ -67,8 +72,8 @@ def _params_earth_tides(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     elif tau.shape != (5,):
         raise ValueError(f"Effect 'earth_tides': expected `tau` to be 5 finite numbers, got "
                          f"{params['tau']!r}")
-    pole = body_pole(system, e, params, "earth_tides")
-    return np.array([e, m, sun, radius, omega, *pole, *k2, *tau])
+    lead = pole_of_date(system, e, params, "earth_tides")
+    return np.array([*lead[:OF_DATE], e, m, sun, radius, omega, *lead[OF_DATE:], *k2, *tau])
 
 
 SPECS = (
@@ -84,9 +89,9 @@ SPECS = (
                     "k2": "[k20, k21, k22] (default DE440's K2E0..2)",
                     "tau": "time lags [TAUE0, TAUE1, TAUE2, TAUER1, TAUER2] (default "
                            "DE440's)",
-                    "pole": "Earth's pole (default the Body's pole)",
+                    "pole": POLE_PARAMETER, "epoch": EPOCH_PARAMETER,
                     "frame": FRAME_PARAMETER},
-        kernel=earth_tides, params=_params_earth_tides,
+        kernel=earth_tides_of_date, params=_params_earth_tides,
         parameter_kinds={"radius": LENGTH, "omega": ANGULAR_SPEED, "tau": TIME},
         name_parameters=("earth", "moon"),
         reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 32; {PARK_2021}",

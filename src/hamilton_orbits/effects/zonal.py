@@ -2,10 +2,13 @@
 
 For the Earth (the default) DE440's ``RE``, ``J2E``, ``J3E``, ``J4E``, acting on
 every other body (the Moon above all); another body needs ``j`` and ``radius``.
-Kernel :func:`~hamilton_orbits._kernels.figures.zonal_field`, Jacobian
-:func:`~hamilton_orbits._kernels.jacobians.zonal_field_jvp`; ``p = [body index,
-radius, pole x, y, z, J2, J3, ...]``.  It keeps no registered energy.  J2 alone
-about any body: :mod:`hamilton_orbits.effects.j2`.
+Kernel :func:`~hamilton_orbits._kernels.figures.zonal_of_date` (it knows the
+time), Jacobian :func:`~hamilton_orbits._kernels.jacobians.zonal_of_date_jvp`;
+``p = [the pole of date's 10 numbers, body index, radius, pole x, y, z, J2, J3,
+...]`` (:func:`~hamilton_orbits.effects.parameters.pole_of_date`).  With
+``pole = "IAU2006"`` the pole is the Earth's of each time (the IAU 2006
+precession), else fixed.  It keeps no registered energy.  J2 alone about any
+body: :mod:`hamilton_orbits.effects.j2`.
 
 References
 ----------
@@ -21,14 +24,16 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits import ephemeris as de
-from hamilton_orbits._kernels.figures import zonal_field
-from hamilton_orbits._kernels.jacobians import zonal_field_jvp
+from hamilton_orbits._kernels.figures import OF_DATE, zonal_of_date
+from hamilton_orbits._kernels.jacobians import zonal_of_date_jvp
 from hamilton_orbits.effects.parameters import (
+    EPOCH_PARAMETER,
     FRAME_PARAMETER,
     PARK_2021,
+    POLE_PARAMETER,
     body_index,
-    body_pole,
     finite_floats,
+    pole_of_date,
     scalar_parameter,
 )
 from hamilton_orbits.effects.registry import EffectSpec
@@ -48,7 +53,8 @@ def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
                 "zonal")
     radius = scalar_parameter(system, params, "radius", "zonal", LENGTH,
                               de.constant("RE") / de.constant("AU"), positive=True)
-    return np.array([b, radius, *body_pole(system, b, params, "zonal"), *j])
+    lead = pole_of_date(system, b, params, "zonal")
+    return np.array([*lead[:OF_DATE], b, radius, *lead[OF_DATE:], *j])
 
 
 SPECS = (
@@ -58,11 +64,11 @@ SPECS = (
         parameters={"body": "the body (default 'earth')",
                     "j": "[J2, J3, ...] (default DE440's J2E, J3E, J4E)",
                     "radius": "reference radius, a length (default DE440's RE)",
-                    "pole": "pole vector (default the Body's pole)",
+                    "pole": POLE_PARAMETER, "epoch": EPOCH_PARAMETER,
                     "frame": FRAME_PARAMETER},
-        kernel=zonal_field, params=_params_zonal,
+        kernel=zonal_of_date, params=_params_zonal,
         parameter_kinds={"radius": LENGTH}, name_parameters=("body",),
-        jacobian=zonal_field_jvp,
+        jacobian=zonal_of_date_jvp,
         reference=f"Moyer (1971), JPL TR 32-1527, eqs. 173-174; {PARK_2021}",
     ),
 )

@@ -191,6 +191,7 @@ class Radau15Tangent:
                  slice_steps: int, control: bool) -> None:
         self.n = n = r0.shape[0]
         self.rhs, self.tangent, self.max_steps, self.slice = rhs, tangent, max_steps, slice_steps
+        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
         self.gm = np.array(gm, dtype=np.float64)  # writable (the kernels take no read-only)
         self.x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
         self.w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
@@ -224,7 +225,7 @@ class Radau15Tangent:
             while True:
                 left = self.max_steps - (self.steps - first)
                 steps, status = _radau.advance_variational(
-                    self.accel, self.rhs.p, x, w, self.gm, t_out[i], st, *self.work, self.csx,
+                    self.accel, self.p, x, w, self.gm, t_out[i], st, *self.work, self.csx,
                     self.csv, bool(self.rhs.velocity_dependent), min(self.slice, left),
                     self.n_phys, self.tangent.ms)
                 self.steps += steps
@@ -310,6 +311,7 @@ class LeapfrogTangent:
         self.dr, self.dv = tangent.dr0.copy(), tangent.dv0.copy()
         self.accel, self.jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
         self.rhs, self.tangent, self.dt, self.slice = rhs, tangent, dt, slice_steps
+        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
         tangent.start(t0)
         self.t, self.steps = t0, 0
 
@@ -327,7 +329,7 @@ class LeapfrogTangent:
             t, t1 = float(t_out[i - 1]), float(t_out[i])
             while True:  # the steps and times of the plain kernel's slices
                 n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
-                done = _var.advance_leapfrog(self.accel, self.jac, self.rhs.p, self.r, self.v,
+                done = _var.advance_leapfrog(self.accel, self.jac, self.p, self.r, self.v,
                                              self.gm, self.dr, self.dv, t, t1, dt,
                                              self.tangent.ms, self.slice)
                 self.steps += done
@@ -376,6 +378,7 @@ class WHTangent:
             self.jac = _tangent_arg(rhs.tangent_extra if has_extra else rhs.tangent)
         self.rhs, self.tangent, self.dt, self.jacobi, self.slice = (rhs, tangent, dt, jacobi,
                                                                      slice_steps)
+        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
         tangent.start(t0)
         self.t, self.steps = t0, 0
 
@@ -386,10 +389,10 @@ class WHTangent:
 
     def _steps(self, n_call: int, h_last: float, t_call: float) -> tuple[int, int]:
         if self.jacobi:
-            return _wht.advance_jacobi(self.extra, self.jac, self.rhs.p, self.has_extra,
+            return _wht.advance_jacobi(self.extra, self.jac, self.p, self.has_extra,
                                        self.order, self.q, self.u, self.g, self.eta, self.dq,
                                        self.du, self.dt, n_call, h_last, t_call, self.tangent.ms)
-        return _wht.advance_dh(self.extra, self.jac, self.rhs.p, self.has_extra, self.order,
+        return _wht.advance_dh(self.extra, self.jac, self.p, self.has_extra, self.order,
                                self.q, self.u, self.g, self.g_p, self.com, self.dq, self.du,
                                self.dcom, self.dt, n_call, h_last, t_call, self.tangent.ms)
 
@@ -446,6 +449,7 @@ class DOP853Tangent:
             n, np.array(gm, dtype=np.float64), tangent, tol, max_step)
         self.max_steps = max_steps
         self.rhs, self.t0, self.acc = rhs, t0, np.empty((rows, 3))
+        self.p = rhs.p.copy()  # (this run's own: its clock set at each evaluation)
         self.y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(),
                                  tangent.dv0.ravel(), [0.0]))
         scale_t = np.full(6 * n * k, np.inf)
@@ -463,7 +467,9 @@ class DOP853Tangent:
         n, rows, acc, rhs = self.n, self.rows, self.acc, self.rhs
         x = y[: 3 * rows].reshape(rows, 3)
         w = y[3 * rows: 6 * rows].reshape(rows, 3)
-        rhs.augmented(x, w, self.gm, acc, rhs.p)
+        p = self.p
+        p[-1] = t  # (the clock)
+        rhs.augmented(x, w, self.gm, acc, p)
         check_finite(acc, t, "dop853")
         dx, dw, da = x[n:2 * n], w[n:2 * n], acc[n:2 * n]
         den = float(np.sum(dx * dx) + np.sum(dw * dw))

@@ -88,6 +88,7 @@ class _State:
         self.n = n = r0.shape[0]
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
         self.rhs, self.acc = rhs, np.empty((n, 3))
+        self.p = rhs.p.copy()  # (this run's own: its clock set at each evaluation)
         self.y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
         self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
         self.t, self.steps, self.max_steps = t0, 0, max_steps
@@ -100,7 +101,9 @@ class _State:
         n = self.n
         r = y[: 3 * n].reshape(n, 3)
         v = y[3 * n :].reshape(n, 3)
-        self.rhs.accel(r, v, self.gm, self.acc, self.rhs.p)
+        p = self.p
+        p[-1] = t  # (the clock)
+        self.rhs.accel(r, v, self.gm, self.acc, p)
         _setup.check_finite(self.acc, t, NAME)
         return np.concatenate((y[3 * n :], self.acc.ravel()))
 

@@ -88,7 +88,8 @@ class _State:
         self.r = np.ascontiguousarray(r0, dtype=np.float64).copy()
         self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
         self.gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
-        self.accel, self.p = accel_arg(rhs.accel), rhs.p
+        self.accel, self.p = accel_arg(rhs.accel), rhs.p.copy()  # (its own: the kernels
+        # write its clock)
         self.log = events if events is not None else EventLog.none(self.r.shape[0])
         self.dt, self.max_steps, self.t, self.steps = dt, max_steps, t0, 0
 

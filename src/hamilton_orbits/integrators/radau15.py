@@ -294,7 +294,8 @@ class _Run:
         self.pause: Any = None
         # the kernel's arguments that stay the same objects between calls (a short
         # call's cost is mostly its arguments; see docs/design.md, "One front door")
-        self.before_t = (self.accel, rhs.p, self.x, self.w, gm)
+        self.before_t = (self.accel, rhs.p.copy(), self.x, self.w, gm)  # (p: this run's own,
+        # the kernels write its clock)
         self.after_t = (self.st, *self.work, self.csx, self.csv, bool(rhs.velocity_dependent))
 
     @property

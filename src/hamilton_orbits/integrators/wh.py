@@ -251,8 +251,9 @@ class _State:
         self.log = events if events is not None else EventLog.none(n)
         if c != 0:
             self.log.index_map = order
-        self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra, rhs.p,
-                            rhs.extra is not None)
+        self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra,
+                            rhs.p.copy(), rhs.extra is not None)  # (p: this run's own, the
+        # kernels write its clock)
         self.split.from_inertial(r0, v0, np.empty_like(r0), np.empty_like(v0))
         self.watch = self.log.kernel_watch()
         self.ws = np.empty(4)  # the events' work space of the kernels (see _drift)
@@ -391,12 +392,16 @@ class _Split:
         runs = ((dt, n_steps - 1), (last, 1)) if n_steps > 1 and last != dt else (
             (dt if n_steps > 1 else last, n_steps),)
         done, bad, status = 0, -1, _k.STATUS_OK
+        t = float(ws[0])  # (the corrector's kicks at the time it is applied at: the clock)
         for h, k in runs:
+            self.p[-1] = t
             bad = _k.corrector_jacobi(*args, h, 1.0, *self.coef)
             if bad < 0:
                 steps, bad, status = advance(*args, h, k, h, *ev)
                 done += steps
+                t += steps * h
             if bad < 0:
+                self.p[-1] = t
                 bad = _k.corrector_jacobi(*args, h, -1.0, *self.coef)
             if bad >= 0 or status != _k.STATUS_OK:
                 break

@@ -40,9 +40,19 @@ keeps the files (:func:`cache_dir`, the digest, :func:`remove_stale`).
 
 The parameter vector
 --------------------
-``p = [o_0, o_1, ..., o_m, params_0..., params_1..., ...]`` for ``m`` effects:
-effect ``i`` receives ``p[o_i:o_(i+1)]`` (its own parameters, as its
-``params`` builder returned them).
+``p = [o_0, o_1, ..., o_m, params_0..., params_1..., ..., clock]`` for ``m``
+effects: effect ``i`` receives ``p[o_i:o_(i+1)]`` (its own parameters, as its
+``params`` builder returned them).  The last element is the clock: before every
+evaluation, the integrator writes there the time of the state it passes
+(:mod:`hamilton_orbits._kernels.signatures`).
+
+Effects that know the time
+--------------------------
+A kernel of six arguments, ``kernel(r, v, gm, acc, p, t)``, receives the time
+``t`` of the state (the simulation's time, in its unit: days for a Quantity
+system; the true time also in a time-reversed run) read from the clock; a
+Jacobian of eight, ``jacobian(r, v, gm, dr, dv, da, p, t)``, likewise.  Kernels
+of five (seven) arguments are compiled as before, without it.
 
 The variational equations
 -------------------------
@@ -80,7 +90,7 @@ from hamilton_orbits.rhs.diskcache import (
 
 __all__ = ["RHS", "STALE_AGE_SECONDS", "cache_dir", "check_ref", "compile_rhs", "kernel_ref",
            "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "source",
-           "tangent_kernels_for", "tangent_source", "time_reversed"]
+           "takes_time", "tangent_kernels_for", "tangent_source", "time_reversed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,8 +132,18 @@ class RHS:
     augmented: Any = None
     reversed: Any = None
 
-    def acceleration(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
-        """The acceleration of every body, shape (n, 3) (float64, internal units).
+    def __post_init__(self) -> None:
+        p = self.p
+        if not (isinstance(p, np.ndarray) and p.dtype == np.float64 and p.ndim == 1
+                and p.size >= 1 and p.flags.c_contiguous and p.flags.writeable):
+            # (the integrators write the clock into p's last element: one must exist)
+            raise ValueError("Expected `p` to be a writable C-contiguous float64 vector of at "
+                             f"least one element (its last the clock), got {p!r}")
+
+    def acceleration(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                     t: float = 0.0) -> np.ndarray:
+        """The acceleration of every body at time ``t`` (for the effects that know
+        it), shape (n, 3) (float64, internal units).
 
         Examples
         --------
@@ -134,7 +154,9 @@ class RHS:
         """
         r, v, gm = (np.require(x, np.float64, ["C", "W"]) for x in (r, v, gm))
         acc = np.empty_like(r)
-        self.accel(r, v, gm, acc, self.p)
+        p = self.p.copy()  # (its own clock: this p may be a running integrator's)
+        p[-1] = t
+        self.accel(r, v, gm, acc, p)
         return acc
 
 
@@ -164,17 +186,40 @@ def newtonian_rhs() -> RHS:
 
 
 def parameter_vector(blocks: list[np.ndarray]) -> np.ndarray:
-    """``p`` from the effects' own parameter vectors, offsets first.
+    """``p`` from the effects' own parameter vectors, offsets first, the clock last.
 
     Examples
     --------
     >>> parameter_vector([np.array([0.0, 173.1]), np.array([1.0])]).tolist()
-    [3.0, 5.0, 6.0, 0.0, 173.1, 1.0]
+    [3.0, 5.0, 6.0, 0.0, 173.1, 1.0, 0.0]
     """
     m = len(blocks)
     offsets = np.cumsum([m + 1] + [len(b) for b in blocks]).astype(np.float64)
     parts = [offsets] + [np.asarray(b, dtype=np.float64).ravel() for b in blocks]
-    return np.ascontiguousarray(np.concatenate(parts))
+    return np.ascontiguousarray(np.concatenate([*parts, np.zeros(1)]))
+
+
+def takes_time(kernel: Any, plain: int) -> bool:
+    """Whether compiled ``kernel`` takes the time: ``plain + 1`` arguments, not
+    ``plain`` (5 for an acceleration kernel, 7 for a Jacobian).
+
+    Raises
+    ------
+    ValueError
+        For another number of arguments.
+
+    Examples
+    --------
+    >>> from hamilton_orbits._kernels import figures, nbody
+    >>> takes_time(nbody.gr_potential, 5), takes_time(figures.zonal_of_date, 5)
+    (False, True)
+    """
+    func = getattr(kernel, "py_func", kernel)
+    count = func.__code__.co_argcount
+    if count not in (plain, plain + 1):
+        raise ValueError(f"Expected the kernel {func.__name__!r} to take {plain} arguments, or "
+                         f"{plain + 1} with the time last, got {count}")
+    return count == plain + 1
 
 
 def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RHS:
@@ -233,9 +278,10 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
 def time_reversed(rhs: RHS) -> RHS:
     """The right-hand side of the time-reversed motion of ``rhs`` (the same effects
     and parameters), which a backward run integrates forwards in ``s = -t`` on the
-    velocities ``w = -v``: ``d2r/ds2 = a(r, -w)``, the effects evaluated at the true
-    velocity (:func:`~hamilton_orbits.rhs.codegen.source`, ``reverse``).  ``rhs``
-    itself when no effect depends on velocities (``a(r, -w) = a(r, w)``).
+    velocities ``w = -v``: ``d2r/ds2 = a(r, -w, t = -s)``, the effects evaluated at
+    the true velocity and the true time (:func:`~hamilton_orbits.rhs.codegen.source`,
+    ``reverse``).  ``rhs`` itself when no effect depends on velocities or on the
+    time (``a(r, -w) = a(r, w)``).
 
     Examples
     --------
@@ -249,10 +295,10 @@ def time_reversed(rhs: RHS) -> RHS:
     """
     if rhs.reversed is not None:
         return rhs.reversed
-    if not rhs.velocity_dependent:
-        return rhs
     specs = [get("nbody", name) for name in rhs.effects[1:]]
     kernels = tuple(spec.kernel for spec in specs)
+    if not rhs.velocity_dependent and not any(takes_time(k, 5) for k in kernels):
+        return rhs
     key = (tuple(kernel_ref(k) for k in kernels),
            any(spec.replaces_newtonian for spec in specs), None, "reversed")
     return RHS(*_memoised(key, kernels), rhs.p, rhs.velocity_dependent, rhs.effects)
@@ -321,15 +367,17 @@ def _build(key: tuple, kernels: tuple[Any, ...],
     refs, replaces_newtonian = key[:2]
     jac_refs = key[2] if len(key) > 2 else None
     reverse = key[3:] == ("reversed",)
+    timed = {"timed": tuple(takes_time(k, 5) for k in kernels),
+             "jac_timed": tuple(j is not None and takes_time(j, 7) for j in jacobians or ())}
     sources = module_sources(refs, replaces_newtonian, jac_refs)
     folder = cache_dir() if sources is not None else None
     if folder is None:
         namespace = _in_memory(refs, replaces_newtonian, kernels, jac_refs, jacobians,
-                               reverse)
+                               reverse, timed)
     else:
         name = digest(refs, replaces_newtonian, jac_refs, sources, reverse)
         text = source(refs, replaces_newtonian, name, jac_refs, sources=sources,
-                      reverse=reverse)
+                      reverse=reverse, **timed)
         namespace = vars(load_module(folder / f"{MODULE_PREFIX}{name}.py", text))
         if str(folder) not in _SWEPT:
             _SWEPT.add(str(folder))
@@ -341,10 +389,10 @@ def _build(key: tuple, kernels: tuple[Any, ...],
 
 def _in_memory(refs: tuple, replaces_newtonian: bool, kernels: tuple[Any, ...],
                jac_refs: tuple | None = None, jacobians: tuple | None = None,
-               reverse: bool = False) -> dict[str, Any]:
+               reverse: bool = False, timed: dict[str, tuple] | None = None) -> dict[str, Any]:
     """The same source compiled for this process only (no disk cache); its namespace."""
     text = source(refs, replaces_newtonian, "in-memory", jac_refs, cache=False, imports=False,
-                  reverse=reverse)
+                  reverse=reverse, **(timed or {}))
     namespace: dict[str, Any] = {f"k{i}": k for i, k in enumerate(kernels)}
     namespace.update({f"j{i}": j for i, j in enumerate(jacobians or ()) if j is not None})
     namespace["__name__"] = f"{MODULE_PREFIX}in_memory"

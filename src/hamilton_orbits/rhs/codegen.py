@@ -25,7 +25,7 @@ __all__ = ["GENERATOR", "VERSION", "check_ref", "kernel_ref", "source", "tangent
 
 #: The generator's version: in every file's first line and in its digest (so in its
 #: name).  Raise it whenever the generated text changes.
-VERSION = 3
+VERSION = 4
 GENERATOR = f"hamilton-orbits rhs v{VERSION}"
 
 
@@ -96,7 +96,7 @@ ${imports}
 
 @njit(ACCEL_SIGNATURE, cache=$cache, error_model='numpy')
 def extra(r, v, gm, acc, p):  # pragma: no cover - compiled
-${reverse}${calls}
+${reverse}${clock}${calls}
 
 
 @njit(ACCEL_SIGNATURE, cache=$cache, error_model='numpy')
@@ -115,7 +115,7 @@ ${imports}${differences}
 
 @njit(TANGENT_SIGNATURE, cache=$cache, error_model='numpy')
 def tangent_extra(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled
-${calls}
+${clock}${calls}
 
 
 @njit(TANGENT_SIGNATURE, cache=$cache, error_model='numpy')
@@ -134,8 +134,8 @@ def augmented(r, v, gm, acc, p):  # pragma: no cover - compiled
 _DIFFERENCES = Template("""\
 
 
-@njit(TANGENT_SIGNATURE, cache=$cache, error_model='numpy')
-def fd${i}(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled
+@njit(${signature}cache=$cache, error_model='numpy')
+def fd${i}(r, v, gm, dr, dv, da, p${time}):  # pragma: no cover - compiled
     n = r.shape[0]
     rs, vs = np.empty_like(r), np.empty_like(v)
     ap, am = np.empty_like(r), np.empty_like(r)
@@ -143,17 +143,34 @@ def fd${i}(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled
     for m in range(dr.shape[0] // n):
         for part in range(${parts}):
             h = fd_shift(r, v, dr, dv, m, part, length, speed, 1.0, rs, vs, ap)
-            k${i}(rs, vs, gm, ap, p)
+            k${i}(rs, vs, gm, ap, p${time})
             fd_shift(r, v, dr, dv, m, part, length, speed, -1.0, rs, vs, am)
-            k${i}(rs, vs, gm, am, p)
+            k${i}(rs, vs, gm, am, p${time})
             fd_add(ap, am, h, da, m)
 """)
 
 
-def _slice_calls(prefixes: list[str], args: str) -> str:
-    """The calls of effect ``i`` on its own slice of ``p``, or ``return`` if none."""
-    return "\n".join(f"    {prefix}{i}({args}, p[int(p[{i}]):int(p[{i + 1}])])"
-                     for i, prefix in enumerate(prefixes)) or "    return"
+def _slice_calls(prefixes: list[str], args: str, timed: tuple[bool, ...] = ()) -> str:
+    """The calls of effect ``i`` on its own slice of ``p`` (and the time ``t`` for
+    an effect whose kernel takes it: ``timed[i]``), or ``return`` if none."""
+    return "\n".join(
+        f"    {prefix}{i}({args}, p[int(p[{i}]):int(p[{i + 1}])]"
+        f"{', t' if i < len(timed) and timed[i] else ''})"
+        for i, prefix in enumerate(prefixes)) or "    return"
+
+
+def _flags(flags: tuple[bool, ...], n: int) -> tuple[bool, ...]:
+    """``flags`` as ``n`` booleans (missing ones False)."""
+    return tuple(bool(x) for x in flags[:n]) + (False,) * (n - len(flags[:n]))
+
+
+def _clock(timed: tuple[bool, ...], reverse: bool = False) -> str:
+    """The line that reads the time from ``p``'s last element (the clock the
+    integrators set, :mod:`hamilton_orbits._kernels.signatures`) when a kernel
+    takes it; minus that in the time-reversed motion, which runs in ``s = -t``."""
+    if not any(timed):
+        return ""
+    return f"    t = {'-' if reverse else ''}p[p.shape[0] - 1]  # (the clock)\n"
 
 
 def _checked(refs: tuple, jac_refs: tuple | None) -> None:
@@ -169,7 +186,8 @@ def _checked(refs: tuple, jac_refs: tuple | None) -> None:
 def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: str,
            jac_refs: tuple[tuple[str, str], ...] | None = None, *, cache: bool = True,
            sources: dict[str, str] | None = None, imports: bool = True,
-           reverse: bool = False) -> str:
+           reverse: bool = False, timed: tuple[bool, ...] = (),
+           jac_timed: tuple[bool, ...] = ()) -> str:
     """The Python source of the module that defines ``accel`` and ``extra`` (and,
     given ``jac_refs``, the tangent right-hand side: see :func:`tangent_source`).
 
@@ -177,6 +195,12 @@ def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: 
     in ``s = -t`` on the velocities ``w = dr/ds = -v``: ``d2r/ds2 = a(r, -w)``, so
     ``extra`` evaluates the effects at ``-w`` (the Newtonian part does not depend
     on velocities).  A backward run with a velocity-dependent effect uses it.
+
+    ``timed[i]``: kernel ``i`` takes the time, ``k(r, v, gm, acc, p, t)``
+    (``jac_timed[i]``: its analytic Jacobian, ``j(r, v, gm, dr, dv, da, p, t)``);
+    ``t`` is read from the clock, ``p``'s last element, which every integrator
+    sets before it evaluates the right-hand side
+    (:mod:`hamilton_orbits._kernels.signatures`).
 
     ``cache`` is numba's ``cache=`` flag of every function; ``sources`` (module ->
     file) is recorded in the header, with the key, so that a stale file can be
@@ -192,42 +216,63 @@ def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: 
     --------
     >>> print(source((("hamilton_orbits._kernels.nbody", "gr_potential"),), False, "x"))
     ... # doctest: +ELLIPSIS
-    # Generated by hamilton-orbits rhs v3 (do not edit); digest x
+    # Generated by hamilton-orbits rhs v4 (do not edit); digest x
     ...
     @njit(ACCEL_SIGNATURE, cache=True, error_model='numpy')
     def extra(r, v, gm, acc, p):  # pragma: no cover - compiled
         k0(r, v, gm, acc, p[int(p[0]):int(p[1])])
     ...
+    >>> print(source((("hamilton_orbits._kernels.figures", "zonal_of_date"),), False, "x",
+    ...              timed=(True,), reverse=True))  # doctest: +ELLIPSIS
+    # Generated by ...
+    def extra(r, v, gm, acc, p):  # pragma: no cover - compiled
+        w = -v  # (the time-reversed motion: the velocity is -w)
+        t = -p[p.shape[0] - 1]  # (the clock)
+        k0(r, w, gm, acc, p[int(p[0]):int(p[1])], t)
+    ...
     """
     _checked(refs, jac_refs)
+    timed = tuple(bool(x) for x in timed)
     base = "zero" if replaces_newtonian else "newtonian"
     text = _ACCEL.substitute(
         generator=GENERATOR, digest=digest, cache=bool(cache),
         key=repr((tuple(refs), bool(replaces_newtonian), jac_refs)
-                 + (("reversed",) if reverse else ())),
+                 + (("reversed",) if reverse else ()) + ((("timed", timed),) if any(timed)
+                                                         else ())),
         sources=repr(dict(sorted((sources or {}).items()))),
         chain=" + ".join([base] + [name for _, name in refs])
         + (", time-reversed" if reverse else ""), base=base,
         imports="".join(f"from {module} import {name} as k{i}\n"
                         for i, (module, name) in enumerate(refs)) if imports else "",
         reverse="    w = -v  # (the time-reversed motion: the velocity is -w)\n"
-        if reverse and refs else "",
-        calls=_slice_calls(["k"] * len(refs), "r, w, gm, acc" if reverse else "r, v, gm, acc"))
+        if reverse and refs else "", clock=_clock(timed, reverse),
+        calls=_slice_calls(["k"] * len(refs), "r, w, gm, acc" if reverse else "r, v, gm, acc",
+                           timed))
     if jac_refs is not None:
-        text += _tangent(replaces_newtonian, jac_refs, bool(cache), imports)
+        text += _tangent(replaces_newtonian, jac_refs, bool(cache), imports, timed, jac_timed)
     return text
 
 
-def _tangent(replaces_newtonian: bool, jac_refs: tuple, cache: bool, imports: bool) -> str:
+def _tangent(replaces_newtonian: bool, jac_refs: tuple, cache: bool, imports: bool,
+             timed: tuple[bool, ...] = (), jac_timed: tuple[bool, ...] = ()) -> str:
+    # (an effect differenced takes the time when its kernel does; an analytic
+    # Jacobian when it does itself)
+    timed, jac_timed = _flags(timed, len(jac_refs)), _flags(jac_timed, len(jac_refs))
+    takes = tuple(timed[i] if module == "fd" else jac_timed[i]
+                  for i, (module, _) in enumerate(jac_refs))
     return _TANGENT.substitute(
         base="zero_jvp" if replaces_newtonian else "newtonian_jvp", cache=cache,
         imports="".join(f"from {module} import {name} as j{i}\n"
                         for i, (module, name) in enumerate(jac_refs)
                         if module != "fd") if imports else "",
-        differences="".join(_DIFFERENCES.substitute(cache=cache, i=i, parts=parts)
-                            for i, (module, parts) in enumerate(jac_refs) if module == "fd"),
+        differences="".join(
+            _DIFFERENCES.substitute(cache=cache, i=i, parts=parts,
+                                    signature="" if takes[i] else "TANGENT_SIGNATURE, ",
+                                    time=", t" if takes[i] else "")
+            for i, (module, parts) in enumerate(jac_refs) if module == "fd"),
+        clock=_clock(takes),
         calls=_slice_calls(["fd" if module == "fd" else "j" for module, _ in jac_refs],
-                           "r, v, gm, dr, dv, da"))
+                           "r, v, gm, dr, dv, da", takes))
 
 
 def tangent_source(replaces_newtonian: bool, jac_refs: tuple[tuple[str, str], ...], *,
