@@ -1,6 +1,12 @@
 """The physics ladder against JPL's DE440: residuals per rung and body, and wall time.
 
     PYTHONPATH=src python benchmarks/bench_de440_ladder.py [--years 100] [--repeat 3]
+    PYTHONPATH=src python benchmarks/bench_de440_ladder.py --pole-of-date
+
+With ``--pole-of-date``: the ``tides`` and top rungs as they are (the Earth's pole
+fixed at J2000's) and with ``zonal`` and ``earth_tides`` about the Earth's pole of
+date (``pole = "IAU2006"``, the IAU 2006 precession), their residuals side by side
+(``benchmarks/results/de440_ladder_pole_of_date.md``).
 
 Every rung (:data:`hamilton_orbits.studies.ladder.RUNGS`) starts from DE440's own state at
 J2000 (ICRF), integrates with ``radau15`` for 100 years and compares heliocentric
@@ -113,11 +119,57 @@ def plot(results: list[ladder.RungResult], path: Path) -> None:
     fig.savefig(path, dpi=90)
 
 
+def of_date(rung: ladder.Rung) -> ladder.Rung:
+    """``rung`` with the Earth's figure and tides about its pole of date."""
+    effects = tuple({"name": e, "pole": "IAU2006"} if e in ("zonal", "earth_tides") else e
+                    for e in rung.effects)
+    return ladder.Rung(f"{rung.name}, pole of date", rung.asteroids, effects)
+
+
+def pole_of_date(years: int) -> str:
+    """The tides and top rungs with the Earth's pole fixed and of date: residuals
+    (km) at 10, 50 and ``years`` years and the largest at any whole year."""
+    marks = [y for y in (10, 50, years) if y <= years]
+    rows = ["| rung | " + " | ".join(f"{y} yr" for y in marks) + " | largest (year) |",
+            "|---|" + "---|" * (len(marks) + 1)]
+    out = {}
+    for base in (ladder.RUNGS[6], ladder.RUNGS[-1]):
+        for rung in (base, of_date(base)):
+            res = ladder.run_rung(rung, years)
+            out[rung.name] = res
+            print(f"  {rung.name:28s} {res.wall_time:6.2f} s", flush=True)
+    for name in BODIES_SHOWN:
+        rows.append(f"| **{SHORT.get(name, name)}** |" + " |" * (len(marks) + 1))
+        for rung_name, res in out.items():
+            k = res.names.index(name)
+            worst = int(np.argmax(res.km[:, k]))
+            rows.append(f"| {rung_name} | " + " | ".join(f"{res.km[y, k]:.3g}" for y in marks)
+                        + f" | {res.km[worst, k]:.3g} ({worst}) |")
+    return "\n".join(rows)
+
+
+BODIES_SHOWN = ("moon", "earth-moon-barycenter", "mercury", "venus", "mars")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--years", type=int, default=100)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--pole-of-date", action="store_true",
+                        help="the tides and top rungs, the Earth's pole fixed and of date")
     args = parser.parse_args(argv)
+    if args.pole_of_date:
+        text = pole_of_date(args.years)
+        print(text)
+        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+        RESULTS.mkdir(parents=True, exist_ok=True)
+        (RESULTS / "de440_ladder_pole_of_date.md").write_text(
+            f"# DE440 ladder: the Earth's pole fixed and of date ({stamp})\n\n"
+            f"`PYTHONPATH=src python benchmarks/bench_de440_ladder.py --pole-of-date --years "
+            f"{args.years}`.  Residuals against DE440, km (heliocentric; the Moon "
+            "geocentric), from DE440's J2000 state; `zonal` and `earth_tides` about J2000's "
+            "pole, or about the IAU 2006 pole of each time.\n\n" + text + "\n")
+        return 0
     print(f"DE440 ladder: {args.years} years, {args.repeat} timed run(s) per rung")
     results = run(args.years, args.repeat)
     text = table(results, args.years)

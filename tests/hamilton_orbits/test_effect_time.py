@@ -91,6 +91,17 @@ def test_a_continued_run_keeps_the_clock(ramp, method, kw):
     assert np.array_equal(sim.integrate(10.0).r[-1], one.r[-1])
 
 
+@pytest.mark.parametrize(("method", "kw"), [("radau15", {}), ("leapfrog", {"dt": 0.01}),
+                                            ("wh", {"dt": 0.01}), ("dop853", {})])
+def test_the_kernels_that_watch_events_set_the_clock(ramp, method, kw):
+    """A watched close encounter the bodies never reach: the run with the events'
+    kernels (compiled apart) is the run without them, bit for bit."""
+    plain = Simulation(_free(), method=method, effects=[ramp], **kw).integrate(10.0)
+    watched = Simulation(_free(), method=method, effects=[ramp], **kw,
+                         events=[{"name": "close_encounter", "distance": 1e-3}]).integrate(10.0)
+    assert np.array_equal(watched.r[-1], plain.r[-1])
+
+
 def test_a_saved_run_continues_with_its_clock(ramp, tmp_path):
     whole = Simulation(_free(), method="radau15", effects=[ramp]).integrate([0.0, 3.0, 7.0])
     sim = Simulation(_free(), method="radau15", effects=[ramp])
