@@ -110,3 +110,44 @@ def test_a_scene_runs_with_quantity_parameters():
     s = System.from_ephemeris(bodies=["earth", "moon"])
     tr = integrate(s, result.times, effects=["moon_figure"])
     assert np.array_equal(np.asarray(result.states["r"]), tr.r.to_value(u.au))
+
+
+def test_the_pole_of_date_takes_the_scenes_epoch():
+    """``pole = "IAU2006"`` in a scene: its ``epoch`` is the scene's start, filled in
+    (another is a problem at load, with the key path)."""
+    from hamilton_orbits._kernels.figures import OF_DATE
+
+    scene = _scene('[{ name = "zonal", pole = "IAU2006" }]',
+                   initial='ephemeris = { epoch = "J2000", bodies = ["sun", "earth", "moon"] }')
+    assert scene.effects[0]["epoch"] == "J2000"
+    lead = _params(scene)[:OF_DATE]
+    assert lead[0] == 1.0 and lead[1] == 0.0  # (of date; 0 days from J2000 at the start)
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[0].epoch: '1950-01-01', but the scene starts at 'J2000' ([initial] "
+            "epoch)")):
+        _scene('[{ name = "zonal", pole = "IAU2006", epoch = "1950-01-01" }]',
+               initial='ephemeris = { epoch = "J2000", bodies = ["sun", "earth", "moon"] }')
+
+
+def test_the_pole_of_date_needs_an_epoch_when_the_scene_has_none():
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[0].epoch: the pole of date needs the TDB of the scene's start")):
+        Scene.from_dict(tomllib.loads('''
+kind = "nbody"
+duration = "10 d"
+effects = [{ name = "zonal", pole = "IAU2006" }]
+[integrator]
+method = "radau15"
+[initial]
+frame = "icrs"
+[[bodies]]
+name = "earth"
+gm = "398600.4418 km3/s2"
+r = ["0 km", "0 km", "0 km"]
+v = ["0 km/s", "0 km/s", "0 km/s"]
+[[bodies]]
+name = "moon"
+gm = "4902.8 km3/s2"
+r = ["384400 km", "0 km", "0 km"]
+v = ["0 km/s", "1.02 km/s", "0 km/s"]
+'''))

@@ -48,6 +48,7 @@ def check(spec: dict, problems: S.Problems) -> None:
         problems.add("bodies", "the scene has no bodies")
     _check_effects(spec, names, problems)
     _effects_in_scene_frame(spec, problems)
+    _effects_at_scene_epoch(spec, problems)
     _check_events(spec, names, problems)
     if spec["variational"] and spec["events"]:
         problems.add("variational", "the variational equations are integrated without "
@@ -223,6 +224,25 @@ def _effects_in_scene_frame(spec: dict, problems: S.Problems) -> None:
         if eff.setdefault("frame", frame) != frame:
             problems.add(f"effects[{i}].frame", f"{eff['frame']!r}, but the scene's states are "
                                                 f"in {frame!r} axes ([initial] frame)")
+
+
+def _effects_at_scene_epoch(spec: dict, problems: S.Problems) -> None:
+    """An effect about the Earth's pole of date (``pole = "IAU2006"``) takes the
+    scene's start as its ``epoch`` (``[initial] ephemeris`` or ``solar_system``'s):
+    filled in where it does not say; a problem where it says another, or where the
+    scene's states have no epoch (bodies of its own: give the effect's ``epoch``)."""
+    init = spec["initial"]
+    start = (init.get("ephemeris") or init.get("solar_system") or {}).get("epoch")
+    for i, eff in enumerate(spec["effects"]):
+        if eff.get("pole") != "IAU2006":
+            continue
+        if start is None:
+            if eff.get("epoch") is None:
+                problems.add(f"effects[{i}].epoch", "the pole of date needs the TDB of the "
+                             "scene's start: give `epoch` (the scene's states have none)")
+        elif eff.setdefault("epoch", start) != start:
+            problems.add(f"effects[{i}].epoch", f"{eff['epoch']!r}, but the scene starts at "
+                                                f"{start!r} ([initial] epoch)")
 
 
 def _check_events(spec: dict, names: list[str], problems: S.Problems) -> None:
