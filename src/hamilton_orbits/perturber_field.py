@@ -74,7 +74,7 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
               effects: Sequence[str],
               perturbers: Sequence[str] = PERTURBERS, without: str | None = None,
               nongrav: Any = None, variational: bool = False,
-              earth_pole: str = "J2000") -> Any:
+              earth_pole: str = "J2000", shadows: Sequence[str] = ()) -> Any:
     """The right-hand side of the small bodies ``names`` and the clock, in the field
     of ``perturbers`` (:data:`~hamilton_orbits.perturber_field.PERTURBERS`, then
     any of the 16 asteroids) read from ``segments`` from TDB Julian date ``epoch``
@@ -84,7 +84,9 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     (both as :func:`~hamilton_orbits.small_bodies.propagate` takes them); its
     time-reversed form attached (``hamilton_orbits.rhs.time_reversed``), and with
     ``variational`` the variational equations (``augmented``, for radau15 and
-    dop853).
+    dop853); ``shadows`` perturbers (of ``perturbers``) followed by rows after the
+    clock, in that order, each on its ephemeris' acceleration (the rows that
+    events between a small body and a perturber watch).
 
     Raises
     ------
@@ -123,11 +125,14 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     seg_table = seg_rows.copy()
     seg_table[4::5] += at + len(seg_table) + len(pert_table)  # (the coefficients' starts)
     head[15], head[14] = at, at + len(seg_table)
-    head[16] = at + len(seg_table) + len(pert_table) + len(coefs)
+    shadow_table = np.array([list(perturbers).index(name) for name in shadows], dtype=float)
+    head[17], head[18] = len(shadows), at + len(seg_table) + len(pert_table) + len(coefs)
+    head[16] = head[18] + len(shadow_table)
     cache = np.full(cache_size(len(perturbers)), np.nan)
     cache[0] = 0.0  # (the next slot; a NaN time matches no time)
-    p = np.concatenate([*parts, seg_table, pert_table, coefs, cache, np.zeros(1)])  # (the
-    # integrators' clock last: this field reads the time from its clock row)
+    p = np.concatenate([*parts, seg_table, pert_table, coefs, shadow_table, cache,
+                        np.zeros(1)])  # (the integrators' clock last: this field reads
+    # the time from its clock row)
     velocity = "eih" in effects or outgassing is not None
     tag = ("newtonian", "small_bodies", *blocks)
     # the time-reversed motion: the same kernel and parameters, the clock's velocity

@@ -29,7 +29,8 @@ propagated without it, the others still pulling on it.
 independent run (:func:`run_job`), one after another, on threads or on a Dask
 cluster (:func:`hamilton_orbits.batches.run_jobs`).  ``stm=True`` adds the state
 transition matrix (the field's Jacobian by central differences), ``variational``
-MEGNO.  Not yet here (issue 35): events (refused by name).
+MEGNO.  ``events``: close encounters with the perturbers
+(:mod:`hamilton_orbits.small_body_events`), forwards.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ import numpy as np
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits.perturber_field import EFFECTS, PERTURBERS, field_rhs, perturber_chain
+from hamilton_orbits.small_body_events import EventBodies, encounters, event_rows, watch_for
 from hamilton_orbits.spk import Segments
 
 __all__ = ["EFFECTS", "PERTURBERS", "Job", "field_rhs", "propagate", "run_job"]
@@ -88,8 +90,13 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
         r)^2``; ``hamilton_orbits.effects.nongrav.COMET_G`` the comets'): one
         mapping for every body, or one (or None) per body.
-    events
-        Not yet supported (``()``).
+    events : sequence of mapping
+        Close encounters with perturbers to record: ``{"name": "close_encounter",
+        "bodies": "earth", "distance": 0.05 * u.au}`` (``bodies``: perturbers, and
+        optionally the small bodies to watch, default all), found on the
+        integrator's interpolant of each step (``traj.events``: time, bodies,
+        distance, speed).  Forwards in time, without ``stm`` / ``variational``
+        (:mod:`hamilton_orbits.small_body_events`).
     variational : bool
         Also integrate the variational equations: MEGNO and the Lyapunov exponent
         of the bodies together (``traj.megno``, ...; they must then run as one:
@@ -152,7 +159,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
 
     r, v = _states(r0, v0)
     names = _names(names, len(r))
-    _refuse_unsupported(asteroids, method, events, variational, stm)
+    _refuse_unsupported(asteroids, method, variational, stm)
     if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
         raise ValueError(f"Expected `chunk` to be a number of bodies >= 1, got {chunk!r}")
     check_workers(workers, "threads")
@@ -170,6 +177,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                          f"ending {float(days[-1])!r} days from the epoch (run forwards from "
                          f"the earlier state)")
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
+    pairs = encounters(events, names, perturbers)
+    if pairs and (stm or variational or days[-1] < days[0]):
+        raise ValueError("`events` are watched forwards in time, without `stm` or "
+                         "`variational`: run those apart")
     segments = _segments(ephemeris, jd1 + jd2 + min(days[0], days[-1]),
                          jd1 + jd2 + max(days[0], days[-1]), asteroids)
     groups: dict[str | None, list[int]] = {}
@@ -181,16 +192,21 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
             part = rows[lo:lo + chunk]
             mine = nongrav if per_body is None else [per_body[k] for k in part]
             parts.append(part)
+            watched = tuple(e._replace(body=part.index(e.body)) for e in pairs
+                            if e.body in part)
             jobs.append(Job([names[k] for k in part], r[part], v[part], days, (jd1, jd2),
                             tuple(effects), perturbers, without, mine, method, tol, stm,
-                            variational, earth_pole))
+                            variational, earth_pole, watched))
     if variational and len(jobs) > 1:
         raise ValueError(f"`variational=True` (MEGNO of the bodies together) needs them in "
                          f"one run, got {len(jobs)} (`chunk` = {chunk}, and a body that is one "
                          f"of the 16 asteroids runs apart); `stm=True` alone has no such limit")
     outs = run_jobs(run_job, segments, jobs, workers=workers, client=client,
                     progress=progress, unit="chunk")
-    return _trajectory(names, list(zip(parts, outs, strict=True)), method, tuple(effects))
+    shadows = [watch_for(job.encounters, len(job.names))[0] for job in jobs]
+    return _trajectory(names, list(zip(parts, outs, strict=True)), method, tuple(effects),
+                       event_rows(list(zip(parts, outs, shadows, strict=True)), len(names),
+                                  perturbers) if pairs else None, perturbers)
 
 
 class Job(NamedTuple):
@@ -210,6 +226,7 @@ class Job(NamedTuple):
     stm: bool = False
     variational: bool = False
     earth_pole: str = "J2000"
+    encounters: tuple = ()  # (the pairs watched: Encounter, bodies indexed in this job)
 
 
 def run_job(segments: Segments, job: Job) -> Any:
@@ -220,11 +237,17 @@ def run_job(segments: Segments, job: Job) -> Any:
     import dataclasses
 
     tangent = job.stm or job.variational
-    rhs = field_rhs(segments, job.names, job.epoch, job.effects, job.perturbers, job.without,
-                    job.nongrav, variational=tangent, earth_pole=job.earth_pole)
-    out = _run(job.names, job.r, job.v, job.days, rhs, job.method, job.tol,
-               _tangent(len(job.names), len(job.days), job.stm) if tangent else None)
     n = len(job.names)
+    shadows, watch = watch_for(job.encounters, n)
+    rhs = field_rhs(segments, job.names, job.epoch, job.effects, job.perturbers, job.without,
+                    job.nongrav, variational=tangent, earth_pole=job.earth_pole,
+                    shadows=shadows)
+    extra = None
+    if shadows:  # (rows after the clock, on the perturbers' states at the start)
+        at, speed = segments.states(np.array([sum(job.epoch) + job.days[0]]), list(shadows))
+        extra = (at[0], speed[0], watch)
+    out = _run(job.names, job.r, job.v, job.days, rhs, job.method, job.tol,
+               _tangent(n, len(job.days), job.stm) if tangent else None, extra)
     return dataclasses.replace(out, r=out.r[:, :n], v=out.v[:, :n], gm=out.gm[:n])
 
 
@@ -277,15 +300,10 @@ def _names(names: Sequence[str] | None, n: int) -> list[str]:
     return names
 
 
-def _refuse_unsupported(asteroids: Any, method: Any, events: Any, variational: Any,
-                        stm: Any) -> None:
-    """The options not yet supported, refused by name (issue 35)."""
+def _refuse_unsupported(asteroids: Any, method: Any, variational: Any, stm: Any) -> None:
+    """The options not supported, refused by name."""
     if not isinstance(asteroids, bool):
         raise ValueError(f"Expected `asteroids` to be True or False, got {asteroids!r}")
-    events = tuple(events) if isinstance(events, (list, tuple)) else events
-    if events != ():
-        raise ValueError(f"`events` is not supported yet by small_bodies.propagate, got "
-                         f"{events!r}")
     for name, value in (("variational", variational), ("stm", stm)):
         if not isinstance(value, bool):
             raise ValueError(f"Expected `{name}` to be True or False, got {value!r}")
@@ -373,32 +391,43 @@ def _tangent(n: int, n_t: int, stm: bool) -> Any:
 
 
 def _run(names: list[str], r: np.ndarray, v: np.ndarray, days: np.ndarray,
-         rhs: Any, method: str, tol: float | None, tangent: Any = None) -> Any:
+         rhs: Any, method: str, tol: float | None, tangent: Any = None,
+         shadows: Any = None) -> Any:
     """The run of the small bodies ``names`` (states ``r``, ``v``) and the clock
-    through ``days`` (with ``tangent``: its variational equations too)."""
+    through ``days`` (with ``tangent``: its variational equations too; with
+    ``shadows``, ``(r, v, watch)``: rows after the clock and the events to watch)."""
     from hamilton_orbits import engine
+    from hamilton_orbits.events import EventLog
 
     n = len(names)
     clock_r, clock_v = np.zeros((1, 3)), np.array([[1.0, 0.0, 0.0]])  # x: days from the epoch
+    log = None
+    if shadows is not None:
+        clock_r, clock_v = np.vstack([clock_r, shadows[0]]), np.vstack([clock_v, shadows[1]])
+        log = EventLog(shadows[2], np.full(n + len(clock_r), np.nan))
     # radau15 with IAS15's global criterion, as ASSIST runs it: PRS23's, from the
     # small bodies' own accelerations, takes 47-day steps over 5303 Parijskij's
     # encounter with Ceres (and misses it by 14,000 km; global: 500 m, as ASSIST)
     options = {"criterion": "global"} if method == "radau15" else None
-    out = engine.run(np.vstack([r, clock_r]), np.vstack([v, clock_v]), np.zeros(n + 1), days,
-                     rhs, method, tol=tol, options=options, variational=tangent)
+    out = engine.run(np.vstack([r, clock_r]), np.vstack([v, clock_v]), np.zeros(n + len(clock_r)),
+                     days, rhs, method, tol=tol, options=options, variational=tangent,
+                     events=log)
     if not out.finite:
         bad = np.argwhere(~np.isfinite(out.r).all(axis=-1) | ~np.isfinite(out.v).all(axis=-1))
         k, b = (int(x) for x in bad[0])
-        who = names[b] if b < n else "the clock"
+        who = names[b] if b < n else "the clock" if b == n else "a watched perturber's row"
         raise ValueError(f"small_bodies.propagate ({method}) lost the state of {who!r} at "
                          f"{float(out.t[k])!r} days from the epoch")
     return out
 
 
 def _trajectory(names: list[str], runs: list[tuple[list[int], Any]], method: str,
-                effects: tuple[str, ...]) -> Any:
+                effects: tuple[str, ...], events: np.ndarray | None = None,
+                perturbers: tuple[str, ...] = ()) -> Any:
     """One Trajectory of the small bodies from the runs of their groups (the steps
-    and wall time summed; no conserved integral: the field changes with time)."""
+    and wall time summed; no conserved integral: the field changes with time), with
+    the ``events`` recorded (rows of :func:`~hamilton_orbits.small_body_events.
+    event_rows`)."""
     import astropy.units as u
 
     from hamilton_orbits.trajectory import Trajectory
@@ -413,6 +442,8 @@ def _trajectory(names: list[str], runs: list[tuple[list[int], Any]], method: str
                       wall_time=sum(out.wall_time for _, out in runs), method=method,
                       effects=("small_bodies", *effects),
                       complete=all(out.complete for _, out in runs), integrals=None,
+                      event_source=None if events is None else (
+                          events, None, EventBodies((*names, *perturbers)), u.day),
                       **_variational(len(names), runs))
 
 

@@ -210,7 +210,7 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(stm="yes"), "`stm` to be True or False"),
     (dict(earth_pole="of date"), "`earth_pole` to be 'J2000' or 'IAU2006', got 'of date'"),
     (dict(stm=True, t=-10 * u.day), "`stm` and `variational` are integrated forwards"),
-    (dict(events=[{"name": "close"}]), "`events` is not supported"),
+    (dict(events=[{"name": "close"}]), "Event at index 0: small_bodies.propagate watches"),
     (dict(names=["a", "a", "b"]), r"`names`.*'a' at index 1"),
     (dict(names=["sun", "b", "c"]), "`names`.*'sun' at index 0"),
     (dict(t=[1.0, 2.0]), "`t`"),

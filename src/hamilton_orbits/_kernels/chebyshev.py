@@ -86,3 +86,41 @@ def add_record(coef, k, intlen, t, u, out):  # pragma: no cover - compiled
                 dx += j * coef[c, k, j] * u[j - 1]
         out[c] += x
         out[3 + c] += dx * 2.0 / intlen
+
+
+@njit(cache=True, inline="always")
+def acceleration_basis(init, intlen, n, jd1, jd2, m, u, du):  # pragma: no cover - compiled
+    """As :func:`basis` for the second derivative: the record ``k`` (-1 outside the
+    segment), the ``U_j(s)`` into ``u`` and their derivatives ``U_j'(s)`` into
+    ``du`` (``U_j' = 2 U_(j-1) + 2 s U_(j-1)' - U_(j-2)'``, from ``U_j = 2 s
+    U_(j-1) - U_(j-2)``), ``j < m``."""
+    d = (jd1 - init) + jd2
+    k = int(np.floor(d / intlen))
+    if k == n and d <= n * intlen:  # (the segment's last instant)
+        k = n - 1
+    if k < 0 or k >= n or not np.isfinite(d):
+        return -1
+    s = 2.0 * (d - k * intlen) / intlen - 1.0
+    u[0] = 1.0
+    du[0] = 0.0
+    if m > 1:
+        u[1] = 2.0 * s
+        du[1] = 2.0
+    for j in range(2, m):
+        u[j] = 2.0 * s * u[j - 1] - u[j - 2]
+        du[j] = 2.0 * u[j - 1] + 2.0 * s * du[j - 1] - du[j - 2]
+    return k
+
+
+@njit(cache=True, inline="always")
+def add_record_acceleration(coef, k, intlen, du, out):  # pragma: no cover - compiled
+    """ADD record ``k``'s acceleration (the unit per day^2) at the derivatives ``du``
+    of :func:`acceleration_basis` to ``out`` (3,): ``d2x/dt2 = (2 / intlen)^2 sum
+    j c_j U_(j-1)'(s)`` (``T_j'' = j U_(j-1)'``)."""
+    m = coef.shape[2]
+    scale = (2.0 / intlen) ** 2
+    for c in range(3):
+        ddx = 0.0
+        for j in range(m - 1, 1, -1):  # (small terms first; T_0'' = T_1'' = 0)
+            ddx += j * coef[c, k, j] * du[j - 1]
+        out[c] += ddx * scale

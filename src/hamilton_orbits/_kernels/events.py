@@ -555,7 +555,7 @@ def scan_steps(watch, ts, xs, vs, gm, out, count):  # pragma: no cover - compile
         if count[0] + watch.shape[0] > out.shape[0]:
             return -2, float(s), -1
         cm[:] = 0.0
-        for k in range(n):
+        for k in range(n if total > 0.0 else 0):  # (massless rows alone: no centre of mass)
             for c in range(3):
                 cm[c] += gm[k] * xs[s, k, c] / total
                 cm[3 + c] += gm[k] * vs[s, k, c] / total

@@ -37,6 +37,15 @@ kept, the perturbers' dropped (they follow the ephemeris).  No astropy here.
   same stage times: what depends on the time alone, for a time met in the last
   ``CACHE_SLOTS``, is copied, not computed again (the same numbers).  One ``p``
   must therefore serve one run at a time.
+- ``p[17]`` the number of *shadow* rows ``ns``, after the clock (rows ``nb + 1``
+  ... ``nb + ns``), ``p[18]`` the start of their table: the perturber each one
+  follows.  A shadow row is given the acceleration of its perturber's ephemeris
+  (:func:`~hamilton_orbits._kernels.chebyshev.add_record_acceleration`), so that,
+  started on the perturber's state, it follows the ephemeris to the integrator's
+  accuracy: the rows the events between a small body and a perturber watch
+  (``small_bodies.propagate(events=...)``).  It acts on nothing;
+- the last element: the integrators' clock (unused here: the clock row holds
+  the time).
 
 What is computed per call is what the small bodies feel: Newton's law from the
 perturbers alone (:func:`hamilton_orbits._kernels.nbody.massless_rows`; the
@@ -50,7 +59,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hamilton_orbits._kernels.chebyshev import add_record, basis
+from hamilton_orbits._kernels.chebyshev import (
+    acceleration_basis,
+    add_record,
+    add_record_acceleration,
+    basis,
+)
 from hamilton_orbits._kernels.figures import precessed_pole, zonal_field
 from hamilton_orbits._kernels.jacobians import fd_add, fd_scales, fd_shift
 from hamilton_orbits._kernels.nbody import j2_field, massless_rows
@@ -61,7 +75,7 @@ __all__ = ["CACHE_SLOTS", "HEADER", "cache_size", "eih_on_particles", "small_bod
            "small_bodies_field", "source_sums"]
 
 #: the entries of ``p`` before the tables
-HEADER = 17
+HEADER = 19
 #: the stage times whose perturbers' states the cache keeps (radau15 has 8)
 CACHE_SLOTS = 8
 #: J2000.0 as a TDB Julian date (the origin of the pole of date's centuries)
@@ -98,6 +112,8 @@ def small_bodies_field(r, v, gm, acc, p):  # pragma: no cover - compiled
             acc[i, c] = big_a[k_p + i, c]
     for c in range(3):
         acc[nb, c] = 0.0
+    if p[17] > 0:
+        _shadows(p, r[nb, 0], acc[nb + 1:nb + 1 + int(p[17])])
 
 
 @njit(cache=True, error_model="numpy")
@@ -372,6 +388,31 @@ def _slot_copy(p, at, k_p, out_r, out_v, acc_n, phi, store):  # pragma: no cover
             p[base + 9] = phi[k]
         else:
             phi[k] = p[base + 9]
+
+
+@njit(cache=True, error_model="numpy")
+def _shadows(p, days, acc):  # pragma: no cover - compiled
+    """The accelerations (au/day^2) of the perturbers the shadow rows follow, at
+    ``days`` from the epoch, into ``acc`` (ns, 3): the second derivative of each
+    segment of the perturber's chain, summed (NaN outside the segments)."""
+    au, table, segs = p[5], int(p[14]), int(p[15])
+    jd1, jd2 = p[2], p[3] + days
+    for s in range(acc.shape[0]):
+        row = table + 4 * int(p[int(p[18]) + s])
+        for c in range(3):
+            acc[s, c] = 0.0
+        for link in range(int(p[row + 1])):
+            at = segs + 5 * int(p[row + 2 + link])
+            n_rec, m, first = int(p[at + 2]), int(p[at + 3]), int(p[at + 4])
+            u, du = np.empty(m), np.empty(m)
+            k = acceleration_basis(p[at], p[at + 1], n_rec, jd1, jd2, m, u, du)
+            if k < 0:
+                acc[s, :] = np.nan
+                break
+            coef = p[first:first + 3 * n_rec * m].reshape((3, n_rec, m))
+            add_record_acceleration(coef, k, p[at + 1], du, acc[s])
+        for c in range(3):
+            acc[s, c] /= au
 
 
 @njit(cache=True, error_model="numpy")

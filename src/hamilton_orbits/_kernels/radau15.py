@@ -561,8 +561,9 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
             cm[c] += gm[k] * x0[3 * k + c]
             cm[3 + c] += gm[k] * v0[3 * k + c]
             cm[6 + c] += gm[k] * r[k, c]
-    for c in range(9):
-        cm[c] /= total
+    if total > 0.0:  # (massless rows alone, small bodies': no centre of mass, no escape)
+        for c in range(9):
+            cm[c] /= total
     h, row = _ev.scan(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
                       a0, b, gm, cm, ev_out, ev_count)
     st[ST_EVENT_ROW] = row
