@@ -137,9 +137,9 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     tag = ("newtonian", "small_bodies", *blocks)
     # the time-reversed motion: the same kernel and parameters, the clock's velocity
     # (-1) says which (and one run at a time uses the cache)
-    reverse = RHS(small_bodies_field, None, p, velocity, tag)
+    reverse = RHS(small_bodies_field, None, p, velocity, tag, per_run=True)
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse,
-               augmented=small_bodies_augmented if variational else None)
+               augmented=small_bodies_augmented if variational else None, per_run=True)
 
 
 #: the parameters of one body's non-gravitational acceleration and their kinds

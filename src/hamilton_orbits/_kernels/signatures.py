@@ -8,7 +8,8 @@ The clock: ``p``'s last element.  Before every evaluation of a right-hand side
 (``accel``, ``extra``, ``augmented``) an integrator writes there the time of the
 state it passes, in its own time variable (``s = -t`` in a time-reversed run; the
 generated right-hand side turns it back), so that an effect may depend on the
-time (:func:`set_clock`).  Each run has its own ``p`` (the drivers copy it).
+time (:func:`set_clock`).  Each run has its own ``p``
+(``hamilton_orbits.rhs.run_parameters``).
 
 The stepping kernels
 take it by its addresses (:data:`ADDRESSES`: the compiled function's C wrapper and

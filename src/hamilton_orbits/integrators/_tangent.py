@@ -44,6 +44,7 @@ from hamilton_orbits.integrators._setup import (
     fixed_steps,
 )
 from hamilton_orbits.integrators.methods import MAX_FIXED_STEPS, MAX_STEPS
+from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["DEFAULT_SEED", "SLICE", "DOP853Tangent", "LeapfrogTangent", "Radau15Tangent",
@@ -191,7 +192,7 @@ class Radau15Tangent:
                  slice_steps: int, control: bool) -> None:
         self.n = n = r0.shape[0]
         self.rhs, self.tangent, self.max_steps, self.slice = rhs, tangent, max_steps, slice_steps
-        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
+        self.p = run_parameters(rhs)  # (the kernels write its clock)
         self.gm = np.array(gm, dtype=np.float64)  # writable (the kernels take no read-only)
         self.x = np.ascontiguousarray(np.vstack([r0, tangent.dr0]))
         self.w = np.ascontiguousarray(np.vstack([v0, tangent.dv0]))
@@ -311,7 +312,7 @@ class LeapfrogTangent:
         self.dr, self.dv = tangent.dr0.copy(), tangent.dv0.copy()
         self.accel, self.jac = accel_arg(rhs.accel), _tangent_arg(rhs.tangent)
         self.rhs, self.tangent, self.dt, self.slice = rhs, tangent, dt, slice_steps
-        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
+        self.p = run_parameters(rhs)  # (the kernels write its clock)
         tangent.start(t0)
         self.t, self.steps = t0, 0
 
@@ -378,7 +379,7 @@ class WHTangent:
             self.jac = _tangent_arg(rhs.tangent_extra if has_extra else rhs.tangent)
         self.rhs, self.tangent, self.dt, self.jacobi, self.slice = (rhs, tangent, dt, jacobi,
                                                                      slice_steps)
-        self.p = rhs.p.copy()  # (this run's own: the kernels write its clock)
+        self.p = run_parameters(rhs)  # (the kernels write its clock)
         tangent.start(t0)
         self.t, self.steps = t0, 0
 
@@ -449,7 +450,7 @@ class DOP853Tangent:
             n, np.array(gm, dtype=np.float64), tangent, tol, max_step)
         self.max_steps = max_steps
         self.rhs, self.t0, self.acc = rhs, t0, np.empty((rows, 3))
-        self.p = rhs.p.copy()  # (this run's own: its clock set at each evaluation)
+        self.p = run_parameters(rhs)  # (its clock set at each evaluation)
         self.y = np.concatenate((r0.ravel(), tangent.dr0.ravel(), v0.ravel(),
                                  tangent.dv0.ravel(), [0.0]))
         scale_t = np.full(6 * n * k, np.inf)

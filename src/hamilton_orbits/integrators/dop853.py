@@ -23,6 +23,7 @@ from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import _setup, _tangent
 from hamilton_orbits.integrators.methods import DOP853
+from hamilton_orbits.rhs import run_parameters
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "DEFAULT_TOL", "NAME", "RTOL_FLOOR", "run", "solve",
            "start"]
@@ -88,7 +89,7 @@ class _State:
         self.n = n = r0.shape[0]
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
         self.rhs, self.acc = rhs, np.empty((n, 3))
-        self.p = rhs.p.copy()  # (this run's own: its clock set at each evaluation)
+        self.p = run_parameters(rhs)  # (its clock set at each evaluation)
         self.y = np.concatenate((np.ravel(r0), np.ravel(v0))).astype(np.float64)
         self.tol, self.atol, self.max_step, self.log = tol, atol, max_step, events
         self.t, self.steps, self.max_steps = t0, 0, max_steps

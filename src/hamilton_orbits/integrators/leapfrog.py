@@ -19,6 +19,7 @@ from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators._setup import accel_arg, check_step_count
 from hamilton_orbits.integrators.methods import Leapfrog
+from hamilton_orbits.rhs import run_parameters
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run", "start"]
 
@@ -88,7 +89,7 @@ class _State:
         self.r = np.ascontiguousarray(r0, dtype=np.float64).copy()
         self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
         self.gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
-        self.accel, self.p = accel_arg(rhs.accel), rhs.p.copy()  # (its own: the kernels
+        self.accel, self.p = accel_arg(rhs.accel), run_parameters(rhs)  # (the kernels
         # write its clock)
         self.log = events if events is not None else EventLog.none(self.r.shape[0])
         self.dt, self.max_steps, self.t, self.steps = dt, max_steps, t0, 0

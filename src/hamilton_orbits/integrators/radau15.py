@@ -44,6 +44,7 @@ from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
+from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "CRITERIA", "DEFAULT_TOL", "MAX_STEPS", "NAME",
@@ -294,8 +295,8 @@ class _Run:
         self.pause: Any = None
         # the kernel's arguments that stay the same objects between calls (a short
         # call's cost is mostly its arguments; see docs/design.md, "One front door")
-        self.before_t = (self.accel, rhs.p.copy(), self.x, self.w, gm)  # (p: this run's own,
-        # the kernels write its clock)
+        self.before_t = (self.accel, run_parameters(rhs), self.x, self.w, gm)  # (p: the
+        # kernels write its clock)
         self.after_t = (self.st, *self.work, self.csx, self.csv, bool(rhs.velocity_dependent))
 
     @property

@@ -70,6 +70,7 @@ from hamilton_orbits.integrators.wh_correctors import (
     corrector_coefficients,
     corrector_series,
 )
+from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = [
@@ -252,8 +253,8 @@ class _State:
         if c != 0:
             self.log.index_map = order
         self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra,
-                            rhs.p.copy(), rhs.extra is not None)  # (p: this run's own, the
-        # kernels write its clock)
+                            run_parameters(rhs), rhs.extra is not None)  # (p: the kernels
+        # write its clock)
         self.split.from_inertial(r0, v0, np.empty_like(r0), np.empty_like(v0))
         self.watch = self.log.kernel_watch()
         self.ws = np.empty(4)  # the events' work space of the kernels (see _drift)

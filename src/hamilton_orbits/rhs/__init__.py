@@ -89,8 +89,8 @@ from hamilton_orbits.rhs.diskcache import (
 )
 
 __all__ = ["RHS", "STALE_AGE_SECONDS", "cache_dir", "check_ref", "compile_rhs", "kernel_ref",
-           "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "source",
-           "takes_time", "tangent_kernels_for", "tangent_source", "time_reversed"]
+           "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "run_parameters",
+           "source", "takes_time", "tangent_kernels_for", "tangent_source", "time_reversed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,6 +120,12 @@ class RHS:
         The right-hand side of the time-reversed motion, for one made outside the
         list of effects (:func:`time_reversed` returns it; None: made from the
         effects).
+    timed : bool
+        True if a kernel reads the time (the clock, ``p``'s last element).
+    per_run : bool
+        True if ``p`` was made for one run (the small bodies' field, made per
+        chunk, whose ``p`` also holds its ephemeris tables and cache): the run uses
+        it in place instead of a copy (:func:`run_parameters`).
     """
 
     accel: Any
@@ -131,6 +137,8 @@ class RHS:
     tangent_extra: Any = None
     augmented: Any = None
     reversed: Any = None
+    timed: bool = False
+    per_run: bool = False
 
     def __post_init__(self) -> None:
         p = self.p
@@ -199,6 +207,22 @@ def parameter_vector(blocks: list[np.ndarray]) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([*parts, np.zeros(1)]))
 
 
+def run_parameters(rhs: RHS) -> np.ndarray:
+    """The parameter vector a run of ``rhs`` passes its kernels, which write its
+    clock: its own copy (two runs of one right-hand side, on two threads, share no
+    clock; and what a snapshot of a run holds is that run's alone), or ``rhs.p``
+    itself when it was made for the one run (``per_run``: no copy of the small
+    bodies' ephemeris tables).
+
+    Examples
+    --------
+    >>> rhs = newtonian_rhs()
+    >>> run_parameters(rhs) is rhs.p, bool((run_parameters(rhs) == rhs.p).all())
+    (False, True)
+    """
+    return rhs.p if rhs.per_run else rhs.p.copy()
+
+
 def takes_time(kernel: Any, plain: int) -> bool:
     """Whether compiled ``kernel`` takes the time: ``plain + 1`` arguments, not
     ``plain`` (5 for an acceleration kernel, 7 for a Jacobian).
@@ -265,14 +289,15 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
     kernels = tuple(spec.kernel for spec in specs)
     p = parameter_vector(blocks)
     names = ("newtonian", *eff.names)
+    timed = any(takes_time(k, 5) for k in kernels)
     if not variational:
         accel, extra = kernels_for(kernels, replaces)
-        return RHS(accel, extra, p, eff.velocity_dependent, names)
+        return RHS(accel, extra, p, eff.velocity_dependent, names, timed=timed)
     jacobians = tuple((spec.jacobian, spec.velocity_dependent) for spec in specs)
     accel, extra, tangent, tangent_extra, augmented = tangent_kernels_for(
         kernels, jacobians, replaces)
     return RHS(accel, extra if eff else None, p, eff.velocity_dependent, names, tangent,
-               tangent_extra if eff else None, augmented)
+               tangent_extra if eff else None, augmented, timed=timed)
 
 
 def time_reversed(rhs: RHS) -> RHS:
@@ -295,13 +320,14 @@ def time_reversed(rhs: RHS) -> RHS:
     """
     if rhs.reversed is not None:
         return rhs.reversed
+    if not rhs.velocity_dependent and not rhs.timed:
+        return rhs
     specs = [get("nbody", name) for name in rhs.effects[1:]]
     kernels = tuple(spec.kernel for spec in specs)
-    if not rhs.velocity_dependent and not any(takes_time(k, 5) for k in kernels):
-        return rhs
     key = (tuple(kernel_ref(k) for k in kernels),
            any(spec.replaces_newtonian for spec in specs), None, "reversed")
-    return RHS(*_memoised(key, kernels), rhs.p, rhs.velocity_dependent, rhs.effects)
+    return RHS(*_memoised(key, kernels), rhs.p, rhs.velocity_dependent, rhs.effects,
+               timed=rhs.timed)
 
 
 _MEMO: dict[tuple, tuple[Any, Any]] = {}
