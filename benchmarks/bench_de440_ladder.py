@@ -3,10 +3,10 @@
     PYTHONPATH=src python benchmarks/bench_de440_ladder.py [--years 100] [--repeat 3]
     PYTHONPATH=src python benchmarks/bench_de440_ladder.py --pole-of-date
 
-With ``--pole-of-date``: the ``tides`` and top rungs as they are (the Earth's pole
-fixed at J2000's) and with ``zonal`` and ``earth_tides`` about the Earth's pole of
-date (``pole = "IAU2006"``, the IAU 2006 precession), their residuals side by side
-(``benchmarks/results/de440_ladder_pole_of_date.md``).
+With ``--pole-of-date``: the ``tides`` and top rungs with ``zonal`` and
+``earth_tides`` about the Earth's pole fixed at J2000's and as they are, about its
+pole of date (``pole = "IAU2006"``, the IAU 2006 precession), their residuals side
+by side (``benchmarks/results/de440_ladder_pole_of_date.md``).
 
 Every rung (:data:`hamilton_orbits.studies.ladder.RUNGS`) starts from DE440's own state at
 J2000 (ICRF), integrates with ``radau15`` for 100 years and compares heliocentric
@@ -119,11 +119,11 @@ def plot(results: list[ladder.RungResult], path: Path) -> None:
     fig.savefig(path, dpi=90)
 
 
-def of_date(rung: ladder.Rung) -> ladder.Rung:
-    """``rung`` with the Earth's figure and tides about its pole of date."""
-    effects = tuple({"name": e, "pole": "IAU2006"} if e in ("zonal", "earth_tides") else e
+def fixed_pole(rung: ladder.Rung) -> ladder.Rung:
+    """``rung`` with the Earth's figure and tides about its pole of J2000 (fixed)."""
+    effects = tuple(e["name"] if isinstance(e, dict) and e.get("pole") == "IAU2006" else e
                     for e in rung.effects)
-    return ladder.Rung(f"{rung.name}, pole of date", rung.asteroids, effects)
+    return ladder.Rung(f"{rung.name}, J2000's pole", rung.asteroids, effects)
 
 
 def pole_of_date(years: int) -> str:
@@ -134,7 +134,7 @@ def pole_of_date(years: int) -> str:
             "|---|" + "---|" * (len(marks) + 1)]
     out = {}
     for base in (ladder.RUNGS[6], ladder.RUNGS[-1]):
-        for rung in (base, of_date(base)):
+        for rung in (fixed_pole(base), base):
             res = ladder.run_rung(rung, years)
             out[rung.name] = res
             print(f"  {rung.name:28s} {res.wall_time:6.2f} s", flush=True)

@@ -14,9 +14,10 @@ effect list:
 3. ``eih``: the Einstein-Infeld-Hoffmann equations for every body instead;
 4. ``sun_j2``: plus the Sun's J2 (``j2`` on the Sun, DE440's J2SUN);
 5. ``sun_lt``: plus the Sun's Lense-Thirring field (DE440's MOISUN, OMGSUN);
-6. ``figures``: plus the Earth's J2-J4 (``zonal``) and the Moon's J2, C22
-   (``moon_figure``);
-7. ``tides``: plus the tides raised on the Earth (``earth_tides``);
+6. ``figures``: plus the Earth's J2-J4 (``zonal``, about the Earth's pole of each
+   time, the IAU 2006 precession) and the Moon's J2, C22 (``moon_figure``);
+7. ``tides``: plus the tides raised on the Earth (``earth_tides``, about the same
+   pole);
 8. ``asteroids``: plus the 16 most massive asteroids as bodies (JPL's sb441-n16;
    72% of the GM of DE440's 343), their own 1PN fields left out;
 9. ``ring``: plus DE440's Kuiper-belt ring (``kuiper_ring``).
@@ -52,7 +53,10 @@ class Rung:
 
 _SUN_J2 = {"name": "j2", "body": "sun"}
 _SUN = (_SUN_J2, "lense_thirring")
-_FIGURES = ("zonal", "moon_figure")
+# the Earth's figure and tides about its pole of date (the run starts at J2000)
+_ZONAL = {"name": "zonal", "pole": "IAU2006"}
+_TIDES = {"name": "earth_tides", "pole": "IAU2006"}
+_FIGURES = (_ZONAL, "moon_figure")
 # with the asteroids as bodies, their own 1PN fields are left out (each is < 1e-9 of
 # the Sun's 1PN field on any planet, far below rounding); every body still feels the
 # 1PN fields of the Sun, planets, Moon and Pluto, and the asteroids' Newtonian pull
@@ -64,9 +68,9 @@ RUNGS: tuple[Rung, ...] = (
     Rung("sun_j2", False, ("eih", _SUN_J2)),
     Rung("sun_lt", False, ("eih", *_SUN)),
     Rung("figures", False, ("eih", *_SUN, *_FIGURES)),
-    Rung("tides", False, ("eih", *_SUN, *_FIGURES, "earth_tides")),
-    Rung("asteroids", True, (_EIH_MAJOR, *_SUN, *_FIGURES, "earth_tides")),
-    Rung("ring", True, (_EIH_MAJOR, *_SUN, *_FIGURES, "earth_tides", "kuiper_ring")),
+    Rung("tides", False, ("eih", *_SUN, *_FIGURES, _TIDES)),
+    Rung("asteroids", True, (_EIH_MAJOR, *_SUN, *_FIGURES, _TIDES)),
+    Rung("ring", True, (_EIH_MAJOR, *_SUN, *_FIGURES, _TIDES, "kuiper_ring")),
 )
 
 
