@@ -49,18 +49,28 @@ def add_state(coef, init, intlen, jd1, jd2, out, t, u):  # pragma: no cover - co
 
 
 @njit(cache=True, inline="always")
-def basis(init, intlen, n, jd1, jd2, m, t, u):  # pragma: no cover - compiled
+def _record(init, intlen, n, jd1, jd2):  # pragma: no cover - compiled
     """The record ``k`` of a segment of ``n`` records of ``intlen`` days from
-    ``init`` that holds the time ``jd1 + jd2`` (-1 outside the segment), and the
-    Chebyshev polynomials ``T_j(s)``, ``U_j(s)``, ``j < m``, at its ``s`` into
-    ``t``, ``u`` (the same for every segment of the same ``init`` and ``intlen``)."""
+    ``init`` that holds the time ``jd1 + jd2`` (-1 outside the segment) and the
+    time's ``s`` in it, in [-1, 1]."""
     d = (jd1 - init) + jd2
     k = int(np.floor(d / intlen))
     if k == n and d <= n * intlen:  # (the segment's last instant)
         k = n - 1
     if k < 0 or k >= n or not np.isfinite(d):
+        return -1, 0.0
+    return k, 2.0 * (d - k * intlen) / intlen - 1.0
+
+
+@njit(cache=True, inline="always")
+def basis(init, intlen, n, jd1, jd2, m, t, u):  # pragma: no cover - compiled
+    """The record ``k`` of a segment of ``n`` records of ``intlen`` days from
+    ``init`` that holds the time ``jd1 + jd2`` (-1 outside the segment), and the
+    Chebyshev polynomials ``T_j(s)``, ``U_j(s)``, ``j < m``, at its ``s`` into
+    ``t``, ``u`` (the same for every segment of the same ``init`` and ``intlen``)."""
+    k, s = _record(init, intlen, n, jd1, jd2)
+    if k < 0:
         return -1
-    s = 2.0 * (d - k * intlen) / intlen - 1.0
     t[0] = 1.0
     u[0] = 1.0
     if m > 1:
@@ -94,13 +104,9 @@ def acceleration_basis(init, intlen, n, jd1, jd2, m, u, du):  # pragma: no cover
     segment), the ``U_j(s)`` into ``u`` and their derivatives ``U_j'(s)`` into
     ``du`` (``U_j' = 2 U_(j-1) + 2 s U_(j-1)' - U_(j-2)'``, from ``U_j = 2 s
     U_(j-1) - U_(j-2)``), ``j < m``."""
-    d = (jd1 - init) + jd2
-    k = int(np.floor(d / intlen))
-    if k == n and d <= n * intlen:  # (the segment's last instant)
-        k = n - 1
-    if k < 0 or k >= n or not np.isfinite(d):
+    k, s = _record(init, intlen, n, jd1, jd2)
+    if k < 0:
         return -1
-    s = 2.0 * (d - k * intlen) / intlen - 1.0
     u[0] = 1.0
     du[0] = 0.0
     if m > 1:
