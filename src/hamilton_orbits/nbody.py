@@ -486,13 +486,17 @@ class System(InitialStates):
         self._check_positions()
 
     # ------------------------------------------------------------- physics
-    def accelerations(self, effects: Sequence[str | Mapping[str, Any]] = ()):
+    def accelerations(self, effects: Sequence[str | Mapping[str, Any]] = (), t: Any = 0.0):
         """Accelerations of every body by equation (B), plus the listed effects.
 
         Parameters
         ----------
         effects : sequence of str or mapping, optional
             Effects as for :func:`hamilton_orbits.integrate` (``"gr"``, ...).
+        t : Quantity or float
+            The time of this state, for the effects that know it (``zonal`` with
+            ``pole="IAU2006"``, ...): 0 at the simulation's start (a time Quantity
+            for a Quantity system; the system's own unit otherwise).
 
         Returns
         -------
@@ -508,8 +512,13 @@ class System(InitialStates):
                [-0.25,  0.  ,  0.  ]])
         """
         from hamilton_orbits.rhs import compile_rhs
+        from hamilton_orbits.units import TIME, is_quantity
 
-        acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm)
+        if self._quantity and not is_quantity(t) and t != 0:
+            raise ValueError(f"Expected `t` as a time Quantity for a system of Quantities, "
+                             f"got {t!r}")
+        days = float(TIME("t", t, "d" if self._quantity else None))  # (refuses inf, NaN)
+        acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm, t=days)
         return acc * A_UNIT if self._quantity else acc
 
     def _energy_hamilton(self) -> float:

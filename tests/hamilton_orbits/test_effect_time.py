@@ -280,3 +280,19 @@ def test_the_pole_of_date_needs_a_quantity_system():
     with pytest.raises(ValueError, match="pole = 'IAU2006' needs a system of Quantities"):
         compile_rhs(s, [{"name": "zonal", "pole": "IAU2006", "j": [1e-3], "radius": 4e-5,
                          "frame": "icrs"}])
+
+
+def test_a_systems_accelerations_at_a_time():
+    """``System.accelerations(effects, t=...)`` evaluates the effects that know the
+    time at ``t`` (the integrators' clock: the same numbers), and refuses a bare
+    number for a system of Quantities."""
+    s, r, v, gm = _earth_moon()
+    eff = [{"name": "zonal", "pole": "IAU2006"}]
+    rhs = compile_rhs(s, eff)
+    got = s.accelerations(eff, t=100 * u.yr).to_value(u.au / u.day**2)
+    assert np.array_equal(got, rhs.acceleration(r, v, gm, t=36525.0))
+    assert not np.array_equal(got, s.accelerations(eff).to_value(u.au / u.day**2))
+    with pytest.raises(ValueError, match="`t` as a time Quantity"):
+        s.accelerations(eff, t=3.0)
+    with pytest.raises(ValueError, match="`t` to be finite"):
+        s.accelerations(eff, t=np.inf * u.day)
