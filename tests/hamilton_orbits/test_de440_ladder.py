@@ -103,6 +103,22 @@ def test_the_bundled_scene_is_the_top_rung():
     assert result.times[-1].to_value(u.yr) == 10.0
 
 
+def test_a_short_runs_table_shows_its_last_year():
+    """The scene's residual table had a column at 10, 50 and 100 years only: a
+    2-year run printed the bodies' names and no number.  It now ends with the last
+    whole year, whose values are the diagnostics' own."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.studies.ladder import BODIES
+
+    result = Scene.bundled("de440-century").with_values({"duration": "2 yr"}).run(
+        progress=False)
+    rows = result.tables["residuals against DE440 (heliocentric; the Moon geocentric)"]
+    km = result.diagnostics["de440_km"]
+    assert [list(row) for row in rows] == [["body", "2 yr"]] * len(BODIES)
+    moon = BODIES.index("moon")
+    assert rows[moon]["2 yr"].startswith(f"{km[-1, moon]:.3g} km")
+
+
 def test_residuals_are_taken_at_the_runs_own_dates():
     """Positions are compared with DE440 at the start's epoch plus the years (issue
     35 item 7: a run started in 1950 was compared with the J2000 table).  DE440's

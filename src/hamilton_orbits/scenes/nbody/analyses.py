@@ -146,7 +146,8 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
     """The positions against DE440's at the whole years from the start among the
     outputs, at the run's own dates (the start's epoch plus those years): km and
     arcsec per body (heliocentric; the Moon geocentric) at 10, 50 and 100 years
-    (those reached), and a figure of the residual against time."""
+    (those reached) and at the last whole year, and a figure of the residual
+    against time."""
     from hamilton_orbits import ephemeris as de
     from hamilton_orbits.studies.ladder import BODIES, residuals
 
@@ -162,13 +163,16 @@ def _de440_residuals(result: Result, system, an: dict) -> None:
                            start_jd=de.epoch_jd(start["epoch"]))
     result.diagnostics["de440_years"] = yrs
     result.diagnostics["de440_km"] = km
+    # (a run shorter than 10 years, or ending between the marks, shows its end too:
+    # a 2-year run's table had no column at all)
+    marks = [y for y in (10, 50, 100) if y in yrs]
+    marks += [] if int(yrs[-1]) in marks else [int(yrs[-1])]
     rows = []
     for k, body in enumerate(BODIES):
         row = {"body": body}
-        for y in (10, 50, 100):
-            if y in yrs:
-                i = int(np.flatnonzero(yrs == y)[0])
-                row[f"{y} yr"] = f"{km[i, k]:.3g} km ({arcsec[i, k]:.2g}\")"
+        for y in marks:
+            i = int(np.flatnonzero(yrs == y)[0])
+            row[f"{y} yr"] = f"{km[i, k]:.3g} km ({arcsec[i, k]:.2g}\")"
         rows.append(row)
     result.tables["residuals against DE440 (heliocentric; the Moon geocentric)"] = rows
     result.metrics["largest residual at the end"] = (
