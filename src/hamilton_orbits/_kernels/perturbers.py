@@ -390,6 +390,16 @@ def _slot_copy(p, at, k_p, out_r, out_v, acc_n, phi, store):  # pragma: no cover
             phi[k] = p[base + 9]
 
 
+@njit(cache=True, inline="always")
+def _width(p):  # pragma: no cover - compiled
+    """The most coefficients a segment of ``p``'s table has (at least 1)."""
+    segs = int(p[15])
+    width = 1
+    for s in range(int((int(p[14]) - segs) / 5)):
+        width = max(width, int(p[segs + 5 * s + 3]))
+    return width
+
+
 @njit(cache=True, error_model="numpy")
 def _shadows(p, days, acc):  # pragma: no cover - compiled
     """The accelerations (au/day^2) of the perturbers the shadow rows follow, at
@@ -397,6 +407,8 @@ def _shadows(p, days, acc):  # pragma: no cover - compiled
     segment of the perturber's chain, summed (NaN outside the segments)."""
     au, table, segs = p[5], int(p[14]), int(p[15])
     jd1, jd2 = p[2], p[3] + days
+    width = _width(p)
+    u, du = np.empty(width), np.empty(width)
     for s in range(acc.shape[0]):
         row = table + 4 * int(p[int(p[18]) + s])
         for c in range(3):
@@ -404,7 +416,6 @@ def _shadows(p, days, acc):  # pragma: no cover - compiled
         for link in range(int(p[row + 1])):
             at = segs + 5 * int(p[row + 2 + link])
             n_rec, m, first = int(p[at + 2]), int(p[at + 3]), int(p[at + 4])
-            u, du = np.empty(m), np.empty(m)
             k = acceleration_basis(p[at], p[at + 1], n_rec, jd1, jd2, m, u, du)
             if k < 0:
                 acc[s, :] = np.nan
@@ -424,9 +435,7 @@ def _perturbers(p, days, out_r, out_v, out_gm):  # pragma: no cover - compiled
     au, k_p, table, segs = p[5], int(p[4]), int(p[14]), int(p[15])
     jd1, jd2 = p[2], p[3] + days
     n_seg = int((table - segs) / 5)
-    width = 1
-    for s in range(n_seg):
-        width = max(width, int(p[segs + 5 * s + 3]))
+    width = _width(p)
     t, u = np.empty(width), np.empty(width)
     seg_state = np.zeros((n_seg, 6))
     k = -1
