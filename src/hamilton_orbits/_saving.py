@@ -263,6 +263,15 @@ class Saving:
                                                  prop.steps, capture.ints):
                 return
         extra = self._extra(rows)
+        if known is not None and known[0] is arch.segment and prop.events is None \
+                and (rows is None or (rows.times is None and not rows.rows)) \
+                and known[1] == extra:  # (a scheduled snapshot between outputs: no row
+            capture = known[2][0]  # pending, the graph's shape checked by ``take``)
+            taken = capture.take(prop)
+            if taken is not None and arch.refill(prop.t, prop.r, prop.v, prop.gm,
+                                                 all_active(prop.r.shape[0]), *taken,
+                                                 prop.steps, capture.ints):
+                return
         if known is not None and known[0] is arch.segment and known[1] == extra and (
                 rows is None or rows.times is None):
             capture, _, index = known[2]

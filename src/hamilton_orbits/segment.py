@@ -327,7 +327,7 @@ class SegmentWriter:
                         (steps, start, start)], out=head[1:], casting="unsafe")
         views[8][...] = active
         file.write(file.checked(), 1)
-        self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]), start)
+        self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]))
         return True
 
     def refill(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
@@ -335,11 +335,17 @@ class SegmentWriter:
                steps: int, ints: list[int]) -> bool:
         """Append the snapshot after one :meth:`_append_state` appended, of the same
         arrays (``r``, ``v``, ``gm``, ``active`` read-only, the ``state`` arrays: their
-        values changed in place) with their new numbers: what :meth:`append` would
-        write, without building the snapshot.  False, nothing written, where an
-        array is another or a number does not fit (``ints``: the positions of the
-        integer arrays of ``state``, checked below 2**53)."""
+        values changed in place; ``r``, ``v`` and state arrays may be others of the
+        same shapes and types, as an output's rows) with their new numbers: what
+        :meth:`append` would write, without building the snapshot.  False, nothing
+        written, where an array is not such, ``gm`` or ``active`` another, or a
+        number does not fit (``ints``: the positions of the integer arrays of
+        ``state``, checked below 2**53)."""
         last, kept = self._last, self._kept[0]
+        if last is not None and (r is not last[0] or v is not last[1]
+                                 or not all(map(operator.is_, kept, state))):
+            last = self._moved(r, v, state)  # (an output's rows: other arrays, the same
+            # shapes and types)
         if (last is None or r is not last[0] or v is not last[1] or gm is not last[2]
                 or active is not last[3] or active.flags.writeable
                 or len(state) != len(kept) or not all(map(operator.is_, kept, state))
@@ -348,7 +354,9 @@ class SegmentWriter:
                 or any(type(x) is int and not -INT_EXACT < x < INT_EXACT for x in scalars)
                 or any(beyond_float(state[k]) for k in ints)):
             return False
-        file, pieces, start = self._file, last[4], last[6]
+        file, pieces = self._file, last[4]
+        start = 0 if self._rows is None else self._rows.count  # (rows written since the
+        # last fill by the general path count)
         if last[5]:  # (arrays not float64 or not contiguous: their values as float64)
             pieces = pieces.copy()
             for k, a in last[5]:
@@ -361,6 +369,29 @@ class SegmentWriter:
             [*pieces, np.array([*scalars, steps, start, start], dtype=np.float64)]))
         file.write(file.checked(), 1)
         return True
+
+    def _moved(self, r: np.ndarray, v: np.ndarray,
+               state: list[np.ndarray]) -> tuple[Any, ...] | None:
+        """The last fill's parts with ``r``, ``v`` and the ``state`` arrays put in the
+        places of those it took (kept for the next :meth:`refill`), or None, nothing
+        changed, where one is not a contiguous array of the same shape and type as
+        the one it replaces, taken whole by the last fill."""
+        last, kept = self._last, self._kept
+        if len(state) != len(kept[0]):
+            return None
+        pieces = list(last[4])  # (r, v, gm, the state's arrays: gm is not replaced)
+        for k, (old, a) in enumerate(zip((last[0], last[1], last[2], *kept[0]),
+                                         (r, v, last[2], *state), strict=True)):
+            if a is not old:
+                if (type(a) is not np.ndarray or a.shape != old.shape or a.dtype != old.dtype
+                        or pieces[k] is None or not a.flags.c_contiguous):
+                    return None
+                pieces[k] = a
+        for k, a in enumerate(state):
+            if a is not kept[0][k]:
+                kept[0][k], kept[1][k] = a, a.reshape(-1)
+        self._last = (r, v, last[2], last[3], pieces, last[5])
+        return self._last
 
     def _forget(self) -> bool:
         """Drop the kept views (a state of another shape: the general path follows)."""
