@@ -528,3 +528,42 @@ def test_drift_side_by_side_is_the_kernel_one_by_one(bodies, per_row_mu):
     assert _kw._kepler_all(q1, u1, mu, 0.05) == bad
     assert not np.array_equal(q1[bad - 1], q[bad - 1])
     np.testing.assert_array_equal(q1[bad:], q[bad:])
+
+
+def _through_the_nested_loop(kernel):
+    """``kernel``'s steps taken by the loop of its events' kernel with nothing watched
+    (the nested loop: jumps, kick and drift behind their inline wrappers)."""
+    def general(*args):
+        return kernel(*args[:-1], np.zeros((0, 8)), np.zeros((0, 8)),
+                      np.zeros(1, np.int64), args[-1])
+    return general
+
+
+@pytest.mark.parametrize("coordinates", wh.COORDINATES)
+@pytest.mark.parametrize("n_massive, n_test", [(2, 0), (3, 0), (6, 0), (7, 0), (4, 1)])
+def test_a_few_massive_bodies_step_as_the_nested_loop_does(monkeypatch, coordinates,
+                                                           n_massive, n_test):
+    """Below the SIMD form's size and with no test particle or effect, the steps run
+    in a loop of their own (``_dh_newton_steps``, ``_jacobi_newton_steps``: the
+    nested one keeps reference counting in the loop, ~half a step at N = 2); it
+    gives the nested loop's bits, shortened last steps included."""
+    rng = np.random.default_rng(n_massive + 10 * n_test)
+    n = n_massive + n_test
+    a = rng.uniform(1.0, 5.0, n - 1)
+    ph = rng.uniform(0.0, 2.0 * np.pi, n - 1)
+    r0, v0 = np.zeros((n, 3)), np.zeros((n, 3))
+    r0[1:] = np.stack([a * np.cos(ph), a * np.sin(ph), 0.02 * a], axis=1)
+    v0[1:] = np.stack([-np.sin(ph), np.cos(ph), 0.01 * ph], axis=1) / np.sqrt(a)[:, None]
+    gm = np.concatenate([[1.0], rng.uniform(1e-6, 1e-3, n_massive - 1), np.zeros(n_test)])
+    t = np.array([0.0, 1.3, 7.0, 7.04, 20.0])
+
+    def run():
+        return wh.run(newtonian_rhs(), r0, v0, gm, t, dt=0.05, coordinates=coordinates)
+
+    flat = run()
+    monkeypatch.setattr(wh._k, "advance_dh", _through_the_nested_loop(_kw.advance_dh_watched))
+    monkeypatch.setattr(wh._k, "advance_jacobi",
+                        _through_the_nested_loop(_kw.advance_jacobi_watched))
+    nested = run()
+    assert flat[2] == nested[2] == 26 + 114 + 1 + 260  # (0.04: one shortened step)
+    assert np.array_equal(flat[0], nested[0]) and np.array_equal(flat[1], nested[1])

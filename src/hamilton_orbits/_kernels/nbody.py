@@ -96,7 +96,7 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
     for k in range(n):
         if gm[k] == 0.0:
             # test particles: never the inlined pair form of newtonian_rows
-            _newtonian_rows_spaced(r, gm, massive_indices(gm), 0, acc)
+            newtonian_rows_spaced(r, gm, massive_indices(gm), 0, acc)
             return
     if n >= SIMD_FROM:
         w = (carray(_stack_scratch(), SCRATCH) if n <= STACK_MASSIVE
@@ -310,13 +310,13 @@ def newtonian_rows(r, gm, idx, first, acc):  # pragma: no cover - compiled
     form inlined into the caller (as :func:`kick_rows`)."""
     nm = idx.shape[0]
     if nm < SIMD_FROM and nm == r.shape[0] - first:
-        _pairs_rows(r, gm, idx, acc)
+        pairs_rows(r, gm, idx, acc)
     else:
-        _newtonian_rows_spaced(r, gm, idx, first, acc)
+        newtonian_rows_spaced(r, gm, idx, first, acc)
 
 
 @njit(cache=True, error_model="numpy")
-def _newtonian_rows_spaced(r, gm, idx, first, acc):  # pragma: no cover - compiled
+def newtonian_rows_spaced(r, gm, idx, first, acc):  # pragma: no cover - compiled
     """:func:`newtonian_rows` with its work space (SIMD columns, test-particle blocks)."""
     n = r.shape[0]
     nm = idx.shape[0]
@@ -369,11 +369,11 @@ def _massive_rows(r, gm, idx, acc, w):  # pragma: no cover - compiled
         _soa_massive(nm, w)
         _scatter_massive(acc, idx, True, nm, w)
         return
-    _pairs_rows(r, gm, idx, acc)
+    pairs_rows(r, gm, idx, acc)
 
 
 @njit(cache=True, error_model="numpy")
-def _pairs_rows(r, gm, idx, acc):  # pragma: no cover - compiled
+def pairs_rows(r, gm, idx, acc):  # pragma: no cover - compiled
     """``acc[idx[a]]`` in the pair form (each massive pair visited once)."""
     nm = idx.shape[0]
     for a in range(nm):
@@ -396,17 +396,17 @@ def kick_rows(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
     A few massive bodies (below :data:`SIMD_FROM`) and no test particle: the
     pairs inlined into the caller's step loop, without the work space (the call
     and its setup cost as much as the one pair of N = 3); otherwise
-    :func:`_kick_rows_spaced`."""
+    :func:`kick_rows_spaced`."""
     nm = idx.shape[0]
     if nm < SIMD_FROM and nm == r.shape[0] - first:
-        _compact_pairs(r, gm, idx, acc_m)
-        _kick_massive(u, idx, h, acc_m)
+        compact_pairs(r, gm, idx, acc_m)
+        kick_massive(u, idx, h, acc_m)
     else:
-        _kick_rows_spaced(r, gm, idx, first, h, u, acc_m)
+        kick_rows_spaced(r, gm, idx, first, h, u, acc_m)
 
 
 @njit(cache=True, error_model="numpy")
-def _kick_rows_spaced(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
+def kick_rows_spaced(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - compiled
     """:func:`kick_rows` with its work space (SIMD columns, test-particle blocks)."""
     n = r.shape[0]
     nm = idx.shape[0]
@@ -417,8 +417,8 @@ def _kick_rows_spaced(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - com
         _soa_massive(nm, w)
         _scatter_massive(acc_m, idx, False, nm, w)
     else:
-        _compact_pairs(r, gm, idx, acc_m)
-    _kick_massive(u, idx, h, acc_m)
+        compact_pairs(r, gm, idx, acc_m)
+    kick_massive(u, idx, h, acc_m)
     if nm == n - first:
         return
     o = 7 * _padded(nm) + 3 * BLOCK
@@ -433,7 +433,7 @@ def _kick_rows_spaced(r, gm, idx, first, h, u, acc_m):  # pragma: no cover - com
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _kick_massive(u, idx, h, acc_m):  # pragma: no cover - compiled
+def kick_massive(u, idx, h, acc_m):  # pragma: no cover - compiled
     """``u[idx[a]] += h acc_m[a]``."""
     for a in range(idx.shape[0]):
         i = idx[a]
@@ -443,7 +443,7 @@ def _kick_massive(u, idx, h, acc_m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _compact_pairs(r, gm, idx, acc_m):  # pragma: no cover - compiled
+def compact_pairs(r, gm, idx, acc_m):  # pragma: no cover - compiled
     """The pair form of :func:`_massive_row` into ``acc_m[a]`` for body ``idx[a]``."""
     nm = idx.shape[0]
     for a in range(nm):

@@ -446,7 +446,14 @@ def _kick_jacobi(
                 # the effects' net force moves the barycentre
                 uj[0, k] += h * a_cm / m_tot
     _inertial_to_jacobi_acc(acc, gm, inv, accj)
-    for i in range(1, n):
+    _kick_interaction(qj, uj, eta, accj, h)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _kick_interaction(qj, uj, eta, accj, h):  # pragma: no cover - compiled
+    """``uj_i += h (aj_i + eta_i qj_i / |qj_i|^3)``, i >= 1: the Jacobi kick, the
+    Kepler part of each body's acceleration taken out (it is in the drift)."""
+    for i in range(1, qj.shape[0]):
         d2 = qj[i, 0] * qj[i, 0] + qj[i, 1] * qj[i, 1] + qj[i, 2] * qj[i, 2]
         f = eta[i] / (d2 * math.sqrt(d2))
         for k in range(3):
@@ -660,6 +667,68 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
     return n_steps, -1, STATUS_OK
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _dh_newton_steps(q, u, gm, com, dt, n_steps, dt_last, ws, mu, idx, acc_m):
+    # pragma: no cover - compiled
+    """:func:`_dh_steps` with no effect and no event: the same arithmetic in the same
+    order, the step's parts called from its own loop.  (Behind the nested inline
+    wrappers of :func:`_kick_dh` and :func:`~hamilton_orbits._kernels.nbody.kick_rows`,
+    arrays passed two levels deep keep reference counting in the loop: about 40% of
+    a step at N = 2.)  A few massive bodies and no test particle: the pairs inlined,
+    as ``kick_rows`` does; otherwise its spaced form, called."""
+    compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == q.shape[0] - 1
+    for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of
+        if s < 0:  # the Kepler solver, whose code is large)
+            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+        else:
+            h = dt if s < n_steps - 1 else dt_last
+            _jump(q, u, gm, 0.5 * h)
+            if compact:
+                _nbody.compact_pairs(q, gm, idx, acc_m)
+                _nbody.kick_massive(u, idx, h, acc_m)
+            else:
+                _nbody.kick_rows_spaced(q, gm, idx, 1, h, u, acc_m)
+            _jump(q, u, gm, 0.5 * h)
+            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            tau = 0.5 * (h + h_next)
+        bad = _kepler_all(q, u, mu, tau)
+        for k in range(3):
+            com[k] += tau * com[3 + k]
+        ws[0] += tau
+        if bad >= 0:
+            return max(s, 0), bad, STATUS_OK
+    return n_steps, -1, STATUS_OK
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _jacobi_newton_steps(qj, uj, gm, eta, dt, n_steps, dt_last, ws, idx, ratio, inv, acc, accj,
+                         r_in):  # pragma: no cover - compiled
+    """:func:`_jacobi_steps` with no effect and no event, as :func:`_dh_newton_steps`:
+    the same arithmetic in the same order."""
+    compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == qj.shape[0]
+    for s in range(-1, n_steps):  # (s = -1: the first half drift)
+        if s < 0:
+            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+        else:
+            h = dt if s < n_steps - 1 else dt_last
+            jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
+            if compact:
+                _nbody.pairs_rows(r_in, gm, idx, acc)
+            else:
+                _nbody.newtonian_rows_spaced(r_in, gm, idx, 0, acc)
+            _inertial_to_jacobi_acc(acc, gm, inv, accj)
+            _kick_interaction(qj, uj, eta, accj, h)
+            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            tau = 0.5 * (h + h_next)
+        bad = _kepler_all(qj, uj, eta, tau)
+        for k in range(3):
+            qj[0, k] += tau * uj[0, k]
+        ws[0] += tau
+        if bad >= 0:
+            return max(s, 0), bad, STATUS_OK
+    return n_steps, -1, STATUS_OK
+
+
 _SPLIT_ARGS = (ADDRESSES, F1, types.boolean, _I1, F2, F2, F1, F1, types.float64, types.int64,
                types.float64)
 _RESULT = types.Tuple((types.int64, types.int64, types.int64))
@@ -705,8 +774,7 @@ def _advance_dh(
     if effects is not None:
         return _dh_steps(False, extra, p, True, q, u, gm, com, dt, n_steps, dt_last,
                          None, None, None, ws, x0, v0, mu, mu_s, kick)
-    return _dh_steps(False, extra, p, False, q, u, gm, com, dt, n_steps, dt_last,
-                     None, None, None, ws, x0, v0, mu, mu_s, kick)
+    return _dh_newton_steps(q, u, gm, com, dt, n_steps, dt_last, ws, mu, idx, acc_m)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -771,8 +839,8 @@ def _advance_jacobi(
     if effects is not None:
         return _jacobi_steps(False, extra, p, True, qj, uj, gm, eta, dt, n_steps, dt_last,
                              None, None, None, ws, x0, v0, kick)
-    return _jacobi_steps(False, extra, p, False, qj, uj, gm, eta, dt, n_steps, dt_last,
-                         None, None, None, ws, x0, v0, kick)
+    return _jacobi_newton_steps(qj, uj, gm, eta, dt, n_steps, dt_last, ws, idx, ratio, inv,
+                                acc, accj, r_in)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
