@@ -637,8 +637,9 @@ def closest_pair(r, gm):  # pragma: no cover - compiled
     return best, bi, bj
 
 
-# compiled eagerly (explicit signatures): after the kernels they call
-@njit(ACCEL_SIGNATURE, cache=True, error_model="numpy")
+# compiled when first asked for (``integrators._setup.addresses``): a run whose
+# method does not evaluate the right-hand side (wh) does not compile it
+@njit(cache=True, error_model="numpy")
 def newtonian_only(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The right-hand side with no effect listed: :func:`newtonian` (``p`` unused)."""
     newtonian(r, v, gm, acc)
