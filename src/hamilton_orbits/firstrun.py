@@ -1,6 +1,6 @@
 """A one-line notice on stderr while the package's kernels compile for the first time.
 
-With no numba cache, the first calls compile kernels for seconds (about 9 s
+With no numba cache, the first calls compile kernels for seconds (about 5 s
 for the main job on two cores: ``benchmarks/bench_first_run.py``), which otherwise
 looks like a hang.  A listener on numba's
 ``numba:compile`` event (fired only when a function is really compiled, not
