@@ -17,7 +17,7 @@ from hamilton_orbits._kernels import wh as _kw
 from hamilton_orbits._kernels.signatures import ACCEL_SIGNATURE
 from hamilton_orbits.integrators import _setup, wh
 from hamilton_orbits.orbit import KeplerOrbit
-from hamilton_orbits.rhs import RHS, newtonian_rhs
+from hamilton_orbits.rhs import RHS, compile_rhs, newtonian_rhs
 
 EPS = np.finfo(float).eps
 ROT = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
@@ -540,13 +540,16 @@ def _through_the_nested_loop(kernel):
 
 
 @pytest.mark.parametrize("coordinates", wh.COORDINATES)
-@pytest.mark.parametrize("n_massive, n_test", [(2, 0), (3, 0), (6, 0), (7, 0), (4, 1)])
-def test_a_few_massive_bodies_step_as_the_nested_loop_does(monkeypatch, coordinates,
-                                                           n_massive, n_test):
-    """Below the SIMD form's size and with no test particle or effect, the steps run
-    in a loop of their own (``_dh_newton_steps``, ``_jacobi_newton_steps``: the
-    nested one keeps reference counting in the loop, ~half a step at N = 2); it
-    gives the nested loop's bits, shortened last steps included."""
+@pytest.mark.parametrize("n_massive, n_test, effects", [
+    (2, 0, False), (3, 0, False), (6, 0, False), (7, 0, False), (4, 1, False), (3, 0, True),
+    (8, 1, True)])
+def test_the_unwatched_steps_are_those_of_the_nested_loop(monkeypatch, coordinates, n_massive,
+                                                          n_test, effects):
+    """Watching no event, the steps run in a loop of their own
+    (``_dh_unwatched_steps``, ``_jacobi_unwatched_steps``: the nested one keeps
+    reference counting in the loop, ~half a step at N = 2); it gives the nested
+    loop's bits, with and without an effect, with a few bodies (the pairs inlined),
+    many or a test particle, and shortened last steps."""
     rng = np.random.default_rng(n_massive + 10 * n_test)
     n = n_massive + n_test
     a = rng.uniform(1.0, 5.0, n - 1)
@@ -556,14 +559,22 @@ def test_a_few_massive_bodies_step_as_the_nested_loop_does(monkeypatch, coordina
     v0[1:] = np.stack([-np.sin(ph), np.cos(ph), 0.01 * ph], axis=1) / np.sqrt(a)[:, None]
     gm = np.concatenate([[1.0], rng.uniform(1e-6, 1e-3, n_massive - 1), np.zeros(n_test)])
     t = np.array([0.0, 1.3, 7.0, 7.04, 20.0])
+    rhs = newtonian_rhs()
+    if effects:
+        from hamilton_orbits import Body, System
+
+        system = System([Body(f"b{i}", gm[i], r0[i], v0[i]) for i in range(n)])
+        rhs = compile_rhs(system, [{"name": "j2", "body": "b0", "j2": 1e-3, "radius": 0.05}])
+        assert rhs.extra is not None
 
     def run():
-        return wh.run(newtonian_rhs(), r0, v0, gm, t, dt=0.05, coordinates=coordinates)
+        return wh.run(rhs, r0, v0, gm, t, dt=0.05, coordinates=coordinates)
 
     flat = run()
-    monkeypatch.setattr(wh._k, "advance_dh", _through_the_nested_loop(_kw.advance_dh_watched))
-    monkeypatch.setattr(wh._k, "advance_jacobi",
-                        _through_the_nested_loop(_kw.advance_jacobi_watched))
+    for name in ("advance_dh", "advance_dh_effects", "advance_jacobi",
+                 "advance_jacobi_effects"):
+        watched = getattr(_kw, name.replace("_effects", "") + "_watched")
+        monkeypatch.setattr(wh._k, name, _through_the_nested_loop(watched))
     nested = run()
     assert flat[2] == nested[2] == 26 + 114 + 1 + 260  # (0.04: one shortened step)
     assert np.array_equal(flat[0], nested[0]) and np.array_equal(flat[1], nested[1])

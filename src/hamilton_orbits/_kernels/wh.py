@@ -288,36 +288,45 @@ def _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_i
     central body, is not in the interaction).  The effects see the bodies in the
     caller's order (row ``i`` is body ``order[i]``; ``gm_c`` the caller's ``G m``):
     their parameters name bodies by the caller's indices."""
-    n = q.shape[0]
-    gm0 = gm[0]
     _jump(q, u, gm, 0.5 * h)
     _nbody.kick_rows(q, gm, idx, 1, h, u, acc_m)
     if has_extra:
-        # inertial state for the effects: r_0 = R - sum m_i Q_i / M
-        c = order[0]
-        for k in range(3):
-            s_q = 0.0
-            s_u = 0.0
-            for i in range(1, n):
-                s_q += gm[i] * q[i, k]
-                s_u += gm[i] * u[i, k]
-            r_in[c, k] = com[k] - s_q / m_tot
-            v_in[c, k] = com[3 + k] - s_u / gm0
-            for i in range(1, n):
-                r_in[order[i], k] = q[i, k] + r_in[c, k]
-                v_in[order[i], k] = u[i, k] + com[3 + k]
-            for i in range(n):
-                acc_x[i, k] = 0.0
-        extra(r_in, v_in, gm_c, acc_x, p)
-        for k in range(3):
-            a_cm = 0.0
-            for i in range(n):
-                a_cm += gm[i] * acc_x[order[i], k]
-            a_cm /= m_tot
-            com[3 + k] += h * a_cm
-            for i in range(1, n):
-                u[i, k] += h * (acc_x[order[i], k] - a_cm)
+        _effects_kick_dh(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order, gm_c)
     _jump(q, u, gm, 0.5 * h)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _effects_kick_dh(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order, gm_c):
+    # pragma: no cover - compiled
+    """The listed effects' kick ``h`` in democratic-heliocentric coordinates (their
+    net force moves the barycentre), evaluated with the bodies in the caller's order
+    (see :func:`_kick_dh`)."""
+    n = q.shape[0]
+    gm0 = gm[0]
+    # inertial state for the effects: r_0 = R - sum m_i Q_i / M
+    c = order[0]
+    for k in range(3):
+        s_q = 0.0
+        s_u = 0.0
+        for i in range(1, n):
+            s_q += gm[i] * q[i, k]
+            s_u += gm[i] * u[i, k]
+        r_in[c, k] = com[k] - s_q / m_tot
+        v_in[c, k] = com[3 + k] - s_u / gm0
+        for i in range(1, n):
+            r_in[order[i], k] = q[i, k] + r_in[c, k]
+            v_in[order[i], k] = u[i, k] + com[3 + k]
+        for i in range(n):
+            acc_x[i, k] = 0.0
+    extra(r_in, v_in, gm_c, acc_x, p)
+    for k in range(3):
+        a_cm = 0.0
+        for i in range(n):
+            a_cm += gm[i] * acc_x[order[i], k]
+        a_cm /= m_tot
+        com[3 + k] += h * a_cm
+        for i in range(1, n):
+            u[i, k] += h * (acc_x[order[i], k] - a_cm)
 
 
 @njit(cache=True, error_model="numpy")
@@ -431,22 +440,31 @@ def _kick_jacobi(
     massive indices of ``gm``; ``ratio``, ``inv``: :func:`_jacobi_factors`); the
     effects evaluated with the bodies in the caller's order (``perm``: see
     :func:`effects_in_order`)."""
-    n = qj.shape[0]
     jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
     _nbody.newtonian_rows(r_in, gm, idx, 0, acc)
     if has_extra:
-        effects_in_order(extra, p, r_in, v_in, acc_x, perm)
-        m_tot = eta[n - 1]
-        for k in range(3):
-            a_cm = 0.0
-            for i in range(n):
-                a_cm += gm[i] * acc_x[i, k]
-                acc[i, k] += acc_x[i, k]
-            if move_com:
-                # the effects' net force moves the barycentre
-                uj[0, k] += h * a_cm / m_tot
+        _effects_jacobi(extra, p, uj, gm, eta, h, move_com, acc, acc_x, r_in, v_in, perm)
     _inertial_to_jacobi_acc(acc, gm, inv, accj)
     _kick_interaction(qj, uj, eta, accj, h)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _effects_jacobi(extra, p, uj, gm, eta, h, move_com, acc, acc_x, r_in, v_in, perm):
+    # pragma: no cover - compiled
+    """The listed effects' accelerations at the inertial rows ``r_in``, ``v_in`` added
+    to ``acc`` (and, with ``move_com``, their net force kicking the barycentre's
+    velocity ``uj[0]`` by ``h``): see :func:`_kick_jacobi`."""
+    n = uj.shape[0]
+    effects_in_order(extra, p, r_in, v_in, acc_x, perm)
+    m_tot = eta[n - 1]
+    for k in range(3):
+        a_cm = 0.0
+        for i in range(n):
+            a_cm += gm[i] * acc_x[i, k]
+            acc[i, k] += acc_x[i, k]
+        if move_com:
+            # the effects' net force moves the barycentre
+            uj[0, k] += h * a_cm / m_tot
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -668,29 +686,38 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _dh_newton_steps(q, u, gm, com, dt, n_steps, dt_last, ws, mu, idx, acc_m):
+def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu, kick):
     # pragma: no cover - compiled
-    """:func:`_dh_steps` with no effect and no event: the same arithmetic in the same
-    order, the step's parts called from its own loop.  (Behind the nested inline
-    wrappers of :func:`_kick_dh` and :func:`~hamilton_orbits._kernels.nbody.kick_rows`,
-    arrays passed two levels deep keep reference counting in the loop: about 40% of
-    a step at N = 2.)  A few massive bodies and no test particle: the pairs inlined,
-    as ``kick_rows`` does; otherwise its spaced form, called."""
+    """:func:`_dh_steps` watching no event: the same arithmetic in the same order,
+    the step's parts called from its own loop.  (Behind the nested inline wrappers of
+    :func:`_kick_dh` and :func:`~hamilton_orbits._kernels.nbody.kick_rows`, arrays
+    passed two levels deep keep reference counting in the loop: about 40% of a step
+    at N = 2.)  A few massive bodies and no test particle: the pairs inlined, as
+    ``kick_rows`` does; otherwise its spaced form, called.  ``has_extra`` is a
+    constant of the caller: the loop without effects has no trace of them."""
+    idx, m_tot, acc_m, r_in, v_in, acc_x, order, gm_c = kick
     compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == q.shape[0] - 1
+    t_step = ws[0]
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of
         if s < 0:  # the Kepler solver, whose code is large)
             tau = 0.5 * (dt if n_steps > 1 else dt_last)
         else:
             h = dt if s < n_steps - 1 else dt_last
+            if has_extra:
+                set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _jump(q, u, gm, 0.5 * h)
             if compact:
                 _nbody.compact_pairs(q, gm, idx, acc_m)
                 _nbody.kick_massive(u, idx, h, acc_m)
             else:
                 _nbody.kick_rows_spaced(q, gm, idx, 1, h, u, acc_m)
+            if has_extra:
+                _effects_kick_dh(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order,
+                                 gm_c)
             _jump(q, u, gm, 0.5 * h)
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
             tau = 0.5 * (h + h_next)
+            t_step += h
         bad = _kepler_all(q, u, mu, tau)
         for k in range(3):
             com[k] += tau * com[3 + k]
@@ -701,25 +728,32 @@ def _dh_newton_steps(q, u, gm, com, dt, n_steps, dt_last, ws, mu, idx, acc_m):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _jacobi_newton_steps(qj, uj, gm, eta, dt, n_steps, dt_last, ws, idx, ratio, inv, acc, accj,
-                         r_in):  # pragma: no cover - compiled
-    """:func:`_jacobi_steps` with no effect and no event, as :func:`_dh_newton_steps`:
-    the same arithmetic in the same order."""
+def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+                            kick):  # pragma: no cover - compiled
+    """:func:`_jacobi_steps` watching no event, as :func:`_dh_unwatched_steps`: the
+    same arithmetic in the same order."""
+    idx, ratio, inv, acc, accj, acc_x, r_in, v_in, perm = kick
     compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == qj.shape[0]
+    t_step = ws[0]
     for s in range(-1, n_steps):  # (s = -1: the first half drift)
         if s < 0:
             tau = 0.5 * (dt if n_steps > 1 else dt_last)
         else:
             h = dt if s < n_steps - 1 else dt_last
+            if has_extra:
+                set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
             if compact:
                 _nbody.pairs_rows(r_in, gm, idx, acc)
             else:
                 _nbody.newtonian_rows_spaced(r_in, gm, idx, 0, acc)
+            if has_extra:
+                _effects_jacobi(extra, p, uj, gm, eta, h, True, acc, acc_x, r_in, v_in, perm)
             _inertial_to_jacobi_acc(acc, gm, inv, accj)
             _kick_interaction(qj, uj, eta, accj, h)
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
             tau = 0.5 * (h + h_next)
+            t_step += h
         bad = _kepler_all(qj, uj, eta, tau)
         for k in range(3):
             qj[0, k] += tau * uj[0, k]
@@ -772,9 +806,10 @@ def _advance_dh(
     # the loop without effects has no trace of them (their branches cost up to 30%
     # of a step at N = 2-3)
     if effects is not None:
-        return _dh_steps(False, extra, p, True, q, u, gm, com, dt, n_steps, dt_last,
-                         None, None, None, ws, x0, v0, mu, mu_s, kick)
-    return _dh_newton_steps(q, u, gm, com, dt, n_steps, dt_last, ws, mu, idx, acc_m)
+        return _dh_unwatched_steps(True, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                                   kick)
+    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                               kick)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -837,10 +872,10 @@ def _advance_jacobi(
                              n_steps, dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)
     # as _advance_dh: the loop without effects has no trace of them
     if effects is not None:
-        return _jacobi_steps(False, extra, p, True, qj, uj, gm, eta, dt, n_steps, dt_last,
-                             None, None, None, ws, x0, v0, kick)
-    return _jacobi_newton_steps(qj, uj, gm, eta, dt, n_steps, dt_last, ws, idx, ratio, inv,
-                                acc, accj, r_in)
+        return _jacobi_unwatched_steps(True, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last,
+                                       ws, kick)
+    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+                                   kick)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
