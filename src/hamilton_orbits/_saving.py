@@ -101,17 +101,16 @@ class Saving:
         times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop
         rest = times[times > prop.t]
-        out, compiled = None, 0.0
+        out = None
         if rest.size:
-            out, compiled = self._advance(np.concatenate(([prop.t], rest)), progress,
-                                          on_output, stop)
+            out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop)
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
         self._start = self._initial
         unit = u.Unit(info["unit"]) if info["unit"] else None
         return self._trajectory(whole, unit, None if info["first"] else self._initial,
-                                max(whole.wall_time - compiled, 0.0))
+                                whole.wall_time)
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Save everything needed to continue: ``Simulation.load(path).integrate(t)``

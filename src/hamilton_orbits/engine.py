@@ -45,6 +45,7 @@ import numpy as np
 
 from hamilton_orbits._kernels.checks import all_finite
 from hamilton_orbits.events import EventLog, StopAtEvent
+from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import (
     INTEGRATORS,
     Integrator,
@@ -74,7 +75,7 @@ class EngineRun:
         inside an output interval took more: the propagation's ``steps`` counts
         them).
     wall_time : float
-        Seconds of the integration proper.
+        Seconds of the integration proper (numba's compilation during it left out).
     complete : bool
         False if the run stopped early (``stop()``, :class:`StopIntegration` from
         an output callback, or Ctrl-C).
@@ -284,6 +285,7 @@ class Propagation:
 
         t_reached = t_out
         start, steps0 = time.perf_counter(), driver.steps
+        compiled = compile_seconds()  # (a first call compiles: not integration)
         complete, interrupted = True, False
         try:
             if self.stop_at_start:  # a collision at the start stops the run there
@@ -300,7 +302,7 @@ class Propagation:
             complete = False
         except KeyboardInterrupt:
             complete, interrupted = False, True
-        wall = time.perf_counter() - start
+        wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
         k = reached[0] + 1
         if backward:  # in place: no second copy of the history
             np.negative(v_out, out=v_out)

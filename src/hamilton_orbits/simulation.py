@@ -51,7 +51,6 @@ from hamilton_orbits.checkpoint import (
     LegRows,
 )
 from hamilton_orbits.effects import EffectSet
-from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
@@ -295,11 +294,11 @@ class Simulation(Saving):
             self._unit = unit
         if self._archive is not None:
             self._new_leg(times)
-        out, compiled = self._advance(times, progress, on_output, stop)
+        out = self._advance(times, progress, on_output, stop)
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
-        return self._trajectory(out, unit, start, max(out.wall_time - compiled, 0.0))
+        return self._trajectory(out, unit, start, out.wall_time)
 
     def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,
                     wall_time: float) -> Trajectory:
@@ -316,30 +315,26 @@ class Simulation(Saving):
         return traj
 
     def _advance(self, times: np.ndarray, progress: bool, on_output: Any,
-                 stop: Any) -> tuple[engine.EngineRun, float]:
+                 stop: Any) -> engine.EngineRun:
         """The propagation through ``times`` (the archive's snapshots taken on the
-        way), and the seconds spent compiling."""
+        way)."""
         prop = self._prop
         close = None
         if progress:
             on_output, close = progress_reporter(prop.method.name, len(times) - 1, on_output)
         archived = None if self._archive is None else self._archived_times(times)
         try:
-            compiled = compile_seconds()
             if archived is None:
-                out = prop.advance(times, on_output=on_output, stop=stop)
-            else:
-                out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
-                                   stop=stop, checkpoint=self._checkpoint(*archived[1:]),
-                                   pause=self._step_snapshots())
-                out = requested_rows(out, archived[1])
-            compiled = compile_seconds() - compiled  # a first call compiles the stepping kernel
+                return prop.advance(times, on_output=on_output, stop=stop)
+            out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
+                               stop=stop, checkpoint=self._checkpoint(*archived[1:]),
+                               pause=self._step_snapshots())
+            return requested_rows(out, archived[1])
         finally:
             if close is not None:
                 close()
             if self._archive is not None:
                 self._archive.close()
-        return out, compiled
 
 def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact: Any,
                 quantity: bool) -> ArchiveWriter | None:
