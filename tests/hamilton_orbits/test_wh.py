@@ -548,8 +548,10 @@ def test_the_unwatched_steps_are_those_of_the_nested_loop(monkeypatch, coordinat
     """Watching no event, the steps run in a loop of their own
     (``_dh_unwatched_steps``, ``_jacobi_unwatched_steps``: the nested one keeps
     reference counting in the loop, ~half a step at N = 2); it gives the nested
-    loop's bits, with and without an effect, with a few bodies (the pairs inlined),
-    many or a test particle, and shortened last steps."""
+    loop's bits, with and without an effect, with a few bodies (the pairs inlined;
+    fewer than ``LANES_FROM``, all massive: the ``_few`` entries, which compile
+    neither the Kepler lanes nor the spaced kick), many or a test particle, and
+    shortened last steps."""
     rng = np.random.default_rng(n_massive + 10 * n_test)
     n = n_massive + n_test
     a = rng.uniform(1.0, 5.0, n - 1)
@@ -570,10 +572,17 @@ def test_the_unwatched_steps_are_those_of_the_nested_loop(monkeypatch, coordinat
     def run():
         return wh.run(rhs, r0, v0, gm, t, dt=0.05, coordinates=coordinates)
 
+    names = [f"advance_{c}{kind}" for c in ("dh", "jacobi") for kind in ("", "_effects", "_few")]
+    called = []
+    for name in names:  # (which entry ran: a few massive bodies take ``_few``)
+        monkeypatch.setattr(wh._k, name, (lambda f, k: lambda *a: called.append(k) or f(*a))(
+            getattr(_kw, name), name))
     flat = run()
-    for name in ("advance_dh", "advance_dh_effects", "advance_jacobi",
-                 "advance_jacobi_effects"):
-        watched = getattr(_kw, name.replace("_effects", "") + "_watched")
+    few = n - 1 < _kw.LANES_FROM and n_test == 0 and not effects
+    assert set(called) == {f"advance_{coordinates[:6].replace('democr', 'dh')}"
+                           f"{'_effects' if effects else '_few' if few else ''}"}
+    for name in names:
+        watched = getattr(_kw, name.replace("_effects", "").replace("_few", "") + "_watched")
         monkeypatch.setattr(wh._k, name, _through_the_nested_loop(watched))
     nested = run()
     assert flat[2] == nested[2] == 26 + 114 + 1 + 260  # (0.04: one shortened step)

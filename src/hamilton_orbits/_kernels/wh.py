@@ -66,7 +66,9 @@ def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     """Advance every body ``i >= 1`` on its Kepler orbit about ``mu[i]`` (``mu[0]``
     for all when ``mu`` has one element) by ``tau``: from :data:`LANES_FROM`
     bodies on side by side (:func:`_kepler_lanes`), else the shared kernel inlined
-    (the bodies' solves overlap in the processor).  The same bits either way.
+    (the bodies' solves overlap in the processor: with effects in the loop, a step
+    of three bodies costs 15% more with it called, as :func:`_kepler_few` does).
+    The same bits either way.
 
     Returns the index of the first failure (NaN from the kernel), else -1."""
     n = q.shape[0]
@@ -75,6 +77,22 @@ def _kepler_all(q, u, mu, tau):  # pragma: no cover - compiled
     one = mu.shape[0] == 1
     for i in range(1, n):
         state = _kepler.propagate_uv_inline(
+            q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[0] if one else mu[i], tau
+        )
+        if not _store(q, u, i, state):
+            return i
+    return -1
+
+
+@njit(cache=True, error_model="numpy")
+def _kepler_few(q, u, mu, tau):  # pragma: no cover - compiled
+    """:func:`_kepler_all` below :data:`LANES_FROM` bodies, the shared kernel called,
+    not inlined (compiled once: a first run of a few bodies compiles neither its
+    inlined copy nor the lanes; without effects a step costs the same).  The same
+    bits."""
+    one = mu.shape[0] == 1
+    for i in range(1, q.shape[0]):
+        state = _kepler.propagate_uv(
             q[i, 0], q[i, 1], q[i, 2], u[i, 0], u[i, 1], u[i, 2], mu[0] if one else mu[i], tau
         )
         if not _store(q, u, i, state):
@@ -686,15 +704,18 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu, kick):
-    # pragma: no cover - compiled
+def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu, kick,
+                        few):  # pragma: no cover - compiled
     """:func:`_dh_steps` watching no event: the same arithmetic in the same order,
     the step's parts called from its own loop.  (Behind the nested inline wrappers of
     :func:`_kick_dh` and :func:`~hamilton_orbits._kernels.nbody.kick_rows`, arrays
     passed two levels deep keep reference counting in the loop: about 40% of a step
     at N = 2.)  A few massive bodies and no test particle: the pairs inlined, as
     ``kick_rows`` does; otherwise its spaced form, called.  ``has_extra`` is a
-    constant of the caller: the loop without effects has no trace of them."""
+    constant of the caller: the loop without effects has no trace of them.  ``few``
+    (True, or None: decided at compile time) for fewer than :data:`LANES_FROM`
+    bodies, all massive: only the forms those take are compiled (the pairs, the
+    Kepler solver one body after another: :func:`_kepler_few`), the same bits."""
     idx, m_tot, acc_m, r_in, v_in, acc_x, order, gm_c = kick
     compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == q.shape[0] - 1
     t_step = ws[0]
@@ -706,7 +727,10 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _jump(q, u, gm, 0.5 * h)
-            if compact:
+            if few is not None:
+                _nbody.compact_pairs(q, gm, idx, acc_m)
+                _nbody.kick_massive(u, idx, h, acc_m)
+            elif compact:
                 _nbody.compact_pairs(q, gm, idx, acc_m)
                 _nbody.kick_massive(u, idx, h, acc_m)
             else:
@@ -718,7 +742,10 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
             tau = 0.5 * (h + h_next)
             t_step += h
-        bad = _kepler_all(q, u, mu, tau)
+        if few is not None:
+            bad = _kepler_few(q, u, mu, tau)
+        else:
+            bad = _kepler_all(q, u, mu, tau)
         for k in range(3):
             com[k] += tau * com[3 + k]
         ws[0] += tau
@@ -729,9 +756,9 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
-                            kick):  # pragma: no cover - compiled
-    """:func:`_jacobi_steps` watching no event, as :func:`_dh_unwatched_steps`: the
-    same arithmetic in the same order."""
+                            kick, few):  # pragma: no cover - compiled
+    """:func:`_jacobi_steps` watching no event, as :func:`_dh_unwatched_steps` (``few``
+    alike): the same arithmetic in the same order."""
     idx, ratio, inv, acc, accj, acc_x, r_in, v_in, perm = kick
     compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == qj.shape[0]
     t_step = ws[0]
@@ -743,7 +770,9 @@ def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, d
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
-            if compact:
+            if few is not None:
+                _nbody.pairs_rows(r_in, gm, idx, acc)
+            elif compact:
                 _nbody.pairs_rows(r_in, gm, idx, acc)
             else:
                 _nbody.newtonian_rows_spaced(r_in, gm, idx, 0, acc)
@@ -754,7 +783,10 @@ def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, d
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
             tau = 0.5 * (h + h_next)
             t_step += h
-        bad = _kepler_all(qj, uj, eta, tau)
+        if few is not None:
+            bad = _kepler_few(qj, uj, eta, tau)
+        else:
+            bad = _kepler_all(qj, uj, eta, tau)
         for k in range(3):
             qj[0, k] += tau * uj[0, k]
         ws[0] += tau
@@ -772,7 +804,7 @@ _EVENT_ARGS = (F2, F2, types.int64[::1])
 @njit(cache=True, error_model="numpy")
 def _advance_dh(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
-    ws, effects,
+    ws, effects, few=None,
 ):  # pragma: no cover - compiled
     """The body of :func:`advance_dh` (``watch`` and ``effects`` None: no events, no
     effects), :func:`advance_dh_effects` (``effects`` True) and
@@ -807,9 +839,9 @@ def _advance_dh(
     # of a step at N = 2-3)
     if effects is not None:
         return _dh_unwatched_steps(True, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
-                                   kick)
+                                   kick, None)
     return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
-                               kick)
+                               kick, few)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -837,6 +869,17 @@ def advance_dh_effects(
                        None, None, None, ws, True)
 
 
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
+def advance_dh_few(
+    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_dh` for fewer than :data:`LANES_FROM` bodies, all massive (no
+    effect, no event): the same bits, without compiling the lanes of the Kepler
+    solver or the spaced kick (a first run of a few bodies compiles less)."""
+    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
+                       None, None, None, ws, None, True)
+
+
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
 def advance_dh_watched(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
@@ -852,7 +895,7 @@ def advance_dh_watched(
 @njit(cache=True, error_model="numpy")
 def _advance_jacobi(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
-    ev_count, ws, effects,
+    ev_count, ws, effects, few=None,
 ):  # pragma: no cover - compiled
     """The body of :func:`advance_jacobi` and :func:`advance_jacobi_watched`, as
     :func:`_advance_dh`."""
@@ -873,9 +916,9 @@ def _advance_jacobi(
     # as _advance_dh: the loop without effects has no trace of them
     if effects is not None:
         return _jacobi_unwatched_steps(True, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last,
-                                       ws, kick)
+                                       ws, kick, None)
     return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
-                                   kick)
+                                   kick, few)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -898,6 +941,16 @@ def advance_jacobi_effects(
     """:func:`advance_jacobi` with the listed effects (``has_extra`` True)."""
     return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
                            dt_last, None, None, None, ws, True)
+
+
+@entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
+def advance_jacobi_few(
+    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+):  # pragma: no cover - compiled
+    """:func:`advance_jacobi` for fewer than :data:`LANES_FROM` bodies, all massive,
+    as :func:`advance_dh_few`."""
+    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
+                           dt_last, None, None, None, ws, None, True)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")

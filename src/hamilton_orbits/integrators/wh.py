@@ -9,7 +9,9 @@ into
 - the Kepler part, each body on a Kepler orbit about ``G M_0`` (advanced
   exactly by the universal-variable kernel
   ``hamilton_orbits._kernels.kepler.propagate_uv``, shared, not copied:
-  the drift loop inlines its body, ``propagate_uv_inline``);
+  the drift loop inlines its body, ``propagate_uv_inline``, calls it for a few
+  bodies without effects, and from four bodies on solves several side by side,
+  ``propagate_lanes``);
 - the interaction part, the mutual attraction of the bodies ``i >= 1``
   (Hamilton's equation (B) without the central body), a kick of the ``u_i``;
 - the "jump" ``|sum_i m_i u_i|^2 / (2 m_0)``, a drift of every ``Q_i`` by
@@ -377,14 +379,19 @@ class _Split:
         watched = watch.shape[0] > 0
         ev = (watch, ev_out, ev_count, ws) if watched else (ws,)
         q, u = self.q, self.u
+        # (a few bodies, all massive: the same bits from an entry that compiles less)
+        few = not watched and not self.has_extra and q.shape[0] - 1 < _k.LANES_FROM \
+            and bool((self.g > 0.0).all())
         if not self.jacobi:
             kernel = (_k.advance_dh_watched if watched else
-                      _k.advance_dh_effects if self.has_extra else _k.advance_dh)
+                      _k.advance_dh_effects if self.has_extra else
+                      _k.advance_dh_few if few else _k.advance_dh)
             return kernel(self.extra, self.p, self.has_extra, self.order, q, u, self.g,
                           self.com, dt, n_steps, last, *ev)
         args = (self.extra, self.p, self.has_extra, self.order, q, u, self.g, self.eta)
         advance = (_k.advance_jacobi_watched if watched else
-                   _k.advance_jacobi_effects if self.has_extra else _k.advance_jacobi)
+                   _k.advance_jacobi_effects if self.has_extra else
+                   _k.advance_jacobi_few if few else _k.advance_jacobi)
         if not self.corrector:
             return advance(*args, dt, n_steps, last, *ev)
         # the corrector conjugates a run of equal steps: a shortened last step gets
