@@ -105,6 +105,13 @@ def newtonian(r, v, gm, acc):  # pragma: no cover - compiled
         _soa_massive(n, w)
         _scatter_massive(acc, gm, False, n, w)
         return
+    _pairs_all(r, gm, acc)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _pairs_all(r, gm, acc):  # pragma: no cover - compiled
+    """The pair form of :func:`newtonian` for every row (all massive)."""
+    n = r.shape[0]
     for k in range(n):
         acc[k, 0] = 0.0
         acc[k, 1] = 0.0
@@ -643,6 +650,15 @@ def closest_pair(r, gm):  # pragma: no cover - compiled
 def newtonian_only(r, v, gm, acc, p):  # pragma: no cover - compiled
     """The right-hand side with no effect listed: :func:`newtonian` (``p`` unused)."""
     newtonian(r, v, gm, acc)
+
+
+@njit(cache=True, error_model="numpy")
+def newtonian_few(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """:func:`newtonian_only` for fewer than :data:`SIMD_FROM` bodies, all massive: the
+    pair form alone, which is what :func:`newtonian` computes for them (the same
+    bits), so that a run of a few bodies compiles neither the SIMD form nor the
+    test particles' (``integrators._setup.force_arg`` chooses it)."""
+    _pairs_all(r, gm, acc)
 
 
 @njit(ACCEL_SIGNATURE, cache=True, error_model="numpy")

@@ -64,6 +64,30 @@ def is_address(arr: np.ndarray) -> bool:
     return id(arr) in _ADDRESS_IDS and arr.dtype == np.int64 and arr.shape == (2,)
 
 
+def force_arg(rhs: Any, gm: np.ndarray, watch: np.ndarray) -> np.ndarray:
+    """:func:`accel_arg` of ``rhs``'s right-hand side, or, for the right-hand side of
+    no effect with fewer than :data:`~hamilton_orbits._kernels.nbody.SIMD_FROM`
+    bodies, all massive, watching no event (the masses then never change), of
+    :func:`~hamilton_orbits._kernels.nbody.newtonian_few`: the same bits, and a first
+    run of a few bodies compiles neither the SIMD form nor the test particles'.
+
+    Examples
+    --------
+    >>> from hamilton_orbits._kernels import nbody
+    >>> from hamilton_orbits.rhs import newtonian_rhs
+    >>> few = force_arg(newtonian_rhs(), np.array([1.0, 1e-3]), np.zeros((0, 5)))
+    >>> few is accel_arg(nbody.newtonian_few)
+    True
+    >>> force_arg(newtonian_rhs(), np.array([1.0, 0.0]), np.zeros((0, 5))) is few
+    False
+    """
+    fn = rhs.accel
+    if (fn is _nbody.newtonian_only and watch.shape[0] == 0 and gm.shape[0] < _nbody.SIMD_FROM
+            and bool((gm > 0.0).all())):
+        fn = _nbody.newtonian_few
+    return accel_arg(fn)
+
+
 def accel_arg(fn: Any) -> np.ndarray:
     """The addresses of a right-hand side ``fn`` (:data:`ACCEL_SIGNATURE`) for a
     stepping kernel (:func:`addresses`)."""

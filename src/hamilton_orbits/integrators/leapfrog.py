@@ -17,7 +17,7 @@ from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
-from hamilton_orbits.integrators._setup import accel_arg, check_step_count
+from hamilton_orbits.integrators._setup import check_step_count, force_arg
 from hamilton_orbits.integrators.methods import Leapfrog
 from hamilton_orbits.rhs import run_parameters
 
@@ -89,9 +89,9 @@ class _State:
         self.r = np.ascontiguousarray(r0, dtype=np.float64).copy()
         self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
         self.gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
-        self.accel, self.p = accel_arg(rhs.accel), run_parameters(rhs)  # (the kernels
-        # write its clock)
         self.log = events if events is not None else EventLog.none(self.r.shape[0])
+        self.accel = force_arg(rhs, self.gm, self.log.watch)
+        self.p = run_parameters(rhs)  # (the kernels write its clock)
         self.dt, self.max_steps, self.t, self.steps = dt, max_steps, t0, 0
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

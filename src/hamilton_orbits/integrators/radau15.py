@@ -282,7 +282,7 @@ class _Run:
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
         m = 3 * r0.shape[0]
         self.rhs, self.gm, self.log, self.max_steps = rhs, gm, log, max_steps
-        self.accel = _setup.accel_arg(rhs.accel)
+        self.accel = _setup.force_arg(rhs, gm, log.watch)
         self.work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
         self.csx = np.zeros(m)
         self.csv = np.zeros(m)
