@@ -253,37 +253,37 @@ class Saving:
         and is read without its checks (without events: they would drain)."""
         arch, prop, cache = self._archive, self._prop, self._record_cache
         known = cache.get("appended")
-        if again and known is not None and known[0] is arch.segment and prop.events is None \
-                and (rows is None or rows.times is None):
+        same = known is not None and known[0] is arch.segment and (
+            rows is None or rows.times is None)
+        if same and again and prop.events is None:
             capture = known[2][0]
-            taken = capture.reread(prop)
-            if taken is not None and arch.refill(prop.t, prop.r, prop.v, prop.gm,
-                                                 all_active(prop.r.shape[0]), *taken,
-                                                 prop.steps, capture.ints):
+            if self._refilled(capture, capture.reread(prop)):
                 return
         extra = self._extra(rows)
-        if known is not None and known[0] is arch.segment and prop.events is None \
-                and (rows is None or (rows.times is None and not rows.rows)) \
-                and known[1] == extra:  # (a scheduled snapshot between outputs: no row
-            capture = known[2][0]  # pending, the graph's shape checked by ``take``)
-            taken = capture.take(prop)
-            if taken is not None and arch.refill(prop.t, prop.r, prop.v, prop.gm,
-                                                 all_active(prop.r.shape[0]), *taken,
-                                                 prop.steps, capture.ints):
-                return
-        if known is not None and known[0] is arch.segment and known[1] == extra and (
-                rows is None or rows.times is None):
+        if same and known[1] == extra:
             capture, _, index = known[2]
             if prop.events is not None:
                 prop.events.drain()  # (as a whole snapshot does)
             taken = capture.take(prop)
             if taken is not None:
+                if prop.events is None and (rows is None or not rows.rows) and \
+                        self._refilled(capture, taken):  # (a scheduled snapshot between
+                    return  # outputs, no row pending: the last record refilled)
                 values = state_values(prop, taken[0], index, taken[1], capture.ints)
                 values["steps"] = prop.steps
                 arch.append(values, {} if rows is None else rows.take())
                 return
         arch.write(*self._record(rows, archive=True))
         cache["appended"] = (arch.segment, extra, cache["capture"])
+
+    def _refilled(self, capture: Any, taken: Any) -> bool:
+        """Whether the archive appended the propagation's state by refilling its last
+        record (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.refill`) from what
+        ``capture`` ``taken``; False, nothing written, where it cannot."""
+        prop = self._prop
+        return taken is not None and self._archive.refill(
+            prop.t, prop.r, prop.v, prop.gm, all_active(prop.r.shape[0]), *taken, prop.steps,
+            capture.ints)
 
     def _record(self, rows: Any = None, archive: bool = False) -> tuple[Any, ...]:
         meta, arrays, dims, units = record(self._system, *self._spec, self._prop,
