@@ -510,9 +510,11 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g, 
     return _all_finite(b[6])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
     """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
+    (Called from the loop, not inlined: inlined, its two rules cost 0.5 s more of
+    a first run's compilation; called once a step, the call costs nothing measurable.)
 
     Adaptive (``st[ST_EPSILON] > 0``): rejects when the rule asks for less than a quarter
     of the step; growth is limited to 4x relative to the step that was planned
@@ -585,14 +587,16 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
     return h
 
 
-@njit(cache=True)
 def _steps(
-    accel, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
+    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
     ev_count,
 ):  # pragma: no cover - compiled
-    """The loop of :func:`advance` and :func:`advance_watched`: step from ``st[ST_T]``
-    to ``t_end`` in place; returns ``(steps, status)``.  ``accel`` is the right-hand
-    side (a first-class function); ``watch`` None (no events) or an array.
+    """The loop of :func:`advance` and :func:`advance_watched`, and their body (each
+    compiled from it with its own signature, not a wrapper calling it: numba would
+    optimise the loop's machine code again in the wrapper, 0.6 s of a first run):
+    step from ``st[ST_T]`` to ``t_end`` in place; returns ``(steps, status)``.
+    ``accel_addr`` are the addresses of the right-hand side (a first-class function
+    inside); ``watch`` None (no events) or an array.
 
     ``st`` is the :data:`NSTATE` state (``epsilon = 0``: fixed steps of ``dt``;
     ``prs23 != 0``: the rule of Pham, Rein & Spiegel 2024, else the global one
@@ -610,6 +614,7 @@ def _steps(
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
     the start state only when events are watched.
     """
+    accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
     # the start of a step, for the events' scan (``watch is None`` is decided at
@@ -686,30 +691,17 @@ def _steps(
 
 _ADVANCE_ARGS = (ADDRESSES, _F1, _F2, _F2, _F1, types.float64, _F1, _F2, _F2, _F2, _F2, _F1, _F1,
                  types.boolean, types.int64)
+_RESULT = types.Tuple((types.int64, types.int64))
 
-
-@entry(types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS), cache=True, nogil=True)
-def advance(
-    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps,
-):  # pragma: no cover - compiled
-    """Step from ``st[ST_T]`` to ``t_end`` in place, watching no events; returns
-    ``(steps, status)`` (see :func:`_steps`).  No event code is compiled into it."""
-    return _steps(accel_at(accel_addr[0], accel_addr[1]), p, r, v, gm, t_end, st, b, br, d,
-                  g, csx, csv, need_v, max_steps, None, None, None)
-
-
-@entry(
-    types.Tuple((types.int64, types.int64))(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
-    cache=True, nogil=True,
-)
-def advance_watched(
-    accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
-    ev_count,
-):  # pragma: no cover - compiled
-    """:func:`advance` watching the events ``watch`` (at least one row), recorded into
-    ``ev_out`` / ``ev_count``."""
-    return _steps(accel_at(accel_addr[0], accel_addr[1]), p, r, v, gm, t_end, st, b, br, d,
-                  g, csx, csv, need_v, max_steps, watch, ev_out, ev_count)
+#: Step from ``st[ST_T]`` to ``t_end`` in place, watching no events (the last three
+#: arguments None); returns ``(steps, status)`` (see :func:`_steps`).  No event code
+#: is compiled into it.
+advance = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none), name="advance",
+                cache=True, nogil=True)(_steps)
+#: :func:`advance` watching the events ``watch`` (at least one row), recorded into
+#: ``ev_out`` / ``ev_count``.
+advance_watched = entry(_RESULT(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
+                        name="advance_watched", cache=True, nogil=True)(_steps)
 
 
 # ---------------------------------------------------------------------------

@@ -549,20 +549,24 @@ def corrector_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, sign,
 def dh_from_inertial(r, v, g, order, q, u, com):  # pragma: no cover - compiled
     """Heliocentric positions ``q`` and barycentric velocities ``u`` (row ``i`` is
     body ``order[i]``; ``order[0]`` the central body) and the barycentre ``com``
-    (position, velocity) from inertial ``r``, ``v``."""
+    (position, velocity) from inertial ``r``, ``v``.  (Sums in scalars, not a
+    work array: no array constructor to compile for a first run.)"""
     n = r.shape[0]
     m_tot = 0.0
-    s = np.zeros(6)
+    sx = sy = sz = su = sv = sw = 0.0
     for i in range(n):  # row by row: one pass over memory
         j = order[i]
         gi = g[i]
         m_tot += gi
         if gi != 0.0:
-            for k in range(3):
-                s[k] += gi * r[j, k]
-                s[3 + k] += gi * v[j, k]
-    for k in range(6):
-        com[k] = s[k] / m_tot
+            sx += gi * r[j, 0]
+            sy += gi * r[j, 1]
+            sz += gi * r[j, 2]
+            su += gi * v[j, 0]
+            sv += gi * v[j, 1]
+            sw += gi * v[j, 2]
+    com[0], com[1], com[2] = sx / m_tot, sy / m_tot, sz / m_tot
+    com[3], com[4], com[5] = su / m_tot, sv / m_tot, sw / m_tot
     c = order[0]
     cx, cy, cz = r[c, 0], r[c, 1], r[c, 2]
     wx, wy, wz = com[3], com[4], com[5]
@@ -579,30 +583,34 @@ def dh_from_inertial(r, v, g, order, q, u, com):  # pragma: no cover - compiled
 @njit(cache=True, error_model="numpy")
 def dh_to_inertial(q, u, g, com, order, r, v):  # pragma: no cover - compiled
     """Inertial ``r``, ``v`` (body ``order[i]`` from row ``i``) from the
-    coordinates of :func:`dh_from_inertial`."""
+    coordinates of :func:`dh_from_inertial` (sums in scalars, as there)."""
     n = q.shape[0]
     m_tot = g[0]
-    s = np.zeros(6)
+    sx = sy = sz = su = sv = sw = 0.0
     for i in range(1, n):
         gi = g[i]
         m_tot += gi
         if gi != 0.0:
-            for k in range(3):
-                s[k] += gi * q[i, k]
-                s[3 + k] += gi * u[i, k]
-    x0 = np.empty(6)
-    for k in range(3):
-        x0[k] = com[k] - s[k] / m_tot
-        x0[3 + k] = com[3 + k] - s[3 + k] / g[0]
+            sx += gi * q[i, 0]
+            sy += gi * q[i, 1]
+            sz += gi * q[i, 2]
+            su += gi * u[i, 0]
+            sv += gi * u[i, 1]
+            sw += gi * u[i, 2]
+    x0, y0, z0 = com[0] - sx / m_tot, com[1] - sy / m_tot, com[2] - sz / m_tot
     c = order[0]
-    for k in range(3):
-        r[c, k] = x0[k]
-        v[c, k] = x0[3 + k]
+    r[c, 0], r[c, 1], r[c, 2] = x0, y0, z0
+    v[c, 0] = com[3] - su / g[0]
+    v[c, 1] = com[4] - sv / g[0]
+    v[c, 2] = com[5] - sw / g[0]
     for i in range(1, n):
         j = order[i]
-        for k in range(3):
-            r[j, k] = q[i, k] + x0[k]
-            v[j, k] = u[i, k] + com[3 + k]
+        r[j, 0] = q[i, 0] + x0
+        r[j, 1] = q[i, 1] + y0
+        r[j, 2] = q[i, 2] + z0
+        v[j, 0] = u[i, 0] + com[3]
+        v[j, 1] = u[i, 1] + com[4]
+        v[j, 2] = u[i, 2] + com[5]
 
 
 @njit(cache=True, error_model="numpy")
@@ -801,47 +809,37 @@ _RESULT = types.Tuple((types.int64, types.int64, types.int64))
 _EVENT_ARGS = (F2, F2, types.int64[::1])
 
 
-@njit(cache=True, error_model="numpy")
-def _advance_dh(
-    extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, watch, ev_out, ev_count,
-    ws, effects, few=None,
-):  # pragma: no cover - compiled
-    """The body of :func:`advance_dh` (``watch`` and ``effects`` None: no events, no
-    effects), :func:`advance_dh_effects` (``effects`` True) and
-    :func:`advance_dh_watched`.  ``watch is None`` and ``effects is None`` are
-    decided at compile time, so an entry compiles only its own loop."""
-    extra = accel_at(extra_addr[0], extra_addr[1])
-    n = q.shape[0]
+@njit(cache=True, inline="always", error_model="numpy")
+def _dh_setup(gm, watched, has_extra, order, gm_c):  # pragma: no cover - compiled
+    """The work arrays of a run in democratic heliocentric coordinates: the
+    drifts' start states for the events' scan (``watched``), the Kepler
+    parameters ``mu`` (and ``mu_s``, the scan's: the central body rests at the
+    origin of these coordinates) and the kick's arrays (the effects' only with
+    ``has_extra``; the planets' mutual pulls between the massive rows >= 1, found
+    once, not per step; ``order`` and ``gm_c`` go with them: see
+    :func:`_effects_kick_dh`).  Inlined into each entry (an entry calling one shared
+    body would have numba optimise that body's machine code twice)."""
+    n = gm.shape[0]
     m = n if has_extra else 0  # the effects' work arrays (n, 3), or none
     r_in = np.empty((m, 3))
     v_in = np.empty((m, 3))
     acc_x = np.empty((m, 3))
-    w = 0 if watch is None else n  # the drifts' start states for the events' scan
+    w = n if watched else 0
     x0, v0 = np.empty((w, 3)), np.empty((w, 3))
     m_tot = 0.0
     for i in range(n):
         m_tot += gm[i]
-    # the planets' mutual pulls: massive rows >= 1 (found once, not per step);
-    # row 0 (unused here) is left out of the interaction
     idx = _nbody.massive_indices(gm)
-    if idx.shape[0] > 0 and idx[0] == 0:
+    if idx.shape[0] > 0 and idx[0] == 0:  # (row 0, unused here, is left out)
         idx = idx[1:]
     acc_m = np.empty((idx.shape[0], 3))
-    mu = np.full(1, gm[0])  # every body about the central one
-    mu_s = np.full(w, gm[0])
-    if watch is not None:
-        mu_s[0] = 0.0  # the central body rests at the origin of these coordinates
-    kick = (idx, m_tot, acc_m, r_in, v_in, acc_x, order, caller_gm(gm, order))
-    if watch is not None:
-        return _dh_steps(watch.shape[0] > 0, extra, p, has_extra, q, u, gm, com, dt, n_steps,
-                         dt_last, watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
-    # the loop without effects has no trace of them (their branches cost up to 30%
-    # of a step at N = 2-3)
-    if effects is not None:
-        return _dh_unwatched_steps(True, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
-                                   kick, None)
-    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
-                               kick, few)
+    mu = np.empty(1)  # every body about the central one
+    mu[0] = gm[0]
+    mu_s = np.empty(w)
+    if watched:
+        mu_s[:] = gm[0]
+        mu_s[0] = 0.0
+    return x0, v0, mu, mu_s, (idx, m_tot, acc_m, r_in, v_in, acc_x, order, gm_c)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -855,9 +853,12 @@ def advance_dh(
     is the caller's body ``order[i]`` (the listed effects see the caller's order:
     their parameters name bodies by its indices); ``ws``: see :func:`_drift`
     (``ws[0]`` the start time).  Returns ``(steps, bad, status)`` with ``bad`` the
-    index of a body whose Kepler step failed, else -1."""
-    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       None, None, None, ws, None)
+    index of a body whose Kepler step failed, else -1.  The loop without effects
+    has no trace of them (their branches cost up to 30% of a step at N = 2-3)."""
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, mu, _, kick = _dh_setup(gm, False, False, order, gm)
+    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                               kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -865,8 +866,10 @@ def advance_dh_effects(
     extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
     """:func:`advance_dh` with the listed effects (``has_extra`` True)."""
-    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       None, None, None, ws, True)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, mu, _, kick = _dh_setup(gm, False, True, order, caller_gm(gm, order))
+    return _dh_unwatched_steps(True, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                               kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -876,8 +879,10 @@ def advance_dh_few(
     """:func:`advance_dh` for fewer than :data:`LANES_FROM` bodies, all massive (no
     effect, no event): the same bits, without compiling the lanes of the Kepler
     solver or the spaced kick (a first run of a few bodies compiles less)."""
-    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       None, None, None, ws, None, True)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, mu, _, kick = _dh_setup(gm, False, False, order, gm)
+    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                               kick, True)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -888,19 +893,17 @@ def advance_dh_watched(
     """:func:`advance_dh` watching the events ``watch``, recorded into ``ev_out`` /
     ``ev_count`` (see :func:`_drift`); at ``STATUS_EVENT`` or ``STATUS_DRAIN`` the
     state is synchronised at the end of step ``steps``."""
-    return _advance_dh(extra_addr, p, has_extra, order, q, u, gm, com, dt, n_steps, dt_last,
-                       watch, ev_out, ev_count, ws, None)
-
-
-@njit(cache=True, error_model="numpy")
-def _advance_jacobi(
-    extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, watch, ev_out,
-    ev_count, ws, effects, few=None,
-):  # pragma: no cover - compiled
-    """The body of :func:`advance_jacobi` and :func:`advance_jacobi_watched`, as
-    :func:`_advance_dh`."""
     extra = accel_at(extra_addr[0], extra_addr[1])
-    n = qj.shape[0]
+    x0, v0, mu, mu_s, kick = _dh_setup(gm, True, has_extra, order, caller_gm(gm, order))
+    return _dh_steps(watch.shape[0] > 0, extra, p, has_extra, q, u, gm, com, dt, n_steps,
+                     dt_last, watch, ev_out, ev_count, ws, x0, v0, mu, mu_s, kick)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _jacobi_setup(has_extra, order, gm, eta):  # pragma: no cover - compiled
+    """The kick's arrays of a run in Jacobi coordinates and the drifts' start
+    states for the events' scan, as :func:`_dh_setup`."""
+    n = gm.shape[0]
     acc = np.empty((n, 3))
     accj = np.empty((n, 3))
     acc_x = np.empty((n, 3))
@@ -909,16 +912,8 @@ def _advance_jacobi(
     x0, v0 = np.empty((n, 3)), np.empty((n, 3))
     idx = _nbody.massive_indices(gm)
     ratio, inv = jacobi_factors(eta)
-    kick = (idx, ratio, inv, acc, accj, acc_x, r_in, v_in, _perm(has_extra, order, gm))
-    if watch is not None:
-        return _jacobi_steps(watch.shape[0] > 0, extra, p, has_extra, qj, uj, gm, eta, dt,
-                             n_steps, dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)
-    # as _advance_dh: the loop without effects has no trace of them
-    if effects is not None:
-        return _jacobi_unwatched_steps(True, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last,
-                                       ws, kick, None)
-    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
-                                   kick, few)
+    return x0, v0, (idx, ratio, inv, acc, accj, acc_x, r_in, v_in,
+                    _perm(has_extra, order, gm))
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -930,8 +925,10 @@ def advance_jacobi(
     sum_{j<=i} G m_j``.  Kick: the inertial accelerations (all pairs, and the
     listed effects) in Jacobi form plus ``G eta_i qj_i / |qj_i|^3``, which
     removes the part the Kepler step already accounts for."""
-    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, None, None, None, ws, None)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
+    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+                                   kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -939,8 +936,10 @@ def advance_jacobi_effects(
     extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
 ):  # pragma: no cover - compiled
     """:func:`advance_jacobi` with the listed effects (``has_extra`` True)."""
-    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, None, None, None, ws, True)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
+    return _jacobi_unwatched_steps(True, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+                                   kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -949,8 +948,10 @@ def advance_jacobi_few(
 ):  # pragma: no cover - compiled
     """:func:`advance_jacobi` for fewer than :data:`LANES_FROM` bodies, all massive,
     as :func:`advance_dh_few`."""
-    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, None, None, None, ws, None, True)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
+    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+                                   kick, True)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, *_EVENT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -960,5 +961,7 @@ def advance_jacobi_watched(
 ):  # pragma: no cover - compiled
     """:func:`advance_jacobi` watching the events ``watch`` (see
     :func:`advance_dh_watched`)."""
-    return _advance_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, n_steps,
-                           dt_last, watch, ev_out, ev_count, ws, None)
+    extra = accel_at(extra_addr[0], extra_addr[1])
+    x0, v0, kick = _jacobi_setup(has_extra, order, gm, eta)
+    return _jacobi_steps(watch.shape[0] > 0, extra, p, has_extra, qj, uj, gm, eta, dt,
+                         n_steps, dt_last, watch, ev_out, ev_count, ws, x0, v0, kick)

@@ -348,7 +348,8 @@ class _Run:
                     *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
                     log.count)
             else:
-                steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget)
+                steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget, None,
+                                            None, None)
             self.steps += steps
             if status == _k.STATUS_MAXSTEPS:
                 _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
