@@ -735,10 +735,7 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _jump(q, u, gm, 0.5 * h)
-            if few is not None:
-                _nbody.compact_pairs(q, gm, idx, acc_m)
-                _nbody.kick_massive(u, idx, h, acc_m)
-            elif compact:
+            if few is not None or compact:  # (one inlined copy of the pairs)
                 _nbody.compact_pairs(q, gm, idx, acc_m)
                 _nbody.kick_massive(u, idx, h, acc_m)
             else:
@@ -778,9 +775,7 @@ def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, d
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
-            if few is not None:
-                _nbody.pairs_rows(r_in, gm, idx, acc)
-            elif compact:
+            if few is not None or compact:  # (one inlined copy of the pairs)
                 _nbody.pairs_rows(r_in, gm, idx, acc)
             else:
                 _nbody.newtonian_rows_spaced(r_in, gm, idx, 0, acc)
