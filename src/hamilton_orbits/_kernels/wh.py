@@ -712,15 +712,19 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu, kick,
-                        few):  # pragma: no cover - compiled
+def _dh_unwatched_steps(effects_kick, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+                        kick, few):  # pragma: no cover - compiled
     """:func:`_dh_steps` watching no event: the same arithmetic in the same order,
     the step's parts called from its own loop.  (Behind the nested inline wrappers of
     :func:`_kick_dh` and :func:`~hamilton_orbits._kernels.nbody.kick_rows`, arrays
     passed two levels deep keep reference counting in the loop: about 40% of a step
     at N = 2.)  A few massive bodies and no test particle: the pairs inlined, as
-    ``kick_rows`` does; otherwise its spaced form, called.  ``has_extra`` is a
-    constant of the caller: the loop without effects has no trace of them.  ``few``
+    ``kick_rows`` does; otherwise its spaced form, called.  ``effects_kick`` is
+    :func:`_effects_kick_dh` or None, a constant of the caller: the loop without
+    effects has no trace of them (numba prunes the branches on it once this loop
+    is inlined; the call, made through this argument, is inlined only where it
+    stays: tested on a flag, it was inlined into every entry first and pruned after,
+    0.25 s of compilation for nothing).  ``few``
     (True, or None: decided at compile time) for fewer than :data:`LANES_FROM`
     bodies, all massive: only the forms those take are compiled (the pairs, the
     Kepler solver one body after another: :func:`_kepler_few`), the same bits."""
@@ -732,7 +736,7 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
             tau = 0.5 * (dt if n_steps > 1 else dt_last)
         else:
             h = dt if s < n_steps - 1 else dt_last
-            if has_extra:
+            if effects_kick is not None:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _jump(q, u, gm, 0.5 * h)
             if few is not None or compact:  # (one inlined copy of the pairs)
@@ -740,9 +744,8 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
                 _nbody.kick_massive(u, idx, h, acc_m)
             else:
                 _nbody.kick_rows_spaced(q, gm, idx, 1, h, u, acc_m)
-            if has_extra:
-                _effects_kick_dh(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order,
-                                 gm_c)
+            if effects_kick is not None:
+                effects_kick(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order, gm_c)
             _jump(q, u, gm, 0.5 * h)
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
             tau = 0.5 * (h + h_next)
@@ -760,10 +763,11 @@ def _dh_unwatched_steps(has_extra, extra, p, q, u, gm, com, dt, n_steps, dt_last
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
-                            kick, few):  # pragma: no cover - compiled
-    """:func:`_jacobi_steps` watching no event, as :func:`_dh_unwatched_steps` (``few``
-    alike): the same arithmetic in the same order."""
+def _jacobi_unwatched_steps(effects_jacobi, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last,
+                            ws, kick, few):  # pragma: no cover - compiled
+    """:func:`_jacobi_steps` watching no event, as :func:`_dh_unwatched_steps`
+    (``effects_jacobi`` :func:`_effects_jacobi` or None; ``few`` alike): the same
+    arithmetic in the same order."""
     idx, ratio, inv, acc, accj, acc_x, r_in, v_in, perm = kick
     compact = idx.shape[0] < _nbody.SIMD_FROM and idx.shape[0] == qj.shape[0]
     t_step = ws[0]
@@ -772,15 +776,15 @@ def _jacobi_unwatched_steps(has_extra, extra, p, qj, uj, gm, eta, dt, n_steps, d
             tau = 0.5 * (dt if n_steps > 1 else dt_last)
         else:
             h = dt if s < n_steps - 1 else dt_last
-            if has_extra:
+            if effects_jacobi is not None:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
             if few is not None or compact:  # (one inlined copy of the pairs)
                 _nbody.pairs_rows(r_in, gm, idx, acc)
             else:
                 _nbody.newtonian_rows_spaced(r_in, gm, idx, 0, acc)
-            if has_extra:
-                _effects_jacobi(extra, p, uj, gm, eta, h, True, acc, acc_x, r_in, v_in, perm)
+            if effects_jacobi is not None:
+                effects_jacobi(extra, p, uj, gm, eta, h, True, acc, acc_x, r_in, v_in, perm)
             _inertial_to_jacobi_acc(acc, gm, inv, accj)
             _kick_interaction(qj, uj, eta, accj, h)
             h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
@@ -852,7 +856,7 @@ def advance_dh(
     has no trace of them (their branches cost up to 30% of a step at N = 2-3)."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, mu, _, kick = _dh_setup(gm, False, False, order, gm)
-    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+    return _dh_unwatched_steps(None, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
                                kick, None)
 
 
@@ -863,8 +867,8 @@ def advance_dh_effects(
     """:func:`advance_dh` with the listed effects (``has_extra`` True)."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, mu, _, kick = _dh_setup(gm, False, True, order, caller_gm(gm, order))
-    return _dh_unwatched_steps(True, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
-                               kick, None)
+    return _dh_unwatched_steps(_effects_kick_dh, extra, p, q, u, gm, com, dt, n_steps, dt_last,
+                               ws, mu, kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -876,7 +880,7 @@ def advance_dh_few(
     solver or the spaced kick (a first run of a few bodies compiles less)."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, mu, _, kick = _dh_setup(gm, False, False, order, gm)
-    return _dh_unwatched_steps(False, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
+    return _dh_unwatched_steps(None, extra, p, q, u, gm, com, dt, n_steps, dt_last, ws, mu,
                                kick, True)
 
 
@@ -922,7 +926,7 @@ def advance_jacobi(
     removes the part the Kepler step already accounts for."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
-    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+    return _jacobi_unwatched_steps(None, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
                                    kick, None)
 
 
@@ -933,8 +937,8 @@ def advance_jacobi_effects(
     """:func:`advance_jacobi` with the listed effects (``has_extra`` True)."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
-    return _jacobi_unwatched_steps(True, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
-                                   kick, None)
+    return _jacobi_unwatched_steps(_effects_jacobi, extra, p, qj, uj, gm, eta, dt, n_steps,
+                                   dt_last, ws, kick, None)
 
 
 @entry(_RESULT(*_SPLIT_ARGS, F1), cache=True, nogil=True, error_model="numpy")
@@ -945,7 +949,7 @@ def advance_jacobi_few(
     as :func:`advance_dh_few`."""
     extra = accel_at(extra_addr[0], extra_addr[1])
     _, _, kick = _jacobi_setup(has_extra, order, gm, eta)
-    return _jacobi_unwatched_steps(False, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
+    return _jacobi_unwatched_steps(None, extra, p, qj, uj, gm, eta, dt, n_steps, dt_last, ws,
                                    kick, True)
 
 
