@@ -3,6 +3,7 @@ package really compiles, at most once per process."""
 
 from __future__ import annotations
 
+import gc
 import os
 import subprocess
 import sys
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import pytest
 from numba import njit
+from numba.core import event
 
 from hamilton_orbits import firstrun
 
@@ -51,6 +53,41 @@ def _run(code: str, cache_dir: str | None = None) -> subprocess.CompletedProcess
 
 
 CALL = "from hamilton_orbits import solve_kepler; print(float(solve_kepler(0.5, 0.1)))"
+
+
+class _GcAtStart(event.Listener):
+    """Records whether the garbage collector runs when each compilation starts."""
+
+    def __init__(self) -> None:
+        self.seen: list[bool] = []
+
+    def on_start(self, ev: event.Event) -> None:
+        self.seen.append(gc.isenabled())
+
+    def on_end(self, ev: event.Event) -> None:
+        pass
+
+
+@pytest.mark.parametrize(("module", "paused"), [("hamilton_orbits._probe", True),
+                                                ("someone_else", False)])
+def test_the_garbage_collector_pauses_while_our_kernels_compile(module, paused):
+    """Paused from the start of the package's compilation to its end, restored after;
+    another package's compilation is left alone."""
+    listener = _GcAtStart()
+    with event.install_listener("numba:compile", listener):
+        assert njit(_fresh_function(module))(1.0) == 3.0
+    assert listener.seen and listener.seen[0] is not paused
+    assert gc.isenabled()
+
+
+def test_a_paused_collector_stays_paused():
+    """A collector the caller turned off is not turned on by a compilation."""
+    gc.disable()
+    try:
+        assert njit(_fresh_function("hamilton_orbits._probe"))(1.0) == 3.0
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
 
 
 def test_no_notice_when_warm():
