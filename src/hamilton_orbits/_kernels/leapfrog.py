@@ -57,10 +57,12 @@ def _drift(r, v, h, t, watch, ev_out, ev_count, ws, x0, cm_gm):  # pragma: no co
             ws[2] = 1.0
 
 
-@njit(cache=True, error_model="numpy")
 def _advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws, max_steps):
     # pragma: no cover - compiled
-    """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
+    """The body of :func:`advance` (``watch``, ``ev_out``, ``ev_count`` None) and
+    :func:`advance_watched`, each compiled from it with its own signature (not a
+    wrapper calling it: see ``docs/design.md``, "Entries are bodies, not wrappers").
+    Steps of at most ``dt`` from ``t0`` to exactly ``t1`` (the steps equal, the
     count rounded up), each ``r += h/2 v; v += h a(r); r += h/2 v``, in place.
     Returns ``(steps, status)``; at ``STATUS_EVENT`` (an event with an action) or
     ``STATUS_DRAIN`` the run stopped at the end of step ``steps``, the time in
@@ -99,18 +101,11 @@ _ARGS = (ADDRESSES, F1, F2, F2, F1, types.float64, types.float64, types.float64)
 _RESULT = types.Tuple((types.int64, types.int64))
 
 
-@entry(_RESULT(*_ARGS, F1, types.int64), cache=True, nogil=True, error_model="numpy")
-def advance(accel_addr, p, r, v, gm, t0, t1, dt, ws, max_steps):  # pragma: no cover - compiled
-    """Steps of at most ``dt`` from ``t0`` to exactly ``t1`` watching no events (see
-    :func:`_advance`); no event code is compiled into it."""
-    return _advance(accel_addr, p, r, v, gm, t0, t1, dt, None, None, None, ws, max_steps)
-
-
-@entry(_RESULT(*_ARGS, F2, F2, types.int64[::1], F1, types.int64), cache=True, nogil=True,
-       error_model="numpy")
-def advance_watched(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws,
-                    max_steps):  # pragma: no cover - compiled
-    """:func:`advance` watching the events ``watch``, recorded into ``ev_out`` /
-    ``ev_count``."""
-    return _advance(accel_addr, p, r, v, gm, t0, t1, dt, watch, ev_out, ev_count, ws,
-                    max_steps)
+#: Steps of at most ``dt`` from ``t0`` to exactly ``t1`` watching no events (the
+#: three event arguments None; see :func:`_advance`): no event code is compiled into it.
+advance = entry(_RESULT(*_ARGS, types.none, types.none, types.none, F1, types.int64),
+                name="advance", cache=True, nogil=True, error_model="numpy")(_advance)
+#: :func:`advance` watching the events ``watch``, recorded into ``ev_out`` / ``ev_count``.
+advance_watched = entry(_RESULT(*_ARGS, F2, F2, types.int64[::1], F1, types.int64),
+                        name="advance_watched", cache=True, nogil=True,
+                        error_model="numpy")(_advance)

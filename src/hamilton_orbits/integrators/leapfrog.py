@@ -128,7 +128,7 @@ class _State:
                 done, status = _k.advance_watched(*args, log.watch, log.buffer, log.count, ws,
                                                   SLICE)
             else:
-                done, status = _k.advance(*args, ws, SLICE)
+                done, status = _k.advance(*args, None, None, None, ws, SLICE)
             self.steps += int(done)
             t = self.t = float(ws[0])
             if status == _k.STATUS_OK:
