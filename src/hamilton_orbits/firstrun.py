@@ -14,7 +14,7 @@ The same listener keeps a clock of compilation (:func:`compile_seconds`,
 (a function compiling the functions it calls is one event), so that a run can
 report its integration time without the compilation that happened inside it,
 and the compilation on its own line.  It also pauses Python's garbage collector
-while a kernel of the package compiles (:func:`_pause_gc`: a fifth of a first
+while a kernel of the package compiles (a fifth of a first
 run's compilation).
 
 Public: ``rigid``'s kernels and scenes report their compilation through it.
