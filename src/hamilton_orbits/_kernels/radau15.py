@@ -667,10 +667,9 @@ def _steps(
         if not _all_finite(b[6]):
             status = STATUS_NONFINITE
             break
-        if st[ST_EPSILON] > 0.0:  # adaptive: the step-size rule (called, not inlined)
-            dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing)
-        else:  # fixed steps: no call
-            dt_new, ok = dt, True
+        # adaptive: the step-size rule (called, not inlined); fixed steps: no call
+        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing) \
+            if st[ST_EPSILON] > 0.0 else (dt, True)
         if not ok:
             dt = dt_new
             continue
