@@ -21,7 +21,6 @@ The Earth's pole (polar motion, the Chandler wobble, prediction) is in
 """
 
 
-from rigid import earth, polar_motion  # noqa: F401  (submodules: rigid.earth, ...)
 from rigid.body import BodySI, RigidBody
 from rigid.free import (
     FreeMotion,
@@ -62,3 +61,15 @@ __all__: list[str] = [
     "poinsot",
     "time_between",
 ]
+
+
+def __getattr__(name: str):
+    """``rigid.earth`` and ``rigid.polar_motion`` imported on first use: ``import
+    rigid`` (which every ``hamilton-orbits`` command's scene-kind lookup does) leaves
+    out the polar-motion record, its fit and its predictions (astropy tables)."""
+    if name in ("earth", "polar_motion"):
+        import importlib
+
+        return importlib.import_module(f"rigid.{name}")
+    raise AttributeError(f"module 'rigid' has no attribute {name!r}")
+

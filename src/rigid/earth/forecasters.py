@@ -58,7 +58,6 @@ from typing import Any
 
 import astropy.units as u
 import numpy as np
-from scipy.signal import lfilter
 
 from hamilton_orbits.units import DIMENSIONLESS, TIME
 from rigid.earth.ar_models import accumulate_covariance, fit_var
@@ -126,6 +125,8 @@ def _step_factor(period: float, q: float, step: float) -> complex:
 
 def _propagate(m0: complex, chi: np.ndarray, a: complex) -> np.ndarray:
     """``m_{k+1} = a m_k + (1 - a) chi_k`` from ``m_0 = m0``: returns ``m_1 .. m_n``."""
+    from scipy.signal import lfilter  # here: scipy.signal takes 0.3 s to import
+
     out, _ = lfilter([1.0 - a], [1.0, -a], np.asarray(chi, dtype=np.complex128),
                      zi=np.array([a * m0]))
     return out

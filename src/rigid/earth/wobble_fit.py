@@ -14,18 +14,19 @@ a prograde term is ``exp(+i sigma t)``.  The public facade is
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import astropy.units as u
 import numpy as np
-from astropy.table import QTable
 from astropy.time import Time
-from scipy.optimize import least_squares
 
 from hamilton_orbits.units import TIME
 from hamilton_orbits.validation import as_float_array
 from rigid._shared import positive_scalar
 from rigid.earth.c04 import PolarMotionRecord, decimal_year, iers2010_mean_pole, mjd_utc
+
+if TYPE_CHECKING:  # astropy.table takes 0.17 s to import: only the fit's table needs it
+    from astropy.table import QTable
 
 __all__ = ["WobbleFit", "fit_wobble", "free_period", "periodogram"]
 
@@ -96,6 +97,8 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     def resid(x):
         _, r = _project(t0, mn, np.array([x[0], -x[0]]), 0)
         return np.concatenate([r.real, r.imag])
+
+    from scipy.optimize import least_squares  # here: 0.2 s to import, rarely needed
 
     sol = least_squares(resid, [sigma0], x_scale=[abs(sigma0)], xtol=1e-15, ftol=1e-15,
                         gtol=1e-15)
@@ -220,6 +223,8 @@ def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: flo
 
     scale = np.concatenate([[1e-4 * freqs[0], 1e-4 * freqs[1]],
                             np.full(x0.size - 2, max(np.std(np.abs(m)), 1e-300))])
+    from scipy.optimize import least_squares
+
     sol = least_squares(fun, x0, jac=jac, x_scale=scale, xtol=1e-12, ftol=1e-12, gtol=1e-12,
                         method="lm")
     r, jc = _wobble_resid(sol.x, t, m, n_trend)
@@ -338,6 +343,8 @@ def fit_wobble(
 
 def _amplitude_by_decade(rec: PolarMotionRecord, wc: float, wa: float) -> QTable:
     """Chandler and annual amplitudes per calendar decade, periods held fixed."""
+    from astropy.table import QTable
+
     yr = decimal_year(rec.time)
     rows = []
     first = int(np.floor(yr[0] / 10.0) * 10)
@@ -447,5 +454,7 @@ def periodogram(
         amp[i:i + chunk] = np.abs(np.exp(-2j * np.pi * np.outer(fs, t)) @ m) / t.size
     with np.errstate(divide="ignore"):
         period = np.where(f != 0, 365.25 / np.where(f != 0, f, 1.0), np.inf)
+    from astropy.table import QTable
+
     return QTable([f / u.yr, period * u.day, amp * u.mas],
                  names=("frequency", "period", "amplitude"))
