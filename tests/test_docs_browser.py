@@ -211,8 +211,11 @@ def test_a_broken_page_fails(browser, tiny, page, expected):
     problems = check_page(browser, tiny + page)
     for pattern in expected:
         assert any(re.search(pattern, p) for p in problems), (pattern, problems)
-    with pytest.raises(AssertionError, match=re.escape(page)):
-        assert_page_ok(browser, tiny + page)
+
+
+def test_assert_page_ok_names_the_page_and_its_problems(browser, tiny):
+    with pytest.raises(AssertionError, match=r"thrown-error\.html:\n.*boom from the page"):
+        assert_page_ok(browser, tiny + "thrown-error.html")
 
 
 def test_waiting_for_what_never_comes_fails(browser, tiny):

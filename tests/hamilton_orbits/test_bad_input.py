@@ -570,7 +570,12 @@ def test_ctrl_c_in_a_one_interval_run_stops_it_promptly(tmp_path):
            "--set", 'duration="100000 d"', "--set", 'cadence="100000 d"',
            "--out", str(tmp_path / "out")]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(8.0)  # import, the scene's checks, and into the run
+    lock = tmp_path / "out" / LOCK_NAME  # taken after the imports and the scene's checks
+    deadline = time.perf_counter() + 120.0
+    while not lock.exists() and proc.poll() is None and time.perf_counter() < deadline:
+        time.sleep(0.05)
+    assert lock.exists(), proc.communicate(timeout=120)[1]
+    time.sleep(1.5)  # the kernels loaded (or compiling, on a cold cache) and into the run
     start = time.perf_counter()
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
