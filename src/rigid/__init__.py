@@ -67,9 +67,11 @@ def __getattr__(name: str):
     """``rigid.earth`` and ``rigid.polar_motion`` imported on first use: ``import
     rigid`` (which every ``hamilton-orbits`` command's scene-kind lookup does) leaves
     out the polar-motion record, its fit and its predictions (astropy tables)."""
-    if name in ("earth", "polar_motion"):
-        import importlib
+    import importlib
 
-        return importlib.import_module(f"rigid.{name}")
+    if name == "earth":
+        return importlib.import_module("rigid.earth")
+    if name == "polar_motion":
+        return importlib.import_module("rigid.polar_motion")
     raise AttributeError(f"module 'rigid' has no attribute {name!r}")
 
