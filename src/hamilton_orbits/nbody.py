@@ -62,6 +62,7 @@ from hamilton_orbits.initial_states import InitialStates, names_repr
 from hamilton_orbits.integrals import energy_gm
 from hamilton_orbits.integrators import _setup
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent
+from hamilton_orbits.validation import check_finite
 
 __all__ = ["Body", "System", "SystemArrays"]
 
@@ -245,7 +246,7 @@ class System(InitialStates):
             if rad.shape != (n,):
                 raise ValueError(f"Expected `radius` to have shape ({n},), got {rad.shape}")
             check_positive("radius", np.where(np.isnan(rad), 1.0, rad))
-            _finite("radius", rad[~np.isnan(rad)], np.flatnonzero(~np.isnan(rad)))
+            check_finite("radius", rad[~np.isnan(rad)], np.flatnonzero(~np.isnan(rad)))
         names_t = tuple(f"b{k}" for k in range(n)) if names is None else tuple(names)
         if len(names_t) != n or not all(isinstance(x, str) and x for x in names_t):
             raise ValueError(f"Expected `names` to be {n} non-empty strings, got {names!r}")
@@ -471,7 +472,7 @@ class System(InitialStates):
         from hamilton_orbits.validation import check_positive
 
         n = len(self._names)
-        _finite("gm", self._gm)
+        check_finite("gm", self._gm)
         check_positive("gm", self._gm, strict=False)
         if not np.any(self._gm > 0):
             raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
@@ -590,17 +591,6 @@ _MOVED = {
     **dict.fromkeys(("LostStateError", "accelerations_quaternion", "energy_gm_many",
                      "integral_errors"), "hamilton_orbits.integrals"),
 }
-
-
-def _finite(name: str, arr: np.ndarray, where: np.ndarray | None = None) -> None:
-    """Refuse a NaN or infinite entry of the 1-d ``arr``, naming ``name``, the index
-    (``where[k]`` for entry ``k`` when given) and the value."""
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
-        k = int(bad[0])
-        index = k if where is None else int(where[k])
-        raise ValueError(f"Expected `{name}` to be finite, got {float(arr[k])!r} at index "
-                         f"{index}")
 
 
 def __getattr__(name: str) -> Any:

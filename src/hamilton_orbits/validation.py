@@ -78,6 +78,27 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     return arr
 
 
+def check_finite(name: str, arr: np.ndarray, where: np.ndarray | None = None) -> None:
+    """Refuse a NaN or infinite entry of the 1-d ``arr``, naming ``name``, the index
+    (``where[k]`` for entry ``k`` when given: ``arr`` a selection of a longer array)
+    and the value.
+
+    Examples
+    --------
+    >>> check_finite("gm", np.array([1.0, 2.0]))
+    >>> check_finite("radius", np.array([1.0, np.inf]), where=np.array([0, 3]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `radius` to be finite, got inf at index 3
+    """
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        k = int(bad[0])
+        index = k if where is None else int(where[k])
+        raise ValueError(f"Expected `{name}` to be finite, got {float(arr[k])!r} at index "
+                         f"{index}")
+
+
 def check_trailing(name: str, arr: np.ndarray, size: int) -> np.ndarray:
     """Require ``arr.shape == (..., size)``.
 
