@@ -24,6 +24,7 @@ from numba import njit, types
 
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
+from hamilton_orbits._kernels.gauss_radau import exact_tables
 from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at, set_clock
 from hamilton_orbits._kernels.variational import megno_update
 
@@ -97,34 +98,12 @@ def coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     and ``D = C^-1`` (g = D b), computed exactly in rationals from the 30-digit
     spacings and rounded once: a constant's rounding error is repeated in every
     step, so it must be the smallest possible (a biased constant is a systematic
-    error, which breaks Brouwer's law).
-
-    ``C[k, j]`` is the coefficient of ``h^(k+1)`` in ``prod_{m=0..j} (h - h_m)``
-    (Rein & Spiegel 2015, eq. 5 expanded into eq. 4).
+    error, which breaks Brouwer's law).  The rationals are
+    :func:`~hamilton_orbits._kernels.gauss_radau.exact_tables`'.
     """
-    h = [Fraction(x) for x in DECIMAL_SPACINGS]
-    rr = np.zeros((8, 8))
-    for n in range(1, 8):
-        for i in range(n):
-            rr[n, i] = float(1 / (h[n] - h[i]))
-    c = [[Fraction(0)] * 7 for _ in range(7)]
-    for j in range(7):
-        poly = [Fraction(1)]  # coefficients, lowest order first
-        for m in range(j + 1):
-            new = [Fraction(0)] * (len(poly) + 1)
-            for p, coef in enumerate(poly):
-                new[p] -= h[m] * coef
-                new[p + 1] += coef
-            poly = new
-        for k in range(j + 1):
-            c[k][j] = poly[k + 1]
-    d = [[Fraction(0)] * 7 for _ in range(7)]
-    for j in range(7):
-        d[j][j] = Fraction(1)
-        for k in range(j - 1, -1, -1):
-            d[k][j] = -sum((c[k][m] * d[m][j] for m in range(k + 1, j + 1)), Fraction(0))
+    recip, c, d = exact_tables([Fraction(x) for x in DECIMAL_SPACINGS])
     to_array = np.vectorize(float)
-    return rr, to_array(np.array(c, dtype=object)), to_array(np.array(d, dtype=object))
+    return tuple(to_array(np.array(t, dtype=object)) for t in (recip, c, d))
 
 
 _RINV, _C, _D = coefficients()

@@ -28,6 +28,8 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
+from hamilton_orbits._kernels.gauss_radau import exact_tables
+
 __all__ = ["advance", "constants", "spacings"]
 
 _SPLIT = 134217729.0  # 2^27 + 1 (Dekker's splitting of a double into two halves)
@@ -99,27 +101,8 @@ def constants() -> dict[str, np.ndarray]:
         h = spacings()
         hf = [Fraction(x) for x in h]
     out = {"h": np.array([_dd(x) for x in hf])}
-    rinv = np.zeros((8, 8, 2))
-    for n in range(1, 8):
-        for i in range(n):
-            rinv[n, i] = _dd(1 / (hf[n] - hf[i]))
-    c = [[Fraction(0)] * 7 for _ in range(7)]
-    for j in range(7):
-        poly = [Fraction(1)]
-        for m in range(j + 1):
-            new = [Fraction(0)] * (len(poly) + 1)
-            for k, coef in enumerate(poly):
-                new[k] -= hf[m] * coef
-                new[k + 1] += coef
-            poly = new
-        for k in range(j + 1):
-            c[k][j] = poly[k + 1]
-    d = [[Fraction(0)] * 7 for _ in range(7)]
-    for j in range(7):
-        d[j][j] = Fraction(1)
-        for k in range(j - 1, -1, -1):
-            d[k][j] = -sum((c[k][m] * d[m][j] for m in range(k + 1, j + 1)), Fraction(0))
-    out["rinv"] = rinv
+    recip, c, d = exact_tables(hf)
+    out["rinv"] = np.array([[_dd(x) for x in row] for row in recip])
     out["c"] = np.array([[_dd(x) for x in row] for row in c])
     out["d"] = np.array([[_dd(x) for x in row] for row in d])
     # positions at h: (((b6 k8 + b5) k7 + ... + b0) k2 + a0) ..., k_j = (j - 1) h / (j + 1)
