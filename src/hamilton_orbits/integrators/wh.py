@@ -338,6 +338,9 @@ class _Split:
     ``order[i]``), held in the arrays ``q``, ``u`` it is given, and its compiled
     steps."""
 
+    #: not state: whether the few-body entries serve it, found on the first call
+    RESTART_SCRATCH = ("few",)
+
     def __init__(self, gm: np.ndarray, order: np.ndarray, jacobi: bool, corrector: int,
                  extra: Any, p: np.ndarray, has_extra: bool) -> None:
         g = np.ascontiguousarray(gm[order])  # a writeable copy, the order of the rows
@@ -345,6 +348,7 @@ class _Split:
         self.gm, self.g, self.order, self.jacobi, self.corrector = gm, g, order, jacobi, corrector
         self.extra, self.p, self.has_extra = extra, p, has_extra
         self.q = self.u = np.empty((0, 3))
+        self.few: bool | None = None
         if jacobi:
             self.eta = np.cumsum(g)
             self.ratio, self.inv_eta = _k.jacobi_factors(self.eta)
@@ -379,9 +383,12 @@ class _Split:
         watched = watch.shape[0] > 0
         ev = (watch, ev_out, ev_count, ws) if watched else (ws,)
         q, u = self.q, self.u
-        # (a few bodies, all massive: the same bits from an entry that compiles less)
-        few = not watched and not self.has_extra and q.shape[0] - 1 < _k.LANES_FROM \
-            and bool((self.g > 0.0).all())
+        # (a few bodies, all massive: the same bits from an entry that compiles less;
+        # found once, a numpy test costing a tenth of a short call)
+        if self.few is None:
+            self.few = not self.has_extra and q.shape[0] - 1 < _k.LANES_FROM \
+                and bool((self.g > 0.0).all())
+        few = self.few and not watched
         if not self.jacobi:
             kernel = (_k.advance_dh_watched if watched else
                       _k.advance_dh_effects if self.has_extra else
