@@ -131,3 +131,29 @@ def test_lazy_attribute_errors():
     else:  # pragma: no cover
         raise AssertionError("expected AttributeError")
     assert set(hamilton_orbits.__all__) <= set(dir(hamilton_orbits))
+
+
+# what looking up the scene kinds (every command line's first step) must not load:
+# the Earth's record, fit and predictions of rigid (0.6-0.8 s of a command)
+NOT_FOR_SCENE_KINDS = ("scipy.signal", "scipy.optimize", "astropy.table", "rigid.polar_motion",
+                       "rigid.earth.prediction")
+
+
+def test_looking_up_the_scene_kinds_leaves_the_earth_s_modules_alone():
+    got = _bare_modules(
+        "from hamilton_orbits.scenes.base import registered_kinds\n"
+        "kinds = registered_kinds()\n"
+        "assert {'nbody', 'rotation', 'polar_motion', 'pole_prediction'} <= set(kinds), kinds\n"
+        "import rigid\n"
+        "assert callable(rigid.polar_motion.predict)\n"  # on first use
+    )
+    # (the probe imported rigid.polar_motion last, on purpose: it resolves lazily)
+    assert "rigid.polar_motion" in got
+
+
+def test_the_scene_kinds_alone_import_no_earth_module():
+    got = _bare_modules(
+        "from hamilton_orbits.scenes.base import registered_kinds\n"
+        "registered_kinds()\n"
+    )
+    assert _loaded(got, NOT_FOR_SCENE_KINDS) == []
