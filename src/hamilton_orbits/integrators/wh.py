@@ -274,17 +274,19 @@ class _State:
         """Rows 1... of ``r_out``, ``v_out`` at ``t_out[1:]`` (``t_out[0]`` the current
         time); an event that stops the run raises
         :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
-        _setup.check_step_count(float(t_out[-1] - t_out[0]), self.dt, self.max_steps, NAME)
+        times = t_out.tolist()  # (Python floats: the same numbers, cheaper arithmetic)
+        _setup.check_step_count(times[-1] - times[0], self.dt, self.max_steps, NAME)
         first = self.steps
-        for i in range(1, t_out.shape[0]):
-            self._interval(i, t_out, (r_out[i], v_out[i]), stop, first)
-            self.t = float(t_out[i])
-            self.split.to_inertial(r_out[i], v_out[i])
-            self.log.mask(r_out[i], v_out[i])
+        for i in range(1, len(times)):
+            row = r_out[i], v_out[i]
+            self._interval(i, times, row, stop, first)
+            self.t = times[i]
+            self.split.to_inertial(*row)
+            self.log.mask(*row)
             if on_output is not None:
                 on_output(i, self.steps - first)
 
-    def _interval(self, i: int, t_out: np.ndarray, row: tuple[np.ndarray, np.ndarray],
+    def _interval(self, i: int, t_out: list[float], row: tuple[np.ndarray, np.ndarray],
                   stop: Callable[[], bool] | None, first: int) -> None:
         """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land
         on it), events acted on at the end of their step (a merge or a removal
