@@ -74,4 +74,3 @@ def __getattr__(name: str):
     if name == "polar_motion":
         return importlib.import_module("rigid.polar_motion")
     raise AttributeError(f"module 'rigid' has no attribute {name!r}")
-

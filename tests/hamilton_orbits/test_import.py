@@ -139,7 +139,7 @@ NOT_FOR_SCENE_KINDS = ("scipy.signal", "scipy.optimize", "astropy.table", "rigid
                        "rigid.earth.prediction")
 
 
-def test_looking_up_the_scene_kinds_leaves_the_earth_s_modules_alone():
+def test_rigid_polar_motion_resolves_on_first_use_after_the_scene_kinds():
     got = _bare_modules(
         "from hamilton_orbits.scenes.base import registered_kinds\n"
         "kinds = registered_kinds()\n"

@@ -98,8 +98,8 @@ def coefficients() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     and ``D = C^-1`` (g = D b), computed exactly in rationals from the 30-digit
     spacings and rounded once: a constant's rounding error is repeated in every
     step, so it must be the smallest possible (a biased constant is a systematic
-    error, which breaks Brouwer's law).  The rationals are
-    :func:`~hamilton_orbits._kernels.gauss_radau.exact_tables`'.
+    error, which breaks Brouwer's law).  The rationals come from
+    :func:`~hamilton_orbits._kernels.gauss_radau.exact_tables`.
     """
     recip, c, d = exact_tables([Fraction(x) for x in DECIMAL_SPACINGS])
     to_array = np.vectorize(float)

@@ -286,33 +286,32 @@ class _State:
             if on_output is not None:
                 on_output(i, self.steps - first)
 
-    def _interval(self, i: int, t_out: list[float], row: tuple[np.ndarray, np.ndarray],
+    def _interval(self, i: int, times: list[float], row: tuple[np.ndarray, np.ndarray],
                   stop: Callable[[], bool] | None, first: int) -> None:
-        """The steps from ``t_out[i - 1]`` to ``t_out[i]`` (the last shortened to land
+        """The steps from ``times[i - 1]`` to ``times[i]`` (the last shortened to land
         on it), events acted on at the end of their step (a merge or a removal
         renews the split).  An event that stops the run leaves its state in ``row``
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
         dt, log = self.dt, self.log
-        n_steps, last = _setup.fixed_steps(t_out[i] - t_out[i - 1], dt)
+        n_steps, last = _setup.fixed_steps(times[i] - times[i - 1], dt)
         done = 0
         while done < n_steps:
             if done and stop is not None and stop():
                 raise StopIntegration
             ws = self.ws
-            ws[0], ws[1], ws[2], ws[3] = t_out[i - 1] + done * dt, np.inf, 0.0, -1.0
+            ws[0], ws[1], ws[2], ws[3] = times[i - 1] + done * dt, np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
             steps, bad, status = self.split.advance(
                 dt, n_call, last if done + n_call == n_steps else dt, self.watch, log.buffer,
                 log.count, ws)
             done += steps
             self.steps += steps
-            self.t = float(t_out[i - 1] + done * dt)
+            self.t = times[i - 1] + done * dt
             if bad >= 0:
                 raise ConvergenceError(
                     f"wh: the Kepler step of body {int(self.split.order[bad])} failed between "
-                    f"t_out[{i - 1}] = {float(t_out[i - 1])!r} and t_out[{i}] = "
-                    f"{float(t_out[i])!r}")
+                    f"t_out[{i - 1}] = {times[i - 1]!r} and t_out[{i}] = {times[i]!r}")
             if status == _k.STATUS_DRAIN:
                 log.drain()
             elif status == _k.STATUS_EVENT:
