@@ -321,6 +321,37 @@ class Propagation:
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
 
+    def advance_end(self, t_end: float) -> EngineRun | None:
+        """A leg to the one later time ``t_end`` (a finite Python float), forwards,
+        with nothing watched, called back or asked: the same steps and the same
+        bits as ``advance(np.array([t, t_end]))``, with less wrapping around them
+        (the continuing call of a prepared simulation: its cost is mostly wrapping).
+        None when the leg is not of that kind (no driver yet, a backward leg, events
+        or variational equations): the caller then calls :meth:`advance`.  On
+        Ctrl-C the propagation keeps the driver's state, as :meth:`advance` does,
+        and ``KeyboardInterrupt`` is raised."""
+        driver = self.driver
+        if (driver is None or self.backward or self.events is not None
+                or self.variational is not None or not self.t < t_end < np.inf):
+            return None
+        t_out = np.array((self.t, t_end))
+        rows = np.empty((2, 2) + self.r.shape)  # positions and velocities, one block
+        r_out, v_out = rows[0], rows[1]
+        r_out[0], v_out[0] = self.r, self.v
+        start, steps0, compiled = time.perf_counter(), driver.steps, compile_seconds()
+        try:
+            driver.advance(t_out, r_out, v_out, None, None)
+        except KeyboardInterrupt:
+            self._between_outputs(driver)
+            raise
+        wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
+        if driver.t == t_end:  # (as advance: else the driver's own state is kept)
+            self.r, self.v, self.t = r_out[1], v_out[1], t_end
+        else:  # pragma: no cover - no driver stops between outputs unasked
+            self._between_outputs(driver)
+        return EngineRun(t_out, r_out, v_out, driver.steps - steps0, wall, True, None, self.gm0,
+                         None, False, 0, all_finite(rows.reshape(-1)))
+
     def _drive(self, driver: Any, t_out: np.ndarray, rows: tuple[np.ndarray, np.ndarray],
                report: Callable[[int, int], None], stop: Any, pause: Any) -> None:
         """``driver.advance`` through ``t_out``, ``pause`` set on a driver that takes

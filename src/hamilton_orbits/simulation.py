@@ -285,6 +285,13 @@ class Simulation(Saving):
             On Ctrl-C (the run stops within a few thousand steps; the simulation
             keeps the state reached), unless ``on_interrupt="keep"``.
         """
+        if (type(t) is float and self._unit is None and self._archive is None
+                and on_output is None and stop is None and not progress
+                and on_interrupt == "raise"):  # one end time, no unit, no archive: the
+            out = self._prop.advance_end(t)  # engine's lean path, when it can
+            if out is not None:
+                start, self._start = self._start, self._initial
+                return self._trajectory(out, None, start, out.wall_time)
         if on_interrupt not in ("raise", "keep"):
             raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
                              f"{on_interrupt!r}")

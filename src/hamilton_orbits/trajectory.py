@@ -175,6 +175,20 @@ class Trajectory(TrajectoryBase):
             lyapunov_time=lyapunov_time, _integrals=integrals, _final_source=final_source,
             _event_source=event_source, _under_resolved=under_resolved)
 
+    #: what a trajectory without variational equations, events or under-resolved
+    #: approaches has (read from the class: a short leg's wrapping sets fewer names)
+    megno = lyapunov = stm = lyapunov_time = _event_source = None
+    _under_resolved: Any = ()
+
+    @classmethod
+    def _plain(cls, values: dict[str, Any]) -> Trajectory:
+        """A trajectory from the attributes in ``values`` (those of ``__init__``, the
+        sources under their own names), the others the class's defaults: without
+        the keyword call, a third of the cost of wrapping a short leg."""
+        new = cls.__new__(cls)
+        new.__dict__.update(values)
+        return new
+
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(f"Trajectory is read-only: cannot set {name!r}")
 
@@ -552,25 +566,24 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         v_out: Any = v << (u.au / u.day)
     else:
         t_out, r_out, v_out = times, r, v
+    values = {"t": t_out, "r": r_out, "v": v_out, "names": system.names,
+              "steps": int(out.steps), "method": method, "effects": effects,
+              "wall_time": out.wall_time if wall_time is None else wall_time,
+              "complete": out.complete, "_integrals": integrals, "_final_source": final}
+    if found:
+        values["_under_resolved"] = found
     tan = out.variational
-    megno = lyap = stm = lyap_time = None
     if tan is not None:
         k = len(times)
-        megno, lyap = tan.megno[:k].copy(), tan.lyapunov[:k].copy()
-        lyap_time = tan.lyapunov_time[:k].copy()
-        stm = tan.stm[:k].copy() if tan.stm is not None else None
+        lyap, lyap_time = tan.lyapunov[:k].copy(), tan.lyapunov_time[:k].copy()
         if system.quantity:
             lyap = (lyap / u.day).to(1 / unit)
             lyap_time = (lyap_time * u.day).to(unit)
-    events = None
+        values.update(megno=tan.megno[:k].copy(), lyapunov=lyap, lyapunov_time=lyap_time,
+                      stm=tan.stm[:k].copy() if tan.stm is not None else None)
     if log is not None:
         stopped = log.stopped_by
-        events = (log.recorded()[out.first_event:],
-                  None if stopped is None else stopped - out.first_event, system, unit)
-    return Trajectory(
-        t=t_out, r=r_out, v=v_out, names=system.names, steps=int(out.steps),
-        wall_time=out.wall_time if wall_time is None else wall_time, method=method,
-        effects=effects, complete=out.complete, integrals=integrals, final_source=final,
-        event_source=events, megno=megno, lyapunov=lyap, stm=stm, lyapunov_time=lyap_time,
-        under_resolved=found,
-    )
+        values["_event_source"] = (log.recorded()[out.first_event:],
+                                   None if stopped is None else stopped - out.first_event,
+                                   system, unit)
+    return Trajectory._plain(values)

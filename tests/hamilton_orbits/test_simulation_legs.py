@@ -101,6 +101,71 @@ def test_two_legs_reach_the_bits_of_one_call(system, kw):
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.final.as_arrays().r)
 
 
+
+@pytest.mark.parametrize(("system", "kw"), _variants())
+def test_legs_of_one_end_time_each_reach_the_bits_of_one_call(system, kw, monkeypatch):
+    """A continuing call to one end time (a float), nothing watched or asked, takes
+    the engine's lean path (``Propagation.advance_end``, not ``advance``); events
+    and the variational equations take the whole one.  Either way every leg has
+    the rows, integrals and steps of the call that was never split."""
+    from hamilton_orbits import engine
+
+    system = system()
+    times = (1.3, 2.9, 4.0)
+    once = Simulation(system, **kw).integrate(list(times))
+    sim = Simulation(system, **kw)
+    whole = []
+    advance = engine.Propagation.advance
+    monkeypatch.setattr(engine.Propagation, "advance",
+                        lambda self, *a, **k: whole.append(1) or advance(self, *a, **k))
+    legs = [sim.integrate(t) for t in times]
+    lean = "events" not in kw and "variational" not in kw
+    assert len(whole) == (1 if lean else 3)  # (the first leg makes the integrator)
+    for k, leg in enumerate(legs):
+        rows = slice(k, k + 2)
+        assert leg.t.tolist() == once.t[rows].tolist() and leg.complete
+        assert _same(leg.r, once.r[rows]) and _same(leg.v, once.v[rows])
+        assert _same(leg.energy_error, once.energy_error[rows])
+        assert _same(leg.angular_momentum_error, once.angular_momentum_error[rows])
+        assert _same(leg.barycentre_drift, once.barycentre_drift[rows])
+        assert (leg.megno is None) == (once.megno is None)
+        if once.megno is not None:
+            assert _same(leg.megno, once.megno[rows]) and _same(leg.stm, once.stm[rows])
+    assert sum(leg.steps for leg in legs) == once.steps == sim.steps
+    assert sum(len(leg.events) for leg in legs) == len(once.events)
+    assert legs[-1].stopped_by is None and len(legs[-1].under_resolved) == 0
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.final.as_arrays().r)
+
+
+def test_ctrl_c_in_a_lean_leg_keeps_the_state_reached(monkeypatch):
+    """Ctrl-C during a continuing call's lean path (here as the leg's state is
+    turned to inertial coordinates, after its steps) raises ``KeyboardInterrupt``
+    with the simulation standing where its integrator stands, as on the whole
+    path: it then continues with the bits of the run that was never
+    interrupted."""
+    from hamilton_orbits._kernels import wh as kernels
+
+    kw = dict(method="wh", dt=0.02)
+    once = Simulation(_disc(), **kw).integrate([1.0, 2.0, 3.0])
+    sim = Simulation(_disc(), **kw)
+    sim.integrate(1.0)
+    to_inertial = kernels.dh_to_inertial
+    pressed = []
+
+    def interrupted(*args):
+        if not pressed:
+            pressed.append(1)
+            raise KeyboardInterrupt
+        return to_inertial(*args)
+
+    monkeypatch.setattr(kernels, "dh_to_inertial", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(2.0)
+    assert pressed and sim.t == 2.0 and sim.steps == 100
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.r[2])
+    assert _same(sim.integrate(3.0).r[-1], once.r[3])
+
+
 def test_integrate_is_a_simulation_integrated_once():
     s = _disc()
     one = integrate(s, [0.5, 2.0], method="wh", dt=0.02, effects=[GR_POTENTIAL])

@@ -259,7 +259,8 @@ class _State:
         # write its clock)
         self.split.from_inertial(r0, v0, np.empty_like(r0), np.empty_like(v0))
         self.watch = self.log.kernel_watch()
-        self.ws = np.empty(4)  # the events' work space of the kernels (see _drift)
+        self.ws = np.array([t0, np.inf, 0.0, -1.0])  # the events' work space of the kernels
+        # (see _drift; only ws[0], the clock, is used when no event is watched)
         self.dt, self.max_steps, self.t, self.steps = dt, method.max_steps, t0, 0
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -275,7 +276,8 @@ class _State:
         time); an event that stops the run raises
         :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
         times = t_out.tolist()  # (Python floats: the same numbers, cheaper arithmetic)
-        _setup.check_step_count(times[-1] - times[0], self.dt, self.max_steps, NAME)
+        if len(times) > 2:  # (one interval: checked by _interval, from its step count)
+            _setup.check_step_count(times[-1] - times[0], self.dt, self.max_steps, NAME)
         first = self.steps
         for i in range(1, len(times)):
             row = r_out[i], v_out[i]
@@ -293,14 +295,19 @@ class _State:
         renews the split).  An event that stops the run leaves its state in ``row``
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
-        dt, log = self.dt, self.log
-        n_steps, last = _setup.fixed_steps(times[i] - times[i - 1], dt)
+        dt, log, ws = self.dt, self.log, self.ws
+        span = times[i] - times[i - 1]
+        if abs(span) > 0.5 * self.max_steps * dt:  # (near the limit: checked as advance
+            _setup.check_step_count(span, dt, self.max_steps, NAME)  # checks a leg of
+        n_steps, last = _setup.fixed_steps(span, dt)  # several intervals)
+        watched = self.watch.shape[0] > 0
         done = 0
         while done < n_steps:
             if done and stop is not None and stop():
                 raise StopIntegration
-            ws = self.ws
-            ws[0], ws[1], ws[2], ws[3] = times[i - 1] + done * dt, np.inf, 0.0, -1.0
+            ws[0] = times[i - 1] + done * dt
+            if watched:  # (the events' part of the work space: see _drift)
+                ws[1], ws[2], ws[3] = np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
             steps, bad, status = self.split.advance(
                 dt, n_call, last if done + n_call == n_steps else dt, self.watch, log.buffer,
