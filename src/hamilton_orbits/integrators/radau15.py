@@ -325,7 +325,8 @@ class _Run:
             stopped = self.advance_to(t_out, i, first)
             r_out[i] = self.x
             v_out[i] = self.w
-            log.mask(r_out[i], v_out[i])
+            if log.gone:  # (bodies taken out of the run: NaN in the outputs)
+                log.mask(r_out[i], v_out[i])
             if stopped:
                 raise StopAtEvent(i, self.t, self.steps - first)
             if on_output is not None:

@@ -284,7 +284,8 @@ class _State:
             self._interval(i, times, row, stop, first)
             self.t = times[i]
             self.split.to_inertial(*row)
-            self.log.mask(*row)
+            if self.log.gone:  # (bodies taken out of the run: NaN in the outputs)
+                self.log.mask(*row)
             if on_output is not None:
                 on_output(i, self.steps - first)
 
