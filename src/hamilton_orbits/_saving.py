@@ -336,6 +336,7 @@ class Saving:
 
     def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
         arch, prop, rows = self._archive, self._prop, self._leg
+        taken = [False]  # a snapshot of this leg's outputs taken
 
         def at(i: int) -> None:
             if i == 0:
@@ -343,7 +344,13 @@ class Saving:
             if asked[i] and rows is not None and arch.path is not None:
                 rows.add(prop.t, prop.r, prop.v, prop.variational)
             if arch.path is not None and (scheduled[i] or arch.due(prop.steps)):
-                self._snapshot(rows)  # (a schedule alone writes nothing)
+                # (again: since this leg's last snapshot only its steps ran and its
+                # outputs put other rows of the same shapes in the propagation's r and
+                # v, no row waits to be written: the layout is read as a pause's)
+                again = taken[0] and prop.variational is None and (rows is None
+                                                                   or not rows.rows)
+                self._snapshot(rows, again)  # (a schedule alone writes nothing)
+                taken[0] = True
 
         return at
 

@@ -83,6 +83,37 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
         assert all(_same(x, y) for x, y in zip(a[:3], b[:3], strict=True))
 
 
+@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="radau15", dt=0.05),
+                                dict(method="wh", dt=0.05),
+                                dict(method="wh", dt=0.05, coordinates="jacobi", corrector=11),
+                                dict(method="leapfrog", dt=0.05), dict(method="dop853"),
+                                dict(method="radau15", variational=True)],
+                         ids=["radau15", "radau15-fixed", "wh", "wh-jacobi-11", "leapfrog",
+                              "dop853", "radau15-variational"])
+def test_the_snapshots_between_a_calls_outputs_hold_the_whole_state(tmp_path, kw):
+    """A call of one end time takes its snapshots at the schedule's times between its
+    outputs; after the call's first, each is read along the layout the first found
+    (nothing but steps ran, no row waits).  Each holds the state that a snapshot
+    taken at an output of that time holds (every array of the integrator's own,
+    bit for bit), and the run resumed from one in the middle ends on the bits of
+    the run never interrupted."""
+    quiet = Simulation(_disc(), archive=tmp_path / "quiet", every=2.5, **kw)
+    end = quiet.integrate(30.0)
+    outputs = Simulation(_disc(), archive=tmp_path / "outputs", every=2.5, **kw)
+    outputs.integrate(2.5 * np.arange(1, 13))  # (every snapshot at an output: a row written)
+    assert _same(end.r[-1], outputs.system.as_arrays().r)
+    a, b = Archive(tmp_path / "quiet"), Archive(tmp_path / "outputs")
+    np.testing.assert_array_equal(a.times, 2.5 * np.arange(13))
+    np.testing.assert_array_equal(b.times, a.times)
+    for k in range(13):
+        x, y = _snapshot_state(tmp_path / "quiet", k), _snapshot_state(tmp_path / "outputs", k)
+        assert all(_same(p, q) for p, q in zip(x, y, strict=True)), k
+    again = a[7]  # t = 17.5, between the call's outputs
+    assert again.t == 17.5
+    rest = again.integrate(30.0)
+    assert _same(rest.r[-1], end.r[-1]) and _same(rest.v[-1], end.v[-1])
+    assert again.steps == quiet.steps
+
 @pytest.mark.parametrize("kw", [KW, dict(method="radau15", every_steps=12)],
                          ids=["every", "every_steps"])
 def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path, kw):
