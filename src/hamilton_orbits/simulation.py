@@ -61,6 +61,7 @@ from hamilton_orbits.trajectory import (
     event_table,
     make_trajectory,
 )
+from hamilton_orbits.units import is_quantity
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -202,8 +203,10 @@ class Simulation(Saving):
     @property
     def t(self) -> Any:
         """The simulation's time (see the class notes)."""
-        t = self._prop.t
-        return t if self._unit is None else (t * DAY).to(self._unit)
+        t, unit = self._prop.t, self._unit
+        if unit is None:
+            return t
+        return t * DAY if unit is DAY else (t * DAY).to(unit)  # (the same value)
 
     @property
     def steps(self) -> int:
@@ -285,13 +288,12 @@ class Simulation(Saving):
             On Ctrl-C (the run stops within a few thousand steps; the simulation
             keeps the state reached), unless ``on_interrupt="keep"``.
         """
-        if (type(t) is float and self._unit is None and self._archive is None
-                and on_output is None and stop is None and not progress
-                and on_interrupt == "raise"):  # one end time, no unit, no archive: the
-            out = self._prop.advance_end(t)  # engine's lean path, when it can
+        if (self._archive is None and on_output is None and stop is None and not progress
+                and on_interrupt == "raise"):  # one end time, no archive: the engine's
+            out = self._lean(t)  # lean path, when it can
             if out is not None:
                 start, self._start = self._start, self._initial
-                return self._trajectory(out, None, start, out.wall_time)
+                return self._trajectory(out, self._unit, start, out.wall_time)
         if on_interrupt not in ("raise", "keep"):
             raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
                              f"{on_interrupt!r}")
@@ -306,6 +308,20 @@ class Simulation(Saving):
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
         return self._trajectory(out, unit, start, out.wall_time)
+
+    def _lean(self, t: Any) -> engine.EngineRun | None:
+        """The leg to ``t`` on the engine's lean path (:meth:`engine.Propagation.advance_end`)
+        when ``t`` is one end time, a float for a system of floats or a scalar
+        Quantity in days for a Quantity system (the simulation's unit then days, as
+        the whole path would make it); None otherwise, nothing done."""
+        if type(t) is float:
+            return None if self._unit is not None else self._prop.advance_end(t)
+        if not (self._quantity and is_quantity(t) and t.unit is DAY and t.ndim == 0):
+            return None
+        out = self._prop.advance_end(float(t.value))
+        if out is not None:
+            self._unit = DAY
+        return out
 
     def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,
                     wall_time: float) -> Trajectory:

@@ -289,6 +289,49 @@ def test_time_steps_and_state_of_a_quantity_system():
         sim.integrate([500, 450] * u.day)
 
 
+
+def test_quantity_legs_of_one_end_time_reach_the_bits_of_one_call(monkeypatch):
+    """A Quantity system continued by scalar end times in days takes the engine's
+    lean path too (the simulation's unit days, as the whole path makes it); an end
+    time in years takes the whole path.  Both give the rows and steps of one call,
+    and every trajectory's times are the bits of ``(t_days * u.day).to(unit)``."""
+    from hamilton_orbits import engine
+
+    s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
+    days = [100.0, 250.0, 400.0, 400.0 + 365.25]
+    once = Simulation(s, method="wh", dt=5 * u.day).integrate(days * u.day)
+    sim = Simulation(s, method="wh", dt=5 * u.day)
+    whole = []
+    advance = engine.Propagation.advance
+    monkeypatch.setattr(engine.Propagation, "advance",
+                        lambda self, *a, **k: whole.append(1) or advance(self, *a, **k))
+    legs = [sim.integrate(d * u.day) for d in days[:3]]
+    assert len(whole) == 1  # (the first leg makes the integrator)
+    assert sim.t.unit is u.day and sim.t == 400.0 * u.day
+    legs.append(sim.integrate(sim.t.to(u.yr) + 1 * u.yr))  # years: the whole path
+    assert len(whole) == 2 and legs[-1].t.unit == u.yr and sim.t.unit == u.yr
+    for k, leg in enumerate(legs):
+        rows = slice(k, k + 2)
+        assert _same(leg.r.to_value(u.au), once.r[rows].to_value(u.au))
+        assert _same(leg.v.to_value(u.au / u.day), once.v[rows].to_value(u.au / u.day))
+        assert leg.r.unit == u.au and leg.v.unit == u.au / u.day
+        t_days = np.array([0.0, *days])[rows]
+        expected = (t_days * u.day).to(leg.t.unit)
+        assert leg.t.unit is expected.unit and _same(leg.t.value, expected.value)
+    assert sum(leg.steps for leg in legs) == once.steps == sim.steps
+
+
+@pytest.mark.parametrize("unit", [u.day, u.yr, u.s, u.h, u.min, u.week, u.Myr,
+                                  u.Unit("2 day"), u.Unit("1000 yr"), u.Unit("0.001 d")])
+def test_a_quantity_trajectorys_times_are_the_bits_of_astropys_conversion(unit):
+    """The times of a Quantity trajectory are its days scaled to the caller's unit
+    with the bits of ``(t_days * u.day).to(unit)`` (the scale made once per unit)."""
+    s = System.solar_system("J2000", bodies=["sun", "jupiter"])
+    t = np.array([0.37, 1.5, 2.25]) * (400 * u.day).to(unit)
+    traj = integrate(s, t, method="leapfrog", dt=7 * u.day)
+    expected = (np.concatenate(([0.0], t.to_value(u.day))) * u.day).to(unit)
+    assert traj.t.unit is expected.unit and _same(traj.t.value, expected.value)
+
 def test_backward_legs_continue_and_a_turn_restarts_from_the_state_reached():
     s = _disc()
     sim = Simulation(s, method="radau15")
