@@ -415,6 +415,30 @@ def bench_simulation_calls(rounds: int) -> None:
         print(f"{method:>9} | {med['o'] * 1e6:>12.2f} us {med['p'] * 1e6:>6.2f} us "
               f"{ratio('p', 'o'):>6.2f} | {med['ps'] * 1e6:>10.2f} us {ratio('ps', 'o'):>6.2f} | "
               f"{med['o1'] * 1e6:>10.2f} us {med['p1'] * 1e6:>11.2f} us {ratio('p1', 'o1'):>6.2f}")
+    _quantity_calls(rounds)
+
+
+def _quantity_calls(rounds: int) -> None:
+    """A continuing call of a Quantity system (the Sun, Jupiter, Saturn at J2000, wh, dt
+    = 10 d), its end time a Quantity in days, beside the same call of the system as
+    floats: what the units cost (rebound has none)."""
+    import astropy.units as u
+
+    from hamilton_orbits import Simulation, System
+
+    s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
+    arrays = s.as_arrays()
+    plain = System.from_arrays(arrays.gm, arrays.r, arrays.v)
+    sim_q = Simulation(s, method="wh", dt=10 * u.day)
+    sim_f = Simulation(plain, method="wh", dt=10.0)
+    step_q, step_f = 10 * u.day, 10.0
+    t = _interleaved({"q": lambda: sim_q.integrate(sim_q.t + step_q),
+                      "f": lambda: sim_f.integrate(sim_f.t + step_f),
+                      "t": lambda: sim_q.t + step_q}, rounds)
+    med = {k: statistics.median(x) * 1e6 for k, x in t.items()}
+    print(f"  Quantity system (3 bodies, wh, dt = 10 d), continuing sim.integrate(sim.t + 10 * "
+          f"u.day): {med['q']:.2f} us, of which sim.t + 10 * u.day {med['t']:.2f} us; the "
+          f"same system as floats: {med['f']:.2f} us")
 
 
 def main() -> None:
