@@ -27,6 +27,7 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+import astropy.units as u
 import numpy as np
 
 from hamilton_orbits import engine
@@ -311,16 +312,25 @@ class Simulation(Saving):
 
     def _lean(self, t: Any) -> engine.EngineRun | None:
         """The leg to ``t`` on the engine's lean path (:meth:`engine.Propagation.advance_end`)
-        when ``t`` is one end time, a float for a system of floats or a scalar
-        Quantity in days for a Quantity system (the simulation's unit then days, as
-        the whole path would make it); None otherwise, nothing done."""
+        when ``t`` is one end time, a float for a system of floats or a scalar time
+        Quantity for a Quantity system (in days as the whole path converts it; the
+        simulation's unit then ``t``'s, as the whole path makes it); None otherwise,
+        nothing done."""
         if type(t) is float:
             return None if self._unit is not None else self._prop.advance_end(t)
-        if not (self._quantity and is_quantity(t) and t.unit is DAY and t.ndim == 0):
+        if not (self._quantity and is_quantity(t) and t.ndim == 0):
             return None
-        out = self._prop.advance_end(float(t.value))
+        unit = t.unit
+        if unit is DAY:
+            end = float(t.value)
+        else:
+            try:
+                end = float(t.to_value(DAY))
+            except u.UnitConversionError:  # (not a time: the whole path says so)
+                return None
+        out = self._prop.advance_end(end)
         if out is not None:
-            self._unit = DAY
+            self._unit = unit
         return out
 
     def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,

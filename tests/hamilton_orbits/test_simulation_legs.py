@@ -291,10 +291,11 @@ def test_time_steps_and_state_of_a_quantity_system():
 
 
 def test_quantity_legs_of_one_end_time_reach_the_bits_of_one_call(monkeypatch):
-    """A Quantity system continued by scalar end times in days takes the engine's
-    lean path too (the simulation's unit days, as the whole path makes it); an end
-    time in years takes the whole path.  Both give the rows and steps of one call,
-    and every trajectory's times are the bits of ``(t_days * u.day).to(unit)``."""
+    """A Quantity system continued by scalar end times takes the engine's lean path
+    too, in days or in years (the simulation's unit then the end time's, as the
+    whole path makes it); the first, which makes the integrator, the whole path; a
+    length, the whole path's error.  All give the rows and steps of one call, and
+    every trajectory's times are the bits of ``(t_days * u.day).to(unit)``."""
     from hamilton_orbits import engine
 
     s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
@@ -308,8 +309,11 @@ def test_quantity_legs_of_one_end_time_reach_the_bits_of_one_call(monkeypatch):
     legs = [sim.integrate(d * u.day) for d in days[:3]]
     assert len(whole) == 1  # (the first leg makes the integrator)
     assert sim.t.unit is u.day and sim.t == 400.0 * u.day
-    legs.append(sim.integrate(sim.t.to(u.yr) + 1 * u.yr))  # years: the whole path
-    assert len(whole) == 2 and legs[-1].t.unit == u.yr and sim.t.unit == u.yr
+    legs.append(sim.integrate(sim.t.to(u.yr) + 1 * u.yr))  # years: lean too
+    assert len(whole) == 1 and legs[-1].t.unit == u.yr and sim.t.unit == u.yr
+    with pytest.raises(ValueError, match=r"Expected `t` to be a time"):
+        sim.integrate(3 * u.km)  # (not a time: the whole path says so)
+    assert sim.t.unit == u.yr
     for k, leg in enumerate(legs):
         rows = slice(k, k + 2)
         assert _same(leg.r.to_value(u.au), once.r[rows].to_value(u.au))
