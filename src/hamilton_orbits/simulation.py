@@ -320,17 +320,13 @@ class Simulation(Saving):
             return None if self._unit is not None else self._prop.advance_end(t)
         if not (self._quantity and is_quantity(t) and t.ndim == 0):
             return None
-        unit = t.unit
-        if unit is DAY:
-            end = float(t.value)
-        else:
-            try:
-                end = float(t.to_value(DAY))
-            except u.UnitConversionError:  # (not a time: the whole path says so)
-                return None
+        try:
+            end = float(t.to_value(DAY))
+        except u.UnitConversionError:  # (not a time: the whole path says so)
+            return None
         out = self._prop.advance_end(end)
         if out is not None:
-            self._unit = unit
+            self._unit = t.unit
         return out
 
     def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,

@@ -587,3 +587,22 @@ def test_the_unwatched_steps_are_those_of_the_nested_loop(monkeypatch, coordinat
     nested = run()
     assert flat[2] == nested[2] == 26 + 114 + 1 + 260  # (0.04: one shortened step)
     assert np.array_equal(flat[0], nested[0]) and np.array_equal(flat[1], nested[1])
+
+
+@pytest.mark.parametrize("t", [[1000.0], [400.0, 800.0, 1000.0], [1e300]],
+                         ids=["one-interval", "several-intervals", "huge"])
+def test_a_leg_beyond_max_steps_is_refused_before_its_first_step(t):
+    """More than ``max_steps`` steps over a leg are refused up front, whether the leg
+    is one interval or several each within the limit (999 / 0.5 = 1998 > 1500), and
+    a span whose step count overflows is the same error, not an ``OverflowError``;
+    the simulation stays where it was."""
+    from hamilton_orbits import Body, Simulation, System
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, method="wh", dt=0.5, max_steps=1500)
+    sim.integrate(1.0)
+    with pytest.raises(ValueError, match=r"wh would take about .* steps of dt = 0\.5 over .* "
+                                         r"\(max_steps = 1500\)"):
+        sim.integrate(t if len(t) > 1 else t[0])
+    assert sim.t == 1.0 and sim.steps == 2
+    assert sim.integrate(700.0).steps == 1398  # within the limit: run

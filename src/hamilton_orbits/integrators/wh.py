@@ -276,8 +276,9 @@ class _State:
         time); an event that stops the run raises
         :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
         times = t_out.tolist()  # (Python floats: the same numbers, cheaper arithmetic)
-        if len(times) > 2:  # (one interval: checked by _interval, from its step count)
-            _setup.check_step_count(times[-1] - times[0], self.dt, self.max_steps, NAME)
+        span = times[-1] - times[0]
+        if abs(span) > 0.5 * self.max_steps * self.dt:  # (only a leg near the limit can
+            _setup.check_step_count(span, self.dt, self.max_steps, NAME)  # be refused)
         first = self.steps
         for i in range(1, len(times)):
             row = r_out[i], v_out[i]
@@ -297,10 +298,7 @@ class _State:
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
         dt, log, ws = self.dt, self.log, self.ws
-        span = times[i] - times[i - 1]
-        if abs(span) > 0.5 * self.max_steps * dt:  # (near the limit: checked as advance
-            _setup.check_step_count(span, dt, self.max_steps, NAME)  # checks a leg of
-        n_steps, last = _setup.fixed_steps(span, dt)  # several intervals)
+        n_steps, last = _setup.fixed_steps(times[i] - times[i - 1], dt)
         watched = self.watch.shape[0] > 0
         done = 0
         while done < n_steps:
