@@ -156,7 +156,9 @@ class Propagation:
     variational : Tangent, optional
         Tangent vectors to integrate beside the state
         (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
-        ``variational=True``); forwards in time and without events.
+        ``variational=True``); without events, in one direction (a backward run
+        integrates the time-reversed motion's tangent vectors, its STM turned
+        back at the outputs).
 
     Examples
     --------
@@ -202,9 +204,17 @@ class Propagation:
 
     def _check(self, backward: bool) -> None:
         watched = self.events is not None and len(self.events.watch)
-        if self.variational is not None and (backward or watched):
-            raise ValueError("The variational equations are integrated forwards in time and "
-                             "without events; integrate forwards, with no events listed")
+        if self.variational is not None and watched:
+            raise ValueError("The variational equations are integrated without events; list "
+                             "no events, or integrate them apart")
+        if self.variational is not None and self.driver is not None:
+            raise ValueError(f"The variational equations are integrated in one direction: "
+                             f"this run went {'back' if self.backward else 'for'}wards (to t = "
+                             f"{self.t!r}); start a new run from the state reached")
+        if self.variational is not None and backward and \
+                time_reversed(self.rhs).augmented is None:
+            raise ValueError("The variational equations of this right-hand side are not "
+                             "integrated backwards (its time-reversed form has none)")
         if watched and backward:
             raise ValueError("Events are watched forwards in time only; integrate forwards")
 
@@ -224,6 +234,8 @@ class Propagation:
         # last watched pair has gone with them
         log = self.events if watched or (self.events is not None and self.events.gone
                                          and not backward) else None
+        if backward and self.variational is not None:  # (tangent vectors (dr, -dv))
+            self.variational.dv0 = -self.variational.dv0
         # backwards: the motion in s = -t, on w = -v (its effects at the velocity -w)
         self.driver = self.module.start(
             time_reversed(self.rhs) if backward else self.rhs, self.r,
@@ -306,6 +318,7 @@ class Propagation:
         k = reached[0] + 1
         if backward:  # in place: no second copy of the history
             np.negative(v_out, out=v_out)
+            _stm_forwards(self.variational, k)
         t_end = float(t_reached[k - 1])
         if driver.t == (-t_end if backward else t_end):  # the driver stands at the last output
             self.r, self.v, self.t = r_out[k - 1], v_out[k - 1], t_end
@@ -406,6 +419,17 @@ class _Pause:
         self.pause(again)
 
 
+def _stm_forwards(tangent: Any, k: int) -> None:
+    """The STMs of a backward leg's outputs 1 ... ``k - 1``, made of the time-reversed
+    motion's tangent vectors ``(dr, dw)`` that started as ``(dr, -dv)``, turned into
+    those of ``(r, v)``: their velocity rows negated (``D M D`` with ``D = diag(1, -1)``
+    per body, the columns' ``D`` given at the start)."""
+    if tangent is None or tangent.stm is None or k < 2:
+        return
+    rows = tangent.stm[1:k].reshape(k - 1, tangent.n, 6, -1)
+    np.negative(rows[:, :, 3:], out=rows[:, :, 3:])
+
+
 def run(
     r0: np.ndarray,
     v0: np.ndarray,
@@ -451,7 +475,9 @@ def run(
     variational : Tangent, optional
         Tangent vectors to integrate beside the state
         (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
-        ``variational=True``); forwards in time and without events.
+        ``variational=True``); without events, in one direction (a backward run
+        integrates the time-reversed motion's tangent vectors, its STM turned
+        back at the outputs).
 
     Returns
     -------

@@ -135,11 +135,15 @@ def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, floa
     # the time from its clock row)
     velocity = "eih" in effects or outgassing is not None
     tag = ("newtonian", "small_bodies", *blocks)
-    # the time-reversed motion: the same kernel and parameters, the clock's velocity
-    # (-1) says which (and one run at a time uses the cache)
-    reverse = RHS(small_bodies_field, None, p, velocity, tag, per_run=True)
+    # the time-reversed motion: the same kernels and parameters, the clock's velocity
+    # (-1) says which (and one run at a time uses the cache); its variational
+    # equations the central differences of that field along the tangent vectors of
+    # the reversed motion, (dr, -dv)
+    augmented = small_bodies_augmented if variational else None
+    reverse = RHS(small_bodies_field, None, p, velocity, tag, augmented=augmented,
+                  per_run=True)
     return RHS(small_bodies_field, None, p, velocity, tag, reversed=reverse,
-               augmented=small_bodies_augmented if variational else None, per_run=True)
+               augmented=augmented, per_run=True)
 
 
 #: the parameters of one body's non-gravitational acceleration and their kinds

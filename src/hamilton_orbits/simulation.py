@@ -428,7 +428,8 @@ def integrate(
         Integrate the first-order variational equations beside the system (every
         listed effect's Jacobian included): the trajectory then has ``megno`` and
         ``lyapunov`` (from one tangent vector, as rebound's MEGNO; see
-        ``docs/variational.md``).  Forwards in time, without events.
+        ``docs/variational.md``).  Forwards or backwards (one direction per run),
+        without events.
     stm : bool
         With ``variational``: also the state transition matrix ``traj.stm`` (6n
         more tangent vectors).

@@ -101,10 +101,11 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         Also integrate the variational equations: MEGNO and the Lyapunov exponent
         of the bodies together (``traj.megno``, ...; they must then run as one:
         ``chunk`` at least their number).  The Jacobian is applied by central
-        differences of the field.  Forwards in time only.
+        differences of the field.  Forwards or backwards (the time-reversed
+        motion's, see ``docs/variational.md``).
     stm : bool
         The state transition matrix ``traj.stm`` (n_t, 6n, 6n), block-diagonal
-        body by body, and so ``traj.covariance(cov0)``.  Forwards in time only.
+        body by body, and so ``traj.covariance(cov0)``.  Forwards or backwards.
     method : {"radau15", "dop853"}
         The integrator.
     tol : float, optional
@@ -172,10 +173,6 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                          f"{len(per_body)}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
-    if (stm or variational) and days[-1] < days[0]:
-        raise ValueError(f"`stm` and `variational` are integrated forwards in time: got `t` "
-                         f"ending {float(days[-1])!r} days from the epoch (run forwards from "
-                         f"the earlier state)")
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     pairs = encounters(events, names, perturbers)
     if pairs and (stm or variational or days[-1] < days[0]):

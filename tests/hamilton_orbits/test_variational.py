@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hamilton_orbits import Body, System, integrate
+from hamilton_orbits import Body, Simulation, System, integrate
 from hamilton_orbits._kernels import kepler, variational
 from hamilton_orbits.rhs import compile_rhs
 
@@ -298,6 +298,60 @@ def test_newtonian_tangent_along_a_gr_orbit_is_wrong():
     assert good < 1e-6 and bad > 1e-4, (good, bad)
 
 
+_BACKWARD = [
+    ("radau15", {}, ()),
+    ("radau15", {}, ({"name": "gr", "c": 30.0},)),
+    ("dop853", {"tol": 1e-12}, ({"name": "gr", "c": 30.0},)),
+    ("wh", {"dt": 0.02}, ()),
+    ("wh", {"dt": 0.02, "coordinates": "jacobi"}, ({"name": "gr_potential", "c": 30.0},)),
+    ("leapfrog", {"dt": 0.002}, ()),
+]
+
+
+@pytest.mark.parametrize("method, kw, effects", _BACKWARD,
+                         ids=["radau15", "radau15-gr", "dop853-gr", "wh", "whjacobi-grpotential",
+                              "leapfrog"])
+def test_backward_stm_against_finite_differences(method, kw, effects):
+    """A backward run's STM (the time-reversed motion's tangent vectors, started as
+    ``(dr, -dv)`` and turned back at the outputs) against central differences of
+    whole backward integrations: 1e-6, as forwards (measured 4.4e-9 to 8.8e-9).
+    ``gr`` depends on the velocity: its Jacobian is applied at the true velocity to
+    the true velocity's part of each vector (the velocity rows left unturned miss
+    by 1.5)."""
+    s = _three()
+    t = -5 * 2 * np.pi
+    tr = integrate(s, t, method=method, effects=list(effects), variational=True, stm=True,
+                   **kw)
+    assert np.array_equal(tr.stm[0], np.eye(18))
+    fd = _fd_stm(s, t, 1e-6, method=method, effects=list(effects), **kw)
+    err = np.max(np.abs(tr.stm[-1] - fd)) / np.max(np.abs(fd))
+    assert err < 1e-6, err
+
+
+@pytest.mark.parametrize("method, kw", [("radau15", {}), ("wh", {"dt": 0.02}),
+                                        ("dop853", {"tol": 1e-12})])
+def test_backward_variational_run_is_the_reflected_forward_one(method, kw):
+    """Newton's motion is reversible: running ``(r, v)`` back in time is running
+    ``(r, -v)`` forwards, the velocities negated.  The backward run integrates
+    exactly that, so its outputs are the reflected forward run's bit for bit: the
+    positions, the velocities negated, MEGNO and the Lyapunov exponent (its tangent
+    vector's velocity part negated too), and the STM ``D M D`` with
+    ``D = diag(1, 1, 1, -1, -1, -1)`` per body."""
+    from hamilton_orbits.integrators._tangent import megno_vector
+
+    s = _three()
+    times = -np.array([0.0, 3.0, 7.5])
+    back = integrate(s, times, method=method, variational=True, stm=True, **kw)
+    vector = megno_vector(3) * np.array([1, 1, 1, -1, -1, -1])
+    fwd = integrate(s.with_state(s.r, -np.asarray(s.v)), -times, method=method,
+                    variational=True, stm=True, tangent=vector, **kw)
+    d = np.kron(np.eye(3), np.diag([1.0, 1, 1, -1, -1, -1]))
+    assert np.array_equal(back.r, fwd.r) and np.array_equal(back.v, -fwd.v)
+    assert np.array_equal(back.megno, fwd.megno)
+    assert np.array_equal(back.lyapunov, fwd.lyapunov)
+    assert np.array_equal(back.stm, d @ fwd.stm @ d)
+
+
 # ---------------------------------------------------------------------------
 # Symplecticity: M^T J M = J
 
@@ -442,8 +496,6 @@ def test_lyapunov_time_in_legs_and_quantities():
     """``lyapunov_time`` in the unit of ``t`` (a Quantity system), continued across
     legs exactly as one call."""
     import astropy.units as u
-
-    from hamilton_orbits import Simulation
 
     s = System.solar_system(bodies=["sun", "jupiter", "saturn"])
     sim = Simulation(s, "wh", dt=100 * u.day, variational=True)
@@ -605,8 +657,11 @@ def test_variational_api_and_errors():
         integrate(s, 1.0, stm=True)
     with pytest.raises(ValueError, match="`tangent` to have shape"):
         integrate(s, 1.0, variational=True, tangent=np.ones(5))
-    with pytest.raises(ValueError, match="forwards in time and without events"):
-        integrate(s, -1.0, variational=True)
+    sim = Simulation(s, method="radau15", variational=True)
+    sim.integrate(1.0)
+    with pytest.raises(ValueError, match=r"in one direction: this run went forwards \(to t = "
+                                         r"1\.0\); start a new run"):
+        sim.integrate(0.5)
     with pytest.raises(ValueError, match="corrector"):
         integrate(s, 1.0, method="wh", dt=0.01, coordinates="jacobi", corrector=3,
                   variational=True)

@@ -306,7 +306,9 @@ def time_reversed(rhs: RHS) -> RHS:
     velocities ``w = -v``: ``d2r/ds2 = a(r, -w, t = -s)``, the effects evaluated at
     the true velocity and the true time (:func:`~hamilton_orbits.rhs.codegen.source`,
     ``reverse``).  ``rhs`` itself when no effect depends on velocities or on the
-    time (``a(r, -w) = a(r, w)``).
+    time (``a(r, -w) = a(r, w)``).  Of ``rhs`` compiled with ``variational=True``,
+    its variational equations too, on the tangent vectors ``(dr, dw) = (dr, -dv)``:
+    the effects' Jacobians applied at the true velocity and time to ``(dr, -dw)``.
 
     Examples
     --------
@@ -324,10 +326,17 @@ def time_reversed(rhs: RHS) -> RHS:
         return rhs
     specs = [get("nbody", name) for name in rhs.effects[1:]]
     kernels = tuple(spec.kernel for spec in specs)
-    key = (tuple(kernel_ref(k) for k in kernels),
-           any(spec.replaces_newtonian for spec in specs), None, "reversed")
-    return RHS(*_memoised(key, kernels), rhs.p, rhs.velocity_dependent, rhs.effects,
-               timed=rhs.timed)
+    refs, replaces = tuple(kernel_ref(k) for k in kernels), any(
+        spec.replaces_newtonian for spec in specs)
+    if rhs.tangent is None:
+        return RHS(*_memoised((refs, replaces, None, "reversed"), kernels), rhs.p,
+                   rhs.velocity_dependent, rhs.effects, timed=rhs.timed)
+    jacobians = tuple((spec.jacobian, spec.velocity_dependent) for spec in specs)
+    key = (refs, replaces, tuple(_jac_ref(j, vd) for j, vd in jacobians), "reversed")
+    accel, extra, tangent, tangent_extra, augmented = _memoised(
+        key, kernels, tuple(j for j, _ in jacobians))
+    return RHS(accel, extra, rhs.p, rhs.velocity_dependent, rhs.effects, tangent,
+               tangent_extra, augmented, timed=rhs.timed)
 
 
 _MEMO: dict[tuple, tuple[Any, Any]] = {}

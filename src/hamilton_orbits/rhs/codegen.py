@@ -115,7 +115,7 @@ ${imports}${differences}
 
 @njit(TANGENT_SIGNATURE, cache=$cache, error_model='numpy')
 def tangent_extra(r, v, gm, dr, dv, da, p):  # pragma: no cover - compiled
-${clock}${calls}
+${reverse}${clock}${calls}
 
 
 @njit(TANGENT_SIGNATURE, cache=$cache, error_model='numpy')
@@ -249,18 +249,24 @@ def source(refs: tuple[tuple[str, str], ...], replaces_newtonian: bool, digest: 
         calls=_slice_calls(["k"] * len(refs), "r, w, gm, acc" if reverse else "r, v, gm, acc",
                            timed))
     if jac_refs is not None:
-        text += _tangent(replaces_newtonian, jac_refs, bool(cache), imports, timed, jac_timed)
+        text += _tangent(replaces_newtonian, jac_refs, bool(cache), imports, timed, jac_timed,
+                         reverse)
     return text
 
 
 def _tangent(replaces_newtonian: bool, jac_refs: tuple, cache: bool, imports: bool,
-             timed: tuple[bool, ...] = (), jac_timed: tuple[bool, ...] = ()) -> str:
+             timed: tuple[bool, ...] = (), jac_timed: tuple[bool, ...] = (),
+             reverse: bool = False) -> str:
     # (an effect differenced takes the time when its kernel does; an analytic
-    # Jacobian when it does itself)
+    # Jacobian when it does itself.  Time-reversed: the effects' Jacobians applied at
+    # the true velocity -w to the true velocity's part -dw of each tangent vector,
+    # the derivative of a(r, -w, -s) along (dr, dw); the Newtonian one reads neither)
     timed, jac_timed = _flags(timed, len(jac_refs)), _flags(jac_timed, len(jac_refs))
     takes = tuple(timed[i] if module == "fd" else jac_timed[i]
                   for i, (module, _) in enumerate(jac_refs))
     return _TANGENT.substitute(
+        reverse="    w, dw = -v, -dv  # (the time-reversed motion: the velocities are -w, "
+        "-dw)\n" if reverse and jac_refs else "",
         base="zero_jvp" if replaces_newtonian else "newtonian_jvp", cache=cache,
         imports="".join(f"from {module} import {name} as j{i}\n"
                         for i, (module, name) in enumerate(jac_refs)
@@ -270,9 +276,10 @@ def _tangent(replaces_newtonian: bool, jac_refs: tuple, cache: bool, imports: bo
                                     signature="" if takes[i] else "TANGENT_SIGNATURE, ",
                                     time=", t" if takes[i] else "")
             for i, (module, parts) in enumerate(jac_refs) if module == "fd"),
-        clock=_clock(takes),
+        clock=_clock(takes, reverse),
         calls=_slice_calls(["fd" if module == "fd" else "j" for module, _ in jac_refs],
-                           "r, v, gm, dr, dv, da", takes))
+                           "r, w, gm, dr, dw, da" if reverse else "r, v, gm, dr, dv, da",
+                           takes))
 
 
 def tangent_source(replaces_newtonian: bool, jac_refs: tuple[tuple[str, str], ...], *,
