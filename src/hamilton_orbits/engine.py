@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels.checks import all_finite
-from hamilton_orbits.events import EventLog, StopAtEvent
+from hamilton_orbits.events import ACTIONS, W_ACTION, EventLog, StopAtEvent
 from hamilton_orbits.firstrun import compile_seconds
 from hamilton_orbits.integrators import (
     INTEGRATORS,
@@ -152,7 +152,8 @@ class Propagation:
     dt, tol : float, optional
         The integrator's step and tolerance, positive and finite (or None).
     events : EventLog, optional
-        Events to watch (:mod:`hamilton_orbits.events`), forwards only.
+        Events to watch (:mod:`hamilton_orbits.events`); backwards, those that
+        only record (their times turned back from the reversed motion's).
     variational : Tangent, optional
         Tangent vectors to integrate beside the state
         (:class:`hamilton_orbits.integrators._tangent.Tangent`; ``rhs`` compiled with
@@ -215,8 +216,9 @@ class Propagation:
                 time_reversed(self.rhs).augmented is None:
             raise ValueError("The variational equations of this right-hand side are not "
                              "integrated backwards (its time-reversed form has none)")
-        if watched and backward:
-            raise ValueError("Events are watched forwards in time only; integrate forwards")
+        if watched and backward and np.any(self.events.watch[:, W_ACTION] != ACTIONS["record"]):
+            raise ValueError("Events with an action (stop, merge, remove) are watched forwards "
+                             "in time only; a backward run records them (action 'record')")
 
     def driver_for(self, backward: bool) -> Any:
         """The driver's state for a leg in this direction (a new one from the state
@@ -236,6 +238,9 @@ class Propagation:
                                          and not backward) else None
         if backward and self.variational is not None:  # (tangent vectors (dr, -dv))
             self.variational.dv0 = -self.variational.dv0
+        if self.events is not None:  # (the rows found so far in the last direction's time)
+            self.events.drain()
+            self.events.sign = -1.0 if backward else 1.0
         # backwards: the motion in s = -t, on w = -v (its effects at the velocity -w)
         self.driver = self.module.start(
             time_reversed(self.rhs) if backward else self.rhs, self.r,

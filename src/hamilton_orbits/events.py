@@ -352,8 +352,12 @@ class EventLog:
     """
 
     #: working space a saved state leaves out (``hamilton_orbits.restart``): the
-    #: buffer holds nothing after :meth:`drain`, which a snapshot does first
-    RESTART_SCRATCH = ("buffer",)
+    #: buffer holds nothing after :meth:`drain`, which a snapshot does first; the
+    #: sign of the driver's time is set with each driver, from the direction
+    RESTART_SCRATCH = ("buffer", "sign")
+    #: the driver's time over the run's: -1 in a backward run, which integrates the
+    #: time-reversed motion in ``s = -t`` (:meth:`drain` turns its times back)
+    sign = 1.0
 
     def __init__(self, watch: np.ndarray, radius: np.ndarray, capacity: int = 1024) -> None:
         self.watch = np.ascontiguousarray(watch, dtype=np.float64).reshape(-1, 5)
@@ -386,6 +390,8 @@ class EventLog:
         """Move the kernel's buffered rows into ``rows`` and empty the buffer."""
         k = int(self.count[0])
         rows = self.buffer[:k].copy()
+        if self.sign < 0:  # (found in s = -t; distances and speeds are the same)
+            np.negative(rows[:, E_TIME], out=rows[:, E_TIME])
         if self.index_map is not None:
             rows[:, E_I] = self.index_map[rows[:, E_I].astype(int)]
             pair = rows[:, E_J] >= 0

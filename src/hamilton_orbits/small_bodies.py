@@ -30,7 +30,7 @@ independent run (:func:`run_job`), one after another, on threads or on a Dask
 cluster (:func:`hamilton_orbits.batches.run_jobs`).  ``stm=True`` adds the state
 transition matrix (the field's Jacobian by central differences), ``variational``
 MEGNO.  ``events``: close encounters with the perturbers
-(:mod:`hamilton_orbits.small_body_events`), forwards.
+(:mod:`hamilton_orbits.small_body_events`), forwards or backwards.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         "bodies": "earth", "distance": 0.05 * u.au}`` (``bodies``: perturbers, and
         optionally the small bodies to watch, default all), found on the
         integrator's interpolant of each step (``traj.events``: time, bodies,
-        distance, speed).  Forwards in time, without ``stm`` / ``variational``
+        distance, speed).  Forwards or backwards, without ``stm`` / ``variational``
         (:mod:`hamilton_orbits.small_body_events`).
     variational : bool
         Also integrate the variational equations: MEGNO and the Lyapunov exponent
@@ -175,9 +175,9 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     days = _output_days(t, jd1, jd2)
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     pairs = encounters(events, names, perturbers)
-    if pairs and (stm or variational or days[-1] < days[0]):
-        raise ValueError("`events` are watched forwards in time, without `stm` or "
-                         "`variational`: run those apart")
+    if pairs and (stm or variational):
+        raise ValueError("`events` are watched without `stm` or `variational`: run those "
+                         "apart")
     segments = _segments(ephemeris, jd1 + jd2 + min(days[0], days[-1]),
                          jd1 + jd2 + max(days[0], days[-1]), asteroids)
     groups: dict[str | None, list[int]] = {}
@@ -203,7 +203,8 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     shadows = [watch_for(job.encounters, len(job.names))[0] for job in jobs]
     return _trajectory(names, list(zip(parts, outs, strict=True)), method, tuple(effects),
                        event_rows(list(zip(parts, outs, shadows, strict=True)), len(names),
-                                  perturbers) if pairs else None, perturbers)
+                                  perturbers, days[-1] < days[0]) if pairs else None,
+                       perturbers)
 
 
 class Job(NamedTuple):

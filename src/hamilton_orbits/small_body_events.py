@@ -144,11 +144,11 @@ def watch_for(pairs: Sequence[Encounter], n: int) -> tuple[tuple[str, ...], np.n
 
 
 def event_rows(runs: Sequence[tuple[Sequence[int], Any, tuple[str, ...]]], n: int,
-               perturbers: Sequence[str]) -> np.ndarray:
+               perturbers: Sequence[str], backward: bool = False) -> np.ndarray:
     """The events recorded by ``runs`` (each: its small bodies' indices, its
     ``EngineRun``, its shadows), their rows' bodies turned from a run's rows into
     indices of :class:`EventBodies` (``n`` small bodies, then ``perturbers``), in
-    order of time."""
+    the order the runs met them: of time, or of decreasing time ``backward``."""
     from hamilton_orbits.events import E_I, E_J, E_TIME, N_EVENT_COLUMNS
 
     parts = [np.zeros((0, N_EVENT_COLUMNS))]
@@ -161,4 +161,5 @@ def event_rows(runs: Sequence[tuple[Sequence[int], Any, tuple[str, ...]]], n: in
                          for j in found[:, E_J]]
         parts.append(found)
     out_rows = np.concatenate(parts)
-    return out_rows[np.argsort(out_rows[:, E_TIME], kind="stable")]
+    return out_rows[np.argsort(-out_rows[:, E_TIME] if backward else out_rows[:, E_TIME],
+                               kind="stable")]

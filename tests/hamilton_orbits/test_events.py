@@ -19,15 +19,16 @@ from hamilton_orbits import Body, KeplerOrbit, System, integrate
 MU = 2.8e-4  # a Jupiter-like planet in au^3/day^2, the planet alone
 
 
-def _flybys(n: int = 100, seed: int = 2026):
+def _flybys(n: int = 100, seed: int = 2026, past: bool = False):
     """``n`` massless particles on hyperbolic flybys of one planet, periapses from
-    1e-6 to 0.1 (log-spaced), each passing periapsis at a known time."""
+    1e-6 to 0.1 (log-spaced), each passing periapsis at a known time (after the
+    start, or before it: ``past``)."""
     rng = np.random.default_rng(seed)
     q = np.logspace(-6, -1, n)
     orbit = KeplerOrbit.from_elements(
         q=q, e=rng.uniform(1.05, 3.0, n), inc=rng.uniform(0, np.pi, n),
         lan=rng.uniform(0, 2 * np.pi, n), argp=rng.uniform(0, 2 * np.pi, n),
-        M=-rng.uniform(0.2, 8.0, n), mu=np.full(n, MU))
+        M=(1.0 if past else -1.0) * rng.uniform(0.2, 8.0, n), mu=np.full(n, MU))
     r, v = orbit.state()
     t_peri = -np.asarray(orbit.M) / np.asarray(orbit.n)
     system = System([Body("planet", MU, [0, 0, 0], [0, 0, 0])]
@@ -56,6 +57,36 @@ def test_every_flyby_is_found_with_its_periapsis(method, kw):
     np.testing.assert_allclose(np.asarray(ev["distance"]), q[k], rtol=1e-9, atol=0)
     np.testing.assert_allclose(np.asarray(ev["time"]), t_peri[k], rtol=1e-9, atol=0)
     assert traj.stopped_by is None and traj.t[-1] == pytest.approx(t_peri.max() * 1.2)
+
+
+@pytest.mark.parametrize(("method", "kw"), [
+    ("radau15", {}),
+    ("wh", {"dt": 1.0}),
+    ("wh", {"dt": 1.0, "coordinates": "jacobi"}),
+])
+def test_a_backward_run_finds_every_flyby_it_came_through(method, kw):
+    """The same 100 flybys with their periapses in the past: a backward run (the
+    time-reversed motion, its events' times turned back) records every one once,
+    at the analytic distance and (negative) time to 1e-9 relative, as forwards."""
+    system, q, t_peri = _flybys(past=True)
+    assert np.all(t_peri < 0)
+    traj = integrate(system, float(t_peri.min()) * 1.2, method=method,
+                     events=[{"name": "close_encounter", "distance": 0.5}], **kw)
+    ev = traj.events
+    k = np.array([int(b.split("-p")[1]) for b in ev["bodies"]])
+    assert sorted(k.tolist()) == list(range(100))
+    times = np.asarray(ev["time"])
+    np.testing.assert_allclose(np.asarray(ev["distance"]), q[k], rtol=1e-9, atol=0)
+    np.testing.assert_allclose(times, t_peri[k], rtol=1e-9, atol=0)
+
+
+def test_events_with_an_action_are_refused_backwards():
+    system = _flybys(5, past=True)[0]
+    with pytest.raises(ValueError, match=r"Events with an action \(stop, merge, remove\) are "
+                                         r"watched forwards in time only; a backward run "
+                                         r"records them"):
+        integrate(system, -10.0, events=[{"name": "close_encounter", "distance": 0.5,
+                                          "action": "stop"}])
 
 
 def test_an_encounter_outside_the_distance_is_not_reported():
