@@ -232,8 +232,8 @@ def event_log(system: System, events: Any) -> EventLog | None:
 
 def check_effects(method: Method, effects: Any) -> EffectSet:
     """The effects as an :class:`~hamilton_orbits.effects.EffectSet`, checked against
-    the typed ``method`` (a velocity-dependent effect refused by a symplectic map,
-    naming the integrators that accept it)."""
+    the typed ``method`` (a velocity-dependent effect refused by a symplectic map, one
+    that replaces Newtonian gravity by ``wh``, naming the integrators that accept it)."""
     eff = EffectSet.of(effects, "nbody")
     if not method.accepts_velocity_dependent:
         for name in eff.names:
@@ -245,6 +245,12 @@ def check_effects(method: Method, effects: Any) -> EffectSet:
                     f"symplectic; integrators that accept it: {', '.join(accepting)}"
                     + (" (or use 'gr_potential')" if name == "gr" else "")
                 )
+    for name in eff.names:
+        if get("nbody", name).replaces_newtonian and not method.accepts_newtonian_replaced:
+            accepting = [m for m in INTEGRATORS if method_of(m).accepts_newtonian_replaced]
+            raise ValueError(f"Effect {name!r} replaces Newtonian gravity, which integrator "
+                             f"{method.name!r} splits into Kepler drifts and kicks of its "
+                             f"own; integrators that accept it: {', '.join(accepting)}")
     return eff
 
 

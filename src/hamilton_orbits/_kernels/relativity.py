@@ -16,6 +16,9 @@ integrates its ephemerides (Moyer 2003, eq. 4-26; Park et al. 2021, section 3):
 
 with ``a_j`` the Newtonian acceleration of body j (the difference is of second
 post-Newtonian order).  Massless bodies feel the field and add nothing to it.
+*Semi-active* bodies (rebound's ``testparticle_type = 1``) pull on every other
+body and feel every other body, but not each other: their pairs are left out of
+the sums (:func:`newtonian_semi_active` is Newton's law alone with that rule).
 No astropy here.
 """
 
@@ -26,10 +29,11 @@ from numba import njit
 
 
 @njit(cache=True)
-def newtonian_and_potential(r, gm, acc_n, phi, inv_d):  # pragma: no cover - compiled
+def newtonian_and_potential(r, gm, semi, acc_n, phi, inv_d):  # pragma: no cover - compiled
     """Overwrite ``acc_n`` (n, 3) with the Newtonian accelerations, ``phi`` (n,) with
     the Newtonian potentials ``sum_{k != i} gm_k / r_ik`` and ``inv_d`` (n, n) with the
-    inverse distances (pairs of massless bodies left out)."""
+    inverse distances (pairs of massless bodies, and of two semi-active bodies,
+    ``semi`` (n,) True, left out)."""
     n = r.shape[0]
     for i in range(n):
         acc_n[i, 0] = 0.0
@@ -38,7 +42,7 @@ def newtonian_and_potential(r, gm, acc_n, phi, inv_d):  # pragma: no cover - com
         phi[i] = 0.0
     for i in range(n):
         for j in range(i + 1, n):
-            if gm[i] == 0.0 and gm[j] == 0.0:
+            if (gm[i] == 0.0 and gm[j] == 0.0) or (semi[i] and semi[j]):
                 continue
             dx = r[j, 0] - r[i, 0]
             dy = r[j, 1] - r[i, 1]
@@ -63,29 +67,63 @@ def newtonian_and_potential(r, gm, acc_n, phi, inv_d):  # pragma: no cover - com
 @njit(cache=True, inline="always")
 def eih_sources(p, gm):  # pragma: no cover - compiled
     """Which bodies are the post-Newtonian sources of :func:`eih`'s ``p = [c, beta,
-    gamma, j_1, j_2, ...]``: those listed (every body when none is), massive."""
+    gamma, j_1, j_2, ...]``: those listed (every body when none is, but the
+    semi-active ones, :func:`semi_active_of`), massive."""
     n = gm.shape[0]
     src = np.zeros(n, dtype=np.bool_)
-    if p.shape[0] > 3:
-        for b in range(3, p.shape[0]):
+    listed = False
+    for b in range(3, p.shape[0]):
+        if p[b] >= 0.0:
             src[int(p[b])] = True
-    else:
+            listed = True
+    if not listed:
+        semi = semi_active_of(p, n)
         for b in range(n):
-            src[b] = True
+            src[b] = not semi[b]
     for i in range(n):
         if gm[i] == 0.0:
             src[i] = False
     return src
 
 
+@njit(cache=True, inline="always")
+def semi_active_of(p, n):  # pragma: no cover - compiled
+    """The semi-active bodies of :func:`eih`'s ``p``, (n,) True: body ``s`` listed
+    after the sources as ``-1 - s``."""
+    semi = np.zeros(n, dtype=np.bool_)
+    for b in range(3, p.shape[0]):
+        if p[b] < 0.0:
+            semi[-1 - int(p[b])] = True
+    return semi
+
+
+@njit(cache=True, error_model="numpy")
+def newtonian_semi_active(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """Newton's law with semi-active bodies, ADDED to ``acc``: ``p`` the indices of
+    the bodies that pull on every other body and feel every other body, but not
+    each other (the ``semi_active`` effect, which replaces the Newtonian kernel)."""
+    n = r.shape[0]
+    semi = np.zeros(n, dtype=np.bool_)
+    for b in range(p.shape[0]):
+        semi[int(p[b])] = True
+    acc_n, phi, inv_d = np.empty((n, 3)), np.empty(n), np.empty((n, n))
+    newtonian_and_potential(r, gm, semi, acc_n, phi, inv_d)
+    for i in range(n):
+        acc[i, 0] += acc_n[i, 0]
+        acc[i, 1] += acc_n[i, 1]
+        acc[i, 2] += acc_n[i, 2]
+
+
 @njit(cache=True)
 def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     """Newtonian plus first post-Newtonian accelerations (Moyer 2003, eq. 4-26), ADDED
-    to ``acc``.  ``p = [c, beta, gamma, j_1, j_2, ...]`` (c in the system's units of
-    speed): the post-Newtonian terms of the sources ``j_1, j_2, ...`` (every massive
-    body when none is given); every other massive body acts by Newton's law alone,
-    on every body.  One pass over the pairs for the Newtonian sums, one for the
-    corrections (both directions of a pair at once)."""
+    to ``acc``.  ``p = [c, beta, gamma, j_1, j_2, ..., -1 - s_1, ...]`` (c in the
+    system's units of speed): the post-Newtonian terms of the sources ``j_1, j_2,
+    ...`` (every massive body but the semi-active ones when none is given); every
+    other massive body acts by Newton's law alone, on every body; the semi-active
+    bodies ``s_1, ...`` not on each other (none of them a source).  One pass over the
+    pairs for the Newtonian sums, one for the corrections (both directions of a pair
+    at once)."""
     ic2 = 1.0 / (p[0] * p[0])
     beta = p[1]
     gamma = p[2]
@@ -93,7 +131,7 @@ def eih(r, v, gm, acc, p):  # pragma: no cover - compiled
     acc_n = np.empty((n, 3))
     phi = np.empty(n)
     inv_d = np.empty((n, n))
-    newtonian_and_potential(r, gm, acc_n, phi, inv_d)
+    newtonian_and_potential(r, gm, semi_active_of(p, n), acc_n, phi, inv_d)
     src = eih_sources(p, gm)
     k = np.empty(7)
     k[0] = 2.0 * (beta + gamma) * ic2  # phi of the receiver

@@ -62,6 +62,7 @@ from hamilton_orbits.effects import (
     newtonian,
     nongrav,
     relativity,
+    semi_active,
     tides,
     zonal,
 )
@@ -113,5 +114,6 @@ BUILT_IN: tuple[EffectSpec, ...] = (
     *tides.SPECS,
     *kuiper_ring.SPECS,
     *nongrav.SPECS,
+    *semi_active.SPECS,
 )
 _ = [register(spec) for spec in BUILT_IN]

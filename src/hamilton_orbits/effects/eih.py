@@ -29,7 +29,7 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.relativity import eih
 from hamilton_orbits.effects.parameters import (
     PARK_2021,
-    body_index,
+    body_list,
     de440_c_au_per_day,
     require_de440_units,
     scalar_parameter,
@@ -47,16 +47,14 @@ def _params_eih(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     beta = scalar_parameter(system, params, "beta", "eih", DIMENSIONLESS, de.constant("BETA"))
     gamma = scalar_parameter(system, params, "gamma", "eih", DIMENSIONLESS,
                              de.constant("GAMMA"))
-    sources: list[int] = []
-    if "sources" in params:
-        names = params["sources"]
-        if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
-            raise ValueError(f"Effect 'eih': expected `sources` to be a list of body names, "
-                             f"got {names!r}")
-        sources = [body_index(system, {"sources": x}, "sources", "", "eih") for x in names]
-        if not sources:
-            raise ValueError("Effect 'eih': `sources` is empty")
-    return np.array([c, beta, gamma, *sources], dtype=float)
+    sources = body_list(system, params, "sources", "eih")
+    semi = body_list(system, params, "semi_active", "eih")
+    for b in semi:
+        if b in sources:
+            raise ValueError(f"Effect 'eih': {system.names[b]!r} is both a source and "
+                             f"semi-active (a semi-active body acts by Newton's law)")
+    # (the semi-active bodies after the sources, as -1 - index: relativity.eih)
+    return np.array([c, beta, gamma, *sources, *(-1.0 - b for b in semi)], dtype=float)
 
 
 SPECS = (
@@ -68,7 +66,11 @@ SPECS = (
                     "beta": "PPN beta (default DE440's, 1)",
                     "gamma": "PPN gamma (default DE440's, 1)",
                     "sources": "bodies whose 1PN field is computed (default every "
-                               "massive body; the others act by Newton's law)"},
+                               "massive body but the semi-active ones; the others act "
+                               "by Newton's law)",
+                    "semi_active": "bodies that pull on every other body and feel every "
+                                   "other body, but not each other (rebound's "
+                                   "testparticle_type = 1; none a source)"},
         kernel=eih, params=_params_eih,
         parameter_kinds={"c": SPEED, "beta": DIMENSIONLESS, "gamma": DIMENSIONLESS},
         excludes={"gr": "the first post-Newtonian terms of the dominant body",

@@ -62,6 +62,7 @@ __all__ = [
     "SYSTEM_UNITS",
     "axes_frame",
     "body_index",
+    "body_list",
     "body_pole",
     "de440_c_au_per_day",
     "distinct_bodies",
@@ -368,6 +369,36 @@ def optional_body_index(system: Any, params: Mapping[str, Any], key: str, defaul
     if name is None or name == "none":
         return -1
     return body_index(system, params, key, default, effect)
+
+
+def body_list(system: Any, params: Mapping[str, Any], key: str, effect: str) -> list[int]:
+    """The indices of the bodies that mapping ``params`` lists under ``key`` (a list
+    of distinct names, at least one; none given: an empty list).
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("vesta", 1e-10, [1, 0, 0],
+    ...                                                           [0, 1, 0])])
+    >>> body_list(s, {"bodies": ["vesta"]}, "bodies", "semi_active")
+    [1]
+    >>> body_list(s, {"bodies": "vesta"}, "bodies", "semi_active")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'semi_active': expected `bodies` to be a list of body names, got 'vesta'
+    """
+    if key not in params:
+        return []
+    names = params[key]
+    if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
+        raise ValueError(f"Effect {effect!r}: expected `{key}` to be a list of body names, "
+                         f"got {names!r}")
+    if not names:
+        raise ValueError(f"Effect {effect!r}: `{key}` is empty")
+    for k, name in enumerate(names):
+        if name in names[:k]:
+            raise ValueError(f"Effect {effect!r}: `{key}` names {name!r} twice (at index {k})")
+    return [body_index(system, {key: x}, key, "", effect) for x in names]
 
 
 def distinct_bodies(system: Any, indices: Mapping[str, int], effect: str) -> None:

@@ -68,6 +68,9 @@ class Method:
     name: ClassVar[str] = ""
     #: True if the method accepts velocity-dependent effects (symplectic maps do not).
     accepts_velocity_dependent: ClassVar[bool] = True
+    #: True if the method takes an effect that replaces Newtonian gravity (``wh``, which
+    #: splits Newtonian gravity into its own Kepler drifts and kicks, does not).
+    accepts_newtonian_replaced: ClassVar[bool] = True
 
     def options(self) -> dict[str, Any]:
         """The options as keyword arguments (field name -> value)."""
@@ -146,6 +149,7 @@ class WH(Method):
 
     name: ClassVar[str] = "wh"
     accepts_velocity_dependent: ClassVar[bool] = False
+    accepts_newtonian_replaced: ClassVar[bool] = False
     coordinates: str = "democratic_heliocentric"
     corrector: int = 0
     max_steps: int = MAX_FIXED_STEPS

@@ -1,0 +1,117 @@
+"""The ``semi_active`` effect and ``eih``'s ``semi_active`` parameter (issue 35 item
+8): bodies that pull on every other body and feel every other body, but not each
+other (rebound's test particles of type 1)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, System, integrate
+from hamilton_orbits.rhs import compile_rhs
+
+SEMI = ["b2", "b3", "b5"]
+
+
+def _system() -> System:
+    """A star, eight bodies of masses 1e-9 to 1e-4 scattered within a few units."""
+    rng = np.random.default_rng(1)
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])]
+                  + [Body(f"b{k}", 10 ** rng.uniform(-9, -4), rng.normal(size=3) * 3,
+                          rng.normal(size=3) * 0.3) for k in range(8)])
+
+
+def _direct(r: np.ndarray, gm: np.ndarray, semi: list[int]) -> np.ndarray:
+    """Newton's law summed body by body, every ordered pair apart, the pairs of two
+    semi-active bodies left out (numpy; another order of the same sums)."""
+    acc = np.zeros_like(r)
+    for i in range(len(r)):
+        for j in range(len(r)):
+            if i != j and not (i in semi and j in semi):
+                d = r[j] - r[i]
+                acc[i] += gm[j] * d / np.linalg.norm(d) ** 3
+    return acc
+
+
+def _state(s: System) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return np.array(s.r, dtype=float), np.array(s.v, dtype=float), s.as_arrays().gm
+
+
+def test_the_acceleration_leaves_out_the_semi_active_pairs_alone():
+    """Against the direct sum, to 1e-15 of the largest acceleration (measured 7e-17:
+    the two sums' rounding); the pairs left out are what it differs from Newton's
+    law by (7.8e-10 here, far above the rounding)."""
+    s = _system()
+    r, v, gm = _state(s)
+    semi = [s.names.index(x) for x in SEMI]
+    got = compile_rhs(s, [{"name": "semi_active", "bodies": SEMI}]).acceleration(r, v, gm)
+    want = _direct(r, gm, semi)
+    scale = np.abs(want).max()
+    assert np.abs(got - want).max() < 1e-15 * scale
+    full = compile_rhs(s).acceleration(r, v, gm)
+    assert np.abs(full - got).max() > 1e-6 * np.abs(_direct(r, gm, []) - want).max() > 0
+
+
+def test_eih_with_semi_active_bodies_is_newton_without_their_pairs_at_large_c():
+    """``eih``'s ``semi_active``: at c = 1e12 (the 1PN terms below 1e-24 of Newton's)
+    the same direct sum, to 1e-15; at c = 1e4 the pairs left out are the whole
+    difference from ``eih`` without them, to 1e-14 of the largest acceleration (what
+    else differs: the 1PN terms of the pairs and of the semi-active bodies' mutual
+    potentials, and the rounding of a difference of accelerations; measured
+    1.3e-15)."""
+    s = _system()
+    r, v, gm = _state(s)
+    semi = [s.names.index(x) for x in SEMI]
+    want = _direct(r, gm, semi)
+    scale = np.abs(want).max()
+    big_c = compile_rhs(s, [{"name": "eih", "c": 1e12, "semi_active": SEMI}])
+    assert np.abs(big_c.acceleration(r, v, gm) - want).max() < 1e-15 * scale
+    with_semi, without = (compile_rhs(s, [{"name": "eih", "c": 1e4, **kw}]).acceleration(
+        r, v, gm) for kw in ({"semi_active": SEMI}, {}))
+    pairs = _direct(r, gm, []) - want
+    assert np.abs((without - with_semi) - pairs).max() < 1e-14 * scale
+
+
+def test_semi_active_bodies_are_not_eih_sources_by_default():
+    """Without ``sources``, every massive body but the semi-active ones is a source:
+    the same bits as listing those."""
+    s = _system()
+    r, v, gm = _state(s)
+    others = [x for x in s.names if x not in SEMI]
+    a, b = (compile_rhs(s, [{"name": "eih", "c": 1e4, "semi_active": SEMI, **kw}])
+            .acceleration(r, v, gm) for kw in ({}, {"sources": others}))
+    assert np.array_equal(a, b)
+
+
+def test_a_run_keeps_the_momentum():
+    """Every pair left in acts both ways: the centre of mass moves uniformly to
+    rounding (radau15 and leapfrog, 1000 days; measured 2.5e-19 and 1.6e-17)."""
+    s = _system()
+    for method, kw in (("radau15", {}), ("leapfrog", {"dt": 0.01})):
+        tr = integrate(s, 1000.0, method=method,
+                       effects=[{"name": "semi_active", "bodies": SEMI}], **kw)
+        assert np.max(tr.barycentre_drift) < 1e-13, method
+
+
+@pytest.mark.parametrize(("effects", "kw", "match"), [
+    ([{"name": "semi_active", "bodies": SEMI}], {"method": "wh", "dt": 0.01},
+     "Effect 'semi_active' replaces Newtonian gravity, which integrator 'wh' splits into "
+     "Kepler drifts and kicks of its own; integrators that accept it: radau15, leapfrog, "
+     "dop853"),
+    (["eih", {"name": "semi_active", "bodies": SEMI}], {},
+     "Effect 'eih' (at index 0) is refused beside 'semi_active' (at index 1)"),
+    ([{"name": "semi_active"}], {}, "Effect 'semi_active' needs the `bodies`"),
+    ([{"name": "semi_active", "bodies": "b2"}], {},
+     "Effect 'semi_active': expected `bodies` to be a list of body names, got 'b2'"),
+    ([{"name": "semi_active", "bodies": ["b2", "b3", "b2"]}], {},
+     "Effect 'semi_active': `bodies` names 'b2' twice (at index 2)"),
+    ([{"name": "semi_active", "bodies": ["b2", "vesta"]}], {},
+     "Effect 'semi_active': `bodies` names body 'vesta', which is not in the system"),
+    ([{"name": "eih", "c": 1e4, "sources": ["sun", "b2"], "semi_active": SEMI}], {},
+     "Effect 'eih': 'b2' is both a source and semi-active"),
+])
+def test_bad_semi_active_input_is_refused_by_name(effects, kw, match):
+    with pytest.raises(ValueError, match=re.escape(match)):
+        integrate(_system(), 1.0, effects=effects, **kw)
