@@ -43,12 +43,13 @@ energy, and its kernel and Jacobian (imported there from
 - ``effects.tides``: ``earth_tides``
 - ``effects.kuiper_ring``: ``kuiper_ring`` (and ``kuiper_ring_gm``)
 - ``effects.nongrav``: ``nongrav`` (and ``COMET_G``)
+- ``effects.semi_active``: ``semi_active``
 
 Examples
 --------
 >>> known("nbody")  # doctest: +NORMALIZE_WHITESPACE
 ('earth_tides', 'eih', 'gr', 'gr_potential', 'j2', 'kuiper_ring', 'lense_thirring',
- 'moon_figure', 'newtonian', 'nongrav', 'zonal')
+ 'moon_figure', 'newtonian', 'nongrav', 'semi_active', 'zonal')
 """
 
 from __future__ import annotations
