@@ -19,7 +19,12 @@ What it prints (medians over interleaved rounds; the machine is shared):
 [3] loading the last snapshot: ``Simulation.load(folder)`` against
     ``rebound.Simulation(file)``;
 [4] where an ``every_steps=100`` snapshot's time goes in the 0.4 s radau15 run:
-    the archive's fixed cost, the pauses alone, the whole (per snapshot).
+    the archive's fixed cost, the pauses alone, the whole (per snapshot);
+[5] a simulation called 1200 times (radau15, 10 bodies, 0.5 days a call, one
+    snapshot a call: each call begins a segment of its own), the time per call
+    over the first and the last 200 calls, against the same calls without an
+    archive: flat, since a simulation continues its own archive without listing
+    the folder.
 """
 
 from __future__ import annotations
@@ -217,6 +222,23 @@ def parts(tmp: Path, rounds: int, t_end: float = 10 * T_END) -> None:
               for k in ("fixed", "pauses", "whole")))
 
 
+def many_calls(tmp: Path, calls: int = 1200, block: int = 200) -> None:
+    s = disc10()
+    archived = Simulation(s, method="radau15", archive=tmp / "calls", every=1e9)
+    plain = Simulation(s, method="radau15")
+    per_call: dict[str, list[float]] = {"archived": [], "plain": []}
+    for k in range(1, calls + 1):
+        for name, sim in (("archived", archived), ("plain", plain)):
+            per_call[name].append(timed(lambda sim=sim, k=k: sim.integrate(0.5 * k)))
+    first, last = (slice(1, block + 1), slice(calls - block, calls))
+    ms = {f"{n} {w}": statistics.median(per_call[n][part]) * 1e3
+          for n in per_call for w, part in (("first", first), ("last", last))}
+    print(f"[5] {calls} calls of one simulation, one snapshot each (ms per call, medians of "
+          f"{block}): archived {ms['archived first']:.2f} (calls 2-{block + 1}) and "
+          f"{ms['archived last']:.2f} (the last {block}, {2 * calls} files in the folder); "
+          f"plain {ms['plain first']:.3f} and {ms['plain last']:.3f}")
+
+
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
@@ -228,6 +250,7 @@ def main() -> None:
         runs(tmp / "long", 5, 10 * T_END)
         (tmp / "parts").mkdir()
         parts(tmp / "parts", 15)
+        many_calls(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

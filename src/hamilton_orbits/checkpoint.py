@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import struct
 import time
@@ -39,7 +40,13 @@ import numpy as np
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.restart import inline
-from hamilton_orbits.segment import SEGMENT_RE, Segment, SegmentWriter, read_segment
+from hamilton_orbits.segment import (
+    SEGMENT_NAME,
+    SEGMENT_RE,
+    Segment,
+    SegmentWriter,
+    read_segment,
+)
 from hamilton_orbits.snapshot import SnapshotError, read
 
 __all__ = [
@@ -156,12 +163,13 @@ def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
 
 def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
     """The files of an archive folder by the number of their (first) snapshot:
-    snapshot files (format 1) and segments (format 2)."""
+    snapshot files (format 1) and segments (format 2).  (The names are matched as
+    the folder lists them; only the files found are made paths.)"""
     found = []
-    for p in folder.iterdir() if folder.is_dir() else ():
-        m = _SNAPSHOT_RE.match(p.name) or SEGMENT_RE.match(p.name)
+    for name in os.listdir(folder) if folder.is_dir() else ():
+        m = _SNAPSHOT_RE.match(name) or SEGMENT_RE.match(name)
         if m:
-            found.append((int(m.group(1)), p))
+            found.append((int(m.group(1)), folder / name))
     return sorted(found)
 
 
@@ -310,6 +318,9 @@ class ArchiveWriter:
         #: the segment being appended to
         self.segment: SegmentWriter | None = None
         self.count = 0
+        #: the last segment this writer closed: its path, its size and the number
+        #: after its last snapshot (:meth:`_continued`)
+        self.left: tuple[Path, int, int] | None = None
         self.last_steps, self.last_wall = 0, time.monotonic()
 
     def schedule_only(self) -> ArchiveWriter:
@@ -336,12 +347,33 @@ class ArchiveWriter:
         except FolderError as exc:
             raise SnapshotError(str(exc).replace("; nothing was run", "")) from None
         self.folder = folder
-        self.count = _next_number(self.path)
+        known = self._continued()
+        self.count = _next_number(self.path) if known is None else known
+
+    def _continued(self) -> int | None:
+        """The next snapshot number without listing the folder (whose listing grows
+        with the archive: one segment per call), when the last segment this writer
+        closed is there as it left it and no file holds that number yet (no other
+        writer came after it: a writer begins a segment of its own at the folder's
+        next number); None otherwise, and the folder is read."""
+        if self.left is None:
+            return None
+        path, size, count = self.left
+        try:
+            if path.stat().st_size != size:
+                return None
+        except OSError:
+            return None
+        if any((self.path / name.format(count)).exists()
+               for name in (SEGMENT_NAME, SNAPSHOT_NAME)):
+            return None
+        return count
 
     def close(self) -> None:
         """Close the segment being written and release the folder's lock."""
         if self.segment is not None:
             self.segment.close()
+            self.left = (self.segment.path, self.segment.size, self.count)
             self.segment = None
         if self.folder is not None:
             self.folder.__exit__(None, None, None)

@@ -70,7 +70,8 @@ from hamilton_orbits.snapshot import (
     write_bytes,
 )
 
-__all__ = ["SEGMENT_FORMAT", "SEGMENT_RE", "Segment", "SegmentWriter", "read_segment"]
+__all__ = ["SEGMENT_FORMAT", "SEGMENT_NAME", "SEGMENT_RE", "Segment", "SegmentWriter",
+           "read_segment"]
 
 SEGMENT_FORMAT = "hamilton-orbits archive segment"
 #: the archive format that segments are: 2 (1 was a file per snapshot)
@@ -269,6 +270,11 @@ class SegmentWriter:
     def count(self) -> int:
         """The snapshots appended."""
         return self._file.count
+
+    @property
+    def size(self) -> int:
+        """The segment file's bytes written (its size on disk)."""
+        return self._file.end
 
     def append(self, snapshot: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append the caller's output ``rows`` (``out_t``, ``out_r``, ... of

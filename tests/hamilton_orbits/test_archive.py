@@ -572,3 +572,36 @@ def test_a_segment_being_written_reads_and_a_record_begun_after_it_is_torn(tmp_p
     with open(path, "ab") as fh:  # the first bytes of a next record, then a kill
         fh.write(b"\x3f\xf0")
     assert Archive(tmp_path).torn == [path] and len(Archive(tmp_path)) == header.numrecs
+
+
+def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp_path,
+                                                                            monkeypatch):
+    """Each archived call begins a segment at the folder's next snapshot number.  A
+    simulation whose writer closed the last segment knows that number: the folder
+    (one segment per call, so a listing that grows with the archive: 1.6 -> 5 ms a
+    call over 1200 calls before) is listed on its first call only, and again after
+    another writer came (its segment holds the number) or the last segment changed
+    (here: removed).  The snapshots are numbered without a gap either way."""
+    from hamilton_orbits import checkpoint
+
+    listed = []
+    real = checkpoint._next_number
+    monkeypatch.setattr(checkpoint, "_next_number",
+                        lambda folder: listed.append(folder) or real(folder))
+    sim = Simulation(_disc(), archive=tmp_path, method="radau15", every=1e9)
+    for k in range(1, 6):
+        sim.integrate(0.5 * k)
+    assert len(listed) == 1
+    other = Simulation.load(tmp_path)  # (another writer: it lists, and begins segment 5)
+    other.integrate(3.0)
+    assert len(listed) == 2
+    sim.integrate(3.5)  # (its number is taken: listed again, continued after the other's)
+    assert len(listed) == 3
+    sim.integrate(4.0)
+    assert len(listed) == 3
+    last = snapshot_files(tmp_path)[-1][1]
+    last.unlink()  # (its last segment gone: the folder is read again)
+    sim.integrate(4.5)
+    assert len(listed) == 4
+    numbers = [s.number for s in Archive(tmp_path).snapshots]
+    assert numbers == list(range(8)), numbers  # (7 again, after the one removed)
