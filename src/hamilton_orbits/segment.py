@@ -103,11 +103,10 @@ class _Appender:
                                                   for n, _, v, a in records]))
         attrs["sha256"] = checksum(_signed(attrs), summed or {})
         header = encode(attrs, fixed, records, record_dim=record_dim)
-        write_bytes(path, header, sync=sync)
-        self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
         #: one record's bytes, reused (its last variable the CRC-32 of the others)
         self.buffer = RecordBuffer([values for _, _, values, _ in records])
-        self.fd = os.open(path, os.O_RDWR)
+        self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
+        self.fd = write_bytes(path, header, sync=sync, keep_open=True)
         #: the count in the header, mapped (a store, not a system call, per append;
         #: its page is the file's own: a killed process leaves it written), or None
         #: (``sync``: a write then a sync, in order; or a file that does not map)

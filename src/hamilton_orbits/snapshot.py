@@ -145,22 +145,33 @@ def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
                    "sha256": checksum(meta_text, arrays)}, variables)
 
 
-def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True) -> None:
+def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True,
+                keep_open: bool = False) -> int | None:
     """Write ``data`` to ``path`` atomically: under a temporary name in the same
-    folder, then renamed over ``path`` (see :func:`write`)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    folder, then renamed over ``path`` (see :func:`write`).  ``keep_open``: return
+    the file's descriptor, open for reading and writing (a segment appended to
+    next), instead of closing it."""
+    folder, name = os.path.split(os.fspath(path))
+    tmp = os.path.join(folder, f".{name}.tmp-{os.getpid()}")
+    fd = -1
     try:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            if sync:
-                os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        fd = os.open(tmp, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o666)
+        view = memoryview(data)
+        while view:  # (a write may take part of it)
+            view = view[os.write(fd, view):]
+        if sync:
+            os.fsync(fd)
+        os.replace(tmp, os.fspath(path))
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
+        if fd >= 0:
+            os.close(fd)
+        Path(tmp).unlink(missing_ok=True)
         raise SnapshotError(f"cannot write the snapshot {path}: "
                             f"{exc.strerror or exc}") from None
+    if keep_open:
+        return fd
+    os.close(fd)
+    return None
 
 
 def variable(name: str, arr: np.ndarray, dims: tuple[str, ...] | None,

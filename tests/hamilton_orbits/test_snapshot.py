@@ -112,13 +112,15 @@ def test_a_missing_or_foreign_file_is_refused(tmp_path):
 
 def test_a_read_only_folder_is_refused_at_the_write(tmp_path, monkeypatch):
     """As the operating system refuses it (mocked: the tests may run as root, whom
-    a read-only mode does not stop)."""
-    from hamilton_orbits import snapshot
+    a read-only mode does not stop): the file opened in that folder refused."""
+    real_open = os.open
 
-    def refused(path, mode="r", *args, **kwargs):
-        raise PermissionError(13, "Permission denied", str(path))
+    def refused(path, flags, *args, **kwargs):
+        if "ro" in Path(path).parts:
+            raise PermissionError(13, "Permission denied", str(path))
+        return real_open(path, flags, *args, **kwargs)
 
-    monkeypatch.setattr(snapshot, "open", refused, raising=False)
+    monkeypatch.setattr(os, "open", refused)
     with pytest.raises(SnapshotError, match=r"cannot write the snapshot .*ro/s.nc: Permission "
                                             r"denied"):
         write(tmp_path / "ro" / "s.nc", {}, _arrays())
