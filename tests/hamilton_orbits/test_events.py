@@ -230,7 +230,8 @@ def test_a_merge_conserves_mass_momentum_and_the_centre_of_mass():
 
 def test_an_escape_is_found_at_the_analytic_time():
     """A test particle on a hyperbola (e = 3, a = -1/2, q = 1, mu = 1) crosses r = 5
-    at t with cosh H = 11/3, t = (e sinh H - H) / sqrt(mu / |a|^3)."""
+    at t with cosh H = 11/3, t = (e sinh H - H) / sqrt(mu / |a|^3); started at its
+    periapsis, it crossed r = 5 at -t too (a backward run records it there)."""
     system = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 2, 0])])
     h = np.arccosh(11 / 3)
     t_escape = (3 * np.sinh(h) - h) / np.sqrt(8.0)
@@ -240,6 +241,10 @@ def test_an_escape_is_found_at_the_analytic_time():
         assert len(traj.events) == 1 and traj.events["bodies"][0] == "b"
         assert traj.events["time"][0] == pytest.approx(t_escape, rel=1e-12)
         assert traj.events["distance"][0] == pytest.approx(5.0, rel=1e-14)
+        back = integrate(system, -10.0, method=method,
+                         events=[{"name": "escape", "distance": 5.0}], **kw)
+        assert len(back.events) == 1
+        assert back.events["time"][0] == pytest.approx(-t_escape, rel=1e-12)
     removed = integrate(system, 10.0, events=[{"name": "escape", "distance": 5.0,
                                                "action": "remove"}])
     assert removed.final.names == ("sun",) and removed.t[-1] == 10.0
