@@ -605,3 +605,52 @@ def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp
     assert len(listed) == 4
     numbers = [s.number for s in Archive(tmp_path).snapshots]
     assert numbers == list(range(8)), numbers  # (7 again, after the one removed)
+
+
+def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was_written(
+        tmp_path, monkeypatch):
+    """The disk fills after the third record (a mocked ``pwrite``): the call raises a
+    SnapshotError naming the segment and the cause, the archive holds the
+    snapshots written before, whole, with nothing damaged or torn, the folder's
+    lock is released, and the simulation, standing where the snapshot failed,
+    continues to the bits of the same archived run that never met a full disk."""
+    real, writes = os.pwrite, [0]
+
+    def full(fd, data, offset):
+        writes[0] += 1
+        if writes[0] > 3:
+            raise OSError(28, "No space left on device")
+        return real(fd, data, offset)
+
+    sim = Simulation(_disc(), archive=tmp_path / "a", **KW)
+    monkeypatch.setattr(os, "pwrite", full)
+    with pytest.raises(SnapshotError, match=r"cannot write the snapshot to .*segment-000000"
+                                            r"\.nc: No space left on device"):
+        sim.integrate(30.0)
+    monkeypatch.setattr(os, "pwrite", real)
+    archive = Archive(tmp_path / "a")
+    assert archive.times.tolist() == [0.0, 2.5] and not archive.damaged and not archive.torn
+    assert not (tmp_path / "a" / ".hamilton-orbits.lock").exists()
+    assert sim.t == 5.0
+    end = sim.integrate(40.0)
+    whole = Simulation(_disc(), archive=tmp_path / "b", **KW)
+    whole.integrate(30.0)
+    assert _same(end.r[-1], whole.integrate(40.0).r[-1]) and sim.steps == whole.steps
+
+
+def test_a_read_only_folder_is_refused_at_the_archives_first_write(tmp_path, monkeypatch):
+    """The folder refuses the lock, the archive's first file (a mocked refusal: the
+    tests may run as root): a SnapshotError naming the folder, before any step."""
+    real = Path.write_text
+
+    def refused(self, *args, **kwargs):
+        if self.parent.name == "ro":
+            raise PermissionError(13, "Permission denied", str(self))
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "write_text", refused)
+    sim = Simulation(_disc(), archive=tmp_path / "ro", **KW)
+    with pytest.raises(SnapshotError, match=r"ro: cannot write in the folder \(Permission "
+                                            r"denied\)"):
+        sim.integrate(30.0)
+    assert sim.t == 0.0 and sim.steps == 0
