@@ -5,7 +5,8 @@
    exponent) as a ratio to the plain run, for ``wh`` (2-day step, 1000 yr) and
    ``radau15`` (100 yr), beside rebound's WHFast and IAS15 with ``init_megno()``
    (one set of variational particles) on the same state; best of ``--repeats``.
-   Also ``wh`` with ``stm=True`` (55 tangent vectors).
+   Also ``wh`` with ``stm=True`` (55 tangent vectors), and both backwards (ours: the
+   time-reversed motion's tangent vectors; rebound: a negative step).
 2. The stability map of ``examples/chaos/stability_map.py`` (Jupiter and a Saturn-mass
    planet over (a, e)), ``--n`` x ``--n`` cells of ``--orbits`` orbits of Jupiter:
    ours through ``Ensemble`` on the local cores, rebound's WHFast MEGNO (Jacobi,
@@ -41,15 +42,17 @@ def _best(fn, repeats: int) -> float:
 
 def _ours(system: System, years: float, method: str, kw: dict, variational: bool,
           stm: bool = False) -> float:
+    """Our wall time over ``years`` (negative: backwards)."""
     tr = integrate(system, years * u.yr, method=method, variational=variational, stm=stm, **kw)
     return tr.wall_time
 
 
 def _rebound(system: System, years: float, integrator: str, variational: bool) -> float:
+    """rebound's wall time over ``years`` (negative: backwards, a negative step)."""
     sim = system.to_rebound()  # G = 1, au, days
     sim.integrator = integrator
     if integrator == "whfast":
-        sim.dt = 2.0
+        sim.dt = 2.0 if years > 0 else -2.0
     if variational:
         sim.init_megno(seed=1)
     start = time.perf_counter()
@@ -79,6 +82,13 @@ def cost(repeats: int, quick: bool) -> None:
         rv = _best(lambda i=peer, y=years: _rebound(s, y, i, True), repeats)
         print(f"{'rebound ' + peer + ' (init_megno)':<34}{years:>10g}{rp:>11.3f}{rv:>17.3f}"
               f"{rv / rp:>8.2f}")
+        _ours(s, -years / 10, method, kw, True)  # (the time-reversed kernels compiled)
+        for name, run in ((f"hamilton-orbits {method}, backwards",
+                           lambda v, m=method, k=kw, y=years: _ours(s, -y, m, k, v)),
+                          (f"rebound {peer}, backwards",
+                           lambda v, i=peer, y=years: _rebound(s, -y, i, v))):
+            bp, bv = (_best(lambda v=v, r=run: r(v), repeats) for v in (False, True))
+            print(f"{name:<34}{-years:>10g}{bp:>11.3f}{bv:>17.3f}{bv / bp:>8.2f}")
 
 
 def _rebound_cell(args: tuple) -> float:
