@@ -216,6 +216,102 @@ def _soa_one(a, nm, w):  # pragma: no cover - compiled
     w[6 * m + a] = sz
 
 
+@njit(cache=True, error_model="numpy")
+def newtonian_semi_active(r, v, gm, acc, p):  # pragma: no cover - compiled
+    """Newton's law with semi-active bodies, ADDED to ``acc``: ``p`` the indices of
+    the bodies that pull on every other body and feel every other body, but not
+    each other (the ``semi_active`` effect, which replaces the Newtonian kernel).
+
+    The SIMD form of :func:`_soa_massive` with the active bodies first
+    (:func:`_soa_semi`): a semi-active source's loop stops after the active
+    bodies' lanes, so the pairs of two semi-active bodies are never computed."""
+    n = r.shape[0]
+    m = _padded(n)
+    # (the columns, then the bodies' order: the active bodies, then the semi-active,
+    # each in order; then which are semi-active: one scratch, on the stack up to
+    # STACK_MASSIVE bodies)
+    w = (carray(_stack_scratch(), SCRATCH) if n <= STACK_MASSIVE
+         else np.empty(7 * m + 2 * n))
+    idx = w[7 * m:7 * m + n]
+    semi = w[7 * m + n:7 * m + 2 * n]
+    for i in range(n):
+        semi[i] = 0.0
+    for b in range(p.shape[0]):
+        semi[int(p[b])] = 1.0
+    na = 0
+    for i in range(n):
+        if semi[i] == 0.0:
+            idx[na] = i
+            na += 1
+    k = na
+    for i in range(n):
+        if semi[i] != 0.0:
+            idx[k] = i
+            k += 1
+    _gather_massive(r, gm, idx, True, n, w)
+    _soa_semi(n, na, w)
+    for a in range(n):
+        i = int(idx[a])
+        acc[i, 0] += w[4 * m + a]
+        acc[i, 1] += w[5 * m + a]
+        acc[i, 2] += w[6 * m + a]
+
+
+@njit(cache=True, error_model="numpy")
+def _soa_semi(nm, na, w):  # pragma: no cover - compiled
+    """:func:`_soa_massive` for bodies of which the first ``na`` are active and the
+    others semi-active: an active source pulls on every lane, a semi-active one on
+    the active bodies' lanes alone (the lanes of semi-active bodies among them
+    masked)."""
+    m = _padded(nm)
+    x = w[0:m]
+    y = w[m:2 * m]
+    z = w[2 * m:3 * m]
+    g = w[3 * m:4 * m]
+    ax = w[4 * m:5 * m]
+    ay = w[5 * m:6 * m]
+    az = w[6 * m:7 * m]
+    for a in range(m):
+        ax[a] = 0.0
+        ay[a] = 0.0
+        az[a] = 0.0
+    for b in range(na):  # an active source: every lane (the padding too: never read)
+        xb = x[b]
+        yb = y[b]
+        zb = z[b]
+        gb = g[b]
+        for a in range(m):
+            dx = xb - x[a]
+            dy = yb - y[a]
+            dz = zb - z[a]
+            d2 = dx * dx + dy * dy + dz * dz
+            same = a == b
+            d2 = 1.0 if same else d2
+            inv3 = 1.0 / (d2 * np.sqrt(d2))
+            f = 0.0 if same else gb * inv3
+            ax[a] += f * dx
+            ay[a] += f * dy
+            az[a] += f * dz
+    ma = min(_padded(na), m)
+    for b in range(na, nm):  # a semi-active source: the active bodies' lanes
+        xb = x[b]
+        yb = y[b]
+        zb = z[b]
+        gb = g[b]
+        for a in range(ma):
+            dx = xb - x[a]
+            dy = yb - y[a]
+            dz = zb - z[a]
+            d2 = dx * dx + dy * dy + dz * dz
+            off = a >= na  # (a semi-active body's lane, b's own among them)
+            d2 = 1.0 if off else d2
+            inv3 = 1.0 / (d2 * np.sqrt(d2))
+            f = 0.0 if off else gb * inv3
+            ax[a] += f * dx
+            ay[a] += f * dy
+            az[a] += f * dz
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _scatter_massive(acc, idx, use_idx, nm, w):  # pragma: no cover - compiled
     """``acc[idx[a]] = `` the accelerations that :func:`_soa_massive` left in ``w``."""

@@ -18,7 +18,8 @@ with ``a_j`` the Newtonian acceleration of body j (the difference is of second
 post-Newtonian order).  Massless bodies feel the field and add nothing to it.
 *Semi-active* bodies (rebound's ``testparticle_type = 1``) pull on every other
 body and feel every other body, but not each other: their pairs are left out of
-the sums (:func:`newtonian_semi_active` is Newton's law alone with that rule).
+the sums (``hamilton_orbits._kernels.nbody.newtonian_semi_active`` is Newton's
+law alone with that rule).
 No astropy here.
 """
 
@@ -95,23 +96,6 @@ def semi_active_of(p, n):  # pragma: no cover - compiled
         if p[b] < 0.0:
             semi[-1 - int(p[b])] = True
     return semi
-
-
-@njit(cache=True, error_model="numpy")
-def newtonian_semi_active(r, v, gm, acc, p):  # pragma: no cover - compiled
-    """Newton's law with semi-active bodies, ADDED to ``acc``: ``p`` the indices of
-    the bodies that pull on every other body and feel every other body, but not
-    each other (the ``semi_active`` effect, which replaces the Newtonian kernel)."""
-    n = r.shape[0]
-    semi = np.zeros(n, dtype=np.bool_)
-    for b in range(p.shape[0]):
-        semi[int(p[b])] = True
-    acc_n, phi, inv_d = np.empty((n, 3)), np.empty(n), np.empty((n, n))
-    newtonian_and_potential(r, gm, semi, acc_n, phi, inv_d)
-    for i in range(n):
-        acc[i, 0] += acc_n[i, 0]
-        acc[i, 1] += acc_n[i, 1]
-        acc[i, 2] += acc_n[i, 2]
 
 
 @njit(cache=True)

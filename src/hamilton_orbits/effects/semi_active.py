@@ -8,7 +8,7 @@ out: the 16 asteroids of the ``de440-century`` ladder then cost ``16 N`` pairs, 
 ``16 N + 120``.  The effect replaces the Newtonian kernel
 (``replaces_newtonian``); with ``eih``, which replaces it too, the same rule is
 ``eih``'s own ``semi_active`` parameter.  Kernel
-:func:`~hamilton_orbits._kernels.relativity.newtonian_semi_active`; no analytic
+:func:`~hamilton_orbits._kernels.nbody.newtonian_semi_active`; no analytic
 Jacobian (the variational equations difference the kernel).  ``p`` = the
 semi-active bodies' indices.
 """
@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._kernels.relativity import newtonian_semi_active
+from hamilton_orbits._kernels.nbody import newtonian_semi_active
 from hamilton_orbits.effects.parameters import body_list
 from hamilton_orbits.effects.registry import EffectSpec
 
