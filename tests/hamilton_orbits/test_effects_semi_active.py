@@ -54,6 +54,25 @@ def test_the_acceleration_leaves_out_the_semi_active_pairs_alone():
     assert np.abs(full - got).max() > 1e-6 * np.abs(_direct(r, gm, []) - want).max() > 0
 
 
+@pytest.mark.parametrize(("n", "semi"), [(3, [1, 2]), (9, [0, 4, 8]), (27, list(range(11, 27))),
+                                         (150, list(range(10, 150, 2)))])
+def test_the_simd_form_at_every_size(n, semi):
+    """The kernel's SIMD form (the active bodies' lanes first, a semi-active source
+    stopping after them; on the stack up to 128 bodies, allocated beyond), a
+    massless semi-active body among them, against the direct sum: 1e-14 of the
+    largest acceleration (the two sums' rounding over up to 150 terms)."""
+    from hamilton_orbits._kernels.nbody import newtonian_semi_active
+
+    rng = np.random.default_rng(n)
+    r, v = rng.normal(size=(n, 3)) * 3.0, rng.normal(size=(n, 3))
+    gm = 10 ** rng.uniform(-9, -3, n)
+    gm[semi[-1]] = 0.0
+    acc = np.zeros((n, 3))
+    newtonian_semi_active(r, v, gm, acc, np.array(semi, dtype=float))
+    want = _direct(r, gm, semi)
+    assert np.abs(acc - want).max() < 1e-14 * np.abs(want).max()
+
+
 def test_eih_with_semi_active_bodies_is_newton_without_their_pairs_at_large_c():
     """``eih``'s ``semi_active``: at c = 1e12 (the 1PN terms below 1e-24 of Newton's)
     the same direct sum, to 1e-15; at c = 1e4 the pairs left out are the whole
