@@ -19,6 +19,8 @@ driver's attributes) is restored as one array reached twice: the layout records
 the alias.  A class may name attributes that are working space, not state, in
 ``RESTART_SCRATCH`` (the events log's buffer, empty after a drain): they are left
 out, and the fresh build's are kept (a layout that holds them is still restored).
+A class with a ``restarted`` method has it called once its attributes are
+restored (to make again what it derives from them, as scratch it left out).
 
 The layout names classes; :func:`restore` refuses a layout whose classes or
 attributes differ from the fresh build's (:class:`LayoutMismatch`), which is what
@@ -418,6 +420,9 @@ def _fill(obj: Any, layout: dict[str, Any], arrays: list[np.ndarray],
                              f"{sorted(fresh)}")
     for key, node in saved.items():
         setattr(obj, key, _value(fresh[key], node, arrays, restored, f"{where}.{key}"))
+    hook = getattr(cls, "restarted", None)
+    if hook is not None:  # (what the object makes of its restored state)
+        hook(obj)
 
 
 def _value(fresh: Any, node: dict[str, Any], arrays: list[np.ndarray],

@@ -105,6 +105,8 @@ class _Appender:
         header = encode(attrs, fixed, records, record_dim=record_dim)
         #: one record's bytes, reused (its last variable the CRC-32 of the others)
         self.buffer = RecordBuffer([values for _, _, values, _ in records])
+        #: the bytes the CRC-32 is of (all the record's but ``check``'s)
+        self.signed = memoryview(self.buffer.data)[:-8]
         self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
         self.fd = write_bytes(path, header, sync=sync, keep_open=True)
         #: the count in the header, mapped (a store, not a system call, per append;
@@ -123,9 +125,10 @@ class _Appender:
         self.write(parts[0] if len(parts) == 1 else b"".join(parts), len(rows))
 
     def checked(self) -> bytearray:
-        """The buffer's record with its CRC-32 put in its ``check``."""
+        """The buffer's record with its CRC-32 put in its ``check`` (its last 8 bytes,
+        a big-endian float64)."""
         data = self.buffer.data
-        self.buffer.views[-1][...] = zlib.crc32(memoryview(data)[:-8])
+        struct.pack_into(">d", data, len(data) - 8, zlib.crc32(self.signed))
         return data
 
     def write(self, data: bytes | bytearray, count: int) -> None:
@@ -133,7 +136,7 @@ class _Appender:
         try:
             os.pwrite(self.fd, data, self.end)
             if self.numrecs is not None:  # (after the records: the count never runs ahead)
-                self.numrecs[NUMRECS_AT:] = struct.pack(">i", self.count + count)
+                struct.pack_into(">i", self.numrecs, NUMRECS_AT, self.count + count)
             else:
                 if self.sync:
                     os.fsync(self.fd)
@@ -153,6 +156,28 @@ class _Appender:
         if self.fd >= 0:
             os.close(self.fd)
             self.fd = -1
+
+
+def _exact(numbers: list[Any]) -> bool:
+    """Whether every integer of ``numbers`` (bools, ints, floats) is exact in a
+    float64 (the bounds first: one pass of two built-ins, where they hold)."""
+    if not numbers or (-INT_EXACT < min(numbers) and max(numbers) < INT_EXACT):
+        return True
+    return not any(type(x) is int and not -INT_EXACT < x < INT_EXACT for x in numbers)
+
+
+def _exact_arrays(arrays: list[np.ndarray], ints: list[int]) -> bool:
+    """Whether the integer arrays ``arrays[k]``, ``k`` in ``ints``, hold only values
+    exact in a float64 (one value read as a Python int, more by
+    :func:`~hamilton_orbits.snapshot.beyond_float`)."""
+    for k in ints:
+        a = arrays[k]
+        if a.size == 1:
+            if not -INT_EXACT < a.item() < INT_EXACT:
+                return False
+        elif beyond_float(a):
+            return False
+    return True
 
 
 def _mapped_count(fd: int) -> mmap.mmap | None:
@@ -347,17 +372,15 @@ class SegmentWriter:
         number does not fit (``ints``: the positions of the integer arrays of
         ``state``, checked below 2**53)."""
         last, kept = self._last, self._kept[0]
-        if last is not None and (r is not last[0] or v is not last[1]
+        if last is not None and (r is not last[0] or v is not last[1] or len(state) != len(kept)
                                  or not all(map(operator.is_, kept, state))):
             last = self._moved(r, v, state)  # (an output's rows: other arrays, the same
-            # shapes and types)
+            # shapes and types; the state's arrays then those kept)
         if (last is None or r is not last[0] or v is not last[1] or gm is not last[2]
                 or active is not last[3] or active.flags.writeable
-                or len(state) != len(kept) or not all(map(operator.is_, kept, state))
                 or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT
                 or len(scalars) != self._file.buffer.views[5].size
-                or any(type(x) is int and not -INT_EXACT < x < INT_EXACT for x in scalars)
-                or any(beyond_float(state[k]) for k in ints)):
+                or not _exact(scalars) or not _exact_arrays(state, ints)):
             return False
         file, pieces = self._file, last[4]
         start = 0 if self._rows is None else self._rows.count  # (rows written since the

@@ -275,15 +275,23 @@ class _Run:
     no event: the state's arrays changed in place, its numbers changed, nothing was
     put in another place; ``stop`` is a question and changes nothing)."""
 
-    #: not state: the hook a run sets and clears (:meth:`Propagation.advance`)
-    RESTART_SCRATCH = ("pause",)
+    #: not state: the hook a run sets and clears (:meth:`Propagation.advance`), a
+    #: step's own ``b`` and ``g`` (written at each step's start from ``br`` and ``d``,
+    #: :func:`~hamilton_orbits._kernels.radau15._begin`, before they are read: a
+    #: snapshot is 40% smaller without them) and the kernel's arguments that hold
+    #: them (made again by :meth:`restarted`)
+    RESTART_SCRATCH = ("pause", "scratch", "after_t")
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
         m = 3 * r0.shape[0]
         self.rhs, self.gm, self.log, self.max_steps = rhs, gm, log, max_steps
         self.accel = _setup.force_arg(rhs, gm, log.watch)
-        self.work = [np.zeros((7, m)) for _ in range(4)]  # b, br, d, g
+        #: the last step's ``br`` and ``d``, its ``b`` and that less its prediction:
+        #: the next step's predictor
+        self.work = [np.zeros((7, m)) for _ in range(2)]
+        #: a step's ``b`` and ``g``, working space
+        self.scratch = (np.zeros((7, m)), np.zeros((7, m)))
         self.csx = np.zeros(m)
         self.csv = np.zeros(m)
         self.st = np.zeros(_k.NSTATE)
@@ -297,7 +305,22 @@ class _Run:
         # call's cost is mostly its arguments; see docs/design.md, "One front door")
         self.before_t = (self.accel, run_parameters(rhs), self.x, self.w, gm)  # (p: the
         # kernels write its clock)
-        self.after_t = (self.st, *self.work, self.csx, self.csv, bool(rhs.velocity_dependent))
+        self.after_t = self._after_t()
+
+    def _after_t(self) -> tuple[Any, ...]:
+        """The kernel's arguments after ``t_end``: ``st``, ``b, br, d, g``, ``csx``,
+        ``csv`` and whether the forces depend on the velocities."""
+        (b, g), (br, d) = self.scratch, self.work
+        return (self.st, b, br, d, g, self.csx, self.csv, bool(self.rhs.velocity_dependent))
+
+    def restarted(self) -> None:
+        """After :func:`~hamilton_orbits.restart.restore` put a saved state in: the
+        kernel's arguments made of the restored arrays.  A state saved before ``b``
+        and ``g`` were working space (``work`` of four arrays, ``b, br, d, g``)
+        keeps its ``br`` and ``d``: the same steps follow."""
+        if len(self.work) == 4:
+            self.work = self.work[1:3]
+        self.after_t = self._after_t()
 
     @property
     def t(self) -> float:
