@@ -53,6 +53,7 @@ import re
 import struct
 import zlib
 from collections.abc import Mapping
+from itertools import compress
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -408,20 +409,19 @@ class SegmentWriter:
         if len(state) != len(kept[0]):
             return None
         pieces = list(last[4])  # (r, v, gm, the state's arrays: gm is not replaced)
-        same = all(map(operator.is_, kept[0], state))  # (the usual case: only r and v
-        # are others, an output's rows)
-        olds, news = ((last[0], last[1]), (r, v)) if same else (
-            (last[0], last[1], last[2], *kept[0]), (r, v, last[2], *state))
-        for k, (old, a) in enumerate(zip(olds, news, strict=True)):
-            if a is not old:
-                if (type(a) is not np.ndarray or a.shape != old.shape or a.dtype != old.dtype
-                        or pieces[k] is None or not a.flags.c_contiguous):
-                    return None
-                pieces[k] = a
-        if not same:
-            for k, a in enumerate(state):
-                if a is not kept[0][k]:
-                    kept[0][k], kept[1][k] = a, a.reshape(-1)
+        olds, news = (last[0], last[1], last[2], *kept[0]), (r, v, last[2], *state)
+        # (the places replaced, found in C: among the state's arrays usually only the
+        # propagation's r and v, the record's own)
+        places = list(compress(range(len(olds)), map(operator.is_not, olds, news)))
+        for k in places:
+            old, a = olds[k], news[k]
+            if (type(a) is not np.ndarray or a.shape != old.shape or a.dtype != old.dtype
+                    or pieces[k] is None or not a.flags.c_contiguous):
+                return None
+            pieces[k] = a
+        for k in places:  # (all checked: the kept views follow)
+            if k >= 3:
+                kept[0][k - 3], kept[1][k - 3] = news[k], news[k].reshape(-1)
         self._last = (r, v, last[2], last[3], pieces, last[5])
         return self._last
 
