@@ -53,8 +53,8 @@ import re
 import struct
 import zlib
 from collections.abc import Mapping
-from itertools import compress
 from dataclasses import dataclass, field
+from itertools import compress
 from pathlib import Path
 from typing import Any
 
