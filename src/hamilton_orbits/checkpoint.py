@@ -173,11 +173,12 @@ def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
     return sorted(found)
 
 
-def _read_file(path: Path, last: bool = False) -> Segment:
+def _read_file(path: Path, last: bool = False, number: int | None = None) -> Segment:
     """A file of an archive folder as a segment (a snapshot file: one snapshot);
-    ``last``: of a segment's snapshots that read, the last only."""
+    ``last``: of a segment's snapshots that read, the last only; ``number``: that
+    snapshot alone (a segment's other records not read)."""
     if SEGMENT_RE.match(path.name):
-        return read_segment(path, last)
+        return read_segment(path, last, number)
     meta, arrays = read(path)
     number = int(meta.get("number", _SNAPSHOT_RE.match(path.name).group(1)))
     return Segment(path, number, 1, [(number, meta, arrays)])
@@ -229,7 +230,7 @@ def snapshot_at(folder: Path, number: int) -> tuple[Path, dict[str, Any],
     files = [(first, p) for first, p in snapshot_files(folder) if first <= number]
     for _, path in reversed(files):
         try:
-            seg = _read_file(path)
+            seg = _read_file(path, number=number)
         except SnapshotError:
             continue
         for k, meta, arrays in seg.snapshots:

@@ -461,11 +461,27 @@ def _fixed_array(header: Header, data: bytes, name: str) -> np.ndarray:
     return header.values(data, name).astype(kind)
 
 
+def _record_at(header: Header, data: bytes | bytearray, k: int) -> dict[str, np.ndarray] | None:
+    """Record ``k`` of ``data`` (the file's bytes, or the bytes before its first
+    record followed by record ``k``'s alone, read as record 0) decoded, or None
+    where its CRC-32 does not match its bytes."""
+    names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
+    at = k * header.record_size  # (each variable's bytes where the header says)
+    raw = b"".join(data[v.begin + at:v.begin + at + v.size]
+                   for v in (header.variables[n] for n in names))
+    check = header.variables.get("check")
+    stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
+    if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
+        return None
+    # (the types and shapes were checked with the header: a record that checks decodes)
+    return {n: header.values(data, n, k).astype(header.variables[n].attrs.get(
+        "dtype_saved", "float64")) for n in names}
+
+
 def _records(header: Header, data: bytes, last: bool = False) -> tuple[
         list[dict[str, np.ndarray]], list[tuple[int, str]], bool]:
     """The records that check (``last``: the last of them only), the damaged ones
     (index, reason), and a torn tail."""
-    names = [k for k, v in header.variables.items() if v.is_record and k != "check"]
     end = header.record_begin + header.numrecs * header.record_size
     good, bad = [], []
     held = max(len(data) - header.record_begin, 0) // max(header.record_size, 1)
@@ -473,20 +489,26 @@ def _records(header: Header, data: bytes, last: bool = False) -> tuple[
         bad.append((held, f"the header counts {header.numrecs} records, the file holds "
                           f"{held}"))
     for k in range(min(header.numrecs, held)):
-        at = k * header.record_size  # (each variable's bytes where the header says)
-        raw = b"".join(data[v.begin + at:v.begin + at + v.size]
-                       for v in (header.variables[n] for n in names))
-        check = header.variables.get("check")
-        stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
-        if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
+        rec = _record_at(header, data, k)
+        if rec is None:
             bad.append((k, "its CRC-32 does not match"))
         else:
-            good.append(k)
-    # (the types and shapes were checked with the header: a record that checks decodes)
-    records = [dict({n: header.values(data, n, k).astype(
-        header.variables[n].attrs.get("dtype_saved", "float64")) for n in names},
-        _index=np.int64(k)) for k in (good[-1:] if last else good)]
-    return records, bad, len(data) > end
+            good.append(dict(rec, _index=np.int64(k)))
+    return (good[-1:] if last else good), bad, len(data) > end
+
+
+def _head(fd: int) -> bytes | None:
+    """The bytes of an open segment or rows file before its first record (its header
+    and fixed variables), or None where its header does not parse from its first
+    64 KiB (the caller then reads the whole file, which says why)."""
+    data = os.pread(fd, 1 << 16, 0)
+    try:
+        begin = parse(data).record_begin
+    except Exception:  # (a damaged header fails in many ways; the whole read names it)
+        return None
+    if begin > len(data):
+        data += os.pread(fd, begin - len(data), len(data))
+    return data[:begin] if begin else None
 
 
 def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
@@ -494,6 +516,18 @@ def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
     its record variables checked."""
     try:
         data = path.read_bytes()
+    except Exception as exc:  # (as a damaged header is named)
+        raise SnapshotError(f"{path} cannot be read as an archive segment (damaged: "
+                            f"{type(exc).__name__}: {exc})") from None
+    header, fixed = _checked(path, data)
+    return header, data, fixed
+
+
+def _checked(path: Path, data: bytes) -> tuple[Header, dict[str, np.ndarray]]:
+    """The header and fixed variables of ``data`` (the bytes of file ``path``, at
+    least those before its first record), its SHA-256 and its record variables
+    checked."""
+    try:
         header = parse(data)
         fmt = header.attrs.get("format")
         if fmt not in (SEGMENT_FORMAT, SEGMENT_FORMAT + " rows"):
@@ -516,12 +550,14 @@ def _open(path: Path) -> tuple[Header, bytes, dict[str, np.ndarray]]:
     if not good or records != header.attrs.get("records"):
         raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
                             f"shared contents")
-    return header, data, fixed
+    return header, fixed
 
 
-def read_segment(path: Path, last: bool = False) -> Segment:
+def read_segment(path: Path, last: bool = False, number: int | None = None) -> Segment:
     """A segment and its rows, every checksum verified (see the module notes);
-    ``last``: of its snapshots that read, the last only.
+    ``last``: of its snapshots that read, the last only; ``number``: snapshot
+    ``number`` alone (none where the segment does not hold it whole).  Either reads
+    only the records it gives and those passed over (:func:`_read_back`).
 
     Raises
     ------
@@ -529,12 +565,12 @@ def read_segment(path: Path, last: bool = False) -> Segment:
         When the segment's header or shared part does not read or check (then none
         of its snapshots can be trusted), naming the path.
     """
+    if last or number is not None:
+        seg = _read_back(path, number)
+        if seg is not None:
+            return seg
     header, data, fixed = _open(path)
-    try:
-        text, first = header.attrs["meta"], int(header.attrs["first"])
-        shared = json.loads(text)
-    except Exception as exc:  # (summed: only another program's file gets here)
-        raise SnapshotError(f"{path} cannot be read as an archive segment ({exc})") from None
+    first, shared = _shared(path, header)
     seg = Segment(path, first, min(header.numrecs, len(data)))
     records, bad, torn = _records(header, data, last)
     seg.damaged = [(path, f"{path}: snapshot {first + k} is damaged ({why})")
@@ -545,6 +581,105 @@ def read_segment(path: Path, last: bool = False) -> Segment:
     seg.torn += rows_torn
     _split(seg, shared, fixed, records, rows)
     return seg
+
+
+def _shared(path: Path, header: Header) -> tuple[int, dict[str, Any]]:
+    """A segment's first snapshot number and what its snapshots share."""
+    try:
+        return int(header.attrs["first"]), json.loads(header.attrs["meta"])
+    except Exception as exc:  # (summed: only another program's file gets here)
+        raise SnapshotError(f"{path} cannot be read as an archive segment ({exc})") from None
+
+
+def _read_back(path: Path, number: int | None = None) -> Segment | None:
+    """:func:`read_segment` with ``last`` (``number`` None) or ``number``, reading
+    only the bytes before the first record (checked as the whole file's are) and
+    the records from the end back to the first that checks, with that one's own
+    output rows (or snapshot ``number``'s record alone): O(snapshot), whatever the
+    segment's length (a long run's archive loads at once).  The records passed over
+    are listed as damaged; the earlier ones are not read.  None where the file's
+    first bytes do not hold its header (the whole file is then read, which says
+    why)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        size, head = os.fstat(fd).st_size, _head(fd)
+        if head is None:
+            return None
+        try:
+            header, fixed = _checked(path, head)
+        except SnapshotError:  # (the whole read says why, or reads what it can)
+            return None
+        first, shared = _shared(path, header)
+        seg = Segment(path, first, min(header.numrecs, size))
+        begin, length = header.record_begin, header.record_size
+        held = max(size - begin, 0) // max(length, 1)
+        bad = [(held, f"the header counts {header.numrecs} records, the file holds {held}")
+               ] if header.numrecs > held else []
+        if size > begin + header.numrecs * length:
+            seg.torn.append(path)
+        rows_path = path.with_name(ROWS_NAME.format(first))
+        count = min(header.numrecs, held)
+        ks = range(count - 1, -1, -1) if number is None else (
+            [number - first] if 0 <= number - first < count else [])
+        for k in ks:
+            rec = _record_at(header, head + os.pread(fd, length, begin + k * length), 0)
+            if rec is None:
+                bad.append((k, "its CRC-32 does not match"))
+                continue
+            before, end = (int(x) for x in rec["rows"])
+            rows, torn = _rows_span(rows_path, before, end)
+            rec.update(_index=np.int64(k), rows=np.array([0.0, end - before]))
+            _split(seg, shared, dict(fixed), [rec], rows)
+            if seg.snapshots:
+                seg.torn += torn
+                break
+    finally:
+        os.close(fd)
+    seg.damaged[:0] = [(path, f"{path}: snapshot {first + k} is damaged ({why})")
+                       for k, why in sorted(bad)]
+    return seg
+
+
+def _rows_span(path: Path, before: int, end: int) -> tuple[dict[str, np.ndarray] | None,
+                                                             list[Path]]:
+    """Rows ``before`` to ``end`` of a segment's companion file, as :func:`_rows`
+    gives them all (None without the file; an empty dict where one of them, or the
+    header, does not check), read alone, and the file if it ends in a torn write."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except FileNotFoundError:
+        return None, []
+    except OSError:
+        return {}, []
+    try:
+        size, head = os.fstat(fd).st_size, _head(fd)
+        try:
+            header, _ = _checked(path, head)
+        except SnapshotError:  # (the whole file read, as its header may still say)
+            rows, torn = _rows(path)
+            if rows is None or not rows or end > len(rows["out_t"]):
+                return (None if rows is None else {}), torn
+            return {n: a[before:end] for n, a in rows.items()}, torn
+        begin, length = header.record_begin, header.record_size
+        if end > min(header.numrecs, max(size - begin, 0) // length):
+            return {}, []
+        records = [_record_at(header, head + os.pread(fd, length, begin + j * length), 0)
+                   for j in range(before, end)]
+        if any(r is None for r in records):
+            return {}, []
+        names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
+        out = {n: np.array([r[n] for r in records], dtype=np.float64).reshape(
+            (len(records), *header.variables[n].shape)) for n in names}
+        out["out_t"].shape  # noqa: B018 - (a rows file without times is damaged)
+        torn = size > begin + header.numrecs * length
+    except Exception:  # a damaged header: no row can be trusted
+        return {}, []
+    finally:
+        os.close(fd)
+    return out, [path] if torn else []
 
 
 def _split(seg: Segment, shared: dict[str, Any], fixed: dict[str, np.ndarray],

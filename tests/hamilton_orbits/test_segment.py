@@ -119,3 +119,92 @@ def test_a_snapshot_at_a_scheduled_time_is_refilled_with_the_outputs_arrays(tmp_
     archive = Archive(tmp_path / "direct")
     assert [s.t for s in archive.snapshots] == [0.125 * k for k in range(33)]
     assert archive.damaged == [] and archive.torn == []
+
+
+def _same_snapshot(a, b):
+    """Two ``(number, meta, arrays)`` of a segment read back, bit for bit."""
+    return (a[0] == b[0] and a[1] == b[1] and a[2].keys() == b[2].keys()
+            and all(np.array_equal(x, b[2][k], equal_nan=True) for k, x in a[2].items()))
+
+
+def _long_segment(tmp_path, every=0.2):
+    """A wh run of the sun and the earth archived ``every`` 0.2 through outputs at 0,
+    3 and 6: one segment of 31 snapshots, its rows file holding three rows, the
+    first record the leg's times."""
+    from hamilton_orbits import Body, System
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    Simulation(s, method="wh", dt=0.05, archive=tmp_path, every=every).integrate(
+        np.arange(0.0, 7.0, 3.0))
+    path, = tmp_path.glob("segment-*.nc")
+    return path
+
+
+def test_the_last_snapshot_and_any_one_read_alone_are_those_of_the_whole_segment(
+        tmp_path, monkeypatch):
+    """``read_segment(last=True)`` and ``read_segment(number=k)`` read the header, the
+    fixed variables and one record with its own rows: the same bits as the whole
+    segment read, in O(snapshot) bytes (every ``pread`` counted)."""
+    import os
+
+    from hamilton_orbits.segment import read_segment
+
+    path = _long_segment(tmp_path)
+    whole = read_segment(path).snapshots
+    assert len(whole) == 31 and "leg_times" in whole[0][2]
+    record = parse(path.read_bytes()).record_size
+    read = []
+    pread = os.pread
+    monkeypatch.setattr(os, "pread", lambda fd, n, at: read.append(n) or pread(fd, n, at))
+    last = read_segment(path, last=True)
+    assert len(last.snapshots) == 1 and _same_snapshot(last.snapshots[0], whole[-1])
+    assert not last.damaged and not last.torn
+    # its header and fixed part (64 KiB asked, the file being shorter), one record;
+    # the rows file's header and one row
+    assert len(read) == 4 and read[1] == record
+    for k in (0, 7, 30):
+        one = read_segment(path, number=k).snapshots
+        assert len(one) == 1 and _same_snapshot(one[0], whole[k])
+    assert read_segment(path, number=31).snapshots == []
+
+
+def test_a_flipped_byte_is_never_read_as_data_by_the_last_or_one_snapshot_read_alone(
+        tmp_path):
+    """The bytes of the segment and of its rows file flipped in turn (the header's
+    every one, the shared JSON text's every 16th, the records' every 5th): the
+    snapshot read alone is the original one's bits or none, the last read is never
+    older than the whole segment's last, and a last snapshot passed over is listed
+    as damaged or torn."""
+    from hamilton_orbits.segment import read_segment
+    from hamilton_orbits.snapshot import SnapshotError
+
+    path = _long_segment(tmp_path, every=1.0)  # (7 snapshots: the flips are many)
+    rows = path.with_name(path.name.replace("segment", "rows"))
+    original = {n: (n, m, a) for n, m, a in read_segment(path).snapshots}
+    for file in (path, rows):
+        data = file.read_bytes()
+        text = parse(data).attrs["meta"].encode()
+        m0 = data.find(text)
+        m1 = m0 + len(text)
+        for i in (*range(m0), *range(m0, m1, 16), *range(m1, len(data), 5)):
+            flipped = bytearray(data)
+            flipped[i] ^= 0x10
+            file.write_bytes(bytes(flipped))
+            try:
+                full = read_segment(path)
+            except SnapshotError:
+                with pytest.raises(SnapshotError):
+                    read_segment(path, last=True)
+                continue
+            last = read_segment(path, last=True)
+            if full.snapshots:
+                assert last.snapshots and _same_snapshot(
+                    last.snapshots[0], original[last.snapshots[0][0]]), (file.name, i)
+                assert last.snapshots[0][0] >= full.snapshots[-1][0], (file.name, i)
+                if last.snapshots[0][0] < 6:  # (a count lowered: the records after it torn)
+                    assert last.damaged or last.torn, (file.name, i)
+            for k in (0, 3, 6):
+                one = read_segment(path, number=k).snapshots
+                assert one == [] or _same_snapshot(one[0], original[k]), (file.name, i, k)
+        file.write_bytes(data)
