@@ -24,7 +24,11 @@ What it prints (medians over interleaved rounds; the machine is shared):
     snapshot a call: each call begins a segment of its own), the time per call
     over the first and the last 200 calls, against the same calls without an
     archive: flat, since a simulation continues its own archive without listing
-    the folder.
+    the folder;
+[6] loading the last snapshot, and one in the middle, of a long run's archive
+    (a snapshot every 10 steps of the 0.3 s radau15 run) against rebound's
+    Simulationarchive of IAS15 with ``step=10``: a snapshot read alone, whatever
+    the segment's length.
 """
 
 from __future__ import annotations
@@ -239,6 +243,51 @@ def many_calls(tmp: Path, calls: int = 1200, block: int = 200) -> None:
           f"plain {ms['plain first']:.3f} and {ms['plain last']:.3f}")
 
 
+def long_archive(tmp: Path, repeat: int = 15, t_end: float = 10 * T_END) -> None:
+    """Loading the last snapshot, and one in the middle, of a long run's archive: a
+    snapshot every 10 steps of the 0.3 s radau15 run (one segment of ~3700), against
+    rebound's Simulationarchive of IAS15 with ``step=10`` over the same time."""
+    s = disc10()
+    arrays = s.as_arrays()
+    folder, reb_file = tmp / "long-archive", tmp / "long-rebound.bin"
+    Simulation(s, method="radau15", archive=folder, every_steps=10).integrate(t_end)
+    reb = rebound_of(arrays.r, arrays.v, arrays.gm, "ias15", DT)
+    reb.integrator.epsilon = 1e-9
+    reb.save_to_file(str(reb_file), step=10, delete_file=True)
+    reb.integrate(t_end, exact_finish_time=1)
+    archive = Archive(folder)
+    n, size = len(archive), sum(p.stat().st_size for p in folder.iterdir())
+    n_reb = len(rebound.Simulationarchive(str(reb_file)))
+
+    def ours_last() -> None:
+        Simulation.load(folder)
+
+    def ours_middle() -> None:
+        archive[n // 2]
+
+    def theirs_last() -> None:
+        rebound.Simulationarchive(str(reb_file))[-1]
+
+    def theirs_middle() -> None:
+        rebound.Simulationarchive(str(reb_file))[n_reb // 2]
+
+    opened = rebound.Simulationarchive(str(reb_file))
+
+    def theirs_opened() -> None:
+        opened[n_reb // 2]
+
+    t = interleaved({"ours last": ours_last, "ours middle": ours_middle,
+                     "theirs last": theirs_last, "theirs middle": theirs_middle,
+                     "theirs opened": theirs_opened}, repeat)
+    med = {k: statistics.median(v) * 1e3 for k, v in t.items()}
+    print(f"[6] a long run's archive ({n} snapshots, {size / 1e6:.1f} MB; rebound's "
+          f"{n_reb}, {reb_file.stat().st_size / 1e6:.1f} MB), ms, median of {repeat}: the "
+          f"last loaded: ours {med['ours last']:.2f}, rebound {med['theirs last']:.2f}; "
+          f"the middle one: ours {med['ours middle']:.2f} (Archive[k], the archive listed "
+          f"once before), rebound {med['theirs middle']:.2f} (the file opened each time), "
+          f"{med['theirs opened']:.2f} (opened once before)")
+
+
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
@@ -251,6 +300,7 @@ def main() -> None:
         (tmp / "parts").mkdir()
         parts(tmp / "parts", 15)
         many_calls(tmp)
+        long_archive(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
