@@ -46,6 +46,7 @@ Examples
 from __future__ import annotations
 
 import json
+import math
 import mmap
 import operator
 import os
@@ -466,12 +467,7 @@ def _record_at(header: Header, data: bytes | bytearray, k: int) -> dict[str, np.
     record followed by record ``k``'s alone, read as record 0) decoded, or None
     where its CRC-32 does not match its bytes."""
     names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
-    at = k * header.record_size  # (each variable's bytes where the header says)
-    raw = b"".join(data[v.begin + at:v.begin + at + v.size]
-                   for v in (header.variables[n] for n in names))
-    check = header.variables.get("check")
-    stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
-    if len(stored) < 8 or zlib.crc32(raw) != struct.unpack(">d", stored)[0]:
+    if not _checks(header, data, k, _spans(header, names)):
         return None
     # (the types and shapes were checked with the header: a record that checks decodes)
     return {n: header.values(data, n, k).astype(header.variables[n].attrs.get(
@@ -488,13 +484,57 @@ def _records(header: Header, data: bytes, last: bool = False) -> tuple[
     if header.numrecs > held:  # a header counting records the file does not hold
         bad.append((held, f"the header counts {header.numrecs} records, the file holds "
                           f"{held}"))
+    names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
+    failed, spans = [], _spans(header, names)
     for k in range(min(header.numrecs, held)):
-        rec = _record_at(header, data, k)
-        if rec is None:
-            bad.append((k, "its CRC-32 does not match"))
+        (good if _checks(header, data, k, spans) else failed).append(k)
+    bad += [(k, "its CRC-32 does not match") for k in failed]
+    ks = good[-1:] if last else good
+    # (each variable of the records that check decoded at once, through a strided
+    # view of the file's bytes; a record's values are then views of those)
+    columns = {n: _column(header, data, n, ks) for n in names}
+    return ([dict({n: columns[n][i, ...] for n in names}, _index=np.int64(k))
+             for i, k in enumerate(ks)], bad, len(data) > end)
+
+
+def _checks(header: Header, data: bytes | bytearray, k: int,
+            spans: list[tuple[int, int]]) -> bool:
+    """Whether record ``k``'s CRC-32 matches its bytes (those of its variables, in
+    record 0 at ``spans`` (:func:`_spans`), without the padding between them)."""
+    at = k * header.record_size
+    check = header.variables.get("check")
+    stored = b"" if check is None else data[check.begin + at:check.begin + at + 8]
+    if len(stored) != 8:
+        return False
+    crc, view = 0, memoryview(data)
+    for begin, end in spans:
+        crc = zlib.crc32(view[begin + at:end + at], crc)
+    return crc == struct.unpack(">d", stored)[0]
+
+
+def _spans(header: Header, names: list[str]) -> list[tuple[int, int]]:
+    """The byte ranges of variables ``names`` in record 0, those that follow one
+    another without padding joined into one."""
+    out: list[tuple[int, int]] = []
+    for v in (header.variables[n] for n in names):
+        if out and out[-1][1] == v.begin:
+            out[-1] = (out[-1][0], v.begin + v.size)
         else:
-            good.append(dict(rec, _index=np.int64(k)))
-    return (good[-1:] if last else good), bad, len(data) > end
+            out.append((v.begin, v.begin + v.size))
+    return out
+
+
+def _column(header: Header, data: bytes, name: str, ks: list[int]) -> np.ndarray:
+    """Record variable ``name`` of records ``ks`` as one native array, its first axis
+    the records (the type it was saved as)."""
+    var = header.variables[name]
+    count = math.prod(var.shape)
+    if not ks:
+        return np.empty((0, *var.shape), var.attrs.get("dtype_saved", "float64"))
+    every = np.ndarray((max(ks, default=-1) + 1, count), var.dtype, data, var.begin,
+                       (header.record_size, var.dtype.itemsize))
+    return every[ks].astype(var.dtype.newbyteorder("=")).reshape(
+        (len(ks), *var.shape)).astype(var.attrs.get("dtype_saved", "float64"))
 
 
 def _head(fd: int) -> bytes | None:
