@@ -525,13 +525,13 @@ def _spans(header: Header, names: list[str]) -> list[tuple[int, int]]:
 
 
 def _column(header: Header, data: bytes, name: str, ks: list[int]) -> np.ndarray:
-    """Record variable ``name`` of records ``ks`` as one native array, its first axis
-    the records (the type it was saved as)."""
+    """Record variable ``name`` of records ``ks`` (increasing) as one native array,
+    its first axis the records (the type it was saved as)."""
     var = header.variables[name]
     count = math.prod(var.shape)
     if not ks:
         return np.empty((0, *var.shape), var.attrs.get("dtype_saved", "float64"))
-    every = np.ndarray((max(ks, default=-1) + 1, count), var.dtype, data, var.begin,
+    every = np.ndarray((ks[-1] + 1, count), var.dtype, data, var.begin,
                        (header.record_size, var.dtype.itemsize))
     return every[ks].astype(var.dtype.newbyteorder("=")).reshape(
         (len(ks), *var.shape)).astype(var.attrs.get("dtype_saved", "float64"))

@@ -278,7 +278,7 @@ class _Run:
     #: not state: the hook a run sets and clears (:meth:`Propagation.advance`), a
     #: step's own ``b`` and ``g`` (written at each step's start from ``br`` and ``d``,
     #: :func:`~hamilton_orbits._kernels.radau15._begin`, before they are read: a
-    #: snapshot is 40% smaller without them) and the kernel's arguments that hold
+    #: snapshot of 10 bodies is 37% smaller without them) and the kernel's arguments that hold
     #: them (made again by :meth:`restarted`)
     RESTART_SCRATCH = ("pause", "scratch", "after_t")
 
