@@ -223,14 +223,7 @@ def test_a_flipped_byte_anywhere_in_a_segment_is_never_read_as_data(tmp_path):
     original = read_segment(path).snapshots
     assert [a["out_t"].size for _, _, a in original] == [1, 0, 1, 1]
     for file in (path, rows):
-        data = file.read_bytes()
-        text = parse(data).attrs["meta"].encode()
-        m0 = data.find(text)
-        m1 = m0 + len(text)
-        for i in (*range(m0), *range(m0, m1, 16), *range(m1, len(data))):
-            flipped = bytearray(data)
-            flipped[i] ^= 0x10
-            file.write_bytes(bytes(flipped))
+        for i in flipped_bytes(file):
             try:
                 seg = read_segment(path)
             except SnapshotError:
@@ -243,6 +236,24 @@ def test_a_flipped_byte_anywhere_in_a_segment_is_never_read_as_data(tmp_path):
                            for k, a in arrays.items()), (file.name, i)
             if len(seg.snapshots) < len(original):
                 assert seg.damaged or seg.torn, (file.name, i)
+
+
+def flipped_bytes(file, every=1):
+    """Flip each byte of segment or rows ``file`` in turn, the file holding that one
+    flip while the caller reads (the shared JSON text, summed by SHA-256 as one,
+    every 16th byte; the records' every ``every``-th), and put the original back
+    after; yields the byte's position."""
+    data = file.read_bytes()
+    text = parse(data).attrs["meta"].encode()
+    m0 = data.find(text)
+    m1 = m0 + len(text)
+    try:
+        for i in (*range(m0), *range(m0, m1, 16), *range(m1, len(data), every)):
+            flipped = bytearray(data)
+            flipped[i] ^= 0x10
+            file.write_bytes(bytes(flipped))
+            yield i
+    finally:
         file.write_bytes(data)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_archive import RADAU15_STEPPED
+from test_archive import RADAU15_STEPPED, flipped_bytes
 
 from hamilton_orbits import Archive, Simulation
 from hamilton_orbits._netcdf3 import parse
@@ -171,8 +171,8 @@ def test_the_last_snapshot_and_any_one_read_alone_are_those_of_the_whole_segment
 
 def test_a_flipped_byte_is_never_read_as_data_by_the_last_or_one_snapshot_read_alone(
         tmp_path):
-    """The bytes of the segment and of its rows file flipped in turn (the header's
-    every one, the shared JSON text's every 16th, the records' every 5th): the
+    """The bytes of the segment and of its rows file flipped in turn (each one before
+    the shared JSON text, the text's every 16th, every 5th after it): the
     snapshot read alone is the original one's bits or none, the last read is never
     older than the whole segment's last, and a last snapshot passed over is listed
     as damaged or torn."""
@@ -183,14 +183,7 @@ def test_a_flipped_byte_is_never_read_as_data_by_the_last_or_one_snapshot_read_a
     rows = path.with_name(path.name.replace("segment", "rows"))
     original = {n: (n, m, a) for n, m, a in read_segment(path).snapshots}
     for file in (path, rows):
-        data = file.read_bytes()
-        text = parse(data).attrs["meta"].encode()
-        m0 = data.find(text)
-        m1 = m0 + len(text)
-        for i in (*range(m0), *range(m0, m1, 16), *range(m1, len(data), 5)):
-            flipped = bytearray(data)
-            flipped[i] ^= 0x10
-            file.write_bytes(bytes(flipped))
+        for i in flipped_bytes(file, every=5):
             try:
                 full = read_segment(path)
             except SnapshotError:
@@ -207,4 +200,3 @@ def test_a_flipped_byte_is_never_read_as_data_by_the_last_or_one_snapshot_read_a
             for k in (0, 3, 6):
                 one = read_segment(path, number=k).snapshots
                 assert one == [] or _same_snapshot(one[0], original[k]), (file.name, i, k)
-        file.write_bytes(data)
