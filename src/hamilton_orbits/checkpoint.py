@@ -41,6 +41,8 @@ from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.restart import inline
 from hamilton_orbits.segment import (
+    NO_LEG,
+    NO_SPAN,
     SEGMENT_NAME,
     SEGMENT_RE,
     Segment,
@@ -63,8 +65,9 @@ __all__ = [
 ]
 
 #: the layout of an archive folder: 1, a netCDF file per snapshot; 2, segments of
-#: snapshots appended (:mod:`hamilton_orbits.segment`); every version reads both
-ARCHIVE_VERSION = 2
+#: snapshots appended (:mod:`hamilton_orbits.segment`), one or more per leg; 3, a
+#: segment continued across the legs of one writer; every version reads them all
+ARCHIVE_VERSION = 3
 SNAPSHOT_NAME = "snapshot-{:06d}.nc"
 _SNAPSHOT_RE = re.compile(r"^snapshot-(\d{6})\.nc$")
 _TORN_RE = re.compile(r"^\.(snapshot|segment|rows)-\d{6}\.nc\.tmp-\d+$")
@@ -322,6 +325,11 @@ class ArchiveWriter:
         #: the last segment this writer closed: its path, its size and the number
         #: after its last snapshot (:meth:`_continued`)
         self.left: tuple[Path, int, int] | None = None
+        #: that segment, when its records hold their leg: the next leg goes on in it
+        #: if it is there as it was left
+        self.parked: SegmentWriter | None = None
+        #: the leg of the snapshots being appended (a record's ``leg``)
+        self.leg: tuple[float, ...] = NO_LEG
         self.last_steps, self.last_wall = 0, time.monotonic()
 
     def schedule_only(self) -> ArchiveWriter:
@@ -350,6 +358,9 @@ class ArchiveWriter:
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
+        parked, self.parked = self.parked, None
+        if known is not None and parked is not None and parked.reopen():
+            self.segment = parked  # (the next leg goes on in it, if it shares the same)
 
     def _continued(self) -> int | None:
         """The next snapshot number without listing the folder (whose listing grows
@@ -375,6 +386,7 @@ class ArchiveWriter:
         if self.segment is not None:
             self.segment.close()
             self.left = (self.segment.path, self.segment.size, self.count)
+            self.parked = self.segment if self.segment.legs else None
             self.segment = None
         if self.folder is not None:
             self.folder.__exit__(None, None, None)
@@ -405,9 +417,19 @@ class ArchiveWriter:
         self.open()
         if self.path is None:
             return None
-        shared = {k: x for k, x in meta.items() if k not in ("t", "steps")}
+        shared = {k: x for k, x in meta.items() if k not in ("t", "steps", "leg", "started")}
         shared["archive"] = self.schedule()
-        seg, arrays = self.segment, {**arrays, "steps": meta["steps"]}
+        leg, times = meta.get("leg"), arrays.get("leg_times")
+        started = float(meta["started"]) if "started" in meta else math.nan
+        self.leg = (started, *NO_LEG[1:]) if leg is None else (
+            started, float(leg["start"]), float(leg["first"]), float(leg["steps0"]),
+            float(leg["first_event"]))
+        # (a leg's times in its first record when they are its start and its end; more
+        # of them are a fixed variable of a segment that leg begins)
+        span = tuple(float(x) for x in times) if times is not None and len(times) == 2 else NO_SPAN
+        arrays = {**{k: x for k, x in arrays.items() if k != "leg_times" or span is NO_SPAN},
+                  "steps": meta["steps"], "leg": self.leg, "leg_span": span}
+        seg = self.segment
         if seg is None or "leg_times" in arrays or not _same(seg, shared):
             if seg is not None:
                 seg.close()
@@ -435,7 +457,9 @@ class ArchiveWriter:
     def append(self, values: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append a snapshot that shares everything but ``values`` (its record: ``t``,
         ``steps``, ``r``, ... as :func:`state_values` gives them) and its output ``rows``
-        with the last one, to the segment being written."""
+        with the last one, to the segment being written (in the same leg)."""
+        if "leg" not in values:
+            values = {**values, "leg": self.leg, "leg_span": NO_SPAN}
         self.segment.append(values, rows)
         self.count += 1
         self.last_steps, self.last_wall = int(values["steps"]), time.monotonic()

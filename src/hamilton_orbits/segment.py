@@ -6,21 +6,26 @@ file (64-bit offsets) with an unlimited dimension ``snapshot``:
 
 - written once, when the segment begins: the global attribute ``meta`` (JSON: what
   every snapshot of the segment shares, i.e. the system's names, the method and its
-  options, the effects, the events, the integrator state's layout, the leg and the
+  options, the effects, the events, the integrator state's layout and the
   archive's schedule) and the fixed variables (the system at time 0, ``initial_*``;
-  the leg's output times ``leg_times`` when the segment begins a leg), with their
-  SHA-256 in the attribute ``sha256``;
+  a leg's output times ``leg_times`` when the segment begins a leg of more than
+  its start and its end), with their SHA-256 in the attribute ``sha256``;
 - one record per snapshot: ``t``, ``r(body, xyz)``, ``v``, ``gm``, ``active``, the
   integrator's packed ``state`` and the numbers of its state ``scalars`` (times,
-  step counts: :func:`hamilton_orbits.restart.flatten`), ``steps``, ``rows`` (the
-  first and the end of the caller's output rows in the companion file that belong
-  to it) and ``check``, the CRC-32 of the record's other bytes.
+  step counts: :func:`hamilton_orbits.restart.flatten`), ``steps``, its ``leg``
+  (:data:`NO_LEG`: whether a leg ran before this one's, the number of the leg's
+  first snapshot, whether it began at time 0, the steps and events before it),
+  ``leg_span`` (the leg's start and end times, in its first record), ``rows``
+  (the first and the end of the caller's output rows in the companion file that
+  belong to it) and ``check``, the CRC-32 of the record's other bytes.
 
 The caller's output rows go to a companion ``rows-NNNNNN.nc`` of the same form
 (unlimited dimension ``row``: ``t``, ``r``, ``v``, the variational equations'
-values, ``check``).  A segment begins when a leg begins, or when what its
-snapshots share changes (an event merged two bodies: the layout changed); a new
-process never appends to another's segment.
+values, ``check``).  A segment begins when what its snapshots share changes (an
+event merged two bodies: the layout changed) or a leg of more output times
+begins; a writer's next leg goes on in the segment it left, when that is as it
+left it (format 3; in format 2 each leg began a segment, its leg in ``meta``).
+A new process never appends to another's segment.
 
 Appending a snapshot writes its record after the last one, then the number of
 records in the header (4 bytes stored through a mapping of the file's first
@@ -76,12 +81,22 @@ __all__ = ["SEGMENT_FORMAT", "SEGMENT_NAME", "SEGMENT_RE", "Segment", "SegmentWr
            "read_segment"]
 
 SEGMENT_FORMAT = "hamilton-orbits archive segment"
-#: the archive format that segments are: 2 (1 was a file per snapshot)
-SEGMENT_VERSION = 2
+#: the archive format that segments are: 3, a segment continued across the legs of
+#: one writer, each record holding its leg (2: a segment per leg; 1 was a file per
+#: snapshot)
+SEGMENT_VERSION = 3
 SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
 #: the record of a snapshot of a propagation's state, in its stored order
 _STATE_RECORD = ["t", "r", "v", "gm", "state", "scalars", "steps", "rows", "active"]
+#: the same with the snapshot's leg (format 3: a segment continued across legs)
+_STATE_RECORD_LEGS = ["t", "r", "v", "gm", "state", "scalars", "steps", "leg", "leg_span",
+                      "rows", "active"]
+#: a record's ``leg`` (whether the simulation had begun a leg before this one, the
+#: number of the leg's first snapshot, whether it began at time 0, the steps and
+#: the events recorded before it) when it has none, and its ``leg_span`` (the leg's
+#: start and end times, in its first record) after the leg's first record
+NO_LEG, NO_SPAN = (math.nan,) * 5, (math.nan,) * 2
 _ROWS = ("out_t", "out_r", "out_v", "out_megno", "out_lyapunov", "out_lyapunov_time",
          "out_stm")
 
@@ -158,6 +173,26 @@ class _Appender:
         if self.fd >= 0:
             os.close(self.fd)
             self.fd = -1
+
+    def reopen(self) -> bool:
+        """Open the file closed by :meth:`close` again, to append after its last
+        record; False, nothing open, where it is not as this appender left it (its
+        size, its count of records)."""
+        try:
+            fd = os.open(self.path, os.O_RDWR)
+        except OSError:
+            return False
+        try:
+            if (os.fstat(fd).st_size != self.end
+                    or os.pread(fd, 4, NUMRECS_AT) != struct.pack(">i", self.count)):
+                os.close(fd)
+                return False
+        except OSError:
+            os.close(fd)
+            return False
+        self.fd = fd
+        self.numrecs = None if self.sync else _mapped_count(fd)
+        return True
 
 
 def _exact(numbers: list[Any]) -> bool:
@@ -275,10 +310,17 @@ class SegmentWriter:
         self._file = _Appender(self.path, attrs, fixed_vars, template, "snapshot", sync, fixed,
                                units)
         self._rows: _Appender | None = None
+        #: the records hold their leg (``leg``, ``leg_span``): the segment goes on
+        #: across legs (format 3)
+        self.legs = "leg" in self.names
+        #: what a record holds after ``steps`` when no leg begins there: its leg and
+        #: no span (with ``legs``)
+        self.tail: tuple[float, ...] = (*NO_LEG, *NO_SPAN) if self.legs else ()
         #: a record of a propagation's state is filled by :meth:`_append_state`, the
         #: flat views of its state's arrays kept while they are the same arrays
-        self._direct = (self.names == _STATE_RECORD
-                        and self._file.buffer.runs[0][:2] == (0, 8))
+        floats = len(self.names) - 1
+        self._direct = (self.names in (_STATE_RECORD, _STATE_RECORD_LEGS)
+                        and self._file.buffer.runs[0][:2] == (0, floats))
         self._kept: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
         #: what the last :meth:`_append_state` filled from, for :meth:`refill`
         self._last: tuple[Any, ...] | None = None
@@ -319,6 +361,8 @@ class SegmentWriter:
                                        units={f"out_{k}": x for k, x in self.units.items()})
             self._rows.append([[np.asarray(rows[k][i], np.float64) for k in names]
                                for i in range(n)])
+        if self.legs:
+            self.tail = (*snapshot["leg"], *NO_SPAN)
         if not n and self._direct and type(snapshot["state"]) is Parts and self._append_state(
                 snapshot, start):
             return
@@ -349,15 +393,18 @@ class SegmentWriter:
                     kept[0][k], kept[1][k] = a, a.reshape(-1)
         r, v, gm, scalars, active, steps = (snap["r"], snap["v"], snap["gm"], snap["scalars"],
                                             snap["active"], snap["steps"])
+        tail = (*snap["leg"], *snap["leg_span"]) if self.legs else ()
         if (r.shape != views[1].shape or v.shape != views[2].shape or gm.shape != views[3].shape
-                or scalars.shape != views[5].shape or np.shape(active) != views[8].shape
-                or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT):
+                or scalars.shape != views[5].shape or np.shape(active) != views[-2].shape
+                or type(steps) is not int or not -INT_EXACT < steps < INT_EXACT
+                or len(tail) != len(self.tail)):
             return False
-        head = file.buffer.runs[0][2]  # (t, r, v, gm, state, scalars, steps, rows)
+        head = file.buffer.runs[0][2]  # (t, r, v, gm, state, scalars, steps, [leg,
+        # leg_span,] rows)
         head[0] = snap["t"]
         np.concatenate([r.reshape(-1), v.reshape(-1), gm, *kept[1], scalars,
-                        (steps, start, start)], out=head[1:], casting="unsafe")
-        views[8][...] = active
+                        (steps, *tail, start, start)], out=head[1:], casting="unsafe")
+        views[-2][...] = active  # (the last variable is check)
         file.write(file.checked(), 1)
         self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]))
         return True
@@ -396,7 +443,7 @@ class SegmentWriter:
         # (the native bytes joined, then turned big-endian by one copy: the bytes the
         # concatenation of :meth:`_append_state` gives, in a third of its time)
         head[1:] = np.frombuffer(b"".join(
-            [*pieces, np.array([*scalars, steps, start, start], dtype=np.float64)]))
+            [*pieces, np.array([*scalars, steps, *self.tail, start, start], dtype=np.float64)]))
         file.write(file.checked(), 1)
         return True
 
@@ -436,6 +483,17 @@ class SegmentWriter:
         self._file.close()
         if self._rows is not None:
             self._rows.close()
+
+    def reopen(self) -> bool:
+        """Open the files closed by :meth:`close` again, to go on appending (a
+        segment whose records hold their leg, continued by the next leg of the same
+        writer); False, nothing open, where one is not as this writer left it."""
+        if not self._file.reopen():
+            return False
+        if self._rows is not None and not self._rows.reopen():
+            self._file.close()
+            return False
+        return True
 
 
 @dataclass
@@ -732,6 +790,16 @@ def _split(seg: Segment, shared: dict[str, Any], fixed: dict[str, np.ndarray],
         before, end = (int(x) for x in rec.pop("rows"))
         number = seg.first + k
         meta = {**shared, "t": float(rec["t"]), "steps": int(rec["steps"]), "number": number}
+        if "leg" in rec:  # (format 3: the record's own leg, and its times at its start)
+            leg, span = rec.pop("leg"), rec.pop("leg_span")
+            if not np.isnan(leg[0]):
+                meta["started"] = bool(leg[0])
+            if not np.isnan(leg[1]):
+                meta["leg"] = {"start": int(leg[1]), "first": bool(leg[2]),
+                               "steps0": int(leg[3]), "unit": shared.get("unit"),
+                               "first_event": int(leg[4])}
+            if not np.isnan(span[0]):
+                rec["leg_times"] = span
         arrays = {**fixed, **rec}
         arrays["t"] = np.float64(rec["t"])
         if k == 0 and leg_times is not None:

@@ -20,7 +20,7 @@ from test_simulation_legs import _disc, _merging, _same
 
 from hamilton_orbits import Archive, Body, Simulation, System
 from hamilton_orbits._netcdf3 import parse
-from hamilton_orbits.checkpoint import snapshot_at, snapshot_files
+from hamilton_orbits.checkpoint import contents, snapshot_at, snapshot_files
 from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.segment import read_segment
 from hamilton_orbits.snapshot import SnapshotError
@@ -587,12 +587,13 @@ def test_a_segment_being_written_reads_and_a_record_begun_after_it_is_torn(tmp_p
 
 def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp_path,
                                                                             monkeypatch):
-    """Each archived call begins a segment at the folder's next snapshot number.  A
-    simulation whose writer closed the last segment knows that number: the folder
-    (one segment per call, so a listing that grows with the archive: 1.6 -> 5 ms a
-    call over 1200 calls before) is listed on its first call only, and again after
-    another writer came (its segment holds the number) or the last segment changed
-    (here: removed).  The snapshots are numbered without a gap either way."""
+    """Each archived call goes on in the segment the simulation's last call wrote, or
+    begins one at the folder's next snapshot number.  A simulation whose writer
+    closed the last segment knows that number: the folder (whose listing grows with
+    the archive: 1.6 -> 5 ms a call over 1200 calls when each call began a segment)
+    is listed on its first call only, and again after another writer came (its
+    segment holds the number) or the last segment changed (here: removed).  The
+    snapshots are numbered without a gap either way."""
     from hamilton_orbits import checkpoint
 
     listed = []
@@ -608,14 +609,15 @@ def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp
     assert len(listed) == 2
     sim.integrate(3.5)  # (its number is taken: listed again, continued after the other's)
     assert len(listed) == 3
-    sim.integrate(4.0)
+    sim.integrate(4.0)  # (in the segment its last call began: 6 and 7)
     assert len(listed) == 3
-    last = snapshot_files(tmp_path)[-1][1]
-    last.unlink()  # (its last segment gone: the folder is read again)
+    files = snapshot_files(tmp_path)
+    assert [first for first, _ in files] == [0, 5, 6]
+    files[-1][1].unlink()  # (its last segment gone: the folder is read again)
     sim.integrate(4.5)
     assert len(listed) == 4
     numbers = [s.number for s in Archive(tmp_path).snapshots]
-    assert numbers == list(range(8)), numbers  # (7 again, after the one removed)
+    assert numbers == list(range(7)), numbers  # (6 again, after the two removed)
 
 
 def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was_written(
@@ -665,3 +667,162 @@ def test_a_read_only_folder_is_refused_at_the_archives_first_write(tmp_path, mon
                                             r"denied\)"):
         sim.integrate(30.0)
     assert sim.t == 0.0 and sim.steps == 0
+
+
+def test_a_simulations_calls_go_on_in_one_segment_each_snapshot_keeping_its_leg(tmp_path):
+    """Archive format 3: a call goes on in the segment the simulation's last call
+    wrote (no file made per call), each record holding its leg (the number of the
+    leg's first snapshot, whether it began at time 0, the steps and events before
+    it) and the leg's first its times; a leg of more output times begins a segment
+    that holds them, and the next calls go on in that one.  A segment changed by
+    someone else is not gone on in."""
+    sim = Simulation(_disc(), archive=tmp_path, method="radau15", every=0.25)
+    starts, steps0 = [], []
+    for t in (0.5, 1.0, 1.5, [1.7, 1.9, 2.0], 2.5, 3.0):
+        starts.append(sim._archive.count)
+        steps0.append(sim.steps)
+        sim.integrate(t)
+    # one segment; the leg of three output times begins another
+    assert [first for first, _ in snapshot_files(tmp_path)] == [0, starts[3]]
+    assert len(list(tmp_path.glob("rows-*.nc"))) == 2
+    by_number = {n: (meta, arrays) for n, _, meta, arrays in contents(tmp_path).snapshots}
+    assert sorted(by_number) == list(range(sim._archive.count))
+    ends = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
+    for k, (start, s0) in enumerate(zip(starts, steps0, strict=True)):
+        stop = starts[k + 1] if k + 1 < len(starts) else sim._archive.count
+        for n in range(start, stop):
+            meta, arrays = by_number[n]
+            assert meta["leg"] == {"start": start, "first": k == 0, "steps0": s0,
+                                   "unit": None, "first_event": 0}, n
+            assert ("leg_times" in arrays) == (n == start), n
+        times = by_number[start][1]["leg_times"]
+        assert times[0] == (0.0 if k == 0 else ends[k - 1]) and times[-1] == ends[k]
+    assert by_number[starts[3]][1]["leg_times"].tolist() == [1.5, 1.7, 1.9, 2.0]
+    rows, = [p for p in tmp_path.glob("rows-*.nc") if p.name.endswith(f"{starts[3]:06d}.nc")]
+    with open(rows, "ab") as fh:  # (its rows file changed: the next call begins a segment)
+        fh.write(b"\0")
+    sim.integrate(3.5)
+    assert [first for first, _ in snapshot_files(tmp_path)][-1] == starts[-1] + 3
+
+
+def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path):
+    """A call stopped (as a kill would leave it) in a segment the simulation's
+    earlier calls began: resumed from the archive, it returns the whole call's rows
+    and bits."""
+    whole = Simulation(_disc(), method="radau15")
+    for t in (0.5, 1.0):
+        whole.integrate(t)
+    ref = whole.integrate(10.0)
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path, every_steps=5)
+    for t in (0.5, 1.0):  # (a stop asked in each: the driver's layout holds one)
+        sim.integrate(t, stop=lambda: False)
+    pauses, before = iter(range(10**6)), sim._archive.count
+    cut = sim.integrate(10.0, stop=lambda: next(pauses) == 4)  # (asked after each pause)
+    assert not cut.complete and snapshot_files(tmp_path)[-1][0] < before  # (gone on in)
+    again = Simulation.load(tmp_path)
+    assert 1.0 < again.t < 10.0
+    traj = again.resume()
+    assert traj.t.tolist() == [1.0, 10.0] and traj.complete
+    assert _same(traj.r, ref.r) and _same(traj.v, ref.v) and traj.steps == ref.steps
+
+
+def test_an_archive_of_the_second_format_is_read_and_continued(tmp_path):
+    """``data/archive-v2`` was written by archive format 2 (a segment per leg, the
+    leg in the segment's shared part; written at commit 6e3b256 as
+    tools/make_snapshot_fixture.py writes archive-v1): the planet of
+    ``test_an_archive_of_the_first_format_is_read_and_continued``, wh, dt = 0.01,
+    outputs 0, 1, ..., 5, a snapshot every 2.  This version lists it, resumes its
+    call whole and continues it in segments of its own format."""
+    import shutil
+
+    from hamilton_orbits import KeplerOrbit
+
+    folder = tmp_path / "archive"
+    shutil.copytree(Path(__file__).parent / "data" / "archive-v2", folder)
+    archive = Archive(folder)
+    assert archive.times.tolist() == [0.0, 2.0, 4.0] and not archive.damaged
+    assert parse((folder / "segment-000000.nc").read_bytes()).attrs["format_version"] == 2
+    orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.5, argp=1.0, nu=0.0, mu=1.0)
+    traj = Simulation.load(folder).resume()
+    assert traj.t.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    # wh is exact on a test particle's Kepler orbit (a single Kepler drift per step),
+    # so the state agrees with the ellipse to rounding (Murray & Dermott 1999, 2.4)
+    for t, r in zip(traj.t, traj.r[:, 1], strict=True):
+        np.testing.assert_allclose(r, orbit.propagate(float(t)).state()[0], rtol=0, atol=1e-12)
+    sim = Simulation.load(folder)
+    sim.integrate(8.0)
+    sim.integrate(10.0)
+    assert Archive(folder).times.tolist() == [0.0, 2.0, 4.0, 4.0, 6.0, 8.0, 8.0, 10.0]
+    assert [first for first, _ in snapshot_files(folder)] == [0, 3]  # (one for both)
+
+
+def _run_calls(folder, paced=False):
+    """The run of ``_run_archived`` as a loop of calls, one per output time (format
+    3: they go on in one segment); ``paced``: 3 ms of wall time after each call."""
+    sim = Simulation(_disc(), archive=folder, **KW)
+    for t in T:
+        sim.integrate(float(t))
+        if paced:
+            time.sleep(0.003)
+    return sim
+
+
+def test_a_loop_of_calls_killed_at_any_moment_loses_at_most_the_snapshot_being_written(
+        tmp_path):
+    """20 loops of calls (each call going on in the segment the last one wrote)
+    killed with SIGKILL, half at random moments, half as soon as the archive holds
+    a random number of snapshots: each archive opens, its snapshots are the
+    reference's, and the interrupted call resumed and the calls after it made reach
+    the reference's state to the bit, with the reference's snapshots."""
+    ref = _run_calls(tmp_path / "ref")
+    reference = Archive(tmp_path / "ref")
+    assert len(reference) >= 25 and len(snapshot_files(tmp_path / "ref")) == 1
+    times = []
+    for k in range(3):
+        start = time.perf_counter()
+        _run_calls(tmp_path / "timing" / str(k), paced=True)
+        times.append(time.perf_counter() - start)
+    t_run = sorted(times)[1]
+    rng = np.random.default_rng(20261129)
+    seen_partial = 0
+    for k in range(20):
+        folder = tmp_path / f"kill{k}"
+        ready, go = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: run and exit without cleaning up
+            try:
+                os.close(ready)
+                os.write(go, b"!")
+                _run_calls(folder, paced=True)
+            finally:
+                os._exit(0)
+        os.close(go)
+        os.read(ready, 1)
+        os.close(ready)
+        ended = False
+        if k % 2:
+            time.sleep(rng.uniform(0.0, 1.1) * t_run)
+        else:
+            ended = _wait_for_snapshots(folder, int(rng.integers(1, 20)), pid)
+        if not ended:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        if not folder.exists() or not Archive(folder).snapshots:
+            sim = _run_calls(folder)  # killed before the first snapshot: anew
+        else:
+            archive = Archive(folder)
+            assert archive.damaged == []
+            seen_partial += len(archive) < len(reference)
+            for snap in archive.snapshots:
+                assert all(_same(x, y) for x, y in zip(
+                    _snapshot_state(folder, snap.number),
+                    _snapshot_state(tmp_path / "ref", snap.number), strict=True))
+            sim = Simulation.load(folder)
+            sim.resume()  # the call the kill interrupted, then the ones after it
+            for t in T[T > sim.t]:
+                sim.integrate(float(t))
+        end, ref_end = sim.system.as_arrays(), ref.system.as_arrays()
+        assert _same(end.r, ref_end.r) and _same(end.v, ref_end.v), f"kill {k}"
+        assert sim.steps == ref.steps, f"kill {k}"
+        assert len(Archive(folder)) == len(reference), f"kill {k}"
+    assert seen_partial >= 5
