@@ -21,10 +21,10 @@ What it prints (medians over interleaved rounds; the machine is shared):
 [4] where an ``every_steps=100`` snapshot's time goes in the 0.4 s radau15 run:
     the archive's fixed cost, the pauses alone, the whole (per snapshot);
 [5] a simulation called 1200 times (radau15, 10 bodies, 0.5 days a call, one
-    snapshot a call: each call begins a segment of its own), the time per call
-    over the first and the last 200 calls, against the same calls without an
-    archive: flat, since a simulation continues its own archive without listing
-    the folder;
+    snapshot a call: each call goes on in the segment the last one wrote), the
+    time per call over the first and the last 200 calls, against the same calls
+    without an archive and rebound's IAS15 call followed by ``save_to_file`` (a
+    snapshot appended to its archive);
 [6] loading the last snapshot, and one in the middle, of a long run's archive
     (a snapshot every 10 steps of the 0.3 s radau15 run) against rebound's
     Simulationarchive of IAS15 with ``step=10``: a snapshot read alone, whatever
@@ -228,19 +228,31 @@ def parts(tmp: Path, rounds: int, t_end: float = 10 * T_END) -> None:
 
 def many_calls(tmp: Path, calls: int = 1200, block: int = 200) -> None:
     s = disc10()
+    arrays = s.as_arrays()
     archived = Simulation(s, method="radau15", archive=tmp / "calls", every=1e9)
     plain = Simulation(s, method="radau15")
-    per_call: dict[str, list[float]] = {"archived": [], "plain": []}
+    reb_file = tmp / "calls-rebound.bin"
+    reb = rebound_of(arrays.r, arrays.v, arrays.gm, "ias15", DT)
+    reb.integrator.epsilon = 1e-9
+
+    def rebound_call(t: float) -> None:  # (its call, then a snapshot appended)
+        reb.integrate(t, exact_finish_time=1)
+        reb.save_to_file(str(reb_file))
+
+    per_call: dict[str, list[float]] = {"archived": [], "plain": [], "rebound": []}
     for k in range(1, calls + 1):
         for name, sim in (("archived", archived), ("plain", plain)):
             per_call[name].append(timed(lambda sim=sim, k=k: sim.integrate(0.5 * k)))
+        per_call["rebound"].append(timed(lambda k=k: rebound_call(0.5 * k)))
     first, last = (slice(1, block + 1), slice(calls - block, calls))
     ms = {f"{n} {w}": statistics.median(per_call[n][part]) * 1e3
           for n in per_call for w, part in (("first", first), ("last", last))}
+    files = len(list((tmp / "calls").iterdir()))
     print(f"[5] {calls} calls of one simulation, one snapshot each (ms per call, medians of "
           f"{block}): archived {ms['archived first']:.2f} (calls 2-{block + 1}) and "
-          f"{ms['archived last']:.2f} (the last {block}, {2 * calls} files in the folder); "
-          f"plain {ms['plain first']:.3f} and {ms['plain last']:.3f}")
+          f"{ms['archived last']:.2f} (the last {block}; {files} files in the folder); "
+          f"plain {ms['plain first']:.3f} and {ms['plain last']:.3f}; rebound's IAS15 call "
+          f"and save_to_file {ms['rebound first']:.3f} and {ms['rebound last']:.3f}")
 
 
 def long_archive(tmp: Path, repeat: int = 15, t_end: float = 10 * T_END) -> None:
