@@ -7,7 +7,9 @@ A planet of zero mass on a Kepler ellipse (a = 1, e = 0.3, inc = 0.2, lan = 0.5,
 argp = 1.0, nu = 0 at t = 0) about a star of GM 1, integrated by wh (dt = 0.01):
 saved at t = 10; archived every 2 time units through the output times 0, 1, ..., 5
 (a kill after the snapshot at t = 4 is what the archive looks like).  Run once per
-new format version:
+new format version (``archive-v1`` was written by format 1; ``archive-v2`` by
+format 2, at commit 6e3b256, with this recipe; the snapshot's format is still 1,
+so running this also writes ``snapshot-v1.nc`` anew):
 
     python tools/make_snapshot_fixture.py
 """
