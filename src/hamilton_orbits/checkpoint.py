@@ -412,18 +412,15 @@ class ArchiveWriter:
     def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
               dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path | None:
         """Append the next snapshot (numbered after the last one in the folder) to the
-        segment being written, or begin a segment (a new leg, or a change in what the
-        snapshots share); nothing without a folder.  Returns the segment's path."""
+        segment being written, a new leg's too, or begin a segment (a change in what
+        the snapshots share, a leg of more output times than its end); nothing
+        without a folder.  Returns the segment's path."""
         self.open()
         if self.path is None:
             return None
         shared = {k: x for k, x in meta.items() if k not in ("t", "steps", "leg", "started")}
         shared["archive"] = self.schedule()
-        leg, times = meta.get("leg"), arrays.get("leg_times")
-        started = float(meta["started"]) if "started" in meta else math.nan
-        self.leg = (started, *NO_LEG[1:]) if leg is None else (
-            started, float(leg["start"]), float(leg["first"]), float(leg["steps0"]),
-            float(leg["first_event"]))
+        self.leg, times = _record_leg(meta), arrays.get("leg_times")
         # (a leg's times in its first record when they are its start and its end; more
         # of them are a fixed variable of a segment that leg begins)
         span = tuple(float(x) for x in times) if times is not None and len(times) == 2 else NO_SPAN
@@ -463,6 +460,17 @@ class ArchiveWriter:
         self.segment.append(values, rows)
         self.count += 1
         self.last_steps, self.last_wall = int(values["steps"]), time.monotonic()
+
+
+def _record_leg(meta: Mapping[str, Any]) -> tuple[float, ...]:
+    """A record's ``leg`` (:data:`~hamilton_orbits.segment.NO_LEG`) from what a
+    snapshot's ``meta`` says of its ``integrate`` call."""
+    started = float(meta["started"]) if "started" in meta else math.nan
+    leg = meta.get("leg")
+    if leg is None:
+        return (started, *NO_LEG[1:])
+    return (started, float(leg["start"]), float(leg["first"]), float(leg["steps0"]),
+            float(leg["first_event"]))
 
 
 def _same(seg: SegmentWriter, shared: dict[str, Any]) -> bool:
