@@ -131,27 +131,8 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
     seen_partial = 0
     for k in range(20):
         folder = tmp_path / f"kill{k}"
-        ready, go = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the child: run and exit without cleaning up
-            try:
-                os.close(ready)
-                os.write(go, b"!")  # the random moment counts from the run's start,
-                _run_archived(folder, kw, paced=True)  # not from the fork (slow for a large
-                # process)
-            finally:
-                os._exit(0)
-        os.close(go)
-        os.read(ready, 1)
-        os.close(ready)
-        ended = False
-        if k % 2:  # at a random moment of the run: before, between or during writes
-            time.sleep(rng.uniform(0.0, 1.1) * t_run)
-        else:  # as soon as it holds a random number of its 25 snapshots: a partial run
-            ended = _wait_for_snapshots(folder, int(rng.integers(1, 20)), pid)
-        if not ended:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
+        _killed(lambda folder=folder: _run_archived(folder, kw, paced=True), folder, k % 2,
+                rng, t_run)
         if not folder.exists() or not Archive(folder).snapshots:
             _, traj = _run_archived(folder, kw)  # killed before the first snapshot: anew
         else:
@@ -168,6 +149,33 @@ def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp
         assert _same(traj.energy_error, whole.energy_error) and traj.steps == whole.steps
         assert len(Archive(folder)) == len(reference)
     assert seen_partial >= 5  # the kills did fall inside the runs
+
+
+def _killed(run, folder, at_random: bool, rng, t_run: float) -> None:
+    """``run()`` in a child process killed with SIGKILL: ``at_random``, at a random
+    moment of a run of ``t_run`` seconds (before, between or during writes), else
+    as soon as archive ``folder`` holds a random number of its snapshots (a partial
+    run); nothing killed if it ended first."""
+    ready, go = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: run and exit without cleaning up
+        try:
+            os.close(ready)
+            os.write(go, b"!")  # the random moment counts from the run's start, not
+            run()  # from the fork (slow for a large process)
+        finally:
+            os._exit(0)
+    os.close(go)
+    os.read(ready, 1)
+    os.close(ready)
+    ended = False
+    if at_random:
+        time.sleep(rng.uniform(0.0, 1.1) * t_run)
+    else:
+        ended = _wait_for_snapshots(folder, int(rng.integers(1, 20)), pid)
+    if not ended:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
 
 
 def _wait_for_snapshots(folder, count: int, pid: int) -> bool:
@@ -787,26 +795,8 @@ def test_a_loop_of_calls_killed_at_any_moment_loses_at_most_the_snapshot_being_w
     seen_partial = 0
     for k in range(20):
         folder = tmp_path / f"kill{k}"
-        ready, go = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the child: run and exit without cleaning up
-            try:
-                os.close(ready)
-                os.write(go, b"!")
-                _run_calls(folder, paced=True)
-            finally:
-                os._exit(0)
-        os.close(go)
-        os.read(ready, 1)
-        os.close(ready)
-        ended = False
-        if k % 2:
-            time.sleep(rng.uniform(0.0, 1.1) * t_run)
-        else:
-            ended = _wait_for_snapshots(folder, int(rng.integers(1, 20)), pid)
-        if not ended:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
+        _killed(lambda folder=folder: _run_calls(folder, paced=True), folder, k % 2, rng,
+                t_run)
         if not folder.exists() or not Archive(folder).snapshots:
             sim = _run_calls(folder)  # killed before the first snapshot: anew
         else:
