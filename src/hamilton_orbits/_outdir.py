@@ -75,18 +75,17 @@ class OutputFolder:
         return FolderError(f"{self.option} {self.path}: {why}; nothing was run")
 
     def __enter__(self) -> OutputFolder:
-        if self.path.exists() and not self.path.is_dir():
-            raise self._fail("is a file, not a folder")
-        try:
-            self.path.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
+        self._make()
         # the lock is written whole under a name of its own, then linked to its name
         # (atomic, and refused if the name exists): a run killed at any moment leaves
         # no empty lock that would look like an unknown run's
-        mine = self.path / f"{LOCK_NAME}.{os.getpid()}"
+        mine = os.path.join(self.path, f"{LOCK_NAME}.{os.getpid()}")
         try:
-            mine.write_text(self._mine, encoding="utf-8")
+            fd = os.open(mine, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o666)
+            try:
+                os.write(fd, self._mine.encode("utf-8"))
+            finally:
+                os.close(fd)
             for _attempt in range(2):
                 try:
                     os.link(mine, self._lock)
@@ -97,8 +96,30 @@ class OutputFolder:
         except OSError as exc:
             raise self._fail(f"cannot write in the folder ({exc.strerror or exc})") from None
         finally:
-            mine.unlink(missing_ok=True)
+            try:
+                os.unlink(mine)
+            except OSError:
+                pass
         raise self._fail("another run keeps taking the folder")  # pragma: no cover
+
+    def _make(self) -> None:
+        """The folder, made with its parents where missing; a file of its name, or a
+        folder that cannot be made, refused."""
+        try:
+            os.mkdir(self.path)
+            return
+        except FileExistsError:
+            if not os.path.isdir(self.path):
+                raise self._fail("is a file, not a folder") from None
+            return
+        except FileNotFoundError:  # (its parents missing: made below)
+            pass
+        except OSError as exc:
+            raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
+        try:
+            self.path.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
 
     def _take_over_stale(self) -> None:
         """Remove the lock of a run that has ended; refuse one of a live run."""
@@ -118,7 +139,12 @@ class OutputFolder:
 
     def __exit__(self, *exc_info: object) -> None:
         try:
-            if self._lock.read_text(encoding="utf-8") == self._mine:
-                self._lock.unlink()
+            fd = os.open(self._lock, os.O_RDONLY)
+            try:
+                held = os.read(fd, 4096)
+            finally:
+                os.close(fd)
+            if held == self._mine.encode("utf-8"):
+                os.unlink(self._lock)
         except OSError:  # gone already (a user removed it): nothing to release
             pass

@@ -87,9 +87,14 @@ def checksum(meta_text: str, arrays: Mapping[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
+#: the names of the common dtypes (``dtype.name`` builds its string at each call)
+_DTYPE_NAMES = {np.dtype(k): np.dtype(k).name for k in (np.float64, np.bool_, np.int8,
+                                                       np.int32, np.int64)}
+
+
 def stored(name: str, arr: np.ndarray) -> tuple[np.ndarray, str]:
     """The array as netCDF-3 stores it (float64, int32 or int8) and its dtype."""
-    kind = arr.dtype.name
+    kind = _DTYPE_NAMES.get(arr.dtype) or arr.dtype.name
     if arr.dtype == np.float64:
         return arr, kind
     if arr.dtype == np.bool_:

@@ -660,16 +660,17 @@ def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was
 
 
 def test_a_read_only_folder_is_refused_at_the_archives_first_write(tmp_path, monkeypatch):
-    """The folder refuses the lock, the archive's first file (a mocked refusal: the
-    tests may run as root): a SnapshotError naming the folder, before any step."""
-    real = Path.write_text
+    """The folder refuses the lock, the archive's first file (a mocked refusal of
+    every file made in it: the tests may run as root): a SnapshotError naming the
+    folder, before any step."""
+    real = os.open
 
-    def refused(self, *args, **kwargs):
-        if self.parent.name == "ro":
-            raise PermissionError(13, "Permission denied", str(self))
-        return real(self, *args, **kwargs)
+    def refused(path, flags, *args, **kwargs):
+        if flags & os.O_CREAT and Path(path).parent.name == "ro":
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path, flags, *args, **kwargs)
 
-    monkeypatch.setattr(Path, "write_text", refused)
+    monkeypatch.setattr(os, "open", refused)
     sim = Simulation(_disc(), archive=tmp_path / "ro", **KW)
     with pytest.raises(SnapshotError, match=r"ro: cannot write in the folder \(Permission "
                                             r"denied\)"):
