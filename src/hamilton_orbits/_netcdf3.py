@@ -26,6 +26,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 import struct
 from collections.abc import Mapping, Sequence
@@ -101,7 +102,8 @@ def encode(global_attrs: Mapping[str, Any],
         blocks.append(data)
         head.append(_entry(name, [ids[d] for d in names], values, attrs, len(data)))
     for name, names, values, attrs in records:
-        sizes.append(len(_bytes(values)))
+        n = values.size * values.dtype.itemsize
+        sizes.append(n + _pad(n))
         head.append(_entry(name, [ids[record_dim]] + [ids[d] for d in names], values, attrs,
                            sizes[-1]))
     count = len(variables) + len(records)
@@ -123,9 +125,20 @@ def _bytes(values: np.ndarray) -> bytes:
 
 def _entry(name: str, dim_ids: list[int], values: np.ndarray, attrs: Mapping[str, Any],
            size: int) -> bytes:
-    """A variable's header entry, without its offset."""
+    """A variable's header entry, without its offset (the same variables' entries
+    are made once: an archive writes a header of the same variables per segment)."""
+    key = (name, tuple(dim_ids), _TYPES[values.dtype], tuple(attrs.items()), size)
+    try:
+        return _entry_of(*key)
+    except TypeError:  # (an attribute that is not hashable: made afresh)
+        return _entry_of.__wrapped__(*key)
+
+
+@functools.lru_cache(maxsize=512)
+def _entry_of(name: str, dim_ids: tuple[int, ...], kind: int,
+              attrs: tuple[tuple[str, Any], ...], size: int) -> bytes:
     return (_name(name) + struct.pack(f">i{len(dim_ids)}i", len(dim_ids), *dim_ids)
-            + _attributes(attrs) + struct.pack(">ii", _TYPES[values.dtype], size))
+            + _attributes(dict(attrs)) + struct.pack(">ii", kind, size))
 
 
 def record(values: Sequence[np.ndarray]) -> bytes:
