@@ -524,7 +524,7 @@ def _record_at(header: Header, data: bytes | bytearray, k: int) -> dict[str, np.
     """Record ``k`` of ``data`` (the file's bytes, or the bytes before its first
     record followed by record ``k``'s alone, read as record 0) decoded, or None
     where its CRC-32 does not match its bytes."""
-    names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
+    names = _record_names(header)
     if not _checks(header, data, k, _spans(header, names)):
         return None
     # (the types and shapes were checked with the header: a record that checks decodes)
@@ -542,7 +542,7 @@ def _records(header: Header, data: bytes, last: bool = False) -> tuple[
     if header.numrecs > held:  # a header counting records the file does not hold
         bad.append((held, f"the header counts {header.numrecs} records, the file holds "
                           f"{held}"))
-    names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
+    names = _record_names(header)
     failed, spans = [], _spans(header, names)
     for k in range(min(header.numrecs, held)):
         (good if _checks(header, data, k, spans) else failed).append(k)
@@ -553,6 +553,20 @@ def _records(header: Header, data: bytes, last: bool = False) -> tuple[
     columns = {n: _column(header, data, n, ks) for n in names}
     return ([dict({n: columns[n][i, ...] for n in names}, _index=np.int64(k))
              for i, k in enumerate(ks)], bad, len(data) > end)
+
+
+def _record_names(header: Header) -> list[str]:
+    """A segment's or rows file's record variables, but ``check``."""
+    return [n for n, v in header.variables.items() if v.is_record and n != "check"]
+
+
+def _row_arrays(header: Header, records: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Rows ``records`` of a rows file as arrays ``out_*`` (a rows file without
+    times is damaged: ``KeyError``)."""
+    out = {n: np.array([r[n] for r in records], dtype=np.float64).reshape(
+        (len(records), *header.variables[n].shape)) for n in _record_names(header)}
+    out["out_t"].shape  # noqa: B018 - (a rows file without times is damaged)
+    return out
 
 
 def _checks(header: Header, data: bytes | bytearray, k: int,
@@ -768,10 +782,7 @@ def _rows_span(path: Path, before: int, end: int) -> tuple[dict[str, np.ndarray]
                    for j in range(before, end)]
         if any(r is None for r in records):
             return {}, []
-        names = [n for n, v in header.variables.items() if v.is_record and n != "check"]
-        out = {n: np.array([r[n] for r in records], dtype=np.float64).reshape(
-            (len(records), *header.variables[n].shape)) for n in names}
-        out["out_t"].shape  # noqa: B018 - (a rows file without times is damaged)
+        out = _row_arrays(header, records)
         torn = size > begin + header.numrecs * length
     except Exception:  # a damaged header: no row can be trusted
         return {}, []
@@ -825,10 +836,7 @@ def _rows(path: Path) -> tuple[dict[str, np.ndarray] | None, list[Path]]:
         records, bad, torn = _records(header, data)
         if bad:
             records = records[:bad[0][0]]
-        names = [k for k, v in header.variables.items() if v.is_record and k != "check"]
-        out = {n: np.array([r[n] for r in records], dtype=np.float64).reshape(
-            (len(records), *header.variables[n].shape)) for n in names}
-        out["out_t"].shape  # noqa: B018 - (a rows file without times is damaged)
+        out = _row_arrays(header, records)
     except Exception:  # a damaged header: no row can be trusted
         return {}, []
     return out, [path] if torn else []
