@@ -41,6 +41,10 @@ from hamilton_orbits.trajectory import Trajectory
 __all__ = ["RestartWarning", "Saving"]
 
 
+#: what a snapshot's ``extra`` holds of its leg alone (its other parts shared)
+_PER_LEG = ("leg", "started")
+
+
 class RestartWarning(UserWarning):
     """A snapshot continued from its physical state only (its integrator state was
     written by a version with other integrator internals)."""
@@ -273,8 +277,38 @@ class Saving:
                 values["steps"] = prop.steps
                 arch.append(values, {} if rows is None else rows.take())
                 return
+        if known is not None and known[0] is arch.segment and self._leg_appended(
+                rows, extra, known):
+            cache["appended"] = (arch.segment, extra, known[2])
+            return
         arch.write(*self._record(rows, archive=True))
         cache["appended"] = (arch.segment, extra, cache["capture"])
+
+    def _leg_appended(self, rows: Any, extra: dict[str, Any], known: tuple[Any, ...]) -> bool:
+        """Whether the first snapshot of a leg of a start and an end (``rows``) was
+        appended to the segment this simulation's last leg wrote and goes on in
+        (archive format 3) from what changes only
+        (:class:`~hamilton_orbits.restart.Capture`, as a snapshot within a leg): the
+        same layout, time unit and schedule as the last snapshot (``known``: its
+        segment, ``extra`` and capture), so that it shares all the segment's
+        snapshots share.  The bytes are those of the whole snapshot.  False,
+        nothing written, otherwise (the whole snapshot is then made)."""
+        arch, prop = self._archive, self._prop
+        times = None if rows is None else rows.times
+        if (times is None or len(times) != 2 or arch.segment is None or not arch.segment.legs
+                or any(extra[k] != known[1].get(k) for k in extra if k not in _PER_LEG)
+                or known[1].keys() != extra.keys()):
+            return False
+        capture, _, index = known[2]
+        if prop.events is not None:
+            prop.events.drain()  # (as a whole snapshot does)
+        taken = capture.take(prop)
+        if taken is None:
+            return False
+        values = state_values(prop, taken[0], index, taken[1], capture.ints)
+        values["steps"] = prop.steps
+        arch.append_leg(values, rows.take(), {"started": extra["started"], "leg": extra["leg"]})
+        return True
 
     def _refilled(self, capture: Any, taken: Any) -> bool:
         """Whether the archive appended the propagation's state by refilling its last

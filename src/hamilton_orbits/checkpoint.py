@@ -451,6 +451,17 @@ class ArchiveWriter:
         self.last_steps, self.last_wall = steps, time.monotonic()
         return True
 
+    def append_leg(self, values: Mapping[str, Any], rows: dict[str, np.ndarray],
+                   meta: Mapping[str, Any]) -> None:
+        """Append a leg's first snapshot to the segment being written, which its
+        last leg wrote (format 3) and whose shared part it shares: as :meth:`append`,
+        its record holding the leg that ``meta`` gives (``started``, ``leg``: as a
+        whole snapshot's ``meta``) and the leg's start and end (``rows``'
+        ``leg_times``, taken out of them)."""
+        span = tuple(float(x) for x in rows.pop("leg_times"))
+        self.leg = _record_leg(meta)
+        self.append({**values, "leg": self.leg, "leg_span": span}, rows)
+
     def append(self, values: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append a snapshot that shares everything but ``values`` (its record: ``t``,
         ``steps``, ``r``, ... as :func:`state_values` gives them) and its output ``rows``

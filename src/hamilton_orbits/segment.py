@@ -363,19 +363,20 @@ class SegmentWriter:
                                for i in range(n)])
         if self.legs:
             self.tail = (*snapshot["leg"], *NO_SPAN)
-        if not n and self._direct and type(snapshot["state"]) is Parts and self._append_state(
-                snapshot, start):
+        if self._direct and type(snapshot["state"]) is Parts and self._append_state(
+                snapshot, start, start + n):
             return
         span = np.array([start, start + n], dtype=np.float64)
         self._file.append([[span if k == "rows" else _stored(k, snapshot[k])
                             for k in self.names]])
 
-    def _append_state(self, snap: Mapping[str, Any], start: int) -> bool:
-        """Append a snapshot of a propagation's state with no output rows (the bytes
-        :meth:`append` writes): the float64 variables, ``t`` to ``rows``, filled by
-        one concatenation, then ``active``.  False, nothing written, where a value is
-        not of its variable's shape or a step count not exact in a float64 (the
-        general path then says why)."""
+    def _append_state(self, snap: Mapping[str, Any], start: int, end: int) -> bool:
+        """Append a snapshot of a propagation's state, its output rows those from
+        ``start`` to ``end`` of the rows file (the bytes :meth:`append` writes): the
+        float64 variables, ``t`` to ``rows``, filled by one concatenation, then
+        ``active``.  False, nothing written, where a value is not of its variable's
+        shape or a step count not exact in a float64 (the general path then says
+        why)."""
         file = self._file
         views, state, kept = file.buffer.views, snap["state"], self._kept
         if len(kept[0]) != len(state):
@@ -403,7 +404,7 @@ class SegmentWriter:
         # leg_span,] rows)
         head[0] = snap["t"]
         np.concatenate([r.reshape(-1), v.reshape(-1), gm, *kept[1], scalars,
-                        (steps, *tail, start, start)], out=head[1:], casting="unsafe")
+                        (steps, *tail, start, end)], out=head[1:], casting="unsafe")
         views[-2][...] = active  # (the last variable is check)
         file.write(file.checked(), 1)
         self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]))

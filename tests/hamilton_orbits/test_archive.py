@@ -20,6 +20,7 @@ from test_simulation_legs import _disc, _merging, _same
 
 from hamilton_orbits import Archive, Body, Simulation, System
 from hamilton_orbits._netcdf3 import parse
+from hamilton_orbits._saving import Saving
 from hamilton_orbits.checkpoint import contents, snapshot_at, snapshot_files
 from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.segment import read_segment
@@ -712,6 +713,42 @@ def test_a_simulations_calls_go_on_in_one_segment_each_snapshot_keeping_its_leg(
         fh.write(b"\0")
     sim.integrate(3.5)
     assert [first for first, _ in snapshot_files(tmp_path)][-1] == starts[-1] + 3
+
+
+@pytest.mark.parametrize("case", ["radau15", "radau15-events", "radau15-merge"])
+def test_a_calls_first_snapshot_in_the_segment_gone_on_in_is_the_whole_snapshots_bytes(
+        tmp_path, monkeypatch, case):
+    """A call that goes on in the segment its simulation's last call wrote appends
+    its first snapshot from what changed since the last (the layout read again,
+    not walked): the segments and rows files hold the bytes the whole snapshot
+    gives, for calls with events recorded between them and calls after a merge
+    (a new layout: a new segment); and that way is taken."""
+    system, kw = RADAU15_STEPPED[case]
+    ends = (0.6, 1.2, 1.8, 2.4, 3.0, 3.6)
+    taken, leg_appended = [], Saving._leg_appended
+
+    def counted(self, *args):
+        taken.append(leg_appended(self, *args))
+        return taken[-1]
+
+    monkeypatch.setattr(Saving, "_leg_appended", counted)
+    sim = Simulation(system(), archive=tmp_path / "fast", every=0.25, **kw)
+    for t in ends:
+        sim.integrate(t)
+    assert sum(taken) >= 3, taken
+    monkeypatch.setattr(Saving, "_leg_appended", lambda self, *args: False)
+    whole = Simulation(system(), archive=tmp_path / "full", every=0.25, **kw)
+    for t in ends:
+        whole.integrate(t)
+    names = sorted(p.name for p in (tmp_path / "fast").glob("*.nc"))
+    assert names == sorted(p.name for p in (tmp_path / "full").glob("*.nc"))
+    for name in names:  # (the records: a segment's header names its folder,
+        # of the same length)
+        one, other = ((tmp_path / folder / name).read_bytes() for folder in ("fast", "full"))
+        begin = parse(one).record_begin
+        assert begin == parse(other).record_begin and one[begin:] == other[begin:], name
+    archive = Archive(tmp_path / "fast")
+    assert archive.damaged == [] and archive.torn == [] and archive.times[-1] == 3.5
 
 
 def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path):

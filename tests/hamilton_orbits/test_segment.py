@@ -32,8 +32,8 @@ def test_a_state_filled_straight_into_its_record_is_the_record_of_the_general_pa
     direct, refill = SegmentWriter._append_state, SegmentWriter.refill
     taken, refilled = [], []
 
-    def counted(self, snap, start):
-        taken.append(direct(self, snap, start))
+    def counted(self, *args):
+        taken.append(direct(self, *args))
         return taken[-1]
 
     def counted_refill(self, *args):
@@ -47,7 +47,7 @@ def test_a_state_filled_straight_into_its_record_is_the_record_of_the_general_pa
         assert sum(taken) >= 4
     else:  # (the refill between two pauses and after an output; the straight fill
         assert sum(taken) >= 1 and sum(refilled) > 10  # once, after the leg's start)
-    monkeypatch.setattr(SegmentWriter, "_append_state", lambda self, snap, start: False)
+    monkeypatch.setattr(SegmentWriter, "_append_state", lambda self, *args: False)
     monkeypatch.setattr(SegmentWriter, "refill", lambda self, *args: False)
     Simulation(system(), archive=tmp_path / "general", every_steps=1, **kw).integrate(times)
     one, other = _records(tmp_path / "direct"), _records(tmp_path / "general")
@@ -109,7 +109,7 @@ def test_a_snapshot_at_a_scheduled_time_is_refilled_with_the_outputs_arrays(tmp_
     direct = Simulation(system(), archive=tmp_path / "direct", every=0.125, **kw)
     traj = direct.integrate(times)
     assert sum(refilled) >= 20  # (32 snapshots, 8 of them with rows)
-    monkeypatch.setattr(SegmentWriter, "_append_state", lambda self, snap, start: False)
+    monkeypatch.setattr(SegmentWriter, "_append_state", lambda self, *args: False)
     monkeypatch.setattr(SegmentWriter, "refill", lambda self, *args: False)
     general = Simulation(system(), archive=tmp_path / "general", every=0.125, **kw)
     again = general.integrate(times)
