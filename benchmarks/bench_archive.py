@@ -28,7 +28,11 @@ What it prints (medians over interleaved rounds; the machine is shared):
 [6] loading the last snapshot, and one in the middle, of a long run's archive
     (a snapshot every 10 steps of the 0.3 s radau15 run) against rebound's
     Simulationarchive of IAS15 with ``step=10``: a snapshot read alone, whatever
-    the segment's length.
+    the segment's length;
+[7] where a snapshot's time goes in the 0.3 s radau15 run, ``every=`` and
+    ``every_steps=100``: inside the calls of the compiled steps (their entry,
+    ``every=``'s landing steps) and outside them (the Python of pauses, outputs
+    and snapshots, the archive's fixed cost spread over the run), per snapshot.
 """
 
 from __future__ import annotations
@@ -226,6 +230,58 @@ def parts(tmp: Path, rounds: int, t_end: float = 10 * T_END) -> None:
               for k in ("fixed", "pauses", "whole")))
 
 
+def inside_and_out(tmp: Path, rounds: int, t_end: float = 10 * T_END) -> None:
+    """Where a snapshot's time goes in a radau15 run, ``every=`` (every 100 mean steps
+    of time) and ``every_steps=100``: in the calls of the compiled steps (timed
+    around each: a call's entry and its first steps with cold caches, and for
+    ``every=`` the landing steps and their corrector iterations) and outside them
+    (the Python of the pauses, the outputs and the snapshots, the archive's fixed
+    cost), per snapshot, against the plain run (interleaved rounds)."""
+    from hamilton_orbits._kernels import radau15 as kernels
+
+    s, count, stepping = disc10(), iter(range(10**6)), kernels.advance
+    probe = Simulation(s, method="radau15")
+    probe.integrate(t_end)
+    inside = [0.0]
+
+    def timed_kernel(*args: object) -> object:
+        start = time.perf_counter()
+        out = stepping(*args)
+        inside[0] += time.perf_counter() - start
+        return out
+
+    def go(kw: dict[str, object]) -> Callable[[], tuple[float, float]]:
+        def run() -> tuple[float, float]:
+            extra = dict(kw, archive=tmp / f"split-{next(count)}") if kw else {}
+            inside[0] = 0.0
+            start = time.perf_counter()
+            Simulation(s, method="radau15", **extra).integrate(t_end)
+            return time.perf_counter() - start, inside[0]
+        return run
+
+    cases = {"plain": go({}), "every": go(dict(every=100 * t_end / probe.steps)),
+             "every_steps": go(dict(every_steps=100))}
+    kernels.advance = timed_kernel  # (looked up at each call by the driver)
+    try:
+        out: dict[str, list[tuple[float, float]]] = {k: [] for k in cases}
+        for fn in cases.values():
+            fn()
+        for _ in range(rounds):
+            for k, fn in cases.items():
+                out[k].append(fn())
+    finally:
+        kernels.advance = stepping
+    n = probe.steps // 100
+    med = {k: (statistics.median(x[0] for x in v), statistics.median(x[1] for x in v))
+           for k, v in out.items()}
+    plain_in, plain_out = med["plain"][1], med["plain"][0] - med["plain"][1]
+    print(f"[7] a snapshot in a radau15 run of {t_end:g} (about {n}), per snapshot, median "
+          f"of {rounds} rounds: " + "; ".join(
+              f"{k} in the compiled calls {(med[k][1] - plain_in) / n * 1e6:+.1f} us, outside "
+              f"them {(med[k][0] - med[k][1] - plain_out) / n * 1e6:+.1f} us (x"
+              f"{med[k][0] / med['plain'][0]:.3f} in all)" for k in ("every", "every_steps")))
+
+
 def many_calls(tmp: Path, calls: int = 1200, block: int = 200) -> None:
     s = disc10()
     arrays = s.as_arrays()
@@ -305,14 +361,16 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
     try:
         one_snapshot(tmp, 200)
-        runs(tmp, 5)
+        runs(tmp, 9)
         loading(tmp, 30)
         (tmp / "long").mkdir()
-        runs(tmp / "long", 5, 10 * T_END)
+        runs(tmp / "long", 9, 10 * T_END)
         (tmp / "parts").mkdir()
         parts(tmp / "parts", 15)
         many_calls(tmp)
         long_archive(tmp)
+        (tmp / "split").mkdir()
+        inside_and_out(tmp / "split", 9)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
