@@ -37,7 +37,13 @@ from hamilton_orbits.checkpoint import contents
 from hamilton_orbits.simulation import Simulation
 from hamilton_orbits.snapshot import SnapshotError
 
-__all__ = ["Archive", "Snapshot"]
+__all__ = ["Archive", "ArchiveIndexError", "Snapshot"]
+
+
+class ArchiveIndexError(IndexError, ValueError):
+    """An index that is not the position of one of an archive's snapshots (an
+    ``IndexError``, which ends a loop over the archive, and a ``ValueError``, as
+    other bad input)."""
 
 
 @dataclass(frozen=True)
@@ -100,8 +106,23 @@ class Archive:
         return np.array([s.t for s in self.snapshots])
 
     def __getitem__(self, k: int) -> Simulation:
-        """Snapshot ``k`` (of :attr:`snapshots`) as a Simulation, not attached to the
-        archive (``Simulation.load(folder)`` continues the archive itself)."""
+        """Snapshot ``k`` (of :attr:`snapshots`; negative from the end) as a
+        Simulation, not attached to the archive (``Simulation.load(folder)``
+        continues the archive itself).
+
+        Raises
+        ------
+        ArchiveIndexError
+            (an ``IndexError`` and a ``ValueError``) When ``k`` is not an integer or
+            not the position of a snapshot, naming it and the archive.
+        """
+        n = len(self.snapshots)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+            raise ArchiveIndexError(f"Expected the index of an archive's snapshot to be an "
+                                    f"integer, got {k!r} ({self.path})")
+        if not -n <= k < n:
+            raise ArchiveIndexError(f"Archive index {int(k)} out of range: {self.path} holds "
+                                    f"{n} snapshots")
         return Simulation.load(self.path, number=self.snapshots[k].number)
 
     def __repr__(self) -> str:

@@ -9,6 +9,7 @@ resumed from its last snapshot ends on the reference's bits.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import socket
 import time
@@ -21,6 +22,7 @@ from test_simulation_legs import _disc, _merging, _same
 from hamilton_orbits import Archive, Body, Simulation, System
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._saving import Saving
+from hamilton_orbits.archive import ArchiveIndexError
 from hamilton_orbits.checkpoint import contents, snapshot_at, snapshot_files
 from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.segment import read_segment
@@ -354,6 +356,25 @@ def test_an_empty_or_missing_archive_is_named(tmp_path):
         Archive(tmp_path / "missing")
     with pytest.raises(SnapshotError, match=r"no readable snapshot in the archive"):
         Simulation.load(tmp_path)
+
+
+def test_an_archive_index_that_is_not_a_snapshots_is_named(tmp_path):
+    """``Archive[k]``: a position out of range or not an integer is an error (an
+    IndexError, which ends a loop over the archive, and a ValueError) naming the
+    index and the archive; a negative position counts from the end; a loop goes
+    over every snapshot."""
+    Simulation(_disc(), method="radau15", archive=tmp_path, every=1.0).integrate(3.0)
+    archive = Archive(tmp_path)
+    assert len(archive) == 4
+    for bad in (4, -5, 10**20):
+        with pytest.raises(ArchiveIndexError, match=rf"index {bad} out of range: .* holds 4 "):
+            archive[bad]
+    for bad in (1.0, "1", True, None):
+        with pytest.raises(ValueError, match=rf"an integer, got {re.escape(repr(bad))}"):
+            archive[bad]
+    assert issubclass(ArchiveIndexError, IndexError)
+    assert archive[-1].t == archive[np.int64(3)].t == 3.0
+    assert [sim.t for sim in archive] == [0.0, 1.0, 2.0, 3.0]
 
 
 @pytest.mark.parametrize("kw", [
