@@ -134,23 +134,44 @@ class Archive:
     def to_xarray(self) -> Any:
         """The snapshots' states as an ``xarray.Dataset`` (dimensions ``time``,
         ``body``, ``xyz``; variables ``r``, ``v``, ``gm``, ``active``; body names
-        as a coordinate; units in the attributes for a Quantity system)."""
+        as a coordinate; units in the attributes for a Quantity system).
+
+        A snapshot that repeats the one before it (the same time, step count and
+        state, bit for bit: the first snapshot of an ``integrate`` call whose call
+        before ended on a scheduled snapshot) is in it once, so that the times
+        are those of distinct states; :attr:`snapshots` lists both."""
         try:
             import xarray as xr
         except ImportError:
             raise ImportError("Archive.to_xarray needs xarray: pip install "
                               "'hamilton-orbits[archive]'") from None
         stack = {k: np.stack([a[k] for a in self._arrays]) for k in ("r", "v", "gm", "active")}
+        times, steps = self.times, np.array([s.steps for s in self.snapshots], dtype=np.int64)
+        keep = ~_repeats(times, steps, stack)
         units = ({"r": "au", "v": "au/day", "gm": "au3/day2", "time": "day"}
                  if self._quantity else {})
-        data = {"r": (("time", "body", "xyz"), stack["r"], _units(units, "r")),
-                "v": (("time", "body", "xyz"), stack["v"], _units(units, "v")),
-                "gm": (("time", "body"), stack["gm"], _units(units, "gm")),
-                "active": (("time", "body"), stack["active"])}
-        coords = {"time": ("time", self.times, _units(units, "time")),
+        data = {"r": (("time", "body", "xyz"), stack["r"][keep], _units(units, "r")),
+                "v": (("time", "body", "xyz"), stack["v"][keep], _units(units, "v")),
+                "gm": (("time", "body"), stack["gm"][keep], _units(units, "gm")),
+                "active": (("time", "body"), stack["active"][keep])}
+        coords = {"time": ("time", times[keep], _units(units, "time")),
                   "body": ("body", list(self._names)), "xyz": ("xyz", ["x", "y", "z"]),
-                  "steps": ("time", np.array([s.steps for s in self.snapshots]))}
+                  "steps": ("time", steps[keep])}
         return xr.Dataset(data, coords=coords, attrs={"archive": str(self.path)})
+
+
+def _repeats(times: np.ndarray, steps: np.ndarray, stack: dict[str, np.ndarray]) -> np.ndarray:
+    """Which snapshots repeat the one before them: the same time and step count and
+    the same arrays of ``stack``, bit for bit (a NaN equal to itself)."""
+    same = np.zeros(times.shape[0], dtype=bool)
+    if times.shape[0] < 2:
+        return same
+    same[1:] = (times[1:] == times[:-1]) & (steps[1:] == steps[:-1])
+    for a in stack.values():
+        bits = a.reshape(a.shape[0], -1)
+        bits = bits.view(np.uint64) if bits.dtype == np.float64 else bits
+        same[1:] &= (bits[1:] == bits[:-1]).all(axis=1)
+    return same
 
 
 def _units(units: dict[str, str], name: str) -> dict[str, str]:

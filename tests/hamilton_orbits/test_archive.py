@@ -277,6 +277,25 @@ def test_an_archive_opens_as_an_xarray_dataset(tmp_path):
     np.testing.assert_array_equal(ds.time.values, 10.0 * np.arange(7))
 
 
+def test_an_xarray_dataset_holds_a_repeated_snapshot_once(tmp_path):
+    """A call's first snapshot repeats the last of the call before when that one
+    ended on a scheduled snapshot (the same time, steps and state): the archive
+    lists both, its Dataset holds distinct states, one per time, each that of a
+    snapshot."""
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path, every=1.0)
+    for t in (2.0, 4.0, 4.5, 6.0):
+        sim.integrate(t)
+    archive = Archive(tmp_path)
+    assert archive.times.tolist() == [0.0, 1.0, 2.0, 2.0, 3.0, 4.0, 4.0, 4.5, 5.0, 6.0]
+    ds = archive.to_xarray()
+    assert ds.time.values.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0, 4.5, 5.0, 6.0]
+    assert np.all(np.diff(ds.steps.values) > 0)
+    for k in (2, 3, 6):  # (a repeated one, the one after it, the last of a call)
+        snap = archive[k]
+        row = ds.sel(time=snap.t)
+        assert row.steps == snap.steps and _same(row.r.values, snap.system.as_arrays().r)
+
+
 def test_a_segment_is_read_without_this_package(tmp_path):
     """A segment is a plain netCDF-3 file: xarray (through scipy's reader, not this
     package) opens it, its record dimension holding the snapshots' t, r and v, with
