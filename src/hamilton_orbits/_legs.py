@@ -132,6 +132,8 @@ def event_list(events: Any) -> list[dict[str, Any]]:
 def time_step(dt: Any, quantity: bool, name: str = "dt") -> float:
     """``dt`` (or the interval ``name``) in days (a Quantity system: a time Quantity
     is required) or the caller's float, positive and finite."""
+    if isinstance(dt, (bool, np.bool_)):
+        raise ValueError(f"Expected `{name}` to be a number, got {dt!r}")
     if quantity and not is_quantity(dt):
         raise ValueError(f"Expected `{name}` as a time Quantity for a Quantity system, got "
                          f"{dt!r} (a bare number would be read as days)")
@@ -142,7 +144,9 @@ def time_step(dt: Any, quantity: bool, name: str = "dt") -> float:
         step = dt  # checked below
     else:
         step = TIME.scalar(name, dt, DAY if quantity else None)
-    if not (np.isfinite(step) and step > 0):
+    if not np.isfinite(step):
+        raise ValueError(f"Expected `{name}` to be finite, got {step!r}")
+    if not step > 0:
         raise ValueError(f"Expected `{name}` > 0, got {step!r}")
     return step
 

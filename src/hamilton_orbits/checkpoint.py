@@ -305,14 +305,18 @@ class ArchiveWriter:
             raise ValueError(f"An archive takes one of `every`, `every_steps`, `every_wall`, "
                              f"got {', '.join(given) or 'none'}")
         for name, x in (("every", every), ("every_wall", every_wall)):
-            if x is not None and not (isinstance(x, (int, float)) and math.isfinite(x)
-                                      and x > 0):
+            if x is not None and not (isinstance(x, (int, float)) and not isinstance(x, bool)
+                                      and math.isfinite(x) and x > 0):
                 raise ValueError(f"Expected `{name}` > 0 and finite, got {x!r}")
         if every_steps is not None and (isinstance(every_steps, bool)
                                         or not isinstance(every_steps, (int, np.integer))
                                         or every_steps < 1):
             raise ValueError(f"Expected `every_steps` to be a whole number >= 1, got "
                              f"{every_steps!r}")
+        if path is not None and (not isinstance(path, (str, os.PathLike))
+                                 or not os.fspath(path)):
+            raise ValueError(f"Expected `archive` to be a folder's path, got {path!r}")
+        every_steps = None if every_steps is None else int(every_steps)  # (kept as JSON)
         self.path = None if path is None else Path(path)
         self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
         if not isinstance(exact, bool):

@@ -358,10 +358,27 @@ def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
                                        r"got 0"),
     (dict(archive="x", every_steps=2.5), r"got 2.5"),
     (dict(archive="x", every_wall=float("nan")), r"Expected `every_wall` > 0 and finite"),
+    (dict(archive="x", every=float("inf")), r"Expected `every` to be finite, got inf"),
+    (dict(archive="", every=1.0), r"Expected `archive` to be a folder's path, got ''"),
+    (dict(archive=5, every=1.0), r"Expected `archive` to be a folder's path, got 5"),
+    (dict(archive="x", every=True), r"Expected `every` to be a number, got True"),
+    (dict(archive="x", every_wall=True), r"Expected `every_wall` > 0 and finite, got True"),
+    (dict(archive="x", every=1.0, dt=True), r"Expected `dt` to be a number, got True"),
 ])
 def test_bad_schedules_are_refused_naming_the_argument(kw, match):
     with pytest.raises(ValueError, match=match):
-        Simulation(_disc(), method="wh", dt=0.05, **kw)
+        Simulation(_disc(), **{"method": "wh", "dt": 0.05, **kw})
+
+
+def test_a_step_count_of_numpy_integer_type_schedules_an_archive(tmp_path):
+    """``every_steps`` as a NumPy integer: kept as a plain int (the schedule is
+    JSON in every snapshot), the same archive as with the int."""
+    for folder, n in (("numpy", np.int64(5)), ("int", 5)):
+        sim = Simulation(_disc(), method="radau15", archive=tmp_path / folder, every_steps=n)
+        sim.integrate(2.0)
+    ours, theirs = Archive(tmp_path / "numpy"), Archive(tmp_path / "int")
+    assert [s.steps for s in ours.snapshots] == [s.steps for s in theirs.snapshots]
+    assert len(ours) > 2 and Simulation.load(tmp_path / "numpy")._archive.every_steps == 5
 
 
 def test_an_archived_simulation_integrates_forwards(tmp_path):
