@@ -45,6 +45,13 @@ __all__ = ["RestartWarning", "Saving"]
 _PER_LEG = ("leg", "started")
 
 
+def _file_path(path: Any, name: str) -> Path:
+    """``path`` as a Path, refused by name when it is not a path or is empty."""
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+        raise ValueError(f"Expected `{name}` to be a file or folder path, got {path!r}")
+    return Path(path)
+
+
 class RestartWarning(UserWarning):
     """A snapshot continued from its physical state only (its integrator state was
     written by a version with other integrator internals)."""
@@ -140,7 +147,7 @@ class Saving:
         >>> bool(np.array_equal(a.r, b.r)), again.steps
         (True, 200)
         """
-        write(path, *self._record(), sync=True)
+        write(_file_path(path, "path"), *self._record(), sync=True)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:
@@ -166,7 +173,11 @@ class Saving:
             For a missing, damaged or foreign file, naming it; for a ``number``
             the folder does not hold whole.
         """
-        path = Path(path)
+        path = _file_path(path, "path")
+        if number is not None and (isinstance(number, (bool, np.bool_))
+                                   or not isinstance(number, (int, np.integer))):
+            raise ValueError(f"Expected `number` to be a whole number (a snapshot's number), "
+                             f"got {number!r}")
         folder = path if path.is_dir() else None
         if folder is None:
             if number is not None:

@@ -387,6 +387,25 @@ def test_an_archived_simulation_integrates_forwards(tmp_path):
         sim.integrate(-2.0)
 
 
+def test_a_path_or_number_that_is_not_one_is_refused_by_name(tmp_path):
+    """``save``/``load`` of an empty or non-path ``path``, and a ``number`` that is
+    not a whole number: a ValueError naming the argument and the value, before any
+    file is touched."""
+    sim = Simulation(_disc(), method="wh", dt=0.05)
+    for bad in ("", 3, None):
+        with pytest.raises(ValueError, match=rf"`path` to be a file or folder path, got "
+                                             rf"{re.escape(repr(bad))}"):
+            sim.save(bad)
+        with pytest.raises(ValueError, match=rf"got {re.escape(repr(bad))}"):
+            Simulation.load(bad)
+    Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0).integrate(2.0)
+    for bad in (True, 1.0, "1"):
+        with pytest.raises(ValueError, match=rf"`number` to be a whole number .*got "
+                                             rf"{re.escape(repr(bad))}"):
+            Simulation.load(tmp_path, number=bad)
+    assert Simulation.load(tmp_path, number=np.int64(1)).t == 1.0
+
+
 def test_an_empty_or_missing_archive_is_named(tmp_path):
     with pytest.raises(SnapshotError, match=r"no archive folder .*missing"):
         Archive(tmp_path / "missing")
