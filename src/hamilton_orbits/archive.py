@@ -139,7 +139,7 @@ class Archive:
         A snapshot that repeats the one before it (the same time, step count and
         state, bit for bit: the first snapshot of an ``integrate`` call whose call
         before ended on a scheduled snapshot) is in it once, so that the times
-        are those of distinct states; :attr:`snapshots` lists both."""
+        are those of distinct states; ``snapshots`` lists both."""
         try:
             import xarray as xr
         except ImportError:
