@@ -1,22 +1,24 @@
 """Write tests/hamilton_orbits/data/snapshot-v<FORMAT_VERSION>.nc and
 archive-v<ARCHIVE_VERSION>/: the snapshot and the archive that
 tests/hamilton_orbits/test_snapshot.py and test_archive.py read with every later
-version of the formats.
+version of the formats.  A fixture that exists is left as it is: it was written by
+the version it pins.
 
 A planet of zero mass on a Kepler ellipse (a = 1, e = 0.3, inc = 0.2, lan = 0.5,
 argp = 1.0, nu = 0 at t = 0) about a star of GM 1, integrated by wh (dt = 0.01):
 saved at t = 10; archived every 2 time units through the output times 0, 1, ..., 5
-(a kill after the snapshot at t = 4 is what the archive looks like).  Run once per
-new format version (``archive-v1`` was written by format 1; ``archive-v2`` by
-format 2, at commit 6e3b256, with this recipe; the snapshot's format is still 1,
-so running this also writes ``snapshot-v1.nc`` anew):
+(a kill after the snapshot at t = 4 is what the archive looks like).  From format
+3 on, two calls follow, to 7 and to 9, which go on in the same segment, each
+record holding its call (a kill after the snapshot at t = 8, in the third call).
+Run once per new format version (``archive-v1`` was written by format 1;
+``archive-v2`` by format 2, at commit 6e3b256; ``archive-v3`` by format 3, in
+session 18 of 2026-11-29):
 
     python tools/make_snapshot_fixture.py
 """
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -34,12 +36,17 @@ def main() -> None:
     sim.integrate(10.0)
     out = Path(__file__).resolve().parents[1] / "tests" / "hamilton_orbits" / "data"
     out.mkdir(parents=True, exist_ok=True)
-    sim.save(out / f"snapshot-v{FORMAT_VERSION}.nc")
+    saved = out / f"snapshot-v{FORMAT_VERSION}.nc"
+    if not saved.exists():
+        sim.save(saved)
     folder = out / f"archive-v{ARCHIVE_VERSION}"
     if folder.exists():
-        shutil.rmtree(folder)
+        return
     archived = Simulation(system, method="wh", dt=0.01, archive=folder, every=2.0)
     archived.integrate(np.arange(6.0))
+    if ARCHIVE_VERSION >= 3:  # (calls that go on in the segment the last one wrote)
+        archived.integrate(7.0)
+        archived.integrate(9.0)
 
 
 if __name__ == "__main__":

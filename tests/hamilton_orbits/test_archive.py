@@ -878,6 +878,48 @@ def test_an_archive_of_the_second_format_is_read_and_continued(tmp_path):
     assert [first for first, _ in snapshot_files(folder)] == [0, 3]  # (one for both)
 
 
+def test_an_archive_of_the_third_format_is_read_and_continued(tmp_path):
+    """``data/archive-v3`` was written by archive format 3 (tools/make_snapshot_fixture.py,
+    session 18 of 2026-11-29): the planet of
+    ``test_an_archive_of_the_first_format_is_read_and_continued`` through the
+    outputs 0, 1, ..., 5, then two calls, to 7 and to 9, in the same segment, each
+    record holding its call; it looks as a kill in the third call after its
+    snapshot at 8 leaves it.  This version lists it, loads a snapshot of the
+    middle call, resumes the third call whole and continues in a segment of its
+    own (a new process does not append to another's segment)."""
+    import shutil
+
+    from hamilton_orbits import KeplerOrbit
+
+    folder = tmp_path / "archive"
+    shutil.copytree(Path(__file__).parent / "data" / "archive-v3", folder)
+    archive = Archive(folder)
+    assert archive.times.tolist() == [0.0, 2.0, 4.0, 5.0, 6.0, 7.0, 8.0]
+    assert not archive.damaged and not archive.torn
+    assert parse((folder / "segment-000000.nc").read_bytes()).attrs["format_version"] == 3
+    assert [first for first, _ in snapshot_files(folder)] == [0]
+    orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.5, argp=1.0, nu=0.0, mu=1.0)
+
+    def on_the_ellipse(t, r):  # wh is exact on a test particle's Kepler orbit (a
+        # single Kepler drift per step): the ellipse to rounding (Murray & Dermott
+        # 1999, 2.4)
+        np.testing.assert_allclose(r, orbit.propagate(float(t)).state()[0], rtol=0, atol=1e-12)
+
+    middle = archive[4]
+    assert middle.t == 6.0
+    on_the_ellipse(6.0, middle.system.as_arrays().r[1])
+    traj = Simulation.load(folder).resume()
+    assert traj.t.tolist() == [7.0, 9.0]
+    for t, r in zip(traj.t, traj.r[:, 1], strict=True):
+        on_the_ellipse(t, r)
+    sim = Simulation.load(folder)
+    sim.integrate(12.0)
+    assert Archive(folder).times.tolist() == [0.0, 2.0, 4.0, 5.0, 6.0, 7.0, 8.0, 8.0, 10.0,
+                                              12.0]
+    assert [first for first, _ in snapshot_files(folder)] == [0, 7]
+    on_the_ellipse(12.0, sim.system.as_arrays().r[1])
+
+
 def _run_calls(folder, paced=False):
     """The run of ``_run_archived`` as a loop of calls, one per output time (format
     3: they go on in one segment); ``paced``: 3 ms of wall time after each call."""
