@@ -96,7 +96,7 @@ def test_a_snapshot_at_a_scheduled_time_is_refilled_with_the_outputs_arrays(tmp_
     and velocities are other arrays (the rows of that output): the refill puts them
     in the places of the last ones and writes the bytes the general fill writes,
     for a run whose caller asks for outputs between the snapshots too (those
-    snapshots carry rows: the general path)."""
+    snapshots carry rows: filled straight, their rows' span with them)."""
     system, kw = RADAU15_STEPPED["radau15"]
     times = np.linspace(0.0, 4.0, 9)
     refill, refilled = SegmentWriter.refill, []
