@@ -114,6 +114,12 @@ class Simulation(Saving):
         methods, which end a step there by their own step control), or at the end
         of the step at or after each (the default of the fixed-step methods, whose
         steps then stay their own).
+    archive_sync : bool
+        Sync each snapshot to the disk before the run goes on, so that the archive
+        survives a power cut or a crash of the machine, not only a killed process
+        (two syncs a snapshot: 0.3 ms on the virtual disk of the benchmarks,
+        milliseconds on a common disk; default False: the operating system writes
+        the file when it will).
     **method_options
         The method's options beside its name (``coordinates="jacobi"``,
         ``corrector=11`` for ``wh``; see :mod:`hamilton_orbits.integrators.methods`).
@@ -159,7 +165,8 @@ class Simulation(Saving):
                  events: Any = (), variational: bool = False, stm: bool = False,
                  tangent: Any = None, archive: Any = None, every: Any = None,
                  every_steps: int | None = None, every_wall: float | None = None,
-                 exact_times: bool | None = None, **method_options: Any) -> None:
+                 exact_times: bool | None = None, archive_sync: bool = False,
+                 **method_options: Any) -> None:
         if not isinstance(system, System):
             raise ValueError(f"Expected `system` to be a System, got {system!r}")
         typed = method_of(method, method_options)
@@ -182,7 +189,7 @@ class Simulation(Saving):
         fixed = step is not None and typed.name != "dop853"
         self._archive = _archive_of(archive, (every, every_steps, every_wall),
                                     not fixed if exact_times is None else exact_times,
-                                    system.quantity)
+                                    system.quantity, archive_sync)
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
         self._resumable: Any = None
@@ -366,16 +373,18 @@ class Simulation(Saving):
                 self._archive.close()
 
 def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact: Any,
-                quantity: bool) -> ArchiveWriter | None:
+                quantity: bool, sync: Any = False) -> ArchiveWriter | None:
     """The archive a simulation writes while it runs (None without ``path``)."""
     every, every_steps, every_wall = schedule
+    if not isinstance(sync, bool):
+        raise ValueError(f"Expected `archive_sync` to be True or False, got {sync!r}")
     if path is None:
-        if schedule != (None, None, None):
-            raise ValueError("`every`, `every_steps` and `every_wall` schedule an archive: "
-                             "give `archive` (a folder) too")
+        if schedule != (None, None, None) or sync:
+            raise ValueError("`every`, `every_steps`, `every_wall` and `archive_sync` are "
+                             "an archive's: give `archive` (a folder) too")
         return None
     return ArchiveWriter(path, every=None if every is None else time_step(every, quantity, "every"),
-                         every_steps=every_steps, every_wall=every_wall, exact=exact)
+                         every_steps=every_steps, every_wall=every_wall, exact=exact, sync=sync)
 
 
 def integrate(

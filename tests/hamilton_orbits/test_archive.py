@@ -348,8 +348,11 @@ def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
 
 
 @pytest.mark.parametrize(("kw", "match"), [
-    (dict(every=1.0), r"`every`, `every_steps` and `every_wall` schedule an archive: give "
-                      r"`archive`"),
+    (dict(every=1.0), r"`every`, `every_steps`, `every_wall` and `archive_sync` are an "
+                      r"archive's: give `archive`"),
+    (dict(archive_sync=True), r"are an archive's: give `archive`"),
+    (dict(archive="x", every=1.0, archive_sync=1), r"Expected `archive_sync` to be True or "
+                                                   r"False, got 1"),
     (dict(archive="x"), r"An archive takes one of `every`, `every_steps`, `every_wall`, got "
                         r"none"),
     (dict(archive="x", every=1.0, every_steps=3), r"got every, every_steps"),
@@ -368,6 +371,34 @@ def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
 def test_bad_schedules_are_refused_naming_the_argument(kw, match):
     with pytest.raises(ValueError, match=match):
         Simulation(_disc(), **{"method": "wh", "dt": 0.05, **kw})
+
+
+def test_a_synced_archive_syncs_each_snapshot_before_the_run_goes_on(tmp_path, monkeypatch):
+    """``archive_sync=True``: each record is synced to the disk, then its count
+    written and synced (in that order: the count never runs ahead of a record on
+    the disk); the records are those of the archive written without syncing; a
+    simulation loaded from it keeps syncing."""
+    real, synced = os.fsync, []
+
+    def counted(fd):
+        synced.append(fd)
+        return real(fd)
+
+    monkeypatch.setattr(os, "fsync", counted)
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path / "sync", every=1.0,
+                     archive_sync=True)
+    sim.integrate(3.0)
+    n = len(Archive(tmp_path / "sync"))
+    assert n == 4 and len(synced) >= 2 * n  # (and the headers, written synced)
+    before = len(synced)
+    Simulation(_disc(), method="radau15", archive=tmp_path / "free", every=1.0).integrate(3.0)
+    assert len(synced) == before  # (the default: nothing synced)
+    for name in ("segment-000000.nc", "rows-000000.nc"):
+        one, other = ((tmp_path / f / name).read_bytes() for f in ("sync", "free"))
+        assert one[parse(one).record_begin:] == other[parse(other).record_begin:], name
+    again = Simulation.load(tmp_path / "sync")
+    again.integrate(4.0)
+    assert len(synced) >= before + 4 and Archive(tmp_path / "sync").times[-1] == 4.0
 
 
 def test_a_step_count_of_numpy_integer_type_schedules_an_archive(tmp_path):
