@@ -55,6 +55,9 @@ def test_a_killed_scene_run_resumes_to_the_files_of_the_whole_run(tmp_path, caps
             assert np.array_equal(resumed[name], values, equal_nan=True), name
         written = {p.name for p in out.iterdir()}
         assert {p.name for p in (tmp_path / "whole").iterdir()} <= written
+        # the run went on from its last snapshot: not begun again from the start
+        times = Archive(out / "archive").times
+        assert np.all(np.diff(times) >= 0) and times.tolist().count(0.0) == 1, times
 
 
 def test_run_refuses_a_folder_holding_an_earlier_run_s_archive(tmp_path, capsys):

@@ -14,6 +14,7 @@ import numpy as np
 
 from hamilton_orbits import effects as _effects
 from hamilton_orbits._progress import progress_bar
+from hamilton_orbits.checkpoint import snapshot_files
 from hamilton_orbits.scenes.nbody.analyses import ANALYSIS_FUNCTIONS
 from hamilton_orbits.scenes.nbody.build import (
     build_system,
@@ -56,8 +57,9 @@ def _compile_ahead(spec: dict) -> None:
 
 
 def resumable(folder: Any) -> bool:
-    """True if archive ``folder`` holds a snapshot (a run to resume)."""
-    return folder is not None and any(Path(folder).glob("snapshot-*.nc"))
+    """True if archive ``folder`` holds a file of snapshots (a run to resume): a
+    segment, or a snapshot file of format 1."""
+    return folder is not None and bool(snapshot_files(Path(folder)))
 
 
 def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
