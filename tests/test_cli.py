@@ -280,3 +280,14 @@ def test_ensemble_without_vary_names_the_option(capsys):
     err = capsys.readouterr().err
     assert "--vary" in err
     assert "`vary`" not in err and "members" not in err
+
+
+def test_ensemble_says_its_members_write_no_archive(tmp_path, capsys):
+    """A scene with ``[output] archive_every`` run as an ensemble: its members write
+    no archive, and the command says so (once), not silently."""
+    args = ["ensemble", "comet-encounter", "--vary", "duration=20 d,30 d", "--vary",
+            "output.archive_every=3 d", "--out", str(tmp_path), "--no-progress"]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert err.count("an ensemble's members write no archive") == 1
+    assert not any(p.is_dir() for p in tmp_path.iterdir())  # (ensemble.csv, ensemble.md)

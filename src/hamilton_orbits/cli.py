@@ -355,6 +355,11 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
         _error(str(exc))
         return EXIT_BAD_SCENE
     folder = Path(out) if out else Path("hamilton-orbits-output") / f"{scene.name}-ensemble"
+    if scene.spec.get("output", {}).get("archive_every") is not None or \
+            "output.archive_every" in vary:
+        print("an ensemble's members write no archive: [output] archive_every is for "
+              "`hamilton-orbits run` (one scene, resumed with `hamilton-orbits resume`)",
+              file=sys.stderr)
     with OutputFolder(folder, "--out" if out else "output folder"):
         client = _dask_client(dask) if dask else None
         try:
