@@ -858,6 +858,20 @@ def test_a_calls_first_snapshot_in_the_segment_gone_on_in_is_the_whole_snapshots
     assert archive.damaged == [] and archive.torn == [] and archive.times[-1] == 3.5
 
 
+def test_calls_given_a_stop_go_on_in_one_segment(tmp_path):
+    """A call's ``stop`` (as a scene's run passes one) is not the simulation's state:
+    the calls with it and without it go on in one segment, whose snapshots reload
+    and continue on the bits of the run that went on."""
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path, every=0.5)
+    for t, stop in ((np.linspace(0.0, 2.0, 5), lambda: False), (3.0, lambda: False),
+                    (4.0, None)):
+        sim.integrate(t, stop=stop)
+    assert [first for first, _ in snapshot_files(tmp_path)] == [0]
+    again = Simulation.load(tmp_path, number=len(Archive(tmp_path)) - 2)
+    assert again.t == 3.5
+    assert _same(again.integrate(5.0).r[-1], sim.integrate(5.0).r[-1])
+
+
 def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path):
     """A call stopped (as a kill would leave it) in a segment the simulation's
     earlier calls began: resumed from the archive, it returns the whole call's rows

@@ -275,12 +275,14 @@ class _Run:
     no event: the state's arrays changed in place, its numbers changed, nothing was
     put in another place; ``stop`` is a question and changes nothing)."""
 
-    #: not state: the hook a run sets and clears (:meth:`Propagation.advance`), a
-    #: step's own ``b`` and ``g`` (written at each step's start from ``br`` and ``d``,
+    #: not state: the hook a run sets and clears (:meth:`Propagation.advance`), the
+    #: caller's ``stop`` of the call (set by each call: a snapshot's layout, and so
+    #: the archive segment it goes in, is the same with it or without), a step's own
+    #: ``b`` and ``g`` (written at each step's start from ``br`` and ``d``,
     #: :func:`~hamilton_orbits._kernels.radau15._begin`, before they are read: a
-    #: snapshot of 10 bodies is 37% smaller without them) and the kernel's arguments that hold
-    #: them (made again by :meth:`restarted`)
-    RESTART_SCRATCH = ("pause", "scratch", "after_t")
+    #: snapshot of 10 bodies is 37% smaller without them) and the kernel's arguments
+    #: that hold them (made again by :meth:`restarted`)
+    RESTART_SCRATCH = ("pause", "stop", "scratch", "after_t")
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
