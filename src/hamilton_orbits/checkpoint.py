@@ -30,7 +30,7 @@ import os
 import re
 import struct
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -283,7 +283,9 @@ class ArchiveWriter:
         that can pause there (radau15's in double precision), else at the first
         output after.
     every_wall : float, optional
-        A snapshot at the first output after every ``every_wall`` seconds.
+        A snapshot at the first look at the clock after every ``every_wall``
+        seconds: at the outputs, and between two steps for a driver that can
+        pause there (radau15's in double precision, every 10 000 steps).
     origin : float
         The time the simulation time schedule counts from.
     exact : bool
@@ -334,7 +336,9 @@ class ArchiveWriter:
         self.parked: SegmentWriter | None = None
         #: the leg of the snapshots being appended (a record's ``leg``)
         self.leg: tuple[float, ...] = NO_LEG
-        self.last_steps, self.last_wall = 0, time.monotonic()
+        #: the wall clock of ``every_wall`` (seconds)
+        self.clock: Callable[[], float] = time.monotonic
+        self.last_steps, self.last_wall = 0, self.clock()
 
     def schedule_only(self) -> ArchiveWriter:
         """The same schedule writing nothing (for a copy of the simulation)."""
@@ -410,7 +414,7 @@ class ArchiveWriter:
         if self.every_steps is not None:
             return steps - self.last_steps >= self.every_steps
         if self.every_wall is not None:
-            return time.monotonic() - self.last_wall >= self.every_wall
+            return self.clock() - self.last_wall >= self.every_wall
         return False
 
     def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
@@ -452,7 +456,7 @@ class ArchiveWriter:
                                                            scalars, steps, ints):
             return False
         self.count += 1
-        self.last_steps, self.last_wall = steps, time.monotonic()
+        self.last_steps, self.last_wall = steps, self.clock()
         return True
 
     def append_leg(self, values: Mapping[str, Any], rows: dict[str, np.ndarray],
@@ -474,7 +478,7 @@ class ArchiveWriter:
             values = {**values, "leg": self.leg, "leg_span": NO_SPAN}
         self.segment.append(values, rows)
         self.count += 1
-        self.last_steps, self.last_wall = int(values["steps"]), time.monotonic()
+        self.last_steps, self.last_wall = int(values["steps"]), self.clock()
 
 
 def _record_leg(meta: Mapping[str, Any]) -> tuple[float, ...]:

@@ -108,7 +108,9 @@ class Simulation(Saving):
         ``every_steps``-th, its steps unchanged; the other methods at the first
         output after;
     every_wall : float, optional
-        or at the first output after every so many seconds of wall-clock time.
+        or every so many seconds of wall-clock time, at the first look at the clock
+        after each: at the outputs, and for radau15 (double precision, without the
+        variational equations) also between two steps, every 10 000 steps.
     exact_times : bool, optional
         Snapshots at exactly the scheduled times (the default of the adaptive
         methods, which end a step there by their own step control), or at the end

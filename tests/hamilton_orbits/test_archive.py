@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from test_simulation_legs import _disc, _merging, _same
 
-from hamilton_orbits import Archive, Body, Simulation, System
+from hamilton_orbits import Archive, Body, Simulation, System, _saving
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._saving import Saving
 from hamilton_orbits.archive import ArchiveIndexError
@@ -627,6 +627,34 @@ RADAU15_STEPPED = {
     "radau15-merge": (_merging, dict(method="radau15",
                                      events=[{"name": "collision", "action": "merge"}])),
 }
+
+
+@pytest.mark.parametrize("case", ["radau15", "radau15-effects", "radau15-events"])
+def test_radau15_looks_at_the_clock_between_steps_for_every_wall(tmp_path, monkeypatch, case):
+    """``every_wall`` with radau15: the clock is looked at between two steps (every
+    ``WALL_CHECK`` steps; here 7, and a clock that ticks a second at each look), not
+    only at the outputs, so a call of one end time gets its snapshots: at the looks
+    after each interval, the steps those of the run without an archive, each
+    snapshot continuing to that run's bits."""
+    monkeypatch.setattr(_saving, "WALL_CHECK", 7)
+    system, kw = RADAU15_STEPPED[case]
+    plain = Simulation(system(), **kw)
+    whole = plain.integrate(12.0)
+    sim = Simulation(system(), archive=tmp_path, every_wall=1.5, **kw)
+    ticks = iter(range(10**6))
+    sim._archive.clock = lambda: float(next(ticks))
+    traj = sim.integrate(12.0)
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and sim.steps == plain.steps
+    archive = Archive(tmp_path)
+    steps = [s.steps for s in archive.snapshots]
+    assert len(steps) >= 4 and steps[0] == 0 and all(k % 7 == 0 for k in steps), steps
+    assert np.all(np.diff(steps) == 14)  # (1.5 s: at the second look after the last)
+    assert archive.damaged == [] and archive.torn == []
+    for snap in archive.snapshots[1::2]:
+        again = Simulation.load(tmp_path, number=snap.number)
+        assert again.steps == snap.steps
+        rest = again.integrate(12.0)
+        assert _same(rest.r[-1], whole.r[-1]) and again.steps == plain.steps
 
 
 @pytest.mark.parametrize("case", list(RADAU15_STEPPED))
