@@ -350,10 +350,12 @@ class Saving:
             info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
                     "unit": self._unit_text(),
                     "first_event": 0 if prop.events is None else len(prop.events.recorded())}
+            if prop.driver is None:  # (made now, not after this snapshot: one segment;
+                prop.driver_for(False)  # bodies that collide at the start do so now)
             self._leg = LegRows(info, times)
             self._leg.add(prop.t, prop.r, prop.v, prop.variational)
-            if prop.driver is None and (prop.events is None or not len(prop.events.watch)):
-                prop.driver_for(False)  # (made now, not after this snapshot: one segment)
+            if prop.events is not None:  # (the leg's first row as the run gives it: the
+                prop.events.mask(*self._leg.rows[0][1:3])  # bodies gone at NaN)
             if arch.path is not None:
                 self._snapshot(self._leg)
         except BaseException:
