@@ -348,9 +348,14 @@ def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
 
 
 @pytest.mark.parametrize(("kw", "match"), [
-    (dict(every=1.0), r"`every`, `every_steps`, `every_wall` and `archive_sync` are an "
-                      r"archive's: give `archive`"),
+    (dict(every=1.0), r"`every`, `every_steps`, `every_wall`, `exact_times` and "
+                      r"`archive_sync` are an archive's: give `archive`"),
     (dict(archive_sync=True), r"are an archive's: give `archive`"),
+    (dict(exact_times=True), r"`exact_times` and `archive_sync` are an archive's"),
+    (dict(method="radau15", dt=None, archive="x", every=1.0, exact_times=False),
+     r"`exact_times` True or None with radau15 without `dt`: an adaptive step ends"),
+    (dict(method="dop853", dt=None, archive="x", every=1.0, exact_times=False),
+     r"`exact_times` True or None with dop853: an adaptive step"),
     (dict(archive="x", every=1.0, archive_sync=1), r"Expected `archive_sync` to be True or "
                                                    r"False, got 1"),
     (dict(archive="x"), r"An archive takes one of `every`, `every_steps`, `every_wall`, got "
