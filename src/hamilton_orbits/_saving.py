@@ -86,7 +86,8 @@ class Saving:
         Raises
         ------
         ValueError
-            When this simulation was not loaded from an archive folder.
+            When this simulation was not loaded from an archive folder, or has
+            integrated since (the interrupted call was left for another).
         SnapshotError
             When a snapshot of the leg is missing or damaged (its rows are lost).
 
@@ -107,7 +108,8 @@ class Saving:
         """
         if self._resumable is None:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
-                             "simulation loaded from its archive folder")
+                             "simulation loaded from its archive folder, before it "
+                             "integrates anything else")
         folder, info, upto = self._resumable  # the leg's rows read now, not at load
         times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop

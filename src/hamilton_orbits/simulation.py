@@ -318,6 +318,7 @@ class Simulation(Saving):
         times, unit = leg_times(t, prop.t, self._quantity)
         if unit is not None:
             self._unit = unit
+        self._resumable = None  # (a call begun: the call a kill interrupted is left)
         if self._archive is not None:
             self._new_leg(times)
         out = self._advance(times, progress, on_output, stop)

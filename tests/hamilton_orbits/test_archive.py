@@ -515,8 +515,13 @@ def test_resume_needs_a_simulation_loaded_from_its_archive(tmp_path):
     with pytest.raises(ValueError, match=r"Nothing to resume"):
         sim.resume()
     whole = sim.integrate(3.0)
-    done = Simulation.load(tmp_path).resume()  # the call had ended: nothing to integrate
+    loaded = Simulation.load(tmp_path)
+    done = loaded.resume()  # the call had ended: nothing to integrate
     assert _same(done.r, whole.r) and done.t.tolist() == whole.t.tolist()
+    assert _same(loaded.resume().r, whole.r)  # (again: the same call, whole)
+    loaded.integrate(4.0)  # (another call: the interrupted one is left)
+    with pytest.raises(ValueError, match=r"Nothing to resume: .* before it integrates"):
+        loaded.resume()
 
 
 def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_times(tmp_path):
