@@ -13,6 +13,7 @@ by :mod:`hamilton_orbits.snapshot` and scheduled by
 
 from __future__ import annotations
 
+import copy
 import os
 import warnings
 from collections.abc import Callable
@@ -50,6 +51,23 @@ def _file_path(path: Any, name: str) -> Path:
     if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
         raise ValueError(f"Expected `{name}` to be a file or folder path, got {path!r}")
     return Path(path)
+
+
+def _start_row(prop: Any) -> tuple[np.ndarray, np.ndarray]:
+    """A leg's first row as the run gives it (the row 0 of
+    :meth:`~hamilton_orbits.engine.Propagation.advance`), the bodies gone at NaN:
+    where the driver is yet to be made with events watched (the leg's run makes it,
+    and with it the collisions already made at the start, recorded as the leg's),
+    after those collisions, carried out here on copies of the state and of the
+    events log."""
+    events, r, v = prop.events, prop.r.copy(), prop.v.copy()
+    if events is None:
+        return r, v
+    if prop.driver is None and len(events.watch):
+        events = copy.deepcopy(events)
+        events.at_start(prop.t, r, v, prop.gm.copy())
+    events.mask(r, v)
+    return r, v
 
 
 class RestartWarning(UserWarning):
@@ -352,12 +370,10 @@ class Saving:
             info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,
                     "unit": self._unit_text(),
                     "first_event": 0 if prop.events is None else len(prop.events.recorded())}
-            if prop.driver is None:  # (made now, not after this snapshot: one segment;
-                prop.driver_for(False)  # bodies that collide at the start do so now)
             self._leg = LegRows(info, times)
-            self._leg.add(prop.t, prop.r, prop.v, prop.variational)
-            if prop.events is not None:  # (the leg's first row as the run gives it: the
-                prop.events.mask(*self._leg.rows[0][1:3])  # bodies gone at NaN)
+            self._leg.add(prop.t, *_start_row(prop), prop.variational)
+            if prop.driver is None and (prop.events is None or not len(prop.events.watch)):
+                prop.driver_for(False)  # (made now, not after this snapshot: one segment)
             if arch.path is not None:
                 self._snapshot(self._leg)
         except BaseException:

@@ -896,28 +896,34 @@ def test_a_calls_first_snapshot_in_the_segment_gone_on_in_is_the_whole_snapshots
     assert archive.damaged == [] and archive.torn == [] and archive.times[-1] == 3.5
 
 
-def test_a_call_whose_bodies_collide_at_its_start_is_resumed_to_its_rows(tmp_path):
-    """Bodies that touch at the start merge there, before the call's first snapshot:
-    the interrupted call resumed returns the rows of the call never interrupted,
-    its first row too (the merged body, the one gone at NaN); the interrupted call's
-    snapshots are in one segment."""
+@pytest.mark.parametrize("action", ["merge", "stop"])
+def test_a_call_whose_bodies_collide_at_its_start_is_resumed_to_its_rows(tmp_path, action):
+    """Bodies that touch at the start collide there, when the call's run begins:
+    the archived call returns what the call without an archive returns (its rows,
+    the collision among its events, what stopped it), and interrupted, then
+    resumed from its archive, the rows of the call never interrupted, its first row
+    too (the merged body, the one gone at NaN)."""
     def system():
         return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01),
                        Body("a", 1e-3, [1, 0, 0], [0, 1, 0], radius=0.01),
                        Body("b", 1e-3, [1.005, 0, 0], [0, 1.1, 0], radius=0.01),
                        Body("c", 1e-4, [2, 0, 0], [0, 0.7, 0])])
 
-    events, times = [{"name": "collision", "action": "merge"}], np.linspace(0.0, 4.0, 9)
+    events, times = [{"name": "collision", "action": action}], np.linspace(0.0, 4.0, 9)
     whole = Simulation(system(), events=events).integrate(times)
-    assert np.isnan(whole.r[0, 2]).all() and len(whole.events) == 1  # (merged at t = 0)
+    assert len(whole.events) == 1 and whole.events["time"][0] == 0.0
+    archived = Simulation(system(), events=events, archive=tmp_path / "whole",
+                          every=0.5).integrate(times)
+    assert _same(archived.r, whole.r) and len(archived.events) == 1
+    assert (archived.stopped_by is None) == (whole.stopped_by is None) == (action == "merge")
     looks = iter(range(10**6))
-    sim = Simulation(system(), events=events, archive=tmp_path, every=0.5)
-    part = sim.integrate(times, stop=lambda: next(looks) >= 3, on_interrupt="keep")
-    assert len(part.t) < len(times)
-    assert [first for first, _ in snapshot_files(tmp_path)] == [0]
-    resumed = Simulation.load(tmp_path).resume()
+    sim = Simulation(system(), events=events, archive=tmp_path / "cut", every=0.5)
+    sim.integrate(times, stop=lambda: next(looks) >= 3, on_interrupt="keep")
+    resumed = Simulation.load(tmp_path / "cut").resume()
     assert resumed.t.tolist() == whole.t.tolist()
     assert _same(resumed.r, whole.r) and _same(resumed.v, whole.v)
+    if action == "merge":
+        assert np.isnan(resumed.r[0, 2]).all() and not np.isnan(resumed.r[0, 1]).any()
 
 
 def test_calls_given_a_stop_go_on_in_one_segment(tmp_path):
