@@ -134,7 +134,8 @@ class Saving:
         rest = times[times > prop.t]
         out = None
         if rest.size:
-            out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop)
+            out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop,
+                                leg=times)
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
@@ -380,14 +381,19 @@ class Saving:
             arch.close()
             raise
 
-    def _archived_times(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _archived_times(self, times: np.ndarray, leg: np.ndarray | None = None) -> tuple[
+            np.ndarray, np.ndarray, np.ndarray]:
         """The output times with the archive's snapshot times merged in, which rows
-        were asked for, and which are scheduled snapshots (the folder claimed)."""
+        were asked for, and which are scheduled snapshots (the folder claimed).  A
+        fixed-step method's snapshots are put on the steps laid from the call's output
+        times (``leg``, those of the whole call ``times`` finish, when resumed: the
+        steps of the call never interrupted)."""
         arch = self._archive
         arch.open()
         extra = arch.times(float(times[0]), float(times[-1]))
         if not arch.exact and self._prop.dt is not None and self._prop.method.name != "dop853":
-            extra = on_step_grid(extra, times, self._prop.dt)
+            extra = on_step_grid(extra, times if leg is None else leg, self._prop.dt)
+            extra = extra[extra > times[0]]  # (moved past the start; none before it)
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 

@@ -361,14 +361,15 @@ class Simulation(Saving):
         return traj
 
     def _advance(self, times: np.ndarray, progress: bool, on_output: Any,
-                 stop: Any) -> engine.EngineRun:
+                 stop: Any, leg: np.ndarray | None = None) -> engine.EngineRun:
         """The propagation through ``times`` (the archive's snapshots taken on the
-        way)."""
+        way); ``leg``: the output times of the whole call that ``times`` finish (a
+        resumed call), whose steps a fixed-step method's snapshots are put on."""
         prop = self._prop
         close = None
         if progress:
             on_output, close = progress_reporter(prop.method.name, len(times) - 1, on_output)
-        archived = None if self._archive is None else self._archived_times(times)
+        archived = None if self._archive is None else self._archived_times(times, leg)
         try:
             if archived is None:
                 return prop.advance(times, on_output=on_output, stop=stop)

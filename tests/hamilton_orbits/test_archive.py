@@ -940,6 +940,29 @@ def test_calls_given_a_stop_go_on_in_one_segment(tmp_path):
     assert _same(again.integrate(5.0).r[-1], sim.integrate(5.0).r[-1])
 
 
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.01), dict(method="leapfrog", dt=0.01),
+                                dict(method="radau15", dt=0.01)], ids=["wh", "leapfrog", "radau15"])
+def test_a_resumed_call_puts_its_snapshots_on_the_steps_of_the_whole_call(tmp_path, kw):
+    """A fixed-step method's snapshots go on its own steps, laid from each output
+    time of the call; the call resumed from a snapshot between two of its outputs
+    lays them from the same outputs, not from the snapshot (0.6 + 30 steps of 0.01
+    is 0.8999999999999999, 0.5 + 40 steps is 0.9): the resumed call's rows are the
+    bits of the call never interrupted, and its snapshots are the same."""
+    system = _disc
+    times = np.linspace(0.0, 3.0, 7)
+    whole = Simulation(system(), archive=tmp_path / "whole", every=0.3, **kw).integrate(times)
+    looks = iter(range(10**6))
+    cut = Simulation(system(), archive=tmp_path / "cut", every=0.3, **kw)
+    cut.integrate(times, stop=lambda: next(looks) >= 2, on_interrupt="keep")
+    again = Simulation.load(tmp_path / "cut")
+    assert again.t == 0.6  # (a snapshot between the outputs 0.5 and 1.0)
+    resumed = again.resume()
+    assert _same(resumed.r, whole.r) and _same(resumed.v, whole.v)
+    ref, ours = Archive(tmp_path / "whole"), Archive(tmp_path / "cut")
+    after = [t for t in ours.times if t > 0.6]
+    assert after == [t for t in ref.times if t > 0.6]
+
+
 def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path):
     """A call stopped (as a kill would leave it) in a segment the simulation's
     earlier calls began: resumed from the archive, it returns the whole call's rows
