@@ -30,6 +30,7 @@ from hamilton_orbits.checkpoint import (
     last_snapshot,
     leg_rows,
     on_step_grid,
+    path_of,
     snapshot_at,
 )
 from hamilton_orbits.integrators import method_of
@@ -44,13 +45,6 @@ __all__ = ["RestartWarning", "Saving"]
 
 #: what a snapshot's ``extra`` holds of its leg alone (its other parts shared)
 _PER_LEG = ("leg", "started")
-
-
-def _file_path(path: Any, name: str) -> Path:
-    """``path`` as a Path, refused by name when it is not a path or is empty."""
-    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
-        raise ValueError(f"Expected `{name}` to be a file or folder path, got {path!r}")
-    return Path(path)
 
 
 def _start_row(prop: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -168,7 +162,7 @@ class Saving:
         >>> bool(np.array_equal(a.r, b.r)), again.steps
         (True, 200)
         """
-        write(_file_path(path, "path"), *self._record(), sync=True)
+        write(path_of(path, "path", "a file or folder path"), *self._record(), sync=True)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:
@@ -194,7 +188,7 @@ class Saving:
             For a missing, damaged or foreign file, naming it; for a ``number``
             the folder does not hold whole.
         """
-        path = _file_path(path, "path")
+        path = path_of(path, "path", "a file or folder path")
         if number is not None and (isinstance(number, (bool, np.bool_))
                                    or not isinstance(number, (int, np.integer))):
             raise ValueError(f"Expected `number` to be a whole number (a snapshot's number), "
@@ -298,16 +292,13 @@ class Saving:
         extra = self._extra(rows)
         if same and known[1] == extra:
             capture, _, index = known[2]
-            if prop.events is not None:
-                prop.events.drain()  # (as a whole snapshot does)
-            taken = capture.take(prop)
+            taken = self._taken(capture)
             if taken is not None:
                 if prop.events is None and (rows is None or not rows.rows) and \
                         self._refilled(capture, taken):  # (a scheduled snapshot between
                     return  # outputs, no row pending: the last record refilled)
-                values = state_values(prop, taken[0], index, taken[1], capture.ints)
-                values["steps"] = prop.steps
-                arch.append(values, {} if rows is None else rows.take())
+                arch.append(self._values(capture, index, taken),
+                            {} if rows is None else rows.take())
                 return
         if known is not None and known[0] is arch.segment and self._leg_appended(
                 rows, extra, known):
@@ -325,22 +316,35 @@ class Saving:
         segment, ``extra`` and capture), so that it shares all the segment's
         snapshots share.  The bytes are those of the whole snapshot.  False,
         nothing written, otherwise (the whole snapshot is then made)."""
-        arch, prop = self._archive, self._prop
+        arch = self._archive
         times = None if rows is None else rows.times
         if (times is None or len(times) != 2 or arch.segment is None or not arch.segment.legs
                 or any(extra[k] != known[1].get(k) for k in extra if k not in _PER_LEG)
                 or known[1].keys() != extra.keys()):
             return False
         capture, _, index = known[2]
-        if prop.events is not None:
-            prop.events.drain()  # (as a whole snapshot does)
-        taken = capture.take(prop)
+        taken = self._taken(capture)
         if taken is None:
             return False
+        arch.append_leg(self._values(capture, index, taken), rows.take(),
+                        {"started": extra["started"], "leg": extra["leg"]})
+        return True
+
+    def _taken(self, capture: Any) -> Any:
+        """What ``capture`` takes of the propagation (:meth:`~hamilton_orbits.restart.
+        Capture.take`), its events log drained first as a whole snapshot's is; None
+        where the propagation's layout is no longer the capture's."""
+        prop = self._prop
+        if prop.events is not None:
+            prop.events.drain()
+        return capture.take(prop)
+
+    def _values(self, capture: Any, index: Any, taken: Any) -> dict[str, Any]:
+        """A record's values (``t``, ``r``, ..., ``steps``) of what ``capture`` took."""
+        prop = self._prop
         values = state_values(prop, taken[0], index, taken[1], capture.ints)
         values["steps"] = prop.steps
-        arch.append_leg(values, rows.take(), {"started": extra["started"], "leg": extra["leg"]})
-        return True
+        return values
 
     def _refilled(self, capture: Any, taken: Any) -> bool:
         """Whether the archive appended the propagation's state by refilling its last
@@ -393,7 +397,8 @@ class Saving:
         extra = arch.times(float(times[0]), float(times[-1]))
         if not arch.exact and self._prop.dt is not None and self._prop.method.name != "dop853":
             extra = on_step_grid(extra, times if leg is None else leg, self._prop.dt)
-            extra = extra[extra > times[0]]  # (moved past the start; none before it)
+            extra = extra[extra > times[0]]  # (one moved back onto the start, at the
+            # rounding of its step, is not an output after it)
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 

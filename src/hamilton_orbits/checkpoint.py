@@ -60,6 +60,7 @@ __all__ = [
     "last_snapshot",
     "leg_rows",
     "on_step_grid",
+    "path_of",
     "snapshot_at",
     "snapshot_files",
 ]
@@ -162,6 +163,14 @@ def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
     a, b = times[k], times[k + 1]
     moved = a + np.ceil((extra - a) / dt * (1.0 - 1e-12)) * dt
     return np.unique(np.where(moved >= b, b, moved))
+
+
+def path_of(path: Any, name: str, what: str) -> Path:
+    """``path`` as a Path, refused by name (the argument ``name``, ``what`` it should
+    be) when it is not a path or is empty."""
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+        raise ValueError(f"Expected `{name}` to be {what}, got {path!r}")
+    return Path(path)
 
 
 def snapshot_files(folder: Path) -> list[tuple[int, Path]]:
@@ -315,11 +324,8 @@ class ArchiveWriter:
                                         or every_steps < 1):
             raise ValueError(f"Expected `every_steps` to be a whole number >= 1, got "
                              f"{every_steps!r}")
-        if path is not None and (not isinstance(path, (str, os.PathLike))
-                                 or not os.fspath(path)):
-            raise ValueError(f"Expected `archive` to be a folder's path, got {path!r}")
         every_steps = None if every_steps is None else int(every_steps)  # (kept as JSON)
-        self.path = None if path is None else Path(path)
+        self.path = None if path is None else path_of(path, "archive", "a folder's path")
         self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
         if not isinstance(exact, bool):
             raise ValueError(f"Expected `exact_times` to be True or False, got {exact!r}")

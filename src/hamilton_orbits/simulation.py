@@ -188,17 +188,9 @@ class Simulation(Saving):
         self._initial = (arrays.r, arrays.v, arrays.gm)
         self._unit: Any = DAY if system.quantity else None
         self._spec = (typed, step, tol, eff.as_list(), event_list(events), variational, stm)
-        fixed = step is not None and typed.name != "dop853"
-        if exact_times is False and not fixed:  # (None, True: checked with the archive)
-            which = "dop853" if typed.name == "dop853" else f"{typed.name} without `dt`"
-            raise ValueError(f"Expected `exact_times` True or None with {which}: an "
-                             f"adaptive step ends exactly at each snapshot time by its own "
-                             f"step control; False takes the snapshots on a fixed step's "
-                             f"own steps")
-        self._archive = _archive_of(archive, (every, every_steps, every_wall),
-                                    not fixed if exact_times is None else exact_times,
-                                    system.quantity, archive_sync,
-                                    given_exact=exact_times is not None)
+        self._archive = _archive_of(archive, (every, every_steps, every_wall), exact_times,
+                                    typed.name, step is not None, system.quantity,
+                                    archive_sync)
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
         self._resumable: Any = None
@@ -383,21 +375,28 @@ class Simulation(Saving):
             if self._archive is not None:
                 self._archive.close()
 
-def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact: Any,
-                quantity: bool, sync: Any = False,
-                given_exact: bool = False) -> ArchiveWriter | None:
-    """The archive a simulation writes while it runs (None without ``path``)."""
+def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact_times: Any, method: str,
+                stepped: bool, quantity: bool, sync: Any) -> ArchiveWriter | None:
+    """The archive a simulation of ``method`` (``stepped``: given a ``dt``) writes
+    while it runs (None without ``path``)."""
     every, every_steps, every_wall = schedule
     if not isinstance(sync, bool):
         raise ValueError(f"Expected `archive_sync` to be True or False, got {sync!r}")
     if path is None:
-        if schedule != (None, None, None) or sync or given_exact:
+        if schedule != (None, None, None) or sync or exact_times is not None:
             raise ValueError("`every`, `every_steps`, `every_wall`, `exact_times` and "
                              "`archive_sync` are an archive's: give `archive` (a folder) "
                              "too")
         return None
+    fixed = stepped and method != "dop853"  # (a fixed step's own grid)
+    if exact_times is False and not fixed:
+        which = "dop853" if method == "dop853" else f"{method} without `dt`"
+        raise ValueError(f"Expected `exact_times` True or None with {which}: an adaptive "
+                         f"step ends exactly at each snapshot time by its own step "
+                         f"control; False takes the snapshots on a fixed step's own steps")
     return ArchiveWriter(path, every=None if every is None else time_step(every, quantity, "every"),
-                         every_steps=every_steps, every_wall=every_wall, exact=exact, sync=sync)
+                         every_steps=every_steps, every_wall=every_wall,
+                         exact=not fixed if exact_times is None else exact_times, sync=sync)
 
 
 def integrate(
