@@ -32,11 +32,18 @@ What it prints (medians over interleaved rounds; the machine is shared):
 [7] where a snapshot's time goes in the 0.3 s radau15 run, ``every=`` and
     ``every_steps=100``: inside the calls of the compiled steps (their entry,
     ``every=``'s landing steps) and outside them (the Python of pauses, outputs
-    and snapshots, the archive's fixed cost spread over the run), per snapshot.
+    and snapshots, the archive's fixed cost spread over the run), per snapshot;
+[8] the cost against the run's length: ``every_steps=100`` and ``every=`` (radau15,
+    the 10-body disc) and rebound's IAS15 with ``step=100``, each archived / plain,
+    over runs of
+    125 to 20000 time units (2 ms to 0.3 s of ours, twice that of IAS15): the
+    archive's fixed cost per call (its folder, lock, two files and first snapshot)
+    against the per-snapshot cost, and the shortest run within 5%.
 """
 
 from __future__ import annotations
 
+import math
 import shutil
 import statistics
 import tempfile
@@ -356,6 +363,66 @@ def long_archive(tmp: Path, repeat: int = 15, t_end: float = 10 * T_END) -> None
           f"{med['theirs opened']:.2f} (opened once before)")
 
 
+def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500.0, 1000.0,
+                                                               2000.0, 5000.0, 20000.0)) -> None:
+    """Archived / plain against the run's length, ours (``every_steps=100``) and
+    rebound's (IAS15, ``step=100``), interleaved rounds per length; and a fit of
+    ours as ``1 + per_snapshot * n / plain + fixed / plain`` (least squares over the
+    lengths' medians of the extra time), to say from which length it is within 5%
+    (``every=``, every 100 mean steps of time, beside it)."""
+    s = disc10()
+    arrays = s.as_arrays()
+    count = iter(range(10**6))
+
+    def ours(t_end: float, archived: dict[str, float] | None) -> Callable[[], None]:
+        def go() -> None:
+            kw = {} if archived is None else dict(archived, archive=tmp / f"len-{next(count)}")
+            Simulation(s, method="radau15", **kw).integrate(t_end)
+        return go
+
+    def theirs(t_end: float, archived: bool) -> Callable[[], None]:
+        def go() -> None:
+            reb = rebound_of(arrays.r, arrays.v, arrays.gm, "ias15", DT)
+            reb.integrator.epsilon = 1e-9
+            if archived:
+                reb.save_to_file(str(tmp / "len-rebound.bin"), step=100, delete_file=True)
+            reb.integrate(t_end, exact_finish_time=1)
+        return go
+
+    print(f"[8] archived / plain against the run's length, a snapshot every 100 steps "
+          f"(medians of {rounds} interleaved rounds):")
+    extra, plain_ms, snaps = [], [], []
+    for t_end in ends:
+        probe = Simulation(s, method="radau15")
+        probe.integrate(t_end)
+        n = probe.steps // 100 + 1  # (the start's snapshot, then one every 100 steps)
+        t = interleaved({"ours": ours(t_end, None),
+                         "ours-archived": ours(t_end, {"every_steps": 100}),
+                         "ours-every": ours(t_end, {"every": 100 * t_end / probe.steps}),
+                         "theirs": theirs(t_end, False),
+                         "theirs-archived": theirs(t_end, True)}, rounds)
+        r_ours, r_every = (statistics.median(a / b for a, b in zip(t[k], t["ours"], strict=True))
+                           for k in ("ours-archived", "ours-every"))
+        r_theirs = statistics.median(a / b for a, b in zip(t["theirs-archived"], t["theirs"],
+                                                            strict=True))
+        plain = statistics.median(t["ours"])
+        extra.append(statistics.median(a - b for a, b in zip(t["ours-archived"], t["ours"],
+                                                             strict=True)))
+        plain_ms.append(plain)
+        snaps.append(n)
+        print(f"    {t_end:7g}: ours x{r_ours:.3f}, every= x{r_every:.3f} (plain "
+              f"{plain * 1e3:6.1f} ms, {n:3d} snapshots), rebound x{r_theirs:.3f} (plain "
+              f"{statistics.median(t['theirs']) * 1e3:6.1f} ms)")
+    per, fixed = np.linalg.lstsq(np.column_stack([snaps, np.ones(len(snaps))]),
+                                 np.array(extra), rcond=None)[0]
+    step = plain_ms[-1] / (snaps[-1] - 1) / 100  # (seconds per step, the longest run)
+    rate = per / (100 * step)
+    within = fixed / (0.05 - rate) if rate < 0.05 else math.inf
+    print(f"    fit of ours: {per * 1e6:.1f} us a snapshot ({rate * 100:.1f}% of its 100 "
+          f"steps), {fixed * 1e3:.2f} ms fixed a call: within 5% from a run of "
+          f"{within * 1e3:.0f} ms")
+
+
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
@@ -371,6 +438,8 @@ def main() -> None:
         long_archive(tmp)
         (tmp / "split").mkdir()
         inside_and_out(tmp / "split", 9)
+        (tmp / "lengths").mkdir()
+        lengths(tmp / "lengths", 9)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -157,15 +157,26 @@ def _state(prop: Any, scalars: list[Any] | None, cache: dict[str, Any] | None) -
     layout), the graph is walked afresh only when its shape changed
     (:class:`~hamilton_orbits.restart.Capture`)."""
     known = None if cache is None else cache.get("capture")
+    if known is None and cache is not None and scalars is not None:
+        known = _RECENT.get(type(prop))  # (another simulation's of the same kind)
     if known is not None and scalars is not None:
         taken = known[0].take(prop)
         if taken is not None:
             scalars += taken[1]
+            cache["capture"] = known
             return known[1], taken[0], known[2]
     layout, state = flatten(prop, scalars)
     if cache is not None:
-        cache["capture"] = (Capture(prop, layout), layout, pack(state)[1])
+        cache["capture"] = _RECENT[type(prop)] = (Capture(prop, layout), layout,
+                                                   pack(state)[1])
     return layout, state, None
+
+
+#: the last capture made, per class of propagation: a simulation's first archived
+#: snapshot tries it before walking its graph (a new simulation of the same kind,
+#: as in a loop of runs, whose layout is then the same: the capture checks it, and
+#: its compiled reading is reused; it holds no array)
+_RECENT: dict[type, tuple[Capture, dict[str, Any], list[list[Any]]]] = {}
 
 
 def _fixed(system: Any, method: Any, dt: float | None, tol: float | None, effects: list,

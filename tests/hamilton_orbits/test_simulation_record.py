@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from test_simulation_legs import _disc
 
-from hamilton_orbits import Simulation
+from hamilton_orbits import Simulation, System
 from hamilton_orbits._netcdf3 import RecordBuffer
 from hamilton_orbits.restart import flatten
+from hamilton_orbits.segment import read_segment
 from hamilton_orbits.simulation_record import (
     from_json,
     pack,
@@ -72,3 +73,49 @@ def test_a_record_of_parts_is_the_record_of_the_packed_state():
                                  else np.float64) for k in names])
     first = bytes(buf.fill([whole[k] for k in names]))
     assert bytes(buf.fill([parts[k] for k in names])) == first
+
+
+def _snapshots(folder):
+    """Every snapshot of an archive's segments: its meta (the archive's path out)
+    and arrays."""
+    out = []
+    for path in sorted(folder.glob("segment-*.nc")):
+        for number, meta, arrays in read_segment(path).snapshots:
+            meta = dict(meta, archive=dict(meta["archive"], path=None))
+            out.append((number, meta, arrays))
+    return out
+
+
+@pytest.mark.parametrize("other", [
+    dict(method="radau15"),  # (the same kind: the capture it left is taken)
+    dict(method="radau15", bodies=4),  # (other shapes: it refuses, the graph walked)
+    dict(method="wh", dt=0.05),  # (another driver: it refuses)
+])
+def test_an_archive_written_through_another_simulations_capture_is_the_one_walked(
+        tmp_path, monkeypatch, other):
+    """A simulation's first archived snapshot tries the capture the last simulation
+    of its kind left (``_RECENT``) before walking its graph: the snapshots are those
+    the walk gives, whether the capture fits or refuses."""
+    from hamilton_orbits import simulation_record
+
+    other = dict(other)
+    bodies = other.pop("bodies", None)
+    system = _disc() if bodies is None else System(list(_disc().bodies)[:bodies])
+    Simulation(_disc(), method="radau15", archive=tmp_path / "a", every_steps=7).integrate(3.0)
+    left = list(simulation_record._RECENT.values())  # (by that first simulation)
+    written = {}
+    for name in ("b", "c"):
+        if name == "c":
+            monkeypatch.setattr(simulation_record, "_RECENT", {})
+        sim = Simulation(system, archive=tmp_path / name, every_steps=7, **other)
+        sim.integrate(2.0)
+        if name == "b":
+            assert (sim._record_cache["capture"] in left) == (other == {"method": "radau15"}
+                                                              and bodies is None)
+        sim.integrate(4.0)
+        written[name] = _snapshots(tmp_path / name)
+    assert len(written["b"]) == len(written["c"]) > 3
+    for (nb, mb, ab), (nc, mc, ac) in zip(written["b"], written["c"], strict=True):
+        assert nb == nc and mb == mc and ab.keys() == ac.keys()
+        assert all(ab[k].dtype == ac[k].dtype and ab[k].shape == ac[k].shape
+                   and ab[k].tobytes() == ac[k].tobytes() for k in ab)  # (to the bit)
