@@ -399,6 +399,9 @@ class Saving:
             extra = on_step_grid(extra, times if leg is None else leg, self._prop.dt)
             extra = extra[extra > times[0]]  # (one moved back onto the start, at the
             # rounding of its step, is not an output after it)
+        if not extra.size and bool(np.all(times[1:] > times[:-1])):  # (no snapshot
+            # scheduled in the call, as in a loop of short calls: its times as they are)
+            return times, np.ones(len(times), bool), np.zeros(len(times), bool)
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 
