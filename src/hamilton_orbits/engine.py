@@ -319,6 +319,9 @@ class Propagation:
             complete = False
         except KeyboardInterrupt:
             complete, interrupted = False, True
+        except BaseException:  # (an error, the driver's or a callback's: the propagation
+            self._between_outputs(driver)  # keeps the state reached, as on Ctrl-C)
+            raise
         wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
         k = reached[0] + 1
         if backward:  # in place: no second copy of the history
@@ -346,8 +349,8 @@ class Propagation:
         (the continuing call of a prepared simulation: its cost is mostly wrapping).
         None when the leg is not of that kind (no driver yet, a backward leg, events
         or variational equations): the caller then calls :meth:`advance`.  On
-        Ctrl-C the propagation keeps the driver's state, as :meth:`advance` does,
-        and ``KeyboardInterrupt`` is raised."""
+        Ctrl-C or an error the propagation keeps the driver's state, as
+        :meth:`advance` does, and the exception goes on."""
         driver = self.driver
         if (driver is None or self.backward or self.events is not None
                 or self.variational is not None or not self.t < t_end < np.inf):
@@ -359,7 +362,7 @@ class Propagation:
         start, steps0, compiled = time.perf_counter(), driver.steps, compile_seconds()
         try:
             driver.advance(t_out, r_out, v_out, None, None)
-        except KeyboardInterrupt:
+        except BaseException:  # (Ctrl-C, or an error such as max_steps reached)
             self._between_outputs(driver)
             raise
         wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)

@@ -13,7 +13,7 @@ import astropy.units as u
 import numpy as np
 import pytest
 
-from hamilton_orbits import Body, Simulation, System, integrate
+from hamilton_orbits import Archive, Body, Simulation, System, integrate
 from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.integrators import DOP853, WH, Leapfrog, Radau15
 
@@ -353,3 +353,54 @@ def test_repr_names_method_effects_time_and_steps():
     sim.integrate(0.1)
     assert repr(sim).startswith("Simulation(6 bodies, method=WH(coordinates=")
     assert "effects=('gr_potential',), t=0.1, steps=5)" in repr(sim)
+
+
+@pytest.mark.parametrize("archived", [False, True])
+def test_an_error_in_a_leg_keeps_the_state_reached(tmp_path, archived):
+    """A leg that ends in an error (here ``max_steps`` reached between two outputs)
+    leaves the simulation where its integrator stands, as Ctrl-C does: the next leg
+    goes on with the bits of the run never stopped, as does the archive's last
+    snapshot, and the next leg's first snapshot holds the state at its time.  (It
+    used to keep the time and state of the leg's
+    start, or of its last snapshot, so that the next leg returned the integrator's
+    later state under the times asked, 3.4 length units off.)"""
+    from hamilton_orbits.validation import ConvergenceError
+
+    kw = dict(archive=tmp_path / "a", every_steps=20) if archived else {}
+    sim = Simulation(_disc(), method="radau15", max_steps=200, **kw)
+    with pytest.raises(ConvergenceError, match="in 200 steps"):
+        sim.integrate(100.0)
+    t = sim.t
+    assert 0.0 < t < 100.0 and sim.steps == 200
+    once = Simulation(_disc(), method="radau15").integrate(t + 5.0)
+    if archived:
+        loaded = Simulation.load(tmp_path / "a")  # (its last snapshot, before the error)
+        assert loaded.t < t and loaded.steps == 180
+        assert _same(loaded.integrate(t + 5.0).r[-1], once.r[-1])
+    leg = sim.integrate(t + 5.0)
+    assert leg.t[0] == t and _same(leg.r[-1], once.r[-1])
+    if archived:  # (the second leg's first snapshot: the time and state reached)
+        archive = Archive(tmp_path / "a")
+        first = archive[list(archive.times).index(t)]
+        assert first.t == t and first.steps == 200
+        assert _same(first.integrate(t + 5.0).r[-1], once.r[-1])
+
+
+@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="wh", dt=0.02),
+                                dict(method="leapfrog", dt=0.02), dict(method="dop853")])
+def test_an_error_from_on_output_keeps_the_output_reached(kw):
+    """An exception from ``on_output`` ends the leg at that output with the
+    simulation standing there (not at the leg's start): the next leg continues with
+    the bits of the run that was never stopped."""
+    once = Simulation(_disc(), **kw).integrate([1.0, 2.0, 3.0, 4.0])
+
+    def fail(i, steps):
+        if i == 2:
+            raise RuntimeError("the caller's own error")
+
+    sim = Simulation(_disc(), **kw)
+    with pytest.raises(RuntimeError, match="own error"):
+        sim.integrate([1.0, 2.0, 3.0, 4.0], on_output=fail)
+    assert sim.t == 2.0
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.r[2])
+    assert _same(sim.integrate([3.0, 4.0]).r[-1], once.r[-1])
