@@ -12,6 +12,7 @@ the run ends.
 
 from __future__ import annotations
 
+import itertools
 import os
 import socket
 from pathlib import Path
@@ -19,6 +20,7 @@ from pathlib import Path
 __all__ = ["LOCK_NAME", "FolderError", "OutputFolder"]
 
 LOCK_NAME = ".hamilton-orbits.lock"
+_CLAIMS = itertools.count(1)
 
 
 class FolderError(ValueError):
@@ -69,7 +71,9 @@ class OutputFolder:
         self.path = Path(path)
         self.option = option
         self._lock = self.path / LOCK_NAME
-        self._mine = f"{os.getpid()} {socket.gethostname()}\n"
+        #: the lock's text: the PID and host, and a number of this claim's own (two
+        #: claims of one process told apart: a claim releases only its own lock)
+        self._mine = f"{os.getpid()} {socket.gethostname()} {next(_CLAIMS)}\n"
 
     def _fail(self, why: str) -> FolderError:
         return FolderError(f"{self.option} {self.path}: {why}; nothing was run")
@@ -132,6 +136,10 @@ class OutputFolder:
         if pid is not None and host == socket.gethostname() and not _alive(pid):
             self._lock.unlink(missing_ok=True)
             return
+        if pid == os.getpid() and host == socket.gethostname():
+            raise self._fail("another simulation of this process is writing into this "
+                             "folder (an archive is written by one simulation at a time); "
+                             "choose another folder")
         who = f"PID {pid} on {host}" if pid is not None else "an unknown run"
         raise self._fail(
             f"another run ({who}) is writing into this folder; choose another folder, or "

@@ -271,6 +271,17 @@ class Saving:
         return extra
 
     def _snapshot(self, rows: Any, again: bool = False) -> None:
+        """Append the archive's next snapshot (``rows``: the leg's rows since the last,
+        ``again``: see :meth:`_appended`).  A snapshot that did not end (Ctrl-C, a full
+        disk) leaves the segment to the folder: the next begins one of its own at the
+        folder's next number (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.lost`)."""
+        try:
+            self._appended(rows, again)
+        except BaseException:
+            self._archive.lost()
+            raise
+
+    def _appended(self, rows: Any, again: bool = False) -> None:
         """Append the archive's next snapshot (``rows``: the leg's rows since the last).
 
         When the segment being written was begun or last appended to by this

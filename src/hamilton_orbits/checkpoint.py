@@ -369,6 +369,9 @@ class ArchiveWriter:
             folder.__enter__()
         except FolderError as exc:
             raise SnapshotError(str(exc).replace("; nothing was run", "")) from None
+        except BaseException:  # (Ctrl-C as the lock was taken: released if it is this one's)
+            folder.__exit__(None, None, None)
+            raise
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
@@ -405,6 +408,16 @@ class ArchiveWriter:
         if self.folder is not None:
             self.folder.__exit__(None, None, None)
             self.folder = None
+
+    def lost(self) -> None:
+        """After a snapshot whose writing did not end (Ctrl-C, an error): the segment
+        closed and left, so that the next snapshot begins a segment of its own at the
+        folder's next number, read from its files (the counts kept here may be behind
+        them: a record written and counted in the file, not yet here)."""
+        if self.segment is not None:
+            self.segment.close()
+            self.segment = None
+        self.left = self.parked = None
 
     def times(self, t0: float, t1: float) -> np.ndarray:
         """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""

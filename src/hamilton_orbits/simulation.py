@@ -311,9 +311,14 @@ class Simulation(Saving):
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
-        if self._archive is not None:
-            self._new_leg(times)
-        out = self._advance(times, progress, on_output, stop)
+        try:
+            if self._archive is not None:
+                self._new_leg(times)
+            out = self._advance(times, progress, on_output, stop)
+        except BaseException:  # (Ctrl-C between the two: the folder released all the same)
+            if self._archive is not None:
+                self._archive.close()
+            raise
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
         start, self._start = self._start, self._initial  # the first leg begins at time 0
@@ -359,10 +364,12 @@ class Simulation(Saving):
         resumed call), whose steps a fixed-step method's snapshots are put on."""
         prop = self._prop
         close = None
-        if progress:
-            on_output, close = progress_reporter(prop.method.name, len(times) - 1, on_output)
-        archived = None if self._archive is None else self._archived_times(times, leg)
-        try:
+        try:  # (the archive's folder, claimed by the leg's first snapshot, released below
+            # whatever happens: Ctrl-C included)
+            if progress:
+                on_output, close = progress_reporter(prop.method.name, len(times) - 1,
+                                                     on_output)
+            archived = None if self._archive is None else self._archived_times(times, leg)
             if archived is None:
                 return prop.advance(times, on_output=on_output, stop=stop)
             out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),

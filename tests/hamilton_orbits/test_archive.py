@@ -1108,3 +1108,101 @@ def test_a_loop_of_calls_killed_at_any_moment_loses_at_most_the_snapshot_being_w
         assert sim.steps == ref.steps, f"kill {k}"
         assert len(Archive(folder)) == len(reference), f"kill {k}"
     assert seen_partial >= 5
+
+
+def _lock(folder):
+    return (folder / ".hamilton-orbits.lock").exists()
+
+
+def test_ctrl_c_as_the_lock_is_taken_or_before_the_steps_leaves_the_folder_free(
+        tmp_path, monkeypatch):
+    """Ctrl-C delivered as the folder's lock has just been linked (the signal raised
+    when ``os.link`` returns), or as the leg's snapshot times are merged before its
+    steps, releases the lock: the same simulation, and another loaded from the
+    folder in the same process, go on writing.  (The first left the lock of this
+    live process for good, so that the same simulation was refused by every later
+    call; the second until its next call.)"""
+    from hamilton_orbits import _outdir
+
+    real_link = os.link
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    ref = Simulation(_disc(), archive=tmp_path / "ref", **kw)  # (never interrupted)
+    whole = [ref.integrate(t).r[-1] for t in (0.5, 1.0, 1.5)]
+    folder = tmp_path / "a"
+    sim = Simulation(_disc(), archive=folder, **kw)
+    sim.integrate(0.5)
+
+    def link_then_ctrl_c(a, b):
+        real_link(a, b)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(_outdir.os, "link", link_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(1.0)
+    monkeypatch.setattr(_outdir.os, "link", real_link)
+    assert not _lock(folder) and sim.t == 0.5
+
+    def merged_then_ctrl_c(self, *args, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Saving, "_archived_times", merged_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(1.0)
+    monkeypatch.undo()
+    assert not _lock(folder)
+    assert _same(Simulation.load(folder).integrate(1.0).r[-1], whole[1])
+    assert _same(sim.integrate(1.0).r[-1], whole[1])
+    assert _same(sim.integrate(1.5).r[-1], whole[2])
+    numbers = [s.number for s in Archive(folder).snapshots]
+    assert numbers == list(range(len(numbers))) and not _lock(folder)
+
+
+@pytest.mark.parametrize("follow", ["end", "times"])
+def test_ctrl_c_after_a_record_is_counted_in_its_file_numbers_on(tmp_path, monkeypatch,
+                                                                  follow):
+    """Ctrl-C after a snapshot's record is written and counted in its segment, before
+    the writer had counted it (here as the record's arrays are kept for the next
+    refill): the next call numbers its snapshots on from the folder's files (it
+    used to number from one behind: two snapshots of one number, or a leg recorded
+    as beginning at the wrong snapshot, whose resume failed with a KeyError)."""
+    from hamilton_orbits import segment
+
+    sim = Simulation(_disc(), method="wh", dt=0.01, archive=tmp_path, every=0.5)
+    sim.integrate(np.linspace(0.0, 3.0, 7))
+    real = segment._joinable
+    calls = []
+
+    def counted_then_ctrl_c(arrays):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(arrays)
+
+    monkeypatch.setattr(segment, "_joinable", counted_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(np.linspace(3.0, 6.0, 7))
+    monkeypatch.undo()
+    leg = sim.integrate(8.0 if follow == "end" else np.linspace(sim.t, 8.0, 5))
+    archive = Archive(tmp_path)
+    numbers = [s.number for s in archive.snapshots]
+    assert numbers == list(range(len(numbers))) and archive.damaged == []
+    resumed = Simulation.load(tmp_path).resume()  # (as after a kill at its end)
+    assert resumed.t.tolist() == leg.t.tolist() and _same(resumed.r, leg.r)
+
+
+def test_a_second_simulation_of_one_process_is_refused_while_the_first_writes(tmp_path):
+    """A simulation that wants the folder while another of the same process writes
+    into it is refused by name (the message used to call this very process
+    "another run (PID ...)"); the first goes on."""
+    sim = Simulation(_disc(), method="wh", dt=0.01, archive=tmp_path, every=0.25)
+    sim.integrate(0.5)
+    refused = []
+
+    def meanwhile(i, steps):
+        if i == 1:
+            with pytest.raises(SnapshotError, match="another simulation of this process"):
+                Simulation.load(tmp_path).integrate(2.0)
+            refused.append(i)
+
+    sim.integrate([0.75, 1.0], on_output=meanwhile)
+    assert refused == [1] and not _lock(tmp_path) and sim.t == 1.0
