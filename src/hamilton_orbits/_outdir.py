@@ -137,9 +137,9 @@ class OutputFolder:
             self._lock.unlink(missing_ok=True)
             return
         if pid == os.getpid() and host == socket.gethostname():
-            raise self._fail("another simulation of this process is writing into this "
-                             "folder (an archive is written by one simulation at a time); "
-                             "choose another folder")
+            raise self._fail(f"another run of this same process (PID {pid}: a simulation "
+                             f"writing its archive) is writing into this folder; choose "
+                             f"another folder")
         who = f"PID {pid} on {host}" if pid is not None else "an unknown run"
         raise self._fail(
             f"another run ({who}) is writing into this folder; choose another folder, or "

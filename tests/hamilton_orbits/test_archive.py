@@ -1200,7 +1200,7 @@ def test_a_second_simulation_of_one_process_is_refused_while_the_first_writes(tm
 
     def meanwhile(i, steps):
         if i == 1:
-            with pytest.raises(SnapshotError, match="another simulation of this process"):
+            with pytest.raises(SnapshotError, match="another run of this same process"):
                 Simulation.load(tmp_path).integrate(2.0)
             refused.append(i)
 

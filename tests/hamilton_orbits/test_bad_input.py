@@ -198,7 +198,8 @@ def test_the_lock_is_taken_released_and_taken_over_when_stale(tmp_path):
     lock.write_text(f"{int(dead.stdout)} {os.uname().nodename}\n")  # a run that has ended
     with OutputFolder(tmp_path):
         assert lock.read_text().split()[0] == str(os.getpid())
-        with pytest.raises(FolderError, match=rf"another run \(PID {os.getpid()}"), \
+        with pytest.raises(FolderError, match=rf"another run of this same process \(PID "
+                                              rf"{os.getpid()}"), \
                 OutputFolder(tmp_path):
             pass
     assert not lock.exists()
