@@ -214,6 +214,7 @@ class Saving:
                                               "exact")}
             sim._archive = ArchiveWriter(folder, origin=schedule["origin"], **sched)
             sim._archive.last_steps = sim.steps
+            sim._archive.continues = True  # (the run of the folder's snapshots)
         leg = meta.get("leg")
         if folder is not None and leg is not None:  # the leg a kill interrupted
             sim._resumable = (folder, leg, meta["number"])

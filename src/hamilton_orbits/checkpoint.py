@@ -344,6 +344,10 @@ class ArchiveWriter:
         self.leg: tuple[float, ...] = NO_LEG
         #: the wall clock of ``every_wall`` (seconds)
         self.clock: Callable[[], float] = time.monotonic
+        #: the snapshots already in the folder are this writer's run's (it wrote them,
+        #: or its simulation was loaded from the folder): appended to; otherwise a
+        #: folder holding snapshots is refused (another run's: the two would mix)
+        self.continues = False
         self.last_steps, self.last_wall = 0, self.clock()
 
     def schedule_only(self) -> ArchiveWriter:
@@ -375,6 +379,13 @@ class ArchiveWriter:
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
+        if self.count and not self.continues:
+            self.close()
+            raise SnapshotError(
+                f"the archive {self.path} holds the snapshots of another run (0 to "
+                f"{self.count - 1}); continue that run with Simulation.load("
+                f"{str(self.path)!r}), or give this simulation another folder")
+        self.continues = True
         parked, self.parked = self.parked, None
         if known is not None and parked is not None and parked.reopen():
             self.segment = parked  # (the next leg goes on in it, if it shares the same)

@@ -1206,3 +1206,29 @@ def test_a_second_simulation_of_one_process_is_refused_while_the_first_writes(tm
 
     sim.integrate([0.75, 1.0], on_output=meanwhile)
     assert refused == [1] and not _lock(tmp_path) and sim.t == 1.0
+
+
+def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp_path):
+    """A simulation that did not come from the folder (``Simulation.load``) and has
+    not written there is refused a folder that holds snapshots, by name, with the
+    way to continue them; nothing is written and the folder stays free.  (Two runs
+    used to be mixed in one archive silently: its times went back to 0, and
+    ``to_xarray`` failed on their shapes.)"""
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    Simulation(_disc(), archive=tmp_path / "a", **kw).integrate(0.5)
+    before = sorted(p.name for p in (tmp_path / "a").iterdir())
+    for system in (_disc(), System(list(_disc().bodies)[:4])):
+        sim = Simulation(system, archive=tmp_path / "a", **kw)
+        with pytest.raises(SnapshotError, match=r"archive .*/a holds the snapshots of another "
+                                                r"run \(0 to 2\); continue that run with "
+                                                r"Simulation\.load"):
+            sim.integrate(1.0)
+        assert sim.t == 0.0
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == before
+    loaded = Simulation.load(tmp_path / "a")  # (the run of those snapshots: goes on)
+    loaded.integrate(1.0)
+    assert Archive(tmp_path / "a").times.tolist() == [0.0, 0.25, 0.5, 0.5, 0.75, 1.0]
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "notes.txt").write_text("not a snapshot")
+    Simulation(_disc(), archive=tmp_path / "b", **kw).integrate(0.5)  # (no snapshot there)
+    assert len(Archive(tmp_path / "b")) == 3
