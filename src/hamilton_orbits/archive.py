@@ -139,12 +139,26 @@ class Archive:
         A snapshot that repeats the one before it (the same time, step count and
         state, bit for bit: the first snapshot of an ``integrate`` call whose call
         before ended on a scheduled snapshot) is in it once, so that the times
-        are those of distinct states; ``snapshots`` lists both."""
+        are those of distinct states; ``snapshots`` lists both.
+
+        Raises
+        ------
+        SnapshotError
+            For an archive of no whole snapshot, or one whose snapshots hold
+            different numbers of bodies (not of one run), naming it.
+        """
         try:
             import xarray as xr
         except ImportError:
             raise ImportError("Archive.to_xarray needs xarray: pip install "
                               "'hamilton-orbits[archive]'") from None
+        shapes = {a["r"].shape for a in self._arrays}
+        if len(shapes) != 1:  # (none, or of two runs: an archive holds one run's)
+            raise SnapshotError(
+                f"the archive {self.path} has no whole snapshot to put in a Dataset"
+                if not shapes else f"the snapshots of the archive {self.path} hold different "
+                f"numbers of bodies ({', '.join(str(x[0]) for x in sorted(shapes))}): they "
+                f"are not of one run")
         stack = {k: np.stack([a[k] for a in self._arrays]) for k in ("r", "v", "gm", "active")}
         times, steps = self.times, np.array([s.steps for s in self.snapshots], dtype=np.int64)
         keep = ~_repeats(times, steps, stack)

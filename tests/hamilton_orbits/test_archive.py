@@ -1232,3 +1232,24 @@ def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp
     (tmp_path / "b" / "notes.txt").write_text("not a snapshot")
     Simulation(_disc(), archive=tmp_path / "b", **kw).integrate(0.5)  # (no snapshot there)
     assert len(Archive(tmp_path / "b")) == 3
+
+
+def test_to_xarray_of_no_snapshot_or_of_two_runs_says_so(tmp_path):
+    """``to_xarray`` of an archive of no whole snapshot, or of snapshots of two runs
+    (here: a folder deleted between two calls of a run, a second run written there
+    meanwhile), is a SnapshotError naming the archive, not numpy's error on stacking
+    no arrays or arrays of two shapes."""
+    pytest.importorskip("xarray")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(SnapshotError, match=r"archive .*empty has no whole snapshot"):
+        Archive(tmp_path / "empty").to_xarray()
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    first = Simulation(_disc(), archive=tmp_path / "a", **kw)
+    first.integrate(0.5)
+    for path in (tmp_path / "a").iterdir():
+        path.unlink()
+    Simulation(System(list(_disc().bodies)[:4]), archive=tmp_path / "a", **kw).integrate(0.5)
+    first.integrate(1.0)  # (it goes on where it wrote: the folder made again)
+    with pytest.raises(SnapshotError, match=r"snapshots of the archive .*a hold different "
+                                            r"numbers of bodies \(4, 6\)"):
+        Archive(tmp_path / "a").to_xarray()
