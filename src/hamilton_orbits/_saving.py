@@ -29,6 +29,7 @@ from hamilton_orbits.checkpoint import (
     LegRows,
     last_snapshot,
     leg_rows,
+    leg_times_of,
     on_step_grid,
     path_of,
     snapshot_at,
@@ -193,7 +194,7 @@ class Saving:
                                    or not isinstance(number, (int, np.integer))):
             raise ValueError(f"Expected `number` to be a whole number (a snapshot's number), "
                              f"got {number!r}")
-        folder = path if path.is_dir() else None
+        folder = source = path if path.is_dir() else None
         if folder is None:
             if number is not None:
                 raise ValueError(f"`number` picks a snapshot of an archive folder; {path} "
@@ -216,6 +217,8 @@ class Saving:
             sim._archive.last_steps = sim.steps
             sim._archive.continues = True  # (the run of the folder's snapshots)
         leg = meta.get("leg")
+        if leg is not None and source is not None:  # (its leg's times, read if needed)
+            sim._asked = (source, int(leg["start"]))
         if folder is not None and leg is not None:  # the leg a kill interrupted
             sim._resumable = (folder, leg, meta["number"])
             sim._leg = LegRows(leg)
@@ -404,11 +407,16 @@ class Saving:
         fixed-step method's snapshots are put on the steps laid from the call's output
         times (``leg``, those of the whole call ``times`` finish, when resumed: the
         steps of the call never interrupted)."""
-        arch = self._archive
+        arch, prop = self._archive, self._prop
         arch.open()
         extra = arch.times(float(times[0]), float(times[-1]))
-        if not arch.exact and self._prop.dt is not None and self._prop.method.name != "dop853":
-            extra = on_step_grid(extra, times if leg is None else leg, self._prop.dt)
+        if not arch.exact and prop.dt is not None and prop.method.name != "dop853":
+            asked = leg
+            if asked is None:
+                before = self._asked_before(float(times[0]))
+                asked = times if before is None else np.concatenate(([before], times[1:]))
+            self._asked = asked
+            extra = on_step_grid(extra, asked, prop.dt, spread=prop.method.name == "leapfrog")
             extra = extra[extra > times[0]]  # (one moved back onto the start, at the
             # rounding of its step, is not an output after it)
         if not extra.size and bool(np.all(times[1:] > times[:-1])):  # (no snapshot
@@ -416,6 +424,20 @@ class Saving:
             return times, np.ones(len(times), bool), np.zeros(len(times), bool)
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
+
+    def _asked_before(self, t: float) -> float | None:
+        """The last output time asked for before ``t`` in the leg the simulation
+        stands in, where it stands between two of them (a leg that ended at a
+        snapshot, or a simulation loaded from one): a fixed-step method's snapshots
+        are put on the steps laid from it, as in the leg never interrupted.  None
+        where it stands on one, or no leg is known."""
+        asked = self._asked
+        if isinstance(asked, tuple):  # (loaded: read from the archive once, when needed)
+            asked = self._asked = leg_times_of(*asked)
+        if asked is None or not asked[0] < t < asked[-1]:
+            return None
+        before = asked[asked <= t]
+        return None if before[-1] == t else float(before[-1])
 
     def _step_snapshots(self) -> _EverySteps | _EveryWall | None:
         """The pause that takes an ``every_steps`` snapshot between two steps, or

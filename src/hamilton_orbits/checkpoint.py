@@ -148,21 +148,35 @@ def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str,
     return found[start]["leg_times"], rows
 
 
-def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float) -> np.ndarray:
+def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float,
+                 spread: bool = False) -> np.ndarray:
     """Snapshot times ``extra`` moved to the end of the step at or after each, for a
     fixed-step method whose steps start afresh at each output time ``times`` (as
-    :func:`hamilton_orbits.integrators._setup.fixed_steps` lays them): the run's
-    steps are then its own, to the rounding of a step's length.
+    :func:`hamilton_orbits.integrators._setup.fixed_steps` lays them: steps of
+    ``dt``, the last shortened; ``spread``: as leapfrog lays them, the interval cut
+    into the fewest equal steps of at most ``dt``): the run's steps are then its
+    own, to the rounding of a step's length.
 
     Examples
     --------
     >>> on_step_grid(np.array([1.0, 2.5]), np.array([0.0, 3.0]), 0.3).round(12).tolist()
     [1.2, 2.7]
+    >>> on_step_grid(np.array([1.0]), np.array([0.0, 2.6]), 0.3, spread=True).round(12).tolist()
+    [1.155555555556]
     """
     k = np.clip(np.searchsorted(times, extra, side="right") - 1, 0, len(times) - 2)
     a, b = times[k], times[k + 1]
-    moved = a + np.ceil((extra - a) / dt * (1.0 - 1e-12)) * dt
+    step = (b - a) / np.maximum(np.ceil((b - a) / dt - 1e-12), 1.0) if spread else dt
+    moved = a + np.ceil((extra - a) / step * (1.0 - 1e-12)) * step
     return np.unique(np.where(moved >= b, b, moved))
+
+
+def leg_times_of(folder: Path, start: int) -> np.ndarray | None:
+    """The output times of the leg that began at snapshot ``start`` of archive
+    ``folder`` (held by that snapshot), or None where it does not read."""
+    found = snapshot_at(folder, start)
+    times = None if found is None else found[2].get("leg_times")
+    return None if times is None else np.asarray(times, dtype=np.float64)
 
 
 def path_of(path: Any, name: str, what: str) -> Path:

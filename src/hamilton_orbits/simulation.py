@@ -194,6 +194,9 @@ class Simulation(Saving):
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
         self._resumable: Any = None
+        #: the output times asked for in the last archived leg, or where to read them
+        #: (``Saving._asked_before``)
+        self._asked: Any = None
         self._warned = False  # an under-resolved encounter is warned of once
         #: how a leg's test-particle approaches are checked: fixed for the simulation
         #: (method, step, tolerance, the state at time 0), so found once, not per call

@@ -1253,3 +1253,42 @@ def test_to_xarray_of_no_snapshot_or_of_two_runs_says_so(tmp_path):
     with pytest.raises(SnapshotError, match=r"snapshots of the archive .*a hold different "
                                             r"numbers of bodies \(4, 6\)"):
         Archive(tmp_path / "a").to_xarray()
+
+
+def test_leapfrog_snapshots_on_its_own_equal_steps(tmp_path):
+    """Leapfrog cuts each output interval into the fewest equal steps of at most
+    ``dt`` (10 / 770 here, not 0.013): its snapshots (``exact_times`` False, its
+    default) are at the end of its own step at or after each scheduled time, so
+    the archived run agrees with the plain one to rounding (the snapshots used to
+    be put on steps of ``dt``, which cut its steps anew: 7e-7 off)."""
+    kw = dict(method="leapfrog", dt=0.013)
+    plain = Simulation(_disc(), **kw).integrate(10.0)
+    archived = Simulation(_disc(), archive=tmp_path, every=1.0, **kw).integrate(10.0)
+    assert plain.steps == archived.steps == 770
+    steps = Archive(tmp_path).times[1:] / (10.0 / 770)
+    np.testing.assert_allclose(steps, np.round(steps), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(archived.r, plain.r, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("method", ["wh", "leapfrog", "radau15"])
+def test_a_fixed_step_run_goes_on_with_its_bits_from_a_snapshot_between_outputs(tmp_path,
+                                                                              method):
+    """A fixed-step run's snapshots (``exact_times`` False) are on its steps laid
+    from the call's output times; continued from one of them (``Archive[k]``, or
+    the folder loaded after a run stopped there, as after a kill) the later ones
+    are laid from the same output times, so the run ends on its own bits.  (They
+    used to be laid from the snapshot's time: 5.005 against 5.004999999999999,
+    and the run 1e-14 off.)"""
+    kw = dict(method=method, dt=0.013, every=1.0)
+    whole = Simulation(_disc(), archive=tmp_path / "whole", **kw).integrate(10.0)
+    archive = Archive(tmp_path / "whole")
+    for k in (1, 2, 3):
+        assert _same(archive[k].integrate(10.0).r[-1], whole.r[-1])
+    looks = iter(range(10**6))
+    cut = Simulation(_disc(), archive=tmp_path / "cut", **kw)
+    cut.integrate(10.0, stop=lambda: next(looks) >= 2, on_interrupt="keep")
+    assert 1.0 < cut.t < 10.0  # (a snapshot, not an output asked for)
+    loaded = Simulation.load(tmp_path / "cut")
+    assert loaded.t == cut.t
+    assert _same(loaded.integrate(10.0).r[-1], whole.r[-1])
+    assert _same(cut.integrate(10.0).r[-1], whole.r[-1])  # (the run stopped, continued)
