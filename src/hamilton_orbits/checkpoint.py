@@ -424,25 +424,32 @@ class ArchiveWriter:
         return count
 
     def close(self) -> None:
-        """Close the segment being written and release the folder's lock."""
-        if self.segment is not None:
-            self.segment.close()
-            self.left = (self.segment.path, self.segment.size, self.count)
-            self.parked = self.segment if self.segment.legs else None
-            self.segment = None
-        if self.folder is not None:
-            self.folder.__exit__(None, None, None)
-            self.folder = None
+        """Close the segment being written and release the folder's lock (again after
+        a Ctrl-C amid them: the segment let go before its files are closed, the lock
+        after it is released)."""
+        seg, self.segment = self.segment, None
+        try:
+            if seg is not None:
+                self.left = (seg.path, seg.size, self.count)
+                self.parked = seg if seg.legs else None
+                seg.close()
+        finally:
+            if self.folder is not None:
+                self.folder.__exit__(None, None, None)
+                self.folder = None
 
     def lost(self) -> None:
         """After a snapshot whose writing did not end (Ctrl-C, an error): the segment
-        closed and left, so that the next snapshot begins a segment of its own at the
+        cut back to its counted records, closed and left, so that the next snapshot begins a segment of its own at the
         folder's next number, read from its files (the counts kept here may be behind
         them: a record written and counted in the file, not yet here)."""
-        if self.segment is not None:
-            self.segment.close()
-            self.segment = None
+        seg, self.segment = self.segment, None
         self.left = self.parked = None
+        if seg is not None:
+            try:
+                seg.trim()  # (no torn tail left by a write this process broke off)
+            finally:
+                seg.close()
 
     def times(self, t0: float, t1: float) -> np.ndarray:
         """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""

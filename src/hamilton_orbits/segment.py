@@ -125,6 +125,7 @@ class _Appender:
         #: the bytes the CRC-32 is of (all the record's but ``check``'s)
         self.signed = memoryview(self.buffer.data)[:-8]
         self.path, self.sync, self.count, self.end = path, sync, 0, len(header)
+        self.begin = len(header)  # (where the records begin)
         self.fd = write_bytes(path, header, sync=sync, keep_open=True)
         #: the count in the header, mapped (a store, not a system call, per append;
         #: its page is the file's own: a killed process leaves it written), or None
@@ -166,13 +167,31 @@ class _Appender:
         self.count += count
         self.end += len(data)
 
+    def trim(self) -> None:
+        """After a write that did not end (Ctrl-C, an error): the file cut back to the
+        records its header counts, and this appender's counts made the file's (a
+        record may have been written and counted there, not yet here)."""
+        if self.fd < 0:
+            return
+        try:
+            count = struct.unpack(">i", os.pread(self.fd, 4, NUMRECS_AT))[0]
+            end = self.begin + count * len(self.buffer.data)
+            os.ftruncate(self.fd, end)
+        except OSError:  # (left as it is: a torn tail is told apart on reading)
+            return
+        self.count, self.end = count, end
+
     def close(self) -> None:
-        if self.numrecs is not None:
-            self.numrecs.close()
-            self.numrecs = None
-        if self.fd >= 0:
-            os.close(self.fd)
-            self.fd = -1
+        """Close the file (each part let go before it is closed: a Ctrl-C amid them
+        leaves none to be closed twice, whose descriptor may be another's by then)."""
+        numrecs, self.numrecs = self.numrecs, None
+        fd, self.fd = self.fd, -1
+        try:
+            if numrecs is not None:
+                numrecs.close()
+        finally:
+            if fd >= 0:
+                os.close(fd)
 
     def reopen(self) -> bool:
         """Open the file closed by :meth:`close` again, to append after its last
@@ -479,11 +498,19 @@ class SegmentWriter:
         self._kept, self._last = ([], []), None
         return False
 
+    def trim(self) -> None:
+        """Cut the files back to their counted records (:meth:`_Appender.trim`)."""
+        self._file.trim()
+        if self._rows is not None:
+            self._rows.trim()
+
     def close(self) -> None:
         """Close the files (what was appended stays)."""
-        self._file.close()
-        if self._rows is not None:
-            self._rows.close()
+        try:
+            self._file.close()
+        finally:
+            if self._rows is not None:
+                self._rows.close()
 
     def reopen(self) -> bool:
         """Open the files closed by :meth:`close` again, to go on appending (a

@@ -1158,30 +1158,37 @@ def test_ctrl_c_as_the_lock_is_taken_or_before_the_steps_leaves_the_folder_free(
 
 
 @pytest.mark.parametrize("follow", ["end", "times"])
-def test_ctrl_c_after_a_record_is_counted_in_its_file_numbers_on(tmp_path, monkeypatch,
-                                                                  follow):
-    """Ctrl-C after a snapshot's record is written and counted in its segment, before
-    the writer had counted it (here as the record's arrays are kept for the next
-    refill): the next call numbers its snapshots on from the folder's files (it
-    used to number from one behind: two snapshots of one number, or a leg recorded
-    as beginning at the wrong snapshot, whose resume failed with a KeyError)."""
+@pytest.mark.parametrize("where", ["counted", "written"])
+def test_ctrl_c_amid_a_records_write_leaves_whole_snapshots_numbered_on(
+        tmp_path, monkeypatch, follow, where):
+    """Ctrl-C as a snapshot's record has been written and counted in its segment,
+    before the writer had counted it (here as the record's arrays are kept for the
+    next refill), or as it has been written, before it was counted: the archive
+    holds whole snapshots only, none torn (the segment cut back to its counted
+    records), and the next call numbers its snapshots on from the folder's files.
+    (It used to number from one behind: two snapshots of one number, or a leg
+    recorded as beginning at the wrong snapshot, whose resume failed with a
+    KeyError; and the write left a torn tail.)"""
     from hamilton_orbits import segment
 
     sim = Simulation(_disc(), method="wh", dt=0.01, archive=tmp_path, every=0.5)
     sim.integrate(np.linspace(0.0, 3.0, 7))
-    real = segment._joinable
+    name, real = (("_joinable", segment._joinable) if where == "counted"
+                  else ("pwrite", os.pwrite))
     calls = []
 
-    def counted_then_ctrl_c(arrays):
+    def then_ctrl_c(*args):
+        out = real(*args) if where == "written" else None
         calls.append(1)
-        if len(calls) == 2:
+        if len(calls) == 3:
             raise KeyboardInterrupt
-        return real(arrays)
+        return real(*args) if where == "counted" else out
 
-    monkeypatch.setattr(segment, "_joinable", counted_then_ctrl_c)
+    monkeypatch.setattr(segment if where == "counted" else os, name, then_ctrl_c)
     with pytest.raises(KeyboardInterrupt):
         sim.integrate(np.linspace(3.0, 6.0, 7))
     monkeypatch.undo()
+    assert Archive(tmp_path).torn == [] and not _lock(tmp_path)
     leg = sim.integrate(8.0 if follow == "end" else np.linspace(sim.t, 8.0, 5))
     archive = Archive(tmp_path)
     numbers = [s.number for s in archive.snapshots]
@@ -1292,3 +1299,33 @@ def test_a_fixed_step_run_goes_on_with_its_bits_from_a_snapshot_between_outputs(
     assert loaded.t == cut.t
     assert _same(loaded.integrate(10.0).r[-1], whole.r[-1])
     assert _same(cut.integrate(10.0).r[-1], whole.r[-1])  # (the run stopped, continued)
+
+
+def test_ctrl_c_as_a_segment_is_closed_closes_nothing_twice(tmp_path, monkeypatch):
+    """Ctrl-C as a segment's file has just been closed at the end of a call: the
+    folder is released and the call ends in ``KeyboardInterrupt``, not in an
+    ``OSError`` of a descriptor closed twice (which by then may be another file's);
+    the next call goes on."""
+    import sys
+
+    from hamilton_orbits import segment
+
+    real, hits = os.close, []
+
+    def close_then_ctrl_c(fd):
+        real(fd)
+        caller = sys._getframe(1).f_code
+        if caller.co_filename == segment.__file__ and not hits:
+            hits.append(fd)
+            raise KeyboardInterrupt
+
+    sim = Simulation(_disc(), method="wh", dt=0.01, archive=tmp_path, every=0.25)
+    sim.integrate(0.5)
+    monkeypatch.setattr(os, "close", close_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(1.0)
+    monkeypatch.undo()
+    assert hits and not _lock(tmp_path)
+    sim.integrate(1.5)
+    archive = Archive(tmp_path)
+    assert archive.times.tolist()[-3:] == [1.0, 1.25, 1.5] and archive.torn == []
