@@ -440,9 +440,10 @@ class ArchiveWriter:
 
     def lost(self) -> None:
         """After a snapshot whose writing did not end (Ctrl-C, an error): the segment
-        cut back to its counted records, closed and left, so that the next snapshot begins a segment of its own at the
-        folder's next number, read from its files (the counts kept here may be behind
-        them: a record written and counted in the file, not yet here)."""
+        cut back to its counted records, closed and left, so that the next snapshot
+        begins a segment of its own at the folder's next number, read from its files
+        (the counts kept here may be behind them: a record written and counted in the
+        file, not yet here)."""
         seg, self.segment = self.segment, None
         self.left = self.parked = None
         if seg is not None:
