@@ -378,6 +378,9 @@ class Simulation(Saving):
             out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
                                stop=stop, checkpoint=self._checkpoint(*archived[1:]),
                                pause=self._step_snapshots())
+            if prop.events is not None and prop.events.stopped_by is not None:
+                self._asked = None  # (stopped at an event's time: the next leg's steps
+                # are laid from there, and its snapshots with them)
             return requested_rows(out, archived[1])
         finally:
             if close is not None:
