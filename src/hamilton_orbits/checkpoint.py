@@ -396,8 +396,8 @@ class ArchiveWriter:
         if self.count and not self.continues:
             self.close()
             raise SnapshotError(
-                f"the archive {self.path} holds the snapshots of another run (0 to "
-                f"{self.count - 1}); continue that run with Simulation.load("
+                f"the archive {self.path} holds the snapshots of another run (the last "
+                f"numbered {self.count - 1}); continue that run with Simulation.load("
                 f"{str(self.path)!r}), or give this simulation another folder")
         self.continues = True
         parked, self.parked = self.parked, None

@@ -1227,7 +1227,7 @@ def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp
     for system in (_disc(), System(list(_disc().bodies)[:4])):
         sim = Simulation(system, archive=tmp_path / "a", **kw)
         with pytest.raises(SnapshotError, match=r"archive .*/a holds the snapshots of another "
-                                                r"run \(0 to 2\); continue that run with "
+                                                r"run \(the last numbered 2\); continue that run with "
                                                 r"Simulation\.load"):
             sim.integrate(1.0)
         assert sim.t == 0.0
