@@ -1329,3 +1329,30 @@ def test_ctrl_c_as_a_segment_is_closed_closes_nothing_twice(tmp_path, monkeypatc
     sim.integrate(1.5)
     archive = Archive(tmp_path)
     assert archive.times.tolist()[-3:] == [1.0, 1.25, 1.5] and archive.torn == []
+
+
+J2_SUN = {"name": "j2", "body": "sun"}
+
+
+def test_dop853_stopped_by_a_collision_writes_no_snapshot_after_the_stop(tmp_path):
+    """dop853 stopped by a collision between two scheduled snapshot times: its row
+    at the contact is not an output reached (as radau15's is not), so no snapshot
+    is written at the scheduled time after it (one used to hold the contact state
+    under that later time, and a resume from it passed through the collision), and
+    the call resumed is the call."""
+    ph = 5.76
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005, j2=1e-3),
+                Body("a", 1e-3, [1.0, 0, 0], [0, 1.0, 0], radius=0.05),
+                Body("b", 1e-3, [1.3 * np.cos(ph), 1.3 * np.sin(ph), 0],
+                     [-0.75 * np.sin(ph), 0.75 * np.cos(ph), 0.0], radius=0.05),
+                Body("c", 1e-4, [2.5, 0, 0], [0, 0.63, 0.0], radius=0.02)])
+    seen = []
+    sim = Simulation(s, method="dop853", effects=[{"name": "gr", "c": 10.0}, J2_SUN],
+                     events=["collision"], archive=tmp_path, every=2.0)
+    call = sim.integrate(np.arange(1.0, 31.0), on_output=lambda i, steps: seen.append(i))
+    assert call.stopped_by is not None and 4.0 < call.t[-1] < 5.0
+    assert seen == list(range(1, len(call.t) - 1))  # (not the stop's row)
+    assert Archive(tmp_path).times.max() <= call.t[-1]
+    resumed = Simulation.load(tmp_path).resume()
+    assert resumed.t.tolist() == call.t.tolist() and _same(resumed.r, call.r)
+    assert resumed.stopped_by is not None

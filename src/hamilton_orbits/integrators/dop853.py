@@ -121,13 +121,13 @@ class _State:
         time); ``stop`` is asked at the outputs only (by the engine)."""
         n, first = self.n, self.steps
 
-        def store(i: int, steps: int, y: np.ndarray) -> None:
+        def store(i: int, steps: int, y: np.ndarray, reached: bool = True) -> None:
             r_out[i] = y[: 3 * n].reshape(n, 3)
             v_out[i] = y[3 * n :].reshape(n, 3)
             if self.log is not None:
                 self.log.mask(r_out[i], v_out[i])
-            if on_output is not None:
-                on_output(i, steps - first)
+            if on_output is not None and reached:  # (not a row of an event that stopped
+                on_output(i, steps - first)  # the run before ``t_out[i]``: as radau15's)
 
         if self.log is not None and len(self.log.watch):
             self._with_events(t_out, store, first)
@@ -140,7 +140,7 @@ class _State:
         solve(self.f, self.y, t_out, rtol=self.tol, atol=self.atol, max_step=self.max_step,
               on_state=keep, max_steps=self.max_steps)
 
-    def _with_events(self, t_out: np.ndarray, store: Callable[[int, int, np.ndarray], None],
+    def _with_events(self, t_out: np.ndarray, store: Callable[..., None],
                      first: int) -> None:
         """DOP853 step by step (scipy's stepper, as ``solve_ivp`` drives it) with every
         step scanned for events on the cubic Hermite interpolant of its ends, before
@@ -176,7 +176,7 @@ class _State:
                 stop = log.act(int(row), self.t, r, v, self.gm)
                 self.y = np.concatenate((r.ravel(), v.ravel()))
                 if stop:
-                    store(i, self.steps, self.y)
+                    store(i, self.steps, self.y, reached=False)
                     raise StopAtEvent(i, self.t, self.steps - first)
                 solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
                                  atol=self.atol, max_step=self.max_step)
