@@ -1227,8 +1227,8 @@ def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp
     for system in (_disc(), System(list(_disc().bodies)[:4])):
         sim = Simulation(system, archive=tmp_path / "a", **kw)
         with pytest.raises(SnapshotError, match=r"archive .*/a holds the snapshots of another "
-                                                r"run \(the last numbered 2\); continue that run with "
-                                                r"Simulation\.load"):
+                                                r"run \(the last numbered 2\); continue that "
+                                                r"run with Simulation\.load"):
             sim.integrate(1.0)
         assert sim.t == 0.0
     assert sorted(p.name for p in (tmp_path / "a").iterdir()) == before
