@@ -61,18 +61,66 @@ def test_a_killed_scene_run_resumes_to_the_files_of_the_whole_run(tmp_path, caps
 
 
 def test_run_refuses_a_folder_holding_an_earlier_run_s_archive(tmp_path, capsys):
+    """Refused before anything runs: exit 2, as any bad command line (docs/scenes.md;
+    it was 1, a failure during the run)."""
     assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 0
-    assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 1
+    assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 2
     assert "holds the snapshots of an earlier run: resume it" in capsys.readouterr().err
 
 
 def test_resume_names_a_folder_without_an_archive(tmp_path, capsys):
-    assert main(["resume", str(tmp_path)]) == 1
+    assert main(["resume", str(tmp_path)]) == 2
     assert "is not the output folder of a scene run with an archive" in (
         capsys.readouterr().err)
 
 
-@pytest.mark.parametrize("value", ["-3 d", "3 m", "soon"])
+def test_a_run_whose_out_is_named_after_its_bundled_scene_resumes(tmp_path, monkeypatch,
+                                                                  capsys):
+    """``run comet-encounter --out comet-encounter``: the folder the run makes does not
+    hide the bundled scene of its name (the archive used to record the folder as the
+    scene's file, and resume failed: "cannot read the scene file (Is a directory)");
+    resumed, the summary says its integration time is that since the resume."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "comet-encounter", "--out", "comet-encounter", *SETS]) == 0
+    capsys.readouterr()
+    assert main(["resume", "comet-encounter", "--no-progress"]) == 0
+    assert "s of integration since the resume at t = 30 d" in capsys.readouterr().out
+    assert main(["run", "comet-encounter", "--out", "other", *SETS]) == 0
+
+
+def test_resume_runs_the_scene_as_the_run_read_it(tmp_path, capsys):
+    """A scene file edited (or gone) after its run began: resume runs the scene the
+    run read, kept in the archive, and says the file has changed (it used to read the
+    file again: another duration, other bodies' names on the run's states)."""
+    from importlib import resources
+
+    text = (resources.files("hamilton_orbits") / "data" / "scenes" /
+            "comet-encounter.toml").read_text(encoding="utf-8")
+    scene = tmp_path / "my scene.toml"
+    scene.write_text(text, encoding="utf-8")
+    out = tmp_path / "out put"
+    assert main(["run", str(scene), "--out", str(out), *SETS]) == 0
+    assert f"hamilton-orbits resume '{out}'" in capsys.readouterr().err  # (quoted)
+    whole = _states(out)
+    scene.write_text(text.replace('duration = "', 'duration = "2 yr" # "'), encoding="utf-8")
+    assert main(["resume", str(out), "--no-progress"]) == 0
+    assert "has changed since the run began; resuming the scene as the run read it" in (
+        capsys.readouterr().err)
+    resumed = _states(out)
+    assert all(np.array_equal(resumed[k], whole[k], equal_nan=True) for k in whole)
+    scene.unlink()
+    assert main(["resume", str(out), "--no-progress"]) == 0
+
+
+def test_an_archive_folder_that_cannot_be_made_is_refused_before_the_run(tmp_path, capsys):
+    (tmp_path / "archive").write_text("a file where the archive goes")
+    assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 2
+    err = capsys.readouterr().err
+    assert f"--out {tmp_path}: cannot write {tmp_path / 'archive'}" in err
+    assert "nothing was run" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("value", ["-3 d", "3 m", "soon", "1e-3 s"])
 def test_a_bad_archive_interval_is_a_bad_scene(value, capsys):
     sets = ["--set", f"output.archive_every={value}", "--set", "duration=1 d"]
     assert main(["run", "comet-encounter", *sets, "--no-progress"]) == 2

@@ -32,6 +32,7 @@ itself (docs/design.md).
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 from collections.abc import Sequence
 from typing import Any
@@ -110,16 +111,34 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
-def _load_scene(ref: str, sets: Sequence[str]):
-    """A scene from a bundled name or a file path, with ``--set`` overrides applied."""
+def _scene_file(ref: str):
+    """The scene file ``ref`` names (a path ending in ``.toml``, or a file that
+    exists), or None for a bundled scene's name (a folder of that name, such as the
+    run's own ``--out``, does not hide it)."""
     from pathlib import Path
 
-    from hamilton_orbits.scene import Scene, SceneError
+    path = Path(ref)
+    return path if ref.endswith(".toml") or path.is_file() else None
 
-    if ref.endswith(".toml") or Path(ref).exists():
+
+def _load_scene(ref: str, sets: Sequence[str], text: str | None = None):
+    """A scene from a bundled name or a file path (``text``: the text it had, as an
+    archived run recorded it), with ``--set`` overrides applied."""
+    from hamilton_orbits.scene import Scene
+
+    if text is not None:
+        scene = Scene.from_text(text, ref)
+    elif _scene_file(ref) is not None:
         scene = Scene.from_toml(ref)
     else:
         scene = Scene.bundled(ref)
+    return _with_sets(scene, sets)
+
+
+def _with_sets(scene, sets: Sequence[str]):
+    """``scene`` with the ``--set KEY=VALUE`` overrides ``sets`` applied."""
+    from hamilton_orbits.scene import SceneError
+
     values = {}
     for item in sets:
         key, sep, value = item.partition("=")
@@ -181,12 +200,11 @@ def _compile_ahead(ref: str, sets: Sequence[str]) -> None:
     of a radau15 ``nbody`` scene sent to compile in a second process on a first run,
     from the scene's own text (the run itself sends it when this cannot tell)."""
     from importlib import resources
-    from pathlib import Path
 
     import tomllib
 
     try:
-        path = (Path(ref) if ref.endswith(".toml") or Path(ref).exists() else
+        path = (_scene_file(ref) or
                 resources.files("hamilton_orbits") / "data" / "scenes" / f"{ref}.toml")
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
         method = raw.get("integrator", {}).get("method")
@@ -210,22 +228,37 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     import json
     from pathlib import Path
 
+    from hamilton_orbits._outdir import FolderError
     from hamilton_orbits.checkpoint import snapshot_files
 
     every = scene.spec.get("output", {}).get("archive_every")
     if every is None:
         return None
     archive = Path(folder) / "archive"
+    resume = f"hamilton-orbits resume {shlex.quote(str(folder))}"
     if snapshot_files(archive):
         raise _CommandError(f"{archive} holds the snapshots of an earlier run: resume it "
-                            f"(hamilton-orbits resume {folder}) or choose another --out")
-    archive.mkdir(parents=True, exist_ok=True)
-    source = str(Path(ref).resolve()) if ref.endswith(".toml") or Path(ref).exists() else ref
-    (archive / "scene.json").write_text(json.dumps({"scene": source, "set": list(sets)}),
-                                        encoding="utf-8")
-    print(f"archiving every {every} to {archive}/ (a killed run resumes with: "
-          f"hamilton-orbits resume {folder})", file=sys.stderr)
+                            f"({resume}) or choose another --out")
+    file = _scene_file(ref)
+    source = ref if file is None else str(file.resolve())
+    record = {"scene": source, "set": list(sets), "text": _scene_text(file, ref)}
+    try:  # (the scene's text kept: a resume runs the scene this run ran)
+        archive.mkdir(parents=True, exist_ok=True)
+        (archive / "scene.json").write_text(json.dumps(record), encoding="utf-8")
+    except OSError as exc:
+        raise FolderError(f"--out {folder}: cannot write {archive} "
+                          f"({exc.strerror or exc}); nothing was run") from None
+    print(f"archiving every {every} to {archive}/ (a killed run resumes with: {resume})",
+          file=sys.stderr)
     return archive
+
+
+def _scene_text(file, ref: str) -> str:
+    """The text of the scene file ``file``, or of the bundled scene ``ref``."""
+    from importlib import resources
+
+    path = file or resources.files("hamilton_orbits") / "data" / "scenes" / f"{ref}.toml"
+    return path.read_text(encoding="utf-8")
 
 
 def _resume(out: str, progress: bool) -> int:
@@ -241,7 +274,13 @@ def _resume(out: str, progress: bool) -> int:
         raise _CommandError(f"{folder} is not the output folder of a scene run with an "
                             f"archive (no {record})")
     source = json.loads(record.read_text(encoding="utf-8"))
-    scene = _load_scene(source["scene"], source["set"])
+    text = source.get("text")  # (the scene as the run ran it; none in older archives)
+    scene = _load_scene(source["scene"], source["set"], text)
+    file = _scene_file(source["scene"])
+    if text is not None and file is not None and file.is_file() and \
+            file.read_text(encoding="utf-8") != text:
+        print(f"hamilton-orbits: {file} has changed since the run began; resuming the "
+              f"scene as the run read it (kept in {record})", file=sys.stderr)
     with OutputFolder(folder, "output folder"):
         result = _run_scene(scene, progress, folder / "archive")
         return _finish(scene, result, folder, folder / "archive")
@@ -261,7 +300,7 @@ def _finish(scene, result, folder, archive) -> int:
     print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
     if not result.complete and archive is not None:
         print(f"the run was interrupted; its archive is {archive}/: continue it with "
-              f"hamilton-orbits resume {folder}")
+              f"hamilton-orbits resume {shlex.quote(str(folder))}")
     return EXIT_OK if result.complete else EXIT_INTERRUPTED
 
 
@@ -541,9 +580,9 @@ def _guarded(args: argparse.Namespace) -> int:
     except FolderError as exc:
         _error(str(exc))
         return EXIT_BAD_SCENE
-    except _CommandError as exc:
+    except _CommandError as exc:  # (a bad command line: nothing was run)
         _error(str(exc))
-        return EXIT_FAILED
+        return EXIT_BAD_SCENE
     except KeyboardInterrupt:  # a second Ctrl-C, or one before any output
         _error("interrupted (Ctrl-C)")
         return EXIT_INTERRUPTED

@@ -21,7 +21,8 @@ import astropy.units as u
 
 from hamilton_orbits import schema as S
 
-__all__ = ["BUILT_IN", "GROUP", "KINDS", "OUTPUT_LIMIT", "SceneKind", "check_output_size",
+__all__ = ["BUILT_IN", "GROUP", "KINDS", "OUTPUT_LIMIT", "SNAPSHOT_BYTES", "SceneKind",
+           "check_archive_size", "check_output_size",
            "format_table", "format_value", "register_kind", "registered_kinds"]
 
 
@@ -139,6 +140,31 @@ def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output:
         f"{n:.4g} outputs of {what} would take {_size(nbytes)} of memory, beyond the limit of "
         f"{_size(OUTPUT_LIMIT)}: choose a cadence of at least {shortest:.3g} or a shorter "
         "duration")
+
+
+#: a generous bound on an archive snapshot's bytes per body (radau15's predictor
+#: values and compensated sums, about 60 float64 a body; the variational equations'
+#: tangent vectors add as much again), and per snapshot beside them
+SNAPSHOT_BYTES = (1000, 4096)
+
+
+def check_archive_size(spec: Mapping[str, Any], problems: S.Problems, bodies: int) -> None:
+    """Refuse an ``[output] archive_every`` so short against ``duration`` that the
+    archive would exceed :data:`OUTPUT_LIMIT` on disk (its snapshots of ``bodies``
+    bodies, :data:`SNAPSHOT_BYTES` each at most), at loading, not after filling the
+    disk."""
+    every, duration = spec.get("output", {}).get("archive_every"), spec.get("duration")
+    if every is None or duration is None:
+        return
+    n = float((duration / every).to_value(u.one)) + 1.0
+    each = SNAPSHOT_BYTES[0] * max(bodies, 1) + SNAPSHOT_BYTES[1]
+    if n * each <= OUTPUT_LIMIT:
+        return
+    shortest = (duration * each / OUTPUT_LIMIT).to(every.unit)
+    problems.add("output.archive_every",
+                 f"{n:.4g} snapshots of {bodies} bodies would take up to {_size(n * each)} "
+                 f"on disk, beyond the limit of {_size(OUTPUT_LIMIT)}: choose an "
+                 f"archive_every of at least {shortest:.3g}")
 
 
 def format_value(value: Any) -> str:

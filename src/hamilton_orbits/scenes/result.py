@@ -41,6 +41,9 @@ class Result:
         The axes of the states (and their origin), named in the summary.
     wall_time : float
         Seconds of the integration proper: no compilation (see ``compile_time``).
+    resumed_from : Quantity or None
+        The simulation time a resumed run went on from (``hamilton-orbits
+        resume``): ``wall_time`` is then that of the part after it alone.
     compile_time : float
         Seconds spent compiling kernels during the run (numba's compile events;
         0 when everything came from the cache), apart from ``wall_time``.
@@ -63,6 +66,7 @@ class Result:
     tables: dict[str, list[dict]] = field(default_factory=dict)
     states: dict[str, Any] = field(default_factory=dict)
     wall_time: float = 0.0
+    resumed_from: Any = None
     complete: bool = True
     frame: str = ""
     compile_time: float = 0.0
@@ -97,8 +101,10 @@ class Result:
             span = span.to(asked.unit)
         elif span > 1 * u.yr:
             span = span.to(u.yr)
-        lines.append(f"simulated: {format_value(span)} in {self.wall_time:.2f} s of integration "
-                     "(compilation apart)")
+        since = ("" if self.resumed_from is None else
+                 f" since the resume at t = {format_value(self.resumed_from.to(span.unit))}")
+        lines.append(f"simulated: {format_value(span)} in {self.wall_time:.2f} s of integration"
+                     f"{since} (compilation apart)")
         if self.compile_count:
             from hamilton_orbits.firstrun import describe  # numba: only once compiled
 
@@ -150,6 +156,7 @@ class Result:
             "complete": self.complete,
             "frame": self.frame,
             "wall_time_s": self.wall_time,
+            "resumed_from": None if self.resumed_from is None else conv(self.resumed_from),
             "compile_time_s": self.compile_time,
             "compile_count": self.compile_count,
             "metrics": {k: conv(v) for k, v in self.metrics.items()},

@@ -314,11 +314,32 @@ class Scene:
         except UnicodeDecodeError as exc:
             raise SceneError([f"{p}: not a scene file: not text in UTF-8 (byte "
                               f"{exc.object[exc.start]:#04x} at offset {exc.start})"]) from None
+        return cls.from_text(text, str(p))
+
+    @classmethod
+    def from_text(cls, text: str, source: str) -> Scene:
+        r"""A scene from the text of a scene file (``source``: the file, for messages).
+
+        Raises
+        ------
+        SceneError
+            For a TOML syntax error (with the line) or any invalid key.
+
+        Examples
+        --------
+        >>> text = "\n".join(['kind = "rotation"', 'duration = "60 s"', 'cadence = "1 s"',
+        ...                   '[body]', 'moments = ["1 kg m2", "2 kg m2", "3 kg m2"]',
+        ...                   'omega = ["0.001 rad/s", "2 rad/s", "0.001 rad/s"]',
+        ...                   '[integrator]', 'dt = "1 ms"'])
+        >>> scene = Scene.from_text(text, "mine.toml")
+        >>> scene.kind, scene.source
+        ('rotation', 'mine.toml')
+        """
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
-            raise SceneError([f"{p}: TOML syntax error: {exc}"]) from exc
-        return cls(data, str(p), text=text)
+            raise SceneError([f"{source}: TOML syntax error: {exc}"]) from exc
+        return cls(data, source, text=text)
 
     @staticmethod
     def _bundled_dir():

@@ -15,7 +15,7 @@ import numpy as np
 from hamilton_orbits import effects as _effects
 from hamilton_orbits import schema as S
 from hamilton_orbits.integrators import WH_CORRECTORS
-from hamilton_orbits.scenes.base import check_output_size
+from hamilton_orbits.scenes.base import check_archive_size, check_output_size
 from hamilton_orbits.scenes.nbody.build import (
     attempt,
     build_system,
@@ -66,6 +66,7 @@ def check(spec: dict, problems: S.Problems) -> None:
     check_output_size(spec, problems, per_output,
                       f"{len(names)} bodies" + (" (and rebound's copy)" if spec["crosscheck"]
                                                 else ""))
+    check_archive_size(spec, problems, len(names))
     if not problems:
         _check_buildable(spec, problems)
 

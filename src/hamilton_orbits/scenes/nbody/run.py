@@ -79,8 +79,10 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     bar = progress_bar(len(times) - 1, progress, "output")
     on_output = None if bar is None else (lambda i, steps: bar.update(1))
     try:
+        resumed_from = None
         if spec["output"]["archive_every"] is not None and resumable(archive):
             sim = Simulation.load(archive)
+            resumed_from = sim.t if isinstance(sim.t, u.Quantity) else sim.t * u.d
             traj = sim.resume(stop=stop, on_interrupt="keep", on_output=on_output)
         else:
             sim = simulation(spec, system, archive)
@@ -91,6 +93,7 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     if len(traj.t) < 2:
         raise KeyboardInterrupt
     result = _result(scene, system, traj, sim.effects)
+    result.resumed_from = resumed_from
     _events_into(result, traj)
     _chaos_into(result, traj)
     for an in spec["analysis"]:
@@ -239,5 +242,8 @@ def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> No
     result.tables["cross-check against rebound: codes"] = table.code_rows
     result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
     result.metrics["rebound wall time (s)"] = table.wall_time["rebound"]
+    if result.resumed_from is not None:  # (ours: the part since the resume alone)
+        result.metrics["our wall time"] = (f"since the resume at t = "
+                                           f"{result.resumed_from.to(u.yr):.6g} only")
     result.metrics["max relative position difference"] = float(
         table.relative_position_difference.max())
