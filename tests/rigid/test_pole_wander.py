@@ -102,3 +102,27 @@ def test_scipy_dop853_agrees_with_the_exact_rigid_earth():
     dop = earth.simulate_wobble(200 * u.day, method="dop853")
     exact = earth.simulate_wobble(200 * u.day, method="exact")
     assert np.max(np.abs(dop.m - exact.m)) < _FLOOR * np.max(np.abs(exact.m))
+
+
+@pytest.mark.parametrize(("dt", "pattern"), [
+    (0 * u.s, r"`dt` > 0 and at most 1 day"),      # (was a ZeroDivisionError)
+    (-1 * u.hour, r"`dt` > 0 and at most 1 day"),  # (was run with a step of 1 day)
+    (1 * u.yr, r"`dt` > 0 and at most 1 day"),     # (idem)
+    (np.nan * u.s, r"`dt` to be finite"),
+])
+def test_simulate_wobble_refuses_a_step_it_cannot_take(dt, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        earth.simulate_wobble(10 * u.day, dt=dt)
+
+
+@pytest.mark.parametrize(("omega", "pattern"), [
+    ([1e-6, 0.0, 0.0], r"`omega` finite with omega_z != 0 .* at index \(\)"),
+    ([[1e-6, 0.0, 1.0], [np.nan, 0.0, 1.0]], r"`omega` finite .* at index \(1,\)"),
+    ([1.0, 0.0, 1.0] * u.m, r"`omega`: "),
+])
+def test_pole_path_refuses_an_omega_without_a_pole(omega, pattern):
+    """``m = omega_xy / omega_z``: omega_z = 0 or a NaN used to give inf or NaN
+    silently (a divide-by-zero warning), a length an error that did not name
+    ``omega``."""
+    with pytest.raises(ValueError, match=pattern):
+        earth.pole_path(omega)

@@ -51,9 +51,17 @@ def pole_path(omega: Any) -> np.ndarray:
     >>> pole_path([[1e-6, 0.0, 1.0], [0.0, -2e-6, 1.0]])
     array([1.e-06+0.e+00j, 0.e+00-2.e-06j])
     """
-    w = _float(omega, u.rad / u.s)
+    try:
+        w = _float(omega, u.rad / u.s)
+    except u.UnitConversionError as exc:
+        raise u.UnitConversionError(f"`omega`: {exc}") from None
     if w.shape[-1:] != (3,):
         raise ValueError(f"Expected `omega` to have shape (..., 3), got {w.shape}")
+    bad = ~np.isfinite(w).all(axis=-1) | (w[..., 2] == 0.0)
+    if bad.any():
+        at = tuple(int(k) for k in np.argwhere(bad)[0])
+        raise ValueError(f"Expected `omega` finite with omega_z != 0 (the pole is "
+                         f"omega_xy / omega_z), got {w[at]!r} at index {at}")
     return (w[..., 0] + 1j * w[..., 1]) / w[..., 2]
 
 
@@ -141,8 +149,11 @@ def simulate_wobble(
         omega = integrate(body, t, method=method).omega
     else:
         step = TIME("dt", dt, u.s)
+        if step.shape != () or not 0.0 < float(step) <= 86400.0:
+            raise ValueError(f"Expected `dt` > 0 and at most 1 day (the outputs are "
+                             f"daily), got {dt!r}")
         # a whole number of steps per day so that the output falls on whole days
-        per_day = max(1, int(np.ceil(86400.0 / float(step))))
+        per_day = int(np.ceil(86400.0 / float(step)))
         tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
         t, omega = tr.t, tr.omega
     return PolePath(t=u.Quantity(t, u.s).to(u.day), m=pole_path(omega), method=method)
