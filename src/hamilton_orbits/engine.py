@@ -219,6 +219,12 @@ class Propagation:
         if watched and backward and np.any(self.events.watch[:, W_ACTION] != ACTIONS["record"]):
             raise ValueError("Events with an action (stop, merge, remove) are watched forwards "
                              "in time only; a backward run records them (action 'record')")
+        if backward and self.events is not None and (self.events.gone
+                                                     or self.events.gm_changes):
+            raise ValueError(f"This run merged or removed bodies (events) before t = "
+                             f"{self.t!r}: it goes on forwards only (backwards the bodies "
+                             f"would not come apart); start a new run from the state "
+                             f"reached to integrate it backwards")
 
     def driver_for(self, backward: bool) -> Any:
         """The driver's state for a leg in this direction (a new one from the state
@@ -277,6 +283,11 @@ class Propagation:
         if events is not None:
             first_event = len(events.recorded())
             events.stopped_by = None
+        if (events is not None and self.driver is not None and not backward
+                and not self.backward and events.overlapping(self.r)):
+            self.steps_before += self.driver.steps  # (bodies in contact where a leg
+            self.driver = None  # begins, as after a stop at a collision: they collide
+            # at its start, as at a first leg's, with a driver made afresh after it)
         driver = self.driver if self.driver is not None and backward == self.backward \
             else self.driver_for(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block

@@ -422,6 +422,16 @@ class EventLog:
         self.drain()
         return np.array(self.rows).reshape(-1, N_EVENT_COLUMNS)
 
+    def overlapping(self, r: np.ndarray) -> bool:
+        """Whether two bodies of a watched collision pair overlap at positions ``r``
+        (``|r_i - r_j| <= R_i + R_j``: a collision no crossing will reveal)."""
+        rows = np.flatnonzero(self.watch[:, W_CODE] == EVENTS["collision"][0])
+        if not rows.size:
+            return False
+        pairs = self.watch[rows][:, [W_I, W_J]].astype(int)
+        d = np.linalg.norm(r[pairs[:, 0]] - r[pairs[:, 1]], axis=1)
+        return bool(np.any(d <= self.watch[rows, W_DIST]))
+
     def at_start(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
         """Collisions already made at the start ``t`` of a run: every watched pair that
         overlaps there (``|r_i - r_j| <= R_i + R_j``, which no crossing will reveal) is
