@@ -50,6 +50,8 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
     ``t_now`` (added first if missing), with the caller's unit."""
     if type(t) is float and not quantity and t != t_now and math.isfinite(t):
         return np.array([t_now, t]), None  # an end time in the caller's units: the common case
+    if isinstance(t, (bool, np.bool_)):
+        raise ValueError(f"Expected `t` to be a time or an array of times, got {t!r}")
     if quantity and not is_quantity(t):
         raise ValueError(f"Expected `t` as a time Quantity for a Quantity system, got {t!r}")
     if not quantity and is_quantity(t):

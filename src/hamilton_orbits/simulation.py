@@ -172,15 +172,18 @@ class Simulation(Saving):
         if not isinstance(system, System):
             raise ValueError(f"Expected `system` to be a System, got {system!r}")
         typed = method_of(method, method_options)
-        eff = check_effects(typed, effects)
+        eff = check_effects(typed, () if effects is None else effects)
         step = None if dt is None else time_step(dt, system.quantity)
         tol = tolerance(tol)
         tan = tangent_of(system, variational, stm, tangent, typed)
+        log = event_log(system, events)
+        if tan is not None and log is not None and len(log.watch):  # (refused here, once)
+            raise ValueError("The variational equations are integrated without events; list "
+                             "no events, or integrate them apart")
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
-                                        tol=tol, events=event_log(system, events),
-                                        variational=tan)
+                                        tol=tol, events=log, variational=tan)
         self._system, self._effects, self._quantity = system, eff, system.quantity
         #: the state at time 0, from which Hamilton's integrals are measured (None
         #: until a first leg has begun there)
@@ -309,6 +312,9 @@ class Simulation(Saving):
         if on_interrupt not in ("raise", "keep"):
             raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
                              f"{on_interrupt!r}")
+        for name, given in (("on_output", on_output), ("stop", stop)):
+            if given is not None and not callable(given):  # (not after the first output)
+                raise ValueError(f"Expected `{name}` to be callable or None, got {given!r}")
         prop = self._prop
         times, unit = leg_times(t, prop.t, self._quantity)
         if unit is not None:

@@ -582,3 +582,36 @@ def test_ctrl_c_in_a_one_interval_run_stops_it_promptly(tmp_path):
     _, err = proc.communicate(timeout=120)
     assert time.perf_counter() - start < 30.0, err
     assert proc.returncode == 130 and "stopping" in err, err
+
+
+def _pair_with_radii():
+    return System([Body("a", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01),
+                   Body("b", 1e-3, [1.0, 0, 0], [0, 1.0, 0], radius=0.01)])
+
+
+@pytest.mark.parametrize(("kw", "pattern"), [
+    (dict(t=True), r"Expected `t` to be a time or an array of times, got True"),
+    (dict(t=1.0, on_output=3), r"Expected `on_output` to be callable or None, got 3"),
+    (dict(t=1.0, stop="soon"), r"Expected `stop` to be callable or None, got 'soon'"),
+])
+def test_integrate_refuses_a_bool_time_or_a_callback_that_is_not_one(kw, pattern):
+    """``t=True`` used to run to t = 1; a callback that is not callable failed with
+    a bare TypeError after the first output, the run gone on to it."""
+    from hamilton_orbits import Simulation
+
+    sim = Simulation(_pair_with_radii())
+    with pytest.raises(ValueError, match=pattern):
+        sim.integrate(**kw)
+    assert sim.t == 0.0 and sim.steps == 0
+
+
+def test_a_simulation_takes_no_effects_as_none_and_refuses_events_with_variational_at_once():
+    """``effects=None`` is no effect (as ``events=None``; it was a bare TypeError);
+    the variational equations with events are refused when the simulation is made,
+    not at its first ``integrate``."""
+    from hamilton_orbits import Simulation
+
+    assert Simulation(_pair_with_radii(), effects=None).integrate(1.0).t.tolist() == [0.0, 1.0]
+    with pytest.raises(ValueError, match=r"variational equations are integrated without "
+                                         r"events"):
+        Simulation(_pair_with_radii(), variational=True, events=["collision"])
