@@ -392,6 +392,8 @@ class EventLog:
         rows = self.buffer[:k].copy()
         if self.sign < 0:  # (found in s = -t; distances and speeds are the same)
             np.negative(rows[:, E_TIME], out=rows[:, E_TIME])
+        if k > 1:  # (a step's rows come in the watch list's order: put in time's)
+            rows = rows[np.argsort(self.sign * rows[:, E_TIME], kind="stable")]
         if self.index_map is not None:
             rows[:, E_I] = self.index_map[rows[:, E_I].astype(int)]
             pair = rows[:, E_J] >= 0
@@ -469,11 +471,14 @@ class EventLog:
         # what the scan found later in the same step did not happen: the run goes on
         # (or ends) from the event's time
         self.rows = [x for x in self.rows if x[E_TIME] <= t]
-        _, i, j, _, action = self.watch[row]
+        code, i, j, _, action = self.watch[row]
         i, j, action = int(i), int(j), int(action)
-        if action == ACTIONS["stop"]:
+        if action == ACTIONS["stop"]:  # (the row of this watch entry: another of the same
+            # pair, recording at another distance, may be later in the rows)
             self.stopped_by = next(k for k in range(len(self.rows) - 1, -1, -1)
-                                   if self.rows[k][E_I] == i and self.rows[k][E_J] == j)
+                                   if self.rows[k][E_I] == i and self.rows[k][E_J] == j
+                                   and self.rows[k][E_CODE] == code
+                                   and self.rows[k][E_ACTION] == action)
             return True
         if action == ACTIONS["merge"]:
             m = gm[i] + gm[j]

@@ -428,3 +428,23 @@ def test_a_run_that_merged_or_removed_bodies_is_refused_backwards(event, method)
     assert sim.t == t
     sim.integrate(t + 0.5)  # (forwards it goes on)
     assert sim.t == t + 0.5
+
+
+@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="wh", dt=0.01),
+                                dict(method="dop853", tol=1e-12)])
+def test_stopped_by_is_the_stop_and_rows_are_in_time_order(kw):
+    """Two escapes watched for one body in one step, a record at 4.999 and a stop at
+    5: the rows are in the order of their times, and ``stopped_by`` is the stop's
+    row (it was the record's, the last row of the same body, and the rows came in
+    the watch list's order)."""
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("b", 0.5, [1.0, 0, 0], [2.0, 0, 0])])
+    events = [{"name": "escape", "distance": 5.0, "action": "stop"},
+              {"name": "escape", "distance": 4.999}]
+    traj = integrate(system, 8.0, events=events, **kw)
+    times = list(traj.events["time"].value if hasattr(traj.events["time"], "value")
+                 else traj.events["time"])
+    assert len(times) == 2 and times == sorted(times)
+    assert traj.stopped_by["action"] == "stop" and traj.stopped_by["distance"] == 5.0
+    # (radau15 and dop853 stop at the event's time, wh at the end of its step)
+    assert 0.0 <= traj.t[-1] - traj.stopped_by["time"] <= kw.get("dt", 0.0)
