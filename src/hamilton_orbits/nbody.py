@@ -420,10 +420,12 @@ class System(InitialStates):
         return f"System({names_repr(self.names)}{', au/day' if self._quantity else ''})"
 
     def with_state(self, r: np.ndarray, v: np.ndarray, gm: np.ndarray | None = None,
-                   keep: np.ndarray | None = None, *, check: bool = True) -> System:
+                   keep: np.ndarray | None = None, *, check: bool = True,
+                   radius: np.ndarray | None = None) -> System:
         """The same bodies at internal-unit positions ``r`` and velocities ``v`` (n, 3);
-        with ``gm`` (n,) their new ``G m`` (after merges), and with the boolean
-        ``keep`` (n,) only the bodies it marks (after removals).
+        with ``gm`` (n,) their new ``G m`` and ``radius`` (n,) their new radii (after
+        merges), and with the boolean ``keep`` (n,) only the bodies it marks (after
+        removals).
 
         The new system shares the names, radii, J2 and poles (read-only arrays) and
         copies the state once: no :class:`Body` object is made until one is asked
@@ -457,7 +459,8 @@ class System(InitialStates):
         gm = self._gm if gm is None else np.array(gm, dtype=np.float64)
         if check and gm.shape != self._gm.shape:
             raise ValueError(f"Expected `gm` to have shape {self._gm.shape}, got {gm.shape}")
-        arrays = (gm, r, v, self._radius, self._j2, self._pole)
+        radius = self._radius if radius is None else np.array(radius, dtype=np.float64)
+        arrays = (gm, r, v, radius, self._j2, self._pole)
         names, index = self._names, self._index
         if keep is not None and not np.all(keep):
             keep = np.asarray(keep, dtype=bool)

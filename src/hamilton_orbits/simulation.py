@@ -234,7 +234,9 @@ class Simulation(Saving):
         event took out of the run are left out)."""
         p = self._prop
         keep = None if p.events is None or not p.events.inactive.any() else ~p.events.inactive
-        return self._system.with_state(p.r, p.v, gm=p.gm, keep=keep, check=False)
+        radius = None if p.events is None else p.events.radius  # (merged bodies' own)
+        return self._system.with_state(p.r, p.v, gm=p.gm, keep=keep, check=False,
+                                       radius=radius)
 
     @property
     def effects(self) -> EffectSet:

@@ -248,8 +248,9 @@ class Trajectory(TrajectoryBase):
     @functools.cached_property
     def final(self) -> Any:
         """The system at the last output time."""
-        system, r, v, gm, keep = self._final_source
-        return system.with_state(r, v, gm=np.atleast_2d(gm)[-1], keep=keep, check=False)
+        system, r, v, gm, keep, radius = self._final_source
+        return system.with_state(r, v, gm=np.atleast_2d(gm)[-1], keep=keep, check=False,
+                                 radius=radius)
 
     @functools.cached_property
     def _tables(self) -> tuple[Any, Any]:
@@ -574,7 +575,8 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         if step is None:
             step = abs(times[-1] - times[0]) / max(int(out.steps), 1)
         found = under_resolved_encounters(r, v, out.gm, times, step, *encounters[1:])
-    final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone)
+    final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone,
+             None if out.events is None else out.events.radius.copy())
     if system.quantity:
         import astropy.units as u
 

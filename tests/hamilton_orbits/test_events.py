@@ -448,3 +448,19 @@ def test_stopped_by_is_the_stop_and_rows_are_in_time_order(kw):
     assert traj.stopped_by["action"] == "stop" and traj.stopped_by["distance"] == 5.0
     # (radau15 and dop853 stop at the event's time, wh at the end of its step)
     assert 0.0 <= traj.t[-1] - traj.stopped_by["time"] <= kw.get("dt", 0.0)
+
+
+def test_a_merged_body_has_the_radius_of_the_summed_volume_in_the_system_after():
+    """The body a merge keeps has the radius of the pair's summed volume in
+    ``sim.system`` and ``traj.final`` (they kept its radius before the merge, which
+    a new simulation made from them would collide with)."""
+    from hamilton_orbits import Simulation
+
+    system, _ = _head_on()
+    sim = Simulation(system, method="radau15",
+                     events=[{"name": "collision", "action": "merge"}])
+    traj = sim.integrate(1.5)
+    assert len(traj.events) == 1
+    merged = np.cbrt(0.01**3 + 0.02**3)
+    assert sim.system.as_arrays().radius.tolist() == [merged]
+    assert traj.final.as_arrays().radius.tolist() == [merged]
