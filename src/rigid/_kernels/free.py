@@ -196,6 +196,56 @@ def _agm_sncn(u, m, m1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _landen_sncn(u, m, m1):  # pragma: no cover - compiled
+    """``(sn, cn)`` of ``0 <= u <= K/2`` by descending Landen transformations (DLMF
+    22.7.1-22.7.2): the modulus ``k_{j+1} = k_j^2 / (1 + k'_j)^2`` (so ``k' =
+    2 sqrt(k'_j) / (1 + k'_j)``) and the argument ``u / (1 + k_{j+1})`` taken down
+    until ``k^2`` is below 1e-34 (then ``sn = sin``, ``cn = cos``: DLMF 22.10.1-2),
+    and back up by ``sn = (1 + k1) s / (1 + k1 s^2)``, ``cn = c d / (1 + k1 s^2)``
+    with ``d = sqrt(k1'^2 + k1^2 c^2)``.  Every step multiplies, divides or adds
+    positive numbers, and at the bottom the argument is at most ``pi/4`` (``u/K``
+    is kept): ``cn`` keeps its relative accuracy where it is small, near the
+    separatrix (``m1 -> 0``, ``cn(K/2) = sqrt(k'/(1 + k'))``), which the AGM's
+    ``asin`` recursion lost (``eps / cn^2``)."""
+    if m == 0.0:
+        return math.sin(u), math.cos(u)
+    if m1 == 0.0:  # (the separatrix itself: DLMF 22.5.iv)
+        return math.tanh(u), 1.0 / math.cosh(u)
+    ks = np.empty(64)
+    kps = np.empty(64)
+    k2 = m
+    kp = math.sqrt(m1)
+    n = 0
+    while k2 > 1e-34 and n < 63:
+        one = 1.0 + kp
+        k1 = k2 / (one * one)
+        kp = 2.0 * math.sqrt(kp) / one
+        u = u / (1.0 + k1)
+        n += 1
+        ks[n] = k1
+        kps[n] = kp
+        k2 = k1 * k1
+    s = math.sin(u)
+    c = math.cos(u)
+    for j in range(n, 0, -1):
+        k1 = ks[j]
+        d = math.sqrt(kps[j] * kps[j] + k1 * k1 * c * c)  # dn at level j
+        den = 1.0 + k1 * s * s
+        s, c = (1.0 + k1) * s / den, c * d / den
+    return s, c
+
+
+@njit(cache=True)
+def _sncn(u, m, m1):  # pragma: no cover - compiled
+    """``(sn, cn)`` of ``0 <= u <= K/2``: by Landen's transformations near the
+    separatrix (``m1 < 1e-3``, where ``cn(K/2)^2 < 0.03``), by the AGM elsewhere
+    (within an ulp or two)."""
+    if m1 < 1e-3:
+        return _landen_sncn(u, m, m1)
+    return _agm_sncn(u, m, m1)
+
+
+@njit(cache=True)
 def jacobi_reduced(r, m, m1, kk):  # pragma: no cover - compiled
     """``sn, cn, dn`` of ``r`` with ``|r| <= K`` (``kk`` = K(m)), ``m + m1 = 1``.
 
@@ -204,10 +254,10 @@ def jacobi_reduced(r, m, m1, kk):  # pragma: no cover - compiled
     """
     v = abs(r)
     if v <= 0.5 * kk:
-        s, c = _agm_sncn(v, m, m1)
+        s, c = _sncn(v, m, m1)
         d = math.sqrt(m1 + m * c * c)
     else:
-        s1, c1 = _agm_sncn(kk - v, m, m1)
+        s1, c1 = _sncn(kk - v, m, m1)
         d1 = math.sqrt(m1 + m * c1 * c1)
         k1 = math.sqrt(m1)
         s = c1 / d1
