@@ -189,8 +189,9 @@ def watch_table(events: EventSet, system: Any) -> np.ndarray:
     Raises
     ------
     ValueError
-        For a body name not in the system, a non-positive distance, or a
-        collision watch with no body radii to collide.
+        For a body name not in the system, a non-positive distance, a
+        collision watch with no body radii to collide, or an event of a body or
+        pair listed twice (the same event, or two collisions of one pair).
 
     Examples
     --------
@@ -201,30 +202,56 @@ def watch_table(events: EventSet, system: Any) -> np.ndarray:
     [[1.0, 0.0, 1.0, 0.1, 0.0]]
     """
     rows: list[list[float]] = []
-    arrays = system.as_arrays()
+    origin: list[int] = []  # (the event each row is of)
     for k, (name, params) in enumerate(events.items):
-        code, _, _ = EVENTS[name]
-        action = float(ACTIONS[params["action"]])
-        where = f"Event at index {k} ({name!r})"
-        if name == "escape":
-            dist = _length(params["distance"], system, where)
-            rows += [[code, i, -1, dist, action]
-                     for i in _bodies(params, system, where, single=True)]
-            continue
-        pairs = _pairs(params, system, where, name)
-        if _hill(params) and params.get("bodies") is None:
-            # in Hill radii, a pair with the most massive body has no encounter sphere
-            top = int(np.argmax(arrays.gm))
-            pairs = [(i, j) for i, j in pairs if top not in (i, j)]
-        if name == "collision" and not pairs:
-            raise ValueError(f"{where}: no pair of bodies has radii (give Body(radius=...))")
-        for i, j in pairs:
-            if name == "collision":
-                dist = arrays.radius[i] + arrays.radius[j]
-            else:
-                dist = _encounter_distance(params["distance"], system, i, j, where)
-            rows.append([code, i, j, dist, action])
+        new = _event_rows(name, params, system, f"Event at index {k} ({name!r})")
+        rows += new
+        origin += [k] * len(new)
+    _refuse_repeats(rows, origin, events, system)
     return np.array(rows, dtype=np.float64).reshape(-1, 5)
+
+
+def _event_rows(name: str, params: Mapping[str, Any], system: Any,
+                where: str) -> list[list[float]]:
+    """The watch rows of one listed event (:func:`watch_table`)."""
+    arrays = system.as_arrays()
+    code, _, _ = EVENTS[name]
+    action = float(ACTIONS[params["action"]])
+    if name == "escape":
+        dist = _length(params["distance"], system, where)
+        return [[code, i, -1, dist, action] for i in _bodies(params, system, where, single=True)]
+    pairs = _pairs(params, system, where, name)
+    if _hill(params) and params.get("bodies") is None:
+        # in Hill radii, a pair with the most massive body has no encounter sphere
+        top = int(np.argmax(arrays.gm))
+        pairs = [(i, j) for i, j in pairs if top not in (i, j)]
+    if name == "collision" and not pairs:
+        raise ValueError(f"{where}: no pair of bodies has radii (give Body(radius=...))")
+    rows = []
+    for i, j in pairs:
+        if name == "collision":
+            dist = arrays.radius[i] + arrays.radius[j]
+        else:
+            dist = _encounter_distance(params["distance"], system, i, j, where)
+        rows.append([code, i, j, dist, action])
+    return rows
+
+
+def _refuse_repeats(rows: list[list[float]], origin: list[int], events: EventSet,
+                    system: Any) -> None:
+    """Refuse a watch listed twice: the same event of the same bodies (each would be
+    recorded twice), or two collisions of one pair (a pair collides once: which
+    action would be carried out?)."""
+    collision = EVENTS["collision"][0]
+    seen: dict[tuple[float, ...], int] = {}
+    for row, k in zip(rows, origin, strict=True):
+        key = tuple(row[:3]) if row[0] == collision else tuple(row)
+        first = seen.setdefault(key, k)
+        if first != k:
+            name = events.items[k][0]
+            who = "-".join(system.names[int(x)] for x in row[1:3] if x >= 0)
+            raise ValueError(f"Event at index {k} ({name!r}) watches {who} as the event at "
+                             f"index {first} does; list each event of a body or pair once")
 
 
 def _bodies(params: Mapping[str, Any], system: Any, where: str, single: bool) -> list[int]:

@@ -615,3 +615,21 @@ def test_a_simulation_takes_no_effects_as_none_and_refuses_events_with_variation
     with pytest.raises(ValueError, match=r"variational equations are integrated without "
                                          r"events"):
         Simulation(_pair_with_radii(), variational=True, events=["collision"])
+
+
+@pytest.mark.parametrize(("events", "pattern"), [
+    (["collision", {"name": "collision", "action": "merge"}],
+     r"Event at index 1 \('collision'\) watches a-b as the event at index 0 does"),
+    ([{"name": "escape", "distance": 5.0}, {"name": "escape", "distance": 5.0}],
+     r"Event at index 1 \('escape'\) watches b as the event at index 0 does"),
+])
+def test_an_event_of_a_body_or_pair_listed_twice_is_refused(events, pattern):
+    """Duplicate effects were refused, duplicate events taken: a pair's collision
+    recorded as a stop and a merge, every escape recorded twice.  Two thresholds of
+    one close encounter stay allowed."""
+    from hamilton_orbits import Simulation
+
+    with pytest.raises(ValueError, match=pattern):
+        Simulation(_pair_with_radii(), events=events)
+    Simulation(_pair_with_radii(), events=[{"name": "close_encounter", "distance": 0.5},
+                                           {"name": "close_encounter", "distance": 0.3}])

@@ -237,12 +237,14 @@ def _landen_sncn(u, m, m1):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _sncn(u, m, m1):  # pragma: no cover - compiled
-    """``(sn, cn)`` of ``0 <= u <= K/2``: by Landen's transformations near the
-    separatrix (``m1 < 1e-3``, where ``cn(K/2)^2 < 0.03``), by the AGM elsewhere
-    (within an ulp or two)."""
-    if m1 < 1e-3:
+    """``(sn, cn)`` of ``0 <= u <= K/2``: by the AGM (within an ulp or two where
+    ``cn`` is not small; its relative error grows as ``eps / cn^2``), and where it
+    gives ``cn^2 < 1/8`` (near the separatrix, ``m1 -> 0``) by Landen's
+    transformations instead (a few ulp, whatever ``cn``)."""
+    s, c = _agm_sncn(u, m, m1)
+    if c * c < 0.125:
         return _landen_sncn(u, m, m1)
-    return _agm_sncn(u, m, m1)
+    return s, c
 
 
 @njit(cache=True)
