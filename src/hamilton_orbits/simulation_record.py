@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from collections.abc import Mapping
 from typing import Any
 
@@ -47,6 +48,11 @@ def to_json(value: Any) -> Any:
                 "unit": value.unit.to_string()}
     if isinstance(value, np.ndarray):
         return {"__array__": value.tolist()}
+    time = sys.modules.get("astropy.time")  # (a Time can only come from a loaded module)
+    if time is not None and isinstance(value, time.Time):  # (an epoch: its two-part JD)
+        return {"__time__": [np.asarray(value.jd1).tolist(), np.asarray(value.jd2).tolist()],
+                "scale": value.scale,
+                "format": value.format}
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, Mapping):
@@ -65,6 +71,13 @@ def from_json(value: Any) -> Any:
             return u.Quantity(value["__quantity__"], u.Unit(value["unit"]), dtype=np.float64)
         if "__array__" in value:
             return np.array(value["__array__"], dtype=np.float64)
+        if "__time__" in value:
+            from astropy.time import Time
+
+            jd1, jd2 = value["__time__"]
+            out = Time(jd1, jd2, format="jd", scale=value["scale"])
+            out.format = value["format"]
+            return out
         return {k: from_json(x) for k, x in value.items()}
     if isinstance(value, list):
         return [from_json(x) for x in value]

@@ -273,3 +273,78 @@ def test_effects_that_exclude_each_other():
             fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")
     finally:  # the registry is the process's: leave no kind behind for later tests
         fx.registry._REGISTRY.pop("test-excl", None)
+
+
+def _earth_moon():
+    return System.from_ephemeris("J2000", bodies=["sun", "earth", "moon"])
+
+
+def _massless(system, name):
+    """``system`` with body ``name`` massless."""
+    bodies = list(system.bodies)
+    k = system.names.index(name)
+    b = bodies[k]
+    bodies[k] = Body(b.name, 0.0 * b.gm.unit, b.r, b.v, radius=b.radius, j2=b.j2, pole=b.pole)
+    return System(bodies)
+
+
+@pytest.mark.parametrize(("effect", "massless", "key"), [
+    ({"name": "zonal"}, "earth", "body"),
+    ({"name": "earth_tides"}, "earth", "earth"),
+    ({"name": "moon_figure"}, "moon", "moon"),
+    ({"name": "lense_thirring"}, "sun", "body"),
+    ({"name": "kuiper_ring"}, "sun", "centre"),
+])
+def test_an_effect_whose_field_is_a_massless_bodys_is_refused(effect, massless, key):
+    """These effects push back on their body by ``gm_i / gm_body``: a massless one
+    failed at the first step (a non-finite acceleration, or a bare
+    ZeroDivisionError), as ``gr`` and ``j2`` refuse it at setup."""
+    with pytest.raises(ValueError, match=rf"`{key}` names body '{massless}', which is "
+                                         r"massless"):
+        compile_rhs(_massless(_earth_moon(), massless), [effect])
+
+
+@pytest.mark.parametrize("effect", [
+    {"name": "zonal", "frame": "galactic"},
+    {"name": "earth_tides", "frame": "ICRS"},
+    {"name": "kuiper_ring", "normal": [0, 0, 1], "frame": "galactic"},
+    {"name": "lense_thirring", "spin": [0.0, 0.0, 1e-7] * u.au**2 / u.day, "frame": 42},
+])
+def test_a_wrong_frame_is_refused_where_it_is_not_used(effect):
+    """A frame the effect's given directions make unused was taken silently."""
+    with pytest.raises(ValueError, match=r"expected `frame` 'icrs' or 'ecliptic'"):
+        compile_rhs(_earth_moon(), [effect])
+
+
+@pytest.mark.parametrize(("effect", "pattern"), [
+    ({"name": "semi_active", "bodies": ["sun", "earth", "moon"]}, r"lists every body"),
+    ({"name": "eih", "semi_active": ["sun", "earth", "moon"]}, r"lists every body"),
+    ({"name": "nongrav", "body": [], "A1": 1e-9 * u.au / u.day**2}, r"got an empty list"),
+    ({"name": "zonal", "j": []}, r"at least J2, got an empty list"),
+    ({"name": "gr", "c": True}, r"expected `c` to be a number, got True"),
+])
+def test_effects_that_would_do_nothing_or_misread_a_bool_are_refused(effect, pattern):
+    """Every body semi-active turned gravity off (free flight); an empty list of
+    bodies or harmonics was a silent no-op; ``c=True`` was read as c = 1."""
+    with pytest.raises(ValueError, match=pattern):
+        compile_rhs(_earth_moon(), [effect])
+
+
+def test_an_epoch_given_as_a_time_is_saved_and_continued_to_the_bit(tmp_path):
+    """docs/effects.md's own example, ``epoch=Time(...)``, could not be saved (a bare
+    TypeError from JSON): the epoch is kept as its two-part Julian date, scale and
+    format, and the simulation loaded goes on with the bits of the one saved."""
+    from astropy.time import Time
+
+    from hamilton_orbits import Simulation
+
+    epoch = Time("1950-01-01", scale="tdb")
+    sim = Simulation(_earth_moon(), effects=[{"name": "zonal", "pole": "IAU2006",
+                                              "epoch": epoch}])
+    sim.integrate(1 * u.day)
+    sim.save(tmp_path / "sim.nc")
+    again = Simulation.load(tmp_path / "sim.nc")
+    kept = again.effects.as_list()[0]["epoch"]
+    assert kept.scale == "tdb" and kept.jd1 == epoch.jd1 and kept.jd2 == epoch.jd2
+    a, b = sim.integrate(3 * u.day), again.integrate(3 * u.day)
+    assert np.array_equal(a.r.value, b.r.value)

@@ -49,6 +49,9 @@ def _params_eih(system: Any, params: Mapping[str, Any]) -> np.ndarray:
                              de.constant("GAMMA"))
     sources = body_list(system, params, "sources", "eih")
     semi = body_list(system, params, "semi_active", "eih")
+    if semi and len(semi) == len(system.names):
+        raise ValueError("Effect 'eih': `semi_active` lists every body, so that none would "
+                         "pull on another")
     for b in semi:
         if b in sources:
             raise ValueError(f"Effect 'eih': {system.names[b]!r} is both a source and "

@@ -26,6 +26,7 @@ from hamilton_orbits.effects.parameters import (
     PARK_2021,
     axes_frame,
     body_index,
+    given_frame,
     require_de440_units,
     scalar_parameter,
     unit_vector,
@@ -52,12 +53,13 @@ def kuiper_ring_gm() -> float:
 
 
 def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    b = body_index(system, params, "centre", "sun", "kuiper_ring")
+    b = body_index(system, params, "centre", "sun", "kuiper_ring", massive=True)
     require_de440_units(system, params, "kuiper_ring", ("gm", "radius"))
     big_m = scalar_parameter(system, params, "gm", "kuiper_ring", GM, kuiper_ring_gm(),
                              nonnegative=True)
     radius = scalar_parameter(system, params, "radius", "kuiper_ring", LENGTH,
                               KUIPER_RING_RADIUS_AU, positive=True)
+    given_frame(params, "kuiper_ring")  # (checked if given, used or not)
     normal = (unit_vector("normal", params["normal"], "kuiper_ring") if "normal" in params
               else de.ecliptic_pole(axes_frame(system, params, "kuiper_ring")))
     return np.array([b, big_m, radius, *normal])

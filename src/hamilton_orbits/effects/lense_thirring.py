@@ -29,6 +29,7 @@ from hamilton_orbits.effects.parameters import (
     axes_frame,
     body_index,
     de440_c_au_per_day,
+    given_frame,
     parameter_array,
     require_de440_units,
     scalar_parameter,
@@ -56,10 +57,11 @@ def sun_spin(frame: str = "icrs") -> np.ndarray:
 
 
 def _params_lense_thirring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    b = body_index(system, params, "body", "sun", "lense_thirring")
+    b = body_index(system, params, "body", "sun", "lense_thirring", massive=True)
     require_de440_units(system, params, "lense_thirring", ("c", "spin"))
     if system.names[b] != "sun" and "spin" not in params:
         raise ValueError("Effect 'lense_thirring': a body other than the Sun needs `spin`")
+    given_frame(params, "lense_thirring")  # (checked if given, used or not)
     spin = parameter_array(system, params, "spin", "lense_thirring", SPECIFIC_ANGULAR_MOMENTUM)
     if spin is None:
         spin = sun_spin(axes_frame(system, params, "lense_thirring"))

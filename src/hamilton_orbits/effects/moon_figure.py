@@ -47,7 +47,7 @@ MOON_EQUATOR_INCLINATION_DEG = 1.5424
 
 
 def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    m = body_index(system, params, "moon", "moon", "moon_figure")
+    m = body_index(system, params, "moon", "moon", "moon_figure", massive=True)
     e = body_index(system, params, "earth", "earth", "moon_figure")
     distinct_bodies(system, {"moon": m, "earth": e}, "moon_figure")
     require_de440_units(system, params, "moon_figure", ("radius",))

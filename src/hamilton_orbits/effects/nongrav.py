@@ -43,6 +43,9 @@ def _bodies(system: Any, params: Mapping[str, Any]) -> list[int]:
         raise ValueError("Effect 'nongrav': expected `body`, the body (or a list of the "
                          "bodies) it acts on")
     names = [names] if isinstance(names, str) else list(names)
+    if not names:
+        raise ValueError("Effect 'nongrav': expected `body`, the body (or a list of the "
+                         "bodies) it acts on, got an empty list")
     out = [body_index(system, {"body": n}, "body", "", "nongrav") for n in names]
     for k, b in enumerate(out):
         if out.index(b) != k:

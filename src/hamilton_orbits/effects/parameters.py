@@ -245,6 +245,9 @@ def parameter_value(system: Any, params: Mapping[str, Any], key: str, effect: st
     ...
     ValueError: Effect 'gr': expected `c` as a plain number in the units of the system ...
     """
+    if isinstance(params.get(key), (bool, np.bool_)):  # (True is not c = 1)
+        raise ValueError(f"Effect {effect!r}: expected `{key}` to be a number, got "
+                         f"{params[key]!r}")
     arr = parameter_array(system, params, key, effect, kind)
     if arr is None:
         return None
@@ -327,9 +330,11 @@ def _not_a_body(system: Any, key: str, name: Any, effect: str) -> ValueError:
 
 
 def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
-               effect: str) -> int:
+               effect: str, massive: bool = False) -> int:
     """The index of the body that mapping ``params`` names under ``key`` (default:
-    the body named ``default``), refusing a name not in ``system``.
+    the body named ``default``), refusing a name not in ``system`` (and with
+    ``massive`` a massless body: an effect whose field is its, pushing back on it
+    by ``gm_i / gm_body``).
 
     Examples
     --------
@@ -342,7 +347,11 @@ def body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
     name = params.get(key, default)
     if not isinstance(name, str) or name not in system.names:
         raise _not_a_body(system, key, name, effect)
-    return system.names.index(name)
+    idx = system.names.index(name)
+    if massive and not system.as_arrays().gm[idx] > 0:
+        raise ValueError(f"Effect {effect!r}: `{key}` names body {name!r}, which is "
+                         f"massless (gm = 0): the effect's field is that body's")
+    return idx
 
 
 def optional_body_index(system: Any, params: Mapping[str, Any], key: str, default: str,
@@ -531,13 +540,27 @@ def axes_frame(system: Any, params: Mapping[str, Any], effect: str) -> str:
     ...            "moon_figure")
     'ecliptic'
     """
-    frame = params.get("frame")
+    frame = given_frame(params, effect)
     if frame is None:
         frame = _frame_of_poles(system)
         if frame is None:
             _refuse_ecliptic_looking(system, effect)
             frame = "icrs"
-    if not isinstance(frame, str) or frame not in ("icrs", "ecliptic"):
+    return frame
+
+
+def given_frame(params: Mapping[str, Any], effect: str) -> str | None:
+    """``params["frame"]`` checked (``"icrs"`` or ``"ecliptic"``), or None when not
+    given: checked even where the effect's directions are all given and the frame
+    is not used, so that a wrong one is never taken silently.
+
+    Examples
+    --------
+    >>> given_frame({"frame": "ecliptic"}, "zonal"), given_frame({}, "zonal")
+    ('ecliptic', None)
+    """
+    frame = params.get("frame")
+    if frame is not None and (not isinstance(frame, str) or frame not in ("icrs", "ecliptic")):
         raise ValueError(f"Effect {effect!r}: expected `frame` 'icrs' or 'ecliptic', "
                          f"got {frame!r}")
     return frame
@@ -557,6 +580,7 @@ def de440_c_au_per_day() -> float:
 def body_pole(system: Any, b: int, params: Mapping[str, Any], effect: str) -> np.ndarray:
     """The pole of body ``b``: ``params["pole"]`` (normalised), else the Body's pole,
     else the z axis of the ICRS in the system's frame (:func:`axes_frame`)."""
+    given_frame(params, effect)
     if "pole" in params:
         return unit_vector("pole", params["pole"], effect)
     pole = system.bodies[b].pole

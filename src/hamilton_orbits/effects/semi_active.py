@@ -32,6 +32,10 @@ def _params_semi_active(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     if not bodies:
         raise ValueError("Effect 'semi_active' needs the `bodies` that do not pull on each "
                          "other, e.g. {'name': 'semi_active', 'bodies': ['ceres', 'vesta']}")
+    if len(bodies) == len(system.names):
+        raise ValueError("Effect 'semi_active': `bodies` lists every body, so that none "
+                         "would pull on another; list only those that do not pull on each "
+                         "other")
     return np.array(bodies, dtype=float)
 
 

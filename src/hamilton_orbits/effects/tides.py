@@ -55,7 +55,7 @@ _TAU = ("TAUE0", "TAUE1", "TAUE2", "TAUER1", "TAUER2")
 
 
 def _params_earth_tides(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    e = body_index(system, params, "earth", "earth", "earth_tides")
+    e = body_index(system, params, "earth", "earth", "earth_tides", massive=True)
     m = body_index(system, params, "moon", "moon", "earth_tides")
     require_de440_units(system, params, "earth_tides", ("radius", "omega", "tau"))
     sun = optional_body_index(system, params, "sun", "sun", "earth_tides")

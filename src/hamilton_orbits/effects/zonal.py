@@ -43,7 +43,7 @@ __all__ = ["SPECS"]
 
 
 def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
-    b = body_index(system, params, "body", "earth", "zonal")
+    b = body_index(system, params, "body", "earth", "zonal", massive=True)
     if system.names[b] != "earth" or not system.quantity:
         for key in ("j", "radius"):
             if key not in params:
@@ -51,6 +51,9 @@ def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
                                  "(DE440's defaults are the Earth's, in au)")
     j = finite_floats("j", params.get("j", [de.constant(f"J{n}E") for n in (2, 3, 4)]), None,
                 "zonal")
+    if j.size == 0:
+        raise ValueError("Effect 'zonal': expected `j` to be [J2, J3, ...], at least J2, "
+                         "got an empty list")
     radius = scalar_parameter(system, params, "radius", "zonal", LENGTH,
                               de.constant("RE") / de.constant("AU"), positive=True)
     lead = pole_of_date(system, b, params, "zonal")
