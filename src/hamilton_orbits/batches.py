@@ -10,6 +10,7 @@ order of the jobs, whichever finishes first.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -53,8 +54,8 @@ def check_workers(workers: Any, what: str) -> None:
     ...
     ValueError: Expected `workers` to be a number of threads >= 1, got 0
     """
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
+    if workers is not None and (isinstance(workers, bool)
+                                or not isinstance(workers, numbers.Integral) or workers < 1):
         raise ValueError(f"Expected `workers` to be a number of {what} >= 1, got {workers!r}")
 
 

@@ -51,6 +51,7 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
         result = scene.run(progress=False)
     except Exception as exc:  # a member's failure is data, not the end of the run
         row["wall time [s]"] = time.perf_counter() - start
+        row["complete"] = False
         row["error"] = f"{type(exc).__name__}: {exc}"
         return row
     for name, value in result.metrics.items():
@@ -233,6 +234,11 @@ class Ensemble:
             if bar is not None:
                 bar.close()
         df = pd.DataFrame(rows)
+        # (the members' own values: pandas would make None a NaN of a string column
+        # where one member failed, and infer the flags' type from them)
+        df["error"] = pd.Series([row["error"] for row in rows], index=df.index, dtype=object)
+        df["complete"] = pd.Series([row["complete"] for row in rows], index=df.index,
+                                   dtype=bool)
         df.attrs["failures"] = int(df["error"].notna().sum())
         return df
 

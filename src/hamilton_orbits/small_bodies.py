@@ -161,8 +161,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     r, v = _states(r0, v0)
     names = _names(names, len(r))
     _refuse_unsupported(asteroids, method, variational, stm)
-    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"Expected `chunk` to be a number of bodies >= 1, got {chunk!r}")
+    chunk = int(chunk)
+    effects = () if effects is None else effects
     check_workers(workers, "threads")
     check_client(client)
     if earth_pole not in ("J2000", "IAU2006"):
@@ -292,7 +294,8 @@ def _names(names: Sequence[str] | None, n: int) -> list[str]:
     if len(names) != n:
         raise ValueError(f"Expected `names` to name the {n} bodies of `r0`, got {len(names)}")
     for k, name in enumerate(names):
-        if not isinstance(name, str) or not name or name in names[:k] or name in PERTURBERS:
+        if (not isinstance(name, str) or not name or name in names[:k]
+                or name.lower() in PERTURBERS):  # (not "Earth" either: an event's bodies)
             raise ValueError(f"Expected `names` distinct non-empty strings, none a perturber's "
                              f"name, got {name!r} at index {k}")
     return names

@@ -242,12 +242,23 @@ class Trajectory(TrajectoryBase):
     @functools.cached_property
     def under_resolved(self) -> Any:
         """The close approaches a fixed step was too long for (a ``QTable``)."""
+        if self._final_source is None:
+            raise ValueError(_NO_FINAL)
         return _encounter_table(self._under_resolved, self._final_source[0],
                                 getattr(self.t, "unit", None))
 
     @functools.cached_property
     def final(self) -> Any:
-        """The system at the last output time."""
+        """The system at the last output time.
+
+        Raises
+        ------
+        ValueError
+            For a trajectory of bodies in a field (small bodies in an ephemeris's),
+            which are not a System: their states are ``r`` and ``v``.
+        """
+        if self._final_source is None:
+            raise ValueError(_NO_FINAL)
         system, r, v, gm, keep, radius = self._final_source
         return system.with_state(r, v, gm=np.atleast_2d(gm)[-1], keep=keep, check=False,
                                  radius=radius)
@@ -350,6 +361,9 @@ class Trajectory(TrajectoryBase):
         )
 
 
+_NO_FINAL = ("This trajectory is of bodies in a field (small bodies in an ephemeris's), "
+             "not of a System: no final System and no encounter check of its steps; its "
+             "states are `r` and `v`")
 _NO_INTEGRALS = ("This trajectory keeps no integrals (bodies in a field that changes with "
                  "time, such as small bodies in an ephemeris's): no energy, angular momentum "
                  "or barycentre error")

@@ -58,8 +58,8 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     unit = traj.r.unit.to_string() if hasattr(traj.r, "unit") else None
     v = np.asarray(getattr(traj.v, "value", traj.v))
     primary = _primary(traj)
-    rel = r - r[:, primary:primary + 1]
-    vel = v[0] - v[0, primary]
+    rel = r if primary is None else r - r[:, primary:primary + 1]
+    vel = v[0] if primary is None else v[0] - v[0, primary]
     if ax is None:
         fig, ax = plt.subplots(figsize=(6.5, 6))
     else:
@@ -67,12 +67,14 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     for k, name in enumerate(traj.names):
         if k != primary:
             _path(ax, rel[:, k, i], rel[:, k, j], (vel[k, i], vel[k, j]), name)
-    ax.plot([0.0], [0.0], "k+", ms=10, mew=1.5, label=f"{traj.names[primary]} (primary)")
+    about = "the frame's origin" if primary is None else traj.names[primary]
+    ax.plot([0.0], [0.0], "k+", ms=10, mew=1.5,
+            label=about if primary is None else f"{about} (primary)")
     suffix = "" if unit is None else f" [{unit}]"
-    ax.set_xlabel(f"{'xyz'[i]} from {traj.names[primary]}{suffix}")
-    ax.set_ylabel(f"{'xyz'[j]} from {traj.names[primary]}{suffix}")
+    ax.set_xlabel(f"{'xyz'[i]} from {about}{suffix}")
+    ax.set_ylabel(f"{'xyz'[j]} from {about}{suffix}")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_title(f"{traj.method}: paths about {traj.names[primary]} "
+    ax.set_title(f"{traj.method}: paths about {about} "
                  f"(open circle: start; dot: end)", fontsize=10)
     if len(traj.names) > 5:
         ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
@@ -81,10 +83,15 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     return fig
 
 
-def _primary(traj: Any) -> int:
-    """The index of the most massive body at the end of the run."""
-    gm = np.atleast_1d(traj.final.as_arrays().gm)
-    return int(traj.names.index(traj.final.names[int(np.argmax(gm))]))
+def _primary(traj: Any) -> int | None:
+    """The index of the most massive body at the end of the run (None for bodies in a
+    field, none of which pulls: the frame's origin is theirs)."""
+    try:
+        final = traj.final
+    except ValueError:
+        return None
+    gm = np.atleast_1d(final.as_arrays().gm)
+    return int(traj.names.index(final.names[int(np.argmax(gm))]))
 
 
 def _path(ax: Any, x: np.ndarray, y: np.ndarray, v0: tuple[float, float], name: str) -> None:

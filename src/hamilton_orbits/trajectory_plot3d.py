@@ -121,10 +121,15 @@ def _positions(traj: Any, unit: Any) -> tuple[np.ndarray, str | None]:
     return np.asarray(r, dtype=float), target.to_string()
 
 
-def _primary(traj: Any) -> int:
-    """The index of the most massive body at the end of the run."""
-    gm = np.atleast_1d(traj.final.as_arrays().gm)
-    return int(traj.names.index(traj.final.names[int(np.argmax(gm))]))
+def _primary(traj: Any) -> int | None:
+    """The index of the most massive body at the end of the run (None for bodies in a
+    field, none of which pulls: the frame's origin is theirs)."""
+    try:
+        final = traj.final
+    except ValueError:
+        return None
+    gm = np.atleast_1d(final.as_arrays().gm)
+    return int(traj.names.index(final.names[int(np.argmax(gm))]))
 
 
 def _centre(traj: Any, origin: str) -> int | None:

@@ -212,6 +212,7 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(events=[{"name": "close"}]), "Event at index 0: small_bodies.propagate watches"),
     (dict(names=["a", "a", "b"]), r"`names`.*'a' at index 1"),
     (dict(names=["sun", "b", "c"]), "`names`.*'sun' at index 0"),
+    (dict(names=["a", "Earth", "c"]), "`names`.*'Earth' at index 1"),  # (an event's body)
     (dict(t=[1.0, 2.0]), "`t`"),
     (dict(t=np.array([5.0, 3.0, 4.0]) * u.day), "`t` strictly monotonic"),
     (dict(epoch="2000-01-01"), "`epoch`"),
@@ -587,3 +588,28 @@ def test_assists_roundtrip_case():
         d = np.linalg.norm(back.r[-1].to_value(u.au) - r, axis=1) * AU_M
         assert d.mean() < tolerance, (days, d)
         assert not np.allclose(there.r[-1].to_value(u.au), r, atol=0.1)  # (they went out)
+
+
+def test_a_small_bodies_trajectory_says_it_has_no_final_system_and_is_drawn():
+    """``final`` and ``under_resolved`` of bodies in a field (no System) raise a
+    ValueError that says so, and the figures draw the paths about the frame's origin
+    (all three were bare TypeErrors); ``effects=None`` is none, and NumPy integers
+    are taken for ``chunk`` and ``workers``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from astropy.time import Time
+
+    from hamilton_orbits.small_bodies import propagate
+
+    r, v = _asteroids()
+    traj = propagate(r * u.au, v * u.au / u.day, Time(2451545.0, format="jd", scale="tdb"),
+                     np.linspace(0.0, 30.0, 4) * u.day, ephemeris=Segments.load(EXCERPT),
+                     asteroids=False, effects=None, chunk=np.int64(1), workers=np.int64(1))
+    for what in ("final", "under_resolved"):
+        with pytest.raises(ValueError, match=r"bodies in a field .* its states are `r`"):
+            getattr(traj, what)
+    fig = traj.plot()
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "x from the frame's origin [AU]"
+    assert len(ax.lines) >= len(traj.names)
