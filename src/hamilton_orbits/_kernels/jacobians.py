@@ -431,7 +431,10 @@ FD_EPS = 6.055454452393343e-06
 def fd_scales(r, v, gm):  # pragma: no cover - compiled
     """``(L, V)``: the shortest distance between two bodies one of which is massive,
     and the relative speed of that pair (at least 1e-6 of the largest speed), the
-    scales against which a displacement of positions and of velocities is small."""
+    scales against which a displacement of positions and of velocities is small.
+    Bodies at one point (perturbers put together, as a made-up field of one point
+    does) give no scale: a zero length would make every displacement zero, and the
+    Jacobian with it."""
     n = r.shape[0]
     best = math.inf
     bi = 0
@@ -446,7 +449,7 @@ def fd_scales(r, v, gm):  # pragma: no cover - compiled
                 continue
             d2 = ((r[j, 0] - r[i, 0]) ** 2 + (r[j, 1] - r[i, 1]) ** 2
                   + (r[j, 2] - r[i, 2]) ** 2)
-            if d2 < best:
+            if 0.0 < d2 < best:
                 best = d2
                 bi = i
                 bj = j

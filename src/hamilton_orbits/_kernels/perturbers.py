@@ -125,8 +125,9 @@ def small_bodies_augmented(r, v, gm, acc, p):  # pragma: no cover - compiled
 
     The Jacobian is applied by central differences of the field along each tangent
     vector (:func:`~hamilton_orbits._kernels.jacobians.fd_shift`, its step a
-    :data:`~hamilton_orbits._kernels.jacobians.FD_EPS` of the closest distance to a
-    perturber, at this time), the small bodies all shifted at once: none pulls on
+    :data:`~hamilton_orbits._kernels.jacobians.FD_EPS` of the closest distance
+    between two bodies apart, one of them massive (:func:`~hamilton_orbits._kernels.
+    jacobians.fd_scales`), at this time), the small bodies all shifted at once: none pulls on
     another, so each one's difference is its own.  The clock is never shifted and
     its tangent rows get 0: a tangent vector that starts without a clock part keeps
     none (the time is not varied)."""
