@@ -283,13 +283,7 @@ class Propagation:
         if events is not None:
             first_event = len(events.recorded())
             events.stopped_by = None
-        if (events is not None and self.driver is not None and not backward
-                and not self.backward and events.overlapping(self.r)):
-            self.steps_before += self.driver.steps  # (bodies in contact where a leg
-            self.driver = None  # begins, as after a stop at a collision: they collide
-            # at its start, as at a first leg's, with a driver made afresh after it)
-        driver = self.driver if self.driver is not None and backward == self.backward \
-            else self.driver_for(backward)
+        driver = self._driver_for_leg(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
         r_out, v_out = rows[0], rows[1]
         r_out[0], v_out[0] = self.r, self.v
@@ -352,6 +346,18 @@ class Propagation:
         finite = all_finite(rows.reshape(-1))  # one compiled pass over both
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
+
+    def _driver_for_leg(self, backward: bool) -> Any:
+        """The driver of a leg in this direction; made afresh where bodies are in
+        contact as the leg begins (as after a stop at a collision): they collide at
+        its start, as at a first leg's (:meth:`driver_for`)."""
+        if (self.events is not None and self.driver is not None and not backward
+                and not self.backward and self.events.overlapping(self.r)):
+            self.steps_before += self.driver.steps
+            self.driver = None
+        if self.driver is not None and backward == self.backward:
+            return self.driver
+        return self.driver_for(backward)
 
     def advance_end(self, t_end: float) -> EngineRun | None:
         """A leg to the one later time ``t_end`` (a finite Python float), forwards,

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["plot_trajectory"]
+__all__ = ["plot_trajectory", "primary_index"]
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 
@@ -57,7 +57,7 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     r = np.asarray(getattr(traj.r, "value", traj.r))
     unit = traj.r.unit.to_string() if hasattr(traj.r, "unit") else None
     v = np.asarray(getattr(traj.v, "value", traj.v))
-    primary = _primary(traj)
+    primary = primary_index(traj)
     rel = r if primary is None else r - r[:, primary:primary + 1]
     vel = v[0] if primary is None else v[0] - v[0, primary]
     if ax is None:
@@ -83,9 +83,19 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     return fig
 
 
-def _primary(traj: Any) -> int | None:
+def primary_index(traj: Any) -> int | None:
     """The index of the most massive body at the end of the run (None for bodies in a
-    field, none of which pulls: the frame's origin is theirs)."""
+    field, none of which pulls: the frame's origin is theirs), which the figures
+    draw the paths about.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System, integrate
+    >>> s = System([Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0]),
+    ...             Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> primary_index(integrate(s, 1.0))
+    1
+    """
     try:
         final = traj.final
     except ValueError:

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits.trajectory_plot import primary_index
+
 __all__ = ["MAX_FRAMES", "plot_trajectory3d"]
 
 MAX_FRAMES = 200
@@ -121,21 +123,10 @@ def _positions(traj: Any, unit: Any) -> tuple[np.ndarray, str | None]:
     return np.asarray(r, dtype=float), target.to_string()
 
 
-def _primary(traj: Any) -> int | None:
-    """The index of the most massive body at the end of the run (None for bodies in a
-    field, none of which pulls: the frame's origin is theirs)."""
-    try:
-        final = traj.final
-    except ValueError:
-        return None
-    gm = np.atleast_1d(final.as_arrays().gm)
-    return int(traj.names.index(final.names[int(np.argmax(gm))]))
-
-
 def _centre(traj: Any, origin: str) -> int | None:
     """The index of the origin body, or None for the integration frame's origin."""
     if origin == "primary":
-        return _primary(traj)
+        return primary_index(traj)
     if origin == "frame":
         return None
     if isinstance(origin, str) and origin in traj.names:
