@@ -333,7 +333,11 @@ def _wrap2pi(x: np.ndarray) -> np.ndarray:
 
 
 def _ecc_vector(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    rn = np.sqrt(np.einsum("...i,...i->...", r, r))[..., None]
+    # |r| by the largest component (r . r overflows from |r| ~ 1e154 and underflows
+    # below 1e-154: mu / |r| was then 0, or off, and the vector with it)
+    big = np.max(np.abs(r), axis=-1, keepdims=True)
+    unit = r / big
+    rn = big * np.sqrt(np.einsum("...i,...i->...", unit, unit))[..., None]
     v2 = np.einsum("...i,...i->...", v, v)[..., None]
     rv = np.einsum("...i,...i->...", r, v)[..., None]
     m = mu[..., None]

@@ -350,7 +350,7 @@ class Conic:
     def normal_length(self, r: Any) -> np.ndarray:
         """N = sqrt(p r r'/a) (eq. 65), the normal between the curve and the axis."""
         c = self._chord(self._on_conic(self._in("r", r, _L)))
-        return self._out(np.sqrt(self._p * c), _L)
+        return self._out(np.sqrt(self._p) * np.sqrt(c), _L)  # (p c overflows beyond 1e154)
 
     @_in_range
     def radius_of_curvature(self, r: Any) -> np.ndarray:
@@ -363,7 +363,7 @@ class Conic:
     def radial_speed_squared(self, r: Any) -> np.ndarray:
         """``(dr/dt)^2 = M (2/r - 1/a - p/r^2)`` (eq. 66), at ``q <= r <= Q``."""
         r = self._on_conic(self._in("r", r, _L))
-        w = self._mu * (2.0 / r - self._inv_a - self._p / (r * r))
+        w = self._mu * (2.0 / r - self._inv_a - self._p / r / r)  # (r r overflows)
         return self._out(np.maximum(w, 0.0), "km2 / s2")  # a rounding-level negative is 0
 
     def _require_areal(self, what: str) -> None:

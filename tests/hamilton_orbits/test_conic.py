@@ -216,3 +216,25 @@ def test_hodograph_scale_free():
     for s in (1e-170, 1e300):
         rot, fix = c.hodograph([s, 0, 0])
         assert (rot + fix).tolist() == pytest.approx([0.0, 1.2, 0.0], abs=4 * EPS)
+
+
+@pytest.mark.parametrize(("length", "time"), [(1e160, 1e240), (1e-160, 1e-240)])
+def test_the_vectors_and_the_conics_lengths_scale_with_the_state(length, time):
+    """The same orbit in units of ``length`` and ``time`` (mu = 1 still): the
+    eccentricity vector and Hamilton's epsilon are the same, the conic's lengths
+    scale by ``length`` and its speeds squared by ``(length / time)^2``, to a few ulp.
+    ``r . r``, ``r r`` and ``p c`` over- or underflowed at these scales: the
+    eccentricity vector came out 1.22 long for e = 0.484, ``radial_speed_squared``
+    6.8x too big, ``normal_length`` refused."""
+    r0, v0 = np.array([1.0, 0.3, 0.1]), np.array([0.1, 1.1, 0.2])
+    one = KeplerOrbit.from_state(r0, v0, 1.0)
+    scaled = KeplerOrbit.from_state(r0 * length, v0 * (length / time), 1.0)
+    for name in ("eccentricity_vector", "hamilton_epsilon"):
+        np.testing.assert_allclose(getattr(scaled, name), getattr(one, name), rtol=0,
+                                   atol=8 * np.finfo(float).eps)
+    rn = np.linalg.norm(r0)
+    for name, factor in (("radius_of_curvature", length), ("normal_length", length),
+                         ("focal_half_chord", length),
+                         ("radial_speed_squared", (length / time) ** 2)):
+        want = getattr(one.conic, name)(rn) * factor
+        assert getattr(scaled.conic, name)(rn * length) == pytest.approx(want, rel=8e-16)
