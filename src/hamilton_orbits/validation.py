@@ -68,6 +68,9 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
         ) from exc
     except (TypeError, ValueError) as exc:
         raise ValueError(f"Expected `{name}` to be numeric, got {value!r}") from exc
+    kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
+    if kind in "USb":  # (numeric strings and bools convert, silently: "1" and True)
+        raise ValueError(f"Expected `{name}` to be numeric, got {value!r}")
     if finite:
         bad = ~np.isfinite(arr)
         if bad.any():

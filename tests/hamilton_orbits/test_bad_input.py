@@ -633,3 +633,17 @@ def test_an_event_of_a_body_or_pair_listed_twice_is_refused(events, pattern):
         Simulation(_pair_with_radii(), events=events)
     Simulation(_pair_with_radii(), events=[{"name": "close_encounter", "distance": 0.5},
                                            {"name": "close_encounter", "distance": 0.3}])
+
+
+@pytest.mark.parametrize(("what", "args"), [
+    ("quaternion", (["1", "0", "0", "0"],)),
+    ("state", (["1", "0", "0"], [0.0, 1.0, 0.0], 1.0)),
+    ("state", ([1.0, 0.0, 0.0], [False, True, False], 1.0)),
+])
+def test_numeric_strings_and_bools_are_not_numbers(what, args):
+    """``as_float_array`` converted ``"1"`` and ``True`` silently (NumPy does)."""
+    from hamilton_orbits import KeplerOrbit, Quaternion
+
+    make = Quaternion if what == "quaternion" else KeplerOrbit.from_state
+    with pytest.raises(ValueError, match=r"to be numeric, got"):
+        make(*args)
