@@ -20,7 +20,7 @@ from hamilton_orbits.restart import LayoutMismatch, flatten, restore
 from hamilton_orbits.snapshot import SnapshotError, read, write
 
 
-@pytest.mark.parametrize(("system", "kw"), _variants())
+@pytest.mark.parametrize(("system", "kw"), list(_variants()))
 def test_a_loaded_simulation_continues_with_the_bits_of_the_saved_one(system, kw, tmp_path):
     sim = Simulation(system(), **kw)
     sim.integrate(1.7)  # the merge (about t = 1.4) happens before the save

@@ -73,7 +73,7 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True))
 
 
-@pytest.mark.parametrize(("system", "kw"), _variants())
+@pytest.mark.parametrize(("system", "kw"), list(_variants()))
 def test_two_legs_reach_the_bits_of_one_call(system, kw):
     system = system()
     t1, t2, t3 = 1.3, 2.9, 4.0
@@ -102,7 +102,7 @@ def test_two_legs_reach_the_bits_of_one_call(system, kw):
 
 
 
-@pytest.mark.parametrize(("system", "kw"), _variants())
+@pytest.mark.parametrize(("system", "kw"), list(_variants()))
 def test_legs_of_one_end_time_each_reach_the_bits_of_one_call(system, kw, monkeypatch):
     """A continuing call to one end time (a float), nothing watched or asked, takes
     the engine's lean path (``Propagation.advance_end``, not ``advance``); events
