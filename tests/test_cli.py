@@ -291,3 +291,13 @@ def test_ensemble_says_its_members_write_no_archive(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("an ensemble's members write no archive") == 1
     assert not any(p.is_dir() for p in tmp_path.iterdir())  # (ensemble.csv, ensemble.md)
+
+
+def test_command_lines_that_would_lose_a_value_are_refused(capsys):
+    """A key given to two --vary used to keep the last values silently, and an empty
+    --out wrote into the default folder: both exit 2 before anything runs."""
+    assert main(["ensemble", "leo-j2", "--vary", "duration=0.5 d", "--vary",
+                 "duration=0.2 d"]) == 2
+    assert "'duration' is varied twice" in capsys.readouterr().err
+    assert main(["run", "leo-j2", "--out", ""]) == 2
+    assert "--out '': an empty path" in capsys.readouterr().err

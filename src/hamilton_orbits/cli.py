@@ -384,6 +384,9 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
         key, sep, values = item.partition("=")
         if not sep or not key.strip() or not _split_values(values):
             raise SceneError([f"{scene.source}: --vary {item!r}: expected KEY=V1,V2,..."])
+        if key.strip() in vary:  # (the later would replace the earlier silently)
+            raise SceneError([f"{scene.source}: --vary {item!r}: {key.strip()!r} is varied "
+                              f"twice; give its values in one --vary KEY=V1,V2,..."])
         vary[key.strip()] = _split_values(values)
     if not vary:  # name the command-line option, not Ensemble's Python arguments
         raise SceneError([f"{scene.source}: ensemble needs at least one --vary KEY=V1,V2,... "
@@ -592,6 +595,9 @@ def _guarded(args: argparse.Namespace) -> int:
 
 
 def _dispatch(args: argparse.Namespace) -> int:
+    if getattr(args, "out", None) is not None and not str(args.out).strip():
+        raise _CommandError(f"--out {args.out!r}: an empty path (give a folder, or leave "
+                            f"--out out for the default)")
     progress = not (args.quiet or getattr(args, "no_progress", False))
     if args.command == "demo":
         return _demo()

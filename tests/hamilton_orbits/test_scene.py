@@ -397,3 +397,37 @@ def test_a_scene_origin_is_barycenter_or_barycentre():
                              "origin": spelling}}}
         result = Scene.from_dict(data).run(progress=False)
         assert "centre of mass of the scene's solar-system bodies" in result.frame
+
+
+def test_summary_json_is_strict_json_with_a_non_finite_quantity(tmp_path):
+    """A metric Quantity that is infinite (a Lyapunov time of a regular orbit) was
+    written as ``Infinity``, which strict JSON readers refuse; it is a string, as a
+    plain float's is."""
+    import json
+
+    from hamilton_orbits.scenes.result import Result
+
+    result = Result(scene=Scene.bundled("leo-j2"), times=np.array([0.0, 1.0]) * u.d,
+                    metrics={"Lyapunov time": np.inf * u.yr, "span": [1.0, np.nan] * u.yr})
+    paths = result.save(tmp_path)
+    text = (tmp_path / "summary.json").read_text()
+
+    def refuse(constant):
+        raise ValueError(constant)
+
+    data = json.loads(text, parse_constant=refuse)
+    assert data["metrics"]["Lyapunov time"] == {"value": "inf", "unit": "yr"}
+    assert data["metrics"]["span"] == {"value": [1.0, "nan"], "unit": "yr"}
+    assert tmp_path / "summary.json" in paths
+
+
+def test_a_leg_whose_event_removed_a_body_has_no_nan_in_its_summary():
+    """The energy change was NaN after a removal (the removed body's state); it is
+    the largest over the outputs where it is defined, and says so."""
+    scene = Scene.bundled("leo-j2").with_values(
+        {"duration": "0.2 d", "events": '[{name="escape", distance="6995 km", '
+                                         'action="remove"}]'})
+    result = scene.run(progress=False)
+    text = result.summary()
+    assert "nan" not in text.lower()
+    assert "(not conserved: bodies were removed)" in result.metrics["energy"]

@@ -485,3 +485,16 @@ def test_hindcast_docstring_imports_what_it_uses():
     (test,) = doctest.DocTestFinder().find(polar_motion.hindcast, "hindcast",
                                            globs={"u": u, "hindcast": polar_motion.hindcast})
     assert doctest.DocTestRunner().run(test).failed == 0
+
+
+def test_a_scene_of_no_period_is_refused_at_loading():
+    """``periods = []`` loaded, ran, then failed as its figures were saved (a 0-row
+    grid of subplots), leaving half the files; a period of reversed dates says why."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scene import SceneError
+
+    scene = Scene.bundled("pole-prediction")
+    with pytest.raises(SceneError, match=r"periods: expected at least one"):
+        scene.with_values({"periods": "[]"})
+    with pytest.raises(SceneError, match=r"periods\[0\]: .* the first date before the second"):
+        scene.with_values({"periods": '["2016-03-01..2016-01-01"]'})

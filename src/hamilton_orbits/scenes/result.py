@@ -138,8 +138,9 @@ class Result:
 
     def _json(self) -> dict:
         def conv(v: Any) -> Any:
-            if isinstance(v, u.Quantity):
-                return {"value": v.value.tolist(), "unit": str(v.unit)}
+            if isinstance(v, u.Quantity):  # (a non-finite value as a string: strict JSON)
+                return {"value": conv(v.value.tolist()) if np.ndim(v) == 0 else
+                        [conv(x) for x in v.value.tolist()], "unit": str(v.unit)}
             if isinstance(v, np.ndarray):
                 return v.tolist()
             if isinstance(v, float) and not math.isfinite(v):

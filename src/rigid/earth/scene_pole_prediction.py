@@ -78,6 +78,8 @@ def _check(spec: dict, problems: S.Problems) -> None:
 def _check_keys(spec: dict, problems: S.Problems) -> None:
     from astropy.time import Time
 
+    if not spec["periods"]:  # (the figures have a row per period)
+        problems.add("periods", 'expected at least one "YYYY-MM-DD..YYYY-MM-DD", got []')
     for i, text in enumerate(spec["periods"]):
         parts = text.split("..") if isinstance(text, str) else []
         try:
@@ -86,7 +88,8 @@ def _check_keys(spec: dict, problems: S.Problems) -> None:
         except ValueError:
             ok = False
         if not ok:
-            problems.add(f"periods[{i}]", f'expected "YYYY-MM-DD..YYYY-MM-DD", got {text!r}')
+            problems.add(f"periods[{i}]", f'expected "YYYY-MM-DD..YYYY-MM-DD", the first '
+                                          f'date before the second, got {text!r}')
     try:
         Time(spec["start"], scale="utc")
     except ValueError:

@@ -169,13 +169,21 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     what = _effects.energy_label(gm, effects, system.names)
     conserved = _effects.effect_energy(system, effects, traj.r.value[:1],
                                        traj.v.value[:1]) is not None
-    merged = "merge" in list(traj.events["action"]) if len(traj.events) else False
-    conserved = conserved and not merged  # a merge is an inelastic collision
+    actions = list(traj.events["action"]) if len(traj.events) else []
+    merged, removed = "merge" in actions, "remove" in actions
+    conserved = conserved and not merged and not removed
     if merged:
         what += " (not conserved: merges are inelastic)"
+    if removed:
+        what += " (not conserved: bodies were removed)"
     result.metrics["energy"] = what
     key = "max |relative energy error|" if conserved else "max |relative energy change|"
-    result.metrics[key] = float(np.max(np.abs(traj.energy_error)))
+    change = np.abs(np.asarray(traj.energy_error, dtype=float))
+    if not np.isfinite(change).all():  # (no NaN in the summary: the outputs it has)
+        change = change[np.isfinite(change)]
+        key += " (while it is defined)"
+    if change.size:
+        result.metrics[key] = float(np.max(change))
     _particles_into(result, traj, gm)
     frame = scene_frame(scene.spec)
     result.frame = frame_note(scene.spec)
