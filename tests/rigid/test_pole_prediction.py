@@ -487,14 +487,17 @@ def test_hindcast_docstring_imports_what_it_uses():
     assert doctest.DocTestRunner().run(test).failed == 0
 
 
-def test_a_scene_of_no_period_is_refused_at_loading():
-    """``periods = []`` loaded, ran, then failed as its figures were saved (a 0-row
-    grid of subplots), leaving half the files; a period of reversed dates says why."""
+def test_a_scene_of_no_period_draws_its_fan_and_saves_every_file(tmp_path):
+    """``periods = []`` (the forecast from ``start`` alone, nothing scored) ran, then
+    failed as its figures were saved (a grid of 0 rows of subplots), leaving half
+    the files; a period of reversed dates says why it is refused."""
     from hamilton_orbits import Scene
     from hamilton_orbits.scene import SceneError
 
     scene = Scene.bundled("pole-prediction")
-    with pytest.raises(SceneError, match=r"periods: expected at least one"):
-        scene.with_values({"periods": "[]"})
     with pytest.raises(SceneError, match=r"periods\[0\]: .* the first date before the second"):
         scene.with_values({"periods": '["2016-03-01..2016-01-01"]'})
+    result = scene.with_values({"periods": "[]", "methods": '["persistence"]'}).run(
+        progress=False)
+    names = {p.name for p in result.save(tmp_path)}
+    assert {"summary.md", "summary.json"} <= names and any(n.endswith(".png") for n in names)

@@ -78,8 +78,6 @@ def _check(spec: dict, problems: S.Problems) -> None:
 def _check_keys(spec: dict, problems: S.Problems) -> None:
     from astropy.time import Time
 
-    if not spec["periods"]:  # (the figures have a row per period)
-        problems.add("periods", 'expected at least one "YYYY-MM-DD..YYYY-MM-DD", got []')
     for i, text in enumerate(spec["periods"]):
         parts = text.split("..") if isinstance(text, str) else []
         try:
@@ -169,8 +167,10 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         hind = sum(s.wall_time for s in by_method.values())
         result.metrics[f"hindcast {text}"] = f"{n} weekly starts, {hind:.1f} s for all methods"
     _tables(result, scores)
-    result.plotters.extend([lambda r: _plot_fan(r, record, fans, start),
-                            lambda r: _plot_mae(r, scores), lambda r: _plot_coverage(r, scores)])
+    result.plotters.append(lambda r: _plot_fan(r, record, fans, start))
+    if scores:  # (no period scored, periods = []: the fan alone, no empty grid of figures)
+        result.plotters.extend([lambda r: _plot_mae(r, scores),
+                                lambda r: _plot_coverage(r, scores)])
     return result
 
 
