@@ -94,6 +94,11 @@ def _check(spec: dict, problems: S.Problems) -> None:
         problems.add(f"effects[{i}]", f"the free rigid body takes no effects (got {eff['name']!r})")
     # kept per output: the attitude and angular velocity, integrated and exact, 4 diagnostics
     check_output_size(spec, problems, 2 * (4 + 3) + 4, "a rigid body")
+    if not problems:  # (built as the run builds it: what it would refuse fails loading)
+        try:
+            build_body(spec)
+        except ValueError as exc:
+            problems.add("body", str(exc))
 
 
 def build_body(spec: dict):

@@ -36,3 +36,24 @@ def test_rotation_scene_validation_names_the_keys(tmp_path):
     assert "body.omga: unknown key (did you mean 'omega'" in text
     assert "integrator.method: unknown value 'splitting' (did you mean 'splitting4'" in text
     assert np.all([p.startswith(str(path)) for p in info.value.problems])
+
+
+@pytest.mark.parametrize(("scene", "values", "pattern"), [
+    ("dzhanibekov", {"body.moments": '["1 kg m2", "-2 kg m2", "3 kg m2"]'},
+     r"body: Expected `inertia` > 0"),
+    ("dzhanibekov", {"body.attitude": "[0, 0, 0, 0]"}, r"body: .*nonzero quaternion"),
+    ("earth-pole-rigid", {"body.wobble": '"-1 arcsec"'}, r"body: Expected `wobble`"),
+    ("chandler-wobble", {"effects": '["free", {name = "damping", Q = -5}]'},
+     r"effects: Expected `Q` > 0"),
+    ("chandler-wobble", {"effects": '["free", {name = "elastic", chandler_period = "433 d", '
+                                    'k2 = 0.3}]'}, r"effects: .*exactly one of `k2`"),
+])
+def test_a_body_or_effects_the_run_would_refuse_fail_at_loading(scene, values, pattern):
+    """docs/scenes.md: a scene that loads does not fail at run time for a reason its
+    file holds.  These loaded and failed in the run (exit 1): the body, and the
+    polar motion's model, are now built when the scene loads."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.scene import SceneError
+
+    with pytest.raises(SceneError, match=pattern):
+        Scene.bundled(scene).with_values(values)

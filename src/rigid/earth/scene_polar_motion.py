@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import textwrap
 import time
+from types import SimpleNamespace
 from typing import Any
 
 import astropy.units as u
@@ -58,6 +59,19 @@ def _check(spec: dict, problems: S.Problems) -> None:
         if "Q" not in damping:
             problems.add(f"effects[{names.index('damping')}].Q",
                          "missing: the effect 'damping' needs a quality factor Q")
+    if not problems:  # (the model built as the run builds it, on a fit's stand-in:
+        try:  # what it would refuse fails loading, not the run)
+            _model(spec, _STAND_IN)
+        except ValueError as exc:
+            problems.add("effects", str(exc))
+
+
+#: the fitted values :func:`_model` takes where the scene gives none (its check's
+#: stand-in for the fit of the record, which loading does not make)
+_STAND_IN = SimpleNamespace(chandler_period=433.0 * u.day, annual_period=365.25 * u.day,
+                            annual_amplitude=0.0, annual_phase=0.0 * u.rad,
+                            annual_retrograde_amplitude=0.0,
+                            annual_retrograde_phase=0.0 * u.rad)
 
 
 def _model(spec: dict, fit: Any):
