@@ -20,17 +20,43 @@ def _present(result: Result, system, *bodies: str) -> np.ndarray:
     return np.flatnonzero(np.all(np.isfinite(r), axis=(1, 2)))
 
 
-def _relative_orbits(result: Result, system, body: str, primary: str, rows: np.ndarray):
-    """The orbits of ``body`` about ``primary`` at the output ``rows``."""
+def _relative_orbits(result: Result, system, body: str, primary: str, rows: np.ndarray,
+                     equator: bool = False):
+    """The orbits of ``body`` about ``primary`` at the output ``rows`` (``equator``: in
+    axes whose z is the primary's pole, when it has one: inclination and node to its
+    equator)."""
     from hamilton_orbits import KeplerOrbit
 
     names = list(system.names)
     i, j = names.index(body), names.index(primary)
     r = result.states["r"][rows, i] - result.states["r"][rows, j]
     v = result.states["v"][rows, i] - result.states["v"][rows, j]
+    pole = getattr(system[primary], "pole", None) if equator else None
+    if pole is not None:
+        axes = _equator_axes(np.asarray(pole, dtype=float))
+        r, v = r @ axes.T, v @ axes.T
     gm = system.gm
     mu = gm[i] + gm[j]
     return KeplerOrbit.from_state(r.to(u.km), v.to(u.km / u.s), mu.to(u.km**3 / u.s**2))
+
+
+def _equator_axes(pole: np.ndarray) -> np.ndarray:
+    """Rows: the axes x (the equator's ascending node on the frame's x-y plane, or
+    the frame's x where the pole is its z), y and z (the pole) of a body's equator.
+
+    Examples
+    --------
+    >>> _equator_axes(np.array([0.0, 0.0, 2.0])).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    >>> bool(np.allclose(_equator_axes(np.array([0.0, 0.5, 1.0])) @ [0.0, 0.5, 1.0],
+    ...                  [0.0, 0.0, np.hypot(0.5, 1.0)]))
+    True
+    """
+    z = pole / np.linalg.norm(pole)
+    node = np.cross([0.0, 0.0, 1.0], z)
+    x = node / np.linalg.norm(node) if np.linalg.norm(node) > 1e-12 else np.array(
+        [1.0, 0.0, 0.0])
+    return np.array([x, np.cross(z, x), z])
 
 
 def _rows_of(result: Result, system, key: str, *bodies: str, least: int = 2):
@@ -80,12 +106,13 @@ def _nodal_regression(result: Result, system, an: dict) -> None:
     rows = _rows_of(result, system, key, an["body"], primary)
     if rows is None:
         return
-    orbits = _relative_orbits(result, system, an["body"], primary, rows)
+    orbits = _relative_orbits(result, system, an["body"], primary, rows, equator=True)
     rate = _rate(result.times[rows], orbits.lan).to(u.deg / u.d)
-    result.metrics[key] = rate
+    result.metrics[key] = rate  # (the node on the primary's equator, where it has a pole)
     prim = system[primary]
     j2 = getattr(prim, "j2", None)
-    if j2 is not None and getattr(prim, "radius", None) is not None:
+    flattened = any(e["name"] in ("j2", "zonal") for e in result.scene.effects)
+    if j2 is not None and getattr(prim, "radius", None) is not None and flattened:
         # first-order secular rate: dOmega/dt = -3/2 n J2 (R/p)^2 cos i (Vallado 4th ed. 9-41)
         o = orbits[0]
         j2v = float(getattr(j2, "value", j2))
