@@ -125,3 +125,26 @@ def test_a_bad_archive_interval_is_a_bad_scene(value, capsys):
     sets = ["--set", f"output.archive_every={value}", "--set", "duration=1 d"]
     assert main(["run", "comet-encounter", *sets, "--no-progress"]) == 2
     assert "archive_every" in capsys.readouterr().err
+
+
+def test_a_scene_reading_a_relative_file_resumes_from_another_folder(tmp_path, monkeypatch):
+    """A scene whose ``[initial] rebound`` is a path relative to the folder the run
+    began in resumes from anywhere (the archive keeps that folder; the resume used
+    to fail: "no such file 'start.bin' (relative to ...)"), and the command leaves
+    the working folder as it found it."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "comet-encounter", "--out", "first", *SETS]) == 0
+    (tmp_path / "start.bin").write_bytes((tmp_path / "first" / "final.bin").read_bytes())
+    (tmp_path / "from-bin.toml").write_text(
+        'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
+        '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
+        '[output]\narchive_every = "2 d"\n', encoding="utf-8")
+    assert main(["run", "from-bin.toml", "--out", "out", "--no-progress"]) == 0
+    whole = _states(tmp_path / "out")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    assert main(["resume", str(tmp_path / "out"), "--no-progress"]) == 0
+    assert os.getcwd() == str(elsewhere)
+    resumed = _states(tmp_path / "out")
+    assert all(np.array_equal(resumed[k], whole[k], equal_nan=True) for k in whole)

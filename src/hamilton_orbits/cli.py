@@ -32,6 +32,7 @@ itself (docs/design.md).
 from __future__ import annotations
 
 import argparse
+import os
 import shlex
 import sys
 from collections.abc import Sequence
@@ -241,7 +242,8 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
                             f"({resume}) or choose another --out")
     file = _scene_file(ref)
     source = ref if file is None else str(file.resolve())
-    record = {"scene": source, "set": list(sets), "text": _scene_text(file, ref)}
+    record = {"scene": source, "set": list(sets), "text": _scene_text(file, ref),
+              "cwd": os.getcwd()}  # (where the scene's relative paths were read)
     try:  # (the scene's text kept: a resume runs the scene this run ran)
         archive.mkdir(parents=True, exist_ok=True)
         (archive / "scene.json").write_text(json.dumps(record), encoding="utf-8")
@@ -275,15 +277,22 @@ def _resume(out: str, progress: bool) -> int:
                             f"archive (no {record})")
     source = json.loads(record.read_text(encoding="utf-8"))
     text = source.get("text")  # (the scene as the run ran it; none in older archives)
-    scene = _load_scene(source["scene"], source["set"], text)
     file = _scene_file(source["scene"])
     if text is not None and file is not None and file.is_file() and \
             file.read_text(encoding="utf-8") != text:
         print(f"hamilton-orbits: {file} has changed since the run began; resuming the "
               f"scene as the run read it (kept in {record})", file=sys.stderr)
-    with OutputFolder(folder, "output folder"):
-        result = _run_scene(scene, progress, folder / "archive")
-        return _finish(scene, result, folder, folder / "archive")
+    here, there = os.getcwd(), source.get("cwd")
+    folder = folder.resolve()  # (the scene's relative paths read where the run read them)
+    try:
+        if there is not None and os.path.isdir(there):
+            os.chdir(there)
+        scene = _load_scene(source["scene"], source["set"], text)
+        with OutputFolder(folder, "output folder"):
+            result = _run_scene(scene, progress, folder / "archive")
+            return _finish(scene, result, folder, folder / "archive")
+    finally:
+        os.chdir(here)
 
 
 def _finish(scene, result, folder, archive) -> int:
