@@ -200,14 +200,10 @@ def _compile_ahead(ref: str, sets: Sequence[str]) -> None:
     """Before the scene loads (its imports take a second or two), the stepping kernel
     of a radau15 ``nbody`` scene sent to compile in a second process on a first run,
     from the scene's own text (the run itself sends it when this cannot tell)."""
-    from importlib import resources
-
     import tomllib
 
     try:
-        path = (_scene_file(ref) or
-                resources.files("hamilton_orbits") / "data" / "scenes" / f"{ref}.toml")
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        raw = tomllib.loads(_scene_text(_scene_file(ref), ref))
         method = raw.get("integrator", {}).get("method")
         for item in sets:
             key, _, value = item.partition("=")

@@ -188,6 +188,9 @@ class Propagation:
             else np.require(x, np.float64, ["C"]) for x in (r0, v0, gm))
         self.gm = self.gm0
         self.t, self.rhs, self.method, self.dt, self.tol = float(t0), rhs, method, dt, tol
+        if variational is not None and events is not None and len(events.watch):
+            raise ValueError("The variational equations are integrated without events; list "
+                             "no events, or integrate them apart")
         self.events, self.variational = events, variational
         self.module = integrator(method.name)
         #: the driver's state (made on the first leg, when the direction is known)
@@ -205,9 +208,6 @@ class Propagation:
 
     def _check(self, backward: bool) -> None:
         watched = self.events is not None and len(self.events.watch)
-        if self.variational is not None and watched:
-            raise ValueError("The variational equations are integrated without events; list "
-                             "no events, or integrate them apart")
         if self.variational is not None and self.driver is not None:
             raise ValueError(f"The variational equations are integrated in one direction: "
                              f"this run went {'back' if self.backward else 'for'}wards (to t = "

@@ -454,12 +454,16 @@ class EventLog:
     def overlapping(self, r: np.ndarray) -> bool:
         """Whether two bodies of a watched collision pair overlap at positions ``r``
         (``|r_i - r_j| <= R_i + R_j``: a collision no crossing will reveal)."""
+        return bool(self._overlaps(r)[3].size)
+
+    def _overlaps(self, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                np.ndarray]:
+        """The watched collision rows, their pairs, the pairs' distances at ``r``, and
+        which of them overlap."""
         rows = np.flatnonzero(self.watch[:, W_CODE] == EVENTS["collision"][0])
-        if not rows.size:
-            return False
         pairs = self.watch[rows][:, [W_I, W_J]].astype(int)
         d = np.linalg.norm(r[pairs[:, 0]] - r[pairs[:, 1]], axis=1)
-        return bool(np.any(d <= self.watch[rows, W_DIST]))
+        return rows, pairs, d, np.flatnonzero(d <= self.watch[rows, W_DIST])
 
     def at_start(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
         """Collisions already made at the start ``t`` of a run: every watched pair that
@@ -469,10 +473,7 @@ class EventLog:
         run must stop there."""
         code = EVENTS["collision"][0]
         while True:
-            rows = np.flatnonzero(self.watch[:, W_CODE] == code)
-            pairs = self.watch[rows][:, [W_I, W_J]].astype(int)
-            d = np.linalg.norm(r[pairs[:, 0]] - r[pairs[:, 1]], axis=1)
-            inside = np.flatnonzero(d <= self.watch[rows, W_DIST])
+            rows, pairs, d, inside = self._overlaps(r)
             if not inside.size:
                 return False
             row = int(rows[inside[0]])

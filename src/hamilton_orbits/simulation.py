@@ -176,14 +176,11 @@ class Simulation(Saving):
         step = None if dt is None else time_step(dt, system.quantity)
         tol = tolerance(tol)
         tan = tangent_of(system, variational, stm, tangent, typed)
-        log = event_log(system, events)
-        if tan is not None and log is not None and len(log.watch):  # (refused here, once)
-            raise ValueError("The variational equations are integrated without events; list "
-                             "no events, or integrate them apart")
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
-                                        tol=tol, events=log, variational=tan)
+                                        tol=tol, events=event_log(system, events),
+                                        variational=tan)
         self._system, self._effects, self._quantity = system, eff, system.quantity
         #: the state at time 0, from which Hamilton's integrals are measured (None
         #: until a first leg has begun there)

@@ -78,8 +78,8 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     times = output_times(spec)
     bar = progress_bar(len(times) - 1, progress, "output")
     on_output = None if bar is None else (lambda i, steps: bar.update(1))
+    resumed_from = None  # (the time a resumed run went on from)
     try:
-        resumed_from = None
         if spec["output"]["archive_every"] is not None and resumable(archive):
             sim = Simulation.load(archive)
             resumed_from = sim.t if isinstance(sim.t, u.Quantity) else sim.t * u.d
