@@ -12,7 +12,8 @@ saved at t = 10; archived every 2 time units through the output times 0, 1, ...,
 record holding its call (a kill after the snapshot at t = 8, in the third call).
 Run once per new format version (``archive-v1`` was written by format 1;
 ``archive-v2`` by format 2, at commit 6e3b256; ``archive-v3`` by format 3, in
-session 18 of 2026-11-29):
+session 18 of 2026-11-29; ``archive-v4`` by format 4, in session 20 of
+2026-11-29):
 
     python tools/make_snapshot_fixture.py
 """

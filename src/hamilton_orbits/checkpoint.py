@@ -67,8 +67,10 @@ __all__ = [
 
 #: the layout of an archive folder: 1, a netCDF file per snapshot; 2, segments of
 #: snapshots appended (:mod:`hamilton_orbits.segment`), one or more per leg; 3, a
-#: segment continued across the legs of one writer; every version reads them all
-ARCHIVE_VERSION = 3
+#: segment continued across the legs of one writer; 4, a leg's first row kept as
+#: its first record's state (no rows file for legs of a start and an end); every
+#: version reads them all
+ARCHIVE_VERSION = 4
 SNAPSHOT_NAME = "snapshot-{:06d}.nc"
 _SNAPSHOT_RE = re.compile(r"^snapshot-(\d{6})\.nc$")
 _TORN_RE = re.compile(r"^\.(snapshot|segment|rows)-\d{6}\.nc\.tmp-\d+$")

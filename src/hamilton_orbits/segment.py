@@ -17,7 +17,9 @@ file (64-bit offsets) with an unlimited dimension ``snapshot``:
   first snapshot, whether it began at time 0, the steps and events before it),
   ``leg_span`` (the leg's start and end times, in its first record), ``rows``
   (the first and the end of the caller's output rows in the companion file that
-  belong to it) and ``check``, the CRC-32 of the record's other bytes.
+  belong to it; :data:`OWN_ROW` twice for one row that is the record's own
+  ``t``, ``r`` and ``v``, format 4) and ``check``, the CRC-32 of the record's
+  other bytes.
 
 The caller's output rows go to a companion ``rows-NNNNNN.nc`` of the same form
 (unlimited dimension ``row``: ``t``, ``r``, ``v``, the variational equations'
@@ -81,11 +83,15 @@ __all__ = ["SEGMENT_FORMAT", "SEGMENT_NAME", "SEGMENT_RE", "Segment", "SegmentWr
            "read_segment"]
 
 SEGMENT_FORMAT = "hamilton-orbits archive segment"
-#: the archive format that segments are: 3, a segment continued across the legs of
-#: one writer, each record holding its leg (2: a segment per leg; 1 was a file per
-#: snapshot)
-SEGMENT_VERSION = 3
+#: the archive format that segments are: 4, a leg's first row kept as its first
+#: record's state (3: written in the rows file too; 3 and 4 continue a segment
+#: across the legs of one writer, each record holding its leg; 2: a segment per
+#: leg; 1 was a file per snapshot)
+SEGMENT_VERSION = 4
 SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
+#: a record's ``rows`` (both ends) when its one output row is its own state, not
+#: written in the rows file (format 4: a leg's first row, at its start)
+OWN_ROW = -1
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
 #: the record of a snapshot of a propagation's state, in its stored order
 _STATE_RECORD = ["t", "r", "v", "gm", "state", "scalars", "steps", "rows", "active"]
@@ -245,6 +251,21 @@ def _mapped_count(fd: int) -> mmap.mmap | None:
         return None
 
 
+def _own_row(snapshot: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> bool:
+    """Whether the one output row of ``rows`` is ``snapshot``'s own state: its time,
+    positions and velocities the snapshot's bit for bit, and nothing else in it."""
+    if rows.keys() != {"out_t", "out_r", "out_v"}:
+        return False
+    return all(_same_bits(rows[f"out_{k}"][0], snapshot.get(k)) for k in ("t", "r", "v"))
+
+
+def _same_bits(a: np.ndarray, b: Any) -> bool:
+    """Whether ``b`` is float64 values of ``a``'s shape and bits (-0.0 is not 0.0,
+    a NaN is its own payload)."""
+    b = np.asarray(b)
+    return b.dtype == np.float64 and b.shape == a.shape and b.tobytes() == a.tobytes()
+
+
 def _joinable(arrays: list[np.ndarray]) -> tuple[list[Any], list[tuple[int, np.ndarray]]]:
     """``arrays`` as pieces whose native bytes join into float64 values: the
     contiguous float64 arrays themselves (their values read when joined), and the
@@ -365,9 +386,15 @@ class SegmentWriter:
 
     def append(self, snapshot: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append the caller's output ``rows`` (``out_t``, ``out_r``, ... of
-        :meth:`~hamilton_orbits.checkpoint.LegRows.take`) and then the snapshot."""
+        :meth:`~hamilton_orbits.checkpoint.LegRows.take`) and then the snapshot.  A
+        row that is the snapshot's own state (a leg's first, at its start: the
+        snapshot's ``t``, ``r`` and ``v``, bit for bit, nothing else) is not written
+        twice: the record's ``rows`` say so (:data:`OWN_ROW`, format 4), and a
+        segment of such legs has no rows file."""
         n = len(rows.get("out_t", ()))
         start = 0 if self._rows is None else self._rows.count
+        if n == 1 and _own_row(snapshot, rows):
+            n, start = 0, OWN_ROW
         if n:
             names = [k for k in _ROWS if k in rows]
             if self._rows is None:
@@ -383,9 +410,10 @@ class SegmentWriter:
         if self.legs:
             self.tail = (*snapshot["leg"], *NO_SPAN)
         if self._direct and type(snapshot["state"]) is Parts and self._append_state(
-                snapshot, start, start + n):
+                snapshot, start, start + n if start != OWN_ROW else OWN_ROW):
             return
-        span = np.array([start, start + n], dtype=np.float64)
+        span = np.array([start, start + n] if start != OWN_ROW else [OWN_ROW, OWN_ROW],
+                        dtype=np.float64)
         self._file.append([[span if k == "rows" else _stored(k, snapshot[k])
                             for k in self.names]])
 
@@ -770,8 +798,10 @@ def _read_back(path: Path, number: int | None = None) -> Segment | None:
                 bad.append((k, "its CRC-32 does not match"))
                 continue
             before, end = (int(x) for x in rec["rows"])
-            rows, torn = _rows_span(rows_path, before, end)
-            rec.update(_index=np.int64(k), rows=np.array([0.0, end - before]))
+            rows, torn = (None, []) if before == OWN_ROW else _rows_span(rows_path, before, end)
+            rec["_index"] = np.int64(k)
+            if before != OWN_ROW:
+                rec["rows"] = np.array([0.0, end - before])
             _split(seg, shared, dict(fixed), [rec], rows)
             if seg.snapshots:
                 seg.torn += torn
@@ -843,7 +873,10 @@ def _split(seg: Segment, shared: dict[str, Any], fixed: dict[str, np.ndarray],
         arrays["t"] = np.float64(rec["t"])
         if k == 0 and leg_times is not None:
             arrays["leg_times"] = leg_times
-        if rows is not None and (not rows or end > len(rows["out_t"])):
+        if before == OWN_ROW:  # (its one row its own state, format 4)
+            arrays.update(out_t=arrays["t"].reshape(1), out_r=rec["r"][None], out_v=rec["v"][None])
+            seg.snapshots.append((number, meta, arrays))
+        elif rows is not None and (not rows or end > len(rows["out_t"])):
             seg.damaged.append((seg.path, f"{seg.path}: the output rows of snapshot "
                                           f"{number} are missing or damaged"))
         else:

@@ -398,9 +398,10 @@ def test_a_synced_archive_syncs_each_snapshot_before_the_run_goes_on(tmp_path, m
     before = len(synced)
     Simulation(_disc(), method="radau15", archive=tmp_path / "free", every=1.0).integrate(3.0)
     assert len(synced) == before  # (the default: nothing synced)
-    for name in ("segment-000000.nc", "rows-000000.nc"):
-        one, other = ((tmp_path / f / name).read_bytes() for f in ("sync", "free"))
-        assert one[parse(one).record_begin:] == other[parse(other).record_begin:], name
+    one, other = ((tmp_path / f / "segment-000000.nc").read_bytes() for f in ("sync", "free"))
+    assert one[parse(one).record_begin:] == other[parse(other).record_begin:]
+    # (the call's one row, at its start, is the first record's own state: no rows file)
+    assert not any((tmp_path / f / "rows-000000.nc").exists() for f in ("sync", "free"))
     again = Simulation.load(tmp_path / "sync")
     again.integrate(4.0)
     assert len(synced) >= before + 4 and Archive(tmp_path / "sync").times[-1] == 4.0
@@ -796,9 +797,10 @@ def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was
         sim.integrate(30.0)
     monkeypatch.setattr(os, "pwrite", real)
     archive = Archive(tmp_path / "a")
-    assert archive.times.tolist() == [0.0, 2.5] and not archive.damaged and not archive.torn
-    assert not (tmp_path / "a" / ".hamilton-orbits.lock").exists()
-    assert sim.t == 5.0
+    # (three records: the call's first row is the first record's state, format 4)
+    assert archive.times.tolist() == [0.0, 2.5, 5.0] and not archive.damaged
+    assert not archive.torn and not (tmp_path / "a" / ".hamilton-orbits.lock").exists()
+    assert sim.t == 7.5
     end = sim.integrate(40.0)
     whole = Simulation(_disc(), archive=tmp_path / "b", **KW)
     whole.integrate(30.0)
@@ -839,7 +841,9 @@ def test_a_simulations_calls_go_on_in_one_segment_each_snapshot_keeping_its_leg(
         sim.integrate(t)
     # one segment; the leg of three output times begins another
     assert [first for first, _ in snapshot_files(tmp_path)] == [0, starts[3]]
-    assert len(list(tmp_path.glob("rows-*.nc"))) == 2
+    # (a rows file for the rows at 1.7 and 1.9 alone: each other row is at its leg's
+    # start or a snapshot time, its record's own state, format 4)
+    assert [p.name for p in tmp_path.glob("rows-*.nc")] == [f"rows-{starts[3]:06d}.nc"]
     by_number = {n: (meta, arrays) for n, _, meta, arrays in contents(tmp_path).snapshots}
     assert sorted(by_number) == list(range(sim._archive.count))
     ends = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
@@ -1014,9 +1018,11 @@ def test_an_archive_of_the_second_format_is_read_and_continued(tmp_path):
     assert [first for first, _ in snapshot_files(folder)] == [0, 3]  # (one for both)
 
 
-def test_an_archive_of_the_third_format_is_read_and_continued(tmp_path):
+@pytest.mark.parametrize("version", [3, 4])
+def test_an_archive_of_the_third_format_is_read_and_continued(tmp_path, version):
     """``data/archive-v3`` was written by archive format 3 (tools/make_snapshot_fixture.py,
-    session 18 of 2026-11-29): the planet of
+    session 18 of 2026-11-29), ``data/archive-v4`` by format 4 (session 20; a
+    snapshot's one row, when its own state, not in the rows file): the planet of
     ``test_an_archive_of_the_first_format_is_read_and_continued`` through the
     outputs 0, 1, ..., 5, then two calls, to 7 and to 9, in the same segment, each
     record holding its call; it looks as a kill in the third call after its
@@ -1028,11 +1034,16 @@ def test_an_archive_of_the_third_format_is_read_and_continued(tmp_path):
     from hamilton_orbits import KeplerOrbit
 
     folder = tmp_path / "archive"
-    shutil.copytree(Path(__file__).parent / "data" / "archive-v3", folder)
+    shutil.copytree(Path(__file__).parent / "data" / f"archive-v{version}", folder)
     archive = Archive(folder)
     assert archive.times.tolist() == [0.0, 2.0, 4.0, 5.0, 6.0, 7.0, 8.0]
     assert not archive.damaged and not archive.torn
-    assert parse((folder / "segment-000000.nc").read_bytes()).attrs["format_version"] == 3
+    for name in ("segment-000000.nc", "rows-000000.nc"):
+        assert parse((folder / name).read_bytes()).attrs["format_version"] == version
+    # (the rows 0, 1, ..., 5 and 7; or those a record's state is not: a snapshot's
+    # rows since the last, when more than its own)
+    rows = parse((folder / "rows-000000.nc").read_bytes()).numrecs
+    assert rows == (7 if version == 3 else 4)
     assert [first for first, _ in snapshot_files(folder)] == [0]
     orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.5, argp=1.0, nu=0.0, mu=1.0)
 

@@ -129,14 +129,15 @@ def _same_snapshot(a, b):
 
 def _long_segment(tmp_path, every=0.2):
     """A wh run of the sun and the earth archived ``every`` 0.2 through outputs at 0,
-    3 and 6: one segment of 31 snapshots, its rows file holding three rows, the
-    first record the leg's times."""
+    3.1 and 6: one segment of 31 snapshots, the first record the leg's times, its
+    rows file holding the row at 3.1 (the rows at 0 and 6, snapshot times, are
+    their records' own states, format 4)."""
     from hamilton_orbits import Body, System
 
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
                 Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
     Simulation(s, method="wh", dt=0.05, archive=tmp_path, every=every).integrate(
-        np.arange(0.0, 7.0, 3.0))
+        np.array([0.0, 3.1, 6.0]))
     path, = tmp_path.glob("segment-*.nc")
     return path
 
@@ -160,8 +161,16 @@ def test_the_last_snapshot_and_any_one_read_alone_are_those_of_the_whole_segment
     last = read_segment(path, last=True)
     assert len(last.snapshots) == 1 and _same_snapshot(last.snapshots[0], whole[-1])
     assert not last.damaged and not last.torn
-    # its header and fixed part (64 KiB asked, the file being shorter), one record;
-    # the rows file's header and one row
+    # its header and fixed part (64 KiB asked, the file being shorter), one record,
+    # whose one row (the output at 6, a snapshot time) is its own state (format 4)
+    assert len(read) == 2 and read[1] == record
+    assert last.snapshots[0][2]["out_t"].tolist() == [6.0]
+    # the snapshot after the output at 3.1 (not a snapshot time): its row read from
+    # the rows file, its header and that one row
+    k, = (k for k, (_, _, a) in enumerate(whole) if a["out_t"].tolist() == [3.1])
+    read.clear()
+    one = read_segment(path, number=k)
+    assert _same_snapshot(one.snapshots[0], whole[k]) and whole[k][1]["t"] > 3.1
     assert len(read) == 4 and read[1] == record
     for k in (0, 7, 30):
         one = read_segment(path, number=k).snapshots
@@ -200,3 +209,39 @@ def test_a_flipped_byte_is_never_read_as_data_by_the_last_or_one_snapshot_read_a
             for k in (0, 3, 6):
                 one = read_segment(path, number=k).snapshots
                 assert one == [] or _same_snapshot(one[0], original[k]), (file.name, i, k)
+
+
+def test_a_row_that_is_its_snapshots_own_state_is_kept_as_that_state(tmp_path):
+    """Format 4: a snapshot's one row that is its own ``t``, ``r``, ``v`` bit for bit
+    is not written to the rows file (its record's ``rows`` are ``(-1, -1)``) and is
+    read back as those values; a row that differs in one bit (a time of -0.0 at a
+    state of 0.0, a position one ulp off) or that carries more (a second row) is
+    written and read from the rows file."""
+    from scipy.io import netcdf_file
+
+    from hamilton_orbits.segment import OWN_ROW, read_segment
+
+    r = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    snap = {"t": np.float64(0.0), "steps": 0, "r": r, "v": v, "active": np.ones(2, bool)}
+
+    def rows(t, dr=0.0):
+        return {"out_t": np.array([t]), "out_r": (r + dr)[None], "out_v": v[None]}
+
+    cases = [("own", rows(0.0)), ("signed", rows(-0.0)),
+             ("moved", rows(0.0, np.array([[0.0] * 3, [np.spacing(1.0), 0.0, 0.0]]))),
+             ("two", {k: np.concatenate([a, a]) for k, a in rows(0.0).items()})]
+    for name, given in cases:
+        folder = tmp_path / name
+        folder.mkdir()
+        seg = SegmentWriter(folder, 0, {"kind": "demo"}, {}, snap, {"r": ("body", "xyz")})
+        seg.append(snap, given)
+        seg.close()
+        own = name == "own"
+        assert (folder / "rows-000000.nc").exists() == (not own), name
+        with netcdf_file(seg.path, "r", mmap=False) as nc:  # (as any reader sees it)
+            span = nc.variables["rows"][0].tolist()
+        assert span == ([OWN_ROW, OWN_ROW] if own else [0, len(given["out_t"])]), name
+        (_, _, arrays), = read_segment(seg.path).snapshots
+        for k in ("t", "r", "v"):
+            assert arrays[f"out_{k}"].tobytes() == given[f"out_{k}"].tobytes(), (name, k)
