@@ -15,7 +15,13 @@ from __future__ import annotations
 import itertools
 import os
 import socket
+import time
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - platforms without flock: takeovers unguarded
+    fcntl = None  # type: ignore[assignment]
 
 __all__ = ["LOCK_NAME", "FolderError", "OutputFolder"]
 
@@ -38,6 +44,23 @@ def _alive(pid: int) -> bool:
     except OSError:  # pragma: no cover - platforms without signal 0
         return True
     return True
+
+
+def _hold(fd: int, patience: float = 2.0) -> None:
+    """Hold an exclusive ``flock`` on file ``fd`` (released when it is closed, or
+    its process ends); another run taking the same lock over holds it for
+    microseconds: waited for, up to ``patience`` seconds."""
+    if fcntl is None:  # pragma: no cover - platforms without flock
+        return
+    give_up = time.monotonic() + patience
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if time.monotonic() > give_up:
+                raise
+            time.sleep(0.001)
 
 
 class OutputFolder:
@@ -73,7 +96,8 @@ class OutputFolder:
         self._lock = self.path / LOCK_NAME
         #: the lock's text: the PID and host, and a number of this claim's own (two
         #: claims of one process told apart: a claim releases only its own lock)
-        self._mine = f"{os.getpid()} {socket.gethostname()} {next(_CLAIMS)}\n"
+        self._claim = next(_CLAIMS)
+        self._mine = f"{os.getpid()} {socket.gethostname()} {self._claim}\n"
 
     def _fail(self, why: str) -> FolderError:
         return FolderError(f"{self.option} {self.path}: {why}; nothing was run")
@@ -83,7 +107,7 @@ class OutputFolder:
         # the lock is written whole under a name of its own, then linked to its name
         # (atomic, and refused if the name exists): a run killed at any moment leaves
         # no empty lock that would look like an unknown run's
-        mine = os.path.join(self.path, f"{LOCK_NAME}.{os.getpid()}")
+        mine = os.path.join(self.path, f"{LOCK_NAME}.{os.getpid()}.{self._claim}")
         try:
             fd = os.open(mine, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o666)
             try:
@@ -126,11 +150,34 @@ class OutputFolder:
             raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
 
     def _take_over_stale(self) -> None:
-        """Remove the lock of a run that has ended; refuse one of a live run."""
+        """Remove the lock of a run that has ended; refuse one of a live run.
+
+        The lock is held (``flock``) while it is judged and removed, and removed
+        only while it is still the folder's lock: of two runs that find one stale
+        lock at once, one takes it over and the other, after it, finds the
+        winner's lock (otherwise the second would remove the first's new lock as
+        "the stale one", and both would write)."""
         try:
-            held = self._lock.read_text(encoding="utf-8", errors="replace").split()
+            fd = os.open(self._lock, os.O_RDONLY)
         except FileNotFoundError:  # released meanwhile
             return
+        try:
+            try:
+                _hold(fd)
+            except BlockingIOError:
+                raise self._fail("another run keeps taking the folder over") from None
+            try:
+                if not os.path.samestat(os.fstat(fd), os.stat(self._lock)):
+                    return  # (taken over or released meanwhile: tried again)
+            except FileNotFoundError:
+                return
+            self._judge(os.read(fd, 4096).decode("utf-8", errors="replace").split())
+        finally:
+            os.close(fd)
+
+    def _judge(self, held: list[str]) -> None:
+        """Remove the lock whose text is ``held`` (PID, host) if its run has ended;
+        refuse it otherwise."""
         pid = int(held[0]) if held and held[0].isdigit() else None
         host = held[1] if len(held) > 1 else "?"
         if pid is not None and host == socket.gethostname() and not _alive(pid):

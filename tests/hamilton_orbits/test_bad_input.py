@@ -20,6 +20,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 
 import astropy.units as u
 import numpy as np
@@ -206,6 +207,57 @@ def test_the_lock_is_taken_released_and_taken_over_when_stale(tmp_path):
     lock.write_text("1234 elsewhere\n")  # another machine: its liveness is unknown
     with pytest.raises(FolderError, match=r"PID 1234 on elsewhere.*delete .*lock"):
         OutputFolder(tmp_path).__enter__()
+
+
+def test_two_runs_that_find_one_stale_lock_at_once_do_not_both_take_it(tmp_path,
+                                                                      monkeypatch):
+    """Two claims (threads; each its own claim) find the lock of a run that has
+    ended at once; the second judges it after the first took it over (the second
+    held back 50 ms where it can be): one claim holds the folder and the other is
+    refused, its lock the holder's.  (Before, the second removed the first's new
+    lock as the stale one, and both held the folder.)"""
+    import threading
+
+    from hamilton_orbits import _outdir
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    lock = tmp_path / LOCK_NAME
+    lock.write_text(f"{int(dead.stdout)} {os.uname().nodename}\n")
+    met, order, real = threading.Barrier(2), [], _outdir._alive
+
+    def judged_together(pid):
+        try:
+            met.wait(timeout=0.3)  # (reached at once where nothing holds one back)
+        except threading.BrokenBarrierError:
+            pass
+        order.append(threading.get_ident())
+        if order.index(threading.get_ident()) == 1:
+            time.sleep(0.05)
+        return real(pid)
+
+    monkeypatch.setattr(_outdir, "_alive", judged_together)
+    claims = [OutputFolder(tmp_path, "archive") for _ in range(2)]
+    outcome = {}
+
+    def claim(k):
+        try:
+            outcome[k] = claims[k].__enter__()
+        except FolderError as exc:
+            outcome[k] = exc
+
+    threads = [threading.Thread(target=claim, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    held = [k for k in range(2) if isinstance(outcome[k], OutputFolder)]
+    assert len(held) == 1, outcome
+    refused = outcome[1 - held[0]]
+    assert isinstance(refused, FolderError) and "same process" in str(refused)
+    assert lock.read_text() == claims[held[0]]._mine
+    claims[held[0]].__exit__(None, None, None)
+    assert not lock.exists() and [p.name for p in tmp_path.iterdir()] == []
 
 
 def test_an_output_folder_that_cannot_be_created_is_refused(tmp_path):
