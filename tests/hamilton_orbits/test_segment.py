@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_archive import RADAU15_STEPPED, _same, flipped_bytes
+from test_archive import RADAU15_STEPPED, _same, flipped_bytes, loop_compiled
 
 from hamilton_orbits import Archive, Simulation, _saving
 from hamilton_orbits._netcdf3 import parse
@@ -262,6 +262,7 @@ def test_the_snapshots_written_from_the_compiled_loop_are_the_pauses_records(
     ``max_steps``; the run's bits are the plain run's."""
     from hamilton_orbits._kernels.snapshots import IO_WRITTEN
 
+    loop_compiled()
     system, kw = RADAU15_STEPPED[case]
     written, counted = [0], _saving._EverySteps.kernel_wrote
 

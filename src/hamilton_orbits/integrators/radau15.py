@@ -35,6 +35,7 @@ step, the state between calls, and the output arrays.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -59,6 +60,35 @@ DEFAULT_CRITERION = "prs23"
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
+
+
+#: the compiled loop that writes an archive's snapshots (``advance_archived``): sent
+#: to compile ahead (True) or not (False), None before a run asks for it; and when
+#: a pause last looked whether that ended
+_LOOP_WRITES: list[Any] = [None, 0.0]
+
+
+def loop_writes() -> bool:
+    """Whether the compiled loop that writes an archive's snapshots may be called
+    now: compiled or in the on-disk cache, or else compiled at its first call where
+    it cannot be compiled ahead.  On a first run of two cores a second process
+    compiles it (5 s) while the pauses write the snapshots; they look whether it has
+    ended every 0.25 s."""
+    from hamilton_orbits._kernels.entry import EntryKernel, compiled_ahead
+    from hamilton_orbits._kernels.entry import compile_ahead as send
+
+    kernel = _k.advance_archived  # (the dispatcher itself once compiled)
+    if not isinstance(kernel, EntryKernel) or kernel.compiled:
+        return True
+
+    state, now = _LOOP_WRITES, time.monotonic()
+    if state[0] is None:
+        state[0], state[1] = bool(send([kernel])), now
+        return not state[0]
+    if now - state[1] < 0.25:
+        return False
+    state[1] = now
+    return compiled_ahead(kernel)
 
 
 def compile_ahead(events: bool) -> None:
@@ -380,7 +410,7 @@ class _Run:
                     again = True
                 # (the pause's snapshots written from the kernel's loop where it can:
                 # no pause then)
-                arch = None if log.watch.shape[0] else pause.in_kernel(self)
+                arch = None if log.watch.shape[0] or not loop_writes() else pause.in_kernel(self)
                 if arch is None:
                     budget = min(budget, max(pause.at - self.steps, 1))
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
