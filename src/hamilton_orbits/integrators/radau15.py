@@ -62,9 +62,9 @@ RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 SLICE = 20000
 
 
-#: the compiled loop that writes an archive's snapshots (``advance_archived``): sent
-#: to compile ahead (True) or not (False), None before a run asks for it; and when
-#: a pause last looked whether that ended
+#: the compiled loop that writes an archive's snapshots (``advance_archived``): being
+#: compiled ahead (True) or not (False), None before a run asks for it; and when a
+#: pause last looked whether that ended
 _LOOP_WRITES: list[Any] = [None, 0.0]
 
 
@@ -84,11 +84,13 @@ def loop_writes() -> bool:
     state, now = _LOOP_WRITES, time.monotonic()
     if state[0] is None:
         state[0], state[1] = bool(send([kernel])), now
-        return not state[0]
+    if not state[0]:  # (not sent: compiled, or loaded from the cache, at its first call)
+        return True
     if now - state[1] < 0.25:
         return False
     state[1] = now
-    return compiled_ahead(kernel)
+    state[0] = not compiled_ahead(kernel)
+    return not state[0]
 
 
 def compile_ahead(events: bool) -> None:
