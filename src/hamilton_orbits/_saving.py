@@ -23,7 +23,6 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits._kernels import snapshots as _snap
 from hamilton_orbits._legs import leg_run
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
@@ -506,15 +505,10 @@ class _EveryWall:
 
 class _EverySteps:
     """An archive's ``every_steps`` snapshots taken between two steps, for a driver
-    that can pause there (:meth:`~hamilton_orbits.engine.Propagation.advance`), or
-    written from its compiled loop (:meth:`in_kernel`)."""
+    that can pause there (:meth:`~hamilton_orbits.engine.Propagation.advance`)."""
 
     def __init__(self, sim: Saving) -> None:
         self.sim, self.arch = sim, sim._archive
-        #: the segment as the compiled loop writes to it, and the segment and its
-        #: count of records it was made for (made again when Python wrote since)
-        self.kernel: tuple[Any, ...] | None = None
-        self.kernel_for: tuple[Any, int] | None = None
 
     @property
     def at(self) -> int:
@@ -523,75 +517,3 @@ class _EverySteps:
 
     def __call__(self, again: bool = False) -> None:
         self.sim._snapshot(self.sim._leg, again)
-
-    def in_kernel(self, driver: Any, prop: Any) -> tuple[Any, ...] | None:
-        """The segment as ``driver``'s compiled loop appends the next snapshots to
-        it (:func:`~hamilton_orbits._kernels.snapshots.write_snapshot`: the records
-        the pauses would append, without pausing), right after a pause appended one
-        (:meth:`~hamilton_orbits.segment.SegmentWriter.refill`); None where the loop
-        cannot (events, the variational equations, a state whose parts it does not
-        know, a synced archive)."""
-        seg, leg = self.arch.segment, self.sim._leg
-        if (seg is None or prop.events is not None or prop.variational is not None
-                or (leg is not None and (leg.rows or leg.times is not None))):
-            return None  # (rows waiting for the next snapshot: Python's to write)
-        if self.kernel_for != (seg, seg.count):
-            self.kernel_for = (seg, seg.count)
-            self.kernel = _kernel_archive(self.sim, seg, driver, prop)
-        if self.kernel is None:
-            return None
-        io = self.kernel[3]
-        io[_snap.IO_NEXT] = self.at - prop.steps
-        io[_snap.IO_DRIVER0], io[_snap.IO_STEPS0] = driver.steps, prop.steps
-        io[_snap.IO_WRITTEN] = 0
-        return self.kernel
-
-    def kernel_wrote(self, kernel: tuple[Any, ...]) -> None:
-        """Count the snapshots the compiled loop appended (:meth:`in_kernel`)."""
-        io, arch = kernel[3], self.arch
-        written = int(io[_snap.IO_WRITTEN])
-        if written:
-            arch.segment.kernel_wrote(io)
-            arch.count += written
-            arch.last_steps = int(io[_snap.IO_STEPS0] + io[_snap.IO_LAST])
-            arch.last_wall = arch.clock()
-            self.kernel_for = (arch.segment, arch.segment.count)
-
-
-#: the numbers of a radau15 propagation's state that a run from its compiled loop
-#: keeps (its time and the driver's step count change: the loop writes them)
-_KEPT_NUMBERS = {("driver", "max_steps"), ("driver", "log", "gone"), ("backward",),
-                 ("steps_before",), ("stop_at_start",)}
-
-
-def _kernel_archive(sim: Saving, seg: Any, driver: Any, prop: Any) -> tuple[Any, ...] | None:
-    """:meth:`~hamilton_orbits.segment.SegmentWriter.kernel_archive` for the
-    propagation's state as the last snapshot's capture reads it: each value named
-    by where it is (the propagation's positions and velocities: the loop's; the
-    driver's arrays: themselves; the masses, the events' log without events:
-    kept), or None where one is none of those."""
-    known, pwrite = sim._record_cache.get("appended"), _snap.pwrite_address()
-    if known is None or known[0] is not seg or pwrite is None or not hasattr(
-            driver, "kernel_arrays"):
-        return None
-    arrays, numbers = known[2][0].paths()
-    taken = known[2][0].take(prop)
-    if taken is None:
-        return None
-    sources = driver.kernel_arrays()
-    codes: list[int | None] = [_snap.SRC_X, _snap.SRC_V, None]  # (r, v, gm)
-    for path, a in zip(arrays, taken[0], strict=True):
-        if path in (("r",), ("v",)):
-            codes.append(_snap.SRC_X if path == ("r",) else _snap.SRC_V)
-        elif id(a) in sources:
-            codes.append(sources[id(a)])
-        elif path in (("gm0",), ("gm",)) or path[:2] == ("driver", "log"):
-            codes.append(None)
-        else:
-            return None
-    for path in numbers:
-        if path not in _KEPT_NUMBERS and path not in (("t",), ("driver", "steps")):
-            return None
-        codes.append(_snap.SRC_T if path == ("t",) else _snap.SRC_DRIVER_STEPS
-                     if path == ("driver", "steps") else None)
-    return seg.kernel_archive(codes, sim._archive.every_steps, pwrite)

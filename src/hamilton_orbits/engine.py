@@ -429,17 +429,6 @@ class _Pause:
     def at(self) -> int:
         return self.pause.at - self.prop.steps_before
 
-    def in_kernel(self, driver: Any) -> Any:
-        """What the driver's compiled loop takes to write the caller's next pauses
-        itself (the caller's ``in_kernel``, for a run of ``driver``), or None."""
-        inner = getattr(self.pause, "in_kernel", None)
-        return None if inner is None else inner(driver, self.prop)
-
-    def kernel_wrote(self, arch: Any) -> None:
-        """After a call of the loop given ``arch`` (:meth:`in_kernel`): the caller
-        counts what it wrote."""
-        self.pause.kernel_wrote(arch)
-
     def __call__(self, again: bool = False) -> None:
         """Stand at the driver's state and pause (``again``: as the driver says, only
         its steps since the last pause; then also only ``r``, ``v``, ``t`` of the

@@ -272,29 +272,6 @@ class Capture:
             if "attrs" in node or "items" in node or "dict" in node:
                 self._compile(x, node, len(self.ops))
 
-    def paths(self) -> tuple[list[tuple[Any, ...]], list[tuple[Any, ...]]]:
-        """Where each array and each number :meth:`take` returns is found: the keys
-        (attribute names, item positions) from the root, in its order.
-
-        Examples
-        --------
-        >>> class Leaf:
-        ...     def __init__(self):
-        ...         self.t, self.x = 2.5, np.zeros(2); self.pair = (self.x, 3)
-        >>> leaf = Leaf()
-        >>> Capture(leaf, flatten(leaf, [])[0]).paths()
-        ([('x',)], [('t',), ('pair', 1)])
-        """
-        where: list[tuple[Any, ...]] = []
-        arrays, numbers = [], []
-        for code, _, parent, key, _ in self.ops:
-            where.append((*(where[parent - 1] if parent else ()), key))
-            if code == _ARR:
-                arrays.append(where[-1])
-            elif code in (_NUM, _NPNUM):
-                numbers.append(where[-1])
-        return arrays, numbers
-
     def take(self, obj: Any) -> tuple[list[np.ndarray], list[Any]] | None:
         """The arrays and numbers ``flatten(obj, scalars)`` would give (its layout the
         one this capture was made from), or None where the graph's shape differs."""

@@ -68,17 +68,6 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._kernels.snapshots import (
-    CRC_TABLES,
-    IO_COUNT,
-    IO_END,
-    IO_EVERY,
-    IO_FD,
-    IO_PWRITE,
-    IO_SIZE,
-    SRC_STEPS,
-    SRC_T,
-)
 from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, encode, parse
 from hamilton_orbits.snapshot import (
     INT_EXACT,
@@ -167,14 +156,9 @@ class _Appender:
         return data
 
     def write(self, data: bytes | bytearray, count: int) -> None:
-        """Write ``count`` whole records ``data`` after the last, then count them (a
-        write that takes part of them goes on with the rest: a file that then
-        refuses it, full, raises before they are counted)."""
+        """Write ``count`` whole records ``data`` after the last, then count them."""
         try:
-            view, at = memoryview(data), self.end
-            while view:
-                done = os.pwrite(self.fd, view, at)
-                view, at = view[done:], at + done
+            os.pwrite(self.fd, data, self.end)
             if self.numrecs is not None:  # (after the records: the count never runs ahead)
                 struct.pack_into(">i", self.numrecs, NUMRECS_AT, self.count + count)
             else:
@@ -380,10 +364,6 @@ class SegmentWriter:
         self._kept: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
         #: what the last :meth:`_append_state` filled from, for :meth:`refill`
         self._last: tuple[Any, ...] | None = None
-        #: the records counted when :meth:`_append_state` or :meth:`refill` last
-        #: wrote one (the buffer then holds the file's last record, of the same
-        #: state's parts: the template of :meth:`kernel_archive`)
-        self.state_at = -1
         # (rows of a segment of this number that a killed run began and this replaces)
         (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
 
@@ -475,7 +455,6 @@ class SegmentWriter:
         views[-2][...] = active  # (the last variable is check)
         file.write(file.checked(), 1)
         self._last = (r, v, gm, active, *_joinable([r, v, gm, *kept[0]]))
-        self.state_at = file.count
         return True
 
     def refill(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
@@ -514,50 +493,7 @@ class SegmentWriter:
         head[1:] = np.frombuffer(b"".join(
             [*pieces, np.array([*scalars, steps, *self.tail, start, start], dtype=np.float64)]))
         file.write(file.checked(), 1)
-        self.state_at = file.count
         return True
-
-    def kernel_archive(self, codes: list[int | None], every: int,
-                       pwrite: int) -> tuple[np.ndarray, ...] | None:
-        """The segment as :func:`~hamilton_orbits._kernels.snapshots.write_snapshot`
-        appends to it from a compiled run, ``(plan, template, rec, io, tables)``,
-        when the file's last record holds the same state's parts (written by
-        :meth:`refill` or :meth:`_append_state`): the records it appends are those
-        :meth:`refill` would, ``codes`` naming the source of each of their values
-        that changes (``SRC_*``; None: the value last written, which stays) in the
-        order :meth:`refill` fills them: ``r``, ``v``, ``gm``, each state array, each
-        number of the state (``t`` and ``steps`` are the run's own; the leg, no leg
-        span and no rows, as :meth:`refill` writes them).  ``every``: the steps
-        between two; ``pwrite``: its address.  None where the last record is not
-        such, the file is synced or a value that is not float64 would change."""
-        file, last = self._file, self._last
-        if (last is None or self.state_at != file.count or self.sync
-                or file.numrecs is None or file.fd < 0):
-            return None
-        sizes = [a.size for a in (last[0], last[1], last[2], *self._kept[0])]
-        sizes += [1] * file.buffer.views[5].size
-        if len(codes) != len(sizes) or any(codes[k] is not None for k, _ in last[5]):
-            return None
-        rows, at = [(0, SRC_T, 1)], 1
-        for code, size in zip(codes, sizes, strict=True):
-            if code is not None:
-                rows.append((at, code, size))
-            at += size
-        rows.append((at, SRC_STEPS, 1))
-        template = file.buffer.runs[0][2].astype(np.float64)
-        start = 0 if self._rows is None else self._rows.count
-        template[at + 1:] = (*self.tail, start, start)
-        io = np.zeros(IO_SIZE, np.int64)
-        io[[IO_EVERY, IO_FD, IO_END, IO_COUNT, IO_PWRITE]] = (every, file.fd, file.end,
-                                                            file.count, pwrite)
-        return (np.array(rows, np.int64), template,
-                np.frombuffer(bytearray(file.buffer.data), np.uint8), io, CRC_TABLES)
-
-    def kernel_wrote(self, io: np.ndarray) -> None:
-        """Count the records a compiled run appended (:meth:`kernel_archive`'s ``io``)."""
-        file = self._file
-        file.count, file.end = int(io[IO_COUNT]), int(io[IO_END])
-        self.state_at = file.count  # (the buffer's parts are the last record's)
 
     def _moved(self, r: np.ndarray, v: np.ndarray,
                state: list[np.ndarray]) -> tuple[Any, ...] | None:

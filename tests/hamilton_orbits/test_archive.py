@@ -40,17 +40,6 @@ def _run_archived(folder, kw=KW, times=T, paced=False):
                               if paced else None)
 
 
-def loop_compiled():
-    """radau15's loop that writes an archive's snapshots compiled here (on a first run
-    of two cores it is compiled ahead by a second process, the pauses writing the
-    snapshots meanwhile: a test of the loop's own would not meet it)."""
-    from hamilton_orbits._kernels import radau15 as kernels
-    from hamilton_orbits._kernels.entry import EntryKernel
-
-    if isinstance(kernels.advance_archived, EntryKernel):  # (else the compiled dispatcher)
-        kernels.advance_archived.dispatcher()
-
-
 def _snapshot_state(folder, number):
     """t, r, v and the integrator's own arrays of snapshot ``number``."""
     _, _, arrays = snapshot_at(folder, number)
@@ -818,60 +807,6 @@ def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was
     assert _same(end.r[-1], whole.integrate(40.0).r[-1]) and sim.steps == whole.steps
 
 
-def test_a_file_size_limit_met_by_a_snapshot_of_the_compiled_loop_stops_the_run(tmp_path):
-    """radau15's ``every_steps`` snapshots are written from its compiled loop; the
-    file refusing one (a child process whose files may not reach the end of its
-    segment's fifth record: ``RLIMIT_FSIZE``, the C library's own error, after a
-    write that takes part of the record) stops the run with the SnapshotError that
-    names the segment and the cause, the archive holding the four snapshots
-    written before, whole, nothing torn or damaged; resumed, the call ends on the
-    bits of the run that met no limit.  (A write that took part of a record was
-    counted whole: the archive's last snapshot was then damaged.)"""
-    import resource
-
-    loop_compiled()
-    kw = dict(method="radau15", every_steps=5)
-    probe = Simulation(_disc(), archive=tmp_path / "probe", **kw)
-    probe.integrate(1.0)
-    data = (tmp_path / "probe" / "segment-000000.nc").read_bytes()
-    limit = parse(data).record_begin + 5 * parse(data).record_size - 100
-    whole = Simulation(_disc(), archive=tmp_path / "whole", **kw).integrate(40.0)
-    folder, (ready, go) = tmp_path / "limited", os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: its files limited, the signal of a file too large ignored
-        try:
-            os.close(ready)
-            written = [0]
-            counted = _saving._EverySteps.kernel_wrote
-
-            def counting(self, kernel):
-                written[0] += int(kernel[3][5])
-                return counted(self, kernel)
-
-            _saving._EverySteps.kernel_wrote = counting
-            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
-            try:
-                Simulation(_disc(), archive=folder, **kw).integrate(40.0)
-                message = "no error"
-            except SnapshotError as exc:
-                message = str(exc)
-            os.write(go, f"{written[0]}|{message}".encode())
-        finally:
-            os._exit(0)
-    os.close(go)
-    with os.fdopen(ready, "rb") as fh:
-        written, message = fh.read().decode().split("|", 1)
-    os.waitpid(pid, 0)
-    assert int(written) >= 2, message  # (the loop's own, before the one refused)
-    assert re.search(r"cannot write the snapshot to .*limited.*segment-000000\.nc: File too "
-                     r"large", message), message
-    archive = Archive(folder)
-    assert len(archive) == 4 and not archive.damaged and not archive.torn
-    traj = Simulation.load(folder).resume()
-    assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and traj.steps == whole.steps
-
-
 def test_a_read_only_folder_is_refused_at_the_archives_first_write(tmp_path, monkeypatch):
     """The folder refuses the lock, the archive's first file (a mocked refusal of
     every file made in it: the tests may run as root): a SnapshotError naming the
@@ -1032,14 +967,10 @@ def test_a_resumed_call_puts_its_snapshots_on_the_steps_of_the_whole_call(tmp_pa
     assert after == [t for t in ref.times if t > 0.6]
 
 
-def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path, monkeypatch):
+def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path):
     """A call stopped (as a kill would leave it) in a segment the simulation's
     earlier calls began: resumed from the archive, it returns the whole call's rows
-    and bits.  (``stop`` is asked between slices of steps, here of 7: the snapshots,
-    every 5 steps, are written from the compiled loop, which does not pause.)"""
-    from hamilton_orbits.integrators import radau15
-
-    monkeypatch.setattr(radau15, "SLICE", 7)
+    and bits."""
     whole = Simulation(_disc(), method="radau15")
     for t in (0.5, 1.0):
         whole.integrate(t)
@@ -1048,7 +979,7 @@ def test_a_call_interrupted_in_a_segment_gone_on_in_is_resumed_whole(tmp_path, m
     for t in (0.5, 1.0):  # (a stop asked in each: the driver's layout holds one)
         sim.integrate(t, stop=lambda: False)
     pauses, before = iter(range(10**6)), sim._archive.count
-    cut = sim.integrate(10.0, stop=lambda: next(pauses) == 4)  # (asked after each slice)
+    cut = sim.integrate(10.0, stop=lambda: next(pauses) == 4)  # (asked after each pause)
     assert not cut.complete and snapshot_files(tmp_path)[-1][0] < before  # (gone on in)
     again = Simulation.load(tmp_path)
     assert 1.0 < again.t < 10.0

@@ -459,37 +459,3 @@ def test_the_issue_reproducer_stops_or_reports_an_infinite_energy_error():
     assert float(str(err.value).split()[5]) == pytest.approx(t_c, rel=1e-4)
     traj = integrate(system, 1.0, method="leapfrog", dt=1e-3)
     assert traj.energy_error.tolist() == [0.0, math.inf]
-
-
-@pytest.mark.parametrize("sent", [False, True])
-def test_the_loop_that_writes_snapshots_is_called_once_compiled_or_when_it_can_be(
-        monkeypatch, sent):
-    """``loop_writes``: the compiled loop that writes an archive's snapshots is
-    called from the start where it is not compiled ahead (compiled, or loaded from
-    the cache, at its first call: every look says so, not only the first); where a
-    second process compiles it, the pauses write the snapshots until that process
-    has ended, looked at every 0.25 s (a clock of our own)."""
-    from numba import types
-
-    from hamilton_orbits._kernels import entry
-    from hamilton_orbits._kernels import radau15 as kernels
-
-    uncompiled = entry.EntryKernel(lambda: 0, types.int64(), {})
-    done, clock = [False], [100.0]
-    monkeypatch.setattr(kernels, "advance_archived", uncompiled)
-    monkeypatch.setattr(radau15, "_LOOP_WRITES", [None, 0.0])
-    monkeypatch.setattr(entry, "compile_ahead", lambda kernels: ["loop"] if sent else [])
-    monkeypatch.setattr(entry, "compiled_ahead", lambda kernel: done[0])
-    monkeypatch.setattr(radau15.time, "monotonic", lambda: clock[0])
-    looks = []
-    for _ in range(3):
-        looks.append(radau15.loop_writes())
-        clock[0] += 0.1
-    done[0] = True
-    for _ in range(4):
-        looks.append(radau15.loop_writes())
-        clock[0] += 0.1
-    if sent:  # (the end seen at the first look 0.25 s after the last)
-        assert looks == [False, False, False, True, True, True, True]
-    else:
-        assert looks == [True] * 7

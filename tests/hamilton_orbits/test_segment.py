@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_archive import RADAU15_STEPPED, _same, flipped_bytes, loop_compiled
+from test_archive import RADAU15_STEPPED, flipped_bytes
 
-from hamilton_orbits import Archive, Simulation, _saving
+from hamilton_orbits import Archive, Simulation
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits.segment import SegmentWriter
 
@@ -42,9 +42,6 @@ def test_a_state_filled_straight_into_its_record_is_the_record_of_the_general_pa
 
     monkeypatch.setattr(SegmentWriter, "_append_state", counted)
     monkeypatch.setattr(SegmentWriter, "refill", counted_refill)
-    # (the pauses' snapshots written by Python, not from the compiled loop: see
-    # test_the_snapshots_written_from_the_compiled_loop_are_the_pauses_records)
-    monkeypatch.setattr(_saving._EverySteps, "in_kernel", lambda self, driver, prop: None)
     Simulation(system(), archive=tmp_path / "direct", every_steps=1, **kw).integrate(times)
     if "events" in kw:  # (the straight fill at each snapshot after an output)
         assert sum(taken) >= 4
@@ -248,48 +245,3 @@ def test_a_row_that_is_its_snapshots_own_state_is_kept_as_that_state(tmp_path):
         (_, _, arrays), = read_segment(seg.path).snapshots
         for k in ("t", "r", "v"):
             assert arrays[f"out_{k}"].tobytes() == given[f"out_{k}"].tobytes(), (name, k)
-
-
-@pytest.mark.parametrize("case", ["radau15", "radau15-effects"])
-@pytest.mark.parametrize("every", [1, 37])
-def test_the_snapshots_written_from_the_compiled_loop_are_the_pauses_records(
-        tmp_path, monkeypatch, case, every):
-    """radau15's ``every_steps`` snapshots are appended from its compiled loop
-    (``_kernels/snapshots.py``: the record, its CRC-32, then the count, without a
-    pause): the segments' records are the bytes the pauses write, through calls
-    of one end and of several outputs (whose rows Python writes with the next
-    snapshot), a loop of calls going on in one segment, and a leg that ends at
-    ``max_steps``; the run's bits are the plain run's."""
-    from hamilton_orbits._kernels.snapshots import IO_WRITTEN
-
-    loop_compiled()
-    system, kw = RADAU15_STEPPED[case]
-    written, counted = [0], _saving._EverySteps.kernel_wrote
-
-    def counting(self, kernel):
-        written[0] += int(kernel[3][IO_WRITTEN])
-        return counted(self, kernel)
-
-    monkeypatch.setattr(_saving._EverySteps, "kernel_wrote", counting)
-
-    def run(folder):
-        sim = Simulation(system(), archive=tmp_path / folder, every_steps=every, **kw)
-        out = [sim.integrate(np.linspace(0.0, 3.0, 4)), sim.integrate(5.0), sim.integrate(6.0)]
-        short = Simulation(system(), archive=tmp_path / f"{folder}-short", every_steps=every,
-                           max_steps=3 * every + every // 2 + 1, **kw)
-        with pytest.raises(ValueError, match="max_steps"):
-            short.integrate(100.0)
-        return out
-
-    loop = run("loop")
-    assert written[0] >= (10 if every == 1 else 2)  # (most of them)
-    monkeypatch.setattr(_saving._EverySteps, "in_kernel", lambda self, driver, prop: None)
-    paused = run("paused")
-    plain = Simulation(system(), **kw)
-    for one, other in zip(loop, paused, strict=True):
-        times = one.t if len(one.t) > 2 else one.t[-1]
-        assert _same(one.r, other.r) and _same(one.r, plain.integrate(times).r)
-    for folder in ("loop", "loop-short"):
-        one, other = _records(tmp_path / folder), _records(tmp_path / folder.replace("loop",
-                                                                                   "paused"))
-        assert len(one) == len(other) >= 1 and one == other, folder

@@ -28,7 +28,7 @@ from typing import Any
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["compile_ahead", "compiled_ahead", "entry"]
+__all__ = ["compile_ahead", "entry"]
 
 _lock = threading.Lock()
 #: Kernels being compiled into the on-disk cache by another process
@@ -150,13 +150,6 @@ def compile_ahead(kernels: Sequence[EntryKernel],
 
     firstrun.notice()
     return [k.key for k in todo]
-
-
-def compiled_ahead(kernel: EntryKernel) -> bool:
-    """Whether ``kernel`` may be called without waiting for a second process
-    compiling it ahead (:func:`compile_ahead`): none was sent, or it has ended."""
-    proc = _AHEAD.get(kernel.key)
-    return proc is None or proc.poll() is not None
 
 
 def _cores() -> int:

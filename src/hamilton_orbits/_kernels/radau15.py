@@ -26,13 +26,11 @@ from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.gauss_radau import exact_tables
 from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at, set_clock
-from hamilton_orbits._kernels.snapshots import IO_NEXT, write_snapshot
 from hamilton_orbits._kernels.variational import megno_update
 
 __all__ = [
     "DECIMAL_SPACINGS",
     "NSTATE",
-    "STATUS_ARCHIVE",
     "STATUS_DRAIN",
     "STATUS_EVENT",
     "STATUS_MAXSTEPS",
@@ -49,7 +47,6 @@ __all__ = [
     "ST_T",
     "ST_T_CS",
     "advance",
-    "advance_archived",
     "advance_variational",
     "advance_watched",
     "coefficients",
@@ -79,10 +76,6 @@ STATUS_MAXSTEPS = 3
 STATUS_EVENT = 4
 #: The event buffer may not hold another step's events: drain it and call again.
 STATUS_DRAIN = 5
-#: The archive's file refused a snapshot written from the loop
-#: (:func:`~hamilton_orbits._kernels.snapshots.write_snapshot`): the state is that
-#: of its step; Python writes it again, which says why.
-STATUS_ARCHIVE = 6
 
 #: The integrator state ``st`` that :func:`advance` reads and updates, slot by slot:
 #: the time, its Kahan compensation, the next step, the last step done, epsilon (0:
@@ -573,22 +566,9 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
     return h
 
 
-@njit(cache=True, inline="always")
-def _archived(arch, st, t, t_cs, dt, dt_last, r, v, gm, br, d, csx, csv, p, steps, max_steps,
-              t_end):  # pragma: no cover - compiled
-    """After a step: the archive's snapshot appended where one is due (the state as
-    a pause sees it, ``st`` saved; not at the budget's end, which the pause takes
-    where the run goes on, nor at ``t_end``, the output's, which its row goes
-    with); False when the file refused it."""
-    if steps != arch[3][IO_NEXT] or steps >= max_steps or t >= t_end:
-        return True
-    _save(st, t, t_cs, dt, dt_last, True)
-    return write_snapshot(arch, r, v, gm, st, br, d, csx, csv, p, steps, ST_T)
-
-
 def _steps(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
-    ev_count, arch,
+    ev_count,
 ):  # pragma: no cover - compiled
     """The loop of :func:`advance` and :func:`advance_watched`, and their body (each
     compiled from it with its own signature, not a wrapper calling it: numba would
@@ -607,10 +587,7 @@ def _steps(
     call may be repeated to go on.  ``watch`` (m, 5) are the events to look for
     after every step on the step's polynomial (:func:`hamilton_orbits._kernels.
     events.scan`), recorded into ``ev_out`` / ``ev_count``; at ``STATUS_EVENT`` the
-    state is that of the event's time.  ``arch`` None, or an archive's segment to
-    which a snapshot is appended after every ``every_steps`` steps from inside the
-    loop (:func:`hamilton_orbits._kernels.snapshots.write_snapshot`; at
-    ``STATUS_ARCHIVE`` the file refused one).
+    state is that of the event's time.
 
     Memory per body: the four (7, 3) arrays above and ``csb`` (840 bytes), the
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
@@ -619,13 +596,15 @@ def _steps(
     accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
-    # (the start of a step for the events' scan; watch None: no event code compiled)
+    # the start of a step, for the events' scan (``watch is None`` is decided at
+    # compile time: numba prunes the branches, so no event code is compiled)
     n_watch = 0 if watch is None else watch.shape[0]
     w = m if n_watch > 0 else 0
     x0, v0 = np.empty(w), np.empty(w)
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     xsf, vsf, atf, a0 = xs.reshape(m), vs.reshape(m), at.reshape(m), a0_2.reshape(m)
-    xf, vf = r.reshape(m), v.reshape(m)
+    xf = r.reshape(m)
+    vf = v.reshape(m)
     csb = np.zeros((7, m))
     t, t_cs, dt, dt_last = st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST]
     have_last = st[ST_HAVE_LAST] != 0.0
@@ -649,7 +628,8 @@ def _steps(
         if not _begin(accel, p, r, v, gm, a0_2, x0, v0, t, q, b, br, d, g, csb):
             status = STATUS_NONFINITE
             break
-        # (:func:`_iterate`'s loop, here: inlined, it kept reference counts, 7% at N = 2-3)
+        # :func:`_iterate`'s loop, here in the step loop: behind the inline wrappers
+        # the arrays passed on keep reference counting in it (7% of a step at N = 2-3)
         pc_err, pc_err_last, iters = 2.0, 3.0, 0
         while pc_err >= 1e-16 and iters < 12 and not (iters > 2 and pc_err_last <= pc_err):
             pc_err_last = pc_err
@@ -686,10 +666,6 @@ def _steps(
         have_last = True
         dt = dt_new
         steps += 1
-        if arch is not None and not _archived(arch, st, t, t_cs, dt, dt_last, r, v, gm, br, d,
-                                              csx, csv, p, steps, max_steps, t_end):
-            status = STATUS_ARCHIVE
-            break
     _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status
 
@@ -701,21 +677,12 @@ _RESULT = types.Tuple((types.int64, types.int64))
 #: Step from ``st[ST_T]`` to ``t_end`` in place, watching no events (the last three
 #: arguments None); returns ``(steps, status)`` (see :func:`_steps`).  No event code
 #: is compiled into it.
-advance = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none, types.none),
-                name="advance", cache=True, nogil=True)(_steps)
+advance = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none), name="advance",
+                cache=True, nogil=True)(_steps)
 #: :func:`advance` watching the events ``watch`` (at least one row), recorded into
 #: ``ev_out`` / ``ev_count``.
-advance_watched = entry(_RESULT(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1], types.none),
+advance_watched = entry(_RESULT(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
                         name="advance_watched", cache=True, nogil=True)(_steps)
-#: an archive's segment, as :func:`~hamilton_orbits._kernels.snapshots.write_snapshot`
-#: takes it: ``(plan, template, rec, io, tables)``
-ARCHIVE_ARG = types.Tuple((types.int64[:, ::1], _F1, types.uint8[::1], types.int64[::1],
-                           types.uint32[:, ::1]))
-#: :func:`advance` appending an archive's ``every_steps`` snapshots from its loop
-#: (no events watched).
-advance_archived = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none,
-                                 ARCHIVE_ARG), name="advance_archived", cache=True,
-                         nogil=True)(_steps)
 
 
 # ---------------------------------------------------------------------------

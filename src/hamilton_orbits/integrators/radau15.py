@@ -35,14 +35,12 @@ step, the state between calls, and the output arrays.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from hamilton_orbits._kernels import radau15 as _k
-from hamilton_orbits._kernels import snapshots as _snap
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
@@ -60,37 +58,6 @@ DEFAULT_CRITERION = "prs23"
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
-
-
-#: the compiled loop that writes an archive's snapshots (``advance_archived``): being
-#: compiled ahead (True) or not (False), None before a run asks for it; and when a
-#: pause last looked whether that ended
-_LOOP_WRITES: list[Any] = [None, 0.0]
-
-
-def loop_writes() -> bool:
-    """Whether the compiled loop that writes an archive's snapshots may be called
-    now: compiled or in the on-disk cache, or else compiled at its first call where
-    it cannot be compiled ahead.  On a first run of two cores a second process
-    compiles it (5 s) while the pauses write the snapshots; they look whether it has
-    ended every 0.25 s."""
-    from hamilton_orbits._kernels.entry import EntryKernel, compiled_ahead
-    from hamilton_orbits._kernels.entry import compile_ahead as send
-
-    kernel = _k.advance_archived  # (the dispatcher itself once compiled)
-    if not isinstance(kernel, EntryKernel) or kernel.compiled:
-        return True
-
-    state, now = _LOOP_WRITES, time.monotonic()
-    if state[0] is None:
-        state[0], state[1] = bool(send([kernel])), now
-    if not state[0]:  # (not sent: compiled, or loaded from the cache, at its first call)
-        return True
-    if now - state[1] < 0.25:
-        return False
-    state[1] = now
-    state[0] = not compiled_ahead(kernel)
-    return not state[0]
 
 
 def compile_ahead(events: bool) -> None:
@@ -366,14 +333,6 @@ class _Run:
         """The current positions, velocities and ``G m`` (copies)."""
         return self.x.copy(), self.w.copy(), self.gm.copy()
 
-    def kernel_arrays(self) -> dict[int, int]:
-        """The arrays of the compiled loop by ``id``, each with its source code for a
-        snapshot written from the loop (:mod:`hamilton_orbits._kernels.snapshots`)."""
-        (br, d), p = self.work, self.before_t[1]
-        return {id(self.x): _snap.SRC_X, id(self.w): _snap.SRC_V, id(self.gm): _snap.SRC_GM,
-                id(br): _snap.SRC_BR, id(d): _snap.SRC_D, id(self.csx): _snap.SRC_CSX,
-                id(self.csv): _snap.SRC_CSV, id(self.st): _snap.SRC_ST, id(p): _snap.SRC_P}
-
     def state_into(self, r: np.ndarray, v: np.ndarray) -> None:
         """The current positions and velocities copied into ``r`` and ``v`` (a pause's
         own arrays, refilled at each pause)."""
@@ -405,34 +364,20 @@ class _Run:
         again = False  # (a pause since which only the kernel ran: see pause's notes)
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             budget = min(SLICE, max_steps - (self.steps - first))
-            arch = None
             if pause is not None:
                 if self.steps >= pause.at:
                     pause(again)
                     again = True
-                # (the pause's snapshots written from the kernel's loop where it can:
-                # no pause then)
-                arch = None if log.watch.shape[0] or not loop_writes() else pause.in_kernel(self)
-                if arch is None:
-                    budget = min(budget, max(pause.at - self.steps, 1))
+                budget = min(budget, max(pause.at - self.steps, 1))
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
                     *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
-                    log.count, None)
-            elif arch is not None:
-                try:
-                    steps, status = _k.advance_archived(*self.before_t, t_out[i],
-                                                        *self.after_t, budget, None, None,
-                                                        None, arch)
-                finally:  # (what it appended counted, whatever happens next)
-                    pause.kernel_wrote(arch)
+                    log.count)
             else:
                 steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget, None,
-                                            None, None, None)
+                                            None, None)
             self.steps += steps
-            if status == _k.STATUS_ARCHIVE:  # (the file refused it: written again by the
-                pause(True)  # pause, which says why, or goes on if it now takes it)
-            elif status == _k.STATUS_MAXSTEPS:
+            if status == _k.STATUS_MAXSTEPS:
                 _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
                 if self.stop is not None and self.stop():
                     raise StopIntegration
