@@ -156,9 +156,14 @@ class _Appender:
         return data
 
     def write(self, data: bytes | bytearray, count: int) -> None:
-        """Write ``count`` whole records ``data`` after the last, then count them."""
+        """Write ``count`` whole records ``data`` after the last, then count them (a
+        write that takes part of them goes on with the rest: a file that then
+        refuses it, full, raises before they are counted)."""
         try:
-            os.pwrite(self.fd, data, self.end)
+            view, at = memoryview(data), self.end
+            while view:
+                done = os.pwrite(self.fd, view, at)
+                view, at = view[done:], at + done
             if self.numrecs is not None:  # (after the records: the count never runs ahead)
                 struct.pack_into(">i", self.numrecs, NUMRECS_AT, self.count + count)
             else:

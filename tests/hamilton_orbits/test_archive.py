@@ -807,6 +807,51 @@ def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was
     assert _same(end.r[-1], whole.integrate(40.0).r[-1]) and sim.steps == whole.steps
 
 
+@pytest.mark.parametrize("kw", [dict(method="radau15", every_steps=5),
+                                dict(method="wh", dt=0.05, every=0.5)],
+                         ids=["every_steps", "every"])
+def test_a_file_that_takes_part_of_a_snapshot_then_refuses_it_stops_the_run(tmp_path, kw):
+    """A child process whose files may not reach the end of its segment's fifth
+    record (``RLIMIT_FSIZE``: the write takes part of the record, the next is
+    refused): the run stops with the SnapshotError that names the segment and the
+    cause, the archive holding the four snapshots written before, whole, nothing
+    torn or damaged; resumed, the call ends on the bits of the run that met no
+    limit.  (The write that took part of a record was counted whole: the
+    archive's last snapshot was then damaged.)"""
+    import resource
+
+    probe = Simulation(_disc(), archive=tmp_path / "probe", **kw)
+    probe.integrate(1.0)
+    header = parse((tmp_path / "probe" / "segment-000000.nc").read_bytes())
+    limit = header.record_begin + 5 * header.record_size - 100
+    whole = Simulation(_disc(), archive=tmp_path / "whole", **kw).integrate(20.0)
+    folder, (ready, go) = tmp_path / "limited", os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: its files limited, the signal of a file too large ignored
+        try:
+            os.close(ready)
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+            try:
+                Simulation(_disc(), archive=folder, **kw).integrate(20.0)
+                message = "no error"
+            except SnapshotError as exc:
+                message = str(exc)
+            os.write(go, message.encode())
+        finally:
+            os._exit(0)
+    os.close(go)
+    with os.fdopen(ready, "rb") as fh:
+        message = fh.read().decode()
+    os.waitpid(pid, 0)
+    assert re.search(r"cannot write the snapshot to .*limited.*segment-000000\.nc: File too "
+                     r"large", message), message
+    archive = Archive(folder)
+    assert len(archive) == 4 and not archive.damaged and not archive.torn
+    traj = Simulation.load(folder).resume()
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and traj.steps == whole.steps
+
+
 def test_a_read_only_folder_is_refused_at_the_archives_first_write(tmp_path, monkeypatch):
     """The folder refuses the lock, the archive's first file (a mocked refusal of
     every file made in it: the tests may run as root): a SnapshotError naming the
