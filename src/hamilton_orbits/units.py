@@ -25,6 +25,7 @@ Every public function converts its arguments through these kinds, e.g.
 from __future__ import annotations
 
 import functools
+import re
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -164,11 +165,15 @@ class Kind:
     """
 
     def __init__(
-        self, name: str, unit: UnitLike, equivalencies: list | Callable[[], list] | None = None
+        self, name: str, unit: UnitLike, equivalencies: list | Callable[[], list] | None = None,
+        *, no_hertz: bool = False
     ) -> None:
         self.name = name
         self._unit = unit
         self._equivalencies = [] if equivalencies is None else equivalencies
+        #: a unit holding the hertz refused: a frequency in cycles per second, which
+        #: the equivalencies would read as radians per second (2 pi off)
+        self.no_hertz = no_hertz
 
     @property
     def unit(self):
@@ -193,6 +198,11 @@ class Kind:
                 raise u.UnitConversionError(
                     f"Expected `{name}` to be dimensionless, got {_short(value)} (an angle)"
                 )
+            if self.no_hertz and _hertz(value.unit):
+                raise u.UnitConversionError(
+                    f"Expected `{name}` to be {self.name}, got {value.unit}: the hertz counts "
+                    f"cycles, 2 pi rad each (ISO 80000-3 gives angular speeds no hertz); give "
+                    f"rad / s, or cycle / s for turns per second")
             try:
                 value = value.to_value(target, equivalencies=self.equivalencies)
             except u.UnitConversionError as exc:
@@ -236,6 +246,12 @@ def _short(q: u.Quantity) -> str:
     return f"{q.unit} values"
 
 
+def _hertz(unit: Any) -> bool:
+    """Whether ``unit`` holds the hertz, prefixed or not (kHz, mHz, Hz / s)."""
+    return any(re.fullmatch(r"[A-Za-z]?Hz", part) for part in re.split(r"[^A-Za-z]+",
+                                                                        unit.to_string()))
+
+
 def _dimensionless_angles() -> list:
     return u.dimensionless_angles()
 
@@ -249,7 +265,7 @@ GM = Kind("a gravitational parameter GM", "m3 / s2")
 MASS = Kind("a mass", "kg")
 DIMENSIONLESS = Kind("dimensionless", "")
 INERTIA = Kind("a moment of inertia", "kg m2")
-ANGULAR_SPEED = Kind("an angular speed", "rad / s", _dimensionless_angles)
+ANGULAR_SPEED = Kind("an angular speed", "rad / s", _dimensionless_angles, no_hertz=True)
 ANGULAR_MOMENTUM = Kind("an angular momentum", "kg m2 / s", _dimensionless_angles)
 ENERGY = Kind("an energy", "J", _dimensionless_angles)
 TORQUE = Kind("a torque", "N m", _dimensionless_angles)

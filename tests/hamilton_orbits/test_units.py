@@ -79,3 +79,19 @@ def test_mixing_quantities_and_plain_numbers_is_refused():
 def test_complex_input_is_refused_not_truncated():
     with pytest.raises(ValueError, match="`x` to be real, got complex"):
         as_float_array("x", [1.0 + 2.0j])
+
+
+@pytest.mark.parametrize("unit", [u.Hz, u.kHz, u.mHz, u.Hz / u.s * u.s])
+def test_an_angular_speed_in_hertz_is_refused_by_name(unit):
+    """A rotation rate in hertz counts cycles per second, 2 pi rad each; the
+    equivalency that reads 1/s as rad/s would take it 2 pi too small, so it is
+    refused (ISO 80000-3: angular speeds in rad/s, never Hz); 1/s (the SI base
+    form of rad/s) and cycle/s (turns per second) are read as such."""
+    from hamilton_orbits.units import ANGULAR_SPEED
+
+    with pytest.raises(u.UnitConversionError, match=r"Expected `spin` to be an angular speed, "
+                                                    r"got .*Hz.*cycle / s"):
+        ANGULAR_SPEED("spin", 2.0 * unit)
+    assert float(ANGULAR_SPEED("spin", 2.0 / u.s)) == 2.0
+    assert float(ANGULAR_SPEED("spin", 1.0 * u.cycle / u.s)) == 2 * np.pi
+    assert float(ANGULAR_SPEED("spin", 360.0 * u.deg / u.s)) == 2 * np.pi

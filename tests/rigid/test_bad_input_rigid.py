@@ -117,3 +117,18 @@ def test_rotation_scene_cadence_beyond_memory_fails_at_loading(tmp_path):
     (problem,) = info.value.problems
     assert re.match(rf"{re.escape(str(path))}:3: cadence: 6e\+10 outputs of a rigid body would "
                     r"take .* beyond the limit of 1 GiB", problem), problem
+
+
+def test_a_spin_given_in_hertz_is_refused_not_read_as_radians_per_second():
+    """``omega = [0, 0, 1] Hz`` (one turn a second) was read as 1 rad/s, a spin 2 pi
+    too slow, silently; it is refused naming ``omega``, and one turn a second as
+    cycle/s is 2 pi rad/s."""
+    import numpy as np
+
+    from rigid import RigidBody
+
+    with pytest.raises(u.UnitConversionError, match=r"`omega` .* got Hz: the hertz counts "
+                                                    r"cycles"):
+        RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.0, 0.0, 1.0] * u.Hz)
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.0, 0.0, 1.0] * u.cycle / u.s)
+    assert body.omega.to_value(u.rad / u.s)[2] == 2 * np.pi
