@@ -25,7 +25,6 @@ Every public function converts its arguments through these kinds, e.g.
 from __future__ import annotations
 
 import functools
-import re
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -247,9 +246,11 @@ def _short(q: u.Quantity) -> str:
 
 
 def _hertz(unit: Any) -> bool:
-    """Whether ``unit`` holds the hertz, prefixed or not (kHz, mHz, Hz / s)."""
-    return any(re.fullmatch(r"[A-Za-z]?Hz", part) for part in re.split(r"[^A-Za-z]+",
-                                                                        unit.to_string()))
+    """Whether ``unit`` holds the hertz, prefixed or not (kHz, daHz, rad Hz), by
+    identity: astropy finds the hertz equal to 1/s, which is not refused."""
+    return any(base is u.Hz or (isinstance(base, u.PrefixUnit)
+                                and any(x is u.Hz for x in base.represents.bases))
+               for base in getattr(unit, "bases", [unit]))
 
 
 def _dimensionless_angles() -> list:

@@ -81,7 +81,7 @@ def test_complex_input_is_refused_not_truncated():
         as_float_array("x", [1.0 + 2.0j])
 
 
-@pytest.mark.parametrize("unit", [u.Hz, u.kHz, u.mHz, u.Hz / u.s * u.s])
+@pytest.mark.parametrize("unit", [u.Hz, u.kHz, u.mHz, u.daHz, u.Hz / u.s * u.s])
 def test_an_angular_speed_in_hertz_is_refused_by_name(unit):
     """A rotation rate in hertz counts cycles per second, 2 pi rad each; the
     equivalency that reads 1/s as rad/s would take it 2 pi too small, so it is
