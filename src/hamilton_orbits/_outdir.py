@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import re
 import socket
 import time
 from pathlib import Path
@@ -33,17 +34,28 @@ class FolderError(ValueError):
     """An output folder that cannot be used (its message says why, naming it)."""
 
 
+#: the claims of this process that hold their folder's lock (a lock of this
+#: process's PID and host with another number is a former process's: a container
+#: restarted with the same PID)
+_HELD: set[int] = set()
+
+
 def _alive(pid: int) -> bool:
-    """True if a process ``pid`` exists on this host."""
+    """True if a process ``pid`` runs on this host (an ended one whose parent has
+    not yet collected it, a zombie, has ended)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:  # it exists, owned by someone else
-        return True
+        pass
     except OSError:  # pragma: no cover - platforms without signal 0
         return True
-    return True
+    try:  # (Linux: its state, after the command's name in parentheses)
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except (OSError, IndexError):
+        return True
 
 
 def _hold(fd: int, patience: float = 2.0) -> None:
@@ -104,6 +116,15 @@ class OutputFolder:
 
     def __enter__(self) -> OutputFolder:
         self._make()
+        _HELD.add(self._claim)  # (before its lock is linked, until it is released)
+        try:
+            return self._claim_lock()
+        except BaseException:
+            _HELD.discard(self._claim)
+            raise
+
+    def _claim_lock(self) -> OutputFolder:
+        """Take the folder's lock (:meth:`__enter__`)."""
         # the lock is written whole under a name of its own, then linked to its name
         # (atomic, and refused if the name exists): a run killed at any moment leaves
         # no empty lock that would look like an unknown run's
@@ -176,14 +197,16 @@ class OutputFolder:
             os.close(fd)
 
     def _judge(self, held: list[str]) -> None:
-        """Remove the lock whose text is ``held`` (PID, host) if its run has ended;
-        refuse it otherwise."""
-        pid = int(held[0]) if held and held[0].isdigit() else None
+        """Remove the lock whose text is ``held`` (PID, host, claim) if its run has
+        ended; refuse it otherwise (a text that is no lock's: an unknown run's)."""
+        pid = int(held[0]) if held and re.fullmatch(r"[0-9]{1,9}", held[0]) else None
         host = held[1] if len(held) > 1 else "?"
-        if pid is not None and host == socket.gethostname() and not _alive(pid):
-            self._lock.unlink(missing_ok=True)
+        claim = int(held[2]) if len(held) > 2 and re.fullmatch(r"[0-9]{1,9}", held[2]) else None
+        here = pid is not None and host == socket.gethostname()
+        if here and (not _alive(pid) if pid != os.getpid() else claim not in _HELD):
+            self._lock.unlink(missing_ok=True)  # (ended, or a former process's of this PID)
             return
-        if pid == os.getpid() and host == socket.gethostname():
+        if here and pid == os.getpid():
             raise self._fail(f"another run of this same process (PID {pid}: a simulation "
                              f"writing its archive) is writing into this folder; choose "
                              f"another folder")
@@ -203,3 +226,5 @@ class OutputFolder:
                 os.unlink(self._lock)
         except OSError:  # gone already (a user removed it): nothing to release
             pass
+        finally:
+            _HELD.discard(self._claim)

@@ -260,6 +260,55 @@ def test_two_runs_that_find_one_stale_lock_at_once_do_not_both_take_it(tmp_path,
     assert not lock.exists() and [p.name for p in tmp_path.iterdir()] == []
 
 
+def test_a_lock_of_this_pid_that_no_claim_here_holds_is_a_former_processs(tmp_path):
+    """A container restarted with the same PID and host (PID 1 of a pod, its volume
+    kept) finds the lock its former process left: this PID, but no claim of this
+    process holds it, so it is taken over (it was refused as "another run of this
+    same process", for ever); a lock one of this process's claims holds is still
+    refused."""
+    lock = tmp_path / LOCK_NAME
+    for text in (f"{os.getpid()} {os.uname().nodename}\n",
+                 f"{os.getpid()} {os.uname().nodename} 987654\n"):
+        lock.write_text(text)
+        with OutputFolder(tmp_path) as folder:
+            assert lock.read_text() == folder._mine
+            with pytest.raises(FolderError, match=r"another run of this same process"):
+                OutputFolder(tmp_path).__enter__()
+        assert not lock.exists()
+
+
+def test_the_lock_of_an_ended_process_not_yet_collected_is_taken_over(tmp_path):
+    """A process that has ended but whose parent has not collected it (a zombie)
+    still answers ``kill(pid, 0)``; its lock was refused as a live run's."""
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    try:
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline:  # (until it has ended, uncollected)
+            with open(f"/proc/{pid}/stat", "rb") as fh:
+                if fh.read().rsplit(b")", 1)[1].split()[0] == b"Z":
+                    break
+            time.sleep(0.001)
+        (tmp_path / LOCK_NAME).write_text(f"{pid} {os.uname().nodename}\n")
+        with OutputFolder(tmp_path) as folder:
+            assert (tmp_path / LOCK_NAME).read_text() == folder._mine
+    finally:
+        os.waitpid(pid, 0)
+
+
+@pytest.mark.parametrize("text", ["99999999999999999999 here\n", "\u00b2 here\n", "\n",
+                                  "12 \n"])
+def test_a_lock_whose_text_is_no_locks_is_refused_naming_the_folder(tmp_path, text):
+    """A lock whose text holds no PID this host could have (too large a number, a
+    superscript digit, nothing) is an unknown run's: refused naming the folder and
+    the lock to delete (it raised OverflowError, or a ValueError of int())."""
+    (tmp_path / LOCK_NAME).write_text(text.replace("here", os.uname().nodename))
+    with pytest.raises(FolderError, match=r"another run \((an unknown run|PID 12 on \?)\) is "
+                                          r"writing into this folder.*delete .*lock"):
+        OutputFolder(tmp_path).__enter__()
+
+
 def test_an_output_folder_that_cannot_be_created_is_refused(tmp_path):
     (tmp_path / "file").write_text("x")
     with pytest.raises(FolderError, match=r"cannot create the folder"):
