@@ -348,3 +348,20 @@ def test_an_epoch_given_as_a_time_is_saved_and_continued_to_the_bit(tmp_path):
     assert kept.scale == "tdb" and kept.jd1 == epoch.jd1 and kept.jd2 == epoch.jd2
     a, b = sim.integrate(3 * u.day), again.integrate(3 * u.day)
     assert np.array_equal(a.r.value, b.r.value)
+
+
+def test_one_effect_given_alone_is_the_list_of_it():
+    """``effects`` as one mapping or one name, which the normaliser takes as the list
+    of it, failed in the effect set with ``zip() argument 2 is shorter than
+    argument 1``; the run is the listed one's, and an error in it names
+    ``effects[0]``."""
+    from hamilton_orbits import Simulation
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-5, [1.0, 0, 0], [0, 1.0, 0])])
+    alone = Simulation(s, effects={"name": "gr", "c": 100.0}).integrate(5.0)
+    listed = Simulation(s, effects=[{"name": "gr", "c": 100.0}]).integrate(5.0)
+    assert np.array_equal(alone.r, listed.r) and alone.effects == ("newtonian", "gr")
+    assert Simulation(s, effects="newtonian").integrate(1.0).effects == ("newtonian",)
+    with pytest.raises(ValueError, match=r"speed of light `c`.*\(effects\[0\]\)"):
+        Simulation(s, effects={"name": "gr"})

@@ -382,7 +382,8 @@ class EffectSet:
                 raise ValueError(f"Expected {kind} effects, got an EffectSet of {effects.kind!r}")
             return effects
         items = normalize_effects(effects, kind)
-        indices = tuple(k for k, item in enumerate(effects)
+        listed = [effects] if isinstance(effects, (str, Mapping)) else effects  # (one alone)
+        indices = tuple(k for k, item in enumerate(listed)
                         if (item if isinstance(item, str) else item["name"]) != "newtonian")
         return cls(kind, items, indices)
 
