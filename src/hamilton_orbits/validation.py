@@ -8,6 +8,8 @@ Public: ``rigid`` stands on it as ``hamilton_orbits`` does (the core both packag
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 
@@ -55,6 +57,8 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     """
     if value is None:  # np.asarray(None, dtype=float) would be a silent NaN
         raise ValueError(f"Expected `{name}` to be numeric, got None")
+    if type(value) is list or type(value) is tuple:
+        _check_listed(name, value, ())
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
     if value is None:  # np.asarray(None, float) is a silent NaN
@@ -79,6 +83,26 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
                 f"Expected `{name}` to be finite, got {float(arr[index])!r}{fmt_index(index)}"
             )
     return arr
+
+
+def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:
+    """Refuse what a list (nested or not) holds that ``numpy.asarray`` would take
+    wrongly: a bool (read as 1.0 or 0.0, silently) or a Quantity (a TypeError deep
+    in numpy), naming the index."""
+    units = sys.modules.get("astropy.units")
+    for k, x in enumerate(values):
+        kind = type(x)
+        if kind is float or kind is int:
+            continue
+        if kind is list or kind is tuple:
+            _check_listed(name, x, (*at, k))
+        elif kind is bool or kind is np.bool_:
+            raise ValueError(f"Expected `{name}` to be numeric, got {x!r}{fmt_index((*at, k))}")
+        elif units is not None and isinstance(x, units.Quantity):
+            raise ValueError(
+                f"Expected `{name}` to be plain numbers or one Quantity array, got the "
+                f"Quantity {x}{fmt_index((*at, k))} in a list (u.Quantity(...) joins a list of "
+                f"Quantities into one)")
 
 
 def check_finite(name: str, arr: np.ndarray, where: np.ndarray | None = None) -> None:

@@ -748,3 +748,25 @@ def test_numeric_strings_and_bools_are_not_numbers(what, args):
     make = Quaternion if what == "quaternion" else KeplerOrbit.from_state
     with pytest.raises(ValueError, match=r"to be numeric, got"):
         make(*args)
+
+
+def test_a_list_holding_quantities_or_bools_is_refused_naming_the_index():
+    """A list of Quantities (``[0, 0, 360 * u.deg / u.s]``) raised numpy's bare
+    ``TypeError: only dimensionless scalar quantities can be converted``; a bool in
+    a list of floats was read as 1.0 (``e=[0.1, True]``: a radial orbit), where a
+    bool alone is refused.  Both are refused naming the argument and the index."""
+    from hamilton_orbits import KeplerOrbit
+    from rigid import RigidBody
+
+    with pytest.raises(ValueError, match=r"Expected `omega` to be plain numbers or one "
+                                          r"Quantity array, got the Quantity 360.0 deg / s at "
+                                          r"index 2 in a list \(u.Quantity"):
+        RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, 360 * u.deg / u.s])
+    with pytest.raises(ValueError, match=r"`r` to be plain numbers .* at index \(1, 0\)"):
+        Body("b", 0.0, [[1.0], [2.0 * u.au]], [0, 1, 0])  # (nested: the index in each)
+    with pytest.raises(ValueError, match=r"Expected `e` to be numeric, got True at index 1"):
+        KeplerOrbit.from_elements(a=1.0, e=[0.1, True], inc=0.0, lan=0.0, argp=0.0, nu=0.0,
+                                  mu=1.0)
+    with pytest.raises(ValueError, match=r"Expected `omega` to be numeric, got True at index 2"):
+        RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, True])
+    assert RigidBody([1.0, 2.0, 3.0], omega=(0.0, 1, 2.5)).omega.tolist() == [0.0, 1.0, 2.5]
