@@ -144,6 +144,8 @@ class System(InitialStates):
     """
 
     def __init__(self, bodies: Iterable[Body], G: float | None = None) -> None:
+        if isinstance(bodies, Body) or not isinstance(bodies, Iterable):
+            raise ValueError(f"Expected `bodies` to be a list of Body objects, got {bodies!r}")
         bodies = list(bodies)
         if not bodies:
             raise ValueError("Expected `bodies` to hold at least one Body, got none")

@@ -47,7 +47,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
-from hamilton_orbits.validation import as_float_array, check_trailing, first_index
+from hamilton_orbits.validation import check_trailing, first_index
 from rigid._kernels import euler as _k
 from rigid.integrators import integrate
 
@@ -372,7 +372,7 @@ def cayley_propagate(
     >>> round(float(tr.attitude[-1].as_axis_angle()[1]), 9), tr.n_recentre
     (2.283185307, 2)
     """
-    r = float(as_float_array("recentre", recentre))
+    r = DIMENSIONLESS.scalar("recentre", recentre)
     if not r > 0.0:
         raise ValueError(f"Expected `recentre` > 0, got {r!r}")
     return integrate(body, _output_grid(t_end, n_out), dt=dt, method="cayley_rk4",

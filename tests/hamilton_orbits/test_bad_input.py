@@ -770,3 +770,10 @@ def test_a_list_holding_quantities_or_bools_is_refused_naming_the_index():
     with pytest.raises(ValueError, match=r"Expected `omega` to be numeric, got True at index 2"):
         RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, True])
     assert RigidBody([1.0, 2.0, 3.0], omega=(0.0, 1, 2.5)).omega.tolist() == [0.0, 1.0, 2.5]
+
+
+@pytest.mark.parametrize("bodies", [5, Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
+def test_a_system_of_something_not_a_list_of_bodies_is_refused(bodies):
+    """``System(5)`` raised ``TypeError: 'int' object is not iterable``."""
+    with pytest.raises(ValueError, match=r"Expected `bodies` to be a list of Body objects"):
+        System(bodies)

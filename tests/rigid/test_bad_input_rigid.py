@@ -132,3 +132,20 @@ def test_a_spin_given_in_hertz_is_refused_not_read_as_radians_per_second():
         RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.0, 0.0, 1.0] * u.Hz)
     body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.0, 0.0, 1.0] * u.cycle / u.s)
     assert body.omega.to_value(u.rad / u.s)[2] == 2 * np.pi
+
+
+def test_an_array_where_one_number_is_asked_is_refused_by_name():
+    """``recentre`` and ``annual_prograde`` given as arrays raised numpy's
+    ``TypeError: only 0-dimensional arrays can be converted to Python scalars``."""
+    from rigid import RigidBody
+    from rigid.rodrigues import cayley_propagate
+
+    body = RigidBody([1.0, 1.0, 1.0], omega=[0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match=r"Expected `recentre` to be one number, got shape "
+                                          r"\(2,\)"):
+        cayley_propagate(body, 1.0, 0.01, recentre=[1.0, 2.0])
+    for name in ("annual_prograde", "annual_retrograde"):
+        kw = {"annual_prograde": 1e-7, name: [1e-7, 2e-7]}
+        with pytest.raises(ValueError, match=rf"Expected `{name}` to be one \(complex\) "
+                                              rf"angle, got shape \(2,\)"):
+            LiouvillePole(("annual_excitation",), **kw)

@@ -398,6 +398,10 @@ def _annual_terms(
         raise ValueError("Effect 'annual_excitation' needs `annual_prograde`")
     cp, _ = _complex_angle("annual_prograde", params["annual_prograde"])
     cr, _ = _complex_angle("annual_retrograde", params.get("annual_retrograde", 0.0))
+    for name, value in (("annual_prograde", cp), ("annual_retrograde", cr)):
+        if value.shape != ():
+            raise ValueError(f"Expected `{name}` to be one (complex) angle, got shape "
+                             f"{value.shape}")
     t_a = float(positive_scalar("annual_period", TIME(
         "annual_period", params.get("annual_period", 365.2422), u.day)))
     ep = TIME("annual_epoch", params.get("annual_epoch", 0.0), u.day)
