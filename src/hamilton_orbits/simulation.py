@@ -62,7 +62,7 @@ from hamilton_orbits.trajectory import (
     event_table,
     make_trajectory,
 )
-from hamilton_orbits.units import is_quantity
+from hamilton_orbits.units import TIME, is_quantity
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -107,10 +107,11 @@ class Simulation(Saving):
         variational equations) takes it between two steps, at the end of every
         ``every_steps``-th, its steps unchanged; the other methods at the first
         output after;
-    every_wall : float, optional
-        or every so many seconds of wall-clock time, at the first look at the clock
-        after each: at the outputs, and for radau15 (double precision, without the
-        variational equations) also between two steps, every 10 000 steps.
+    every_wall : float or Quantity, optional
+        or every so many seconds (or a time Quantity) of wall-clock time, at the
+        first look at the clock after each: at the outputs, and for radau15
+        (double precision, without the variational equations) also between two
+        steps, every 10 000 steps.
     exact_times : bool, optional
         Snapshots at exactly the scheduled times (the default of the adaptive
         methods, which end a step there by their own step control), or at the end
@@ -413,8 +414,19 @@ def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact_times: Any, met
                          f"step ends exactly at each snapshot time by its own step "
                          f"control; False takes the snapshots on a fixed step's own steps")
     return ArchiveWriter(path, every=None if every is None else time_step(every, quantity, "every"),
-                         every_steps=every_steps, every_wall=every_wall,
+                         every_steps=every_steps, every_wall=_wall_seconds(every_wall),
                          exact=not fixed if exact_times is None else exact_times, sync=sync)
+
+
+def _wall_seconds(every_wall: Any) -> Any:
+    """``every_wall`` in seconds: a time Quantity converted, a NumPy number made a
+    float (the schedule is JSON in every snapshot); anything else as given (the
+    archive refuses what is not a positive number)."""
+    if is_quantity(every_wall):
+        return TIME.scalar("every_wall", every_wall, u.s)
+    if isinstance(every_wall, (np.floating, np.integer)):
+        return float(every_wall)
+    return every_wall
 
 
 def integrate(

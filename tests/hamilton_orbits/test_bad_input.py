@@ -777,3 +777,19 @@ def test_a_system_of_something_not_a_list_of_bodies_is_refused(bodies):
     """``System(5)`` raised ``TypeError: 'int' object is not iterable``."""
     with pytest.raises(ValueError, match=r"Expected `bodies` to be a list of Body objects"):
         System(bodies)
+
+
+def test_every_wall_as_a_time_quantity_or_a_numpy_number_is_taken(tmp_path):
+    """``every_wall`` (wall-clock seconds) given as ``np.float32(1.0)`` or ``2 * u.s``
+    was refused as "Expected `every_wall` > 0 and finite", which it was; a time
+    Quantity is converted to seconds, a NumPy number taken as a float, and a
+    length refused by name."""
+    from hamilton_orbits import Simulation
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-5, [1, 0, 0], [0, 1, 0])])
+    for k, (given, seconds) in enumerate([(np.float32(1.5), 1.5), (2 * u.s, 2.0),
+                                          (0.5 * u.min, 30.0), (np.int64(3), 3.0)]):
+        sim = Simulation(s, archive=tmp_path / str(k), every_wall=given)
+        assert sim._archive.every_wall == seconds and type(sim._archive.every_wall) is float
+    with pytest.raises(u.UnitConversionError, match=r"Expected `every_wall` to be a time"):
+        Simulation(s, archive=tmp_path / "m", every_wall=1 * u.m)
