@@ -201,7 +201,7 @@ class Kind:
                 raise u.UnitConversionError(
                     f"Expected `{name}` to be {self.name}, got {value.unit}: the hertz counts "
                     f"cycles, 2 pi rad each (ISO 80000-3 gives angular speeds no hertz); give "
-                    f"rad / s, or cycle / s for turns per second")
+                    f"{self.unit:generic} counting radians (cycle / s for turns per second)")
             try:
                 value = value.to_value(target, equivalencies=self.equivalencies)
             except u.UnitConversionError as exc:

@@ -49,7 +49,7 @@ __all__ = [
 
 _TORQUE = u.N * u.m
 _RATE = u.rad / u.s
-_GM_OVER_R3 = Kind("a squared rate GM / r^3", u.s**-2)
+_GM_OVER_R3 = Kind("a squared rate GM / r^3", u.s**-2, u.dimensionless_angles, no_hertz=True)
 
 
 def _moments(moments: Any) -> np.ndarray:

@@ -149,3 +149,16 @@ def test_an_array_where_one_number_is_asked_is_refused_by_name():
         with pytest.raises(ValueError, match=rf"Expected `{name}` to be one \(complex\) "
                                               rf"angle, got shape \(2,\)"):
             LiouvillePole(("annual_excitation",), **kw)
+
+
+def test_a_squared_rate_in_hertz_is_refused_and_in_radians_taken():
+    """``GravityGradientTorque``'s ``gm_over_r3`` (n squared) in Hz**2 was read as
+    1/s**2 (4 pi**2 too small, were the hertz cycles); it is refused, and n**2 of a
+    rad/s Quantity, refused before ("got rad2 / s2"), is taken."""
+    from rigid.euler import GravityGradientTorque
+
+    with pytest.raises(u.UnitConversionError, match=r"`gm_over_r3` .* got Hz2: the hertz"):
+        GravityGradientTorque((1e-3 * u.Hz) ** 2)
+    radians = GravityGradientTorque((1e-3 * u.rad / u.s) ** 2).encode()
+    per_second = GravityGradientTorque(1e-6 / u.s**2).encode()
+    assert radians[0] == per_second[0] and radians[1].tolist() == per_second[1].tolist()
