@@ -365,3 +365,16 @@ def test_one_effect_given_alone_is_the_list_of_it():
     assert Simulation(s, effects="newtonian").integrate(1.0).effects == ("newtonian",)
     with pytest.raises(ValueError, match=r"speed of light `c`.*\(effects\[0\]\)"):
         Simulation(s, effects={"name": "gr"})
+
+
+def test_a_string_parameter_on_a_system_of_floats_is_named_as_the_string_given():
+    """A string such as ``"1e4"`` for ``c`` on a system of plain floats is read as a
+    Quantity and refused; the message showed "got the Quantity 10000.0", a value
+    the user never wrote: it names the string."""
+    from hamilton_orbits import Simulation
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-5, [1.0, 0, 0], [0, 1.0, 0])])
+    with pytest.raises(ValueError, match=r"plain number in the units of the system .*got "
+                                          r"the string '1e4' \(read as a Quantity\)"):
+        Simulation(s, effects=[{"name": "gr", "c": "1e4"}])

@@ -198,9 +198,12 @@ def parameter_array(system: Any, params: Mapping[str, Any], key: str, effect: st
                 f"to {kind.unit}; e.g. a string such as '{unit_example(kind)}') for a system of "
                 f"Quantities, got the plain number {_shown(value)}")
         if not system.quantity and is_quantity(value):
+            given = params[key]
+            shown = (f"the string {given!r} (read as a Quantity)" if isinstance(given, str)
+                     else f"the Quantity {_shown(value)}")
             raise ValueError(
                 f"Effect {effect!r}: expected `{key}` as a plain number in the units of the "
-                f"system (a system of plain floats), got the Quantity {_shown(value)}")
+                f"system (a system of plain floats), got {shown}")
         unit = SYSTEM_UNITS[kind] if system.quantity else None
     try:
         return kind(key, value, unit)
