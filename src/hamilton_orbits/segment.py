@@ -881,7 +881,8 @@ def _split(seg: Segment, shared: dict[str, Any], fixed: dict[str, np.ndarray],
         if before == OWN_ROW:  # (its one row its own state, format 4)
             arrays.update(out_t=arrays["t"].reshape(1), out_r=rec["r"][None], out_v=rec["v"][None])
             seg.snapshots.append((number, meta, arrays))
-        elif rows is not None and (not rows or end > len(rows["out_t"])):
+        elif (end > before and rows is None) or (rows is not None and (
+                not rows or end > len(rows["out_t"]))):  # (its rows file gone, or short)
             seg.damaged.append((seg.path, f"{seg.path}: the output rows of snapshot "
                                           f"{number} are missing or damaged"))
         else:

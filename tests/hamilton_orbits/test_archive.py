@@ -1412,3 +1412,26 @@ def test_dop853_stopped_by_a_collision_writes_no_snapshot_after_the_stop(tmp_pat
     resumed = Simulation.load(tmp_path).resume()
     assert resumed.t.tolist() == call.t.tolist() and _same(resumed.r, call.r)
     assert resumed.stopped_by is not None
+
+
+def test_a_missing_rows_file_makes_its_snapshots_damaged_not_short(tmp_path):
+    """A segment's rows file deleted (a user who copied the segments alone: format 4
+    makes an archive without one usual): the snapshots whose records name rows in
+    it are listed as damaged, not read with no rows, and the call resumed from the
+    last whole snapshot is the whole call, to the bit.  (The resumed call came back
+    without the rows the file held, and nothing was listed.)"""
+    times = np.arange(0.0, 6.0, 0.5)
+    whole = Simulation(_disc(), method="radau15", archive=tmp_path / "whole", every=1.0
+                       ).integrate(times)
+    calls = iter(range(100))
+    sim = Simulation(_disc(), method="radau15", archive=tmp_path / "cut", every=1.0)
+    cut = sim.integrate(times, stop=lambda: next(calls) >= 6)
+    assert not cut.complete
+    (tmp_path / "cut" / "rows-000000.nc").unlink()
+    archive = Archive(tmp_path / "cut")
+    lost = {snap for _, why in archive.damaged
+            for snap in re.findall(r"the output rows of snapshot (\d+) are missing", why)}
+    assert lost and len(archive) == 1 and archive.times.tolist() == [0.0]
+    traj = Simulation.load(tmp_path / "cut").resume()
+    assert traj.t.tolist() == times.tolist()
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and traj.steps == whole.steps
