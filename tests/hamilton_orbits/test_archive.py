@@ -1435,3 +1435,27 @@ def test_a_missing_rows_file_makes_its_snapshots_damaged_not_short(tmp_path):
     traj = Simulation.load(tmp_path / "cut").resume()
     assert traj.t.tolist() == times.tolist()
     assert _same(traj.r, whole.r) and _same(traj.v, whole.v) and traj.steps == whole.steps
+
+
+@pytest.mark.parametrize("every_steps", [4, 100])
+def test_a_call_that_begins_in_a_deep_encounter_is_not_judged_by_its_pauses(tmp_path,
+                                                                         every_steps):
+    """A call that begins at a close encounter's closest point (1e-9 of the orbit:
+    the previous call stopped there) takes tiny steps at first.  radau15 judges the
+    pace of a run at the end of each slice of 20000 steps; an ``every_steps``
+    archive's pauses cut the slices short, and the pace was judged after the first
+    few tiny steps: a ConvergenceError ("needs about 1.1e+11 steps") for a call that
+    the run without an archive finishes.  The pace is judged where that run judges
+    it: the same steps, the same bits."""
+    system = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("a", 1e-3, [1.0, 0, 0], [0, 1.0, 0]),
+                     Body("b", 1e-3, [-1.0, 0.0, 1e-3], [0, 1.0, 0.0])])  # (b retrograde)
+    events = [{"name": "close_encounter", "distance": 0.1, "action": "stop"}]
+    runs = []
+    for kw in ({}, dict(archive=tmp_path / "a", every_steps=every_steps)):
+        sim = Simulation(system, method="radau15", events=events, **kw)
+        first = sim.integrate(10.0)  # (stops at the closest approach)
+        runs.append((first, sim.integrate(10.0), sim.steps))
+    (first, second, steps), (first_a, second_a, steps_a) = runs
+    assert first.t[-1] == first_a.t[-1] < 10.0
+    assert _same(second.r, second_a.r) and steps == steps_a

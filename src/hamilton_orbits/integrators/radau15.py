@@ -362,12 +362,15 @@ class _Run:
         the steps before this call, for its budget of ``max_steps``)."""
         log, max_steps, pause = self.log, self.max_steps, self.pause
         again = False  # (a pause since which only the kernel ran: see pause's notes)
+        left = SLICE  # (of this slice: the pace is judged at its end, pauses or not)
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
-            budget = min(SLICE, max_steps - (self.steps - first))
+            budget = min(left, max_steps - (self.steps - first))
+            cut = False  # (the budget cut short by a pause)
             if pause is not None:
                 if self.steps >= pause.at:
                     pause(again)
                     again = True
+                cut = pause.at - self.steps < budget
                 budget = min(budget, max(pause.at - self.steps, 1))
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
@@ -377,15 +380,18 @@ class _Run:
                 steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget, None,
                                             None, None)
             self.steps += steps
+            left -= steps
             if status == _k.STATUS_MAXSTEPS:
-                _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
+                if not cut:  # (a slice's end or max_steps, where a run without pauses is)
+                    _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
+                    left = SLICE
                 if self.stop is not None and self.stop():
                     raise StopIntegration
             elif status == _k.STATUS_DRAIN:
                 log.drain()
-                again = False
+                again, left = False, SLICE
             elif status == _k.STATUS_EVENT:
-                again = False
+                again, left = False, SLICE
                 if log.act(int(self.st[_k.ST_EVENT_ROW]), self.t, self.x, self.w, self.gm):
                     return True
             elif status == _k.STATUS_OK:
