@@ -46,7 +46,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, is_quantity, wrap
+from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, Kind, is_quantity, wrap
 from hamilton_orbits.validation import check_trailing, first_index
 from rigid._kernels import euler as _k
 from rigid.integrators import integrate
@@ -59,6 +59,10 @@ __all__ = [
     "omega_from_gibbs_rate",
     "relative_gibbs",
 ]
+
+
+#: a rate of Cayley's parameters (pure numbers) per unit of time
+_PER_TIME = Kind("a rate (per unit of time)", u.s**-1)
 
 
 def _vec(name: str, value: Any) -> np.ndarray:
@@ -139,13 +143,13 @@ def omega_from_gibbs_rate(gibbs: Any, gibbs_dot: Any) -> np.ndarray:
     ----------
     gibbs : array_like, shape (..., 3)
         (lambda, mu, nu).
-    gibbs_dot : array_like, shape (..., 3)
-        d(lambda, mu, nu)/dt (1/time).
+    gibbs_dot : array_like or Quantity, shape (..., 3)
+        d(lambda, mu, nu)/dt (1/time; a Quantity as :func:`gibbs_rate` gives it).
 
     Returns
     -------
-    ndarray, shape (..., 3)
-        (p, q, r) in the same time unit.
+    ndarray or Quantity, shape (..., 3)
+        (p, q, r) in the same time unit (rad/s when ``gibbs_dot`` was a Quantity).
 
     Raises
     ------
@@ -158,9 +162,12 @@ def omega_from_gibbs_rate(gibbs: Any, gibbs_dot: Any) -> np.ndarray:
     array([0., 0., 1.])
     """
     g = _vec("gibbs", gibbs)
-    d = _vec("gibbs_dot", gibbs_dot)
+    quantity = is_quantity(gibbs_dot)
+    d = check_trailing("gibbs_dot", _PER_TIME("gibbs_dot", gibbs_dot), 3) if quantity else _vec(
+        "gibbs_dot", gibbs_dot)
     g, d = _pair(("gibbs", "gibbs_dot"), g, d)
-    return _guarded(("gibbs", "gibbs_dot"), "omega", lambda: _k.gibbs_omega_gufunc(g, d))
+    out = _guarded(("gibbs", "gibbs_dot"), "omega", lambda: _k.gibbs_omega_gufunc(g, d))
+    return wrap(out, u.rad / u.s, quantity)
 
 
 def direction_cosines(gibbs: Any) -> np.ndarray:

@@ -173,3 +173,24 @@ def test_cayley_bad_input():
         omega_from_gibbs_rate([0.0, 0.0, 0.0], [1.0, 0.0])
     with pytest.raises(ValueError, match="broadcast"):
         compose_gibbs(np.zeros((2, 3)), np.zeros((4, 3)))
+
+
+def test_omega_from_gibbs_rate_takes_the_quantity_gibbs_rate_gives():
+    """``omega_from_gibbs_rate`` is documented as the inverse of ``gibbs_rate``, which
+    answers a Quantity (1/s) for a Quantity ``omega``; given it back, it refused
+    it ("Expected `gibbs_dot` to be dimensionless, got 1 / s").  The round trip
+    gives the rates back, in rad/s, to rounding (Cayley 1843, p. 228, both ways)."""
+    import astropy.units as u
+
+    from rigid.rodrigues import gibbs_rate, omega_from_gibbs_rate
+
+    g = np.array([[0.1, -0.2, 0.3], [2.0, 0.5, -1.0]])
+    w = np.array([[0.2, 0.4, 0.6], [-1.0, 0.3, 0.7]]) * u.rad / u.s
+    back = omega_from_gibbs_rate(g, gibbs_rate(g, w))
+    assert back.unit == u.rad / u.s
+    # (a few ulp of rates of order 1: the map and its inverse each round a few times)
+    np.testing.assert_allclose(back.to_value(u.rad / u.s), w.value, rtol=0, atol=1e-15)
+    per_day = omega_from_gibbs_rate(g, gibbs_rate(g, w).to(1 / u.day))
+    np.testing.assert_allclose(per_day.to_value(u.rad / u.s), w.value, rtol=1e-15, atol=0)
+    with pytest.raises(u.UnitConversionError, match=r"Expected `gibbs_dot` to be a rate"):
+        omega_from_gibbs_rate(g, [0.0, 0.0, 1.0] * u.m)
