@@ -210,8 +210,8 @@ class Kind:
                 else:
                     what = f"{self.name} (convertible to {target})"
                 raise u.UnitConversionError(
-                    f"Expected `{name}` to be {what}, got {value.unit}"
-                ) from exc
+                    f"Expected `{name}` to be {what}, got "
+                    f"{str(value.unit) or 'a number without a unit'}") from exc
         return as_float_array(name, value, finite=finite)
 
     def scalar(self, name: str, value: Any, unit: UnitLike | None = None) -> float:

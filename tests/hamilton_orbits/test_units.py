@@ -95,3 +95,14 @@ def test_an_angular_speed_in_hertz_is_refused_by_name(unit):
     assert float(ANGULAR_SPEED("spin", 2.0 / u.s)) == 2.0
     assert float(ANGULAR_SPEED("spin", 1.0 * u.cycle / u.s)) == 2 * np.pi
     assert float(ANGULAR_SPEED("spin", 360.0 * u.deg / u.s)) == 2 * np.pi
+
+
+def test_a_number_without_a_unit_where_a_unit_is_asked_is_named_so():
+    """A dimensionless Quantity (an effect's string '1.5424', read without a unit)
+    where an angle is asked was refused as "got " (the empty unit)."""
+    from hamilton_orbits.units import ANGLE
+
+    with pytest.raises(u.UnitConversionError, match=r"Expected `inc` to be an angle "
+                                                    r"\(convertible to rad\), got a number "
+                                                    r"without a unit$"):
+        ANGLE("inc", 1.5 * u.dimensionless_unscaled)
