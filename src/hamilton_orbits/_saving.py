@@ -163,7 +163,12 @@ class Saving:
         >>> bool(np.array_equal(a.r, b.r)), again.steps
         (True, 200)
         """
-        write(path_of(path, "path", "a file or folder path"), *self._record(), sync=True)
+        meta, arrays, dims, units = self._record()
+        asked = self._asked_times()
+        if asked is not None:  # (a fixed-step archive's snapshots are laid from them)
+            arrays["asked_times"] = np.asarray(asked, dtype=np.float64)
+        write(path_of(path, "path", "a file or folder path"), meta, arrays, dims, units,
+              sync=True)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:
@@ -209,6 +214,8 @@ class Saving:
             path, meta, arrays = found
             folder = None  # not attached: a snapshot of the run, writing nothing
         sim = cls._rebuild(meta, arrays, path)
+        if source is None and "asked_times" in arrays:  # (a file of save: the leg's
+            sim._asked = np.array(arrays["asked_times"], dtype=np.float64)  # times asked)
         schedule = meta.get("archive")
         if schedule:  # the archived run's schedule: written on when its folder is loaded
             sched = {k: schedule[k] for k in ("every", "every_steps", "every_wall", "sync",
@@ -425,15 +432,21 @@ class Saving:
         merged = np.union1d(times, extra)
         return merged, np.isin(merged, times), np.isin(merged, extra)
 
+    def _asked_times(self) -> np.ndarray | None:
+        """The output times asked for in the leg the simulation stands in (a
+        fixed-step method's archive lays its snapshots from them), or None."""
+        asked = self._asked
+        if isinstance(asked, tuple):  # (loaded: read from the archive once, when needed)
+            asked = self._asked = leg_times_of(*asked)
+        return asked
+
     def _asked_before(self, t: float) -> float | None:
         """The last output time asked for before ``t`` in the leg the simulation
         stands in, where it stands between two of them (a leg that ended at a
         snapshot, or a simulation loaded from one): a fixed-step method's snapshots
         are put on the steps laid from it, as in the leg never interrupted.  None
         where it stands on one, or no leg is known."""
-        asked = self._asked
-        if isinstance(asked, tuple):  # (loaded: read from the archive once, when needed)
-            asked = self._asked = leg_times_of(*asked)
+        asked = self._asked_times()
         if asked is None or not asked[0] < t < asked[-1]:
             return None
         before = asked[asked <= t]

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.checkpoint import contents
+from hamilton_orbits.checkpoint import contents, path_of
 from hamilton_orbits.simulation import Simulation
 from hamilton_orbits.snapshot import SnapshotError
 
@@ -84,7 +84,7 @@ class Archive:
     """
 
     def __init__(self, path: str | Path) -> None:
-        self.path = Path(path)
+        self.path = path_of(path, "path", "an archive folder's path")
         if not self.path.is_dir():
             raise SnapshotError(f"no archive folder {self.path}")
         found = contents(self.path, keep=("t", "r", "v", "gm", "active"))

@@ -157,7 +157,8 @@ def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True,
     the file's descriptor, open for reading and writing (a segment appended to
     next), instead of closing it."""
     folder, name = os.path.split(os.fspath(path))
-    tmp = os.path.join(folder, f".{name}.tmp-{os.getpid()}")
+    # (a name of 255 bytes is legal: the temporary one made of it kept within that)
+    tmp = os.path.join(folder, f".{name[:200]}.tmp-{os.getpid()}")
     fd = -1
     try:
         fd = os.open(tmp, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o666)
@@ -170,7 +171,10 @@ def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True,
     except OSError as exc:
         if fd >= 0:
             os.close(fd)
-        Path(tmp).unlink(missing_ok=True)
+        try:
+            os.unlink(tmp)
+        except OSError:  # (none made: its folder is not one, or the name too long)
+            pass
         raise SnapshotError(f"cannot write the snapshot {path}: "
                             f"{exc.strerror or exc}") from None
     if keep_open:

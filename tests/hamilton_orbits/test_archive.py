@@ -1459,3 +1459,47 @@ def test_a_call_that_begins_in_a_deep_encounter_is_not_judged_by_its_pauses(tmp_
     (first, second, steps), (first_a, second_a, steps_a) = runs
     assert first.t[-1] == first_a.t[-1] < 10.0
     assert _same(second.r, second_a.r) and steps == steps_a
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.01), dict(method="leapfrog", dt=0.013),
+                                dict(method="radau15", dt=0.02)], ids=["wh", "leapfrog",
+                                                                       "radau15-dt"])
+def test_a_stopped_fixed_step_archived_run_saved_to_a_file_goes_on_with_its_bits(tmp_path, kw):
+    """A fixed-step archived run stopped between two output times lays its next
+    snapshots on the steps drawn from the last output time asked for; saved to a
+    file and loaded, it had forgotten those times, so its snapshots, and its steps,
+    differed (4e-16 off).  The file keeps them (``asked_times``), as the folder's
+    snapshot does: the saved run, its file, the folder's snapshot and that one's
+    file go on with the same bits."""
+    sim = Simulation(_disc(), archive=tmp_path / "run", every=0.7, **kw)
+    sim.integrate(np.array([0.0, 1.0, 2.0, 3.0]), stop=lambda: True)  # (stops at 0.7)
+    assert 0.0 < sim.t < 1.0
+    sim.save(tmp_path / "snap.nc")
+    snapshot = Simulation.load(tmp_path / "run", number=1)
+    assert snapshot.t == sim.t
+    snapshot.save(tmp_path / "snapshot.nc")
+    runs = [sim, Simulation.load(tmp_path / "snap.nc"), snapshot,
+            Simulation.load(tmp_path / "snapshot.nc")]
+    ends = [run.integrate(4.5) for run in runs]
+    for run, end in zip(runs[1:], ends[1:], strict=True):
+        assert _same(end.r, ends[0].r) and _same(end.v, ends[0].v) and run.steps == sim.steps
+
+
+def test_bad_paths_of_save_and_archive_are_refused_naming_them(tmp_path):
+    """``Simulation.save`` under a path whose folder is a file raised the bare
+    NotADirectoryError of its temporary file's clean-up; a legal name of 254 bytes
+    failed as its temporary name grew past 255; ``Archive('')`` opened the current
+    folder and ``Archive(None)`` raised a TypeError.  Each is a SnapshotError or
+    ValueError naming the path, and the long name is saved."""
+    sim = Simulation(_disc(), method="wh", dt=0.05)
+    (tmp_path / "f.nc").write_text("a file")
+    with pytest.raises(SnapshotError, match=r"cannot write the snapshot .*f\.nc/x\.nc: Not a "
+                                            r"directory"):
+        sim.save(tmp_path / "f.nc" / "x.nc")
+    long = tmp_path / ("x" * 251 + ".nc")
+    sim.save(long)
+    assert Simulation.load(long).t == sim.t
+    for path in ("", None, b"."):
+        with pytest.raises(ValueError, match=r"Expected `path` to be an archive folder's "
+                                             r"path, got"):
+            Archive(path)
