@@ -148,3 +148,51 @@ def test_a_scene_reading_a_relative_file_resumes_from_another_folder(tmp_path, m
     assert os.getcwd() == str(elsewhere)
     resumed = _states(tmp_path / "out")
     assert all(np.array_equal(resumed[k], whole[k], equal_nan=True) for k in whole)
+
+
+@pytest.mark.parametrize("text", ["{\"scene\": \"comet-encounter\", \"set\": [\"a", "", "{}",
+                                  "[]"])
+def test_resume_of_a_damaged_scene_record_says_so_naming_it(tmp_path, capsys, text):
+    """``archive/scene.json`` cut short (a run that could not write it whole) or not
+    a run's record gave ``JSONDecodeError``, ``KeyError: 'scene'`` or an
+    AttributeError (exit 1); it is named as damaged (exit 2), and the run's own
+    writes it whole (under a temporary name, then renamed)."""
+    (tmp_path / "archive").mkdir()
+    (tmp_path / "archive" / "scene.json").write_text(text)
+    assert main(["resume", str(tmp_path), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "archive/scene.json is damaged" in err and "hamilton-orbits run" in err
+
+
+def test_resume_of_an_empty_path_names_outdir(capsys):
+    """``resume ''`` named ``--out``, an option ``resume`` does not have."""
+    assert main(["resume", ""]) == 2
+    assert "OUTDIR '': an empty path" in capsys.readouterr().err
+
+
+def test_ctrl_c_while_a_finished_run_is_saved_keeps_its_files(tmp_path, capsys):
+    """A Ctrl-C while ``run`` writes the files of a finished run aborted the saving:
+    exit 130 with only the summary written.  The first is kept until the files are
+    written (exit 130, every file there); a second would abort."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from hamilton_orbits import cli
+
+    class Finished:
+        complete = True
+
+        def summary(self):
+            return "summary"
+
+        def save(self, folder):
+            os.kill(os.getpid(), signal.SIGINT)  # (Ctrl-C, the moment saving begins)
+            time.sleep(0.01)
+            path = Path(folder) / "states.nc"
+            path.write_text("states")
+            return [path]
+
+    code = cli._finish(SimpleNamespace(name="demo"), Finished(), tmp_path, None)
+    assert code == cli.EXIT_INTERRUPTED and (tmp_path / "states.nc").read_text() == "states"
+    captured = capsys.readouterr()
+    assert "saving the run's files first" in captured.err and "wrote 1 files" in captured.out

@@ -32,10 +32,11 @@ itself (docs/design.md).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import shlex
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -240,9 +241,11 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     source = ref if file is None else str(file.resolve())
     record = {"scene": source, "set": list(sets), "text": _scene_text(file, ref),
               "cwd": os.getcwd()}  # (where the scene's relative paths were read)
-    try:  # (the scene's text kept: a resume runs the scene this run ran)
+    try:  # (the scene's text kept, written whole: a resume runs the scene this run ran)
         archive.mkdir(parents=True, exist_ok=True)
-        (archive / "scene.json").write_text(json.dumps(record), encoding="utf-8")
+        part = archive / f".scene.json.tmp-{os.getpid()}"
+        part.write_text(json.dumps(record), encoding="utf-8")
+        os.replace(part, archive / "scene.json")
     except OSError as exc:
         raise FolderError(f"--out {folder}: cannot write {archive} "
                           f"({exc.strerror or exc}); nothing was run") from None
@@ -271,7 +274,14 @@ def _resume(out: str, progress: bool) -> int:
     if not record.is_file():
         raise _CommandError(f"{folder} is not the output folder of a scene run with an "
                             f"archive (no {record})")
-    source = json.loads(record.read_text(encoding="utf-8"))
+    try:
+        source = json.loads(record.read_text(encoding="utf-8"))
+        if not (isinstance(source, dict) and isinstance(source.get("scene"), str)
+                and isinstance(source.get("set", []), list)):
+            raise ValueError("not the record of a run")
+    except (OSError, ValueError) as exc:  # (JSONDecodeError and UnicodeDecodeError too)
+        raise _CommandError(f"{record} is damaged ({_one_line(exc)}): the run's scene cannot "
+                            f"be read; start it again with hamilton-orbits run") from None
     text = source.get("text")  # (the scene as the run ran it; none in older archives)
     file = _scene_file(source["scene"])
     if text is not None and file is not None and file.is_file() and \
@@ -283,7 +293,7 @@ def _resume(out: str, progress: bool) -> int:
     try:
         if there is not None and os.path.isdir(there):
             os.chdir(there)
-        scene = _load_scene(source["scene"], source["set"], text)
+        scene = _load_scene(source["scene"], source.get("set", []), text)
         with OutputFolder(folder, "output folder"):
             result = _run_scene(scene, progress, folder / "archive")
             return _finish(scene, result, folder, folder / "archive")
@@ -292,21 +302,49 @@ def _resume(out: str, progress: bool) -> int:
 
 
 def _finish(scene, result, folder, archive) -> int:
-    """Print the summary, save the result into ``folder``; the exit code."""
+    """Print the summary, save the result into ``folder`` (a Ctrl-C meanwhile kept
+    until the files are written: a finished run is not thrown away); the exit code."""
     if result is None:
         return EXIT_FAILED
-    print(result.summary())
-    try:
-        paths = result.save(folder)
-    except Exception as exc:
-        _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
-               f"{_one_line(exc)}")
-        return EXIT_FAILED
-    print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+    with _saving_through_ctrl_c() as caught:
+        print(result.summary())
+        try:
+            paths = result.save(folder)
+        except Exception as exc:
+            _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
+                   f"{_one_line(exc)}")
+            return EXIT_FAILED
+        print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
     if not result.complete and archive is not None:
         print(f"the run was interrupted; its archive is {archive}/: continue it with "
               f"hamilton-orbits resume {shlex.quote(str(folder))}")
-    return EXIT_OK if result.complete else EXIT_INTERRUPTED
+    return EXIT_OK if result.complete and not caught else EXIT_INTERRUPTED
+
+
+@contextlib.contextmanager
+def _saving_through_ctrl_c() -> Iterator[list[int]]:
+    """While the run's files are written: the first Ctrl-C noted (the list it
+    gives), the files written on; a second aborts."""
+    import signal
+
+    caught: list[int] = []
+
+    def on_sigint(signum, frame):
+        if caught:
+            raise KeyboardInterrupt
+        caught.append(signum)
+        print("\nhamilton-orbits: saving the run's files first (Ctrl-C again to abort)",
+              file=sys.stderr)
+
+    try:
+        previous = signal.signal(signal.SIGINT, on_sigint)
+    except ValueError:  # not the main thread: leave Ctrl-C alone
+        previous = None
+    try:
+        yield caught
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 def _run_scene(scene, progress: bool, archive=None):
@@ -601,6 +639,9 @@ def _guarded(args: argparse.Namespace) -> int:
 
 def _dispatch(args: argparse.Namespace) -> int:
     if getattr(args, "out", None) is not None and not str(args.out).strip():
+        if args.command == "resume":
+            raise _CommandError(f"OUTDIR {args.out!r}: an empty path (give the output "
+                                f"folder of the run to resume)")
         raise _CommandError(f"--out {args.out!r}: an empty path (give a folder, or leave "
                             f"--out out for the default)")
     progress = not (args.quiet or getattr(args, "no_progress", False))
