@@ -306,7 +306,7 @@ def _finish(scene, result, folder, archive) -> int:
     until the files are written: a finished run is not thrown away); the exit code."""
     if result is None:
         return EXIT_FAILED
-    with _saving_through_ctrl_c() as caught:
+    with _ctrl_c("saving the run's files first (Ctrl-C again to abort)") as caught:
         print(result.summary())
         try:
             paths = result.save(folder)
@@ -322,9 +322,9 @@ def _finish(scene, result, folder, archive) -> int:
 
 
 @contextlib.contextmanager
-def _saving_through_ctrl_c() -> Iterator[list[int]]:
-    """While the run's files are written: the first Ctrl-C noted (the list it
-    gives), the files written on; a second aborts."""
+def _ctrl_c(saying: str) -> Iterator[list[int]]:
+    """Within it, the first Ctrl-C noted in the list it gives (and ``saying`` said on
+    stderr), the work going on; a second aborts (KeyboardInterrupt)."""
     import signal
 
     caught: list[int] = []
@@ -333,8 +333,7 @@ def _saving_through_ctrl_c() -> Iterator[list[int]]:
         if caught:
             raise KeyboardInterrupt
         caught.append(signum)
-        print("\nhamilton-orbits: saving the run's files first (Ctrl-C again to abort)",
-              file=sys.stderr)
+        print(f"\nhamilton-orbits: {saying}", file=sys.stderr)
 
     try:
         previous = signal.signal(signal.SIGINT, on_sigint)
@@ -351,35 +350,16 @@ def _run_scene(scene, progress: bool, archive=None):
     """Run ``scene`` with Ctrl-C handled (the first stops the run soon and keeps what
     it reached, the second aborts);
     None (after one line on stderr) if the run failed."""
-    interrupted: list[int] = []
-
-    def stop() -> bool:
-        return bool(interrupted)
-
-    def on_sigint(signum, frame):  # first Ctrl-C: stop soon, keep what was reached
-        if interrupted:
-            raise KeyboardInterrupt
-        interrupted.append(signum)
-        print("\nhamilton-orbits: stopping (within a few thousand steps; what was reached is "
-              "kept; Ctrl-C again to abort)", file=sys.stderr)
-
-    import signal
-
-    previous = signal.getsignal(signal.SIGINT)
-    try:
-        signal.signal(signal.SIGINT, on_sigint)
-    except ValueError:  # not the main thread: leave Ctrl-C alone
-        previous = None
-    try:
-        return scene.run(progress=progress and sys.stderr.isatty(), stop=stop, archive=archive)
-    except KeyboardInterrupt:
-        raise
-    except Exception as exc:
-        _error(f"the run of {scene.name} failed: {_one_line(exc)}")
-        return None
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
+    with _ctrl_c("stopping (within a few thousand steps; what was reached is kept; Ctrl-C "
+                 "again to abort)") as interrupted:
+        try:
+            return scene.run(progress=progress and sys.stderr.isatty(),
+                             stop=lambda: bool(interrupted), archive=archive)
+        except KeyboardInterrupt:
+            raise
+        except Exception as exc:
+            _error(f"the run of {scene.name} failed: {_one_line(exc)}")
+            return None
 
 
 def _crosscheck(ref: str, sets: Sequence[str]) -> int:

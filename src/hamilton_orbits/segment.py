@@ -414,11 +414,11 @@ class SegmentWriter:
                                for i in range(n)])
         if self.legs:
             self.tail = (*snapshot["leg"], *NO_SPAN)
+        end = start + n if start != OWN_ROW else OWN_ROW
         if self._direct and type(snapshot["state"]) is Parts and self._append_state(
-                snapshot, start, start + n if start != OWN_ROW else OWN_ROW):
+                snapshot, start, end):
             return
-        span = np.array([start, start + n] if start != OWN_ROW else [OWN_ROW, OWN_ROW],
-                        dtype=np.float64)
+        span = np.array([start, end], dtype=np.float64)
         self._file.append([[span if k == "rows" else _stored(k, snapshot[k])
                             for k in self.names]])
 
