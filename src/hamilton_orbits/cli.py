@@ -324,14 +324,18 @@ def _finish(scene, result, folder, archive) -> int:
 @contextlib.contextmanager
 def _ctrl_c(saying: str) -> Iterator[list[int]]:
     """Within it, the first Ctrl-C noted in the list it gives (and ``saying`` said on
-    stderr), the work going on; a second aborts (KeyboardInterrupt)."""
+    stderr), the work going on; a second aborts (KeyboardInterrupt, held as the
+    drivers hold Ctrl-C: :mod:`hamilton_orbits.integrators._held`)."""
     import signal
+
+    from hamilton_orbits.integrators._held import HELD
 
     caught: list[int] = []
 
     def on_sigint(signum, frame):
         if caught:
-            raise KeyboardInterrupt
+            HELD.interrupt()
+            return
         caught.append(signum)
         print(f"\nhamilton-orbits: {saying}", file=sys.stderr)
 

@@ -300,8 +300,11 @@ class Simulation(Saving):
         ValueError
             For bad times, or a lost state (a collision or a step too long).
         KeyboardInterrupt
-            On Ctrl-C (the run stops within a few thousand steps; the simulation
-            keeps the state reached), unless ``on_interrupt="keep"``.
+            On Ctrl-C (the run stops within a slice of steps; the simulation keeps
+            the state reached, its time and step count with it: continued, it gives
+            the bits of the run never interrupted), unless ``on_interrupt="keep"``.
+            A Ctrl-C during a compiled call is held until its steps are counted
+            (:mod:`hamilton_orbits.integrators._held`); a second is raised at once.
         """
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's

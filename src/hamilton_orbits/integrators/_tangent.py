@@ -35,6 +35,7 @@ from hamilton_orbits._kernels import variational as _var
 from hamilton_orbits._kernels import wh as _wh
 from hamilton_orbits._kernels import wh_tangent as _wht
 from hamilton_orbits.integrators import StopIntegration
+from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators._setup import (
     accel_arg,
     addresses,
@@ -225,11 +226,12 @@ class Radau15Tangent:
         for i in range(1, t_out.shape[0]):
             while True:
                 left = self.max_steps - (self.steps - first)
-                steps, status = _radau.advance_variational(
-                    self.accel, self.p, x, w, self.gm, t_out[i], st, *self.work, self.csx,
-                    self.csv, bool(self.rhs.velocity_dependent), min(self.slice, left),
-                    self.n_phys, self.tangent.ms)
-                self.steps += steps
+                with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
+                    steps, status = _radau.advance_variational(
+                        self.accel, self.p, x, w, self.gm, t_out[i], st, *self.work, self.csx,
+                        self.csv, bool(self.rhs.velocity_dependent), min(self.slice, left),
+                        self.n_phys, self.tangent.ms)
+                    self.steps += steps
                 if status == _radau.STATUS_OK:
                     break
                 if status != _radau.STATUS_MAXSTEPS or steps >= left:
@@ -330,14 +332,17 @@ class LeapfrogTangent:
             t, t1 = float(t_out[i - 1]), float(t_out[i])
             while True:  # the steps and times of the plain kernel's slices
                 n_left = max(1, math.ceil((t1 - t) / dt - 1e-12))
-                done = _var.advance_leapfrog(self.accel, self.jac, self.p, self.r, self.v,
-                                             self.gm, self.dr, self.dv, t, t1, dt,
-                                             self.tangent.ms, self.slice)
-                self.steps += done
-                if done >= n_left:
+                with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
+                    done = _var.advance_leapfrog(self.accel, self.jac, self.p, self.r, self.v,
+                                                 self.gm, self.dr, self.dv, t, t1, dt,
+                                                 self.tangent.ms, self.slice)
+                    self.steps += done
+                    finished = done >= n_left
+                    if not finished:
+                        t = t + done * ((t1 - t) / n_left)
+                    self.t = t1 if finished else t
+                if finished:
                     break
-                t = t + done * ((t1 - t) / n_left)
-                self.t = t
                 if stop is not None and stop():
                     raise StopIntegration
             self.t = t1
@@ -411,10 +416,11 @@ class WHTangent:
                     raise StopIntegration
                 n_call = min(n_steps - done, self.slice)  # stop() is asked between calls
                 h_last = last if done + n_call == n_steps else dt
-                steps, bad = self._steps(n_call, h_last, float(t_out[i - 1] + done * dt))
-                done += steps
-                self.steps += steps
-                self.t = float(t_out[i - 1] + done * dt)
+                with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
+                    steps, bad = self._steps(n_call, h_last, float(t_out[i - 1] + done * dt))
+                    done += steps
+                    self.steps += steps
+                    self.t = float(t_out[i - 1] + done * dt)
                 if bad >= 0:
                     raise ConvergenceError(
                         f"wh: the Kepler step of body {int(self.order[bad])} failed between "

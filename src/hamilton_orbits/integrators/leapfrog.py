@@ -17,6 +17,7 @@ from hamilton_orbits._kernels import leapfrog as _k
 from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
+from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators._setup import check_step_count, force_arg
 from hamilton_orbits.integrators.methods import Leapfrog
 from hamilton_orbits.rhs import run_parameters
@@ -76,7 +77,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
         dt = choose_dt(r0, v0, gm, tol)
     if variational is not None:
         return _tangent.LeapfrogTangent(rhs, r0, v0, gm, t0, variational, dt=float(dt),
-                                        max_steps=method.max_steps)
+                                        max_steps=method.max_steps, slice_steps=SLICE)
     return _State(rhs, r0, v0, gm, t0, float(dt), method.max_steps, events)
 
 
@@ -124,13 +125,14 @@ class _State:
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
             args = (self.accel, self.p, r, v, self.gm, t, float(t_out[i]), self.dt)
-            if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
-                done, status = _k.advance_watched(*args, log.watch, log.buffer, log.count, ws,
-                                                  SLICE)
-            else:
-                done, status = _k.advance(*args, None, None, None, ws, SLICE)
-            self.steps += int(done)
-            t = self.t = float(ws[0])
+            with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
+                if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
+                    done, status = _k.advance_watched(*args, log.watch, log.buffer, log.count,
+                                                      ws, SLICE)
+                else:
+                    done, status = _k.advance(*args, None, None, None, ws, SLICE)
+                self.steps += int(done)
+                t = self.t = float(ws[0])
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
             if status == _k.STATUS_SLICE:  # Ctrl-C and stop() are seen between slices

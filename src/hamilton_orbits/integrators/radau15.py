@@ -43,6 +43,7 @@ import numpy as np
 from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
+from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
 from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
@@ -254,11 +255,13 @@ class _DoubleDouble:
             while done < n_steps:
                 k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1
                 h = dt_f if done < n_steps - 1 else last
-                self._steps(h, k, t_out, i)
-                self.h_last = h
-                done += k
-            self.steps += n_steps
-            self.t = float(t_out[i])
+                with HELD:  # (the state's time and steps those of its arrays, a Ctrl-C
+                    self._steps(h, k, t_out, i)  # in the call raised after them)
+                    self.h_last = h
+                    done += k
+                    self.steps += k
+                    self.t = (float(t_out[i - 1]) + done * dt_f if done < n_steps
+                              else float(t_out[i]))
             r_out[i] = self.x[:, :, 0] + self.x[:, :, 1]
             v_out[i] = self.v[:, :, 0] + self.v[:, :, 1]
             if on_output is not None:
@@ -372,14 +375,15 @@ class _Run:
                     again = True
                 cut = pause.at - self.steps < budget
                 budget = min(budget, max(pause.at - self.steps, 1))
-            if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
-                steps, status = _k.advance_watched(
-                    *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
-                    log.count)
-            else:
-                steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget, None,
-                                            None, None)
-            self.steps += steps
+            with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
+                if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
+                    steps, status = _k.advance_watched(
+                        *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
+                        log.count)
+                else:
+                    steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget,
+                                                None, None, None)
+                self.steps += steps
             left -= steps
             if status == _k.STATUS_MAXSTEPS:
                 if not cut:  # (a slice's end or max_steps, where a run without pauses is)

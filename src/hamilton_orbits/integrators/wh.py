@@ -64,6 +64,7 @@ from hamilton_orbits._kernels import nbody as _nbody
 from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
+from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators.methods import WH
 from hamilton_orbits.integrators.methods import WH_COORDINATES as COORDINATES
 from hamilton_orbits.integrators.wh_correctors import (
@@ -235,7 +236,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, m
         dt = default_step(r0, v0, gm, tol)
     if variational is not None:
         return _tangent.WHTangent(rhs, r0, v0, gm, t0, variational, dt=dt, jacobi=method.jacobi,
-                                  max_steps=method.max_steps)
+                                  max_steps=method.max_steps, slice_steps=SLICE)
     return _State(rhs, r0, v0, gm, t0, method, dt, events)
 
 
@@ -308,12 +309,13 @@ class _State:
             if watched:  # (the events' part of the work space: see _drift)
                 ws[1], ws[2], ws[3] = np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
-            steps, bad, status = self.split.advance(
-                dt, n_call, last if done + n_call == n_steps else dt, self.watch, log.buffer,
-                log.count, ws)
-            done += steps
-            self.steps += steps
-            self.t = times[i - 1] + done * dt
+            with HELD:  # (a Ctrl-C in the calls: raised once their steps are counted)
+                steps, bad, status = self.split.advance(
+                    dt, n_call, last if done + n_call == n_steps else dt, self.watch,
+                    log.buffer, log.count, ws)
+                done += steps
+                self.steps += steps
+                self.t = times[i - 1] + done * dt
             if bad >= 0:
                 raise ConvergenceError(
                     f"wh: the Kepler step of body {int(self.split.order[bad])} failed between "

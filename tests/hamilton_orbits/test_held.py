@@ -1,0 +1,151 @@
+"""Ctrl-C in a compiled stepping call (``hamilton_orbits.integrators._held``).
+
+CPython runs a pending signal's Python handler at the end of the call instruction
+that was running when it came: after a compiled kernel has stepped the state's
+arrays in place, before the driver has counted the steps and the time it reached.
+The in-process tests wrap each driver's kernel so that, once it has returned,
+Python's SIGINT handler runs there, as CPython runs it: what the handler does (raise,
+or hold until the counts are taken) is the package's.  The subprocess test sends a
+real SIGINT to a real run.  In both, the simulation kept after the Ctrl-C
+continues with the bits and the step count of the run never interrupted: before,
+a ``wh`` run went on from a state a slice ahead of its clock (19 au off over 6000
+time units), ``radau15`` counted a slice of steps too few.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from hamilton_orbits import Body, Simulation, System
+from hamilton_orbits._kernels import leapfrog as leapfrog_kernels
+from hamilton_orbits._kernels import radau15 as radau15_kernels
+from hamilton_orbits._kernels import radau15_dd, variational, wh_tangent
+from hamilton_orbits._kernels import wh as wh_kernels
+from hamilton_orbits.integrators import leapfrog, radau15, wh
+from hamilton_orbits.integrators._held import HELD
+
+DT = 1 / 64  # (a power of two: the slices' times t0 + k dt are exact)
+
+
+def _planets(n: int = 4) -> System:
+    rng = np.random.default_rng(5)
+    bodies = [Body("star", 1.0, [0, 0, 0], [0, 0, 0])]
+    for k, a in enumerate(np.linspace(1.0, 3.0, n - 1)):
+        ph = rng.uniform(0, 2 * np.pi)
+        bodies.append(Body(f"p{k}", 1e-4, [a * np.cos(ph), a * np.sin(ph), 0.01 * k],
+                           [-np.sin(ph) / np.sqrt(a), np.cos(ph) / np.sqrt(a), 0.0]))
+    return System(bodies)
+
+
+#: (Simulation options, the kernels' module and names to wrap, the driver's module
+#: whose SLICE is made small: several calls to the first end time)
+CASES = {
+    "radau15": (dict(method="radau15"), radau15_kernels, ["advance"], radau15, 8),
+    "radau15-dd": (dict(method="radau15", dt=1 / 8, precision="double-double"), radau15_dd,
+                   ["advance"], radau15, 300),
+    "wh": (dict(method="wh", dt=DT), wh_kernels, ["advance_dh", "advance_dh_few"], wh, 50),
+    "wh-jacobi-corrected": (dict(method="wh", dt=DT, coordinates="jacobi", corrector=11),
+                            wh_kernels, ["advance_jacobi", "advance_jacobi_few"], wh, 50),
+    "leapfrog": (dict(method="leapfrog", dt=DT), leapfrog_kernels, ["advance"], leapfrog, 50),
+    "radau15-variational": (dict(method="radau15", variational=True), radau15_kernels,
+                            ["advance_variational"], radau15, 8),
+    "wh-variational": (dict(method="wh", dt=DT, variational=True), wh_tangent,
+                       ["advance_dh", "advance_jacobi"], wh, 50),
+    "leapfrog-variational": (dict(method="leapfrog", dt=DT, variational=True), variational,
+                             ["advance_leapfrog"], leapfrog, 50),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_a_ctrl_c_in_a_compiled_call_keeps_a_state_that_continues_bit_for_bit(case,
+                                                                            monkeypatch):
+    options, kernels, names, driver, slice_steps = CASES[case]
+    monkeypatch.setattr(driver, "SLICE", slice_steps)  # (wh's bits depend on the slices:
+    once = Simulation(_planets(), **options)  # the same in both runs)
+    once.integrate(12.0)
+    calls = []
+
+    def wrapped(real):
+        def kernel(*args):
+            out = real(*args)
+            calls.append(1)
+            if len(calls) == 3:  # (mid-leg: the Python handler, as CPython runs it here)
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+            return out
+        return kernel
+
+    sim = Simulation(_planets(), **options)
+    with monkeypatch.context() as patched:
+        for name in names:
+            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+        cut = sim.integrate(8.0, on_interrupt="keep")
+    assert len(calls) == 3 and not cut.complete
+    assert 0.0 < sim.t < 8.0  # (the state reached between outputs is the one kept)
+    sim.integrate(12.0)
+    assert sim.steps == once.steps
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)
+    np.testing.assert_array_equal(sim.system.as_arrays().v, once.system.as_arrays().v)
+
+
+def test_held_raises_as_it_is_left_and_a_second_ctrl_c_at_once():
+    with pytest.raises(KeyboardInterrupt), HELD:
+        HELD.interrupt()
+        reached = True  # (held: the block goes on to its end)
+    assert reached and HELD.depth == 0 and not HELD.pending
+    with pytest.raises(KeyboardInterrupt), HELD:
+        HELD.interrupt()
+        HELD.interrupt()  # (a second: raised here, not held)
+        pytest.fail("the second Ctrl-C was held")  # pragma: no cover
+    assert HELD.depth == 0 and not HELD.pending
+
+
+def test_an_error_within_is_not_replaced_by_the_ctrl_c_held():
+    with pytest.raises(ZeroDivisionError), HELD:
+        HELD.interrupt()
+        1 / 0  # noqa: B018
+    assert HELD.depth == 0 and not HELD.pending
+    with pytest.raises(KeyboardInterrupt):  # (outside: at once)
+        HELD.interrupt()
+
+
+_REAL = textwrap.dedent("""
+    import json, os, signal, sys, threading
+    import numpy as np
+    from hamilton_orbits import Body, Simulation, System
+
+    bodies = [Body("star", 1.0, [0, 0, 0], [0, 0, 0])]
+    for k, a in enumerate(np.linspace(1.0, 6.0, 9)):
+        bodies.append(Body(f"p{k}", 1e-5, [a, 0.0, 0.01 * k], [0.0, a ** -0.5, 0.0]))
+    system = System(bodies)
+    Simulation(system, method="wh", dt=2.0 ** -10).integrate(1.0)  # (kernels loaded)
+    sim = Simulation(system, method="wh", dt=2.0 ** -10)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    cut = sim.integrate(4000.0, on_interrupt="keep")  # (some 4 s: interrupted at 0.3)
+    timer.join()
+    t_cut = float(sim.t)
+    sim.integrate(4000.0)
+    once = Simulation(system, method="wh", dt=2.0 ** -10)
+    once.integrate(4000.0)
+    print(json.dumps(dict(complete=cut.complete, t_cut=t_cut, steps=[sim.steps, once.steps],
+                          dr=float(np.abs(sim.system.as_arrays().r
+                                          - once.system.as_arrays().r).max()))))
+""")
+
+
+def test_a_real_ctrl_c_in_a_wh_run_keeps_a_state_that_continues_bit_for_bit():
+    """SIGINT from a timer 0.3 s into a run of some 4 s (its steps in slices of
+    100 000, each about a second): the Ctrl-C comes in a compiled call."""
+    proc = subprocess.run([sys.executable, "-c", _REAL], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout.splitlines()[-1])
+    assert not out["complete"] and 0.0 < out["t_cut"] < 4000.0, out
+    assert out["steps"][0] == out["steps"][1] and out["dr"] == 0.0, out
