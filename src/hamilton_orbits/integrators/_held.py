@@ -23,11 +23,14 @@ is then not waited on).  A handler of one's own is left alone (it may call
 Examples
 --------
 >>> from hamilton_orbits.integrators._held import HELD
->>> with HELD:
-...     HELD.interrupt()  # (as a Ctrl-C within: held until HELD is left)
-...     print("counted")
-Traceback (most recent call last):
-KeyboardInterrupt
+>>> try:
+...     with HELD:
+...         HELD.interrupt()  # (as a Ctrl-C within: held until HELD is left)
+...         print("counted")
+... except KeyboardInterrupt:
+...     print("then raised")
+counted
+then raised
 >>> HELD.depth, HELD.pending
 (0, False)
 """
