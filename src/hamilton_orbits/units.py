@@ -198,10 +198,7 @@ class Kind:
                     f"Expected `{name}` to be dimensionless, got {_short(value)} (an angle)"
                 )
             if self.no_hertz and _hertz(value.unit):
-                raise u.UnitConversionError(
-                    f"Expected `{name}` to be {self.name}, got {value.unit}: the hertz counts "
-                    f"cycles, 2 pi rad each (ISO 80000-3 gives angular speeds no hertz); give "
-                    f"{self.unit:generic} counting radians (cycle / s for turns per second)")
+                raise u.UnitConversionError(self._no_hertz(name, value.unit))
             try:
                 value = value.to_value(target, equivalencies=self.equivalencies)
             except u.UnitConversionError as exc:
@@ -213,6 +210,16 @@ class Kind:
                     f"Expected `{name}` to be {what}, got "
                     f"{str(value.unit) or 'a number without a unit'}") from exc
         return as_float_array(name, value, finite=finite)
+
+    def _no_hertz(self, name: str, unit: Any) -> str:
+        """Why ``unit``, holding the hertz (or a count of decays), is refused."""
+        head = f"Expected `{name}` to be {self.name}, got {unit}: "
+        if not _holds(unit, (u.Hz,)):
+            return (head + "a count of decays per second, not of radians; give "
+                    f"{self.unit:generic}")
+        turns = " (cycle / s for turns per second)" if self._equivalencies else ""
+        return (head + "the hertz counts cycles, 2 pi rad each (ISO 80000-3 gives angular "
+                f"speeds no hertz); give {self.unit:generic} counting radians{turns}")
 
     def scalar(self, name: str, value: Any, unit: UnitLike | None = None) -> float:
         """One number of this kind, as a float (a Quantity converted to ``unit``).
@@ -245,11 +252,26 @@ def _short(q: u.Quantity) -> str:
     return f"{q.unit} values"
 
 
+#: units of counts per second, equal to 1/s for astropy: the hertz (cycles), the
+#: becquerel and the curie (decays)
+_COUNTS_PER_SECOND = (u.Hz, u.Bq, u.Ci)
+
+
 def _hertz(unit: Any) -> bool:
-    """Whether ``unit`` holds the hertz, prefixed or not (kHz, daHz, rad Hz), by
-    identity: astropy finds the hertz equal to 1/s, which is not refused."""
-    return any(base is u.Hz or (isinstance(base, u.PrefixUnit)
-                                and any(x is u.Hz for x in base.represents.bases))
+    """Whether ``unit`` holds the hertz (or the becquerel, or the curie), prefixed or
+    not (kHz, daHz, rad Hz, MBq): astropy finds them equal to 1/s (the curie to
+    3.7e10/s), which is not refused."""
+    return _holds(unit, _COUNTS_PER_SECOND)
+
+
+def _holds(unit: Any, units: tuple[Any, ...]) -> bool:
+    """Whether ``unit`` holds one of ``units``, prefixed or not, by identity (astropy's
+    ``==`` finds the hertz and the becquerel equal)."""
+    def one(x: Any) -> bool:
+        return any(x is c for c in units)
+
+    return any(one(base) or (isinstance(base, u.PrefixUnit)
+                             and any(one(x) for x in base.represents.bases))
                for base in getattr(unit, "bases", [unit]))
 
 
@@ -267,7 +289,8 @@ MASS = Kind("a mass", "kg")
 DIMENSIONLESS = Kind("dimensionless", "")
 INERTIA = Kind("a moment of inertia", "kg m2")
 ANGULAR_SPEED = Kind("an angular speed", "rad / s", _dimensionless_angles, no_hertz=True)
-ANGULAR_MOMENTUM = Kind("an angular momentum", "kg m2 / s", _dimensionless_angles)
+ANGULAR_MOMENTUM = Kind("an angular momentum", "kg m2 / s", _dimensionless_angles,
+                        no_hertz=True)
 ENERGY = Kind("an energy", "J", _dimensionless_angles)
 TORQUE = Kind("a torque", "N m", _dimensionless_angles)
 

@@ -499,6 +499,13 @@ def test_moon_figure_takes_its_radius_and_inclination_in_any_unit():
                                           "finite, got inf"),
     ("lense_thirring", {"spin": [0, 0, 1e-7]},
      "Effect 'lense_thirring': expected `spin` as a Quantity (an angular momentum per unit mass"),
+    # (R^2 omega with omega in cycles per second: read as radians, 2 pi off; a count of
+    # decays per second is no rotation rate at all: both were taken as 1/s)
+    ("lense_thirring", {"spin": [0, 0, 1e-7] * u.au**2 * u.Hz},
+     "Effect 'lense_thirring': Expected `spin` to be an angular momentum per unit mass, got "
+     "AU2 Hz: the hertz counts cycles"),
+    ("earth_tides", {"omega": 7.292115e-5 * u.Bq},
+     "Effect 'earth_tides': Expected `omega` to be an angular speed, got Bq: a count of decays"),
     ("kuiper_ring", {"gm": 1e-11}, "Effect 'kuiper_ring': expected `gm` as a Quantity"),
     ("kuiper_ring", {"gm": -1e-11 * u.au**3 / u.d**2},
      "Effect 'kuiper_ring': expected `gm` >= 0, got -1e-11 AU3 / d2"),

@@ -97,6 +97,26 @@ def test_an_angular_speed_in_hertz_is_refused_by_name(unit):
     assert float(ANGULAR_SPEED("spin", 360.0 * u.deg / u.s)) == 2 * np.pi
 
 
+@pytest.mark.parametrize("unit", [u.Bq, u.MBq, u.Ci])
+def test_an_angular_speed_in_decays_per_second_is_refused_by_name(unit):
+    """The becquerel and the curie are equal to 1/s for astropy (as the hertz is),
+    and were read as radians per second."""
+    from hamilton_orbits.units import ANGULAR_SPEED
+
+    with pytest.raises(u.UnitConversionError, match=r"Expected `spin` to be an angular speed, "
+                                                    r"got .*: a count of decays per second"):
+        ANGULAR_SPEED("spin", 2.0 * unit)
+
+
+def test_an_angular_momentum_in_hertz_is_refused_by_name():
+    """I omega with omega in cycles per second, 2 pi off as a rate in hertz is."""
+    from hamilton_orbits.units import ANGULAR_MOMENTUM
+
+    with pytest.raises(u.UnitConversionError, match=r"`L` to be an angular momentum, got .*Hz"):
+        ANGULAR_MOMENTUM("L", 2.0 * u.kg * u.m**2 * u.Hz)
+    assert float(ANGULAR_MOMENTUM("L", 2.0 * u.kg * u.m**2 * u.cycle / u.s)) == 4 * np.pi
+
+
 def test_a_number_without_a_unit_where_a_unit_is_asked_is_named_so():
     """A dimensionless Quantity (an effect's string '1.5424', read without a unit)
     where an angle is asked was refused as "got " (the empty unit)."""

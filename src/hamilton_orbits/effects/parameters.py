@@ -111,7 +111,7 @@ def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) 
 
 
 #: A spin: an angular momentum per unit mass (``lense_thirring``'s ``spin``).
-SPECIFIC_ANGULAR_MOMENTUM = Kind("an angular momentum per unit mass", "m2 / s")
+SPECIFIC_ANGULAR_MOMENTUM = Kind("an angular momentum per unit mass", "m2 / s", no_hertz=True)
 
 #: The internal unit of each dimension for a system of Quantities
 #: (:mod:`hamilton_orbits.nbody`: au and days), to which a Quantity parameter is
