@@ -61,8 +61,12 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
         _check_listed(name, value, ())
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
-    if value is None:  # np.asarray(None, float) is a silent NaN
-        raise ValueError(f"Expected `{name}` to be numeric, got None")
+    if isinstance(value, np.ma.MaskedArray):  # (numpy.asarray takes the values under
+        masked = np.ma.getmaskarray(value)  # the mask, silently)
+        if masked.any():
+            index = first_index(masked) if masked.ndim else ()
+            raise ValueError(f"Expected `{name}` to be numbers, got a masked value"
+                             f"{fmt_index(index)}")
     try:
         arr = np.asarray(value, dtype=np.float64)
     except OverflowError as exc:  # a Python int beyond the float64 range

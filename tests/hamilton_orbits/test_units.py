@@ -76,6 +76,19 @@ def test_mixing_quantities_and_plain_numbers_is_refused():
         require_consistent(("t", "dt"), (1.0 * u.s, 0.1))
 
 
+def test_a_masked_value_is_refused_not_read_from_under_its_mask():
+    """numpy.asarray reads a masked array's values under the mask: an orbit built
+    from a catalogue column with a missing ``a`` took whatever number lay there."""
+    from hamilton_orbits.orbit import KeplerOrbit
+
+    with pytest.raises(ValueError, match=r"`x` to be numbers, got a masked value at index 1"):
+        as_float_array("x", np.ma.array([1.0, 2.0, 3.0], mask=[0, 1, 0]))
+    with pytest.raises(ValueError, match=r"`a` to be numbers, got a masked value at index 1"):
+        KeplerOrbit.from_elements(a=np.ma.array([1.0, 2.0], mask=[0, 1]), e=[0.1, 0.2],
+                                  inc=[0, 0], lan=[0, 0], argp=[0, 0], nu=[0, 0], mu=1.0)
+    np.testing.assert_array_equal(as_float_array("x", np.ma.array([1.0, 2.0])), [1.0, 2.0])
+
+
 def test_complex_input_is_refused_not_truncated():
     with pytest.raises(ValueError, match="`x` to be real, got complex"):
         as_float_array("x", [1.0 + 2.0j])
