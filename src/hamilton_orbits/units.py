@@ -252,16 +252,11 @@ def _short(q: u.Quantity) -> str:
     return f"{q.unit} values"
 
 
-#: units of counts per second, equal to 1/s for astropy: the hertz (cycles), the
-#: becquerel and the curie (decays)
-_COUNTS_PER_SECOND = (u.Hz, u.Bq, u.Ci)
-
-
 def _hertz(unit: Any) -> bool:
     """Whether ``unit`` holds the hertz (or the becquerel, or the curie), prefixed or
     not (kHz, daHz, rad Hz, MBq): astropy finds them equal to 1/s (the curie to
     3.7e10/s), which is not refused."""
-    return _holds(unit, _COUNTS_PER_SECOND)
+    return _holds(unit, (u.Hz, u.Bq, u.Ci))  # (counts of cycles, of decays, per second)
 
 
 def _holds(unit: Any, units: tuple[Any, ...]) -> bool:
