@@ -22,6 +22,7 @@ import numpy as np
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import _setup, _tangent
+from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators.methods import DOP853
 from hamilton_orbits.rhs import run_parameters
 
@@ -154,9 +155,11 @@ class _State:
                              atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
                 t_prev, y_prev = solver.t, solver.y.copy()
-                if solver.step() is not None:
-                    raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
-                self.steps += 1
+                with HELD:  # (a Ctrl-C in the step: raised once it is the state kept,
+                    if solver.step() is not None:  # its steps counted)
+                        raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
+                    self.steps += 1
+                    self.t, self.y = float(solver.t), solver.y  # (scipy makes a new y a step)
                 if (self.steps - first) % 100 == 0:
                     _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
                 if log.count[0] + len(log.watch) > log.buffer.shape[0]:
