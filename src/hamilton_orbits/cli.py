@@ -325,7 +325,7 @@ def _finish(scene, result, folder, archive) -> int:
 def _ctrl_c(saying: str) -> Iterator[list[int]]:
     """Within it, the first Ctrl-C noted in the list it gives (and ``saying`` said on
     stderr), the work going on; a second aborts (KeyboardInterrupt, held as the
-    drivers hold Ctrl-C: :mod:`hamilton_orbits.integrators._held`)."""
+    drivers hold Ctrl-C: ``hamilton_orbits.integrators._held``)."""
     import signal
 
     from hamilton_orbits.integrators._held import HELD

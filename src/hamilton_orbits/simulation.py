@@ -304,7 +304,7 @@ class Simulation(Saving):
             the state reached, its time and step count with it: continued, it gives
             the bits of the run never interrupted), unless ``on_interrupt="keep"``.
             A Ctrl-C during a compiled call is held until its steps are counted
-            (:mod:`hamilton_orbits.integrators._held`); a second is raised at once.
+            (``hamilton_orbits.integrators._held``); a second is raised at once.
         """
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
