@@ -63,23 +63,44 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
     if arr.ndim != 1:
         raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
                          f"{arr.shape}")
+    if quantity and abs(arr[0] - t_now) <= _ROUND_TRIP * abs(t_now):
+        arr[0] = t_now  # (the simulation's time given back in the caller's unit: its
+        # round trip through that unit may move it by an ulp or two, not a time of its own)
     if arr.size == 1:
         if arr[0] == t_now:
             raise ValueError("Expected `t` to be a nonzero end time, got 0" if t_now == 0.0
                              else f"Expected `t` to differ from the simulation's time "
                                   f"{t_now!r}, got {float(arr[0])!r}")
-        arr = np.array([t_now, arr[0]])
-    elif arr[0] != t_now:
+        return np.array([t_now, arr[0]]), unit
+    added = int(arr[0] != t_now)
+    if added:
         arr = np.concatenate(([t_now], arr))
-    d = np.diff(arr)
-    if not (np.all(d > 0) or np.all(d < 0)):
-        k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
-        start = "0" if t_now == 0.0 else repr(t_now)
-        raise ValueError(
-            f"Expected `t` to be strictly monotonic (times after the start {start}), got "
-            f"{arr[k + 1]!r} after {arr[k]!r} at index {k + 1}"
-        )
+    _check_monotonic(arr, t_now, added)
     return arr, unit
+
+
+#: how far (relative) a time given back through another unit may be from the one it
+#: was (two roundings each way, with a margin)
+_ROUND_TRIP = 8 * np.finfo(np.float64).eps
+
+
+def _check_monotonic(arr: np.ndarray, t_now: float, added: int) -> None:
+    """Refuse output times ``arr`` (the simulation's time first, ``added`` to the
+    caller's times when 1) that are not strictly monotonic, naming the caller's
+    index and value."""
+    d = np.diff(arr)
+    if np.all(d > 0) or np.all(d < 0):
+        return
+    start = "0" if t_now == 0.0 else repr(t_now)
+    if added and d[0] < 0 < d[1:].max(initial=-1.0):
+        raise ValueError(f"Expected `t` to be strictly monotonic from the simulation's time "
+                         f"{start}, got {float(arr[1])!r} at index 0 and {float(arr[2])!r} at "
+                         f"index 1")
+    k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
+    raise ValueError(
+        f"Expected `t` to be strictly monotonic (times after the start {start}), got "
+        f"{float(arr[k + 1])!r} after {float(arr[k])!r} at index {k + 1 - added}"
+    )
 
 
 

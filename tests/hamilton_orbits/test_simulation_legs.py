@@ -271,6 +271,33 @@ def test_ctrl_c_still_raises_keyboard_interrupt():
         integrate(_disc(), [1.0, 2.0], on_output=on_output)
 
 
+@pytest.mark.parametrize("days", [99.0, 102.0])
+def test_the_simulations_time_given_back_in_another_unit_is_its_time(days):
+    """``sim.t`` in years, given back as the first output time (as documented: the
+    simulation's time, added if missing), comes back through the unit an ulp off:
+    99 d made a leg of 1e-14 d and one step more, 102 d a refusal naming the wrong
+    index and value."""
+    s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
+    plain, given = (Simulation(s, method="wh", dt=3 * u.day) for _ in range(2))
+    for sim in (plain, given):
+        sim.integrate(days * u.day)
+    assert given.t.to(u.yr).to_value(u.day) != days  # (the round trip moves it)
+    rest = plain.integrate([0.9, 1.0] * u.yr)
+    back = given.integrate(u.Quantity([given.t.to(u.yr), 0.9 * u.yr, 1.0 * u.yr]))
+    assert given.steps == plain.steps and len(back.t) == len(rest.t)
+    np.testing.assert_array_equal(back.r[-1].value, rest.r[-1].value)
+
+
+def test_output_times_that_turn_back_from_the_start_are_named_by_the_callers_index():
+    sim = Simulation(_disc(), method="wh", dt=0.02)
+    sim.integrate(1.0)
+    with pytest.raises(ValueError, match=r"monotonic from the simulation's time 1.0, got 0.5 at "
+                                         r"index 0 and 2.0 at index 1"):
+        sim.integrate([0.5, 2.0])
+    with pytest.raises(ValueError, match=r"got 1.5 after 2.0 at index 1"):
+        sim.integrate([2.0, 1.5])
+
+
 def test_time_steps_and_state_of_a_quantity_system():
     s = System.solar_system("J2000", bodies=["sun", "jupiter", "saturn"])
     sim = Simulation(s, method="wh", dt=5 * u.day)
