@@ -84,7 +84,8 @@ class Archive:
     """
 
     def __init__(self, path: str | Path) -> None:
-        self.path = path_of(path, "path", "an archive folder's path")
+        # (absolute: its snapshots are read later, from whatever directory)
+        self.path = path_of(path, "path", "an archive folder's path").absolute()
         if not self.path.is_dir():
             raise SnapshotError(f"no archive folder {self.path}")
         found = contents(self.path, keep=("t", "r", "v", "gm", "active"))

@@ -341,7 +341,9 @@ class ArchiveWriter:
             raise ValueError(f"Expected `every_steps` to be a whole number >= 1, got "
                              f"{every_steps!r}")
         every_steps = None if every_steps is None else int(every_steps)  # (kept as JSON)
-        self.path = None if path is None else path_of(path, "archive", "a folder's path")
+        self.path = None if path is None else path_of(path, "archive", "a folder's path").absolute()
+        # (made absolute once: a relative folder is the one of the directory it was
+        # given in, whatever directory a later call is made from)
         self.every, self.every_steps, self.every_wall = every, every_steps, every_wall
         if not isinstance(exact, bool):
             raise ValueError(f"Expected `exact_times` to be True or False, got {exact!r}")

@@ -1503,3 +1503,20 @@ def test_bad_paths_of_save_and_archive_are_refused_naming_them(tmp_path):
         with pytest.raises(ValueError, match=r"Expected `path` to be an archive folder's "
                                              r"path, got"):
             Archive(path)
+
+
+def test_a_relative_archive_folder_stays_the_one_it_was_given_in(tmp_path, monkeypatch):
+    """A relative ``archive=`` was looked up again at each call: after a change of
+    directory (a notebook's ``%cd``) the run went on in another folder, into
+    another run's archive there, with no refusal."""
+    for name in ("one", "two"):
+        (tmp_path / name).mkdir()
+    monkeypatch.chdir(tmp_path / "one")
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive="run.archive", every=1.0)
+    sim.integrate(2.0)
+    archive = Archive("run.archive")
+    monkeypatch.chdir(tmp_path / "two")
+    sim.integrate(4.0)
+    assert not (tmp_path / "two" / "run.archive").exists()
+    assert Archive(tmp_path / "one" / "run.archive").times[-1] == 4.0
+    assert archive.path == tmp_path / "one" / "run.archive" and archive[-1].t == 2.0
