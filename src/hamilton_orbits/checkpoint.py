@@ -358,6 +358,9 @@ class ArchiveWriter:
         #: that segment, when its records hold their leg: the next leg goes on in it
         #: if it is there as it was left
         self.parked: SegmentWriter | None = None
+        #: the number of the snapshot a simulation loaded from the folder stands at,
+        #: until this writer has written (:meth:`_gone_on`)
+        self.loaded: int | None = None
         #: the leg of the snapshots being appended (a record's ``leg``)
         self.leg: tuple[float, ...] = NO_LEG
         #: the wall clock of ``every_wall`` (seconds)
@@ -397,6 +400,14 @@ class ArchiveWriter:
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
+        if known is None and self._gone_on():
+            self.close()
+            raise SnapshotError(
+                f"the archive {self.path} has gone on without this simulation: another "
+                f"simulation (loaded from it, or writing it as well) wrote its snapshots from "
+                f"number {self.left[2] if self.left else self.loaded + 1} on; continue from "
+                f"the archive's last snapshot with Simulation.load({str(self.path)!r}), or "
+                f"give this simulation another folder")
         if self.count and not self.continues:
             self.close()
             raise SnapshotError(
@@ -427,6 +438,20 @@ class ArchiveWriter:
             return None
         return count
 
+    def _gone_on(self) -> bool:
+        """Whether another writer has written in the folder after this one's last
+        snapshot (a snapshot file begun at the number after it), or after the
+        snapshot this writer's simulation was loaded from (a whole snapshot after it:
+        a damaged or torn one after it is the run's own, passed over by the load):
+        its snapshots would interleave with that writer's."""
+        if self.left is not None:
+            count = self.left[2]
+            return any((self.path / name.format(count)).exists()
+                       for name in (SEGMENT_NAME, SNAPSHOT_NAME))
+        if self.loaded is not None and self.count > self.loaded + 1:
+            return snapshot_at(self.path, self.count - 1) is not None
+        return False
+
     def close(self) -> None:
         """Close the segment being written and release the folder's lock (again after
         a Ctrl-C amid them: the segment let go before its files are closed, the lock
@@ -434,7 +459,7 @@ class ArchiveWriter:
         seg, self.segment = self.segment, None
         try:
             if seg is not None:
-                self.left = (seg.path, seg.size, self.count)
+                self.left, self.loaded = (seg.path, seg.size, self.count), None
                 self.parked = seg if seg.legs else None
                 seg.close()
         finally:

@@ -747,8 +747,9 @@ def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp
     closed the last segment knows that number: the folder (whose listing grows with
     the archive: 1.6 -> 5 ms a call over 1200 calls when each call began a segment)
     is listed on its first call only, and again after another writer came (its
-    segment holds the number) or the last segment changed (here: removed).  The
-    snapshots are numbered without a gap either way."""
+    segment holds the number: the first is then refused, the archive being the
+    other's run) or the last segment changed (here: removed).  The snapshots are
+    numbered without a gap either way."""
     from hamilton_orbits import checkpoint
 
     listed = []
@@ -762,17 +763,19 @@ def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp
     other = Simulation.load(tmp_path)  # (another writer: it lists, and begins segment 5)
     other.integrate(3.0)
     assert len(listed) == 2
-    sim.integrate(3.5)  # (its number is taken: listed again, continued after the other's)
-    assert len(listed) == 3
-    sim.integrate(4.0)  # (in the segment its last call began: 6 and 7)
+    with pytest.raises(SnapshotError, match=r"has gone on without this simulation: another "
+                                            r"simulation .* from number 5 on"):
+        sim.integrate(3.5)  # (its number is taken: listed again, and refused)
+    assert len(listed) == 3 and sim.t == 2.5 and not _lock(tmp_path)
+    other.integrate(3.5)  # (in the segment its last call began: 5 and 6)
     assert len(listed) == 3
     files = snapshot_files(tmp_path)
-    assert [first for first, _ in files] == [0, 5, 6]
+    assert [first for first, _ in files] == [0, 5]
     files[-1][1].unlink()  # (its last segment gone: the folder is read again)
-    sim.integrate(4.5)
+    other.integrate(4.0)
     assert len(listed) == 4
     numbers = [s.number for s in Archive(tmp_path).snapshots]
-    assert numbers == list(range(7)), numbers  # (6 again, after the two removed)
+    assert numbers == list(range(6)), numbers  # (5 again, after the two removed)
 
 
 def test_a_full_disk_during_a_run_stops_it_naming_the_segment_and_keeps_what_was_written(
@@ -1206,9 +1209,13 @@ def test_ctrl_c_as_the_lock_is_taken_or_before_the_steps_leaves_the_folder_free(
         sim.integrate(1.0)
     monkeypatch.undo()
     assert not _lock(folder)
-    assert _same(Simulation.load(folder).integrate(1.0).r[-1], whole[1])
-    assert _same(sim.integrate(1.0).r[-1], whole[1])
-    assert _same(sim.integrate(1.5).r[-1], whole[2])
+    assert _same(sim.copy().integrate(1.0).r[-1], whole[1])  # (a copy writes nothing)
+    loaded = Simulation.load(folder)
+    assert _same(loaded.integrate(1.0).r[-1], whole[1])
+    with pytest.raises(SnapshotError, match=r"has gone on without this simulation"):
+        sim.integrate(1.0)  # (the loaded one's run now: one archive, one run)
+    assert not _lock(folder) and sim.t == 0.5
+    assert _same(loaded.integrate(1.5).r[-1], whole[2])
     numbers = [s.number for s in Archive(folder).snapshots]
     assert numbers == list(range(len(numbers))) and not _lock(folder)
 
@@ -1347,14 +1354,17 @@ def test_a_fixed_step_run_goes_on_with_its_bits_from_a_snapshot_between_outputs(
     archive = Archive(tmp_path / "whole")
     for k in (1, 2, 3):
         assert _same(archive[k].integrate(10.0).r[-1], whole.r[-1])
-    looks = iter(range(10**6))
-    cut = Simulation(_disc(), archive=tmp_path / "cut", **kw)
-    cut.integrate(10.0, stop=lambda: next(looks) >= 2, on_interrupt="keep")
-    assert 1.0 < cut.t < 10.0  # (a snapshot, not an output asked for)
+    cuts = []
+    for name in ("cut", "cut-continued"):  # (two folders: one archive holds one run)
+        looks = iter(range(10**6))
+        cuts.append(Simulation(_disc(), archive=tmp_path / name, **kw))
+        cuts[-1].integrate(10.0, stop=lambda looks=looks: next(looks) >= 2, on_interrupt="keep")
+    cut, stopped = cuts
+    assert 1.0 < cut.t < 10.0 and stopped.t == cut.t  # (a snapshot, not an output asked for)
     loaded = Simulation.load(tmp_path / "cut")
     assert loaded.t == cut.t
     assert _same(loaded.integrate(10.0).r[-1], whole.r[-1])
-    assert _same(cut.integrate(10.0).r[-1], whole.r[-1])  # (the run stopped, continued)
+    assert _same(stopped.integrate(10.0).r[-1], whole.r[-1])  # (the run stopped, continued)
 
 
 def test_ctrl_c_as_a_segment_is_closed_closes_nothing_twice(tmp_path, monkeypatch):
@@ -1520,3 +1530,23 @@ def test_a_relative_archive_folder_stays_the_one_it_was_given_in(tmp_path, monke
     assert not (tmp_path / "two" / "run.archive").exists()
     assert Archive(tmp_path / "one" / "run.archive").times[-1] == 4.0
     assert archive.path == tmp_path / "one" / "run.archive" and archive[-1].t == 2.0
+
+
+def test_two_simulations_cannot_write_two_timelines_into_one_archive(tmp_path):
+    """A simulation loaded from an archive that goes on in it makes the archive its
+    run's: the simulation that wrote it before, or another loaded at the same
+    snapshot, is refused by name rather than appending its own continuation after
+    the first's (the archive's times went back, ``to_xarray`` repeated them, and
+    ``Simulation.load`` took whichever wrote last)."""
+    kw = dict(method="wh", dt=0.05, every=1.0)
+    sim = Simulation(_disc(), archive=tmp_path / "a", **kw)
+    sim.integrate(5.0)
+    first, second = Simulation.load(tmp_path / "a"), Simulation.load(tmp_path / "a")
+    first.integrate(8.0)
+    for late in (sim, second):
+        with pytest.raises(SnapshotError, match=r"has gone on without this simulation"):
+            late.integrate(10.0)
+        assert late.t == 5.0 and not _lock(tmp_path / "a")
+    first.integrate(10.0)
+    times = Archive(tmp_path / "a").times
+    assert np.all(np.diff(times) >= 0) and times[-1] == 10.0
