@@ -151,13 +151,17 @@ def test_a_real_ctrl_c_in_a_wh_run_keeps_a_state_that_continues_bit_for_bit():
     assert out["steps"][0] == out["steps"][1] and out["dr"] == 0.0, out
 
 
-def test_a_ctrl_c_in_a_dop853_step_with_events_keeps_the_state_of_its_steps(monkeypatch):
-    """dop853 with events steps through scipy's stepper in Python: a Ctrl-C in a step
-    kept the state of the last output (t = 0 here) with the steps taken since counted;
-    the state kept is now the last step's, with its count."""
+@pytest.mark.parametrize("options", [
+    dict(), dict(events=[{"name": "close_encounter", "distance": 0.01}]),
+    dict(variational=True)], ids=["plain", "events", "variational"])
+def test_a_ctrl_c_in_a_dop853_step_keeps_the_state_of_its_steps(options, monkeypatch):
+    """dop853 steps through scipy's stepper in Python: a Ctrl-C in a step kept the
+    state of the last output (t = 0 here: a one-end-time run lost all its work),
+    with events the steps taken since counted; the state kept is now the last
+    step's, with its count."""
     from scipy.integrate import DOP853
 
-    options = dict(method="dop853", events=[{"name": "close_encounter", "distance": 0.01}])
+    options = dict(method="dop853", **options)
     once = Simulation(_planets(), **options)
     once.integrate(12.0)
     real, reached = DOP853.step, []

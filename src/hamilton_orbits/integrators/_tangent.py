@@ -503,13 +503,15 @@ class DOP853Tangent:
                             atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
                 t_prev, ys_prev = solver.t, solver.y[-1]
-                if solver.step() is not None:
-                    raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
-                self.steps += 1
+                with HELD:  # (a Ctrl-C in the step: raised once it is the state kept)
+                    if solver.step() is not None:
+                        raise ConvergenceError(f"dop853 (variational) failed at t = {t_prev}")
+                    self.steps += 1
+                    _var.megno_update(self.tangent.ms, float(solver.y[-1] - ys_prev),
+                                      float(solver.t), float(solver.t - t_prev))
+                    self.y, self.t = solver.y, float(solver.t)  # (scipy makes a new y a step)
                 if (self.steps - first) % 100 == 0:
                     check_pace(self.steps - first, self.max_steps, solver.t, t_out, "dop853")
-                _var.megno_update(self.tangent.ms, float(solver.y[-1] - ys_prev),
-                                  float(solver.t), float(solver.t - t_prev))
             self.y = solver.y.copy()
             self.t = float(t_out[i])
             x = self.y[: 3 * rows].reshape(rows, 3)

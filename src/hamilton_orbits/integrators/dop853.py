@@ -133,13 +133,27 @@ class _State:
         if self.log is not None and len(self.log.watch):
             self._with_events(t_out, store, first)
             return
+        from scipy.integrate import DOP853 as Stepper
 
-        def keep(i: int, steps: int, y: np.ndarray) -> None:
-            self.y, self.t, self.steps = y, float(t_out[i]), first + steps
-            store(i, first + steps, y)
+        for i in range(1, len(t_out)):  # (the steps of solve(): the same bits, each step's
+            solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,  # state
+                             atol=self.atol, max_step=self.max_step)  # kept as it is taken)
+            while solver.status == "running":
+                self._step(solver, t_out, first)
+            self.t, self.y = float(t_out[i]), solver.y.copy()
+            store(i, self.steps, self.y)
 
-        solve(self.f, self.y, t_out, rtol=self.tol, atol=self.atol, max_step=self.max_step,
-              on_state=keep, max_steps=self.max_steps)
+    def _step(self, solver: Any, t_out: np.ndarray, first: int) -> None:
+        """One step of scipy's stepper ``solver``, its state kept as the run's (a Ctrl-C
+        in it held until then), the pace judged every 100 steps."""
+        t_prev = solver.t
+        with HELD:
+            if solver.step() is not None:
+                raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
+            self.steps += 1
+            self.t, self.y = float(solver.t), solver.y  # (scipy makes a new y a step)
+        if (self.steps - first) % 100 == 0:
+            _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
 
     def _with_events(self, t_out: np.ndarray, store: Callable[..., None],
                      first: int) -> None:
@@ -155,13 +169,7 @@ class _State:
                              atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
                 t_prev, y_prev = solver.t, solver.y.copy()
-                with HELD:  # (a Ctrl-C in the step: raised once it is the state kept,
-                    if solver.step() is not None:  # its steps counted)
-                        raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
-                    self.steps += 1
-                    self.t, self.y = float(solver.t), solver.y  # (scipy makes a new y a step)
-                if (self.steps - first) % 100 == 0:
-                    _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
+                self._step(solver, t_out, first)
                 if log.count[0] + len(log.watch) > log.buffer.shape[0]:
                     log.drain()
                 xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n]
