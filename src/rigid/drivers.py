@@ -6,8 +6,8 @@ method (see :mod:`rigid.integrators`).  The fixed-step methods run their whole t
 loop in one compiled function of :mod:`rigid._kernels.euler` (the splittings with the
 composition of :func:`rigid.splitting.split_ops`, the exact flow plus kicks, RK4 with
 quaternion or Cayley kinematics), in chunks only when a progress bar is shown; DOP853
-is the shared driver of both packages, :func:`hamilton_orbits.integrators.dop853.solve`,
-on Euler's equations plus ``dq/dt = q omega / 2``.
+is the driver of :func:`hamilton_orbits.integrators.dop853.solve` (whose steps a
+``Simulation``'s dop853 takes too), on Euler's equations plus ``dq/dt = q omega / 2``.
 """
 
 from __future__ import annotations

@@ -213,9 +213,10 @@ def solve(
     max_steps: int = DOP853.max_steps,
     hint: str | None = None,
 ) -> tuple[np.ndarray, int, int]:
-    """The one DOP853 driver of both packages: ``y' = f(t, y)`` from ``y0`` at
+    """The DOP853 driver of a whole run (rigid's): ``y' = f(t, y)`` from ``y0`` at
     ``t_out[0]``, restarted at each output time (so that an output is a step end,
-    not an interpolation).
+    not an interpolation).  A ``Simulation``'s dop853 takes the same steps, stepping
+    scipy's stepper itself to keep each step's state (Ctrl-C).
 
     Parameters
     ----------
