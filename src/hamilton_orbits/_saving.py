@@ -393,7 +393,12 @@ class Saving:
         times, its start) written, so a folder that cannot take it fails now."""
         arch, prop = self._archive, self._prop
         if times[-1] < times[0]:
-            raise ValueError("A simulation with an archive integrates forwards in time")
+            if arch.path is None:  # (the schedule of a run it was taken from, writing
+                self._asked = None  # nothing: a leg back in time has no snapshot of it
+                return  # to keep to, and leaves the run's steps behind)
+            raise ValueError(f"A simulation writing an archive integrates forwards in time "
+                             f"(its archive {arch.path} is one run's timeline); integrate a "
+                             f"copy backwards (Simulation.copy(), which writes nothing)")
         try:
             arch.open()
             info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,

@@ -275,8 +275,9 @@ class Simulation(Saving):
             simulation's time (0 at the system given); a time Quantity for a
             Quantity system, plain floats otherwise.  Backwards is allowed with
             every effect (the time-reversed motion is integrated, velocity-dependent
-            effects at the true velocity), not with events or the variational
-            equations.
+            effects at the true velocity), with the variational equations and with
+            events that record only (not those that stop, merge or remove), not while
+            writing an archive (a copy, which writes nothing, may go back).
         progress : bool
             Show a progress bar (tqdm, on stderr) over the output times.
         on_output : callable, optional
@@ -381,7 +382,8 @@ class Simulation(Saving):
             if progress:
                 on_output, close = progress_reporter(prop.method.name, len(times) - 1,
                                                      on_output)
-            archived = None if self._archive is None else self._archived_times(times, leg)
+            archived = (None if self._archive is None or times[-1] < times[0]  # (backwards:
+                        else self._archived_times(times, leg))  # no snapshot, see _new_leg)
             if archived is None:
                 return prop.advance(times, on_output=on_output, stop=stop)
             out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),

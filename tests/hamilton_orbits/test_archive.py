@@ -420,7 +420,7 @@ def test_a_step_count_of_numpy_integer_type_schedules_an_archive(tmp_path):
 
 def test_an_archived_simulation_integrates_forwards(tmp_path):
     sim = Simulation(_disc(), method="radau15", archive=tmp_path, every=1.0)
-    with pytest.raises(ValueError, match=r"with an archive integrates forwards"):
+    with pytest.raises(ValueError, match=r"writing an archive integrates forwards"):
         sim.integrate(-2.0)
 
 
@@ -1550,3 +1550,27 @@ def test_two_simulations_cannot_write_two_timelines_into_one_archive(tmp_path):
     first.integrate(10.0)
     times = Archive(tmp_path / "a").times
     assert np.all(np.diff(times) >= 0) and times[-1] == 10.0
+
+
+def test_a_snapshot_that_writes_nothing_integrates_backwards(tmp_path):
+    """``Archive[k]``, a copy and a saved file of an archived run keep its schedule
+    and write nothing: they were refused a leg back in time ("A simulation with an
+    archive integrates forwards"), and, let through, went nowhere (the snapshot
+    times merged into the backward times in ascending order).  A simulation that
+    writes its archive is refused by name, pointed to a copy."""
+    kw = dict(method="wh", dt=0.05)
+    sim = Simulation(_disc(), archive=tmp_path / "a", every=1.0, exact_times=True, **kw)
+    sim.integrate(5.0)
+    sim.save(tmp_path / "saved.nc")
+    plain = Simulation(_disc(), **kw)
+    plain.integrate(np.arange(6.0))  # (the archived run's steps: outputs at its snapshots)
+    back = plain.copy().integrate(1.0).r[-1]
+    for made in (sim.copy(), Simulation.load(tmp_path / "saved.nc")):
+        assert _same(made.integrate(1.0).r[-1], back) and made.t == 1.0
+    at3 = Simulation(_disc(), **kw)
+    at3.integrate(np.arange(4.0))
+    assert _same(Archive(tmp_path / "a")[3].integrate(1.0).r[-1], at3.integrate(1.0).r[-1])
+    with pytest.raises(ValueError, match=r"writing an archive integrates forwards in time .* "
+                                         r"integrate a copy backwards"):
+        sim.integrate(1.0)
+    assert sim.t == 5.0 and not _lock(tmp_path / "a")
