@@ -196,3 +196,37 @@ def test_ctrl_c_while_a_finished_run_is_saved_keeps_its_files(tmp_path, capsys):
     assert code == cli.EXIT_INTERRUPTED and (tmp_path / "states.nc").read_text() == "states"
     captured = capsys.readouterr()
     assert "saving the run's files first" in captured.err and "wrote 1 files" in captured.out
+
+
+def test_a_run_stopped_before_its_first_snapshot_is_resumed_and_may_be_run_again(
+        tmp_path, monkeypatch, capsys):
+    """A disk full at the first snapshot's record (a mocked ``pwrite``; a SIGKILL
+    there leaves the same) leaves a segment of no snapshot: ``resume`` failed ("no
+    readable snapshot") and ``run`` refused the folder ("holds the snapshots of an
+    earlier run"), so that only deleting files by hand went on.  ``resume`` now runs
+    the scene from its start, to the files of the run never stopped, and ``run``
+    takes the folder again."""
+    import errno
+
+    from hamilton_orbits import segment
+
+    assert main(["run", "comet-encounter", "--out", str(tmp_path / "whole"), *SETS]) == 0
+    whole = _states(tmp_path / "whole")
+    real = os.pwrite
+
+    def full(fd, data, offset):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    for out in (tmp_path / "resumed", tmp_path / "run-again"):
+        monkeypatch.setattr(segment.os, "pwrite", full)
+        assert main(["run", "comet-encounter", "--out", str(out), *SETS]) != 0
+        monkeypatch.setattr(segment.os, "pwrite", real)
+        assert "No space left on device" in capsys.readouterr().err
+        assert len(Archive(out / "archive")) == 0 and list((out / "archive").glob("segment-*"))
+    assert main(["resume", str(tmp_path / "resumed"), "--no-progress"]) == 0
+    assert main(["run", "comet-encounter", "--out", str(tmp_path / "run-again"), *SETS]) == 0
+    for out in (tmp_path / "resumed", tmp_path / "run-again"):
+        resumed = _states(out)
+        assert sorted(resumed) == sorted(whole)
+        for name, values in whole.items():
+            assert np.array_equal(resumed[name], values, equal_nan=True), name

@@ -57,6 +57,7 @@ __all__ = [
     "Contents",
     "LegRows",
     "contents",
+    "holds_snapshots",
     "last_snapshot",
     "leg_rows",
     "on_step_grid",
@@ -267,6 +268,14 @@ def snapshot_at(folder: Path, number: int) -> tuple[Path, dict[str, Any],
         if seg.first <= number < seg.first + seg.count:
             return None  # its file holds it, damaged
     return None
+
+
+def holds_snapshots(folder: Path) -> bool:
+    """Whether archive ``folder`` holds a snapshot (whole or not): a run's to resume,
+    which a new run is refused.  A segment begun by a run killed (or stopped by a
+    full disk) before its first snapshot was written holds none: a new run replaces
+    it."""
+    return _next_number(Path(folder)) > 0
 
 
 def _next_number(folder: Path) -> int:

@@ -227,14 +227,14 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     from pathlib import Path
 
     from hamilton_orbits._outdir import FolderError
-    from hamilton_orbits.checkpoint import snapshot_files
+    from hamilton_orbits.checkpoint import holds_snapshots
 
     every = scene.spec.get("output", {}).get("archive_every")
     if every is None:
         return None
     archive = Path(folder) / "archive"
     resume = f"hamilton-orbits resume {shlex.quote(str(folder))}"
-    if snapshot_files(archive):
+    if holds_snapshots(archive):
         raise _CommandError(f"{archive} holds the snapshots of an earlier run: resume it "
                             f"({resume}) or choose another --out")
     file = _scene_file(ref)

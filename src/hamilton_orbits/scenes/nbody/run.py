@@ -14,7 +14,7 @@ import numpy as np
 
 from hamilton_orbits import effects as _effects
 from hamilton_orbits._progress import progress_bar
-from hamilton_orbits.checkpoint import snapshot_files
+from hamilton_orbits.checkpoint import holds_snapshots
 from hamilton_orbits.scenes.nbody.analyses import ANALYSIS_FUNCTIONS
 from hamilton_orbits.scenes.nbody.build import (
     build_system,
@@ -57,9 +57,10 @@ def _compile_ahead(spec: dict) -> None:
 
 
 def resumable(folder: Any) -> bool:
-    """True if archive ``folder`` holds a file of snapshots (a run to resume): a
-    segment, or a snapshot file of format 1."""
-    return folder is not None and bool(snapshot_files(Path(folder)))
+    """True if archive ``folder`` holds snapshots (a run to resume; a segment of
+    none, begun by a run killed before its first snapshot, is a run to begin again:
+    :func:`~hamilton_orbits.checkpoint.holds_snapshots`)."""
+    return folder is not None and holds_snapshots(Path(folder))
 
 
 def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
