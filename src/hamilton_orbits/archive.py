@@ -127,7 +127,8 @@ class Archive:
         return Simulation.load(self.path, number=self.snapshots[k].number)
 
     def __repr__(self) -> str:
-        span = f"t = {self.times[0]!r} ... {self.times[-1]!r}" if self.snapshots else "empty"
+        span = (f"t = {float(self.times[0])!r} ... {float(self.times[-1])!r}" if self.snapshots
+                else "empty")
         more = "".join(f", {len(x)} {what}" for x, what in ((self.damaged, "damaged"),
                                                            (self.torn, "torn")) if x)
         return f"Archive({str(self.path)!r}: {len(self)} snapshots, {span}{more})"

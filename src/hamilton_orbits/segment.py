@@ -93,6 +93,8 @@ SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
 #: written in the rows file (format 4: a leg's first row, at its start)
 OWN_ROW = -1
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
+#: a segment's or a rows file's name, with the number of its first snapshot
+_NUMBERED_RE = re.compile(r"^(?:segment|rows)-(\d{6})\.nc$")
 #: the record of a snapshot of a propagation's state, in its stored order
 _STATE_RECORD = ["t", "r", "v", "gm", "state", "scalars", "steps", "rows", "active"]
 #: the same with the snapshot's leg (format 3: a segment continued across legs)
@@ -720,6 +722,11 @@ def _checked(path: Path, data: bytes) -> tuple[Header, dict[str, np.ndarray]]:
     except Exception as exc:  # any damage of the header surfaces as some error
         raise SnapshotError(f"{path} cannot be read as an archive segment (damaged: "
                             f"{type(exc).__name__}: {exc})") from None
+    named = _NUMBERED_RE.match(path.name)
+    if good and named and int(named.group(1)) != int(header.attrs.get("first", -1)):
+        raise SnapshotError(f"{path} holds the snapshots from number {header.attrs['first']}"
+                            f" on, not from {int(named.group(1))} as its name says (a file "
+                            f"renamed or copied): not read as its name's")
     if not good or records != header.attrs.get("records"):
         raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
                             f"shared contents")
@@ -778,7 +785,10 @@ def _read_back(path: Path, number: int | None = None) -> Segment | None:
     except OSError:
         return None
     try:
-        size, head = os.fstat(fd).st_size, _head(fd)
+        try:
+            size, head = os.fstat(fd).st_size, _head(fd)
+        except OSError:  # (not a file: a folder of a segment's name; the whole read says so)
+            return None
         if head is None:
             return None
         try:

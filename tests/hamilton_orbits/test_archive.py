@@ -1574,3 +1574,48 @@ def test_a_snapshot_that_writes_nothing_integrates_backwards(tmp_path):
                                          r"integrate a copy backwards"):
         sim.integrate(1.0)
     assert sim.t == 5.0 and not _lock(tmp_path / "a")
+
+
+def test_a_segment_or_rows_file_under_another_number_is_damaged_not_read_as_it(tmp_path):
+    """Each file's header holds the number of its first snapshot (under its
+    SHA-256); nothing compared it with the file's name, so that a segment copied
+    under a later number (a backup put back) was read as the run's last snapshots:
+    numbers listed twice, ``Simulation.load`` gone back in time, and no damage
+    said.  Rows files swapped between two segments gave snapshots the other's
+    rows."""
+    import shutil
+
+    folder = tmp_path / "a"
+    sim = Simulation(_disc(), method="wh", dt=0.05, archive=folder, every=1.0)
+    sim.integrate(np.linspace(0.0, 5.0, 11))  # (rows beside the snapshots)
+    sim.integrate(np.linspace(5.0, 10.0, 11))  # (a second segment, with its rows)
+    before = Archive(folder)
+    firsts = [first for first, _ in snapshot_files(folder)]
+    assert len(firsts) == 2 and list((folder).glob("rows-*"))
+    shutil.copy(folder / f"segment-{firsts[0]:06d}.nc", folder / "segment-000040.nc")
+    after = Archive(folder)
+    assert [s.number for s in after.snapshots] == [s.number for s in before.snapshots]
+    assert [p.name for p, _ in after.damaged] == ["segment-000040.nc"]
+    assert re.search(r"holds the snapshots from number 0 on, not from 40 as its name says",
+                     after.damaged[0][1])
+    assert Simulation.load(folder).t == 10.0
+    (folder / "segment-000040.nc").unlink()
+    rows = sorted(folder.glob("rows-*"))
+    assert len(rows) == 2
+    rows[0].rename(tmp_path / "swap")
+    rows[1].rename(rows[0])
+    (tmp_path / "swap").rename(rows[1])
+    swapped = Archive(folder)  # (the snapshots with rows: damaged, not given the other's)
+    whole = {s.number for s in swapped.snapshots}
+    assert swapped.damaged and whole < {s.number for s in before.snapshots}
+    assert all("output rows of snapshot" in why for _, why in swapped.damaged)
+
+
+def test_a_folder_named_as_a_segment_is_listed_damaged_and_passed_over(tmp_path):
+    """``Simulation.load`` of an archive holding a folder of a segment's name raised
+    a bare ``IsADirectoryError``; ``Archive`` listed it damaged."""
+    folder = tmp_path / "a"
+    Simulation(_disc(), method="wh", dt=0.05, archive=folder, every=1.0).integrate(3.0)
+    (folder / "segment-000030.nc").mkdir()
+    assert [p.name for p, _ in Archive(folder).damaged] == ["segment-000030.nc"]
+    assert Simulation.load(folder).t == 3.0
