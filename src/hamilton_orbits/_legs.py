@@ -75,7 +75,7 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
     added = int(arr[0] != t_now)
     if added:
         arr = np.concatenate(([t_now], arr))
-    _check_monotonic(arr, t_now, added)
+    _check_monotonic(arr, t_now, added, " d" if quantity else "")
     return arr, unit
 
 
@@ -84,22 +84,22 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
 _ROUND_TRIP = 8 * np.finfo(np.float64).eps
 
 
-def _check_monotonic(arr: np.ndarray, t_now: float, added: int) -> None:
+def _check_monotonic(arr: np.ndarray, t_now: float, added: int, unit: str) -> None:
     """Refuse output times ``arr`` (the simulation's time first, ``added`` to the
     caller's times when 1) that are not strictly monotonic, naming the caller's
-    index and value."""
+    index and value (``unit``: " d" for a Quantity system's days)."""
     d = np.diff(arr)
     if np.all(d > 0) or np.all(d < 0):
         return
-    start = "0" if t_now == 0.0 else repr(t_now)
+    start = "0" if t_now == 0.0 else f"{t_now!r}{unit}"
     if added and d[0] < 0 < d[1:].max(initial=-1.0):
         raise ValueError(f"Expected `t` to be strictly monotonic from the simulation's time "
-                         f"{start}, got {float(arr[1])!r} at index 0 and {float(arr[2])!r} at "
-                         f"index 1")
+                         f"{start}, got {float(arr[1])!r}{unit} at index 0 and "
+                         f"{float(arr[2])!r}{unit} at index 1")
     k = int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))
     raise ValueError(
         f"Expected `t` to be strictly monotonic (times after the start {start}), got "
-        f"{float(arr[k + 1])!r} after {float(arr[k])!r} at index {k + 1 - added}"
+        f"{float(arr[k + 1])!r}{unit} after {float(arr[k])!r}{unit} at index {k + 1 - added}"
     )
 
 

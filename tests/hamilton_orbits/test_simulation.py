@@ -66,7 +66,7 @@ def test_backwards_and_forwards_return():
     ("t", "match"),
     [
         (0 * u.day, r"nonzero"),
-        ([1.0, 3.0, 2.0] * u.day, r"monotonic.*got 2.0 after 3.0 at index 2"),  # (the caller's index)
+        ([1.0, 3.0, 2.0] * u.day, r"monotonic.*got 2.0 d after 3.0 d at index 2"),
         (5.0, r"time Quantity"),
         (5 * u.m, r"t"),
     ],
