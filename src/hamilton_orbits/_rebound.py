@@ -16,12 +16,13 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["arrays_from_simulation", "particle_name", "simulation_from_arrays"]
+__all__ = ["arrays_from_simulation", "particle_name", "radii_of", "simulation_from_arrays"]
 
 
 def simulation_from_arrays(names: Sequence[str], gm: np.ndarray, r: np.ndarray,
-                           v: np.ndarray) -> Any:
-    """A ``rebound.Simulation`` with ``G = 1``, ``m = gm`` and the given state.
+                           v: np.ndarray, radius: np.ndarray | None = None) -> Any:
+    """A ``rebound.Simulation`` with ``G = 1``, ``m = gm`` and the given state (and
+    the particles' radii ``radius``, NaN for none).
 
     Examples
     --------
@@ -38,6 +39,8 @@ def simulation_from_arrays(names: Sequence[str], gm: np.ndarray, r: np.ndarray,
         x, y, z = (float(c) for c in r[k])
         vx, vy, vz = (float(c) for c in v[k])
         sim.add(m=float(gm[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz)
+        if radius is not None and radius[k] > 0:  # (NaN: none, rebound's 0)
+            sim.particles[k].r = float(radius[k])
         # set through the particle in the simulation: rebound copies the name into
         # memory the simulation owns (``add(name=...)`` keeps a pointer to a
         # temporary Python buffer, which may be reused before the file is written)
@@ -62,6 +65,22 @@ def particle_name(particle: Any) -> str | None:
 
     ptr = ctypes.c_void_p.from_buffer(particle, rebound.Particle._name.offset).value
     return ctypes.string_at(ptr).decode("utf-8") if ptr else None
+
+
+def radii_of(sim: Any) -> np.ndarray:
+    """The particles' radii of a ``rebound.Simulation``, NaN where it has none (0).
+
+    Examples
+    --------
+    >>> sim = simulation_from_arrays(["a", "b"], np.array([1.0, 0.0]),
+    ...                              np.array([[0.0, 0, 0], [1.0, 0, 0]]), np.zeros((2, 3)),
+    ...                              radius=np.array([0.5, np.nan]))
+    >>> radii_of(sim).tolist()
+    [0.5, nan]
+    """
+    radius = np.array([sim.particles[k].r for k in range(sim.N)], dtype=np.float64)
+    radius[~(radius > 0)] = np.nan
+    return radius
 
 
 def arrays_from_simulation(

@@ -58,7 +58,8 @@ class InitialStates:
     """
 
     def to_rebound(self):
-        """A ``rebound.Simulation`` of this system (G = 1, m = gm, internal units: exact).
+        """A ``rebound.Simulation`` of this system (G = 1, m = gm, internal units: exact;
+        the radii given, as the particles' ``r``).
 
         Examples
         --------
@@ -70,12 +71,16 @@ class InitialStates:
         from hamilton_orbits._rebound import simulation_from_arrays
 
         arrays = self.as_arrays()
-        return simulation_from_arrays(arrays.names, arrays.gm, arrays.r, arrays.v)
+        return simulation_from_arrays(arrays.names, arrays.gm, arrays.r, arrays.v,
+                                      arrays.radius)
 
     @classmethod
     def from_rebound(cls, sim, *, quantity: bool = False,
                      names: Sequence[str] | None = None) -> System:
-        """A System from a ``rebound.Simulation`` (``gm = G m``; exact for G = 1).
+        """A System from a ``rebound.Simulation`` (``gm = G m``, exact for G = 1; the
+        system's ``G`` is the simulation's, so that ``energy`` and
+        ``angular_momentum`` are rebound's; a particle's radius ``r`` is its body's
+        ``radius``, none where 0).
 
         Parameters
         ----------
@@ -102,15 +107,16 @@ class InitialStates:
         ...
         ValueError: Expected `sim` to be a rebound.Simulation, got 'x'
         """
-        from hamilton_orbits._rebound import arrays_from_simulation
+        from hamilton_orbits._rebound import arrays_from_simulation, radii_of
 
         names, gm, r, v = arrays_from_simulation(sim, names)
-        if quantity:
-            bodies = [body_from_floats(name, gm[k], r[k], v[k], None, None, None, True)
+        radius = [None if np.isnan(x) else float(x) for x in radii_of(sim)]
+        if quantity:  # (au, as its positions; G astropy's, m = gm / G)
+            bodies = [body_from_floats(name, gm[k], r[k], v[k], radius[k], None, None, True)
                       for k, name in enumerate(names)]
-        else:
-            bodies = [Body(name, gm[k], r[k], v[k]) for k, name in enumerate(names)]
-        return cls(bodies)
+            return cls(bodies)
+        bodies = [Body(name, gm[k], r[k], v[k], radius=radius[k]) for k, name in enumerate(names)]
+        return cls(bodies, G=sim.G)
 
     @classmethod
     def from_ephemeris(

@@ -141,6 +141,26 @@ def test_rebound_round_trip_bit_for_bit():
     np.testing.assert_array_equal(back._gm, f._gm)
 
 
+def test_from_rebound_keeps_its_g_and_radii():
+    """A rebound simulation in au, yr and solar masses (G = 4 pi^2): the System's
+    energy and angular momentum were G times rebound's (``gm / G`` with G = 1), and
+    the particles' radii (a collision's set-up) were dropped."""
+    import rebound
+
+    sim = rebound.Simulation()
+    sim.G = 4 * np.pi**2
+    sim.add(m=1.0, r=0.005)
+    sim.add(m=9.5e-4, a=5.2, e=0.05, inc=0.02, r=0.0005)
+    sim.add(m=1e-9, a=1.3, e=0.3)  # (no radius: 0 in rebound)
+    s = System.from_rebound(sim)
+    assert s.G == sim.G
+    assert s.energy() == pytest.approx(sim.energy(), rel=1e-14)
+    np.testing.assert_allclose(s.angular_momentum(), sim.angular_momentum(), rtol=1e-14)
+    np.testing.assert_array_equal(s.as_arrays().radius, [0.005, 0.0005, np.nan])
+    back = s.to_rebound()  # (G = 1, m = gm: the same radii)
+    assert [p.r for p in back.particles] == [0.005, 0.0005, 0.0]
+
+
 def test_solar_system_offline_and_cited_gm():
     s = System.solar_system("J2000")
     assert s.names == ("sun", "mercury", "venus", "earth-moon-barycenter", "mars",
