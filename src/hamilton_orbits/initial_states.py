@@ -299,7 +299,7 @@ def solar_system_epoch(epoch: Any = "J2000"):
     from astropy.time import Time
 
     if isinstance(epoch, Time):
-        t = epoch.tdb
+        t = _tdb(epoch)
     elif isinstance(epoch, str) and epoch.strip().upper() == "J2000":
         t = Time("2000-01-01T12:00:00", scale="tdb")
     elif isinstance(epoch, str) and epoch.strip().lower() == "now":
@@ -318,11 +318,33 @@ def solar_system_epoch(epoch: Any = "J2000"):
         raise ValueError(f"Expected `epoch` to be one time, got shape {t.shape}")
     years = (t.jd1 - 2451545.0 + t.jd2) / 365.25  # Julian years from J2000, as epv00
     if not abs(years) <= 100.0:
-        lo, hi = SOLAR_SYSTEM_SPAN
-        raise ValueError(
-            f"Expected `epoch` within {lo}-{hi} (the span of ERFA's epv00, behind astropy's "
-            f"built-in ephemeris), got {epoch!r} ({t.iso} TDB)")
+        _beyond(epoch, f"{t.iso} TDB")
     return t
+
+
+def _beyond(epoch: Any, when: str) -> None:
+    lo, hi = SOLAR_SYSTEM_SPAN
+    raise ValueError(
+        f"Expected `epoch` within {lo}-{hi} (the span of ERFA's epv00, behind astropy's "
+        f"built-in ephemeris), got {epoch!r} ({when})")
+
+
+def _tdb(epoch: Any) -> Any:
+    """An astropy ``Time`` in TDB: one far outside the span refused first (its
+    conversion fails in ERFA, or warns), on its own scale's Julian date (scales
+    differ by about a minute: a day's margin); ERFA's "dubious year" of UTC's leap
+    seconds silenced for a time not given in UTC or UT1 (TT to TDB takes UT for a
+    term of microseconds only)."""
+    import warnings
+
+    from erfa import ErfaWarning
+
+    if epoch.isscalar and not abs((epoch.jd1 - 2451545.0 + epoch.jd2) / 365.25) <= 100.003:
+        _beyond(epoch, f"{epoch.jyear:.6g} on its {epoch.scale.upper()} scale, as a Julian year")
+    with warnings.catch_warnings():
+        if epoch.scale not in ("utc", "ut1"):
+            warnings.filterwarnings("ignore", "ERFA function .*dubious year", ErfaWarning)
+        return epoch.tdb
 
 
 def solar_system_bodies(bodies: Any = None) -> list[str]:
