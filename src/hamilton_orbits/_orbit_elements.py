@@ -287,7 +287,8 @@ class OrbitElements:
     @property
     def mean_longitude(self):
         """``varpi + M`` (``varpi - M`` for inc > pi/2); in [0, 2 pi) for bound orbits."""
-        varpi = self._col("lan") + self._sign * self._col("argp")
+        varpi = _wrap2pi(self._col("lan") + self._sign * self._col("argp"))  # (as
+        # longitude_of_periapsis gives it: an open orbit's M is added to it unwrapped)
         ml = varpi + self._sign * self._col("M")
         kind = self._kind
         bound = (kind == _el.ELLIPSE) | (kind == _el.RADIAL_ELLIPSE)

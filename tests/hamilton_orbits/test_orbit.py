@@ -435,3 +435,14 @@ def test_repr_single_and_batch():
     assert "a in [-3, 3], e in [0, 2]" in text and "mu in [1, 1]" in text
     assert repr(batch[:0]) == "KeplerOrbit(shape=(0,))"
     assert "e=1" in repr(KeplerOrbit.from_state([1.0, 0, 0], [0.5, 0, 0], 1.0))  # radial
+
+
+def test_an_open_orbits_mean_longitude_is_its_varpi_plus_m():
+    """Documented as ``varpi + M`` (varpi in [0, 2 pi), left unwrapped only for open
+    orbits): a hyperbola's added the unwrapped ``lan + argp``, 2 pi more here."""
+    for inc, sign in ((0.3, 1.0), (2.8, -1.0)):
+        o = KeplerOrbit.from_elements(e=2.0, inc=inc, lan=5.0, argp=5.0, M=0.5, a=-1.0, mu=1.0)
+        varpi = float(o.varpi)
+        assert 0.0 <= varpi < 2 * np.pi
+        assert float(o.mean_longitude) == varpi + sign * float(o.M)
+        assert float(o.M) == pytest.approx(0.5, rel=1e-14)  # (M through the state)
