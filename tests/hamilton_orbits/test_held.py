@@ -183,3 +183,84 @@ def test_a_ctrl_c_in_a_dop853_step_keeps_the_state_of_its_steps(options, monkeyp
     # cut: the two agree to the method's error at its default tolerance, 2e-14 au here)
     np.testing.assert_allclose(sim.system.as_arrays().r, once.system.as_arrays().r,
                                rtol=0, atol=1e-12)
+
+
+def _merging() -> System:
+    """Two bodies falling into contact (they merge about t = 1.4) and a bystander."""
+    return System([Body("a", 1.0, [0, 0, 0], [0, 0.01, 0], radius=0.01),
+                   Body("b", 0.5, [1.0, 0, 0], [0, -0.02, 0.005], radius=0.02),
+                   Body("c", 0.0, [5.0, 0, 0], [0, 0.4, 0])])
+
+
+#: (Simulation options, the kernels' module and the watched kernels' names: the
+#: call that stops at the event, and the status it returns it with)
+EVENT_CASES = {
+    "radau15": (dict(method="radau15"), radau15_kernels, ["advance_watched"]),
+    "wh": (dict(method="wh", dt=DT), wh_kernels, ["advance_dh_watched"]),
+    "leapfrog": (dict(method="leapfrog", dt=DT), leapfrog_kernels, ["advance_watched"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(EVENT_CASES))
+def test_a_ctrl_c_in_the_call_that_finds_a_merge_leaves_it_done(case, monkeypatch):
+    """The call that stops at an event returns early; a Ctrl-C anywhere in it was
+    raised as the steps were counted, before the event's action: the bodies stayed
+    apart, and the next leg found them in contact at its start and recorded the
+    collision again.  The action is now taken before the Ctrl-C is raised."""
+    options, kernels, names = EVENT_CASES[case]
+    options = dict(options, events=[{"name": "collision", "action": "merge"}])
+    once = Simulation(_merging(), **options)
+    whole = once.integrate(3.0)
+    pressed = []
+
+    def wrapped(real):
+        def kernel(*args):
+            out = real(*args)
+            if out[-1] == kernels.STATUS_EVENT and not pressed:  # (the event's call)
+                pressed.append(1)
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+            return out
+        return kernel
+
+    sim = Simulation(_merging(), **options)
+    with monkeypatch.context() as patched:
+        for name in names:
+            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+        cut = sim.integrate(3.0, on_interrupt="keep")
+    assert pressed and not cut.complete and len(cut.events) == 1
+    assert len(sim.system.names) == 2  # (merged: a + b, and c)
+    rest = sim.integrate(3.0)
+    assert len(rest.events) == 0 and sim.steps == once.steps
+    assert len(whole.events) == 1
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)
+
+
+def test_a_ctrl_c_in_a_dop853_step_that_holds_an_event_leaves_it_found(monkeypatch):
+    """dop853 scans each step for events after taking it: a Ctrl-C in the step
+    was raised before its scan, and the continued run began after the step, so
+    that the step's events were never found (nor their actions taken)."""
+    from hamilton_orbits._kernels import events as event_kernels
+
+    options = dict(method="dop853", events=[{"name": "collision", "action": "merge"}])
+    once = Simulation(_merging(), **options)
+    once.integrate(3.0)
+    real, pressed = event_kernels.scan_steps, []
+
+    def scan(*args):
+        out = real(*args)
+        if out[0] >= 0 and not pressed:  # (the step holding the event)
+            pressed.append(1)
+            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+        return out
+
+    sim = Simulation(_merging(), **options)
+    with monkeypatch.context() as patched:
+        patched.setattr(event_kernels, "scan_steps", scan)
+        cut = sim.integrate(3.0, on_interrupt="keep")
+    assert pressed and not cut.complete and len(cut.events) == 1
+    assert len(sim.system.names) == 2
+    assert len(sim.integrate(3.0).events) == 0
+    # (both restart the stepper at the merge; the cut run's leg after it is a call of
+    # its own: its steps agree with the run's to the method's error)
+    np.testing.assert_allclose(sim.system.as_arrays().r, once.system.as_arrays().r,
+                               rtol=0, atol=1e-12)

@@ -14,6 +14,7 @@ linearly with time.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import Any
 
@@ -143,17 +144,22 @@ class _State:
             self.t, self.y = float(t_out[i]), solver.y.copy()
             store(i, self.steps, self.y)
 
-    def _step(self, solver: Any, t_out: np.ndarray, first: int) -> None:
-        """One step of scipy's stepper ``solver``, its state kept as the run's (a Ctrl-C
-        in it held until then), the pace judged every 100 steps."""
+    def _step(self, solver: Any, t_out: np.ndarray, first: int,
+              scanned: Callable[[], bool] | None = None) -> bool:
+        """One step of scipy's stepper ``solver``, its state kept as the run's, and
+        ``scanned()`` (the step's events acted on: True where one did, the state then
+        its), a Ctrl-C in them held until they are done; the pace judged every 100
+        steps.  Returns what ``scanned`` does (False without it)."""
         t_prev = solver.t
         with HELD:
             if solver.step() is not None:
                 raise ValueError(f"dop853 failed at t = {t_prev}: the step underflowed")
             self.steps += 1
             self.t, self.y = float(solver.t), solver.y  # (scipy makes a new y a step)
+            acted = scanned is not None and scanned()
         if (self.steps - first) % 100 == 0:
             _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
+        return acted
 
     def _with_events(self, t_out: np.ndarray, store: Callable[..., None],
                      first: int) -> None:
@@ -163,36 +169,43 @@ class _State:
         time (or stops the run there)."""
         from scipy.integrate import DOP853 as Stepper
 
-        log, n = self.log, self.n
         for i in range(1, len(t_out)):
             solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
                              atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
                 t_prev, y_prev = solver.t, solver.y.copy()
-                self._step(solver, t_out, first)
-                if log.count[0] + len(log.watch) > log.buffer.shape[0]:
-                    log.drain()
-                xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n]
-                                          .reshape(2, n, 3))
-                vs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, 3 * n :]
-                                          .reshape(2, n, 3))
-                k, h, row = _ev.scan_steps(log.watch, np.array([t_prev, solver.t]), xs, vs,
-                                           self.gm, log.buffer, log.count)
-                if k < 0:
-                    continue
-                r, v = np.empty((n, 3)), np.empty((n, 3))
-                _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
-                             np.zeros(1), np.zeros((7, 1)), self.gm, r, v)
-                self.t = float(t_prev + h * (solver.t - t_prev))
-                stop = log.act(int(row), self.t, r, v, self.gm)
-                self.y = np.concatenate((r.ravel(), v.ravel()))
-                if stop:
-                    store(i, self.steps, self.y, reached=False)
-                    raise StopAtEvent(i, self.t, self.steps - first)
-                solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
-                                 atol=self.atol, max_step=self.max_step)
+                if self._step(solver, t_out, first, functools.partial(
+                        self._scanned, solver, t_prev, y_prev, i, store, first)):
+                    solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
+                                     atol=self.atol, max_step=self.max_step)
             self.t, self.y = float(t_out[i]), solver.y.copy()
             store(i, self.steps, self.y)
+
+    def _scanned(self, solver: Any, t_prev: float, y_prev: np.ndarray, i: int,
+                 store: Callable[..., None], first: int) -> bool:
+        """The step of ``solver`` from ``t_prev`` (state ``y_prev``) scanned for events:
+        True where one acted (the state then the event's, at its time: the caller
+        restarts the stepper there); a stop leaves its state in output ``i`` and
+        raises :class:`StopAtEvent`."""
+        log, n = self.log, self.n
+        if log.count[0] + len(log.watch) > log.buffer.shape[0]:
+            log.drain()
+        xs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, : 3 * n].reshape(2, n, 3))
+        vs = np.ascontiguousarray(np.stack([y_prev, solver.y])[:, 3 * n :].reshape(2, n, 3))
+        k, h, row = _ev.scan_steps(log.watch, np.array([t_prev, solver.t]), xs, vs, self.gm,
+                                   log.buffer, log.count)
+        if k < 0:
+            return False
+        r, v = np.empty((n, 3)), np.empty((n, 3))
+        _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
+                     np.zeros(1), np.zeros((7, 1)), self.gm, r, v)
+        self.t = float(t_prev + h * (solver.t - t_prev))
+        stop = log.act(int(row), self.t, r, v, self.gm)
+        self.y = np.concatenate((r.ravel(), v.ravel()))
+        if stop:
+            store(i, self.steps, self.y, reached=False)
+            raise StopAtEvent(i, self.t, self.steps - first)
+        return True
 
 
 #: scipy's smallest accepted relative tolerance (100 eps); below it scipy warns.

@@ -125,22 +125,21 @@ class _State:
         while t < t_out[i]:
             ws = np.array([t, np.inf, 0.0, -1.0])
             args = (self.accel, self.p, r, v, self.gm, t, float(t_out[i]), self.dt)
-            with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
-                if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
-                    done, status = _k.advance_watched(*args, log.watch, log.buffer, log.count,
-                                                      ws, SLICE)
+            with HELD:  # (a Ctrl-C in the call: raised once its steps are counted and its
+                if log.watch.shape[0]:  # event acted on; the kernel with the events' code,
+                    done, status = _k.advance_watched(  # compiled apart)
+                        *args, log.watch, log.buffer, log.count, ws, SLICE)
                 else:
                     done, status = _k.advance(*args, None, None, None, ws, SLICE)
                 self.steps += int(done)
                 t = self.t = float(ws[0])
+                if status not in (_k.STATUS_OK, _k.STATUS_SLICE):
+                    log.drain()
+                    if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, self.gm):
+                        row[0][:], row[1][:] = r, v
+                        log.mask(row[0], row[1])
+                        raise StopAtEvent(i, t, self.steps - first)
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
-            if status == _k.STATUS_SLICE:  # Ctrl-C and stop() are seen between slices
-                if stop is not None and stop():
-                    raise StopIntegration
-                continue
-            log.drain()
-            if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, self.gm):
-                row[0][:], row[1][:] = r, v
-                log.mask(row[0], row[1])
-                raise StopAtEvent(i, t, self.steps - first)
+            if status == _k.STATUS_SLICE and stop is not None and stop():
+                raise StopIntegration  # (Ctrl-C and stop() are seen between slices)

@@ -360,10 +360,32 @@ class _Run:
             if on_output is not None:
                 on_output(i, self.steps - first)
 
+    def _slice(self, t_end: Any, budget: int) -> tuple[int, int, bool]:
+        """One compiled call of at most ``budget`` steps towards ``t_end``: its steps
+        counted, the events' log drained where full, and the event it stopped at
+        acted on, a Ctrl-C in the call held until all three are done (the state's
+        arrays, its counts and the event's action then agree): ``(steps, status,
+        whether the event stopped the run)``."""
+        log = self.log
+        with HELD:
+            if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
+                steps, status = _k.advance_watched(
+                    *self.before_t, t_end, *self.after_t, budget, log.watch, log.buffer,
+                    log.count)
+            else:
+                steps, status = _k.advance(*self.before_t, t_end, *self.after_t, budget, None,
+                                            None, None)
+            self.steps += steps
+            if status == _k.STATUS_DRAIN:
+                log.drain()
+            stopped = status == _k.STATUS_EVENT and log.act(
+                int(self.st[_k.ST_EVENT_ROW]), self.t, self.x, self.w, self.gm)
+        return steps, status, stopped
+
     def advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
         the steps before this call, for its budget of ``max_steps``)."""
-        log, max_steps, pause = self.log, self.max_steps, self.pause
+        max_steps, pause = self.max_steps, self.pause
         again = False  # (a pause since which only the kernel ran: see pause's notes)
         left = SLICE  # (of this slice: the pace is judged at its end, pauses or not)
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
@@ -375,15 +397,7 @@ class _Run:
                     again = True
                 cut = pause.at - self.steps < budget
                 budget = min(budget, max(pause.at - self.steps, 1))
-            with HELD:  # (a Ctrl-C in the call: raised once its steps are counted)
-                if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
-                    steps, status = _k.advance_watched(
-                        *self.before_t, t_out[i], *self.after_t, budget, log.watch, log.buffer,
-                        log.count)
-                else:
-                    steps, status = _k.advance(*self.before_t, t_out[i], *self.after_t, budget,
-                                                None, None, None)
-                self.steps += steps
+            steps, status, stopped = self._slice(t_out[i], budget)
             left -= steps
             if status == _k.STATUS_MAXSTEPS:
                 if not cut:  # (a slice's end or max_steps, where a run without pauses is)
@@ -392,11 +406,10 @@ class _Run:
                 if self.stop is not None and self.stop():
                     raise StopIntegration
             elif status == _k.STATUS_DRAIN:
-                log.drain()
                 again, left = False, SLICE
             elif status == _k.STATUS_EVENT:
                 again, left = False, SLICE
-                if log.act(int(self.st[_k.ST_EVENT_ROW]), self.t, self.x, self.w, self.gm):
+                if stopped:
                     return True
             elif status == _k.STATUS_OK:
                 return False

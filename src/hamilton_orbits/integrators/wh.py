@@ -309,21 +309,21 @@ class _State:
             if watched:  # (the events' part of the work space: see _drift)
                 ws[1], ws[2], ws[3] = np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
-            with HELD:  # (a Ctrl-C in the calls: raised once their steps are counted)
-                steps, bad, status = self.split.advance(
+            with HELD:  # (a Ctrl-C in the calls: raised once their steps are counted and
+                steps, bad, status = self.split.advance(  # their event acted on)
                     dt, n_call, last if done + n_call == n_steps else dt, self.watch,
                     log.buffer, log.count, ws)
                 done += steps
                 self.steps += steps
                 self.t = times[i - 1] + done * dt
+                if bad < 0 and status == _k.STATUS_DRAIN:
+                    log.drain()
+                elif bad < 0 and status == _k.STATUS_EVENT:
+                    self._act(i, row, ws, first)
             if bad >= 0:
                 raise ConvergenceError(
                     f"wh: the Kepler step of body {int(self.split.order[bad])} failed between "
                     f"t_out[{i - 1}] = {times[i - 1]!r} and t_out[{i}] = {times[i]!r}")
-            if status == _k.STATUS_DRAIN:
-                log.drain()
-            elif status == _k.STATUS_EVENT:
-                self._act(i, row, ws, first)
 
     def _act(self, i: int, row: tuple[np.ndarray, np.ndarray], ws: np.ndarray,
              first: int) -> None:
