@@ -264,3 +264,34 @@ def test_a_ctrl_c_in_a_dop853_step_that_holds_an_event_leaves_it_found(monkeypat
     # its own: its steps agree with the run's to the method's error)
     np.testing.assert_allclose(sim.system.as_arrays().r, once.system.as_arrays().r,
                                rtol=0, atol=1e-12)
+
+
+def test_python_s_default_handler_put_back_is_replaced_again(monkeypatch):
+    """Jupyter puts Python's default SIGINT handler back before each cell: the held
+    handler, installed once, was then gone for good, and a Ctrl-C in a compiled
+    call left the state a slice ahead again (8 au off over the rest of the run)."""
+    options, kernels, names, driver, slice_steps = CASES["wh"]
+    monkeypatch.setattr(driver, "SLICE", slice_steps)
+    once = Simulation(_planets(), **options)
+    once.integrate(12.0)  # (the held handler installed)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # (a new cell)
+    try:
+        calls = []
+
+        def kernel(*args, real=getattr(kernels, names[1])):
+            out = real(*args)
+            calls.append(1)
+            if len(calls) == 3:
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+            return out
+
+        sim = Simulation(_planets(), **options)
+        with monkeypatch.context() as patched:
+            patched.setattr(kernels, names[1], kernel)
+            cut = sim.integrate(8.0, on_interrupt="keep")
+        assert len(calls) == 3 and not cut.complete
+        sim.integrate(12.0)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert sim.steps == once.steps
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)

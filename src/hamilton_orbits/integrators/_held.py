@@ -12,8 +12,9 @@ without a word: a 10-body ``wh`` run 19 au off its uninterrupted self after 6000
 more time units; a ``radau15`` one 20 000 steps short in its count.
 
 :data:`HELD` is entered around each compiled stepping call and the count of what
-it did.  Python's default SIGINT handler is replaced, on the first such call in
-the main thread, by one that does what it does (raise ``KeyboardInterrupt``)
+it did.  Python's default SIGINT handler is replaced, on each such call in the
+main thread that finds it in place (Jupyter puts it back before each cell), by
+one that does what it does (raise ``KeyboardInterrupt``)
 except within :data:`HELD`: there the Ctrl-C is held, and raised as :data:`HELD`
 is left, the state and its counts then agreeing.  A second Ctrl-C within is
 raised at once (a Ctrl-C during a first call's compilation, which runs within,
@@ -41,15 +42,23 @@ import signal
 import threading
 from types import FrameType, TracebackType
 
+# the C function behind signal.getsignal, without its conversion to an enum: 10 ns
+# against 1.5 us a call (the handlers are compared by identity: the same either way)
+try:
+    from _signal import getsignal as _getsignal
+except ImportError:  # pragma: no cover - (another Python: the public one)
+    _getsignal = signal.getsignal
+
 __all__ = ["HELD", "CtrlCHeld"]
 
 _thread = threading.get_ident
+_SIGINT = signal.SIGINT
 
 
 class CtrlCHeld:
     """A Ctrl-C held within (``with``), raised as it is left (see the module)."""
 
-    __slots__ = ("_main", "_ours", "depth", "pending")
+    __slots__ = ("_handler", "_main", "depth", "pending")
 
     def __init__(self) -> None:
         #: how deep the main thread is within
@@ -57,12 +66,12 @@ class CtrlCHeld:
         #: a Ctrl-C within, to raise as it is left
         self.pending = False
         self._main = threading.main_thread().ident
-        self._ours = False  # (the SIGINT handler is this one's)
+        self._handler = self._on_sigint  # (one bound method: installed, and looked for)
 
     def __enter__(self) -> CtrlCHeld:
         if _thread() == self._main:
-            if not self._ours:
-                self._install()
+            if _getsignal(_SIGINT) is not self._handler:  # (looked at each time: Python's
+                self._install()  # default may have been put back, as Jupyter does per cell)
             self.depth += 1
         return self
 
@@ -91,12 +100,11 @@ class CtrlCHeld:
 
     def _install(self) -> None:
         """This one's handler for SIGINT where Python's default is (the main thread)."""
-        try:
-            if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-                signal.signal(signal.SIGINT, self._on_sigint)
-                self._ours = True
-        except ValueError:  # pragma: no cover - (not the main interpreter)
-            self._ours = True
+        if _getsignal(_SIGINT) is signal.default_int_handler:
+            try:
+                signal.signal(_SIGINT, self._handler)
+            except ValueError:  # pragma: no cover - (not the main interpreter)
+                pass
 
 
 #: the one :class:`CtrlCHeld` the drivers enter
