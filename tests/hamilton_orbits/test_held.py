@@ -276,9 +276,9 @@ def test_python_s_default_handler_put_back_is_replaced_again(monkeypatch):
     once.integrate(12.0)  # (the held handler installed)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # (a new cell)
     try:
-        calls = []
+        calls, real = [], getattr(kernels, names[1])
 
-        def kernel(*args, real=getattr(kernels, names[1])):
+        def kernel(*args):
             out = real(*args)
             calls.append(1)
             if len(calls) == 3:
