@@ -301,3 +301,23 @@ def test_command_lines_that_would_lose_a_value_are_refused(capsys):
     assert "'duration' is varied twice" in capsys.readouterr().err
     assert main(["run", "leo-j2", "--out", ""]) == 2
     assert "--out '': an empty path" in capsys.readouterr().err
+
+
+def test_a_ctrl_c_during_the_cross_check_keeps_the_finished_run(tmp_path, monkeypatch,
+                                                                capsys):
+    """rebound takes Ctrl-C over while it integrates (its own KeyboardInterrupt, past
+    the command line's handler): a Ctrl-C during the cross-check of a finished run
+    threw the whole run away (exit 130, no file written).  The run's files are
+    written, the cross-check said skipped, and the exit is 130."""
+    import hamilton_orbits
+
+    def interrupted(*args, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(hamilton_orbits, "crosscheck", interrupted)
+    out = tmp_path / "out"
+    code = main(["run", "comet-encounter", "--out", str(out), "--set", "duration=5 d",
+                 "--set", "cadence=1 d", "--set", "crosscheck=true", "--no-progress"])
+    printed = capsys.readouterr().out
+    assert code == 130 and "skipped: interrupted (Ctrl-C)" in printed
+    assert (out / "states.nc").exists() and (out / "summary.md").exists()

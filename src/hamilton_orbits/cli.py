@@ -318,7 +318,8 @@ def _finish(scene, result, folder, archive) -> int:
     if not result.complete and archive is not None:
         print(f"the run was interrupted; its archive is {archive}/: continue it with "
               f"hamilton-orbits resume {shlex.quote(str(folder))}")
-    return EXIT_OK if result.complete and not caught else EXIT_INTERRUPTED
+    done = result.complete and not caught and not getattr(result, "interrupted", False)
+    return EXIT_OK if done else EXIT_INTERRUPTED
 
 
 @contextlib.contextmanager
@@ -599,9 +600,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _guarded(args: argparse.Namespace) -> int:
     """Run the command; every error becomes one line on stderr and an exit code."""
-    from hamilton_orbits._outdir import FolderError
-    from hamilton_orbits.scene import SceneError
-
+    try:  # (a Ctrl-C as the package is imported: one line too)
+        from hamilton_orbits._outdir import FolderError
+        from hamilton_orbits.scene import SceneError
+    except KeyboardInterrupt:
+        _error("interrupted (Ctrl-C)")
+        return EXIT_INTERRUPTED
     try:
         return _dispatch(args)
     except SceneError as exc:  # every problem, with file, line and key

@@ -37,6 +37,9 @@ class Result:
         Arrays to save (``names``, ``r``, ``v`` for n-body scenes).
     complete : bool
         False if the run was stopped early (Ctrl-C); what was done is kept.
+    interrupted : bool
+        True if a Ctrl-C cut what followed a complete run (the cross-check against
+        rebound, then skipped); the run's results are kept.
     frame : str
         The axes of the states (and their origin), named in the summary.
     wall_time : float
@@ -68,6 +71,7 @@ class Result:
     wall_time: float = 0.0
     resumed_from: Any = None
     complete: bool = True
+    interrupted: bool = False
     frame: str = ""
     compile_time: float = 0.0
     compile_count: int = 0

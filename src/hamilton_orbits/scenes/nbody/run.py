@@ -246,7 +246,13 @@ def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> No
             f"skipped: events changed the bodies ({', '.join(dict.fromkeys(changed))}), "
             "which rebound's run of the starting state does not")
         return
-    table = crosscheck(system, None, method=traj.method, effects=effects, trajectory=traj)
+    try:
+        table = crosscheck(system, None, method=traj.method, effects=effects, trajectory=traj)
+    except KeyboardInterrupt:  # (rebound takes Ctrl-C over while it runs, whatever handler
+        # was set: the run is done and kept, the cross-check skipped)
+        result.metrics["cross-check against rebound"] = "skipped: interrupted (Ctrl-C)"
+        result.interrupted = True
+        return
     result.tables["cross-check against rebound: final position difference"] = table.rows
     result.tables["cross-check against rebound: codes"] = table.code_rows
     result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
