@@ -302,10 +302,14 @@ class Simulation(Saving):
             For bad times, or a lost state (a collision or a step too long).
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
-            the state reached, its time and step count with it: continued, it gives
-            the bits of the run never interrupted), unless ``on_interrupt="keep"``.
-            A Ctrl-C during a compiled call is held until its steps are counted
-            (``hamilton_orbits.integrators._held``); a second is raised at once.
+            the state reached, its time and step count with it), unless
+            ``on_interrupt="keep"``.  Continued, radau15 gives the bits of the run
+            never interrupted; the fixed-step methods too, but for the last step of
+            the output interval the Ctrl-C cut, laid again from the time reached
+            (the same bits where ``dt`` is a power of two); dop853 begins its own
+            steps there.  A Ctrl-C during a compiled call is held until its steps
+            are counted and its event acted on (``hamilton_orbits.integrators.
+            _held``); a second is raised at once.
         """
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
