@@ -308,8 +308,8 @@ class Simulation(Saving):
             the output interval the Ctrl-C cut, laid again from the time reached
             (the same bits where ``dt`` is a power of two); dop853 begins its own
             steps there.  A Ctrl-C during a compiled call is held until its steps
-            are counted and its event acted on (``hamilton_orbits.integrators.
-            _held``); a second is raised at once.
+            are counted and its event acted on (the drivers' ``_held``); a second
+            is raised at once.
         """
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
