@@ -115,3 +115,31 @@ def test_ensemble_command_table_fits_a_terminal(tmp_path, capsys):
     assert max(len(line) for line in table.splitlines()) <= 100
     assert "None" not in table and "error" not in table.split("\n", 1)[0]
     assert "the same for every member:\n  exact flip interval" in table
+
+
+def test_a_ctrl_c_ends_a_serial_ensemble(monkeypatch):
+    """A member run in this process keeps what it reached on Ctrl-C (as a scene's run
+    does): a serial ensemble then took the cut member as a row (``complete`` False,
+    its metrics from part of the run, no error) and ran the next ones.  The Ctrl-C
+    ends the ensemble, as it does a pool of workers."""
+    import signal
+
+    from hamilton_orbits._kernels import radau15 as kernels
+
+    calls = []
+
+    def wrapped(real):
+        def kernel(*args):
+            out = real(*args)
+            calls.append(1)
+            if len(calls) == 3:  # (in the first member: Python's handler, as CPython runs
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)  # it after the call)
+            return out
+        return kernel
+
+    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9}] * 3)
+    for name in ("advance", "advance_watched"):
+        monkeypatch.setattr(kernels, name, wrapped(getattr(kernels, name)))
+    with pytest.raises(KeyboardInterrupt):
+        ens.run(progress=False, workers=1)
+    assert len(calls) == 3  # (no member after it ran)
