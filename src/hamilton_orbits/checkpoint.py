@@ -368,7 +368,8 @@ class ArchiveWriter:
         #: if it is there as it was left
         self.parked: SegmentWriter | None = None
         #: the number of the snapshot a simulation loaded from the folder stands at,
-        #: until this writer has written (:meth:`_gone_on`)
+        #: until this writer has written there (:meth:`_gone_on`: after that, its
+        #: last segment is what tells another writer's coming)
         self.loaded: int | None = None
         #: the leg of the snapshots being appended (a record's ``leg``)
         self.leg: tuple[float, ...] = NO_LEG
@@ -545,7 +546,7 @@ class ArchiveWriter:
         if self.segment is None or not self.segment.refill(t, r, v, gm, active, state,
                                                            scalars, steps, ints):
             return False
-        self.count += 1
+        self.count, self.loaded = self.count + 1, None  # (written: its own from here)
         self.last_steps, self.last_wall = steps, self.clock()
         return True
 
@@ -567,7 +568,7 @@ class ArchiveWriter:
         if "leg" not in values:
             values = {**values, "leg": self.leg, "leg_span": NO_SPAN}
         self.segment.append(values, rows)
-        self.count += 1
+        self.count, self.loaded = self.count + 1, None  # (written: its own from here)
         self.last_steps, self.last_wall = int(values["steps"]), self.clock()
 
 

@@ -1619,3 +1619,33 @@ def test_a_folder_named_as_a_segment_is_listed_damaged_and_passed_over(tmp_path)
     (folder / "segment-000030.nc").mkdir()
     assert [p.name for p, _ in Archive(folder).damaged] == ["segment-000030.nc"]
     assert Simulation.load(folder).t == 3.0
+
+
+def test_a_loaded_simulation_cut_amid_a_snapshot_goes_on_writing(tmp_path, monkeypatch):
+    """A simulation loaded from its archive and cut (Ctrl-C, a full disk) as a
+    snapshot was written had its own later snapshots taken for another writer's,
+    and was refused ("has gone on without this simulation") when continued."""
+    from hamilton_orbits import checkpoint
+
+    folder = tmp_path / "a"
+    Simulation(_disc(), method="radau15", archive=folder, every=1.0).integrate(5.0)
+    sim = Simulation.load(folder)
+    calls = []
+    for name in ("refill", "append", "write"):
+        real = getattr(checkpoint.ArchiveWriter, name)
+
+        def cut(self, *args, real=real, **kw):
+            out = real(self, *args, **kw)
+            calls.append(1)
+            if len(calls) == 3:  # (the third snapshot written, then Ctrl-C)
+                raise KeyboardInterrupt
+            return out
+
+        monkeypatch.setattr(checkpoint.ArchiveWriter, name, cut)
+    with pytest.raises(KeyboardInterrupt):
+        sim.integrate(10.0)
+    monkeypatch.undo()
+    assert 5.0 < sim.t < 10.0
+    sim.integrate(12.0)
+    times = Archive(folder).times
+    assert sim.t == 12.0 and times[-1] == 12.0 and np.all(np.diff(times) >= 0)
