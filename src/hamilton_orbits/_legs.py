@@ -63,9 +63,10 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
     if arr.ndim != 1:
         raise ValueError(f"Expected `t` to be a time or a 1-d array of times, got shape "
                          f"{arr.shape}")
-    if quantity and abs(arr[0] - t_now) <= _ROUND_TRIP * abs(t_now):
+    if quantity and unit != DAY and abs(arr[0] - t_now) <= _ROUND_TRIP * abs(t_now):
         arr[0] = t_now  # (the simulation's time given back in the caller's unit: its
-        # round trip through that unit may move it by an ulp or two, not a time of its own)
+        # round trip through that unit may move it by an ulp or two, not a time of its
+        # own; in days, the unit it is kept in, a time given is the time meant)
     if arr.size == 1:
         if arr[0] == t_now:
             raise ValueError("Expected `t` to be a nonzero end time, got 0" if t_now == 0.0
@@ -92,7 +93,9 @@ def _check_monotonic(arr: np.ndarray, t_now: float, added: int, unit: str) -> No
     if np.all(d > 0) or np.all(d < 0):
         return
     start = "0" if t_now == 0.0 else f"{t_now!r}{unit}"
-    if added and d[0] < 0 < d[1:].max(initial=-1.0):
+    rest = d[added:]
+    if added and rest.size and (np.all(rest > 0) or np.all(rest < 0)):  # (the caller's
+        # times monotonic, the first on the wrong side of the simulation's time)
         raise ValueError(f"Expected `t` to be strictly monotonic from the simulation's time "
                          f"{start}, got {float(arr[1])!r}{unit} at index 0 and "
                          f"{float(arr[2])!r}{unit} at index 1")

@@ -194,7 +194,9 @@ class Saving:
             For a missing, damaged or foreign file, naming it; for a ``number``
             the folder does not hold whole.
         """
-        path = path_of(path, "path", "a file or folder path")
+        # (absolute: the folder and file it names are read again later, a leg's rows
+        # when it is resumed, whatever directory that is done from)
+        path = path_of(path, "path", "a file or folder path").absolute()
         if number is not None and (isinstance(number, (bool, np.bool_))
                                    or not isinstance(number, (int, np.integer))):
             raise ValueError(f"Expected `number` to be a whole number (a snapshot's number), "

@@ -1649,3 +1649,22 @@ def test_a_loaded_simulation_cut_amid_a_snapshot_goes_on_writing(tmp_path, monke
     sim.integrate(12.0)
     times = Archive(folder).times
     assert sim.t == 12.0 and times[-1] == 12.0 and np.all(np.diff(times) >= 0)
+
+
+def test_a_relative_folder_loaded_resumes_from_its_own_rows(tmp_path, monkeypatch):
+    """``Simulation.load("arch")`` kept the relative folder for the leg's rows that
+    ``resume`` reads: after a change of directory, they were read from another
+    run's ``arch`` there, silently (1.8 length units off)."""
+    for name, a in (("A", 1.0), ("B", 1.3)):
+        (tmp_path / name).mkdir()
+        monkeypatch.chdir(tmp_path / name)
+        s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                    Body("earth", 3e-6, [a, 0, 0], [0, a ** -0.5, 0])])
+        whole = Simulation(s, method="wh", dt=0.01, archive="arch", every=2.0).integrate(
+            np.arange(0.0, 7.0))
+        if name == "A":
+            whole_a = whole
+    monkeypatch.chdir(tmp_path / "A")
+    again = Simulation.load("arch")  # (as after a kill: its last snapshot at t = 6)
+    monkeypatch.chdir(tmp_path / "B")
+    assert _same(again.resume().r, whole_a.r)

@@ -294,8 +294,26 @@ def test_output_times_that_turn_back_from_the_start_are_named_by_the_callers_ind
     with pytest.raises(ValueError, match=r"monotonic from the simulation's time 1.0, got 0.5 at "
                                          r"index 0 and 2.0 at index 1"):
         sim.integrate([0.5, 2.0])
-    with pytest.raises(ValueError, match=r"got 1.5 after 2.0 at index 1"):
-        sim.integrate([2.0, 1.5])
+    with pytest.raises(ValueError, match=r"from the simulation's time 1.0, got 2.0 at index 0 "
+                                         r"and 1.5 at index 1"):
+        sim.integrate([2.0, 1.5])  # (backwards from 1.0 with a first time after it)
+    sim.integrate(2.5)
+    for times, message in (([2.0, 1.0, 1.5], "got 1.5 after 1.0 at index 2"),
+                           ([2.0, 1.0, 0.5, 0.7], "got 0.7 after 0.5 at index 3")):
+        with pytest.raises(ValueError, match=message):  # (backwards, then turning: the
+            sim.integrate(times)  # first time that turns named, not the first two)
+
+
+def test_a_time_given_in_days_a_few_ulp_from_the_simulations_is_its_own():
+    """Days are the unit a Quantity system keeps its time in: a time given in days
+    went through no other unit, and is the time asked for, however near (it was
+    taken as the simulation's own, a row asked for dropped silently)."""
+    s = System.solar_system("J2000", bodies=["sun", "jupiter"])
+    sim = Simulation(s, method="wh", dt=4 * u.day)
+    sim.integrate(4096 * u.day)
+    near = 4096.000000000003
+    leg = sim.integrate([near, 4106.0] * u.day)
+    assert len(leg.t) == 3 and leg.t[1].to_value(u.day) == near
 
 
 def test_time_steps_and_state_of_a_quantity_system():
