@@ -330,8 +330,9 @@ def test_time_steps_and_state_of_a_quantity_system():
         sim.integrate(500.0)
     with pytest.raises(ValueError, match=r"Expected `t` to differ from the simulation's time"):
         sim.integrate(400 * u.day)
-    with pytest.raises(ValueError, match=r"strictly monotonic \(times after the start 400"):
-        sim.integrate([500, 450] * u.day)
+    with pytest.raises(ValueError, match=r"strictly monotonic from the simulation's time "
+                                         r"400.0 d, got 500.0 d at index 0 and 450.0 d"):
+        sim.integrate([500, 450] * u.day)  # (backwards from 400 d with a first time after)
 
 
 
