@@ -106,6 +106,16 @@ def test_held_raises_as_it_is_left_and_a_second_ctrl_c_at_once():
     assert HELD.depth == 0 and not HELD.pending
 
 
+def test_a_ctrl_c_left_pending_outside_is_not_raised_by_the_next_call(monkeypatch):
+    """A second Ctrl-C between ``__exit__``'s count and its look at ``pending`` is
+    raised at once (HELD is then at depth 0) and leaves the first's ``pending``: it
+    was raised again, stale, as the next call's HELD was left."""
+    monkeypatch.setattr(HELD, "pending", True)  # (as that second Ctrl-C leaves it)
+    with HELD:
+        pass
+    assert not HELD.pending
+
+
 def test_an_error_within_is_not_replaced_by_the_ctrl_c_held():
     with pytest.raises(ZeroDivisionError), HELD:
         HELD.interrupt()

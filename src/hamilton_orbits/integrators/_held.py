@@ -72,6 +72,8 @@ class CtrlCHeld:
         if _thread() == self._main:
             if _getsignal(_SIGINT) is not self._handler:  # (looked at each time: Python's
                 self._install()  # default may have been put back, as Jupyter does per cell)
+            if not self.depth:  # (one left by a second Ctrl-C amid __exit__, raised then)
+                self.pending = False
             self.depth += 1
         return self
 
