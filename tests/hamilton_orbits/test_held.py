@@ -308,3 +308,39 @@ def test_python_s_default_handler_put_back_is_replaced_again(monkeypatch):
         signal.signal(signal.SIGINT, previous)
     assert sim.steps == once.steps
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)
+
+
+@pytest.mark.parametrize("case", [*sorted(EVENT_CASES), "dop853"])
+def test_a_ctrl_c_in_the_call_that_finds_a_stop_is_raised(case, monkeypatch):
+    """A stop found in the call a Ctrl-C came in: the stop's ``StopAtEvent`` was
+    raised within HELD, which then let the Ctrl-C go (a run asked to raise on
+    Ctrl-C returned, stopped); the Ctrl-C is raised, the state the stop's."""
+    from hamilton_orbits._kernels import events as event_kernels
+
+    if case == "dop853":
+        options, kernels, names = dict(method="dop853"), event_kernels, ["scan_steps"]
+    else:
+        options, kernels, names = EVENT_CASES[case]
+    options = dict(options, events=[{"name": "collision", "action": "stop"}])
+    once = Simulation(_merging(), **options)
+    t_stop = float(once.integrate(3.0).t[-1])
+    pressed = []
+
+    def wrapped(real):
+        def kernel(*args):
+            out = real(*args)
+            found = (out[0] >= 0 if case == "dop853"
+                     else out[-1] == kernels.STATUS_EVENT)
+            if found and not pressed:
+                pressed.append(1)
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+            return out
+        return kernel
+
+    sim = Simulation(_merging(), **options)
+    with monkeypatch.context() as patched:
+        for name in names:
+            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+        with pytest.raises(KeyboardInterrupt):
+            sim.integrate(3.0)
+    assert pressed and sim.t == t_stop < 3.0

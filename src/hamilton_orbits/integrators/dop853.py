@@ -145,11 +145,12 @@ class _State:
             store(i, self.steps, self.y)
 
     def _step(self, solver: Any, t_out: np.ndarray, first: int,
-              scanned: Callable[[], bool] | None = None) -> bool:
+              scanned: Callable[[], Any] | None = None) -> Any:
         """One step of scipy's stepper ``solver``, its state kept as the run's, and
         ``scanned()`` (the step's events acted on: True where one did, the state then
-        its), a Ctrl-C in them held until they are done; the pace judged every 100
-        steps.  Returns what ``scanned`` does (False without it)."""
+        its, or the :class:`StopAtEvent` of a stop), a Ctrl-C in them held until they
+        are done; the pace judged every 100 steps.  Returns what ``scanned`` does
+        (False without it)."""
         t_prev = solver.t
         with HELD:
             if solver.step() is not None:
@@ -174,19 +175,22 @@ class _State:
                              atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
                 t_prev, y_prev = solver.t, solver.y.copy()
-                if self._step(solver, t_out, first, functools.partial(
-                        self._scanned, solver, t_prev, y_prev, i, store, first)):
+                acted = self._step(solver, t_out, first, functools.partial(
+                    self._scanned, solver, t_prev, y_prev, i, store, first))
+                if isinstance(acted, StopAtEvent):  # (raised out of HELD: a Ctrl-C held
+                    raise acted  # is raised first)
+                if acted:
                     solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
                                      atol=self.atol, max_step=self.max_step)
             self.t, self.y = float(t_out[i]), solver.y.copy()
             store(i, self.steps, self.y)
 
     def _scanned(self, solver: Any, t_prev: float, y_prev: np.ndarray, i: int,
-                 store: Callable[..., None], first: int) -> bool:
+                 store: Callable[..., None], first: int) -> bool | StopAtEvent:
         """The step of ``solver`` from ``t_prev`` (state ``y_prev``) scanned for events:
         True where one acted (the state then the event's, at its time: the caller
         restarts the stepper there); a stop leaves its state in output ``i`` and
-        raises :class:`StopAtEvent`."""
+        returns the :class:`StopAtEvent` to raise."""
         log, n = self.log, self.n
         if log.count[0] + len(log.watch) > log.buffer.shape[0]:
             log.drain()
@@ -204,7 +208,7 @@ class _State:
         self.y = np.concatenate((r.ravel(), v.ravel()))
         if stop:
             store(i, self.steps, self.y, reached=False)
-            raise StopAtEvent(i, self.t, self.steps - first)
+            return StopAtEvent(i, self.t, self.steps - first)
         return True
 
 

@@ -115,6 +115,17 @@ class _State:
             if on_output is not None:
                 on_output(i, self.steps - first)
 
+    def _act(self, status: int, ws: np.ndarray, row: tuple[np.ndarray, np.ndarray]) -> bool:
+        """The events' log drained, and the action of the event the kernel stopped at
+        (``status``, ``ws``) taken: True for a stop (its state then in ``row``)."""
+        log, r, v = self.log, self.r, self.v
+        log.drain()
+        if status == _k.STATUS_EVENT and log.act(int(ws[3]), float(ws[0]), r, v, self.gm):
+            row[0][:], row[1][:] = r, v
+            log.mask(row[0], row[1])
+            return True
+        return False
+
     def _interval(self, t_out: np.ndarray, i: int, stop: Callable[[], bool] | None, first: int,
                   row: tuple[np.ndarray, np.ndarray]) -> None:
         """The steps from ``t_out[i - 1]`` to ``t_out[i]``, in slices (Ctrl-C and
@@ -133,12 +144,10 @@ class _State:
                     done, status = _k.advance(*args, None, None, None, ws, SLICE)
                 self.steps += int(done)
                 t = self.t = float(ws[0])
-                if status not in (_k.STATUS_OK, _k.STATUS_SLICE):
-                    log.drain()
-                    if status == _k.STATUS_EVENT and log.act(int(ws[3]), t, r, v, self.gm):
-                        row[0][:], row[1][:] = r, v
-                        log.mask(row[0], row[1])
-                        raise StopAtEvent(i, t, self.steps - first)
+                stopped = status not in (_k.STATUS_OK, _k.STATUS_SLICE) and self._act(
+                    status, ws, row)
+            if stopped:  # (raised out of HELD: a Ctrl-C held is raised first)
+                raise StopAtEvent(i, t, self.steps - first)
             if status == _k.STATUS_OK:
                 break  # t is t_out[i], exactly
             if status == _k.STATUS_SLICE and stop is not None and stop():

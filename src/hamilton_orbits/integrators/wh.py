@@ -316,30 +316,34 @@ class _State:
                 done += steps
                 self.steps += steps
                 self.t = times[i - 1] + done * dt
+                stopped = None
                 if bad < 0 and status == _k.STATUS_DRAIN:
                     log.drain()
                 elif bad < 0 and status == _k.STATUS_EVENT:
-                    self._act(i, row, ws, first)
+                    stopped = self._act(i, row, ws, first)
             if bad >= 0:
                 raise ConvergenceError(
                     f"wh: the Kepler step of body {int(self.split.order[bad])} failed between "
                     f"t_out[{i - 1}] = {times[i - 1]!r} and t_out[{i}] = {times[i]!r}")
+            if stopped is not None:  # (raised out of HELD: a Ctrl-C held is raised first)
+                raise stopped
 
     def _act(self, i: int, row: tuple[np.ndarray, np.ndarray], ws: np.ndarray,
-             first: int) -> None:
+             first: int) -> StopAtEvent | None:
         """The action of the event in ``ws`` at the end of its step: a stop leaves the
-        state in ``row`` and raises :class:`StopAtEvent`; a merge or a removal renews
-        the split from the changed inertial state."""
+        state in ``row`` and returns the :class:`StopAtEvent` to raise; a merge or a
+        removal renews the split from the changed inertial state."""
         r_now, v_now = np.empty_like(self.split.q), np.empty_like(self.split.u)
         self.split.to_inertial(r_now, v_now)
         if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm):
             row[0][:], row[1][:] = r_now, v_now
             self.log.mask(row[0], row[1])
             self.t = float(ws[0])  # the end of the step (the split holds that state)
-            raise StopAtEvent(i, float(ws[0]), self.steps - first)
+            return StopAtEvent(i, float(ws[0]), self.steps - first)
         self.split = self.split.renewed(self.gm)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
         self.watch = self.log.kernel_watch()
+        return None
 
 
 class _Split:
