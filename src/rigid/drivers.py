@@ -38,15 +38,25 @@ def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]
     return n_steps, h, out_steps
 
 
-def _progress_chunks(n_steps: int, progress: bool):
-    """Chunk boundaries (in steps) for an optional tqdm bar; one chunk without it."""
+def _progress_chunks(n_steps: int, progress: bool, stop: Any = None):
+    """Chunk boundaries (in steps) for an optional tqdm bar, or a ``stop`` asked
+    between chunks (the same steps and bits either way); one chunk without them."""
     bar = _bar(n_steps, "step", progress)
-    if bar is None:
+    if bar is None and stop is None:
         return [0, n_steps], None
     return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
 
 
-def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress):
+def _stopped(stop: Any, b: int, n_steps: int, out_steps: np.ndarray) -> int | None:
+    """After the chunk ending at step ``b``: the number of outputs reached when
+    ``stop()`` asks the run to end there, else None."""
+    if stop is None or b >= n_steps or not stop():
+        return None
+    return int(np.searchsorted(out_steps, b, side="right"))
+
+
+def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress,
+                   stop=None):
     types, fracs, toffs, inv = split_ops(method, m, kind != _k.TORQUE_NONE)
     qh = q0.copy()
     ql = np.zeros(4)
@@ -57,7 +67,8 @@ def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progr
     l_out = np.empty((nout, 3))
     drift = 0.0
     pending = False
-    bounds, bar = _progress_chunks(n_steps, progress)
+    reached = nout
+    bounds, bar = _progress_chunks(n_steps, progress, stop)
     for a, b in itertools.pairwise(bounds):
         sel = (out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b)
         idx = np.nonzero(sel)[0]
@@ -71,18 +82,23 @@ def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progr
         l_out[idx] = lo
         if bar is not None:
             bar.update(b - a)
+        cut = _stopped(stop, b, n_steps, out_steps)
+        if cut is not None:
+            reached = cut
+            break
     if bar is not None:
         bar.close()
-    return q_out, l_out / m, drift
+    return q_out[:reached], l_out[:reached] / m, drift
 
 
-def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
+def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress, stop=None):
     quat = q0.copy()
     omega = w0.copy()
     nout = out_steps.shape[0]
     q_out = np.empty((nout, 4))
     w_out = np.empty((nout, 3))
-    bounds, bar = _progress_chunks(n_steps, progress)
+    reached = nout
+    bounds, bar = _progress_chunks(n_steps, progress, stop)
     for a, b in itertools.pairwise(bounds):
         idx = np.nonzero((out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b))[0]
         qo = np.empty((idx.size, 4))
@@ -93,9 +109,13 @@ def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress):
         w_out[idx] = wo
         if bar is not None:
             bar.update(b - a)
+        cut = _stopped(stop, b, n_steps, out_steps)
+        if cut is not None:
+            reached = cut
+            break
     if bar is not None:
         bar.close()
-    return q_out, w_out
+    return q_out[:reached], w_out[:reached]
 
 
 def _unit_rows(y: np.ndarray) -> tuple[np.ndarray, float]:
@@ -130,15 +150,19 @@ def _unit_rows(y: np.ndarray) -> tuple[np.ndarray, float]:
     return q, float(np.max(np.abs(qn - 1.0)))
 
 
-def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress):
-    """``(q, omega, count, drift)`` of a fixed-step method on the step grid."""
+def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress,
+               stop=None):
+    """``(q, omega, count, drift)`` of a fixed-step method on the step grid (the
+    splittings and ``exact_kick``: the outputs before a ``stop()`` asked between
+    chunks of steps)."""
     count = 0
     drift = 0.0
     if method in SPLITTINGS:
         q, w, drift = _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params,
-                                     progress)
+                                     progress, stop)
     elif method == "exact_kick":
-        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress)
+        q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress,
+                               stop)
     elif method == "rk4":
         y = np.empty((out_steps.size, 7))
         _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
@@ -212,13 +236,17 @@ def integrate_arrays(
     atol: Any = 1e-14,
     recentre: float = 1.0,
     progress: bool = False,
+    stop: Any = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float]:
     """Kernel-level integration on plain float arrays (no validation, no units).
 
     ``t`` is an end time (``n_out`` equally spaced outputs, default 101) or an
     increasing array of output times starting at 0.  ``dt`` is the step of the
     fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
-    (7,) for ``(q, omega)``) are DOP853's tolerances.
+    (7,) for ``(q, omega)``) are DOP853's tolerances.  ``stop()``, asked between
+    chunks of about 1% of the steps by the splittings and ``exact_kick`` (the same
+    steps and bits), ends the run there with the outputs reached (the others run
+    to the end).
 
     Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
     with unit quaternions; ``t`` the times reached; ``count`` is the number of
@@ -247,6 +275,9 @@ def integrate_arrays(
         return t_out, q, w, steps, nfev, drift
     n_steps, h, out_steps = _grid(t_arr, float(dt), n_out)
     q, w, count, drift = _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params,
-                                    recentre, progress)
+                                    recentre, progress, stop)
+    if len(q) < len(out_steps):  # (stopped: the outputs reached, the steps to the last)
+        out_steps = out_steps[:len(q)]
+        n_steps = int(out_steps[-1]) if len(q) else 0
     return out_steps * h, q, w, n_steps, count, drift
 

@@ -227,6 +227,7 @@ def integrate(
     torque: Any = None,
     progress: bool = False,
     recentre: float = 1.0,
+    stop: Any = None,
     t_end: Any = _UNSET,
     n_out: Any = _UNSET,
     rtol: Any = _UNSET,
@@ -260,6 +261,11 @@ def integrate(
         Show a tqdm progress bar (needs the ``progress`` extra).
     recentre : float, optional
         Re-centring threshold on ``|g_0|`` for ``"cayley_rk4"``.
+    stop : callable, optional
+        ``stop()``, asked between chunks of about 1% of the steps by the
+        splittings and ``"exact_kick"`` (their steps and bits unchanged): True ends
+        the run there, the trajectory then holding the outputs reached (as a
+        scene does on Ctrl-C).  The other methods run to the end.
 
     Other Parameters
     ----------------
@@ -285,7 +291,8 @@ def integrate(
         missing ``dt``, more than 1e12 steps, ``tol`` with a fixed-step method,
         ``n_out`` not an integer in [2, 1e9], a plain ``dt`` beside a Quantity
         ``t`` (or the reverse, or plain times for a body with units), an
-        unsupported torque or one beyond float64 beside the moments, an angle
+        unsupported torque or one beyond float64 beside the moments, a ``stop``
+        that is not callable, an angle
         turned ``t |omega|`` beyond float64, or a run whose state leaves float64
         (a step far too long for the method: naming ``dt``).
     hamilton_orbits.validation.ConvergenceError
@@ -322,6 +329,8 @@ def integrate(
     _ = (si.kinetic_energy, si.angular_momentum_norm)
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
+    if stop is not None and not callable(stop):
+        raise ValueError(f"Expected `stop` to be callable or None, got {stop!r}")
     quantity = call_units(body, ("t", "dt"), (t, dt))
     times = _output_times(TIME("t", t))
     dtf = _step(method, dt, float(times.max()), tol)
@@ -337,7 +346,7 @@ def integrate(
                 moments, si.attitude, si.omega / sw, times * sw, method=method,
                 dt=None if dtf is None else dtf * sw, n_out=n_out, kind=kind,
                 params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
-                progress=progress,
+                progress=progress, stop=stop,
             )
     except ZeroDivisionError:  # a kernel's state left float64 (its norm 0 or inf)
         raise _failed(method, dtf, "a division by zero in the kernel") from None

@@ -136,7 +136,9 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         kw["dt"] = integ["dt"].to(u.s)
     compiled = compile_seconds()
     start = time.perf_counter()
-    traj = integrate(body, np.linspace(0.0 * duration, duration, n_out), **kw)
+    traj = integrate(body, np.linspace(0.0 * duration, duration, n_out), stop=stop, **kw)
+    if len(traj.t) < 2:  # (stopped before its first output: nothing to keep)
+        raise KeyboardInterrupt
     # the integration proper: the kernels' first-run compilation is reported apart
     wall = time.perf_counter() - start - (compile_seconds() - compiled)
     t = traj.t.to(u.s) if isinstance(traj.t, u.Quantity) else traj.t * u.s
@@ -160,6 +162,7 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         states={"omega": omega * u.rad / u.s,
                 "attitude": traj.attitude.as_array()},
         wall_time=wall,
+        complete=len(t) == n_out,
     )
     result.metrics["integrator"] = integ["method"]
     result.metrics["max attitude error vs exact"] = np.max(diag["attitude_error"]).to(u.rad)

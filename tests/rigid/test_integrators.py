@@ -377,3 +377,28 @@ def test_deprecated_keywords_refuse_a_mix_with_the_new_ones():
     with pytest.warns(DeprecationWarning), pytest.raises(
             ValueError, match=r"`n_out` to be an integer in \[2, 1e9\], got 1"):
         integrate(BODY, 1.0, dt=0.1, n_out=1)
+
+
+@pytest.mark.parametrize("method", ["splitting4", "exact_kick"])
+def test_stop_ends_a_run_between_chunks_with_the_outputs_reached(method):
+    """``stop()`` is asked between chunks of about 1% of the steps: never true, the
+    run is the one without it, bit for bit; true after the tenth look, the run ends
+    there with the outputs reached, each the whole run's."""
+    b = RigidBody([1.0, 2.0, 3.0], omega=[0.1, 1.0, 0.1])
+    t = np.linspace(0.0, 50.0, 41)
+    whole = integrate(b, t, dt=0.01, method=method)
+    looks = []
+    same = integrate(b, t, dt=0.01, method=method, stop=lambda: looks.append(1) and False)
+    assert len(looks) == 99  # (100 chunks: no look after the last)
+    np.testing.assert_array_equal(same.omega, whole.omega)
+    np.testing.assert_array_equal(same.attitude.as_array(), whole.attitude.as_array())
+    looks.clear()
+    cut = integrate(b, t, dt=0.01, method=method,
+                    stop=lambda: len(looks.append(1) or looks) >= 10)
+    n = len(cut.t)
+    assert 2 <= n < len(t) and len(looks) == 10
+    np.testing.assert_array_equal(cut.t, whole.t[:n])
+    np.testing.assert_array_equal(cut.omega, whole.omega[:n])
+    np.testing.assert_array_equal(cut.attitude.as_array(), whole.attitude.as_array()[:n])
+    with pytest.raises(ValueError, match=r"Expected `stop` to be callable or None, got 3"):
+        integrate(b, t, dt=0.01, method=method, stop=3)

@@ -57,3 +57,15 @@ def test_a_body_or_effects_the_run_would_refuse_fail_at_loading(scene, values, p
 
     with pytest.raises(SceneError, match=pattern):
         Scene.bundled(scene).with_values(values)
+
+
+def test_a_rotation_scene_stops_when_asked_and_keeps_what_it_reached():
+    """The command line's first Ctrl-C asks the run to stop (``stop()``); a rotation
+    scene ignored it, said it was stopping, ran to its end and exited 0."""
+    scene = Scene.bundled("dzhanibekov").with_values({"duration": "30 s"})
+    looks = []
+    result = scene.run(progress=False, stop=lambda: len(looks.append(1) or looks) >= 20)
+    whole = scene.run(progress=False)
+    n = len(result.times)
+    assert not result.complete and whole.complete and 2 <= n < len(whole.times)
+    np.testing.assert_array_equal(result.states["omega"], whole.states["omega"][:n])
