@@ -34,6 +34,36 @@ from hamilton_orbits.integrators._held import HELD
 DT = 1 / 64  # (a power of two: the slices' times t0 + k dt are exact)
 
 
+def _pressing(real, when):
+    """``real`` wrapped so that after a call whose result ``when(out)`` picks,
+    Python's SIGINT handler runs, as CPython runs it as a compiled call returns
+    (what the handler then does is the package's)."""
+    def wrapper(*args):
+        out = real(*args)
+        if when(out):
+            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+        return out
+    return wrapper
+
+
+def _nth(n, calls):
+    """A ``when`` of :func:`_pressing` picking the ``n``-th call (counted in ``calls``)."""
+    def when(out):
+        calls.append(1)
+        return len(calls) == n
+    return when
+
+
+def _first(found, pressed):
+    """A ``when`` picking the first call whose result ``found(out)`` picks."""
+    def when(out):
+        if found(out) and not pressed:
+            pressed.append(1)
+            return True
+        return False
+    return when
+
+
 def _planets(n: int = 4) -> System:
     rng = np.random.default_rng(5)
     bodies = [Body("star", 1.0, [0, 0, 0], [0, 0, 0])]
@@ -71,20 +101,10 @@ def test_a_ctrl_c_in_a_compiled_call_keeps_a_state_that_continues_bit_for_bit(ca
     once = Simulation(_planets(), **options)  # the same in both runs)
     once.integrate(12.0)
     calls = []
-
-    def wrapped(real):
-        def kernel(*args):
-            out = real(*args)
-            calls.append(1)
-            if len(calls) == 3:  # (mid-leg: the Python handler, as CPython runs it here)
-                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
-            return out
-        return kernel
-
     sim = Simulation(_planets(), **options)
     with monkeypatch.context() as patched:
-        for name in names:
-            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+        for name in names:  # (Ctrl-C in the third call: mid-leg)
+            patched.setattr(kernels, name, _pressing(getattr(kernels, name), _nth(3, calls)))
         cut = sim.integrate(8.0, on_interrupt="keep")
     assert len(calls) == 3 and not cut.complete
     assert 0.0 < sim.t < 8.0  # (the state reached between outputs is the one kept)
@@ -225,20 +245,11 @@ def test_a_ctrl_c_in_the_call_that_finds_a_merge_leaves_it_done(case, monkeypatc
     once = Simulation(_merging(), **options)
     whole = once.integrate(3.0)
     pressed = []
-
-    def wrapped(real):
-        def kernel(*args):
-            out = real(*args)
-            if out[-1] == kernels.STATUS_EVENT and not pressed:  # (the event's call)
-                pressed.append(1)
-                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
-            return out
-        return kernel
-
+    at_event = _first(lambda out: out[-1] == kernels.STATUS_EVENT, pressed)
     sim = Simulation(_merging(), **options)
     with monkeypatch.context() as patched:
         for name in names:
-            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+            patched.setattr(kernels, name, _pressing(getattr(kernels, name), at_event))
         cut = sim.integrate(3.0, on_interrupt="keep")
     assert pressed and not cut.complete and len(cut.events) == 1
     assert len(sim.system.names) == 2  # (merged: a + b, and c)
@@ -257,17 +268,10 @@ def test_a_ctrl_c_in_a_dop853_step_that_holds_an_event_leaves_it_found(monkeypat
     options = dict(method="dop853", events=[{"name": "collision", "action": "merge"}])
     once = Simulation(_merging(), **options)
     once.integrate(3.0)
-    real, pressed = event_kernels.scan_steps, []
-
-    def scan(*args):
-        out = real(*args)
-        if out[0] >= 0 and not pressed:  # (the step holding the event)
-            pressed.append(1)
-            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
-        return out
-
+    pressed = []
+    scan = _pressing(event_kernels.scan_steps, _first(lambda out: out[0] >= 0, pressed))
     sim = Simulation(_merging(), **options)
-    with monkeypatch.context() as patched:
+    with monkeypatch.context() as patched:  # (Ctrl-C in the step holding the event)
         patched.setattr(event_kernels, "scan_steps", scan)
         cut = sim.integrate(3.0, on_interrupt="keep")
     assert pressed and not cut.complete and len(cut.events) == 1
@@ -289,15 +293,8 @@ def test_python_s_default_handler_put_back_is_replaced_again(monkeypatch):
     once.integrate(12.0)  # (the held handler installed)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # (a new cell)
     try:
-        calls, real = [], getattr(kernels, names[1])
-
-        def kernel(*args):
-            out = real(*args)
-            calls.append(1)
-            if len(calls) == 3:
-                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
-            return out
-
+        calls = []
+        kernel = _pressing(getattr(kernels, names[1]), _nth(3, calls))
         sim = Simulation(_planets(), **options)
         with monkeypatch.context() as patched:
             patched.setattr(kernels, names[1], kernel)
@@ -325,22 +322,12 @@ def test_a_ctrl_c_in_the_call_that_finds_a_stop_is_raised(case, monkeypatch):
     once = Simulation(_merging(), **options)
     t_stop = float(once.integrate(3.0).t[-1])
     pressed = []
-
-    def wrapped(real):
-        def kernel(*args):
-            out = real(*args)
-            found = (out[0] >= 0 if case == "dop853"
-                     else out[-1] == kernels.STATUS_EVENT)
-            if found and not pressed:
-                pressed.append(1)
-                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
-            return out
-        return kernel
-
+    at_event = _first((lambda out: out[0] >= 0) if case == "dop853" else
+                      (lambda out: out[-1] == kernels.STATUS_EVENT), pressed)
     sim = Simulation(_merging(), **options)
     with monkeypatch.context() as patched:
         for name in names:
-            patched.setattr(kernels, name, wrapped(getattr(kernels, name)))
+            patched.setattr(kernels, name, _pressing(getattr(kernels, name), at_event))
         with pytest.raises(KeyboardInterrupt):
             sim.integrate(3.0)
     assert pressed and sim.t == t_stop < 3.0
