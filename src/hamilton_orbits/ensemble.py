@@ -229,10 +229,15 @@ class Ensemble:
                 else:
                     pool = _pool(n, ProcessPoolExecutor, mp)
                     futs = {pool.submit(run_member, *a): i for i, a in enumerate(args)}
-                    for fut in as_completed(futs):
-                        rows[futs[fut]] = fut.result()
-                        if bar is not None:
-                            bar.update(1)
+                    try:
+                        for fut in as_completed(futs):
+                            rows[futs[fut]] = fut.result()
+                            if bar is not None:
+                                bar.update(1)
+                    except BaseException:  # (Ctrl-C, a worker lost: the members not
+                        for fut in futs:  # begun are not run for nothing, the pool's
+                            fut.cancel()  # workers left for the next ensemble)
+                        raise
         finally:
             if bar is not None:
                 bar.close()

@@ -143,3 +143,30 @@ def test_a_ctrl_c_ends_a_serial_ensemble(monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         ens.run(progress=False, workers=1)
     assert len(calls) == 3  # (no member after it ran)
+
+
+def test_a_ctrl_c_cancels_the_members_a_pool_has_not_begun(monkeypatch):
+    """A Ctrl-C in a pool's ensemble left its other members queued: the workers ran
+    them all for nothing, and the next ensemble waited behind them."""
+    import concurrent.futures
+    import threading
+
+    from hamilton_orbits import ensemble
+
+    ran, lock = [], threading.Lock()
+
+    def member(data, source, values):
+        with lock:
+            ran.append(values)
+        if len(ran) == 1:
+            raise KeyboardInterrupt  # (as the first member's worker sees the Ctrl-C)
+        return {"error": None, "complete": True}
+
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+    monkeypatch.setattr(ensemble, "run_member", member)
+    monkeypatch.setattr(ensemble, "_pool", lambda n, executor, mp: pool)
+    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9}] * 10)
+    with pytest.raises(KeyboardInterrupt):
+        ens.run(progress=False, workers=2)
+    pool.shutdown(wait=True)
+    assert len(ran) <= 2  # (the first, and at most the one the worker had taken)

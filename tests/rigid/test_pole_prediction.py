@@ -501,3 +501,17 @@ def test_a_scene_of_no_period_draws_its_fan_and_saves_every_file(tmp_path):
         progress=False)
     names = {p.name for p in result.save(tmp_path)}
     assert {"summary.md", "summary.json"} <= names and any(n.endswith(".png") for n in names)
+
+
+def test_a_pole_prediction_stopped_between_periods_says_it_is_incomplete():
+    """A Ctrl-C (``stop()``) ends the hindcast after the period it is in: the rest
+    were dropped from every file with the result saying it was complete (exit 0)."""
+    from hamilton_orbits import Scene
+
+    scene = Scene.bundled("pole-prediction").with_values({
+        "periods": '["2016-01-01..2016-02-01", "2017-01-01..2017-02-01"]',
+        "methods": '["persistence"]'})
+    stopped = scene.run(progress=False, stop=lambda: True)
+    assert not stopped.complete and len([k for k in stopped.metrics if
+                                         k.startswith("hindcast ")]) == 1
+    assert scene.run(progress=False).complete

@@ -153,7 +153,9 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         if stop():
             break
     wall = time.perf_counter() - begin
-    result = Result(scene=scene, times=dense, wall_time=wall)
+    result = Result(scene=scene, times=dense, wall_time=wall,
+                    complete=len(scores) == len(spec["periods"]))  # (stopped: the periods
+    # hindcast kept, the run said incomplete)
     for i, by_method in enumerate(scores.values()):  # the MAE curves, saved to states.nc
         for method, score in by_method.items():
             key = method.replace("+", "_")
