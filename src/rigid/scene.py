@@ -188,12 +188,29 @@ def _flip_time(result: Result, omega: np.ndarray, t: u.Quantity, par) -> None:
     crossings = ts[k] - w2[k] * (ts[k + 1] - ts[k]) / (w2[k + 1] - w2[k])
     flip = u.Quantity(par.flip_interval, u.s)  # a Quantity for Quantity bodies, else SI
     result.metrics["exact flip interval 2K(m)/lambda"] = flip
+    if _too_sparse(result, "simulated flip interval", ts, flip.to_value(u.s), "flips", "s"):
+        return
     if crossings.size >= 2:
         measured = np.mean(np.diff(crossings))
         result.metrics["simulated flip interval"] = measured * u.s
         result.metrics["relative difference"] = float(measured / flip.to_value(u.s) - 1.0)
     else:
         result.metrics["simulated flip interval"] = "fewer than two flips in the run"
+
+
+def _too_sparse(result: Result, name: str, ts: np.ndarray, interval: float, what: str,
+                unit: str) -> bool:
+    """Whether outputs at times ``ts`` are too far apart to time sign changes
+    ``interval`` apart (both in ``unit``) by their zero crossings: more than a
+    quarter of it (they alias: a run right to 1e-7 rad gave a flip interval 100% to
+    880% off); the metric ``name`` then says so."""
+    gap = float(np.max(np.diff(ts))) if ts.size > 1 else 0.0
+    if not gap > interval / 4:
+        return False
+    result.metrics[name] = (f"outputs {gap:.6g} {unit} apart cannot time {what} "
+                            f"{interval:.6g} {unit} apart (give a cadence of at most a "
+                            f"quarter of it)")
+    return True
 
 
 def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) -> None:
@@ -204,6 +221,9 @@ def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) 
     not advance uniformly, but it crosses each axis once per period.
     """
     ts = t.to_value(u.d)
+    period = u.Quantity(par.period, u.s).to_value(u.d)
+    if _too_sparse(result, "simulated wobble period", ts, period, "turns", "d"):
+        return
     w1 = omega[:, 0]
     k = np.flatnonzero((w1[:-1] < 0) & (w1[1:] >= 0))
     if k.size < 2:

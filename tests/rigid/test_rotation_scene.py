@@ -1,5 +1,7 @@
 """The rotation scene kind (registered by rigid) and its bundled scenes."""
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -69,3 +71,13 @@ def test_a_rotation_scene_stops_when_asked_and_keeps_what_it_reached():
     n = len(result.times)
     assert not result.complete and whole.complete and 2 <= n < len(whole.times)
     np.testing.assert_array_equal(result.states["omega"], whole.states["omega"][:n])
+
+
+def test_a_flip_interval_the_outputs_cannot_resolve_is_said_so():
+    """Outputs 20 s apart for flips 15 s apart: the zero crossings alias, and the
+    summary gave a flip interval 101% off (880% with 100 s) for a run right to
+    1e-7 rad, without a word."""
+    scene = Scene.bundled("dzhanibekov").with_values({"duration": "400 s", "cadence": "20 s"})
+    said = scene.run(progress=False).metrics["simulated flip interval"]
+    assert isinstance(said, str) and re.match(
+        r"outputs 20 s apart cannot time flips 14.966 s apart", said), said
