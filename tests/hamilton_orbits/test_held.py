@@ -331,3 +331,28 @@ def test_a_ctrl_c_in_the_call_that_finds_a_stop_is_raised(case, monkeypatch):
         with pytest.raises(KeyboardInterrupt):
             sim.integrate(3.0)
     assert pressed and sim.t == t_stop < 3.0
+
+
+@pytest.mark.parametrize("how", ["ctrl-c", "stop"])
+def test_wh_cut_mid_interval_goes_on_with_the_bits_of_the_run_never_cut(how, monkeypatch):
+    """A step not a power of two (0.01): the leg going on from a cut laid the cut
+    interval's steps again from the time reached, its last step rounded otherwise
+    (the run never cut's bits lost).  It lays them from the interval's start."""
+    options = dict(method="wh", dt=0.01)
+    monkeypatch.setattr(wh, "SLICE", 1000)
+    once = Simulation(_planets(), **options)
+    once.integrate(100.0)
+    sim = Simulation(_planets(), **options)
+    if how == "stop":
+        looks = []
+        cut = sim.integrate(100.0, stop=lambda: len(looks.append(1) or looks) >= 3,
+                            on_interrupt="keep")
+    else:
+        with monkeypatch.context() as patched:
+            patched.setattr(wh_kernels, "advance_dh_few",
+                            _pressing(wh_kernels.advance_dh_few, _nth(3, [])))
+            cut = sim.integrate(100.0, on_interrupt="keep")
+    assert not cut.complete and 0.0 < sim.t < 100.0
+    sim.integrate(100.0)
+    assert sim.steps == once.steps
+    np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)

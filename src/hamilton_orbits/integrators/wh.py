@@ -244,6 +244,11 @@ class _State:
     """The map's state between calls: the splitting (its coordinates and compiled
     steps), the events log and the masses (merges change them)."""
 
+    #: not saved: where the interval a Ctrl-C or ``stop()`` cut began and the steps
+    #: taken in it, so that the leg going on from there in this process lays its
+    #: steps as the run never cut does (a loaded one lays them from its time)
+    RESTART_SCRATCH = ("cut",)
+
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  method: WH, dt: float, events: EventLog | None) -> None:
         n = r0.shape[0]
@@ -263,6 +268,7 @@ class _State:
         self.ws = np.array([t0, np.inf, 0.0, -1.0])  # the events' work space of the kernels
         # (see _drift; only ws[0], the clock, is used when no event is watched)
         self.dt, self.max_steps, self.t, self.steps = dt, method.max_steps, t0, 0
+        self.cut: tuple[float, int] | None = None
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The current inertial positions, velocities and ``G m`` (copies)."""
@@ -299,13 +305,13 @@ class _State:
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
         dt, log, ws = self.dt, self.log, self.ws
-        n_steps, last = _setup.fixed_steps(times[i] - times[i - 1], dt)
+        origin, done = self._origin(i, times)
+        n_steps, last = _setup.fixed_steps(times[i] - origin, dt)
         watched = self.watch.shape[0] > 0
-        done = 0
         while done < n_steps:
             if done and stop is not None and stop():
                 raise StopIntegration
-            ws[0] = times[i - 1] + done * dt
+            ws[0] = origin + done * dt
             if watched:  # (the events' part of the work space: see _drift)
                 ws[1], ws[2], ws[3] = np.inf, 0.0, -1.0
             n_call = min(n_steps - done, SLICE)
@@ -315,7 +321,8 @@ class _State:
                     log.buffer, log.count, ws)
                 done += steps
                 self.steps += steps
-                self.t = times[i - 1] + done * dt
+                self.t = origin + done * dt
+                self.cut = (origin, done) if done < n_steps else None
                 stopped = None
                 if bad < 0 and status == _k.STATUS_DRAIN:
                     log.drain()
@@ -328,6 +335,17 @@ class _State:
             if stopped is not None:  # (raised out of HELD: a Ctrl-C held is raised first)
                 raise stopped
 
+    def _origin(self, i: int, times: list[float]) -> tuple[float, int]:
+        """Where the steps to ``times[i]`` are laid from, and how many are taken: from
+        ``times[i - 1]``, none; but for a leg's first interval going on from where a
+        Ctrl-C or ``stop()`` cut one (:attr:`cut`), from that one's start, its steps
+        taken, so that its last step is the one the run never cut takes."""
+        cut, self.cut = self.cut, None
+        if cut is not None and i == 1 and cut[0] + cut[1] * self.dt == times[0]:
+            if _setup.fixed_steps(times[1] - cut[0], self.dt)[0] > cut[1]:
+                return cut
+        return times[i - 1], 0
+
     def _act(self, i: int, row: tuple[np.ndarray, np.ndarray], ws: np.ndarray,
              first: int) -> StopAtEvent | None:
         """The action of the event in ``ws`` at the end of its step: a stop leaves the
@@ -339,6 +357,7 @@ class _State:
             row[0][:], row[1][:] = r_now, v_now
             self.log.mask(row[0], row[1])
             self.t = float(ws[0])  # the end of the step (the split holds that state)
+            self.cut = None  # (a stop ends the call: the next lays its steps afresh)
             return StopAtEvent(i, float(ws[0]), self.steps - first)
         self.split = self.split.renewed(self.gm)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
