@@ -303,13 +303,11 @@ class Simulation(Saving):
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
             the state reached, its time and step count with it), unless
-            ``on_interrupt="keep"``.  Continued, radau15 and wh give the bits of the
-            run never interrupted (wh laying the cut interval's steps from its
-            start, as after a ``stop()``; in this process: loaded from a file saved
-            then, from the time reached); leapfrog and double-double radau15 too,
-            but for the cut interval's last step, laid again from the time reached
-            (the same bits where ``dt`` is a power of two); dop853 begins its own
-            steps there.  A Ctrl-C during a compiled call is held until its steps
+            ``on_interrupt="keep"``.  Continued, every method but dop853 gives the
+            bits of the run never interrupted (the fixed steps laid from the cut
+            interval's start, as after a ``stop()``, in this process; a simulation
+            saved then and loaded lays them from the time reached); dop853 begins
+            its own steps there.  A Ctrl-C during a compiled call is held until its steps
             are counted and its event acted on (the drivers' ``_held``); a second
             is raised at once.
         """

@@ -333,26 +333,34 @@ def test_a_ctrl_c_in_the_call_that_finds_a_stop_is_raised(case, monkeypatch):
     assert pressed and sim.t == t_stop < 3.0
 
 
-@pytest.mark.parametrize("how", ["ctrl-c", "stop"])
-def test_wh_cut_mid_interval_goes_on_with_the_bits_of_the_run_never_cut(how, monkeypatch):
+@pytest.mark.parametrize(("method", "how"), [("wh", "ctrl-c"), ("wh", "stop"),
+                                           ("radau15-dd", "ctrl-c")])
+def test_a_cut_mid_interval_goes_on_with_the_bits_of_the_run_never_cut(method, how,
+                                                                       monkeypatch):
     """A step not a power of two (0.01): the leg going on from a cut laid the cut
     interval's steps again from the time reached, its last step rounded otherwise
     (the run never cut's bits lost).  It lays them from the interval's start."""
-    options = dict(method="wh", dt=0.01)
-    monkeypatch.setattr(wh, "SLICE", 1000)
+    if method == "wh":
+        options, kernels, name, end = dict(method="wh", dt=0.01), wh_kernels, \
+            "advance_dh_few", 100.0
+        monkeypatch.setattr(wh, "SLICE", 1000)
+    else:
+        options, kernels, name, end = dict(method="radau15", dt=0.01,
+                                           precision="double-double"), radau15_dd, \
+            "advance", 2.0
+        monkeypatch.setattr(radau15, "SLICE", 2000)  # (slices of 20 steps)
     once = Simulation(_planets(), **options)
-    once.integrate(100.0)
+    once.integrate(end)
     sim = Simulation(_planets(), **options)
     if how == "stop":
         looks = []
-        cut = sim.integrate(100.0, stop=lambda: len(looks.append(1) or looks) >= 3,
+        cut = sim.integrate(end, stop=lambda: len(looks.append(1) or looks) >= 3,
                             on_interrupt="keep")
     else:
         with monkeypatch.context() as patched:
-            patched.setattr(wh_kernels, "advance_dh_few",
-                            _pressing(wh_kernels.advance_dh_few, _nth(3, [])))
-            cut = sim.integrate(100.0, on_interrupt="keep")
-    assert not cut.complete and 0.0 < sim.t < 100.0
-    sim.integrate(100.0)
+            patched.setattr(kernels, name, _pressing(getattr(kernels, name), _nth(3, [])))
+            cut = sim.integrate(end, on_interrupt="keep")
+    assert not cut.complete and 0.0 < sim.t < end
+    sim.integrate(end)
     assert sim.steps == once.steps
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)

@@ -349,6 +349,28 @@ def fixed_steps(span: float, dt: float) -> tuple[int, float]:
     n = max(1, math.ceil(span / dt * (1.0 - 1e-12)))
     return n, span - (n - 1) * dt
 
+
+def interval_origin(cut: tuple[float, int] | None, i: int, times: Any,
+                    dt: float) -> tuple[float, int]:
+    """Where a fixed-step method lays the steps to ``times[i]`` from, and how many
+    are taken: from ``times[i - 1]``, none; but for a leg's first interval going on
+    from where a Ctrl-C or ``stop()`` cut one (``cut``: that interval's start and
+    its steps taken, the leg's start ``times[0]`` their end), from that interval's
+    start, its steps taken, so that the last step is the one the run never cut
+    takes (laid from the time reached, it is rounded otherwise).
+
+    Examples
+    --------
+    >>> interval_origin((0.0, 3), 1, [0.30000000000000004, 1.0], 0.1)
+    (0.0, 3)
+    >>> interval_origin(None, 1, [0.3, 1.0], 0.1)
+    (0.3, 0)
+    """
+    if cut is not None and i == 1 and cut[0] + cut[1] * dt == times[0]:
+        if fixed_steps(float(times[1]) - cut[0], dt)[0] > cut[1]:
+            return cut
+    return float(times[i - 1]), 0
+
 def run_once(start: Callable[..., Any], method: type, rhs: Any, r0: Any, v0: Any, gm: Any,
              t_out: Any, *, dt: Any = None, tol: Any = None,
              on_output: Callable[[int, int], None] | None = None,

@@ -201,6 +201,10 @@ class _DoubleDouble:
     """radau15 in double-double (``precision="double-double"``, see :func:`run`): the
     state between calls."""
 
+    #: not saved: where the interval a Ctrl-C cut began and the steps taken in it
+    #: (:func:`~hamilton_orbits.integrators._setup.interval_origin`)
+    RESTART_SCRATCH = ("cut",)
+
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float | None, tol: float | None, events: EventLog | None,
                  max_steps: int) -> None:
@@ -221,6 +225,7 @@ class _DoubleDouble:
         self.gm = np.array(gm, dtype=np.float64)
         self.dt, self.h_last, self.t, self.steps = dt, 0.0, t0, 0
         self.max_steps = max_steps
+        self.cut: tuple[float, int] | None = None
 
     def _steps(self, h: float, k: int, t_out: np.ndarray, i: int) -> None:
         """``k`` steps of ``h`` (the kernel), a collision named (its double-double
@@ -250,8 +255,9 @@ class _DoubleDouble:
         _setup.check_step_count(float(t_out[-1] - t_out[0]), dt_f, self.max_steps,
                                 "radau15 in double-double")
         for i in range(1, len(t_out)):
-            n_steps, last = _setup.fixed_steps(float(t_out[i] - t_out[i - 1]), dt_f)
-            done = 0
+            origin, done = _setup.interval_origin(self.cut, i, t_out, dt_f)
+            self.cut = None
+            n_steps, last = _setup.fixed_steps(float(t_out[i]) - origin, dt_f)
             while done < n_steps:
                 k = min(n_steps - 1 - done, SLICE // 100) if done < n_steps - 1 else 1
                 h = dt_f if done < n_steps - 1 else last
@@ -260,8 +266,8 @@ class _DoubleDouble:
                     self.h_last = h
                     done += k
                     self.steps += k
-                    self.t = (float(t_out[i - 1]) + done * dt_f if done < n_steps
-                              else float(t_out[i]))
+                    self.t = origin + done * dt_f if done < n_steps else float(t_out[i])
+                    self.cut = (origin, done) if done < n_steps else None
             r_out[i] = self.x[:, :, 0] + self.x[:, :, 1]
             v_out[i] = self.v[:, :, 0] + self.v[:, :, 1]
             if on_output is not None:

@@ -305,7 +305,8 @@ class _State:
         (output ``i``).  The steps go in slices of ``SLICE``: Ctrl-C and ``stop()``
         are seen between them."""
         dt, log, ws = self.dt, self.log, self.ws
-        origin, done = self._origin(i, times)
+        origin, done = _setup.interval_origin(self.cut, i, times, dt)
+        self.cut = None
         n_steps, last = _setup.fixed_steps(times[i] - origin, dt)
         watched = self.watch.shape[0] > 0
         while done < n_steps:
@@ -334,17 +335,6 @@ class _State:
                     f"t_out[{i - 1}] = {times[i - 1]!r} and t_out[{i}] = {times[i]!r}")
             if stopped is not None:  # (raised out of HELD: a Ctrl-C held is raised first)
                 raise stopped
-
-    def _origin(self, i: int, times: list[float]) -> tuple[float, int]:
-        """Where the steps to ``times[i]`` are laid from, and how many are taken: from
-        ``times[i - 1]``, none; but for a leg's first interval going on from where a
-        Ctrl-C or ``stop()`` cut one (:attr:`cut`), from that one's start, its steps
-        taken, so that its last step is the one the run never cut takes."""
-        cut, self.cut = self.cut, None
-        if cut is not None and i == 1 and cut[0] + cut[1] * self.dt == times[0]:
-            if _setup.fixed_steps(times[1] - cut[0], self.dt)[0] > cut[1]:
-                return cut
-        return times[i - 1], 0
 
     def _act(self, i: int, row: tuple[np.ndarray, np.ndarray], ws: np.ndarray,
              first: int) -> StopAtEvent | None:
