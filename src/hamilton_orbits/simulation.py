@@ -307,9 +307,9 @@ class Simulation(Saving):
             bits of the run never interrupted (the fixed steps laid from the cut
             interval's start, as after a ``stop()``, in this process; a simulation
             saved then and loaded lays them from the time reached); dop853 begins
-            its own steps there.  A Ctrl-C during a compiled call is held until its steps
-            are counted and its event acted on (the drivers' ``_held``); a second
-            is raised at once.
+            its own steps there.  A Ctrl-C during a compiled call is held until its
+            steps are counted and its event acted on (the drivers' ``_held``); a
+            second is raised at once.
         """
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
