@@ -318,7 +318,7 @@ def _finish(scene, result, folder, archive) -> int:
     if not result.complete and archive is not None:
         print(f"the run was interrupted; its archive is {archive}/: continue it with "
               f"hamilton-orbits resume {shlex.quote(str(folder))}")
-    done = result.complete and not caught and not getattr(result, "interrupted", False)
+    done = result.complete and not caught and not result.interrupted
     return EXIT_OK if done else EXIT_INTERRUPTED
 
 

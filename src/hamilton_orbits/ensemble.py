@@ -49,7 +49,7 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     try:
         scene = Scene.from_values(data, source, dict(values))  # checked once, built once
         result = scene.run(progress=False)
-        if not result.complete or getattr(result, "interrupted", False):
+        if not result.complete or result.interrupted:
             raise KeyboardInterrupt  # (no stop is given: a Ctrl-C cut the member, and
             # it ends the ensemble, as in a pool of workers, not the member alone)
     except Exception as exc:  # a member's failure is data, not the end of the run

@@ -131,18 +131,29 @@ class _State:
             if on_output is not None and reached:  # (not a row of an event that stopped
                 on_output(i, steps - first)  # the run before ``t_out[i]``: as radau15's)
 
-        if self.log is not None and len(self.log.watch):
-            self._with_events(t_out, store, first)
-            return
-        from scipy.integrate import DOP853 as Stepper
-
-        for i in range(1, len(t_out)):  # (the steps of solve(): the same bits, each step's
-            solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,  # state
-                             atol=self.atol, max_step=self.max_step)  # kept as it is taken)
+        watched = self.log is not None and len(self.log.watch) > 0
+        for i in range(1, len(t_out)):
+            solver = self._stepper(t_out[i])
             while solver.status == "running":
-                self._step(solver, t_out, first)
+                scanned = None
+                if watched:  # (each step scanned for events before the next is taken)
+                    scanned = functools.partial(self._scanned, solver, solver.t,
+                                                solver.y.copy(), i, store, first)
+                acted = self._step(solver, t_out, first, scanned)
+                if isinstance(acted, StopAtEvent):  # (raised out of HELD: a Ctrl-C held
+                    raise acted  # is raised first)
+                if acted:  # (an event's action: the integration restarted at its time)
+                    solver = self._stepper(t_out[i])
             self.t, self.y = float(t_out[i]), solver.y.copy()
             store(i, self.steps, self.y)
+
+    def _stepper(self, t_end: Any) -> Any:
+        """scipy's DOP853 stepper from the state towards ``t_end`` (stepped as
+        ``solve_ivp`` steps it: the same bits)."""
+        from scipy.integrate import DOP853 as Stepper
+
+        return Stepper(self.f, self.t, self.y, float(t_end), rtol=self.tol, atol=self.atol,
+                       max_step=self.max_step)
 
     def _step(self, solver: Any, t_out: np.ndarray, first: int,
               scanned: Callable[[], Any] | None = None) -> Any:
@@ -162,35 +173,13 @@ class _State:
             _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
         return acted
 
-    def _with_events(self, t_out: np.ndarray, store: Callable[..., None],
-                     first: int) -> None:
-        """DOP853 step by step (scipy's stepper, as ``solve_ivp`` drives it) with every
-        step scanned for events on the cubic Hermite interpolant of its ends, before
-        the next is taken; an event with an action restarts the integration at its
-        time (or stops the run there)."""
-        from scipy.integrate import DOP853 as Stepper
-
-        for i in range(1, len(t_out)):
-            solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
-                             atol=self.atol, max_step=self.max_step)
-            while solver.status == "running":
-                t_prev, y_prev = solver.t, solver.y.copy()
-                acted = self._step(solver, t_out, first, functools.partial(
-                    self._scanned, solver, t_prev, y_prev, i, store, first))
-                if isinstance(acted, StopAtEvent):  # (raised out of HELD: a Ctrl-C held
-                    raise acted  # is raised first)
-                if acted:
-                    solver = Stepper(self.f, self.t, self.y, float(t_out[i]), rtol=self.tol,
-                                     atol=self.atol, max_step=self.max_step)
-            self.t, self.y = float(t_out[i]), solver.y.copy()
-            store(i, self.steps, self.y)
-
     def _scanned(self, solver: Any, t_prev: float, y_prev: np.ndarray, i: int,
                  store: Callable[..., None], first: int) -> bool | StopAtEvent:
-        """The step of ``solver`` from ``t_prev`` (state ``y_prev``) scanned for events:
-        True where one acted (the state then the event's, at its time: the caller
-        restarts the stepper there); a stop leaves its state in output ``i`` and
-        returns the :class:`StopAtEvent` to raise."""
+        """The step of ``solver`` from ``t_prev`` (state ``y_prev``) scanned for events
+        on the cubic Hermite interpolant of its ends: True where one acted (the state
+        then the event's, at its time: the caller restarts the stepper there); a stop
+        leaves its state in output ``i`` and returns the :class:`StopAtEvent` to
+        raise."""
         log, n = self.log, self.n
         if log.count[0] + len(log.watch) > log.buffer.shape[0]:
             log.drain()
@@ -225,7 +214,6 @@ def solve(
     atol: Any,
     max_step: float = np.inf,
     on_output: Callable[[int, int], None] | None = None,
-    on_state: Callable[[int, int, np.ndarray], None] | None = None,
     restart: bool = True,
     max_steps: int = DOP853.max_steps,
     hint: str | None = None,
@@ -248,8 +236,6 @@ def solve(
         A cap on the step.
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i``.
-    on_state : callable, optional
-        ``on_state(i, steps, y_i)`` after output ``i`` (instead of ``on_output``).
     restart : bool, optional
         True (default): a new integration from each output time, so that every
         output is a step end.  False: one integration, the outputs read from
@@ -298,9 +284,7 @@ def solve(
         y_out[1:] = sol.sol(t_out[1:]).T
         steps, nfev = int(sol.t.size - 1), int(sol.nfev)
         for i in range(1, len(t_out)):
-            if on_state is not None:
-                on_state(i, steps, y_out[i])
-            elif on_output is not None:
+            if on_output is not None:
                 on_output(i, steps)
         return y_out, steps, nfev
     for i in range(1, len(t_out)):
@@ -313,9 +297,7 @@ def solve(
         steps += max(len(sol.t) - 1, 0)
         nfev += int(sol.nfev)
         y_out[i] = y
-        if on_state is not None:
-            on_state(i, steps, y)
-        elif on_output is not None:
+        if on_output is not None:
             on_output(i, steps)
     return y_out, steps, nfev
 
