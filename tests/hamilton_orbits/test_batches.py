@@ -39,7 +39,7 @@ def test_an_exception_in_a_job_is_raised_by_the_batch():
 def test_on_an_in_process_dask_cluster_as_locally():
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         out = run_jobs(_slow_square, 10, [0, 1, 2, 3], client=client)
     assert [x for x, _ in out] == [10, 11, 14, 19]

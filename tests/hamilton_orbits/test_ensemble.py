@@ -44,7 +44,7 @@ def test_grid_local_and_on_an_in_process_dask_cluster_agree_bit_for_bit():
     # a looser tolerance takes fewer steps
     assert local["steps"][1] < local["steps"][0]
     with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         remote = ens.run(client=client, progress=False)
     same_rows(numeric(local), numeric(remote))

@@ -284,7 +284,7 @@ def test_chunks_give_the_same_bits_serially_on_threads_and_on_dask():
     serial = propagate(**args, chunk=3)
     threads = propagate(**args, chunk=3, workers=2)
     with distributed.LocalCluster(processes=False, n_workers=1, threads_per_worker=2,
-                                  dashboard_address=None) as cluster, \
+                                  dashboard_address=":0") as cluster, \
             distributed.Client(cluster) as client:
         dask = propagate(**args, chunk=3, client=client)
     for other in (threads, dask):
