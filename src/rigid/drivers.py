@@ -2,10 +2,12 @@
 
 :func:`integrate_arrays` is :func:`rigid.integrate` below validation and units: moments,
 attitude and angular velocity as float64 arrays in one unit system, output times, a
-method (see :mod:`rigid.integrators`).  The fixed-step methods run their whole time
-loop in one compiled function of :mod:`rigid._kernels.euler` (the splittings with the
+method (see :mod:`rigid.integrators`).  The fixed-step methods run their time loop
+in compiled functions of :mod:`rigid._kernels.euler` (the splittings with the
 composition of :func:`rigid.splitting.split_ops`, the exact flow plus kicks, RK4 with
-quaternion or Cayley kinematics), in chunks only when a progress bar is shown; DOP853
+quaternion or Cayley kinematics), called on chunks of at most 65 536 steps (a Ctrl-C
+is seen between two: within milliseconds) and of about 1% of the run when a progress
+bar is shown or ``stop`` asked, the same steps and bits as one call; DOP853
 is the driver of :func:`hamilton_orbits.integrators.dop853.solve` (whose steps a
 ``Simulation``'s dop853 takes too), on Euler's equations plus ``dq/dt = q omega / 2``.
 """
@@ -38,13 +40,30 @@ def _steps(t_end: float, dt: float, n_out: int) -> tuple[int, float, np.ndarray]
     return n_steps, h, out_steps
 
 
-def _progress_chunks(n_steps: int, progress: bool, stop: Any = None):
-    """Chunk boundaries (in steps) for an optional tqdm bar, or a ``stop`` asked
-    between chunks (the same steps and bits either way); one chunk without them."""
+#: the most steps of one compiled call: a run is cut into calls of at most this
+#: many (the same steps and bits), so that a Ctrl-C is seen, and ``stop()`` asked,
+#: within some milliseconds (about 10 ms of a splitting's steps)
+_CHUNK = 1 << 16
+
+
+def _progress_chunks(n_steps: int, progress: bool, stop: Any = None) -> tuple[list[int], Any]:
+    """Coarse chunk boundaries (in steps) for an optional tqdm bar, or a ``stop``
+    asked between chunks (about 1% of the run each; one chunk without them), and
+    the bar."""
     bar = _bar(n_steps, "step", progress)
     if bar is None and stop is None:
         return [0, n_steps], None
     return sorted({int(b) for b in np.linspace(0, n_steps, min(n_steps, 100) + 1)}), bar
+
+
+def _chunks(coarse: list[int]):
+    """The chunks ``(a, b)`` (steps ``a + 1`` to ``b``) of the coarse ones, each cut
+    into equal ones of at most :data:`_CHUNK` steps (made as they are run: a run of
+    1e12 steps has 1.5e7 of them)."""
+    for a, b in itertools.pairwise(coarse):
+        k = -(-(b - a) // _CHUNK)
+        for j in range(k):
+            yield a + (b - a) * j // k, a + (b - a) * (j + 1) // k
 
 
 def _stopped(stop: Any, b: int, n_steps: int, out_steps: np.ndarray) -> int | None:
@@ -55,67 +74,84 @@ def _stopped(stop: Any, b: int, n_steps: int, out_steps: np.ndarray) -> int | No
     return int(np.searchsorted(out_steps, b, side="right"))
 
 
+def _in_chunks(advance: Any, n_steps: int, out_steps: np.ndarray, progress: bool,
+               stop: Any) -> int:
+    """Run ``advance(a, b, lo, hi)`` (steps ``a + 1`` to ``b``, the outputs ``lo`` to
+    ``hi`` among them: ``out_steps`` sorted) over the run's chunks; returns the
+    number of outputs reached (all of them unless ``stop()`` ended the run)."""
+    coarse, bar = _progress_chunks(n_steps, progress, stop)
+    try:
+        for a, b in _chunks(coarse):
+            lo = 0 if a == 0 else int(np.searchsorted(out_steps, a, side="right"))
+            advance(a, b, lo, int(np.searchsorted(out_steps, b, side="right")))
+            if bar is not None:
+                bar.update(b - a)
+            cut = _stopped(stop, b, n_steps, out_steps)
+            if cut is not None:
+                return cut
+    finally:
+        if bar is not None:
+            bar.close()
+    return out_steps.shape[0]
+
+
 def _run_splitting(method, m, q0, w0, h, n_steps, out_steps, kind, params, progress,
                    stop=None):
     types, fracs, toffs, inv = split_ops(method, m, kind != _k.TORQUE_NONE)
-    qh = q0.copy()
-    ql = np.zeros(4)
-    lh = m * w0
-    ll = np.zeros(3)
-    nout = out_steps.shape[0]
-    q_out = np.empty((nout, 4))
-    l_out = np.empty((nout, 3))
-    drift = 0.0
-    pending = False
-    reached = nout
-    bounds, bar = _progress_chunks(n_steps, progress, stop)
-    for a, b in itertools.pairwise(bounds):
-        sel = (out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b)
-        idx = np.nonzero(sel)[0]
-        qo = np.empty((idx.size, 4))
-        lo = np.empty((idx.size, 3))
-        d, pending = _k.run_splitting(types, fracs, toffs, inv, m, qh, ql, lh, ll, a * h, h,
-                                      b - a, out_steps[idx] - a, kind, params, qo, lo,
-                                      pending, b < n_steps)
-        drift = max(drift, float(d))
-        q_out[idx] = qo
-        l_out[idx] = lo
-        if bar is not None:
-            bar.update(b - a)
-        cut = _stopped(stop, b, n_steps, out_steps)
-        if cut is not None:
-            reached = cut
-            break
-    if bar is not None:
-        bar.close()
-    return q_out[:reached], l_out[:reached] / m, drift
+    qh, ql, lh, ll = q0.copy(), np.zeros(4), m * w0, np.zeros(3)
+    q_out = np.empty((out_steps.shape[0], 4))
+    l_out = np.empty((out_steps.shape[0], 3))
+    carry = [0.0, False]  # (the largest drift of |q| at an output, ``pending``)
+
+    def advance(a: int, b: int, lo: int, hi: int) -> None:
+        d, carry[1] = _k.run_splitting(types, fracs, toffs, inv, m, qh, ql, lh, ll, a, h,
+                                       b - a, out_steps[lo:hi] - a, kind, params,
+                                       q_out[lo:hi], l_out[lo:hi], carry[1], b < n_steps)
+        carry[0] = max(carry[0], float(d))
+
+    reached = _in_chunks(advance, n_steps, out_steps, progress, stop)
+    return q_out[:reached], l_out[:reached] / m, carry[0]
 
 
 def _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress, stop=None):
-    quat = q0.copy()
-    omega = w0.copy()
-    nout = out_steps.shape[0]
-    q_out = np.empty((nout, 4))
-    w_out = np.empty((nout, 3))
-    reached = nout
-    bounds, bar = _progress_chunks(n_steps, progress, stop)
-    for a, b in itertools.pairwise(bounds):
-        idx = np.nonzero((out_steps >= (a if a == 0 else a + 1)) & (out_steps <= b))[0]
-        qo = np.empty((idx.size, 4))
-        wo = np.empty((idx.size, 3))
-        _k.run_exact_kick(m, quat, omega, a * h, h, b - a, out_steps[idx] - a, kind, params,
-                          qo, wo)
-        q_out[idx] = qo
-        w_out[idx] = wo
-        if bar is not None:
-            bar.update(b - a)
-        cut = _stopped(stop, b, n_steps, out_steps)
-        if cut is not None:
-            reached = cut
-            break
-    if bar is not None:
-        bar.close()
+    quat, omega = q0.copy(), w0.copy()
+    q_out = np.empty((out_steps.shape[0], 4))
+    w_out = np.empty((out_steps.shape[0], 3))
+
+    def advance(a: int, b: int, lo: int, hi: int) -> None:
+        _k.run_exact_kick(m, quat, omega, a, h, b - a, out_steps[lo:hi] - a, kind, params,
+                          q_out[lo:hi], w_out[lo:hi])
+
+    reached = _in_chunks(advance, n_steps, out_steps, progress, stop)
     return q_out[:reached], w_out[:reached]
+
+
+def _run_rk4(m, q0, w0, h, n_steps, out_steps, kind, params, progress, stop=None):
+    """``(y (n, 7), n)``: RK4's rows ``(q, omega)`` (q not normalised) and their count."""
+    y = np.concatenate([q0, w0])
+    y_out = np.empty((out_steps.shape[0], 7))
+
+    def advance(a: int, b: int, lo: int, hi: int) -> None:
+        _k.run_rk4_quaternion(m, y, a, h, b - a, out_steps[lo:hi] - a, kind, params,
+                              y_out[lo:hi])
+
+    return y_out, _in_chunks(advance, n_steps, out_steps, progress, stop)
+
+
+def _run_cayley(m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress,
+                stop=None):
+    """``(y (n, 7), n, re-centrings)``: the rows ``(q, omega)`` of RK4 on Cayley's
+    parameters, their count and the number of re-centrings."""
+    off, y = q0.copy(), np.concatenate([np.zeros(3), w0])
+    y_out = np.empty((out_steps.shape[0], 7))
+    count = [0]
+
+    def advance(a: int, b: int, lo: int, hi: int) -> None:
+        count[0] += int(_k.run_rk4_cayley(m, off, y, a, h, b - a, out_steps[lo:hi] - a, kind,
+                                          params, recentre, y_out[lo:hi]))
+
+    reached = _in_chunks(advance, n_steps, out_steps, progress, stop)
+    return y_out, reached, count[0]
 
 
 def _unit_rows(y: np.ndarray) -> tuple[np.ndarray, float]:
@@ -153,8 +189,7 @@ def _unit_rows(y: np.ndarray) -> tuple[np.ndarray, float]:
 def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre, progress,
                stop=None):
     """``(q, omega, count, drift)`` of a fixed-step method on the step grid (the
-    splittings and ``exact_kick``: the outputs before a ``stop()`` asked between
-    chunks of steps)."""
+    outputs before a ``stop()`` asked between chunks of steps)."""
     count = 0
     drift = 0.0
     if method in SPLITTINGS:
@@ -164,16 +199,13 @@ def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre,
         q, w = _run_exact_kick(m, q0, w0, h, n_steps, out_steps, kind, params, progress,
                                stop)
     elif method == "rk4":
-        y = np.empty((out_steps.size, 7))
-        _k.run_rk4_quaternion(m, np.concatenate([q0, w0]), 0.0, h, n_steps, out_steps, kind,
-                              params, y)
-        q, drift = _unit_rows(y[:, :4])
-        w = y[:, 4:]
+        y, reached = _run_rk4(m, q0, w0, h, n_steps, out_steps, kind, params, progress, stop)
+        q, drift = _unit_rows(y[:reached, :4])
+        w = y[:reached, 4:]
     elif method == "cayley_rk4":
-        y = np.empty((out_steps.size, 7))
-        count = int(_k.run_rk4_cayley(m, q0, w0, 0.0, h, n_steps, out_steps, kind, params,
-                                      recentre, y))
-        q, w = y[:, :4], y[:, 4:]
+        y, reached, count = _run_cayley(m, q0, w0, h, n_steps, out_steps, kind, params,
+                                        recentre, progress, stop)
+        q, w = y[:reached, :4], y[:reached, 4:]
     else:
         raise ValueError(f"Expected `method` to be one of {METHODS}, got {method!r}")
     return q, w, count, drift
@@ -244,9 +276,9 @@ def integrate_arrays(
     increasing array of output times starting at 0.  ``dt`` is the step of the
     fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
     (7,) for ``(q, omega)``) are DOP853's tolerances.  ``stop()``, asked between
-    chunks of about 1% of the steps by the splittings and ``exact_kick`` (the same
-    steps and bits), ends the run there with the outputs reached (the others run
-    to the end).
+    chunks of about 1% of the steps (and of at most 65 536) by the fixed-step
+    methods (the same steps and bits), ends the run there with the outputs reached
+    (DOP853 runs to the end).
 
     Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
     with unit quaternions; ``t`` the times reached; ``count`` is the number of

@@ -262,10 +262,10 @@ def integrate(
     recentre : float, optional
         Re-centring threshold on ``|g_0|`` for ``"cayley_rk4"``.
     stop : callable, optional
-        ``stop()``, asked between chunks of about 1% of the steps by the
-        splittings and ``"exact_kick"`` (their steps and bits unchanged): True ends
-        the run there, the trajectory then holding the outputs reached (as a
-        scene does on Ctrl-C).  The other methods run to the end.
+        ``stop()``, asked between chunks of about 1% of the steps (and of at
+        most 65 536) by the fixed-step methods (their steps and bits unchanged):
+        True ends the run there, the trajectory then holding the outputs reached
+        (as a scene does on Ctrl-C).  ``"dop853"`` runs to the end.
 
     Other Parameters
     ----------------

@@ -336,10 +336,12 @@ def _op_factors(types, fracs, inv, h):  # pragma: no cover - compiled
 
 @njit(cache=True, fastmath={"contract"})
 def run_splitting(
-    types, fracs, toffs, inv, moments, qh, ql, lh, ll, t0, h, n_steps, out_steps, kind, params,
+    types, fracs, toffs, inv, moments, qh, ql, lh, ll, n0, h, n_steps, out_steps, kind, params,
     q_out, l_out, pending, more,
 ):  # pragma: no cover - compiled
-    """Run ``n_steps`` steps of a splitting method given as ops; the time loop is compiled.
+    """Run ``n_steps`` steps of a splitting method given as ops, after step ``n0``
+    (time ``n0 h``: step ``n`` of the call begins at ``(n0 + n - 1) h``, the same
+    time however a run is cut into calls); the time loop is compiled.
 
     Op ``j`` of a step is the flow of type ``types[j]`` for time tau = ``fracs[j] h``,
     at time t_step + ``toffs[j]`` h:
@@ -359,8 +361,8 @@ def run_splitting(
     (e.g. R1(h/2) R1(h/2)), they are fused into one (their flows commute) unless
     an output falls between them.  ``pending``: the first op of the first step
     was already applied (fused) by the previous call; ``more``: another call
-    continues this run, so the last step may fuse into it.  (Chunked runs, e.g.
-    with a progress bar, are then bitwise identical to one call.)
+    continues this run, so the last step may fuse into it.  (A run in chunks, as
+    every long run is, is then bitwise identical to one call.)
 
     The state is the compensated pair (``qh + ql``, ``lh + ll``), advanced in
     place (held in registers inside the loop).  The state after step
@@ -384,7 +386,7 @@ def run_splitting(
     nout = out_steps.shape[0]
     for n in range(0, n_steps + 1):
         if n > 0:
-            ts = t0 + (n - 1) * h
+            ts = (n0 + n - 1) * h
             out_here = k < nout and out_steps[k] == n
             for j in range(1 if pending else 0, last + 1):
                 fj = f[j]
@@ -492,10 +494,11 @@ def _rhs_cayley(kind, params, moments, t, off, y, dy):  # pragma: no cover - com
 
 @njit(cache=True)
 def run_rk4_quaternion(
-    moments, y0, t0, h, n_steps, out_steps, kind, params, y_out
+    moments, y, n0, h, n_steps, out_steps, kind, params, y_out
 ):  # pragma: no cover - compiled
-    """Classical RK4 on y = (q, omega), q not normalised inside (only on output)."""
-    y = y0.copy()
+    """Classical RK4 on y = (q, omega), q not normalised inside (only on output):
+    ``n_steps`` steps after step ``n0`` (time ``n0 h``), ``y`` advanced in place;
+    outputs as in :func:`run_splitting`."""
     k1 = np.empty(7)
     k2 = np.empty(7)
     k3 = np.empty(7)
@@ -507,7 +510,7 @@ def run_rk4_quaternion(
         y_out[k, :] = y
         k += 1
     for n in range(1, n_steps + 1):
-        t = t0 + (n - 1) * h
+        t = (n0 + n - 1) * h
         _rhs_quat(kind, params, moments, t, y, k1)
         for i in range(7):
             tmp[i] = y[i] + 0.5 * h * k1[i]
@@ -527,22 +530,19 @@ def run_rk4_quaternion(
 
 @njit(cache=True)
 def run_rk4_cayley(
-    moments, off0, omega0, t0, h, n_steps, out_steps, kind, params, recentre, y_out
+    moments, off, y, n0, h, n_steps, out_steps, kind, params, recentre, y_out
 ):  # pragma: no cover - compiled
     """Classical RK4 on Cayley's (lambda0, mu0, nu0) and Euler's equations.
 
-    The attitude is off (1, g0) / sqrt(kappa0) with a constant offset ``off``
-    (unit quaternion, initially ``off0``) and g0 = 0 at the start.  After a step
-    that takes |g0| above ``recentre`` the offset absorbs it, off <- off (1, g0)
+    The attitude is off (1, g0) / sqrt(kappa0) with an offset ``off`` (a unit
+    quaternion) and ``y = (g0, omega)``, g0 = 0 at the start of a run.  After a
+    step that takes |g0| above ``recentre`` the offset absorbs it, off <- off (1, g0)
     (Cayley's composition formula in homogeneous form: (P_0, P_0 lambda,
-    P_0 mu, P_0 nu)), and g0 restarts at 0.  Rows of ``y_out`` hold the attitude
-    quaternion (4) and omega (3).  Returns the number of re-centrings.
+    P_0 mu, P_0 nu)), and g0 restarts at 0.  ``n_steps`` steps after step ``n0``
+    (time ``n0 h``), ``off`` and ``y`` advanced in place; rows of ``y_out`` hold
+    the attitude quaternion (4) and omega (3) (outputs as in
+    :func:`run_splitting`).  Returns the number of re-centrings.
     """
-    off = off0.copy()
-    y = np.zeros(6)
-    y[3] = omega0[0]
-    y[4] = omega0[1]
-    y[5] = omega0[2]
     k1 = np.empty(6)
     k2 = np.empty(6)
     k3 = np.empty(6)
@@ -554,7 +554,7 @@ def run_rk4_cayley(
     nout = out_steps.shape[0]
     for n in range(0, n_steps + 1):
         if n > 0:
-            t = t0 + (n - 1) * h
+            t = (n0 + n - 1) * h
             _rhs_cayley(kind, params, moments, t, off, y, k1)
             for i in range(6):
                 tmp[i] = y[i] + 0.5 * h * k1[i]
@@ -600,14 +600,14 @@ def run_rk4_cayley(
 
 @njit(cache=True)
 def run_exact_kick(
-    moments, quat, omega, t0, h, n_steps, out_steps, kind, params, q_out, w_out
+    moments, quat, omega, n0, h, n_steps, out_steps, kind, params, q_out, w_out
 ):  # pragma: no cover - compiled
     """Kick(h/2) exact-free-drift(h) kick(h/2), advancing ``quat``, ``omega`` in place.
 
     The drift is the closed-form torque-free motion of :mod:`rigid.free`
     (``free_step``); the kicks are the exact flow of the (t, q)-dependent torque.
     Symmetric, hence second order in the torque, and exact for the free body.
-    Outputs as in :func:`run_splitting`.
+    ``n0`` and the outputs as in :func:`run_splitting`.
     """
     k = 0
     nout = out_steps.shape[0]
@@ -619,7 +619,7 @@ def run_exact_kick(
         w_out[k, :] = omega
         k += 1
     for n in range(1, n_steps + 1):
-        t = t0 + (n - 1) * h
+        t = (n0 + n - 1) * h
         if kind != TORQUE_NONE:
             nx, ny, nz = torque_scalar(kind, params, a, b, c, t, quat[0], quat[1], quat[2],
                                        quat[3])
