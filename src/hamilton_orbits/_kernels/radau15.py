@@ -789,18 +789,20 @@ def _renormalise(r, v, b, br, d, g, csx, csv, n):  # pragma: no cover - compiled
 def advance_variational(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, n_phys, ms,
 ):  # pragma: no cover - compiled
-    """:func:`advance` for the state of ``n_phys`` bodies followed by tangent
-    vectors (``r``, ``v`` of ``n_phys (1 + k)`` rows; ``accel`` the augmented
-    right-hand side, :mod:`hamilton_orbits.rhs`): the same steps and the same
-    predictor-corrector iteration over every component (as rebound's IAS15 with
-    variational particles), the step size chosen from the bodies alone (the
-    tangent vectors, which grow, do not drive it), and after each accepted step
-    the MEGNO update from tangent vector 0 (:func:`_megno_radau`, from the step's
-    start state, which stays in ``r``, ``v`` until the step is accepted).  No
-    events."""
+    """:func:`advance` for the state of the bodies (``gm``'s, ``nb`` of them)
+    followed by tangent vectors (``r``, ``v`` of ``nb (1 + k)`` rows; ``accel``
+    the augmented right-hand side, :mod:`hamilton_orbits.rhs`): the same steps and
+    the same predictor-corrector iteration over every component (as rebound's
+    IAS15 with variational particles), the step size chosen from the first
+    ``n_phys`` rows (the bodies alone, ``nb``: the tangent vectors, which grow, do
+    not drive it; or every row, ``tangent_control``), and after each accepted
+    step the MEGNO update from tangent vector 0, rows ``nb`` to ``2 nb``
+    (:func:`_megno_radau`, from the step's start state, which stays in ``r``,
+    ``v`` until the step is accepted).  No events."""
     accel = accel_at(accel_addr[0], accel_addr[1])
     n = r.shape[0]
     m = 3 * n
+    nb = gm.shape[0]
     x0, v0 = np.empty(0), np.empty(0)  # no events: the start state is not saved
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     a0 = a0_2.reshape(m)
@@ -832,9 +834,9 @@ def advance_variational(
         if not ok:
             dt = dt_new
             continue
-        _megno_radau(ms, t, dt_try, b, a0, xf, vf, 3 * n_phys, 6 * n_phys)
+        _megno_radau(ms, t, dt_try, b, a0, xf, vf, 3 * nb, 6 * nb)
         _accept(xf, vf, csx, csv, b, a0, vf, dt_try)
-        _renormalise(r, v, b, br, d, g, csx, csv, gm.shape[0])
+        _renormalise(r, v, b, br, d, g, csx, csv, nb)
         t, t_cs = _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d)
         dt_last = dt_try
         have_last = True
