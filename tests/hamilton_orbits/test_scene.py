@@ -182,6 +182,47 @@ def test_stop_keeps_what_is_done_and_saves_it(tmp_path):
     assert (tmp_path / "states.nc") in paths
 
 
+def test_a_scene_named_and_saved_beyond_ascii(tmp_path, monkeypatch):
+    """A scene file ``mé.toml`` saved into ``oé/``: scipy's netCDF writer took only
+    ASCII text (the title holds the scene's name) and rebound opens only an ASCII
+    path (``final.bin``, and a scene starting from it): the run ended and its files
+    were lost, a torn ``states.nc`` left.  The text is UTF-8, rebound's binary
+    written and read as bytes, and a states file that fails leaves none."""
+    import rebound
+    import xarray as xr
+
+    first = Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)
+    first.save(tmp_path / "oé")
+    (tmp_path / "mé.toml").write_text(
+        'kind = "nbody"\ndescription = "from a binary in oé"\nduration = "0.05 yr"\n'
+        '[initial]\nrebound = "oé/final.bin"\n'
+        'names = ["sun", "jupiter", "saturn", "comet"]\n', encoding="utf-8")
+    # (the names given: read from a binary this process wrote, rebound 5.2.2 gives
+    # the first particle another's name about every other time)
+    monkeypatch.chdir(tmp_path)
+    result = Scene.from_toml("mé.toml").run(progress=False)
+    result.save("oé 2")
+    with xr.open_dataset(tmp_path / "oé 2" / "states.nc") as ds:
+        assert ds.attrs["title"] == "hamilton-orbits scene mé"
+        assert ds.attrs["bodies"] == ",".join(result.states["names"])
+        np.testing.assert_array_equal(ds["r"].values, result.states["r"].to_value(u.au))
+    end = rebound.Simulation((tmp_path / "oé 2" / "final.bin").read_bytes())
+    np.testing.assert_array_equal([[p.x, p.y, p.z] for p in end.particles],
+                                  result.states["r"][-1].to_value(u.au))
+    np.testing.assert_array_equal(result.states["r"][0].to_value(u.au),
+                                  first.states["r"][-1].to_value(u.au))
+
+    def torn(path):
+        path.write_bytes(b"CDF")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(type(result), "_write_states", lambda self, path: torn(path))
+    with pytest.raises(OSError, match="No space left"):
+        result.save("oé 3")
+    assert not [p.name for p in (tmp_path / "oé 3").iterdir() if "states" in p.name]
+
+
 def test_rebound_binary_in_and_out(tmp_path):
     first = Scene.bundled("comet-encounter").with_values(
         {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)

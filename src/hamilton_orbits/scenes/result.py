@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -200,12 +201,24 @@ class Result:
         return written
 
     def _save_states(self, out: Path) -> list[Path]:
+        """``states.nc``, written whole under a temporary name and then renamed (a
+        write that fails leaves no torn file); its text attributes UTF-8 (scipy's
+        writer took only ASCII: a scene named ``mé`` lost its files)."""
+        path = out / "states.nc"
+        tmp = out / f".states.nc.tmp-{os.getpid()}"
+        try:
+            self._write_states(tmp)
+            os.replace(tmp, path)
+        finally:
+            tmp.unlink(missing_ok=True)
+        return [path]
+
+    def _write_states(self, path: Path) -> None:
         from scipy.io import netcdf_file
 
-        path = out / "states.nc"
         t = self.times.to_value(u.d)
         with netcdf_file(path, "w") as f:
-            f.title = f"hamilton-orbits scene {self.scene.name}"
+            f.title = _utf8(f"hamilton-orbits scene {self.scene.name}")
             f.createDimension("time", len(t))
             var = f.createVariable("time", "d", ("time",))
             var[:] = t
@@ -218,7 +231,7 @@ class Result:
                     continue
                 var = f.createVariable(name, "d", ("time",))
                 var[:] = arr
-                var.units = str(getattr(series, "unit", ""))
+                var.units = _utf8(str(getattr(series, "unit", "")))
             for name, value in self.states.items():
                 arr = np.asarray(getattr(value, "value", value))
                 if arr.dtype.kind not in "fi" or arr.ndim == 0:
@@ -230,8 +243,13 @@ class Result:
                     f.createDimension(dims[k], arr.shape[k])
                 var = f.createVariable(name, "d", tuple(dims))
                 var[:] = arr
-                var.units = str(getattr(value, "unit", ""))
+                var.units = _utf8(str(getattr(value, "unit", "")))
             names = self.states.get("names")
             if names is not None:
-                f.bodies = ",".join(str(n) for n in names)
-        return [path]
+                f.bodies = _utf8(",".join(str(n) for n in names))
+
+
+def _utf8(text: str) -> bytes:
+    """A text attribute of a netCDF-3 file: its UTF-8 bytes (``char``, as netCDF-C
+    writes text; xarray reads it back as the ``str``)."""
+    return text.encode("utf-8")

@@ -5,6 +5,7 @@ frame of its states."""
 from __future__ import annotations
 
 import re
+from pathlib import Path
 from typing import Any
 
 import astropy.units as u
@@ -19,13 +20,19 @@ _DEFAULT_SOLAR = ("sun", "mercury", "venus", "earth-moon-barycenter", "mars", "j
                   "saturn", "uranus", "neptune")
 
 
-def rebound_names(path: str) -> list[str]:
-    """Names of the particles in a rebound binary (``body<k>`` for unnamed ones)."""
+def read_rebound(path: str) -> Any:
+    """The last snapshot of the rebound binary ``path``, a ``rebound.Simulation``
+    (from its bytes: rebound opens only an ASCII path)."""
     import rebound
 
+    return rebound.Simulation(Path(path).read_bytes())
+
+
+def rebound_names(path: str) -> list[str]:
+    """Names of the particles in a rebound binary (``body<k>`` for unnamed ones)."""
     from hamilton_orbits.rebound_bridge import particle_name
 
-    sim = rebound.Simulation(str(path))
+    sim = read_rebound(path)
     return [particle_name(sim.particles[k]) or f"body{k}" for k in range(sim.N)]
 
 
@@ -139,11 +146,9 @@ def _build(spec: dict, problems: S.Problems | None):
     init = spec["initial"]
     bodies: list = []
     if init.get("rebound") is not None:
-        import rebound
-
         # lengths in au, times in days, G m in au^3/day^2 (what final.bin holds)
         base = attempt(problems, "initial.rebound", lambda: System.from_rebound(
-            rebound.Simulation(str(init["rebound"])), quantity=True, names=init.get("names")))
+            read_rebound(init["rebound"]), quantity=True, names=init.get("names")))
         bodies += [] if base is None else [base[n] for n in base.names]
     ss = init.get("solar_system")
     if ss is not None:

@@ -6,6 +6,7 @@ integrals, the events, MEGNO, the analyses, the cross-check and the figures."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -192,10 +193,15 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     result.plotters.append(lambda res: plot_energy(res, what, conserved))
 
     def write_rebound(_result: Result, folder: Path) -> list[Path]:
-        path = folder / "final.bin"
-        if path.exists():
-            path.unlink()  # rebound appends to an existing archive
-        traj.final.to_rebound().save_to_file(str(path))
+        # rebound's binary, as its save_to_file writes it, from its pickling (the
+        # bytes): written whole, renamed into place (save_to_file takes only an
+        # ASCII path, and appends to a file already there)
+        path, tmp = folder / "final.bin", folder / f".final.bin.tmp-{os.getpid()}"
+        try:
+            tmp.write_bytes(traj.final.to_rebound().__reduce__()[1][0])
+            os.replace(tmp, path)
+        finally:
+            tmp.unlink(missing_ok=True)
         return [path]
 
     result.writers.append(write_rebound)
