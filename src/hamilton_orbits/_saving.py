@@ -401,6 +401,7 @@ class Saving:
             raise ValueError(f"A simulation writing an archive integrates forwards in time "
                              f"(its archive {arch.path} is one run's timeline); integrate a "
                              f"copy backwards (Simulation.copy(), which writes nothing)")
+        arch.scheduled(float(times[0]), float(times[-1]))  # (too many refused here)
         try:
             arch.open()
             info = {"start": arch.count, "first": self._start is None, "steps0": self.steps,

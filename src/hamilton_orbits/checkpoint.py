@@ -299,6 +299,10 @@ def _next_number(folder: Path) -> int:
         return first + 1
 
 
+#: the most snapshots of ``every`` in one ``integrate`` call: 10 GB on disk at
+#: least (about a kilobyte each), their times 80 MB in memory
+MAX_SNAPSHOTS = 10**7
+
 class ArchiveWriter:
     """The schedule and folder of an archive written while a simulation runs.
 
@@ -493,12 +497,32 @@ class ArchiveWriter:
 
     def times(self, t0: float, t1: float) -> np.ndarray:
         """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""
-        if self.every is None or not t1 > t0:
+        span = self.scheduled(t0, t1)
+        if span is None:
             return np.empty(0)
-        k0 = math.floor((t0 - self.origin) / self.every) + 1
-        k1 = math.floor((t1 - self.origin) / self.every)
-        ts = self.origin + self.every * np.arange(k0, k1 + 1, dtype=np.float64)
+        ts = self.origin + self.every * np.arange(span[0], span[1] + 1, dtype=np.float64)
         return ts[(ts > t0) & (ts <= t1)]
+
+    def scheduled(self, t0: float, t1: float) -> tuple[int, int] | None:
+        """The multiples ``(k0, k1)`` of ``every`` from ``origin`` in ``(t0, t1]``
+        (None without ``every``, or backwards).
+
+        Raises
+        ------
+        ValueError
+            When more than :data:`MAX_SNAPSHOTS` fall in it (``every`` named): asked
+            before the call writes its first snapshot.
+        """
+        if self.every is None or not t1 > t0:
+            return None
+        n = (t1 - t0) / self.every  # (inf where it overflows: refused as well)
+        if not n <= MAX_SNAPSHOTS - 1:
+            raise ValueError(
+                f"Expected `every` to schedule at most {MAX_SNAPSHOTS:.0e} snapshots in one "
+                f"call, got every={self.every!r}: {n:.3g} snapshots from t = {t0!r} to "
+                f"{t1!r}; choose a longer `every`, or integrate in shorter calls")
+        return (math.floor((t0 - self.origin) / self.every) + 1,
+                math.floor((t1 - self.origin) / self.every))
 
     def due(self, steps: int) -> bool:
         """True if a steps or wall-clock snapshot is due after ``steps`` steps."""

@@ -378,6 +378,22 @@ def test_bad_schedules_are_refused_naming_the_argument(kw, match):
         Simulation(_disc(), **{"method": "wh", "dt": 0.05, **kw})
 
 
+@pytest.mark.parametrize("every", [1e-11, 1e-300, 5e-324])
+def test_an_every_too_short_for_a_call_is_refused_before_its_first_snapshot(tmp_path, every):
+    """``every`` scheduling more than 1e7 snapshots in one call: numpy's
+    ``Maximum allowed size exceeded`` or a 745 GiB allocation, after the call's first
+    snapshot was written, so that the folder then refused the corrected call as
+    another run's.  Now ``every`` is named, before anything is written: the same
+    folder takes the corrected call."""
+    folder = tmp_path / "a"
+    with pytest.raises(ValueError, match=r"Expected `every` to schedule at most 1e\+07 "
+                                         r"snapshots in one call, got every="):
+        Simulation(_disc(), method="radau15", archive=folder, every=every).integrate(1.0)
+    assert not snapshot_files(folder)
+    Simulation(_disc(), method="radau15", archive=folder, every=0.25).integrate(1.0)
+    assert list(Archive(folder).times) == [0.0, 0.25, 0.5, 0.75, 1.0]
+
+
 def test_a_synced_archive_syncs_each_snapshot_before_the_run_goes_on(tmp_path, monkeypatch):
     """``archive_sync=True``: each record is synced to the disk, then its count
     written and synced (in that order: the count never runs ahead of a record on
