@@ -185,8 +185,11 @@ class Saving:
             A snapshot file, or an archive folder.
         number : int, optional
             For a folder: snapshot ``number`` of the archive instead of the last
-            one, not attached to the folder (it writes nothing;
-            ``Archive(folder)[k]``).
+            one, not attached to the folder (it writes nothing).  A snapshot's
+            number is the order it was written in, kept in its file
+            (``Archive(folder).snapshots[k].number``); ``Archive(folder)[k]`` is the
+            ``k``-th of those that read whole, the same one as long as none before
+            it is damaged or missing.
 
         Raises
         ------

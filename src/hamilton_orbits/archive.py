@@ -70,8 +70,9 @@ class Archive:
     snapshots : list of Snapshot
         The snapshots that read whole, in the order written.
     damaged : list of (Path, str)
-        Files or snapshots that do not read (a flipped byte, a truncated file), with
-        the reason: never read as data.
+        Files or snapshots that do not read (a flipped byte, a truncated file), and
+        snapshot numbers no file holds (a file removed), with the reason: never read
+        as data.
     torn : list of Path
         Files ending in a write that never finished (the process was killed while
         writing): the snapshot it was to become does not exist, and those bytes are

@@ -237,12 +237,17 @@ def contents(folder: Path, keep: tuple[str, ...] | None = None) -> Contents:
     """Every snapshot of archive ``folder``, each checked (``keep``: keep only these
     arrays of each, to hold a long archive in memory)."""
     out = Contents([], [], sorted(p for p in folder.iterdir() if _TORN_RE.match(p.name)))
-    for _, path in snapshot_files(folder):
+    after: int | None = 0  # (the number after the last file's snapshots, where known)
+    for first, path in snapshot_files(folder):
         try:
             seg = _read_file(path)
-        except SnapshotError as exc:
-            out.damaged.append((path, str(exc)))
+        except SnapshotError as exc:  # (its damage said: no gap told before or after it,
+            out.damaged.append((path, str(exc)))  # how many it held not known)
+            after = None
             continue
+        if after is not None and first > after:
+            out.damaged.append((folder, _missing(folder, after, first - 1)))
+        after = seg.first + seg.count
         out.damaged += seg.damaged
         out.torn += seg.torn
         for number, meta, arrays in seg.snapshots:
@@ -251,6 +256,15 @@ def contents(folder: Path, keep: tuple[str, ...] | None = None) -> Contents:
             out.snapshots.append((number, path, meta, arrays))
     return out
 
+
+
+def _missing(folder: Path, a: int, b: int) -> str:
+    """What a gap in an archive's numbers, snapshots ``a`` to ``b``, says: no file
+    of the folder holds them (a writer numbers its snapshots on from the folder's
+    last one: a gap is a file removed or moved)."""
+    which = f"snapshot {a} is" if a == b else f"snapshots {a} to {b} are"
+    return (f"{folder}: {which} missing: no file of the archive holds them (a file "
+            f"removed or moved away?)")
 
 def snapshot_at(folder: Path, number: int) -> tuple[Path, dict[str, Any],
                                                      dict[str, np.ndarray]] | None:

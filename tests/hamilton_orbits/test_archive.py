@@ -1592,6 +1592,30 @@ def test_a_snapshot_that_writes_nothing_integrates_backwards(tmp_path):
     assert sim.t == 5.0 and not _lock(tmp_path / "a")
 
 
+def test_a_segment_file_removed_is_said_missing_by_its_numbers(tmp_path):
+    """A segment file removed from the middle or the start of an archive: its
+    snapshots were gone without a word (``damaged`` and ``torn`` empty, the next
+    file's numbers simply following).  The numbers no file holds are said; a
+    snapshot's ``number`` stays the one ``Simulation.load(number=)`` takes, while
+    ``Archive[k]`` counts the snapshots that read."""
+    folder = tmp_path / "a"
+    Simulation(_disc(), method="radau15", archive=folder, every=0.5).integrate(1.0)
+    Simulation.load(folder).integrate(2.0)
+    Simulation.load(folder).integrate(3.0)
+    files = [path for _, path in snapshot_files(folder)]
+    assert len(files) == 3 and not Archive(folder).damaged
+    files[1].unlink()
+    gap = Archive(folder)
+    assert [s.number for s in gap.snapshots] == [0, 1, 2, 6, 7, 8]
+    assert gap.damaged == [(folder, f"{folder}: snapshots 3 to 5 are missing: no file of "
+                                    f"the archive holds them (a file removed or moved away?)")]
+    assert gap[3].t == Simulation.load(folder, number=6).t == 2.0
+    files[0].unlink()
+    assert [why for _, why in Archive(folder).damaged] == [
+        f"{folder}: snapshots 0 to 5 are missing: no file of the archive holds them (a file "
+        f"removed or moved away?)"]
+
+
 def test_a_segment_or_rows_file_under_another_number_is_damaged_not_read_as_it(tmp_path):
     """Each file's header holds the number of its first snapshot (under its
     SHA-256); nothing compared it with the file's name, so that a segment copied
