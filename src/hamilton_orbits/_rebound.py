@@ -11,12 +11,14 @@ imports neither.
 from __future__ import annotations
 
 import ctypes
+import struct
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-__all__ = ["arrays_from_simulation", "particle_name", "radii_of", "simulation_from_arrays"]
+__all__ = ["arrays_from_simulation", "binary_of", "particle_name", "radii_of",
+           "simulation_from_arrays"]
 
 
 def simulation_from_arrays(names: Sequence[str], gm: np.ndarray, r: np.ndarray,
@@ -119,3 +121,71 @@ def arrays_from_simulation(
         r[k] = p.x, p.y, p.z
         v[k] = p.vx, p.vy, p.vz
     return list(out), gm, r, v
+
+
+#: the bytes of a rebound binary's header, before its first field
+_HEADER = 64
+
+
+def _fields(data: bytes) -> dict[bytes, tuple[int, int]] | None:
+    """The fields of a rebound binary (one snapshot): name -> (offset, size) of its
+    data; None where ``data`` is not laid out as rebound 5 writes it (a 64-byte
+    header, then fields of ``size_name``, ``size_data`` (uint64), the name with its
+    NUL, the data, up to ``end``)."""
+    out, at = {}, _HEADER
+    while at + 16 <= len(data):
+        size_name, size_data = struct.unpack_from("<QQ", data, at)
+        begin = at + 16 + size_name
+        if not 0 < size_name < 256 or begin + size_data > len(data):
+            return None
+        name = data[at + 16:begin - 1]
+        if name == b"end":
+            return out
+        out[name] = (begin, size_data)
+        at = begin + size_data
+    return None
+
+
+def binary_of(sim: Any) -> bytes:
+    """The bytes of ``sim`` as rebound's ``save_to_file`` writes them (one
+    snapshot), the particles' names bound to their strings by numbers 1, 2, ...
+    instead of this process's addresses of the strings.
+
+    rebound stores each name with the address it had and each particle with the
+    address of its name, and on loading gives a particle the name whose stored
+    address is the particle's; but it goes on comparing after it has put the new
+    string's address in the particle, so that a file loaded in the process that
+    wrote it, whose new string may take the place of another name's freed one,
+    gave the first body another's name about every other time (rebound 5.2.2).
+    No address is a small number: the names then read as written, in any process.
+    Bytes not laid out as expected are given as rebound wrote them.
+
+    Examples
+    --------
+    >>> import rebound
+    >>> sim = simulation_from_arrays(["sun", "saturn"], np.ones(2), np.eye(2, 3),
+    ...                              np.zeros((2, 3)))
+    >>> back = rebound.Simulation(binary_of(sim))
+    >>> [particle_name(p) for p in back.particles]
+    ['sun', 'saturn']
+    """
+    import rebound
+
+    data = bytearray(sim.__reduce__()[1][0])
+    fields = _fields(bytes(data))
+    if fields is None or b"name_list" not in fields or b"particles" not in fields:
+        return bytes(data)
+    numbers, (at, size) = {}, fields[b"name_list"]
+    end = at + size
+    while at < end:
+        nul = data.index(b"\0", at, end)
+        numbers[struct.unpack_from("<Q", data, nul + 1)[0]] = len(numbers) + 1
+        struct.pack_into("<Q", data, nul + 1, len(numbers))
+        at = nul + 9
+    (at, size), step = fields[b"particles"], ctypes.sizeof(rebound.Particle)
+    for k in range(size // step):
+        where = at + k * step + rebound.Particle._name.offset
+        address = struct.unpack_from("<Q", data, where)[0]
+        if address:
+            struct.pack_into("<Q", data, where, numbers.get(address, 0))
+    return bytes(data)

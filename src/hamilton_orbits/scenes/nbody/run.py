@@ -15,6 +15,7 @@ import numpy as np
 
 from hamilton_orbits import effects as _effects
 from hamilton_orbits._progress import progress_bar
+from hamilton_orbits._rebound import binary_of
 from hamilton_orbits.checkpoint import holds_snapshots
 from hamilton_orbits.scenes.nbody.analyses import ANALYSIS_FUNCTIONS
 from hamilton_orbits.scenes.nbody.build import (
@@ -193,12 +194,12 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     result.plotters.append(lambda res: plot_energy(res, what, conserved))
 
     def write_rebound(_result: Result, folder: Path) -> list[Path]:
-        # rebound's binary, as its save_to_file writes it, from its pickling (the
-        # bytes): written whole, renamed into place (save_to_file takes only an
+        # rebound's binary (binary_of: its names read back right in this process
+        # too), written whole and renamed into place (save_to_file takes only an
         # ASCII path, and appends to a file already there)
         path, tmp = folder / "final.bin", folder / f".final.bin.tmp-{os.getpid()}"
         try:
-            tmp.write_bytes(traj.final.to_rebound().__reduce__()[1][0])
+            tmp.write_bytes(binary_of(traj.final.to_rebound()))
             os.replace(tmp, path)
         finally:
             tmp.unlink(missing_ok=True)
