@@ -16,7 +16,8 @@ pole and run against the record.  Keys (``docs/scenes.md``)::
 Parameters of the effects that the scene does not give come from the fit:
 ``chandler_period`` for ``"elastic"`` (unless ``k2`` is given) and the annual
 excitation that produces the fitted annual terms, ``chi = m (sigma_c - w) /
-sigma_c``, for ``"annual_excitation"``.
+sigma_c`` with the model's own ``sigma_c`` (from ``k2``, the period given or
+fitted, or Euler's without ``"elastic"``), for ``"annual_excitation"``.
 """
 
 from __future__ import annotations
@@ -84,9 +85,9 @@ def _model(spec: dict, fit: Any):
     if "elastic" in names and "k2" not in params and "chandler_period" not in params:
         params["chandler_period"] = fit.chandler_period
     if "annual_excitation" in names and "annual_prograde" not in params:
-        period = params.get("chandler_period", fit.chandler_period)
-        q_inv = 1.0 / float(params["Q"]) if "Q" in params else 0.0
-        sig = 2 * np.pi / u.Quantity(period, u.day).to_value(u.day) * (1 + 0.5j * q_inv)
+        # the model's own sigma_c (from k2, a period, or Euler's when not elastic), of
+        # the model without its excitation: the fit's period gave another forced term
+        sig = LiouvillePole(names, **params, annual_prograde=0.0).sigma
         w_a = 2 * np.pi / fit.annual_period.to_value(u.day)
         c_p = fit.annual_amplitude * np.exp(1j * fit.annual_phase.to_value(u.rad))
         c_r = fit.annual_retrograde_amplitude * np.exp(
