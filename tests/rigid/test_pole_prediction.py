@@ -472,6 +472,24 @@ def test_scene_start_and_periods_outside_the_record_are_refused_at_load(record):
                          "periods": [], "horizon": "2000 d"})
 
 
+def test_hindcast_scores_each_horizon_against_its_own_date_across_a_gap(record):
+    """A record with a day missing after a start (a user's file, or one built by
+    hand): the outcome of horizon h was taken ``h`` rows on, the day after its own
+    (60 d from 2019-01-01 scored against 2019-03-03, 46.758 mas for 48.343).  Each
+    outcome is found by its date; the missing day's horizon is not scored."""
+    drop = int(np.searchsorted(record.time.mjd, Time("2019-02-01").mjd))
+    keep = np.ones(len(record), bool)
+    keep[drop] = False
+    gap = PolarMotionRecord(record.time[keep], record.x[keep], record.y[keep], "a gap")
+    score = hindcast(gap, Time(["2019-01-01"]), [10, 31, 60] * u.day, "persistence")
+    newest = int(np.searchsorted(record.time.mjd, Time("2018-12-31").mjd))
+    for j, date in ((0, "2019-01-11"), (2, "2019-03-02")):
+        k = int(np.searchsorted(record.time.mjd, Time(date).mjd))
+        assert score.errors_x[0, j] == record.x[newest] - record.x[k]
+    assert np.isnan(score.errors_x[0, 1])  # (2019-02-01, the day missing)
+    assert score.table["count"].tolist() == [1, 0, 1]
+
+
 def test_hindcast_docstring_imports_what_it_uses():
     """The example of hindcast (reached through rigid.polar_motion) imports weekly_starts
     from where it lives: the docstring runs as written in a fresh namespace (issue 34)."""

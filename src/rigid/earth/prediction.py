@@ -471,8 +471,12 @@ def hindcast(
         _check_history(x, y, int(k), history)
         mx, my, vx, vy = forecast(method, x, y, int(k), steps)
         j = lat + hs - 1  # forecast index of each horizon
-        truth = k + lat + hs
-        seen = truth < mjd.size
+        # (each horizon's outcome found by its date: a record with a day missing
+        # after the start is not scored against the day after it; that horizon is
+        # then not scored, as one beyond the record)
+        day = mjd[k] + lat + hs
+        truth = np.minimum(np.searchsorted(mjd, day), mjd.size - 1)
+        seen = mjd[truth] == day
         jj, tt = j[seen], truth[seen]
         ex[i, seen], ey[i, seen] = mx[jj] - x[tt], my[jj] - y[tt]
         sx[i, seen], sy[i, seen] = np.sqrt(vx[jj]), np.sqrt(vy[jj])
