@@ -171,7 +171,7 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     par = free_parameters(body)
     for an in spec["analysis"]:
         if an["name"] == "flip_time":
-            _flip_time(result, omega, t, par)
+            _flip_time(result, omega[:, int(np.argsort(moments)[1])], t, par)
         elif an["name"] == "wobble_period":
             _wobble_period(result, omega, t, par, spec)
     result.frame = ("angular velocity on the body's principal axes; attitude: body axes "
@@ -180,9 +180,9 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     return result
 
 
-def _flip_time(result: Result, omega: np.ndarray, t: u.Quantity, par) -> None:
-    """Mean interval between sign changes of the middle-axis spin (linear interpolation)."""
-    w2 = omega[:, 1]
+def _flip_time(result: Result, w2: np.ndarray, t: u.Quantity, par) -> None:
+    """Mean interval between sign changes of the middle-axis spin ``w2`` (the axis of
+    the middle moment, wherever it is; linear interpolation)."""
     ts = t.to_value(u.s)
     k = np.flatnonzero(np.sign(w2[1:]) != np.sign(w2[:-1]))
     crossings = ts[k] - w2[k] * (ts[k + 1] - ts[k]) / (w2[k + 1] - w2[k])
@@ -216,7 +216,8 @@ def _too_sparse(result: Result, name: str, ts: np.ndarray, interval: float, what
 def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) -> None:
     """Period of the spin axis about the figure axis in the body frame.
 
-    From the upward zero crossings of ``omega_1`` (linear interpolation between
+    From the upward zero crossings of the spin about the first axis that is not
+    the one the path circles (``par.polar_axis``; linear interpolation between
     outputs): the path is an ellipse for a triaxial body, so its polar angle does
     not advance uniformly, but it crosses each axis once per period.
     """
@@ -224,7 +225,7 @@ def _wobble_period(result: Result, omega: np.ndarray, t: u.Quantity, par, spec) 
     period = u.Quantity(par.period, u.s).to_value(u.d)
     if _too_sparse(result, "simulated wobble period", ts, period, "turns", "d"):
         return
-    w1 = omega[:, 0]
+    w1 = omega[:, 1 if par.polar_axis == 0 else 0]
     k = np.flatnonzero((w1[:-1] < 0) & (w1[1:] >= 0))
     if k.size < 2:
         result.metrics["simulated wobble period"] = "less than one full turn in the run"

@@ -81,3 +81,24 @@ def test_a_flip_interval_the_outputs_cannot_resolve_is_said_so():
     said = scene.run(progress=False).metrics["simulated flip interval"]
     assert isinstance(said, str) and re.match(
         r"outputs 20 s apart cannot time flips 14.966 s apart", said), said
+
+
+def test_the_analyses_time_the_axes_the_motion_turns_about_wherever_they_are():
+    """``flip_time`` timed ``omega[:, 1]`` and ``wobble_period`` the crossings of
+    ``omega[:, 0]`` whatever the body: moments (1, 3, 2), the middle axis third, gave
+    "fewer than two flips" for a run of four; a wobble about the first axis "less
+    than one full turn" for 22.  Each now times the middle axis, and an axis the
+    spin's path circles, against the exact 2K(m)/lambda and free-motion period."""
+    flip = Scene.bundled("dzhanibekov").with_values({
+        "duration": "60 s", "body.moments": ["1 kg m2", "3 kg m2", "2 kg m2"],
+        "body.omega": ["0.001 rad/s", "0.001 rad/s", "2 rad/s"]}).run(progress=False)
+    assert abs((flip.metrics["simulated flip interval"]
+                / flip.metrics["exact flip interval 2K(m)/lambda"]).to_value(u.one) - 1) < 1e-5
+    wobble = Scene.bundled("dzhanibekov").with_values({
+        "duration": "200 s", "cadence": "0.05 s", "body.moments": ["3 kg m2", "2 kg m2",
+                                                                   "1.5 kg m2"],
+        "body.omega": ["1 rad/s", "0.05 rad/s", "0.05 rad/s"],
+        "analysis": [{"name": "wobble_period"}]}).run(progress=False)
+    # (crossings interpolated between outputs 0.05 s apart, over 22 turns: 1e-5)
+    assert abs((wobble.metrics["simulated wobble period"]
+                / wobble.metrics["exact free-motion period"]).to_value(u.one) - 1) < 1e-5
