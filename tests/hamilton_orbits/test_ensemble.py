@@ -93,9 +93,11 @@ def test_ensemble_command(tmp_path, capsys):
     assert main(["ensemble", "dzhanibekov", "--vary", "duration"]) == 2
 
 
-def test_dask_option_without_dask_names_the_extra(monkeypatch, capsys):
+def test_dask_option_without_dask_names_the_extra(monkeypatch, capsys, tmp_path):
     """Dask is an extra: without it `--dask` says which one to install (None in
-    sys.modules makes the import fail as if the package were absent)."""
+    sys.modules makes the import fail as if the package were absent).  (Run in the
+    test's own folder: the default output folder is made in the current one.)"""
+    monkeypatch.chdir(tmp_path)
     monkeypatch.setitem(sys.modules, "dask.distributed", None)
     code = main(["ensemble", "dzhanibekov", "--vary", "duration=40 s", "--dask", "local",
                  "--no-progress"])

@@ -157,8 +157,11 @@ def test_a_notebook_displays_it_as_a_plotly_figure():
         "            Body('p', 1e-3, [1.0, 0, 0], [0, 1.0, 0])])\n"
         "integrate(s, np.linspace(0, 6.0, 50)).plot3d()")]
     nbclient.NotebookClient(nb, timeout=600, kernel_name="python3").execute()
-    outputs = nb.cells[0].outputs
-    assert [o["output_type"] for o in outputs] == ["display_data"], outputs
+    # (a kernel that compiles radau15 itself says so on stderr first: a stream output
+    # whether there is one depends on numba's cache, not on the figure)
+    outputs = [o for o in nb.cells[0].outputs
+               if not (o["output_type"] == "stream" and o.get("name") == "stderr")]
+    assert [o["output_type"] for o in outputs] == ["display_data"], nb.cells[0].outputs
     figure = outputs[0]["data"]["application/vnd.plotly.v1+json"]
     assert {t["name"] for t in figure["data"]} >= {"p", "p now", "sun (origin)"}  # the bodies
     assert figure["layout"]["sliders"], "the time slider"
