@@ -223,7 +223,9 @@ def test_quoted_run_time_is_what_the_command_takes(tmp_path):
     assert measured / 3 < quoted < 3 * measured
 
 
-def test_report_without_its_extra_names_it_without_a_traceback(monkeypatch, capsys):
+def test_report_without_its_extra_names_it_without_a_traceback(monkeypatch, capsys,
+                                                                tmp_path):
+    monkeypatch.chdir(tmp_path)  # (the default output folder is made in the current one)
     monkeypatch.setitem(sys.modules, "mpmath", None)  # as if mpmath were not installed
     assert main(["report", "--quick", "--no-progress"]) == 1
     err = capsys.readouterr().err
@@ -321,3 +323,39 @@ def test_a_ctrl_c_during_the_cross_check_keeps_the_finished_run(tmp_path, monkey
     printed = capsys.readouterr().out
     assert code == 130 and "skipped: interrupted (Ctrl-C)" in printed
     assert (out / "states.nc").exists() and (out / "summary.md").exists()
+
+
+def test_a_first_ctrl_c_while_the_kernels_compile_stops_at_once(tmp_path, monkeypatch,
+                                                                capsys):
+    """The first Ctrl-C asks a run to stop at its next look (after a slice of steps):
+    pressed while the kernels compiled (seconds on a cold cache, 14-21 s on a busy
+    machine) it waited for the compilation and the first slice.  Nothing has run
+    yet: it stops at once (exit 130), saying why.  The Ctrl-C is pressed as the
+    run's first kernel starts compiling (numba's own event)."""
+    import signal
+
+    import numba
+    from numba.core import event
+
+    import rigid.scene
+    from rigid._kernels import euler
+
+    rigid.scene.register()
+
+    class Press(event.Listener):
+        def on_start(self, ev):
+            if not pressed:
+                pressed.append(1)
+                signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+
+        def on_end(self, ev):
+            pass
+
+    pressed = []
+    # (the run's stepping kernel made anew, uncached: it compiles at the first call)
+    monkeypatch.setattr(euler, "run_splitting", numba.njit(euler.run_splitting.py_func))
+    with event.install_listener("numba:compile", Press()):
+        code = main(["run", "dzhanibekov", "--out", str(tmp_path / "out"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert pressed and code == 130, err
+    assert "stopping (the kernels were compiling: nothing run yet)" in err

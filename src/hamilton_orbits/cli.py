@@ -329,6 +329,7 @@ def _ctrl_c(saying: str) -> Iterator[list[int]]:
     drivers hold Ctrl-C: ``hamilton_orbits.integrators._held``)."""
     import signal
 
+    from hamilton_orbits.firstrun import compiling
     from hamilton_orbits.integrators._held import HELD
 
     caught: list[int] = []
@@ -338,6 +339,10 @@ def _ctrl_c(saying: str) -> Iterator[list[int]]:
             HELD.interrupt()
             return
         caught.append(signum)
+        if compiling():  # (nothing run yet, and the compilation takes seconds)
+            print("\nhamilton-orbits: stopping (the kernels were compiling: nothing run "
+                  "yet)", file=sys.stderr)
+            raise KeyboardInterrupt
         print(f"\nhamilton-orbits: {saying}", file=sys.stderr)
 
     try:

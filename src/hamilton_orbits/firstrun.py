@@ -111,6 +111,21 @@ class _CompileNotice(event.Listener):
             add_compilation(getattr(_local, "name", "?"), time.perf_counter() - _local.start)
 
 
+def compiling() -> bool:
+    """Whether this thread is inside a numba compilation now (of any package's
+    function: between its ``numba:compile`` events' start and end).
+
+    Examples
+    --------
+    >>> compiling()
+    False
+    >>> with event.trigger_event("numba:compile", data={}):
+    ...     compiling()
+    True
+    """
+    return getattr(_local, "depth", 0) > 0
+
+
 def compile_seconds() -> float:
     """Seconds spent compiling with numba in this process so far (every package's
     functions; nested compilations counted once).

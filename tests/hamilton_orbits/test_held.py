@@ -364,3 +364,34 @@ def test_a_cut_mid_interval_goes_on_with_the_bits_of_the_run_never_cut(method, h
     sim.integrate(end)
     assert sim.steps == once.steps
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)
+
+
+def test_a_ctrl_c_while_a_kernel_compiles_is_raised_at_once():
+    """A Ctrl-C while numba compiles a call's kernel (a first run, seconds on a
+    cold cache) was held like one during its steps: it waited for the compilation
+    and then for the first slice of steps.  No step is taken yet: it is raised at
+    once (a real compilation, the Ctrl-C pressed as it starts), and the function
+    compiles when called again."""
+    import numba
+    from numba.core import event
+
+    from hamilton_orbits.integrators._held import HELD
+
+    @numba.njit
+    def kernel(x):
+        return x + 1.0
+
+    class Press(event.Listener):
+        def on_start(self, ev):
+            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+
+        def on_end(self, ev):
+            pass
+
+    reached = []
+    with event.install_listener("numba:compile", Press()):
+        with pytest.raises(KeyboardInterrupt):
+            with HELD:
+                reached.append(kernel(1.0))
+    assert reached == [] and not HELD.pending and HELD.depth == 0
+    assert kernel(1.0) == 2.0

@@ -16,9 +16,11 @@ it did.  Python's default SIGINT handler is replaced, on each such call in the
 main thread that finds it in place (Jupyter puts it back before each cell), by
 one that does what it does (raise ``KeyboardInterrupt``)
 except within :data:`HELD`: there the Ctrl-C is held, and raised as :data:`HELD`
-is left, the state and its counts then agreeing.  A second Ctrl-C within is
-raised at once (a Ctrl-C during a first call's compilation, which runs within,
-is then not waited on).  A handler of one's own is left alone (it may call
+is left, the state and its counts then agreeing.  A Ctrl-C while numba compiles
+the call's kernel (a first call, within: no step taken yet,
+:func:`hamilton_orbits.firstrun.compiling`) and a second Ctrl-C within are raised
+at once (a first one waited for the compilation, seconds, and then for the first
+slice of steps).  A handler of one's own is left alone (it may call
 :meth:`CtrlCHeld.interrupt` to be held likewise); other threads are not held.
 
 Examples
@@ -41,6 +43,8 @@ from __future__ import annotations
 import signal
 import threading
 from types import FrameType, TracebackType
+
+from hamilton_orbits.firstrun import compiling
 
 # the C function behind signal.getsignal, without its conversion to an enum: 10 ns
 # against 1.5 us a call (the handlers are compared by identity: the same either way)
@@ -95,10 +99,10 @@ class CtrlCHeld:
             raise KeyboardInterrupt
 
     def _on_sigint(self, signum: int, frame: FrameType | None) -> None:
-        if self.depth and not self.pending:
+        if self.depth and not self.pending and not compiling():
             self.pending = True
-        else:
-            signal.default_int_handler(signum, frame)
+        else:  # (raised at once also while numba compiles the call's kernel: no step
+            signal.default_int_handler(signum, frame)  # taken yet, nothing to count)
 
     def _install(self) -> None:
         """This one's handler for SIGINT where Python's default is (the main thread)."""
