@@ -149,11 +149,14 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     moments = _si(body.moments, u.kg * u.m**2)
     energy = 0.5 * np.sum(moments * omega**2, axis=-1)
     ang = np.linalg.norm(moments * omega, axis=-1)
+    rest = not scale > 0  # (a body at rest: the changes themselves, not relative ones)
     diag = {
         "attitude_error": attitude.rotation_distance(traj.attitude) * u.rad,
-        "omega_error": np.linalg.norm(omega - omega_ex, axis=-1) / scale,
-        "energy_error": (energy - energy[0]) / energy[0],
-        "angular_momentum_error": (ang - ang[0]) / ang[0],
+        "omega_error": (np.linalg.norm(omega - omega_ex, axis=-1)
+                        * (u.rad / u.s if rest else 1.0 / scale)),
+        "energy_error": (energy - energy[0]) * u.J if rest else (energy - energy[0]) / energy[0],
+        "angular_momentum_error": ((ang - ang[0]) * (u.J * u.s) if rest
+                                   else (ang - ang[0]) / ang[0]),
     }
     result = Result(
         scene=scene,
@@ -166,8 +169,14 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
     )
     result.metrics["integrator"] = integ["method"]
     result.metrics["max attitude error vs exact"] = np.max(diag["attitude_error"]).to(u.rad)
-    result.metrics["max |omega error| / |omega|"] = float(np.max(diag["omega_error"]))
-    result.metrics["max |relative energy error|"] = float(np.max(np.abs(diag["energy_error"])))
+    if rest:
+        result.metrics["max |omega error| (a body at rest)"] = np.max(diag["omega_error"])
+        result.metrics["max |energy change| (a body at rest)"] = np.max(
+            np.abs(diag["energy_error"]))
+    else:
+        result.metrics["max |omega error| / |omega|"] = float(np.max(diag["omega_error"]))
+        result.metrics["max |relative energy error|"] = float(np.max(np.abs(
+            diag["energy_error"])))
     par = free_parameters(body)
     for an in spec["analysis"]:
         if an["name"] == "flip_time":
@@ -274,6 +283,11 @@ def _plot_omega(result: Result):
     err = result.diagnostics["attitude_error"].to_value(u.rad)[1:]
     shown = err > 0  # an exact zero has no place on a log axis: not drawn
     ax2.semilogy(t[1:][shown], err[shown], lw=0.8)
+    if not shown.any():  # (a body at rest, or exact throughout: said, not an empty frame)
+        ax2.set_yscale("linear")
+        ax2.set_yticks([])
+        ax2.text(0.5, 0.5, "0 at every output", transform=ax2.transAxes, ha="center",
+                 va="center", fontsize=9)
     ax2.set_ylabel("attitude error vs the exact\nmotion (angle) [rad]", fontsize=9)
     ax2.set_xlabel(f"time since the start [{t_unit}]")
     fig.suptitle(f"{result.scene.name}: {result.metrics.get('integrator', '')} against the "

@@ -102,3 +102,21 @@ def test_the_analyses_time_the_axes_the_motion_turns_about_wherever_they_are():
     # (crossings interpolated between outputs 0.05 s apart, over 22 turns: 1e-5)
     assert abs((wobble.metrics["simulated wobble period"]
                 / wobble.metrics["exact free-motion period"]).to_value(u.one) - 1) < 1e-5
+
+
+def test_a_body_at_rest_gives_its_changes_not_nan(tmp_path):
+    """A body at rest: the omega and energy errors relative to zero printed ``nan``
+    (and wrote it to summary.json).  Its changes themselves are given, in rad/s and
+    J, named as such; the figure says the attitude error is 0 throughout."""
+    import json
+
+    result = Scene.bundled("dzhanibekov").with_values(
+        {"body.omega": ["0 rad/s", "0 rad/s", "0 rad/s"]}).run(progress=False)
+    m = result.metrics
+    assert m["max |omega error| (a body at rest)"] == 0 * u.rad / u.s
+    assert m["max |energy change| (a body at rest)"] == 0 * u.J
+    assert "max |relative energy error|" not in m
+    result.save(tmp_path)
+    assert "nan" not in (tmp_path / "summary.json").read_text().lower()
+    fig = result.plot()[0]
+    assert [t.get_text() for t in fig.axes[1].texts] == ["0 at every output"]
