@@ -46,12 +46,14 @@ def sinc(t: np.ndarray) -> np.ndarray:
     return np.where(small, 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0), direct)
 
 
-def raise_zero(name: str, n: np.ndarray, what: str) -> None:
+def raise_zero(name: str, n: np.ndarray, what: str, kind: str = "quaternion") -> None:
+    """Refuse a zero norm in ``n``, naming ``name`` (a ``kind``: quaternion, vector),
+    the index and why (``what``)."""
     bad = n == 0
     if np.any(bad):
         index = first_index(np.atleast_1d(bad)) if n.ndim else ()
         where = f" at index {index[0] if len(index) == 1 else index}" if index else ""
-        raise ValueError(f"Expected `{name}` to be a nonzero quaternion{where}: {what}")
+        raise ValueError(f"Expected `{name}` to be a nonzero {kind}{where}: {what}")
 
 
 def dimensionless(name: str, value: Any, size: int | None = None) -> np.ndarray:
@@ -92,10 +94,10 @@ def norm_last(a: np.ndarray) -> np.ndarray:
         return np.ldexp(nb, e)
 
 
-def unit_last(name: str, a: np.ndarray, what: str) -> np.ndarray:
+def unit_last(name: str, a: np.ndarray, what: str, kind: str = "quaternion") -> np.ndarray:
     """``a / |a|`` over the last axis for any magnitude; a zero row raises."""
     b, _, nb = scale_exactly(a)
-    raise_zero(name, nb, what)
+    raise_zero(name, nb, what, kind)
     return b / nb[..., None]
 
 

@@ -99,7 +99,8 @@ class RotationForms:
         if degrees:
             ang = np.deg2rad(ang)
         shape = broadcast_shapes(("axis", "angle"), ax.shape[:-1], ang.shape)
-        unit_axis = unit_last("axis", ax, "a rotation axis must have nonzero length")
+        unit_axis = unit_last("axis", ax, "a rotation axis must have nonzero length",
+                              "vector")
         half = 0.5 * ang
         a = np.empty(shape + (4,))
         a[..., 0] = np.cos(half)

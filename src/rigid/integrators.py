@@ -178,14 +178,10 @@ def _output_times(t_s: np.ndarray) -> np.ndarray:
     return t_s if t_s[0] == 0.0 else np.concatenate([[0.0], t_s])
 
 
-def _step(method: str, dt: Any, t_last: float, tol: Any) -> float | None:
+def _step(method: str, dt: Any, t_last: float) -> float | None:
     """The step (fixed-step methods, required) or DOP853's step cap (optional), s."""
-    if method in _FIXED:
-        if tol is not None:
-            raise ValueError(f"Expected `tol` only with method 'dop853' (a fixed-step method "
-                             f"takes `dt`), got tol = {tol!r} for method {method!r}")
-        if dt is None:
-            raise ValueError(f"Expected `dt` for method {method!r}, got None")
+    if method in _FIXED and dt is None:
+        raise ValueError(f"Expected `dt` for method {method!r}, got None")
     if dt is None:
         return None
     dtf = float(_scalar_positive("dt", TIME("dt", dt)))
@@ -254,7 +250,8 @@ def integrate(
     tol : float, optional
         ``"dop853"`` only: its relative tolerance (default 1e-12; the absolute
         tolerance is ``tol / 100`` on the unit quaternion and
-        ``tol / 100 max|omega0|`` on omega).  Refused by the fixed-step methods.
+        ``tol / 100 max|omega0|`` on omega).  Refused by the fixed-step methods
+        (and so are the deprecated ``rtol``, ``atol``).
     torque : BodyTorque, SpaceTorque, GravityGradientTorque or None, optional
         External torque (see :mod:`rigid.euler`).  Default None (free body).
     progress : bool, optional
@@ -333,7 +330,12 @@ def integrate(
         raise ValueError(f"Expected `stop` to be callable or None, got {stop!r}")
     quantity = call_units(body, ("t", "dt"), (t, dt))
     times = _output_times(TIME("t", t))
-    dtf = _step(method, dt, float(times.max()), tol)
+    for name, given in (("tol", tol), ("rtol", rtol), ("atol", atol)):
+        if given is not None and method in _FIXED:  # (the deprecated ones as `tol`)
+            raise ValueError(f"Expected `{name}` only with method 'dop853' (a fixed-step "
+                             f"method takes `dt`), got {name} = {given!r} for method "
+                             f"{method!r}")
+    dtf = _step(method, dt, float(times.max()))
     rtol_f, atol_f = _tolerances(tol, rtol, atol, si.omega)
     recentre = float(_scalar_positive("recentre", DIMENSIONLESS("recentre", recentre)))
     kind, params = encode_torque(torque)
@@ -475,9 +477,12 @@ def _check_finite(t: np.ndarray, q: np.ndarray, w: np.ndarray, method: str, dt: 
     bad = ~(np.isfinite(q).all(axis=-1) & np.isfinite(w).all(axis=-1))
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])
+        hint = ("" if method != "cayley_rk4" else
+                " (or a `recentre` of about 1: Cayley's parameters grow without bound as "
+                "the attitude nears a half turn from its offset)")
         raise ValueError(
             f"Expected `dt` small enough for a finite solution, got a non-finite state at "
-            f"t = {float(t[k])!r} s with method {method!r} and dt = {dt!r} s"
+            f"t = {float(t[k])!r} s with method {method!r} and dt = {dt!r} s{hint}"
         )
     if not math.isfinite(drift):
         raise _failed(method, dt, "|q| beyond float64 (its norm drift)")

@@ -353,9 +353,11 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     e1, e2 = np.sum(mom * w1s * w1s), np.sum(mom * w2s * w2s)
     l1, l2 = np.sum((mom * w1s) ** 2), np.sum((mom * w2s) ** 2)
     if abs(e1 - e2) > 1e-10 * e1 or abs(l1 - l2) > 1e-10 * l1:
-        raise ValueError(
-            f"Expected `omega2` on the polhode of `omega1` (same T and |L|), got 2T = {e2!r}"
-            f" vs {e1!r} and L^2 = {l2!r} vs {l1!r}"
+        raise ValueError(  # (relative differences: the same for the body as for the
+            # scaled problem, whose values would not be the body's)
+            f"Expected `omega2` on the polhode of `omega1` (the same T and |L|, to 1e-10), "
+            f"got its 2T {float(e2 / e1 - 1):+.3g} and its L^2 {float(l2 / l1 - 1):+.3g} "
+            f"(relative) off those of `omega1`"
         )
     # one scale for both states (the kernel's rates and phases must compare), lifted
     # when a thin body needs larger rates than max|omega| / sw (see free_scale)

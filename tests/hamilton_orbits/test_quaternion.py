@@ -395,8 +395,9 @@ def test_wrong_shape_raises():
         Quaternion.from_rotation_matrix(np.eye(4))
     with pytest.raises(ValueError, match="rotation matrix"):
         Quaternion.from_rotation_matrix(np.diag([1.0, 1.0, -1.0]))
-    with pytest.raises(ValueError, match="nonzero length"):
-        Quaternion.from_axis_angle([0, 0, 0], 1.0)
+    with pytest.raises(ValueError, match=r"Expected `axis` to be a nonzero vector at index 1: "
+                                         r"a rotation axis must have nonzero length"):
+        Quaternion.from_axis_angle([[0, 0, 1], [0, 0, 0]], 1.0)  # (a vector, not a quaternion)
 
 
 def test_gibbs_near_half_turn_policy():

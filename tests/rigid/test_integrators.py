@@ -205,6 +205,16 @@ def test_progress_and_quantities():
 def test_bad_input():
     with pytest.raises(ValueError, match="`method` to be one of"):
         integrate(BODY, 1.0, dt=0.1, method="euler")
+    # (the deprecated tolerances were taken and ignored by a fixed-step method)
+    with pytest.warns(DeprecationWarning), pytest.raises(
+            ValueError, match=r"Expected `rtol` only with method 'dop853' \(a fixed-step "
+                              r"method takes `dt`\), got rtol = 1e-06 for method 'splitting4'"):
+        integrate(BODY, 1.0, dt=0.1, rtol=1e-6)
+    # (a non-finite cayley_rk4 run blamed `dt` alone: a huge `recentre` is the cause)
+    with pytest.raises(ValueError, match=r"non-finite state .* with method 'cayley_rk4' .* "
+                                         r"\(or a `recentre` of about 1"):
+        integrate(RigidBody([1.0, 2.0, 3.0], omega=[0.4, 1.1, -0.3]), 50.0, dt=0.001,
+                  method="cayley_rk4", recentre=1e300)
     with pytest.raises(ValueError, match="Expected `dt` for method 'splitting2'"):
         integrate(BODY, 1.0, method="splitting2")
     with pytest.raises(ValueError, match="`t` to be finite, got nan"):

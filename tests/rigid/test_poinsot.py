@@ -53,6 +53,15 @@ def test_plot_and_errors(tmp_path):
     fig = plot_poinsot(BODY, T)
     fig.savefig(tmp_path / "p.png")
     assert (tmp_path / "p.png").stat().st_size > 1000
+    # every axis named with its unit, and the ellipsoid drawn in its own proportions
+    # (the 3-D box was a cube: a 1 : 0.71 : 0.58 ellipsoid looked like a sphere)
+    ellipsoid, plane = fig.axes
+    for label in (ellipsoid.get_xlabel(), ellipsoid.get_zlabel(), plane.get_xlabel(),
+                  plane.get_ylabel()):
+        assert label.endswith("[(kg m$^2$)$^{-1/2}$]"), label
+    box = np.asarray(ellipsoid.get_box_aspect())
+    semi = 1.0 / np.sqrt(BODY.moments)
+    np.testing.assert_allclose(box / box[0], semi / semi[0], rtol=1e-12)
     import matplotlib.pyplot as plt
     plt.close(fig)
     with pytest.raises(ValueError, match="at rest"):

@@ -162,6 +162,10 @@ def test_bad_windows_raise(record):
         fit_wobble(record, 2100, 2200)
     with pytest.raises(ValueError, match="at least 2 epochs"):
         record.select(2000, 2000.001)
+    # (a Time of two dates was a raw TypeError from astropy's float conversion)
+    with pytest.raises(ValueError, match=r"Expected `start` to be one time, got a Time of "
+                                         r"shape \(2,\)"):
+        record.select(Time(["2000-01-01", "2001-01-01"]))
     with pytest.raises(ValueError, match="trend"):
         fit_wobble(record, trend="quadratic")
 

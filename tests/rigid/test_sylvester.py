@@ -139,6 +139,12 @@ def test_time_between_positions():
     assert abs(time_between(body, w[0], w[1]) - 3.0) < 1e-12 * period
     with pytest.raises(ValueError, match="same T and"):
         time_between(body, body.omega, 1.1 * body.omega)
+    # (the refusal quoted the internally rescaled 2T and L^2 as np.float64 reprs,
+    # not the body's: now the relative differences, the body's as the problem's)
+    other = RigidBody([1.0, 2.0, 2.5], omega=[1.0, 0.5, 0.2])  # 2T = 1.6, L^2 = 2.25
+    with pytest.raises(ValueError, match=r"got its 2T \+0.0781 and its L\^2 \+0.139 "
+                                         r"\(relative\) off those of `omega1`"):
+        time_between(other, [1.0, 0.5, 0.2], [1.0, 0.5, 0.3])  # 1.725, 2.5625
     with pytest.raises(ValueError, match=r"`omega2` to have shape \(3,\)"):
         time_between(body, body.omega, [1.0, 2.0])
 

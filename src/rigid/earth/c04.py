@@ -140,6 +140,9 @@ def decimal_year(time: Time) -> np.ndarray:
 
 def _year(name: str, value: Any) -> float:
     if isinstance(value, Time):
+        if value.shape != ():
+            raise ValueError(f"Expected `{name}` to be one time, got a Time of shape "
+                             f"{value.shape}")
         return float(decimal_year(value))
     if isinstance(value, u.Quantity):
         return TIME.scalar(name, value, u.yr)
