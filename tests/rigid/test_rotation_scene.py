@@ -108,7 +108,6 @@ def test_a_body_at_rest_gives_its_changes_not_nan(tmp_path):
     """A body at rest: the omega and energy errors relative to zero printed ``nan``
     (and wrote it to summary.json).  Its changes themselves are given, in rad/s and
     J, named as such; the figure says the attitude error is 0 throughout."""
-    import json
 
     result = Scene.bundled("dzhanibekov").with_values(
         {"body.omega": ["0 rad/s", "0 rad/s", "0 rad/s"]}).run(progress=False)
