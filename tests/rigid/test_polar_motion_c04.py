@@ -135,6 +135,18 @@ def test_q_estimate_comes_with_its_caveat(fits):
     fit = fits["all"]
     assert 10 < fit.q_estimate < 1000
     assert "not a measurement" in fit.q_caveat and "resolution" in fit.q_caveat
+    assert "upper bound" not in fit.q_caveat
+
+
+def test_a_q_of_a_line_wider_than_the_band_searched_is_said_a_bound(record):
+    """Over 2010-2014 the Chandler line's half-power points lie beyond the band
+    searched (f_C +- 0.04 cycles/yr): the width was the band's and Q (11) read as
+    an estimate.  It is said to be an upper bound, the window too short to part the
+    Chandler line from the annual one."""
+    fit = fit_wobble(record, 2010, 2014)
+    assert fit.q_caveat.startswith(
+        f"The Chandler line is wider than the band searched (f_C +- 0.04 cycles/yr): Q "
+        f"is at most {fit.q_estimate:.0f}, an upper bound, not an estimate")
 
 
 def test_units_degrees_work_and_metres_raise(record):

@@ -385,8 +385,15 @@ def _q_estimate(rec: PolarMotionRecord, t_c: float) -> tuple[float, str]:
         hi += 1
     fwhm = float(freqs[hi] - freqs[lo])
     q = f_c / fwhm
+    # (a half-power point not reached within the searched band: the line is wider than
+    # the band, and Q at most this; a short window blends it with the annual line)
+    bound = power[lo] > half or power[hi] > half
     caveat = (
-        f"Q = f_C / FWHM of the Chandler line = {q:.0f}.  The window's own resolution "
+        (f"The Chandler line is wider than the band searched (f_C +- 0.04 cycles/yr): "
+         f"Q is at most {q:.0f}, an upper bound, not an estimate; a window of "
+         f"{years:.1f} yr resolves {1 / years:.3f} cycles/yr, too coarse to part the "
+         f"Chandler line from the annual one (0.16 cycles/yr apart).  " if bound else "")
+        + f"Q = f_C / FWHM of the Chandler line = {q:.0f}.  The window's own resolution "
         f"({1 / years:.3f} cycles/yr over {years:.1f} yr) limits the width, so this is of "
         "the order of the largest Q the record can resolve, not a measurement of the "
         "damping: the wobble is re-excited continuously (atmosphere, ocean, hydrology), so a "
