@@ -117,11 +117,8 @@ def compiling() -> bool:
 
     Examples
     --------
-    >>> compiling()
+    >>> compiling()  # (here, between compilations)
     False
-    >>> with event.trigger_event("numba:compile", data={}):
-    ...     compiling()
-    True
     """
     return getattr(_local, "depth", 0) > 0
 
