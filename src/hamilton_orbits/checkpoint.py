@@ -534,7 +534,8 @@ class ArchiveWriter:
             raise ValueError(
                 f"Expected `every` to schedule at most {MAX_SNAPSHOTS:.0e} snapshots in one "
                 f"call, got every={self.every!r}: {n:.3g} snapshots from t = {t0!r} to "
-                f"{t1!r}; choose a longer `every`, or integrate in shorter calls")
+                f"{t1!r} (in the simulation's time unit: days for a system of Quantities); "
+                f"choose a longer `every`, or integrate in shorter calls")
         return (math.floor((t0 - self.origin) / self.every) + 1,
                 math.floor((t1 - self.origin) / self.every))
 
