@@ -33,7 +33,7 @@ print(ensemble)
 # Run it on a local Dask client (threads, no worker processes)
 # ------------------------------------------------------------
 with Client(processes=False, n_workers=1, threads_per_worker=2,
-            dashboard_address=None) as client:
+            dashboard_address=":0") as client:
     table = ensemble.run(client=client, progress=False)
 print(f"{len(table)} members, {table.attrs['failures']} failed")
 rate_col = next(c for c in table.columns if c.startswith("nodal regression"))

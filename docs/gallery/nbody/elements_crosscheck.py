@@ -60,6 +60,8 @@ def diff(A, B):
 def main(argv=None) -> str:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", help="write elements_crosscheck.txt into this folder "
+                                  "(default: examples/out)")
     args = ap.parse_args(argv)
     n = 2000 if args.quick else 100000
     lines = []
@@ -99,8 +101,8 @@ def main(argv=None) -> str:
                 lines.append(f"  {c.name:44s} {name:8s} {A[i, j]:12.5g} {B[i, j]:12.5g}")
     lines.append("  (lan/argp differences at degenerate inc or e are convention: ours are 0)")
     text = "\n".join(lines)
-    out = HERE.parent / "out"
-    out.mkdir(exist_ok=True)
+    out = HERE.parent / "out" if args.out is None else Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
     (out / "elements_crosscheck.txt").write_text(text + "\n")
     print(text)
     return text

@@ -141,7 +141,7 @@ def simulate_wobble(
     -----
     RuntimeWarning
         When the simulated pole departs from the exact free motion's by more than
-        :data:`WOBBLE_TOLERANCE` of the wobble (its distance kept in
+        ``WOBBLE_TOLERANCE`` (1e-4) of the wobble (its distance kept in
         ``PolePath.error``): ``"splitting4y"`` at the default step of an hour put
         the period 12% short (267.5 d), ``"splitting2"`` lost the pole.
 
