@@ -24,7 +24,7 @@ import argparse
 import os
 import platform
 import sys
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -161,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.pole_of_date:
         text = pole_of_date(args.years)
         print(text)
-        stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+        stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
         RESULTS.mkdir(parents=True, exist_ok=True)
         (RESULTS / "de440_ladder_pole_of_date.md").write_text(
             f"# DE440 ladder: the Earth's pole fixed and of date ({stamp})\n\n"
@@ -177,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     print(summary)
     RESULTS.mkdir(parents=True, exist_ok=True)
-    stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     md = (
         f"# DE440 ladder ({stamp})\n\n"
         f"`PYTHONPATH=src python benchmarks/bench_de440_ladder.py --years {args.years} "

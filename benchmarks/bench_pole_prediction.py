@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import astropy.units as u
@@ -66,7 +66,7 @@ def main(argv: list[str] | None = None) -> str:
     args = parser.parse_args(argv)
     record = load_c04()
     hindcast(record, weekly_starts("2019-01-01", "2019-01-15"), method="ls+ar")  # warm-up
-    when = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    when = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     lines = [f"# Pole prediction hindcasts ({when}, 2-core machine, load average "
              f"{os.getloadavg()[0]:.1f})", ""]
     for label, period in (("paper's period (assumed)", PAPER_PERIOD),

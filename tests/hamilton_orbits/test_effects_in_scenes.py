@@ -4,11 +4,11 @@ effects that exclude each other, all checked at load (issue 32, classes 3 and 17
 from __future__ import annotations
 
 import re
+import tomllib
 
 import astropy.units as u
 import numpy as np
 import pytest
-import tomllib
 
 from hamilton_orbits import Scene, System, integrate
 from hamilton_orbits import effects as fx

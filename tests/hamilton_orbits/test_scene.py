@@ -281,9 +281,8 @@ def test_the_nbody_kind_registers_through_the_entry_point_group():
     """``nbody`` is declared in the group ``hamilton_orbits.scene_kinds`` as
     ``rigid``'s ``rotation`` is; where the installed metadata lacks it, the registry
     loads the same entry point from :data:`~hamilton_orbits.scenes.base.BUILT_IN`."""
-    from pathlib import Path
-
     import tomllib
+    from pathlib import Path
 
     from hamilton_orbits.scenes import base
     from hamilton_orbits.scenes.nbody import kind
