@@ -359,3 +359,21 @@ def test_a_first_ctrl_c_while_the_kernels_compile_stops_at_once(tmp_path, monkey
     err = capsys.readouterr().err
     assert pressed and code == 130, err
     assert "stopping (the kernels were compiling: nothing run yet)" in err
+
+
+def test_a_reader_that_stops_reading_loses_no_file(tmp_path):
+    """``hamilton-orbits run ... | head -3``: the summary was printed before the files
+    were saved, and the broken pipe (the reader gone) ended the command with none
+    written (exit 1, ``BrokenPipeError``).  The files are saved first, and a reader
+    gone is no error.  Here the reader is gone from the start."""
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "hamilton_orbits", "run", "leo-j2",
+                             "--out", str(out), "--no-progress"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    assert proc.wait(timeout=300) == 0, err
+    assert "BrokenPipe" not in err
+    assert {"summary.md", "summary.json", "states.nc", "final.bin"} <= {
+        p.name for p in out.iterdir()}

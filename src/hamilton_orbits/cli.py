@@ -307,20 +307,32 @@ def _finish(scene, result, folder, archive) -> int:
     if result is None:
         return EXIT_FAILED
     with _ctrl_c("saving the run's files first (Ctrl-C again to abort)") as caught:
-        print(result.summary())
-        try:
-            paths = result.save(folder)
+        try:  # (saved before the summary is printed: a reader that stops reading, as
+            paths = result.save(folder)  # `| head` does, loses no file)
         except Exception as exc:
+            _say(result.summary())
             _error(f"the run of {scene.name} ended but saving into {folder}/ failed: "
                    f"{_one_line(exc)}")
             return EXIT_FAILED
-        print(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+        _say(result.summary())
+        _say(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
     if not result.complete and archive is not None:
-        print(f"the run was interrupted; its archive is {archive}/: continue it with "
-              f"hamilton-orbits resume {shlex.quote(str(folder))}")
+        _say(f"the run was interrupted; its archive is {archive}/: continue it with "
+             f"hamilton-orbits resume {shlex.quote(str(folder))}")
     done = result.complete and not caught and not result.interrupted
     return EXIT_OK if done else EXIT_INTERRUPTED
 
+
+
+def _say(text: str) -> None:
+    """Print ``text`` on stdout; a reader gone (``| head`` done, ``less`` quit: a
+    broken pipe) is no error, and the rest of the output goes nowhere."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # (Python's flush at exit then finds none)
+        os.close(devnull)
 
 @contextlib.contextmanager
 def _ctrl_c(saying: str) -> Iterator[list[int]]:
