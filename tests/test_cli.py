@@ -377,3 +377,16 @@ def test_a_reader_that_stops_reading_loses_no_file(tmp_path):
     assert "BrokenPipe" not in err
     assert {"summary.md", "summary.json", "states.nc", "final.bin"} <= {
         p.name for p in out.iterdir()}
+
+
+def test_a_run_without_matplotlib_writes_all_but_its_figures(tmp_path, monkeypatch, capsys):
+    """matplotlib is an extra (``plot``): without it a run integrated, then failed
+    to save (``ModuleNotFoundError``, exit 1), leaving no states file.  The states
+    and summaries are written, the figures left out with the extra named."""
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if it were not installed
+    out = tmp_path / "out"
+    assert main(["run", "dzhanibekov", "--out", str(out), "--no-progress"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["states.nc", "summary.json",
+                                                      "summary.md"]
+    assert ("not written: figures: matplotlib is not installed (python -m pip install "
+            "'hamilton-orbits[plot]')") in capsys.readouterr().err

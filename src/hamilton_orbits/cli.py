@@ -316,6 +316,8 @@ def _finish(scene, result, folder, archive) -> int:
             return EXIT_FAILED
         _say(result.summary())
         _say(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
+        for what in result.not_saved:
+            print(f"hamilton-orbits: not written: {what}", file=sys.stderr)
     if not result.complete and archive is not None:
         _say(f"the run was interrupted; its archive is {archive}/: continue it with "
              f"hamilton-orbits resume {shlex.quote(str(folder))}")

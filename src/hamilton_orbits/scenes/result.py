@@ -79,6 +79,8 @@ class Result:
     compiled: list[tuple[str, float]] = field(default_factory=list)
     units: dict[str, Any] = field(default_factory=dict)
     plotters: list[Callable[[Result], Any]] = field(default_factory=list, repr=False)
+    #: what :meth:`save` could not write, and why (figures without matplotlib)
+    not_saved: list[str] = field(default_factory=list, repr=False)
     writers: list[Callable[[Result, Path], list[Path]]] = field(default_factory=list,
                                                                 repr=False)
 
@@ -175,7 +177,9 @@ class Result:
 
         A scene kind may add files (n-body scenes: the final state as a rebound
         binary, ``final.bin``).  Returns the paths written.  The states file is
-        netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.
+        netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.  The
+        figures need matplotlib (the ``plot`` extra): without it they are left out,
+        the rest written, and :attr:`not_saved` says so.
         """
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
@@ -186,7 +190,16 @@ class Result:
         js = out / "summary.json"
         js.write_text(json.dumps(self._json(), indent=2) + "\n", encoding="utf-8")
         written.append(js)
-        if self.plotters:
+        written.extend(self._save_states(out))
+        for writer in self.writers:
+            written.extend(writer(self, out))
+        self.not_saved = []
+        if self.plotters and not _can_draw():
+            # (an extra: the states and summaries are written all the same, last
+            # the figures, each run's own)
+            self.not_saved.append("figures: matplotlib is not installed (python -m pip "
+                                  "install 'hamilton-orbits[plot]')")
+        elif self.plotters:
             import matplotlib.pyplot as plt
 
             for i, fig in enumerate(self.plot()):
@@ -195,9 +208,6 @@ class Result:
                 fig.savefig(path, dpi=110, bbox_inches="tight")
                 plt.close(fig)
                 written.append(path)
-        written.extend(self._save_states(out))
-        for writer in self.writers:
-            written.extend(writer(self, out))
         return written
 
     def _save_states(self, out: Path) -> list[Path]:
@@ -253,3 +263,12 @@ def _utf8(text: str) -> bytes:
     """A text attribute of a netCDF-3 file: its UTF-8 bytes (``char``, as netCDF-C
     writes text; xarray reads it back as the ``str``)."""
     return text.encode("utf-8")
+
+
+def _can_draw() -> bool:
+    """Whether matplotlib (the ``plot`` extra) imports."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
