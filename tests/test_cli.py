@@ -390,3 +390,11 @@ def test_a_run_without_matplotlib_writes_all_but_its_figures(tmp_path, monkeypat
                                                       "summary.md"]
     assert ("not written: figures: matplotlib is not installed (python -m pip install "
             "'hamilton-orbits[plot]')") in capsys.readouterr().err
+
+
+def test_a_cross_check_of_effects_without_reboundx_names_the_extra(monkeypatch, capsys):
+    """reboundx is an extra (``crosscheck``): without it the cross-check of a scene
+    with effects ended in a bare ``No module named 'reboundx'``."""
+    monkeypatch.setitem(sys.modules, "reboundx", None)  # as if it were not installed
+    assert main(["--no-progress", "crosscheck", "leo-j2"]) == 1
+    assert "python -m pip install 'hamilton-orbits[crosscheck]'" in capsys.readouterr().err

@@ -88,7 +88,11 @@ def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
     """Attach the reboundx equivalents of the listed effects; returns the Extras."""
     if not effects:
         return None
-    import reboundx
+    try:
+        import reboundx
+    except ImportError:
+        raise ImportError("the cross-check of effects against reboundx needs it: python -m "
+                          "pip install 'hamilton-orbits[crosscheck]'") from None
 
     rebx = reboundx.Extras(sim)
     for name, params in effects:
