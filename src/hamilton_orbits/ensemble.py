@@ -201,7 +201,7 @@ class Ensemble:
             import pandas as pd
         except ImportError as exc:  # pragma: no cover - pandas comes with the extra
             raise ImportError(
-                "Ensemble tables need pandas: pip install 'hamilton-orbits[dask]'"
+                "Ensemble tables need pandas: pip install 'hamilton-orbits[ensemble]'"
             ) from exc
         args = [(self.scene.data, self.scene.source, m) for m in self.members]
         bar = progress_bar(len(args), progress, "member")

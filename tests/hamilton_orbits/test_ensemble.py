@@ -172,3 +172,14 @@ def test_a_ctrl_c_cancels_the_members_a_pool_has_not_begun(monkeypatch):
         ens.run(progress=False, workers=2)
     pool.shutdown(wait=True)
     assert len(ran) <= 2  # (the first, and at most the one the worker had taken)
+
+
+def test_a_local_ensemble_without_pandas_names_its_own_extra(monkeypatch, tmp_path, capsys):
+    """Ensemble tables need pandas, which only the Dask extra brought: the message
+    sent a user who runs on this machine to install Dask.  pandas is the
+    ``ensemble`` extra's."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # as if it were not installed
+    code = main(["ensemble", "dzhanibekov", "--vary", "duration=40 s", "--no-progress"])
+    assert code != 0
+    assert "pip install 'hamilton-orbits[ensemble]'" in capsys.readouterr().err
