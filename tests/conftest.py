@@ -12,6 +12,7 @@ line when numba's cache holds none of the kernels yet (:func:`numba_cache_cold`)
 
 import importlib.util
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -76,3 +77,21 @@ def _close_figures():
     if pyplot is not None:
         for num in set(pyplot.get_fignums()) - before:
             pyplot.close(num)
+
+
+@pytest.fixture(autouse=True)
+def _pythons_ctrl_c():
+    """Tests that press Ctrl-C do so where CPython's own SIGINT handler is, as in an
+    interactive process; a suite started with SIGINT ignored (a background job of a
+    non-interactive shell, some CI runners) has none (``getsignal`` gives
+    ``SIG_IGN``, which cannot be called), and is given it for each test, then the
+    handler it had back.  Elsewhere nothing is changed."""
+    previous = signal.getsignal(signal.SIGINT)
+    if callable(previous):
+        yield
+        return
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
