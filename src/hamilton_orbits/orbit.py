@@ -262,7 +262,9 @@ class KeplerOrbit(OrbitElements):
         e : array_like, shape (...)
             Eccentricity, ``e >= 0``; ``e == 1`` exactly is the parabola.
         inc : array_like or Quantity (angle), shape (...)
-            Inclination in [0, pi] (``inc == pi`` is exactly retrograde).
+            Inclination in [0, pi] (``inc == pi`` is exactly retrograde).  An angle
+            given as a plain number is in radians, beside Quantity lengths too
+            (``lan=10`` is 10 rad, 573 deg: give ``10 * u.deg``).
         lan, argp : array_like or Quantity (angle), shape (...)
             Longitude of the ascending node, argument of periapsis.
         nu, M : array_like or Quantity (angle), shape (...); exactly one
