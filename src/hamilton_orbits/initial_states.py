@@ -231,7 +231,8 @@ class InitialStates:
         Returns
         -------
         System
-            A Quantity system (au, day); the bodies' names are as asked.
+            A Quantity system (au, day); the bodies' names are the ones asked, in lower
+            case (astropy's: ``"Jupiter"`` is ``s["jupiter"]``).
 
         Raises
         ------
