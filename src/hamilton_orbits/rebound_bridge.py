@@ -214,29 +214,46 @@ def rebound_trajectory(system: System, t_out: np.ndarray, effects: Sequence[Any]
 
     Returns ``(r, v, wall_time, steps)`` with ``r``, ``v`` of shape (n_t, n, 3).
     """
-    sim = to_rebound(system)
+    effects = EffectSet.of(effects, "nbody")
+    order = _source_first(system, effects)  # (rebound's rows: our bodies in this order)
+    work = system if order == sorted(order) else System([system[system.names[k]]
+                                                          for k in order])
+    sim = to_rebound(work)
     sim.integrator = integrator
     sim.t = float(t_out[0])
-    rebx = _add_reboundx_effects(sim, system, EffectSet.of(effects, "nbody"))
+    rebx = _add_reboundx_effects(sim, work, effects)
     n = len(system)
     r = np.empty((len(t_out), n, 3))
     v = np.empty_like(r)
     buf = np.empty((n, 3))
     sim.serialize_particle_data(xyz=buf)
-    r[0] = buf
+    r[0, order] = buf
     sim.serialize_particle_data(vxvyvz=buf)
-    v[0] = buf
+    v[0, order] = buf
     wall = 0.0
     for k in range(1, len(t_out)):
         start = _time.perf_counter()
         sim.integrate(float(t_out[k]), exact_finish_time=1)
         wall += _time.perf_counter() - start
         sim.serialize_particle_data(xyz=buf)
-        r[k] = buf
+        r[k, order] = buf
         sim.serialize_particle_data(vxvyvz=buf)
-        v[k] = buf
+        v[k, order] = buf
     _ = rebx
     return r, v, wall, int(sim.steps_done)
+
+
+def _source_first(system: System, effects: EffectSet) -> list[int]:
+    """Our bodies in the order rebound is given them: the source of ``gr`` or
+    ``gr_potential`` first (reboundx 5.1 takes particle 0 for it whichever particle
+    its ``gr_source`` marks: with the Sun last, Mercury's GR precession was not
+    there at all, a false disagreement of 1e4 km), the others as they are."""
+    n = len(system)
+    for name, params in effects:
+        if name in ("gr", "gr_potential"):
+            source = int(get("nbody", name).params(system, dict(params))[0])
+            return [source] + [k for k in range(n) if k != source]
+    return list(range(n))
 
 
 def crosscheck(
