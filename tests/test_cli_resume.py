@@ -179,8 +179,8 @@ def test_ctrl_c_while_a_finished_run_is_saved_keeps_its_files(tmp_path, capsys):
 
     from hamilton_orbits import cli
 
-    class Finished:
-        complete = True
+    class Finished:  # (a Result's interface, as the command line reads it)
+        complete, interrupted, not_saved = True, False, []
 
         def summary(self):
             return "summary"

@@ -464,3 +464,26 @@ def test_a_merged_body_has_the_radius_of_the_summed_volume_in_the_system_after()
     merged = np.cbrt(0.01**3 + 0.02**3)
     assert sim.system.as_arrays().radius.tolist() == [merged]
     assert traj.final.as_arrays().radius.tolist() == [merged]
+
+
+@pytest.mark.parametrize("coordinates", ["democratic_heliocentric", "jacobi"])
+def test_wh_goes_on_when_its_central_body_merges_into_one_listed_before_it(coordinates):
+    """A comet listed before the Sun falls into it: the merge keeps the lower index
+    (the comet, now of the Sun's mass), and wh kept the Sun's row, massless and
+    parked, as its central body: ``the Kepler step of body 0 failed``.  The body of
+    largest GM is made the centre again; the run is the one with the Sun listed
+    first, bit for bit (the same bodies in the same rows before and after)."""
+    from hamilton_orbits.integrators import WH
+
+    def run(order):
+        bodies = {"sun": Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01),
+                  "comet": Body("comet", 1e-6, [0.5, 0, 0], [0, 0.05, 0], radius=1e-4),
+                  "planet": Body("planet", 1e-3, [0, 2.0, 0], [-0.7, 0, 0], radius=1e-3)}
+        return integrate(System([bodies[n] for n in order]), 2.0,
+                         method=WH(coordinates=coordinates), dt=1e-3,
+                         events=[{"name": "collision", "action": "merge"}])
+
+    first, later = run(["sun", "comet", "planet"]), run(["comet", "sun", "planet"])
+    assert later.final.names == ("comet", "planet") and later.final.gm[0] == 1.000001
+    assert later.events[0]["time"] == first.events[0]["time"]
+    np.testing.assert_array_equal(later.final.as_arrays().r, first.final.as_arrays().r)

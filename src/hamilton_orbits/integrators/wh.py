@@ -252,13 +252,11 @@ class _State:
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  method: WH, dt: float, events: EventLog | None) -> None:
         n = r0.shape[0]
-        c = int(gm.argmax())
-        # the central body first (row i of the coordinates is body order[i])
-        order = np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
+        order = _central_first(gm)  # (row i of the coordinates is body order[i])
         extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
         self.log = events if events is not None else EventLog.none(n)
-        if c != 0:
+        if order[0] != 0:
             self.log.index_map = order
         self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra,
                             run_parameters(rhs), rhs.extra is not None)  # (p: the kernels
@@ -349,10 +347,21 @@ class _State:
             self.t = float(ws[0])  # the end of the step (the split holds that state)
             self.cut = None  # (a stop ends the call: the next lays its steps afresh)
             return StopAtEvent(i, float(ws[0]), self.steps - first)
-        self.split = self.split.renewed(self.gm)
+        order = self.split.order
+        if self.gm[order[0]] < self.gm.max():  # (the central body merged into another,
+            order = _central_first(self.gm)  # which keeps the lower index: the largest
+            self.log.index_map = order if order[0] != 0 else None  # GM is the centre)
+        self.split = self.split.renewed(self.gm, order)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
         self.watch = self.log.kernel_watch()
         return None
+
+
+def _central_first(gm: np.ndarray) -> np.ndarray:
+    """The bodies' order in the coordinates: the one of largest ``gm`` (the central
+    body) first, the others as they are."""
+    n, c = len(gm), int(np.argmax(gm))
+    return np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
 
 
 class _Split:
@@ -379,10 +388,10 @@ class _Split:
         else:
             self.com = np.empty(6)
 
-    def renewed(self, gm: np.ndarray) -> _Split:
-        """The same splitting for new ``gm`` (after a merge or a removal), on the same
-        arrays."""
-        new = _Split(gm, self.order, self.jacobi, self.corrector, self.extra, self.p,
+    def renewed(self, gm: np.ndarray, order: np.ndarray) -> _Split:
+        """The same splitting for new ``gm`` (after a merge or a removal) and the
+        bodies in ``order``, on the same arrays."""
+        new = _Split(gm, order, self.jacobi, self.corrector, self.extra, self.p,
                      self.has_extra)
         new.q, new.u = self.q, self.u
         return new
