@@ -398,3 +398,18 @@ def test_a_cross_check_of_effects_without_reboundx_names_the_extra(monkeypatch, 
     monkeypatch.setitem(sys.modules, "reboundx", None)  # as if it were not installed
     assert main(["--no-progress", "crosscheck", "leo-j2"]) == 1
     assert "python -m pip install 'hamilton-orbits[crosscheck]'" in capsys.readouterr().err
+
+
+def test_set_puts_right_a_value_the_file_gets_wrong(tmp_path, capsys):
+    """The file was checked before the ``--set`` overrides were applied: a value it
+    gets wrong (``duration = "10"``, no unit) was refused at its line, whatever
+    ``--set duration=...`` said.  The overrides are applied first, the scene then
+    checked once; without them the file's line is still named."""
+    scene = tmp_path / "cont.toml"
+    scene.write_text('kind = "nbody"\ndescription = "x"\nduration = "10"\ncadence = "1 d"\n'
+                     '[initial]\nsolar_system = { bodies = ["sun", "jupiter"] }\n')
+    assert main(["run", str(scene), "--out", str(tmp_path / "a"), "--no-progress"]) == 2
+    assert "cont.toml:3: duration: expected a time" in capsys.readouterr().err
+    assert main(["run", str(scene), "--out", str(tmp_path / "b"), "--no-progress",
+                 "--set", 'duration="20 d"']) == 0
+    assert (tmp_path / "b" / "states.nc").exists()

@@ -128,26 +128,27 @@ def _load_scene(ref: str, sets: Sequence[str], text: str | None = None):
     archived run recorded it), with ``--set`` overrides applied."""
     from hamilton_orbits.scene import Scene
 
+    # (the overrides applied before the scene is checked: a value the file gets wrong
+    # may be set right on the command line)
+    values = _set_values(ref, sets)
     if text is not None:
-        scene = Scene.from_text(text, ref)
-    elif _scene_file(ref) is not None:
-        scene = Scene.from_toml(ref)
-    else:
-        scene = Scene.bundled(ref)
-    return _with_sets(scene, sets)
+        return Scene.from_text(text, ref, values)
+    if _scene_file(ref) is not None:
+        return Scene.from_toml(ref, values)
+    return Scene.bundled(ref, values)
 
 
-def _with_sets(scene, sets: Sequence[str]):
-    """``scene`` with the ``--set KEY=VALUE`` overrides ``sets`` applied."""
+def _set_values(ref: str, sets: Sequence[str]) -> dict[str, str]:
+    """The ``--set KEY=VALUE`` overrides ``sets`` as a mapping."""
     from hamilton_orbits.scene import SceneError
 
     values = {}
     for item in sets:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise SceneError([f"{scene.source}: --set {item!r}: expected KEY=VALUE"])
+            raise SceneError([f"{ref}: --set {item!r}: expected KEY=VALUE"])
         values[key.strip()] = value.strip()
-    return scene.with_values(values) if values else scene
+    return values
 
 
 def _wrap(text: str, width: int) -> list[str]:

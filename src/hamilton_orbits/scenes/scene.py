@@ -296,8 +296,10 @@ class Scene:
         return cls(data, source)
 
     @classmethod
-    def from_toml(cls, path: str | Path) -> Scene:
-        """Read and validate a scene file.
+    def from_toml(cls, path: str | Path, values: Mapping[str, Any] | None = None) -> Scene:
+        """Read and validate a scene file (``values``: keys replaced first, as
+        :meth:`with_values` does, the scene then checked once: a value the file gets
+        wrong may be set right).
 
         Raises
         ------
@@ -313,11 +315,13 @@ class Scene:
         except UnicodeDecodeError as exc:
             raise SceneError([f"{p}: not a scene file: not text in UTF-8 (byte "
                               f"{exc.object[exc.start]:#04x} at offset {exc.start})"]) from None
-        return cls.from_text(text, str(p))
+        return cls.from_text(text, str(p), values)
 
     @classmethod
-    def from_text(cls, text: str, source: str) -> Scene:
-        r"""A scene from the text of a scene file (``source``: the file, for messages).
+    def from_text(cls, text: str, source: str,
+                  values: Mapping[str, Any] | None = None) -> Scene:
+        r"""A scene from the text of a scene file (``source``: the file, for messages;
+        ``values``: keys replaced before the scene is checked, as in :meth:`from_toml`).
 
         Raises
         ------
@@ -338,21 +342,32 @@ class Scene:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise SceneError([f"{source}: TOML syntax error: {exc}"]) from exc
-        return cls(data, source, text=text)
+        return cls._checked(data, source, text, values)
+
+    @classmethod
+    def _checked(cls, data: dict, source: str, text: str,
+                 values: Mapping[str, Any] | None) -> Scene:
+        """The scene of ``data`` (read from ``text``) with ``values`` replaced, checked
+        once."""
+        if not values:
+            return cls(data, source, text=text)
+        data, overrides = _with_values(data, source, values, ())
+        return cls(data, source, text=text, overrides=overrides)
 
     @staticmethod
     def _bundled_dir():
         return resources.files("hamilton_orbits") / "data" / "scenes"
 
     @classmethod
-    def bundled(cls, name: str) -> Scene:
-        """One of the scenes that ship with the package (see :meth:`list_bundled`)."""
+    def bundled(cls, name: str, values: Mapping[str, Any] | None = None) -> Scene:
+        """One of the scenes that ship with the package (see :meth:`list_bundled`;
+        ``values`` as in :meth:`from_toml`)."""
         names = [n for n, _ in cls.list_bundled()]
         if name not in names:
             raise SceneError([f"{name}: no bundled scene of that name{S.closest(name, names)}"])
         res = cls._bundled_dir() / f"{name}.toml"
         text = res.read_text(encoding="utf-8")
-        return cls(tomllib.loads(text), f"{name}.toml", text=text)
+        return cls._checked(tomllib.loads(text), f"{name}.toml", text, values)
 
     @classmethod
     def list_bundled(cls) -> list[tuple[str, str]]:
