@@ -219,6 +219,8 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(ephemeris="de430"), "`ephemeris`"),
     (dict(t=2000 * u.day), r"`ephemeris` to cover JD"),
     (dict(chunk=0), "`chunk` .* got 0"),
+    (dict(tol=2.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 2.0"),  # (was taken)
+    (dict(tol=0.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 0.0"),
     (dict(chunk=True), "`chunk`"),
     (dict(workers=1.5), "`workers` .* threads .* got 1.5"),
     (dict(client="tcp://127.0.0.1:8786"), "`client` .* connect first"),
