@@ -239,6 +239,23 @@ def test_names_read_back_from_a_binary_this_process_wrote(tmp_path):
     assert read == [["sun", "jupiter", "saturn", "comet"]] * 16
 
 
+def test_a_scene_from_a_rebound_binary_says_whose_axes_it_takes(tmp_path):
+    """A rebound binary records no frame: a scene started from the ecliptic solar
+    system's ``final.bin`` said "ICRS axes" of ecliptic numbers.  Without
+    ``[initial] frame`` the summary says the axes are taken as ICRS's."""
+    first = Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)
+    first.save(tmp_path / "a")
+    base = {"kind": "nbody", "description": "from a binary", "duration": "1 d",
+            "initial": {"rebound": str(tmp_path / "a" / "final.bin"),
+                        "names": ["sun", "jupiter", "saturn", "comet"]}}
+    taken = Scene.from_dict(base).run(progress=False)
+    assert taken.frame == ("ICRS axes (equatorial) as taken for the rebound binary's, "
+                           "which records none ([initial] frame names them)")
+    named = Scene.from_dict({**base, "initial": {**base["initial"], "frame": "ecliptic"}})
+    assert named.run(progress=False).frame == "J2000 mean ecliptic and equinox"
+
+
 def test_rebound_binary_in_and_out(tmp_path):
     first = Scene.bundled("comet-encounter").with_values(
         {"duration": "0.1 yr", "crosscheck": False}).run(progress=False)

@@ -181,11 +181,19 @@ def scene_frame(spec: dict) -> str:
     return spec["initial"].get("frame") or "icrs"
 
 
-def frame_note(spec: dict) -> str:
+def frame_note(spec: dict, given: dict | None = None) -> str:
     """The frame line of a scene's summary: the axes, and the origin of the
-    solar-system bodies."""
+    solar-system bodies (``given``: the scene's ``[initial]`` table as written, to
+    tell a frame named from the default)."""
     note = frame_label(scene_frame(spec))
-    ss = spec["initial"].get("solar_system")
+    init = spec["initial"]
+    if init.get("rebound") is not None and "frame" not in (given or {}) and not any(
+            init.get(k) is not None for k in ("solar_system", "ephemeris")):
+        # (a rebound binary records no frame: a final.bin of the ecliptic solar
+        # system was called ICRS without a word)
+        note += (" as taken for the rebound binary's, which records none ([initial] "
+                 "frame names them)")
+    ss = init.get("solar_system")
     if ss is not None:
         origin = ss.get("origin") or "barycenter"
         note += ("; origin: the centre of mass of the scene's solar-system bodies, at rest"

@@ -189,7 +189,7 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
         result.metrics[key] = float(np.max(change))
     _particles_into(result, traj, gm)
     frame = scene_frame(scene.spec)
-    result.frame = frame_note(scene.spec)
+    result.frame = frame_note(scene.spec, scene.data.get("initial"))
     result.plotters.append(lambda res: plot_orbits(res, gm, frame))
     result.plotters.append(lambda res: plot_energy(res, what, conserved))
 
