@@ -413,3 +413,18 @@ def test_set_puts_right_a_value_the_file_gets_wrong(tmp_path, capsys):
     assert main(["run", str(scene), "--out", str(tmp_path / "b"), "--no-progress",
                  "--set", 'duration="20 d"']) == 0
     assert (tmp_path / "b" / "states.nc").exists()
+
+
+def test_a_run_into_a_folder_of_an_earlier_run_names_the_files_it_did_not_write(
+        tmp_path, capsys):
+    """A rotation scene run into the folder of an n-body one left that run's
+    figures and final.bin beside its own summary, as if they were its own, without
+    a word.  Nothing is removed; the files this run did not write are named."""
+    out = tmp_path / "out"
+    assert main(["run", "leo-j2", "--set", "duration=1 h", "--out", str(out),
+                 "--no-progress"]) == 0
+    capsys.readouterr()
+    assert main(["run", "dzhanibekov", "--out", str(out), "--no-progress"]) == 0
+    assert (f"{out}/ also holds files this run did not write (an earlier run's?): "
+            f"energy_error.png, final.bin, orbits.png") in capsys.readouterr().err
+    assert (out / "final.bin").exists()

@@ -37,6 +37,7 @@ import os
 import shlex
 import sys
 from collections.abc import Iterator, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -319,6 +320,7 @@ def _finish(scene, result, folder, archive) -> int:
         _say(f"\nwrote {len(paths)} files to {folder}/: {', '.join(p.name for p in paths)}")
         for what in result.not_saved:
             print(f"hamilton-orbits: not written: {what}", file=sys.stderr)
+        _earlier_files(folder, paths)
     if not result.complete and archive is not None:
         _say(f"the run was interrupted; its archive is {archive}/: continue it with "
              f"hamilton-orbits resume {shlex.quote(str(folder))}")
@@ -326,6 +328,20 @@ def _finish(scene, result, folder, archive) -> int:
     return EXIT_OK if done else EXIT_INTERRUPTED
 
 
+
+
+def _earlier_files(folder: Path, written: list[Path]) -> None:
+    """Say which files of ``folder`` this run did not write (an earlier run's figures
+    beside this one's summary read as this run's); none is removed."""
+    names = {p.name for p in written}
+    try:
+        other = sorted(p.name for p in Path(folder).iterdir()
+                       if p.is_file() and not p.name.startswith(".") and p.name not in names)
+    except OSError:
+        return
+    if other:
+        print(f"hamilton-orbits: {folder}/ also holds files this run did not write (an "
+              f"earlier run's?): {', '.join(other)}", file=sys.stderr)
 
 def _say(text: str) -> None:
     """Print ``text`` on stdout; a reader gone (``| head`` done, ``less`` quit: a
