@@ -62,7 +62,6 @@ def pytest_collection_finish(session):
     gc.freeze()
 
 
-
 @pytest.fixture(autouse=True)
 def _close_figures():
     """Close the figures a test opened and left open (a scene's ``plot()`` returns its

@@ -172,7 +172,6 @@ def test_crosscheck_command_on_an_nbody_scene(capsys):
     assert "rebound ias15 + reboundx" in out and "satellite" in out
 
 
-
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 
 

@@ -257,7 +257,6 @@ def contents(folder: Path, keep: tuple[str, ...] | None = None) -> Contents:
     return out
 
 
-
 def _missing(folder: Path, a: int, b: int) -> str:
     """What a gap in an archive's numbers, snapshots ``a`` to ``b``, says: no file
     of the folder holds them (a writer numbers its snapshots on from the folder's
@@ -265,6 +264,7 @@ def _missing(folder: Path, a: int, b: int) -> str:
     which = f"snapshot {a} is" if a == b else f"snapshots {a} to {b} are"
     return (f"{folder}: {which} missing: no file of the archive holds them (a file "
             f"removed or moved away?)")
+
 
 def snapshot_at(folder: Path, number: int) -> tuple[Path, dict[str, Any],
                                                      dict[str, np.ndarray]] | None:
@@ -316,6 +316,7 @@ def _next_number(folder: Path) -> int:
 #: the most snapshots of ``every`` in one ``integrate`` call: 10 GB on disk at
 #: least (about a kilobyte each), their times 80 MB in memory
 MAX_SNAPSHOTS = 10**7
+
 
 class ArchiveWriter:
     """The schedule and folder of an archive written while a simulation runs.

@@ -328,8 +328,6 @@ def _finish(scene, result, folder, archive) -> int:
     return EXIT_OK if done else EXIT_INTERRUPTED
 
 
-
-
 def _earlier_files(folder: Path, written: list[Path]) -> None:
     """Say which files of ``folder`` this run did not write (an earlier run's figures
     beside this one's summary read as this run's); none is removed."""
@@ -343,6 +341,7 @@ def _earlier_files(folder: Path, written: list[Path]) -> None:
         print(f"hamilton-orbits: {folder}/ also holds files this run did not write (an "
               f"earlier run's?): {', '.join(other)}", file=sys.stderr)
 
+
 def _say(text: str) -> None:
     """Print ``text`` on stdout; a reader gone (``| head`` done, ``less`` quit: a
     broken pipe) is no error, and the rest of the output goes nowhere."""
@@ -352,6 +351,7 @@ def _say(text: str) -> None:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # (Python's flush at exit then finds none)
         os.close(devnull)
+
 
 @contextlib.contextmanager
 def _ctrl_c(saying: str) -> Iterator[list[int]]:

@@ -402,7 +402,6 @@ DEFAULT_BODIES = (
 )
 
 
-
 def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None,
                        frame: str = "icrs", origin: str = "barycenter") -> list[dict[str, Any]]:
     """The keyword arguments of one :class:`~hamilton_orbits.nbody.Body` per body of

@@ -117,6 +117,7 @@ def test_the_snapshots_between_a_calls_outputs_hold_the_whole_state(tmp_path, kw
     assert _same(rest.r[-1], end.r[-1]) and _same(rest.v[-1], end.v[-1])
     assert again.steps == quiet.steps
 
+
 @pytest.mark.parametrize("kw", [KW, dict(method="radau15", every_steps=12)],
                          ids=["every", "every_steps"])
 def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path, kw):

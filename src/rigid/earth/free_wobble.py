@@ -27,6 +27,7 @@ from rigid.integrators import integrate
 
 __all__ = ["WOBBLE_TOLERANCE", "PolePath", "pole_path", "simulate_wobble"]
 
+
 def _float(x: Any, unit: u.UnitBase) -> np.ndarray:
     """SI floats from a Quantity or from the SI floats of RigidBody/RigidTrajectory."""
     if isinstance(x, u.Quantity):

@@ -105,7 +105,6 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     return (2.0 * np.pi / abs(float(sol.x[0]))) * u.day
 
 
-
 @dataclass(frozen=True)
 class WobbleFit:
     """The least-squares wobble fit of :func:`fit_wobble`.

@@ -59,7 +59,6 @@ def initial_names(spec: dict) -> list[str]:
     return names
 
 
-
 def output_times(spec: dict) -> u.Quantity:
     """The output times of a validated ``nbody`` scene: every ``cadence`` (a thousandth
     of the duration by default) from 0 to ``duration``, the end included."""
