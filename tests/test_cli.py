@@ -367,7 +367,7 @@ def test_a_reader_that_stops_reading_loses_no_file(tmp_path):
     gone is no error.  Here the reader is gone from the start."""
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "hamilton_orbits", "run", "leo-j2",
-                             "--out", str(out), "--no-progress"],
+                             "--set", "duration=1 h", "--out", str(out), "--no-progress"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.close()
     err = proc.stderr.read().decode()
