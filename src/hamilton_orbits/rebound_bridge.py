@@ -216,8 +216,7 @@ def rebound_trajectory(system: System, t_out: np.ndarray, effects: Sequence[Any]
     """
     effects = EffectSet.of(effects, "nbody")
     order = _source_first(system, effects)  # (rebound's rows: our bodies in this order)
-    work = system if order == sorted(order) else System([system[system.names[k]]
-                                                          for k in order])
+    work = system if order[0] == 0 else System([system[system.names[k]] for k in order])
     sim = to_rebound(work)
     sim.integrator = integrator
     sim.t = float(t_out[0])

@@ -256,8 +256,7 @@ class _State:
         extra = _setup.accel_arg(rhs.extra if rhs.extra is not None else _nbody.no_effects)
         self.gm = np.array(gm, dtype=np.float64)  # merges change it
         self.log = events if events is not None else EventLog.none(n)
-        if order[0] != 0:
-            self.log.index_map = order
+        self.log.index_map = _index_map(order)
         self.split = _Split(self.gm, order, method.jacobi, method.corrector, extra,
                             run_parameters(rhs), rhs.extra is not None)  # (p: the kernels
         # write its clock)
@@ -350,7 +349,7 @@ class _State:
         order = self.split.order
         if self.gm[order[0]] < self.gm.max():  # (the central body merged into another,
             order = _central_first(self.gm)  # which keeps the lower index: the largest
-            self.log.index_map = order if order[0] != 0 else None  # GM is the centre)
+            self.log.index_map = _index_map(order)  # GM is the centre)
         self.split = self.split.renewed(self.gm, order)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
         self.watch = self.log.kernel_watch()
@@ -362,6 +361,11 @@ def _central_first(gm: np.ndarray) -> np.ndarray:
     body) first, the others as they are."""
     n, c = len(gm), int(np.argmax(gm))
     return np.arange(n) if c == 0 else np.concatenate([[c], np.delete(np.arange(n), c)])
+
+
+def _index_map(order: np.ndarray) -> np.ndarray | None:
+    """The events log's kernel-to-system body numbers for ``order`` (None: the same)."""
+    return order if order[0] != 0 else None
 
 
 class _Split:
