@@ -521,3 +521,24 @@ def test_the_nodal_regression_is_measured_on_the_primarys_equator():
     metrics = leo.with_values({"duration": "0.5 d", "effects": "[]"}).run(
         progress=False).metrics
     assert "J2 first-order formula" not in metrics and "ratio simulated / formula" not in metrics
+
+
+def test_the_summary_says_what_was_set_since_the_scenes_file(tmp_path):
+    """``--set duration="10 yr"`` ran 10 years under the file's description "for
+    1000 years", and nothing said so; the summary (text and JSON) names the keys
+    set since the file, with their values, in the order set."""
+    import json
+
+    from hamilton_orbits.scenes.result import Result
+
+    scene = Scene.bundled("solar-system", {"duration": "10 yr", "initial.frame": "icrs"})
+    assert scene.changed == {"duration": "10 yr", "initial.frame": "icrs"}
+    assert Scene.bundled("solar-system").changed == {}
+    result = Result(scene=scene, times=np.array([0.0, 1.0]) * u.yr)
+    lines = result.summary().splitlines()
+    assert lines[1] == "set since the scene's file: duration = 10 yr, initial.frame = icrs"
+    result.save(tmp_path)
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["set"] == {"duration": "10 yr", "initial.frame": "icrs"}
+    plain = Result(scene=Scene.bundled("solar-system"), times=np.array([0.0, 1.0]) * u.yr)
+    assert not any(line.startswith("set since") for line in plain.summary().splitlines())

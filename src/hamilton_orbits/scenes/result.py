@@ -96,6 +96,9 @@ class Result:
         """The summary table as text (what the command prints)."""
         s = self.scene
         lines = [f"scene {s.name} ({s.kind}): {s.spec.get('description', '').strip()}"]
+        if s.changed:  # (the description is the file's: what was set since, said)
+            lines.append("set since the scene's file: " + ", ".join(
+                f"{k} = {v}" for k, v in s.changed.items()))
         effects = ", ".join(e["name"] for e in s.effects) or "none"
         lines.append(f"effects: {effects}")
         if self.frame:
@@ -160,6 +163,7 @@ class Result:
             "scene": self.scene.name,
             "kind": self.scene.kind,
             "description": self.scene.spec.get("description", ""),
+            "set": {k: conv(v) for k, v in self.scene.changed.items()},
             "effects": [{k: conv(v) for k, v in e.items()} for e in self.scene.effects],
             "complete": self.complete,
             "frame": self.frame,

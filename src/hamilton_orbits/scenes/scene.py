@@ -283,6 +283,25 @@ class Scene:
         self._overrides = tuple(overrides)
         self.spec = self._validate(self.data)
 
+    @property
+    def changed(self) -> dict[str, Any]:
+        """The keys set since the scene's file or mapping (``--set KEY=VALUE``,
+        :meth:`with_values`), ``{"key.path": value}``, in the order set (the
+        ``description`` is the file's: it does not follow them).
+
+        Examples
+        --------
+        >>> Scene.bundled("dzhanibekov").with_values({"duration": "40 s"}).changed
+        {'duration': '40 s'}
+        """
+        out: dict[str, Any] = {}
+        for path in self._overrides:
+            node: Any = self.data
+            for part in path:
+                node = node[part]
+            out[_path_text(path)] = node
+        return out
+
     # --- construction -------------------------------------------------
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> Scene:
