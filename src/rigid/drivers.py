@@ -211,15 +211,17 @@ def _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params, recentre,
     return q, w, count, drift
 
 
-def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress):
+def _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol, max_step, progress, stop=None):
     """``(q, omega, steps, nfev, drift)`` by the shared DOP853 driver
-    (:func:`hamilton_orbits.integrators.dop853.solve`, dense output)."""
+    (:func:`hamilton_orbits.integrators.dop853.solve`, dense output; the bar moved,
+    output by output, as the steps pass them; the outputs reached when ``stop()``,
+    asked every few dozen steps, ended the run)."""
     bar = _bar(t_out.size - 1, "output", progress)
     y, steps, nfev = dop853.solve(
         lambda t, y: _k.rhs_quaternion(t, y, m, kind, params), np.concatenate([q0, w0]),
         t_out, rtol=rtol, atol=atol, max_step=max_step, restart=False,
         on_output=None if bar is None else (lambda i, n: bar.update(1)),
-        hint="a shorter span, or a fixed-step method with its dt",
+        hint="a shorter span, or a fixed-step method with its dt", stop=stop,
     )
     if bar is not None:
         bar.close()
@@ -277,8 +279,8 @@ def integrate_arrays(
     fixed-step methods and caps DOP853's step; ``rtol``, ``atol`` (scalar or
     (7,) for ``(q, omega)``) are DOP853's tolerances.  ``stop()``, asked between
     chunks of about 1% of the steps (and of at most 65 536) by the fixed-step
-    methods (the same steps and bits), ends the run there with the outputs reached
-    (DOP853 runs to the end).
+    methods (the same steps and bits), and every 64 steps by DOP853 (the same steps
+    and outputs), ends the run there with the outputs reached.
 
     Returns ``(t (n,), q (n, 4), omega (n, 3), steps, count, norm_drift)``
     with unit quaternions; ``t`` the times reached; ``count`` is the number of
@@ -303,8 +305,9 @@ def integrate_arrays(
         t_out = (np.linspace(0.0, float(t_arr), 101 if n_out is None else n_out)
                  if t_arr.ndim == 0 else t_arr)
         q, w, steps, nfev, drift = _run_dop853(m, q0, w0, t_out, kind, params, rtol, atol,
-                                               np.inf if dt is None else float(dt), progress)
-        return t_out, q, w, steps, nfev, drift
+                                               np.inf if dt is None else float(dt), progress,
+                                               stop)
+        return t_out[:len(q)], q, w, steps, nfev, drift
     n_steps, h, out_steps = _grid(t_arr, float(dt), n_out)
     q, w, count, drift = _run_fixed(method, m, q0, w0, h, n_steps, out_steps, kind, params,
                                     recentre, progress, stop)

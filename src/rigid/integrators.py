@@ -260,9 +260,10 @@ def integrate(
         Re-centring threshold on ``|g_0|`` for ``"cayley_rk4"``.
     stop : callable, optional
         ``stop()``, asked between chunks of about 1% of the steps (and of at
-        most 65 536) by the fixed-step methods (their steps and bits unchanged):
-        True ends the run there, the trajectory then holding the outputs reached
-        (as a scene does on Ctrl-C).  ``"dop853"`` runs to the end.
+        most 65 536) by the fixed-step methods, and every 64 steps by
+        ``"dop853"`` (their steps and bits unchanged): True ends the run there,
+        the trajectory then holding the outputs reached (as a scene does on
+        Ctrl-C).
 
     Other Parameters
     ----------------

@@ -50,3 +50,31 @@ def test_a_run_within_the_budget_is_unchanged():
 def test_max_steps_is_checked_naming_it():
     with pytest.raises(ValueError, match=r"Expected `max_steps` to be a positive integer, got 0"):
         DOP853(max_steps=0)
+
+
+def test_solve_in_one_integration_is_scipys_dense_solution_output_by_output():
+    """``solve(restart=False)`` (rigid's DOP853) steps scipy's DOP853 itself: each
+    output, read as its step passes it, is bit for bit what ``solve_ivp(...,
+    dense_output=True)`` gives there (an output on a step's end taken from the step
+    ending there, as scipy's ``OdeSolution`` does), forwards and backwards;
+    ``on_output`` is called as the steps pass each output (a progress bar moved
+    only at the end), and the dense output is made only for steps that hold one."""
+    from scipy.integrate import solve_ivp
+
+    from hamilton_orbits.integrators.dop853 import solve
+
+    def pendulum(t, y):
+        calls.append(t)
+        return np.array([y[1], -np.sin(y[0]) + 0.1 * np.cos(0.7 * t)])
+
+    for t_out in (np.linspace(0.0, 40.0, 23), -np.linspace(0.0, 25.0, 9),
+                  np.array([0.0, 1e-9, 0.5, 0.5 + 1e-12, 30.0])):
+        calls, seen = [], []
+        y, steps, nfev = solve(pendulum, np.array([1.0, 0.0]), t_out, rtol=1e-10, atol=1e-12,
+                               restart=False, on_output=lambda i, n: seen.append(len(calls)))
+        total = len(calls)
+        ref = solve_ivp(pendulum, (t_out[0], t_out[-1]), [1.0, 0.0], method="DOP853",
+                        rtol=1e-10, atol=1e-12, dense_output=True)
+        np.testing.assert_array_equal(y[1:], ref.sol(t_out[1:]).T)
+        assert steps == ref.t.size - 1 and nfev == total < ref.nfev
+        assert len(seen) == len(t_out) - 1 and seen[0] < total // 2 and seen == sorted(seen)

@@ -414,6 +414,31 @@ def test_stop_ends_a_run_between_chunks_with_the_outputs_reached(method):
         integrate(b, t, dt=0.01, method=method, stop=3)
 
 
+def test_dop853_asks_stop_and_ends_with_the_outputs_reached():
+    """DOP853 ran to the end whatever ``stop()`` said (a rotation scene's Ctrl-C was
+    not heard): it asks every ``STOP_EVERY`` steps; never true, the run is the one
+    without it, bit for bit; true at the third look, the run ends there with the
+    outputs reached, each the whole run's."""
+    from hamilton_orbits.integrators.dop853 import STOP_EVERY
+
+    b = RigidBody([1.0, 2.0, 3.0], omega=[0.1, 1.0, 0.1])
+    t = np.linspace(0.0, 200.0, 201)
+    whole = integrate(b, t, method="dop853")
+    assert whole.steps > 5 * STOP_EVERY
+    looks = []
+    same = integrate(b, t, method="dop853", stop=lambda: looks.append(1) and False)
+    assert len(looks) == (whole.steps - 1) // STOP_EVERY
+    np.testing.assert_array_equal(same.attitude.as_array(), whole.attitude.as_array())
+    np.testing.assert_array_equal(same.omega, whole.omega)
+    looks.clear()
+    cut = integrate(b, t, method="dop853", stop=lambda: len(looks.append(1) or looks) >= 3)
+    n = len(cut.t)
+    assert 2 <= n < len(t) and len(looks) == 3
+    np.testing.assert_array_equal(cut.t, whole.t[:n])
+    np.testing.assert_array_equal(cut.omega, whole.omega[:n])
+    np.testing.assert_array_equal(cut.attitude.as_array(), whole.attitude.as_array()[:n])
+
+
 @pytest.mark.parametrize("method", ["splitting2", "splitting4", "splitting4y", "exact_kick",
                                     "rk4", "cayley_rk4"])
 def test_a_run_in_chunks_is_the_run_in_one_call_with_a_torque_of_time(method, monkeypatch):

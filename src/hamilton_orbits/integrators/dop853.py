@@ -217,6 +217,7 @@ def solve(
     restart: bool = True,
     max_steps: int = DOP853.max_steps,
     hint: str | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, int, int]:
     """The DOP853 driver of a whole run (rigid's): ``y' = f(t, y)`` from ``y0`` at
     ``t_out[0]``, restarted at each output time (so that an output is a step end,
@@ -240,16 +241,21 @@ def solve(
         True (default): a new integration from each output time, so that every
         output is a step end.  False: one integration, the outputs read from
         DOP853's 7th-order dense output (many closely spaced outputs then do not
-        cap the step); the callbacks are called at the end.
+        cap the step), each as its step is taken (``on_output`` then called).
     max_steps : int, optional
         Give up after about this many steps, or as soon as the pace projects more
         than 100 times as many (:class:`~hamilton_orbits.integrators._setup.
         StepBudget`); ``hint``: what the error then advises.
+    stop : callable, optional
+        With ``restart=False``: ``stop()`` asked every :data:`STOP_EVERY` steps;
+        True ends the run there, ``y`` then holding the outputs reached (the
+        steps before it unchanged).
 
     Returns
     -------
     y : ndarray, shape (n_t, m)
-        The state at each output time (row 0 is ``y0``).
+        The state at each output time (row 0 is ``y0``; the rows reached, when
+        ``stop()`` ended the run).
     steps, nfev : int
         Accepted steps and right-hand-side evaluations.
 
@@ -275,18 +281,8 @@ def solve(
     y = np.asarray(y0, dtype=np.float64)
     steps = nfev = 0
     if not restart and len(t_out) > 1:
-        sol = solve_ivp(f, (float(t_out[0]), float(t_out[-1])), y, method="DOP853",
-                        rtol=max(float(rtol), RTOL_FLOOR), atol=atol, max_step=max_step,
-                        dense_output=True)
-        if not sol.success:
-            raise ValueError(f"dop853 failed between t = {t_out[0]} and {t_out[-1]}: "
-                             f"{sol.message}")
-        y_out[1:] = sol.sol(t_out[1:]).T
-        steps, nfev = int(sol.t.size - 1), int(sol.nfev)
-        for i in range(1, len(t_out)):
-            if on_output is not None:
-                on_output(i, steps)
-        return y_out, steps, nfev
+        return _dense_run(f, y_out, t_out, max(float(rtol), RTOL_FLOOR), atol, max_step,
+                          on_output, stop)
     for i in range(1, len(t_out)):
         sol = solve_ivp(f, (float(t_out[i - 1]), float(t_out[i])), y, method="DOP853",
                         rtol=max(float(rtol), RTOL_FLOOR), atol=atol, max_step=max_step)
@@ -300,6 +296,43 @@ def solve(
         if on_output is not None:
             on_output(i, steps)
     return y_out, steps, nfev
+
+
+#: steps between two questions to ``stop()`` in :func:`solve` (``restart=False``)
+STOP_EVERY = 64
+
+
+def _dense_run(f: Callable[[float, np.ndarray], np.ndarray], y_out: np.ndarray,
+               t_out: np.ndarray, rtol: float, atol: Any, max_step: float,
+               on_output: Callable[[int, int], None] | None,
+               stop: Callable[[], bool] | None) -> tuple[np.ndarray, int, int]:
+    """:func:`solve` with ``restart=False``: scipy's DOP853 stepped from ``y_out[0]``
+    at ``t_out[0]`` to ``t_out[-1]``, each output read from the dense output of the
+    step that reaches it (a step ending on it: that step's), as it is passed (the
+    values ``solve_ivp(..., dense_output=True)`` gives, whose interpolants are the
+    same steps'); ``stop()`` asked every :data:`STOP_EVERY` steps."""
+    from scipy.integrate import DOP853 as Stepper
+
+    t0, t1 = float(t_out[0]), float(t_out[-1])
+    solver = Stepper(f, t0, y_out[0], t1, rtol=rtol, atol=atol, max_step=max_step)
+    ahead = 1.0 if t1 >= t0 else -1.0
+    steps, i, n = 0, 1, len(t_out)
+    while i < n:
+        message = solver.step()
+        if solver.status == "failed":
+            raise ValueError(f"dop853 failed between t = {t0} and {t1}: at t = "
+                             f"{solver.t}, {message}")
+        steps += 1
+        dense = None
+        while i < n and ahead * (float(t_out[i]) - solver.t) <= 0.0:
+            dense = solver.dense_output() if dense is None else dense
+            y_out[i] = dense(float(t_out[i]))
+            if on_output is not None:
+                on_output(i, steps)
+            i += 1
+        if i < n and stop is not None and steps % STOP_EVERY == 0 and stop():
+            return y_out[:i], steps, int(solver.nfev)
+    return y_out, steps, int(solver.nfev)
 
 
 def _body_scale(x: np.ndarray) -> np.ndarray:
