@@ -63,15 +63,19 @@ def test_solve_in_one_integration_is_scipys_dense_solution_output_by_output():
 
     from hamilton_orbits.integrators.dop853 import solve
 
+    calls = []
+
     def pendulum(t, y):
         calls.append(t)
         return np.array([y[1], -np.sin(y[0]) + 0.1 * np.cos(0.7 * t)])
 
     for t_out in (np.linspace(0.0, 40.0, 23), -np.linspace(0.0, 25.0, 9),
                   np.array([0.0, 1e-9, 0.5, 0.5 + 1e-12, 30.0])):
-        calls, seen = [], []
+        calls.clear()
+        seen = []
         y, steps, nfev = solve(pendulum, np.array([1.0, 0.0]), t_out, rtol=1e-10, atol=1e-12,
-                               restart=False, on_output=lambda i, n: seen.append(len(calls)))
+                               restart=False, on_output=lambda i, n, seen=seen: seen.append(
+                                   len(calls)))
         total = len(calls)
         ref = solve_ivp(pendulum, (t_out[0], t_out[-1]), [1.0, 0.0], method="DOP853",
                         rtol=1e-10, atol=1e-12, dense_output=True)
