@@ -75,7 +75,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from typing import Any
+from typing import Any, NoReturn
 
 import astropy.units as u
 import numpy as np
@@ -342,6 +342,7 @@ def integrate(
     kind, params = encode_torque(torque)
     moments, params, sw = _scaled_problem(si, kind, params, method, times, dtf)
     start = time.perf_counter()
+    asked = _Asked(stop)
     try:
         # a value beyond float64 on the way leaves a non-finite result, refused below
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -349,16 +350,12 @@ def integrate(
                 moments, si.attitude, si.omega / sw, times * sw, method=method,
                 dt=None if dtf is None else dtf * sw, n_out=n_out, kind=kind,
                 params=params, rtol=rtol_f, atol=atol_f, recentre=recentre,
-                progress=progress, stop=stop,
+                progress=progress, stop=None if stop is None else asked,
             )
-    except ZeroDivisionError:  # a kernel's state left float64 (its norm 0 or inf)
-        raise _failed(method, dtf, "a division by zero in the kernel") from None
-    except ConvergenceError as exc:  # DOP853's step budget (times in the scaled unit)
-        raise ConvergenceError(f"method 'dop853' cannot finish this span: {exc}") from None
-    except ValueError as exc:  # the shared DOP853 driver: scipy's step size collapsed
-        if method != "dop853":  # pragma: no cover - the fixed-step drivers raise none
+    except (ZeroDivisionError, ValueError) as exc:
+        if exc is asked.raised:  # (the caller's own: not the run's failure)
             raise
-        raise _failed(method, dtf, str(exc)) from None
+        _refuse_failed(exc, method, dtf)
     wall = time.perf_counter() - start
     t_f = t_f / sw
     with np.errstate(over="ignore"):  # a rate beyond float64: refused by _check_finite
@@ -460,6 +457,34 @@ def _rate_scale(moments: np.ndarray, omega: np.ndarray, kind: int, params: np.nd
                          f"t = {t_end!r} s with |omega| (or the torque's rate) ~ {rate!r} "
                          f"rad/s")
     return sw
+
+
+class _Asked:
+    """``stop`` asked, the exception it raised (if any) kept: told apart from the
+    run's own failures, it reaches the caller as it is."""
+
+    __slots__ = ("raised", "stop")
+
+    def __init__(self, stop: Any) -> None:
+        self.stop, self.raised = stop, None
+
+    def __call__(self) -> Any:
+        try:
+            return self.stop()
+        except BaseException as exc:
+            self.raised = exc
+            raise
+
+
+def _refuse_failed(exc: ZeroDivisionError | ValueError, method: str, dt: Any) -> NoReturn:
+    """Raise the refusal of a run that failed with ``exc``."""
+    if isinstance(exc, ZeroDivisionError):  # a kernel's state left float64 (norm 0 or inf)
+        raise _failed(method, dt, "a division by zero in the kernel") from None
+    if isinstance(exc, ConvergenceError):  # DOP853's step budget (times in the scaled unit)
+        raise ConvergenceError(f"method 'dop853' cannot finish this span: {exc}") from None
+    if method != "dop853":  # pragma: no cover - the fixed-step drivers raise none
+        raise exc
+    raise _failed(method, dt, str(exc)) from None  # (scipy's step size collapsed)
 
 
 def _failed(method: str, dt: Any, what: str) -> ValueError:

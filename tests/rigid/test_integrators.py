@@ -414,6 +414,27 @@ def test_stop_ends_a_run_between_chunks_with_the_outputs_reached(method):
         integrate(b, t, dt=0.01, method=method, stop=3)
 
 
+@pytest.mark.parametrize("method", ["splitting4", "rk4", "dop853"])
+def test_an_error_of_the_callers_stop_reaches_the_caller_as_it_is(method):
+    """An exception raised by the caller's ``stop`` was taken for the run's own
+    failure: a ZeroDivisionError became "Expected `dt` small enough ...", a
+    ValueError of DOP853's run "Expected `tol` and `dt` within DOP853's reach, got
+    <the caller's message>"; it reaches the caller unchanged."""
+    b = RigidBody([1.0, 2.0, 2.5], omega=[0.1, 0.5, 1.0])
+
+    def divides():
+        return 1 / 0
+
+    def refuses():
+        raise ValueError("the caller's own message")
+
+    with pytest.raises(ZeroDivisionError, match="division by zero") as info:
+        integrate(b, 50.0, method=method, dt=0.01, stop=divides)
+    assert info.traceback[-1].name == "divides"
+    with pytest.raises(ValueError, match="^the caller's own message$"):
+        integrate(b, 50.0, method=method, dt=0.01, stop=refuses)
+
+
 def test_dop853_asks_stop_and_ends_with_the_outputs_reached():
     """DOP853 ran to the end whatever ``stop()`` said (a rotation scene's Ctrl-C was
     not heard): it asks every ``STOP_EVERY`` steps; never true, the run is the one
