@@ -431,7 +431,7 @@ def test_an_error_of_the_callers_stop_reaches_the_caller_as_it_is(method):
     with pytest.raises(ZeroDivisionError, match="division by zero") as info:
         integrate(b, 50.0, method=method, dt=0.01, stop=divides)
     assert info.traceback[-1].name == "divides"
-    with pytest.raises(ValueError, match="^the caller's own message$"):
+    with pytest.raises(ValueError, match=r"^the caller's own message$"):
         integrate(b, 50.0, method=method, dt=0.01, stop=refuses)
 
 

@@ -1,6 +1,8 @@
 """The rigid-Earth wobble from the nonlinear integrator against the Euler period,
 the exact free motion and the linear theory (Liouville / linearised Euler)."""
 
+import warnings
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -102,6 +104,28 @@ def test_scipy_dop853_agrees_with_the_exact_rigid_earth():
     dop = earth.simulate_wobble(200 * u.day, method="dop853")
     exact = earth.simulate_wobble(200 * u.day, method="exact")
     assert np.max(np.abs(dop.m - exact.m)) < _FLOOR * np.max(np.abs(exact.m))
+
+
+@pytest.mark.parametrize(("kw", "name"), [({"duration": 3.0}, "duration"),
+                                         ({"wobble": 0.2}, "wobble"), ({"dt": 60.0}, "dt")])
+def test_simulate_wobble_refuses_bare_numbers(kw, name):
+    """A bare number was read in one of three units: ``duration=3.0`` as 3 days (the
+    default is 100 years), ``wobble=0.2`` as 0.2 rad (a pole 11 degrees off, where
+    the default is 0.2 arcsec), ``dt=60.0`` as seconds; each is refused, named."""
+    kw = {"duration": 3 * u.day, **kw}
+    with pytest.raises(ValueError, match=rf"Expected `{name}` to be a Quantity .* got the "
+                                         rf"bare number {kw[name]!r}"):
+        earth.simulate_wobble(**kw)
+
+
+@pytest.mark.parametrize("method", ["exact", "splitting4", "dop853"])
+def test_a_path_without_wobble_has_no_error_and_no_warning(method):
+    """``wobble=0`` warned (0/0, "invalid value in scalar divide") and kept a NaN
+    error; the pole stays on the figure axis, followed exactly: error 0."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        path = earth.simulate_wobble(20 * u.day, wobble=0 * u.arcsec, method=method)
+    assert path.error == 0.0 and not np.any(path.m)
 
 
 @pytest.mark.parametrize(("dt", "pattern"), [

@@ -12,6 +12,7 @@ prograde, with the Euler frequency ``sigma_E = OMEGA (C - A) / A`` (Euler 1765);
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 from typing import Any
@@ -131,7 +132,8 @@ def simulate_wobble(
         Initial angle between the rotation and figure axes (default 0.2 arcsec).
     dt : Quantity
         Step of the fixed-step integrator (default 1 hour; ignored for
-        ``"exact"`` and ``"dop853"``).
+        ``"exact"`` and ``"dop853"``).  All three are Quantities: a bare number
+        is refused (it could mean days, radians or seconds).
     method : str
         A method of :func:`rigid.integrate`, or ``"exact"`` for
         :func:`rigid.free_motion`.
@@ -152,6 +154,11 @@ def simulate_wobble(
     >>> print(f"{path.period():.1f}")
     303.6 d
     """
+    for name, value, like in (("duration", duration, "100 * u.yr"),
+                              ("wobble", wobble, "0.2 * u.arcsec"), ("dt", dt, "1 * u.hour")):
+        if not isinstance(value, u.Quantity):  # (three units a bare number could mean)
+            raise ValueError(f"Expected `{name}` to be a Quantity (such as {like}), got the "
+                             f"bare number {value!r}")
     t_end = TIME("duration", duration, u.day)
     if t_end.shape != () or not float(t_end) >= 1.0:
         raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
@@ -192,5 +199,9 @@ _PLAIN_SPLITS = ("splitting2", "splitting4y")
 
 
 def _error(m: np.ndarray, exact: np.ndarray) -> float:
-    """``max |m - exact| / max |exact|``."""
-    return float(np.max(np.abs(m - exact)) / np.max(np.abs(exact)))
+    """``max |m - exact| / max |exact|`` (0 for a path without wobble followed
+    exactly, inf for one that left it)."""
+    off, scale = float(np.max(np.abs(m - exact))), float(np.max(np.abs(exact)))
+    if scale == 0.0:
+        return 0.0 if off == 0.0 else math.inf
+    return off / scale
