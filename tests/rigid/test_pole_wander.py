@@ -96,6 +96,25 @@ def test_free_period_refuses_bad_input():
         free_period(t, np.ones(19, complex))
     with pytest.raises(u.UnitConversionError, match="`t`"):
         free_period(t * u.m, np.exp(1j * t))
+    # equal times: six LAPACK lines on stderr, a RuntimeWarning, then numpy's
+    # "SVD did not converge"; times out of order likewise unchecked
+    with pytest.raises(ValueError, match=r"`t` increasing, got t\[1\] = 0.0 after t\[0\] "
+                                         r"= 0.0 \(days\)"):
+        free_period(np.zeros(20), np.exp(1j * t))
+    with pytest.raises(ValueError, match=r"`t` increasing, got t\[5\] = 4.0 after"):
+        free_period(np.r_[t[:5], t[4:-1]], np.exp(1j * t))
+
+
+@pytest.mark.parametrize("ratio", [1.0, 0.9, 0.0])
+def test_free_period_of_a_wobble_along_a_line(ratio):
+    """A path whose prograde and retrograde circles are (nearly) equal, ``|b| ~ |a|``:
+    a line, whose phase jumps by pi, so that its mean turn started the fit anywhere
+    (a 433-day wobble along x gave 4.4e9 days); the periodogram's peak starts it,
+    and the period is found (the model's own case: ``b = 0`` to ``b = a``)."""
+    t = np.linspace(0.0, 3000.0, 300)
+    sigma = 2 * np.pi / 433.0
+    m = 0.1 * np.exp(1j * sigma * t) + ratio * 0.1 * np.exp(-1j * sigma * t + 0.3j)
+    assert abs(free_period(t * u.d, m * u.arcsec) / (433.0 * u.d) - 1) < 1e-12
 
 
 def test_scipy_dop853_agrees_with_the_exact_rigid_earth():

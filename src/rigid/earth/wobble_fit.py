@@ -87,22 +87,51 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     scale = float(np.max(np.abs(mm)))
     if scale == 0.0:
         raise ValueError("Expected `m` to wobble, got a path identically zero")
+    step = np.diff(tt)
+    if not np.all(step > 0):
+        k = int(np.argmin(step > 0)) + 1
+        raise ValueError(f"Expected `t` increasing, got t[{k}] = {float(tt[k])!r} after "
+                         f"t[{k - 1}] = {float(tt[k - 1])!r} (days)")
     t0 = tt - tt[0]
     phase = np.unwrap(np.angle(mm))
     sigma0 = float(np.polyfit(t0, phase, 1)[0])
-    if sigma0 == 0.0:
-        raise ValueError("Expected `m` to turn about the figure axis, got no mean rotation")
     mn = mm / scale
+    sol = _fit_sigma(t0, mn, sigma0) if sigma0 != 0.0 else None
+    if sol is None or sol.cost > 0.25 * float(np.vdot(mn, mn).real):
+        # (the mean turn of the phase no start: a path near a line, |a| ~ |b|, whose
+        # phase jumps by pi; the periodogram's highest peak then starts the fit)
+        other = _fit_sigma(t0, mn, _peak(t0, mn))
+        sol = other if sol is None or other.cost < 0.5 * sol.cost else sol
+    if not sol.x[0] != 0.0:
+        raise ValueError("Expected `m` to turn about the figure axis, got no mean rotation")
+    return (2.0 * np.pi / abs(float(sol.x[0]))) * u.day
+
+
+def _fit_sigma(t0: np.ndarray, mn: np.ndarray, sigma0: float) -> Any:
+    """scipy's least-squares fit of :func:`free_period`'s ``sigma`` from ``sigma0``."""
+    from scipy.optimize import least_squares  # here: 0.2 s to import, rarely needed
 
     def resid(x):
         _, r = _project(t0, mn, np.array([x[0], -x[0]]), 0)
         return np.concatenate([r.real, r.imag])
 
-    from scipy.optimize import least_squares  # here: 0.2 s to import, rarely needed
+    return least_squares(resid, [sigma0], x_scale=[abs(sigma0)], xtol=1e-15, ftol=1e-15,
+                         gtol=1e-15)
 
-    sol = least_squares(resid, [sigma0], x_scale=[abs(sigma0)], xtol=1e-15, ftol=1e-15,
-                        gtol=1e-15)
-    return (2.0 * np.pi / abs(float(sol.x[0]))) * u.day
+
+def _peak(t0: np.ndarray, mn: np.ndarray) -> float:
+    """The angular frequency (> 0) of the highest peak of the power of ``mn`` in
+    both senses, ``|sum mn e^(-i s t)|^2 + |sum mn e^(i s t)|^2``, on a grid of
+    ``s`` from one turn over the span to the mean sampling's Nyquist rate (at
+    most 4096 points)."""
+    span = float(t0[-1])
+    top = min(len(t0) // 2, 4096)
+    s = 2.0 * np.pi * np.arange(1, top + 1) / span
+    power = np.empty(top)
+    for k in range(0, top, 256):  # (256 frequencies at a time: memory O(256 n))
+        e = np.exp(-1j * np.outer(s[k:k + 256], t0))
+        power[k:k + 256] = np.abs(e @ mn) ** 2 + np.abs(e.conj() @ mn) ** 2
+    return float(s[np.argmax(power)])
 
 
 @dataclass(frozen=True)
