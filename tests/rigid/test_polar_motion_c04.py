@@ -131,6 +131,24 @@ def test_periodogram_peaks(record):
     np.testing.assert_allclose(pg_day["amplitude"].value, amp[:5], rtol=1e-10)
 
 
+def test_periodogram_of_one_frequency_and_refusals(record):
+    """One frequency (a scalar Quantity) raised numpy's "too many indices"; it is
+    a table of one row, the value of the same frequency in an array.  A frequency
+    in metres named no argument; an empty record was accepted, and every fit then
+    raised a bare IndexError."""
+    one = periodogram(record, 1 / (433 * u.day))
+    many = periodogram(record, [1 / 433, 1 / 365.25] / u.day)
+    assert len(one) == 1
+    # (the sum over 20 000 days by a matrix-vector product of one row or of two:
+    # BLAS may add in another order, a few ulp apart)
+    np.testing.assert_allclose(one["amplitude"][0].value, many["amplitude"][0].value,
+                               rtol=1e-13)
+    with pytest.raises(u.UnitConversionError, match="`frequency` to be a Quantity of 1/time"):
+        periodogram(record, [1 / 433] * u.m)
+    with pytest.raises(ValueError, match=r"`time` of shape \(n,\), n >= 1, got \(0,\)"):
+        PolarMotionRecord(Time([], format="mjd"), [] * u.arcsec, [] * u.arcsec)
+
+
 def test_q_estimate_comes_with_its_caveat(fits):
     fit = fits["all"]
     assert 10 < fit.q_estimate < 1000

@@ -470,7 +470,14 @@ def periodogram(
             raise u.UnitConversionError(
                 f"Expected `frequency` to be a Quantity of 1/time, got {frequency!r}"
             )
-        f = as_float_array("frequency", frequency.to_value(1 / u.yr))
+        try:
+            per_year = frequency.to_value(1 / u.yr)
+        except u.UnitConversionError:
+            raise u.UnitConversionError(f"Expected `frequency` to be a Quantity of 1/time, "
+                                        f"got {frequency!r}") from None
+        f = np.atleast_1d(as_float_array("frequency", per_year))
+        if f.ndim != 1:
+            raise ValueError(f"Expected `frequency` of shape (n,), got {f.shape}")
     days = mjd_utc(record.time)
     t = (days - days[0]) / 365.25
     m = record.m.to_value(u.mas)
