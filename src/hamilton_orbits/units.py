@@ -323,9 +323,11 @@ def require_consistent(names: Sequence[str], values: Sequence[Any]) -> bool:
     qname, qvalue = quantities[0]
     for n, v in given:
         if not is_quantity(v):
+            what = ("the plain number" if isinstance(v, int | float | complex | np.number
+                                                     | np.ndarray | list | tuple)
+                    else f"a {type(v).__name__}")  # (a TimeDelta is no plain number)
             raise ValueError(
-                f"Expected `{n}` to be a Quantity like `{qname}` ({qvalue}), "
-                f"got the plain number {v!r}"
+                f"Expected `{n}` to be a Quantity like `{qname}` ({qvalue}), got {what} {v!r}"
             )
     return True
 

@@ -374,13 +374,17 @@ class RigidBody:
     __slots__ = ("_moments", "_omega", "_quantity", "attitude")
 
     def __init__(self, inertia: Any, attitude: Any = None, omega: Any = None) -> None:
-        quantity = require_consistent(("inertia", "omega"), (inertia, omega))
-        inertia_arr = INERTIA("inertia", inertia)
+        self._build(inertia, attitude, omega)
+
+    def _build(self, inertia: Any, attitude: Any, omega: Any, name: str = "inertia") -> None:
+        """Set the body up (``name``: what the caller calls ``inertia``)."""
+        quantity = require_consistent((name, "omega"), (inertia, omega))
+        inertia_arr = INERTIA(name, inertia)
         omega_arr = np.zeros(3) if omega is None else ANGULAR_SPEED("omega", omega)
         if omega_arr.shape != (3,):
             raise ValueError(f"Expected `omega` to have shape (3,), got {omega_arr.shape}")
         q = unit_quaternion("attitude", attitude)
-        moments, axes = _principal("inertia", inertia_arr)
+        moments, axes = _principal(name, inertia_arr)
         if axes is not None:
             # v_given = axes @ v_principal, so omega_principal = axes^T omega_given and
             # the new attitude composes q (given -> space) with axes (principal -> given).
@@ -414,7 +418,10 @@ class RigidBody:
         >>> RigidBody.from_si([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0], quantity=True).omega
         <Quantity [0., 0., 2.] rad / s>
         """
-        body = cls(moments, attitude, omega)
+        if not isinstance(quantity, bool | np.bool_):  # (any text would be true)
+            raise ValueError(f"Expected `quantity` to be True or False, got {quantity!r}")
+        body = cls.__new__(cls)
+        body._build(moments, attitude, omega, name="moments")
         body._quantity = bool(quantity)
         return body
 

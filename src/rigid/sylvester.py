@@ -344,6 +344,9 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     for name, w in (("omega1", w1), ("omega2", w2)):
         if w.shape != (3,):
             raise ValueError(f"Expected `{name}` to have shape (3,), got {w.shape}")
+    if not np.any(w1):  # (its T and |L| are 0: no polhode to measure time along)
+        raise ValueError(f"Expected `omega1` nonzero (a body at rest stays at rest: no time "
+                         f"leads from it to another state), got {omega1!r}")
     # homogeneous: moments / sm and omega / sw (powers of two), times scale by 1 / sw
     sm = pow2(body.si.moments)
     sw = max(pow2(w1), pow2(w2))

@@ -72,8 +72,13 @@ def test_mixing_quantities_and_plain_numbers_is_refused():
 
     assert require_consistent(("t", "dt"), (1.0, 0.1)) is False
     assert require_consistent(("t", "dt"), (1.0 * u.s, None)) is True
-    with pytest.raises(ValueError, match="`dt` to be a Quantity like `t`"):
+    with pytest.raises(ValueError, match="`dt` to be a Quantity like `t`.*the plain number 0.1"):
         require_consistent(("t", "dt"), (1.0 * u.s, 0.1))
+    # a TimeDelta was called "the plain number <TimeDelta ...>"
+    from astropy.time import TimeDelta
+
+    with pytest.raises(ValueError, match=r"like `t` \(1.0 s\), got a TimeDelta <TimeDelta"):
+        require_consistent(("t", "dt"), (1.0 * u.s, TimeDelta(1.0, format="sec")))
 
 
 def test_a_masked_value_is_refused_not_read_from_under_its_mask():

@@ -197,8 +197,17 @@ def test_from_si_and_quantity_flag():
     plain = RigidBody.from_si([1.0, 2.0, 3.0], omega=[0.0, 0.0, 2.0])
     assert not plain.quantity and plain.kinetic_energy == 6.0
     assert RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2).quantity
-    with pytest.raises(ValueError, match=r"Expected `inertia` > 0, got -1.0 at index 0"):
+    # named as from_si names it (it said `inertia`, the constructor's name)
+    with pytest.raises(ValueError, match=r"Expected `moments` > 0, got -1.0 at index 0"):
         RigidBody.from_si([-1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"Expected `moments` to be finite, got nan at index 1"):
+        RigidBody.from_si([1.0, np.nan, 3.0])
+    with pytest.raises(ValueError, match=r"Expected `inertia` > 0, got -1.0 at index 0"):
+        RigidBody([-1.0, 2.0, 3.0])
+    # any text was true: quantity="no" built a body of Quantities
+    with pytest.raises(ValueError, match=r"Expected `quantity` to be True or False, got 'no'"):
+        RigidBody.from_si([1.0, 2.0, 3.0], quantity="no")
+    assert RigidBody.from_si([1.0, 2.0, 3.0], quantity=np.bool_(True)).quantity
 
 
 def test_si_view_refuses_integrals_beyond_float64():

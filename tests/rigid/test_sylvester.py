@@ -147,6 +147,14 @@ def test_time_between_positions():
         time_between(other, [1.0, 0.5, 0.2], [1.0, 0.5, 0.3])  # 1.725, 2.5625
     with pytest.raises(ValueError, match=r"`omega2` to have shape \(3,\)"):
         time_between(body, body.omega, [1.0, 2.0])
+    # a body at rest: a divide-by-zero warning, then `omega2` blamed ("+inf off")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"`omega1` nonzero \(a body at rest stays at "
+                                             r"rest.*got \[0.0, 0.0, 0.0\]"):
+            time_between(body, [0.0, 0.0, 0.0], body.omega)
 
 
 def test_time_between_on_separatrix():
