@@ -72,7 +72,7 @@ def test_mixing_quantities_and_plain_numbers_is_refused():
 
     assert require_consistent(("t", "dt"), (1.0, 0.1)) is False
     assert require_consistent(("t", "dt"), (1.0 * u.s, None)) is True
-    with pytest.raises(ValueError, match="`dt` to be a Quantity like `t`.*the plain number 0.1"):
+    with pytest.raises(ValueError, match=r"`dt` to be a Quantity like `t`.*the plain number 0\.1"):
         require_consistent(("t", "dt"), (1.0 * u.s, 0.1))
     # a TimeDelta was called "the plain number <TimeDelta ...>"
     from astropy.time import TimeDelta
