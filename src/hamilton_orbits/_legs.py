@@ -142,6 +142,13 @@ def tangent_of(system: System, variational: Any, stm: Any, vector: Any, method: 
             raise ValueError(f"Expected `tangent` to have shape ({n}, 6), got {vec.shape}")
         if not np.any(vec):
             raise ValueError("Expected `tangent` to be nonzero, got all zeros")
+        with np.errstate(over="ignore", under="ignore"):
+            square = float(np.sum(vec * vec))
+        if not np.finfo(np.float64).tiny <= square < np.inf:  # (its log-norm kept by MEGNO)
+            top = float(np.max(np.abs(vec)))
+            raise ValueError(f"Expected `tangent` of a norm of about 1e-150 to 1e150 (MEGNO "
+                             f"does not depend on its scale), got a norm of "
+                             f"{top * float(np.linalg.norm(vec / top)):.3g}")
         vector = vec.reshape(n, 6)
     return Tangent(n, 1, stm=stm, vector=vector)
 

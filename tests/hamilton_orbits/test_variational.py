@@ -756,3 +756,21 @@ def test_ensemble_rows_carry_megno():
     assert df.attrs["failures"] == 0
     assert {"MEGNO", "Lyapunov time [yr]", "Lyapunov exponent [1 / yr]"} <= set(df.columns)
     assert df["MEGNO"].iloc[0] < 2.2 and df["MEGNO"].max() > 4
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-170])
+def test_a_tangent_whose_square_leaves_float64_is_refused(scale):
+    """MEGNO takes the log of the tangent's squared norm: a tangent of 1e300 (its
+    square inf) gave MEGNO and the Lyapunov exponent NaN, without a warning; one of
+    1e-170 (its square 0) likewise.  Any scale between gives the same MEGNO."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    with pytest.raises(ValueError, match=r"`tangent` of a norm of about 1e-150 to 1e150 .* got "
+                                         r"a norm of 3.46e[+-]"):
+        integrate(s, 2.0, method="wh", dt=0.01, variational=True,
+                  tangent=np.full((2, 6), scale))
+    with pytest.raises(ValueError, match=r"`tangent` to be nonzero, got all zeros"):
+        integrate(s, 2.0, method="wh", dt=0.01, variational=True, tangent=np.zeros((2, 6)))
+    one, wide = (integrate(s, 2.0, method="wh", dt=0.01, variational=True,
+                           tangent=np.full((2, 6), k)) for k in (1.0, 1e150))
+    np.testing.assert_allclose(wide.megno, one.megno, rtol=1e-13)  # (rounding apart)
