@@ -456,12 +456,15 @@ class System(InitialStates):
         ValueError: Expected `gm` >= 0, got -1.0 at index 0
         """
         out = object.__new__(System)
-        r = np.array(r, dtype=np.float64)
-        v = np.array(v, dtype=np.float64)
-        gm = self._gm if gm is None else np.array(gm, dtype=np.float64)
+        r = self._internal("r", r, LENGTH, L_UNIT)
+        v = self._internal("v", v, SPEED, V_UNIT)
+        gm = self._gm if gm is None else self._internal("gm", gm, GM, GM_UNIT)
         if check and gm.shape != self._gm.shape:
             raise ValueError(f"Expected `gm` to have shape {self._gm.shape}, got {gm.shape}")
-        radius = self._radius if radius is None else np.array(radius, dtype=np.float64)
+        radius = self._radius if radius is None else self._internal("radius", radius, LENGTH,
+                                                                      L_UNIT)
+        if check:
+            self._check_new(radius, keep)
         arrays = (gm, r, v, radius, self._j2, self._pole)
         names, index = self._names, self._index
         if keep is not None and not np.all(keep):
@@ -472,6 +475,30 @@ class System(InitialStates):
         if check:
             out._check_state()
         return out
+
+    def _internal(self, name: str, value: Any, kind: Any, unit: Any) -> np.ndarray:
+        """``value`` of :meth:`with_state` in the internal units: a Quantity converted
+        (for a system of Quantities; refused for one of plain numbers, whose units
+        are the caller's own), plain numbers as they are."""
+        if isinstance(value, u.Quantity):
+            if not self._quantity:
+                raise ValueError(f"Expected `{name}` as plain numbers in this system's own "
+                                 f"units (it was built from plain numbers), got {value!r}")
+            return np.array(kind(name, value, unit, finite=False), dtype=np.float64)
+        return np.array(value, dtype=np.float64)
+
+    def _check_new(self, radius: np.ndarray, keep: Any) -> None:
+        """:meth:`with_state`'s ``radius`` (n,), each NaN (none) or finite and >= 0,
+        and ``keep``, None or n booleans."""
+        from hamilton_orbits.validation import check_positive
+
+        n = len(self._names)
+        if radius.shape != (n,):
+            raise ValueError(f"Expected `radius` to have shape ({n},), got {radius.shape}")
+        check_positive("radius", np.where(np.isnan(radius), 1.0, radius), strict=False)
+        check_finite("radius", radius[~np.isnan(radius)], np.flatnonzero(~np.isnan(radius)))
+        if keep is not None and np.shape(keep) != (n,):
+            raise ValueError(f"Expected `keep` to have shape ({n},), got {np.shape(keep)}")
 
     def _check_state(self) -> None:
         from hamilton_orbits.validation import check_positive

@@ -243,6 +243,28 @@ def test_with_state_takes_new_masses():
     assert s.as_arrays().gm.tolist() == [2.0, 0.0]
 
 
+def test_with_state_converts_quantities_and_checks_radius_and_keep():
+    """A Quantity in other units lost its unit (1 au given in km stored as 1.5e8
+    au); a negative radius was taken; a ``keep`` of the wrong length raised numpy's
+    bare IndexError."""
+    q = System.from_arrays([1.0, 1e-3] * u.au**3 / u.day**2, [[0, 0, 0], [1, 0, 0]] * u.au,
+                           [[0, 0, 0], [0, 1, 0]] * u.au / u.day)
+    moved = q.with_state(q.r.to(u.km), q.v.to(u.km / u.s))
+    np.testing.assert_allclose(moved.as_arrays().r, q.as_arrays().r, rtol=1e-15, atol=0)
+    np.testing.assert_allclose(moved.as_arrays().v, q.as_arrays().v, rtol=1e-15, atol=0)
+    with pytest.raises(u.UnitConversionError, match="`r` to be a length"):
+        q.with_state(q.r.value * u.s, q.v)
+    plain = _pair()
+    r, v = plain.as_arrays().r, plain.as_arrays().v
+    with pytest.raises(ValueError, match=r"`r` as plain numbers in this system's own units"):
+        plain.with_state(r * u.au, v)
+    with pytest.raises(ValueError, match=r"Expected `radius` >= 0, got -5.0 at index 1"):
+        plain.with_state(r, v, radius=[1.0, -5.0])
+    with pytest.raises(ValueError, match=r"Expected `keep` to have shape \(2,\), got \(3,\)"):
+        plain.with_state(r, v, keep=[True, False, True])
+    assert plain.with_state(r, v, radius=[np.nan, 0.1]).names == plain.names
+
+
 def test_two_massless_particles_may_share_a_position():
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
                 Body("p", 0.0, [1, 0, 0], [0, 1, 0]), Body("q", 0.0, [1, 0, 0], [0, 1.1, 0])])
