@@ -571,8 +571,11 @@ class System(InitialStates):
         >>> s.energy()
         -1.0
         """
-        e = self._energy_hamilton()
-        return e * E_SI * u.J if self._quantity else e / self._G
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            e = self._energy_hamilton()
+            e = e * E_SI if self._quantity else e / self._G
+        self._representable("energy", e)
+        return e * u.J if self._quantity else e
 
     def _angular_momentum_hamilton(self) -> np.ndarray:
         return np.einsum("i,ij->j", self._gm, np.cross(self._r, self._v))
@@ -588,8 +591,17 @@ class System(InitialStates):
         >>> s.angular_momentum()
         array([0., 0., 1.])
         """
-        h = self._angular_momentum_hamilton()
-        return h * L_SI * (u.kg * u.m**2 / u.s) if self._quantity else h / self._G
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            h = self._angular_momentum_hamilton()
+            h = h * L_SI if self._quantity else h / self._G
+        self._representable("angular momentum", h)
+        return h * (u.kg * u.m**2 / u.s) if self._quantity else h
+
+    def _representable(self, what: str, value: Any) -> None:
+        """Refuse an integral of the state beyond float64 (its terms overflowed)."""
+        if not np.all(np.isfinite(value)):
+            raise ValueError(f"Expected a state whose {what} is within float64, got {value} "
+                             f"(positions, velocities or gm too large, or G too small)")
 
     def _barycentre_internal(self) -> tuple[np.ndarray, np.ndarray]:
         total = float(np.sum(self._gm))

@@ -265,6 +265,26 @@ def test_with_state_converts_quantities_and_checks_radius_and_keep():
     assert plain.with_state(r, v, radius=[np.nan, 0.1]).names == plain.names
 
 
+@pytest.mark.parametrize(("scale_gm", "scale_r", "scale_v", "what"), [
+    (1e300, 1e300, 1e300, "energy"), (1.0, 1.0, 1e300, "energy"),
+    (1.0, 1e200, 1e200, "angular momentum")])
+def test_integrals_beyond_float64_are_refused_without_warnings(scale_gm, scale_r, scale_v,
+                                                               what):
+    """A state whose energy or angular momentum overflows gave nan or inf, with
+    numpy's overflow warnings; it is a ValueError saying which."""
+    import warnings
+
+    gm = np.array([1.0, 1e-3, 1e-6])
+    r = np.array([[0, 0, 0], [1.0, 0, 0], [0, 2.0, 0]])
+    v = np.array([[0, 0, 0], [0, 1.0, 0], [-0.7, 0, 0]])
+    s = System.from_arrays(gm * scale_gm, r * scale_r, v * scale_v)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=f"a state whose {what} is within float64"):
+            s.energy() if what == "energy" else s.angular_momentum()
+    assert np.isfinite(_pair().energy()) and np.all(np.isfinite(_pair().angular_momentum()))
+
+
 def test_two_massless_particles_may_share_a_position():
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
                 Body("p", 0.0, [1, 0, 0], [0, 1, 0]), Body("q", 0.0, [1, 0, 0], [0, 1.1, 0])])
