@@ -64,7 +64,7 @@ from hamilton_orbits._quaternion_arrays import (
     unit_last,
 )
 from hamilton_orbits._quaternion_rotations import RotationForms
-from hamilton_orbits.validation import broadcast_shapes
+from hamilton_orbits.validation import as_float_array, broadcast_shapes, check_positive
 
 __all__ = ["Quaternion", "slerp"]
 
@@ -73,6 +73,15 @@ def _check_quaternion(name: str, value: Any) -> Quaternion:
     if not isinstance(value, Quaternion):
         raise ValueError(f"Expected `{name}` to be a Quaternion, got {type(value).__name__}")
     return value
+
+
+def _tolerance(name: str, value: Any) -> float:
+    """A tolerance of :meth:`Quaternion.allclose`: one finite number >= 0."""
+    arr = as_float_array(name, value)
+    if arr.shape != ():
+        raise ValueError(f"Expected `{name}` to be one number, got shape {arr.shape}")
+    check_positive(name, arr, strict=False)
+    return float(arr)
 
 
 class Quaternion(RotationForms):
@@ -458,10 +467,12 @@ class Quaternion(RotationForms):
         """Componentwise closeness (as quaternions, so q and -q differ)."""
         other = _check_quaternion("other", other)
         broadcast_shapes(("self", "other"), self.shape, other.shape)
+        rtol, atol = _tolerance("rtol", rtol), _tolerance("atol", atol)
         return bool(np.allclose(self._a, other._a, rtol=rtol, atol=atol))
 
     def rotation_allclose(self, other: Quaternion, *, atol: float = 1e-13) -> bool:
         """True if every pair of rotations is within ``atol`` radians (q ~ -q)."""
+        atol = _tolerance("atol", atol)
         return bool(np.all(self.rotation_distance(other) <= atol))
 
     # ------------------------------------------------------------ container protocol

@@ -419,3 +419,18 @@ def test_axis_angle_identity_convention():
     axis, angle = Quaternion.from_array([1.0, 0, 0, 0]).as_axis_angle()
     np.testing.assert_array_equal(axis, [1.0, 0.0, 0.0])
     assert angle == 0.0
+
+
+@pytest.mark.parametrize(("method", "kw", "pattern"), [
+    ("allclose", {"rtol": float("nan")}, r"`rtol` to be finite, got nan"),
+    ("allclose", {"atol": "a"}, r"`atol` to be numeric, got 'a'"),
+    ("allclose", {"atol": [1e-9, 1e-9]}, r"`atol` to be one number, got shape \(2,\)"),
+    ("rotation_allclose", {"atol": -1}, r"`atol` >= 0, got -1.0"),
+])
+def test_closeness_refuses_a_tolerance_that_is_none(method, kw, pattern):
+    """A NaN rtol gave numpy's RuntimeWarning, a text atol a bare TypeError, and a
+    negative atol called the identical rotation not close (False)."""
+    q = Quaternion.from_axis_angle([0.0, 0.0, 1.0], 0.3)
+    with pytest.raises(ValueError, match=pattern):
+        getattr(q, method)(q, **kw)
+    assert getattr(q, method)(q) and getattr(q, method)(q, atol=0.0)
