@@ -86,8 +86,9 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray):
     raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)")
     raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)")
     radial = e == 1.0
-    p = length * (1.0 - e) * (1.0 + e)
-    inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
+    with np.errstate(over="ignore"):  # (a p beyond float64: refused by the caller's check)
+        p = length * (1.0 - e) * (1.0 + e)
+        inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
     return p, inv_a, radial
 
 

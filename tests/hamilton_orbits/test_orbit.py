@@ -446,3 +446,15 @@ def test_an_open_orbits_mean_longitude_is_its_varpi_plus_m():
         assert 0.0 <= varpi < 2 * np.pi
         assert float(o.mean_longitude) == varpi + sign * float(o.M)
         assert float(o.M) == pytest.approx(0.5, rel=1e-14)  # (M through the state)
+
+
+def test_elements_beyond_float64_are_refused_without_a_warning():
+    """A hyperbola of a = -1e300, e = 1e10 warned "overflow encountered in multiply"
+    (its p) before it was refused; the refusal comes alone."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"Expected `a` to give a finite state .* got -1e\+300"):
+            KeplerOrbit.from_elements(a=-1e300, e=1e10, inc=0.5, lan=0.1, argp=0.2, M=0.3,
+                                      mu=398600.0)
