@@ -161,7 +161,9 @@ def test_simulate_wobble_refuses_a_step_it_cannot_take(dt, pattern):
 @pytest.mark.parametrize(("omega", "pattern"), [
     ([1e-6, 0.0, 0.0], r"`omega` finite with omega_z != 0 .* at index \(\)"),
     ([[1e-6, 0.0, 1.0], [np.nan, 0.0, 1.0]], r"`omega` finite .* at index \(1,\)"),
-    ([1.0, 0.0, 1.0] * u.m, r"`omega`: "),
+    ([1.0, 0.0, 1.0] * u.m, r"`omega` to be an angular speed"),
+    ([1.0, 0.0, 1.0] * u.Hz, r"`omega` to be an angular speed, got Hz"),  # (2 pi off)
+    ("a", r"`omega` to be numeric, got 'a'"),  # (numpy's bare "could not convert")
 ])
 def test_pole_path_refuses_an_omega_without_a_pole(omega, pattern):
     """``m = omega_xy / omega_z``: omega_z = 0 or a NaN used to give inf or NaN

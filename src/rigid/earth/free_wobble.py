@@ -20,20 +20,13 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.units import TIME
+from hamilton_orbits.units import ANGULAR_SPEED, TIME
 from rigid.earth.constants import rigid_body
 from rigid.earth.wobble_fit import free_period
 from rigid.free import free_motion
 from rigid.integrators import integrate
 
 __all__ = ["WOBBLE_TOLERANCE", "PolePath", "pole_path", "simulate_wobble"]
-
-
-def _float(x: Any, unit: u.UnitBase) -> np.ndarray:
-    """SI floats from a Quantity or from the SI floats of RigidBody/RigidTrajectory."""
-    if isinstance(x, u.Quantity):
-        return x.to_value(unit, equivalencies=u.dimensionless_angles())
-    return np.asarray(x, dtype=np.float64)
 
 
 def pole_path(omega: Any) -> np.ndarray:
@@ -54,10 +47,7 @@ def pole_path(omega: Any) -> np.ndarray:
     >>> pole_path([[1e-6, 0.0, 1.0], [0.0, -2e-6, 1.0]])
     array([1.e-06+0.e+00j, 0.e+00-2.e-06j])
     """
-    try:
-        w = _float(omega, u.rad / u.s)
-    except u.UnitConversionError as exc:
-        raise u.UnitConversionError(f"`omega`: {exc}") from None
+    w = ANGULAR_SPEED("omega", omega, finite=False)  # (SI floats as they are)
     if w.shape[-1:] != (3,):
         raise ValueError(f"Expected `omega` to have shape (..., 3), got {w.shape}")
     bad = ~np.isfinite(w).all(axis=-1) | (w[..., 2] == 0.0)
