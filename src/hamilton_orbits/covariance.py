@@ -14,6 +14,8 @@ gravitational coupling.
 Examples
 --------
 >>> import numpy as np
+
+from hamilton_orbits.validation import as_float_array
 >>> phi = np.tile(np.eye(6), (2, 1, 1))          # no motion: Phi = 1 at both times
 >>> phi[1, 0, 3] = 10.0                          # x(t) = x0 + 10 vx0
 >>> c0 = np.diag([1e-12, 0, 0, 1e-16, 0, 0])
@@ -68,7 +70,7 @@ def _checked(cov0: Any, n: int) -> np.ndarray:
     if hasattr(cov0, "unit"):
         raise ValueError("Expected `cov0` as floats in the state's units (au and au/day "
                          "for a Quantity system): its blocks mix units, got a Quantity")
-    c0 = np.asarray(cov0, dtype=np.float64)
+    c0 = as_float_array("cov0", cov0, finite=False)  # (numbers, named; finite below)
     if c0.shape == (6, 6):
         c0 = np.broadcast_to(c0, (n, 6, 6))
     if c0.shape != (n, 6, 6):

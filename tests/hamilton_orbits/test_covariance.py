@@ -101,6 +101,7 @@ def test_a_quantity_system_takes_au_and_days():
     (np.diag([1.0, 1, 1, 1, 1, -1e-3]), r"positive semi-definite, got an eigenvalue -0.001 "
                                           r"for body 0"),
     (np.stack([np.eye(6), np.full((6, 6), np.nan)]), r"finite, got .*nan.* for body 1"),
+    ("a", r"`cov0` to be numeric, got 'a'"),  # (numpy's bare "could not convert")
 ])
 def test_a_bad_initial_covariance_is_refused_naming_it(cov0, match):
     with pytest.raises(ValueError, match=match):
