@@ -14,8 +14,6 @@ gravitational coupling.
 Examples
 --------
 >>> import numpy as np
-
-from hamilton_orbits.validation import as_float_array
 >>> phi = np.tile(np.eye(6), (2, 1, 1))          # no motion: Phi = 1 at both times
 >>> phi[1, 0, 3] = 10.0                          # x(t) = x0 + 10 vx0
 >>> c0 = np.diag([1e-12, 0, 0, 1e-16, 0, 0])
@@ -29,6 +27,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+
+from hamilton_orbits.validation import as_float_array
 
 __all__ = ["propagate"]
 
