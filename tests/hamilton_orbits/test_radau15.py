@@ -459,3 +459,21 @@ def test_the_issue_reproducer_stops_or_reports_an_infinite_energy_error():
     assert float(str(err.value).split()[5]) == pytest.approx(t_c, rel=1e-4)
     traj = integrate(system, 1.0, method="leapfrog", dt=1e-3)
     assert traj.energy_error.tolist() == [0.0, math.inf]
+
+
+def test_a_tolerance_far_below_rounding_is_named_when_the_step_underflows():
+    """``tol=1e-300``: the step shrank until it underflowed, and the refusal asked "a
+    collision, or an encounter closer than float64 resolves?", never naming the
+    tolerance; it names it now (and only a tolerance below float64's rounding)."""
+    from hamilton_orbits import Body, System, integrate
+    from hamilton_orbits.validation import ConvergenceError
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0.1, 0], [0, 1.0, 0.1])])
+    with pytest.raises(ConvergenceError, match=r"the step underflowed .* or `tol` = 1e-300: "
+                                               r"below float64's rounding \(1e-16\)"):
+        integrate(s, 2.0, tol=1e-300)
+    crash = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1.0, [1e-3, 0, 0], [0, 0, 0])])
+    with pytest.raises(ConvergenceError) as info:
+        integrate(crash, 1.0, tol=1e-9)
+    assert "`tol`" not in str(info.value)
