@@ -59,6 +59,8 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
         raise ValueError(f"Expected `{name}` to be numeric, got None")
     if type(value) is list or type(value) is tuple:
         _check_listed(name, value, ())
+    elif isinstance(value, np.ndarray) and value.dtype == object:  # (None in it: nan)
+        _check_listed(name, value.tolist(), ())
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
     if isinstance(value, np.ma.MaskedArray):  # (numpy.asarray takes the values under
@@ -91,8 +93,8 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
 
 def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:
     """Refuse what a list (nested or not) holds that ``numpy.asarray`` would take
-    wrongly: a bool (read as 1.0 or 0.0, silently) or a Quantity (a TypeError deep
-    in numpy), naming the index."""
+    wrongly: a bool (read as 1.0 or 0.0, silently), None (read as nan) or a
+    Quantity (a TypeError deep in numpy), naming the index."""
     units = sys.modules.get("astropy.units")
     for k, x in enumerate(values):
         kind = type(x)
@@ -100,7 +102,7 @@ def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:
             continue
         if kind is list or kind is tuple:
             _check_listed(name, x, (*at, k))
-        elif kind is bool or kind is np.bool_:
+        elif kind is bool or kind is np.bool_ or x is None:  # (None: read as nan)
             raise ValueError(f"Expected `{name}` to be numeric, got {x!r}{fmt_index((*at, k))}")
         elif units is not None and isinstance(x, units.Quantity):
             raise ValueError(

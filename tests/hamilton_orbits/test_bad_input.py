@@ -774,6 +774,13 @@ def test_a_list_holding_quantities_or_bools_is_refused_naming_the_index():
     with pytest.raises(ValueError, match=r"Expected `omega` to be numeric, got True at index 2"):
         RigidBody([1.0, 2.0, 3.0], omega=[0.0, 0.0, True])
     assert RigidBody([1.0, 2.0, 3.0], omega=(0.0, 1, 2.5)).omega.tolist() == [0.0, 1.0, 2.5]
+    # None in a list or an object array was read as nan ("got nan at index 1")
+    from hamilton_orbits import solve_kepler
+
+    with pytest.raises(ValueError, match=r"Expected `M` to be numeric, got None at index 1"):
+        solve_kepler(np.array([1.0, None]), 0.5)
+    with pytest.raises(ValueError, match=r"`e` to be numeric, got None at index \(0, 1\)"):
+        solve_kepler(1.0, [[0.1, None]])
 
 
 @pytest.mark.parametrize("bodies", [5, Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
