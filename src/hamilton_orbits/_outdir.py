@@ -19,6 +19,8 @@ import socket
 import time
 from pathlib import Path
 
+from hamilton_orbits.integrators._held import held
+
 try:
     import fcntl
 except ImportError:  # pragma: no cover - platforms without flock: takeovers unguarded
@@ -123,6 +125,7 @@ class OutputFolder:
             _HELD.discard(self._claim)
             raise
 
+    @held
     def _claim_lock(self) -> OutputFolder:
         """Take the folder's lock (:meth:`__enter__`)."""
         # the lock is written whole under a name of its own, then linked to its name
@@ -170,6 +173,7 @@ class OutputFolder:
         except OSError as exc:
             raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
 
+    @held
     def _take_over_stale(self) -> None:
         """Remove the lock of a run that has ended; refuse one of a live run.
 
@@ -215,6 +219,7 @@ class OutputFolder:
             f"another run ({who}) is writing into this folder; choose another folder, or "
             f"wait for it to end (if it has ended on another machine, delete {self._lock})")
 
+    @held
     def __exit__(self, *exc_info: object) -> None:
         try:
             fd = os.open(self._lock, os.O_RDONLY)

@@ -39,6 +39,7 @@ import numpy as np
 
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
+from hamilton_orbits.integrators._held import held
 from hamilton_orbits.restart import inline
 from hamilton_orbits.segment import (
     NO_LEG,
@@ -414,6 +415,7 @@ class ArchiveWriter:
                 "every_steps": self.every_steps, "every_wall": self.every_wall,
                 "origin": self.origin, "sync": self.sync, "exact": self.exact}
 
+    @held
     def open(self) -> None:
         """Claim the folder (lock) and find the next snapshot number."""
         if self.folder is not None or self.path is None:
@@ -481,6 +483,7 @@ class ArchiveWriter:
             return snapshot_at(self.path, self.count - 1) is not None
         return False
 
+    @held
     def close(self) -> None:
         """Close the segment being written and release the folder's lock (again after
         a Ctrl-C amid them: the segment let go before its files are closed, the lock
@@ -496,6 +499,7 @@ class ArchiveWriter:
                 self.folder.__exit__(None, None, None)
                 self.folder = None
 
+    @held
     def lost(self) -> None:
         """After a snapshot whose writing did not end (Ctrl-C, an error): the segment
         cut back to its counted records, closed and left, so that the next snapshot
@@ -548,6 +552,7 @@ class ArchiveWriter:
             return self.clock() - self.last_wall >= self.every_wall
         return False
 
+    @held
     def write(self, meta: dict[str, Any], arrays: Mapping[str, np.ndarray],
               dims: Mapping[str, tuple[str, ...]], units: Mapping[str, str]) -> Path | None:
         """Append the next snapshot (numbered after the last one in the folder) to the
@@ -577,6 +582,7 @@ class ArchiveWriter:
         self.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
         return seg.path
 
+    @held
     def refill(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
                active: np.ndarray, state: list[np.ndarray], scalars: list[Any], steps: int,
                ints: list[int]) -> bool:
@@ -590,6 +596,7 @@ class ArchiveWriter:
         self.last_steps, self.last_wall = steps, self.clock()
         return True
 
+    @held
     def append_leg(self, values: Mapping[str, Any], rows: dict[str, np.ndarray],
                    meta: Mapping[str, Any]) -> None:
         """Append a leg's first snapshot to the segment being written, which its
@@ -601,6 +608,7 @@ class ArchiveWriter:
         self.leg = _record_leg(meta)
         self.append({**values, "leg": self.leg, "leg_span": span}, rows)
 
+    @held
     def append(self, values: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> None:
         """Append a snapshot that shares everything but ``values`` (its record: ``t``,
         ``steps``, ``r``, ... as :func:`state_values` gives them) and its output ``rows``

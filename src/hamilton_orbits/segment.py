@@ -69,6 +69,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, encode, parse
+from hamilton_orbits.integrators._held import held
 from hamilton_orbits.snapshot import (
     INT_EXACT,
     SnapshotError,
@@ -771,6 +772,7 @@ def _shared(path: Path, header: Header) -> tuple[int, dict[str, Any]]:
         raise SnapshotError(f"{path} cannot be read as an archive segment ({exc})") from None
 
 
+@held
 def _read_back(path: Path, number: int | None = None) -> Segment | None:
     """:func:`read_segment` with ``last`` (``number`` None) or ``number``, reading
     only the bytes before the first record (checked as the whole file's are) and
@@ -828,6 +830,7 @@ def _read_back(path: Path, number: int | None = None) -> Segment | None:
     return seg
 
 
+@held
 def _rows_span(path: Path, before: int, end: int) -> tuple[dict[str, np.ndarray] | None,
                                                              list[Path]]:
     """Rows ``before`` to ``end`` of a segment's companion file, as :func:`_rows`

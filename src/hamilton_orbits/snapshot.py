@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._netcdf3 import encode
+from hamilton_orbits.integrators._held import held
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "INT_EXACT", "SnapshotError", "beyond_float", "checksum",
            "encode_snapshot", "read", "stored", "variable", "write", "write_bytes"]
@@ -150,6 +151,7 @@ def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
                    "sha256": checksum(meta_text, arrays)}, variables)
 
 
+@held
 def write_bytes(path: str | os.PathLike[str], data: bytes, *, sync: bool = True,
                 keep_open: bool = False) -> int | None:
     """Write ``data`` to ``path`` atomically: under a temporary name in the same

@@ -40,11 +40,13 @@ then raised
 
 from __future__ import annotations
 
+import functools
 import signal
+import sys
 import threading
+from collections.abc import Callable
 from types import FrameType, TracebackType
-
-from hamilton_orbits.firstrun import compiling
+from typing import Any, TypeVar
 
 # the C function behind signal.getsignal, without its conversion to an enum: 10 ns
 # against 1.5 us a call (the handlers are compared by identity: the same either way)
@@ -53,10 +55,18 @@ try:
 except ImportError:  # pragma: no cover - (another Python: the public one)
     _getsignal = signal.getsignal
 
-__all__ = ["HELD", "CtrlCHeld"]
+__all__ = ["HELD", "CtrlCHeld", "held"]
 
 _thread = threading.get_ident
 _SIGINT = signal.SIGINT
+
+
+def _compiling() -> bool:
+    """Whether numba compiles a call's kernel (:func:`hamilton_orbits.firstrun.
+    compiling`; never before that module is imported: this one imports no numba,
+    for the archive's files it guards too)."""
+    firstrun = sys.modules.get("hamilton_orbits.firstrun")
+    return firstrun is not None and firstrun.compiling()
 
 
 class CtrlCHeld:
@@ -99,7 +109,7 @@ class CtrlCHeld:
             raise KeyboardInterrupt
 
     def _on_sigint(self, signum: int, frame: FrameType | None) -> None:
-        if self.depth and not self.pending and not compiling():
+        if self.depth and not self.pending and not _compiling():
             self.pending = True
         else:  # (raised at once also while numba compiles the call's kernel: no step
             signal.default_int_handler(signum, frame)  # taken yet, nothing to count)
@@ -115,3 +125,23 @@ class CtrlCHeld:
 
 #: the one :class:`CtrlCHeld` the drivers enter
 HELD = CtrlCHeld()
+
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def held(function: _F) -> _F:
+    """``function`` called within :data:`HELD`: a Ctrl-C meanwhile raised as it
+    returns.  For the archive's files: a Ctrl-C between a system call that opens a
+    file (or makes one) and the statement that keeps its descriptor left the
+    descriptor open for good, or a temporary file behind; a function so wrapped
+    keeps what it opens where its caller's cleanup finds it (its return value is
+    then lost: wrap the method that stores a descriptor, not the one returning it)."""
+
+    @functools.wraps(function)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        with HELD:
+            return function(*args, **kwargs)
+
+    return call  # type: ignore[return-value]
+
