@@ -181,7 +181,10 @@ class Ensemble:
         progress : bool
             A progress bar over the whole grid (tqdm, quiet when not a terminal).
         workers : int, optional
-            Local processes (default: all cores, at most one per member).
+            Local processes (default: all cores, at most one per member).  They are
+            kept for the next ensemble of as many (their start and compilation paid
+            once); another count replaces them, and a pool that lost a worker (killed
+            by the system) is replaced.
 
         Returns
         -------
@@ -217,9 +220,6 @@ class Ensemble:
                     if bar is not None:
                         bar.update(1)
             else:
-                import multiprocessing as mp
-                from concurrent.futures import ProcessPoolExecutor, as_completed
-
                 n = workers or min(len(args), os.cpu_count() or 1)
                 if n <= 1:
                     for i, a in enumerate(args):
@@ -227,17 +227,7 @@ class Ensemble:
                         if bar is not None:
                             bar.update(1)
                 else:
-                    pool = _pool(n, ProcessPoolExecutor, mp)
-                    futs = {pool.submit(run_member, *a): i for i, a in enumerate(args)}
-                    try:
-                        for fut in as_completed(futs):
-                            rows[futs[fut]] = fut.result()
-                            if bar is not None:
-                                bar.update(1)
-                    except BaseException:  # (Ctrl-C, a worker lost: the members not
-                        for fut in futs:  # begun are not run for nothing, the pool's
-                            fut.cancel()  # workers left for the next ensemble)
-                        raise
+                    _in_pool(n, args, rows, bar)
         finally:
             if bar is not None:
                 bar.close()
@@ -254,15 +244,61 @@ class Ensemble:
 _POOLS: dict[int, Any] = {}
 
 
-def _pool(n: int, executor: Any, mp: Any) -> Any:
+def _in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any) -> None:
+    """Run the members ``args`` on the kept pool of ``n`` processes into ``rows``.  A
+    pool found broken (one of its workers killed since the last ensemble: the
+    out-of-memory killer) is replaced; one that breaks now is dropped, so that the
+    next ensemble starts a new one (it failed every later ensemble)."""
+    from concurrent.futures import as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        futs = _submitted(_pool(n), args)
+    except BrokenProcessPool:
+        _drop(n)
+        futs = _submitted(_pool(n), args)
+    try:
+        for fut in as_completed(futs):
+            rows[futs[fut]] = fut.result()
+            if bar is not None:
+                bar.update(1)
+    except BaseException as exc:  # (Ctrl-C, a worker lost: the members not begun are
+        for fut in futs:  # not run for nothing, the pool's workers left for the next
+            fut.cancel()  # ensemble, unless one of them was lost)
+        if isinstance(exc, BrokenProcessPool):
+            _drop(n)
+            raise BrokenProcessPool(f"a worker process of the ensemble's pool of {n} ended "
+                                    f"abruptly (killed: out of memory?); the members it had "
+                                    f"not finished are lost; the next run starts a new "
+                                    f"pool") from exc
+        raise
+
+
+def _submitted(pool: Any, args: list[tuple]) -> dict[Any, int]:
+    return {pool.submit(run_member, *a): i for i, a in enumerate(args)}
+
+
+def _pool(n: int) -> Any:
     """A pool of ``n`` worker processes kept for the session (started once: the
-    workers' imports and compiled kernels are paid on the first ensemble only)."""
+    workers' imports and compiled kernels are paid on the first ensemble only); a
+    pool of another size is shut down first (one pool's processes at a time)."""
+    for other in [k for k in _POOLS if k != n]:
+        _drop(other)
     pool = _POOLS.get(n)
     if pool is None:
         import atexit
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor
 
         ctx = mp.get_context("spawn")  # safe beside numba's threads
-        pool = executor(max_workers=n, mp_context=ctx)
+        pool = ProcessPoolExecutor(max_workers=n, mp_context=ctx)
         _POOLS[n] = pool
         atexit.register(pool.shutdown, wait=False, cancel_futures=True)
     return pool
+
+
+def _drop(n: int) -> None:
+    """Shut the kept pool of ``n`` processes down (its workers end)."""
+    pool = _POOLS.pop(n, None)
+    if pool is not None:
+        pool.shutdown(wait=False, cancel_futures=True)

@@ -166,7 +166,7 @@ def test_a_ctrl_c_cancels_the_members_a_pool_has_not_begun(monkeypatch):
 
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=1)
     monkeypatch.setattr(ensemble, "run_member", member)
-    monkeypatch.setattr(ensemble, "_pool", lambda n, executor, mp: pool)
+    monkeypatch.setattr(ensemble, "_pool", lambda n: pool)
     ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9}] * 10)
     with pytest.raises(KeyboardInterrupt):
         ens.run(progress=False, workers=2)
@@ -183,3 +183,55 @@ def test_a_local_ensemble_without_pandas_names_its_own_extra(monkeypatch, tmp_pa
     code = main(["ensemble", "dzhanibekov", "--vary", "duration=40 s", "--no-progress"])
     assert code != 0
     assert "pip install 'hamilton-orbits[ensemble]'" in capsys.readouterr().err
+
+
+def test_a_pool_that_lost_a_worker_is_replaced_and_one_pool_is_kept(monkeypatch):
+    """A kept pool one of whose workers was killed (the out-of-memory killer) made
+    every later ensemble of as many workers fail with BrokenProcessPool until Python
+    restarted; pools of 2, 3 and 4 workers were all kept (11 processes, 1.9 GB).
+    A broken pool is replaced; one that breaks during a run fails that run, saying
+    so, and the next starts a new one; a new count shuts the other pool down.  (The
+    pools here are of threads, the members stand-ins: the logic, not the spawn.)"""
+    import concurrent.futures
+    from concurrent.futures.process import BrokenProcessPool
+
+    from hamilton_orbits import ensemble
+
+    made, broken = [], set()
+
+    class Pool(concurrent.futures.ThreadPoolExecutor):
+        def __init__(self, max_workers, mp_context=None):
+            super().__init__(max_workers=max_workers)
+            made.append(self)
+
+        def submit(self, fn, *args):
+            if self in broken:
+                raise BrokenProcessPool("A process in the process pool was terminated")
+            return super().submit(fn, *args)
+
+    def member(data, source, values):
+        if values.get("integrator.tol") == 1e-7:  # (this member's worker is killed)
+            broken.add(made[-1])
+            raise BrokenProcessPool("A process in the process pool was terminated")
+        return {"error": None, "complete": True}
+
+    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", Pool)
+    monkeypatch.setattr(ensemble, "run_member", member)
+    monkeypatch.setattr(ensemble, "_POOLS", {})
+    ens = Ensemble(comet(), members=[{"integrator.tol": 1e-9}] * 3)
+    assert len(ens.run(progress=False, workers=2)) == 3 and len(made) == 1
+    broken.add(made[0])  # (a worker killed while the pool waited)
+    assert len(ens.run(progress=False, workers=2)) == 3 and len(made) == 2
+    assert list(ensemble._POOLS) == [2] and ensemble._POOLS[2] is made[1]
+    dying = Ensemble(comet(), members=[{"integrator.tol": 1e-9}, {"integrator.tol": 1e-7}])
+    with pytest.raises(BrokenProcessPool, match=r"a worker process of the ensemble's pool "
+                                                 r"of 2 ended abruptly .* the next run starts "
+                                                 r"a new pool"):
+        dying.run(progress=False, workers=2)
+    assert ensemble._POOLS == {}
+    assert len(ens.run(progress=False, workers=2)) == 3 and len(made) == 3
+    assert len(ens.run(progress=False, workers=3)) == 3 and list(ensemble._POOLS) == [3]
+    assert made[2]._shutdown  # (the pool of 2 shut down: one pool's processes at a time)
+    for pool in made:
+        pool.shutdown(wait=True)
+
