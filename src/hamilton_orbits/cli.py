@@ -467,24 +467,34 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
               "`hamilton-orbits run` (one scene, resumed with `hamilton-orbits resume`)",
               file=sys.stderr)
     with OutputFolder(folder, "--out" if out else "output folder"):
-        client = _dask_client(dask) if dask else None
+        client, cluster = _dask_client(dask) if dask else (None, None)
         try:
             df = ens.run(client=client, progress=progress and sys.stderr.isatty())
         finally:
             if client is not None:
                 client.close()
+            if cluster is not None:  # (a client does not close the cluster it was given:
+                cluster.close()  # its worker processes outlived the command in-process)
         _write_ensemble(scene, df, folder, list(vary))
     return EXIT_OK if df.attrs["failures"] == 0 else EXIT_FAILED
 
 
 def _dask_client(address: str):
-    """A Dask client on ``address`` (``"local"``: a cluster on this machine)."""
+    """A Dask client on ``address`` and the cluster made for it (``"local"``: one on
+    this machine, to close after the client; None for a scheduler's address)."""
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError:
         raise _CommandError("--dask needs Dask: pip install 'hamilton-orbits[dask]'") from None
     try:
-        return Client(LocalCluster()) if address == "local" else Client(address)
+        if address != "local":
+            return Client(address), None
+        cluster = LocalCluster()
+        try:
+            return Client(cluster), cluster
+        except BaseException:
+            cluster.close()
+            raise
     except (OSError, ValueError, TypeError) as exc:
         raise _CommandError(f"--dask {address}: cannot connect to the scheduler "
                            f"({_one_line(exc)})") from None
