@@ -318,7 +318,9 @@ def progress_reporter(method: str, total: int,
         from tqdm.auto import tqdm
     except ImportError:  # pragma: no cover - tqdm is an optional extra
         return on_output, None
-    bar = tqdm(total=total, desc=method, unit="output", leave=False)
+    # (disable=None: quiet where stderr is no terminal, a log file or a pipe, which
+    # kept each bar's text; a notebook's widget bar shows)
+    bar = tqdm(total=total, desc=method, unit="output", leave=False, disable=None)
 
     def report(i: int, steps: int) -> None:
         bar.update(1)

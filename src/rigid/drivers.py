@@ -237,7 +237,8 @@ def _bar(total: int, unit: str, progress: bool) -> Any:
         from tqdm.auto import tqdm
     except ImportError:  # pragma: no cover - optional extra
         return None
-    return tqdm(total=total, unit=unit, leave=False)
+    return tqdm(total=total, unit=unit, leave=False, disable=None)  # (None: quiet off a
+    # terminal, a log file keeping each bar's text; a notebook's widget bar shows)
 
 
 def _grid(t: np.ndarray, dt: float, n_out: int | None) -> tuple[int, float, np.ndarray]:
