@@ -26,7 +26,7 @@ try:
 except ImportError:  # pragma: no cover - platforms without flock: takeovers unguarded
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["LOCK_NAME", "FolderError", "OutputFolder"]
+__all__ = ["LOCK_NAME", "FolderError", "OutputFolder", "live_holder"]
 
 LOCK_NAME = ".hamilton-orbits.lock"
 _CLAIMS = itertools.count(1)
@@ -58,6 +58,31 @@ def _alive(pid: int) -> bool:
             return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
     except (OSError, IndexError):
         return True
+
+
+def live_holder(folder: str | Path) -> int | None:
+    """The PID of the run of this machine that holds ``folder``'s lock and is alive
+    (this process's own included); None for no lock, a run that has ended, or one of
+    another machine (whose life cannot be told from here).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     with OutputFolder(tmp):
+    ...         live_holder(tmp) == os.getpid()
+    ...     live_holder(tmp)
+    True
+    """
+    try:
+        held = (Path(folder) / LOCK_NAME).read_text(encoding="utf-8", errors="replace").split()
+    except OSError:
+        return None
+    if len(held) < 2 or not re.fullmatch(r"[0-9]{1,9}", held[0]) or \
+            held[1] != socket.gethostname():
+        return None
+    pid = int(held[0])
+    return pid if pid == os.getpid() or _alive(pid) else None
 
 
 def _hold(fd: int, patience: float = 2.0) -> None:

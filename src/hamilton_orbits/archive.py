@@ -27,12 +27,14 @@ Examples
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._outdir import live_holder
 from hamilton_orbits.checkpoint import contents, path_of
 from hamilton_orbits.simulation import Simulation
 from hamilton_orbits.snapshot import SnapshotError
@@ -44,6 +46,10 @@ class ArchiveIndexError(IndexError, ValueError):
     """An index that is not the position of one of an archive's snapshots (an
     ``IndexError``, which ends a loop over the archive, and a ``ValueError``, as
     other bad input)."""
+
+
+#: a segment's or its rows' file name, its number
+_NUMBER = re.compile(r"(?:segment|rows|snapshot)-(\d{6})\.nc")
 
 
 @dataclass(frozen=True)
@@ -77,6 +83,13 @@ class Archive:
         Files ending in a write that never finished (the process was killed while
         writing): the snapshot it was to become does not exist, and those bytes are
         never read.
+    writing : int or None
+        The PID of a live run of this machine writing into the folder now (its
+        lock held), else None.
+    in_progress : list of Path
+        That run's newest files, whose last write was still going on as they were
+        read (they would otherwise be listed as torn); the snapshots before it are
+        read as any.
 
     Raises
     ------
@@ -89,11 +102,13 @@ class Archive:
         self.path = path_of(path, "path", "an archive folder's path").absolute()
         if not self.path.is_dir():
             raise SnapshotError(f"no archive folder {self.path}")
+        before = live_holder(self.path)  # (and after: a call may begin or end meanwhile)
         found = contents(self.path, keep=("t", "r", "v", "gm", "active"))
         self.snapshots = [Snapshot(number, file, float(meta["t"]), int(meta["steps"]))
                           for number, file, meta, _ in found.snapshots]
         self.damaged: list[tuple[Path, str]] = found.damaged
-        self.torn: list[Path] = found.torn
+        self.writing = live_holder(self.path) or before
+        self.torn, self.in_progress = _in_progress(self.path, found.torn, self.writing)
         self._arrays = [arrays for *_, arrays in found.snapshots]
         last = found.snapshots[-1][2] if found.snapshots else None
         self._names: tuple[str, ...] = () if last is None else tuple(last["system"]["names"])
@@ -175,6 +190,21 @@ class Archive:
                   "body": ("body", list(self._names)), "xyz": ("xyz", ["x", "y", "z"]),
                   "steps": ("time", steps[keep])}
         return xr.Dataset(data, coords=coords, attrs={"archive": str(self.path)})
+
+
+def _in_progress(folder: Path, torn: list[Path],
+                 writing: int | None) -> tuple[list[Path], list[Path]]:
+    """``torn`` split into the files torn and those a live writer (PID ``writing``)
+    is writing: its temporary files and the newest numbered files of the folder
+    (a segment and its rows), whose last record is being appended as they are read."""
+    if writing is None or not torn:
+        return torn, []
+    numbered = [int(m.group(1)) for p in folder.iterdir()
+                if not p.name.startswith(".") and (m := _NUMBER.fullmatch(p.name))]
+    newest = max(numbered, default=-1)
+    live = [p for p in torn if p.name.endswith(f".tmp-{writing}") or (
+        (m := _NUMBER.fullmatch(p.name)) is not None and int(m.group(1)) == newest)]
+    return [p for p in torn if p not in live], live
 
 
 def _repeats(times: np.ndarray, steps: np.ndarray, stack: dict[str, np.ndarray]) -> np.ndarray:
