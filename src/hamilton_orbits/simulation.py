@@ -254,11 +254,25 @@ class Simulation(Saving):
         """An independent copy (its own state; the compiled right-hand side shared):
         integrating one does not change the other.  The copy of an archived
         simulation keeps its schedule but writes nothing."""
-        new = copy.copy(self)
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
         new._prop = copy.deepcopy(self._prop, shared_memo(self._prop))
         if self._archive is not None:  # the same output times; only the original writes
             new._archive = self._archive.schedule_only()
         return new
+
+    def __copy__(self) -> Simulation:
+        # (copy.copy shared the state: integrating the copy moved the original)
+        return self.copy()
+
+    def __deepcopy__(self, memo: dict) -> Simulation:
+        # (it failed: "cannot pickle 'module' object")
+        return self.copy()
+
+    def __reduce__(self) -> Any:
+        raise TypeError("A Simulation is not pickled (its compiled kernels are this "
+                        "process's): save it with sim.save(path) and continue it anywhere "
+                        "with Simulation.load(path); copy it with sim.copy()")
 
     # ------------------------------------------------------------------ run
     def integrate(self, t: Any, *, progress: bool = False,

@@ -6,7 +6,16 @@ import astropy.units as u
 import numpy as np
 import pytest
 
-from hamilton_orbits import Body, KeplerOrbit, System, Trajectory, crosscheck, integrate
+from hamilton_orbits import (
+    Archive,
+    Body,
+    KeplerOrbit,
+    Simulation,
+    System,
+    Trajectory,
+    crosscheck,
+    integrate,
+)
 
 EPS = np.finfo(float).eps
 
@@ -362,3 +371,22 @@ def test_no_test_particles_no_particle_check():
     traj = integrate(sun_jupiter_saturn(), 100 * u.day, method="wh", dt=10 * u.day)
     assert traj.particle_check == ("", "", "") and np.isnan(traj.particle_error).all()
     assert len(traj.under_resolved) == 0
+
+
+def test_copy_module_copies_are_independent_and_pickling_says_what_to_do(tmp_path):
+    """``copy.copy(sim)`` shared the state (integrating the copy moved the original);
+    ``copy.deepcopy`` and ``pickle`` failed with "cannot pickle 'module' object".
+    Both copies are ``sim.copy()`` (the archive's writing left to the original);
+    pickling is refused naming save/load and copy."""
+    import copy
+    import pickle
+
+    sim = Simulation(sun_jupiter_saturn(), archive=tmp_path / "a", every=10 * u.day)
+    sim.integrate(20 * u.day)
+    for made in (copy.copy(sim), copy.deepcopy(sim)):
+        made.integrate(40 * u.day)
+        assert sim.t == 20 * u.day and made.t == 40 * u.day
+    assert len(Archive(tmp_path / "a")) == 3  # (only the original wrote: 0, 10, 20 days)
+    with pytest.raises(TypeError, match=r"sim.save\(path\) .* Simulation.load\(path\); copy "
+                                        r"it with sim.copy\(\)"):
+        pickle.dumps(sim)
