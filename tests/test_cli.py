@@ -201,6 +201,25 @@ def test_scene_listing_keeps_words_whole(capsys):
         assert set(description.split()) <= words, name  # no word cut in two
 
 
+def test_scene_listing_lists_every_registered_effect_by_the_kinds_taking_it(capsys):
+    """docs/effects.md: "`hamilton-orbits scenes` lists what is registered"; it listed
+    the bundled scenes' effects only (gr_potential, nongrav, semi_active never
+    appeared).  Every registered effect is listed with its summary's first words,
+    under the scene kinds that take it (not the free rigid body's, which takes none)."""
+    from hamilton_orbits.effects.registry import get, known
+
+    assert main(["scenes"]) == 0
+    out = capsys.readouterr().out
+    table = out[out.index("scene kinds"):].splitlines()
+    a, b = table[0].index("effect"), table[0].index("what it adds")
+    for kind in ("nbody", "rotation"):
+        for name in known(kind):
+            row = next(line for line in table if line[a:b].strip() == name)
+            assert " ".join(get(kind, name).summary.split()[:3]) in row
+    table = "\n".join(table)
+    assert "polar_motion, pole_prediction" in table and "rotation," not in table
+
+
 def test_quoted_run_time_is_what_the_command_takes(tmp_path):
     """The listing quoted 3-4x the measured times.  The quoted time of a quick scene
     is the whole command's, warm, within a factor 3 either way.  Measured as the

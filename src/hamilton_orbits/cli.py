@@ -182,7 +182,33 @@ def _list_scenes() -> int:
           "first run\non a machine adds the one-time compilation of the kernels it uses (its "
           "summary says\nwhich and how long; the main job's is measured by "
           "benchmarks/bench_first_run.py)")
+    print("\n" + format_table(_effect_rows()))
+    print("\neffects: what a scene's `effects = [...]` may list, by the kinds of scene that "
+          "take\nthem (docs/effects.md gives every parameter, its unit and its default)")
     return EXIT_OK
+
+
+def _effect_rows() -> list[dict[str, str]]:
+    """A row per registered effect: the scene kinds that take it, its name, its
+    summary (the kinds registered by the bundled scenes' packages)."""
+    import hamilton_orbits.effects  # noqa: F401  (registers the built-in effects)
+    from hamilton_orbits.effects.registry import get, known
+    from hamilton_orbits.scenes.base import KINDS
+
+    groups: dict[str, list[str]] = {}
+    for kind in sorted(KINDS.values(), key=lambda k: k.name):
+        if kind.takes_effects:
+            groups.setdefault(kind.effect_kind, []).append(kind.name)
+    rows = []
+    for effect_kind, scene_kinds in groups.items():
+        label = ", ".join(scene_kinds)
+        for name in known(effect_kind):
+            lines = _wrap(get(effect_kind, name).summary, 64)
+            rows.append({"scene kinds": label, "effect": name, "what it adds": lines[0]})
+            rows += [{"scene kinds": "", "effect": "", "what it adds": line}
+                     for line in lines[1:]]
+            label = ""
+    return rows
 
 
 def _run(ref: str, out: str | None, sets: Sequence[str], progress: bool) -> int:

@@ -319,6 +319,7 @@ KIND = SceneKind(
     check=_check,
     run=_run,
     crosscheck=_crosscheck,
+    takes_effects=False,  # (the free body: _check refuses any)
 )
 
 

@@ -48,6 +48,9 @@ class SceneKind:
         user asked to stop (Ctrl-C): the run ends early and keeps what it has.
     crosscheck : callable or None
         ``crosscheck(scene) -> str``: the same scene in a peer code, tabled.
+    takes_effects : bool
+        Whether its scenes may list effects (False: its ``check`` refuses any;
+        ``hamilton-orbits scenes`` then lists none for it).
     """
 
     name: str
@@ -57,6 +60,7 @@ class SceneKind:
     check: Callable[[dict, S.Problems], None]
     run: Callable[..., Any]
     crosscheck: Callable[[Any], str] | None = None
+    takes_effects: bool = True
 
 
 KINDS: dict[str, SceneKind] = {}
