@@ -325,6 +325,19 @@ def test_an_effect_whose_field_is_a_massless_bodys_is_refused(effect, massless, 
         compile_rhs(_massless(_earth_moon(), massless), [effect])
 
 
+@pytest.mark.parametrize(("effect", "key", "typo", "meant"), [
+    ({"name": "gr"}, "source", "son", "sun"), ({"name": "j2"}, "body", "jupyter", "jupiter"),
+    ({"name": "gr_potential"}, "source", "Sun", "sun")])
+def test_a_misspelt_source_body_is_answered_with_the_closest_name(effect, key, typo, meant):
+    """docs/effects.md: "the closest names are suggested"; ``gr``'s and ``j2``'s body
+    named no suggestion, only every body (``nongrav`` and the DE440 effects did)."""
+    system = System.solar_system("J2000", bodies=["sun", "jupiter"])
+    with pytest.raises(ValueError, match=rf"`{key}` names body '{typo}', which is not in the "
+                                         rf"system \(did you mean '{meant}'\?\); bodies: sun, "
+                                         r"jupiter"):
+        compile_rhs(system, [{**effect, key: typo}])
+
+
 @pytest.mark.parametrize("effect", [
     {"name": "zonal", "frame": "galactic"},
     {"name": "earth_tides", "frame": "ICRS"},

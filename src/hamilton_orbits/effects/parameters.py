@@ -99,11 +99,8 @@ def source_index(system: Any, params: Mapping[str, Any], key: str, effect: str) 
     if not isinstance(name, str):
         raise ValueError(f"Effect {effect!r}: expected `{key}` to be the name of a body, got "
                          f"{name!r}; bodies: {', '.join(system.names)}")
-    if name not in system.names:
-        raise ValueError(
-            f"Effect {effect!r}: `{key}` names body {name!r}, which is not in the system; "
-            f"bodies: {', '.join(system.names)}"
-        )
+    if name not in system.names:  # (the closest names suggested, as for the others)
+        raise _not_a_body(system, key, name, effect)
     idx = system.names.index(name)
     if not gm[idx] > 0:
         raise ValueError(f"Effect {effect!r}: body {name!r} is massless (gm = 0)")
