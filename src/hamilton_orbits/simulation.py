@@ -53,6 +53,7 @@ from hamilton_orbits.checkpoint import (
 )
 from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
+from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
 from hamilton_orbits.trajectory import (
@@ -176,6 +177,10 @@ class Simulation(Saving):
         eff = check_effects(typed, () if effects is None else effects)
         step = None if dt is None else time_step(dt, system.quantity)
         tol = tolerance(tol)
+        if step is not None and tol is not None and typed.name in FIXED_STEP:
+            raise ValueError(f"Expected `dt` or `tol` with method {typed.name!r} (a fixed step, "
+                             f"or a tolerance that chooses it), got both: dt = {dt!r}, tol = "
+                             f"{tol!r} (the tolerance would be ignored)")
         tan = tangent_of(system, variational, stm, tangent, typed)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()

@@ -12,6 +12,8 @@ import os
 import re
 import signal
 import socket
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -754,6 +756,10 @@ def test_a_segment_being_written_reads_and_a_record_begun_after_it_is_torn(tmp_p
         np.testing.assert_array_equal(ds.t.values, archive.times)
     with open(path, "ab") as fh:  # the first bytes of a next record, then a kill
         fh.write(b"\x3f\xf0")
+    assert Archive(tmp_path).in_progress == [path]  # (this live process holds the lock)
+    ended = subprocess.Popen([sys.executable, "-c", "pass"])
+    ended.wait()  # (a process that has ended: the killed run's lock is left with its PID)
+    (tmp_path / ".hamilton-orbits.lock").write_text(f"{ended.pid} {socket.gethostname()} 1\n")
     assert Archive(tmp_path).torn == [path] and len(Archive(tmp_path)) == header.numrecs
 
 

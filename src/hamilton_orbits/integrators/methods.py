@@ -25,11 +25,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-__all__ = ["CRITERIA", "DOP853", "INTEGRATORS", "METHODS", "PRECISIONS", "WH", "WH_COORDINATES",
-           "WH_CORRECTORS", "Leapfrog", "Method", "Radau15", "method_of"]
+__all__ = ["CRITERIA", "DOP853", "FIXED_STEP", "INTEGRATORS", "METHODS", "PRECISIONS", "WH",
+           "WH_COORDINATES", "WH_CORRECTORS", "Leapfrog", "Method", "Radau15", "method_of"]
 
 #: The methods, in the order they are listed to users.
 INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
+#: The methods of a fixed step: ``dt``, or a ``tol`` that chooses it (not both).
+FIXED_STEP = ("wh", "leapfrog")
 #: radau15's step-size criteria: ``"global"`` (Rein & Spiegel 2015, section 3.2) and
 #: ``"prs23"`` (Pham, Rein & Spiegel 2024, IAS15's default since rebound 4).
 CRITERIA = ("global", "prs23")

@@ -15,6 +15,7 @@ import numpy as np
 from hamilton_orbits import effects as _effects
 from hamilton_orbits import schema as S
 from hamilton_orbits.integrators import WH_CORRECTORS
+from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.scenes.base import check_archive_size, check_output_size
 from hamilton_orbits.scenes.nbody.build import (
     attempt,
@@ -268,6 +269,10 @@ def _check_integrator(integ: dict, problems: S.Problems) -> None:
     if integ["method"] == "leapfrog" and integ["dt"] is None and integ["tol"] is None:
         problems.add("integrator.dt", "missing: method 'leapfrog' takes a fixed step `dt` "
                                       "(or a tolerance `tol` from which to choose one)")
+    if integ["method"] in FIXED_STEP and integ["dt"] is not None and integ["tol"] is not None:
+        problems.add("integrator.tol", f"method {integ['method']!r} takes a fixed step `dt` or "
+                                       "a tolerance `tol` that chooses it, not both (the "
+                                       "tolerance was ignored)")
     if integ["corrector"] not in (None, *WH_CORRECTORS):
         problems.add("integrator.corrector", "expected one of "
                      f"{', '.join(map(str, WH_CORRECTORS))}, got {integ['corrector']!r}")
