@@ -619,3 +619,32 @@ def test_an_unknown_frame_whose_orbits_lie_in_x_y_asks_for_frame():
     a_ecl = _alone(ecl, "kuiper_ring", {"frame": "ecliptic"})
     rot = de.frame_rotation("ecliptic")
     assert np.abs(a_ecl - a_icrs @ rot.T).max() < 1e-12 * np.abs(a_icrs).max()
+
+
+@pytest.mark.parametrize("effect", ["kuiper_ring", "zonal"])
+def test_an_unknown_frame_whose_test_particles_orbit_in_x_y_asks_for_frame(effect):
+    """The check looked at the angular momentum, to which massless bodies add none: a
+    Sun with a massless rock in the ecliptic's x-y plane took ICRS axes silently
+    (the ring's normal 23.4 deg off), a hand-built Earth with a massless equatorial
+    satellite likewise (docs/effects.md says it asks for ``frame`` there too).  With
+    one massive body the test particles' orbits decide."""
+    import astropy.units as u
+
+    centre = "sun" if effect == "kuiper_ring" else "earth"
+    gm = (2.959e-4 if centre == "sun" else 8.887e-10) * u.au**3 / u.day**2
+    d = (1.0 if centre == "sun" else 5e-5) * u.au
+    w = np.sqrt(gm / d).to(u.au / u.day)
+    zero = [0, 0, 0] * u.au
+
+    def system(r, v):
+        return System([Body(centre, gm, zero, zero / u.day, radius=(6.4e3 * u.km).to(u.au)),
+                       Body("rock", 0.0 * gm, r, v)])
+
+    plane = system(u.Quantity([0 * d, d, 0 * d]), u.Quantity([-w, 0 * w, 0 * w]))
+    with pytest.raises(ValueError, match=re.escape(
+            f"Effect {effect!r}: expected `frame` ('icrs' or 'ecliptic')")):
+        plane.accelerations([effect])
+    assert np.all(np.isfinite(plane.accelerations([{"name": effect, "frame": "icrs"}])))
+    tilted = system(u.Quantity([d, 0 * d, 0 * d]), u.Quantity([0 * w, 0 * w, w]))
+    assert np.all(np.isfinite(tilted.accelerations([effect])))  # (its orbit far from x-y)
+

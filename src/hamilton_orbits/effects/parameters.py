@@ -499,16 +499,23 @@ def _frame_of_poles(system: Any) -> str | None:
 def _refuse_ecliptic_looking(system: Any, effect: str) -> None:
     """Refuse to take as ICRS axes a system whose orbits lie near its x-y plane (its
     angular momentum about the barycentre within 10 degrees of z, nearer z than the
-    ICRS's ecliptic pole): such axes are ecliptic ones, or the system is not the
-    solar system, and the effect's default directions (the ecliptic pole, the Sun's
-    and the Earth's poles) would be wrong by the obliquity."""
+    ICRS's ecliptic pole; with one massive body, the mean normal of the test
+    particles' orbits about it): such axes are ecliptic ones, or the system is not
+    the solar system, and the effect's default directions (the ecliptic pole, the
+    Sun's and the Earth's poles) would be wrong by the obliquity."""
     arrays = system.as_arrays()
     gm = arrays.gm
     if not gm.sum() > 0:
         return
     r = arrays.r - gm @ arrays.r / gm.sum()
     v = arrays.v - gm @ arrays.v / gm.sum()
-    h = gm @ np.cross(r, v)
+    each = np.cross(r, v)
+    h = gm @ each
+    if not float(np.linalg.norm(h)) > 0:  # (one massive body: the orbits are the test
+        # particles', which carry no angular momentum: their planes' mean normal)
+        sizes = np.linalg.norm(each, axis=1, keepdims=True)
+        h = np.sum(np.divide(each, sizes, out=np.zeros_like(each), where=sizes > 0)[gm == 0],
+                   axis=0)
     norm = float(np.linalg.norm(h))
     if not (np.isfinite(norm) and norm > 0):
         return
