@@ -3,8 +3,8 @@ An ensemble on Dask: nodal regression against inclination
 =========================================================
 
 One scene, many variations: the bundled scene ``leo-j2`` (a satellite at
-7000 km about an oblate Earth, effect ``j2``) is run for inclinations from 0°
-to 180° by :class:`hamilton_orbits.Ensemble`, each member a task on a Dask
+7000 km about an oblate Earth, effect ``j2``) is run for inclinations from 10°
+to 170° by :class:`hamilton_orbits.Ensemble`, each member a task on a Dask
 client.  Here the client is a local cluster of threads in this process
 (``processes=False``); give ``Client("tcp://...")`` for a real one, the code is
 the same.  Each member reports the nodal regression rate it measured and the
