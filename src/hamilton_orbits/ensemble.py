@@ -246,31 +246,41 @@ _POOLS: dict[int, Any] = {}
 
 def _in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any) -> None:
     """Run the members ``args`` on the kept pool of ``n`` processes into ``rows``.  A
-    pool found broken (one of its workers killed since the last ensemble: the
-    out-of-memory killer) is replaced; one that breaks now is dropped, so that the
-    next ensemble starts a new one (it failed every later ensemble)."""
-    from concurrent.futures import as_completed
+    pool found broken before any member of this run has ended (one of its workers
+    killed since the last ensemble: the out-of-memory killer) is replaced and the run
+    begun again on the new one; one that breaks later fails the run, saying so, and
+    is dropped, so that the next ensemble starts a new pool (a broken pool failed
+    every later ensemble)."""
     from concurrent.futures.process import BrokenProcessPool
 
-    try:
-        futs = _submitted(_pool(n), args)
-    except BrokenProcessPool:
-        _drop(n)
-        futs = _submitted(_pool(n), args)
+    for attempt in (1, 2):
+        try:
+            futs = _submitted(_pool(n), args)
+            _collected(futs, rows, bar)
+            return
+        except BrokenProcessPool as exc:
+            _drop(n)
+            if attempt == 1 and all(row is None for row in rows):
+                continue  # (the pool was broken before: this run begun again)
+            raise BrokenProcessPool(f"a worker process of the ensemble's pool of {n} ended "
+                                    f"abruptly (killed: out of memory?); the members it had "
+                                    f"not finished are lost; the next run starts a new "
+                                    f"pool") from exc
+
+
+def _collected(futs: dict[Any, int], rows: list[dict | None], bar: Any) -> None:
+    """The members' rows as their futures end; on any exception (Ctrl-C, a worker
+    lost) the members not begun are cancelled, not run for nothing."""
+    from concurrent.futures import as_completed
+
     try:
         for fut in as_completed(futs):
             rows[futs[fut]] = fut.result()
             if bar is not None:
                 bar.update(1)
-    except BaseException as exc:  # (Ctrl-C, a worker lost: the members not begun are
-        for fut in futs:  # not run for nothing, the pool's workers left for the next
-            fut.cancel()  # ensemble, unless one of them was lost)
-        if isinstance(exc, BrokenProcessPool):
-            _drop(n)
-            raise BrokenProcessPool(f"a worker process of the ensemble's pool of {n} ended "
-                                    f"abruptly (killed: out of memory?); the members it had "
-                                    f"not finished are lost; the next run starts a new "
-                                    f"pool") from exc
+    except BaseException:
+        for fut in futs:
+            fut.cancel()
         raise
 
 

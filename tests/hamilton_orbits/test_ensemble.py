@@ -209,8 +209,9 @@ def test_a_pool_that_lost_a_worker_is_replaced_and_one_pool_is_kept(monkeypatch)
     """A kept pool one of whose workers was killed (the out-of-memory killer) made
     every later ensemble of as many workers fail with BrokenProcessPool until Python
     restarted; pools of 2, 3 and 4 workers were all kept (11 processes, 1.9 GB).
-    A broken pool is replaced; one that breaks during a run fails that run, saying
-    so, and the next starts a new one; a new count shuts the other pool down.  (The
+    A pool broken before any member ended is replaced and the run begun again on
+    the new one; one that breaks later fails that run, saying so, and the next
+    starts a new one; a new count shuts the other pool down.  (The
     pools here are of threads, the members stand-ins: the logic, not the spawn.)"""
     import concurrent.futures
     from concurrent.futures.process import BrokenProcessPool
@@ -229,7 +230,12 @@ def test_a_pool_that_lost_a_worker_is_replaced_and_one_pool_is_kept(monkeypatch)
                 raise BrokenProcessPool("A process in the process pool was terminated")
             return super().submit(fn, *args)
 
+    late = []
+
     def member(data, source, values):
+        if values.get("integrator.tol") == 1e-8 and not late:  # (a worker killed while
+            late.append(1)  # idle, seen by the pool only as the run's members fail)
+            raise BrokenProcessPool("A process in the process pool was terminated")
         if values.get("integrator.tol") == 1e-7:  # (this member's worker is killed)
             broken.add(made[-1])
             raise BrokenProcessPool("A process in the process pool was terminated")
@@ -249,9 +255,14 @@ def test_a_pool_that_lost_a_worker_is_replaced_and_one_pool_is_kept(monkeypatch)
                                                  r"a new pool"):
         dying.run(progress=False, workers=2)
     assert ensemble._POOLS == {}
-    assert len(ens.run(progress=False, workers=2)) == 3 and len(made) == 3
+    assert len(ens.run(progress=False, workers=2)) == 3 and ensemble._POOLS[2] is made[-1]
+    two = made[-1]
+    again = Ensemble(comet(), members=[{"integrator.tol": 1e-8}])  # (one: no row before)
+    assert len(again.run(progress=False, workers=2)) == 1 and late == [1]  # (begun again)
+    assert ensemble._POOLS[2] is made[-1] and made[-1] is not two
+    two = made[-1]
     assert len(ens.run(progress=False, workers=3)) == 3 and list(ensemble._POOLS) == [3]
-    assert made[2]._shutdown  # (the pool of 2 shut down: one pool's processes at a time)
+    assert two._shutdown  # (the pool of 2 shut down: one pool's processes at a time)
     for pool in made:
         pool.shutdown(wait=True)
 
