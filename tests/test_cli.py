@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import astropy.units as u
 import numpy as np
 
 import hamilton_orbits
@@ -119,6 +120,37 @@ def test_a_scene_whose_escape_removes_a_body_saves_everything(tmp_path, capsys):
     for name in ("summary.md", "summary.json", "orbits.png", "energy_error.png",
                  "states.nc", "final.bin"):
         assert (out / name).exists(), name
+
+
+def test_the_states_file_says_its_bodies_its_time_origin_and_frame(tmp_path):
+    """states.nc gave r and v anonymous dimensions and the names only as a comma-joined
+    attribute (a name with a comma split in two); time had units "day" and no origin
+    (which epoch? for the pole scene, which fit epoch?), the frame only in the summary;
+    a rotation scene's seconds were stored as days, 291 of 1001 not converting back
+    bit for bit; final.bin said t = 0 after the run.  Read here by xarray and rebound
+    alone."""
+    import rebound
+    import xarray as xr
+
+    from hamilton_orbits.scene import Scene
+
+    out = tmp_path / "ss"
+    assert main(["run", "solar-system", "--set", "duration=2 yr", "--set", "crosscheck=false",
+                 "--out", str(out), "--no-progress"]) == 0
+    with xr.open_dataset(out / "states.nc", engine="scipy") as ds:
+        assert list(ds.body.values[:2]) == ["sun", "mercury"] and ds.r.dims == (
+            "time", "body", "xyz") and ds.v.dims == ("time", "body", "xyz")
+        assert ds.time.attrs["units"] == "d" and ds.time.values[-1] == 730.5
+        assert ds.time.attrs["time_origin"].startswith("J2000, the epoch of the initial state")
+        assert ds.attrs["frame"].startswith("J2000 mean ecliptic and equinox")
+        r_end = ds.r.values[-1]
+    final = rebound.Simulation(str(out / "final.bin"))
+    assert final.t == 730.5 and final.particles[1].x == r_end[1, 0]
+    spin = Scene.bundled("dzhanibekov", {"duration": "10 s"}).run(progress=False)
+    spin.save(tmp_path / "spin")
+    with xr.open_dataset(tmp_path / "spin" / "states.nc", engine="scipy") as ds:
+        assert ds.time.attrs["units"] == "s"
+        np.testing.assert_array_equal(ds.time.values, spin.times.to_value(u.s))
 
 
 def test_a_scene_the_run_would_refuse_exits_2_before_running(tmp_path, capsys):

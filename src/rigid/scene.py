@@ -166,6 +166,7 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
                 "attitude": traj.attitude.as_array()},
         wall_time=wall,
         complete=len(t) == n_out,
+        time_origin="the start of the run",
     )
     result.metrics["integrator"] = integ["method"]
     result.metrics["max attitude error vs exact"] = np.max(diag["attitude_error"]).to(u.rad)

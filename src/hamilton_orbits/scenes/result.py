@@ -43,6 +43,9 @@ class Result:
         rebound, then skipped); the run's results are kept.
     frame : str
         The axes of the states (and their origin), named in the summary.
+    time_origin : str
+        What time 0 of ``times`` is (an epoch, a fit's epoch, each prediction's
+        start), written into ``states.nc``.
     wall_time : float
         Seconds of the integration proper: no compilation (see ``compile_time``).
     resumed_from : Quantity or None
@@ -74,6 +77,7 @@ class Result:
     complete: bool = True
     interrupted: bool = False
     frame: str = ""
+    time_origin: str = ""
     compile_time: float = 0.0
     compile_count: int = 0
     compiled: list[tuple[str, float]] = field(default_factory=list)
@@ -230,13 +234,20 @@ class Result:
     def _write_states(self, path: Path) -> None:
         from scipy.io import netcdf_file
 
-        t = self.times.to_value(u.d)
+        t = np.asarray(self.times.value, dtype=float)  # (the run's own floats and unit)
         with netcdf_file(path, "w") as f:
             f.title = _utf8(f"hamilton-orbits scene {self.scene.name}")
+            if self.frame:
+                f.frame = _utf8(self.frame)
             f.createDimension("time", len(t))
             var = f.createVariable("time", "d", ("time",))
             var[:] = t
-            var.units = "day"
+            var.units = _utf8(str(self.times.unit))
+            if self.time_origin:
+                var.time_origin = _utf8(self.time_origin)
+            names = self.states.get("names")
+            if names is not None:
+                _write_names(f, [str(n) for n in names])
             for name, series in self.diagnostics.items():
                 if isinstance(series, dict):  # what a figure marks, not a time series
                     continue
@@ -253,14 +264,30 @@ class Result:
                 dims = ["time"] + [f"{name}_dim{k}" for k in range(1, arr.ndim)]
                 if arr.shape[0] != len(t):
                     continue
+                if names is not None and arr.ndim == 3 and arr.shape[1:] == (len(names), 3):
+                    dims[1:] = ["body", "xyz"]  # (shared with the names, as to_xarray has)
                 for k in range(1, arr.ndim):
-                    f.createDimension(dims[k], arr.shape[k])
+                    if dims[k] not in f.dimensions:
+                        f.createDimension(dims[k], arr.shape[k])
                 var = f.createVariable(name, "d", tuple(dims))
                 var[:] = arr
                 var.units = _utf8(str(getattr(value, "unit", "")))
-            names = self.states.get("names")
-            if names is not None:
+            if names is not None:  # (kept beside the variable: files read it so far)
                 f.bodies = _utf8(",".join(str(n) for n in names))
+
+
+def _write_names(f: Any, names: list[str]) -> None:
+    """The body names as the coordinate variable ``body`` (UTF-8 characters, as
+    xarray decodes them to strings), on the dimension ``body``; ``xyz`` too."""
+    data = [n.encode("utf-8") for n in names]
+    width = max([1] + [len(b) for b in data])
+    f.createDimension("body", len(names))
+    f.createDimension("xyz", 3)
+    f.createDimension("name_length", width)
+    var = f.createVariable("body", "c", ("body", "name_length"))
+    if data:
+        var[:] = np.array([np.frombuffer(b.ljust(width, b"\0"), dtype="S1") for b in data])
+    var._Encoding = "utf-8"
 
 
 def _utf8(text: str) -> bytes:

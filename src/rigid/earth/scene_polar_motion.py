@@ -124,6 +124,8 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
         },
         states={"x_p": rec.x.to(u.mas), "y_p": rec.y.to(u.mas)},
         wall_time=wall,
+        time_origin=f"the fit epoch {fit.epoch.utc.iso[:16]} UTC (MJD {fit.epoch.utc.mjd:.2f}, "
+                    "the window's middle)",
     )
     ks = float(secular_love_number())
     t_e = euler_period()
@@ -181,7 +183,7 @@ def _plot(result: Result):
              label="observed m1 (trend removed)")
     ax2.plot(years, result.diagnostics["model_m1"].to_value(u.mas), lw=0.8,
              label="Liouville model")
-    ax2.set_xlabel("time from the fit epoch [yr]")
+    ax2.set_xlabel(f"time from {result.time_origin.split(' (')[0]} [yr]")
     ax2.set_ylabel("m1 = x_p, towards Greenwich [mas]")
     ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
                frameon=False)

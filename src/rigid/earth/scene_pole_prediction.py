@@ -154,8 +154,9 @@ def _run(scene: Scene, progress: bool = True, stop=lambda: False) -> Result:
             break
     wall = time.perf_counter() - begin
     result = Result(scene=scene, times=dense, wall_time=wall,
-                    complete=len(scores) == len(spec["periods"]))  # (stopped: the periods
-    # hindcast kept, the run said incomplete)
+                    complete=len(scores) == len(spec["periods"]),  # (stopped: the periods
+                    # hindcast kept, the run said incomplete)
+                    time_origin="each prediction's start: the time is its horizon")
     for i, by_method in enumerate(scores.values()):  # the MAE curves, saved to states.nc
         for method, score in by_method.items():
             key = method.replace("+", "_")

@@ -190,6 +190,7 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
     _particles_into(result, traj, gm)
     frame = scene_frame(scene.spec)
     result.frame = frame_note(scene.spec, scene.data.get("initial"))
+    result.time_origin = _time_origin(scene.spec)
     result.plotters.append(lambda res: plot_orbits(res, gm, frame))
     result.plotters.append(lambda res: plot_energy(res, what, conserved))
 
@@ -199,7 +200,10 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
         # ASCII path, and appends to a file already there)
         path, tmp = folder / "final.bin", folder / f".final.bin.tmp-{os.getpid()}"
         try:
-            tmp.write_bytes(binary_of(traj.final.to_rebound()))
+            final = traj.final.to_rebound()
+            end = traj.t[-1]  # (rebound's t in days, as its states: it said 0 after 20 yr)
+            final.t = float(end.to_value(u.day) if hasattr(end, "unit") else end)
+            tmp.write_bytes(binary_of(final))
             os.replace(tmp, path)
         finally:
             tmp.unlink(missing_ok=True)
@@ -207,6 +211,16 @@ def _result(scene: Any, system: Any, traj: Any, effects: Any) -> Result:
 
     result.writers.append(write_rebound)
     return result
+
+
+def _time_origin(spec: dict) -> str:
+    """What time 0 of an n-body scene is: the epoch of its initial state."""
+    initial = spec.get("initial") or {}
+    for key in ("solar_system", "ephemeris"):
+        part = initial.get(key) or {}
+        if part.get("epoch") is not None:
+            return f"{part['epoch']}, the epoch of the initial state ([initial] {key})"
+    return "the initial state (the scene names no epoch)"
 
 
 def _particles_into(result: Result, traj: Any, gm: np.ndarray) -> None:
