@@ -128,3 +128,28 @@ def test_orbit_plots_mark_start_and_direction(figures):
             assert len(starts) >= len(tracks) >= 1, scene  # a moon is drawn as dots
             assert len(arrows) == len(starts), scene
             assert any("start" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def test_an_energy_the_effects_change_is_drawn_signed_and_a_peers_apart(figures):
+    """An energy the effects change was drawn as |change| on a log axis, each change
+    of sign a deep dip that looked like structure; it is signed, on a linear axis.
+    rebound's errors were drawn over ours on one axis (both on the same few levels
+    of rounding: ours hidden); they have a panel of their own, on the same scales.
+    The DE440 residuals, sampled yearly, are points: joined, the orbits' periods
+    aliased into slow wiggles."""
+    scene, figs = figures
+    by_label = {fig.get_label(): fig for fig in figs}
+    energy = by_label.get("energy_error")
+    if energy is None:
+        pytest.skip(f"{scene} draws no energy figure")
+    axes = [ax for ax in energy.axes if _data_lines(ax)]
+    if scene == "de440-century":
+        (ax,) = axes
+        assert ax.get_yscale() == "linear" and "signed" in ax.get_ylabel()
+        assert any(list(line.get_ydata()) == [0, 0] for line in _data_lines(ax))  # (zero)
+        residuals = by_label["de440_residuals"].axes[0]
+        assert all(line.get_linestyle() == "None" for line in _data_lines(residuals))
+    else:
+        assert all(ax.get_yscale() == "log" for ax in axes)
+        if scene in ("solar-system", "comet-encounter") and len(axes) > 1:
+            assert axes[0].get_shared_y_axes().joined(axes[0], axes[1])

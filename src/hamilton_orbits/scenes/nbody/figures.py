@@ -33,7 +33,9 @@ def plot_megno(result: Result):
 
 
 def plot_de440(result: Result):
-    """The position residuals against DE440 against time, one line a body."""
+    """The position residuals against DE440 against time, a body's points each
+    (the samples are yearly: joined by lines, the orbits' periods alias into slow
+    wiggles that look like residual oscillations)."""
     import matplotlib.pyplot as plt
 
     from hamilton_orbits.studies.ladder import BODIES
@@ -41,19 +43,21 @@ def plot_de440(result: Result):
     fig, ax = plt.subplots(figsize=(9.5, 4.8))
     years = result.diagnostics["de440_years"]
     km = result.diagnostics["de440_km"]
-    colors = plt.cm.tab20(np.arange(len(BODIES)) / len(BODIES))
+    colors = plt.cm.tab10(np.arange(10) / 10)
+    markers = "osD^v<>PX*h"
     for k, body in enumerate(BODIES):
         moon = body == "moon"
-        ax.semilogy(years[1:], np.maximum(km[1:, k], 1e-6), lw=1.4 if moon else 1, marker=".",
-                    ms=3,
-                    ls="--" if moon else "-", color="k" if moon else colors[k],
+        ax.semilogy(years[1:], np.maximum(km[1:, k], 1e-6), ls="none",
+                    marker=markers[k % len(markers)], ms=4 if moon else 3,
+                    mfc="none" if k >= 10 else None, color="k" if moon else colors[k % 10],
                     label="moon (from the earth)" if moon else body)
     epoch = str(result.scene.spec["initial"]["ephemeris"]["epoch"])
     start = "J2000" if epoch.strip().upper() == "J2000" else f"the start, {epoch} TDB"
     ax.set_xlabel(f"time from {start} [yr]")
     ax.set_ylabel("position residual against DE440 [km]")
     # (distances: the same on any axes, so no frame is named)
-    ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric)")
+    ax.set_title(f"{result.scene.name}: heliocentric residuals (the Moon geocentric), "
+                 "sampled once a year")
     ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0),
               frameon=False)
     fig.tight_layout()
@@ -563,38 +567,77 @@ def plot_orbits(result: Result, gm: np.ndarray, frame: str):
 def plot_energy(result: Result, what: str, conserved: bool):
     """The relative energy error against time (log scale).  Exact zeros (the
     energy came back bit for bit) have no place on a log axis: they are counted
-    in the legend, not drawn at an invented floor."""
+    in the legend, not drawn at an invented floor.  An energy not conserved (the
+    effects change it) is drawn signed on a linear axis: its absolute value on a
+    log axis made each change of sign a deep dip, which looked like structure.
+    rebound's errors, beside, are drawn in a panel of their own below ours (on one
+    axis its points covered ours: both sit on the same few levels of rounding)."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
     span = result.times[-1] - result.times[0]
     t_unit = u.yr if span > 1 * u.yr else u.d
     t = result.times.to_value(t_unit)
     series = [("hamilton-orbits", result.diagnostics["energy_error"], {})]
     peer = result.diagnostics.get("rebound_energy_error")
-    if peer is not None:
-        series.append(("rebound IAS15", peer, {"alpha": 0.6}))
-    for label, values, style in series:
-        err = np.abs(np.asarray(values[1:], dtype=float))
-        nonzero = err > 0
-        zeros = int(np.count_nonzero(~nonzero))
-        note = f" ({zeros} of {len(err)} outputs exactly 0, not drawn)" if zeros else ""
-        ax.semilogy(t[1:][nonzero], err[nonzero], ".", ms=2, label=label + note, **style)
+    if not conserved:
+        fig, ax = plt.subplots(figsize=(7.5, 4.8))
+        if peer is not None:
+            series.append(("rebound IAS15", peer, {"marker": "x", "ms": 3, "alpha": 0.7}))
+        return _energy_change(fig, ax, result, t, t_unit, series, what)
+    if peer is None:
+        fig, ax = plt.subplots(figsize=(7.5, 4.8))
+        axes = [ax]
+    else:
+        fig, axes = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True, sharey=True)
+        series.append(("rebound IAS15", peer, {"color": "C1"}))
+    for ax, (label, values, style) in zip(axes, series, strict=True):
+        _log_errors(ax, t, np.abs(np.asarray(values[1:], dtype=float)), label, style)
+        ax.set_ylabel("|relative energy error|\n(dimensionless)")
+    return _energy_frame(fig, axes[-1], result, t_unit, "energy error", what, top=axes[0])
+
+
+def _log_errors(ax: Any, t: np.ndarray, err: np.ndarray, label: str, style: dict) -> None:
+    """One series of errors >= 0 on a log axis, its exact zeros counted in the legend
+    (not drawn at an invented floor); machine epsilon marked where they come near."""
+    nonzero = err > 0
+    zeros = int(np.count_nonzero(~nonzero))
+    note = f" ({zeros} of {len(err)} outputs exactly 0, not drawn)" if zeros else ""
+    ax.semilogy(t[1:][nonzero], err[nonzero], ls="none", marker=".", ms=2, label=label + note,
+                **style)
     eps = np.finfo(float).eps
-    drawn = [line.get_ydata() for line in ax.get_lines() if len(line.get_ydata())]
-    top = max((float(np.max(y)) for y in drawn), default=0.0)
+    top = float(np.max(err[nonzero])) if nonzero.any() else 0.0
     if top < 1e3 * eps:  # the line only where the data come near it
         ax.axhline(eps, color="0.5", lw=0.7, ls=":", label=f"machine epsilon {eps:.1e}")
-    if not drawn:
+    if not nonzero.any():
         ax.set_ylim(eps / 100, eps * 100)
+
+
+def _energy_change(fig: Any, ax: Any, result: Result, t: np.ndarray, t_unit: Any,
+                   series: list, what: str) -> Any:
+    """:func:`plot_energy` of an energy the effects change: signed, linear axis."""
+    for label, values, style in series:
+        change = np.asarray(values[1:], dtype=float)
+        style = {"marker": ".", "ms": 2, **style}
+        ax.plot(t[1:], change, ls="none", label=label, **style)
+    ax.axhline(0.0, color="0.5", lw=0.7)
+    ax.set_ylabel("relative energy change, signed (dimensionless)")
+    return _energy_frame(fig, ax, result, t_unit,
+                         "energy change (not an error: not conserved)", what)
+
+
+def _energy_frame(fig: Any, ax: Any, result: Result, t_unit: Any, title: str,
+                  what: str, top: Any = None) -> Any:
+    """The energy figure's time axis (``ax``, the lowest), title (on ``top``, the
+    highest axis), one legend of every axis's series below, and file name."""
     ax.set_xlabel(f"time since the start [{t_unit}]")
-    ax.set_ylabel("|relative energy error| (dimensionless)" if conserved
-                  else "|relative energy change| (dimensionless)")
-    title = "energy error" if conserved else "energy change (not an error: not conserved)"
-    ax.set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
-              frameon=False)
-    fig.tight_layout()
+    (top or ax).set_title(f"{result.scene.name}: {title}\nof {what}", fontsize=9)
+    entries: dict[str, Any] = {}
+    for each in fig.axes:
+        for handle, label in zip(*each.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)  # (machine epsilon once)
+    fig.legend(list(entries.values()), list(entries), fontsize=7, loc="lower center", ncol=2,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0.03 + 0.025 * ((len(entries) + 1) // 2), 1, 1))
     fig.set_label("energy_error")  # the file name Result.save gives it
     return fig
 
