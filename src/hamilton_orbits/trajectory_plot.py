@@ -47,7 +47,7 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
     >>> fig = integrate(s, np.linspace(0, 2 * np.pi, 100)).plot()
     >>> fig.axes[0].get_xlabel()
-    'x from sun'
+    "x from sun [the system's length unit]"
     """
     import matplotlib.pyplot as plt
 
@@ -70,7 +70,7 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     about = "the frame's origin" if primary is None else traj.names[primary]
     ax.plot([0.0], [0.0], "k+", ms=10, mew=1.5,
             label=about if primary is None else f"{about} (primary)")
-    suffix = "" if unit is None else f" [{unit}]"
+    suffix = " [the system's length unit]" if unit is None else f" [{unit}]"
     ax.set_xlabel(f"{'xyz'[i]} from {about}{suffix}")
     ax.set_ylabel(f"{'xyz'[j]} from {about}{suffix}")
     ax.set_aspect("equal", adjustable="datalim")
@@ -116,7 +116,8 @@ def _path(ax: Any, x: np.ndarray, y: np.ndarray, v0: tuple[float, float], name: 
     sparse = steps.size > 0 and float(np.median(steps)) > 0.2 * extent
     (line,) = ax.plot(x, y, "." if sparse else "-", lw=0.9, ms=3, label=name)
     color = line.get_color()
-    ax.plot(x[0], y[0], "o", mfc="none", mec=color, ms=7)
+    ax.plot(x[0], y[0], "o", color=color, mfc="none", ms=7)  # (its colour given: the
+    # cycle then moves on by one a body, the same body the same colour in every figure)
     ax.plot(x[-1], y[-1], "o", color=color, ms=4)
     speed = float(np.hypot(*v0))
     if speed > 0 and np.isfinite(speed):  # the direction of motion at the start

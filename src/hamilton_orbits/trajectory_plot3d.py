@@ -74,7 +74,7 @@ def plot_trajectory3d(traj: Any, bodies: Sequence[str] | None = None,
     ...             Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
     >>> fig = integrate(s, np.linspace(0, 2 * np.pi, 500)).plot3d()
     >>> fig.layout.scene.xaxis.title.text
-    'x from sun'
+    "x from sun [the system's length unit]"
     >>> len(fig.frames)
     200
     """
@@ -201,7 +201,7 @@ def _layout(fig: Any, traj: Any, names: tuple[str, ...], centre: int | None,
             unit: str | None, keep: np.ndarray) -> None:
     """Axis titles (origin and unit), equal aspect, the slider and play/pause buttons."""
     where = " (integration frame)" if centre is None else f" from {names[centre]}"
-    suffix = "" if unit is None else f" [{unit}]"
+    suffix = " [the system's length unit]" if unit is None else f" [{unit}]"
     axes = {f"{c}axis": {"title": {"text": f"{c}{where}{suffix}"}} for c in "xyz"}
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
                "transition": {"duration": 0}}

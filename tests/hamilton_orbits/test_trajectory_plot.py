@@ -62,7 +62,7 @@ def test_a_plane_is_chosen_and_a_bad_one_named():
                 Body("p", 1e-3, [1.0, 0, 0], [0, 0.6, 0.8])])
     traj = integrate(s, np.linspace(0, 3, 60))
     fig = traj.plot(plane="xz")
-    assert fig.axes[0].get_ylabel() == "z from sun"  # plain floats: no unit to name
+    assert fig.axes[0].get_ylabel() == "z from sun [the system's length unit]"
     np.testing.assert_array_equal(_lines(fig.axes[0], "p")[0].get_ydata(),
                                   traj.r[:, 1, 2] - traj.r[:, 0, 2])
     plt.close(fig)
@@ -79,4 +79,26 @@ def test_a_body_an_event_took_out_ends_where_it_left():
     fig = traj.plot()
     (path,) = _lines(fig.axes[0], "b")
     assert 0 < len(path.get_xdata()) < 200 and np.isfinite(path.get_xdata()).all()
+    plt.close(fig)
+
+
+def test_a_body_keeps_its_colour_and_a_plain_system_names_its_unit():
+    """The start marker took no colour: the cycle moved on by two a body (C0, C2,
+    C4), so that a body had another colour beside other figures of the same bodies
+    (the Pythagorean example's m4 green in one, orange in the next).  A system of
+    plain numbers labelled its axes "x from sun", with no unit."""
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits import Body, System, integrate
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("a", 1e-3, [1.0, 0, 0], [0, 1.0, 0]),
+                Body("b", 1e-3, [0, 2.0, 0], [-0.7, 0, 0]),
+                Body("c", 1e-3, [-3.0, 0, 0], [0, -0.58, 0])])
+    fig = integrate(s, np.linspace(0.0, 20.0, 200)).plot()
+    ax = fig.axes[0]
+    paths = [line for line in ax.get_lines() if line.get_label() in ("a", "b", "c")]
+    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    assert [line.get_color() for line in paths] == cycle[:3]
+    assert ax.get_xlabel() == "x from sun [the system's length unit]"
     plt.close(fig)

@@ -84,7 +84,7 @@ def test_axis_titles_carry_origin_and_unit_and_the_aspect_is_the_data(inner, flo
     fig = inner.plot3d(origin="frame")
     assert fig.layout.scene.xaxis.title.text == "x (integration frame) [AU]"
     np.testing.assert_array_equal(_trace(fig, "sun").x, inner.r[:, 0, 0].to_value(u.au))
-    assert floats.plot3d().layout.scene.xaxis.title.text == "x from sun"  # no unit to name
+    assert floats.plot3d().layout.scene.xaxis.title.text == "x from sun [the system's length unit]"
 
 
 def test_bodies_and_origin_choose_what_is_drawn(floats):
