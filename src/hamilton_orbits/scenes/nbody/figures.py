@@ -454,10 +454,11 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
     handles.append(sun)
     handles.append(Line2D([], [], marker="o", ls="none", mfc="w", mec="k",
                           label="start (t = 0); arrow: direction of motion"))
-    if "ends" in drawn:
+    if "ends" in drawn:  # (a handle of each style: one solid line said both)
         handles.append(Line2D([], [], color="k", lw=1.3, label=(
-            "bold, dashed: the two-body orbit at the first,\nthe last output "
-            "(pale: the whole track)")))
+            "the two-body orbit at the first output\n(pale: the whole track)")))
+        handles.append(Line2D([], [], color="k", lw=1.3, ls="--",
+                              label="the two-body orbit at the last output"))
     if "dots" in drawn:
         handles.append(Line2D([], [], color="k", lw=0.6, marker=".", ms=3, label=(
             f"dots: the outputs (every {view['cadence_text']}), more\nthan a {PER_ORBIT}th "
