@@ -255,7 +255,8 @@ def _plot_mae(result: Result, scores: dict):
                 mae = t[f"mae_{coord}"].to_value(u.mas)
                 label = method
                 if method == "persistence" and len(by_method) > 1:
-                    label += " (runs off the top)"
+                    label += " (beyond the top where it is off the axis)"  # (not everywhere:
+                    # in 2016-2024 it comes back into view)
                 else:
                     top = max(top, float(np.nanmax(mae)))
                 ax.plot(t["horizon"].to_value(u.day), mae, color=_COLOURS[method], lw=1.4,
