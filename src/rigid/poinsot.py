@@ -153,12 +153,12 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
     unit = "[(kg m$^2$)$^{-1/2}$]"  # (x . I x = 1 on the inertia ellipsoid)
     for k, set_label in enumerate((ax1.set_xlabel, ax1.set_ylabel, ax1.set_zlabel)):
         set_label(f"body axis {k + 1} {unit}", fontsize=8)
-    ax1.set_title("polhode on the inertia ellipsoid (body)")
+    ax1.set_title("polhode on the inertia ellipsoid (body)", fontsize=10)
     ax2 = fig.add_subplot(1, 2, 2)
     ax2.plot(*herpolhode.T, color="C0", linewidth=0.8)
     ax2.set_aspect("equal")
     ax2.set_xlabel(f"along e1 in the invariable plane {unit}", fontsize=8)
     ax2.set_ylabel(f"along e2 {unit}", fontsize=8)
-    ax2.set_title(f"herpolhode (invariable plane at d = {distance:.4g} {unit})")
+    ax2.set_title(f"herpolhode (invariable plane at d = {distance:.4g} {unit})", fontsize=10)
     fig.tight_layout()
     return fig
