@@ -29,6 +29,7 @@ print(result.summary())
 # The figures
 # -----------
 # The scene draws the orbits face-on in the J2000 ecliptic frame and the
-# errors of Hamilton's integrals, ours beside rebound's.
+# energy error (the law of vis viva, Hamilton's (E)), ours above rebound's; the
+# angular momentum's error (the law of areas, (D)) is in the summary's table.
 figures = result.plot()
 plt.show()
