@@ -30,6 +30,7 @@ print(result.summary())
 # -----------
 # The scene draws the orbits face-on in the J2000 ecliptic frame and the
 # energy error (the law of vis viva, Hamilton's (E)), ours above rebound's; the
-# angular momentum's error (the law of areas, (D)) is in the summary's table.
+# angular momentum's (the law of areas, (D)) is among the run's diagnostics,
+# ``result.diagnostics["angular_momentum_error"]``.
 figures = result.plot()
 plt.show()
