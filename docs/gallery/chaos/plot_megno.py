@@ -19,6 +19,7 @@ quasi-periodic orbit and grows like ``lambda t / 2`` on a chaotic one, where
 # Units: G = 1, masses in solar masses, lengths in au; the time unit is then
 # 1/(2 pi) yr.  Jupiter starts on a circle at 5.2 au, the planet at
 # eccentricity 0.05 on the opposite side.
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -48,14 +49,19 @@ def system(a: float, e: float = 0.05) -> System:
 n_orbits = 500
 times = np.linspace(0, n_orbits * P_JUPITER, 401)
 fig, ax = plt.subplots(figsize=(8, 4.5))
+styles = {6.6: "-", 7.6: "--", 9.5: ":"}  # (two regular curves lie on each other)
 for a in (6.6, 7.6, 9.5):
     sim = Simulation(system(a), method="radau15", variational=True)
     traj = sim.integrate(times)
     verdict = "chaotic" if traj.megno[-1] > 4 else "regular"
     print(f"a = {a} au: MEGNO after {n_orbits} orbits of Jupiter = {traj.megno[-1]:.3f} "
           f"({verdict}); energy error {np.max(np.abs(traj.energy_error)):.1e}")
-    ax.semilogy(times[1:] / P_JUPITER, traj.megno[1:], label=f"a = {a} au ({verdict})")
-ax.axhline(2.0, color="k", ls=":", lw=1, label="2: quasi-periodic limit")
+    ax.semilogy(times[1:] / P_JUPITER, traj.megno[1:], ls=styles[a], lw=1.6,
+                label=f"a = {a} au ({verdict})")
+ax.axhline(2.0, color="0.4", ls="-", lw=0.8, label="2: quasi-periodic limit")
+ax.yaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())  # (2, 5, 10: no 2x10^0)
+ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 ax.set_xlabel("time (orbits of Jupiter)")
 ax.set_ylabel("MEGNO <Y> (dimensionless, log scale)")
 ax.set_title("Saturn-mass planet beside Jupiter, e = 0.05 (radau15, variational equations)")

@@ -70,8 +70,7 @@ def _resonances(ax) -> None:
 
 def plot(a, e, maps: dict, out: Path, orbits: float) -> Path:
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6), constrained_layout=True)
-    cmap = plt.get_cmap("RdYlBu_r").copy()
-    cmap.set_bad("0.6")  # failed cells
+    cmap = plt.get_cmap("RdYlBu_r").with_extremes(bad="0.6")  # failed cells
     for ax, (title, megno) in zip(axes[:2], maps.items(), strict=True):
         mesh = ax.pcolormesh(a, e, np.clip(megno, 1.8, CHAOTIC + 1), cmap=cmap,
                              shading="nearest", vmin=1.8, vmax=CHAOTIC + 1)
@@ -80,19 +79,26 @@ def plot(a, e, maps: dict, out: Path, orbits: float) -> Path:
         ax.set_ylabel("eccentricity e (dimensionless)")
         ax.set_title(title, pad=14)
         fig.colorbar(mesh, ax=ax,
-                     label=f"MEGNO <Y> (2: quasi-periodic; clipped at {CHAOTIC + 1:g})")
+                     label=f"MEGNO <Y> (2: quasi-periodic; clipped to 1.8 .. {CHAOTIC + 1:g})")
     newton, gr = maps.values()
-    diff = np.log10(np.abs(gr - newton) + 1e-12)
+    same = gr == newton  # (exact zeros: no log; shown apart, not at a floor)
+    diff = np.log10(np.where(same, np.nan, np.abs(gr - newton)))
     mesh = axes[2].pcolormesh(a, e, diff, cmap="viridis", shading="nearest", vmin=-10, vmax=2)
+    axes[2].set_facecolor("0.85")  # (the cells where GR changed MEGNO not at all)
     flipped = np.argwhere((newton > CHAOTIC) != (gr > CHAOTIC))
     aa, ee = np.meshgrid(a, e)
-    axes[2].plot(aa[tuple(flipped.T)], ee[tuple(flipped.T)], "x", color="red", ms=5,
-                 label=f"verdict changed (MEGNO {CHAOTIC:g} threshold): {len(flipped)} cells")
+    if len(flipped):  # (an empty entry drew a red x for "0 cells")
+        axes[2].plot(aa[tuple(flipped.T)], ee[tuple(flipped.T)], "x", color="red", ms=5,
+                     label=f"verdict changed (MEGNO {CHAOTIC:g} threshold): "
+                           f"{len(flipped)} cells")
+    axes[2].set_title(f"what GR changes\n(grey: unchanged or failed, {int(np.sum(same))} "
+                      f"cells; "
+                      f"verdict changed: {len(flipped)} cells)", pad=14, fontsize=9)
     _resonances(axes[2])
     axes[2].set_xlabel("semi-major axis a [au]")
     axes[2].set_ylabel("eccentricity e (dimensionless)")
-    axes[2].set_title("what GR changes", pad=14)
-    axes[2].legend(loc="lower left", fontsize=7, framealpha=0.9)
+    if len(flipped):
+        axes[2].legend(loc="lower left", fontsize=7, framealpha=0.9)
     fig.colorbar(mesh, ax=axes[2],
                  label="log10 |MEGNO with GR - MEGNO Newtonian| (dimensionless)")
     fig.suptitle(f"Sun, Jupiter and a Saturn-mass planet: MEGNO after {orbits:g} orbits of "

@@ -48,21 +48,35 @@ t_ca = result.metrics["at time"].to_value(u.yr)
 d_ca = result.metrics["closest approach comet-jupiter"].to_value(u.au)
 print(f"closest approach to Jupiter: {d_ca:.4f} au at t = {t_ca:.4f} yr; "
       f"perihelion {d_sun.min():.4f} au at t = {t[np.argmin(d_sun)]:.4f} yr (outputs)")
+# the perihelion distance itself: the comet's two-body orbit about the Sun at the
+# start (the 6-hour outputs pass perihelion twice as far out)
+from astropy.constants import GM_sun  # noqa: E402
+
+from hamilton_orbits import KeplerOrbit  # noqa: E402
+
+v = np.asarray(result.states["v"].to_value(u.au / u.day))
+q = KeplerOrbit.from_state(r[0, comet] - r[0, sun], v[0, comet] - v[0, sun],
+                           GM_sun.to_value(u.au**3 / u.day**2)).q
+print(f"perihelion distance q of the two-body orbit at the start: {q:.4f} au")
 
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5))
 ax1.semilogy(t, d_sun, label="comet - Sun")
 ax1.semilogy(t, d_jup, label="comet - Jupiter")
 ax1.plot(t_ca, d_ca, "v", color="C3", ms=8, label=f"closest approach, {d_ca:.3f} au")
+ax1.axhline(q, color="C0", ls=":", lw=1,
+            label=f"perihelion q = {q:.3f} au (between\nthe 6-hour outputs drawn)")
 ax1.set_xlabel("time since the start (yr)")
 ax1.set_ylabel("distance (au)")
-ax1.set_title("perihelion at 0.01 au, then Jupiter")
-ax1.legend(loc="lower right", fontsize=8)
+ax1.set_title(f"perihelion at q = {q:.2f} au, then Jupiter")
+ax1.legend(loc="center right", fontsize=8)
 i_ca = int(np.argmin(np.abs(t - t_ca)))
 for k, name in ((jup, "Jupiter"), (comet, "comet")):
     xy = r[:, k, :2] - r[:, sun, :2]
     (line,) = ax2.plot(xy[:, 0], xy[:, 1], lw=1, label=name)
     ax2.plot(*xy[0], "o", color=line.get_color(), ms=6)
-    ax2.annotate("", xy=xy[40], xytext=xy[0],
+    step = xy[1] - xy[0]  # (an arrow of one length for both: Jupiter's 40 outputs
+    size = 0.08 * float(np.ptp(r[:, :, :2]))  # were too short to be seen)
+    ax2.annotate("", xy=xy[0] + size * step / np.hypot(*step), xytext=xy[0],
                  arrowprops={"arrowstyle": "-|>", "color": line.get_color()})
 ax2.plot(*(r[i_ca, comet, :2] - r[i_ca, sun, :2]), "v", color="C3", ms=8,
          label="closest approach")

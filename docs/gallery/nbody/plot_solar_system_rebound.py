@@ -29,6 +29,8 @@ print(result.summary())
 # The figures
 # -----------
 # The scene draws the orbits face-on in the J2000 ecliptic frame and the
-# errors of Hamilton's integrals, ours beside rebound's.
+# energy error (the law of vis viva, Hamilton's (E)), ours above rebound's; the
+# angular momentum's (the law of areas, (D)) is among the run's diagnostics,
+# ``result.diagnostics["angular_momentum_error"]``.
 figures = result.plot()
 plt.show()

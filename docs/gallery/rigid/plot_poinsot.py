@@ -32,18 +32,11 @@ print(f"distance of the invariable plane from the centre: {paths.distance:.6f} "
 # The polhode closes on the ellipsoid after one period; the herpolhode on the
 # plane in general does not close.  The ellipsoid's semi-axes are
 # ``1 / sqrt(I)`` for the principal moments ``I``, so both curves are in units of
-# ``1 / sqrt(I)`` (here dimensionless); the
-# start of the contact point's path is marked on both.
+# ``(kg m^2)^(-1/2)`` (a body of plain numbers is in SI units; the figure's axes
+# say so); the start of the contact point's path is marked on both.
 fig = plot_poinsot(body, np.linspace(0.0, 40.0, 4000))
 ax3d, ax2d = fig.axes
-unit = "(1/√I)"
-ax3d.set_xlabel(f"body 1 {unit}", fontsize=7, labelpad=-2)
-ax3d.set_ylabel(f"body 2 {unit}", fontsize=7, labelpad=-2)
-ax3d.set_zlabel(f"body 3 {unit}", fontsize=7, labelpad=-2)
 ax3d.plot(*paths.polhode[0], "o", color="k", ms=5)
-ax2d.set_xlabel(f"invariable plane, axis 1 {unit}")
-ax2d.set_ylabel(f"invariable plane, axis 2 {unit}")
 ax2d.plot(*paths.herpolhode[0], "o", color="k", ms=5, label="start (t = 0)")
-ax2d.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
-fig.tight_layout()
+ax2d.legend(loc="lower left", fontsize=7)  # (inside: the figure keeps plot_poinsot's layout)
 plt.show()
