@@ -60,9 +60,9 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     for name, value in result.metrics.items():
         if isinstance(value, u.Quantity) and value.isscalar:
             row[f"{name} [{value.unit.to_string()}]"] = float(value.value)
-        elif isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-            value, bool
-        ):
+        elif isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+            row[name] = int(value)  # (a count: an integer, in the table and its CSV)
+        elif isinstance(value, (float, np.floating)):
             row[name] = float(value)
         elif isinstance(value, str) and name.startswith("first "):
             row[name] = value  # the bodies of a member's first event of a kind
@@ -237,6 +237,12 @@ class Ensemble:
         df["error"] = pd.Series([row["error"] for row in rows], index=df.index, dtype=object)
         df["complete"] = pd.Series([row["complete"] for row in rows], index=df.index,
                                    dtype=bool)
+        for column in df.columns:  # (counts stay integers where a member failed: 2274,
+            values = [row.get(column) for row in rows]  # not 2274.0 in the CSV)
+            given = [v for v in values if v is not None]
+            if given and all(isinstance(v, int | np.integer) and not isinstance(v, bool)
+                             for v in given):
+                df[column] = pd.array(values, dtype="Int64")
         df.attrs["failures"] = int(df["error"].notna().sum())
         return df
 

@@ -65,6 +65,11 @@ def test_a_failing_member_leaves_the_others():
     assert df["error"][0] is None and df["error"][2] is None
     assert df["complete"].tolist() == [True, False, True] and df["complete"].dtype == bool
     assert df["steps"][0] > 0 and df["steps"][2] > 0
+    # a count stays an integer where a member failed (it became 2274.0 in the CSV)
+    assert str(df["steps"].dtype) == "Int64" and df["steps"].isna().tolist() == [
+        False, True, False]
+    assert df.to_csv(index=False).splitlines()[1].split(",")[
+        list(df.columns).index("steps")] == str(df["steps"][0])
 
 
 def test_invalid_members_are_refused_before_anything_runs():

@@ -277,7 +277,7 @@ def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> No
     result.tables["cross-check against rebound: final position difference"] = table.rows
     result.tables["cross-check against rebound: codes"] = table.code_rows
     result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
-    result.metrics["rebound wall time (s)"] = table.wall_time["rebound"]
+    result.metrics["rebound wall time [s]"] = table.wall_time["rebound"]  # (as "wall time [s]")
     if result.resumed_from is not None:  # (ours: the part since the resume alone)
         result.metrics["our wall time"] = (f"since the resume at t = "
                                            f"{result.resumed_from.to(u.yr):.6g} only")
