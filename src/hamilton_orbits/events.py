@@ -311,6 +311,10 @@ def _length(value: Any, system: Any, where: str) -> float:
     if system.quantity and not is_quantity(value):
         raise ValueError(f"{where}: expected `distance` as a length Quantity for a Quantity "
                          f"system, got {value!r}")
+    if not system.quantity and is_quantity(value):  # (it was read in metres: 30 au as
+        raise ValueError(f"{where}: expected `distance` as a plain number in the system's "
+                         f"own length unit (it was built from plain numbers), got "
+                         f"{value!r}")  # 4.5e12 of the system's unit)
     try:
         dist = float(LENGTH("distance", value, u.au if system.quantity else None))
     except (ValueError, TypeError, u.UnitsError) as exc:

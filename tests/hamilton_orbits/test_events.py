@@ -487,3 +487,18 @@ def test_wh_goes_on_when_its_central_body_merges_into_one_listed_before_it(coord
     assert later.final.names == ("comet", "planet") and later.final.gm[0] == 1.000001
     assert later.events[0]["time"] == first.events[0]["time"]
     np.testing.assert_array_equal(later.final.as_arrays().r, first.final.as_arrays().r)
+
+
+@pytest.mark.parametrize("name", ["escape", "close_encounter"])
+def test_a_distance_quantity_on_a_system_of_plain_numbers_is_refused(name):
+    """A Quantity distance on a system of plain numbers was read in metres: an escape
+    at 30 au watched 4.5e12 of the system's unit (never fired), an encounter at 0.01
+    au recorded every pass at 0.998.  It is refused, as dt, every and the effects'
+    parameters are; and a plain number on a Quantity system as before."""
+    plain = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                    Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    with pytest.raises(ValueError, match=rf"Event at index 0 \('{name}'\): expected "
+                                         r"`distance` as a plain number in the system's own "
+                                         r"length unit .* got <Quantity 30\. AU>"):
+        integrate(plain, 1.0, events=[{"name": name, "distance": 30 * u.au}])
+    assert integrate(plain, 1.0, events=[{"name": name, "distance": 30.0}]).t[-1] == 1.0
