@@ -186,16 +186,17 @@ class LostStateError(ValueError):
 def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
                   extra: np.ndarray | None) -> np.ndarray:
     """The energy part of :func:`integral_errors`."""
+    # (a body taken out, G m = 0, adds no effect energy: its NaN times 0 was NaN)
     if np.ndim(gm) == 2:  # masses changed (a merge, a removal): Hamilton's E as it is
         energy = energy_gm_many(r, v, gm)
         if extra is not None:
-            energy = energy + np.einsum("tj,tj->t", extra, gm)
+            energy = energy + np.einsum("tj,tj->t", np.where(gm > 0, extra, 0.0), gm)
         return relative_change(energy)
     massive = np.flatnonzero(gm > 0)
     if len(massive) != 1 or len(gm) == 1:
         energy = energy_gm_many(r, v, gm)
         if extra is not None:
-            energy = energy + extra @ gm
+            energy = energy + np.where(gm > 0, extra, 0.0) @ gm
         return relative_change(energy)
     s = int(massive[0])
     tp = np.flatnonzero(gm == 0)
@@ -206,7 +207,8 @@ def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
         eps = eps + extra[:, tp]
     scale = np.abs(eps[0])
     change = (eps - eps[0]) / np.where(scale > 0, scale, 1.0)
-    pick = np.argmax(np.abs(change), axis=1)
+    # (the largest over the particles still in the run: a removed one's is NaN)
+    pick = np.argmax(np.where(np.isfinite(change), np.abs(change), -1.0), axis=1)
     return change[np.arange(len(change)), pick]
 
 

@@ -502,3 +502,31 @@ def test_a_distance_quantity_on_a_system_of_plain_numbers_is_refused(name):
                                          r"length unit .* got <Quantity 30\. AU>"):
         integrate(plain, 1.0, events=[{"name": name, "distance": 30 * u.au}])
     assert integrate(plain, 1.0, events=[{"name": name, "distance": 30.0}]).t[-1] == 1.0
+
+
+@pytest.mark.parametrize("effects", [[{"name": "gr", "c": 100.0}],
+                                     [{"name": "j2", "body": "sun", "j2": 1e-3,
+                                       "radius": 0.005}]])
+def test_the_energy_error_after_a_merge_or_removal_is_finite_with_effects(effects):
+    """With ``gr`` or ``j2`` listed the energy error was NaN after a merge or removal
+    (the body taken out had a NaN effect energy, times its G m of 0); it is the
+    energy of the bodies in the run, as without effects."""
+    from hamilton_orbits import Simulation
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005),
+                Body("a", 1e-3, [1.0, 0, 0], [0, 1.0, 0], radius=0.05),
+                Body("b", 5e-4, [0, 1.0, 0.0], [1.0, 0.0, 0.0], radius=0.05),
+                Body("c", 1e-5, [-2.0, 0, 0], [0, -np.sqrt(0.5), 0], radius=0.01)])
+    merged = Simulation(s, events=[{"name": "collision", "action": "merge"}],
+                        effects=effects).integrate([0, 0.5, 1.0, 1.5])
+    plain = Simulation(s, events=[{"name": "collision", "action": "merge"}]).integrate(
+        [0, 0.5, 1.0, 1.5])
+    assert len(merged.events) == 1 and np.all(np.isfinite(merged.energy_error))
+    # (the merge's inelastic loss, -0.885, as without the effects, to their share: 7e-4)
+    np.testing.assert_allclose(merged.energy_error[2:], plain.energy_error[2:], rtol=1e-2)
+    tp = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                 Body("x", 0.0, [1.0, 0, 0], [0, 1.6, 0]),
+                 Body("y", 0.0, [1.2, 0, 0], [0, 0.9, 0])])
+    gone = Simulation(tp, events=[{"name": "escape", "distance": 3.0, "action": "remove"}],
+                      effects=[{"name": "gr", "c": 100.0}]).integrate([0, 5, 10, 20])
+    assert len(gone.events) == 1 and np.all(np.isfinite(gone.energy_error))
