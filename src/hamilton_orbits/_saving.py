@@ -35,6 +35,7 @@ from hamilton_orbits.checkpoint import (
     snapshot_at,
 )
 from hamilton_orbits.integrators import method_of
+from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.simulation_record import all_active, record, spec, state_values
@@ -245,9 +246,13 @@ class Saving:
         system = System.from_system_arrays(sp["system"])
         days = (lambda x: x) if not system.quantity else (lambda x: x * DAY)
 
+        # (a wh or leapfrog file of dt and tol both, written before both were refused:
+        # its tol was ignored, and is left out)
+        tol = None if sp["method"] in FIXED_STEP and sp["dt"] is not None else sp["tol"]
+
         def fresh() -> Any:
             return cls(system, method_of(sp["method"], sp["options"]),
-                       dt=None if sp["dt"] is None else days(sp["dt"]), tol=sp["tol"],
+                       dt=None if sp["dt"] is None else days(sp["dt"]), tol=tol,
                        effects=sp["effects"], events=sp["events"],
                        variational=sp["variational"], stm=sp["stm"])
 

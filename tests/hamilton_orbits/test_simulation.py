@@ -390,3 +390,20 @@ def test_copy_module_copies_are_independent_and_pickling_says_what_to_do(tmp_pat
     with pytest.raises(TypeError, match=r"sim.save\(path\) .* Simulation.load\(path\); copy "
                                         r"it with sim.copy\(\)"):
         pickle.dumps(sim)
+
+
+def test_a_wh_file_of_dt_and_tol_from_before_their_refusal_still_loads(tmp_path):
+    """wh and leapfrog refuse dt and tol together now (tol was ignored); a file saved
+    before, with both, must still load and continue (it failed with the refusal),
+    on the same steps as the run never saved (its tol was ignored then too)."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, method="wh", dt=0.01)
+    sim.integrate(1.0)
+    spec = list(sim._spec)
+    spec[2] = 1e-8  # (the tol a file of the last version kept beside dt)
+    sim._spec = tuple(spec)
+    sim.save(tmp_path / "old.nc")
+    loaded = Simulation.load(tmp_path / "old.nc")
+    np.testing.assert_array_equal(loaded.integrate(2.0).r[-1], sim.integrate(2.0).r[-1])
+    with pytest.raises(ValueError, match=r"`dt` or `tol` with method 'wh'"):
+        Simulation(s, method="wh", dt=0.01, tol=1e-8)
