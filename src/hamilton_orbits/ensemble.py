@@ -248,6 +248,10 @@ class Ensemble:
 
 
 _POOLS: dict[int, Any] = {}
+#: the runs going on in each kept pool (another thread's ensemble): a pool in use is
+#: not shut down for one of another size (its queued members were cancelled, unseen
+#: by its run's wait: that run waited for ever)
+_IN_USE: dict[int, int] = {}
 
 
 def _in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any) -> None:
@@ -257,6 +261,18 @@ def _in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any) -> No
     begun again on the new one; one that breaks later fails the run, saying so, and
     is dropped, so that the next ensemble starts a new pool (a broken pool failed
     every later ensemble)."""
+    kept = n in _POOLS  # (a pool this run makes and its members break: not run again)
+    _IN_USE[n] = _IN_USE.get(n, 0) + 1
+    try:
+        _runs_in_pool(n, args, rows, bar, kept)
+    finally:
+        _IN_USE[n] -= 1
+
+
+def _runs_in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any,
+                  kept: bool) -> None:
+    """:func:`_in_pool`'s attempts: a second on a new pool only where the kept one
+    (``kept``) broke before any member of this run ended."""
     from concurrent.futures.process import BrokenProcessPool
 
     for attempt in (1, 2):
@@ -266,7 +282,7 @@ def _in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any) -> No
             return
         except BrokenProcessPool as exc:
             _drop(n)
-            if attempt == 1 and all(row is None for row in rows):
+            if attempt == 1 and kept and all(row is None for row in rows):
                 continue  # (the pool was broken before: this run begun again)
             raise BrokenProcessPool(f"a worker process of the ensemble's pool of {n} ended "
                                     f"abruptly (killed: out of memory?); the members it had "
@@ -297,8 +313,9 @@ def _submitted(pool: Any, args: list[tuple]) -> dict[Any, int]:
 def _pool(n: int) -> Any:
     """A pool of ``n`` worker processes kept for the session (started once: the
     workers' imports and compiled kernels are paid on the first ensemble only); a
-    pool of another size is shut down first (one pool's processes at a time)."""
-    for other in [k for k in _POOLS if k != n]:
+    pool of another size is shut down first, unless a run uses it (one pool's
+    processes at a time, but for runs going on at once)."""
+    for other in [k for k in _POOLS if k != n and not _IN_USE.get(k)]:
         _drop(other)
     pool = _POOLS.get(n)
     if pool is None:

@@ -271,3 +271,52 @@ def test_a_pool_that_lost_a_worker_is_replaced_and_one_pool_is_kept(monkeypatch)
     for pool in made:
         pool.shutdown(wait=True)
 
+
+
+def test_runs_at_once_keep_their_pools_and_a_new_pool_broken_is_not_run_again(monkeypatch):
+    """A run needing a pool of another size shut the kept one down while another
+    thread's ensemble ran on it: that run's queued members were cancelled unseen and
+    it waited for ever.  A pool in use is kept.  And a pool this run made and its own
+    members broke (its worker killed: out of memory) ran the whole ensemble again,
+    for the same failure; only a pool kept from before is replaced and run again."""
+    import concurrent.futures
+    import threading
+    import time
+    from concurrent.futures.process import BrokenProcessPool
+
+    from hamilton_orbits import ensemble
+
+    class Pool(concurrent.futures.ThreadPoolExecutor):
+        def __init__(self, max_workers, mp_context=None):
+            super().__init__(max_workers=max_workers)
+
+    calls = []
+
+    def member(data, source, values):
+        calls.append(values.get("integrator.tol"))
+        if values.get("integrator.tol") == 1e-7:
+            raise BrokenProcessPool("A process in the process pool was terminated")
+        time.sleep(0.05 if values.get("integrator.tol") == 1e-9 else 0.0)
+        return {"error": None, "complete": True}
+
+    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", Pool)
+    monkeypatch.setattr(ensemble, "run_member", member)
+    monkeypatch.setattr(ensemble, "_POOLS", {})
+    monkeypatch.setattr(ensemble, "_IN_USE", {})
+    slow = Ensemble(comet(), members=[{"integrator.tol": 1e-9}] * 12)
+    done = []
+    first = threading.Thread(target=lambda: done.append(len(slow.run(progress=False,
+                                                                      workers=2))))
+    first.start()
+    time.sleep(0.1)  # (the first run is on its pool of 2)
+    quick = Ensemble(comet(), members=[{"integrator.tol": 1e-8}] * 3)
+    assert len(quick.run(progress=False, workers=3)) == 3
+    first.join(timeout=20)
+    assert not first.is_alive() and done == [12]
+    calls.clear()
+    ensemble._drop(2)
+    with pytest.raises(BrokenProcessPool, match="ended abruptly"):
+        Ensemble(comet(), members=[{"integrator.tol": 1e-7}]).run(progress=False, workers=2)
+    assert calls == [1e-7]  # (once: the pool was this run's own)
+    for n in list(ensemble._POOLS):
+        ensemble._drop(n)
