@@ -82,7 +82,10 @@ def live_holder(folder: str | Path) -> int | None:
             held[1] != socket.gethostname():
         return None
     pid = int(held[0])
-    return pid if pid == os.getpid() or _alive(pid) else None
+    if pid == os.getpid():  # (a former process of this PID's lock, a container restarted,
+        claim = held[2] if len(held) > 2 else ""  # is stale: as _judge has it)
+        return pid if re.fullmatch(r"[0-9]{1,9}", claim) and int(claim) in _HELD else None
+    return pid if _alive(pid) else None
 
 
 def _hold(fd: int, patience: float = 2.0) -> None:

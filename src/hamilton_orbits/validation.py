@@ -60,7 +60,10 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     if type(value) is list or type(value) is tuple:
         _check_listed(name, value, ())
     elif isinstance(value, np.ndarray) and value.dtype == object:  # (None in it: nan)
-        _check_listed(name, value.tolist(), ())
+        if value.ndim:
+            _check_listed(name, value.tolist(), ())
+        elif value.item() is None or isinstance(value.item(), bool | np.bool_):
+            raise ValueError(f"Expected `{name}` to be numeric, got {value.item()!r}")
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
     if isinstance(value, np.ma.MaskedArray):  # (numpy.asarray takes the values under

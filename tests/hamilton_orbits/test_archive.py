@@ -787,6 +787,12 @@ def test_a_live_writers_record_being_appended_is_in_progress_not_torn(tmp_path):
         live = Archive(tmp_path)
         assert live.writing == os.getpid() and live.torn == [old]
         assert live.in_progress == [temp, new] and len(live) == len(done)
+    # a lock of this PID with a claim of no live run here (a former process of the same
+    # PID: a container restarted) is a killed run's, stale, as the folder's lock has it
+    (tmp_path / ".hamilton-orbits.lock").write_text(f"{os.getpid()} {socket.gethostname()} "
+                                                    f"999999\n")
+    stale = Archive(tmp_path)
+    assert stale.writing is None and stale.torn == [temp, old, new]
 
 
 def test_a_simulations_calls_continue_its_archive_without_listing_the_folder(tmp_path,

@@ -153,3 +153,26 @@ def test_an_energy_the_effects_change_is_drawn_signed_and_a_peers_apart(figures)
         assert all(ax.get_yscale() == "log" for ax in axes)
         if scene in ("solar-system", "comet-encounter") and len(axes) > 1:
             assert axes[0].get_shared_y_axes().joined(axes[0], axes[1])
+
+
+def test_a_panel_of_exact_zeros_does_not_hide_the_other_panels_errors():
+    """The two energy panels shared their y axis: rebound's errors all exactly 0 set
+    the limits eps/100 .. eps*100 for both, and none of ours (1e-10) was in view."""
+    import astropy.units as u
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.scenes.nbody.figures import plot_energy
+    from hamilton_orbits.scenes.result import Result
+
+    t = np.linspace(0.0, 10.0, 200) * u.yr
+    ours = np.linspace(0.0, 1e-10, 200)
+    result = Result(scene=Scene.bundled("solar-system"), times=t,
+                    diagnostics={"energy_error": ours, "rebound_energy_error": 0 * ours})
+    fig = plot_energy(result, "the total energy", True)
+    fig.canvas.draw()
+    top = fig.axes[0]
+    low, high = top.get_ylim()
+    drawn = np.concatenate([line.get_ydata() for line in top.get_lines()
+                            if line.get_linestyle() == "None"])
+    assert np.all((drawn >= low) & (drawn <= high)) and len(drawn) == 199
+    plt.close(fig)

@@ -395,3 +395,28 @@ def test_a_ctrl_c_while_a_kernel_compiles_is_raised_at_once():
                 reached.append(kernel(1.0))
     assert reached == [] and not HELD.pending and HELD.depth == 0
     assert kernel(1.0) == 2.0
+
+
+def test_a_ctrl_c_held_in_a_file_section_that_fails_is_raised_not_lost():
+    """A held file section (``held``: Simulation.save's write, the archive's) that
+    raised (a full disk) while a Ctrl-C was held cleared it: the caller that handled
+    the error went on as if no Ctrl-C had come.  The Ctrl-C is raised, the error its
+    cause; a section that ends well raises it as before."""
+    from hamilton_orbits.integrators._held import held
+
+    @held
+    def fails():
+        signal.getsignal(signal.SIGINT)(signal.SIGINT, None)  # (a Ctrl-C within)
+        raise OSError("No space left on device")
+
+    @held
+    def ends():
+        signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+        return 1
+
+    with pytest.raises(KeyboardInterrupt) as info:
+        fails()
+    assert isinstance(info.value.__cause__, OSError)
+    with pytest.raises(KeyboardInterrupt):
+        ends()
+    assert HELD.depth == 0 and not HELD.pending

@@ -542,3 +542,17 @@ def test_the_summary_says_what_was_set_since_the_scenes_file(tmp_path):
     assert data["set"] == {"duration": "10 yr", "initial.frame": "icrs"}
     plain = Result(scene=Scene.bundled("solar-system"), times=np.array([0.0, 1.0]) * u.yr)
     assert not any(line.startswith("set since") for line in plain.summary().splitlines())
+
+
+def test_changed_skips_a_key_a_later_value_above_it_replaced():
+    """``--set integrator.dt=...`` then ``--set integrator={...}``: the first path
+    no longer led anywhere, and ``Scene.changed`` (so the summary) raised KeyError."""
+    scene = Scene.bundled("solar-system", {"integrator.dt": "1 d",
+                                           "integrator": '{method = "radau15"}'})
+    assert scene.changed == {"integrator": {"method": "radau15"}}
+
+
+def test_a_pole_prediction_refuses_effects_it_would_not_apply():
+    """They were accepted and listed, and the run never read them."""
+    with pytest.raises(SceneError, match=r"effects\[0\]: a pole prediction takes no effects"):
+        Scene.bundled("pole-prediction", {"effects": '[{name = "damping", Q = 100}]'})

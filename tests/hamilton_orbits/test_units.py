@@ -144,3 +144,14 @@ def test_a_number_without_a_unit_where_a_unit_is_asked_is_named_so():
                                                     r"\(convertible to rad\), got a number "
                                                     r"without a unit$"):
         ANGLE("inc", 1.5 * u.dimensionless_unscaled)
+
+
+def test_a_zero_dimensional_object_array_is_read_as_its_value():
+    """A 0-d object array (of a float, a Fraction) was read as its value; the check of
+    None in object arrays broke it (iterating a scalar)."""
+    from fractions import Fraction
+
+    assert float(as_float_array("x", np.array(1.5, dtype=object))) == 1.5
+    assert float(as_float_array("x", np.array(Fraction(1, 2), dtype=object))) == 0.5
+    with pytest.raises(ValueError, match=r"Expected `x` to be numeric, got None$"):
+        as_float_array("x", np.array(None, dtype=object))

@@ -98,11 +98,18 @@ def test_free_period_refuses_bad_input():
         free_period(t * u.m, np.exp(1j * t))
     # equal times: six LAPACK lines on stderr, a RuntimeWarning, then numpy's
     # "SVD did not converge"; times out of order likewise unchecked
-    with pytest.raises(ValueError, match=r"`t` increasing, got t\[1\] = 0.0 after t\[0\] "
-                                         r"= 0.0 \(days\)"):
+    with pytest.raises(ValueError, match=r"`t` strictly monotonic, got t\[1\] = 0.0 after "
+                                         r"t\[0\] = 0.0 \(days\)"):
         free_period(np.zeros(20), np.exp(1j * t))
-    with pytest.raises(ValueError, match=r"`t` increasing, got t\[5\] = 4.0 after"):
+    with pytest.raises(ValueError, match=r"`t` strictly monotonic, got t\[5\] = 4.0 after"):
         free_period(np.r_[t[:5], t[4:-1]], np.exp(1j * t))
+    # a path that does not turn (an offset, a drift) was fitted a period of 2.3 d or
+    # of 1e9 d, made up; a backward run's decreasing times are a path like any
+    with pytest.raises(ValueError, match=r"`m` to turn about the figure axis at least once"):
+        free_period(t, np.full(20, 0.1 + 0.05j))
+    with pytest.raises(ValueError, match=r"`m` to turn about the figure axis at least once"):
+        free_period(t, 0.1 + 1e-3 * t + 0j)
+    assert abs(free_period(-t, np.exp(-1j * t)) / (2 * np.pi * u.day) - 1) < 1e-12
 
 
 @pytest.mark.parametrize("ratio", [1.0, 0.9, 0.0])
@@ -193,3 +200,17 @@ def test_a_pole_that_departs_from_the_exact_one_is_said_so(method, dt, warned):
     assert (error > earth.free_wobble.WOBBLE_TOLERANCE) == warned
     assert [str(w.message).startswith(f"simulate_wobble: the {method} pole departs")
             for w in said] == ([True] if warned else [])
+
+
+def test_simulate_wobble_takes_no_dt_where_it_is_ignored_and_a_record_a_scalar_time_named():
+    """``dt=None`` is documented as ignored by "exact" and "dop853" (refused since bare
+    numbers are); a record of a scalar Time raised a bare TypeError."""
+    from astropy.time import Time
+
+    from rigid.polar_motion import PolarMotionRecord
+
+    assert earth.simulate_wobble(30 * u.day, method="exact", dt=None).error == 0.0
+    with pytest.raises(ValueError, match=r"`dt` to be a Quantity"):
+        earth.simulate_wobble(30 * u.day, method="splitting4", dt=None)
+    with pytest.raises(ValueError, match=r"`time` of shape \(n,\), n >= 1, got \(\)"):
+        PolarMotionRecord(Time(51544.0, format="mjd"), 0.1 * u.arcsec, 0.1 * u.arcsec)

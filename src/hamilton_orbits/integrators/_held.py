@@ -136,12 +136,21 @@ def held(function: _F) -> _F:
     file (or makes one) and the statement that keeps its descriptor left the
     descriptor open for good, or a temporary file behind; a function so wrapped
     keeps what it opens where its caller's cleanup finds it (its return value is
-    then lost: wrap the method that stores a descriptor, not the one returning it)."""
+    then lost: wrap the method that stores a descriptor, not the one returning it).
+    If the function raises meanwhile, the Ctrl-C is raised instead, the error its
+    cause (the caller that handles the error would have gone on as if no Ctrl-C
+    had come)."""
 
     @functools.wraps(function)
     def call(*args: Any, **kwargs: Any) -> Any:
         with HELD:
-            return function(*args, **kwargs)
+            try:
+                return function(*args, **kwargs)
+            except Exception as exc:  # (a Ctrl-C held meanwhile is not lost with it:
+                if HELD.depth == 1 and HELD.pending:  # raised, the error its cause)
+                    HELD.pending = False
+                    raise KeyboardInterrupt from exc
+                raise
 
     return call  # type: ignore[return-value]
 

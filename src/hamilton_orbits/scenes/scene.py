@@ -297,8 +297,11 @@ class Scene:
         out: dict[str, Any] = {}
         for path in self._overrides:
             node: Any = self.data
-            for part in path:
-                node = node[part]
+            try:
+                for part in path:
+                    node = node[part]
+            except (KeyError, IndexError, TypeError):  # (a later value of a key above it
+                continue  # replaced it: that one is listed)
             out[_path_text(path)] = node
         return out
 

@@ -48,10 +48,10 @@ class PolarMotionRecord:
     def __post_init__(self) -> None:
         if not isinstance(self.time, Time):
             raise ValueError(f"Expected `time` to be an astropy Time, got {type(self.time)}")
-        n = len(self.time)
-        if self.time.ndim != 1 or n == 0:
+        if self.time.ndim != 1 or len(self.time) == 0:
             raise ValueError(f"Expected `time` of shape (n,), n >= 1, got "
                              f"{self.time.shape}")
+        n = len(self.time)
         for name in ("x", "y"):
             value = getattr(self, name)
             if not isinstance(value, u.Quantity):

@@ -146,6 +146,8 @@ def simulate_wobble(
     """
     for name, value, like in (("duration", duration, "100 * u.yr"),
                               ("wobble", wobble, "0.2 * u.arcsec"), ("dt", dt, "1 * u.hour")):
+        if value is None and name == "dt" and method in ("exact", "dop853"):
+            continue  # (not used: documented as ignored)
         if not isinstance(value, u.Quantity):  # (three units a bare number could mean)
             raise ValueError(f"Expected `{name}` to be a Quantity (such as {like}), got the "
                              f"bare number {value!r}")

@@ -68,6 +68,9 @@ SCHEMA: dict[str, S.Field] = {
 def _check(spec: dict, problems: S.Problems) -> None:
     from erfa import ErfaWarning
 
+    for i, eff in enumerate(spec.get("effects", ())):  # (accepted, then never read)
+        problems.add(f"effects[{i}]", f"a pole prediction takes no effects: its methods "
+                                      f"are its `methods` (got {eff['name']!r})")
     with warnings.catch_warnings():  # a date past the leap-second table: "dubious year"
         warnings.simplefilter("ignore", ErfaWarning)
         _check_keys(spec, problems)
@@ -315,6 +318,7 @@ KIND = SceneKind(
     effect_kind="rotation",
     check=_check,
     run=_run,
+    takes_effects=False,  # (_check refuses any)
 )
 
 

@@ -50,7 +50,9 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     The model is ``m(t) = a exp(i sigma t) + b exp(-i sigma t)`` (the ellipse
     of the triaxial linear theory; ``b = 0`` for an axisymmetric body), fitted by
     nonlinear least squares in ``sigma`` with the amplitudes projected out.  The
-    starting value is the mean rate of the unwrapped phase of ``m``.
+    starting value is the mean rate of the unwrapped phase of ``m``, or, where that
+    fits less than half of the path (a wobble near a line, whose phase jumps by pi),
+    the highest peak of its periodogram in both senses.
 
     Parameters
     ----------
@@ -87,11 +89,11 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     scale = float(np.max(np.abs(mm)))
     if scale == 0.0:
         raise ValueError("Expected `m` to wobble, got a path identically zero")
-    step = np.diff(tt)
+    step = np.diff(tt) * (1.0 if tt[-1] >= tt[0] else -1.0)  # (a backward run's too)
     if not np.all(step > 0):
         k = int(np.argmin(step > 0)) + 1
-        raise ValueError(f"Expected `t` increasing, got t[{k}] = {float(tt[k])!r} after "
-                         f"t[{k - 1}] = {float(tt[k - 1])!r} (days)")
+        raise ValueError(f"Expected `t` strictly monotonic, got t[{k}] = {float(tt[k])!r} "
+                         f"after t[{k - 1}] = {float(tt[k - 1])!r} (days)")
     t0 = tt - tt[0]
     phase = np.unwrap(np.angle(mm))
     sigma0 = float(np.polyfit(t0, phase, 1)[0])
@@ -102,8 +104,14 @@ def free_period(t: Any, m: Any) -> u.Quantity:
         # phase jumps by pi; the periodogram's highest peak then starts the fit)
         other = _fit_sigma(t0, mn, _peak(t0, mn))
         sol = other if sol is None or other.cost < 0.5 * sol.cost else sol
-    if not sol.x[0] != 0.0:
-        raise ValueError("Expected `m` to turn about the figure axis, got no mean rotation")
+    span = abs(float(t0[-1]))
+    if not abs(float(sol.x[0])) * span >= 2.0 * np.pi or \
+            sol.cost > 0.25 * float(np.vdot(mn, mn).real):
+        # (no wobble that turns once within the span and explains half of the path: a
+        # constant offset, a drift, fitted by a "period" of 1e20 days, made up)
+        raise ValueError(f"Expected `m` to turn about the figure axis at least once in the "
+                         f"span of `t` ({span:.6g} d), got no such wobble that explains the "
+                         f"path")
     return (2.0 * np.pi / abs(float(sol.x[0]))) * u.day
 
 
@@ -124,7 +132,7 @@ def _peak(t0: np.ndarray, mn: np.ndarray) -> float:
     both senses, ``|sum mn e^(-i s t)|^2 + |sum mn e^(i s t)|^2``, on a grid of
     ``s`` from one turn over the span to the mean sampling's Nyquist rate (at
     most 4096 points)."""
-    span = float(t0[-1])
+    span = abs(float(t0[-1]))
     top = min(len(t0) // 2, 4096)
     s = 2.0 * np.pi * np.arange(1, top + 1) / span
     power = np.empty(top)

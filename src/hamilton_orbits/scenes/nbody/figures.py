@@ -589,7 +589,8 @@ def plot_energy(result: Result, what: str, conserved: bool):
         fig, ax = plt.subplots(figsize=(7.5, 4.8))
         axes = [ax]
     else:
-        fig, axes = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True, sharey=True)
+        fig, axes = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True)  # (not sharey: a
+        # panel of exact zeros alone would set the other's limits, hiding its points)
         series.append(("rebound IAS15", peer, {"color": "C1"}))
     for ax, (label, values, style) in zip(axes, series, strict=True):
         _log_errors(ax, t, np.abs(np.asarray(values[1:], dtype=float)), label, style)
