@@ -53,6 +53,7 @@ from hamilton_orbits.checkpoint import (
 )
 from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
+from hamilton_orbits.integrators._setup import check_step_count
 from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
@@ -347,6 +348,10 @@ class Simulation(Saving):
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
+        if self._archive is not None and prop.dt is not None and \
+                prop.method.name in FIXED_STEP:  # (refused before the leg's first snapshot:
+            check_step_count(abs(float(times[-1] - times[0])), prop.dt,  # a call refused
+                             prop.method.max_steps, prop.method.name)  # wrote one, resumed)
         try:
             if self._archive is not None:
                 self._new_leg(times)

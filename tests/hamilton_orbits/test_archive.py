@@ -1801,3 +1801,18 @@ def test_a_relative_folder_loaded_resumes_from_its_own_rows(tmp_path, monkeypatc
     again = Simulation.load("arch")  # (as after a kill: its last snapshot at t = 6)
     monkeypatch.chdir(tmp_path / "B")
     assert _same(again.resume().r, whole_a.r)
+
+
+def test_a_call_refused_for_its_steps_writes_no_snapshot(tmp_path):
+    """wh refusing a call of more than ``max_steps`` steps had written the call's
+    first snapshot already: three refusals left three phantom calls in the archive,
+    and ``load().resume()`` retried the refused call."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, method="wh", dt=0.01, max_steps=1000, archive=tmp_path, every=1.0)
+    sim.integrate(5.0)
+    before = Archive(tmp_path).times.tolist()
+    for _ in range(3):
+        with pytest.raises(ValueError, match=r"wh would take about 9.5e\+03 steps"):
+            sim.integrate(100.0)
+    assert Archive(tmp_path).times.tolist() == before and not _lock(tmp_path)
+    assert sim.integrate(6.0).t[-1] == 6.0
