@@ -407,3 +407,16 @@ def test_a_wh_file_of_dt_and_tol_from_before_their_refusal_still_loads(tmp_path)
     np.testing.assert_array_equal(loaded.integrate(2.0).r[-1], sim.integrate(2.0).r[-1])
     with pytest.raises(ValueError, match=r"`dt` or `tol` with method 'wh'"):
         Simulation(s, method="wh", dt=0.01, tol=1e-8)
+
+
+@pytest.mark.parametrize(("kw", "pattern"), [
+    (dict(method="leapfrog"), r"leapfrog needs a step `dt` or a tolerance `tol`"),
+    (dict(method="wh", dt=0.01, coordinates="jacobi", corrector=11, variational=True),
+     r"wh with variational=True takes no `corrector`")])
+def test_what_the_driver_refuses_is_refused_as_the_simulation_is_made(tmp_path, kw, pattern):
+    """Refused only at the first integrate: an archived simulation had made its folder,
+    empty, which Simulation.load then called "no readable snapshot"."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    with pytest.raises(ValueError, match=pattern):
+        Simulation(s, archive=tmp_path / "a", every=1.0, **kw)
+    assert not (tmp_path / "a").exists()
