@@ -85,6 +85,20 @@ def _from_state(prop: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) 
         prop.events.gm_changes.append((prop.t, prop.gm.copy()))
 
 
+
+def _numbered_as_the_call(on_output: Any, shift: int, steps: int) -> Any:
+    """``on_output`` called by a resumed call as the interrupted call would have: its
+    outputs numbered in the call's own times (``shift`` of them passed before the
+    resumed part's first) and its steps counted from the call's start (``steps``
+    taken before); it was (1, 40) where the call had (6, 240)."""
+    if on_output is None:
+        return None
+
+    def numbered(i: int, taken: int) -> Any:
+        return on_output(i + shift, taken + steps)
+
+    return numbered
+
 class Saving:
     """Saving, loading, the archive and ``resume`` of a
     :class:`~hamilton_orbits.simulation.Simulation` (a mixin: it stands on the
@@ -130,6 +144,8 @@ class Saving:
         rest = times[times > prop.t]
         out = None
         if rest.size:
+            on_output = _numbered_as_the_call(on_output, times.size - rest.size - 1,
+                                              self.steps - info["steps0"])
             out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop,
                                 leg=times)
             if out.interrupted and on_interrupt == "raise":

@@ -1816,3 +1816,29 @@ def test_a_call_refused_for_its_steps_writes_no_snapshot(tmp_path):
             sim.integrate(100.0)
     assert Archive(tmp_path).times.tolist() == before and not _lock(tmp_path)
     assert sim.integrate(6.0).t[-1] == 6.0
+
+
+@pytest.mark.parametrize("schedule", [{"every": 2.0}, {"every_steps": 30}])
+def test_resume_numbers_its_outputs_and_steps_as_the_interrupted_call(tmp_path, schedule):
+    """resume() called ``on_output`` with the outputs numbered from where it resumed
+    and the steps counted from there: (1, 40), (2, 80) where the call had (6, 240),
+    (7, 280); a callback writing rows by number wrote the wrong ones."""
+    from hamilton_orbits.engine import StopIntegration
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0]),
+                Body("q", 1e-4, [2.0, 0, 0], [0, 0.7, 0])])
+    times = np.linspace(0, 14, 8)
+    whole = []
+    Simulation(s, method="wh", dt=0.05, archive=tmp_path / "ref", **schedule).integrate(
+        times, on_output=lambda i, steps: whole.append((i, steps)))
+
+    def cut(i, steps):
+        if i == 5:
+            raise StopIntegration  # (as a kill after output 5)
+
+    Simulation(s, method="wh", dt=0.05, archive=tmp_path / "a", **schedule).integrate(
+        times, on_output=cut)
+    resumed = []
+    Simulation.load(tmp_path / "a").resume(on_output=lambda i, steps: resumed.append((i, steps)))
+    assert resumed and resumed == whole[-len(resumed):]
