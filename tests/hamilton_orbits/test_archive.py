@@ -517,7 +517,7 @@ def test_resume_returns_the_interrupted_call_whole_even_after_a_second_interrupt
     first = Simulation.load(tmp_path / "cut")
     t_first = first.t
     assert 0.0 < t_first < 4.0
-    first.resume(on_output=stopper(4))  # interrupted again
+    first.resume(on_output=stopper(9))  # interrupted again (the call's own output 9)
     second = Simulation.load(tmp_path / "cut")
     assert second.t > t_first
     traj = second.resume()
