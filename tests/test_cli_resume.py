@@ -30,6 +30,24 @@ def _same(a: np.ndarray, b: np.ndarray) -> bool:
     return np.array_equal(a, b, equal_nan=a.dtype.kind == "f")
 
 
+def _pause_after_snapshots(count: int) -> None:
+    """In the forked child: the archive writer sleeps once it has written ``count``
+    snapshots, so that the parent's SIGKILL comes then, not after the run's end (a
+    30-day run could end between two of the parent's looks: the test raced it)."""
+    from hamilton_orbits.checkpoint import ArchiveWriter
+
+    for name in ("write", "append", "refill"):
+        real = getattr(ArchiveWriter, name)
+
+        def paused(self, *args, _real=real, **kwargs):
+            out = _real(self, *args, **kwargs)
+            if self.count >= count:
+                time.sleep(3600)  # (until killed)
+            return out
+
+        setattr(ArchiveWriter, name, paused)
+
+
 def _kill_after_snapshots(pid: int, archive, count: int) -> None:
     """SIGKILL ``pid`` as soon as ``archive`` holds ``count`` snapshots."""
     while not archive.is_dir() or len(Archive(archive)) < count:
@@ -49,6 +67,7 @@ def test_a_killed_scene_run_resumes_to_the_files_of_the_whole_run(tmp_path, caps
         pid = os.fork()
         if pid == 0:  # the child: the same command, killed part way
             try:
+                _pause_after_snapshots(count)
                 main(["run", "comet-encounter", "--out", str(out), *SETS])
             finally:
                 os._exit(0)
