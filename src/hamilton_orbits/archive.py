@@ -27,7 +27,6 @@ Examples
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -35,7 +34,8 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._outdir import live_holder
-from hamilton_orbits.checkpoint import contents, path_of
+from hamilton_orbits.checkpoint import contents, path_of, snapshot_files
+from hamilton_orbits.segment import ROWS_NAME
 from hamilton_orbits.simulation import Simulation
 from hamilton_orbits.snapshot import SnapshotError
 
@@ -46,10 +46,6 @@ class ArchiveIndexError(IndexError, ValueError):
     """An index that is not the position of one of an archive's snapshots (an
     ``IndexError``, which ends a loop over the archive, and a ``ValueError``, as
     other bad input)."""
-
-
-#: a segment's or its rows' file name, its number
-_NUMBER = re.compile(r"(?:segment|rows|snapshot)-(\d{6})\.nc")
 
 
 @dataclass(frozen=True)
@@ -199,11 +195,9 @@ def _in_progress(folder: Path, torn: list[Path],
     (a segment and its rows), whose last record is being appended as they are read."""
     if writing is None or not torn:
         return torn, []
-    numbered = [int(m.group(1)) for p in folder.iterdir()
-                if not p.name.startswith(".") and (m := _NUMBER.fullmatch(p.name))]
-    newest = max(numbered, default=-1)
-    live = [p for p in torn if p.name.endswith(f".tmp-{writing}") or (
-        (m := _NUMBER.fullmatch(p.name)) is not None and int(m.group(1)) == newest)]
+    files = snapshot_files(folder)
+    newest = {files[-1][1], folder / ROWS_NAME.format(files[-1][0])} if files else set()
+    live = [p for p in torn if p.name.endswith(f".tmp-{writing}") or p in newest]
     return [p for p in torn if p not in live], live
 
 

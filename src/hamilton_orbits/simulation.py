@@ -54,7 +54,7 @@ from hamilton_orbits.checkpoint import (
 from hamilton_orbits.effects import EffectSet
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.integrators._setup import check_step_count
-from hamilton_orbits.integrators.methods import FIXED_STEP
+from hamilton_orbits.integrators.methods import FIXED_STEP, check_run
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS, compile_rhs
 from hamilton_orbits.trajectory import (
@@ -71,14 +71,6 @@ __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log
 
 
 
-def _refused_up_front(method: Method, step: Any, tol: Any, variational: Any) -> None:
-    """What the drivers refuse at their start, refused as the simulation is made (an
-    archived one made its folder first, empty, then failed to load)."""
-    if method.name == "leapfrog" and step is None and tol is None:
-        raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
-    if method.name == "wh" and getattr(method, "corrector", 0) and variational:
-        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
-                         "is not implemented); use corrector=0")
 
 class Simulation(Saving):
     """A prepared n-body integration that lives across calls.
@@ -192,7 +184,7 @@ class Simulation(Saving):
             raise ValueError(f"Expected `dt` or `tol` with method {typed.name!r} (a fixed step, "
                              f"or a tolerance that chooses it), got both: dt = {dt!r}, tol = "
                              f"{tol!r} (the tolerance would be ignored)")
-        _refused_up_front(typed, step, tol, variational)
+        check_run(typed, step, tol, bool(variational))  # (before any folder is made)
         tan = tangent_of(system, variational, stm, tangent, typed)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()

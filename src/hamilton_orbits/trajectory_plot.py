@@ -17,9 +17,13 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["plot_trajectory", "primary_index"]
+__all__ = ["PLAIN_UNIT", "plot_trajectory", "primary_index"]
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
+
+
+#: the unit an axis of a system of plain numbers names (its own, whatever it is)
+PLAIN_UNIT = "the system's length unit"
 
 
 def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
@@ -70,7 +74,7 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     about = "the frame's origin" if primary is None else traj.names[primary]
     ax.plot([0.0], [0.0], "k+", ms=10, mew=1.5,
             label=about if primary is None else f"{about} (primary)")
-    suffix = " [the system's length unit]" if unit is None else f" [{unit}]"
+    suffix = f" [{unit or PLAIN_UNIT}]"
     ax.set_xlabel(f"{'xyz'[i]} from {about}{suffix}")
     ax.set_ylabel(f"{'xyz'[j]} from {about}{suffix}")
     ax.set_aspect("equal", adjustable="datalim")

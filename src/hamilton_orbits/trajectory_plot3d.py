@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.trajectory_plot import primary_index
+from hamilton_orbits.trajectory_plot import PLAIN_UNIT, primary_index
 
 __all__ = ["MAX_FRAMES", "plot_trajectory3d"]
 
@@ -201,7 +201,7 @@ def _layout(fig: Any, traj: Any, names: tuple[str, ...], centre: int | None,
             unit: str | None, keep: np.ndarray) -> None:
     """Axis titles (origin and unit), equal aspect, the slider and play/pause buttons."""
     where = " (integration frame)" if centre is None else f" from {names[centre]}"
-    suffix = " [the system's length unit]" if unit is None else f" [{unit}]"
+    suffix = f" [{unit or PLAIN_UNIT}]"
     axes = {f"{c}axis": {"title": {"text": f"{c}{where}{suffix}"}} for c in "xyz"}
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
                "transition": {"duration": 0}}

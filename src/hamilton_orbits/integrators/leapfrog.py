@@ -19,7 +19,7 @@ from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators._held import HELD
 from hamilton_orbits.integrators._setup import check_step_count, force_arg
-from hamilton_orbits.integrators.methods import Leapfrog
+from hamilton_orbits.integrators.methods import Leapfrog, check_run
 from hamilton_orbits.rhs import run_parameters
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "NAME", "SLICE", "choose_dt", "run", "start"]
@@ -71,9 +71,8 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
           events: EventLog | None = None, variational: Any = None) -> Any:
     """The map's state at ``t0`` (a :class:`~hamilton_orbits.integrators.DriverState`),
     for arguments already checked (``method`` a :class:`Leapfrog`)."""
+    check_run(method, dt, tol, variational is not None)
     if dt is None:
-        if tol is None:
-            raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
         dt = choose_dt(r0, v0, gm, tol)
     if variational is not None:
         return _tangent.LeapfrogTangent(rhs, r0, v0, gm, t0, variational, dt=float(dt),

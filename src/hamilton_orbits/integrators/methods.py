@@ -26,7 +26,8 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 __all__ = ["CRITERIA", "DOP853", "FIXED_STEP", "INTEGRATORS", "METHODS", "PRECISIONS", "WH",
-           "WH_COORDINATES", "WH_CORRECTORS", "Leapfrog", "Method", "Radau15", "method_of"]
+           "WH_COORDINATES", "WH_CORRECTORS", "Leapfrog", "Method", "Radau15", "check_run",
+           "method_of"]
 
 #: The methods, in the order they are listed to users.
 INTEGRATORS = ("radau15", "wh", "leapfrog", "dop853")
@@ -276,3 +277,23 @@ def method_of(method: Any, options: Mapping[str, Any] | None = None) -> Method:
                 f"Unknown option `{key}` = {value!r} for method {method!r}; it takes: "
                 + (", ".join(takes) if takes else "no options beyond dt and tol"))
     return cls(**options)
+
+
+def check_run(method: Method, dt: Any, tol: Any, variational: bool) -> None:
+    """The refusals of a run's set-up that depend on nothing but its options: made by
+    the drivers as they start, and by ``Simulation`` as it is made (an archived one
+    would otherwise make its folder before the first call refused it).
+
+    Examples
+    --------
+    >>> check_run(Leapfrog(), None, None, False)
+    Traceback (most recent call last):
+    ...
+    ValueError: leapfrog needs a step `dt` or a tolerance `tol`, got neither
+    """
+    if method.name == "leapfrog" and dt is None and tol is None:
+        raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
+    if method.name == "wh" and method.corrector and variational:
+        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
+                         "is not implemented); use corrector=0")
+

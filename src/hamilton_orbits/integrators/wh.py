@@ -65,7 +65,7 @@ from hamilton_orbits._kernels import wh as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators._held import HELD
-from hamilton_orbits.integrators.methods import WH
+from hamilton_orbits.integrators.methods import WH, check_run
 from hamilton_orbits.integrators.methods import WH_COORDINATES as COORDINATES
 from hamilton_orbits.integrators.wh_correctors import (
     CORRECTOR_ALPHA_SQUARED,
@@ -226,9 +226,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, m
             f"wh is a symplectic map and refuses velocity-dependent effects; listed: "
             f"{', '.join(rhs.effects)}.  Use method='radau15' (or 'dop853') for them"
         )
-    if method.corrector and variational is not None:
-        raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
-                         "is not implemented); use corrector=0")
+    check_run(method, dt, None, variational is not None)
     if r0.shape[0] == 0 or not gm[int(gm.argmax())] > 0.0:
         raise ValueError("wh needs a central body with `gm` > 0; "
                          + ("there are no bodies" if r0.shape[0] == 0 else "all `gm` are 0"))
