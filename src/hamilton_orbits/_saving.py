@@ -451,13 +451,14 @@ class Saving:
         arch, prop = self._archive, self._prop
         arch.open()
         extra = arch.times(float(times[0]), float(times[-1]))
-        if not arch.exact and prop.dt is not None and prop.method.name != "dop853":
+        step = prop.fixed_step()
+        if not arch.exact and step is not None and prop.method.name != "dop853":
             asked = leg
             if asked is None:
                 before = self._asked_before(float(times[0]))
                 asked = times if before is None else np.concatenate(([before], times[1:]))
             self._asked = asked
-            extra = on_step_grid(extra, asked, prop.dt, spread=prop.method.name == "leapfrog")
+            extra = on_step_grid(extra, asked, step, spread=prop.method.name == "leapfrog")
             extra = extra[extra > times[0]]  # (one moved back onto the start, at the
             # rounding of its step, is not an output after it)
         if not extra.size and bool(np.all(times[1:] > times[:-1])):  # (no snapshot

@@ -54,6 +54,7 @@ from hamilton_orbits.integrators import (
     method_of,
 )
 from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
+from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.rhs import RHS, time_reversed
 
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
@@ -205,6 +206,17 @@ class Propagation:
     def steps(self) -> int:
         """Steps taken since the start."""
         return self.steps_before + (self.driver.steps if self.driver is not None else 0)
+
+    def fixed_step(self) -> float | None:
+        """The step of a run of fixed steps: ``dt``, or the one a fixed-step method
+        (wh, leapfrog) chooses at the start without it (its driver's, once made;
+        before, the one it will choose from the state it starts from); None for an
+        adaptive method."""
+        if self.dt is not None or self.method.name not in FIXED_STEP:
+            return self.dt
+        if self.driver is not None:
+            return float(self.driver.dt)
+        return self.module.chosen_step(self.r, self.v, self.gm, self.tol)
 
     def _check(self, backward: bool) -> None:
         watched = self.events is not None and len(self.events.watch)

@@ -120,7 +120,8 @@ class Simulation(Saving):
         Snapshots at exactly the scheduled times (the default of the adaptive
         methods, which end a step there by their own step control), or at the end
         of the step at or after each (the default of the fixed-step methods, whose
-        steps then stay their own).
+        steps then stay their own: wh and leapfrog, with a ``dt`` given or the step
+        they choose without it, and radau15 with ``dt``).
     archive_sync : bool
         Sync each snapshot to the disk before the run goes on, so that the archive
         survives a power cut or a crash of the machine, not only a killed process
@@ -199,7 +200,8 @@ class Simulation(Saving):
         self._unit: Any = DAY if system.quantity else None
         self._spec = (typed, step, tol, eff.as_list(), event_list(events), variational, stm)
         self._archive = _archive_of(archive, (every, every_steps, every_wall), exact_times,
-                                    typed.name, step is not None, system.quantity,
+                                    typed.name, step is not None or typed.name in FIXED_STEP,
+                                    system.quantity,
                                     archive_sync)
         #: the archived leg in progress, and what resume() finishes (after a load)
         self._leg: LegRows | None = None
@@ -351,10 +353,10 @@ class Simulation(Saving):
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
-        if self._archive is not None and prop.dt is not None and \
-                prop.method.name in FIXED_STEP:  # (refused before the leg's first snapshot:
-            check_step_count(abs(float(times[-1] - times[0])), prop.dt,  # a call refused
-                             prop.method.max_steps, prop.method.name)  # wrote one, resumed)
+        step = None if self._archive is None else prop.fixed_step()
+        if step is not None and prop.method.name in FIXED_STEP:  # (a call of too many steps
+            check_step_count(abs(float(times[-1] - times[0])), step,  # refused before the
+                             prop.method.max_steps, prop.method.name)  # leg's first snapshot)
         try:
             if self._archive is not None:
                 self._new_leg(times)
@@ -432,8 +434,9 @@ class Simulation(Saving):
 
 def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact_times: Any, method: str,
                 stepped: bool, quantity: bool, sync: Any) -> ArchiveWriter | None:
-    """The archive a simulation of ``method`` (``stepped``: given a ``dt``) writes
-    while it runs (None without ``path``)."""
+    """The archive a simulation of ``method`` (``stepped``: of fixed steps, a ``dt``
+    given or chosen by a fixed-step method) writes while it runs (None without
+    ``path``)."""
     every, every_steps, every_wall = schedule
     if not isinstance(sync, bool):
         raise ValueError(f"Expected `archive_sync` to be True or False, got {sync!r}")

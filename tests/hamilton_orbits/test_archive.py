@@ -566,6 +566,36 @@ def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_t
                    exact_times="yes")
 
 
+@pytest.mark.parametrize("kw", [dict(method="wh"), dict(method="wh", tol=1e-8),
+                                dict(method="leapfrog", tol=1e-4)])
+def test_a_step_the_method_chooses_is_a_fixed_step_for_the_archive(tmp_path, kw):
+    """wh without ``dt`` (its default step, or one from ``tol``) and leapfrog with
+    ``tol`` take a fixed step they choose at the start: the archive puts its
+    snapshots on those steps as it does on a ``dt`` given (not shortening the step
+    before each, as for an adaptive method): the same snapshots and bits as the run
+    given that step as ``dt`` (which agrees with the unarchived run to rounding,
+    above), with ``exact_times`` None, False or True."""
+    from hamilton_orbits.integrators import leapfrog, wh
+
+    a = _disc().as_arrays()
+    choose = wh.default_step if kw["method"] == "wh" else leapfrog.choose_dt
+    given = dict(method=kw["method"], dt=choose(a.r, a.v, a.gm, kw.get("tol")))
+    runs = {}
+    for exact_times in (None, False, True):
+        for name, options in (("chosen", kw), ("given", given)):
+            folder = tmp_path / f"{name}-{exact_times}"
+            out = Simulation(_disc(), **options, archive=folder, every=0.77,
+                             exact_times=exact_times).integrate(T)
+            runs[name, exact_times] = out.r, Archive(folder).times
+        assert _same(runs["chosen", exact_times][0], runs["given", exact_times][0])
+        np.testing.assert_array_equal(runs["chosen", exact_times][1],
+                                      runs["given", exact_times][1])
+    on_grid, exact = runs["chosen", None][1][1:], runs["chosen", True][1][1:]
+    assert np.all(on_grid - 0.77 * np.arange(1, len(on_grid) + 1) >= 0)  # at or after
+    np.testing.assert_array_equal(exact, 0.77 * np.arange(1, 78))
+    assert not np.array_equal(on_grid, exact)
+
+
 def test_an_archive_of_the_first_format_is_read_and_continued(tmp_path):
     """``data/archive-v1`` was written by archive format 1, a netCDF file per
     snapshot (tools/make_snapshot_fixture.py): a planet on a Kepler ellipse (a = 1,

@@ -66,6 +66,14 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
     return _setup.run_once(start, Leapfrog, rhs, r0, v0, gm, t_out, **options)
 
 
+def chosen_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | None) -> float:
+    """The step :func:`start` takes from ``r0``, ``gm`` without ``dt`` (from ``tol``,
+    :func:`choose_dt`): a fixed step chosen once, at the start."""
+    if tol is None:
+        raise ValueError("leapfrog needs a step `dt` or a tolerance `tol`, got neither")
+    return choose_dt(r0, v0, gm, tol)
+
+
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
           method: Leapfrog, *, dt: float | None, tol: float | None,
           events: EventLog | None = None, variational: Any = None) -> Any:
@@ -73,7 +81,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
     for arguments already checked (``method`` a :class:`Leapfrog`)."""
     check_run(method, dt, tol, variational is not None)
     if dt is None:
-        dt = choose_dt(r0, v0, gm, tol)
+        dt = chosen_step(r0, v0, gm, tol)
     if variational is not None:
         return _tangent.LeapfrogTangent(rhs, r0, v0, gm, t0, variational, dt=float(dt),
                                         max_steps=method.max_steps, slice_steps=SLICE)

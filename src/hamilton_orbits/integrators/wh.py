@@ -214,6 +214,12 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
     return _setup.run_once(start, WH, rhs, r0, v0, gm, t_out, **options)
 
 
+def chosen_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, tol: float | None) -> float:
+    """The step :func:`start` takes from ``r0``, ``v0``, ``gm`` without ``dt``
+    (:func:`default_step`): a fixed step chosen once, at the start."""
+    return default_step(r0, v0, gm, tol)
+
+
 def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, method: WH, *,
           dt: float | None, tol: float | None, events: EventLog | None = None,
           variational: Any = None) -> Any:
@@ -231,7 +237,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float, m
         raise ValueError("wh needs a central body with `gm` > 0; "
                          + ("there are no bodies" if r0.shape[0] == 0 else "all `gm` are 0"))
     if dt is None:
-        dt = default_step(r0, v0, gm, tol)
+        dt = chosen_step(r0, v0, gm, tol)
     if variational is not None:
         return _tangent.WHTangent(rhs, r0, v0, gm, t0, variational, dt=dt, jacobi=method.jacobi,
                                   max_steps=method.max_steps, slice_steps=SLICE)
