@@ -9,8 +9,10 @@ in ``docs/elements.md``) in brief:
 * ``e`` is the length of the modern eccentricity vector when that is below 1/2
   (no cancellation for near-circular orbits) and ``sqrt(1 - p inv_a)`` above
   (no cancellation for near-radial orbits); ``e`` below ``4 eps`` is set to 0.
-  The orbit is parabolic when ``|inv_a| max(r, p) <= 8 eps`` (then ``inv_a = 0``
-  and ``e = 1``), and radial when ``|r x v| <= 8 eps |r| |v|`` (then ``e = 1``,
+  The orbit is parabolic when ``|inv_a| <= 4 eps (2/r + v^2/mu)`` (vis viva's 0
+  to within the rounding of its two terms, :func:`~hamilton_orbits._kernels.
+  kepler.parabolic`; then ``inv_a = 0`` and ``e = 1``; a parabola propagated
+  stays one), and radial when ``|r x v| <= 8 eps |r| |v|`` (then ``e = 1``,
   ``p = 0``).
 * The true anomaly comes from ``e sin nu = (r.v) h / (mu r)`` and
   ``e cos nu = (h^2 - mu r)/(mu r)`` (an atan2, full relative precision near
@@ -54,6 +56,7 @@ from hamilton_orbits._kernels._dispatch import parallel_kernel
 from hamilton_orbits._kernels.kepler import (
     anomaly_from_nu,
     mean_from_anomaly,
+    parabolic,
     sinh_minus_x,
     state_in_safe_range,
     state_scales,
@@ -67,10 +70,9 @@ TWO_PI = 2.0 * math.pi
 FOUR_PI = 4.0 * math.pi
 
 _CIRC_TOL = 4.0 * EPS
-# |1/a| below this many eps of (2/r + v^2/mu), the rounding bound of vis viva
+# (a parabola: |1/a| below 4 eps of (2/r + v^2/mu), the rounding bound of vis viva
 # (each term carries ~1.5 eps from the state's own rounding and the arithmetic),
-# is indistinguishable from the parabola's 0
-_PARAB_TOL = 4.0 * EPS
+# is indistinguishable from the parabola's 0: kepler.parabolic)
 _RADIAL_TOL = 8.0 * EPS
 # |r.v| below this many eps of |r| |v| near apoapsis: the sign of r.v is not
 # fixed by the rounding of the state (and of r.v), so it is at apoapsis to its
@@ -211,7 +213,7 @@ def _radial_elements(rx, ry, rz, r, v2, rv, inv_a, mu):  # pragma: no cover - co
     inc, lan, nx, ny, mx, my, mz = _node_basis(nx_, ny_, nz_)
     u = wrap_2pi(math.atan2(rx * mx + ry * my + rz * mz, rx * nx + ry * ny))
     argp = wrap_2pi(u - PI)
-    if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
+    if parabolic(inv_a, r, v2, mu):
         # radial parabola: time since collision t = sqrt(2/mu) r^1.5 / 3
         tau = math.sqrt(2.0 / mu) * r * math.sqrt(r) / 3.0
         if rv < 0.0:
@@ -245,7 +247,7 @@ def _eccentricity(rx, ry, rz, vx, vy, vz, r, v2, rv, h, p, inv_a, mu):  # pragma
     ome = 1.0 - ev if ev < 0.5 else ome_w
     if e <= _CIRC_TOL:
         e = 0.0
-    if abs(inv_a) <= _PARAB_TOL * (2.0 / r + v2 / mu):
+    if parabolic(inv_a, r, v2, mu):
         # 1/a = 2/r - v^2/mu is zero to within the rounding of its two terms
         inv_a = 0.0
         e = 1.0

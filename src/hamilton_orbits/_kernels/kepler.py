@@ -925,6 +925,76 @@ def _fg_velocity(x, y, z, wx, wy, wz, rr, hx, hy, hz):  # pragma: no cover - com
     )
 
 
+#: 1/a = 2/r - v^2/mu is taken as zero (a parabola) within this many ulps of the
+#: sum of its two terms (:func:`parabolic`)
+PARABOLA_TOL = 4.0 * EPS
+
+
+@njit(cache=True, inline="always")
+def parabolic(inv_a, r, v2, mu):  # pragma: no cover - compiled
+    """Whether a state of ``1/a = inv_a`` (``2/r - v2/mu``) is a parabola: ``1/a`` zero
+    to within the rounding of its two terms (the rule of the elements,
+    :mod:`hamilton_orbits._kernels.elements`)."""
+    return abs(inv_a) <= PARABOLA_TOL * (2.0 / r + v2 / mu)
+
+
+@njit(cache=True, inline="always")
+def _propagate(rx, ry, rz, vx, vy, vz, mu, dt, exact_parabola):  # pragma: no cover
+    """:func:`propagate_uv`'s body; ``exact_parabola``: a state that is a parabola
+    (:func:`parabolic`) moved on the parabola, ``1/a`` exactly 0, to a state that
+    is one (:func:`_escape_speed`).  (Its ``1/a`` of a few ulps of ``2/r``, kept by
+    the motion, is no longer within the rounding of ``2/r`` far out: a comet
+    propagated 10 years became an ellipse or a hyperbola of ``a`` ~ 1e15 au.)"""
+    nan = math.nan
+    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
+    if not (r0 > 0.0):
+        return nan, nan, nan, nan, nan, nan
+    if dt == 0.0:
+        return rx, ry, rz, vx, vy, vz
+    v2 = vx * vx + vy * vy + vz * vz
+    smu = math.sqrt(mu)
+    sigma0 = (rx * vx + ry * vy + rz * vz) / smu
+    alpha = 2.0 / r0 - v2 / mu
+    on_parabola = exact_parabola and parabolic(alpha, r0, v2, mu)
+    if on_parabola:
+        alpha = 0.0  # (a parabola's: its state's rounding kept out of the motion)
+    tau = smu * _reduce_period(dt, mu, smu, alpha)
+    hx = ry * vz - rz * vy
+    hy = rz * vx - rx * vz
+    hz = rx * vy - ry * vx
+    h2 = hx * hx + hy * hy + hz * hz
+    # anchor only when it matters: heading for periapsis with a step long
+    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20,
+    # and e^2 = 1 - alpha p >= 1/4
+    anchor = False
+    pp = 0.0
+    e2 = 0.0
+    if sigma0 * tau < 0.0 and abs(sigma0 * tau) > 0.1 * r0 * r0:
+        pp = h2 / mu
+        e2 = 1.0 - alpha * pp
+        anchor = e2 >= 0.25
+    if anchor:
+        r, u1, u2, g = _step_anchored(tau, r0, sigma0, alpha, pp, e2, smu)
+    else:
+        r, u1, u2, g = _step_direct(tau, r0, sigma0, alpha, h2, smu)
+    out = _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz)
+    return _escape_speed(out, mu) if on_parabola else out
+
+
+@njit(cache=True, inline="always")
+def _escape_speed(state, mu):  # pragma: no cover - compiled
+    """``state`` with its speed made the escape speed ``sqrt(2 mu / r)`` (a change of
+    a few ulps on a state moved on a parabola: its ``1/a`` then 0 to within the
+    rounding of ``2/r``, so the state is a parabola by :func:`parabolic`)."""
+    x, y, z, a, b, c = state
+    r2 = x * x + y * y + z * z
+    w2 = a * a + b * b + c * c
+    if not (r2 > 0.0 and w2 > 0.0 and math.isfinite(r2 + w2)):
+        return state
+    f = math.sqrt(2.0 * mu / math.sqrt(r2) / w2)
+    return x, y, z, a * f, b * f, c * f
+
+
 @njit(cache=True)
 def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """Two-body state after time ``dt`` by universal variables (f and g series).
@@ -954,36 +1024,7 @@ def propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     :data:`propagate_uv_inline` is this function compiled to be inlined (at
     numba's IR level) into the loop that calls it.
     """
-    nan = math.nan
-    r0 = math.sqrt(rx * rx + ry * ry + rz * rz)
-    if not (r0 > 0.0):
-        return nan, nan, nan, nan, nan, nan
-    if dt == 0.0:
-        return rx, ry, rz, vx, vy, vz
-    v2 = vx * vx + vy * vy + vz * vz
-    smu = math.sqrt(mu)
-    sigma0 = (rx * vx + ry * vy + rz * vz) / smu
-    alpha = 2.0 / r0 - v2 / mu
-    tau = smu * _reduce_period(dt, mu, smu, alpha)
-    hx = ry * vz - rz * vy
-    hy = rz * vx - rx * vz
-    hz = rx * vy - ry * vx
-    h2 = hx * hx + hy * hy + hz * hz
-    # anchor only when it matters: heading for periapsis with a step long
-    # enough that sigma0 U2 ~ sigma0 chi^2/2 (chi ~ tau/r0) reaches r0 U1 / 20,
-    # and e^2 = 1 - alpha p >= 1/4
-    anchor = False
-    pp = 0.0
-    e2 = 0.0
-    if sigma0 * tau < 0.0 and abs(sigma0 * tau) > 0.1 * r0 * r0:
-        pp = h2 / mu
-        e2 = 1.0 - alpha * pp
-        anchor = e2 >= 0.25
-    if anchor:
-        r, u1, u2, g = _step_anchored(tau, r0, sigma0, alpha, pp, e2, smu)
-    else:
-        r, u1, u2, g = _step_direct(tau, r0, sigma0, alpha, h2, smu)
-    return _fg_state(rx, ry, rz, vx, vy, vz, r0, r, u1, u2, g, smu, hx, hy, hz)
+    return _propagate(rx, ry, rz, vx, vy, vz, mu, dt, False)
 
 
 # The Wisdom-Holman drift loop (over bodies with the same mu and dt) calls this
@@ -1199,18 +1240,19 @@ def state_scales(rx, ry, rz, vx, vy, vz, mu):  # pragma: no cover - compiled
 @njit(cache=True)
 def propagate_scaled(rx, ry, rz, vx, vy, vz, mu, dt):  # pragma: no cover - compiled
     """:func:`propagate_uv` on the state scaled to order 1 (:func:`state_scales`),
-    so that no intermediate product overflows or underflows; NaN for a ``dt``
-    that is not finite."""
+    so that no intermediate product overflows or underflows, a parabola moved on
+    the parabola (``1/a`` exactly 0, so that it stays one); NaN for a ``dt`` that
+    is not finite."""
     er, ev, ok = state_scales(rx, ry, rz, vx, vy, vz, mu)
     if not ok or not math.isfinite(dt):
         nan = math.nan
         return nan, nan, nan, nan, nan, nan
     if er == 0 and ev == 0:
-        return propagate_uv(rx, ry, rz, vx, vy, vz, mu, dt)
-    x, y, z, a, b, c = propagate_uv(
+        return _propagate(rx, ry, rz, vx, vy, vz, mu, dt, True)
+    x, y, z, a, b, c = _propagate(
         math.ldexp(rx, -er), math.ldexp(ry, -er), math.ldexp(rz, -er),
         math.ldexp(vx, -ev), math.ldexp(vy, -ev), math.ldexp(vz, -ev),
-        math.ldexp(mu, -er - 2 * ev), math.ldexp(dt, ev - er),
+        math.ldexp(mu, -er - 2 * ev), math.ldexp(dt, ev - er), True,
     )
     return (
         math.ldexp(x, er), math.ldexp(y, er), math.ldexp(z, er),
