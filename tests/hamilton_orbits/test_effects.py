@@ -286,7 +286,7 @@ def test_effects_that_exclude_each_other():
     """``EffectSpec.excludes``: listing both would count the same terms twice."""
     assert fx.get("nbody", "eih").excludes.keys() == {"gr", "gr_potential"}
     assert fx.exclusion_problems(["gr", "j2"]) == []
-    assert [k for k, _ in fx.exclusion_problems(["gr_potential", "eih", "gr"])] == [1, 2]
+    assert [k for k, _ in fx.exclusion_problems(["gr_potential", "eih", "gr"])] == [1, 2, 2]
     fx.register(fx.EffectSpec("ex_a", "test-excl", "a", excludes={"ex_b": "b's terms"}))
     fx.register(fx.EffectSpec("ex_b", "test-excl", "b"))
     try:
@@ -297,6 +297,20 @@ def test_effects_that_exclude_each_other():
             fx.EffectSet.of(["ex_b", "ex_a"], "test-excl")
     finally:  # the registry is the process's: leave no kind behind for later tests
         fx.registry._REGISTRY.pop("test-excl", None)
+
+
+def test_gr_and_gr_potential_are_refused_together():
+    """``gr`` (the 1PN force of a dominant body) and ``gr_potential`` (a potential
+    of the same perihelion advance) listed together counted Mercury's 43" a
+    century twice (86"); refused, naming both and their indices."""
+    assert fx.exclusion_problems(["gr", "j2"]) == []
+    with pytest.raises(ValueError, match=r"^Effect 'gr_potential' \(at index 1\) is refused "
+                                         r"beside 'gr' \(at index 0\): 'gr' already computes "
+                                         r"the relativistic perihelion advance"):
+        fx.EffectSet.of(["gr", "gr_potential"])
+    with pytest.raises(ValueError, match=r"'gr_potential' \(at index 0\) is refused beside "
+                                         r"'gr' \(at index 2\)"):
+        fx.EffectSet.of(["gr_potential", "j2", "gr"])
 
 
 def _earth_moon():

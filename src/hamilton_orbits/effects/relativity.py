@@ -90,6 +90,9 @@ SPECS = (
         parameter_kinds={"c": SPEED},
         name_parameters=("source",),
         energy=_energy_gr,
+        excludes={"gr_potential": "the relativistic perihelion advance of a dominant body "
+                                  "(gr_potential is a potential of the same advance; with "
+                                  "more than one source, use eih)"},
         reference="Anderson et al. (1975), ApJ 200, 221; reboundx 'gr' (Tamayo et al. 2020)",
     ),
     EffectSpec(
