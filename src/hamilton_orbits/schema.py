@@ -170,6 +170,8 @@ class Number(Field):
     minimum: float | None = None
     positive: bool = False
     integer: bool = False
+    #: an exclusive upper bound (a tolerance: below 1)
+    below: float | None = None
 
     def check(self, value: Any, path: str, problems: Problems) -> Any:
         if isinstance(value, bool) or not isinstance(value, int | float):
@@ -186,6 +188,9 @@ class Number(Field):
             return None
         if self.minimum is not None and value < self.minimum:
             problems.add(path, f"expected a number >= {self.minimum}, got {value!r}")
+            return None
+        if self.below is not None and not value < self.below:
+            problems.add(path, f"expected a number < {self.below}, got {value!r}")
             return None
         return value
 

@@ -411,6 +411,20 @@ def test_set_paths_that_lead_nowhere_on_the_command_line():
     assert "bodies[7].gm: bodies has 2 entries" in res.stderr
 
 
+@pytest.mark.parametrize("tol", ["1.5", "1"])
+def test_a_scene_tolerance_of_one_or_more_is_refused_on_loading(tmp_path, tol):
+    """A scene that loads does not fail at run time for a reason its file holds
+    (docs/scenes.md): ``integrator.tol = 1.5`` loaded, then the run failed (exit 1)
+    on integrate's "Expected tol in (0, 1)"."""
+    with pytest.raises(SceneError, match=rf"integrator.tol: expected a number < 1.0, got "
+                                         rf"{tol}"):
+        Scene.bundled("leo-j2").with_values({"integrator.tol": tol})
+    res = _cli("run", "leo-j2", "--set", f"integrator.tol={tol}", "--no-progress",
+               "--out", str(tmp_path / "out"))
+    assert res.returncode == 2
+    _no_traceback(res)
+
+
 def test_a_quantity_tolerance_names_tol():  # fixed in simulation.integrate by the lead
     with pytest.raises(u.UnitConversionError, match=r"Expected `tol` to be dimensionless, got s"):
         integrate(quantities(), 1 * u.min, tol=1e-9 * u.s)

@@ -85,7 +85,7 @@ SCHEMA: dict[str, S.Field] = {
         default={},
         fields={
             "method": S.Choice(choices=METHODS, default="radau15"),
-            "tol": S.Number(positive=True),
+            "tol": S.Number(positive=True, below=1.0),  # (a relative tolerance)
             "dt": S.Quantity(kind=TIME, positive=True),
             # options of ``wh`` (integrate(..., coordinates=, corrector=))
             "coordinates": S.Choice(choices=("democratic_heliocentric", "jacobi")),
