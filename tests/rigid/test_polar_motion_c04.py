@@ -253,3 +253,44 @@ def test_error_bars_cover_the_truth_with_white_noise():
     err = fit.chandler_period_error.to_value(u.day)
     assert abs(fit.chandler_period.to_value(u.day) - 433.0) < 4 * err
     assert 0.9 < fit.rms_residual.to_value(u.mas) / 20 < 1.1
+
+
+@pytest.mark.parametrize("every", [5, 7, 30])
+def test_decade_amplitudes_of_a_record_sampled_every_few_days(record, every):
+    """The decades of a record not sampled daily (a 5-day, weekly or monthly
+    series) were dropped: two years of span were counted as 730 samples.  The
+    amplitudes per decade of the sub-sampled record are those of the daily one
+    (the same lines, fewer points: 0.3 mas apart at most, measured)."""
+    daily = fit_wobble(record).amplitude_by_decade
+    sub = PolarMotionRecord(record.time[::every], record.x[::every], record.y[::every])
+    table = fit_wobble(sub).amplitude_by_decade
+    assert list(table["decade"]) == list(daily["decade"])
+    np.testing.assert_allclose(table["chandler_amplitude"].to_value(u.mas),
+                               daily["chandler_amplitude"].to_value(u.mas), rtol=0, atol=1.0)
+
+
+@pytest.mark.parametrize("guess", [380.0, 303.6, 550.0])
+def test_a_chandler_guess_far_from_the_line_is_refused(record, guess):
+    """A guess more than 10% off (the rigid Euler period, say) gave a sidelobe of a
+    few mas as the Chandler line, the record's 120 mas at 433 d unsaid."""
+    with pytest.raises(ValueError, match=rf"Expected `chandler_guess` within 10% of the "
+                                         rf"record's Chandler line: the guess {guess:.1f} d "
+                                         rf"led to a line of .* mas at .* d, but the record "
+                                         rf"has one of 1[0-9][0-9] mas at 43[0-9] d"):
+        fit_wobble(record, chandler_guess=guess * u.day)
+
+
+def test_a_record_whose_epochs_do_not_increase_is_refused(record):
+    """Two decades joined in the wrong order were taken, and the fits, select and
+    predict then failed with windows of -1 d and ranges that end before they begin."""
+    a, b = record.select(1990, 2000), record.select(1980, 1990)
+    time = Time(np.concatenate([a.time.mjd, b.time.mjd]), format="mjd", scale="utc")
+    x, y = np.concatenate([a.x, b.x]), np.concatenate([a.y, b.y])
+    k = len(a)
+    with pytest.raises(ValueError, match=rf"Expected `time` to increase, got 1980-01-01 "
+                                         rf"00:00:00.000 at index {k} after 1999-12-31 "
+                                         rf"00:00:00.000 at index {k - 1}"):
+        PolarMotionRecord(time, x, y)
+    with pytest.raises(ValueError, match=r"Expected `time` to increase, .* at index 1 after"):
+        PolarMotionRecord(Time([51544.0, 51544.0], format="mjd"), [0, 0] * u.mas,
+                          [0, 0] * u.mas)

@@ -51,6 +51,12 @@ class PolarMotionRecord:
         if self.time.ndim != 1 or len(self.time) == 0:
             raise ValueError(f"Expected `time` of shape (n,), n >= 1, got "
                              f"{self.time.shape}")
+        days = (self.time.jd1 - self.time.jd1[0]) + (self.time.jd2 - self.time.jd2[0])
+        bad = np.nonzero(~(np.diff(days) > 0))[0]
+        if bad.size:  # (the fits, select and predict read the record as a time series)
+            k = int(bad[0]) + 1
+            raise ValueError(f"Expected `time` to increase, got {self.time[k].iso} at index "
+                             f"{k} after {self.time[k - 1].iso} at index {k - 1}")
         n = len(self.time)
         for name in ("x", "y"):
             value = getattr(self, name)

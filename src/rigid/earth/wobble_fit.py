@@ -313,8 +313,15 @@ def fit_wobble(
     -------
     WobbleFit
         Also ``amplitude_by_decade`` (the Chandler and annual amplitudes fitted per
-        calendar decade with the periods of the whole window held fixed) and a Q
-        estimate with its caveat.
+        calendar decade, of two years' span or more, with the periods of the whole
+        window held fixed) and a Q estimate with its caveat.
+
+    Raises
+    ------
+    ValueError
+        A window under 3 Chandler periods; a ``chandler_guess`` more than 10% from
+        the record's line (the line found from it more than twice weaker than one
+        beyond the 10% searched).
 
     Examples
     --------
@@ -349,6 +356,7 @@ def fit_wobble(
     x, cov, _r, rho, rms = _fit_core(t, m, n_trend, t_c0, 365.25)
     wc, wa = x[0], x[1]
     coef = x[2::2] + 1j * x[3::2]
+    _check_guess(t, m, n_trend, 2 * np.pi / wc, abs(coef[n_trend]), t_c0)
     inflate = np.sqrt((1 + rho) / (1 - rho)) if rho < 1 else np.inf
     err_wc = np.sqrt(cov[0, 0])
     err_wa = np.sqrt(cov[1, 1])
@@ -377,6 +385,27 @@ def fit_wobble(
     )
 
 
+def _check_guess(t: np.ndarray, m: np.ndarray, n_trend: int, t_c: float, amp: float,
+                 t_c0: float) -> None:
+    """Refuse a Chandler line found from a guess more than 10% off: the fitted line
+    (period ``t_c``, amplitude ``amp``) when the record has a prograde line more than
+    twice as strong beyond 10% of the guess ``t_c0``, within 0.6-1.6 ``t_c`` (the
+    annual lines projected out first).  (A guess of 380 d, or the rigid Euler
+    period, gave a sidelobe of 16 or 4 mas as "the Chandler line", the record's
+    122 mas at 433 d unsaid.)"""
+    _, detrended = _project(t, m, 2 * np.pi / np.array([365.25, -365.25]), n_trend)
+    f = np.linspace(1 / (1.6 * t_c), 1 / (0.6 * t_c), 101)
+    f = f[np.abs(f * 365.25 - 1) > 0.03]  # (the annual line's place, projected out)
+    lines = np.abs(np.exp(-2j * np.pi * np.outer(f, t)) @ detrended) / t.size
+    k = int(np.argmax(lines))
+    if lines[k] > 2 * amp and abs(1 / (f[k] * t_c0) - 1) > 0.1:
+        raise ValueError(
+            f"Expected `chandler_guess` within 10% of the record's Chandler line: the guess "
+            f"{t_c0:.1f} d led to a line of {amp:.1f} mas at {t_c:.1f} d, but the record has "
+            f"one of {lines[k]:.0f} mas at {1 / f[k]:.0f} d, beyond the 10% searched about "
+            f"the guess (the periodogram() shows the lines)")
+
+
 def _amplitude_by_decade(rec: PolarMotionRecord, wc: float, wa: float) -> QTable:
     """Chandler and annual amplitudes per calendar decade, periods held fixed."""
     from astropy.table import QTable
@@ -386,8 +415,8 @@ def _amplitude_by_decade(rec: PolarMotionRecord, wc: float, wa: float) -> QTable
     first = int(np.floor(yr[0] / 10.0) * 10)
     for dec in range(first, int(yr[-1]) + 1, 10):
         sel = (yr >= dec) & (yr < dec + 10)
-        if sel.sum() < 2 * 365:  # under two years: the terms cannot be separated
-            continue
+        if sel.sum() < 10 or yr[sel][-1] - yr[sel][0] < 2.0:  # under two years (of any
+            continue  # sampling): the terms cannot be separated
         sub = PolarMotionRecord(rec.time[sel], rec.x[sel], rec.y[sel])
         days = mjd_utc(sub.time)
         t = days - 0.5 * (days[0] + days[-1])
