@@ -323,6 +323,10 @@ def require_consistent(names: Sequence[str], values: Sequence[Any]) -> bool:
     qname, qvalue = quantities[0]
     for n, v in given:
         if not is_quantity(v):
+            if isinstance(v, list | tuple) and any(is_quantity(x) for x in v):
+                raise ValueError(f"Expected `{n}` to be a Quantity like `{qname}` ({qvalue}), "
+                                 f"got a {type(v).__name__} of Quantities {v!r}: make it one "
+                                 f"Quantity (u.Quantity({n}))")
             what = ("the plain number" if isinstance(v, int | float | complex | np.number
                                                      | np.ndarray | list | tuple)
                     else f"a {type(v).__name__}")  # (a TimeDelta is no plain number)

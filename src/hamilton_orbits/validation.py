@@ -17,6 +17,24 @@ class ConvergenceError(ValueError):
     """An iterative solver did not reach its tolerance (never a silent NaN)."""
 
 
+def as_flag(name: str, value: object) -> bool:
+    """``value`` as a bool, refused unless it is one (``"no"`` or ``"False"`` would be
+    true, as any non-empty text is).
+
+    Examples
+    --------
+    >>> as_flag("triaxial", False)
+    False
+    >>> as_flag("triaxial", "no")
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `triaxial` to be True or False, got 'no'
+    """
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"Expected `{name}` to be True or False, got {value!r}")
+    return bool(value)
+
+
 def first_index(mask: np.ndarray) -> tuple[int, ...]:
     idx = np.argwhere(mask)[0]
     return tuple(int(i) for i in idx)

@@ -141,8 +141,9 @@ def contrafocal(body: RigidBody, lam: Any) -> RigidBody:
     -------
     RigidBody
         Same attitude, body angular momentum ``-L``, so ``omega' = omega - lam L``.
-        Its principal axes make supplementary angles with the invariable line of
-        ``body`` (equal angles with its own line ``-L``) and it differs from
+        Its principal axes make, at every time, the same angles with the invariable
+        line ``L`` of ``body`` as ``body``'s axes do (supplementary angles with its
+        own line ``-L``: Sylvester's "equal but contrary"), and it differs from
         ``body`` by the uniform rotation ``-lam |L| t`` about ``L``.
 
     Notes

@@ -162,3 +162,57 @@ def test_a_squared_rate_in_hertz_is_refused_and_in_radians_taken():
     radians = GravityGradientTorque((1e-3 * u.rad / u.s) ** 2).encode()
     per_second = GravityGradientTorque(1e-6 / u.s**2).encode()
     assert radians[0] == per_second[0] and radians[1].tolist() == per_second[1].tolist()
+
+
+@pytest.mark.parametrize("flag", ["False", "no", 0, None])
+def test_the_triaxial_flag_takes_a_bool_only(flag):
+    """``triaxial="False"`` was true (any non-empty text is): the triaxial Euler
+    period, the moments A != B kept; refused by name."""
+    from rigid.earth.constants import chandler_period, euler_period, rigid_body
+    from rigid.earth.free_wobble import simulate_wobble
+
+    pattern = rf"Expected `triaxial` to be True or False, got {re.escape(repr(flag))}"
+    for call in (lambda: euler_period(triaxial=flag), lambda: rigid_body(triaxial=flag),
+                 lambda: chandler_period(0.3, triaxial=flag),
+                 lambda: simulate_wobble(2 * u.yr, method="exact", triaxial=flag)):
+        with pytest.raises(ValueError, match=pattern):
+            call()
+
+
+def test_the_excitation_of_a_series_is_refused_beyond_its_span():
+    """``excitation`` and ``rhs`` (for checks with an ODE solver) held the series'
+    end value beyond ``chi_t`` while ``solve`` refused those times: a check then
+    integrated another model."""
+    model = LiouvillePole(("elastic", "excitation_series"), chandler_period=433 * u.day,
+                          chi_t=[0.0, 10.0, 20.0] * u.day, chi=[0.0, 1e-7, 2e-7])
+    assert model.excitation([5.0, 20.0])[1] == 2e-7  # (within: interpolated)
+    for call in (lambda: model.excitation([5.0, 100.0]), lambda: model.rhs(100.0, 0j),
+                 lambda: model.solve([0.0, 100.0], 0j)):
+        with pytest.raises(ValueError, match=r"Expected `t` within the span of `chi_t` "
+                                             r"\[0.0, 20.0\] d, got 100.0"):
+            call()
+
+
+def test_a_periodogram_takes_cycles_per_year(record):
+    """``u.cycle / u.yr`` (the docstring's "cycles per year") was refused as "not
+    1/time"; it is the frequency of as many turns a year."""
+    from rigid.polar_motion import periodogram
+
+    turns = periodogram(record.select(2000, 2010), [0.843, -1.0] * u.cycle / u.yr)
+    plain = periodogram(record.select(2000, 2010), [0.843, -1.0] / u.yr)
+    assert turns["amplitude"].value.tolist() == plain["amplitude"].value.tolist()
+
+
+def test_a_list_of_quantities_and_a_duration_array_are_named_as_such():
+    """A list of Quantities was "the plain number [...]"; a duration of shape (1,)
+    was told to be ">= 1 day"."""
+    from rigid import RigidBody, free_motion
+    from rigid.earth.free_wobble import simulate_wobble
+
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.4, 1.1, -0.3] * u.rad / u.s)
+    with pytest.raises(ValueError, match=r"got a list of Quantities \[.*\]: make it one "
+                                         r"Quantity \(u.Quantity\(t\)\)"):
+        free_motion(body, [0 * u.s, 1 * u.min])
+    with pytest.raises(ValueError, match=r"Expected `duration` to be one time, got "
+                                         r"<Quantity \[3.\] yr> of shape \(1,\)"):
+        simulate_wobble([3] * u.yr, method="exact")

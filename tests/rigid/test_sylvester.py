@@ -62,6 +62,9 @@ def test_contrafocal_theorem(lam):
     np.testing.assert_allclose(other.invariable_plane, -lhat, atol=8 * EPS)
     np.testing.assert_allclose(_axes_cosines(att2, other.invariable_plane),
                                -_axes_cosines(att, lhat), atol=1e-13)
+    # (so against the invariable line of BODY the angles are the same, not
+    # supplementary, as contrafocal's docstring said before)
+    np.testing.assert_allclose(_axes_cosines(att2, lhat), _axes_cosines(att, lhat), atol=1e-13)
     rot = confocal_rotation(BODY, -lam, T)
     assert _qdist((rot * att).as_array(), att2.as_array()).max() < 1e-12
 

@@ -41,6 +41,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS
+from hamilton_orbits.validation import as_flag
 from rigid.body import RigidBody
 
 __all__ = [
@@ -139,7 +140,7 @@ def euler_period(triaxial: bool = False) -> u.Quantity:
     303.63 d
     """
     a, b, c = moments()
-    if triaxial:
+    if as_flag("triaxial", triaxial):
         ratio = np.sqrt((c - a) * (c - b) / (a * b))
     else:
         a_bar = 0.5 * (a + b)
@@ -232,7 +233,7 @@ def rigid_body(wobble: Any = 0.2 * u.arcsec, *, triaxial: bool = True) -> RigidB
     if not 0.0 <= float(w) < np.pi / 2:
         raise ValueError(f"Expected `wobble` in [0, 90 deg), got {wobble!r}")
     mom = moments()
-    if not triaxial:
+    if not as_flag("triaxial", triaxial):
         a_bar = 0.5 * (mom[0] + mom[1])
         mom = u.Quantity([a_bar, a_bar, mom[2]])
     om = OMEGA.to_value(u.rad / u.s)

@@ -152,7 +152,10 @@ def simulate_wobble(
             raise ValueError(f"Expected `{name}` to be a Quantity (such as {like}), got the "
                              f"bare number {value!r}")
     t_end = TIME("duration", duration, u.day)
-    if t_end.shape != () or not float(t_end) >= 1.0:
+    if t_end.shape != ():
+        raise ValueError(f"Expected `duration` to be one time, got {duration!r} of shape "
+                         f"{t_end.shape}")
+    if not float(t_end) >= 1.0:
         raise ValueError(f"Expected `duration` >= 1 day, got {duration!r}")
     n_out = int(np.floor(float(t_end))) + 1
     body = rigid_body(wobble, triaxial=triaxial)

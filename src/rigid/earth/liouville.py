@@ -206,7 +206,8 @@ class LiouvillePole:
                 f"Q={'inf' if self.q_inv == 0 else 1 / self.q_inv!r})")
 
     def excitation(self, t: Any) -> np.ndarray:
-        """The model's ``chi(t)`` in radians (zero without forcing effects).
+        """The model's ``chi(t)`` in radians (zero without forcing effects); with an
+        excitation series, ``t`` within its span (as :meth:`solve` takes it).
 
         Examples
         --------
@@ -218,6 +219,7 @@ class LiouvillePole:
         for c, w, ep in self._sinusoids:
             chi += c * np.exp(1j * w * (tt - ep))
         if self._series is not None:
+            self._within_series("t", tt)
             st, sc = self._series
             chi += np.interp(tt, st, sc.real) + 1j * np.interp(tt, st, sc.imag)
         return chi
@@ -304,17 +306,23 @@ class LiouvillePole:
             return u.Quantity(m, u.rad).to(m0.unit)
         return m
 
+    def _within_series(self, name: str, vals: np.ndarray) -> None:
+        """Refuse times ``vals`` beyond the excitation series' span (``chi`` is not
+        known there: an interpolation would hold its end value)."""
+        st, _ = self._series  # type: ignore[misc]
+        lo, hi = float(st[0]), float(st[-1])
+        out = (vals < lo) | (vals > hi)
+        if np.any(out):
+            k = np.argwhere(np.atleast_1d(out))[0][0]
+            raise ValueError(
+                f"Expected `{name}` within the span of `chi_t` [{lo!r}, {hi!r}] d, got "
+                f"{float(np.atleast_1d(vals)[k])!r}{f' at index {k}' if vals.ndim else ''}"
+            )
+
     def _series_response(self, tt: np.ndarray, start: float) -> np.ndarray:
         st, sc = self._series  # type: ignore[misc]
-        lo, hi = float(st[0]), float(st[-1])
         for name, vals in (("t0", np.array(start)), ("t", tt)):
-            out = (vals < lo) | (vals > hi)
-            if np.any(out):
-                k = np.argwhere(np.atleast_1d(out))[0][0]
-                raise ValueError(
-                    f"Expected `{name}` within the span of `chi_t` [{lo!r}, {hi!r}] d, got "
-                    f"{float(np.atleast_1d(vals)[k])!r}{f' at index {k}' if vals.ndim else ''}"
-                )
+            self._within_series(name, vals)
         if np.any(tt < start):
             k = int(np.argmax(np.atleast_1d(tt < start)))
             raise ValueError(

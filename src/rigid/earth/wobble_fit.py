@@ -482,7 +482,8 @@ def periodogram(
     ----------
     record : PolarMotionRecord
     frequency : Quantity, optional
-        Frequencies (1/yr, 1/day ...); default -1.5 .. 1.5 cycles/yr, 1201 points.
+        Frequencies (1/yr, 1/day, cycle/yr ...; negative: retrograde); default
+        -1.5 .. 1.5 cycles/yr, 1201 points.
     trend : {"linear", "iers2010"}
         What is removed first (a least-squares line, or the IERS 2010 mean pole).
 
@@ -507,6 +508,8 @@ def periodogram(
             raise u.UnitConversionError(
                 f"Expected `frequency` to be a Quantity of 1/time, got {frequency!r}"
             )
+        if frequency.unit.is_equivalent(u.cycle / u.yr):  # (cycles per year: turns)
+            frequency = frequency / u.cycle
         try:
             per_year = frequency.to_value(1 / u.yr)
         except u.UnitConversionError:
