@@ -177,7 +177,12 @@ def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
         for key, kind in NONGRAV_KEYS.items():
             x = row.get(key, _NONGRAV_DEFAULTS[key])
             unit = {"acceleration": u.au / u.day**2, "length": u.au}.get(kind)
-            x = x.to_value(unit) if is_quantity(x) and unit is not None else x
+            if is_quantity(x) and unit is not None:
+                if not x.unit.is_equivalent(unit):
+                    raise u.UnitConversionError(
+                        f"Expected `nongrav` {key} to be an {kind} (such as {unit}), got "
+                        f"{x!r} at index {k}")
+                x = x.to_value(unit)
             if not isinstance(x, (int, float, np.floating, np.integer)) or not np.isfinite(x):
                 raise ValueError(f"Expected `nongrav` {key} a finite number (or Quantity), "
                                  f"got {row[key]!r} at index {k}")

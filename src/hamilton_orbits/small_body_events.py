@@ -82,8 +82,22 @@ def encounters(events: Any, names: Sequence[str], perturbers: Sequence[str]
                              f"chunk of small bodies), got {event['action']!r}")
         mine, theirs = _named(event.get("bodies"), names, perturbers, where)
         dist = _distance(event.get("distance"), where)
-        out += [Encounter(i, p, dist) for i in mine or range(len(names)) for p in theirs]
+        watched = [Encounter(i, p, dist) for i in mine or range(len(names)) for p in theirs]
+        _refuse_repeats(watched, out, where, names)
+        out += watched
     return tuple(out)
+
+
+def _refuse_repeats(watched: list[Encounter], before: list[Encounter], where: str,
+                    names: Sequence[str]) -> None:
+    """Refuse a pair watched at a distance an earlier event watches it at (each
+    encounter would be recorded twice), as the n-body events do."""
+    known = set(before)
+    for pair in watched:
+        if pair in known:
+            raise ValueError(f"{where} watches {names[pair.body]}-{pair.perturber} within "
+                             f"{pair.distance!r} au as an earlier event does; list each "
+                             f"event of a pair once")
 
 
 def _named(bodies: Any, names: Sequence[str], perturbers: Sequence[str], where: str

@@ -173,6 +173,22 @@ def test_a_small_body_about_one_moving_point_follows_kepler_at_the_right_times(m
     assert np.abs(np.outer(days, w / au)).max() > 1.0  # (a clock stuck would miss by 1 au)
 
 
+def test_one_effect_named_as_a_string_is_that_effect():
+    """``effects="eih"`` was read letter by letter ("got 'e' at index 0"); one name
+    is that effect, as the n-body front door takes it: the same bits as ("eih",)."""
+    from astropy.time import Time
+
+    from hamilton_orbits.small_bodies import propagate
+
+    segments = Segments.load(EXCERPT)
+    r, v = _asteroids()
+    epoch = Time(2451545.0, 0.25, format="jd", scale="tdb")
+    one, listed = (propagate(r * u.au, v * u.au / u.day, epoch, 20 * u.day, ephemeris=segments,
+                             asteroids=False, effects=effects) for effects in ("eih", ("eih",)))
+    assert one.r.value.tolist() == listed.r.value.tolist()
+    assert one.v.value.tolist() == listed.v.value.tolist()
+
+
 def test_a_run_forward_then_backward_returns_to_its_start():
     """Three small bodies, every effect and a comet's and a Yarkovsky push, 400 days
     forward and back from the end (the
@@ -206,6 +222,10 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(method="wh"), "`method`"),
     (dict(nongrav={"A4": 1e-14}), "`nongrav` mappings"),
     (dict(nongrav=[None, {"A2": np.nan}, None]), "`nongrav` A2 .* at index 1"),
+    # (a length for an acceleration was a bare UnitConversionError naming neither)
+    (dict(nongrav=[None, {"A1": 1e-8 * u.au}, None]),
+     r"Expected `nongrav` A1 to be an acceleration \(such as AU / d2\), got "
+     r"<Quantity 1.e-08 AU> at index 1"),
     (dict(nongrav=[None]), "`nongrav` to be a mapping or one per body"),
     (dict(variational=1), "`variational` to be True or False"),
     (dict(stm="yes"), "`stm` to be True or False"),

@@ -166,6 +166,11 @@ def test_only_the_named_small_bodies_are_watched(excerpt, flyby):
     ({"name": "close_encounter"}, {}, "Expected `events` to be a list of mappings"),
     ([{"name": "close_encounter", "bodies": "earth", "distance": 0.1}], {"stm": True},
      "`events` are watched without `stm` or `variational`"),
+    # (the same watch twice recorded each encounter twice; the n-body events refuse it)
+    ([{"name": "close_encounter", "bodies": "earth", "distance": 0.1},
+      {"name": "close_encounter", "bodies": ["earth", "rock"], "distance": 0.1}], {},
+     r"Event at index 1 watches rock-earth within 0.1 au as an earlier event does; list "
+     r"each event of a pair once"),
 ])
 def test_bad_events_are_refused_by_name(excerpt, flyby, events, kw, message):
     with pytest.raises(ValueError, match=message):
