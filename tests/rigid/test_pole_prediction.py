@@ -490,6 +490,29 @@ def test_hindcast_scores_each_horizon_against_its_own_date_across_a_gap(record):
     assert score.table["count"].tolist() == [1, 0, 1]
 
 
+def test_a_day_missing_in_the_history_is_named(record):
+    """A record with a day missing in the history before ``at`` (or a weekly one)
+    was refused with "Expected `at` within the record, from 1964 to 2026, got
+    2019-01-01": a date plainly within it.  The message names the day missing."""
+    at = Time("2019-01-01", scale="utc")
+    drop = int(np.searchsorted(record.time.mjd, at.mjd)) - 100
+    keep = np.ones(len(record), bool)
+    keep[drop] = False
+    gap = PolarMotionRecord(record.time[keep], record.x[keep], record.y[keep], "a gap")
+    missing = record.time[drop].iso[:10]
+    with pytest.raises(ValueError, match=rf"Expected a daily record without gaps over the "
+                                         rf"\d+ days of history up to `at` less the 1 d "
+                                         rf"latency, got 2019-01-01 00:00:00.000: {missing} is "
+                                         rf"not in the record"):
+        polar_motion.predict(gap, at=at, horizon=30 * u.day, method="ls")
+    weekly = PolarMotionRecord(record.time[::7], record.x[::7], record.y[::7])
+    with pytest.raises(ValueError, match=r"Expected a daily record without gaps"):
+        polar_motion.predict(weekly, at=weekly.time[-100] + 1 * u.day, horizon=30 * u.day,
+                             method="ls")
+    with pytest.raises(ValueError, match=r"Expected `at` at 0h UTC within the record"):
+        polar_motion.predict(record, at=Time("1963-01-01"), horizon=30 * u.day, method="ls")
+
+
 def test_hindcast_docstring_imports_what_it_uses():
     """The example of hindcast (reached through rigid.polar_motion) imports weekly_starts
     from where it lives: the docstring runs as written in a fresh namespace (issue 34)."""

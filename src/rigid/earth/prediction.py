@@ -167,12 +167,25 @@ def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
         i = int(np.argmin(ok))
         first = Time(mjd[0] + history - 1 + latency, format="mjd", scale="utc").iso[:10]
         last = Time(mjd[-1] + latency, format="mjd", scale="utc").iso[:10]
+        got = (f"{Time(at[i], format='mjd', scale='utc').iso}"
+               f"{f' at index {i}' if at.size > 1 else ''}")
+        if mjd[0] + history - 1 <= target[i] <= mjd[-1] and target[i] == round(target[i]):
+            raise ValueError(  # (within the span: a day missing, or not a daily record)
+                f"Expected a daily record without gaps over the {history} days of history "
+                f"up to `{name}` less the {latency} d latency, got {got}: "
+                f"{_first_missing(mjd, target[i] - history + 1, target[i])} is not in the "
+                f"record")
         raise ValueError(
             f"Expected `{name}` at 0h UTC within the record, from {first} ({history} days "
-            f"of history plus the {latency} d latency) to {last}, got "
-            f"{Time(at[i], format='mjd', scale='utc').iso}"
-            f"{f' at index {i}' if at.size > 1 else ''}")
+            f"of history plus the {latency} d latency) to {last}, got {got}")
     return k
+
+
+def _first_missing(mjd: np.ndarray, start: float, end: float) -> str:
+    """The first day from ``start`` to ``end`` (MJD, whole days) not in ``mjd``."""
+    days = np.arange(start, end + 1)
+    missing = days[~np.isin(days, mjd)]
+    return Time(missing[0], format="mjd", scale="utc").iso[:10]
 
 
 def _as_mjd(name: str, value: Any) -> np.ndarray:
@@ -237,7 +250,8 @@ def predict(
     Parameters
     ----------
     record : PolarMotionRecord
-        From :func:`rigid.polar_motion.load_c04`.
+        From :func:`rigid.polar_motion.load_c04`: daily values (0h UTC), without a day
+        missing over the method's history before ``at``.
     at : Time or str
         The start date (0h UTC), e.g. ``"2019-01-01"``.  Only epochs up to
         ``at - latency`` are used.
@@ -256,7 +270,8 @@ def predict(
     ------
     ValueError
         For an unknown method, an empty record, ``at`` outside the record (or without
-        the method's history before it), a horizon or latency that is not a single
+        the method's history before it, or with a day missing in it: the first
+        missing day named), a horizon or latency that is not a single
         whole number of days, a latency below a day, a lead ``latency + horizon`` beyond
         the method's ``rigid.earth.forecasters.max_lead`` (ten years; five for
         ``"persistence"``), or data in the history used that are not finite or jump
