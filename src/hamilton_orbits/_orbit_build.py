@@ -7,6 +7,8 @@ index, which Hamilton's products (:mod:`hamilton_orbits._hamilton_products`) sha
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
@@ -30,16 +32,21 @@ __all__ = ["anomaly_of", "element_inputs", "p_and_inv_a", "raise_at", "state_of"
 _L, _MU = STATE_UNITS[0], STATE_UNITS[2]
 
 
-def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str) -> None:
-    """Raise ValueError naming ``name``, the first index where ``mask`` and its value."""
+def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str,
+             given: Any = None) -> None:
+    """Raise ValueError naming ``name``, the first index where ``mask`` and its value:
+    as ``given`` (the argument as the caller wrote it) has it when that is a Quantity
+    (``values`` are in the internal units: "got -3.0 AU", not "-448793612.1")."""
     if np.any(mask):
         mask = np.atleast_1d(mask)
         values = np.broadcast_to(np.atleast_1d(values), mask.shape)
         index = first_index(mask)
         shown = index if np.ndim(mask) and mask.size > 1 else ()
-        raise ValueError(
-            f"Expected `{name}` {what}, got {float(values[index])!r}{fmt_index(shown)}"
-        )
+        value = repr(float(values[index]))
+        if is_quantity(given):
+            number = np.broadcast_to(np.atleast_1d(given.value), mask.shape)[index]
+            value = f"{float(number)!r} {given.unit.to_string()}"
+        raise ValueError(f"Expected `{name}` {what}, got {value}{fmt_index(shown)}")
 
 
 def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
@@ -68,23 +75,24 @@ def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
         GM("mu", mu, _MU), LENGTH(lname, lval, _L), ANGLE(aname, aval),
     )
     e_, inc_, lan_, argp_, mu_, length, angle = values
-    raise_at("e", ~(e_ >= 0), e_, ">= 0")
+    raise_at("e", ~(e_ >= 0), e_, ">= 0", e)
     check_positive("mu", mu_)
-    raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi]")
+    raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi] rad", inc)
     return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
 
 
-def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray):
+def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray, given: Any = None):
     """``(p, 1/a, radial)`` from ``a``, ``p`` or ``q`` (``lname``) and ``e``;
     ``radial`` where ``e == 1`` with ``a`` given (the rectilinear orbit of that
-    energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0."""
+    energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0 (``given``:
+    the length as written, for the message)."""
     if lname != "a":
-        raise_at(lname, ~(length > 0), length, "> 0")
+        raise_at(lname, ~(length > 0), length, "> 0", given)
         p = length if lname == "p" else length * (1.0 + e)
         return p, (1.0 - e) * (1.0 + e) / p, np.zeros(e.shape, dtype=bool)
-    raise_at("a", length == 0, length, "nonzero")
-    raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)")
-    raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)")
+    raise_at("a", length == 0, length, "nonzero", given)
+    raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)", given)
+    raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)", given)
     radial = e == 1.0
     with np.errstate(over="ignore"):  # (a p beyond float64: refused by the caller's check)
         p = length * (1.0 - e) * (1.0 + e)
@@ -92,17 +100,19 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray):
     return p, inv_a, radial
 
 
-def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray):
+def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
+               given: Any = None):
     """The anomaly (E, D or F by ``e``) from ``nu`` or ``M`` (``aname``); NaN
     for a radial orbit (its M is solved by :func:`_radial_from_mean`).
     Refuses ``nu`` for a radial orbit or beyond the asymptote, and a Kepler
     equation not solved (ConvergenceError)."""
     if aname == "nu":
         raise_at(
-            "nu", radial, angle, "to be replaced by `M` for a radial orbit (e == 1, a given)"
-        )
+            "nu", radial, angle, "to be replaced by `M` for a radial orbit (e == 1, a given)",
+            given)
         anom = np.asarray(_kk.anomaly_from_nu_ufunc(angle, e))
-        raise_at("nu", ~np.isfinite(anom), angle, "inside the asymptotes (1 + e cos nu > 0)")
+        raise_at("nu", ~np.isfinite(anom), angle, "inside the asymptotes (1 + e cos nu > 0)",
+                 given)
         return anom
     with np.errstate(invalid="ignore"):
         anom = np.asarray(_kk.solve_ufunc(angle, np.where(radial, 0.0, e)))

@@ -818,3 +818,20 @@ def test_every_wall_as_a_time_quantity_or_a_numpy_number_is_taken(tmp_path):
         assert sim._archive.every_wall == seconds and type(sim._archive.every_wall) is float
     with pytest.raises(u.UnitConversionError, match=r"Expected `every_wall` to be a time"):
         Simulation(s, archive=tmp_path / "m", every_wall=1 * u.m)
+
+
+@pytest.mark.parametrize(("kw", "pattern"), [
+    (dict(a=[1, 2, -3] * u.au, e=0.1, inc=10 * u.deg),
+     r"Expected `a` > 0 for e < 1 \(a and e inconsistent\), got -3.0 AU at index 2"),
+    (dict(a=1 * u.au, e=0.1, inc=[10, 190] * u.deg),
+     r"Expected `inc` in \[0, pi\] rad, got 190.0 deg at index 1"),
+    (dict(q=-1 * u.au, e=0.1, inc=10 * u.deg), r"Expected `q` > 0, got -1.0 AU$"),
+])
+def test_element_errors_quote_the_value_as_written(kw, pattern):
+    """The values were quoted in the internal units without a unit ("got
+    -448793612.09999996 at index 2" for -3 au; 3.3161255787892263 for 190 deg)."""
+    from hamilton_orbits import KeplerOrbit
+
+    mu = 1.32712440018e11 * u.km**3 / u.s**2
+    with pytest.raises(ValueError, match=pattern):
+        KeplerOrbit.from_elements(**kw, lan=0 * u.deg, argp=0 * u.deg, M=0 * u.deg, mu=mu)
