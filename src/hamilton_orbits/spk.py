@@ -115,26 +115,25 @@ class Segments:
                                            np.ascontiguousarray(data[key]))
         return cls(out)
 
-    def states(self, jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-        """Barycentric ICRF positions and velocities (au, au/day) of ``names`` at TDB
-        Julian dates ``jd`` (n_t,): arrays (n_t, n, 3).
+    def states(self, jd: np.ndarray, names: Sequence[str] | str) -> tuple[np.ndarray, np.ndarray]:
+        """Barycentric ICRF positions and velocities (au, au/day) of ``names`` (body
+        names; one name alone is a list of one) at TDB Julian dates ``jd`` (n_t,):
+        arrays (n_t, n, 3).
 
         Raises
         ------
         ValueError
-            For a body without its segments here, or a date they do not cover,
-            naming it.
+            For dates that are not one date or a 1-d array of finite numbers, a body
+            without its segments here, or a date they do not cover, naming it (all
+            but the last before anything is compiled).
         """
-        jd = np.atleast_1d(np.asarray(jd, dtype=np.float64))
+        jd = de.checked_jd(jd)
+        chains = self._chains(names)
         jd1 = np.floor(jd)
         jd2 = jd - jd1
         au = de.constant("AU")
-        out = np.zeros((len(names), jd.shape[0], 6))
-        for k, name in enumerate(names):
-            chain = CHAINS.get(str(name).lower()) or de.ASTEROID_CHAINS.get(str(name).lower())
-            if chain is None or any(pair not in self.segments for pair in chain):
-                raise ValueError(f"Expected `names` among the bodies of these segments, got "
-                                 f"{name!r} at index {k}")
+        out = np.zeros((len(chains), jd.shape[0], 6))
+        for k, (name, chain) in enumerate(chains):
             for pair in chain:
                 seg = self.segments[pair]
                 bad = add_states(seg.coef, seg.init, seg.intlen, jd1, jd2, out[k])
@@ -145,3 +144,18 @@ class Segments:
                                      f"index {bad}")
         out /= au
         return out[:, :, :3].transpose(1, 0, 2).copy(), out[:, :, 3:].transpose(1, 0, 2).copy()
+
+    def _chains(self, names: Sequence[str] | str) -> list[tuple[str, tuple[tuple[int, int], ...]]]:
+        """Each of ``names`` (one name alone: a list of one) with its chain of segments,
+        all of them here (``ValueError`` naming `names`, the index and the value)."""
+        if isinstance(names, str):
+            names = [names]
+        out = []
+        for k, name in enumerate(names):
+            key = str(name).lower()
+            chain = CHAINS.get(key) or de.ASTEROID_CHAINS.get(key)
+            if chain is None or any(pair not in self.segments for pair in chain):
+                raise ValueError(f"Expected `names` among the bodies of these segments, got "
+                                 f"{name!r} at index {k}")
+            out.append((name, chain))
+        return out

