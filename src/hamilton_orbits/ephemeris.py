@@ -589,12 +589,12 @@ def _unshipped(jd: np.ndarray, k: np.ndarray, shipped: np.ndarray, names: Sequen
         i = int(np.flatnonzero(~shipped)[0])
         return ("Expected `jd` among the shipped table's dates (J2000 + 0..100 Julian years, "
                 f"JD 2451545.0 + 365.25 k) without DE440's kernel, got {float(jd[i])!r} at "
-                f"index {i}; other dates need the kernel: {EXTRA_HINT}")
+                f"index {i}: any other date needs the kernel: {EXTRA_HINT}")
     i = int(np.flatnonzero(k != 0)[0])
     j, name = next((j, n) for j, n in enumerate(names) if n not in ref_names)
     return (f"Expected `bodies` among the shipped yearly table's ({', '.join(ref_names)}) at "
             f"JD {float(jd[i])!r} (index {i} of `jd`), got {name!r} at index {j}: the shipped "
-            "table holds the Sun and the asteroids at J2000 only, other dates need the "
+            "table holds the Sun and the asteroids at J2000 only, any other date needs the "
             f"kernel: {_SMALL_HINT if name in _ASTEROID_NUMBER else EXTRA_HINT}")
 
 
