@@ -33,9 +33,18 @@ import numpy as np
 
 from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
+from hamilton_orbits._orbit_build import raise_at
 from hamilton_orbits.twobody import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
-from hamilton_orbits.validation import check_trailing, first_index, fmt_index
+from hamilton_orbits.validation import (
+    as_flag,
+    as_float_array,
+    broadcast,
+    check_positive,
+    check_trailing,
+    first_index,
+    fmt_index,
+)
 
 __all__ = ["Conic"]
 
@@ -73,6 +82,49 @@ def _in_range(method):
         return out
 
     return guarded
+
+
+_ELEMENTS = ("p", "e", "inv_a", "inc", "lan", "argp", "mu")
+# |(1 - e^2) - p/a| allowed, in units of eps max(1, e)^2 (the elements of a state,
+# twobody.classical_columns, stay within 4 over the contract's magnitudes)
+_CONSISTENT = 64.0 * np.finfo(float).eps
+
+
+def _checked_elements(*values: Any) -> list[np.ndarray]:
+    """The arguments ``p, e, inv_a, inc, lan, argp, mu`` of :meth:`Conic.from_elements`
+    as float arrays (their own shapes), refused as :meth:`KeplerOrbit.from_elements
+    <hamilton_orbits.KeplerOrbit.from_elements>` refuses its own: each finite plain
+    floats, ``e >= 0``, ``inc`` in [0, pi], ``mu > 0``; and ``p >= 0`` (0 only for
+    the radial orbit, ``e == 1``), ``1/a`` of the sign of ``1 - e`` and equal to
+    ``(1 - e^2)/p`` to rounding.  ValueError naming the argument, the first bad
+    index and the value."""
+    arrays = []
+    for name, x in zip(_ELEMENTS, values, strict=True):
+        if is_quantity(x):
+            raise ValueError(
+                f"Expected `{name}` as plain floats (km, km^3/s^2 and rad with "
+                f"`quantity=True`), got the Quantity {x}"
+            )
+        arrays.append(as_float_array(name, x))
+    p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
+    raise_at("p", ~(p >= 0), p, ">= 0")
+    raise_at("e", ~(e >= 0), e, ">= 0")
+    raise_at("p", (p == 0) & (e != 1), p, "> 0 for e != 1 (p = 0 is a radial orbit, e = 1)")
+    raise_at("inv_a", (e < 1) & ~(inv_a > 0), inv_a, "> 0 for e < 1 (inv_a and e inconsistent)")
+    raise_at("inv_a", (e > 1) & ~(inv_a < 0), inv_a, "< 0 for e > 1 (inv_a and e inconsistent)")
+    m = np.maximum(e, 1.0)
+    with np.errstate(all="ignore"):  # (scaled by max(1, e)^2; an overflow here is inconsistent)
+        off = np.abs((1.0 - e) / m * ((1.0 + e) / m) - (p / m) * (inv_a / m)) > _CONSISTENT
+        if np.any(off):
+            i = first_index(np.atleast_1d(off)) if off.ndim else ()
+            want = (1.0 - e[i]) * (1.0 + e[i]) / p[i]
+            raise ValueError(
+                f"Expected `inv_a` = (1 - e^2)/p = {float(want)!r} (inv_a, p and e "
+                f"inconsistent), got {float(inv_a[i])!r}{fmt_index(i if off.size > 1 else ())}"
+            )
+    raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi]")
+    check_positive("mu", mu)
+    return arrays
 
 
 class Conic:
@@ -160,12 +212,16 @@ class Conic:
         ----------
         p, e, inv_a : array_like, shape (...)
             Semi-parameter, eccentricity and 1/a (0 for the parabola), as
-            :class:`~hamilton_orbits.orbit.KeplerOrbit` computes them.
+            :class:`~hamilton_orbits.orbit.KeplerOrbit` computes them: finite,
+            ``e >= 0``, ``p > 0`` (``p = 0`` only for a radial orbit, ``e = 1``),
+            ``1/a`` of the sign of ``1 - e`` and ``p/a = 1 - e^2`` to rounding
+            (64 eps ``max(1, e)^2``).
         inc, lan, argp : array_like, shape (...)
-            Inclination (``inc == pi``, the float, is exactly retrograde),
-            longitude of the ascending node, argument of periapsis, in rad.
+            Inclination in [0, pi] (``inc == pi``, the float, is exactly
+            retrograde), longitude of the ascending node, argument of
+            periapsis, in rad, finite.
         mu : array_like, shape (...)
-            Gravitational parameter.
+            Gravitational parameter, finite and > 0.
         quantity : bool, optional
             Whether the floats are in km and km^3/s^2 and the conic's lengths
             and speeds are to be Quantities (as for a Quantity orbit).
@@ -178,12 +234,25 @@ class Conic:
             ``n = (cos lan, sin lan, 0)`` points to the ascending node and
             ``m`` is the normal times ``n``.
 
+        Raises
+        ------
+        ValueError
+            For an argument outside that domain (a Quantity included), or the
+            arguments not broadcasting together, naming the argument, the
+            first offending index and the value.
+
         Examples
         --------
         >>> c = Conic.from_elements(1.44, 0.44, 0.56, 0.0, 0.0, 0.0, 1.0)
         >>> c.periapsis_direction.tolist(), c.normal.tolist(), float(c.a)
         ([1.0, 0.0, 0.0], [0.0, -0.0, 1.0], 1.7857142857142856)
+        >>> Conic.from_elements(1.44, [0.44, -0.5], 0.56, 0.0, 0.0, 0.0, 1.0)
+        Traceback (most recent call last):
+        ...
+        ValueError: Expected `e` >= 0, got -0.5 at index 1
         """
+        p, e, inv_a, inc, lan, argp, mu = _checked_elements(p, e, inv_a, inc, lan, argp, mu)
+        quantity = as_flag("quantity", quantity)
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))

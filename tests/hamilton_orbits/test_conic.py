@@ -7,7 +7,7 @@ import math
 import astropy.units as u
 import numpy as np
 import pytest
-from hard_cases import perifocal_state
+from hard_cases import CASES, perifocal_state
 
 from hamilton_orbits.conic import Conic
 from hamilton_orbits.orbit import KeplerOrbit
@@ -238,3 +238,64 @@ def test_the_vectors_and_the_conics_lengths_scale_with_the_state(length, time):
                          ("radial_speed_squared", (length / time) ** 2)):
         want = getattr(one.conic, name)(rn) * factor
         assert getattr(scaled.conic, name)(rn * length) == pytest.approx(want, rel=8e-16)
+
+
+# p, e, inv_a, inc, lan, argp, mu of the ellipse of the docstrings (p/a = 1 - e^2 exactly)
+GOOD = {"p": 1.44, "e": 0.44, "inv_a": 0.56, "inc": 0.1, "lan": 0.2, "argp": 0.3, "mu": 1.0}
+
+
+@pytest.mark.parametrize(("bad", "message"), [
+    ({"e": [0.44, np.nan]}, r"Expected `e` to be finite, got nan at index 1"),
+    ({"e": [0.44, 0.44, -0.5]}, r"Expected `e` >= 0, got -0.5 at index 2"),
+    ({"p": -1.0}, r"Expected `p` >= 0, got -1.0$"),
+    ({"p": [1.44, np.inf]}, r"Expected `p` to be finite, got inf at index 1"),
+    ({"p": 0.0}, r"Expected `p` > 0 for e != 1 \(p = 0 is a radial orbit, e = 1\), got 0.0$"),
+    ({"inv_a": -0.75}, r"Expected `inv_a` > 0 for e < 1 \(inv_a and e inconsistent\), got -0.75$"),
+    ({"inv_a": 0.0}, r"Expected `inv_a` > 0 for e < 1 .*got 0.0$"),
+    ({"p": 1.25, "e": 1.5, "inv_a": [-1.0, 0.5]}, r"Expected `inv_a` < 0 for e > 1 .*got 0.5 at "
+                                                 r"index 1"),
+    ({"inv_a": 100.0}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.56.* \(inv_a, p and e "
+                       r"inconsistent\), got 100.0$"),
+    ({"e": 1.0, "inv_a": 0.1}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.0 .*got 0.1$"),
+    ({"inc": 5.0}, r"Expected `inc` in \[0, pi\], got 5.0$"),
+    ({"inc": [0.1, -0.1]}, r"Expected `inc` in \[0, pi\], got -0.1 at index 1"),
+    ({"lan": np.nan}, r"Expected `lan` to be finite, got nan$"),
+    ({"argp": [0.3, -np.inf]}, r"Expected `argp` to be finite, got -inf at index 1"),
+    ({"mu": -1.0}, r"Expected `mu` > 0, got -1.0$"),
+    ({"mu": np.inf}, r"Expected `mu` to be finite, got inf$"),
+    ({"mu": None}, r"Expected `mu` to be numeric, got None"),
+    ({"p": 1.44 * u.km}, r"Expected `p` as plain floats .*got the Quantity 1.44 km"),
+    ({"e": [0.44, 0.44], "p": [1.44, 1.44, 1.44]}, r"Expected `p`, `e`, .* to broadcast"),
+])
+def test_from_elements_refuses_bad_elements_by_name(bad, message):
+    """Conic.from_elements checked nothing: e = NaN gave a NaN second focus and
+    later "nu inside the asymptotes (e = nan)"; e = -0.5 gave radius(0) = 2.0;
+    p = -1 gave b = NaN with a RuntimeWarning, radius(0) = -0.67 and a hodograph
+    refused as "a radial orbit (p = 0)"; inc = 5 rad, 1/a < 0 with e < 1 and
+    1/a far from (1 - e^2)/p were taken; mu = -1 made the hodograph blame `r`.
+    Now a ValueError naming the argument, the first offending index and the value."""
+    args = {**GOOD, **bad}
+    with pytest.raises(ValueError, match=message):
+        Conic.from_elements(*args.values())
+
+
+def test_from_elements_refuses_a_quantity_flag_that_is_not_a_bool():
+    """``quantity="no"`` (any non-empty text is true) made the conic one of Quantities."""
+    with pytest.raises(ValueError, match=r"Expected `quantity` to be True or False, got 'no'"):
+        Conic.from_elements(*GOOD.values(), quantity="no")
+
+
+def test_from_elements_takes_every_conic_the_orbits_make():
+    """The domain's edges stay open: the radial orbit (p = 0, e = 1, any 1/a), the
+    parabola (1/a = 0), the quasi-rectilinear e = 1 with p/a ~ eps, the circle,
+    inc = 0 and pi; and the conic of every hard-case orbit."""
+    for p, e, inv_a in ((0.0, 1.0, 0.5), (0.0, 1.0, 0.0), (0.0, 1.0, -0.5), (2.0, 1.0, 0.0),
+                        (1e-20, 1.0, 1.0), (1.0, 0.0, 1.0), (1.25, 1.5, -1.0)):
+        for inc in (0.0, math.pi):
+            c = Conic.from_elements(p, e, inv_a, inc, 0.0, 0.0, 1.0)
+            assert c.normal.tolist() == [0.0, 0.0, 1.0 if inc == 0 else -1.0]
+    r = np.array([c.r for c in CASES])
+    v = np.array([c.v for c in CASES])
+    mu = np.array([c.mu for c in CASES])
+    conic = KeplerOrbit.from_state(r, v, mu).conic
+    assert conic.e.shape == (len(CASES),)
