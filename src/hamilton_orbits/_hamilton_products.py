@@ -19,10 +19,11 @@ import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._orbit_build import raise_at
+from hamilton_orbits._quaternion_arrays import NO_SCALE, scale_exactly
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.twobody import STATE_UNITS
 from hamilton_orbits.units import GM, LENGTH, SPEED, require_consistent, wrap
-from hamilton_orbits.validation import check_positive, check_trailing
+from hamilton_orbits.validation import broadcast_shapes, check_positive, check_trailing
 
 # astropy is imported on first use (hamilton_orbits._lazy)
 u = LazyModule("astropy.units", globals(), "u")
@@ -40,12 +41,14 @@ def _hamilton_args(r: Any, v: Any, *mu: Any):
     r_ = check_trailing("r", LENGTH("r", r, _L), 3)
     v_ = check_trailing("v", SPEED("v", v, _V), 3)
     mu_ = check_positive("mu", GM("mu", mu[0], _MU)) if mu else None
+    broadcast_shapes(("r", "v", "mu")[: 2 + len(mu)], r_.shape[:-1], v_.shape[:-1],
+                     *((np.shape(mu_),) if mu else ()))
     return r_, v_, mu_, quantity
 
 
-def _finite_or_raise(f, r: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _finite_or_raise(f, r: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
     """``f(r, v)`` without floating-point warnings; a result beyond float64
-    raises ValueError naming ``r`` and ``v``."""
+    raises ValueError naming ``r`` and ``v`` (and Hamilton's ``name``)."""
     with np.errstate(all="ignore"):
         try:
             out = np.asarray(f(r, v))
@@ -53,16 +56,24 @@ def _finite_or_raise(f, r: np.ndarray, v: np.ndarray) -> np.ndarray:
             out = np.asarray(np.inf)
     if not np.all(np.isfinite(out)):
         raise ValueError(
-            f"Expected `r`, `v` (and `mu`) for which Hamilton's {f.__name__.split('_')[0]} "
-            f"fits in float64, got r={r.tolist()}, v={v.tolist()}"
+            f"Expected `r`, `v` (and `mu`) for which Hamilton's {name} fits in float64, "
+            f"got r={r.tolist()}, v={v.tolist()}"
         )
     return out
 
 
 def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
-    alpha = Quaternion.from_vector(r)
-    dalpha = Quaternion.from_vector(v)
-    return ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+    """beta of ``r`` and ``v`` each scaled by a power of two (exact), then scaled
+    back: the scalar part of ``alpha alpha'`` (``-r . v``), which beta does not keep,
+    cannot overflow (r, v of 1e160 gave no beta of 1e60)."""
+    rs, er, _ = scale_exactly(r)
+    vs, ev, _ = scale_exactly(v)
+    alpha = Quaternion.from_vector(rs)
+    dalpha = Quaternion.from_vector(vs)
+    beta = ((alpha * dalpha - dalpha * alpha) * 0.5).vector
+    if er is NO_SCALE and ev is NO_SCALE:
+        return beta
+    return np.ldexp(beta, np.broadcast_to(er + ev, beta.shape[:-1])[..., None])
 
 
 def hamilton_beta(r: Any, v: Any):
@@ -98,7 +109,7 @@ def hamilton_beta(r: Any, v: Any):
     <Quantity [0., 0., 2.] km2 / s>
     """
     r_, v_, _, quantity = _hamilton_args(r, v)
-    return wrap(_finite_or_raise(_beta, r_, v_), "km2 / s", quantity)
+    return wrap(_finite_or_raise(_beta, r_, v_, "beta"), "km2 / s", quantity)
 
 
 def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
@@ -149,7 +160,7 @@ def hamilton_epsilon_from_products(r: Any, v: Any, mu: Any):
         beta = Quaternion.from_vector(_beta(r_, v_))
         return (iota - (dalpha * beta) * (1.0 / mu_)).vector
 
-    return wrap(_finite_or_raise(eps_of, r_, v_), "", quantity)
+    return wrap(_finite_or_raise(eps_of, r_, v_, "epsilon"), "", quantity)
 
 
 def hamilton_p(r: Any, v: Any, mu: Any):
@@ -176,4 +187,4 @@ def hamilton_p(r: Any, v: Any, mu: Any):
         beta = Quaternion.from_vector(_beta(r_, v_))
         return -(beta * beta).scalar / mu_
 
-    return wrap(_finite_or_raise(p_of, r_, v_), _L, quantity)
+    return wrap(_finite_or_raise(p_of, r_, v_, "p"), _L, quantity)

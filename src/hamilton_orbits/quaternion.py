@@ -129,12 +129,18 @@ class Quaternion(RotationForms):
         if isinstance(array, Quaternion):
             self._a = array._a
             return
-        self._a = dimensionless("array", array, 4)
+        a = dimensionless("array", array, 4)
+        if isinstance(array, np.ndarray) and np.may_share_memory(a, array):
+            a = a.copy()  # (the caller's buffer, refilled, changed checked components)
+        a.flags.writeable = False
+        self._a = a
 
     @classmethod
     def _wrap(cls, a: np.ndarray) -> Quaternion:
-        """Wrap an already validated float array without copying or checking."""
+        """Wrap an already validated float array without copying or checking (made
+        read-only: the components, and the views the accessors give, are fixed)."""
         obj = object.__new__(cls)
+        a.flags.writeable = False
         obj._a = a
         return obj
 
@@ -167,7 +173,8 @@ class Quaternion(RotationForms):
 
     # ------------------------------------------------------------ exporters
     def as_array(self) -> np.ndarray:
-        """The components ``[w, x, y, z]`` as an ndarray of shape (..., 4)."""
+        """The components ``[w, x, y, z]`` as an ndarray of shape (..., 4) (read-only:
+        the quaternion's own; copy it to change it)."""
         return self._a
 
     # ------------------------------------------------------------ Hamilton's S, V, T, U
@@ -283,10 +290,11 @@ class Quaternion(RotationForms):
             b, e, nb = scale_exactly(other._a)
             raise_zero("other", nb, "division by the zero quaternion")
             inv_scaled = (b * CONJ) / (nb * nb)[..., None]  # (other / 2^e)^-1
+            a, ea, _ = scale_exactly(self._a)  # (both scaled: 1.7e308 / 1e300 is 1.7e8)
             with np.errstate(over="ignore"):
-                out = product(self._a, inv_scaled)[0]
-                if e is not NO_SCALE:
-                    out = np.ldexp(out, -e[..., None])
+                out = product(a, inv_scaled)[0]
+                if e is not NO_SCALE or ea is not NO_SCALE:
+                    out = np.ldexp(out, np.broadcast_to(ea - e, out.shape[:-1])[..., None])
             value = lambda: np.broadcast_to(other._a, out.shape)  # noqa: E731
         else:
             s = self._real(other)
@@ -298,9 +306,12 @@ class Quaternion(RotationForms):
 
     def __rtruediv__(self, other: Any) -> Quaternion:
         s = self._real(other)
-        inv = self._inverse_array()
+        b, e, nb = scale_exactly(self._a)  # (s times the scaled inverse, then its scale:
+        raise_zero("self", nb, "it has no inverse")  # 1e-10 / 1e-310 is 1e300, 0 / it 0)
         with np.errstate(over="ignore", invalid="ignore"):
-            out = s[..., None] * inv
+            out = s[..., None] * ((b * CONJ) / (nb * nb)[..., None])
+            if e is not NO_SCALE:
+                out = np.ldexp(out, np.broadcast_to(-e, out.shape[:-1])[..., None])
         value = lambda: np.broadcast_to(self._a, out.shape)  # noqa: E731
         return Quaternion._wrap(finite_or_raise("self", out, "the quotient", value))
 
@@ -510,6 +521,15 @@ class Quaternion(RotationForms):
             return NotImplemented
         return np.all(self._a == other._a, axis=-1)
 
+    def __ne__(self, other: object) -> Any:  # (not ``not ==``: a batch has no one truth)
+        if not isinstance(other, Quaternion):
+            return NotImplemented
+        return np.any(self._a != other._a, axis=-1)
+
+    def __bool__(self) -> bool:
+        raise TypeError("The truth value of a Quaternion is ambiguous: compare it (==, "
+                        "allclose) or its norm")
+
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
@@ -565,4 +585,12 @@ def slerp(q0: Quaternion, q1: Quaternion, t: Any) -> Quaternion:
     p = Quaternion._wrap(unit_last("q0", q0._a, "the zero quaternion is no rotation"))
     p1 = Quaternion._wrap(unit_last("q1", q1._a, "the zero quaternion is no rotation"))
     d = (p.conj() * p1).canonical()
-    return p * (d**t)
+    # d^t of the unit d as exp(t (0, angle axis)): its log|d| of an ulp or so, times a
+    # large t, shrank the result (|slerp| 0.33 at t = 1e16, 0 at 1e20)
+    lg = d.log().as_array().copy()
+    lg[..., 0] = 0.0
+    shape = broadcast_shapes(("q0", "q1", "t"), lg.shape[:-1], t.shape)
+    with np.errstate(over="ignore", invalid="ignore"):
+        turn = lg * t[..., None]
+    finite_or_raise("t", turn, "t times the angle", lambda: np.broadcast_to(t, shape))
+    return p * Quaternion._wrap(exp_components(turn, "t", lambda: np.broadcast_to(t, shape)))

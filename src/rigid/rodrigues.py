@@ -18,10 +18,11 @@ the body-frame angular velocity component along x_1.  With this identification
 his kinematic equations are exactly dq/dt = q (0, omega) / 2 written for
 g = q_vec / q_w (see :func:`gibbs_rate`).
 
-Composition (Cayley's Pi formulas): with (l, m, n) then (l_1, m_1, n_1),
-Pi = 1 - l l_1 - m m_1 - n n_1, Pi lambda = l + l_1 + n_1 m - n m_1, ...; this is
-the Hamilton product (1, g_a)(1, g_b) = (1 - g_a.g_b, g_a + g_b + g_a x g_b), so
-:func:`compose_gibbs` (g_a, g_b) is the Gibbs vector of q_a q_b.  His P_0 system
+Composition (Cayley's Pi formulas): of (l, m, n) and (l_1, m_1, n_1), as he
+writes them, Pi = 1 - l l_1 - m m_1 - n n_1, Pi lambda = l + l_1 + n_1 m - n m_1,
+...; this is the Hamilton product (1, g_a)(1, g_b) = (1 - g_a.g_b, g_a + g_b +
+g_a x g_b), so :func:`compose_gibbs` (g_a, g_b) is the Gibbs vector of q_a q_b:
+the active rotation g_b applied first, then g_a (R(q_a q_b) = R(q_a) R(q_b)).  His P_0 system
 (the end of the paper) writes the general solution of the kinematics as the
 composition of arbitrary constants (l, m, n) with a particular solution
 (lambda_0, mu_0, nu_0): q(t) = q_lmn q_0(t).  This is what re-centring uses: the
@@ -247,12 +248,15 @@ def compose_gibbs(first: Any, second: Any) -> np.ndarray:
     Pi mu = m + m_1 + l_1 n - l n_1, Pi nu = n + n_1 + m_1 l - m l_1
     (Cayley 1843, p. 226, with the cross terms as in his P_0 system; the
     transcription's Pi mu line prints "l m_1" for "l n_1").  The result is the
-    Gibbs vector of q(first) q(second) (Hamilton product).
+    Gibbs vector of q(first) q(second) (Hamilton product): as active rotations,
+    ``second`` is applied first, then ``first`` (``R(q(first) q(second)) =
+    R(q(first)) R(q(second))``; the names follow Cayley's order of writing).
 
     Parameters
     ----------
     first, second : array_like, shape (..., 3)
-        (l, m, n) and (l_1, m_1, n_1).
+        (l, m, n) and (l_1, m_1, n_1): the rotation applied second, and the one
+        applied first.
 
     Returns
     -------
@@ -266,7 +270,8 @@ def compose_gibbs(first: Any, second: Any) -> np.ndarray:
 
     Examples
     --------
-    Quarter turns about x then y (tan(pi/4) = 1):
+    A quarter turn about y, then one about x (tan(pi/4) = 1; z goes to x under
+    the first, and x stays under the second):
 
     >>> compose_gibbs([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     array([1., 1., 1.])

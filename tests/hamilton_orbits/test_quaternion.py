@@ -434,3 +434,103 @@ def test_closeness_refuses_a_tolerance_that_is_none(method, kw, pattern):
     with pytest.raises(ValueError, match=pattern):
         getattr(q, method)(q, **kw)
     assert getattr(q, method)(q) and getattr(q, method)(q, atol=0.0)
+
+
+def test_a_quaternion_keeps_its_components_when_the_callers_buffer_changes():
+    """``Quaternion(array)`` kept the caller's array and the accessors gave
+    writable views: three quaternions built from one reused buffer all had the
+    last one's components, and a buffer refilled with NaN after the check gave
+    NaN rotation matrices.  The components are copied where shared and
+    read-only."""
+    buf = np.empty(4)
+    made = []
+    for angle in (0.1, 0.2, 0.3):
+        buf[:] = [np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)]
+        made.append(Quaternion(buf))
+    np.testing.assert_allclose([q.as_axis_angle()[1] for q in made], [0.1, 0.2, 0.3],
+                               rtol=1e-15)
+    buf[1] = np.nan
+    assert np.isfinite(made[-1].as_rotation_matrix()).all()
+    for view in (made[0].as_array(), made[0].w, made[0].vector):
+        with pytest.raises(ValueError, match="read-only"):
+            view[...] = 5.0
+    product = made[0] * made[1]  # (results too)
+    with pytest.raises(ValueError, match="read-only"):
+        product.as_array()[0] = np.inf
+
+
+def test_not_equal_is_componentwise_for_a_batch_and_truth_is_refused():
+    """``a != b`` of a batch raised "the truth value of an array is ambiguous"
+    (Python's fallback ``not (a == b)``), and ``bool(q)`` said "len() of a single
+    (0-d) Quaternion"."""
+    a = Quaternion(np.eye(4))
+    b = Quaternion(np.eye(4)[[0, 2, 1, 3]])
+    assert (a != b).tolist() == [False, True, True, False]
+    assert (a == b).tolist() == [True, False, False, True]
+    with pytest.raises(TypeError, match="truth value of a Quaternion is ambiguous"):
+        bool(Quaternion([1.0, 0, 0, 0]))
+
+
+@pytest.mark.parametrize("t", [1e6, 1e10, 1e16, 1e20, -1e20])
+def test_slerp_with_a_large_parameter_stays_a_unit_rotation(t):
+    """q0 (q0^-1 q1)^t of unit quaternions is one: the ulp of |q0^-1 q1| in its
+    log, times t, shrank it to 0.33 at t = 1e16 and 0 at 1e20 (no rotation)."""
+    q0, q1 = Quaternion([1.0, 2.0, 3.0, 4.0]), Quaternion([0.0, 1.0, 0.0, 0.0])
+    s = slerp(q0, q1, t)
+    assert abs(float(s.norm()) - 1.0) <= 4 * EPS
+    # the turn about the same axis by t times the angle, modulo two turns, where
+    # that phase means anything (t angle's own rounding below a tenth of a radian)
+    p = q0 * (1.0 / float(q0.norm()))
+    axis, angle = (p.conj() * q1).canonical().as_axis_angle()
+    if abs(t) * angle * EPS < 0.1:
+        want = (p * Quaternion.from_axis_angle(axis, np.fmod(t * angle, 4 * np.pi)))
+        np.testing.assert_allclose(s.canonical().as_array(), want.canonical().as_array(),
+                                   rtol=0, atol=abs(t) * angle * 8 * EPS)
+
+
+def test_division_is_exact_in_scale():
+    """"Every operation is exact in scale" (docs/quaternion.md): 1.7e308 / 1e300
+    raised "the quotient overflows" while p * q.inverse() gave 1.7e8; a real over a
+    tiny quaternion (1e-10 / 1e-310, 0 / 1e-310) raised where the quotient is 1e300
+    and 0."""
+    p, q = Quaternion([1.7e308] * 4), Quaternion([1e300] * 4)
+    np.testing.assert_allclose((p / q).as_array(), (p * q.inverse()).as_array(), rtol=4 * EPS)
+    np.testing.assert_allclose((p / q).as_array(), [1.7e8, 0, 0, 0], rtol=4 * EPS, atol=1e-7)
+    tiny = Quaternion([2.0**-1000, 0.0, 0.0, 0.0])
+    assert (1e-10 / tiny).as_array().tolist() == [1e-10 * 2.0**1000, -0.0, -0.0, -0.0]
+    assert (0.0 / tiny).as_array().tolist() == [0.0, -0.0, -0.0, -0.0]
+    with pytest.raises(ValueError, match="quotient"):
+        Quaternion([1e300, 0, 0, 0]) / Quaternion([1e-300, 0, 0, 0])  # (1e600: refused)
+
+
+def test_the_rotation_kernel_gives_nan_for_the_zero_quaternion():
+    """``quaternion_kernels.qrot`` of the zero quaternion: NaN, which the caller
+    checks (its docstring); it raised ZeroDivisionError, from Python and from a
+    user's compiled kernel alike."""
+    from numba import njit
+
+    from hamilton_orbits.quaternion_kernels import qrot
+
+    @njit
+    def caller(w):
+        return qrot(w, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0)[0]
+
+    assert all(np.isnan(qrot(0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0)))
+    assert np.isnan(caller(0.0))
+    assert caller(1.0) == 1.0
+
+
+def test_hamiltons_products_name_shapes_and_survive_a_large_dot_product():
+    """A shape mismatch was reported as "Hamilton's  fits in float64" (an overflow,
+    its name empty); r, v of 1e160 with r x v = 1e60 raised, the scalar part
+    -r.v of alpha alpha' (which beta does not keep) overflowing."""
+    from hamilton_orbits.orbit import hamilton_beta, hamilton_p
+
+    with pytest.raises(ValueError, match=r"Expected `r`, `v` to broadcast together, got "
+                                         r"shapes \(2,\), \(3,\)"):
+        hamilton_beta(np.ones((2, 3)), np.ones((3, 3)))
+    r, v = np.array([1e160, 0.0, 0.0]), np.array([1e160, 1e-100, 0.0])
+    assert hamilton_beta(r, v).tolist() == np.cross(r, v).tolist()
+    np.testing.assert_allclose(hamilton_p(r, v, 1.0), 1e120, rtol=4 * EPS)
+    with pytest.raises(ValueError, match=r"Hamilton's beta fits in float64"):
+        hamilton_beta([1e200, 0.0, 0.0], [0.0, 1e200, 0.0])  # (r x v = 1e400 itself)

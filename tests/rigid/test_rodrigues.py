@@ -194,3 +194,13 @@ def test_omega_from_gibbs_rate_takes_the_quantity_gibbs_rate_gives():
     np.testing.assert_allclose(per_day.to_value(u.rad / u.s), w.value, rtol=1e-15, atol=0)
     with pytest.raises(u.UnitConversionError, match=r"Expected `gibbs_dot` to be a rate"):
         omega_from_gibbs_rate(g, [0.0, 0.0, 1.0] * u.m)
+
+
+def test_compose_gibbs_applies_its_second_argument_first():
+    """The docstring's example said "quarter turns about x then y" of
+    compose_gibbs(x, y): the result, q(x) q(y), turns about y first (z to x), then
+    about x (x stays), as active rotations compose (docs/quaternion.md)."""
+    g = compose_gibbs([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    z_to = Quaternion([1.0, *g]).rotate([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(z_to, [1.0, 0.0, 0.0], atol=4 * EPS)
+    assert "``second`` is applied first, then ``first``" in compose_gibbs.__doc__

@@ -75,6 +75,9 @@ def qrot(w, x, y, z, vx, vy, vz):  # pragma: no cover - compiled
     v2 = vx * vx + vy * vy + vz * vz
     if _Q2_LO < n2 < _Q2_HI and _V2_LO < v2 < _V2_HI:
         return _qrot_core(w, x, y, z, vx, vy, vz, n2)
+    if w == 0.0 and x == 0.0 and y == 0.0 and z == 0.0:  # (2 / |q|^2 would divide by 0:
+        nan = math.nan  # a ZeroDivisionError under numba's Python error model)
+        return nan, nan, nan
     mv = max(max(abs(vx), abs(vy)), abs(vz))
     if mv == 0.0:
         return vx, vy, vz
