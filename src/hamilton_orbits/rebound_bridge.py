@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._legs import leg_times
 from hamilton_orbits._rebound import particle_name
 from hamilton_orbits.effects import (
     EffectSet,
@@ -273,7 +274,9 @@ def crosscheck(
     system, t, method, effects, dt, tol, progress
         As for :func:`hamilton_orbits.integrate`; ``t`` an end time.
     trajectory : Trajectory, optional
-        A trajectory of ours already computed from ``system`` (it is not recomputed).
+        A trajectory of ours already computed from ``system`` (it is not recomputed):
+        of the same ``effects``, and ending at ``t`` (or ``t`` None: its end).  A
+        trajectory of other effects, or of another end, is refused.
 
     Returns
     -------
@@ -299,6 +302,7 @@ def crosscheck(
                                progress=progress)
     _check_same_start(system, trajectory)
     times = trajectory.t.to_value("day") if system.quantity else np.asarray(trajectory.t)
+    _check_same_run(system, trajectory, times, t, effects)
     r_all, v_all, wall, steps = rebound_trajectory(system, times, effects)
     arrays = system.as_arrays()
     energy, ang, _ = integral_errors(r_all, v_all, arrays.gm, times,
@@ -323,6 +327,25 @@ def crosscheck(
         rebound_angular_momentum_error=ang,
         length_unit="au" if system.quantity else "",
     )
+
+
+def _check_same_run(system: System, trajectory: Any, times: np.ndarray, t: Any,
+                    effects: EffectSet) -> None:
+    """Refuse a trajectory of other effects than ``effects`` (rebound would run other
+    physics: a gr trajectory checked against Newton's law showed 1e-4 for 1e-10) or
+    of another end than ``t`` (the check ran to the trajectory's end, unsaid)."""
+    theirs = tuple(n for n in getattr(trajectory, "effects", ()) if n != "newtonian")
+    mine = tuple(n for n in effects.names if n != "newtonian")
+    if theirs != mine:
+        raise ValueError(f"Expected `effects` to be those of `trajectory` ({list(theirs)}), "
+                         f"got {list(mine)}: rebound would integrate other physics; give the "
+                         f"trajectory's effects (with their parameters)")
+    if t is None:  # (the trajectory's own end)
+        return
+    end = float(leg_times(t, float(times[0]), system.quantity)[0][-1])
+    if not abs(end - times[-1]) <= 1e-12 * max(abs(end), abs(times[-1])):
+        raise ValueError(f"Expected `t` to be the end of `trajectory` ({float(times[-1])!r}"
+                         f"{' d' if system.quantity else ''}), got {t!r}")
 
 
 def _check_same_start(system: System, trajectory: Any) -> None:

@@ -835,3 +835,20 @@ def test_element_errors_quote_the_value_as_written(kw, pattern):
     mu = 1.32712440018e11 * u.km**3 / u.s**2
     with pytest.raises(ValueError, match=pattern):
         KeplerOrbit.from_elements(**kw, lan=0 * u.deg, argp=0 * u.deg, M=0 * u.deg, mu=mu)
+
+
+def test_a_crosscheck_of_a_trajectory_of_other_effects_or_end_is_refused():
+    """``crosscheck(system, t, trajectory=traj)`` of a gr trajectory, effects not
+    repeated, compared it with Newton's law in rebound (a "disagreement" of 1e-4
+    for 1e-10), and a trajectory ending at 50 yr checked "to 100 yr" ran to 50."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    gr = [{"name": "gr", "c": 1e4}]
+    traj = integrate(s, 2.0, method="dop853", effects=gr)
+    with pytest.raises(ValueError, match=r"Expected `effects` to be those of `trajectory` "
+                                         r"\(\['gr'\]\), got \[\]: rebound would integrate"):
+        crosscheck(s, 2.0, trajectory=traj)
+    with pytest.raises(ValueError, match=r"Expected `t` to be the end of `trajectory` "
+                                         r"\(2.0\), got 4.0"):
+        crosscheck(s, 4.0, effects=gr, trajectory=traj)
+    assert crosscheck(s, 2.0, effects=gr, trajectory=traj).relative_position_difference.max() \
+        < 1e-9
