@@ -164,7 +164,7 @@ def test_a_scene_the_run_would_refuse_exits_2_before_running(tmp_path, capsys):
     path.write_text(ESCAPE_SCENE.replace('name = "escape"\ndistance = "5 au"\n'
                                          'action = "remove"', 'name = "collision"'))
     assert main(["run", str(path), "--no-progress"]) == 2
-    assert "events[0]: no pair of bodies has radii" in capsys.readouterr().err
+    assert "events[0]: no pair of bodies with radii has a massive body" in capsys.readouterr().err
 
 
 def test_bad_scene_and_setting(capsys):

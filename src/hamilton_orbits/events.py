@@ -76,12 +76,14 @@ EVENTS: dict[str, tuple[int, tuple[str, ...], dict[str, str]]] = {
         "action": "'record' (default) or 'stop'",
     }),
     "collision": (2, ("stop", "merge"), {
-        "bodies": "two body names (default: every pair of bodies with radii)",
+        "bodies": "two body names (default: every pair of bodies with radii, one of "
+                  "them massive; two massless ones collide when named)",
         "action": "'stop' (default) or 'merge'",
     }),
     "escape": (3, ("record", "stop", "remove"), {
         "bodies": "body names (default: every body but the most massive)",
-        "distance": "a length from the centre of mass (required)",
+        "distance": "a length from the centre of mass (required; crossed outwards, "
+                    "or, in a backward run, outwards as time runs back: an entry)",
         "action": "'record' (default), 'stop' or 'remove'",
     }),
 }
@@ -226,7 +228,9 @@ def _event_rows(name: str, params: Mapping[str, Any], system: Any,
         top = int(np.argmax(arrays.gm))
         pairs = [(i, j) for i, j in pairs if top not in (i, j)]
     if name == "collision" and not pairs:
-        raise ValueError(f"{where}: no pair of bodies has radii (give Body(radius=...))")
+        raise ValueError(f"{where}: no pair of bodies with radii has a massive body (give "
+                         f"Body(radius=...); two massless bodies collide when named: "
+                         f"bodies=[a, b])")
     rows = []
     for i, j in pairs:
         if name == "collision":

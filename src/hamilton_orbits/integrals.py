@@ -493,9 +493,26 @@ def _runs(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, h: np.nda
         before = max([x for x in np.flatnonzero(far[:start])[-1:]] or [max(start - 1, 0)])
         after = min([x for x in end + np.flatnonzero(far[end:])[:1]] or [len(t) - 1])
         inv_a, e = _osculating(r, v, gm, i, c, (int(before), int(after)))
-        found.append(Encounter(i, b, c, float(t[k]), float(dist[k]), float(tau[k]),
-                               float(h[k]), int(before), int(after), inv_a, e))
+        found.append(Encounter(i, b, c, _closest_time(r, v, gm, t, k, i, b), float(dist[k]),
+                               float(tau[k]), float(h[k]), int(before), int(after), inv_a, e))
     return found
+
+
+def _closest_time(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, k: int,
+                  i: int, b: int) -> float:
+    """When body ``i`` passed closest to body ``b`` about output ``k``: its two-body
+    periapsis time about ``b`` where that falls between output ``k`` and the one
+    before (the approach seen between them: output 10 was reported for a
+    periapsis at 1.56), else the output's time."""
+    from hamilton_orbits._kernels import elements
+
+    d = (r[k, i] - r[k, b])[None]
+    w = (v[k, i] - v[k, b])[None]
+    since = np.empty(1)
+    elements.state_to_time_since_periapsis(d, w, np.array([gm[b] + gm[i]]), since)
+    when = float(t[k] - since[0])
+    lo, hi = sorted((float(t[max(k - 1, 0)]), float(t[k])))
+    return when if lo <= when <= hi else float(t[k])
 
 
 def _far(r: np.ndarray, gm: np.ndarray, i: int, b: int, c: int) -> np.ndarray:

@@ -264,7 +264,7 @@ def test_events_with_quantities_and_hill_radii():
     ([{"name": "escape"}], r"`distance` is required"),
     ([{"name": "collision", "action": "bounce"}], r"expected `action` one of 'stop', 'merge'"),
     ([{"name": "close_encounter", "distance": 0.1, "bodies": ["a", "x"]}], r"'x', which is not"),
-    (["collision"], r"no pair of bodies has radii"),
+    (["collision"], r"no pair of bodies with radii has a massive body"),
     ([{"name": "close_encounter", "distance": -1.0}], r"`distance` > 0"),
     # issue 32, class 13: a bare TypeError, a message not naming `hill`, an escape
     # recorded twice
@@ -530,3 +530,19 @@ def test_the_energy_error_after_a_merge_or_removal_is_finite_with_effects(effect
     gone = Simulation(tp, events=[{"name": "escape", "distance": 3.0, "action": "remove"}],
                       effects=[{"name": "gr", "c": 100.0}]).integrate([0, 5, 10, 20])
     assert len(gone.events) == 1 and np.all(np.isfinite(gone.energy_error))
+
+
+def test_two_massless_bodies_with_radii_collide_when_named():
+    """The default collision watch skips pairs of two massless bodies (they do
+    not act on each other): said so, and the error where no other pair has radii
+    ("no pair of bodies has radii", with two grains of radii) says how to watch
+    them; named, they collide."""
+    grains = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("a", 0.0, [1.0, 0, 0], [0, 1.0, 0], radius=0.01),
+                     Body("b", 0.0, [1.0, 0.1, 0], [0, 0.5, 0], radius=0.01)])
+    with pytest.raises(ValueError, match=r"no pair of bodies with radii has a massive body .*"
+                                         r"two massless bodies collide when named"):
+        integrate(grains, 1.0, events=["collision"])
+    traj = integrate(grains, 1.0, events=[{"name": "collision", "bodies": ["a", "b"]}])
+    assert list(traj.events["name"]) == ["collision"]
+    assert 0.1 < traj.events["time"][0] < 0.2  # (0.08 closed at about 0.5 a unit of time)

@@ -414,8 +414,9 @@ def test_a_collision_event_without_radii_is_refused_at_load():
     data = _merge_data()
     for b in data["bodies"]:
         b.pop("radius")
-    assert _problems(data) == ["<dict>: events[0]: no pair of bodies has radii "
-                               "(give Body(radius=...))"]
+    assert _problems(data) == ["<dict>: events[0]: no pair of bodies with radii has a "
+                               "massive body (give Body(radius=...); two massless bodies "
+                               "collide when named: bodies=[a, b])"]
 
 
 def test_a_hill_sphere_about_the_star_is_refused_at_load():

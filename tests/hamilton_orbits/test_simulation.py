@@ -420,3 +420,21 @@ def test_what_the_driver_refuses_is_refused_as_the_simulation_is_made(tmp_path, 
     with pytest.raises(ValueError, match=pattern):
         Simulation(s, archive=tmp_path / "a", every=1.0, **kw)
     assert not (tmp_path / "a").exists()
+
+
+def test_an_under_resolved_approach_is_dated_at_its_periapsis_not_the_next_output():
+    """A comet (q = 0.006, periapsis at t = 0.3 sqrt(27) = 1.559 from M = -0.3, n =
+    1/sqrt(27)) stepped by leapfrog at 0.01, outputs at 0 and 10 only: the
+    encounter was reported "at t = 10", the output after it, where the comet is
+    5 away; it is dated at its two-body periapsis between the two outputs (from the
+    under-resolved state after it: to 1e-3)."""
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    orb = KeplerOrbit.from_elements(a=3.0, e=1 - 0.006 / 3.0, inc=0.3, lan=0.2, argp=0.1,
+                                    M=-0.3, mu=1.0)
+    r, v = orb.state()
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("comet", 0.0, list(r), list(v))])
+    with pytest.warns(UnderResolvedEncounterWarning, match=r"\(0.006 at t = 1.55"):
+        traj = integrate(s, 10.0, method="leapfrog", dt=0.01)
+    assert traj.under_resolved["time"][0] == pytest.approx(0.3 * np.sqrt(27.0), abs=1e-3)
