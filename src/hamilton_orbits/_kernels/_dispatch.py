@@ -301,17 +301,27 @@ class LazyUfunc:
         return f"LazyUfunc({self.__qualname__}, {state})"
 
 
-def lazy_vectorize(*args: Any, **kwargs: Any) -> Callable[[Callable], LazyUfunc]:
-    """``numba.vectorize`` with its arguments, built on first use.
+def lazy_vectorize(*args: Any, **kwargs: Any) -> Any:
+    """``numba.vectorize`` with its arguments, built on first use; as numba's, also
+    bare (``@lazy_vectorize`` over a function: a ufunc compiled for the types it is
+    called with).
 
     Examples
     --------
     >>> from hamilton_orbits._kernels.kepler import solve_ufunc
     >>> float(solve_ufunc(0.0, 0.5))
     0.0
+    >>> import numpy as np
+    >>> @lazy_vectorize
+    ... def twice(x):
+    ...     return 2 * x
+    >>> twice(np.arange(3.0)).tolist()
+    [0.0, 2.0, 4.0]
     """
     from numba import vectorize
 
+    if len(args) == 1 and not kwargs and callable(args[0]) and not isinstance(args[0], str):
+        return LazyUfunc(vectorize, (), {}, args[0])
     return lambda func: LazyUfunc(vectorize, args, kwargs, func)
 
 
