@@ -279,11 +279,25 @@ def compose_gibbs(first: Any, second: Any) -> np.ndarray:
     a = _vec("first", first)
     b = _vec("second", second)
     a, b = _pair(("first", "second"), a, b)
+    (a, sa), (b, sb) = _homogeneous(a), _homogeneous(b)
     with np.errstate(over="ignore", invalid="ignore"):
-        pi = 1.0 - np.sum(a * b, axis=-1)
+        pi = sa * sb - np.sum(a * b, axis=-1)
     _check_pi(pi, "composition", ("first", "second"))
     return _guarded(("first", "second"), "composition",
-                    lambda: (a + b + np.cross(a, b)) / pi[..., None])
+                    lambda: (sb[..., None] * a + sa[..., None] * b + np.cross(a, b))
+                    / pi[..., None])
+
+
+def _homogeneous(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(g s, s)``: the homogeneous form ``s (1, g)`` of Gibbs vectors, ``s`` a power
+    of two taking a row beyond 1e150 to order 1 (exact), else 1 (the same bits as
+    ``(g, 1)``): Cayley's Pi and its cross products of such rows cannot overflow
+    (the composition of two of 1e155, an ordinary quarter turn, raised "nan")."""
+    big = np.max(np.abs(g), axis=-1) > 1e150
+    if not np.any(big):
+        return g, np.ones(g.shape[:-1])
+    e = np.where(big, np.frexp(np.max(np.abs(g), axis=-1))[1], 0)
+    return np.ldexp(g, -e[..., None]), np.ldexp(1.0, -e)
 
 
 def relative_gibbs(gibbs: Any, gibbs0: Any) -> np.ndarray:
@@ -319,11 +333,13 @@ def relative_gibbs(gibbs: Any, gibbs0: Any) -> np.ndarray:
     g = _vec("gibbs", gibbs)
     g0 = _vec("gibbs0", gibbs0)
     g, g0 = _pair(("gibbs", "gibbs0"), g, g0)
+    (g, s), (g0, s0) = _homogeneous(g), _homogeneous(g0)
     with np.errstate(over="ignore", invalid="ignore"):
-        den = 1.0 + np.sum(g * g0, axis=-1)
+        den = s * s0 + np.sum(g * g0, axis=-1)
     _check_pi(den, "relative rotation", ("gibbs", "gibbs0"))
     return _guarded(("gibbs", "gibbs0"), "relative rotation",
-                    lambda: (g - g0 - np.cross(g, g0)) / den[..., None])
+                    lambda: (s0[..., None] * g - s[..., None] * g0 - np.cross(g, g0))
+                    / den[..., None])
 
 
 def cayley_propagate(

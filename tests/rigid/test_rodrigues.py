@@ -125,8 +125,10 @@ def test_direction_cosines_near_a_half_turn():
     e = np.array([1.0, 2.0, 2.0]) / 3.0
     r = direction_cosines(1e200 * e)
     np.testing.assert_allclose(r, 2.0 * np.outer(e, e) - np.eye(3), atol=4 * EPS)
-    with pytest.raises(ValueError, match=r"`first`, `second` with a representable composition"):
-        compose_gibbs([1e200, 1e200, 0.0], [0.0, 1e200, 1e200])
+    # two rotations near half-turns compose to an ordinary one: (1, a)(1, b) with a.b
+    # and a x b of 1e400 (their ratio exact), refused before as beyond float64
+    np.testing.assert_allclose(compose_gibbs([1e200, 1e200, 0.0], [0.0, 1e200, 1e200]),
+                               [-1.0, 1.0, -1.0], rtol=4 * EPS)
 
 
 def test_sphere_through_half_turns_matches_exact():
@@ -204,3 +206,23 @@ def test_compose_gibbs_applies_its_second_argument_first():
     z_to = Quaternion([1.0, *g]).rotate([0.0, 0.0, 1.0])
     np.testing.assert_allclose(z_to, [1.0, 0.0, 0.0], atol=4 * EPS)
     assert "``second`` is applied first, then ``first``" in compose_gibbs.__doc__
+
+
+def test_compose_and_relative_gibbs_of_large_vectors_keep_their_scale():
+    """Gibbs vectors of 1e155 (rotations within 1e-155 of a half-turn): Cayley's Pi
+    and the cross products, unscaled, overflowed (a "nan" error, or -0 for a
+    component of 1e-310): the homogeneous form scaled by a power of two gives the
+    quaternion product's Gibbs vector."""
+    def reference(a, b, sign=1.0):
+        qa, qb = np.array([1.0, *a]), np.array([1.0, *(sign * np.asarray(b))])
+        s = 2.0**-520  # (the quaternions scaled: their product cannot overflow)
+        p = (Quaternion(qa * s) * Quaternion(qb * s)).as_array()
+        return p[1:] / p[0]
+
+    for a, b in (([1e155, 0, 0], [1e155, 1e155, 0]), ([1e155, 0, 0], [1e155, 1, 0])):
+        np.testing.assert_allclose(compose_gibbs(a, b), reference(a, b), rtol=8 * EPS)
+    g, g0 = [1e155, 0, 0], [-1e155, 1e155, 0]
+    np.testing.assert_allclose(relative_gibbs(g, g0), reference(g, g0, -1.0), rtol=8 * EPS)
+    assert compose_gibbs([0.1, 0.2, 0.3], [0.3, -0.1, 0.2]).tolist() == (
+        (np.array([0.1, 0.2, 0.3]) + [0.3, -0.1, 0.2] + np.cross([0.1, 0.2, 0.3], [0.3, -0.1, 0.2]))
+        / (1 - np.dot([0.1, 0.2, 0.3], [0.3, -0.1, 0.2]))).tolist()  # (ordinary: the same bits)
