@@ -39,6 +39,11 @@ __all__ = ["ENCOUNTER_STEP_FRACTION", "Encounter", "LostStateError",
 #: past Jupiter (time scale 2.1 d) ends with ``wh`` at 0.1 d on ``1/a`` off by twice
 #: what the encounter changed, at 0.05 d by 1% of it, at 0.02 d by 3e-6.
 ENCOUNTER_STEP_FRACTION = 1.0 / 30.0
+#: A body whose GM is at most this fraction of the largest (a comet, a small
+#: asteroid) is checked as a test particle (:func:`under_resolved_encounters`): its
+#: own pull does not matter to whether its approaches are resolved (a comet of GM
+#: 1e-12 through a sungrazing passage went unwarned where GM 0 was warned of).
+LIGHT = 1e-10
 #: The largest eccentricity of the two massive bodies' mutual orbit for which a test
 #: particle's Jacobi constant is its check (it varies by about that much).
 JACOBI_MAX_ECCENTRICITY = 1e-6
@@ -408,12 +413,26 @@ def _jacobi(r: np.ndarray, v: np.ndarray, gm: np.ndarray, m: np.ndarray,
     return 2.0 * pot + 2.0 * spin - np.einsum("tik,tik->ti", u, u)
 
 
+def light_as_massless(gm: np.ndarray) -> np.ndarray:
+    """``gm`` with the bodies of at most :data:`LIGHT` of the largest GM made 0 (test
+    particles, for the check of their approaches).
+
+    Examples
+    --------
+    >>> light_as_massless(np.array([1.0, 1e-3, 1e-12, 0.0])).tolist()
+    [1.0, 0.001, 0.0, 0.0]
+    """
+    top = float(np.max(gm)) if gm.size else 0.0
+    return np.where(gm <= LIGHT * top, 0.0, gm) if top > 0 else gm
+
+
 def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray,
                               step: float, exempt: tuple[int, float] | None = None,
                               fraction: float = ENCOUNTER_STEP_FRACTION) -> list[Encounter]:
     """The test particles' close approaches to massive bodies, seen at the output
     states ``r``, ``v`` (n_t, n, 3) at times ``t``, that a fixed ``step`` was too long
-    for.
+    for (bodies of at most :data:`LIGHT` of the largest GM checked as test
+    particles, :func:`light_as_massless`).
 
     An approach is a pericentre passage about the particle's primary
     (:func:`primaries`) whose time scale is under a tenth of the orbit's own pace
@@ -449,7 +468,7 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     >>> under_resolved_encounters(r, v, gm, t, 0.00001)
     []
     """
-    gm0 = np.atleast_2d(np.asarray(gm, dtype=np.float64))[0]
+    gm0 = light_as_massless(np.atleast_2d(np.asarray(gm, dtype=np.float64))[0])
     tp = np.flatnonzero(gm0 == 0)
     m = np.flatnonzero(gm0 > 0)
     if len(t) < 2 or not len(tp) or not len(m):

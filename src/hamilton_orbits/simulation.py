@@ -52,6 +52,7 @@ from hamilton_orbits.checkpoint import (
     LegRows,
 )
 from hamilton_orbits.effects import EffectSet
+from hamilton_orbits.integrals import light_as_massless
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.integrators._setup import check_step_count
 from hamilton_orbits.integrators.methods import FIXED_STEP, check_run
@@ -215,8 +216,9 @@ class Simulation(Saving):
         #: the parts of a snapshot that never change, made at the first (simulation_record.record)
         self._record_cache: dict[str, Any] = {}
         self._encounters = encounter_check(typed, step, tol, arrays.r, arrays.gm)
-        if self._prop.events is None and not (arrays.gm == 0).any():
-            self._encounters = None  # no test particle, ever: nothing to check per leg
+        if self._prop.events is None and not (light_as_massless(arrays.gm) == 0).any():
+            self._encounters = None  # no test particle (nor a body as light), ever:
+            # nothing to check per leg
 
     # ------------------------------------------------------------------ state
     @property

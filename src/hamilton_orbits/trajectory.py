@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.integrals import relative_change
+from hamilton_orbits.integrals import light_as_massless, relative_change
 
 __all__ = ["Trajectory", "TrajectoryBase", "encounter_check", "encounter_warning", "event_table",
            "make_trajectory", "relative_change"]
@@ -582,7 +582,7 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         _check_finite(system, method, r, v, times, gone)
     integrals = (system, r, v, out.gm, times, gone, effect_set, start)  # for _integrals
     found: Any = ()
-    if encounters is not None and (np.atleast_2d(out.gm)[0] == 0).any():
+    if encounters is not None and (light_as_massless(np.atleast_2d(out.gm)[0]) == 0).any():
         from hamilton_orbits.integrals import under_resolved_encounters
 
         step = encounters[0]

@@ -438,3 +438,27 @@ def test_an_under_resolved_approach_is_dated_at_its_periapsis_not_the_next_outpu
     with pytest.warns(UnderResolvedEncounterWarning, match=r"\(0.006 at t = 1.55"):
         traj = integrate(s, 10.0, method="leapfrog", dt=0.01)
     assert traj.under_resolved["time"][0] == pytest.approx(0.3 * np.sqrt(27.0), abs=1e-3)
+
+
+@pytest.mark.parametrize("method", ["wh", "leapfrog"])
+def test_a_comet_of_negligible_mass_is_checked_as_a_test_particle(method):
+    """A sungrazing comet (q = 0.004) of GM 1e-12 beside Jupiter, stepped too
+    coarsely, ended tens of units off radau15's with no word, where the same comet
+    of GM 0 was warned of: a body of at most 1e-10 of the largest GM is checked as
+    a test particle."""
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    orb = KeplerOrbit.from_elements(a=3.0, e=1 - 0.004 / 3.0, inc=0.3, lan=0.2, argp=0.1,
+                                    M=-0.3, mu=1.0)
+    r, v = orb.state()
+    bodies = [Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+              Body("jupiter", 1e-3, [5.2, 0, 0], [0, 5.2**-0.5, 0])]
+    for gm in (0.0, 1e-12):
+        s = System([*bodies, Body("comet", gm, list(r), list(v))])
+        with pytest.warns(UnderResolvedEncounterWarning, match=r"'comet' to 'sun'"):
+            traj = integrate(s, 10.0, method=method,  # (wh in Jacobi coordinates: the
+                             # democratic-heliocentric drifts take the Sun's approaches exactly)
+                             **(dict(dt=0.1, coordinates="jacobi") if method == "wh"
+                                else dict(dt=0.01)))
+        assert "comet" in set(traj.under_resolved["particle"])
