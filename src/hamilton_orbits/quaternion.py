@@ -132,17 +132,22 @@ class Quaternion(RotationForms):
         a = dimensionless("array", array, 4)
         if isinstance(array, np.ndarray) and np.may_share_memory(a, array):
             a = a.copy()  # (the caller's buffer, refilled, changed checked components)
-        a.flags.writeable = False
         self._a = a
 
     @classmethod
     def _wrap(cls, a: np.ndarray) -> Quaternion:
-        """Wrap an already validated float array without copying or checking (made
-        read-only: the components, and the views the accessors give, are fixed)."""
+        """Wrap an already validated float array without copying or checking (one
+        this module made or took as its own: the accessors give read-only views)."""
         obj = object.__new__(cls)
-        a.flags.writeable = False
         obj._a = a
         return obj
+
+    def _view(self, key: Any) -> np.ndarray:
+        """A read-only view of the components ``key`` (the quaternion's own, checked
+        once: written through, they would change it)."""
+        out = self._a[key]
+        out.flags.writeable = False
+        return out
 
     # ------------------------------------------------------------ constructors
     @classmethod
@@ -175,38 +180,38 @@ class Quaternion(RotationForms):
     def as_array(self) -> np.ndarray:
         """The components ``[w, x, y, z]`` as an ndarray of shape (..., 4) (read-only:
         the quaternion's own; copy it to change it)."""
-        return self._a
+        return self._view(...)
 
     # ------------------------------------------------------------ Hamilton's S, V, T, U
     @property
     def scalar(self) -> np.ndarray:
         """Hamilton's S q: the scalar part w, shape (...)."""
-        return self._a[..., 0]
+        return self._view((..., 0))
 
     @property
     def vector(self) -> np.ndarray:
         """Hamilton's V q: the vector part (x, y, z), shape (..., 3)."""
-        return self._a[..., 1:]
+        return self._view((..., slice(1, None)))
 
     @property
     def w(self) -> np.ndarray:
         """Scalar component."""
-        return self._a[..., 0]
+        return self._view((..., 0))
 
     @property
     def x(self) -> np.ndarray:
         """i component."""
-        return self._a[..., 1]
+        return self._view((..., 1))
 
     @property
     def y(self) -> np.ndarray:
         """j component."""
-        return self._a[..., 2]
+        return self._view((..., 2))
 
     @property
     def z(self) -> np.ndarray:
         """k component."""
-        return self._a[..., 3]
+        return self._view((..., 3))
 
     def norm(self) -> np.ndarray:
         """Hamilton's tensor ``T q = |q| = sqrt(w^2 + x^2 + y^2 + z^2)``, without overflow.
