@@ -451,6 +451,9 @@ class Saving:
         arch, prop = self._archive, self._prop
         arch.open()
         extra = arch.times(float(times[0]), float(times[-1]))
+        if prop.driver is None and prop.dt is None and prop.method.name in FIXED_STEP:
+            prop.driver_for(False)  # (made now, as the leg would next: the step a fixed-step
+            # method chooses from the state after the collisions at the start)
         step = prop.fixed_step()
         if not arch.exact and step is not None and prop.method.name != "dop853":
             asked = leg

@@ -211,11 +211,14 @@ class Propagation:
         """The step of a run of fixed steps: ``dt``, or the one a fixed-step method
         (wh, leapfrog) chooses at the start without it (its driver's, once made;
         before, the one it will choose from the state it starts from); None for an
-        adaptive method."""
+        adaptive method, or one not yet known: events watched, the driver not made)."""
         if self.dt is not None or self.method.name not in FIXED_STEP:
             return self.dt
         if self.driver is not None:
             return float(self.driver.dt)
+        if self.events is not None and len(self.events.watch):
+            return None  # (chosen from the state after the collisions at the start, which
+            # the driver's making carries out: not known before)
         return self.module.chosen_step(self.r, self.v, self.gm, self.tol)
 
     def _check(self, backward: bool) -> None:

@@ -520,8 +520,8 @@ def _runs(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, h: np.nda
 def _closest_time(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, k: int,
                   i: int, b: int) -> float:
     """When body ``i`` passed closest to body ``b`` about output ``k``: its two-body
-    periapsis time about ``b`` where that falls between output ``k`` and the one
-    before (the approach seen between them: output 10 was reported for a
+    periapsis time about ``b`` where that falls between the outputs on either side
+    of ``k`` (the approach seen between them: output 10 was reported for a
     periapsis at 1.56), else the output's time."""
     from hamilton_orbits._kernels import elements
 
@@ -530,8 +530,8 @@ def _closest_time(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, k
     since = np.empty(1)
     elements.state_to_time_since_periapsis(d, w, np.array([gm[b] + gm[i]]), since)
     when = float(t[k] - since[0])
-    lo, hi = sorted((float(t[max(k - 1, 0)]), float(t[k])))
-    return when if lo <= when <= hi else float(t[k])
+    near = (float(t[max(k - 1, 0)]), float(t[min(k + 1, len(t) - 1)]))  # (either side:
+    return when if min(near) <= when <= max(near) else float(t[k])  # a backward run's too)
 
 
 def _far(r: np.ndarray, gm: np.ndarray, i: int, b: int, c: int) -> np.ndarray:

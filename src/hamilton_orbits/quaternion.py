@@ -130,8 +130,9 @@ class Quaternion(RotationForms):
             self._a = array._a
             return
         a = dimensionless("array", array, 4)
-        if isinstance(array, np.ndarray) and np.may_share_memory(a, array):
-            a = a.copy()  # (the caller's buffer, refilled, changed checked components)
+        if not isinstance(array, list | tuple) and np.may_share_memory(a, np.asarray(array)):
+            a = a.copy()  # (the caller's buffer, refilled, changed checked components: an
+            # ndarray, array.array, memoryview, a pandas Series ...)
         self._a = a
 
     @classmethod

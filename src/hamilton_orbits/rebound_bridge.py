@@ -336,10 +336,13 @@ def _check_same_run(system: System, trajectory: Any, times: np.ndarray, t: Any,
     of another end than ``t`` (the check ran to the trajectory's end, unsaid)."""
     theirs = tuple(n for n in getattr(trajectory, "effects", ()) if n != "newtonian")
     mine = tuple(n for n in effects.names if n != "newtonian")
-    if theirs != mine:
-        raise ValueError(f"Expected `effects` to be those of `trajectory` ({list(theirs)}), "
-                         f"got {list(mine)}: rebound would integrate other physics; give the "
-                         f"trajectory's effects (with their parameters)")
+    listed = getattr(trajectory, "effect_set", None)  # (with their parameters, if held)
+    if sorted(theirs) != sorted(mine) or (listed is not None
+                                          and set(listed.items) != set(effects.items)):
+        raise ValueError(f"Expected `effects` to be those of `trajectory` "
+                         f"({listed.as_list() if listed is not None else list(theirs)}), got "
+                         f"{effects.as_list()}: rebound would integrate other physics; give "
+                         f"the trajectory's effects (with their parameters)")
     if t is None:  # (the trajectory's own end)
         return
     end = float(leg_times(t, float(times[0]), system.quantity)[0][-1])

@@ -192,6 +192,14 @@ class Trajectory(TrajectoryBase):
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(f"Trajectory is read-only: cannot set {name!r}")
 
+    @property
+    def effect_set(self) -> Any:
+        """The effects the trajectory was integrated with, with their parameters (an
+        :class:`~hamilton_orbits.effects.EffectSet`), or None where it does not hold
+        them (``effects`` then gives their names)."""
+        source = self._integrals
+        return source[6] if isinstance(source, tuple) else None
+
     @functools.cached_property
     def _errors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         source = self._integrals

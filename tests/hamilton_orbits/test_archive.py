@@ -596,6 +596,30 @@ def test_a_step_the_method_chooses_is_a_fixed_step_for_the_archive(tmp_path, kw)
     assert not np.array_equal(on_grid, exact)
 
 
+def test_a_chosen_step_after_a_merge_at_the_start_is_the_archives_step(tmp_path):
+    """wh without ``dt``, a grain inside the Sun merged at the start: the archive
+    laid its snapshots on the step chosen from the state before the merge (1.1e-4
+    against the driver's 0.31: the steps shortened, the run 2e-5 off, or refused
+    as 1.8e7 steps); the step is the driver's, chosen after the merge."""
+    def system():
+        return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01),
+                       Body("grain", 1e-12, [0.005, 0, 0], [0, np.sqrt(1 / 0.005), 0],
+                            radius=1e-5),
+                       Body("planet", 1e-3, [1.0, 0, 0], [0, 1.0, 0]),
+                       Body("moon", 1e-9, [1.6, 0, 0], [0, np.sqrt(1 / 1.6), 0])])
+
+    ev = [{"name": "collision", "bodies": ["sun", "grain"], "action": "merge"}]
+    times = np.linspace(0, 20, 5)[1:]
+    chosen = Simulation(system(), method="wh", events=ev, archive=tmp_path / "a", every=0.77)
+    out = chosen.integrate(times)  # (refused before: "about 1.8e+07 steps")
+    plain = Simulation(system(), method="wh", events=ev).integrate(times)
+    # the snapshots on the run's own steps: the unarchived run to rounding (2e-5 off
+    # with the steps shortened to land on a grid of another step)
+    np.testing.assert_allclose(out.r[-1, [0, 2, 3]], plain.r[-1, [0, 2, 3]], rtol=0,
+                               atol=1e-12)
+    assert len(Archive(tmp_path / "a")) > 20
+
+
 def test_an_archive_of_the_first_format_is_read_and_continued(tmp_path):
     """``data/archive-v1`` was written by archive format 1, a netCDF file per
     snapshot (tools/make_snapshot_fixture.py): a planet on a Kepler ellipse (a = 1,

@@ -852,3 +852,17 @@ def test_a_crosscheck_of_a_trajectory_of_other_effects_or_end_is_refused():
         crosscheck(s, 4.0, effects=gr, trajectory=traj)
     assert crosscheck(s, 2.0, effects=gr, trajectory=traj).relative_position_difference.max() \
         < 1e-9
+
+
+def test_a_crosscheck_of_a_trajectory_of_other_effect_parameters_is_refused():
+    """A trajectory of gr at c = 100 checked with gr at c = 10 was taken: a relative
+    difference of 1.6 reported as a disagreement.  The parameters are compared where
+    the trajectory holds them (``Trajectory.effect_set``); the order of the list
+    does not matter."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    traj = integrate(s, 2.0, method="dop853", effects=[{"name": "gr", "c": 100.0}])
+    assert traj.effect_set.as_list() == [{"name": "gr", "c": 100.0}]
+    with pytest.raises(ValueError, match=r"Expected `effects` to be those of `trajectory` "
+                                         r"\(\[\{'name': 'gr', 'c': 100.0\}\]\), got "
+                                         r"\[\{'name': 'gr', 'c': 10.0\}\]"):
+        crosscheck(s, 2.0, effects=[{"name": "gr", "c": 10.0}], trajectory=traj)

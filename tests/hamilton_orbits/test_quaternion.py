@@ -534,3 +534,17 @@ def test_hamiltons_products_name_shapes_and_survive_a_large_dot_product():
     np.testing.assert_allclose(hamilton_p(r, v, 1.0), 1e120, rtol=4 * EPS)
     with pytest.raises(ValueError, match=r"Hamilton's beta fits in float64"):
         hamilton_beta([1e200, 0.0, 0.0], [0.0, 1e200, 0.0])  # (r x v = 1e400 itself)
+
+
+def test_a_quaternion_of_a_buffer_that_is_no_ndarray_keeps_its_components():
+    """The copy was made for an ndarray only: an array.array or a memoryview
+    written into after the check changed the quaternion."""
+    import array
+
+    for buffer in (array.array("d", [1.0, 0.0, 0.0, 0.0]),):
+        q = Quaternion(buffer)
+        view = memoryview(buffer)
+        r = Quaternion(view)
+        buffer[1] = np.nan
+        assert q.as_array().tolist() == [1.0, 0.0, 0.0, 0.0]
+        assert r.as_array().tolist() == [1.0, 0.0, 0.0, 0.0]

@@ -462,3 +462,21 @@ def test_a_comet_of_negligible_mass_is_checked_as_a_test_particle(method):
                              **(dict(dt=0.1, coordinates="jacobi") if method == "wh"
                                 else dict(dt=0.01)))
         assert "comet" in set(traj.under_resolved["particle"])
+
+
+@pytest.mark.parametrize("a", [3.0, -3.0])
+def test_an_under_resolved_approach_of_a_backward_run_is_dated_at_its_periapsis(a):
+    """Backwards (outputs every 0.5 down to -10), the periapsis at -1.559 was
+    reported at the output -1.5: the passage lies on the other side of the output
+    the run found it at."""
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    orb = KeplerOrbit.from_elements(a=a, e=1 + np.sign(-a) * 0.006 / 3.0, inc=0.3, lan=0.2,
+                                    argp=0.1, M=0.3, mu=1.0)
+    r, v = orb.state()
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("comet", 0.0, list(r), list(v))])
+    with pytest.warns(UnderResolvedEncounterWarning):
+        traj = integrate(s, -np.arange(0, 10.01, 0.5), method="leapfrog", dt=0.01)
+    assert traj.under_resolved["time"][0] == pytest.approx(
+        -float(orb.time_since_periapsis), abs=1e-3)

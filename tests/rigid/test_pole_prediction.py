@@ -556,3 +556,18 @@ def test_a_pole_prediction_stopped_between_periods_says_it_is_incomplete():
     assert not stopped.complete and len([k for k in stopped.metrics if
                                          k.startswith("hindcast ")]) == 1
     assert scene.run(progress=False).complete
+
+
+def test_a_record_of_more_than_one_epoch_a_day_is_named(record):
+    """Half-day epochs among the days (every day present): the "day missing"
+    message looked for a missing day and found none (an IndexError)."""
+    sub = record.select(1995, 2019)
+    mjd = sub.time.mjd
+    t = np.sort(np.concatenate([mjd, mjd[:-1] + 0.5]))
+    x = np.interp(t, mjd, sub.x.to_value(u.mas)) * u.mas
+    y = np.interp(t, mjd, sub.y.to_value(u.mas)) * u.mas
+    twice = PolarMotionRecord(Time(t, format="mjd", scale="utc"), x, y)
+    with pytest.raises(ValueError, match=r"Expected a daily record without gaps .*: the "
+                                         r"record has \d+ epochs over those \d+ days, not "
+                                         r"one a day at 0h UTC"):
+        polar_motion.predict(twice, at="2018-06-01", horizon=30 * u.day, method="persistence")

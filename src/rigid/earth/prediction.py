@@ -173,8 +173,7 @@ def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
             raise ValueError(  # (within the span: a day missing, or not a daily record)
                 f"Expected a daily record without gaps over the {history} days of history "
                 f"up to `{name}` less the {latency} d latency, got {got}: "
-                f"{_first_missing(mjd, target[i] - history + 1, target[i])} is not in the "
-                f"record")
+                f"{_first_missing(mjd, target[i] - history + 1, target[i])}")
         raise ValueError(
             f"Expected `{name}` at 0h UTC within the record, from {first} ({history} days "
             f"of history plus the {latency} d latency) to {last}, got {got}")
@@ -182,10 +181,14 @@ def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
 
 
 def _first_missing(mjd: np.ndarray, start: float, end: float) -> str:
-    """The first day from ``start`` to ``end`` (MJD, whole days) not in ``mjd``."""
+    """What keeps ``mjd`` from being one epoch a day from ``start`` to ``end`` (MJD,
+    whole days): the first day missing, else the count of epochs there."""
     days = np.arange(start, end + 1)
     missing = days[~np.isin(days, mjd)]
-    return Time(missing[0], format="mjd", scale="utc").iso[:10]
+    if missing.size:
+        return f"{Time(missing[0], format='mjd', scale='utc').iso[:10]} is not in the record"
+    count = int(np.count_nonzero((mjd >= start) & (mjd <= end)))
+    return f"the record has {count} epochs over those {days.size} days, not one a day at 0h UTC"
 
 
 def _as_mjd(name: str, value: Any) -> np.ndarray:
