@@ -845,7 +845,8 @@ def test_a_crosscheck_of_a_trajectory_of_other_effects_or_end_is_refused():
     gr = [{"name": "gr", "c": 1e4}]
     traj = integrate(s, 2.0, method="dop853", effects=gr)
     with pytest.raises(ValueError, match=r"Expected `effects` to be those of `trajectory` "
-                                         r"\(\['gr'\]\), got \[\]: rebound would integrate"):
+                                         r"\(\[\{'name': 'gr', 'c': 10000.0\}\]\), got \[\]: "
+                                         r"rebound would integrate"):
         crosscheck(s, 2.0, trajectory=traj)
     with pytest.raises(ValueError, match=r"Expected `t` to be the end of `trajectory` "
                                          r"\(2.0\), got 4.0"):
