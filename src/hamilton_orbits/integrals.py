@@ -28,10 +28,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["ENCOUNTER_STEP_FRACTION", "Encounter", "LostStateError",
+__all__ = ["ENCOUNTER_STEP_FRACTION", "LIGHT", "Encounter", "LostStateError",
            "UnderResolvedEncounterWarning", "accelerations_quaternion", "energy_gm",
-           "energy_gm_many", "integral_errors", "particle_errors", "prepare", "primaries",
-           "relative_change", "under_resolved_encounters"]
+           "energy_gm_many", "integral_errors", "light_as_massless", "particle_errors",
+           "prepare", "primaries", "relative_change", "under_resolved_encounters"]
 
 #: A fixed step of a second-order map (``wh``, ``leapfrog``) is too long for a close
 #: approach when it exceeds this fraction of the approach's time scale
