@@ -45,7 +45,7 @@ def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str,
         value = repr(float(values[index]))
         if is_quantity(given):
             number = np.broadcast_to(np.atleast_1d(given.value), mask.shape)[index]
-            value = f"{float(number)!r} {given.unit.to_string()}"
+            value = f"{float(number)!r} {given.unit.to_string()}".rstrip()  # (dimensionless)
         raise ValueError(f"Expected `{name}` {what}, got {value}{fmt_index(shown)}")
 
 

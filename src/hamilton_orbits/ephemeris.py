@@ -559,6 +559,12 @@ def heliocentric_positions(
     if shipped.all() and all(n in ref_names for n in names):
         idx = [ref_names.index(n) for n in names]
         return ref_r[k][:, idx]
+    if shipped.all() and all(n in ref_names or n == "sun" for n in names):
+        out = np.zeros((len(jd), len(names), 3))  # (the Sun's heliocentric position: 0)
+        for c, n in enumerate(names):
+            if n != "sun":
+                out[:, c] = ref_r[k, ref_names.index(n)]
+        return out
     if shipped.all() and not k.any():  # J2000 alone: the shipped barycentric states too
         return np.broadcast_to(_j2000_heliocentric(names, frame), (len(jd), len(names), 3)).copy()
     if not kernel_available():

