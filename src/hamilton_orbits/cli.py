@@ -440,16 +440,17 @@ def _crosscheck(ref: str, sets: Sequence[str]) -> int:
 
 
 def _split_values(text: str) -> list[str]:
-    """``"1e-8,1e-10"`` -> two values; commas inside ``[...]`` or quotes do not split."""
+    """``"1e-8,1e-10"`` -> two values; commas inside ``[...]``, ``{...}`` (a TOML
+    inline table) or quotes do not split."""
     out, depth, quote, cur = [], 0, "", []
     for ch in text:
         if quote:
             quote = "" if ch == quote else quote
         elif ch in "\"'":
             quote = ch
-        elif ch == "[":
+        elif ch in "[{":
             depth += 1
-        elif ch == "]":
+        elif ch in "]}":
             depth -= 1
         elif ch == "," and depth == 0:
             out.append("".join(cur).strip())

@@ -52,6 +52,12 @@ __all__ = ["EFFECTS", "PERTURBERS", "Job", "field_rhs", "propagate", "run_job"]
 MARGIN_DAYS = 32.0
 
 
+
+#: An output Time within this many days of the epoch is the epoch (1 us: a scale's
+#: round trip or a float JD leaves 1e-17 to 1e-10 d)
+EPOCH_MATCH = 1e-6 / 86400.0
+
+
 def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | None = None,
               ephemeris: str | Segments = "de440", asteroids: bool = True,
               effects: Sequence[str] = ("eih", "sun_j2", "earth_zonal"),
@@ -347,6 +353,9 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
     if days.ndim != 1:
         raise ValueError(f"Expected `t` to be one time or a 1-d array of times, got shape "
                          f"{days.shape}")
+    if isinstance(t, Time) and abs(days[0]) <= EPOCH_MATCH:  # (the epoch itself, read
+        days = days.copy()  # through another time scale or a float JD: its residue of
+        days[0] = 0.0  # 1e-17 to 1e-10 d made an extra first output, or a refusal)
     if days[0] != 0.0:
         days = np.concatenate([[0.0], days])
     d = np.diff(days)

@@ -85,6 +85,9 @@ def test_vary_values_split_outside_brackets():
     assert _split_values('1e-8, 1e-10') == ["1e-8", "1e-10"]
     assert _split_values('["1 rad/s", "2 rad/s"],["3 rad/s", "4 rad/s"]') == [
         '["1 rad/s", "2 rad/s"]', '["3 rad/s", "4 rad/s"]']
+    # (a TOML inline table was cut at its inner comma, as `run --set` takes it whole)
+    assert _split_values('{method = "wh", dt = "120 d"},{method = "radau15"}') == [
+        '{method = "wh", dt = "120 d"}', '{method = "radau15"}']
 
 
 def test_ensemble_command(tmp_path, capsys):
@@ -320,3 +323,22 @@ def test_runs_at_once_keep_their_pools_and_a_new_pool_broken_is_not_run_again(mo
     assert calls == [1e-7]  # (once: the pool was this run's own)
     for n in list(ensemble._POOLS):
         ensemble._drop(n)
+
+
+def test_a_member_stopped_at_its_start_by_a_collision_keeps_its_row_and_the_others():
+    """A member starting inside the Earth (a collision, "stop", at t = 0) ended with
+    one row, which the scene took for a Ctrl-C before the first output: the whole
+    ensemble was interrupted (exit 130; on an in-process Dask client it hung).  Its
+    row says the collision, and the others are kept."""
+    from hamilton_orbits.ensemble import run_member
+
+    scene = Scene.bundled("leo-j2").with_values({
+        "duration": "0.5 d", "cadence": "30 min", "bodies.satellite.radius": "1 km",
+        "events": [{"name": "collision", "bodies": ["earth", "satellite"], "action": "stop"}]})
+    row = run_member(scene.data, scene.source, {"bodies.satellite.a": "6000 km"})
+    assert row["error"] is None and row["first collision bodies"] == "earth-satellite"
+    assert row["first collision at [yr]"] == 0.0
+    table = Ensemble(scene, vary={"bodies.satellite.a": ["7000 km", "6000 km"]}).run(
+        workers=1, progress=False)
+    assert list(table["complete"]) == [True, True] and table["error"].isna().all()
+    assert table["events found"].tolist() == [0, 1]

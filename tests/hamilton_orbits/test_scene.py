@@ -557,3 +557,13 @@ def test_a_pole_prediction_refuses_effects_it_would_not_apply():
     """They were accepted and listed, and the run never read them."""
     with pytest.raises(SceneError, match=r"effects\[0\]: a pole prediction takes no effects"):
         Scene.bundled("pole-prediction", {"effects": '[{name = "damping", Q = 100}]'})
+
+
+def test_an_epoch_set_as_a_date_is_the_text_of_the_date():
+    """``--set``/``--vary`` values are read as TOML, which reads 2000-01-01 as a
+    date: "initial.solar_system.epoch: expected a string, got
+    datetime.datetime(2000, 1, 1, 12, 0)" for what was given as one.  A date or
+    time is kept as the text given (a scene file quotes its epoch)."""
+    for text in ("2000-01-01", "2000-01-01T12:00:00", " 2001-06-30 "):
+        scene = Scene.bundled("stability-map").with_values({"initial.solar_system.epoch": text})
+        assert scene.data["initial"]["solar_system"]["epoch"] == text.strip()

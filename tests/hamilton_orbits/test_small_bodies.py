@@ -670,3 +670,21 @@ def test_the_stm_in_a_field_of_perturbers_at_one_point_is_keplers():
         want[:, k] = (ends[0] - ends[1]) / (2 * h)
     assert np.abs(want).max() > 10.0  # (a free particle's STM would be [[I, 200 I], [0, I]])
     np.testing.assert_allclose(stm, want, rtol=0, atol=1e-7 * np.abs(want).max())
+
+
+@pytest.mark.parametrize("scale", ["tt", "tdb"])
+def test_output_times_that_start_at_the_epoch_in_another_scale(scale):
+    """Output Times whose first is the epoch read through another scale (the epoch
+    in TT or TDB, the times in UTC): a residue of 1e-18 d made a 7th output at
+    2e-18 d (TT), or the times were refused as not monotonic (TDB).  The epoch is
+    the first output, to 1 us."""
+    from astropy.time import Time
+
+    from hamilton_orbits.small_bodies import propagate
+
+    segments = Segments.load(EXCERPT)
+    epoch = Time("2000-06-01T12:00:00", scale=scale)
+    t = epoch.utc + np.arange(0, 60, 10) * u.day
+    traj = propagate([2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.day, epoch, t,
+                     ephemeris=segments, asteroids=False)
+    assert len(traj.t) == 6 and traj.t[0].to_value(u.day) == 0.0

@@ -32,6 +32,7 @@ through the entry-point group ``hamilton_orbits.scene_kinds``, so that
 from __future__ import annotations
 
 import copy
+import datetime
 import re
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
@@ -116,9 +117,13 @@ def _effect_quantity(kind: Any, value: Any, path: str, problems: S.Problems) -> 
 
 def _parse_override(value: str) -> Any:
     try:
-        return tomllib.loads(f"x = {value}")["x"]
+        parsed = tomllib.loads(f"x = {value}")["x"]
     except tomllib.TOMLDecodeError:
         return value
+    if isinstance(parsed, datetime.date | datetime.time):  # (TOML reads 2000-01-01 as a
+        return value.strip()  # date; a scene's epoch is text: "expected a string, got
+        # datetime.datetime(2000, 1, 1)" for what was one)
+    return parsed
 
 
 def _override_parts(key: str, source: str) -> list[str | int]:

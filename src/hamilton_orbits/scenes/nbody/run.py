@@ -93,8 +93,9 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     finally:
         if bar is not None:
             bar.close()
-    if len(traj.t) < 2:
-        raise KeyboardInterrupt
+    if len(traj.t) < 2 and getattr(traj, "stopped_by", None) is None:
+        raise KeyboardInterrupt  # (a Ctrl-C before the first output; a stop at the start
+        # by an event, a collision there, is the run's result)
     result = _result(scene, system, traj, sim.effects)
     result.resumed_from = resumed_from
     _events_into(result, traj)
