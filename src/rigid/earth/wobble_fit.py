@@ -229,11 +229,13 @@ def _wobble_resid(x, t, m, n_trend):
     return r, jac_c
 
 
-def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: float):
-    """Nonlinear least squares; returns (x, covariance (scaled), residual, rho, rms)."""
+def _fit_core(t: np.ndarray, m: np.ndarray, n_trend: int, t_c0: float, t_a0: float,
+              detrended: np.ndarray):
+    """Nonlinear least squares; returns (x, covariance (scaled), residual, rho, rms).
+    ``detrended``: ``m`` with the trend and the annual terms of period ``t_a0``
+    projected out (:func:`_without_annual`)."""
     # start: the highest prograde line within +-10% of the guess, once the trend and the
     # annual terms are removed (one matrix product instead of a nonlinear search)
-    _, detrended = _project(t, m, 2 * np.pi / np.array([t_a0, -t_a0]), n_trend)
     grid = np.linspace(0.9 * t_c0, 1.1 * t_c0, 61)  # 0.33% steps; the line is ~2% wide
     amp = np.abs(np.exp(-2j * np.pi * np.outer(1.0 / grid, t)) @ detrended)
     tc = float(grid[int(np.argmax(amp))])
@@ -353,10 +355,11 @@ def fit_wobble(
         xb, yb = iers2010_mean_pole(rec.time)
         m = m - (xb.to_value(u.mas) - 1j * yb.to_value(u.mas))
         n_trend = 1
-    x, cov, _r, rho, rms = _fit_core(t, m, n_trend, t_c0, 365.25)
+    detrended = _without_annual(t, m, n_trend, 365.25)
+    x, cov, _r, rho, rms = _fit_core(t, m, n_trend, t_c0, 365.25, detrended)
     wc, wa = x[0], x[1]
     coef = x[2::2] + 1j * x[3::2]
-    _check_guess(t, m, n_trend, 2 * np.pi / wc, abs(coef[n_trend]), t_c0)
+    _check_guess(t, detrended, 2 * np.pi / wc, abs(coef[n_trend]), t_c0)
     inflate = np.sqrt((1 + rho) / (1 - rho)) if rho < 1 else np.inf
     err_wc = np.sqrt(cov[0, 0])
     err_wa = np.sqrt(cov[1, 1])
@@ -385,15 +388,20 @@ def fit_wobble(
     )
 
 
-def _check_guess(t: np.ndarray, m: np.ndarray, n_trend: int, t_c: float, amp: float,
+def _without_annual(t: np.ndarray, m: np.ndarray, n_trend: int, t_a: float) -> np.ndarray:
+    """``m`` with the trend and the annual lines (period ``t_a``, both senses)
+    projected out."""
+    return _project(t, m, 2 * np.pi / np.array([t_a, -t_a]), n_trend)[1]
+
+
+def _check_guess(t: np.ndarray, detrended: np.ndarray, t_c: float, amp: float,
                  t_c0: float) -> None:
     """Refuse a Chandler line found from a guess more than 10% off: the fitted line
     (period ``t_c``, amplitude ``amp``) when the record has a prograde line more than
     twice as strong beyond 10% of the guess ``t_c0``, within 0.6-1.6 ``t_c`` (the
-    annual lines projected out first).  (A guess of 380 d, or the rigid Euler
-    period, gave a sidelobe of 16 or 4 mas as "the Chandler line", the record's
-    122 mas at 433 d unsaid.)"""
-    _, detrended = _project(t, m, 2 * np.pi / np.array([365.25, -365.25]), n_trend)
+    annual lines projected out first: ``detrended``).  (A guess of 380 d, or the
+    rigid Euler period, gave a sidelobe of 16 or 4 mas as "the Chandler line", the
+    record's 122 mas at 433 d unsaid.)"""
     f = np.linspace(1 / (1.6 * t_c), 1 / (0.6 * t_c), 101)
     f = f[np.abs(f * 365.25 - 1) > 0.03]  # (the annual line's place, projected out)
     lines = np.abs(np.exp(-2j * np.pi * np.outer(f, t)) @ detrended) / t.size
