@@ -101,11 +101,13 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray, given: Any = None
 
 
 def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
-               given: Any = None):
+               inv_a: np.ndarray, given: Any = None):
     """The anomaly (E, D or F by ``e``) from ``nu`` or ``M`` (``aname``); NaN
     for a radial orbit (its M is solved by :func:`_radial_from_mean`).
-    Refuses ``nu`` for a radial orbit or beyond the asymptote, and a Kepler
-    equation not solved (ConvergenceError)."""
+    Refuses ``nu`` for a radial orbit or beyond the asymptote, a radial orbit's
+    ``M`` at its collision with the centre (0: r = 0 at infinite speed) or, bound
+    (``inv_a > 0``), outside (-pi, pi], and a Kepler equation not solved
+    (ConvergenceError)."""
     if aname == "nu":
         raise_at(
             "nu", radial, angle, "to be replaced by `M` for a radial orbit (e == 1, a given)",
@@ -114,6 +116,10 @@ def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
         raise_at("nu", ~np.isfinite(anom), angle, "inside the asymptotes (1 + e cos nu > 0)",
                  given)
         return anom
+    raise_at("M", radial & (angle == 0), angle, "!= 0 for a radial orbit (M = 0 is its "
+             "collision with the centre: r = 0 at infinite speed)", given)
+    raise_at("M", radial & (inv_a > 0) & ~((angle > -np.pi) & (angle <= np.pi)), angle,
+             "in (-pi, pi] for a radial orbit of e == 1 and a > 0", given)
     with np.errstate(invalid="ignore"):
         anom = np.asarray(_kk.solve_ufunc(angle, np.where(radial, 0.0, e)))
     bad = ~np.isfinite(anom) & ~radial
@@ -158,8 +164,6 @@ def _radial_from_mean(el, mu, m, radial, r_out, v_out) -> None:
     idx = np.flatnonzero(radial)
     mm = m[idx]
     rows = np.ascontiguousarray(el[idx])
-    bound = rows[:, 2] > 0
-    raise_at("M", bound & ~((mm > -np.pi) & (mm <= np.pi)), mm, "in (-pi, pi] for a radial orbit")
     rows[:, 0] = 0.0
     rows[:, 6] = _kk.solve_radial_ufunc(mm, rows[:, 2])
     r1 = np.empty((idx.size, 3))

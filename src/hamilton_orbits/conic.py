@@ -90,6 +90,27 @@ _ELEMENTS = ("p", "e", "inv_a", "inc", "lan", "argp", "mu")
 _CONSISTENT = 64.0 * np.finfo(float).eps
 
 
+def _check_shape(p: np.ndarray, e: np.ndarray, inv_a: np.ndarray) -> None:
+    """Refuse ``p``, ``e`` and ``1/a`` (broadcast together) that are not one conic's:
+    ``p >= 0`` (0 only for the radial orbit, ``e == 1``), ``e >= 0``, ``1/a`` of the
+    sign of ``1 - e`` and equal to ``(1 - e^2)/p`` to 64 eps ``max(1, e)^2``."""
+    raise_at("p", ~(p >= 0), p, ">= 0")
+    raise_at("e", ~(e >= 0), e, ">= 0")
+    raise_at("p", (p == 0) & (e != 1), p, "> 0 for e != 1 (p = 0 is a radial orbit, e = 1)")
+    raise_at("inv_a", (e < 1) & ~(inv_a > 0), inv_a, "> 0 for e < 1 (inv_a and e inconsistent)")
+    raise_at("inv_a", (e > 1) & ~(inv_a < 0), inv_a, "< 0 for e > 1 (inv_a and e inconsistent)")
+    m = np.maximum(e, 1.0)
+    with np.errstate(all="ignore"):  # (scaled by max(1, e)^2; an overflow here is inconsistent)
+        off = np.abs((1.0 - e) / m * ((1.0 + e) / m) - (p / m) * (inv_a / m)) > _CONSISTENT
+        if np.any(off):
+            i = first_index(np.atleast_1d(off)) if off.ndim else ()
+            want = (1.0 - e[i]) * (1.0 + e[i]) / p[i]
+            raise ValueError(
+                f"Expected `inv_a` = (1 - e^2)/p = {float(want)!r} (inv_a, p and e "
+                f"inconsistent), got {float(inv_a[i])!r}{fmt_index(i if off.size > 1 else ())}"
+            )
+
+
 def _checked_elements(*values: Any) -> list[np.ndarray]:
     """The arguments ``p, e, inv_a, inc, lan, argp, mu`` of :meth:`Conic.from_elements`
     as float arrays (their own shapes), refused as :meth:`KeplerOrbit.from_elements
@@ -107,24 +128,51 @@ def _checked_elements(*values: Any) -> list[np.ndarray]:
             )
         arrays.append(as_float_array(name, x))
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
-    raise_at("p", ~(p >= 0), p, ">= 0")
-    raise_at("e", ~(e >= 0), e, ">= 0")
-    raise_at("p", (p == 0) & (e != 1), p, "> 0 for e != 1 (p = 0 is a radial orbit, e = 1)")
-    raise_at("inv_a", (e < 1) & ~(inv_a > 0), inv_a, "> 0 for e < 1 (inv_a and e inconsistent)")
-    raise_at("inv_a", (e > 1) & ~(inv_a < 0), inv_a, "< 0 for e > 1 (inv_a and e inconsistent)")
-    m = np.maximum(e, 1.0)
-    with np.errstate(all="ignore"):  # (scaled by max(1, e)^2; an overflow here is inconsistent)
-        off = np.abs((1.0 - e) / m * ((1.0 + e) / m) - (p / m) * (inv_a / m)) > _CONSISTENT
-        if np.any(off):
-            i = first_index(np.atleast_1d(off)) if off.ndim else ()
-            want = (1.0 - e[i]) * (1.0 + e[i]) / p[i]
-            raise ValueError(
-                f"Expected `inv_a` = (1 - e^2)/p = {float(want)!r} (inv_a, p and e "
-                f"inconsistent), got {float(inv_a[i])!r}{fmt_index(i if off.size > 1 else ())}"
-            )
+    _check_shape(p, e, inv_a)
     raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi]")
     check_positive("mu", mu)
     return arrays
+
+
+#: how far from unit length and from orthogonal the axes given to :class:`Conic` may
+#: be (|P.P - 1|, |n.n - 1|, |P.n|: those of :meth:`Conic.from_elements`, made of
+#: sines and cosines, are within a few eps)
+_AXES = 64.0 * np.finfo(float).eps
+
+
+def _checked_attributes(p: Any, e: Any, inv_a: Any, periapsis: Any, normal: Any,
+                        mu: Any) -> tuple[np.ndarray, ...]:
+    """The attributes given to :class:`Conic` as float arrays (their own shapes),
+    refused as :meth:`Conic.from_elements` refuses its elements (``p``, ``e``,
+    ``inv_a``, ``mu``), and the axes unless each is of shape ``(..., 3)``, finite,
+    of unit length and the two orthogonal (to :data:`_AXES`)."""
+    names = ("p", "e", "inv_a", "periapsis_direction", "normal", "mu")
+    arrays = []
+    for name, x in zip(names, (p, e, inv_a, periapsis, normal, mu), strict=True):
+        if is_quantity(x):
+            raise ValueError(f"Expected `{name}` as plain floats (km and km^3/s^2 with "
+                             f"`quantity=True`), got the Quantity {x}")
+        arrays.append(as_float_array(name, x))
+    for k in (3, 4):
+        check_trailing(names[k], arrays[k], 3)
+    pp, ee, ia, mm = broadcast(names[:3] + names[5:], *arrays[:3], arrays[5])
+    _check_shape(pp, ee, ia)
+    check_positive("mu", mm)
+    big, n = broadcast(names[3:5], arrays[3], arrays[4])
+    broadcast(names, *(a[..., 0] if k in (3, 4) else a for k, a in enumerate(arrays)))
+    for name, x in ((names[3], _dot(big, big) - 1.0), (names[4], _dot(n, n) - 1.0)):
+        bad = np.abs(x) > _AXES
+        if np.any(bad):
+            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            raise ValueError(f"Expected `{name}` of unit length, got the length "
+                             f"{float(np.sqrt(x[i] + 1.0))!r}{fmt_index(i)}")
+    cos = _dot(big, n)
+    bad = np.abs(cos) > _AXES
+    if np.any(bad):
+        i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+        raise ValueError(f"Expected `periapsis_direction` orthogonal to `normal`, got their "
+                         f"dot product {float(cos[i])!r}{fmt_index(i)}")
+    return tuple(arrays)
 
 
 class Conic:
@@ -132,7 +180,10 @@ class Conic:
 
     Build from an orbit (``KeplerOrbit.conic``), with :meth:`from_state` or
     :meth:`from_elements`, or from its attributes.  Plain floats in the
-    orbit's internal units (km, km/s for Quantity orbits).
+    orbit's internal units (km, km/s for Quantity orbits).  The attributes are
+    checked as :meth:`from_elements` checks its elements, and the two axes must be
+    of unit length and orthogonal (to 64 eps): a ValueError names the attribute,
+    the first offending index and the value.
 
     Attributes
     ----------
@@ -157,12 +208,13 @@ class Conic:
     def __init__(
         self, p, e, inv_a, periapsis_direction, normal, mu, quantity: bool = False
     ) -> None:
-        self._p = np.asarray(p, float)
-        self.e = np.asarray(e, float)
-        self._inv_a = np.asarray(inv_a, float)
-        self.periapsis_direction = np.asarray(periapsis_direction, float)
-        self.normal = np.asarray(normal, float)
-        self._mu = np.asarray(mu, float)
+        values = _checked_attributes(p, e, inv_a, periapsis_direction, normal, mu)
+        self._set(*values, as_flag("quantity", quantity))
+
+    def _set(self, p: np.ndarray, e: np.ndarray, inv_a: np.ndarray, periapsis: np.ndarray,
+             normal: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
+        self._p, self.e, self._inv_a, self._mu = p, e, inv_a, mu
+        self.periapsis_direction, self.normal = periapsis, normal
         self._quantity = quantity
 
     def __repr__(self) -> str:
@@ -259,7 +311,9 @@ class Conic:
         cw, sw = np.cos(argp), np.sin(argp)
         P = np.stack([cw * cl - sw * ci * sl, cw * sl + sw * ci * cl, sw * si], axis=-1)
         h = np.stack([si * sl, -si * cl, ci], axis=-1)
-        return cls(p, e, inv_a, P, h, mu, quantity=quantity)
+        conic = cls.__new__(cls)  # (checked above: the axes are unit and orthogonal)
+        conic._set(p, e, inv_a, P, h, mu, quantity)
+        return conic
 
     @classmethod
     def from_state(cls, r: Any, v: Any, mu: Any) -> Conic:

@@ -315,7 +315,7 @@ class KeplerOrbit(OrbitElements):
         )
         written = {"a": a, "p": p, "q": q, "nu": nu, "M": M}  # (for the messages)
         p_, inv_a, radial = p_and_inv_a(lname, length, e_, written[lname])
-        anom = anomaly_of(aname, angle, e_, radial, written[aname])
+        anom = anomaly_of(aname, angle, e_, radial, inv_a, written[aname])
         state = state_of(p_, e_, inv_a, inc_, lan_, argp_, anom, radial, mu_, angle)
         bad = ~np.all(np.isfinite(state[..., :6]), axis=-1)
         raise_at(lname, bad, length, "to give a finite state (check the elements)",

@@ -299,3 +299,48 @@ def test_from_elements_takes_every_conic_the_orbits_make():
     mu = np.array([c.mu for c in CASES])
     conic = KeplerOrbit.from_state(r, v, mu).conic
     assert conic.e.shape == (len(CASES),)
+
+
+#: a conic's attributes as Conic() takes them (those of GOOD's elements)
+ATTRS = {"p": 1.44, "e": 0.44, "inv_a": 0.56, "periapsis_direction": [0.6, 0.8, 0.0],
+         "normal": [0.0, 0.0, 1.0], "mu": 1.0}
+
+
+@pytest.mark.parametrize(("bad", "message"), [
+    ({"e": -0.5}, r"Expected `e` >= 0, got -0.5$"),
+    ({"p": [1.44, -1.0], "inv_a": [0.56, -0.56]}, r"Expected `p` >= 0, got -1.0 at index 1"),
+    ({"inv_a": 0.7}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.56.*got 0.7$"),
+    ({"e": 1.5}, r"Expected `inv_a` < 0 for e > 1 .*got 0.56$"),
+    ({"mu": 0.0}, r"Expected `mu` > 0, got 0.0$"),
+    ({"e": np.nan}, r"Expected `e` to be finite, got nan$"),
+    ({"normal": [0.0, 0.0, 2.0]}, r"Expected `normal` of unit length, got the length 2.0$"),
+    ({"periapsis_direction": [[0.6, 0.8, 0.0], [1.0, 0.0, 1e-3]]},
+     r"Expected `periapsis_direction` of unit length, got the length 1.0000004.* at index 1"),
+    ({"normal": [0.0, 1.0, 0.0]}, r"orthogonal to `normal`, got their dot product 0.8$"),
+    ({"periapsis_direction": [1.0, 0.0]}, r"`periapsis_direction` to have shape \(\.\.\., 3\)"),
+    ({"normal": [0.0, 0.0, np.inf]}, r"Expected `normal` to be finite, got inf at index 2"),
+    ({"p": 1.44 * u.km}, r"Expected `p` as plain floats .*got the Quantity 1.44 km"),
+    ({"e": [0.44, 0.44], "p": [1.44] * 3}, r"Expected `p`, `e`, .* to broadcast"),
+    ({"quantity": "no"}, r"Expected `quantity` to be True or False, got 'no'"),
+])
+def test_init_refuses_what_is_not_a_conic(bad, message):
+    """``Conic(...)`` from its attributes checked nothing: e = -0.5, p < 0, 1/a far
+    from (1 - e^2)/p, mu = 0, axes of length 2 or not orthogonal were all taken (a
+    normal of length 2 doubled the hodograph's speeds, axes 37 deg apart put the
+    second focus out of the plane).  Refused now as from_elements refuses its
+    elements, the axes unit and orthogonal to 64 eps."""
+    with pytest.raises(ValueError, match=message):
+        Conic(**{**ATTRS, **bad})
+
+
+def test_init_takes_what_from_elements_and_from_state_make():
+    """Every conic the orbits make rebuilds from its attributes, unchanged (the axes
+    of sines and cosines are unit and orthogonal within a few eps)."""
+    r = np.array([c.r for c in CASES])
+    v = np.array([c.v for c in CASES])
+    mu = np.array([c.mu for c in CASES])
+    conic = KeplerOrbit.from_state(r, v, mu).conic
+    again = Conic(conic.p, conic.e, conic.inv_a, conic.periapsis_direction, conic.normal,
+                  conic.mu)
+    for name in ("p", "e", "inv_a", "periapsis_direction", "normal", "mu"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(conic, name))

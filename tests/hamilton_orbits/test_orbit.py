@@ -485,3 +485,20 @@ def test_elements_beyond_float64_are_refused_without_a_warning():
         with pytest.raises(ValueError, match=r"`a` to give a finite state .* got -1e\+300"):
             KeplerOrbit.from_elements(a=-1e300, e=1e10, inc=0.5, lan=0.1, argp=0.2, M=0.3,
                                       mu=398600.0)
+
+
+@pytest.mark.parametrize(("a", "M", "match"), [
+    ([1.0, 2.0], [0.3, 0.0], r"Expected `M` != 0 for a radial orbit \(M = 0 is its collision "
+                             r"with the centre.*got 0.0 at index 1"),
+    ([2.0, -1.5], [0.3, 0.0], r"Expected `M` != 0 .*got 0.0 at index 1"),
+    ([2.0, 2.0], [0.3, 7.0], r"Expected `M` in \(-pi, pi\] for a radial orbit of e == 1 and "
+                             r"a > 0, got 7.0 at index 1"),
+])
+def test_radial_orbit_refuses_its_collision_and_names_the_index(a, M, match):
+    """A radial orbit at M = 0 (its collision: r = 0, infinite speed) was refused as
+    "Expected `a` to give a finite state", blaming `a`; a bound one's M outside
+    (-pi, pi] was refused at its index among the radial orbits only (index 0 here,
+    the first orbit being elliptic or fine)."""
+    e = [0.5 if x > 0 and k == 0 and M[1] == 7.0 else 1.0 for k, x in enumerate(a)]
+    with pytest.raises(ValueError, match=match):
+        KeplerOrbit.from_elements(a=a, e=e, inc=0.1, lan=0.2, argp=0.3, M=M, mu=1.0)
