@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -46,12 +47,18 @@ from hamilton_orbits._netcdf3 import encode
 from hamilton_orbits.integrators._held import held
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "INT_EXACT", "SnapshotError", "beyond_float", "checksum",
-           "encode_snapshot", "read", "stored", "variable", "write", "write_bytes"]
+           "encode_snapshot", "read", "stored", "strict_json", "variable", "write",
+           "write_bytes"]
 
 FORMAT = "hamilton-orbits snapshot"
 #: the version of the layout of a snapshot file; every later version reads every
-#: earlier one (tests/hamilton_orbits/data/snapshot-v1.nc)
-FORMAT_VERSION = 1
+#: earlier one (tests/hamilton_orbits/data/snapshot-v1.nc, -v2.nc).  Format 2: the
+#: ``meta`` text is strict JSON, a float JSON has no number for written as
+#: ``{"$float": "inf"}`` (format 1 wrote a bare ``Infinity``, which Python's json
+#: reads and a strict reader refuses: dop853's ``max_step``)
+FORMAT_VERSION = 2
+#: the key of a float JSON has no number for (inf, -inf, nan) in a ``meta`` text
+NONFINITE = "$float"
 #: integers a float64 holds exactly are below this in magnitude
 INT_EXACT = 2 ** 53
 
@@ -144,7 +151,7 @@ def encode_snapshot(meta: Mapping[str, Any], arrays: Mapping[str, np.ndarray],
     """The bytes of a snapshot file (see :func:`write`): a copy, so the arrays may
     change as soon as it returns."""
     dims, units = dims or {}, units or {}
-    meta_text = json.dumps(meta, sort_keys=True, allow_nan=True)
+    meta_text = strict_json(meta)
     variables = [variable(name, np.asarray(value), dims.get(name), units.get(name))
                  for name, value in arrays.items()]
     return encode({"format": FORMAT, "format_version": FORMAT_VERSION, "meta": meta_text,
@@ -243,4 +250,36 @@ def read(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np.nda
     if checksum(meta_text, arrays) != stored:
         raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
                             f"contents")
-    return json.loads(meta_text), arrays
+    return json.loads(meta_text, object_hook=_untagged), arrays
+
+
+def strict_json(meta: Any) -> str:
+    """``meta`` as strict JSON text (keys sorted): a float JSON has no number for as
+    ``{"$float": "inf"}`` (``"-inf"``, ``"nan"``), read back by :func:`read`.
+
+    Examples
+    --------
+    >>> strict_json({"max_step": float("inf"), "dt": 0.5})
+    '{"dt": 0.5, "max_step": {"$float": "inf"}}'
+    """
+    try:
+        return json.dumps(meta, sort_keys=True, allow_nan=False)
+    except ValueError:  # (a float out of JSON's range: tagged, the rest as it was)
+        return json.dumps(_tagged(meta), sort_keys=True, allow_nan=False)
+
+
+def _tagged(x: Any) -> Any:
+    if isinstance(x, float) and not math.isfinite(x):
+        return {NONFINITE: repr(float(x))}
+    if isinstance(x, dict):
+        return {k: _tagged(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_tagged(v) for v in x]
+    return x
+
+
+def _untagged(obj: dict[str, Any]) -> Any:
+    """A JSON object read back: a tagged float as that float."""
+    if len(obj) == 1 and isinstance(obj.get(NONFINITE), str):
+        return float(obj[NONFINITE])
+    return obj

@@ -144,7 +144,8 @@ def test_a_later_format_version_is_refused(tmp_path):
     data = path.read_bytes()
     with netcdf_file(path, "a", mmap=False) as nc:
         nc.format_version = FORMAT_VERSION + 1
-    with pytest.raises(SnapshotError, match=r"format version 2; this version .* reads up to 1"):
+    with pytest.raises(SnapshotError, match=rf"format version {FORMAT_VERSION + 1}; this "
+                                            rf"version .* reads up to {FORMAT_VERSION}"):
         read(path)
     path.write_bytes(data)
 
@@ -172,6 +173,82 @@ def test_the_first_format_is_read_by_this_version():
     sim.integrate(12.0)
     r12, _ = orbit.propagate(12.0).state()
     np.testing.assert_allclose(sim.system["planet"].r, r12, rtol=0, atol=1e-12)
+
+
+def test_the_second_format_is_read_by_this_version():
+    """``data/snapshot-v2.nc`` was written by format 2 (tools/make_snapshot_fixture.py):
+    the same planet integrated by dop853 (tol 1e-12) to t = 10, its infinite
+    ``max_step`` written as strict JSON.  It must read (the infinity back as a
+    float) and continue."""
+    import json
+
+    from hamilton_orbits import KeplerOrbit
+
+    path = DATA / "snapshot-v2.nc"
+    with netcdf_file(path, "r", mmap=False) as nc:
+        assert int(nc.format_version) == 2
+        text = nc.meta.decode()
+
+    def refuse(constant: str) -> None:
+        raise AssertionError(f"not strict JSON: {constant}")
+
+    json.loads(text, parse_constant=refuse)
+    meta, _ = read(path)
+    assert meta["method"]["name"] == "dop853"
+    assert '"$float": "inf"' in text and _infinities(meta) >= 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RestartWarning)
+        sim = Simulation.load(path)
+    assert sim.t == 10.0
+    # dop853 at tol 1e-12 on a test particle's Kepler orbit: the state within 1e-9
+    # of the ellipse (the method's error over 1.6 orbits, not a rounding bound)
+    orbit = KeplerOrbit.from_elements(a=1.0, e=0.3, inc=0.2, lan=0.5, argp=1.0, nu=0.0, mu=1.0)
+    for t in (10.0, 12.0):
+        if t > sim.t:
+            sim.integrate(t)
+        r, _ = orbit.propagate(t).state()
+        np.testing.assert_allclose(sim.system["planet"].r, r, rtol=0, atol=1e-9)
+
+
+def _infinities(x: object) -> int:
+    if isinstance(x, float):
+        return int(x == float("inf"))
+    if isinstance(x, dict):
+        return sum(_infinities(v) for v in x.values())
+    if isinstance(x, list):
+        return sum(_infinities(v) for v in x)
+    return 0
+
+
+def test_a_saved_file_holds_strict_json_and_continues_bit_for_bit(tmp_path):
+    """dop853's state holds ``max_step = inf``: format 1 wrote it as a bare
+    ``Infinity`` in ``meta``, which a strict JSON reader (JavaScript's, jq, Rust's
+    serde_json) refuses, so the file was not readable without Python.  Now every
+    saved ``meta`` is strict JSON, the infinity tagged, read back as the float,
+    and the loaded simulation continues on the bits of the run never saved."""
+    import json
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0.1]),
+                Body("q", 1e-4, [0, 2.0, 0], [-0.7, 0, 0])])
+    for method in ("dop853", "radau15", "wh", "leapfrog"):
+        kw = {"dt": 0.01} if method in ("wh", "leapfrog") else {}
+        sim = Simulation(s, method=method, **kw)
+        sim.integrate(1.0)
+        path = tmp_path / f"{method}.nc"
+        sim.save(path)
+        with netcdf_file(path, "r", mmap=False) as nc:
+            text = nc.meta.decode()
+
+        def refuse(constant: str) -> None:
+            raise AssertionError(f"{method}: not strict JSON: {constant}")
+
+        json.loads(text, parse_constant=refuse)
+        loaded = Simulation.load(path)
+        sim.integrate(2.0)
+        loaded.integrate(2.0)
+        np.testing.assert_array_equal(loaded.system.r, sim.system.r)
+        np.testing.assert_array_equal(loaded.system.v, sim.system.v)
 
 
 def test_an_archived_snapshot_reads_back_as_the_snapshot_saved_alone(tmp_path):
