@@ -220,6 +220,10 @@ def _infinities(x: object) -> int:
     return 0
 
 
+def _refused(constant: str) -> None:
+    raise AssertionError(f"not strict JSON: {constant}")
+
+
 def test_a_saved_file_holds_strict_json_and_continues_bit_for_bit(tmp_path):
     """dop853's state holds ``max_step = inf``: format 1 wrote it as a bare
     ``Infinity`` in ``meta``, which a strict JSON reader (JavaScript's, jq, Rust's
@@ -240,10 +244,7 @@ def test_a_saved_file_holds_strict_json_and_continues_bit_for_bit(tmp_path):
         with netcdf_file(path, "r", mmap=False) as nc:
             text = nc.meta.decode()
 
-        def refuse(constant: str) -> None:
-            raise AssertionError(f"{method}: not strict JSON: {constant}")
-
-        json.loads(text, parse_constant=refuse)
+        json.loads(text, parse_constant=_refused)
         loaded = Simulation.load(path)
         sim.integrate(2.0)
         loaded.integrate(2.0)
