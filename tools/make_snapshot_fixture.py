@@ -9,8 +9,9 @@ argp = 1.0, nu = 0 at t = 0) about a star of GM 1, integrated by wh (dt = 0.01):
 saved at t = 10 (from snapshot format 2 on, integrated by dop853 instead: its
 ``max_step``, infinite, is what format 2 writes as strict JSON); archived every 2
 time units through the output times 0, 1, ..., 5 (a kill after the snapshot at
-t = 4 is what the archive looks like).  From format 3 on, two calls follow, to 7 and to 9, which go on in the same segment, each
-record holding its call (a kill after the snapshot at t = 8, in the third call).
+t = 4 is what the archive looks like).  From format 3 on, two calls follow, to 7
+and to 9, which go on in the same segment, each record holding its call (a kill
+after the snapshot at t = 8, in the third call).
 Run once per new format version (``archive-v1`` was written by format 1;
 ``archive-v2`` by format 2, at commit 6e3b256; ``archive-v3`` by format 3, in
 session 18 of 2026-11-29; ``archive-v4`` by format 4, in session 20 of
