@@ -25,7 +25,7 @@ import numpy as np
 
 from hamilton_orbits import Body, Simulation, System
 
-M_JUPITER, M_SATURN = 9.548e-4, 2.858e-4  # solar masses (IAU 2015 nominal values)
+M_JUPITER, M_SATURN = 9.548e-4, 2.859e-4  # solar masses (DE440's system masses, GM/GM_sun)
 A_JUPITER = 5.2
 P_JUPITER = 2 * np.pi * np.sqrt(A_JUPITER**3 / (1 + M_JUPITER))  # time units
 

@@ -45,7 +45,7 @@ print(f"largest |relative energy error| {np.max(np.abs(traj.energy_error)):.1e},
 fig = traj.plot()
 ax = fig.axes[0]
 ax.set_xlabel("x from m5 (length unit of the problem, G = 1)")
-ax.set_ylabel("y from m5 (length unit of the problem, G = 1)")
+_ = ax.set_ylabel("y from m5 (length unit of the problem, G = 1)")
 
 # %%
 # The same paths about the centre of mass (which stays at the origin: the

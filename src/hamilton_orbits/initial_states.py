@@ -191,9 +191,11 @@ class InitialStates:
 
         Positions and velocities from
         ``astropy.coordinates.get_body_barycentric_posvel(..., ephemeris="builtin")``
-        (the ERFA routines ``epv00`` and ``plan94``: no download, accuracy of order
-        1e-7 au for the inner planets and worse for the outer ones, which is
-        ample for the dynamics but not an ephemeris), on the axes of ``frame``.
+        (the ERFA routines ``epv00`` and ``plan94``: no download; at J2000 within
+        8e-7 au of JPL's DE440 for the Sun, 3e-6 au for Mercury and Venus, 4e-5 au
+        for Mars and 9e-5 to 2e-3 au for the outer planets, which is ample for the
+        dynamics but not an ephemeris: :meth:`from_ephemeris` gives DE440), on the
+        axes of ``frame``.
 
         The origin: by default the chosen bodies' own centre of mass, at rest.
         The ephemeris gives states about the solar-system barycentre, which is

@@ -5,7 +5,8 @@ The outer solar system in 3-D, interactive
 :meth:`hamilton_orbits.Trajectory.plot3d` draws a trajectory as an interactive
 plotly figure: the orbits, each body's start, and the bodies at an output chosen
 with the time slider (drag it, or press play).  The Sun, Jupiter, Saturn, Uranus and
-Neptune from the J2000 state (JPL DE440, shipped with the package) for one orbit of
+Neptune at J2000 from astropy's built-in ephemeris (ERFA's ``plan94``, offline; within
+2e-3 au of JPL's DE440, which ``System.from_ephemeris`` gives) for one orbit of
 Neptune with ``radau15``; the axes are the J2000 ecliptic ones, centred on the Sun.
 The figure needs the ``plot3d`` extra (plotly); the page embeds plotly.js, so it
 works offline.  :meth:`~hamilton_orbits.Trajectory.plot` draws the same run with
