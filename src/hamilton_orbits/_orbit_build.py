@@ -119,7 +119,7 @@ def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
     raise_at("M", radial & (angle == 0), angle, "!= 0 for a radial orbit (M = 0 is its "
              "collision with the centre: r = 0 at infinite speed)", given)
     raise_at("M", radial & (inv_a > 0) & ~((angle > -np.pi) & (angle <= np.pi)), angle,
-             "in (-pi, pi] for a radial orbit of e == 1 and a > 0", given)
+             "in (-pi, pi] for a radial orbit", given)
     with np.errstate(invalid="ignore"):
         anom = np.asarray(_kk.solve_ufunc(angle, np.where(radial, 0.0, e)))
     bad = ~np.isfinite(anom) & ~radial

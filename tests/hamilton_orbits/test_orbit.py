@@ -491,8 +491,8 @@ def test_elements_beyond_float64_are_refused_without_a_warning():
     ([1.0, 2.0], [0.3, 0.0], r"Expected `M` != 0 for a radial orbit \(M = 0 is its collision "
                              r"with the centre.*got 0.0 at index 1"),
     ([2.0, -1.5], [0.3, 0.0], r"Expected `M` != 0 .*got 0.0 at index 1"),
-    ([2.0, 2.0], [0.3, 7.0], r"Expected `M` in \(-pi, pi\] for a radial orbit of e == 1 and "
-                             r"a > 0, got 7.0 at index 1"),
+    ([2.0, 2.0], [0.3, 7.0], r"Expected `M` in \(-pi, pi\] for a radial orbit, "
+                             r"got 7.0 at index 1"),
 ])
 def test_radial_orbit_refuses_its_collision_and_names_the_index(a, M, match):
     """A radial orbit at M = 0 (its collision: r = 0, infinite speed) was refused as
