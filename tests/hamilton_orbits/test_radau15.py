@@ -477,3 +477,35 @@ def test_a_tolerance_far_below_rounding_is_named_when_the_step_underflows():
     with pytest.raises(ConvergenceError) as info:
         integrate(crash, 1.0, tol=1e-9)
     assert "`tol`" not in str(info.value)
+
+
+def test_a_body_whose_acceleration_passes_through_zero_is_crossed():
+    """Sitnikov's problem (Sitnikov 1960; the circular case: two unit masses on a
+    circle of radius 1/2, a test particle on the axis through their barycentre,
+    released at rest at z = 0.3).  At each crossing of the plane the particle's
+    acceleration passes through zero, so its PRS23 timescale ``|a| / |a'|`` does
+    too: each step covered a quarter of what was left to the crossing and the run
+    stopped at t = 0.4869 ("the step underflowed ... a collision?"), nothing being
+    near anything.  Now it crosses; z(t) through three crossings against the axis's
+    own equation ``z'' = -2 z / (1/4 + z^2)^(3/2)`` integrated by scipy's DOP853 at
+    rtol 1e-13 (agreement 6e-14: radau15's error at its default tolerance, bounded at
+    1e-12), and the rule stays the paper's elsewhere (the steps' bits are those of
+    the rule without the crossing's exception on every run of this module)."""
+    from scipy.integrate import solve_ivp
+
+    from hamilton_orbits import Body, Simulation, System
+
+    vb = math.sqrt(0.5)  # (the circular speed of each about the barycentre)
+    s = System([Body("a", 1.0, [-0.5, 0, 0], [0, -vb, 0]), Body("b", 1.0, [0.5, 0, 0], [0, vb, 0]),
+                Body("c", 0.0, [0, 0, 0.3], [0, 0, 0])])
+    ts = np.linspace(0.0, 3.0, 31)
+    z = Simulation(s, method="radau15").integrate(ts).r[:, 2, 2]
+    ref = solve_ivp(lambda t, y: [y[1], -2.0 * y[0] / (0.25 + y[0] ** 2) ** 1.5], (0.0, 3.0),
+                    [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-15, t_eval=ts).y[0]
+    assert np.count_nonzero(np.diff(np.sign(z))) == 3
+    np.testing.assert_allclose(z, ref, rtol=0, atol=1e-12)
+    # a particle falling from rest through the midpoint of a pair that falls too
+    pair = System([Body("a", 1.0, [-0.5, 0, 0], [0, 0, 0]), Body("b", 1.0, [0.5, 0, 0], [0, 0, 0]),
+                   Body("c", 0.0, [0, 0.16, 0], [0, 0, 0])])
+    fallen = Simulation(pair, method="radau15").integrate(0.6)
+    assert fallen.r[-1, 2, 1] < 0.0 and fallen.r[-1, 2, 0] == 0.0

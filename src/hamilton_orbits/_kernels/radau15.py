@@ -325,7 +325,38 @@ def _squares_ok(a0i, y2, y3, y4):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
+def _tau2(a0, b, i):  # pragma: no cover - compiled
+    """Body ``i``'s ``tau^2`` of :func:`_dt_prs23` (inf where it is left out) and the
+    magnitudes of its acceleration at the end and at the start of the step."""
+    if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
+        return math.inf, 0.0, 0.0
+    f = 1.0
+    for attempt in range(2):  # one call site (inlined once): plain, then scaled
+        a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, f)
+        if attempt == 1 or _squares_ok(a0i, y2, y3, y4):
+            break
+        if not (top > 0.0 and top < math.inf):
+            return math.inf, 0.0, 0.0
+        f = math.ldexp(1.0, -math.frexp(top)[1])
+    if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
+        return math.inf, 0.0, 0.0
+    if not (y2 > 0.0 and y2 < math.inf):
+        return math.inf, 0.0, 0.0
+    den = y3 + math.sqrt(y4 * y2)
+    if not den > 0.0:  # a constant acceleration: no timescale (no division by 0)
+        return math.inf, 0.0, 0.0
+    tau2 = 2.0 * y2 / den
+    return tau2 if tau2 > 0.0 else math.inf, math.sqrt(y2) / f, math.sqrt(a0i) / f
+
+
+#: a body whose acceleration fell over the step to below this fraction of the
+#: largest acceleration of the step's end (sqrt(eps): forces of that size cancelled
+#: to 8 digits) is at a zero crossing of its acceleration (:func:`_dt_prs23`)
+_CROSSING = 1.4901161193847656e-08
+
+
+@njit(cache=True, inline="always")
+def _dt_prs23(a0, b, n, dt_done, eps, least):  # pragma: no cover - compiled
     """Pham, Rein & Spiegel (2024): the shortest timescale
     ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
     from the polynomial at the end of the step (derivatives per unit h).  A body
@@ -336,36 +367,50 @@ def _dt_prs23(a0, b, n, dt_done, eps):  # pragma: no cover - compiled
     very large length scale: accelerations beyond 1e150 or below 1e-150) the
     components are first scaled by a power of two (``tau`` is a ratio, the scale
     cancels), so that the step follows the motion at every scale instead of
-    leaving the body out.  Returns the next step."""
+    leaving the body out.
+
+    A body whose acceleration passes through zero elsewhere (a particle crossing
+    the midpoint of a pair, Sitnikov's problem) has ``tau -> 0`` as the step's end
+    nears the crossing: each step covers a quarter of what is left to it, and the
+    steps fall to the rounding of ``t`` without reaching it (rebound's IAS15 then
+    takes thousands of steps that do not advance ``t``).  Where the step would be at
+    most ``least`` (no longer advancing ``t``), the bodies at such a crossing are
+    left out (:func:`_without_crossings`) and the step is that of the others; a
+    collision (accelerations that grow) or a tolerance below rounding still
+    underflow, as before.  Elsewhere the rule is the paper's, to the bit.  Returns
+    the next step."""
+    min_tau2 = math.inf
+    top = 0.0  # (the largest acceleration at the step's end)
+    for i in range(n):
+        tau2, a_end, _ = _tau2(a0, b, i)
+        if tau2 < min_tau2:
+            min_tau2 = tau2
+        if a_end > top:
+            top = a_end
+    if min_tau2 < math.inf:
+        dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
+        if dt_new <= least:
+            rest = _without_crossings(a0, b, n, top)
+            if rest < math.inf:
+                return math.sqrt(rest) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
+        return dt_new
+    return dt_done / _SAFETY
+
+
+@njit(cache=True)
+def _without_crossings(a0, b, n, top):  # pragma: no cover - compiled
+    """The shortest ``tau^2`` of :func:`_dt_prs23` over the bodies that are not at a
+    zero crossing of their acceleration: one whose acceleration fell over the step
+    to below :data:`_CROSSING` of ``top``, the largest at the step's end, is left
+    out (inf if none is left).  Called only where the step would underflow."""
     min_tau2 = math.inf
     for i in range(n):
-        if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
+        tau2, a_end, a_start = _tau2(a0, b, i)
+        if a_end < a_start and a_end < _CROSSING * top:
             continue
-        skip = False
-        f = 1.0
-        for attempt in range(2):  # one call site (inlined once): plain, then scaled
-            a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, f)
-            if attempt == 1 or _squares_ok(a0i, y2, y3, y4):
-                break
-            if not (top > 0.0 and top < math.inf):
-                skip = True
-                break
-            f = math.ldexp(1.0, -math.frexp(top)[1])
-        if skip:
-            continue
-        if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
-            continue
-        if not (y2 > 0.0 and y2 < math.inf):
-            continue
-        den = y3 + math.sqrt(y4 * y2)
-        if not den > 0.0:  # a constant acceleration: no timescale (no division by 0)
-            continue
-        tau2 = 2.0 * y2 / den
-        if tau2 > 0.0 and tau2 < min_tau2:
+        if tau2 < min_tau2:
             min_tau2 = tau2
-    if min_tau2 < math.inf:
-        return math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
-    return dt_done / _SAFETY
+    return min_tau2
 
 
 @njit(cache=True, inline="always")
@@ -490,8 +535,9 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g, 
 
 
 @njit(cache=True)
-def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - compiled
-    """The step after one of ``dt_done`` (planned ``dt``), and whether to accept it.
+def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing, t):  # pragma: no cover - compiled
+    """The step after one of ``dt_done`` (planned ``dt``) ending at ``t``, and whether to
+    accept it.
     (Called from the loop, not inlined: inlined, its two rules cost 0.5 s more of
     a first run's compilation; called once a step, the call costs nothing measurable.)
 
@@ -504,7 +550,7 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing):  # pragma: no cover - c
     n = r.shape[0]
     m = 3 * n
     if st[ST_PRS23] != 0.0:
-        dt_new = _dt_prs23(a0, b, n, dt_done, eps)
+        dt_new = _dt_prs23(a0, b, n, dt_done, eps, 4.0 * _EPS * abs(t))
     else:
         dt_new = _dt_global(at.reshape(m), b, r.reshape(m), v.reshape(m), n, dt_done, eps)
     if dt_new < _SAFETY * dt_done:
@@ -647,7 +693,7 @@ def _steps(
             status = STATUS_NONFINITE
             break
         # adaptive: the step-size rule (called, not inlined); fixed steps: no call
-        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing) \
+        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing, t + dt_try) \
             if st[ST_EPSILON] > 0.0 else (dt, True)
         if not ok:
             dt = dt_new
@@ -830,7 +876,7 @@ def advance_variational(
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at[:n_phys], r[:n_phys], v[:n_phys], dt_try, dt,
-                              landing)
+                              landing, t + dt_try)
         if not ok:
             dt = dt_new
             continue
