@@ -34,12 +34,13 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._outdir import live_holder
+from hamilton_orbits._saving import RestartWarning
 from hamilton_orbits.checkpoint import contents, path_of, snapshot_files
 from hamilton_orbits.segment import ROWS_NAME
 from hamilton_orbits.simulation import Simulation
 from hamilton_orbits.snapshot import SnapshotError
 
-__all__ = ["Archive", "ArchiveIndexError", "Snapshot"]
+__all__ = ["Archive", "ArchiveIndexError", "RestartWarning", "Snapshot", "SnapshotError"]
 
 
 class ArchiveIndexError(IndexError, ValueError):

@@ -319,6 +319,10 @@ def _next_number(folder: Path) -> int:
 MAX_SNAPSHOTS = 10**7
 
 
+#: the largest finite float64
+_FLOAT_MAX = 1.7976931348623157e308
+
+
 class ArchiveWriter:
     """The schedule and folder of an archive written while a simulation runs.
 
@@ -362,7 +366,8 @@ class ArchiveWriter:
                              f"got {', '.join(given) or 'none'}")
         for name, x in (("every", every), ("every_wall", every_wall)):
             if x is not None and not (isinstance(x, (int, float)) and not isinstance(x, bool)
-                                      and math.isfinite(x) and x > 0):
+                                      and 0 < x <= _FLOAT_MAX):  # (an int beyond
+                # float64 compares, where math.isfinite would overflow)
                 raise ValueError(f"Expected `{name}` > 0 and finite, got {x!r}")
         if every_steps is not None and (isinstance(every_steps, bool)
                                         or not isinstance(every_steps, (int, np.integer))

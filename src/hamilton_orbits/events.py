@@ -171,6 +171,10 @@ def _check_entry(item: Any, k: int) -> tuple[str, dict[str, Any]]:
                          "or {'hill': k})")
     if isinstance(params.get("distance"), Mapping):
         _check_hill(params["distance"], f"Event at index {k} ({name!r})", name)
+    if isinstance(params.get("bodies"), (tuple, np.ndarray)):  # (names as a list of str,
+        # as a snapshot keeps them; _bodies checks them)
+        params["bodies"] = np.asarray(params["bodies"], dtype=object).tolist() \
+            if isinstance(params["bodies"], np.ndarray) else list(params["bodies"])
     return name, {**params, "action": action}
 
 

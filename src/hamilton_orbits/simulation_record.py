@@ -47,7 +47,10 @@ def to_json(value: Any) -> Any:
         return {"__quantity__": np.asarray(value.value).tolist(),
                 "unit": value.unit.to_string()}
     if isinstance(value, np.ndarray):
-        return {"__array__": value.tolist()}
+        if value.dtype == np.float64:
+            return {"__array__": value.tolist()}
+        return {"__array__": value.tolist(), "dtype": value.dtype.str}  # (names, ints:
+        # read back as what they were, not as floats)
     time = sys.modules.get("astropy.time")  # (a Time can only come from a loaded module)
     if time is not None and isinstance(value, time.Time):  # (an epoch: its two-part JD)
         return {"__time__": [np.asarray(value.jd1).tolist(), np.asarray(value.jd2).tolist()],
@@ -70,7 +73,7 @@ def from_json(value: Any) -> Any:
 
             return u.Quantity(value["__quantity__"], u.Unit(value["unit"]), dtype=np.float64)
         if "__array__" in value:
-            return np.array(value["__array__"], dtype=np.float64)
+            return np.array(value["__array__"], dtype=np.dtype(value.get("dtype", "<f8")))
         if "__time__" in value:
             from astropy.time import Time
 

@@ -233,8 +233,13 @@ def read(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np.nda
             fmt = getattr(nc, "format", b"")
             fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
             if fmt != FORMAT:
+                hint = ""
+                if fmt.startswith("hamilton-orbits archive segment"):  # (segment.SEGMENT_FORMAT)
+                    hint = (f"; it is a file of the archive {path.parent}: load the folder "
+                            f"instead, Simulation.load({str(path.parent)!r}) (its last "
+                            f"snapshot; number=n for another)")
                 raise SnapshotError(f"{path} is not a hamilton-orbits snapshot "
-                                    f"(format {fmt!r})")
+                                    f"(format {fmt!r}){hint}")
             version = int(nc.format_version)
             meta_text = nc.meta.decode("utf-8")
             stored = nc.sha256.decode()

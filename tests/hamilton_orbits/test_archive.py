@@ -369,12 +369,18 @@ def test_a_stale_lock_of_a_killed_run_is_taken_over(tmp_path):
                                        r"got 0"),
     (dict(archive="x", every_steps=2.5), r"got 2.5"),
     (dict(archive="x", every_wall=float("nan")), r"Expected `every_wall` > 0 and finite"),
+    # (an int beyond float64: OverflowError "int too large to convert to float" before)
+    (dict(archive="x", every_wall=10**400), r"Expected `every_wall` > 0 and finite, got 1000"),
+    (dict(archive="x", every=10**400), r"Expected `every` .*got 1000"),
     (dict(archive="x", every=float("inf")), r"Expected `every` to be finite, got inf"),
     (dict(archive="", every=1.0), r"Expected `archive` to be a folder's path, got ''"),
     (dict(archive=5, every=1.0), r"Expected `archive` to be a folder's path, got 5"),
     (dict(archive="x", every=True), r"Expected `every` to be a number, got True"),
     (dict(archive="x", every_wall=True), r"Expected `every_wall` > 0 and finite, got True"),
     (dict(archive="x", every=1.0, dt=True), r"Expected `dt` to be a number, got True"),
+    # (refused at the first integrate before, after the folder was made: left empty)
+    (dict(method="radau15", precision="double-double", dt=None, archive="x", every=1.0),
+     r"radau15 in double-double runs fixed steps: give `dt` and no `tol`, got dt = None"),
 ])
 def test_bad_schedules_are_refused_naming_the_argument(kw, match):
     with pytest.raises(ValueError, match=match):
@@ -1896,3 +1902,28 @@ def test_resume_numbers_its_outputs_and_steps_as_the_interrupted_call(tmp_path, 
     resumed = []
     Simulation.load(tmp_path / "a").resume(on_output=lambda i, steps: resumed.append((i, steps)))
     assert resumed and resumed == whole[-len(resumed):]
+
+
+def test_an_event_of_bodies_named_by_an_array_archives_and_loads(tmp_path):
+    """An event whose ``bodies`` were a NumPy array of names ran and wrote its
+    archive, but ``Simulation.load(folder)``, ``Archive(folder)[k]`` and a saved
+    file all failed ("could not convert string to float: 'p1'"): a run that could
+    never be resumed.  The names are taken as a list, and the loaded run goes on to
+    the bits of the run never interrupted."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p1", 1e-5, [1.0, 0, 0], [0, 1.0, 0]),
+                Body("p2", 1e-5, [1.5, 0, 0], [0, 0.8, 0])])
+    events = [{"name": "close_encounter", "bodies": np.array(["p1", "p2"]), "distance": 0.3},
+              {"name": "escape", "bodies": ("p1",), "distance": 50.0}]
+    sim = Simulation(s, archive=tmp_path / "run", every=0.25, events=events)
+    sim.integrate(1.0)
+    twin = sim.copy()  # (the run never interrupted; it writes nothing)
+    sim.save(tmp_path / "alone.nc")
+    loaded = Simulation.load(tmp_path / "run")
+    again = Archive(tmp_path / "run")[2]
+    alone = Simulation.load(tmp_path / "alone.nc")
+    for other in (twin, loaded, alone):
+        other.integrate(4.0)
+    for other in (loaded, alone):
+        np.testing.assert_array_equal(other.system.r, twin.system.r)
+    assert again.t == 0.5

@@ -119,3 +119,19 @@ def test_an_archive_written_through_another_simulations_capture_is_the_one_walke
         assert nb == nc and mb == mc and ab.keys() == ac.keys()
         assert all(ab[k].dtype == ac[k].dtype and ab[k].shape == ac[k].shape
                    and ab[k].tobytes() == ac[k].tobytes() for k in ab)  # (to the bit)
+
+
+def test_arrays_that_are_not_floats_come_back_as_they_were():
+    """``to_json`` kept any array as a list and ``from_json`` read it back as float64:
+    an event's ``bodies`` given as a NumPy array of names (a table's column) made an
+    archive that was written, listed as whole, and never loaded ("could not convert
+    string to float: 'p1'").  A non-float array now keeps its dtype; a float64 one is
+    written as before (and an old file's array, without a dtype, read as float64)."""
+    from hamilton_orbits.simulation_record import from_json, to_json
+
+    for a in (np.array(["p1", "jupiter"]), np.arange(3), np.array([True, False]),
+              np.array([0.1, np.pi])):
+        back = from_json(json.loads(json.dumps(to_json({"x": a}))))["x"]
+        assert back.dtype == a.dtype and back.tolist() == a.tolist()
+    assert to_json(np.array([0.5])) == {"__array__": [0.5]}
+    assert from_json({"__array__": [1, 2]}).dtype == np.float64

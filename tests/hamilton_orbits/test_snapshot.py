@@ -8,6 +8,7 @@ cannot be written is a SnapshotError at the write, naming the path.
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from pathlib import Path
 
@@ -282,3 +283,16 @@ def test_an_archived_snapshot_reads_back_as_the_snapshot_saved_alone(tmp_path):
     # merge's layout; "started", which the first call's end sets): more than one,
     # fewer than the legs
     assert 1 < len(list((tmp_path / "run").glob("segment-*.nc"))) < 4
+
+
+def test_a_segment_loaded_as_a_snapshot_points_to_its_folder(tmp_path):
+    """``Simulation.load(".../segment-000000.nc")`` was refused as "not a hamilton-orbits
+    snapshot (format 'hamilton-orbits archive segment')", the way to load it unsaid."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-5, [1.0, 0, 0], [0, 1.0, 0])])
+    Simulation(s, archive=tmp_path / "run", every=0.5).integrate(1.0)
+    folder = str(tmp_path / "run")
+    with pytest.raises(SnapshotError, match=r"segment-000000.nc is not a hamilton-orbits snapshot "
+                                            r".*: load the folder instead, Simulation.load\("
+                                            + re.escape(repr(folder)) + r"\) \(its last"):
+        Simulation.load(tmp_path / "run" / "segment-000000.nc")
+    assert Simulation.load(folder).t == 1.0

@@ -296,4 +296,8 @@ def check_run(method: Method, dt: Any, tol: Any, variational: bool) -> None:
     if method.name == "wh" and method.corrector and variational:
         raise ValueError("wh with variational=True takes no `corrector` (its tangent map "
                          "is not implemented); use corrector=0")
+    if method.name == "radau15" and method.precision == "double-double" and (
+            dt is None or tol is not None):
+        raise ValueError("radau15 in double-double runs fixed steps: give `dt` and no "
+                         f"`tol`, got dt = {dt!r}, tol = {tol!r}")
 
