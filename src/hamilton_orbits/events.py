@@ -497,9 +497,12 @@ class EventLog:
             if self.act(row, t, r, v, gm):
                 return True
 
-    def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> bool:
+    def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+            at: float | None = None) -> bool:
         """Carry out the action of watch row ``row`` at time ``t`` on the state
-        ``r``, ``v``, ``gm`` (changed in place); True if the run must stop.
+        ``r``, ``v``, ``gm`` (changed in place); True if the run must stop.  ``at``: the
+        time of the event that acts, where the action is taken at the end of its step
+        (wh, leapfrog: ``t``); the rows the step's scan found after it are dropped.
 
         ``"merge"`` keeps the lower-indexed body with the pair's summed ``gm`` at
         their centre of mass, with their total momentum and the radius of their
@@ -508,17 +511,12 @@ class EventLog:
         nothing) and marked ``inactive``; its outputs are NaN from then on.
         """
         self.drain()
-        # what the scan found later in the same step did not happen: the run goes on
-        # (or ends) from the event's time
-        self.rows = [x for x in self.rows if x[E_TIME] <= t]
         code, i, j, _, action = self.watch[row]
         i, j, action = int(i), int(j), int(action)
-        if action == ACTIONS["stop"]:  # (the row of this watch entry: another of the same
-            # pair, recording at another distance, may be later in the rows)
-            self.stopped_by = next(k for k in range(len(self.rows) - 1, -1, -1)
-                                   if self.rows[k][E_I] == i and self.rows[k][E_J] == j
-                                   and self.rows[k][E_CODE] == code
-                                   and self.rows[k][E_ACTION] == action)
+        gone = -1 if action == ACTIONS["stop"] else j if action == ACTIONS["merge"] else i
+        acting = self._kept_until(code, i, j, action, t, t if at is None else at, gone)
+        if action == ACTIONS["stop"]:
+            self.stopped_by = acting
             return True
         if action == ACTIONS["merge"]:
             m = gm[i] + gm[j]
@@ -533,6 +531,30 @@ class EventLog:
         self._park(gone, r, v, gm)
         self.gm_changes.append((t, gm.copy()))
         return False
+
+    def _kept_until(self, code: float, i: int, j: int, action: int, t: float, at: float,
+                    gone: int) -> int:
+        """Keep the rows up to the event that acts: the row of this watch entry (its
+        pair, code and action) at or before ``t`` nearest to ``at``, its time.  What the
+        scan found later in the same step did not happen, the run going on (or ending)
+        from it: with wh and leapfrog, which act at the end of the step, the rows
+        after the contact but within the step were kept, and a stop named the last
+        of them.  At the same instant, a row of another pair of the body the action
+        takes out (``gone``) did not happen either (a body touching two others at
+        once merges into the first).  Returns the index of the row that acts."""
+        mine = [k for k, x in enumerate(self.rows)
+                if x[E_I] == i and x[E_J] == j and x[E_CODE] == code and x[E_ACTION] == action
+                and x[E_TIME] <= t]
+        if not mine:  # (not found in the log: every row up to ``t`` kept, as before)
+            self.rows = [x for x in self.rows if x[E_TIME] <= t]
+            return len(self.rows) - 1
+        acting = min(mine, key=lambda k: (abs(self.rows[k][E_TIME] - at), -k))
+        t_ev = self.rows[acting][E_TIME]
+        kept = [k for k, x in enumerate(self.rows)
+                if x[E_TIME] < t_ev or k == acting
+                or (x[E_TIME] == t_ev and gone not in (int(x[E_I]), int(x[E_J])))]
+        self.rows = [self.rows[k] for k in kept]
+        return kept.index(acting)
 
     def park(self, k: int, r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> None:
         """Take body ``k`` out of the run (in place in ``r``, ``v``, ``gm``): parked far

@@ -546,3 +546,43 @@ def test_two_massless_bodies_with_radii_collide_when_named():
     traj = integrate(grains, 1.0, events=[{"name": "collision", "bodies": ["a", "b"]}])
     assert list(traj.events["name"]) == ["collision"]
     assert 0.1 < traj.events["time"][0] < 0.2  # (0.08 closed at about 0.5 a unit of time)
+
+
+@pytest.mark.parametrize("method", ["wh", "leapfrog"])
+@pytest.mark.parametrize("action", ["merge", "stop"])
+def test_a_fixed_step_contact_ends_what_its_step_found_after_it(method, action):
+    """wh and leapfrog act on a contact at the end of its step, and kept every row
+    the step's scan found up to that end: after the contact of p1 and p2 (t = 16.010)
+    the table listed a close encounter of the pair at 16.09, a second contact at
+    16.35 (two merges of one pair, the run merging once) and another encounter, and
+    a stop named the last contact (16.35) as ``stopped_by``.  Now the rows end at
+    the first contact, which is the one that acts."""
+    gs = 0.01720209895**2
+    s = System([Body("sun", gs, [0, 0, 0], [0, 0, 0], radius=0.00465),
+                Body("p1", gs * 1e-3, [1, 0, 0], [0, 0.0172, 0], radius=0.001),
+                Body("p2", gs * 1e-3, [1.0, 0.05, 0], [0, 0.0172, 0.0005], radius=0.001)])
+    tr = integrate(s, 40.0, method=method, dt=0.5,
+                   events=[{"name": "collision", "action": action},
+                           {"name": "close_encounter", "distance": 0.02}])
+    contact = [row for row in tr.events if row["name"] == "collision"]
+    assert len(contact) == 1
+    assert max(float(row["time"]) for row in tr.events) == float(contact[0]["time"])
+    assert 15.9 < float(contact[0]["time"]) < 16.1  # (radau15: 15.9968)
+    if action == "stop":
+        assert tr.stopped_by["name"] == "collision"
+        assert float(tr.stopped_by["time"]) == float(contact[0]["time"])
+
+
+@pytest.mark.parametrize("method", ["radau15", "dop853", "wh"])
+def test_a_body_touching_two_at_once_merges_once(method):
+    """A massless body falling through the midpoint of a pair touches both at the
+    same instant: the table listed an a-c merge and a b-c merge, c being gone after
+    the first (every method).  Only the merge that acts is listed."""
+    s = System([Body("a", 1.0, [-0.5, 0, 0], [0, 0, 0], radius=0.1),
+                Body("b", 1.0, [0.5, 0, 0], [0, 0, 0], radius=0.1),
+                Body("c", 0.0, [0, 0.16, 0], [0, 0, 0], radius=0.05)])
+    kw = {"dt": 1e-4} if method == "wh" else {}
+    tr = integrate(s, [0, 0.74], method=method, events=[{"name": "collision", "action": "merge"}],
+                   **kw)
+    assert [str(row["bodies"]) for row in tr.events] == ["a-c"]
+    assert tr.final.names == ("a", "b")

@@ -127,7 +127,8 @@ class _State:
         (``status``, ``ws``) taken: True for a stop (its state then in ``row``)."""
         log, r, v = self.log, self.r, self.v
         log.drain()
-        if status == _k.STATUS_EVENT and log.act(int(ws[3]), float(ws[0]), r, v, self.gm):
+        if status == _k.STATUS_EVENT and log.act(int(ws[3]), float(ws[0]), r, v, self.gm,
+                                                 at=float(ws[1])):
             row[0][:], row[1][:] = r, v
             log.mask(row[0], row[1])
             return True

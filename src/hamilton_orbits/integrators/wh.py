@@ -344,7 +344,8 @@ class _State:
         removal renews the split from the changed inertial state."""
         r_now, v_now = np.empty_like(self.split.q), np.empty_like(self.split.u)
         self.split.to_inertial(r_now, v_now)
-        if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm):
+        if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm,
+                        at=float(ws[1])):
             row[0][:], row[1][:] = r_now, v_now
             self.log.mask(row[0], row[1])
             self.t = float(ws[0])  # the end of the step (the split holds that state)
