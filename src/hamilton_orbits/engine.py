@@ -36,6 +36,7 @@ the one before starts the integrator afresh from the state reached.
 from __future__ import annotations
 
 import importlib
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -56,9 +57,31 @@ from hamilton_orbits.integrators import (
 from hamilton_orbits.integrators._setup import check_dt_tol, check_inputs
 from hamilton_orbits.integrators.methods import FIXED_STEP
 from hamilton_orbits.rhs import RHS, time_reversed
+from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
+
+
+#: a time in a driver's message (``t = 0.9`` or ``t_out[1] = 1.0``; not ``dt =``)
+_TIME_IN_MESSAGE = re.compile(r"(?<![\w.])(t|t_out\[\d+\]) = (-?(?:\d[\d.]*(?:e[+-]?\d+)?|inf))")
+
+
+def _turned_back(message: str) -> str:
+    """A driver's message about a backward run, which it integrates in ``s = -t``:
+    its times turned back to the run's (``stopped at t = 0.9068 before t_out[1] =
+    1.0`` of a run to t = -1 reads ``t = -0.9068 ... t_out[1] = -1.0``).
+
+    Examples
+    --------
+    >>> _turned_back("radau15 stopped at t = 0.5 before t_out[1] = 1.0 (dt = 1e-16)")
+    'radau15 stopped at t = -0.5 before t_out[1] = -1.0 (dt = 1e-16)'
+    """
+    def back(match: re.Match[str]) -> str:
+        x = match.group(2)
+        return f"{match.group(1)} = {x[1:] if x.startswith('-') else '-' + x}"
+
+    return _TIME_IN_MESSAGE.sub(back, message)
 
 @dataclass(slots=True)
 class EngineRun:
@@ -339,8 +362,10 @@ class Propagation:
             complete = False
         except KeyboardInterrupt:
             complete, interrupted = False, True
-        except BaseException:  # (an error, the driver's or a callback's: the propagation
-            self._between_outputs(driver)  # keeps the state reached, as on Ctrl-C)
+        except BaseException as exc:  # (an error, the driver's or a callback's: the
+            self._between_outputs(driver)  # propagation keeps the state reached, as on
+            if backward and type(exc) in (ConvergenceError, ValueError):  # Ctrl-C)
+                raise type(exc)(_turned_back(str(exc))) from None
             raise
         wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
         k = reached[0] + 1

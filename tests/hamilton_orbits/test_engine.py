@@ -100,3 +100,21 @@ def test_a_backward_legs_first_row_is_the_state_it_starts_from(kw):
     again = sim.integrate(0.0)
     assert np.array_equal(again.v[0], there.v[-1]) and np.array_equal(again.r[0],
                                                                        there.r[-1])
+
+
+@pytest.mark.parametrize(("method", "kind", "pattern"), [
+    ("radau15", "ConvergenceError", r"radau15 stopped at t = -0.90689968\d* before t_out\[1\] "
+                                    r"= -1.0: the step underflowed \(dt = 7"),
+    ("dop853", "ValueError", r"dop853 failed at t = -0.90689968\d*: the step underflowed"),
+])
+def test_a_backward_run_names_its_own_times_when_it_fails(method, kind, pattern):
+    """A head-on fall (GM 1 and 0.5 at rest 1 apart: they meet at |t| = pi/2
+    sqrt(1/3) = 0.90690) integrated to t = -1 failed with "stopped at t = 0.9069
+    before t_out[1] = 1.0": the driver's reversed time s = -t.  The message now
+    names the run's times."""
+    from hamilton_orbits import Body, System, integrate
+
+    s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.5, [1, 0, 0], [0, 0, 0])])
+    with pytest.raises(Exception, match=pattern) as info:
+        integrate(s, -1.0, method=method)
+    assert type(info.value).__name__ == kind
