@@ -323,6 +323,9 @@ def _length(value: Any, system: Any, where: str) -> float:
         raise ValueError(f"{where}: expected `distance` as a plain number in the system's "
                          f"own length unit (it was built from plain numbers), got "
                          f"{value!r}")  # 4.5e12 of the system's unit)
+    if np.ndim(getattr(value, "value", value)) != 0:  # (float() of an array said "only
+        # 0-dimensional arrays can be converted to Python scalars")
+        raise ValueError(f"{where}: expected `distance` to be one length, got {value!r}")
     try:
         dist = float(LENGTH("distance", value, u.au if system.quantity else None))
     except (ValueError, TypeError, u.UnitsError) as exc:

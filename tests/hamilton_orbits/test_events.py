@@ -279,6 +279,10 @@ def test_events_with_quantities_and_hill_radii():
     ([{"name": "escape", "distance": {"hill": 3}}],
      r"Event at index 0 \('escape'\): expected `distance` to be a length, got \{'hill': 3\}"),
     ([{"name": "escape", "distance": "far"}], r"^Event at index 0 \('escape'\): .*'far'"),
+    # (float() of the array: "only 0-dimensional arrays can be converted to Python scalars")
+    ([{"name": "close_encounter", "distance": [0.1, 0.2]}],
+     r"^Event at index 0 \('close_encounter'\): expected `distance` to be one length, got "
+     r"\[0.1, 0.2\]$"),
     ([{"name": "escape", "distance": 3.0, "bodies": ["b", "b"]}],
      r"^Event at index 0 \('escape'\): `bodies` names 'b' twice \(at indices 0 and 1\)$"),
     ([{"name": "escape", "distance": 3.0, "bodies": [1]}],
