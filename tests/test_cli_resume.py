@@ -58,6 +58,18 @@ def _kill_after_snapshots(pid: int, archive, count: int) -> None:
     os.waitpid(pid, 0)
 
 
+def _killed_at_its_end(out) -> None:
+    """The run in ``out`` as if killed after its last snapshot, before its files were
+    written: its archive's record without the mark a finished run leaves (a finished
+    run is not resumed: "there is nothing to resume")."""
+    import json
+
+    record = out / "archive" / "scene.json"
+    text = json.loads(record.read_text(encoding="utf-8"))
+    assert text.pop("finished") is True
+    record.write_text(json.dumps(text), encoding="utf-8")
+
+
 def test_a_killed_scene_run_resumes_to_the_files_of_the_whole_run(tmp_path, capsys):
     assert main(["run", "comet-encounter", "--out", str(tmp_path / "whole"), *SETS]) == 0
     assert "hamilton-orbits resume" in capsys.readouterr().err  # says how to resume
@@ -89,6 +101,7 @@ def test_run_refuses_a_folder_holding_an_earlier_run_s_archive(tmp_path, capsys)
     """Refused before anything runs: exit 2, as any bad command line (docs/scenes.md;
     it was 1, a failure during the run)."""
     assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 0
+    _killed_at_its_end(tmp_path)
     assert main(["run", "comet-encounter", "--out", str(tmp_path), *SETS]) == 2
     assert "holds the snapshots of an earlier run: resume it" in capsys.readouterr().err
 
@@ -108,6 +121,7 @@ def test_a_run_whose_out_is_named_after_its_bundled_scene_resumes(tmp_path, monk
     monkeypatch.chdir(tmp_path)
     assert main(["run", "comet-encounter", "--out", "comet-encounter", *SETS]) == 0
     capsys.readouterr()
+    _killed_at_its_end(tmp_path / "comet-encounter")
     assert main(["resume", "comet-encounter", "--no-progress"]) == 0
     assert "s of integration since the resume at t = 30 d" in capsys.readouterr().out
     assert main(["run", "comet-encounter", "--out", "other", *SETS]) == 0
@@ -128,12 +142,14 @@ def test_resume_runs_the_scene_as_the_run_read_it(tmp_path, capsys):
     assert f"hamilton-orbits resume '{out}'" in capsys.readouterr().err  # (quoted)
     whole = _states(out)
     scene.write_text(text.replace('duration = "', 'duration = "2 yr" # "'), encoding="utf-8")
+    _killed_at_its_end(out)
     assert main(["resume", str(out), "--no-progress"]) == 0
     assert "has changed since the run began; resuming the scene as the run read it" in (
         capsys.readouterr().err)
     resumed = _states(out)
     assert all(_same(resumed[k], whole[k]) for k in whole)
     scene.unlink()
+    _killed_at_its_end(out)
     assert main(["resume", str(out), "--no-progress"]) == 0
 
 
@@ -169,6 +185,7 @@ def test_a_scene_reading_a_relative_file_resumes_from_another_folder(tmp_path, m
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)
+    _killed_at_its_end(tmp_path / "out")
     assert main(["resume", str(tmp_path / "out"), "--no-progress"]) == 0
     assert os.getcwd() == str(elsewhere)
     resumed = _states(tmp_path / "out")
@@ -255,3 +272,84 @@ def test_a_run_stopped_before_its_first_snapshot_is_resumed_and_may_be_run_again
         assert sorted(resumed) == sorted(whole)
         for name, values in whole.items():
             assert _same(resumed[name], values), name
+
+
+def test_a_finished_run_is_not_taken_for_one_to_resume(tmp_path, capsys):
+    """A run that finished left an archive that ``run`` refused as "the snapshots of
+    an earlier run: resume it", and that ``resume`` ran again (rewriting every file,
+    "0.00 s of integration since the resume at t = 30 d"; with ``archive_every``
+    longer than the run, its whole span again).  Now ``run`` says the run finished
+    and how to run into the folder again, and ``resume`` that there is nothing to
+    resume; the files stay the finished run's."""
+    out = tmp_path / "done"
+    assert main(["run", "comet-encounter", "--out", str(out), *SETS]) == 0
+    whole = (out / "states.nc").read_bytes()
+    capsys.readouterr()
+    assert main(["run", "comet-encounter", "--out", str(out), *SETS]) == 2
+    err = capsys.readouterr().err
+    assert "holds the archive of an earlier run, which finished" in err
+    assert f"remove {out / 'archive'} to run into {out} again" in err and "resume" not in err
+    assert main(["resume", str(out), "--no-progress"]) == 2
+    assert f"the run in {out} finished" in capsys.readouterr().err
+    assert (out / "states.nc").read_bytes() == whole
+
+
+def test_a_run_without_an_archive_does_not_take_a_killed_run_s_folder(tmp_path, capsys):
+    """``run`` of a scene with no ``archive_every`` into a folder holding a killed
+    run's snapshots ran there; a later ``resume`` of the killed run then replaced the
+    new run's files with its own, unsaid.  It is refused, naming ``resume``."""
+    out = tmp_path / "mixed"
+    assert main(["run", "comet-encounter", "--out", str(out), *SETS]) == 0
+    _killed_at_its_end(out)
+    capsys.readouterr()
+    assert main(["run", "leo-j2", "--set", "duration=1 d", "--out", str(out),
+                 "--no-progress"]) == 2
+    assert "holds the snapshots of an earlier run: resume it" in capsys.readouterr().err
+
+
+def test_resume_begins_from_the_state_the_run_read(tmp_path, monkeypatch, capsys):
+    """A scene whose ``[initial] rebound`` file changed after its run began was
+    resumed with the system read again from the file: a body moved made the resume
+    fail ("Expected `trajectory` to start from `system`'s state"), a mass changed
+    gave a cross-check against another system.  The resume begins from the state
+    the run began with (the archive's), says the file changed, and ends on the
+    files of the run never interrupted."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "comet-encounter", "--out", "first", *SETS]) == 0
+    start = (tmp_path / "first" / "final.bin").read_bytes()
+    (tmp_path / "start.bin").write_bytes(start)
+    (tmp_path / "from-bin.toml").write_text(
+        'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
+        '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
+        '[output]\narchive_every = "2 d"\n', encoding="utf-8")
+    assert main(["run", "from-bin.toml", "--out", "out", "--no-progress"]) == 0
+    whole = _states(tmp_path / "out")
+    capsys.readouterr()
+    import rebound
+
+    moved = rebound.Simulation(start)  # (the comet moved by 0.5 au)
+    moved.particles[3].x += 0.5
+    moved.save_to_file(str(tmp_path / "start.bin"), delete_file=True)
+    _killed_at_its_end(tmp_path / "out")
+    assert main(["resume", "out", "--no-progress"]) == 0
+    assert ("the scene's [initial] rebound file 'start.bin' has changed since the run began; "
+            "resuming from the state the run began with") in capsys.readouterr().err
+    resumed = _states(tmp_path / "out")
+    assert all(_same(resumed[k], whole[k]) for k in whole)
+
+
+def test_an_aborted_archived_run_says_how_to_resume(tmp_path, capsys):
+    """A second Ctrl-C (the run aborted, no file written) printed only "interrupted
+    (Ctrl-C)", though the archive was there and ``resume`` continues it."""
+    from types import SimpleNamespace
+
+    from hamilton_orbits import cli
+
+    def aborted(**kwargs):
+        raise KeyboardInterrupt
+
+    scene = SimpleNamespace(name="demo", run=aborted)
+    with pytest.raises(KeyboardInterrupt):
+        cli._run_scene(scene, False, tmp_path / "out" / "archive")
+    assert (f"its archive is {tmp_path / 'out' / 'archive'}/: continue the run with "
+            f"hamilton-orbits resume {tmp_path / 'out'}") in capsys.readouterr().err

@@ -258,13 +258,18 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     from hamilton_orbits.checkpoint import holds_snapshots
 
     every = scene.spec.get("output", {}).get("archive_every")
-    if every is None:
-        return None
     archive = Path(folder) / "archive"
     resume = f"hamilton-orbits resume {shlex.quote(str(folder))}"
-    if holds_snapshots(archive):
+    if holds_snapshots(archive):  # (also for a scene that archives nothing: its files
+        # would be taken by a resume of the earlier run)
+        if _finished(archive):
+            raise _CommandError(f"{archive} holds the archive of an earlier run, which "
+                                f"finished (its results are in {folder}/): choose another "
+                                f"--out, or remove {archive} to run into {folder} again")
         raise _CommandError(f"{archive} holds the snapshots of an earlier run: resume it "
                             f"({resume}) or choose another --out")
+    if every is None:
+        return None
     file = _scene_file(ref)
     source = ref if file is None else str(file.resolve())
     record = {"scene": source, "set": list(sets), "text": _scene_text(file, ref),
@@ -280,6 +285,38 @@ def _archive_for(scene, folder, ref: str, sets: Sequence[str]):
     print(f"archiving every {every} to {archive}/ (a killed run resumes with: {resume})",
           file=sys.stderr)
     return archive
+
+
+#: the key of ``archive/scene.json`` that says the run finished (its files written)
+_FINISHED = "finished"
+
+
+def _finished(archive) -> bool:
+    """Whether the scene run that wrote the archive folder ``archive`` finished (its
+    ``scene.json`` says so: written when the run's files were)."""
+    import json
+
+    try:
+        record = json.loads((archive / "scene.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(record, dict) and record.get(_FINISHED) is True
+
+
+def _mark_finished(archive) -> None:
+    """Say in ``archive/scene.json`` that the run finished (rewritten whole; a failure
+    to write it only leaves the run resumable, as before)."""
+    import json
+
+    record_path = archive / "scene.json"
+    try:
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        record[_FINISHED] = True
+        part = archive / f".scene.json.tmp-{os.getpid()}"
+        part.write_text(json.dumps(record), encoding="utf-8")
+        os.replace(part, record_path)
+    except (OSError, ValueError, TypeError):
+        return
 
 
 def _scene_text(file, ref: str) -> str:
@@ -310,6 +347,9 @@ def _resume(out: str, progress: bool) -> int:
     except (OSError, ValueError) as exc:  # (JSONDecodeError and UnicodeDecodeError too)
         raise _CommandError(f"{record} is damaged ({_one_line(exc)}): the run's scene cannot "
                             f"be read; start it again with hamilton-orbits run") from None
+    if source.get(_FINISHED) is True:
+        raise _CommandError(f"the run in {folder} finished (its results are in {folder}/): "
+                            f"there is nothing to resume")
     text = source.get("text")  # (the scene as the run ran it; none in older archives)
     file = _scene_file(source["scene"])
     if text is not None and file is not None and file.is_file() and \
@@ -351,6 +391,8 @@ def _finish(scene, result, folder, archive) -> int:
         _say(f"the run was interrupted; its archive is {archive}/: continue it with "
              f"hamilton-orbits resume {shlex.quote(str(folder))}")
     done = result.complete and not caught and not result.interrupted
+    if done and archive is not None:
+        _mark_finished(archive)
     return EXIT_OK if done else EXIT_INTERRUPTED
 
 
@@ -422,7 +464,11 @@ def _run_scene(scene, progress: bool, archive=None):
         try:
             return scene.run(progress=progress and sys.stderr.isatty(),
                              stop=lambda: bool(interrupted), archive=archive)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt:  # (aborted: no file written, the archive kept)
+            if archive is not None:
+                print(f"hamilton-orbits: its archive is {archive}/: continue the run with "
+                      f"hamilton-orbits resume {shlex.quote(str(archive.parent))}",
+                      file=sys.stderr)
             raise
         except Exception as exc:
             _error(f"the run of {scene.name} failed: {_one_line(exc)}")

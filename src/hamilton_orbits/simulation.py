@@ -250,6 +250,23 @@ class Simulation(Saving):
                                        radius=radius)
 
     @property
+    def initial_system(self) -> System:
+        """The system at time 0 this simulation integrates from: as it was given, or,
+        for a simulation loaded from a snapshot, as the snapshot recorded it (not as a
+        file it was once read from reads now).
+
+        Examples
+        --------
+        >>> from hamilton_orbits import Body, System
+        >>> sim = Simulation(System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+        ...                          Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])]))
+        >>> _ = sim.integrate(1.0)
+        >>> sim.initial_system["p"].r.tolist(), sim.system["p"].r.tolist() != [1.0, 0, 0]
+        ([1.0, 0.0, 0.0], True)
+        """
+        return self._system
+
+    @property
     def effects(self) -> EffectSet:
         """The effects beyond Newtonian gravity."""
         return self._effects

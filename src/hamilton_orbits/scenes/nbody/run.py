@@ -7,6 +7,7 @@ integrals, the events, MEGNO, the analyses, the cross-check and the figures."""
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -85,6 +86,7 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     try:
         if spec["output"]["archive_every"] is not None and resumable(archive):
             sim = Simulation.load(archive)
+            system = _as_the_run_read_it(system, sim.initial_system, spec)
             resumed_from = sim.t if isinstance(sim.t, u.Quantity) else sim.t * u.d
             traj = sim.resume(stop=stop, on_interrupt="keep", on_output=on_output)
         else:
@@ -105,6 +107,23 @@ def run_scene(scene: Any, progress: bool = True, stop=lambda: False,
     if spec["crosscheck"] and result.complete:
         _crosscheck_into(result, system, traj, sim.effects)
     return result
+
+
+def _as_the_run_read_it(system: Any, archived: Any, spec: dict) -> Any:
+    """The system a resumed run began from: the archive's (the scene's starting
+    state as the run read it).  Where the scene builds another now (its ``[initial]
+    rebound`` file changed since the run began), that is said on stderr, and the
+    archive's is the one the result and the cross-check are of."""
+    now, then = system.as_arrays(), archived.as_arrays()
+    same = tuple(system.names) == tuple(archived.names) and all(
+        np.array_equal(getattr(now, k), getattr(then, k)) for k in ("r", "v", "gm"))
+    if not same:
+        source = spec["initial"].get("rebound")
+        what = f"[initial] rebound file {source!r}" if source else "starting state"
+        print(f"hamilton-orbits: the scene's {what} has changed since the run began; "
+              f"resuming from the state the run began with (kept in its archive)",
+              file=sys.stderr)
+    return archived
 
 
 def _events_into(result: Result, traj: Any) -> None:
