@@ -16,6 +16,7 @@ the run, in one line).
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import subprocess
@@ -162,8 +163,34 @@ def test_a_cadence_that_would_fill_memory_is_refused_at_loading():
                          "initial": {"solar_system": {}}})
     (problem,) = info.value.problems
     assert problem.startswith("<dict>: cadence: 3.653e+11 outputs of 9 bodies would take ")
-    assert "beyond the limit of 1 GiB: choose a cadence of at least" in problem
+    assert "beyond the limit of 1 GiB of memory: choose a cadence of at least" in problem
     assert OUTPUT_LIMIT == 2**30
+
+
+@pytest.mark.parametrize(("key", "value", "duration"), [
+    ("cadence", "1e-5 d", "10 yr"), ("cadence", "1e-6 d", "3 yr"),
+    ("output.archive_every", "1e-9 s", "10 yr"), ("output.archive_every", "1e-9 s", "3 yr"),
+])
+def test_the_shortest_interval_a_size_refusal_suggests_passes(key, value, duration):
+    """The interval a size refusal suggested was rounded to nearest and its count
+    left out the output (or snapshot) at the start: "choose an archive_every of at
+    least 1.79e+03 s", and 1.79e+03 s was refused in its turn ("1 GiB, beyond the
+    limit of 1 GiB").  The suggestion is rounded up from the count that fits, and
+    passes."""
+    from hamilton_orbits.cli import _load_scene
+
+    with pytest.raises(SceneError) as info:
+        _load_scene("mercury-gr", [f"duration={duration}", f"{key}={value}"])
+    (problem,) = info.value.problems
+    shortest = re.search(r"of at least (\S+ \S+)", problem).group(1)
+    _load_scene("mercury-gr", [f"duration={duration}", f"{key}={shortest}"])
+    digits = shortest.split()[0]  # (and the interval one step shorter in its 3rd digit fails)
+    mantissa, _, exponent = digits.partition("e")
+    lower = f"{float(mantissa) - 10.0 ** (math.floor(math.log10(float(mantissa))) - 2):.3g}"
+    with pytest.raises(SceneError):
+        _load_scene("mercury-gr", [f"duration={duration}",
+                                   f"{key}={lower}{'e' + exponent if exponent else ''} "
+                                   f"{shortest.split()[1]}"])
 
 
 def test_a_cadence_that_would_fill_memory_does_not_hang_the_command(tmp_path):

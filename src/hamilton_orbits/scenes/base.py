@@ -115,6 +115,27 @@ def _size(nbytes: float) -> str:
     return ""  # pragma: no cover
 
 
+def _beyond(nbytes: float) -> str:
+    """``"X, beyond the limit of Y"``, in bytes where the two would read the same."""
+    size, limit = _size(nbytes), _size(OUTPUT_LIMIT)
+    if size == limit:  # (just beyond it: "1 GiB, beyond the limit of 1 GiB")
+        size, limit = f"{nbytes:.0f} bytes", f"{OUTPUT_LIMIT} bytes"
+    return f"{size}, beyond the limit of {limit}"
+
+
+def _at_least(value: Any) -> str:
+    """A positive Quantity rounded up to 3 significant digits, as text: an interval
+    suggested as the shortest that passes passes (rounded to nearest, "1.79e+03 s"
+    was refused in its turn)."""
+    x = float(value.value)
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    up = math.ceil(x / step) * step
+    text = f"{up:.3g}"
+    if float(text) < x:  # (the product rounded below: one more in the third digit)
+        text = f"{up + step:.3g}"
+    return f"{text} {value.unit.to_string()}"
+
+
 def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output: int,
                       what: str) -> None:
     """Refuse a ``duration`` / ``cadence`` whose outputs would exceed :data:`OUTPUT_LIMIT`.
@@ -137,13 +158,14 @@ def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output:
     nbytes = n * per_output * 8.0
     if nbytes <= OUTPUT_LIMIT:
         return
-    shortest = (duration * per_output * 8.0 / OUTPUT_LIMIT).to(
-        cadence.unit if cadence is not None else duration.unit)
+    # (n = duration / cadence + 1 outputs at most fit: the shortest cadence that keeps
+    # them within the limit, the last output counted)
+    fit = math.floor(OUTPUT_LIMIT / (per_output * 8.0)) - 1.0
+    shortest = (duration / fit).to(cadence.unit if cadence is not None else duration.unit)
     problems.add(
         "cadence" if cadence is not None else "duration",
-        f"{n:.4g} outputs of {what} would take {_size(nbytes)} of memory, beyond the limit of "
-        f"{_size(OUTPUT_LIMIT)}: choose a cadence of at least {shortest:.3g} or a shorter "
-        "duration")
+        f"{n:.4g} outputs of {what} would take {_beyond(nbytes)} of memory: choose a "
+        f"cadence of at least {_at_least(shortest)} or a shorter duration")
 
 
 #: a generous bound on an archive snapshot's bytes per body (radau15's predictor
@@ -164,11 +186,11 @@ def check_archive_size(spec: Mapping[str, Any], problems: S.Problems, bodies: in
     each = SNAPSHOT_BYTES[0] * max(bodies, 1) + SNAPSHOT_BYTES[1]
     if n * each <= OUTPUT_LIMIT:
         return
-    shortest = (duration * each / OUTPUT_LIMIT).to(every.unit)
+    fit = math.floor(OUTPUT_LIMIT / each) - 1.0  # (the snapshot at the start counted)
+    shortest = (duration / fit).to(every.unit)
     problems.add("output.archive_every",
-                 f"{n:.4g} snapshots of {bodies} bodies would take up to {_size(n * each)} "
-                 f"on disk, beyond the limit of {_size(OUTPUT_LIMIT)}: choose an "
-                 f"archive_every of at least {shortest:.3g}")
+                 f"{n:.4g} snapshots of {bodies} bodies would take up to {_beyond(n * each)} "
+                 f"on disk: choose an archive_every of at least {_at_least(shortest)}")
 
 
 def format_value(value: Any) -> str:
