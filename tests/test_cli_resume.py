@@ -193,7 +193,9 @@ def test_a_scene_reading_a_relative_file_resumes_from_another_folder(tmp_path, m
 
 
 @pytest.mark.parametrize("text", ["{\"scene\": \"comet-encounter\", \"set\": [\"a", "", "{}",
-                                  "[]"])
+                                  "[]", '{"scene": "mercury-gr", "set": [1]}',
+                                  '{"scene": "mercury-gr", "text": 5}',
+                                  '{"scene": "mercury-gr", "cwd": []}'])
 def test_resume_of_a_damaged_scene_record_says_so_naming_it(tmp_path, capsys, text):
     """``archive/scene.json`` cut short (a run that could not write it whole) or not
     a run's record gave ``JSONDecodeError``, ``KeyError: 'scene'`` or an

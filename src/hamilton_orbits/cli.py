@@ -342,7 +342,10 @@ def _resume(out: str, progress: bool) -> int:
     try:
         source = json.loads(record.read_text(encoding="utf-8"))
         if not (isinstance(source, dict) and isinstance(source.get("scene"), str)
-                and isinstance(source.get("set", []), list)):
+                and isinstance(source.get("set", []), list)
+                and all(isinstance(x, str) for x in source.get("set", []))
+                and isinstance(source.get("text", ""), (str, type(None)))
+                and isinstance(source.get("cwd", ""), (str, type(None)))):
             raise ValueError("not the record of a run")
     except (OSError, ValueError) as exc:  # (JSONDecodeError and UnicodeDecodeError too)
         raise _CommandError(f"{record} is damaged ({_one_line(exc)}): the run's scene cannot "
