@@ -256,7 +256,11 @@ class Quantity(Field):
             problems.add(path, f"expected {wanted}, got {value!r}")
             return None
         except ValueError as exc:
-            problems.add(path, str(exc))
+            text = str(exc)
+            if isinstance(value, str) and "to be finite, got" in text:  # (quoted as the
+                # file writes it: "1e400 yr" was "got inf")
+                text = f"{text.partition(', got ')[0]}, got {value!r}"
+            problems.add(path, text)
             return None
         if number.shape != ():
             problems.add(path, f"expected one value, got {value!r}")

@@ -567,3 +567,12 @@ def test_an_epoch_set_as_a_date_is_the_text_of_the_date():
     for text in ("2000-01-01", "2000-01-01T12:00:00", " 2001-06-30 "):
         scene = Scene.bundled("stability-map").with_values({"initial.solar_system.epoch": text})
         assert scene.data["initial"]["solar_system"]["epoch"] == text.strip()
+
+
+@pytest.mark.parametrize(("key", "value"), [("duration", "1e400 yr"),
+                                            ("cadence", "nan d")])
+def test_a_non_finite_quantity_is_quoted_as_the_file_writes_it(key, value):
+    """``duration = "1e400 yr"`` was refused as "got inf": the message now quotes the
+    value as written, as every other refusal of a scene value does."""
+    data = {"kind": "nbody", "duration": "2 d", "initial": {"solar_system": {}}, key: value}
+    assert _problems(data) == [f"<dict>: {key}: Expected `{key}` to be finite, got {value!r}"]
