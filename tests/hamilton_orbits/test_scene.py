@@ -576,3 +576,21 @@ def test_a_non_finite_quantity_is_quoted_as_the_file_writes_it(key, value):
     value as written, as every other refusal of a scene value does."""
     data = {"kind": "nbody", "duration": "2 d", "initial": {"solar_system": {}}, key: value}
     assert _problems(data) == [f"<dict>: {key}: Expected `{key}` to be finite, got {value!r}"]
+
+
+def test_a_scene_sets_the_integrator_s_max_steps():
+    """A run beyond the integrator's step budget was refused with "pass max_steps=...
+    to go on", which a scene could not: ``integrator.max_steps`` passes it (and the
+    refusal names it)."""
+    from hamilton_orbits.validation import ConvergenceError
+
+    data = {"kind": "nbody", "duration": "100 d",
+            "initial": {"solar_system": {"bodies": ["sun", "earth"]}}}
+    short = Scene.from_dict({**data, "integrator": {"max_steps": 10}})
+    with pytest.raises(ConvergenceError, match=r"more than max_steps = 10 .*a scene's "
+                                               r"integrator.max_steps"):
+        short.run(progress=False)
+    assert Scene.from_dict({**data, "integrator": {"max_steps": 1000}}).run(
+        progress=False).complete
+    assert _problems({**data, "integrator": {"max_steps": 0}}) == [
+        "<dict>: integrator.max_steps: expected a number >= 1, got 0"]

@@ -250,7 +250,8 @@ def initial_step(r0: np.ndarray, v0: np.ndarray, gm: np.ndarray) -> float:
 MAX_FIXED_STEPS = 1_000_000_000
 
 
-_HINT = "pass max_steps=... to go on, or a shorter span"
+_HINT = ("pass max_steps=... to go on (a scene's integrator.max_steps), or a shorter "
+         "span")
 
 
 def check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray, method: str,

@@ -38,7 +38,8 @@ def simulation(spec: dict, system: Any, archive: Any = None) -> Any:
     from hamilton_orbits import Simulation
 
     integ = spec["integrator"]
-    options = {k: integ[k] for k in ("coordinates", "corrector") if integ[k] is not None}
+    options = {k: integ[k] for k in ("coordinates", "corrector", "max_steps")
+               if integ[k] is not None}
     events = [{k: v for k, v in ev.items() if v is not None} for ev in spec["events"]]
     every = spec["output"]["archive_every"]
     if archive is not None and every is not None:

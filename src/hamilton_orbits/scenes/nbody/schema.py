@@ -90,6 +90,9 @@ SCHEMA: dict[str, S.Field] = {
             # options of ``wh`` (integrate(..., coordinates=, corrector=))
             "coordinates": S.Choice(choices=("democratic_heliocentric", "jacobi")),
             "corrector": S.Number(integer=True, minimum=0),
+            # (every method's: the steps one run may take, the refusal's "pass
+            # max_steps=... to go on" from a scene)
+            "max_steps": S.Number(integer=True, minimum=1),
         },
     ),
     "initial": S.Table(
