@@ -351,6 +351,10 @@ def test_command_lines_that_would_lose_a_value_are_refused(capsys):
     assert main(["ensemble", "leo-j2", "--vary", "duration=0.5 d", "--vary",
                  "duration=0.2 d"]) == 2
     assert "'duration' is varied twice" in capsys.readouterr().err
+    # (one value twice: two members of one name, shown as one column of the table)
+    assert main(["ensemble", "leo-j2", "--vary", "duration=0.5 d,0.2 d,0.5 d"]) == 2
+    assert "'0.5 d' is listed twice; give each value of 'duration' once" in (
+        capsys.readouterr().err)
     assert main(["run", "leo-j2", "--out", ""]) == 2
     assert "--out '': an empty path" in capsys.readouterr().err
 

@@ -527,7 +527,12 @@ def _ensemble(ref: str, varies: Sequence[str], dask: str | None, out: str | None
         if key.strip() in vary:  # (the later would replace the earlier silently)
             raise SceneError([f"{scene.source}: --vary {item!r}: {key.strip()!r} is varied "
                               f"twice; give its values in one --vary KEY=V1,V2,..."])
-        vary[key.strip()] = _split_values(values)
+        listed = _split_values(values)
+        twice = sorted({v for v in listed if listed.count(v) > 1})
+        if twice:  # (two members of one name: one column of the table for both)
+            raise SceneError([f"{scene.source}: --vary {item!r}: {twice[0]!r} is listed "
+                              f"twice; give each value of {key.strip()!r} once"])
+        vary[key.strip()] = listed
     if not vary:  # name the command-line option, not Ensemble's Python arguments
         raise SceneError([f"{scene.source}: ensemble needs at least one --vary KEY=V1,V2,... "
                           "(the values of a key to run)"])
