@@ -424,7 +424,9 @@ class KeplerOrbit(OrbitElements):
             # a copy of the state, propagated in place (the kernel reads a row before
             # it writes it)
             new = self._state.copy() if lead == shape else np.array(
-                np.broadcast_to(self._state, (*lead, 7)))
+                np.broadcast_to(self._state, (*lead, 7)), order="C")  # (C order: the
+            # rows below a view of it; a broadcast's own order made them a copy, and the
+            # orbits came back unpropagated)
             rows = new.reshape(-1, 7)
             r, v = rows[:, :3], rows[:, 3:6]
             if dt_.shape == lead:

@@ -502,3 +502,20 @@ def test_radial_orbit_refuses_its_collision_and_names_the_index(a, M, match):
     e = [0.5 if x > 0 and k == 0 and M[1] == 7.0 else 1.0 for k, x in enumerate(a)]
     with pytest.raises(ValueError, match=match):
         KeplerOrbit.from_elements(a=a, e=e, inc=0.1, lan=0.2, argp=0.3, M=M, mu=1.0)
+
+
+def test_propagate_broadcasts_dt_over_the_orbits():
+    """Two orbits propagated by ``dt`` of shape (2, 1) (a larger broadcast shape than
+    the orbits') came back exactly as they started, with no error: the broadcast
+    copy of the state was not C-ordered, the kernel updated a copy of its rows.
+    Each element must be the orbit propagated alone by its own dt."""
+    o = KeplerOrbit.from_state([[1.0, 0, 0], [2.0, 0, 0]], [0, 1.0, 0], 1.0)
+    dt = np.array([[1.0], [2.0]])
+    p = o.propagate(dt)
+    assert p.shape == (2, 2)
+    r, v = p.state()
+    for i in range(2):
+        for j in range(2):
+            ri, vi = o[j].propagate(float(dt[i, 0])).state()
+            np.testing.assert_array_equal(r[i, j], ri)
+            np.testing.assert_array_equal(v[i, j], vi)
