@@ -142,9 +142,41 @@ def integral_errors(
     lost = integrals.integral_errors(r, v, gm2, t, gone_b, out[0], out[1], out[2])
     if gone is not None and lost >= 0:
         raise LostStateError(divmod(int(lost), n))
-    if extra_energy is not None or _one_centre(gm2):
+    if _one_centre(gm2):  # (the particles' own energies; one removed is NaN from then
+        out[0] = _energy_error(r, v, gm2[0], extra_energy)  # on, passed over)
+    elif extra_energy is not None:
         out[0] = _energy_error(*_present(r, v, gm), extra_energy)
+    else:
+        out[0] = _near_zero_scaled(out[0], r[0], v[0], gm2[0])
     return out[0], out[1], out[2]
+
+
+#: where ``|E(0)|`` is below this fraction of the size of its terms (the kinetic
+#: energy plus the magnitude of the potential), it is known to fewer than half its
+#: digits (a parabola, a pair at escape speed: E(0) is their rounding residue, 1e-19
+#: beside terms of 1e-4), and a change relative to it reads O(1) for a perfect run:
+#: the energy error is then relative to the size of the terms
+NEAR_ZERO = 2.0**-26
+
+
+def _terms(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> tuple[float, float]:
+    """Hamilton's E of one state (gm units) and the size of its terms, ``T + |U|``
+    (the bodies of a non-finite state left out)."""
+    ok = np.isfinite(r).all(axis=1) & np.isfinite(v).all(axis=1)
+    r, v, gm = r[ok], v[ok], gm[ok]
+    kinetic = 0.5 * float(np.einsum("j,jk,jk->", gm, v, v))
+    potential = kinetic - energy_gm(r, v, gm)
+    return kinetic - potential, kinetic + abs(potential)
+
+
+def _near_zero_scaled(error: np.ndarray, r0: np.ndarray, v0: np.ndarray,
+                      gm0: np.ndarray) -> np.ndarray:
+    """The energy error ``(E - E0) / |E0|`` (absolute where ``E0 = 0``) relative to
+    the size of E's terms instead, where ``|E0|`` is below :data:`NEAR_ZERO` of it."""
+    e0, size = _terms(r0, v0, gm0)
+    if not (size > 0 and abs(e0) < NEAR_ZERO * size):
+        return error
+    return error * (abs(e0) / size) if e0 != 0 else error / size
 
 
 def prepare() -> None:
@@ -165,8 +197,12 @@ def prepare() -> None:
 
 
 def _one_centre(gm: np.ndarray) -> bool:
-    """One massive body and test particles, masses unchanged (``gm`` (1, n))."""
-    return gm.shape[0] == 1 and gm.shape[1] > 1 and int(np.count_nonzero(gm[0] > 0)) == 1
+    """One massive body and test particles, its mass unchanged (``gm`` (1, n), or (n_t,
+    n) where events took test particles out of the run, or merged them into it)."""
+    massive = gm[0] > 0
+    return (gm.shape[1] > 1 and int(np.count_nonzero(massive)) == 1
+            and bool(np.all((gm > 0) == massive))
+            and bool(np.all(gm[:, massive] == gm[0, massive])))
 
 
 def _present(r: np.ndarray, v: np.ndarray, gm: np.ndarray
@@ -194,23 +230,28 @@ def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
     # (a body taken out, G m = 0, adds no effect energy: its NaN times 0 was NaN)
     if np.ndim(gm) == 2:  # masses changed (a merge, a removal): Hamilton's E as it is
         energy = energy_gm_many(r, v, gm)
-        if extra is not None:
-            energy = energy + np.einsum("tj,tj->t", np.where(gm > 0, extra, 0.0), gm)
-        return relative_change(energy)
+        effect = 0.0 if extra is None else np.einsum("tj,tj->t", np.where(gm > 0, extra, 0.0),
+                                                      gm)
+        return _near_zero_scaled(relative_change(energy + effect), r[0], v[0], gm[0])
     massive = np.flatnonzero(gm > 0)
     if len(massive) != 1 or len(gm) == 1:
         energy = energy_gm_many(r, v, gm)
-        if extra is not None:
-            energy = energy + np.where(gm > 0, extra, 0.0) @ gm
-        return relative_change(energy)
+        effect = 0.0 if extra is None else np.where(gm > 0, extra, 0.0) @ gm
+        return _near_zero_scaled(relative_change(energy + effect), r[0], v[0], gm)
     s = int(massive[0])
     tp = np.flatnonzero(gm == 0)
     d = r[:, tp] - r[:, s:s + 1]
     w = v[:, tp] - v[:, s:s + 1]
-    eps = 0.5 * np.einsum("tij,tij->ti", w, w) - gm[s] / np.sqrt(np.einsum("tij,tij->ti", d, d))
+    kinetic = 0.5 * np.einsum("tij,tij->ti", w, w)
+    potential = gm[s] / np.sqrt(np.einsum("tij,tij->ti", d, d))
+    eps = kinetic - potential
+    size = kinetic[0] + potential[0]
     if extra is not None:
         eps = eps + extra[:, tp]
-    scale = np.abs(eps[0])
+        size = size + np.abs(extra[0, tp])
+    # (each relative to its own start, or to the size of its terms where the start
+    # is near 0: NEAR_ZERO)
+    scale = np.where(np.abs(eps[0]) >= NEAR_ZERO * size, np.abs(eps[0]), size)
     change = (eps - eps[0]) / np.where(scale > 0, scale, 1.0)
     # (the largest over the particles still in the run: a removed one's is NaN)
     pick = np.argmax(np.where(np.isfinite(change), np.abs(change), -1.0), axis=1)
@@ -375,16 +416,20 @@ def particle_errors(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
         return errors, tuple(checks)
     if len(m) == 2 and _circular(r[0, m], v[0, m], gm0[m]):
         x, jac = _jacobi(r, v, gm0, m, tp), True
+        size = np.abs(x[0])
     else:
         prim = primaries(r[0], v[0], gm0)[tp]
         d = r[:, tp] - r[:, prim]
         w = v[:, tp] - v[:, prim]
-        x = 0.5 * np.einsum("tij,tij->ti", w, w) - gm0[prim] / np.sqrt(
-            np.einsum("tij,tij->ti", d, d))
-        jac = False
+        kinetic = 0.5 * np.einsum("tij,tij->ti", w, w)
+        potential = gm0[prim] / np.sqrt(np.einsum("tij,tij->ti", d, d))
+        x, size, jac = kinetic - potential, kinetic[0] + potential[0], False
     if extra is not None:
         x = x + (-2.0 if jac else 1.0) * extra[:, tp]
-    scale = np.abs(x[0])
+        size = size + np.abs(extra[0, tp]) * (2.0 if jac else 1.0)
+    # (relative to the start, or to the size of the energy's terms where the start is
+    # near 0, a parabolic comet's: NEAR_ZERO)
+    scale = np.where(np.abs(x[0]) >= NEAR_ZERO * size, np.abs(x[0]), size)
     errors[:, tp] = (x - x[0]) / np.where(scale > 0, scale, 1.0)
     for k, i in enumerate(tp):
         checks[i] = "jacobi" if jac else f"energy about {int(prim[k])}"

@@ -480,3 +480,65 @@ def test_an_under_resolved_approach_of_a_backward_run_is_dated_at_its_periapsis(
         traj = integrate(s, -np.arange(0, 10.01, 0.5), method="leapfrog", dt=0.01)
     assert traj.under_resolved["time"][0] == pytest.approx(
         -float(orb.time_since_periapsis), abs=1e-3)
+
+
+def test_energy_error_of_one_centre_after_a_removal_is_the_particles():
+    """One massive body and test particles: an escape that removed a particle made
+    ``gm`` vary over the run, and the energy error fell back to Hamilton's E of the
+    one massive body, identically 0 for the whole run (a 3.9% drift of a comet
+    integrated with far too long a step read as perfect).  It is the particles'
+    own energies, as without the removal (the comet's two-body energy about the Sun
+    computed here from the trajectory)."""
+    import astropy.units as u
+
+    from hamilton_orbits import Body, System, integrate
+
+    gm = 1.32712440018e11 * u.km**3 / u.s**2
+    s = System([Body("sun", gm, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                Body("comet", 0 * gm, [0.3, 0, 0] * u.au, [0, 70, 0] * u.km / u.s),
+                Body("x", 0 * gm, [1, 0.1, 0] * u.au, [0, 60, 0] * u.km / u.s)])
+    times = np.linspace(0, 3, 7) * u.yr
+    with pytest.warns(UserWarning):  # (the step is too long for the comet's perihelion)
+        rem = integrate(s, times, method="leapfrog", dt=8 * u.day,
+                        events=[{"name": "escape", "distance": 3 * u.au, "action": "remove"}])
+    mu = gm.to_value(u.au**3 / u.day**2)
+    d = (rem.r[:, 1] - rem.r[:, 0]).to_value(u.au)
+    w = (rem.v[:, 1] - rem.v[:, 0]).to_value(u.au / u.day)
+    eps = 0.5 * (w**2).sum(1) - mu / np.linalg.norm(d, axis=1)
+    assert len(rem.events) == 1 and np.isnan(rem.r[-1, 2].value).all()
+    np.testing.assert_allclose(rem.energy_error, (eps - eps[0]) / abs(eps[0]), rtol=1e-12,
+                               atol=1e-15)
+    assert np.max(np.abs(rem.energy_error)) > 0.03
+
+
+def test_energy_error_of_an_energy_near_zero_is_relative_to_its_terms():
+    """A parabolic comet (E(0) = -5e-20 beside terms of 2e-4, its rounding residue)
+    integrated to rounding read ``max |dE/E| = 1``, and an equal-mass pair at escape
+    speed 0.5: changes of rounding size relative to a rounding residue.  Where
+    ``|E(0)|`` is below 2^-26 of its terms, the error is relative to the terms; the
+    run then reads at rounding level (bound 1e-14: radau15's error on these runs).
+    A bound orbit's error is unchanged."""
+    import astropy.units as u
+
+    from hamilton_orbits import Body, KeplerOrbit, System, integrate
+    from hamilton_orbits.integrals import integral_errors
+
+    mu = 1.32712440018e11 * u.km**3 / u.s**2
+    o = KeplerOrbit.from_elements(q=1 * u.au, e=1.0, inc=10 * u.deg, lan=0 * u.deg,
+                                  argp=0 * u.deg, nu=-60 * u.deg, mu=mu)
+    r, v = o.state()
+    comet = System([Body("sun", mu, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                    Body("comet", 0 * mu, r, v)])
+    vv = np.sqrt(0.5)
+    pair = System([Body("a", 1.0, [-1, 0, 0], [0, -vv, 0]), Body("b", 1.0, [1, 0, 0], [0, vv, 0])])
+    for system, times in ((comet, np.linspace(0, 1, 5) * u.yr), (pair, np.linspace(0, 10, 5))):
+        assert np.max(np.abs(integrate(system, times).energy_error)) < 1e-14
+    # a bound pair: the error relative to |E(0)| as before, bit for bit
+    rr = np.array([[[-1.0, 0, 0], [1.0, 0, 0]], [[-1.0, 0, 0], [1.0, 0, 0]]])
+    vb = np.zeros((2, 2, 3))
+    vb[:, 0, 1], vb[:, 1, 1] = -0.3, 0.3
+    vb[1, 1, 1] = 0.3 + 2.0**-30
+    e0 = 0.5 * 0.09 * 2 - 0.5
+    e1 = 0.5 * (0.09 + (0.3 + 2.0**-30) ** 2) - 0.5
+    assert integral_errors(rr, vb, np.array([1.0, 1.0]), np.array([0.0, 1.0]))[0][1] == \
+        pytest.approx((e1 - e0) / abs(e0), rel=1e-6)
