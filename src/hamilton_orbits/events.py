@@ -96,6 +96,8 @@ NAMES = {code: name for name, (code, _, _) in EVENTS.items()}
 W_CODE, W_I, W_J, W_DIST, W_ACTION = range(5)
 #: Columns of a recorded event: code, i, j, time, distance, speed, action.
 E_CODE, E_I, E_J, E_TIME, E_DIST, E_SPEED, E_ACTION = range(7)
+#: no body (a stop takes none out; -1 is the second body of a one-body event's row)
+_NOBODY = -2
 N_EVENT_COLUMNS = 7
 
 
@@ -516,7 +518,7 @@ class EventLog:
         self.drain()
         code, i, j, _, action = self.watch[row]
         i, j, action = int(i), int(j), int(action)
-        gone = -1 if action == ACTIONS["stop"] else j if action == ACTIONS["merge"] else i
+        gone = _NOBODY if action == ACTIONS["stop"] else j if action == ACTIONS["merge"] else i
         acting = self._kept_until(code, i, j, action, t, t if at is None else at, gone)
         if action == ACTIONS["stop"]:
             self.stopped_by = acting
@@ -539,12 +541,15 @@ class EventLog:
                     gone: int) -> int:
         """Keep the rows up to the event that acts: the row of this watch entry (its
         pair, code and action) at or before ``t`` nearest to ``at``, its time.  What the
-        scan found later in the same step did not happen, the run going on (or ending)
-        from it: with wh and leapfrog, which act at the end of the step, the rows
-        after the contact but within the step were kept, and a stop named the last
-        of them.  At the same instant, a row of another pair of the body the action
-        takes out (``gone``) did not happen either (a body touching two others at
-        once merges into the first).  Returns the index of the row that acts."""
+        scan found later in the same step did not happen, the run going on (or
+        ending) from it.  With wh and leapfrog, which act at the end of the step
+        (``at < t``), the run has passed through the rest of the step: the rows of
+        other bodies up to ``t`` are kept, those of the acting pair after its event
+        dropped (they kept them all, listed a second merge of a pair merged once,
+        and a stop named the last contact).  At the same instant, a row of another
+        pair of the body the action takes out (``gone``) did not happen either (a
+        body touching two others at once merges into the first).  Returns the index
+        of the row that acts."""
         mine = [k for k, x in enumerate(self.rows)
                 if x[E_I] == i and x[E_J] == j and x[E_CODE] == code and x[E_ACTION] == action
                 and x[E_TIME] <= t]
@@ -553,9 +558,16 @@ class EventLog:
             return len(self.rows) - 1
         acting = min(mine, key=lambda k: (abs(self.rows[k][E_TIME] - at), -k))
         t_ev = self.rows[acting][E_TIME]
-        kept = [k for k, x in enumerate(self.rows)
-                if x[E_TIME] < t_ev or k == acting
-                or (x[E_TIME] == t_ev and gone not in (int(x[E_I]), int(x[E_J])))]
+
+        def happened(k: int, x: np.ndarray) -> bool:
+            bodies = (int(x[E_I]), int(x[E_J]))
+            if x[E_TIME] < t_ev or k == acting:
+                return True
+            if x[E_TIME] == t_ev:
+                return gone not in bodies
+            return x[E_TIME] <= t and t_ev < t and i not in bodies and j not in bodies
+
+        kept = [k for k, x in enumerate(self.rows) if happened(k, x)]
         self.rows = [self.rows[k] for k in kept]
         return kept.index(acting)
 

@@ -559,22 +559,29 @@ def test_a_fixed_step_contact_ends_what_its_step_found_after_it(method, action):
     the step's scan found up to that end: after the contact of p1 and p2 (t = 16.010)
     the table listed a close encounter of the pair at 16.09, a second contact at
     16.35 (two merges of one pair, the run merging once) and another encounter, and
-    a stop named the last contact (16.35) as ``stopped_by``.  Now the rows end at
-    the first contact, which is the one that acts."""
+    a stop named the last contact (16.35) as ``stopped_by``.  Now the pair's rows
+    end at its first contact, the one that acts; the other bodies' rows of the rest
+    of the step, which the run passed through, are kept (p3 and p4 pass each other
+    at 16.2343 inside the step [16.0, 16.5]: radau15 lists it too)."""
     gs = 0.01720209895**2
+    vc = 0.01720209895 / np.sqrt(3.0)
     s = System([Body("sun", gs, [0, 0, 0], [0, 0, 0], radius=0.00465),
                 Body("p1", gs * 1e-3, [1, 0, 0], [0, 0.0172, 0], radius=0.001),
-                Body("p2", gs * 1e-3, [1.0, 0.05, 0], [0, 0.0172, 0.0005], radius=0.001)])
-    tr = integrate(s, 40.0, method=method, dt=0.5,
+                Body("p2", gs * 1e-3, [1.0, 0.05, 0], [0, 0.0172, 0.0005], radius=0.001),
+                Body("p3", gs * 1e-12, [0, 3, 0], [-vc, 0, 0]),
+                Body("p4", gs * 1e-12, [0.1625, 3.005, 0], [-vc - 0.01, 0, 0])])
+    tr = integrate(s, 17.0, method=method, dt=0.5,
                    events=[{"name": "collision", "action": action},
                            {"name": "close_encounter", "distance": 0.02}])
-    contact = [row for row in tr.events if row["name"] == "collision"]
-    assert len(contact) == 1
-    assert max(float(row["time"]) for row in tr.events) == float(contact[0]["time"])
-    assert 15.9 < float(contact[0]["time"]) < 16.1  # (radau15: 15.9968)
+    pair = [row for row in tr.events if str(row["bodies"]) == "p1-p2"]
+    assert [str(row["name"]) for row in pair] == ["collision"]
+    assert 15.9 < float(pair[0]["time"]) < 16.1  # (radau15: 15.9968)
+    other = [row for row in tr.events if str(row["bodies"]) == "p3-p4"]
+    assert len(other) == 1 and abs(float(other[0]["time"]) - 16.2343) < 1e-4
     if action == "stop":
         assert tr.stopped_by["name"] == "collision"
-        assert float(tr.stopped_by["time"]) == float(contact[0]["time"])
+        assert float(tr.stopped_by["time"]) == float(pair[0]["time"])
+        assert float(tr.t[-1]) == 16.5  # (the end of the contact's step)
 
 
 @pytest.mark.parametrize("method", ["radau15", "dop853", "wh"])
