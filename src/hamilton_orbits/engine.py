@@ -61,10 +61,13 @@ from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["EngineRun", "Propagation", "StopIntegration", "integrator", "run"]
 
-
-
-#: a time in a driver's message (``t = 0.9`` or ``t_out[1] = 1.0``; not ``dt =``)
-_TIME_IN_MESSAGE = re.compile(r"(?<![\w.])(t|t_out\[\d+\]) = (-?(?:\d[\d.]*(?:e[+-]?\d+)?|inf))")
+#: a number in a driver's message
+_NUMBER = r"(-?(?:\d[\d.]*(?:e[+-]?\d+)?|inf))"
+#: the times in a driver's message: ``between t = 0.5 and 0.9``, ``reached t = 0.5 of
+#: 1.0``, ``t = 0.9``, ``t_out[1] = 1.0`` (not ``dt = ...``)
+_TIME_IN_MESSAGE = re.compile(
+    rf"(?<![\w.])(?:(between t = ){_NUMBER}( and ){_NUMBER}|(reached t = ){_NUMBER}( of )"
+    rf"{_NUMBER}|(t = |t_out\[\d+\] = ){_NUMBER})")
 
 
 def _turned_back(message: str) -> str:
@@ -78,10 +81,12 @@ def _turned_back(message: str) -> str:
     'radau15 stopped at t = -0.5 before t_out[1] = -1.0 (dt = 1e-16)'
     """
     def back(match: re.Match[str]) -> str:
-        x = match.group(2)
-        return f"{match.group(1)} = {x[1:] if x.startswith('-') else '-' + x}"
+        parts = [x for x in match.groups() if x is not None]  # (words, numbers in turn)
+        return "".join(x if k % 2 == 0 else (x[1:] if x.startswith("-") else "-" + x)
+                       for k, x in enumerate(parts))
 
     return _TIME_IN_MESSAGE.sub(back, message)
+
 
 @dataclass(slots=True)
 class EngineRun:
@@ -333,8 +338,11 @@ class Propagation:
             self.variational.new_leg(n_t)
         reached = [0, 0]  # last output index, steps
 
+        calling = [False]  # (a callback's own error is not the driver's: left as it is)
+
         def report(i: int, steps: int) -> None:
             reached[0], reached[1] = i, steps
+            calling[0] = True
             if checkpoint is not None:
                 self._stand_at(float(t_out[i]), r_out[i], v_out[i])
                 checkpoint(i)
@@ -342,6 +350,7 @@ class Propagation:
                 on_output(i, steps)
             if stop is not None and stop():
                 raise StopIntegration
+            calling[0] = False
 
         t_reached = t_out
         start, steps0 = time.perf_counter(), driver.steps
@@ -364,8 +373,9 @@ class Propagation:
             complete, interrupted = False, True
         except BaseException as exc:  # (an error, the driver's or a callback's: the
             self._between_outputs(driver)  # propagation keeps the state reached, as on
-            if backward and type(exc) in (ConvergenceError, ValueError):  # Ctrl-C)
-                raise type(exc)(_turned_back(str(exc))) from None
+            if (backward and not calling[0] and isinstance(exc, (ConvergenceError, ValueError))
+                    and exc.args and isinstance(exc.args[0], str)):  # Ctrl-C)
+                exc.args = (_turned_back(exc.args[0]), *exc.args[1:])  # (its traceback kept)
             raise
         wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
         k = reached[0] + 1

@@ -118,3 +118,25 @@ def test_a_backward_run_names_its_own_times_when_it_fails(method, kind, pattern)
     with pytest.raises(Exception, match=pattern) as info:
         integrate(s, -1.0, method=method)
     assert type(info.value).__name__ == kind
+
+
+def test_a_backward_run_s_messages_are_turned_back_and_a_callback_s_left_alone():
+    """The budget's refusal of a backward run read "reached t = -3.18 of 100.0" (or,
+    from dop853, ``np.float64(15.05)`` unconverted); and a callback's own ValueError
+    mentioning a time was rewritten as if the driver's, its traceback cut.  The
+    driver's messages are turned back whole; a callback's error is its own."""
+    from hamilton_orbits import Body, Simulation, System, integrate
+    from hamilton_orbits.validation import ConvergenceError
+
+    s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1e-3, [1, 0, 0], [0, 1, 0])])
+    for method in ("radau15", "dop853"):
+        with pytest.raises(ConvergenceError, match=rf"{method} reached t = -\d+\.\d+ of -100.0 "
+                                                   r"in \d+ steps"):
+            integrate(s, -100.0, method=method, max_steps=20)
+
+    def check(i, steps):
+        raise ValueError("my check failed at t = 2.0")
+
+    with pytest.raises(ValueError, match=r"^my check failed at t = 2.0$") as info:
+        Simulation(s).integrate(-1.0, on_output=check)
+    assert info.traceback[-1].name == "check"

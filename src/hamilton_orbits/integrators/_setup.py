@@ -273,7 +273,7 @@ def check_pace(total: int, max_steps: int, t: float, t_out: np.ndarray, method: 
     projected = total * abs(t_out[-1] - t_out[0]) / covered if covered > 0 else math.inf
     if total >= max_steps or projected > 100.0 * max_steps:
         raise ConvergenceError(
-            f"{method} reached t = {t!r} of {float(t_out[-1])!r} in {total} steps; at this "
+            f"{method} reached t = {float(t)!r} of {float(t_out[-1])!r} in {total} steps; at this "
             f"pace the run needs about {projected:.3g} steps, more than max_steps = "
             f"{max_steps} (a step far shorter than the span: {hint or _HINT})"
         )
