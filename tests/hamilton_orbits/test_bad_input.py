@@ -894,3 +894,22 @@ def test_a_crosscheck_of_a_trajectory_of_other_effect_parameters_is_refused():
                                          r"\(\[\{'name': 'gr', 'c': 100.0\}\]\), got "
                                          r"\[\{'name': 'gr', 'c': 10.0\}\]"):
         crosscheck(s, 2.0, effects=[{"name": "gr", "c": 10.0}], trajectory=traj)
+
+
+def test_a_size_refusal_where_no_interval_fits_says_so():
+    """Where one snapshot (or the start's and end's outputs) already exceeds half the
+    limit, the shortest interval that fits is none: the suggestion divided by a
+    count of 0 or less raised OverflowError (600 000 bodies) or "math domain error"
+    (2 000 000).  It says no interval fits."""
+    from hamilton_orbits import schema as S
+    from hamilton_orbits.scenes.base import check_archive_size, check_output_size
+
+    for bodies in (600_000, 2_000_000):
+        problems = S.Problems("x")
+        check_archive_size({"duration": 10 * u.yr, "output": {"archive_every": 1 * u.yr}},
+                           problems, bodies)
+        assert "no archive_every fits; leave it out" in problems.items[0]
+    problems = S.Problems("x")
+    check_output_size({"duration": 10 * u.yr, "cadence": 1 * u.yr}, problems, 6 * 30_000_000,
+                      "30e6 bodies")
+    assert "the start and the end alone 2.68 GiB: fewer bodies" in problems.items[0]

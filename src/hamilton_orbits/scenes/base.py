@@ -161,6 +161,12 @@ def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output:
     # (n = duration / cadence + 1 outputs at most fit: the shortest cadence that keeps
     # them within the limit, the last output counted)
     fit = math.floor(OUTPUT_LIMIT / (per_output * 8.0)) - 1.0
+    if fit < 1.0:  # (two outputs, the start and the end, do not fit)
+        problems.add("cadence" if cadence is not None else "duration",
+                     f"{n:.4g} outputs of {what} would take {_beyond(nbytes)} of memory, and "
+                     f"the start and the end alone {_size(2 * per_output * 8.0)}: fewer "
+                     f"bodies")
+        return
     shortest = (duration / fit).to(cadence.unit if cadence is not None else duration.unit)
     problems.add(
         "cadence" if cadence is not None else "duration",
@@ -187,6 +193,12 @@ def check_archive_size(spec: Mapping[str, Any], problems: S.Problems, bodies: in
     if n * each <= OUTPUT_LIMIT:
         return
     fit = math.floor(OUTPUT_LIMIT / each) - 1.0  # (the snapshot at the start counted)
+    if fit < 1.0:  # (two snapshots, the start's and one more, do not fit)
+        problems.add("output.archive_every",
+                     f"{n:.4g} snapshots of {bodies} bodies would take up to "
+                     f"{_beyond(n * each)} on disk, and two snapshots alone {_size(2 * each)}: "
+                     f"no archive_every fits; leave it out")
+        return
     shortest = (duration / fit).to(every.unit)
     problems.add("output.archive_every",
                  f"{n:.4g} snapshots of {bodies} bodies would take up to {_beyond(n * each)} "
