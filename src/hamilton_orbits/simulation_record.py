@@ -73,7 +73,12 @@ def from_json(value: Any) -> Any:
 
             return u.Quantity(value["__quantity__"], u.Unit(value["unit"]), dtype=np.float64)
         if "__array__" in value:
-            return np.array(value["__array__"], dtype=np.dtype(value.get("dtype", "<f8")))
+            if "dtype" in value:
+                return np.array(value["__array__"], dtype=np.dtype(value["dtype"]))
+            try:  # (written without a dtype: floats, or, by a version that lost the
+                return np.array(value["__array__"], dtype=np.float64)  # dtype, names)
+            except (TypeError, ValueError):
+                return np.array(value["__array__"])
         if "__time__" in value:
             from astropy.time import Time
 

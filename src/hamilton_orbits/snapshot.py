@@ -255,7 +255,11 @@ def read(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np.nda
     if checksum(meta_text, arrays) != stored:
         raise SnapshotError(f"{path} is corrupted: its checksum does not match its "
                             f"contents")
-    return json.loads(meta_text, object_hook=_untagged), arrays
+    try:
+        meta = json.loads(meta_text, object_hook=_untagged if version >= 2 else None)
+    except ValueError as exc:  # (a tag that is not a float's: never written by us)
+        raise SnapshotError(f"{path} cannot be read as a snapshot ({exc})") from None
+    return meta, arrays
 
 
 def strict_json(meta: Any) -> str:

@@ -135,3 +135,13 @@ def test_arrays_that_are_not_floats_come_back_as_they_were():
         assert back.dtype == a.dtype and back.tolist() == a.tolist()
     assert to_json(np.array([0.5])) == {"__array__": [0.5]}
     assert from_json({"__array__": [1, 2]}).dtype == np.float64
+
+
+def test_an_array_of_names_written_without_its_dtype_reads_as_names():
+    """Archives written before the arrays kept their dtype hold an event's names as
+    ``{"__array__": ["p1", "p2"]}``: read as floats they failed ("could not convert
+    string to float"); an array that is not numbers is read as it was written."""
+    from hamilton_orbits.simulation_record import from_json
+
+    assert from_json({"__array__": ["p1", "p2"]}).tolist() == ["p1", "p2"]
+    assert from_json({"__array__": [1, 2]}).dtype == np.float64

@@ -356,7 +356,7 @@ _CROSSING = 1.4901161193847656e-08
 
 
 @njit(cache=True, inline="always")
-def _dt_prs23(a0, b, n, dt_done, eps, least):  # pragma: no cover - compiled
+def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     """Pham, Rein & Spiegel (2024): the shortest timescale
     ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
     from the polynomial at the end of the step (derivatives per unit h).  A body
@@ -373,9 +373,10 @@ def _dt_prs23(a0, b, n, dt_done, eps, least):  # pragma: no cover - compiled
     the midpoint of a pair, Sitnikov's problem) has ``tau -> 0`` as the step's end
     nears the crossing: each step covers a quarter of what is left to it, and the
     steps fall to the rounding of ``t`` without reaching it (rebound's IAS15 then
-    takes thousands of steps that do not advance ``t``).  Where the step would be at
-    most ``least`` (no longer advancing ``t``), the bodies at such a crossing are
-    left out (:func:`_without_crossings`) and the step is that of the others; a
+    takes thousands of steps that do not advance ``t``).  Where the step would no
+    longer advance the time it starts from (``t``, the start of the step just taken,
+    where it is rejected and taken again; its end otherwise), the bodies at such a
+    crossing are left out (:func:`_without_crossings`) and the step is that of the others; a
     collision (accelerations that grow) or a tolerance below rounding still
     underflow, as before.  Elsewhere the rule is the paper's, to the bit.  Returns
     the next step."""
@@ -389,7 +390,8 @@ def _dt_prs23(a0, b, n, dt_done, eps, least):  # pragma: no cover - compiled
             top = a_end
     if min_tau2 < math.inf:
         dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
-        if dt_new <= least:
+        start = t if dt_new < _SAFETY * dt_done else t + dt_done  # (:func:`_next_dt`)
+        if dt_new <= 4.0 * _EPS * abs(start):  # (as :func:`_try_length` refuses it)
             rest = _without_crossings(a0, b, n, top)
             if rest < math.inf:
                 return math.sqrt(rest) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
@@ -536,7 +538,7 @@ def _corrected(accel, p, r, v, gm, a0_2, x0, v0, t, dt_try, q, st, b, br, d, g, 
 
 @njit(cache=True)
 def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing, t):  # pragma: no cover - compiled
-    """The step after one of ``dt_done`` (planned ``dt``) ending at ``t``, and whether to
+    """The step after one of ``dt_done`` (planned ``dt``) begun at ``t``, and whether to
     accept it.
     (Called from the loop, not inlined: inlined, its two rules cost 0.5 s more of
     a first run's compilation; called once a step, the call costs nothing measurable.)
@@ -550,7 +552,7 @@ def _next_dt(st, a0, b, at, r, v, dt_done, dt, landing, t):  # pragma: no cover 
     n = r.shape[0]
     m = 3 * n
     if st[ST_PRS23] != 0.0:
-        dt_new = _dt_prs23(a0, b, n, dt_done, eps, 4.0 * _EPS * abs(t))
+        dt_new = _dt_prs23(a0, b, n, dt_done, eps, t)
     else:
         dt_new = _dt_global(at.reshape(m), b, r.reshape(m), v.reshape(m), n, dt_done, eps)
     if dt_new < _SAFETY * dt_done:
@@ -693,7 +695,7 @@ def _steps(
             status = STATUS_NONFINITE
             break
         # adaptive: the step-size rule (called, not inlined); fixed steps: no call
-        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing, t + dt_try) \
+        dt_new, ok = _next_dt(st, a0, b, at, r, v, dt_try, dt, landing, t) \
             if st[ST_EPSILON] > 0.0 else (dt, True)
         if not ok:
             dt = dt_new
@@ -876,7 +878,7 @@ def advance_variational(
             status = STATUS_NONFINITE
             break
         dt_new, ok = _next_dt(st, a0, b, at[:n_phys], r[:n_phys], v[:n_phys], dt_try, dt,
-                              landing, t + dt_try)
+                              landing, t)
         if not ok:
             dt = dt_new
             continue
