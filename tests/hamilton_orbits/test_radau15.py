@@ -486,11 +486,12 @@ def test_a_body_whose_acceleration_passes_through_zero_is_crossed():
     acceleration passes through zero, so its PRS23 timescale ``|a| / |a'|`` does
     too: each step covered a quarter of what was left to the crossing and the run
     stopped there (t = 0.4685 on this grid: "the step underflowed ... a
-    collision?"), nothing being near anything.  Now it crosses; z(t) through three
-    crossings against the axis's own equation ``z'' = -2 z / (1/4 + z^2)^(3/2)`` integrated by scipy's DOP853 at
-    rtol 1e-13 (agreement 6e-14: radau15's error at its default tolerance, bounded at
-    1e-12), and the rule stays the paper's elsewhere (the steps' bits are those of
-    the rule without the crossing's exception on every run of this module)."""
+    collision?"), nothing being near anything.  Now it crosses; z(t) through
+    three crossings against the axis's own equation
+    ``z'' = -2 z / (1/4 + z^2)^(3/2)`` integrated by scipy's DOP853 at rtol 1e-13
+    (agreement 6e-14: radau15's error at its default tolerance, bounded at 1e-12),
+    and the rule stays the paper's elsewhere (the steps' bits are those of the rule
+    without the crossing's exception on every run of this module)."""
     from scipy.integrate import solve_ivp
 
     from hamilton_orbits import Body, Simulation, System
