@@ -329,6 +329,24 @@ def crosscheck(
     )
 
 
+def _same_physics(a: EffectSet, b: EffectSet, system: System) -> bool:
+    """Whether two effect sets are the same physics for ``system``: the same effects,
+    each with the same parameter vector to 8 eps (``c`` given as its default value,
+    299792.458 km/s converted at 1 ulp from the default in au/day, or left out
+    alike; parameters that are lists compared as well, where a set of the items was
+    refused as unhashable), in any order."""
+    try:
+        pa, pb = a.parameters(system), b.parameters(system)
+    except ValueError:
+        return False
+    ka = sorted((name, tuple(np.ravel(x).tolist())) for name, x in zip(a.names, pa, strict=True))
+    kb = sorted((name, tuple(np.ravel(x).tolist())) for name, x in zip(b.names, pb, strict=True))
+    return len(ka) == len(kb) and all(
+        x[0] == y[0] and len(x[1]) == len(y[1])
+        and np.allclose(x[1], y[1], rtol=8 * np.finfo(float).eps, atol=0.0)
+        for x, y in zip(ka, kb, strict=True))
+
+
 def _check_same_run(system: System, trajectory: Any, times: np.ndarray, t: Any,
                     effects: EffectSet) -> None:
     """Refuse a trajectory of other effects than ``effects`` (rebound would run other
@@ -338,7 +356,7 @@ def _check_same_run(system: System, trajectory: Any, times: np.ndarray, t: Any,
     mine = tuple(n for n in effects.names if n != "newtonian")
     listed = getattr(trajectory, "effect_set", None)  # (with their parameters, if held)
     if sorted(theirs) != sorted(mine) or (listed is not None
-                                          and set(listed.items) != set(effects.items)):
+                                          and not _same_physics(listed, effects, system)):
         raise ValueError(f"Expected `effects` to be those of `trajectory` "
                          f"({listed.as_list() if listed is not None else list(theirs)}), got "
                          f"{effects.as_list()}: rebound would integrate other physics; give "

@@ -896,6 +896,25 @@ def test_a_crosscheck_of_a_trajectory_of_other_effect_parameters_is_refused():
         crosscheck(s, 2.0, effects=[{"name": "gr", "c": 10.0}], trajectory=traj)
 
 
+def test_a_crosscheck_compares_the_physics_of_the_effects_not_how_they_were_written():
+    """The trajectory's effects were compared with the ones given as a set of their
+    items: parameters that are lists (``zonal``'s ``j``, ``eih``'s ``sources``) raised
+    ``TypeError: unhashable type: 'list'``, and ``c`` given as its default value
+    (299792.458 km/s) was refused as "other physics" beside ``gr`` with no ``c``.
+    They are compared as the parameter vectors the run integrates (to 8 eps)."""
+    s = System.from_ephemeris(bodies=["sun", "mercury"])
+    traj = integrate(s, 10 * u.d, effects=[{"name": "gr", "c": 299792.458 * u.km / u.s}])
+    assert crosscheck(s, 10 * u.d, trajectory=traj, effects=["gr"]) is not None
+    with pytest.raises(ValueError, match=r"Expected `effects` to be those of `trajectory`"):
+        crosscheck(s, 10 * u.d, trajectory=traj,
+                   effects=[{"name": "gr", "c": 299792.0 * u.km / u.s}])
+    three = System.from_ephemeris(bodies=["sun", "earth", "moon"])
+    zonal = [{"name": "zonal", "j": [1.08e-3]}]
+    traj = integrate(three, 1 * u.d, effects=zonal)
+    with pytest.raises(ValueError, match=r"Effect 'zonal' has no reboundx counterpart"):
+        crosscheck(three, 1 * u.d, trajectory=traj, effects=zonal)
+
+
 def test_a_size_refusal_where_no_interval_fits_says_so():
     """Where one snapshot (or the start's and end's outputs) already exceeds half the
     limit, the shortest interval that fits is none: the suggestion divided by a

@@ -2,7 +2,13 @@
 
 ``gr``
     The first post-Newtonian correction of the one-body metric (Anderson et al.
-    1975, as reboundx's ``gr``), velocity dependent; kernel
+    1975), velocity dependent: every other body as a test particle in the
+    source's field.  reboundx's ``gr`` puts each body's whole Newtonian
+    acceleration (the source's pull and every other's) in its 1PN terms: the two
+    agree where the source's pull dominates (the planets about the Sun), and
+    differ for a body pulled by another (the Moon: 2 km in a year of a
+    ``crosscheck`` of Sun, Earth and Moon); ``eih`` is the n-body 1PN equation
+    (reboundx's ``gr_full``) for such systems; kernel
     :func:`~hamilton_orbits._kernels.nbody.gr_anderson`, Jacobian
     :func:`~hamilton_orbits._kernels.jacobians.gr_anderson_jvp`.
 ``gr_potential``
