@@ -33,6 +33,7 @@ __all__ = [
     "particle_name",
     "rebound_accelerations",
     "rebound_trajectory",
+    "reboundx_counterparts",
     "to_rebound",
 ]
 
@@ -96,28 +97,54 @@ def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
                           "pip install 'hamilton-orbits[crosscheck]'") from None
 
     rebx = reboundx.Extras(sim)
-    for name, params in effects:
-        # the effect's own parameter builder: one validation and one unit rule for both codes
-        p = get("nbody", name).params(system, dict(params))
+    for name, p in reboundx_counterparts(system, effects):
         if name in ("gr", "gr_potential"):  # p = [source, c]
             force = rebx.load_force(name)
             rebx.add_force(force)
             force.params["c"] = float(p[1])
             sim.particles[int(p[0])].params["gr_source"] = 1
-        elif name == "j2":  # p = [body, j2, radius, pole]
+        else:  # j2: p = [body, j2, radius, pole]
             force = rebx.load_force("gravitational_harmonics")
             rebx.add_force(force)
             b = int(p[0])
-            if tuple(p[3:]) != (0.0, 0.0, 1.0):
-                raise ValueError(
-                    "reboundx's gravitational_harmonics takes the pole along z; rotate the "
-                    f"system so that body {system.names[b]!r} has its pole on z to cross-check"
-                )
             sim.particles[b].params["J2"] = float(p[1])
             sim.particles[b].params["R_eq"] = float(p[2])
-        else:
-            raise ValueError(f"Effect {name!r} has no reboundx counterpart to cross-check")
     return rebx
+
+
+def reboundx_counterparts(system: System, effects: Any) -> list[tuple[str, np.ndarray]]:
+    """The listed effects with their parameter vectors, where reboundx can run each
+    (``gr``, ``gr_potential``, ``j2`` with its pole on z): checked before anything is
+    integrated (a scene with ``crosscheck = true`` is refused as it loads, not after
+    its run).
+
+    Raises
+    ------
+    ValueError
+        Naming an effect without a reboundx counterpart, or a ``j2`` pole off z.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
+    >>> reboundx_counterparts(s, [{"name": "eih", "c": 1e4}])
+    Traceback (most recent call last):
+    ...
+    ValueError: Effect 'eih' has no reboundx counterpart to cross-check
+    """
+    out = []
+    for name, params in EffectSet.of(effects, "nbody"):
+        if name not in ("gr", "gr_potential", "j2"):
+            raise ValueError(f"Effect {name!r} has no reboundx counterpart to cross-check")
+        # the effect's own parameter builder: one validation and one unit rule for both codes
+        p = get("nbody", name).params(system, dict(params))
+        if name == "j2" and tuple(p[3:]) != (0.0, 0.0, 1.0):
+            raise ValueError(
+                "reboundx's gravitational_harmonics takes the pole along z; rotate the "
+                f"system so that body {system.names[int(p[0])]!r} has its pole on z to "
+                f"cross-check")
+        out.append((name, p))
+    return out
 
 
 @dataclass
@@ -297,6 +324,7 @@ def crosscheck(
     from hamilton_orbits.simulation import integrate
 
     effects = EffectSet.of(effects, "nbody")
+    reboundx_counterparts(system, effects)  # (refused before our run, not after it)
     if trajectory is None:
         trajectory = integrate(system, t, method=method, dt=dt, tol=tol, effects=effects,
                                progress=progress)

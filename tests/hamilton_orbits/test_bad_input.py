@@ -932,3 +932,17 @@ def test_a_size_refusal_where_no_interval_fits_says_so():
     check_output_size({"duration": 10 * u.yr, "cadence": 1 * u.yr}, problems, 6 * 30_000_000,
                       "30e6 bodies")
     assert "the start and the end alone 2.68 GiB: fewer bodies" in problems.items[0]
+
+
+def test_a_crosscheck_rebound_cannot_run_is_refused_before_our_run(monkeypatch):
+    """``crosscheck(system, t, effects=["eih"])`` integrated the whole run, then
+    refused the effect; it is refused first."""
+    from hamilton_orbits import simulation
+
+    def never(*args, **kwargs):
+        raise AssertionError("integrated before the refusal")
+
+    monkeypatch.setattr(simulation, "integrate", never)
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    with pytest.raises(ValueError, match=r"Effect 'eih' has no reboundx counterpart"):
+        crosscheck(s, 1.0, effects=[{"name": "eih", "c": 1e4}])

@@ -299,6 +299,12 @@ def _check_buildable(spec: dict, problems: S.Problems) -> None:
         params = {k: v for k, v in eff.items() if k != "name"}
         attempt(problems, f"effects[{i}]", lambda ek=ek, p=params: ek.params(system, p),
                  tuple(ek.parameters))
+    if spec["crosscheck"] and not problems:  # (refused now, not after the run)
+        from hamilton_orbits.rebound_bridge import reboundx_counterparts
+
+        attempt(problems, "crosscheck", lambda: reboundx_counterparts(
+            system, [{k: v for k, v in eff.items() if v is not None} for eff in spec["effects"]]),
+            ())
     if spec["events"] and not problems:  # (an ensemble's members: no set-up without events)
         _check_simulation(spec, system, problems)
 
