@@ -47,6 +47,22 @@ def names_repr(names: Sequence[str], most: int = 12) -> str:
     return f"[{', '.join(shown)}] ({len(names)} bodies)"
 
 
+
+def _au_and_days(sim: Any) -> None:
+    """Refuse a rebound simulation whose numbers are not au, days and G m in au^3/day^2
+    (as ``System.to_rebound`` writes them: G = 1, no units; or rebound's units
+    ``("day", "AU", "Msun")``): read as those, a simulation in years moved the Earth
+    365 orbits a year (its speeds in au/yr taken as au/day)."""
+    units = getattr(sim, "units", None) or {}
+    given = tuple(str(units.get(k) or "").lower() for k in ("time", "length", "mass"))
+    if (given == ("", "", "") and sim.G == 1.0) or given == ("day", "au", "msun"):
+        return
+    raise ValueError(
+        f"Expected `sim` in au and days (G = 1 with G m as masses, or units ('day', 'AU', "
+        f"'Msun')) for quantity=True, got G = {sim.G!r}, units {units or 'not set'}: convert "
+        f"it first (sim.convert_particle_units('day', 'AU', 'Msun')), or read it with "
+        f"quantity=False")
+
 class InitialStates:
     """The classmethods of :class:`~hamilton_orbits.nbody.System` that build a system
     from the states others hold (:meth:`solar_system`: astropy's built-in ephemeris;
@@ -112,6 +128,7 @@ class InitialStates:
         names, gm, r, v = arrays_from_simulation(sim, names)
         radius = [None if np.isnan(x) else float(x) for x in radii_of(sim)]
         if quantity:  # (au, as its positions; G astropy's, m = gm / G)
+            _au_and_days(sim)
             bodies = [body_from_floats(name, gm[k], r[k], v[k], radius[k], None, None, True)
                       for k, name in enumerate(names)]
             return cls(bodies)

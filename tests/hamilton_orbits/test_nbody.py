@@ -299,3 +299,30 @@ def test_repr_of_a_thousand_bodies_is_one_short_line():
     text = repr(System(bodies))
     assert len(text) < 120 and "\n" not in text and "(1000 bodies)" in text, text
     assert repr(System(bodies[:2])) == "System(['sun', 'p0'])"  # a few bodies: all named
+
+
+def test_from_rebound_with_quantities_refuses_other_units():
+    """A rebound simulation in years (``sim.units = ("yr", "AU", "Msun")``, G = 4 pi^2)
+    read with ``quantity=True`` took its speeds in au/yr as au/day and G m as
+    au^3/day^2: the Earth at 10 879 km/s, making 365 orbits a year, unsaid.  Other
+    units are refused, naming G and the units; au and days (G = 1 with G m as
+    masses, as ``to_rebound`` writes, or rebound's ("day", "AU", "Msun")) are read."""
+    import astropy.units as u
+    import rebound
+
+    for units, ok in ((("yr", "AU", "Msun"), False), (("s", "m", "kg"), False),
+                      (("day", "AU", "Msun"), True)):
+        sim = rebound.Simulation()
+        sim.units = units
+        m_sun = 1.0 if units[2] == "Msun" else 1.989e30
+        sim.add(m=m_sun)
+        sim.add(m=3e-6 * m_sun, a=1.0 if units[1] == "AU" else 1.496e11)
+        if ok:
+            earth = System.from_rebound(sim, quantity=True)["body1"]
+            assert abs(earth.v.to_value(u.km / u.s) @ [0, 1, 0] - 29.8) < 0.1
+        else:
+            with pytest.raises(ValueError, match=r"Expected `sim` in au and days .*got G = "):
+                System.from_rebound(sim, quantity=True)
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    back = System.from_rebound(s.to_rebound(), quantity=True)  # (G = 1, no units: read)
+    assert back.names == ("sun", "p")
