@@ -648,3 +648,21 @@ def test_an_unknown_frame_whose_test_particles_orbit_in_x_y_asks_for_frame(effec
     tilted = system(u.Quantity([d, 0 * d, 0 * d]), u.Quantity([0 * w, 0 * w, w]))
     assert np.all(np.isfinite(tilted.accelerations([effect])))  # (its orbit far from x-y)
 
+
+
+def test_a_default_pole_is_not_taken_for_the_axes():
+    """An Earth given ``j2`` and no pole gets the pole z, which is also DE440's Earth
+    pole in ICRS axes: a hand-built system in ecliptic axes (its orbits in its x-y
+    plane) was taken for an ICRS one, and ``kuiper_ring`` put its normal 23.4 deg
+    off the system's ecliptic pole.  A pole along z says nothing about the axes:
+    such a system is asked for ``frame`` as one whose Earth has no J2."""
+    from hamilton_orbits import Body, System
+    from hamilton_orbits.effects import get
+
+    earth = Body("earth", 3e-6, [1, 0, 0], [0, 1, 0.01], radius=4e-5, j2=1e-3)
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), earth,
+                Body("moon", 3.7e-8, [1.0026, 0, 0], [0, 1.034, 0.01])])
+    with pytest.raises(ValueError, match=r"Effect 'kuiper_ring': expected `frame`"):
+        get("nbody", "kuiper_ring").params(s, {"gm": 1e-8, "radius": 44})
+    ring = get("nbody", "kuiper_ring").params(s, {"gm": 1e-8, "radius": 44, "frame": "ecliptic"})
+    np.testing.assert_allclose(ring[-3:], [0.0, 0.0, 1.0], atol=1e-15)

@@ -486,9 +486,12 @@ def unit_vector(name: str, value: Any, effect: str) -> np.ndarray:
 def _frame_of_poles(system: Any) -> str | None:
     """The frame recognised from a pole :meth:`System.from_ephemeris` gives the Sun,
     the Earth or the Moon (:func:`hamilton_orbits.ephemeris.pole` in that frame), or
-    None."""
+    None.  A pole along z says nothing: it is the Earth's in ICRS axes, and also
+    what any body given ``j2`` and no pole has (a hand-built Earth in ecliptic axes
+    was taken for an ICRS one, the effects' directions 23.4 degrees off)."""
     for name in ("sun", "earth", "moon"):
-        if name in system.names and system[name].pole is not None:
+        if name in system.names and system[name].pole is not None \
+                and tuple(system[name].pole) != (0.0, 0.0, 1.0):
             pole = np.array(system[name].pole)
             for frame in ("icrs", "ecliptic"):
                 if np.allclose(pole, de.pole(name, frame), rtol=0, atol=1e-12):
