@@ -485,7 +485,10 @@ class System(InitialStates):
                 raise ValueError(f"Expected `{name}` as plain numbers in this system's own "
                                  f"units (it was built from plain numbers), got {value!r}")
             return np.array(kind(name, value, unit, finite=False), dtype=np.float64)
-        return np.array(value, dtype=np.float64)
+        try:
+            return np.array(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"Expected `{name}` to be numbers, got {value!r}") from None
 
     def _check_new(self, radius: np.ndarray, keep: Any) -> None:
         """:meth:`with_state`'s ``radius`` (n,), each NaN (none) or finite and >= 0,
@@ -499,6 +502,10 @@ class System(InitialStates):
         check_finite("radius", radius[~np.isnan(radius)], np.flatnonzero(~np.isnan(radius)))
         if keep is not None and np.shape(keep) != (n,):
             raise ValueError(f"Expected `keep` to have shape ({n},), got {np.shape(keep)}")
+        if keep is not None and np.asarray(keep).dtype != np.bool_:  # (indices 0, 1 were
+            # read as False, True: another body kept than the one meant)
+            raise ValueError(f"Expected `keep` to be {n} booleans (True for a body kept), "
+                             f"got {np.asarray(keep).tolist()!r}")
 
     def _check_state(self) -> None:
         from hamilton_orbits.validation import check_positive

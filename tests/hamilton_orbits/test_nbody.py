@@ -326,3 +326,16 @@ def test_from_rebound_with_quantities_refuses_other_units():
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
     back = System.from_rebound(s.to_rebound(), quantity=True)  # (G = 1, no units: read)
     assert back.names == ("sun", "p")
+
+
+def test_with_state_refuses_indices_for_keep_and_names_a_bad_state():
+    """``with_state(..., keep=np.array([0, 1]))`` read the indices as booleans and kept
+    the second body only; ``with_state("x", v)`` said "could not convert string to
+    float", not naming `r`."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("earth", 3e-6, [1, 0, 0], [0, 1, 0])])
+    with pytest.raises(ValueError, match=r"Expected `keep` to be 2 booleans \(True for a body "
+                                         r"kept\), got \[0, 1\]"):
+        s.with_state(s.r, s.v, keep=np.array([0, 1]))
+    assert s.with_state(s.r, s.v, keep=[True, False]).names == ("sun",)
+    with pytest.raises(ValueError, match=r"Expected `r` to be numbers, got 'x'"):
+        s.with_state("x", s.v)
