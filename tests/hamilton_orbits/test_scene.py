@@ -607,3 +607,22 @@ def test_a_crosscheck_rebound_cannot_run_is_refused_as_the_scene_loads():
     assert problem.endswith("crosscheck: Effect 'eih' has no reboundx counterpart to "
                             "cross-check")
     assert Scene.from_dict({**data, "crosscheck": False}).spec["crosscheck"] is False
+
+
+def test_a_result_of_an_effect_with_a_time_epoch_saves(tmp_path):
+    """An effect's ``epoch`` given as an astropy ``Time`` (as docs/effects.md allows)
+    ran, then ``result.save`` raised "Object of type Time is not JSON serializable",
+    leaving only ``summary.md``.  It is written as its ISO text and scale."""
+    import json
+
+    from astropy.time import Time
+
+    sc = Scene.from_dict({"kind": "nbody", "duration": "2 d", "cadence": "1 d",
+                          "initial": {"ephemeris": {"epoch": "J2000",
+                                                    "bodies": ["sun", "earth", "moon"]}},
+                          "effects": [{"name": "zonal", "pole": "IAU2006",
+                                       "epoch": Time("J2000")}]})
+    paths = sc.run(progress=False).save(tmp_path)
+    assert {p.name for p in paths} >= {"summary.md", "summary.json", "states.nc"}
+    summary = json.loads((tmp_path / "summary.json").read_text(encoding="utf-8"))
+    assert summary["effects"][0]["epoch"] == {"time": "2000-01-01T12:00:00.000", "scale": "tt"}

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -161,6 +162,9 @@ class Result:
                 return str(v)
             if isinstance(v, np.floating | np.integer):
                 return v.item()
+            time = sys.modules.get("astropy.time")  # (an effect's epoch as a Time: its ISO
+            if time is not None and isinstance(v, time.Time):  # text and scale)
+                return {"time": np.asarray(v.isot).tolist(), "scale": v.scale}
             return v
 
         return {
@@ -196,7 +200,8 @@ class Result:
         md.write_text(f"# {self.scene.name}\n\n```\n{self.summary()}\n```\n", encoding="utf-8")
         written.append(md)
         js = out / "summary.json"
-        js.write_text(json.dumps(self._json(), indent=2) + "\n", encoding="utf-8")
+        js.write_text(json.dumps(self._json(), indent=2, default=str) + "\n",  # (any other
+                      encoding="utf-8")  # value as its text, not a failure after the run)
         written.append(js)
         written.extend(self._save_states(out))
         for writer in self.writers:
