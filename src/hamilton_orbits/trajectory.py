@@ -608,7 +608,9 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         r_out: Any = r << au  # views: no second copy of the history
         v_out: Any = v << au_day
     else:
-        t_out, r_out, v_out = times, r, v
+        t_out, r_out, v_out = times.view(), r.view(), v.view()
+    for view in (t_out, r_out, v_out):  # (read-only views: an in-place change of r or v
+        view.flags.writeable = False  # changed energy_error and final, computed from them)
     values = {"t": t_out, "r": r_out, "v": v_out, "names": system.names,
               "steps": int(out.steps), "method": method, "effects": effects,
               "wall_time": out.wall_time if wall_time is None else wall_time,

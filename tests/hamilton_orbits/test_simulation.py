@@ -542,3 +542,23 @@ def test_energy_error_of_an_energy_near_zero_is_relative_to_its_terms():
     e1 = 0.5 * (0.09 + (0.3 + 2.0**-30) ** 2) - 0.5
     assert integral_errors(rr, vb, np.array([1.0, 1.0]), np.array([0.0, 1.0]))[0][1] == \
         pytest.approx((e1 - e0) / abs(e0), rel=1e-6)
+
+
+def test_a_trajectory_s_arrays_are_read_only():
+    """``tr.r`` and ``tr.v`` were writable views of the arrays ``energy_error`` and
+    ``final`` are computed from (lazily): made heliocentric in place, they changed
+    the energy error to 1e-3 and put the Sun at the origin of ``final``; and
+    ``tr.r -= ...`` changed the data before refusing the attribute.  They are
+    read-only; a copy is the caller's own."""
+    from hamilton_orbits import Body, System, integrate
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    tr = integrate(s, np.linspace(0.0, 2.0, 5))
+    before = tr.r.copy()
+    with pytest.raises(ValueError, match="read-only"):
+        r = tr.r
+        r -= tr.r[:, :1]
+    np.testing.assert_array_equal(tr.r, before)
+    helio = tr.r - tr.r[:, :1]  # (a new array: the caller's)
+    helio[0] = 0.0
+    assert not tr.t.flags.writeable and not tr.v.flags.writeable
