@@ -64,8 +64,10 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     primary = primary_index(traj)
     rel = r if primary is None else r - r[:, primary:primary + 1]
     vel = v[0] if primary is None else v[0] - v[0, primary]
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.5, 6))
+    if ax is None:  # (constrained: the legend beside the axes, past five bodies, is kept
+        # within the figure; it was cut off by savefig)
+        fig, ax = plt.subplots(figsize=(6.5 if len(traj.names) <= 5 else 8.0, 6),
+                               layout="constrained")
     else:
         fig = ax.figure
     for k, name in enumerate(traj.names):

@@ -54,6 +54,8 @@ def test_many_bodies_put_the_legend_outside_the_axes():
     ax = fig.axes[0]
     legend = ax.get_legend().get_window_extent()
     assert legend.x0 >= ax.get_window_extent().x1  # not over the data
+    # and within the figure (it was cut off by savefig: x1 = 773 of 650 px)
+    assert legend.x1 <= fig.bbox.x1 and legend.y0 >= fig.bbox.y0
     plt.close(fig)
 
 
