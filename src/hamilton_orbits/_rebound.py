@@ -108,6 +108,8 @@ def arrays_from_simulation(
     if not isinstance(sim, rebound.Simulation):
         raise ValueError(f"Expected `sim` to be a rebound.Simulation, got {sim!r}")
     n = sim.N
+    if isinstance(names, str):  # ("xyz" was taken as the names 'x', 'y', 'z')
+        raise ValueError(f"Expected `names` to be a list of {n} names, got the string {names!r}")
     if names is not None and len(names) != n:
         raise ValueError(f"Expected `names` to hold {n} names, got {len(names)}")
     out = names if names is not None else [

@@ -57,10 +57,17 @@ def propagate(stm: np.ndarray, cov0: Any, n: int) -> np.ndarray:
     ------
     ValueError
         For a ``cov0`` of another shape, not finite, not symmetric or not positive
-        semi-definite, naming the body and the value.
+        semi-definite, naming the body and the value; an ``stm`` not of shape
+        ``(n_t, 6n, 6n)``, or ``n`` not a number of bodies.
     """
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+        raise ValueError(f"Expected `n` to be a number of bodies >= 1, got {n!r}")
     c0 = _checked(cov0, n)
-    phi = np.asarray(stm, dtype=np.float64).reshape(stm.shape[0], n, 6, n, 6)
+    phi = as_float_array("stm", stm, finite=False)
+    if phi.ndim != 3 or phi.shape[1:] != (6 * n, 6 * n):
+        raise ValueError(f"Expected `stm` of shape (n_t, {6 * n}, {6 * n}) for n = {n} bodies, "
+                         f"got {phi.shape}")
+    phi = phi.reshape(phi.shape[0], n, 6, n, 6)
     out = np.einsum("tiajb,jbc,tidjc->tiad", phi, c0, phi, optimize=True)
     return 0.5 * (out + np.swapaxes(out, -1, -2))
 

@@ -946,3 +946,29 @@ def test_a_crosscheck_rebound_cannot_run_is_refused_before_our_run(monkeypatch):
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
     with pytest.raises(ValueError, match=r"Effect 'eih' has no reboundx counterpart"):
         crosscheck(s, 1.0, effects=[{"name": "eih", "c": 1e4}])
+
+
+def test_small_refusals_name_the_argument():
+    """``Scene.bundled(None)`` raised a TypeError from inside difflib;
+    ``System.from_rebound(sim, names="xyz")`` took the string as the names 'x', 'y',
+    'z'; ``covariance.propagate`` with an ``stm`` of the wrong shape or a list said
+    "cannot reshape array of size 108" or "'list' object has no attribute 'shape'"."""
+    from hamilton_orbits import Scene
+    from hamilton_orbits.covariance import propagate
+    from hamilton_orbits.scene import SceneError
+
+    with pytest.raises(SceneError, match=r"expected a bundled scene's name \(a string\)"):
+        Scene.bundled(None)
+    s = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1e-3, [1, 0, 0], [0, 1, 0]),
+                Body("c", 0.0, [2, 0, 0], [0, 0.7, 0])])
+    with pytest.raises(ValueError, match=r"Expected `names` to be a list of 3 names, got the "
+                                         r"string 'xyz'"):
+        System.from_rebound(s.to_rebound(), names="xyz")
+    with pytest.raises(ValueError, match=r"Expected `stm` of shape \(n_t, 12, 12\) for n = 2 "
+                                         r"bodies, got \(12, 12\)"):
+        propagate(np.eye(12), np.eye(6), 2)
+    with pytest.raises(ValueError, match=r"Expected `stm` of shape \(n_t, 12, 12\) .*got \(1, 3\)"):
+        propagate([[1.0, 2.0, 3.0]], np.eye(6), 2)
+    with pytest.raises(ValueError, match=r"Expected `n` to be a number of bodies >= 1, got 2.5"):
+        propagate(np.stack([np.eye(12)] * 3), np.eye(6), 2.5)
+    assert propagate(np.stack([np.eye(12)] * 3), np.eye(6), 2).shape == (3, 2, 6, 6)

@@ -390,6 +390,9 @@ class Scene:
         """One of the scenes that ship with the package (see :meth:`list_bundled`;
         ``values`` as in :meth:`from_toml`)."""
         names = [n for n, _ in cls.list_bundled()]
+        if not isinstance(name, str):  # (None went into difflib: a TypeError)
+            raise SceneError([f"{name!r}: expected a bundled scene's name (a string), one of "
+                              f"{', '.join(names)}"])
         if name not in names:
             raise SceneError([f"{name}: no bundled scene of that name{S.closest(name, names)}"])
         res = cls._bundled_dir() / f"{name}.toml"
