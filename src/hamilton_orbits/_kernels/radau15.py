@@ -350,8 +350,9 @@ def _tau2(a0, b, i):  # pragma: no cover - compiled
 
 
 #: a body whose acceleration fell over the step to below this fraction of the
-#: largest acceleration of the step's end (sqrt(eps): forces of that size cancelled
-#: to 8 digits) is at a zero crossing of its acceleration (:func:`_dt_prs23`)
+#: largest acceleration component at the step's start (sqrt(eps): forces of that
+#: size cancelled to 8 digits) is at a zero crossing of its acceleration
+#: (:func:`_dt_prs23`)
 _CROSSING = 1.4901161193847656e-08
 
 
@@ -376,43 +377,30 @@ def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     takes thousands of steps that do not advance ``t``).  Where the step would no
     longer advance the time it starts from (``t``, the start of the step just taken,
     where it is rejected and taken again; its end otherwise), the bodies at such a
-    crossing are left out (:func:`_without_crossings`) and the step is that of the others; a
-    collision (accelerations that grow) or a tolerance below rounding still
-    underflow, as before.  Elsewhere the rule is the paper's, to the bit.  Returns
+    crossing (an acceleration that fell over the step to below :data:`_CROSSING` of
+    the largest) are left out and the step is that of the others; a collision
+    (accelerations that grow) or a tolerance below rounding still underflow, as
+    before.  Elsewhere the rule is the paper's, to the bit.  Returns
     the next step."""
     min_tau2 = math.inf
-    top = 0.0  # (the largest acceleration at the step's end)
+    min_rest = math.inf  # (over the bodies not at a crossing)
+    top = 0.0  # (the largest acceleration component at the step's start)
+    for k in range(3 * n):
+        top = max(top, abs(a0[k]))
     for i in range(n):
-        tau2, a_end, _ = _tau2(a0, b, i)
+        tau2, a_end, a_start = _tau2(a0, b, i)
         if tau2 < min_tau2:
             min_tau2 = tau2
-        if a_end > top:
-            top = a_end
+        if tau2 < min_rest and not (a_end < a_start and a_end < _CROSSING * top):
+            min_rest = tau2
     if min_tau2 < math.inf:
         dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
         start = t if dt_new < _SAFETY * dt_done else t + dt_done  # (:func:`_next_dt`)
-        if dt_new <= 4.0 * _EPS * abs(start):  # (as :func:`_try_length` refuses it)
-            rest = _without_crossings(a0, b, n, top)
-            if rest < math.inf:
-                return math.sqrt(rest) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
+        if dt_new <= 4.0 * _EPS * abs(start) and min_rest < math.inf:  # (as
+            # :func:`_try_length` would refuse it)
+            return math.sqrt(min_rest) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
         return dt_new
     return dt_done / _SAFETY
-
-
-@njit(cache=True)
-def _without_crossings(a0, b, n, top):  # pragma: no cover - compiled
-    """The shortest ``tau^2`` of :func:`_dt_prs23` over the bodies that are not at a
-    zero crossing of their acceleration: one whose acceleration fell over the step
-    to below :data:`_CROSSING` of ``top``, the largest at the step's end, is left
-    out (inf if none is left).  Called only where the step would underflow."""
-    min_tau2 = math.inf
-    for i in range(n):
-        tau2, a_end, a_start = _tau2(a0, b, i)
-        if a_end < a_start and a_end < _CROSSING * top:
-            continue
-        if tau2 < min_tau2:
-            min_tau2 = tau2
-    return min_tau2
 
 
 @njit(cache=True, inline="always")
