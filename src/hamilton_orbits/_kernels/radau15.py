@@ -326,27 +326,29 @@ def _squares_ok(a0i, y2, y3, y4):  # pragma: no cover - compiled
 
 @njit(cache=True, inline="always")
 def _tau2(a0, b, i):  # pragma: no cover - compiled
-    """Body ``i``'s ``tau^2`` of :func:`_dt_prs23` (inf where it is left out) and the
-    magnitudes of its acceleration at the end and at the start of the step."""
+    """Body ``i``'s ``tau^2`` of :func:`_dt_prs23` (inf where it is left out), the
+    squares of its acceleration at the end and at the start of the step, each
+    component multiplied by ``f``, and ``f`` (1, or the power of two that keeps the
+    squares within float64)."""
     if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
-        return math.inf, 0.0, 0.0
+        return math.inf, 0.0, 0.0, 1.0
     f = 1.0
     for attempt in range(2):  # one call site (inlined once): plain, then scaled
         a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, f)
         if attempt == 1 or _squares_ok(a0i, y2, y3, y4):
             break
         if not (top > 0.0 and top < math.inf):
-            return math.inf, 0.0, 0.0
+            return math.inf, 0.0, 0.0, 1.0
         f = math.ldexp(1.0, -math.frexp(top)[1])
     if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
-        return math.inf, 0.0, 0.0
+        return math.inf, 0.0, 0.0, 1.0
     if not (y2 > 0.0 and y2 < math.inf):
-        return math.inf, 0.0, 0.0
+        return math.inf, 0.0, 0.0, 1.0
     den = y3 + math.sqrt(y4 * y2)
     if not den > 0.0:  # a constant acceleration: no timescale (no division by 0)
-        return math.inf, 0.0, 0.0
+        return math.inf, 0.0, 0.0, 1.0
     tau2 = 2.0 * y2 / den
-    return tau2 if tau2 > 0.0 else math.inf, math.sqrt(y2) / f, math.sqrt(a0i) / f
+    return tau2 if tau2 > 0.0 else math.inf, y2, a0i, f
 
 
 #: a body whose acceleration fell over the step to below this fraction of the
@@ -388,11 +390,11 @@ def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     for k in range(3 * n):
         top = max(top, abs(a0[k]))
     for i in range(n):
-        tau2, a_end, a_start = _tau2(a0, b, i)
+        tau2, y2, a0i, f = _tau2(a0, b, i)
         if tau2 < min_tau2:
             min_tau2 = tau2
-        if tau2 < min_rest and not (a_end < a_start and a_end < _CROSSING * top):
-            min_rest = tau2
+        if tau2 < min_rest and not (y2 < a0i and y2 < (_CROSSING * top * f) ** 2):
+            min_rest = tau2  # (squares compared: no square root a body a step)
     if min_tau2 < math.inf:
         dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
         start = t if dt_new < _SAFETY * dt_done else t + dt_done  # (:func:`_next_dt`)
