@@ -510,3 +510,31 @@ def test_a_body_whose_acceleration_passes_through_zero_is_crossed():
                    Body("c", 0.0, [0, 0.16, 0], [0, 0, 0])])
     fallen = Simulation(pair, method="radau15").integrate(0.6)
     assert fallen.r[-1, 2, 1] < 0.0 and fallen.r[-1, 2, 0] == 0.0
+
+
+@pytest.mark.parametrize("t0", [1e6, -1e8, 1e12])
+def test_a_zero_crossing_is_crossed_far_from_the_time_origin(t0):
+    """The crossing's test measured the acceleration against the largest (below
+    sqrt(eps) of it): far from t = 0 the steps reach the rounding of ``t`` before
+    the acceleration is that small, and Sitnikov's problem stopped at t = 1e6 +
+    0.4685 ("the step underflowed").  The test is now whether the acceleration, at
+    the pace it falls, reaches zero within 64 roundings of ``t``: free of ``t``'s
+    size.  Against the axis's own equation (scipy's DOP853 at rtol 1e-13) at the
+    output times reached: the steps' times near t0 are rounded to eps |t0| (2e-4 at
+    1e12, the speeds ~1), and the errors are 0.3-1.1 of that; bounded at 8 eps |t0|
+    plus 1e-12."""
+    from scipy.integrate import solve_ivp
+
+    from hamilton_orbits import engine
+    from hamilton_orbits.rhs import newtonian_rhs
+
+    vb = math.sqrt(0.5)
+    r = np.array([[-0.5, 0, 0], [0.5, 0, 0], [0, 0, 0.3]])
+    v = np.array([[0, -vb, 0], [0, vb, 0], [0, 0, 0]])
+    s = np.linspace(0.0, 3.0, 31)
+    out = engine.run(r, v, np.array([1.0, 1.0, 0.0]), t0 + s, newtonian_rhs(), "radau15")
+    ref = solve_ivp(lambda t, y: [y[1], -2.0 * y[0] / (0.25 + y[0] ** 2) ** 1.5], (0.0, 3.0),
+                    [0.3, 0.0], method="DOP853", rtol=1e-13, atol=1e-15, t_eval=out.t - t0).y[0]
+    z = out.r[:, 2, 2]
+    assert np.count_nonzero(np.diff(np.sign(z))) == 3
+    np.testing.assert_allclose(z, ref, rtol=0, atol=8 * np.finfo(float).eps * abs(t0) + 1e-12)

@@ -326,36 +326,36 @@ def _squares_ok(a0i, y2, y3, y4):  # pragma: no cover - compiled
 
 @njit(cache=True, inline="always")
 def _tau2(a0, b, i):  # pragma: no cover - compiled
-    """Body ``i``'s ``tau^2`` of :func:`_dt_prs23` (inf where it is left out), the
-    squares of its acceleration at the end and at the start of the step, each
-    component multiplied by ``f``, and ``f`` (1, or the power of two that keeps the
-    squares within float64)."""
+    """Body ``i``'s ``tau^2`` of :func:`_dt_prs23` (inf where it is left out), and the
+    squares of its acceleration at the end and at the start of the step and of its
+    derivative per unit step (each component scaled alike, by 1 or the power of two
+    that keeps the squares within float64)."""
     if a0[3 * i] == 0.0 and a0[3 * i + 1] == 0.0 and a0[3 * i + 2] == 0.0:
-        return math.inf, 0.0, 0.0, 1.0
+        return math.inf, 0.0, 0.0, 0.0
     f = 1.0
     for attempt in range(2):  # one call site (inlined once): plain, then scaled
         a0i, y2, y3, y4, top = _prs23_sums(a0, b, i, f)
         if attempt == 1 or _squares_ok(a0i, y2, y3, y4):
             break
         if not (top > 0.0 and top < math.inf):
-            return math.inf, 0.0, 0.0, 1.0
+            return math.inf, 0.0, 0.0, 0.0
         f = math.ldexp(1.0, -math.frexp(top)[1])
     if not (a0i >= 2.2250738585072014e-308 and a0i < math.inf):
-        return math.inf, 0.0, 0.0, 1.0
+        return math.inf, 0.0, 0.0, 0.0
     if not (y2 > 0.0 and y2 < math.inf):
-        return math.inf, 0.0, 0.0, 1.0
+        return math.inf, 0.0, 0.0, 0.0
     den = y3 + math.sqrt(y4 * y2)
     if not den > 0.0:  # a constant acceleration: no timescale (no division by 0)
-        return math.inf, 0.0, 0.0, 1.0
+        return math.inf, 0.0, 0.0, 0.0
     tau2 = 2.0 * y2 / den
-    return tau2 if tau2 > 0.0 else math.inf, y2, a0i, f
+    return tau2 if tau2 > 0.0 else math.inf, y2, a0i, y3
 
 
-#: a body whose acceleration fell over the step to below this fraction of the
-#: largest acceleration component at the step's start (sqrt(eps): forces of that
-#: size cancelled to 8 digits) is at a zero crossing of its acceleration
-#: (:func:`_dt_prs23`)
-_CROSSING = 1.4901161193847656e-08
+#: a body whose acceleration is falling and, at the pace it falls, would reach zero
+#: within this many roundings of ``t`` is at a zero crossing of its acceleration
+#: (:func:`_dt_prs23`; at the step's underflow, each step a quarter of what is left
+#: to the crossing, it is there within about 16)
+_CROSSING = 64.0 * _EPS
 
 
 @njit(cache=True, inline="always")
@@ -379,22 +379,21 @@ def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     takes thousands of steps that do not advance ``t``).  Where the step would no
     longer advance the time it starts from (``t``, the start of the step just taken,
     where it is rejected and taken again; its end otherwise), the bodies at such a
-    crossing (an acceleration that fell over the step to below :data:`_CROSSING` of
-    the largest) are left out and the step is that of the others; a collision
-    (accelerations that grow) or a tolerance below rounding still underflow, as
-    before.  Elsewhere the rule is the paper's, to the bit.  Returns
-    the next step."""
+    crossing (an acceleration that fell over the step and, at that pace, reaches zero
+    within :data:`_CROSSING` of ``t``: ``|a| dt / |a' dt| <= 64 eps |t|``, a test
+    free of the system's scale and of ``t``'s) are left out and the step is that of
+    the others; a collision (accelerations that grow) or a tolerance below rounding
+    (accelerations far from zero) still underflow, as before.  Elsewhere the rule
+    is the paper's, to the bit.  Returns the next step."""
     min_tau2 = math.inf
     min_rest = math.inf  # (over the bodies not at a crossing)
-    top = 0.0  # (the largest acceleration component at the step's start)
-    for k in range(3 * n):
-        top = max(top, abs(a0[k]))
+    near = (_CROSSING * abs(t) / dt_done) ** 2  # (the crossing's test, in squares)
     for i in range(n):
-        tau2, y2, a0i, f = _tau2(a0, b, i)
+        tau2, y2, a0i, y3 = _tau2(a0, b, i)
         if tau2 < min_tau2:
             min_tau2 = tau2
-        if tau2 < min_rest and not (y2 < a0i and y2 < (_CROSSING * top * f) ** 2):
-            min_rest = tau2  # (squares compared: no square root a body a step)
+        if tau2 < min_rest and not (y2 < a0i and y2 <= y3 * near):
+            min_rest = tau2
     if min_tau2 < math.inf:
         dt_new = math.sqrt(min_tau2) * dt_done * (eps * 5040.0) ** (1.0 / 7.0)
         start = t if dt_new < _SAFETY * dt_done else t + dt_done  # (:func:`_next_dt`)
