@@ -559,13 +559,15 @@ class EventLog:
         acting = min(mine, key=lambda k: (abs(self.rows[k][E_TIME] - at), -k))
         t_ev = self.rows[acting][E_TIME]
 
+        pair = {i, j} - {-1}  # (a one-body event's second body is -1: no body)
+
         def happened(k: int, x: np.ndarray) -> bool:
-            bodies = (int(x[E_I]), int(x[E_J]))
+            bodies = {int(x[E_I]), int(x[E_J])} - {-1}
             if x[E_TIME] < t_ev or k == acting:
                 return True
             if x[E_TIME] == t_ev:
                 return gone not in bodies
-            return x[E_TIME] <= t and t_ev < t and i not in bodies and j not in bodies
+            return x[E_TIME] <= t and t_ev < t and not pair & bodies
 
         kept = [k for k, x in enumerate(self.rows) if happened(k, x)]
         self.rows = [self.rows[k] for k in kept]

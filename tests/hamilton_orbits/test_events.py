@@ -597,3 +597,20 @@ def test_a_body_touching_two_at_once_merges_once(method):
                    **kw)
     assert [str(row["bodies"]) for row in tr.events] == ["a-c"]
     assert tr.final.names == ("a", "b")
+
+
+@pytest.mark.parametrize("method", ["wh", "leapfrog"])
+@pytest.mark.parametrize("action", ["remove", "stop"])
+def test_a_one_body_event_that_acts_keeps_the_other_bodies_events_of_its_step(method, action):
+    """An escape (a one-body event: its second body -1) that acts at the end of a
+    wh or leapfrog step dropped every other escape the step found after it, -1
+    counted as a body of the acting pair: b's and c's escapes at 0.15 and 0.20,
+    inside the step [0, 0.5] where a escapes at 0.10, were lost (radau15 lists
+    them)."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("a", 0.0, [2.9, 0, 0], [1.0, 0, 0]), Body("b", 0.0, [0, 2.8, 0], [0, 1.0, 0]),
+                Body("c", 0.0, [0, -2.85, 0], [0, -1.0, 0])])
+    events = [{"name": "escape", "bodies": ["a"], "distance": 3.0, "action": action},
+              {"name": "escape", "bodies": ["b", "c"], "distance": 3.0, "action": "record"}]
+    tr = integrate(s, np.array([0.0, 1.0, 2.0]), method=method, dt=0.5, events=events)
+    assert [str(row["bodies"]) for row in tr.events] == ["a", "c", "b"]
