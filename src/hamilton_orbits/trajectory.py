@@ -518,14 +518,21 @@ def encounter_warning(traj: Trajectory) -> Any:
     first = found[0]
     day, au = (" d", " au") if traj._final_source[0].quantity else ("", "")
     more = f" (and {len(found) - 1} more: see `under_resolved`)" if len(found) > 1 else ""
+    who = names[first.particle]
+    if np.isfinite(first.inv_a[1]) and np.isfinite(first.e[1]):
+        across = (f"across it the osculating 1/a of {who!r} about {names[first.primary]!r} went "
+                  f"from {first.inv_a[0]:.6g} to {first.inv_a[1]:.6g}{' /au' if au else ''} "
+                  f"and e from {first.e[0]:.6g} to {first.e[1]:.6g}: not to be trusted")
+    else:  # (taken out of the run after it: "went from -0.31 to nan" before)
+        across = (f"{who!r} was taken out of the run after it (its orbit about "
+                  f"{names[first.primary]!r} then: 1/a = {first.inv_a[0]:.6g}"
+                  f"{' /au' if au else ''}, e = {first.e[0]:.6g}), its path to there not to "
+                  f"be trusted")
     return UnderResolvedEncounterWarning(
         f"The step ({first.step:.4g}{day}) was too long for the close approach of "
-        f"{names[first.particle]!r} to {names[first.body]!r} ({first.distance:.4g}{au} at "
-        f"t = {first.time:.6g}{day}, time scale {first.timescale:.4g}{day}){more}; across it "
-        f"the osculating 1/a of {names[first.particle]!r} about {names[first.primary]!r} went "
-        f"from {first.inv_a[0]:.6g} to {first.inv_a[1]:.6g}{' /au' if au else ''} and e from "
-        f"{first.e[0]:.6g} to {first.e[1]:.6g}: not to be trusted; shorten the step or use "
-        "an adaptive method (radau15)")
+        f"{who!r} to {names[first.body]!r} ({first.distance:.4g}{au} at "
+        f"t = {first.time:.6g}{day}, time scale {first.timescale:.4g}{day}){more}; {across}; "
+        "shorten the step or use an adaptive method (radau15)")
 
 
 def _encounter_table(found: Any, system: Any, unit: Any) -> Any:

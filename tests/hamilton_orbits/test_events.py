@@ -612,5 +612,10 @@ def test_a_one_body_event_that_acts_keeps_the_other_bodies_events_of_its_step(me
                 Body("c", 0.0, [0, -2.85, 0], [0, -1.0, 0])])
     events = [{"name": "escape", "bodies": ["a"], "distance": 3.0, "action": action},
               {"name": "escape", "bodies": ["b", "c"], "distance": 3.0, "action": "record"}]
-    tr = integrate(s, np.array([0.0, 1.0, 2.0]), method=method, dt=0.5, events=events)
+    if method == "leapfrog":  # (its step, 0.5, is too long for a's start at 2.9 from
+        # the Sun by the check's own measure, time scale 2.9: said, and a's removal too)
+        with pytest.warns(UserWarning, match=r"too long for the close approach of 'a'"):
+            tr = integrate(s, np.array([0.0, 1.0, 2.0]), method=method, dt=0.5, events=events)
+    else:
+        tr = integrate(s, np.array([0.0, 1.0, 2.0]), method=method, dt=0.5, events=events)
     assert [str(row["bodies"]) for row in tr.events] == ["a", "c", "b"]
