@@ -666,3 +666,11 @@ def test_a_default_pole_is_not_taken_for_the_axes():
         get("nbody", "kuiper_ring").params(s, {"gm": 1e-8, "radius": 44})
     ring = get("nbody", "kuiper_ring").params(s, {"gm": 1e-8, "radius": 44, "frame": "ecliptic"})
     np.testing.assert_allclose(ring[-3:], [0.0, 0.0, 1.0], atol=1e-15)
+    # DE440's Earth in ICRS axes (its pole z) with a satellite in a low orbit, no Sun:
+    # still taken for ICRS axes (the z pole is doubted only beside the Sun)
+    from hamilton_orbits.effects.parameters import axes_frame
+
+    earth = System.from_ephemeris(bodies=["earth"])
+    sat = Body("sat", 0.0 * u.km**3 / u.s**2, earth["earth"].r + [7000, 0, 0] * u.km,
+               earth["earth"].v + [0, 7.5, 0.1] * u.km / u.s)
+    assert axes_frame(System([earth["earth"], sat]), {}, "zonal") == "icrs"

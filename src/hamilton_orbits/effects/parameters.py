@@ -486,12 +486,16 @@ def unit_vector(name: str, value: Any, effect: str) -> np.ndarray:
 def _frame_of_poles(system: Any) -> str | None:
     """The frame recognised from a pole :meth:`System.from_ephemeris` gives the Sun,
     the Earth or the Moon (:func:`hamilton_orbits.ephemeris.pole` in that frame), or
-    None.  A pole along z says nothing: it is the Earth's in ICRS axes, and also
-    what any body given ``j2`` and no pole has (a hand-built Earth in ecliptic axes
-    was taken for an ICRS one, the effects' directions 23.4 degrees off)."""
+    None.  A pole along z is the Earth's in ICRS axes, and also what any body given
+    ``j2`` and no pole has: it is not taken for ICRS axes where the system has the
+    Sun and its orbits lie near its x-y plane (:func:`_ecliptic_tilt`: a hand-built
+    Earth in ecliptic axes was taken for an ICRS one, the effects' directions 23.4
+    degrees off)."""
     for name in ("sun", "earth", "moon"):
-        if name in system.names and system[name].pole is not None \
-                and tuple(system[name].pole) != (0.0, 0.0, 1.0):
+        if name in system.names and system[name].pole is not None:
+            if tuple(system[name].pole) == (0.0, 0.0, 1.0) and "sun" in system.names \
+                    and _ecliptic_tilt(system) is not None:
+                continue
             pole = np.array(system[name].pole)
             for frame in ("icrs", "ecliptic"):
                 if np.allclose(pole, de.pole(name, frame), rtol=0, atol=1e-12):
@@ -506,10 +510,24 @@ def _refuse_ecliptic_looking(system: Any, effect: str) -> None:
     particles' orbits about it): such axes are ecliptic ones, or the system is not
     the solar system, and the effect's default directions (the ecliptic pole, the
     Sun's and the Earth's poles) would be wrong by the obliquity."""
+    to_z = _ecliptic_tilt(system)
+    if to_z is not None:
+        raise ValueError(
+            f"Effect {effect!r}: expected `frame` ('icrs' or 'ecliptic'): the system's axes "
+            f"are not known (no DE440 pole of the Sun, the Earth or the Moon to recognise "
+            f"them by), and its orbits lie {to_z:.1f} deg from its x-y plane, as in "
+            "ecliptic axes, not the ICRS's that the effect would take by default")
+
+
+def _ecliptic_tilt(system: Any) -> float | None:
+    """The angle in degrees of the system's angular momentum about its barycentre
+    from z (with one massive body, of the mean normal of the test particles' orbits)
+    where it is within 10 degrees of z and nearer z than the ICRS's ecliptic pole (the
+    axes look ecliptic, see :func:`_refuse_ecliptic_looking`); else None."""
     arrays = system.as_arrays()
     gm = arrays.gm
     if not gm.sum() > 0:
-        return
+        return None
     r = arrays.r - gm @ arrays.r / gm.sum()
     v = arrays.v - gm @ arrays.v / gm.sum()
     each = np.cross(r, v)
@@ -521,16 +539,11 @@ def _refuse_ecliptic_looking(system: Any, effect: str) -> None:
                    axis=0)
     norm = float(np.linalg.norm(h))
     if not (np.isfinite(norm) and norm > 0):
-        return
+        return None
     k = h / norm
     to_z = float(np.degrees(np.arccos(np.clip(k[2], -1.0, 1.0))))
     to_ecliptic = float(np.degrees(np.arccos(np.clip(k @ de.ecliptic_pole("icrs"), -1.0, 1.0))))
-    if to_z < 10.0 and to_z < to_ecliptic:
-        raise ValueError(
-            f"Effect {effect!r}: expected `frame` ('icrs' or 'ecliptic'): the system's axes "
-            f"are not known (no DE440 pole of the Sun, the Earth or the Moon to recognise "
-            f"them by), and its orbits lie {to_z:.1f} deg from its x-y plane, as in "
-            "ecliptic axes, not the ICRS's that the effect would take by default")
+    return to_z if to_z < 10.0 and to_z < to_ecliptic else None
 
 
 def axes_frame(system: Any, params: Mapping[str, Any], effect: str) -> str:
