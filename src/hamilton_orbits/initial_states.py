@@ -50,18 +50,29 @@ def names_repr(names: Sequence[str], most: int = 12) -> str:
 
 def _au_and_days(sim: Any) -> None:
     """Refuse a rebound simulation whose numbers are not au, days and G m in au^3/day^2
-    (as ``System.to_rebound`` writes them: G = 1, no units; or rebound's units
-    ``("day", "AU", "Msun")``): read as those, a simulation in years moved the Earth
-    365 orbits a year (its speeds in au/yr taken as au/day)."""
+    (as ``System.to_rebound`` writes them: G = 1, no units; or rebound's units of a
+    day, an au and a solar mass, by any of its names for them): read as those, a
+    simulation in years moved the Earth 365 orbits a year (its speeds in au/yr taken
+    as au/day).  A simulation of G = 1 with no units set cannot be told from one in
+    rebound's default units (years / 2 pi, au, solar masses): it is read as
+    ``to_rebound`` writes it."""
+    from rebound import units as ru
+
     units = getattr(sim, "units", None) or {}
     given = tuple(str(units.get(k) or "").lower() for k in ("time", "length", "mass"))
-    if (given == ("", "", "") and sim.G == 1.0) or given == ("day", "au", "msun"):
+    if given == ("", "", "") and sim.G == 1.0:
+        return
+    # (rebound's names for a unit: "days", "d", "aus", "sunmass" are its day, au, Msun)
+    tables = (ru.times_SI, ru.lengths_SI, ru.masses_SI)
+    if all(table.get(name) == table[w]
+           for table, name, w in zip(tables, given, ("day", "au", "msun"), strict=True)):
         return
     raise ValueError(
         f"Expected `sim` in au and days (G = 1 with G m as masses, or units ('day', 'AU', "
         f"'Msun')) for quantity=True, got G = {sim.G!r}, units {units or 'not set'}: convert "
         f"it first (sim.convert_particle_units('day', 'AU', 'Msun')), or read it with "
         f"quantity=False")
+
 
 class InitialStates:
     """The classmethods of :class:`~hamilton_orbits.nbody.System` that build a system

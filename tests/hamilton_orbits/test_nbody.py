@@ -311,12 +311,13 @@ def test_from_rebound_with_quantities_refuses_other_units():
     import rebound
 
     for units, ok in ((("yr", "AU", "Msun"), False), (("s", "m", "kg"), False),
-                      (("day", "AU", "Msun"), True)):
+                      (("day", "AU", "Msun"), True), (("days", "AU", "Msun"), True),
+                      (("d", "aus", "sunmass"), True)):  # (rebound's names for them)
         sim = rebound.Simulation()
         sim.units = units
-        m_sun = 1.0 if units[2] == "Msun" else 1.989e30
+        m_sun = 1.989e30 if units[2] == "kg" else 1.0
         sim.add(m=m_sun)
-        sim.add(m=3e-6 * m_sun, a=1.0 if units[1] == "AU" else 1.496e11)
+        sim.add(m=3e-6 * m_sun, a=1.496e11 if units[1] == "m" else 1.0)
         if ok:
             earth = System.from_rebound(sim, quantity=True)["body1"]
             assert abs(earth.v.to_value(u.km / u.s) @ [0, 1, 0] - 29.8) < 0.1
