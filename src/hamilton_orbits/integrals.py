@@ -114,7 +114,9 @@ def integral_errors(
         Hamilton's E (it would be constant, and its error a meaningless 0), the
         specific orbital energies of the test particles about the massive body,
         ``w^2 / 2 - mu / d`` (plus ``extra_energy``), each relative to its own
-        start: at each time the one of largest magnitude.
+        start (to the size of its terms where that start is near 0,
+        :data:`NEAR_ZERO`): at each time the one of largest magnitude among the
+        particles still in the run, 0 where none is left.
     angular_momentum_error : ndarray, (n_t,)
         ``|L(t) - L(0)| / |L(0)|``, areas (D); absolute where ``L(0) = 0``.
     barycentre_drift : ndarray, (n_t,)
@@ -253,9 +255,11 @@ def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
     # is near 0: NEAR_ZERO)
     scale = np.where(np.abs(eps[0]) >= NEAR_ZERO * size, np.abs(eps[0]), size)
     change = (eps - eps[0]) / np.where(scale > 0, scale, 1.0)
-    # (the largest over the particles still in the run: a removed one's is NaN)
-    pick = np.argmax(np.where(np.isfinite(change), np.abs(change), -1.0), axis=1)
-    return change[np.arange(len(change)), pick]
+    # (the largest over the particles still in the run: a removed one's is NaN; where
+    # none is left, 0: the one body alone keeps its energy)
+    finite = np.isfinite(change)
+    pick = np.argmax(np.where(finite, np.abs(change), -1.0), axis=1)
+    return np.where(finite.any(axis=1), change[np.arange(len(change)), pick], 0.0)
 
 
 def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:

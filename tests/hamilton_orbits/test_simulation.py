@@ -509,6 +509,13 @@ def test_energy_error_of_one_centre_after_a_removal_is_the_particles():
     np.testing.assert_allclose(rem.energy_error, (eps - eps[0]) / abs(eps[0]), rtol=1e-12,
                                atol=1e-15)
     assert np.max(np.abs(rem.energy_error)) > 0.03
+    # every particle taken out: 0 from then on (the one body keeps its energy), no NaN
+    lone = System([Body("sun", gm, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                   Body("x", 0 * gm, [1, 0.1, 0] * u.au, [0, 60, 0] * u.km / u.s)])
+    gone = integrate(lone, times, events=[{"name": "escape", "distance": 3 * u.au,
+                                          "action": "remove"}])
+    assert len(gone.events) == 1 and np.all(np.isfinite(gone.energy_error))
+    assert gone.energy_error[-1] == 0.0
 
 
 def test_energy_error_of_an_energy_near_zero_is_relative_to_its_terms():
