@@ -569,3 +569,10 @@ def test_a_trajectory_s_arrays_are_read_only():
     helio = tr.r - tr.r[:, :1]  # (a new array: the caller's)
     helio[0] = 0.0
     assert not tr.t.flags.writeable and not tr.v.flags.writeable
+    import copy
+    import pickle
+
+    for again in (pickle.loads(pickle.dumps(tr)), copy.deepcopy(tr)):  # (an ensemble's
+        # members come back pickled)
+        assert not (again.t.flags.writeable or again.r.flags.writeable
+                    or again.v.flags.writeable)
