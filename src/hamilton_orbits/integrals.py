@@ -28,7 +28,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["ENCOUNTER_STEP_FRACTION", "LIGHT", "Encounter", "LostStateError",
+__all__ = ["ENCOUNTER_STEP_FRACTION", "LIGHT", "NEAR_ZERO", "Encounter", "LostStateError",
            "UnderResolvedEncounterWarning", "accelerations_quaternion", "energy_gm",
            "energy_gm_many", "integral_errors", "light_as_massless", "particle_errors",
            "prepare", "primaries", "relative_change", "under_resolved_encounters"]
