@@ -282,7 +282,10 @@ def test_a_finished_run_is_not_taken_for_one_to_resume(tmp_path, capsys):
     "0.00 s of integration since the resume at t = 30 d"; with ``archive_every``
     longer than the run, its whole span again).  Now ``run`` says the run finished
     and how to run into the folder again, and ``resume`` that there is nothing to
-    resume; the files stay the finished run's."""
+    resume; the files stay the finished run's.  And ``run`` of a scene with no
+    ``archive_every`` into a folder holding a killed run's snapshots ran there (a
+    later ``resume`` of the killed run then replaced its files, unsaid): it is
+    refused, naming ``resume``."""
     out = tmp_path / "done"
     assert main(["run", "comet-encounter", "--out", str(out), *SETS]) == 0
     whole = (out / "states.nc").read_bytes()
@@ -294,16 +297,7 @@ def test_a_finished_run_is_not_taken_for_one_to_resume(tmp_path, capsys):
     assert main(["resume", str(out), "--no-progress"]) == 2
     assert f"the run in {out} finished" in capsys.readouterr().err
     assert (out / "states.nc").read_bytes() == whole
-
-
-def test_a_run_without_an_archive_does_not_take_a_killed_run_s_folder(tmp_path, capsys):
-    """``run`` of a scene with no ``archive_every`` into a folder holding a killed
-    run's snapshots ran there; a later ``resume`` of the killed run then replaced the
-    new run's files with its own, unsaid.  It is refused, naming ``resume``."""
-    out = tmp_path / "mixed"
-    assert main(["run", "comet-encounter", "--out", str(out), *SETS]) == 0
-    _killed_at_its_end(out)
-    capsys.readouterr()
+    _killed_at_its_end(out)  # (the same folder, as if killed after its last snapshot)
     assert main(["run", "leo-j2", "--set", "duration=1 d", "--out", str(out),
                  "--no-progress"]) == 2
     assert "holds the snapshots of an earlier run: resume it" in capsys.readouterr().err
@@ -316,10 +310,18 @@ def test_resume_begins_from_the_state_the_run_read(tmp_path, monkeypatch, capsys
     gave a cross-check against another system.  The resume begins from the state
     the run began with (the archive's), says the file changed, and ends on the
     files of the run never interrupted."""
-    monkeypatch.chdir(tmp_path)
-    assert main(["run", "comet-encounter", "--out", "first", *SETS]) == 0
-    start = (tmp_path / "first" / "final.bin").read_bytes()
-    (tmp_path / "start.bin").write_bytes(start)
+    import astropy.units as u
+
+    from hamilton_orbits import Body, System
+
+    monkeypatch.chdir(tmp_path)  # (a start as a run's final.bin is: to_rebound's binary)
+    planets = System.from_ephemeris(bodies=["sun", "jupiter", "saturn"])
+    sun = planets.bodies[0]  # (the comet: 1.3 au from the Sun, 30 km/s about it)
+    comet = Body("comet", 0 * u.km**3 / u.s**2, [1.3, 0, 0] * u.au + sun.r,
+                 [0, 30, 0] * u.km / u.s + sun.v)
+    System([*planets.bodies, comet]).to_rebound().save_to_file(str(tmp_path / "start.bin"),
+                                                               delete_file=True)
+    start = (tmp_path / "start.bin").read_bytes()
     (tmp_path / "from-bin.toml").write_text(
         'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
         '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
