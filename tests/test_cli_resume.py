@@ -58,6 +58,15 @@ def _kill_after_snapshots(pid: int, archive, count: int) -> None:
     os.waitpid(pid, 0)
 
 
+def _write_from_bin(folder) -> None:
+    """``folder/from-bin.toml``: a 6-day scene starting from ``start.bin`` (a rebound
+    binary of the Sun, Jupiter, Saturn and a comet), archived every 2 days."""
+    (folder / "from-bin.toml").write_text(
+        'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
+        '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
+        '[output]\narchive_every = "2 d"\n', encoding="utf-8")
+
+
 def _killed_at_its_end(out) -> None:
     """The run in ``out`` as if killed after its last snapshot, before its files were
     written: its archive's record without the mark a finished run leaves (a finished
@@ -176,10 +185,7 @@ def test_a_scene_reading_a_relative_file_resumes_from_another_folder(tmp_path, m
     monkeypatch.chdir(tmp_path)
     assert main(["run", "comet-encounter", "--out", "first", *SETS]) == 0
     (tmp_path / "start.bin").write_bytes((tmp_path / "first" / "final.bin").read_bytes())
-    (tmp_path / "from-bin.toml").write_text(
-        'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
-        '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
-        '[output]\narchive_every = "2 d"\n', encoding="utf-8")
+    _write_from_bin(tmp_path)
     assert main(["run", "from-bin.toml", "--out", "out", "--no-progress"]) == 0
     whole = _states(tmp_path / "out")
     elsewhere = tmp_path / "elsewhere"
@@ -322,10 +328,7 @@ def test_resume_begins_from_the_state_the_run_read(tmp_path, monkeypatch, capsys
     System([*planets.bodies, comet]).to_rebound().save_to_file(str(tmp_path / "start.bin"),
                                                                delete_file=True)
     start = (tmp_path / "start.bin").read_bytes()
-    (tmp_path / "from-bin.toml").write_text(
-        'kind = "nbody"\nduration = "6 d"\ncadence = "1 d"\ncrosscheck = false\n'
-        '[initial]\nrebound = "start.bin"\nnames = ["sun", "jupiter", "saturn", "comet"]\n'
-        '[output]\narchive_every = "2 d"\n', encoding="utf-8")
+    _write_from_bin(tmp_path)
     assert main(["run", "from-bin.toml", "--out", "out", "--no-progress"]) == 0
     whole = _states(tmp_path / "out")
     capsys.readouterr()

@@ -70,6 +70,14 @@ _TIME_IN_MESSAGE = re.compile(
     rf"{_NUMBER}|(t = |t_out\[\d+\] = ){_NUMBER})")
 
 
+def _turn_back(exc: BaseException) -> None:
+    """A driver's error of a backward run, its message's times turned back in place
+    (:func:`_turned_back`; its traceback kept)."""
+    if isinstance(exc, (ConvergenceError, ValueError)) and exc.args \
+            and isinstance(exc.args[0], str):
+        exc.args = (_turned_back(exc.args[0]), *exc.args[1:])
+
+
 def _turned_back(message: str) -> str:
     """A driver's message about a backward run, which it integrates in ``s = -t``:
     its times turned back to the run's (``stopped at t = 0.9068 before t_out[1] =
@@ -337,7 +345,6 @@ class Propagation:
         if self.variational is not None:
             self.variational.new_leg(n_t)
         reached = [0, 0]  # last output index, steps
-
         calling = [False]  # (a callback's own error is not the driver's: left as it is)
 
         def report(i: int, steps: int) -> None:
@@ -373,9 +380,8 @@ class Propagation:
             complete, interrupted = False, True
         except BaseException as exc:  # (an error, the driver's or a callback's: the
             self._between_outputs(driver)  # propagation keeps the state reached, as on
-            if (backward and not calling[0] and isinstance(exc, (ConvergenceError, ValueError))
-                    and exc.args and isinstance(exc.args[0], str)):  # Ctrl-C)
-                exc.args = (_turned_back(exc.args[0]), *exc.args[1:])  # (its traceback kept)
+            if backward and not calling[0]:  # Ctrl-C; a driver's message in the run's time)
+                _turn_back(exc)
             raise
         wall = max(time.perf_counter() - start - (compile_seconds() - compiled), 0.0)
         k = reached[0] + 1
