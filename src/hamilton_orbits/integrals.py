@@ -137,7 +137,8 @@ def integral_errors(
     r = np.ascontiguousarray(r, dtype=np.float64)
     v = np.ascontiguousarray(v, dtype=np.float64)
     gm2 = np.ascontiguousarray(np.atleast_2d(np.asarray(gm, dtype=np.float64)))
-    t = np.ascontiguousarray(t, dtype=np.float64)
+    t = np.array(t, dtype=np.float64)  # (a copy: a trajectory's read-only times, as a
+    # cross-check passes them, would compile the kernel again for read-only arrays)
     k, n = r.shape[0], r.shape[1]
     out = np.empty((3, k))
     gone_b = np.zeros(n, np.bool_) if gone is None else np.ascontiguousarray(gone, np.bool_)
