@@ -71,7 +71,8 @@ def leg_times(t: Any, t_now: float, quantity: bool) -> tuple[np.ndarray, Any]:
         if arr[0] == t_now:
             raise ValueError("Expected `t` to be a nonzero end time, got 0" if t_now == 0.0
                              else f"Expected `t` to differ from the simulation's time "
-                                  f"{t_now!r}, got {float(arr[0])!r}")
+                                  f"{t_now!r}{' d' if quantity else ''}, got "
+                                  f"{float(arr[0])!r}{' d' if quantity else ''}")
         return np.array([t_now, arr[0]]), unit
     added = int(arr[0] != t_now)
     if added:

@@ -164,14 +164,15 @@ def _checked_attributes(p: Any, e: Any, inv_a: Any, periapsis: Any, normal: Any,
         bad = np.abs(x) > _AXES
         if np.any(bad):
             i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            at = fmt_index(i if bad.size > 1 else ())
             raise ValueError(f"Expected `{name}` of unit length, got the length "
-                             f"{float(np.sqrt(x[i] + 1.0))!r}{fmt_index(i)}")
+                             f"{float(np.sqrt(x[i] + 1.0))!r}{at}")
     cos = _dot(big, n)
     bad = np.abs(cos) > _AXES
     if np.any(bad):
         i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
         raise ValueError(f"Expected `periapsis_direction` orthogonal to `normal`, got their "
-                         f"dot product {float(cos[i])!r}{fmt_index(i)}")
+                         f"dot product {float(cos[i])!r}{fmt_index(i if bad.size > 1 else ())}")
     return tuple(arrays)
 
 

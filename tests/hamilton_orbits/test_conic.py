@@ -344,3 +344,11 @@ def test_init_takes_what_from_elements_and_from_state_make():
                   conic.mu)
     for name in ("p", "e", "inv_a", "periapsis_direction", "normal", "mu"):
         np.testing.assert_array_equal(getattr(again, name), getattr(conic, name))
+
+
+def test_an_axis_of_one_row_is_named_without_an_index():
+    """An axis of shape (1, 3) not unit was refused "... at index 0", unlike every
+    other refusal of one value (which names no index)."""
+    with pytest.raises(ValueError, match=r"Expected `periapsis_direction` of unit length, got "
+                                         r"the length 1.0049875621120892$"):
+        Conic(**{**ATTRS, "periapsis_direction": [[0.6, 0.8, 0.1]]})
