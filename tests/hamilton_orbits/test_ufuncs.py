@@ -107,3 +107,22 @@ def test_processes_building_at_once_leave_a_cache_later_processes_load(tmp_path)
                            capture_output=True, text=True, timeout=300)
     for out, err, code in [*results, (later.stdout, later.stderr, later.returncode)]:
         assert (code, out.strip()) == (0, "ok"), err[-2000:]
+
+
+def test_a_lazy_ufunc_pickles_by_name():
+    """``pool.map(solve_ufunc, ...)`` failed: "cannot pickle '_thread.lock'" (the lazy
+    wrapper's lock).  A lazy ufunc pickles by name, as a module's function does, and
+    comes back as the same object (built in the other process on first use)."""
+    import pickle
+
+    from hamilton_orbits._kernels.kepler import solve_ufunc
+    from hamilton_orbits._kernels.quaternion import qmul_gufunc
+
+    for f in (solve_ufunc, qmul_gufunc):
+        assert pickle.loads(pickle.dumps(f)) is f
+    # and what another process rebuilds from the bytes is the same ufunc at work
+    code = ("import pickle, sys; f = pickle.loads(sys.stdin.buffer.read()); "
+            "print(repr(float(f(0.5, 0.1))))")
+    out = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(solve_ufunc),
+                         capture_output=True, check=True).stdout.decode().strip()
+    assert float(out) == float(solve_ufunc(0.5, 0.1))

@@ -300,6 +300,12 @@ class LazyUfunc:
         state = "built" if self._ufunc is not None else "not built"
         return f"LazyUfunc({self.__qualname__}, {state})"
 
+    def __reduce__(self) -> str:
+        """Pickled by name, as a module's function is (its lock is not picklable:
+        ``pool.map(solve_ufunc, ...)`` failed "cannot pickle '_thread.lock'"); the
+        other process finds it in its module, built there on first use."""
+        return self.__qualname__
+
 
 def lazy_vectorize(*args: Any, **kwargs: Any) -> Any:
     """``numba.vectorize`` with its arguments, built on first use; as numba's, also
