@@ -119,14 +119,7 @@ def _checked_elements(*values: Any) -> list[np.ndarray]:
     the radial orbit, ``e == 1``), ``1/a`` of the sign of ``1 - e`` and equal to
     ``(1 - e^2)/p`` to rounding.  ValueError naming the argument, the first bad
     index and the value."""
-    arrays = []
-    for name, x in zip(_ELEMENTS, values, strict=True):
-        if is_quantity(x):
-            raise ValueError(
-                f"Expected `{name}` as plain floats (km, km^3/s^2 and rad with "
-                f"`quantity=True`), got the Quantity {x}"
-            )
-        arrays.append(as_float_array(name, x))
+    arrays = _plain_floats(_ELEMENTS, values, "km, km^3/s^2 and rad")
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
     _check_shape(p, e, inv_a)
     raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi]")
@@ -147,12 +140,7 @@ def _checked_attributes(p: Any, e: Any, inv_a: Any, periapsis: Any, normal: Any,
     ``inv_a``, ``mu``), and the axes unless each is of shape ``(..., 3)``, finite,
     of unit length and the two orthogonal (to :data:`_AXES`)."""
     names = ("p", "e", "inv_a", "periapsis_direction", "normal", "mu")
-    arrays = []
-    for name, x in zip(names, (p, e, inv_a, periapsis, normal, mu), strict=True):
-        if is_quantity(x):
-            raise ValueError(f"Expected `{name}` as plain floats (km and km^3/s^2 with "
-                             f"`quantity=True`), got the Quantity {x}")
-        arrays.append(as_float_array(name, x))
+    arrays = _plain_floats(names, (p, e, inv_a, periapsis, normal, mu), "km and km^3/s^2")
     for k in (3, 4):
         check_trailing(names[k], arrays[k], 3)
     pp, ee, ia, mm = broadcast(names[:3] + names[5:], *arrays[:3], arrays[5])
@@ -161,19 +149,35 @@ def _checked_attributes(p: Any, e: Any, inv_a: Any, periapsis: Any, normal: Any,
     big, n = broadcast(names[3:5], arrays[3], arrays[4])
     broadcast(names, *(a[..., 0] if k in (3, 4) else a for k, a in enumerate(arrays)))
     for name, x in ((names[3], _dot(big, big) - 1.0), (names[4], _dot(n, n) - 1.0)):
-        bad = np.abs(x) > _AXES
-        if np.any(bad):
-            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
-            at = fmt_index(i if bad.size > 1 else ())
-            raise ValueError(f"Expected `{name}` of unit length, got the length "
-                             f"{float(np.sqrt(x[i] + 1.0))!r}{at}")
+        _refuse_beyond(x, lambda i, at, name=name, x=x: (
+            f"Expected `{name}` of unit length, got the length {float(np.sqrt(x[i] + 1.0))!r}"
+            f"{at}"))
     cos = _dot(big, n)
-    bad = np.abs(cos) > _AXES
+    _refuse_beyond(cos, lambda i, at: (
+        f"Expected `periapsis_direction` orthogonal to `normal`, got their dot product "
+        f"{float(cos[i])!r}{at}"))
+    return tuple(arrays)
+
+
+def _plain_floats(names: tuple[str, ...], values: Any, units: str) -> list[np.ndarray]:
+    """``values`` as finite float arrays (their own shapes), a Quantity refused by the
+    name of its argument (the conic's numbers are in ``units`` with ``quantity=True``)."""
+    arrays = []
+    for name, x in zip(names, values, strict=True):
+        if is_quantity(x):
+            raise ValueError(f"Expected `{name}` as plain floats ({units} with "
+                             f"`quantity=True`), got the Quantity {x}")
+        arrays.append(as_float_array(name, x))
+    return arrays
+
+
+def _refuse_beyond(x: np.ndarray, message: Any) -> None:
+    """A ValueError of ``message(index, " at index ...")`` at the first element of
+    ``x`` beyond :data:`_AXES` in magnitude (no index where ``x`` holds one value)."""
+    bad = np.abs(x) > _AXES
     if np.any(bad):
         i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
-        raise ValueError(f"Expected `periapsis_direction` orthogonal to `normal`, got their "
-                         f"dot product {float(cos[i])!r}{fmt_index(i if bad.size > 1 else ())}")
-    return tuple(arrays)
+        raise ValueError(message(i, fmt_index(i if bad.size > 1 else ())))
 
 
 class Conic:
