@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import os
 import time
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -26,9 +27,13 @@ import numpy as np
 
 from hamilton_orbits._progress import progress_bar
 from hamilton_orbits.batches import check_client, check_workers
+from hamilton_orbits.integrals import UnderResolvedEncounterWarning
 from hamilton_orbits.scene import Scene
 
-__all__ = ["Ensemble", "run_member"]
+__all__ = ["UNDER_RESOLVED", "Ensemble", "run_member"]
+
+#: The column of a member's count of close approaches its fixed step was too long for.
+UNDER_RESOLVED = "under-resolved encounters"
 
 
 def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) -> dict:
@@ -48,7 +53,10 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     start = time.perf_counter()
     try:
         scene = Scene.from_values(data, source, dict(values))  # checked once, built once
-        result = scene.run(progress=False)
+        with warnings.catch_warnings():  # (counted in the row, and the ensemble warns
+            # once for all its members: a map of 64 cells warned 4 times, of 10 000 ...)
+            warnings.simplefilter("ignore", UnderResolvedEncounterWarning)
+            result = scene.run(progress=False)
         if not result.complete or result.interrupted:
             raise KeyboardInterrupt  # (no stop is given: a Ctrl-C cut the member, and
             # it ends the ensemble, as in a pool of workers, not the member alone)
@@ -244,7 +252,22 @@ class Ensemble:
                              for v in given):
                 df[column] = pd.array(values, dtype="Int64")
         df.attrs["failures"] = int(df["error"].notna().sum())
+        _warn_under_resolved(df)
         return df
+
+
+def _warn_under_resolved(df: Any) -> None:
+    """One warning for the members whose fixed step was too long for a close approach
+    (each member's run would have warned on its own)."""
+    if UNDER_RESOLVED not in df.columns:
+        return
+    hit = df[UNDER_RESOLVED].fillna(0) > 0
+    if hit.any():
+        warnings.warn(UnderResolvedEncounterWarning(
+            f"{int(hit.sum())} of {len(df)} members crossed close approaches their fixed "
+            f"step was too long for (column {UNDER_RESOLVED!r}): their results after them "
+            "are not to be trusted; shorten the step or use an adaptive method (radau15)"),
+            stacklevel=3)
 
 
 _POOLS: dict[int, Any] = {}

@@ -12,8 +12,8 @@ state that became non-finite), gives (E) on plain arrays (:func:`energy_gm`,
 
 Test particles (massless bodies) do not enter Hamilton's integrals; each gets
 its own check (:func:`particle_errors`: its Jacobi constant, or its two-body
-energy about its primary), and a fixed step too long for a particle's close
-approach to a massive body is found at the outputs
+energy about its primary), and a fixed step too long for a close approach (a
+particle's to a massive body, a massive body's to a heavier one) is found at the outputs
 (:func:`under_resolved_encounters`, :class:`UnderResolvedEncounterWarning`).
 
 References
@@ -337,7 +337,8 @@ class UnderResolvedEncounterWarning(UserWarning):
 
 
 class Encounter(NamedTuple):
-    """A test particle's close approach crossed with too long a step (internal units:
+    """A close approach crossed with too long a step (``particle``: a test particle,
+    or the lighter body of a massive pair; internal units:
     days, au, au/day); ``before`` and ``after`` the outputs around it, and the
     particle's osculating ``1/a`` and ``e`` about its primary there."""
 
@@ -479,10 +480,14 @@ def light_as_massless(gm: np.ndarray) -> np.ndarray:
 def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray,
                               step: float, exempt: tuple[int, float] | None = None,
                               fraction: float = ENCOUNTER_STEP_FRACTION) -> list[Encounter]:
-    """The test particles' close approaches to massive bodies, seen at the output
-    states ``r``, ``v`` (n_t, n, 3) at times ``t``, that a fixed ``step`` was too long
-    for (bodies of at most :data:`LIGHT` of the largest GM checked as test
-    particles, :func:`light_as_massless`).
+    """The close approaches of test particles to massive bodies, and of massive
+    bodies to heavier ones, seen at the output states ``r``, ``v`` (n_t, n, 3) at
+    times ``t``, that a fixed ``step`` was too long for (bodies of at most
+    :data:`LIGHT` of the largest GM checked as test particles,
+    :func:`light_as_massless`).  A pair of massive bodies is checked once, from
+    its lighter body (of two equal, the later one) as "the particle", with the
+    pair's summed GM; a massive body's primary is the heavier body it is bound to
+    on the smallest orbit, else the most massive body.
 
     An approach is a pericentre passage about the particle's primary
     (:func:`primaries`) whose time scale is under a tenth of the orbit's own pace
@@ -518,33 +523,34 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     >>> under_resolved_encounters(r, v, gm, t, 0.00001)
     []
     """
-    gm0 = light_as_massless(np.atleast_2d(np.asarray(gm, dtype=np.float64))[0])
-    tp = np.flatnonzero(gm0 == 0)
-    m = np.flatnonzero(gm0 > 0)
-    if len(t) < 2 or not len(tp) or not len(m):
-        return []
     from hamilton_orbits._kernels import integrals
 
+    r = np.ascontiguousarray(r, dtype=np.float64)
+    v = np.ascontiguousarray(v, dtype=np.float64)
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    gm = np.ascontiguousarray(np.atleast_2d(gm)[0], dtype=np.float64)
+    ex, ex_dist = (-1, 0.0) if exempt is None else (int(exempt[0]), float(exempt[1]))
+    if not integrals.screen(r, v, gm, t, float(step), ex, ex_dist, float(fraction), LIGHT):
+        return []  # (all resolved: nearly every run, found in one compiled call)
+    gm0 = light_as_massless(gm)
+    m = np.flatnonzero(gm0 > 0)
+    tp = np.delete(np.arange(len(gm0)), m[np.argmax(gm0[m])])  # all but the most massive
     gap = np.abs(np.diff(t))
     h = np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
                                     np.concatenate((gap, gap[-1:]))))
-    r = np.ascontiguousarray(r, dtype=np.float64)
-    v = np.ascontiguousarray(v, dtype=np.float64)
-    prim = integrals.primaries(r[0], v[0], gm0, np.empty(len(gm0), np.int64))
-    ex, ex_dist = (-1, 0.0) if exempt is None else (int(exempt[0]), float(exempt[1]))
-    bad = np.zeros((len(t), len(tp), len(m)), np.bool_)
+    prim = integrals.primaries(r[0], v[0], gm0, np.empty(len(gm0), np.int64), True)
+    bad = np.zeros((1, len(tp), len(m)), np.bool_)
     none = np.empty((0, 0, 0))
-    if not integrals.approaches(r, v, gm0, tp, m, prim, ex, ex_dist, h, float(fraction), bad,
-                                none, none):
-        return []
+    integrals.approaches(r, v, gm0, tp, m, prim, ex, ex_dist, h, float(fraction), bad, none,
+                         none)
     found: list[Encounter] = []
-    for p, j in zip(*np.nonzero(bad.any(axis=0)), strict=True):
-        one = np.empty((len(t), 1, 1))
-        dist, tau = one, one.copy()
+    for p, j in zip(*np.nonzero(bad[0]), strict=True):
+        dist, tau = np.empty((len(t), 1, 1)), np.empty((len(t), 1, 1))
+        at = np.zeros((len(t), 1, 1), np.bool_)  # (the outputs this pair was flagged at)
         integrals.approaches(r, v, gm0, tp[p:p + 1], m[j:j + 1], prim, ex, ex_dist, h,
-                             float(fraction), np.empty((len(t), 1, 1), np.bool_), dist, tau)
+                             float(fraction), at, dist, tau)
         found += _runs(r, v, gm0, t, h, int(tp[p]), int(m[j]), int(prim[tp[p]]),
-                       bad[:, p, j], dist[:, 0, 0], tau[:, 0, 0])
+                       at[:, 0, 0], dist[:, 0, 0], tau[:, 0, 0])
     return sorted(found, key=lambda enc: (enc.time, enc.particle))
 
 
@@ -599,7 +605,7 @@ def _osculating(r: np.ndarray, v: np.ndarray, gm: np.ndarray, i: int, c: int,
     inv_a, ecc = [], []
     for k in rows:
         d, w = r[k, i] - r[k, c], v[k, i] - v[k, c]
-        mu, dist = float(gm[c]), float(np.linalg.norm(d))
+        mu, dist = float(gm[c] + gm[i]), float(np.linalg.norm(d))
         inv_a.append(2.0 / dist - float(np.dot(w, w)) / mu)
         e = (np.dot(w, w) / mu - 1.0 / dist) * d - np.dot(d, w) / mu * w
         ecc.append(float(np.linalg.norm(e)))

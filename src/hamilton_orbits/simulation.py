@@ -52,7 +52,6 @@ from hamilton_orbits.checkpoint import (
     LegRows,
 )
 from hamilton_orbits.effects import EffectSet
-from hamilton_orbits.integrals import light_as_massless
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.integrators._setup import check_step_count
 from hamilton_orbits.integrators.methods import FIXED_STEP, check_run
@@ -211,14 +210,13 @@ class Simulation(Saving):
         #: (``Saving._asked_before``)
         self._asked: Any = None
         self._warned = False  # an under-resolved encounter is warned of once
-        #: how a leg's test-particle approaches are checked: fixed for the simulation
-        #: (method, step, tolerance, the state at time 0), so found once, not per call
         #: the parts of a snapshot that never change, made at the first (simulation_record.record)
         self._record_cache: dict[str, Any] = {}
+        #: how a leg's close approaches are checked: fixed for the simulation (method,
+        #: step, tolerance, the state at time 0), so found once, not per call
         self._encounters = encounter_check(typed, step, tol, arrays.r, arrays.gm)
-        if self._prop.events is None and not (light_as_massless(arrays.gm) == 0).any():
-            self._encounters = None  # no test particle (nor a body as light), ever:
-            # nothing to check per leg
+        if len(arrays.gm) < 2:
+            self._encounters = None  # one body: nothing to check per leg
 
     # ------------------------------------------------------------------ state
     @property

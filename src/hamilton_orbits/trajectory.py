@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.integrals import light_as_massless, relative_change
+from hamilton_orbits.integrals import LIGHT, relative_change, under_resolved_encounters
 
 __all__ = ["Trajectory", "TrajectoryBase", "encounter_check", "encounter_warning", "event_table",
            "make_trajectory", "relative_change"]
@@ -111,7 +111,8 @@ class Trajectory(TrajectoryBase):
         What ``particle_error`` measures for each body: ``"Jacobi constant"``,
         ``"energy about <name>"``, or ``""`` (a massive body).
     under_resolved : astropy.table.QTable
-        The test particles' close approaches to massive bodies that a fixed step
+        The close approaches (of test particles, and of massive bodies to
+        heavier ones) that a fixed step
         was too long for (longer than 1/30 of the approach's time scale), seen
         at the outputs of this leg: ``particle``, ``body``, ``time``, ``distance``,
         ``timescale``, ``step``, and the particle's osculating ``1/a`` and ``e``
@@ -553,6 +554,24 @@ def encounter_warning(traj: Trajectory) -> Any:
         "shorten the step or use an adaptive method (radau15)")
 
 
+def _under_resolved(r: np.ndarray, v: np.ndarray, out: Any, times: np.ndarray,
+                    encounters: tuple[float | None, Any, float]) -> Any:
+    """The close approaches of an engine run's outputs that its fixed step was too
+    long for (``encounters`` from :func:`encounter_check`): one compiled call finds
+    that there are none (after nearly every call: 2 us of a continuing call of one
+    step of ten bodies), the details only where there are."""
+    from hamilton_orbits._kernels.integrals import screen
+
+    step, exempt, fraction = encounters
+    if step is None:
+        step = abs(times[-1] - times[0]) / max(int(out.steps), 1)
+    gm = out.gm if out.gm.ndim == 1 else out.gm[0]
+    ex, ex_dist = (-1, 0.0) if exempt is None else exempt
+    if not screen(r, v, gm, times, float(step), ex, ex_dist, fraction, LIGHT):
+        return ()
+    return under_resolved_encounters(r, v, gm, times, step, exempt, fraction)
+
+
 def _encounter_table(found: Any, system: Any, unit: Any) -> Any:
     """The under-resolved approaches as a ``QTable`` (Quantities for a Quantity system)."""
     import astropy.units as u
@@ -615,13 +634,8 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         _check_finite(system, method, r, v, times, gone)
     integrals = (system, r, v, out.gm, times, gone, effect_set, start)  # for _integrals
     found: Any = ()
-    if encounters is not None and (light_as_massless(np.atleast_2d(out.gm)[0]) == 0).any():
-        from hamilton_orbits.integrals import under_resolved_encounters
-
-        step = encounters[0]
-        if step is None:
-            step = abs(times[-1] - times[0]) / max(int(out.steps), 1)
-        found = under_resolved_encounters(r, v, out.gm, times, step, *encounters[1:])
+    if encounters is not None and r.shape[1] > 1:
+        found = _under_resolved(r, v, out, times, encounters)
     final = (system, r[-1], v[-1], out.gm, None if gone is None else ~gone,
              None if out.events is None else out.events.radius.copy())
     if system.quantity:

@@ -30,6 +30,12 @@ from hamilton_orbits.engine import StopIntegration
 from hamilton_orbits.segment import read_segment
 from hamilton_orbits.snapshot import SnapshotError
 
+#: The disc's planets p1 and p2 pass within 0.15-0.18 of each other near t = 9 (time
+#: scale 1.3), which wh's and leapfrog's steps of 0.05 do not resolve (the run warns
+#: of it); these tests are about the archive's bits and files, not the physics.
+UNRESOLVED = pytest.mark.filterwarnings(
+    "ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")
+
 T = np.linspace(0.0, 60.0, 13)[1:]  # the caller's outputs: every 5
 KW = dict(method="radau15", every=2.5)
 
@@ -68,6 +74,7 @@ def test_snapshots_land_on_the_schedule_and_the_caller_sees_only_its_outputs(tmp
                                 dict(method="leapfrog", dt=0.05, every=2.5),
                                 dict(method="radau15", every=2.5, variational=True)],
                          ids=["wh", "dop853", "leapfrog", "radau15-variational"])
+@UNRESOLVED
 def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_path, kw):
     ref, whole = _run_archived(tmp_path / "whole", kw)
     cut = Simulation(_disc(), archive=tmp_path / "cut", **kw)
@@ -95,6 +102,7 @@ def test_a_run_resumed_from_its_archive_ends_on_the_bits_of_the_whole_run(tmp_pa
                                 dict(method="radau15", variational=True)],
                          ids=["radau15", "radau15-fixed", "wh", "wh-jacobi-11", "leapfrog",
                               "dop853", "radau15-variational"])
+@UNRESOLVED
 def test_the_snapshots_between_a_calls_outputs_hold_the_whole_state(tmp_path, kw):
     """A call of one end time takes its snapshots at the schedule's times between its
     outputs; after the call's first, each is read along the layout the first found
@@ -204,6 +212,7 @@ def _timed_run(folder, kw=KW) -> float:
     return sorted(times)[1]
 
 
+@UNRESOLVED
 def test_an_archive_lists_damaged_and_torn_snapshots_and_never_reads_them(tmp_path):
     _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
     # (two segments: the first snapshot's, before the driver was made, and the rest)
@@ -271,6 +280,7 @@ def flipped_bytes(file, every=1):
         file.write_bytes(data)
 
 
+@UNRESOLVED
 def test_an_archive_opens_as_an_xarray_dataset(tmp_path):
     sim, _ = _run_archived(tmp_path, dict(method="wh", dt=0.05, every=10.0))
     ds = Archive(tmp_path).to_xarray()
@@ -321,6 +331,7 @@ def test_a_segment_is_read_without_this_package(tmp_path):
         assert ds.attrs["format"] == "hamilton-orbits archive segment"
 
 
+@UNRESOLVED
 def test_step_and_wall_clock_schedules(tmp_path):
     sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / "steps",
                      every_steps=200)
@@ -550,6 +561,7 @@ def test_resume_needs_a_simulation_loaded_from_its_archive(tmp_path):
         loaded.resume()
 
 
+@UNRESOLVED
 def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_times(tmp_path):
     """wh's snapshots at the end of the step at or after each scheduled time keep its
     steps (the run agrees with the unarchived one to rounding); exact times shorten
@@ -572,6 +584,7 @@ def test_a_fixed_step_method_snapshots_on_its_own_steps_unless_asked_for_exact_t
                    exact_times="yes")
 
 
+@UNRESOLVED
 @pytest.mark.parametrize("kw", [dict(method="wh"), dict(method="wh", tol=1e-8),
                                 dict(method="leapfrog", tol=1e-4)])
 def test_a_step_the_method_chooses_is_a_fixed_step_for_the_archive(tmp_path, kw):
@@ -691,6 +704,7 @@ def test_events_recorded_before_a_snapshot_are_kept_and_the_buffer_is_not_saved(
                                       np.asarray(whole.events[col]))
 
 
+@UNRESOLVED
 def test_damaged_rows_of_the_last_snapshot_fall_back_to_the_one_before(tmp_path):
     """The rows a snapshot carries are part of it: the last snapshot's rows damaged,
     loading the archive takes the snapshot before (in the same segment)."""
@@ -1701,6 +1715,7 @@ def test_a_relative_archive_folder_stays_the_one_it_was_given_in(tmp_path, monke
     assert archive.path == tmp_path / "one" / "run.archive" and archive[-1].t == 2.0
 
 
+@UNRESOLVED
 def test_two_simulations_cannot_write_two_timelines_into_one_archive(tmp_path):
     """A simulation loaded from an archive that goes on in it makes the archive its
     run's: the simulation that wrote it before, or another loaded at the same
@@ -1769,6 +1784,7 @@ def test_a_segment_file_removed_is_said_missing_by_its_numbers(tmp_path):
         f"removed or moved away?)"]
 
 
+@UNRESOLVED
 def test_a_segment_or_rows_file_under_another_number_is_damaged_not_read_as_it(tmp_path):
     """Each file's header holds the number of its first snapshot (under its
     SHA-256); nothing compared it with the file's name, so that a segment copied

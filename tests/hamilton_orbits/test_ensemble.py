@@ -72,6 +72,22 @@ def test_a_failing_member_leaves_the_others():
         list(df.columns).index("steps")] == str(df["steps"][0])
 
 
+def test_members_with_under_resolved_approaches_are_warned_of_once():
+    """Every member whose fixed step was too long for a close approach warned on its
+    own (a stability map of 64 cells warned 4 times, each a paragraph, from the
+    workers): the members' warnings are counted in their rows, and the ensemble
+    warns once, with how many members."""
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    leapfrog = {"integrator.method": "leapfrog", "integrator.dt": "1 d"}
+    ens = Ensemble(comet(), members=[leapfrog, {"integrator.method": "radau15"}, leapfrog])
+    with pytest.warns(UnderResolvedEncounterWarning) as caught:
+        df = ens.run(progress=False, workers=1)
+    assert len(caught) == 1
+    assert str(caught[0].message).startswith("2 of 3 members crossed close approaches")
+    assert list(df["under-resolved encounters"].fillna(0)) == [1, 0, 1]
+
+
 def test_invalid_members_are_refused_before_anything_runs():
     with pytest.raises(ValueError, match=r"Member 1 .*integrator.dt"):
         Ensemble(Scene.bundled("dzhanibekov"), vary={"integrator.dt": ["1 ms", "bogus"]})

@@ -15,6 +15,11 @@ from hamilton_orbits import Simulation
 from hamilton_orbits.integrators._setup import accel_arg
 from hamilton_orbits.restart import Capture, flatten
 
+#: The disc's planets p0 and p1 pass 0.11 apart at t = 3.5 (time scale 0.45), which
+#: steps of 0.05 do not resolve (the run warns of it); the capture is what is tested.
+UNRESOLVED = pytest.mark.filterwarnings(
+    "ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")
+
 
 class _Leaf:
     def __init__(self) -> None:
@@ -144,6 +149,7 @@ def test_random_sequences_of_changes_never_give_another_state():
                                 dict(method="radau15",
                                      events=[{"name": "close_encounter", "distance": 2.0}])],
                          ids=["radau15", "wh", "dop853", "leapfrog", "variational", "events"])
+@UNRESOLVED
 def test_a_propagation_is_captured_as_it_is_flattened(kw):
     from test_simulation_legs import _disc
 

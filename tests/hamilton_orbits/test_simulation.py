@@ -482,6 +482,46 @@ def test_an_under_resolved_approach_of_a_backward_run_is_dated_at_its_periapsis(
         -float(orb.time_since_periapsis), abs=1e-3)
 
 
+@pytest.mark.parametrize("method", ["wh", "leapfrog"])
+def test_massive_bodies_through_each_other_at_a_fixed_step_warn(method):
+    """Two planets of GM 1e-3 falling head-on into each other beside a star, stepped
+    at 0.01 through the fall (radau15 stops there, at t = 0.301, its step
+    underflowed): wh and leapfrog passed through the singularity and flew apart at
+    1e5 a unit of time, the energy error 6e9 (wh) and 6e6 (leapfrog), without a
+    word: only test particles' approaches were checked.  The lighter body of a
+    massive pair (of two equal, the later) is now checked against the heavier with
+    the pair's summed GM, dated at the passage between the outputs 0 and 2."""
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    s = System([Body("b0", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("b1", 1e-3, [1.0, 0.1, 0], [0, -0.3, 0]),
+                Body("b2", 1e-3, [1.0, -0.1, 0], [0, 0.3, 0])])
+    with pytest.warns(UnderResolvedEncounterWarning, match="of 'b2' to 'b1'"):
+        traj = integrate(s, 2.0, method=method, dt=0.01)
+    row = traj.under_resolved[0]
+    assert (row["particle"], row["body"], row["primary"]) == ("b2", "b1", "b0")
+    assert 0.30 < row["time"] < 0.33 and row["distance"] < 1e-3
+    assert row["inv_a_after"] < 0 < row["inv_a_before"]  # (flung out of the system)
+
+
+@pytest.mark.parametrize("method", ["wh", "leapfrog"])
+def test_a_moon_about_its_planet_about_a_star_is_no_approach(method):
+    """A moon (GM 3.7e-8, 0.00257 from its planet of 3e-6: the Moon and the Earth)
+    stepped 55 times an orbit: its orbit about the planet, whose pace it keeps, and
+    the planet's and its own about the star (the moon inside the star's "Hill
+    sphere" about the planet: the approach's time scale is the year's) are no
+    approaches the step is too long for."""
+    d, gm_p, gm_m = 0.00257, 3e-6 * 2.959e-4, 3.7e-8 * 2.959e-4
+    w = np.sqrt((gm_p + gm_m) / d)
+    vp = np.sqrt(2.959e-4)
+    s = System([Body("star", 2.959e-4, [0, 0, 0], [0, 0, 0]),
+                Body("planet", gm_p, [1.0, 0, 0], [0, vp, 0]),
+                Body("moon", gm_m, [1.0 + d, 0, 0], [0, vp + w, 0])])
+    traj = integrate(s, np.linspace(0, 365.25, 37), method=method, dt=0.5)
+    assert len(traj.under_resolved) == 0  # (and no warning: warnings are errors here)
+    assert abs(traj.energy_error).max() < 1e-3
+
+
 def test_energy_error_of_one_centre_after_a_removal_is_the_particles():
     """One massive body and test particles: an escape that removed a particle made
     ``gm`` vary over the run, and the energy error fell back to Hamilton's E of the

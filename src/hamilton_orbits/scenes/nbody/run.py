@@ -250,8 +250,14 @@ def _particles_into(result: Result, traj: Any, gm: np.ndarray) -> None:
     a fixed step was too long for (a count and a table; the run also warned)."""
     checks = traj.particle_check
     tp = [i for i, c in enumerate(checks) if c]
-    if not tp:
-        return
+    if tp:
+        _worst_particle_into(result, traj, gm, tp)
+    _under_resolved_into(result, traj)
+
+
+def _worst_particle_into(result: Result, traj: Any, gm: np.ndarray, tp: list[int]) -> None:
+    """The largest change of a test particle's own check, and which particle."""
+    checks = traj.particle_check
     err = np.abs(traj.particle_error[:, tp])
     worst = int(np.nanargmax(np.nanmax(err, axis=0))) if np.isfinite(err).any() else 0
     jacobi = checks[tp[0]] == "Jacobi constant"
@@ -263,6 +269,10 @@ def _particles_into(result: Result, traj: Any, gm: np.ndarray) -> None:
     result.metrics[key] = float(np.nanmax(err)) if np.isfinite(err).any() else float("nan")
     result.metrics["test particle of largest change"] = (
         f"{traj.names[tp[worst]]} ({checks[tp[worst]]})")
+
+
+def _under_resolved_into(result: Result, traj: Any) -> None:
+    """The close approaches a fixed step was too long for: a count and a table."""
     table = traj.under_resolved
     if not len(table):
         return
