@@ -56,6 +56,34 @@ ENTRIES: dict[str, str] = {
   pages = {1424--1437},
   doi = {10.1093/mnras/stu2164}
 }""",
+    "pham2024": """@article{pham2024,
+  author = {Pham, Dang and Rein, Hanno and Spiegel, David S.},
+  title = {A new timestep criterion for {N}-body simulations},
+  journal = {The Open Journal of Astrophysics},
+  volume = {7},
+  year = {2024},
+  doi = {10.21105/astro.2401.02849}
+}""",
+    "duncan1998": """@article{duncan1998,
+  author = {Duncan, Martin J. and Levison, Harold F. and Lee, Man Hoi},
+  title = {A multiple time step symplectic algorithm for integrating close
+           encounters},
+  journal = {The Astronomical Journal},
+  volume = {116},
+  number = {4},
+  year = {1998},
+  pages = {2067--2077},
+  doi = {10.1086/300541}
+}""",
+    "marsden1973": """@article{marsden1973,
+  author = {Marsden, B. G. and Sekanina, Z. and Yeomans, D. K.},
+  title = {Comets and nongravitational forces. {V}},
+  journal = {The Astronomical Journal},
+  volume = {78},
+  year = {1973},
+  pages = {211--225},
+  doi = {10.1086/111402}
+}""",
     "wisdom1991": """@article{wisdom1991,
   author = {Wisdom, Jack and Holman, Matthew},
   title = {Symplectic maps for the {N}-body problem},
@@ -165,7 +193,8 @@ _METHOD_KEYS = {
 #: the effects whose model is DE440's (Park et al. 2021)
 _DE440_EFFECTS = frozenset({"eih", "lense_thirring", "zonal", "moon_figure", "earth_tides",
                             "kuiper_ring"})
-_EFFECT_KEYS = {"gr": ("anderson1975", "tamayo2020"), "gr_potential": ("nobili1986",)}
+_EFFECT_KEYS = {"gr": ("anderson1975", "tamayo2020"), "gr_potential": ("nobili1986",),
+                "nongrav": ("marsden1973",)}
 
 
 def _effect_names(effects: Any) -> tuple[str, ...]:
@@ -195,7 +224,7 @@ def keys_for(run: Any = None, effects: Iterable[Any] = (), *, variational: bool 
     Examples
     --------
     >>> keys_for("wh", ["gr_potential"], corrector=11)
-    ['hamilton1845', 'wisdom1991', 'wisdom1996', 'rein2015whfast', 'nobili1986']
+    ['hamilton1845', 'wisdom1991', 'duncan1998', 'wisdom1996', 'rein2015whfast', 'nobili1986']
     """
     name, options, names, variational = _describe(run, effects, variational)
     corrector = options.get("corrector", corrector)
@@ -204,6 +233,10 @@ def keys_for(run: Any = None, effects: Iterable[Any] = (), *, variational: bool 
         if name not in _METHOD_KEYS:
             raise ValueError(f"Expected a method among {', '.join(_METHOD_KEYS)}, got {name!r}")
         keys += _METHOD_KEYS[name]
+    if name == "radau15" and options.get("criterion", "prs23") == "prs23":
+        keys.append("pham2024")  # the default step rule (a name, a Trajectory: its default)
+    if name == "wh" and options.get("coordinates", "democratic_heliocentric") != "jacobi":
+        keys.append("duncan1998")  # the default splitting, democratic heliocentric
     if name == "wh" and corrector:  # the correctors, at WHFast's orders
         keys += ("wisdom1996", "rein2015whfast")
     for effect in names:
@@ -239,7 +272,10 @@ def cite(run: Any = None, effects: Iterable[Any] = (), *, variational: bool = Fa
     corrector : int
         With ``"wh"`` as a name: the corrector's order (0: none).  (A
         Trajectory keeps the method's name only: cite the Simulation, or pass
-        these, to cite the corrector.)
+        these, to cite the corrector.)  A method given by name, or a Trajectory's,
+        cites its default options' papers: radau15's step rule (Pham, Rein &
+        Spiegel 2024), wh's democratic-heliocentric splitting (Duncan, Levison &
+        Lee 1998).
 
     Returns
     -------
@@ -252,7 +288,7 @@ def cite(run: Any = None, effects: Iterable[Any] = (), *, variational: bool = Fa
     >>> from hamilton_orbits import cite
     >>> bib = cite("radau15")
     >>> [line.split("{")[1].rstrip(",") for line in bib.splitlines() if line.startswith("@")]
-    ['hamilton_orbits', 'hamilton1845', 'everhart1985', 'rein2015ias15']
+    ['hamilton_orbits', 'hamilton1845', 'everhart1985', 'rein2015ias15', 'pham2024']
     """
     from hamilton_orbits import __version__
 

@@ -58,9 +58,20 @@ def test_package_alone():
 def test_radau15_run():
     traj = integrate(_system(), 1.0, method="radau15")
     keys = _keys(cite(traj))
-    assert keys == ["hamilton_orbits", "hamilton1845", "everhart1985", "rein2015ias15"]
+    # (its default step rule is Pham, Rein & Spiegel's: it was not cited)
+    assert keys == ["hamilton_orbits", "hamilton1845", "everhart1985", "rein2015ias15",
+                    "pham2024"]
     assert _keys(cite(Simulation(_system()))) == keys
     assert _keys(cite("radau15")) == keys
+    assert "pham2024" not in _keys(cite(Simulation(_system(), criterion="global")))
+
+
+def test_the_default_wh_cites_its_democratic_heliocentric_splitting():
+    """wh's default coordinates are Duncan, Levison & Lee's (1998): not cited."""
+    keys = _keys(cite(integrate(_system(), 1.0, method="wh", dt=0.01)))
+    assert keys[2:] == ["wisdom1991", "duncan1998"]
+    assert "duncan1998" not in _keys(cite(Simulation(_system(), method="wh", dt=0.01,
+                                                     coordinates="jacobi")))
 
 
 def test_wh_with_corrector_and_gr_potential():
@@ -70,8 +81,10 @@ def test_wh_with_corrector_and_gr_potential():
     keys = _keys(cite(sim))
     assert keys == ["hamilton_orbits", "hamilton1845", "wisdom1991", "wisdom1996",
                     "rein2015whfast", "nobili1986"]
-    # the same from a name: the corrector given
-    assert _keys(cite("wh", ["gr_potential"], corrector=11)) == keys
+    # the same from a name, the corrector given (and the default coordinates' paper)
+    assert _keys(cite("wh", ["gr_potential"], corrector=11)) == [
+        "hamilton_orbits", "hamilton1845", "wisdom1991", "duncan1998", "wisdom1996",
+        "rein2015whfast", "nobili1986"]
     # without a corrector: the map only
     assert "wisdom1996" not in _keys(cite("wh", ["gr_potential"]))
 
@@ -91,6 +104,7 @@ def test_variational_run():
     (("radau15", ["gr", {"name": "j2", "body": "sun"}]), {}, ["anderson1975", "tamayo2020"]),
     (("radau15", ["eih"]), {}, ["park2021"]),
     (("radau15",), {"ephemeris": True}, ["park2021"]),
+    (("radau15", [{"name": "nongrav", "A2": 1e-12}]), {}, ["marsden1973"]),
 ])
 def test_other_methods_and_effects(args, kw, expected):
     keys = _keys(cite(*args, **kw))
