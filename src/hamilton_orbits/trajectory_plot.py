@@ -6,7 +6,8 @@ body at the end of the run) in the chosen plane, a line through the outputs (dot
 when they are too sparse for a line to follow the orbit), an open circle where
 the body starts with an arrow along its first motion, a filled dot where it ends,
 and the primary as a cross at the origin.  Every axis names its origin and unit
-(au for a Quantity system, the system's own length unit otherwise); the aspect is
+(au for a Quantity system, km where every path stays within 0.01 au of the primary,
+the system's own length unit otherwise); the aspect is
 equal, so that a circle looks like one; the legend is placed outside the axes
 when there are more than a few bodies.
 """
@@ -17,13 +18,19 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PLAIN_UNIT", "plot_trajectory", "primary_index"]
+__all__ = ["AU_KM", "PLAIN_UNIT", "SMALL_EXTENT_AU", "plot_trajectory", "primary_index",
+           "within_extent"]
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 
 
 #: the unit an axis of a system of plain numbers names (its own, whatever it is)
 PLAIN_UNIT = "the system's length unit"
+#: a Quantity trajectory whose paths about the primary stay within this many au is
+#: drawn in km (as the scenes' orbit figures are)
+SMALL_EXTENT_AU = 0.01
+#: km in an au (IAU 2012 Resolution B2: exactly 149 597 870 700 m)
+AU_KM = 149_597_870.7
 
 
 def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
@@ -64,6 +71,9 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     primary = primary_index(traj)
     rel = r if primary is None else r - r[:, primary:primary + 1]
     vel = v[0] if primary is None else v[0] - v[0, primary]
+    if unit is not None and within_extent(rel, SMALL_EXTENT_AU):  # (a satellite's orbit in
+        # au: ticks of +-4 under an offset of 1e-5)
+        rel, unit = rel * AU_KM, "km"
     if ax is None:  # (constrained: the legend beside the axes, past five bodies, is kept
         # within the figure; it was cut off by savefig)
         fig, ax = plt.subplots(figsize=(6.5 if len(traj.names) <= 5 else 8.0, 6),
@@ -87,6 +97,20 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     else:
         ax.legend(loc="best", fontsize=8)
     return fig
+
+
+def within_extent(rel: np.ndarray, extent: float) -> bool:
+    """Whether every finite position of ``rel`` (n_t, n, 3) is within ``extent`` of
+    the origin (and there is one).
+
+    Examples
+    --------
+    >>> within_extent(np.array([[[3e-5, 0, 0], [np.nan, 0, 0]]]), SMALL_EXTENT_AU)
+    True
+    """
+    dist = np.linalg.norm(rel, axis=-1)
+    dist = dist[np.isfinite(dist)]
+    return bool(dist.size) and float(dist.max()) <= extent
 
 
 def primary_index(traj: Any) -> int | None:

@@ -17,7 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.trajectory_plot import PLAIN_UNIT, primary_index
+from hamilton_orbits.trajectory_plot import (
+    AU_KM,
+    PLAIN_UNIT,
+    SMALL_EXTENT_AU,
+    primary_index,
+    within_extent,
+)
 
 __all__ = ["MAX_FRAMES", "plot_trajectory3d"]
 
@@ -43,7 +49,8 @@ def plot_trajectory3d(traj: Any, bodies: Sequence[str] | None = None,
         origin of the coordinates the system was integrated in).
     unit : str or astropy.units.Unit, optional
         The length unit of the axes, for a trajectory of Quantities (default:
-        its own, au); a trajectory of plain floats has no unit to convert.
+        au, or km where every path stays within 0.01 au of the origin); a
+        trajectory of plain floats has no unit to convert.
     max_frames : int, default 200
         The most slider steps: the outputs are subsampled evenly (the first and
         the last always kept) to at most this many animation frames, so that a
@@ -87,6 +94,8 @@ def plot_trajectory3d(traj: Any, bodies: Sequence[str] | None = None,
             or max_frames < 2:
         raise ValueError(f"Expected `max_frames` to be an integer >= 2, got {max_frames!r}")
     rel = r if centre is None else r - r[:, centre:centre + 1]
+    if unit is None and unit_name is not None and within_extent(rel, SMALL_EXTENT_AU):
+        rel, unit_name = rel * AU_KM, "km"  # (as Trajectory.plot: a satellite's in km)
     keep = np.unique(np.linspace(0, r.shape[0] - 1, min(r.shape[0], int(max_frames)))
                      .round().astype(int))
     fig = go.Figure(data=_traces(go, rel, names, shown, centre))

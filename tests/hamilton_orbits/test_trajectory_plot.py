@@ -104,3 +104,30 @@ def test_a_body_keeps_its_colour_and_a_plain_system_names_its_unit():
     assert [line.get_color() for line in paths] == cycle[:3]
     assert ax.get_xlabel() == "x from sun [the system's length unit]"
     plt.close(fig)
+
+
+def _leo():
+    """A satellite 7000 km from the Earth's centre (e = 0.1), in km and km/s."""
+    from hamilton_orbits import KeplerOrbit
+
+    mu = 398600.4418 * u.km**3 / u.s**2
+    orb = KeplerOrbit.from_elements(a=7000 * u.km, e=0.1, inc=51.6 * u.deg, lan=0 * u.deg,
+                                    argp=0 * u.deg, M=0 * u.deg, mu=mu)
+    r, v = orb.state()
+    s = System([Body("earth", mu, [0, 0, 0] * u.km, [0, 0, 0] * u.km / u.s),
+                Body("sat", 0 * mu, r, v)])
+    return integrate(s, np.linspace(0, 2, 121) * u.hour)
+
+
+def test_a_satellite_s_orbit_is_drawn_in_km():
+    """A satellite's orbit was drawn in au: ticks of +-4 under an offset of 1e-5.
+    Paths within 0.01 au of the primary are drawn in km (as the scenes' figures)."""
+    traj = _leo()
+    ax = traj.plot().axes[0]
+    assert ax.get_xlabel() == "x from earth [km]"
+    (path,) = _lines(ax, "sat")
+    rel = (traj.r[:, 1] - traj.r[:, 0]).to_value(u.km)
+    np.testing.assert_allclose(path.get_xdata(), rel[:, 0], rtol=1e-14)  # (au -> km)
+    # (starts at periapsis, a (1 - e) = 6300 km along x: the node and periapsis there)
+    assert path.get_xdata()[0] == pytest.approx(6300.0, rel=1e-12)
+    plt.close(ax.figure)

@@ -165,3 +165,15 @@ def test_a_notebook_displays_it_as_a_plotly_figure():
     figure = outputs[0]["data"]["application/vnd.plotly.v1+json"]
     assert {t["name"] for t in figure["data"]} >= {"p", "p now", "sun (origin)"}  # the bodies
     assert figure["layout"]["sliders"], "the time slider"
+
+
+def test_a_satellite_s_orbit_is_drawn_in_km_unless_a_unit_is_asked():
+    """As ``Trajectory.plot``: paths within 0.01 au of the origin in km."""
+    from test_trajectory_plot import _leo
+
+    traj = _leo()
+    fig = traj.plot3d()
+    assert fig.layout.scene.xaxis.title.text == "x from earth [km]"
+    rel = (traj.r[:, 1] - traj.r[:, 0]).to_value(u.km)
+    np.testing.assert_allclose(_trace(fig, "sat").x, rel[:, 0], rtol=1e-14)
+    assert traj.plot3d(unit="au").layout.scene.xaxis.title.text == "x from earth [AU]"
