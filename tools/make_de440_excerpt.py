@@ -16,8 +16,8 @@ from pathlib import Path
 from hamilton_orbits.ephemeris import J2000_JD
 from hamilton_orbits.spk import Segments
 
-OUT = Path(__file__).resolve().parents[1] / "tests" / "hamilton_orbits" / "data" / \
-    "de440_excerpt.npz"
+OUT = Path(__file__).resolve().parents[1] / "src" / "hamilton_orbits" / "data" / \
+    "de440_excerpt.npz"  # (hamilton_orbits.spk.EXCERPT)
 
 
 def main() -> None:

@@ -156,11 +156,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
 
     Examples
     --------
-    >>> from pathlib import Path
     >>> import astropy.units as u
     >>> from astropy.time import Time
-    >>> from hamilton_orbits.spk import Segments
-    >>> excerpt = Segments.load(Path("tests/hamilton_orbits/data/de440_excerpt.npz"))
+    >>> from hamilton_orbits.spk import EXCERPT, Segments
+    >>> excerpt = Segments.load(EXCERPT)  # (two years of DE440 the package ships)
     >>> traj = propagate([2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.day,
     ...                  Time("2000-01-01T12:00:00", scale="tdb"), 30 * u.day,
     ...                  ephemeris=excerpt, asteroids=False, names=["belt"])

@@ -5,8 +5,8 @@ motion of one body (``target``) about another (``center``) as Chebyshev series
 over fixed records (``hamilton_orbits._kernels.chebyshev``).  :class:`Segments`
 holds some of them as plain arrays, read from the ``[ephemeris]`` extra's kernel
 (:meth:`Segments.from_kernel`, any span DE440 covers) or from a file of them
-(:meth:`Segments.load`; ``tools/make_de440_excerpt.py`` writes the few years the
-tests use), and gives barycentric states of the bodies by chaining the segments
+(:meth:`Segments.load`; ``tools/make_de440_excerpt.py`` writes the two years the
+package ships, :data:`EXCERPT`), and gives barycentric states of the bodies by chaining the segments
 (the Moon: the Earth-Moon barycentre about the solar-system barycentre, plus the
 Moon about the Earth-Moon barycentre), in au and au/day, with no Python per time.
 This is the evaluation under ephemeris-driven perturbers (issue 35).
@@ -36,7 +36,12 @@ from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels.chebyshev import add_states
 from hamilton_orbits.ephemeris import CHAINS
 
-__all__ = ["Segment", "Segments"]
+__all__ = ["EXCERPT", "Segment", "Segments"]
+
+#: DE440's segments of the Sun, the planets and the Moon over two years about J2000
+#: (JD 2451504.5 to 2452320.5), shipped with the package for examples and tests
+#: (``tools/make_de440_excerpt.py``): ``Segments.load(EXCERPT)``; no asteroid.
+EXCERPT = Path(__file__).resolve().parent / "data" / "de440_excerpt.npz"
 
 @dataclass(frozen=True)
 class Segment:

@@ -13,9 +13,10 @@ from hamilton_orbits._kernels.perturbers import small_bodies_field
 from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.rhs import compile_rhs, time_reversed
 from hamilton_orbits.small_bodies import EFFECTS, PERTURBERS, field_rhs
-from hamilton_orbits.spk import Segments
-
-EXCERPT = Path(__file__).parent / "data" / "de440_excerpt.npz"  # JD 2451504.5 + 816 d
+from hamilton_orbits.spk import (
+    EXCERPT,  # JD 2451504.5 + 816 d
+    Segments,
+)
 
 
 def _asteroids():
@@ -395,7 +396,7 @@ def test_assists_holman_case_against_horizons_at_assists_tolerance(start, end):
     from hamilton_orbits.small_bodies import propagate
 
     x0, x1 = np.array(HOLMAN[start]), np.array(HOLMAN[end])
-    segments = Segments.load(EXCERPT.with_name("holman_excerpt.npz"))
+    segments = Segments.load(Path(__file__).parent / "data" / "holman_excerpt.npz")
     traj = propagate(x0[:3] * u.au, x0[3:] * u.au / u.day,
                      Time(2451545.0, start, format="jd", scale="tdb"),
                      (end - start) * u.day, ephemeris=segments)

@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import astropy.units as u
 import numpy as np
 import pytest
@@ -15,9 +13,8 @@ from hamilton_orbits import engine
 from hamilton_orbits._kernels import chebyshev
 from hamilton_orbits.perturber_field import field_rhs
 from hamilton_orbits.small_bodies import propagate
-from hamilton_orbits.spk import Segments
+from hamilton_orbits.spk import EXCERPT, Segments
 
-EXCERPT = Path(__file__).parent / "data" / "de440_excerpt.npz"
 JD0 = 2451545.0
 EPOCH = Time(JD0, format="jd", scale="tdb")
 T = 40.0  # days: the encounter built below

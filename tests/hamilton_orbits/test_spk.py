@@ -8,16 +8,13 @@ where the ``[ephemeris]`` extra is installed.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits.ephemeris import CHAINS
-from hamilton_orbits.spk import Segments
+from hamilton_orbits.spk import EXCERPT, Segments
 
-EXCERPT = Path(__file__).parent / "data" / "de440_excerpt.npz"
 NAMES = [n for n in CHAINS if n != "sun"]
 
 
