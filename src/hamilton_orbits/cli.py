@@ -593,6 +593,15 @@ def _write_ensemble(scene, df, folder, varied: Sequence[str]) -> None:
     print(f"\nwrote ensemble.csv, ensemble.md to {folder}/")
 
 
+def _all_equal(values: list[object]) -> bool:
+    """Whether the values are all equal (NaN equal to NaN: a quantity no member has)."""
+    def same(a: object, b: object) -> bool:
+        nan = isinstance(a, float) and isinstance(b, float) and a != a and b != b
+        return nan or bool(a == b)
+
+    return all(same(values[0], v) for v in values[1:])
+
+
 def ensemble_table(rows: Sequence[dict], varied: Sequence[str]) -> str:
     """An ensemble's rows for the terminal: what is the same for every member said
     once, the ``complete`` and ``error`` columns only where a member stopped or
@@ -622,13 +631,15 @@ def ensemble_table(rows: Sequence[dict], varied: Sequence[str]) -> str:
     failed = [i for i, r in enumerate(rows) if r.get("error") is not None]
     shown, same = [], []
     for key in keys:
-        values = [fmt(r.get(key)) for r in rows]
         if key == "error" and not failed:
             continue
         if key == "complete" and all(r.get(key) is True for r in rows):
             continue
-        if len(rows) > 1 and len(set(values)) == 1 and key not in ("error", "complete"):
-            same.append(f"{key} = {values[0]}")
+        # (the same values, not the same 4 digits: a flip interval 1.3e-9 apart was
+        # said the same for every member beside its relative difference, which varied)
+        if len(rows) > 1 and _all_equal([r.get(key) for r in rows]) \
+                and key not in ("error", "complete"):
+            same.append(f"{key} = {fmt(rows[0].get(key))}")
         else:
             shown.append(key)
     names = [", ".join(f"{k} = {r[k]}" for k in varied) or f"member {i}"

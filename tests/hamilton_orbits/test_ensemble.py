@@ -161,6 +161,12 @@ def test_ensemble_command_table_fits_a_terminal(tmp_path, capsys):
     assert max(len(line) for line in table.splitlines()) <= 100
     assert "None" not in table and "error" not in table.split("\n", 1)[0]
     assert "the same for every member:\n  exact flip interval" in table
+    # the simulated interval differs (by 1e-9 of it) from member to member: it was said
+    # the same for every member, its 4 digits being so, beside a row "relative
+    # difference" that varied and named no quantity
+    shared = table.split("the same for every member:", 1)[1]
+    assert "simulated flip interval" not in shared
+    assert "\nsimulated/exact flip interval - 1 " in table
 
 
 def test_a_ctrl_c_ends_a_serial_ensemble(monkeypatch):
