@@ -306,11 +306,13 @@ def _crosscheck_into(result: Result, system: Any, traj: Any, effects: Any) -> No
         result.interrupted = True
         return
     result.tables["cross-check against rebound: final position difference"] = table.rows
-    result.tables["cross-check against rebound: codes"] = table.code_rows
+    codes = table.code_rows
+    if result.resumed_from is not None:  # (ours: the part since the resume alone)
+        since = f"since the resume at t = {result.resumed_from.to(u.yr):.6g} only"
+        result.metrics["our wall time"] = since
+        codes[0]["code"] += f" (steps and wall time {since}; rebound's: the whole run)"
+    result.tables["cross-check against rebound: codes"] = codes
     result.diagnostics["rebound_energy_error"] = table.rebound_energy_error
     result.metrics["rebound wall time [s]"] = table.wall_time["rebound"]  # (as "wall time [s]")
-    if result.resumed_from is not None:  # (ours: the part since the resume alone)
-        result.metrics["our wall time"] = (f"since the resume at t = "
-                                           f"{result.resumed_from.to(u.yr):.6g} only")
     result.metrics["max relative position difference"] = float(
         table.relative_position_difference.max())
