@@ -554,14 +554,21 @@ def encounter_warning(traj: Trajectory) -> Any:
         "shorten the step or use an adaptive method (radau15)")
 
 
+#: compiled kernels this module calls after each leg, imported at the first
+_KERNELS: dict[str, Any] = {}
+
+
 def _under_resolved(r: np.ndarray, v: np.ndarray, out: Any, times: np.ndarray,
                     encounters: tuple[float | None, Any, float]) -> Any:
     """The close approaches of an engine run's outputs that its fixed step was too
     long for (``encounters`` from :func:`encounter_check`): one compiled call finds
     that there are none (after nearly every call: 2 us of a continuing call of one
     step of ten bodies), the details only where there are."""
-    from hamilton_orbits._kernels.integrals import screen
+    screen = _KERNELS.get("screen")
+    if screen is None:  # (numba's, imported once: an import statement per call cost
+        from hamilton_orbits._kernels.integrals import screen  # 0.6 us of 10)
 
+        _KERNELS["screen"] = screen
     step, exempt, fraction = encounters
     if step is None:
         step = abs(times[-1] - times[0]) / max(int(out.steps), 1)

@@ -298,7 +298,54 @@ def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
         if k + 1 < n_t:
             gap = max(gap, abs(t[k + 1] - t[k]))
         h[k] = min(step, gap)
+    if not _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
+        return 0
     prim = primaries(r[0], v[0], gm0, np.empty(n, np.int64), True)
     bad = np.zeros((1, n - 1, len(m)), np.bool_)
     none = np.empty((0, 0, 0))
     return approaches(r, v, gm0, tp, m, prim, exempt, exempt_dist, h, fraction, bad, none, none)
+
+
+@njit(cache=True, error_model="numpy")
+def _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
+    # pragma: no cover - compiled
+    """Whether :func:`approaches` could flag any pair: its test without the primaries'
+    pruning (beyond three Hill radii, or at the orbit's own pace, an approach is not
+    one), which only takes flags away, in squares (no square root where no closest
+    point passed between outputs), with a margin of 1e-9 for their rounding.  Most
+    calls of most runs end here: no pair is that close for its speed."""
+    n_t, n = r.shape[0], r.shape[1]
+    slack = 1.0 + 1e-9
+    ex2 = (exempt_dist * slack) ** 2
+    for i in range(n):
+        if i == top:
+            continue
+        for j in range(n):
+            if j == i or not gm0[j] > 0 or gm0[j] < gm0[i] or (gm0[j] == gm0[i] and j > i):
+                continue
+            mu = gm0[j] + gm0[i]
+            pd2, pu2, rad0 = 0.0, 0.0, 0.0
+            for t in range(n_t):
+                d2, u2, rad = 0.0, 0.0, 0.0
+                for k in range(3):
+                    dk = r[t, i, k] - r[t, j, k]
+                    uk = v[t, i, k] - v[t, j, k]
+                    d2 += dk * dk
+                    u2 += uk * uk
+                    rad += dk * uk
+                dd2, speed2 = d2, u2
+                if t > 0 and rad0 < 0 and rad > 0:  # (as approaches: the closest point)
+                    q0, inv0 = _periapsis(pd2, pu2, rad0, mu)
+                    q, inv_a = _periapsis(d2, u2, rad, mu)
+                    qmax = max(q0, q)
+                    if qmax < math.sqrt(min(pd2, d2)):
+                        dd2 = qmax * qmax
+                        speed2 = max(mu * (2.0 / qmax - max(inv0, inv_a)), 0.0)
+                pd2, pu2, rad0 = d2, u2, rad
+                if j == exempt and dd2 > ex2:
+                    continue
+                reach = h[t] / fraction * slack  # flagged: ts < reach, ts the lesser of
+                if dd2 < reach * reach * speed2 or (  # d / speed and sqrt(d^3 / mu)
+                        dd2 * dd2 * dd2 < (reach * reach * mu) ** 2 * slack):
+                    return True
+    return False
