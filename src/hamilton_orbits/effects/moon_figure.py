@@ -63,6 +63,14 @@ def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([m, e, radius, j2, c22, *pole, inc])
 
 
+def _body_moon_figure(p: np.ndarray) -> int:
+    """The Moon, or -1 for a J2 of zero (only C22: the J2 left to ``j2`` or
+    ``zonal``)."""
+    return int(p[0]) if p[3] != 0.0 else -1
+
+
+_MOON_J2 = "the Moon's J2 (its `j2`, DE440's J2M by default)"
+
 SPECS = (
     EffectSpec(
         name="moon_figure", kind="nbody",
@@ -77,6 +85,8 @@ SPECS = (
         kernel=moon_figure, params=_params_moon_figure,
         parameter_kinds={"radius": LENGTH, "j2": DIMENSIONLESS, "c22": DIMENSIONLESS},
         name_parameters=("moon", "earth"),
+        same_body_excludes={"j2": _MOON_J2, "zonal": _MOON_J2},
+        body_of=_body_moon_figure,
         reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 28; {PARK_2021}",
     ),
 )
