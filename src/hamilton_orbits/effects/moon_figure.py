@@ -3,7 +3,10 @@
 DE440's ``AM``, ``J2M``, ``C22M`` in principal axes built from the Earth-Moon
 geometry and Cassini's laws (the axes follow the orbit normal, from the
 Earth-Moon relative velocity: velocity dependent), with the lunar equator
-inclined by :data:`MOON_EQUATOR_INCLINATION_DEG` to the ecliptic.  Kernel
+inclined by :data:`MOON_EQUATOR_INCLINATION_DEG` to the ecliptic (less for an
+orbit within ``MOON_NODE_TILT``, 1e-6 rad, of the ecliptic, whose node is
+ill-defined: none at zero tilt, where the equator is the orbit's plane; see
+:func:`~hamilton_orbits._kernels.figures.moon_frame`).  Kernel
 :func:`~hamilton_orbits._kernels.figures.moon_figure`; no analytic Jacobian (the
 Moon's frame is a nested function of the state): the variational equations
 differentiate the kernel by compiled central differences
