@@ -10,6 +10,7 @@ import pytest
 
 from hamilton_orbits import Body, KeplerOrbit, System, integrate
 from hamilton_orbits import effects as fx
+from hamilton_orbits import ephemeris as de
 from hamilton_orbits._kernels import nbody as kernels
 from hamilton_orbits.rebound_bridge import run_rebound
 from hamilton_orbits.rhs import compile_rhs
@@ -315,6 +316,57 @@ def test_gr_and_gr_potential_are_refused_together():
 
 def _earth_moon():
     return System.from_ephemeris("J2000", bodies=["sun", "earth", "moon"])
+
+
+def test_j2_and_zonal_on_the_same_body_are_refused():
+    """``j2`` on the Earth beside ``zonal`` (the Earth's J2, J3, J4 by default) applied
+    the Earth's J2 twice: its pull on the Moon doubled (1.99998 times ``zonal``'s).
+    Refused with the system, naming both effects, their indices and the body; ``j2``
+    on another body, or ``zonal`` without its J2, is no double count."""
+    s = _earth_moon()
+    message = ("Effect 'j2' (at index 0) is refused beside 'zonal' (at index 1) on body "
+               "'earth': 'zonal' already computes its body's J2 (the first of its `j`), "
+               "which would count twice; list one of them, or put 'j2' on another body")
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        s.accelerations([{"name": "j2", "body": "earth"}, "zonal"])
+    with pytest.raises(ValueError, match=r"^Effect 'j2' \(at index 2\) is refused beside "
+                                         r"'zonal' \(at index 0\) on body 'earth'"):
+        integrate(s, 1.0 * u.day, effects=["zonal", "gr", {"name": "j2", "body": "earth"}])
+    # the Sun's J2 beside the Earth's zonal harmonics: two bodies, nothing twice
+    s.accelerations([{"name": "j2", "body": "sun", "j2": 2.2e-7, "radius": 696000 * u.km},
+                     "zonal"])
+    # zonal's J2 set to zero, the J2 left to j2: nothing twice either
+    j = [0.0, de.constant("J3E"), de.constant("J4E")]
+    s.accelerations([{"name": "j2", "body": "earth"}, {"name": "zonal", "j": j}])
+
+
+def test_j2_or_zonal_on_the_moon_beside_moon_figure_is_refused():
+    """``moon_figure`` applies the Moon's J2 (J2M) itself: ``j2`` on the Moon (which
+    ``System.from_ephemeris`` gives J2M) beside it counted it twice, and so would
+    ``zonal`` on the Moon.  With ``moon_figure``'s ``j2`` zero (its C22 alone) the
+    Moon's J2 is counted once."""
+    s = _earth_moon()
+    with pytest.raises(ValueError, match="^" + re.escape(
+            "Effect 'j2' (at index 1) is refused beside 'moon_figure' (at index 0) on body "
+            "'moon': 'moon_figure' already computes the Moon's J2 (its `j2`, DE440's J2M by "
+            "default), which would count twice; list one of them, or put 'j2' on another "
+            "body") + "$"):
+        s.accelerations(["moon_figure", {"name": "j2", "body": "moon"}])
+    moon_zonal = {"name": "zonal", "body": "moon", "j": [2.03e-4, 8.5e-6],
+                  "radius": 1738.0 * u.km}
+    with pytest.raises(ValueError, match=r"^Effect 'zonal' \(at index 0\) is refused beside "
+                                         r"'moon_figure' \(at index 1\) on body 'moon'"):
+        s.accelerations([moon_zonal, "moon_figure"])
+    # a moon_figure named by its own `moon` parameter: the same body, another name
+    renamed = System([b if b.name != "moon" else Body("luna", b.gm, b.r, b.v,
+                                                      radius=b.radius, j2=b.j2, pole=b.pole)
+                      for b in s.bodies])
+    with pytest.raises(ValueError, match=r"on body 'luna'"):
+        renamed.accelerations([{"name": "moon_figure", "moon": "luna"},
+                               {"name": "j2", "body": "luna"}])
+    # legitimate: the Moon's J2 once (moon_figure's C22 alone), the Earth's J2 beside it
+    s.accelerations([{"name": "moon_figure", "j2": 0.0}, {"name": "j2", "body": "moon"}])
+    s.accelerations(["moon_figure", {"name": "j2", "body": "earth"}, "earth_tides"])
 
 
 def _massless(system, name):

@@ -75,6 +75,18 @@ def test_eih_and_gr_together_are_refused_at_load():
         _scene('["eih", "kuiper_ring", "gr"]')
 
 
+def test_j2_and_zonal_on_the_same_body_are_refused_at_load():
+    """The Earth's J2 counted twice by ``j2`` on the Earth and ``zonal`` is a problem
+    of the scene at load, at the later effect; ``j2`` on the Sun beside it is not."""
+    moon = 'ephemeris = { bodies = ["sun", "earth", "moon"] }'
+    with pytest.raises(SceneError, match=re.escape(
+            "effects[1]: effect 'j2' (at index 1) is refused beside 'zonal' (at index 0) on "
+            "body 'earth': 'zonal' already computes its body's J2")):
+        _scene('["zonal", { name = "j2", body = "earth" }]', initial=moon)
+    _scene('["zonal", { name = "j2", body = "sun", j2 = 2.2e-7, radius = "696000 km" }]',
+           initial=moon)
+
+
 def test_the_scene_frame_reaches_kuiper_ring():
     """``[initial] frame = "ecliptic"`` was not passed to ``kuiper_ring``: the ring's
     normal was the ICRS's ecliptic pole on ecliptic axes, 23.4 deg off.  The ring's

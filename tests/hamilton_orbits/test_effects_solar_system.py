@@ -204,6 +204,86 @@ def test_moon_figure_frame_follows_cassini_and_field_is_its_gradient():
     assert np.allclose(acc[2], grad, rtol=1e-6, atol=0)
 
 
+def _coplanar_earth_moon(vz: float = 0.0) -> System:
+    """A hand-built Earth and Moon in ecliptic axes, the Moon's orbit in the ecliptic
+    tilted by ``vz / 1.022`` rad (its velocity's z, km/s), and two massless probes
+    near the Moon, one in the plane, one out of it."""
+    gm_e = 398600.4418 * u.km**3 / u.s**2
+    return System([
+        Body("earth", gm_e, [0, 0, 0] * u.km, [0, 0, 0] * u.km / u.s),
+        Body("moon", 4902.8 * u.km**3 / u.s**2, [384400, 0, 0] * u.km,
+             [0, 1.022, vz] * u.km / u.s),
+        Body("in_plane", 0 * gm_e, [386000, 1200, 0] * u.km, [0, 2.5, 0] * u.km / u.s),
+        Body("above", 0 * gm_e, [386400, 0, 300] * u.km, [0, 2.5, 0.2] * u.km / u.s)])
+
+
+_ECLIPTIC_MOON = {"name": "moon_figure", "frame": "ecliptic"}
+
+
+def test_moon_figure_is_finite_for_an_orbit_in_the_ecliptic():
+    """The Moon's orbit exactly in the ecliptic has no node: ``moon_frame``
+    normalised the zero vector, ``accelerations`` was all NaN and ``integrate``
+    stopped at once ("the acceleration became non-finite (a collision?)").  At zero
+    tilt the Moon's pole is the ecliptic pole (its equator in its orbit's plane):
+    the figure pulls the bodies in the plane within it, so the orbit stays in the
+    ecliptic, bit for bit."""
+    s = _coplanar_earth_moon()
+    acc = s.accelerations([_ECLIPTIC_MOON]).to_value(u.km / u.s**2)
+    assert np.isfinite(acc).all()
+    assert not acc[:3, 2].any()  # (mirror symmetry about the ecliptic: exactly zero)
+    tr = integrate(s, [0, 1] * u.day, effects=[_ECLIPTIC_MOON])
+    assert np.isfinite(tr.r.value).all() and np.isfinite(tr.v.value).all()
+    assert not tr.r[:, :3, 2].value.any()
+
+
+def test_moon_figure_is_continuous_as_the_orbit_tilts_to_the_ecliptic():
+    """The field at a tilt of 1e-9 rad (and 1e-12 rad) against exactly zero tilt.
+
+    Below ``MOON_NODE_TILT`` (1e-6 rad) the pole's inclination to the ecliptic is
+    scaled down with the tilt ``t``: the pole turns by ``theta = atan(tan(I) t /
+    MOON_NODE_TILT)`` from the ecliptic pole (I = 1.5424 deg), about the Earth
+    direction ``x``, which stays put (the orbit normal's part in the ecliptic is
+    perpendicular to it).  The degree-2 potential ``mu R^2 q.A q / |q|^5`` of
+    principal moments spanning ``3 C22 + 3/2 J2`` then changes by ``|Q A Q^T - A| <=
+    theta (3 C22 + 3/2 J2)``, and its gradient ``2 A q / |q|^5 - 5 (q.A q) q /
+    |q|^7`` by at most ``7 mu R^2 theta (3 C22 + 3/2 J2) / |q|^4`` on each body.  The
+    change is linear in the tilt (it is the first order of a rotation): 1000 times
+    as large at 1e-9 rad as at 1e-12 rad, to the rotation's second order
+    (``theta`` = 2.7e-5 rad at 1e-9: 1e-4 relative)."""
+    fields = {}
+    for tilt in (0.0, 1e-12, -1e-12, 1e-9, -1e-9):
+        s = _coplanar_earth_moon(1.022 * np.tan(tilt))
+        arrays = s.as_arrays()
+        p = fx.get("nbody", "moon_figure").params(s, {"frame": "ecliptic"})
+        fields[tilt] = np.zeros_like(arrays.r)
+        figures.moon_figure(arrays.r, arrays.v, arrays.gm, fields[tilt], p)
+    mu, rad, j2, c22, inc = arrays.gm[1], p[2], p[3], p[4], p[8]
+    others = [0, 2, 3]  # (the Moon itself feels their sum, pushed back)
+    q = np.linalg.norm(arrays.r[others] - arrays.r[1], axis=1)
+    for tilt in (1e-12, -1e-12, 1e-9, -1e-9):
+        theta = np.arctan(np.tan(inc) * abs(tilt) / figures.MOON_NODE_TILT)
+        bound = 7 * mu * rad**2 * theta * (3 * c22 + 1.5 * j2) / q**4
+        change = np.linalg.norm(fields[tilt][others] - fields[0.0][others], axis=1)
+        assert (change <= bound).all(), (tilt, change, bound)
+        # not vacuous: the probes see the pole turn (0.11 and 0.027 of the bound, the
+        # worst case over directions); the Earth, on the axis of the turn, sees nothing
+        assert (change[1:] > 0.01 * bound[1:]).all(), (tilt, change, bound)
+    for sign in (1, -1):
+        big, small = (fields[sign * t] - fields[0.0] for t in (1e-9, 1e-12))
+        np.testing.assert_allclose(big, 1000 * small, rtol=0, atol=1e-4 * np.abs(big).max())
+
+
+def test_moon_frame_keeps_cassinis_laws_above_the_node_tilt():
+    """Above ``MOON_NODE_TILT`` the pole is at I from the ecliptic pole whatever the
+    tilt (Cassini's laws, as before); at half of it, at ``atan(tan(I) / 2)``."""
+    ecl = np.array([0.0, 0.0, 1.0])
+    inc = np.deg2rad(1.5424)
+    for tilt, want in ((0.09, inc), (2e-6, inc), (0.5e-6, np.arctan(np.tan(inc) / 2))):
+        arrays = _coplanar_earth_moon(1.022 * np.tan(tilt)).as_arrays()
+        axes = figures.moon_frame(arrays.r, arrays.v, 1, 0, *ecl, inc)
+        assert np.arccos(axes[2] @ ecl) == pytest.approx(want, rel=1e-9)
+
+
 def _mean_longitude_offset(system: System, years: float, effects: list) -> tuple:
     t = np.linspace(0, years * 365.25, int(years * 73) + 1)
     out = []

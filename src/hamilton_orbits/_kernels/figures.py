@@ -36,6 +36,14 @@ _ARCSEC = np.pi / 648000.0
 #: 3, by rows).
 OF_DATE = 11
 
+#: The tilt (rad) of the Moon's orbit to the ecliptic below which :func:`moon_frame`
+#: no longer takes the node from the orbit: the node is undefined at zero tilt (the
+#: orbit normal along the ecliptic pole) and ill-conditioned near it, so the pole's
+#: inclination to the ecliptic is scaled down with the tilt, to zero at zero tilt.
+#: 1e-6 rad (0.2"): five orders of magnitude below the Moon's 5.1 deg, where the
+#: node's direction is still good to 1e-10 rad (the rounding of the orbit normal).
+MOON_NODE_TILT = 1e-6
+
 
 @njit(cache=True, error_model="numpy")
 def precessed_pole(t, out):  # pragma: no cover - compiled
@@ -130,6 +138,14 @@ def moon_frame(r, v, m, e, ex, ey, ez, inc):  # pragma: no cover - compiled
     side of the ecliptic pole, at the inclination ``inc`` (rad) from it; the long
     axis ``x`` points to the Earth, projected on the equator (the mean sub-Earth
     direction: optical and physical librations are left out).
+
+    An orbit tilted by less than :data:`MOON_NODE_TILT` to the ecliptic has no
+    well-defined node: ``z`` is then ``cos(inc) e - sin(inc) (t / MOON_NODE_TILT)
+    p`` normalised, ``t`` the tilt's sine and ``p`` the unit vector towards the
+    orbit normal in the ecliptic, so that the pole comes continuously to the
+    ecliptic pole at zero tilt (the Moon's equator in its orbit's plane), where it
+    was 0 / 0 (NaN).  Above that tilt the frame is the one of Cassini's laws, bit
+    for bit.
     """
     dx = r[e, 0] - r[m, 0]
     dy = r[e, 1] - r[m, 1]
@@ -141,7 +157,13 @@ def moon_frame(r, v, m, e, ex, ey, ez, inc):  # pragma: no cover - compiled
     hy = dz * wx - dx * wz
     hz = dx * wy - dy * wx
     he = hx * ex + hy * ey + hz * ez
-    px, py, pz = _unit(hx - he * ex, hy - he * ey, hz - he * ez)  # towards the orbit normal
+    px = hx - he * ex  # towards the orbit normal, in the ecliptic
+    py = hy - he * ey
+    pz = hz - he * ez
+    pn = np.sqrt(px * px + py * py + pz * pz)  # |h| times the tilt's sine
+    scale = max(pn, MOON_NODE_TILT * np.sqrt(hx * hx + hy * hy + hz * hz))
+    if scale > 0.0:  # (a unit vector above MOON_NODE_TILT, shorter below it)
+        px, py, pz = px / scale, py / scale, pz / scale
     ci = np.cos(inc)
     si = np.sin(inc)
     zx, zy, zz = _unit(ci * ex - si * px, ci * ey - si * py, ci * ez - si * pz)

@@ -29,7 +29,8 @@ energy, and its kernel and Jacobian (imported there from
 ``hamilton_orbits._kernels`` by name).
 
 - ``effects.registry``: ``EffectSpec``, ``register``, :func:`get`, :func:`known`, ``EffectSet``,
-  normalisation, :func:`exclusion_problems`, the entry points
+  normalisation, :func:`exclusion_problems`, :func:`body_exclusion_problems`, the
+  entry points
 - ``effects.parameters``: :func:`source_index`, :func:`parameter_value`, :func:`speed_of_light`,
   DE440's defaults
 - ``effects.energy``: :func:`effect_energy`, :func:`energy_label`
@@ -77,6 +78,7 @@ from hamilton_orbits.effects.parameters import (
 from hamilton_orbits.effects.registry import (
     EffectSet,
     EffectSpec,
+    body_exclusion_problems,
     entry_problems,
     exclusion_problems,
     get,
@@ -90,6 +92,7 @@ __all__ = [
     "C_AU_PER_DAY",
     "EffectSet",
     "EffectSpec",
+    "body_exclusion_problems",
     "effect_energy",
     "energy_label",
     "entry_problems",

@@ -62,6 +62,12 @@ def _energy_j2(r: np.ndarray, v: np.ndarray, gm: np.ndarray, p: np.ndarray) -> n
     return out
 
 
+def _body_j2(p: np.ndarray) -> int:
+    """The oblate body, or -1 for a J2 of zero (for the refusals of ``zonal`` and
+    ``moon_figure`` on the same body)."""
+    return int(p[0]) if p[1] != 0.0 else -1
+
+
 SPECS = (
     EffectSpec(
         "j2",
@@ -78,6 +84,7 @@ SPECS = (
         parameter_kinds={"j2": DIMENSIONLESS, "radius": LENGTH},
         name_parameters=("body",),
         energy=_energy_j2,
+        body_of=_body_j2,
         reference="Vallado (2013), Fundamentals of Astrodynamics, 4th ed., sec. 8.6.1",
     ),
 )

@@ -3,7 +3,10 @@
 DE440's ``AM``, ``J2M``, ``C22M`` in principal axes built from the Earth-Moon
 geometry and Cassini's laws (the axes follow the orbit normal, from the
 Earth-Moon relative velocity: velocity dependent), with the lunar equator
-inclined by :data:`MOON_EQUATOR_INCLINATION_DEG` to the ecliptic.  Kernel
+inclined by :data:`MOON_EQUATOR_INCLINATION_DEG` to the ecliptic (less for an
+orbit within ``MOON_NODE_TILT``, 1e-6 rad, of the ecliptic, whose node is
+ill-defined: none at zero tilt, where the equator is the orbit's plane; see
+:func:`~hamilton_orbits._kernels.figures.moon_frame`).  Kernel
 :func:`~hamilton_orbits._kernels.figures.moon_figure`; no analytic Jacobian (the
 Moon's frame is a nested function of the state): the variational equations
 differentiate the kernel by compiled central differences
@@ -63,6 +66,14 @@ def _params_moon_figure(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([m, e, radius, j2, c22, *pole, inc])
 
 
+def _body_moon_figure(p: np.ndarray) -> int:
+    """The Moon, or -1 for a J2 of zero (only C22: the J2 left to ``j2`` or
+    ``zonal``)."""
+    return int(p[0]) if p[3] != 0.0 else -1
+
+
+_MOON_J2 = "the Moon's J2 (its `j2`, DE440's J2M by default)"
+
 SPECS = (
     EffectSpec(
         name="moon_figure", kind="nbody",
@@ -77,6 +88,8 @@ SPECS = (
         kernel=moon_figure, params=_params_moon_figure,
         parameter_kinds={"radius": LENGTH, "j2": DIMENSIONLESS, "c22": DIMENSIONLESS},
         name_parameters=("moon", "earth"),
+        same_body_excludes={"j2": _MOON_J2, "zonal": _MOON_J2},
+        body_of=_body_moon_figure,
         reference=f"Folkner et al. (2014), IPN PR 42-196, eq. 28; {PARK_2021}",
     ),
 )

@@ -27,6 +27,7 @@ from hamilton_orbits.units import Kind
 __all__ = [
     "EffectSet",
     "EffectSpec",
+    "body_exclusion_problems",
     "entry_problems",
     "exclusion_problems",
     "get",
@@ -95,6 +96,16 @@ class EffectSpec:
         The effects this one already computes (name -> what both would compute),
         refused beside it: ``eih`` holds the 1PN terms that ``gr`` adds, so
         ``["eih", "gr"]`` would count them twice (:func:`exclusion_problems`).
+    same_body_excludes : Mapping[str, str]
+        As ``excludes``, for the effects that count something twice only when both
+        act on the same body (``body_of``): ``zonal`` applies its body's J2, so
+        ``j2`` on that body beside it would count J2 twice, ``j2`` on another body
+        would not (:func:`body_exclusion_problems`, checked with the system).
+    body_of : callable or None
+        ``"nbody"`` effects named in a ``same_body_excludes`` (their own or
+        another's): ``body_of(p) -> int``, the index of the body the effect acts
+        on, read from its parameter vector ``p``, or -1 where it computes nothing
+        another could count twice (a J2 of zero).
     """
 
     name: str
@@ -112,6 +123,8 @@ class EffectSpec:
     jacobian: Any = None
     energy: Callable[..., np.ndarray] | None = None
     excludes: Mapping[str, str] = field(default_factory=dict)
+    same_body_excludes: Mapping[str, str] = field(default_factory=dict)
+    body_of: Callable[[np.ndarray], int] | None = None
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}
@@ -249,6 +262,67 @@ def exclusion_problems(names: Sequence[str], kind: str = "nbody") -> list[tuple[
                 out.append((max(j, k), f"effect {other!r} (at index {j}) is refused beside "
                                        f"{name!r} (at index {k}): {name!r} already computes "
                                        f"{what}, which would count twice; list one of them"))
+    return sorted(out)
+
+
+def body_exclusion_problems(
+    names: Sequence[str], blocks: Sequence[np.ndarray], bodies: Sequence[str],
+    kind: str = "nbody", indices: Sequence[int] | None = None,
+) -> list[tuple[int, str]]:
+    """``(index, message)`` for each listed effect that another listed one already
+    computes on the same body (``EffectSpec.same_body_excludes``, the bodies read
+    by ``EffectSpec.body_of`` from the parameter vectors), at the later of the two
+    indices.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The listed effects' names.
+    blocks : sequence of ndarray
+        Their parameter vectors (``EffectSpec.params``), in the same order.
+    bodies : sequence of str
+        The system's body names (``System.names``).
+    kind : str
+        The kind of simulation.
+    indices : sequence of int or None
+        Each effect's index in the caller's list, for the messages (default: its
+        position in ``names``).
+
+    Returns
+    -------
+    list of (int, str)
+        Sorted by index; empty if nothing counts twice.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> j2_earth = np.array([1, 1.08e-3, 4.3e-5, 0, 0, 1])
+    >>> zonal_earth = np.array([0.0] * 11 + [1, 4.3e-5, 0, 0, 1, 1.08e-3, -2.5e-6])
+    >>> body_exclusion_problems(["j2", "zonal"], [j2_earth, zonal_earth],
+    ...                         ["sun", "earth"])  # doctest: +NORMALIZE_WHITESPACE
+    [(1, "effect 'j2' (at index 0) is refused beside 'zonal' (at index 1) on body
+      'earth': 'zonal' already computes its body's J2 (the first of its `j`), which
+      would count twice; list one of them, or put 'j2' on another body")]
+    >>> j2_sun = np.array([0, 2.2e-7, 4.7e-3, 0, 0, 1])
+    >>> body_exclusion_problems(["j2", "zonal"], [j2_sun, zonal_earth], ["sun", "earth"])
+    []
+    """
+    indices = list(range(len(names))) if indices is None else list(indices)
+    acting: dict[str, tuple[int, int]] = {}  # name -> (body, index)
+    for name, p, k in zip(names, blocks, indices, strict=True):
+        spec = get(kind, name) if name in known(kind) else None
+        if spec is not None and spec.body_of is not None:
+            acting.setdefault(name, (int(spec.body_of(np.asarray(p))), k))
+    out = []
+    for name, (body, k) in acting.items():
+        for other, what in get(kind, name).same_body_excludes.items():
+            if other in acting and body >= 0 and acting[other][0] == body:
+                j = acting[other][1]
+                out.append((max(j, k), f"effect {other!r} (at index {j}) is refused beside "
+                                       f"{name!r} (at index {k}) on body {bodies[body]!r}: "
+                                       f"{name!r} already computes {what}, which would "
+                                       f"count twice; list one of them, or put {other!r} "
+                                       f"on another body"))
     return sorted(out)
 
 
@@ -407,7 +481,9 @@ class EffectSet:
             For an effect without a parameter builder, or bad parameters: the
             builder's message, naming the effect and the parameter, and the
             effect's index in the list the set was built from (``"Effect 'eih':
-            expected `c` ... (effects[0])"``).
+            expected `c` ... (effects[0])"``); or for an effect that another
+            listed one already computes on the same body of ``system``
+            (:func:`body_exclusion_problems`: ``j2`` on the Earth beside ``zonal``).
 
         Examples
         --------
@@ -432,6 +508,9 @@ class EffectSet:
                 if not msg.startswith(f"Effect {name!r}"):
                     msg = f"Effect {name!r}: {msg}"
                 raise type(exc)(f"{msg} (effects[{k}])") from None
+        for _, message in body_exclusion_problems(self.names, out, system.names, self.kind,
+                                                  indices)[:1]:
+            raise ValueError(message[0].upper() + message[1:])
         return out
 
     def as_list(self) -> list[str | dict[str, Any]]:

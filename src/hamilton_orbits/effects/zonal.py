@@ -60,6 +60,12 @@ def _params_zonal(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([*lead[:OF_DATE], b, radius, *lead[OF_DATE:], *j])
 
 
+def _body_zonal(p: np.ndarray) -> int:
+    """The body of the harmonics, or -1 for a J2 of zero (``j = [0, J3, ...]``: the
+    J2 left to ``j2``)."""
+    return int(p[OF_DATE]) if p[OF_DATE + 5] != 0.0 else -1
+
+
 SPECS = (
     EffectSpec(
         name="zonal", kind="nbody",
@@ -72,6 +78,8 @@ SPECS = (
         kernel=zonal_of_date, params=_params_zonal,
         parameter_kinds={"radius": LENGTH}, name_parameters=("body",),
         jacobian=zonal_of_date_jvp,
+        same_body_excludes={"j2": "its body's J2 (the first of its `j`)"},
+        body_of=_body_zonal,
         reference=f"Moyer (1971), JPL TR 32-1527, eqs. 173-174; {PARK_2021}",
     ),
 )

@@ -287,6 +287,7 @@ def _check_buildable(spec: dict, problems: S.Problems) -> None:
     system = build_system(spec, problems)
     if system is None:
         return
+    blocks = []
     for i, eff in enumerate(spec["effects"]):
         ek = _effects.get("nbody", eff["name"])
         for key, value in eff.items():
@@ -297,8 +298,14 @@ def _check_buildable(spec: dict, problems: S.Problems) -> None:
         if ek.params is None or problems:
             continue
         params = {k: v for k, v in eff.items() if k != "name"}
-        attempt(problems, f"effects[{i}]", lambda ek=ek, p=params: ek.params(system, p),
-                 tuple(ek.parameters))
+        blocks.append((eff["name"], attempt(problems, f"effects[{i}]",
+                                            lambda ek=ek, p=params: ek.params(system, p),
+                                            tuple(ek.parameters)), i))
+    if blocks and not problems:  # (two effects that count the same body's J2 twice)
+        names, vectors, indices = zip(*blocks, strict=True)
+        for j, message in _effects.body_exclusion_problems(names, vectors, system.names,
+                                                           indices=indices):
+            problems.add(f"effects[{j}]", message)
     if spec["crosscheck"] and not problems:  # (refused now, not after the run)
         from hamilton_orbits.rebound_bridge import reboundx_counterparts
 
