@@ -25,15 +25,15 @@ def _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction):
                         none)
 
 
-def test_the_screen_counts_what_the_whole_check_counts():
-    """The screen leaves a leg at a test without the primaries (which only take flags
-    away), in squares: on 3000 random legs of 2 to 6 bodies (test particles, bodies
-    as light as ``LIGHT`` and massive ones, close pairs passing between outputs,
-    exempt central bodies or none) its count is the whole check's, every time, and
-    both find approaches in a good share of them (so that the comparison is not one
-    of zeros)."""
+def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
+    """The screen rules a leg out by a test without the primaries (which only take
+    flags away), in squares: on 3000 random legs of 2 to 6 bodies (test particles,
+    bodies as light as ``LIGHT`` and massive ones, close pairs passing between
+    outputs, exempt central bodies or none) it passes every leg in which the whole
+    check finds an approach (a good share of them, so that the comparison is not one
+    of zeros), and rules out most of the others."""
     rng = np.random.default_rng(2026)
-    found = 0
+    found = passed = 0
     for _ in range(3000):
         n, n_t = int(rng.integers(2, 7)), int(rng.integers(2, 6))
         gm = rng.choice([0.0, 1e-12, 1e-5, 1e-3, 1.0], size=n)
@@ -46,6 +46,9 @@ def test_the_screen_counts_what_the_whole_check_counts():
         exempt_dist = float(rng.choice([0.0, 0.05]))
         fraction = float(rng.choice([ENCOUNTER_STEP_FRACTION, 1.0 / 3.0]))
         whole = _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction)
-        assert k.screen(r, v, gm, t, step, exempt, exempt_dist, fraction, LIGHT) == whole
+        maybe = k.screen(r, v, gm, t, step, exempt, exempt_dist, fraction, LIGHT)
+        assert maybe or whole == 0
         found += whole > 0
+        passed += maybe
     assert 300 < found < 2700
+    assert passed - found < 0.5 * (3000 - found)  # (the ones it lets through in vain)

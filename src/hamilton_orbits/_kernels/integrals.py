@@ -270,40 +270,32 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
 @njit(cache=True, error_model="numpy")
 def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
     # pragma: no cover - compiled
-    """The number of outputs and pairs :func:`approaches` finds in states ``r``, ``v``
+    """Whether :func:`approaches` could find any approach in states ``r``, ``v``
     (n_t, n, 3) at times ``t`` of a run of fixed ``step`` (``gm`` (n,): bodies of at
-    most ``light`` of the largest GM checked as test particles): the whole check in
-    one compiled call, which a run whose every approach is resolved (nearly all)
-    leaves at (a continuing call of one step of ten bodies: 1 us, not 35)."""
+    most ``light`` of the largest GM checked as test particles): False rules it
+    out in one compiled call, which a run whose every approach is resolved (nearly
+    all) leaves at (a continuing call of one step of ten bodies: 1 us); True (a
+    pair close enough for its speed) calls for the whole check.  Small, so that a
+    first run compiles it quickly, the whole check only where it is needed."""
     n_t, n = r.shape[0], r.shape[1]
     if n_t < 2 or n < 2:
-        return 0
+        return False
     top = 0
     for i in range(n):
         if gm[i] > gm[top]:
             top = i
     if not gm[top] > 0:
-        return 0
-    gm0 = np.where(gm <= light * gm[top], 0.0, gm)
-    m = np.flatnonzero(gm0 > 0)
-    tp = np.empty(n - 1, np.int64)
-    k = 0
+        return False
+    gm0 = np.empty(n)
     for i in range(n):
-        if i != top:
-            tp[k] = i
-            k += 1
+        gm0[i] = 0.0 if gm[i] <= light * gm[top] else gm[i]
     h = np.empty(n_t)
     for k in range(n_t):
         gap = abs(t[max(k, 1)] - t[max(k, 1) - 1])
         if k + 1 < n_t:
             gap = max(gap, abs(t[k + 1] - t[k]))
         h[k] = min(step, gap)
-    if not _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
-        return 0
-    prim = primaries(r[0], v[0], gm0, np.empty(n, np.int64), True)
-    bad = np.zeros((1, n - 1, len(m)), np.bool_)
-    none = np.empty((0, 0, 0))
-    return approaches(r, v, gm0, tp, m, prim, exempt, exempt_dist, h, fraction, bad, none, none)
+    return _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction)
 
 
 @njit(cache=True, error_model="numpy")
