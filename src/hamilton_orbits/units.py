@@ -46,6 +46,7 @@ __all__ = [
     "DIMENSIONLESS",
     "ENERGY",
     "GM",
+    "GM_NAME",
     "INERTIA",
     "LENGTH",
     "MASS",
@@ -157,10 +158,10 @@ class Kind:
     astropy.units.errors.UnitConversionError: Expected `e` to be dimensionless, got 5.7 deg ...
     >>> LENGTH("a", 1.0 * u.au, u.km)
     array(1.49597871e+08)
-    >>> LENGTH("a", 1.0 * u.s)
+    >>> LENGTH("a", 1.0 * u.s)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    astropy.units.errors.UnitConversionError: Expected `a` to be a length (convertible to m), got s
+    astropy...UnitConversionError: Expected `a` to be a length (convertible to m), got 1 s
     """
 
     def __init__(
@@ -206,10 +207,18 @@ class Kind:
                     what = "dimensionless"
                 else:
                     what = f"{self.name} (convertible to {target})"
+                got = (_short(value) if str(value.unit)
+                       else f"{_short(value)}(a number without a unit)")
                 raise u.UnitConversionError(
-                    f"Expected `{name}` to be {what}, got "
-                    f"{str(value.unit) or 'a number without a unit'}") from exc
+                    f"Expected `{name}` to be {what}, got {got}{self._hint(value)}"
+                ) from exc
         return as_float_array(name, value, finite=finite)
+
+    def _hint(self, value: Any) -> str:
+        """What to give instead, where a common mistake is plain: a mass for a GM."""
+        if self.name == GM_NAME and value.unit.physical_type == "mass":
+            return "; a mass: give G times it (astropy.constants.G * m), or the GM itself"
+        return ""
 
     def _no_hertz(self, name: str, unit: Any) -> str:
         """Why ``unit``, holding the hertz (or a count of decays), is refused."""
@@ -234,7 +243,7 @@ class Kind:
         >>> DIMENSIONLESS.scalar("tol", 1e-9 * u.s)
         Traceback (most recent call last):
         ...
-        astropy.units.errors.UnitConversionError: Expected `tol` to be dimensionless, got s
+        astropy.units.errors.UnitConversionError: Expected `tol` to be dimensionless, got 1e-09 s
         >>> LENGTH.scalar("radius", [1.0, 2.0])
         Traceback (most recent call last):
         ...
@@ -247,8 +256,12 @@ class Kind:
 
 
 def _short(q: u.Quantity) -> str:
+    """A Quantity in a message: its value (up to 6 numbers) and unit."""
     if q.isscalar:
         return f"{q.value:g} {q.unit}"
+    if q.size <= 6:
+        values = ", ".join(f"{x:g}" for x in np.ravel(q.value))
+        return f"[{values}] {q.unit}"
     return f"{q.unit} values"
 
 
@@ -279,7 +292,9 @@ LENGTH = Kind("a length", "m")
 TIME = Kind("a time", "s")
 SPEED = Kind("a speed", "m / s")
 ACCELERATION = Kind("an acceleration", "m / s2")
-GM = Kind("a gravitational parameter GM", "m3 / s2")
+#: the name of the kind of a gravitational parameter (a mass given for it is hinted at)
+GM_NAME = "a gravitational parameter GM"
+GM = Kind(GM_NAME, "m3 / s2")
 MASS = Kind("a mass", "kg")
 DIMENSIONLESS = Kind("dimensionless", "")
 INERTIA = Kind("a moment of inertia", "kg m2")

@@ -597,7 +597,7 @@ def test_moon_figure_takes_its_radius_and_inclination_in_any_unit():
     ("zonal", {"j": [np.nan]}, "Effect 'zonal': expected `j` to be some finite number(s), "
                                "got [nan]"),
     ("earth_tides", {"k2": [0.3, 0.3, 0.3] * u.km},
-     "Effect 'earth_tides': Expected `k2` to be dimensionless, got km"),
+     "Effect 'earth_tides': Expected `k2` to be dimensionless, got [0.3, 0.3, 0.3] km"),
     ("earth_tides", {"omega": "fast"}, "Effect 'earth_tides': cannot read `omega` = 'fast' as "
                                        "a number with a unit (e.g. '7.292115e-5 rad/s')"),
     ("kuiper_ring", {"normal": ["a", 0, 1]},

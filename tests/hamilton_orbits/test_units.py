@@ -24,7 +24,7 @@ def test_strip_converts_quantities_and_passes_floats():
 
 
 def test_strip_names_the_argument_on_unit_errors():
-    msg = r"`mu` to be a quantity \(convertible to km3 / s2\), got km"
+    msg = r"`mu` to be a quantity \(convertible to km3 / s2\), got 1 km$"
     with pytest.raises(u.UnitConversionError, match=msg):
         strip("mu", 1.0 * u.km, u.km**3 / u.s**2)
 
@@ -141,8 +141,8 @@ def test_a_number_without_a_unit_where_a_unit_is_asked_is_named_so():
     from hamilton_orbits.units import ANGLE
 
     with pytest.raises(u.UnitConversionError, match=r"Expected `inc` to be an angle "
-                                                    r"\(convertible to rad\), got a number "
-                                                    r"without a unit$"):
+                                                    r"\(convertible to rad\), got 1.5 \(a "
+                                                    r"number without a unit\)$"):
         ANGLE("inc", 1.5 * u.dimensionless_unscaled)
 
 
@@ -155,3 +155,23 @@ def test_a_zero_dimensional_object_array_is_read_as_its_value():
     assert float(as_float_array("x", np.array(Fraction(1, 2), dtype=object))) == 0.5
     with pytest.raises(ValueError, match=r"Expected `x` to be numeric, got None$"):
         as_float_array("x", np.array(None, dtype=object))
+
+
+def test_a_wrong_unit_is_named_with_its_value_and_a_mass_for_a_gm_so():
+    """A unit of the wrong dimension was named without its value ("got kg"), and a
+    mass given for a GM (const.M_sun, a body's mass) had no word of what to give."""
+    import astropy.constants as const
+
+    from hamilton_orbits import Body, KeplerOrbit
+
+    with pytest.raises(u.UnitConversionError,
+                       match=r"expected `gm` to be a gravitational parameter GM \(convertible "
+                             r"to AU3 / d2\), got 1 solMass; a mass: give G times it "
+                             r"\(astropy.constants.G \* m\), or the GM itself$"):
+        Body("sun", 1 * u.M_sun, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s)
+    with pytest.raises(u.UnitConversionError, match=r"got 5.97217e\+24 kg; a mass: give G"):
+        KeplerOrbit.from_elements(a=7000 * u.km, e=0.1, inc=0 * u.deg, lan=0 * u.deg,
+                                  argp=0 * u.deg, M=0 * u.deg, mu=const.M_earth)
+    with pytest.raises(u.UnitConversionError, match=r"to be a speed \(convertible to AU / d\), "
+                                                    r"got \[0, 29.78, 0\] km$"):
+        Body("p", 0.0 * u.km**3 / u.s**2, [1, 0, 0] * u.au, [0, 29.78, 0] * u.km)
