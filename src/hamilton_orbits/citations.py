@@ -233,7 +233,8 @@ def keys_for(run: Any = None, effects: Iterable[Any] = (), *, variational: bool 
         if name not in _METHOD_KEYS:
             raise ValueError(f"Expected a method among {', '.join(_METHOD_KEYS)}, got {name!r}")
         keys += _METHOD_KEYS[name]
-    if name == "radau15" and options.get("criterion", "prs23") == "prs23":
+    if name == "radau15" and options.get("criterion", "prs23") == "prs23" \
+            and getattr(run, "dt", None) is None:  # (a fixed step has no rule)
         keys.append("pham2024")  # the default step rule (a name, a Trajectory: its default)
     if name == "wh" and options.get("coordinates", "democratic_heliocentric") != "jacobi":
         keys.append("duncan1998")  # the default splitting, democratic heliocentric

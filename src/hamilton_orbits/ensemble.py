@@ -27,7 +27,7 @@ import numpy as np
 
 from hamilton_orbits._progress import progress_bar
 from hamilton_orbits.batches import check_client, check_workers
-from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+from hamilton_orbits.integrals import WARN_UNDER_RESOLVED, UnderResolvedEncounterWarning
 from hamilton_orbits.scene import Scene
 
 __all__ = ["UNDER_RESOLVED", "Ensemble", "run_member"]
@@ -53,10 +53,11 @@ def run_member(data: Mapping[str, Any], source: str, values: Mapping[str, Any]) 
     start = time.perf_counter()
     try:
         scene = Scene.from_values(data, source, dict(values))  # checked once, built once
-        with warnings.catch_warnings():  # (counted in the row, and the ensemble warns
-            # once for all its members: a map of 64 cells warned 4 times, of 10 000 ...)
-            warnings.simplefilter("ignore", UnderResolvedEncounterWarning)
+        quiet = WARN_UNDER_RESOLVED.set(False)  # (counted in the row, and the ensemble
+        try:  # warns once for all its members: a map of 64 cells warned 4 times)
             result = scene.run(progress=False)
+        finally:
+            WARN_UNDER_RESOLVED.reset(quiet)
         if not result.complete or result.interrupted:
             raise KeyboardInterrupt  # (no stop is given: a Ctrl-C cut the member, and
             # it ends the ensemble, as in a pool of workers, not the member alone)

@@ -24,14 +24,30 @@ questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l: equations (A)-
 
 from __future__ import annotations
 
+from contextvars import ContextVar
 from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["ENCOUNTER_STEP_FRACTION", "LIGHT", "NEAR_ZERO", "Encounter", "LostStateError",
-           "UnderResolvedEncounterWarning", "accelerations_quaternion", "energy_gm",
-           "energy_gm_many", "integral_errors", "light_as_massless", "particle_errors",
-           "prepare", "primaries", "relative_change", "under_resolved_encounters"]
+__all__ = [
+    "ENCOUNTER_STEP_FRACTION",
+    "LIGHT",
+    "NEAR_ZERO",
+    "WARN_UNDER_RESOLVED",
+    "Encounter",
+    "LostStateError",
+    "UnderResolvedEncounterWarning",
+    "accelerations_quaternion",
+    "energy_gm",
+    "energy_gm_many",
+    "integral_errors",
+    "light_as_massless",
+    "particle_errors",
+    "prepare",
+    "primaries",
+    "relative_change",
+    "under_resolved_encounters",
+]
 
 #: A fixed step of a second-order map (``wh``, ``leapfrog``) is too long for a close
 #: approach when it exceeds this fraction of the approach's time scale
@@ -331,9 +347,19 @@ def relative_change(values: np.ndarray) -> np.ndarray:
 
 
 class UnderResolvedEncounterWarning(UserWarning):
-    """A fixed step was too long for a test particle's close approach to a massive
-    body that the run crossed: the particle's orbit after it is not to be trusted
-    (see :func:`under_resolved_encounters`)."""
+    """A fixed step was too long for a close approach the run crossed (a test
+    particle's to a massive body, a massive body's to a heavier one): the lighter
+    body's orbit after it is not to be trusted (see
+    :func:`under_resolved_encounters`)."""
+
+
+#: Whether a run warns of the approaches its fixed step was too long for
+#: (:class:`UnderResolvedEncounterWarning`; ``Trajectory.under_resolved`` lists them
+#: either way).  An ensemble's member sets it False while it runs (its row counts
+#: them, and the ensemble warns once): a context variable, so that members run in
+#: threads (Dask's) change no other thread's, where ``warnings.catch_warnings`` left
+#: the process's filters ignoring the warning for good.
+WARN_UNDER_RESOLVED: ContextVar[bool] = ContextVar("WARN_UNDER_RESOLVED", default=True)
 
 
 class Encounter(NamedTuple):
@@ -486,8 +512,12 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     :data:`LIGHT` of the largest GM checked as test particles,
     :func:`light_as_massless`).  A pair of massive bodies is checked once, from
     its lighter body (of two equal, the later one) as "the particle", with the
-    pair's summed GM; a massive body's primary is the heavier body it is bound to
-    on the smallest orbit, else the most massive body.
+    pair's summed GM, in systems of at most 32 massive bodies
+    (``hamilton_orbits._kernels.integrals.MASSIVE_PAIRS_MAX``: beyond, checking
+    every pair at every output would cost about a force evaluation per output); a
+    massive body's primary is the heavier body it is bound to on the smallest
+    orbit, else the most massive body, and its approaches to it are not checked
+    (its own orbit, which the energy's error measures).
 
     An approach is a pericentre passage about the particle's primary
     (:func:`primaries`) whose time scale is under a tenth of the orbit's own pace
@@ -535,6 +565,8 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     gm0 = light_as_massless(gm)
     m = np.flatnonzero(gm0 > 0)
     tp = np.delete(np.arange(len(gm0)), m[np.argmax(gm0[m])])  # all but the most massive
+    if len(m) > integrals.MASSIVE_PAIRS_MAX:  # (massive pairs: only in smaller systems)
+        tp = tp[gm0[tp] == 0]
     gap = np.abs(np.diff(t))
     h = np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
                                     np.concatenate((gap, gap[-1:]))))
@@ -549,17 +581,19 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
         at = np.zeros((len(t), 1, 1), np.bool_)  # (the outputs this pair was flagged at)
         integrals.approaches(r, v, gm0, tp[p:p + 1], m[j:j + 1], prim, ex, ex_dist, h,
                              float(fraction), at, dist, tau)
-        found += _runs(r, v, gm0, t, h, int(tp[p]), int(m[j]), int(prim[tp[p]]),
-                       at[:, 0, 0], dist[:, 0, 0], tau[:, 0, 0])
+        found += _runs(r, v, gm0, t, h, int(tp[p]), int(m[j]), (int(prim[tp[p]]),
+                       int(prim[m[j]])), at[:, 0, 0], dist[:, 0, 0], tau[:, 0, 0])
     return sorted(found, key=lambda enc: (enc.time, enc.particle))
 
 
 def _runs(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, h: np.ndarray,
-          i: int, b: int, c: int, bad: np.ndarray, dist: np.ndarray, tau: np.ndarray
-          ) -> list[Encounter]:
-    """The encounters of particle ``i`` with body ``b`` (primary ``c``): one per run
-    of consecutive outputs ``bad``."""
-    far = _far(r, gm, i, b, c)
+          i: int, b: int, primaries: tuple[int, int], bad: np.ndarray, dist: np.ndarray,
+          tau: np.ndarray) -> list[Encounter]:
+    """The encounters of particle ``i`` with body ``b`` (``primaries``: ``i``'s and
+    ``b``'s, -1 for the most massive body): one per run of consecutive outputs
+    ``bad``."""
+    c = primaries[0]
+    far = _far(r, gm, i, b, primaries)
     edges = np.diff(np.concatenate(([0], bad.astype(np.int8), [0])))
     found = []
     for start, end in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1),
@@ -590,12 +624,17 @@ def _closest_time(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, k
     return when if min(near) <= when <= max(near) else float(t[k])  # a backward run's too)
 
 
-def _far(r: np.ndarray, gm: np.ndarray, i: int, b: int, c: int) -> np.ndarray:
+def _far(r: np.ndarray, gm: np.ndarray, i: int, b: int, primaries: tuple[int, int]
+         ) -> np.ndarray:
     """At which outputs body ``i`` is beyond three Hill radii of body ``b`` about
-    ``c`` (everywhere when ``b`` is ``c``)."""
+    ``b``'s own primary (``primaries``: ``i``'s and ``b``'s): everywhere when ``b`` is
+    ``i``'s primary, nowhere when ``b`` is the most massive body (no primary)."""
+    c, cb = primaries
     if b == c:
         return np.ones(len(r), bool)
-    hill = np.linalg.norm(r[:, b] - r[:, c], axis=1) * (gm[b] / (3.0 * gm[c])) ** (1.0 / 3.0)
+    if cb < 0:
+        return np.zeros(len(r), bool)
+    hill = np.linalg.norm(r[:, b] - r[:, cb], axis=1) * (gm[b] / (3.0 * gm[cb])) ** (1.0 / 3.0)
     return np.linalg.norm(r[:, i] - r[:, b], axis=1) > 3.0 * hill
 
 

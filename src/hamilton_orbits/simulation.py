@@ -52,6 +52,7 @@ from hamilton_orbits.checkpoint import (
     LegRows,
 )
 from hamilton_orbits.effects import EffectSet
+from hamilton_orbits.integrals import WARN_UNDER_RESOLVED
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.integrators._setup import check_step_count
 from hamilton_orbits.integrators.methods import FIXED_STEP, check_run
@@ -238,6 +239,14 @@ class Simulation(Saving):
         return self._prop.steps
 
     @property
+    def dt(self) -> Any:
+        """The fixed step the simulation was made with (a Quantity in days for a
+        Quantity system), or None: a step the method chooses (radau15, dop853), or
+        one from ``tol`` (wh, leapfrog)."""
+        step = self._spec[1]
+        return step if step is None or self._unit is None else step * DAY
+
+    @property
     def system(self) -> System:
         """The current state as a :class:`~hamilton_orbits.nbody.System` (bodies an
         event took out of the run are left out)."""
@@ -408,14 +417,14 @@ class Simulation(Saving):
 
     def _trajectory(self, out: engine.EngineRun, unit: Any, start: Any,
                     wall_time: float) -> Trajectory:
-        """The Trajectory of a leg, its test particles' approaches checked against the
-        step (a warning, once per simulation, of an encounter a step was too long for)."""
+        """The Trajectory of a leg, its close approaches checked against a fixed step
+        (a warning, once per simulation, of an encounter a step was too long for)."""
         prop = self._prop
         traj = make_trajectory(self._system, out, unit, prop.method.name, prop.rhs.effects,
                                self._effects, start=start, wall_time=wall_time,
                                encounters=self._encounters)
         warning = encounter_warning(traj)
-        if warning is not None and not self._warned:
+        if warning is not None and not self._warned and WARN_UNDER_RESOLVED.get():
             self._warned = True  # once per simulation
             warnings.warn(warning, stacklevel=caller_level())
         return traj

@@ -490,7 +490,7 @@ def _particle_errors(system: Any, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
 
 def encounter_check(method: Any, dt: float | None, tol: float | None, r0: np.ndarray,
                     gm: np.ndarray) -> tuple[float | None, Any, float] | None:
-    """What ``make_trajectory`` checks the test particles' approaches with, for a
+    """What ``make_trajectory`` checks the close approaches with, for a
     run from positions ``r0``: None for an adaptive method, else ``(step, exempt,
     fraction)``: the fixed step (None: the leg's mean step), ``(body, distance)``,
     the body whose approaches beyond that distance the method integrates exactly
@@ -626,7 +626,7 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
     :class:`~hamilton_orbits.effects.EffectSet` run) adds the effects' energies to
     the energy whose error is reported, where they keep one; ``start`` (``(r0, v0,
     gm0)`` at time 0) when the run did not begin there; ``encounters`` (from
-    :func:`encounter_check`) to find the test particles' close approaches a fixed
+    :func:`encounter_check`) to find the close approaches a fixed
     step was too long for (``under_resolved``).
 
     Raises

@@ -64,6 +64,7 @@ def test_radau15_run():
     assert _keys(cite(Simulation(_system()))) == keys
     assert _keys(cite("radau15")) == keys
     assert "pham2024" not in _keys(cite(Simulation(_system(), criterion="global")))
+    assert "pham2024" not in _keys(cite(Simulation(_system(), dt=0.01)))  # (no step rule)
 
 
 def test_the_default_wh_cites_its_democratic_heliocentric_splitting():

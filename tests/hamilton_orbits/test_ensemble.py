@@ -364,3 +364,43 @@ def test_a_member_stopped_at_its_start_by_a_collision_keeps_its_row_and_the_othe
         workers=1, progress=False)
     assert list(table["complete"]) == [True, True] and table["error"].isna().all()
     assert table["events found"].tolist() == [0, 1]
+
+
+def test_members_in_threads_leave_the_warning_filters_as_they_were(monkeypatch):
+    """Each member silenced the warning with ``warnings.catch_warnings``, which saves
+    and restores the process's filters: two members overlapping in threads (Dask's)
+    restored each other's, and the warning was ignored for good after the ensemble
+    (its own summary, and every later run of the session).  Held here so that they
+    overlap that way every time: A begins, B begins, A ends, B ends."""
+    import threading
+    import warnings
+
+    from hamilton_orbits.ensemble import run_member
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    real_run = Scene.run
+    entered = {"A": threading.Event(), "B": threading.Event()}
+    release = {"A": threading.Event(), "B": threading.Event()}
+    rows = {}
+
+    def held(self, *args, **kwargs):
+        name = threading.current_thread().name
+        entered[name].set()
+        release[name].wait(60)
+        return real_run(self, *args, **kwargs)
+
+    monkeypatch.setattr(Scene, "run", held)
+    scene = comet()
+    leapfrog = {"integrator.method": "leapfrog", "integrator.dt": "1 d"}
+    threads = {name: threading.Thread(name=name, target=lambda n=name: rows.setdefault(
+        n, run_member(scene.data, scene.source, leapfrog))) for name in "AB"}
+    before = list(warnings.filters)
+    for name in "AB":
+        threads[name].start()
+        assert entered[name].wait(60)
+    for name in "AB":
+        release[name].set()
+        threads[name].join(120)
+    assert warnings.filters == before
+    assert [rows[n]["under-resolved encounters"] for n in "AB"] == [1, 1]
+    assert not any(f[2] is UnderResolvedEncounterWarning for f in warnings.filters)

@@ -31,11 +31,6 @@ from hamilton_orbits._kernels import wh as wh_kernels
 from hamilton_orbits.integrators import leapfrog, radau15, wh
 from hamilton_orbits.integrators._held import HELD
 
-#: The merging pair falls into contact, which leapfrog's fixed steps do not resolve
-#: (the run warns of it); what a Ctrl-C does is tested, not the physics.
-UNRESOLVED = pytest.mark.filterwarnings(
-    "ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")
-
 DT = 1 / 64  # (a power of two: the slices' times t0 + k dt are exact)
 
 
@@ -312,7 +307,6 @@ def test_python_s_default_handler_put_back_is_replaced_again(monkeypatch):
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.system.as_arrays().r)
 
 
-@UNRESOLVED
 @pytest.mark.parametrize("case", [*sorted(EVENT_CASES), "dop853"])
 def test_a_ctrl_c_in_the_call_that_finds_a_stop_is_raised(case, monkeypatch):
     """A stop found in the call a Ctrl-C came in: the stop's ``StopAtEvent`` was

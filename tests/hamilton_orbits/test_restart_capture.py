@@ -15,7 +15,7 @@ from hamilton_orbits import Simulation
 from hamilton_orbits.integrators._setup import accel_arg
 from hamilton_orbits.restart import Capture, flatten
 
-#: The disc's planets p0 and p1 pass 0.11 apart at t = 3.5 (time scale 0.45), which
+#: The disc's planets p1 and p2 pass 0.15 apart near t = 8.9 (time scale 1.3), which
 #: steps of 0.05 do not resolve (the run warns of it); the capture is what is tested.
 UNRESOLVED = pytest.mark.filterwarnings(
     "ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")

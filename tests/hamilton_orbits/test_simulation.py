@@ -504,6 +504,30 @@ def test_massive_bodies_through_each_other_at_a_fixed_step_warn(method):
     assert row["inv_a_after"] < 0 < row["inv_a_before"]  # (flung out of the system)
 
 
+def test_massive_pairs_are_checked_in_systems_of_at_most_32_massive_bodies():
+    """The head-on pair beside 29 (then 30) distant bodies of GM 1e-9: with 32 massive
+    bodies it is listed, with 33 not (checking every pair at every output would cost
+    about a force evaluation per output: twelve times a one-step call of 300
+    bodies; the test particles' are checked at any size)."""
+    from hamilton_orbits._kernels.integrals import MASSIVE_PAIRS_MAX
+
+    def system(extra):  # (the star, the pair, and extra bodies far out)
+        far = [Body(f"x{k}", 1e-9, [30.0 + k, 0, 0], [0, 0.18, 0]) for k in range(extra)]
+        return System([Body("b0", 1.0, [0, 0, 0], [0, 0, 0]),
+                       Body("b1", 1e-3, [1.0, 0.1, 0], [0, -0.3, 0]),
+                       Body("b2", 1e-3, [1.0, -0.1, 0], [0, 0.3, 0]), *far])
+
+    assert MASSIVE_PAIRS_MAX == 32
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        few = integrate(system(29), 2.0, method="wh", dt=0.01).under_resolved  # (32)
+        many = integrate(system(30), 2.0, method="wh", dt=0.01).under_resolved  # (33)
+    assert [(str(r["particle"]), str(r["body"])) for r in few] == [("b2", "b1")]
+    assert len(many) == 0
+
+
 @pytest.mark.parametrize("method", ["wh", "leapfrog"])
 def test_a_moon_about_its_planet_about_a_star_is_no_approach(method):
     """A moon (GM 3.7e-8, 0.00257 from its planet of 3e-6: the Moon and the Earth)
@@ -618,3 +642,14 @@ def test_a_trajectory_s_arrays_are_read_only():
         # members come back pickled)
         assert not (again.t.flags.writeable or again.r.flags.writeable
                     or again.v.flags.writeable)
+
+
+def test_dt_is_the_fixed_step_in_the_system_s_units():
+    """``Simulation.dt``: the fixed step made with (days for a Quantity system), or
+    None where the method chooses it, or ``tol`` does."""
+    s = System.solar_system("J2000", bodies=["sun", "earth"])
+    assert Simulation(s, "wh", dt=2 * u.day).dt == 2 * u.day
+    assert Simulation(s, "wh", dt=1 * u.yr).dt.unit == u.day
+    assert Simulation(s).dt is None and Simulation(s, "wh", tol=1e-9).dt is None
+    plain = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+    assert Simulation(plain, "radau15", dt=0.01).dt == 0.01

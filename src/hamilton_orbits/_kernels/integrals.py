@@ -20,8 +20,14 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["COLUMNS", "approaches", "integral_errors", "integral_sums", "primaries",
-           "screen"]
+__all__ = ["COLUMNS", "MASSIVE_PAIRS_MAX", "approaches", "integral_errors", "integral_sums",
+           "primaries", "screen"]
+
+#: The most massive bodies whose pairs' close approaches are checked (beyond, only
+#: test particles' are): the check of every pair at every output costs about a
+#: force evaluation of its own (three times a one-step call of 30 bodies, twelve
+#: times one of 300), which a run of more bodies pays at each output.
+MASSIVE_PAIRS_MAX = 32
 
 #: Columns of :func:`integral_sums`'s output.
 COLUMNS = ("energy", "lx", "ly", "lz", "gm", "rx", "ry", "rz", "vx", "vy", "vz")
@@ -153,21 +159,28 @@ def primaries(r, v, gm, out, massive=False):  # pragma: no cover - compiled
         out[i] = -1
         if (gm[i] != 0 and not massive) or big < 0 or i == big:
             continue
-        best, best_inv = big, 0.0
-        for j in range(n):
-            if gm[j] > gm[i] or (gm[j] == gm[i] and j < i and gm[j] > 0):
-                d2, w2 = 0.0, 0.0
-                for k in range(3):
-                    d2 += (r[i, k] - r[j, k]) ** 2
-                    w2 += (v[i, k] - v[j, k]) ** 2
-                mu = gm[j] + gm[i]
-                if w2 * w2 * d2 >= 4.0 * mu * mu and gm[i] > 0:
-                    continue  # unbound to it (1/a <= 0: no square root to take)
-                inv_a = 2.0 / math.sqrt(d2) - w2 / mu
-                if inv_a > best_inv:
-                    best, best_inv = j, inv_a
-        out[i] = best
+        out[i] = _primary_of(r, v, gm, i, big)
     return out
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _primary_of(r, v, gm, i, big):  # pragma: no cover - compiled
+    """Body ``i``'s primary in the state ``r``, ``v`` (n, 3) (see :func:`primaries`;
+    ``big`` the first of largest GM)."""
+    best, best_inv = big, 0.0
+    for j in range(len(gm)):
+        if gm[j] > gm[i] or (gm[j] == gm[i] and j < i and gm[j] > 0):
+            d2, w2 = 0.0, 0.0
+            for k in range(3):
+                d2 += (r[i, k] - r[j, k]) ** 2
+                w2 += (v[i, k] - v[j, k]) ** 2
+            mu = gm[j] + gm[i]
+            if w2 * w2 * d2 >= 4.0 * mu * mu and gm[i] > 0:
+                continue  # unbound to it (1/a <= 0: no square root to take)
+            inv_a = 2.0 / math.sqrt(d2) - w2 / mu
+            if inv_a > best_inv:
+                best, best_inv = j, inv_a
+    return best
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -177,6 +190,20 @@ def _periapsis(d2, u2, rad, mu):  # pragma: no cover - compiled
     h2 = max(d2 * u2 - rad * rad, 0.0)
     ecc = math.sqrt(max(1.0 - h2 / mu * inv_a, 0.0))
     return h2 / mu / (1.0 + ecc), inv_a
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _within_hill(r, gm, j, cj, t, d2):  # pragma: no cover - compiled
+    """Whether a distance ``sqrt(d2)`` from body ``j`` is within three of its Hill
+    radii about its primary ``cj`` at output ``t``, ``3 (gm_j / 3 gm_cj)^(1/3) |r_j -
+    r_cj|``, in sixth powers (no root to take); always for the most massive body
+    (``cj`` -1: it has no primary)."""
+    if cj < 0:
+        return True
+    sep2 = 0.0
+    for k in range(3):
+        sep2 += (r[t, j, k] - r[t, cj, k]) ** 2
+    return d2 * d2 * d2 * gm[cj] * gm[cj] <= 81.0 * gm[j] * gm[j] * sep2 * sep2 * sep2
 
 
 @njit(cache=True, error_model="numpy")
@@ -192,10 +219,11 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
     A pair is checked once, from its lighter body (of two equal, the later one),
     with ``mu`` the pair's summed GM.  An approach is one to the body's primary
     ``prim[tp[p]]`` faster than a tenth of the orbit's pace ``1 / n`` at the first
-    output (any, unbound), or within three Hill radii of another body, not to
-    ``exempt`` beyond ``exempt_dist``; at an
+    output (any, unbound), or within three Hill radii of another body (about that
+    body's own primary), not to ``exempt`` beyond ``exempt_dist``; at an
     output its distance is ``|d|``, between outputs where the radial velocity
-    turned from negative to positive the larger two-body periapsis of the two
+    turned from negative to positive (the pair about the primary, or within the
+    Hill sphere at one of the two) the larger two-body periapsis of the two
     outputs; its time scale ``min(dist / speed, sqrt(dist^3 / mu))``."""
     n_t = r.shape[0]
     keep = dist.shape[0] > 0
@@ -207,6 +235,8 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
             j = m[jj]
             if j == i or gm[j] < gm[i] or (gm[j] == gm[i] and j > i):
                 continue  # (the pair is checked from its other body)
+            if gm[i] > 0 and j == c:
+                continue  # a massive body's own orbit: its energy shows how it went
             mu = gm[j] + gm[i]
             pace = math.inf
             if j == c:  # the orbit's own pace 1 / n at the first output (inf: unbound)
@@ -217,7 +247,8 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
                 inv_a0 = 2.0 / math.sqrt(d2) - u2 / mu
                 if inv_a0 > 0:
                     pace = 1.0 / math.sqrt(inv_a0 ** 3 * mu)
-            pd2, pu2, rad0 = 0.0, 0.0, 0.0
+            cj = prim[j]  # (the Hill sphere is j's about its own primary)
+            pd2, pu2, rad0, near0 = 0.0, 0.0, 0.0, False
             for t in range(n_t):
                 d2, u2, rad = 0.0, 0.0, 0.0
                 for k in range(3):
@@ -226,25 +257,23 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
                     d2 += dk * dk
                     u2 += uk * uk
                     rad += dk * uk
+                near = j == c or _within_hill(r, gm, j, cj, t, d2)
                 # (square roots only where needed: most pairs of most runs are far apart)
                 dd, dd2, speed = math.sqrt(d2) if keep else -1.0, d2, -1.0
-                if t > 0 and rad0 < 0 and rad > 0:  # a closest point passed between
+                if t > 0 and rad0 < 0 and rad > 0 and (near or near0):
+                    # a closest point passed between, on the pair's two-body conic where
+                    # it means one: about the primary, or within the Hill sphere at an
+                    # end (Mars and Jupiter's, both about the Sun, was no path: 0.74 au)
                     q0, inv0 = _periapsis(pd2, pu2, rad0, mu)
                     q, inv_a = _periapsis(d2, u2, rad, mu)
                     qmax = max(q0, q)
                     if qmax < math.sqrt(min(pd2, d2)):
                         dd, dd2 = qmax, qmax * qmax
                         speed = math.sqrt(max(mu * (2.0 / qmax - max(inv0, inv_a)), 0.0))
-                pd2, pu2, rad0 = d2, u2, rad
+                pd2, pu2, rad0, near0 = d2, u2, rad, near
                 far = j == exempt and dd2 > exempt_dist * exempt_dist
                 if not far and j != c:
-                    sep2 = 0.0
-                    for k in range(3):
-                        sep2 += (r[t, j, k] - r[t, c, k]) ** 2
-                    # within three Hill radii, 3 (gm_j / 3 gm_c)^(1/3) |r_j - r_c|, in
-                    # sixth powers: no cube root, no square root
-                    far = not dd2 * dd2 * dd2 * gm[c] * gm[c] <= (
-                        81.0 * gm[j] * gm[j] * sep2 * sep2 * sep2)
+                    far = not _within_hill(r, gm, j, cj, t, dd2)
                 ts = math.inf  # (beyond the Hill sphere, or integrated exactly there)
                 if not far:
                     if dd < 0.0:
@@ -301,43 +330,101 @@ def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
 @njit(cache=True, error_model="numpy")
 def _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
     # pragma: no cover - compiled
-    """Whether :func:`approaches` could flag any pair: its test without the primaries'
-    pruning (beyond three Hill radii, or at the orbit's own pace, an approach is not
-    one), which only takes flags away, in squares (no square root where no closest
-    point passed between outputs), with a margin of 1e-9 for their rounding.  Most
-    calls of most runs end here: no pair is that close for its speed."""
+    """Whether :func:`approaches` could flag any pair: its test, with each body's
+    primary found only for a pair near enough to need it, the approach's time scale
+    compared in squares with a margin of 1e-9 for their rounding, and without the
+    pruning of an approach at the orbit's own pace (which only takes flags away).
+    For each body and output, the other bodies in one loop without branches (the
+    compiler's vector instructions: a disc of 1000 massive bodies costs about a force
+    evaluation); the pairs it finds near looked at one by one.  Most calls of most
+    runs end here."""
     n_t, n = r.shape[0], r.shape[1]
     slack = 1.0 + 1e-9
     ex2 = (exempt_dist * slack) ** 2
+    last = np.empty((4, n))  # |d|^2, |u|^2, d . u of each pair at the output before
+    now = np.empty((4, n))  # (and in row 3, 1.0 where a pair is to be looked at)
+    pair = np.empty(n)  # 1.0 where (i, j) is a pair checked from i
+    prim = np.full(n, -2)  # the bodies' primaries, found where needed (-2: not yet)
+    massive = 0
     for i in range(n):
-        if i == top:
+        massive += gm0[i] > 0
+    for i in range(n):
+        if i == top or (gm0[i] > 0 and massive > MASSIVE_PAIRS_MAX):
             continue
         for j in range(n):
-            if j == i or not gm0[j] > 0 or gm0[j] < gm0[i] or (gm0[j] == gm0[i] and j > i):
-                continue
-            mu = gm0[j] + gm0[i]
-            pd2, pu2, rad0 = 0.0, 0.0, 0.0
-            for t in range(n_t):
-                d2, u2, rad = 0.0, 0.0, 0.0
-                for k in range(3):
-                    dk = r[t, i, k] - r[t, j, k]
-                    uk = v[t, i, k] - v[t, j, k]
-                    d2 += dk * dk
-                    u2 += uk * uk
-                    rad += dk * uk
-                dd2, speed2 = d2, u2
-                if t > 0 and rad0 < 0 and rad > 0:  # (as approaches: the closest point)
-                    q0, inv0 = _periapsis(pd2, pu2, rad0, mu)
-                    q, inv_a = _periapsis(d2, u2, rad, mu)
-                    qmax = max(q0, q)
-                    if qmax < math.sqrt(min(pd2, d2)):
-                        dd2 = qmax * qmax
-                        speed2 = max(mu * (2.0 / qmax - max(inv0, inv_a)), 0.0)
-                pd2, pu2, rad0 = d2, u2, rad
-                if j == exempt and dd2 > ex2:
-                    continue
-                reach = h[t] / fraction * slack  # flagged: ts < reach, ts the lesser of
-                if dd2 < reach * reach * speed2 or (  # d / speed and sqrt(d^3 / mu)
-                        dd2 * dd2 * dd2 < (reach * reach * mu) ** 2 * slack):
-                    return True
+            pair[j] = 1.0 if (j != i and gm0[j] > 0 and (gm0[j] > gm0[i] or (
+                gm0[j] == gm0[i] and j < i))) else 0.0
+        for t in range(n_t):
+            reach2 = (h[t] / fraction * slack) ** 2  # flagged: ts^2 < reach2
+            if _rows(r[t], v[t], i, gm0, pair, reach2, now, last, t > 0):  # (a pair near
+                # now, or a closest point passed between: looked at one by one)
+                for j in range(n):
+                    if now[3, j] > 0 and _flagged(r, v, gm0, top, prim, t, i, j, now[:, j],
+                                                  last[:, j], reach2, slack, j == exempt,
+                                                  ex2):
+                        return True
+            last[:, :] = now
     return False
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _primary_cached(r, v, gm0, top, prim, i):  # pragma: no cover - compiled
+    """Body ``i``'s primary at the first output, found once (-1: the most massive)."""
+    if prim[i] == -2:
+        prim[i] = -1 if i == top else _primary_of(r[0], v[0], gm0, i, top)
+    return prim[i]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex2):
+    # pragma: no cover - compiled
+    """The test of :func:`approaches` for the pair ``(i, j)`` at output ``t`` (``now``,
+    ``last``: its ``|d|^2``, ``|u|^2``, ``d . u`` there and at the output before),
+    but for the pruning at the orbit's pace and with the time scale in squares."""
+    c = _primary_cached(r, v, gm0, top, prim, i)
+    if gm0[i] > 0 and j == c:
+        return False  # (a massive body's own orbit: not checked)
+    cj = _primary_cached(r, v, gm0, top, prim, j)
+    mu = gm0[i] + gm0[j]
+    near = j == c or _within_hill(r, gm0, j, cj, t, now[0])
+    dd2, speed2 = now[0], now[1]
+    if t > 0 and last[2] < 0 and now[2] > 0 and (
+            near or _within_hill(r, gm0, j, cj, t - 1, last[0])):
+        q0, inv0 = _periapsis(last[0], last[1], last[2], mu)  # (as approaches: the
+        q, inv_a = _periapsis(now[0], now[1], now[2], mu)  # closest point between)
+        qmax = max(q0, q)
+        if qmax < math.sqrt(min(last[0], now[0])):
+            dd2 = qmax * qmax
+            speed2 = max(mu * (2.0 / qmax - max(inv0, inv_a)), 0.0)
+    if exempt and dd2 > ex2:
+        return False
+    if j != c and not _within_hill(r, gm0, j, cj, t, dd2):
+        return False
+    # ts the lesser of d / speed and sqrt(d^3 / mu)
+    return dd2 < reach2 * speed2 or dd2 * dd2 * dd2 < (reach2 * mu) ** 2 * slack
+
+
+@njit(cache=True, error_model="numpy")
+def _rows(rt, vt, i, gm0, pair, reach2, now, last, between):
+    # pragma: no cover - compiled
+    """``now``: each pair's ``|d|^2``, ``|u|^2``, ``d . u`` of body ``i`` with the
+    others in the states ``rt``, ``vt`` (n, 3); whether one of ``pair`` is within the
+    flagging test ignoring an exempt body, or (``between``) passed its closest point
+    since ``last`` (no branch in the loop: vectorised)."""
+    any_hit = 0.0
+    turn = 1.0 if between else 0.0
+    for j in range(rt.shape[0]):
+        dx, dy, dz = rt[i, 0] - rt[j, 0], rt[i, 1] - rt[j, 1], rt[i, 2] - rt[j, 2]
+        ux, uy, uz = vt[i, 0] - vt[j, 0], vt[i, 1] - vt[j, 1], vt[i, 2] - vt[j, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        u2 = ux * ux + uy * uy + uz * uz
+        rad = dx * ux + dy * uy + dz * uz
+        now[0, j], now[1, j], now[2, j] = d2, u2, rad
+        mu = gm0[i] + gm0[j]
+        near = (d2 < reach2 * u2) | (d2 * d2 * d2 < 2.0 * (reach2 * mu) ** 2)
+        passed = turn * ((last[2, j] < 0.0) & (rad > 0.0))
+        look = pair[j] * max(near, passed)
+        now[3, j] = look
+        any_hit = max(any_hit, look)
+    return any_hit > 0
+
