@@ -504,6 +504,48 @@ def test_massive_bodies_through_each_other_at_a_fixed_step_warn(method):
     assert row["inv_a_after"] < 0 < row["inv_a_before"]  # (flung out of the system)
 
 
+def _massless(system, name):
+    """``system`` with body ``name`` a test particle (GM 0)."""
+    a = system.as_arrays()
+    gm = a.gm.copy()
+    gm[list(system.names).index(name)] = 0.0
+    return System.from_arrays(gm * u.au**3 / u.day**2, a.r * u.au, a.v * u.au / u.day,
+                              names=system.names)
+
+
+def test_a_closest_point_between_outputs_is_taken_only_where_the_conic_is_the_path():
+    """Mars (a test particle here, as before the massive pairs were checked; massive
+    now, the same) over 5 years of wh at 4 d, outputs at the ends: its closest point
+    to Jupiter between them was taken from their two-body conic, "0.74 au at t =
+    1374 d", and warned of, where the two never came within 3.5 au: both go about the
+    Sun, and no conic of theirs is their path.  The conic is taken about the primary,
+    or where the pair is within the Hill sphere at an output."""
+    import warnings
+
+    s = System.solar_system("J2000")
+    for system in (_massless(s, "mars"), s):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            traj = integrate(system, 5 * u.yr, method="wh", dt=4 * u.day)
+        assert len(traj.under_resolved) == 0
+
+
+def test_the_hill_sphere_of_the_body_passed_is_its_own_about_its_primary():
+    """A particle about the Earth (the Moon, massless) passing Venus at 0.3-0.4 au
+    was "within three Hill radii" of Venus measured about the Earth (twice their
+    distance) and warned of 8 times in 10 years of wh at 2 d; Venus's are 0.02 au
+    about the Sun."""
+    import warnings
+
+    s = System.solar_system("J2000", bodies=["sun", "venus", "earth", "moon"])
+    t = np.arange(2, 3653, 2.0) * u.day
+    for system in (_massless(s, "moon"), s):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            traj = integrate(system, t, method="wh", dt=2 * u.day)
+        assert len(traj.under_resolved) == 0
+
+
 def test_massive_pairs_are_checked_in_systems_of_at_most_32_massive_bodies():
     """The head-on pair beside 29 (then 30) distant bodies of GM 1e-9: with 32 massive
     bodies it is listed, with 33 not (checking every pair at every output would cost
