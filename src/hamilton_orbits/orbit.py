@@ -50,7 +50,7 @@ from hamilton_orbits._orbit_build import (
 )
 from hamilton_orbits._orbit_elements import OrbitElements
 from hamilton_orbits.twobody import STATE_UNITS, check_state
-from hamilton_orbits.units import TIME, is_quantity
+from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
@@ -391,7 +391,8 @@ class KeplerOrbit(OrbitElements):
 
         Parameters
         ----------
-        dt : array_like or Quantity (time), shape (...)
+        dt : array_like, Quantity (time) or TimeDelta, shape (...)
+            A TimeDelta is the Quantity in days it holds.
 
         Returns
         -------
@@ -412,6 +413,7 @@ class KeplerOrbit(OrbitElements):
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        dt = time_quantity(dt)  # (a TimeDelta: the Quantity in days it holds)
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
         dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below

@@ -73,10 +73,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         Barycentric ICRS positions and velocities (or plain floats in au and au/day).
     epoch : astropy.time.Time
         The time of ``r0``, ``v0`` (any scale: TDB is used).
-    t : Quantity or Time
-        A duration, an end ``Time``, or output times (durations from ``epoch`` or
-        ``Time`` values), monotonic, forwards or backwards; ``epoch`` is the first
-        output.
+    t : Quantity, TimeDelta or Time
+        A duration (a time Quantity or a TimeDelta), an end ``Time``, or output
+        times (durations from ``epoch`` or ``Time`` values), monotonic, forwards or
+        backwards; ``epoch`` is the first output.
     names : sequence of str, optional
         The small bodies' names (default ``"body0"``, ``"body1"``, ...).
     ephemeris : "de440" or Segments
@@ -338,8 +338,9 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
     """The output times in days from the epoch, 0 first, strictly monotonic."""
     from astropy.time import Time
 
-    from hamilton_orbits.units import TIME
+    from hamilton_orbits.units import TIME, time_quantity
 
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     if isinstance(t, Time):
         tdb = t.tdb
         days = np.atleast_1d((tdb.jd1 - jd1) + (tdb.jd2 - jd2)).astype(np.float64)
@@ -347,7 +348,8 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
         from hamilton_orbits.units import is_quantity
 
         if not is_quantity(t):
-            raise ValueError(f"Expected `t` to be a time Quantity or an astropy Time, got {t!r}")
+            raise ValueError(f"Expected `t` to be a time Quantity, a TimeDelta or an astropy "
+                             f"Time, got {t!r}")
         days = np.atleast_1d(TIME("t", t, "d")).astype(np.float64)
     if days.ndim != 1:
         raise ValueError(f"Expected `t` to be one time or a 1-d array of times, got shape "

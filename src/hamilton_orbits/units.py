@@ -58,6 +58,7 @@ __all__ = [
     "is_quantity",
     "require_consistent",
     "strip",
+    "time_quantity",
     "wrap",
 ]
 
@@ -116,6 +117,44 @@ def any_quantity(*values: Any) -> bool:
     """
     q = _quantity_class()
     return q is not None and any(isinstance(v, q) for v in values)
+
+
+def time_quantity(value: Any) -> Any:
+    """``value``, an astropy TimeDelta made the time Quantity in days it holds.
+
+    A duration is taken as a time Quantity or as astropy's own duration type, a
+    :class:`~astropy.time.TimeDelta` (scalar or array): the public functions that
+    take a duration pass it through here first, once, so that a TimeDelta is then
+    accepted, converted and refused exactly as the Quantity in days it equals
+    (refused beside a system of plain floats, as a Quantity is).  ``value.to(u.day)``
+    keeps its precision (the sum of its two doubles of days, rounded once).
+
+    Parameters
+    ----------
+    value : Any
+        What the caller gave for a duration.
+
+    Returns
+    -------
+    Any
+        A TimeDelta as a Quantity in days; anything else as given (without importing
+        astropy.time: a caller that has not imported it cannot have given a TimeDelta).
+
+    Examples
+    --------
+    >>> from astropy.time import TimeDelta
+    >>> time_quantity(TimeDelta(1800.0, format="sec"))
+    <Quantity 0.02083333 d>
+    >>> time_quantity(TimeDelta([0.0, 1.5], format="jd"))
+    <Quantity [0. , 1.5] d>
+    >>> time_quantity(2.0)
+    2.0
+    """
+    time = sys.modules.get("astropy.time")
+    delta = None if time is None else getattr(time, "TimeDelta", None)
+    if delta is not None and isinstance(value, delta):
+        return value.to(u.day)
+    return value
 
 
 class Kind:
