@@ -93,14 +93,15 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         (:data:`~hamilton_orbits.perturber_field.EFFECTS`).
     nongrav : mapping or sequence of (mapping or None), optional
         Marsden, Sekanina & Yeomans (1973) accelerations ``A1``, ``A2``, ``A3``
-        (Quantities of acceleration, or floats in au/day^2) with ``g(r)``'s
+        (Quantities of acceleration, strings that read as one such as
+        ``"-2.9e-14 au/day2"``, or floats in au/day^2) with ``g(r)``'s
         ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
         r)^2``; ``hamilton_orbits.effects.nongrav.COMET_G`` the comets'): one
         mapping for every body, or one (or None) per body.
     events : sequence of mapping
         Close encounters with perturbers to record: ``{"name": "close_encounter",
-        "bodies": "earth", "distance": 0.05 * u.au}`` (``bodies``: perturbers, and
-        optionally the small bodies to watch, default all), found on the
+        "bodies": "earth", "distance": 0.05 * u.au}`` (or ``"0.05 au"``; ``bodies``:
+        perturbers, and optionally the small bodies to watch, default all), found on the
         integrator's interpolant of each step (``traj.events``: time, bodies,
         distance, speed).  Forwards or backwards, without ``stm`` / ``variational``
         (:mod:`hamilton_orbits.small_body_events`).
