@@ -163,9 +163,13 @@ class KeplerOrbit(OrbitElements):
         Parameters
         ----------
         r : array_like or Quantity (length), shape (..., 3)
-            Position relative to the attracting centre (nonzero).
+            Position relative to the attracting centre (nonzero).  A list of
+            Quantities is the one Quantity ``u.Quantity`` joins it into; an astropy
+            representation (``CartesianRepresentation``, ...) its Cartesian
+            coordinates.
         v : array_like or Quantity (length/time), shape (..., 3)
-            Velocity.
+            Velocity (a list of Quantities, a representation or a
+            ``CartesianDifferential`` as for ``r``).
         mu : array_like or Quantity (length^3/time^2), shape (...)
             ``G (m1 + m2) > 0`` (Hamilton's M).
 
@@ -272,7 +276,9 @@ class KeplerOrbit(OrbitElements):
             anomaly (Kepler's equation by :func:`hamilton_orbits.solve_kepler`).
             A radial orbit takes ``M``.
         mu : array_like or Quantity (length^3/time^2), shape (...)
-            Gravitational parameter, ``> 0``.
+            Gravitational parameter, ``> 0``.  Each of these parameters may also
+            be a list of Quantities, the one Quantity ``u.Quantity`` joins it into
+            (``a=[7000 * u.km, 1 * u.Mm]``).
 
         Returns
         -------
