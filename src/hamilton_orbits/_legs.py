@@ -25,7 +25,7 @@ from hamilton_orbits.events import EventLog, EventSet, watch_table
 from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.nbody import DAY, System
 from hamilton_orbits.rhs import RHS
-from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity
+from hamilton_orbits.units import DIMENSIONLESS, TIME, is_quantity, time_quantity
 from hamilton_orbits.validation import as_float_array
 
 __all__ = [
@@ -165,7 +165,8 @@ def event_list(events: Any) -> list[dict[str, Any]]:
 
 def time_step(dt: Any, quantity: bool, name: str = "dt") -> float:
     """``dt`` (or the interval ``name``) in days (a Quantity system: a time Quantity
-    is required) or the caller's float, positive and finite."""
+    is required, or a TimeDelta) or the caller's float, positive and finite."""
+    dt = time_quantity(dt)
     if isinstance(dt, (bool, np.bool_)):
         raise ValueError(f"Expected `{name}` to be a number, got {dt!r}")
     if quantity and not is_quantity(dt):

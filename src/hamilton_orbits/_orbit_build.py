@@ -13,7 +13,7 @@ import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits.twobody import STATE_UNITS
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, is_quantity
+from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, as_quantity, is_quantity
 from hamilton_orbits.validation import (
     ConvergenceError,
     broadcast,
@@ -57,13 +57,17 @@ def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
     ``(lname, length, aname, angle, e, inc, lan, argp, mu, quantity)``: the
     name and value of the length and of the anomaly given, and every value as
     float arrays broadcast together (km and km^3/s^2 if ``quantity``), with
-    ``e >= 0``, ``mu > 0`` and ``inc`` in [0, pi] checked."""
+    ``e >= 0``, ``mu > 0`` and ``inc`` in [0, pi] checked.  A list of Quantities
+    is one Quantity (:func:`hamilton_orbits.units.as_quantity`)."""
     if sum(x is not None for x in lengths.values()) != 1:
         raise ValueError("Expected exactly one of `a`, `p`, `q`")
     if sum(x is not None for x in anomalies.values()) != 1:
         raise ValueError("Expected exactly one of `nu`, `M`")
     lname, lval = next((k, x) for k, x in lengths.items() if x is not None)
     aname, aval = next((k, x) for k, x in anomalies.items() if x is not None)
+    lval, aval, mu = as_quantity(lname, lval), as_quantity(aname, aval), as_quantity("mu", mu)
+    e, inc, lan, argp = (as_quantity(n, x) for n, x in
+                         (("e", e), ("inc", inc), ("lan", lan), ("argp", argp)))
     quantity = is_quantity(lval) or is_quantity(mu)
     if quantity and not (is_quantity(lval) and is_quantity(mu)):
         raise ValueError(

@@ -8,6 +8,10 @@ by name or as mappings with parameters, like effects::
     {"name": "collision", "action": "merge"}          # uses Body(radius=)
     {"name": "escape", "distance": 1000 * u.au, "action": "remove"}
 
+A ``distance`` is a length Quantity or a string that reads as one (``"0.1 au"``, as
+the effects' parameters read one) for a Quantity system, a plain number in the
+system's own length unit for a system of plain floats.
+
 What each finds
 ---------------
 ``close_encounter``
@@ -316,25 +320,28 @@ def _pairs(params: Mapping[str, Any], system: Any, where: str, name: str) -> lis
 def _length(value: Any, system: Any, where: str) -> float:
     import astropy.units as u
 
+    from hamilton_orbits.effects.parameters import with_units
     from hamilton_orbits.units import LENGTH, is_quantity
 
+    given, value = value, with_units(value, "distance", where, LENGTH)  # ("0.1 au" as
+    # the effects read it)
     if system.quantity and not is_quantity(value):
-        raise ValueError(f"{where}: expected `distance` as a length Quantity for a Quantity "
-                         f"system, got {value!r}")
+        raise ValueError(f"{where}: expected `distance` as a length Quantity (or a string "
+                         f"such as '0.1 au') for a Quantity system, got {given!r}")
     if not system.quantity and is_quantity(value):  # (it was read in metres: 30 au as
         raise ValueError(f"{where}: expected `distance` as a plain number in the system's "
                          f"own length unit (it was built from plain numbers), got "
-                         f"{value!r}")  # 4.5e12 of the system's unit)
+                         f"{given!r}")  # 4.5e12 of the system's unit)
     if np.ndim(getattr(value, "value", value)) != 0:  # (float() of an array said "only
         # 0-dimensional arrays can be converted to Python scalars")
-        raise ValueError(f"{where}: expected `distance` to be one length, got {value!r}")
+        raise ValueError(f"{where}: expected `distance` to be one length, got {given!r}")
     try:
         dist = float(LENGTH("distance", value, u.au if system.quantity else None))
     except (ValueError, TypeError, u.UnitsError) as exc:
         msg = str(exc)
         raise ValueError(f"{where}: {msg[:1].lower()}{msg[1:]}") from None
     if not (np.isfinite(dist) and dist > 0):
-        raise ValueError(f"{where}: expected `distance` > 0, got {value!r}")
+        raise ValueError(f"{where}: expected `distance` > 0, got {given!r}")
     return dist
 
 

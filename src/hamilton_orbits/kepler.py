@@ -40,7 +40,17 @@ import numpy as np
 
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits.deprecation import moved_name
-from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, SPEED, TIME, is_quantity, wrap
+from hamilton_orbits.units import (
+    ANGLE,
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    SPEED,
+    TIME,
+    is_quantity,
+    time_quantity,
+    wrap,
+)
 from hamilton_orbits.validation import (
     ConvergenceError,
     broadcast,
@@ -300,9 +310,10 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any, *, threads: bool = True) -> tupl
         Velocity.
     mu : array_like or Quantity (length^3/time^2), shape (...)
         Gravitational parameter ``G (m1 + m2) > 0`` (Hamilton's M).
-    dt : array_like or Quantity (time), shape (...)
+    dt : array_like, Quantity (time) or TimeDelta, shape (...)
         Time step, any sign and size (a bound orbit's dt is reduced modulo the
-        exact period first, so 1e6 periods cost the same as one).
+        exact period first, so 1e6 periods cost the same as one); a TimeDelta is
+        the Quantity in days it holds.
     threads : bool
         Share many rows (from 65536) among threads (the default); False: one
         thread whatever the rows, so the threaded kernel is never compiled (worth
@@ -350,6 +361,7 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any, *, threads: bool = True) -> tupl
     >>> np.round(r, 12) + 0.0, np.round(v, 12) + 0.0
     (array([0., 1., 0.]), array([-1.,  0.,  0.]))
     """
+    dt = time_quantity(dt)  # (a TimeDelta: the Quantity in days it holds)
     flags = [is_quantity(x) for x in (r, v, mu, dt)]
     quantity = all(flags)
     if any(flags) and not quantity:

@@ -533,10 +533,10 @@ class System(InitialStates):
         ----------
         effects : sequence of str or mapping, optional
             Effects as for :func:`hamilton_orbits.integrate` (``"gr"``, ...).
-        t : Quantity or float
+        t : Quantity, TimeDelta or float
             The time of this state, for the effects that know it (``zonal`` with
-            ``pole="IAU2006"``, ...): 0 at the simulation's start (a time Quantity
-            for a Quantity system; the system's own unit otherwise).
+            ``pole="IAU2006"``, ...): 0 at the simulation's start (a time Quantity,
+            or a TimeDelta, for a Quantity system; the system's own unit otherwise).
 
         Returns
         -------
@@ -552,8 +552,9 @@ class System(InitialStates):
                [-0.25,  0.  ,  0.  ]])
         """
         from hamilton_orbits.rhs import compile_rhs
-        from hamilton_orbits.units import TIME, is_quantity
+        from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
+        t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
         if self._quantity and not is_quantity(t) and t != 0:
             raise ValueError(f"Expected `t` as a time Quantity for a system of Quantities, "
                              f"got {t!r}")

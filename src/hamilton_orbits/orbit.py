@@ -50,7 +50,7 @@ from hamilton_orbits._orbit_build import (
 )
 from hamilton_orbits._orbit_elements import OrbitElements
 from hamilton_orbits.twobody import STATE_UNITS, check_state
-from hamilton_orbits.units import TIME, is_quantity
+from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
@@ -163,9 +163,13 @@ class KeplerOrbit(OrbitElements):
         Parameters
         ----------
         r : array_like or Quantity (length), shape (..., 3)
-            Position relative to the attracting centre (nonzero).
+            Position relative to the attracting centre (nonzero).  A list of
+            Quantities is the one Quantity ``u.Quantity`` joins it into; an astropy
+            representation (``CartesianRepresentation``, ...) its Cartesian
+            coordinates.
         v : array_like or Quantity (length/time), shape (..., 3)
-            Velocity.
+            Velocity (a list of Quantities, a representation or a
+            ``CartesianDifferential`` as for ``r``).
         mu : array_like or Quantity (length^3/time^2), shape (...)
             ``G (m1 + m2) > 0`` (Hamilton's M).
 
@@ -272,7 +276,9 @@ class KeplerOrbit(OrbitElements):
             anomaly (Kepler's equation by :func:`hamilton_orbits.solve_kepler`).
             A radial orbit takes ``M``.
         mu : array_like or Quantity (length^3/time^2), shape (...)
-            Gravitational parameter, ``> 0``.
+            Gravitational parameter, ``> 0``.  Each of these parameters may also
+            be a list of Quantities, the one Quantity ``u.Quantity`` joins it into
+            (``a=[7000 * u.km, 1 * u.Mm]``).
 
         Returns
         -------
@@ -391,7 +397,8 @@ class KeplerOrbit(OrbitElements):
 
         Parameters
         ----------
-        dt : array_like or Quantity (time), shape (...)
+        dt : array_like, Quantity (time) or TimeDelta, shape (...)
+            A TimeDelta is the Quantity in days it holds.
 
         Returns
         -------
@@ -412,6 +419,7 @@ class KeplerOrbit(OrbitElements):
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        dt = time_quantity(dt)  # (a TimeDelta: the Quantity in days it holds)
         if is_quantity(dt) != self._quantity:
             raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
         dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below

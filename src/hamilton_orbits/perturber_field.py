@@ -158,7 +158,8 @@ def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
     for every body, or one mapping (or None) per body; None where no body has one."""
     import astropy.units as u
 
-    from hamilton_orbits.units import is_quantity
+    from hamilton_orbits.effects.parameters import with_units
+    from hamilton_orbits.units import ACCELERATION, LENGTH, is_quantity
 
     if nongrav is None:
         return None
@@ -177,6 +178,9 @@ def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
         for key, kind in NONGRAV_KEYS.items():
             x = row.get(key, _NONGRAV_DEFAULTS[key])
             unit = {"acceleration": u.au / u.day**2, "length": u.au}.get(kind)
+            if unit is not None:  # ("-2.9e-14 au/day2" as the effects read it)
+                x = with_units(x, key, f"`nongrav` at index {k}",
+                               ACCELERATION if kind == "acceleration" else LENGTH)
             if is_quantity(x) and unit is not None:
                 if not x.unit.is_equivalent(unit):
                     raise u.UnitConversionError(

@@ -25,6 +25,7 @@ from hamilton_orbits.effects import (
 )
 from hamilton_orbits.integrals import integral_errors
 from hamilton_orbits.nbody import System
+from hamilton_orbits.units import time_quantity
 
 __all__ = [
     "CrossCheck",
@@ -299,7 +300,8 @@ def crosscheck(
     Parameters
     ----------
     system, t, method, effects, dt, tol, progress
-        As for :func:`hamilton_orbits.integrate`; ``t`` an end time.
+        As for :func:`hamilton_orbits.integrate`; ``t`` an end time (a TimeDelta
+        is the Quantity in days it holds).
     trajectory : Trajectory, optional
         A trajectory of ours already computed from ``system`` (it is not recomputed):
         of the same ``effects``, and ending at ``t`` (or ``t`` None: its end).  A
@@ -323,6 +325,7 @@ def crosscheck(
     """
     from hamilton_orbits.simulation import integrate
 
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     effects = EffectSet.of(effects, "nbody")
     reboundx_counterparts(system, effects)  # (refused before our run, not after it)
     if trajectory is None:

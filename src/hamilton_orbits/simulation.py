@@ -65,7 +65,7 @@ from hamilton_orbits.trajectory import (
     event_table,
     make_trajectory,
 )
-from hamilton_orbits.units import TIME, is_quantity
+from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -84,9 +84,10 @@ class Simulation(Saving):
         ``"radau15"`` (default), ``"wh"``, ``"leapfrog"``, ``"dop853"``, or a typed
         value (:class:`~hamilton_orbits.Radau15`,
         :class:`~hamilton_orbits.WH`, ...) that carries the options.
-    dt : Quantity or float, optional
+    dt : Quantity, TimeDelta or float, optional
         A fixed step (``radau15``, ``wh``, ``leapfrog``) or a step cap
-        (``dop853``); a time Quantity for a Quantity system.
+        (``dop853``); a time Quantity (or an astropy TimeDelta, the Quantity in
+        days it holds) for a Quantity system.
     tol : float, optional
         The integrator's tolerance (adaptive methods) or the accuracy from which a
         fixed-step method chooses its step.
@@ -105,8 +106,9 @@ class Simulation(Saving):
     archive : path, optional
         A folder to write snapshots into while the simulation integrates
         (``docs/archive.md``), on one of these schedules:
-    every : Quantity or float, optional
-        A snapshot at every multiple of this much simulation time;
+    every : Quantity, TimeDelta or float, optional
+        A snapshot at every multiple of this much simulation time (a TimeDelta:
+        the Quantity in days it holds);
     every_steps : int, optional
         or every so many steps: radau15 (double precision, without the
         variational equations) takes it between two steps, at the end of every
@@ -320,11 +322,12 @@ class Simulation(Saving):
 
         Parameters
         ----------
-        t : Quantity or float or array_like
+        t : Quantity, TimeDelta, float or array_like
             An end time, or output times (monotonic from the simulation's time
             :attr:`t`, which is added as the first output if missing), in the
-            simulation's time (0 at the system given); a time Quantity for a
-            Quantity system, plain floats otherwise.  Backwards is allowed with
+            simulation's time (0 at the system given); a time Quantity (or an
+            astropy TimeDelta, the Quantity in days it holds) for a Quantity
+            system, plain floats otherwise.  Backwards is allowed with
             every effect (the time-reversed motion is integrated, velocity-dependent
             effects at the true velocity), with the variational equations and with
             events that record only (not those that stop, merge or remove), not while
@@ -362,6 +365,7 @@ class Simulation(Saving):
             steps are counted and its event acted on (the drivers' ``_held``); a
             second is raised at once.
         """
+        t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
             out = self._lean(t)  # lean path, when it can
@@ -515,13 +519,14 @@ def integrate(
     Parameters
     ----------
     system : System
-    t : Quantity or float or array_like
+    t : Quantity, TimeDelta, float or array_like
         An end time, or output times (monotonic; a start at 0 is added if missing).
-        A time Quantity for a Quantity system, plain floats otherwise.
+        A time Quantity (or an astropy TimeDelta, the Quantity in days it holds)
+        for a Quantity system, plain floats otherwise.
     method : {"radau15", "wh", "leapfrog", "dop853"} or Method
         The integrator (see :mod:`hamilton_orbits.integrators`), by name or as a
         typed value with its options (``WH(coordinates="jacobi")``).
-    dt : Quantity or float, optional
+    dt : Quantity, TimeDelta or float, optional
         A fixed step (``radau15``, ``wh``, ``leapfrog``) or a step cap (``dop853``).
     tol : float, optional
         The integrator's tolerance (adaptive methods) or the accuracy from which a

@@ -73,10 +73,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         Barycentric ICRS positions and velocities (or plain floats in au and au/day).
     epoch : astropy.time.Time
         The time of ``r0``, ``v0`` (any scale: TDB is used).
-    t : Quantity or Time
-        A duration, an end ``Time``, or output times (durations from ``epoch`` or
-        ``Time`` values), monotonic, forwards or backwards; ``epoch`` is the first
-        output.
+    t : Quantity, TimeDelta or Time
+        A duration (a time Quantity or a TimeDelta), an end ``Time``, or output
+        times (durations from ``epoch`` or ``Time`` values), monotonic, forwards or
+        backwards; ``epoch`` is the first output.
     names : sequence of str, optional
         The small bodies' names (default ``"body0"``, ``"body1"``, ...).
     ephemeris : "de440" or Segments
@@ -93,14 +93,15 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         (:data:`~hamilton_orbits.perturber_field.EFFECTS`).
     nongrav : mapping or sequence of (mapping or None), optional
         Marsden, Sekanina & Yeomans (1973) accelerations ``A1``, ``A2``, ``A3``
-        (Quantities of acceleration, or floats in au/day^2) with ``g(r)``'s
+        (Quantities of acceleration, strings that read as one such as
+        ``"-2.9e-14 au/day2"``, or floats in au/day^2) with ``g(r)``'s
         ``alpha``, ``r0``, ``m``, ``n``, ``k`` (default the asteroid form ``(1 au /
         r)^2``; ``hamilton_orbits.effects.nongrav.COMET_G`` the comets'): one
         mapping for every body, or one (or None) per body.
     events : sequence of mapping
         Close encounters with perturbers to record: ``{"name": "close_encounter",
-        "bodies": "earth", "distance": 0.05 * u.au}`` (``bodies``: perturbers, and
-        optionally the small bodies to watch, default all), found on the
+        "bodies": "earth", "distance": 0.05 * u.au}`` (or ``"0.05 au"``; ``bodies``:
+        perturbers, and optionally the small bodies to watch, default all), found on the
         integrator's interpolant of each step (``traj.events``: time, bodies,
         distance, speed).  Forwards or backwards, without ``stm`` / ``variational``
         (:mod:`hamilton_orbits.small_body_events`).
@@ -338,8 +339,9 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
     """The output times in days from the epoch, 0 first, strictly monotonic."""
     from astropy.time import Time
 
-    from hamilton_orbits.units import TIME
+    from hamilton_orbits.units import TIME, time_quantity
 
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     if isinstance(t, Time):
         tdb = t.tdb
         days = np.atleast_1d((tdb.jd1 - jd1) + (tdb.jd2 - jd2)).astype(np.float64)
@@ -347,7 +349,8 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
         from hamilton_orbits.units import is_quantity
 
         if not is_quantity(t):
-            raise ValueError(f"Expected `t` to be a time Quantity or an astropy Time, got {t!r}")
+            raise ValueError(f"Expected `t` to be a time Quantity, a TimeDelta or an astropy "
+                             f"Time, got {t!r}")
         days = np.atleast_1d(TIME("t", t, "d")).astype(np.float64)
     if days.ndim != 1:
         raise ValueError(f"Expected `t` to be one time or a 1-d array of times, got shape "

@@ -124,16 +124,18 @@ def _named(bodies: Any, names: Sequence[str], perturbers: Sequence[str], where: 
 
 
 def _distance(value: Any, where: str) -> float:
+    from hamilton_orbits.effects.parameters import with_units
     from hamilton_orbits.units import LENGTH
 
     if value is None:
         raise ValueError(f"{where}: needs `distance` (a length, or au)")
+    given, value = value, with_units(value, "distance", where, LENGTH)  # ("0.1 au")
     try:
         dist = float(LENGTH("distance", value, "au"))
     except (ValueError, TypeError) as exc:
         raise ValueError(f"{where}: {exc}") from None
     if not (np.isfinite(dist) and dist > 0):
-        raise ValueError(f"{where}: expected `distance` > 0, got {value!r}")
+        raise ValueError(f"{where}: expected `distance` > 0, got {given!r}")
     return dist
 
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from hamilton_orbits import _columns
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits.units import GM, LENGTH, SPEED, is_quantity
+from hamilton_orbits.units import GM, LENGTH, SPEED, as_quantity, is_quantity
 from hamilton_orbits.validation import (
     broadcast,
     check_positive,
@@ -98,11 +98,14 @@ def check_state(r: Any, v: Any, mu: Any):
     Parameters
     ----------
     r : array_like or Quantity (length), shape (..., 3)
-        Position relative to the attracting centre (nonzero).
+        Position relative to the attracting centre (nonzero).  A list of
+        Quantities is joined into one, an astropy representation is its Cartesian
+        coordinates (:func:`hamilton_orbits.units.as_quantity`).
     v : array_like or Quantity (length/time), shape (..., 3)
-        Velocity.
+        Velocity (a list of Quantities, or a representation or a
+        ``CartesianDifferential``, as ``r``).
     mu : array_like or Quantity (length^3/time^2), shape (...)
-        ``G (m1 + m2) > 0`` (Hamilton's M).
+        ``G (m1 + m2) > 0`` (Hamilton's M); a list of Quantities is joined.
 
     Returns
     -------
@@ -141,6 +144,8 @@ def check_state(r: Any, v: Any, mu: Any):
     ...
     ValueError: Expected `r` to be nonzero, got [0.0, 0.0, 0.0] at index 1
     """
+    r, v = as_quantity("r", r, vector=True), as_quantity("v", v, vector=True)
+    mu = as_quantity("mu", mu)
     try:
         checked = _copy_valid_state(r, v, mu)
     except ValueError:

@@ -56,9 +56,11 @@ __all__ = [
     "Kind",
     "UnitLike",
     "any_quantity",
+    "as_quantity",
     "is_quantity",
     "require_consistent",
     "strip",
+    "time_quantity",
     "wrap",
 ]
 
@@ -117,6 +119,113 @@ def any_quantity(*values: Any) -> bool:
     """
     q = _quantity_class()
     return q is not None and any(isinstance(v, q) for v in values)
+
+
+def as_quantity(name: str, value: Any, *, vector: bool = False) -> Any:
+    """``value`` with the other forms an astropy user gives one Quantity in made one.
+
+    A list or tuple holding Quantities (nested or not) is joined by ``u.Quantity``
+    (compatible units converted to the first one's: ``[7000 * u.km, 1 * u.Mm]`` is
+    ``[7000, 1000] km``); for a ``vector`` argument, an astropy coordinate
+    representation is its Cartesian coordinates (``get_xyz(xyz_axis=-1)``: the three
+    last, as a vector argument takes them) and a ``CartesianDifferential`` its
+    ``get_d_xyz(xyz_axis=-1)``.  The caller then checks the result as any Quantity.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, for messages.
+    value : Any
+        What the caller gave.
+    vector : bool, optional
+        Whether the argument is a vector of three coordinates (last axis), which a
+        representation can stand for.
+
+    Returns
+    -------
+    Any
+        One Quantity for the forms above; anything else as given.
+
+    Raises
+    ------
+    ValueError
+        For a list whose items do not join into one Quantity (another dimension, a
+        plain number or a string beside a Quantity), naming the argument and the
+        value.
+
+    Examples
+    --------
+    >>> as_quantity("a", [7000 * u.km, 1 * u.Mm])
+    <Quantity [7000., 1000.] km>
+    >>> as_quantity("a", [1.0, 2.0])
+    [1.0, 2.0]
+    >>> as_quantity("a", [7000 * u.km, 2.0])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `a` to be values of one dimension, each with its unit, got [...]
+    """
+    if isinstance(value, list | tuple) and _holds_quantity(value):
+        try:
+            return _joined(value)
+        except (TypeError, ValueError):  # UnitConversionError included
+            raise ValueError(f"Expected `{name}` to be values of one dimension, each with "
+                             f"its unit, got {value!r}") from None
+    coordinates = sys.modules.get("astropy.coordinates") if vector else None
+    if coordinates is not None:  # (not imported: no representation was given)
+        if isinstance(value, coordinates.BaseRepresentation):
+            return value.to_cartesian().get_xyz(xyz_axis=-1)
+        if isinstance(value, coordinates.CartesianDifferential):
+            return value.get_d_xyz(xyz_axis=-1)
+    return value
+
+
+def _holds_quantity(items: list | tuple) -> bool:
+    """Whether a list or tuple holds a Quantity, at any depth."""
+    return any(is_quantity(x) or (isinstance(x, list | tuple) and _holds_quantity(x))
+               for x in items)
+
+
+def _joined(items: list | tuple):
+    """One Quantity of nested lists (``u.Quantity`` joins one level only)."""
+    return u.Quantity([_joined(x) if isinstance(x, list | tuple) else x for x in items])
+
+
+def time_quantity(value: Any) -> Any:
+    """``value``, an astropy TimeDelta made the time Quantity in days it holds.
+
+    A duration is taken as a time Quantity or as astropy's own duration type, a
+    :class:`~astropy.time.TimeDelta` (scalar or array): the public functions that
+    take a duration pass it through here first, once, so that a TimeDelta is then
+    accepted, converted and refused exactly as the Quantity in days it equals
+    (refused beside a system of plain floats, as a Quantity is).  ``value.to(u.day)``
+    keeps its precision (the sum of its two doubles of days, rounded once).
+
+    Parameters
+    ----------
+    value : Any
+        What the caller gave for a duration.
+
+    Returns
+    -------
+    Any
+        A TimeDelta as a Quantity in days; anything else as given (without importing
+        astropy.time: a caller that has not imported it cannot have given a TimeDelta).
+
+    Examples
+    --------
+    >>> from astropy.time import TimeDelta
+    >>> time_quantity(TimeDelta(1800.0, format="sec"))
+    <Quantity 0.02083333 d>
+    >>> time_quantity(TimeDelta([0.0, 1.5], format="jd"))
+    <Quantity [0. , 1.5] d>
+    >>> time_quantity(2.0)
+    2.0
+    """
+    time = sys.modules.get("astropy.time")
+    delta = None if time is None else getattr(time, "TimeDelta", None)
+    if delta is not None and isinstance(value, delta):
+        return value.to(u.day)
+    return value
 
 
 class Kind:

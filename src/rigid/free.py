@@ -31,7 +31,14 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import ANGULAR_SPEED, INERTIA, TIME, require_consistent, wrap
+from hamilton_orbits.units import (
+    ANGULAR_SPEED,
+    INERTIA,
+    TIME,
+    require_consistent,
+    time_quantity,
+    wrap,
+)
 from rigid._kernels import free as _fk
 from rigid._shared import free_flow_scaled, free_setup_scaled
 from rigid.body import RigidBody, call_units, check_body, check_moments, unit_quaternion
@@ -67,8 +74,9 @@ def free_motion_arrays(
         Initial attitude, scalar first, body to space; normalised on input.
     omega0 : array_like or Quantity, shape (3,), rad/s
         Initial body-frame angular velocity.
-    t : array_like or Quantity, shape (n,) or any shape, s
-        Times since the initial state (plain floats: the time unit of ``omega0``).
+    t : array_like, Quantity or TimeDelta, shape (n,) or any shape, s
+        Times since the initial state (plain floats: the time unit of ``omega0``;
+        a TimeDelta: the Quantity in days it holds).
 
     Returns
     -------
@@ -105,6 +113,7 @@ def free_motion_arrays(
     >>> print((moments * w**2).sum(axis=-1).round(14))  # 2T is conserved
     [3.1 3.1 3.1]
     """
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = require_consistent(("moments", "omega0", "t"), (moments, omega0, t))
     moments, q0, omega0 = _check_state(moments, q0, omega0)
     t_arr = TIME("t", t)
@@ -143,8 +152,9 @@ def free_motion(body: RigidBody, t: Any) -> FreeMotion:
     ----------
     body : RigidBody
         Moments, initial attitude and initial body angular velocity.
-    t : array_like or Quantity, any shape, s
-        Times since the body's state.  A Quantity gives omega in rad/s back.
+    t : array_like, Quantity or TimeDelta, any shape, s
+        Times since the body's state.  A Quantity (or a TimeDelta, the Quantity
+        in days it holds) gives omega in rad/s back.
 
     Returns
     -------
@@ -195,6 +205,7 @@ def free_motion(body: RigidBody, t: Any) -> FreeMotion:
      [1.  0.6 2.4]]
     """
     body = check_body(body)
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = call_units(body, ("t",), (t,))
     t_arr = TIME("t", t)
     flat = np.ascontiguousarray(t_arr.reshape(-1))

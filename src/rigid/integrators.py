@@ -81,7 +81,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import DIMENSIONLESS, TIME, wrap
+from hamilton_orbits.units import DIMENSIONLESS, TIME, time_quantity, wrap
 from hamilton_orbits.validation import ConvergenceError, check_positive
 from rigid._kernels import euler as _euler_k
 from rigid._shared import free_scale, pow2
@@ -235,15 +235,16 @@ def integrate(
     ----------
     body : RigidBody
         Initial state: ``moments`` (3,), ``attitude`` (Quaternion), ``omega`` (3,).
-    t : float, array_like or Quantity
+    t : float, array_like, Quantity or TimeDelta
         An end time (> 0; 101 equally spaced outputs from 0 to it), or the output
         times from the body's state, shape (n,), strictly increasing (a start at
         0 is added if missing).  s for plain floats; a Quantity if ``body`` was
-        built from Quantities.
+        built from Quantities (an astropy TimeDelta is the Quantity in days it
+        holds).
     method : str, optional
         One of ``METHODS`` (see the module docstring).  Default
         ``"splitting4"``.
-    dt : float or Quantity, optional
+    dt : float, Quantity or TimeDelta, optional
         Step of the fixed-step methods (required for them), rounded down so that
         a whole number of steps spans the last time; for ``"dop853"`` a cap on
         the step.  A Quantity exactly when ``t`` is one.
@@ -322,6 +323,7 @@ def integrate(
     """
     body = check_body(body)
     t, n_out, rtol, atol = _deprecated(t, t_end, n_out, rtol, atol, tol)
+    t, dt = time_quantity(t), time_quantity(dt)  # (a TimeDelta: the Quantity in days)
     si = body.si
     # a body whose I omega^2 or I omega leaves float64 is refused here
     _ = (si.kinetic_energy, si.angular_momentum_norm)

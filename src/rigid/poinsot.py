@@ -18,7 +18,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
-from hamilton_orbits.units import TIME, wrap
+from hamilton_orbits.units import TIME, time_quantity, wrap
 from rigid._shared import free_flow_scaled
 from rigid.body import RigidBody, call_units, check_body
 
@@ -71,8 +71,9 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     ----------
     body : RigidBody
         Not at rest.
-    t : array_like (n,) or Quantity, s
-        A Quantity if ``body`` was built from Quantities.
+    t : array_like (n,), Quantity or TimeDelta, s
+        A Quantity if ``body`` was built from Quantities (a TimeDelta is the
+        Quantity in days it holds).
 
     Returns
     -------
@@ -96,6 +97,7 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     0.659843359
     """
     body = check_body(body)
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = call_units(body, ("t",), (t,))
     normal = body.invariable_plane
     t_s = TIME("t", t)  # validated, in seconds for the computation

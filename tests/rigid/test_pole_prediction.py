@@ -322,6 +322,23 @@ def test_bad_horizon(record, horizon, match):
         predict(record, at=AT, horizon=horizon)
 
 
+def test_horizon_and_latency_may_be_timedeltas(record):
+    from astropy.time import TimeDelta
+
+    a = predict(record, at=AT, horizon=TimeDelta(30, format="jd"), method="ls",
+                latency=TimeDelta(2, format="jd"))
+    b = predict(record, at=AT, horizon=30 * u.day, method="ls", latency=2 * u.day)
+    for name in ("x", "y", "sigma_x", "sigma_y"):  # bit for bit
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    starts = ["2019-01-01", "2019-01-08"]
+    h = hindcast(record, starts, TimeDelta([10, 20], format="jd"), method="ls")
+    k = hindcast(record, starts, [10, 20] * u.day, method="ls")
+    np.testing.assert_array_equal(h.errors_x, k.errors_x)
+    with pytest.raises(ValueError, match=r"`horizon` in whole days from 0 d to 3651 d, "
+                                         r"got 10.5 d"):
+        predict(record, at=AT, horizon=TimeDelta(10.5, format="jd"))
+
+
 def test_bad_horizons_latency_starts_and_record(record):
     starts = weekly_starts("2019-01-01", "2019-02-01")
     with pytest.raises(ValueError, match=r"`horizons` in whole days from 0 d to 3651 d, "

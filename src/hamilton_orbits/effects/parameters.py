@@ -76,6 +76,7 @@ __all__ = [
     "speed_of_light",
     "unit_example",
     "unit_vector",
+    "with_units",
 ]
 
 C_AU_PER_DAY = 299792458.0 * 86400.0 / 149597870700.0  # IAU 2012 au, SI c and day
@@ -124,9 +125,46 @@ def _shown(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _with_units(value: Any, key: str, effect: str, kind: Kind) -> Any:
+def with_units(value: Any, key: str, where: str, kind: Kind) -> Any:
     """``value`` with a string read as a Quantity (``"6378 km"``), and a list holding
-    Quantities or strings as one Quantity array."""
+    Quantities or strings as one Quantity array; anything else as given.
+
+    The one reader of the unit strings that the mappings of effects, events and
+    ``small_bodies.propagate(nongrav=...)`` take; the caller then converts the
+    result as it converts a Quantity (its dimension checked there).
+
+    Parameters
+    ----------
+    value : Any
+        The value given.
+    key : str
+        Its name, for messages.
+    where : str
+        What the messages begin with (``"Effect 'gr'"``).
+    kind : Kind
+        The kind expected, for the example in a message.
+
+    Returns
+    -------
+    Any
+        A Quantity for a string or a list holding strings or Quantities, else
+        ``value``.
+
+    Raises
+    ------
+    ValueError
+        For a string that is not a number with a unit, and a list of values that
+        do not join into one Quantity, naming ``where``, the key and the value.
+
+    Examples
+    --------
+    >>> with_units("0.1 au", "distance", "Event 0", LENGTH)
+    <Quantity 0.1 AU>
+    >>> with_units("0.1 auu", "distance", "Event 0", LENGTH)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Event 0: cannot read `distance` = '0.1 auu' as a number with a unit (e.g. ...)
+    """
     import astropy.units as u
 
     def one(x: Any) -> Any:
@@ -135,7 +173,7 @@ def _with_units(value: Any, key: str, effect: str, kind: Kind) -> Any:
         try:
             return u.Quantity(x)
         except (TypeError, ValueError):
-            raise ValueError(f"Effect {effect!r}: cannot read `{key}` = {value!r} as a number "
+            raise ValueError(f"{where}: cannot read `{key}` = {value!r} as a number "
                              f"with a unit (e.g. '{unit_example(kind)}')") from None
 
     if isinstance(value, str):
@@ -145,7 +183,7 @@ def _with_units(value: Any, key: str, effect: str, kind: Kind) -> Any:
         try:
             return u.Quantity([one(x) for x in value])
         except (TypeError, ValueError):  # UnitConversionError included
-            raise ValueError(f"Effect {effect!r}: expected `{key}` to be values of one "
+            raise ValueError(f"{where}: expected `{key}` to be values of one "
                              f"dimension, each with its unit, got {_shown(value)}") from None
     return value
 
@@ -183,7 +221,7 @@ def parameter_array(system: Any, params: Mapping[str, Any], key: str, effect: st
         return None
     value = params[key]
     if kind is not DIMENSIONLESS:
-        value = _with_units(value, key, effect, kind)
+        value = with_units(value, key, f"Effect {effect!r}", kind)
     if kind is ANGLE:
         unit = "deg"  # the parameter's name says degrees (inclination_deg)
     elif kind is DIMENSIONLESS:

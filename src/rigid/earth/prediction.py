@@ -45,7 +45,7 @@ import numpy as np
 from astropy.table import QTable
 from astropy.time import Time
 
-from hamilton_orbits.units import TIME
+from hamilton_orbits.units import TIME, time_quantity
 from rigid.earth.forecasters import (
     METHODS,
     fitted_parameters,
@@ -125,7 +125,8 @@ def _check_record(record: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _whole_days(name: str, value: Any, *, minimum: int, maximum: int,
                 single: bool = False, note: str = "") -> np.ndarray:
-    """A time (Quantity or days) as whole days in [minimum, maximum] (int array)."""
+    """A time (Quantity or TimeDelta) as whole days in [minimum, maximum] (int array)."""
+    value = time_quantity(value)  # (a TimeDelta: the Quantity in days it holds)
     if not isinstance(value, u.Quantity):
         raise ValueError(f"Expected `{name}` to be a time Quantity (e.g. 365 * u.day), "
                          f"got {value!r}")
@@ -258,11 +259,11 @@ def predict(
     at : Time or str
         The start date (0h UTC), e.g. ``"2019-01-01"``.  Only epochs up to
         ``at - latency`` are used.
-    horizon : Quantity
+    horizon : Quantity or TimeDelta
         Whole days >= 0.
     method : {"persistence", "ls", "ls+ar", "ls+var", "liouville"}
         See the module docstring.
-    latency : Quantity
+    latency : Quantity or TimeDelta
         Age of the newest datum at ``at``; whole days >= 1 (default 1 day).
 
     Returns
@@ -444,11 +445,11 @@ def hindcast(
         Start dates (0h UTC).  Default: weekly over ``PAPER_PERIOD`` (the 1st EOP
         PCC's Oct 2005 - Mar 2008, assumed for Lei et al. 2023); the second period is
         ``weekly_starts(*RECENT_PERIOD)`` (``rigid.earth.prediction.weekly_starts``).
-    horizons : Quantity
+    horizons : Quantity or TimeDelta
         Whole days >= 0 (default 10, 30, 90, 150, 270, 365 d).
     method : str
         One of ``METHODS``.
-    latency : Quantity
+    latency : Quantity or TimeDelta
         Age of the newest datum at each start (default 1 day).
 
     Returns

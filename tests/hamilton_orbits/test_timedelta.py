@@ -1,0 +1,136 @@
+"""An astropy TimeDelta is taken wherever a time Quantity is: converted once at the
+boundary (units.time_quantity) to the Quantity in days it holds, it gives the bits of
+that Quantity, and beside plain floats it is refused with the Quantity's message."""
+
+import re
+
+import astropy.units as u
+import numpy as np
+import pytest
+from astropy.time import Time, TimeDelta
+
+from hamilton_orbits import Body, KeplerOrbit, Simulation, System, integrate, kepler
+from hamilton_orbits.archive import Archive
+
+GM_SUN = 1.32712440018e11 * u.km**3 / u.s**2
+
+
+def _system() -> System:
+    return System([Body("sun", GM_SUN, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
+                   Body("p", 1e-6 * GM_SUN, [1, 0, 0] * u.au, [0, 29.78, 0] * u.km / u.s)])
+
+
+def _plain() -> System:
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                   Body("p", 1e-6, [1.0, 0, 0], [0, 1.0, 0])])
+
+
+def _same(a, b) -> None:
+    """Equal bit for bit, in the same unit."""
+    assert getattr(a, "unit", None) == getattr(b, "unit", None)
+    np.testing.assert_array_equal(np.asarray(getattr(a, "value", a)),
+                                  np.asarray(getattr(b, "value", b)))
+
+
+def test_time_quantity_is_the_quantity_in_days_and_leaves_the_rest():
+    from hamilton_orbits.units import time_quantity
+
+    q = time_quantity(TimeDelta([0.0, 1.5, 365.25], format="jd"))
+    assert q.unit == u.day
+    np.testing.assert_array_equal(q.value, [0.0, 1.5, 365.25])
+    # both doubles of a TimeDelta summed: a second in days as 1/86400 rounds it
+    assert time_quantity(TimeDelta(1.0, format="sec")).value == 1.0 / 86400.0
+    for other in (2.0, 3.0 * u.s, "1 d", None, Time("J2000")):
+        assert time_quantity(other) is other
+
+
+def test_integrate_and_simulation_take_a_timedelta_as_the_quantity_in_days():
+    s = _system()
+    for t in (TimeDelta(365.25, format="jd"), TimeDelta([10.0, 200.0, 365.25], format="jd")):
+        q = t.jd * u.day
+        a, b = integrate(s, t), integrate(s, q)
+        _same(a.t, b.t), _same(a.r, b.r), _same(a.v, b.v)
+        a = Simulation(s, method="wh", dt=TimeDelta(1.0, format="jd")).integrate(t)
+        b = Simulation(s, method="wh", dt=1.0 * u.day).integrate(q)
+        _same(a.t, b.t), _same(a.r, b.r)
+
+
+def test_an_archive_takes_every_as_a_timedelta(tmp_path):
+    s, kw = _system(), dict(method="wh", dt=1.0 * u.day)
+    Simulation(s, archive=tmp_path / "td", every=TimeDelta(30.0, format="jd"),
+               **kw).integrate(100.0 * u.day)
+    Simulation(s, archive=tmp_path / "q", every=30.0 * u.day, **kw).integrate(100.0 * u.day)
+    a, b = Archive(tmp_path / "td"), Archive(tmp_path / "q")
+    np.testing.assert_array_equal(a.times, [0.0, 30.0, 60.0, 90.0])
+    np.testing.assert_array_equal(a.times, b.times)
+
+
+def test_crosscheck_takes_a_timedelta():
+    pytest.importorskip("rebound")
+    from hamilton_orbits import crosscheck
+
+    s = _system()
+    a = crosscheck(s, TimeDelta(100.0, format="jd"), method="dop853", tol=1e-12)
+    b = crosscheck(s, 100.0 * u.day, method="dop853", tol=1e-12)
+    _same(a.relative_position_difference, b.relative_position_difference)
+    # a trajectory checked against its end given as a TimeDelta
+    traj = integrate(s, 100.0 * u.day, method="dop853", tol=1e-12)
+    c = crosscheck(s, TimeDelta(100.0, format="jd"), method="dop853", trajectory=traj)
+    _same(c.relative_position_difference, b.relative_position_difference)
+
+
+def test_kepler_propagation_takes_a_timedelta():
+    o = KeplerOrbit.from_elements(a=7000 * u.km, e=0.1, inc=98 * u.deg, lan=10 * u.deg,
+                                  argp=20 * u.deg, M=0 * u.deg,
+                                  mu=398600.4418 * u.km**3 / u.s**2)
+    td = TimeDelta([0.0, 0.0625, 0.5], format="jd")
+    (r, v), (rq, vq) = o.propagate(td).state(), o.propagate([0.0, 0.0625, 0.5] * u.day).state()
+    _same(r, rq), _same(v, vq)
+    r0, v0 = o.state()
+    r, v = kepler.propagate(r0, v0, 398600.4418 * u.km**3 / u.s**2, td)
+    rq, vq = kepler.propagate(r0, v0, 398600.4418 * u.km**3 / u.s**2,
+                              [0.0, 0.0625, 0.5] * u.day)
+    _same(r, rq), _same(v, vq)
+
+
+def test_accelerations_at_a_timedelta():
+    s = _system()
+    _same(s.accelerations(effects=["gr"], t=TimeDelta(3.0, format="jd")),
+          s.accelerations(effects=["gr"], t=3.0 * u.day))
+
+
+def _message(call, value):
+    with pytest.raises(ValueError) as info:
+        call(value)
+    return str(info.value)
+
+
+@pytest.mark.parametrize("call", [
+    lambda t: integrate(_plain(), t),
+    lambda t: Simulation(_plain(), method="wh", dt=t),
+    lambda t: Simulation(_plain(), method="wh", dt=0.1, archive="unused", every=t),
+    lambda t: KeplerOrbit.from_elements(a=1.0, e=0.1, inc=0.1, lan=0.2, argp=0.3, M=0.4,
+                                        mu=1.0).propagate(t),
+], ids=["integrate", "dt", "every", "propagate"])
+def test_beside_plain_floats_a_timedelta_is_refused_as_the_quantity(call, tmp_path,
+                                                                   monkeypatch):
+    monkeypatch.chdir(tmp_path)  # (an archive folder is never made: refused before)
+    got = _message(call, TimeDelta(2.0, format="jd"))
+    assert got == _message(call, 2.0 * u.day)
+    assert re.search(r"plain floats?|a Quantity exactly when", got)
+    assert not (tmp_path / "unused").exists()
+
+
+def test_small_bodies_propagate_takes_a_timedelta():
+    from hamilton_orbits.small_bodies import propagate
+    from hamilton_orbits.spk import EXCERPT, Segments
+
+    kw = dict(ephemeris=Segments.load(EXCERPT), asteroids=False)
+    r0, v0 = [2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.d
+    epoch = Time("2000-01-01T12:00:00", scale="tdb")
+    a = propagate(r0, v0, epoch, TimeDelta([10.0, 30.0], format="jd"), **kw)
+    b = propagate(r0, v0, epoch, [10.0, 30.0] * u.day, **kw)
+    _same(a.r, b.r), _same(a.v, b.v)
+    with pytest.raises(ValueError, match=r"a time Quantity, a TimeDelta or an astropy Time, "
+                                         r"got 30\.0"):
+        propagate(r0, v0, epoch, 30.0, **kw)
