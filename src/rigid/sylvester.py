@@ -328,7 +328,8 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     ValueError
         If the two states are not on one polhode (relative mismatch of ``T`` or
         ``|L|`` above 1e-10), or the motion is steady or on the separatrix beyond
-        reach (``omega2`` not after ``omega1``).
+        reach (``omega2`` not after ``omega1``, or on another of its heteroclinic
+        arcs: one of them is never reached from another).
 
     Examples
     --------
@@ -384,6 +385,13 @@ def time_between(body: RigidBody, omega1: Any, omega2: Any) -> Any:
     du = p2[_fk.U0] - p1[_fk.U0]
     if kind == 1.0:
         dt = float(np.mod(du, 4.0 * p1[_fk.K]) / p1[_fk.LAM])
+    elif np.sign(p2[_fk.A]) != np.sign(p1[_fk.A]):
+        # the separatrix is four heteroclinic arcs; on each omega_W1 = a sech(u) keeps
+        # the sign of a (Landau & Lifshitz, Mechanics §37): the other arc is never reached
+        raise ValueError(
+            f"Expected `omega2` on the arc of the separatrix of `omega1` (reached from it), "
+            f"got {omega2!r} on another arc, never reached from `omega1` = {omega1!r}"
+        )
     elif du < 0.0:
         raise ValueError(
             f"Expected `omega2` after `omega1` on the separatrix, got it before ({omega2!r})"

@@ -554,3 +554,105 @@ def test_free_motion_is_a_named_result():
     q, w = free_motion_arrays(body.moments, body.attitude, body.omega, t)
     np.testing.assert_array_equal(motion.attitude.as_array(), q)
     np.testing.assert_array_equal(motion.omega.value, w.value)
+
+
+# --- a spin about the intermediate axis with a tiny perturbation (separatrix limit) -------
+
+
+def _intermediate_axis_reference(eps):
+    """``(K, lambda, k', c)`` at 50 digits for moments (1, 2, 3), omega = (0, 1, eps).
+
+    Landau & Lifshitz, Mechanics §37 (and docs/free_rigid_body.md §2): L^2 - 2TB = 3 eps^2,
+    L^2 - 2TA = 2 + 6 eps^2, 2TC - L^2 = 2, so m1 = 1 - m = 6 eps^2 / (2 + 6 eps^2),
+    lambda^2 = (2 + 6 eps^2) / 6, a = b = 1, c^2 = (2 + 6 eps^2) / 6; K = R_F(0, m1, 1)
+    (DLMF 19.25.1) with mpmath's exponent range (m1 = 3e-600 for eps = 1e-300).
+    """
+    with mpmath.workdps(50):
+        e = mpmath.mpf(eps)
+        m1 = 6 * e**2 / (2 + 6 * e**2)
+        lam = mpmath.sqrt((2 + 6 * e**2) / 6)
+        return mpmath.elliprf(0, m1, 1), lam, mpmath.sqrt(m1), lam
+
+
+@pytest.mark.parametrize("eps", [1e-19, 5.8e-21, 5.7e-21, 1e-149, 1e-151, 1e-160, 1e-300])
+def test_tiny_perturbation_of_the_intermediate_axis_flips(eps):
+    # A spin (0, 1, eps) on moments (1, 2, 3) leaves the unstable middle axis like
+    # eps e^{lambda t} and flips: omega_2 = b sn(K + lambda t) (L&L §37).  Below
+    # |omega_3 / omega_2| ~ 3e-150 it was taken as steady (kind "steady", period inf,
+    # omega_2 never flipping), because 1 - m = 3 eps^2 underflows; the kernel now takes
+    # k' = sqrt(1 - m) itself and, for k' < 1e-20, K = ln(4/k') (A&S 17.3.26).  The eps
+    # straddle that switch (k' = sqrt(3) eps = 1e-20) and the underflow of m1.
+    moments = np.array([1.0, 2.0, 3.0])
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    w0 = np.array([0.0, 1.0, eps])
+    kk, lam, kp, c = _intermediate_axis_reference(eps)
+    par = free_parameters(RigidBody(moments, q0, w0))
+    assert par.kind == "periodic" and par.polar_axis == 2
+    # K = ln(4/k') from the logarithms of k''s factors (|ln k'| <= 746), lambda from a
+    # square root: measured within 2 ulp of the period; 8 ulp leave room.
+    assert abs(par.period / float(4 * kk / lam) - 1.0) <= 8 * EPS
+    # omega at u = K (1 + j/2), j = 1..4, from u0 = K: sn, cn, dn at K/2 are
+    # (1 + k')^-1/2, (k' / (1 + k'))^1/2, k'^1/2 (DLMF Table 22.5.2), shifted by K
+    # (sn(K + v) = cd v, cn(K + v) = -k' sd v, dn(K + v) = k' nd v: DLMF Table 22.4.3).
+    with mpmath.workdps(50):
+        h = 1 / mpmath.sqrt(1 + kp)
+        refs = [(-mpmath.sqrt(kp) * h, h, c * mpmath.sqrt(kp)), (-1, 0, c),
+                (-mpmath.sqrt(kp) * h, -h, c * mpmath.sqrt(kp)), (0, -1, c * kp)]
+        t = np.array([float(j * kk / (2 * lam)) for j in (1, 2, 3, 4)])
+    refs = np.array([[float(x) for x in r] for r in refs])
+    _, w = free_motion_arrays(moments, q0, w0, t)
+    # The phase u = K + lambda t <= 3K (<= 2100) is rounded to ~u eps, and at these
+    # points |d ln omega_i / du| <= 1 for each nonzero component: measured 2e-13 at
+    # eps = 1e-300; 4 u eps.  A zero one moves by du times its slope: b dn = 1 for
+    # omega_2 at 2K, a k' for omega_1 at 3K (cn(3K + du) = k' sd du).
+    tol = 4.0 * float(3 * kk) * EPS
+    nonzero = refs != 0.0
+    assert np.all(np.abs(w[nonzero] / refs[nonzero] - 1.0) <= tol)
+    assert abs(w[1, 1]) <= tol and abs(w[3, 0]) <= tol * float(kp)
+
+
+def test_tiny_perturbation_of_the_intermediate_axis_other_family():
+    # (eps, 1, 0): L^2 - 2TB = -eps^2 < 0, the polhode encircles the smallest axis (the
+    # second family, form B of the precession).  After half a period, u0 + 2K, the
+    # components along the middle axis and the polar (smallest) one have come back
+    # with omega_2 reversed: (eps, -1, 0) (sn(u + 2K) = -sn u, dn(u + 2K) = dn u).
+    moments = np.array([1.0, 2.0, 3.0])
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    for eps in (1e-151, 1e-300):
+        w0 = np.array([eps, 1.0, 0.0])
+        par = free_parameters(RigidBody(moments, q0, w0))
+        assert par.kind == "periodic" and par.polar_axis == 0
+        _, w = free_motion_arrays(moments, q0, w0, [par.flip_interval])
+        # the phase 3K ~ 2100 rounded to ~u eps, as above
+        assert abs(w[0, 0] / eps - 1.0) < 2e-12 and abs(w[0, 1] + 1.0) < 2e-12
+        assert abs(w[0, 2]) < 2e-12 * eps
+
+
+def test_intermediate_axis_separatrix_limit_attitude_against_high_precision():
+    # The separatrix-limit branch (k' < 1e-20) for the attitude too: the precession
+    # angle's third-kind integral in its m = 1 form, both families (forms A and B),
+    # past the flip (u = K + 1.2 K: the complete part and both reduced ranges), against
+    # mpmath's Taylor integration at 20 digits (exact to the digits asked for).
+    moments = np.array([1.0, 2.0, 3.0])
+    q0 = np.array([0.8, 0.2, -0.4, 0.4])
+    for w0 in (np.array([0.0, 1.0, 5.7e-21]), np.array([5.7e-21, 1.0, 0.0])):
+        t = np.array([0.6 * free_parameters(RigidBody(moments, q0, w0)).flip_interval])
+        q, w = free_motion_arrays(moments, q0, w0, t)
+        qr, wr = _mp_reference(moments, q0, w0, t, dps=20)
+        # measured 4e-15: the angle turned (~100 rad) times eps, a decade of room
+        assert np.abs(w - wr).max() < 1e-13 and qdist(q, qr).max() < 1e-13
+
+
+def test_exact_kick_leaves_the_intermediate_axis():
+    # exact_kick's drift is the exact flow: it took (0, 1, 1e-151) as steady and never
+    # flipped; it now matches the exact flow through the flip (t = K / lambda, half of
+    # the flip interval).  60 000 steps, each re-deriving the motion from a rounded
+    # state: ~n eps relative in the departure, amplified at the saddle; measured 1e-9.
+    from rigid import integrate
+
+    body = RigidBody([1.0, 2.0, 3.0], omega=[0.0, 1.0, 1e-151])
+    t = 0.5 * free_parameters(body).flip_interval
+    tr = integrate(body, [0.0, t], method="exact_kick", dt=0.01)
+    _, w = free_motion(body, [t])
+    assert abs(w[0, 1]) < 1e-3  # the middle of the flip
+    assert np.abs(tr.omega[-1] - w[0]).max() < 1e-6

@@ -166,3 +166,27 @@ def test_time_between_on_separatrix():
     assert abs(time_between(body, body.omega, w) - 3.0) < 1e-12
     with pytest.raises(ValueError, match="after `omega1`"):
         time_between(body, w, body.omega)
+
+
+def test_time_between_refuses_another_arc_of_the_separatrix():
+    # Body (2, 5, 6), omega1 = (1, 0.5, 1): L^2 = 46.25 = 2 T B exactly (the separatrix).
+    # On it omega_1 = a sech(tau), omega_2 = b tanh(tau), omega_3 = c sech(tau) (Landau &
+    # Lifshitz, Mechanics §37): omega_1 keeps its sign, so the states with omega_1 = -1
+    # (same T and |L|) lie on another heteroclinic arc and are never reached.  The first
+    # was answered 0.0 s, the second refused as "before" omega1.
+    body = RigidBody([2.0, 5.0, 6.0], omega=[1.0, 0.5, 1.0])
+    assert free_parameters(body).kind == "separatrix"
+    for w2 in ([-1.0, -0.5, 1.0], [-1.0, 0.5, 1.0]):
+        with pytest.raises(ValueError, match=r"`omega2` on the arc of the separatrix of "
+                                             r"`omega1`.*on another arc, never reached"):
+            time_between(body, body.omega, w2)
+    # on the same arc: the time from sinh(u) = (omega_2 / b) / (omega_1 / a), with
+    # a^2 = (2T C - L^2) / (A (C - A)) = 9.25 / 8, b^2 = (2T C - L^2) / (B (C - B)) = 9.25 / 5,
+    # lambda^2 = (C - B)(L^2 - 2 T A) / (A B C) = 27.75 / 60 (L&L §37): omega1 -> (1, -0.5, 1)
+    # goes from u0 to -u0, backwards (refused), and (1, -0.5, 1) -> omega1 takes
+    # 2 asinh(0.5 sqrt(5/8)) / lambda.
+    with pytest.raises(ValueError, match="got it before"):
+        time_between(body, body.omega, [1.0, -0.5, 1.0])
+    expected = 2.0 * np.arcsinh(0.5 * np.sqrt(0.625)) / np.sqrt(27.75 / 60.0)
+    got = time_between(body, [1.0, -0.5, 1.0], body.omega)
+    assert abs(got - expected) <= 1e-14 * expected  # a few ulp of asinh and sqrt

@@ -22,6 +22,9 @@ J3 the axis the polhode encircles, omega_W3 >= 0).  The slot indices below are
 public: the callers (:mod:`rigid.free`, :mod:`rigid.sylvester`) read
 ``prm[KIND]``, ``prm[P:P + 9]``, ``prm[LAM]``, ``prm[K]``, ``prm[M]``, ``prm[M1]``,
 ``prm[N]`` and ``prm[U0]``; a slot's meaning is part of this module's contract.
+Near the intermediate axis (``k' = sqrt(m1) < 1e-20``, slot ``KP``) the periodic
+motion is evaluated in the separatrix limit (:func:`jacobi_limit`; ``M1`` may then
+underflow to 0 while ``KP`` and ``K`` stay exact).
 The rates (``LAM``, ``L``) are in the time unit of the ``omega`` given.
 """
 
@@ -61,7 +64,17 @@ SB = 36  # sign of b (= sign(J3 - J1))
 W0 = 37  # 3 entries: omega in the body frame (steady case)
 Q0 = 40  # 4 entries: q0 (steady case)
 FORM = 44  # 1: secular (L/J3) t + coef Pi (J3 > J1); 0: (L/J1) t + coef (Pi - u)
-NPARAM = 45
+KP = 45  # k' = sqrt(m1), computed without underflow (m1 itself may underflow)
+NPARAM = 46
+
+# Below this k' (m1 < 1e-40) the periodic motion is evaluated in the separatrix limit
+# (A&S 16.15, 17.3.26): sn = tanh, cn = dn = sech for |r| <= K/2 and the reflection
+# sn = 1, cn = k' sinh v, dn = k' cosh v beyond (v = K - |r|), K = ln(4/k'), Pi from its
+# m = 1 form.  The neglected terms are of relative size m1 e^{2|r|} / 16 <= k' / 4
+# (below 2.5e-21, under the rounding of float64); the general formulas would need
+# m1 = k'^2, which underflows for a spin within ~1e-154 of the intermediate axis.
+_KP_LIMIT = 1e-20
+_LN4 = math.log(4.0)
 
 _R = 2.0**-53
 _QF = (3.0 * _R) ** (-1.0 / 6.0)
@@ -271,6 +284,35 @@ def jacobi_reduced(r, m, m1, kk):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def jacobi_limit(r, kp, kk):  # pragma: no cover - compiled
+    """``sn, cn, dn`` of ``|r| <= K`` (``kk`` = K(m)) for ``k' = sqrt(1 - m) < 1e-20``.
+
+    The separatrix limit (A&S 16.15.1-16.15.3 to first order in ``m1 = k'^2``):
+    ``sn = tanh r``, ``cn = dn = sech r`` for ``|r| <= K/2``, and beyond it the
+    quarter-period reflection (DLMF 22.4.iii) of those, ``sn = 1``,
+    ``cn = k' sinh v``, ``dn = k' cosh v`` with ``v = K - |r|``: relative errors of
+    at most ``m1 e^{2 min(|r|, v)} / 16 <= k' / 4``, and ``k'`` is passed itself
+    (``m1`` underflows below ``k' ~ 1e-154``).
+    """
+    v = abs(r)
+    if v <= 0.5 * kk:
+        e = math.exp(-v)
+        s = math.tanh(v)
+        c = 2.0 * e / (1.0 + e * e)
+        d = c
+    else:
+        w = kk - v
+        if w < 0.0:  # rounding at the upper edge
+            w = 0.0
+        s = 1.0
+        c = kp * math.sinh(w)
+        d = kp * math.cosh(w)
+    if r < 0.0:
+        s = -s
+    return s, c, d
+
+
+@njit(cache=True)
 def ellipk_m1(m1):  # pragma: no cover - compiled
     """``K(m)`` from the complementary parameter ``m1 = 1 - m`` (DLMF 19.25.1)."""
     return carlson_rf(0.0, m1, 1.0)
@@ -365,13 +407,28 @@ def _periodic_at(prm, u):  # pragma: no cover - compiled
     r = u - 2.0 * kk * k
     if r > kk:  # rounding at the upper edge
         r = kk
-    s, c, d = jacobi_reduced(r, prm[M], prm[M1], kk)
+    limit = prm[KP] < _KP_LIMIT
+    if limit:
+        s, c, d = jacobi_limit(r, prm[KP], kk)
+    else:
+        s, c, d = jacobi_reduced(r, prm[M], prm[M1], kk)
     sg = 1.0 if (int(k) & 1) == 0 else -1.0
     w1 = prm[A] * sg * c
     w2 = prm[B] * sg * s
     w3 = prm[C] * d
     n = prm[N]
-    if prm[FORM] == 0.0:
+    if limit:
+        # Pi(n; am r | m) = (r + sqrt(nu) atan(sqrt(nu) tanh r)) / (1 + nu), nu = -n, the
+        # m = 1 form (as in _separatrix_at), to O(k' K) absolute over all |r| <= K (where
+        # sn^2 and tanh^2 both differ from 1 by at most ~k' beyond K/2).
+        nu = -n
+        snu = math.sqrt(nu)
+        th = math.tanh(r)
+        if prm[FORM] == 0.0:
+            pi_u = 2.0 * k * prm[PIC] + (snu * math.atan(snu * th) - nu * r) / (1.0 + nu)
+        else:
+            pi_u = 2.0 * k * prm[PIC] + (r + snu * math.atan(snu * th)) / (1.0 + nu)
+    elif prm[FORM] == 0.0:
         pi_u = 2.0 * k * prm[PIC] + _pi_minus_f(n, s, c, d)
     elif n >= -1.0:
         pi_u = 2.0 * k * prm[PIC] + (r + _pi_minus_f(n, s, c, d))
@@ -405,12 +462,19 @@ def _separatrix_at(prm, u):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _is_steady(moments, w0):  # pragma: no cover - compiled
-    """Whether ``I omega`` is parallel to ``omega`` (sphere, rest, principal axis).
+    """Whether the motion is taken as steady (sphere, rest, principal axis).
 
-    Tested on omega / max|omega| so that nothing underflows, and with a relative
-    threshold of 1e-150: below it the polhode's squared amplitudes (p1, p3 in
-    :func:`_setup_shape`) underflow, while the departure from the steady spin, of
-    relative size 1e-150 * |omega| t, is invisible for any representable time.
+    ``I omega`` parallel to ``omega``, tested on omega / max|omega| so that nothing
+    underflows, with a relative threshold of 1e-150 -- except near the intermediate
+    axis.  Near the largest or the smallest axis (stable) the polhode's squared
+    amplitudes (p1, p3 in :func:`_setup_shape`) would underflow below that threshold,
+    while the true motion stays within a relative 1e-150 of the steady spin (its
+    phase within 1e-150 |omega| t): invisible.  About the intermediate axis (its
+    moment strictly between the others: unstable) a departure ``eps`` grows like
+    ``eps e^{lambda t}`` and the body flips after ``t ~ ln(4 / k') / lambda``
+    (``k' ~ eps``; Landau & Lifshitz, Mechanics §37): there only an exact spin
+    (no cross term at all) is steady, and the rest is periodic, evaluated in the
+    separatrix limit (``_KP_LIMIT``).
     """
     i0, i1, i2 = moments[0], moments[1], moments[2]
     wn = max(abs(w0[0]), abs(w0[1]), abs(w0[2]))
@@ -420,7 +484,72 @@ def _is_steady(moments, w0):  # pragma: no cover - compiled
     cx = (i1 - i2) * s1_ * s2_
     cy = (i2 - i0) * s2_ * s0_
     cz = (i0 - i1) * s0_ * s1_
-    return max(abs(cx), abs(cy), abs(cz)) <= 1e-150 * max(i0, i1, i2)
+    cross = max(abs(cx), abs(cy), abs(cz))
+    if cross == 0.0:
+        return True
+    if cross > 1e-150 * max(i0, i1, i2):
+        return False
+    # the dominant axis: steady unless it is strictly the intermediate one
+    if abs(s0_) == 1.0:
+        j, o1, o2 = i0, i1, i2
+    elif abs(s1_) == 1.0:
+        j, o1, o2 = i1, i2, i0
+    else:
+        j, o1, o2 = i2, i0, i1
+    return not (min(o1, o2) < j < max(o1, o2))
+
+
+_D_FLOOR = 2.0**-900
+
+
+@njit(cache=True)
+def _scaled_d(ja, va, jb, vb, jmid):  # pragma: no cover - compiled
+    """``(D / s^2, s)`` for ``D = Ja va^2 (Ja - Jmid) + Jb vb^2 (Jb - Jmid)``: ``s`` the
+    power of two near the larger amplitude ``|v| sqrt(J |J - Jmid|)`` (exact; a term
+    with no amplitude is 0), so that the larger term is of order one."""
+    fa = math.sqrt(ja * abs(ja - jmid))
+    fb = math.sqrt(jb * abs(jb - jmid))
+    ea = -100000
+    eb = -100000
+    if fa > 0.0 and va != 0.0:
+        ea = math.frexp(va)[1] + math.frexp(fa)[1]
+    if fb > 0.0 and vb != 0.0:
+        eb = math.frexp(vb)[1] + math.frexp(fb)[1]
+    e = max(ea, eb)
+    if e == -100000:
+        return 0.0, 1.0
+    s = math.ldexp(1.0, e)
+    ta = 0.0
+    tb = 0.0
+    if ea != -100000:
+        xa = va / s
+        ta = ja * xa * xa * (ja - jmid)
+    if eb != -100000:
+        xb = vb / s
+        tb = jb * xb * xb * (jb - jmid)
+    return ta + tb, s
+
+
+@njit(cache=True)
+def _kprime(j1, j2, j3, v1, v3, p1):  # pragma: no cover - compiled
+    """``(k', ln k')``: ``k'^2 = m1 = (J3 - J1) D / ((J3 - J2) P1)`` with
+    ``D = J1 v1^2 (J1 - J2) + J3 v3^2 (J3 - J2)``; where ``D`` is below 2^-900 it is
+    taken on ``v / s`` (:func:`_scaled_d`), so that ``k'`` does not underflow where
+    ``m1`` does (a spin within ~1e-154 of the intermediate axis); ``ln k'`` from
+    ``ln s`` and the scaled rest, accurate even when ``k'`` is subnormal."""
+    dm = j1 * v1 * v1 * (j1 - j2) + j3 * v3 * v3 * (j3 - j2)
+    # (the magnitude: D is recomputed here in another order of the products than in
+    # _polar_order, and where it is at the level of its rounding its sign may differ)
+    if abs(dm) >= _D_FLOOR:  # as before: k' = sqrt(m1)
+        kp = math.sqrt(min(abs((j3 - j1) * dm / ((j3 - j2) * p1)), 1.0))
+        return kp, math.log(kp)
+    ds, s = _scaled_d(j1, v1, j3, v3, j2)
+    g2 = abs((j3 - j1) * ds / ((j3 - j2) * p1))
+    if g2 == 0.0:  # D = 0 to rounding, though _polar_order saw it nonzero: the
+        # separatrix to rounding; the smallest k' keeps K finite (ln(4/k') ~ 745)
+        return 5e-324, math.log(5e-324)
+    g = math.sqrt(g2)
+    return s * g, math.log(s) + math.log(g)
 
 
 @njit(cache=True)
@@ -435,8 +564,12 @@ def _polar_order(moments, w0):  # pragma: no cover - compiled
                 idx[b], idx[b + 1] = idx[b + 1], idx[b]
     imin, imid, imax = idx[0], idx[1], idx[2]
     jmin, jmid, jmax = moments[imin], moments[imid], moments[imax]
-    # L^2 - 2 T B, without cancellation beyond its own conditioning.
+    # L^2 - 2 T B, without cancellation beyond its own conditioning; where it is below
+    # 2^-900, on the rates scaled by a power of two (exact) so that its sign survives
+    # near the intermediate axis, where it underflows (only its sign is used).
     d2 = jmin * w0[imin] ** 2 * (jmin - jmid) + jmax * w0[imax] ** 2 * (jmax - jmid)
+    if abs(d2) < _D_FLOOR:
+        d2, _ = _scaled_d(jmin, w0[imin], jmax, w0[imax], jmid)
     kind = 1.0
     if d2 > 0.0 or (d2 == 0.0 and jmid == jmin):
         order = (imin, imid, imax)
@@ -501,7 +634,7 @@ def _setup_shape(prm, kind, j1, j2, j3, v1, v2, v3):  # pragma: no cover - compi
 
 
 @njit(cache=True)
-def _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm):  # pragma: no cover - compiled
+def _setup_periodic(prm, j1, j2, j3, v1, v2, v3, a, b, p1, p3, dm):  # pragma: no cover - compiled
     """Write the slots of a periodic motion; return omega_W, Pi and alpha at ``u0``."""
     nchar = prm[N]
     sb = _sign(j3 - j1)
@@ -511,16 +644,31 @@ def _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm):  # pragma: no co
     m1 = (j3 - j1) * dm / ((j3 - j2) * p1)
     m = min(max(m, 0.0), 1.0)
     m1 = min(max(m1, 0.0), 1.0)
-    kk = ellipk_m1(m1)
-    pic = 0.0  # Pi(n | m) - K(m)
-    if nchar != 0.0:
-        pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
-    if prm[FORM] == 1.0:  # the complete Pi(n | m) itself
-        pic = kk + pic if nchar >= -1.0 else _pi_reduced(nchar, m, 1.0, 0.0, math.sqrt(m1))
+    kp, log_kp = _kprime(j1, j2, j3, v1, v3, p1)
+    if kp < _KP_LIMIT:
+        # the separatrix limit: K = ln(4/k') + (m1/4)(ln(4/k') - 1) + ... (A&S 17.3.26),
+        # ln k' from its unrounded factors; Pi(n | m) = (K + sqrt(nu) atan sqrt(nu)) /
+        # (1 + nu) (the m = 1 form at u = K, nu = -n; see _periodic_at)
+        lk = _LN4 - log_kp
+        kk = lk + 0.25 * m1 * (lk - 1.0)
+        nu = -nchar
+        snu = math.sqrt(nu)
+        if prm[FORM] == 1.0:
+            pic = (kk + snu * math.atan(snu)) / (1.0 + nu)
+        else:
+            pic = (snu * math.atan(snu) - nu * kk) / (1.0 + nu)
+    else:
+        kk = ellipk_m1(m1)
+        pic = 0.0  # Pi(n | m) - K(m)
+        if nchar != 0.0:
+            pic = nchar / 3.0 * carlson_rj(0.0, m1, 1.0, 1.0 - nchar)
+        if prm[FORM] == 1.0:  # the complete Pi(n | m) itself
+            pic = kk + pic if nchar >= -1.0 else _pi_reduced(nchar, m, 1.0, 0.0, math.sqrt(m1))
     prm[A] = a
     prm[B] = sb * b
     prm[M] = m
     prm[M1] = m1
+    prm[KP] = kp
     prm[K] = kk
     prm[PIC] = pic
     prm[RHO] = rho
@@ -531,8 +679,17 @@ def _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm):  # pragma: no co
     h = math.hypot(s0, c0)
     s0 /= h
     c0 /= h
-    dd = m1 + m * c0 * c0
-    f = s0 * carlson_rf(c0 * c0, dd, 1.0)
+    if kp < _KP_LIMIT:
+        # F(phi0 | m) in the separatrix limit (see jacobi_limit): sinh F = |sn / cn| up
+        # to K/2 (cn^2 > k' there), else sinh(K - F) = |cn| / k'
+        ac = abs(c0)
+        if ac * ac > kp:
+            f = _sign(s0) * math.asinh(abs(s0) / ac)
+        else:
+            f = _sign(s0) * (kk - math.asinh(ac / kp))
+    else:
+        dd = m1 + m * c0 * c0
+        f = s0 * carlson_rf(c0 * c0, dd, 1.0)
     if c0 >= 0.0:
         u0 = f
     else:
@@ -606,7 +763,8 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
             prm[P + 3 * i + j] = pm[i, j]
     a, b, p1, p3, dm = _setup_shape(prm, kind, j1, j2, j3, v1, v2, v3)
     if kind == 1.0:
-        w1, w2, w3, pi0, alpha0 = _setup_periodic(prm, j1, j2, j3, v1, v2, a, b, p1, p3, dm)
+        w1, w2, w3, pi0, alpha0 = _setup_periodic(prm, j1, j2, j3, v1, v2, v3, a, b, p1, p3,
+                                                  dm)
     else:
         w1, w2, w3, pi0, alpha0 = _setup_separatrix(prm, j1, j2, j3, v1, v2, a, b)
     prm[PI0] = pi0
