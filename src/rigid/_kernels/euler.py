@@ -33,6 +33,7 @@ from numba import njit
 
 from hamilton_orbits.quaternion_kernels import qmul, qrot
 from hamilton_orbits.ufuncs import lazy_guvectorize
+
 # (numba's cache of these kernels is keyed on this file alone: the exact-flow kernels
 # they compile in from free.py are stale in a warm cache when free.py changes and this
 # file does not; this line changed with free.py's separatrix limit, session 26, so
