@@ -628,6 +628,8 @@ def test_tiny_perturbation_of_the_intermediate_axis_other_family():
         assert abs(w[0, 2]) < 2e-12 * eps
 
 
+@pytest.mark.slow  # (11 s of mpmath's Taylor integration: a study; the branch's rates are
+# checked against mpmath's K and DLMF's tables in the default run, its flip by exact_kick)
 def test_intermediate_axis_separatrix_limit_attitude_against_high_precision():
     # The separatrix-limit branch (k' < 1e-20) for the attitude too: the precession
     # angle's third-kind integral in its m = 1 form, both families (forms A and B),
