@@ -363,7 +363,7 @@ def _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
                                                   last[:, j], reach2, slack, j == exempt,
                                                   ex2):
                         return True
-            last[:, :] = now
+            now, last = last, now  # (this output's rows are the next one's before)
     return False
 
 
@@ -404,7 +404,7 @@ def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex
     return dd2 < reach2 * speed2 or dd2 * dd2 * dd2 < (reach2 * mu) ** 2 * slack
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rows(rt, vt, i, gm0, pair, reach2, now, last, between):
     # pragma: no cover - compiled
     """``now``: each pair's ``|d|^2``, ``|u|^2``, ``d . u`` of body ``i`` with the
