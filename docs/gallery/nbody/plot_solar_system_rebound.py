@@ -5,8 +5,8 @@ The solar system, checked against rebound
 The bundled scene ``solar-system``: the Sun and the eight planets (the
 Earth-Moon barycentre as one body) from their J2000 positions, integrated with
 ``radau15`` (Everhart 1985; Rein & Spiegel 2015) and, in the same run, with
-rebound's IAS15 from the same initial state.  Here the century is shortened to
-20 years so the example runs in seconds; the cross-check table gives each
+rebound's IAS15 from the same initial state.  Here the scene's thousand years are
+shortened to 20 so that the example runs in seconds; the cross-check table gives each
 body's final position difference between the two codes, and the diagnostics
 are Hamilton's integrals (energy, vis viva, and angular momentum, the law of
 areas; Hamilton 1845, eqs. (D), (E)).
