@@ -52,3 +52,22 @@ def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
         passed += maybe
     assert 300 < found < 2700
     assert passed - found < 0.5 * (3000 - found)  # (the ones it lets through in vain)
+
+
+def test_the_screen_rules_out_the_legs_of_an_ordinary_run():
+    """The solar system with wh at 4 d (Mercury's period / 22), legs of one step: the
+    screen alone answers for every one (a screen by the time scale alone let every
+    leg through, the inner planets being "near" for a step that long, so that the
+    whole check ran after each call: the Hill spheres rule them out)."""
+    import astropy.units as u
+
+    from hamilton_orbits import Simulation, System
+
+    sim = Simulation(System.solar_system("J2000"), method="wh", dt=4 * u.day)
+    gm = sim.system.as_arrays().gm
+    for _ in range(200):
+        traj = sim.integrate(sim.t + 4 * u.day)
+        r, v = traj.r.to_value(u.au), traj.v.to_value(u.au / u.day)
+        t = traj.t.to_value(u.day)
+        assert not k.screen(np.ascontiguousarray(r), np.ascontiguousarray(v), gm, t, 4.0, 0,
+                            0.0, ENCOUNTER_STEP_FRACTION, LIGHT)
