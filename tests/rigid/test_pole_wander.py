@@ -65,9 +65,11 @@ def test_nonlinear_path_matches_the_linear_triaxial_solution(century):
     s = 2 * np.pi / earth.euler_period(triaxial=True).to_value(u.day)
     e = np.sqrt((c - a) * a / ((c - b) * b))
     t = split.t.to_value(u.day)
-    m0 = split.m[0].real
+    # (in the principal frame: the path is turned to Greenwich by the A axis's longitude)
+    body = split.m * np.exp(-1j * earth.constants.A_AXIS_LONGITUDE.to_value(u.rad))
+    m0 = body[0].real
     lin = m0 * (np.cos(s * t) + 1j * e * np.sin(s * t))
-    assert np.max(np.abs(split.m - lin)) < _FLOOR * abs(m0)
+    assert np.max(np.abs(body - lin)) < _FLOOR * abs(m0)
 
 
 def test_liouville_free_matches_nonlinear_axisymmetric_rigid_earth():
@@ -76,6 +78,23 @@ def test_liouville_free_matches_nonlinear_axisymmetric_rigid_earth():
     model = LiouvillePole(("free",))
     m = model.solve(path.t, path.m[0])
     assert np.max(np.abs(m - path.m)) < _FLOOR * abs(path.m[0])
+
+
+def test_the_pole_is_turned_from_the_a_axis_to_greenwich():
+    """The body frame's x is the least moment's axis A, at atan2(S22, C22) / 2 =
+    -14.93 deg (Lambeck 1980, eq. 2.4.2; IERS 2010 C22, S22): a pole displaced
+    towards A read x_p = 200 mas, y_p = 0, where the IERS x_p (towards Greenwich)
+    and y_p (towards 90 deg W) are 200 cos(14.93 deg) = 193.25 and 200 sin(14.93
+    deg) = 51.52 mas."""
+    from rigid.earth.constants import A_AXIS_LONGITUDE, C22_BAR, S22_BAR
+
+    lam = 0.5 * np.arctan2(float(S22_BAR), float(C22_BAR))
+    assert A_AXIS_LONGITUDE.to_value(u.rad) == pytest.approx(lam, rel=1e-15)
+    assert A_AXIS_LONGITUDE.to_value(u.deg) == pytest.approx(-14.9285, abs=1e-4)
+    path = earth.simulate_wobble(2 * u.day, wobble=200 * u.mas, method="exact")
+    # (a vector at longitude lam: x_p = r cos(lam), y_p = -r sin(lam), west positive)
+    assert path.x[0].to_value(u.mas) == pytest.approx(200 * np.cos(lam), rel=1e-12)
+    assert path.y[0].to_value(u.mas) == pytest.approx(-200 * np.sin(lam), rel=1e-12)
 
 
 def test_x_y_follow_the_iers_sign_convention():

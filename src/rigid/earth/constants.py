@@ -23,7 +23,9 @@ Geophys. J. Int. 106, 699).
 The mass is ``M = GM / G`` with the CODATA 2018 G (astropy).
 
 Sign convention of the pole (IERS): the rotation pole in the body frame is
-``m = m1 + i m2`` with ``m1 = x_p`` and ``m2 = -y_p`` (x_p towards Greenwich,
+``m = m1 + i m2`` with ``m1 = x_p`` and ``m2 = -y_p`` in the terrestrial frame
+(:func:`simulate_wobble` turns the principal frame's pole by ``A_AXIS_LONGITUDE``;
+x_p towards Greenwich,
 y_p towards 90 degrees west).  A free wobble of an axisymmetric rigid Earth is
 ``m(t) = m0 exp(i sigma_E t)``: prograde (anticlockwise seen from above the
 North pole), with ``sigma_E = OMEGA (C - A) / A`` (Euler 1765).
@@ -45,6 +47,7 @@ from hamilton_orbits.validation import as_flag
 from rigid.body import RigidBody
 
 __all__ = [
+    "A_AXIS_LONGITUDE",
     "C22_BAR",
     "GM",
     "J2",
@@ -74,6 +77,11 @@ H = 3273795e-9 * u.dimensionless_unscaled
 C22_BAR = 2.43938357328313e-6 * u.dimensionless_unscaled
 #: Normalised S22 of EGM2008 (IERS Conventions 2010, Table 6.2).
 S22_BAR = -1.40027370385934e-6 * u.dimensionless_unscaled
+#: The longitude of the least moment's axis A, ``atan2(S22, C22) / 2`` (Lambeck 1980,
+#: eq. 2.4.2; the normalisation cancels): about 14.93 deg west of Greenwich.  The
+#: body frame of :func:`rigid_body` has x along it; :func:`simulate_wobble` turns its
+#: pole into the IERS ``x_p`` (towards Greenwich) and ``y_p`` (towards 90 deg west).
+A_AXIS_LONGITUDE = (0.5 * np.arctan2(float(S22_BAR), float(C22_BAR)) * u.rad).to(u.deg)
 
 _SIDEREAL_DAY = (2.0 * np.pi * u.rad / OMEGA).to(u.s)
 
@@ -204,8 +212,9 @@ def chandler_period(k2: Any, *, triaxial: bool = False) -> u.Quantity:
 def rigid_body(wobble: Any = 0.2 * u.arcsec, *, triaxial: bool = True) -> RigidBody:
     """The rigid Earth spinning at OMEGA with its rotation axis off the figure axis.
 
-    The body frame is the principal frame (x towards the A axis, z the figure
-    axis C); the attitude is the identity and the angular velocity is
+    The body frame is the principal frame (x towards the A axis, at
+    :data:`A_AXIS_LONGITUDE` (14.93 deg west), not Greenwich; z the figure axis C);
+    the attitude is the identity and the angular velocity is
     ``OMEGA (sin w, 0, cos w)``, ``w`` the wobble angle.
 
     Parameters

@@ -21,7 +21,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.units import ANGULAR_SPEED, TIME
-from rigid.earth.constants import rigid_body
+from rigid.earth.constants import A_AXIS_LONGITUDE, rigid_body
 from rigid.earth.wobble_fit import free_period
 from rigid.free import free_motion
 from rigid.integrators import integrate
@@ -67,7 +67,8 @@ class PolePath:
     t : Quantity, shape (n,), day
         Output times.
     m : ndarray, complex, shape (n,)
-        ``m1 + i m2`` in radians.
+        ``m1 + i m2`` in radians, in the terrestrial frame (x towards Greenwich:
+        the body frame's pole turned by ``A_AXIS_LONGITUDE``, the A axis's).
     method : str
         The integrator (``"splitting4"``, ``"exact"``, ...).
     error : float
@@ -173,8 +174,12 @@ def simulate_wobble(
         per_day = int(np.ceil(86400.0 / float(step)))
         tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
         t, omega = tr.t, tr.omega
-    m = pole_path(omega)
-    error = 0.0 if method == "exact" else _error(m, pole_path(free_motion(body, t)[1]))
+    # (the body frame's x is the A axis, 14.93 deg west: turned to Greenwich's, so that
+    # x and y are the IERS x_p and y_p; a pole along A read 200 mas in x_p, 0 in y_p,
+    # where it is at 193.25 and 51.52 mas)
+    turn = np.exp(1j * A_AXIS_LONGITUDE.to_value(u.rad))
+    m = pole_path(omega) * turn
+    error = 0.0 if method == "exact" else _error(m, pole_path(free_motion(body, t)[1]) * turn)
     if error > WOBBLE_TOLERANCE:
         why = (f"{method} splits the Earth's spin itself (docs/pole_wander.md): use "
                f"splitting4, or a step of about a minute" if method in _PLAIN_SPLITS
