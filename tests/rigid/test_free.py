@@ -658,3 +658,22 @@ def test_exact_kick_leaves_the_intermediate_axis():
     _, w = free_motion(body, [t])
     assert abs(w[0, 1]) < 1e-3  # the middle of the flip
     assert np.abs(tr.omega[-1] - w[0]).max() < 1e-6
+
+
+def test_a_state_on_the_separatrix_by_cancellation_stays_on_it():
+    """w(2 s) of the separatrix motion of (2, 5, 6) from (1, 0.5, 1) has D = L^2 - 2 T B
+    exactly 0 by the cancellation of two terms of order 1; the separatrix limit's
+    rescaling (meant for terms that underflow) recomputed it to a rounding residue and
+    called the state periodic (K = 20.7, a flip at 61 s where the motion tends to
+    the intermediate axis): the flow from w(2) for 38 s left the flow from w(0) for
+    40 s, and time_between refused them as on other branches."""
+    from rigid import time_between
+
+    moments = [2.0, 5.0, 6.0]
+    body = RigidBody(moments, omega=[1.0, 0.5, 1.0])
+    _, w = free_motion(body, [2.0, 40.0])
+    later = RigidBody(moments, omega=w[0])
+    assert free_parameters(later).kind == "separatrix"
+    assert time_between(body, body.omega, w[0]) == pytest.approx(2.0, rel=1e-14)
+    _, again = free_motion(later, [38.0])
+    np.testing.assert_allclose(again[0], w[1], rtol=0, atol=1e-13)

@@ -24,8 +24,9 @@ writes ``DIR/pole_wander_rigid_earth.png`` and ``DIR/pole_wander_rigid_earth.txt
 # Integrate and solve
 # -------------------
 # :func:`rigid.earth.simulate_wobble` starts the rotation axis 0.2 arcsec off
-# the figure axis; ``method="splitting4"`` integrates Euler's equations,
-# ``method="exact"`` evaluates the free motion in Jacobi's elliptic functions.
+# the figure axis, towards the least moment's axis A (14.93° W);
+# ``method="splitting4"`` integrates Euler's equations, ``method="exact"``
+# evaluates the free motion in Jacobi's elliptic functions.
 import argparse
 import time
 from pathlib import Path
@@ -95,8 +96,8 @@ x0, y0 = split.x[0].to_value(u.mas), split.y[0].to_value(u.mas)
 ax1.plot(x0, y0, "o", color="C3", ms=7, label="start")
 ax1.annotate("", xy=(split.x[15].to_value(u.mas), split.y[15].to_value(u.mas)), xytext=(x0, y0),
              arrowprops={"arrowstyle": "-|>", "color": "C3", "lw": 1.5})
-ax1.set_xlabel("x_p = m1, along body axis 1 (mas)")
-ax1.set_ylabel("y_p = -m2, against body axis 2 (mas; IERS: towards 90° W)")
+ax1.set_xlabel("x_p, towards Greenwich (mas)")
+ax1.set_ylabel("y_p, towards 90° W (mas)")
 ax1.set_aspect("equal")
 ax1.set_title(f"rigid-Earth pole, period {p_split.to_value(u.day):.2f} d")
 ax1.legend(loc="center", fontsize=8)

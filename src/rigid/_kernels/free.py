@@ -537,11 +537,15 @@ def _kprime(j1, j2, j3, v1, v3, p1):  # pragma: no cover - compiled
     taken on ``v / s`` (:func:`_scaled_d`), so that ``k'`` does not underflow where
     ``m1`` does (a spin within ~1e-154 of the intermediate axis); ``ln k'`` from
     ``ln s`` and the scaled rest, accurate even when ``k'`` is subnormal."""
-    dm = j1 * v1 * v1 * (j1 - j2) + j3 * v3 * v3 * (j3 - j2)
+    t1 = j1 * v1 * v1 * (j1 - j2)
+    t3 = j3 * v3 * v3 * (j3 - j2)
+    dm = t1 + t3
     # (the magnitude: D is recomputed here in another order of the products than in
     # _polar_order, and where it is at the level of its rounding its sign may differ)
-    if abs(dm) >= _D_FLOOR:  # as before: k' = sqrt(m1)
+    if max(abs(t1), abs(t3)) >= _D_FLOOR:  # as before: k' = sqrt(m1)
         kp = math.sqrt(min(abs((j3 - j1) * dm / ((j3 - j2) * p1)), 1.0))
+        if kp == 0.0:  # (D = 0 in this order of the products: as below)
+            return 5e-324, math.log(5e-324)
         return kp, math.log(kp)
     ds, s = _scaled_d(j1, v1, j3, v3, j2)
     g2 = abs((j3 - j1) * ds / ((j3 - j2) * p1))
@@ -567,8 +571,11 @@ def _polar_order(moments, w0):  # pragma: no cover - compiled
     # L^2 - 2 T B, without cancellation beyond its own conditioning; where it is below
     # 2^-900, on the rates scaled by a power of two (exact) so that its sign survives
     # near the intermediate axis, where it underflows (only its sign is used).
-    d2 = jmin * w0[imin] ** 2 * (jmin - jmid) + jmax * w0[imax] ** 2 * (jmax - jmid)
-    if abs(d2) < _D_FLOOR:
+    ta = jmin * w0[imin] ** 2 * (jmin - jmid)
+    tb = jmax * w0[imax] ** 2 * (jmax - jmid)
+    d2 = ta + tb
+    if max(abs(ta), abs(tb)) < _D_FLOOR:  # (both terms that small: not a cancellation
+        # of two large ones, whose 0 is the separatrix to rounding, kept so)
         d2, _ = _scaled_d(jmin, w0[imin], jmax, w0[imax], jmid)
     kind = 1.0
     if d2 > 0.0 or (d2 == 0.0 and jmid == jmin):

@@ -213,7 +213,7 @@ def rigid_body(wobble: Any = 0.2 * u.arcsec, *, triaxial: bool = True) -> RigidB
     """The rigid Earth spinning at OMEGA with its rotation axis off the figure axis.
 
     The body frame is the principal frame (x towards the A axis, at
-    :data:`A_AXIS_LONGITUDE` (14.93 deg west), not Greenwich; z the figure axis C);
+    ``A_AXIS_LONGITUDE`` (14.93 deg west), not Greenwich; z the figure axis C);
     the attitude is the identity and the angular velocity is
     ``OMEGA (sin w, 0, cos w)``, ``w`` the wobble angle.
 
