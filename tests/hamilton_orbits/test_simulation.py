@@ -546,6 +546,26 @@ def test_the_hill_sphere_of_the_body_passed_is_its_own_about_its_primary():
         assert len(traj.under_resolved) == 0
 
 
+def test_a_moon_s_conic_about_the_sun_is_not_its_path():
+    """A massive moon (Callisto about Jupiter) with leapfrog at 0.5 d, daily outputs:
+    its closest point to the Sun between two outputs was taken from their two-body
+    conic ("0.46 at t = 2", never nearer than 5.18): the most massive body has no
+    Hill sphere to be within, and is not the moon's primary (the review's case)."""
+    import warnings
+
+    mu_s, mu_j, mu_c, a, rho = 2.9591220828e-4, 2.825e-7, 1.6e-11, 5.2, 0.01259
+    vj, vc, th = np.sqrt(mu_s / a), np.sqrt(mu_j / rho), np.radians(-40)
+    rel = rho * np.array([-np.cos(th), -np.sin(th), 0])
+    vrel = vc * np.array([np.sin(th), -np.cos(th), 0])
+    s = System([Body("sun", mu_s, [0, 0, 0], [0, 0, 0]),
+                Body("jupiter", mu_j, [a, 0, 0], [0, vj, 0]),
+                Body("callisto", mu_c, list([a, 0, 0] + rel), list([0, vj, 0] + vrel))])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        traj = integrate(s, np.arange(0, 30.0, 1.0), method="leapfrog", dt=0.5)
+    assert len(traj.under_resolved) == 0
+
+
 def test_massive_pairs_are_checked_in_systems_of_at_most_32_massive_bodies():
     """The head-on pair beside 29 (then 30) distant bodies of GM 1e-9: with 32 massive
     bodies it is listed, with 33 not (checking every pair at every output would cost

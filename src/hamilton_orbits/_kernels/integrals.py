@@ -257,7 +257,9 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
                     d2 += dk * dk
                     u2 += uk * uk
                     rad += dk * uk
-                near = j == c or _within_hill(r, gm, j, cj, t, d2)
+                # (the most massive body, cj -1, has no Hill sphere to be within: a
+                # moon's conic about the Sun is not its path, 0.46 for 5.2 au)
+                near = j == c or (cj >= 0 and _within_hill(r, gm, j, cj, t, d2))
                 # (square roots only where needed: most pairs of most runs are far apart)
                 dd, dd2, speed = math.sqrt(d2) if keep else -1.0, d2, -1.0
                 if t > 0 and rad0 < 0 and rad > 0 and (near or near0):
@@ -387,10 +389,10 @@ def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex
         return False  # (a massive body's own orbit: not checked)
     cj = _primary_cached(r, v, gm0, top, prim, j)
     mu = gm0[i] + gm0[j]
-    near = j == c or _within_hill(r, gm0, j, cj, t, now[0])
+    near = j == c or (cj >= 0 and _within_hill(r, gm0, j, cj, t, now[0]))
     dd2, speed2 = now[0], now[1]
     if t > 0 and last[2] < 0 and now[2] > 0 and (
-            near or _within_hill(r, gm0, j, cj, t - 1, last[0])):
+            near or (cj >= 0 and _within_hill(r, gm0, j, cj, t - 1, last[0]))):
         q0, inv0 = _periapsis(last[0], last[1], last[2], mu)  # (as approaches: the
         q, inv_a = _periapsis(now[0], now[1], now[2], mu)  # closest point between)
         qmax = max(q0, q)
