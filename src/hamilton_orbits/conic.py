@@ -35,7 +35,17 @@ from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits._orbit_build import raise_at
 from hamilton_orbits.twobody import STATE_UNITS, check_state, classical_columns
-from hamilton_orbits.units import ANGLE, LENGTH, is_quantity, wrap
+from hamilton_orbits.units import (
+    ANGLE,
+    DIMENSIONLESS,
+    GM,
+    LENGTH,
+    Kind,
+    as_quantity,
+    is_quantity,
+    require_consistent,
+    wrap,
+)
 from hamilton_orbits.validation import (
     as_flag,
     as_float_array,
@@ -111,20 +121,43 @@ def _check_shape(p: np.ndarray, e: np.ndarray, inv_a: np.ndarray) -> None:
             )
 
 
-def _checked_elements(*values: Any) -> list[np.ndarray]:
+def _checked_elements(*values: Any) -> tuple[list[np.ndarray], bool]:
     """The arguments ``p, e, inv_a, inc, lan, argp, mu`` of :meth:`Conic.from_elements`
-    as float arrays (their own shapes), refused as :meth:`KeplerOrbit.from_elements
-    <hamilton_orbits.KeplerOrbit.from_elements>` refuses its own: each finite plain
-    floats, ``e >= 0``, ``inc`` in [0, pi], ``mu > 0``; and ``p >= 0`` (0 only for
-    the radial orbit, ``e == 1``), ``1/a`` of the sign of ``1 - e`` and equal to
-    ``(1 - e^2)/p`` to rounding.  ValueError naming the argument, the first bad
-    index and the value."""
-    arrays = _plain_floats(_ELEMENTS, values, "km, km^3/s^2 and rad")
+    as float arrays (their own shapes), and whether they came as Quantities, refused as
+    :meth:`KeplerOrbit.from_elements <hamilton_orbits.KeplerOrbit.from_elements>`
+    refuses its own: each finite, ``e >= 0``, ``inc`` in [0, pi], ``mu > 0``; and
+    ``p >= 0`` (0 only for the radial orbit, ``e == 1``), ``1/a`` of the sign of
+    ``1 - e`` and equal to ``(1 - e^2)/p`` to rounding.  Quantities are converted to
+    the conic's units (km, 1/km, km^3/s^2, rad; :func:`_element_floats`).  ValueError
+    naming the argument, the first bad index and the value."""
+    arrays, quantity = _element_floats(values)
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
     _check_shape(p, e, inv_a)
     raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi]")
     check_positive("mu", mu)
-    return arrays
+    return arrays, quantity
+
+
+#: the kind of ``inv_a`` (1/a), converted to the conic's 1/km
+_INV_LENGTH = Kind("a reciprocal length", "1 / km")
+
+
+def _element_floats(values: Any) -> tuple[list[np.ndarray], bool]:
+    """The elements ``p, e, inv_a, inc, lan, argp, mu`` as float arrays, and whether
+    ``p``, ``inv_a`` and ``mu`` are Quantities (all three or none: a unit cannot be
+    guessed).  Quantities are converted to the units of a conic of Quantities (those of
+    :class:`~hamilton_orbits.orbit.KeplerOrbit`: km, 1/km, km^3/s^2), angles of any
+    unit to radians (a plain float angle is radians), ``e`` a dimensionless Quantity or
+    a number; a list of Quantities is the one Quantity it joins into
+    (:func:`~hamilton_orbits.units.as_quantity`).  Plain floats are taken as given.
+    The wrong dimension raises astropy's UnitConversionError (a ValueError) naming the
+    argument."""
+    p, e, inv_a, inc, lan, argp, mu = (as_quantity(n, x) for n, x in
+                                       zip(_ELEMENTS, values, strict=True))
+    quantity = require_consistent(("p", "inv_a", "mu"), (p, inv_a, mu))
+    arrays = [LENGTH("p", p, _L), DIMENSIONLESS("e", e), _INV_LENGTH("inv_a", inv_a),
+              ANGLE("inc", inc), ANGLE("lan", lan), ANGLE("argp", argp), GM("mu", mu, _MU)]
+    return arrays, quantity
 
 
 #: how far from unit length and from orthogonal the axes given to :class:`Conic` may
@@ -263,25 +296,31 @@ class Conic:
         cls, p: Any, e: Any, inv_a: Any, inc: Any, lan: Any, argp: Any, mu: Any, *,
         quantity: bool = False,
     ) -> Conic:
-        """The conic of classical elements given as floats.
+        """The conic of classical elements, given as floats or as Quantities.
 
         Parameters
         ----------
-        p, e, inv_a : array_like, shape (...)
-            Semi-parameter, eccentricity and 1/a (0 for the parabola), as
+        p, e, inv_a : array_like or Quantity, shape (...)
+            Semi-parameter (a length), eccentricity (a number) and 1/a (a reciprocal
+            length; 0 for the parabola), as
             :class:`~hamilton_orbits.orbit.KeplerOrbit` computes them: finite,
             ``e >= 0``, ``p > 0`` (``p = 0`` only for a radial orbit, ``e = 1``),
             ``1/a`` of the sign of ``1 - e`` and ``p/a = 1 - e^2`` to rounding
             (64 eps ``max(1, e)^2``).
-        inc, lan, argp : array_like, shape (...)
+        inc, lan, argp : array_like or Quantity (angle), shape (...)
             Inclination in [0, pi] (``inc == pi``, the float, is exactly
             retrograde), longitude of the ascending node, argument of
-            periapsis, in rad, finite.
-        mu : array_like, shape (...)
+            periapsis, finite; a plain number is in radians (beside Quantity
+            lengths too), a Quantity of any angular unit (``30 * u.deg``).
+        mu : array_like or Quantity, shape (...)
             Gravitational parameter, finite and > 0.
         quantity : bool, optional
-            Whether the floats are in km and km^3/s^2 and the conic's lengths
-            and speeds are to be Quantities (as for a Quantity orbit).
+            Whether plain floats are in km and km^3/s^2 and the conic's lengths
+            and speeds are to be Quantities (as for a Quantity orbit).  Given
+            as Quantities (``p``, ``inv_a`` and ``mu`` all three, a list of
+            Quantities being the one Quantity it joins into), the elements are
+            converted to km, 1/km and km^3/s^2 and the conic is one of
+            Quantities whatever ``quantity`` says.
 
         Returns
         -------
@@ -294,9 +333,13 @@ class Conic:
         Raises
         ------
         ValueError
-            For an argument outside that domain (a Quantity included), or the
-            arguments not broadcasting together, naming the argument, the
-            first offending index and the value.
+            For an argument outside that domain, the arguments not broadcasting
+            together, or ``p``, ``inv_a`` and ``mu`` not all Quantities or all
+            plain floats, naming the argument, the first offending index and the
+            value.
+        astropy.units.UnitConversionError
+            (a ValueError) For a Quantity of the wrong dimension (``p`` in
+            seconds, an angle for ``e``, a mass for ``mu``), naming the argument.
 
         Examples
         --------
@@ -307,9 +350,14 @@ class Conic:
         Traceback (most recent call last):
         ...
         ValueError: Expected `e` >= 0, got -0.5 at index 1
+        >>> c = Conic.from_elements(1.0 * u.au, 0.0, 1.0 / u.au, 90 * u.deg, 0.0, 0.0,
+        ...                         1.32712440041e20 * u.m**3 / u.s**2)
+        >>> c.p, c.normal.round(12).tolist()
+        (<Quantity 1.49597871e+08 km>, [0.0, -1.0, 0.0])
         """
-        p, e, inv_a, inc, lan, argp, mu = _checked_elements(p, e, inv_a, inc, lan, argp, mu)
-        quantity = as_flag("quantity", quantity)
+        values, quantities = _checked_elements(p, e, inv_a, inc, lan, argp, mu)
+        p, e, inv_a, inc, lan, argp, mu = values
+        quantity = as_flag("quantity", quantity) or quantities
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))

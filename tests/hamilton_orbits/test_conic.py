@@ -264,7 +264,8 @@ GOOD = {"p": 1.44, "e": 0.44, "inv_a": 0.56, "inc": 0.1, "lan": 0.2, "argp": 0.3
     ({"mu": -1.0}, r"Expected `mu` > 0, got -1.0$"),
     ({"mu": np.inf}, r"Expected `mu` to be finite, got inf$"),
     ({"mu": None}, r"Expected `mu` to be numeric, got None"),
-    ({"p": 1.44 * u.km}, r"Expected `p` as plain floats .*got the Quantity 1.44 km"),
+    ({"p": 1.44 * u.km}, r"Expected `inv_a` to be a Quantity like `p` \(1.44 km\), got the "
+                         r"plain number 0.56"),
     ({"e": [0.44, 0.44], "p": [1.44, 1.44, 1.44]}, r"Expected `p`, `e`, .* to broadcast"),
 ])
 def test_from_elements_refuses_bad_elements_by_name(bad, message):
@@ -275,6 +276,58 @@ def test_from_elements_refuses_bad_elements_by_name(bad, message):
     1/a far from (1 - e^2)/p were taken; mu = -1 made the hodograph blame `r`.
     Now a ValueError naming the argument, the first offending index and the value."""
     args = {**GOOD, **bad}
+    with pytest.raises(ValueError, match=message):
+        Conic.from_elements(*args.values())
+
+
+def test_from_elements_takes_quantities():
+    """``Conic.from_elements`` refused every Quantity ("Expected `p` as plain floats");
+    it now converts them as ``KeplerOrbit.from_elements`` does: lengths to km, ``1/a``
+    to 1/km, ``mu`` to km^3/s^2 and angles of any unit to radians, the conic being one
+    of Quantities; plain floats are read as before."""
+    au_km = (1.0 * u.au).to_value(u.km)
+    mu_sun = 1.32712440041e20 * u.m**3 / u.s**2
+    c = Conic.from_elements(1.3 * u.au, 0.3, [0.7, 0.7] / u.au, 30 * u.deg, 0.5 * u.rad,
+                            [10, 20] * u.deg, mu_sun)
+    floats = Conic.from_elements(1.3 * au_km, 0.3, 0.7 / au_km, np.radians(30.0), 0.5,
+                                 np.radians([10.0, 20.0]), 1.32712440041e11, quantity=True)
+    for name in ("p", "inv_a", "mu"):
+        assert getattr(c, name).unit == getattr(floats, name).unit
+        assert np.allclose(getattr(c, name).value, getattr(floats, name).value,
+                           rtol=4 * EPS, atol=0), name
+    assert np.allclose(c.normal, floats.normal, rtol=0, atol=4 * EPS)
+    assert np.allclose(c.periapsis_direction, floats.periapsis_direction, rtol=0,
+                       atol=4 * EPS)
+    assert c.a.unit == u.km and c.a.value == pytest.approx(au_km / 0.7, rel=1e-15)
+    assert float(c.e) == 0.3
+    assert Conic.from_elements(1.44, 0.44 * u.one, 0.56, 0, 0, 0, 1.0).e == 0.44  # (e: a
+    # dimensionless Quantity too)
+    # a plain float is read as before: radians, in the caller's own units
+    plain = Conic.from_elements(*GOOD.values())
+    assert not isinstance(plain.p, u.Quantity) and float(plain.p) == 1.44
+    # a list of Quantities is the one Quantity it joins into
+    joined = Conic.from_elements([1 * u.au, 149597870.7 * u.km], 0.0, 1 / u.au, 0, 0, 0,
+                                 mu_sun)
+    assert np.allclose(joined.p.to_value(u.km), au_km, rtol=4 * EPS, atol=0)
+
+
+@pytest.mark.parametrize(("bad", "message"), [
+    ({"p": 1.0 * u.s}, r"Expected `p` to be a length \(convertible to km\), got 1 s"),
+    ({"inv_a": 1.0 * u.km}, r"Expected `inv_a` to be a reciprocal length \(convertible to "
+                            r"1 / km\), got 1 km"),
+    ({"e": 5.7 * u.deg}, r"Expected `e` to be dimensionless, got 5.7 deg \(an angle\)"),
+    ({"inc": 0.1 * u.m}, r"Expected `inc` to be an angle \(convertible to rad\), got 0.1 m"),
+    ({"mu": 1.0 * u.kg}, r"Expected `mu` to be a gravitational parameter GM .*got 1 kg"),
+    ({"mu": 1.0}, r"Expected `mu` to be a Quantity like `p` \(1.44 km\), got the plain "
+                  r"number 1.0"),
+    ({"inc": [0.1, 200.0] * u.deg}, r"Expected `inc` in \[0, pi\], got 3.49.* at index 1"),
+])
+def test_from_elements_refuses_bad_quantities_by_name(bad, message):
+    """A Quantity of the wrong dimension, or beside a plain float where a unit would
+    have to be guessed, is a ValueError (UnitConversionError is one) naming the
+    argument and the value."""
+    args = {**GOOD, "p": 1.44 * u.km, "inv_a": 0.56 / u.km, "mu": 1.0 * u.km**3 / u.s**2,
+            **bad}
     with pytest.raises(ValueError, match=message):
         Conic.from_elements(*args.values())
 
