@@ -233,9 +233,12 @@ class InitialStates:
         the whole subset would drift across the figures.  ``origin="ssb"`` keeps
         the ephemeris's barycentric states as they are.
 
-        GM values: the Sun's is the IAU 2015 nominal solar mass parameter (IAU 2015
-        Resolution B3); the planets' are the system GMs (planet plus satellites) of
-        JPL DE440 (Park et al. 2021); the Moon's is DE440's as well.
+        GM values (:data:`~hamilton_orbits.initial_states.SOLAR_SYSTEM_GM`), all
+        of JPL DE440 (Park et al. 2021): the Sun's is DE440's 132712440041.279419
+        km^3/s^2 to 12 digits, 1.32712440041e20 m^3/s^2 (2e-12 below DE440's, far
+        within the built-in ephemeris's accuracy; not the IAU 2015 nominal
+        1.3271244e20 m^3/s^2 of Resolution B3); the planets' are the system GMs
+        (planet plus satellites); the Earth's and the Moon's are DE440's as well.
 
         Parameters
         ----------
@@ -272,8 +275,7 @@ class InitialStates:
 
         References
         ----------
-        E. Mamajek et al., IAU 2015 Resolution B3 (nominal solar and planetary
-        conversion constants). R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs,
+        R. S. Park, W. M. Folkner, J. G. Williams, D. H. Boggs,
         "The JPL Planetary and Lunar Ephemerides DE440 and DE441", AJ 161, 105 (2021).
 
         Examples
@@ -407,10 +409,10 @@ def solar_system_bodies(bodies: Any = None) -> list[str]:
     return names
 
 
-# GM in m^3/s^2.  Sun: IAU 2015 Resolution B3 nominal (G M_sun)^N.  Planets: system GMs
-# (planet + satellites) of JPL DE440, Park et al. (2021), AJ 161, 105, table 8 as given
-# in REFERENCES.md; Earth and Moon separately from the same ephemeris (DE440: GM_earth
-# 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2; their sum is the Earth-Moon
+# GM in m^3/s^2, all of JPL DE440, Park et al. (2021), AJ 161, 105.  Sun: DE440's
+# 132712440041.279419 km^3/s^2 to 12 digits (not the IAU 2015 B3 nominal 1.3271244e20).
+# Planets: system GMs (planet + satellites), table 8; Earth and Moon separately from the
+# same ephemeris (DE440: GM_earth 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2; their sum is the Earth-Moon
 # system GM 403503.235625... within 1e-9 of the listed 4.03503235502e14).
 SOLAR_SYSTEM_GM: dict[str, float] = {
     "sun": 1.32712440041e20,

@@ -161,11 +161,26 @@ def test_from_rebound_keeps_its_g_and_radii():
     assert [p.r for p in back.particles] == [0.005, 0.0005, 0.0]
 
 
+def test_solar_system_cites_the_sun_gm_it_uses():
+    """``System.solar_system``'s docstring called the Sun's GM the IAU 2015 nominal
+    solar mass parameter (1.3271244e20 m^3/s^2 exactly), while the code holds DE440's
+    (132712440041.279419 km^3/s^2, Park et al. 2021; the header of the DE440 kernel)
+    to 12 digits; the docstring now cites DE440 for it and gives the number used."""
+    de440 = 132712440041.279419e9  # m^3/s^2
+    assert SOLAR_SYSTEM_GM["sun"] == float(f"{de440:.11e}") == 1.32712440041e20
+    doc = " ".join(System.solar_system.__doc__.split())
+    gm = doc[doc.index("GM values"):doc.index("Parameters")]
+    assert "DE440" in gm and "Park et al. 2021" in gm
+    assert "132712440041.279419 km^3/s^2" in gm and "1.32712440041e20 m^3/s^2" in gm
+    assert "the Sun's is the IAU 2015 nominal" not in doc
+    assert "Mamajek" not in doc  # (no longer cited for a value not used)
+
+
 def test_solar_system_offline_and_cited_gm():
     s = System.solar_system("J2000")
     assert s.names == ("sun", "mercury", "venus", "earth-moon-barycenter", "mars",
                        "jupiter", "saturn", "uranus", "neptune")
-    # IAU 2015 B3 nominal solar GM
+    # DE440's solar GM to 12 digits
     assert s["sun"].gm.to_value(u.m**3 / u.s**2) == pytest.approx(1.32712440041e20, rel=1e-15)
     # Earth-Moon distance at J2000 from the built-in ephemeris: the Moon is 402,000 km away
     em = System.solar_system("J2000", bodies=["sun", "earth", "moon"])

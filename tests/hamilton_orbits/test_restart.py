@@ -48,7 +48,7 @@ def test_a_simulation_saved_before_its_first_step_is_the_new_one(tmp_path):
 
 
 def test_a_quantity_simulation_keeps_its_units_and_bits(tmp_path):
-    gm_sun = 1.32712440041e20 * u.m**3 / u.s**2  # IAU 2015 nominal
+    gm_sun = 1.32712440041e20 * u.m**3 / u.s**2  # DE440's, to 12 digits
     s = System([Body("sun", gm_sun, [0, 0, 0] * u.au, [0, 0, 0] * u.km / u.s),
                 Body("earth", 3.986004e14 * u.m**3 / u.s**2, [1, 0, 0] * u.au,
                      [0, 29.78, 0] * u.km / u.s)])
