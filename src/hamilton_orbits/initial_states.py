@@ -412,8 +412,9 @@ def solar_system_bodies(bodies: Any = None) -> list[str]:
 # GM in m^3/s^2, all of JPL DE440, Park et al. (2021), AJ 161, 105.  Sun: DE440's
 # 132712440041.279419 km^3/s^2 to 12 digits (not the IAU 2015 B3 nominal 1.3271244e20).
 # Planets: system GMs (planet + satellites), table 8; Earth and Moon separately from the
-# same ephemeris (DE440: GM_earth 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2; their sum is the Earth-Moon
-# system GM 403503.235625... within 1e-9 of the listed 4.03503235502e14).
+# same ephemeris (DE440: GM_earth 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2;
+# their sum is the Earth-Moon system GM 403503.235625... within 1e-9 of the listed
+# 4.03503235502e14).
 SOLAR_SYSTEM_GM: dict[str, float] = {
     "sun": 1.32712440041e20,
     "mercury": 2.2031868551e13,
