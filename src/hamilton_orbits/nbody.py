@@ -534,14 +534,24 @@ class System(InitialStates):
         effects : sequence of str or mapping, optional
             Effects as for :func:`hamilton_orbits.integrate` (``"gr"``, ...).
         t : Quantity, TimeDelta or float
-            The time of this state, for the effects that know it (``zonal`` with
-            ``pole="IAU2006"``, ...): 0 at the simulation's start (a time Quantity,
-            or a TimeDelta, for a Quantity system; the system's own unit otherwise).
+            The time of this state, one number, for the effects that know it
+            (``zonal`` with ``pole="IAU2006"``, ...): 0 at the simulation's start.
+            For a Quantity system a time Quantity or a TimeDelta (a bare number is
+            refused but for the default 0); for a system of plain floats a float in
+            the system's own unit (a Quantity or a TimeDelta is refused, as
+            :func:`~hamilton_orbits.integrate` refuses it: that unit is not known).
 
         Returns
         -------
         ndarray or Quantity, shape (n, 3)
             au/day^2 for Quantity systems.
+
+        Raises
+        ------
+        ValueError
+            For a ``t`` of the wrong kind for the system (above), not one number,
+            not finite, or of the wrong dimension (astropy's UnitConversionError),
+            naming ``t`` and the value.
 
         Examples
         --------
@@ -554,11 +564,15 @@ class System(InitialStates):
         from hamilton_orbits.rhs import compile_rhs
         from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
+        given = t
         t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
-        if self._quantity and not is_quantity(t) and t != 0:
+        if not self._quantity and is_quantity(t):
+            raise ValueError(f"Expected `t` as a plain float for a system of plain floats "
+                             f"(its time unit is the caller's own), got {given!r}")
+        days = TIME.scalar("t", t, "d" if self._quantity else None)  # (refuses inf, NaN)
+        if self._quantity and not is_quantity(t) and days != 0:
             raise ValueError(f"Expected `t` as a time Quantity for a system of Quantities, "
                              f"got {t!r}")
-        days = float(TIME("t", t, "d" if self._quantity else None))  # (refuses inf, NaN)
         acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm, t=days)
         return acc * A_UNIT if self._quantity else acc
 

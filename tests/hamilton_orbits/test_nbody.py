@@ -355,3 +355,34 @@ def test_with_state_refuses_indices_for_keep_and_names_a_bad_state():
     assert s.with_state(s.r, s.v, keep=[True, False]).names == ("sun",)
     with pytest.raises(ValueError, match=r"Expected `r` to be numbers, got 'x'"):
         s.with_state("x", s.v)
+
+
+def test_accelerations_take_the_time_as_the_system_does():
+    """``System.accelerations(t=...)`` on a system of plain floats took a time Quantity
+    or a TimeDelta and silently read it in seconds (``t = 1 * u.day`` was 86400 of the
+    system's own unit, which ``integrate`` refuses to guess); it is refused now, by
+    name.  On a Quantity system a TimeDelta is the Quantity in days it holds, and an
+    array of times (a TypeError, "only 0-dimensional arrays...") is refused as a
+    ValueError naming `t` and its shape."""
+    from astropy.time import TimeDelta
+
+    plain = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                    Body("dust", 0.0, [2.0, 0, 0], [0, 0.7, 0])])
+    assert np.array_equal(plain.accelerations(t=3.0), plain.accelerations())
+    for t in (1.0 * u.day, TimeDelta(1.0, format="jd"), 0.0 * u.s):
+        with pytest.raises(ValueError, match=r"Expected `t` as a plain float for a system "
+                                             r"of plain floats .*got <(Quantity|TimeDelta)"):
+            plain.accelerations(t=t)
+    s = System.solar_system("J2000", bodies=["sun", "mars"])
+    days = s.accelerations(["gr"], t=2.5 * u.day)
+    assert np.array_equal(s.accelerations(["gr"], t=TimeDelta(2.5, format="jd")), days)
+    assert np.array_equal(s.accelerations(["gr"], t=60.0 * u.h), days)
+    assert np.array_equal(s.accelerations(["gr"], t=0), s.accelerations(["gr"]))
+    for t, message in (([1.0, 2.0] * u.day, r"Expected `t` to be one number, got shape \(2,\)"),
+                       (TimeDelta([1.0], format="jd"),
+                        r"Expected `t` to be one number, got shape \(1,\)"),
+                       (1.5, r"Expected `t` as a time Quantity for a system of Quantities, "
+                             r"got 1.5"),
+                       (1.0 * u.m, r"Expected `t` to be a time \(convertible to d\), got 1 m")):
+        with pytest.raises(ValueError, match=message):
+            s.accelerations(t=t)
