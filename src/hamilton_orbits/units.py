@@ -130,6 +130,9 @@ def as_quantity(name: str, value: Any, *, vector: bool = False) -> Any:
     representation is its Cartesian coordinates (``get_xyz(xyz_axis=-1)``: the three
     last, as a vector argument takes them) and a ``CartesianDifferential`` its
     ``get_d_xyz(xyz_axis=-1)``.  The caller then checks the result as any Quantity.
+    Another differential (a ``SphericalDifferential``, ...) is refused: its
+    components are Cartesian only with the position they are taken at, which a
+    vector argument alone does not have.
 
     Parameters
     ----------
@@ -150,8 +153,9 @@ def as_quantity(name: str, value: Any, *, vector: bool = False) -> Any:
     ------
     ValueError
         For a list whose items do not join into one Quantity (another dimension, a
-        plain number or a string beside a Quantity), naming the argument and the
-        value.
+        plain number or a string beside a Quantity), or a ``vector`` argument given
+        as a differential other than a ``CartesianDifferential``, naming the
+        argument and the value (and, for the differential, how to make it Cartesian).
 
     Examples
     --------
@@ -176,7 +180,21 @@ def as_quantity(name: str, value: Any, *, vector: bool = False) -> Any:
             return value.to_cartesian().get_xyz(xyz_axis=-1)
         if isinstance(value, coordinates.CartesianDifferential):
             return value.get_d_xyz(xyz_axis=-1)
+        if isinstance(value, coordinates.BaseDifferential):
+            raise ValueError(_not_cartesian(name, value))
     return value
+
+
+def _not_cartesian(name: str, value: Any) -> str:
+    """Why a differential other than a CartesianDifferential is refused for ``name``."""
+    kind = type(value).__name__
+    shown = " ".join(repr(value).split())
+    return (f"Expected `{name}` to be Cartesian (a Quantity of shape (..., 3), a coordinate "
+            f"representation or a CartesianDifferential), got a {kind} {shown}: its "
+            f"components ({', '.join(value.components)}) are Cartesian only with the "
+            f"position they are taken at; give `{name}.to_cartesian(base=position)` (a "
+            f"CartesianRepresentation), or `{name}.represent_as(CartesianDifferential, "
+            f"base=position)`")
 
 
 def _holds_quantity(items: list | tuple) -> bool:

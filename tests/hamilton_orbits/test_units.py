@@ -175,3 +175,46 @@ def test_a_wrong_unit_is_named_with_its_value_and_a_mass_for_a_gm_so():
     with pytest.raises(u.UnitConversionError, match=r"to be a speed \(convertible to AU / d\), "
                                                     r"got \[0, 29.78, 0\] km$"):
         Body("p", 0.0 * u.km**3 / u.s**2, [1, 0, 0] * u.au, [0, 29.78, 0] * u.km)
+
+
+def test_a_non_cartesian_differential_is_refused_by_name_with_the_way_to_convert_it():
+    """A ``SphericalDifferential`` (or any differential but a CartesianDifferential)
+    given as a velocity was passed on as it was and refused as "`r`, `v`, `mu` ... got
+    a mix", which it is not; its components are Cartesian only with the position they
+    are taken at, so it is refused naming the argument, the value, what is taken and
+    how to convert it (``v.to_cartesian(base=position)``, which is then taken)."""
+    from astropy.coordinates import (
+        CartesianRepresentation,
+        SphericalCosLatDifferential,
+        SphericalDifferential,
+        SphericalRepresentation,
+    )
+
+    from hamilton_orbits import KeplerOrbit
+    from hamilton_orbits.conic import Conic
+    from hamilton_orbits.units import as_quantity
+
+    mu = 398600.4418 * u.km**3 / u.s**2
+    r = SphericalRepresentation(30 * u.deg, 0 * u.deg, 7000 * u.km)
+    v = SphericalDifferential(1e-3 * u.rad / u.s, 0 * u.deg / u.s, 0 * u.km / u.s)
+    message = (r"Expected `v` to be Cartesian \(a Quantity of shape \(\.\.\., 3\), a "
+               r"coordinate representation or a CartesianDifferential\), got a "
+               r"SphericalDifferential <SphericalDifferential \(d_lon, d_lat, d_distance\) "
+               r".*give `v.to_cartesian\(base=position\)`")
+    with pytest.raises(ValueError, match=message):
+        as_quantity("v", v, vector=True)
+    with pytest.raises(ValueError, match=message):
+        KeplerOrbit.from_state(r, v, mu)
+    with pytest.raises(ValueError, match=message):
+        Conic.from_state(r, v, mu)
+    cos_lat = SphericalCosLatDifferential(1e-3 * u.rad / u.s, 0 * u.deg / u.s, 0 * u.km / u.s)
+    with pytest.raises(ValueError, match=r"Expected `r` to be Cartesian .*got a "
+                                         r"SphericalCosLatDifferential"):
+        KeplerOrbit.from_state(cos_lat, [0, 7.5, 0] * u.km / u.s, mu)
+    assert as_quantity("v", v) is v  # (not a vector argument: the caller refuses it)
+    # the way the message gives: 7 km/s along the local east, at longitude 30 deg
+    o = KeplerOrbit.from_state(r, v.to_cartesian(base=r), mu)
+    _, vel = o.state()
+    assert isinstance(v.to_cartesian(base=r), CartesianRepresentation)
+    assert np.allclose(vel.to_value(u.km / u.s), [-3.5, 7 * np.cos(np.radians(30)), 0.0],
+                       rtol=0, atol=1e-12)
