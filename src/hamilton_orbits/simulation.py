@@ -114,9 +114,10 @@ class Simulation(Saving):
         variational equations) takes it between two steps, at the end of every
         ``every_steps``-th, its steps unchanged; the other methods at the first
         output after;
-    every_wall : float or Quantity, optional
-        or every so many seconds (or a time Quantity) of wall-clock time, at the
-        first look at the clock after each: at the outputs, and for radau15
+    every_wall : float, Quantity or TimeDelta, optional
+        or every so many seconds (or a time Quantity, or a TimeDelta) of
+        wall-clock time, at the first look at the clock after each: at the
+        outputs, and for radau15
         (double precision, without the variational equations) also between two
         steps, every 10 000 steps.
     exact_times : bool, optional
@@ -488,9 +489,11 @@ def _archive_of(path: Any, schedule: tuple[Any, Any, Any], exact_times: Any, met
 
 
 def _wall_seconds(every_wall: Any) -> Any:
-    """``every_wall`` in seconds: a time Quantity converted, a NumPy number made a
-    float (the schedule is JSON in every snapshot); anything else as given (the
-    archive refuses what is not a positive number)."""
+    """``every_wall`` in seconds: a time Quantity converted (a TimeDelta as the
+    Quantity in days it holds), a NumPy number made a float (the schedule is JSON in
+    every snapshot); anything else as given (the archive refuses what is not a
+    positive number)."""
+    every_wall = time_quantity(every_wall)
     if is_quantity(every_wall):
         return TIME.scalar("every_wall", every_wall, u.s)
     if isinstance(every_wall, (np.floating, np.integer)):

@@ -715,3 +715,22 @@ def test_dt_is_the_fixed_step_in_the_system_s_units():
     assert Simulation(s).dt is None and Simulation(s, "wh", tol=1e-9).dt is None
     plain = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
     assert Simulation(plain, "radau15", dt=0.01).dt == 0.01
+
+
+def test_every_wall_takes_a_timedelta_as_the_quantity_it_holds(tmp_path):
+    """``Simulation(..., archive=..., every_wall=TimeDelta(...))`` was refused as
+    "Expected `every_wall` > 0 and finite", while the time Quantity it holds was taken:
+    a TimeDelta is now that Quantity in days, in seconds as the archive keeps it; an
+    array of them is refused by name."""
+    from astropy.time import TimeDelta
+
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-5, [1, 0, 0], [0, 1, 0])])
+    for k, given in enumerate([TimeDelta(90.0, format="sec"), TimeDelta(0.25, format="jd")]):
+        sim = Simulation(s, archive=tmp_path / f"td{k}", every_wall=given)
+        same = Simulation(s, archive=tmp_path / f"q{k}", every_wall=given.to(u.day))
+        seconds = sim._archive.every_wall
+        assert seconds == same._archive.every_wall and type(seconds) is float
+        assert seconds == pytest.approx(given.to_value(u.s), rel=1e-15)
+    with pytest.raises(ValueError, match=r"Expected `every_wall` to be one number, got "
+                                         r"shape \(2,\)"):
+        Simulation(s, archive=tmp_path / "two", every_wall=TimeDelta([1.0, 2.0], format="sec"))
