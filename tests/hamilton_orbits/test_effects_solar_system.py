@@ -754,3 +754,23 @@ def test_a_default_pole_is_not_taken_for_the_axes():
     sat = Body("sat", 0.0 * u.km**3 / u.s**2, earth["earth"].r + [7000, 0, 0] * u.km,
                earth["earth"].v + [0, 7.5, 0.1] * u.km / u.s)
     assert axes_frame(System([earth["earth"], sat]), {}, "zonal") == "icrs"
+
+
+def test_a_time_parameter_takes_a_timedelta_as_the_quantity_it_holds():
+    """An effect's time parameter (``earth_tides``' ``tau``) given as an astropy
+    TimeDelta, or a list of them, was refused as "the plain number <TimeDelta ...>";
+    the reader of the effects' and events' values (``effects.parameters.with_units``)
+    now takes a TimeDelta as the time Quantity in days it holds, to the bit, and a
+    TimeDelta given for a length is refused as the time it is."""
+    from astropy.time import TimeDelta
+
+    s = System.from_ephemeris("J2000", bodies=["sun", "earth", "moon"])
+    days = [0.1, 0.2, 0.3, 0.4, 0.5]
+    want = s.accelerations([{"name": "earth_tides", "tau": days * u.day}])
+    for tau in (TimeDelta(days, format="jd"), [TimeDelta(x, format="jd") for x in days],
+                [TimeDelta(days[0], format="jd"), *days[1:] * u.day]):
+        got = s.accelerations([{"name": "earth_tides", "tau": tau}])
+        assert np.array_equal(got, want)
+    with pytest.raises(u.UnitConversionError, match=r"Effect 'earth_tides': Expected `radius` "
+                                                    r"to be a length .*got 1 d"):
+        s.accelerations([{"name": "earth_tides", "radius": TimeDelta(1.0, format="jd")}])

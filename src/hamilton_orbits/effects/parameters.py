@@ -52,6 +52,7 @@ from hamilton_orbits.units import (
     TIME,
     Kind,
     is_quantity,
+    time_quantity,
 )
 
 __all__ = [
@@ -126,12 +127,15 @@ def _shown(value: Any) -> str:
 
 
 def with_units(value: Any, key: str, where: str, kind: Kind) -> Any:
-    """``value`` with a string read as a Quantity (``"6378 km"``), and a list holding
-    Quantities or strings as one Quantity array; anything else as given.
+    """``value`` with a string read as a Quantity (``"6378 km"``), an astropy
+    TimeDelta as the time Quantity in days it holds
+    (:func:`~hamilton_orbits.units.time_quantity`), and a list holding Quantities,
+    TimeDeltas or strings as one Quantity array; anything else as given.
 
     The one reader of the unit strings that the mappings of effects, events and
     ``small_bodies.propagate(nongrav=...)`` take; the caller then converts the
-    result as it converts a Quantity (its dimension checked there).
+    result as it converts a Quantity (its dimension checked there: a TimeDelta given
+    for a length is refused as the time it is).
 
     Parameters
     ----------
@@ -147,8 +151,8 @@ def with_units(value: Any, key: str, where: str, kind: Kind) -> Any:
     Returns
     -------
     Any
-        A Quantity for a string or a list holding strings or Quantities, else
-        ``value``.
+        A Quantity for a string, a TimeDelta or a list holding strings, TimeDeltas
+        or Quantities, else ``value``.
 
     Raises
     ------
@@ -169,17 +173,16 @@ def with_units(value: Any, key: str, where: str, kind: Kind) -> Any:
 
     def one(x: Any) -> Any:
         if not isinstance(x, str):
-            return x
+            return time_quantity(x)  # (a TimeDelta: the Quantity in days it holds)
         try:
             return u.Quantity(x)
         except (TypeError, ValueError):
             raise ValueError(f"{where}: cannot read `{key}` = {value!r} as a number "
                              f"with a unit (e.g. '{unit_example(kind)}')") from None
 
-    if isinstance(value, str):
+    if not isinstance(value, (list, tuple)):
         return one(value)
-    if isinstance(value, (list, tuple)) and any(isinstance(x, str) or is_quantity(x)
-                                                for x in value):
+    if any(isinstance(x, str) or is_quantity(one(x)) for x in value):
         try:
             return u.Quantity([one(x) for x in value])
         except (TypeError, ValueError):  # UnitConversionError included
