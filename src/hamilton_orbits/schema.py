@@ -22,7 +22,7 @@ from typing import Any
 
 import astropy.units as u
 
-from hamilton_orbits.units import Kind
+from hamilton_orbits.units import Kind, time_quantity
 
 __all__ = [
     "Array",
@@ -214,7 +214,9 @@ class Quantity(Field):
         Require a value other than 0.
 
     Messages quote the value as the file gives it (``'-1 km3/s2'``), not in an
-    internal unit.
+    internal unit.  A scene built in Python may give a Quantity, or an astropy
+    TimeDelta: the time Quantity in days it holds
+    (:func:`~hamilton_orbits.units.time_quantity`), checked as that Quantity.
     """
 
     kind: Kind | None = None
@@ -224,6 +226,7 @@ class Quantity(Field):
 
     def check(self, value: Any, path: str, problems: Problems) -> Any:
         assert self.kind is not None
+        value = time_quantity(value)  # (a TimeDelta: the Quantity in days it holds)
         if isinstance(value, bool):
             problems.add(path, f"expected {self.type_name()}, got {value!r}")
             return None

@@ -626,3 +626,33 @@ def test_a_result_of_an_effect_with_a_time_epoch_saves(tmp_path):
     assert {p.name for p in paths} >= {"summary.md", "summary.json", "states.nc"}
     summary = json.loads((tmp_path / "summary.json").read_text(encoding="utf-8"))
     assert summary["effects"][0]["epoch"] == {"time": "2000-01-01T12:00:00.000", "scale": "tt"}
+
+
+def test_a_scene_built_in_python_takes_a_timedelta_as_the_quantity_it_holds():
+    """A scene built in Python (``Scene.from_dict``, ``with_values``) took a time
+    Quantity for its ``duration`` but refused an astropy TimeDelta ("expected a time
+    (s), got <TimeDelta ...>"); every value with a unit (``schema.Quantity``, the one
+    reader of the scenes of both packages) now takes a TimeDelta as the time Quantity
+    in days it holds, and refuses it where a time is not wanted as that time."""
+    from astropy.time import TimeDelta
+
+    scene = _events_scene("escape", duration=TimeDelta(400.0, format="jd"))
+    assert scene.spec["duration"] == 400 * u.day
+    changed = scene.with_values({"duration": TimeDelta(86400.0 * 30, format="sec")})
+    assert changed.spec["duration"] == 30 * u.day
+    with pytest.raises(SceneError, match=r"bodies\[1\]\.a: expected a length .*got "
+                                         r"<Quantity 1\. d>"):
+        scene.with_values({"bodies[1].a": TimeDelta(1.0, format="jd")})
+
+
+def test_a_timedelta_set_on_a_scene_is_saved_as_the_quantity_it_holds(tmp_path):
+    """``summary.json`` lists the values set since the scene's mapping (``set``): a
+    TimeDelta there is the Quantity in days it holds, as JSON."""
+    import json
+
+    from astropy.time import TimeDelta
+
+    scene = _events_scene("escape").with_values({"duration": TimeDelta(40.0, format="jd")})
+    scene.run(progress=False).save(tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["set"] == {"duration": {"value": 40.0, "unit": "d"}}

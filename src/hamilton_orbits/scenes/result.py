@@ -16,6 +16,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.scenes.base import format_table, format_value
+from hamilton_orbits.units import time_quantity
 
 __all__ = ["Result"]
 
@@ -153,6 +154,7 @@ class Result:
 
     def _json(self) -> dict:
         def conv(v: Any) -> Any:
+            v = time_quantity(v)  # (a TimeDelta set in Python: the Quantity in days)
             if isinstance(v, u.Quantity):  # (a non-finite value as a string: strict JSON)
                 return {"value": conv(v.value.tolist()) if np.ndim(v) == 0 else
                         [conv(x) for x in v.value.tolist()], "unit": str(v.unit)}
