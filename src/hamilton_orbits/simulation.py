@@ -117,9 +117,8 @@ class Simulation(Saving):
     every_wall : float, Quantity or TimeDelta, optional
         or every so many seconds (or a time Quantity, or a TimeDelta) of
         wall-clock time, at the first look at the clock after each: at the
-        outputs, and for radau15
-        (double precision, without the variational equations) also between two
-        steps, every 10 000 steps.
+        outputs, and for radau15 (double precision, without the variational
+        equations) also between two steps, every 10 000 steps.
     exact_times : bool, optional
         Snapshots at exactly the scheduled times (the default of the adaptive
         methods, which end a step there by their own step control), or at the end
