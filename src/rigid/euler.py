@@ -33,6 +33,7 @@ from hamilton_orbits.units import (
     TORQUE,
     Kind,
     require_consistent,
+    time_quantity,
     wrap,
 )
 from hamilton_orbits.validation import check_positive, check_trailing
@@ -261,8 +262,9 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
         Principal moments (A, B, C) (kg m^2 when a Quantity).
     attitude : Quaternion or array_like, shape (..., 4)
         Body-to-space attitude (any nonzero scale).
-    t : float or Quantity, shape (...), optional
-        Time (s when a Quantity).  Default 0.  A Quantity if ``moments`` is one.
+    t : float, Quantity or TimeDelta, shape (...), optional
+        Time (s when a float).  Default 0.  A Quantity (or an astropy TimeDelta, the
+        Quantity in days it holds) if ``moments`` is one.
 
     Returns
     -------
@@ -279,6 +281,7 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     >>> torque_on(BodyTorque([1.0, 2.0, 3.0]), [1.0, 1.0, 1.0], Quaternion([1, 0, 0, 0]))
     array([1., 2., 3.])
     """
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = require_consistent(("moments", "t"), (moments, t))
     m = _moments(moments)
     q = _quat_array("attitude", attitude)
