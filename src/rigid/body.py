@@ -484,7 +484,22 @@ class RigidBody:
     def with_state(self, attitude: Any = None, omega: Any = None) -> RigidBody:
         """A body with the same moments and a new attitude and/or omega.
 
-        ``omega`` is a Quantity exactly when the body was built from Quantities.
+        Parameters
+        ----------
+        attitude : Quaternion or array_like, shape (4,), optional
+            The new attitude (dimensionless; default the body's).
+        omega : array_like or Quantity, shape (3,), optional
+            The new angular velocity in the body frame (default the body's): a
+            Quantity (any angular speed) exactly when the body was built from
+            Quantities, plain numbers (rad/s, SI) exactly when it was not.
+
+        Raises
+        ------
+        ValueError
+            For a plain ``omega`` for a body of Quantities, or a Quantity for a body
+            of plain numbers (its unit is the body's: no other is guessed), and
+            for the checks of :class:`RigidBody` (naming the argument, index and
+            value).
 
         Examples
         --------
