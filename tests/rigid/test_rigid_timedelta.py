@@ -112,3 +112,14 @@ def test_the_earths_pole_entries_take_a_timedelta():
 
     a, b = _both(solve, TimeDelta(433.0, format="jd"), TD, TimeDelta(0.1, format="jd"))
     _same(a[0], b[0]), _same(a[1], b[1])
+
+
+def test_cayley_propagate_takes_a_timedelta_end():
+    # its grid of n_out times was made from the TimeDelta itself (an array of
+    # TimeDelta objects, refused as "the plain number array([<TimeDelta ...")
+    from rigid.rodrigues import cayley_propagate
+
+    a, b = _both(lambda te, h: cayley_propagate(_body(), te, h, n_out=3),
+                 TimeDelta(2.0**-14, format="jd"), TimeDelta(2.0**-20, format="jd"))
+    _same(a.t, b.t), _same(a.omega, b.omega)
+    np.testing.assert_array_equal(a.attitude.as_array(), b.attitude.as_array())
