@@ -429,6 +429,11 @@ class System(InitialStates):
         merges), and with the boolean ``keep`` (n,) only the bodies it marks (after
         removals).
 
+        Units: a Quantity is converted (a system of Quantities only); plain numbers
+        are the internal units, which for a system of Quantities are au, au/day and
+        au^3/day^2 (the integrators hand their states back so), beside Quantities
+        too: each argument is read on its own.
+
         The new system shares the names, radii, J2 and poles (read-only arrays) and
         copies the state once: no :class:`Body` object is made until one is asked
         for.  ``check=False`` skips the checks of the state (finite, shapes, no two

@@ -262,7 +262,11 @@ class Kind:
 
     Calling a kind, ``KIND(name, value, unit=None, finite=True)``, returns a
     float64 array: Quantities are converted to ``unit`` (default: the kind's
-    unit), plain numbers pass as they are.
+    unit), plain numbers pass as they are.  An astropy ``TimeDelta`` is the
+    Quantity in days it holds (:func:`time_quantity`), to the bit, so that every
+    time argument converted here takes one (a caller whose plain numbers are in
+    some other unit of its own refuses a Quantity, and so a TimeDelta passed
+    through :func:`time_quantity` first, before this call).
 
     Raises
     ------
@@ -319,6 +323,7 @@ class Kind:
     def __call__(
         self, name: str, value: Any, unit: UnitLike | None = None, *, finite: bool = True
     ) -> np.ndarray:
+        value = time_quantity(value)  # (a TimeDelta: the Quantity in days it holds)
         if is_quantity(value):
             target = self.unit if unit is None else as_unit(unit)
             if self is DIMENSIONLESS and value.unit.physical_type == "angle":

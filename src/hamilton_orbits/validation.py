@@ -84,12 +84,7 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
             raise ValueError(f"Expected `{name}` to be numeric, got {value.item()!r}")
     if np.iscomplexobj(value):
         raise ValueError(f"Expected `{name}` to be real, got complex {value!r}")
-    if isinstance(value, np.ma.MaskedArray):  # (numpy.asarray takes the values under
-        masked = np.ma.getmaskarray(value)  # the mask, silently)
-        if masked.any():
-            index = first_index(masked) if masked.ndim else ()
-            raise ValueError(f"Expected `{name}` to be numbers, got a masked value"
-                             f"{fmt_index(index)}")
+    check_unmasked(name, value)
     try:
         arr = np.asarray(value, dtype=np.float64)
     except OverflowError as exc:  # a Python int beyond the float64 range
@@ -110,6 +105,33 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
                 f"Expected `{name}` to be finite, got {float(arr[index])!r}{fmt_index(index)}"
             )
     return arr
+
+
+def check_unmasked(name: str, value: object) -> None:
+    """Refuse a masked value: a numpy masked array or an astropy ``Masked`` one (a
+    masked Quantity included) with any element masked, naming ``name`` and the index
+    of the first masked element (``numpy.asarray`` and ``Quantity.to_value`` read
+    the values under the mask, silently).
+
+    Examples
+    --------
+    >>> check_unmasked("x", np.ma.array([1.0, 2.0]))  # nothing masked: taken
+    >>> check_unmasked("x", np.ma.array([1.0, 2.0], mask=[0, 1]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `x` to be numbers, got a masked value at index 1
+    """
+    if isinstance(value, np.ma.MaskedArray):
+        mask = np.ma.getmaskarray(value)
+    else:
+        module = sys.modules.get("astropy.utils.masked")  # (not imported: none was made)
+        if module is None or not isinstance(value, module.Masked):
+            return
+        mask = np.asarray(value.mask, dtype=bool)
+    if mask.any():
+        index = first_index(mask) if mask.ndim else ()
+        raise ValueError(f"Expected `{name}` to be numbers, got a masked value"
+                         f"{fmt_index(index)}")
 
 
 def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:

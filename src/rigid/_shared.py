@@ -54,31 +54,6 @@ def pow2(x: np.ndarray) -> float:
     return 1.0 if big == 0.0 else math.ldexp(1.0, math.frexp(big)[1] - 1)
 
 
-def _steady(moments: np.ndarray, omega: np.ndarray) -> bool:
-    """The kernel's test of a steady motion (``I omega`` parallel to ``omega`` to a
-    relative 1e-150, on ``omega / max|omega|``, but exactly when the dominant axis is
-    the intermediate one: unstable), on the numbers the kernel sees (the mirror of
-    :func:`rigid._kernels.free._is_steady`)."""
-    wn = float(np.max(np.abs(omega)))
-    if wn == 0.0:
-        return True
-    i0, i1, i2 = (float(x) for x in moments)
-    s0, s1, s2 = (float(x) / wn for x in omega)
-    cross = max(abs(c) for c in ((i1 - i2) * s1 * s2, (i2 - i0) * s2 * s0,
-                                  (i0 - i1) * s0 * s1))
-    if cross == 0.0:
-        return True
-    if cross > 1e-150 * max(i0, i1, i2):
-        return False
-    if abs(s0) == 1.0:
-        j, o1, o2 = i0, i1, i2
-    elif abs(s1) == 1.0:
-        j, o1, o2 = i1, i2, i0
-    else:
-        j, o1, o2 = i2, i0, i1
-    return not (min(o1, o2) < j < max(o1, o2))
-
-
 def free_scale(moments: np.ndarray, omega: np.ndarray, who: str) -> float:
     """The power of two ``sw`` by which the free-motion kernel takes ``omega``: exact.
 
@@ -106,7 +81,9 @@ def free_scale(moments: np.ndarray, omega: np.ndarray, who: str) -> float:
     """
     sw = pow2(omega)
     moments = moments / pow2(moments)
-    if _steady(moments, omega / sw):
+    # the kernel's own test of a steady motion, run as Python on the numbers it will
+    # see (its source, not a mirror: nothing to keep in step, and nothing compiled)
+    if _fk.is_steady.py_func(moments.tolist(), (omega / sw).tolist()):
         return sw
     nz = omega != 0.0
     log_w = np.full(3, -np.inf)

@@ -33,6 +33,7 @@ from hamilton_orbits.units import (
     DIMENSIONLESS,
     INERTIA,
     require_consistent,
+    time_quantity,
 )
 from hamilton_orbits.validation import as_float_array
 from rigid._shared import pow2
@@ -180,7 +181,9 @@ def call_units(body: RigidBody, names: tuple[str, ...], values: tuple[Any, ...])
     The values must not mix Quantities and plain numbers
     (:func:`hamilton_orbits.units.require_consistent`); a body built from
     Quantities needs Quantities (a plain time beside it has no unit); a body of
-    plain floats is SI and accepts either.  ``None`` values are ignored.
+    plain floats is SI and accepts either.  ``None`` values are ignored; an astropy
+    ``TimeDelta`` counts as the Quantity in days it holds
+    (:func:`hamilton_orbits.units.time_quantity`), as the time kind converts it.
 
     Examples
     --------
@@ -190,6 +193,7 @@ def call_units(body: RigidBody, names: tuple[str, ...], values: tuple[Any, ...])
     ...
     ValueError: Expected `t` to be a Quantity like `body` ([1. 2. 3.] m2 kg), got the plain ...
     """
+    values = tuple(time_quantity(v) for v in values)
     quantity = require_consistent(names, values)
     if body._quantity:
         require_consistent(("body", *names), (body.moments, *values))
@@ -480,7 +484,22 @@ class RigidBody:
     def with_state(self, attitude: Any = None, omega: Any = None) -> RigidBody:
         """A body with the same moments and a new attitude and/or omega.
 
-        ``omega`` is a Quantity exactly when the body was built from Quantities.
+        Parameters
+        ----------
+        attitude : Quaternion or array_like, shape (4,), optional
+            The new attitude (dimensionless; default the body's).
+        omega : array_like or Quantity, shape (3,), optional
+            The new angular velocity in the body frame (default the body's): a
+            Quantity (any angular speed) exactly when the body was built from
+            Quantities, plain numbers (rad/s, SI) exactly when it was not.
+
+        Raises
+        ------
+        ValueError
+            For a plain ``omega`` for a body of Quantities, or a Quantity for a body
+            of plain numbers (its unit is the body's: no other is guessed), and
+            for the checks of :class:`RigidBody` (naming the argument, index and
+            value).
 
         Examples
         --------

@@ -32,7 +32,9 @@ from hamilton_orbits.units import (
     TIME,
     TORQUE,
     Kind,
+    is_quantity,
     require_consistent,
+    time_quantity,
     wrap,
 )
 from hamilton_orbits.validation import check_positive, check_trailing
@@ -88,6 +90,8 @@ class _Torque:
     """Base class: ``kind`` and ``params`` encode the torque for the kernels."""
 
     kind: int = _k.TORQUE_NONE
+    #: the arguments with a dimension (a Quantity, or plain SI numbers)
+    _dimensional: tuple[str, ...] = ()
 
     def encode(self) -> tuple[int, np.ndarray]:
         """(kind, params) for the compiled kernels (plain SI floats)."""
@@ -100,6 +104,7 @@ class _ConstantTorque(_Torque):
 
     torque: Any
     _params: np.ndarray = field(init=False, repr=False, compare=False)
+    _dimensional = ("torque",)
 
     def __post_init__(self) -> None:
         t = TORQUE("torque", self.torque)
@@ -118,7 +123,9 @@ class BodyTorque(_ConstantTorque):
     Parameters
     ----------
     torque : array_like or Quantity, shape (3,)
-        Body-frame torque (N m when a Quantity).
+        Body-frame torque: a Quantity (any unit of torque), or plain numbers in N m
+        (SI).  Plain numbers (but zeros) are refused beside a body or moments of
+        Quantities (:func:`check_torque_units`): their unit cannot be guessed.
 
     Examples
     --------
@@ -136,7 +143,9 @@ class SpaceTorque(_ConstantTorque):
     Parameters
     ----------
     torque : array_like or Quantity, shape (3,)
-        Space-frame torque (N m when a Quantity).
+        Space-frame torque: a Quantity (any unit of torque), or plain numbers in N m
+        (SI).  Plain numbers (but zeros) are refused beside a body or moments of
+        Quantities (:func:`check_torque_units`): their unit cannot be guessed.
 
     Examples
     --------
@@ -162,12 +171,18 @@ class GravityGradientTorque(_Torque):
     Parameters
     ----------
     gm_over_r3 : float or Quantity
-        GM / R^3 (1/s^2), the square of the orbital mean motion on a Kepler
-        orbit; set independently to study a fixed direction (``mean_motion=0``).
+        GM / R^3 (1/s^2 for a plain number), the square of the orbital mean motion
+        on a Kepler orbit; set independently to study a fixed direction
+        (``mean_motion=0``).
     mean_motion : float or Quantity, optional
-        Rate n at which the direction turns (rad/s).  Default 0.
+        Rate n at which the direction turns (rad/s for a plain number).  Default 0.
+        ``gm_over_r3`` and ``mean_motion`` are both Quantities or both plain
+        numbers (a mix is refused: the plain one's unit cannot be guessed), but for
+        a plain zero, which is zero in every unit (the default).
     phase : float or Quantity, optional
-        Angle of the direction at t = 0 (rad).  Default 0.
+        Angle of the direction at t = 0.  Default 0.  A plain number is radians,
+        beside Quantities too (as every angle of the package:
+        :data:`hamilton_orbits.units.ANGLE`); ``30 * u.deg`` for degrees.
     e1, e2 : array_like, shape (3,), optional
         Orthonormal space-frame vectors spanning the orbit plane; default the
         x and y axes.
@@ -175,7 +190,9 @@ class GravityGradientTorque(_Torque):
     Raises
     ------
     ValueError
-        If ``gm_over_r3`` is negative or ``e1``, ``e2`` are not orthonormal.
+        If ``gm_over_r3`` is negative, ``e1``, ``e2`` are not orthonormal, or one of
+        ``gm_over_r3`` and ``mean_motion`` is a Quantity and the other a nonzero
+        plain number (naming it and its value).
 
     Examples
     --------
@@ -193,8 +210,11 @@ class GravityGradientTorque(_Torque):
     e1: Any = (1.0, 0.0, 0.0)
     e2: Any = (0.0, 1.0, 0.0)
     _params: np.ndarray = field(init=False, repr=False, compare=False)
+    _dimensional = ("gm_over_r3", "mean_motion")
 
     def __post_init__(self) -> None:
+        require_consistent(self._dimensional, tuple(
+            None if _plain_zero(v) else v for v in (self.gm_over_r3, self.mean_motion)))
         k = _GM_OVER_R3("gm_over_r3", self.gm_over_r3)
         check_positive("gm_over_r3", k, strict=False)
         n = ANGULAR_SPEED("mean_motion", self.mean_motion)
@@ -217,6 +237,60 @@ class GravityGradientTorque(_Torque):
 
     def encode(self) -> tuple[int, np.ndarray]:
         return _k.TORQUE_GRAVITY_GRADIENT, self._params.copy()
+
+
+def _plain_zero(value: Any) -> bool:
+    """Whether ``value`` is plain numbers, all zero (zero in every unit)."""
+    if is_quantity(value):
+        return False
+    try:
+        return bool(np.all(np.asarray(value, dtype=np.float64) == 0.0))
+    except (TypeError, ValueError):  # (refused by name where it is converted)
+        return False
+
+
+def check_torque_units(torque: Any, quantity: bool, like: str) -> None:
+    """Refuse a torque of plain numbers for a body or moments of Quantities.
+
+    A body built from Quantities takes Quantities (its times, its rates: a plain
+    number beside it has no unit that could be guessed), and so does its torque:
+    ``BodyTorque([0, 0, 1])`` is not read as N m beside it.  Zeros are taken (zero
+    in every unit), and a body of plain numbers (SI) takes either.
+
+    Parameters
+    ----------
+    torque : BodyTorque, SpaceTorque, GravityGradientTorque or None
+        The torque model (anything else is left to :func:`encode_torque`).
+    quantity : bool
+        Whether the body (or the moments) is in Quantities.
+    like : str
+        The body's argument and its value, for the message.
+
+    Raises
+    ------
+    ValueError
+        Naming the torque's argument, the index and the value of its first
+        nonzero plain number.
+
+    Examples
+    --------
+    >>> check_torque_units(BodyTorque([0.0, 0.0, 1.0]), True, "`body`")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected BodyTorque's `torque` to be a Quantity like `body`, got ... at index 2
+    >>> check_torque_units(BodyTorque([0.0, 0.0, 1.0]), False, "`body`")  # SI: taken
+    """
+    if not quantity or not isinstance(torque, _Torque):
+        return
+    for name in torque._dimensional:
+        value = getattr(torque, name)
+        if is_quantity(value) or _plain_zero(value):
+            continue
+        arr = np.asarray(value, dtype=np.float64)  # (checked numeric when built)
+        k = tuple(int(i) for i in np.argwhere(arr != 0.0)[0])
+        where = f" at index {k[0] if len(k) == 1 else k}" if k else ""
+        raise ValueError(f"Expected {type(torque).__name__}'s `{name}` to be a Quantity like "
+                         f"{like}, got the plain number {float(arr[k])!r}{where}")
 
 
 def encode_torque(torque: Any) -> tuple[int, np.ndarray]:
@@ -261,8 +335,9 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
         Principal moments (A, B, C) (kg m^2 when a Quantity).
     attitude : Quaternion or array_like, shape (..., 4)
         Body-to-space attitude (any nonzero scale).
-    t : float or Quantity, shape (...), optional
-        Time (s when a Quantity).  Default 0.  A Quantity if ``moments`` is one.
+    t : float, Quantity or TimeDelta, shape (...), optional
+        Time (s when a float).  Default 0.  A Quantity (or an astropy TimeDelta, the
+        Quantity in days it holds) if ``moments`` is one.
 
     Returns
     -------
@@ -279,8 +354,10 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     >>> torque_on(BodyTorque([1.0, 2.0, 3.0]), [1.0, 1.0, 1.0], Quaternion([1, 0, 0, 0]))
     array([1., 2., 3.])
     """
+    t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = require_consistent(("moments", "t"), (moments, t))
     m = _moments(moments)
+    check_torque_units(torque, is_quantity(moments), f"`moments` ({moments})")
     q = _quat_array("attitude", attitude)
     tt = np.zeros(()) if t is None else TIME("t", t)
     kind, params = encode_torque(torque)

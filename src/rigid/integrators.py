@@ -87,7 +87,13 @@ from rigid._kernels import euler as _euler_k
 from rigid._shared import free_scale, pow2
 from rigid.body import call_units, check_body
 from rigid.drivers import METHODS, integrate_arrays
-from rigid.euler import BodyTorque, GravityGradientTorque, SpaceTorque, encode_torque
+from rigid.euler import (
+    BodyTorque,
+    GravityGradientTorque,
+    SpaceTorque,
+    check_torque_units,
+    encode_torque,
+)
 from rigid.splitting import BM_A, BM_B, SPLITTINGS, YOSHIDA_W  # noqa: F401  (their old home)
 from rigid.trajectory import RigidTrajectory, integral_errors
 
@@ -341,6 +347,7 @@ def integrate(
     dtf = _step(method, dt, float(times.max()))
     rtol_f, atol_f = _tolerances(tol, rtol, atol, si.omega)
     recentre = float(_scalar_positive("recentre", DIMENSIONLESS("recentre", recentre)))
+    check_torque_units(torque, body.quantity, f"`body` ({body.moments})")
     kind, params = encode_torque(torque)
     moments, params, sw = _scaled_problem(si, kind, params, method, times, dtf)
     start = time.perf_counter()

@@ -47,7 +47,14 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.units import ANGULAR_SPEED, DIMENSIONLESS, Kind, is_quantity, wrap
+from hamilton_orbits.units import (
+    ANGULAR_SPEED,
+    DIMENSIONLESS,
+    Kind,
+    is_quantity,
+    time_quantity,
+    wrap,
+)
 from hamilton_orbits.validation import check_trailing, first_index
 from rigid._kernels import euler as _k
 from rigid.integrators import integrate
@@ -366,10 +373,11 @@ def cayley_propagate(
     ----------
     body : RigidBody
         Initial state (moments, attitude, omega).
-    t_end : float, array_like or Quantity
-        Time span (s when a Quantity), or an array of output times as ``t`` of
+    t_end : float, array_like, Quantity or TimeDelta
+        Time span (s when plain numbers; an astropy TimeDelta is the Quantity in
+        days it holds), or an array of output times as ``t`` of
         :func:`rigid.integrators.integrate`.
-    dt : float or Quantity
+    dt : float, Quantity or TimeDelta
         Step (rounded so that a whole number of steps spans ``t_end``).
     n_out : int, optional
         Number of equally spaced output times (including 0 and ``t_end``) for an
@@ -403,6 +411,7 @@ def cayley_propagate(
     r = DIMENSIONLESS.scalar("recentre", recentre)
     if not r > 0.0:
         raise ValueError(f"Expected `recentre` > 0, got {r!r}")
+    t_end = time_quantity(t_end)  # (a TimeDelta: the Quantity in days it holds)
     return integrate(body, _output_grid(t_end, n_out), dt=dt, method="cayley_rk4",
                      torque=torque, recentre=r)
 

@@ -162,3 +162,45 @@ def test_bad_input():
         GravityGradientTorque(1.0, e2=[1.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="Expected `torque` to be None"):
         torque_on("gravity", [1.0, 2.0, 3.0], [1.0, 0.0, 0.0, 0.0])
+
+
+# --- a plain number beside Quantities: GM / R^3 and the mean motion of the gravity
+# gradient, and a torque's numbers beside a body of Quantities, were read as SI
+
+
+def test_gravity_gradient_refuses_a_quantity_beside_a_plain_rate():
+    with pytest.raises(ValueError, match=r"Expected `mean_motion` to be a Quantity like "
+                                         r"`gm_over_r3` \(1e-06 1 / s2\), got the plain "
+                                         r"number 0.001$"):
+        GravityGradientTorque(1e-6 / u.s**2, mean_motion=1e-3)
+    with pytest.raises(ValueError, match=r"Expected `gm_over_r3` to be a Quantity like "
+                                         r"`mean_motion`.*got the plain number 1e-06$"):
+        GravityGradientTorque(1e-6, mean_motion=1e-3 * u.rad / u.s)
+    # a plain zero (the default mean motion) is zero in every unit; a plain phase is
+    # radians, beside Quantities too (the package's angles), as documented
+    a = GravityGradientTorque(1e-6 / u.s**2, phase=0.5).encode()[1]
+    b = GravityGradientTorque(1e-6 / u.s**2, 0.0 * u.rad / u.s, 0.5 * u.rad).encode()[1]
+    np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize(("torque", "name", "value", "index"), [
+    (BodyTorque([0.0, 0.0, 2.0]), "torque", 2.0, " at index 2"),
+    (SpaceTorque([0.0, -1.0, 0.0]), "torque", -1.0, " at index 1"),
+    (GravityGradientTorque(1e-6), "gm_over_r3", 1e-06, ""),
+], ids=["body", "space", "gravity-gradient"])
+def test_a_plain_torque_beside_a_body_of_quantities_is_refused(torque, name, value, index):
+    from rigid import RigidBody, integrate
+
+    body = RigidBody([1.0, 2.0, 3.0] * u.kg * u.m**2, omega=[0.1, 0.2, 0.3] * u.rad / u.s)
+    kind = type(torque).__name__
+    got = rf"got the plain number {value}{index}$"
+    with pytest.raises(ValueError, match=rf"Expected {kind}'s `{name}` to be a Quantity like "
+                                         rf"`body` \(\[1. 2. 3.\] m2 kg\), {got}"):
+        integrate(body, [0.0, 1.0] * u.s, dt=0.5 * u.s, torque=torque)
+    with pytest.raises(ValueError, match=rf"{kind}'s `{name}` to be a Quantity like "
+                                         rf"`moments`.*{got}"):
+        torque_on(torque, body.moments, [1.0, 0.0, 0.0, 0.0])
+    # zeros are zero in every unit; a body of plain numbers (SI) takes either
+    torque_on(BodyTorque([0.0, 0.0, 0.0]), body.moments, [1.0, 0.0, 0.0, 0.0])
+    plain = torque_on(BodyTorque([0.0, 0.0, 2.0] * u.N * u.m), [1.0, 2.0, 3.0], [1, 0, 0, 0])
+    np.testing.assert_array_equal(plain, [0.0, 0.0, 2.0])

@@ -677,3 +677,38 @@ def test_a_state_on_the_separatrix_by_cancellation_stays_on_it():
     assert time_between(body, body.omega, w[0]) == pytest.approx(2.0, rel=1e-14)
     _, again = free_motion(later, [38.0])
     np.testing.assert_allclose(again[0], w[1], rtol=0, atol=1e-13)
+
+
+# moments (scaled) and rates at the edges of the kernel's steady test: rest, a sphere,
+# exact principal spins, cross terms just below and above 1e-150 of the largest moment
+# near each axis (the intermediate one: only an exact spin is steady), negative rates
+STEADY_EDGES = [
+    ([1.0, 2.0, 3.0], [0.0, 0.0, 0.0]),
+    ([1.5, 1.5, 1.5], [0.3, -1.0, 0.7]),
+    ([1.0, 2.0, 3.0], [0.0, 0.0, -1.0]),
+    ([1.0, 2.0, 3.0], [0.0, 1.5, 0.0]),
+    ([1.0, 2.0, 3.0], [1e-151, 0.0, 1.0]),
+    ([1.0, 2.0, 3.0], [1e-149, 0.0, 1.0]),
+    ([1.0, 2.0, 3.0], [1.0, -1e-151, 0.0]),
+    ([1.0, 2.0, 3.0], [1e-151, 1.0, 0.0]),
+    ([1.0, 2.0, 3.0], [0.0, 1.0, 1e-300]),
+    ([1.0, 1.0, 1.5], [1e-200, 1e-200, 1.0]),
+    ([1.0, 1.5, 1.5], [0.0, 1.0, 1.0]),
+    ([1.0, 1.5, 1.5], [1e-151, 1.0, -1.0]),
+    ([1.0, 1.75, 1.0], [1.0, 1e-151, 1.0]),
+    ([1.0, 2.0, 3.0], [1.5e-150, 0.0, 1.0]),
+]
+
+
+@pytest.mark.parametrize(("moments", "w"), STEADY_EDGES)
+def test_free_scale_sees_a_steady_motion_as_the_kernel_does(moments, w):
+    # rigid._shared.free_scale asks the kernel's own is_steady (run as Python, no
+    # compile), where it had a mirror of it: they must agree on every edge case
+    from rigid._shared import pow2
+
+    m, w = np.array(moments), np.array(w)
+    m = m / pow2(m)
+    w = w / pow2(w) if np.any(w) else w
+    python = fk.is_steady.py_func(m.tolist(), w.tolist())
+    prm = fk.free_setup(m, np.array([1.0, 0.0, 0.0, 0.0]), np.ascontiguousarray(w))
+    assert python == (prm[fk.KIND] == 0.0)

@@ -461,7 +461,7 @@ def _separatrix_at(prm, u):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _is_steady(moments, w0):  # pragma: no cover - compiled
+def is_steady(moments, w0):  # pragma: no cover - compiled
     """Whether the motion is taken as steady (sphere, rest, principal axis).
 
     ``I omega`` parallel to ``omega``, tested on omega / max|omega| so that nothing
@@ -475,6 +475,10 @@ def _is_steady(moments, w0):  # pragma: no cover - compiled
     (``k' ~ eps``; Landau & Lifshitz, Mechanics §37): there only an exact spin
     (no cross term at all) is steady, and the rest is periodic, evaluated in the
     separatrix limit (``_KP_LIMIT``).
+
+    The one definition of the test: :func:`rigid._shared.free_scale` runs this same
+    source as Python (``is_steady.py_func`` on floats, no compile) to see the motion
+    as the kernel will.
     """
     i0, i1, i2 = moments[0], moments[1], moments[2]
     wn = max(abs(w0[0]), abs(w0[1]), abs(w0[2]))
@@ -749,7 +753,7 @@ def _setup_attitude(prm, q0, pm, j1, j2, j3, w1, w2, w3):  # pragma: no cover - 
 def free_setup(moments, q0, w0):  # pragma: no cover - compiled
     """Reduce ``(moments (3,), q0 (4,) unit, omega0 (3,))`` to the parameter vector.
 
-    Steady motion (:func:`_is_steady`) keeps only ``KIND = 0``, ``W0`` and ``Q0``;
+    Steady motion (:func:`is_steady`) keeps only ``KIND = 0``, ``W0`` and ``Q0``;
     otherwise the working frame (:func:`_polar_order`, :func:`_working_frame`),
     the elliptic parameters (:func:`_setup_shape` and :func:`_setup_periodic` or
     :func:`_setup_separatrix`) and the attitude constants
@@ -760,7 +764,7 @@ def free_setup(moments, q0, w0):  # pragma: no cover - compiled
         prm[W0 + i] = w0[i]
     for i in range(4):
         prm[Q0 + i] = q0[i]
-    if _is_steady(moments, w0):
+    if is_steady(moments, w0):
         prm[KIND] = 0.0
         return prm
     order, kind = _polar_order(moments, w0)

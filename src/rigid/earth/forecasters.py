@@ -60,6 +60,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.units import DIMENSIONLESS, TIME
+from hamilton_orbits.validation import check_unmasked
 from rigid.earth.ar_models import accumulate_covariance, fit_var
 
 __all__ = [
@@ -183,6 +184,8 @@ def propagate_pole(
     if not (period > 0 and qq > 0 and h > 0) or np.isnan(qq):
         raise ValueError(f"Expected `chandler_period`, `q`, `step` > 0, got {period!r} d, "
                          f"{qq!r}, {h!r} d")
+    check_unmasked("m0", m0)  # (complex values: not through a unit kind's check)
+    check_unmasked("chi", chi)
     unit = m0.unit if isinstance(m0, u.Quantity) else None
     m0v = complex(m0.to_value(unit) if unit is not None else m0)
     cv = chi.to_value(unit) if unit is not None and isinstance(chi, u.Quantity) else chi

@@ -20,7 +20,7 @@ from typing import Any
 import astropy.units as u
 import numpy as np
 
-from hamilton_orbits.units import ANGULAR_SPEED, TIME
+from hamilton_orbits.units import ANGULAR_SPEED, TIME, time_quantity
 from rigid.earth.constants import A_AXIS_LONGITUDE, rigid_body
 from rigid.earth.wobble_fit import free_period
 from rigid.free import free_motion
@@ -117,11 +117,12 @@ def simulate_wobble(
 
     Parameters
     ----------
-    duration : Quantity
-        Time span (default 100 years).
+    duration : Quantity or TimeDelta
+        Time span (default 100 years; an astropy TimeDelta is the Quantity in days
+        it holds).
     wobble : Quantity
         Initial angle between the rotation and figure axes (default 0.2 arcsec).
-    dt : Quantity
+    dt : Quantity or TimeDelta
         Step of the fixed-step integrator (default 1 hour; ignored for
         ``"exact"`` and ``"dop853"``).  All three are Quantities: a bare number
         is refused (it could mean days, radians or seconds).
@@ -145,6 +146,7 @@ def simulate_wobble(
     >>> print(f"{path.period():.1f}")
     303.6 d
     """
+    duration, dt = time_quantity(duration), time_quantity(dt)  # (a TimeDelta: days)
     for name, value, like in (("duration", duration, "100 * u.yr"),
                               ("wobble", wobble, "0.2 * u.arcsec"), ("dt", dt, "1 * u.hour")):
         if value is None and name == "dt" and method in ("exact", "dop853"):

@@ -21,7 +21,7 @@ import numpy as np
 from astropy.time import Time
 
 from hamilton_orbits.units import TIME
-from hamilton_orbits.validation import as_float_array
+from hamilton_orbits.validation import as_float_array, check_unmasked
 from rigid._shared import positive_scalar
 from rigid.earth.c04 import PolarMotionRecord, decimal_year, iers2010_mean_pole, mjd_utc
 
@@ -78,6 +78,7 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     433.000000 d
     """
     tt = TIME("t", t, u.day)
+    check_unmasked("m", m)  # (a complex path: not through the unit kinds' check)
     mm = np.asarray(m.value if isinstance(m, u.Quantity) else m, dtype=np.complex128)
     if tt.ndim != 1 or mm.shape != tt.shape or tt.size < 8:
         raise ValueError(
