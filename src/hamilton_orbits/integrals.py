@@ -528,15 +528,18 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     ``mu`` is ``min(d / u, sqrt(d^3 / mu))`` (the time to cross the distance,
     or to fall through it): the time over which that body's pull turns.  It is
     taken at each output, and between two outputs where the particle passed its
-    closest point to the body (its radial velocity from negative to positive)
-    at the two-body periapsis about that body (the larger of those from the two
-    outputs; the speed there from the vis-viva law).  A step (``step``, or the
+    closest point to the body (its radial velocity from approaching to receding in
+    the run's direction: from negative to positive forwards, from positive to
+    negative in a run backwards, ``t`` decreasing) at the two-body periapsis
+    about that body (the larger of those from the two outputs; the speed there
+    from the vis-viva law).  A step (``step``, or the
     output interval where shorter: steps land on the outputs) longer than
     ``fraction`` of it does not resolve the approach; each run of
     consecutive such outputs is one encounter, reported at its closest point,
     with the particle's osculating ``1/a`` and ``e`` about its primary before and
-    after (at the outputs around it, beyond three Hill radii of the body where
-    the leg has them).  ``exempt = (body, distance)``: a body whose approaches
+    after it in the run (backwards: at the later time, then the earlier; at the
+    outputs around it, beyond three Hill radii of the body where the leg has
+    them).  ``exempt = (body, distance)``: a body whose approaches
     beyond that distance the method integrates exactly (``wh``'s central body:
     at any distance in democratic-heliocentric coordinates; in Jacobi
     coordinates, whose Kepler motions are about the inner bodies' centre of mass,
@@ -573,13 +576,13 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     prim = integrals.primaries(r[0], v[0], gm0, np.empty(len(gm0), np.int64), True)
     bad = np.zeros((1, len(tp), len(m)), np.bool_)
     none = np.empty((0, 0, 0))
-    integrals.approaches(r, v, gm0, tp, m, prim, ex, ex_dist, h, float(fraction), bad, none,
-                         none)
+    integrals.approaches(r, v, gm0, t, tp, m, prim, ex, ex_dist, h, float(fraction), bad,
+                         none, none)
     found: list[Encounter] = []
     for p, j in zip(*np.nonzero(bad[0]), strict=True):
         dist, tau = np.empty((len(t), 1, 1)), np.empty((len(t), 1, 1))
         at = np.zeros((len(t), 1, 1), np.bool_)  # (the outputs this pair was flagged at)
-        integrals.approaches(r, v, gm0, tp[p:p + 1], m[j:j + 1], prim, ex, ex_dist, h,
+        integrals.approaches(r, v, gm0, t, tp[p:p + 1], m[j:j + 1], prim, ex, ex_dist, h,
                              float(fraction), at, dist, tau)
         found += _runs(r, v, gm0, t, h, int(tp[p]), int(m[j]), (int(prim[tp[p]]),
                        int(prim[m[j]])), at[:, 0, 0], dist[:, 0, 0], tau[:, 0, 0])

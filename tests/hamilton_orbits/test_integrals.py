@@ -4,6 +4,7 @@ for, whose compiled screen must find every one the whole check finds."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from hamilton_orbits._kernels import integrals as k
 from hamilton_orbits.integrals import ENCOUNTER_STEP_FRACTION, LIGHT, light_as_massless
@@ -21,8 +22,8 @@ def _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction):
     prim = k.primaries(r[0], v[0], gm0, np.empty(len(gm), np.int64), True)
     bad = np.zeros((1, len(tp), len(m)), np.bool_)
     none = np.empty((0, 0, 0))
-    return k.approaches(r, v, gm0, tp, m, prim, exempt, exempt_dist, h, fraction, bad, none,
-                        none)
+    return k.approaches(r, v, gm0, t, tp, m, prim, exempt, exempt_dist, h, fraction, bad,
+                        none, none)
 
 
 def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
@@ -31,9 +32,13 @@ def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
     bodies as light as ``LIGHT`` and massive ones, close pairs passing between
     outputs, exempt central bodies or none) it passes every leg in which the whole
     check finds an approach (a good share of them, so that the comparison is not one
-    of zeros), and rules out most of the others."""
+    of zeros), and rules out most of the others.  The same states at times run
+    backwards (``-t``) likewise; and each leg's mirror (velocities reversed, run
+    backwards: the same passages) gives both the same answers, to the bit (a run
+    backwards looked for a closest point between outputs where the radial velocity
+    turned from negative to positive: where the pair recedes, going back in time)."""
     rng = np.random.default_rng(2026)
-    found = passed = 0
+    found = passed = back_found = back_passed = 0
     for _ in range(3000):
         n, n_t = int(rng.integers(2, 7)), int(rng.integers(2, 6))
         gm = rng.choice([0.0, 1e-12, 1e-5, 1e-3, 1.0], size=n)
@@ -45,20 +50,32 @@ def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
         exempt = int(rng.integers(-1, n))
         exempt_dist = float(rng.choice([0.0, 0.05]))
         fraction = float(rng.choice([ENCOUNTER_STEP_FRACTION, 1.0 / 3.0]))
-        whole = _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction)
-        maybe = k.screen(r, v, gm, t, step, exempt, exempt_dist, fraction, LIGHT)
+        args = (step, exempt, exempt_dist, fraction)
+        whole = _whole_count(r, v, gm, t, *args)
+        maybe = k.screen(r, v, gm, t, *args, LIGHT)
         assert maybe or whole == 0
         found += whole > 0
         passed += maybe
-    assert 300 < found < 2700
-    assert passed - found < 0.5 * (3000 - found)  # (the ones it lets through in vain)
+        back = _whole_count(r, v, gm, -t, *args)  # (the same states, backwards)
+        back_maybe = k.screen(r, v, gm, -t, *args, LIGHT)
+        assert back_maybe or back == 0
+        back_found += back > 0
+        back_passed += back_maybe
+        mirror = np.ascontiguousarray(-v)  # (the same passages, backwards)
+        assert _whole_count(r, mirror, gm, -t, *args) == whole
+        assert k.screen(r, mirror, gm, -t, *args, LIGHT) == maybe
+    for f, p in ((found, passed), (back_found, back_passed)):
+        assert 300 < f < 2700
+        assert p - f < 0.5 * (3000 - f)  # (the ones it lets through in vain)
 
 
-def test_the_screen_rules_out_the_legs_of_an_ordinary_run():
+@pytest.mark.parametrize("sign", [1, -1])
+def test_the_screen_rules_out_the_legs_of_an_ordinary_run(sign):
     """The solar system with wh at 4 d (Mercury's period / 22), legs of one step: the
     screen alone answers for every one (a screen by the time scale alone let every
     leg through, the inner planets being "near" for a step that long, so that the
-    whole check ran after each call: the Hill spheres rule them out)."""
+    whole check ran after each call: the Hill spheres rule them out); backwards
+    (``sign`` -1) too."""
     import astropy.units as u
 
     from hamilton_orbits import Simulation, System
@@ -66,7 +83,7 @@ def test_the_screen_rules_out_the_legs_of_an_ordinary_run():
     sim = Simulation(System.solar_system("J2000"), method="wh", dt=4 * u.day)
     gm = sim.system.as_arrays().gm
     for _ in range(200):
-        traj = sim.integrate(sim.t + 4 * u.day)
+        traj = sim.integrate(sim.t + sign * 4 * u.day)
         r, v = traj.r.to_value(u.au), traj.v.to_value(u.au / u.day)
         t = traj.t.to_value(u.day)
         assert not k.screen(np.ascontiguousarray(r), np.ascontiguousarray(v), gm, t, 4.0, 0,

@@ -482,6 +482,64 @@ def test_an_under_resolved_approach_of_a_backward_run_is_dated_at_its_periapsis(
         -float(orb.time_since_periapsis), abs=1e-3)
 
 
+def _mirrored(system):
+    """``system`` with its velocities reversed: run backward, it passes through the
+    states of ``system`` run forward (at ``-t``), velocities reversed."""
+    a = system.as_arrays()
+    return System([Body(name, gm, list(r), list(-v))
+                   for name, gm, r, v in zip(system.names, a.gm, a.r, a.v, strict=True)])
+
+
+def _sungrazer(gm_planet=None):
+    """A comet (q = 0.006) 1.559 before its periapsis about a star of GM 1 (and a
+    planet of ``gm_planet`` at 5.2)."""
+    orb = KeplerOrbit.from_elements(a=3.0, e=1 - 0.006 / 3.0, inc=0.3, lan=0.2, argp=0.1,
+                                    M=-0.3, mu=1.0)
+    r, v = orb.state()
+    planet = [] if gm_planet is None else [
+        Body("planet", gm_planet, [5.2, 0, 0], [0, 5.2**-0.5, 0])]
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), *planet,
+                   Body("comet", 0.0, list(r), list(v))])
+
+
+def _head_on_pair():
+    """Two planets of GM 1e-3 falling into each other beside a star of GM 1."""
+    return System([Body("b0", 1.0, [0, 0, 0], [0, 0, 0]),
+                   Body("b1", 1e-3, [1.0, 0.1, 0], [0, -0.3, 0]),
+                   Body("b2", 1e-3, [1.0, -0.1, 0], [0, 0.3, 0])])
+
+
+@pytest.mark.parametrize(("system", "kw", "pair"), [
+    (_sungrazer, dict(method="leapfrog", dt=0.01), ("comet", "sun")),
+    (_sungrazer, dict(method="radau15", dt=0.01), ("comet", "sun")),
+    (lambda: _sungrazer(1e-3), dict(method="wh", dt=0.1, coordinates="jacobi"),
+     ("comet", "sun")),
+    (_head_on_pair, dict(method="wh", dt=0.01), ("b2", "b1")),
+    (_head_on_pair, dict(method="leapfrog", dt=0.01), ("b2", "b1")),
+])
+def test_a_closest_point_between_outputs_of_a_backward_run_is_found(system, kw, pair):
+    """An approach whose closest point falls between two outputs (only the ends
+    here) warns run forward; run backward through the same passage (from the mirrored
+    state: velocities reversed) it did not: the passage between outputs was looked
+    for where the radial velocity turned from negative to positive, which going back
+    in time is the receding of a pair, not its approach.  The same encounter now, at
+    the same distance, dated at ``-t``."""
+    from hamilton_orbits.integrals import UnderResolvedEncounterWarning
+
+    with pytest.warns(UnderResolvedEncounterWarning):
+        ahead = integrate(system(), 2.0, **kw)
+    with pytest.warns(UnderResolvedEncounterWarning):
+        back = integrate(_mirrored(system()), -2.0, **kw)
+    assert len(ahead.t) == len(back.t) == 2
+    for table in (ahead.under_resolved, back.under_resolved):
+        assert [(str(row["particle"]), str(row["body"])) for row in table] == [pair]
+    (one,), (other,) = ahead.under_resolved, back.under_resolved
+    assert other["distance"] == pytest.approx(one["distance"], rel=1e-6)
+    assert other["time"] == pytest.approx(-one["time"], abs=1e-6)
+    for key in ("inv_a_before", "inv_a_after", "e_before", "e_after"):  # (the mirror's
+        assert other[key] == pytest.approx(one[key], rel=1e-6)  # orbits: the same)
+
+
 @pytest.mark.parametrize("method", ["wh", "leapfrog"])
 def test_massive_bodies_through_each_other_at_a_fixed_step_warn(method):
     """Two planets of GM 1e-3 falling head-on into each other beside a star, stepped
@@ -528,6 +586,23 @@ def test_a_closest_point_between_outputs_is_taken_only_where_the_conic_is_the_pa
             warnings.simplefilter("error")
             traj = integrate(system, 5 * u.yr, method="wh", dt=4 * u.day)
         assert len(traj.under_resolved) == 0
+
+
+@pytest.mark.parametrize("every", [None, 4.0, 100.0])
+def test_the_solar_system_run_backwards_at_a_fixed_step_warns_of_nothing(every):
+    """The solar system (and with Mars a test particle) 10 years back with wh at 4 d,
+    outputs at the ends, every step, or every 100 d: no approach is under-resolved
+    (backwards, the closest points between outputs are looked for where the pairs'
+    distances shrink, then grow, going back in time)."""
+    import warnings
+
+    s = System.solar_system("J2000")
+    t = -10 * u.yr if every is None else -np.arange(0, 3653, every) * u.day
+    for system in (_massless(s, "mars"), s):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            traj = integrate(system, t, method="wh", dt=4 * u.day)
+        assert len(traj.under_resolved) == 0 and traj.t[-1] <= -3600 * u.day
 
 
 def test_the_hill_sphere_of_the_body_passed_is_its_own_about_its_primary():

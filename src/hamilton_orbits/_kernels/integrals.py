@@ -192,6 +192,19 @@ def _periapsis(d2, u2, rad, mu):  # pragma: no cover - compiled
     return h2 / mu / (1.0 + ecc), inv_a
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _ahead(t, k):  # pragma: no cover - compiled
+    """The direction of time over the leg from output ``k - 1`` to ``k`` of the times
+    ``t``: 1.0 forwards, -1.0 backwards, 0.0 for the first output (no leg) or a leg of
+    no time.  A pair passed its closest point in the leg where its radial velocity
+    ``d . u`` times it turned from negative to positive (approaching, then receding,
+    in the run's direction: backwards, ``d . u`` from positive to negative), exactly
+    (a product by +-1 rounds nothing)."""
+    if k == 0:
+        return 0.0
+    return 1.0 if t[k] > t[k - 1] else (-1.0 if t[k] < t[k - 1] else 0.0)
+
+
 @njit(cache=True, error_model="numpy")
 def _within_hill(r, gm, j, cj, t, d2):  # pragma: no cover - compiled
     """Whether a distance ``sqrt(d2)`` from body ``j`` is within three of its Hill
@@ -207,11 +220,12 @@ def _within_hill(r, gm, j, cj, t, d2):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dist, tau
-               ):  # pragma: no cover - compiled
+def approaches(r, v, gm, t_out, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dist,
+               tau):  # pragma: no cover - compiled
     """For the bodies ``tp`` (test particles, and massive bodies other than the most
-    massive) and massive bodies ``m`` over states ``r``, ``v`` (n_t, n, 3): ``bad[t,
-    p, j]`` where the step ``h[t]`` exceeds ``fraction`` of the approach's time scale,
+    massive) and massive bodies ``m`` over states ``r``, ``v`` (n_t, n, 3) at times
+    ``t_out`` (increasing, or decreasing: a run backwards): ``bad[t, p, j]`` where
+    the step ``h[t]`` exceeds ``fraction`` of the approach's time scale,
     with the distance and time scale in ``dist``, ``tau`` (n_t, n_tp, n_m); when
     ``dist`` has no rows, neither is stored and ``bad`` (1, n_tp, n_m) is set where
     any output is; returns the count.
@@ -221,8 +235,10 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
     ``prim[tp[p]]`` faster than a tenth of the orbit's pace ``1 / n`` at the first
     output (any, unbound), or within three Hill radii of another body (about that
     body's own primary), not to ``exempt`` beyond ``exempt_dist``; at an
-    output its distance is ``|d|``, between outputs where the radial velocity
-    turned from negative to positive (the pair about the primary, or within the
+    output its distance is ``|d|``, between outputs where the pair passed its
+    closest point, the radial velocity turned from approaching to receding in the
+    direction of the run (from negative to positive forwards, from positive to
+    negative backwards: :func:`_ahead`; the pair about the primary, or within the
     Hill sphere at one of the two) the larger two-body periapsis of the two
     outputs; its time scale ``min(dist / speed, sqrt(dist^3 / mu))``."""
     n_t = r.shape[0]
@@ -250,6 +266,7 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
             cj = prim[j]  # (the Hill sphere is j's about its own primary)
             pd2, pu2, rad0, near0 = 0.0, 0.0, 0.0, False
             for t in range(n_t):
+                ahead = _ahead(t_out, t)
                 d2, u2, rad = 0.0, 0.0, 0.0
                 for k in range(3):
                     dk = r[t, i, k] - r[t, j, k]
@@ -262,7 +279,7 @@ def approaches(r, v, gm, tp, m, prim, exempt, exempt_dist, h, fraction, bad, dis
                 near = j == c or (cj >= 0 and _within_hill(r, gm, j, cj, t, d2))
                 # (square roots only where needed: most pairs of most runs are far apart)
                 dd, dd2, speed = math.sqrt(d2) if keep else -1.0, d2, -1.0
-                if t > 0 and rad0 < 0 and rad > 0 and (near or near0):
+                if ahead * rad0 < 0 and ahead * rad > 0 and (near or near0):
                     # a closest point passed between, on the pair's two-body conic where
                     # it means one: about the primary, or within the Hill sphere at an
                     # end (Mars and Jupiter's, both about the Sun, was no path: 0.74 au)
@@ -326,11 +343,11 @@ def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
         if k + 1 < n_t:
             gap = max(gap, abs(t[k + 1] - t[k]))
         h[k] = min(step, gap)
-    return _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction)
+    return _may_be_flagged(r, v, gm0, t, top, h, exempt, exempt_dist, fraction)
 
 
 @njit(cache=True, error_model="numpy")
-def _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
+def _may_be_flagged(r, v, gm0, t_out, top, h, exempt, exempt_dist, fraction):
     # pragma: no cover - compiled
     """Whether :func:`approaches` could flag any pair: its test, with each body's
     primary found only for a pair near enough to need it, the approach's time scale
@@ -359,12 +376,13 @@ def _may_be_flagged(r, v, gm0, top, h, exempt, exempt_dist, fraction):
                 gm0[j] == gm0[i] and j < i))) else 0.0
         for t in range(n_t):
             reach2 = (h[t] / fraction * slack) ** 2  # flagged: ts^2 < reach2
-            if _rows(r[t], v[t], i, gm0, pair, reach2, now, last, t > 0):  # (a pair near
+            ahead = _ahead(t_out, t)
+            if _rows(r[t], v[t], i, gm0, pair, reach2, now, last, ahead):  # (a pair near
                 # now, or a closest point passed between: looked at one by one)
                 for j in range(n):
-                    if now[3, j] > 0 and _flagged(r, v, gm0, top, prim, t, i, j, now[:, j],
-                                                  last[:, j], reach2, slack, j == exempt,
-                                                  ex2):
+                    if now[3, j] > 0 and _flagged(r, v, gm0, top, prim, t, ahead, i, j,
+                                                  now[:, j], last[:, j], reach2, slack,
+                                                  j == exempt, ex2):
                         return True
             now, last = last, now  # (this output's rows are the next one's before)
     return False
@@ -379,11 +397,12 @@ def _primary_cached(r, v, gm0, top, prim, i):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex2):
+def _flagged(r, v, gm0, top, prim, t, ahead, i, j, now, last, reach2, slack, exempt, ex2):
     # pragma: no cover - compiled
     """The test of :func:`approaches` for the pair ``(i, j)`` at output ``t`` (``now``,
-    ``last``: its ``|d|^2``, ``|u|^2``, ``d . u`` there and at the output before),
-    but for the pruning at the orbit's pace and with the time scale in squares."""
+    ``last``: its ``|d|^2``, ``|u|^2``, ``d . u`` there and at the output before;
+    ``ahead`` the leg's direction of time, :func:`_ahead`), but for the pruning at
+    the orbit's pace and with the time scale in squares."""
     c = _primary_cached(r, v, gm0, top, prim, i)
     if gm0[i] > 0 and j == c:
         return False  # (a massive body's own orbit: not checked)
@@ -391,7 +410,7 @@ def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex
     mu = gm0[i] + gm0[j]
     near = j == c or (cj >= 0 and _within_hill(r, gm0, j, cj, t, now[0]))
     dd2, speed2 = now[0], now[1]
-    if t > 0 and last[2] < 0 and now[2] > 0 and (
+    if ahead * last[2] < 0 and ahead * now[2] > 0 and (
             near or (cj >= 0 and _within_hill(r, gm0, j, cj, t - 1, last[0]))):
         q0, inv0 = _periapsis(last[0], last[1], last[2], mu)  # (as approaches: the
         q, inv_a = _periapsis(now[0], now[1], now[2], mu)  # closest point between)
@@ -408,14 +427,14 @@ def _flagged(r, v, gm0, top, prim, t, i, j, now, last, reach2, slack, exempt, ex
 
 
 @njit(cache=True, error_model="numpy")
-def _rows(rt, vt, i, gm0, pair, reach2, now, last, between):
+def _rows(rt, vt, i, gm0, pair, reach2, now, last, ahead):
     # pragma: no cover - compiled
     """``now``: each pair's ``|d|^2``, ``|u|^2``, ``d . u`` of body ``i`` with the
     others in the states ``rt``, ``vt`` (n, 3); whether one of ``pair`` is within the
-    flagging test ignoring an exempt body, or (``between``) passed its closest point
-    since ``last`` (no branch in the loop: vectorised)."""
+    flagging test ignoring an exempt body, or passed its closest point since ``last``
+    in the direction of time ``ahead`` of the leg (:func:`_ahead`: 0.0, none to
+    pass; no branch in the loop: vectorised)."""
     any_hit = 0.0
-    turn = 1.0 if between else 0.0
     for j in range(rt.shape[0]):
         dx, dy, dz = rt[i, 0] - rt[j, 0], rt[i, 1] - rt[j, 1], rt[i, 2] - rt[j, 2]
         ux, uy, uz = vt[i, 0] - vt[j, 0], vt[i, 1] - vt[j, 1], vt[i, 2] - vt[j, 2]
@@ -425,7 +444,7 @@ def _rows(rt, vt, i, gm0, pair, reach2, now, last, between):
         now[0, j], now[1, j], now[2, j] = d2, u2, rad
         mu = gm0[i] + gm0[j]
         near = (d2 < reach2 * u2) | (d2 * d2 * d2 < 2.0 * (reach2 * mu) ** 2)
-        passed = turn * ((last[2, j] < 0.0) & (rad > 0.0))
+        passed = (ahead * last[2, j] < 0.0) & (ahead * rad > 0.0)
         look = pair[j] * max(near, passed)
         now[3, j] = look
         any_hit = max(any_hit, look)
