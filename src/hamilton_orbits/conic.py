@@ -27,6 +27,7 @@ dynamical questions", Proc. R. Irish Acad. 3 (1847), Appendix, pp. xxxvi-l.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Any
 
 import numpy as np
@@ -164,6 +165,11 @@ def _element_floats(values: Any) -> tuple[list[np.ndarray], bool]:
 #: be (|P.P - 1|, |n.n - 1|, |P.n|: those of :meth:`Conic.from_elements`, made of
 #: sines and cosines, are within a few eps)
 _AXES = 64.0 * np.finfo(float).eps
+
+#: ``cos(x/2)`` at the float ``x = pi``: a parabola's ``nu`` no farther from an odd
+#: multiple of pi than the float pi is (``|cos(nu/2)|`` at most this) is on its
+#: asymptote (:meth:`Conic.radius`)
+_COS_HALF_PI = float(np.cos(0.5 * np.pi))
 
 
 def _checked_attributes(p: Any, e: Any, inv_a: Any, periapsis: Any, normal: Any,
@@ -440,11 +446,26 @@ class Conic:
     def radius(self, nu: Any) -> np.ndarray:
         """Focal distance ``r = p / (1 + e cos nu)`` (eq. 20).
 
+        The denominator is evaluated as ``(1 - e) + 2 e cos^2(nu/2)``, the same
+        number: for ``e <= 1`` a sum of two terms >= 0 (``1 - e`` is exact for
+        ``1/2 <= e <= 2``), where ``1 + e cos nu`` cancels near ``nu = pi``
+        (8e-4 relative for the parabola at ``pi - 1e-7``, 5e-9 for ``e = 1 - 1e-12``
+        at ``pi - 1e-4``).  The radius is then good to a few ulp times the
+        condition number ``(|1 - e| + 2 e cos^2(nu/2)) / (1 + e cos nu)`` of that
+        sum: 1 for the closed conics and the parabola, large only near a
+        hyperbola's asymptote.  The same denominator decides the asymptote, so
+        that every ``nu`` refused is one without a positive radius.
+
         Parameters
         ----------
         nu : array_like or Quantity (angle)
-            True anomaly; for an open conic strictly inside the asymptotes,
-            ``|nu| < arccos(-1/e)`` (``|nu| < pi`` for the parabola).
+            True anomaly (modulo 2 pi), broadcasting against the conic's shape;
+            for an open conic strictly inside the asymptotes:
+            ``|nu| < arccos(-1/e)`` for the hyperbola, ``|nu| < pi`` for the
+            parabola (every float but the float pi, 1.2e-16 below pi, which is
+            taken as pi, its asymptote, as
+            :meth:`KeplerOrbit.from_elements <hamilton_orbits.KeplerOrbit.from_elements>`
+            takes it).
 
         Raises
         ------
@@ -456,23 +477,31 @@ class Conic:
         >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
         >>> round(float(c.radius(np.pi)), 12)  # apoapsis p / (1 - e)
         2.571428571429
+        >>> parabola = Conic.from_elements(2.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # q = 1
+        >>> float(parabola.radius(np.pi - 1e-7))  # that of the float nu to 1 ulp
+        400000000329546.0
         >>> Conic.from_state([1.0, 0, 0], [0, 2.0, 0], 1.0).radius(np.pi)
         Traceback (most recent call last):
         ...
-        ValueError: Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = 1.910633 rad (e = 3.0), got 3.141592653589793
+        ValueError: Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = 1.9106332362490186 rad (e = 3.0), got 3.141592653589793
         """  # noqa: E501
         nu = ANGLE("nu", nu)
-        den = 1.0 + self.e * np.cos(nu)
-        bad = ~(den > 0.0)
+        e = self.e
+        c = np.cos(0.5 * nu)
+        den = (1.0 - e) + 2.0 * e * (c * c)  # 1 + e cos nu
+        bad = ~(den > 0.0) | ((e == 1.0) & ~(np.abs(c) > _COS_HALF_PI))
         if np.any(bad):
-            e_b = np.broadcast_to(self.e, bad.shape)
+            e_b = np.broadcast_to(e, bad.shape)
             nu_b = np.broadcast_to(nu, bad.shape)
             i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             e_i = float(e_b[i])
-            lim = np.arccos(-1.0 / e_i) if e_i > 0 else np.pi
+            # arccos(-1/e) as 2 atan(sqrt((e + 1)/(e - 1))), to an ulp or two (arccos
+            # of the rounded -1/e was 3e-15 off for e = 1 + 1e-6, inside the limit)
+            lim = 2.0 * math.atan2(math.sqrt(e_i + 1.0), math.sqrt(e_i - 1.0))
+            limit = f"|nu| < arccos(-1/e) = {lim!r} rad" if e_i > 1.0 else "|nu| < pi"
             raise ValueError(
-                f"Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = {lim:.7g} rad "
-                f"(e = {e_i!r}), got {float(nu_b[i])!r}{fmt_index(i)}"
+                f"Expected `nu` inside the asymptotes, {limit} (e = {e_i!r}), "
+                f"got {float(nu_b[i])!r}{fmt_index(i)}"
             )
         return self._out(self._p / den, _L)
 

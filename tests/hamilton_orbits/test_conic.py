@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import astropy.units as u
+import mpmath
 import numpy as np
 import pytest
 from hard_cases import CASES, perifocal_state
@@ -183,7 +184,7 @@ def test_points_off_the_conic_are_refused():
     negative radius; now a ValueError naming the argument, value and range."""
     hyp = Conic.from_state([1.0, 0, 0], [0, 2.0, 0], 1.0)  # e = 3, q = 1
     with pytest.raises(ValueError, match=r"`nu` inside the asymptotes, \|nu\| < arccos\(-1/e\) "
-                                         r"= 1.910633 rad \(e = 3.0\), got 3.14159"):
+                                         r"= 1.9106332362490186 rad \(e = 3.0\), got 3.14159"):
         hyp.radius(math.pi)
     # just inside the asymptote: a large but finite radius (p / (1 + e cos nu) > 0)
     assert 0 < hyp.radius(math.acos(-1 / 3) - 1e-9) < np.inf
@@ -405,3 +406,102 @@ def test_an_axis_of_one_row_is_named_without_an_index():
     with pytest.raises(ValueError, match=r"Expected `periapsis_direction` of unit length, got "
                                          r"the length 1.0049875621120892$"):
         Conic(**{**ATTRS, "periapsis_direction": [[0.6, 0.8, 0.1]]})
+
+
+# ------------------------------------------------------------- radius near nu = pi
+# q = 1 conics of eccentricity at and around 1 (p = q (1 + e), 1/a = (1 - e)(1 + e)/p)
+NEAR_PARABOLIC = (1.0, 1.0 - 1e-12, 1.0 + 1e-12, 1.0 - 1e-6, 1.0 + 1e-6)
+
+
+def _near_parabolic(e):
+    p = 1.0 + e
+    return Conic.from_elements(p, e, (1.0 - e) * (1.0 + e) / p, 0.0, 0.0, 0.0, 1.0)
+
+
+def _exact_radius(p, e, nu):
+    """``p / (1 + e cos nu)`` of the floats ``p``, ``e``, ``nu`` at 50 digits, and the
+    condition number ``kappa = (|1 - e| + 2 e cos^2(nu/2)) / (1 + e cos nu)`` of the
+    sum the denominator is computed as: its terms are rounded to an ulp or two
+    (``cos`` to one, ``1 - e`` exact here), so the radius is good to a few ulp
+    times kappa (1 for ``e <= 1``, ``~2 (e - 1) / (1 + e cos nu)`` near a hyperbola's
+    asymptote)."""
+    with mpmath.workdps(50):
+        e_, nu_ = mpmath.mpf(e), mpmath.mpf(nu)
+        den = 1 + e_ * mpmath.cos(nu_)
+        terms = abs(1 - e_) + 2 * e_ * mpmath.cos(nu_ / 2) ** 2
+        return mpmath.mpf(p) / den, float(terms / den), den
+
+
+def _anomalies_towards_the_asymptote(e):
+    """Float anomalies approaching pi (closed conics, parabola) or arccos(-1/e)
+    (hyperbolas) from inside, both signs, up to the last float inside."""
+    with mpmath.workdps(50):
+        lim = mpmath.pi if e <= 1.0 else mpmath.acos(-1 / mpmath.mpf(e))
+        gap = mpmath.pi - lim if e > 1.0 else mpmath.mpf(1)
+        nus = [float(lim - gap * mpmath.mpf(10) ** -k) for k in range(16)]
+        # the last float inside: exactly, 1 + e cos nu > 0 (the parabola's below the
+        # float pi, which stands for pi; an ellipse's the float pi)
+        top = math.nextafter(np.pi, 0.0) if e == 1.0 else float(lim)
+        while not (1 + mpmath.mpf(e) * mpmath.cos(mpmath.mpf(top)) > 0) or top >= lim:
+            top = math.nextafter(top, 0.0)
+        nus.append(top)
+    nus = sorted({x for x in nus if x < top or x == top})
+    return np.array(nus + [-x for x in nus])
+
+
+@pytest.mark.parametrize("e", NEAR_PARABOLIC)
+def test_radius_near_pi_and_the_asymptote_against_mpmath(e):
+    """``Conic.radius`` evaluated ``p / (1 + e cos nu)``, which cancels near
+    ``nu = pi``: 8e-4 relative for the parabola at pi - 1e-7 (4.0032e14 for
+    4.0000e14), a refusal at pi - 1e-8 and below, 5e-9 for e = 1 - 1e-12 at
+    pi - 1e-4, and near a hyperbola's asymptote errors of eps / (1 + e cos nu)
+    instead of eps 2 (e - 1) / (1 + e cos nu).  Now ``(1 - e) + 2 e cos^2(nu/2)``:
+    within 4 eps times the condition number of that sum (``_exact_radius``), for
+    every anomaly towards pi or the asymptote down to the last float inside."""
+    conic = _near_parabolic(e)
+    p = float(conic.p)
+    nus = _anomalies_towards_the_asymptote(e)
+    got = conic.radius(nus)
+    for nu, r in zip(nus, got, strict=True):
+        exact, kappa, _ = _exact_radius(p, e, nu)
+        assert abs(float(r / exact - 1)) <= 4 * EPS * max(kappa, 1.0), (nu, r, exact, kappa)
+
+
+@pytest.mark.parametrize("e", [x for x in NEAR_PARABOLIC if x >= 1.0])
+def test_the_asymptote_refused_exactly_where_the_radius_ends(e):
+    """The refusal and the value agree: ``nu`` is refused exactly where
+    ``1 + e cos nu <= 0`` for the float ``nu`` (exactly, the floats on each side of
+    a hyperbola's asymptote), and for the parabola at the float pi alone, which
+    stands for pi (as in ``KeplerOrbit``).  The parabola refused every nu from
+    pi - 1e-8 with "|nu| < arccos(-1/e) = 3.141593 rad (e = 1.0), got
+    3.141592643589793" (a nu below the limit it named); near a hyperbola's
+    asymptote the rounding of ``e cos nu`` decided."""
+    conic = _near_parabolic(e)
+    p = float(conic.p)
+    if e == 1.0:
+        for nu in (np.pi, -np.pi):
+            with pytest.raises(ValueError, match=r"`nu` inside the asymptotes, \|nu\| < pi "
+                                                 r"\(e = 1.0\), got -?3.141592653589793$"):
+                conic.radius(nu)
+        below = math.nextafter(np.pi, 0.0)  # 2 p / (pi - nu)^2 = 1.5e31: taken
+        exact, _, _ = _exact_radius(p, e, below)
+        assert float(conic.radius(below)) == pytest.approx(float(exact), rel=4 * EPS)
+        return
+    with mpmath.workdps(50):
+        start = float(mpmath.acos(-1 / mpmath.mpf(e)))  # the asymptote, rounded
+    nu = start
+    for _ in range(6):
+        nu = math.nextafter(nu, 0.0)
+    for _ in range(12):
+        exact, kappa, den = _exact_radius(p, e, nu)
+        if den > 0:
+            assert abs(float(conic.radius(nu) / exact - 1)) <= 4 * EPS * kappa
+        else:
+            with pytest.raises(ValueError, match=r"`nu` inside the asymptotes, \|nu\| < "
+                                                 r"arccos\(-1/e\) = ") as info:
+                conic.radius(nu)
+            # the limit named is the asymptote to 2 ulp (arccos of the float -1/e was
+            # 3.140178440616719 for e = 1 + 1e-6, below accepted anomalies)
+            named = float(str(info.value).split("= ")[1].split(" rad")[0])
+            assert abs(named - start) <= 2 * np.spacing(start)
+        nu = math.nextafter(nu, 4.0)
