@@ -227,7 +227,10 @@ class Conic:
     orbit's internal units (km, km/s for Quantity orbits).  The attributes are
     checked as :meth:`from_elements` checks its elements, and the two axes must be
     of unit length and orthogonal (to 64 eps): a ValueError names the attribute,
-    the first offending index and the value.
+    the first offending index and the value.  The conic's shape is that of its
+    attributes broadcast together (the axes' without their last axis); the
+    methods taking a point (``nu``, ``r``) refuse one whose shape does not
+    broadcast against it, naming the argument and both shapes.
 
     Attributes
     ----------
@@ -269,15 +272,35 @@ class Conic:
         return f"Conic(p={fmt(self._p)}, e={fmt(self.e)}, inv_a={fmt(self._inv_a)}){unit}"
 
     # ---------------------------------------------------------------- units
-    def _in(self, name: str, value: Any, unit: u.UnitBase) -> np.ndarray:
-        """A length (or vector of lengths) in the conic's units; no unit mixing."""
+    def _in(self, name: str, value: Any, unit: u.UnitBase, vector: bool = False) -> np.ndarray:
+        """A length (or, ``vector``, positions of shape (..., 3)) in the conic's units,
+        broadcasting against the conic's shape (:meth:`_against`); no unit mixing."""
         if is_quantity(value) != self._quantity:
             kind = "a Quantity" if self._quantity else "plain floats"
             raise ValueError(
                 f"Expected `{name}` as {kind} like the orbit this conic came from, "
                 f"got {type(value).__name__}"
             )
-        return LENGTH(name, value, unit)
+        x = LENGTH(name, value, unit)
+        return self._against(name, check_trailing(name, x, 3) if vector else x, vector)
+
+    def _against(self, name: str, x: np.ndarray, vector: bool = False) -> np.ndarray:
+        """``x``, refused unless its shape (its leading dimensions for a ``vector`` of
+        shape (..., 3)) broadcasts against the conic's, that of its attributes
+        broadcast together (the axes' without their last axis): ValueError naming
+        the argument and both shapes."""
+        mine = np.broadcast_shapes(self._p.shape, self.e.shape, self._inv_a.shape,
+                                   self._mu.shape, self.periapsis_direction.shape[:-1],
+                                   self.normal.shape[:-1])
+        try:
+            np.broadcast_shapes(mine, x.shape[:-1] if vector else x.shape)
+        except ValueError:
+            what = "of shape (..., 3) with leading dimensions" if vector else "of a shape"
+            raise ValueError(
+                f"Expected `{name}` {what} broadcasting against the conic's shape {mine}, "
+                f"got shape {x.shape}"
+            ) from None
+        return x
 
     def _out(self, value: np.ndarray, unit: u.UnitBase):
         return wrap(value, unit, self._quantity)
@@ -470,7 +493,8 @@ class Conic:
         Raises
         ------
         ValueError
-            For ``nu`` on or beyond an asymptote, naming the value and the range.
+            For ``nu`` on or beyond an asymptote, naming the value and the range,
+            or of a shape not broadcasting against the conic's, naming both shapes.
 
         Examples
         --------
@@ -485,7 +509,7 @@ class Conic:
         ...
         ValueError: Expected `nu` inside the asymptotes, |nu| < arccos(-1/e) = 1.9106332362490186 rad (e = 3.0), got 3.141592653589793
         """  # noqa: E501
-        nu = ANGLE("nu", nu)
+        nu = self._against("nu", ANGLE("nu", nu))
         e = self.e
         c = np.cos(0.5 * nu)
         den = (1.0 - e) + 2.0 * e * (c * c)  # 1 + e cos nu
@@ -591,7 +615,8 @@ class Conic:
         Parameters
         ----------
         r : array_like, shape (..., 3)
-            A position on the orbit.
+            A position on the orbit, its leading dimensions broadcasting against
+            the conic's shape.
 
         Examples
         --------
@@ -600,7 +625,7 @@ class Conic:
         >>> (rot + fix + 0.0).round(12).tolist()
         [0.0, 1.2, 0.0]
         """
-        r = check_trailing("r", self._in("r", r, _L), 3)
+        r = self._in("r", r, _L, vector=True)
         nonzero = np.any(r != 0, axis=-1)
         if not np.all(nonzero):
             i = first_index(np.atleast_1d(~nonzero)) if nonzero.ndim else ()

@@ -505,3 +505,51 @@ def test_the_asymptote_refused_exactly_where_the_radius_ends(e):
             named = float(str(info.value).split("= ")[1].split(" rad")[0])
             assert abs(named - start) <= 2 * np.spacing(start)
         nu = math.nextafter(nu, 4.0)
+
+
+# ------------------------------------------------------------------ shapes
+def _three_conics():
+    r = np.array([[1.0, 0.0, 0.0]] * 3)
+    v = np.array([[0.0, 1.2, 0.0], [0.0, 2.0, 0.0], [0.0, 2.0**0.5, 0.0]])
+    return Conic.from_state(r, v, 1.0)  # an ellipse, a hyperbola, a parabola: shape (3,)
+
+
+@pytest.mark.parametrize("method", ["radius", "focal_half_chord", "second_focal_distance",
+                                    "normal_length", "radius_of_curvature",
+                                    "radial_speed_squared"])
+def test_a_point_not_broadcasting_against_the_conic_is_refused_by_name(method):
+    """The methods at a point gave numpy's message for a point of another shape
+    ("operands could not be broadcast together with shapes (3,) (2,)"); now a
+    ValueError naming the argument and both shapes.  Shapes that broadcast are
+    taken, each conic at its own point."""
+    c = _three_conics()
+    name = "nu" if method == "radius" else "r"
+    with pytest.raises(ValueError, match=rf"Expected `{name}` of a shape broadcasting against "
+                                         r"the conic's shape \(3,\), got shape \(2,\)$"):
+        getattr(c, method)([1.0, 1.0])
+    with pytest.raises(ValueError, match=r"the conic's shape \(3,\), got shape \(4, 2\)$"):
+        getattr(c, method)(np.ones((4, 2)))
+    assert getattr(c, method)(np.ones((4, 1))).shape == (4, 3)
+    assert getattr(c, method)(1.0).shape == (3,)
+    single = getattr(c, method)([0.5, 1.0, 1.5] if name == "nu" else [1.0, 1.1, 1.2])
+    for k in range(3):
+        one = Conic(c.p[k], c.e[k], c.inv_a[k], c.periapsis_direction[k], c.normal[k], 1.0)
+        x = [0.5, 1.0, 1.5][k] if name == "nu" else [1.0, 1.1, 1.2][k]
+        assert getattr(one, method)(x) == single[k]
+
+
+def test_hodograph_positions_not_broadcasting_against_the_conic_are_refused_by_name():
+    """``hodograph`` gave numpy's "shape mismatch: objects cannot be broadcast to a
+    single shape" for positions of another leading shape; now named with both
+    shapes.  Leading shapes that broadcast are taken."""
+    c = _three_conics()
+    with pytest.raises(ValueError, match=r"Expected `r` of shape \(\.\.\., 3\) with leading "
+                                         r"dimensions broadcasting against the conic's shape "
+                                         r"\(3,\), got shape \(2, 3\)$"):
+        c.hodograph(np.array([[1.0, 0.0, 0.0]] * 2))
+    rot, _ = c.hodograph(np.ones((4, 1, 3)))
+    assert rot.shape == (4, 3, 3)
+    rot, fix = c.hodograph([1.0, 0.0, 0.0])  # one position for the three conics
+    np.testing.assert_allclose(rot + fix, [[0, 1.2, 0], [0, 2.0, 0], [0, 2**0.5, 0]],
+                               rtol=0, atol=4 * EPS)
+
