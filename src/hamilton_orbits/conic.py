@@ -387,6 +387,7 @@ class Conic:
         values, quantities = _checked_elements(p, e, inv_a, inc, lan, argp, mu)
         p, e, inv_a, inc, lan, argp, mu = values
         quantity = as_flag("quantity", quantity) or quantities
+        inc, lan, argp = np.broadcast_arrays(inc, lan, argp)  # (checked: they broadcast)
         cl, sl = np.cos(lan), np.sin(lan)
         ci = np.where(inc == np.pi, -1.0, np.cos(inc))
         si = np.where(inc == np.pi, 0.0, np.sin(inc))

@@ -553,3 +553,14 @@ def test_hodograph_positions_not_broadcasting_against_the_conic_are_refused_by_n
     np.testing.assert_allclose(rot + fix, [[0, 1.2, 0], [0, 2.0, 0], [0, 2**0.5, 0]],
                                rtol=0, atol=4 * EPS)
 
+
+def test_from_elements_broadcasts_the_angles():
+    """``from_elements`` stacked the axes' components unbroadcast: angles of
+    different shapes that broadcast together (one ``inc``, two ``lan``) gave numpy's
+    "all input arrays must have the same shape"; now each conic's axes are those
+    of its own angles."""
+    c = Conic.from_elements(1.44, 0.44, 0.56, 0.3, [0.0, 0.1], [[0.2], [0.4], [0.5]], 1.0)
+    assert c.periapsis_direction.shape == c.normal.shape == (3, 2, 3)
+    one = Conic.from_elements(1.44, 0.44, 0.56, 0.3, 0.1, 0.4, 1.0)
+    np.testing.assert_array_equal(c.periapsis_direction[1, 1], one.periapsis_direction)
+    np.testing.assert_array_equal(c.normal[1, 1], one.normal)
