@@ -477,8 +477,9 @@ class Conic:
         at ``pi - 1e-4``).  The radius is then good to a few ulp times the
         condition number ``(|1 - e| + 2 e cos^2(nu/2)) / (1 + e cos nu)`` of that
         sum: 1 for the closed conics and the parabola, large only near a
-        hyperbola's asymptote.  The same denominator decides the asymptote, so
-        that every ``nu`` refused is one without a positive radius.
+        hyperbola's asymptote.  The same denominator decides a hyperbola's
+        asymptote: ``nu`` is refused exactly where it is not positive (the
+        parabola refuses the float pi alone, below).
 
         Parameters
         ----------
@@ -520,10 +521,12 @@ class Conic:
             nu_b = np.broadcast_to(nu, bad.shape)
             i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
             e_i = float(e_b[i])
-            # arccos(-1/e) as 2 atan(sqrt((e + 1)/(e - 1))), to an ulp or two (arccos
-            # of the rounded -1/e was 3e-15 off for e = 1 + 1e-6, inside the limit)
-            lim = 2.0 * math.atan2(math.sqrt(e_i + 1.0), math.sqrt(e_i - 1.0))
-            limit = f"|nu| < arccos(-1/e) = {lim!r} rad" if e_i > 1.0 else "|nu| < pi"
+            limit = "|nu| < pi"  # (the parabola; a closed conic refuses no nu)
+            if e_i > 1.0:
+                # arccos(-1/e) as 2 atan(sqrt((e + 1)/(e - 1))), to an ulp or two (arccos
+                # of the rounded -1/e was 3e-15 off for e = 1 + 1e-6, inside the limit)
+                lim = 2.0 * math.atan2(math.sqrt(e_i + 1.0), math.sqrt(e_i - 1.0))
+                limit = f"|nu| < arccos(-1/e) = {lim!r} rad"
             raise ValueError(
                 f"Expected `nu` inside the asymptotes, {limit} (e = {e_i!r}), "
                 f"got {float(nu_b[i])!r}{fmt_index(i)}"
