@@ -324,7 +324,20 @@ def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
     out in one compiled call, which a run whose every approach is resolved (nearly
     all) leaves at (a continuing call of one step of ten bodies: 1 us); True (a
     pair close enough for its speed) calls for the whole check.  Small, so that a
-    first run compiles it quickly, the whole check only where it is needed."""
+    first run compiles it quickly, the whole check only where it is needed.
+
+    Its test is that of :func:`approaches`, with each body's primary found only for
+    a pair near enough to need it, the approach's time scale compared in squares
+    with a margin of 1e-9 for their rounding, and without the pruning of an approach
+    at the orbit's own pace (which only takes flags away).  For each body and
+    output, the other bodies in one loop without branches (:func:`_rows`: the
+    compiler's vector instructions; a disc of 1000 massive bodies costs about a
+    force evaluation); the pairs it finds near looked at one by one
+    (:func:`_flagged`).  Two levels of compiled calls, no more: numba optimises a
+    function with every function it calls linked in, so each level of calls
+    compiles its callees' code again (a third level, this function's loop apart
+    from its set-up, and a fourth, the primaries' cache, cost a first fixed-step
+    run 0.7 s more of its 3.1 s for this function, CPU time on this machine)."""
     n_t, n = r.shape[0], r.shape[1]
     if n_t < 2 or n < 2:
         return False
@@ -343,22 +356,6 @@ def screen(r, v, gm, t, step, exempt, exempt_dist, fraction, light):
         if k + 1 < n_t:
             gap = max(gap, abs(t[k + 1] - t[k]))
         h[k] = min(step, gap)
-    return _may_be_flagged(r, v, gm0, t, top, h, exempt, exempt_dist, fraction)
-
-
-@njit(cache=True, error_model="numpy")
-def _may_be_flagged(r, v, gm0, t_out, top, h, exempt, exempt_dist, fraction):
-    # pragma: no cover - compiled
-    """Whether :func:`approaches` could flag any pair: its test, with each body's
-    primary found only for a pair near enough to need it, the approach's time scale
-    compared in squares with a margin of 1e-9 for their rounding, and without the
-    pruning of an approach at the orbit's own pace (which only takes flags away).
-    For each body and output, the other bodies in one loop without branches (the
-    compiler's vector instructions: a disc of 1000 massive bodies costs about a force
-    evaluation); the pairs it finds near looked at one by one.  Most calls of most
-    runs end here.  (Its parts are compiled apart, not inlined: 3 s of a first run's
-    compilation instead of 4.)"""
-    n_t, n = r.shape[0], r.shape[1]
     slack = 1.0 + 1e-9
     ex2 = (exempt_dist * slack) ** 2
     last = np.empty((4, n))  # |d|^2, |u|^2, d . u of each pair at the output before
@@ -374,13 +371,13 @@ def _may_be_flagged(r, v, gm0, t_out, top, h, exempt, exempt_dist, fraction):
         for j in range(n):
             pair[j] = 1.0 if (j != i and gm0[j] > 0 and (gm0[j] > gm0[i] or (
                 gm0[j] == gm0[i] and j < i))) else 0.0
-        for t in range(n_t):
-            reach2 = (h[t] / fraction * slack) ** 2  # flagged: ts^2 < reach2
-            ahead = _ahead(t_out, t)
-            if _rows(r[t], v[t], i, gm0, pair, reach2, now, last, ahead):  # (a pair near
+        for k in range(n_t):
+            reach2 = (h[k] / fraction * slack) ** 2  # flagged: ts^2 < reach2
+            ahead = _ahead(t, k)
+            if _rows(r[k], v[k], i, gm0, pair, reach2, now, last, ahead):  # (a pair near
                 # now, or a closest point passed between: looked at one by one)
                 for j in range(n):
-                    if now[3, j] > 0 and _flagged(r, v, gm0, top, prim, t, ahead, i, j,
+                    if now[3, j] > 0 and _flagged(r, v, gm0, top, prim, k, ahead, i, j,
                                                   now[:, j], last[:, j], reach2, slack,
                                                   j == exempt, ex2):
                         return True
@@ -388,7 +385,7 @@ def _may_be_flagged(r, v, gm0, t_out, top, h, exempt, exempt_dist, fraction):
     return False
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _primary_cached(r, v, gm0, top, prim, i):  # pragma: no cover - compiled
     """Body ``i``'s primary at the first output, found once (-1: the most massive)."""
     if prim[i] == -2:
