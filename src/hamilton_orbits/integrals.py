@@ -557,13 +557,14 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     []
     """
     from hamilton_orbits._kernels import integrals
+    from hamilton_orbits._screening import screen
 
     r = np.ascontiguousarray(r, dtype=np.float64)
     v = np.ascontiguousarray(v, dtype=np.float64)
     t = np.ascontiguousarray(t, dtype=np.float64)
     gm = np.ascontiguousarray(np.atleast_2d(gm)[0], dtype=np.float64)
     ex, ex_dist = (-1, 0.0) if exempt is None else (int(exempt[0]), float(exempt[1]))
-    if not integrals.screen(r, v, gm, t, float(step), ex, ex_dist, float(fraction), LIGHT):
+    if not screen(r, v, gm, t, float(step), ex, ex_dist, float(fraction), LIGHT):
         return []  # (all resolved: nearly every run, found in one compiled call)
     gm0 = light_as_massless(gm)
     m = np.flatnonzero(gm0 > 0)

@@ -554,7 +554,7 @@ def encounter_warning(traj: Trajectory) -> Any:
         "shorten the step or use an adaptive method (radau15)")
 
 
-#: compiled kernels this module calls after each leg, imported at the first
+#: the screen this module calls after each leg, imported at the first
 _KERNELS: dict[str, Any] = {}
 
 
@@ -565,8 +565,8 @@ def _under_resolved(r: np.ndarray, v: np.ndarray, out: Any, times: np.ndarray,
     that there are none (after nearly every call: 2 us of a continuing call of one
     step of ten bodies), the details only where there are."""
     screen = _KERNELS.get("screen")
-    if screen is None:  # (numba's, imported once: an import statement per call cost
-        from hamilton_orbits._kernels.integrals import screen  # 0.6 us of 10)
+    if screen is None:  # (the compiled screen's, imported once: an import statement
+        from hamilton_orbits._screening import screen  # per call cost 0.6 us of 10)
 
         _KERNELS["screen"] = screen
     step, exempt, fraction = encounters

@@ -28,7 +28,7 @@ from typing import Any
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["compile_ahead", "entry"]
+__all__ = ["compile_ahead", "entry", "on_disk"]
 
 _lock = threading.Lock()
 #: Kernels being compiled into the on-disk cache by another process
@@ -109,6 +109,26 @@ class EntryKernel:
     def __repr__(self) -> str:
         state = "compiled" if self.compiled else "not compiled yet"
         return f"<entry kernel {self.__module__}.{self.__qualname__} ({state})>"
+
+
+def on_disk(dispatcher: Any, args: tuple) -> bool:
+    """Whether numba's on-disk cache holds the lazily compiled ``dispatcher`` (an
+    ``njit(cache=True)`` function) for the types of ``args``, without compiling it
+    (True when it cannot tell: the caller then compiles, as it would have).
+
+    Examples
+    --------
+    >>> from numba import njit
+    >>> on_disk(njit(cache=False)(lambda x: x + 1), (1.0,))  # (no cache: cannot tell)
+    True
+    """
+    try:
+        from numba import typeof
+
+        sig = tuple(typeof(a) for a in args)
+        return dispatcher._cache.load_overload(sig, dispatcher.targetctx) is not None
+    except Exception:  # (numba's cache API is its own: never fail a run on it)
+        return True
 
 
 def compile_ahead(kernels: Sequence[EntryKernel],
