@@ -125,7 +125,7 @@ class BodyTorque(_ConstantTorque):
     torque : array_like or Quantity, shape (3,)
         Body-frame torque: a Quantity (any unit of torque), or plain numbers in N m
         (SI).  Plain numbers (but zeros) are refused beside a body or moments of
-        Quantities (:func:`check_torque_units`): their unit cannot be guessed.
+        Quantities (``check_torque_units``): their unit cannot be guessed.
 
     Examples
     --------
@@ -145,7 +145,7 @@ class SpaceTorque(_ConstantTorque):
     torque : array_like or Quantity, shape (3,)
         Space-frame torque: a Quantity (any unit of torque), or plain numbers in N m
         (SI).  Plain numbers (but zeros) are refused beside a body or moments of
-        Quantities (:func:`check_torque_units`): their unit cannot be guessed.
+        Quantities (``check_torque_units``): their unit cannot be guessed.
 
     Examples
     --------
@@ -182,7 +182,7 @@ class GravityGradientTorque(_Torque):
     phase : float or Quantity, optional
         Angle of the direction at t = 0.  Default 0.  A plain number is radians,
         beside Quantities too (as every angle of the package:
-        :data:`hamilton_orbits.units.ANGLE`); ``30 * u.deg`` for degrees.
+        ``hamilton_orbits.units.ANGLE``); ``30 * u.deg`` for degrees.
     e1, e2 : array_like, shape (3,), optional
         Orthonormal space-frame vectors spanning the orbit plane; default the
         x and y axes.
