@@ -482,3 +482,14 @@ def test_a_run_into_a_folder_of_an_earlier_run_names_the_files_it_did_not_write(
     assert (f"{out}/ also holds files this run did not write (an earlier run's?): "
             f"energy_error.png, final.bin, orbits.png") in capsys.readouterr().err
     assert (out / "final.bin").exists()
+
+
+def test_a_folder_or_a_device_given_as_the_scene_is_named_as_such(tmp_path, capsys):
+    """``run FOLDER`` said "no bundled scene of that name", as if a name were
+    misspelt; a path that exists and is no file is named as what it is (exit 2,
+    nothing run)."""
+    assert main(["run", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
+    assert "a folder, not a scene file" in capsys.readouterr().err
+    assert main(["run", "/dev/null", "--out", str(tmp_path / "out")]) == 2
+    assert "not a regular file, not a scene file" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

@@ -136,7 +136,23 @@ def _load_scene(ref: str, sets: Sequence[str], text: str | None = None):
         return Scene.from_text(text, ref, values)
     if _scene_file(ref) is not None:
         return Scene.from_toml(ref, values)
+    _not_a_scene_file(ref)
     return Scene.bundled(ref, values)
+
+
+def _not_a_scene_file(ref: str) -> None:
+    """Refuse a path that exists but is not a file (a folder, a device) and names
+    no bundled scene, saying what it is: "no bundled scene of that name" misled."""
+    from pathlib import Path
+
+    from hamilton_orbits.scene import Scene, SceneError
+
+    path = Path(ref)
+    if ref in dict(Scene.list_bundled()) or not path.exists():
+        return
+    what = "a folder" if path.is_dir() else "not a regular file"
+    raise SceneError([f"{ref}: {what}, not a scene file (a .toml file) nor a bundled "
+                      "scene's name (`hamilton-orbits scenes` lists them)"])
 
 
 def _set_values(ref: str, sets: Sequence[str]) -> dict[str, str]:
