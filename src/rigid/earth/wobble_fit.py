@@ -47,19 +47,40 @@ def _project(t: np.ndarray, m: np.ndarray, freqs: np.ndarray, n_trend: int):
 def free_period(t: Any, m: Any) -> u.Quantity:
     """The period of a free wobble fitted to a pole path.
 
-    The model is ``m(t) = a exp(i sigma t) + b exp(-i sigma t)`` (the ellipse
-    of the triaxial linear theory; ``b = 0`` for an axisymmetric body), fitted by
-    nonlinear least squares in ``sigma`` with the amplitudes projected out.  The
-    starting value is the mean rate of the unwrapped phase of ``m``, or, where that
-    fits less than half of the path (a wobble near a line, whose phase jumps by pi),
-    the highest peak of its periodogram in both senses.
+    The model is ``m(t) = c + a exp(i sigma t) + b exp(-i sigma t)``: the ellipse
+    of the triaxial linear theory (``b = 0`` for an axisymmetric body) about a
+    mean pole ``c`` (the IERS C04 pole of 1962-2026 turns about ``x_p = 52``,
+    ``y_p = 303`` mas, 0.31 arcsec from the origin).  It is fitted by nonlinear
+    least squares in ``sigma``, with ``c``, ``a`` and ``b`` solved linearly at each
+    trial ``sigma``, so the period does not depend on the offset: ``free_period(t,
+    m + z)`` is ``free_period(t, m)`` for any constant ``z``, to the rounding of
+    ``m + z``.  (The model had no ``c`` before: a 433-day wobble of 0.2 about a
+    centre 0.1 or 0.15 off the origin gave 426.1 or 423.0 days, unflagged; larger
+    offsets were refused.)  A mean pole that drifts is not modelled:
+    :func:`fit_wobble` fits a trend.  The starting value
+    is the mean rate of the unwrapped phase of ``m - mean(m)``; where that fits less
+    than half of the path (a wobble near a line, whose phase jumps by pi) or where
+    the phase steps by over a quarter turn between samples (a sparse path, whose
+    phase does not unwrap), the fit is also started from the highest peak of the
+    periodogram in both senses, and the better fit kept.
+
+    The model is exact for the linear theory only.  A large wobble of a triaxial
+    body has a polhode with harmonics of its period, and the single-frequency fit
+    is then biased, the more so the nearer the separatrix and the fewer the turns
+    fitted: for moments 1 : 2 : 2.9, against the exact period of
+    :func:`rigid.free_parameters` (``k^2`` its elliptic parameter ``m``), -0.14% at
+    ``k^2 = 0.65`` and -0.60% at ``k^2 = 0.98`` over 3 turns, -0.18% at ``k^2 =
+    0.98`` over 3.37 turns, and at ``k^2 = 0.9993`` -3.5% over 1.5 turns, -0.08% over
+    10.5.  The rigid Earth's wobble (``|m| ~ 1e-6`` rad, nonlinear terms
+    ~ ``|m|^2``) is fitted to 1e-12 of its linear Euler period.
 
     Parameters
     ----------
     t : Quantity or array_like, shape (n,)
-        Times (days if plain floats).
+        Times (days if plain floats), strictly monotonic.
     m : array_like, complex, shape (n,)
-        The pole path ``m1 + i m2`` (any angular unit; only the phase matters).
+        The pole path ``m1 + i m2`` (any angular unit; its offset from the origin,
+        its size and its sense do not change the period).
 
     Returns
     -------
@@ -69,12 +90,21 @@ def free_period(t: Any, m: Any) -> u.Quantity:
     Raises
     ------
     ValueError
-        For fewer than 8 points, mismatched shapes or a path without a wobble.
+        For fewer than 8 points, mismatched shapes, times not strictly monotonic,
+        a value not finite (named with its index), or a path without a wobble: a
+        constant one (a value and its index named) or one that no wobble turning
+        at least once within the span explains half of (its spread about its mean).
 
     Examples
     --------
     >>> t = np.arange(0.0, 2000.0)
     >>> print(f"{free_period(t, 1e-6 * np.exp(2j * np.pi * t / 433.0)):.6f}")
+    433.000000 d
+
+    A wobble of 0.2 arcsec about a mean pole 0.15 arcsec from the origin:
+
+    >>> m = 0.15 + 0.2 * np.exp(2j * np.pi * t / 433.0)
+    >>> print(f"{free_period(t, m):.6f}")
     433.000000 d
     """
     tt = TIME("t", t, u.day)
@@ -95,21 +125,36 @@ def free_period(t: Any, m: Any) -> u.Quantity:
         k = int(np.argmin(step > 0)) + 1
         raise ValueError(f"Expected `t` strictly monotonic, got t[{k}] = {float(tt[k])!r} "
                          f"after t[{k - 1}] = {float(tt[k - 1])!r} (days)")
+    # (the mean pole: the fit's constant term ``c`` takes it exactly; the path is
+    # centred first so that the start below, the phase's turn, turns about the centre)
+    mc = mm - mm.mean()
+    spread = float(np.max(np.abs(mc)))
+    if spread <= 64.0 * np.finfo(float).eps * scale:  # (a constant, to rounding)
+        k = int(np.argmax(np.abs(mc)))
+        raise ValueError(f"Expected `m` to turn about the figure axis at least once, got a "
+                         f"constant path: {complex(mm[k])!r} at index {k}, every value "
+                         f"within {spread:.3g} of the mean {complex(mm.mean())!r}")
     t0 = tt - tt[0]
-    phase = np.unwrap(np.angle(mm))
+    phase = np.unwrap(np.angle(mc))
     sigma0 = float(np.polyfit(t0, phase, 1)[0])
-    mn = mm / scale
+    mn = mc / spread
+    # (least_squares' cost is half the sum of squares: a cost over ``var`` leaves more
+    # than half of the path's spread about its mean unexplained)
+    var = 0.25 * float(np.vdot(mn, mn).real)
     sol = _fit_sigma(t0, mn, sigma0) if sigma0 != 0.0 else None
-    if sol is None or sol.cost > 0.25 * float(np.vdot(mn, mn).real):
+    jump = float(np.max(np.abs(np.angle(mc[1:] * mc[:-1].conj()))))
+    if sol is None or sol.cost > var or jump > 0.5 * np.pi:
         # (the mean turn of the phase no start: a path near a line, |a| ~ |b|, whose
-        # phase jumps by pi; the periodogram's highest peak then starts the fit)
+        # phase jumps by pi, or one sampled too sparsely for its phase to unwrap, a
+        # step of over a quarter turn (16 random points over 2.7 turns, a gap of 0.6
+        # turn, went from a start of 5800 d to a false minimum at 847 d); the
+        # periodogram's highest peak then starts a second fit, the better one kept)
         other = _fit_sigma(t0, mn, _peak(t0, mn))
-        sol = other if sol is None or other.cost < 0.5 * sol.cost else sol
+        sol = other if sol is None or other.cost < sol.cost else sol
     span = abs(float(t0[-1]))
-    if not abs(float(sol.x[0])) * span >= 2.0 * np.pi or \
-            sol.cost > 0.25 * float(np.vdot(mn, mn).real):
-        # (no wobble that turns once within the span and explains half of the path: a
-        # constant offset, a drift, fitted by a "period" of 1e20 days, made up)
+    if not abs(float(sol.x[0])) * span >= 2.0 * np.pi or sol.cost > var:
+        # (no wobble that turns once within the span and explains half of the path's
+        # spread about its mean: a drift, fitted by a "period" of 1e20 days, made up)
         raise ValueError(f"Expected `m` to turn about the figure axis at least once in the "
                          f"span of `t` ({span:.6g} d), got no such wobble that explains the "
                          f"path")
@@ -121,7 +166,7 @@ def _fit_sigma(t0: np.ndarray, mn: np.ndarray, sigma0: float) -> Any:
     from scipy.optimize import least_squares  # here: 0.2 s to import, rarely needed
 
     def resid(x):
-        _, r = _project(t0, mn, np.array([x[0], -x[0]]), 0)
+        _, r = _project(t0, mn, np.array([x[0], -x[0]]), 1)  # (c + a e^ist + b e^-ist)
         return np.concatenate([r.real, r.imag])
 
     return least_squares(resid, [sigma0], x_scale=[abs(sigma0)], xtol=1e-15, ftol=1e-15,
@@ -132,10 +177,13 @@ def _peak(t0: np.ndarray, mn: np.ndarray) -> float:
     """The angular frequency (> 0) of the highest peak of the power of ``mn`` in
     both senses, ``|sum mn e^(-i s t)|^2 + |sum mn e^(i s t)|^2``, on a grid of
     ``s`` from one turn over the span to the mean sampling's Nyquist rate (at
-    most 4096 points)."""
+    most 4096 points; steps of a quarter turn over the span where that stays within
+    them, so that a wobble of 1.5 turns is not read at 1 or 2, or at an alias)."""
     span = abs(float(t0[-1]))
     top = min(len(t0) // 2, 4096)
-    s = 2.0 * np.pi * np.arange(1, top + 1) / span
+    over = max(1, min(4, 4096 // max(top, 1)))
+    s = 2.0 * np.pi * np.arange(over, over * top + 1) / (over * span)
+    top = s.size
     power = np.empty(top)
     for k in range(0, top, 256):  # (256 frequencies at a time: memory O(256 n))
         e = np.exp(-1j * np.outer(s[k:k + 256], t0))
