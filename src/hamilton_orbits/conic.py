@@ -101,24 +101,35 @@ _ELEMENTS = ("p", "e", "inv_a", "inc", "lan", "argp", "mu")
 _CONSISTENT = 64.0 * np.finfo(float).eps
 
 
-def _check_shape(p: np.ndarray, e: np.ndarray, inv_a: np.ndarray) -> None:
+def _check_shape(p: np.ndarray, e: np.ndarray, inv_a: np.ndarray,
+                 given: tuple[Any, Any, Any] = (None, None, None)) -> None:
     """Refuse ``p``, ``e`` and ``1/a`` (broadcast together) that are not one conic's:
     ``p >= 0`` (0 only for the radial orbit, ``e == 1``), ``e >= 0``, ``1/a`` of the
-    sign of ``1 - e`` and equal to ``(1 - e^2)/p`` to 64 eps ``max(1, e)^2``."""
-    raise_at("p", ~(p >= 0), p, ">= 0")
-    raise_at("e", ~(e >= 0), e, ">= 0")
-    raise_at("p", (p == 0) & (e != 1), p, "> 0 for e != 1 (p = 0 is a radial orbit, e = 1)")
-    raise_at("inv_a", (e < 1) & ~(inv_a > 0), inv_a, "> 0 for e < 1 (inv_a and e inconsistent)")
-    raise_at("inv_a", (e > 1) & ~(inv_a < 0), inv_a, "< 0 for e > 1 (inv_a and e inconsistent)")
+    sign of ``1 - e`` and equal to ``(1 - e^2)/p`` to 64 eps ``max(1, e)^2``.
+    ``given``: ``p``, ``e`` and ``inv_a`` as the caller wrote them, the values quoted
+    as a Quantity there has them ("got -1.0 AU", not the km of ``p``)."""
+    gp, ge, gi = given
+    raise_at("p", ~(p >= 0), p, ">= 0", gp)
+    raise_at("e", ~(e >= 0), e, ">= 0", ge)
+    raise_at("p", (p == 0) & (e != 1), p, "> 0 for e != 1 (p = 0 is a radial orbit, e = 1)",
+             gp)
+    raise_at("inv_a", (e < 1) & ~(inv_a > 0), inv_a, "> 0 for e < 1 (inv_a and e inconsistent)",
+             gi)
+    raise_at("inv_a", (e > 1) & ~(inv_a < 0), inv_a, "< 0 for e > 1 (inv_a and e inconsistent)",
+             gi)
     m = np.maximum(e, 1.0)
     with np.errstate(all="ignore"):  # (scaled by max(1, e)^2; an overflow here is inconsistent)
         off = np.abs((1.0 - e) / m * ((1.0 + e) / m) - (p / m) * (inv_a / m)) > _CONSISTENT
         if np.any(off):
             i = first_index(np.atleast_1d(off)) if off.ndim else ()
-            want = (1.0 - e[i]) * (1.0 + e[i]) / p[i]
+            want, got = f"{float((1.0 - e[i]) * (1.0 + e[i]) / p[i])!r}", f"{float(inv_a[i])!r}"
+            if is_quantity(gi):  # (in the unit of the inv_a given, as given)
+                unit = gi.unit
+                want = f"{float((float(want) / u.Unit(_L)).to_value(unit))!r} {unit.to_string()}"
+                got = f"{float(np.broadcast_to(gi.value, off.shape)[i])!r} {unit.to_string()}"
             raise ValueError(
-                f"Expected `inv_a` = (1 - e^2)/p = {float(want)!r} (inv_a, p and e "
-                f"inconsistent), got {float(inv_a[i])!r}{fmt_index(i if off.size > 1 else ())}"
+                f"Expected `inv_a` = (1 - e^2)/p = {want} (inv_a, p and e "
+                f"inconsistent), got {got}{fmt_index(i if off.size > 1 else ())}"
             )
 
 
@@ -131,10 +142,13 @@ def _checked_elements(*values: Any) -> tuple[list[np.ndarray], bool]:
     ``1 - e`` and equal to ``(1 - e^2)/p`` to rounding.  Quantities are converted to
     the conic's units (km, 1/km, km^3/s^2, rad; :func:`_element_floats`).  ValueError
     naming the argument, the first bad index and the value."""
-    arrays, quantity = _element_floats(values)
+    arrays, quantity, given = _element_floats(values)
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
-    _check_shape(p, e, inv_a)
-    raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi]")
+    gp, ge, gi, ginc, _, _, gmu = given
+    _check_shape(p, e, inv_a, (gp, ge, gi))
+    raise_at("inc", ~((inc >= 0) & (inc <= np.pi)), inc, "in [0, pi] rad", ginc)
+    if is_quantity(gmu):
+        raise_at("mu", ~(mu > 0), mu, "> 0", gmu)
     check_positive("mu", mu)
     return arrays, quantity
 
@@ -143,10 +157,11 @@ def _checked_elements(*values: Any) -> tuple[list[np.ndarray], bool]:
 _INV_LENGTH = Kind("a reciprocal length", "1 / km")
 
 
-def _element_floats(values: Any) -> tuple[list[np.ndarray], bool]:
-    """The elements ``p, e, inv_a, inc, lan, argp, mu`` as float arrays, and whether
+def _element_floats(values: Any) -> tuple[list[np.ndarray], bool, list[Any]]:
+    """The elements ``p, e, inv_a, inc, lan, argp, mu`` as float arrays, whether
     ``p``, ``inv_a`` and ``mu`` are Quantities (all three or none: a unit cannot be
-    guessed).  Quantities are converted to the units of a conic of Quantities (those of
+    guessed), and the values as given (a list of Quantities joined), for messages.
+    Quantities are converted to the units of a conic of Quantities (those of
     :class:`~hamilton_orbits.orbit.KeplerOrbit`: km, 1/km, km^3/s^2), angles of any
     unit to radians (a plain float angle is radians), ``e`` a dimensionless Quantity or
     a number; a list of Quantities is the one Quantity it joins into
@@ -158,7 +173,7 @@ def _element_floats(values: Any) -> tuple[list[np.ndarray], bool]:
     quantity = require_consistent(("p", "inv_a", "mu"), (p, inv_a, mu))
     arrays = [LENGTH("p", p, _L), DIMENSIONLESS("e", e), _INV_LENGTH("inv_a", inv_a),
               ANGLE("inc", inc), ANGLE("lan", lan), ANGLE("argp", argp), GM("mu", mu, _MU)]
-    return arrays, quantity
+    return arrays, quantity, [p, e, inv_a, inc, lan, argp, mu]
 
 
 #: how far from unit length and from orthogonal the axes given to :class:`Conic` may
@@ -365,7 +380,8 @@ class Conic:
             For an argument outside that domain, the arguments not broadcasting
             together, or ``p``, ``inv_a`` and ``mu`` not all Quantities or all
             plain floats, naming the argument, the first offending index and the
-            value.
+            value as given (a Quantity in its own unit: "got -1.0 AU", "got 200.0
+            deg").
         astropy.units.UnitConversionError
             (a ValueError) For a Quantity of the wrong dimension (``p`` in
             seconds, an angle for ``e``, a mass for ``mu``), naming the argument.

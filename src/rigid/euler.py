@@ -330,7 +330,11 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     Parameters
     ----------
     torque : BodyTorque, SpaceTorque, GravityGradientTorque or None
-        The torque model.
+        The torque model.  Beside ``moments`` of Quantities its dimensional values
+        (a ``BodyTorque``'s or ``SpaceTorque``'s ``torque``, a gravity gradient's
+        ``gm_over_r3`` and ``mean_motion``) are Quantities too: a plain non-zero
+        number is refused, its unit not guessed (zeros are taken;
+        :func:`check_torque_units`).
     moments : array_like or Quantity, shape (..., 3)
         Principal moments (A, B, C) (kg m^2 when a Quantity).
     attitude : Quaternion or array_like, shape (..., 4)
@@ -347,12 +351,21 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     Raises
     ------
     ValueError
-        For NaN, wrong shapes, a zero attitude or a non-positive moment.
+        For NaN, wrong shapes, a zero attitude or a non-positive moment; for a
+        torque of plain non-zero numbers beside ``moments`` of Quantities
+        (``torque_on(SpaceTorque([1.0, 0, 0]), [1, 2, 3] * u.kg * u.m**2, q)``),
+        naming the torque's argument, the index and the value.
 
     Examples
     --------
     >>> torque_on(BodyTorque([1.0, 2.0, 3.0]), [1.0, 1.0, 1.0], Quaternion([1, 0, 0, 0]))
     array([1., 2., 3.])
+    >>> import astropy.units as u
+    >>> torque_on(SpaceTorque([1.0, 0.0, 0.0]), [1.0, 2.0, 3.0] * u.kg * u.m**2,
+    ...           Quaternion([1, 0, 0, 0]))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected SpaceTorque's `torque` to be a Quantity like `moments` ...at index 0
     """
     t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
     quantity = require_consistent(("moments", "t"), (moments, t))

@@ -260,7 +260,12 @@ def integrate(
         ``tol / 100 max|omega0|`` on omega).  Refused by the fixed-step methods
         (and so are the deprecated ``rtol``, ``atol``).
     torque : BodyTorque, SpaceTorque, GravityGradientTorque or None, optional
-        External torque (see :mod:`rigid.euler`).  Default None (free body).
+        External torque (see :mod:`rigid.euler`).  Default None (free body).  For a
+        ``body`` built from Quantities its dimensional values (a ``BodyTorque``'s or
+        ``SpaceTorque``'s ``torque``, a gravity gradient's ``gm_over_r3`` and
+        ``mean_motion``) are Quantities too: a plain non-zero number is refused (its
+        unit cannot be guessed; zeros are taken), as
+        :func:`~rigid.euler.check_torque_units` says.
     progress : bool, optional
         Show a tqdm progress bar (needs the ``progress`` extra).
     recentre : float, optional
@@ -296,7 +301,9 @@ def integrate(
         missing ``dt``, more than 1e12 steps, ``tol`` with a fixed-step method,
         ``n_out`` not an integer in [2, 1e9], a plain ``dt`` beside a Quantity
         ``t`` (or the reverse, or plain times for a body with units), an
-        unsupported torque or one beyond float64 beside the moments, a ``stop``
+        unsupported torque or one beyond float64 beside the moments, a torque of
+        plain non-zero numbers for a body of Quantities (naming the torque's
+        argument, the index and the value), a ``stop``
         that is not callable, an angle
         turned ``t |omega|`` beyond float64, or a run whose state leaves float64
         (a step far too long for the method: naming ``dt``).

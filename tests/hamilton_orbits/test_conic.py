@@ -258,8 +258,8 @@ GOOD = {"p": 1.44, "e": 0.44, "inv_a": 0.56, "inc": 0.1, "lan": 0.2, "argp": 0.3
     ({"inv_a": 100.0}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.56.* \(inv_a, p and e "
                        r"inconsistent\), got 100.0$"),
     ({"e": 1.0, "inv_a": 0.1}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.0 .*got 0.1$"),
-    ({"inc": 5.0}, r"Expected `inc` in \[0, pi\], got 5.0$"),
-    ({"inc": [0.1, -0.1]}, r"Expected `inc` in \[0, pi\], got -0.1 at index 1"),
+    ({"inc": 5.0}, r"Expected `inc` in \[0, pi\] rad, got 5.0$"),
+    ({"inc": [0.1, -0.1]}, r"Expected `inc` in \[0, pi\] rad, got -0.1 at index 1"),
     ({"lan": np.nan}, r"Expected `lan` to be finite, got nan$"),
     ({"argp": [0.3, -np.inf]}, r"Expected `argp` to be finite, got -inf at index 1"),
     ({"mu": -1.0}, r"Expected `mu` > 0, got -1.0$"),
@@ -321,16 +321,41 @@ def test_from_elements_takes_quantities():
     ({"mu": 1.0 * u.kg}, r"Expected `mu` to be a gravitational parameter GM .*got 1 kg"),
     ({"mu": 1.0}, r"Expected `mu` to be a Quantity like `p` \(1.44 km\), got the plain "
                   r"number 1.0"),
-    ({"inc": [0.1, 200.0] * u.deg}, r"Expected `inc` in \[0, pi\], got 3.49.* at index 1"),
+    ({"inc": [0.1, 200.0] * u.deg}, r"Expected `inc` in \[0, pi\] rad, got 200.0 deg at "
+                                     r"index 1$"),
 ])
 def test_from_elements_refuses_bad_quantities_by_name(bad, message):
     """A Quantity of the wrong dimension, or beside a plain float where a unit would
     have to be guessed, is a ValueError (UnitConversionError is one) naming the
-    argument and the value."""
+    argument and the value (as given: an angle in its own unit)."""
     args = {**GOOD, "p": 1.44 * u.km, "inv_a": 0.56 / u.km, "mu": 1.0 * u.km**3 / u.s**2,
             **bad}
     with pytest.raises(ValueError, match=message):
         Conic.from_elements(*args.values())
+
+
+_AU_CONIC = {"p": 1.0 * u.au, "e": 0.5, "inv_a": 0.75 / u.au, "inc": 0.0, "lan": 0.0,
+             "argp": 0.0, "mu": 1.32712440041e20 * u.m**3 / u.s**2}
+
+
+@pytest.mark.parametrize(("bad", "message"), [
+    ({"p": -1.0 * u.au}, r"Expected `p` >= 0, got -1.0 AU$"),
+    ({"p": [1.0, 0.0] * u.au}, r"Expected `p` > 0 for e != 1 .*, got 0.0 AU at index 1$"),
+    ({"inc": 200.0 * u.deg}, r"Expected `inc` in \[0, pi\] rad, got 200.0 deg$"),
+    ({"inv_a": -0.75 / u.au}, r"Expected `inv_a` > 0 for e < 1 .*, got -0.75 1 / AU$"),
+    ({"inv_a": 1.0 / u.au}, r"Expected `inv_a` = \(1 - e\^2\)/p = 0.75\d* 1 / AU \(inv_a, p "
+                            r"and e inconsistent\), got 1.0 1 / AU$"),
+    ({"mu": -1.32712440041e20 * u.m**3 / u.s**2}, r"Expected `mu` > 0, got -1.32712440041e\+20 "
+                                                   r"m3 / s2$"),
+])
+def test_from_elements_quotes_a_bad_quantity_as_given(bad, message):
+    """A bad element given as a Quantity was quoted in the conic's internal units
+    without a unit ("Expected `p` >= 0, got -149597870.7" for -1 au, "got
+    3.490658503988659" for 200 deg); it is quoted as given, with its unit, as
+    ``KeplerOrbit.from_elements`` quotes its own."""
+    with pytest.raises(ValueError, match=message):
+        Conic.from_elements(*{**_AU_CONIC, **bad}.values())
+    assert float(Conic.from_elements(*_AU_CONIC.values()).e) == 0.5
 
 
 def test_from_elements_refuses_a_quantity_flag_that_is_not_a_bool():

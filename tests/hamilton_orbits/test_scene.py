@@ -656,3 +656,25 @@ def test_a_timedelta_set_on_a_scene_is_saved_as_the_quantity_it_holds(tmp_path):
     scene.run(progress=False).save(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["set"] == {"duration": {"value": 40.0, "unit": "d"}}
+
+
+def test_timedeltas_set_in_a_list_on_a_scene_are_saved_with_their_unit(tmp_path):
+    """An effect set on a scene with its time lags as TimeDeltas (``earth_tides``'
+    ``tau``) ran as the Quantity in days they hold, but ``summary.json``'s ``set``
+    wrote each as the text of its number ('0.1'), the unit lost (a value in a list or
+    a table was not converted).  Each is written as the Quantity it holds."""
+    import json
+
+    from astropy.time import TimeDelta
+
+    scene = Scene.from_dict({"kind": "nbody", "duration": "2 d", "cadence": "1 d",
+                             "initial": {"ephemeris": {"epoch": "J2000",
+                                                       "bodies": ["sun", "earth", "moon"]}},
+                             "effects": []})
+    days = [0.1, 0.2, 0.3, 0.4, 0.5]
+    tau = [TimeDelta(x, format="jd") for x in days]
+    scene = scene.with_values({"effects": [{"name": "earth_tides", "tau": tau}]})
+    scene.run(progress=False).save(tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["set"]["effects"][0]["tau"] == [{"value": x, "unit": "d"} for x in days]
+    assert summary["effects"][0]["tau"] == {"value": days, "unit": "d"}

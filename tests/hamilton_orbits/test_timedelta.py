@@ -134,3 +134,35 @@ def test_small_bodies_propagate_takes_a_timedelta():
     with pytest.raises(ValueError, match=r"a time Quantity, a TimeDelta or an astropy Time, "
                                          r"got 30\.0"):
         propagate(r0, v0, epoch, 30.0, **kw)
+
+
+def test_an_effect_parameter_as_a_timedelta_is_saved_archived_and_continued_as_the_quantity(
+        tmp_path):
+    """An effect's time parameter given as a TimeDelta (``earth_tides``' ``tau``) was
+    read as the Quantity it holds but kept raw in the effects: ``Simulation.save`` and
+    an archive's first snapshot failed with "TypeError: Object of type TimeDelta is
+    not JSON serializable" (the archive's folder left empty).  The effects hold the
+    Quantity in days: saved, loaded and continued, and archived, to the bits of the
+    run given that Quantity."""
+    s = System.from_ephemeris("J2000", bodies=["sun", "earth", "moon"])
+    days = [0.1, 0.2, 0.3, 0.4, 0.5]
+    runs = {}
+    for label, tau in (("q", days * u.day), ("td", TimeDelta(days, format="jd")),
+                       ("list", [TimeDelta(x, format="jd") for x in days])):
+        sim = Simulation(s, "dop853", tol=1e-9, effects=[{"name": "earth_tides", "tau": tau}])
+        sim.integrate(1.0 * u.day)
+        sim.save(tmp_path / f"{label}.nc")
+        loaded = Simulation.load(tmp_path / f"{label}.nc")
+        _same(loaded.effects.as_list()[0]["tau"], days * u.day)
+        after = loaded.integrate([1.0, 2.0] * u.day)
+        archived = Simulation(s, "dop853", tol=1e-9,
+                              effects=[{"name": "earth_tides", "tau": tau}],
+                              archive=tmp_path / label, every=0.5 * u.day)
+        whole = archived.integrate(2.0 * u.day)
+        np.testing.assert_array_equal(Archive(tmp_path / label).times,
+                                      [0.0, 0.5, 1.0, 1.5, 2.0])
+        resumed = Simulation.load(tmp_path / label).integrate(3.0 * u.day)
+        runs[label] = (after, whole, resumed)
+    for label in ("td", "list"):
+        for got, want in zip(runs[label], runs["q"], strict=True):
+            _same(got.t, want.t), _same(got.r, want.r), _same(got.v, want.v)

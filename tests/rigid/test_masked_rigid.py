@@ -62,3 +62,33 @@ def test_nothing_masked_is_taken_as_the_values():
     a = free_motion(BODY, Masked(T, mask=[False] * 3))
     b = free_motion(BODY, T)
     np.testing.assert_array_equal(a.omega.value, b.omega.value)
+
+
+_SERIES = dict(chandler_period=433.0, chi_t=[0.0, 100.0, 200.0, 300.0])
+COMPLEX_CASES = [
+    ("chi", 2, lambda: LiouvillePole(
+        ("elastic", "excitation_series"), **_SERIES,
+        chi=np.ma.array([0, 1e-7 + 1e-7j, 2e-7, 0], mask=[0, 0, 1, 0])).excitation([150.0])),
+    ("m0", None, lambda: LiouvillePole(("elastic",), chandler_period=433.0).solve(
+        [0.0, 1.0], np.ma.array(1e-6 + 0j, mask=True))),
+    ("m0", 0, lambda: LiouvillePole(("elastic",), chandler_period=433.0).solve(
+        [0.0, 1.0], np.ma.array([1e-6 + 0j], mask=[1]))),
+    ("annual_prograde", None, lambda: LiouvillePole(
+        ("annual_excitation",), annual_prograde=np.ma.array(1e-7 + 1e-8j, mask=True))),
+    ("annual_retrograde", None, lambda: LiouvillePole(
+        ("annual_excitation",), annual_prograde=1e-7,
+        annual_retrograde=np.ma.array(1e-8 + 0j, mask=True))),
+]
+
+
+@pytest.mark.parametrize(("name", "index", "call"), COMPLEX_CASES,
+                         ids=[f"{k}-{c[0]}" for k, c in enumerate(COMPLEX_CASES)])
+def test_a_masked_complex_angle_of_the_liouville_pole_is_refused(name, index, call):
+    """The complex angles of ``LiouvillePole`` (``chi``, ``m0`` of ``solve``, the
+    annual amplitudes) as numpy masked arrays were read through ``np.asarray``, the
+    values under the mask used ("excitation([150.0])" interpolated the masked 2e-7);
+    they are refused by name and index, as ``propagate_pole`` refuses them."""
+    where = "" if index is None else f" at index {index}"
+    with pytest.raises(ValueError, match=rf"^Expected `{name}` to be numbers, got a masked "
+                                         rf"value{where}$"):
+        call()

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.units import Kind
+from hamilton_orbits.units import Kind, time_quantity
 
 __all__ = [
     "EffectSet",
@@ -371,10 +371,43 @@ def normalize_effects(
         if name in seen:
             raise ValueError(f"Effect {name!r} is listed twice (at indices {seen[name]} and {k})")
         seen[name] = k
-        out.append((name, tuple(sorted(params.items()))))
+        out.append((name, tuple(sorted((key, _as_kept(val)) for key, val in params.items()))))
     for _, message in exclusion_problems(listed, kind)[:1]:
         raise ValueError(message[0].upper() + message[1:])
     return tuple(out)
+
+
+def _as_kept(value: Any) -> Any:
+    """A parameter value as an :class:`EffectSet` keeps it: an astropy TimeDelta as
+    the time Quantity in days it holds (:func:`~hamilton_orbits.units.time_quantity`,
+    as the effects' reader ``parameters.with_units`` takes it), and a list or tuple
+    holding TimeDeltas as the one Quantity its values join into (each TimeDelta that
+    Quantity where they do not join: the reader refuses them by name), so that the
+    set is saved, archived and compared as with that Quantity; anything else as
+    given.
+
+    Examples
+    --------
+    >>> from astropy.time import TimeDelta
+    >>> import astropy.units as u
+    >>> _as_kept([TimeDelta(0.5, format="jd"), 12 * u.h])
+    <Quantity [0.5, 0.5] d>
+    >>> _as_kept([TimeDelta(0.5, format="jd"), "earth"])
+    [<Quantity 0.5 d>, 'earth']
+    >>> _as_kept("earth")
+    'earth'
+    """
+    if not isinstance(value, (list, tuple)):
+        return time_quantity(value)
+    kept = [_as_kept(x) for x in value]
+    if all(k is x for k, x in zip(kept, value, strict=True)):
+        return value
+    import astropy.units as u
+
+    try:
+        return u.Quantity(kept, dtype=np.float64)
+    except (TypeError, ValueError):  # UnitConversionError included
+        return kept if isinstance(value, list) else tuple(kept)
 
 
 def _frozen(value: Any) -> Any:

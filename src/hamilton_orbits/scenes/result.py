@@ -160,6 +160,10 @@ class Result:
                         [conv(x) for x in v.value.tolist()], "unit": str(v.unit)}
             if isinstance(v, np.ndarray):
                 return v.tolist()
+            if isinstance(v, list | tuple):  # (a value set as a list or a table: each
+                return [conv(x) for x in v]  # TimeDelta or Quantity in it with its unit)
+            if isinstance(v, dict):
+                return {k: conv(x) for k, x in v.items()}
             if isinstance(v, float) and not math.isfinite(v):
                 return str(v)
             if isinstance(v, np.floating | np.integer):

@@ -24,6 +24,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, TIME
+from hamilton_orbits.validation import check_unmasked
 from rigid._kernels import liouville as _lk
 from rigid._shared import positive_scalar
 from rigid.earth.constants import euler_period, secular_love_number
@@ -74,7 +75,9 @@ _SUMMARY = {
 
 
 def _complex_angle(name: str, value: Any) -> tuple[np.ndarray, bool]:
-    """Complex angle -> complex radians; True if it came as a Quantity."""
+    """Complex angle -> complex radians; True if it came as a Quantity.  A masked
+    value is refused (``np.asarray`` would read under the mask)."""
+    check_unmasked(name, value)  # (complex values: not through a unit kind's check)
     if isinstance(value, u.Quantity):
         re = ANGLE(name, value.real)
         im = ANGLE(name, value.imag)
