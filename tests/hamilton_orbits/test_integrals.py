@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from random_legs import random_leg
 
 from hamilton_orbits._kernels import integrals as k
 from hamilton_orbits.integrals import ENCOUNTER_STEP_FRACTION, LIGHT, light_as_massless
@@ -40,16 +41,9 @@ def test_the_screen_passes_every_leg_the_whole_check_finds_approaches_in():
     rng = np.random.default_rng(2026)
     found = passed = back_found = back_passed = 0
     for _ in range(3000):
-        n, n_t = int(rng.integers(2, 7)), int(rng.integers(2, 6))
-        gm = rng.choice([0.0, 1e-12, 1e-5, 1e-3, 1.0], size=n)
-        gm[rng.integers(n)] = 1.0
-        r = rng.normal(size=(n_t, n, 3)) * 10.0 ** rng.uniform(-3, 0.5)
-        v = rng.normal(size=(n_t, n, 3))
-        t = np.cumsum(rng.uniform(0.01, 0.5, n_t)) - 0.01
-        step = float(10.0 ** rng.uniform(-4, -0.5))
-        exempt = int(rng.integers(-1, n))
+        r, v, gm, t, step, fraction = random_leg(rng)
+        exempt = int(rng.integers(-1, len(gm)))
         exempt_dist = float(rng.choice([0.0, 0.05]))
-        fraction = float(rng.choice([ENCOUNTER_STEP_FRACTION, 1.0 / 3.0]))
         args = (step, exempt, exempt_dist, fraction)
         whole = _whole_count(r, v, gm, t, *args)
         maybe = k.screen(r, v, gm, t, *args, LIGHT)

@@ -8,6 +8,7 @@ import warnings
 import astropy.units as u
 import numpy as np
 import pytest
+from random_legs import random_leg
 
 from hamilton_orbits import Simulation, System, _screening
 from hamilton_orbits._kernels import integrals as k
@@ -22,21 +23,6 @@ _WITH_MOON = ["sun", "mercury", "venus", "earth", "mars", "jupiter", "saturn", "
               "neptune", "moon"]
 
 
-def _random_leg(rng):
-    """A random leg as the kernel's own test makes them: 2 to 6 bodies (test
-    particles, bodies as light as ``LIGHT``, massive ones), close pairs passing
-    between outputs."""
-    n, n_t = int(rng.integers(2, 7)), int(rng.integers(2, 6))
-    gm = rng.choice([0.0, 1e-12, 1e-5, 1e-3, 1.0], size=n)
-    gm[rng.integers(n)] = 1.0
-    r = rng.normal(size=(n_t, n, 3)) * 10.0 ** rng.uniform(-3, 0.5)
-    v = rng.normal(size=(n_t, n, 3))
-    t = np.cumsum(rng.uniform(0.01, 0.5, n_t)) - 0.01
-    step = float(10.0 ** rng.uniform(-4, -0.5))
-    fraction = float(rng.choice([ENCOUNTER_STEP_FRACTION, 1.0 / 3.0]))
-    return r, v, gm, t, step, fraction
-
-
 def test_numpy_never_rules_out_a_leg_the_screen_flags():
     """On 4000 random legs, forwards and backwards, with and without an exempt body:
     wherever the compiled screen answers True, numpy's test does too (a good share
@@ -45,7 +31,7 @@ def test_numpy_never_rules_out_a_leg_the_screen_flags():
     rng = np.random.default_rng(2027)
     flagged = ruled_out = kept_out = 0
     for _ in range(4000):
-        r, v, gm, t, step, fraction = _random_leg(rng)
+        r, v, gm, t, step, fraction = random_leg(rng)
         for times in (t, -t):
             for exempt in (-1, int(rng.integers(len(gm)))):
                 dist = float(rng.choice([0.0, 0.05]))
