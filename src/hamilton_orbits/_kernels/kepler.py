@@ -728,6 +728,16 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
             xn = x - 5.0 * f / den
         else:
             xn = math.nan
+        if xn == x and math.isinf(b - a):
+            # the step is below half an ulp of chi: x is the root to the floats,
+            # though at large chi r (an ulp of chi moves T by many ulps of tau)
+            # its residual may exceed the 2 ulps tested below.  x bounds the
+            # bracket now, so the step is not inside it, and with the bracket
+            # still open the safeguard below would double away from the root
+            # (to 2 tau/r0, where T overflows, and the bisection back used up the
+            # iterations: e = 1 + 1e-6, dt = 1e15).  (A finite bracket's
+            # bisection stays next to x and ends by the 8-ulp test.)
+            return x, t, r, u0, u1, u2, u3
         if not (a < xn < b):
             if math.isinf(b):
                 xn = 2.0 * max(abs(x), abs(x1))
