@@ -696,6 +696,29 @@ def _long_guess(tau, sgn, x1, x, alpha):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
+def _cubic_cap(tau, sgn, a, b, xn):  # pragma: no cover - compiled
+    """The bracket ``(a, b)`` and next point ``xn`` of :func:`_solve_uv_bracketed`
+    after an overflow on an open orbit moving away from periapsis (``alpha <= 0``,
+    ``sigma0 tau >= 0``): all terms of T then have the sign of tau and
+    ``|U3| >= |chi|^3/6``, so the root lies within ``chi_c = (6 |tau|)^(1/3)``
+    (the bound is taken 4 ulps wider for the rounding of the cube root).  The
+    far end of the bracket is moved there and ``xn`` is kept inside it.
+
+    Without this a long parabolic step started at ``tau/r0`` (1e102 for dt =
+    1e102, the root ~ 1e34), where T, r^2 or f r' overflows and Laguerre's step
+    cannot be formed, bisected once per bit of the overestimate and ran out of
+    iterations."""
+    c = sgn * (np.cbrt(6.0 * abs(tau)) * (1.0 + 4.0 * EPS))
+    if sgn > 0.0:
+        b = min(b, c)
+    else:
+        a = max(a, c)
+    if not (a < xn < b):
+        xn = 0.5 * (a + b)
+    return a, b, xn
+
+
+@njit(cache=True, inline="always")
 def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover - compiled
     """:func:`_solve_uv` by Laguerre's method inside a bracket, from the guess ``x``.
 
@@ -717,7 +740,10 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
         f = t - tau
         if f == 0.0:
             return x, t, r, u0, u1, u2, u3
-        if f < 0.0:
+        if f < 0.0 or (sgn < 0.0 and not f > 0.0):
+            # (a NaN T, the inf - inf or 0 inf of terms that overflow, puts x
+            # beyond the root: it bounded the wrong end going backwards, where
+            # the doubling then went on to chi^2 = inf, e.g. the parabola at dt = -1e155)
             a = x
         else:
             b = x
@@ -745,6 +771,8 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
                 xn = -2.0 * max(abs(x), abs(x1))
             else:
                 xn = 0.5 * (a + b)
+                if not math.isfinite(den) and alpha <= 0.0 and sigma0 * sgn >= 0.0:
+                    a, b, xn = _cubic_cap(tau, sgn, a, b, xn)
         if abs(xn - x) <= 4.0 * EPS * abs(xn) or xn == xp:
             if abs(f) <= 2.0 * EPS * abs(tau) or xn == xp:
                 return x, t, r, u0, u1, u2, u3
