@@ -675,9 +675,11 @@ def _series_x(x1, ir, c2, r0, sigma0, alpha):  # pragma: no cover - compiled
 
 # A first guess of the bracketed solver within this factor of the cubic bound
 # (_long_guess) is kept: from there Laguerre's ~2.7 per step costs at most ~90 of
-# its 200 iterations, and the results settled from such guesses keep their bits
+# its 200 iterations (after at most ~40 bisections while T overflows, for a
+# result whose |r|^2 fits a float), and the results settled from such guesses
+# keep their bits
 # (2^20 changed 1.5% of 2e5 random states by a few ulps, long parabolic steps;
-# 2^128 changed 79 nearly radial ones, h < 2e-16 r v, ill-conditioned anyway).
+# 2^128 changed 84 nearly radial ones, h < 1e-15 r v, ill-conditioned anyway).
 _CAP_RATIO = 2.0**128
 
 
@@ -689,12 +691,13 @@ def _long_guess(tau, sgn, x1, x, sigma0, alpha):  # pragma: no cover - compiled
     logarithmic one (hyperbolic), else ``x1``.
 
     On an open orbit moving away from periapsis (``alpha <= 0``, ``sigma0 tau >=
-    0``) a guess more than :data:`_CAP_RATIO` times the root's bound
-    ``(6 |tau|)^(1/3)`` (:func:`_cubic_cap`) is replaced by that bound: ``x1 =
-    tau/r0`` is far above the root on a very long parabolic step, or from the
-    tiny periapsis distance of a nearly radial orbit, and Laguerre's step gains
-    only a factor ~2.7 per iteration from there (1e101 for a root of 3e22 used up
-    the iterations)."""
+    0``) all terms of T have the sign of tau and ``|U3| >= |chi|^3/6``, so the
+    root lies within ``(6 |tau|)^(1/3)``; a guess more than :data:`_CAP_RATIO`
+    times that bound is replaced by it.  ``x1 = tau/r0`` is far above the root
+    on a very long parabolic step (1e102 at dt = 1e102, the root ~ 1e34), or from
+    the tiny periapsis distance of a nearly radial orbit; T, r^2 or f r'
+    overflowed there and the solver bisected, or Laguerre's step gained only a
+    factor ~2.7 per iteration, until the iterations ran out."""
     if alpha > 0.0:
         if abs(x1) * math.sqrt(alpha) > 0.5 or x * sgn <= 0.0:
             x = tau * alpha
@@ -709,33 +712,10 @@ def _long_guess(tau, sgn, x1, x, sigma0, alpha):  # pragma: no cover - compiled
     if x * sgn <= 0.0 or not math.isfinite(x):
         x = x1
     if alpha <= 0.0 and sigma0 * sgn >= 0.0:
-        xc = np.cbrt(6.0 * abs(tau))
+        xc = (6.0 * abs(tau)) ** (1.0 / 3.0)  # (a guess: pow compiles faster than cbrt)
         if abs(x) > _CAP_RATIO * xc:
             x = sgn * xc
     return x
-
-
-@njit(cache=True, inline="always")
-def _cubic_cap(tau, sgn, a, b, xn):  # pragma: no cover - compiled
-    """The bracket ``(a, b)`` and next point ``xn`` of :func:`_solve_uv_bracketed`
-    after an overflow on an open orbit moving away from periapsis (``alpha <= 0``,
-    ``sigma0 tau >= 0``): all terms of T then have the sign of tau and
-    ``|U3| >= |chi|^3/6``, so the root lies within ``chi_c = (6 |tau|)^(1/3)``
-    (the bound is taken 4 ulps wider for the rounding of the cube root).  The
-    far end of the bracket is moved there and ``xn`` is kept inside it.
-
-    Without this a long parabolic step started at ``tau/r0`` (1e102 for dt =
-    1e102, the root ~ 1e34), where T, r^2 or f r' overflows and Laguerre's step
-    cannot be formed, bisected once per bit of the overestimate and ran out of
-    iterations."""
-    c = sgn * (np.cbrt(6.0 * abs(tau)) * (1.0 + 4.0 * EPS))
-    if sgn > 0.0:
-        b = min(b, c)
-    else:
-        a = max(a, c)
-    if not (a < xn < b):
-        xn = 0.5 * (a + b)
-    return a, b, xn
 
 
 @njit(cache=True, inline="always")
@@ -746,9 +726,8 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
     2 pi/sqrt(alpha) for a bound orbit, else (0, inf), grown by doubling from
     ``max(|x|, |x1|)``; a step that leaves it is replaced by bisection.  A step
     below half an ulp of chi while the bracket is still open is convergence;
-    after an overflow (T, r^2 or f r') on an open orbit the bracket closes at
-    the cubic bound (:func:`_cubic_cap`), and where only r^2 or f r' overflows
-    Laguerre's step is formed in ratios."""
+    where r^2 or f r' overflows Laguerre's step is formed in ratios, and a NaN
+    T (terms that overflow) bounds the far end of the bracket."""
     big = 2.0 * PI / math.sqrt(alpha) if alpha > 0.0 else math.inf
     if sgn > 0.0:
         a = 0.0
@@ -798,8 +777,6 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
                 xn = -2.0 * max(abs(x), abs(x1))
             else:
                 xn = 0.5 * (a + b)
-                if not math.isfinite(den) and alpha <= 0.0 and sigma0 * sgn >= 0.0:
-                    a, b, xn = _cubic_cap(tau, sgn, a, b, xn)
         if abs(xn - x) <= 4.0 * EPS * abs(xn) or xn == xp:
             if abs(f) <= 2.0 * EPS * abs(tau) or xn == xp:
                 return x, t, r, u0, u1, u2, u3
