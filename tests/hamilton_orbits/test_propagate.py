@@ -5,13 +5,14 @@ from __future__ import annotations
 import math
 
 import astropy.units as u
+import mpmath as mp
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from hamilton_orbits import ConvergenceError
+from hamilton_orbits import ConvergenceError, KeplerOrbit
 from hamilton_orbits.kepler import propagate
 
 EPS = np.finfo(float).eps
@@ -278,3 +279,151 @@ def test_one_thread_gives_the_bits_of_the_threaded_kernel():
     assert np.array_equal(threaded[0], serial[0]) and np.array_equal(threaded[1], serial[1])
     with pytest.raises(ValueError, match="`threads`"):
         propagate(r[0], v[0], 1.0, 1.0, threads=1)
+
+
+
+def _universal_mp(r0, v0, dt, mu=1.0, dps=50):
+    """``(r, v, s)`` after ``dt`` by the universal Kepler equation solved in
+    ``dps``-digit arithmetic (a doubling bracket, bisection to 1e-6, then Newton;
+    the Stumpff functions in closed form), for the float state ``r0, v0`` with the
+    float ``1/a = 2/|r0| - |v0|^2/mu`` that :func:`propagate` forms (see the test
+    below for why); ``s = sqrt(-1/a) |chi|``, the argument of the hyperbolic
+    functions."""
+    rf = math.sqrt(sum(float(x) * float(x) for x in r0))
+    inv_a = 2.0 / rf - sum(float(x) * float(x) for x in v0) / mu
+    with mp.workdps(dps):
+        rr = [mp.mpf(float(x)) for x in r0]
+        vv = [mp.mpf(float(x)) for x in v0]
+        m, alpha, tau = mp.mpf(mu), mp.mpf(inv_a), mp.sqrt(mu) * mp.mpf(float(dt))
+        rn = mp.sqrt(sum(x * x for x in rr))
+        sigma0 = sum(a * b for a, b in zip(rr, vv, strict=True)) / mp.sqrt(m)
+
+        def funcs(chi):  # U1, U2, U3 for alpha < 0 (hyperbola) or alpha = 0
+            if alpha == 0:
+                return chi, chi**2 / 2, chi**3 / 6
+            s = mp.sqrt(-alpha)
+            return (mp.sinh(s * chi) / s, (mp.cosh(s * chi) - 1) / -alpha,
+                    (mp.sinh(s * chi) - s * chi) / (-alpha * s))
+
+        def residual(chi):
+            u1, u2, u3 = funcs(chi)
+            return rn * u1 + sigma0 * u2 + u3 - tau, rn + sigma0 * u1 - alpha * rn * u2 + u2
+
+        sgn = 1 if tau > 0 else -1
+        lo, hi = mp.mpf(0), mp.mpf(sgn)
+        while sgn * residual(hi)[0] < 0:
+            lo, hi = hi, 2 * hi
+        while abs(hi - lo) > mp.mpf(10) ** -6 * abs(hi):  # bisection, then Newton
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if sgn * residual(mid)[0] < 0 else (lo, mid)
+        chi = hi
+        for _ in range(30):
+            f, df = residual(chi)
+            step = f / df
+            chi -= step
+            if abs(step) <= mp.mpf(10) ** (5 - dps) * abs(chi):
+                break
+        u1, u2, u3 = funcs(chi)
+        r = rn + sigma0 * u1 - alpha * rn * u2 + u2
+        f, g = 1 - u2 / rn, (tau - u3) / mp.sqrt(m)
+        fd, gd = -mp.sqrt(m) * u1 / (r * rn), 1 - u2 / r
+        return ([float(f * a + g * b) for a, b in zip(rr, vv, strict=True)],
+                [float(fd * a + gd * b) for a, b in zip(rr, vv, strict=True)],
+                float(mp.sqrt(-alpha) * abs(chi)))
+
+
+def _barker_time_mp(r, v, q, mu=1.0, dps=50):
+    """Time since periapsis on the parabola of periapsis distance ``q`` through
+    the float state ``r, v``, by Barker's equation ``t = sqrt(2 q^3/mu) (D +
+    D^3/3)`` with ``D = tan(nu/2) = (r.v)/sqrt(2 q mu)`` (no anomaly from the
+    state's direction: far out its transverse velocity is below its rounding)."""
+    with mp.workdps(dps):
+        rv = sum(mp.mpf(float(a)) * mp.mpf(float(b)) for a, b in zip(r, v, strict=True))
+        qq, m = mp.mpf(float(q)), mp.mpf(mu)
+        d = rv / mp.sqrt(2 * qq * m)
+        return float(mp.sqrt(2 * qq**3 / m) * (d + d**3 / 3))
+
+
+def test_near_parabolic_and_parabolic_steps_of_any_size_converge():
+    """Regression: near e = 1 the universal Kepler equation was not solved at
+    scattered large dt (e = 1 + 1e-6: dt = 1e15, 10^15.5, 1e16; 1 + 1e-9: 8 values
+    ~1e20-1e23; 1 + 1e-12: 16 values ~1e24-1e31; the parabola: 350 values from
+    ~3e102), far from any overflow: ConvergenceError.  Laguerre's last step there
+    is below half an ulp of chi (an ulp of chi moves T by many ulps of tau) and was
+    taken for a step out of the bracket, whose doubling or bisection used up the
+    iterations; a long parabolic step started at tau/r0 ~ 1e102 for a root ~ 1e34.
+    Every dt = +-10^k, k = 0, 0.25, ..., 150 now gives a state.
+
+    References, independent of the kernel's solver and its Stumpff series:
+
+    * the parabola, every point: Barker's equation with D = (r.v)/sqrt(2 q mu) of
+      the returned state (50 digits) gives back dt within 64 eps (measured at most
+      25: t ~ D^3 triples the few eps of r and v);
+    * the hyperbolas, every fifth decade: the universal Kepler equation solved in
+      50 digits with sinh / cosh.  It takes 1/a as the kernel forms it in floats:
+      at periapsis 2/r0 - v0^2 cancels to e - 1 = 1e-12, so the float state's
+      own 1/a is known to ~1e-4 only, and far out the state scales with
+      sqrt(-1/a); that conditioning is not the solver's.  |r| within
+      16 (1 + s) eps (measured at most 7 s eps at dt = 1e150, s = 317): chi holds
+      53 bits and psi = chi^2/a carries a few eps, moving e^s by s times that;
+      v within 32 eps (measured 8)."""
+    dts = 10.0 ** np.arange(0.0, 150.001, 0.25)
+    dts = np.concatenate([dts, -dts])
+    for e in [1.0 + 1e-12, 1.0 + 1e-9, 1.0 + 1e-6, 1.0, 1.001, 1.0 - 1e-12]:
+        r0, v0 = _periapsis_state(e)
+        r, v = propagate(r0, v0, 1.0, dts)  # (ConvergenceError before the fix)
+        assert np.all(np.isfinite(r)) and np.all(np.isfinite(v)), e
+        if e == 1.0:
+            q = 0.5 * np.sum(np.cross(r0, v0) ** 2)
+            for i in range(len(dts)):
+                t = _barker_time_mp(r[i], v[i], q)
+                assert abs(t - dts[i]) <= 64 * EPS * abs(dts[i]), (dts[i], t)
+        elif 1.0 < e < 1.001:
+            for i in range(0, len(dts), 20):
+                ref_r, ref_v, s = _universal_mp(r0, v0, dts[i])
+                big = np.max(np.abs(ref_r))  # (|r|^2 may overflow)
+                assert _rel(r[i] / big, np.array(ref_r) / big) <= 16 * (1 + s) * EPS, (e, dts[i])
+                assert _rel(v[i], np.array(ref_v)) <= 32 * EPS, (e, dts[i])
+
+
+def test_long_steps_near_parabolic_converge_up_to_the_float_range():
+    """Three more ways the solver ran out of iterations before a state it could
+    return (ConvergenceError before the fix, each):
+
+    * a parabola of periapsis distance q = 1e-34 (nearly radial: the periapsis
+      of a nearly radial orbit is tiny) from its periapsis: the first guess
+      tau/q is ~1e50 times the root from dt = 1e70, and Laguerre's step gains
+      only ~2.7 per iteration from there (Barker's equation as in the test
+      above: within 64 eps of dt);
+    * a hyperbola (e = 1 + 1e-15) going back through its periapsis to |r| ~ 7e153,
+      where 16 r^2 in Laguerre's step overflows (checked against the 50-digit
+      universal solution as above; the step anchored at periapsis carries ~s eps
+      in v too, measured 1.3 s eps here and at dt = -1e50 on the old code, so v
+      gets the bound of r);
+    * the parabola up to |r| = 7.7e153 (dt = 10^230.5).
+
+    Beyond, where |r|^2 of the result leaves the float range (the parabola at dt =
+    1e231, |r| = 1.65e154), ConvergenceError is still raised."""
+    q = 1e-34
+    r0, v0 = ROT @ np.array([q, 0.0, 0.0]), ROT @ np.array([0.0, math.sqrt(2.0 / q), 0.0])
+    dts = 10.0 ** np.arange(70.0, 200.001, 10.0) * np.resize([1.0, -1.0], 14)
+    r, v = propagate(r0, v0, 1.0, dts)
+    q = 0.5 * np.sum(np.cross(r0, v0) ** 2)
+    for i, dt in enumerate(dts):
+        assert abs(_barker_time_mp(r[i], v[i], q) - dt) <= 64 * EPS * abs(dt), dt
+
+    r0, v0 = KeplerOrbit.from_elements(q=1e-3, e=1.0 + 1e-15, inc=0.4, lan=0.5, argp=0.6,
+                                       M=0.5, mu=1.0).state()
+    for dt in [-7.943282347242789e159, -1.2e160]:
+        r, v = propagate(r0, v0, 1.0, dt)
+        ref_r, ref_v, s = _universal_mp(r0, v0, dt)
+        big = np.max(np.abs(ref_r))
+        assert _rel(r / big, np.array(ref_r) / big) <= 16 * (1 + s) * EPS, dt
+        assert _rel(v, np.array(ref_v)) <= 16 * (1 + s) * EPS, dt
+
+    r0, v0 = [1.0, 0.0, 0.0], [0.0, math.sqrt(2.0), 0.0]
+    r, v = propagate(r0, v0, 1.0, 10.0**230.5)
+    q = 0.5 * np.sum(np.cross(r0, v0) ** 2)
+    assert abs(_barker_time_mp(r, v, q) - 10.0**230.5) <= 64 * EPS * 10.0**230.5
+    with pytest.raises(ConvergenceError, match="propagate failed"):
+        propagate(r0, v0, 1.0, 1e231)

@@ -673,12 +673,31 @@ def _series_x(x1, ir, c2, r0, sigma0, alpha):  # pragma: no cover - compiled
     return x1 * (1.0 + x1 * (-c2 + x1 * (k3 + x1 * (k4 + x1 * k5))))
 
 
+# A first guess of the bracketed solver within this factor of the cubic bound
+# (_long_guess) is kept: from there Laguerre's ~2.7 per step costs at most ~90 of
+# its 200 iterations (after at most ~40 bisections while T overflows, for a
+# result whose |r|^2 fits a float), and the results settled from such guesses
+# keep their bits
+# (2^20 changed 1.5% of 2e5 random states by a few ulps, long parabolic steps;
+# 2^128 changed 84 nearly radial ones, h < 1e-15 r v, ill-conditioned anyway).
+_CAP_RATIO = 2.0**128
+
+
 @njit(cache=True, inline="always")
-def _long_guess(tau, sgn, x1, x, alpha):  # pragma: no cover - compiled
+def _long_guess(tau, sgn, x1, x, sigma0, alpha):  # pragma: no cover - compiled
     """The first guess of the bracketed solver: ``x`` from :func:`_series_guess`
     unless the step is long (``|x1| sqrt|alpha| > 1/2``) or ``x`` is on the wrong
     side of 0: then the mean-motion guess ``tau alpha`` (elliptic) or a
-    logarithmic one (hyperbolic), else ``x1``."""
+    logarithmic one (hyperbolic), else ``x1``.
+
+    On an open orbit moving away from periapsis (``alpha <= 0``, ``sigma0 tau >=
+    0``) all terms of T have the sign of tau and ``|U3| >= |chi|^3/6``, so the
+    root lies within ``(6 |tau|)^(1/3)``; a guess more than :data:`_CAP_RATIO`
+    times that bound is replaced by it.  ``x1 = tau/r0`` is far above the root
+    on a very long parabolic step (1e102 at dt = 1e102, the root ~ 1e34), or from
+    the tiny periapsis distance of a nearly radial orbit; T, r^2 or f r'
+    overflowed there and the solver bisected, or Laguerre's step gained only a
+    factor ~2.7 per iteration, until the iterations ran out."""
     if alpha > 0.0:
         if abs(x1) * math.sqrt(alpha) > 0.5 or x * sgn <= 0.0:
             x = tau * alpha
@@ -692,6 +711,10 @@ def _long_guess(tau, sgn, x1, x, alpha):  # pragma: no cover - compiled
             x = x1
     if x * sgn <= 0.0 or not math.isfinite(x):
         x = x1
+    if alpha <= 0.0 and sigma0 * sgn >= 0.0:
+        xc = (6.0 * abs(tau)) ** (1.0 / 3.0)  # (a guess: pow compiles faster than cbrt)
+        if abs(x) > _CAP_RATIO * xc:
+            x = sgn * xc
     return x
 
 
@@ -701,7 +724,10 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
 
     The bracket starts as (0, chi_max) on the side of ``sgn`` with chi_max =
     2 pi/sqrt(alpha) for a bound orbit, else (0, inf), grown by doubling from
-    ``max(|x|, |x1|)``; a step that leaves it is replaced by bisection."""
+    ``max(|x|, |x1|)``; a step that leaves it is replaced by bisection.  A step
+    below half an ulp of chi while the bracket is still open is convergence;
+    where r^2 or f r' overflows Laguerre's step is formed in ratios, and a NaN
+    T (terms that overflow) bounds the far end of the bracket."""
     big = 2.0 * PI / math.sqrt(alpha) if alpha > 0.0 else math.inf
     if sgn > 0.0:
         a = 0.0
@@ -717,17 +743,33 @@ def _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha):  # pragma: no cover
         f = t - tau
         if f == 0.0:
             return x, t, r, u0, u1, u2, u3
-        if f < 0.0:
+        if f < 0.0 or (sgn < 0.0 and not f > 0.0):
+            # (a NaN T, the inf - inf or 0 inf of terms that overflow, puts x
+            # beyond the root: it bounded the wrong end going backwards, where
+            # the doubling then went on to chi^2 = inf, e.g. the parabola at dt = -1e155)
             a = x
         else:
             b = x
         # Laguerre, n = 5: dx = n f / (f' + sign(f') sqrt|(n-1)^2 f'^2 - n(n-1) f f''|)
         disc = math.sqrt(abs(16.0 * r * r - 20.0 * f * rp))
+        if not math.isfinite(disc) and math.isfinite(f) and 0.0 < r < math.inf:
+            # r^2 or f r' overflows (r beyond ~3e153): the same in ratios
+            disc = r * math.sqrt(abs(16.0 - 20.0 * (f / r) * (rp / r)))
         den = r + disc if r >= 0.0 else r - disc
         if den != 0.0 and math.isfinite(den):
             xn = x - 5.0 * f / den
         else:
             xn = math.nan
+        if xn == x and math.isinf(b - a):
+            # the step is below half an ulp of chi: x is the root to the floats,
+            # though at large chi r (an ulp of chi moves T by many ulps of tau)
+            # its residual may exceed the 2 ulps tested below.  x bounds the
+            # bracket now, so the step is not inside it, and with the bracket
+            # still open the safeguard below would double away from the root
+            # (to 2 tau/r0, where T overflows, and the bisection back used up the
+            # iterations: e = 1 + 1e-6, dt = 1e15).  (A finite bracket's
+            # bisection stays next to x and ends by the 8-ulp test.)
+            return x, t, r, u0, u1, u2, u3
         if not (a < xn < b):
             if math.isinf(b):
                 xn = 2.0 * max(abs(x), abs(x1))
@@ -775,7 +817,7 @@ def _solve_uv(tau, r0, sigma0, alpha):  # pragma: no cover - compiled
         sol = _solve_uv_short(tau, x, r0, sigma0, alpha)
         if math.isfinite(sol[0]):
             return sol
-    x = _long_guess(tau, sgn, x1, x, alpha)
+    x = _long_guess(tau, sgn, x1, x, sigma0, alpha)
     return _solve_uv_bracketed(tau, sgn, x1, x, r0, sigma0, alpha)
 
 
