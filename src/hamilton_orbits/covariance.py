@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits.validation import as_float_array
+from hamilton_orbits.validation import as_float_array, first_index, fmt_index
 
 __all__ = ["propagate"]
 
@@ -82,16 +82,43 @@ def _checked(cov0: Any, n: int) -> np.ndarray:
         c0 = np.broadcast_to(c0, (n, 6, 6))
     if c0.shape != (n, 6, 6):
         raise ValueError(f"Expected `cov0` of shape (6, 6) or ({n}, 6, 6), got {c0.shape}")
-    for i, c in enumerate(c0):
-        scale = float(np.max(np.abs(c)))
-        if not np.isfinite(c).all():
-            raise ValueError(f"Expected `cov0` finite, got {c.tolist()} for body {i}")
-        asym = float(np.max(np.abs(c - c.T)))
-        if asym > 1e-12 * scale:
-            raise ValueError(f"Expected `cov0` symmetric, got a difference of {asym:.3g} "
-                             f"between its transposed entries for body {i}")
-        low = float(np.linalg.eigvalsh(0.5 * (c + c.T))[0])
-        if low < -1e-12 * scale:
-            raise ValueError(f"Expected `cov0` positive semi-definite, got an eigenvalue "
-                             f"{low:.3g} for body {i}")
+    _check_covariances(c0)
     return c0
+
+
+#: Rounding allowed in the checks of a covariance, relative to its standard deviations
+COV_TOL = 1e-12
+
+
+def _check_covariances(c0: np.ndarray) -> None:
+    """Refuse covariances ``c0`` (n, 6, 6) that are not finite, not symmetric or not
+    positive semi-definite, free of their units: a variance below 0, two transposed
+    entries apart by more than :data:`COV_TOL` of ``sigma_j sigma_k``, or the
+    correlation matrix ``D^-1/2 C D^-1/2`` (``D`` the variances) with an eigenvalue
+    below ``-COV_TOL`` (a variance of 0 with a covariance beside it included), naming
+    the index and the value.  A test against the largest entry (au^2 beside
+    (au/day)^2, 1e8 times smaller) let negative velocity variances through."""
+    bad = ~np.isfinite(c0)
+    if bad.any():
+        at = first_index(bad)
+        raise ValueError(f"Expected `cov0` finite, got {float(c0[at])!r}{fmt_index(at)}")
+    var = np.diagonal(c0, axis1=1, axis2=2)  # (n, 6)
+    if (var < 0).any():
+        at = first_index(var < 0)
+        raise ValueError(f"Expected `cov0`'s variances >= 0, got {float(var[at])!r}"
+                         f"{fmt_index((at[0], at[1], at[1]))}")
+    sig = np.sqrt(var)
+    bound = COV_TOL * sig[:, :, None] * sig[:, None, :]
+    asym = np.abs(c0 - np.swapaxes(c0, 1, 2)) > bound
+    if asym.any():
+        i, j, k = first_index(asym)
+        raise ValueError(f"Expected `cov0` symmetric, got {float(c0[i, j, k])!r} and "
+                         f"{float(c0[i, k, j])!r} at indices {(i, j, k)} and {(i, k, j)}")
+    unit = np.where(sig > 0, sig, 1.0)
+    corr = 0.5 * (c0 + np.swapaxes(c0, 1, 2)) / (unit[:, :, None] * unit[:, None, :])
+    low = np.linalg.eigvalsh(corr)[:, 0]
+    if (low < -COV_TOL).any():
+        i = int(np.argmax(low < -COV_TOL))
+        raise ValueError(f"Expected `cov0` positive semi-definite, got its correlation "
+                         f"matrix's eigenvalue {low[i]:.3g} for body {i} (`cov0[{i}]`)")
+
