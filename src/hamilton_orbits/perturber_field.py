@@ -181,13 +181,16 @@ def _nongrav_effect(nongrav: Any, n: int) -> dict[str, Any] | None:
             if unit is not None:  # ("-2.9e-14 au/day2" as the effects read it)
                 x = with_units(x, key, f"`nongrav` at index {k}",
                                ACCELERATION if kind == "acceleration" else LENGTH)
+            if is_quantity(x) and unit is None and x.unit.is_equivalent(u.one):
+                x = x.to_value(u.one)  # (a dimensionless exponent, `2 * u.one`)
             if is_quantity(x) and unit is not None:
                 if not x.unit.is_equivalent(unit):
                     raise u.UnitConversionError(
                         f"Expected `nongrav` {key} to be an {kind} (such as {unit}), got "
                         f"{x!r} at index {k}")
                 x = x.to_value(unit)
-            if not isinstance(x, (int, float, np.floating, np.integer)) or not np.isfinite(x):
+            if (not isinstance(x, (int, float, np.floating, np.integer))
+                    or isinstance(x, bool) or not np.isfinite(x)):  # (True: read as 1)
                 raise ValueError(f"Expected `nongrav` {key} a finite number (or Quantity), "
                                  f"got {row[key]!r} at index {k}")
             values[key].append(float(x))

@@ -85,3 +85,17 @@ def test_nongrav_of_small_bodies_takes_strings():
     with pytest.raises(u.UnitConversionError, match=r"Expected `nongrav` A2 to be an "
                                                     r"acceleration"):
         _propagate(nongrav={"A2": "1 km"})
+
+
+def test_nongrav_of_small_bodies_refuses_a_bool_and_takes_a_dimensionless_quantity():
+    """``{"A2": True}`` was read as 1 au/day^2 (the body 0.08 au off after a day), and
+    ``m`` as ``2 * u.one`` refused as not "a finite number (or Quantity)"."""
+    with pytest.raises(ValueError, match=r"Expected `nongrav` A2 a finite number .* got "
+                                         r"True at index 0"):
+        _propagate(nongrav={"A2": True})
+    with pytest.raises(ValueError, match=r"Expected `nongrav` m a finite number .* got "
+                                         r"False at index 0"):
+        _propagate(nongrav={"A2": -2.9e-8, "m": False})
+    a = _propagate(nongrav={"A2": -2.9e-8, "m": 2.0})
+    b = _propagate(nongrav={"A2": -2.9e-8, "m": 2 * u.one})
+    np.testing.assert_array_equal(a.r.value, b.r.value)
