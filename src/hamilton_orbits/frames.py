@@ -142,8 +142,13 @@ def pole(name: str, frame: str = "icrs") -> np.ndarray:
     """The pole :func:`hamilton_orbits.ephemeris.body_specs` gives body ``name``
     (``"sun"``, ``"earth"``, ``"moon"``), in ``frame``: the Sun's IAU pole
     (:func:`sun_pole`), the Earth's mean pole of J2000 (the ICRF z axis to 0.02"),
-    the Moon's mean pole of J2000 (IAU WGCCRE 2015: RA 269.9949 deg, Dec 66.5392
-    deg).
+    the Moon's mean pole (IAU WGCCRE 2015, Archinal et al. 2018: the constant terms
+    RA 269.9949 deg, Dec 66.5392 deg).  The Moon's is the centre about which its
+    pole turns in 18.6 years (Cassini's laws), 0.02 deg from the ecliptic's pole;
+    its pole at any date is 1.54 deg from there (at J2000, with the WGCCRE's
+    periodic terms, RA 266.86 deg, Dec 65.64 deg: 1.56 deg from this one).  A
+    ``j2`` of the Moon about it is therefore an average over that cycle; the
+    ``moon_figure`` effect follows the Moon's pole as it turns.
 
     Examples
     --------
