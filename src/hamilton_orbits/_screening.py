@@ -112,7 +112,11 @@ def may_be_near(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, ste
     False
     """
     n_t, n = r.shape[0], r.shape[1]
-    if n_t < 2 or n < 2 or not np.max(gm) > 0:
+    if n_t < 2 or n < 2:
+        return False
+    if not (np.isfinite(gm).all() and np.isfinite(t).all()):
+        return True  # (the screen's comparisons pass over a NaN as numpy's do not)
+    if not np.max(gm) > 0:
         return False
     gm0 = np.where(gm <= light * np.max(gm), 0.0, gm)
     prim = primaries(r[0], v[0], gm0)

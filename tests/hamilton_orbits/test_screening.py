@@ -24,13 +24,13 @@ _WITH_MOON = ["sun", "mercury", "venus", "earth", "mars", "jupiter", "saturn", "
 
 
 def test_numpy_never_rules_out_a_leg_the_screen_flags():
-    """On 4000 random legs, forwards and backwards, with and without an exempt body:
+    """On 1500 random legs, forwards and backwards, with and without an exempt body:
     wherever the compiled screen answers True, numpy's test does too (a good share
     of them, so that the comparison is not one of zeros), and it rules out most of
     the legs the screen rules out (it is looser, not useless)."""
     rng = np.random.default_rng(2027)
     flagged = ruled_out = kept_out = 0
-    for _ in range(4000):
+    for _ in range(1500):
         r, v, gm, t, step, fraction = random_leg(rng)
         for times in (t, -t):
             for exempt in (-1, int(rng.integers(len(gm)))):
@@ -42,7 +42,7 @@ def test_numpy_never_rules_out_a_leg_the_screen_flags():
                 flagged += maybe
                 ruled_out += not maybe
                 kept_out += not near and not maybe
-    assert flagged > 2000 and ruled_out > 2000
+    assert flagged > 2000 and ruled_out > 2000  # (of 6000: 3152 and 2848)
     assert kept_out > 0.5 * ruled_out
 
 
@@ -143,3 +143,38 @@ def test_a_first_run_asks_the_screen_only_where_numpy_cannot_rule_it_out(uncompi
     sim.integrate(sim.t + 10 * u.day)  # (the screen from then on)
     sim.integrate(sim.t + 10 * u.day)
     assert uncompiled.calls == asked + 2
+
+
+def test_a_nan_is_left_to_the_screen():
+    """A NaN GM or time, which the screen's comparisons pass over and numpy's do not:
+    numpy defers to the screen (a NaN GM of a third body hid the approach of the
+    first two on a first run)."""
+    t = np.array([0.0, 1.0])
+    r = np.zeros((2, 3, 3))
+    v = np.zeros((2, 3, 3))
+    r[:, 1, 0], v[:, 1, 1], r[:, 2, 0], v[:, 2, 1] = 0.01, 20.0, 5.0, 0.3
+    none = (-1, 0.0)
+    assert _screening.may_be_near(r, v, np.array([1.0, 0.0, np.nan]), t, 0.1, none, 1 / 30,
+                                  LIGHT)
+    assert _screening.may_be_near(r, v, np.array([1.0, 0.0, 1e-3]), np.array([0.0, np.nan]),
+                                  0.1, none, 1 / 30, LIGHT)
+    assert k.screen(r, v, np.array([1.0, 0.0, np.nan]), t, 0.1, -1, 0.0, 1 / 30, LIGHT)
+
+
+def test_on_disk_looks_at_numba_s_cache(tmp_path, monkeypatch):
+    """False for a cached kernel not compiled yet (a module of its own, new), True
+    once compiled into the cache, and True where there is no cache to look at."""
+    import importlib
+
+    from numba import njit
+
+    from hamilton_orbits._kernels.entry import on_disk
+
+    (tmp_path / "tiny_kernel.py").write_text(
+        "from numba import njit\n\n\n@njit(cache=True)\ndef f(x):\n    return x + 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    tiny = importlib.import_module("tiny_kernel")
+    assert not on_disk(tiny.f, (1.0,))
+    assert tiny.f(1.0) == 2.0
+    assert on_disk(tiny.f, (1.0,)) and not on_disk(tiny.f, (1,))  # (int64: not compiled)
+    assert on_disk(njit(cache=False)(lambda x: x + 1), (1.0,))

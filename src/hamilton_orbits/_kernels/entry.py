@@ -125,8 +125,11 @@ def on_disk(dispatcher: Any, args: tuple) -> bool:
     try:
         from numba import typeof
 
+        cache = dispatcher._cache
+        if type(cache).__name__ == "NullCache":  # (no cache: nothing to look at)
+            return True
         sig = tuple(typeof(a) for a in args)
-        return dispatcher._cache.load_overload(sig, dispatcher.targetctx) is not None
+        return cache.load_overload(sig, dispatcher.targetctx) is not None
     except Exception:  # (numba's cache API is its own: never fail a run on it)
         return True
 
