@@ -208,9 +208,9 @@ def _joined(items: list | tuple):
     return u.Quantity([_joined(x) if isinstance(x, list | tuple) else x for x in items])
 
 
-#: Types that are never a TimeDelta (:func:`time_quantity`'s quick answer)
-_NOT_TIME_DELTA = frozenset({float, int, np.float64, np.ndarray, u.Quantity, list, tuple,
-                             type(None)})
+#: Types that are never a TimeDelta (:func:`time_quantity`'s quick answer; not
+#: astropy's Quantity: naming it here would import astropy with the package)
+_NOT_TIME_DELTA = frozenset({float, int, np.float64, np.ndarray, list, tuple, type(None)})
 
 
 def time_quantity(value: Any) -> Any:
@@ -244,7 +244,7 @@ def time_quantity(value: Any) -> Any:
     >>> time_quantity(2.0)
     2.0
     """
-    if type(value) in _NOT_TIME_DELTA:  # (the common types at once: an isinstance
+    if type(value) in _NOT_TIME_DELTA:  # (plain types at once: an isinstance
         return value  # against astropy's TimeDelta costs 0.3 us of every call)
     time = sys.modules.get("astropy.time")
     delta = None if time is None else getattr(time, "TimeDelta", None)
