@@ -326,13 +326,15 @@ class Propagation:
         continues bit for bit).  ``pause()`` (forwards only; a driver that can pause
         between steps, radau15's) is called between two steps once :attr:`steps`
         reaches ``pause.at``, the propagation standing at the driver's own state
-        (the steps unchanged: a snapshot taken then continues bit for bit)."""
+        (the steps unchanged: a snapshot taken then continues bit for bit).
+        ``on_output(i, steps)`` and ``stop()`` after output ``i`` see the propagation
+        standing there as ``checkpoint`` does (a snapshot or copy taken in them
+        continues as the run does)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         events = self.events
-        first_event = 0
+        first_event = 0 if events is None else len(events.recorded())
         if events is not None:
-            first_event = len(events.recorded())
             events.stopped_by = None
         driver = self._driver_for_leg(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
@@ -346,12 +348,14 @@ class Propagation:
             self.variational.new_leg(n_t)
         reached = [0, 0]  # last output index, steps
         calling = [False]  # (a callback's own error is not the driver's: left as it is)
+        stand = checkpoint is not None or on_output is not None or stop is not None
 
         def report(i: int, steps: int) -> None:
             reached[0], reached[1] = i, steps
             calling[0] = True
+            if stand:  # (a callback sees the output it is told of: see above)
+                self._stand_at(float(t_out[i]), r_out[i], -v_out[i] if backward else v_out[i])
             if checkpoint is not None:
-                self._stand_at(float(t_out[i]), r_out[i], v_out[i])
                 checkpoint(i)
             if on_output is not None:
                 on_output(i, steps)

@@ -453,3 +453,49 @@ def test_an_error_from_on_output_keeps_the_output_reached(kw):
     assert sim.t == 2.0
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.r[2])
     assert _same(sim.integrate([3.0, 4.0]).r[-1], once.r[-1])
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.02), dict(method="leapfrog", dt=0.02),
+                                dict(method="radau15"), dict(method="dop853")])
+def test_a_callback_stands_at_the_output_it_is_told_of(tmp_path, kw):
+    """Inside ``on_output`` and ``stop`` the simulation stands at the output reached
+    (its time, state and integrator), not at the leg's start: a snapshot saved or a
+    copy taken there continues with the bits of the run never stopped.  (Without an
+    archive they showed the leg's start beside the current step count: a save at
+    t = 2 loaded at t = 0, and wh continued from its t = 2 state under t = 0.)"""
+    times = [1.0, 2.0, 3.0, 4.0]
+    once = Simulation(_disc(), **kw).integrate(times)
+    sim = Simulation(_disc(), **kw)
+    seen, copies = [], []
+
+    def on_output(i, steps):
+        seen.append((sim.t, sim.steps == steps, _same(sim.system.as_arrays().r, once.r[i]),
+                     _same(sim.system.as_arrays().v, once.v[i])))
+        if i == 2:
+            sim.save(tmp_path / "mid.nc")
+            copies.append(sim.copy())
+
+    def stop():
+        seen.append(sim.t)
+        return False
+
+    whole = sim.integrate(times, on_output=on_output, stop=stop)
+    assert _same(whole.r, once.r) and whole.steps == once.steps
+    assert seen == [x for t in times for x in ((t, True, True, True), t)]
+    for later in (Simulation.load(tmp_path / "mid.nc"), copies[0]):
+        assert later.t == 2.0
+        rest = later.integrate([3.0, 4.0])
+        assert _same(rest.r, once.r[2:]) and _same(rest.v, once.v[2:])
+        assert later.steps == once.steps
+
+
+def test_a_callback_of_a_backward_leg_stands_at_its_output():
+    """A backward leg's callback sees the output's time and true velocities."""
+    sim = Simulation(_disc(), method="radau15")
+    seen = []
+    back = sim.integrate([-1.0, -2.0],
+                         on_output=lambda i, steps: seen.append((sim.t, sim.system.as_arrays())))
+    assert [t for t, _ in seen] == [-1.0, -2.0]
+    for (_, s), r, v in zip(seen, back.r[1:], back.v[1:], strict=True):
+        assert _same(s.r, r) and _same(s.v, v)
+
