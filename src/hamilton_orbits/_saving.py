@@ -146,8 +146,12 @@ class Saving:
         if rest.size:
             on_output = _numbered_as_the_call(on_output, times.size - rest.size - 1,
                                               self.steps - info["steps0"])
-            out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop,
-                                leg=times)
+            try:
+                out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output,
+                                    stop, leg=times)
+            except BaseException:  # (cut: the next leg's integrals measured from time 0)
+                self._start = self._initial
+                raise
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
@@ -286,7 +290,9 @@ class Saving:
                 "from its positions, velocities and masses with the integrator started "
                 "afresh: not bit for bit the run that wrote it, and events found and MEGNO "
                 "sums before it are not carried over"), stacklevel=3)
-        if meta.get("started"):
+        if meta.get("started") or meta.get("t", 0.0) != 0.0 or meta.get("steps", 0):
+            # (a snapshot taken after time 0, within the first integrate call too,
+            # which records started False: the integrals measured from time 0)
             sim._start = sim._initial
         if meta.get("unit"):
             sim._unit = u.Unit(meta["unit"])

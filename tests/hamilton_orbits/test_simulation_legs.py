@@ -499,3 +499,55 @@ def test_a_callback_of_a_backward_leg_stands_at_its_output():
     for (_, s), r, v in zip(seen, back.r[1:], back.v[1:], strict=True):
         assert _same(s.r, r) and _same(s.v, v)
 
+
+def _same_integrals(a, b) -> bool:
+    return all(_same(getattr(a, k), getattr(b, k)) for k in (
+        "energy_error", "angular_momentum_error", "barycentre_drift"))
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.02), dict(method="radau15")])
+def test_a_snapshot_of_the_first_call_measures_the_integrals_from_time_0(tmp_path, kw):
+    """A simulation loaded from a snapshot taken within its first integrate call (an
+    archive's, or one saved from ``on_output``) measures Hamilton's integrals from
+    the system at time 0, as the run never stopped does: the same bits.  (It
+    measured them from its own first row, 0.0 at the snapshot's time.)"""
+    times = [1.0, 2.0, 3.0, 3.5]
+    once = Simulation(_disc(), **kw).integrate(times)
+    sim = Simulation(_disc(), archive=tmp_path / "a", every=1.0, **kw)
+    sim.integrate(times,
+                  on_output=lambda i, steps: i == 2 and sim.save(tmp_path / "mid.nc"))
+    archive = Archive(tmp_path / "a")
+    for later in (archive[list(archive.times).index(2.0)], Simulation.load(tmp_path / "mid.nc")):
+        assert later.t == 2.0
+        rest = later.integrate([3.0, 3.5])
+        assert _same(rest.r, once.r[2:])
+        assert _same_integrals(rest, _Rows(once, slice(2, None)))
+        assert rest.energy_error[0] != 0.0
+
+
+@pytest.mark.parametrize("cut", [KeyboardInterrupt, RuntimeError])
+@pytest.mark.parametrize("kw", [dict(method="leapfrog", dt=0.05), dict(method="dop853")])
+def test_a_first_call_cut_short_measures_the_next_legs_integrals_from_time_0(kw, cut):
+    """Ctrl-C (``on_interrupt="raise"``) or an error ending the first integrate call:
+    the next leg measures Hamilton's integrals from the system at time 0, as the
+    run never cut does (it measured them from the state the cut left)."""
+    once = Simulation(_disc(), **kw).integrate([1.0, 2.0, 3.0])
+    sim = Simulation(_disc(), **kw)
+
+    def cut_at_2(i, steps):
+        if i == 2:
+            raise cut
+
+    with pytest.raises(cut):
+        sim.integrate([1.0, 2.0, 3.0], on_output=cut_at_2)
+    rest = sim.integrate(3.0)
+    assert _same(rest.r[-1], once.r[-1])
+    assert _same_integrals(rest, _Rows(once, slice(2, None)))
+
+
+class _Rows:
+    """The rows ``rows`` of a trajectory's integrals."""
+
+    def __init__(self, traj, rows):
+        for k in ("energy_error", "angular_momentum_error", "barycentre_drift"):
+            setattr(self, k, getattr(traj, k)[rows])
