@@ -500,6 +500,8 @@ class _Pause:
         else:
             r, v, _ = driver.state()
             self.mine = (r, v)
+        if prop.events is not None:  # (the bodies taken out at NaN, as in the outputs:
+            prop.events.mask(r, v)  # the driver keeps their parked state to go on)
         prop._stand_at(driver.t, r, v)
         self.pause(again)
 

@@ -1943,3 +1943,25 @@ def test_an_event_of_bodies_named_by_an_array_archives_and_loads(tmp_path):
     for other in (loaded, alone):
         np.testing.assert_array_equal(other.system.r, twin.system.r)
     assert again.t == 0.5
+
+
+def test_snapshots_between_steps_after_a_merge_hold_the_body_taken_out_at_nan(tmp_path):
+    """``every_steps`` snapshots (radau15, between two steps) after a merge: the body
+    taken out is NaN in their rows, as in the outputs and at ``every`` snapshots
+    (they held the integrator's parked position, r ~ 3e8), and each continues to
+    the run's bits."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005),
+                Body("a", 1e-4, [1.0, 0, 0], [0, 1.0, 0], radius=0.01),
+                Body("b", 1e-5, [1.0, 0.05, 0], [0, 0.9, 0], radius=0.01)])  # (merge, t 0.26)
+    kw = dict(method="radau15", events=[{"name": "collision", "action": "merge"}])
+    whole = Simulation(s, archive=tmp_path / "a", every_steps=3, **kw).integrate(2.0)
+    ds = Archive(tmp_path / "a").to_xarray()
+    gone = ~ds.active.values[:, 2]
+    assert gone.sum() >= 3 and ds.time.values[gone].min() < 1.0
+    assert np.isnan(ds.r.values[gone, 2]).all() and np.isnan(ds.v.values[gone, 2]).all()
+    assert np.isfinite(ds.r.values[~gone]).all()
+    archive = Archive(tmp_path / "a")
+    for k in range(len(archive)):
+        snap = archive[k]
+        if 0.0 < snap.t < 2.0:
+            assert _same(snap.integrate(2.0).r[-1], whole.r[-1]), k
