@@ -470,6 +470,7 @@ class Saving:
             extra = on_step_grid(extra, asked, step, spread=prop.method.name == "leapfrog")
             extra = extra[extra > times[0]]  # (one moved back onto the start, at the
             # rounding of its step, is not an output after it)
+        extra = _onto_near_times(extra, times)
         if not extra.size and bool(np.all(times[1:] > times[:-1])):  # (no snapshot
             # scheduled in the call, as in a loop of short calls: its times as they are)
             return times, np.ones(len(times), bool), np.zeros(len(times), bool)
@@ -526,6 +527,36 @@ class Saving:
                 taken[0] = True
 
         return at
+
+
+#: how many ulp apart a scheduled snapshot time and a caller's output time are one
+#: time (a snapshot a few ulp from an output would cost a step of that length)
+NEAR_ULPS = 4
+
+
+def _onto_near_times(extra: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """The snapshot times ``extra`` (increasing, after ``times[0]``) with those within
+    :data:`NEAR_ULPS` ulp of an output time of ``times`` (forwards) taken as that
+    output time (the caller's), one on the start left out (the leg's first
+    snapshot is there).
+
+    Examples
+    --------
+    >>> times = np.concatenate(([0.0], np.cumsum(np.full(10, 0.1))))  # (0.6 ... 0.9999999999999999)
+    >>> _onto_near_times(0.1 * np.array([5, 6, 10]), times).tolist()  # (0.6000000000000001, 1.0)
+    [0.5, 0.6, 0.9999999999999999]
+    """
+    if not extra.size or times.size < 2:
+        return extra
+    k = np.clip(np.searchsorted(times, extra), 1, times.size - 1)
+    lo, hi = times[k - 1], times[k]
+    near = np.where(extra - lo <= hi - extra, lo, hi)
+    close = np.abs(extra - near) <= NEAR_ULPS * np.spacing(np.maximum(np.abs(extra),
+                                                                      np.abs(near)))
+    if not close.any():
+        return extra
+    out = np.where(close, near, extra)
+    return out[out > times[0]]
 
 
 #: the steps between two looks at the clock of an ``every_wall`` archive between two
