@@ -1989,3 +1989,26 @@ def test_snapshot_times_an_ulp_from_output_times_are_the_outputs(tmp_path, kw):
         snaps = Archive(folder).times
         assert len(snaps) == 30 + len(calls)  # (the second call's start snapshot too)
         assert np.isin(snaps[1:], times).all()
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_a_snapshot_of_an_earlier_formats_first_call_measures_from_time_0(tmp_path, version):
+    """The snapshots of ``data/archive-v1`` and ``-v2`` were taken within their first
+    integrate call (recorded ``started`` False): loaded, the next leg measures the
+    particle's integrals from time 0, as the call resumed whole does at the same
+    state (it measured them from the snapshot's own state, 0.0 at t = 4)."""
+    import shutil
+    import warnings
+
+    from hamilton_orbits._saving import RestartWarning
+
+    folder = tmp_path / "archive"
+    shutil.copytree(Path(__file__).parent / "data" / f"archive-v{version}", folder)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RestartWarning)  # (format 1's integrator state)
+        whole = Simulation.load(folder).resume()
+        loaded = Archive(folder)[-1]
+    assert loaded.t == 4.0 == whole.t[4]
+    leg = loaded.integrate(5.0)
+    assert _same(leg.r[0], whole.r[4])
+    assert _same(leg.particle_error[0], whole.particle_error[4]) and leg.particle_error[0, 1] != 0
