@@ -453,7 +453,20 @@ class Propagation:
     def _drive(self, driver: Any, t_out: np.ndarray, rows: tuple[np.ndarray, np.ndarray],
                report: Callable[[int, int], None], stop: Any, pause: Any) -> None:
         """``driver.advance`` through ``t_out``, ``pause`` set on a driver that takes
-        it (and cleared after)."""
+        it (and cleared after); ``stop()``, which the driver asks between slices of
+        steps, asked with the propagation standing at the driver's state (its time,
+        as its step count is; the bodies taken out at NaN)."""
+        if stop is not None:
+            asked = stop
+
+            def stop() -> bool:
+                r, v, _ = driver.state()  # (copies: the driver's own kept)
+                if self.events is not None:
+                    self.events.mask(r, v)
+                sign = -1.0 if self.backward else 1.0  # (gm as at the outputs: not
+                self._stand_at(sign * driver.t, r, sign * v)  # replaced when unchanged)
+                return asked()
+
         pausing = pause is not None and hasattr(driver, "pause")
         if pausing:
             driver.pause = _Pause(self, pause)
@@ -464,7 +477,8 @@ class Propagation:
                 driver.pause = None
 
     def _stand_at(self, t: float, r: np.ndarray, v: np.ndarray) -> None:
-        """Stand at output time ``t`` with its state (forwards), as a leg ending there."""
+        """Stand at time ``t`` with its state (``v`` the true velocities), as a leg
+        ending there (``gm`` replaced only where events changed it)."""
         self.r, self.v, self.t = r, v, t
         if self.events is not None and self.events.gm_changes:
             self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]

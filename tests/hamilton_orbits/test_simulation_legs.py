@@ -551,3 +551,34 @@ class _Rows:
     def __init__(self, traj, rows):
         for k in ("energy_error", "angular_momentum_error", "barycentre_drift"):
             setattr(self, k, getattr(traj, k)[rows])
+
+
+@pytest.mark.parametrize(("kw", "end"), [(dict(method="wh", dt=1e-4), 15.0),
+                                         (dict(method="leapfrog", dt=1e-4), 15.0),
+                                         (dict(method="radau15"), 1e4)])
+def test_stop_asked_between_slices_of_steps_sees_the_state_reached(tmp_path, kw, end):
+    """``stop()`` asked between two slices of steps (within an output interval) sees
+    the simulation at the time its step count is at, with that state, and a
+    snapshot saved there loads at that time (it saw the leg's start, t = 0, beside
+    100 000 steps)."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, **kw)
+    seen = []
+
+    def stop():
+        if not seen:
+            seen.append((sim.t, sim.steps, sim.system.as_arrays()))
+            sim.save(tmp_path / "between.nc")
+        return False
+
+    sim.integrate(end, stop=stop)
+    t, steps, state = seen[0]
+    assert 0.0 < t < end and steps >= 20_000
+    if "dt" in kw:
+        assert t == pytest.approx(steps * kw["dt"], rel=1e-12)
+    there = Simulation(s, **kw).integrate(t)
+    np.testing.assert_allclose(state.r, there.r[-1], rtol=0, atol=1e-8)
+    loaded = Simulation.load(tmp_path / "between.nc")
+    assert loaded.t == t and loaded.steps == steps
+    np.testing.assert_allclose(loaded.integrate(end).r[-1], sim.system.as_arrays().r,
+                               rtol=0, atol=1e-8)
