@@ -337,10 +337,13 @@ class Simulation(Saving):
         on_output : callable, optional
             ``on_output(i, steps)`` after output ``i``; it may raise
             :class:`~hamilton_orbits.integrators.StopIntegration` to end the leg there
-            (the trajectory then has ``complete == False``).
+            (the trajectory then has ``complete == False``).  The simulation stands
+            at output ``i`` while it runs (:attr:`t`, :attr:`system`, :attr:`steps`):
+            a :meth:`save` or :meth:`copy` there continues to the run's bits.
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
-            the leg there (``complete == False``).
+            the leg there (``complete == False``).  It sees the simulation at the
+            output, or between slices at the time and state its integrator reached.
         on_interrupt : {"raise", "keep"}
             What Ctrl-C does: raise ``KeyboardInterrupt`` (default), or end the leg
             at the last output reached and return it (``complete == False``), as a
