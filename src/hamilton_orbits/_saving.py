@@ -14,6 +14,7 @@ by :mod:`hamilton_orbits.snapshot` and scheduled by
 from __future__ import annotations
 
 import copy
+import math
 import os
 import warnings
 from collections.abc import Callable
@@ -548,6 +549,17 @@ def _onto_near_times(extra: np.ndarray, times: np.ndarray) -> np.ndarray:
     """
     if not extra.size or times.size < 2:
         return extra
+    if extra.size * times.size <= 64:  # (a short call, the usual one: in Python floats,
+        ts = times.tolist()  # at a tenth of the cost of the arrays' way below)
+        out = extra.tolist()
+        for j, e in enumerate(out):
+            near = min(ts, key=lambda t, e=e: abs(e - t))
+            if abs(e - near) <= NEAR_ULPS * math.ulp(max(abs(e), abs(near))):
+                out[j] = near
+        if out == extra.tolist():
+            return extra
+        moved = np.array(out)
+        return moved[moved > times[0]]
     k = np.clip(np.searchsorted(times, extra), 1, times.size - 1)
     lo, hi = times[k - 1], times[k]
     near = np.where(extra - lo <= hi - extra, lo, hi)
