@@ -14,6 +14,7 @@ by :mod:`hamilton_orbits.snapshot` and scheduled by
 from __future__ import annotations
 
 import copy
+import math
 import os
 import warnings
 from collections.abc import Callable
@@ -146,8 +147,12 @@ class Saving:
         if rest.size:
             on_output = _numbered_as_the_call(on_output, times.size - rest.size - 1,
                                               self.steps - info["steps0"])
-            out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output, stop,
-                                leg=times)
+            try:
+                out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output,
+                                    stop, leg=times)
+            except BaseException:  # (cut: the next leg's integrals measured from time 0)
+                self._start = self._initial
+                raise
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
@@ -286,7 +291,9 @@ class Saving:
                 "from its positions, velocities and masses with the integrator started "
                 "afresh: not bit for bit the run that wrote it, and events found and MEGNO "
                 "sums before it are not carried over"), stacklevel=3)
-        if meta.get("started"):
+        if meta.get("started") or meta.get("t", 0.0) != 0.0 or meta.get("steps", 0):
+            # (a snapshot taken after time 0, within the first integrate call too,
+            # which records started False: the integrals measured from time 0)
             sim._start = sim._initial
         if meta.get("unit"):
             sim._unit = u.Unit(meta["unit"])
@@ -464,6 +471,7 @@ class Saving:
             extra = on_step_grid(extra, asked, step, spread=prop.method.name == "leapfrog")
             extra = extra[extra > times[0]]  # (one moved back onto the start, at the
             # rounding of its step, is not an output after it)
+        extra = _onto_near_times(extra, times)
         if not extra.size and bool(np.all(times[1:] > times[:-1])):  # (no snapshot
             # scheduled in the call, as in a loop of short calls: its times as they are)
             return times, np.ones(len(times), bool), np.zeros(len(times), bool)
@@ -520,6 +528,47 @@ class Saving:
                 taken[0] = True
 
         return at
+
+
+#: how many ulp apart a scheduled snapshot time and a caller's output time are one
+#: time (a snapshot a few ulp from an output would cost a step of that length)
+NEAR_ULPS = 4
+
+
+def _onto_near_times(extra: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """The snapshot times ``extra`` (increasing, after ``times[0]``) with those within
+    :data:`NEAR_ULPS` ulp of an output time of ``times`` (forwards) taken as that
+    output time (the caller's), one on the start left out (the leg's first
+    snapshot is there).
+
+    Examples
+    --------
+    >>> times = np.concatenate(([0.0], np.cumsum(np.full(10, 0.1))))  # (0.6 ... 0.9999999999999999)
+    >>> _onto_near_times(0.1 * np.array([5, 6, 10]), times).tolist()  # (0.6000000000000001, 1.0)
+    [0.5, 0.6, 0.9999999999999999]
+    """
+    if not extra.size or times.size < 2:
+        return extra
+    if extra.size * times.size <= 64:  # (a short call, the usual one: in Python floats,
+        ts = times.tolist()  # at a tenth of the cost of the arrays' way below)
+        out = extra.tolist()
+        for j, e in enumerate(out):
+            near = min(ts, key=lambda t, e=e: abs(e - t))
+            if abs(e - near) <= NEAR_ULPS * math.ulp(max(abs(e), abs(near))):
+                out[j] = near
+        if out == extra.tolist():
+            return extra
+        moved = np.array(out)
+        return moved[moved > times[0]]
+    k = np.clip(np.searchsorted(times, extra), 1, times.size - 1)
+    lo, hi = times[k - 1], times[k]
+    near = np.where(extra - lo <= hi - extra, lo, hi)
+    close = np.abs(extra - near) <= NEAR_ULPS * np.spacing(np.maximum(np.abs(extra),
+                                                                      np.abs(near)))
+    if not close.any():
+        return extra
+    out = np.where(close, near, extra)
+    return out[out > times[0]]
 
 
 #: the steps between two looks at the clock of an ``every_wall`` archive between two

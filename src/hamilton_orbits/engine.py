@@ -326,13 +326,15 @@ class Propagation:
         continues bit for bit).  ``pause()`` (forwards only; a driver that can pause
         between steps, radau15's) is called between two steps once :attr:`steps`
         reaches ``pause.at``, the propagation standing at the driver's own state
-        (the steps unchanged: a snapshot taken then continues bit for bit)."""
+        (the steps unchanged: a snapshot taken then continues bit for bit).
+        ``on_output(i, steps)`` and ``stop()`` after output ``i`` see the propagation
+        standing there as ``checkpoint`` does (a snapshot or copy taken in them
+        continues as the run does)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         events = self.events
-        first_event = 0
+        first_event = 0 if events is None else len(events.recorded())
         if events is not None:
-            first_event = len(events.recorded())
             events.stopped_by = None
         driver = self._driver_for_leg(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
@@ -346,12 +348,14 @@ class Propagation:
             self.variational.new_leg(n_t)
         reached = [0, 0]  # last output index, steps
         calling = [False]  # (a callback's own error is not the driver's: left as it is)
+        stand = checkpoint is not None or on_output is not None or stop is not None
 
         def report(i: int, steps: int) -> None:
             reached[0], reached[1] = i, steps
             calling[0] = True
+            if stand:  # (a callback sees the output it is told of: see above)
+                self._stand_at(float(t_out[i]), r_out[i], -v_out[i] if backward else v_out[i])
             if checkpoint is not None:
-                self._stand_at(float(t_out[i]), r_out[i], v_out[i])
                 checkpoint(i)
             if on_output is not None:
                 on_output(i, steps)
@@ -449,7 +453,20 @@ class Propagation:
     def _drive(self, driver: Any, t_out: np.ndarray, rows: tuple[np.ndarray, np.ndarray],
                report: Callable[[int, int], None], stop: Any, pause: Any) -> None:
         """``driver.advance`` through ``t_out``, ``pause`` set on a driver that takes
-        it (and cleared after)."""
+        it (and cleared after); ``stop()``, which the driver asks between slices of
+        steps, asked with the propagation standing at the driver's state (its time,
+        as its step count is; the bodies taken out at NaN)."""
+        if stop is not None:
+            asked = stop
+
+            def stop() -> bool:
+                r, v, _ = driver.state()  # (copies: the driver's own kept)
+                if self.events is not None:
+                    self.events.mask(r, v)
+                sign = -1.0 if self.backward else 1.0  # (gm as at the outputs: not
+                self._stand_at(sign * driver.t, r, sign * v)  # replaced when unchanged)
+                return asked()
+
         pausing = pause is not None and hasattr(driver, "pause")
         if pausing:
             driver.pause = _Pause(self, pause)
@@ -460,7 +477,8 @@ class Propagation:
                 driver.pause = None
 
     def _stand_at(self, t: float, r: np.ndarray, v: np.ndarray) -> None:
-        """Stand at output time ``t`` with its state (forwards), as a leg ending there."""
+        """Stand at time ``t`` with its state (``v`` the true velocities), as a leg
+        ending there (``gm`` replaced only where events changed it)."""
         self.r, self.v, self.t = r, v, t
         if self.events is not None and self.events.gm_changes:
             self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]
@@ -496,6 +514,8 @@ class _Pause:
         else:
             r, v, _ = driver.state()
             self.mine = (r, v)
+        if prop.events is not None:  # (the bodies taken out at NaN, as in the outputs:
+            prop.events.mask(r, v)  # the driver keeps their parked state to go on)
         prop._stand_at(driver.t, r, v)
         self.pause(again)
 

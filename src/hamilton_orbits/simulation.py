@@ -337,10 +337,13 @@ class Simulation(Saving):
         on_output : callable, optional
             ``on_output(i, steps)`` after output ``i``; it may raise
             :class:`~hamilton_orbits.integrators.StopIntegration` to end the leg there
-            (the trajectory then has ``complete == False``).
+            (the trajectory then has ``complete == False``).  The simulation stands
+            at output ``i`` while it runs (:attr:`t`, :attr:`system`, :attr:`steps`):
+            a :meth:`save` or :meth:`copy` there continues to the run's bits.
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
-            the leg there (``complete == False``).
+            the leg there (``complete == False``).  It sees the simulation at the
+            output, or between slices at the time and state its integrator reached.
         on_interrupt : {"raise", "keep"}
             What Ctrl-C does: raise ``KeyboardInterrupt`` (default), or end the leg
             at the last output reached and return it (``complete == False``), as a
@@ -368,10 +371,12 @@ class Simulation(Saving):
         t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
+            # (the integrals measured from time 0 once a leg has begun: after Ctrl-C too)
+            start, self._start = self._start, self._initial
             out = self._lean(t)  # lean path, when it can
             if out is not None:
-                start, self._start = self._start, self._initial
                 return self._trajectory(out, self._unit, start, out.wall_time)
+            self._start = start
         if on_interrupt not in ("raise", "keep"):
             raise ValueError(f"Expected `on_interrupt` to be 'raise' or 'keep', got "
                              f"{on_interrupt!r}")
@@ -387,17 +392,21 @@ class Simulation(Saving):
         if step is not None and prop.method.name in FIXED_STEP:  # (a call of too many steps
             check_step_count(abs(float(times[-1] - times[0])), step,  # refused before the
                              prop.method.max_steps, prop.method.name)  # leg's first snapshot)
+        start, begun = self._start, False  # (start None: this leg begins at time 0)
         try:
             if self._archive is not None:
                 self._new_leg(times)
+            begun = True
             out = self._advance(times, progress, on_output, stop)
         except BaseException:  # (Ctrl-C between the two: the folder released all the same)
             if self._archive is not None:
                 self._archive.close()
+            if begun:  # (a leg cut by Ctrl-C or an error: the next measures Hamilton's
+                self._start = self._initial  # integrals from time 0, as it would have)
             raise
+        self._start = self._initial  # the first leg begins at time 0
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt
-        start, self._start = self._start, self._initial  # the first leg begins at time 0
         return self._trajectory(out, unit, start, out.wall_time)
 
     def _lean(self, t: Any) -> engine.EngineRun | None:

@@ -1943,3 +1943,72 @@ def test_an_event_of_bodies_named_by_an_array_archives_and_loads(tmp_path):
     for other in (loaded, alone):
         np.testing.assert_array_equal(other.system.r, twin.system.r)
     assert again.t == 0.5
+
+
+def test_snapshots_between_steps_after_a_merge_hold_the_body_taken_out_at_nan(tmp_path):
+    """``every_steps`` snapshots (radau15, between two steps) after a merge: the body
+    taken out is NaN in their rows, as in the outputs and at ``every`` snapshots
+    (they held the integrator's parked position, r ~ 3e8), and each continues to
+    the run's bits."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005),
+                Body("a", 1e-4, [1.0, 0, 0], [0, 1.0, 0], radius=0.01),
+                Body("b", 1e-5, [1.0, 0.05, 0], [0, 0.9, 0], radius=0.01)])  # (merge, t 0.26)
+    kw = dict(method="radau15", events=[{"name": "collision", "action": "merge"}])
+    whole = Simulation(s, archive=tmp_path / "a", every_steps=3, **kw).integrate(2.0)
+    ds = Archive(tmp_path / "a").to_xarray()
+    gone = ~ds.active.values[:, 2]
+    assert gone.sum() >= 3 and ds.time.values[gone].min() < 1.0
+    assert np.isnan(ds.r.values[gone, 2]).all() and np.isnan(ds.v.values[gone, 2]).all()
+    assert np.isfinite(ds.r.values[~gone]).all()
+    archive = Archive(tmp_path / "a")
+    for k in range(len(archive)):
+        snap = archive[k]
+        if 0.0 < snap.t < 2.0:
+            assert _same(snap.integrate(2.0).r[-1], whole.r[-1]), k
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.01, exact_times=True),
+                                dict(method="leapfrog", dt=0.01, exact_times=True),
+                                dict(method="radau15"), dict(method="dop853")])
+def test_snapshot_times_an_ulp_from_output_times_are_the_outputs(tmp_path, kw):
+    """Output times a few ulp off the snapshot grid (``np.cumsum`` of 0.1, against
+    ``k * every``): the snapshot is taken at the caller's time, not at a second time
+    an ulp away that cost a step of 1e-16 (wh took 323 steps for 300, and radau15's
+    and dop853's rows left the bits of the run without an archive), in one call,
+    in two and in ten."""
+    times = np.cumsum(np.full(30, 0.1))
+    assert (times != 0.1 * np.arange(1, 31)).sum() > 10
+    plain_kw = {k: x for k, x in kw.items() if k != "exact_times"}
+    plain = Simulation(_disc(), **plain_kw).integrate(times)
+    for calls in ([times], [times[:15], times[15:]], np.split(times, 10)):  # (short calls
+        # of 3 outputs: merged in Python floats, not arrays)
+        folder = tmp_path / str(len(calls))
+        sim = Simulation(_disc(), archive=folder, every=0.1, **kw)
+        legs = [sim.integrate(t) for t in calls]
+        assert sim.steps == plain.steps
+        assert _same(legs[-1].r[-1], plain.r[-1]) and _same(legs[-1].v[-1], plain.v[-1])
+        snaps = Archive(folder).times
+        assert np.unique(snaps).tolist() == [0.0, *times.tolist()]  # (and the calls' starts)
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_a_snapshot_of_an_earlier_formats_first_call_measures_from_time_0(tmp_path, version):
+    """The snapshots of ``data/archive-v1`` and ``-v2`` were taken within their first
+    integrate call (recorded ``started`` False): loaded, the next leg measures the
+    particle's integrals from time 0, as the call resumed whole does at the same
+    state (it measured them from the snapshot's own state, 0.0 at t = 4)."""
+    import shutil
+    import warnings
+
+    from hamilton_orbits._saving import RestartWarning
+
+    folder = tmp_path / "archive"
+    shutil.copytree(Path(__file__).parent / "data" / f"archive-v{version}", folder)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RestartWarning)  # (format 1's integrator state)
+        whole = Simulation.load(folder).resume()
+        loaded = Archive(folder)[-1]
+    assert loaded.t == 4.0 == whole.t[4]
+    leg = loaded.integrate(5.0)
+    assert _same(leg.r[0], whole.r[4])
+    assert _same(leg.particle_error[0], whole.particle_error[4]) and leg.particle_error[0, 1] != 0

@@ -453,3 +453,132 @@ def test_an_error_from_on_output_keeps_the_output_reached(kw):
     assert sim.t == 2.0
     np.testing.assert_array_equal(sim.system.as_arrays().r, once.r[2])
     assert _same(sim.integrate([3.0, 4.0]).r[-1], once.r[-1])
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.02), dict(method="leapfrog", dt=0.02),
+                                dict(method="radau15"), dict(method="dop853")])
+def test_a_callback_stands_at_the_output_it_is_told_of(tmp_path, kw):
+    """Inside ``on_output`` and ``stop`` the simulation stands at the output reached
+    (its time, state and integrator), not at the leg's start: a snapshot saved or a
+    copy taken there continues with the bits of the run never stopped.  (Without an
+    archive they showed the leg's start beside the current step count: a save at
+    t = 2 loaded at t = 0, and wh continued from its t = 2 state under t = 0.)"""
+    times = [1.0, 2.0, 3.0, 4.0]
+    once = Simulation(_disc(), **kw).integrate(times)
+    sim = Simulation(_disc(), **kw)
+    seen, copies = [], []
+
+    def on_output(i, steps):
+        seen.append((sim.t, sim.steps == steps, _same(sim.system.as_arrays().r, once.r[i]),
+                     _same(sim.system.as_arrays().v, once.v[i])))
+        if i == 2:
+            sim.save(tmp_path / "mid.nc")
+            copies.append(sim.copy())
+
+    def stop():
+        seen.append(sim.t)
+        return False
+
+    whole = sim.integrate(times, on_output=on_output, stop=stop)
+    assert _same(whole.r, once.r) and whole.steps == once.steps
+    assert seen == [x for t in times for x in ((t, True, True, True), t)]
+    for later in (Simulation.load(tmp_path / "mid.nc"), copies[0]):
+        assert later.t == 2.0
+        rest = later.integrate([3.0, 4.0])
+        assert _same(rest.r, once.r[2:]) and _same(rest.v, once.v[2:])
+        assert later.steps == once.steps
+
+
+def test_a_callback_of_a_backward_leg_stands_at_its_output():
+    """A backward leg's callback sees the output's time and true velocities."""
+    sim = Simulation(_disc(), method="radau15")
+    seen = []
+    back = sim.integrate([-1.0, -2.0],
+                         on_output=lambda i, steps: seen.append((sim.t, sim.system.as_arrays())))
+    assert [t for t, _ in seen] == [-1.0, -2.0]
+    for (_, s), r, v in zip(seen, back.r[1:], back.v[1:], strict=True):
+        assert _same(s.r, r) and _same(s.v, v)
+
+
+def _same_integrals(a, b) -> bool:
+    return all(_same(getattr(a, k), getattr(b, k)) for k in (
+        "energy_error", "angular_momentum_error", "barycentre_drift"))
+
+
+@pytest.mark.parametrize("kw", [dict(method="wh", dt=0.02), dict(method="radau15")])
+def test_a_snapshot_of_the_first_call_measures_the_integrals_from_time_0(tmp_path, kw):
+    """A simulation loaded from a snapshot taken within its first integrate call (an
+    archive's, or one saved from ``on_output``) measures Hamilton's integrals from
+    the system at time 0, as the run never stopped does: the same bits.  (It
+    measured them from its own first row, 0.0 at the snapshot's time.)"""
+    times = [1.0, 2.0, 3.0, 3.5]
+    once = Simulation(_disc(), **kw).integrate(times)
+    sim = Simulation(_disc(), archive=tmp_path / "a", every=1.0, **kw)
+    sim.integrate(times,
+                  on_output=lambda i, steps: i == 2 and sim.save(tmp_path / "mid.nc"))
+    archive = Archive(tmp_path / "a")
+    for later in (archive[list(archive.times).index(2.0)], Simulation.load(tmp_path / "mid.nc")):
+        assert later.t == 2.0
+        rest = later.integrate([3.0, 3.5])
+        assert _same(rest.r, once.r[2:])
+        assert _same_integrals(rest, _Rows(once, slice(2, None)))
+        assert rest.energy_error[0] != 0.0
+
+
+@pytest.mark.parametrize("cut", [KeyboardInterrupt, RuntimeError])
+@pytest.mark.parametrize("kw", [dict(method="leapfrog", dt=0.05), dict(method="dop853")])
+def test_a_first_call_cut_short_measures_the_next_legs_integrals_from_time_0(kw, cut):
+    """Ctrl-C (``on_interrupt="raise"``) or an error ending the first integrate call:
+    the next leg measures Hamilton's integrals from the system at time 0, as the
+    run never cut does (it measured them from the state the cut left)."""
+    once = Simulation(_disc(), **kw).integrate([1.0, 2.0, 3.0])
+    sim = Simulation(_disc(), **kw)
+
+    def cut_at_2(i, steps):
+        if i == 2:
+            raise cut
+
+    with pytest.raises(cut):
+        sim.integrate([1.0, 2.0, 3.0], on_output=cut_at_2)
+    rest = sim.integrate(3.0)
+    assert _same(rest.r[-1], once.r[-1])
+    assert _same_integrals(rest, _Rows(once, slice(2, None)))
+
+
+class _Rows:
+    """The rows ``rows`` of a trajectory's integrals."""
+
+    def __init__(self, traj, rows):
+        for k in ("energy_error", "angular_momentum_error", "barycentre_drift"):
+            setattr(self, k, getattr(traj, k)[rows])
+
+
+@pytest.mark.parametrize(("kw", "end"), [(dict(method="wh", dt=1e-4), 15.0),
+                                         (dict(method="leapfrog", dt=1e-4), 15.0),
+                                         (dict(method="radau15"), 1e4)])
+def test_stop_asked_between_slices_of_steps_sees_the_state_reached(tmp_path, kw, end):
+    """``stop()`` asked between two slices of steps (within an output interval) sees
+    the simulation at the time its step count is at, with that state, and a
+    snapshot saved there loads at that time (it saw the leg's start, t = 0, beside
+    100 000 steps)."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    sim = Simulation(s, **kw)
+    seen = []
+
+    def stop():
+        if not seen:
+            seen.append((sim.t, sim.steps, sim.system.as_arrays()))
+            sim.save(tmp_path / "between.nc")
+        return False
+
+    sim.integrate(end, stop=stop)
+    t, steps, state = seen[0]
+    assert 0.0 < t < end and steps >= 20_000
+    if "dt" in kw:
+        assert t == pytest.approx(steps * kw["dt"], rel=1e-12)
+    there = Simulation(s, **kw).integrate(t)
+    np.testing.assert_allclose(state.r, there.r[-1], rtol=0, atol=1e-8)
+    loaded = Simulation.load(tmp_path / "between.nc")
+    assert loaded.t == t and loaded.steps == steps
+    np.testing.assert_allclose(loaded.integrate(end).r[-1], sim.system.as_arrays().r,
+                               rtol=0, atol=1e-8)
