@@ -339,7 +339,7 @@ class Simulation(Saving):
             :class:`~hamilton_orbits.integrators.StopIntegration` to end the leg there
             (the trajectory then has ``complete == False``).  The simulation stands
             at output ``i`` while it runs (:attr:`t`, :attr:`system`, :attr:`steps`):
-            a :meth:`save` or :meth:`copy` there continues to the run's bits.
+            a ``save`` or ``copy`` there continues to the run's bits.
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
             the leg there (``complete == False``).  It sees the simulation at the

@@ -334,7 +334,7 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
         (a ``BodyTorque``'s or ``SpaceTorque``'s ``torque``, a gravity gradient's
         ``gm_over_r3`` and ``mean_motion``) are Quantities too: a plain non-zero
         number is refused, its unit not guessed (zeros are taken;
-        :func:`check_torque_units`).
+        ``check_torque_units``).
     moments : array_like or Quantity, shape (..., 3)
         Principal moments (A, B, C) (kg m^2 when a Quantity).
     attitude : Quaternion or array_like, shape (..., 4)

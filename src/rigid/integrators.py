@@ -265,7 +265,7 @@ def integrate(
         ``SpaceTorque``'s ``torque``, a gravity gradient's ``gm_over_r3`` and
         ``mean_motion``) are Quantities too: a plain non-zero number is refused (its
         unit cannot be guessed; zeros are taken), as
-        :func:`~rigid.euler.check_torque_units` says.
+        ``check_torque_units`` says.
     progress : bool, optional
         Show a tqdm progress bar (needs the ``progress`` extra).
     recentre : float, optional
