@@ -108,6 +108,8 @@ def test_stability_map_quick(tmp_path):
     assert (tmp_path / "stability_map.png").stat().st_size > 30_000
 
 
+@pytest.mark.slow  # a study (126 weekly hindcasts of five methods, in a subprocess): 9 s of
+# the cold suite's 5 minutes; predict and hindcast are tested in tests/rigid
 def test_pole_prediction_quick(tmp_path):
     """The hindcast tables carry every method beside the published rows; figures written."""
     out = run("earth_pole/pole_prediction.py", str(tmp_path), "--quick")
