@@ -296,6 +296,9 @@ class Simulation(Saving):
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
         new._prop = copy.deepcopy(self._prop, shared_memo(self._prop))
+        if new._start is None and (self._prop.t != 0.0 or self._prop.steps):
+            new._start = new._initial  # (a copy taken within the first call, from a
+            # callback: its integrals from time 0, as a snapshot loaded there has them)
         if self._archive is not None:  # the same output times; only the original writes
             new._archive = self._archive.schedule_only()
         return new
