@@ -481,7 +481,7 @@ class Propagation:
         ending there (``gm`` replaced only where events changed it)."""
         self.r, self.v, self.t = r, v, t
         if self.events is not None and self.events.gm_changes:
-            self.gm = self.events.gm_at(np.array([t]), self.gm0)[0]
+            self.gm = self.events.gm_of(t, self.gm0)
 
     def _between_outputs(self, driver: Any) -> None:
         """Keep the state of a leg stopped between outputs: the driver's own state at

@@ -600,6 +600,16 @@ class EventLog:
         pairs = self.watch[collision][:, [W_I, W_J]].astype(int)
         self.watch[collision, W_DIST] = self.radius[pairs[:, 0]] + self.radius[pairs[:, 1]]
 
+    def gm_of(self, t: float, gm0: np.ndarray) -> np.ndarray:
+        """``G m`` of every body at the one time ``t`` (n,), a new array: a row of
+        :meth:`gm_at` without its arrays (a callback's output stands there: 5 us an
+        output that way)."""
+        gm = gm0
+        for t_change, changed in self.gm_changes:
+            if t >= t_change:
+                gm = changed
+        return np.array(gm, dtype=np.float64)
+
     def gm_at(self, times: np.ndarray, gm0: np.ndarray) -> np.ndarray:
         """``G m`` of every body at each of ``times`` (n_t, n): changed by merges and
         removals; ``gm0`` before the first."""
