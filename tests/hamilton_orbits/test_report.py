@@ -10,6 +10,11 @@ import pytest
 
 from hamilton_orbits.studies.report import build_report
 
+# The report is a study (every problem with every method and its peers, 12 s of the
+# cold suite's 5 minutes on 2 cores): run with `python -m pytest -m slow`, as the
+# gallery's long examples are.
+pytestmark = pytest.mark.slow
+
 
 def _tool(name: str):
     """A developer tool of ``tools/`` (not installed), imported from its file."""
