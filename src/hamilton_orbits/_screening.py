@@ -51,7 +51,7 @@ def screen(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, step: fl
     --------
     >>> t = np.array([0.0, 1.0]); gm = np.array([1.0, 0.0])
     >>> r = np.zeros((2, 2, 3)); r[:, 1, 0] = 1.0; v = np.zeros((2, 2, 3)); v[:, 1, 1] = 1.0
-    >>> screen(r, v, gm, t, 0.01, -1, 0.0, 1 / 30, 1e-10)  # a circular orbit, 600 steps
+    >>> screen(r, v, gm, t, 0.01, -1, 0.0, 1 / 30, 1e-10)  # a circular orbit, 628 steps a turn
     False
     """
     args = (r, v, gm, t, step, exempt, exempt_dist, fraction, light)
