@@ -17,7 +17,6 @@ from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, as_quantity,
 from hamilton_orbits.validation import (
     ConvergenceError,
     broadcast,
-    check_positive,
     first_index,
     fmt_index,
 )
@@ -80,7 +79,7 @@ def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
     )
     e_, inc_, lan_, argp_, mu_, length, angle = values
     raise_at("e", ~(e_ >= 0), e_, ">= 0", e)
-    check_positive("mu", mu_)
+    raise_at("mu", ~(mu_ > 0), mu_, "> 0", mu)
     raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi] rad", inc)
     return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
 

@@ -854,15 +854,18 @@ def test_every_wall_as_a_time_quantity_or_a_numpy_number_is_taken(tmp_path):
     (dict(a=1 * u.au, e=0.1, inc=[10, 190] * u.deg),
      r"Expected `inc` in \[0, pi\] rad, got 190.0 deg at index 1"),
     (dict(q=-1 * u.au, e=0.1, inc=10 * u.deg), r"Expected `q` > 0, got -1.0 AU$"),
+    (dict(q=1 * u.au, e=0.1, inc=10 * u.deg, mu=[1.0, -2.0] * u.au**3 / u.day**2),
+     r"Expected `mu` > 0, got -2.0 AU3 / d2 at index 1"),
 ])
 def test_element_errors_quote_the_value_as_written(kw, pattern):
     """The values were quoted in the internal units without a unit ("got
-    -448793612.09999996 at index 2" for -3 au; 3.3161255787892263 for 190 deg)."""
+    -448793612.09999996 at index 2" for -3 au; 3.3161255787892263 for 190 deg; a
+    `mu` in au^3/day^2 in km^3/s^2)."""
     from hamilton_orbits import KeplerOrbit
 
-    mu = 1.32712440018e11 * u.km**3 / u.s**2
+    kw = {"mu": 1.32712440018e11 * u.km**3 / u.s**2, **kw}
     with pytest.raises(ValueError, match=pattern):
-        KeplerOrbit.from_elements(**kw, lan=0 * u.deg, argp=0 * u.deg, M=0 * u.deg, mu=mu)
+        KeplerOrbit.from_elements(**kw, lan=0 * u.deg, argp=0 * u.deg, M=0 * u.deg)
 
 
 def test_a_crosscheck_of_a_trajectory_of_other_effects_or_end_is_refused():
