@@ -25,7 +25,8 @@ import numpy as np
 
 from hamilton_orbits._kernels import integrals
 
-__all__ = ["PREFILTER_CALLS", "PREFILTER_SIZE", "may_be_near", "primaries", "screen"]
+__all__ = ["PREFILTER_CALLS", "PREFILTER_SIZE", "may_be_near", "output_steps", "primaries",
+           "screen"]
 
 #: Calls a process answers by numpy before it compiles the screen (a loop of
 #: calls: the compilation then costs it less than numpy's 20-100 us a call)
@@ -134,10 +135,7 @@ def may_be_near(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, ste
     sep2 = (sep[..., 0] ** 2 + sep[..., 1] ** 2) + sep[..., 2] ** 2
     rule = (own | (cb < 0), 81.0 * gm0[b] ** 2 * sep2 ** 3 * _MARGIN, gm0[cb] ** 2,
             b != exempt[0], (exempt[1] * _MARGIN) ** 2)
-    gap = np.abs(np.diff(t))
-    h = np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
-                                    np.concatenate((gap, gap[-1:]))))
-    reach2 = ((h / fraction * _MARGIN) ** 2)[:, None]
+    reach2 = ((output_steps(t, step) / fraction * _MARGIN) ** 2)[:, None]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         if np.any(_within(d2, u2, mu, reach2, rule)):
             return True
@@ -182,6 +180,22 @@ def primaries(r: np.ndarray, v: np.ndarray, gm0: np.ndarray) -> np.ndarray:
     best = np.argmax(np.where(bound, inv_a, -np.inf), axis=1)
     prim = np.where(bound[np.arange(n), best], best, top)
     return np.where(np.arange(n) != top, prim, -1)
+
+
+def output_steps(t: np.ndarray, step: float) -> np.ndarray:
+    """The step taken about each output of times ``t`` (n_t,) of a run of fixed
+    ``step``: ``step``, or the longer of the output intervals beside it where that
+    is shorter (steps land on the outputs), as the check of close approaches
+    (:func:`hamilton_orbits.integrals.under_resolved_encounters`) takes it (``n_t >= 2``).
+
+    Examples
+    --------
+    >>> output_steps(np.array([0.0, 0.5, 10.0, 10.25]), 1.0).tolist()
+    [0.5, 1.0, 1.0, 0.25]
+    """
+    gap = np.abs(np.diff(t))
+    return np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
+                                       np.concatenate((gap, gap[-1:]))))
 
 
 def _within(d2: np.ndarray, u2: np.ndarray, mu: np.ndarray, reach2: np.ndarray,

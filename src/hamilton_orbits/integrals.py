@@ -557,7 +557,7 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     []
     """
     from hamilton_orbits._kernels import integrals
-    from hamilton_orbits._screening import screen
+    from hamilton_orbits._screening import output_steps, screen
 
     r = np.ascontiguousarray(r, dtype=np.float64)
     v = np.ascontiguousarray(v, dtype=np.float64)
@@ -571,9 +571,7 @@ def under_resolved_encounters(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: n
     tp = np.delete(np.arange(len(gm0)), m[np.argmax(gm0[m])])  # all but the most massive
     if len(m) > integrals.MASSIVE_PAIRS_MAX:  # (massive pairs: only in smaller systems)
         tp = tp[gm0[tp] == 0]
-    gap = np.abs(np.diff(t))
-    h = np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
-                                    np.concatenate((gap, gap[-1:]))))
+    h = output_steps(t, step)
     prim = integrals.primaries(r[0], v[0], gm0, np.empty(len(gm0), np.int64), True)
     bad = np.zeros((1, len(tp), len(m)), np.bool_)
     none = np.empty((0, 0, 0))

@@ -8,7 +8,12 @@ import pytest
 from random_legs import random_leg
 
 from hamilton_orbits._kernels import integrals as k
-from hamilton_orbits.integrals import ENCOUNTER_STEP_FRACTION, LIGHT, light_as_massless
+from hamilton_orbits._screening import output_steps
+from hamilton_orbits.integrals import (
+    ENCOUNTER_STEP_FRACTION,
+    LIGHT,
+    light_as_massless,
+)
 
 
 def _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction):
@@ -17,9 +22,7 @@ def _whole_count(r, v, gm, t, step, exempt, exempt_dist, fraction):
     top = int(np.argmax(gm0))
     tp = np.array([i for i in range(len(gm)) if i != top], np.int64)
     m = np.flatnonzero(gm0 > 0)
-    gap = np.abs(np.diff(t))
-    h = np.minimum(step, np.maximum(np.concatenate((gap[:1], gap)),
-                                    np.concatenate((gap, gap[-1:]))))
+    h = output_steps(t, step)
     prim = k.primaries(r[0], v[0], gm0, np.empty(len(gm), np.int64), True)
     bad = np.zeros((1, len(tp), len(m)), np.bool_)
     none = np.empty((0, 0, 0))
