@@ -50,6 +50,30 @@ def pytest_sessionstart(session):
             reporter.write_line(COLD_NOTICE)
 
 
+#: test files sent to one worker process, one after the other (pytest-xdist's
+#: ``--dist loadfile`` sends each file whole to one worker): their first tests
+#: compile the same event-watching step loops of radau15 and wh (about 25 s of a cold
+#: cache, measured 2026-11-30 with numba's compile events), which two workers running
+#: them at once each compiled; one after the other, the second loads them from the cache
+SHARE_A_WORKER = {
+    "tests/hamilton_orbits/test_simulation_legs.py": "tests/hamilton_orbits/test_archive.py",
+}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile`` with the files of :data:`SHARE_A_WORKER` in one unit of work."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class SharedCompiles(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            scope = super()._split_scope(nodeid)
+            return SHARE_A_WORKER.get(scope, scope)
+
+    return SharedCompiles(config, log)
+
+
 def pytest_collection_finish(session):
     """Once collected, the half-million objects of the imported libraries and the test
     items are moved out of the garbage collector's sight (``gc.freeze``): they live to

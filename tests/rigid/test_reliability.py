@@ -8,6 +8,7 @@ naming the argument, never a warning or a bare kernel error.
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 
@@ -320,7 +321,14 @@ def test_repr_and_str_show_units():
 BODY_F = RigidBody([1.0, 2.0, 3.0], Q0, [1.0, 0.3, 0.8])
 W3 = [1.0, 0.3, 0.8] * RADS
 I3 = [1.0, 2.0, 3.0] * KGM2
-_, _W25 = free_motion(qbody(), 2.5 * u.s)
+
+
+@functools.cache
+def _w25() -> u.Quantity:
+    """The spin of ``qbody()`` after 2.5 s, made at the first test that asks (not at
+    collection: every test process would compile the free motion's kernel there)."""
+    return free_motion(qbody(), 2.5 * u.s)[1]
+
 
 # (label, argument name, call with the argument given the wrong dimension `bad`)
 UNIT_TABLE = [
@@ -343,8 +351,8 @@ UNIT_TABLE = [
     ("contrafocal", "lam", lambda bad: contrafocal(qbody(), 2.0 * bad)),
     ("confocal_rotation", "lam", lambda bad: confocal_rotation(qbody(), 0.1 * bad, 1.0 * u.s)),
     ("confocal_rotation", "t", lambda bad: confocal_rotation(qbody(), 0.1 / KGM2, 1.0 * bad)),
-    ("time_between", "omega1", lambda bad: time_between(qbody(), W3.value * bad, _W25)),
-    ("time_between", "omega2", lambda bad: time_between(qbody(), W3, _W25.value * bad)),
+    ("time_between", "omega1", lambda bad: time_between(qbody(), W3.value * bad, _w25())),
+    ("time_between", "omega2", lambda bad: time_between(qbody(), W3, _w25().value * bad)),
     ("BodyTorque", "torque", lambda bad: BodyTorque([0.0, 0.0, 1.0] * bad)),
     ("SpaceTorque", "torque", lambda bad: SpaceTorque([0.0, 0.0, 1.0] * bad)),
     ("GravityGradientTorque", "gm_over_r3", lambda bad: GravityGradientTorque(1.0 * bad)),
