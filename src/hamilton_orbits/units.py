@@ -24,6 +24,7 @@ Every public function converts its arguments through these kinds, e.g.
 
 from __future__ import annotations
 
+import datetime
 import functools
 import sys
 from collections.abc import Callable, Sequence
@@ -244,13 +245,49 @@ def time_quantity(value: Any) -> Any:
     >>> time_quantity(2.0)
     2.0
     """
-    if type(value) in _NOT_TIME_DELTA:  # (plain types at once: an isinstance
-        return value  # against astropy's TimeDelta costs 0.3 us of every call)
+    kind = type(value)
+    if kind in _NOT_TIME_DELTA:  # (plain types at once: an isinstance
+        # against astropy's TimeDelta costs 0.3 us of every call)
+        return numpy_duration(value) if kind is np.ndarray and value.dtype.kind == "m" else value
     time = sys.modules.get("astropy.time")
     delta = None if time is None else getattr(time, "TimeDelta", None)
     if delta is not None and isinstance(value, delta):
         return value.to(u.day)
-    return value
+    if isinstance(value, datetime.timedelta):  # (pandas' Timedelta too, to the ns)
+        to64 = getattr(value, "to_timedelta64", None)
+        a = np.asarray(to64() if to64 is not None else np.timedelta64(value))
+    else:
+        dtype = getattr(value, "dtype", None)  # (numpy's scalar, pandas' Series, Index)
+        if not (isinstance(dtype, np.dtype) and dtype.kind == "m"):
+            return value
+        a = np.asarray(value)
+    out = numpy_duration(a)
+    return value if out is a else out  # (as given where it is refused: named so)
+
+
+#: numpy's time units of a fixed length, as astropy's (a year or a month of numpy's
+#: calendar is not one: refused)
+_NUMPY_TIME_UNITS = {"W": "wk", "D": "d", "h": "h", "m": "min", "s": "s", "ms": "ms",
+                     "us": "us", "ns": "ns", "ps": "ps", "fs": "fs", "as": "as"}
+
+
+def numpy_duration(value: np.ndarray) -> Any:
+    """A numpy ``timedelta64`` array as the time Quantity it is, in its own unit (its
+    counts exact in a float64 below 2**53); ``NaT`` a NaN, which the argument's check
+    then refuses by its name and index.  A timedelta64 of no unit, of years or of
+    months (numpy's calendar units: not a fixed duration) is returned as given,
+    for that check to refuse.
+
+    Examples
+    --------
+    >>> numpy_duration(np.array([90, 120], dtype="timedelta64[m]"))
+    <Quantity [ 90., 120.] min>
+    """
+    unit, count = np.datetime_data(value.dtype)
+    if unit not in _NUMPY_TIME_UNITS:
+        return value
+    counts = np.where(np.isnat(value), np.nan, value.astype(np.int64) * float(count))
+    return counts * u.Unit(_NUMPY_TIME_UNITS[unit])
 
 
 class Kind:

@@ -97,6 +97,13 @@ def as_float_array(name: str, value, *, finite: bool = True) -> np.ndarray:
     kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
     if kind in "USb":  # (numeric strings and bools convert, silently: "1" and True)
         raise ValueError(f"Expected `{name}` to be numeric, got {value!r}")
+    if kind in "mMV":  # (numpy's durations, dates and records convert, silently, to
+        # their counts or fields: a minute as 1)
+        what = {"m": "a numpy timedelta64 (a duration: give it as a time Quantity, or "
+                     "in this argument's unit)",
+                "M": "a numpy datetime64 (a date, not a number)",
+                "V": "a structured array (records, not numbers)"}[kind]
+        raise ValueError(f"Expected `{name}` to be numeric, got {what}: {value!r}")
     if finite:
         bad = ~np.isfinite(arr)
         if bad.any():

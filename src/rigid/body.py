@@ -35,7 +35,7 @@ from hamilton_orbits.units import (
     require_consistent,
     time_quantity,
 )
-from hamilton_orbits.validation import as_float_array
+from hamilton_orbits.validation import as_float_array, first_index, fmt_index
 from rigid._shared import pow2
 
 __all__ = ["BodySI", "RigidBody"]  # check_*, call_units, unit_quaternion: shared inside rigid
@@ -80,22 +80,38 @@ def check_moments(name: str, moments: np.ndarray) -> np.ndarray:
     if np.any(bad):
         k = int(np.argwhere(bad)[0][0])
         raise ValueError(f"Expected `{name}` > 0, got {float(moments[k])!r} at index {k}")
-    # compare on moments / max so that the sum cannot overflow
+    check_triangle(name, moments)
     big = float(np.max(moments))
-    scaled = moments / big
-    total = float(np.sum(scaled))
-    for k in range(3):
-        others = total - scaled[k]
-        if scaled[k] > others + _SLACK * total:
-            raise ValueError(
-                f"Expected `{name}` to satisfy A + B >= C, got {float(moments[k])!r} "
-                f"at index {k} > {_sum_others(moments, k)!r}"
-            )
     k = int(np.argmin(moments))
-    if scaled[k] < _MIN_RATIO:
+    if moments[k] / big < _MIN_RATIO:
         raise ValueError(
             f"Expected `{name}` within a ratio of {1 / _MIN_RATIO:.0e} of each other, got "
             f"{float(moments[k])!r} at index {k} beside {big!r}"
+        )
+    return moments
+
+
+def check_triangle(name: str, moments: np.ndarray) -> np.ndarray:
+    """Require positive principal moments ``(..., 3)`` to satisfy ``A + B >= C`` for
+    every permutation (Sylvester 1866, as :func:`check_moments`, with its slack),
+    naming the argument, the index and the value.
+
+    Examples
+    --------
+    >>> check_triangle("moments", np.array([[1.0, 2.0, 3.0], [1.0, 1.0, 3.0]]))
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `moments` to satisfy A + B >= C, got 3.0 at index (1, 2) > 2.0
+    """
+    # compared on moments / max, so that the sum cannot overflow
+    scaled = moments / np.max(moments, axis=-1, keepdims=True)
+    total = np.sum(scaled, axis=-1, keepdims=True)
+    bad = scaled > (total - scaled) + _SLACK * total
+    if np.any(bad):
+        index = first_index(bad)
+        raise ValueError(
+            f"Expected `{name}` to satisfy A + B >= C, got {float(moments[index])!r}"
+            f"{fmt_index(index)} > {_sum_others(moments[index[:-1]], index[-1])!r}"
         )
     return moments
 

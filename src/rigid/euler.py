@@ -39,6 +39,7 @@ from hamilton_orbits.units import (
 )
 from hamilton_orbits.validation import check_positive, check_trailing
 from rigid._kernels import euler as _k
+from rigid.body import check_triangle
 
 __all__ = [
     "BodyTorque",
@@ -56,7 +57,7 @@ _GM_OVER_R3 = Kind("a squared rate GM / r^3", u.s**-2, u.dimensionless_angles, n
 
 def _moments(moments: Any) -> np.ndarray:
     m = check_trailing("moments", INERTIA("moments", moments), 3)
-    return check_positive("moments", m)
+    return check_triangle("moments", check_positive("moments", m))
 
 
 def _quat_array(name: str, attitude: Any) -> np.ndarray:
@@ -424,9 +425,7 @@ def euler_equations(moments: Any, omega: Any, torque: Any = None) -> np.ndarray:
     m = _moments(moments)
     w = check_trailing("omega", ANGULAR_SPEED("omega", omega), 3)
     n = np.zeros(3) if torque is None else TORQUE("torque", torque)
-    if n.ndim == 0:
-        n = np.broadcast_to(n, (3,))
-    check_trailing("torque", n, 3)
+    check_trailing("torque", n, 3)  # (a number is no torque vector: refused)
     try:
         with np.errstate(over="ignore", invalid="ignore"):
             out = _k.euler_gufunc(m, w, n)

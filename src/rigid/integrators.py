@@ -112,6 +112,12 @@ _FIXED = (*SPLITTINGS, "exact_kick", "rk4", "cayley_rk4")
 
 _MAX_STEPS = 1e12  # beyond this a fixed-step run is a typo, not a plan (days of CPU)
 
+#: the largest drift of the attitude quaternion's norm, max | |q| - 1 |, that
+#: :func:`integrate` returns without a warning: the exact flow keeps |q| = 1, and a
+#: run whose |q| has moved by more (a step far too long for rk4, a loose ``tol``) has
+#: an attitude no better than that, which normalising the output would hide
+NORM_DRIFT_WARNING = 1e-3
+
 
 def _scalar_positive(name: str, value: np.ndarray) -> float:
     if value.shape != ():
@@ -313,6 +319,13 @@ def integrate(
     astropy.units.UnitConversionError
         For a time of the wrong dimension, naming the argument.
 
+    Warns
+    -----
+    RuntimeWarning
+        When the attitude quaternion's norm drifted by more than
+        :data:`NORM_DRIFT_WARNING` (1e-3; the trajectory's ``norm_drift``): a step far
+        too long for the method, or a loose ``tol``.
+
     References
     ----------
     McLachlan, R. I. (1993), Phys. Rev. Lett. 71, 3043; Touma, J. & Wisdom, J.
@@ -377,6 +390,12 @@ def integrate(
     with np.errstate(over="ignore"):  # a rate beyond float64: refused by _check_finite
         w = w * sw
     _check_finite(t_f, q, w, method, dtf, drift)
+    if drift > NORM_DRIFT_WARNING:
+        warnings.warn(f"integrate: the attitude quaternion's norm drifted by {drift:.3g} in "
+                      f"this {method} run (it is normalised on output): the attitude is no "
+                      f"better than that; give a " + ("smaller `tol`" if dtf is None else
+                                                      f"shorter `dt` than {dtf!r} s"),
+                      RuntimeWarning, stacklevel=2)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         energy_error, am_error = integral_errors(si.moments, q, w)
     if not (np.all(np.isfinite(energy_error)) and np.all(np.isfinite(am_error))):

@@ -166,3 +166,68 @@ def test_an_effect_parameter_as_a_timedelta_is_saved_archived_and_continued_as_t
     for label in ("td", "list"):
         for got, want in zip(runs[label], runs["q"], strict=True):
             _same(got.t, want.t), _same(got.r, want.r), _same(got.v, want.v)
+
+
+# --- numpy's timedelta64 (and pandas' and the standard library's durations) -----------
+# numpy defines np.timedelta64(1, "m") / np.timedelta64(1, "s") == 60; these were read as
+# their counts (a minute as 1 s, 1000 ms as 1000 s), silently
+
+
+def test_a_numpy_duration_is_the_time_quantity_it_is():
+    import datetime
+
+    import pandas as pd
+
+    from hamilton_orbits.units import time_quantity
+
+    q = time_quantity(np.array([90, 120], dtype="timedelta64[m]"))
+    assert q.unit == u.min
+    np.testing.assert_array_equal(q.value, [90.0, 120.0])
+    for given, seconds in ((np.timedelta64(1, "m"), 60.0), (np.timedelta64(1500, "ms"), 1.5),
+                           (np.timedelta64(2, "W"), 14 * 86400.0),
+                           (datetime.timedelta(minutes=1, microseconds=5), 60.000005),
+                           (pd.Timedelta(1, "ns"), 1e-9)):
+        assert time_quantity(given).to_value(u.s) == pytest.approx(seconds, rel=1e-15, abs=0)
+    series = time_quantity(pd.Series(pd.to_timedelta([1, 2], unit="m")))
+    np.testing.assert_array_equal(series.to_value(u.s), [60.0, 120.0])
+    # not a fixed duration (numpy's calendar year, no unit): left for the argument's check
+    for other in (np.timedelta64(1, "Y"), np.timedelta64(5)):
+        assert time_quantity(other) is other
+
+
+def test_rigid_and_orbit_entries_read_a_numpy_duration_in_its_unit():
+    from rigid import RigidBody, free_motion
+    from rigid import integrate as rigid_integrate
+
+    body = RigidBody([1.0, 2.0, 3.0], omega=[1.0, 0.3, 0.8])
+    _same(free_motion(body, np.timedelta64(1, "m")).omega, free_motion(body, 1.0 * u.min).omega)
+    run = rigid_integrate(body, np.timedelta64(2, "s"), dt=np.timedelta64(100, "ms"),
+                          method="rk4")
+    assert run.steps == 20
+    orbit = KeplerOrbit.from_state([7000.0, 0, 0] * u.km, [0, 7.5, 0] * u.km / u.s,
+                                   398600.4418 * u.km**3 / u.s**2)
+    _same(orbit.propagate(np.timedelta64(10, "m")).state()[0],
+          orbit.propagate(10.0 * u.min).state()[0])
+    a = Simulation(_system(), method="radau15").integrate(np.timedelta64(36, "h"))
+    b = Simulation(_system(), method="radau15").integrate(36.0 * u.h)
+    _same(a.t, b.t), _same(a.r, b.r)
+
+
+def test_a_numpy_date_duration_or_record_that_is_no_number_is_refused_by_name():
+    from rigid import RigidBody, free_motion
+
+    body = RigidBody([1.0, 2.0, 3.0], omega=[1.0, 0.3, 0.8])
+    for bad, why in ((np.datetime64("2020-01-01"), "a numpy datetime64"),
+                     (np.array([(60.0,)], dtype=[("a", "f8")]), "a structured array"),
+                     (np.timedelta64(1, "Y"), "a numpy timedelta64"),
+                     (np.timedelta64(5), "a numpy timedelta64")):
+        with pytest.raises(ValueError, match=f"Expected `t` to be numeric, got {why}"):
+            free_motion(body, bad)
+    with pytest.raises(ValueError, match="Expected `t` to be finite, got nan at index 1"):
+        free_motion(body, np.array([1, "NaT"], dtype="timedelta64[s]"))
+    # beside plain floats, refused as the Quantity it is (as a TimeDelta)
+    with pytest.raises(ValueError, match="plain floats for a system of plain floats"):
+        Simulation(_plain()).integrate(np.timedelta64(2, "D"))
+    # a duration where a number of no time is due
+    with pytest.raises(ValueError, match="`e` to be dimensionless, got 1 s"):
+        kepler.solve_kepler(1.0, np.timedelta64(1, "s"))

@@ -23,7 +23,10 @@ GRID = 2.0**-1074  # the spacing of float64 below the normal range (subnormals)
 finite = st.floats(-3.0, 3.0, allow_nan=False)
 positive = st.floats(0.1, 5.0)
 vec3 = st.tuples(finite, finite, finite).map(np.array)
-moments3 = st.tuples(positive, positive, positive).map(np.array)
+# principal moments of a body (A + B >= C for every order: the sums of pairs of three
+# positive numbers are every such triple)
+moments3 = st.tuples(positive, positive, positive).map(
+    lambda x: np.array([x[0] + x[1], x[1] + x[2], x[2] + x[0]]) / 2.0)
 quat4 = st.tuples(finite, finite, finite, finite).map(np.array).filter(
     lambda q: np.linalg.norm(q) > 0.1
 )
@@ -39,8 +42,8 @@ def test_euler_hand_values():
 
 @settings(deadline=None, max_examples=60)
 @given(moments3, vec3, vec3)
-@example(np.array([0.1, 5.0, 2.5]), np.array([3.0, -1e-310, 2e-320]), np.array([5e-324, 0.0, -3.0]))
-@example(np.array([0.1, 0.1, 5.0]), np.array([1e-160, 2e-160, -3e-160]), np.array([1e-300] * 3))
+@example(np.array([2.6, 5.0, 2.5]), np.array([3.0, -1e-310, 2e-320]), np.array([5e-324, 0.0, -3.0]))
+@example(np.array([2.5, 2.5, 5.0]), np.array([1e-160, 2e-160, -3e-160]), np.array([1e-300] * 3))
 def test_euler_energy_and_momentum_rates(m, w, n):
     # Identities of Euler's equations: dT/dt = omega . N (the gyroscopic terms
     # cancel) and d|L|^2/dt / 2 = L . N.  Both to a few ulp of the term sizes.
@@ -63,9 +66,27 @@ def test_euler_broadcast_and_quantities():
     got = euler_equations(m, w)
     assert got.shape == (2, 3)
     np.testing.assert_array_equal(got[1], [0.0, 0.0, 0.0])  # sphere, no torque
-    q = euler_equations(m * u.kg * u.m**2, w * u.rad / u.s, 1.0 * u.N * u.m)
+    q = euler_equations(m * u.kg * u.m**2, w * u.rad / u.s, [1.0, 1.0, 1.0] * u.N * u.m)
     assert q.unit.is_equivalent(u.rad / u.s**2)
     np.testing.assert_allclose(q.to_value(u.rad / u.s**2)[1], [0.5, 0.5, 0.5], rtol=EPS)
+    # a number is no torque vector: it was taken as (N, N, N), sqrt(3) times as large
+    with pytest.raises(ValueError, match=r"`torque` to have shape \(\.\.\., 3\), got \(\)"):
+        euler_equations(m, w, 1.0)
+
+
+def test_moments_of_no_body_are_refused():
+    # Sylvester (1866): each principal moment "must be not greater than the sum of the
+    # other two"; RigidBody refuses [1, 1, 3], and so do the functions taking moments
+    with pytest.raises(ValueError, match=r"`moments` to satisfy A \+ B >= C, got 3.0 at "
+                                         r"index 2 > 2.0"):
+        euler_equations([1.0, 1.0, 3.0], [1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match=r"A \+ B >= C, got 3.5 at index \(1, 2\) > 2.0"):
+        euler_equations([[1.0, 2.0, 3.0], [1.0, 1.0, 3.5]], [1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match=r"`moments` to satisfy A \+ B >= C, got 3.0 at index 2"):
+        torque_on(BodyTorque([1.0, 0.0, 0.0]), [1.0, 1.0, 3.0], Quaternion([1.0, 0, 0, 0]))
+    # a flat disk (C = A + B, built in floating point) is a body
+    np.testing.assert_array_equal(euler_equations([0.1, 0.2, 0.1 + 0.2], [0.0, 0.0, 1.0]),
+                                  [0.0, 0.0, 0.0])
 
 
 @settings(deadline=None, max_examples=60)

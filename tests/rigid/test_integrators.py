@@ -497,3 +497,25 @@ def test_a_run_in_chunks_is_the_run_in_one_call_with_a_torque_of_time(method, mo
         np.testing.assert_array_equal(other.attitude.as_array(), whole.attitude.as_array())
         np.testing.assert_array_equal(other.omega, whole.omega)
         np.testing.assert_array_equal(other.t, whole.t)
+
+
+def test_a_run_whose_quaternion_norm_drifted_says_so():
+    # The rigid Earth with rk4 at a step of one day (its spin turns once a step): |q|
+    # grows to 1e9 in 29 steps and the attitude, normalised on output, is over a radian
+    # from the exact one (free_motion), with no other sign (|L| and T stay within 1e-7:
+    # the error is in the spin's phase).  splitting4 at the same step keeps |q| to 1e-13.
+    import warnings
+
+    from rigid import free_motion
+    from rigid.earth import rigid_body
+    from rigid.integrators import NORM_DRIFT_WARNING
+
+    earth, t = rigid_body(), np.arange(0.0, 30.0) * u.day
+    with pytest.warns(RuntimeWarning, match=r"norm drifted by 1.36e\+09 in this rk4 run .* "
+                                            r"shorter `dt` than 86400.0 s"):
+        bad = integrate(earth, t, dt=1.0 * u.day, method="rk4")
+    assert bad.attitude.rotation_distance(free_motion(earth, bad.t).attitude).max() > 1.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        good = integrate(earth, t, dt=1.0 * u.day, method="splitting4")
+    assert good.norm_drift < NORM_DRIFT_WARNING * 1e-9
