@@ -62,7 +62,7 @@ from hamilton_orbits.initial_states import InitialStates, names_repr
 from hamilton_orbits.integrals import energy_gm
 from hamilton_orbits.integrators import _setup
 from hamilton_orbits.units import DIMENSIONLESS, GM, LENGTH, SPEED, require_consistent
-from hamilton_orbits.validation import check_finite
+from hamilton_orbits.validation import as_float_array, check_finite
 
 __all__ = ["Body", "System", "SystemArrays"]
 
@@ -249,6 +249,10 @@ class System(InitialStates):
                 raise ValueError(f"Expected `radius` to have shape ({n},), got {rad.shape}")
             check_positive("radius", np.where(np.isnan(rad), 1.0, rad))
             check_finite("radius", rad[~np.isnan(rad)], np.flatnonzero(~np.isnan(rad)))
+        if isinstance(names, str):  # (its letters would be the names, one a body)
+            raise ValueError(f"Expected `names` to be {n} non-empty strings, got the one "
+                             f"string {names!r} (one body's name is a list of one: "
+                             f"[{names!r}])")
         names_t = tuple(f"b{k}" for k in range(n)) if names is None else tuple(names)
         if len(names_t) != n or not all(isinstance(x, str) and x for x in names_t):
             raise ValueError(f"Expected `names` to be {n} non-empty strings, got {names!r}")
@@ -461,13 +465,13 @@ class System(InitialStates):
         ValueError: Expected `gm` >= 0, got -1.0 at index 0
         """
         out = object.__new__(System)
-        r = self._internal("r", r, LENGTH, L_UNIT)
-        v = self._internal("v", v, SPEED, V_UNIT)
-        gm = self._gm if gm is None else self._internal("gm", gm, GM, GM_UNIT)
+        r = self._internal("r", r, LENGTH, L_UNIT, check)
+        v = self._internal("v", v, SPEED, V_UNIT, check)
+        gm = self._gm if gm is None else self._internal("gm", gm, GM, GM_UNIT, check)
         if check and gm.shape != self._gm.shape:
             raise ValueError(f"Expected `gm` to have shape {self._gm.shape}, got {gm.shape}")
         radius = self._radius if radius is None else self._internal("radius", radius, LENGTH,
-                                                                      L_UNIT)
+                                                                      L_UNIT, check)
         if check:
             self._check_new(radius, keep)
         arrays = (gm, r, v, radius, self._j2, self._pole)
@@ -481,19 +485,22 @@ class System(InitialStates):
             out._check_state()
         return out
 
-    def _internal(self, name: str, value: Any, kind: Any, unit: Any) -> np.ndarray:
-        """``value`` of :meth:`with_state` in the internal units: a Quantity converted
-        (for a system of Quantities; refused for one of plain numbers, whose units
-        are the caller's own), plain numbers as they are."""
+    def _internal(self, name: str, value: Any, kind: Any, unit: Any,
+                  check: bool = True) -> np.ndarray:
+        """``value`` of :meth:`with_state` in the internal units, a copy: a Quantity
+        converted (for a system of Quantities; refused for one of plain numbers, whose
+        units are the caller's own), plain numbers as they are.  ``check``: refused
+        as :func:`~hamilton_orbits.validation.as_float_array` refuses (a list holding
+        Quantities, whose units would be dropped; bools, text, masked values);
+        otherwise an integrator's own arrays, copied."""
         if isinstance(value, u.Quantity):
             if not self._quantity:
                 raise ValueError(f"Expected `{name}` as plain numbers in this system's own "
                                  f"units (it was built from plain numbers), got {value!r}")
             return np.array(kind(name, value, unit, finite=False), dtype=np.float64)
-        try:
-            return np.array(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ValueError(f"Expected `{name}` to be numbers, got {value!r}") from None
+        if check:
+            return np.array(as_float_array(name, value, finite=False), dtype=np.float64)
+        return np.array(value, dtype=np.float64)
 
     def _check_new(self, radius: np.ndarray, keep: Any) -> None:
         """:meth:`with_state`'s ``radius`` (n,), each NaN (none) or finite and >= 0,
@@ -503,7 +510,7 @@ class System(InitialStates):
         n = len(self._names)
         if radius.shape != (n,):
             raise ValueError(f"Expected `radius` to have shape ({n},), got {radius.shape}")
-        check_positive("radius", np.where(np.isnan(radius), 1.0, radius), strict=False)
+        check_positive("radius", np.where(np.isnan(radius), 1.0, radius))  # (as a Body's)
         check_finite("radius", radius[~np.isnan(radius)], np.flatnonzero(~np.isnan(radius)))
         if keep is not None and np.shape(keep) != (n,):
             raise ValueError(f"Expected `keep` to have shape ({n},), got {np.shape(keep)}")

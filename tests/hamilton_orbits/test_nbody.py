@@ -273,11 +273,45 @@ def test_with_state_converts_quantities_and_checks_radius_and_keep():
     r, v = plain.as_arrays().r, plain.as_arrays().v
     with pytest.raises(ValueError, match=r"`r` as plain numbers in this system's own units"):
         plain.with_state(r * u.au, v)
-    with pytest.raises(ValueError, match=r"Expected `radius` >= 0, got -5.0 at index 1"):
+    with pytest.raises(ValueError, match=r"Expected `radius` > 0, got -5.0 at index 1"):
         plain.with_state(r, v, radius=[1.0, -5.0])
     with pytest.raises(ValueError, match=r"Expected `keep` to have shape \(2,\), got \(3,\)"):
         plain.with_state(r, v, keep=[True, False, True])
     assert plain.with_state(r, v, radius=[np.nan, 0.1]).names == plain.names
+
+
+def test_with_state_refuses_what_from_arrays_refuses():
+    """A list of Quantities was read as bare numbers in au and au/day (13 km/s as 13
+    au/day); bools, text and masked values were taken, a radius of 0 as well: each
+    is refused by name, as System.from_arrays and Body refuse it."""
+    q = System.from_arrays([1.0, 1e-3] * u.au**3 / u.day**2, [[0, 0, 0], [5, 0, 0]] * u.au,
+                           [[0, 0, 0], [0, 0.0075, 0]] * u.au / u.day)
+    r, v = q.r, q.v
+    kms = [[0, 0, 0] * u.km / u.s, [0, 13, 0] * u.km / u.s]
+    with pytest.raises(ValueError, match=r"`v` to be plain numbers or one Quantity array, "
+                                         r"got the Quantity \[0. 0. 0.\] km / s at index 0"):
+        q.with_state(r, kms)
+    assert q.with_state(r, u.Quantity(kms)).v[1, 1].to_value(u.km / u.s) == pytest.approx(
+        13.0, rel=1e-15)
+    with pytest.raises(ValueError, match=r"`gm` to be numeric, got True at index 0"):
+        q.with_state(r, v, gm=[True, False])
+    with pytest.raises(ValueError, match=r"`gm` to be numbers, got a masked value at index 1"):
+        q.with_state(r, v, gm=np.ma.array([1.0, 5.0], mask=[False, True]))
+    with pytest.raises(ValueError, match=r"`r` to be numeric"):
+        q.with_state([["1", "0", "0"], ["5", "0", "0"]], v)
+    with pytest.raises(ValueError, match=r"`radius` > 0, got 0.0 at index 0"):
+        q.with_state(r, v, radius=[0.0, np.nan])
+    # plain numbers are the internal units, as before
+    same = q.with_state(r.to_value(u.au), v.to_value(u.au / u.day))
+    np.testing.assert_array_equal(same.as_arrays().v, q.as_arrays().v)
+
+
+def test_one_string_is_not_the_names_of_many_bodies():
+    # its letters were the names: ('s', 'u', 'n')
+    with pytest.raises(ValueError, match=r"`names` to be 3 non-empty strings, got the one "
+                                         r"string 'sun'"):
+        System.from_arrays([1.0, 0.0, 0.0], np.eye(3), np.zeros((3, 3)), names="sun")
+    assert System.from_arrays([1.0], [[0, 0, 0]], [[0, 0, 0]], names=["sun"]).names == ("sun",)
 
 
 @pytest.mark.parametrize(("scale_gm", "scale_r", "scale_v", "what"), [
@@ -353,7 +387,7 @@ def test_with_state_refuses_indices_for_keep_and_names_a_bad_state():
                                          r"kept\), got \[0, 1\]"):
         s.with_state(s.r, s.v, keep=np.array([0, 1]))
     assert s.with_state(s.r, s.v, keep=[True, False]).names == ("sun",)
-    with pytest.raises(ValueError, match=r"Expected `r` to be numbers, got 'x'"):
+    with pytest.raises(ValueError, match=r"Expected `r` to be numeric, got 'x'"):
         s.with_state("x", s.v)
 
 
