@@ -82,3 +82,16 @@ def test_solve_in_one_integration_is_scipys_dense_solution_output_by_output():
         np.testing.assert_array_equal(y[1:], ref.sol(t_out[1:]).T)
         assert steps == ref.t.size - 1 and nfev == total < ref.nfev
         assert len(seen) == len(t_out) - 1 and seen[0] < total // 2 and seen == sorted(seen)
+
+
+def test_a_body_at_1e300_sets_its_tolerance_without_overflow():
+    # its |r| as norm(): the squares overflowed to inf (numpy's overflow warning, an
+    # error in this suite) and its absolute tolerance with them; by hypot it is 1e300
+    # (a tenth of the way in float64 headroom: tol * 1e300 is finite)
+    from hamilton_orbits import System, integrate
+
+    s = System.from_arrays([1.0, 1e-3], [[0, 0, 0], [1e300, 0, 0]], [[0, 0, 0], [0, 1, 0]])
+    run = integrate(s, 1.0, method="dop853")
+    # (y = t exactly, no force at 1e300; the stage sums of the step round: a few ulp)
+    np.testing.assert_allclose(run.r[-1], [[0.0, 0.0, 0.0], [1e300, 1.0, 0.0]],
+                               rtol=4 * np.finfo(float).eps, atol=0)

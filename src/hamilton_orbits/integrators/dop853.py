@@ -337,8 +337,10 @@ def _dense_run(f: Callable[[float, np.ndarray], np.ndarray], y_out: np.ndarray,
 
 def _body_scale(x: np.ndarray) -> np.ndarray:
     """|x_i| for each body, repeated over its three components (a zero row takes the
-    largest, so that a body at rest at the origin does not demand zero error)."""
-    norm = np.linalg.norm(x, axis=1)
+    largest, so that a body at rest at the origin does not demand zero error); by
+    ``hypot``, whose squares do not overflow (a body at 1e300: ``norm`` gave inf and
+    numpy's overflow warning)."""
+    norm = np.hypot(np.hypot(x[:, 0], x[:, 1]), x[:, 2])
     top = float(np.max(norm)) if norm.size else 0.0
     norm = np.where(norm > 0, norm, top if top > 0 else 1.0)
     return np.repeat(norm, 3)
