@@ -215,14 +215,18 @@ _NOT_TIME_DELTA = frozenset({float, int, np.float64, np.ndarray, list, tuple, ty
 
 
 def time_quantity(value: Any) -> Any:
-    """``value``, an astropy TimeDelta made the time Quantity in days it holds.
+    """``value``, an astropy TimeDelta made the time Quantity in days it holds (a
+    numpy duration the Quantity in its unit).
 
     A duration is taken as a time Quantity or as astropy's own duration type, a
     :class:`~astropy.time.TimeDelta` (scalar or array): the public functions that
     take a duration pass it through here first, once, so that a TimeDelta is then
     accepted, converted and refused exactly as the Quantity in days it equals
     (refused beside a system of plain floats, as a Quantity is).  ``value.to(u.day)``
-    keeps its precision (the sum of its two doubles of days, rounded once).
+    keeps its precision (the sum of its two doubles of days, rounded once).  A numpy
+    ``timedelta64`` (scalar or array; pandas' ``Timedelta`` and its Series, Python's
+    ``datetime.timedelta``) is the time Quantity in its own unit
+    (:func:`numpy_duration`): read as a number, it was its count (a minute as 1).
 
     Parameters
     ----------
