@@ -323,7 +323,7 @@ def integrate(
     -----
     RuntimeWarning
         When the attitude quaternion's norm drifted by more than
-        :data:`NORM_DRIFT_WARNING` (1e-3; the trajectory's ``norm_drift``): a step far
+        ``NORM_DRIFT_WARNING`` (1e-3; the trajectory's ``norm_drift``): a step far
         too long for the method, or a loose ``tol``.
 
     References
