@@ -21,7 +21,11 @@ callback raises :class:`StopIntegration`, or when the user presses Ctrl-C
 (``KeyboardInterrupt``) during the run, the engine returns what was reached
 (``complete=False``; ``interrupted=True`` for Ctrl-C) instead of losing it.  The
 integrators return to Python at least every few thousand steps (radau15) or
-every output (the fixed-step maps), so an interrupt is seen promptly.
+every output (the fixed-step maps), so an interrupt is seen promptly.  An event
+whose action is ``"stop"`` ends the run as its result, not a cut
+(``complete=True``, ``events.stopped_by``); the next leg goes on from there, where
+a close approach or an escape is not found again, but not from a collision's
+contact (a ``ValueError`` names the pair).
 
 Backward integration
 --------------------
@@ -104,7 +108,8 @@ class EngineRun:
     Attributes
     ----------
     t : ndarray, shape (k,)
-        The output times reached (``k = len(t_out)`` when ``complete``).
+        The output times reached (``k = len(t_out)`` when ``complete`` and no event
+        stopped the run).
     r, v : ndarray, shape (k, n, 3)
         The states at those times.
     steps : int
@@ -114,11 +119,13 @@ class EngineRun:
     wall_time : float
         Seconds of the integration proper (numba's compilation during it left out).
     complete : bool
-        False if the run stopped early (``stop()``, :class:`StopIntegration` from
-        an output callback, or Ctrl-C).
+        False if the run was cut short (``stop()``, :class:`StopIntegration` from
+        an output callback, or Ctrl-C).  A stop by an event's action is the run's
+        end, not a cut: ``complete`` stays True (``events.stopped_by`` says it).
     events : EventLog or None
         The events found (when any were watched); an event that stopped the run
-        is ``events.stopped_by``, and ``t[-1]`` is its time.
+        is ``events.stopped_by``, and ``t[-1]`` is its time (or, with wh and
+        leapfrog, the end of the step it occurred in).
     gm : ndarray, shape (n,) or (k, n)
         ``G m`` of every body; per output, (k, n), when merges or removals
         changed it during the run.
@@ -329,12 +336,16 @@ class Propagation:
         (the steps unchanged: a snapshot taken then continues bit for bit).
         ``on_output(i, steps)`` and ``stop()`` after output ``i`` see the propagation
         standing there as ``checkpoint`` does (a snapshot or copy taken in them
-        continues as the run does)."""
+        continues as the run does).  A leg forwards from where a collision stopped
+        the run is refused with a ``ValueError`` naming the pair
+        (:meth:`~hamilton_orbits.events.EventLog.refuse_going_on`)."""
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         events = self.events
         first_event = 0 if events is None else len(events.recorded())
         if events is not None:
+            if n_t > 1 and not backward:  # (not on through a collision's stop)
+                events.refuse_going_on(when=self.t)
             events.stopped_by = None
         driver = self._driver_for_leg(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
@@ -409,8 +420,9 @@ class Propagation:
 
     def _driver_for_leg(self, backward: bool) -> Any:
         """The driver of a leg in this direction; made afresh where bodies are in
-        contact as the leg begins (as after a stop at a collision): they collide at
-        its start, as at a first leg's (:meth:`driver_for`)."""
+        contact as the leg begins (a contact no crossing will reveal, not one a
+        collision stopped the run at, which :meth:`advance` refuses): they collide
+        at its start, as at a first leg's (:meth:`driver_for`)."""
         if (self.events is not None and self.driver is not None and not backward
                 and not self.backward and self.events.overlapping(self.r)):
             self.steps_before += self.driver.steps

@@ -26,14 +26,22 @@ What each finds
     itself are then not watched).
 ``collision``
     The first contact of two bodies with radii (``|r_i - r_j| = R_i + R_j``),
-    solved on the interpolant.  ``"stop"`` ends the run there; ``"merge"``
-    replaces the pair by one body with their summed mass at their centre of
-    mass with their total momentum, and goes on.  Bodies that already overlap
-    at the start of a run collide there, at its first time.
+    solved on the interpolant.  ``"stop"`` ends the run there, for good: the
+    bodies are in contact, and a later ``integrate`` onwards raises a
+    ``ValueError`` naming them (:meth:`EventLog.refuse_going_on`; go on from
+    ``sim.system`` with the pair merged or one removed, or watch it with
+    ``"merge"``).  ``"merge"`` replaces the pair by one body with their summed
+    mass at their centre of mass with their total momentum, and goes on.  Bodies
+    that already overlap at the start of a run collide there, at its first time.
 ``escape``
     A body's distance from the system's centre of mass crossing ``distance``
     outwards.  ``"record"`` (default) goes on; ``"stop"`` ends the run;
     ``"remove"`` takes the body out of the run.
+
+A run stopped by a close approach or an escape goes on at the next
+``integrate``, from the state it stopped at, where that event is not found again
+(its crossing lies behind it); the next one is.  A stop is the run's end, not a
+cut: the trajectory's ``complete`` stays True, ``stopped_by`` says why it ended.
 
 Where actions take effect
 -------------------------
@@ -474,6 +482,49 @@ class EventLog:
         """Every recorded row, shape (k, 7)."""
         self.drain()
         return np.array(self.rows).reshape(-1, N_EVENT_COLUMNS)
+
+    def refuse_going_on(self, names: Sequence[str] | None = None, when: Any = None) -> None:
+        """Refuse a leg onwards from where a collision with the action ``"stop"`` ended
+        the run (the last leg's ``stopped_by``): its bodies are in contact there, and
+        integrating on would take them through each other (and, found at once
+        again, the same collision would end every later leg where it began).
+
+        Parameters
+        ----------
+        names : sequence of str, optional
+            The bodies' names (default: ``body <index>``).
+        when : optional
+            The time the run stands at, as the message quotes it.
+
+        Raises
+        ------
+        ValueError
+            Naming the two bodies and what to do.
+
+        Examples
+        --------
+        >>> log = EventLog(np.array([[2.0, 0, 1, 0.03, ACTIONS["stop"]]]), np.full(2, 0.015))
+        >>> log.refuse_going_on(["a", "b"])  # (nothing stopped the run)
+        >>> r, v, gm = np.array([[0.0, 0, 0], [0.02, 0, 0]]), np.zeros((2, 3)), np.ones(2)
+        >>> log.at_start(0.0, r, v, gm)
+        True
+        >>> log.refuse_going_on(["a", "b"], 0.0)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: Bodies 'a' and 'b' are in contact: their collision (action 'stop') ...
+        """
+        if self.stopped_by is None:
+            return
+        code, i, j = self.rows[self.stopped_by][[E_CODE, E_I, E_J]].astype(int)
+        if code != EVENTS["collision"][0]:
+            return  # (a stop at a close approach or an escape: not found again there)
+        a, b = (repr(names[k]) if names is not None else f"body {k}" for k in (i, j))
+        at = "" if when is None else f", which stands at t = {when}"
+        raise ValueError(
+            f"Bodies {a} and {b} are in contact: their collision (action 'stop') ended "
+            f"this run{at}; it does not go on through them.  Go on from the state "
+            f"reached (sim.system) with a new simulation in which they are merged or "
+            f"one of them is removed, or watch that collision with action 'merge'")
 
     def overlapping(self, r: np.ndarray) -> bool:
         """Whether two bodies of a watched collision pair overlap at positions ``r``

@@ -94,7 +94,10 @@ class Simulation(Saving):
     effects : sequence of str or mapping
         Effects beyond Newtonian gravity (:mod:`hamilton_orbits.effects`).
     events : sequence of str or mapping, optional
-        Events to find (:mod:`hamilton_orbits.events`).
+        Events to find (:mod:`hamilton_orbits.events`).  An action ``"stop"``
+        ends the leg at the event (its trajectory complete, ``stopped_by`` the
+        event's row); the next :meth:`integrate` goes on from there, the event
+        not found again, but not from a collision's contact (a ``ValueError``).
     variational : bool
         Integrate the first-order variational equations beside the system (MEGNO,
         the Lyapunov exponent; see ``docs/variational.md``).
@@ -359,7 +362,12 @@ class Simulation(Saving):
         Raises
         ------
         ValueError
-            For bad times, or a lost state (a collision or a step too long).
+            For bad times, or a lost state (a collision or a step too long); for a
+            leg forwards from where a collision (action ``"stop"``) ended the run,
+            naming its bodies, which are in contact there (go on with a new
+            simulation of :attr:`system` in which they are merged or one is
+            removed, or watch the collision with action ``"merge"``).  A stop at a
+            close approach or an escape goes on: that event is not found again.
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
             the state reached, its time and step count with it), unless
@@ -388,6 +396,8 @@ class Simulation(Saving):
                 raise ValueError(f"Expected `{name}` to be callable or None, got {given!r}")
         prop = self._prop
         times, unit = leg_times(t, prop.t, self._quantity)
+        if prop.events is not None and times[-1] > times[0]:  # (refused before the
+            prop.events.refuse_going_on(self._system.names, self.t)  # leg's snapshot)
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
@@ -558,7 +568,7 @@ def integrate(
         Events to find during the run: ``close_encounter``, ``collision``,
         ``escape`` (see :mod:`hamilton_orbits.events`); the trajectory's
         ``events`` table lists them and ``stopped_by`` names the one that ended
-        the run, if any.
+        the run, if any (an end, not a cut: ``complete`` stays True).
     variational : bool
         Integrate the first-order variational equations beside the system (every
         listed effect's Jacobian included): the trajectory then has ``megno`` and

@@ -128,9 +128,12 @@ class Trajectory(TrajectoryBase):
     method : str
     effects : tuple of str
     complete : bool
-        False when the leg ended early: ``stop()`` returned True, or an output
-        callback raised :class:`~hamilton_orbits.integrators.StopIntegration` (the
-        outputs reached are kept; Ctrl-C raises ``KeyboardInterrupt`` instead).
+        False when the leg was cut short: ``stop()`` returned True, an output
+        callback raised :class:`~hamilton_orbits.integrators.StopIntegration`, or
+        Ctrl-C came with ``on_interrupt="keep"`` (the outputs reached are kept).
+        An event whose action is ``"stop"`` ends the leg as its result, not a cut:
+        ``complete`` stays True, ``stopped_by`` is that event's row and ``t[-1]``
+        is before the end asked for (see ``docs/events.md``).
     events : astropy.table.QTable
         One row per event found in this leg (``name``, ``time``, ``bodies``,
         ``distance``, ``speed``, ``action``); empty when none was listed or found.

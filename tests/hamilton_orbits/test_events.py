@@ -387,25 +387,134 @@ def test_the_events_table_prints_every_column_in_80_characters():
     np.testing.assert_array_equal(table["distance"].to_value(u.au), rows[:, 4])  # values kept
 
 
-@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="radau15", dt=1e-3),
-                                dict(method="wh", dt=1e-4), dict(method="leapfrog", dt=1e-4),
-                                dict(method="dop853", tol=1e-12)])
-def test_a_leg_after_a_collision_stop_stops_at_its_start(kw):
-    """The bodies a collision stopped in contact collide again where the next leg
-    begins, as overlapping bodies at a first leg's start do: that leg stops there
-    (the next leg used to integrate through the contact: no event, the energy off by
-    3.8 to 3e6 with the maps, a step underflow with radau15 and dop853)."""
+#: every method (and radau15 at a fixed step, wh in both coordinate systems)
+EVERY_METHOD = [pytest.param(dict(method="radau15"), id="radau15"),
+                pytest.param(dict(method="radau15", dt=1e-3), id="radau15-dt"),
+                pytest.param(dict(method="wh", dt=1e-4), id="wh"),
+                pytest.param(dict(method="wh", dt=1e-4, coordinates="jacobi"), id="wh-jacobi"),
+                pytest.param(dict(method="leapfrog", dt=1e-4), id="leapfrog"),
+                pytest.param(dict(method="dop853", tol=1e-12), id="dop853")]
+IN_CONTACT = r"Bodies 'a' and 'b' are in contact: their collision \(action 'stop'\) ended "
+
+
+def _state_of(sim):
+    """What a refused call must leave as it was: the time, the steps, the state's bits
+    and the events found."""
+    arrays = sim.system.as_arrays()
+    return sim.t, sim.steps, arrays.r.tobytes(), arrays.v.tobytes(), sim.copy()
+
+
+def _unchanged(sim, before):
+    t, steps, r, v, _ = before
+    arrays = sim.system.as_arrays()
+    assert (sim.t, sim.steps, arrays.r.tobytes(), arrays.v.tobytes()) == (t, steps, r, v)
+
+
+@pytest.mark.parametrize("kw", EVERY_METHOD)
+def test_a_leg_after_a_collision_stop_is_refused_naming_the_pair(kw, tmp_path):
+    """After a stop at a collision, each later call returned one row at the stop's
+    time and listed the same collision again (wh and leapfrog at the step's end,
+    with the distance there), ``complete`` True: ``while sim.t < T:
+    sim.integrate(T)`` never ended (and before that, the next call integrated
+    through the contact).  The call is refused by a ValueError naming the bodies
+    and what to do, the simulation left as it was; a copy and a saved and loaded
+    simulation refuse it alike, and a new simulation of the state reached that
+    merges the pair goes on."""
     from hamilton_orbits import Simulation
 
     system, _ = _head_on()
     sim = Simulation(system, events=["collision"], **kw)
     first = sim.integrate(2.0)
-    t_stop = first.t[-1]
-    assert first.stopped_by is not None and t_stop < 1.0
-    again = sim.integrate(2.0)
-    assert again.t.tolist() == [t_stop] and again.stopped_by is not None
-    assert again.stopped_by["name"] == "collision" and again.stopped_by["time"] == t_stop
-    assert sim.t == t_stop
+    assert first.complete and first.stopped_by["name"] == "collision"  # (its end, no cut)
+    assert len(first.events) == 1 and sim.t == first.t[-1] < 1.0
+    sim.save(tmp_path / "stopped.nc")
+    before = _state_of(sim)
+    for _ in range(2):  # (every later call alike)
+        with pytest.raises(ValueError, match=IN_CONTACT + r".*merged or one of them is "
+                           r"removed, or watch that collision with action 'merge'"):
+            sim.integrate(2.0)
+        _unchanged(sim, before)
+    for other in (before[-1], Simulation.load(tmp_path / "stopped.nc")):
+        with pytest.raises(ValueError, match=IN_CONTACT):
+            other.integrate(np.array([float(sim.t), 1.5, 2.0]))
+        _unchanged(other, before)
+    merging = Simulation(sim.system, events=[{"name": "collision", "action": "merge"}], **kw)
+    on = merging.integrate(1.0)
+    assert on.t[-1] == 1.0 and on.final.names == ("a",) and len(on.events) == 1
+
+
+@pytest.mark.parametrize("kw", [dict(method="radau15"), dict(method="wh", dt=1e-3),
+                                dict(method="leapfrog", dt=1e-3), dict(method="dop853")],
+                         ids=["radau15", "wh", "leapfrog", "dop853"])
+def test_an_archived_run_stopped_by_a_collision_refuses_the_next_call_unwritten(kw, tmp_path):
+    """The refused call writes no snapshot (the old one began a new leg in the
+    archive, which a load then resumed into the same collision); loaded from the
+    archive, the run resumes to its stop with the rows of the run never cut, and
+    then refuses the next call alike."""
+    from hamilton_orbits import Simulation
+    from hamilton_orbits.archive import Archive
+
+    system, _ = _head_on()
+    times = np.linspace(0.0, 2.0, 5)
+    sim = Simulation(system, events=["collision"], archive=tmp_path, every=0.25, **kw)
+    whole = sim.integrate(times)
+    snapshots = len(Archive(tmp_path))
+    with pytest.raises(ValueError, match=IN_CONTACT):
+        sim.integrate(2.0)
+    assert len(Archive(tmp_path)) == snapshots
+    again = Simulation.load(tmp_path)
+    assert again.t < whole.t[-1]  # (the last snapshot: before the stop)
+    resumed = again.resume()
+    assert resumed.t.tolist() == whole.t.tolist() and len(resumed.events) == 1
+    assert np.array_equal(resumed.r, whole.r) and again.t == sim.t
+    with pytest.raises(ValueError, match=IN_CONTACT):
+        again.integrate(2.0)
+
+
+@pytest.mark.parametrize("kw", EVERY_METHOD)
+def test_a_leg_after_a_stop_at_the_start_is_refused(kw):
+    """Bodies in contact at t = 0 collide there (one row, t = 0); each later call
+    listed that collision again at t = 0, for ever.  It is refused by name."""
+    from hamilton_orbits import Simulation
+
+    system = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0], radius=0.1),
+                     Body("b", 1e-3, [0.05, 0, 0], [0, 1.0, 0], radius=0.1)])
+    sim = Simulation(system, events=["collision"], **kw)
+    first = sim.integrate(1.0)
+    assert first.t.tolist() == [0.0] and first.stopped_by["time"] == 0.0
+    before = _state_of(sim)
+    with pytest.raises(ValueError, match=IN_CONTACT + r"this run, which stands at t = 0\.0;"):
+        sim.integrate(1.0)
+    _unchanged(sim, before)
+
+
+@pytest.mark.parametrize("kw", EVERY_METHOD)
+@pytest.mark.parametrize(("bodies", "event"), [
+    ([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.5, [1.0, 0, 0], [0, 0.5, 0])],
+     {"name": "close_encounter", "distance": 0.5, "action": "stop"}),
+    ([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.5, [1.0, 0, 0], [3.0, 0, 0])],
+     {"name": "escape", "distance": 1.5, "action": "stop"}),
+], ids=["close_encounter", "escape"])
+def test_a_leg_after_a_stop_at_an_approach_or_an_escape_goes_on(kw, bodies, event):
+    """A stop at a closest approach or at an escape is not found again at the state
+    it stopped at: the next call goes on, to the next closest approach (one orbit
+    later, at the same distance) or to the end."""
+    from hamilton_orbits import Simulation
+
+    sim = Simulation(System(bodies), events=[event], **kw)
+    first = sim.integrate(5.0)
+    assert first.complete and first.stopped_by["name"] == event["name"]
+    t_stop, t_event = float(sim.t), float(first.stopped_by["time"])
+    second = sim.integrate(5.0)
+    assert second.t[0] == t_stop and sim.t > t_stop
+    assert all(float(t) > t_stop for t in second.events["time"])  # (not found again)
+    if event["name"] == "escape":
+        assert len(second.events) == 0 and sim.t == 5.0
+    else:  # (the next periapsis of the pair's orbit)
+        row = second.stopped_by
+        assert float(row["time"]) - t_event == pytest.approx(2.0666, abs=2e-3)
+        assert float(row["distance"]) == pytest.approx(float(first.stopped_by["distance"]),
+                                                       rel=1e-3)
 
 
 @pytest.mark.parametrize(("event", "method"), [
