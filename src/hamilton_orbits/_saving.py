@@ -42,6 +42,7 @@ from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.simulation_record import all_active, record, spec, state_values
 from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["RestartWarning", "Saving"]
 
@@ -116,7 +117,8 @@ class Saving:
         ------
         ValueError
             When this simulation was not loaded from an archive folder, or has
-            integrated since (the interrupted call was left for another).
+            integrated since (the interrupted call was left for another); for a
+            ``progress`` not True or False.
         SnapshotError
             When a snapshot of the leg is missing or damaged (its rows are lost).
 
@@ -139,6 +141,7 @@ class Saving:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder, before it "
                              "integrates anything else")
+        progress = as_flag("progress", progress)
         folder, info, upto = self._resumable  # the leg's rows read now, not at load
         times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop

@@ -66,6 +66,7 @@ from hamilton_orbits.trajectory import (
     make_trajectory,
 )
 from hamilton_orbits.units import TIME, is_quantity, time_quantity
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -359,7 +360,8 @@ class Simulation(Saving):
         Raises
         ------
         ValueError
-            For bad times, or a lost state (a collision or a step too long).
+            For bad times, a ``progress`` not True or False, or a lost state (a
+            collision or a step too long).
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
             the state reached, its time and step count with it), unless
@@ -372,6 +374,7 @@ class Simulation(Saving):
             second is raised at once.
         """
         t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
+        progress = as_flag("progress", progress)  # ("no" was a bar: any text is true)
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
             # (the integrals measured from time 0 once a leg has begun: after Ctrl-C too)

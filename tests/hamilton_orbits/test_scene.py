@@ -678,3 +678,10 @@ def test_timedeltas_set_in_a_list_on_a_scene_are_saved_with_their_unit(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["set"]["effects"][0]["tau"] == [{"value": x, "unit": "d"} for x in days]
     assert summary["effects"][0]["tau"] == {"value": days, "unit": "d"}
+
+
+def test_run_refuses_a_progress_that_is_not_a_bool():
+    """``Scene.run(progress="no")`` drew a bar (any non-empty text is true); it is
+    refused by name before the scene is built."""
+    with pytest.raises(ValueError, match=r"`progress` to be True or False, got 'no'"):
+        Scene.bundled("mercury-gr").run(progress="no")

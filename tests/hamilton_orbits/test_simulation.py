@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -209,6 +211,32 @@ def test_a_progress_bar_is_quiet_when_stderr_is_no_terminal(capsys, method):
     rigid.integrate(rigid.RigidBody([1.0, 2.0, 3.0], omega=[0.4, 1.1, -0.3]), 2.0,
                     method="dop853", progress=True)
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("progress", ["no", "False", "", 0, 1, None])
+def test_progress_that_is_not_a_bool_is_refused_by_name(progress):
+    """``progress="no"`` drew a bar (any non-empty text is true) while a text for
+    ``variational`` was refused: ``integrate``, ``Simulation.integrate`` and
+    ``resume`` refuse anything but True or False by name, with the value, a falsy
+    one (0, None, "") on the lean path too."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    pattern = rf"`progress` to be True or False, got {re.escape(repr(progress))}"
+    with pytest.raises(ValueError, match=pattern):
+        integrate(s, 1.0, method="leapfrog", dt=0.1, progress=progress)
+    with pytest.raises(ValueError, match=pattern):
+        Simulation(s, method="leapfrog", dt=0.1).integrate([0.0, 1.0], progress=progress)
+    sim = Simulation(s, method="leapfrog", dt=0.1)
+    assert sim.integrate(1.0, progress=np.False_).t[-1] == 1.0  # (numpy's bool: one)
+
+
+def test_resume_refuses_a_progress_that_is_not_a_bool(tmp_path):
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    Simulation(s, method="wh", dt=0.01, archive=tmp_path / "a", every=2.0).integrate(
+        np.arange(0.0, 3.0))
+    with pytest.raises(ValueError, match=r"`progress` to be True or False, got 'no'"):
+        Simulation.load(tmp_path / "a").resume(progress="no")
 
 
 # -- issue 32 item 8: each test particle's own check; under-resolved encounters --------

@@ -47,6 +47,7 @@ from hamilton_orbits.effects.parameters import unit_example
 from hamilton_orbits.scenes.base import KINDS, registered_kinds
 from hamilton_orbits.scenes.result import Result
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["Scene", "SceneError"]
 
@@ -550,6 +551,7 @@ class Scene:
         from hamilton_orbits.firstrun import claim_compilation, last_claim
 
         extra = {} if archive is None else {"archive": archive}
+        progress = as_flag("progress", progress)  # (every kind's, before it builds anything)
         result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False),
                                       **extra)
         result.compile_time, result.compile_count = claim_compilation()
