@@ -156,6 +156,28 @@ def test_overrides_address_keys_by_path_and_by_name(tmp_path):
         scene.with_values({"duration": "3 m"})
 
 
+@pytest.mark.parametrize(("name", "key", "said"), [
+    ("mercury-gr", "bodies.mercury.e", "no entry named 'mercury' in bodies: the scene has "
+                                       "no [[bodies]]"),
+    ("mercury-gr", "bodies[1].e", "bodies has no entries; [1] is beyond it"),
+    ("comet-encounter", "bodies.jupiter.gm", "no entry named 'jupiter' in bodies (valid: "
+                                             "'comet')"),
+])
+def test_a_body_of_initial_is_not_set_by_key_and_the_message_says_so(name, key, said):
+    """``bodies.mercury.e`` on ``mercury-gr`` (its bodies from ``[initial]
+    solar_system``) said "bodies: expected a list, got {'mercury': {'e': 0.5}}": it
+    is refused as a name not in ``bodies``, with where the scene's bodies come from
+    and what may be set instead."""
+    with pytest.raises(SceneError) as info:
+        Scene.bundled(name).with_values({key: 0.5})
+    text = str(info.value)
+    assert f"{key}: {said}" in text
+    assert ("the scene takes bodies from [initial] solar_system, whose states are read, "
+            "not set by key: set initial.solar_system.epoch or "
+            "initial.solar_system.bodies") in text
+    assert "expected a list" not in text
+
+
 def test_bundled_scenes_are_valid_and_listed():
     listed = dict(Scene.list_bundled())
     for name in ("solar-system", "mercury-gr", "leo-j2"):
