@@ -25,6 +25,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._legs import leg_run
+from hamilton_orbits._output_memory import check_output_memory
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
     LegRows,
@@ -145,6 +146,7 @@ class Saving:
         folder, info, upto = self._resumable  # the leg's rows read now, not at load
         times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop
+        check_output_memory(len(times), len(prop.gm), bool(self._spec[6]))
         rest = times[times > prop.t]
         out = None
         if rest.size:

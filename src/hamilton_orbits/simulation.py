@@ -46,6 +46,7 @@ from hamilton_orbits._legs import (
     time_step,
     tolerance,
 )
+from hamilton_orbits._output_memory import check_output_memory
 from hamilton_orbits._saving import Saving
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
@@ -191,6 +192,8 @@ class Simulation(Saving):
                              f"{tol!r} (the tolerance would be ignored)")
         check_run(typed, step, tol, bool(variational))  # (before any folder is made)
         tan = tangent_of(system, variational, stm, tangent, typed)
+        if tan is not None and stm:  # (every leg keeps two outputs: the start, the end)
+            check_output_memory(2, len(system.names), True)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
@@ -360,8 +363,9 @@ class Simulation(Saving):
         Raises
         ------
         ValueError
-            For bad times, a ``progress`` not True or False, or a lost state (a
-            collision or a step too long).
+            For bad times, a ``progress`` not True or False, outputs that would take
+            more than half the machine's memory (naming ``stm`` when its matrices
+            do), or a lost state (a collision or a step too long).
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
             the state reached, its time and step count with it), unless
@@ -391,6 +395,8 @@ class Simulation(Saving):
                 raise ValueError(f"Expected `{name}` to be callable or None, got {given!r}")
         prop = self._prop
         times, unit = leg_times(t, prop.t, self._quantity)
+        check_output_memory(len(times), len(prop.gm), bool(self._spec[6]))  # (before the
+        # leg's arrays: numpy's MemoryError came after the setting up, or never)
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
