@@ -101,7 +101,9 @@ class Simulation(Saving):
         Integrate the first-order variational equations beside the system (MEGNO,
         the Lyapunov exponent; see ``docs/variational.md``).
     stm : bool
-        With ``variational``: also the state transition matrix.
+        With ``variational``: also the state transition matrix, ``(6n)^2`` values an
+        output: a call whose outputs would take more than half the machine's
+        memory is refused (``ValueError``) before it runs.
     tangent : array_like, shape (n, 6), optional
         MEGNO's initial tangent vector (default: random, as rebound's
         ``init_megno`` draws it, a fixed seed).
@@ -576,7 +578,9 @@ def integrate(
         without events.
     stm : bool
         With ``variational``: also the state transition matrix ``traj.stm`` (6n
-        more tangent vectors).
+        more tangent vectors; ``(6n)^2`` values an output).  Outputs that would take
+        more than half the machine's memory (the STM's counted twice: the
+        integrator's and the trajectory's) are refused by name before the run.
     tangent : array_like, shape (n, 6), optional
         MEGNO's initial tangent vector (x, y, z, vx, vy, vz per body, internal
         units); default: random, each body's six components of unit length, as
