@@ -174,6 +174,17 @@ def test_bad_scene_and_setting(capsys):
     assert "duration" in capsys.readouterr().err
 
 
+def test_setting_a_body_of_initial_solar_system_says_where_it_comes_from(capsys, tmp_path):
+    """``--set bodies.mercury.e=0.5`` on ``mercury-gr`` said "bodies: expected a list,
+    got {'mercury': {'e': 0.5}}"."""
+    assert main(["run", "mercury-gr", "--set", "bodies.mercury.e=0.5", "--out",
+                 str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "bodies.mercury.e: no entry named 'mercury' in bodies" in err
+    assert "[initial] solar_system" in err and "initial.solar_system.epoch" in err
+    assert "expected a list" not in err and not (tmp_path / "out").exists()
+
+
 def _cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "hamilton_orbits.cli", *args],
                           capture_output=True, text=True, cwd=cwd, timeout=600)

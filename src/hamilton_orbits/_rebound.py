@@ -93,7 +93,8 @@ def arrays_from_simulation(
     Raises
     ------
     ValueError
-        If ``sim`` is not a rebound simulation, or ``names`` has the wrong length.
+        If ``sim`` is not a rebound simulation or holds no particle, or ``names``
+        has the wrong length.
 
     Examples
     --------
@@ -108,6 +109,9 @@ def arrays_from_simulation(
     if not isinstance(sim, rebound.Simulation):
         raise ValueError(f"Expected `sim` to be a rebound.Simulation, got {sim!r}")
     n = sim.N
+    if n == 0:  # (the System built from it blamed `bodies`, which the caller never gave)
+        raise ValueError("Expected `sim` to hold at least one particle, got a "
+                         "rebound.Simulation with none")
     if isinstance(names, str):  # ("xyz" was taken as the names 'x', 'y', 'z')
         raise ValueError(f"Expected `names` to be a list of {n} names, got the string {names!r}")
     if names is not None and len(names) != n:

@@ -25,6 +25,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._legs import leg_run
+from hamilton_orbits._output_memory import check_output_memory
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
     LegRows,
@@ -42,6 +43,7 @@ from hamilton_orbits.restart import LayoutMismatch, restore
 from hamilton_orbits.simulation_record import all_active, record, spec, state_values
 from hamilton_orbits.snapshot import SnapshotError, read, write
 from hamilton_orbits.trajectory import Trajectory
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["RestartWarning", "Saving"]
 
@@ -116,7 +118,8 @@ class Saving:
         ------
         ValueError
             When this simulation was not loaded from an archive folder, or has
-            integrated since (the interrupted call was left for another).
+            integrated since (the interrupted call was left for another); for a
+            ``progress`` not True or False.
         SnapshotError
             When a snapshot of the leg is missing or damaged (its rows are lost).
 
@@ -139,9 +142,11 @@ class Saving:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder, before it "
                              "integrates anything else")
+        progress = as_flag("progress", progress)
         folder, info, upto = self._resumable  # the leg's rows read now, not at load
         times, rows = leg_rows(folder, info["start"], upto)
         prop = self._prop
+        check_output_memory(len(times), len(prop.gm), bool(self._spec[6]))
         rest = times[times > prop.t]
         out = None
         if rest.size:

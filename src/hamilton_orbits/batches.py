@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from hamilton_orbits._progress import progress_bar
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["check_client", "check_workers", "run_jobs"]
 
@@ -94,7 +95,7 @@ def run_jobs(fn: Callable[[Any, Any], Any], shared: Any, jobs: Sequence[Any], *,
     """
     check_client(client)
     check_workers(workers, "threads")
-    bar = progress_bar(len(jobs), progress and len(jobs) > 1, unit)
+    bar = progress_bar(len(jobs), as_flag("progress", progress) and len(jobs) > 1, unit)
     out: list[Any] = [None] * len(jobs)
     try:
         for k, result in _completed(fn, shared, jobs, workers, client):

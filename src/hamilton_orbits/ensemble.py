@@ -309,9 +309,72 @@ def _runs_in_pool(n: int, args: list[tuple], rows: list[dict | None], bar: Any,
             if attempt == 1 and kept and all(row is None for row in rows):
                 continue  # (the pool was broken before: this run begun again)
             raise BrokenProcessPool(f"a worker process of the ensemble's pool of {n} ended "
-                                    f"abruptly (killed: out of memory?); the members it had "
+                                    f"abruptly ({_likely_cause()}); the members it had "
                                     f"not finished are lost; the next run starts a new "
                                     f"pool") from exc
+
+
+def _likely_cause() -> str:
+    """Why a worker ended abruptly, as likely as can be told: a script's run not under
+    ``if __name__ == "__main__":`` (each worker, started by the spawn method, runs the
+    script's module-level statements again, this run among them, and dies starting
+    a pool of its own: Python's bootstrapping RuntimeError, on stderr), or else the
+    memory.  That is told from where this run was called, not guessed."""
+    where = _unguarded_call()
+    if where is None:
+        return "killed: out of memory?"
+    return (f"the script calls this run at {where} outside an `if __name__ == "
+            f"\"__main__\":` block: each worker, started by the spawn method, runs the "
+            f"script again up to there and fails starting its own pool (Python's "
+            f"RuntimeError about the bootstrapping phase, above); put the script's run "
+            f"under that guard")
+
+
+def _unguarded_call() -> str | None:
+    """``"file:line"`` of the module-level statement of the ``__main__`` script (a
+    file: not a notebook or ``python -c``) through which this run was called, when
+    it stands outside an ``if __name__ == "__main__":`` block; None otherwise (or
+    when the script cannot be read)."""
+    import inspect
+    import sys
+    from pathlib import Path
+
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    frame = inspect.currentframe()
+    while frame is not None and not (frame.f_code.co_name == "<module>"
+                                     and frame.f_globals is getattr(main, "__dict__", None)):
+        frame = frame.f_back
+    if path is None or frame is None:
+        return None
+    try:
+        source = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    line = frame.f_lineno
+    return None if _in_main_guard(source, line) else f"{path}:{line}"
+
+
+def _in_main_guard(source: str, line: int) -> bool:
+    r"""True if ``line`` of the module ``source`` lies in an ``if __name__ ==
+    "__main__":`` block (or the source cannot be parsed: nothing is claimed).
+
+    Examples
+    --------
+    >>> code = 'import x\nx.run()\nif __name__ == "__main__":\n    x.run()\n'
+    >>> _in_main_guard(code, 2), _in_main_guard(code, 4)
+    (False, True)
+    """
+    import ast
+
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return True
+    guards = ('__name__ == "__main__"', '"__main__" == __name__')
+    return any(isinstance(node, ast.If) and ast.unparse(node.test).replace("'", '"') in guards
+               and node.lineno <= line <= (node.end_lineno or node.lineno)
+               for node in ast.walk(tree))  # (a guard within a try: block too)
 
 
 def _collected(futs: dict[Any, int], rows: list[dict | None], bar: Any) -> None:

@@ -121,7 +121,8 @@ class InitialStates:
         Raises
         ------
         ValueError
-            If ``sim`` is not a ``rebound.Simulation`` or ``names`` has the wrong length.
+            If ``sim`` is not a ``rebound.Simulation`` or holds no particle, or
+            ``names`` has the wrong length.
 
         Examples
         --------

@@ -46,6 +46,7 @@ from hamilton_orbits._legs import (
     time_step,
     tolerance,
 )
+from hamilton_orbits._output_memory import check_output_memory
 from hamilton_orbits._saving import Saving
 from hamilton_orbits.checkpoint import (
     ArchiveWriter,
@@ -66,6 +67,7 @@ from hamilton_orbits.trajectory import (
     make_trajectory,
 )
 from hamilton_orbits.units import TIME, is_quantity, time_quantity
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["INTEGRATORS", "Simulation", "Trajectory", "check_method", "event_log",
            "event_table", "integrate", "make_trajectory"]
@@ -102,7 +104,9 @@ class Simulation(Saving):
         Integrate the first-order variational equations beside the system (MEGNO,
         the Lyapunov exponent; see ``docs/variational.md``).
     stm : bool
-        With ``variational``: also the state transition matrix.
+        With ``variational``: also the state transition matrix, ``(6n)^2`` values an
+        output: a call whose outputs would take more than half the machine's
+        memory is refused (``ValueError``) before it runs.
     tangent : array_like, shape (n, 6), optional
         MEGNO's initial tangent vector (default: random, as rebound's
         ``init_megno`` draws it, a fixed seed).
@@ -193,6 +197,8 @@ class Simulation(Saving):
                              f"{tol!r} (the tolerance would be ignored)")
         check_run(typed, step, tol, bool(variational))  # (before any folder is made)
         tan = tangent_of(system, variational, stm, tangent, typed)
+        if tan is not None and stm:  # (every leg keeps two outputs: the start, the end)
+            check_output_memory(2, len(system.names), True)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
@@ -362,7 +368,9 @@ class Simulation(Saving):
         Raises
         ------
         ValueError
-            For bad times, or a lost state (a collision or a step too long); for a
+            For bad times, a ``progress`` not True or False, outputs that would take
+            more than half the machine's memory (naming ``stm`` when its matrices
+            do), or a lost state (a collision or a step too long); for a
             leg forwards from where a collision (action ``"stop"``) ended the run,
             naming its bodies, which are in contact there (go on with a new
             simulation of :attr:`system` in which they are merged or one is
@@ -380,6 +388,7 @@ class Simulation(Saving):
             second is raised at once.
         """
         t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
+        progress = as_flag("progress", progress)  # ("no" was a bar: any text is true)
         if (self._archive is None and on_output is None and stop is None and not progress
                 and on_interrupt == "raise"):  # one end time, no archive: the engine's
             # (the integrals measured from time 0 once a leg has begun: after Ctrl-C too)
@@ -398,6 +407,8 @@ class Simulation(Saving):
         times, unit = leg_times(t, prop.t, self._quantity)
         if prop.events is not None and times[-1] > times[0]:  # (refused before the
             prop.events.refuse_going_on(self._system.names, self.t)  # leg's snapshot)
+        check_output_memory(len(times), len(prop.gm), bool(self._spec[6]))  # (before the
+        # leg's arrays: numpy's MemoryError came after the setting up, or never)
         if unit is not None:
             self._unit = unit
         self._resumable = None  # (a call begun: the call a kill interrupted is left)
@@ -577,7 +588,9 @@ def integrate(
         without events.
     stm : bool
         With ``variational``: also the state transition matrix ``traj.stm`` (6n
-        more tangent vectors).
+        more tangent vectors; ``(6n)^2`` values an output).  Outputs that would take
+        more than half the machine's memory (the STM's counted twice: the
+        integrator's and the trajectory's) are refused by name before the run.
     tangent : array_like, shape (n, 6), optional
         MEGNO's initial tangent vector (x, y, z, vx, vy, vz per body, internal
         units); default: random, each body's six components of unit length, as

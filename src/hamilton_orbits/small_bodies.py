@@ -42,6 +42,7 @@ import numpy as np
 
 from hamilton_orbits import ephemeris as de
 from hamilton_orbits._legs import tolerance
+from hamilton_orbits._output_memory import check_output_memory
 from hamilton_orbits.perturber_field import EFFECTS, PERTURBERS, field_rhs, perturber_chain
 from hamilton_orbits.small_body_events import EventBodies, encounters, event_rows, watch_for
 from hamilton_orbits.spk import Segments
@@ -152,8 +153,10 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     Raises
     ------
     ValueError
-        For bad input (naming the argument), a span the ephemeris does not cover, or
-        ``ephemeris="de440"`` without the ``[ephemeris]`` extra.
+        For bad input (naming the argument), a span the ephemeris does not cover,
+        ``ephemeris="de440"`` without the ``[ephemeris]`` extra, or outputs beyond
+        half the machine's memory (naming ``stm`` when its dense matrices take them
+        beyond, ``t`` otherwise), refused before any chunk runs.
 
     Examples
     --------
@@ -187,6 +190,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                          f"{len(per_body)}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
+    check_output_memory(len(days), len(r), stm)  # (the STM is dense: (6n)^2 an output)
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     pairs = encounters(events, names, perturbers)
     if pairs and (stm or variational):

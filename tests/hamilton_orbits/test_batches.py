@@ -54,3 +54,9 @@ def test_on_an_in_process_dask_cluster_as_locally():
 def test_bad_arguments_are_refused_naming_them(kw, match):
     with pytest.raises(ValueError, match=match):
         run_jobs(_slow_square, 0, [1], **kw)
+
+
+def test_a_progress_that_is_not_a_bool_is_refused_by_name():
+    """``progress="no"`` drew a bar over the jobs (any non-empty text is true)."""
+    with pytest.raises(ValueError, match=r"`progress` to be True or False, got 'no'"):
+        run_jobs(_slow_square, 10, [0, 1], progress="no")

@@ -404,3 +404,39 @@ def test_members_in_threads_leave_the_warning_filters_as_they_were(monkeypatch):
     assert warnings.filters == before
     assert [rows[n]["under-resolved encounters"] for n in "AB"] == [1, 1]
     assert not any(f[2] is UnderResolvedEncounterWarning for f in warnings.filters)
+
+
+NO_GUARD = """from hamilton_orbits import Ensemble, Scene
+Ensemble(Scene.bundled("mercury-gr"), vary={"duration": ["10 d", "20 d"]}).run(
+    progress=False, workers=2)
+"""
+
+
+def test_a_script_without_the_main_guard_is_named_as_the_cause(tmp_path):
+    """A script running an ensemble at module level, not under ``if __name__ ==
+    "__main__":``, failed with "a worker ... ended abruptly (killed: out of
+    memory?)": each worker (spawned) ran the script again and died starting a pool
+    of its own.  The message names the script's line and the guard."""
+    import subprocess
+
+    script = tmp_path / "noguard.py"
+    script.write_text(NO_GUARD)
+    res = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=600, cwd=tmp_path)
+    assert res.returncode == 1
+    last = res.stderr.strip().splitlines()[-1]
+    assert last.startswith("concurrent.futures.process.BrokenProcessPool: ")
+    assert f"the script calls this run at {script}:2 outside an `if __name__ == " in last
+    assert "spawn method" in last and "out of memory" not in last
+
+
+def test_the_main_guard_is_found_where_it_stands():
+    """The guard's test in either order and quoting, nested in a block; a line
+    outside it, or a script that cannot be parsed (nothing claimed), is told apart."""
+    from hamilton_orbits.ensemble import _in_main_guard
+
+    code = ("import x\nx.run()\nif __name__ == '__main__':\n    x.run()\n"
+            "try:\n    if \"__main__\" == __name__:\n        x.run()\nexcept OSError:\n"
+            "    x.run()\n")
+    assert [_in_main_guard(code, k) for k in (2, 4, 7, 9)] == [False, True, True, False]
+    assert _in_main_guard("if (:\n", 1)

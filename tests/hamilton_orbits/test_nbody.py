@@ -161,6 +161,16 @@ def test_from_rebound_keeps_its_g_and_radii():
     assert [p.r for p in back.particles] == [0.005, 0.0005, 0.0]
 
 
+def test_from_rebound_of_an_empty_simulation_names_sim():
+    """A rebound simulation with no particle blamed ``bodies``, an argument the caller
+    never gave: the message names ``sim``, through both front doors."""
+    import rebound
+
+    for read in (System.from_rebound, from_rebound):
+        with pytest.raises(ValueError, match=r"`sim` to hold at least one particle"):
+            read(rebound.Simulation())
+
+
 def test_solar_system_cites_the_sun_gm_it_uses():
     """``System.solar_system``'s docstring called the Sun's GM the IAU 2015 nominal
     solar mass parameter (1.3271244e20 m^3/s^2 exactly), while the code holds DE440's

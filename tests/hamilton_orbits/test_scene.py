@@ -156,6 +156,28 @@ def test_overrides_address_keys_by_path_and_by_name(tmp_path):
         scene.with_values({"duration": "3 m"})
 
 
+@pytest.mark.parametrize(("name", "key", "said"), [
+    ("mercury-gr", "bodies.mercury.e", "no entry named 'mercury' in bodies: the scene has "
+                                       "no [[bodies]]"),
+    ("mercury-gr", "bodies[1].e", "bodies has no entries; [1] is beyond it"),
+    ("comet-encounter", "bodies.jupiter.gm", "no entry named 'jupiter' in bodies (valid: "
+                                             "'comet')"),
+])
+def test_a_body_of_initial_is_not_set_by_key_and_the_message_says_so(name, key, said):
+    """``bodies.mercury.e`` on ``mercury-gr`` (its bodies from ``[initial]
+    solar_system``) said "bodies: expected a list, got {'mercury': {'e': 0.5}}": it
+    is refused as a name not in ``bodies``, with where the scene's bodies come from
+    and what may be set instead."""
+    with pytest.raises(SceneError) as info:
+        Scene.bundled(name).with_values({key: 0.5})
+    text = str(info.value)
+    assert f"{key}: {said}" in text
+    assert ("the scene takes bodies from [initial] solar_system, whose states are read, "
+            "not set by key: set initial.solar_system.epoch or "
+            "initial.solar_system.bodies") in text
+    assert "expected a list" not in text
+
+
 def test_bundled_scenes_are_valid_and_listed():
     listed = dict(Scene.list_bundled())
     for name in ("solar-system", "mercury-gr", "leo-j2"):
@@ -678,3 +700,10 @@ def test_timedeltas_set_in_a_list_on_a_scene_are_saved_with_their_unit(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["set"]["effects"][0]["tau"] == [{"value": x, "unit": "d"} for x in days]
     assert summary["effects"][0]["tau"] == {"value": days, "unit": "d"}
+
+
+def test_run_refuses_a_progress_that_is_not_a_bool():
+    """``Scene.run(progress="no")`` drew a bar (any non-empty text is true); it is
+    refused by name before the scene is built."""
+    with pytest.raises(ValueError, match=r"`progress` to be True or False, got 'no'"):
+        Scene.bundled("mercury-gr").run(progress="no")

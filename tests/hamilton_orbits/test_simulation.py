@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -209,6 +211,32 @@ def test_a_progress_bar_is_quiet_when_stderr_is_no_terminal(capsys, method):
     rigid.integrate(rigid.RigidBody([1.0, 2.0, 3.0], omega=[0.4, 1.1, -0.3]), 2.0,
                     method="dop853", progress=True)
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("progress", ["no", "False", "", 0, 1, None])
+def test_progress_that_is_not_a_bool_is_refused_by_name(progress):
+    """``progress="no"`` drew a bar (any non-empty text is true) while a text for
+    ``variational`` was refused: ``integrate``, ``Simulation.integrate`` and
+    ``resume`` refuse anything but True or False by name, with the value, a falsy
+    one (0, None, "") on the lean path too."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    pattern = rf"`progress` to be True or False, got {re.escape(repr(progress))}"
+    with pytest.raises(ValueError, match=pattern):
+        integrate(s, 1.0, method="leapfrog", dt=0.1, progress=progress)
+    with pytest.raises(ValueError, match=pattern):
+        Simulation(s, method="leapfrog", dt=0.1).integrate([0.0, 1.0], progress=progress)
+    sim = Simulation(s, method="leapfrog", dt=0.1)
+    assert sim.integrate(1.0, progress=np.False_).t[-1] == 1.0  # (numpy's bool: one)
+
+
+def test_resume_refuses_a_progress_that_is_not_a_bool(tmp_path):
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    Simulation(s, method="wh", dt=0.01, archive=tmp_path / "a", every=2.0).integrate(
+        np.arange(0.0, 3.0))
+    with pytest.raises(ValueError, match=r"`progress` to be True or False, got 'no'"):
+        Simulation.load(tmp_path / "a").resume(progress="no")
 
 
 # -- issue 32 item 8: each test particle's own check; under-resolved encounters --------
@@ -809,3 +837,55 @@ def test_every_wall_takes_a_timedelta_as_the_quantity_it_holds(tmp_path):
     with pytest.raises(ValueError, match=r"Expected `every_wall` to be one number, got "
                                          r"shape \(2,\)"):
         Simulation(s, archive=tmp_path / "two", every_wall=TimeDelta([1.0, 2.0], format="sec"))
+
+
+def _ring(n: int) -> System:
+    """A star and ``n - 1`` massless bodies on circular orbits (G M = 1)."""
+    radius = np.linspace(1.0, 3.0, n - 1)
+    r = np.vstack([[0.0, 0, 0], np.c_[radius, np.zeros((n - 1, 2))]])
+    v = np.vstack([[0.0, 0, 0], np.c_[np.zeros(n - 1), 1 / np.sqrt(radius), np.zeros(n - 1)]])
+    return System.from_arrays(np.r_[1.0, np.zeros(n - 1)], r, v)
+
+
+def test_stm_outputs_beyond_the_memory_limit_are_refused_before_the_run(monkeypatch):
+    """``stm=True`` for 300 bodies at 1001 outputs raised numpy's ``MemoryError:
+    Unable to allocate 24.2 GiB`` after the setting up (and a request a little under
+    the machine's memory was granted, then ran it out of memory): it is refused by
+    ``stm``'s name, with the outputs, the bodies and the size, before any step."""
+    from hamilton_orbits import _output_memory
+    from hamilton_orbits.scene import OUTPUT_LIMIT
+
+    assert _output_memory.OUTPUT_LIMIT is OUTPUT_LIMIT  # (one limit, the scenes')
+    assert _output_memory.memory_limit() >= OUTPUT_LIMIT
+    # (the limit of a machine with 2 GiB: the same refusal on any machine)
+    monkeypatch.setattr(_output_memory, "memory_limit", lambda: OUTPUT_LIMIT)
+    sim = Simulation(_ring(300), variational=True, stm=True)
+    with pytest.raises(ValueError, match=r"`stm` = True\) to fit in memory: 1001 outputs of "
+                                         r"300 bodies would take 48\.3 GiB, beyond the limit "
+                                         r"of 1 GiB .* at most 20 outputs"):
+        sim.integrate(np.linspace(0, 10, 1001)[1:])
+    assert sim.t == 0.0 and sim.steps == 0
+    with pytest.raises(ValueError, match=r"`stm` = True\) .* 2 outputs of 3000 bodies .* "
+                                         r"not even the start and the end fit: fewer bodies"):
+        Simulation(_ring(3000), variational=True, stm=True)
+
+
+def test_outputs_beyond_the_memory_limit_are_refused_by_t(monkeypatch, tmp_path):
+    """The positions and velocities of many outputs of many bodies alike, by ``t``'s
+    name; a call within the limit runs, and resume() checks its call's outputs."""
+    from hamilton_orbits import _output_memory
+
+    monkeypatch.setattr(_output_memory, "memory_limit", lambda: 2**20)
+    sim = Simulation(_ring(3), method="leapfrog", dt=0.01)
+    with pytest.raises(ValueError, match=r"`t` to ask for outputs that fit in memory: "
+                                         r"1e\+04 outputs of 3 bodies would take 1\.68 MiB, "
+                                         r"beyond the limit of 1 MiB .* at most 5957 outputs"):
+        sim.integrate(np.linspace(0, 1, 10_000))
+    assert sim.t == 0.0 and sim.steps == 0
+    assert sim.integrate(np.linspace(0, 1, 5000)).r.shape == (5000, 3, 3)
+    Simulation(_ring(3), method="wh", dt=0.01, archive=tmp_path / "a", every=2.0).integrate(
+        np.arange(0.0, 7.0))
+    again = Simulation.load(tmp_path / "a")
+    monkeypatch.setattr(_output_memory, "memory_limit", lambda: 1000)
+    with pytest.raises(ValueError, match=r"`t` .* 7 outputs of 3 bodies would take 1\.2 KiB"):
+        again.resume()

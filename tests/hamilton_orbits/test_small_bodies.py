@@ -261,6 +261,28 @@ def test_bad_input_is_refused_naming_the_argument(kw, match):
         propagate(**args)
 
 
+def test_stm_outputs_beyond_the_memory_limit_are_refused_by_name(monkeypatch):
+    """``stm=True`` keeps a dense (6n, 6n) matrix an output (1000 bodies at 100
+    outputs: 27 GiB for the assembled matrices alone, which numpy refused, or the
+    machine ran out of memory, after the chunks had run): outputs beyond the limit
+    are refused before, by ``stm``'s name, as ``integrate`` refuses them (here 10
+    bodies against a limit of 1 MiB)."""
+    from astropy.time import Time
+
+    from hamilton_orbits import _output_memory
+    from hamilton_orbits.small_bodies import propagate
+
+    monkeypatch.setattr(_output_memory, "memory_limit", lambda: 2**20)
+    r, v = _asteroids()
+    r, v = np.repeat(r[:1], 10, axis=0), np.repeat(v[:1], 10, axis=0)
+    epoch = Time(2451545.0, format="jd", scale="tdb")
+    with pytest.raises(ValueError, match=r"`stm` = True\) to fit in memory: 100 outputs of "
+                                         r"10 bodies would take 5\.54 MiB, beyond the limit of "
+                                         r"1 MiB .* at most 18 outputs"):
+        propagate(r * u.au, v * u.au / u.day, epoch, np.linspace(1, 30, 99) * u.day,
+                  ephemeris=Segments.load(EXCERPT), asteroids=False, stm=True)
+
+
 def test_bad_states_are_refused_naming_the_argument_and_the_index():
     from astropy.time import Time
 

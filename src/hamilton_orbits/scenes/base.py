@@ -20,6 +20,7 @@ from typing import Any
 import astropy.units as u
 
 from hamilton_orbits import schema as S
+from hamilton_orbits._output_memory import OUTPUT_LIMIT, beyond_limit, format_size
 
 __all__ = ["BUILT_IN", "GROUP", "KINDS", "OUTPUT_LIMIT", "SNAPSHOT_BYTES", "SceneKind",
            "check_archive_size", "check_output_size",
@@ -101,28 +102,6 @@ def registered_kinds() -> dict[str, SceneKind]:
     return KINDS
 
 
-OUTPUT_LIMIT = 2**30
-"""The most memory (bytes) a scene's outputs may take: 1 GiB of float64 values
-kept at the output times (the states, and as much again in ``states.nc``).  A
-scene asking for more is refused at loading, not after hours of running."""
-
-
-def _size(nbytes: float) -> str:
-    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if nbytes < 1024 or unit == "PiB":
-            return f"{nbytes:.3g} {unit}"
-        nbytes /= 1024
-    return ""  # pragma: no cover
-
-
-def _beyond(nbytes: float) -> str:
-    """``"X, beyond the limit of Y"``, in bytes where the two would read the same."""
-    size, limit = _size(nbytes), _size(OUTPUT_LIMIT)
-    if size == limit:  # (just beyond it: "1 GiB, beyond the limit of 1 GiB")
-        size, limit = f"{nbytes:.0f} bytes", f"{OUTPUT_LIMIT} bytes"
-    return f"{size}, beyond the limit of {limit}"
-
-
 def _at_least(value: Any) -> str:
     """A positive Quantity rounded up to 3 significant digits, as text: an interval
     suggested as the shortest that passes passes (rounded to nearest, "1.79e+03 s"
@@ -163,14 +142,14 @@ def check_output_size(spec: Mapping[str, Any], problems: S.Problems, per_output:
     fit = math.floor(OUTPUT_LIMIT / (per_output * 8.0)) - 1.0
     if fit < 1.0:  # (two outputs, the start and the end, do not fit)
         problems.add("cadence" if cadence is not None else "duration",
-                     f"{n:.4g} outputs of {what} would take {_beyond(nbytes)} of memory, and "
-                     f"the start and the end alone {_size(2 * per_output * 8.0)}: fewer "
-                     f"bodies")
+                     f"{n:.4g} outputs of {what} would take {beyond_limit(nbytes)} of "
+                     f"memory, and the start and the end alone "
+                     f"{format_size(2 * per_output * 8.0)}: fewer bodies")
         return
     shortest = (duration / fit).to(cadence.unit if cadence is not None else duration.unit)
     problems.add(
         "cadence" if cadence is not None else "duration",
-        f"{n:.4g} outputs of {what} would take {_beyond(nbytes)} of memory: choose a "
+        f"{n:.4g} outputs of {what} would take {beyond_limit(nbytes)} of memory: choose a "
         f"cadence of at least {_at_least(shortest)} or a shorter duration")
 
 
@@ -196,12 +175,13 @@ def check_archive_size(spec: Mapping[str, Any], problems: S.Problems, bodies: in
     if fit < 1.0:  # (two snapshots, the start's and one more, do not fit)
         problems.add("output.archive_every",
                      f"{n:.4g} snapshots of {bodies} bodies would take up to "
-                     f"{_beyond(n * each)} on disk, and two snapshots alone {_size(2 * each)}: "
-                     f"no archive_every fits; leave it out")
+                     f"{beyond_limit(n * each)} on disk, and two snapshots alone "
+                     f"{format_size(2 * each)}: no archive_every fits; leave it out")
         return
     shortest = (duration / fit).to(every.unit)
     problems.add("output.archive_every",
-                 f"{n:.4g} snapshots of {bodies} bodies would take up to {_beyond(n * each)} "
+                 f"{n:.4g} snapshots of {bodies} bodies would take up to "
+                 f"{beyond_limit(n * each)} "
                  f"on disk: choose an archive_every of at least {_at_least(shortest)}")
 
 

@@ -47,6 +47,7 @@ from hamilton_orbits.effects.parameters import unit_example
 from hamilton_orbits.scenes.base import KINDS, registered_kinds
 from hamilton_orbits.scenes.result import Result
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS
+from hamilton_orbits.validation import as_flag
 
 __all__ = ["Scene", "SceneError"]
 
@@ -177,17 +178,23 @@ def _set_path(data: dict, key: str, value: Any, source: str) -> tuple[str | int,
                 names = [x.get("name") for x in node if isinstance(x, dict)]
                 if part not in names:
                     raise fail(f"no entry named {part!r} in {where}"
-                               f"{S.closest(part, [str(n) for n in names])}")
+                               f"{S.closest(part, [str(n) for n in names])}"
+                               f"{_initial_note(data, where)}")
                 part = names.index(part)
             elif not part < len(node):
                 held = (f"{len(node)} entries (indices 0 to {len(node) - 1})" if node
                         else "no entries")
                 raise fail(f"{where} has {held}; [{part}] is beyond it (an override "
-                           "changes an entry, it does not add one)")
+                           f"changes an entry, it does not add one){_initial_note(data, where)}")
         elif isinstance(node, dict):
             if isinstance(part, int):
                 raise fail(f"{where} is a table, not a list: name its key, not [{part}]")
             if not last and part not in node:
+                if not resolved and part == "bodies" and isinstance(parts[i + 1], str):
+                    # (a scene of no [[bodies]]: "bodies: expected a list, got
+                    # {'mercury': {'e': 0.5}}" for the table made here)
+                    raise fail(f"no entry named {parts[i + 1]!r} in bodies: the scene has "
+                               f"no [[bodies]]{_initial_note(data, 'bodies')}")
                 node[part] = [] if isinstance(parts[i + 1], int) else {}
         else:
             raise fail(f"{where} is a value ({node!r}), not a table: it has no key {part!r}")
@@ -196,9 +203,43 @@ def _set_path(data: dict, key: str, value: Any, source: str) -> tuple[str | int,
             node[part] = value
         else:
             node = node[part]
-
-
     return tuple(resolved)
+
+
+#: where an n-body scene's ``[initial]`` takes bodies from, and what of it an override
+#: may set (the states themselves are read, not keys)
+_INITIAL_KEYS = {
+    "solar_system": ("initial.solar_system.epoch", "initial.solar_system.bodies"),
+    "ephemeris": ("initial.ephemeris.epoch", "initial.ephemeris.bodies"),
+    "rebound": ("initial.rebound", "initial.names"),
+}
+
+
+def _initial_note(data: Mapping[str, Any], where: str) -> str:
+    """For an entry of ``bodies`` not found: where the scene's other bodies come
+    from (``[initial]``) and what of it may be set; "" for another list or a scene
+    whose ``[initial]`` gives no bodies.
+
+    Examples
+    --------
+    >>> _initial_note({"initial": {"solar_system": {"epoch": "J2000"}}}, "bodies")[:52]
+    '; the scene takes bodies from [initial] solar_system'
+    >>> _initial_note({"bodies": []}, "bodies")
+    ''
+    """
+    init = data.get("initial")
+    if where != "bodies" or not isinstance(init, Mapping):
+        return ""
+    given = [k for k in _INITIAL_KEYS if init.get(k) is not None]
+    if not given:
+        return ""
+    keys = " or ".join(key for k in given for key in _INITIAL_KEYS[k])
+    return (f"; the scene takes bodies from [initial] {' and '.join(given)}, whose "
+            f"states are read, not set by key: set {keys}, or give the body as a "
+            f"[[bodies]] entry of a scene file (a primary and its elements) and leave it "
+            f"out of [initial]")
+
+
 def _with_values(data: Mapping[str, Any], source: str, values: Mapping[str, Any],
                  overrides: Sequence[tuple]) -> tuple[dict, list[tuple]]:
     """A copy of ``data`` with ``values`` set at their key paths, and the key paths set."""
@@ -550,6 +591,7 @@ class Scene:
         from hamilton_orbits.firstrun import claim_compilation, last_claim
 
         extra = {} if archive is None else {"archive": archive}
+        progress = as_flag("progress", progress)  # (every kind's, before it builds anything)
         result = KINDS[self.kind].run(self, progress=progress, stop=stop or (lambda: False),
                                       **extra)
         result.compile_time, result.compile_count = claim_compilation()
