@@ -28,6 +28,7 @@ from hamilton_orbits._quaternion_arrays import (
 )
 from hamilton_orbits.units import ANGLE, is_quantity
 from hamilton_orbits.validation import (
+    as_flag,
     as_float_array,
     broadcast_shapes,
     check_trailing,
@@ -89,6 +90,7 @@ class RotationForms:
         >>> float(p.rotation_distance(q))
         0.0
         """
+        degrees = as_flag("degrees", degrees)  # ("False" or 0.5 read 90 as degrees)
         if degrees and is_quantity(angle):
             raise ValueError(
                 f"Expected `angle` to be a plain number with degrees=True, got the Quantity "

@@ -548,3 +548,15 @@ def test_a_quaternion_of_a_buffer_that_is_no_ndarray_keeps_its_components():
         buffer[1] = np.nan
         assert q.as_array().tolist() == [1.0, 0.0, 0.0, 0.0]
         assert r.as_array().tolist() == [1.0, 0.0, 0.0, 0.0]
+
+
+def test_degrees_is_true_or_false():
+    # any truthy value read the angle as degrees ("False" and 0.5 included)
+    for bad in ("False", 0.5, None):
+        with pytest.raises(ValueError, match=f"`degrees` to be True or False, got {bad!r}"):
+            Quaternion.from_axis_angle([0, 0, 1], 90.0, degrees=bad)
+    for flag, turn in ((np.True_, 90.0), (False, np.pi / 2)):
+        q = Quaternion.from_axis_angle([0, 0, 1], turn, degrees=flag)
+        # (a quarter turn of a unit vector: rounding of a few ulp of 1 in each part)
+        np.testing.assert_allclose(q.rotate([1.0, 0, 0]), [0.0, 1.0, 0.0], rtol=0,
+                                   atol=4 * np.finfo(float).eps)
