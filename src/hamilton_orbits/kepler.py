@@ -105,7 +105,7 @@ def _solved(ufunc: Any, name: str, x: Any, e: Any,
     out = np.asarray(ufunc(xa, ea), dtype=np.float64)
     i = _first_nan(out)
     if i is not None:
-        raise refuse(xa.ravel()[i], ea.ravel()[i], _index(out.shape, i))
+        raise refuse(float(xa.ravel()[i]), float(ea.ravel()[i]), _index(out.shape, i))
     return _out(out, quantity)
 
 
@@ -214,7 +214,8 @@ def mean_anomaly(anomaly: Any, e: Any):
         i = int(np.flatnonzero(~np.isfinite(out).ravel())[0])
         raise ValueError(
             f"Expected `anomaly` small enough for a finite mean anomaly, got "
-            f"{xa.ravel()[i]!r} with e={ea.ravel()[i]!r}{_index(out.shape, i)}"
+            f"{float(xa.ravel()[i])!r} with e={float(ea.ravel()[i])!r}"
+            f"{_index(out.shape, i)}"
         )
     return _out(out, quantity)
 
@@ -407,12 +408,12 @@ def propagate(r: Any, v: Any, mu: Any, dt: Any, *, threads: bool = True) -> tupl
         if math.log2(big_r) + 2 * math.log2(max(big_v, 1e-300)) - math.log2(mub[bad]) > 440:
             raise ValueError(
                 f"Expected `v` with |r| |v|^2 / mu (~ e) below 2^450 ~ 3e135, got "
-                f"r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, mu={mub[bad]!r}"
+                f"r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, mu={mub[bad].tolist()!r}"
                 f"{_index(lead, bad)}"
             )
         raise ConvergenceError(
             f"propagate failed for r={rb[bad].tolist()!r}, v={vb[bad].tolist()!r}, "
-            f"mu={mub[bad]!r}, dt={dtb[bad]!r}{_index(lead, bad)}"
+            f"mu={mub[bad].tolist()!r}, dt={dtb[bad].tolist()!r}{_index(lead, bad)}"
         )
     r_out = r_out.reshape((*lead, 3))
     v_out = v_out.reshape((*lead, 3))

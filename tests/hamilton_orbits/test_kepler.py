@@ -582,3 +582,17 @@ def test_check_state_copies_and_broadcasts():
 def test_check_state_names_the_first_bad_argument(r, v, mu, match):
     with pytest.raises(ValueError, match=match):
         check_state(r, v, mu)
+
+
+def test_refusals_quote_plain_numbers():
+    # numpy 2's scalar repr leaked into the messages: "got np.float64(800.0)"
+    from hamilton_orbits import kepler
+
+    for call, quoted in ((lambda: kepler.mean_anomaly(800.0, 2.0), "got 800.0 with e=2.0"),
+                         (lambda: kepler.anomaly_from_true([1.0, 3.0], 2.0),
+                          "got 3.0 with e=2.0 at index 1"),
+                         (lambda: kepler.propagate([1, 0, 0], [0, 1e200, 0], 1.0, 1.0),
+                          "mu=1.0")):
+        with pytest.raises(ValueError) as info:
+            call()
+        assert quoted in str(info.value) and "np.float64" not in str(info.value)
