@@ -117,8 +117,9 @@ class KeplerOrbit(OrbitElements):
         ``M / n`` (for the radial parabola the time since the collision);
         Hamilton's beta = r x v (twice the areal velocity, eq. 3); the modern
         eccentricity vector, towards periapsis; Hamilton's epsilon =
-        -eccentricity_vector, towards apoapsis (eq. 13).  Quantities if the orbit
-        was built from Quantities.
+        -eccentricity_vector, towards apoapsis (eq. 13).  The first two are
+        Quantities if the orbit was built from Quantities; the two eccentricity
+        vectors, dimensionless, are plain numbers then too (as ``e`` is).
 
     Notes
     -----
