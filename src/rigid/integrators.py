@@ -82,7 +82,7 @@ import numpy as np
 
 from hamilton_orbits.quaternion import Quaternion
 from hamilton_orbits.units import DIMENSIONLESS, TIME, time_quantity, wrap
-from hamilton_orbits.validation import ConvergenceError, check_positive
+from hamilton_orbits.validation import ConvergenceError, as_flag, check_positive
 from rigid._kernels import euler as _euler_k
 from rigid._shared import free_scale, pow2
 from rigid.body import call_units, check_body
@@ -348,6 +348,7 @@ def integrate(
     <Quantity 10. min>
     """
     body = check_body(body)
+    progress = as_flag("progress", progress)  # ("no" was a bar: any text is true)
     t, n_out, rtol, atol = _deprecated(t, t_end, n_out, rtol, atol, tol)
     t, dt = time_quantity(t), time_quantity(dt)  # (a TimeDelta: the Quantity in days)
     si = body.si

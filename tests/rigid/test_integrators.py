@@ -519,3 +519,9 @@ def test_a_run_whose_quaternion_norm_drifted_says_so():
         warnings.simplefilter("error")
         good = integrate(earth, t, dt=1.0 * u.day, method="splitting4")
     assert good.norm_drift < NORM_DRIFT_WARNING * 1e-9
+
+
+def test_progress_is_true_or_false():
+    # a text was a bar ("no" is true), as in hamilton_orbits' integrate
+    with pytest.raises(ValueError, match="`progress` to be True or False, got 'no'"):
+        integrate(BODY, 1.0, dt=0.1, method="splitting4", progress="no")
