@@ -60,6 +60,7 @@ SHARE_A_WORKER = {
 }
 
 
+@pytest.hookimpl(optionalhook=True)  # (xdist's hook: unknown without xdist, as -p no:xdist)
 def pytest_xdist_make_scheduler(config, log):
     """``--dist loadfile`` with the files of :data:`SHARE_A_WORKER` in one unit of work."""
     if config.getvalue("dist") != "loadfile":

@@ -71,10 +71,12 @@ def memory_limit() -> int:
     return max(OUTPUT_LIMIT, physical // 2)
 
 
-def output_bytes(n_outputs: int, n_bodies: int, stm: bool) -> tuple[float, float]:
+def output_bytes(n_outputs: int, n_bodies: int, stm: bool,
+                 copies: float = 2.0) -> tuple[float, float]:
     """The bytes of ``n_outputs`` outputs of ``n_bodies`` bodies: the positions and
     velocities (and MEGNO's three columns), and the STM's (``6n x 6n`` a row,
-    counted twice: the integrator's rows and the trajectory's copy; 0 without it).
+    counted ``copies`` times: twice for a Simulation, the integrator's rows and the
+    trajectory's copy; 0 without it).
 
     Examples
     --------
@@ -82,13 +84,20 @@ def output_bytes(n_outputs: int, n_bodies: int, stm: bool) -> tuple[float, float
     48.3
     """
     states = n_outputs * (6.0 * n_bodies + 4.0) * 8.0
-    matrices = 2.0 * n_outputs * (6.0 * n_bodies) ** 2 * 8.0 if stm else 0.0
+    matrices = copies * n_outputs * (6.0 * n_bodies) ** 2 * 8.0 if stm else 0.0
     return states, matrices
 
 
-def check_output_memory(n_outputs: int, n_bodies: int, stm: bool) -> None:
+def _times(copies: float) -> str:
+    """``copies`` as words: "once", "twice", "1.3 times"."""
+    return {1.0: "once", 2.0: "twice"}.get(copies, f"{copies:.3g} times")
+
+
+def check_output_memory(n_outputs: int, n_bodies: int, stm: bool,
+                        copies: float = 2.0) -> None:
     """Refuse, before a run, outputs beyond :func:`memory_limit`: naming ``stm``
-    when the STM takes them beyond it, ``t`` (the output times) otherwise.
+    when the STM takes them beyond it, ``t`` (the output times) otherwise (the STM
+    counted ``copies`` times, as :func:`output_bytes`).
 
     Raises
     ------
@@ -103,7 +112,7 @@ def check_output_memory(n_outputs: int, n_bodies: int, stm: bool) -> None:
     ...
     ValueError: Expected `t` to ask for outputs that fit in memory: 1e+09 outputs of 300 ...
     """
-    states, matrices = output_bytes(n_outputs, n_bodies, stm)
+    states, matrices = output_bytes(n_outputs, n_bodies, stm, copies)
     limit = memory_limit()
     if states + matrices <= limit:
         return
@@ -115,7 +124,8 @@ def check_output_memory(n_outputs: int, n_bodies: int, stm: bool) -> None:
     if stm and states <= limit:  # (the STM's rows take the outputs beyond it)
         raise ValueError(
             f"Expected the STM's outputs (`stm` = True) to fit in memory: {size} with "
-            f"the STM ({6 * n_bodies} x {6 * n_bodies} an output, kept twice){advice} "
+            f"the STM ({6 * n_bodies} x {6 * n_bodies} an output, kept {_times(copies)})"
+            f"{advice} "
             f"fewer bodies, or stm=False (MEGNO and the Lyapunov exponent need no STM)")
     raise ValueError(f"Expected `t` to ask for outputs that fit in memory: {size} for the "
                      f"positions and velocities{' and the STM' if stm else ''}{advice} "

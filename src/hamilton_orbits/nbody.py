@@ -448,7 +448,9 @@ class System(InitialStates):
         ValueError
             For a non-finite or ill-shaped ``r``, ``v`` or ``gm``, a negative
             ``gm``, no massive body left, or two bodies (one of them massive) at
-            one position.
+            one position; as :meth:`from_arrays`, for a list holding Quantities
+            (``u.Quantity(...)`` joins it), bools, text, masked values, and a
+            radius that is not NaN (none) or > 0.
 
         Examples
         --------
@@ -503,7 +505,7 @@ class System(InitialStates):
         return np.array(value, dtype=np.float64)
 
     def _check_new(self, radius: np.ndarray, keep: Any) -> None:
-        """:meth:`with_state`'s ``radius`` (n,), each NaN (none) or finite and >= 0,
+        """:meth:`with_state`'s ``radius`` (n,), each NaN (none) or finite and > 0,
         and ``keep``, None or n booleans."""
         from hamilton_orbits.validation import check_positive
 

@@ -26,6 +26,7 @@ from hamilton_orbits.effects import (
 from hamilton_orbits.integrals import integral_errors
 from hamilton_orbits.nbody import System
 from hamilton_orbits.units import time_quantity
+from hamilton_orbits.validation import as_flag
 
 __all__ = [
     "CrossCheck",
@@ -326,6 +327,7 @@ def crosscheck(
     from hamilton_orbits.simulation import integrate
 
     t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
+    progress = as_flag("progress", progress)  # (refused with a trajectory given too)
     effects = EffectSet.of(effects, "nbody")
     reboundx_counterparts(system, effects)  # (refused before our run, not after it)
     if trajectory is None:

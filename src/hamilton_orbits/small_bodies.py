@@ -59,6 +59,15 @@ MARGIN_DAYS = 32.0
 EPOCH_MATCH = 1e-6 / 86400.0
 
 
+def _stm_copies(n: int, chunk: int, workers: int | None) -> float:
+    """The STMs' memory at once, in dense ``(6n)^2`` matrices an output: the dense
+    one the chunks fill, and the chunks' own being run (``(6c + 6)^2`` each, ``c``
+    bodies a chunk and the epoch's column: one a thread of ``workers``)."""
+    c = max(1, min(int(chunk), n))
+    threads = workers if type(workers) is int and workers > 1 else 1  # (checked later)
+    return 1.0 + min(threads, -(-n // c)) * ((6.0 * c + 6.0) / (6.0 * n)) ** 2
+
+
 def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | None = None,
               ephemeris: str | Segments = "de440", asteroids: bool = True,
               effects: Sequence[str] = ("eih", "sun_j2", "earth_zonal"),
@@ -190,7 +199,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
                          f"{len(per_body)}")
     jd1, jd2 = _epoch(epoch)
     days = _output_days(t, jd1, jd2)
-    check_output_memory(len(days), len(r), stm)  # (the STM is dense: (6n)^2 an output)
+    check_output_memory(len(days), len(r), stm, _stm_copies(len(r), chunk, workers))
     perturbers = PERTURBERS + (de.ASTEROIDS if asteroids else ())
     pairs = encounters(events, names, perturbers)
     if pairs and (stm or variational):

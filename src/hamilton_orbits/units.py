@@ -262,8 +262,8 @@ def time_quantity(value: Any) -> Any:
         a = np.asarray(to64() if to64 is not None else np.timedelta64(value))
     else:
         dtype = getattr(value, "dtype", None)  # (numpy's scalar, pandas' Series, Index)
-        if not (isinstance(dtype, np.dtype) and dtype.kind == "m"):
-            return value
+        if not (isinstance(dtype, np.dtype) and dtype.kind == "m") or np.ma.is_masked(value):
+            return value  # (masked: refused by the argument's check, not read unmasked)
         a = np.asarray(value)
     out = numpy_duration(a)
     return value if out is a else out  # (as given where it is refused: named so)

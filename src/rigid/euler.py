@@ -352,8 +352,10 @@ def torque_on(torque: Any, moments: Any, attitude: Any, t: Any = None) -> np.nda
     Raises
     ------
     ValueError
-        For NaN, wrong shapes, a zero attitude or a non-positive moment; for a
-        torque of plain non-zero numbers beside ``moments`` of Quantities
+        For NaN, wrong shapes, a zero attitude, a non-positive moment or moments of
+        no body (one greater than the sum of the other two, A + B >= C, as
+        :class:`~rigid.RigidBody` refuses them); for a torque of plain non-zero
+        numbers beside ``moments`` of Quantities
         (``torque_on(SpaceTorque([1.0, 0, 0]), [1, 2, 3] * u.kg * u.m**2, q)``),
         naming the torque's argument, the index and the value.
 
@@ -413,8 +415,10 @@ def euler_equations(moments: Any, omega: Any, torque: Any = None) -> np.ndarray:
     Raises
     ------
     ValueError
-        For NaN / inf, wrong shapes, non-positive moments or shapes that do not
-        broadcast (naming the argument and index).
+        For NaN / inf, wrong shapes (a number for ``torque``: a torque is a
+        3-vector), non-positive moments, moments of no body (A + B >= C, as
+        :class:`~rigid.RigidBody`), or shapes that do not broadcast (naming the
+        argument and index).
 
     Examples
     --------

@@ -889,3 +889,12 @@ def test_outputs_beyond_the_memory_limit_are_refused_by_t(monkeypatch, tmp_path)
     monkeypatch.setattr(_output_memory, "memory_limit", lambda: 1000)
     with pytest.raises(ValueError, match=r"`t` .* 7 outputs of 3 bodies would take 1\.2 KiB"):
         again.resume()
+
+
+def test_crosscheck_refuses_a_progress_that_is_no_bool_with_a_trajectory_given():
+    # with a trajectory given, progress went unused and unchecked ("no" taken)
+    system = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    traj = integrate(system, 0.5, method="dop853")
+    with pytest.raises(ValueError, match="`progress` to be True or False, got 'no'"):
+        crosscheck(system, 0.5, method="dop853", trajectory=traj, progress="no")

@@ -276,9 +276,21 @@ def test_stm_outputs_beyond_the_memory_limit_are_refused_by_name(monkeypatch):
     r, v = _asteroids()
     r, v = np.repeat(r[:1], 10, axis=0), np.repeat(v[:1], 10, axis=0)
     epoch = Time(2451545.0, format="jd", scale="tdb")
+    # (the dense matrix, 60 x 60 an output, and the one chunk's own, 66 x 66 with the
+    # epoch's column: 2.21 dense matrices)
     with pytest.raises(ValueError, match=r"`stm` = True\) to fit in memory: 100 outputs of "
-                                         r"10 bodies would take 5\.54 MiB, beyond the limit of "
-                                         r"1 MiB .* at most 18 outputs"):
+                                         r"10 bodies would take 6\.12 MiB, beyond the limit of "
+                                         r"1 MiB .* kept 2\.21 times\): ask for at most 16 "
+                                         r"outputs"):
+        propagate(r * u.au, v * u.au / u.day, epoch, np.linspace(1, 30, 99) * u.day,
+                  ephemeris=Segments.load(EXCERPT), asteroids=False, stm=True)
+    # 1000 bodies in chunks of 100: the dense matrices and one chunk's at a time, 1.01
+    # of them (27.1 GiB at 100 outputs; it was counted twice, 53.6 GiB, and refused
+    # where it fitted)
+    monkeypatch.setattr(_output_memory, "memory_limit", lambda: 20 * 2**30)
+    r, v = np.repeat(r[:1], 1000, axis=0), np.repeat(v[:1], 1000, axis=0)
+    with pytest.raises(ValueError, match=r"100 outputs of 1000 bodies would take 27\.1 GiB, "
+                                         r"beyond the limit of 20 GiB .* kept 1\.01 times"):
         propagate(r * u.au, v * u.au / u.day, epoch, np.linspace(1, 30, 99) * u.day,
                   ephemeris=Segments.load(EXCERPT), asteroids=False, stm=True)
 

@@ -231,3 +231,14 @@ def test_a_numpy_date_duration_or_record_that_is_no_number_is_refused_by_name():
     # a duration where a number of no time is due
     with pytest.raises(ValueError, match="`e` to be dimensionless, got 1 s"):
         kepler.solve_kepler(1.0, np.timedelta64(1, "s"))
+
+
+def test_a_masked_numpy_duration_is_refused_as_masked():
+    # np.asarray dropped the mask: the masked value was read as data
+    from hamilton_orbits.units import TIME
+
+    masked = np.ma.array(np.array([1, 2], "m8[s]"), mask=[False, True])
+    with pytest.raises(ValueError, match="`t` to be numbers, got a masked value at index 1"):
+        TIME("t", masked, "s")
+    unmasked = np.ma.array(np.array([1, 2], "m8[m]"))  # (nothing masked: read)
+    np.testing.assert_array_equal(TIME("t", unmasked, "s"), [60.0, 120.0])

@@ -174,7 +174,11 @@ def simulate_wobble(
                              f"daily), got {dt!r}")
         # a whole number of steps per day so that the output falls on whole days
         per_day = int(np.ceil(86400.0 / float(step)))
-        tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
+        with warnings.catch_warnings():  # (the pole's own error is said below: the
+            # attitude's, |q|'s drift, would say the same twice, from in here)
+            warnings.filterwarnings("ignore", "integrate: the attitude quaternion's norm",
+                                    RuntimeWarning)
+            tr = integrate(body, t, dt=86400.0 / per_day * u.s, method=method)
         t, omega = tr.t, tr.omega
     # (the body frame's x is the A axis, 14.93 deg west: turned to Greenwich's, so that
     # x and y are the IERS x_p and y_p; a pole along A read 200 mas in x_p, 0 in y_p,
