@@ -43,8 +43,14 @@ _P, _E, _INV_A, _INC, _LAN, _ARGP, _NU, _A = (
 )
 
 
-def _scalar(a: np.ndarray):
-    return a[()] if isinstance(a, np.ndarray) and a.ndim == 0 else a
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (no copy): the orbit's columns and state are
+    returned as such, so that a caller's in-place arithmetic on an attribute
+    cannot change the orbit (as :class:`~hamilton_orbits.quaternion.Quaternion`
+    returns its components)."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _in_range(prop):
@@ -90,7 +96,7 @@ def _element(name: str, unit: str | None, doc: str) -> property:
             c = orbit._elements()
         if is_a and orbit._a_beyond:
             orbit._refuse_not_finite("a", c[i] == c[i])
-        return orbit._out(c[i], unit) if orbit._quantity else c[i]
+        return orbit._out(c[i], unit)
 
     read.__name__ = name
     return property(read, doc=doc)
@@ -147,14 +153,19 @@ class OrbitElements:
         return self._full[_COL[name]]
 
     def _out(self, value: np.ndarray, unit: str | None):
-        """A float result as returned: a float64 for one orbit, an array for
-        many, a Quantity in ``unit`` (if not None) for an orbit of Quantities."""
-        if not self._quantity:
-            return value[()] if type(value) is np.ndarray and value.ndim == 0 else value
-        if unit is not None:
-            # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
-            return wrap(np.array(value, dtype=np.float64), unit, True)
-        return _scalar(np.asarray(value))
+        """A float result as returned: a float64 for one orbit, a read-only array
+        for many (a view of the orbit's columns or state, never writable), a
+        read-only Quantity in ``unit`` (if not None) for an orbit of Quantities."""
+        value = np.asarray(value)
+        if value.ndim == 0:
+            if not self._quantity or unit is None:
+                return value[()]
+        elif not self._quantity or unit is None:
+            return _read_only(value)
+        # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
+        out = wrap(np.array(value, dtype=np.float64), unit, True)
+        out.flags.writeable = False
+        return out
 
     def _refuse_not_finite(self, name: str, finite: np.ndarray) -> None:
         """Raise, if ``finite`` is not all true, naming ``r``, ``v``, ``mu`` of

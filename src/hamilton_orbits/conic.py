@@ -225,6 +225,16 @@ def _plain_floats(names: tuple[str, ...], values: Any, units: str) -> list[np.nd
     return arrays
 
 
+def _frozen(x: np.ndarray) -> np.ndarray:
+    """A read-only float64 copy of ``x``: a conic keeps its own attributes, so that
+    neither the caller's arrays (``p`` given to :meth:`Conic.from_elements`, an
+    orbit's columns) nor in-place arithmetic on an attribute read back (``c.e``,
+    ``c.p``) can change it."""
+    out = np.array(x, dtype=np.float64)
+    out.flags.writeable = False
+    return out
+
+
 def _refuse_beyond(x: np.ndarray, message: Any) -> None:
     """A ValueError of ``message(index, " at index ...")`` at the first element of
     ``x`` beyond :data:`_AXES` in magnitude (no index where ``x`` holds one value)."""
@@ -256,6 +266,9 @@ class Conic:
     mu : ndarray, shape (...)
         Gravitational parameter (for the hodograph).
 
+    The conic keeps read-only copies of what it is given (an array written
+    afterwards by the caller does not change it).
+
     Examples
     --------
     >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
@@ -275,6 +288,8 @@ class Conic:
 
     def _set(self, p: np.ndarray, e: np.ndarray, inv_a: np.ndarray, periapsis: np.ndarray,
              normal: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
+        p, e, inv_a, mu, periapsis, normal = (
+            _frozen(x) for x in (p, e, inv_a, mu, periapsis, normal))
         self._p, self.e, self._inv_a, self._mu = p, e, inv_a, mu
         self.periapsis_direction, self.normal = periapsis, normal
         self._quantity = quantity

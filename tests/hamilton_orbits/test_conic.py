@@ -589,3 +589,15 @@ def test_from_elements_broadcasts_the_angles():
     one = Conic.from_elements(1.44, 0.44, 0.56, 0.3, 0.1, 0.4, 1.0)
     np.testing.assert_array_equal(c.periapsis_direction[1, 1], one.periapsis_direction)
     np.testing.assert_array_equal(c.normal[1, 1], one.normal)
+
+
+def test_from_elements_keeps_its_own_arrays():
+    # the conic copies what it is given: the caller's later writes do not reach it
+    p, e, mu = np.array([1.44, 1.44]), np.array([0.44, 0.44]), np.array([1.0, 1.0])
+    c = Conic.from_elements(p, e, 0.56, 0.0, 0.0, 0.0, mu)
+    p[0], e[0], mu[0] = 99.0, 0.9, 100.0
+    np.testing.assert_array_equal(c.p, [1.44, 1.44])
+    np.testing.assert_array_equal(c.e, [0.44, 0.44])
+    np.testing.assert_array_equal(c.mu, [1.0, 1.0])
+    with pytest.raises(ValueError, match="read-only"):
+        c.e[0] = 0.9

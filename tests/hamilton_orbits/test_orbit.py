@@ -519,3 +519,36 @@ def test_propagate_broadcasts_dt_over_the_orbits():
             ri, vi = o[j].propagate(float(dt[i, 0])).state()
             np.testing.assert_array_equal(r[i, j], ri)
             np.testing.assert_array_equal(v[i, j], vi)
+
+
+def test_batch_attributes_are_read_only():
+    # an orbit's elements, mu and derived columns are returned read-only (views of its
+    # columns or state): the caller's in-place arithmetic raises, the orbit stays whole
+    o = KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.2, 0], 1.0)
+    e, q, mu = o.e.copy(), o.q.copy(), o.mu.copy()
+    for name in ("e", "p", "a", "inc", "nu", "mu", "M", "q", "anomaly", "mean_longitude",
+                 "time_since_periapsis", "n", "period", "energy"):
+        x = getattr(o, name)
+        with pytest.raises(ValueError, match="read-only"):
+            x *= 2
+    np.testing.assert_array_equal(o.e, e)
+    np.testing.assert_array_equal(o.q, q)
+    np.testing.assert_array_equal(o.mu, mu)
+    c = o.conic
+    for x in (c.e, c.p, c.inv_a, c.mu, c.periapsis_direction, c.normal):
+        with pytest.raises(ValueError, match="read-only"):
+            x[0] = 0.9
+    np.testing.assert_array_equal(o.e, e)
+
+
+def test_quantity_attributes_are_read_only_and_scalars_numbers():
+    o = KeplerOrbit.from_state([[7000.0, 0, 0], [8000.0, 0, 0]] * u.km, [0, 7.5, 0] * u.km / u.s,
+                               398600.0 * u.km**3 / u.s**2)
+    a = o.a.copy()
+    for x in (o.a, o.mu, o.M):
+        with pytest.raises(ValueError, match="read-only"):
+            x[0] = 1.0 * x.unit
+    np.testing.assert_array_equal(o.a, a)
+    one = KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    assert isinstance(one.e, float) and isinstance(one.mu, float)
+    assert one.e * 2 == 2 * float(one.e) and one.mu + 1 == 2.0
