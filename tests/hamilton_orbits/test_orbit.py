@@ -552,3 +552,31 @@ def test_quantity_attributes_are_read_only_and_scalars_numbers():
     one = KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
     assert isinstance(one.e, float) and isinstance(one.mu, float)
     assert one.e * 2 == 2 * float(one.e) and one.mu + 1 == 2.0
+
+
+def _p_mpmath(r, v, mu):
+    # |r x v|^2 / mu in 50 digits (the float inputs taken exactly)
+    mpmath.mp.dps = 50
+    r, v = [mpmath.mpf(x) for x in r], [mpmath.mpf(x) for x in v]
+    h = (r[1] * v[2] - r[2] * v[1], r[2] * v[0] - r[0] * v[2], r[0] * v[1] - r[1] * v[0])
+    return float(sum(x * x for x in h) / mpmath.mpf(mu))
+
+
+@pytest.mark.parametrize("sr, sv, mu", [(1e-170, 1.0, 1e-170), (1e150, 1e10, 1e170),
+                                        (1.0, 1.0, 1.0), (1e-100, 1e-100, 1e-250)])
+def test_hamilton_p_beyond_the_square_range(sr, sv, mu):
+    # beta^2 was formed unscaled: -0.0 for a true p of 1.48e-170, a refusal for 1.48e150
+    r = np.array([1.0, 0.2, 0.1]) * sr
+    v = np.array([0.1, 1.2, 0.3]) * sv
+    want = _p_mpmath(r, v, mu)
+    p = float(hamilton_p(r, v, mu))
+    # a cross product, a sum of three squares and a division: 8 eps is ample
+    assert abs(p - want) <= 8 * EPS * want
+    assert abs(float(KeplerOrbit.from_state(r, v, mu).p) - want) <= 8 * EPS * want
+
+
+def test_hamilton_p_radial_is_plus_zero():
+    p = hamilton_p([1.0, 0, 0], [2.0, 0, 0], 1.0)
+    assert p == 0.0 and math.copysign(1.0, float(p)) == 1.0
+    with pytest.raises(ValueError, match="fits in float64"):
+        hamilton_p([1.0, 0, 0], [0, 1.0, 0], 1e-320)  # p = 1e320 does not fit
