@@ -228,7 +228,7 @@ class OrbitElements:
         q = np.where(p > 0, p / (1.0 + self._col("e")), 1.0)
         n = np.where(
             kind == _el.PARABOLA,
-            np.sqrt(self._mu / (2.0 * q**3)),
+            _parabola_mean_motion(q, self._mu),
             np.sqrt(self._mu) * inv * np.sqrt(inv),
         )
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
@@ -337,6 +337,24 @@ class OrbitElements:
         return Conic.from_elements(
             c[_P], c[_E], c[_INV_A], c[_INC], c[_LAN], c[_ARGP], self._mu, quantity=self._quantity
         )
+
+
+def _even_frexp(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(m, k)`` with ``x = m 2**k`` exactly, ``k`` even and ``m`` in [1/2, 2)."""
+    m, k = np.frexp(x)
+    odd = (k % 2) != 0
+    return np.where(odd, 2.0 * m, m), np.where(odd, k - 1, k)
+
+
+def _parabola_mean_motion(q: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """The parabola's ``n = sqrt(mu / (2 q^3))`` with ``q`` and ``mu`` scaled by even
+    powers of two (exact) and the result scaled back once: ``q**3`` over- and
+    underflowed from ``q`` ~ 6e102 (n was 0) and below ~1e-103 (n was refused),
+    while ``n`` fits.  The roundings are those of the formula (the scalings are
+    exact): within 1 ulp of mpmath's n, as before, in the float range."""
+    qm, kq = _even_frexp(q)
+    mm, km = _even_frexp(mu)
+    return np.ldexp(np.sqrt(mm / (2.0 * qm**3)), (km - 3 * kq) // 2)
 
 
 def _wrap2pi(x: np.ndarray) -> np.ndarray:

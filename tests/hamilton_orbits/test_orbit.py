@@ -580,3 +580,14 @@ def test_hamilton_p_radial_is_plus_zero():
     assert p == 0.0 and math.copysign(1.0, float(p)) == 1.0
     with pytest.raises(ValueError, match="fits in float64"):
         hamilton_p([1.0, 0, 0], [0, 1.0, 0], 1e-320)  # p = 1e320 does not fit
+
+
+@pytest.mark.parametrize("q", [1e-120, 1e-110, 1e-103, 1e103, 1e120, 1.0, 3.7e-5])
+def test_parabola_mean_motion_beyond_q_cubed(q):
+    # n = sqrt(mu / (2 q^3)) through q**3: refused for q <= ~1e-103, 0.0 for q >= ~6e102
+    o = KeplerOrbit.from_elements(q=q, e=1.0, inc=0, lan=0, argp=0, nu=1.0, mu=1.0)
+    mpmath.mp.dps = 40
+    want = float(mpmath.sqrt(1 / (2 * mpmath.mpf(q) ** 3)))
+    # the formula's roundings (a cube, a division, a square root; the scalings by
+    # powers of two exact): 1 ulp over 20000 random q, mu in the float range, 2 allowed
+    assert abs(float(o.n) - want) <= 2 * np.spacing(want)
