@@ -454,40 +454,81 @@ class Conic:
     # ---------------------------------------------------------------- shape
     @property
     def a(self) -> np.ndarray:
-        """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola."""
+        """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola.
+
+        Raises
+        ------
+        ValueError
+            Where ``1/inv_a`` is beyond float64 (``inv_a`` subnormal), naming
+            ``inv_a``, the first such index and its value.
+        """
         safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
-        return self._out(np.where(self._inv_a == 0, np.inf, 1.0 / safe), _L)
+        with np.errstate(all="ignore"):
+            a = 1.0 / safe
+        self._refuse_beyond_float("a", a)
+        return self._out(np.where(self._inv_a == 0, np.inf, a), _L)
 
     @property
     def b(self) -> np.ndarray:
         """Semi-minor axis ``a sqrt(1 - e^2) = sqrt(a p)`` (eq. 43) for the ellipse;
         for the hyperbola the length ``|a| sqrt(e^2 - 1)`` of the imaginary
         (conjugate) semi-axis, Hamilton's "vector with a positive square" (eq. 42);
-        inf for the parabola."""
+        inf for the parabola.  ``sqrt(p / |inv_a|)``, or ``sqrt(p) / sqrt(|inv_a|)``
+        where ``p / |inv_a|`` alone is beyond float64 (``b`` fits where ``a`` may not).
+
+        Raises
+        ------
+        ValueError
+            Where ``b`` itself is beyond float64, naming ``inv_a``, the index and value.
+        """
         ia = np.abs(np.where(self._inv_a == 0, 1.0, self._inv_a))
-        return self._out(np.where(self._inv_a == 0, np.inf, np.sqrt(self._p / ia)), _L)
+        with np.errstate(all="ignore"):
+            direct = np.sqrt(self._p / ia)
+            b = np.where(np.isfinite(direct), direct, np.sqrt(self._p) / np.sqrt(ia))
+        self._refuse_beyond_float("b", b)
+        return self._out(np.where(self._inv_a == 0, np.inf, b), _L)
+
+    def _refuse_beyond_float(self, name: str, x: np.ndarray) -> None:
+        """Refuse ``x`` (attribute ``name``, of the conic's shape or (..., 3)) where it is
+        not finite outside the parabola: ValueError naming ``inv_a``, index and value."""
+        ia = self._inv_a
+        bad = ~np.isfinite(x)
+        if x.ndim > np.ndim(ia):
+            bad = np.any(bad, axis=-1)
+        bad &= ia != 0
+        if np.any(bad):
+            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            value = float(np.broadcast_to(ia, bad.shape)[i])
+            raise ValueError(
+                f"Expected a conic for which `{name}` fits in float64, got inv_a={value!r}"
+                f"{fmt_index(i if bad.size > 1 else ())}"
+            )
 
     @property
     def hamilton_epsilon(self) -> np.ndarray:
         """Hamilton's epsilon = -e * periapsis direction (eq. 13), towards apoapsis."""
         return -self.e[..., None] * self.periapsis_direction
 
-    def _finite_a(self, what: str) -> np.ndarray:
+    def _times_a(self, what: str, x: np.ndarray) -> np.ndarray:
+        """``a x`` (``x`` of shape (..., 3)), as ``x / inv_a``; refused for the parabola
+        and where a component is beyond float64 (``inv_a`` subnormal)."""
         if np.any(self._inv_a == 0):
             raise ValueError(f"Expected a conic with a centre for `{what}`, got a parabola "
                              "(e = 1: the centre and second focus are at infinity)")
-        return 1.0 / self._inv_a
+        with np.errstate(all="ignore"):
+            out = x / self._inv_a[..., None]
+        self._refuse_beyond_float(what, out)
+        return out
 
     @property
     def centre(self) -> np.ndarray:
         """Vector of the centre from the focus, ``a epsilon`` (eq. 36)."""
-        return self._out(self._finite_a("centre")[..., None] * self.hamilton_epsilon, _L)
+        return self._out(self._times_a("centre", self.hamilton_epsilon), _L)
 
     @property
     def second_focus(self) -> np.ndarray:
         """Vector of the second focus, ``2 a epsilon`` (eq. 31)."""
-        focus = 2.0 * self._finite_a("second_focus")[..., None] * self.hamilton_epsilon
-        return self._out(focus, _L)
+        return self._out(self._times_a("second_focus", 2.0 * self.hamilton_epsilon), _L)
 
     @property
     def directrix_distance(self) -> np.ndarray:

@@ -359,9 +359,10 @@ class KeplerOrbit(OrbitElements):
             return f"KeplerOrbit(shape={self.shape})"
         col = self._col
         inv = col("inv_a")
-        a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
+        with np.errstate(over="ignore"):  # (an a beyond float64: q is shown instead)
+            a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
         q = col("p") / (1.0 + col("e"))
-        length = "q" if np.all(inv == 0) else "a"
+        length = "q" if np.all(inv == 0) or not np.all(np.isfinite(a) | (inv == 0)) else "a"
         cols = [(length, q if length == "q" else a, str(_L)), ("e", col("e"), "")]
         scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
         for name in ("inc", "lan", "argp", "nu"):
