@@ -88,19 +88,38 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray, given: Any = None
     """``(p, 1/a, radial)`` from ``a``, ``p`` or ``q`` (``lname``) and ``e``;
     ``radial`` where ``e == 1`` with ``a`` given (the rectilinear orbit of that
     energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0 (``given``:
-    the length as written, for the message)."""
+    the length as written, for the message), and ``p`` or ``1/a`` beyond float64
+    (:func:`_refuse_beyond`)."""
     if lname != "a":
         raise_at(lname, ~(length > 0), length, "> 0", given)
-        p = length if lname == "p" else length * (1.0 + e)
-        return p, (1.0 - e) * (1.0 + e) / p, np.zeros(e.shape, dtype=bool)
+        with np.errstate(over="ignore", invalid="ignore"):
+            p = length if lname == "p" else length * (1.0 + e)
+            inv_a = (1.0 - e) * (1.0 + e) / p
+        _refuse_beyond(lname, length, e, p, inv_a, given)
+        return p, inv_a, np.zeros(e.shape, dtype=bool)
     raise_at("a", length == 0, length, "nonzero", given)
     raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)", given)
     raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)", given)
     radial = e == 1.0
-    with np.errstate(over="ignore"):  # (a p beyond float64: refused by the caller's check)
+    with np.errstate(over="ignore", invalid="ignore"):
         p = length * (1.0 - e) * (1.0 + e)
         inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
+    _refuse_beyond("a", length, e, p, inv_a, given)
     return p, inv_a, radial
+
+
+def _refuse_beyond(lname: str, length: np.ndarray, e: np.ndarray, p: np.ndarray,
+                   inv_a: np.ndarray, given: Any) -> None:
+    """Refuse ``p`` or ``1/a`` beyond float64 (computed with overflow ignored), naming
+    ``e`` where ``1 - e^2`` alone is (e ~ 1e200: the length was named, after a
+    RuntimeWarning), else the length ``lname`` (as the caller refuses a state
+    beyond float64)."""
+    bad = ~(np.isfinite(p) & np.isfinite(inv_a))
+    if np.any(bad):
+        with np.errstate(over="ignore"):
+            e_bad = bad & ~np.isfinite((1.0 - e) * (1.0 + e))
+        raise_at("e", e_bad, e, "for which 1 - e^2 fits in float64")
+        raise_at(lname, bad, length, "to give a finite state (check the elements)", given)
 
 
 def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,

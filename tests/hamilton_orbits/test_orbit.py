@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import astropy.units as u
 import mpmath
@@ -591,3 +592,18 @@ def test_parabola_mean_motion_beyond_q_cubed(q):
     # the formula's roundings (a cube, a division, a square root; the scalings by
     # powers of two exact): 1 ulp over 20000 random q, mu in the float range, 2 allowed
     assert abs(float(o.n) - want) <= 2 * np.spacing(want)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"p": 1.0, "e": 1e200}, r"Expected `e` for which 1 - e\^2 fits in float64, got 1e\+200$"),
+    ({"q": 1.0, "e": [0.5, 1e200]}, r"`e` for which 1 - e\^2 fits .*got 1e\+200 at index 1$"),
+    ({"a": -1.0, "e": 1e200}, r"`e` for which 1 - e\^2 fits in float64, got 1e\+200$"),
+    ({"p": 1e-320, "e": 0.5}, r"`p` to give a finite state .*got 1e-320$"),
+    ({"q": 1e300, "e": 1e10}, r"`q` to give a finite state .*got 1e\+300$"),
+])
+def test_from_elements_beyond_float64_names_the_culprit_without_warning(kwargs, match):
+    # e = 1e200 overflowed 1 - e^2 with a RuntimeWarning, then `p` was named
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=match):
+            KeplerOrbit.from_elements(**kwargs, inc=0, lan=0, argp=0, nu=0, mu=1.0)
