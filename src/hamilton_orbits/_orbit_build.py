@@ -25,7 +25,12 @@ from hamilton_orbits.validation import (
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
 _kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
 
-__all__ = ["anomaly_of", "element_inputs", "p_and_inv_a", "raise_at", "state_of"]
+__all__ = ["anomaly_of", "clamp_inc", "element_inputs", "p_and_inv_a", "raise_at",
+           "state_of"]
+
+# two ulp above the float pi: an inclination of 180 degrees in another unit converts to
+# up to this (648 000 000 mas is one ulp above pi in astropy's conversion)
+_PI_PLUS_2ULP = float(np.nextafter(np.nextafter(np.pi, 4.0), 4.0))
 
 # internal units when Quantities come in
 _L, _MU = STATE_UNITS[0], STATE_UNITS[2]
@@ -46,6 +51,15 @@ def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str,
             number = np.broadcast_to(np.atleast_1d(given.value), mask.shape)[index]
             value = f"{float(number)!r} {given.unit.to_string()}".rstrip()  # (dimensionless)
         raise ValueError(f"Expected `{name}` {what}, got {value}{fmt_index(shown)}")
+
+
+def clamp_inc(inc: np.ndarray) -> np.ndarray:
+    """``inc`` with an excess of at most two ulp over the float pi taken as pi: the
+    conversion of exactly 180 degrees from another unit rounds there (648 000 000 mas
+    gives one ulp above pi), an inclination no element set can mean otherwise; the
+    rest, beyond, is refused by the caller."""
+    inc = np.asarray(inc, dtype=np.float64)
+    return np.where((inc > np.pi) & (inc <= _PI_PLUS_2ULP), np.pi, inc)
 
 
 def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
@@ -80,6 +94,7 @@ def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
     e_, inc_, lan_, argp_, mu_, length, angle = values
     raise_at("e", ~(e_ >= 0), e_, ">= 0", e)
     raise_at("mu", ~(mu_ > 0), mu_, "> 0", mu)
+    inc_ = clamp_inc(inc_)
     raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi] rad", inc)
     return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
 

@@ -34,7 +34,7 @@ import numpy as np
 
 from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._orbit_build import raise_at
+from hamilton_orbits._orbit_build import clamp_inc, raise_at
 from hamilton_orbits.twobody import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import (
     ANGLE,
@@ -143,6 +143,7 @@ def _checked_elements(*values: Any) -> tuple[list[np.ndarray], bool]:
     the conic's units (km, 1/km, km^3/s^2, rad; :func:`_element_floats`).  ValueError
     naming the argument, the first bad index and the value."""
     arrays, quantity, given = _element_floats(values)
+    arrays[3] = clamp_inc(arrays[3])  # (180 degrees in mas: an ulp above pi)
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
     gp, ge, gi, ginc, _, _, gmu = given
     _check_shape(p, e, inv_a, (gp, ge, gi))
@@ -368,9 +369,10 @@ class Conic:
             (64 eps ``max(1, e)^2``).
         inc, lan, argp : array_like or Quantity (angle), shape (...)
             Inclination in [0, pi] (``inc == pi``, the float, is exactly
-            retrograde), longitude of the ascending node, argument of
-            periapsis, finite; a plain number is in radians (beside Quantity
-            lengths too), a Quantity of any angular unit (``30 * u.deg``).
+            retrograde; up to two ulp above it is pi: 180 degrees in mas),
+            longitude of the ascending node, argument of periapsis, finite; a
+            plain number is in radians (beside Quantity lengths too), a Quantity
+            of any angular unit (``30 * u.deg``).
         mu : array_like or Quantity, shape (...)
             Gravitational parameter, finite and > 0.
         quantity : bool, optional

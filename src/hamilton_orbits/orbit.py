@@ -266,7 +266,9 @@ class KeplerOrbit(OrbitElements):
         e : array_like, shape (...)
             Eccentricity, ``e >= 0``; ``e == 1`` exactly is the parabola.
         inc : array_like or Quantity (angle), shape (...)
-            Inclination in [0, pi] (``inc == pi`` is exactly retrograde).  An angle
+            Inclination in [0, pi] (``inc == pi`` is exactly retrograde; up to
+            two ulp above the float pi is pi: 180 degrees converted from
+            another unit, 648 000 000 mas, rounds there).  An angle
             given as a plain number is in radians, beside Quantity lengths too
             (``lan=10`` is 10 rad, 573 deg: give ``10 * u.deg``).
         lan, argp : array_like or Quantity (angle), shape (...)

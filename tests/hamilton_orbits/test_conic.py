@@ -624,3 +624,9 @@ def test_a_beyond_float64_refused_by_name(recwarn):
     assert repr(_beyond_a_orbit()[0]) == (
         "KeplerOrbit(q=1e+300, e=1, inc=0, lan=0, argp=0, nu=0, mu=1)")
     assert not recwarn.list
+
+
+def test_from_elements_inc_of_180_degrees_in_mas():
+    # 648 000 000 mas converts to one ulp above pi: the retrograde normal (0, 0, -1) exactly
+    c = Conic.from_elements(1.44, 0.44, 0.56, 648_000_000 * u.mas, 0.0, 0.0, 1.0)
+    assert c.normal.tolist() == [0.0, -0.0, -1.0]

@@ -607,3 +607,19 @@ def test_from_elements_beyond_float64_names_the_culprit_without_warning(kwargs, 
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=match):
             KeplerOrbit.from_elements(**kwargs, inc=0, lan=0, argp=0, nu=0, mu=1.0)
+
+
+def test_inc_of_180_degrees_in_mas_is_accepted():
+    # 648 000 000 mas (exactly 180 deg) converts to one ulp above the float pi: taken as
+    # pi (the same state as inc = pi bit for bit); two ulp are, three are refused
+    inc = 648_000_000 * u.mas
+    assert inc.to_value(u.rad) == np.nextafter(np.pi, 4.0)
+    kw = {"a": 7000 * u.km, "e": 0.1, "lan": 0, "argp": 0, "nu": 0.3,
+          "mu": 398600 * u.km**3 / u.s**2}
+    want = KeplerOrbit.from_elements(inc=np.pi * u.rad, **kw).state()
+    got = KeplerOrbit.from_elements(inc=inc, **kw).state()
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g.value, w.value)
+    three = np.nextafter(np.nextafter(np.nextafter(np.pi, 4.0), 4.0), 4.0)
+    with pytest.raises(ValueError, match=r"`inc` in \[0, pi\] rad, got 3.14159265358979"):
+        KeplerOrbit.from_elements(a=1.0, e=0.1, inc=three, lan=0, argp=0, nu=0, mu=1.0)
