@@ -38,6 +38,7 @@ _RAD = "rad"
 # first, in one pass), _COL for all COLUMNS (u, the anomaly, M too, when asked)
 _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
+_TAU = _COL["tau"]  # (the last column)
 _P, _E, _INV_A, _INC, _LAN, _ARGP, _NU, _A = (
     _CI[n] for n in ("p", "e", "inv_a", "inc", "lan", "argp", "nu", "a")
 )
@@ -135,7 +136,9 @@ class OrbitElements:
         rows = self._state.reshape(-1, 7)
         out = np.empty((rows.shape[0], _columns.NCOL))
         _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
-        refuse_beyond_range(out, rows, self.shape)
+        # every column but tau, the last (read from :attr:`_tau`, which refuses it by
+        # name): a tau beyond float64 (a = 1e250) blocked the angles, M and u
+        refuse_beyond_range(out[:, :_TAU], rows, self.shape)
         return out.T.reshape((_columns.NCOL, *self.shape))  # a view
 
     @cached_property
@@ -259,8 +262,9 @@ class OrbitElements:
         rows = self._state.reshape(-1, 7)
         out = np.empty(rows.shape[0])
         _el.state_to_time_since_periapsis(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
-        refuse_beyond_range(out[:, None], rows, self.shape)
-        return out.reshape(self.shape)
+        tau = out.reshape(self.shape)
+        self._refuse_not_finite("time_since_periapsis", np.isfinite(tau))
+        return tau
 
     @property
     def time_since_periapsis(self):

@@ -623,3 +623,21 @@ def test_inc_of_180_degrees_in_mas_is_accepted():
     three = np.nextafter(np.nextafter(np.nextafter(np.pi, 4.0), 4.0), 4.0)
     with pytest.raises(ValueError, match=r"`inc` in \[0, pi\] rad, got 3.14159265358979"):
         KeplerOrbit.from_elements(a=1.0, e=0.1, inc=three, lan=0, argp=0, nu=0, mu=1.0)
+
+
+def test_tau_beyond_float64_blocks_only_what_needs_it():
+    # a = 1e250: tau ~ a^1.5 overflows; the angles were refused with it.  Reference:
+    # Kepler's equation in closed form, E = 2 atan(sqrt((1 - e)/(1 + e)) tan(nu/2)),
+    # M = E - e sin E (the same elements at a = 1, where everything fits)
+    o = KeplerOrbit.from_elements(a=[1.0, 1e250], e=0.5, inc=0.3, lan=0.2, argp=0.1, nu=1.0,
+                                  mu=1.0)
+    big = math.atan(math.sqrt(0.5 / 1.5) * math.tan(0.5)) * 2.0
+    # the angles of a state rounded to ~eps relative: 16 eps allows their roundings
+    np.testing.assert_allclose(o.anomaly, big, rtol=16 * EPS)
+    np.testing.assert_allclose(o.M, big - 0.5 * math.sin(big), rtol=16 * EPS)
+    np.testing.assert_allclose(o.argument_of_latitude, 1.1, rtol=16 * EPS)
+    np.testing.assert_allclose(o.true_longitude, 1.3, rtol=16 * EPS)
+    assert np.all(np.isfinite(o.mean_longitude))
+    for name in ("time_since_periapsis", "period"):
+        with pytest.raises(ValueError, match=rf"`{name}` fits in float64, .* at index 1$"):
+            getattr(o, name)
