@@ -62,18 +62,38 @@ def _finite_or_raise(f, r: np.ndarray, v: np.ndarray, name: str) -> np.ndarray:
     return out
 
 
-def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """beta of ``r`` and ``v`` each scaled by a power of two (exact), then scaled
-    back: the scalar part of ``alpha alpha'`` (``-r . v``), which beta does not keep,
-    cannot overflow (r, v of 1e160 gave no beta of 1e60)."""
+def _beta_scaled(r: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(b, k)`` with beta = ``b 2**k``: beta of ``r`` and ``v`` each scaled by a
+    power of two (exact), so that the scalar part of ``alpha alpha'`` (``-r . v``),
+    which beta does not keep, cannot overflow (r, v of 1e160 gave no beta of 1e60)."""
     rs, er, _ = scale_exactly(r)
     vs, ev, _ = scale_exactly(v)
     alpha = Quaternion.from_vector(rs)
     dalpha = Quaternion.from_vector(vs)
     beta = ((alpha * dalpha - dalpha * alpha) * 0.5).vector
     if er is NO_SCALE and ev is NO_SCALE:
+        return beta, NO_SCALE
+    return beta, np.broadcast_to(er + ev, beta.shape[:-1])
+
+
+def _beta(r: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """beta of ``r`` and ``v``, scaled back from :func:`_beta_scaled`."""
+    beta, k = _beta_scaled(r, v)
+    if k is NO_SCALE:
         return beta
-    return np.ldexp(beta, np.broadcast_to(er + ev, beta.shape[:-1])[..., None])
+    return np.ldexp(beta, k[..., None])
+
+
+def _p(r: np.ndarray, v: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """``-beta^2 / M`` with beta and M scaled by powers of two (exact) and the result
+    scaled back once: beta^2 formed unscaled under- or overflowed (-0.0 for a true p
+    of 1e-170, a refusal of a p of 1e150 that fits); +0 for a radial state."""
+    beta, k = _beta_scaled(r, v)
+    b, kb, _ = scale_exactly(beta)  # (b safe to square)
+    mu_m, mu_e = np.frexp(mu)  # mu = mu_m 2**mu_e, mu_m in [1/2, 1)
+    bq = Quaternion.from_vector(b)
+    q = -(bq * bq).scalar / mu_m
+    return np.ldexp(q, 2 * (k + kb) - mu_e) + 0.0  # (+0.0: no -0.0 where beta = 0)
 
 
 def hamilton_beta(r: Any, v: Any):
@@ -184,7 +204,6 @@ def hamilton_p(r: Any, v: Any, mu: Any):
     r_, v_, mu_, quantity = _hamilton_args(r, v, mu)
 
     def p_of(r_, v_):
-        beta = Quaternion.from_vector(_beta(r_, v_))
-        return -(beta * beta).scalar / mu_
+        return _p(r_, v_, mu_)
 
     return wrap(_finite_or_raise(p_of, r_, v_, "p"), _L, quantity)

@@ -25,7 +25,12 @@ from hamilton_orbits.validation import (
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
 _kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
 
-__all__ = ["anomaly_of", "element_inputs", "p_and_inv_a", "raise_at", "state_of"]
+__all__ = ["anomaly_of", "clamp_inc", "element_inputs", "p_and_inv_a", "raise_at",
+           "state_of"]
+
+# two ulp above the float pi: an inclination of 180 degrees in another unit converts to
+# up to this (648 000 000 mas is one ulp above pi in astropy's conversion)
+_PI_PLUS_2ULP = float(np.nextafter(np.nextafter(np.pi, 4.0), 4.0))
 
 # internal units when Quantities come in
 _L, _MU = STATE_UNITS[0], STATE_UNITS[2]
@@ -46,6 +51,15 @@ def raise_at(name: str, mask: np.ndarray, values: np.ndarray, what: str,
             number = np.broadcast_to(np.atleast_1d(given.value), mask.shape)[index]
             value = f"{float(number)!r} {given.unit.to_string()}".rstrip()  # (dimensionless)
         raise ValueError(f"Expected `{name}` {what}, got {value}{fmt_index(shown)}")
+
+
+def clamp_inc(inc: np.ndarray) -> np.ndarray:
+    """``inc`` with an excess of at most two ulp over the float pi taken as pi: the
+    conversion of exactly 180 degrees from another unit rounds there (648 000 000 mas
+    gives one ulp above pi), an inclination no element set can mean otherwise; the
+    rest, beyond, is refused by the caller."""
+    inc = np.asarray(inc, dtype=np.float64)
+    return np.where((inc > np.pi) & (inc <= _PI_PLUS_2ULP), np.pi, inc)
 
 
 def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
@@ -80,6 +94,7 @@ def element_inputs(lengths: dict, anomalies: dict, e, inc, lan, argp, mu):
     e_, inc_, lan_, argp_, mu_, length, angle = values
     raise_at("e", ~(e_ >= 0), e_, ">= 0", e)
     raise_at("mu", ~(mu_ > 0), mu_, "> 0", mu)
+    inc_ = clamp_inc(inc_)
     raise_at("inc", ~((inc_ >= 0) & (inc_ <= np.pi)), inc_, "in [0, pi] rad", inc)
     return lname, length, aname, angle, e_, inc_, lan_, argp_, mu_, quantity
 
@@ -88,19 +103,38 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray, given: Any = None
     """``(p, 1/a, radial)`` from ``a``, ``p`` or ``q`` (``lname``) and ``e``;
     ``radial`` where ``e == 1`` with ``a`` given (the rectilinear orbit of that
     energy).  Refuses ``a`` and ``e`` inconsistent, ``p`` or ``q`` <= 0 (``given``:
-    the length as written, for the message)."""
+    the length as written, for the message), and ``p`` or ``1/a`` beyond float64
+    (:func:`_refuse_beyond`)."""
     if lname != "a":
         raise_at(lname, ~(length > 0), length, "> 0", given)
-        p = length if lname == "p" else length * (1.0 + e)
-        return p, (1.0 - e) * (1.0 + e) / p, np.zeros(e.shape, dtype=bool)
+        with np.errstate(over="ignore", invalid="ignore"):
+            p = length if lname == "p" else length * (1.0 + e)
+            inv_a = (1.0 - e) * (1.0 + e) / p
+        _refuse_beyond(lname, length, e, p, inv_a, given)
+        return p, inv_a, np.zeros(e.shape, dtype=bool)
     raise_at("a", length == 0, length, "nonzero", given)
     raise_at("a", (length > 0) & (e > 1), length, "< 0 for e > 1 (a and e inconsistent)", given)
     raise_at("a", (length < 0) & (e < 1), length, "> 0 for e < 1 (a and e inconsistent)", given)
     radial = e == 1.0
-    with np.errstate(over="ignore"):  # (a p beyond float64: refused by the caller's check)
+    with np.errstate(over="ignore", invalid="ignore"):
         p = length * (1.0 - e) * (1.0 + e)
         inv_a = np.where(radial, 1.0 / length, (1.0 - e) * (1.0 + e) / np.where(radial, 1, p))
+    _refuse_beyond("a", length, e, p, inv_a, given)
     return p, inv_a, radial
+
+
+def _refuse_beyond(lname: str, length: np.ndarray, e: np.ndarray, p: np.ndarray,
+                   inv_a: np.ndarray, given: Any) -> None:
+    """Refuse ``p`` or ``1/a`` beyond float64 (computed with overflow ignored), naming
+    ``e`` where ``1 - e^2`` alone is (e ~ 1e200: the length was named, after a
+    RuntimeWarning), else the length ``lname`` (as the caller refuses a state
+    beyond float64)."""
+    bad = ~(np.isfinite(p) & np.isfinite(inv_a))
+    if np.any(bad):
+        with np.errstate(over="ignore"):
+            e_bad = bad & ~np.isfinite((1.0 - e) * (1.0 + e))
+        raise_at("e", e_bad, e, "for which 1 - e^2 fits in float64")
+        raise_at(lname, bad, length, "to give a finite state (check the elements)", given)
 
 
 def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,

@@ -38,13 +38,20 @@ _RAD = "rad"
 # first, in one pass), _COL for all COLUMNS (u, the anomaly, M too, when asked)
 _CI = {name: i for i, name in enumerate(_columns.CLASSICAL)}
 _COL = {name: i for i, name in enumerate(_columns.COLUMNS)}
+_TAU = _COL["tau"]  # (the last column)
 _P, _E, _INV_A, _INC, _LAN, _ARGP, _NU, _A = (
     _CI[n] for n in ("p", "e", "inv_a", "inc", "lan", "argp", "nu", "a")
 )
 
 
-def _scalar(a: np.ndarray):
-    return a[()] if isinstance(a, np.ndarray) and a.ndim == 0 else a
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (no copy): the orbit's columns and state are
+    returned as such, so that a caller's in-place arithmetic on an attribute
+    cannot change the orbit (as :class:`~hamilton_orbits.quaternion.Quaternion`
+    returns its components)."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _in_range(prop):
@@ -90,7 +97,7 @@ def _element(name: str, unit: str | None, doc: str) -> property:
             c = orbit._elements()
         if is_a and orbit._a_beyond:
             orbit._refuse_not_finite("a", c[i] == c[i])
-        return orbit._out(c[i], unit) if orbit._quantity else c[i]
+        return orbit._out(c[i], unit)
 
     read.__name__ = name
     return property(read, doc=doc)
@@ -129,7 +136,9 @@ class OrbitElements:
         rows = self._state.reshape(-1, 7)
         out = np.empty((rows.shape[0], _columns.NCOL))
         _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
-        refuse_beyond_range(out, rows, self.shape)
+        # every column but tau, the last (read from :attr:`_tau`, which refuses it by
+        # name): a tau beyond float64 (a = 1e250) blocked the angles, M and u
+        refuse_beyond_range(out[:, :_TAU], rows, self.shape)
         return out.T.reshape((_columns.NCOL, *self.shape))  # a view
 
     @cached_property
@@ -147,14 +156,19 @@ class OrbitElements:
         return self._full[_COL[name]]
 
     def _out(self, value: np.ndarray, unit: str | None):
-        """A float result as returned: a float64 for one orbit, an array for
-        many, a Quantity in ``unit`` (if not None) for an orbit of Quantities."""
-        if not self._quantity:
-            return value[()] if type(value) is np.ndarray and value.ndim == 0 else value
-        if unit is not None:
-            # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
-            return wrap(np.array(value, dtype=np.float64), unit, True)
-        return _scalar(np.asarray(value))
+        """A float result as returned: a float64 for one orbit, a read-only array
+        for many (a view of the orbit's columns or state, never writable), a
+        read-only Quantity in ``unit`` (if not None) for an orbit of Quantities."""
+        value = np.asarray(value)
+        if value.ndim == 0:
+            if not self._quantity or unit is None:
+                return value[()]
+        elif not self._quantity or unit is None:
+            return _read_only(value)
+        # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
+        out = wrap(np.array(value, dtype=np.float64), unit, True)
+        out.flags.writeable = False
+        return out
 
     def _refuse_not_finite(self, name: str, finite: np.ndarray) -> None:
         """Raise, if ``finite`` is not all true, naming ``r``, ``v``, ``mu`` of
@@ -217,7 +231,7 @@ class OrbitElements:
         q = np.where(p > 0, p / (1.0 + self._col("e")), 1.0)
         n = np.where(
             kind == _el.PARABOLA,
-            np.sqrt(self._mu / (2.0 * q**3)),
+            _parabola_mean_motion(q, self._mu),
             np.sqrt(self._mu) * inv * np.sqrt(inv),
         )
         return np.where(kind == _el.RADIAL_PARABOLA, np.inf, n)
@@ -248,8 +262,9 @@ class OrbitElements:
         rows = self._state.reshape(-1, 7)
         out = np.empty(rows.shape[0])
         _el.state_to_time_since_periapsis(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
-        refuse_beyond_range(out[:, None], rows, self.shape)
-        return out.reshape(self.shape)
+        tau = out.reshape(self.shape)
+        self._refuse_not_finite("time_since_periapsis", np.isfinite(tau))
+        return tau
 
     @property
     def time_since_periapsis(self):
@@ -326,6 +341,24 @@ class OrbitElements:
         return Conic.from_elements(
             c[_P], c[_E], c[_INV_A], c[_INC], c[_LAN], c[_ARGP], self._mu, quantity=self._quantity
         )
+
+
+def _even_frexp(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(m, k)`` with ``x = m 2**k`` exactly, ``k`` even and ``m`` in [1/2, 2)."""
+    m, k = np.frexp(x)
+    odd = (k % 2) != 0
+    return np.where(odd, 2.0 * m, m), np.where(odd, k - 1, k)
+
+
+def _parabola_mean_motion(q: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """The parabola's ``n = sqrt(mu / (2 q^3))`` with ``q`` and ``mu`` scaled by even
+    powers of two (exact) and the result scaled back once: ``q**3`` over- and
+    underflowed from ``q`` ~ 6e102 (n was 0) and below ~1e-103 (n was refused),
+    while ``n`` fits.  The roundings are those of the formula (the scalings are
+    exact): within 1 ulp of mpmath's n, as before, in the float range."""
+    qm, kq = _even_frexp(q)
+    mm, km = _even_frexp(mu)
+    return np.ldexp(np.sqrt(mm / (2.0 * qm**3)), (km - 3 * kq) // 2)
 
 
 def _wrap2pi(x: np.ndarray) -> np.ndarray:

@@ -34,7 +34,7 @@ import numpy as np
 
 from hamilton_orbits._columns import CLASSICAL
 from hamilton_orbits._lazy import LazyModule
-from hamilton_orbits._orbit_build import raise_at
+from hamilton_orbits._orbit_build import clamp_inc, raise_at
 from hamilton_orbits.twobody import STATE_UNITS, check_state, classical_columns
 from hamilton_orbits.units import (
     ANGLE,
@@ -143,6 +143,7 @@ def _checked_elements(*values: Any) -> tuple[list[np.ndarray], bool]:
     the conic's units (km, 1/km, km^3/s^2, rad; :func:`_element_floats`).  ValueError
     naming the argument, the first bad index and the value."""
     arrays, quantity, given = _element_floats(values)
+    arrays[3] = clamp_inc(arrays[3])  # (180 degrees in mas: an ulp above pi)
     p, e, inv_a, inc, _, _, mu = broadcast(_ELEMENTS, *arrays)
     gp, ge, gi, ginc, _, _, gmu = given
     _check_shape(p, e, inv_a, (gp, ge, gi))
@@ -225,6 +226,16 @@ def _plain_floats(names: tuple[str, ...], values: Any, units: str) -> list[np.nd
     return arrays
 
 
+def _frozen(x: np.ndarray) -> np.ndarray:
+    """A read-only float64 copy of ``x``: a conic keeps its own attributes, so that
+    neither the caller's arrays (``p`` given to :meth:`Conic.from_elements`, an
+    orbit's columns) nor in-place arithmetic on an attribute read back (``c.e``,
+    ``c.p``) can change it."""
+    out = np.array(x, dtype=np.float64)
+    out.flags.writeable = False
+    return out
+
+
 def _refuse_beyond(x: np.ndarray, message: Any) -> None:
     """A ValueError of ``message(index, " at index ...")`` at the first element of
     ``x`` beyond :data:`_AXES` in magnitude (no index where ``x`` holds one value)."""
@@ -256,6 +267,9 @@ class Conic:
     mu : ndarray, shape (...)
         Gravitational parameter (for the hodograph).
 
+    The conic keeps read-only copies of what it is given (an array written
+    afterwards by the caller does not change it).
+
     Examples
     --------
     >>> c = Conic.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
@@ -275,6 +289,8 @@ class Conic:
 
     def _set(self, p: np.ndarray, e: np.ndarray, inv_a: np.ndarray, periapsis: np.ndarray,
              normal: np.ndarray, mu: np.ndarray, quantity: bool) -> None:
+        p, e, inv_a, mu, periapsis, normal = (
+            _frozen(x) for x in (p, e, inv_a, mu, periapsis, normal))
         self._p, self.e, self._inv_a, self._mu = p, e, inv_a, mu
         self.periapsis_direction, self.normal = periapsis, normal
         self._quantity = quantity
@@ -353,9 +369,10 @@ class Conic:
             (64 eps ``max(1, e)^2``).
         inc, lan, argp : array_like or Quantity (angle), shape (...)
             Inclination in [0, pi] (``inc == pi``, the float, is exactly
-            retrograde), longitude of the ascending node, argument of
-            periapsis, finite; a plain number is in radians (beside Quantity
-            lengths too), a Quantity of any angular unit (``30 * u.deg``).
+            retrograde; up to two ulp above it is pi: 180 degrees in mas),
+            longitude of the ascending node, argument of periapsis, finite; a
+            plain number is in radians (beside Quantity lengths too), a Quantity
+            of any angular unit (``30 * u.deg``).
         mu : array_like or Quantity, shape (...)
             Gravitational parameter, finite and > 0.
         quantity : bool, optional
@@ -439,40 +456,81 @@ class Conic:
     # ---------------------------------------------------------------- shape
     @property
     def a(self) -> np.ndarray:
-        """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola."""
+        """Semi-major axis ``p / (1 - e^2)`` (eq. 29); inf for the parabola.
+
+        Raises
+        ------
+        ValueError
+            Where ``1/inv_a`` is beyond float64 (``inv_a`` subnormal), naming
+            ``inv_a``, the first such index and its value.
+        """
         safe = np.where(self._inv_a == 0, 1.0, self._inv_a)
-        return self._out(np.where(self._inv_a == 0, np.inf, 1.0 / safe), _L)
+        with np.errstate(all="ignore"):
+            a = 1.0 / safe
+        self._refuse_beyond_float("a", a)
+        return self._out(np.where(self._inv_a == 0, np.inf, a), _L)
 
     @property
     def b(self) -> np.ndarray:
         """Semi-minor axis ``a sqrt(1 - e^2) = sqrt(a p)`` (eq. 43) for the ellipse;
         for the hyperbola the length ``|a| sqrt(e^2 - 1)`` of the imaginary
         (conjugate) semi-axis, Hamilton's "vector with a positive square" (eq. 42);
-        inf for the parabola."""
+        inf for the parabola.  ``sqrt(p / |inv_a|)``, or ``sqrt(p) / sqrt(|inv_a|)``
+        where ``p / |inv_a|`` alone is beyond float64 (``b`` fits where ``a`` may not).
+
+        Raises
+        ------
+        ValueError
+            Where ``b`` itself is beyond float64, naming ``inv_a``, the index and value.
+        """
         ia = np.abs(np.where(self._inv_a == 0, 1.0, self._inv_a))
-        return self._out(np.where(self._inv_a == 0, np.inf, np.sqrt(self._p / ia)), _L)
+        with np.errstate(all="ignore"):
+            direct = np.sqrt(self._p / ia)
+            b = np.where(np.isfinite(direct), direct, np.sqrt(self._p) / np.sqrt(ia))
+        self._refuse_beyond_float("b", b)
+        return self._out(np.where(self._inv_a == 0, np.inf, b), _L)
+
+    def _refuse_beyond_float(self, name: str, x: np.ndarray) -> None:
+        """Refuse ``x`` (attribute ``name``, of the conic's shape or (..., 3)) where it is
+        not finite outside the parabola: ValueError naming ``inv_a``, index and value."""
+        ia = self._inv_a
+        bad = ~np.isfinite(x)
+        if x.ndim > np.ndim(ia):
+            bad = np.any(bad, axis=-1)
+        bad &= ia != 0
+        if np.any(bad):
+            i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
+            value = float(np.broadcast_to(ia, bad.shape)[i])
+            raise ValueError(
+                f"Expected a conic for which `{name}` fits in float64, got inv_a={value!r}"
+                f"{fmt_index(i if bad.size > 1 else ())}"
+            )
 
     @property
     def hamilton_epsilon(self) -> np.ndarray:
         """Hamilton's epsilon = -e * periapsis direction (eq. 13), towards apoapsis."""
         return -self.e[..., None] * self.periapsis_direction
 
-    def _finite_a(self, what: str) -> np.ndarray:
+    def _times_a(self, what: str, x: np.ndarray) -> np.ndarray:
+        """``a x`` (``x`` of shape (..., 3)), as ``x / inv_a``; refused for the parabola
+        and where a component is beyond float64 (``inv_a`` subnormal)."""
         if np.any(self._inv_a == 0):
             raise ValueError(f"Expected a conic with a centre for `{what}`, got a parabola "
                              "(e = 1: the centre and second focus are at infinity)")
-        return 1.0 / self._inv_a
+        with np.errstate(all="ignore"):
+            out = x / self._inv_a[..., None]
+        self._refuse_beyond_float(what, out)
+        return out
 
     @property
     def centre(self) -> np.ndarray:
         """Vector of the centre from the focus, ``a epsilon`` (eq. 36)."""
-        return self._out(self._finite_a("centre")[..., None] * self.hamilton_epsilon, _L)
+        return self._out(self._times_a("centre", self.hamilton_epsilon), _L)
 
     @property
     def second_focus(self) -> np.ndarray:
         """Vector of the second focus, ``2 a epsilon`` (eq. 31)."""
-        focus = 2.0 * self._finite_a("second_focus")[..., None] * self.hamilton_epsilon
-        return self._out(focus, _L)
+        return self._out(self._times_a("second_focus", 2.0 * self.hamilton_epsilon), _L)
 
     @property
     def directrix_distance(self) -> np.ndarray:

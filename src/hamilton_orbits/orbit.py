@@ -267,7 +267,9 @@ class KeplerOrbit(OrbitElements):
         e : array_like, shape (...)
             Eccentricity, ``e >= 0``; ``e == 1`` exactly is the parabola.
         inc : array_like or Quantity (angle), shape (...)
-            Inclination in [0, pi] (``inc == pi`` is exactly retrograde).  An angle
+            Inclination in [0, pi] (``inc == pi`` is exactly retrograde; up to
+            two ulp above the float pi is pi: 180 degrees converted from
+            another unit, 648 000 000 mas, rounds there).  An angle
             given as a plain number is in radians, beside Quantity lengths too
             (``lan=10`` is 10 rad, 573 deg: give ``10 * u.deg``).
         lan, argp : array_like or Quantity (angle), shape (...)
@@ -360,9 +362,10 @@ class KeplerOrbit(OrbitElements):
             return f"KeplerOrbit(shape={self.shape})"
         col = self._col
         inv = col("inv_a")
-        a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
+        with np.errstate(over="ignore"):  # (an a beyond float64: q is shown instead)
+            a = np.where(inv == 0, np.inf, 1.0 / np.where(inv == 0, 1.0, inv))
         q = col("p") / (1.0 + col("e"))
-        length = "q" if np.all(inv == 0) else "a"
+        length = "q" if np.all(inv == 0) or not np.all(np.isfinite(a) | (inv == 0)) else "a"
         cols = [(length, q if length == "q" else a, str(_L)), ("e", col("e"), "")]
         scale, aunit = (180.0 / np.pi, "deg") if self._quantity else (1.0, "")
         for name in ("inc", "lan", "argp", "nu"):

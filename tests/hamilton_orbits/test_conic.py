@@ -589,3 +589,44 @@ def test_from_elements_broadcasts_the_angles():
     one = Conic.from_elements(1.44, 0.44, 0.56, 0.3, 0.1, 0.4, 1.0)
     np.testing.assert_array_equal(c.periapsis_direction[1, 1], one.periapsis_direction)
     np.testing.assert_array_equal(c.normal[1, 1], one.normal)
+
+
+def test_from_elements_keeps_its_own_arrays():
+    # the conic copies what it is given: the caller's later writes do not reach it
+    p, e, mu = np.array([1.44, 1.44]), np.array([0.44, 0.44]), np.array([1.0, 1.0])
+    c = Conic.from_elements(p, e, 0.56, 0.0, 0.0, 0.0, mu)
+    p[0], e[0], mu[0] = 99.0, 0.9, 100.0
+    np.testing.assert_array_equal(c.p, [1.44, 1.44])
+    np.testing.assert_array_equal(c.e, [0.44, 0.44])
+    np.testing.assert_array_equal(c.mu, [1.0, 1.0])
+    with pytest.raises(ValueError, match="read-only"):
+        c.e[0] = 0.9
+
+
+def _beyond_a_orbit():
+    # an ellipse with e = 1 - 2e-10 and a ~ 5e309: 1/a is subnormal, a beyond float64
+    v = float(np.sqrt(2e-300 * (1 - 1e-10)))
+    return KeplerOrbit.from_state([[1e300, 0.0, 0.0], [1.0, 0, 0]], [[0.0, v, 0.0], [0, 1.2, 0]],
+                                  1.0)
+
+
+def test_a_beyond_float64_refused_by_name(recwarn):
+    c = _beyond_a_orbit().conic
+    for name in ("a", "centre", "second_focus"):
+        with pytest.raises(ValueError, match=rf"`{name}` fits in float64, got inv_a=2\.0.*e-310 "
+                                             r"at index 0"):
+            getattr(c, name)
+    # b = sqrt(p / inv_a) ~ 1e305 fits: sqrt(p) / sqrt(inv_a), each rounding correct
+    # (sqrt of the subnormal inv_a too) and a division: within 2 ulp of mpmath's
+    mpmath.mp.dps = 40
+    want = float(mpmath.sqrt(mpmath.mpf(float(c.p[0])) / mpmath.mpf(float(c.inv_a[0]))))
+    assert abs(float(c.b[0]) - want) <= 2 * np.spacing(want)
+    assert repr(_beyond_a_orbit()[0]) == (
+        "KeplerOrbit(q=1e+300, e=1, inc=0, lan=0, argp=0, nu=0, mu=1)")
+    assert not recwarn.list
+
+
+def test_from_elements_inc_of_180_degrees_in_mas():
+    # 648 000 000 mas converts to one ulp above pi: the retrograde normal (0, 0, -1) exactly
+    c = Conic.from_elements(1.44, 0.44, 0.56, 648_000_000 * u.mas, 0.0, 0.0, 1.0)
+    assert c.normal.tolist() == [0.0, -0.0, -1.0]

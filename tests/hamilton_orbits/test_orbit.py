@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import astropy.units as u
 import mpmath
@@ -519,3 +520,124 @@ def test_propagate_broadcasts_dt_over_the_orbits():
             ri, vi = o[j].propagate(float(dt[i, 0])).state()
             np.testing.assert_array_equal(r[i, j], ri)
             np.testing.assert_array_equal(v[i, j], vi)
+
+
+def test_batch_attributes_are_read_only():
+    # an orbit's elements, mu and derived columns are returned read-only (views of its
+    # columns or state): the caller's in-place arithmetic raises, the orbit stays whole
+    o = KeplerOrbit.from_state([[1.0, 0, 0], [1.5, 0, 0]], [0, 1.2, 0], 1.0)
+    e, q, mu = o.e.copy(), o.q.copy(), o.mu.copy()
+    for name in ("e", "p", "a", "inc", "nu", "mu", "M", "q", "anomaly", "mean_longitude",
+                 "time_since_periapsis", "n", "period", "energy"):
+        x = getattr(o, name)
+        with pytest.raises(ValueError, match="read-only"):
+            x *= 2
+    np.testing.assert_array_equal(o.e, e)
+    np.testing.assert_array_equal(o.q, q)
+    np.testing.assert_array_equal(o.mu, mu)
+    c = o.conic
+    for x in (c.e, c.p, c.inv_a, c.mu, c.periapsis_direction, c.normal):
+        with pytest.raises(ValueError, match="read-only"):
+            x[0] = 0.9
+    np.testing.assert_array_equal(o.e, e)
+
+
+def test_quantity_attributes_are_read_only_and_scalars_numbers():
+    o = KeplerOrbit.from_state([[7000.0, 0, 0], [8000.0, 0, 0]] * u.km, [0, 7.5, 0] * u.km / u.s,
+                               398600.0 * u.km**3 / u.s**2)
+    a = o.a.copy()
+    for x in (o.a, o.mu, o.M):
+        with pytest.raises(ValueError, match="read-only"):
+            x[0] = 1.0 * x.unit
+    np.testing.assert_array_equal(o.a, a)
+    one = KeplerOrbit.from_state([1.0, 0, 0], [0, 1.2, 0], 1.0)
+    assert isinstance(one.e, float) and isinstance(one.mu, float)
+    assert one.e * 2 == 2 * float(one.e) and one.mu + 1 == 2.0
+
+
+def _p_mpmath(r, v, mu):
+    # |r x v|^2 / mu in 50 digits (the float inputs taken exactly)
+    mpmath.mp.dps = 50
+    r, v = [mpmath.mpf(x) for x in r], [mpmath.mpf(x) for x in v]
+    h = (r[1] * v[2] - r[2] * v[1], r[2] * v[0] - r[0] * v[2], r[0] * v[1] - r[1] * v[0])
+    return float(sum(x * x for x in h) / mpmath.mpf(mu))
+
+
+@pytest.mark.parametrize("sr, sv, mu", [(1e-170, 1.0, 1e-170), (1e150, 1e10, 1e170),
+                                        (1.0, 1.0, 1.0), (1e-100, 1e-100, 1e-250)])
+def test_hamilton_p_beyond_the_square_range(sr, sv, mu):
+    # beta^2 was formed unscaled: -0.0 for a true p of 1.48e-170, a refusal for 1.48e150
+    r = np.array([1.0, 0.2, 0.1]) * sr
+    v = np.array([0.1, 1.2, 0.3]) * sv
+    want = _p_mpmath(r, v, mu)
+    p = float(hamilton_p(r, v, mu))
+    # a cross product, a sum of three squares and a division: 8 eps is ample
+    assert abs(p - want) <= 8 * EPS * want
+    assert abs(float(KeplerOrbit.from_state(r, v, mu).p) - want) <= 8 * EPS * want
+
+
+def test_hamilton_p_radial_is_plus_zero():
+    p = hamilton_p([1.0, 0, 0], [2.0, 0, 0], 1.0)
+    assert p == 0.0 and math.copysign(1.0, float(p)) == 1.0
+    with pytest.raises(ValueError, match="fits in float64"):
+        hamilton_p([1.0, 0, 0], [0, 1.0, 0], 1e-320)  # p = 1e320 does not fit
+
+
+@pytest.mark.parametrize("q", [1e-120, 1e-110, 1e-103, 1e103, 1e120, 1.0, 3.7e-5])
+def test_parabola_mean_motion_beyond_q_cubed(q):
+    # n = sqrt(mu / (2 q^3)) through q**3: refused for q <= ~1e-103, 0.0 for q >= ~6e102
+    o = KeplerOrbit.from_elements(q=q, e=1.0, inc=0, lan=0, argp=0, nu=1.0, mu=1.0)
+    mpmath.mp.dps = 40
+    want = float(mpmath.sqrt(1 / (2 * mpmath.mpf(q) ** 3)))
+    # the formula's roundings (a cube, a division, a square root; the scalings by
+    # powers of two exact): 1 ulp over 20000 random q, mu in the float range, 2 allowed
+    assert abs(float(o.n) - want) <= 2 * np.spacing(want)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"p": 1.0, "e": 1e200}, r"Expected `e` for which 1 - e\^2 fits in float64, got 1e\+200$"),
+    ({"q": 1.0, "e": [0.5, 1e200]}, r"`e` for which 1 - e\^2 fits .*got 1e\+200 at index 1$"),
+    ({"a": -1.0, "e": 1e200}, r"`e` for which 1 - e\^2 fits in float64, got 1e\+200$"),
+    ({"p": 1e-320, "e": 0.5}, r"`p` to give a finite state .*got 1e-320$"),
+    ({"q": 1e300, "e": 1e10}, r"`q` to give a finite state .*got 1e\+300$"),
+])
+def test_from_elements_beyond_float64_names_the_culprit_without_warning(kwargs, match):
+    # e = 1e200 overflowed 1 - e^2 with a RuntimeWarning, then `p` was named
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=match):
+            KeplerOrbit.from_elements(**kwargs, inc=0, lan=0, argp=0, nu=0, mu=1.0)
+
+
+def test_inc_of_180_degrees_in_mas_is_accepted():
+    # 648 000 000 mas (exactly 180 deg) converts to one ulp above the float pi: taken as
+    # pi (the same state as inc = pi bit for bit); two ulp are, three are refused
+    inc = 648_000_000 * u.mas
+    assert inc.to_value(u.rad) == np.nextafter(np.pi, 4.0)
+    kw = {"a": 7000 * u.km, "e": 0.1, "lan": 0, "argp": 0, "nu": 0.3,
+          "mu": 398600 * u.km**3 / u.s**2}
+    want = KeplerOrbit.from_elements(inc=np.pi * u.rad, **kw).state()
+    got = KeplerOrbit.from_elements(inc=inc, **kw).state()
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g.value, w.value)
+    three = np.nextafter(np.nextafter(np.nextafter(np.pi, 4.0), 4.0), 4.0)
+    with pytest.raises(ValueError, match=r"`inc` in \[0, pi\] rad, got 3.14159265358979"):
+        KeplerOrbit.from_elements(a=1.0, e=0.1, inc=three, lan=0, argp=0, nu=0, mu=1.0)
+
+
+def test_tau_beyond_float64_blocks_only_what_needs_it():
+    # a = 1e250: tau ~ a^1.5 overflows; the angles were refused with it.  Reference:
+    # Kepler's equation in closed form, E = 2 atan(sqrt((1 - e)/(1 + e)) tan(nu/2)),
+    # M = E - e sin E (the same elements at a = 1, where everything fits)
+    o = KeplerOrbit.from_elements(a=[1.0, 1e250], e=0.5, inc=0.3, lan=0.2, argp=0.1, nu=1.0,
+                                  mu=1.0)
+    big = math.atan(math.sqrt(0.5 / 1.5) * math.tan(0.5)) * 2.0
+    # the angles of a state rounded to ~eps relative: 16 eps allows their roundings
+    np.testing.assert_allclose(o.anomaly, big, rtol=16 * EPS)
+    np.testing.assert_allclose(o.M, big - 0.5 * math.sin(big), rtol=16 * EPS)
+    np.testing.assert_allclose(o.argument_of_latitude, 1.1, rtol=16 * EPS)
+    np.testing.assert_allclose(o.true_longitude, 1.3, rtol=16 * EPS)
+    assert np.all(np.isfinite(o.mean_longitude))
+    for name in ("time_since_periapsis", "period"):
+        with pytest.raises(ValueError, match=rf"`{name}` fits in float64, .* at index 1$"):
+            getattr(o, name)
