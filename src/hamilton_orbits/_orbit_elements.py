@@ -44,16 +44,6 @@ _P, _E, _INV_A, _INC, _LAN, _ARGP, _NU, _A = (
 )
 
 
-def _read_only(a: np.ndarray) -> np.ndarray:
-    """A read-only view of ``a`` (no copy): the orbit's columns and state are
-    returned as such, so that a caller's in-place arithmetic on an attribute
-    cannot change the orbit (as :class:`~hamilton_orbits.quaternion.Quaternion`
-    returns its components)."""
-    view = a.view()
-    view.flags.writeable = False
-    return view
-
-
 def _in_range(prop):
     """Derived attribute computed without floating-point warnings; a NaN, or an
     infinity where the attribute is not documented to be infinite (``period``
@@ -156,19 +146,16 @@ class OrbitElements:
         return self._full[_COL[name]]
 
     def _out(self, value: np.ndarray, unit: str | None):
-        """A float result as returned: a float64 for one orbit, a read-only array
-        for many (a view of the orbit's columns or state, never writable), a
-        read-only Quantity in ``unit`` (if not None) for an orbit of Quantities."""
+        """A float result as returned: a float64 for one orbit, an array of its own
+        for many (a copy: the orbit's columns and state are never handed out, so
+        that in-place arithmetic on an attribute cannot change the orbit), a
+        Quantity in ``unit`` (if not None) for an orbit of Quantities."""
         value = np.asarray(value)
-        if value.ndim == 0:
-            if not self._quantity or unit is None:
-                return value[()]
-        elif not self._quantity or unit is None:
-            return _read_only(value)
-        # a 0-d array, not a numpy scalar: Quantity(copy=False) rejects those
-        out = wrap(np.array(value, dtype=np.float64), unit, True)
-        out.flags.writeable = False
-        return out
+        if value.ndim == 0 and (not self._quantity or unit is None):
+            return value[()]
+        out = np.array(value, dtype=np.float64)  # (a copy; 0-d for a Quantity, which
+        # Quantity(copy=False) takes where it rejects a numpy scalar)
+        return wrap(out, unit, True) if self._quantity and unit is not None else out
 
     def _refuse_not_finite(self, name: str, finite: np.ndarray) -> None:
         """Raise, if ``finite`` is not all true, naming ``r``, ``v``, ``mu`` of

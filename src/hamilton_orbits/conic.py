@@ -295,6 +295,13 @@ class Conic:
         self.periapsis_direction, self.normal = periapsis, normal
         self._quantity = quantity
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """A pickled or deep-copied conic: its arrays read-only again (numpy's pickle
+        does not keep the flag, and a write would leave the conic inconsistent)."""
+        self.__dict__.update(state)
+        for name in ("_p", "e", "_inv_a", "_mu", "periapsis_direction", "normal"):
+            self.__dict__[name] = _frozen(self.__dict__[name])
+
     def __repr__(self) -> str:
         def fmt(x: np.ndarray) -> str:
             return np.array2string(np.asarray(x), precision=6, threshold=6)
@@ -490,17 +497,18 @@ class Conic:
         self._refuse_beyond_float("b", b)
         return self._out(np.where(self._inv_a == 0, np.inf, b), _L)
 
-    def _refuse_beyond_float(self, name: str, x: np.ndarray) -> None:
-        """Refuse ``x`` (attribute ``name``, of the conic's shape or (..., 3)) where it is
-        not finite outside the parabola: ValueError naming ``inv_a``, index and value."""
-        ia = self._inv_a
+    def _refuse_beyond_float(self, name: str, x: np.ndarray, vector: bool = False) -> None:
+        """Refuse ``x`` (attribute ``name``, of the conic's shape, or (..., 3) with
+        ``vector``) where it is not finite outside the parabola: ValueError naming
+        ``inv_a``, index and value (the attributes of a conic broadcast: ``x`` may have
+        more dimensions than ``inv_a``)."""
         bad = ~np.isfinite(x)
-        if x.ndim > np.ndim(ia):
+        if vector:
             bad = np.any(bad, axis=-1)
-        bad &= ia != 0
+        bad = bad & (self._inv_a != 0)
         if np.any(bad):
             i = first_index(np.atleast_1d(bad)) if bad.ndim else ()
-            value = float(np.broadcast_to(ia, bad.shape)[i])
+            value = float(np.broadcast_to(self._inv_a, bad.shape)[i])
             raise ValueError(
                 f"Expected a conic for which `{name}` fits in float64, got inv_a={value!r}"
                 f"{fmt_index(i if bad.size > 1 else ())}"
@@ -519,7 +527,7 @@ class Conic:
                              "(e = 1: the centre and second focus are at infinity)")
         with np.errstate(all="ignore"):
             out = x / self._inv_a[..., None]
-        self._refuse_beyond_float(what, out)
+        self._refuse_beyond_float(what, out, vector=True)
         return out
 
     @property

@@ -391,7 +391,7 @@ class KeplerOrbit(OrbitElements):
         >>> [x.tolist() for x in o.state()]
         [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
         """
-        return self._out(self._r.copy(), _L), self._out(self._v.copy(), _V)
+        return self._out(self._r, _L), self._out(self._v, _V)  # (copies)
 
     def propagate(self, dt: Any) -> KeplerOrbit:
         """The orbit after time ``dt`` (any sign; broadcast over the leading dims).

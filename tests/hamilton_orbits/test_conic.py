@@ -630,3 +630,12 @@ def test_from_elements_inc_of_180_degrees_in_mas():
     # 648 000 000 mas converts to one ulp above pi: the retrograde normal (0, 0, -1) exactly
     c = Conic.from_elements(1.44, 0.44, 0.56, 648_000_000 * u.mas, 0.0, 0.0, 1.0)
     assert c.normal.tolist() == [0.0, -0.0, -1.0]
+
+
+def test_b_of_a_conic_whose_attributes_broadcast():
+    # p of shape (2, 4) or (3, 1) beside inv_a of shape (4,): the refusal's mask was
+    # taken for a vector's and failed to broadcast (numpy's ValueError)
+    direction, normal = np.array([1.0, 0, 0]), np.array([0, 0, 1.0])
+    for p in (np.ones((2, 4)), np.ones((3, 1))):
+        c = Conic(p, 0.5, np.full(4, 0.75), direction, normal, 1.0)
+        np.testing.assert_array_equal(c.b, np.broadcast_to(np.sqrt(1.0 / 0.75), (len(p), 4)))
