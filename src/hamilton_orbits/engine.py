@@ -342,11 +342,7 @@ class Propagation:
         n_t = t_out.shape[0]
         backward = n_t > 1 and t_out[-1] < t_out[0]
         events = self.events
-        first_event = 0 if events is None else len(events.recorded())
-        if events is not None:
-            if n_t > 1 and not backward:  # (not on through a collision's stop)
-                events.refuse_going_on(when=self.t)
-            events.stopped_by = None
+        first_event = self._leg_events(n_t > 1 and not backward)
         driver = self._driver_for_leg(backward)
         rows = np.empty((2, n_t) + self.r.shape)  # positions and velocities, one block
         r_out, v_out = rows[0], rows[1]
@@ -417,6 +413,18 @@ class Propagation:
         finite = all_finite(rows.reshape(-1))  # one compiled pass over both
         return EngineRun(t_reached, r_out, v_out, reached[1], wall, complete, events, gm_out,
                          self.variational, interrupted, first_event, finite)
+
+    def _leg_events(self, onwards: bool) -> int:
+        """The number of events recorded before a leg begins (0 without events), the
+        last leg's stop forgotten; a leg ``onwards`` (forwards, past its start) from
+        where a collision stopped the run refused, naming the pair."""
+        events = self.events
+        if events is None:
+            return 0
+        if onwards:  # (not on through a collision's stop)
+            events.refuse_going_on(when=self.t)
+        events.stopped_by = None
+        return len(events.recorded())
 
     def _driver_for_leg(self, backward: bool) -> Any:
         """The driver of a leg in this direction; made afresh where bodies are in
