@@ -483,7 +483,8 @@ class Conic:
         for the hyperbola the length ``|a| sqrt(e^2 - 1)`` of the imaginary
         (conjugate) semi-axis, Hamilton's "vector with a positive square" (eq. 42);
         inf for the parabola.  ``sqrt(p / |inv_a|)``, or ``sqrt(p) / sqrt(|inv_a|)``
-        where ``p / |inv_a|`` alone is beyond float64 (``b`` fits where ``a`` may not).
+        where ``p / |inv_a|`` alone is beyond float64 or below its normal range (``b``
+        fits where ``a`` may not).
 
         Raises
         ------
@@ -492,8 +493,11 @@ class Conic:
         """
         ia = np.abs(np.where(self._inv_a == 0, 1.0, self._inv_a))
         with np.errstate(all="ignore"):
-            direct = np.sqrt(self._p / ia)
-            b = np.where(np.isfinite(direct), direct, np.sqrt(self._p) / np.sqrt(ia))
+            ratio = self._p / ia
+            # (p / |inv_a| beyond float64, or below its normal range, where it loses
+            # digits: p = 1e-165 gave b = 0; then each root apart)
+            whole = np.isfinite(ratio) & (ratio >= np.finfo(np.float64).tiny)
+            b = np.where(whole, np.sqrt(ratio), np.sqrt(self._p) / np.sqrt(ia))
         self._refuse_beyond_float("b", b)
         return self._out(np.where(self._inv_a == 0, np.inf, b), _L)
 

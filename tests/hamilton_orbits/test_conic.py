@@ -639,3 +639,14 @@ def test_b_of_a_conic_whose_attributes_broadcast():
     for p in (np.ones((2, 4)), np.ones((3, 1))):
         c = Conic(p, 0.5, np.full(4, 0.75), direction, normal, 1.0)
         np.testing.assert_array_equal(c.b, np.broadcast_to(np.sqrt(1.0 / 0.75), (len(p), 4)))
+
+
+def test_b_of_a_tiny_conic():
+    # p / inv_a below float64's normal range lost its digits under the root: a = 1e-165,
+    # e = 0.5 gave b = 0 (8.66e-166 = a sqrt(1 - e^2)); each root apart, within 2 ulp
+    # of mpmath's (two roots and a division of exact inputs)
+    mpmath.mp.dps = 40
+    for a in (1e-165, 1e-160, 1e-150):
+        c = Conic.from_elements(a * 0.75, 0.5, 1.0 / a, 0.3, 0.2, 0.1, 1.0)
+        want = float(mpmath.sqrt(mpmath.mpf(float(c.p)) / mpmath.mpf(float(c.inv_a))))
+        assert abs(float(c.b) - want) <= 2 * np.spacing(want), (a, float(c.b), want)
