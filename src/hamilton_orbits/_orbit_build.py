@@ -125,16 +125,16 @@ def p_and_inv_a(lname: str, length: np.ndarray, e: np.ndarray, given: Any = None
 
 def _refuse_beyond(lname: str, length: np.ndarray, e: np.ndarray, p: np.ndarray,
                    inv_a: np.ndarray, given: Any) -> None:
-    """Refuse ``p`` or ``1/a`` beyond float64 (computed with overflow ignored), naming
-    ``e`` where ``1 - e^2`` alone is (e ~ 1e200: the length was named, after a
-    RuntimeWarning), else the length ``lname`` (as the caller refuses a state
-    beyond float64)."""
-    bad = ~(np.isfinite(p) & np.isfinite(inv_a))
-    if np.any(bad):
-        with np.errstate(over="ignore"):
-            e_bad = bad & ~np.isfinite((1.0 - e) * (1.0 + e))
-        raise_at("e", e_bad, e, "for which 1 - e^2 fits in float64")
-        raise_at(lname, bad, length, "to give a finite state (check the elements)", given)
+    """Refuse ``1 - e^2`` beyond float64, naming ``e`` (e ~ 1e200: the length was
+    named, after a RuntimeWarning), and ``p`` beyond it, naming the length ``lname``
+    (as the caller refuses a state beyond float64).  A ``1/a`` beyond float64 alone
+    (``inv_a`` inf: a length below 1/1.8e308, subnormal) is no refusal: the state
+    of such an orbit is built, and its elements refuse what does not fit, by name."""
+    with np.errstate(over="ignore"):
+        e_bad = ~np.isfinite((1.0 - e) * (1.0 + e))
+    raise_at("e", e_bad, e, "for which 1 - e^2 fits in float64")
+    raise_at(lname, ~np.isfinite(p), length, "to give a finite state (check the elements)",
+             given)
 
 
 def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
