@@ -120,7 +120,8 @@ def check_output_memory(n_outputs: int, n_bodies: int, stm: bool,
     advice = (f": ask for at most {fit} outputs, or" if fit >= 2
               else "; not even the start and the end fit:")
     size = (f"{n_outputs:.4g} outputs of {n_bodies} bodies would take "
-            f"{beyond_limit(states + matrices, limit)} (half this machine's memory)")
+            f"{beyond_limit(states + matrices, limit)} (half this machine's memory, at "
+            f"least 1 GiB)")
     if stm and states <= limit:  # (the STM's rows take the outputs beyond it)
         raise ValueError(
             f"Expected the STM's outputs (`stm` = True) to fit in memory: {size} with "
