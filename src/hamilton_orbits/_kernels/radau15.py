@@ -356,6 +356,14 @@ def _tau2(a0, b, i):  # pragma: no cover - compiled
 #: (:func:`_dt_prs23`; at the step's underflow, each step a quarter of what is left
 #: to the crossing, it is there within about 16)
 _CROSSING = 64.0 * _EPS
+#: a body whose acceleration (its largest component) is at most this fraction of the
+#: largest body's is left out of :func:`_dt_prs23`'s timescale: such an acceleration
+#: is the rounding residue of pulls that cancel (the central body of a point-symmetric
+#: system: 1e-19 of its planets' 1), whose ``tau`` measures noise and sent the step
+#: to underflow at the start, as IAS15's does (there a physical acceleration is a
+#: body's pull at 10^7 times the distance of the closest pair, whose pace is not the
+#: system's)
+_RESIDUE = 64.0 * _EPS
 
 
 @njit(cache=True, inline="always")
@@ -366,7 +374,8 @@ def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     whose acceleration at the start of the step is zero (the third body of the
     figure-eight at t = 0, a body at an equilibrium) is left out, as rebound's
     IAS15 does: its timescale measures the zero crossing of ``a``, not a fast
-    motion.  Where the squares over- or underflow (a system of a very small or
+    motion; so is a body whose acceleration is within :data:`_RESIDUE` of zero
+    relative to the largest (the rounding residue of pulls that cancel).  Where the squares over- or underflow (a system of a very small or
     very large length scale: accelerations beyond 1e150 or below 1e-150) the
     components are first scaled by a power of two (``tau`` is a ratio, the scale
     cancels), so that the step follows the motion at every scale instead of
@@ -388,7 +397,13 @@ def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
     min_tau2 = math.inf
     min_rest = math.inf  # (over the bodies not at a crossing)
     near = (_CROSSING * abs(t) / dt_done) ** 2  # (the crossing's test, in squares)
+    top = 0.0
+    for k in range(3 * n):
+        top = max(top, abs(a0[k]))
+    residue = _RESIDUE * top if top < math.inf else 0.0
     for i in range(n):
+        if max(abs(a0[3 * i]), abs(a0[3 * i + 1]), abs(a0[3 * i + 2])) <= residue:
+            continue  # (a rounding residue: see _RESIDUE)
         tau2, y2, a0i, y3 = _tau2(a0, b, i)
         if tau2 < min_tau2:
             min_tau2 = tau2
