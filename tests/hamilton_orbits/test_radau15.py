@@ -524,8 +524,10 @@ def test_a_central_body_whose_pulls_cancel_does_not_set_the_step():
     from hamilton_orbits import Body, Radau15, System, integrate
 
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
-                Body("a", 1e-3, [1, 0, 0], [0, 1, 0]), Body("b", 1e-3, [1.2, 0, 0], [-0.5, 0.9, 0]),
-                Body("c", 1e-3, [-1, 0, 0], [0, -1, 0]), Body("d", 1e-3, [-1.2, 0, 0], [0.5, -0.9, 0])])
+                Body("a", 1e-3, [1, 0, 0], [0, 1, 0]),
+                Body("b", 1e-3, [1.2, 0, 0], [-0.5, 0.9, 0]),
+                Body("c", 1e-3, [-1, 0, 0], [0, -1, 0]),
+                Body("d", 1e-3, [-1.2, 0, 0], [0.5, -0.9, 0])])
     assert 0.0 < np.abs(s.accelerations()[0]).max() < 1e-18  # (the residue, not 0)
     tr = integrate(s, 1.0)
     ref = integrate(s, 1.0, method=Radau15(criterion="global"))

@@ -368,18 +368,17 @@ _RESIDUE = 64.0 * _EPS
 
 @njit(cache=True, inline="always")
 def _dt_prs23(a0, b, n, dt_done, eps, t):  # pragma: no cover - compiled
-    """Pham, Rein & Spiegel (2024): the shortest timescale
-    ``tau^2 = 2 |a|^2 / (|a'|^2 + |a| |a''|)`` over bodies, with ``a, a', a''``
-    from the polynomial at the end of the step (derivatives per unit h).  A body
-    whose acceleration at the start of the step is zero (the third body of the
-    figure-eight at t = 0, a body at an equilibrium) is left out, as rebound's
-    IAS15 does: its timescale measures the zero crossing of ``a``, not a fast
-    motion; so is a body whose acceleration is within :data:`_RESIDUE` of zero
-    relative to the largest (the rounding residue of pulls that cancel).  Where the squares over- or underflow (a system of a very small or
-    very large length scale: accelerations beyond 1e150 or below 1e-150) the
-    components are first scaled by a power of two (``tau`` is a ratio, the scale
-    cancels), so that the step follows the motion at every scale instead of
-    leaving the body out.
+    """Pham, Rein & Spiegel (2024): the shortest timescale ``tau^2 = 2 |a|^2 / (|a'|^2 +
+    |a| |a''|)`` over bodies, with ``a, a', a''`` from the polynomial at the end of the
+    step (derivatives per unit h).  A body whose acceleration at the start of the step
+    is zero (the third body of the figure-eight at t = 0, a body at an equilibrium) is
+    left out, as rebound's IAS15 does: its timescale measures the zero crossing of
+    ``a``, not a fast motion; so is a body whose acceleration is within :data:`_RESIDUE`
+    of zero relative to the largest (the rounding residue of pulls that cancel).  Where
+    the squares over- or underflow (a system of a very small or very large length scale:
+    accelerations beyond 1e150 or below 1e-150) the components are first scaled by a
+    power of two (``tau`` is a ratio, the scale cancels), so that the step follows the
+    motion at every scale instead of leaving the body out.
 
     A body whose acceleration passes through zero elsewhere (a particle crossing
     the midpoint of a pair, Sitnikov's problem) has ``tau -> 0`` as the step's end
