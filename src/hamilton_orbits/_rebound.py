@@ -22,9 +22,10 @@ __all__ = ["arrays_from_simulation", "binary_of", "particle_name", "radii_of",
 
 
 def simulation_from_arrays(names: Sequence[str], gm: np.ndarray, r: np.ndarray,
-                           v: np.ndarray, radius: np.ndarray | None = None) -> Any:
-    """A ``rebound.Simulation`` with ``G = 1``, ``m = gm`` and the given state (and
-    the particles' radii ``radius``, NaN for none).
+                           v: np.ndarray, radius: np.ndarray | None = None,
+                           G: float = 1.0) -> Any:
+    """A ``rebound.Simulation`` with ``sim.G = G``, ``m = gm / G`` and the given state
+    (and the particles' radii ``radius``, NaN for none).
 
     Examples
     --------
@@ -32,15 +33,20 @@ def simulation_from_arrays(names: Sequence[str], gm: np.ndarray, r: np.ndarray,
     ...                              np.zeros((1, 3)))
     >>> sim.particles["sun"].m, sim.G
     (1.0, 1.0)
+    >>> sim = simulation_from_arrays(["sun"], np.array([1.0]), np.zeros((1, 3)),
+    ...                              np.zeros((1, 3)), G=2.0)
+    >>> sim.particles["sun"].m, sim.G
+    (0.5, 2.0)
     """
     import rebound
 
     sim = rebound.Simulation()
-    sim.G = 1.0
+    sim.G = float(G)  # (with m = gm / G: rebound's energy is the system's, not G times it)
+    m = np.asarray(gm, dtype=np.float64) / float(G)
     for k, name in enumerate(names):
         x, y, z = (float(c) for c in r[k])
         vx, vy, vz = (float(c) for c in v[k])
-        sim.add(m=float(gm[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz)
+        sim.add(m=float(m[k]), x=x, y=y, z=z, vx=vx, vy=vy, vz=vz)
         if radius is not None and radius[k] > 0:  # (NaN: none, rebound's 0)
             sim.particles[k].r = float(radius[k])
         # set through the particle in the simulation: rebound copies the name into
@@ -69,8 +75,16 @@ def particle_name(particle: Any) -> str | None:
     return ctypes.string_at(ptr).decode("utf-8") if ptr else None
 
 
-def radii_of(sim: Any) -> np.ndarray:
-    """The particles' radii of a ``rebound.Simulation``, NaN where it has none (0).
+def radii_of(sim: Any, names: Sequence[str] | None = None) -> np.ndarray:
+    """The particles' radii of a ``rebound.Simulation``, NaN where it has none (0,
+    rebound's default).
+
+    Raises
+    ------
+    ValueError
+        For a negative (or NaN) radius ``r``, naming the particle's index, its name
+        (``names``, else rebound's) and the value: read as no radius, it dropped the
+        particle's collisions unsaid.
 
     Examples
     --------
@@ -79,10 +93,54 @@ def radii_of(sim: Any) -> np.ndarray:
     ...                              radius=np.array([0.5, np.nan]))
     >>> radii_of(sim).tolist()
     [0.5, nan]
+    >>> sim.particles[1].r = -0.1
+    >>> radii_of(sim)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `sim`'s particles to have a radius r >= 0 ..., got r = -0.1 ...('b')
     """
     radius = np.array([sim.particles[k].r for k in range(sim.N)], dtype=np.float64)
+    bad = np.flatnonzero(~(radius >= 0))
+    if bad.size:
+        k = int(bad[0])
+        name = names[k] if names is not None else particle_name(sim.particles[k])
+        raise ValueError(f"Expected `sim`'s particles to have a radius r >= 0 (0 for none), "
+                         f"got r = {float(radius[k])!r} for particle {k}"
+                         f"{f' ({name!r})' if name else ''}")
     radius[~(radius > 0)] = np.nan
     return radius
+
+
+def _check_test_particles(sim: Any, names: Sequence[str]) -> None:
+    """Refuse particles beyond rebound's ``N_active`` that carry mass (rebound's massive
+    test particles): a System has no such bodies, and read as full bodies they pulled
+    on every body, other physics than rebound's, unsaid.  Massless ones are our
+    massless bodies (they pull on none and feel every massive body): accepted."""
+    n, n_active = sim.N, sim.N_active
+    if not 0 <= n_active < n:  # (-1: every particle active)
+        return
+    heavy = [k for k in range(n_active, n) if sim.particles[k].m != 0.0]
+    if not heavy:
+        return
+    k, kind = heavy[0], sim.testparticle_type
+    more = f" and {len(heavy) - 1} more" if len(heavy) > 1 else ""
+    # (every particle beyond N_active: rebound's test particles feel none of each
+    # other, its massless ones not the massive ones either)
+    listed = (list(names[n_active:]) if n - n_active <= 6
+              else f"<the names of particles {n_active} to {n - 1}>")
+    if kind == 1 and n_active > 0:
+        what = ("with testparticle_type = 1 rebound lets them pull on the active bodies but "
+                "not on each other: for rebound's physics set sim.N_active = -1 and "
+                f"integrate with effects=[{{'name': 'semi_active', 'bodies': {listed}}}] "
+                "(without it they pull on each other too), or set their m to 0 to make "
+                "them test particles that pull on none")
+    else:
+        what = (f"with testparticle_type = {kind} rebound lets them pull on nothing: set "
+                "their m to 0 for rebound's physics (massless bodies), or sim.N_active = -1 "
+                "to make them full bodies (other physics: they pull on every body)")
+    raise ValueError(f"Expected `sim`'s particles beyond N_active = {n_active} (rebound's test "
+                     f"particles) to be massless, got m = {sim.particles[k].m!r} for particle "
+                     f"{k} ({names[k]!r}){more}: {what}")
 
 
 def arrays_from_simulation(
@@ -93,8 +151,12 @@ def arrays_from_simulation(
     Raises
     ------
     ValueError
-        If ``sim`` is not a rebound simulation or holds no particle, or ``names``
-        has the wrong length.
+        If ``sim`` is not a rebound simulation or holds no particle, ``names`` has
+        the wrong length, or a particle beyond ``sim.N_active`` carries mass
+        (rebound's massive test particles, which pull on nothing with
+        ``testparticle_type = 0`` and on the active bodies alone with 1; the
+        message says how to read them).  Massless particles beyond ``N_active``
+        are massless bodies.
 
     Examples
     --------
@@ -118,6 +180,7 @@ def arrays_from_simulation(
         raise ValueError(f"Expected `names` to hold {n} names, got {len(names)}")
     out = names if names is not None else [
         particle_name(sim.particles[k]) or f"body{k}" for k in range(n)]
+    _check_test_particles(sim, out)
     r = np.empty((n, 3))
     v = np.empty((n, 3))
     gm = np.empty(n)

@@ -85,8 +85,14 @@ class InitialStates:
     """
 
     def to_rebound(self):
-        """A ``rebound.Simulation`` of this system (G = 1, m = gm, internal units: exact;
-        the radii given, as the particles' ``r``).
+        """A ``rebound.Simulation`` of this system, in its internal units, the radii
+        given as the particles' ``r``.
+
+        A plain-float system gives rebound its ``G`` and masses ``m = gm / G``, so
+        that rebound's ``energy()`` and ``angular_momentum()`` are the system's and
+        :meth:`from_rebound` gives back its ``G`` (``gm`` bit for bit for ``G = 1``
+        or a power of 2, else to 1 ulp: ``G m`` in floats); a Quantity system gives
+        ``G = 1`` and ``m = gm`` in au^3/day^2 (exact).
 
         Examples
         --------
@@ -94,12 +100,15 @@ class InitialStates:
         >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
         >>> s.to_rebound().particles["sun"].m
         1.0
+        >>> sim = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])], G=2.0).to_rebound()
+        >>> sim.G, sim.particles["sun"].m
+        (2.0, 0.5)
         """
         from hamilton_orbits._rebound import simulation_from_arrays
 
         arrays = self.as_arrays()
         return simulation_from_arrays(arrays.names, arrays.gm, arrays.r, arrays.v,
-                                      arrays.radius)
+                                      arrays.radius, 1.0 if arrays.quantity else arrays.G)
 
     @classmethod
     def from_rebound(cls, sim, *, quantity: bool = False,
@@ -108,6 +117,14 @@ class InitialStates:
         system's ``G`` is the simulation's, so that ``energy`` and
         ``angular_momentum`` are rebound's; a particle's radius ``r`` is its body's
         ``radius``, none where 0).
+
+        rebound's test particles (those beyond ``sim.N_active``, where it is set)
+        are read as massless bodies, which pull on none and feel every massive
+        body, as rebound's do; one that carries mass is refused, as no System holds
+        it (rebound lets it pull on nothing with ``testparticle_type = 0``, on the
+        active bodies alone with 1: for rebound's physics set its ``m`` to 0 for
+        the former; for the latter set ``sim.N_active = -1`` and integrate with the
+        effect ``semi_active`` listing every particle beyond ``N_active``).
 
         Parameters
         ----------
@@ -121,8 +138,11 @@ class InitialStates:
         Raises
         ------
         ValueError
-            If ``sim`` is not a ``rebound.Simulation`` or holds no particle, or
-            ``names`` has the wrong length.
+            If ``sim`` is not a ``rebound.Simulation`` or holds no particle,
+            ``names`` has the wrong length, a particle beyond ``sim.N_active``
+            carries mass, or a particle's radius ``r`` is negative (naming the
+            particle and the value); for ``quantity=True``, a simulation not in au
+            and days.
 
         Examples
         --------
@@ -138,7 +158,7 @@ class InitialStates:
         from hamilton_orbits._rebound import arrays_from_simulation, radii_of
 
         names, gm, r, v = arrays_from_simulation(sim, names)
-        radius = [None if np.isnan(x) else float(x) for x in radii_of(sim)]
+        radius = [None if np.isnan(x) else float(x) for x in radii_of(sim, names)]
         if quantity:  # (au, as its positions; G astropy's, m = gm / G)
             _au_and_days(sim)
             bodies = [body_from_floats(name, gm[k], r[k], v[k], radius[k], None, None, True)

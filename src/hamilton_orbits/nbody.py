@@ -211,7 +211,7 @@ class System(InitialStates):
         ------
         ValueError
             Naming the argument and index: non-finite values (an infinite
-            ``radius``), wrong shapes, negative ``gm``, no massive body, duplicate
+            ``radius``), wrong shapes, negative ``gm``, no body, no massive body, duplicate
             names, two bodies at one position; a mix of Quantities and floats.
 
         Examples
@@ -239,6 +239,9 @@ class System(InitialStates):
                 raise ValueError(f"Expected `{name}` to have shape ({n}, 3), got {arr.shape}")
             arrays.append(arr)
         check_positive("gm", gm_a, strict=False)
+        if n == 0:  # (it spoke of massless bodies that were not there)
+            raise ValueError("Expected `gm`, `r` and `v` to hold at least one body, got none "
+                             "(shape (0,))")
         if not np.any(gm_a > 0):
             raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
         rad = np.full(n, math.nan)
@@ -520,6 +523,8 @@ class System(InitialStates):
             # read as False, True: another body kept than the one meant)
             raise ValueError(f"Expected `keep` to be {n} booleans (True for a body kept), "
                              f"got {np.asarray(keep).tolist()!r}")
+        if keep is not None and not np.any(keep):
+            raise ValueError(f"Expected `keep` to keep at least one body, got {n} False")
 
     def _check_state(self) -> None:
         from hamilton_orbits.validation import check_positive
@@ -527,6 +532,8 @@ class System(InitialStates):
         n = len(self._names)
         check_finite("gm", self._gm)
         check_positive("gm", self._gm, strict=False)
+        if n == 0:  # (it spoke of massless bodies that were not there)
+            raise ValueError("Expected at least one body, got none")
         if not np.any(self._gm > 0):
             raise ValueError("Expected at least one body with `gm` > 0, got only massless bodies")
         for name, arr in (("r", self._r), ("v", self._v)):

@@ -1,9 +1,11 @@
 """rebound and reboundx: the same system in the peer code, and a cross-check against it.
 
-The conversion is exact: rebound is given ``G = 1`` and masses equal to the
-system's ``gm`` in its internal units (au and day for Quantity systems), so that
-positions, velocities and ``G m`` pass through bit for bit.  Bodies keep their
-names (rebound's ``Particle.name``).
+The conversion: rebound is given the system's ``G`` and masses ``m = gm / G`` in
+its internal units (for Quantity systems au and day, ``G = 1`` and ``m = gm``), so
+that positions and velocities pass through bit for bit and ``G m`` too for ``G = 1``
+(else to 1 ulp).  Bodies keep their names (rebound's ``Particle.name``).  rebound's
+massless test particles (beyond ``N_active``) are massless bodies; massive ones are
+refused (:meth:`System.from_rebound`).
 """
 
 from __future__ import annotations
@@ -41,7 +43,9 @@ __all__ = [
 
 
 def to_rebound(system: System) -> Any:
-    """A ``rebound.Simulation`` holding ``system`` (G = 1, m = gm, internal units).
+    """A ``rebound.Simulation`` holding ``system`` (its internal units; see
+    :meth:`System.to_rebound`: the system's G and m = gm / G for a plain-float system,
+    G = 1 and m = gm for a Quantity system).
 
     Examples
     --------

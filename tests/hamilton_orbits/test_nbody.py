@@ -161,6 +161,113 @@ def test_from_rebound_keeps_its_g_and_radii():
     assert [p.r for p in back.particles] == [0.005, 0.0005, 0.0]
 
 
+def test_to_rebound_keeps_a_plain_float_g():
+    """A plain-float system of G = 2 went to rebound as G = 1, m = gm: the round trip
+    gave G = 1 and rebound's energy and angular momentum were twice the system's.
+    rebound is given the system's G and m = gm / G: the round trip keeps G (and gm
+    bit for bit for a power of 2, to 1 ulp otherwise), rebound's integrals are the
+    system's, its accelerations ours, and its orbit of a pair the circular one."""
+    for g in (2.0, 3.7):
+        gm = np.array([g, 1e-3 * g])  # (masses 1 and 1e-3)
+        a = System([Body("a", gm[0], [0, 0, 0], [0, 0, 0]),
+                    Body("b", gm[1], [1, 0, 0], [0, math.sqrt(gm.sum()), 0], radius=0.1)],
+                   G=g)
+        sim = a.to_rebound()
+        assert sim.G == g
+        assert sim.energy() == pytest.approx(a.energy(), rel=1e-14)
+        np.testing.assert_allclose(sim.angular_momentum(), a.angular_momentum(), rtol=1e-14)
+        back = from_rebound(sim)
+        assert back.G == g and back.names == a.names
+        np.testing.assert_array_equal(back._r, a._r)
+        np.testing.assert_array_equal(back._v, a._v)
+        np.testing.assert_array_equal(back.as_arrays().radius, [np.nan, 0.1])
+        if g == 2.0:
+            np.testing.assert_array_equal(back._gm, a._gm)
+        else:
+            np.testing.assert_allclose(back._gm, a._gm, rtol=EPS, atol=0)
+        assert back.energy() == pytest.approx(a.energy(), rel=1e-15)
+        scale = np.abs(a.accelerations()).max()
+        assert np.abs(rebound_accelerations(a) - a.accelerations()).max() <= 4 * EPS * scale
+        # rebound integrates the same pair: the circular orbit of mean motion sqrt(sum gm)
+        sim.integrator = "ias15"
+        sim.integrate(1.0, exact_finish_time=1)
+        rel = np.array(sim.particles[1].xyz) - np.array(sim.particles[0].xyz)
+        n = math.sqrt(gm.sum())
+        np.testing.assert_allclose(rel, [math.cos(n), math.sin(n), 0.0], rtol=0, atol=1e-13)
+
+
+def _with_test_particles(kind: int, m_test: float):
+    import rebound
+
+    sim = rebound.Simulation()
+    sim.add(m=1.0, name="sun")
+    sim.add(m=1e-3, a=1.0, name="planet")
+    sim.add(m=m_test, a=1.3, name="tp1")
+    sim.add(m=m_test, a=1.6, f=2.0, name="tp2")
+    sim.add(m=0.0, a=2.0, f=1.0, name="dust")
+    sim.N_active, sim.testparticle_type = 2, kind
+    return sim
+
+
+@pytest.mark.parametrize(("kind", "match"), [
+    (0, "with testparticle_type = 0 rebound lets them pull on nothing: set their m to 0 "
+        "for rebound's physics (massless bodies), or sim.N_active = -1 to make them full "
+        "bodies"),
+    (1, "with testparticle_type = 1 rebound lets them pull on the active bodies but not on "
+        "each other: for rebound's physics set sim.N_active = -1 and integrate with "
+        "effects=[{'name': 'semi_active', 'bodies': ['tp1', 'tp2', 'dust']}]"),
+], ids=["type0", "type1"])
+def test_from_rebound_refuses_massive_test_particles(kind, match):
+    """rebound's particles beyond N_active that carry mass (its massive test
+    particles: type 0 pull on nothing, type 1 on the active bodies alone) were read
+    as full bodies, pulling on each other and on every body: other physics than
+    rebound's, unsaid.  They are refused, naming the particle, its mass and what
+    reproduces rebound's rule; massless ones are read as massless bodies."""
+    import re
+
+    sim = _with_test_particles(kind, 1e-2)
+    head = ("Expected `sim`'s particles beyond N_active = 2 (rebound's test particles) to "
+            "be massless, got m = 0.01 for particle 2 ('tp1') and 1 more: ")
+    for read in (System.from_rebound, from_rebound):
+        with pytest.raises(ValueError, match=re.escape(head + match)):
+            read(sim)
+    with pytest.raises(ValueError, match=r"for particle 2 \('x2'\)"):
+        System.from_rebound(sim, names=["x0", "x1", "x2", "x3", "x4"])
+    s = System.from_rebound(_with_test_particles(kind, 0.0))  # (massless: accepted)
+    assert s.gm.tolist() == [1.0, 1e-3, 0.0, 0.0, 0.0]
+    sim.N_active = -1  # (every particle active: full bodies, as asked)
+    assert System.from_rebound(sim).gm.tolist() == [1.0, 1e-3, 1e-2, 1e-2, 0.0]
+
+
+def test_from_rebound_refuses_a_negative_radius():
+    """A rebound particle of radius r = -0.1 was read as no radius (rebound's 0),
+    unsaid; it is refused, naming the particle and the value (0 is still none)."""
+    import rebound
+
+    sim = rebound.Simulation()
+    sim.add(m=1.0, r=0.01, name="sun")
+    sim.add(m=1e-3, a=1.0, r=-0.1, name="p")
+    sim.add(m=0.0, a=2.0)
+    with pytest.raises(ValueError, match=r"^Expected `sim`'s particles to have a radius "
+                                         r"r >= 0 \(0 for none\), got r = -0\.1 for "
+                                         r"particle 1 \('p'\)$"):
+        System.from_rebound(sim)
+    sim.particles[1].r = 0.0
+    np.testing.assert_array_equal(System.from_rebound(sim).as_arrays().radius,
+                                  [0.01, np.nan, np.nan])
+
+
+def test_no_body_is_not_called_massless_bodies():
+    """``System.from_arrays`` with no body said "got only massless bodies"."""
+    with pytest.raises(ValueError, match=r"^Expected `gm`, `r` and `v` to hold at least one "
+                                         r"body, got none \(shape \(0,\)\)$"):
+        System.from_arrays(np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
+    s = random_system(2, 1)
+    with pytest.raises(ValueError, match=r"^Expected `keep` to keep at least one body, got "
+                                         r"2 False$"):
+        s.with_state(s.r, s.v, keep=np.array([False, False]))
+
+
 def test_from_rebound_of_an_empty_simulation_names_sim():
     """A rebound simulation with no particle blamed ``bodies``, an argument the caller
     never gave: the message names ``sim``, through both front doors."""
