@@ -49,6 +49,8 @@ Where actions take effect
 symplectic maps (``wh``, ``leapfrog``) report every event at its refined time,
 but act (stop, merge, remove) at the end of the step in which it occurred: a
 step cut short, or a body changed mid-step, would break the map's symplecticity.
+Every event of the step (or of the instant) acts: two pairs that collide in one
+step both merge, a stop and a merge in one step end the run with the merge done.
 Merging or removing bodies changes the Hamiltonian itself; the integrals'
 errors after such an event measure the change, not the integrator.
 
@@ -379,6 +381,15 @@ def _encounter_distance(value: Any, system: Any, i: int, j: int, where: str) -> 
     return k * (1.0 / inv_a) * (a.gm[big] / (3.0 * a.gm[top])) ** (1.0 / 3.0)
 
 
+def _same_instant(a: float, b: float) -> bool:
+    """Whether two events' times are one instant to rounding.  Simultaneous events (of
+    a symmetric set-up) are found by separate root solves, whose times can differ in
+    their last bits: an event one ulp after the one that acts at its time (radau15,
+    dop853) was dropped as not having happened, and its pair passed through each
+    other."""
+    return abs(a - b) <= 64 * np.spacing(max(abs(a), abs(b)))
+
+
 class StopAtEvent(Exception):
     """Raised by a driver when an event stopped the run; ``index`` is the output
     row that holds the state at the event's time ``t``, after ``steps`` steps."""
@@ -562,10 +573,48 @@ class EventLog:
 
     def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
             at: float | None = None) -> bool:
-        """Carry out the action of watch row ``row`` at time ``t`` on the state
-        ``r``, ``v``, ``gm`` (changed in place); True if the run must stop.  ``at``: the
-        time of the event that acts, where the action is taken at the end of its step
-        (wh, leapfrog: ``t``); the rows the step's scan found after it are dropped.
+        """Carry out the actions of the events of one step (wh, leapfrog) or one
+        instant (radau15, dop853) on the state ``r``, ``v``, ``gm`` (changed in place);
+        True if the run must stop.
+
+        Parameters
+        ----------
+        row : int
+            The watch row of the event the kernel stopped at.
+        t : float
+            The time the actions are taken at: the end of the step (wh, leapfrog),
+            the event's own time (radau15, dop853).
+        r, v : ndarray, shape (n, 3)
+            Positions and velocities at ``t``, in the system's body order.
+        gm : ndarray, shape (n,)
+            The bodies' ``G m``.
+        at : float, optional
+            The time of the kernel's event, where the action is taken at the end of
+            its step (wh, leapfrog); default ``t``.
+
+        Returns
+        -------
+        bool
+            Whether one of the actions is a stop.
+
+        Notes
+        -----
+        The event of ``row`` acts first (the kernel's: the step's first with an
+        action), then every other event with an action (stop, merge, remove) among
+        the rows drained here, in the log's (time) order, each as
+        :meth:`_kept_until` keeps the log up to it: the rows the scan found after
+        an event of the same bodies are dropped, as are those of another pair of a
+        body taken out at the same instant (a body touching two others at once
+        merges into the first), and a row of a body an earlier action took out is
+        dropped unacted.  Two pairs that touch in one step (wh, leapfrog) or at one
+        instant to rounding (radau15, dop853) thus both merge, and two bodies that
+        escape with ``"remove"`` both leave (only the kernel's event acted; the
+        others stayed listed, their bodies going through each other or on).  The
+        rows in the log before this call were acted on in their own steps (the
+        drivers drain a step with an action here only), and are not acted on again.
+        ``stopped_by`` is the first stop among them; the merges and removals are
+        done also where a stop comes first.  ``gm_changes`` gets one entry, at
+        ``t``, for each merge or removal.
 
         ``"merge"`` keeps the lower-indexed body with the pair's summed ``gm`` at
         their centre of mass, with their total momentum and the radius of their
@@ -573,14 +622,40 @@ class EventLog:
         far away with ``gm = 0`` (it then pulls on nothing and is pulled by almost
         nothing) and marked ``inactive``; its outputs are NaN from then on.
         """
+        before = len(self.rows)
         self.drain()
+        fresh = self.rows[before:]  # (this step's or instant's rows: see Notes)
         code, i, j, _, action = self.watch[row]
-        i, j, action = int(i), int(j), int(action)
+        done = [self._carry_out(code, int(i), int(j), int(action), t,
+                                t if at is None else at, r, v, gm, [])]
+        for x in [x for x in fresh if x[E_ACTION] != ACTIONS["record"]]:
+            if any(x is y for y, _ in done) or id(x) not in {id(y) for y in self.rows}:
+                continue  # (acted on, or dropped by an action as not having happened)
+            bodies = [int(x[E_I])] + ([int(x[E_J])] if x[E_J] >= 0 else [])
+            if self.inactive[bodies].any():  # (taken out by an action of the batch)
+                self.rows = [y for y in self.rows if y is not x]
+                continue
+            done.append(self._carry_out(  # (at its own time: actions act forwards only)
+                x[E_CODE], int(x[E_I]), int(x[E_J]), int(x[E_ACTION]), t, float(x[E_TIME]),
+                r, v, gm, [y for y, _ in done]))
+        stops = [y for y, a in done if a == ACTIONS["stop"]]
+        if stops:  # (indices only now: each action's _kept_until drops rows before them)
+            where = [k for k, y in enumerate(self.rows) if any(y is s for s in stops)]
+            self.stopped_by = min(where) if where else len(self.rows) - 1
+        return bool(stops)
+
+    def _carry_out(self, code: float, i: int, j: int, action: int, t: float, at: float,
+                   r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                   acted: list[np.ndarray]) -> tuple[np.ndarray | None, int]:
+        """One action of :meth:`act`: the log kept up to its event (the rows in ``acted``,
+        carried out before it, kept), then the merge or removal done.  Returns the
+        log's row of the event (None where the log has none) and the action."""
         gone = _NOBODY if action == ACTIONS["stop"] else j if action == ACTIONS["merge"] else i
-        acting = self._kept_until(code, i, j, action, t, t if at is None else at, gone)
+        # (a further event of the instant may lie ulps after ``t``: see _same_instant)
+        k = self._kept_until(code, i, j, action, max(t, at), at, gone, acted)
+        acting = self.rows[k] if 0 <= k < len(self.rows) else None
         if action == ACTIONS["stop"]:
-            self.stopped_by = acting
-            return True
+            return acting, action
         if action == ACTIONS["merge"]:
             m = gm[i] + gm[j]
             wi, wj = (gm[i] / m, gm[j] / m) if m > 0 else (0.5, 0.5)
@@ -588,15 +663,12 @@ class EventLog:
             v[i] = wi * v[i] + wj * v[j]
             gm[i] = m
             self.radius[i] = np.cbrt(self.radius[i] ** 3 + self.radius[j] ** 3)
-            gone = j
-        else:
-            gone = i
         self._park(gone, r, v, gm)
         self.gm_changes.append((t, gm.copy()))
-        return False
+        return acting, action
 
     def _kept_until(self, code: float, i: int, j: int, action: int, t: float, at: float,
-                    gone: int) -> int:
+                    gone: int, acted: Sequence[np.ndarray] = ()) -> int:
         """Keep the rows up to the event that acts: the row of this watch entry (its
         pair, code and action) at or before ``t`` nearest to ``at``, its time.  What the
         scan found later in the same step did not happen, the run going on (or
@@ -606,8 +678,10 @@ class EventLog:
         dropped (they kept them all, listed a second merge of a pair merged once,
         and a stop named the last contact).  At the same instant, a row of another
         pair of the body the action takes out (``gone``) did not happen either (a
-        body touching two others at once merges into the first).  Returns the index
-        of the row that acts."""
+        body touching two others at once merges into the first); the same instant
+        is the same time to rounding (:func:`_same_instant`).  The rows of
+        ``acted``, events acted on before this one in the same step, are kept.
+        Returns the index of the row that acts."""
         mine = [k for k, x in enumerate(self.rows)
                 if x[E_I] == i and x[E_J] == j and x[E_CODE] == code and x[E_ACTION] == action
                 and x[E_TIME] <= t]
@@ -621,9 +695,9 @@ class EventLog:
 
         def happened(k: int, x: np.ndarray) -> bool:
             bodies = {int(x[E_I]), int(x[E_J])} - {-1}
-            if x[E_TIME] < t_ev or k == acting:
+            if x[E_TIME] < t_ev or k == acting or any(x is y for y in acted):
                 return True
-            if x[E_TIME] == t_ev:
+            if _same_instant(x[E_TIME], t_ev):
                 return gone not in bodies
             return x[E_TIME] <= t and t_ev < t and not pair & bodies
 

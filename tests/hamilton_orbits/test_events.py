@@ -728,3 +728,104 @@ def test_a_one_body_event_that_acts_keeps_the_other_bodies_events_of_its_step(me
     else:
         tr = integrate(s, np.array([0.0, 1.0, 2.0]), method=method, dt=0.5, events=events)
     assert [str(row["bodies"]) for row in tr.events] == ["a", "c", "b"]
+
+
+def _two_pairs(gm_d: float = 1e-3, sun: bool = True) -> System:
+    """Pairs a-b and c-d on opposite sides of the origin, each coming into contact
+    once near t = 0.3 (radii 0.01; without the Sun at 0.96, radii 0.05).  With
+    ``gm_d = 1e-3`` the set-up is symmetric through the origin: the two contacts are
+    one instant (found by two root solves: to rounding)."""
+    if not sun:  # (radau15 fails on the symmetric set-up with the Sun at rest at its
+        # centre, whose acceleration is zero: see the notes of its step-size rule)
+        return System([Body("a", 1e-2, [1, 0, 0], [0, 0.05, 0], radius=0.05),
+                       Body("b", 2e-2, [1.3, 0, 0], [0, 0.02, 0.01], radius=0.05),
+                       Body("c", 1e-2, [-1, 0, 0], [0, -0.05, 0], radius=0.05),
+                       Body("d", 2e-2, [-1.3, 0, 0], [0, -0.02, -0.01], radius=0.05)])
+    return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                   Body("a", 1e-3, [1, 0, 0], [0, 1, 0], radius=0.01),
+                   Body("b", 1e-3, [1.05, 0, 0], [0, 0.9, 0.01], radius=0.01),
+                   Body("c", 1e-3, [-1, 0, 0], [0, -1, 0], radius=0.01),
+                   Body("d", gm_d, [-1.05, 0, 0], [0, -0.9, -0.01], radius=0.01)])
+
+
+def _in_one_step(times, dt: float) -> bool:
+    """Whether the events' times lie in one fixed step of length ``dt`` from 0."""
+    return len({int(np.floor(float(t) / dt)) for t in times}) == 1
+
+
+# radau15 and dop853: two contacts at one instant; wh and leapfrog: at 0.30046
+# (c-d) and 0.30103 (a-b), in one step of 0.01
+TWO_CONTACTS = [pytest.param("radau15", {}, dict(sun=False), id="radau15"),
+                pytest.param("dop853", {}, {}, id="dop853"),
+                pytest.param("wh", {"dt": 0.01}, dict(gm_d=1.005e-3), id="wh"),
+                pytest.param("leapfrog", {"dt": 0.01}, dict(gm_d=1.005e-3), id="leapfrog")]
+
+
+@pytest.mark.parametrize(("method", "kw", "setup"), TWO_CONTACTS)
+def test_two_pairs_that_merge_in_one_step_or_instant_both_merge(method, kw, setup):
+    """Two merges of two pairs at one instant (radau15, dop853), or in one step (wh,
+    leapfrog, which act at its end): both were listed, only the first carried out
+    (one watch row acted), and the other pair went through each other.  dop853
+    found c-d's contact one ulp after a-b's, and dropped it as not having happened."""
+    system = _two_pairs(**setup)
+    traj = integrate(system, 1.0, method=method,
+                     events=[{"name": "collision", "action": "merge"}], **kw)
+    assert sorted(str(b) for b in traj.events["bodies"]) == ["a-b", "c-d"]
+    assert list(traj.events["action"]) == ["merge", "merge"]
+    if "dt" in kw:
+        assert _in_one_step(traj.events["time"], kw["dt"])
+    else:
+        t_a, t_c = (float(t) for t in traj.events["time"])
+        assert t_a == pytest.approx(t_c, rel=1e-14)
+    arrays, final = system.as_arrays(), traj.final.as_arrays()
+    assert traj.final.names == system.names[:-4] + ("a", "c")
+    gm = dict(zip(system.names, arrays.gm, strict=True))
+    np.testing.assert_array_equal(final.gm[-2:], [gm["a"] + gm["b"], gm["c"] + gm["d"]])
+    # the merges conserve momentum: to rounding of the largest momenta in play (dop853
+    # and wh, leapfrog conserve it to rounding too, in a set-up symmetric to ~1e-3)
+    v_max = np.nanmax(np.linalg.norm(np.asarray(traj.v), axis=2), axis=0)
+    scale = float(arrays.gm @ v_max)
+    np.testing.assert_allclose(final.gm @ final.v, arrays.gm @ arrays.v, rtol=0,
+                               atol=8 * np.finfo(float).eps * scale)
+    assert np.all(np.isnan(np.asarray(traj.r)[-1, [-3, -1]]))  # b and d are gone
+    assert traj.stopped_by is None and float(traj.t[-1]) == 1.0
+
+
+@pytest.mark.parametrize(("method", "kw", "v_q"), [
+    ("radau15", {}, -3.0), ("dop853", {}, -3.0), ("wh", {"dt": 0.05}, -3.001),
+    ("leapfrog", {"dt": 0.01}, -3.001)])
+def test_two_bodies_that_escape_in_one_step_or_instant_are_both_removed(method, kw, v_q):
+    """Two escapes with ``"remove"`` at one instant (radau15, dop853: p and q
+    symmetric), or in one step (wh, leapfrog: at 0.67230 and 0.67253): both were
+    listed as removed, one body was taken out, the other integrated on."""
+    system = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                     Body("p", 0.0, [3, 0, 0], [3, 0, 0]), Body("q", 0.0, [-3, 0, 0], [v_q, 0, 0])])
+    traj = integrate(system, np.array([0.0, 0.5, 1.0]), method=method,
+                     events=[{"name": "escape", "distance": 5.0, "action": "remove"}], **kw)
+    assert sorted(str(b) for b in traj.events["bodies"]) == ["p", "q"]
+    assert list(traj.events["action"]) == ["remove", "remove"]
+    if "dt" in kw:
+        assert _in_one_step(traj.events["time"], kw["dt"])
+    assert traj.final.names == ("sun",)
+    r = np.asarray(traj.r)
+    assert np.isfinite(r[1, 1:]).all() and np.isnan(r[2, 1:]).all()  # (gone at 0.67)
+
+
+@pytest.mark.parametrize("stop", ["a-b", "c-d"])
+def test_a_stop_and_a_merge_in_one_wh_step_stop_the_run_with_the_merge_done(stop):
+    """A collision that stops the run and one that merges in one wh step (c-d at
+    0.30046, a-b at 0.30103, the step [0.30, 0.31]): the merge was listed but not
+    carried out where the stop came first, the merged body then still in the state
+    the run stopped at.  Now the run stops at the step's end with the merge done,
+    whichever comes first; ``stopped_by`` is the stop."""
+    merge = {"a-b": "c-d", "c-d": "a-b"}[stop]
+    events = [{"name": "collision", "bodies": pair.split("-"),
+               "action": "stop" if pair == stop else "merge"} for pair in ("a-b", "c-d")]
+    traj = integrate(_two_pairs(gm_d=1.005e-3), 1.0, method="wh", dt=0.01, events=events)
+    assert {str(row["bodies"]): str(row["action"]) for row in traj.events} == {
+        stop: "stop", merge: "merge"}
+    assert str(traj.stopped_by["bodies"]) == stop
+    assert float(traj.t[-1]) == pytest.approx(0.31, abs=1e-12)  # (the step's end)
+    gone = merge.split("-")[1]
+    assert gone not in traj.final.names and len(traj.final.names) == 4
+    assert np.isnan(np.asarray(traj.r)[-1, "abcd".index(gone) + 1]).all()

@@ -126,9 +126,12 @@ class _State:
         """The events' log drained, and the action of the event the kernel stopped at
         (``status``, ``ws``) taken: True for a stop (its state then in ``row``)."""
         log, r, v = self.log, self.r, self.v
-        log.drain()
-        if status == _k.STATUS_EVENT and log.act(int(ws[3]), float(ws[0]), r, v, self.gm,
-                                                 at=float(ws[1])):
+        if status != _k.STATUS_EVENT:
+            log.drain()
+            return False
+        # (act drains the buffer itself: the rows it drains are the step's, each of
+        # whose actions it carries out)
+        if log.act(int(ws[3]), float(ws[0]), r, v, self.gm, at=float(ws[1])):
             row[0][:], row[1][:] = r, v
             log.mask(row[0], row[1])
             return True
