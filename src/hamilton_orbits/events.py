@@ -614,7 +614,9 @@ class EventLog:
         drivers drain a step with an action here only), and are not acted on again.
         ``stopped_by`` is the first stop among them; the merges and removals are
         done also where a stop comes first.  ``gm_changes`` gets one entry, at
-        ``t``, for each merge or removal.
+        ``t``, for each merge or removal.  A merged body that is then in contact with
+        another watched for collisions (``|r_i - r_j| <= R_i + R_j``: its radius grew,
+        its centre moved) collides with it at ``t`` (:meth:`at_start`), and so on.
 
         ``"merge"`` keeps the lower-indexed body with the pair's summed ``gm`` at
         their centre of mass, with their total momentum and the radius of their
@@ -638,11 +640,16 @@ class EventLog:
             done.append(self._carry_out(  # (at its own time: actions act forwards only)
                 x[E_CODE], int(x[E_I]), int(x[E_J]), int(x[E_ACTION]), t, float(x[E_TIME]),
                 r, v, gm, [y for y, _ in done]))
+        # a merged body in contact with another (its radius grew, its centre moved)
+        # collides with it now, as at a leg's start: no crossing would reveal it, and a
+        # leg begun there merged them where one call through went on (other bits)
+        merged = any(a == ACTIONS["merge"] for _, a in done)
+        contact = merged and self.overlapping(r) and self.at_start(t, r, v, gm)
         stops = [y for y, a in done if a == ACTIONS["stop"]]
         if stops:  # (indices only now: each action's _kept_until drops rows before them)
             where = [k for k, y in enumerate(self.rows) if any(y is s for s in stops)]
             self.stopped_by = min(where) if where else len(self.rows) - 1
-        return bool(stops)
+        return bool(stops) or contact
 
     def _carry_out(self, code: float, i: int, j: int, action: int, t: float, at: float,
                    r: np.ndarray, v: np.ndarray, gm: np.ndarray,

@@ -102,6 +102,42 @@ def test_two_legs_reach_the_bits_of_one_call(system, kw):
 
 
 
+def _crossing() -> System:
+    """Seven planets of radius 0.15 on crossing orbits about a star: p6 merges into p1
+    at t = 3.159, and the merged body (its radius grown to 0.189, its centre moved)
+    is then in contact with p3 (0.319 apart, 0.339 their radii)."""
+    rng = np.random.default_rng(7)
+    bodies = [Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01)]
+    for i in range(1, 8):
+        a, th = 0.6 + 0.25 * i, rng.uniform(0, 2 * np.pi)
+        w = 1.15 / np.sqrt(a) if i % 2 else 1 / np.sqrt(a) / 1.15
+        bodies.append(Body(f"p{i}", 1e-4, [a * np.cos(th), a * np.sin(th), 0.002 * i],
+                           [-w * np.sin(th), w * np.cos(th), 0.0], radius=0.15))
+    return System(bodies)
+
+
+@pytest.mark.parametrize("kw", list(METHODS.values()), ids=list(METHODS))
+def test_a_merged_body_in_contact_with_another_merges_with_it_in_every_leg(kw):
+    """A merge that leaves the merged body in contact with a third: it collides with
+    it at once (at the merge's time; wh and leapfrog at the end of the step), as a
+    leg begun there does.  Before, one call went on with the two overlapping, while
+    a leg begun after the merge merged them at its start from the last output row,
+    whose merged-away body was NaN: every force NaN, the leg failed ("the
+    acceleration became non-finite", "the Kepler step of body 6 failed"), and so
+    did resuming from a snapshot there."""
+    events = [{"name": "collision", "action": "merge"}]
+    sim = Simulation(_crossing(), events=events, **kw)
+    first, second = sim.integrate(3.2), sim.integrate([3.33, 5.0])
+    once = Simulation(_crossing(), events=events, **kw).integrate([3.2, 3.33, 5.0])
+    assert [str(b) for b in once.events["bodies"]] == ["p1-p6", "p1-p3"]
+    assert once.events["time"][0] < 3.2 and once.events["time"][1] < 3.2
+    assert list(first.events["time"]) + list(second.events["time"]) == list(
+        once.events["time"])
+    assert _same(second.r, once.r[1:]) and _same(second.v, once.v[1:])
+    assert first.steps + second.steps == once.steps
+    assert sim.system.names == once.final.names == ("sun", "p1", "p2", "p4", "p5", "p7")
+
+
 @pytest.mark.parametrize(("system", "kw"), list(_variants()))
 def test_legs_of_one_end_time_each_reach_the_bits_of_one_call(system, kw, monkeypatch):
     """A continuing call to one end time (a float), nothing watched or asked, takes
