@@ -424,10 +424,13 @@ class EventLog:
     #: working space a saved state leaves out (``hamilton_orbits.restart``): the
     #: buffer holds nothing after :meth:`drain`, which a snapshot does first; the
     #: sign of the driver's time is set with each driver, from the direction
-    RESTART_SCRATCH = ("buffer", "sign")
+    RESTART_SCRATCH = ("buffer", "sign", "same_approach")
     #: the driver's time over the run's: -1 in a backward run, which integrates the
     #: time-reversed motion in ``s = -t`` (:meth:`drain` turns its times back)
     sign = 1.0
+    #: close approaches of one pair recorded closer in time than this are one approach
+    #: (:meth:`_one_per_approach`): leapfrog's step, set by its driver; 0: none merged
+    same_approach = 0.0
 
     def __init__(self, watch: np.ndarray, radius: np.ndarray, capacity: int = 1024) -> None:
         self.watch = np.ascontiguousarray(watch, dtype=np.float64).reshape(-1, 5)
@@ -468,8 +471,39 @@ class EventLog:
             rows[:, E_I] = self.index_map[rows[:, E_I].astype(int)]
             pair = rows[:, E_J] >= 0
             rows[pair, E_J] = self.index_map[rows[pair, E_J].astype(int)]
+        since = len(self.rows)
         self.rows.extend(rows)
         self.count[0] = 0
+        if self.same_approach > 0.0 and k:
+            self._one_per_approach(since)
+
+    def _one_per_approach(self, since: int) -> None:
+        """The close approaches of one pair recorded (action ``"record"``) less than
+        :attr:`same_approach` apart in time, among the rows from ``since`` on and the
+        pair's rows before them, made one: the closest kept, at its place in the log.
+        leapfrog's path is a straight drift on each side of a kick, and about a
+        pericentre the pair can come closest on both sides of one kick: two minima
+        half a step apart (one periapsis passage listed twice), where the motion has
+        one.  Two approaches of one pair within a step are not resolved by the step
+        in any case."""
+        code, record, rows = EVENTS["close_encounter"][0], ACTIONS["record"], self.rows
+        k = since
+        while k < len(rows):
+            x = rows[k]
+            k += 1
+            if x[E_CODE] != code or x[E_ACTION] != record:
+                continue
+            for m in range(k - 2, -1, -1):  # (back through the rows within the interval)
+                y = rows[m]
+                if abs(x[E_TIME] - y[E_TIME]) >= self.same_approach:
+                    break
+                if (y[E_CODE] == code and y[E_ACTION] == record and y[E_I] == x[E_I]
+                        and y[E_J] == x[E_J]):
+                    if x[E_DIST] < y[E_DIST]:
+                        rows[m] = x
+                    k -= 1
+                    del rows[k]
+                    break
 
     def mask(self, r: np.ndarray, v: np.ndarray) -> None:
         """Set the bodies taken out of the run to NaN in ``r``, ``v`` (one output row

@@ -80,6 +80,25 @@ def test_a_backward_run_finds_every_flyby_it_came_through(method, kw):
     np.testing.assert_allclose(times, t_peri[k], rtol=1e-9, atol=0)
 
 
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["forwards", "backwards"])
+def test_leapfrog_lists_each_periapsis_passage_once(sign):
+    """A particle on an orbit of e = 0.95 (q = 0.05, period 2 pi) started at apoapsis,
+    through two periapsis passages (at +-pi and +-3 pi).  leapfrog's path is a
+    straight drift on each side of each kick, and about the pericentre it came
+    closest on both sides of one kick: each passage was listed twice, half a step
+    apart, as radau15 and wh list it once.  Now once, at its closest (the distance
+    the map's own path reaches, within 2e-5 of q at dt = 1e-4)."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("b", 0.0, [-1.95, 0, 0], [0, -np.sqrt(0.05 / 1.95), 0])])
+    traj = integrate(s, sign * 4 * np.pi, method="leapfrog", dt=1e-4,
+                     events=[{"name": "close_encounter", "distance": 0.1}])
+    ev = traj.events
+    assert len(ev) == 2 and set(ev["bodies"]) == {"sun-b"}
+    np.testing.assert_allclose(np.asarray(ev["time"]), sign * np.array([np.pi, 3 * np.pi]),
+                               rtol=0, atol=1e-3)
+    np.testing.assert_allclose(np.asarray(ev["distance"]), 0.05, rtol=2e-5)
+
+
 def test_events_with_an_action_are_refused_backwards():
     system = _flybys(5, past=True)[0]
     with pytest.raises(ValueError, match=r"Events with an action \(stop, merge, remove\) are "

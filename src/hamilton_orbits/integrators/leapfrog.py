@@ -98,6 +98,7 @@ class _State:
         self.v = np.ascontiguousarray(v0, dtype=np.float64).copy()
         self.gm = np.ascontiguousarray(gm, dtype=np.float64).copy()
         self.log = events if events is not None else EventLog.none(self.r.shape[0])
+        self.log.same_approach = float(dt)  # (one approach seen on both sides of a kick)
         self.accel = force_arg(rhs, self.gm, self.log.watch)
         self.p = run_parameters(rhs)  # (the kernels write its clock)
         self.dt, self.max_steps, self.t, self.steps = dt, max_steps, t0, 0
