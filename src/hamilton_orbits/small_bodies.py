@@ -54,9 +54,12 @@ MARGIN_DAYS = 32.0
 
 
 
-#: An output Time within this many days of the epoch is the epoch (1 us: a scale's
-#: round trip or a float JD leaves 1e-17 to 1e-10 d)
-EPOCH_MATCH = 1e-6 / 86400.0
+#: An output Time within this many days of the epoch is the epoch: 2**-29 d (161 us),
+#: 4 ulp of a float JD in 2**21..2**22 d (years -3000 to 6700, all of DE440's span),
+#: where a float JD is rounded to 2**-31 d (40 us).  A scale's round trip leaves
+#: ~1e-17 d, the epoch read back as a float JD (e.g. through UTC) up to half an
+#: ulp, 20 us (measured 2.0e-10 and -1.9e-10 d): 1 us, as it was, refused them
+EPOCH_MATCH = 2.0**-29
 
 
 def _stm_copies(n: int, chunk: int, workers: int | None) -> float:
@@ -370,15 +373,20 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
                          f"{days.shape}")
     if isinstance(t, Time) and abs(days[0]) <= EPOCH_MATCH:  # (the epoch itself, read
         days = days.copy()  # through another time scale or a float JD: its residue of
-        days[0] = 0.0  # 1e-17 to 1e-10 d made an extra first output, or a refusal)
-    if days[0] != 0.0:
+        days[0] = 0.0  # 1e-17 to 2e-10 d made an extra first output, or a refusal)
+    added = int(days[0] != 0.0)
+    if added:
         days = np.concatenate([[0.0], days])
     d = np.diff(days)
     if not len(d) or not (np.all(d > 0) or np.all(d < 0)):
-        k = 0 if not len(d) else int(np.argmax(~(d > 0))) if d[0] > 0 else int(
-            np.argmax(~(d < 0)))
+        if not len(d):
+            k = 0
+        elif added and len(d) > 1 and (np.all(d[1:] > 0) or np.all(d[1:] < 0)):
+            k = 0  # (the caller's times monotonic, the first on the wrong side of the epoch)
+        else:  # (the caller's index of the first time that does not go on as the first)
+            k = (int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))) + 1 - added
         raise ValueError(f"Expected `t` strictly monotonic from the epoch, got {t!r} (at "
-                         f"index {k})")
+                         f"index {k}: {float(days[k + added])!r} d from the epoch)")
     return days
 
 

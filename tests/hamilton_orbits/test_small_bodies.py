@@ -723,3 +723,32 @@ def test_output_times_that_start_at_the_epoch_in_another_scale(scale):
     traj = propagate([2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.day, epoch, t,
                      ephemeris=segments, asteroids=False)
     assert len(traj.t) == 6 and traj.t[0].to_value(u.day) == 0.0
+
+
+@pytest.mark.parametrize("jd", [2451573.6814667555, 2451990.873181125])
+def test_output_times_that_start_at_the_epoch_read_back_as_a_float_jd(jd):
+    """The epoch read back through UTC as one float JD is off by up to half an ulp
+    of a JD (ulp 4.7e-10 d near 2.45e6: measured +2.0e-10 and -1.9e-10 d here): it
+    is the epoch.  EPOCH_MATCH was 1 us (1.2e-11 d): the first made an extra
+    output at 2e-10 d, the second was refused as not monotonic, at index 1."""
+    from astropy.time import Time
+
+    from hamilton_orbits.small_bodies import EPOCH_MATCH, _epoch, _output_days
+
+    epoch = Time(jd, format="jd", scale="tdb")
+    t = Time([Time(epoch.utc.jd, format="jd", scale="utc"), (epoch + 10 * u.day).utc])
+    jd1, jd2 = _epoch(epoch)
+    assert 1e-10 < abs(float((t[0].tdb - epoch).to_value(u.day))) < EPOCH_MATCH
+    days = _output_days(t, jd1, jd2)
+    assert len(days) == 2 and days[0] == 0.0 and abs(days[1] - 10.0) < 1e-9
+
+
+def test_output_times_on_either_side_of_the_epoch_name_the_first():
+    """A first output time before the epoch, the rest after: the fault is at index 0
+    (the message said index 1)."""
+    from hamilton_orbits.small_bodies import _output_days
+
+    with pytest.raises(ValueError, match=r"at index 0: -0.5 d from the epoch"):
+        _output_days([-0.5, 10.0] * u.day, 2451545.0, 0.0)
+    with pytest.raises(ValueError, match=r"at index 2: 3.0 d from the epoch"):
+        _output_days([1.0, 5.0, 3.0] * u.day, 2451545.0, 0.0)
