@@ -14,7 +14,7 @@ from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.rhs import compile_rhs, time_reversed
 from hamilton_orbits.small_bodies import EFFECTS, PERTURBERS, field_rhs
 from hamilton_orbits.spk import (
-    EXCERPT,  # JD 2451504.5 + 816 d
+    EXCERPT,  # JD 2451504.5 + 812 d (the Earth's and the Moon's: the others' more)
     Segments,
 )
 
