@@ -243,6 +243,10 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(chunk=0), "`chunk` .* got 0"),
     (dict(tol=2.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 2.0"),  # (was taken)
     (dict(tol=0.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 0.0"),
+    # (1e-12 took 970 000 steps for 120 days of an ordinary orbit, unsaid)
+    (dict(tol=1e-12), r"`tol` >= 2e-12 with method='radau15', got 1e-12: .* float64's "
+                      r"rounding .* method='dop853'"),
+    (dict(tol=1.9e-12), r"`tol` >= 2e-12 with method='radau15', got 1.9e-12"),
     (dict(chunk=True), "`chunk`"),
     (dict(workers=1.5), "`workers` .* threads .* got 1.5"),
     (dict(client="tcp://127.0.0.1:8786"), "`client` .* connect first"),
