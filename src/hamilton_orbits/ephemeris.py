@@ -536,9 +536,11 @@ def heliocentric_positions(
     Raises
     ------
     ValueError
-        For dates that are not a 1-d array of finite numbers, an unknown body, or
-        dates and bodies the shipped tables do not hold without the extra (naming
-        it), naming the argument, the index and the value.
+        For dates that are not a 1-d array of finite numbers, ``bodies`` empty or
+        with a name unknown, not a string or given twice (names are stripped and
+        lower-cased, as :func:`barycentric_states`'), or dates and bodies the
+        shipped tables do not hold without the extra (naming it), naming the
+        argument, the index and the value.
 
     Returns
     -------
@@ -551,8 +553,10 @@ def heliocentric_positions(
     True
     """
     jd = checked_jd(jd)
-    names = [str(b).lower() for b in ([bodies] if isinstance(bodies, str) else bodies)]
-    _check_names(names)
+    if bodies is None:  # (no default here: checked_names would take None as none)
+        raise ValueError("Expected `bodies` to be names from BODIES, got None")
+    names = checked_names(bodies, BODIES, (), "DE440")  # (as barycentric_states': the
+    # names stripped, an empty list, a non-string and a name given twice refused)
     ref_jd, ref_names, ref_r = reference_table(frame)
     k = np.clip(np.rint((jd - J2000_JD) / 365.25), -1, len(ref_jd)).astype(int)
     shipped = (np.abs(jd - (J2000_JD + 365.25 * k)) < 1e-9) & (k >= 0) & (k <= len(ref_jd) - 1)

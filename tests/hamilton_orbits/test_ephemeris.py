@@ -306,3 +306,20 @@ def test_the_suns_heliocentric_position_is_zero_on_every_shipped_date(monkeypatc
     assert both[:, 1].tolist() == [[0.0, 0.0, 0.0]] * 2
     planets = de.heliocentric_positions(dates, ["earth", "mars"])
     assert both[:, [0, 2]].tolist() == planets.tolist()
+
+
+@pytest.mark.parametrize(("bodies", "match"), [
+    (["earth", "earth"], r"`bodies` to name each body once, got 'earth' at indices 0 and 1"),
+    ([], r"`bodies` to name at least one body, got an empty list"),
+    (["mars", 3], r"`bodies` to hold names, got 3 at index 1"),
+    (None, r"`bodies` to be names from BODIES, got None"),
+    (["earth", "vulcan"], r"Unknown DE440 body 'vulcan' at index 1 of `bodies`"),
+])
+def test_heliocentric_positions_check_bodies_as_barycentric_states_do(bodies, match):
+    """heliocentric_positions took a name twice and an empty list (an empty array),
+    named no argument for a non-string ("Unknown DE440 body '3'") and refused
+    " Mars ", all of which barycentric_states checks (ephemeris.checked_names)."""
+    with pytest.raises(ValueError, match=match):
+        de.heliocentric_positions([de.J2000_JD], bodies)
+    np.testing.assert_array_equal(de.heliocentric_positions([de.J2000_JD], [" Mars "]),
+                                  de.heliocentric_positions([de.J2000_JD], ["mars"]))
