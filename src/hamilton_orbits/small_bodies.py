@@ -100,7 +100,9 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     t : Quantity, TimeDelta or Time
         A duration (a time Quantity or a TimeDelta), an end ``Time``, or output
         times (durations from ``epoch`` or ``Time`` values), monotonic, forwards or
-        backwards; ``epoch`` is the first output.
+        backwards; ``epoch`` is the first output (a first ``Time`` within
+        ``EPOCH_MATCH``, 161 us, of it is taken as it: the epoch read back as a
+        float JD, e.g. through UTC, is off by up to 20 us).
     names : sequence of str, optional
         The small bodies' names (default ``"body0"``, ``"body1"``, ...).
     ephemeris : "de440" or Segments
