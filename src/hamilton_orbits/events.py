@@ -650,7 +650,7 @@ class EventLog:
         done also where a stop comes first.  ``gm_changes`` gets one entry, at
         ``t``, for each merge or removal.  A merged body that is then in contact with
         another watched for collisions (``|r_i - r_j| <= R_i + R_j``: its radius grew,
-        its centre moved) collides with it at ``t`` (:meth:`at_start`), and so on.
+        its centre moved) collides with it at ``t``, and so on, as at a leg's start.
 
         ``"merge"`` keeps the lower-indexed body with the pair's summed ``gm`` at
         their centre of mass, with their total momentum and the radius of their
@@ -674,16 +674,37 @@ class EventLog:
             done.append(self._carry_out(  # (at its own time: actions act forwards only)
                 x[E_CODE], int(x[E_I]), int(x[E_J]), int(x[E_ACTION]), t, float(x[E_TIME]),
                 r, v, gm, [y for y, _ in done]))
-        # a merged body in contact with another (its radius grew, its centre moved)
-        # collides with it now, as at a leg's start: no crossing would reveal it, and a
-        # leg begun there merged them where one call through went on (other bits)
-        merged = any(a == ACTIONS["merge"] for _, a in done)
-        contact = merged and self.overlapping(r) and self.at_start(t, r, v, gm)
+        if any(a == ACTIONS["merge"] for _, a in done):
+            self._contacts(t, r, v, gm, done)
         stops = [y for y, a in done if a == ACTIONS["stop"]]
         if stops:  # (indices only now: each action's _kept_until drops rows before them)
             where = [k for k, y in enumerate(self.rows) if any(y is s for s in stops)]
             self.stopped_by = min(where) if where else len(self.rows) - 1
-        return bool(stops) or contact
+        return bool(stops)
+
+    def _contacts(self, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                  done: list[tuple[np.ndarray | None, int]]) -> None:
+        """After the merges of :meth:`act` (``done``: its actions so far, to which these
+        are added), a merged body in contact with another watched for collisions (its
+        radius grew, its centre moved: no crossing will reveal it) collides with it at
+        ``t``, as at a leg's start (:meth:`at_start`), and so on: a leg begun there
+        merged them where one call through went on.  A pair whose collision acted in
+        this batch (a stop: still in contact) is not recorded again."""
+        code = EVENTS["collision"][0]
+        seen = {(int(y[E_I]), int(y[E_J])) for y, _ in done
+                if y is not None and y[E_CODE] == code}
+        while True:
+            rows, pairs, d, inside = self._overlaps(r)
+            new = [k for k in inside if (int(pairs[k, 0]), int(pairs[k, 1])) not in seen]
+            if not new:
+                return
+            k = new[0]
+            i, j, action = int(pairs[k, 0]), int(pairs[k, 1]), int(self.watch[rows[k], W_ACTION])
+            seen.add((i, j))
+            self.rows.append(np.array([code, i, j, t, d[k], float(np.linalg.norm(v[i] - v[j])),
+                                       action]))
+            done.append(self._carry_out(code, i, j, action, t, t, r, v, gm,
+                                        [y for y, _ in done]))
 
     def _carry_out(self, code: float, i: int, j: int, action: int, t: float, at: float,
                    r: np.ndarray, v: np.ndarray, gm: np.ndarray,

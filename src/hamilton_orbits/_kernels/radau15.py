@@ -358,11 +358,14 @@ def _tau2(a0, b, i):  # pragma: no cover - compiled
 _CROSSING = 64.0 * _EPS
 #: a body whose acceleration (its largest component) is at most this fraction of the
 #: largest body's is left out of :func:`_dt_prs23`'s timescale: such an acceleration
-#: is the rounding residue of pulls that cancel (the central body of a point-symmetric
-#: system: 1e-19 of its planets' 1), whose ``tau`` measures noise and sent the step
-#: to underflow at the start, as IAS15's does (there a physical acceleration is a
-#: body's pull at 10^7 times the distance of the closest pair, whose pace is not the
-#: system's)
+#: is most often the rounding residue of pulls that cancel (the central body of a
+#: point-symmetric system: 1e-19 of its planets' 1), whose ``tau`` measures noise and
+#: sent the step to underflow at the start, as IAS15's does.  The price: a body whose
+#: acceleration is physical and that small while its pace is the fastest (a subsystem
+#: 1e14 times smaller in its accelerations than the rest and faster than it, e.g. a
+#: particle 1e-17 from a body of GM 1e-48 beside a pair of GM 1 at 1e8) no longer sets
+#: the step, and is integrated at the pace of the others (the global criterion,
+#: ``Radau15(criterion="global")``, still follows it)
 _RESIDUE = 64.0 * _EPS
 
 

@@ -344,13 +344,21 @@ class _State:
         removal renews the split from the changed inertial state."""
         r_now, v_now = np.empty_like(self.split.q), np.empty_like(self.split.u)
         self.split.to_inertial(r_now, v_now)
-        if self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm,
-                        at=float(ws[1])):
+        changes = len(self.log.gm_changes)
+        stop = self.log.act(int(ws[3]), float(ws[0]), r_now, v_now, self.gm, at=float(ws[1]))
+        if len(self.log.gm_changes) > changes or not stop:  # (a merge or a removal of the
+            self._renew(r_now, v_now)  # step, with a stop too: the next leg goes on from it)
+        if stop:
             row[0][:], row[1][:] = r_now, v_now
             self.log.mask(row[0], row[1])
             self.t = float(ws[0])  # the end of the step (the split holds that state)
             self.cut = None  # (a stop ends the call: the next lays its steps afresh)
             return StopAtEvent(i, float(ws[0]), self.steps - first)
+        return None
+
+    def _renew(self, r_now: np.ndarray, v_now: np.ndarray) -> None:
+        """The split made afresh from the inertial state ``r_now``, ``v_now`` after a
+        merge or a removal changed the bodies (their ``gm``, the central body)."""
         order = self.split.order
         if self.gm[order[0]] < self.gm.max():  # (the central body merged into another,
             order = _central_first(self.gm)  # which keeps the lower index: the largest
@@ -358,7 +366,6 @@ class _State:
         self.split = self.split.renewed(self.gm, order)
         self.split.from_inertial(r_now, v_now, self.split.q, self.split.u)
         self.watch = self.log.kernel_watch()
-        return None
 
 
 def _central_first(gm: np.ndarray) -> np.ndarray:
