@@ -306,7 +306,13 @@ class Simulation(Saving):
         simulation keeps its schedule but writes nothing."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
-        new._prop = copy.deepcopy(self._prop, shared_memo(self._prop))
+        memo = shared_memo(self._prop)
+        pause = getattr(self._prop.driver, "pause", None)
+        if pause is not None:  # (taken in a callback of an archived call: the step
+            # schedule's pause holds this simulation, whose copy would copy it again;
+            # the copy's driver pauses for nothing, as between two calls)
+            memo[id(pause)] = None
+        new._prop = copy.deepcopy(self._prop, memo)
         if new._start is None and (self._prop.t != 0.0 or self._prop.steps):
             new._start = new._initial  # (a copy taken within the first call, from a
             # callback: its integrals from time 0, as a snapshot loaded there has them)

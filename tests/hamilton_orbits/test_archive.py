@@ -2012,3 +2012,40 @@ def test_a_snapshot_of_an_earlier_formats_first_call_measures_from_time_0(tmp_pa
     leg = loaded.integrate(5.0)
     assert _same(leg.r[0], whole.r[4])
     assert _same(leg.particle_error[0], whole.particle_error[4]) and leg.particle_error[0, 1] != 0
+
+
+@pytest.mark.parametrize("schedule", [dict(every_steps=3), dict(every_wall=1.5)],
+                         ids=["every_steps", "every_wall"])
+def test_a_copy_or_save_in_a_callback_of_a_step_paused_call_goes_on_to_its_bits(
+        tmp_path, monkeypatch, schedule):
+    """A ``copy`` or ``save`` in ``on_output`` or ``stop`` of a radau15 call whose
+    archive pauses between two steps (``every_steps``, ``every_wall``: a clock that
+    ticks a second at each look, looked at every 3 steps) was a RecursionError (the
+    driver's pause holds the simulation, which the copy copied again); each goes on
+    to the run's bits, and the run to those of the run without an archive."""
+    monkeypatch.setattr(_saving, "WALL_CHECK", 3)
+    times = np.linspace(0.0, 4.0, 5)
+    whole = Simulation(_disc(3), method="radau15").integrate(times)
+    sim = Simulation(_disc(3), method="radau15", archive=tmp_path / "a", **schedule)
+    ticks = iter(range(10**6))
+    sim._archive.clock = lambda: float(next(ticks))
+    taken = {}
+
+    def on_output(i, steps):
+        if i == 2:
+            taken["on_output"] = sim.copy()
+            sim.save(tmp_path / "at2.nc")
+
+    def stop():
+        if "stop" not in taken and sim.t > 2.0 and sim.t not in times:  # (between two
+            # outputs, at a pause)
+            taken["stop"] = sim.copy()
+        return False
+
+    traj = sim.integrate(times, on_output=on_output, stop=stop)
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v)
+    assert len(Archive(tmp_path / "a")) > 2 and taken["stop"].t not in times
+    for again in (taken["on_output"], taken["stop"], Simulation.load(tmp_path / "at2.nc")):
+        rest = again.integrate(times[times > again.t])
+        assert _same(rest.r[-1], whole.r[-1]) and _same(rest.v[-1], whole.v[-1])
+        assert again.steps == sim.steps
