@@ -107,6 +107,22 @@ class Saving:
     :class:`~hamilton_orbits.simulation.Simulation` (a mixin: it stands on the
     simulation's propagation, system and specification)."""
 
+    #: an ``integrate`` or ``resume`` call of this simulation is running: its
+    #: callbacks (``on_output``, ``stop``) may copy or save the simulation, not
+    #: integrate it again (the outer call would go on from a state moved under it,
+    #: and its archive would get a second timeline)
+    _busy = False
+
+    def _refuse_within(self, what: str) -> None:
+        """Refuse ``what`` (``"integrate"`` or ``"resume"``) called from within a call
+        of this simulation (:attr:`_busy`)."""
+        raise ValueError(f"Simulation.{what}() called from within an integrate or resume "
+                         f"call of the same simulation (its on_output or stop callback): "
+                         f"it would move the state that call stands on, and write a second "
+                         f"timeline into its archive; integrate a copy there "
+                         f"(sim.copy(), which writes nothing), or call {what}() after the "
+                         f"call has returned")
+
     def resume(self, *, progress: bool = False, on_output: Any = None, stop: Any = None,
                on_interrupt: str = "raise") -> Trajectory:
         """Finish the ``integrate`` call a killed run was in, from the archive's last
@@ -119,7 +135,8 @@ class Saving:
         ValueError
             When this simulation was not loaded from an archive folder, or has
             integrated since (the interrupted call was left for another); for a
-            ``progress`` not True or False.
+            ``progress`` not True or False; when called from within a call of the
+            same simulation (its ``on_output`` or ``stop``).
         SnapshotError
             When a snapshot of the leg is missing or damaged (its rows are lost).
 
@@ -138,6 +155,8 @@ class Saving:
         >>> bool(np.array_equal(traj.r, whole.r)), traj.t.tolist() == whole.t.tolist()
         (True, True)
         """
+        if self._busy:
+            self._refuse_within("resume")
         if self._resumable is None:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder, before it "
@@ -152,12 +171,15 @@ class Saving:
         if rest.size:
             on_output = _numbered_as_the_call(on_output, times.size - rest.size - 1,
                                               self.steps - info["steps0"])
+            self._busy = True  # (its callbacks may copy or save it: see _busy)
             try:
                 out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output,
                                     stop, leg=times)
             except BaseException:  # (cut: the next leg's integrals measured from time 0)
                 self._start = self._initial
                 raise
+            finally:
+                self._busy = False
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])

@@ -2049,3 +2049,34 @@ def test_a_copy_or_save_in_a_callback_of_a_step_paused_call_goes_on_to_its_bits(
         rest = again.integrate(times[times > again.t])
         assert _same(rest.r[-1], whole.r[-1]) and _same(rest.v[-1], whole.v[-1])
         assert again.steps == sim.steps
+
+
+def test_integrate_or_resume_from_within_an_archived_call_is_refused(tmp_path):
+    """``integrate`` (or ``resume``) from a callback of an archived call of the same
+    simulation wrote a second timeline into its archive (times going back) and left
+    the run off its bits: refused, the archive's times increasing, the run going on
+    to the bits of the run never interrupted, and ``resume`` refused alike from
+    within its own call."""
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    times = np.linspace(0.0, 2.0, 5)
+    whole = Simulation(_disc(3), archive=tmp_path / "whole", **kw).integrate(times)
+    sim = Simulation(_disc(3), archive=tmp_path / "a", **kw)
+    within = r"Simulation\.(integrate|resume)\(\) called from within an integrate or resume"
+    with pytest.raises(ValueError, match=within):
+        sim.integrate(times, on_output=lambda i, steps: i == 2 and sim.integrate(9.0))
+    with pytest.raises(ValueError, match=within):
+        sim.integrate(times[times >= 1.0], stop=lambda: sim.resume())
+    assert np.all(np.diff(Archive(tmp_path / "a").times) >= 0) and sim.t == 1.25  # (its
+    # first output: a snapshot's)
+    rest = sim.integrate(times[times > 1.0])
+    assert _same(rest.r[1:], whole.r[3:]) and np.all(np.diff(Archive(tmp_path / "a").times) >= 0)
+    cut = Simulation(_disc(3), archive=tmp_path / "cut", **kw)
+    cut.integrate(times, stop=lambda: cut.t >= 1.0)
+    loaded = {}
+    for callback in (dict(on_output=lambda i, steps: loaded["sim"].resume()),
+                     dict(stop=lambda: loaded["sim"].integrate(9.0))):
+        loaded["sim"] = Simulation.load(tmp_path / "cut")
+        with pytest.raises(ValueError, match=within):
+            loaded["sim"].resume(**callback)
+    assert np.all(np.diff(Archive(tmp_path / "cut").times) >= 0)
+    assert _same(Simulation.load(tmp_path / "cut").resume().r, whole.r)
