@@ -278,7 +278,7 @@ class Saving:
             sim._archive.last_steps = sim.steps
             sim._archive.continues = True  # (the run of the folder's snapshots)
             if folder is not None:  # (the snapshot it stands at: see ArchiveWriter.loaded)
-                sim._archive.loaded = int(meta["number"])
+                sim._archive.loaded_from(int(meta["number"]), path)
         leg = meta.get("leg")
         if leg is not None and source is not None:  # (its leg's times, read if needed)
             sim._asked = (source, int(leg["start"]))

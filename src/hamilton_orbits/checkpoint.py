@@ -314,6 +314,17 @@ def _next_number(folder: Path) -> int:
         return first + 1
 
 
+def _signature(path: Path) -> tuple[int, int, int] | None:
+    """What tells a file of an archive from another of the same name: its inode, size
+    and time of last change (in ns); None where it is not there.  (Not the folder's
+    inode alone: a folder removed and made again at once gets the same one.)"""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
 #: the most snapshots of ``every`` in one ``integrate`` call: 10 GB on disk at
 #: least (about a kilobyte each), their times 80 MB in memory
 MAX_SNAPSHOTS = 10**7
@@ -396,6 +407,11 @@ class ArchiveWriter:
         #: until this writer has written there (:meth:`_gone_on`: after that, its
         #: last segment is what tells another writer's coming)
         self.loaded: int | None = None
+        #: the files of the folder this writer closed, or its simulation was loaded
+        #: from, each as it left it (:func:`_signature`): a folder that holds
+        #: snapshots and none of them is no longer this run's (removed and used
+        #: again by another run: :meth:`open` refuses it)
+        self.mine: dict[Path, tuple[int, int, int] | None] = {}
         #: the leg of the snapshots being appended (a record's ``leg``)
         self.leg: tuple[float, ...] = NO_LEG
         #: the wall clock of ``every_wall`` (seconds)
@@ -436,6 +452,8 @@ class ArchiveWriter:
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
+        if known is None and self.count and self.mine and not self._holds_mine():
+            self._refuse_replaced()  # (read only where the folder is not as left)
         if known is None and self._gone_on():
             self.close()
             raise SnapshotError(
@@ -454,6 +472,32 @@ class ArchiveWriter:
         parked, self.parked = self.parked, None
         if known is not None and parked is not None and parked.reopen():
             self.segment = parked  # (the next leg goes on in it, if it shares the same)
+
+    def loaded_from(self, number: int, path: Path) -> None:
+        """Attach this writer to the folder its simulation was loaded from, standing at
+        snapshot ``number`` (:attr:`loaded`) of its file ``path`` (one of the run's,
+        :attr:`mine`)."""
+        self.loaded = number
+        self.mine[path] = _signature(path)
+
+    def _holds_mine(self) -> bool:
+        """Whether one of the files this writer left (:attr:`mine`) is in the folder
+        as it left it: the folder is still its run's (a file of it removed, say; not
+        removed as a whole and made again by another run)."""
+        return any(_signature(path) == known for path, known in reversed(self.mine.items()))
+
+    def _refuse_replaced(self) -> None:
+        """Release the folder and refuse it: it holds snapshots and none of the files
+        this writer left there, so it is no longer the folder of this run (removed,
+        and made again by another run)."""
+        self.close()
+        raise SnapshotError(
+            f"the archive {self.path} is no longer the folder this simulation wrote: its "
+            f"files are gone, and it holds the snapshots of another run now (the last "
+            f"numbered {self.count - 1}; the folder removed and written again?), which "
+            f"this simulation's would mix with (one archive holds one run); continue that "
+            f"run with Simulation.load({str(self.path)!r}), and this simulation from a copy "
+            f"(sim.copy(), which writes nothing) or a file (sim.save(path))")
 
     def _continued(self) -> int | None:
         """The next snapshot number without listing the folder (whose listing grows
@@ -499,6 +543,7 @@ class ArchiveWriter:
                 self.left, self.loaded = (seg.path, seg.size, self.count), None
                 self.parked = seg if seg.legs else None
                 seg.close()
+                self.mine[seg.path] = _signature(seg.path)  # (one stat a call)
         finally:
             if self.folder is not None:
                 self.folder.__exit__(None, None, None)
@@ -518,6 +563,7 @@ class ArchiveWriter:
                 seg.trim()  # (no torn tail left by a write this process broke off)
             finally:
                 seg.close()
+                self.mine[seg.path] = _signature(seg.path)
 
     def times(self, t0: float, t1: float) -> np.ndarray:
         """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""

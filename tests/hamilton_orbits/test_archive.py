@@ -1489,20 +1489,23 @@ def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp
 
 def test_to_xarray_of_no_snapshot_or_of_two_runs_says_so(tmp_path):
     """``to_xarray`` of an archive of no whole snapshot, or of snapshots of two runs
-    (here: a folder deleted between two calls of a run, a second run written there
-    meanwhile), is a SnapshotError naming the archive, not numpy's error on stacking
-    no arrays or arrays of two shapes."""
+    (here: another run's segment copied into it; a run no longer appends to a folder
+    emptied and written by another run), is a SnapshotError naming the archive, not
+    numpy's error on stacking no arrays or arrays of two shapes."""
+    import shutil
+
     pytest.importorskip("xarray")
     (tmp_path / "empty").mkdir()
     with pytest.raises(SnapshotError, match=r"archive .*empty has no whole snapshot"):
         Archive(tmp_path / "empty").to_xarray()
     kw = dict(method="wh", dt=0.01, every=0.25)
-    first = Simulation(_disc(), archive=tmp_path / "a", **kw)
-    first.integrate(0.5)
-    for path in (tmp_path / "a").iterdir():
-        path.unlink()
-    Simulation(System(list(_disc().bodies)[:4]), archive=tmp_path / "a", **kw).integrate(0.5)
-    first.integrate(1.0)  # (it goes on where it wrote: the folder made again)
+    Simulation(_disc(), archive=tmp_path / "a", **kw).integrate(0.5)  # (snapshots 0 to 2)
+    other = Simulation(System(list(_disc().bodies)[:4]), archive=tmp_path / "b", **kw)
+    other.integrate(0.5)
+    other.integrate([0.75, 1.0])  # (a segment of its own, from number 3)
+    for path in (tmp_path / "b").glob("*-000003.nc"):
+        shutil.copy(path, tmp_path / "a" / path.name)
+    assert [s.number for s in Archive(tmp_path / "a").snapshots] == [0, 1, 2, 3, 4, 5]
     with pytest.raises(SnapshotError, match=r"snapshots of the archive .*a hold different "
                                             r"numbers of bodies \(4, 6\)"):
         Archive(tmp_path / "a").to_xarray()
@@ -2080,3 +2083,36 @@ def test_integrate_or_resume_from_within_an_archived_call_is_refused(tmp_path):
             loaded["sim"].resume(**callback)
     assert np.all(np.diff(Archive(tmp_path / "cut").times) >= 0)
     assert _same(Simulation.load(tmp_path / "cut").resume().r, whole.r)
+
+
+def test_a_run_whose_folder_was_removed_and_written_by_another_run_is_refused(tmp_path):
+    """A folder removed between two calls of a run is made again by its next call;
+    removed and made the archive of another run meanwhile, the first run appended
+    its snapshots to that run's (two runs in one archive, ``Simulation.load`` taking
+    whichever wrote last): refused by name, the folder released and left to the run
+    that holds it, while a file of the run removed (not the folder) is gone on
+    from."""
+    import shutil
+
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    folder = tmp_path / "a"
+    first = Simulation(_disc(3), archive=folder, **kw)
+    first.integrate(0.5)
+    shutil.rmtree(folder)
+    first.integrate(1.0)  # (made again: this run's)
+    assert Archive(folder).times.tolist() == [0.5, 0.75, 1.0]
+    shutil.rmtree(folder)
+    second = Simulation(_disc(4), archive=folder, **kw)
+    second.integrate(0.5)
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"the archive {folder} is no longer the folder this simulation wrote: its files "
+            f"are gone, and it holds the snapshots of another run now (the last numbered 2;")
+            + r".* continue that run with Simulation\.load\(.*\), and this simulation from a "
+              r"copy \(sim\.copy\(\), which writes nothing\)"):
+        first.integrate(1.5)
+    assert first.t == 1.0 and not _lock(folder)
+    assert Archive(folder).times.tolist() == [0.0, 0.25, 0.5]
+    second.integrate([0.75, 1.0])  # (a segment of its own: from number 3)
+    (folder / "segment-000003.nc").unlink()
+    second.integrate(1.25)  # (a file of it removed: its run's folder still)
+    assert Archive(folder).times.tolist() == [0.0, 0.25, 0.5, 1.0, 1.25]
