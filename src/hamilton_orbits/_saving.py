@@ -138,7 +138,8 @@ class Saving:
             ``progress`` not True or False; when called from within a call of the
             same simulation (its ``on_output`` or ``stop``).
         SnapshotError
-            When a snapshot of the leg is missing or damaged (its rows are lost).
+            When a snapshot of the leg is missing or damaged (its rows are lost),
+            naming the archive, the file that held it and how to go on.
 
         Examples
         --------

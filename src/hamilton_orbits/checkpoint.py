@@ -127,10 +127,12 @@ def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str,
     Raises
     ------
     SnapshotError
-        When one of those snapshots is missing or damaged (its rows are lost).
+        When one of those snapshots is missing or damaged (its rows are lost), naming
+        the archive, the file that holds it (if one does) and what can be done.
     """
     files = snapshot_files(folder)
     found: dict[int, dict[str, np.ndarray]] = {}
+    ends: dict[Path, int] = {}  # (the number after a file's snapshots, where it reads)
     for i, (first, path) in enumerate(files):
         after = files[i + 1][0] if i + 1 < len(files) else upto + 1
         if first > upto or after <= start:
@@ -139,17 +141,34 @@ def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str,
             seg = _read_file(path)
         except SnapshotError:
             continue
+        ends[path] = seg.first + seg.count
         found.update((k, arrays) for k, _, arrays in seg.snapshots if start <= k <= upto)
     parts: dict[str, list[np.ndarray]] = {}
     for k in range(start, upto + 1):
         if k not in found:
-            raise SnapshotError(f"snapshot {k} of the leg being resumed is missing or "
-                                f"damaged")
+            raise SnapshotError(_lost_row(folder, files, ends, k))
         for name, a in found[k].items():
             if name.startswith("out_") and a.shape[0]:
                 parts.setdefault(name, []).append(a)
     rows = {name: np.concatenate(a) for name, a in parts.items()}
     return found[start]["leg_times"], rows
+
+
+def _lost_row(folder: Path, files: list[tuple[int, Path]], ends: dict[Path, int],
+              k: int) -> str:
+    """What a resume says of snapshot ``k`` of its call, missing or damaged in archive
+    ``folder`` (``files`` by their first number, ``ends``: the number after each
+    file's snapshots, for those that read): where it was, and what can be done."""
+    holder = [path for first, path in files if first <= k]
+    if holder and (holder[-1] not in ends or k < ends[holder[-1]]):
+        where = f"damaged in {holder[-1]}"
+    else:
+        where = "missing: no file of the archive holds it"
+    return (f"snapshot {k} of the call being resumed from the archive {folder} is {where}; "
+            f"the call's rows it held are lost, so the call cannot be returned whole. Go on "
+            f"without them from the archive's last snapshot (Simulation.load("
+            f"{str(folder)!r}).integrate(t)), or from an earlier whole one (Archive("
+            f"{str(folder)!r})[k], or Simulation.load(folder, number=n)) and integrate from it")
 
 
 def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float,

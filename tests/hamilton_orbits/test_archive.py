@@ -2116,3 +2116,33 @@ def test_a_run_whose_folder_was_removed_and_written_by_another_run_is_refused(tm
     (folder / "segment-000003.nc").unlink()
     second.integrate(1.25)  # (a file of it removed: its run's folder still)
     assert Archive(folder).times.tolist() == [0.0, 0.25, 0.5, 1.0, 1.25]
+
+
+def test_resume_of_a_call_with_a_damaged_or_missing_snapshot_names_the_archive_and_a_way(
+        tmp_path):
+    """A snapshot of the call being resumed damaged (its rows lost) was "snapshot 1
+    of the leg being resumed is missing or damaged", no folder, no file, no way on
+    (the command line printed just that): the message names the archive, the file
+    that held it, and how to go on."""
+    folder = tmp_path / "a"
+    Simulation(_disc(3), method="wh", dt=0.01, archive=folder, every=0.5).integrate(
+        np.linspace(0.0, 2.0, 9))
+    path, = folder.glob("segment-*.nc")
+    data = bytearray(path.read_bytes())
+    header = parse(bytes(data))
+    data[header.record_begin + header.record_size + header.record_size // 2] ^= 0xFF
+    path.write_bytes(bytes(data))  # (snapshot 1 damaged)
+    loaded = Simulation.load(folder)
+    way = (r"; the call's rows it held are lost, so the call cannot be returned whole\. Go "
+           r"on without them from the archive's last snapshot \(Simulation\.load\(.*\)"
+           r"\.integrate\(t\)\), or from an earlier whole one \(Archive\(.*\)\[k\], or "
+           r"Simulation\.load\(folder, number=n\)\) and integrate from it")
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"snapshot 1 of the call being resumed from the archive {folder} is damaged in "
+            f"{path}") + way):
+        loaded.resume()
+    path.unlink()
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"snapshot 0 of the call being resumed from the archive {folder} is missing: no "
+            f"file of the archive holds it") + way):
+        loaded.resume()
