@@ -89,6 +89,20 @@ def _from_state(prop: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) 
 
 
 
+def _file_path(path: Any) -> Path:
+    """The ``path`` of :meth:`Saving.save` as a Path, refused by name where it ends in
+    a separator or names a folder (``Path`` drops a trailing separator: a file was
+    written under the folder's name)."""
+    out = path_of(path, "path", "a file or folder path")
+    raw = os.fspath(path)
+    seps = tuple(sep for sep in (os.sep, os.altsep) if sep)
+    if (isinstance(raw, str) and raw.endswith(seps)) or out.is_dir():
+        raise ValueError(f"Expected `path` to be a file's path, got {path!r}: a folder's "
+                         f"(save writes one file, such as {os.path.join(raw, 'sim.nc')!r}; an "
+                         f"archive folder is written by Simulation(..., archive=folder))")
+    return out
+
+
 def _numbered_as_the_call(on_output: Any, shift: int, steps: int) -> Any:
     """``on_output`` called by a resumed call as the interrupted call would have: its
     outputs numbered in the call's own times (``shift`` of them passed before the
@@ -197,6 +211,17 @@ class Saving:
         by any netCDF reader; the method, effects, events and the integrator's own
         state for this package), written atomically (``docs/archive.md``).
 
+        Parameters
+        ----------
+        path : path
+            The file to write (replaced if it exists); not a folder, nor a path
+            ending in a separator.
+
+        Raises
+        ------
+        ValueError
+            For a ``path`` that is not a path, ends in a separator or names a folder.
+
         Examples
         --------
         >>> import os, tempfile
@@ -213,12 +238,12 @@ class Saving:
         >>> bool(np.array_equal(a.r, b.r)), again.steps
         (True, 200)
         """
+        target = _file_path(path)
         meta, arrays, dims, units = self._record()
         asked = self._asked_times()
         if asked is not None:  # (a fixed-step archive's snapshots are laid from them)
             arrays["asked_times"] = np.asarray(asked, dtype=np.float64)
-        write(path_of(path, "path", "a file or folder path"), meta, arrays, dims, units,
-              sync=True)
+        write(target, meta, arrays, dims, units, sync=True)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:

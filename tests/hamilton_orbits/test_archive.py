@@ -2146,3 +2146,17 @@ def test_resume_of_a_call_with_a_damaged_or_missing_snapshot_names_the_archive_a
             f"snapshot 0 of the call being resumed from the archive {folder} is missing: no "
             f"file of the archive holds it") + way):
         loaded.resume()
+
+
+def test_save_refuses_a_folders_path_by_name(tmp_path):
+    """``sim.save("newdir/")`` wrote a file named ``newdir`` (``Path`` drops the
+    separator); a path ending in a separator, or naming a folder, is a ValueError
+    naming it, nothing written."""
+    sim = Simulation(_disc(3), method="wh", dt=0.05)
+    for bad in (f"{tmp_path / 'newdir'}{os.sep}", tmp_path, str(tmp_path)):
+        with pytest.raises(ValueError, match=rf"Expected `path` to be a file's path, got "
+                                             rf"{re.escape(repr(bad))}: a folder's"):
+            sim.save(bad)
+    assert list(tmp_path.iterdir()) == []
+    sim.save(tmp_path / "newdir.nc")
+    assert Simulation.load(tmp_path / "newdir.nc").t == 0.0
