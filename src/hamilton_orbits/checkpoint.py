@@ -503,7 +503,8 @@ class ArchiveWriter:
         """Whether one of the files this writer left (:attr:`mine`) is in the folder
         as it left it: the folder is still its run's (a file of it removed, say; not
         removed as a whole and made again by another run)."""
-        return any(_signature(path) == known for path, known in reversed(self.mine.items()))
+        return any(known is not None and _signature(path) == known
+                   for path, known in reversed(self.mine.items()))
 
     def _refuse_replaced(self) -> None:
         """Release the folder and refuse it: it holds snapshots and none of the files
