@@ -89,6 +89,20 @@ def _from_state(prop: Any, meta: dict[str, Any], arrays: dict[str, np.ndarray]) 
 
 
 
+def _file_path(path: Any) -> Path:
+    """The ``path`` of :meth:`Saving.save` as a Path, refused by name where it ends in
+    a separator or names a folder (``Path`` drops a trailing separator: a file was
+    written under the folder's name)."""
+    out = path_of(path, "path", "a file or folder path")
+    raw = os.fspath(path)
+    seps = tuple(sep for sep in (os.sep, os.altsep) if sep)
+    if (isinstance(raw, str) and raw.endswith(seps)) or out.is_dir():
+        raise ValueError(f"Expected `path` to be a file's path, got {path!r}: a folder's "
+                         f"(save writes one file, such as {os.path.join(raw, 'sim.nc')!r}; an "
+                         f"archive folder is written by Simulation(..., archive=folder))")
+    return out
+
+
 def _numbered_as_the_call(on_output: Any, shift: int, steps: int) -> Any:
     """``on_output`` called by a resumed call as the interrupted call would have: its
     outputs numbered in the call's own times (``shift`` of them passed before the
@@ -107,6 +121,22 @@ class Saving:
     :class:`~hamilton_orbits.simulation.Simulation` (a mixin: it stands on the
     simulation's propagation, system and specification)."""
 
+    #: an ``integrate`` or ``resume`` call of this simulation is running: its
+    #: callbacks (``on_output``, ``stop``) may copy or save the simulation, not
+    #: integrate it again (the outer call would go on from a state moved under it,
+    #: and its archive would get a second timeline)
+    _busy = False
+
+    def _refuse_within(self, what: str) -> None:
+        """Refuse ``what`` (``"integrate"`` or ``"resume"``) called from within a call
+        of this simulation (:attr:`_busy`)."""
+        raise ValueError(f"Simulation.{what}() called from within an integrate or resume "
+                         f"call of the same simulation (its on_output or stop callback): "
+                         f"it would move the state that call stands on, and write a second "
+                         f"timeline into its archive; integrate a copy there "
+                         f"(sim.copy(), which writes nothing), or call {what}() after the "
+                         f"call has returned")
+
     def resume(self, *, progress: bool = False, on_output: Any = None, stop: Any = None,
                on_interrupt: str = "raise") -> Trajectory:
         """Finish the ``integrate`` call a killed run was in, from the archive's last
@@ -119,9 +149,11 @@ class Saving:
         ValueError
             When this simulation was not loaded from an archive folder, or has
             integrated since (the interrupted call was left for another); for a
-            ``progress`` not True or False.
+            ``progress`` not True or False; when called from within a call of the
+            same simulation (its ``on_output`` or ``stop``).
         SnapshotError
-            When a snapshot of the leg is missing or damaged (its rows are lost).
+            When a snapshot of the leg is missing or damaged (its rows are lost),
+            naming the archive, the file that held it and how to go on.
 
         Examples
         --------
@@ -138,6 +170,8 @@ class Saving:
         >>> bool(np.array_equal(traj.r, whole.r)), traj.t.tolist() == whole.t.tolist()
         (True, True)
         """
+        if self._busy:
+            self._refuse_within("resume")
         if self._resumable is None:
             raise ValueError("Nothing to resume: resume() finishes the integrate call of a "
                              "simulation loaded from its archive folder, before it "
@@ -152,12 +186,15 @@ class Saving:
         if rest.size:
             on_output = _numbered_as_the_call(on_output, times.size - rest.size - 1,
                                               self.steps - info["steps0"])
+            self._busy = True  # (its callbacks may copy or save it: see _busy)
             try:
                 out = self._advance(np.concatenate(([prop.t], rest)), progress, on_output,
                                     stop, leg=times)
             except BaseException:  # (cut: the next leg's integrals measured from time 0)
                 self._start = self._initial
                 raise
+            finally:
+                self._busy = False
             if out.interrupted and on_interrupt == "raise":
                 raise KeyboardInterrupt
         whole = leg_run(rows, out, prop, self.steps - info["steps0"], info["first_event"])
@@ -173,6 +210,17 @@ class Saving:
         The file is a self-describing netCDF file (``t``, ``r``, ``v``, ``gm`` readable
         by any netCDF reader; the method, effects, events and the integrator's own
         state for this package), written atomically (``docs/archive.md``).
+
+        Parameters
+        ----------
+        path : path
+            The file to write (replaced if it exists); not a folder, nor a path
+            ending in a separator.
+
+        Raises
+        ------
+        ValueError
+            For a ``path`` that is not a path, ends in a separator or names a folder.
 
         Examples
         --------
@@ -190,12 +238,12 @@ class Saving:
         >>> bool(np.array_equal(a.r, b.r)), again.steps
         (True, 200)
         """
+        target = _file_path(path)
         meta, arrays, dims, units = self._record()
         asked = self._asked_times()
         if asked is not None:  # (a fixed-step archive's snapshots are laid from them)
             arrays["asked_times"] = np.asarray(asked, dtype=np.float64)
-        write(path_of(path, "path", "a file or folder path"), meta, arrays, dims, units,
-              sync=True)
+        write(target, meta, arrays, dims, units, sync=True)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str], number: int | None = None) -> Any:
@@ -256,7 +304,7 @@ class Saving:
             sim._archive.last_steps = sim.steps
             sim._archive.continues = True  # (the run of the folder's snapshots)
             if folder is not None:  # (the snapshot it stands at: see ArchiveWriter.loaded)
-                sim._archive.loaded = int(meta["number"])
+                sim._archive.loaded_from(int(meta["number"]), path)
         leg = meta.get("leg")
         if leg is not None and source is not None:  # (its leg's times, read if needed)
             sim._asked = (source, int(leg["start"]))

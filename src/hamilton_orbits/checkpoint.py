@@ -127,10 +127,12 @@ def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str,
     Raises
     ------
     SnapshotError
-        When one of those snapshots is missing or damaged (its rows are lost).
+        When one of those snapshots is missing or damaged (its rows are lost), naming
+        the archive, the file that holds it (if one does) and what can be done.
     """
     files = snapshot_files(folder)
     found: dict[int, dict[str, np.ndarray]] = {}
+    ends: dict[Path, int] = {}  # (the number after a file's snapshots, where it reads)
     for i, (first, path) in enumerate(files):
         after = files[i + 1][0] if i + 1 < len(files) else upto + 1
         if first > upto or after <= start:
@@ -139,17 +141,34 @@ def leg_rows(folder: Path, start: int, upto: int) -> tuple[np.ndarray, dict[str,
             seg = _read_file(path)
         except SnapshotError:
             continue
+        ends[path] = seg.first + seg.count
         found.update((k, arrays) for k, _, arrays in seg.snapshots if start <= k <= upto)
     parts: dict[str, list[np.ndarray]] = {}
     for k in range(start, upto + 1):
         if k not in found:
-            raise SnapshotError(f"snapshot {k} of the leg being resumed is missing or "
-                                f"damaged")
+            raise SnapshotError(_lost_row(folder, files, ends, k))
         for name, a in found[k].items():
             if name.startswith("out_") and a.shape[0]:
                 parts.setdefault(name, []).append(a)
     rows = {name: np.concatenate(a) for name, a in parts.items()}
     return found[start]["leg_times"], rows
+
+
+def _lost_row(folder: Path, files: list[tuple[int, Path]], ends: dict[Path, int],
+              k: int) -> str:
+    """What a resume says of snapshot ``k`` of its call, missing or damaged in archive
+    ``folder`` (``files`` by their first number, ``ends``: the number after each
+    file's snapshots, for those that read): where it was, and what can be done."""
+    holder = [path for first, path in files if first <= k]
+    if holder and (holder[-1] not in ends or k < ends[holder[-1]]):
+        where = f"damaged in {holder[-1]}"
+    else:
+        where = "missing: no file of the archive holds it"
+    return (f"snapshot {k} of the call being resumed from the archive {folder} is {where}; "
+            f"the call's rows it held are lost, so the call cannot be returned whole. Go on "
+            f"without them from the archive's last snapshot (Simulation.load("
+            f"{str(folder)!r}).integrate(t)), or from an earlier whole one (Archive("
+            f"{str(folder)!r})[k], or Simulation.load(folder, number=n)) and integrate from it")
 
 
 def on_step_grid(extra: np.ndarray, times: np.ndarray, dt: float,
@@ -314,6 +333,17 @@ def _next_number(folder: Path) -> int:
         return first + 1
 
 
+def _signature(path: Path) -> tuple[int, int, int] | None:
+    """What tells a file of an archive from another of the same name: its inode, size
+    and time of last change (in ns); None where it is not there.  (Not the folder's
+    inode alone: a folder removed and made again at once gets the same one.)"""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
 #: the most snapshots of ``every`` in one ``integrate`` call: 10 GB on disk at
 #: least (about a kilobyte each), their times 80 MB in memory
 MAX_SNAPSHOTS = 10**7
@@ -396,6 +426,11 @@ class ArchiveWriter:
         #: until this writer has written there (:meth:`_gone_on`: after that, its
         #: last segment is what tells another writer's coming)
         self.loaded: int | None = None
+        #: the files of the folder this writer closed, or its simulation was loaded
+        #: from, each as it left it (:func:`_signature`): a folder that holds
+        #: snapshots and none of them is no longer this run's (removed and used
+        #: again by another run: :meth:`open` refuses it)
+        self.mine: dict[Path, tuple[int, int, int] | None] = {}
         #: the leg of the snapshots being appended (a record's ``leg``)
         self.leg: tuple[float, ...] = NO_LEG
         #: the wall clock of ``every_wall`` (seconds)
@@ -436,6 +471,8 @@ class ArchiveWriter:
         self.folder = folder
         known = self._continued()
         self.count = _next_number(self.path) if known is None else known
+        if known is None and self.count and self.mine and not self._holds_mine():
+            self._refuse_replaced()  # (read only where the folder is not as left)
         if known is None and self._gone_on():
             self.close()
             raise SnapshotError(
@@ -454,6 +491,33 @@ class ArchiveWriter:
         parked, self.parked = self.parked, None
         if known is not None and parked is not None and parked.reopen():
             self.segment = parked  # (the next leg goes on in it, if it shares the same)
+
+    def loaded_from(self, number: int, path: Path) -> None:
+        """Attach this writer to the folder its simulation was loaded from, standing at
+        snapshot ``number`` (:attr:`loaded`) of its file ``path`` (one of the run's,
+        :attr:`mine`)."""
+        self.loaded = number
+        self.mine[path] = _signature(path)
+
+    def _holds_mine(self) -> bool:
+        """Whether one of the files this writer left (:attr:`mine`) is in the folder
+        as it left it: the folder is still its run's (a file of it removed, say; not
+        removed as a whole and made again by another run)."""
+        return any(known is not None and _signature(path) == known
+                   for path, known in reversed(self.mine.items()))
+
+    def _refuse_replaced(self) -> None:
+        """Release the folder and refuse it: it holds snapshots and none of the files
+        this writer left there, so it is no longer the folder of this run (removed,
+        and made again by another run)."""
+        self.close()
+        raise SnapshotError(
+            f"the archive {self.path} is no longer the folder this simulation wrote: its "
+            f"files are gone, and it holds the snapshots of another run now (the last "
+            f"numbered {self.count - 1}; the folder removed and written again?), which "
+            f"this simulation's would mix with (one archive holds one run); continue that "
+            f"run with Simulation.load({str(self.path)!r}), and this simulation from a copy "
+            f"(sim.copy(), which writes nothing) or a file (sim.save(path))")
 
     def _continued(self) -> int | None:
         """The next snapshot number without listing the folder (whose listing grows
@@ -499,6 +563,7 @@ class ArchiveWriter:
                 self.left, self.loaded = (seg.path, seg.size, self.count), None
                 self.parked = seg if seg.legs else None
                 seg.close()
+                self.mine[seg.path] = _signature(seg.path)  # (one stat a call)
         finally:
             if self.folder is not None:
                 self.folder.__exit__(None, None, None)
@@ -518,6 +583,7 @@ class ArchiveWriter:
                 seg.trim()  # (no torn tail left by a write this process broke off)
             finally:
                 seg.close()
+                self.mine[seg.path] = _signature(seg.path)
 
     def times(self, t0: float, t1: float) -> np.ndarray:
         """The scheduled snapshot times in ``(t0, t1]`` (simulation time schedule)."""

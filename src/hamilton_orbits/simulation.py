@@ -306,7 +306,14 @@ class Simulation(Saving):
         simulation keeps its schedule but writes nothing."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
-        new._prop = copy.deepcopy(self._prop, shared_memo(self._prop))
+        new.__dict__.pop("_busy", None)  # (a copy taken in a callback is not running)
+        memo = shared_memo(self._prop)
+        pause = getattr(self._prop.driver, "pause", None)
+        if pause is not None:  # (taken in a callback of an archived call: the step
+            # schedule's pause holds this simulation, whose copy would copy it again;
+            # the copy's driver pauses for nothing, as between two calls)
+            memo[id(pause)] = None
+        new._prop = copy.deepcopy(self._prop, memo)
         if new._start is None and (self._prop.t != 0.0 or self._prop.steps):
             new._start = new._initial  # (a copy taken within the first call, from a
             # callback: its integrals from time 0, as a snapshot loaded there has them)
@@ -353,7 +360,8 @@ class Simulation(Saving):
             :class:`~hamilton_orbits.integrators.StopIntegration` to end the leg there
             (the trajectory then has ``complete == False``).  The simulation stands
             at output ``i`` while it runs (:attr:`t`, :attr:`system`, :attr:`steps`):
-            a ``save`` or ``copy`` there continues to the run's bits.
+            a ``save`` or ``copy`` there continues to the run's bits (integrate the
+            copy there, not the simulation itself: that is refused).
         stop : callable, optional
             ``stop()`` after every output and between slices of steps; True ends
             the leg there (``complete == False``).  It sees the simulation at the
@@ -378,6 +386,8 @@ class Simulation(Saving):
             simulation of :attr:`system` in which they are merged or one is
             removed, or watch the collision with action ``"merge"``).  A stop at a
             close approach or an escape goes on: that event is not found again.
+            Called from within a call of the same simulation (its ``on_output`` or
+            ``stop``), naming ``sim.copy()`` to integrate there instead.
         KeyboardInterrupt
             On Ctrl-C (the run stops within a slice of steps; the simulation keeps
             the state reached, its time and step count with it), unless
@@ -389,6 +399,8 @@ class Simulation(Saving):
             steps are counted and its event acted on (the drivers' ``_held``); a
             second is raised at once.
         """
+        if self._busy:  # (from a callback of its own call: refused, see Saving._busy)
+            self._refuse_within("integrate")
         t = time_quantity(t)  # (a TimeDelta: the Quantity in days it holds)
         progress = as_flag("progress", progress)  # ("no" was a bar: any text is true)
         if (self._archive is None and on_output is None and stop is None and not progress
@@ -419,6 +431,7 @@ class Simulation(Saving):
             check_step_count(abs(float(times[-1] - times[0])), step,  # refused before the
                              prop.method.max_steps, prop.method.name)  # leg's first snapshot)
         start, begun = self._start, False  # (start None: this leg begins at time 0)
+        self._busy = True  # (its callbacks may copy or save it, not integrate it)
         try:
             if self._archive is not None:
                 self._new_leg(times)
@@ -430,6 +443,8 @@ class Simulation(Saving):
             if begun:  # (a leg cut by Ctrl-C or an error: the next measures Hamilton's
                 self._start = self._initial  # integrals from time 0, as it would have)
             raise
+        finally:
+            self._busy = False
         self._start = self._initial  # the first leg begins at time 0
         if out.interrupted and on_interrupt == "raise":
             raise KeyboardInterrupt

@@ -1489,20 +1489,23 @@ def test_a_new_simulation_is_refused_a_folder_holding_another_runs_snapshots(tmp
 
 def test_to_xarray_of_no_snapshot_or_of_two_runs_says_so(tmp_path):
     """``to_xarray`` of an archive of no whole snapshot, or of snapshots of two runs
-    (here: a folder deleted between two calls of a run, a second run written there
-    meanwhile), is a SnapshotError naming the archive, not numpy's error on stacking
-    no arrays or arrays of two shapes."""
+    (here: another run's segment copied into it; a run no longer appends to a folder
+    emptied and written by another run), is a SnapshotError naming the archive, not
+    numpy's error on stacking no arrays or arrays of two shapes."""
+    import shutil
+
     pytest.importorskip("xarray")
     (tmp_path / "empty").mkdir()
     with pytest.raises(SnapshotError, match=r"archive .*empty has no whole snapshot"):
         Archive(tmp_path / "empty").to_xarray()
     kw = dict(method="wh", dt=0.01, every=0.25)
-    first = Simulation(_disc(), archive=tmp_path / "a", **kw)
-    first.integrate(0.5)
-    for path in (tmp_path / "a").iterdir():
-        path.unlink()
-    Simulation(System(list(_disc().bodies)[:4]), archive=tmp_path / "a", **kw).integrate(0.5)
-    first.integrate(1.0)  # (it goes on where it wrote: the folder made again)
+    Simulation(_disc(), archive=tmp_path / "a", **kw).integrate(0.5)  # (snapshots 0 to 2)
+    other = Simulation(System(list(_disc().bodies)[:4]), archive=tmp_path / "b", **kw)
+    other.integrate(0.5)
+    other.integrate([0.75, 1.0])  # (a segment of its own, from number 3)
+    for path in (tmp_path / "b").glob("*-000003.nc"):
+        shutil.copy(path, tmp_path / "a" / path.name)
+    assert [s.number for s in Archive(tmp_path / "a").snapshots] == [0, 1, 2, 3, 4, 5]
     with pytest.raises(SnapshotError, match=r"snapshots of the archive .*a hold different "
                                             r"numbers of bodies \(4, 6\)"):
         Archive(tmp_path / "a").to_xarray()
@@ -2012,3 +2015,148 @@ def test_a_snapshot_of_an_earlier_formats_first_call_measures_from_time_0(tmp_pa
     leg = loaded.integrate(5.0)
     assert _same(leg.r[0], whole.r[4])
     assert _same(leg.particle_error[0], whole.particle_error[4]) and leg.particle_error[0, 1] != 0
+
+
+@pytest.mark.parametrize("schedule", [dict(every_steps=3), dict(every_wall=1.5)],
+                         ids=["every_steps", "every_wall"])
+def test_a_copy_or_save_in_a_callback_of_a_step_paused_call_goes_on_to_its_bits(
+        tmp_path, monkeypatch, schedule):
+    """A ``copy`` or ``save`` in ``on_output`` or ``stop`` of a radau15 call whose
+    archive pauses between two steps (``every_steps``, ``every_wall``: a clock that
+    ticks a second at each look, looked at every 3 steps) was a RecursionError (the
+    driver's pause holds the simulation, which the copy copied again); each goes on
+    to the run's bits, and the run to those of the run without an archive."""
+    monkeypatch.setattr(_saving, "WALL_CHECK", 3)
+    times = np.linspace(0.0, 4.0, 5)
+    whole = Simulation(_disc(3), method="radau15").integrate(times)
+    sim = Simulation(_disc(3), method="radau15", archive=tmp_path / "a", **schedule)
+    ticks = iter(range(10**6))
+    sim._archive.clock = lambda: float(next(ticks))
+    taken = {}
+
+    def on_output(i, steps):
+        if i == 2:
+            taken["on_output"] = sim.copy()
+            sim.save(tmp_path / "at2.nc")
+
+    def stop():
+        if "stop" not in taken and sim.t > 2.0 and sim.t not in times:  # (between two
+            # outputs, at a pause)
+            taken["stop"] = sim.copy()
+        return False
+
+    traj = sim.integrate(times, on_output=on_output, stop=stop)
+    assert _same(traj.r, whole.r) and _same(traj.v, whole.v)
+    assert len(Archive(tmp_path / "a")) > 2 and taken["stop"].t not in times
+    for again in (taken["on_output"], taken["stop"], Simulation.load(tmp_path / "at2.nc")):
+        rest = again.integrate(times[times > again.t])
+        assert _same(rest.r[-1], whole.r[-1]) and _same(rest.v[-1], whole.v[-1])
+        assert again.steps == sim.steps
+
+
+def test_integrate_or_resume_from_within_an_archived_call_is_refused(tmp_path):
+    """``integrate`` (or ``resume``) from a callback of an archived call of the same
+    simulation wrote a second timeline into its archive (times going back) and left
+    the run off its bits: refused, the archive's times increasing, the run going on
+    to the bits of the run never interrupted, and ``resume`` refused alike from
+    within its own call."""
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    times = np.linspace(0.0, 2.0, 5)
+    whole = Simulation(_disc(3), archive=tmp_path / "whole", **kw).integrate(times)
+    sim = Simulation(_disc(3), archive=tmp_path / "a", **kw)
+    within = r"Simulation\.(integrate|resume)\(\) called from within an integrate or resume"
+    with pytest.raises(ValueError, match=within):
+        sim.integrate(times, on_output=lambda i, steps: i == 2 and sim.integrate(9.0))
+    with pytest.raises(ValueError, match=within):
+        sim.integrate(times[times >= 1.0], stop=lambda: sim.resume())
+    assert np.all(np.diff(Archive(tmp_path / "a").times) >= 0) and sim.t == 1.25  # (its
+    # first output: a snapshot's)
+    rest = sim.integrate(times[times > 1.0])
+    assert _same(rest.r[1:], whole.r[3:]) and np.all(np.diff(Archive(tmp_path / "a").times) >= 0)
+    cut = Simulation(_disc(3), archive=tmp_path / "cut", **kw)
+    cut.integrate(times, stop=lambda: cut.t >= 1.0)
+    loaded = {}
+    for callback in (dict(on_output=lambda i, steps: loaded["sim"].resume()),
+                     dict(stop=lambda: loaded["sim"].integrate(9.0))):
+        loaded["sim"] = Simulation.load(tmp_path / "cut")
+        with pytest.raises(ValueError, match=within):
+            loaded["sim"].resume(**callback)
+    assert np.all(np.diff(Archive(tmp_path / "cut").times) >= 0)
+    assert _same(Simulation.load(tmp_path / "cut").resume().r, whole.r)
+
+
+def test_a_run_whose_folder_was_removed_and_written_by_another_run_is_refused(tmp_path):
+    """A folder removed between two calls of a run is made again by its next call;
+    removed and made the archive of another run meanwhile, the first run appended
+    its snapshots to that run's (two runs in one archive, ``Simulation.load`` taking
+    whichever wrote last): refused by name, the folder released and left to the run
+    that holds it, while a file of the run removed (not the folder) is gone on
+    from."""
+    import shutil
+
+    kw = dict(method="wh", dt=0.01, every=0.25)
+    folder = tmp_path / "a"
+    first = Simulation(_disc(3), archive=folder, **kw)
+    first.integrate(0.5)
+    shutil.rmtree(folder)
+    first.integrate(1.0)  # (made again: this run's)
+    assert Archive(folder).times.tolist() == [0.5, 0.75, 1.0]
+    shutil.rmtree(folder)
+    second = Simulation(_disc(4), archive=folder, **kw)
+    second.integrate(0.5)
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"the archive {folder} is no longer the folder this simulation wrote: its files "
+            f"are gone, and it holds the snapshots of another run now (the last numbered 2;")
+            + r".* continue that run with Simulation\.load\(.*\), and this simulation from a "
+              r"copy \(sim\.copy\(\), which writes nothing\)"):
+        first.integrate(1.5)
+    assert first.t == 1.0 and not _lock(folder)
+    assert Archive(folder).times.tolist() == [0.0, 0.25, 0.5]
+    second.integrate([0.75, 1.0])  # (a segment of its own: from number 3)
+    (folder / "segment-000003.nc").unlink()
+    second.integrate(1.25)  # (a file of it removed: its run's folder still)
+    assert Archive(folder).times.tolist() == [0.0, 0.25, 0.5, 1.0, 1.25]
+
+
+def test_resume_of_a_call_with_a_damaged_or_missing_snapshot_names_the_archive_and_a_way(
+        tmp_path):
+    """A snapshot of the call being resumed damaged (its rows lost) was "snapshot 1
+    of the leg being resumed is missing or damaged", no folder, no file, no way on
+    (the command line printed just that): the message names the archive, the file
+    that held it, and how to go on."""
+    folder = tmp_path / "a"
+    Simulation(_disc(3), method="wh", dt=0.01, archive=folder, every=0.5).integrate(
+        np.linspace(0.0, 2.0, 9))
+    path, = folder.glob("segment-*.nc")
+    data = bytearray(path.read_bytes())
+    header = parse(bytes(data))
+    data[header.record_begin + header.record_size + header.record_size // 2] ^= 0xFF
+    path.write_bytes(bytes(data))  # (snapshot 1 damaged)
+    loaded = Simulation.load(folder)
+    way = (r"; the call's rows it held are lost, so the call cannot be returned whole\. Go "
+           r"on without them from the archive's last snapshot \(Simulation\.load\(.*\)"
+           r"\.integrate\(t\)\), or from an earlier whole one \(Archive\(.*\)\[k\], or "
+           r"Simulation\.load\(folder, number=n\)\) and integrate from it")
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"snapshot 1 of the call being resumed from the archive {folder} is damaged in "
+            f"{path}") + way):
+        loaded.resume()
+    path.unlink()
+    with pytest.raises(SnapshotError, match=re.escape(
+            f"snapshot 0 of the call being resumed from the archive {folder} is missing: no "
+            f"file of the archive holds it") + way):
+        loaded.resume()
+
+
+def test_save_refuses_a_folders_path_by_name(tmp_path):
+    """``sim.save("newdir/")`` wrote a file named ``newdir`` (``Path`` drops the
+    separator); a path ending in a separator, or naming a folder, is a ValueError
+    naming it, nothing written."""
+    sim = Simulation(_disc(3), method="wh", dt=0.05)
+    for bad in (f"{tmp_path / 'newdir'}{os.sep}", tmp_path, str(tmp_path)):
+        with pytest.raises(ValueError, match=rf"Expected `path` to be a file's path, got "
+                                             rf"{re.escape(repr(bad))}: a folder's"):
+            sim.save(bad)
+    assert list(tmp_path.iterdir()) == []
+    sim.save(tmp_path / "newdir.nc")
+    assert Simulation.load(tmp_path / "newdir.nc").t == 0.0

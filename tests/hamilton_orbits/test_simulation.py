@@ -898,3 +898,35 @@ def test_crosscheck_refuses_a_progress_that_is_no_bool_with_a_trajectory_given()
     traj = integrate(system, 0.5, method="dop853")
     with pytest.raises(ValueError, match="`progress` to be True or False, got 'no'"):
         crosscheck(system, 0.5, method="dop853", trajectory=traj, progress="no")
+
+
+def test_integrate_from_within_its_own_call_is_refused_and_a_copy_goes_on():
+    """``sim.integrate`` from ``on_output`` or ``stop`` of a call of the same
+    simulation ran a second integration under the first (the lean path's one end
+    time, or output times), the outer call then going on from a moved state (1.4
+    off at its end): refused, naming the copy to integrate there instead, the
+    simulation standing where its call was cut and going on as the run does."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
+    times = np.linspace(0.0, 2.0, 5)
+    plain = Simulation(s, method="wh", dt=0.01).integrate(times)
+    within = r"Simulation\.integrate\(\) called from within an integrate or resume call .* " \
+             r"integrate a copy there \(sim\.copy\(\), which writes nothing\)"
+    for again in (9.0, [1.0, 9.0]):
+        for where in ("on_output", "stop"):
+            sim = Simulation(s, method="wh", dt=0.01)
+            callback = (lambda i, steps, again=again, sim=sim: i == 2 and sim.integrate(again)) \
+                if where == "on_output" else (lambda again=again, sim=sim: sim.t == 1.0 and
+                                              sim.integrate(again))
+            with pytest.raises(ValueError, match=within):
+                sim.integrate(times, **{where: callback})
+            assert sim.t == 1.0 and sim.steps == 100  # (where the call was cut)
+            rest = sim.integrate(times[times > 1.0])  # (no longer within a call)
+            assert np.array_equal(rest.r, plain.r[2:]) and sim.steps == plain.steps
+    sim, branches = Simulation(s, method="wh", dt=0.01), []
+
+    def on_output(i, steps):
+        branches.append(sim.copy())
+        branches[-1].integrate(9.0)  # (a copy: integrated there)
+
+    traj = sim.integrate(times, on_output=on_output)
+    assert np.array_equal(traj.r, plain.r) and branches[-1].t == 9.0
