@@ -429,7 +429,7 @@ class EventLog:
     #: time-reversed motion in ``s = -t`` (:meth:`drain` turns its times back)
     sign = 1.0
     #: close approaches of one pair recorded closer in time than this are one approach
-    #: (:meth:`_one_per_approach`): leapfrog's step, set by its driver; 0: none merged
+    #: (``_one_per_approach``): leapfrog's step, set by its driver; 0: none merged
     same_approach = 0.0
 
     def __init__(self, watch: np.ndarray, radius: np.ndarray, capacity: int = 1024) -> None:
@@ -636,7 +636,7 @@ class EventLog:
         The event of ``row`` acts first (the kernel's: the step's first with an
         action), then every other event with an action (stop, merge, remove) among
         the rows drained here, in the log's (time) order, each as
-        :meth:`_kept_until` keeps the log up to it: the rows the scan found after
+        ``_kept_until`` keeps the log up to it: the rows the scan found after
         an event of the same bodies are dropped, as are those of another pair of a
         body taken out at the same instant (a body touching two others at once
         merges into the first), and a row of a body an earlier action took out is

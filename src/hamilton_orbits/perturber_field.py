@@ -71,7 +71,7 @@ def perturber_chain(name: str) -> tuple[tuple[int, int], ...]:
     Parameters
     ----------
     name : str
-        A body of DE440 (:data:`~hamilton_orbits.ephemeris.CHAINS`) or one of the 16
+        A body of DE440 (``hamilton_orbits.ephemeris.CHAINS``) or one of the 16
         asteroids of ``sb441-n16``, in any case (stripped, as elsewhere in the
         package).
 

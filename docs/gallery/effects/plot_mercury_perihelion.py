@@ -8,7 +8,8 @@ the form of Anderson et al. 1975 that reboundx's ``gr`` uses).  Without other
 planets the only precession left is Einstein's,
 ``6 pi GM / (c^2 a (1 - e^2))`` per orbit (Einstein 1915), 42.98 arcsec per
 century for Mercury.  The scene fits the advance of the perihelion longitude
-over a century and prints the fitted rate beside that value.
+over a century and prints the fitted rate; its figure draws the rate beside
+that value.
 """
 
 # %%
