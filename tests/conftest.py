@@ -52,11 +52,15 @@ def pytest_sessionstart(session):
 
 #: test files sent to one worker process, one after the other (pytest-xdist's
 #: ``--dist loadfile`` sends each file whole to one worker): their first tests
-#: compile the same event-watching step loops of radau15 and wh (about 25 s of a cold
-#: cache, measured 2026-11-30 with numba's compile events), which two workers running
-#: them at once each compiled; one after the other, the second loads them from the cache
+#: compile the same event-watching step loops of radau15 and wh (about 25-30 s of a
+#: cold cache, measured 2026-11-30 with numba's compile events: test_events.py's
+#: first tests compiled them on the other worker at the very moments test_archive.py
+#: did), which two workers running them at once each compiled; one after the other,
+#: the later files load them from the cache.  The rigid body's RK4 loop (6 s) alike
 SHARE_A_WORKER = {
     "tests/hamilton_orbits/test_simulation_legs.py": "tests/hamilton_orbits/test_archive.py",
+    "tests/hamilton_orbits/test_events.py": "tests/hamilton_orbits/test_archive.py",
+    "tests/rigid/test_reliability.py": "tests/rigid/test_pole_wander.py",
 }
 
 
