@@ -575,11 +575,36 @@ def _under_resolved(r: np.ndarray, v: np.ndarray, out: Any, times: np.ndarray,
     step, exempt, fraction = encounters
     if step is None:
         step = abs(times[-1] - times[0]) / max(int(out.steps), 1)
-    gm = out.gm if out.gm.ndim == 1 else out.gm[0]
     ex, ex_dist = (-1, 0.0) if exempt is None else exempt
-    if not screen(r, v, gm, times, float(step), ex, ex_dist, fraction, LIGHT):
-        return ()
-    return under_resolved_encounters(r, v, gm, times, step, exempt, fraction)
+    parts = _constant_masses(r, v, out.gm, times)
+    found: list[Any] = []
+    for rp, vp, gm, tp in parts:
+        if screen(rp, vp, gm, tp, float(step), ex, ex_dist, fraction, LIGHT):
+            found.extend(under_resolved_encounters(rp, vp, gm, tp, step, exempt, fraction))
+    return tuple(found) if len(parts) > 1 else (found or ())
+
+
+def _constant_masses(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
+                     times: np.ndarray) -> list[tuple[np.ndarray, ...]]:
+    """A leg's outputs in parts of constant masses, for the screen: the outputs
+    between two merges or removals (``gm`` (n_t, n) where they changed), and each
+    interval across one with the bodies it changed left out (NaN, massless): the
+    change in 1/a across it is the merge's, not the step's, and the approach it
+    showed one to a body that had left.  One part, the leg, where nothing changed."""
+    if gm.ndim == 1:
+        return [(r, v, gm, times)]
+    changed = gm[1:] != gm[:-1]
+    cut = np.flatnonzero(changed.any(axis=1)) + 1
+    parts = [(r[a:b], v[a:b], gm[a], times[a:b])
+             for a, b in zip(np.r_[0, cut].tolist(), np.r_[cut, len(times)].tolist())
+             if b - a >= 2]
+    for k in cut.tolist():  # (the intervals across a change: the few merges of a leg)
+        rk, vk, gk = r[k - 1:k + 1].copy(), v[k - 1:k + 1].copy(), gm[k - 1].copy()
+        rk[:, changed[k - 1]] = np.nan
+        vk[:, changed[k - 1]] = np.nan
+        gk[changed[k - 1]] = 0.0
+        parts.append((rk, vk, gk, times[k - 1:k + 1]))
+    return parts
 
 
 def _encounter_table(found: Any, system: Any, unit: Any) -> Any:
