@@ -596,7 +596,7 @@ def _constant_masses(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
     changed = gm[1:] != gm[:-1]
     cut = np.flatnonzero(changed.any(axis=1)) + 1
     parts = [(r[a:b], v[a:b], gm[a], times[a:b])
-             for a, b in zip(np.r_[0, cut].tolist(), np.r_[cut, len(times)].tolist())
+             for a, b in zip(np.r_[0, cut].tolist(), np.r_[cut, len(times)].tolist(), strict=True)
              if b - a >= 2]
     for k in cut.tolist():  # (the intervals across a change: the few merges of a leg)
         rk, vk, gk = r[k - 1:k + 1].copy(), v[k - 1:k + 1].copy(), gm[k - 1].copy()
