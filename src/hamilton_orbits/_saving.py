@@ -131,7 +131,8 @@ class Saving:
         """Refuse ``what`` (``"integrate"`` or ``"resume"``) called from within a call
         of this simulation (:attr:`_busy`)."""
         raise ValueError(f"Simulation.{what}() called from within an integrate or resume "
-                         f"call of the same simulation (its on_output or stop callback): "
+                         f"call of the same simulation (its on_output or stop callback, or "
+                         f"another thread while it runs): "
                          f"it would move the state that call stands on, and write a second "
                          f"timeline into its archive; integrate a copy there "
                          f"(sim.copy(), which writes nothing), or call {what}() after the "
