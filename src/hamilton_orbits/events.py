@@ -591,19 +591,26 @@ class EventLog:
         recorded at ``t`` and its action carried out on ``r``, ``v``, ``gm`` (in place;
         a merged body that overlaps another collides with it in turn).  True if the
         run must stop there."""
-        code = EVENTS["collision"][0]
         while True:
-            rows, pairs, d, inside = self._overlaps(r)
-            if not inside.size:
+            overlaps = self._overlaps(r)
+            if not overlaps[3].size:
                 return False
-            row = int(rows[inside[0]])
-            i, j = pairs[inside[0]]
-            speed = float(np.linalg.norm(v[i] - v[j]))
             self.drain()
-            self.rows.append(np.array([code, i, j, t, d[inside[0]], speed,
-                                       self.watch[row, W_ACTION]]))
+            row = self._record_contact(t, v, overlaps, int(overlaps[3][0]))[0]
             if self.act(row, t, r, v, gm):
                 return True
+
+    def _record_contact(self, t: float, v: np.ndarray, overlaps: tuple[np.ndarray, ...],
+                        k: int) -> tuple[int, int, int, int]:
+        """Record the contact ``k`` of :meth:`_overlaps`'s ``overlaps`` as a collision at
+        ``t`` (its distance there, the pair's relative speed in ``v``); returns its
+        watch row, its two bodies and its action."""
+        rows, pairs, d, _ = overlaps
+        row, i, j = int(rows[k]), int(pairs[k, 0]), int(pairs[k, 1])
+        action = int(self.watch[row, W_ACTION])
+        self.rows.append(np.array([EVENTS["collision"][0], i, j, t, d[k],
+                                   float(np.linalg.norm(v[i] - v[j])), action]))
+        return row, i, j, action
 
     def act(self, row: int, t: float, r: np.ndarray, v: np.ndarray, gm: np.ndarray,
             at: float | None = None) -> bool:
@@ -694,15 +701,13 @@ class EventLog:
         seen = {(int(y[E_I]), int(y[E_J])) for y, _ in done
                 if y is not None and y[E_CODE] == code}
         while True:
-            rows, pairs, d, inside = self._overlaps(r)
-            new = [k for k in inside if (int(pairs[k, 0]), int(pairs[k, 1])) not in seen]
+            overlaps = self._overlaps(r)
+            pairs = overlaps[1]
+            new = [k for k in overlaps[3] if (int(pairs[k, 0]), int(pairs[k, 1])) not in seen]
             if not new:
                 return
-            k = new[0]
-            i, j, action = int(pairs[k, 0]), int(pairs[k, 1]), int(self.watch[rows[k], W_ACTION])
+            _, i, j, action = self._record_contact(t, v, overlaps, int(new[0]))
             seen.add((i, j))
-            self.rows.append(np.array([code, i, j, t, d[k], float(np.linalg.norm(v[i] - v[j])),
-                                       action]))
             done.append(self._carry_out(code, i, j, action, t, t, r, v, gm,
                                         [y for y, _ in done]))
 
