@@ -343,6 +343,42 @@ def test_step_and_wall_clock_schedules(tmp_path):
     assert len(Archive(tmp_path / "wall")) == 6  # the start and every output
 
 
+@UNRESOLVED
+def test_appending_a_snapshot_writes_and_reads_as_much_however_long_the_archive(
+        tmp_path, monkeypatch):
+    """Issue 33, item 4: a snapshot appended costs O(snapshot), not O(archive).  Two
+    archives of one run, of 21 and 401 snapshots, each continued by the same call of
+    20 steps (wh, a snapshot a step, and the leg's first at its start): every byte
+    written and read by the system calls counted, the same for both, one record a
+    snapshot and a lock file's text."""
+    sims = {}
+    for name, t in (("short", 1.0), ("long", 20.0)):
+        sims[name] = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path / name,
+                                every=0.05)
+        sims[name].integrate(t)
+    assert [len(Archive(tmp_path / k)) for k in sims] == [21, 401]
+    counted = {}
+    for name, sim in sims.items():
+        io = counted[name] = {"written": 0, "read": 0}
+        with monkeypatch.context() as m:
+            for call, key in ((os.pwrite, "written"), (os.write, "written"),
+                              (os.pread, "read"), (os.read, "read")):
+                def counting(*a, call=call, key=key, io=io):
+                    out = call(*a)
+                    io[key] += len(a[1]) if key == "written" else len(out)
+                    return out
+                m.setattr(os, call.__name__, counting)
+            sim.integrate(sim.t + 1.0)
+    assert len(Archive(tmp_path / "long")) == 422
+    assert counted["short"] == counted["long"]
+    segment, = (tmp_path / "long").glob("segment-*.nc")
+    record = parse(segment.read_bytes()).record_size
+    lock_text = 200  # (the lock's text written, read back as it is released; a count)
+    assert 21 * record <= counted["long"]["written"] <= 21 * record + lock_text
+    assert counted["long"]["read"] <= lock_text
+    assert segment.stat().st_size > 400 * record  # (what an O(archive) append would touch)
+
+
 def test_two_writers_cannot_share_an_archive(tmp_path):
     (tmp_path / ".hamilton-orbits.lock").write_text(f"1 {socket.gethostname()}\n")  # PID 1 lives
     sim = Simulation(_disc(), method="wh", dt=0.05, archive=tmp_path, every=1.0)
