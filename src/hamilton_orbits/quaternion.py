@@ -512,7 +512,7 @@ class Quaternion(RotationForms):
         key = key if isinstance(key, tuple) else (key,)
         if any(k is Ellipsis for k in key):
             return Quaternion._wrap(self._a[(*key, slice(None))])
-        if len(key) > self.ndim:
+        if sum(k is not None for k in key) > self.ndim:  # (None, a new axis, takes none)
             raise IndexError(
                 f"too many indices for Quaternion of shape {self.shape}: {len(key)} given"
             )
@@ -525,11 +525,15 @@ class Quaternion(RotationForms):
     def __eq__(self, other: object) -> Any:  # componentwise, like numpy
         if not isinstance(other, Quaternion):
             return NotImplemented
+        if self._a.shape != other._a.shape:  # (numpy's message names no operand)
+            broadcast_shapes(("self", "other"), self.shape, other.shape)
         return np.all(self._a == other._a, axis=-1)
 
     def __ne__(self, other: object) -> Any:  # (not ``not ==``: a batch has no one truth)
         if not isinstance(other, Quaternion):
             return NotImplemented
+        if self._a.shape != other._a.shape:
+            broadcast_shapes(("self", "other"), self.shape, other.shape)
         return np.any(self._a != other._a, axis=-1)
 
     def __bool__(self) -> bool:

@@ -355,6 +355,26 @@ def test_indexing_len_shape_equality():
     assert [x.shape for x in p] == [()] * 4
 
 
+def test_a_new_axis_indexes_as_numpy_and_unbroadcastable_comparisons_name_the_operands():
+    """``None`` adds an axis and takes none (numpy's ``a[:, None]``), so the outer
+    product ``q[:, None] * p[None, :]`` works; ``==`` and ``!=`` of shapes that do not
+    broadcast raise the ValueError naming the operands that ``*`` raises."""
+    q, p = random_unit(5), random_unit(3)
+    a = q.as_array()
+    for got, want in ((q[:, None], a[:, None]), (q[None], a[None]),
+                      (q[..., None], a[..., None, :]), (q[None, 2], a[None, 2])):
+        np.testing.assert_array_equal(got.as_array(), want)
+    outer = q[:, None] * p[None, :]
+    assert outer.shape == (5, 3)
+    np.testing.assert_array_equal(outer[4, 2].as_array(), (q[4] * p[2]).as_array())
+    with pytest.raises(IndexError, match="too many indices"):
+        q[0, None, 0]
+    for op in ("__eq__", "__ne__", "__mul__"):
+        with pytest.raises(ValueError, match=r"`self`, `other` to broadcast together, got "
+                                             r"shapes \(5,\), \(3,\)"):
+            getattr(q, op)(p)
+
+
 # ---------------------------------------------------------------- bad input and hard cases
 def test_zero_quaternion_raises():
     z = Quaternion.from_array([[1.0, 0, 0, 0], [0.0, 0, 0, 0]])
