@@ -279,7 +279,7 @@ def _energy_error(r: np.ndarray, v: np.ndarray, gm: np.ndarray,
     return np.where(finite.any(axis=1), change[np.arange(len(change)), pick], 0.0)
 
 
-def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
+def accelerations_quaternion(r: Any, gm: Any) -> Any:
     """Equation (B) evaluated with :class:`~hamilton_orbits.quaternion.Quaternion` products.
 
     Exactly as Hamilton writes it: for each body alpha and each other body alpha' of
@@ -291,24 +291,51 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
 
     Parameters
     ----------
-    r : array_like, shape (n, 3)
-    gm : array_like, shape (n,)
+    r : Quantity or array_like, shape (n, 3)
+        Positions (a Quantity: any length unit).
+    gm : Quantity or array_like, shape (n,)
+        ``G m >= 0`` (a Quantity: any unit of a gravitational parameter); both
+        Quantities or both plain floats in the caller's consistent units.
 
     Returns
     -------
-    ndarray, shape (n, 3)
+    ndarray or Quantity, shape (n, 3)
+        In au/day^2 for Quantities (as :meth:`hamilton_orbits.nbody.System.accelerations`);
+        else in the caller's units.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, the index and the value: a non-finite ``r`` or ``gm``, a
+        negative ``gm``, two bodies (one of them massive) at one position (both indices
+        in ``r``), shapes that do not match (both shapes), a Quantity beside a plain
+        number (astropy's ``UnitConversionError``, a ``ValueError``, for a wrong unit).
 
     Examples
     --------
     >>> accelerations_quaternion([[0.0, 0, 0], [2.0, 0, 0]], [1.0, 0.0])
     array([[ 0.  ,  0.  ,  0.  ],
            [-0.25,  0.  ,  0.  ]])
+    >>> import astropy.units as u
+    >>> accelerations_quaternion([[0.0, 0, 0], [2.0, 0, 0]] * u.au,
+    ...                          [1.0, 0.0] * u.au**3 / u.day**2)[1]
+    <Quantity [-0.25,  0.  ,  0.  ] AU / d2>
     """
+    from hamilton_orbits._body import A_UNIT, GM_UNIT, L_UNIT
+    from hamilton_orbits.integrators._setup import check_apart
     from hamilton_orbits.quaternion import Quaternion
+    from hamilton_orbits.units import GM, LENGTH, require_consistent
+    from hamilton_orbits.validation import check_positive
 
-    r = np.asarray(r, dtype=float)
-    gm = np.asarray(gm, dtype=float)
-    n = len(gm)
+    quantity = require_consistent(("r", "gm"), (r, gm))
+    r = LENGTH("r", r, L_UNIT if quantity else None)
+    gm = GM("gm", gm, GM_UNIT if quantity else None)
+    n = len(gm) if gm.ndim == 1 else -1
+    if r.shape != (n, 3):
+        raise ValueError(f"Expected `gm` of shape (n,) and `r` of shape (n, 3), got `gm` of "
+                         f"shape {gm.shape} and `r` of shape {r.shape}")
+    check_positive("gm", gm, strict=False)
+    check_apart(r, gm, arg="r")
     i, j = np.nonzero(~np.eye(n, dtype=bool) & (gm[None, :] != 0))
     alpha = Quaternion.from_vector(r[i] - r[j])  # alpha - alpha'
     square = (alpha * alpha).scalar  # (alpha - alpha')^2 = -T^2, a real number
@@ -316,7 +343,7 @@ def accelerations_quaternion(r: Any, gm: Any) -> np.ndarray:
     term = denominator.inverse() * gm[j]  # m' / (...)
     acc = np.zeros((n, 4))
     np.add.at(acc, i, term.as_array())
-    return acc[:, 1:]
+    return acc[:, 1:] * A_UNIT if quantity else acc[:, 1:]
 
 
 def relative_change(values: np.ndarray) -> np.ndarray:

@@ -3,6 +3,7 @@ for, whose compiled screen must find every one the whole check finds."""
 
 from __future__ import annotations
 
+import astropy.units as u
 import numpy as np
 import pytest
 from random_legs import random_leg
@@ -12,6 +13,7 @@ from hamilton_orbits._screening import output_steps
 from hamilton_orbits.integrals import (
     ENCOUNTER_STEP_FRACTION,
     LIGHT,
+    accelerations_quaternion,
     light_as_massless,
 )
 
@@ -85,3 +87,32 @@ def test_the_screen_rules_out_the_legs_of_an_ordinary_run(sign):
         t = traj.t.to_value(u.day)
         assert not k.screen(np.ascontiguousarray(r), np.ascontiguousarray(v), gm, t, 4.0, 0,
                             0.0, ENCOUNTER_STEP_FRACTION, LIGHT)
+
+
+def test_accelerations_quaternion_converts_quantities_and_returns_them():
+    """Quantities in, Quantities out (au/day^2, as ``System.accelerations``): a km read
+    as an au gave a plain [[1, 0, 0], [-1, 0, 0]]; a plain number beside a Quantity is
+    refused, as everywhere."""
+    gm = [1.0, 1.0] * u.au**3 / u.day**2
+    acc = accelerations_quaternion([[0.0, 0, 0], [1.0, 0, 0]] * u.km, gm)
+    km = (1.0 * u.km).to_value(u.au)
+    assert acc.unit == u.au / u.day**2
+    np.testing.assert_allclose(acc.value, [[1 / km**2, 0, 0], [-1 / km**2, 0, 0]], rtol=1e-14)
+    with pytest.raises(ValueError, match="`gm` to be a Quantity like `r`"):
+        accelerations_quaternion([[0.0, 0, 0], [1.0, 0, 0]] * u.km, [1.0, 1.0])
+    plain = accelerations_quaternion([[0.0, 0, 0], [1.0, 0, 0]], [1.0, 1.0])
+    assert type(plain) is np.ndarray
+
+
+@pytest.mark.parametrize(("r", "gm", "message"), [
+    ([[0.0, 0, 0], [1.0, 0, 0]], [1.0, -1.0], r"`gm` >= 0, got -1.0 at index 1"),
+    ([[0.0, 0, 0], [0.0, 0, 0]], [1.0, 1.0], r"indices 0 and 1 of `r` are at one position"),
+    ([[0.0, 0, 0], [np.nan, 0, 0]], [1.0, 1.0], r"`r` to be finite, got nan at index \(1, 0\)"),
+    ([[0.0, 0, 0], [1.0, 0, 0]], [1.0, 1.0, 1.0], r"`gm` .*\(3,\).*`r` .*\(2, 3\)"),
+    ([0.0, 0, 0], [1.0], r"`gm` .*\(1,\).*`r` .*\(3,\)"),
+])
+def test_accelerations_quaternion_names_the_argument_index_and_value(r, gm, message):
+    """A negative GM was taken; two bodies at one point were blamed on ``self``, a NaN
+    on ``vector`` at the wrong index; a ``gm`` too long was an IndexError."""
+    with pytest.raises(ValueError, match=message):
+        accelerations_quaternion(r, gm)
