@@ -65,8 +65,76 @@ LIGHT = 1e-10
 JACOBI_MAX_ECCENTRICITY = 1e-6
 
 
-def energy_gm(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> float:
-    """Hamilton's (E) in gm units; pairs with at least one massless body add nothing."""
+def _checked_states(r: Any, v: Any, gm: Any, *, many: bool, finite: bool = True
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``r``, ``v`` and ``gm`` as float64 arrays, checked at once (vectorised, before any
+    kernel reads them): ``r`` of shape (n_t, n, 3) with ``n_t >= 1`` (``many``) or (n,
+    3), ``v`` of r's shape, ``gm`` (n,) (or (n_t, n), or (1, n), with ``many``), finite
+    and ``>= 0``; ``r`` and ``v`` finite where ``finite``.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its shape, or the index and the value.
+    """
+    from hamilton_orbits.validation import as_float_array, check_positive
+
+    r = as_float_array("r", r, finite=finite)
+    v = as_float_array("v", v, finite=finite)
+    gm = as_float_array("gm", gm)
+    if r.ndim != (3 if many else 2) or r.shape[-1] != 3 or (many and r.shape[0] == 0):
+        want = "(n_t, n, 3) with n_t >= 1" if many else "(n, 3)"
+        raise ValueError(f"Expected `r` to have shape {want}, got {r.shape}")
+    if v.shape != r.shape:
+        raise ValueError(f"Expected `v` to have the shape of `r`, {r.shape}, got {v.shape}")
+    n = r.shape[-2]
+    shapes = [(n,), (r.shape[0], n), (1, n)] if many else [(n,)]
+    if gm.shape not in shapes:
+        raise ValueError(f"Expected `gm` to have shape {' or '.join(map(str, shapes[:2]))} "
+                         f"for `r` of shape {r.shape}, got {gm.shape}")
+    check_positive("gm", gm, strict=False)
+    return r, v, gm
+
+
+def _refuse_coinciding(r: np.ndarray, i: np.ndarray, j: np.ndarray, zero: np.ndarray,
+                       where: str = "") -> None:
+    """Refuse the first pair ``(i[k], j[k])`` of bodies at one position (``zero[k]``),
+    naming their indices in ``r`` (the potential between them is infinite)."""
+    if zero.any():
+        k = int(np.argmax(zero))
+        a, b = int(i[k]), int(j[k])
+        raise ValueError(f"Bodies at indices {a} and {b} of `r` are at one position "
+                         f"{r[a].tolist()}{where}: their potential energy is infinite")
+
+
+def energy_gm(r: Any, v: Any, gm: Any) -> float:
+    """Hamilton's (E) in gm units; pairs with at least one massless body add nothing.
+
+    Parameters
+    ----------
+    r, v : array_like, shape (n, 3)
+        Finite positions and velocities, in the caller's consistent units.
+    gm : array_like, shape (n,)
+        ``G m >= 0``, finite.
+
+    Returns
+    -------
+    float
+        ``sum gm v^2 / 2 - sum_{pairs} gm gm' / d``.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its shape, or the index and the value: shapes that do
+        not match, a non-finite value, a negative ``gm``, two massive bodies at one
+        position (both indices in ``r``).
+
+    Examples
+    --------
+    >>> energy_gm([[0.0, 0, 0], [2.0, 0, 0]], [[0.0, 0, 0], [0, 1.0, 0]], [1.0, 1.0])
+    0.0
+    """
+    r, v, gm = _checked_states(r, v, gm, many=False)
     kinetic = 0.5 * float(gm @ np.einsum("ij,ij->i", v, v))
     idx = np.flatnonzero(gm > 0)
     rm = r[idx]
@@ -75,12 +143,36 @@ def energy_gm(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> float:
         return kinetic
     i, j = np.triu_indices(len(idx), 1)
     d = np.sqrt(np.einsum("ij,ij->i", rm[i] - rm[j], rm[i] - rm[j]))
+    _refuse_coinciding(r, idx[i], idx[j], d == 0)
     return kinetic - float(np.sum(gmm[i] * gmm[j] / d))
 
 
-def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
-    """Hamilton's (E) in gm units for states ``r``, ``v`` of shape (n_t, n, 3);
-    ``gm`` (n,), or (n_t, n) where masses change between states."""
+def energy_gm_many(r: Any, v: Any, gm: Any) -> np.ndarray:
+    """Hamilton's (E) in gm units for many states.
+
+    Parameters
+    ----------
+    r, v : array_like, shape (n_t, n, 3)
+        Finite positions and velocities, in the caller's consistent units.
+    gm : array_like, shape (n,), or (n_t, n) where masses change between states
+        ``G m >= 0``, finite.
+
+    Returns
+    -------
+    ndarray, shape (n_t,)
+
+    Raises
+    ------
+    ValueError
+        As :func:`energy_gm`, two massive bodies at one position named with the output.
+
+    Examples
+    --------
+    >>> r = np.array([[[0.0, 0, 0], [2.0, 0, 0]]] * 2); v = np.zeros((2, 2, 3))
+    >>> energy_gm_many(r, v, np.array([[1.0, 1.0], [1.0, 0.0]])).tolist()
+    [-0.5, 0.0]
+    """
+    r, v, gm = _checked_states(r, v, gm, many=True)
     gm_t = np.broadcast_to(gm, r.shape[:2])
     kinetic = 0.5 * np.einsum("tj,tjk,tjk->t", gm_t, v, v)
     idx = np.flatnonzero((gm_t > 0).any(axis=0))
@@ -92,6 +184,11 @@ def energy_gm_many(r: np.ndarray, v: np.ndarray, gm: np.ndarray) -> np.ndarray:
     dist = np.sqrt(np.einsum("tpk,tpk->tp", d, d))
     g = gm_t[:, idx]
     pair = g[:, i] * g[:, j]
+    zero = (pair != 0.0) & (dist == 0.0)
+    if zero.any():
+        out, p = np.unravel_index(int(np.argmax(zero)), zero.shape)
+        _refuse_coinciding(r[out], idx[i[p:p + 1]], idx[j[p:p + 1]], np.ones(1, bool),
+                           f" at output {int(out)}")
     return kinetic - np.where(pair != 0.0, pair / np.where(dist > 0, dist, 1.0), 0.0).sum(axis=1)
 
 
@@ -149,13 +246,23 @@ def integral_errors(
     [0.0, 4.76837158203125e-07]
     """
     from hamilton_orbits._kernels import integrals
+    from hamilton_orbits.validation import as_float_array
 
-    r = np.ascontiguousarray(r, dtype=np.float64)
-    v = np.ascontiguousarray(v, dtype=np.float64)
-    gm2 = np.ascontiguousarray(np.atleast_2d(np.asarray(gm, dtype=np.float64)))
+    # (checked before the kernel, which reads ``v``, ``gm`` and ``t`` by r's shape; r and
+    # v may hold NaN: the bodies taken out of the run)
+    r, v, gm = _checked_states(r, v, gm, many=True, finite=False)
+    k, n = r.shape[0], r.shape[1]
+    t = as_float_array("t", t)
+    for name, value, shape in (("t", t, (k,)), ("extra_energy", extra_energy, (k, n)),
+                               ("gone", gone, (n,))):
+        if value is not None and np.shape(value) != shape:
+            raise ValueError(f"Expected `{name}` to have shape {shape} for `r` of shape "
+                             f"{r.shape}, got {np.shape(value)}")
+    r = np.ascontiguousarray(r)
+    v = np.ascontiguousarray(v)
+    gm2 = np.ascontiguousarray(np.atleast_2d(gm))
     t = np.array(t, dtype=np.float64)  # (a copy: a trajectory's read-only times, as a
     # cross-check passes them, would compile the kernel again for read-only arrays)
-    k, n = r.shape[0], r.shape[1]
     out = np.empty((3, k))
     gone_b = np.zeros(n, np.bool_) if gone is None else np.ascontiguousarray(gone, np.bool_)
     lost = integrals.integral_errors(r, v, gm2, t, gone_b, out[0], out[1], out[2])

@@ -3,6 +3,8 @@ for, whose compiled screen must find every one the whole check finds."""
 
 from __future__ import annotations
 
+import warnings
+
 import astropy.units as u
 import numpy as np
 import pytest
@@ -14,6 +16,9 @@ from hamilton_orbits.integrals import (
     ENCOUNTER_STEP_FRACTION,
     LIGHT,
     accelerations_quaternion,
+    energy_gm,
+    energy_gm_many,
+    integral_errors,
     light_as_massless,
 )
 
@@ -116,3 +121,72 @@ def test_accelerations_quaternion_names_the_argument_index_and_value(r, gm, mess
     on ``vector`` at the wrong index; a ``gm`` too long was an IndexError."""
     with pytest.raises(ValueError, match=message):
         accelerations_quaternion(r, gm)
+
+
+def _states():
+    """Three states of two bodies (n_t, n, 3), their GMs and times."""
+    r = np.array([[[0.0, 0, 0], [1.0, 0, 0]]] * 3)
+    v = np.zeros((3, 2, 3))
+    v[:, 1, 1] = 1.0
+    return r, v, np.array([1.0, 1.0]), np.arange(3.0)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda r, v, gm, t: (r, v[:2], gm, t), r"`v` .*\(3, 2, 3\).*\(2, 2, 3\)"),
+    (lambda r, v, gm, t: (r, v[:, :1], gm, t), r"`v` .*\(3, 2, 3\).*\(3, 1, 3\)"),
+    (lambda r, v, gm, t: (r, v, gm, t[:2]), r"`t` to have shape \(3,\).*got \(2,\)"),
+    (lambda r, v, gm, t: (r, v, gm[:1], t), r"`gm` to have shape \(2,\).*got \(1,\)"),
+    (lambda r, v, gm, t: (r, v, np.array([1.0, np.nan]), t),
+     r"`gm` to be finite, got nan at index 1"),
+    (lambda r, v, gm, t: (r, v, np.array([1.0, -1.0]), t), r"`gm` >= 0, got -1.0 at index 1"),
+    (lambda r, v, gm, t: (r, v, gm, np.array([0.0, np.inf, 2.0])),
+     r"`t` to be finite, got inf at index 1"),
+    (lambda r, v, gm, t: (r[:0], v[:0], gm, t[:0]), r"`r` to have shape \(n_t, n, 3\)"),
+    (lambda r, v, gm, t: (r[..., :2], v[..., :2], gm, t), r"`r` to have shape \(n_t, n, 3\)"),
+])
+def test_integral_errors_refuses_mismatched_or_bad_input_before_its_kernel(change, message):
+    """A ``v`` of fewer outputs than ``r`` was read past its end by the compiled kernel
+    (numbers out), a ``t`` too short gave a NaN, a ``v`` of fewer bodies numbers, a
+    ``gm`` too short an IndexError, a NaN in ``gm`` "argmax of an empty sequence"."""
+    with pytest.raises(ValueError, match=message):
+        integral_errors(*change(*_states()))
+
+
+def test_integral_errors_refuses_extra_energy_and_gone_of_the_wrong_shape():
+    r, v, gm, t = _states()
+    with pytest.raises(ValueError, match=r"`extra_energy` to have shape \(3, 2\).*got \(3, 1\)"):
+        integral_errors(r, v, gm, t, np.zeros((3, 1)))
+    with pytest.raises(ValueError, match=r"`gone` to have shape \(2,\).*got \(3,\)"):
+        integral_errors(r, v, gm, t, gone=np.zeros(3, bool))
+
+
+def test_energy_gm_many_refuses_mismatched_shapes_and_coinciding_bodies():
+    """A ``v`` of one body for two gave numbers; two massive bodies at one point were
+    counted as 1 apart."""
+    r, v, gm, _ = _states()
+    with pytest.raises(ValueError, match=r"`v` .*\(3, 2, 3\).*\(3, 1, 3\)"):
+        energy_gm_many(r, v[:, :1], gm)
+    with pytest.raises(ValueError, match=r"`gm` to have shape \(2,\) or \(3, 2\)"):
+        energy_gm_many(r, v, np.ones((2, 2)))
+    r[2, 1] = r[2, 0]
+    with pytest.raises(ValueError, match=r"indices 0 and 1 of `r` are at one position "
+                                         r"\[0.0, 0.0, 0.0\] at output 2"):
+        energy_gm_many(r, v, gm)
+
+
+def test_energy_gm_refuses_coinciding_bodies_and_bad_input_without_a_warning():
+    """Two bodies at one point gave numpy's divide-by-zero RuntimeWarning and an
+    infinite energy."""
+    r, v, gm, _ = _states()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"indices 0 and 1 of `r` are at one position"):
+            energy_gm(np.zeros((2, 3)), v[0], gm)
+        with pytest.raises(ValueError, match=r"`r` to be finite, got nan at index \(1, 0\)"):
+            energy_gm(np.array([[0.0, 0, 0], [np.nan, 0, 0]]), v[0], gm)
+        with pytest.raises(ValueError, match=r"`gm` to have shape \(2,\).*got \(1,\)"):
+            energy_gm(r[0], v[0], gm[:1])
+        with pytest.raises(ValueError, match=r"`v` .*\(2, 3\).*\(1, 3\)"):
+            energy_gm(r[0], v[0, :1], gm)
+    # (a test particle at the massive body's point adds no potential: taken)
+    assert energy_gm(np.zeros((2, 3)), v[0], np.array([1.0, 0.0])) == 0.0
