@@ -47,10 +47,12 @@ class RigidTrajectory(TrajectoryBase):
         Integrator name.
     energy_error : ndarray, shape (n,)
         ``(T(t) - T(0)) / T(0)``, ``T = (A p^2 + B q^2 + C r^2) / 2`` (the
-        absolute change for a body at rest).
+        absolute change ``T(t) - T(0)`` for a body at rest, in the units of the
+        moments times those of omega squared: J for Quantity calls).
     angular_momentum_error : ndarray, shape (n,)
         ``|L_s(t) - L_s(0)| / |L_s(0)|``, ``L_s = q (A p, B q, C r) q^-1``
-        Cayley's ``(g, g', g'')``.
+        Cayley's ``(g, g', g'')`` (the absolute change ``|L_s(t) - L_s(0)|`` for
+        a body at rest, kg m^2/s for Quantity calls).
     attitude : Quaternion, shape (n,)
         Unit body-to-space attitudes.
     omega : ndarray or Quantity, shape (n, 3)
@@ -147,7 +149,11 @@ def integral_errors(
     ``L_s = q (A p, B q, C r) q^-1`` from the first output
     (:func:`hamilton_orbits.trajectory.relative_change`), computed on
     ``moments / sm`` and ``omega / sw`` (exact powers of two: the ratios are
-    those of the unscaled integrals, and nothing under- or overflows).
+    those of the unscaled integrals, and nothing under- or overflows).  For a
+    body at rest at the first output (``omega[0] = 0``) the absolute changes
+    ``T(t) - T(0)`` and ``|L_s(t) - L_s(0)|``, in the units of ``moments`` and
+    ``omega`` (the scaled ones multiplied back by ``sm sw^2`` and ``sm sw``, exact
+    but for an overflow, which the caller refuses).
 
     Parameters
     ----------
@@ -162,9 +168,17 @@ def integral_errors(
     >>> de, dl = integral_errors(np.array([1.0, 2.0, 3.0]), q, np.array([[1.0, 0, 0]] * 2))
     >>> de.tolist(), dl.tolist()  # a half turn about z reverses L_s = (1, 0, 0)
     ([0.0, 0.0], [0.0, 2.0])
+    >>> de, dl = integral_errors(np.array([1.0, 2.0, 3.0]), q, np.array([[0.0, 0, 0],
+    ...                                                                 [0, 0, 1.0]]))
+    >>> de.tolist(), dl.tolist()  # from rest: T = 3 / 2, |L_s| = 3
+    ([0.0, 1.5], [0.0, 3.0])
     """
-    ms = moments / pow2(moments)
-    ws = omega / pow2(omega)
+    sm, sw = pow2(moments), pow2(omega)
+    ms = moments / sm
+    ws = omega / sw
     energy = 0.5 * np.sum(ms * ws * ws, axis=-1)
     ell = np.asarray(Quaternion(q).rotate(ms * ws), dtype=np.float64)
-    return relative_change(energy), relative_change(ell)
+    de, dl = relative_change(energy), relative_change(ell)
+    if not np.any(omega[0]):  # at rest: the absolute changes, in the caller's units
+        de, dl = de * (sm * sw * sw), dl * (sm * sw)
+    return de, dl

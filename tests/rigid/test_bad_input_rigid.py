@@ -107,6 +107,28 @@ def test_polar_scene_reads_periods_with_units_and_refuses_a_duplicate(tmp_path):
         Scene.from_dict({"kind": "polar_motion", "effects": ["elastic", "elastic"]})
 
 
+def test_polar_scene_reads_the_annual_excitation_as_an_angle_with_its_unit():
+    """``annual_prograde = "5 mas"`` was refused ("Expected `annual_prograde` to be
+    numeric, got array('5 mas', dtype='<U5')") while the periods took "433 d": any
+    angular unit is read (DESIGN.md, one unit boundary per kind), a bare number stays
+    radians, and a unit of another dimension is refused naming the key."""
+    def scene(value):
+        return Scene.from_dict({"kind": "polar_motion", "start": 1980, "end": 2010,
+                                "effects": [{"name": "damping", "Q": 179},
+                                            {"name": "annual_excitation",
+                                             "annual_prograde": value,
+                                             "annual_retrograde": value}]})
+    for value, expected in (("5 mas", 5 * u.mas), ("2e-6 deg", 2e-6 * u.deg)):
+        effect = scene(value).effects[1]
+        assert effect["annual_prograde"] == effect["annual_retrograde"] == expected
+    assert scene(2.4e-8).effects[1]["annual_prograde"] == 2.4e-8
+    with pytest.raises(SceneError) as info:
+        scene("5 m")
+    assert [p.split(": ", 1)[1] for p in info.value.problems] == [
+        f"effects[1].{key}: expected an angle (a unit convertible to rad), got '5 m'"
+        for key in ("annual_prograde", "annual_retrograde")]
+
+
 def test_rotation_scene_cadence_beyond_memory_fails_at_loading(tmp_path):
     path = tmp_path / "spin.toml"
     path.write_text('kind = "rotation"\nduration = "60 s"\ncadence = "1e-9 s"\n[body]\n'

@@ -280,6 +280,30 @@ def test_a_chandler_guess_far_from_the_line_is_refused(record, guess):
         fit_wobble(record, chandler_guess=guess * u.day)
 
 
+@pytest.mark.parametrize("guess", [365.0, 350.0])
+def test_a_chandler_guess_near_one_year_is_refused(record, guess):
+    """A guess of 340-375 d over 1970-2010 gave a degenerate fit: "Chandler" and
+    annual lines at 368.0 and 367.5 d of 574 and 644 mas cancelling each other,
+    three times the residual.  Refused: the record has 11 mas at 368 d once the
+    annual terms are projected out, and ~150 mas at 433 d."""
+    with pytest.raises(ValueError, match=rf"Expected `chandler_guess` within 10% of the "
+                                         rf"record's Chandler line: the guess {guess:.1f} d "
+                                         rf"led to a line of [0-9]+\.[0-9] mas at 36[0-9]\.[0-9] "
+                                         rf"d, but the record has one of 1[0-9][0-9] mas at "
+                                         rf"43[0-9] d"):
+        fit_wobble(record, 1970, 2010, chandler_guess=guess * u.day)
+
+
+@pytest.mark.parametrize("guess", [420.0, 445.0])
+def test_a_chandler_guess_within_10_percent_gives_the_fit_of_433_d(record, fits, guess):
+    """The guesses within 10% of the record's line still find it: the fit of the
+    default guess (433 d), to the solver's tolerance (1e-12 relative in the
+    parameters; the start differs)."""
+    fit, ref = fit_wobble(record, 1970, 2010, chandler_guess=guess * u.day), fits["1970-2010"]
+    for name in ("chandler_period", "annual_period", "chandler_amplitude", "rms_residual"):
+        assert abs(getattr(fit, name) / getattr(ref, name) - 1) < 1e-9, name
+
+
 def test_a_record_whose_epochs_do_not_increase_is_refused(record):
     """Two decades joined in the wrong order were taken, and the fits, select and
     predict then failed with windows of -1 d and ranges that end before they begin."""

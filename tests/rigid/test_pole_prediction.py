@@ -174,6 +174,39 @@ def test_every_method_follows_a_noiseless_synthetic_wobble():
         assert np.max(np.abs(pred.x.to_value(u.mas) - truth.real)) < 1e-6, method
 
 
+def test_a_noise_free_record_is_named_when_its_residuals_determine_no_var():
+    """The Liouville method on a noise-free record: its excitation residuals are
+    exact sinusoids, which their lagged values fit exactly.  The refusal named
+    `series`, no argument of predict's; it names the record, the history used and
+    why, as hindcast does with the start's index."""
+    rec, _, _ = _synthetic(0.0)
+    with pytest.raises(ValueError, match=r"^Expected `record` to hold noise in the history "
+                                         r"used for `at` \(2007-09-04 to 2017-09-03\): method "
+                                         r"'liouville' fits a VAR\(5\) to the residuals of its "
+                                         r"fitted terms, and their lagged regression is "
+                                         r"singular \(pivot [0-9]+ of 10\): the residuals of a "
+                                         r"noise-free record"):
+        predict(rec, at=rec.time[AT_SYN], horizon=30 * u.day, method="liouville")
+    with pytest.raises(ValueError, match=r"^Expected `record` to hold noise in the history "
+                                         r"used for `starts` at index 0 \(2007-08-28 to "
+                                         r"2017-08-27\): method 'liouville'"):
+        hindcast(rec, rec.time[[AT_SYN - 7, AT_SYN]], [10] * u.day, "liouville")
+
+
+@pytest.mark.parametrize("method", ["ls+ar", "ls+var"])
+def test_a_record_shorter_than_the_history_of_a_method_says_so(method):
+    """A record of 7300 days for the methods of 20 years (7305 days) of history was
+    refused with a range that ends before it begins ("from 2000-01-01 (7305 days of
+    history plus the 1 d latency) to 1999-12-27")."""
+    rec, _, _ = _synthetic(0.0)
+    short = PolarMotionRecord(rec.time[:7300], rec.x[:7300], rec.y[:7300])
+    with pytest.raises(ValueError, match=rf"^Expected `record` to span at least the 7305 days "
+                                         rf"of history that method '{re.escape(method)}' uses "
+                                         rf"before `at` \(less the 1 d latency\), got 7300 "
+                                         rf"days, from 1995-10-10 to 2015-10-04$"):
+        predict(short, at=short.time[-100], horizon=30 * u.day, method=method)
+
+
 # --------------------------------------------------------------------------
 # The Liouville propagator against LiouvillePole.solve
 # --------------------------------------------------------------------------

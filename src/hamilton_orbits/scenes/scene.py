@@ -103,7 +103,9 @@ class _EffectField(S.Field):
 def _effect_quantity(kind: Any, value: Any, path: str, problems: S.Problems) -> Any:
     """An effect's parameter with a dimension: a value with its unit, or a list of
     them; a bare number is refused, naming the unit it needs (a scene's system is
-    in Quantities: ``docs/effects.md``)."""
+    in Quantities: ``docs/effects.md``), but for a dimensionless parameter and an
+    angle, whose bare number is the effect's own (radians for the Liouville
+    pole's ``annual_prograde``) and is passed on as given."""
     items = value if isinstance(value, list) else [value]
     bare = [v for v in items if isinstance(v, int | float) and not isinstance(v, bool)]
     if bare and kind not in (DIMENSIONLESS, ANGLE):
@@ -111,6 +113,8 @@ def _effect_quantity(kind: Any, value: Any, path: str, problems: S.Problems) -> 
                            f"\"{unit_example(kind)}\", got the bare number {bare[0]!r} (a unit "
                            "cannot be guessed)")
         return None
+    if kind is ANGLE and len(bare) == len(items):  # (the schema's Quantity would refuse it)
+        return value
     field = (S.Vector(kind=kind, size=len(value)) if isinstance(value, list)
              else S.Quantity(kind=kind))
     return field.check(value, path, problems)

@@ -24,7 +24,27 @@ import numpy as np
 
 from rigid._kernels import var as _vk
 
-__all__ = ["VARModel", "accumulate_covariance", "fit_var"]
+__all__ = ["SingularRegressionError", "VARModel", "accumulate_covariance", "fit_var"]
+
+
+class SingularRegressionError(ValueError):
+    """:func:`fit_var` of a series that does not determine the model: its lagged
+    regression is singular (a constant series, or a few exact sinusoids, which obey a
+    short linear recurrence exactly).
+
+    Attributes
+    ----------
+    order : int
+        The VAR order ``p``.
+    pivot : int
+        The Cholesky pivot (1-based) that failed, of ``size``.
+    size : int
+        ``p d``, the unknowns per component.
+    """
+
+    def __init__(self, message: str, *, order: int, pivot: int, size: int) -> None:
+        super().__init__(message)
+        self.order, self.pivot, self.size = order, pivot, size
 
 
 @dataclass(frozen=True)
@@ -165,7 +185,8 @@ def fit_var(series: Any, order: int) -> VARModel:
     ValueError
         For an order below 1, a series too short for the order (``n - p`` must exceed
         ``p d``), non-finite values, or a series that does not determine the model (a
-        singular lagged regression, e.g. a constant series).
+        singular lagged regression, e.g. a constant series: a
+        :class:`SingularRegressionError`).
 
     Examples
     --------
@@ -202,8 +223,9 @@ def fit_var(series: Any, order: int) -> VARModel:
     sol = np.array(cross)  # (p d, d), solved in place (compiled Cholesky, one thread)
     status = _vk.spd_solve(np.array(normal), sol)
     if status:
-        raise ValueError(f"Expected `series` to determine a VAR({p}): the lagged regression "
-                         f"is singular (pivot {status} of {p * d})")
+        raise SingularRegressionError(
+            f"Expected `series` to determine a VAR({p}): the lagged regression is singular "
+            f"(pivot {status} of {p * d})", order=p, pivot=int(status), size=p * d)
     resid = target - np.einsum("ni,ij->nj", lagged, sol)
     cov = np.einsum("ni,nj->ij", resid, resid) / (target.shape[0] - p * d)
     coef = np.ascontiguousarray(sol.T.reshape(d, p, d).transpose(1, 0, 2))

@@ -53,9 +53,12 @@ _PARAMETERS: dict[str, dict[str, str]] = {
     },
 }
 
-# the scalar parameters with a dimension (a scene reads "433 d" into a Quantity)
+# the scalar parameters with a dimension (a scene reads "433 d" into a Quantity, and
+# "5 mas" into an angle: a real amplitude there, TOML having no complex numbers; a bare
+# number stays radians)
 _KINDS = {"euler_period": TIME, "k2": DIMENSIONLESS, "chandler_period": TIME,
-          "Q": DIMENSIONLESS, "annual_period": TIME, "annual_epoch": TIME}
+          "Q": DIMENSIONLESS, "annual_period": TIME, "annual_epoch": TIME,
+          "annual_prograde": ANGLE, "annual_retrograde": ANGLE}
 
 _REFERENCES = {
     "free": "Euler (1765); Lambeck 1980, The Earth's Variable Rotation, sec. 3.1",

@@ -46,6 +46,7 @@ from astropy.table import QTable
 from astropy.time import Time
 
 from hamilton_orbits.units import TIME, time_quantity
+from rigid.earth.ar_models import SingularRegressionError
 from rigid.earth.forecasters import (
     METHODS,
     fitted_parameters,
@@ -157,8 +158,15 @@ def _lead_days(method: str, horizon: Any, latency: Any, name: str,
 
 
 def _newest_index(name: str, mjd: np.ndarray, at: np.ndarray, latency: int,
-                  history: int) -> np.ndarray:
+                  history: int, method: str) -> np.ndarray:
     """Index of the newest datum ``at - latency`` for each start; checks the span."""
+    if mjd[-1] - mjd[0] + 1 < history:  # (no start date at all: say so, not a range
+        raise ValueError(  # that ends before it begins)
+            f"Expected `record` to span at least the {history} days of history that method "
+            f"{method!r} uses before `{name}` (less the {latency} d latency), got "
+            f"{mjd[-1] - mjd[0] + 1:.0f} days, from "
+            f"{Time(mjd[0], format='mjd', scale='utc').iso[:10]} to "
+            f"{Time(mjd[-1], format='mjd', scale='utc').iso[:10]}")
     target = at - latency
     k = np.searchsorted(mjd, target)
     k_safe = np.minimum(k, mjd.size - 1)
@@ -273,9 +281,11 @@ def predict(
     Raises
     ------
     ValueError
-        For an unknown method, an empty record, ``at`` outside the record (or without
-        the method's history before it, or with a day missing in it: the first
-        missing day named), a horizon or latency that is not a single
+        For an unknown method, an empty record, a record shorter than the method's
+        history, ``at`` outside the record (or without the method's history before
+        it, or with a day missing in it: the first missing day named), a record
+        without noise in the history used (its residuals determine no VAR, for
+        ``"ls+ar"``, ``"ls+var"`` and ``"liouville"``), a horizon or latency that is not a single
         whole number of days, a latency below a day, a lead ``latency + horizon`` beyond
         the method's ``rigid.earth.forecasters.max_lead`` (ten years; five for
         ``"persistence"``), or data in the history used that are not finite or jump
@@ -301,9 +311,9 @@ def predict(
         raise ValueError(f"Expected `at` to be a single Time, got {at_mjd.size} epochs")
     hs, lat = _lead_days(method, horizon, latency, "horizon", single=True)
     n_h = int(hs[0])
-    k = int(_newest_index("at", mjd, at_mjd, lat, history_days(method))[0])
+    k = int(_newest_index("at", mjd, at_mjd, lat, history_days(method), method)[0])
     _check_history(x, y, k, history_days(method))
-    mx, my, vx, vy = forecast(method, x, y, k, lat + n_h)
+    mx, my, vx, vy = _forecast(method, x, y, k, lat + n_h, mjd, "at", None)
     sl = slice(lat - 1, lat + n_h)
     t = Time(at_mjd[0] + np.arange(n_h + 1), format="mjd", scale="utc")
     return PolePrediction(
@@ -334,8 +344,27 @@ def check_inputs(record: PoleRecord, starts: Time, horizons: u.Quantity, method:
     lat = int(_whole_days("latency", latency, minimum=1, maximum=max_lead(method),
                           single=True)[0])
     history = history_days(method)
-    for k in _newest_index("starts", mjd, at, lat, history):
+    for k in _newest_index("starts", mjd, at, lat, history, method):
         _check_history(x, y, int(k), history)
+
+
+def _forecast(method: str, x: np.ndarray, y: np.ndarray, k: int, steps: int,
+              mjd: np.ndarray, name: str, index: int | None):
+    """:func:`rigid.earth.forecasters.forecast`, a singular VAR fit said of the record
+    (the VAR's `series` is no argument of the caller's)."""
+    try:
+        return forecast(method, x, y, k, steps)
+    except SingularRegressionError as exc:
+        first = Time(mjd[k - history_days(method) + 1], format="mjd", scale="utc").iso[:10]
+        newest = Time(mjd[k], format="mjd", scale="utc").iso[:10]
+        where = f"`{name}`" + ("" if index is None else f" at index {index}")
+        raise ValueError(
+            f"Expected `record` to hold noise in the history used for {where} ({first} to "
+            f"{newest}): method {method!r} fits a VAR({exc.order}) to the residuals of its "
+            f"fitted terms, and their lagged regression is singular (pivot {exc.pivot} of "
+            f"{exc.size}): the residuals of a noise-free record (a synthetic one, say) are "
+            f"a few exact sinusoids, which their own lagged values fit exactly; method "
+            f"'ls' forecasts such a record") from None
 
 
 def _check_history(x: np.ndarray, y: np.ndarray, k: int, history: int) -> None:
@@ -461,8 +490,9 @@ def hindcast(
     ValueError
         For an unknown method, an empty record, no start dates, a start date outside
         the record (naming its index), negative or fractional horizons or a lead beyond
-        the method's (as for :func:`predict`), a latency below a day, or a bad datum in
-        a history used (as for :func:`predict`).
+        the method's (as for :func:`predict`), a latency below a day, a record shorter
+        than the method's history, or a bad datum in a history used or one without
+        noise (as for :func:`predict`).
 
     Examples
     --------
@@ -483,12 +513,13 @@ def hindcast(
     if hs.size == 0:
         raise ValueError("Expected `horizons` to hold at least one horizon, got none")
     history = history_days(method)
-    ks = _newest_index("starts", mjd, at, lat, history)
+    ks = _newest_index("starts", mjd, at, lat, history, method)
     ex, ey, sx, sy = (np.full((at.size, hs.size), np.nan) for _ in range(4))
     steps = lat + int(hs.max())
     for i, k in enumerate(ks):  # per start: a few vectorised calls
         _check_history(x, y, int(k), history)
-        mx, my, vx, vy = forecast(method, x, y, int(k), steps)
+        mx, my, vx, vy = _forecast(method, x, y, int(k), steps, mjd, "starts",
+                                   i if at.size > 1 else None)
         j = lat + hs - 1  # forecast index of each horizon
         # (each horizon's outcome found by its date: a record with a day missing
         # after the start is not scored against the day after it; that horizon is
