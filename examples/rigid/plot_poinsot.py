@@ -30,13 +30,11 @@ print(f"distance of the invariable plane from the centre: {paths.distance:.6f} "
 # Polhode and herpolhode
 # ----------------------
 # The polhode closes on the ellipsoid after one period; the herpolhode on the
-# plane in general does not close.  The ellipsoid's semi-axes are
-# ``1 / sqrt(I)`` for the principal moments ``I``, so both curves are in units of
-# ``(kg m^2)^(-1/2)`` (a body of plain numbers is in SI units; the figure's axes
-# say so); the start of the contact point's path is marked on both.
+# plane in general does not close.  The ellipsoid ``x . I x = 1`` has semi-axes
+# ``1 / sqrt(I)`` for the principal moments ``I``; the figure's coordinates are
+# multiplied by ``sqrt(C)``, ``C`` the largest moment (3 here, in whatever units
+# the numbers are in), so that they are free of units and of order one.  The
+# middle panel is the polhode seen along the axis it goes round, framed on
+# itself; the first time's point is marked on every panel.
 fig = plot_poinsot(body, np.linspace(0.0, 40.0, 4000))
-ax3d, ax2d = fig.axes
-ax3d.plot(*paths.polhode[0], "o", color="k", ms=5)
-ax2d.plot(*paths.herpolhode[0], "o", color="k", ms=5, label="start (t = 0)")
-ax2d.legend(loc="lower left", fontsize=7)  # (inside: the figure keeps plot_poinsot's layout)
 plt.show()

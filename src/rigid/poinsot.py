@@ -127,10 +127,84 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     )
 
 
+def _exponent(values: np.ndarray) -> int:
+    """``e`` with the largest magnitude of ``values`` / 10**e in [1, 10); 0 when that
+    magnitude is already of order one (0.01 to 1000), zero or not finite."""
+    top = float(np.max(np.abs(values))) if values.size else 0.0
+    if top == 0.0 or not np.isfinite(top) or 1e-2 <= top < 1e3:
+        return 0
+    return int(np.floor(np.log10(top)))
+
+
+def _over(e: int) -> str:
+    """The ``/ 10^e`` of an axis label whose numbers are the quantity over 10**e."""
+    return "" if e == 0 else f" / $10^{{{e}}}$"
+
+
+def _joinable(xy: np.ndarray) -> bool:
+    """Whether every step of the path ``xy`` (n, 2) turns less than 30 degrees about
+    the origin, so that a straight line between the points follows the curve."""
+    if len(xy) < 2:
+        return False
+    turn = np.arctan2(xy[:-1, 0] * xy[1:, 1] - xy[:-1, 1] * xy[1:, 0],
+                      np.sum(xy[:-1] * xy[1:], axis=-1))
+    return bool(np.all(np.abs(turn) < np.pi / 6))
+
+
+def _unjoined(joined: bool, n: int) -> str:
+    """The title's note on a path drawn as its points."""
+    if joined:
+        return ""
+    return "\n(one time: its point)" if n == 1 else "\n(points: the times too far apart to join)"
+
+
+def _circled_axis(si: Any) -> int:
+    """The principal axis the polhode goes round: the largest moment's if
+    ``L^2 / 2T`` is at least the middle moment, else the smallest's."""
+    sm, sw = si.scales()
+    m, w = si.moments / sm, si.omega / sw
+    ratio = float(np.sum((m * w) ** 2) / np.sum(m * w**2))  # L^2 / 2T, over sm
+    return int(np.argmax(m)) if ratio >= float(np.sort(m)[1]) else int(np.argmin(m))
+
+
+def _curve(ax: Any, xy: np.ndarray, joined: bool, color: str) -> None:
+    """A path as a line if ``joined``, else as its points; its first point marked."""
+    if joined:
+        ax.plot(*xy.T, color=color, linewidth=1.0)
+    else:
+        ax.plot(*xy.T, ".", color=color, ms=2)
+    ax.plot(*xy[0], "o", color="k", ms=5, label="first time")
+
+
 def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
-    """Plot the polhode on the inertia ellipsoid and the herpolhode in the plane.
+    """Plot the polhode on the inertia ellipsoid, framed on itself, and the herpolhode.
 
     Needs matplotlib (the ``plot`` extra), imported only here.
+
+    Three panels: the polhode on the inertia ellipsoid (body frame, 3-D); the
+    polhode seen along the principal axis it goes round, framed on the curve (for
+    a nearly symmetric body such as the Earth it is tiny beside the ellipsoid);
+    the herpolhode in the invariable plane, about the foot of its normal.  The
+    coordinates are the ellipsoid's ``x . I x = 1`` times ``sqrt(C)``, ``C`` the
+    largest moment: numbers free of units and of order one on the ellipsoid
+    (its semi-axes are ``sqrt(C / I)``), whatever the body's units; ``C`` is
+    stated in the figure's title, in kg m^2 for a body of Quantities and in the
+    caller's units for one of plain numbers.  Where the curves are small, a
+    panel's numbers are its coordinates over a power of ten written in the axis
+    label (``/ 10^-6``): no offset texts.
+
+    A curve whose consecutive points are more than 30 degrees apart about its
+    centre (times too far apart for the motion) is drawn as its points, not
+    joined by chords.  The first time's point is marked on every panel, so that
+    one time (or a body spinning about a principal axis, whose polhode is a
+    point) shows as that point.
+
+    Parameters
+    ----------
+    body, t
+        As for :func:`poinsot`; ``t`` of one or more times.
+    fig : matplotlib.figure.Figure, optional
+        Drawn into (a new figure if not given).
 
     Returns
     -------
@@ -140,27 +214,60 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
 
     import matplotlib.pyplot as plt  # lazy: optional dependency
 
-    if fig is None:
-        fig = plt.figure(figsize=(10, 4.5))
-    ax1 = fig.add_subplot(1, 2, 1, projection="3d")
-    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
-    semi = 1.0 / np.sqrt(body.si.moments)
-    polhode = np.asarray(getattr(paths.polhode, "value", paths.polhode))
+    si = body.si
+    big = float(np.max(si.moments))
+    root_c = np.sqrt(big)  # the coordinates' factor sqrt(C) (x . I x = 1 -> of order one)
+    polhode = np.asarray(getattr(paths.polhode, "value", paths.polhode)).reshape(-1, 3)
+    polhode = polhode * root_c
     herpolhode = np.asarray(getattr(paths.herpolhode, "value", paths.herpolhode))
-    distance = float(getattr(paths.distance, "value", paths.distance))
+    herpolhode = herpolhode.reshape(-1, 2) * root_c
+    distance = float(getattr(paths.distance, "value", paths.distance)) * root_c
+    if isinstance(body.moments, u.Quantity):
+        scale = f"{big:.4g} kg m$^2$"
+    else:
+        scale = f"{big:.4g} in the caller's units"
+
+    if fig is None:
+        fig = plt.figure(figsize=(15, 4.8))
+    ax1 = fig.add_subplot(1, 3, 1, projection="3d")
+    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+    semi = np.sqrt(big / si.moments)
     ax1.plot_wireframe(semi[0] * np.cos(uu) * np.sin(vv), semi[1] * np.sin(uu) * np.sin(vv),
                        semi[2] * np.cos(vv), color="0.8", linewidth=0.4)
-    ax1.plot(*polhode.T, color="C3", linewidth=1.5)
+    k = _circled_axis(si)
+    i, j = (k + 1) % 3, (k + 2) % 3  # (i, j, k) right-handed: seen from +k
+    seen = polhode[:, [i, j]]
+    joined = _joinable(seen)
+    _curve(ax1, polhode, joined, "C3")
     ax1.set_box_aspect(semi)  # (the ellipsoid's own shape, not a sphere's)
-    unit = "[(kg m$^2$)$^{-1/2}$]"  # (x . I x = 1 on the inertia ellipsoid)
-    for k, set_label in enumerate((ax1.set_xlabel, ax1.set_ylabel, ax1.set_zlabel)):
-        set_label(f"body axis {k + 1} {unit}", fontsize=8)
+    for n, set_label in enumerate((ax1.set_xlabel, ax1.set_ylabel, ax1.set_zlabel)):
+        set_label(f"body axis {n + 1}, $\\rho_{n + 1}\\sqrt{{C}}$", fontsize=8)
     ax1.set_title("polhode on the inertia ellipsoid (body)", fontsize=10)
-    ax2 = fig.add_subplot(1, 2, 2)
-    ax2.plot(*herpolhode.T, color="C0", linewidth=0.8)
-    ax2.set_aspect("equal")
-    ax2.set_xlabel(f"along e1 in the invariable plane {unit}", fontsize=8)
-    ax2.set_ylabel(f"along e2 {unit}", fontsize=8)
-    ax2.set_title(f"herpolhode (invariable plane at d = {distance:.4g} {unit})", fontsize=10)
+
+    ax2 = fig.add_subplot(1, 3, 2)
+    e = _exponent(seen)
+    _curve(ax2, seen / 10.0**e, joined, "C3")
+    ax2.set_aspect("equal", adjustable="datalim")
+    ax2.set_xlabel(f"body axis {i + 1}, $\\rho_{i + 1}\\sqrt{{C}}${_over(e)}", fontsize=8)
+    ax2.set_ylabel(f"body axis {j + 1}, $\\rho_{j + 1}\\sqrt{{C}}${_over(e)}", fontsize=8)
+    ax2.set_title(f"polhode seen along body axis {k + 1}"
+                  + _unjoined(joined, len(seen)),
+                  fontsize=10)
+
+    ax3 = fig.add_subplot(1, 3, 3)
+    e = _exponent(herpolhode)
+    joined = _joinable(herpolhode)
+    _curve(ax3, herpolhode / 10.0**e, joined, "C0")
+    ax3.set_aspect("equal", adjustable="datalim")
+    ax3.set_xlabel(f"along e1 in the invariable plane, $x\\sqrt{{C}}${_over(e)}", fontsize=8)
+    ax3.set_ylabel(f"along e2, $y\\sqrt{{C}}${_over(e)}", fontsize=8)
+    ax3.set_title(f"herpolhode (invariable plane at $d\\sqrt{{C}}$ = {distance:.6g})"
+                  + _unjoined(joined, len(herpolhode)),
+                  fontsize=10)
+    ax3.legend(loc="lower left", fontsize=7)
+    for ax in (ax2, ax3):
+        ax.ticklabel_format(useOffset=False, style="plain")
+    fig.suptitle("Poinsot's construction: the inertia ellipsoid $x \\cdot I x = 1$ in "
+                 f"coordinates times $\\sqrt{{C}}$ (C, the largest moment, = {scale})", fontsize=10)
     fig.tight_layout()
     return fig

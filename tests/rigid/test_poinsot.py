@@ -53,14 +53,15 @@ def test_plot_and_errors(tmp_path):
     fig = plot_poinsot(BODY, T)
     fig.savefig(tmp_path / "p.png")
     assert (tmp_path / "p.png").stat().st_size > 1000
-    # every axis named with its unit, and the ellipsoid drawn in its own proportions
-    # (the 3-D box was a cube: a 1 : 0.71 : 0.58 ellipsoid looked like a sphere)
-    ellipsoid, plane = fig.axes
-    for label in (ellipsoid.get_xlabel(), ellipsoid.get_zlabel(), plane.get_xlabel(),
-                  plane.get_ylabel()):
-        assert label.endswith("[(kg m$^2$)$^{-1/2}$]"), label
+    # the coordinates are x . I x = 1 times sqrt(C), free of units: a body of plain
+    # numbers claims none (they were labelled in (kg m^2)^-1/2 whatever the input)
+    ellipsoid = fig.axes[0]
+    for ax in fig.axes:
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert "sqrt{C}" in label and "kg" not in label, label
+    assert "3 in the caller's units" in fig.texts[0].get_text()
     box = np.asarray(ellipsoid.get_box_aspect())
-    semi = 1.0 / np.sqrt(BODY.moments)
+    semi = np.sqrt(3.0 / BODY.moments)
     np.testing.assert_allclose(box / box[0], semi / semi[0], rtol=1e-12)
     import matplotlib.pyplot as plt
     plt.close(fig)
@@ -68,3 +69,47 @@ def test_plot_and_errors(tmp_path):
         poinsot(RigidBody([1.0, 2.0, 3.0]), T)
     with pytest.raises(ValueError, match="RigidBody"):
         poinsot(None, T)
+
+
+def test_plot_of_the_earth_in_si_is_of_order_one():
+    # The Earth in SI: the axes had offset texts 1e19 and 1e-28 over their labels, the
+    # polhode was invisible on the ellipsoid and the herpolhode, sampled 3 times a day
+    # for a daily circle, a solid ring of chords.
+    import astropy.units as u
+    import matplotlib.pyplot as plt
+    om = 7.292115e-5
+    earth = RigidBody([8.0101e37, 8.0103e37, 8.0365e37] * u.kg * u.m**2,
+                      omega=[om * 1e-6, 0.0, om] * u.rad / u.s)
+    fig = plot_poinsot(earth, np.linspace(0.0, 600.0, 2000) * u.d)
+    fig.canvas.draw()
+    polhode, plane = fig.axes[1:]
+    assert "8.037e+37 kg m$^2$" in fig.texts[0].get_text()
+    for ax in (polhode, plane):
+        for axis in (ax.xaxis, ax.yaxis):
+            assert axis.get_offset_text().get_text() == ""
+    # the polhode framed on itself, seen along axis 3, in units of 1e-6 stated in the labels
+    assert polhode.get_title().startswith("polhode seen along body axis 3")
+    assert polhode.get_xlabel().endswith("/ $10^{-6}$")
+    x, y = polhode.lines[0].get_data()
+    assert 0.9 < np.max(np.hypot(x, y)) < 1.1
+    np.testing.assert_allclose(polhode.get_xlim(), [-1.0, 1.0], atol=0.6)
+    # the herpolhode (a circle of 3.3e-9 turned once a day) as unjoined points
+    assert plane.get_xlabel().endswith("/ $10^{-9}$")
+    line = plane.lines[0]
+    assert line.get_linestyle() == "None" and line.get_marker() == "."
+    np.testing.assert_allclose(np.hypot(*line.get_data()), 3.285, rtol=1e-2)
+    assert "too far apart" in plane.get_title()
+    plt.close(fig)
+
+
+def test_plot_of_one_time_is_its_point():
+    # One time drew two empty panels: its point is marked on each.
+    import matplotlib.pyplot as plt
+    fig = plot_poinsot(BODY, [5.0])
+    p = poinsot(BODY, [5.0])
+    plane = fig.axes[2]
+    marks = [line for line in plane.lines if line.get_marker() == "o"]
+    np.testing.assert_allclose(np.ravel(marks[0].get_data()), p.herpolhode[0] * np.sqrt(3.0))
+    assert all(any(line.get_marker() == "o" for line in ax.lines) for ax in fig.axes)
+    assert "one time" in plane.get_title()
+    plt.close(fig)

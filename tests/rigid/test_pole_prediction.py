@@ -592,6 +592,12 @@ def test_a_scene_of_no_period_draws_its_fan_and_saves_every_file(tmp_path):
         progress=False)
     names = {p.name for p in result.save(tmp_path)}
     assert {"summary.md", "summary.json"} <= names and any(n.endswith(".png") for n in names)
+    # the fan's time axis says its time scale (it said "[d]" only)
+    fan = result.plotters[0](result)
+    assert fan.axes[1].get_xlabel().startswith("time from the start 2019-01-01 00:00 UTC (days "
+                                               "of UTC, as the IERS C04 record's MJD;")
+    import matplotlib.pyplot as plt
+    plt.close(fan)
 
 
 def test_a_pole_prediction_stopped_between_periods_says_it_is_incomplete():

@@ -236,7 +236,8 @@ def _plot_fan(result: Result, record: Any, fans: dict, start: Any):
         ax.set_ylabel(f"{coord}_p (mas; CIP in the ITRS, IERS convention)")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8, ncol=3, loc="best")
-    axes[1].set_xlabel(f"time from the start date {start.iso[:10]} (data before it only) [d]")
+    axes[1].set_xlabel(f"time from the start {start.utc.iso[:16]} UTC (days of UTC, as the IERS "
+                       "C04 record's MJD; data before it only) [d]")
     axes[0].set_title(f"{result.scene.name}: the prediction fan from {start.iso[:10]} "
                       "against the record that followed")
     fig.tight_layout()
