@@ -46,6 +46,7 @@ from hamilton_orbits._orbit_build import (
     element_inputs,
     p_and_inv_a,
     raise_at,
+    refuse_unreadable,
     state_of,
 )
 from hamilton_orbits._orbit_elements import OrbitElements
@@ -293,7 +294,9 @@ class KeplerOrbit(OrbitElements):
             Naming the argument, index and value: ``e < 0``, ``a`` and ``e``
             inconsistent, ``p <= 0``, ``q <= 0``, ``mu <= 0``, ``inc`` outside
             [0, pi], ``nu`` beyond the asymptote, NaN / inf, incompatible
-            shapes, not exactly one of a/p/q or nu/M.
+            shapes, not exactly one of a/p/q or nu/M; ``M`` (or ``e``) whose state
+            the elements kernel could not read back (``|r| |v|^2 / mu`` beyond 2^450
+            ~ 3e135: ``|M|`` that large on a hyperbola, ``e`` that large).
         ConvergenceError
             If Kepler's equation cannot be solved.
 
@@ -329,6 +332,7 @@ class KeplerOrbit(OrbitElements):
         bad = ~np.all(np.isfinite(state[..., :6]), axis=-1)
         raise_at(lname, bad, length, "to give a finite state (check the elements)",
                  written[lname])
+        refuse_unreadable(state, e_, inv_a, aname, angle, e, written[aname])
         return cls(state, quantity)
 
     def __len__(self) -> int:
