@@ -51,7 +51,7 @@ from hamilton_orbits._orbit_build import (
 )
 from hamilton_orbits._orbit_elements import OrbitElements
 from hamilton_orbits.twobody import STATE_UNITS, check_state
-from hamilton_orbits.units import TIME, is_quantity, time_quantity
+from hamilton_orbits.units import TIME, is_quantity, refuse_epoch, shown, time_quantity
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
@@ -416,7 +416,8 @@ class KeplerOrbit(OrbitElements):
         ------
         ValueError
             NaN / inf, shapes that do not broadcast, a Quantity ``dt`` for an
-            orbit of plain floats or the reverse.
+            orbit of plain floats or the reverse, an astropy Time (an epoch, not
+            a duration).
         ConvergenceError
             As ``hamilton_orbits.kepler.propagate``.
 
@@ -427,9 +428,13 @@ class KeplerOrbit(OrbitElements):
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        refuse_epoch("dt", dt)  # (an astropy Time: an epoch, said so)
         dt = time_quantity(dt)  # (a TimeDelta: the Quantity in days it holds)
         if is_quantity(dt) != self._quantity:
-            raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
+            what = ("it has: give a time Quantity or a TimeDelta" if self._quantity else
+                    "it has none: give a plain number, in the orbit's unit of time")
+            raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has "
+                             f"units ({what}), got {shown(dt)}")
         dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below
         shape = self.shape
         try:
