@@ -825,6 +825,23 @@ def test_a_list_holding_quantities_or_bools_is_refused_naming_the_index():
         solve_kepler(1.0, [[0.1, None]])
 
 
+def test_a_ragged_list_is_refused_naming_the_argument_and_index():
+    """A ragged ``r`` raised numpy's "setting an array element with a sequence",
+    naming nothing."""
+    from hamilton_orbits import KeplerOrbit, solve_kepler
+
+    with pytest.raises(ValueError, match=r"^Expected `r` to be a regular array \(rows of one "
+                                          r"length\), got \[1.0, 0\] at index 1, which has 2 "
+                                          r"entries, where index 0 has 3 entries$"):
+        KeplerOrbit.from_state([[1.0, 0, 0], [1.0, 0]], [0, 1.0, 0], 1.0)
+    with pytest.raises(ValueError, match=r"`M` .*got 2.0 at index 1, which is a number, "
+                                          r"where index 0 has 1 entry$"):
+        solve_kepler([[1.0], 2.0], 0.5)
+    with pytest.raises(ValueError, match=r"`v` .*got \[0.0\] at index \(0, 1\), which has 1 "
+                                          r"entry, where index \(0, 0\) has 2 entries$"):
+        KeplerOrbit.from_state([1.0, 0, 0], [[[0.0, 1.0], [0.0]]], 1.0)
+
+
 @pytest.mark.parametrize("bodies", [5, Body("a", 1.0, [0, 0, 0], [0, 0, 0])])
 def test_a_system_of_something_not_a_list_of_bodies_is_refused(bodies):
     """``System(5)`` raised ``TypeError: 'int' object is not iterable``."""
