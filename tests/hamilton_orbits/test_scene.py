@@ -204,6 +204,17 @@ def test_stop_keeps_what_is_done_and_saves_it(tmp_path):
     assert (tmp_path / "states.nc") in paths
 
 
+def test_save_into_a_file_names_it(tmp_path):
+    """``Result.save(existing_file)`` raised os.mkdir's bare "File exists"."""
+    result = Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.01 yr", "crosscheck": False}).run(progress=False)
+    (tmp_path / "f").write_text("mine")
+    with pytest.raises(FileExistsError, match=r"^Expected `directory` to be a folder, got "
+                                              r"'.*f', a file: give a folder"):
+        result.save(tmp_path / "f")
+    assert (tmp_path / "f").read_text() == "mine"
+
+
 def test_a_scene_named_and_saved_beyond_ascii(tmp_path, monkeypatch):
     """A scene file ``mé.toml`` saved into ``oé/``: scipy's netCDF writer took only
     ASCII text (the title holds the scene's name) and rebound opens only an ASCII
