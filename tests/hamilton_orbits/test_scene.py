@@ -90,6 +90,18 @@ CATALOGUE = [
      r"kind: unknown kind 'n-body' \(did you mean 'nbody'"),
     ("TOML syntax error", ('description = "a test scene"', 'description = "a test scene'),
      r"TOML syntax error: .*line 2"),
+    # the values quoted as the file writes them (docs/scenes.md): "got 200.0 deg" was the
+    # Quantity read, "got a = 1.0 AU" too
+    ("an inclination beyond pi", ('inc = "0 deg"', 'inc = "200 deg"'),
+     r"bodies\[1\]\.inc: expected `inc` in \[0, pi\] rad, got '200 deg'"),
+    ("a > 0 with e > 1", ("e = 0.0167", "e = 1.5"),
+     r"bodies\[1\]\.a: expected a < 0 for a hyperbola \(e = 1\.5 > 1\), got a = '1 au'; "),
+    # elements about a primary of gm 0, the body's gm 0: "bodies[1]: expected `mu` > 0",
+    # a key no scene has
+    ("elements about a primary of gm 0", (('gm = "1.32712440041e20 m3 / s2"', 'gm = "0 m3/s2"'),
+                                          ('gm = "398600.4418 km3 / s2"', 'gm = "0 km3/s2"')),
+     r"bad\.toml:\d+: bodies\[0\]\.gm: expected a value > 0, got '0 m3/s2': bodies\[1\] "
+     r"\('earth', gm 0\) orbits this body by elements"),
 ]
 
 
