@@ -135,6 +135,17 @@ def test_bad_scene_messages_name_the_file_and_the_key(tmp_path, case, edits, pat
     assert re.search(pattern, str(info.value)), str(info.value)
 
 
+def test_a_scene_file_with_a_byte_order_mark_is_read(tmp_path):
+    """A file saved as "UTF-8 with BOM" was "TOML syntax error: Invalid statement (at line
+    1, column 1)", with no hint: the mark is skipped, and the lines stay the file's."""
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + GOOD.encode("utf-8"))
+    assert Scene.from_toml(path).spec["duration"] == 1 * u.yr
+    path.write_bytes(b"\xef\xbb\xbf" + _edit(GOOD, ('a = "1 au"', 'a = "1 s"')).encode())
+    with pytest.raises(SceneError, match=re.escape(f"{path}:") + r"19: bodies\[1\]\.a: "):
+        Scene.from_toml(path)
+
+
 def test_every_problem_is_reported_at_once(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(_edit(GOOD, (("duration =", "duraton ="), ('a = "1 au"', 'a = "1 s"'))))

@@ -403,6 +403,7 @@ class Scene:
                   values: Mapping[str, Any] | None = None) -> Scene:
         r"""A scene from the text of a scene file (``source``: the file, for messages;
         ``values``: keys replaced before the scene is checked, as in :meth:`from_toml`).
+        A leading byte-order mark (U+FEFF) is skipped.
 
         Raises
         ------
@@ -419,6 +420,9 @@ class Scene:
         >>> scene.kind, scene.source
         ('rotation', 'mine.toml')
         """
+        # a byte-order mark (an editor's "UTF-8 with BOM") is no TOML: it was "Invalid
+        # statement (at line 1, column 1)"; read past it, as utf-8-sig does
+        text = text[1:] if text.startswith("\ufeff") else text
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
