@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._columns import NCLASSICAL
 from hamilton_orbits._lazy import LazyModule
 from hamilton_orbits.twobody import STATE_UNITS
 from hamilton_orbits.units import ANGLE, DIMENSIONLESS, GM, LENGTH, as_quantity, is_quantity
@@ -26,11 +27,16 @@ _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
 _kk = LazyModule("hamilton_orbits._kernels.kepler", globals(), "_kk")
 
 __all__ = ["anomaly_of", "clamp_inc", "element_inputs", "p_and_inv_a", "raise_at",
-           "state_of"]
+           "refuse_unreadable", "state_of"]
 
 # two ulp above the float pi: an inclination of 180 degrees in another unit converts to
 # up to this (648 000 000 mas is one ulp above pi in astropy's conversion)
 _PI_PLUS_2ULP = float(np.nextafter(np.nextafter(np.pi, 4.0), 4.0))
+
+# |r| |v|^2 / mu (max-norm) of a state above which :func:`refuse_unreadable` asks the
+# elements kernel whether it reads the state back (its range: below 2^450, the constant
+# MAX_E_EXPONENT of hamilton_orbits._kernels.kepler)
+_SUSPECT = 2.0**440
 
 # internal units when Quantities come in
 _L, _MU = STATE_UNITS[0], STATE_UNITS[2]
@@ -167,6 +173,56 @@ def anomaly_of(aname: str, angle: np.ndarray, e: np.ndarray, radial: np.ndarray,
             f"{float(np.atleast_1d(angle)[index])!r}{fmt_index(index if bad.ndim else ())}"
         )
     return anom
+
+
+def refuse_unreadable(state: np.ndarray, e: np.ndarray, inv_a: np.ndarray, aname: str,
+                      angle: np.ndarray, given_e: Any = None, given_angle: Any = None) -> None:
+    """Refuse elements whose state the elements kernel cannot read back although every
+    element fits in float64: ``|r| |v|^2 / mu`` beyond its range, 2^450 ~ 3e135 (far
+    out on a hyperbola it is ~ ``|M|``, at periapsis ~ ``e``).  The orbit keeps its state
+    only, so that its ``e``, ``M`` ... would be refused when read, naming `r`, `v`, `mu`
+    the caller never passed; named here instead: ``M`` (``aname``) where ``|M| >= e``,
+    else ``e``.  A state whose ``1/a`` itself is beyond float64 (a subnormal length) is
+    built, as before: its elements do not fit, and are refused by name when read.
+
+    Parameters
+    ----------
+    state : ndarray, shape (..., 7)
+        The state built (:func:`state_of`).
+    e, inv_a, angle : ndarray, shape (...)
+        The eccentricity, ``1/a`` and the anomaly given (radians).
+    aname : str
+        ``"nu"`` or ``"M"``.
+    given_e, given_angle : optional
+        ``e`` and the anomaly as the caller wrote them (for the message).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, its first such index and its value.
+    """
+    rows = state.reshape(-1, 7)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        vm = np.max(np.abs(rows[:, 3:6]), axis=-1)
+        x = np.max(np.abs(rows[:, :3]), axis=-1) * vm * vm / rows[:, 6]
+    suspect = ~(x < _SUSPECT) & np.isfinite(inv_a).reshape(-1)
+    if not np.any(suspect):
+        return
+    idx = np.flatnonzero(suspect)
+    sub = np.ascontiguousarray(rows[idx])
+    out = np.empty((idx.size, NCLASSICAL))
+    _el.state_to_elements_classical(sub[:, :3], sub[:, 3:6], sub[:, 6], out)
+    bad = np.zeros(rows.shape[0], dtype=bool)
+    bad[idx] = ~np.all(np.isfinite(out[:, :-1]), axis=-1)  # (a, the last, NaN with them)
+    bad = bad.reshape(e.shape)
+    if not np.any(bad):
+        return
+    index = first_index(np.atleast_1d(bad))
+    use_m = aname == "M" and abs(np.atleast_1d(angle)[index]) >= np.atleast_1d(e)[index]
+    name, values, given = (aname, angle, given_angle) if use_m else ("e", e, given_e)
+    raise_at(name, bad, values,
+             "for which the state's elements can be read back (|r| |v|^2 / mu, ~ |M| far "
+             "out on a hyperbola and ~ e at periapsis, below 2^450 ~ 3e135)", given)
 
 
 def state_of(p, e, inv_a, inc, lan, argp, anom, radial, mu, m):

@@ -248,7 +248,7 @@ def _compile_ahead(ref: str, sets: Sequence[str]) -> None:
     import tomllib
 
     try:
-        raw = tomllib.loads(_scene_text(_scene_file(ref), ref))
+        raw = tomllib.loads(_scene_text(_scene_file(ref), ref).removeprefix("\ufeff"))
         method = raw.get("integrator", {}).get("method")
         for item in sets:
             key, _, value = item.partition("=")

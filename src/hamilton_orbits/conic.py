@@ -526,9 +526,12 @@ class Conic:
     def _times_a(self, what: str, x: np.ndarray) -> np.ndarray:
         """``a x`` (``x`` of shape (..., 3)), as ``x / inv_a``; refused for the parabola
         and where a component is beyond float64 (``inv_a`` subnormal)."""
-        if np.any(self._inv_a == 0):
+        parabola = self._inv_a == 0
+        if np.any(parabola):
+            i = first_index(np.atleast_1d(parabola)) if parabola.ndim else ()
             raise ValueError(f"Expected a conic with a centre for `{what}`, got a parabola "
-                             "(e = 1: the centre and second focus are at infinity)")
+                             "(e = 1, inv_a = 0.0: the centre and second focus are at "
+                             f"infinity){fmt_index(i if parabola.size > 1 else ())}")
         with np.errstate(all="ignore"):
             out = x / self._inv_a[..., None]
         self._refuse_beyond_float(what, out, vector=True)

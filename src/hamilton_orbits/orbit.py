@@ -46,11 +46,12 @@ from hamilton_orbits._orbit_build import (
     element_inputs,
     p_and_inv_a,
     raise_at,
+    refuse_unreadable,
     state_of,
 )
 from hamilton_orbits._orbit_elements import OrbitElements
 from hamilton_orbits.twobody import STATE_UNITS, check_state
-from hamilton_orbits.units import TIME, is_quantity, time_quantity
+from hamilton_orbits.units import TIME, is_quantity, refuse_epoch, shown, time_quantity
 
 # numba and astropy are imported on first use (hamilton_orbits._lazy)
 _el = LazyModule("hamilton_orbits._kernels.elements", globals(), "_el")
@@ -293,7 +294,9 @@ class KeplerOrbit(OrbitElements):
             Naming the argument, index and value: ``e < 0``, ``a`` and ``e``
             inconsistent, ``p <= 0``, ``q <= 0``, ``mu <= 0``, ``inc`` outside
             [0, pi], ``nu`` beyond the asymptote, NaN / inf, incompatible
-            shapes, not exactly one of a/p/q or nu/M.
+            shapes, not exactly one of a/p/q or nu/M; ``M`` (or ``e``) whose state
+            the elements kernel could not read back (``|r| |v|^2 / mu`` beyond 2^450
+            ~ 3e135: ``|M|`` that large on a hyperbola, ``e`` that large).
         ConvergenceError
             If Kepler's equation cannot be solved.
 
@@ -329,6 +332,7 @@ class KeplerOrbit(OrbitElements):
         bad = ~np.all(np.isfinite(state[..., :6]), axis=-1)
         raise_at(lname, bad, length, "to give a finite state (check the elements)",
                  written[lname])
+        refuse_unreadable(state, e_, inv_a, aname, angle, e, written[aname])
         return cls(state, quantity)
 
     def __len__(self) -> int:
@@ -412,7 +416,8 @@ class KeplerOrbit(OrbitElements):
         ------
         ValueError
             NaN / inf, shapes that do not broadcast, a Quantity ``dt`` for an
-            orbit of plain floats or the reverse.
+            orbit of plain floats or the reverse, an astropy Time (an epoch, not
+            a duration).
         ConvergenceError
             As ``hamilton_orbits.kepler.propagate``.
 
@@ -423,9 +428,13 @@ class KeplerOrbit(OrbitElements):
         >>> round(float(o.propagate(2.0).M), 12)
         2.5
         """
+        refuse_epoch("dt", dt)  # (an astropy Time: an epoch, said so)
         dt = time_quantity(dt)  # (a TimeDelta: the Quantity in days it holds)
         if is_quantity(dt) != self._quantity:
-            raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has units")
+            what = ("it has: give a time Quantity or a TimeDelta" if self._quantity else
+                    "it has none: give a plain number, in the orbit's unit of time")
+            raise ValueError("Expected `dt` to be a Quantity exactly when the orbit has "
+                             f"units ({what}), got {shown(dt)}")
         dt_ = TIME("dt", dt, _T, finite=False)  # a NaN or inf dt: the kernel fails, named below
         shape = self.shape
         try:

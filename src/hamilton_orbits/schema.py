@@ -74,6 +74,16 @@ class Problems:
         self.source = source
         self.locate = locate
         self.items: list[str] = []
+        #: ``written(path) -> value``: the value of a key path as the file (or an
+        #: override) writes it, None where unknown (set by the scene)
+        self.written: Callable[[str], Any] | None = None
+
+    def quoted(self, path: str, value: Any) -> str:
+        """``value`` (the key ``path``'s, as read) quoted as the file writes it: the
+        file's text where it is a string (``'7000 km'``, not ``7000.0 km``), else
+        ``str(value)``."""
+        raw = None if self.written is None else self.written(path)
+        return repr(raw) if isinstance(raw, str) else str(value)
 
     def add(self, path: str, message: str) -> None:
         line = self.locate(path) if (self.locate is not None and path) else None

@@ -59,7 +59,9 @@ __all__ = [
     "any_quantity",
     "as_quantity",
     "is_quantity",
+    "refuse_epoch",
     "require_consistent",
+    "shown",
     "strip",
     "time_quantity",
     "wrap",
@@ -267,6 +269,46 @@ def time_quantity(value: Any) -> Any:
         a = np.asarray(value)
     out = numpy_duration(a)
     return value if out is a else out  # (as given where it is refused: named so)
+
+
+def refuse_epoch(name: str, value: Any) -> None:
+    """Refuse an astropy :class:`~astropy.time.Time` given for the duration ``name``:
+    a Time is an epoch, not a duration (subtract an epoch from it, or give a TimeDelta
+    or a time Quantity), naming the argument and quoting the value.
+
+    Examples
+    --------
+    >>> from astropy.time import Time
+    >>> refuse_epoch("dt", 2.0)  # not an epoch: nothing to say
+    >>> refuse_epoch("dt", Time("2020-01-01"))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: Expected `dt` to be a duration, got the epoch <Time ...2020-01-01 00:00:00.000>: ...
+    """
+    if type(value) in _NOT_TIME_DELTA:  # (plain types at once)
+        return
+    time = sys.modules.get("astropy.time")  # (not imported: no Time was made)
+    if time is not None and isinstance(value, time.Time):
+        raise ValueError(
+            f"Expected `{name}` to be a duration, got the epoch {value!r}: an astropy Time "
+            "is an epoch; subtract the epoch the state is at (t - t0, a TimeDelta), or "
+            "give a TimeDelta or a time Quantity")
+
+
+def shown(value: Any) -> str:
+    """``value`` as a message quotes it: a Quantity as its number(s) and unit, a string
+    with how to read it as a Quantity, anything else as its repr (cut at 60 characters).
+
+    Examples
+    --------
+    >>> shown(2.0 * u.day), shown("30 min"), shown(1.5)
+    ('2 d', "'30 min' (a string: u.Quantity('30 min') reads it)", '1.5')
+    """
+    if is_quantity(value):
+        return _short(value)
+    text = repr(value)
+    text = text if len(text) <= 60 else text[:57] + "..."
+    return f"{text} (a string: u.Quantity({text}) reads it)" if isinstance(value, str) else text
 
 
 #: numpy's time units of a fixed length, as astropy's (a year or a month of numpy's

@@ -9,6 +9,7 @@ Public: ``rigid`` stands on it as ``hamilton_orbits`` does (the core both packag
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -153,11 +154,20 @@ def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:
     wrongly: a bool (read as 1.0 or 0.0, silently), None (read as nan) or a
     Quantity (a TypeError deep in numpy), naming the index."""
     units = sys.modules.get("astropy.units")
+    first = None  # the first entry's length (-1: a number), which every entry must have
     for k, x in enumerate(values):
         kind = type(x)
         if kind is float or kind is int:
+            if first is None:
+                first = -1
+            elif first != -1:
+                _refuse_ragged(name, x, (*at, k), -1, first)
             continue
         if kind is list or kind is tuple:
+            if first is None:
+                first = len(x)
+            elif first != len(x):
+                _refuse_ragged(name, x, (*at, k), len(x), first)
             _check_listed(name, x, (*at, k))
         elif kind is bool or kind is np.bool_ or x is None:  # (None: read as nan)
             raise ValueError(f"Expected `{name}` to be numeric, got {x!r}{fmt_index((*at, k))}")
@@ -166,6 +176,19 @@ def _check_listed(name: str, values: list | tuple, at: tuple[int, ...]) -> None:
                 f"Expected `{name}` to be plain numbers or one Quantity array, got the "
                 f"Quantity {x}{fmt_index((*at, k))} in a list (u.Quantity(...) joins a list of "
                 f"Quantities into one)")
+
+
+def _refuse_ragged(name: str, x: Any, at: tuple[int, ...], length: int, first: int) -> None:
+    """Refuse a ragged list (numpy's "inhomogeneous shape"): entry ``x`` at index ``at``
+    of ``length`` entries (-1: a number) where the first of its row has ``first``."""
+    def entries(n: int) -> str:
+        return "is a number" if n == -1 else "has 1 entry" if n == 1 else f"has {n} entries"
+
+    shown = repr(x) if len(repr(x)) <= 60 else repr(x)[:57] + "..."
+    raise ValueError(
+        f"Expected `{name}` to be a regular array (rows of one length), got {shown}"
+        f"{fmt_index(at)}, which {entries(length)}, where index "
+        f"{fmt_index((*at[:-1], 0))[10:]} {entries(first)}")
 
 
 def check_finite(name: str, arr: np.ndarray, where: np.ndarray | None = None) -> None:

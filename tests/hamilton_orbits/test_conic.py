@@ -118,6 +118,18 @@ def test_parabola_limits():
     assert np.all(c.focal_half_chord(rn) == 2 * rn)
 
 
+def test_centre_of_a_batch_names_the_parabola_by_index():
+    """The refusal of a batch's centre or second focus did not say which conic is the
+    parabola."""
+    c = Conic.from_elements([1.44, 2.0, 1.0], [0.44, 1.0, 1.0], [0.56, 0.0, 0.0], 0, 0, 0, 1.0)
+    for name in ("centre", "second_focus"):
+        with pytest.raises(ValueError, match=rf"^Expected a conic with a centre for `{name}`, "
+                                             r"got a parabola \(e = 1, .*\) at index 1$"):
+            getattr(c, name)
+    with pytest.raises(ValueError, match=r"at infinity\)$"):  # one conic: no index
+        _ = Conic.from_elements(2.0, 1.0, 0.0, 0, 0, 0, 1.0).centre
+
+
 def test_orbit_conic_matches_state():
     o = KeplerOrbit.from_elements(a=2.0, e=0.4, inc=math.pi, lan=0.0, argp=1.0, nu=0.5, mu=1.0)
     c = o.conic

@@ -239,3 +239,21 @@ def test_contract_regressions_found_by_the_property_test():
     o = KeplerOrbit.from_state([1.0, 0, 0], [0, 1e160, 0], 1e300)  # e ~ 1e20, v^2 ~ 1e320
     with pytest.raises(ValueError, match="`energy` fits in float64"):
         _ = o.energy
+
+
+def test_from_elements_refuses_elements_it_could_not_read_back():
+    """Far out on a hyperbola (|M| ~ |r| |v|^2 / mu beyond 2^450) the state was built and
+    reading ``e`` blamed `r`, `v`, `mu`, which the caller never passed: the elements are
+    refused by name, index and value; ``e`` ~ 1e140 the same way."""
+    el = dict(a=-1.0, inc=0.0, lan=0.0, argp=0.0, mu=1.0)
+    with pytest.raises(ValueError, match=r"^Expected `M` .*2\^450.*, got 1e\+200 at index 1$"):
+        KeplerOrbit.from_elements(e=2.0, M=[0.5, 1e200], **el)
+    with pytest.raises(ValueError, match=r"^Expected `e` .*2\^450.*, got 1e\+140$"):
+        KeplerOrbit.from_elements(e=1e140, nu=0.3, **el)
+    # what the kernels read back is kept: M = 1e100 (read back to ~1e-14; its e, on the
+    # asymptote, is the representation limit of from_state), and the subnormal lengths
+    # whose 1/a alone does not fit (test_orbit.py) are built as before
+    o = KeplerOrbit.from_elements(e=2.0, M=[0.5, 1e100], **el)
+    assert o.M[1] == pytest.approx(1e100, rel=1e-12) and np.all(np.isfinite(o.e))
+    assert KeplerOrbit.from_elements(a=1e-310, e=0.5, inc=0.3, lan=0.2, argp=0.1, nu=0.3,
+                                     mu=1.0).shape == ()

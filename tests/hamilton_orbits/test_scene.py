@@ -90,6 +90,18 @@ CATALOGUE = [
      r"kind: unknown kind 'n-body' \(did you mean 'nbody'"),
     ("TOML syntax error", ('description = "a test scene"', 'description = "a test scene'),
      r"TOML syntax error: .*line 2"),
+    # the values quoted as the file writes them (docs/scenes.md): "got 200.0 deg" was the
+    # Quantity read, "got a = 1.0 AU" too
+    ("an inclination beyond pi", ('inc = "0 deg"', 'inc = "200 deg"'),
+     r"bodies\[1\]\.inc: expected `inc` in \[0, pi\] rad, got '200 deg'"),
+    ("a > 0 with e > 1", ("e = 0.0167", "e = 1.5"),
+     r"bodies\[1\]\.a: expected a < 0 for a hyperbola \(e = 1\.5 > 1\), got a = '1 au'; "),
+    # elements about a primary of gm 0, the body's gm 0: "bodies[1]: expected `mu` > 0",
+    # a key no scene has
+    ("elements about a primary of gm 0", (('gm = "1.32712440041e20 m3 / s2"', 'gm = "0 m3/s2"'),
+                                          ('gm = "398600.4418 km3 / s2"', 'gm = "0 km3/s2"')),
+     r"bad\.toml:\d+: bodies\[0\]\.gm: expected a value > 0, got '0 m3/s2': bodies\[1\] "
+     r"\('earth', gm 0\) orbits this body by elements"),
 ]
 
 
@@ -121,6 +133,17 @@ def test_bad_scene_messages_name_the_file_and_the_key(tmp_path, case, edits, pat
     where = re.compile(re.escape(str(path)) + r"(:\d+)?: ")
     assert any(where.match(p) for p in info.value.problems), info.value.problems
     assert re.search(pattern, str(info.value)), str(info.value)
+
+
+def test_a_scene_file_with_a_byte_order_mark_is_read(tmp_path):
+    """A file saved as "UTF-8 with BOM" was "TOML syntax error: Invalid statement (at line
+    1, column 1)", with no hint: the mark is skipped, and the lines stay the file's."""
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + GOOD.encode("utf-8"))
+    assert Scene.from_toml(path).spec["duration"] == 1 * u.yr
+    path.write_bytes(b"\xef\xbb\xbf" + _edit(GOOD, ('a = "1 au"', 'a = "1 s"')).encode())
+    with pytest.raises(SceneError, match=re.escape(f"{path}:") + r"19: bodies\[1\]\.a: "):
+        Scene.from_toml(path)
 
 
 def test_every_problem_is_reported_at_once(tmp_path):
@@ -202,6 +225,17 @@ def test_stop_keeps_what_is_done_and_saves_it(tmp_path):
     assert "STOPPED EARLY" in result.summary()
     paths = result.save(tmp_path)
     assert (tmp_path / "states.nc") in paths
+
+
+def test_save_into_a_file_names_it(tmp_path):
+    """``Result.save(existing_file)`` raised os.mkdir's bare "File exists"."""
+    result = Scene.bundled("comet-encounter").with_values(
+        {"duration": "0.01 yr", "crosscheck": False}).run(progress=False)
+    (tmp_path / "f").write_text("mine")
+    with pytest.raises(FileExistsError, match=r"^Expected `directory` to be a folder, got "
+                                              r"'.*f', a file: give a folder"):
+        result.save(tmp_path / "f")
+    assert (tmp_path / "f").read_text() == "mine"
 
 
 def test_a_scene_named_and_saved_beyond_ascii(tmp_path, monkeypatch):

@@ -242,3 +242,23 @@ def test_a_masked_numpy_duration_is_refused_as_masked():
         TIME("t", masked, "s")
     unmasked = np.ma.array(np.array([1, 2], "m8[m]"))  # (nothing masked: read)
     np.testing.assert_array_equal(TIME("t", unmasked, "s"), [60.0, 120.0])
+
+
+def test_propagate_names_an_epoch_and_quotes_the_value():
+    """An astropy Time given for ``dt`` is an epoch, said so; a string or a number beside
+    an orbit of units is quoted (the message had no value)."""
+    o = KeplerOrbit.from_elements(a=7000 * u.km, e=0.1, inc=98 * u.deg, lan=10 * u.deg,
+                                  argp=20 * u.deg, M=0 * u.deg,
+                                  mu=398600.4418 * u.km**3 / u.s**2)
+    plain = KeplerOrbit.from_elements(a=1.0, e=0.1, inc=0.1, lan=0.2, argp=0.3, M=0.4, mu=1.0)
+    for orbit in (o, plain):
+        with pytest.raises(ValueError, match=r"^Expected `dt` to be a duration, got the epoch "
+                                             r"<Time .*2020-01-01.*>: .*TimeDelta"):
+            orbit.propagate(Time("2020-01-01"))
+    with pytest.raises(ValueError, match=r"units \(it has: .*\), got '30 min' \(a string: "
+                                         r"u\.Quantity\('30 min'\) reads it\)$"):
+        o.propagate("30 min")
+    with pytest.raises(ValueError, match=r"units \(it has: .*\), got 1800\.0$"):
+        o.propagate(1800.0)
+    with pytest.raises(ValueError, match=r"units \(it has none: .*\), got 2 h$"):
+        plain.propagate(2 * u.h)

@@ -198,9 +198,31 @@ class Result:
         netCDF-3 (scipy's writer), which xarray, netCDF4 and ``ncdump`` read.  The
         figures need matplotlib (the ``plot`` extra): without it they are left out,
         the rest written, and :attr:`not_saved` says so.
+
+        Parameters
+        ----------
+        directory : str or Path
+            The folder to write into (made, with its parents, if missing).
+
+        Returns
+        -------
+        list of Path
+            The files written.
+
+        Raises
+        ------
+        FileExistsError
+            For a ``directory`` that is a file (the message names the path);
+            nothing is written.
         """
         out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except FileExistsError as exc:  # (a file of its name: os.mkdir says "File exists")
+            raise FileExistsError(
+                f"Expected `directory` to be a folder, got {str(out)!r}, a file: give a "
+                "folder to write the results into (made if missing), or move the file"
+            ) from exc
         written = []
         md = out / "summary.md"
         md.write_text(f"# {self.scene.name}\n\n```\n{self.summary()}\n```\n", encoding="utf-8")

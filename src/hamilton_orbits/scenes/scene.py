@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import copy
 import datetime
+import functools
 import re
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
@@ -278,6 +279,17 @@ class _Recorded(S.Problems):
         return self.earlier or bool(self.items)
 
 
+def _written(data: dict, path: str) -> Any:
+    """The value at key ``path`` of a scene's mapping as written (None if absent)."""
+    node: Any = data
+    try:
+        for part in S.split_path(path):
+            node = node[part]
+    except (KeyError, IndexError, TypeError):
+        return None
+    return node
+
+
 def _related(a: str, b: str) -> bool:
     """One key path is the other or under it (``bodies[1]`` and ``bodies[1].gm``)."""
     short, long = sorted((a, b), key=len)
@@ -290,6 +302,7 @@ def _cross_key_problems(kind: Any, spec: dict, problems: S.Problems) -> None:
     missing in ``spec``), as far as the refused keys let the checks run."""
     refused = list(getattr(problems, "paths", ()))
     cross = _Recorded(problems.source, problems.locate, earlier=True)
+    cross.written = problems.written
     try:
         kind.check(spec, cross)
     except (TypeError, AttributeError, KeyError, ValueError):
@@ -394,6 +407,7 @@ class Scene:
                   values: Mapping[str, Any] | None = None) -> Scene:
         r"""A scene from the text of a scene file (``source``: the file, for messages;
         ``values``: keys replaced before the scene is checked, as in :meth:`from_toml`).
+        A leading byte-order mark (U+FEFF) is skipped.
 
         Raises
         ------
@@ -410,6 +424,9 @@ class Scene:
         >>> scene.kind, scene.source
         ('rotation', 'mine.toml')
         """
+        # a byte-order mark (an editor's "UTF-8 with BOM") is no TOML: it was "Invalid
+        # statement (at line 1, column 1)"; read past it, as utf-8-sig does
+        text = text[1:] if text.startswith("\ufeff") else text
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -514,6 +531,7 @@ class Scene:
     # --- validation ---------------------------------------------------
     def _validate(self, data: dict) -> dict:
         problems = _Recorded(self.source, self._locate(), earlier=False)
+        problems.written = functools.partial(_written, data)
         kinds = registered_kinds()
         kind_name = data.get("kind")
         if kind_name is None:

@@ -75,20 +75,38 @@ def problem_text(exc: Exception) -> str:
     return "e" + msg[1:] if msg.startswith("Expected ") else msg
 
 
-def attempt(problems: S.Problems | None, path: str, build, keys=()):
+def attempt(problems: S.Problems | None, path: str, build, keys=(), values=None):
     """``build()``, or with ``problems`` its ``ValueError`` as a problem at ``path``
-    (at ``path.key`` when the message names one of ``keys`` first) and None."""
+    (at ``path.key`` when the message names one of ``keys`` first) and None.
+
+    ``values``: the keys' values as read (Quantities); a message that quotes the
+    named key's value as read (``got 200.0 deg``) quotes it as the file writes it
+    instead (``got '200 deg'``)."""
     if problems is None:
         return build()
     try:
         return build()
     except ValueError as exc:
-        msg = str(exc)
+        msg = problem_text(exc)
         named = re.search(r"`(\w+)`", msg)
         if named and named.group(1) in keys:
             path = f"{path}.{named.group(1)}"
-        problems.add(path, problem_text(exc))
+            msg = _as_written(msg, (values or {}).get(named.group(1)), path, problems)
+        problems.add(path, msg)
         return None
+
+
+def _as_written(msg: str, value: Any, path: str, problems: S.Problems) -> str:
+    """``msg`` with the value it quotes after ``, got `` (as the library quotes a
+    Quantity: ``200.0 deg``) replaced by the file's text at ``path`` (``'200 deg'``)."""
+    if not isinstance(value, u.Quantity) or value.shape != ():
+        return msg
+    head, sep, tail = msg.partition(", got ")
+    read = f"{float(value.value)!r} {value.unit.to_string()}".rstrip()
+    quoted = problems.quoted(path, value)
+    if not sep or not tail.startswith(read) or not quoted.startswith("'"):
+        return msg
+    return f"{head}, got {quoted}{tail[len(read):]}"
 
 
 def _scene_body(b: dict, by_name: dict):
@@ -165,14 +183,37 @@ def _build(spec: dict, problems: S.Problems | None):
     for i, b in enumerate(spec["bodies"]):
         if b["r"] is None and b["primary"] not in by_name:
             continue  # its primary was refused: said already
+        if problems is not None and _refuse_no_mu(spec, i, by_name, problems):
+            continue
         body = attempt(problems, f"bodies[{i}]", lambda b=b: _scene_body(b, by_name),
-                        tuple(BODY.fields))
+                        tuple(BODY.fields), b)
         if body is not None:
             bodies.append(body)
             by_name[body.name] = body
     if problems:
         return None
     return attempt(problems, "bodies", lambda: System(bodies))
+
+
+def _refuse_no_mu(spec: dict, i: int, by_name: dict, problems: S.Problems) -> bool:
+    """Whether body ``i``, given by elements about its primary, has ``mu`` = the
+    primary's ``gm`` + its own <= 0 (both 0): a problem then, at the primary's ``gm``
+    (no scene key is called ``mu``), or at ``bodies[i].primary`` for a primary of
+    ``[initial]``."""
+    b = spec["bodies"][i]
+    if b["r"] is not None or (by_name[b["primary"]].gm + b["gm"]).value > 0:
+        return False
+    j = next((k for k, c in enumerate(spec["bodies"]) if c["name"] == b["primary"]), None)
+    path = f"bodies[{i}].primary" if j is None else f"bodies[{j}].gm"
+    gm = by_name[b["primary"]].gm
+    need = "by elements, which need mu = G (m1 + m2), the two gm summed, > 0"
+    if j is None:
+        problems.add(path, f"{b['primary']!r} has gm {gm} and this body gm 0: it orbits it "
+                           f"{need}")
+    else:
+        problems.add(path, f"expected a value > 0, got {problems.quoted(path, gm)}: "
+                           f"bodies[{i}] ({b['name']!r}, gm 0) orbits this body {need}")
+    return True
 
 
 def scene_frame(spec: dict) -> str:

@@ -187,14 +187,15 @@ def _check_a_and_e(b: dict, path: str, problems: S.Problems) -> None:
     a = b["a"]
     e = 0.0 if b["e"] is None else float(b["e"].to_value(u.one))
     shown = f"e = {e:g}" + ("" if b["e"] is not None else " (the default)")
+    written = problems.quoted(f"{path}.a", a)  # (as the file writes it: '7000 km')
     if e == 1.0:
         problems.add(f"{path}.a", f"a parabola ({shown}) has no finite `a`: give `p` or `q`")
     elif e > 1.0 and a.value > 0:
         problems.add(f"{path}.a", f"expected a < 0 for a hyperbola ({shown} > 1), got "
-                                  f"a = {a}; an ellipse (a > 0) has e < 1")
+                                  f"a = {written}; an ellipse (a > 0) has e < 1")
     elif e < 1.0 and a.value < 0:
         problems.add(f"{path}.a", f"expected a > 0 for an ellipse ({shown} < 1), got "
-                                  f"a = {a}; a hyperbola (a < 0) has e > 1")
+                                  f"a = {written}; a hyperbola (a < 0) has e > 1")
 
 
 def _check_effects(spec: dict, names: list[str], problems: S.Problems) -> None:
