@@ -207,3 +207,46 @@ def test_rigid_earth_figure_shows_the_wobble_in_mas_and_years():
     # the scene's 0.2 arcsec offset of the rotation axis from the figure axis
     assert amplitude == pytest.approx(200.0, rel=0.01)
     assert "principal axes" in result.summary()
+
+
+def test_a_removed_body_leaves_the_orbit_figure_in_au():
+    """A body removed or merged is NaN after it left: the largest distance was NaN,
+    "above 0.01 au" false, and a 6 au orbit was drawn in km with 1e9 offsets."""
+    from hamilton_orbits.scenes.nbody.figures import orbit_view
+
+    r = np.zeros((3, 3, 3))
+    r[:, 1, 0] = 5.2
+    r[:, 2, 0] = [1.0, 2.0, np.nan]
+    view = orbit_view(["sun", "jupiter", "comet"], np.array([1.0, 1e-3, 0.0]), r)
+    assert view["unit"] == "au" and view["reach"].tolist() == [0.0, 5.2, 2.0]
+
+
+def test_a_distance_still_closing_at_a_removal_is_not_called_the_closest_approach():
+    """The comet is removed at 5 au from the Sun still closing on Jupiter: its last
+    distance is no closest approach (the figure said "the closest approach (0.046 au)")."""
+    comet = {"name": "comet", "gm": "0 km3 / s2", "primary": "sun", "q": "0.01 au",
+             "e": 0.9999, "inc": "36.003522070993 deg", "lan": "32.42821444595107 deg",
+             "argp": "222.42981967246678 deg", "M": "-0.016637268139259004 deg"}
+    result = Scene.from_dict({
+        "kind": "nbody", "description": "comet removed", "duration": "1 yr",
+        "cadence": "1 d", "crosscheck": False, "effects": [],
+        "events": [{"name": "escape", "distance": "5 au", "bodies": ["comet"],
+                    "action": "remove"}],
+        "integrator": {"method": "radau15"},
+        "initial": {"solar_system": {"epoch": "J2000", "bodies": ["sun", "jupiter"]}},
+        "bodies": [comet],
+        "analysis": [{"name": "close_approach", "body": "comet", "other": "jupiter"}],
+    }).run(progress=False)
+    assert result.metrics["closest approach comet-jupiter"].startswith(
+        "not reached: ") and "comet was removed" in result.metrics[
+        "closest approach comet-jupiter"]
+    fig = _figure(result, "orbits")
+    for ax in fig.axes:
+        assert ax.get_xlabel().endswith("[au]") and ax.get_ylabel().endswith("[au]")
+        fig.canvas.draw()
+        assert ax.xaxis.get_offset_text().get_text() == ""
+        assert ax.yaxis.get_offset_text().get_text() == ""
+        labels = [h.get_label() for h in ax.get_legend().legend_handles]
+        assert not any("closest approach (" in t for t in labels)
+        assert any(t.startswith("comet at the last output before comet was removed") or
+                   t.startswith("the last output before comet was removed") for t in labels)

@@ -107,7 +107,8 @@ def plot_perihelion(result: Result):
 
 def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any]:
     """What the orbit figure draws: positions relative to the primary (the most
-    massive body), in km below 0.01 au of extent and au above, and the bodies of an
+    massive body), in km below 0.01 au of extent and au above (the outputs where a
+    body exists: NaN after a removal or a merge is left out), and the bodies of an
     inner panel (those inside the largest gap, by a factor 2.5 or more, in the
     bodies' largest distances from the primary, when the outermost is 5 times
     farther; without such a gap, when the outermost is 20 times farther than the
@@ -129,7 +130,8 @@ def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any
     """
     k = int(np.argmax(gm))
     rel = r - r[:, k:k + 1]
-    reach = np.linalg.norm(rel, axis=-1).max(axis=0)
+    # (NaN where a body was removed or merged: fmax skips it, 0 for a body never there)
+    reach = np.fmax.reduce(np.linalg.norm(rel, axis=-1), axis=0, initial=0.0)
     others = [i for i in range(len(names)) if i != k]
     unit = "au" if reach.max(initial=0.0) > 0.01 else "km"
     scale = 1.0 if unit == "au" else (1 * u.au).to_value(u.km)
@@ -425,9 +427,12 @@ def _draw_encounter(ax: Any, view: dict, shown: list[str]) -> list:
     for name, marker in ((enc["body"], "*"), (enc["other"], "P")):
         if name in shown and name != view["primary"]:
             x, y = view["rel"][enc["row"], view["names"].index(name), :2]
+            label = (f"{name} at {enc['what']}" if name == enc["body"] or enc["reached"]
+                     else f"{name} at that output")
+            if name == enc["body"]:
+                label += f" ({enc['text']})" if enc["reached"] else f"\n({enc['text']})"
             (h,) = ax.plot([x], [y], marker, ms=11, mfc="none", mec="crimson", mew=1.2,
-                           gid="encounter", label=f"{name} at the closest approach" +
-                           (f" ({enc['text']})" if name == enc["body"] else ""))
+                           gid="encounter", label=label)
             handles.append(h)
     return handles
 
@@ -493,8 +498,14 @@ def _orbit_data(result: Result, gm: np.ndarray) -> dict:
     view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
     enc = result.diagnostics.get("close_approach")
     if enc is not None:
-        view["encounter"] = {**enc, "text": f"{enc['distance'].to_value(u.au):.3g} au "
-                                            f"at {enc['time'].to_value(u.yr):.3g} yr"}
+        text = f"{enc['distance'].to_value(u.au):.3g} au at {enc['time'].to_value(u.yr):.3g} yr"
+        reached = enc.get("reached", True)
+        if not reached:  # (closing at the last output before a body left the run)
+            text = (f"{enc['distance'].to_value(u.au):.3g} au from {enc['other']} at "
+                    f"{enc['time'].to_value(u.yr):.3g} yr,\nstill closing: the closest "
+                    "approach was not reached")
+        view["encounter"] = {**enc, "text": text, "reached": reached, "what": (
+            "the closest approach" if reached else f"the last output before {enc['ended']}")}
     return view
 
 
@@ -517,7 +528,8 @@ def _draw_flyby(ax: Any, view: dict, frame: str) -> None:
     _draw_body(ax, sub, 0, color, f"{enc['body']}, from {enc['other']}")
     x, y = d[enc["row"], :2]
     ax.plot([x], [y], "*", ms=11, mfc="none", mec="crimson", mew=1.2, gid="encounter",
-            label=f"the output nearest the closest approach ({enc['text']})")
+            label=(f"the output nearest the closest approach ({enc['text']})"
+                   if enc["reached"] else f"{enc['what']}\n({enc['text']})"))
     ax.plot([0.0], [0.0], "P", color="0.3", ms=8, label=f"{enc['other']} (origin)")
     handles = ax.get_lines()
     handles = [h for h in handles if not h.get_label().startswith("_")] + [
