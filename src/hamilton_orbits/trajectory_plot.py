@@ -4,7 +4,8 @@ path about the primary (:func:`plot_trajectory`, ``Trajectory.plot()``).
 What it draws: each body's positions relative to the primary (the most massive
 body at the end of the run) in the chosen plane, a line through the outputs (dots
 when they are too sparse for a line to follow the orbit), an open circle where
-the body starts with an arrow along its first motion, a filled dot where it ends,
+the body starts with an arrow along its first motion (along -v on a backward run:
+the way the path is drawn, in the outputs' order), a filled dot where it ends,
 and the primary as a cross at the origin.  A merge (``traj.events``) breaks the
 kept body's line (no path joins its last output before the merge to the merged
 body's first) and is marked with a red cross at the merged body's first output;
@@ -74,6 +75,9 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     primary = primary_index(traj)
     rel = r if primary is None else r - r[:, primary:primary + 1]
     vel = v[0] if primary is None else v[0] - v[0, primary]
+    t = np.asarray(getattr(traj.t, "value", traj.t), dtype=float).ravel()
+    if t.size > 1 and t[-1] < t[0]:  # a backward run: drawn along -v (the outputs' order)
+        vel = -vel
     if unit is not None and within_extent(rel, SMALL_EXTENT_AU):  # (a satellite's orbit in
         # au: ticks of +-4 under an offset of 1e-5)
         rel, unit = rel * AU_KM, "km"
@@ -104,9 +108,14 @@ def plot_trajectory(traj: Any, plane: str = "xy", ax: Any = None) -> Any:
     ax.set_xlabel(f"{'xyz'[i]} from {about}{suffix}")
     ax.set_ylabel(f"{'xyz'[j]} from {about}{suffix}")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_title(f"{traj.method}: paths about {about} "
+    t_unit = f" {traj.t.unit.to_string()}" if hasattr(traj.t, "unit") else (
+        " (the system's time unit)")
+    span = (f", t = {t[0]:.4g}{t_unit}" if t.size == 1 else
+            f", t = {t[0]:.4g} \N{RIGHTWARDS ARROW} {t[-1]:.4g}{t_unit}"
+            + (" (backwards)" if t[-1] < t[0] else "")) if t.size else ""
+    ax.set_title(f"{traj.method}: paths about {about}{span}\n"
                  f"(open circle: start; dot: end)" + (
-                     "\n(a merged body's path ends at its last output before the merge)"
+                     "\n(an absorbed body's path ends at its last output before the merge)"
                      if merges else ""), fontsize=10)
     if len(traj.names) > 5:
         ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
@@ -187,7 +196,7 @@ def _merges(traj: Any, r: np.ndarray) -> list[tuple[int, int, int, str]]:
 def _path(ax: Any, x: np.ndarray, y: np.ndarray, v0: tuple[float, float], name: str,
           breaks: list[int] = (), absorbed: bool = False) -> None:
     """One body's path: a line (dots when the outputs are sparse), its start with an
-    arrow along its velocity there, and its end (none for a body absorbed in a merge:
+    arrow along ``v0`` (its motion as drawn), and its end (none for a body absorbed in a merge:
     its path stops at its last output before it); the line broken (a NaN) before
     each output index of ``breaks``, the first after a merge that kept it."""
     ok = np.isfinite(x) & np.isfinite(y)  # a body an event took out ends there

@@ -160,3 +160,24 @@ def test_a_merge_breaks_the_kept_body_s_line_and_is_marked():
     assert (rel[m - 1, 2, 0], rel[m - 1, 2, 1]) not in ends  # pb: no ordinary end
     assert (rel[-1, 1, 0], rel[-1, 1, 1]) in ends
     plt.close(fig)
+
+
+def test_a_backward_run_s_arrow_follows_the_drawn_motion_and_the_title_says_so():
+    """The arrow (the "first motion") followed v at t = 0 while the path was drawn
+    the other way, and the title did not say time ran backwards."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    traj = integrate(s, np.linspace(0, -3.0, 31))
+    fig = traj.plot()
+    ax = fig.axes[0]
+    (arrow,) = ax.texts
+    d = np.subtract(arrow.xy, arrow.xyann)
+    drawn = (traj.r[1, 1] - traj.r[0, 1])[:2]  # from the first output to the second
+    assert d @ drawn > 0 and d[1] < 0  # along -v (v = +y at the start)
+    assert "t = 0 \N{RIGHTWARDS ARROW} -3 (the system's time unit) (backwards)" in \
+        ax.get_title()
+    plt.close(fig)
+    q = System.solar_system("J2000", bodies=["sun", "earth"])
+    fig = integrate(q, np.linspace(0, -0.25, 11) * u.yr).plot()
+    assert "t = 0 \N{RIGHTWARDS ARROW} -0.25 yr (backwards)" in fig.axes[0].get_title()
+    plt.close(fig)
