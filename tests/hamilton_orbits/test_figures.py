@@ -250,3 +250,25 @@ def test_a_distance_still_closing_at_a_removal_is_not_called_the_closest_approac
         assert not any("closest approach (" in t for t in labels)
         assert any(t.startswith("comet at the last output before comet was removed") or
                    t.startswith("the last output before comet was removed") for t in labels)
+
+
+def test_perihelion_outputs_are_points_under_the_fit_and_two_points_make_no_fit(mercury):
+    """The lower panel joined thousands of osculating samples swinging +-0.08" within
+    each orbit: a solid block over the fit and GR lines.  Two outputs were "a
+    least-squares fit of 43.01"/century"."""
+    fig = _figure(mercury, "perihelion")
+    for ax in fig.axes:
+        (samples,) = [ln for ln in ax.get_lines() if ln.get_label().startswith("mercury")
+                      or ln.get_linestyle() == "None"]
+        assert samples.get_linestyle() == "None" and samples.get_marker() == "."
+        over = [ln for ln in ax.get_lines() if ln is not samples]
+        assert len(over) == 2 and all(ln.get_zorder() > samples.get_zorder() for ln in over)
+    assert any(t.startswith("least-squares fit") for t in
+               fig.axes[0].get_legend_handles_labels()[1])
+    short = Scene.bundled("mercury-gr").with_values(
+        {"duration": "88 d", "cadence": "88 d"}).run(progress=False)
+    fig = _figure(short, "perihelion")
+    ax, ax2 = fig.axes
+    labels = ax.get_legend_handles_labels()[1]
+    assert not any("fit" in t for t in labels) and not ax2.get_lines()
+    assert "too few orbits run for a fit" in ax2.texts[0].get_text()

@@ -98,6 +98,8 @@ def _perihelion_advance(result: Result, system, an: dict) -> None:
     result.diagnostics["perihelion"] = {  # for the figure of the advance
         "body": an["body"], "times": result.times[rows],
         "varpi": np.unwrap(orbits.varpi.to_value(u.rad)) * u.rad, "rate": rate,
+        "orbits": float(((result.times[rows[-1]] - result.times[rows[0]])
+                         / np.atleast_1d(orbits.period)[0]).to_value(u.one)),
         "gr": any(e.get("name") == "gr" for e in result.scene.effects)}
     result.plotters.append(plot_perihelion)
 

@@ -69,10 +69,17 @@ def plot_de440(result: Result):
 GR_MERCURY = 42.98  # arcsec per century: 6 pi GM / (c^2 a (1 - e^2)) per orbit (REFERENCES.md)
 
 
+FIT_ORBITS = 2  # orbits run, at least, for the least-squares line to be drawn as a fit
+
+
 def plot_perihelion(result: Result):
     """The advance of the longitude of perihelion against time (the osculating
-    two-body orbit at each output), the least-squares line whose slope is the
-    scene's rate, and, for Mercury with ``gr``, the relativistic 42.98"/cy."""
+    two-body orbit at each output, drawn as points: it swings within each orbit,
+    ~0.08" for Mercury, and a line through thousands of outputs was a solid block
+    over the fit), the least-squares line whose slope is the scene's rate (above
+    the points; not drawn, and the figure says why, over fewer than
+    :data:`FIT_ORBITS` orbits or 3 outputs: two points make no fit), and, for
+    Mercury with ``gr``, the relativistic 42.98"/cy."""
     import matplotlib.pyplot as plt
 
     per = result.diagnostics["perihelion"]
@@ -81,25 +88,44 @@ def plot_perihelion(result: Result):
     rate = per["rate"].to_value(u.arcsec / (100 * u.yr)) / 100  # arcsec per year
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True,
                                   height_ratios=(2, 1))
-    fit = adv.mean() + rate * (t - t.mean())
-    lines = [(adv, dict(lw=0.7, color="C0"),
-              f"{per['body']}: osculating perihelion longitude at each output"),
-             (fit, dict(lw=1.2, color="C3", ls="--"),
-              f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)")]
+    orbits = per.get("orbits", np.inf)
+    fitted = len(t) >= 3 and orbits >= FIT_ORBITS
+    fit = adv.mean() + rate * (t - t.mean()) if fitted else adv
+    dense = len(t) > 2000  # (pale small points, the lines over them seen)
+    points = dict(ls="none", marker=".", ms=1 if dense else 4, color="C0",
+                  alpha=0.35 if dense else 1.0, zorder=1)
+    lines = [(adv, points, f"{per['body']}: osculating perihelion longitude at each output")]
+    if fitted:
+        lines.append((fit, dict(lw=1.6, color="C3", ls="--", zorder=3),
+                      f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)"))
     if per["body"] == "mercury" and per["gr"]:
-        lines.append((GR_MERCURY / 100 * (t - t[0]), dict(lw=1.0, color="k", ls=":"),
+        lines.append((GR_MERCURY / 100 * (t - t[0]),
+                      dict(lw=1.6, color="k", ls=":", zorder=3),
                       f"general relativity: {GR_MERCURY}\"/century (Einstein 1915; "
                       "REFERENCES.md)"))
     for y, style, label in lines:
         ax.plot(t, y, label=label, **style)
-        ax2.plot(t, y - fit, **style)
+        if fitted:
+            ax2.plot(t, y - fit, **style)
     ax.set_ylabel("advance of the longitude of\nperihelion since the start [arcsec]",
                   fontsize=9)
-    ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
     ax2.set_xlabel("time since the start [yr]")
+    if fitted:
+        ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
+    else:
+        ax2.set_ylabel("(no fit)", fontsize=9)
+        ax2.set_yticks([])
+        ax2.text(0.5, 0.5, f"too few orbits run for a fit: {orbits:.3g} orbit(s), "
+                 f"{len(t)} outputs\n(a rate needs at least {FIT_ORBITS} orbits: the "
+                 "osculating perihelion swings within each)", ha="center", va="center",
+                 fontsize=9, transform=ax2.transAxes)
     ax.set_title(f"{result.scene.name}: perihelion advance of {per['body']}", fontsize=10)
-    ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
-               bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
+    legend = ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
+                        bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
+    for handle in legend.legend_handles:
+        if handle.get_marker() == ".":
+            handle.set_markersize(5)
+            handle.set_alpha(1.0)
     fig.tight_layout()
     fig.set_label("perihelion")  # the file name Result.save gives it
     return fig
