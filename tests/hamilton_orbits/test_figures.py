@@ -272,3 +272,41 @@ def test_perihelion_outputs_are_points_under_the_fit_and_two_points_make_no_fit(
     labels = ax.get_legend_handles_labels()[1]
     assert not any("fit" in t for t in labels) and not ax2.get_lines()
     assert "too few orbits run for a fit" in ax2.texts[0].get_text()
+
+
+def _fake_result(n=101, **diagnostics):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(times=np.linspace(0.0, 100.0, n) * u.yr, diagnostics=diagnostics,
+                           scene=SimpleNamespace(name="fake"))
+
+
+def test_an_energy_change_names_its_scale_in_the_label_not_an_offset():
+    """de440-century: a "1e-9" above the y axis, apart from its label."""
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.scenes.nbody.figures import plot_energy
+
+    change = 2e-9 * np.sin(np.arange(101.0))
+    fig = plot_energy(_fake_result(energy_error=change), "the total energy", conserved=False)
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    assert ax.yaxis.get_offset_text().get_text() == ""
+    assert "[$10^{-9}$]" in ax.get_ylabel() and "dimensionless" in ax.get_ylabel()
+    (points,) = [ln for ln in ax.get_lines() if ln.get_label() == "hamilton-orbits"]
+    np.testing.assert_allclose(points.get_ydata(), change[1:] * 1e9, rtol=1e-12)
+    plt.close(fig)
+
+
+def test_megno_is_drawn_from_the_first_output_after_the_start():
+    """MEGNO's value at t = 0 (0 by definition) was drawn: a spike from 0."""
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.scenes.nbody.figures import plot_megno
+
+    megno = np.concatenate([[0.0], 2.0 + 1.0 / np.arange(1.0, 11.0)])
+    fig = plot_megno(_fake_result(11, megno=megno))
+    (line,) = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("MEGNO")]
+    assert line.get_xdata()[0] > 0 and line.get_ydata().min() > 2.0
+    np.testing.assert_array_equal(line.get_ydata(), megno[1:])
+    plt.close(fig)

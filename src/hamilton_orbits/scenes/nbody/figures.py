@@ -14,12 +14,16 @@ from hamilton_orbits.scenes.result import Result
 
 
 def plot_megno(result: Result):
-    """MEGNO against time (``variational = true``)."""
+    """MEGNO against time (``variational = true``), from the first output after the
+    start: MEGNO's value at t = 0 is its initial value (0, by definition), not a
+    measurement, and drawn it made a spike from 0 at the start."""
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.4))
     t = result.times.to_value(u.yr)
-    ax.plot(t, result.diagnostics["megno"], lw=0.8, label="MEGNO <Y>")
+    after = t != 0  # (the outputs after the start)
+    megno = np.asarray(result.diagnostics["megno"], dtype=float)[after]
+    ax.plot(t[after], megno, lw=0.8, label="MEGNO <Y> (from the first output after t = 0)")
     ax.axhline(2.0, color="0.6", lw=0.6, ls=":", label="2 (quasi-periodic)")
     ax.set_xlabel("time [yr]")
     ax.set_ylabel("MEGNO <Y> (dimensionless)")
@@ -654,13 +658,21 @@ def _log_errors(ax: Any, t: np.ndarray, err: np.ndarray, label: str, style: dict
 
 def _energy_change(fig: Any, ax: Any, result: Result, t: np.ndarray, t_unit: Any,
                    series: list, what: str) -> Any:
-    """:func:`plot_energy` of an energy the effects change: signed, linear axis."""
-    for label, values, style in series:
-        change = np.asarray(values[1:], dtype=float)
+    """:func:`plot_energy` of an energy the effects change: signed, linear axis, the
+    values in units of a power of ten the axis's label names (matplotlib's "1e-9"
+    above the axis, apart from its label, was easily missed)."""
+    changes = [np.asarray(values[1:], dtype=float) for _, values, _ in series]
+    finite = np.abs(np.concatenate(changes))
+    finite = finite[np.isfinite(finite) & (finite > 0)]
+    power = int(np.floor(np.log10(finite.max()))) if finite.size else 0
+    power = power if not -3 <= power <= 3 else 0
+    for (label, _, style), change in zip(series, changes, strict=True):
         style = {"marker": ".", "ms": 2, **style}
-        ax.plot(t[1:], change, ls="none", label=label, **style)
+        ax.plot(t[1:], change / 10.0**power, ls="none", label=label, **style)
     ax.axhline(0.0, color="0.5", lw=0.7)
-    ax.set_ylabel("relative energy change, signed (dimensionless)")
+    ax.ticklabel_format(axis="y", style="plain", useOffset=False)
+    scale = f" [$10^{{{power}}}$]" if power else ""
+    ax.set_ylabel(f"relative energy change, signed{scale}\n(dimensionless)")
     return _energy_frame(fig, ax, result, t_unit,
                          "energy change (not an error: not conserved)", what)
 
