@@ -310,3 +310,39 @@ def test_megno_is_drawn_from_the_first_output_after_the_start():
     assert line.get_xdata()[0] > 0 and line.get_ydata().min() > 2.0
     np.testing.assert_array_equal(line.get_ydata(), megno[1:])
     plt.close(fig)
+
+
+def test_a_merge_breaks_the_kept_body_s_track_in_the_scene_s_orbit_figure():
+    """pa's line ran from its last output before the merge to the pair's centre of
+    mass, a path no body travelled, with nothing marking the merge."""
+    def planet(name, gm, y, vy):
+        return {"name": name, "gm": f"{gm} km3 / s2", "radius": "0.05 au",
+                "r": ["1.0 au", f"{y} au", "0 au"], "v": ["0 au / d", f"{vy} au / d", "0 au / d"]}
+
+    result = Scene.from_dict({
+        "kind": "nbody", "description": "two planets merging", "duration": "0.3 yr",
+        "cadence": "2 d", "crosscheck": False, "effects": [],
+        "events": [{"name": "collision", "action": "merge"}],
+        "integrator": {"method": "radau15"},
+        "bodies": [{"name": "sun", "gm": "1.32712440018e11 km3 / s2", "radius": "0.005 au",
+                    "r": ["0 au", "0 au", "0 au"], "v": ["0 au / d", "0 au / d", "0 au / d"]},
+                   planet("pa", 1.32712440018e8, 0, 0.01720209895),
+                   planet("pb", 2.65424880036e8, 0.3, 0.01376167916)],
+    }).run(progress=False)
+    (event,) = result.tables["events"]
+    assert event["bodies"] == "pa-pb" and event["action"] == "merge"
+    r = result.states["r"].to_value(u.au)
+    m = int(np.argmax(~np.isfinite(r[:, 2, 0])))  # pb's first NaN: the first output after
+    rel = r[:, 1] - r[:, 0]
+    ax = _figure(result, "orbits").axes[0]
+    (pa,) = [ln for ln in ax.get_lines() if ln.get_label() == "pa"]
+    xy = pa.get_xydata()
+    gap = np.flatnonzero(np.isnan(xy[:, 0]))
+    assert gap.size == 1  # one break, between the last output before and the first after
+    assert xy[gap[0] - 1].tolist() == rel[m - 1, :2].tolist()
+    assert xy[gap[0] + 1].tolist() == rel[m, :2].tolist()
+    (mark,) = [ln for ln in ax.get_lines() if ln.get_gid() == "merge"]
+    assert mark.get_xydata()[0].tolist() == rel[m, :2].tolist()
+    assert mark.get_label().startswith("merge: pb into pa")
+    assert mark in ax.get_legend().legend_handles or any(
+        t.get_text() == mark.get_label() for t in ax.get_legend().get_texts())

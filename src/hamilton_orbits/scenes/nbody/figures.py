@@ -411,6 +411,67 @@ def _draw_ends(ax: Any, view: dict, k: int, color: Any) -> None:
                 label="_nolegend_")
 
 
+def _track(view: dict, k: int) -> tuple[np.ndarray, bool]:
+    """:func:`refined_track` of body ``k`` over each run of outputs where it exists,
+    split too at a merge that kept it (``view["merges"]``: no line, nor Kepler arc
+    from the state before, to the merged body's first output), the runs joined by
+    a NaN row."""
+    r, v, t = view["rel"][:, k], view["vrel"][:, k], view["t"]
+    here = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(v), axis=-1)
+    cut = np.zeros(len(t), bool)
+    cut[1:] = here[1:] != here[:-1]
+    for kept, _, m, _ in view.get("merges", ()):
+        if kept == k:
+            cut[m] = True
+    parts, refined = [], False
+    for rows in np.split(np.arange(len(t)), np.flatnonzero(cut)):
+        if rows.size and here[rows[0]]:
+            pts, more = refined_track(t[rows], r[rows], v[rows], view["mu"][k])
+            parts += [pts, np.full((1, 3), np.nan)]
+            refined |= more
+    return (np.vstack(parts[:-1]) if parts else r[:0]), refined
+
+
+def _merges(result: Result, names: list[str], r: np.ndarray) -> list:
+    """The merges of the run's events table: (the body kept, the body absorbed, the
+    first output after the merge, its time as text), the absorbed body the one of
+    the pair whose positions end at that output."""
+    pairs = {f"{a}-{b}": (ka, kb) for ka, a in enumerate(names)
+             for kb, b in enumerate(names) if ka != kb}
+    t = result.times.to_value(u.yr)
+    found = np.all(np.isfinite(r), axis=-1)
+    out = []
+    for row in result.tables.get("events", []):
+        pair = pairs.get(str(row["bodies"]))
+        if str(row["action"]) != "merge" or pair is None:
+            continue
+        when = row["time"].to_value(u.yr)
+        ends = {}
+        for k in pair:
+            present = np.flatnonzero(found[:, k])
+            if present.size and present[-1] + 1 < len(t):
+                ends[k] = int(present[-1]) + 1
+        if ends:
+            gone = min(ends, key=lambda k: abs(t[ends[k]] - when))
+            kept = pair[0] if gone == pair[1] else pair[1]
+            out.append((kept, gone, ends[gone], f"{when:.3g} yr"))
+    return out
+
+
+def _draw_merges(ax: Any, view: dict, shown: list[str]) -> list:
+    """A red cross at the merged body's first output after each merge (its line is
+    broken there: :func:`_track`)."""
+    handles = []
+    for kept, gone, m, when in view.get("merges", ()):
+        if view["names"][kept] in shown and kept != view["index"]:
+            x, y = view["rel"][m, kept, :2]
+            (h,) = ax.plot([x], [y], "X", ms=9, color="crimson", mec="k", mew=0.5,
+                           gid="merge", label=f"merge: {view['names'][gone]} into "
+                           f"{view['names'][kept]} at {when}\n(the merged body's first output)")
+            handles.append(h)
+    return handles
+
+
 def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> set[str]:
     """One body's track, its start marker and an arrow along its first velocity;
     what was drawn: "dots" if its outputs are drawn as dots on Kepler arcs, "arcs"
@@ -425,8 +486,7 @@ def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> se
                 else "_nolegend_")
         pts, refined = view["rel"][:, k], False
     else:
-        pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
-                                     view["mu"][k])
+        pts, refined = _track(view, k)
         ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
                 alpha=0.3 if many else 1.0, label=label or "_nolegend_")
     dots = refined and np.mean(np.diff(view["t"])) > period / PER_ORBIT  # sparse outputs
@@ -484,6 +544,7 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
             f"{len(rest)} more: {', '.join(rest[:3])}, ..." if len(rest) > 3
             else ", ".join(rest))))
     handles += _draw_encounter(ax, view, shown)
+    handles += _draw_merges(ax, view, shown)
     (sun,) = ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
                      label=f"{primary} (origin)")
     handles.append(sun)
@@ -526,6 +587,7 @@ def _orbit_data(result: Result, gm: np.ndarray) -> dict:
     unit = (u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d
             else u.h if cadence >= 1 * u.h else u.min)
     view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
+    view["merges"] = _merges(result, names, view["rel"])
     enc = result.diagnostics.get("close_approach")
     if enc is not None:
         text = f"{enc['distance'].to_value(u.au):.3g} au at {enc['time'].to_value(u.yr):.3g} yr"
@@ -553,7 +615,7 @@ def _draw_flyby(ax: Any, view: dict, frame: str) -> None:
     rows = np.arange(near.min(), near.max() + 1)
     mu = (view["gm"][i] + view["gm"][j]) * view["scale"] ** 3
     sub = dict(view, t=view["t"][rows], rel=d[rows][:, None], vrel=w[rows][:, None],
-               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max())
+               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max(), merges=[])
     color = PALETTE[view["named"].index(enc["body"]) % len(PALETTE)]
     _draw_body(ax, sub, 0, color, f"{enc['body']}, from {enc['other']}")
     x, y = d[enc["row"], :2]
