@@ -120,3 +120,28 @@ def test_pole_prediction_quick(tmp_path):
     for png in ("prediction_fan", "mae_vs_horizon", "coverage"):
         assert (tmp_path / f"{png}.png").stat().st_size > 10_000
     assert (tmp_path / "pole_prediction.txt").read_text().startswith("scene pole-prediction")
+
+
+def test_comet_encounter_colours_a_body_alike_and_its_legend_hides_no_data(monkeypatch):
+    """The legend covered the comet - Jupiter curve after closest approach, and blue
+    was the comet - Sun distance in one panel and Jupiter in the other."""
+    import runpy
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    monkeypatch.setattr(plt, "show", lambda *a, **k: None)
+    runpy.run_path(str(EXAMPLES / "events" / "plot_comet_encounter.py"), run_name="__main__")
+    fig = plt.figure(plt.get_fignums()[-1])
+    ax1, ax2 = fig.axes
+    colour = {ln.get_label(): matplotlib.colors.to_hex(ln.get_color())
+              for ax in (ax1, ax2) for ln in ax.get_lines()}
+    assert colour["comet - Jupiter"] == colour["Jupiter"]
+    assert colour["comet - Sun"] == colour["Sun"] != colour["comet"]
+    assert colour["comet"] not in (colour["Jupiter"], colour["Sun"])
+    fig.canvas.draw()
+    legend = ax1.get_legend().get_window_extent()
+    assert legend.y1 <= ax1.get_window_extent().y0  # below the axes, over no data
+    plt.close("all")

@@ -207,3 +207,142 @@ def test_rigid_earth_figure_shows_the_wobble_in_mas_and_years():
     # the scene's 0.2 arcsec offset of the rotation axis from the figure axis
     assert amplitude == pytest.approx(200.0, rel=0.01)
     assert "principal axes" in result.summary()
+
+
+def test_a_removed_body_leaves_the_orbit_figure_in_au():
+    """A body removed or merged is NaN after it left: the largest distance was NaN,
+    "above 0.01 au" false, and a 6 au orbit was drawn in km with 1e9 offsets."""
+    from hamilton_orbits.scenes.nbody.figures import orbit_view
+
+    r = np.zeros((3, 3, 3))
+    r[:, 1, 0] = 5.2
+    r[:, 2, 0] = [1.0, 2.0, np.nan]
+    view = orbit_view(["sun", "jupiter", "comet"], np.array([1.0, 1e-3, 0.0]), r)
+    assert view["unit"] == "au" and view["reach"].tolist() == [0.0, 5.2, 2.0]
+
+
+def test_a_distance_still_closing_at_a_removal_is_not_called_the_closest_approach():
+    """The comet is removed at 5 au from the Sun still closing on Jupiter: its last
+    distance is no closest approach (the figure said "the closest approach (0.046 au)")."""
+    comet = {"name": "comet", "gm": "0 km3 / s2", "primary": "sun", "q": "0.01 au",
+             "e": 0.9999, "inc": "36.003522070993 deg", "lan": "32.42821444595107 deg",
+             "argp": "222.42981967246678 deg", "M": "-0.016637268139259004 deg"}
+    result = Scene.from_dict({
+        "kind": "nbody", "description": "comet removed", "duration": "1 yr",
+        "cadence": "1 d", "crosscheck": False, "effects": [],
+        "events": [{"name": "escape", "distance": "5 au", "bodies": ["comet"],
+                    "action": "remove"}],
+        "integrator": {"method": "radau15"},
+        "initial": {"solar_system": {"epoch": "J2000", "bodies": ["sun", "jupiter"]}},
+        "bodies": [comet],
+        "analysis": [{"name": "close_approach", "body": "comet", "other": "jupiter"}],
+    }).run(progress=False)
+    assert result.metrics["closest approach comet-jupiter"].startswith(
+        "not reached: ") and "comet was removed" in result.metrics[
+        "closest approach comet-jupiter"]
+    fig = _figure(result, "orbits")
+    for ax in fig.axes:
+        assert ax.get_xlabel().endswith("[au]") and ax.get_ylabel().endswith("[au]")
+        fig.canvas.draw()
+        assert ax.xaxis.get_offset_text().get_text() == ""
+        assert ax.yaxis.get_offset_text().get_text() == ""
+        labels = [h.get_label() for h in ax.get_legend().legend_handles]
+        assert not any("closest approach (" in t for t in labels)
+        assert any(t.startswith("comet at the last output before comet was removed") or
+                   t.startswith("the last output before comet was removed") for t in labels)
+
+
+def test_perihelion_outputs_are_points_under_the_fit_and_two_points_make_no_fit(mercury):
+    """The lower panel joined thousands of osculating samples swinging +-0.08" within
+    each orbit: a solid block over the fit and GR lines.  Two outputs were "a
+    least-squares fit of 43.01"/century"."""
+    fig = _figure(mercury, "perihelion")
+    for ax in fig.axes:
+        (samples,) = [ln for ln in ax.get_lines() if ln.get_label().startswith("mercury")
+                      or ln.get_linestyle() == "None"]
+        assert samples.get_linestyle() == "None" and samples.get_marker() == "."
+        over = [ln for ln in ax.get_lines() if ln is not samples]
+        assert len(over) == 2 and all(ln.get_zorder() > samples.get_zorder() for ln in over)
+    assert any(t.startswith("least-squares fit") for t in
+               fig.axes[0].get_legend_handles_labels()[1])
+    short = Scene.bundled("mercury-gr").with_values(
+        {"duration": "88 d", "cadence": "88 d"}).run(progress=False)
+    fig = _figure(short, "perihelion")
+    ax, ax2 = fig.axes
+    labels = ax.get_legend_handles_labels()[1]
+    assert not any("fit" in t for t in labels) and not ax2.get_lines()
+    assert "too few orbits run for a fit" in ax2.texts[0].get_text()
+
+
+def _fake_result(n=101, **diagnostics):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(times=np.linspace(0.0, 100.0, n) * u.yr, diagnostics=diagnostics,
+                           scene=SimpleNamespace(name="fake"))
+
+
+def test_an_energy_change_names_its_scale_in_the_label_not_an_offset():
+    """de440-century: a "1e-9" above the y axis, apart from its label."""
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.scenes.nbody.figures import plot_energy
+
+    change = 2e-9 * np.sin(np.arange(101.0))
+    fig = plot_energy(_fake_result(energy_error=change), "the total energy", conserved=False)
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    assert ax.yaxis.get_offset_text().get_text() == ""
+    assert "[$10^{-9}$]" in ax.get_ylabel() and "dimensionless" in ax.get_ylabel()
+    (points,) = [ln for ln in ax.get_lines() if ln.get_label() == "hamilton-orbits"]
+    np.testing.assert_allclose(points.get_ydata(), change[1:] * 1e9, rtol=1e-12)
+    plt.close(fig)
+
+
+def test_megno_is_drawn_from_the_first_output_after_the_start():
+    """MEGNO's value at t = 0 (0 by definition) was drawn: a spike from 0."""
+    import matplotlib.pyplot as plt
+
+    from hamilton_orbits.scenes.nbody.figures import plot_megno
+
+    megno = np.concatenate([[0.0], 2.0 + 1.0 / np.arange(1.0, 11.0)])
+    fig = plot_megno(_fake_result(11, megno=megno))
+    (line,) = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("MEGNO")]
+    assert line.get_xdata()[0] > 0 and line.get_ydata().min() > 2.0
+    np.testing.assert_array_equal(line.get_ydata(), megno[1:])
+    plt.close(fig)
+
+
+def test_a_merge_breaks_the_kept_body_s_track_in_the_scene_s_orbit_figure():
+    """pa's line ran from its last output before the merge to the pair's centre of
+    mass, a path no body travelled, with nothing marking the merge."""
+    def planet(name, gm, y, vy):
+        return {"name": name, "gm": f"{gm} km3 / s2", "radius": "0.05 au",
+                "r": ["1.0 au", f"{y} au", "0 au"], "v": ["0 au / d", f"{vy} au / d", "0 au / d"]}
+
+    result = Scene.from_dict({
+        "kind": "nbody", "description": "two planets merging", "duration": "0.3 yr",
+        "cadence": "2 d", "crosscheck": False, "effects": [],
+        "events": [{"name": "collision", "action": "merge"}],
+        "integrator": {"method": "radau15"},
+        "bodies": [{"name": "sun", "gm": "1.32712440018e11 km3 / s2", "radius": "0.005 au",
+                    "r": ["0 au", "0 au", "0 au"], "v": ["0 au / d", "0 au / d", "0 au / d"]},
+                   planet("pa", 1.32712440018e8, 0, 0.01720209895),
+                   planet("pb", 2.65424880036e8, 0.3, 0.01376167916)],
+    }).run(progress=False)
+    (event,) = result.tables["events"]
+    assert event["bodies"] == "pa-pb" and event["action"] == "merge"
+    r = result.states["r"].to_value(u.au)
+    m = int(np.argmax(~np.isfinite(r[:, 2, 0])))  # pb's first NaN: the first output after
+    rel = r[:, 1] - r[:, 0]
+    ax = _figure(result, "orbits").axes[0]
+    (pa,) = [ln for ln in ax.get_lines() if ln.get_label() == "pa"]
+    xy = pa.get_xydata()
+    gap = np.flatnonzero(np.isnan(xy[:, 0]))
+    assert gap.size == 1  # one break, between the last output before and the first after
+    assert xy[gap[0] - 1].tolist() == rel[m - 1, :2].tolist()
+    assert xy[gap[0] + 1].tolist() == rel[m, :2].tolist()
+    (mark,) = [ln for ln in ax.get_lines() if ln.get_gid() == "merge"]
+    assert mark.get_xydata()[0].tolist() == rel[m, :2].tolist()
+    assert mark.get_label().startswith("merge: pb into pa")
+    assert mark in ax.get_legend().legend_handles or any(
+        t.get_text() == mark.get_label() for t in ax.get_legend().get_texts())

@@ -131,3 +131,53 @@ def test_a_satellite_s_orbit_is_drawn_in_km():
     # (starts at periapsis, a (1 - e) = 6300 km along x: the node and periapsis there)
     assert path.get_xdata()[0] == pytest.approx(6300.0, rel=1e-12)
     plt.close(ax.figure)
+
+
+def test_a_merge_breaks_the_kept_body_s_line_and_is_marked():
+    """The kept body's line ran from its last output before the merge to the pair's
+    centre of mass, a path no body travelled, and nothing marked the merge."""
+    s = System([Body("star", 1.0, [0, 0, 0], [0, 0, 0], radius=0.005),
+                Body("pa", 1e-3, [1.0, 0, 0], [0, 1.0, 0], radius=0.05),
+                Body("pb", 2e-3, [1.0, 0.3, 0], [0, 0.8, 0], radius=0.05)])
+    traj = integrate(s, np.linspace(0, 2, 41), events=[{"name": "collision",
+                                                         "action": "merge"}])
+    (row,) = traj.events
+    assert row["bodies"] == "pa-pb" and row["action"] == "merge"
+    m = int(np.searchsorted(traj.t, row["time"]))  # the first output after it
+    assert np.isnan(traj.r[m, 2]).all() and np.isfinite(traj.r[m - 1, 2]).all()
+    fig = traj.plot()
+    ax = fig.axes[0]
+    rel = traj.r - traj.r[:, :1]
+    (pa,) = _lines(ax, "pa")
+    x = pa.get_xdata()
+    assert len(x) == len(traj.t) + 1 and np.isnan(x[m]) and np.isfinite(np.delete(x, m)).all()
+    np.testing.assert_array_equal(np.delete(x, m), rel[:, 1, 0])
+    (mark,) = [ln for ln in ax.lines if ln.get_gid() == "merge"]
+    assert "merge" in mark.get_label()
+    assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (rel[m, 1, 0], rel[m, 1, 1])
+    ends = [(float(ln.get_xdata()[0]), float(ln.get_ydata()[0])) for ln in ax.lines
+            if ln.get_marker() == "o" and ln.get_markerfacecolor() != "none"]
+    assert (rel[m - 1, 2, 0], rel[m - 1, 2, 1]) not in ends  # pb: no ordinary end
+    assert (rel[-1, 1, 0], rel[-1, 1, 1]) in ends
+    plt.close(fig)
+
+
+def test_a_backward_run_s_arrow_follows_the_drawn_motion_and_the_title_says_so():
+    """The arrow (the "first motion") followed v at t = 0 while the path was drawn
+    the other way, and the title did not say time ran backwards."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                Body("earth", 3e-6, [1.0, 0, 0], [0, 1.0, 0])])
+    traj = integrate(s, np.linspace(0, -3.0, 31))
+    fig = traj.plot()
+    ax = fig.axes[0]
+    (arrow,) = ax.texts
+    d = np.subtract(arrow.xy, arrow.xyann)
+    drawn = (traj.r[1, 1] - traj.r[0, 1])[:2]  # from the first output to the second
+    assert d @ drawn > 0 and d[1] < 0  # along -v (v = +y at the start)
+    assert "t = 0 \N{RIGHTWARDS ARROW} -3 (the system's time unit) (backwards)" in \
+        ax.get_title()
+    plt.close(fig)
+    q = System.solar_system("J2000", bodies=["sun", "earth"])
+    fig = integrate(q, np.linspace(0, -0.25, 11) * u.yr).plot()
+    assert "t = 0 \N{RIGHTWARDS ARROW} -0.25 yr (backwards)" in fig.axes[0].get_title()
+    plt.close(fig)

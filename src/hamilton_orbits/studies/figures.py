@@ -58,7 +58,7 @@ def _draw(ax: Any, rows: list[Row]) -> None:
     colours = matplotlib.colormaps["tab20"].colors  # 20 distinct: a problem has up to ~12 lines
     for k, ((code, method), rs) in enumerate(groups.items()):
         rs = sorted(rs, key=lambda r: r.wall_time)
-        ours = code == "hamilton-orbits"
+        ours = code.split(" ")[0] == "hamilton-orbits"  # ("hamilton-orbits radau15" too)
         ax.loglog([r.wall_time for r in rs], [r.error for r in rs], "-o" if ours else "--s",
                   color=colours[(2 * k) % 20 if k < 10 else (2 * k + 1) % 20],
                   label=f"{method} ({code})")
@@ -69,9 +69,32 @@ def _draw(ax: Any, rows: list[Row]) -> None:
     ax.set_title(f"{first.problem}: error vs wall time\nreference: {first.reference}",
                  fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    from matplotlib.ticker import NullFormatter
-
-    ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels overlapped on short spans
+    for axis in (ax.xaxis, ax.yaxis):
+        _minor_labels(axis)
     # below the axes: inside, a dozen entries hid the points they name
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2,
               frameon=False)
+
+
+def _minor_labels(axis: Any) -> None:
+    """Minor tick labels where the axis's view holds fewer than two powers of ten (one
+    label, or none, on a log axis spanning about a decade): at 2 and 5 times a power
+    of ten, at every minor tick over less than half a decade; none otherwise (every
+    minor label overlapped on long spans)."""
+    import math
+
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    lo, hi = sorted(axis.get_view_interval())
+    if lo <= 0 or math.floor(math.log10(hi)) - math.ceil(math.log10(lo)) + 1 >= 2:
+        axis.set_minor_formatter(NullFormatter())
+        return
+
+    def label(x: float, _pos: Any = None) -> str:
+        e = math.floor(math.log10(x) + 1e-9)
+        m = round(x / 10.0**e)
+        return rf"$\mathdefault{{{m}\times10^{{{e}}}}}$" if m in shown else ""
+
+    shown = range(1, 10) if math.log10(hi / lo) < 0.5 else (2, 5)
+
+    axis.set_minor_formatter(FuncFormatter(label))

@@ -4,6 +4,8 @@ closest approach, the residuals against DE440."""
 
 from __future__ import annotations
 
+import re
+
 import astropy.units as u
 import numpy as np
 
@@ -96,6 +98,8 @@ def _perihelion_advance(result: Result, system, an: dict) -> None:
     result.diagnostics["perihelion"] = {  # for the figure of the advance
         "body": an["body"], "times": result.times[rows],
         "varpi": np.unwrap(orbits.varpi.to_value(u.rad)) * u.rad, "rate": rate,
+        "orbits": float(((result.times[rows[-1]] - result.times[rows[0]])
+                         / np.atleast_1d(orbits.period)[0]).to_value(u.one)),
         "gr": any(e.get("name") == "gr" for e in result.scene.effects)}
     result.plotters.append(plot_perihelion)
 
@@ -120,6 +124,19 @@ def _nodal_regression(result: Result, system, an: dict) -> None:
         formula = formula.to(u.deg / u.d)
         result.metrics["J2 first-order formula"] = formula
         result.metrics["ratio simulated / formula"] = float(rate / formula)
+
+
+def _how_it_left(result: Result, row: int, *bodies: str) -> str:
+    """Which of ``bodies`` left the run after output ``row``, and how (the events
+    table's action), e.g. "comet was removed"."""
+    names = list(result.states["names"])
+    r = result.states["r"].to_value(u.au)[row + 1]
+    gone = [b for b in bodies if not np.all(np.isfinite(r[names.index(b)]))] or list(bodies)
+    actions = {str(e["action"]) for e in result.tables.get("events", [])
+               if set(gone) & set(re.split(r"[\s,-]+", str(e["bodies"])))}
+    verb = {"remove": "removed", "merge": "merged"}
+    how = " or ".join(sorted(verb.get(a, a) for a in actions)) or "removed or merged"
+    return f"{' and '.join(gone)} {'were' if len(gone) > 1 else 'was'} {how}"
 
 
 def _close_approach(result: Result, system, an: dict) -> None:
@@ -148,11 +165,21 @@ def _close_approach(result: Result, system, an: dict) -> None:
     ww = float(w[k] @ w[k])
     tau = float(np.clip(-(d[k] @ w[k]) / ww, lo, hi)) if ww > 0 else 0.0
     closest = float(np.linalg.norm(d[k] + w[k] * tau))
-    result.metrics[key] = closest * u.au
+    # the nearest output the last before a body left the run, still approaching: the
+    # closest approach was never reached (its distance is the last one, not a minimum)
+    reached = not (k == len(rows) - 1 and rows[-1] != len(result.times) - 1
+                   and float(d[k] @ w[k]) < 0)
+    ended = "" if reached else _how_it_left(result, rows[-1], an["body"], an["other"])
+    if reached:
+        result.metrics[key] = closest * u.au
+    else:
+        result.metrics[key] = (f"not reached: {closest:.6g} AU apart and closing at the "
+                               f"last output before {ended}")
     result.metrics["at time"] = ((t[k] + tau) * u.d).to(u.yr)
     result.diagnostics["close_approach"] = {  # marked on the orbit figure
         "body": an["body"], "other": an["other"], "row": int(rows[k]),
-        "distance": closest * u.au, "time": ((t[k] + tau) * u.d).to(u.yr)}
+        "distance": closest * u.au, "time": ((t[k] + tau) * u.d).to(u.yr),
+        "reached": reached, "ended": ended}
     primary = an.get("primary")
     if primary:
         rows = _rows_of(result, system, f"{an['body']} orbit", an["body"], primary, least=1)

@@ -14,12 +14,16 @@ from hamilton_orbits.scenes.result import Result
 
 
 def plot_megno(result: Result):
-    """MEGNO against time (``variational = true``)."""
+    """MEGNO against time (``variational = true``), from the first output after the
+    start: MEGNO's value at t = 0 is its initial value (0, by definition), not a
+    measurement, and drawn it made a spike from 0 at the start."""
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.4))
     t = result.times.to_value(u.yr)
-    ax.plot(t, result.diagnostics["megno"], lw=0.8, label="MEGNO <Y>")
+    after = t != 0  # (the outputs after the start)
+    megno = np.asarray(result.diagnostics["megno"], dtype=float)[after]
+    ax.plot(t[after], megno, lw=0.8, label="MEGNO <Y> (from the first output after t = 0)")
     ax.axhline(2.0, color="0.6", lw=0.6, ls=":", label="2 (quasi-periodic)")
     ax.set_xlabel("time [yr]")
     ax.set_ylabel("MEGNO <Y> (dimensionless)")
@@ -69,10 +73,17 @@ def plot_de440(result: Result):
 GR_MERCURY = 42.98  # arcsec per century: 6 pi GM / (c^2 a (1 - e^2)) per orbit (REFERENCES.md)
 
 
+FIT_ORBITS = 2  # orbits run, at least, for the least-squares line to be drawn as a fit
+
+
 def plot_perihelion(result: Result):
     """The advance of the longitude of perihelion against time (the osculating
-    two-body orbit at each output), the least-squares line whose slope is the
-    scene's rate, and, for Mercury with ``gr``, the relativistic 42.98"/cy."""
+    two-body orbit at each output, drawn as points: it swings within each orbit,
+    ~0.08" for Mercury, and a line through thousands of outputs was a solid block
+    over the fit), the least-squares line whose slope is the scene's rate (above
+    the points; not drawn, and the figure says why, over fewer than
+    :data:`FIT_ORBITS` orbits or 3 outputs: two points make no fit), and, for
+    Mercury with ``gr``, the relativistic 42.98"/cy."""
     import matplotlib.pyplot as plt
 
     per = result.diagnostics["perihelion"]
@@ -81,25 +92,44 @@ def plot_perihelion(result: Result):
     rate = per["rate"].to_value(u.arcsec / (100 * u.yr)) / 100  # arcsec per year
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True,
                                   height_ratios=(2, 1))
-    fit = adv.mean() + rate * (t - t.mean())
-    lines = [(adv, dict(lw=0.7, color="C0"),
-              f"{per['body']}: osculating perihelion longitude at each output"),
-             (fit, dict(lw=1.2, color="C3", ls="--"),
-              f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)")]
+    orbits = per.get("orbits", np.inf)
+    fitted = len(t) >= 3 and orbits >= FIT_ORBITS
+    fit = adv.mean() + rate * (t - t.mean()) if fitted else adv
+    dense = len(t) > 2000  # (pale small points, the lines over them seen)
+    points = dict(ls="none", marker=".", ms=1 if dense else 4, color="C0",
+                  alpha=0.35 if dense else 1.0, zorder=1)
+    lines = [(adv, points, f"{per['body']}: osculating perihelion longitude at each output")]
+    if fitted:
+        lines.append((fit, dict(lw=1.6, color="C3", ls="--", zorder=3),
+                      f"least-squares fit: {rate * 100:.2f}\"/century (the scene's rate)"))
     if per["body"] == "mercury" and per["gr"]:
-        lines.append((GR_MERCURY / 100 * (t - t[0]), dict(lw=1.0, color="k", ls=":"),
+        lines.append((GR_MERCURY / 100 * (t - t[0]),
+                      dict(lw=1.6, color="k", ls=":", zorder=3),
                       f"general relativity: {GR_MERCURY}\"/century (Einstein 1915; "
                       "REFERENCES.md)"))
     for y, style, label in lines:
         ax.plot(t, y, label=label, **style)
-        ax2.plot(t, y - fit, **style)
+        if fitted:
+            ax2.plot(t, y - fit, **style)
     ax.set_ylabel("advance of the longitude of\nperihelion since the start [arcsec]",
                   fontsize=9)
-    ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
     ax2.set_xlabel("time since the start [yr]")
+    if fitted:
+        ax2.set_ylabel("minus the fit [arcsec]", fontsize=9)
+    else:
+        ax2.set_ylabel("(no fit)", fontsize=9)
+        ax2.set_yticks([])
+        ax2.text(0.5, 0.5, f"too few orbits run for a fit: {orbits:.3g} orbit(s), "
+                 f"{len(t)} outputs\n(a rate needs at least {FIT_ORBITS} orbits: the "
+                 "osculating perihelion swings within each)", ha="center", va="center",
+                 fontsize=9, transform=ax2.transAxes)
     ax.set_title(f"{result.scene.name}: perihelion advance of {per['body']}", fontsize=10)
-    ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
-               bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
+    legend = ax2.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper center",
+                        bbox_to_anchor=(0.5, -0.32), ncol=1, frameon=False)
+    for handle in legend.legend_handles:
+        if handle.get_marker() == ".":
+            handle.set_markersize(5)
+            handle.set_alpha(1.0)
     fig.tight_layout()
     fig.set_label("perihelion")  # the file name Result.save gives it
     return fig
@@ -107,7 +137,8 @@ def plot_perihelion(result: Result):
 
 def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any]:
     """What the orbit figure draws: positions relative to the primary (the most
-    massive body), in km below 0.01 au of extent and au above, and the bodies of an
+    massive body), in km below 0.01 au of extent and au above (the outputs where a
+    body exists: NaN after a removal or a merge is left out), and the bodies of an
     inner panel (those inside the largest gap, by a factor 2.5 or more, in the
     bodies' largest distances from the primary, when the outermost is 5 times
     farther; without such a gap, when the outermost is 20 times farther than the
@@ -129,7 +160,8 @@ def orbit_view(names: list[str], gm: np.ndarray, r: np.ndarray) -> dict[str, Any
     """
     k = int(np.argmax(gm))
     rel = r - r[:, k:k + 1]
-    reach = np.linalg.norm(rel, axis=-1).max(axis=0)
+    # (NaN where a body was removed or merged: fmax skips it, 0 for a body never there)
+    reach = np.fmax.reduce(np.linalg.norm(rel, axis=-1), axis=0, initial=0.0)
     others = [i for i in range(len(names)) if i != k]
     unit = "au" if reach.max(initial=0.0) > 0.01 else "km"
     scale = 1.0 if unit == "au" else (1 * u.au).to_value(u.km)
@@ -379,6 +411,67 @@ def _draw_ends(ax: Any, view: dict, k: int, color: Any) -> None:
                 label="_nolegend_")
 
 
+def _track(view: dict, k: int) -> tuple[np.ndarray, bool]:
+    """:func:`refined_track` of body ``k`` over each run of outputs where it exists,
+    split too at a merge that kept it (``view["merges"]``: no line, nor Kepler arc
+    from the state before, to the merged body's first output), the runs joined by
+    a NaN row."""
+    r, v, t = view["rel"][:, k], view["vrel"][:, k], view["t"]
+    here = np.all(np.isfinite(r), axis=-1) & np.all(np.isfinite(v), axis=-1)
+    cut = np.zeros(len(t), bool)
+    cut[1:] = here[1:] != here[:-1]
+    for kept, _, m, _ in view.get("merges", ()):
+        if kept == k:
+            cut[m] = True
+    parts, refined = [], False
+    for rows in np.split(np.arange(len(t)), np.flatnonzero(cut)):
+        if rows.size and here[rows[0]]:
+            pts, more = refined_track(t[rows], r[rows], v[rows], view["mu"][k])
+            parts += [pts, np.full((1, 3), np.nan)]
+            refined |= more
+    return (np.vstack(parts[:-1]) if parts else r[:0]), refined
+
+
+def _merges(result: Result, names: list[str], r: np.ndarray) -> list:
+    """The merges of the run's events table: (the body kept, the body absorbed, the
+    first output after the merge, its time as text), the absorbed body the one of
+    the pair whose positions end at that output."""
+    pairs = {f"{a}-{b}": (ka, kb) for ka, a in enumerate(names)
+             for kb, b in enumerate(names) if ka != kb}
+    t = result.times.to_value(u.yr)
+    found = np.all(np.isfinite(r), axis=-1)
+    out = []
+    for row in result.tables.get("events", []):
+        pair = pairs.get(str(row["bodies"]))
+        if str(row["action"]) != "merge" or pair is None:
+            continue
+        when = row["time"].to_value(u.yr)
+        ends = {}
+        for k in pair:
+            present = np.flatnonzero(found[:, k])
+            if present.size and present[-1] + 1 < len(t):
+                ends[k] = int(present[-1]) + 1
+        if ends:
+            gone = min(ends, key=lambda k: abs(t[ends[k]] - when))
+            kept = pair[0] if gone == pair[1] else pair[1]
+            out.append((kept, gone, ends[gone], f"{when:.3g} yr"))
+    return out
+
+
+def _draw_merges(ax: Any, view: dict, shown: list[str]) -> list:
+    """A red cross at the merged body's first output after each merge (its line is
+    broken there: :func:`_track`)."""
+    handles = []
+    for kept, gone, m, when in view.get("merges", ()):
+        if view["names"][kept] in shown and kept != view["index"]:
+            x, y = view["rel"][m, kept, :2]
+            (h,) = ax.plot([x], [y], "X", ms=9, color="crimson", mec="k", mew=0.5,
+                           gid="merge", label=f"merge: {view['names'][gone]} into "
+                           f"{view['names'][kept]} at {when}\n(the merged body's first output)")
+            handles.append(h)
+    return handles
+
+
 def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> set[str]:
     """One body's track, its start marker and an arrow along its first velocity;
     what was drawn: "dots" if its outputs are drawn as dots on Kepler arcs, "arcs"
@@ -393,8 +486,7 @@ def _draw_body(ax: Any, view: dict, k: int, color: Any, label: str | None) -> se
                 else "_nolegend_")
         pts, refined = view["rel"][:, k], False
     else:
-        pts, refined = refined_track(view["t"], view["rel"][:, k], view["vrel"][:, k],
-                                     view["mu"][k])
+        pts, refined = _track(view, k)
         ax.plot(pts[:, 0], pts[:, 1], lw=0.6 if refined else 0.8, color=color,
                 alpha=0.3 if many else 1.0, label=label or "_nolegend_")
     dots = refined and np.mean(np.diff(view["t"])) > period / PER_ORBIT  # sparse outputs
@@ -425,9 +517,12 @@ def _draw_encounter(ax: Any, view: dict, shown: list[str]) -> list:
     for name, marker in ((enc["body"], "*"), (enc["other"], "P")):
         if name in shown and name != view["primary"]:
             x, y = view["rel"][enc["row"], view["names"].index(name), :2]
+            label = (f"{name} at {enc['what']}" if name == enc["body"] or enc["reached"]
+                     else f"{name} at that output")
+            if name == enc["body"]:
+                label += f" ({enc['text']})" if enc["reached"] else f"\n({enc['text']})"
             (h,) = ax.plot([x], [y], marker, ms=11, mfc="none", mec="crimson", mew=1.2,
-                           gid="encounter", label=f"{name} at the closest approach" +
-                           (f" ({enc['text']})" if name == enc["body"] else ""))
+                           gid="encounter", label=label)
             handles.append(h)
     return handles
 
@@ -449,6 +544,7 @@ def _draw_orbits(ax: Any, view: dict, shown: list[str], frame: str) -> None:
             f"{len(rest)} more: {', '.join(rest[:3])}, ..." if len(rest) > 3
             else ", ".join(rest))))
     handles += _draw_encounter(ax, view, shown)
+    handles += _draw_merges(ax, view, shown)
     (sun,) = ax.plot([0.0], [0.0], "o", color="orange", mec="k", mew=0.4, ms=6,
                      label=f"{primary} (origin)")
     handles.append(sun)
@@ -491,10 +587,17 @@ def _orbit_data(result: Result, gm: np.ndarray) -> dict:
     unit = (u.yr if cadence >= 100 * u.d else u.d if cadence >= 1 * u.d
             else u.h if cadence >= 1 * u.h else u.min)
     view["cadence_text"] = f"{cadence.to_value(unit):.3g} {unit}"
+    view["merges"] = _merges(result, names, view["rel"])
     enc = result.diagnostics.get("close_approach")
     if enc is not None:
-        view["encounter"] = {**enc, "text": f"{enc['distance'].to_value(u.au):.3g} au "
-                                            f"at {enc['time'].to_value(u.yr):.3g} yr"}
+        text = f"{enc['distance'].to_value(u.au):.3g} au at {enc['time'].to_value(u.yr):.3g} yr"
+        reached = enc.get("reached", True)
+        if not reached:  # (closing at the last output before a body left the run)
+            text = (f"{enc['distance'].to_value(u.au):.3g} au from {enc['other']} at "
+                    f"{enc['time'].to_value(u.yr):.3g} yr,\nstill closing: the closest "
+                    "approach was not reached")
+        view["encounter"] = {**enc, "text": text, "reached": reached, "what": (
+            "the closest approach" if reached else f"the last output before {enc['ended']}")}
     return view
 
 
@@ -512,12 +615,13 @@ def _draw_flyby(ax: Any, view: dict, frame: str) -> None:
     rows = np.arange(near.min(), near.max() + 1)
     mu = (view["gm"][i] + view["gm"][j]) * view["scale"] ** 3
     sub = dict(view, t=view["t"][rows], rel=d[rows][:, None], vrel=w[rows][:, None],
-               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max())
+               mu=np.array([mu]), extent=np.abs(d[rows, :2]).max(), merges=[])
     color = PALETTE[view["named"].index(enc["body"]) % len(PALETTE)]
     _draw_body(ax, sub, 0, color, f"{enc['body']}, from {enc['other']}")
     x, y = d[enc["row"], :2]
     ax.plot([x], [y], "*", ms=11, mfc="none", mec="crimson", mew=1.2, gid="encounter",
-            label=f"the output nearest the closest approach ({enc['text']})")
+            label=(f"the output nearest the closest approach ({enc['text']})"
+                   if enc["reached"] else f"{enc['what']}\n({enc['text']})"))
     ax.plot([0.0], [0.0], "P", color="0.3", ms=8, label=f"{enc['other']} (origin)")
     handles = ax.get_lines()
     handles = [h for h in handles if not h.get_label().startswith("_")] + [
@@ -616,13 +720,21 @@ def _log_errors(ax: Any, t: np.ndarray, err: np.ndarray, label: str, style: dict
 
 def _energy_change(fig: Any, ax: Any, result: Result, t: np.ndarray, t_unit: Any,
                    series: list, what: str) -> Any:
-    """:func:`plot_energy` of an energy the effects change: signed, linear axis."""
-    for label, values, style in series:
-        change = np.asarray(values[1:], dtype=float)
+    """:func:`plot_energy` of an energy the effects change: signed, linear axis, the
+    values in units of a power of ten the axis's label names (matplotlib's "1e-9"
+    above the axis, apart from its label, was easily missed)."""
+    changes = [np.asarray(values[1:], dtype=float) for _, values, _ in series]
+    finite = np.abs(np.concatenate(changes))
+    finite = finite[np.isfinite(finite) & (finite > 0)]
+    power = int(np.floor(np.log10(finite.max()))) if finite.size else 0
+    power = power if not -3 <= power <= 3 else 0
+    for (label, _, style), change in zip(series, changes, strict=True):
         style = {"marker": ".", "ms": 2, **style}
-        ax.plot(t[1:], change, ls="none", label=label, **style)
+        ax.plot(t[1:], change / 10.0**power, ls="none", label=label, **style)
     ax.axhline(0.0, color="0.5", lw=0.7)
-    ax.set_ylabel("relative energy change, signed (dimensionless)")
+    ax.ticklabel_format(axis="y", style="plain", useOffset=False)
+    scale = f" [$10^{{{power}}}$]" if power else ""
+    ax.set_ylabel(f"relative energy change, signed{scale}\n(dimensionless)")
     return _energy_frame(fig, ax, result, t_unit,
                          "energy change (not an error: not conserved)", what)
 
