@@ -407,7 +407,7 @@ def accelerations_quaternion(r: Any, gm: Any) -> Any:
     Returns
     -------
     ndarray or Quantity, shape (n, 3)
-        In au/day^2 for Quantities (as :meth:`hamilton_orbits.nbody.System.accelerations`);
+        In au/day^2 for Quantities (as ``System.accelerations``);
         else in the caller's units.
 
     Raises

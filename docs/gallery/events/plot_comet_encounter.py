@@ -59,20 +59,25 @@ q = KeplerOrbit.from_state(r[0, comet] - r[0, sun], v[0, comet] - v[0, sun],
                            GM_sun.to_value(u.au**3 / u.day**2)).q
 print(f"perihelion distance q of the two-body orbit at the start: {q:.4f} au")
 
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5))
-ax1.semilogy(t, d_sun, label="comet - Sun")
-ax1.semilogy(t, d_jup, label="comet - Jupiter")
+# One colour a body in both panels: the Sun orange, Jupiter blue, the comet green;
+# a distance from the comet takes the colour of the body it is measured to.
+COLOURS = {"Sun": "C1", "Jupiter": "C0", "comet": "C2"}
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5.6))
+ax1.semilogy(t, d_sun, color=COLOURS["Sun"], label="comet - Sun")
+ax1.semilogy(t, d_jup, color=COLOURS["Jupiter"], label="comet - Jupiter")
 ax1.plot(t_ca, d_ca, "v", color="C3", ms=8, label=f"closest approach, {d_ca:.3f} au")
-ax1.axhline(q, color="C0", ls=":", lw=1,
+ax1.axhline(q, color=COLOURS["Sun"], ls=":", lw=1,
             label=f"perihelion q = {q:.3f} au (between\nthe 6-hour outputs drawn)")
 ax1.set_xlabel("time since the start (yr)")
 ax1.set_ylabel("distance (au)")
 ax1.set_title(f"perihelion at q = {q:.2f} au, then Jupiter")
-ax1.legend(loc="center right", fontsize=8)
+# below the axes: inside, it covered the comet - Jupiter curve after the encounter
+ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=8,
+           frameon=False)
 i_ca = int(np.argmin(np.abs(t - t_ca)))
 for k, name in ((jup, "Jupiter"), (comet, "comet")):
     xy = r[:, k, :2] - r[:, sun, :2]
-    (line,) = ax2.plot(xy[:, 0], xy[:, 1], lw=1, label=name)
+    (line,) = ax2.plot(xy[:, 0], xy[:, 1], lw=1, color=COLOURS[name], label=name)
     ax2.plot(*xy[0], "o", color=line.get_color(), ms=6)
     step = xy[1] - xy[0]  # (an arrow of one length for both: Jupiter's 40 outputs
     size = 0.08 * float(np.ptp(r[:, :, :2]))  # were too short to be seen)
@@ -80,7 +85,7 @@ for k, name in ((jup, "Jupiter"), (comet, "comet")):
                  arrowprops={"arrowstyle": "-|>", "color": line.get_color()})
 ax2.plot(*(r[i_ca, comet, :2] - r[i_ca, sun, :2]), "v", color="C3", ms=8,
          label="closest approach")
-ax2.plot(0, 0, "*", color="orange", ms=12, label="Sun")
+ax2.plot(0, 0, "*", color=COLOURS["Sun"], ms=12, label="Sun")
 ax2.plot([], [], "o", color="0.3", label="start; arrow: direction")
 ax2.set_xlabel("x from the Sun, ICRS axes (au)")
 ax2.set_ylabel("y from the Sun, ICRS axes (au)")
