@@ -38,6 +38,22 @@ def test_a_run_beyond_the_step_budget_stops_naming_max_steps(kw):
     assert time.perf_counter() - start < 60.0
 
 
+@pytest.mark.parametrize("kw", [{}, {"events": [{"name": "collision", "action": "stop"}]},
+                                {"variational": True}], ids=["plain", "events", "variational"])
+def test_max_steps_below_the_pace_check_is_exact(kw):
+    """``max_steps`` held exactly below the pace check's 100 steps: a run of ``n``
+    steps completes with ``max_steps = n`` and stops naming it with ``n - 1`` (one
+    orbit with max_steps=10 took 44 steps and returned)."""
+    n = Simulation(_pair(), method="dop853", **kw).integrate(2 * np.pi).steps
+    assert 10 < n < 100
+    assert Simulation(_pair(), method=DOP853(max_steps=n), **kw).integrate(2 * np.pi).steps == n
+    for cap in (10, n - 1):
+        sim = Simulation(_pair(), method=DOP853(max_steps=cap), **kw)
+        with pytest.raises(ConvergenceError, match=rf"dop853 reached t = .* in {cap} steps; "
+                                                   rf".* more than max_steps = {cap} "):
+            sim.integrate(2 * np.pi)
+
+
 def test_a_run_within_the_budget_is_unchanged():
     """The budget only counts: the same run with and without a tight-enough budget
     gives the same bits."""

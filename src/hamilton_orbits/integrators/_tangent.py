@@ -502,6 +502,8 @@ class DOP853Tangent:
             solver = DOP853(self.f, float(t_out[i - 1]), self.y, float(t_out[i]), rtol=self.tol,
                             atol=self.atol, max_step=self.max_step)
             while solver.status == "running":
+                if self.steps - first >= self.max_steps:  # (exact: no step beyond it)
+                    check_pace(self.steps - first, self.max_steps, solver.t, t_out, "dop853")
                 t_prev, ys_prev = solver.t, solver.y[-1]
                 with HELD:  # (a Ctrl-C in the step: raised once it is the state kept)
                     if solver.step() is not None:

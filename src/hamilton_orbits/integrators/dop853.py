@@ -160,8 +160,11 @@ class _State:
         """One step of scipy's stepper ``solver``, its state kept as the run's, and
         ``scanned()`` (the step's events acted on: True where one did, the state then
         its, or the :class:`StopAtEvent` of a stop), a Ctrl-C in them held until they
-        are done; the pace judged every 100 steps.  Returns what ``scanned`` does
-        (False without it)."""
+        are done; a step beyond ``max_steps`` in this call refused before it is taken
+        (the limit exact, as radau15's), the pace judged every 100 steps.  Returns
+        what ``scanned`` does (False without it)."""
+        if self.steps - first >= self.max_steps:  # (one integer compare a step)
+            _setup.check_pace(self.steps - first, self.max_steps, solver.t, t_out, NAME)
         t_prev = solver.t
         with HELD:
             if solver.step() is not None:
