@@ -461,18 +461,28 @@ def test_the_issue_reproducer_stops_or_reports_an_infinite_energy_error():
     assert traj.energy_error.tolist() == [0.0, math.inf]
 
 
-def test_a_tolerance_far_below_rounding_is_named_when_the_step_underflows():
-    """``tol=1e-300``: the step shrank until it underflowed, and the refusal asked "a
-    collision, or an encounter closer than float64 resolves?", never naming the
-    tolerance; it names it now (and only a tolerance below float64's rounding)."""
-    from hamilton_orbits import Body, System, integrate
+def test_a_tolerance_below_rounding_is_refused_naming_tol():
+    """``tol=1e-300``: the step shrank until it underflowed (a refusal that named a
+    collision first); ``tol=1e-30`` ran silently, 36 497 steps of an orbit of 39 at
+    the default with no accuracy gained.  A ``tol`` below float64's rounding
+    (``TOL_FLOOR``) is now refused before the first step, naming it (with the
+    variational equations too); the floor itself is accepted, and a collision's
+    underflow does not name ``tol``."""
+    from hamilton_orbits import Body, Simulation, System, integrate
+    from hamilton_orbits.integrators.radau15 import TOL_FLOOR
     from hamilton_orbits.validation import ConvergenceError
 
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
                 Body("p", 1e-3, [1.0, 0.1, 0], [0, 1.0, 0.1])])
-    with pytest.raises(ConvergenceError, match=r"the step underflowed .* or `tol` = 1e-300: "
-                                               r"below float64's rounding \(1e-16\)"):
-        integrate(s, 2.0, tol=1e-300)
+    for tol, kw in ((1e-300, {}), (1e-30, {}), (1e-17, {"dt": 0.01}),
+                    (1e-30, {"variational": True})):
+        with pytest.raises(ValueError, match=rf"Expected radau15's `tol` >= 1e-16 \(float64's "
+                                             rf"rounding\), got {tol!r}: below it a tolerance "
+                                             "buys no accuracy"):
+            integrate(s, 2.0, tol=tol, **kw)
+    with pytest.raises(ValueError, match=r"got 1e-30: below it"):
+        Simulation(s, tol=1e-30)  # (as it is made, before a run or an archive's folder)
+    assert integrate(s, 0.1, tol=TOL_FLOOR).steps > 0
     crash = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1.0, [1e-3, 0, 0], [0, 0, 0])])
     with pytest.raises(ConvergenceError) as info:
         integrate(crash, 1.0, tol=1e-9)

@@ -44,12 +44,19 @@ from hamilton_orbits._kernels import radau15 as _k
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators._held import HELD
-from hamilton_orbits.integrators.methods import CRITERIA, MAX_STEPS, PRECISIONS, Radau15
+from hamilton_orbits.integrators.methods import (
+    CRITERIA,
+    MAX_STEPS,
+    PRECISIONS,
+    RADAU15_TOL_FLOOR,
+    Radau15,
+    check_run,
+)
 from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["ACCEPTS_VELOCITY_DEPENDENT", "CRITERIA", "DEFAULT_TOL", "MAX_STEPS", "NAME",
-           "PRECISIONS", "RADAU_SPACINGS", "compile_ahead", "run", "start"]
+           "PRECISIONS", "RADAU_SPACINGS", "TOL_FLOOR", "compile_ahead", "run", "start"]
 
 NAME = "radau15"
 ACCEPTS_VELOCITY_DEPENDENT = True
@@ -93,7 +100,8 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
         is shortened to land on it).  With ``tol``: the first trial step.
     tol : float, optional
         IAS15's epsilon for the step control (default 1e-9 when ``dt`` is not
-        given either); ``max |b6| / max |a| ~ tol`` per step.
+        given either); ``max |b6| / max |a| ~ tol`` per step.  At least
+        :data:`TOL_FLOOR` (float64's rounding; a ValueError below it).
     on_output : callable, optional
         ``on_output(i, steps)`` after output ``i`` is reached.
     max_steps : int, optional
@@ -146,7 +154,7 @@ def run(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t_out: np.ndar
     ------
     ValueError
         Non-finite or ill-shaped input, negative ``gm``, non-increasing
-        ``t_out``, ``dt <= 0`` or ``tol <= 0``.
+        ``t_out``, ``dt <= 0`` or ``tol`` below :data:`TOL_FLOOR`.
     ConvergenceError
         If an acceleration becomes non-finite (a collision) or the step
         underflows, naming the time reached.
@@ -179,6 +187,7 @@ def start(rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
     (1/100 of the shortest pair free-fall time); the span of a first call does not
     shorten it, so that a run continued in legs takes the steps of one run.
     """
+    check_run(method, dt, tol, variational is not None)  # (a `tol` below TOL_FLOOR)
     if method.precision != "double":
         if variational is not None:
             raise ValueError("radau15 in double-double integrates no variational equations; "
@@ -427,19 +436,15 @@ class _Run:
 
 
 #: below this ``tol`` (float64's rounding) a tolerance buys no accuracy, only
-#: shorter steps (1e-40 took 260 000 steps of a 2-day orbit, 1e-60 underflowed):
-#: a step that underflows then names ``tol``
-TOL_FLOOR = 1e-16
+#: shorter steps: refused (:data:`~hamilton_orbits.integrators.methods.RADAU15_TOL_FLOOR`)
+TOL_FLOOR = RADAU15_TOL_FLOOR
 
 
 def _why(status: int, st: np.ndarray, max_steps: int) -> str:
-    tol = float(st[_k.ST_EPSILON])
-    small = (f", or `tol` = {tol!r}: below float64's rounding ({TOL_FLOOR}) a tolerance "
-             "buys no accuracy, only shorter steps" if 0.0 < tol < TOL_FLOOR else "")
     return {
         _k.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
         _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r}; a "
                              "collision, or an encounter closer than float64 resolves at this "
-                             f"time{small}?)",
+                             "time?)",
         _k.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
     }[status]
