@@ -672,6 +672,28 @@ def test_radau15_variational_asks_stop_between_slices():
     assert len(asked) == 2
 
 
+def test_radau15_variational_stops_with_the_plain_runs_reason():
+    """radau15 with ``variational=True`` stopped "(status 3: a non-finite
+    acceleration, an underflowing step, or more than max_steps = 10 steps)", leaving
+    the cause to guess; it gives the plain run's words: the budget (and the pace)
+    as :func:`check_pace` says them, and the step's underflow with its ``dt``."""
+    from hamilton_orbits.validation import ConvergenceError
+
+    def message(system, t, **kw):
+        with pytest.raises(ConvergenceError) as info:
+            integrate(system, t, **kw)
+        return str(info.value)
+
+    plain = message(_three(), 20.0, max_steps=10)
+    assert "reached t = " in plain and "more than max_steps = 10 " in plain
+    assert message(_three(), 20.0, max_steps=10, variational=True) == plain
+    crash = System([Body("a", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 1.0, [1e-3, 0, 0], [0, 0, 0])])
+    plain = message(crash, 1.0)
+    assert "the step underflowed (dt = " in plain
+    assert message(crash, 1.0, variational=True) == plain.replace("radau15 stopped",
+                                                                  "radau15 (variational) stopped")
+
+
 # ---------------------------------------------------------------------------
 # The API
 

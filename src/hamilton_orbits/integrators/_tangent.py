@@ -49,7 +49,7 @@ from hamilton_orbits.rhs import run_parameters
 from hamilton_orbits.validation import ConvergenceError
 
 __all__ = ["DEFAULT_SEED", "SLICE", "DOP853Tangent", "LeapfrogTangent", "Radau15Tangent",
-           "Tangent", "WHTangent", "megno_vector"]
+           "Tangent", "WHTangent", "megno_vector", "radau15_why"]
 
 #: The seed of the random tangent vector of MEGNO when none is given.
 DEFAULT_SEED = 2275
@@ -234,17 +234,37 @@ class Radau15Tangent:
                     self.steps += steps
                 if status == _radau.STATUS_OK:
                     break
-                if status != _radau.STATUS_MAXSTEPS or steps >= left:
+                if status != _radau.STATUS_MAXSTEPS:
                     raise ConvergenceError(
                         f"radau15 (variational) stopped at t = {self.t!r} before t_out[{i}] "
-                        f"= {float(t_out[i])!r} (status {status}: a non-finite acceleration, an "
-                        f"underflowing step, or more than max_steps = {self.max_steps} steps)")
+                        f"= {float(t_out[i])!r}: {radau15_why(status, st, self.max_steps)}")
+                # (a slice's end or max_steps: the budget and the pace judged as the
+                # plain run's, in its words)
+                check_pace(self.steps - first, self.max_steps, self.t, t_out, "radau15")
                 if stop is not None and stop():
                     raise StopIntegration
             r_out[i], v_out[i] = x[:n], w[:n]
             self.tangent.record(i, float(t_out[i]), x[n:], w[n:])
             if on_output is not None:
                 on_output(i, self.steps - first)
+
+
+def radau15_why(status: int, st: np.ndarray, max_steps: int) -> str:
+    """Why radau15's kernel (plain or variational) stopped with ``status``, its state
+    ``st``, short of its output time: the words of the ConvergenceError.
+
+    Examples
+    --------
+    >>> radau15_why(_radau.STATUS_NONFINITE, np.zeros(_radau.NSTATE), 10)
+    'the acceleration became non-finite (a collision?)'
+    """
+    return {
+        _radau.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
+        _radau.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_radau.ST_DT])!r}; a "
+                                 "collision, or an encounter closer than float64 resolves at "
+                                 "this time?)",
+        _radau.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
+    }.get(status, f"status {status}")
 
 
 def _tangent_arg(fn: Any) -> np.ndarray:

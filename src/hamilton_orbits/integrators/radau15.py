@@ -431,7 +431,7 @@ class _Run:
             else:
                 raise ConvergenceError(
                     f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
-                    f"{float(t_out[i])!r}: {_why(status, self.st, max_steps)}"
+                    f"{float(t_out[i])!r}: {_tangent.radau15_why(status, self.st, max_steps)}"
                 )
 
 
@@ -439,12 +439,3 @@ class _Run:
 #: shorter steps: refused (:data:`~hamilton_orbits.integrators.methods.RADAU15_TOL_FLOOR`)
 TOL_FLOOR = RADAU15_TOL_FLOOR
 
-
-def _why(status: int, st: np.ndarray, max_steps: int) -> str:
-    return {
-        _k.STATUS_NONFINITE: "the acceleration became non-finite (a collision?)",
-        _k.STATUS_UNDERFLOW: f"the step underflowed (dt = {float(st[_k.ST_DT])!r}; a "
-                             "collision, or an encounter closer than float64 resolves at this "
-                             "time?)",
-        _k.STATUS_MAXSTEPS: f"more than max_steps = {max_steps} steps were needed",
-    }[status]
