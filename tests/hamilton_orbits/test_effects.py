@@ -394,6 +394,16 @@ def test_an_effect_whose_field_is_a_massless_bodys_is_refused(effect, massless, 
         compile_rhs(_massless(_earth_moon(), massless), [effect])
 
 
+def test_a_massless_eih_source_is_refused_as_gr_refuses_it():
+    """``eih`` took a massless body in `sources` and dropped its 1PN terms silently
+    (``gr`` refused the same body as its `source`): refused, naming the argument, the
+    index and the body."""
+    with pytest.raises(ValueError, match=r"^Effect 'eih': `sources` names body 'moon' \(at "
+                                         r"index 1\), which is massless \(gm = 0\)"):
+        compile_rhs(_massless(_earth_moon(), "moon"),
+                    [{"name": "eih", "sources": ["sun", "moon"]}])
+
+
 @pytest.mark.parametrize(("effect", "key", "typo", "meant"), [
     ({"name": "gr"}, "source", "son", "sun"), ({"name": "j2"}, "body", "jupyter", "jupiter"),
     ({"name": "gr_potential"}, "source", "Sun", "sun")])
