@@ -135,6 +135,27 @@ def test_the_cross_check_of_gr_does_not_depend_on_where_the_sun_is(effect):
     assert b.relative_position_difference.max() < 1e-10
 
 
+def test_the_cross_check_of_eih_runs_reboundx_gr_full():
+    """``crosscheck`` refused ``eih`` ("no reboundx counterpart") though it is the
+    n-body 1PN equation of reboundx's ``gr_full``: run beside it, with the same
+    ``c``.  Sun, Mercury and Jupiter over a year: Mercury's 1PN shift (3.9e-7 au from
+    Newton's law) agrees to 1e-12 au.  What ``gr_full`` cannot run (some massive body
+    not a source, a semi-active body, beta or gamma other than 1) is refused by name."""
+    from hamilton_orbits import crosscheck
+
+    pytest.importorskip("reboundx")
+    s = System.solar_system("J2000", bodies=["sun", "mercury", "jupiter"])
+    table = crosscheck(s, 1 * u.yr, effects=["eih"])
+    assert table.peer == "rebound ias15 + reboundx"
+    assert table.position_difference.max() < 1e-12
+    for effect, pattern in (({"sources": ["sun"]}, r"leave out `sources` \(it leaves out "
+                                                    r"\['mercury', 'jupiter'\]\)"),
+                            ({"semi_active": ["jupiter"]}, r"leave out `semi_active`"),
+                            ({"gamma": 0.5}, r"leave `gamma` at 1, got 0.5")):
+        with pytest.raises(ValueError, match=r"^Effect 'eih': reboundx's gr_full .*" + pattern):
+            crosscheck(s, 1 * u.yr, effects=[{"name": "eih", **effect}])
+
+
 def leo(inc_deg: float = 50.0, e: float = 0.001):
     gm, radius, j2 = 3.986004418e14, 6378136.6, 1.0826359e-3  # IERS Conventions 2010
     a = 7000e3
