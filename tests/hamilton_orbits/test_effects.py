@@ -202,6 +202,34 @@ def test_j2_against_reboundx_gravitational_harmonics():
     assert np.linalg.norm(ours.r[-1, 1] - ours.r[-1, 0] - rel(rebx)) < 1e-9 * a
 
 
+def test_j2_of_the_earth_is_the_same_physics_in_ecliptic_axes():
+    """``System.solar_system(frame="ecliptic")`` gave the Earth no pole (``from_ephemeris``
+    gives one), so ``j2`` took the ecliptic's z axis for it, 23.4 degrees off: its pull
+    on the Moon was 57 % away from the ICRS run's.  The Sun, the Earth and the Moon
+    carry their poles in the system's axes; the J2 acceleration (the effect alone,
+    ``rhs.extra``) in ecliptic axes is the ICRS one rotated by the IAU 2006 obliquity
+    at J2000, 84381.406" (Hilton et al. 2006; IERS Conventions 2010, chapter 5), to
+    1e-12."""
+    effect = [{"name": "j2", "body": "earth", "j2": de.constant("J2E"),  # DE440's
+               "radius": de.constant("RE") * u.km}]
+    bodies = ["sun", "earth", "moon"]
+    acc = {}
+    for frame in ("icrs", "ecliptic"):
+        s = System.solar_system("J2000", bodies=bodies, frame=frame)
+        assert s["earth"].pole == tuple(de.pole("earth", frame))
+        arrays = s.as_arrays()
+        rhs = compile_rhs(s, effect)
+        acc[frame] = np.zeros((3, 3))
+        rhs.extra(arrays.r.copy(), arrays.v.copy(), arrays.gm.copy(), acc[frame], rhs.p)
+    eps = np.deg2rad(84381.406 / 3600.0)
+    to_ecliptic = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(eps), np.sin(eps)],
+                            [0.0, -np.sin(eps), np.cos(eps)]])
+    moon = acc["icrs"][2]
+    assert np.linalg.norm(moon) > 1e-11  # au/day^2: the Earth's J2 on the Moon
+    np.testing.assert_allclose(acc["ecliptic"], acc["icrs"] @ to_ecliptic.T, rtol=0,
+                               atol=1e-12 * np.linalg.norm(moon))
+
+
 def test_effect_with_momentum_conserving_reaction():
     """gr, gr_potential and j2 push the source back: total momentum is conserved."""
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0], radius=0.01, j2=0.1),
