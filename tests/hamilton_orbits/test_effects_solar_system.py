@@ -706,6 +706,28 @@ def test_an_unknown_frame_whose_orbits_lie_in_x_y_asks_for_frame():
     np.testing.assert_array_equal(_alone(ecl, "kuiper_ring", {}), a_ecl)
 
 
+def test_a_body_on_the_kuiper_ring_is_refused_by_name():
+    """A body exactly on the ring, where its potential is singular: ``System.
+    accelerations`` returned NaN (for the Sun too, by the ring's reaction) and a run
+    stopped saying only "the acceleration became non-finite (a collision?)".  Both
+    refuse it naming the effect, its index, the body and the cause; off the ring
+    (0.1 au above it) the field is finite."""
+    ring = {"name": "kuiper_ring", "gm": 1e-8, "radius": 44.0, "normal": [0, 0, 1]}
+
+    def system(z):
+        return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                       Body("tno", 0.0, [44.0, 0, z], [0, 0.15, 0])])
+
+    message = ("Effect 'kuiper_ring' (effects[0]) at t = 0.0: body 'tno' (index 1) lies on "
+               "the ring (radius 44.0, its distance to the ring 0.0): the ring's potential "
+               "is singular there; move it off the ring")
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        system(0.0).accelerations([ring])
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        integrate(system(0.0), 1.0, effects=[ring])
+    assert np.isfinite(system(0.1).accelerations([ring])).all()
+
+
 @pytest.mark.parametrize("effect", ["kuiper_ring", "zonal"])
 def test_an_unknown_frame_whose_test_particles_orbit_in_x_y_asks_for_frame(effect):
     """The check looked at the angular momentum, to which massless bodies add none: a
