@@ -22,7 +22,7 @@ import astropy.units as u
 import numpy as np
 
 from hamilton_orbits._body import Body, body_from_floats
-from hamilton_orbits.frames import check_frame, frame_rotation
+from hamilton_orbits.frames import check_frame, frame_rotation, pole
 
 if TYPE_CHECKING:  # pragma: no cover
     from hamilton_orbits.nbody import System
@@ -244,7 +244,10 @@ class InitialStates:
         8e-7 au of JPL's DE440 for the Sun, 3e-6 au for Mercury and Venus, 4e-5 au
         for Mars and 9e-5 to 2e-3 au for the outer planets, which is ample for the
         dynamics but not an ephemeris: :meth:`from_ephemeris` gives DE440), on the
-        axes of ``frame``.
+        axes of ``frame``.  The Sun, the Earth and the Moon carry their poles in those
+        axes, as :meth:`from_ephemeris` gives them (:func:`hamilton_orbits.frames.pole`:
+        the axes of ``j2`` on them, and of ``zonal``, ``lense_thirring``, ...); no
+        radius or J2 (give them to ``j2``).
 
         The origin: by default the chosen bodies' own centre of mass, at rest.
         The ephemeris gives states about the solar-system barycentre, which is
@@ -462,7 +465,9 @@ def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None
     """The keyword arguments of one :class:`~hamilton_orbits.nbody.Body` per body of
     :meth:`System.solar_system <hamilton_orbits.nbody.System.solar_system>` (which
     documents the arguments and what they refuse): the name, ``gm``, ``r`` and ``v``
-    as Quantities.
+    as Quantities, and for the Sun, the Earth and the Moon their ``pole`` in
+    ``frame`` (:func:`hamilton_orbits.frames.pole`, as
+    :meth:`~InitialStates.from_ephemeris` gives them).
 
     Examples
     --------
@@ -472,7 +477,8 @@ def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None
     from astropy.coordinates import get_body_barycentric_posvel
 
     bodies = solar_system_bodies(bodies)
-    rotation = frame_rotation(check_frame(frame))
+    frame = check_frame(frame)
+    rotation = frame_rotation(frame)
     origin = "barycenter" if origin == "barycentre" else origin  # either spelling
     if origin not in ("barycenter", "ssb"):
         raise ValueError(f"Expected `origin` to be 'barycenter' or 'ssb', got {origin!r}")
@@ -488,5 +494,9 @@ def solar_system_specs(epoch: Any = "J2000", bodies: Sequence[str] | None = None
         r -= gm @ r / gm.sum()
         v -= gm @ v / gm.sum()
     r, v = r @ rotation.T, v @ rotation.T
-    return [{"name": name, "gm": gm[k] * u.m**3 / u.s**2, "r": r[k] * u.au,
-             "v": v[k] * (u.au / u.day)} for k, name in enumerate(bodies)]
+    out = [{"name": name, "gm": gm[k] * u.m**3 / u.s**2, "r": r[k] * u.au,
+            "v": v[k] * (u.au / u.day)} for k, name in enumerate(bodies)]
+    for spec in out:  # (the poles from_ephemeris gives, in the system's axes)
+        if spec["name"] in ("sun", "earth", "moon"):
+            spec["pole"] = pole(spec["name"], frame)
+    return out

@@ -572,7 +572,9 @@ class System(InitialStates):
         ValueError
             For a ``t`` of the wrong kind for the system (above), not one number,
             not finite, or of the wrong dimension (astropy's UnitConversionError),
-            naming ``t`` and the value.
+            naming ``t`` and the value; for an effect whose acceleration is not
+            finite in this state (a body on the Kuiper ring), naming the effect, its
+            index, the body and the cause (:func:`hamilton_orbits.rhs.refuse_nonfinite`).
 
         Examples
         --------
@@ -582,7 +584,7 @@ class System(InitialStates):
         array([[ 0.  ,  0.  ,  0.  ],
                [-0.25,  0.  ,  0.  ]])
         """
-        from hamilton_orbits.rhs import compile_rhs
+        from hamilton_orbits.rhs import compile_rhs, refuse_nonfinite
         from hamilton_orbits.units import TIME, is_quantity, time_quantity
 
         given = t
@@ -595,6 +597,7 @@ class System(InitialStates):
             raise ValueError(f"Expected `t` as a time Quantity for a system of Quantities, "
                              f"got {t!r}")
         acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm, t=days)
+        refuse_nonfinite(self, effects, acc, self._r, self._v, self._gm, days)
         return acc * A_UNIT if self._quantity else acc
 
     def _energy_hamilton(self) -> float:

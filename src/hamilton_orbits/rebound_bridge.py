@@ -109,6 +109,10 @@ def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
             rebx.add_force(force)
             force.params["c"] = float(p[1])
             sim.particles[int(p[0])].params["gr_source"] = 1
+        elif name == "eih":  # p = [c, beta, gamma] (every massive body a source)
+            force = rebx.load_force("gr_full")
+            rebx.add_force(force)
+            force.params["c"] = float(p[0])
         else:  # j2: p = [body, j2, radius, pole]
             force = rebx.load_force("gravitational_harmonics")
             rebx.add_force(force)
@@ -120,30 +124,38 @@ def _add_reboundx_effects(sim: Any, system: System, effects: EffectSet) -> Any:
 
 def reboundx_counterparts(system: System, effects: Any) -> list[tuple[str, np.ndarray]]:
     """The listed effects with their parameter vectors, where reboundx can run each
-    (``gr``, ``gr_potential``, ``j2`` with its pole on z): checked before anything is
+    (``gr``, ``gr_potential``, ``j2`` with its pole on z, ``eih`` as reboundx's
+    ``gr_full``, the n-body 1PN equations: with every massive body a source, no
+    semi-active body, and PPN beta = gamma = 1): checked before anything is
     integrated (a scene with ``crosscheck = true`` is refused as it loads, not after
     its run).
 
     Raises
     ------
     ValueError
-        Naming an effect without a reboundx counterpart, or a ``j2`` pole off z.
+        Naming an effect without a reboundx counterpart, a ``j2`` pole off z, or an
+        ``eih`` that ``gr_full`` cannot run (some massive body not a source, a
+        semi-active body, beta or gamma other than 1).
 
     Examples
     --------
     >>> from hamilton_orbits import Body
     >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0])])
-    >>> reboundx_counterparts(s, [{"name": "eih", "c": 1e4}])
+    >>> [name for name, _ in reboundx_counterparts(s, [{"name": "eih", "c": 1e4}])]
+    ['eih']
+    >>> reboundx_counterparts(s, [{"name": "nongrav", "body": "sun"}])
     Traceback (most recent call last):
     ...
-    ValueError: Effect 'eih' has no reboundx counterpart to cross-check
+    ValueError: Effect 'nongrav' has no reboundx counterpart to cross-check
     """
     out = []
     for name, params in EffectSet.of(effects, "nbody"):
-        if name not in ("gr", "gr_potential", "j2"):
+        if name not in ("gr", "gr_potential", "j2", "eih"):
             raise ValueError(f"Effect {name!r} has no reboundx counterpart to cross-check")
         # the effect's own parameter builder: one validation and one unit rule for both codes
         p = get("nbody", name).params(system, dict(params))
+        if name == "eih":
+            _check_gr_full(system, p)
         if name == "j2" and tuple(p[3:]) != (0.0, 0.0, 1.0):
             raise ValueError(
                 "reboundx's gravitational_harmonics takes the pole along z; rotate the "
@@ -151,6 +163,28 @@ def reboundx_counterparts(system: System, effects: Any) -> list[tuple[str, np.nd
                 f"cross-check")
         out.append((name, p))
     return out
+
+
+def _check_gr_full(system: System, p: np.ndarray) -> None:
+    """Refuse an ``eih`` (``p = [c, beta, gamma, sources..., -1 - semi-active...]``)
+    that reboundx's ``gr_full`` would not run as it is: ``gr_full`` takes every
+    massive body for a source, none semi-active, and general relativity's PPN
+    beta = gamma = 1."""
+    for k, key in ((1, "beta"), (2, "gamma")):
+        if p[k] != 1.0:
+            raise ValueError(f"Effect 'eih': reboundx's gr_full is general relativity (PPN "
+                             f"beta = gamma = 1); to cross-check, leave `{key}` at 1, got "
+                             f"{float(p[k])!r}")
+    listed = [int(x) for x in p[3:]]
+    if any(x < 0 for x in listed):
+        raise ValueError("Effect 'eih': reboundx's gr_full has no semi-active bodies; to "
+                         "cross-check, leave out `semi_active`")
+    massive = np.flatnonzero(system.as_arrays().gm > 0).tolist()
+    if listed and sorted(listed) != massive:
+        left = [system.names[k] for k in massive if k not in listed]
+        raise ValueError(f"Effect 'eih': reboundx's gr_full takes every massive body for a "
+                         f"source; to cross-check, leave out `sources` (it leaves out "
+                         f"{left})")
 
 
 @dataclass

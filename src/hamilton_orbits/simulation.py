@@ -58,7 +58,7 @@ from hamilton_orbits.integrators import INTEGRATORS, Method, method_of
 from hamilton_orbits.integrators._setup import check_step_count
 from hamilton_orbits.integrators.methods import FIXED_STEP, check_run
 from hamilton_orbits.nbody import DAY, System
-from hamilton_orbits.rhs import RHS, compile_rhs
+from hamilton_orbits.rhs import RHS, compile_rhs, refuse_nonfinite
 from hamilton_orbits.trajectory import (
     Trajectory,
     encounter_check,
@@ -203,6 +203,9 @@ class Simulation(Saving):
         tan = tangent_of(system, variational, stm, tangent, typed)
         rhs = compile_rhs(system, eff, variational=tan is not None)
         arrays = system.as_arrays()
+        if eff and not rhs.per_run:  # (an effect singular at the start: refused by name)
+            refuse_nonfinite(system, eff, rhs.acceleration(arrays.r, arrays.v, arrays.gm),
+                             arrays.r, arrays.v, arrays.gm)
         self._prop = engine.Propagation(arrays.r, arrays.v, arrays.gm, 0.0, rhs, typed, dt=step,
                                         tol=tol, events=event_log(system, events),
                                         variational=tan)

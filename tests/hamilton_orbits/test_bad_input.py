@@ -956,7 +956,8 @@ def test_a_size_refusal_where_no_interval_fits_says_so():
 
 def test_a_crosscheck_rebound_cannot_run_is_refused_before_our_run(monkeypatch):
     """``crosscheck(system, t, effects=["eih"])`` integrated the whole run, then
-    refused the effect; it is refused first."""
+    refused the effect; it is refused first (now ``eih`` is cross-checked against
+    reboundx's ``gr_full``: an ``eih`` it cannot run, of PPN beta 2)."""
     from hamilton_orbits import simulation
 
     def never(*args, **kwargs):
@@ -964,8 +965,9 @@ def test_a_crosscheck_rebound_cannot_run_is_refused_before_our_run(monkeypatch):
 
     monkeypatch.setattr(simulation, "integrate", never)
     s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("p", 1e-3, [1.0, 0, 0], [0, 1.0, 0])])
-    with pytest.raises(ValueError, match=r"Effect 'eih' has no reboundx counterpart"):
-        crosscheck(s, 1.0, effects=[{"name": "eih", "c": 1e4}])
+    with pytest.raises(ValueError, match=r"Effect 'eih': reboundx's gr_full is general "
+                                         r"relativity .* leave `beta` at 1, got 2.0"):
+        crosscheck(s, 1.0, effects=[{"name": "eih", "c": 1e4, "beta": 2.0}])
 
 
 def test_small_refusals_name_the_argument():

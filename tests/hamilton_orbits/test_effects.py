@@ -135,6 +135,27 @@ def test_the_cross_check_of_gr_does_not_depend_on_where_the_sun_is(effect):
     assert b.relative_position_difference.max() < 1e-10
 
 
+def test_the_cross_check_of_eih_runs_reboundx_gr_full():
+    """``crosscheck`` refused ``eih`` ("no reboundx counterpart") though it is the
+    n-body 1PN equation of reboundx's ``gr_full``: run beside it, with the same
+    ``c``.  Sun, Mercury and Jupiter over a year: Mercury's 1PN shift (3.9e-7 au from
+    Newton's law) agrees to 1e-12 au.  What ``gr_full`` cannot run (some massive body
+    not a source, a semi-active body, beta or gamma other than 1) is refused by name."""
+    from hamilton_orbits import crosscheck
+
+    pytest.importorskip("reboundx")
+    s = System.solar_system("J2000", bodies=["sun", "mercury", "jupiter"])
+    table = crosscheck(s, 1 * u.yr, effects=["eih"])
+    assert table.peer == "rebound ias15 + reboundx"
+    assert table.position_difference.max() < 1e-12
+    for effect, pattern in (({"sources": ["sun"]}, r"leave out `sources` \(it leaves out "
+                                                    r"\['mercury', 'jupiter'\]\)"),
+                            ({"semi_active": ["jupiter"]}, r"leave out `semi_active`"),
+                            ({"gamma": 0.5}, r"leave `gamma` at 1, got 0.5")):
+        with pytest.raises(ValueError, match=r"^Effect 'eih': reboundx's gr_full .*" + pattern):
+            crosscheck(s, 1 * u.yr, effects=[{"name": "eih", **effect}])
+
+
 def leo(inc_deg: float = 50.0, e: float = 0.001):
     gm, radius, j2 = 3.986004418e14, 6378136.6, 1.0826359e-3  # IERS Conventions 2010
     a = 7000e3
@@ -179,6 +200,34 @@ def test_j2_against_reboundx_gravitational_harmonics():
     assert shift > 1e5  # metres: the J2 displacement after 10 orbits
     # same force model: agreement at the integrators' accuracy, ~1e-12 of the orbit
     assert np.linalg.norm(ours.r[-1, 1] - ours.r[-1, 0] - rel(rebx)) < 1e-9 * a
+
+
+def test_j2_of_the_earth_is_the_same_physics_in_ecliptic_axes():
+    """``System.solar_system(frame="ecliptic")`` gave the Earth no pole (``from_ephemeris``
+    gives one), so ``j2`` took the ecliptic's z axis for it, 23.4 degrees off: its pull
+    on the Moon was 57 % away from the ICRS run's.  The Sun, the Earth and the Moon
+    carry their poles in the system's axes; the J2 acceleration (the effect alone,
+    ``rhs.extra``) in ecliptic axes is the ICRS one rotated by the IAU 2006 obliquity
+    at J2000, 84381.406" (Hilton et al. 2006; IERS Conventions 2010, chapter 5), to
+    1e-12."""
+    effect = [{"name": "j2", "body": "earth", "j2": de.constant("J2E"),  # DE440's
+               "radius": de.constant("RE") * u.km}]
+    bodies = ["sun", "earth", "moon"]
+    acc = {}
+    for frame in ("icrs", "ecliptic"):
+        s = System.solar_system("J2000", bodies=bodies, frame=frame)
+        assert s["earth"].pole == tuple(de.pole("earth", frame))
+        arrays = s.as_arrays()
+        rhs = compile_rhs(s, effect)
+        acc[frame] = np.zeros((3, 3))
+        rhs.extra(arrays.r.copy(), arrays.v.copy(), arrays.gm.copy(), acc[frame], rhs.p)
+    eps = np.deg2rad(84381.406 / 3600.0)
+    to_ecliptic = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(eps), np.sin(eps)],
+                            [0.0, -np.sin(eps), np.cos(eps)]])
+    moon = acc["icrs"][2]
+    assert np.linalg.norm(moon) > 1e-11  # au/day^2: the Earth's J2 on the Moon
+    np.testing.assert_allclose(acc["ecliptic"], acc["icrs"] @ to_ecliptic.T, rtol=0,
+                               atol=1e-12 * np.linalg.norm(moon))
 
 
 def test_effect_with_momentum_conserving_reaction():
@@ -392,6 +441,16 @@ def test_an_effect_whose_field_is_a_massless_bodys_is_refused(effect, massless, 
     with pytest.raises(ValueError, match=rf"`{key}` names body '{massless}', which is "
                                          r"massless"):
         compile_rhs(_massless(_earth_moon(), massless), [effect])
+
+
+def test_a_massless_eih_source_is_refused_as_gr_refuses_it():
+    """``eih`` took a massless body in `sources` and dropped its 1PN terms silently
+    (``gr`` refused the same body as its `source`): refused, naming the argument, the
+    index and the body."""
+    with pytest.raises(ValueError, match=r"^Effect 'eih': `sources` names body 'moon' \(at "
+                                         r"index 1\), which is massless \(gm = 0\)"):
+        compile_rhs(_massless(_earth_moon(), "moon"),
+                    [{"name": "eih", "sources": ["sun", "moon"]}])
 
 
 @pytest.mark.parametrize(("effect", "key", "typo", "meant"), [

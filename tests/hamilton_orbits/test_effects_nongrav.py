@@ -160,5 +160,27 @@ def test_each_body_takes_its_own_coefficients_and_form_of_g():
         k = s.names.index(name)
         # (the step control sees both pushes, so the steps may differ: 2e-15 here)
         np.testing.assert_allclose(together.r[-1, k], one.r[-1, k], rtol=0, atol=1e-13)
-    with pytest.raises(ValueError, match=r"expected `m` >= 0, got \[1.0, -2.0\] \(body 1\)"):
+    with pytest.raises(ValueError, match=r"expected `m` within \[0, 100\] .*, got \[1.0, -2.0\] "
+                                         r"\(body 1\)"):
         Simulation(s, method="radau15", effects=[{**both, "m": [1.0, -2.0]}])
+
+
+def test_an_exponent_m_that_overflows_g_is_refused_by_name():
+    """``m = 1e6`` made ``(r / r0)^-m`` overflow: ``System.accelerations`` returned NaN
+    (infinity times the A1 of zero) and a run stopped saying only "the acceleration
+    became non-finite (a collision?)".  ``m`` beyond 100 is refused with the
+    parameters; a state where ``g`` still overflows (m = 100 at 5e-5 r0) is refused
+    naming the effect, its index and the body."""
+    s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("sat", 0.0, [0.5, 0, 0],
+                                                            [0, 1.4, 0])])
+    with pytest.raises(ValueError, match=r"^Effect 'nongrav': expected `m` within \[0, 100\] "
+                                         r".* got 1000000.0 \(body 0\) \(effects\[0\]\)$"):
+        s.accelerations([{"name": "nongrav", "body": "sat", "A2": 1e-9, "m": 1e6}])
+    far = {"name": "nongrav", "body": "sat", "A2": 1e-9, "m": 100.0, "r0": 1e4}
+    with pytest.raises(ValueError, match=r"^Effect 'nongrav' \(effects\[1\]\) at t = 0.0: the "
+                                         r"acceleration of body 'sat' \(index 1\) is not "
+                                         r"finite$"):
+        s.accelerations(["newtonian", far])
+    with pytest.raises(ValueError, match=r"^Effect 'nongrav' \(effects\[0\]\)"):
+        Simulation(s, effects=[far])  # (refused as the run is set up, not at its step)
+    assert np.isfinite(s.accelerations([{**far, "r0": 1.0}])).all()

@@ -686,19 +686,46 @@ def test_moon_figure_on_an_ecliptic_earth_and_moon_without_the_sun():
 
 
 def test_an_unknown_frame_whose_orbits_lie_in_x_y_asks_for_frame():
-    """``System.solar_system(frame="ecliptic")`` has no poles to recognise its axes by;
-    the ring's normal was put along the ICRS's ecliptic pole, 23.4 deg off.  Now the
-    effect asks for ``frame``; given, it is the ICRS one rotated."""
+    """A system in ecliptic axes with no poles to recognise them by (as
+    ``System.solar_system(frame="ecliptic")`` was, its bodies here without their
+    poles): the ring's normal was put along the ICRS's ecliptic pole, 23.4 deg off.
+    Now the effect asks for ``frame``; given, it is the ICRS one rotated.  The
+    bodies of ``solar_system`` carry their poles (the Sun's here), which tell the
+    axes: the same ring, no ``frame`` asked."""
     ecl = System.solar_system(bodies=["sun", "jupiter", "neptune"], frame="ecliptic")
+    bare = System([Body(b.name, b.gm, b.r, b.v) for b in ecl.bodies])
     with pytest.raises(ValueError, match=re.escape(
             "Effect 'kuiper_ring': expected `frame` ('icrs' or 'ecliptic'): the system's axes "
             "are not known")):
-        ecl.accelerations(["kuiper_ring"])
+        bare.accelerations(["kuiper_ring"])
     icrs = System.solar_system(bodies=["sun", "jupiter", "neptune"])
     a_icrs = _alone(icrs, "kuiper_ring", {})  # ICRS axes: taken as such, as before
-    a_ecl = _alone(ecl, "kuiper_ring", {"frame": "ecliptic"})
+    a_ecl = _alone(bare, "kuiper_ring", {"frame": "ecliptic"})
     rot = de.frame_rotation("ecliptic")
     assert np.abs(a_ecl - a_icrs @ rot.T).max() < 1e-12 * np.abs(a_icrs).max()
+    np.testing.assert_array_equal(_alone(ecl, "kuiper_ring", {}), a_ecl)
+
+
+def test_a_body_on_the_kuiper_ring_is_refused_by_name():
+    """A body exactly on the ring, where its potential is singular: ``System.
+    accelerations`` returned NaN (for the Sun too, by the ring's reaction) and a run
+    stopped saying only "the acceleration became non-finite (a collision?)".  Both
+    refuse it naming the effect, its index, the body and the cause; off the ring
+    (0.1 au above it) the field is finite."""
+    ring = {"name": "kuiper_ring", "gm": 1e-8, "radius": 44.0, "normal": [0, 0, 1]}
+
+    def system(z):
+        return System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]),
+                       Body("tno", 0.0, [44.0, 0, z], [0, 0.15, 0])])
+
+    message = ("Effect 'kuiper_ring' (effects[0]) at t = 0.0: body 'tno' (index 1) lies on "
+               "the ring (radius 44.0, its distance to the ring 0.0): the ring's potential "
+               "is singular there; move it off the ring")
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        system(0.0).accelerations([ring])
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        integrate(system(0.0), 1.0, effects=[ring])
+    assert np.isfinite(system(0.1).accelerations([ring])).all()
 
 
 @pytest.mark.parametrize("effect", ["kuiper_ring", "zonal"])

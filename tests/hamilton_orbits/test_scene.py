@@ -653,15 +653,17 @@ def test_a_scene_sets_the_integrator_s_max_steps():
 
 
 def test_a_crosscheck_rebound_cannot_run_is_refused_as_the_scene_loads():
-    """``crosscheck = true`` with an effect reboundx has no counterpart for (``eih``)
-    or a ``j2`` pole off z ran the whole integration, then failed (exit 1) with the
-    run's results thrown away.  The scene is refused as it loads, at ``crosscheck``."""
+    """``crosscheck = true`` with an effect reboundx cannot run (an ``eih`` with
+    `sources` short of every massive body: ``gr_full`` takes them all) or a ``j2``
+    pole off z ran the whole integration, then failed (exit 1) with the run's
+    results thrown away.  The scene is refused as it loads, at ``crosscheck``."""
     data = {"kind": "nbody", "duration": "2 d", "crosscheck": True,
             "initial": {"solar_system": {"bodies": ["sun", "earth"]}},
-            "effects": [{"name": "eih"}]}
+            "effects": [{"name": "eih", "sources": ["sun"]}]}
     (problem,) = _problems(data)
-    assert problem.endswith("crosscheck: Effect 'eih' has no reboundx counterpart to "
-                            "cross-check")
+    assert problem.endswith("crosscheck: Effect 'eih': reboundx's gr_full takes every "
+                            "massive body for a source; to cross-check, leave out "
+                            "`sources` (it leaves out ['earth'])")
     assert Scene.from_dict({**data, "crosscheck": False}).spec["crosscheck"] is False
 
 

@@ -48,6 +48,11 @@ def _params_eih(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     gamma = scalar_parameter(system, params, "gamma", "eih", DIMENSIONLESS,
                              de.constant("GAMMA"))
     sources = body_list(system, params, "sources", "eih")
+    gm = system.as_arrays().gm
+    for k, b in enumerate(sources):
+        if not gm[b] > 0:  # (its 1PN field would be dropped silently: ``gr`` refuses it)
+            raise ValueError(f"Effect 'eih': `sources` names body {system.names[b]!r} (at "
+                             f"index {k}), which is massless (gm = 0): it has no field")
     semi = body_list(system, params, "semi_active", "eih")
     if semi and len(semi) == len(system.names):
         raise ValueError("Effect 'eih': `semi_active` lists every body, so that none would "

@@ -65,6 +65,22 @@ def _params_kuiper_ring(system: Any, params: Mapping[str, Any]) -> np.ndarray:
     return np.array([b, big_m, radius, *normal])
 
 
+def _singular_ring(system: Any, r: np.ndarray, p: np.ndarray) -> str | None:
+    """The body on the ring itself (its potential singular there), or None."""
+    b, rad, k = int(p[0]), p[2], p[3:6]
+    d = r - r[b]
+    z = d @ k
+    rho = np.linalg.norm(d - np.outer(z, k), axis=1)
+    off = np.hypot(rho - rad, z)
+    off[b] = np.inf
+    i = int(np.argmin(off))
+    if not off[i] <= 1e-9 * rad:
+        return None
+    return (f"body {system.names[i]!r} (index {i}) lies on the ring (radius {float(rad)!r}, "
+            f"its distance to the ring {float(off[i])!r}): the ring's potential is singular "
+            f"there; move it off the ring")
+
+
 SPECS = (
     EffectSpec(
         name="kuiper_ring", kind="nbody",
@@ -74,6 +90,7 @@ SPECS = (
                     "frame": FRAME_PARAMETER},
         kernel=ring_field, params=_params_kuiper_ring,
         parameter_kinds={"gm": GM, "radius": LENGTH}, name_parameters=("centre",),
+        singular=_singular_ring,
         reference=f"{PARK_2021}, section 3 (ring masses MA8201..MA8236)",
     ),
 )

@@ -54,11 +54,17 @@ def _bodies(system: Any, params: Mapping[str, Any]) -> list[int]:
     return out
 
 
+#: the largest ``m``: ``(r / r0)^-m`` overflows to infinity (and ``g`` with it, NaN with
+#: an ``A`` of zero) within ``10^(-308.25 / m) r0`` of the centre; with m <= 100 only
+#: within 8.3e-4 r0 (inside the Sun for r0 = 1 au), where the fitted forms (m = 2 of
+#: the asteroids' A2, 2.15 of the comets', Marsden et al. 1973) have no meaning anyway
+M_MAX = 100.0
+
 #: the parameters of each body's row beside its index: (name, kind, default, check)
 _ROW = (("A1", ACCELERATION, 0.0, ""), ("A2", ACCELERATION, 0.0, ""),
         ("A3", ACCELERATION, 0.0, ""), ("alpha", DIMENSIONLESS, 1.0, "positive"),
         ("r0", LENGTH, 1.0, "positive"),  # (1 au; 1 in the units of plain floats)
-        ("m", DIMENSIONLESS, 2.0, "nonnegative"), ("n", DIMENSIONLESS, 0.0, "nonnegative"),
+        ("m", DIMENSIONLESS, 2.0, "exponent"), ("n", DIMENSIONLESS, 0.0, "nonnegative"),
         ("k", DIMENSIONLESS, 0.0, "nonnegative"))
 
 
@@ -74,10 +80,14 @@ def _rows(system: Any, params: Mapping[str, Any], n: int) -> np.ndarray:
                              f"(one per body), got {params[key]!r}")
         out[:, j] = value
         bad = (out[:, j] <= 0) if check == "positive" else (
-            out[:, j] < 0) if check == "nonnegative" else np.zeros(n, bool)
+            out[:, j] < 0) if check == "nonnegative" else ~(
+            (out[:, j] >= 0) & (out[:, j] <= M_MAX)) if check == "exponent" else np.zeros(
+            n, bool)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            need = "> 0" if check == "positive" else ">= 0"
+            need = {"positive": "> 0", "nonnegative": ">= 0"}.get(
+                check, f"within [0, {M_MAX:g}] (the (r / r0)^-m of g(r) overflows within "
+                       f"10^(-308.25 / m) r0 of the centre: within r0 / 2 for m >= 1024)")
             raise ValueError(f"Effect 'nongrav': expected `{key}` {need}, got "
                              f"{params[key]!r} (body {k})")
     return out

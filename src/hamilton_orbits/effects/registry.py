@@ -106,6 +106,12 @@ class EffectSpec:
         another's): ``body_of(p) -> int``, the index of the body the effect acts
         on, read from its parameter vector ``p``, or -1 where it computes nothing
         another could count twice (a J2 of zero).
+    singular : callable or None
+        ``singular(system, r, p) -> str | None``: where the effect's field is not
+        finite at positions ``r`` (a body on a singularity of it), why, naming the
+        body and its index; for the refusal of such a state
+        (:func:`hamilton_orbits.rhs.refuse_nonfinite`).  None: the bodies whose
+        acceleration is not finite are named.
     """
 
     name: str
@@ -125,6 +131,7 @@ class EffectSpec:
     excludes: Mapping[str, str] = field(default_factory=dict)
     same_body_excludes: Mapping[str, str] = field(default_factory=dict)
     body_of: Callable[[np.ndarray], int] | None = None
+    singular: Callable[[Any, np.ndarray, np.ndarray], str | None] | None = None
 
 
 _REGISTRY: dict[str, dict[str, EffectSpec]] = {}

@@ -89,8 +89,9 @@ from hamilton_orbits.rhs.diskcache import (
 )
 
 __all__ = ["RHS", "STALE_AGE_SECONDS", "cache_dir", "check_ref", "compile_rhs", "kernel_ref",
-           "kernels_for", "newtonian_rhs", "parameter_vector", "remove_stale", "run_parameters",
-           "source", "takes_time", "tangent_kernels_for", "tangent_source", "time_reversed"]
+           "kernels_for", "newtonian_rhs", "parameter_vector", "refuse_nonfinite",
+           "remove_stale", "run_parameters", "source", "takes_time", "tangent_kernels_for",
+           "tangent_source", "time_reversed"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -298,6 +299,64 @@ def compile_rhs(system: Any, effects: Any = (), variational: bool = False) -> RH
         kernels, jacobians, replaces)
     return RHS(accel, extra if eff else None, p, eff.velocity_dependent, names, tangent,
                tangent_extra if eff else None, augmented, timed=timed)
+
+
+def refuse_nonfinite(system: Any, effects: Any, acc: np.ndarray, r: np.ndarray,
+                     v: np.ndarray, gm: np.ndarray, t: float = 0.0) -> None:
+    """Refuse a state whose acceleration ``acc`` is not finite through one of the
+    listed ``effects``, naming the effect, its index in the list, the body and the
+    cause (the effect's ``EffectSpec.singular``): the run would stop at its first
+    step saying only "the acceleration became non-finite (a collision?)", and
+    :meth:`System.accelerations <hamilton_orbits.nbody.System.accelerations>` would
+    return NaN.  Each effect's kernel is evaluated alone (on this path only); a
+    non-finite acceleration no effect makes (two bodies at one point) is left to
+    the integrators' own refusal.
+
+    Parameters
+    ----------
+    system : hamilton_orbits.nbody.System
+    effects : EffectSet or sequence of str or mapping
+    acc : ndarray, shape (n, 3)
+        The acceleration of the state with every effect.
+    r, v : ndarray, shape (n, 3)
+    gm : ndarray, shape (n,)
+    t : float
+        The time of the state (for the effects that know it).
+
+    Raises
+    ------
+    ValueError
+        For an effect whose acceleration alone is not finite.
+
+    Examples
+    --------
+    >>> from hamilton_orbits import Body, System
+    >>> s = System([Body("sun", 1.0, [0, 0, 0], [0, 0, 0]), Body("b", 0.0, [1, 0, 0], [0, 1, 0])])
+    >>> refuse_nonfinite(s, [], np.zeros((2, 3)), s.r, s.v, s.gm)  # finite: nothing to say
+    """
+    if np.isfinite(acc).all():
+        return
+    eff = EffectSet.of(effects, "nbody")
+    if not eff:
+        return
+    indices = eff.indices or range(len(eff.names))
+    for k, name, p in zip(indices, eff.names, eff.parameters(system), strict=True):
+        spec = get("nbody", name)
+        alone = np.zeros((len(gm), 3))
+        q = np.array(p, dtype=np.float64)
+        args = (r, v, gm, alone, q) + ((float(t),) if takes_time(spec.kernel, 5) else ())
+        try:  # (called from Python, a kernel raises where its run gives inf or NaN)
+            with np.errstate(all="ignore"):
+                spec.kernel(*args)
+            bad = np.flatnonzero(~np.isfinite(alone).all(axis=1))
+            what = " is not finite"
+        except ZeroDivisionError:
+            bad, what = np.arange(len(gm)), " is not finite (a division by zero)"
+        if bad.size:
+            why = spec.singular(system, r, q) if spec.singular is not None else None
+            where = why or "the acceleration of " + ", ".join(
+                f"body {system.names[i]!r} (index {i})" for i in bad) + what
+            raise ValueError(f"Effect {name!r} (effects[{k}]) at t = {float(t)!r}: {where}")
 
 
 def time_reversed(rhs: RHS) -> RHS:
