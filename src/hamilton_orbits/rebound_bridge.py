@@ -158,9 +158,12 @@ def reboundx_counterparts(system: System, effects: Any) -> list[tuple[str, np.nd
             _check_gr_full(system, p)
         if name == "j2" and tuple(p[3:]) != (0.0, 0.0, 1.0):
             raise ValueError(
-                "reboundx's gravitational_harmonics takes the pole along z; rotate the "
-                f"system so that body {system.names[int(p[0])]!r} has its pole on z to "
-                f"cross-check")
+                f"reboundx's gravitational_harmonics takes the pole along z, and body "
+                f"{system.names[int(p[0])]!r} has its pole at {list(map(float, p[3:]))} "
+                f"(System.solar_system and from_ephemeris give the Sun, the Earth and the "
+                f"Moon their real poles); to cross-check, give the j2 effect "
+                f"pole = [0, 0, 1] (the z axis), or rotate the system so that the pole is on "
+                f"z, or leave out the cross-check")
         out.append((name, p))
     return out
 

@@ -97,3 +97,19 @@ def test_rebound_hyperbolic_tiny_mean_anomaly():
     assert abs(o.M - M_ref) <= 16 * EPS * M_ref
     rebound_err = abs(A[0, 6] - M_ref) / M_ref
     assert rebound_err > 1e-3  # rebound loses the digits (REFERENCES.md: comes back as 0)
+
+
+def test_a_j2_pole_off_z_says_how_to_cross_check():
+    """System.solar_system gives the Sun its real pole (7.25 deg from the ecliptic's
+    z): reboundx's gravitational_harmonics cannot tilt it, and the refusal says what
+    a scene can do (a pole on z, or no cross-check), not only "rotate the system"."""
+    import astropy.units as u
+
+    from hamilton_orbits import System
+    from hamilton_orbits.rebound_bridge import reboundx_counterparts
+
+    s = System.solar_system(frame="ecliptic")
+    with pytest.raises(ValueError, match=r"body 'sun' has its pole at .*give the j2 effect "
+                                         r"pole = \[0, 0, 1\].*or leave out the cross-check"):
+        reboundx_counterparts(s, [{"name": "j2", "body": "sun", "j2": 2.2e-7,
+                                   "radius": 696000 * u.km}])
