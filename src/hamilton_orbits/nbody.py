@@ -574,7 +574,7 @@ class System(InitialStates):
             not finite, or of the wrong dimension (astropy's UnitConversionError),
             naming ``t`` and the value; for an effect whose acceleration is not
             finite in this state (a body on the Kuiper ring), naming the effect, its
-            index, the body and the cause (:func:`hamilton_orbits.rhs.refuse_nonfinite`).
+            index, the body and the cause (``hamilton_orbits.rhs.refuse_nonfinite``).
 
         Examples
         --------

@@ -110,7 +110,7 @@ class EffectSpec:
         ``singular(system, r, p) -> str | None``: where the effect's field is not
         finite at positions ``r`` (a body on a singularity of it), why, naming the
         body and its index; for the refusal of such a state
-        (:func:`hamilton_orbits.rhs.refuse_nonfinite`).  None: the bodies whose
+        (``hamilton_orbits.rhs.refuse_nonfinite``).  None: the bodies whose
         acceleration is not finite are named.
     """
 
