@@ -598,6 +598,10 @@ class System(InitialStates):
                              f"got {t!r}")
         acc = compile_rhs(self, effects).acceleration(self._r, self._v, self._gm, t=days)
         refuse_nonfinite(self, effects, acc, self._r, self._v, self._gm, days)
+        if not np.isfinite(acc).all():  # (no effect's: the bodies' own)
+            k = int(np.argmax(~np.isfinite(acc).all(axis=1)))
+            raise ValueError(f"The acceleration of body {self.names[k]!r} (index {k}) is not "
+                             f"finite: two bodies at one position?")
         return acc * A_UNIT if self._quantity else acc
 
     def _energy_hamilton(self) -> float:

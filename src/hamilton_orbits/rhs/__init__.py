@@ -165,7 +165,10 @@ class RHS:
         acc = np.empty_like(r)
         p = self.p.copy()  # (its own clock: this p may be a running integrator's)
         p[-1] = t
-        self.accel(r, v, gm, acc, p)
+        try:
+            self.accel(r, v, gm, acc, p)
+        except ZeroDivisionError:  # (called from Python, a compiled division by zero
+            acc[...] = np.nan  # raises where a run gets inf or NaN: the run's value)
         return acc
 
 
