@@ -127,6 +127,19 @@ def poinsot(body: RigidBody, t: Any) -> PoinsotPaths:
     )
 
 
+def _plane_panel(ax: Any, points: np.ndarray, joined: bool, colour: str,
+                 labels: tuple[str, str], title: str) -> None:
+    """A flat panel of ``points`` (n, 2): over a stated power of ten where small
+    (:func:`_exponent`), equal aspect, no offset text."""
+    e = _exponent(points)
+    _curve(ax, points / 10.0**e, joined, colour)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(labels[0] + _over(e), fontsize=8)
+    ax.set_ylabel(labels[1] + _over(e), fontsize=8)
+    ax.set_title(title + _unjoined(joined, len(points)), fontsize=10)
+    ax.ticklabel_format(useOffset=False, style="plain")
+
+
 def _exponent(values: np.ndarray) -> int:
     """``e`` with the largest magnitude of ``values`` / 10**e in [1, 10); 0 when that
     magnitude is already of order one (0.01 to 1000), zero or not finite."""
@@ -245,28 +258,14 @@ def plot_poinsot(body: RigidBody, t: Any, *, fig: Any = None) -> Any:
     ax1.set_title("polhode on the inertia ellipsoid (body)", fontsize=10)
 
     ax2 = fig.add_subplot(1, 3, 2)
-    e = _exponent(seen)
-    _curve(ax2, seen / 10.0**e, joined, "C3")
-    ax2.set_aspect("equal", adjustable="datalim")
-    ax2.set_xlabel(f"body axis {i + 1}, $\\rho_{i + 1}\\sqrt{{C}}${_over(e)}", fontsize=8)
-    ax2.set_ylabel(f"body axis {j + 1}, $\\rho_{j + 1}\\sqrt{{C}}${_over(e)}", fontsize=8)
-    ax2.set_title(f"polhode seen along body axis {k + 1}"
-                  + _unjoined(joined, len(seen)),
-                  fontsize=10)
-
+    _plane_panel(ax2, seen, joined, "C3", (f"body axis {i + 1}, $\\rho_{i + 1}\\sqrt{{C}}$",
+                                          f"body axis {j + 1}, $\\rho_{j + 1}\\sqrt{{C}}$"),
+                 f"polhode seen along body axis {k + 1}")
     ax3 = fig.add_subplot(1, 3, 3)
-    e = _exponent(herpolhode)
-    joined = _joinable(herpolhode)
-    _curve(ax3, herpolhode / 10.0**e, joined, "C0")
-    ax3.set_aspect("equal", adjustable="datalim")
-    ax3.set_xlabel(f"along e1 in the invariable plane, $x\\sqrt{{C}}${_over(e)}", fontsize=8)
-    ax3.set_ylabel(f"along e2, $y\\sqrt{{C}}${_over(e)}", fontsize=8)
-    ax3.set_title(f"herpolhode (invariable plane at $d\\sqrt{{C}}$ = {distance:.6g})"
-                  + _unjoined(joined, len(herpolhode)),
-                  fontsize=10)
+    _plane_panel(ax3, herpolhode, _joinable(herpolhode), "C0",
+                 ("along e1 in the invariable plane, $x\\sqrt{C}$", "along e2, $y\\sqrt{C}$"),
+                 f"herpolhode (invariable plane at $d\\sqrt{{C}}$ = {distance:.6g})")
     ax3.legend(loc="lower left", fontsize=7)
-    for ax in (ax2, ax3):
-        ax.ticklabel_format(useOffset=False, style="plain")
     fig.suptitle("Poinsot's construction: the inertia ellipsoid $x \\cdot I x = 1$ in "
                  f"coordinates times $\\sqrt{{C}}$ (C, the largest moment, = {scale})", fontsize=10)
     fig.tight_layout()
