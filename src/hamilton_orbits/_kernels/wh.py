@@ -205,7 +205,7 @@ STATUS_DRAIN = 5
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
-           jump):  # pragma: no cover - compiled
+           jump, no_ab):  # pragma: no cover - compiled
     """One Kepler drift of ``tau`` with the barycentre; with events watched
     (``watch`` not None and ``watched``; ``watch`` None is decided at compile time:
     the loops without events have no trace of them), the drift is scanned on the Kepler arcs
@@ -214,10 +214,11 @@ def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0,
     :func:`hamilton_orbits._kernels.events._dh_constants`; ``g`` the rows' ``G m``).
     ``ws = [t, t_action, drain, row]``: the drift's start time (advanced here),
     the time and watch row of the first event with an action, and whether the
-    buffer must be drained.  Returns a failing body or -1."""
+    buffer must be drained.  ``no_ab``: zero arrays (1,) and (7, 1) for the scan's
+    unused arguments (see :func:`_no_ab`).  Returns a failing body or -1."""
     if watch is not None and watched:
         return _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0,
-                              mu_s, g, jump)
+                              mu_s, g, jump, no_ab)
     bad = _kepler_all(q, u, mu, tau)
     if jacobi:
         for k in range(3):
@@ -229,10 +230,13 @@ def _drift(watched, q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0,
     return bad
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, v0, mu_s, g,
-                   jump):  # pragma: no cover - compiled
-    """:func:`_drift` with its events scanned."""
+                   jump, no_ab):  # pragma: no cover - compiled
+    """:func:`_drift` with its events scanned.  Inlined, at the one call site of
+    :func:`_dh_steps` (and of :func:`_jacobi_steps`): called, it was a level of
+    linking more, the scan optimised once more (1.3 s of compilation), and both
+    branches on ``jacobi`` were compiled into every entry."""
     n_watch = watch.shape[0]
     _copy(q, u, x0, v0)
     bad = _kepler_all(q, u, mu, tau)
@@ -246,11 +250,11 @@ def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, 
         if jacobi:  # escapes from the barycentre, Jacobi row 0
             for k in range(3):
                 cm[k], cm[3 + k], cm[6 + k] = x0[0, k], v0[0, k], q[0, k]
-            h, row = _ev.scan(watch, _ev.JACOBI, ws[0], tau, x0, v0, q, u, _NO_A0, _NO_B, mu_s,
-                              cm, ev_out, ev_count)
+            h, row = _ev.scan(watch, _ev.JACOBI, ws[0], tau, x0, v0, q, u, no_ab[0], no_ab[1],
+                              mu_s, cm, ev_out, ev_count)
         else:  # the jump before the drift in cm[0], the masses in place of a0
             cm[0] = jump
-            h, row = _ev.scan(watch, _ev.DH, ws[0], tau, x0, v0, q, u, g, _NO_B, mu_s, cm,
+            h, row = _ev.scan(watch, _ev.DH, ws[0], tau, x0, v0, q, u, g, no_ab[1], mu_s, cm,
                               ev_out, ev_count)
         if row >= 0 and ws[0] + h * tau < ws[1]:
             ws[1] = ws[0] + h * tau
@@ -261,9 +265,16 @@ def _drift_watched(q, u, mu, tau, jacobi, com, watch, ev_out, ev_count, ws, x0, 
     return bad
 
 
-_NO_A0 = np.zeros(1)
-_NO_B = np.zeros((7, 1))
 _ORIGIN = np.zeros(9)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _no_ab():  # pragma: no cover - compiled
+    """Zero arrays (1,) and (7, 1) for the arguments ``a0``, ``b`` of the events' scan
+    that the Kepler arcs do not use: writable, as radau15's (global arrays are read-only
+    to numba, another type), so that every caller shares one compiled scan (each
+    type of them compiled it again: 15 s)."""
+    return np.zeros(1), np.zeros((7, 1))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -275,7 +286,7 @@ def _copy(q, u, x, v):  # pragma: no cover - compiled
             v[i, k] = u[i, k]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def _stop_here(q, u, mu, h_back, jacobi, com, ws, t_end_step, ev_out, ev_count):
     # pragma: no cover - compiled
     """After a merged drift, go back ``h_back`` (exact: Kepler drifts reverse) to the
@@ -525,23 +536,19 @@ def corrector_jacobi(extra_addr, p, has_extra, order, qj, uj, gm, eta, dt, sign,
     for k in range(a.shape[0]):
         ak = a[k] * dt
         bk = sign * b[k] * dt
-        bad = _kepler_all(qj, uj, eta, ak)
-        if bad >= 0:
-            return bad
-        _kick_jacobi(
-            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, -bk, False,
-            acc, accj, acc_x, r_in, v_in, perm,
-        )
-        bad = _kepler_all(qj, uj, eta, -2.0 * ak)
-        if bad >= 0:
-            return bad
-        _kick_jacobi(
-            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, bk, False,
-            acc, accj, acc_x, r_in, v_in, perm,
-        )
-        bad = _kepler_all(qj, uj, eta, ak)
-        if bad >= 0:
-            return bad
+        # Z's five stages from one call site each of the drift and of the inlined
+        # kick (the kick written out twice, and the drift called thrice, cost 1.3 s
+        # more of compilation for the same arithmetic; measured)
+        for stage in range(5):
+            if stage % 2 == 0:
+                bad = _kepler_all(qj, uj, eta, -2.0 * ak if stage == 2 else ak)
+                if bad >= 0:
+                    return bad
+            else:
+                _kick_jacobi(
+                    extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv,
+                    -bk if stage == 1 else bk, False, acc, accj, acc_x, r_in, v_in, perm,
+                )
     return -1
 
 
@@ -656,27 +663,31 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
               ev_count, ws, x0, v0, mu, mu_s, kick):  # pragma: no cover - compiled
     """The steps of :func:`advance_dh` (``kick``: its work arrays)."""
     idx, m_tot, acc_m, r_in, v_in, acc_x, order, gm_c = kick
+    no_ab = _no_ab()
     t_step = ws[0]
-    h = dt if n_steps > 1 else dt_last
-    bad = _drift(watched, q, u, mu, 0.5 * h, False, com, watch, ev_out, ev_count, ws, x0, v0,
-                 mu_s, gm, 0.0)
-    if bad >= 0:
-        return 0, bad, STATUS_OK
-    for s in range(n_steps):
-        h = dt if s < n_steps - 1 else dt_last
-        if has_extra:
-            set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
-        _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in, acc_x,
-                 order, gm_c)
-        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
-        bad = _drift(watched, q, u, mu, 0.5 * (h + h_next), False, com, watch, ev_out, ev_count,
-                     ws, x0, v0, mu_s, gm, 0.5 * h)
+    h = h_next = 0.0
+    for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of the
+        if s < 0:  # inlined drift, with its scan: see _drift_watched)
+            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            jump = 0.0
+        else:
+            h = dt if s < n_steps - 1 else dt_last
+            if has_extra:
+                set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
+            _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in,
+                     acc_x, order, gm_c)
+            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            tau = 0.5 * (h + h_next)
+            jump = 0.5 * h
+        bad = _drift(watched, q, u, mu, tau, False, com, watch, ev_out, ev_count, ws, x0, v0,
+                     mu_s, gm, jump, no_ab)
         if bad >= 0:
-            return s, bad, STATUS_OK
-        t_step += h
-        if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
-            return s + 1, -1, _stop_here(q, u, mu, 0.5 * h_next, False, com, ws, t_step,
-                                         ev_out, ev_count)
+            return max(s, 0), bad, STATUS_OK
+        if s >= 0:
+            t_step += h
+            if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
+                return s + 1, -1, _stop_here(q, u, mu, 0.5 * h_next, False, com, ws, t_step,
+                                             ev_out, ev_count)
     return n_steps, -1, STATUS_OK
 
 
@@ -685,29 +696,31 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
                   ev_out, ev_count, ws, x0, v0, kick):  # pragma: no cover - compiled
     """The steps of :func:`advance_jacobi` (``kick``: its work arrays)."""
     idx, ratio, inv, acc, accj, acc_x, r_in, v_in, perm = kick
+    no_ab = _no_ab()
     t_step = ws[0]
-    h = dt if n_steps > 1 else dt_last
-    bad = _drift(watched, qj, uj, eta, 0.5 * h, True, eta, watch, ev_out, ev_count, ws, x0, v0,
-                 eta, gm, 0.0)
-    if bad >= 0:
-        return 0, bad, STATUS_OK
-    for s in range(n_steps):
-        h = dt if s < n_steps - 1 else dt_last
-        if has_extra:
-            set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
-        _kick_jacobi(
-            extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
-            acc, accj, acc_x, r_in, v_in, perm,
-        )
-        h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
-        bad = _drift(watched, qj, uj, eta, 0.5 * (h + h_next), True, eta, watch, ev_out,
-                     ev_count, ws, x0, v0, eta, gm, 0.0)
+    h = h_next = 0.0
+    for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of the
+        if s < 0:  # inlined drift, as in _dh_steps)
+            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+        else:
+            h = dt if s < n_steps - 1 else dt_last
+            if has_extra:
+                set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
+            _kick_jacobi(
+                extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
+                acc, accj, acc_x, r_in, v_in, perm,
+            )
+            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            tau = 0.5 * (h + h_next)
+        bad = _drift(watched, qj, uj, eta, tau, True, eta, watch, ev_out, ev_count, ws, x0, v0,
+                     eta, gm, 0.0, no_ab)
         if bad >= 0:
-            return s, bad, STATUS_OK
-        t_step += h
-        if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
-            return s + 1, -1, _stop_here(qj, uj, eta, 0.5 * h_next, True, eta, ws, t_step,
-                                         ev_out, ev_count)
+            return max(s, 0), bad, STATUS_OK
+        if s >= 0:
+            t_step += h
+            if watch is not None and (ws[1] <= t_step or ws[2] > 0.0):
+                return s + 1, -1, _stop_here(qj, uj, eta, 0.5 * h_next, True, eta, ws, t_step,
+                                             ev_out, ev_count)
     return n_steps, -1, STATUS_OK
 
 
