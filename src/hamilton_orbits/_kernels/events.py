@@ -34,14 +34,15 @@ a quadratic to rounding.
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 from numba import njit
 
 from hamilton_orbits._kernels import kepler as _kepler
 
-__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_steps",
-           "state_at"]
+__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_radau",
+           "scan_steps", "state_at", "state_at_hermite", "state_at_radau"]
 
 RADAU = 0
 LINE = 1
@@ -49,6 +50,12 @@ KEPLER = 2
 HERMITE = 3
 JACOBI = 4
 DH = 5
+
+#: The interpolant these functions are compiled for: -1 (here) any, read from their
+#: ``kind`` argument at run time; in the copies of :func:`_for_kind`, that one alone
+#: (every ``kind ==`` test then a constant, and numba prunes the other kinds' branches
+#: before it compiles them).
+_KIND = -1
 
 _CODE_ENCOUNTER = 1
 _CODE_COLLISION = 2
@@ -59,6 +66,7 @@ _CODE_ESCAPE = 3
 def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
     """Position and velocity of body ``k`` at ``h`` into ``out`` (6,) (not ``DH``:
     :func:`_dh_state`)."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     if kind == DH:
         raise ValueError("events: the DH interpolant needs the drift's constants (_dh_state)")
     if kind == JACOBI:
@@ -240,6 +248,7 @@ def _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
     """``(|d|^2, d . w, |w|)`` of body ``i`` relative to body ``j`` (``j < 0``: the
     centre of mass, ``cm = [x_cm(0), v_cm, x_cm(1) ...]`` moving uniformly; for
     ``DH``, ``a0`` the rows' ``G m`` and ``cm`` from :func:`_dh_constants`)."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     if kind == DH and (j < 0 or mu[i] == 0.0 or mu[j] == 0.0):
         fr = np.empty(12)
         _dh_frame(h, dt, x0, v0, x1, v1, a0, mu, cm, fr)
@@ -277,6 +286,7 @@ def _ends(kind, x0, v0, x1, v1, mu, a0, cm, ce):  # pragma: no cover - compiled
     """The positions and velocities at both ends of the step in the frame the
     events are watched in (computed once per step: O(n), not O(n) per pair), and
     into ``ce`` (12,) the centre of mass's position and velocity at both ends."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     for c in range(3):  # uniform motion (every kind but DH)
         ce[c], ce[3 + c], ce[6 + c], ce[9 + c] = cm[c], cm[3 + c], cm[6 + c], cm[3 + c]
     if kind == DH:  # relative to the central body, the common offset added
@@ -318,6 +328,7 @@ def _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b):  # pragma: no cover -
     ``DH`` (given the arcs themselves) with the common offset's own,
     ``sum m_k bound_k / m_0`` (``a0`` the rows' ``G m``), added; infinite (no
     filter) for the other interpolants."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     n = p0.shape[0]
     out = np.full(n, np.inf)
     if kind == RADAU:  # |a(h)| <= |a0| + sum |b_k| on [0, 1], per component
@@ -471,6 +482,9 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
     barycentric velocities (row 0 the central body, ``mu[0] = 0``), ``a0`` (n,) the
     rows' ``G m``, ``cm[0]`` the jump before the drift (see :func:`_dh_constants`).
     """
+    if _KIND >= 0 and kind != _KIND:
+        raise ValueError("events: scan called for another interpolant than its copy's")
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     si = np.empty(6)
     sj = np.empty(6)
     ce = np.empty(12)
@@ -530,6 +544,8 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
 def state_at(kind, h, dt, x0, v0, x1, v1, a0, b, mu, r, v):  # pragma: no cover - compiled
     """Every body's position and velocity at ``h`` into ``r``, ``v`` (n, 3) (any kind
     but ``DH``)."""
+    if _KIND >= 0 and kind != _KIND:
+        raise ValueError("events: state_at called for another interpolant than its copy's")
     s = np.empty(6)
     for k in range(r.shape[0]):
         _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, s)
@@ -560,8 +576,51 @@ def scan_steps(watch, ts, xs, vs, gm, out, count):  # pragma: no cover - compile
                 cm[c] += gm[k] * xs[s, k, c] / total
                 cm[3 + c] += gm[k] * vs[s, k, c] / total
                 cm[6 + c] += gm[k] * xs[s + 1, k, c] / total
-        h, row = scan(watch, HERMITE, ts[s], ts[s + 1] - ts[s], xs[s], vs[s], xs[s + 1],
+        h, row = _scan_hermite(watch, HERMITE, ts[s], ts[s + 1] - ts[s], xs[s], vs[s], xs[s + 1],
                       vs[s + 1], no_a0, no_b, gm, cm, out, count)
         if row >= 0:
             return s, h, row
     return -1, 2.0, -1
+
+
+#: the functions whose code depends on the interpolant, directly or through a call
+_BY_KIND = ("_state", "_relative", "_ends", "_deviation_bound", "_bisect", "_g", "scan",
+            "state_at")
+
+
+def _for_kind(kind: int, suffix: str) -> dict:
+    """Copies of :data:`_BY_KIND` compiled for the interpolant ``kind`` alone, by name
+    (each ``name + "_" + suffix``, its own cache files).  They share one table of
+    globals in which ``_KIND`` is ``kind`` and each name is its copy, so that they
+    call one another; the arithmetic is the same code (the same bits).
+
+    Why: compiled with ``kind`` a run-time number, :func:`scan` compiles every
+    interpolant's code (the Kepler solver, the Jacobi and democratic-heliocentric
+    frames) for every caller: radau15's ``advance_watched`` took 21.2 s of CPU to
+    compile, 9.3 s with its ``RADAU`` copy; ``scan_steps`` (dop853) 11.4 s, see the
+    commit's figures with its ``HERMITE`` copy."""
+    table = dict(globals())
+    table["_KIND"] = kind
+    copies = {}
+    for name in _BY_KIND:
+        dispatcher = globals()[name]
+        func = dispatcher.py_func
+        copy = types.FunctionType(func.__code__, table, f"{func.__name__}_{suffix}",
+                                  func.__defaults__, func.__closure__)
+        copy.__qualname__ = f"{func.__qualname__}_{suffix}"
+        copy.__doc__ = func.__doc__
+        copy.__kwdefaults__ = func.__kwdefaults__
+        options = {k: v for k, v in dispatcher.targetoptions.items() if k != "nopython"}
+        copies[name] = njit(cache=True, **options)(copy)
+    table.update(copies)
+    return copies
+
+
+_RADAU_COPIES = _for_kind(RADAU, "radau")
+#: :func:`scan` and :func:`state_at` for radau15's polynomial alone (``kind`` must be
+#: ``RADAU``)
+scan_radau, state_at_radau = _RADAU_COPIES["scan"], _RADAU_COPIES["state_at"]
+_HERMITE_COPIES = _for_kind(HERMITE, "hermite")
+#: :func:`scan` and :func:`state_at` for the cubic Hermite interpolant alone (``kind``
+#: must be ``HERMITE``; dop853's, through :func:`scan_steps`)
+_scan_hermite, state_at_hermite = _HERMITE_COPIES["scan"], _HERMITE_COPIES["state_at"]
