@@ -34,14 +34,15 @@ a quadratic to rounding.
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 from numba import njit
 
 from hamilton_orbits._kernels import kepler as _kepler
 
-__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_steps",
-           "state_at"]
+__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_radau",
+           "scan_steps", "state_at", "state_at_hermite", "state_at_radau"]
 
 RADAU = 0
 LINE = 1
@@ -49,6 +50,12 @@ KEPLER = 2
 HERMITE = 3
 JACOBI = 4
 DH = 5
+
+#: The interpolant these functions are compiled for: -1 (here) any, read from their
+#: ``kind`` argument at run time; in the copies of :func:`_for_kind`, that one alone
+#: (every ``kind ==`` test then a constant, and numba prunes the other kinds' branches
+#: before it compiles them).
+_KIND = -1
 
 _CODE_ENCOUNTER = 1
 _CODE_COLLISION = 2
@@ -59,6 +66,7 @@ _CODE_ESCAPE = 3
 def _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, out):  # pragma: no cover - compiled
     """Position and velocity of body ``k`` at ``h`` into ``out`` (6,) (not ``DH``:
     :func:`_dh_state`)."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     if kind == DH:
         raise ValueError("events: the DH interpolant needs the drift's constants (_dh_state)")
     if kind == JACOBI:
@@ -240,6 +248,7 @@ def _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
     """``(|d|^2, d . w, |w|)`` of body ``i`` relative to body ``j`` (``j < 0``: the
     centre of mass, ``cm = [x_cm(0), v_cm, x_cm(1) ...]`` moving uniformly; for
     ``DH``, ``a0`` the rows' ``G m`` and ``cm`` from :func:`_dh_constants`)."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     if kind == DH and (j < 0 or mu[i] == 0.0 or mu[j] == 0.0):
         fr = np.empty(12)
         _dh_frame(h, dt, x0, v0, x1, v1, a0, mu, cm, fr)
@@ -277,6 +286,7 @@ def _ends(kind, x0, v0, x1, v1, mu, a0, cm, ce):  # pragma: no cover - compiled
     """The positions and velocities at both ends of the step in the frame the
     events are watched in (computed once per step: O(n), not O(n) per pair), and
     into ``ce`` (12,) the centre of mass's position and velocity at both ends."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     for c in range(3):  # uniform motion (every kind but DH)
         ce[c], ce[3 + c], ce[6 + c], ce[9 + c] = cm[c], cm[3 + c], cm[6 + c], cm[3 + c]
     if kind == DH:  # relative to the central body, the common offset added
@@ -318,6 +328,7 @@ def _deviation_bound(kind, p0, w0, p1, w1, mu, dt, a0, b):  # pragma: no cover -
     ``DH`` (given the arcs themselves) with the common offset's own,
     ``sum m_k bound_k / m_0`` (``a0`` the rows' ``G m``), added; infinite (no
     filter) for the other interpolants."""
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     n = p0.shape[0]
     out = np.full(n, np.inf)
     if kind == RADAU:  # |a(h)| <= |a0| + sum |b_k| on [0, 1], per component
@@ -398,15 +409,17 @@ def _at_end(i, j, p, w, ce, at):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _bisect(which, kind, i, j, lo, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
+def _bisect(kind, i, j, lo, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
     # pragma: no cover - compiled
-    """The root in ``[lo, hi]`` of ``f`` (``which = 0``: ``d . w``, negative at ``lo``)
-    or of ``|d|^2 - target2`` (``which = 1``), bracketed: Illinois steps (regula
+    """The root in ``[lo, hi]`` of ``f`` (``target2 < 0``: ``d . w``, negative at ``lo``)
+    or of ``|d|^2 - target2`` (``target2 >= 0``), bracketed: Illinois steps (regula
     falsi that halves a stale end's value), a bisection whenever the bracket did not
     halve, until it is two adjacent floats (a few to a dozen evaluations instead of
-    fifty for bisection alone)."""
-    g_lo = _g(which, kind, i, j, lo, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
-    g_hi = _g(which, kind, i, j, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+    fifty for bisection alone).  (Which root, from the sign of ``target2`` rather
+    than from a flag: a constant flag made numba compile one copy of this function
+    for each value, 0.4-0.9 s more of a first run.)"""
+    g_lo = _g(kind, i, j, lo, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+    g_hi = _g(kind, i, j, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
     if g_hi == 0.0:
         return hi
     side = 0
@@ -421,7 +434,7 @@ def _bisect(which, kind, i, j, lo, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, c
             x = 0.5 * (lo + hi)
             if not (lo < x < hi):
                 break
-        g = _g(which, kind, i, j, x, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
+        g = _g(kind, i, j, x, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
         if g == 0.0:
             return x
         if (g < 0.0) == (g_lo < 0.0):
@@ -438,10 +451,10 @@ def _bisect(which, kind, i, j, lo, hi, target2, dt, x0, v0, x1, v1, a0, b, mu, c
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _g(which, kind, i, j, h, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
+def _g(kind, i, j, h, target2, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj):
     # pragma: no cover - compiled
     d2, f, _ = _relative(kind, i, j, h, dt, x0, v0, x1, v1, a0, b, mu, cm, si, sj)
-    return f if which == 0 else d2 - target2
+    return f if target2 < 0.0 else d2 - target2
 
 
 @njit(cache=True, error_model="numpy")
@@ -471,6 +484,9 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
     barycentric velocities (row 0 the central body, ``mu[0] = 0``), ``a0`` (n,) the
     rows' ``G m``, ``cm[0]`` the jump before the drift (see :func:`_dh_constants`).
     """
+    if _KIND >= 0 and kind != _KIND:
+        raise ValueError("events: scan called for another interpolant than its copy's")
+    kind = _KIND if _KIND >= 0 else kind  # (a constant in :func:`_for_kind`'s copies)
     si = np.empty(6)
     sj = np.empty(6)
     ce = np.empty(12)
@@ -494,7 +510,7 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
         h = -1.0
         if code == _CODE_ESCAPE:
             if d2a < thr2 <= d2b:
-                h = _bisect(1, kind, i, j, 0.0, 1.0, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
+                h = _bisect(kind, i, j, 0.0, 1.0, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
                             si, sj)
         else:
             h_min = 1.0
@@ -503,7 +519,7 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
             if _too_far(i, j, p0, w0, dt, d2a, fa, thr2, bound):
                 continue  # cannot come within the distance in this step
             if 0.0 <= fb:
-                h_min = _bisect(0, kind, i, j, 0.0, 1.0, 0.0, dt, x0, v0, x1, v1, a0, b, mu,
+                h_min = _bisect(kind, i, j, 0.0, 1.0, -1.0, dt, x0, v0, x1, v1, a0, b, mu,
                                 cm, si, sj)
             d2m = d2b  # approaching all through the step: the end is the closest
             if h_min < 1.0:
@@ -513,7 +529,7 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
                 if fa < 0.0 <= fb and d2m < thr2:
                     h = h_min
             elif d2a > thr2 >= d2m:
-                h = _bisect(1, kind, i, j, 0.0, h_min, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
+                h = _bisect(kind, i, j, 0.0, h_min, thr2, dt, x0, v0, x1, v1, a0, b, mu, cm,
                             si, sj)
         if h < 0.0:
             continue
@@ -530,6 +546,8 @@ def scan(watch, kind, t0, dt, x0, v0, x1, v1, a0, b, mu, cm, out, count):
 def state_at(kind, h, dt, x0, v0, x1, v1, a0, b, mu, r, v):  # pragma: no cover - compiled
     """Every body's position and velocity at ``h`` into ``r``, ``v`` (n, 3) (any kind
     but ``DH``)."""
+    if _KIND >= 0 and kind != _KIND:
+        raise ValueError("events: state_at called for another interpolant than its copy's")
     s = np.empty(6)
     for k in range(r.shape[0]):
         _state(kind, k, h, dt, x0, v0, x1, v1, a0, b, mu, s)
@@ -560,8 +578,53 @@ def scan_steps(watch, ts, xs, vs, gm, out, count):  # pragma: no cover - compile
                 cm[c] += gm[k] * xs[s, k, c] / total
                 cm[3 + c] += gm[k] * vs[s, k, c] / total
                 cm[6 + c] += gm[k] * xs[s + 1, k, c] / total
-        h, row = scan(watch, HERMITE, ts[s], ts[s + 1] - ts[s], xs[s], vs[s], xs[s + 1],
+        h, row = _scan_hermite(watch, HERMITE, ts[s], ts[s + 1] - ts[s], xs[s], vs[s], xs[s + 1],
                       vs[s + 1], no_a0, no_b, gm, cm, out, count)
         if row >= 0:
             return s, h, row
     return -1, 2.0, -1
+
+
+#: the functions whose code depends on the interpolant, directly or through a call
+_BY_KIND = ("_state", "_relative", "_ends", "_deviation_bound", "_bisect", "_g", "scan",
+            "state_at")
+
+
+def _for_kind(kind: int, suffix: str) -> dict:
+    """Copies of :data:`_BY_KIND` compiled for the interpolant ``kind`` alone, by name
+    (each ``name + "_" + suffix``, its own cache files).  They share one table of
+    globals in which ``_KIND`` is ``kind`` and each name is its copy, so that they
+    call one another; the arithmetic is the same code (the same bits).
+
+    Why: compiled with ``kind`` a run-time number, :func:`scan` compiles every
+    interpolant's code (the Kepler solver, the Jacobi and democratic-heliocentric
+    frames) for every caller: on a cold cache (CPU seconds, medians of 2 runs)
+    radau15's ``advance_watched`` compiled in 19.6 s, 9.5 s with its ``RADAU`` copy;
+    ``scan_steps`` (dop853) in 10.8 s, 3.2 s with its ``HERMITE`` copy.  (wh and
+    leapfrog call the generic :func:`scan` with constant kinds; a copy of theirs would
+    cut their compilation alike.)"""
+    table = dict(globals())
+    table["_KIND"] = kind
+    copies = {}
+    for name in _BY_KIND:
+        dispatcher = globals()[name]
+        func = dispatcher.py_func
+        copy = types.FunctionType(func.__code__, table, f"{func.__name__}_{suffix}",
+                                  func.__defaults__, func.__closure__)
+        copy.__qualname__ = f"{func.__qualname__}_{suffix}"
+        copy.__doc__ = func.__doc__
+        copy.__kwdefaults__ = func.__kwdefaults__
+        options = {k: v for k, v in dispatcher.targetoptions.items() if k != "nopython"}
+        copies[name] = njit(cache=True, **options)(copy)
+    table.update(copies)
+    return copies
+
+
+_RADAU_COPIES = _for_kind(RADAU, "radau")
+#: :func:`scan` and :func:`state_at` for radau15's polynomial alone (``kind`` must be
+#: ``RADAU``)
+scan_radau, state_at_radau = _RADAU_COPIES["scan"], _RADAU_COPIES["state_at"]
+_HERMITE_COPIES = _for_kind(HERMITE, "hermite")
+#: :func:`scan` and :func:`state_at` for the cubic Hermite interpolant alone (``kind``
+#: must be ``HERMITE``; dop853's, through :func:`scan_steps`)
+_scan_hermite, state_at_hermite = _HERMITE_COPIES["scan"], _HERMITE_COPIES["state_at"]

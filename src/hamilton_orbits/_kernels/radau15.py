@@ -609,12 +609,12 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
     if total > 0.0:  # (massless rows alone, small bodies': no centre of mass, no escape)
         for c in range(9):
             cm[c] /= total
-    h, row = _ev.scan(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
+    h, row = _ev.scan_radau(watch, _ev.RADAU, t, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v,
                       a0, b, gm, cm, ev_out, ev_count)
     st[ST_EVENT_ROW] = row
     if h <= 1.0:
-        _ev.state_at(_ev.RADAU, h, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v, a0, b, gm,
-                     r, v)
+        _ev.state_at_radau(_ev.RADAU, h, dt, x0.reshape((n, 3)), v0.reshape((n, 3)), r, v, a0,
+                           b, gm, r, v)
         csx[:] = 0.0
         csv[:] = 0.0
     return h

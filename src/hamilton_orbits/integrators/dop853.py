@@ -193,8 +193,8 @@ class _State:
         if k < 0:
             return False
         r, v = np.empty((n, 3)), np.empty((n, 3))
-        _ev.state_at(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
-                     np.zeros(1), np.zeros((7, 1)), self.gm, r, v)
+        _ev.state_at_hermite(_ev.HERMITE, h, solver.t - t_prev, xs[0], vs[0], xs[1], vs[1],
+                             np.zeros(1), np.zeros((7, 1)), self.gm, r, v)
         self.t = float(t_prev + h * (solver.t - t_prev))
         stop = log.act(int(row), self.t, r, v, self.gm)
         self.y = np.concatenate((r.ravel(), v.ravel()))
