@@ -600,9 +600,11 @@ def _for_kind(kind: int, suffix: str) -> dict:
     interpolant's code (the Kepler solver, the Jacobi and democratic-heliocentric
     frames) for every caller: on a cold cache (CPU seconds, medians of 2 runs)
     radau15's ``advance_watched`` compiled in 19.6 s, 9.5 s with its ``RADAU`` copy;
-    ``scan_steps`` (dop853) in 10.8 s, 3.2 s with its ``HERMITE`` copy.  (wh and
-    leapfrog call the generic :func:`scan` with constant kinds; a copy of theirs would
-    cut their compilation alike.)"""
+    ``scan_steps`` (dop853) in 10.8 s, 3.2 s with its ``HERMITE`` copy.  wh and
+    leapfrog share the generic :func:`scan` (wh's kernels call it for both ``JACOBI``
+    and ``DH``): copies of their own, tried 2026-12-01, cut a first watched wh run
+    (democratic-heliocentric) from 23.4 to 20.0 s but cost the Jacobi and leapfrog
+    runs after it 5.5 s more (one cold process, CPU seconds)."""
     table = dict(globals())
     table["_KIND"] = kind
     copies = {}
