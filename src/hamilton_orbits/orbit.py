@@ -74,14 +74,16 @@ _SHAPE3 = (3,)
 _ONE_ORBIT_SIZE = _columns.ONE_ORBIT_SIZE
 
 
-def _three(x: Any) -> np.ndarray | tuple | None:
-    """``x`` if it is a float64 array of shape (3,), as a tuple if it is a list
-    or tuple of three Python floats, else None (the general path then takes
-    it): one orbit's ``r`` or ``v`` for ``hamilton_orbits._kernels.elements.one_orbit``."""
+def _three(x: Any) -> tuple | None:
+    """``x`` as a tuple of three Python floats if it is a float64 array of shape (3,)
+    or a list or tuple of three Python floats, else None (the general path then takes
+    it): one orbit's ``r`` or ``v`` for ``hamilton_orbits._kernels.elements.one_orbit``.
+    (Always a tuple: arrays, strided arrays and tuples were each a type of their own,
+    and each pair of them compiled the kernel again, 2.5-3.8 s a time.)"""
     t = type(x)
     if t is np.ndarray:
         # dtype identity: the native float64 (any other dtype takes the general path)
-        return x if x.dtype is _F64 and x.shape == _SHAPE3 else None
+        return tuple(x.tolist()) if x.dtype is _F64 and x.shape == _SHAPE3 else None
     if (t is list or t is tuple) and len(x) == 3:
         a, b, c = x
         if type(a) is float and type(b) is float and type(c) is float:
