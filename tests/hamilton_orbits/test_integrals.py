@@ -90,7 +90,9 @@ def test_the_screen_rules_out_the_legs_of_an_ordinary_run(sign):
         traj = sim.integrate(sim.t + sign * 4 * u.day)
         r, v = traj.r.to_value(u.au), traj.v.to_value(u.au / u.day)
         t = traj.t.to_value(u.day)
-        assert not k.screen(np.ascontiguousarray(r), np.ascontiguousarray(v), gm, t, 4.0, 0,
+        # (writable copies, as a run's own states are: the trajectory's read-only
+        # views would compile the kernel again for another type, 3 s)
+        assert not k.screen(np.array(r), np.array(v), gm, np.array(t), 4.0, 0,
                             0.0, ENCOUNTER_STEP_FRACTION, LIGHT)
 
 
