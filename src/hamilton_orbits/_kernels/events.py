@@ -41,8 +41,8 @@ from numba import njit
 
 from hamilton_orbits._kernels import kepler as _kepler
 
-__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_radau",
-           "scan_steps", "state_at", "state_at_hermite", "state_at_radau"]
+__all__ = ["DH", "HERMITE", "JACOBI", "KEPLER", "LINE", "RADAU", "scan", "scan_line",
+           "scan_radau", "scan_steps", "state_at", "state_at_hermite", "state_at_radau"]
 
 RADAU = 0
 LINE = 1
@@ -600,11 +600,11 @@ def _for_kind(kind: int, suffix: str) -> dict:
     interpolant's code (the Kepler solver, the Jacobi and democratic-heliocentric
     frames) for every caller: on a cold cache (CPU seconds, medians of 2 runs)
     radau15's ``advance_watched`` compiled in 19.6 s, 9.5 s with its ``RADAU`` copy;
-    ``scan_steps`` (dop853) in 10.8 s, 3.2 s with its ``HERMITE`` copy.  wh and
-    leapfrog share the generic :func:`scan` (wh's kernels call it for both ``JACOBI``
-    and ``DH``): copies of their own, tried 2026-12-01, cut a first watched wh run
-    (democratic-heliocentric) from 23.4 to 20.0 s but cost the Jacobi and leapfrog
-    runs after it 5.5 s more (one cold process, CPU seconds)."""
+    ``scan_steps`` (dop853) in 10.8 s, 3.2 s with its ``HERMITE`` copy; leapfrog's
+    watched steps with its ``LINE`` copy in 8.2 s instead of 19.4 s.  wh keeps the
+    generic :func:`scan` (its kernels call it for both ``JACOBI`` and ``DH``): copies
+    of their own, tried 2026-12-01, cut a first watched wh run (democratic-
+    heliocentric) from 23.4 to 20.0 s but cost a Jacobi run after it 4 s more."""
     table = dict(globals())
     table["_KIND"] = kind
     copies = {}
@@ -630,3 +630,5 @@ _HERMITE_COPIES = _for_kind(HERMITE, "hermite")
 #: :func:`scan` and :func:`state_at` for the cubic Hermite interpolant alone (``kind``
 #: must be ``HERMITE``; dop853's, through :func:`scan_steps`)
 _scan_hermite, state_at_hermite = _HERMITE_COPIES["scan"], _HERMITE_COPIES["state_at"]
+#: :func:`scan` for straight drifts alone (``kind`` must be ``LINE``; leapfrog's)
+scan_line = _for_kind(LINE, "line")["scan"]
