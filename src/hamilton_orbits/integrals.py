@@ -258,13 +258,13 @@ def integral_errors(
         if value is not None and np.shape(value) != shape:
             raise ValueError(f"Expected `{name}` to have shape {shape} for `r` of shape "
                              f"{r.shape}, got {np.shape(value)}")
-    r = np.ascontiguousarray(r)
-    v = np.ascontiguousarray(v)
-    gm2 = np.ascontiguousarray(np.atleast_2d(gm))
-    t = np.array(t, dtype=np.float64)  # (a copy: a trajectory's read-only times, as a
-    # cross-check passes them, would compile the kernel again for read-only arrays)
+    # the kernel's inputs as read-only views, whatever they came as (a trajectory's
+    # are read-only, a run's own states and a merged run's G m writable: each mix was
+    # another type, compiled again, 1.3-1.7 s a time)
+    r, v, gm2, t, gone_b = (_read_only(a) for a in (
+        r, v, np.atleast_2d(gm), np.asarray(t, dtype=np.float64),
+        np.zeros(n, np.bool_) if gone is None else np.asarray(gone, np.bool_)))
     out = np.empty((3, k))
-    gone_b = np.zeros(n, np.bool_) if gone is None else np.ascontiguousarray(gone, np.bool_)
     lost = integrals.integral_errors(r, v, gm2, t, gone_b, out[0], out[1], out[2])
     if gone is not None and lost >= 0:
         raise LostStateError(divmod(int(lost), n))
@@ -275,6 +275,13 @@ def integral_errors(
     else:
         out[0] = _near_zero_scaled(out[0], r[0], v[0], gm2[0])
     return out[0], out[1], out[2]
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A C-ordered read-only view of ``a`` (a copy where it is not C-ordered)."""
+    a = np.ascontiguousarray(a).view()
+    a.flags.writeable = False
+    return a
 
 
 #: where ``|E(0)|`` is below this fraction of the size of its terms (the kinetic

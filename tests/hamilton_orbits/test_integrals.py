@@ -192,3 +192,26 @@ def test_energy_gm_refuses_coinciding_bodies_and_bad_input_without_a_warning():
             energy_gm(r[0], v[0, :1], gm)
     # (a test particle at the massive body's point adds no potential: taken)
     assert energy_gm(np.zeros((2, 3)), v[0], np.array([1.0, 0.0])) == 0.0
+
+
+def test_integral_errors_compiles_one_type_whatever_the_inputs_writability():
+    """A trajectory's arrays are read-only, a run's own states and a merged run's G m
+    writable: each mix was another type of the kernel's inputs, compiled again (1.3-1.7
+    s a time).  They reach it as read-only views, one type; the same errors."""
+    rng = np.random.default_rng(5)
+    r = rng.normal(size=(4, 3, 3))
+    v = rng.normal(size=(4, 3, 3))
+    gm = np.array([1.0, 1e-3, 2e-3])
+    t = np.arange(4.0)
+    frozen = [a.copy() for a in (r, v, gm, t)]
+    for a in frozen:
+        a.flags.writeable = False
+    before = set(k.integral_errors.signatures)
+    plain = integral_errors(r, v, gm, t)
+    mixed = integral_errors(frozen[0], v, frozen[2], t)
+    read_only = integral_errors(*frozen)
+    for errors in (mixed, read_only):
+        for a, b in zip(errors, plain, strict=True):
+            np.testing.assert_array_equal(a, b)
+    added = set(k.integral_errors.signatures) - before
+    assert all(all(x.mutable is False for x in sig[:5]) for sig in added), added

@@ -78,9 +78,11 @@ def test_numpy_rules_out_an_ordinary_run_of_the_solar_system(moon):
     for sign in (1, -1):
         traj = Simulation(sim.system, method="wh", dt=4 * u.day).integrate(
             sign * np.arange(1, 914) * 4 * u.day)
-        r = np.ascontiguousarray(traj.r.to_value(u.au))
-        v = np.ascontiguousarray(traj.v.to_value(u.au / u.day))
-        t = traj.t.to_value(u.day)
+        # (writable copies, as a run's own states are: the trajectory's read-only
+        # views would compile the kernel again for another type, 3 s)
+        r = np.array(traj.r.to_value(u.au))
+        v = np.array(traj.v.to_value(u.au / u.day))
+        t = np.array(traj.t.to_value(u.day))
         assert not k.screen(r, v, gm, t, 4.0, 0, 0.0, ENCOUNTER_STEP_FRACTION, LIGHT)
         assert not _screening.may_be_near(r, v, gm, t, 4.0, (0, 0.0), ENCOUNTER_STEP_FRACTION,
                                           LIGHT)
