@@ -211,7 +211,7 @@ def refuse_unreadable(state: np.ndarray, e: np.ndarray, inv_a: np.ndarray, aname
     idx = np.flatnonzero(suspect)
     sub = np.ascontiguousarray(rows[idx])
     out = np.empty((idx.size, NCLASSICAL))
-    _el.state_to_elements_classical(sub[:, :3], sub[:, 3:6], sub[:, 6], out)
+    _el.state_to_elements_classical(*_el.row_columns(sub), out)
     bad = np.zeros(rows.shape[0], dtype=bool)
     bad[idx] = ~np.all(np.isfinite(out[:, :-1]), axis=-1)  # (a, the last, NaN with them)
     bad = bad.reshape(e.shape)

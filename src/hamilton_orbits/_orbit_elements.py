@@ -125,7 +125,7 @@ class OrbitElements:
         (NCOL, ...); the classical ones bit for bit those of :meth:`_elements`."""
         rows = self._state.reshape(-1, 7)
         out = np.empty((rows.shape[0], _columns.NCOL))
-        _el.state_to_elements(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        _el.state_to_elements(*_el.row_columns(rows), out)
         # every column but tau, the last (read from :attr:`_tau`, which refuses it by
         # name): a tau beyond float64 (a = 1e250) blocked the angles, M and u
         refuse_beyond_range(out[:, :_TAU], rows, self.shape)
@@ -248,7 +248,7 @@ class OrbitElements:
     def _tau(self) -> np.ndarray:
         rows = self._state.reshape(-1, 7)
         out = np.empty(rows.shape[0])
-        _el.state_to_time_since_periapsis(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+        _el.state_to_time_since_periapsis(*_el.row_columns(rows), out)
         tau = out.reshape(self.shape)
         self._refuse_not_finite("time_since_periapsis", np.isfinite(tau))
         return tau

@@ -67,7 +67,7 @@ def _copy_valid_state(r_in: Any, v_in: Any, mu_in: Any):
     if rows.shape[0] and _el.check_copy_state(
         _contiguous(r, (*lead, 3)).reshape(-1, 3), _contiguous(v, (*lead, 3)).reshape(-1, 3),
         (mu if mu.ndim == 0 else _contiguous(mu, lead)).reshape(-1),
-        rows[:, :3], rows[:, 3:6], rows[:, 6],
+        rows[:, :3], rows[:, 3:6], rows[:, 6],  # (written: views of the state)
     ):
         return None
     return state, quantity
@@ -229,7 +229,7 @@ def classical_columns(state: np.ndarray):
     lead = state.shape[:-1]
     rows = state.reshape(-1, 7)
     out = np.empty((rows.shape[0], _columns.NCLASSICAL))
-    a_beyond = _el.state_to_elements_classical(rows[:, :3], rows[:, 3:6], rows[:, 6], out)
+    a_beyond = _el.state_to_elements_classical(*_el.row_columns(rows), out)
     if a_beyond:  # a row with a NaN a: refused here if another value is not finite
         refuse_beyond_range(out[:, :-1], rows, lead)
     return out.T.reshape((_columns.NCLASSICAL, *lead)), a_beyond  # a view

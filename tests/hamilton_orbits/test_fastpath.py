@@ -339,3 +339,22 @@ def test_a_alone_beyond_float64_is_named_when_read(batch):
     assert np.all((o.e > 0.99) & (o.e < 1.0)) and np.all(np.isfinite(o.p)) and np.all(o.inc == 0)
     with pytest.raises(ValueError, match=r"for which `a` fits in float64, got r=\[1e\+300"):
         o.a  # noqa: B018
+
+
+def test_elements_of_one_orbit_and_of_many_compile_one_layout():
+    """The columns of many state rows are strided views, of one row contiguous ones:
+    each layout was another type of the elements' kernels, compiled again (2-2.5 s of
+    a first run reading one orbit's elements, then many orbits').  They reach the
+    kernels as C-ordered copies; the same elements to the bit as one orbit alone."""
+    kernels = (_el.state_to_elements_classical.serial, _el.state_to_elements.serial,
+               _el.state_to_time_since_periapsis.serial)
+    before = [set(k.signatures) for k in kernels]
+    r = np.array([[1.0, 0.25, -0.5], [2.0, 0.0, 0.125]])
+    v = np.array([[0.0, 1.0, 0.25], [0.0, 0.5, 0.0]])
+    one = KeplerOrbit.from_state(r[:1], v[:1], 1.0)
+    many = KeplerOrbit.from_state(r, v, 1.0)
+    for name in ("e", "p", "inc", "M", "time_since_periapsis"):
+        assert getattr(one, name)[0] == getattr(many, name)[0], name
+    for k, seen in zip(kernels, before, strict=True):
+        added = set(k.signatures) - seen
+        assert all(a.layout == "C" for sig in added for a in sig[:3]), (k, added)

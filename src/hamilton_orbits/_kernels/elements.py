@@ -768,3 +768,13 @@ def elements_to_state(el, mu, r_out, v_out):  # pragma: no cover - compiled
 def empty_elements(n: int) -> np.ndarray:
     """An uninitialised (n, NCOL) output array."""
     return np.empty((n, NCOL))
+
+
+def row_columns(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``r`` (n, 3), ``v`` (n, 3) and ``mu`` (n,) of state rows ``rows`` (n, 7), each
+    C-ordered (a copy of the columns): the kernels above then see one type of array.
+    The columns of many rows are strided views, of one row contiguous ones, and each
+    layout compiled a kernel again (2-2.5 s of a first run that reads one orbit's
+    elements and then many orbits')."""
+    return (np.ascontiguousarray(rows[:, :3]), np.ascontiguousarray(rows[:, 3:6]),
+            np.ascontiguousarray(rows[:, 6]))
