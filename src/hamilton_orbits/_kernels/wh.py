@@ -269,6 +269,16 @@ _ORIGIN = np.zeros(9)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def step_length(k, n_steps, dt, dt_last):  # pragma: no cover - compiled
+    """The length of step ``k`` of a call of ``n_steps`` steps: ``dt``, the last one
+    ``dt_last``, 0 after the last (step 0 is never 0: a call's first half drift).
+    The one rule of every Wisdom-Holman step loop, here and in ``wh_tangent``."""
+    if k > 0 and k >= n_steps:
+        return 0.0
+    return dt if k < n_steps - 1 else dt_last
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _no_ab():  # pragma: no cover - compiled
     """Zero arrays (1,) and (7, 1) for the arguments ``a0``, ``b`` of the events' scan
     that the Kepler arcs do not use: writable, as radau15's (global arrays are read-only
@@ -668,15 +678,15 @@ def _dh_steps(watched, extra, p, has_extra, q, u, gm, com, dt, n_steps, dt_last,
     h = h_next = 0.0
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of the
         if s < 0:  # inlined drift, with its scan: see _drift_watched)
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
             jump = 0.0
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _kick_dh(extra, p, has_extra, q, u, gm, idx, com, h, m_tot, acc_m, r_in, v_in,
                      acc_x, order, gm_c)
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
             jump = 0.5 * h
         bad = _drift(watched, q, u, mu, tau, False, com, watch, ev_out, ev_count, ws, x0, v0,
@@ -701,16 +711,16 @@ def _jacobi_steps(watched, extra, p, has_extra, qj, uj, gm, eta, dt, n_steps, dt
     h = h_next = 0.0
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of the
         if s < 0:  # inlined drift, as in _dh_steps)
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             if has_extra:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _kick_jacobi(
                 extra, p, has_extra, qj, uj, gm, idx, eta, ratio, inv, h, True,
                 acc, accj, acc_x, r_in, v_in, perm,
             )
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
         bad = _drift(watched, qj, uj, eta, tau, True, eta, watch, ev_out, ev_count, ws, x0, v0,
                      eta, gm, 0.0, no_ab)
@@ -746,9 +756,9 @@ def _dh_unwatched_steps(effects_kick, extra, p, q, u, gm, com, dt, n_steps, dt_l
     t_step = ws[0]
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of
         if s < 0:  # the Kepler solver, whose code is large)
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             if effects_kick is not None:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             _jump(q, u, gm, 0.5 * h)
@@ -760,7 +770,7 @@ def _dh_unwatched_steps(effects_kick, extra, p, q, u, gm, com, dt, n_steps, dt_l
             if effects_kick is not None:
                 effects_kick(extra, p, q, u, gm, com, h, m_tot, r_in, v_in, acc_x, order, gm_c)
             _jump(q, u, gm, 0.5 * h)
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
             t_step += h
         if few is not None:
@@ -786,9 +796,9 @@ def _jacobi_unwatched_steps(effects_jacobi, extra, p, qj, uj, gm, eta, dt, n_ste
     t_step = ws[0]
     for s in range(-1, n_steps):  # (s = -1: the first half drift)
         if s < 0:
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             if effects_jacobi is not None:
                 set_clock(p, t_step + 0.5 * h)  # (the kick: the middle of the step)
             jacobi_to_inertial_pos(qj, gm, eta, ratio, inv, r_in)
@@ -800,7 +810,7 @@ def _jacobi_unwatched_steps(effects_jacobi, extra, p, qj, uj, gm, eta, dt, n_ste
                 effects_jacobi(extra, p, uj, gm, eta, h, True, acc, acc_x, r_in, v_in, perm)
             _inertial_to_jacobi_acc(acc, gm, inv, accj)
             _kick_interaction(qj, uj, eta, accj, h)
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
             t_step += h
         if few is not None:  # (written out here and in _dh_unwatched_steps: one inline

@@ -35,7 +35,12 @@ from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.jacobians import newtonian_jvp, tangent_at
 from hamilton_orbits._kernels.signatures import ADDRESSES, F1, F2, accel_at, set_clock
 from hamilton_orbits._kernels.variational import kepler_tangent, megno_map_step, renormalise
-from hamilton_orbits._kernels.wh import caller_gm, jacobi_factors, jacobi_to_inertial_pos
+from hamilton_orbits._kernels.wh import (
+    caller_gm,
+    jacobi_factors,
+    jacobi_to_inertial_pos,
+    step_length,
+)
 
 _I1 = types.int64[::1]
 
@@ -234,9 +239,9 @@ def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, order, q, u, gm, gm
     h = 0.0
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of
         if s < 0:  # the drift and of the kick, inlined: see _drift_dh)
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             set_clock(p, t + 0.5 * h)  # (the kick: the middle of the step)
             _kick_dh(extra, tangent_extra, p, has_extra, q, u, com, dq, du, dcom, gm, gm_p, idx,
                      h, m_tot, w, perm)
@@ -247,7 +252,7 @@ def advance_dh(extra_addr, tangent_extra_addr, p, has_extra, order, q, u, gm, gm
                 for c in range(6):
                     dcom[0, c] *= f
             t_last = t + 0.5 * h
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
         bad = _drift_dh(q, u, com, dq, du, dcom, mu, tau, xa, va)
         if bad >= 0:
@@ -366,9 +371,9 @@ def advance_jacobi(extra_addr, tangent_addr, p, has_extra, order, qj, uj, gm, et
     h = 0.0
     for s in range(-1, n_steps):  # (s = -1: the first half drift; one call site of
         if s < 0:  # the drift and of the kick, inlined: see _drift_dh)
-            tau = 0.5 * (dt if n_steps > 1 else dt_last)
+            tau = 0.5 * step_length(0, n_steps, dt, dt_last)
         else:
-            h = dt if s < n_steps - 1 else dt_last
+            h = step_length(s, n_steps, dt, dt_last)
             set_clock(p, t + 0.5 * h)  # (the kick: the middle of the step)
             _kick_jacobi(extra, tangent, p, has_extra, qj, uj, dq, du, gm, idx, eta, ratio, inv,
                          h, w, perm)
@@ -376,7 +381,7 @@ def advance_jacobi(extra_addr, tangent_addr, p, has_extra, order, qj, uj, gm, et
                            t + 0.5 * h, t + 0.5 * h - t_last)
             renormalise(ms, dq, du, n)
             t_last = t + 0.5 * h
-            h_next = 0.0 if s == n_steps - 1 else (dt if s + 1 < n_steps - 1 else dt_last)
+            h_next = step_length(s + 1, n_steps, dt, dt_last)
             tau = 0.5 * (h + h_next)
         bad = _drift_jacobi(qj, uj, dq, du, eta, tau, xa, va)
         if bad >= 0:
