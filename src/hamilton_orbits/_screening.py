@@ -24,6 +24,7 @@ import threading
 import numpy as np
 
 from hamilton_orbits._kernels import integrals
+from hamilton_orbits.validation import read_only
 
 __all__ = ["PREFILTER_CALLS", "PREFILTER_SIZE", "may_be_near", "output_steps", "primaries",
            "screen"]
@@ -55,9 +56,9 @@ def screen(r: np.ndarray, v: np.ndarray, gm: np.ndarray, t: np.ndarray, step: fl
     >>> screen(r, v, gm, t, 0.01, -1, 0.0, 1 / 30, 1e-10)  # a circular orbit, 628 steps a turn
     False
     """
-    if gm.flags.writeable:  # (read-only, as a system's G m is: a merged or loaded run's
-        gm = gm.view()  # writable one compiled the kernel again for another type, 0.7 s)
-        gm.flags.writeable = False
+    # (read-only, as a system's G m is: a merged or loaded run's writable one compiled
+    # the kernel again for another type, 0.7 s)
+    gm = read_only(gm)
     args = (r, v, gm, t, step, exempt, exempt_dist, fraction, light)
     if _state["ready"]:  # (a continuing call: the kernel's answer, at once)
         return integrals.screen(*args)

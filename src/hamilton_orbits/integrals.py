@@ -246,7 +246,7 @@ def integral_errors(
     [0.0, 4.76837158203125e-07]
     """
     from hamilton_orbits._kernels import integrals
-    from hamilton_orbits.validation import as_float_array
+    from hamilton_orbits.validation import as_float_array, read_only
 
     # (checked before the kernel, which reads ``v``, ``gm`` and ``t`` by r's shape; r and
     # v may hold NaN: the bodies taken out of the run)
@@ -261,7 +261,7 @@ def integral_errors(
     # the kernel's inputs as read-only views, whatever they came as (a trajectory's
     # are read-only, a run's own states and a merged run's G m writable: each mix was
     # another type, compiled again, 1.3-1.7 s a time)
-    r, v, gm2, t, gone_b = (_read_only(a) for a in (
+    r, v, gm2, t, gone_b = (read_only(np.ascontiguousarray(a)) for a in (
         r, v, np.atleast_2d(gm), np.asarray(t, dtype=np.float64),
         np.zeros(n, np.bool_) if gone is None else np.asarray(gone, np.bool_)))
     out = np.empty((3, k))
@@ -275,13 +275,6 @@ def integral_errors(
     else:
         out[0] = _near_zero_scaled(out[0], r[0], v[0], gm2[0])
     return out[0], out[1], out[2]
-
-
-def _read_only(a: np.ndarray) -> np.ndarray:
-    """A C-ordered read-only view of ``a`` (a copy where it is not C-ordered)."""
-    a = np.ascontiguousarray(a).view()
-    a.flags.writeable = False
-    return a
 
 
 #: where ``|E(0)|`` is below this fraction of the size of its terms (the kinetic

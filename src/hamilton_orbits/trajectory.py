@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits.integrals import LIGHT, relative_change, under_resolved_encounters
+from hamilton_orbits.validation import read_only
 
 __all__ = ["Trajectory", "TrajectoryBase", "encounter_check", "encounter_warning", "event_table",
            "make_trajectory", "relative_change"]
@@ -174,7 +175,7 @@ class Trajectory(TrajectoryBase):
                  under_resolved: Any = ()) -> None:
         # one dict update: a short leg's wrapping is part of the cost of a call
         self.__dict__.update(
-            t=_read_only(t), r=_read_only(r), v=_read_only(v), names=names, steps=steps,
+            t=read_only(t), r=read_only(r), v=read_only(v), names=names, steps=steps,
             wall_time=wall_time, method=method,
             effects=effects, complete=complete, megno=megno, lyapunov=lyapunov, stm=stm,
             lyapunov_time=lyapunov_time, _integrals=integrals, _final_source=final_source,
@@ -201,7 +202,7 @@ class Trajectory(TrajectoryBase):
         """Unpickled (or deep-copied): its ``t``, ``r``, ``v`` read-only, as made."""
         self.__dict__.update(state)
         for name in ("t", "r", "v"):
-            self.__dict__[name] = _read_only(state.get(name))
+            self.__dict__[name] = read_only(state.get(name))
 
     @property
     def effect_set(self) -> Any:
@@ -517,17 +518,6 @@ def encounter_check(method: Any, dt: float | None, tol: float | None, r0: np.nda
     return None
 
 
-def _read_only(x: Any) -> Any:
-    """A read-only view of array ``x`` (a Quantity stays one); anything else as it is:
-    a trajectory's ``t``, ``r`` and ``v`` share the arrays its ``energy_error`` and
-    ``final`` are computed from (lazily), which an in-place change would change."""
-    if not isinstance(x, np.ndarray) or not x.flags.writeable:
-        return x
-    view = x.view()
-    view.flags.writeable = False
-    return view
-
-
 def encounter_warning(traj: Trajectory) -> Any:
     """An :class:`~hamilton_orbits.integrals.UnderResolvedEncounterWarning` saying
     which close approaches of ``traj`` a fixed step was too long for, or None."""
@@ -683,7 +673,7 @@ def make_trajectory(system: Any, out: Any, unit: Any, method: str,
         v_out: Any = v << au_day
     else:
         t_out, r_out, v_out = times, r, v
-    t_out, r_out, v_out = _read_only(t_out), _read_only(r_out), _read_only(v_out)
+    t_out, r_out, v_out = read_only(t_out), read_only(r_out), read_only(v_out)
     values = {"t": t_out, "r": r_out, "v": v_out, "names": system.names,
               "steps": int(out.steps), "method": method, "effects": effects,
               "wall_time": out.wall_time if wall_time is None else wall_time,

@@ -334,3 +334,25 @@ def check_finite_result(
     raise ValueError(
         f"Expected `{name}` to keep {what} finite{got}{fmt_index(index)}: it overflows"
     )
+
+
+def read_only(x: Any) -> Any:
+    """A read-only view of array ``x`` (a Quantity stays one; ``x`` itself where it is
+    read-only already); anything else as it is.
+
+    For arrays a caller must not change through what it is given (a trajectory's
+    ``t``, ``r``, ``v``) and for a kernel's inputs, which numba compiles again for
+    each mix of read-only and writable arrays (a type of its own).
+
+    Examples
+    --------
+    >>> a = np.zeros(3)
+    >>> b = read_only(a)
+    >>> b.flags.writeable, a.flags.writeable, b.base is a
+    (False, True, True)
+    """
+    if not isinstance(x, np.ndarray) or not x.flags.writeable:
+        return x
+    view = x.view()
+    view.flags.writeable = False
+    return view
