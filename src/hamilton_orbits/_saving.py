@@ -671,3 +671,20 @@ class _EverySteps:
 
     def __call__(self, again: bool = False) -> None:
         self.sim._snapshot(self.sim._leg, again)
+
+    def compiled(self, arrays: dict[str, np.ndarray], aliases: list[tuple[np.ndarray, str]],
+                 t_at: tuple[str, int], steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan with which the driver's kernel appends the next snapshots itself
+        (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.compiled_plan`), where the
+        segment being written is the one the last snapshot went to and no events
+        are watched; else None."""
+        sim, arch = self.sim, self.arch
+        known = sim._record_cache.get("appended")
+        if known is None or known[0] is not arch.segment or sim._prop.events is not None:
+            return None
+        return arch.compiled_plan(arrays, aliases, t_at, steps)
+
+    def wrote(self, plan: np.ndarray, last_steps: int) -> None:
+        """Count the snapshots the kernel appended with ``plan``, the last after
+        ``last_steps`` steps of the simulation."""
+        self.arch.compiled_wrote(plan, last_steps)

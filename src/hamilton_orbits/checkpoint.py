@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._kernels.records import P_WRITTEN
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.integrators._held import held
@@ -666,6 +667,24 @@ class ArchiveWriter:
         self.count, self.loaded = self.count + 1, None  # (written: its own from here)
         self.last_steps, self.last_wall = steps, self.clock()
         return True
+
+    def compiled_plan(self, arrays: Mapping[str, np.ndarray],
+                      aliases: list[tuple[np.ndarray, str]], t_at: tuple[str, int],
+                      steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan with which a stepping kernel appends the next ``every_steps``
+        snapshots itself (:meth:`~hamilton_orbits.segment.SegmentWriter.compiled_plan`),
+        or None."""
+        if self.segment is None or self.every_steps is None:
+            return None
+        return self.segment.compiled_plan(arrays, aliases, t_at, steps, self.every_steps)
+
+    @held
+    def compiled_wrote(self, plan: np.ndarray, last_steps: int) -> None:
+        """Count the snapshots a kernel appended with ``plan`` (the last after
+        ``last_steps`` steps of the simulation)."""
+        self.segment.compiled_wrote(plan)
+        self.count, self.loaded = self.count + int(plan[P_WRITTEN]), None
+        self.last_steps, self.last_wall = last_steps, self.clock()
 
     @held
     def append_leg(self, values: Mapping[str, Any], rows: dict[str, np.ndarray],

@@ -517,7 +517,7 @@ class _Pause:
 
     def __init__(self, prop: Propagation, pause: Any) -> None:
         self.prop, self.pause = prop, pause
-        self.mine: tuple[np.ndarray, np.ndarray] | None = None  # (the r, v it put)
+        self.mine: tuple[np.ndarray, tuple[Any, ...]] | None = None  # (the r, v it put)
 
     @property
     def at(self) -> int:
@@ -538,6 +538,22 @@ class _Pause:
             prop.events.mask(r, v)  # the driver keeps their parked state to go on)
         prop._stand_at(driver.t, r, v)
         self.pause(again)
+
+    def compiled(self, arrays: dict[str, np.ndarray],
+                 t_at: tuple[str, int], steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan with which the driver's kernel (its arrays ``arrays``, its time at
+        ``t_at``, ``steps`` its steps) writes the caller's next snapshots itself, or
+        None (see ``_EverySteps.compiled``); the positions and velocities this pause
+        puts in the propagation are the kernel's at a snapshot."""
+        ask = getattr(self.pause, "compiled", None)
+        if ask is None or self.mine is None or self.prop.events is not None:
+            return None
+        return ask(arrays, [(self.mine[0], "r"), (self.mine[1], "v")], t_at, steps)
+
+    def wrote(self, plan: np.ndarray, last: int) -> None:
+        """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
+        of the driver's steps."""
+        self.pause.wrote(plan, self.prop.steps_before + last)
 
 
 def _stm_forwards(tangent: Any, k: int) -> None:

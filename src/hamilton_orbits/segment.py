@@ -68,6 +68,7 @@ from typing import Any
 
 import numpy as np
 
+from hamilton_orbits._kernels import records as _rec
 from hamilton_orbits._netcdf3 import NUMRECS_AT, Header, Parts, RecordBuffer, encode, parse
 from hamilton_orbits.integrators._held import held
 from hamilton_orbits.snapshot import (
@@ -94,6 +95,9 @@ SEGMENT_NAME, ROWS_NAME = "segment-{:06d}.nc", "rows-{:06d}.nc"
 #: written in the rows file (format 4: a leg's first row, at its start)
 OWN_ROW = -1
 SEGMENT_RE = re.compile(r"^segment-(\d{6})\.nc$")
+#: whether a stepping kernel may append the snapshots of a run itself, where it
+#: can (:meth:`SegmentWriter.compiled_plan`); False: every record written by Python
+COMPILED_WRITES = True
 #: a segment's or a rows file's name, with the number of its first snapshot
 _NUMBERED_RE = re.compile(r"^(?:segment|rows)-(\d{6})\.nc$")
 #: the record of a snapshot of a propagation's state, in its stored order
@@ -274,6 +278,32 @@ def _same_bits(a: np.ndarray, b: Any) -> bool:
     return b.dtype == np.float64 and b.shape == a.shape and b.tobytes() == a.tobytes()
 
 
+def _varying(history: tuple[tuple[float, list[Any], int], ...],
+             steps: int) -> list[tuple[int, int | None]] | None:
+    """The numbers of a record that changed between the two records of ``history``
+    (each its time, numbers and step count), each as ``(position, first)``: ``first``
+    None for the record's time, else a step count, ``first`` plus the kernel's steps
+    (``steps`` now); None where one changed otherwise (the kernel cannot write it)."""
+    (t0, old, n0), (t1, new, n1) = history
+    out: list[tuple[int, int | None]] = []
+    for j, (x0, x1) in enumerate(zip(old, new, strict=True)):
+        if type(x0) is type(x1) and (x0 == x1 if type(x1) is not float
+                                     else _bits(x0) == _bits(x1)):
+            continue
+        if type(x1) is float and type(x0) is float and _bits(x1) == _bits(t1) \
+                and _bits(x0) == _bits(t0):
+            out.append((j, None))
+        elif type(x1) is int and type(x0) is int and x1 - x0 == n1 - n0 > 0:
+            out.append((j, x1 - steps))
+        else:
+            return None
+    return out
+
+
+def _bits(x: float) -> bytes:
+    return struct.pack("<d", x)
+
+
 def _joinable(arrays: list[np.ndarray]) -> tuple[list[Any], list[tuple[int, np.ndarray]]]:
     """``arrays`` as pieces whose native bytes join into float64 values: the
     contiguous float64 arrays themselves (their values read when joined), and the
@@ -372,6 +402,9 @@ class SegmentWriter:
         self._kept: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
         #: what the last :meth:`_append_state` filled from, for :meth:`refill`
         self._last: tuple[Any, ...] | None = None
+        #: the time, numbers and step count of the last two records, where each was
+        #: written by :meth:`refill` right after the other (:meth:`compiled_plan`)
+        self._history: tuple[tuple[float, list[Any], int], ...] = ()
         # (rows of a segment of this number that a killed run began and this replaces)
         (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
 
@@ -417,6 +450,7 @@ class SegmentWriter:
                                for i in range(n)])
         if self.legs:
             self.tail = (*snapshot["leg"], *NO_SPAN)
+        self._history = ()
         end = start + n if start != OWN_ROW else OWN_ROW
         if self._direct and type(snapshot["state"]) is Parts and self._append_state(
                 snapshot, start, end):
@@ -501,7 +535,77 @@ class SegmentWriter:
         head[1:] = np.frombuffer(b"".join(
             [*pieces, np.array([*scalars, steps, *self.tail, start, start], dtype=np.float64)]))
         file.write(file.checked(), 1)
+        self._history = (*self._history[-1:], (t, list(scalars), steps))
         return True
+
+    def compiled_plan(self, arrays: Mapping[str, np.ndarray],
+                      aliases: list[tuple[np.ndarray, str]], t_at: tuple[str, int],
+                      steps: int, every: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan (and what it reads and writes, to be kept while it is used: its
+        addresses are theirs) with which a stepping kernel appends the
+        next snapshots itself, every ``every`` of its steps, while only it runs
+        (:mod:`hamilton_orbits._kernels.records`); None where it cannot: the last two
+        records were not written by :meth:`refill` one after the other, a number
+        changed from one to the other in a way the steps do not explain, or the
+        segment is synced or the system has no ``pwrite`` for it.
+
+        ``arrays`` are the kernel's own (by their names in
+        :data:`~hamilton_orbits._kernels.records.SOURCES`), ``aliases`` other arrays
+        of the record that hold the same values as one of them at a snapshot (a
+        pause's copies of the positions and velocities), ``t_at`` where the kernel
+        keeps the time (the array's name and the index), and ``steps`` the
+        kernel's count of steps now, the record's step counts being that plus a
+        fixed number each.  The record's other values stay as :meth:`refill` wrote
+        them.
+        """
+        last, file = self._last, self._file
+        if last is None or len(self._history) < 2 or self.sync or file.fd < 0:
+            return None
+        pwrite, crc = _rec.c_functions() if COMPILED_WRITES else (0, 0)
+        if not pwrite:
+            return None
+        if arrays.keys() != set(_rec.SOURCES) or not all(
+                a.dtype == np.float64 and a.flags.c_contiguous for a in arrays.values()):
+            return None
+        names = {id(a): (_rec.SOURCES.index(k), a.size) for k, a in arrays.items()}
+        names.update((id(a), names[id(arrays[k])]) for a, k in aliases)
+        runs = [(_rec.SOURCES.index(t_at[0]), t_at[1], 0, 1)]
+        slot, convert = 1, dict(last[5])
+        for k, a in enumerate(last[4]):
+            size = convert[k].size if a is None else a.size
+            source = None if a is None else names.get(id(a))
+            if source is not None:
+                if source[1] != size:
+                    return None
+                runs.append((source[0], 0, slot, size))
+            slot += size
+        counters = _varying(self._history, steps)
+        if counters is None:
+            return None
+        t_run = runs[0]
+        for j, first in counters:  # (the time, or a step count: that plus the steps)
+            runs.append((*t_run[:2], slot + j, 1) if first is None
+                        else (_rec.SRC_STEPS, first, slot + j, 1))
+        slot += len(self._history[-1][1])
+        runs.append((_rec.SRC_STEPS, self._history[-1][2] - steps, slot, 1))
+        if slot + 1 + len(self.tail) + 2 != file.buffer.runs[0][2].size:
+            return None
+        rec = np.frombuffer(file.buffer.data, np.uint8)  # (kept with the plan: its
+        # buffer then stays where it is)
+        plan = np.zeros(_rec.P_RUNS + 4 * len(runs), np.int64)
+        plan[[_rec.P_EVERY, _rec.P_FD, _rec.P_END, _rec.P_COUNT, _rec.P_PWRITE, _rec.P_CRC,
+              _rec.P_NRUNS, _rec.P_REC, _rec.P_SIZE]] = (
+            every, file.fd, file.end, file.count, pwrite, crc, len(runs), rec.ctypes.data,
+            rec.size)
+        plan[_rec.P_ADDRESSES:_rec.P_RUNS] = [arrays[k].ctypes.data for k in _rec.SOURCES]
+        plan[_rec.P_RUNS:] = np.array(runs, np.int64).reshape(-1)
+        return plan, (rec, *arrays.values())
+
+    def compiled_wrote(self, plan: np.ndarray) -> None:
+        """Take the records a kernel appended with ``plan`` (:meth:`compiled_plan`) as
+        written: counted here as in the file."""
+        self._file.count, self._file.end = int(plan[_rec.P_COUNT]), int(plan[_rec.P_END])
+        self._history = ()
 
     def _moved(self, r: np.ndarray, v: np.ndarray,
                state: list[np.ndarray]) -> tuple[Any, ...] | None:
@@ -536,12 +640,14 @@ class SegmentWriter:
 
     def trim(self) -> None:
         """Cut the files back to their counted records (:meth:`_Appender.trim`)."""
+        self._history = ()
         self._file.trim()
         if self._rows is not None:
             self._rows.trim()
 
     def close(self) -> None:
         """Close the files (what was appended stays)."""
+        self._history = ()
         try:
             self._file.close()
         finally:

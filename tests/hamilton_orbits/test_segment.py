@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from test_archive import RADAU15_STEPPED, flipped_bytes
 
-from hamilton_orbits import Archive, Simulation
+from hamilton_orbits import Archive, Simulation, segment
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits.segment import SegmentWriter
 
@@ -29,6 +29,8 @@ def test_a_state_filled_straight_into_its_record_is_the_record_of_the_general_pa
     begins a new segment)."""
     system, kw = RADAU15_STEPPED[case]
     times = np.linspace(0.0, 4.0, 5)[1:]
+    monkeypatch.setattr(segment, "COMPILED_WRITES", False)  # (every record by Python: the kernel
+    # writes none, test_records_written_by_the_kernel_are_those_of_the_python_path)
     direct, refill = SegmentWriter._append_state, SegmentWriter.refill
     taken, refilled = [], []
 

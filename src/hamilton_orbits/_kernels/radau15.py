@@ -25,6 +25,7 @@ from numba import njit, types
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.gauss_radau import exact_tables
+from hamilton_orbits._kernels.records import P_EVERY, P_NEXT, P_WRITER, record_at
 from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at, set_clock
 from hamilton_orbits._kernels.variational import megno_update
 
@@ -620,9 +621,19 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
     return h
 
 
+@njit(cache=True, inline="always")
+def _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps):  # pragma: no cover - compiled
+    """An archive's record of the state after ``steps`` steps of :func:`_steps`
+    appended (its numbers saved into ``st`` first, as at the call's end); False
+    where the write failed (:func:`hamilton_orbits._kernels.records.write_record`,
+    called at the plan's addresses of it)."""
+    _save(st, t, t_cs, dt, dt_last, have_last)
+    return record_at(plan[P_WRITER], plan[P_WRITER + 1])(plan, steps)
+
+
 def _steps(
     accel_addr, p, r, v, gm, t_end, st, b, br, d, g, csx, csv, need_v, max_steps, watch, ev_out,
-    ev_count,
+    ev_count, plan,
 ):  # pragma: no cover - compiled
     """The loop of :func:`advance` and :func:`advance_watched`, and their body (each
     compiled from it with its own signature, not a wrapper calling it: numba would
@@ -643,13 +654,20 @@ def _steps(
     events.scan`), recorded into ``ev_out`` / ``ev_count``; at ``STATUS_EVENT`` the
     state is that of the event's time.
 
+    ``plan`` (None: no archive code compiled): an archive's records
+    written between two steps, every ``plan[P_EVERY]`` steps from step
+    ``plan[P_NEXT]`` of the call
+    (:func:`hamilton_orbits._kernels.records.write_record`), but not after the
+    call's last step (at ``t_end`` or ``max_steps``: the caller writes that one, as
+    it does without a plan).  A failed write ends the call at ``STATUS_MAXSTEPS``
+    before its snapshot, which the caller then writes.
+
     Memory per body: the four (7, 3) arrays above and ``csb`` (840 bytes), the
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
     the start state only when events are watched.
     """
     accel = accel_at(accel_addr[0], accel_addr[1])
-    n = r.shape[0]
-    m = 3 * n
+    n, m = r.shape[0], 3 * r.shape[0]
     # the start of a step, for the events' scan (``watch is None`` is decided at
     # compile time: numba prunes the branches, so no event code is compiled)
     n_watch = 0 if watch is None else watch.shape[0]
@@ -657,13 +675,12 @@ def _steps(
     x0, v0 = np.empty(w), np.empty(w)
     xs, vs, at, a0_2 = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
     xsf, vsf, atf, a0 = xs.reshape(m), vs.reshape(m), at.reshape(m), a0_2.reshape(m)
-    xf = r.reshape(m)
-    vf = v.reshape(m)
+    xf, vf = r.reshape(m), v.reshape(m)
     csb = np.zeros((7, m))
     t, t_cs, dt, dt_last = st[ST_T], st[ST_T_CS], st[ST_DT], st[ST_DT_LAST]
     have_last = st[ST_HAVE_LAST] != 0.0
-    steps = 0
-    status = STATUS_OK
+    steps, status = 0, STATUS_OK
+    snap_at = -1 if plan is None or plan[P_EVERY] <= 0 else plan[P_NEXT]
     while t < t_end:
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
@@ -672,11 +689,8 @@ def _steps(
             status = STATUS_DRAIN
             break
         dt_try, landing, short = _try_length(t, t_end, dt)
-        if short:
-            if short == 1:
-                t = t_end  # a remainder at rounding level of t: finish exactly
-            else:
-                status = STATUS_UNDERFLOW
+        if short:  # (1: a remainder at rounding level of t: finish exactly)
+            t, status = (t_end, status) if short == 1 else (t, STATUS_UNDERFLOW)
             break
         q = dt_try / dt_last if have_last else math.inf
         if not _begin(accel, p, r, v, gm, a0_2, x0, v0, t, q, b, br, d, g, csb):
@@ -716,10 +730,13 @@ def _steps(
                 status = STATUS_EVENT
                 break
         t, t_cs = _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d)
-        dt_last = dt_try
-        have_last = True
-        dt = dt_new
+        dt_last, have_last, dt = dt_try, True, dt_new
         steps += 1
+        if plan is not None and steps == snap_at and t < t_end and steps < max_steps:
+            if not _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps):
+                status = STATUS_MAXSTEPS
+                break
+            snap_at += plan[P_EVERY]
     _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status
 
@@ -731,11 +748,11 @@ _RESULT = types.Tuple((types.int64, types.int64))
 #: Step from ``st[ST_T]`` to ``t_end`` in place, watching no events (the last three
 #: arguments None); returns ``(steps, status)`` (see :func:`_steps`).  No event code
 #: is compiled into it.
-advance = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none), name="advance",
-                cache=True, nogil=True)(_steps)
+advance = entry(_RESULT(*_ADVANCE_ARGS, types.none, types.none, types.none, types.int64[::1]),
+                name="advance", cache=True, nogil=True)(_steps)
 #: :func:`advance` watching the events ``watch`` (at least one row), recorded into
 #: ``ev_out`` / ``ev_count``.
-advance_watched = entry(_RESULT(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1]),
+advance_watched = entry(_RESULT(*_ADVANCE_ARGS, _F2, _F2, types.int64[::1], types.none),
                         name="advance_watched", cache=True, nogil=True)(_steps)
 
 

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from hamilton_orbits._kernels import radau15 as _k
+from hamilton_orbits._kernels import records as _rec
 from hamilton_orbits.events import EventLog, StopAtEvent
 from hamilton_orbits.integrators import StopIntegration, _setup, _tangent
 from hamilton_orbits.integrators._held import HELD
@@ -66,6 +67,8 @@ DEFAULT_CRITERION = "prs23"
 RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
+#: the kernel's archive arguments when it writes no snapshot (a plan of no interval)
+_NO_PLAN = (np.zeros(_rec.PLAN_HEAD, np.int64), ())
 
 
 def compile_ahead(events: bool) -> None:
@@ -300,7 +303,7 @@ class _Run:
     #: :func:`~hamilton_orbits._kernels.radau15._begin`, before they are read: a
     #: snapshot of 10 bodies is 37% smaller without them) and the kernel's arguments
     #: that hold them (made again by :meth:`restarted`)
-    RESTART_SCRATCH = ("pause", "stop", "scratch", "after_t")
+    RESTART_SCRATCH = ("pause", "stop", "scratch", "after_t", "plan")
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
@@ -321,6 +324,9 @@ class _Run:
         self.steps = 0
         self.stop: Callable[[], bool] | None = None
         self.pause: Any = None
+        #: the kernel's plan of an archive's snapshots while it writes them (and what
+        #: the plan's addresses are of, kept: :meth:`_compiled`); else one of none
+        self.plan: tuple[np.ndarray, tuple[Any, ...]] = _NO_PLAN
         # the kernel's arguments that stay the same objects between calls (a short
         # call's cost is mostly its arguments; see docs/design.md, "One front door")
         self.before_t = (self.accel, run_parameters(rhs), self.x, self.w, gm)  # (p: the
@@ -386,11 +392,14 @@ class _Run:
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
                     *self.before_t, t_end, *self.after_t, budget, log.watch, log.buffer,
-                    log.count)
+                    log.count, None)
             else:
                 steps, status = _k.advance(*self.before_t, t_end, *self.after_t, budget, None,
-                                            None, None)
+                                            None, None, self.plan[0])
             self.steps += steps
+            if self.plan[0][_rec.P_WRITTEN]:
+                self.pause.wrote(self.plan[0], int(self.plan[0][_rec.P_LAST]
+                                                   + self.plan[0][_rec.P_BASE]))
             if status == _k.STATUS_DRAIN:
                 log.drain()
             stopped = status == _k.STATUS_EVENT and log.act(
@@ -400,18 +409,28 @@ class _Run:
     def advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
         the steps before this call, for its budget of ``max_steps``)."""
+        try:
+            return self._advance_to(t_out, i, first)
+        finally:
+            self.plan = _NO_PLAN  # (the kernel writes snapshots within one call only)
+
+    def _advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         max_steps, pause = self.max_steps, self.pause
         again = False  # (a pause since which only the kernel ran: see pause's notes)
         left = SLICE  # (of this slice: the pace is judged at its end, pauses or not)
         while True:  # slices of SLICE steps: Ctrl-C is seen between them
             budget = min(left, max_steps - (self.steps - first))
             cut = False  # (the budget cut short by a pause)
-            if pause is not None:
-                if self.steps >= pause.at:
+            if pause is not None and not self._compiled(pause):
+                paused = self.steps >= pause.at
+                if paused:
                     pause(again)
                     again = True
-                cut = pause.at - self.steps < budget
-                budget = min(budget, max(pause.at - self.steps, 1))
+                # (a plan only right after a pause: it wrote what the kernel cannot, as
+                # the rows of the outputs since the snapshot before)
+                if not (paused and self._compiled(pause, ask=True)):
+                    cut = pause.at - self.steps < budget
+                    budget = min(budget, max(pause.at - self.steps, 1))
             steps, status, stopped = self._slice(t_out[i], budget)
             left -= steps
             if status == _k.STATUS_MAXSTEPS:
@@ -433,6 +452,36 @@ class _Run:
                     f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
                     f"{float(t_out[i])!r}: {_tangent.radau15_why(status, self.st, max_steps)}"
                 )
+
+    def _compiled(self, pause: Any, ask: bool = False) -> bool:
+        """Whether the kernel writes the archive's next snapshots itself (its plan set
+        for the next call: where the next is due, the steps so far); ``ask``: a plan
+        asked for first, after a pause (:meth:`~hamilton_orbits.engine._Pause.
+        compiled`); none while a caller's ``stop`` is asked (it is asked at each
+        snapshot, where the call returns).  A plan whose write failed is dropped:
+        the pause then writes that snapshot, and says why it cannot."""
+        plan = self.plan[0]
+        if ask and self.stop is None:
+            made = pause.compiled(self._arrays(), ("st", _k.ST_T), self.steps)
+            self.plan = _NO_PLAN if made is None else made
+            if made is not None:  # (compiled at the first plan, not into the kernel)
+                made[0][_rec.P_WRITER:_rec.P_WRITER + 2] = _setup.addresses(
+                    _rec.write_record, _rec.RECORD_SIGNATURE)
+            plan = self.plan[0]
+        if not plan[_rec.P_EVERY]:
+            return False
+        if plan[_rec.P_FAILED] or pause.at <= self.steps:  # (or one due at the call's
+            self.plan = _NO_PLAN  # end, which the kernel leaves to the pause, as the
+            return False  # budget's last step)
+        plan[_rec.P_NEXT], plan[_rec.P_BASE] = pause.at - self.steps, self.steps
+        plan[_rec.P_WRITTEN] = 0
+        return True
+
+    def _arrays(self) -> dict[str, np.ndarray]:
+        """The kernel's arrays that a record's values are read from (by their names in
+        :data:`~hamilton_orbits._kernels.records.SOURCES`)."""
+        return {"r": self.x, "v": self.w, "gm": self.gm, "p": self.before_t[1], "st": self.st,
+                "br": self.work[0], "d": self.work[1], "csx": self.csx, "csv": self.csv}
 
 
 #: below this ``tol`` (float64's rounding) a tolerance buys no accuracy, only
