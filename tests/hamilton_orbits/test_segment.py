@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from test_archive import RADAU15_STEPPED, flipped_bytes
+from test_simulation_legs import _same
 
 from hamilton_orbits import Archive, Simulation, segment
 from hamilton_orbits._netcdf3 import parse
@@ -247,3 +248,88 @@ def test_a_row_that_is_its_snapshots_own_state_is_kept_as_that_state(tmp_path):
         (_, _, arrays), = read_segment(seg.path).snapshots
         for k in ("t", "r", "v"):
             assert arrays[f"out_{k}"].tobytes() == given[f"out_{k}"].tobytes(), (name, k)
+
+
+def _kernel_written(monkeypatch):
+    """A list whose first item counts the records stepping kernels append."""
+    from hamilton_orbits._kernels.records import P_WRITTEN
+    from hamilton_orbits.checkpoint import ArchiveWriter
+
+    count, took = [0], ArchiveWriter.compiled_wrote
+
+    def counting(self, plan, last_steps):
+        count[0] += int(plan[P_WRITTEN])
+        return took(self, plan, last_steps)
+
+    monkeypatch.setattr(ArchiveWriter, "compiled_wrote", counting)
+    return count
+
+
+def _archived_runs(tmp_path, name, compiled, kw, calls, monkeypatch):
+    """The files (name -> bytes) of an ``every_steps`` archive written by ``calls``
+    (end times; a ``"load"`` between two: the run continued by a simulation
+    loaded from its archive), in one folder path whichever way it is written (the
+    path is in the segments' headers), the trajectories, and the records the
+    kernel appended."""
+    monkeypatch.setattr(segment, "COMPILED_WRITES", compiled)
+    count = _kernel_written(monkeypatch)
+    system, options = RADAU15_STEPPED[kw]
+    folder = tmp_path / "run"
+    sim = Simulation(system(), archive=folder, every_steps=3, **options)
+    trajs = []
+    for t in calls:
+        if isinstance(t, str):  # ("load")
+            sim = Simulation.load(folder)
+        else:
+            trajs.append(sim.integrate(t))
+    files = {p.name: p.read_bytes() for p in folder.iterdir() if not p.name.startswith(".")}
+    folder.rename(tmp_path / name)
+    return files, trajs, count[0]
+
+
+@pytest.mark.parametrize(("kw", "calls"), [
+    ("radau15", [6.0]),
+    ("radau15", [np.linspace(0.0, 12.0, 4)]),  # (outputs between the snapshots)
+    ("radau15", [4.0, 10.0, "load", 16.0]),  # (legs, and a run loaded from its archive)
+    ("radau15-effects", [8.0]),
+    ("radau15-fixed", [1.0, 3.0]),
+])
+def test_records_written_by_the_kernel_are_those_of_the_python_path(tmp_path, monkeypatch,
+                                                                    kw, calls):
+    """radau15 appends most ``every_steps`` snapshots from inside its compiled call
+    (after two written by Python in a row); the archive's files are, byte for byte,
+    those of the same run whose every snapshot Python writes, as are the run's
+    outputs, with outputs, legs, a loaded run, effects and fixed steps."""
+    ours, trajs, kernel = _archived_runs(tmp_path, "kernel", True, kw, calls, monkeypatch)
+    theirs, ref, none = _archived_runs(tmp_path, "python", False, kw, calls, monkeypatch)
+    assert ours.keys() == theirs.keys() and ours == theirs
+    assert all(_same(a.r, b.r) and _same(a.v, b.v) for a, b in zip(trajs, ref, strict=True))
+    total = len(Archive(tmp_path / "kernel"))
+    assert none == 0 and kernel >= total // 2, (kernel, total)
+
+
+def test_a_record_the_kernel_fails_to_write_is_written_by_python(tmp_path, monkeypatch):
+    """A write that fails inside the kernel (here every plan's file descriptor made
+    one that is not open, so ``pwrite`` fails) ends its call at the snapshot, which
+    the Python path then writes: the archive is that of the run written by Python
+    alone, and the kernel counted none."""
+    from hamilton_orbits._kernels.records import P_FD
+    from hamilton_orbits.segment import SegmentWriter
+
+    plan_of = SegmentWriter.compiled_plan
+    made = []
+
+    def broken(self, *args):
+        out = plan_of(self, *args)
+        if out is not None:
+            made.append(1)
+            out[0][P_FD] = -1
+        return out
+
+    ours, trajs, kernel = None, None, None
+    with monkeypatch.context() as m:
+        m.setattr(SegmentWriter, "compiled_plan", broken)
+        ours, trajs, kernel = _archived_runs(tmp_path, "broken", True, "radau15", [6.0], m)
+    theirs, ref, _ = _archived_runs(tmp_path, "python", False, "radau15", [6.0], monkeypatch)
+    assert len(made) > 3 and kernel == 0
+    assert ours == theirs and _same(trajs[0].r, ref[0].r)
