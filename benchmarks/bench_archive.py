@@ -1,6 +1,8 @@
 """Archives against rebound's Simulationarchive, same runs, same process.
 
-Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py
+Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py [--lengths]
+
+(``--lengths``: section [8] alone.)
 
 What it prints (medians over interleaved rounds; the machine is shared):
 
@@ -33,9 +35,12 @@ What it prints (medians over interleaved rounds; the machine is shared):
     ``every_steps=100``: inside the calls of the compiled steps (their entry,
     ``every=``'s landing steps) and outside them (the Python of pauses, outputs
     and snapshots, the archive's fixed cost spread over the run), per snapshot;
-[8] the cost against the run's length: ``every_steps=100`` and ``every=`` (radau15,
-    the 10-body disc) and rebound's IAS15 with ``step=100``, each archived / plain,
-    over runs of
+[8] the cost against the run's length: ``every_steps=100`` (its snapshots appended
+    by radau15's compiled call once two are written, and, beside it, all of them
+    written by Python, ``segment.COMPILED_WRITES = False``) and ``every=``
+    (radau15, the 10-body disc) and rebound's IAS15 with ``step=100``, each
+    archived / plain in CPU time of the process (the machine's other work not
+    counted), over runs of
     125 to 20000 time units (2 ms to 0.3 s of ours, twice that of IAS15): the
     archive's fixed cost per call (its folder, lock, two files and first snapshot)
     against the per-snapshot cost, and the shortest run within 5%.
@@ -46,6 +51,7 @@ from __future__ import annotations
 import math
 import shutil
 import statistics
+import sys
 import tempfile
 import time
 from collections.abc import Callable
@@ -55,7 +61,7 @@ import numpy as np
 import rebound
 from bench_overhead import rebound_of
 
-from hamilton_orbits import Archive, Body, Simulation, System
+from hamilton_orbits import Archive, Body, Simulation, System, segment
 
 T_END = 2000.0
 DT = 0.05
@@ -74,19 +80,20 @@ def disc10() -> System:
     return System(bodies)
 
 
-def timed(fn: Callable[[], object]) -> float:
-    start = time.perf_counter()
+def timed(fn: Callable[[], object], clock: Callable[[], float] = time.perf_counter) -> float:
+    start = clock()
     fn()
-    return time.perf_counter() - start
+    return clock() - start
 
 
-def interleaved(fns: dict[str, Callable[[], object]], rounds: int) -> dict[str, list[float]]:
+def interleaved(fns: dict[str, Callable[[], object]], rounds: int,
+                clock: Callable[[], float] = time.perf_counter) -> dict[str, list[float]]:
     for fn in fns.values():
         fn()
     out: dict[str, list[float]] = {k: [] for k in fns}
     for _ in range(rounds):
         for k, fn in fns.items():
-            out[k].append(timed(fn))
+            out[k].append(timed(fn, clock))
     return out
 
 
@@ -374,10 +381,15 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
     arrays = s.as_arrays()
     count = iter(range(10**6))
 
-    def ours(t_end: float, archived: dict[str, float] | None) -> Callable[[], None]:
+    def ours(t_end: float, archived: dict[str, float] | None,
+             kernel: bool = True) -> Callable[[], None]:
         def go() -> None:
             kw = {} if archived is None else dict(archived, archive=tmp / f"len-{next(count)}")
-            Simulation(s, method="radau15", **kw).integrate(t_end)
+            segment.COMPILED_WRITES = kernel
+            try:
+                Simulation(s, method="radau15", **kw).integrate(t_end)
+            finally:
+                segment.COMPILED_WRITES = True
         return go
 
     def theirs(t_end: float, archived: bool) -> Callable[[], None]:
@@ -390,7 +402,7 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
         return go
 
     print(f"[8] archived / plain against the run's length, a snapshot every 100 steps "
-          f"(medians of {rounds} interleaved rounds):")
+          f"(CPU time of the process, medians of {rounds} interleaved rounds):")
     extra, plain_ms, snaps = [], [], []
     for t_end in ends:
         probe = Simulation(s, method="radau15")
@@ -398,11 +410,13 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
         n = probe.steps // 100 + 1  # (the start's snapshot, then one every 100 steps)
         t = interleaved({"ours": ours(t_end, None),
                          "ours-archived": ours(t_end, {"every_steps": 100}),
+                         "ours-python": ours(t_end, {"every_steps": 100}, kernel=False),
                          "ours-every": ours(t_end, {"every": 100 * t_end / probe.steps}),
                          "theirs": theirs(t_end, False),
-                         "theirs-archived": theirs(t_end, True)}, rounds)
-        r_ours, r_every = (statistics.median(a / b for a, b in zip(t[k], t["ours"], strict=True))
-                           for k in ("ours-archived", "ours-every"))
+                         "theirs-archived": theirs(t_end, True)}, rounds, time.process_time)
+        r_ours, r_python, r_every = (
+            statistics.median(a / b for a, b in zip(t[k], t["ours"], strict=True))
+            for k in ("ours-archived", "ours-python", "ours-every"))
         r_theirs = statistics.median(a / b for a, b in zip(t["theirs-archived"], t["theirs"],
                                                             strict=True))
         plain = statistics.median(t["ours"])
@@ -410,7 +424,8 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
                                                              strict=True)))
         plain_ms.append(plain)
         snaps.append(n)
-        print(f"    {t_end:7g}: ours x{r_ours:.3f}, every= x{r_every:.3f} (plain "
+        print(f"    {t_end:7g}: ours x{r_ours:.3f} (Python's records x{r_python:.3f}), every= "
+              f"x{r_every:.3f} (plain "
               f"{plain * 1e3:6.1f} ms, {n:3d} snapshots), rebound x{r_theirs:.3f} (plain "
               f"{statistics.median(t['theirs']) * 1e3:6.1f} ms)")
     per, fixed = np.linalg.lstsq(np.column_stack([snaps, np.ones(len(snaps))]),
@@ -426,6 +441,13 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
+    if "--lengths" in sys.argv:  # (section 8 alone)
+        try:
+            (tmp / "lengths").mkdir()
+            lengths(tmp / "lengths", 15)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        return
     try:
         one_snapshot(tmp, 200)
         runs(tmp, 9)
@@ -439,7 +461,7 @@ def main() -> None:
         (tmp / "split").mkdir()
         inside_and_out(tmp / "split", 9)
         (tmp / "lengths").mkdir()
-        lengths(tmp / "lengths", 9)
+        lengths(tmp / "lengths", 15)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
