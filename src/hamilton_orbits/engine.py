@@ -517,7 +517,7 @@ class _Pause:
 
     def __init__(self, prop: Propagation, pause: Any) -> None:
         self.prop, self.pause = prop, pause
-        self.mine: tuple[np.ndarray, tuple[Any, ...]] | None = None  # (the r, v it put)
+        self.mine: tuple[np.ndarray, np.ndarray] | None = None  # (the r, v it put)
 
     @property
     def at(self) -> int:
