@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import re
+
 import numpy as np
 import pytest
 from test_archive import RADAU15_STEPPED, flipped_bytes
@@ -333,3 +336,54 @@ def test_a_record_the_kernel_fails_to_write_is_written_by_python(tmp_path, monke
     theirs, ref, _ = _archived_runs(tmp_path, "python", False, "radau15", [6.0], monkeypatch)
     assert len(made) > 3 and kernel == 0
     assert ours == theirs and _same(trajs[0].r, ref[0].r)
+
+
+def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tmp_path,
+                                                                             monkeypatch):
+    """A real write failure where the kernel appends the records: a child process
+    limited to a file size (``RLIMIT_FSIZE``, as a full disk refuses a write; its
+    signal ignored) runs an ``every_steps`` archive past the limit.  The call
+    raises the SnapshotError naming the segment and the system's reason, the
+    run stands at the snapshot that met the limit, the archive holds only whole
+    snapshots, those before it, and the folder's lock is released; the run
+    resumed from it (no limit) reaches the bits of the run never stopped."""
+    import resource
+    import signal
+
+    system, kw = RADAU15_STEPPED["radau15"]
+    whole = Simulation(system(), archive=tmp_path / "whole", every_steps=3, **kw)
+    ref = whole.integrate(12.0)
+    size = next((tmp_path / "whole").glob("segment-*.nc")).stat().st_size
+    count = _kernel_written(monkeypatch)  # (counted in the child)
+    folder = tmp_path / "limited"
+    ready, done = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: the limit, the run, what it raised, and out
+        try:
+            os.close(ready)
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (size // 2, resource.RLIM_INFINITY))
+            sim = Simulation(system(), archive=folder, every_steps=3, **kw)
+            try:
+                sim.integrate(12.0)
+                said = "no error"
+            except Exception as exc:  # (what the parent checks)
+                said = f"{type(exc).__name__}: {exc}"
+            os.write(done, f"{count[0]} {sim.steps}\n{said}".encode())
+        finally:
+            os._exit(0)
+    os.close(done)
+    with os.fdopen(ready, "rb") as fh:
+        counts, said = fh.read().decode().split("\n", 1)
+    kernel, steps = (int(x) for x in counts.split())
+    os.waitpid(pid, 0)
+    assert re.fullmatch(r"SnapshotError: cannot write the snapshot to .*segment-000000\.nc: "
+                        r"File too large", said), said
+    archive = Archive(folder)
+    assert archive.damaged == [] and archive.torn == [] and kernel >= 5
+    assert 5 < len(archive) < len(Archive(tmp_path / "whole"))
+    # (stopped at the snapshot that met the limit, the one after the last written)
+    assert steps == archive.snapshots[-1].steps + 3
+    assert not (folder / ".hamilton-orbits.lock").exists()
+    end = Simulation.load(folder).integrate(12.0)
+    assert _same(end.r[-1], ref.r[-1]) and _same(end.v[-1], ref.v[-1])
