@@ -409,49 +409,47 @@ class _Run:
     def advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         """Step to ``t_out[i]`` in slices; True if an event stopped the run (``first``:
         the steps before this call, for its budget of ``max_steps``)."""
-        try:
-            return self._advance_to(t_out, i, first)
-        finally:
-            self.plan = _NO_PLAN  # (the kernel writes snapshots within one call only)
-
-    def _advance_to(self, t_out: np.ndarray, i: int, first: int) -> bool:
         max_steps, pause = self.max_steps, self.pause
         again = False  # (a pause since which only the kernel ran: see pause's notes)
         left = SLICE  # (of this slice: the pace is judged at its end, pauses or not)
-        while True:  # slices of SLICE steps: Ctrl-C is seen between them
-            budget = min(left, max_steps - (self.steps - first))
-            cut = False  # (the budget cut short by a pause)
-            if pause is not None and not self._compiled(pause):
-                paused = self.steps >= pause.at
-                if paused:
-                    pause(again)
-                    again = True
-                # (a plan only right after a pause: it wrote what the kernel cannot, as
-                # the rows of the outputs since the snapshot before)
-                if not (paused and self._compiled(pause, ask=True)):
-                    cut = pause.at - self.steps < budget
-                    budget = min(budget, max(pause.at - self.steps, 1))
-            steps, status, stopped = self._slice(t_out[i], budget)
-            left -= steps
-            if status == _k.STATUS_MAXSTEPS:
-                if not cut:  # (a slice's end or max_steps, where a run without pauses is)
-                    _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
-                    left = SLICE
-                if self.stop is not None and self.stop():
-                    raise StopIntegration
-            elif status == _k.STATUS_DRAIN:
-                again, left = False, SLICE
-            elif status == _k.STATUS_EVENT:
-                again, left = False, SLICE
-                if stopped:
-                    return True
-            elif status == _k.STATUS_OK:
-                return False
-            else:
-                raise ConvergenceError(
-                    f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
-                    f"{float(t_out[i])!r}: {_tangent.radau15_why(status, self.st, max_steps)}"
-                )
+        try:
+            while True:  # slices of SLICE steps: Ctrl-C is seen between them
+                budget = min(left, max_steps - (self.steps - first))
+                cut = False  # (the budget cut short by a pause)
+                if pause is not None and not self._compiled(pause):
+                    paused = self.steps >= pause.at
+                    if paused:
+                        pause(again)
+                        again = True
+                    # (a plan only right after a pause: it wrote what the kernel cannot,
+                    # as the rows of the outputs since the snapshot before)
+                    if not (paused and self._compiled(pause, ask=True)):
+                        cut = pause.at - self.steps < budget
+                        budget = min(budget, max(pause.at - self.steps, 1))
+                steps, status, stopped = self._slice(t_out[i], budget)
+                left -= steps
+                if status == _k.STATUS_MAXSTEPS:
+                    if not cut:  # (a slice's end or max_steps, where a run without pauses is)
+                        _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
+                        left = SLICE
+                    if self.stop is not None and self.stop():
+                        raise StopIntegration
+                elif status == _k.STATUS_DRAIN:
+                    again, left = False, SLICE
+                elif status == _k.STATUS_EVENT:
+                    again, left = False, SLICE
+                    if stopped:
+                        return True
+                elif status == _k.STATUS_OK:
+                    return False
+                else:
+                    raise ConvergenceError(
+                        f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
+                        f"{float(t_out[i])!r}: "
+                        f"{_tangent.radau15_why(status, self.st, max_steps)}")
+        finally:
+            if pause is not None:  # (the kernel writes snapshots within one call only)
+                self.plan = _NO_PLAN
 
     def _compiled(self, pause: Any, ask: bool = False) -> bool:
         """Whether the kernel writes the archive's next snapshots itself (its plan set
