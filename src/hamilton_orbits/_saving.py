@@ -676,11 +676,11 @@ class _EverySteps:
                  t_at: tuple[str, int], steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
         """The plan with which the driver's kernel appends the next snapshots itself
         (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.compiled_plan`), where the
-        segment being written is the one the last snapshot went to and no events
-        are watched; else None."""
+        segment being written is the one the last snapshot went to (the driver's
+        pause asks only where no events are watched); else None."""
         sim, arch = self.sim, self.arch
         known = sim._record_cache.get("appended")
-        if known is None or known[0] is not arch.segment or sim._prop.events is not None:
+        if known is None or known[0] is not arch.segment:
             return None
         return arch.compiled_plan(arrays, aliases, t_at, steps)
 

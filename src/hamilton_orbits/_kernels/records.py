@@ -30,6 +30,7 @@ meets the failure and says why.
 from __future__ import annotations
 
 import ctypes
+import functools
 import sys
 
 import numpy as np
@@ -38,8 +39,9 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from hamilton_orbits._kernels.signatures import function_at
+from hamilton_orbits._netcdf3 import NUMRECS_AT
 
-__all__ = ["PLAN_HEAD", "P_ADDRESSES", "P_BASE", "P_COUNT", "P_CRC", "P_END", "P_EVERY",
+__all__ = ["P_ADDRESSES", "P_BASE", "P_COUNT", "P_CRC", "P_END", "P_EVERY",
            "P_FAILED", "P_FD", "P_LAST", "P_NEXT", "P_PWRITE", "P_REC", "P_RUNS", "P_SIZE",
            "P_WRITER", "P_WRITTEN", "RECORD_SIGNATURE", "SOURCES", "SRC_STEPS",
            "c_functions", "record_at", "write_record"]
@@ -59,18 +61,15 @@ __all__ = ["PLAN_HEAD", "P_ADDRESSES", "P_BASE", "P_COUNT", "P_CRC", "P_END", "P
 #: from :data:`P_ADDRESSES` on: C-contiguous float64 arrays the plan's holder keeps)
 SOURCES = ("r", "v", "gm", "p", "st", "br", "d", "csx", "csv")
 SRC_STEPS = len(SOURCES)
-P_ADDRESSES = 17
+P_ADDRESSES = P_WRITER + 2
 #: where the runs begin
-P_RUNS = PLAN_HEAD = P_ADDRESSES + len(SOURCES)
-#: where a netCDF-3 header keeps its count of records
-NUMRECS_AT = 4
+P_RUNS = P_ADDRESSES + len(SOURCES)
 
 #: ``ssize_t pwrite(int fd, const void *buf, size_t count, off_t offset)``
 _PWRITE = function_at(types.FunctionType(types.int64(types.int64, types.int64, types.int64,
                                                      types.int64)))
 #: ``uLong crc32(uLong crc, const Bytef *buf, uInt len)``
 _CRC32 = function_at(types.FunctionType(types.int64(types.int64, types.int64, types.int64)))
-_FOUND: list[tuple[int, int]] = []
 
 #: ``write_record(plan, steps) -> bool``: a stepping kernel calls it at its
 #: addresses (:func:`record_at`), so that it is compiled only where an archive is
@@ -80,16 +79,11 @@ RECORD_SIGNATURE = types.boolean(types.int64[::1], types.int64)
 record_at = function_at(types.FunctionType(RECORD_SIGNATURE))
 
 
+@functools.cache
 def c_functions() -> tuple[int, int]:
     """The addresses of the C library's ``pwrite`` and of zlib's ``crc32`` (the CRC
     of :func:`zlib.crc32`), found once; ``(0, 0)`` where either is missing (the
     Python path then writes every record)."""
-    if not _FOUND:
-        _FOUND.append(_find())
-    return _FOUND[0]
-
-
-def _find() -> tuple[int, int]:
     if sys.platform == "win32":
         return 0, 0
     names = ("libz.dylib",) if sys.platform == "darwin" else ("libz.so.1", "libz.so")

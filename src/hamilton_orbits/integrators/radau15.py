@@ -68,7 +68,7 @@ RADAU_SPACINGS = np.array([float(x) for x in _k.DECIMAL_SPACINGS])
 #: Steps per compiled call: the driver returns to Python this often (Ctrl-C).
 SLICE = 20000
 #: the kernel's archive arguments when it writes no snapshot (a plan of no interval)
-_NO_PLAN = (np.zeros(_rec.PLAN_HEAD, np.int64), ())
+_NO_PLAN = (np.zeros(_rec.P_RUNS, np.int64), ())
 
 
 def compile_ahead(events: bool) -> None:
