@@ -35,10 +35,10 @@ What it prints (medians over interleaved rounds; the machine is shared):
     ``every_steps=100``: inside the calls of the compiled steps (their entry,
     ``every=``'s landing steps) and outside them (the Python of pauses, outputs
     and snapshots, the archive's fixed cost spread over the run), per snapshot;
-[8] the cost against the run's length: ``every_steps=100`` (its snapshots appended
-    by radau15's compiled call once two are written, and, beside it, all of them
-    written by Python, ``segment.COMPILED_WRITES = False``) and ``every=``
-    (radau15, the 10-body disc) and rebound's IAS15 with ``step=100``, each
+[8] the cost against the run's length: ``every_steps=100`` and ``every=`` (their
+    snapshots appended by radau15's compiled call once two are written, and,
+    beside each, all of them written by Python, ``segment.COMPILED_WRITES =
+    False``; radau15, the 10-body disc) and rebound's IAS15 with ``step=100``, each
     archived / plain in CPU time of the process (the machine's other work not
     counted), over runs of
     125 to 20000 time units (2 ms to 0.3 s of ours, twice that of IAS15): the
@@ -412,11 +412,13 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
                          "ours-archived": ours(t_end, {"every_steps": 100}),
                          "ours-python": ours(t_end, {"every_steps": 100}, kernel=False),
                          "ours-every": ours(t_end, {"every": 100 * t_end / probe.steps}),
+                         "ours-every-python": ours(t_end, {"every": 100 * t_end / probe.steps},
+                                                   kernel=False),
                          "theirs": theirs(t_end, False),
                          "theirs-archived": theirs(t_end, True)}, rounds, time.process_time)
-        r_ours, r_python, r_every = (
+        r_ours, r_python, r_every, r_every_python = (
             statistics.median(a / b for a, b in zip(t[k], t["ours"], strict=True))
-            for k in ("ours-archived", "ours-python", "ours-every"))
+            for k in ("ours-archived", "ours-python", "ours-every", "ours-every-python"))
         r_theirs = statistics.median(a / b for a, b in zip(t["theirs-archived"], t["theirs"],
                                                             strict=True))
         plain = statistics.median(t["ours"])
@@ -425,7 +427,7 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
         plain_ms.append(plain)
         snaps.append(n)
         print(f"    {t_end:7g}: ours x{r_ours:.3f} (Python's records x{r_python:.3f}), every= "
-              f"x{r_every:.3f} (plain "
+              f"x{r_every:.3f} (Python's x{r_every_python:.3f}) (plain "
               f"{plain * 1e3:6.1f} ms, {n:3d} snapshots), rebound x{r_theirs:.3f} (plain "
               f"{statistics.median(t['theirs']) * 1e3:6.1f} ms)")
     per, fixed = np.linalg.lstsq(np.column_stack([snaps, np.ones(len(snaps))]),

@@ -563,6 +563,14 @@ class Saving:
             return _EverySteps(self)
         return None if arch.every_wall is None else _EveryWall(self)
 
+    def _time_snapshots(self, asked: np.ndarray, scheduled: np.ndarray) -> _EveryTime | None:
+        """The rows of an ``every`` archive's snapshots that a driver may land on and
+        write itself (None with another schedule, or when nothing is written)."""
+        arch = self._archive
+        if arch is None or arch.path is None or arch.every is None or not scheduled.any():
+            return None
+        return _EveryTime(self, asked, scheduled)
+
     def _checkpoint(self, asked: np.ndarray, scheduled: np.ndarray) -> Callable[[int], None]:
         arch, prop, rows = self._archive, self._prop, self._leg
         taken = [False]  # a snapshot of this leg's outputs taken
@@ -657,12 +665,35 @@ class _EveryWall:
             self.steps_only = True
 
 
-class _EverySteps:
-    """An archive's ``every_steps`` snapshots taken between two steps, for a driver
-    that can pause there (:meth:`~hamilton_orbits.engine.Propagation.advance`)."""
+class _KernelWrites:
+    """An archive's snapshots that a stepping kernel may append itself."""
 
     def __init__(self, sim: Saving) -> None:
         self.sim, self.arch = sim, sim._archive
+
+    def compiled(self, arrays: dict[str, np.ndarray], aliases: list[tuple[np.ndarray, str]],
+                 t_at: tuple[str, int], steps: int, times: np.ndarray | None = None,
+                 ) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan with which the driver's kernel appends the next snapshots itself
+        (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.compiled_plan`; ``times``:
+        those of an ``every`` schedule it lands on), where the segment being written
+        is the one the last snapshot went to (the driver asks only where no events
+        are watched); else None."""
+        sim, arch = self.sim, self.arch
+        known = sim._record_cache.get("appended")
+        if known is None or known[0] is not arch.segment:
+            return None
+        return arch.compiled_plan(arrays, aliases, t_at, steps, times)
+
+    def wrote(self, plan: np.ndarray, last_steps: int) -> None:
+        """Count the snapshots the kernel appended with ``plan``, the last after
+        ``last_steps`` steps of the simulation."""
+        self.arch.compiled_wrote(plan, last_steps)
+
+
+class _EverySteps(_KernelWrites):
+    """An archive's ``every_steps`` snapshots taken between two steps, for a driver
+    that can pause there (:meth:`~hamilton_orbits.engine.Propagation.advance`)."""
 
     @property
     def at(self) -> int:
@@ -672,19 +703,18 @@ class _EverySteps:
     def __call__(self, again: bool = False) -> None:
         self.sim._snapshot(self.sim._leg, again)
 
-    def compiled(self, arrays: dict[str, np.ndarray], aliases: list[tuple[np.ndarray, str]],
-                 t_at: tuple[str, int], steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
-        """The plan with which the driver's kernel appends the next snapshots itself
-        (:meth:`~hamilton_orbits.checkpoint.ArchiveWriter.compiled_plan`), where the
-        segment being written is the one the last snapshot went to (the driver's
-        pause asks only where no events are watched); else None."""
-        sim, arch = self.sim, self.arch
-        known = sim._record_cache.get("appended")
-        if known is None or known[0] is not arch.segment:
-            return None
-        return arch.compiled_plan(arrays, aliases, t_at, steps)
 
-    def wrote(self, plan: np.ndarray, last_steps: int) -> None:
-        """Count the snapshots the kernel appended with ``plan``, the last after
-        ``last_steps`` steps of the simulation."""
-        self.arch.compiled_wrote(plan, last_steps)
+class _EveryTime(_KernelWrites):
+    """An archive's ``every`` snapshots at output rows of their own (``only``: the
+    scheduled times no caller asked for), which a driver that lands on them may
+    write itself (:class:`~hamilton_orbits.engine._Landings`)."""
+
+    def __init__(self, sim: Saving, asked: np.ndarray, scheduled: np.ndarray) -> None:
+        super().__init__(sim)
+        self.only = scheduled & ~asked
+        others = np.flatnonzero(~self.only)  # (the last row is always one: asked)
+        self.ends = others[np.searchsorted(others, np.arange(self.only.size))]
+
+    def through(self, i: int) -> int:
+        """The first row from ``i`` on that is not a snapshot alone."""
+        return int(self.ends[i])

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from hamilton_orbits._kernels.records import P_WRITTEN
+from hamilton_orbits._kernels.records import P_LAND, P_LAND_END, P_WRITTEN
 from hamilton_orbits._netcdf3 import parse
 from hamilton_orbits._outdir import FolderError, OutputFolder
 from hamilton_orbits.integrators._held import held
@@ -670,13 +670,22 @@ class ArchiveWriter:
 
     def compiled_plan(self, arrays: Mapping[str, np.ndarray],
                       aliases: list[tuple[np.ndarray, str]], t_at: tuple[str, int],
-                      steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+                      steps: int, times: np.ndarray | None = None,
+                      ) -> tuple[np.ndarray, tuple[Any, ...]] | None:
         """The plan with which a stepping kernel appends the next ``every_steps``
         snapshots itself (:meth:`~hamilton_orbits.segment.SegmentWriter.compiled_plan`),
-        or None."""
-        if self.segment is None or self.every_steps is None:
+        or, given ``times`` (an ``every`` schedule's, increasing), those at these
+        simulation times, landing on each (the times after the plan's runs, from
+        ``P_LAND`` to ``P_LAND_END``: :func:`~hamilton_orbits._kernels.records.
+        next_landing`); or None."""
+        if self.segment is None or (self.every_steps if times is None else self.every) is None:
             return None
-        return self.segment.compiled_plan(arrays, aliases, t_at, steps, self.every_steps)
+        made = self.segment.compiled_plan(arrays, aliases, t_at, steps, self.every_steps or 0)
+        if made is None or times is None:
+            return made
+        plan = np.concatenate([made[0], np.ascontiguousarray(times, np.float64).view(np.int64)])
+        plan[P_LAND], plan[P_LAND_END] = made[0].size, plan.size
+        return plan, made[1]
 
     @held
     def compiled_wrote(self, plan: np.ndarray, last_steps: int) -> None:

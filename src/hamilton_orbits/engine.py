@@ -325,7 +325,7 @@ class Propagation:
     def advance(self, t_out: np.ndarray, *, on_output: Callable[[int, int], None] | None = None,
                 stop: Callable[[], bool] | None = None,
                 checkpoint: Callable[[int], None] | None = None,
-                pause: Any = None) -> EngineRun:
+                pause: Any = None, landings: Any = None) -> EngineRun:
         """Integrate through ``t_out`` (strictly monotonic, ``t_out[0]`` the current
         time :attr:`t`, forwards or backwards); see :func:`run`.  ``checkpoint(i)``
         (forwards only) is called at output ``i`` with the propagation standing there
@@ -334,6 +334,9 @@ class Propagation:
         between steps, radau15's) is called between two steps once :attr:`steps`
         reaches ``pause.at``, the propagation standing at the driver's own state
         (the steps unchanged: a snapshot taken then continues bit for bit).
+        ``landings`` (forwards only, with ``checkpoint``): the output rows that are
+        snapshots alone (``landings.only``), which a driver that can land on them and
+        write them itself (radau15's) may leave unreported (:class:`_Landings`).
         ``on_output(i, steps)`` and ``stop()`` after output ``i`` see the propagation
         standing there as ``checkpoint`` does (a snapshot or copy taken in them
         continues as the run does).  A leg forwards from where a collision stopped
@@ -379,7 +382,7 @@ class Propagation:
                 self.stop_at_start = False
                 raise StopAtEvent(0, self.t, 0)
             self._drive(driver, -t_out if backward else t_out, (r_out, v_out), report, stop,
-                        pause)
+                        (pause, landings))
             reached[0], reached[1] = n_t - 1, driver.steps - steps0
         except StopAtEvent as stopped:
             reached[0], reached[1] = stopped.index, stopped.steps
@@ -471,9 +474,11 @@ class Propagation:
                          None, False, 0, all_finite(rows.reshape(-1)))
 
     def _drive(self, driver: Any, t_out: np.ndarray, rows: tuple[np.ndarray, np.ndarray],
-               report: Callable[[int, int], None], stop: Any, pause: Any) -> None:
-        """``driver.advance`` through ``t_out``, ``pause`` set on a driver that takes
-        it (and cleared after); ``stop()``, which the driver asks between slices of
+               report: Callable[[int, int], None], stop: Any,
+               snapshots: tuple[Any, Any]) -> None:
+        """``driver.advance`` through ``t_out``, ``snapshots`` (``pause``, ``landings``:
+        see :meth:`advance`) set on a driver that takes them (and cleared after);
+        ``stop()``, which the driver asks between slices of
         steps, asked with the propagation standing at the driver's state (its time,
         as its step count is; the bodies taken out at NaN)."""
         if stop is not None:
@@ -487,14 +492,20 @@ class Propagation:
                 self._stand_at(sign * driver.t, r, sign * v)  # replaced when unchanged)
                 return asked()
 
+        pause, landings = snapshots
         pausing = pause is not None and hasattr(driver, "pause")
+        landing = landings is not None and hasattr(driver, "landings") and stop is None
         if pausing:
             driver.pause = _Pause(self, pause)
+        if landing:
+            driver.landings = _Landings(self, landings)
         try:
             driver.advance(t_out, *rows, report, stop)
         finally:
             if pausing:
                 driver.pause = None
+            if landing:
+                driver.landings = None
 
     def _stand_at(self, t: float, r: np.ndarray, v: np.ndarray) -> None:
         """Stand at time ``t`` with its state (``v`` the true velocities), as a leg
@@ -554,6 +565,39 @@ class _Pause:
         """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
         of the driver's steps."""
         self.pause.wrote(plan, self.prop.steps_before + last)
+
+
+class _Landings:
+    """A caller's snapshot rows as the driver sees them: ``only[i]`` where output row
+    ``i`` is a snapshot alone (no caller's output, so not reported when the driver
+    writes it), and the plan with which the driver's kernel lands on such rows and
+    writes their snapshots itself, with the propagation standing at the last
+    reported row."""
+
+    def __init__(self, prop: Propagation, landings: Any) -> None:
+        self.prop, self.landings = prop, landings
+        self.only: np.ndarray = landings.only
+
+    def through(self, i: int) -> int:
+        """The first row from ``i`` on that is not a snapshot alone."""
+        return self.landings.through(i)
+
+    def compiled(self, arrays: dict[str, np.ndarray], t_at: tuple[str, int], steps: int,
+                 times: np.ndarray) -> tuple[np.ndarray, tuple[Any, ...]] | None:
+        """The plan with which the driver's kernel (its arrays ``arrays``, its time at
+        ``t_at``, ``steps`` its steps) lands on ``times`` and writes their snapshots,
+        or None (events watched); asked right after a snapshot row, where the
+        positions and velocities the propagation stands at are the kernel's."""
+        prop = self.prop
+        if prop.events is not None:
+            return None
+        return self.landings.compiled(arrays, [(prop.r, "r"), (prop.v, "v")], t_at, steps,
+                                      times)
+
+    def wrote(self, plan: np.ndarray, last: int) -> None:
+        """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
+        of the driver's steps."""
+        self.landings.wrote(plan, self.prop.steps_before + last)
 
 
 def _stm_forwards(tangent: Any, k: int) -> None:

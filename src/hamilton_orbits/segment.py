@@ -574,6 +574,8 @@ class SegmentWriter:
         for k, a in enumerate(last[4]):
             size = convert[k].size if a is None else a.size
             source = None if a is None else names.get(id(a))
+            if source is None and k < 2:  # (the positions and velocities: the kernel's
+                return None  # own, or no plan)
             if source is not None:
                 if source[1] != size:
                     return None

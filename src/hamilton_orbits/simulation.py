@@ -504,7 +504,8 @@ class Simulation(Saving):
                 return prop.advance(times, on_output=on_output, stop=stop)
             out = prop.advance(archived[0], on_output=rows_of(on_output, archived[1]),
                                stop=stop, checkpoint=self._checkpoint(*archived[1:]),
-                               pause=self._step_snapshots())
+                               pause=self._step_snapshots(),
+                               landings=self._time_snapshots(*archived[1:]))
             if prop.events is not None and prop.events.stopped_by is not None:
                 self._asked = None  # (stopped at an event's time: the next leg's steps
                 # are laid from there, and its snapshots with them)

@@ -128,16 +128,19 @@ def test_the_snapshots_between_a_calls_outputs_hold_the_whole_state(tmp_path, kw
     assert again.steps == quiet.steps
 
 
-@pytest.mark.parametrize("kw", [KW, dict(method="radau15", every_steps=4)],
-                         ids=["every", "every_steps"])
+@pytest.mark.parametrize("kw", [KW, dict(method="radau15", every=0.5),
+                                dict(method="radau15", every_steps=4)],
+                         ids=["every", "every-landed", "every_steps"])
 def test_a_run_killed_at_any_moment_loses_at_most_the_snapshot_being_written(tmp_path, kw):
     """20 runs killed with SIGKILL, half at random moments (before, between and
     during writes), half as soon as the archive holds a random number of snapshots:
     each archive opens, its snapshots are the reference's, and the call resumed
     from it returns the reference's trajectory, every row to the bit; with
-    snapshots at output times (``every``) and between two steps (``every_steps``:
-    about 9 between two outputs, the first two refilled by Python, the others
-    appended by the compiled call itself)."""
+    snapshots at output times (``every``: 2.5, between outputs 5 apart; 0.5: 9
+    between two outputs, the first two refilled by Python, the others, 83 of the
+    121, appended by the compiled call landing on their times) and between two steps
+    (``every_steps``: about 9 between two outputs, the first two refilled by Python,
+    the others appended by the compiled call itself)."""
     _, whole = _run_archived(tmp_path / "ref", kw)
     reference = Archive(tmp_path / "ref")
     assert len(reference) >= 25

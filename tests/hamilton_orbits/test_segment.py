@@ -106,6 +106,8 @@ def test_a_snapshot_at_a_scheduled_time_is_refilled_with_the_outputs_arrays(tmp_
     system, kw = RADAU15_STEPPED["radau15"]
     times = np.linspace(0.0, 4.0, 9)
     refill, refilled = SegmentWriter.refill, []
+    monkeypatch.setattr(segment, "COMPILED_WRITES", False)  # (every record by Python: the
+    # kernel writes none, test_records_written_by_the_kernel_are_those_of_the_python_path)
 
     def counted(self, *args):
         refilled.append(refill(self, *args))
@@ -268,17 +270,17 @@ def _kernel_written(monkeypatch):
     return count
 
 
-def _archived_runs(tmp_path, name, compiled, kw, calls, monkeypatch):
-    """The files (name -> bytes) of an ``every_steps`` archive written by ``calls``
-    (end times; a ``"load"`` between two: the run continued by a simulation
-    loaded from its archive), in one folder path whichever way it is written (the
-    path is in the segments' headers), the trajectories, and the records the
-    kernel appended."""
+def _archived_runs(tmp_path, name, compiled, kw, calls, monkeypatch, schedule=None):
+    """The files (name -> bytes) of an archive (``every_steps=3``, or ``schedule``)
+    written by ``calls`` (end times; a ``"load"`` between two: the run continued by
+    a simulation loaded from its archive), in one folder path whichever way it is
+    written (the path is in the segments' headers), the trajectories, and the
+    records the kernel appended."""
     monkeypatch.setattr(segment, "COMPILED_WRITES", compiled)
     count = _kernel_written(monkeypatch)
     system, options = RADAU15_STEPPED[kw]
     folder = tmp_path / "run"
-    sim = Simulation(system(), archive=folder, every_steps=3, **options)
+    sim = Simulation(system(), archive=folder, **(schedule or {"every_steps": 3}), **options)
     trajs = []
     for t in calls:
         if isinstance(t, str):  # ("load")
@@ -311,7 +313,42 @@ def test_records_written_by_the_kernel_are_those_of_the_python_path(tmp_path, mo
     assert none == 0 and kernel >= total // 2, (kernel, total)
 
 
-def test_a_record_the_kernel_fails_to_write_is_written_by_python(tmp_path, monkeypatch):
+@pytest.mark.parametrize(("kw", "calls", "slice_steps"), [
+    ("radau15", [6.0], None),
+    ("radau15", [np.linspace(0.0, 12.0, 4)], None),  # (outputs between the snapshots)
+    ("radau15", [np.array([0.0, 0.55, 4.0, 4.35, 6.0])], None),  # (and on them)
+    ("radau15", [4.0, 10.0, "load", 16.0], None),  # (legs, and a run loaded from its archive)
+    ("radau15", [6.0], 2),  # (a compiled call of 2 steps at most: a landing at a call's end)
+    ("radau15-effects", [8.0], None),
+    ("radau15-fixed", [1.0, 3.0], None),  # (snapshots on the steps)
+])
+def test_snapshots_the_kernel_lands_on_are_those_of_the_python_path(tmp_path, monkeypatch,
+                                                                     kw, calls, slice_steps):
+    """radau15 lands on most ``every`` snapshot times and appends their snapshots
+    from inside its compiled call (after two written by Python in a row between the
+    caller's outputs); the archive's files are, byte for byte, those of the same run
+    whose every snapshot Python writes at a call of its own to each snapshot time, as
+    are the run's outputs, with outputs, legs, a loaded run, effects, fixed steps and
+    calls cut short by their budget of steps."""
+    from hamilton_orbits.integrators import radau15
+
+    if slice_steps is not None:
+        monkeypatch.setattr(radau15, "SLICE", slice_steps)
+    every = {"every": 0.05 if kw == "radau15-fixed" else 0.25}
+    ours, trajs, kernel = _archived_runs(tmp_path, "kernel", True, kw, calls, monkeypatch,
+                                         every)
+    theirs, ref, none = _archived_runs(tmp_path, "python", False, kw, calls, monkeypatch,
+                                       every)
+    assert ours.keys() == theirs.keys() and ours == theirs
+    assert all(_same(a.r, b.r) and _same(a.v, b.v) and _same(a.t, b.t)
+               for a, b in zip(trajs, ref, strict=True))
+    total = len(Archive(tmp_path / "kernel"))
+    assert none == 0 and kernel >= total // 2, (kernel, total)
+
+
+@pytest.mark.parametrize("schedule", [{"every_steps": 3}, {"every": 0.25}])
+def test_a_record_the_kernel_fails_to_write_is_written_by_python(tmp_path, monkeypatch,
+                                                                  schedule):
     """A write that fails inside the kernel (here every plan's file descriptor made
     one that is not open, so ``pwrite`` fails) ends its call at the snapshot, which
     the Python path then writes: the archive is that of the run written by Python
@@ -332,17 +369,21 @@ def test_a_record_the_kernel_fails_to_write_is_written_by_python(tmp_path, monke
     ours, trajs, kernel = None, None, None
     with monkeypatch.context() as m:
         m.setattr(SegmentWriter, "compiled_plan", broken)
-        ours, trajs, kernel = _archived_runs(tmp_path, "broken", True, "radau15", [6.0], m)
-    theirs, ref, _ = _archived_runs(tmp_path, "python", False, "radau15", [6.0], monkeypatch)
+        ours, trajs, kernel = _archived_runs(tmp_path, "broken", True, "radau15", [6.0], m,
+                                             schedule)
+    theirs, ref, _ = _archived_runs(tmp_path, "python", False, "radau15", [6.0], monkeypatch,
+                                    schedule)
     assert len(made) > 3 and kernel == 0
-    assert ours == theirs and _same(trajs[0].r, ref[0].r)
+    assert ours == theirs and _same(trajs[0].r, ref[0].r) and _same(trajs[0].t, ref[0].t)
 
 
+@pytest.mark.parametrize("schedule", [{"every_steps": 3}, {"every": 0.25}])
 def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tmp_path,
-                                                                             monkeypatch):
+                                                                             monkeypatch,
+                                                                             schedule):
     """A real write failure where the kernel appends the records: a child process
     limited to a file size (``RLIMIT_FSIZE``, as a full disk refuses a write; its
-    signal ignored) runs an ``every_steps`` archive past the limit.  The call
+    signal ignored) runs an ``every_steps`` or ``every`` archive past the limit.  The call
     raises the SnapshotError naming the segment and the system's reason, the
     run stands at the snapshot that met the limit, the archive holds only whole
     snapshots, those before it, and the folder's lock is released; the run
@@ -351,7 +392,7 @@ def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tm
     import signal
 
     system, kw = RADAU15_STEPPED["radau15"]
-    whole = Simulation(system(), archive=tmp_path / "whole", every_steps=3, **kw)
+    whole = Simulation(system(), archive=tmp_path / "whole", **schedule, **kw)
     ref = whole.integrate(12.0)
     size = next((tmp_path / "whole").glob("segment-*.nc")).stat().st_size
     count = _kernel_written(monkeypatch)  # (counted in the child)
@@ -363,19 +404,19 @@ def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tm
             os.close(ready)
             signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
             resource.setrlimit(resource.RLIMIT_FSIZE, (size // 2, resource.RLIM_INFINITY))
-            sim = Simulation(system(), archive=folder, every_steps=3, **kw)
+            sim = Simulation(system(), archive=folder, **schedule, **kw)
             try:
                 sim.integrate(12.0)
                 said = "no error"
             except Exception as exc:  # (what the parent checks)
                 said = f"{type(exc).__name__}: {exc}"
-            os.write(done, f"{count[0]} {sim.steps}\n{said}".encode())
+            os.write(done, f"{count[0]} {sim.steps} {sim.t!r}\n{said}".encode())
         finally:
             os._exit(0)
     os.close(done)
     with os.fdopen(ready, "rb") as fh:
         counts, said = fh.read().decode().split("\n", 1)
-    kernel, steps = (int(x) for x in counts.split())
+    kernel, steps, t = (float(x) for x in counts.split())
     os.waitpid(pid, 0)
     assert re.fullmatch(r"SnapshotError: cannot write the snapshot to .*segment-000000\.nc: "
                         r"File too large", said), said
@@ -383,7 +424,9 @@ def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tm
     assert archive.damaged == [] and archive.torn == [] and kernel >= 5
     assert 5 < len(archive) < len(Archive(tmp_path / "whole"))
     # (stopped at the snapshot that met the limit, the one after the last written)
-    assert steps == archive.snapshots[-1].steps + 3
+    last = archive.snapshots[-1]
+    assert (steps == last.steps + 3 if "every_steps" in schedule
+            else t == 0.25 * (round(last.t / 0.25) + 1) and steps > last.steps)
     assert not (folder / ".hamilton-orbits.lock").exists()
     end = Simulation.load(folder).integrate(12.0)
     assert _same(end.r[-1], ref.r[-1]) and _same(end.v[-1], ref.v[-1])

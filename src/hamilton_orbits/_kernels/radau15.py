@@ -25,7 +25,14 @@ from numba import njit, types
 from hamilton_orbits._kernels import events as _ev
 from hamilton_orbits._kernels.entry import entry
 from hamilton_orbits._kernels.gauss_radau import exact_tables
-from hamilton_orbits._kernels.records import P_EVERY, P_NEXT, P_WRITER, record_at
+from hamilton_orbits._kernels.records import (
+    P_EVERY,
+    P_LAND,
+    P_NEXT,
+    P_WRITER,
+    next_landing,
+    record_at,
+)
 from hamilton_orbits._kernels.signatures import ADDRESSES, accel_at, set_clock
 from hamilton_orbits._kernels.variational import megno_update
 
@@ -622,13 +629,22 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
 
 
 @njit(cache=True, inline="always")
-def _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps):  # pragma: no cover - compiled
+def _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps, snap_at, t_end):
+    # pragma: no cover - compiled
     """An archive's record of the state after ``steps`` steps of :func:`_steps`
-    appended (its numbers saved into ``st`` first, as at the call's end); False
-    where the write failed (:func:`hamilton_orbits._kernels.records.write_record`,
-    called at the plan's addresses of it)."""
+    appended (its numbers saved into ``st`` first, as at the call's end)
+    (:func:`hamilton_orbits._kernels.records.write_record`, called at the plan's
+    addresses of it): whether it was written, and the step count and the time of
+    the next snapshot (the first ``snap_at`` unchanged where the record was one of
+    the times, the second the time of the next, or ``t_end``, after one at a time;
+    both unchanged where the write failed)."""
     _save(st, t, t_cs, dt, dt_last, have_last)
-    return record_at(plan[P_WRITER], plan[P_WRITER + 1])(plan, steps)
+    if not record_at(plan[P_WRITER], plan[P_WRITER + 1])(plan, steps):
+        return False, snap_at, t
+    if steps == snap_at:
+        return True, snap_at + plan[P_EVERY], t_end
+    plan[P_LAND] += 1
+    return True, snap_at, next_landing(plan, t_end)
 
 
 def _steps(
@@ -657,10 +673,12 @@ def _steps(
     ``plan`` (None: no archive code compiled): an archive's records
     written between two steps, every ``plan[P_EVERY]`` steps from step
     ``plan[P_NEXT]`` of the call
-    (:func:`hamilton_orbits._kernels.records.write_record`), but not after the
-    call's last step (at ``t_end`` or ``max_steps``: the caller writes that one, as
-    it does without a plan).  A failed write ends the call at ``STATUS_MAXSTEPS``
-    before its snapshot, which the caller then writes.
+    (:func:`hamilton_orbits._kernels.records.write_record`), or at the plan's
+    snapshot times (:func:`hamilton_orbits._kernels.records.next_landing`), each
+    landed on as a call ending there lands (the same steps: the state is kept
+    between two calls as it is between two steps); but not at ``t_end`` (the
+    caller writes that one, as it does without a plan).  A failed write ends the
+    call at ``STATUS_MAXSTEPS`` at its snapshot, which the caller then writes.
 
     Memory per body: the four (7, 3) arrays above and ``csb`` (840 bytes), the
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
@@ -681,17 +699,25 @@ def _steps(
     have_last = st[ST_HAVE_LAST] != 0.0
     steps, status = 0, STATUS_OK
     snap_at = -1 if plan is None or plan[P_EVERY] <= 0 else plan[P_NEXT]
-    while t < t_end:
+    t_stop = t_end if plan is None else next_landing(plan, t_end)
+    while t < t_end and status == STATUS_OK:
+        # (a snapshot due: on one of its times, or after its steps; none at the call's end)
+        if plan is not None and (t_stop <= t or steps == snap_at):
+            written, snap_at, t_stop = _archived(plan, st, t, t_cs, dt, dt_last, have_last,
+                                                 steps, snap_at, t_end)
+            if not written:
+                status = STATUS_MAXSTEPS
+                break
         if steps >= max_steps:
             status = STATUS_MAXSTEPS
             break
         if watch is not None and n_watch > 0 and ev_count[0] + n_watch > ev_out.shape[0]:
             status = STATUS_DRAIN
             break
-        dt_try, landing, short = _try_length(t, t_end, dt)
-        if short:  # (1: a remainder at rounding level of t: finish exactly)
-            t, status = (t_end, status) if short == 1 else (t, STATUS_UNDERFLOW)
-            break
+        dt_try, landing, short = _try_length(t, t_stop, dt)
+        if short:  # (1: a remainder at rounding level of t: there exactly, no step)
+            t, status = (t_stop, status) if short == 1 else (t, STATUS_UNDERFLOW)
+            continue
         q = dt_try / dt_last if have_last else math.inf
         if not _begin(accel, p, r, v, gm, a0_2, x0, v0, t, q, b, br, d, g, csb):
             status = STATUS_NONFINITE
@@ -729,14 +755,9 @@ def _steps(
                 steps += 1
                 status = STATUS_EVENT
                 break
-        t, t_cs = _after_step(t, t_cs, dt_try, t_end, landing, q, b, br, d)
+        t, t_cs = _after_step(t, t_cs, dt_try, t_stop, landing, q, b, br, d)
         dt_last, have_last, dt = dt_try, True, dt_new
         steps += 1
-        if plan is not None and steps == snap_at and t < t_end and steps < max_steps:
-            if not _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps):
-                status = STATUS_MAXSTEPS
-                break
-            snap_at += plan[P_EVERY]
     _save(st, t, t_cs, dt, dt_last, have_last)
     return steps, status
 

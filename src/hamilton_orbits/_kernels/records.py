@@ -20,7 +20,10 @@ the source (its number in :data:`SOURCES`), the first element read, the record's
 float64 slot written first (the record's float64 values come first), the length.
 A source ``SRC_STEPS`` is the kernel's count of steps: the value written is the
 run's "first element" plus :data:`P_BASE` plus the steps of the call (a step count
-the record holds).
+the record holds).  An ``every`` schedule's snapshot times follow the runs (each
+float64's bits as an int64, from ``plan[P_LAND]``, the next, to
+``plan[P_LAND_END]``): the kernel lands on each by its own step control, as a call
+ending there would, and writes its record there.
 
 A ``pwrite`` that fails (a full disk) writes nothing more: the kernel stops at the
 snapshot with :data:`P_FAILED` set, and the Python path writes it again, which
@@ -42,9 +45,9 @@ from hamilton_orbits._kernels.signatures import function_at
 from hamilton_orbits._netcdf3 import NUMRECS_AT
 
 __all__ = ["P_ADDRESSES", "P_BASE", "P_COUNT", "P_CRC", "P_END", "P_EVERY",
-           "P_FAILED", "P_FD", "P_LAST", "P_NEXT", "P_PWRITE", "P_REC", "P_RUNS", "P_SIZE",
-           "P_WRITER", "P_WRITTEN", "RECORD_SIGNATURE", "SOURCES", "SRC_STEPS",
-           "c_functions", "record_at", "write_record"]
+           "P_FAILED", "P_FD", "P_LAND", "P_LAND_END", "P_LAST", "P_NEXT", "P_PWRITE",
+           "P_REC", "P_RUNS", "P_SIZE", "P_WRITER", "P_WRITTEN", "RECORD_SIGNATURE", "SOURCES",
+           "SRC_STEPS", "c_functions", "next_landing", "record_at", "write_record"]
 
 #: the plan's entries: the snapshot interval in steps (0: none), the steps of the call
 #: at which the next is due, the file's descriptor, where the next record goes (its
@@ -52,11 +55,12 @@ __all__ = ["P_ADDRESSES", "P_BASE", "P_COUNT", "P_CRC", "P_END", "P_EVERY",
 #: ``pwrite`` and of zlib's ``crc32``, the records written by the call, the step (of
 #: the call) of the last, a failed write (1), the step count at the call's start, the
 #: number of runs, the address and size of the record's buffer (its float64 values
-#: first), 8 bytes of working space, and the addresses of :func:`write_record`
+#: first), 8 bytes of working space, where the next snapshot time to land on is kept
+#: and where those times end (:func:`next_landing`), and the addresses of :func:`write_record`
 #: (:data:`RECORD_SIGNATURE`; two: its C wrapper and entry point, as a right-hand
 #: side's, :mod:`hamilton_orbits._kernels.signatures`)
 (P_EVERY, P_NEXT, P_FD, P_END, P_COUNT, P_PWRITE, P_CRC, P_WRITTEN, P_LAST, P_FAILED, P_BASE,
- P_NRUNS, P_REC, P_SIZE, P_SCRATCH, P_WRITER) = range(16)
+ P_NRUNS, P_REC, P_SIZE, P_SCRATCH, P_LAND, P_LAND_END, P_WRITER) = range(18)
 #: the kernel's arrays a record's values are read from, by number (their addresses
 #: from :data:`P_ADDRESSES` on: C-contiguous float64 arrays the plan's holder keeps)
 SOURCES = ("r", "v", "gm", "p", "st", "br", "d", "csx", "csv")
@@ -125,6 +129,23 @@ def _bits(typingctx, x):  # pragma: no cover - compiled
     def codegen(context, builder, signature, args):
         return builder.bitcast(args[0], ir.IntType(64))
     return types.uint64(types.float64), codegen
+
+
+@intrinsic
+def _float(typingctx, bits):  # pragma: no cover - compiled
+    """The float64 whose bits are ``bits`` (int64)."""
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+    return types.float64(types.int64), codegen
+
+
+@njit(cache=True, inline="always")
+def next_landing(plan, t_end):  # pragma: no cover - compiled
+    """The next snapshot time the kernel lands on (the float64 whose bits are
+    ``plan[plan[P_LAND]]``, the times being kept from there to ``plan[P_LAND_END]``:
+    an ``every`` schedule's), or ``t_end`` where none is left."""
+    k = plan[P_LAND]
+    return _float(plan[k]) if k < plan[P_LAND_END] else t_end
 
 
 @njit(cache=True)

@@ -294,7 +294,13 @@ class _Run:
     the steps are the same as without it.  ``pause(again)``: ``again`` True when
     only the compiled steps ran since the last pause of the same call (no output,
     no event: the state's arrays changed in place, its numbers changed, nothing was
-    put in another place; ``stop`` is a question and changes nothing)."""
+    put in another place; ``stop`` is a question and changes nothing).
+
+    ``landings``, when set (an archive's simulation-time schedule, whose snapshot
+    times are output rows no caller sees): the kernel lands on a run of such rows
+    and writes their snapshots itself where ``landings`` gives it a plan
+    (:meth:`~hamilton_orbits.engine._Landings.compiled`); those rows are then not
+    reported to ``on_output``."""
 
     #: not state: the hook a run sets and clears (:meth:`Propagation.advance`), the
     #: caller's ``stop`` of the call (set by each call: a snapshot's layout, and so
@@ -303,7 +309,7 @@ class _Run:
     #: :func:`~hamilton_orbits._kernels.radau15._begin`, before they are read: a
     #: snapshot of 10 bodies is 37% smaller without them) and the kernel's arguments
     #: that hold them (made again by :meth:`restarted`)
-    RESTART_SCRATCH = ("pause", "stop", "scratch", "after_t", "plan")
+    RESTART_SCRATCH = ("pause", "landings", "stop", "scratch", "after_t", "plan")
 
     def __init__(self, rhs: Any, r0: np.ndarray, v0: np.ndarray, gm: np.ndarray, t0: float,
                  dt: float, tol: float, prs23: bool, log: EventLog, max_steps: int) -> None:
@@ -324,6 +330,7 @@ class _Run:
         self.steps = 0
         self.stop: Callable[[], bool] | None = None
         self.pause: Any = None
+        self.landings: Any = None
         #: the kernel's plan of an archive's snapshots while it writes them (and what
         #: the plan's addresses are of, kept: :meth:`_compiled`); else one of none
         self.plan: tuple[np.ndarray, tuple[Any, ...]] = _NO_PLAN
@@ -370,8 +377,17 @@ class _Run:
         :class:`~hamilton_orbits.events.StopAtEvent` with its row."""
         log, first = self.log, self.steps
         self.stop = stop
-        for i in range(1, t_out.shape[0]):
-            stopped = self.advance_to(t_out, i, first)
+        i = 1
+        while i < t_out.shape[0]:
+            j = self._landing_plan(t_out, i)  # (rows i ... j - 1 landed on by the kernel)
+            plan = self.plan[0]
+            land = int(plan[_rec.P_LAND])
+            stopped = self.advance_to(t_out, j, first)
+            if j > i:  # (the row it stands at: j, or one whose write failed in the
+                k = i + int(plan[_rec.P_LAND]) - land
+                r_out[i:k] = self.x  # kernel, which Python then writes; the rows the kernel
+                v_out[i:k] = self.w  # wrote filled with the state, finite as theirs, seen
+                i = k if k < j else j  # by no caller)
             r_out[i] = self.x
             v_out[i] = self.w
             if log.gone:  # (bodies taken out of the run: NaN in the outputs)
@@ -380,6 +396,26 @@ class _Run:
                 raise StopAtEvent(i, self.t, self.steps - first)
             if on_output is not None:
                 on_output(i, self.steps - first)
+            i += 1
+
+    def _landing_plan(self, t_out: np.ndarray, i: int) -> int:
+        """The row to step to next from row ``i - 1``: ``i``, or the row after a
+        run of snapshot rows from ``i`` on, whose snapshots the kernel writes, landing
+        on their times (the plan set, with their times, where :attr:`landings`
+        gives one: after a snapshot written by Python at the row before, no caller's
+        ``stop``)."""
+        landings = self.landings
+        if (landings is None or self.stop is not None or not landings.only[i]
+                or not landings.only[i - 1]):
+            return i
+        j = landings.through(i)
+        if j == i:
+            return i
+        made = landings.compiled(self._arrays(), ("st", _k.ST_T), self.steps, t_out[i:j])
+        if made is None:
+            return i
+        self.plan = _writing(made)
+        return j
 
     def _slice(self, t_end: Any, budget: int) -> tuple[int, int, bool]:
         """One compiled call of at most ``budget`` steps towards ``t_end``: its steps
@@ -387,7 +423,9 @@ class _Run:
         acted on, a Ctrl-C in the call held until all three are done (the state's
         arrays, its counts and the event's action then agree): ``(steps, status,
         whether the event stopped the run)``."""
-        log = self.log
+        log, plan = self.log, self.plan[0]
+        if plan[_rec.P_LAND_END]:  # (landing on snapshot times: the record's step
+            plan[_rec.P_BASE] = self.steps  # counts are this plus the call's steps)
         with HELD:
             if log.watch.shape[0]:  # the kernel with the events' code, compiled apart
                 steps, status = _k.advance_watched(
@@ -395,11 +433,12 @@ class _Run:
                     log.count, None)
             else:
                 steps, status = _k.advance(*self.before_t, t_end, *self.after_t, budget, None,
-                                            None, None, self.plan[0])
+                                            None, None, plan)
             self.steps += steps
-            if self.plan[0][_rec.P_WRITTEN]:
-                self.pause.wrote(self.plan[0], int(self.plan[0][_rec.P_LAST]
-                                                   + self.plan[0][_rec.P_BASE]))
+            if plan[_rec.P_WRITTEN]:
+                (self.pause or self.landings).wrote(plan, int(plan[_rec.P_LAST]
+                                                              + plan[_rec.P_BASE]))
+                plan[_rec.P_WRITTEN] = 0
             if status == _k.STATUS_DRAIN:
                 log.drain()
             stopped = status == _k.STATUS_EVENT and log.act(
@@ -429,6 +468,8 @@ class _Run:
                 steps, status, stopped = self._slice(t_out[i], budget)
                 left -= steps
                 if status == _k.STATUS_MAXSTEPS:
+                    if self.plan[0][_rec.P_FAILED] and self.plan[0][_rec.P_LAND_END]:
+                        return False  # (at the snapshot time whose write failed)
                     if not cut:  # (a slice's end or max_steps, where a run without pauses is)
                         _setup.check_pace(self.steps - first, max_steps, self.t, t_out, NAME)
                         left = SLICE
@@ -447,8 +488,8 @@ class _Run:
                         f"radau15 stopped at t = {self.t!r} before t_out[{i}] = "
                         f"{float(t_out[i])!r}: "
                         f"{_tangent.radau15_why(status, self.st, max_steps)}")
-        finally:
-            if pause is not None:  # (the kernel writes snapshots within one call only)
+        finally:  # (the kernel writes snapshots within one call only)
+            if self.plan is not _NO_PLAN:
                 self.plan = _NO_PLAN
 
     def _compiled(self, pause: Any, ask: bool = False) -> bool:
@@ -461,16 +502,13 @@ class _Run:
         plan = self.plan[0]
         if ask and self.stop is None:
             made = pause.compiled(self._arrays(), ("st", _k.ST_T), self.steps)
-            self.plan = _NO_PLAN if made is None else made
-            if made is not None:  # (compiled at the first plan, not into the kernel)
-                made[0][_rec.P_WRITER:_rec.P_WRITER + 2] = _setup.addresses(
-                    _rec.write_record, _rec.RECORD_SIGNATURE)
+            self.plan = _NO_PLAN if made is None else _writing(made)
             plan = self.plan[0]
         if not plan[_rec.P_EVERY]:
             return False
-        if plan[_rec.P_FAILED] or pause.at <= self.steps:  # (or one due at the call's
-            self.plan = _NO_PLAN  # end, which the kernel leaves to the pause, as the
-            return False  # budget's last step)
+        if plan[_rec.P_FAILED] or pause.at <= self.steps:  # (or one due where the last
+            self.plan = _NO_PLAN  # call ended, at its t_end, which the kernel leaves to
+            return False  # the pause)
         plan[_rec.P_NEXT], plan[_rec.P_BASE] = pause.at - self.steps, self.steps
         plan[_rec.P_WRITTEN] = 0
         return True
@@ -480,6 +518,15 @@ class _Run:
         :data:`~hamilton_orbits._kernels.records.SOURCES`)."""
         return {"r": self.x, "v": self.w, "gm": self.gm, "p": self.before_t[1], "st": self.st,
                 "br": self.work[0], "d": self.work[1], "csx": self.csx, "csv": self.csv}
+
+
+def _writing(made: tuple[np.ndarray, tuple[Any, ...]]) -> tuple[np.ndarray, tuple[Any, ...]]:
+    """An archive's plan ``made`` with the addresses of the function that writes its
+    records (:func:`~hamilton_orbits._kernels.records.write_record`: compiled at
+    the first plan, not into the kernel)."""
+    made[0][_rec.P_WRITER:_rec.P_WRITER + 2] = _setup.addresses(_rec.write_record,
+                                                                _rec.RECORD_SIGNATURE)
+    return made
 
 
 #: below this ``tol`` (float64's rounding) a tolerance buys no accuracy, only
