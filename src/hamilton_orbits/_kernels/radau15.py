@@ -676,9 +676,10 @@ def _steps(
     (:func:`hamilton_orbits._kernels.records.write_record`), or at the plan's
     snapshot times (:func:`hamilton_orbits._kernels.records.next_landing`), each
     landed on as a call ending there lands (the same steps: the state is kept
-    between two calls as it is between two steps); but not at ``t_end`` (the
-    caller writes that one, as it does without a plan).  A failed write ends the
-    call at ``STATUS_MAXSTEPS`` at its snapshot, which the caller then writes.
+    between two calls as it is between two steps); but not at ``t_end``, nor
+    ``plan[P_EVERY]``'s after the budget's last step (the caller writes those, as it
+    does without a plan).  A failed write ends the call at ``STATUS_MAXSTEPS`` at
+    its snapshot, which the caller then writes.
 
     Memory per body: the four (7, 3) arrays above and ``csb`` (840 bytes), the
     work arrays at, a0 (and vs for velocity-dependent forces) (48-72 bytes), and
@@ -701,8 +702,8 @@ def _steps(
     snap_at = -1 if plan is None or plan[P_EVERY] <= 0 else plan[P_NEXT]
     t_stop = t_end if plan is None else next_landing(plan, t_end)
     while t < t_end and status == STATUS_OK:
-        # (a snapshot due: on one of its times, or after its steps; none at the call's end)
-        if plan is not None and (t_stop <= t or steps == snap_at):
+        # (a snapshot due: at one of its times; or after its steps, not the budget's last)
+        if plan is not None and (t_stop <= t or (steps == snap_at and steps < max_steps)):
             written, snap_at, t_stop = _archived(plan, st, t, t_cs, dt, dt_last, have_last,
                                                  steps, snap_at, t_end)
             if not written:

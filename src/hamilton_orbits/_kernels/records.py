@@ -13,7 +13,11 @@ record's CRC-32 and appends it with ``pwrite``, then writes the segment's count 
 records, in that order (the order the Python path keeps: a process killed between
 the two loses that snapshot, never reads a torn one).  ``pwrite`` and the CRC-32
 are the C library's and zlib's own functions, called at their addresses
-(:func:`c_functions`).
+(:func:`c_functions`).  An ``every`` snapshot (a simulation time) is written the
+same way: the kernel, given the snapshot times up to the next output, lands on
+each as a call ending there would have, and writes its record there, where the
+Python path ended the call, wrote the snapshot and called again (40-100 us a
+snapshot).
 
 The plan (an int64 array) holds, from :data:`P_RUNS` on, runs of four integers:
 the source (its number in :data:`SOURCES`), the first element read, the record's
