@@ -472,3 +472,51 @@ def test_a_file_size_limit_met_by_the_kernel_stops_the_run_naming_the_segment(tm
     assert not (folder / ".hamilton-orbits.lock").exists()
     end = Simulation.load(folder).integrate(12.0)
     assert _same(end.r[-1], ref.r[-1]) and _same(end.v[-1], ref.v[-1])
+
+
+def test_a_ctrl_c_after_snapshots_the_kernel_landed_on_keeps_them_and_goes_on(tmp_path,
+                                                                             monkeypatch):
+    """Ctrl-C in a compiled call that landed on ``every`` snapshot times and wrote
+    their snapshots, then stepped on (Python's SIGINT handler run as the call
+    returns, as CPython runs it; test_held.py): the snapshots are counted and kept,
+    the simulation stands at the state the call reached, between two snapshot
+    times, and the call made again goes on to the bits of the run never
+    interrupted, its archive holding the same states at the same times (and the
+    state reached, where the second leg begins)."""
+    import signal
+
+    from hamilton_orbits._kernels import radau15 as kernels
+    from hamilton_orbits._kernels.records import P_WRITTEN
+    from hamilton_orbits.integrators import radau15
+
+    monkeypatch.setattr(radau15, "SLICE", 5)  # (calls of 5 steps, 2-3 between snapshots)
+    system, kw = RADAU15_STEPPED["radau15"]
+    once = Simulation(system(), archive=tmp_path / "once", every=0.25, **kw)
+    ref = once.integrate(6.0)
+    pressed, real = [], kernels.advance
+
+    def ctrl_c(*args):  # (as the first call that wrote a snapshot and went on returns)
+        out = real(*args)
+        t = float(args[6][kernels.ST_T])
+        if not pressed and args[-1][P_WRITTEN] >= 1 and t != 0.25 * round(t / 0.25):
+            pressed.append(t)
+            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+        return out
+
+    sim = Simulation(system(), archive=tmp_path / "cut", every=0.25, **kw)
+    with monkeypatch.context() as patched:
+        patched.setattr(kernels, "advance", ctrl_c)
+        cut = sim.integrate(6.0, on_interrupt="keep")
+    kept = Archive(tmp_path / "cut")
+    assert pressed and not cut.complete and sim.t == pressed[0] and 0.0 < sim.t < 6.0
+    assert kept.damaged == [] and kept.torn == [] and 0.0 < kept.times[-1] < sim.t
+    assert len(kept) == round(kept.times[-1] / 0.25) + 1 >= 5  # (those before it, all)
+    end = sim.integrate(6.0)
+    assert _same(end.r[-1], ref.r[-1]) and _same(end.v[-1], ref.v[-1])
+    assert sim.steps == once.steps
+    whole, archive = Archive(tmp_path / "once"), Archive(tmp_path / "cut")
+    assert sorted(archive.times) == sorted([*whole.times, pressed[0]])
+    at = {s.t: s.number for s in archive.snapshots}
+    for snap in whole.snapshots:
+        a, b = whole[snap.number].system.as_arrays(), archive[at[snap.t]].system.as_arrays()
+        assert _same(a.r, b.r) and _same(a.v, b.v), snap.t

@@ -632,12 +632,12 @@ def _watch_step(watch, t, dt, x0, v0, r, v, a0, b, gm, ev_out, ev_count, st, csx
 def _archived(plan, st, t, t_cs, dt, dt_last, have_last, steps, snap_at, t_end):
     # pragma: no cover - compiled
     """An archive's record of the state after ``steps`` steps of :func:`_steps`
-    appended (its numbers saved into ``st`` first, as at the call's end)
-    (:func:`hamilton_orbits._kernels.records.write_record`, called at the plan's
-    addresses of it): whether it was written, and the step count and the time of
-    the next snapshot (the first ``snap_at`` unchanged where the record was one of
-    the times, the second the time of the next, or ``t_end``, after one at a time;
-    both unchanged where the write failed)."""
+    appended (its numbers saved into ``st`` first, as at the call's end;
+    :func:`hamilton_orbits._kernels.records.write_record`, called at the plan's
+    addresses of it).  Returns ``(written, snap_at, t_stop)``, where the next
+    snapshot is due: after one due at ``snap_at`` steps, ``plan[P_EVERY]`` steps
+    later; after one at a time, at the plan's next time (or ``t_end``, none left);
+    after a failed write, ``snap_at`` and ``t`` as they were."""
     _save(st, t, t_cs, dt, dt_last, have_last)
     if not record_at(plan[P_WRITER], plan[P_WRITER + 1])(plan, steps):
         return False, snap_at, t
