@@ -1,8 +1,8 @@
 """Archives against rebound's Simulationarchive, same runs, same process.
 
-Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py [--lengths]
+Run:  NUMBA_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_archive.py [--lengths | --ab]
 
-(``--lengths``: section [8] alone.)
+(``--lengths``: section [8] alone; ``--ab``: section [9] alone.)
 
 What it prints (medians over interleaved rounds; the machine is shared):
 
@@ -43,7 +43,12 @@ What it prints (medians over interleaved rounds; the machine is shared):
     counted), over runs of
     125 to 20000 time units (2 ms to 0.3 s of ours, twice that of IAS15): the
     archive's fixed cost per call (its folder, lock, two files and first snapshot)
-    against the per-snapshot cost, and the shortest run within 5%.
+    against the per-snapshot cost, and the shortest run within 5%;
+[9] (``--ab`` only) for comparing two checkouts in alternating processes
+    (``PYTHONPATH`` pointing at each in turn): a run of 5000 time units (92
+    snapshots), plain, and the extra CPU time of ``every_steps=100`` and of
+    ``every=`` (every 100 mean steps of time), each the minimum over 15 interleaved
+    rounds less the plain run's (on a busy host the minimum is what repeats).
 """
 
 from __future__ import annotations
@@ -440,9 +445,39 @@ def lengths(tmp: Path, rounds: int, ends: tuple[float, ...] = (125.0, 250.0, 500
           f"{within * 1e3:.0f} ms")
 
 
+def extra_minima(tmp: Path, rounds: int, t_end: float = 5000.0) -> None:
+    """Section [9]: the plain run's minimum CPU time and what each schedule adds to
+    it (minimum less minimum), interleaved rounds."""
+    s = disc10()
+    probe = Simulation(s, method="radau15")
+    probe.integrate(t_end)
+    count = iter(range(10**6))
+    kinds = {"plain": None, "every_steps": {"every_steps": 100},
+             "every": {"every": 100 * t_end / probe.steps}}
+
+    def run(kw: dict[str, float] | None) -> Callable[[], None]:
+        def go() -> None:
+            more = {} if kw is None else dict(kw, archive=tmp / f"ab-{next(count)}")
+            Simulation(s, method="radau15", **more).integrate(t_end)
+        return go
+
+    t = interleaved({k: run(kw) for k, kw in kinds.items()}, rounds, time.process_time)
+    plain = min(t["plain"])
+    print(f"[9] a run of {t_end:g} ({probe.steps // 100 + 1} snapshots), CPU time, minima "
+          f"of {rounds} rounds: plain {plain * 1e3:.1f} ms; every_steps=100 adds "
+          f"{(min(t['every_steps']) - plain) * 1e3:.2f} ms, every= "
+          f"{(min(t['every']) - plain) * 1e3:.2f} ms")
+
+
 def main() -> None:
     print(time.strftime("run of %Y-%m-%d %H:%M UTC", time.gmtime()))
     tmp = Path(tempfile.mkdtemp(prefix="bench-archive-"))
+    if "--ab" in sys.argv:  # (section 9 alone)
+        try:
+            extra_minima(tmp, 15)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+        return
     if "--lengths" in sys.argv:  # (section 8 alone)
         try:
             (tmp / "lengths").mkdir()
