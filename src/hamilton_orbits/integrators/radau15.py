@@ -383,11 +383,11 @@ class _Run:
             plan = self.plan[0]
             land = int(plan[_rec.P_LAND])
             stopped = self.advance_to(t_out, j, first)
-            if j > i:  # (the row it stands at: j, or one whose write failed in the
-                k = i + int(plan[_rec.P_LAND]) - land
-                r_out[i:k] = self.x  # kernel, which Python then writes; the rows the kernel
-                v_out[i:k] = self.w  # wrote filled with the state, finite as theirs, seen
-                i = k if k < j else j  # by no caller)
+            if j > i:  # (it stands at row k: j, or the row whose write failed in the
+                k = i + int(plan[_rec.P_LAND]) - land  # kernel, which Python then writes)
+                r_out[i:k] = self.x  # (the rows the kernel wrote, which no caller sees:
+                v_out[i:k] = self.w  # the state, finite as theirs were)
+                i = k
             r_out[i] = self.x
             v_out[i] = self.w
             if log.gone:  # (bodies taken out of the run: NaN in the outputs)
