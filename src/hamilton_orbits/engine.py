@@ -522,17 +522,30 @@ class Propagation:
         self.r, self.v, self.t = r_now, sign * v_now, sign * driver.t
 
 
-class _Pause:
+class _Written:
+    """What a driver's kernel wrote for a caller (``caller``: its ``pause`` or
+    ``landings``), counted in the propagation's steps."""
+
+    def __init__(self, prop: Propagation, caller: Any) -> None:
+        self.prop, self.caller = prop, caller
+
+    def wrote(self, plan: np.ndarray, last: int) -> None:
+        """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
+        of the driver's steps."""
+        self.caller.wrote(plan, self.prop.steps_before + last)
+
+
+class _Pause(_Written):
     """A caller's ``pause`` as the driver sees it: ``at`` counted in the driver's own
     steps, and the propagation made to stand at the driver's state before it."""
 
     def __init__(self, prop: Propagation, pause: Any) -> None:
-        self.prop, self.pause = prop, pause
+        super().__init__(prop, pause)
         self.mine: tuple[np.ndarray, np.ndarray] | None = None  # (the r, v it put)
 
     @property
     def at(self) -> int:
-        return self.pause.at - self.prop.steps_before
+        return self.caller.at - self.prop.steps_before
 
     def __call__(self, again: bool = False) -> None:
         """Stand at the driver's state and pause (``again``: as the driver says, only
@@ -548,7 +561,7 @@ class _Pause:
         if prop.events is not None:  # (the bodies taken out at NaN, as in the outputs:
             prop.events.mask(r, v)  # the driver keeps their parked state to go on)
         prop._stand_at(driver.t, r, v)
-        self.pause(again)
+        self.caller(again)
 
     def compiled(self, arrays: dict[str, np.ndarray],
                  t_at: tuple[str, int], steps: int) -> tuple[np.ndarray, tuple[Any, ...]] | None:
@@ -556,31 +569,27 @@ class _Pause:
         ``t_at``, ``steps`` its steps) writes the caller's next snapshots itself, or
         None (see ``_EverySteps.compiled``); the positions and velocities this pause
         puts in the propagation are the kernel's at a snapshot."""
-        ask = getattr(self.pause, "compiled", None)
+        ask = getattr(self.caller, "compiled", None)
         if ask is None or self.mine is None or self.prop.events is not None:
             return None
         return ask(arrays, [(self.mine[0], "r"), (self.mine[1], "v")], t_at, steps)
 
-    def wrote(self, plan: np.ndarray, last: int) -> None:
-        """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
-        of the driver's steps."""
-        self.pause.wrote(plan, self.prop.steps_before + last)
 
-
-class _Landings:
+class _Landings(_Written):
     """A caller's snapshot rows as the driver sees them: ``only[i]`` where output row
     ``i`` is a snapshot alone (no caller's output, so not reported when the driver
     writes it), and the plan with which the driver's kernel lands on such rows and
     writes their snapshots itself, with the propagation standing at the last
     reported row."""
 
-    def __init__(self, prop: Propagation, landings: Any) -> None:
-        self.prop, self.landings = prop, landings
-        self.only: np.ndarray = landings.only
+    @property
+    def only(self) -> np.ndarray:
+        """Whether each output row is a snapshot alone."""
+        return self.caller.only
 
     def through(self, i: int) -> int:
         """The first row from ``i`` on that is not a snapshot alone."""
-        return self.landings.through(i)
+        return self.caller.through(i)
 
     def compiled(self, arrays: dict[str, np.ndarray], t_at: tuple[str, int], steps: int,
                  times: np.ndarray) -> tuple[np.ndarray, tuple[Any, ...]] | None:
@@ -591,13 +600,8 @@ class _Landings:
         prop = self.prop
         if prop.events is not None:
             return None
-        return self.landings.compiled(arrays, [(prop.r, "r"), (prop.v, "v")], t_at, steps,
+        return self.caller.compiled(arrays, [(prop.r, "r"), (prop.v, "v")], t_at, steps,
                                       times)
-
-    def wrote(self, plan: np.ndarray, last: int) -> None:
-        """Count the snapshots the kernel wrote with ``plan``, the last after ``last``
-        of the driver's steps."""
-        self.landings.wrote(plan, self.prop.steps_before + last)
 
 
 def _stm_forwards(tangent: Any, k: int) -> None:
