@@ -263,6 +263,14 @@ def _mapped_count(fd: int) -> mmap.mmap | None:
         return None
 
 
+def _packed_like(value: Any) -> Any:
+    """``value``, or for :class:`~hamilton_orbits._netcdf3.Parts` float64 values of
+    the size they pack into (a record variable's shape and type, for its template)."""
+    if type(value) is Parts:
+        return np.zeros(sum(a.size for a in value))
+    return value
+
+
 def _own_row(snapshot: Mapping[str, Any], rows: Mapping[str, np.ndarray]) -> bool:
     """Whether the one output row of ``rows`` is ``snapshot``'s own state: its time,
     positions and velocities the snapshot's bit for bit, and nothing else in it."""
@@ -377,8 +385,8 @@ class SegmentWriter:
                  "meta": text}
         #: the record variables: the snapshot's values but the fixed ones and the rows
         names = [k for k in like if k not in fixed and not k.startswith("out_")]
-        template = [(k, self._dims(k, like[k]), *stored(k, np.asarray(like[k])))
-                    for k in names]
+        template = [(k, self._dims(k, x), *stored(k, np.asarray(x)))
+                    for k in names for x in [_packed_like(like[k])]]
         template.append(("rows", ("from_to",), np.zeros(2, np.float64), "int64"))
         # (the float64 variables first: a record is then filled by few concatenations)
         template.sort(key=lambda var: var[2].dtype != np.float64)

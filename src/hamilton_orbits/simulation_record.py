@@ -101,8 +101,10 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     system at time 0 is ``system`` and whose propagation is ``prop``; ``cache``: a
     dict kept by the simulation, where the parts that never change (the system at
     time 0, the method, the effects and events as JSON) are made once; ``split``:
-    the numbers of the state in an array ``scalars``, out of the layout (for an
-    archive segment, whose snapshots share their layout)."""
+    the numbers of the state in an array ``scalars``, out of the layout, and the
+    state's arrays as the propagation's own, :class:`~hamilton_orbits._netcdf3.Parts`
+    packed only into the record (for an archive segment, whose snapshots share their
+    layout, and whose next record can then be refilled from the same arrays)."""
     scalars: list[Any] | None = [] if split else None
     if prop.events is not None:
         prop.events.drain()  # (its buffer is then empty: not saved)
@@ -117,8 +119,13 @@ def record(system: Any, method: Any, dt: float | None, tol: float | None, effect
     meta = {**head, "t": float(prop.t), "steps": int(prop.steps), "layout": layout,
             **to_json(dict(extra))}
     arrays: dict[str, np.ndarray] = {f"initial_{k}": getattr(sa, k) for k in _SYSTEM_FIELDS}
-    arrays.update(state_values(prop, state, index, scalars))
-    meta["state_arrays"] = arrays.pop("state_arrays")
+    if split and cache is not None:  # (the capture and the index of its layout: _state's)
+        capture, _, index = cache["capture"]
+        arrays.update(state_values(prop, state, index, scalars, capture.ints))
+        meta["state_arrays"] = index
+    else:
+        arrays.update(state_values(prop, state, index, scalars))
+        meta["state_arrays"] = arrays.pop("state_arrays")
     dims = {"r": ("body", "xyz"), "v": ("body", "xyz"), "gm": ("body",),
             "active": ("body",), "initial_r": ("body", "xyz"), "initial_v": ("body", "xyz"),
             "initial_gm": ("body",), "initial_radius": ("body",), "initial_j2": ("body",),

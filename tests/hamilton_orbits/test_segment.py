@@ -313,6 +313,42 @@ def test_records_written_by_the_kernel_are_those_of_the_python_path(tmp_path, mo
     assert none == 0 and kernel >= total // 2, (kernel, total)
 
 
+@pytest.mark.parametrize("schedule", [{"every_steps": 3}, {"every": 0.25}])
+def test_a_new_segment_s_first_record_is_filled_from_the_run_s_own_arrays(tmp_path,
+                                                                         monkeypatch,
+                                                                         schedule):
+    """The first snapshot of a new segment (a run's first call, at its start) is
+    filled straight from the propagation's own arrays, as the snapshots after it
+    are: the next two are refills of it, after which the kernel appends the rest
+    but the one at the call's end.  Every record Python writes is so filled (the
+    start was filled by the general path, the snapshot after it straight, then
+    the two refills: a record more by Python); the files are those of the run
+    whose every record Python writes."""
+    direct, refill = SegmentWriter._append_state, SegmentWriter.refill
+    calls = []
+
+    def counted(self, snap, *args):
+        calls.append(("straight", type(snap["state"]).__name__, direct(self, snap, *args)))
+        return calls[-1][-1]
+
+    def counted_refill(self, *args):
+        calls.append(("refill", "", refill(self, *args)))
+        return calls[-1][-1]
+
+    monkeypatch.setattr(SegmentWriter, "_append_state", counted)
+    monkeypatch.setattr(SegmentWriter, "refill", counted_refill)
+    files, _, kernel = _archived_runs(tmp_path, "kernel", True, "radau15", [6.0], monkeypatch,
+                                      schedule)
+    total = len(Archive(tmp_path / "kernel"))
+    assert calls[:3] == [("straight", "Parts", True), ("refill", "", True),
+                         ("refill", "", True)], calls
+    assert all(ok for *_, ok in calls) and total - kernel == len(calls) == 4, (calls, total,
+                                                                                kernel)
+    theirs, _, _ = _archived_runs(tmp_path, "python", False, "radau15", [6.0], monkeypatch,
+                                  schedule)
+    assert files == theirs
+
+
 EVERY = {"every": 0.25}
 
 
