@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
+import tempfile
+from pathlib import Path
 
+import hypothesis
 import numpy as np
 import pytest
+from hypothesis import strategies as st
 from test_archive import RADAU15_STEPPED, flipped_bytes
-from test_simulation_legs import _same
+from test_simulation_legs import _disc, _same
 
 from hamilton_orbits import Archive, Simulation, segment
 from hamilton_orbits._netcdf3 import parse
@@ -389,6 +394,95 @@ def test_snapshots_the_kernel_lands_on_are_those_of_the_python_path(tmp_path, mo
     # its start, three in a row, the last of which makes the plan, and the one at its end)
     intervals = sum(np.size(t) - (np.size(t) > 1) for t in calls if not isinstance(t, str))
     assert none == 0 and total - kernel <= 5 * intervals, (kernel, total)
+
+
+def _random_archived_run(rng: np.random.Generator) -> tuple[dict, dict, list, int | None,
+                                                            int | None]:
+    """A random archived radau15 run: its options, schedule, calls (end times, output
+    times, ``"load"``: continued by a simulation loaded from the archive), step
+    budget and compiled slice (None: the defaults)."""
+    kw = {"method": "radau15"}
+    if rng.random() < 0.3:
+        kw["dt"] = float(rng.choice([0.01, 0.02, 0.037]))
+    elif rng.random() < 0.3:
+        kw["tol"] = float(10 ** rng.uniform(-13, -8))
+    if rng.random() < 0.3:
+        kw["effects"] = [{"name": "gr", "c": 100.0}, {"name": "j2", "body": "star"}]
+    if rng.random() < 0.5:
+        schedule = {"every_steps": int(rng.choice([1, 2, 3, 17, 60]))}
+    else:
+        schedule = {"every": float(rng.choice([0.013, 0.05, 0.25, 0.7]))}
+        if "dt" in kw:
+            schedule["exact_times"] = bool(rng.random() < 0.5)
+    calls, t = [], 0.0
+    for _ in range(int(rng.integers(1, 4))):
+        span, kind = float(rng.uniform(0.2, 4.0)), rng.random()
+        if kind < 0.3 and calls:
+            calls.append("load")
+        elif kind < 0.6:
+            times = np.sort(rng.uniform(t, t + span, int(rng.integers(2, 7))))
+            if "every" in schedule:  # (some on the snapshot times)
+                every = schedule["every"]
+                times = np.union1d(times, every * (np.floor(t / every) + np.arange(1, 3)))
+            calls.append(np.concatenate([[t], times[times > t]]))
+            t = float(calls[-1][-1])
+        else:
+            t += span
+            calls.append(t)
+    if isinstance(calls[-1], str):  # (a run loaded last goes on)
+        calls.append(t + 1.0)
+    budget = int(rng.integers(5, 400)) if rng.random() < 0.15 else None
+    slice_steps = int(rng.choice([1, 2, 7, 50])) if rng.random() < 0.3 else None
+    return kw, schedule, calls, budget, slice_steps
+
+
+def _written(folder: Path, compiled: bool, system, kw, schedule, calls, budget,
+             slice_steps) -> tuple[dict[str, bytes], list]:
+    """The archive's files and the outputs (their bytes; a refused call's message)
+    of a run of :func:`_random_archived_run`, the kernel appending records or not."""
+    from hamilton_orbits.integrators import radau15
+    from hamilton_orbits.validation import ConvergenceError
+
+    before = radau15.SLICE
+    segment.COMPILED_WRITES = compiled
+    radau15.SLICE = slice_steps or before
+    outputs: list = []
+    try:
+        options = dict(kw, **schedule, **({} if budget is None else {"max_steps": budget}))
+        sim = Simulation(system, archive=folder, **options)
+        for t in calls:
+            if isinstance(t, str):
+                sim = Simulation.load(folder)
+                continue
+            try:
+                traj = sim.integrate(t)
+            except ConvergenceError as exc:  # (the budget: continued from the archive)
+                outputs.append(str(exc))
+                sim = Simulation.load(folder)
+                continue
+            outputs.append([np.asarray(x).tobytes() for x in (traj.t, traj.r, traj.v)])
+    finally:
+        segment.COMPILED_WRITES, radau15.SLICE = True, before
+    files = {p.name: p.read_bytes() for p in folder.iterdir() if not p.name.startswith(".")}
+    return files, outputs
+
+
+@hypothesis.settings(max_examples=40, deadline=None)  # (about 3 s; 200 in 11 s found nothing)
+@hypothesis.given(seed=st.integers(0, 2**32 - 1), bodies=st.integers(2, 6))
+def test_random_runs_archived_by_the_kernel_are_those_python_archives(seed, bodies):
+    """Random radau15 runs, adaptive or of fixed steps, with
+    effects or not, of either schedule, of end times, output times (some on the
+    snapshot times), runs loaded from their archive, a step budget met and
+    compiled calls cut short: the archive's files are byte for byte those of the
+    same run whose every record Python writes, and the outputs the same bits."""
+    run = _random_archived_run(np.random.default_rng(seed))
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for compiled in (True, False):  # (in one folder: its path is in the headers)
+            out.append(_written(Path(tmp) / "run", compiled, _disc(bodies, seed % 1000), *run))
+            shutil.rmtree(Path(tmp) / "run")
+    assert out[0][1] == out[1][1]
+    assert out[0][0] == out[1][0]
 
 
 @pytest.mark.parametrize("schedule", [{"every_steps": 3}, {"every": 0.25}])
