@@ -281,18 +281,11 @@ def _archived_runs(tmp_path, name, compiled, kw, calls, monkeypatch, schedule=No
     a simulation loaded from its archive), in one folder path whichever way it is
     written (the path is in the segments' headers), the trajectories, and the
     records the kernel appended."""
-    monkeypatch.setattr(segment, "COMPILED_WRITES", compiled)
     count = _kernel_written(monkeypatch)
     system, options = RADAU15_STEPPED[kw]
     folder = tmp_path / "run"
-    sim = Simulation(system(), archive=folder, **(schedule or {"every_steps": 3}), **options)
-    trajs = []
-    for t in calls:
-        if isinstance(t, str):  # ("load")
-            sim = Simulation.load(folder)
-        else:
-            trajs.append(sim.integrate(t))
-    files = {p.name: p.read_bytes() for p in folder.iterdir() if not p.name.startswith(".")}
+    files, trajs = _written(folder, compiled, system(), options,
+                            schedule or {"every_steps": 3}, calls)
     folder.rename(tmp_path / name)
     return files, trajs, count[0]
 
@@ -462,10 +455,13 @@ def _random_archived_run(rng: np.random.Generator) -> tuple[dict, dict, list, in
     return kw, schedule, calls, budget, slice_steps
 
 
-def _written(folder: Path, compiled: bool, system, kw, schedule, calls, budget,
-             slice_steps) -> tuple[dict[str, bytes], list]:
-    """The archive's files and the outputs (their bytes; a refused call's message)
-    of a run of :func:`_random_archived_run`, the kernel appending records or not."""
+def _written(folder: Path, compiled: bool, system, kw, schedule, calls, budget=None,
+             slice_steps=None) -> tuple[dict[str, bytes], list]:
+    """The archive's files and the outputs (each call's trajectory, or a refused
+    call's message) of a run of ``calls`` (end times or output times; a ``"load"``:
+    the run continued by a simulation loaded from its archive), with a step
+    ``budget`` and a compiled ``slice_steps`` or not (:func:`_random_archived_run`),
+    the kernel appending records or not."""
     from hamilton_orbits.integrators import radau15
     from hamilton_orbits.validation import ConvergenceError
 
@@ -486,7 +482,7 @@ def _written(folder: Path, compiled: bool, system, kw, schedule, calls, budget,
                 outputs.append(str(exc))
                 sim = Simulation.load(folder)
                 continue
-            outputs.append([np.asarray(x).tobytes() for x in (traj.t, traj.r, traj.v)])
+            outputs.append(traj)
     finally:
         segment.COMPILED_WRITES, radau15.SLICE = True, before
     files = {p.name: p.read_bytes() for p in folder.iterdir() if not p.name.startswith(".")}
@@ -496,18 +492,21 @@ def _written(folder: Path, compiled: bool, system, kw, schedule, calls, budget,
 @hypothesis.settings(max_examples=40, deadline=None)  # (about 3 s; 200 in 11 s found nothing)
 @hypothesis.given(seed=st.integers(0, 2**32 - 1), bodies=st.integers(2, 6))
 def test_random_runs_archived_by_the_kernel_are_those_python_archives(seed, bodies):
-    """Random radau15 runs, adaptive or of fixed steps, with
-    effects or not, of either schedule, of end times, output times (some on the
-    snapshot times), runs loaded from their archive, a step budget met and
-    compiled calls cut short: the archive's files are byte for byte those of the
-    same run whose every record Python writes, and the outputs the same bits."""
+    """Random radau15 runs, adaptive or of fixed steps, with effects or not, of
+    either schedule, of end times, output times (some on the snapshot times), runs
+    loaded from their archive, a step budget met and compiled calls cut short: the
+    archive's files are byte for byte those of the same run whose every record
+    Python writes, and the outputs the same bits."""
     run = _random_archived_run(np.random.default_rng(seed))
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         for compiled in (True, False):  # (in one folder: its path is in the headers)
             out.append(_written(Path(tmp) / "run", compiled, _disc(bodies, seed % 1000), *run))
             shutil.rmtree(Path(tmp) / "run")
-    assert out[0][1] == out[1][1]
+    ours, theirs = ([x if isinstance(x, str) else [np.asarray(a).tobytes()
+                                                   for a in (x.t, x.r, x.v)] for x in outputs]
+                    for _, outputs in out)
+    assert ours == theirs
     assert out[0][0] == out[1][0]
 
 
