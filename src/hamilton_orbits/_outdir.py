@@ -140,6 +140,8 @@ class OutputFolder:
         #: claims of one process told apart: a claim releases only its own lock)
         self._claim = next(_CLAIMS)
         self._mine = f"{os.getpid()} {socket.gethostname()} {self._claim}\n"
+        #: whether entering made the folder (it then holds nothing but the lock)
+        self.made = False
 
     def _fail(self, why: str) -> FolderError:
         return FolderError(f"{self.option} {self.path}: {why}; nothing was run")
@@ -187,6 +189,7 @@ class OutputFolder:
         folder that cannot be made, refused."""
         try:
             os.mkdir(self.path)
+            self.made = True
             return
         except FileExistsError:
             if not os.path.isdir(self.path):
@@ -197,7 +200,11 @@ class OutputFolder:
         except OSError as exc:
             raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
         try:
-            self.path.mkdir(parents=True, exist_ok=True)
+            self.path.mkdir(parents=True)
+            self.made = True
+        except FileExistsError:  # (made meanwhile by another: as a folder found)
+            if not os.path.isdir(self.path):
+                raise self._fail("is a file, not a folder") from None
         except OSError as exc:
             raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
 

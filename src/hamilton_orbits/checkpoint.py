@@ -440,6 +440,8 @@ class ArchiveWriter:
         #: or its simulation was loaded from the folder): appended to; otherwise a
         #: folder holding snapshots is refused (another run's: the two would mix)
         self.continues = False
+        #: the folder was made by this writer's claim and no segment begun in it yet
+        self.fresh = False
         self.last_steps, self.last_wall = 0, self.clock()
 
     def schedule_only(self) -> ArchiveWriter:
@@ -471,7 +473,11 @@ class ArchiveWriter:
             raise
         self.folder = folder
         known = self._continued()
-        self.count = _next_number(self.path) if known is None else known
+        #: a folder this claim made holds no file of a snapshot: none listed, and no
+        #: file of the first segment's number replaced (:class:`SegmentWriter`'s
+        #: ``fresh``) until one is begun
+        self.fresh = folder.made
+        self.count = (0 if folder.made else _next_number(self.path)) if known is None else known
         if known is None and self.count and self.mine and not self._holds_mine():
             self._refuse_replaced()  # (read only where the folder is not as left)
         if known is None and self._gone_on():
@@ -530,12 +536,11 @@ class ArchiveWriter:
             return None
         path, size, count = self.left
         try:
-            if path.stat().st_size != size:
+            if os.stat(path).st_size != size:
                 return None
         except OSError:
             return None
-        if any((self.path / name.format(count)).exists()
-               for name in (SEGMENT_NAME, SNAPSHOT_NAME)):
+        if self._numbered(count):
             return None
         return count
 
@@ -546,12 +551,17 @@ class ArchiveWriter:
         a damaged or torn one after it is the run's own, passed over by the load):
         its snapshots would interleave with that writer's."""
         if self.left is not None:
-            count = self.left[2]
-            return any((self.path / name.format(count)).exists()
-                       for name in (SEGMENT_NAME, SNAPSHOT_NAME))
+            return self._numbered(self.left[2])
         if self.loaded is not None and self.count > self.loaded + 1:
             return snapshot_at(self.path, self.count - 1) is not None
         return False
+
+    def _numbered(self, count: int) -> bool:
+        """Whether the folder holds a file (a segment, or a file of format 1) that
+        begins at snapshot number ``count``."""
+        folder = os.fspath(self.path)
+        return any(os.path.exists(os.path.join(folder, name.format(count)))
+                   for name in (SEGMENT_NAME, SNAPSHOT_NAME))
 
     @held
     def close(self) -> None:
@@ -648,8 +658,9 @@ class ArchiveWriter:
                 seg.close()
             fixed = {k: x for k, x in arrays.items()
                      if k.startswith("initial_") or k == "leg_times"}
+            fresh, self.fresh = self.fresh, False
             seg = self.segment = SegmentWriter(self.path, self.count, shared, fixed, arrays,
-                                               dims, units, self.sync)
+                                               dims, units, self.sync, fresh=fresh)
         seg.shared = shared  # (equal: its parts now the ones a next snapshot may share)
         self.append(arrays, {k: x for k, x in arrays.items() if k.startswith("out_")})
         return seg.path

@@ -369,12 +369,16 @@ class SegmentWriter:
         Dimension names and ``units`` attributes of the variables.
     sync : bool
         ``fsync`` each append (survives a power cut, not only a killed process).
+    fresh : bool
+        The folder holds no file of this number (made by the writer's claim, no
+        segment begun in it): no rows file of a killed run's segment to remove.
     """
 
     def __init__(self, folder: Path, first: int, shared: dict[str, Any],
                  fixed: Mapping[str, np.ndarray], like: Mapping[str, Any],
                  dims: Mapping[str, tuple[str, ...]] | None = None,
-                 units: Mapping[str, str] | None = None, sync: bool = False) -> None:
+                 units: Mapping[str, str] | None = None, sync: bool = False,
+                 fresh: bool = False) -> None:
         dims, units = dict(dims or {}), dict(units or {})
         self.shared, self.first, self.folder, self.sync = shared, first, folder, sync
         self.dims, self.units = dims, units
@@ -413,8 +417,8 @@ class SegmentWriter:
         #: the time, numbers and step count of the last two records, where each was
         #: written by :meth:`refill` right after the other (:meth:`compiled_plan`)
         self._history: tuple[tuple[float, list[Any], int], ...] = ()
-        # (rows of a segment of this number that a killed run began and this replaces)
-        (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)
+        if not fresh:  # (rows of a segment of this number that a killed run began and
+            (folder / ROWS_NAME.format(first)).unlink(missing_ok=True)  # this replaces)
 
     def _dims(self, name: str, value: Any) -> tuple[str, ...]:
         shape = np.shape(value)
