@@ -16,7 +16,10 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
+import hypothesis
+import hypothesis.strategies as st
 import numpy as np
 import pytest
 from test_simulation_legs import _disc, _merging, _same
@@ -585,6 +588,81 @@ def test_resume_returns_the_interrupted_call_whole_even_after_a_second_interrupt
         assert (x is None and y is None) or _same(x, y), name
     assert list(traj.events["time"]) == list(whole.events["time"])
     assert traj.final.names == whole.final.names
+
+
+def _random_run(rng: np.random.Generator) -> tuple[Any, dict, dict, list]:
+    """A random archived run for :func:`test_random_runs_of_every_method_resume_and_
+    continue_on_their_bits`: the system, the method's options (effects, a merge,
+    variational equations or not), the schedule and the calls (end times, or output
+    times from the call's start)."""
+    from test_simulation_legs import GR, GR_POTENTIAL, J2, METHODS, SYMPLECTIC
+
+    name = str(rng.choice(list(METHODS)))
+    kw, system = dict(METHODS[name]), _disc
+    if rng.random() < 0.2:
+        system, kw["events"] = _merging, [{"name": "collision", "action": "merge"}]
+    if rng.random() < 0.3:
+        kw["effects"] = [GR_POTENTIAL if name in SYMPLECTIC else GR] + (
+            [] if "events" in kw else [J2])
+    if rng.random() < 0.15 and "events" not in kw and "corrector" not in kw:
+        kw["variational"] = True
+    schedule = ({"every": float(rng.choice([0.05, 0.3, 0.77]))} if rng.random() < 0.5
+                else {"every_steps": int(rng.choice([1, 3, 20, 100]))})
+    calls, t = [], 0.0
+    for _ in range(int(rng.integers(1, 4))):
+        end = round(t + float(rng.uniform(0.3, 2.5)), 3)
+        calls.append(np.linspace(t, end, int(rng.integers(2, 7))) if rng.random() < 0.6
+                     else end)
+        t = end
+    return system, kw, schedule, calls
+
+
+def _bits(*arrays) -> bytes:
+    return b"".join(np.asarray(a).tobytes() for a in arrays)
+
+
+def _end_bits(sim) -> tuple[float, bytes]:
+    arrays = sim.system.as_arrays()
+    return sim.t, _bits(arrays.r, arrays.v, arrays.gm)
+
+
+@pytest.mark.filterwarnings("ignore::hamilton_orbits.integrals.UnderResolvedEncounterWarning")
+@hypothesis.settings(max_examples=12, deadline=None)  # (about 4 s; 900 runs found nothing)
+@hypothesis.given(seed=st.integers(0, 2**32 - 1))
+def test_random_runs_of_every_method_resume_and_continue_on_their_bits(tmp_path_factory,
+                                                                       seed):
+    """Random archived runs of every method (effects, a merge, variational equations,
+    either schedule, calls of end times or output times): a call stopped at a random
+    snapshot, as a kill right after it leaves the archive, is resumed from the
+    archive to the uninterrupted call's rows, and the run goes on to its bits; where
+    every call is of an end time, any snapshot of the archive continued through the
+    calls after it ends on those bits too."""
+    rng = np.random.default_rng(seed)
+    system, kw, schedule, calls = _random_run(rng)
+    folder = tmp_path_factory.mktemp("random")
+    whole = Simulation(system(), archive=folder / "whole", **kw, **schedule)
+    rows = [_bits(tr.t, tr.r, tr.v) for tr in map(whole.integrate, calls)]
+    stopped, asked = int(rng.integers(0, len(calls))), int(rng.integers(0, 6))
+    sim = Simulation(system(), archive=folder / "cut", **kw, **schedule)
+    for t in calls[:stopped]:
+        sim.integrate(t)
+    pauses = iter(range(10**6))
+    cut = sim.integrate(calls[stopped], stop=lambda: next(pauses) == asked)
+    if not cut.complete:
+        sim = Simulation.load(folder / "cut")
+        cut = sim.resume()
+    assert _bits(cut.t, cut.r, cut.v) == rows[stopped]
+    for t in calls[stopped + 1:]:
+        sim.integrate(t)
+    assert _end_bits(sim) == _end_bits(whole)
+    if all(np.ndim(t) == 0 for t in calls):
+        archive = Archive(folder / "whole")
+        for k in sorted(set(rng.integers(0, len(archive), 2).tolist())):
+            again = archive[k]
+            for t in calls:
+                if t > again.t:
+                    again.integrate(t)
+            assert _end_bits(again) == _end_bits(whole), k
 
 
 def test_resume_needs_a_simulation_loaded_from_its_archive(tmp_path):
