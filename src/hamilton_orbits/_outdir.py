@@ -187,22 +187,10 @@ class OutputFolder:
     def _make(self) -> None:
         """The folder, made with its parents where missing; a file of its name, or a
         folder that cannot be made, refused."""
-        try:
-            os.mkdir(self.path)
-            self.made = True
-            return
-        except FileExistsError:
-            if not os.path.isdir(self.path):
-                raise self._fail("is a file, not a folder") from None
-            return
-        except FileNotFoundError:  # (its parents missing: made below)
-            pass
-        except OSError as exc:
-            raise self._fail(f"cannot create the folder ({exc.strerror or exc})") from None
-        try:
+        try:  # (one mkdir where the parents are there; they are made first where not)
             self.path.mkdir(parents=True)
             self.made = True
-        except FileExistsError:  # (made meanwhile by another: as a folder found)
+        except FileExistsError:  # (there already, or made meanwhile by another run)
             if not os.path.isdir(self.path):
                 raise self._fail("is a file, not a folder") from None
         except OSError as exc:
